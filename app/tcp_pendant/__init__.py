@@ -1,0 +1,1 @@
+"""TCP Pendant: a teach-pendant style web app for tool calibration training."""

@@ -1,0 +1,1 @@
+"""tcpcal: TCP and TOOL-frame calibration solvers (unit-agnostic, numpy/scipy only)."""
