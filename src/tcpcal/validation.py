@@ -1,0 +1,190 @@
+"""Reusable input checks: turn user input into float arrays or raise a clear error.
+
+Every function returns a new float64 array (never a view of the caller's data) and raises
+:class:`tcpcal.errors.InvalidInputError` whose message names the argument, the 0-based index of
+the bad item (also in ``.index``), what is wrong and what to do. Used by the solvers, the
+orientation methods and the CLI.
+
+A rotation is accepted when it is finite, orthonormal within ``ORTHONORMAL_TOL`` (maximum
+absolute entry of ``R^T R - I``) and proper (``det R > 0``, i.e. +1 within the tolerance).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from tcpcal.errors import InvalidInputError
+
+__all__ = [
+    "ORTHONORMAL_TOL",
+    "as_rotations",
+    "as_rotation",
+    "as_positions",
+    "as_vector3",
+]
+
+ORTHONORMAL_TOL: float = 1e-6
+"""Largest accepted ``max |R^T R - I|`` of a rotation matrix."""
+
+
+def _as_float_array(x: Any, name: str, expected: str) -> np.ndarray:
+    try:
+        arr = np.array(x, dtype=float)  # always a copy
+    except (TypeError, ValueError) as exc:
+        raise InvalidInputError(
+            f"{name} must be {expected} of numbers; could not read it as numbers ({exc})."
+        ) from None
+    return arr
+
+
+def _first_nonfinite(arr: np.ndarray) -> int | None:
+    """0-based index along axis 0 of the first item holding NaN or inf, or None."""
+    flat = arr.reshape(arr.shape[0], -1)
+    bad = ~np.isfinite(flat).all(axis=1)
+    if bad.any():
+        return int(np.argmax(bad))
+    return None
+
+
+def as_rotations(x: Any, name: str = "rotations") -> np.ndarray:
+    """Check a stack of rotation matrices (e.g. ``R_world_flange`` of every touch).
+
+    Args:
+        x: array-like of shape (N, 3, 3), N >= 1.
+        name: argument name used in error messages.
+
+    Returns:
+        (N, 3, 3) float64 array (a copy).
+
+    Raises:
+        InvalidInputError: wrong shape, NaN/inf, a matrix that is not orthonormal within
+            ``ORTHONORMAL_TOL`` or has determinant -1 (a reflection). Errors about one matrix
+            carry ``.index``.
+    """
+    arr = _as_float_array(x, name, "an (N, 3, 3) array of rotation matrices")
+    if arr.ndim != 3 or arr.shape[1:] != (3, 3):
+        raise InvalidInputError(
+            f"{name} must have shape (N, 3, 3) (one 3x3 rotation matrix per touch), "
+            f"got shape {arr.shape}."
+        )
+    if arr.shape[0] == 0:
+        raise InvalidInputError(f"{name} is empty; pass at least one 3x3 rotation matrix.")
+    i = _first_nonfinite(arr)
+    if i is not None:
+        raise InvalidInputError(
+            f"{name}[{i}] contains NaN or inf; every entry of a rotation matrix must be a "
+            "finite number (re-record or remove that touch).",
+            index=i,
+        )
+    gram = np.einsum("nki,nkj->nij", arr, arr)
+    gram[:, [0, 1, 2], [0, 1, 2]] -= 1.0
+    defect = np.abs(gram).reshape(arr.shape[0], 9).max(axis=1)
+    bad = defect > ORTHONORMAL_TOL
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise InvalidInputError(
+            f"{name}[{i}] is not a rotation matrix: it is not orthonormal within "
+            f"{ORTHONORMAL_TOL:g} (max |R^T R - I| = {defect[i]:.3g}); pass a proper rotation "
+            "(check the column order, the angle units and that enough digits were printed).",
+            index=i,
+        )
+    # det = c0 . (c1 x c2), vectorised; orthonormal => det is +1 or -1.
+    det = np.einsum("ni,ni->n", arr[:, :, 0], np.cross(arr[:, :, 1], arr[:, :, 2]))
+    bad = det < 0.0
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise InvalidInputError(
+            f"{name}[{i}] is a reflection (determinant {det[i]:.6g}), not a rotation; a proper "
+            "rotation has determinant +1 (check for a swapped or negated axis).",
+            index=i,
+        )
+    return arr
+
+
+def as_rotation(x: Any, name: str = "rotation") -> np.ndarray:
+    """Check one rotation matrix.
+
+    Args:
+        x: array-like of shape (3, 3).
+        name: argument name used in error messages.
+
+    Returns:
+        (3, 3) float64 array (a copy).
+
+    Raises:
+        InvalidInputError: wrong shape, NaN/inf, not orthonormal within ``ORTHONORMAL_TOL``,
+            or a reflection.
+    """
+    arr = _as_float_array(x, name, "a 3x3 rotation matrix")
+    if arr.shape != (3, 3):
+        raise InvalidInputError(
+            f"{name} must be a 3x3 rotation matrix, got shape {arr.shape}."
+        )
+    try:
+        return as_rotations(arr[None], name=name)[0]
+    except InvalidInputError as exc:
+        # Drop the "[0]" index of the one-element stack from the message.
+        raise InvalidInputError(str(exc).replace(f"{name}[0]", name, 1)) from None
+
+
+def as_positions(x: Any, n: int | None = None, name: str = "positions") -> np.ndarray:
+    """Check a stack of 3-vectors (e.g. ``p_world_flange`` of every touch).
+
+    Args:
+        x: array-like of shape (N, 3).
+        n: required number of rows (e.g. the number of rotations), or None for any N >= 1.
+        name: argument name used in error messages.
+
+    Returns:
+        (N, 3) float64 array (a copy).
+
+    Raises:
+        InvalidInputError: wrong shape, a row count different from ``n``, NaN/inf (with
+            ``.index`` of the first bad row).
+    """
+    arr = _as_float_array(x, name, "an (N, 3) array of positions")
+    if arr.ndim != 2 or arr.shape[1] != 3:
+        raise InvalidInputError(
+            f"{name} must have shape (N, 3) (one x, y, z position per touch), got shape "
+            f"{arr.shape}."
+        )
+    if arr.shape[0] == 0:
+        raise InvalidInputError(f"{name} is empty; pass at least one x, y, z position.")
+    if n is not None and arr.shape[0] != n:
+        raise InvalidInputError(
+            f"{name} has {arr.shape[0]} rows but there are {n} rotations; pass exactly one "
+            "position per rotation (same touches, same order)."
+        )
+    i = _first_nonfinite(arr)
+    if i is not None:
+        raise InvalidInputError(
+            f"{name}[{i}] contains NaN or inf; every coordinate must be a finite number "
+            "(re-record or remove that touch).",
+            index=i,
+        )
+    return arr
+
+
+def as_vector3(x: Any, name: str = "vector") -> np.ndarray:
+    """Check one finite 3-vector.
+
+    Args:
+        x: array-like of 3 numbers.
+        name: argument name used in error messages.
+
+    Returns:
+        (3,) float64 array (a copy).
+
+    Raises:
+        InvalidInputError: not 3 numbers, or NaN/inf.
+    """
+    arr = _as_float_array(x, name, "a 3-vector")
+    if arr.shape != (3,):
+        raise InvalidInputError(
+            f"{name} must be 3 numbers (x, y, z), got shape {arr.shape}."
+        )
+    if not np.isfinite(arr).all():
+        raise InvalidInputError(f"{name} contains NaN or inf; pass 3 finite numbers.")
+    return arr
