@@ -1,0 +1,299 @@
+"""Read recorded flange poses from a CSV file (the input of ``tcpcal solve``).
+
+One flange pose ``T_world_flange`` per row; a header row names the columns. Position columns
+``x, y, z`` are in millimetres (tcpcal itself is unit-agnostic, the CLI speaks mm). The
+orientation is given by exactly one of these column sets (the *layout*):
+
+===========  ==========================  ==================================================
+layout       columns                     meaning
+===========  ==========================  ==================================================
+``kuka``     ``a, b, c``                 KUKA A, B, C in degrees: ``R = Rz(A) Ry(B) Rx(C)``
+``fanuc``    ``w, p, r``                 FANUC W, P, R in degrees: ``R = Rz(R) Ry(P) Rx(W)``
+``abb``      ``qw, qx, qy, qz``          unit quaternion, scalar first (ABB ``q1..q4``)
+``rotvec``   ``rx, ry, rz``              rotation vector (axis times angle), radians
+``matrix``   ``r11, r12, ..., r33``      rotation matrix ``R_world_flange``, row-major
+===========  ==========================  ==================================================
+
+(methods.md section 6 and docs/architecture.md "Conventions"; every conversion goes through
+``scipy.spatial.transform.Rotation``.)
+
+Leniency, all documented in docs/cli.md: header names are case-insensitive and may carry
+surrounding whitespace; blank lines and lines starting with ``#`` are skipped; the delimiter is
+a comma, or a semicolon or tab when the header contains no comma; any other column whose name
+is not one of the pose columns above (``name``, ``label``, ``time``, ...) is ignored. A header
+that mixes two orientation layouts, lacks one of a layout's columns, or repeats a column is an
+error.
+
+Strictness: every pose cell must be a finite number. A quaternion whose norm differs from 1 by
+more than 1e-6 and a matrix with ``max |R^T R - I| > 1e-6`` or ``det R < 0`` are errors (they
+are not silently normalised: they usually mean a column mix-up or too few printed digits).
+
+Every error is a :class:`tcpcal.errors.InvalidInputError` whose message starts with the file
+name and, for an error in one row, ``line L (data row k)``: ``L`` is the 1-based line number in
+the file (as an editor shows it), ``k`` the 1-based number of the pose among the data rows.
+Such errors also carry ``.index`` = ``k - 1`` (the 0-based touch index of the architecture's
+error convention).
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from tcpcal.errors import InvalidInputError
+from tcpcal.validation import ORTHONORMAL_TOL
+
+__all__ = [
+    "LAYOUTS",
+    "ORTHONORMAL_TOL",
+    "FlangePoses",
+    "accepted_layouts_text",
+    "read_poses_csv",
+]
+
+# ORTHONORMAL_TOL (1e-6, dimensionless) bounds ``| |q| - 1 |`` and ``max |R^T R - I|``; it is
+# the solvers' own tolerance (tcpcal.validation), so a file accepted here passes them.
+
+POSITION_COLUMNS: tuple[str, ...] = ("x", "y", "z")
+
+#: Orientation layouts: name -> column names, in the order the converter expects them.
+LAYOUTS: dict[str, tuple[str, ...]] = {
+    "kuka": ("a", "b", "c"),
+    "fanuc": ("w", "p", "r"),
+    "abb": ("qw", "qx", "qy", "qz"),
+    "rotvec": ("rx", "ry", "rz"),
+    "matrix": tuple(f"r{i}{j}" for i in (1, 2, 3) for j in (1, 2, 3)),
+}
+
+_LAYOUT_UNITS: dict[str, str] = {
+    "kuka": "KUKA A,B,C in deg",
+    "fanuc": "FANUC W,P,R in deg",
+    "abb": "unit quaternion, scalar first",
+    "rotvec": "rotation vector in rad",
+    "matrix": "rotation matrix, row-major",
+}
+
+_POSE_COLUMNS = frozenset(POSITION_COLUMNS).union(*LAYOUTS.values())
+
+
+def accepted_layouts_text() -> str:
+    """One line listing the accepted header layouts (used in error messages and ``--help``)."""
+    parts = [f"{','.join(POSITION_COLUMNS)},{','.join(cols) if name != 'matrix' else 'r11,r12,...,r33'}"
+             f" ({_LAYOUT_UNITS[name]})" for name, cols in LAYOUTS.items()]
+    return "accepted headers: " + "; ".join(parts)
+
+
+@dataclass(frozen=True)
+class FlangePoses:
+    """Flange poses read from a CSV file.
+
+    Attributes:
+        rotations: (N, 3, 3) ``R_world_flange``, proper rotations (converted with scipy).
+        positions_mm: (N, 3) ``p_world_flange`` in millimetres.
+        layout: orientation layout of the file: ``"kuka"``, ``"fanuc"``, ``"abb"``, ``"rotvec"``
+            or ``"matrix"``.
+        line_numbers: 1-based file line number of each pose (for messages).
+        path: the file that was read.
+        labels: the ``name`` or ``label`` column of each row if the file has one, else ``None``.
+    """
+
+    rotations: np.ndarray
+    positions_mm: np.ndarray
+    layout: str
+    line_numbers: tuple[int, ...]
+    path: Path
+    labels: tuple[str, ...] | None = None
+
+    def __post_init__(self) -> None:
+        for arr in (self.rotations, self.positions_mm):
+            arr.flags.writeable = False
+
+    def __len__(self) -> int:
+        return int(self.positions_mm.shape[0])
+
+    @property
+    def n_rows(self) -> int:
+        """Number of poses (data rows)."""
+        return len(self)
+
+    def where(self, index: int) -> str:
+        """``"<file>, line L (data row k)"`` for the 0-based pose ``index``."""
+        return f"{self.path}, line {self.line_numbers[index]} (data row {index + 1})"
+
+
+def _error(msg: str, *, index: int | None = None) -> InvalidInputError:
+    return InvalidInputError(msg, index=index)
+
+
+def _detect_delimiter(header_line: str) -> str:
+    if "," in header_line:
+        return ","
+    if ";" in header_line:
+        return ";"
+    if "\t" in header_line:
+        return "\t"
+    return ","
+
+
+def _choose_layout(path: Path, line_no: int, names: Sequence[str]) -> str:
+    """Return the single orientation layout named by the header ``names``."""
+    where = f"{path}, line {line_no} (header)"
+    seen: set[str] = set()
+    for name in names:
+        if name and name in seen and name in _POSE_COLUMNS:
+            raise _error(f"{where}: column '{name}' appears twice")
+        seen.add(name)
+    missing_pos = [c for c in POSITION_COLUMNS if c not in seen]
+    complete = [lay for lay, cols in LAYOUTS.items() if all(c in seen for c in cols)]
+    partial = {lay: [c for c in cols if c not in seen]
+               for lay, cols in LAYOUTS.items()
+               if any(c in seen for c in cols) and lay not in complete}
+    if missing_pos:
+        raise _error(f"{where}: missing position column(s) {','.join(missing_pos)} (mm); "
+                     f"{accepted_layouts_text()}")
+    if len(complete) > 1:
+        raise _error(f"{where}: the header mixes orientation layouts {' and '.join(complete)}; "
+                     f"keep the columns of one; {accepted_layouts_text()}")
+    if partial:
+        lay, miss = next(iter(partial.items()))
+        if complete:
+            raise _error(f"{where}: the header mixes orientation layout {complete[0]} with column(s) "
+                         f"of {lay}; keep the columns of one; {accepted_layouts_text()}")
+        raise _error(f"{where}: orientation layout {lay} lacks column(s) {','.join(miss)}; "
+                     f"{accepted_layouts_text()}")
+    if not complete:
+        raise _error(f"{where}: no orientation columns recognised in header "
+                     f"{','.join(n for n in names)!r}; {accepted_layouts_text()}")
+    return complete[0]
+
+
+def _rotation_from_row(layout: str, v: np.ndarray, where: str, index: int) -> np.ndarray:
+    """Convert one row's orientation numbers to ``R_world_flange`` (3, 3) with scipy."""
+    if layout == "kuka":
+        return Rotation.from_euler("ZYX", v, degrees=True).as_matrix()
+    if layout == "fanuc":
+        return Rotation.from_euler("xyz", v, degrees=True).as_matrix()
+    if layout == "rotvec":
+        return Rotation.from_rotvec(v).as_matrix()
+    if layout == "abb":
+        norm = float(np.linalg.norm(v))
+        if abs(norm - 1.0) > ORTHONORMAL_TOL:
+            raise _error(f"{where}: quaternion qw,qx,qy,qz has norm {norm:.9g}, not 1 within "
+                         f"{ORTHONORMAL_TOL:g}; check the column order and print more digits",
+                         index=index)
+        return Rotation.from_quat(v, scalar_first=True).as_matrix()
+    if layout == "matrix":
+        m = v.reshape(3, 3)
+        defect = float(np.max(np.abs(m.T @ m - np.eye(3))))
+        if defect > ORTHONORMAL_TOL:
+            raise _error(f"{where}: rotation r11..r33 is not orthonormal within {ORTHONORMAL_TOL:g} "
+                         f"(max |R^T R - I| = {defect:.3g}); check the row-major column order and "
+                         f"print more digits", index=index)
+        if np.linalg.det(m) < 0:
+            raise _error(f"{where}: rotation r11..r33 is a reflection (det = -1), not a rotation; "
+                         f"check the row-major column order", index=index)
+        return Rotation.from_matrix(m).as_matrix()
+    raise AssertionError(layout)  # pragma: no cover
+
+
+def read_poses_csv(path: str | Path, *, min_rows: int = 1, max_rows: int | None = None,
+                   purpose: str = "") -> FlangePoses:
+    """Read flange poses ``T_world_flange`` (positions in mm) from a CSV file.
+
+    Args:
+        path: the CSV file (header row + one pose per row; see the module docstring).
+        min_rows: fewer data rows than this is an error.
+        max_rows: more data rows than this is an error (``None``: no limit).
+        purpose: what the rows are for, quoted in the row-count message (e.g. ``"xyz4"``).
+
+    Returns:
+        The poses, their layout and the line number of each row.
+
+    Raises:
+        InvalidInputError: unknown or ambiguous header, a cell that is not a finite number, a
+            row with the wrong number of cells, a quaternion or matrix that is not orthonormal
+            within 1e-6, or too few / too many rows. The message names the file and the line.
+        OSError: the file cannot be opened or read. ``UnicodeDecodeError`` (a ``ValueError``)
+            is turned into an ``InvalidInputError``.
+    """
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise _error(f"{path}: not a UTF-8 text file ({exc.reason} at byte {exc.start}); "
+                     f"save the CSV as UTF-8") from None
+
+    lines = text.splitlines()
+    content = [(i + 1, ln) for i, ln in enumerate(lines)
+               if ln.strip() and not ln.lstrip().startswith("#")]
+    if not content:
+        raise _error(f"{path}: the file is empty (no header row); {accepted_layouts_text()}")
+
+    header_no, header_line = content[0]
+    delim = _detect_delimiter(header_line)
+    try:
+        parsed = list(csv.reader([ln for _, ln in content], delimiter=delim, strict=True))
+    except csv.Error as exc:
+        raise _error(f"{path}: CSV syntax error: {exc}") from None
+    names = [h.strip().lower() for h in parsed[0]]
+    layout = _choose_layout(path, header_no, names)
+    pose_cols = POSITION_COLUMNS + LAYOUTS[layout]
+    col_index = [names.index(c) for c in pose_cols]
+    label_col = next((names.index(c) for c in ("name", "label") if c in names), None)
+
+    rotations: list[np.ndarray] = []
+    positions: list[np.ndarray] = []
+    line_numbers: list[int] = []
+    labels: list[str] = []
+    for (line_no, _), cells in zip(content[1:], parsed[1:]):
+        index = len(positions)
+        where = f"{path}, line {line_no} (data row {index + 1})"
+        if len(cells) > len(names) and not any(c.strip() for c in cells[len(names):]):
+            cells = cells[: len(names)]  # trailing empty cells (spreadsheet export)
+        if len(cells) != len(names):
+            raise _error(f"{where}: {len(cells)} cells but the header has {len(names)} columns",
+                         index=index)
+        values = np.empty(len(pose_cols))
+        for k, (col, j) in enumerate(zip(pose_cols, col_index)):
+            cell = cells[j].strip()
+            if not cell:
+                raise _error(f"{where}: column '{col}' is empty", index=index)
+            try:
+                val = float(cell)
+            except ValueError:
+                raise _error(f"{where}: column '{col}' is not a number: {cell!r}",
+                             index=index) from None
+            if not math.isfinite(val):
+                raise _error(f"{where}: column '{col}' is {cell!r}, not a finite number",
+                             index=index)
+            values[k] = val
+        rotations.append(_rotation_from_row(layout, values[3:], where, index))
+        positions.append(values[:3])
+        line_numbers.append(line_no)
+        if label_col is not None:
+            labels.append(cells[label_col].strip())
+
+    n = len(positions)
+    what = f" for {purpose}" if purpose else ""
+    if n < min_rows:
+        need = f"exactly {min_rows}" if max_rows == min_rows else f"at least {min_rows}"
+        raise _error(f"{path}: too few rows: {n} data row(s), {need} needed{what} "
+                     f"(one flange pose per row after the header)")
+    if max_rows is not None and n > max_rows:
+        need = f"exactly {max_rows}" if max_rows == min_rows else f"at most {max_rows}"
+        raise _error(f"{path}: too many rows: {n} data rows, {need} expected{what}")
+
+    return FlangePoses(
+        rotations=np.array(rotations, dtype=float).reshape(n, 3, 3),
+        positions_mm=np.array(positions, dtype=float).reshape(n, 3),
+        layout=layout,
+        line_numbers=tuple(line_numbers),
+        path=path,
+        labels=tuple(labels) if label_col is not None else None,
+    )
