@@ -1,0 +1,446 @@
+"""A controller-like tool table persisted as a human-readable JSON file.
+
+File format (UTF-8 JSON, indented, fixed key order, one line per number triple; hand-editable)::
+
+    {
+      "format": "tcp-pendant-tool-library",
+      "version": 1,
+      "active_slot": 1,                 # int 1..16 of an occupied slot, or null
+      "tools": {"1": {...}, "3": {...}} # slot number (as a string) -> Tool.to_dict()
+    }
+
+The tool dictionaries are those of :meth:`tcpcal.tool.Tool.to_dict` (keys documented in
+:mod:`tcpcal.tool`). Default location: ``platformdirs.user_data_dir("tcp-pendant")/tools.json``;
+pass another ``path`` to use another file.
+
+Consistency rules:
+
+- Every read (``tools``, ``get``, ``find``, ``active_*``, ``first_free_slot``) reads the file
+  afresh, so another process's saves are always seen.
+- Every mutation takes an exclusive ``filelock.FileLock`` on ``<path>.lock``, re-reads the
+  file, applies the change, writes the whole table to a temporary file in the same directory,
+  flushes and fsyncs it, ``os.replace``-s it over the file and fsyncs the directory. A reader
+  or a crash therefore sees either the previous or the new file, never a partial one, and two
+  processes saving at once lose nothing. Leftover temporary files of a killed writer are
+  removed by the next mutation (under the lock).
+- A file that cannot be decoded (bad UTF-8 or JSON, wrong format/version, invalid slot or
+  tool) is *moved aside* (under the lock) to ``<stem>.corrupt-<UTC timestamp>.json`` next to
+  it, never overwritten; ``recovered_backup`` then names the backup and a
+  :class:`ToolLibraryWarning` is issued. The library continues empty. A file that exists but
+  cannot be read at all (permissions, I/O error) raises :class:`ToolLibraryError` instead.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import os
+import re
+import tempfile
+import warnings
+from datetime import datetime, timezone
+from pathlib import Path
+from typing import Any
+
+import filelock
+import platformdirs
+
+from tcpcal.errors import InvalidInputError, TcpcalError
+from tcpcal.tool import Tool
+
+__all__ = [
+    "FORMAT_NAME",
+    "FORMAT_VERSION",
+    "ToolLibrary",
+    "ToolLibraryError",
+    "ToolLibraryWarning",
+    "default_library_path",
+]
+
+FORMAT_NAME = "tcp-pendant-tool-library"
+FORMAT_VERSION = 1
+LOCK_TIMEOUT_S = 30.0
+_NUMBER_ARRAY = re.compile(r"\[\n\s*([-+0-9.eE,\s]+?)\n\s*\]")
+
+
+class ToolLibraryError(TcpcalError):
+    """A tool-library operation that cannot be done (duplicate name, empty slot, file I/O)."""
+
+
+class ToolLibraryWarning(UserWarning):
+    """Issued when a corrupt library file was moved aside."""
+
+
+class _CorruptFile(Exception):
+    """Internal: the file content is not a valid library (message says why)."""
+
+
+def default_library_path() -> Path:
+    """``platformdirs.user_data_dir("tcp-pendant")/tools.json`` (not created until a save)."""
+    return Path(platformdirs.user_data_dir("tcp-pendant", appauthor=False)) / "tools.json"
+
+
+def _check_slot(slot: Any, n_slots: int) -> int:
+    if isinstance(slot, bool) or not isinstance(slot, int):
+        raise InvalidInputError(f"slot must be a whole number 1..{n_slots}, got {slot!r}.")
+    if not 1 <= slot <= n_slots:
+        raise InvalidInputError(
+            f"slot {slot} does not exist; the tool table has slots 1..{n_slots}."
+        )
+    return int(slot)
+
+
+class _State:
+    """In-memory content of the library file."""
+
+    def __init__(self, tools: dict[int, Tool] | None = None, active: int | None = None) -> None:
+        self.tools: dict[int, Tool] = dict(tools or {})
+        self.active: int | None = active
+
+    def to_json(self) -> str:
+        doc = {
+            "format": FORMAT_NAME,
+            "version": FORMAT_VERSION,
+            "active_slot": self.active,
+            "tools": {str(k): self.tools[k].to_dict() for k in sorted(self.tools)},
+        }
+        text = json.dumps(doc, indent=2, ensure_ascii=False, allow_nan=False)
+        # Put arrays of numbers (tcp_mm, abc_deg) on one line; a literal newline never occurs
+        # inside a JSON string, so this cannot touch names or notes.
+        text = _NUMBER_ARRAY.sub(
+            lambda m: "[" + ", ".join(x.strip() for x in m.group(1).split(",")) + "]", text
+        )
+        return text + "\n"
+
+    @classmethod
+    def from_json(cls, text: str, n_slots: int) -> _State:
+        try:
+            doc = json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise _CorruptFile(f"not valid JSON ({exc})") from None
+        if not isinstance(doc, dict):
+            raise _CorruptFile("the top level is not a JSON object")
+        if doc.get("format") != FORMAT_NAME:
+            raise _CorruptFile(f"'format' is {doc.get('format')!r}, expected {FORMAT_NAME!r}")
+        if doc.get("version") != FORMAT_VERSION:
+            raise _CorruptFile(
+                f"'version' is {doc.get('version')!r}; this tcpcal reads version {FORMAT_VERSION}"
+            )
+        unknown = sorted(set(doc) - {"format", "version", "active_slot", "tools"})
+        if unknown:
+            raise _CorruptFile(f"unknown top-level keys {unknown}")
+        raw_tools = doc.get("tools", {})
+        if not isinstance(raw_tools, dict):
+            raise _CorruptFile("'tools' is not an object of slot -> tool")
+        tools: dict[int, Tool] = {}
+        names: dict[str, int] = {}
+        for key, value in raw_tools.items():
+            if not (isinstance(key, str) and key.isdigit() and 1 <= int(key) <= n_slots):
+                raise _CorruptFile(f"tool slot key {key!r} is not a slot number 1..{n_slots}")
+            slot = int(key)
+            if slot in tools:
+                raise _CorruptFile(f"slot {slot} appears twice")
+            try:
+                tool = Tool.from_dict(value)
+            except TcpcalError as exc:
+                raise _CorruptFile(f"slot {slot}: {exc}") from None
+            if tool.name in names:
+                raise _CorruptFile(
+                    f"tool name {tool.name!r} is used by slots {names[tool.name]} and {slot}"
+                )
+            names[tool.name] = slot
+            tools[slot] = tool
+        active = doc.get("active_slot")
+        if active is not None and (
+            isinstance(active, bool) or not isinstance(active, int) or active not in tools
+        ):
+            raise _CorruptFile(f"'active_slot' {active!r} is not an occupied slot")
+        return cls(tools, active)
+
+
+class ToolLibrary:
+    """Controller-like tool table: slots 1..16 with unique names, at most one active tool.
+
+    Args:
+        path: library file; default :func:`default_library_path`. The directory is created on
+            the first save.
+
+    Attributes:
+        path: the library file.
+        recovered_backup: where the last corrupt file seen by this object was moved, or None.
+    """
+
+    N_SLOTS = 16
+
+    def __init__(self, path: Path | str | None = None) -> None:
+        self.path: Path = Path(path) if path is not None else default_library_path()
+        self.recovered_backup: Path | None = None
+        self._lock = filelock.FileLock(str(self.path) + ".lock", timeout=LOCK_TIMEOUT_S)
+
+    # ------------------------------------------------------------------ reading
+    def _read_text(self) -> str | None:
+        try:
+            data = self.path.read_bytes()
+        except FileNotFoundError:
+            return None
+        except OSError as exc:
+            raise ToolLibraryError(
+                f"cannot read the tool library {self.path}: {exc.strerror or exc}; check the "
+                "file's permissions or pass another path."
+            ) from None
+        try:
+            return data.decode("utf-8")
+        except UnicodeDecodeError as exc:
+            raise _CorruptFile(f"not UTF-8 text ({exc})") from None
+
+    def _load(self) -> _State:
+        """Read and parse the file; raises _CorruptFile when it is not a valid library."""
+        text = self._read_text()
+        if text is None:
+            return _State()
+        return _State.from_json(text, self.N_SLOTS)
+
+    def _move_aside(self, reason: str) -> None:
+        """Move the corrupt file to ``<stem>.corrupt-<timestamp>.json`` (caller holds the lock)."""
+        stamp = datetime.now(timezone.utc).strftime("%Y%m%dT%H%M%SZ")
+        base = self.path.with_name(f"{self.path.stem}.corrupt-{stamp}")
+        backup = base.with_name(base.name + ".json")
+        n = 1
+        while backup.exists():
+            backup = base.with_name(f"{base.name}-{n}.json")
+            n += 1
+        try:
+            os.replace(self.path, backup)
+        except OSError as exc:
+            raise ToolLibraryError(
+                f"the tool library {self.path} is corrupt ({reason}) and could not be moved "
+                f"aside to {backup}: {exc.strerror or exc}; move or repair it by hand."
+            ) from None
+        self._fsync_dir()
+        self.recovered_backup = backup
+        warnings.warn(
+            f"the tool library {self.path} was corrupt ({reason}); it was moved aside to "
+            f"{backup} and the library starts empty. Repair that file by hand to recover its "
+            "tools.",
+            ToolLibraryWarning,
+            stacklevel=5,
+        )
+
+    def _read_locked(self) -> _State:
+        """Read the file; caller holds the lock, so a corrupt file can be moved aside."""
+        try:
+            return self._load()
+        except _CorruptFile as exc:
+            self._move_aside(str(exc))
+            return _State()
+
+    def _read(self) -> _State:
+        """Fresh read without the lock (writes are atomic); take the lock only if corrupt."""
+        try:
+            return self._load()
+        except _CorruptFile:
+            with self._locked():
+                return self._read_locked()
+
+    # ------------------------------------------------------------------ writing
+    def _locked(self) -> filelock.BaseFileLock:
+        try:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise ToolLibraryError(
+                f"cannot create the directory {self.path.parent}: {exc.strerror or exc}; pass a "
+                "path in a writable directory."
+            ) from None
+        return _LockContext(self._lock, self.path)  # type: ignore[return-value]
+
+    def _fsync_dir(self) -> None:
+        if os.name != "posix":  # directories cannot be opened for fsync on Windows
+            return
+        fd = os.open(self.path.parent, os.O_RDONLY)
+        try:
+            os.fsync(fd)
+        finally:
+            os.close(fd)
+
+    def _tmp_prefix(self) -> str:
+        return f".{self.path.name}."
+
+    def _remove_stale_temps(self) -> None:
+        """Delete temporary files left by a killed writer (safe: we hold the lock)."""
+        for p in self.path.parent.glob(self._tmp_prefix() + "*.tmp"):
+            try:
+                p.unlink()
+            except OSError:
+                pass
+
+    def _write_locked(self, state: _State) -> None:
+        text = state.to_json()
+        self._remove_stale_temps()
+        fd, tmp = tempfile.mkstemp(dir=self.path.parent, prefix=self._tmp_prefix(), suffix=".tmp")
+        try:
+            with os.fdopen(fd, "w", encoding="utf-8") as fh:
+                fh.write(text)
+                fh.flush()
+                os.fsync(fh.fileno())
+            try:
+                mode = self.path.stat().st_mode & 0o777
+            except OSError:
+                mode = 0o644
+            os.chmod(tmp, mode)
+            os.replace(tmp, self.path)
+        except BaseException:
+            try:
+                os.unlink(tmp)
+            except OSError:
+                pass
+            raise
+        self._fsync_dir()
+
+    def _mutate(self, change: Any) -> None:
+        """Lock, re-read, apply ``change(state)``, write atomically, unlock."""
+        with self._locked():
+            state = self._read_locked()
+            change(state)
+            try:
+                self._write_locked(state)
+            except OSError as exc:
+                raise ToolLibraryError(
+                    f"cannot write the tool library {self.path}: {exc.strerror or exc}; check "
+                    "the free space and the permissions of its directory."
+                ) from None
+
+    # ------------------------------------------------------------------ public reads
+    def tools(self) -> dict[int, Tool]:
+        """All stored tools by slot (fresh read from disk), slots in increasing order."""
+        state = self._read()
+        return {k: state.tools[k] for k in sorted(state.tools)}
+
+    def get(self, slot: int) -> Tool | None:
+        """The tool in ``slot`` (1..16) or None if the slot is empty."""
+        return self._read().tools.get(_check_slot(slot, self.N_SLOTS))
+
+    def find(self, name: str) -> tuple[int, Tool] | None:
+        """``(slot, tool)`` of the tool called exactly ``name``, or None."""
+        for slot, tool in self.tools().items():
+            if tool.name == name:
+                return slot, tool
+        return None
+
+    def active_slot(self) -> int | None:
+        """Slot of the active tool, or None (TCP = flange)."""
+        return self._read().active
+
+    def active_tool(self) -> Tool | None:
+        """The active tool, or None."""
+        state = self._read()
+        return None if state.active is None else state.tools[state.active]
+
+    def first_free_slot(self) -> int | None:
+        """Lowest empty slot, or None when all 16 are used."""
+        used = self._read().tools
+        for slot in range(1, self.N_SLOTS + 1):
+            if slot not in used:
+                return slot
+        return None
+
+    # ------------------------------------------------------------------ public mutations
+    def save(self, slot: int, tool: Tool, *, activate: bool = False) -> None:
+        """Store ``tool`` in ``slot``, replacing what was there; optionally make it active.
+
+        Raises:
+            InvalidInputError: bad slot number or not a Tool.
+            ToolLibraryError: another slot already holds a tool of that name.
+        """
+        slot = _check_slot(slot, self.N_SLOTS)
+        if not isinstance(tool, Tool):
+            raise InvalidInputError(f"save() needs a tcpcal.Tool, got {type(tool).__name__}.")
+
+        def change(state: _State) -> None:
+            self._check_unique(state, tool.name, slot)
+            state.tools[slot] = tool
+            if activate:
+                state.active = slot
+
+        self._mutate(change)
+
+    def remove(self, slot: int) -> None:
+        """Empty ``slot``; if it was the active tool, no tool is active afterwards.
+
+        Raises:
+            ToolLibraryError: the slot is already empty.
+        """
+        slot = _check_slot(slot, self.N_SLOTS)
+
+        def change(state: _State) -> None:
+            self._check_occupied(state, slot, "remove")
+            del state.tools[slot]
+            if state.active == slot:
+                state.active = None
+
+        self._mutate(change)
+
+    def rename(self, slot: int, name: str) -> None:
+        """Give the tool in ``slot`` a new name (validated like ``Tool.name``, unique)."""
+        slot = _check_slot(slot, self.N_SLOTS)
+
+        def change(state: _State) -> None:
+            self._check_occupied(state, slot, "rename")
+            renamed = dataclasses.replace(state.tools[slot], name=name)
+            self._check_unique(state, renamed.name, slot)
+            state.tools[slot] = renamed
+
+        self._mutate(change)
+
+    def activate(self, slot: int | None) -> None:
+        """Make the tool in ``slot`` active, or deactivate every tool with None."""
+        if slot is not None:
+            slot = _check_slot(slot, self.N_SLOTS)
+
+        def change(state: _State) -> None:
+            if slot is not None:
+                self._check_occupied(state, slot, "activate")
+            state.active = slot
+
+        self._mutate(change)
+
+    # ------------------------------------------------------------------ helpers
+    @staticmethod
+    def _check_unique(state: _State, name: str, slot: int) -> None:
+        for other, tool in state.tools.items():
+            if other != slot and tool.name == name:
+                raise ToolLibraryError(
+                    f"the name {name!r} is already used by slot {other}; choose another name, "
+                    f"rename or remove slot {other}, or save into slot {other} to replace it."
+                )
+
+    @staticmethod
+    def _check_occupied(state: _State, slot: int, action: str) -> None:
+        if slot not in state.tools:
+            used = sorted(state.tools)
+            raise ToolLibraryError(
+                f"cannot {action} slot {slot}: it is empty; occupied slots: "
+                f"{used if used else 'none'}."
+            )
+
+    def __repr__(self) -> str:
+        return f"ToolLibrary({str(self.path)!r})"
+
+
+class _LockContext:
+    """FileLock context that turns a lock timeout into a ToolLibraryError."""
+
+    def __init__(self, lock: filelock.BaseFileLock, path: Path) -> None:
+        self._lock = lock
+        self._path = path
+
+    def __enter__(self) -> None:
+        try:
+            self._lock.acquire()
+        except filelock.Timeout:
+            raise ToolLibraryError(
+                f"another program has held the lock {self._lock.lock_file} for more than "
+                f"{LOCK_TIMEOUT_S:g} s; close the other program using {self._path} and retry."
+            ) from None
+
+    def __exit__(self, *exc: object) -> None:
+        self._lock.release()
