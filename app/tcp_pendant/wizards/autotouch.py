@@ -1,0 +1,170 @@
+"""Training mode auto-touch: let the virtual controller perform the current step of any wizard.
+
+For demos ("a full 4-point calibration in four clicks"): the controller's ``auto_approach``
+moves the hidden true TOOL frame onto the reference tip from a chosen or random direction,
+with a simulated operator error (Gaussian, ``sigma_mm`` per axis, 0-2 mm), then the flange pose
+is recorded into the wizard. What each step role asks of the controller:
+
+=================  ===========================================================================
+step role          controller call
+=================  ===========================================================================
+``touch``          ``auto_approach(tip_offset_tool_mm=(0, 0, 0))``
+``minus_x``        ``auto_approach(tip_offset_tool_mm=(-d, 0, 0))``  (tip on tool -X axis)
+``plus_y``         ``auto_approach(tip_offset_tool_mm=(0, d, 0))``   (variant 1)
+``plus_y_half``    ``auto_approach(tip_offset_tool_mm=(-20, d, 0))`` (variant 2)
+``parallel``       ``move_true_tool_to`` the (PA-1) orientation, tip ``hover_mm`` above the
+                   reference tip, with an optional angular error (``angle_sigma_deg`` per axis,
+                   about the tool axes); for the 5D variant a random turn about tool X.
+=================  ===========================================================================
+
+``d`` is ``distance_mm`` (60 mm by default). Three-point steps 2 and 3 reuse the approach
+direction of the wizard's previous auto-touch unless one is given, as an operator jogging
+along tool axes keeps the orientation. The controller must have the physical tool the step
+asks for mounted: auto-touch mounts it (from ``tools``, default ``builtin_tools()``).
+"""
+
+from __future__ import annotations
+
+import weakref
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from tcp_pendant.wizards.abc_world import R_WORLD_TOOL_TARGET, AbcWorldWizard
+from tcp_pendant.wizards.base import StepInfo, Wizard, WizardError, WizardStateError
+
+DEFAULT_DISTANCE_MM = 60.0
+_last_direction: "weakref.WeakKeyDictionary[Wizard, tuple[float, float, float]]" = weakref.WeakKeyDictionary()
+
+
+@dataclass(frozen=True)
+class AutoTouchOutcome:
+    """What one auto-touch did.
+
+    Attributes:
+        ok: the controller reached the pose and the pose was recorded.
+        step_index: 0-based step it was for.
+        role: the step's role.
+        tilt_deg, azimuth_deg, spin_deg: approach direction used (None for ``parallel``).
+        message: plain words (the controller's message on failure).
+        attempts: controller calls made (random directions are retried when unreachable).
+    """
+
+    ok: bool
+    step_index: int
+    role: str
+    tilt_deg: float | None
+    azimuth_deg: float | None
+    spin_deg: float | None
+    message: str
+    attempts: int
+
+
+def _tip_offset(role: str, distance_mm: float) -> tuple[float, float, float]:
+    if role == "touch":
+        return (0.0, 0.0, 0.0)
+    if role == "minus_x":
+        return (-distance_mm, 0.0, 0.0)
+    if role == "plus_y":
+        return (0.0, distance_mm, 0.0)
+    if role == "plus_y_half":
+        return (-20.0, distance_mm, 0.0)
+    raise WizardError(f"Auto-touch does not know the step role {role!r}.")
+
+
+def _ensure_mounted(wizard: Wizard, controller: Any, step: StepInfo,
+                    tools: Mapping[str, Any] | None) -> None:
+    key = step.mount_tool_key
+    if key is not None and getattr(controller.mounted_tool, "key", None) != key:
+        if tools is None:
+            from tcp_pendant.controller import builtin_tools
+            tools = builtin_tools()
+        if key not in tools:
+            raise WizardError(f"The step needs the tool '{key}', which is not among {sorted(tools)}.")
+        controller.mount_tool(tools[key])
+    wizard.note_mounted_tool(getattr(controller.mounted_tool, "key", None))
+
+
+def auto_touch(wizard: Wizard, controller: Any, *,
+               direction_deg: tuple[float, float, float] | None = None,
+               sigma_mm: float = 0.0, angle_sigma_deg: float = 0.0,
+               distance_mm: float = DEFAULT_DISTANCE_MM, hover_mm: float = 30.0,
+               rng: np.random.Generator | None = None, advance: bool = True,
+               tools: Mapping[str, Any] | None = None, max_attempts: int = 12) -> AutoTouchOutcome:
+    """Perform the wizard's current step with the controller and record the flange pose.
+
+    Args:
+        wizard: any wizard, in progress.
+        controller: a ``tcp_pendant.controller.VirtualController``.
+        direction_deg: (tilt, azimuth, spin) in degrees (see ``VirtualController.auto_approach``);
+            None: random (tilt 20-50 deg for touches, 5-30 deg for three-point steps, azimuth
+            0-360, spin -90..90), retried up to ``max_attempts`` times when unreachable.
+        sigma_mm: simulated operator position error, per axis (0-2 mm in the pendant).
+        angle_sigma_deg: simulated angular error per tool axis for ``parallel`` steps.
+        distance_mm: displacement of the three-point steps 2 and 3.
+        hover_mm: height of the tip above the reference tip for ``parallel`` steps.
+        rng: random generator (seed it for reproducible demos and tests).
+        advance: after recording, go to the next step (never finishes the wizard: Finish is
+            the user's click).
+        tools: physical tools by key, to mount the one the step needs.
+    """
+    if wizard.status != "in_progress":
+        raise WizardStateError(f"Cannot auto-touch: {wizard.blocked_reason}")
+    if not 0.0 <= sigma_mm <= 10.0 or not 0.0 <= angle_sigma_deg <= 30.0:
+        raise WizardError(f"sigma_mm must be in 0..10 mm and angle_sigma_deg in 0..30 deg, "
+                          f"got {sigma_mm} and {angle_sigma_deg}.")
+    rng = np.random.default_rng() if rng is None else rng
+    step = wizard.step
+    _ensure_mounted(wizard, controller, step, tools)
+    if not wizard.can_record:
+        raise WizardStateError(f"Cannot auto-touch: {wizard.blocked_reason}")
+
+    if step.role == "parallel":
+        R = R_WORLD_TOOL_TARGET.copy()
+        if isinstance(wizard, AbcWorldWizard) and wizard.variant == "5d":
+            R = R @ Rotation.from_euler("x", rng.uniform(-60.0, 60.0), degrees=True).as_matrix()
+        if angle_sigma_deg > 0.0:
+            R = R @ Rotation.from_rotvec(rng.normal(0.0, angle_sigma_deg, 3), degrees=True).as_matrix()
+        T = np.eye(4)
+        T[:3, :3] = R
+        T[:3, 3] = np.asarray(controller.reference_tip_world_m, dtype=float) + [0.0, 0.0, hover_mm / 1000.0]
+        res = controller.move_true_tool_to(T)
+        if not res.ok:
+            return AutoTouchOutcome(False, step.index, step.role, None, None, None,
+                                    f"Could not align the tool with WORLD: {res.message}", 1)
+        wizard.record(controller.T_world_flange())
+        if advance and not wizard.on_last_step:
+            wizard.next()
+        return AutoTouchOutcome(True, step.index, step.role, None, None, None,
+                                "Tool aligned with WORLD and recorded.", 1)
+
+    offset = _tip_offset(step.role, distance_mm)
+    three_point = step.role != "touch" or wizard.kind == "three-point"
+    fixed = direction_deg
+    if fixed is None and three_point and step.index > 0:
+        fixed = _last_direction.get(wizard)
+    attempts = 0
+    last_message = ""
+    while attempts < (1 if fixed is not None else max_attempts):
+        attempts += 1
+        if fixed is not None:
+            tilt, azimuth, spin = (float(v) for v in fixed)
+        else:
+            lo, hi = (5.0, 30.0) if three_point else (20.0, 50.0)
+            tilt, azimuth, spin = rng.uniform(lo, hi), rng.uniform(0.0, 360.0), rng.uniform(-90.0, 90.0)
+        res = controller.auto_approach(tilt_deg=tilt, azimuth_deg=azimuth, spin_deg=spin,
+                                       sigma_mm=sigma_mm, tip_offset_tool_mm=offset, rng=rng)
+        if res.ok:
+            wizard.record(controller.T_world_flange())
+            _last_direction[wizard] = (tilt, azimuth, spin)
+            if advance and not wizard.on_last_step:
+                wizard.next()
+            return AutoTouchOutcome(True, step.index, step.role, tilt, azimuth, spin,
+                                    f"Recorded {step.title.lower()} (tilt {tilt:.0f} deg, azimuth "
+                                    f"{azimuth:.0f} deg).", attempts)
+        last_message = res.message
+    return AutoTouchOutcome(False, step.index, step.role, None, None, None,
+                            f"Auto-touch failed after {attempts} attempt(s): {last_message}", attempts)

@@ -1,0 +1,532 @@
+"""Common machinery of the calibration wizards: steps, navigation, recording, results.
+
+A wizard is a state machine that knows nothing of viser. It is fed flange poses
+``T_world_flange_m`` (4x4, **metres**, as the virtual controller gives them), converts them to
+**millimetres** for ``tcpcal`` (which is unit-agnostic: its results then come out in mm), and
+calls ``tcpcal`` for every bit of calibration math. Views render it; the app acts on it.
+
+Life cycle (``status``)::
+
+    "in_progress" --next() on the last step--> "complete" --back()/add_point()--> "in_progress"
+          |  ^                                     |
+   cancel()  resume()                           cancel()
+          v  |                                     v
+        "cancelled"  (nothing recorded is lost; resume() returns to where the user was)
+
+Navigation: ``record()`` stores the pose of the current step (re-recording overwrites it) and
+does not move; ``next()`` moves on once the current step is recorded, and on the last step
+computes the result (``tcpcal`` errors become :class:`CalibrationFailedError`, the wizard stays
+where it was so the user can re-record); ``back()`` moves back without deleting anything.
+"""
+
+from __future__ import annotations
+
+import abc
+import datetime as _dt
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any, ClassVar, Literal
+
+import numpy as np
+
+from tcpcal.errors import TcpcalError
+from tcpcal.origin import TcpResult
+from tcpcal.orientation import OrientationResult
+from tcpcal.tool import Calibration, Tool
+
+M_TO_MM = 1000.0
+"""Metres (controller) to millimetres (tcpcal input and every ``*_mm`` figure)."""
+
+Status = Literal["in_progress", "complete", "cancelled"]
+
+
+class WizardError(ValueError):
+    """Base of every error a wizard raises: wrong state, bad input. The message says what to do."""
+
+
+class InvalidPoseError(WizardError):
+    """A pose handed to ``record`` or ``preview`` is not a finite rigid 4x4 transform."""
+
+
+class WizardStateError(WizardError):
+    """The action is not possible in the wizard's current state (e.g. Next before Record)."""
+
+
+class CalibrationFailedError(WizardError):
+    """``tcpcal`` could not compute a result from the recorded poses (message from tcpcal)."""
+
+    def __init__(self, message: str, cause: TcpcalError | None = None) -> None:
+        super().__init__(message)
+        self.cause = cause
+
+
+def utc_now_iso() -> str:
+    """Current time, ISO 8601 UTC with seconds (``2026-11-22T18:55:17Z``)."""
+    return _dt.datetime.now(_dt.timezone.utc).replace(microsecond=0).isoformat().replace("+00:00", "Z")
+
+
+def check_pose_m(T_world_flange_m: Any, *, what: str = "flange pose") -> np.ndarray:
+    """Validate a rigid transform in metres and return it as a float (4,4) copy.
+
+    Raises:
+        InvalidPoseError: wrong shape, NaN/inf, bottom row not (0,0,0,1), or a rotation block
+            that is not orthonormal with determinant +1 within 1e-6.
+    """
+    try:
+        T = np.array(T_world_flange_m, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise InvalidPoseError(f"The {what} is not a 4x4 numeric matrix: {exc}.") from None
+    if T.shape != (4, 4):
+        raise InvalidPoseError(f"The {what} must be a 4x4 matrix, got shape {T.shape}.")
+    if not np.all(np.isfinite(T)):
+        raise InvalidPoseError(f"The {what} contains NaN or infinity; read the pose again.")
+    if not np.allclose(T[3], [0.0, 0.0, 0.0, 1.0], atol=1e-9):
+        raise InvalidPoseError(f"The {what} has bottom row {T[3].tolist()}, expected [0, 0, 0, 1].")
+    R = T[:3, :3]
+    if not np.allclose(R.T @ R, np.eye(3), atol=1e-6) or np.linalg.det(R) < 0.0:
+        raise InvalidPoseError(
+            f"The rotation of the {what} is not a proper orthonormal matrix within 1e-6."
+        )
+    return T
+
+
+def rotation_and_position_mm(T_world_flange_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Split a flange pose in metres into ``R_world_flange`` (3,3) and ``p_world_flange`` in mm."""
+    return T_world_flange_m[:3, :3].copy(), T_world_flange_m[:3, 3] * M_TO_MM
+
+
+@dataclass(frozen=True)
+class RecordedPose:
+    """One pose recorded at a wizard step.
+
+    Attributes:
+        T_world_flange_m: (4,4) flange pose in WORLD, metres.
+        recorded_at: ISO 8601 UTC time of the recording.
+    """
+
+    T_world_flange_m: np.ndarray
+    recorded_at: str
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"T_world_flange_m": self.T_world_flange_m.tolist(), "recorded_at": self.recorded_at}
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> "RecordedPose":
+        return cls(check_pose_m(d["T_world_flange_m"]), str(d["recorded_at"]))
+
+
+@dataclass(frozen=True)
+class StepSpec:
+    """What one step asks for (defined by each wizard).
+
+    Attributes:
+        role: what the recorded pose means: "touch" (tip on the reference tip), "minus_x" (tip
+            on the tool's -X axis), "plus_y" (tip on the +Y axis), "plus_y_half" (tip in the +Y
+            half of the tool XY plane), "parallel" (tool axes parallel to WORLD as prescribed).
+        title: short name of the step ("Touch 3").
+        instruction: one plain-words instruction: what to touch, from where.
+        mount_tool_key: physical tool (ToolModel key) that must be mounted for this step, or
+            None when any tool will do. The app does the swap.
+    """
+
+    role: str
+    title: str
+    instruction: str
+    mount_tool_key: str | None = None
+
+
+@dataclass(frozen=True)
+class StepInfo:
+    """Everything a view needs to render the current step.
+
+    Attributes:
+        index: 0-based index of the step.
+        count: number of steps.
+        heading: "Step k of n" (k is 1-based).
+        title, instruction, role, mount_tool_key: as in :class:`StepSpec`.
+        recorded: whether a pose is stored for this step.
+    """
+
+    index: int
+    count: int
+    heading: str
+    title: str
+    instruction: str
+    role: str
+    mount_tool_key: str | None
+    recorded: bool
+
+
+@dataclass(frozen=True, eq=False, kw_only=True)
+class WizardResult:
+    """The outcome of a finished wizard. Lengths in mm, angles in degrees.
+
+    Attributes:
+        wizard: "xyz4" | "reference" | "three-point" | "abc-world".
+        method: calibration method as stored in ``tcpcal.Calibration.method``
+            ("xyz4-lstsq", "reference", "three-point-1", "abc-world-5d", ...).
+        tcp_mm: TCP X, Y, Z in FLANGE (calibrated by XYZ wizards, carried from the tool for
+            orientation wizards).
+        abc_deg: KUKA A, B, C of ``R_flange_tool`` when orientation is calibrated, else None.
+        rotation: (3,3) ``R_flange_tool`` when orientation is calibrated, else None.
+        tcp_result: the ``tcpcal`` TCP result (XYZ wizards) or None.
+        orientation_result: the ``tcpcal`` orientation result or None.
+        per_touch_error_mm: ``|e_i|`` per touch used (4P-3 residuals), empty for orientation.
+        mean_error_mm, max_error_mm, rms_error_mm, ci95_mm: tcpcal figures or None.
+        orthogonality_defect_deg: tcpcal figure (orientation) or None.
+        displacements_mm: ``|Delta|`` lengths used by the orientation method.
+        warnings: plain words, tcpcal's own first, then the wizard's.
+        notes: standing advice that is not a warning about this result (e.g. that a small
+            residual does not prove an accurate TCP).
+        computed_at: ISO 8601 UTC.
+    """
+
+    wizard: str
+    method: str
+    tcp_mm: tuple[float, float, float]
+    abc_deg: tuple[float, float, float] | None = None
+    rotation: np.ndarray | None = None
+    tcp_result: TcpResult | None = None
+    orientation_result: OrientationResult | None = None
+    per_touch_error_mm: tuple[float, ...] = ()
+    mean_error_mm: float | None = None
+    max_error_mm: float | None = None
+    rms_error_mm: float | None = None
+    ci95_mm: float | None = None
+    orthogonality_defect_deg: float | None = None
+    displacements_mm: tuple[float, ...] = ()
+    warnings: tuple[str, ...] = ()
+    notes: tuple[str, ...] = ()
+    computed_at: str = field(default_factory=utc_now_iso)
+
+    @property
+    def orientation_calibrated(self) -> bool:
+        """True when this result calibrates the TOOL orientation (A, B, C)."""
+        return self.abc_deg is not None
+
+    @property
+    def figures(self) -> dict[str, float]:
+        """Quality figures for ``tcpcal.Calibration.figures`` (only those that exist)."""
+        out: dict[str, float] = {}
+        for key in ("mean_error_mm", "max_error_mm", "rms_error_mm", "ci95_mm",
+                    "orthogonality_defect_deg"):
+            value = getattr(self, key)
+            if value is not None:
+                out[key] = float(value)
+        for i, d in enumerate(self.displacements_mm, start=1):
+            out[f"displacement_{i}_mm"] = float(d)
+        if self.tcp_result is not None:
+            out["n_touches"] = float(self.tcp_result.n_touches)
+        return out
+
+    def summary(self) -> dict[str, Any]:
+        """JSON-ready summary (used by the session record): method, frame, figures, warnings."""
+        return {
+            "wizard": self.wizard,
+            "method": self.method,
+            "tcp_mm": list(self.tcp_mm),
+            "abc_deg": None if self.abc_deg is None else list(self.abc_deg),
+            "per_touch_error_mm": list(self.per_touch_error_mm),
+            "figures": self.figures,
+            "warnings": list(self.warnings),
+            "computed_at": self.computed_at,
+        }
+
+
+class Wizard(abc.ABC):
+    """Base state machine of a calibration wizard (see the module docstring for the life cycle).
+
+    Subclasses define ``kind``, ``_step_specs()``, ``_compute()``, ``_params()`` and
+    ``_from_params()``.
+    """
+
+    kind: ClassVar[str]
+    title: ClassVar[str]
+
+    def __init__(self) -> None:
+        self._poses: dict[int, RecordedPose] = {}
+        self._index = 0
+        self._status: Status = "in_progress"
+        self._result: WizardResult | None = None
+        self._mounted_tool_key: str | None = None
+        self.started_at = utc_now_iso()
+
+    # ----- to be provided by each wizard --------------------------------------------------
+    @abc.abstractmethod
+    def _step_specs(self) -> list[StepSpec]:
+        """The steps in order (may depend on the wizard's options)."""
+
+    @abc.abstractmethod
+    def _compute(self, poses: list[np.ndarray]) -> WizardResult:
+        """Call tcpcal on the recorded poses (metres, in step order) and build the result."""
+
+    @abc.abstractmethod
+    def _params(self) -> dict[str, Any]:
+        """JSON-ready constructor options, for ``to_dict``."""
+
+    @classmethod
+    @abc.abstractmethod
+    def _from_params(cls, params: Mapping[str, Any]) -> "Wizard":
+        """Inverse of ``_params``."""
+
+    # ----- steps --------------------------------------------------------------------------
+    @property
+    def status(self) -> Status:
+        return self._status
+
+    @property
+    def n_steps(self) -> int:
+        return len(self._step_specs())
+
+    @property
+    def step_index(self) -> int:
+        """0-based index of the current step."""
+        return self._index
+
+    @property
+    def steps(self) -> tuple[StepInfo, ...]:
+        """All steps, e.g. for a step list in the view."""
+        specs = self._step_specs()
+        return tuple(self._info(i, s, len(specs)) for i, s in enumerate(specs))
+
+    @property
+    def step(self) -> StepInfo:
+        """The current step."""
+        specs = self._step_specs()
+        return self._info(self._index, specs[self._index], len(specs))
+
+    def _info(self, i: int, spec: StepSpec, n: int) -> StepInfo:
+        return StepInfo(index=i, count=n, heading=f"Step {i + 1} of {n}", title=spec.title,
+                        instruction=spec.instruction, role=spec.role,
+                        mount_tool_key=spec.mount_tool_key, recorded=i in self._poses)
+
+    @property
+    def progress(self) -> float:
+        """Fraction 0..1 of the work done: recorded steps plus the result, over steps + 1."""
+        n = self.n_steps
+        done = sum(1 for i in range(n) if i in self._poses)
+        return (done + (1 if self._status == "complete" else 0)) / (n + 1)
+
+    @property
+    def is_complete(self) -> bool:
+        return self._status == "complete"
+
+    @property
+    def result(self) -> WizardResult | None:
+        """The result once complete, else None."""
+        return self._result if self._status == "complete" else None
+
+    @property
+    def recorded_poses(self) -> dict[int, RecordedPose]:
+        """Copy of the poses recorded so far, by 0-based step index."""
+        return dict(self._poses)
+
+    # ----- mounted tool (the app tells the wizard what is bolted on) ----------------------
+    @property
+    def mounted_tool_key(self) -> str | None:
+        return self._mounted_tool_key
+
+    def note_mounted_tool(self, key: str | None) -> None:
+        """Tell the wizard which physical tool is mounted (None: unknown, no check)."""
+        self._mounted_tool_key = key
+
+    @property
+    def blocked_reason(self) -> str | None:
+        """Why Record is disabled right now, in words; None when it is enabled."""
+        if self._status == "cancelled":
+            return "The wizard was cancelled; resume it to continue."
+        if self._status == "complete":
+            return "The calibration is finished; go back to change a step."
+        spec = self._step_specs()[self._index]
+        if (spec.mount_tool_key is not None and self._mounted_tool_key is not None
+                and self._mounted_tool_key != spec.mount_tool_key):
+            return f"Mount the tool '{spec.mount_tool_key}' first (now mounted: '{self._mounted_tool_key}')."
+        return None
+
+    @property
+    def can_record(self) -> bool:
+        """True only when the current step can be recorded (enables the Record button)."""
+        return self.blocked_reason is None
+
+    @property
+    def can_back(self) -> bool:
+        return self._status == "complete" or (self._status == "in_progress" and self._index > 0)
+
+    @property
+    def can_next(self) -> bool:
+        """True when Next (or Finish, on the last step) is possible."""
+        return self._status == "in_progress" and self._index in self._poses
+
+    @property
+    def on_last_step(self) -> bool:
+        return self._index == self.n_steps - 1
+
+    # ----- actions ------------------------------------------------------------------------
+    def record(self, T_world_flange_m: Any) -> StepInfo:
+        """Store the flange pose (4x4, metres, WORLD) for the current step; overwrite any earlier.
+
+        Returns:
+            The current step, now marked recorded. The wizard does not move on by itself.
+
+        Raises:
+            WizardStateError: Record is disabled (see ``blocked_reason``).
+            InvalidPoseError: the pose is not a rigid transform.
+        """
+        reason = self.blocked_reason
+        if reason is not None:
+            raise WizardStateError(f"Cannot record now: {reason}")
+        T = check_pose_m(T_world_flange_m)
+        self._poses[self._index] = RecordedPose(T, utc_now_iso())
+        return self.step
+
+    def clear_step(self) -> None:
+        """Forget the pose of the current step (only while in progress)."""
+        if self._status != "in_progress":
+            raise WizardStateError("Only a wizard in progress can clear a step; go back first.")
+        self._poses.pop(self._index, None)
+
+    def next(self) -> StepInfo | WizardResult:
+        """Go to the next step, or on the last step compute the result.
+
+        Returns:
+            The new current step, or the result when the wizard is now complete.
+
+        Raises:
+            WizardStateError: the current step is not recorded, or the wizard is not in progress.
+            CalibrationFailedError: tcpcal rejected the poses (e.g. degenerate touches); the
+                wizard stays on the last step so the user can re-record or add points.
+        """
+        if self._status != "in_progress":
+            raise WizardStateError(f"Next is not possible: the wizard is {self._status.replace('_', ' ')}.")
+        if self._index not in self._poses:
+            raise WizardStateError(f"Record step {self._index + 1} before going on.")
+        if not self.on_last_step:
+            self._index += 1
+            return self.step
+        return self.finish()
+
+    def finish(self) -> WizardResult:
+        """Compute the result from all steps (each must be recorded) and mark the wizard complete."""
+        if self._status == "cancelled":
+            raise WizardStateError("The wizard was cancelled; resume it first.")
+        missing = [i + 1 for i in range(self.n_steps) if i not in self._poses]
+        if missing:
+            raise WizardStateError(f"Steps {missing} are not recorded yet.")
+        poses = [self._poses[i].T_world_flange_m for i in range(self.n_steps)]
+        try:
+            result = self._compute(poses)
+        except TcpcalError as exc:
+            raise CalibrationFailedError(str(exc), exc) from exc
+        self._result = result
+        self._status = "complete"
+        self._index = self.n_steps - 1
+        return result
+
+    def back(self) -> StepInfo:
+        """Go back one step (from the result: back to the last step). Nothing is deleted."""
+        if self._status == "complete":
+            self._status = "in_progress"
+            self._result = None
+            return self.step
+        if self._status != "in_progress" or self._index == 0:
+            raise WizardStateError("There is no step before this one." if self._index == 0
+                                   else "The wizard was cancelled; resume it first.")
+        self._index -= 1
+        return self.step
+
+    def go_to(self, index: int) -> StepInfo:
+        """Jump to step ``index`` (0-based) if every step before it is recorded."""
+        if self._status == "cancelled":
+            raise WizardStateError("The wizard was cancelled; resume it first.")
+        if not 0 <= index < self.n_steps:
+            raise WizardStateError(f"There is no step {index + 1}; the wizard has {self.n_steps}.")
+        if any(i not in self._poses for i in range(index)):
+            raise WizardStateError("Record the earlier steps first.")
+        self._status = "in_progress"
+        self._result = None
+        self._index = index
+        return self.step
+
+    def cancel(self) -> None:
+        """Leave the wizard. Nothing recorded is lost and nothing is saved anywhere: ``resume()``."""
+        if self._status == "cancelled":
+            return
+        self._cancelled_from: Status = self._status
+        self._status = "cancelled"
+
+    def resume(self) -> StepInfo | WizardResult:
+        """Return to where the user was before ``cancel()``."""
+        if self._status != "cancelled":
+            raise WizardStateError("Only a cancelled wizard can be resumed.")
+        self._status = getattr(self, "_cancelled_from", "in_progress")
+        return self.result if self._status == "complete" and self._result is not None else self.step
+
+    # ----- saving to the library ----------------------------------------------------------
+    def _calibration(self, result: WizardResult, figures: Mapping[str, float]) -> Calibration:
+        return Calibration(method=result.method, calibrated_at=result.computed_at,
+                           figures=dict(figures))
+
+    @abc.abstractmethod
+    def to_tool(self, name: str) -> Tool:
+        """The calibrated tool (for "Save to tool library"), with its Calibration record."""
+
+    def _require_result(self) -> WizardResult:
+        if self.result is None:
+            raise WizardStateError("Finish the wizard before saving the tool.")
+        return self.result
+
+    # ----- serialisation (resume, session record) -----------------------------------------
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready state: kind, options, recorded poses (metres), step, status."""
+        status = self._status
+        if status == "cancelled":
+            status = getattr(self, "_cancelled_from", "in_progress")
+        return {
+            "kind": self.kind,
+            "params": self._params(),
+            "poses": {str(i): p.to_dict() for i, p in sorted(self._poses.items())},
+            "step_index": self._index,
+            "status": self._status,
+            "resume_status": status,
+            "started_at": self.started_at,
+        }
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> "Wizard":
+        """Rebuild a wizard from ``to_dict`` output; a complete wizard is recomputed with tcpcal.
+
+        Called on the base class, dispatches on ``d["kind"]``.
+        """
+        from tcp_pendant.wizards import WIZARD_TYPES  # local import: registry lives in __init__
+
+        kind = d.get("kind")
+        target = cls
+        if cls is Wizard or getattr(cls, "kind", None) != kind:
+            if kind not in WIZARD_TYPES:
+                raise WizardError(f"Unknown wizard kind {kind!r}; expected one of {sorted(WIZARD_TYPES)}.")
+            target = WIZARD_TYPES[kind]
+        wiz = target._from_params(d.get("params", {}))
+        wiz._load_state(d)
+        return wiz
+
+    def _load_state(self, d: Mapping[str, Any]) -> None:
+        self._poses = {int(i): RecordedPose.from_dict(p) for i, p in d.get("poses", {}).items()}
+        n = self.n_steps
+        bad = [i for i in self._poses if not 0 <= i < n]
+        if bad:
+            raise WizardError(f"Recorded poses for steps {bad} do not exist in this wizard ({n} steps).")
+        self._index = min(max(int(d.get("step_index", 0)), 0), n - 1)
+        self.started_at = str(d.get("started_at", self.started_at))
+        resume_status = d.get("resume_status", d.get("status", "in_progress"))
+        if resume_status == "complete":
+            self.finish()
+        else:
+            self._status = "in_progress"
+        if d.get("status") == "cancelled":
+            self.cancel()
+
+
+def mm3(v: Sequence[float] | np.ndarray) -> tuple[float, float, float]:
+    """A 3-vector as a tuple of Python floats."""
+    x, y, z = (float(t) for t in v)
+    return (x, y, z)

@@ -1,0 +1,111 @@
+"""XYZ reference wizard (methods.md section 3): one touch with a calibrated tool, one with the new.
+
+Math: ``tcpcal.origin.solve_reference`` (REF-1), ``t_2 = R_2^T (r - f_2)`` with
+``r = R_1 t_1 + f_1``. Poses come in metres and go to tcpcal in mm.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any, ClassVar
+
+import numpy as np
+
+from tcpcal.origin import solve_reference
+from tcpcal.tool import Tool
+
+from tcp_pendant.wizards.base import StepSpec, Wizard, WizardError, WizardResult, mm3
+
+ERRORS_ADD_UP = (
+    "The reference method uses one touch per tool: the new TCP carries the error of both "
+    "touches plus the reference tool's own calibration error. Check it, or use the 4-point "
+    "method for a tool that matters."
+)
+
+
+class ReferenceWizard(Wizard):
+    """XYZ reference: touch a fixed tip with a calibrated tool, swap tools, touch it again.
+
+    Args:
+        reference_tool: calibrated tool data of the reference tool (from the library).
+        reference_tool_key: physical tool (ToolModel key) that the reference data belongs to;
+            the app mounts it for step 1 (None: whatever is mounted).
+        new_tool_key: physical tool to calibrate; the app mounts it for step 2.
+        new_tool_label: how the instructions call the new tool (default: its key).
+    """
+
+    kind: ClassVar[str] = "reference"
+    title: ClassVar[str] = "XYZ reference"
+
+    def __init__(self, reference_tool: Tool, *, reference_tool_key: str | None = None,
+                 new_tool_key: str | None = None, new_tool_label: str | None = None) -> None:
+        super().__init__()
+        if not isinstance(reference_tool, Tool):
+            raise WizardError("Pick the calibrated reference tool from the tool library "
+                              f"(a tcpcal Tool), got {type(reference_tool).__name__}.")
+        if (reference_tool_key is not None and new_tool_key is not None
+                and reference_tool_key == new_tool_key):
+            raise WizardError("The reference tool and the new tool are the same physical tool; "
+                              "pick the tool you want to calibrate as the new tool.")
+        self.reference_tool = reference_tool
+        self.reference_tool_key = reference_tool_key
+        self.new_tool_key = new_tool_key
+        self.new_tool_label = new_tool_label or new_tool_key or "the new tool"
+
+    def _step_specs(self) -> list[StepSpec]:
+        ref = self.reference_tool.name
+        return [
+            StepSpec(role="touch", title="Touch with the reference tool",
+                     instruction=(f"With the reference tool '{ref}' mounted and active, jog its tip "
+                                  "onto the reference tip, from any direction; then press Record. "
+                                  "Do not move the reference tip afterwards."),
+                     mount_tool_key=self.reference_tool_key),
+            StepSpec(role="touch", title="Touch with the new tool",
+                     instruction=(f"Change the tool: mount {self.new_tool_label}. Jog its tip onto "
+                                  "the same reference tip, from any direction; then press Record."),
+                     mount_tool_key=self.new_tool_key),
+        ]
+
+    @property
+    def tool_to_mount(self) -> str | None:
+        """Physical tool key the current step needs mounted (the app swaps the tool model)."""
+        return self.step.mount_tool_key
+
+    def _compute(self, poses: list[np.ndarray]) -> WizardResult:
+        T1, T2 = poses
+        res = solve_reference(np.asarray(self.reference_tool.tcp_mm, dtype=float),
+                              T1[:3, :3], T1[:3, 3] * 1000.0,   # metres -> mm for tcpcal
+                              T2[:3, :3], T2[:3, 3] * 1000.0)
+        warnings = list(res.warnings) + [ERRORS_ADD_UP]
+        cal = self.reference_tool.calibration
+        if cal is None:
+            warnings.append(f"The reference tool '{self.reference_tool.name}' has no calibration "
+                            "record: its TCP may never have been measured.")
+        elif "ci95_mm" in cal.figures:
+            warnings.append(f"The reference tool's own TCP is uncertain by about "
+                            f"{float(cal.figures['ci95_mm']):.2f} mm (95 %); the new TCP inherits it.")
+        return WizardResult(
+            wizard=self.kind, method="reference", tcp_mm=mm3(res.tcp), tcp_result=res,
+            per_touch_error_mm=tuple(float(e) for e in res.residuals),
+            mean_error_mm=float(res.mean_error), max_error_mm=float(res.max_error),
+            rms_error_mm=float(res.rms_error),
+            ci95_mm=float(res.ci95_radius) if np.isfinite(res.ci95_radius) else None,
+            warnings=tuple(warnings),
+        )
+
+    def to_tool(self, name: str) -> Tool:
+        """The new tool with the TCP from (REF-1); orientation A = B = C = 0 (not calibrated)."""
+        res = self._require_result()
+        return Tool(name=name, tcp_mm=res.tcp_mm, calibration=self._calibration(res, res.figures))
+
+    def _params(self) -> dict[str, Any]:
+        return {"reference_tool": self.reference_tool.to_dict(),
+                "reference_tool_key": self.reference_tool_key,
+                "new_tool_key": self.new_tool_key, "new_tool_label": self.new_tool_label}
+
+    @classmethod
+    def _from_params(cls, params: Mapping[str, Any]) -> "ReferenceWizard":
+        return cls(Tool.from_dict(params["reference_tool"]),
+                   reference_tool_key=params.get("reference_tool_key"),
+                   new_tool_key=params.get("new_tool_key"),
+                   new_tool_label=params.get("new_tool_label"))

@@ -1,0 +1,124 @@
+"""Training mode: compare a wizard result with the hidden true TOOL frame of the mounted tool.
+
+The truth is ``ToolModel.T_flange_tcp_true`` (4x4, metres, FLANGE -> true TOOL). Errors are
+reported in mm and degrees:
+
+- position error: ``|t_result - t_true|`` (mm), the TCP in FLANGE coordinates;
+- orientation error: the angle of ``R_true^T R_result`` (deg, the geodesic distance between the
+  two tool orientations, via ``scipy.spatial.transform.Rotation.magnitude``); for the 5D ABC
+  world variant, which calibrates only tool X, the angle between the true and the computed
+  tool X axes is the graded figure (``x_axis_error_deg``).
+
+Verdict thresholds (``POSITION_THRESHOLDS_MM``, ``ORIENTATION_THRESHOLDS_DEG``):
+good below 0.5 mm / 0.5 deg, fair below 2 mm / 2 deg, poor otherwise. Only what the wizard
+calibrated is graded (position for the XYZ wizards, orientation for the orientation wizards);
+the other figure is still reported.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Literal
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from tcp_pendant.wizards.base import WizardError, WizardResult, check_pose_m
+
+Grade = Literal["good", "fair", "poor"]
+POSITION_THRESHOLDS_MM: tuple[float, float] = (0.5, 2.0)
+ORIENTATION_THRESHOLDS_DEG: tuple[float, float] = (0.5, 2.0)
+_ORDER: dict[Grade, int] = {"good": 0, "fair": 1, "poor": 2}
+
+
+@dataclass(frozen=True, eq=False)
+class TruthComparison:
+    """A result against the true TOOL frame.
+
+    Attributes:
+        position_error_mm: ``|t_result - t_true|``.
+        position_error_vector_mm: ``t_result - t_true`` in FLANGE, mm.
+        orientation_error_deg: angle of ``R_true^T R_result``, None when the result has no
+            orientation.
+        x_axis_error_deg: angle between true and computed tool X (working direction), or None.
+        inside_ci95: whether the position error is within the result's 95 % radius (None when
+            the result has no 95 % radius).
+        graded: which figures the grade is based on ("position", "orientation", "x_axis").
+        grade: "good" | "fair" | "poor".
+        verdict: short words, e.g. "good: position error 0.21 mm < 0.5 mm".
+    """
+
+    position_error_mm: float
+    position_error_vector_mm: tuple[float, float, float]
+    orientation_error_deg: float | None
+    x_axis_error_deg: float | None
+    inside_ci95: bool | None
+    graded: tuple[str, ...]
+    grade: Grade
+    verdict: str
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"position_error_mm": self.position_error_mm,
+                "position_error_vector_mm": list(self.position_error_vector_mm),
+                "orientation_error_deg": self.orientation_error_deg,
+                "x_axis_error_deg": self.x_axis_error_deg, "inside_ci95": self.inside_ci95,
+                "graded": list(self.graded), "grade": self.grade, "verdict": self.verdict}
+
+
+def _grade(value: float, thresholds: tuple[float, float]) -> Grade:
+    return "good" if value < thresholds[0] else "fair" if value < thresholds[1] else "poor"
+
+
+def _phrase(grade: Grade, what: str, value: float, unit: str, thresholds: tuple[float, float]) -> str:
+    if grade == "good":
+        return f"{what} {value:.2f} {unit} < {thresholds[0]:g} {unit}"
+    if grade == "fair":
+        return f"{what} {value:.2f} {unit} < {thresholds[1]:g} {unit}"
+    return f"{what} {value:.2f} {unit} >= {thresholds[1]:g} {unit}"
+
+
+def compare_with_truth(result: WizardResult, T_flange_tcp_true_m: Any) -> TruthComparison:
+    """Errors of ``result`` against the true TOOL frame (see the module docstring).
+
+    Args:
+        result: a finished wizard's result (mm, deg).
+        T_flange_tcp_true_m: (4,4) true FLANGE -> TOOL transform in metres.
+    """
+    if not isinstance(result, WizardResult):
+        raise WizardError(f"compare_with_truth needs a wizard result, got {type(result).__name__}.")
+    T_true = check_pose_m(T_flange_tcp_true_m, what="true tool frame")
+    t_true_mm = T_true[:3, 3] * 1000.0
+    dvec = np.asarray(result.tcp_mm, dtype=float) - t_true_mm
+    pos_err = float(np.linalg.norm(dvec))
+    ori_err = x_err = None
+    if result.rotation is not None:
+        R_true = T_true[:3, :3]
+        ori_err = float(np.degrees(Rotation.from_matrix(R_true.T @ result.rotation).magnitude()))
+        cos_x = float(np.clip(R_true[:, 0] @ result.rotation[:, 0], -1.0, 1.0))
+        x_err = float(np.degrees(np.arccos(cos_x)))
+    inside = None if result.ci95_mm is None else bool(pos_err <= result.ci95_mm)
+
+    parts: list[tuple[Grade, str]] = []
+    graded: list[str] = []
+    if not result.orientation_calibrated:
+        g = _grade(pos_err, POSITION_THRESHOLDS_MM)
+        parts.append((g, _phrase(g, "position error", pos_err, "mm", POSITION_THRESHOLDS_MM)))
+        graded.append("position")
+    elif result.method == "abc-world-5d":
+        assert x_err is not None
+        g = _grade(x_err, ORIENTATION_THRESHOLDS_DEG)
+        parts.append((g, _phrase(g, "tool X error", x_err, "deg", ORIENTATION_THRESHOLDS_DEG)))
+        graded.append("x_axis")
+    else:
+        assert ori_err is not None
+        g = _grade(ori_err, ORIENTATION_THRESHOLDS_DEG)
+        parts.append((g, _phrase(g, "orientation error", ori_err, "deg", ORIENTATION_THRESHOLDS_DEG)))
+        graded.append("orientation")
+    grade = max((g for g, _ in parts), key=_ORDER.__getitem__)
+    verdict = f"{grade}: " + "; ".join(p for _, p in parts)
+    if result.orientation_calibrated:
+        verdict += f" (TCP used is {pos_err:.2f} mm off the true one)"
+    return TruthComparison(position_error_mm=pos_err,
+                           position_error_vector_mm=(float(dvec[0]), float(dvec[1]), float(dvec[2])),
+                           orientation_error_deg=ori_err, x_axis_error_deg=x_err,
+                           inside_ci95=inside, graded=tuple(graded), grade=grade, verdict=verdict)

@@ -1,0 +1,323 @@
+"""XYZ 4-point wizard (methods.md section 2): touch one reference tip from N >= 4 orientations.
+
+All calibration math is ``tcpcal.origin.solve_xyz4`` ((4P-1) to (4P-3)) and, for the live
+pose-diversity meter, ``tcpcal.pose_quality.candidate_gain`` / ``assess_touches``. Poses come
+in metres and are handed to tcpcal in millimetres, so every figure of the result is in mm.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field
+from typing import Any, ClassVar, Literal
+
+import numpy as np
+
+from tcpcal.errors import TcpcalError
+from tcpcal.origin import TcpResult, solve_xyz4
+from tcpcal.pose_quality import CandidateGain, PoseQuality, assess_touches, candidate_gain
+from tcpcal.tool import Tool
+
+from tcp_pendant.wizards.base import (
+    StepSpec,
+    Wizard,
+    WizardError,
+    WizardResult,
+    WizardStateError,
+    check_pose_m,
+    mm3,
+    rotation_and_position_mm,
+)
+
+Estimator = Literal["lstsq", "sphere", "pairwise"]
+ESTIMATORS: tuple[Estimator, ...] = ("lstsq", "sphere", "pairwise")
+ESTIMATOR_LABELS: dict[str, str] = {
+    "lstsq": "joint least squares (4P-3), default",
+    "sphere": "best-fit sphere (4P-1a)",
+    "pairwise": "pairwise differences (4P-2)",
+}
+
+RESIDUAL_CAVEAT = (
+    "A small residual does not prove an accurate TCP: systematic errors (a bent tip, a "
+    "reference that moved, a wrong robot model) hide in it. Check the TCP by rotating about it."
+)
+
+
+@dataclass(frozen=True, eq=False, kw_only=True)
+class Xyz4Result(WizardResult):
+    """Result of the XYZ 4-point wizard. Lengths in mm, directions unit vectors in WORLD.
+
+    Attributes:
+        estimator: the estimator of ``tcp_mm`` ("lstsq" | "sphere" | "pairwise").
+        used_indices: 0-based indices of the recorded touches used (all but the excluded).
+        excluded: touches the user dropped.
+        outliers: touches tcpcal flags as outliers, as 0-based indices of the *recorded*
+            touches (not of the used subset).
+        sphere_centre_mm: fitted reference point ``r`` in WORLD (the sphere's centre).
+        sphere_radius_mm: ``|t|``, distance flange origin to TCP (the sphere's radius).
+        flange_positions_mm: (N,3) flange origins ``f_i`` in WORLD of every recorded touch.
+        approach_directions_world: (N,3) tool direction at each touch in WORLD: the unit
+            vector from the flange origin towards the computed TCP, ``R_i t / |t|``.
+        estimators: the tcpcal result of each estimator on the same touches (side by side).
+        estimator_errors: estimator -> tcpcal's message, for those that could not solve.
+    """
+
+    estimator: str
+    used_indices: tuple[int, ...]
+    excluded: tuple[int, ...]
+    outliers: tuple[int, ...]
+    sphere_centre_mm: tuple[float, float, float]
+    sphere_radius_mm: float
+    flange_positions_mm: np.ndarray
+    approach_directions_world: np.ndarray
+    estimators: Mapping[str, TcpResult] = field(default_factory=dict)
+    estimator_errors: Mapping[str, str] = field(default_factory=dict)
+
+    def comparison_rows(self) -> list[dict[str, Any]]:
+        """One row per estimator for the side-by-side table (mm), in ``ESTIMATORS`` order."""
+        rows: list[dict[str, Any]] = []
+        for name in ESTIMATORS:
+            res = self.estimators.get(name)
+            if res is None:
+                rows.append({"estimator": name, "label": ESTIMATOR_LABELS[name], "ok": False,
+                             "error": self.estimator_errors.get(name, "not computed")})
+                continue
+            rows.append({
+                "estimator": name, "label": ESTIMATOR_LABELS[name], "ok": True,
+                "tcp_mm": mm3(res.tcp), "mean_error_mm": float(res.mean_error),
+                "max_error_mm": float(res.max_error), "rms_error_mm": float(res.rms_error),
+                "ci95_mm": float(res.ci95_radius), "chosen": name == self.estimator,
+            })
+        return rows
+
+
+class Xyz4Wizard(Wizard):
+    """XYZ 4-point: touch the reference tip with the tool tip from N clearly different orientations.
+
+    Args:
+        n_points: number of touch steps to start with (4..20); "Add point" adds more.
+        estimator: tcpcal estimator of the reported TCP ("lstsq" is the default and the best).
+        assumed_sigma_mm: operator jogging error assumed by the pose-diversity meter.
+        base_tool: when re-calibrating an existing tool, its orientation (A, B, C) is kept by
+            ``to_tool``; otherwise A = B = C = 0.
+    """
+
+    kind: ClassVar[str] = "xyz4"
+    title: ClassVar[str] = "XYZ 4-point"
+    MIN_POINTS: ClassVar[int] = 4
+    MAX_POINTS: ClassVar[int] = 20
+
+    def __init__(self, *, n_points: int = 4, estimator: Estimator = "lstsq",
+                 assumed_sigma_mm: float = 0.5, base_tool: Tool | None = None) -> None:
+        super().__init__()
+        if not self.MIN_POINTS <= int(n_points) <= self.MAX_POINTS:
+            raise WizardError(f"n_points must be between {self.MIN_POINTS} and {self.MAX_POINTS}, got {n_points}.")
+        if not (np.isfinite(assumed_sigma_mm) and assumed_sigma_mm > 0):
+            raise WizardError(f"assumed_sigma_mm must be a positive number of mm, got {assumed_sigma_mm}.")
+        self._check_estimator(estimator)
+        self._n_points = int(n_points)
+        self._estimator: Estimator = estimator
+        self.assumed_sigma_mm = float(assumed_sigma_mm)
+        self.base_tool = base_tool
+        self._excluded: tuple[int, ...] = ()
+
+    @staticmethod
+    def _check_estimator(estimator: str) -> None:
+        if estimator not in ESTIMATORS:
+            raise WizardError(f"Unknown estimator {estimator!r}; choose one of {list(ESTIMATORS)}.")
+
+    # ----- steps --------------------------------------------------------------------------
+    def _step_specs(self) -> list[StepSpec]:
+        specs = []
+        for i in range(self._n_points):
+            if i == 0:
+                text = ("Jog the tool tip onto the reference tip, approaching from any direction; "
+                        "then press Record.")
+            elif i < 4:
+                text = (f"Back off, tilt the tool 30 to 60 degrees about a different axis than "
+                        f"before, and touch the reference tip again from this new orientation "
+                        f"(touch {i + 1}); then press Record.")
+            else:
+                text = (f"Extra touch {i + 1}: touch the reference tip from an orientation unlike "
+                        f"the earlier ones (watch the pose-diversity meter); then press Record.")
+            specs.append(StepSpec(role="touch", title=f"Touch {i + 1}", instruction=text))
+        return specs
+
+    @property
+    def n_points(self) -> int:
+        return self._n_points
+
+    @property
+    def can_add_point(self) -> bool:
+        return self.status != "cancelled" and self._n_points < self.MAX_POINTS
+
+    def add_point(self) -> None:
+        """Add one touch step at the end (up to 20) and go to it (a finished wizard reopens)."""
+        if not self.can_add_point:
+            raise WizardStateError(f"At most {self.MAX_POINTS} touches." if self.status != "cancelled"
+                                   else "The wizard was cancelled; resume it first.")
+        self._n_points += 1
+        self._status = "in_progress"
+        self._result = None
+        self._index = self._n_points - 1 if all(i in self._poses for i in range(self._n_points - 1)) \
+            else self._index
+
+    def remove_point(self, index: int) -> None:
+        """Delete touch ``index`` (0-based) and its step, keeping at least 4 steps."""
+        if self.status == "cancelled":
+            raise WizardStateError("The wizard was cancelled; resume it first.")
+        if self._n_points <= self.MIN_POINTS:
+            raise WizardStateError(f"At least {self.MIN_POINTS} touches are needed; re-record instead.")
+        if not 0 <= index < self._n_points:
+            raise WizardStateError(f"There is no touch {index + 1}.")
+        self._poses = {(i if i < index else i - 1): p for i, p in self._poses.items() if i != index}
+        self._n_points -= 1
+        self._excluded = ()
+        self._status = "in_progress"
+        self._result = None
+        self._index = min(self._index, self._n_points - 1)
+
+    # ----- estimator and outliers ---------------------------------------------------------
+    @property
+    def estimator(self) -> Estimator:
+        return self._estimator
+
+    def set_estimator(self, estimator: Estimator) -> WizardResult | None:
+        """Choose the estimator of the reported TCP; a finished wizard is recomputed."""
+        self._check_estimator(estimator)
+        self._estimator = estimator
+        return self.finish() if self.is_complete else None
+
+    @property
+    def excluded(self) -> tuple[int, ...]:
+        """0-based indices of recorded touches left out of the computation."""
+        return self._excluded
+
+    def set_excluded(self, indices: Iterable[int]) -> WizardResult | None:
+        """Leave these touches out (0-based); recompute if finished. At least 4 must remain."""
+        idx = tuple(sorted({int(i) for i in indices}))
+        if any(not 0 <= i < self._n_points for i in idx):
+            raise WizardError(f"Touch indices {list(idx)} out of range 0..{self._n_points - 1}.")
+        if self._n_points - len(idx) < self.MIN_POINTS:
+            raise WizardError(f"Dropping {len(idx)} touches leaves fewer than {self.MIN_POINTS}; "
+                              "add points first.")
+        old = self._excluded
+        self._excluded = idx
+        if self.is_complete:
+            try:
+                return self.finish()
+            except WizardError:
+                self._excluded = old
+                self.finish()
+                raise
+        return None
+
+    def drop_outliers(self) -> WizardResult:
+        """Exclude the touches flagged as outliers in the current result and recompute."""
+        res = self.result
+        if not isinstance(res, Xyz4Result):
+            raise WizardStateError("Finish the wizard first.")
+        if not res.outliers:
+            raise WizardStateError("No touch is flagged as an outlier.")
+        out = self.set_excluded(set(self._excluded) | set(res.outliers))
+        assert out is not None
+        return out
+
+    def restore_all(self) -> WizardResult | None:
+        """Use every recorded touch again."""
+        return self.set_excluded(())
+
+    # ----- live pose-diversity meter ------------------------------------------------------
+    def _other_rotations(self) -> np.ndarray:
+        rots = [p.T_world_flange_m[:3, :3] for i, p in sorted(self._poses.items())
+                if i != self._index or self.is_complete]
+        return np.array(rots, dtype=float).reshape(-1, 3, 3)
+
+    def preview(self, T_world_flange_m: Any, *, min_angle_deg: float = 15.0) -> CandidateGain:
+        """Predicted TCP uncertainty if the current pose were recorded (tcpcal.candidate_gain).
+
+        Compares the candidate flange orientation with the touches recorded so far (except the
+        current step's own, which a new recording would replace), for an operator error of
+        ``assumed_sigma_mm`` per axis. Figures in mm; ``too_close`` flags an orientation within
+        ``min_angle_deg`` of an earlier one.
+        """
+        T = check_pose_m(T_world_flange_m, what="candidate flange pose")
+        return candidate_gain(self._other_rotations(), T[:3, :3], sigma=self.assumed_sigma_mm,
+                              min_angle_deg=min_angle_deg)
+
+    def quality(self) -> PoseQuality | None:
+        """tcpcal's verdict on the touches recorded so far (None before the first touch)."""
+        rots = np.array([p.T_world_flange_m[:3, :3] for _, p in sorted(self._poses.items())],
+                        dtype=float).reshape(-1, 3, 3)
+        if len(rots) == 0:
+            return None
+        return assess_touches(rots, sigma=self.assumed_sigma_mm)
+
+    # ----- result -------------------------------------------------------------------------
+    def _compute(self, poses: list[np.ndarray]) -> Xyz4Result:
+        used = tuple(i for i in range(len(poses)) if i not in self._excluded)
+        R_all = np.array([T[:3, :3] for T in poses])
+        f_all_mm = np.array([T[:3, 3] for T in poses]) * 1000.0  # metres -> mm for tcpcal
+        R, f = R_all[list(used)], f_all_mm[list(used)]
+        chosen = solve_xyz4(R, f, method=self._estimator)   # TcpcalError propagates: no result
+        estimators: dict[str, TcpResult] = {self._estimator: chosen}
+        errors: dict[str, str] = {}
+        for name in ESTIMATORS:
+            if name == self._estimator:
+                continue
+            try:
+                estimators[name] = solve_xyz4(R, f, method=name)
+            except TcpcalError as exc:
+                errors[name] = str(exc)
+        t = np.asarray(chosen.tcp, dtype=float)
+        radius = float(np.linalg.norm(t))
+        directions = (R_all @ t) / radius if radius > 0 else np.zeros((len(poses), 3))
+        outliers = tuple(used[i] for i in chosen.outliers)
+        warnings = list(chosen.warnings)
+        if outliers:
+            warnings.append(
+                "Touch(es) " + ", ".join(str(i + 1) for i in outliers)
+                + " stand out from the others (outliers): drop them to recompute without them.")
+        if self._excluded:
+            warnings.append("Touch(es) " + ", ".join(str(i + 1) for i in self._excluded)
+                            + " were dropped by you and are not used.")
+        return Xyz4Result(
+            wizard=self.kind, method=f"xyz4-{self._estimator}", tcp_mm=mm3(t),
+            tcp_result=chosen,
+            per_touch_error_mm=tuple(float(e) for e in chosen.residuals),
+            mean_error_mm=float(chosen.mean_error), max_error_mm=float(chosen.max_error),
+            rms_error_mm=float(chosen.rms_error), ci95_mm=float(chosen.ci95_radius),
+            warnings=tuple(warnings), notes=(RESIDUAL_CAVEAT,),
+            estimator=self._estimator, used_indices=used, excluded=self._excluded,
+            outliers=outliers, sphere_centre_mm=mm3(chosen.reference), sphere_radius_mm=radius,
+            flange_positions_mm=f_all_mm, approach_directions_world=directions,
+            estimators=estimators, estimator_errors=errors,
+        )
+
+    def to_tool(self, name: str) -> Tool:
+        """The tool with the calibrated TCP; orientation from ``base_tool`` (or A = B = C = 0)."""
+        res = self._require_result()
+        kw: dict[str, Any] = {}
+        abc = (0.0, 0.0, 0.0)
+        if self.base_tool is not None:
+            abc = tuple(float(v) for v in self.base_tool.abc_deg)  # type: ignore[assignment]
+            kw = {"mass_kg": self.base_tool.mass_kg, "notes": self.base_tool.notes}
+        return Tool(name=name, tcp_mm=res.tcp_mm, abc_deg=abc,
+                    calibration=self._calibration(res, res.figures), **kw)
+
+    # ----- serialisation ------------------------------------------------------------------
+    def _params(self) -> dict[str, Any]:
+        return {"n_points": self._n_points, "estimator": self._estimator,
+                "assumed_sigma_mm": self.assumed_sigma_mm,
+                "base_tool": None if self.base_tool is None else self.base_tool.to_dict(),
+                "excluded": list(self._excluded)}
+
+    @classmethod
+    def _from_params(cls, params: Mapping[str, Any]) -> "Xyz4Wizard":
+        base = params.get("base_tool")
+        wiz = cls(n_points=int(params.get("n_points", 4)),
+                  estimator=params.get("estimator", "lstsq"),
+                  assumed_sigma_mm=float(params.get("assumed_sigma_mm", 0.5)),
+                  base_tool=None if base is None else Tool.from_dict(base))
+        wiz._excluded = tuple(int(i) for i in params.get("excluded", ()))
+        return wiz
