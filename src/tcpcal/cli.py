@@ -1,0 +1,512 @@
+"""The ``tcpcal`` command line: solve calibrations from recorded poses, convert tool data,
+manage the tool library.
+
+Units: millimetres and degrees (KUKA A, B, C unless a format says otherwise). Exit status 0 on
+success, 2 on bad input or usage (one line on stderr that names the file, the row and what is
+wrong), 1 on an internal error (a bug: one line, the traceback only with ``TCPCAL_DEBUG=1``).
+Documentation with examples and the JSON keys: docs/cli.md.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import re
+import sys
+import traceback
+import warnings
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any, NoReturn
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from tcpcal.errors import DegenerateTouchesError, TcpcalError
+from tcpcal.poses_csv import FlangePoses, accepted_layouts_text, read_poses_csv
+from tcpcal.report import (format_orientation_report, format_tcp_report, format_tool,
+                           format_tool_table, json_dumps, orientation_result_to_dict,
+                           tcp_result_to_dict, tool_to_dict)
+
+__all__ = ["main", "build_parser", "CliInputError"]
+
+FORMATS = ("kuka", "abb", "fanuc", "ur", "matrix")
+
+#: Numbers of ``tcpcal convert --from FMT VALUES``, per format.
+VALUE_COUNTS: dict[str, tuple[int, ...]] = {"kuka": (6,), "fanuc": (6,), "ur": (6,),
+                                            "abb": (7,), "matrix": (12, 16)}
+
+
+class CliInputError(Exception):
+    """Bad command-line input found after argparse (exit 2, message printed as is)."""
+
+
+class _Parser(argparse.ArgumentParser):
+    """ArgumentParser whose usage errors are one line on stderr (exit 2).
+
+    Also treats every token that starts with ``-`` followed by a digit or ``.`` as a value, so
+    ``--tcp -10,20,30`` and ``convert --from kuka -10,20,30,0,0,0`` work (no option of tcpcal
+    starts with a digit).
+    """
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = re.compile(r"^-\.?\d")
+
+    def error(self, message: str) -> NoReturn:
+        self.exit(2, f"{self.prog}: error: {message} (see '{self.prog} --help')\n")
+
+
+def _floats(text: str, n: int, what: str) -> tuple[float, ...]:
+    parts = [p for p in re.split(r"[,\s]+", text.strip()) if p]
+    if len(parts) != n:
+        raise argparse.ArgumentTypeError(
+            f"{what} needs {n} comma-separated numbers, got {text!r}")
+    try:
+        vals = tuple(float(p) for p in parts)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{what} must be numbers, got {text!r}") from None
+    if not all(np.isfinite(vals)):
+        raise argparse.ArgumentTypeError(f"{what} must be finite numbers, got {text!r}")
+    return vals
+
+
+def _xyz_arg(text: str) -> tuple[float, float, float]:
+    return _floats(text, 3, "X,Y,Z")  # type: ignore[return-value]
+
+
+def _abc_arg(text: str) -> tuple[float, float, float]:
+    return _floats(text, 3, "A,B,C")  # type: ignore[return-value]
+
+
+def _positive_float(text: str) -> float:
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a number, got {text!r}") from None
+    if not (np.isfinite(v) and v > 0):
+        raise argparse.ArgumentTypeError(f"must be a positive number, got {text!r}")
+    return v
+
+
+# ----------------------------------------------------------------------------------- parser
+def build_parser() -> argparse.ArgumentParser:
+    """The argparse tree of ``tcpcal`` (see docs/cli.md)."""
+    p = _Parser(prog="tcpcal", description="TCP and TOOL-frame calibration from recorded "
+                "flange poses; controller tool-data conversion; the tool library. "
+                "Lengths in mm, angles in deg. See docs/cli.md.")
+    sub = p.add_subparsers(dest="command", required=True, metavar="{solve,convert,tools}")
+
+    # solve ---------------------------------------------------------------------------------
+    solve = sub.add_parser("solve", help="calibrate from a CSV of flange poses",
+                           description="Calibrate from a CSV of flange poses (one pose per "
+                           "row, header row naming the columns). " + accepted_layouts_text())
+    ssub = solve.add_subparsers(dest="method_cmd", required=True,
+                                metavar="{xyz4,reference,three-point,abc-world}")
+
+    def add_common(sp: argparse.ArgumentParser) -> None:
+        sp.add_argument("poses", metavar="POSES.csv", type=Path,
+                        help="flange poses, x,y,z in mm + one orientation layout")
+        sp.add_argument("--json", action="store_true", help="print one JSON object")
+
+    xyz4 = ssub.add_parser("xyz4", help="TCP from N >= 4 touches of one reference point",
+                           description="XYZ 4-point: the tool tip touches one fixed point from "
+                           "N >= 4 different orientations; one touch per row.")
+    add_common(xyz4)
+    xyz4.add_argument("--method", choices=("lstsq", "sphere", "pairwise"), default="lstsq",
+                      help="estimator (default lstsq: joint least squares, the best)")
+    xyz4.add_argument("--sigma", type=_positive_float, metavar="MM", default=None,
+                      help="assumed touch noise per axis in mm (default: estimated from the "
+                      "residuals)")
+    xyz4.add_argument("--no-outliers", dest="detect_outliers", action="store_false",
+                      help="do not flag outliers")
+
+    ref = ssub.add_parser("reference", help="TCP of a new tool from one touch each",
+                          description="XYZ reference: row 1 = the calibrated tool's touch, "
+                          "row 2 = the new tool's touch of the same point.")
+    add_common(ref)
+    ref.add_argument("--known-tcp", type=_xyz_arg, required=True, metavar="X,Y,Z",
+                     help="TCP of the calibrated tool in FLANGE, mm")
+    ref.add_argument("--sigma", type=_positive_float, metavar="MM", default=None,
+                     help="assumed touch noise per axis in mm")
+
+    tp = ssub.add_parser("three-point", help="TOOL orientation from three poses",
+                         description="Three-point orientation: row 1 = TCP on the reference, "
+                         "row 2 = reference tip on the tool's -X axis, row 3 = tip on the +Y "
+                         "axis (variant 1) or in the +Y half of the XY plane (variant 2).")
+    add_common(tp)
+    tp.add_argument("--tcp", type=_xyz_arg, required=True, metavar="X,Y,Z",
+                    help="calibrated TCP in FLANGE, mm")
+    tp.add_argument("--variant", type=int, choices=(1, 2), required=True)
+
+    abc = ssub.add_parser("abc-world", help="TOOL orientation from the aligned flange pose",
+                          description="ABC world (parallel axes): one row, the flange pose "
+                          "while tool X points down (WORLD -Z), tool Y along WORLD +Y "
+                          "(6d) - or only tool X down (5d).")
+    add_common(abc)
+    abc.add_argument("--variant", choices=("6d", "5d"), default="6d")
+    abc.add_argument("--current-abc", type=_abc_arg, metavar="A,B,C", default=None,
+                     help="5d only: the tool's present KUKA A,B,C (deg) whose rotation about "
+                     "tool X is kept")
+
+    # convert -------------------------------------------------------------------------------
+    conv = sub.add_parser(
+        "convert", help="convert tool data between controller formats",
+        description="Convert one tool frame between controller formats. VALUES is either the "
+        "numbers (kuka: X,Y,Z,A,B,C mm/deg; fanuc: X,Y,Z,W,P,R mm/deg; abb: x,y,z,q1,q2,q3,q4 "
+        "mm/unit quaternion scalar first; ur: x,y,z,rx,ry,rz m/rad; matrix: 12 or 16 numbers of "
+        "the 4x4 T_flange_tool row-major, mm), or the controller text as the controller writes "
+        "it (quote it), or '-' to read that text from stdin.")
+    conv.add_argument("--from", dest="from_fmt", choices=FORMATS, required=True)
+    conv.add_argument("--to", dest="to_fmt", choices=FORMATS, required=True)
+    conv.add_argument("--name", default="tool", help="tool name used in the output text")
+    conv.add_argument("--slot", type=int, default=1, help="tool number in the output text")
+    conv.add_argument("--json", action="store_true", help="print one JSON object")
+    conv.add_argument("values", nargs="+", metavar="VALUES")
+
+    # tools ---------------------------------------------------------------------------------
+    lib_help = "tool library file (default: the user data directory's tools.json)"
+    tools = sub.add_parser("tools", help="the tool library (slots 1..16, one active)")
+    tools.add_argument("--library", type=Path, default=None, metavar="PATH", help=lib_help)
+    lib_parent = _Parser(add_help=False)
+    lib_parent.add_argument("--library", type=Path, default=argparse.SUPPRESS, metavar="PATH",
+                            help=lib_help)
+    tsub = tools.add_subparsers(dest="tools_cmd", required=True,
+                                metavar="{list,show,add,remove,activate,export}")
+    tl = tsub.add_parser("list", parents=[lib_parent], help="the tool table")
+    tl.add_argument("--json", action="store_true")
+    ts = tsub.add_parser("show", parents=[lib_parent], help="one tool in detail")
+    ts.add_argument("slot", metavar="SLOT", help="slot number or tool name")
+    ts.add_argument("--json", action="store_true")
+    ta = tsub.add_parser("add", parents=[lib_parent], help="store a tool in a slot")
+    ta.add_argument("slot", metavar="SLOT", type=int)
+    ta.add_argument("name", metavar="NAME")
+    ta.add_argument("--xyz", type=_xyz_arg, required=True, metavar="X,Y,Z",
+                    help="TCP in FLANGE, mm")
+    ta.add_argument("--abc", type=_abc_arg, default=(0.0, 0.0, 0.0), metavar="A,B,C",
+                    help="TOOL orientation, KUKA A,B,C in deg (default 0,0,0)")
+    ta.add_argument("--mass", type=_positive_float, default=None, metavar="KG")
+    ta.add_argument("--notes", default="")
+    ta.add_argument("--activate", action="store_true", help="make it the active tool")
+    ta.add_argument("--replace", action="store_true", help="overwrite an occupied slot")
+    tr = tsub.add_parser("remove", parents=[lib_parent], help="empty a slot")
+    tr.add_argument("slot", metavar="SLOT", help="slot number or tool name")
+    tact = tsub.add_parser("activate", parents=[lib_parent], help="make a tool the active one")
+    tact.add_argument("slot", metavar="SLOT", help="slot number, tool name, or 'none'")
+    te = tsub.add_parser("export", parents=[lib_parent], help="print a tool as controller text")
+    te.add_argument("slot", metavar="SLOT", help="slot number or tool name")
+    te.add_argument("--format", dest="fmt", choices=FORMATS, required=True)
+    return p
+
+
+# ------------------------------------------------------------------------------ solve paths
+def _solver_error(exc: TcpcalError, poses: FlangePoses, rows: Sequence[int] | None = None) -> str:
+    """One line for a solver error: file, row (when the error names one) and the message."""
+    msg = " ".join(str(exc).split())
+    index = getattr(exc, "index", None)
+    if isinstance(index, (int, np.integer)) and index >= 0:
+        row = int(rows[index]) if rows is not None and index < len(rows) else int(index)
+        where = poses.where(row) if row < len(poses) else str(poses.path)
+    else:
+        where = f"{poses.path}, data rows 1-{len(poses)}" if len(poses) > 1 else str(poses.path)
+    if isinstance(exc, DegenerateTouchesError):
+        axis = getattr(exc, "unobservable_axis", None)
+        if axis is not None:
+            u = np.asarray(axis, dtype=float)
+            k = int(np.argmax(np.abs(u)))
+            near = f"~ flange {'-' if u[k] < 0 else '+'}{'XYZ'[k]}" if abs(u[k]) > 0.9 else ""
+            msg += (f" [unobservable direction in FLANGE: ({u[0]:.3f}, {u[1]:.3f}, {u[2]:.3f})"
+                    f"{' ' + near if near else ''}]")
+    return f"{where}: {msg}"
+
+
+def _emit(text: str) -> None:
+    sys.stdout.write(text if text.endswith("\n") else text + "\n")
+
+
+def _run_solve(args: argparse.Namespace) -> int:
+    cmd = args.method_cmd
+    if cmd == "xyz4":
+        poses = read_poses_csv(args.poses, min_rows=4, purpose="xyz4")
+        from tcpcal.origin import solve_xyz4
+
+        try:
+            res = solve_xyz4(poses.rotations, poses.positions_mm, method=args.method,
+                             sigma=args.sigma, detect_outliers=args.detect_outliers)
+        except TcpcalError as exc:
+            raise CliInputError(_solver_error(exc, poses)) from None
+        out = tcp_result_to_dict(res)
+        _emit(_with_source(out, poses) if args.json
+              else format_tcp_report(res, poses, command="solve xyz4"))
+        return 0
+    if cmd == "reference":
+        poses = read_poses_csv(args.poses, min_rows=2, max_rows=2, purpose="reference "
+                               "(row 1: calibrated tool, row 2: new tool)")
+        from tcpcal.origin import solve_reference
+
+        try:
+            res = solve_reference(np.array(args.known_tcp), poses.rotations[0],
+                                  poses.positions_mm[0], poses.rotations[1],
+                                  poses.positions_mm[1], sigma=args.sigma)
+        except TcpcalError as exc:
+            raise CliInputError(_solver_error(exc, poses)) from None
+        out = tcp_result_to_dict(res)
+        out["known_tcp_mm"] = list(args.known_tcp)
+        _emit(_with_source(out, poses) if args.json
+              else format_tcp_report(res, poses, command="solve reference"))
+        return 0
+    if cmd == "three-point":
+        from tcpcal.orientation import solve_three_point
+
+        poses = read_poses_csv(args.poses, min_rows=3, max_rows=3, purpose="three-point "
+                               "(row 1: touch, row 2: tip on -X, row 3: tip on +Y)")
+        try:
+            ores = solve_three_point(poses.rotations, poses.positions_mm, np.array(args.tcp),
+                                     variant=args.variant)
+        except TcpcalError as exc:
+            raise CliInputError(_solver_error(exc, poses)) from None
+        out = orientation_result_to_dict(ores)
+        out["tcp_mm"] = list(args.tcp)
+        _emit(_with_source(out, poses) if args.json else format_orientation_report(
+            ores, poses, command=f"solve three-point --variant {args.variant}", tcp_mm=args.tcp))
+        return 0
+    if cmd == "abc-world":
+        from tcpcal.orientation import solve_abc_world
+
+        poses = read_poses_csv(args.poses, min_rows=1, max_rows=1, purpose="abc-world (the "
+                               "flange pose at alignment)")
+        if args.current_abc is not None and args.variant != "5d":
+            raise CliInputError("--current-abc applies only to --variant 5d")
+        current = (None if args.current_abc is None else
+                   Rotation.from_euler("ZYX", args.current_abc, degrees=True).as_matrix())
+        try:
+            ores = solve_abc_world(poses.rotations[0], variant=args.variant,
+                                   current_rotation=current)
+        except TcpcalError as exc:
+            raise CliInputError(_solver_error(exc, poses)) from None
+        out = orientation_result_to_dict(ores)
+        _emit(_with_source(out, poses) if args.json else format_orientation_report(
+            ores, poses, command=f"solve abc-world --variant {args.variant}"))
+        return 0
+    raise AssertionError(cmd)  # pragma: no cover - argparse restricts the choices
+
+
+def _with_source(out: dict[str, Any], poses: FlangePoses) -> str:
+    out = dict(out)
+    out["input"] = {"path": str(poses.path), "layout": poses.layout, "n_rows": len(poses),
+                    "line_numbers": list(poses.line_numbers)}
+    return json_dumps(out)
+
+
+# ---------------------------------------------------------------------------- convert path
+def _tool_from_values(values: Sequence[float], fmt: str, name: str) -> Any:
+    """Tool from the bare numbers of ``convert --from FMT`` (conventions of methods.md s. 6)."""
+    from tcpcal.tool import Tool
+
+    v = np.asarray(values, dtype=float)
+    if fmt == "kuka":
+        return Tool(name=name, tcp_mm=tuple(v[:3]), abc_deg=tuple(v[3:6]))
+    if fmt == "fanuc":
+        rot = Rotation.from_euler("xyz", v[3:6], degrees=True)
+        return Tool.from_rotation(name, tuple(v[:3]), rot.as_matrix())
+    if fmt == "ur":
+        rot = Rotation.from_rotvec(v[3:6])
+        return Tool.from_rotation(name, tuple(v[:3] * 1000.0), rot.as_matrix())
+    if fmt == "abb":
+        q = v[3:7]
+        norm = float(np.linalg.norm(q))
+        if abs(norm - 1.0) > 1e-6:
+            raise CliInputError(f"convert --from abb: quaternion q1..q4 has norm {norm:.9g}, not "
+                                f"1 within 1e-6; check the order (q1 = scalar) and the digits")
+        return Tool.from_rotation(name, tuple(v[:3]),
+                                  Rotation.from_quat(q, scalar_first=True).as_matrix())
+    if fmt == "matrix":
+        m = v.reshape(-1, 4)
+        if m.shape[0] == 4 and not np.allclose(m[3], [0, 0, 0, 1], atol=1e-9):
+            raise CliInputError("convert --from matrix: the last row of the 4x4 matrix must be "
+                                "0,0,0,1")
+        r = m[:3, :3]
+        defect = float(np.max(np.abs(r.T @ r - np.eye(3))))
+        if defect > 1e-6 or np.linalg.det(r) < 0:
+            raise CliInputError(f"convert --from matrix: the 3x3 block is not a rotation within "
+                                f"1e-6 (max |R^T R - I| = {defect:.3g}, det = "
+                                f"{np.linalg.det(r):.6g}); give the 4x4 matrix row-major")
+        return Tool.from_rotation(name, tuple(m[:3, 3]), Rotation.from_matrix(r).as_matrix())
+    raise AssertionError(fmt)  # pragma: no cover
+
+
+def _run_convert(args: argparse.Namespace) -> int:
+    from tcpcal.formats import export_tool, import_tool
+
+    if args.values == ["-"]:
+        raw = sys.stdin.read()
+    else:
+        raw = " ".join(args.values)
+    tokens = [t for t in re.split(r"[,\s]+", raw.strip()) if t]
+    numbers: list[float] | None
+    try:
+        numbers = [float(t) for t in tokens]
+    except ValueError:
+        numbers = None
+    if numbers is not None and tokens:
+        counts = VALUE_COUNTS[args.from_fmt]
+        if len(numbers) not in counts:
+            raise CliInputError(f"convert --from {args.from_fmt}: {len(numbers)} numbers given, "
+                                f"{' or '.join(map(str, counts))} expected "
+                                f"(see 'tcpcal convert --help')")
+        if not all(np.isfinite(numbers)):
+            raise CliInputError(f"convert --from {args.from_fmt}: the values must be finite "
+                                f"numbers")
+        tool = _tool_from_values(numbers, args.from_fmt, args.name)
+    else:
+        try:
+            tool = import_tool(raw, args.from_fmt, name=args.name)
+        except TcpcalError as exc:
+            raise CliInputError(f"convert --from {args.from_fmt}: "
+                                f"{' '.join(str(exc).split())}") from None
+    text = export_tool(tool, args.to_fmt, slot=args.slot)
+    if args.json:
+        _emit(json_dumps({"from": args.from_fmt, "to": args.to_fmt, "text": text,
+                          "tcp_mm": list(tool.tcp_mm), "kuka_abc_deg": list(tool.abc_deg),
+                          "rotation_matrix": np.asarray(tool.rotation)}))
+    else:
+        _emit(text)
+    return 0
+
+
+# ------------------------------------------------------------------------------ tools path
+def _resolve_slot(lib: Any, key: str) -> int:
+    """A slot number from ``SLOT`` (a number 1..16 or a stored tool's name)."""
+    key = key.strip()
+    if re.fullmatch(r"\d+", key):
+        slot = int(key)
+        if not 1 <= slot <= lib.N_SLOTS:
+            raise CliInputError(f"slot {slot} is out of range 1..{lib.N_SLOTS}")
+        return slot
+    found = lib.find(key)
+    if found is None:
+        raise CliInputError(f"{lib.path}: no tool named {key!r}; 'tcpcal tools list' shows "
+                            f"the table")
+    return int(found[0])
+
+
+def _run_tools(args: argparse.Namespace) -> int:
+    from tcpcal.library import ToolLibrary
+
+    lib = ToolLibrary(args.library)
+    try:
+        with warnings.catch_warnings():  # reported below as one line, not a Python warning
+            warnings.simplefilter("ignore")
+            return _tools_command(lib, args)
+    finally:
+        if getattr(lib, "recovered_backup", None) is not None:
+            print(f"tcpcal: warning: the tool library {lib.path} was corrupt; it was moved "
+                  f"aside to {lib.recovered_backup} and the library started empty",
+                  file=sys.stderr)
+
+
+def _tools_command(lib: Any, args: argparse.Namespace) -> int:
+    cmd = args.tools_cmd
+    if cmd == "list":
+        tools = lib.tools()
+        active = lib.active_slot()
+        if args.json:
+            _emit(json_dumps({"library": str(lib.path), "active_slot": active,
+                              "tools": [tool_to_dict(t, slot=s, active=s == active)
+                                        for s, t in sorted(tools.items())]}))
+        else:
+            _emit(f"Tool library {lib.path}\n{format_tool_table(tools, active)}")
+        return 0
+    if cmd == "add":
+        from tcpcal.tool import Tool
+
+        if not 1 <= args.slot <= lib.N_SLOTS:
+            raise CliInputError(f"slot {args.slot} is out of range 1..{lib.N_SLOTS}")
+        old = lib.get(args.slot)
+        if old is not None and not args.replace:
+            raise CliInputError(f"{lib.path}: slot {args.slot} holds {old.name!r}; add "
+                                f"--replace to overwrite it or choose a free slot "
+                                f"(first free: {lib.first_free_slot()})")
+        tool = Tool(name=args.name, tcp_mm=tuple(args.xyz), abc_deg=tuple(args.abc),
+                    mass_kg=args.mass, notes=args.notes)
+        lib.save(args.slot, tool, activate=args.activate)
+        _emit(f"Stored {args.name!r} in slot {args.slot}"
+              f"{' (active)' if args.activate else ''} of {lib.path}")
+        return 0
+    if cmd == "activate" and args.slot.strip().lower() in ("none", "0"):
+        lib.activate(None)
+        _emit("No active tool (TCP = flange).")
+        return 0
+    slot = _resolve_slot(lib, args.slot)
+    tool = lib.get(slot)
+    if tool is None:
+        raise CliInputError(f"{lib.path}: slot {slot} is empty; 'tcpcal tools list' shows the "
+                            f"table")
+    if cmd == "show":
+        active = lib.active_slot() == slot
+        _emit(json_dumps(tool_to_dict(tool, slot=slot, active=active)) if args.json
+              else format_tool(tool, slot=slot, active=active))
+    elif cmd == "remove":
+        lib.remove(slot)
+        _emit(f"Removed {tool.name!r} from slot {slot}")
+    elif cmd == "activate":
+        lib.activate(slot)
+        _emit(f"Active tool: slot {slot} {tool.name!r}")
+    elif cmd == "export":
+        from tcpcal.formats import export_tool
+
+        _emit(export_tool(tool, args.fmt, slot=slot))
+    else:  # pragma: no cover - argparse restricts the choices
+        raise AssertionError(cmd)
+    return 0
+
+
+# ----------------------------------------------------------------------------------- main
+def _one_line(text: str) -> str:
+    return " ".join(str(text).split())
+
+
+def _os_error_line(exc: OSError) -> str:
+    name = exc.filename if exc.filename is not None else ""
+    why = exc.strerror or exc.__class__.__name__
+    return f"{name}: cannot read or write the file: {why}" if name else f"{why}: {exc}"
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run ``tcpcal`` with ``argv`` (default ``sys.argv[1:]``); return the exit status.
+
+    0: success. 2: bad input or usage; exactly one line on stderr. 1: internal error (a bug).
+    """
+    parser = build_parser()
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exc:  # --help (0) or a usage error (2): argparse already printed
+        return int(exc.code) if isinstance(exc.code, int) else 2
+    try:
+        if args.command == "solve":
+            return _run_solve(args)
+        if args.command == "convert":
+            return _run_convert(args)
+        if args.command == "tools":
+            return _run_tools(args)
+        raise AssertionError(args.command)  # pragma: no cover
+    except CliInputError as exc:
+        print(f"tcpcal: error: {_one_line(str(exc))}", file=sys.stderr)
+    except TcpcalError as exc:
+        print(f"tcpcal: error: {_one_line(str(exc))}", file=sys.stderr)
+    except OSError as exc:
+        print(f"tcpcal: error: {_one_line(_os_error_line(exc))}", file=sys.stderr)
+    except KeyboardInterrupt:
+        print("tcpcal: interrupted", file=sys.stderr)
+        return 130
+    except Exception as exc:  # noqa: BLE001 - no traceback reaches the user
+        if os.environ.get("TCPCAL_DEBUG"):
+            traceback.print_exc()
+        print(f"tcpcal: internal error: {exc.__class__.__name__}: {_one_line(str(exc))} "
+              f"(a bug; rerun with TCPCAL_DEBUG=1 for the traceback)", file=sys.stderr)
+        return 1
+    return 2
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

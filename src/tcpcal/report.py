@@ -1,0 +1,271 @@
+"""Human-readable reports and JSON objects for the ``tcpcal`` command line.
+
+Lengths are millimetres and angles degrees (the CLI's units); the keys of the JSON objects are
+a documented contract (docs/cli.md, "JSON output"): change them only together with that page.
+Figures that are not defined (e.g. an infinite confidence radius) become JSON ``null``.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Mapping, Sequence
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+if TYPE_CHECKING:  # imported for type hints only; the CLI imports the modules themselves
+    from tcpcal.orientation import OrientationResult
+    from tcpcal.origin import TcpResult
+    from tcpcal.poses_csv import FlangePoses
+    from tcpcal.tool import Tool
+
+__all__ = [
+    "CAVEAT",
+    "METHOD_TITLES",
+    "format_orientation_report",
+    "format_tcp_report",
+    "format_tool",
+    "format_tool_table",
+    "json_dumps",
+    "orientation_result_to_dict",
+    "tcp_result_to_dict",
+    "tool_to_dict",
+]
+
+#: The standing caveat printed under every TCP report.
+CAVEAT = ("Note: a small residual does not prove an accurate TCP. Systematic errors (robot "
+          "calibration, a bent or loose tool, the same misjudgement at every touch) hide in it. "
+          "Check the TCP by rotating the tool about it: the tip must stay on the reference.")
+
+METHOD_TITLES: dict[str, str] = {
+    "lstsq": "XYZ 4-point, joint least squares (4P-3)",
+    "sphere": "XYZ 4-point, sphere fit (4P-1a)",
+    "pairwise": "XYZ 4-point, pairwise differences (4P-2)",
+    "reference": "XYZ reference (REF-1)",
+}
+
+
+def _finite_or_none(x: float) -> float | None:
+    x = float(x)
+    return x if math.isfinite(x) else None
+
+
+def _jsonable(obj: Any) -> Any:
+    """Convert numpy values and non-finite floats (-> ``None``) for strict JSON."""
+    if isinstance(obj, Mapping):
+        return {str(k): _jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, np.ndarray):
+        return _jsonable(obj.tolist())
+    if isinstance(obj, (list, tuple)):
+        return [_jsonable(v) for v in obj]
+    if isinstance(obj, (bool, np.bool_)):
+        return bool(obj)
+    if isinstance(obj, (int, np.integer)):
+        return int(obj)
+    if isinstance(obj, (float, np.floating)):
+        return _finite_or_none(obj)
+    return obj
+
+
+def json_dumps(obj: Any) -> str:
+    """Strict JSON (no NaN/Infinity tokens), indented for reading."""
+    return json.dumps(_jsonable(obj), indent=2, allow_nan=False)
+
+
+def tcp_result_to_dict(result: TcpResult, *, rows: Sequence[int] | None = None) -> dict[str, Any]:
+    """The JSON object of a TCP origin result (``solve xyz4`` and ``solve reference``).
+
+    Args:
+        result: the solver result; lengths in mm because the CLI feeds mm.
+        rows: 0-based input row index of each touch of ``result`` (identity when ``None``);
+            used for the result recomputed without outliers, whose touches are a subset.
+    """
+    n = int(result.n_touches)
+    rows = list(range(n)) if rows is None else list(rows)
+    out: dict[str, Any] = {
+        "method": result.method,
+        "n_touches": n,
+        "rows": rows,
+        "tcp_mm": np.asarray(result.tcp, dtype=float),
+        "reference_mm": np.asarray(result.reference, dtype=float),
+        "residuals_mm": np.asarray(result.residuals, dtype=float),
+        "residual_vectors_mm": np.asarray(result.residual_vectors, dtype=float),
+        "mean_error_mm": result.mean_error,
+        "max_error_mm": result.max_error,
+        "rms_error_mm": result.rms_error,
+        "noise_sigma_mm": result.noise_sigma,
+        "ci95_mm": result.ci95_radius,
+        "covariance_mm2": np.asarray(result.covariance, dtype=float),
+        "max_angle_deg": result.max_angle_deg,
+        "min_angle_deg": result.min_angle_deg,
+        "condition_number": result.condition_number,
+        "outliers": [rows[i] for i in result.outliers],
+        "warnings": list(result.warnings),
+    }
+    sub = result.without_outliers
+    if sub is not None:
+        kept = [r for i, r in enumerate(rows) if i not in set(result.outliers)]
+        out["without_outliers"] = tcp_result_to_dict(sub, rows=kept)
+    else:
+        out["without_outliers"] = None
+    return out
+
+
+def orientation_result_to_dict(result: OrientationResult) -> dict[str, Any]:
+    """The JSON object of a TOOL-orientation result (``solve three-point`` / ``abc-world``)."""
+    return {
+        "method": result.method,
+        "rotation_matrix": np.asarray(result.rotation, dtype=float),
+        "kuka_abc_deg": np.asarray(result.kuka_abc_deg, dtype=float),
+        "orthogonality_defect_deg": result.orthogonality_defect_deg,
+        "displacements_mm": list(result.displacements),
+        "warnings": list(result.warnings),
+    }
+
+
+def _xyz(v: Sequence[float] | np.ndarray, fmt: str = "9.3f") -> str:
+    x, y, z = (float(c) for c in v)
+    return f"X {x:{fmt}}  Y {y:{fmt}}  Z {z:{fmt}}"
+
+
+def _abc(v: Sequence[float] | np.ndarray, fmt: str = "9.3f") -> str:
+    a, b, c = (float(c) for c in v)
+    return f"A {a:{fmt}}  B {b:{fmt}}  C {c:{fmt}}"
+
+
+def _fig(x: float, unit: str = " mm", fmt: str = ".3f") -> str:
+    x = float(x)
+    return f"{x:{fmt}}{unit}" if math.isfinite(x) else "undefined"
+
+
+def _tcp_block(result: TcpResult) -> list[str]:
+    return [
+        f"TCP in FLANGE (mm):       {_xyz(result.tcp)}",
+        f"Reference in WORLD (mm):  {_xyz(result.reference)}",
+        f"Error (mm):               mean {_fig(result.mean_error, '')}   "
+        f"max {_fig(result.max_error, '')}   RMS {_fig(result.rms_error, '')}",
+        f"95 % radius of the TCP:   {_fig(result.ci95_radius)}   "
+        f"(estimated touch noise {_fig(result.noise_sigma)} per axis)",
+        f"Touch orientations:       largest angle {_fig(result.max_angle_deg, ' deg', '.1f')}, "
+        f"smallest {_fig(result.min_angle_deg, ' deg', '.1f')}; "
+        f"condition number {_fig(result.condition_number, '', '.1f')}",
+    ]
+
+
+def format_tcp_report(result: TcpResult, poses: FlangePoses | None = None, *,
+                      command: str = "solve xyz4") -> str:
+    """A short plain-text report of a TCP origin result (lengths in mm, angles in deg).
+
+    Lists the TCP (FLANGE) and reference point (WORLD), mean / max / RMS error, 95 % confidence
+    radius, estimated noise, tilt angles, condition number, per-touch residuals ``|e_i|`` with
+    their components, the outliers and the result without them, warnings and :data:`CAVEAT`.
+    """
+    n = int(result.n_touches)
+    title = METHOD_TITLES.get(result.method, result.method)
+    src = f" from {poses.path} (layout {poses.layout})" if poses is not None else ""
+    lines = [f"tcpcal {command}: {title}, {n} touch{'es' if n != 1 else ''}{src}", ""]
+    lines += _tcp_block(result)
+    lines += ["", "Per-touch residuals e_i = R_i t + f_i - r (mm):",
+              "   row  line      |e|       ex       ey       ez"]
+    outliers = set(result.outliers)
+    for i in range(n):
+        line_no = poses.line_numbers[i] if poses is not None and i < len(poses) else None
+        e = np.asarray(result.residual_vectors[i], dtype=float)
+        mark = "  <- outlier" if i in outliers else ""
+        label = ""
+        if poses is not None and poses.labels is not None and i < len(poses.labels):
+            label = f"  {poses.labels[i]}" if poses.labels[i] else ""
+        lines.append(f"  {i + 1:4d}  {'' if line_no is None else line_no:>4}  "
+                     f"{float(result.residuals[i]):7.3f}  {e[0]:7.3f}  {e[1]:7.3f}  {e[2]:7.3f}"
+                     f"{label}{mark}")
+    lines.append("")
+    if outliers:
+        rows = ", ".join(str(i + 1) for i in sorted(outliers))
+        lines.append(f"Outliers: data row(s) {rows} stand out from the others.")
+        sub = result.without_outliers
+        if sub is not None:
+            lines.append("Result without them:")
+            lines += ["  " + s for s in _tcp_block(sub)]
+    else:
+        lines.append("Outliers: none")
+    if result.warnings:
+        lines.append("Warnings:")
+        lines += [f"  - {w}" for w in result.warnings]
+    else:
+        lines.append("Warnings: none")
+    lines += ["", CAVEAT]
+    return "\n".join(lines)
+
+
+def format_orientation_report(result: OrientationResult, poses: FlangePoses | None = None, *,
+                              command: str, tcp_mm: Sequence[float] | None = None) -> str:
+    """A short plain-text report of a TOOL-orientation result (mm, deg)."""
+    src = f" from {poses.path} (layout {poses.layout})" if poses is not None else ""
+    r = np.asarray(result.rotation, dtype=float)
+    lines = [f"tcpcal {command}: method {result.method}{src}", ""]
+    if tcp_mm is not None:
+        lines.append(f"TCP in FLANGE (mm, given):  {_xyz(tcp_mm)}")
+    lines += [
+        f"TOOL orientation, KUKA (deg): {_abc(result.kuka_abc_deg)}",
+        "R_flange_tool (columns: tool X, Y, Z in FLANGE):",
+        *[f"  [{row[0]:10.6f} {row[1]:10.6f} {row[2]:10.6f}]" for row in r],
+        f"Orthogonality defect:   {_fig(result.orthogonality_defect_deg, ' deg', '.3f')}",
+    ]
+    if len(result.displacements):
+        lines.append("Displacements used:     "
+                     + ", ".join(f"{float(d):.1f} mm" for d in result.displacements)
+                     + "  (longer gives a smaller angular error)")
+    if result.warnings:
+        lines.append("Warnings:")
+        lines += [f"  - {w}" for w in result.warnings]
+    else:
+        lines.append("Warnings: none")
+    return "\n".join(lines)
+
+
+def tool_to_dict(tool: Tool, *, slot: int | None = None, active: bool = False) -> dict[str, Any]:
+    """JSON object of a stored tool (``tcpcal tools list/show --json``)."""
+    d: dict[str, Any] = {"slot": slot, "active": active}
+    d.update(tool.to_dict())
+    d["rotation_matrix"] = np.asarray(tool.rotation, dtype=float)
+    return d
+
+
+def format_tool(tool: Tool, *, slot: int | None = None, active: bool = False) -> str:
+    """Several lines describing one tool (``tcpcal tools show``)."""
+    head = f"Slot {slot}: " if slot is not None else ""
+    lines = [f"{head}{tool.name}{'  (active)' if active else ''}",
+             f"  TCP in FLANGE (mm):     {_xyz(tool.tcp_mm)}",
+             f"  Orientation KUKA (deg): {_abc(tool.abc_deg)}"]
+    if tool.mass_kg is not None:
+        lines.append(f"  Mass: {tool.mass_kg:g} kg")
+    if tool.notes:
+        lines.append(f"  Notes: {tool.notes}")
+    cal = tool.calibration
+    if cal is not None:
+        lines.append(f"  Calibrated: {cal.method} at {cal.calibrated_at}")
+        for k, v in cal.figures.items():
+            lines.append(f"    {k}: {v:g}" if isinstance(v, (int, float)) else f"    {k}: {v}")
+    else:
+        lines.append("  Calibrated: no record")
+    return "\n".join(lines)
+
+
+def format_tool_table(tools: Mapping[int, Tool], active_slot: int | None) -> str:
+    """The tool table (``tcpcal tools list``): one line per used slot, ``*`` marks the active."""
+    if not tools:
+        return "No tools stored."
+    lines = ["  slot  name                        X mm       Y mm       Z mm      A deg     "
+             "B deg     C deg  calibration"]
+    for slot in sorted(tools):
+        t = tools[slot]
+        mark = "*" if slot == active_slot else " "
+        cal = t.calibration.method if t.calibration is not None else "-"
+        x, y, z = t.tcp_mm
+        a, b, c = t.abc_deg
+        lines.append(f"{mark} {slot:4d}  {t.name[:24]:24s} {x:10.3f} {y:10.3f} {z:10.3f} "
+                     f"{a:9.3f} {b:9.3f} {c:9.3f}  {cal}")
+    if active_slot is None:
+        lines.append("No active tool (TCP = flange).")
+    return "\n".join(lines)

@@ -1,0 +1,105 @@
+"""Tests of ``tcpcal tools ...`` and ``tcpcal convert`` on a temporary library path."""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from tcpcal.cli import main
+
+
+def run(argv: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
+    code = main(argv)
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def ok(argv: list[str], capsys: pytest.CaptureFixture[str]) -> str:
+    code, out, err = run(argv, capsys)
+    assert code == 0, err
+    return out
+
+
+def one_error_line(argv: list[str], capsys: pytest.CaptureFixture[str], *words: str) -> str:
+    code, out, err = run(argv, capsys)
+    assert code == 2, (code, out, err)
+    assert err.count("\n") == 1 and "Traceback" not in err, err
+    for w in words:
+        assert re.search(w, err), (w, err)
+    return err
+
+
+def rot_abc(a: float, b: float, c: float) -> np.ndarray:
+    """R = Rz(A) Ry(B) Rx(C), by hand."""
+    a, b, c = np.radians([a, b, c])
+    rz = np.array([[np.cos(a), -np.sin(a), 0], [np.sin(a), np.cos(a), 0], [0, 0, 1]])
+    ry = np.array([[np.cos(b), 0, np.sin(b)], [0, 1, 0], [-np.sin(b), 0, np.cos(b)]])
+    rx = np.array([[1, 0, 0], [0, np.cos(c), -np.sin(c)], [0, np.sin(c), np.cos(c)]])
+    return rz @ ry @ rx
+
+
+def test_tools_lifecycle(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    lib = tmp_path / "lib" / "tools.json"
+    L = ["--library", str(lib)]
+    out = ok(["tools", *L, "list"], capsys)
+    assert "No tools stored" in out
+    ok(["tools", "add", "3", "torch", "--xyz", "12.5,-30.25,180.75", "--abc", "10,-20,30",
+        "--mass", "1.5", "--notes", "MIG torch 22 deg", *L], capsys)
+    ok(["tools", "add", "5", "pointer", "--xyz", "0,0,150", "--activate", *L], capsys)
+    assert lib.exists()
+
+    d = json.loads(ok(["tools", "list", "--json", *L], capsys))
+    assert d["active_slot"] == 5
+    by_slot = {t["slot"]: t for t in d["tools"]}
+    assert set(by_slot) == {3, 5}
+    assert by_slot[3]["name"] == "torch" and by_slot[3]["tcp_mm"] == [12.5, -30.25, 180.75]
+    assert by_slot[3]["abc_deg"] == pytest.approx([10, -20, 30])
+    assert by_slot[3]["mass_kg"] == 1.5 and by_slot[3]["active"] is False
+    np.testing.assert_allclose(by_slot[3]["rotation_matrix"], rot_abc(10, -20, 30), atol=1e-12)
+    assert by_slot[5]["active"] is True
+
+    out = ok(["tools", *L, "list"], capsys)
+    assert re.search(r"^\* +5 +pointer", out, re.M) and re.search(r"^  +3 +torch", out, re.M)
+
+    out = ok(["tools", *L, "show", "torch"], capsys)   # by name
+    assert "Slot 3: torch" in out and "12.500" in out and "-30.250" in out and "1.5 kg" in out
+
+    ok(["tools", *L, "activate", "3"], capsys)
+    assert json.loads(ok(["tools", *L, "show", "3", "--json"], capsys))["active"] is True
+    ok(["tools", *L, "activate", "none"], capsys)
+    assert json.loads(ok(["tools", *L, "list", "--json"], capsys))["active_slot"] is None
+
+    ok(["tools", *L, "remove", "5"], capsys)
+    d = json.loads(ok(["tools", *L, "list", "--json"], capsys))
+    assert [t["slot"] for t in d["tools"]] == [3]
+
+
+def test_tools_errors(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    L = ["--library", str(tmp_path / "tools.json")]
+    ok(["tools", *L, "add", "1", "gripper", "--xyz", "0,0,100"], capsys)
+    one_error_line(["tools", *L, "add", "1", "other", "--xyz", "1,2,3"], capsys,
+                   "slot 1 holds 'gripper'", "--replace")
+    ok(["tools", *L, "add", "1", "other", "--xyz", "1,2,3", "--replace"], capsys)
+    one_error_line(["tools", *L, "show", "2"], capsys, "slot 2 is empty")
+    one_error_line(["tools", *L, "show", "17"], capsys, "out of range 1..16")
+    one_error_line(["tools", *L, "add", "0", "x", "--xyz", "1,2,3"], capsys, "out of range")
+    one_error_line(["tools", *L, "export", "nosuch", "--format", "kuka"], capsys,
+                   "no tool named 'nosuch'")
+    one_error_line(["tools", *L, "add", "2", "bad", "--xyz", "1,2,nan"], capsys, "finite")
+    one_error_line(["tools", *L, "export", "1"], capsys, "--format")
+
+
+def test_tools_corrupt_library_is_reported(tmp_path: Path,
+                                           capsys: pytest.CaptureFixture[str]) -> None:
+    lib = tmp_path / "tools.json"
+    lib.write_text("{ this is not json")
+    code, out, err = run(["tools", "--library", str(lib), "list"], capsys)
+    assert code == 0
+    assert "No tools stored" in out
+    assert err.count("\n") == 1 and "corrupt" in err and "moved aside" in err
+    backups = list(tmp_path.glob("tools.corrupt-*"))
+    assert len(backups) == 1 and backups[0].read_text() == "{ this is not json"
