@@ -21,6 +21,7 @@ ERRORS_ADD_UP = (
     "touches plus the reference tool's own calibration error. Check it, or use the 4-point "
     "method for a tool that matters."
 )
+"""Said in the result's warnings unless tcpcal already says that the errors add up."""
 
 
 class ReferenceWizard(Wizard):
@@ -32,14 +33,20 @@ class ReferenceWizard(Wizard):
             the app mounts it for step 1 (None: whatever is mounted).
         new_tool_key: physical tool to calibrate; the app mounts it for step 2.
         new_tool_label: how the instructions call the new tool (default: its key).
+        assumed_sigma_mm: operator touch error per axis assumed for the 95 % radius (one touch
+            per tool leaves no residual to estimate it from); None: no radius.
     """
 
     kind: ClassVar[str] = "reference"
     title: ClassVar[str] = "XYZ reference"
 
     def __init__(self, reference_tool: Tool, *, reference_tool_key: str | None = None,
-                 new_tool_key: str | None = None, new_tool_label: str | None = None) -> None:
+                 new_tool_key: str | None = None, new_tool_label: str | None = None,
+                 assumed_sigma_mm: float | None = 0.5) -> None:
         super().__init__()
+        if assumed_sigma_mm is not None and not (np.isfinite(assumed_sigma_mm) and assumed_sigma_mm > 0):
+            raise WizardError(f"assumed_sigma_mm must be a positive number of mm or None, got {assumed_sigma_mm}.")
+        self.assumed_sigma_mm = None if assumed_sigma_mm is None else float(assumed_sigma_mm)
         if not isinstance(reference_tool, Tool):
             raise WizardError("Pick the calibrated reference tool from the tool library "
                               f"(a tcpcal Tool), got {type(reference_tool).__name__}.")
@@ -75,8 +82,10 @@ class ReferenceWizard(Wizard):
         T1, T2 = poses
         res = solve_reference(np.asarray(self.reference_tool.tcp_mm, dtype=float),
                               T1[:3, :3], T1[:3, 3] * 1000.0,   # metres -> mm for tcpcal
-                              T2[:3, :3], T2[:3, 3] * 1000.0)
-        warnings = list(res.warnings) + [ERRORS_ADD_UP]
+                              T2[:3, :3], T2[:3, 3] * 1000.0, sigma=self.assumed_sigma_mm)
+        warnings = list(res.warnings)
+        if not any("sum of" in w or "add up" in w for w in warnings):
+            warnings.append(ERRORS_ADD_UP)
         cal = self.reference_tool.calibration
         if cal is None:
             warnings.append(f"The reference tool '{self.reference_tool.name}' has no calibration "
@@ -91,6 +100,9 @@ class ReferenceWizard(Wizard):
             rms_error_mm=float(res.rms_error),
             ci95_mm=float(res.ci95_radius) if np.isfinite(res.ci95_radius) else None,
             warnings=tuple(warnings),
+            notes=(() if self.assumed_sigma_mm is None else
+                   (f"The 95 % radius is predicted from an assumed touch error of "
+                    f"{self.assumed_sigma_mm:g} mm per axis, not measured.",)),
         )
 
     def to_tool(self, name: str) -> Tool:
@@ -101,11 +113,13 @@ class ReferenceWizard(Wizard):
     def _params(self) -> dict[str, Any]:
         return {"reference_tool": self.reference_tool.to_dict(),
                 "reference_tool_key": self.reference_tool_key,
-                "new_tool_key": self.new_tool_key, "new_tool_label": self.new_tool_label}
+                "new_tool_key": self.new_tool_key, "new_tool_label": self.new_tool_label,
+                "assumed_sigma_mm": self.assumed_sigma_mm}
 
     @classmethod
     def _from_params(cls, params: Mapping[str, Any]) -> "ReferenceWizard":
         return cls(Tool.from_dict(params["reference_tool"]),
                    reference_tool_key=params.get("reference_tool_key"),
                    new_tool_key=params.get("new_tool_key"),
-                   new_tool_label=params.get("new_tool_label"))
+                   new_tool_label=params.get("new_tool_label"),
+                   assumed_sigma_mm=params.get("assumed_sigma_mm", 0.5))
