@@ -64,11 +64,14 @@ def abc_deg_from_rotation(rotation: np.ndarray) -> np.ndarray:
     """Rotation matrix to KUKA A, B, C in degrees (inverse of :func:`rotation_from_abc_deg`).
 
     At B = +-90 deg (gimbal lock) only A - C (or A + C) is defined; scipy then sets C = 0,
-    which represents the same rotation. Its gimbal-lock warning is silenced here.
+    which represents the same rotation. Its gimbal-lock warning is silenced here. The angles
+    are rounded to 12 decimals (changes the rotation by < 1e-14 rad) so that e.g. -90 deg does
+    not read -89.99999999999999.
     """
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)
-        return Rotation.from_matrix(rotation).as_euler("ZYX", degrees=True)
+        abc = Rotation.from_matrix(rotation).as_euler("ZYX", degrees=True)
+    return np.round(abc, 12) + 0.0  # + 0.0 turns -0.0 into 0.0
 
 
 def _finite_float(value: Any, what: str) -> float:
