@@ -20,13 +20,13 @@ from pathlib import Path
 from typing import Any, NoReturn
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from tcpcal.errors import DegenerateTouchesError, TcpcalError
 from tcpcal.poses_csv import FlangePoses, accepted_layouts_text, read_poses_csv
 from tcpcal.report import (format_orientation_report, format_tcp_report, format_tool,
                            format_tool_table, json_dumps, orientation_result_to_dict,
                            tcp_result_to_dict, tool_to_dict)
+from tcpcal.tool import rotation_from_abc_deg
 
 __all__ = ["main", "build_parser", "CliInputError"]
 
@@ -212,11 +212,13 @@ def _solver_error(exc: TcpcalError, poses: FlangePoses, rows: Sequence[int] | No
     if isinstance(exc, DegenerateTouchesError):
         axis = getattr(exc, "unobservable_axis", None)
         if axis is not None:
-            u = np.asarray(axis, dtype=float)
+            u = np.asarray(axis, dtype=float) + 0.0  # + 0.0: no "-0.000"
             k = int(np.argmax(np.abs(u)))
-            near = f"~ flange {'-' if u[k] < 0 else '+'}{'XYZ'[k]}" if abs(u[k]) > 0.9 else ""
-            msg += (f" [unobservable direction in FLANGE: ({u[0]:.3f}, {u[1]:.3f}, {u[2]:.3f})"
-                    f"{' ' + near if near else ''}]")
+            if abs(u[k]) > 0.9:
+                msg += f" [unobservable direction ~ flange {'XYZ'[k]} axis]"
+            else:
+                msg += (f" [unobservable direction in FLANGE: ({u[0]:.3f}, {u[1]:.3f}, "
+                        f"{u[2]:.3f})]")
     return f"{where}: {msg}"
 
 
@@ -277,8 +279,8 @@ def _run_solve(args: argparse.Namespace) -> int:
                                "flange pose at alignment)")
         if args.current_abc is not None and args.variant != "5d":
             raise CliInputError("--current-abc applies only to --variant 5d")
-        current = (None if args.current_abc is None else
-                   Rotation.from_euler("ZYX", args.current_abc, degrees=True).as_matrix())
+        current = (None if args.current_abc is None
+                   else rotation_from_abc_deg(args.current_abc))
         try:
             ores = solve_abc_world(poses.rotations[0], variant=args.variant,
                                    current_rotation=current)
@@ -299,39 +301,22 @@ def _with_source(out: dict[str, Any], poses: FlangePoses) -> str:
 
 
 # ---------------------------------------------------------------------------- convert path
-def _tool_from_values(values: Sequence[float], fmt: str, name: str) -> Any:
-    """Tool from the bare numbers of ``convert --from FMT`` (conventions of methods.md s. 6)."""
-    from tcpcal.tool import Tool
-
-    v = np.asarray(values, dtype=float)
-    if fmt == "kuka":
-        return Tool(name=name, tcp_mm=tuple(v[:3]), abc_deg=tuple(v[3:6]))
-    if fmt == "fanuc":
-        rot = Rotation.from_euler("xyz", v[3:6], degrees=True)
-        return Tool.from_rotation(name, tuple(v[:3]), rot.as_matrix())
-    if fmt == "ur":
-        rot = Rotation.from_rotvec(v[3:6])
-        return Tool.from_rotation(name, tuple(v[:3] * 1000.0), rot.as_matrix())
-    if fmt == "abb":
-        q = v[3:7]
-        norm = float(np.linalg.norm(q))
-        if abs(norm - 1.0) > 1e-6:
-            raise CliInputError(f"convert --from abb: quaternion q1..q4 has norm {norm:.9g}, not "
-                                f"1 within 1e-6; check the order (q1 = scalar) and the digits")
-        return Tool.from_rotation(name, tuple(v[:3]),
-                                  Rotation.from_quat(q, scalar_first=True).as_matrix())
-    if fmt == "matrix":
-        m = v.reshape(-1, 4)
-        if m.shape[0] == 4 and not np.allclose(m[3], [0, 0, 0, 1], atol=1e-9):
-            raise CliInputError("convert --from matrix: the last row of the 4x4 matrix must be "
-                                "0,0,0,1")
-        r = m[:3, :3]
-        defect = float(np.max(np.abs(r.T @ r - np.eye(3))))
-        if defect > 1e-6 or np.linalg.det(r) < 0:
-            raise CliInputError(f"convert --from matrix: the 3x3 block is not a rotation within "
-                                f"1e-6 (max |R^T R - I| = {defect:.3g}, det = "
-                                f"{np.linalg.det(r):.6g}); give the 4x4 matrix row-major")
-        return Tool.from_rotation(name, tuple(m[:3, 3]), Rotation.from_matrix(r).as_matrix())
+def _values_as_controller_text(values: Sequence[float], fmt: str) -> str:
+    """The bare numbers of ``convert --from FMT`` written in FMT's own syntax, so that
+    :func:`tcpcal.formats.import_tool` alone interprets them (one place for the conventions of
+    methods.md section 6)."""
+    v = [repr(float(x)) for x in values]
+    if fmt == "kuka":    # X, Y, Z mm; A, B, C deg
+        return "TOOL_DATA[1]={" + ",".join(f"{k} {x}" for k, x in zip("XYZABC", v)) + "}"
+    if fmt == "fanuc":   # X, Y, Z mm; W, P, R deg
+        return " ".join(f"{k}: {x}" for k, x in zip("XYZWPR", v))
+    if fmt == "abb":     # x, y, z mm; q1..q4 (q1 scalar); unknown load as ABB's tool0
+        return (f"[TRUE,[[{v[0]},{v[1]},{v[2]}],[{','.join(v[3:7])}]],"
+                f"[0.001,[0,0,0.001],[1,0,0,0],0,0,0]]")
+    if fmt == "ur":      # x, y, z m; rx, ry, rz rad
+        return "p[" + ",".join(v) + "]"
+    if fmt == "matrix":  # 16 (or 12) numbers row-major, mm
+        return " ".join(v)
     raise AssertionError(fmt)  # pragma: no cover
 
 
@@ -343,12 +328,11 @@ def _run_convert(args: argparse.Namespace) -> int:
     else:
         raw = " ".join(args.values)
     tokens = [t for t in re.split(r"[,\s]+", raw.strip()) if t]
-    numbers: list[float] | None
     try:
-        numbers = [float(t) for t in tokens]
+        numbers: list[float] | None = [float(t) for t in tokens] if tokens else None
     except ValueError:
         numbers = None
-    if numbers is not None and tokens:
+    if numbers is not None:
         counts = VALUE_COUNTS[args.from_fmt]
         if len(numbers) not in counts:
             raise CliInputError(f"convert --from {args.from_fmt}: {len(numbers)} numbers given, "
@@ -357,13 +341,11 @@ def _run_convert(args: argparse.Namespace) -> int:
         if not all(np.isfinite(numbers)):
             raise CliInputError(f"convert --from {args.from_fmt}: the values must be finite "
                                 f"numbers")
-        tool = _tool_from_values(numbers, args.from_fmt, args.name)
-    else:
-        try:
-            tool = import_tool(raw, args.from_fmt, name=args.name)
-        except TcpcalError as exc:
-            raise CliInputError(f"convert --from {args.from_fmt}: "
-                                f"{' '.join(str(exc).split())}") from None
+        raw = _values_as_controller_text(numbers, args.from_fmt)
+    try:
+        tool = import_tool(raw, args.from_fmt, name=args.name)
+    except TcpcalError as exc:
+        raise CliInputError(f"convert: {' '.join(str(exc).split())}") from None
     text = export_tool(tool, args.to_fmt, slot=args.slot)
     if args.json:
         _emit(json_dumps({"from": args.from_fmt, "to": args.to_fmt, "text": text,

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import math
+import textwrap
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
@@ -194,7 +195,7 @@ def format_tcp_report(result: TcpResult, poses: FlangePoses | None = None, *,
         lines += [f"  - {w}" for w in result.warnings]
     else:
         lines.append("Warnings: none")
-    lines += ["", CAVEAT]
+    lines += ["", *textwrap.wrap(CAVEAT, width=92)]
     return "\n".join(lines)
 
 

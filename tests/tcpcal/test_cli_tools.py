@@ -103,3 +103,81 @@ def test_tools_corrupt_library_is_reported(tmp_path: Path,
     assert err.count("\n") == 1 and "corrupt" in err and "moved aside" in err
     backups = list(tmp_path.glob("tools.corrupt-*"))
     assert len(backups) == 1 and backups[0].read_text() == "{ this is not json"
+
+
+# ---------------------------------------------------------------------------------- convert
+def test_convert_kuka_numbers_to_abb(capsys: pytest.CaptureFixture[str]) -> None:
+    d = json.loads(ok(["convert", "--from", "kuka", "--to", "abb", "10,20,30,0,-90,0",
+                       "--json"], capsys))
+    np.testing.assert_allclose(d["rotation_matrix"], rot_abc(0, -90, 0), atol=1e-12)
+    assert d["tcp_mm"] == [10, 20, 30]
+    # Ry(-90 deg) as a unit quaternion, scalar first: (cos -45 deg, 0, sin -45 deg, 0)
+    quat = re.search(r"\[\[10(?:\.0)?,20(?:\.0)?,30(?:\.0)?\],\[([^\]]+)\]\]", d["text"])
+    assert quat, d["text"]
+    np.testing.assert_allclose([float(v) for v in quat.group(1).split(",")],
+                               [np.sqrt(0.5), 0, -np.sqrt(0.5), 0], atol=1e-12)
+    # the plain output is the same text
+    assert ok(["convert", "--from", "kuka", "--to", "abb", "10,20,30,0,-90,0"], capsys) \
+        .strip() == d["text"].strip()
+
+
+def test_convert_fanuc_ur_and_matrix_numbers(capsys: pytest.CaptureFixture[str]) -> None:
+    # FANUC W = 90 deg about fixed X is KUKA C = 90 deg; negative first value is not an option
+    d = json.loads(ok(["convert", "--from", "fanuc", "--to", "kuka", "-10,20,30,90,0,0",
+                       "--json"], capsys))
+    assert d["tcp_mm"] == [-10, 20, 30]
+    np.testing.assert_allclose(d["kuka_abc_deg"], [0, 0, 90], atol=1e-9)
+    assert "TOOL_DATA[1]" in d["text"]
+    # UR: metres and a rotation vector in rad (here 90 deg about Z), space-separated values
+    d = json.loads(ok(["convert", "--from", "ur", "--to", "kuka", "0.01", "0.02", "-0.03", "0",
+                       "0", str(np.pi / 2), "--json"], capsys))
+    np.testing.assert_allclose(d["tcp_mm"], [10, 20, -30], atol=1e-12)
+    np.testing.assert_allclose(d["rotation_matrix"], rot_abc(90, 0, 0), atol=1e-12)
+    # matrix: 16 numbers row-major
+    T = np.eye(4)
+    T[:3, :3] = rot_abc(30, 20, 10)
+    T[:3, 3] = [1, 2, 3]
+    d = json.loads(ok(["convert", "--from", "matrix", "--to", "kuka",
+                       ",".join(repr(float(v)) for v in T.reshape(-1)), "--json"], capsys))
+    np.testing.assert_allclose(d["kuka_abc_deg"], [30, 20, 10], atol=1e-9)
+
+
+def test_convert_controller_text_and_stdin(capsys: pytest.CaptureFixture[str],
+                                           monkeypatch: pytest.MonkeyPatch) -> None:
+    text = 'TOOL_DATA[4]={X 12.5,Y -3,Z 180.25,A 0,B 90,C 0}'
+    d = json.loads(ok(["convert", "--from", "kuka", "--to", "matrix", text, "--json"], capsys))
+    np.testing.assert_allclose(d["tcp_mm"], [12.5, -3, 180.25])
+    np.testing.assert_allclose(d["rotation_matrix"], rot_abc(0, 90, 0), atol=1e-12)
+    rows = [[float(v) for v in ln.split()] for ln in d["text"].strip().splitlines()]
+    np.testing.assert_allclose(np.array(rows)[:3, :3], rot_abc(0, 90, 0), atol=1e-12)
+    # the matrix text read back from stdin gives the KUKA values again
+    import io
+    monkeypatch.setattr("sys.stdin", io.StringIO(d["text"]))
+    back = json.loads(ok(["convert", "--from", "matrix", "--to", "kuka", "-", "--json"], capsys))
+    np.testing.assert_allclose(back["tcp_mm"], [12.5, -3, 180.25], atol=1e-9)
+    np.testing.assert_allclose(back["kuka_abc_deg"], [0, 90, 0], atol=1e-9)
+
+
+def test_convert_errors(capsys: pytest.CaptureFixture[str]) -> None:
+    one_error_line(["convert", "--from", "kuka", "--to", "abb", "1,2,3"], capsys,
+                   "3 numbers given, 6 expected")
+    one_error_line(["convert", "--from", "abb", "--to", "kuka", "1,2,3,0.5,0.5,0.5,0.1"],
+                   capsys, "norm")
+    one_error_line(["convert", "--from", "kuka", "--to", "abb", "TOOL_DATA[1]={X_1}"], capsys,
+                   "convert: kuka")
+    one_error_line(["convert", "--from", "kuka", "--to", "abb", "1,2,3,nan,0,0"], capsys,
+                   "finite")
+    one_error_line(["convert", "--from", "kuka", "--to", "cnc", "1,2,3,0,0,0"], capsys,
+                   "invalid choice")
+
+
+def test_tools_export_reads_back(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    L = ["--library", str(tmp_path / "t.json")]
+    ok(["tools", *L, "add", "7", "spindle", "--xyz", "1.5,-2,250", "--abc", "0,-90,0"], capsys)
+    for fmt in ("kuka", "abb", "fanuc", "ur", "matrix"):
+        text = ok(["tools", *L, "export", "spindle", "--format", fmt], capsys)
+        if fmt == "kuka":
+            assert text.startswith("TOOL_DATA[7]=")
+        back = json.loads(ok(["convert", "--from", fmt, "--to", "kuka", text, "--json"], capsys))
+        np.testing.assert_allclose(back["tcp_mm"], [1.5, -2, 250], atol=1e-9)
+        np.testing.assert_allclose(back["rotation_matrix"], rot_abc(0, -90, 0), atol=1e-9)
