@@ -233,16 +233,20 @@ class Xyz4Wizard(Wizard):
                 if i != self._index or self.is_complete]
         return np.array(rots, dtype=float).reshape(-1, 3, 3)
 
-    def preview(self, T_world_flange_m: Any, *, min_angle_deg: float = 15.0) -> CandidateGain:
+    def preview(self, T_world_flange_m: Any, *, min_angle_deg: float = 15.0) -> CandidateGain | None:
         """Predicted TCP uncertainty if the current pose were recorded (tcpcal.candidate_gain).
 
         Compares the candidate flange orientation with the touches recorded so far (except the
         current step's own, which a new recording would replace), for an operator error of
         ``assumed_sigma_mm`` per axis. Figures in mm; ``too_close`` flags an orientation within
-        ``min_angle_deg`` of an earlier one.
+        ``min_angle_deg`` of an earlier one. None while there is no earlier touch to compare
+        with (the first touch can be anywhere).
         """
         T = check_pose_m(T_world_flange_m, what="candidate flange pose")
-        return candidate_gain(self._other_rotations(), T[:3, :3], sigma=self.assumed_sigma_mm,
+        others = self._other_rotations()
+        if len(others) == 0:
+            return None
+        return candidate_gain(others, T[:3, :3], sigma=self.assumed_sigma_mm,
                               min_angle_deg=min_angle_deg)
 
     def quality(self) -> PoseQuality | None:
