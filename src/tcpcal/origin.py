@@ -1,0 +1,550 @@
+"""TCP origin: the XYZ 4-point method and the XYZ reference method (methods.md sections 2-3).
+
+Unit-agnostic: lengths come out in the unit the positions went in (the CLI uses mm). Angles
+are reported in degrees (``*_deg``).
+
+Touch ``i`` is the flange pose ``(R_i, f_i)`` = (``R_world_flange``, ``p_world_flange``)
+recorded while the tool tip touches the fixed reference point ``r`` (WORLD). The unknown TCP
+``t`` is in FLANGE coordinates::
+
+    R_i t + f_i = r                                                   (4P-1)
+
+A small residual does not prove an accurate TCP: systematic errors (robot calibration, a
+reference that moved, a tool that bends) are consistent across touches and hide in ``t``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+from scipy.special import chdtrc, fdtrc
+
+from tcpcal._stats import (
+    SAME_ORIENTATION_DEG,
+    AngleExtremes,
+    Information,
+    angle_between,
+    angle_extremes,
+    ci_radius,
+    duplicate_orientations,
+    fmt_vec,
+    information,
+)
+from tcpcal.errors import DegenerateTouchesError, InvalidInputError
+from tcpcal.validation import as_positions, as_rotation, as_rotations, as_vector3
+
+__all__ = ["TcpResult", "solve_xyz4", "solve_reference", "METHODS"]
+
+Method = Literal["lstsq", "sphere", "pairwise"]
+METHODS: tuple[str, ...] = ("lstsq", "sphere", "pairwise")
+
+MIN_TOUCHES = 4
+OUTLIER_ALPHA = 0.01
+"""Family-wise false-alarm probability of the outlier test on a clean set (Bonferroni over the
+touches, at each deletion step)."""
+SMALL_TILT_DEG = 20.0
+"""Warn when the largest angle between two touch orientations is below this."""
+NEAR_DUPLICATE_DEG = 5.0
+"""Warn when two touch orientations are closer than this."""
+WEAK_AXIS_RATIO = 5.0
+"""Warn when the TCP standard deviation along the weakest flange direction exceeds that along
+the strongest by this factor."""
+COPLANAR_RATIO = 0.2
+"""Sphere fit: warn when the flange positions' thickness / extent is below this."""
+_EXACT_REL = 1e-9
+"""Residual noise below this fraction of the data scale counts as exact data (no outlier test)."""
+
+
+def _frozen(a: np.ndarray) -> np.ndarray:
+    a = np.array(a, dtype=float)
+    a.setflags(write=False)
+    return a
+
+
+@dataclass(frozen=True)
+class TcpResult:
+    """Result of a TCP origin calibration (methods.md sections 2-3).
+
+    Lengths are in the unit of the input positions; angles in degrees.
+
+    Attributes:
+        method: ``"lstsq"`` (4P-3), ``"sphere"`` (2a), ``"pairwise"`` (4P-2) or
+            ``"reference"`` (REF-1).
+        tcp: (3,) TCP ``t`` in FLANGE coordinates.
+        reference: (3,) reference point ``r`` in WORLD coordinates.
+        residual_vectors: (N, 3) ``e_i = R_i t + f_i - r`` (WORLD).
+        residuals: (N,) ``|e_i|``.
+        mean_error: mean of ``|e_i|``.
+        max_error: max of ``|e_i|``.
+        rms_error: ``sqrt(mean |e_i|^2)`` (root mean square of the residual lengths; not
+            the mean).
+        noise_sigma: per-axis touch noise: the estimate ``s = sqrt(sum |e_i|^2 / (3N - 6))``,
+            or the ``sigma`` given by the caller (NaN for the reference method without sigma).
+        covariance: (3, 3) covariance of ``tcp`` (``noise_sigma^2 (A^T A)^-1`` restricted to
+            ``t`` for lstsq; the first-order propagation of the touch noise for the others).
+        ci95_radius: radius of the sphere about ``tcp`` that contains the true TCP with 95 %
+            probability under ``covariance`` (with the 3N - 6 degrees of freedom of ``s``
+            when sigma was estimated).
+        max_angle_deg: largest rotation angle between two touch orientations.
+        min_angle_deg: smallest rotation angle between two touch orientations.
+        condition_number: of the stacked (4P-3) matrix ``A`` (3N x 6).
+        outliers: 0-based indices of touches flagged as outliers.
+        without_outliers: the same method on the other touches (indices renumbered in
+            order), or None if no touch was flagged.
+        warnings: plain-words remarks on the data.
+        n_touches: N.
+    """
+
+    method: str
+    tcp: np.ndarray
+    reference: np.ndarray
+    residual_vectors: np.ndarray
+    residuals: np.ndarray
+    mean_error: float
+    max_error: float
+    rms_error: float
+    noise_sigma: float
+    covariance: np.ndarray
+    ci95_radius: float
+    max_angle_deg: float
+    min_angle_deg: float
+    condition_number: float
+    outliers: tuple[int, ...]
+    without_outliers: TcpResult | None
+    warnings: tuple[str, ...]
+    n_touches: int
+
+
+def _check_sigma(sigma: float | None) -> float | None:
+    if sigma is None:
+        return None
+    try:
+        s = float(sigma)
+    except (TypeError, ValueError):
+        raise InvalidInputError(f"sigma must be a number (touch noise per axis), got {sigma!r}.") from None
+    if not (math.isfinite(s) and s > 0.0):
+        raise InvalidInputError(
+            f"sigma must be a finite positive number (touch noise per axis), got {sigma!r}; "
+            "omit it to estimate the noise from the residuals."
+        )
+    return s
+
+
+def _check_observable(rotations: np.ndarray, info: Information, ext: AngleExtremes) -> None:
+    """Raise DegenerateTouchesError when the touches cannot determine the TCP."""
+    n = rotations.shape[0]
+    if ext.max_deg < SAME_ORIENTATION_DEG:
+        raise DegenerateTouchesError(
+            f"all {n} touches have the same orientation (at most {ext.max_deg:.2f} deg apart), so "
+            "the TCP cannot be determined; the 4-point method needs clearly different "
+            "orientations: tilt the tool 30-60 deg between touches, about two different axes.",
+            unobservable_axis=None,
+        )
+    if not info.observable:
+        axis = info.weakest_axis
+        raise DegenerateTouchesError(
+            f"all touches rotate about nearly the same axis (flange {fmt_vec(axis)}), so the TCP "
+            "along that axis cannot be determined; tilt the tool about a second axis "
+            f"(spread about it: {math.degrees(info.weakest_tilt_rad):.3f} deg).",
+            unobservable_axis=axis,
+        )
+    if ext.min_deg < SAME_ORIENTATION_DEG:
+        dups = duplicate_orientations(rotations)
+        distinct = n - len(dups)
+        if distinct < MIN_TOUCHES:
+            i, j = dups[0]
+            raise DegenerateTouchesError(
+                f"touches {i} and {j} (0-based) have the same orientation "
+                f"({math.degrees(angle_between(rotations[i], rotations[j])):.2f} deg apart): "
+                f"only {distinct} clearly different orientations among {n} touches, the "
+                f"4-point method needs at least {MIN_TOUCHES}; re-record touch {j} from a "
+                "different orientation.",
+                index=j,
+            )
+
+
+def _lstsq_core(info: Information, rotations: np.ndarray, f: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Joint least squares (4P-3) through the reduced normal equations.
+
+    With ``d_i = f_i - fbar``: ``M t = -sum_i (R_i - Rbar)^T d_i = -sum_i R_i^T d_i`` (as
+    ``sum d_i = 0``), ``r = Rbar t + fbar`` (second block row), ``e_i = R_i t + f_i - r``.
+    The sums are single BLAS products over the (3N, 3) stack of rotation rows.
+    Returns ``(t, r, e)``.
+    """
+    n = rotations.shape[0]
+    fbar = f.sum(axis=0) / n
+    dd = f - fbar
+    rows = rotations.reshape(3 * n, 3)
+    t = info.m_inv() @ -(dd.reshape(3 * n) @ rows)
+    r = info.rbar @ t + fbar
+    e = (rows @ t).reshape(n, 3) + (f - r)
+    return t, r, e
+
+
+def _pairwise_core(rotations: np.ndarray, f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Pairwise differences (4P-2) over the N - 1 consecutive pairs ``(a, a+1)``.
+
+    Stacks ``(R_a - R_{a+1}) t = -(f_a - f_{a+1})`` and solves with the pseudo-inverse
+    (``numpy.linalg.lstsq``). Returns ``(t, cov_unit)`` with ``cov_unit`` the covariance of
+    ``t`` per unit touch variance: ``t - t_true = -G^-1 sum_i K_i^T eps_i`` with
+    ``G = sum D_a^T D_a`` and ``K_i = D_i - D_{i-1}`` (pairs that contain touch i).
+    """
+    n = rotations.shape[0]
+    dr = rotations[:-1] - rotations[1:]
+    y = -(f[:-1] - f[1:])
+    t, *_ = np.linalg.lstsq(dr.reshape(3 * (n - 1), 3), y.reshape(-1), rcond=None)
+    g_inv = np.linalg.inv(np.einsum("aki,akj->ij", dr, dr))
+    k = np.zeros_like(rotations)
+    k[:-1] += dr
+    k[1:] -= dr
+    inner = np.einsum("nki,nkj->ij", k, k)
+    return t, g_inv @ inner @ g_inv
+
+
+def _sphere_core(rotations: np.ndarray, f: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
+    """Best-fit sphere (methods.md 2a).
+
+    ``|d_i|^2 = 2 d_i . r' + k`` (``d_i = f_i - fbar``, ``r = fbar + r'``) by linear least
+    squares, then ``t = mean_i R_i^T (r - f_i)``. The covariance per unit touch variance is the
+    first-order propagation: ``dr = P_r [2 (f_i - r) . df_i]_i`` (``P_r`` the first three rows of
+    the pseudo-inverse of ``[2 d_i, 1]``), ``dt = Rbar^T dr - (1/N) sum R_i^T df_i``. It ignores
+    the sphere fit's bias (methods.md section 7). Returns ``(t, cov_unit, flatness)`` with
+    ``flatness`` = smallest / largest singular value of the centred flange positions.
+    """
+    n = rotations.shape[0]
+    fbar = f.mean(axis=0)
+    dd = f - fbar
+    sv = np.linalg.svd(dd, compute_uv=False)
+    flatness = float(sv[-1] / sv[0]) if sv[0] > 0 else 0.0
+    if flatness < 1e-6:
+        raise DegenerateTouchesError(
+            "the flange positions are coplanar, so the sphere fit cannot locate the reference "
+            f"(thickness / extent = {flatness:.2g}); use method 'lstsq', or touch from "
+            "orientations that move the flange out of that plane.",
+            unobservable_axis=None,
+        )
+    h = np.empty((n, 4))
+    h[:, :3] = 2.0 * dd
+    h[:, 3] = 1.0
+    h_pinv = np.linalg.pinv(h)
+    z = h_pinv @ np.einsum("ni,ni->n", dd, dd)
+    r = fbar + z[:3]
+    t = np.einsum("nki,nk->i", rotations, r - f) / n
+    rbar = rotations.mean(axis=0)
+    # J_i = Rbar^T outer(P_r[:, i], 2 (f_i - r)) - R_i^T / N
+    jac = np.einsum("ki,kn,nj->nij", rbar, h_pinv[:3], 2.0 * (f - r)) - rotations.transpose(0, 2, 1) / n
+    cov_unit = np.einsum("nij,nkj->ik", jac, jac)
+    return t, cov_unit, flatness
+
+
+def _find_outliers(rotations: np.ndarray, f: np.ndarray) -> list[int]:
+    """Touches whose residual stands out, by sequential deletion.
+
+    For the linear model (4P-3) the hat-matrix block of touch i is
+    ``H_ii = I/N + D_i M^-1 D_i^T``; the deleted (leave-one-out) statistic
+    ``Q_i = e_i^T (I - H_ii)^-1 e_i`` and ``s_(i)^2 = (SSE - Q_i) / (3N - 9)`` give
+    ``T_i = Q_i / (3 s_(i)^2) ~ F(3, 3N - 9)`` for a clean touch under Gaussian noise
+    (externally studentised residual of a 3-row block). The touch with the largest ``T_i`` is
+    flagged if its p-value is below ``OUTLIER_ALPHA / N`` (Bonferroni), removed, and the test
+    repeated, as long as at least 4 touches would remain. Touches with ``det(I - H_ii) ~ 0``
+    (without them the rest is degenerate) cannot be tested.
+    """
+    idx = np.arange(rotations.shape[0])
+    flagged: list[int] = []
+    eye = np.eye(3)
+    while idx.size > MIN_TOUCHES:
+        rot = rotations[idx]
+        ff = f[idx]
+        n = idx.size
+        info = information(rot)
+        if not info.observable:
+            break
+        t, _, e = _lstsq_core(info, rot, ff)
+        sse = float(np.einsum("ni,ni->", e, e))
+        scale = max(float(np.abs(ff - ff.mean(axis=0)).max()), float(np.linalg.norm(t)), 1e-300)
+        if sse <= (_EXACT_REL * scale) ** 2 * (3 * n - 6):
+            break
+        d = rot - info.rbar
+        hmat = eye / n + d @ info.m_inv() @ d.transpose(0, 2, 1)
+        b = eye - hmat
+        # Inverse of the symmetric 3x3 blocks by cross products: adj rows are b1xb2, b2xb0, b0xb1.
+        c0 = np.cross(b[:, 1], b[:, 2])
+        c1 = np.cross(b[:, 2], b[:, 0])
+        c2 = np.cross(b[:, 0], b[:, 1])
+        det = np.einsum("ni,ni->n", b[:, 0], c0)
+        adj_e = np.stack(
+            [np.einsum("ni,ni->n", c0, e), np.einsum("ni,ni->n", c1, e), np.einsum("ni,ni->n", c2, e)],
+            axis=1,
+        )
+        testable = det > 1e-9
+        q = np.where(testable, np.einsum("ni,ni->n", e, adj_e) / np.where(testable, det, 1.0), 0.0)
+        dof = 3 * n - 9
+        s2 = (sse - q) / dof
+        tstat = np.where(testable & (s2 > 0), q / (3.0 * np.maximum(s2, 1e-300)), 0.0)
+        k = int(np.argmax(tstat))
+        p = float(fdtrc(3, dof, tstat[k]))
+        if p * n >= OUTLIER_ALPHA:
+            break
+        flagged.append(int(idx[k]))
+        idx = np.delete(idx, k)
+    return sorted(flagged)
+
+
+def _fmt_idx(indices: list[int] | tuple[int, ...]) -> str:
+    return ", ".join(str(i) for i in indices)
+
+
+def solve_xyz4(
+    rotations: np.ndarray,
+    positions: np.ndarray,
+    *,
+    method: Method = "lstsq",
+    sigma: float | None = None,
+    detect_outliers: bool = True,
+) -> TcpResult:
+    """XYZ 4-point method: the TCP from N >= 4 touches of one reference point (4P-1).
+
+    Estimators (methods.md section 2):
+
+    - ``"lstsq"`` (default, (4P-3)): joint linear least squares for ``x = (t, r)``, solved
+      through the normal equations reduced to sums over the touches
+      (``A^T A = [[N I, -S^T], [-S, N I]]``, ``S = sum R_i``; eliminating ``r`` leaves the 3x3
+      system ``M t = -sum D_i^T d_i``, ``M = sum D_i^T D_i``, ``D_i = R_i - Rbar``,
+      ``d_i = f_i - fbar``). O(N), the 3N x 6 matrix is never formed. It is the
+      maximum-likelihood estimate under isotropic Gaussian touch noise and reaches the
+      Cramer-Rao bound ``sigma^2 M^-1`` (methods.md section 7).
+    - ``"pairwise"`` ((4P-2)): the N - 1 **consecutive** pairs ``(a, a+1)`` stacked and solved
+      with the pseudo-inverse (the lecture's idea, generalised from pairs (1,2), (3,4)).
+      Consecutive rather than all pairs because stacking *all* pairs with equal weights gives
+      exactly the ``"lstsq"`` estimate (``sum_{a<b} D_ab^T D_ab = N M``), so it would not be a
+      different method; consecutive pairs discard information, as methods.md section 7 says.
+    - ``"sphere"`` (2a): best-fit sphere through the flange positions, centre = reference;
+      ``t = mean_i R_i^T (r - f_i)``. Biased for small tilts, poor when the flange positions
+      are nearly coplanar (typical of N = 4).
+
+    Quality figures: residuals ``e_i = R_i t + f_i - r``; noise ``s^2 = sum |e_i|^2 / (3N - 6)``
+    (or the given ``sigma``); covariance ``noise^2 M^-1`` for lstsq (first-order propagation
+    for the others); 95 % confidence radius from the eigenvalues of the covariance (see
+    ``tcpcal._stats.ci_radius``); condition number of ``A`` from ``N +- s_max(S)``.
+
+    Outliers (``detect_outliers``, N >= 5): leave-one-out F test on the linear model
+    (``_find_outliers``), independent of ``method``; flagged touches are listed in ``outliers``
+    and the same method is re-run without them (``without_outliers``), keeping at least 4.
+
+    Args:
+        rotations: (N, 3, 3) ``R_world_flange`` of each touch.
+        positions: (N, 3) ``p_world_flange`` of each touch (any length unit).
+        method: ``"lstsq"``, ``"pairwise"`` or ``"sphere"``.
+        sigma: known per-axis touch noise (length unit); if given it replaces the estimate
+            ``s`` in the covariance and confidence radius.
+        detect_outliers: run the outlier test.
+
+    Returns:
+        A frozen :class:`TcpResult`; TCP in FLANGE coordinates, reference in WORLD.
+
+    Raises:
+        InvalidInputError: wrong shapes, NaN/inf, non-rotations, fewer than 4 touches, unknown
+            method, bad sigma.
+        DegenerateTouchesError: the touches cannot determine the TCP (all the same orientation,
+            rotations about one common axis (``unobservable_axis`` in FLANGE coordinates),
+            fewer than 4 different orientations, coplanar flange positions for the sphere fit).
+    """
+    if method not in METHODS:
+        raise InvalidInputError(
+            f"unknown method {method!r}; choose one of {', '.join(METHODS)} (lstsq is the default)."
+        )
+    rot = as_rotations(rotations, name="rotations")
+    f = as_positions(positions, n=rot.shape[0], name="positions")
+    s_given = _check_sigma(sigma)
+    n = rot.shape[0]
+    if n < MIN_TOUCHES:
+        raise InvalidInputError(
+            f"the 4-point method needs at least {MIN_TOUCHES} touches, got {n}; record "
+            f"{MIN_TOUCHES - n} more from clearly different orientations."
+        )
+    return _solve(rot, f, method, s_given, detect_outliers)
+
+
+def _solve(rot: np.ndarray, f: np.ndarray, method: str, sigma: float | None, detect_outliers: bool) -> TcpResult:
+    n = rot.shape[0]
+    info = information(rot)
+    ext = angle_extremes(rot)
+    _check_observable(rot, info, ext)
+    warnings: list[str] = []
+
+    if method == "lstsq":
+        t, r, e = _lstsq_core(info, rot, f)
+        cov_unit = None
+    else:
+        if method == "pairwise":
+            t, cov_unit = _pairwise_core(rot, f)
+        else:
+            t, cov_unit, flatness = _sphere_core(rot, f)
+            if flatness < COPLANAR_RATIO:
+                warnings.append(
+                    f"the flange positions are nearly coplanar (thickness / extent = {flatness:.2f}): "
+                    "the sphere fit is very sensitive to touch noise here; prefer method 'lstsq'."
+                )
+        r = info.rbar @ t + f.mean(axis=0)  # = mean_i (R_i t + f_i)
+        e = rot @ t + (f - r)
+
+    res = np.sqrt(np.einsum("ni,ni->n", e, e))
+    sse = float(res @ res)
+    dof = 3 * n - 6
+    s_est = math.sqrt(sse / dof)
+    noise = s_est if sigma is None else sigma
+    if cov_unit is None:
+        cov = noise**2 * info.m_inv()
+        cov_eig = noise**2 / np.maximum(info.eigvals, 1e-300)
+    else:
+        cov = noise**2 * cov_unit
+        cov_eig = np.linalg.eigvalsh(cov)
+    ci95 = ci_radius(cov_eig, None if sigma is not None else dof)
+
+    outliers: list[int] = _find_outliers(rot, f) if detect_outliers and n > MIN_TOUCHES else []
+    without: TcpResult | None = None
+    if outliers:
+        keep = np.setdiff1d(np.arange(n), outliers)
+        try:
+            without = _solve(rot[keep], f[keep], method, sigma, False)
+        except DegenerateTouchesError as exc:
+            warnings.append(f"without the outliers the touches are degenerate: {exc}")
+        scale = f"noise estimate {without.noise_sigma:.3g}" if without is not None else "the others"
+        plural = len(outliers) > 1
+        warnings.append(
+            f"touch{'es' if plural else ''} {_fmt_idx(outliers)} (0-based) stand{'' if plural else 's'} out "
+            f"(residual {', '.join(f'{res[i]:.3g}' for i in outliers)} vs {scale}): probably a careless "
+            f"touch; see the result without {'them' if plural else 'it'} (without_outliers), or re-record "
+            f"{'them' if plural else 'it'}."
+        )
+
+    if ext.max_deg < SMALL_TILT_DEG:
+        warnings.append(
+            f"the touch orientations differ by at most {ext.max_deg:.1f} deg: tilt the tool 30-60 deg "
+            "between touches, about two different axes, for a precise TCP."
+        )
+    ratio = math.sqrt(info.eigvals[2] / info.eigvals[0])
+    if ratio > WEAK_AXIS_RATIO:
+        warnings.append(
+            f"the TCP along flange {fmt_vec(info.weakest_axis)} is {ratio:.0f} times less certain "
+            "than across it: the touches tilt little about a second axis; add a touch tilted "
+            "about another axis."
+        )
+    if ext.min_deg < NEAR_DUPLICATE_DEG:
+        i, j = ext.min_pair
+        warnings.append(
+            f"touches {i} and {j} (0-based) are only {ext.min_deg:.1f} deg apart in orientation, so "
+            "one of them adds little: re-record it from a clearly different orientation."
+        )
+    if sigma is not None and float(chdtrc(dof, sse / sigma**2)) < 1e-3:
+        warnings.append(
+            f"the residuals (noise estimate {s_est:.3g}) are larger than the given sigma {sigma:.3g} "
+            "explains: the touches are less precise than assumed, or something is not rigid or not "
+            "calibrated (tool, reference point, robot)."
+        )
+    if detect_outliers and n == MIN_TOUCHES:
+        warnings.append(
+            "with only 4 touches a careless touch cannot be detected; record 5 to 8 touches for a "
+            "checkable result."
+        )
+
+    return TcpResult(
+        method=method,
+        tcp=_frozen(t),
+        reference=_frozen(r),
+        residual_vectors=_frozen(e),
+        residuals=_frozen(res),
+        mean_error=float(res.mean()),
+        max_error=float(res.max()),
+        rms_error=math.sqrt(sse / n),
+        noise_sigma=float(noise),
+        covariance=_frozen(cov),
+        ci95_radius=ci95,
+        max_angle_deg=ext.max_deg,
+        min_angle_deg=ext.min_deg,
+        condition_number=info.condition_number,
+        outliers=tuple(outliers),
+        without_outliers=without,
+        warnings=tuple(warnings),
+        n_touches=n,
+    )
+
+
+def solve_reference(
+    known_tcp: np.ndarray,
+    rotation_known: np.ndarray,
+    position_known: np.ndarray,
+    rotation_new: np.ndarray,
+    position_new: np.ndarray,
+    *,
+    sigma: float | None = None,
+) -> TcpResult:
+    """XYZ reference method (methods.md section 3, (REF-1)).
+
+    A tool with known TCP ``t_1`` touches a reference point at flange pose
+    ``(R_1, f_1)``: ``r = R_1 t_1 + f_1``. The new tool touches the same point at ``(R_2, f_2)``:
+    ``t_2 = R_2^T (r - f_2)``.
+
+    There is no redundancy: residuals are zero by construction and the noise cannot be
+    estimated. With a given ``sigma`` (per-axis noise of each touch) the covariance is
+    ``2 sigma^2 I`` (``t_2`` error ``= R_2^T (eps_1 - eps_2)``), not counting ``t_1``'s own error.
+
+    Args:
+        known_tcp: (3,) TCP of the calibrated tool, FLANGE coordinates.
+        rotation_known: (3, 3) ``R_world_flange`` of the calibrated tool's touch.
+        position_known: (3,) ``p_world_flange`` of that touch.
+        rotation_new: (3, 3) ``R_world_flange`` of the new tool's touch.
+        position_new: (3,) ``p_world_flange`` of that touch.
+        sigma: per-axis touch noise (length unit), optional.
+
+    Returns:
+        :class:`TcpResult` with ``method="reference"``, ``n_touches=2``; ``noise_sigma``,
+        ``covariance`` and ``ci95_radius`` are NaN when ``sigma`` is None.
+    """
+    t1 = as_vector3(known_tcp, name="known_tcp")
+    r1 = as_rotation(rotation_known, name="rotation_known")
+    f1 = as_vector3(position_known, name="position_known")
+    r2 = as_rotation(rotation_new, name="rotation_new")
+    f2 = as_vector3(position_new, name="position_new")
+    s_given = _check_sigma(sigma)
+    ref = r1 @ t1 + f1
+    t2 = r2.T @ (ref - f2)
+    angle = math.degrees(angle_between(r1, r2))
+    warnings = [
+        "reference method: one touch per tool and no redundancy, so the residuals are zero by "
+        "construction; the TCP error is the sum of both touches' errors and of the known TCP's own "
+        "error. Check the result, e.g. with a 4-point calibration."
+    ]
+    if s_given is None:
+        cov = np.full((3, 3), math.nan)
+        ci95 = math.nan
+        noise = math.nan
+        warnings.append("no sigma given: the uncertainty of the TCP cannot be estimated from one touch per tool.")
+    else:
+        cov = 2.0 * s_given**2 * np.eye(3)
+        ci95 = ci_radius(np.full(3, 2.0 * s_given**2), None)
+        noise = s_given
+    zeros = np.zeros((2, 3))
+    return TcpResult(
+        method="reference",
+        tcp=_frozen(t2),
+        reference=_frozen(ref),
+        residual_vectors=_frozen(zeros),
+        residuals=_frozen(np.zeros(2)),
+        mean_error=0.0,
+        max_error=0.0,
+        rms_error=0.0,
+        noise_sigma=noise,
+        covariance=_frozen(cov),
+        ci95_radius=ci95,
+        max_angle_deg=angle,
+        min_angle_deg=angle,
+        condition_number=1.0,
+        outliers=(),
+        without_outliers=None,
+        warnings=tuple(warnings),
+        n_touches=2,
+    )
