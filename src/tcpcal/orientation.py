@@ -268,9 +268,10 @@ def _common_warnings(
             "the -X and +Y touches disagree; repeat them more carefully and farther from the TCP."
         )
     t_norm = float(np.linalg.norm(t))
-    if t_norm > 0.0 and float(np.dot(c1, t)) < 0.0:
+    if t_norm > 0.0 and float(np.dot(c1, t)) < -0.5 * t_norm:
         msgs.append(
-            "tool X points back towards the flange (c1 . t < 0): if the tool's working direction "
+            "tool X points back towards the flange (more than 120 deg from the TCP direction): "
+            "if the tool's working direction "
             "points away from the flange, the tip was probably placed on the +X axis in the "
             "second step (Delta1 > 0 instead of negative); check and repeat it."
         )
