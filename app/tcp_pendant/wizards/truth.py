@@ -94,8 +94,8 @@ def compare_with_truth(result: WizardResult, T_flange_tcp_true_m: Any) -> TruthC
     if result.rotation is not None:
         R_true = T_true[:3, :3]
         ori_err = float(np.degrees(Rotation.from_matrix(R_true.T @ result.rotation).magnitude()))
-        cos_x = float(np.clip(R_true[:, 0] @ result.rotation[:, 0], -1.0, 1.0))
-        x_err = float(np.degrees(np.arccos(cos_x)))
+        a, b = R_true[:, 0], result.rotation[:, 0]  # atan2 form: accurate near 0 deg too
+        x_err = float(np.degrees(np.arctan2(np.linalg.norm(np.cross(a, b)), float(a @ b))))
     inside = None if result.ci95_mm is None else bool(pos_err <= result.ci95_mm)
 
     parts: list[tuple[Grade, str]] = []
