@@ -451,7 +451,7 @@ def _one_line(text: str) -> str:
 def _os_error_line(exc: OSError) -> str:
     name = exc.filename if exc.filename is not None else ""
     why = exc.strerror or exc.__class__.__name__
-    return f"{name}: cannot read or write the file: {why}" if name else f"{why}: {exc}"
+    return f"{name}: cannot open the file: {why}" if name else f"{why}: {exc}"
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -69,9 +69,21 @@ def _jsonable(obj: Any) -> Any:
     return obj
 
 
+def _dump(obj: Any, level: int) -> str:
+    if isinstance(obj, dict) and obj:
+        pad = "  " * (level + 1)
+        items = [f"{pad}{json.dumps(k)}: {_dump(v, level + 1)}" for k, v in obj.items()]
+        return "{\n" + ",\n".join(items) + "\n" + "  " * level + "}"
+    if isinstance(obj, list) and obj and any(isinstance(v, (dict, list)) for v in obj):
+        pad = "  " * (level + 1)
+        return ("[\n" + ",\n".join(pad + _dump(v, level + 1) for v in obj) + "\n"
+                + "  " * level + "]")
+    return json.dumps(obj, allow_nan=False)
+
+
 def json_dumps(obj: Any) -> str:
-    """Strict JSON (no NaN/Infinity tokens), indented for reading."""
-    return json.dumps(_jsonable(obj), indent=2, allow_nan=False)
+    """Strict JSON (no NaN/Infinity tokens): one key per line, number lists on one line."""
+    return _dump(_jsonable(obj), 0)
 
 
 def tcp_result_to_dict(result: TcpResult, *, rows: Sequence[int] | None = None) -> dict[str, Any]:
@@ -182,11 +194,14 @@ def format_tcp_report(result: TcpResult, poses: FlangePoses | None = None, *,
                      f"{label}{mark}")
     lines.append("")
     if outliers:
-        rows = ", ".join(str(i + 1) for i in sorted(outliers))
-        lines.append(f"Outliers: data row(s) {rows} stand out from the others.")
+        rows = ", ".join(f"{i + 1}" + (f" (line {poses.line_numbers[i]})" if poses is not None
+                                        and i < len(poses) else "") for i in sorted(outliers))
+        lines.append(f"Outliers: data row {rows} stand{'s' if len(outliers) == 1 else ''} out "
+                     f"from the others; re-record {'it' if len(outliers) == 1 else 'them'} "
+                     f"or use the result without {'it' if len(outliers) == 1 else 'them'}.")
         sub = result.without_outliers
         if sub is not None:
-            lines.append("Result without them:")
+            lines.append(f"Result without {'it' if len(outliers) == 1 else 'them'}:")
             lines += ["  " + s for s in _tcp_block(sub)]
     else:
         lines.append("Outliers: none")

@@ -152,7 +152,8 @@ def test_xyz4_outlier_flagged_and_result_without_it(
     code, out, err = run(["solve", "xyz4", str(p)], capsys)
     assert code == 0
     assert re.search(r"^\s+6\s+7\s+.*<- outlier$", out, re.M), out  # data row 6 = file line 7
-    assert "Result without them" in out
+    assert "Outliers: data row 6 (line 7) stands out" in out
+    assert "Result without it:" in out
 
 
 def test_xyz4_human_report(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
