@@ -241,3 +241,25 @@ def test_to_tool_and_serialisation(synth):
         Xyz4Wizard().to_tool("x")
     with pytest.raises(WizardError, match="Unknown wizard kind"):
         Wizard.from_dict({"kind": "nope"})
+
+
+def test_save_to_library(synth, tmp_path):
+    from tcpcal.errors import TcpcalError
+    from tcpcal.library import ToolLibrary
+
+    tool = synth.tools["pointer"]
+    lib = ToolLibrary(tmp_path / "tools.json")
+    wiz = Xyz4Wizard()
+    with pytest.raises(WizardStateError, match="Finish"):
+        wiz.save_to_library(lib, "pointer")
+    run_xyz4(wiz, synth, tool, synth.directions[:4])
+    slot, saved = wiz.save_to_library(lib, "pointer")
+    assert slot == 1 and lib.active_slot() == 1
+    assert lib.get(1).tcp_mm == pytest.approx(tuple(tool.tcp_mm), abs=1e-6)
+    assert lib.get(1).calibration.method == "xyz4-lstsq"
+    # same name again: same slot, overwritten; explicit slot elsewhere with that name: refused
+    assert wiz.save_to_library(lib, "pointer")[0] == 1
+    with pytest.raises(TcpcalError):
+        wiz.save_to_library(lib, "pointer", slot=5)
+    assert wiz.save_to_library(lib, "pointer 2", slot=5, activate=False)[0] == 5
+    assert lib.active_slot() == 1
