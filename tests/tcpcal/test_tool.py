@@ -1,0 +1,182 @@
+"""Tool and Calibration data: validation, KUKA A, B, C convention, dict/JSON contract."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+from datetime import datetime, timezone
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy.spatial.transform import Rotation
+
+from tcpcal.errors import InvalidInputError, TcpcalError
+from tcpcal.tool import Calibration, Tool
+
+
+def Rz(deg):
+    c, s = math.cos(math.radians(deg)), math.sin(math.radians(deg))
+    return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
+
+
+def Ry(deg):
+    c, s = math.cos(math.radians(deg)), math.sin(math.radians(deg))
+    return np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]])
+
+
+def Rx(deg):
+    c, s = math.cos(math.radians(deg)), math.sin(math.radians(deg))
+    return np.array([[1, 0, 0], [0, c, -s], [0, s, c]])
+
+
+def test_rotation_is_kuka_rz_ry_rx_built_by_hand():
+    tool = Tool("t", (1.0, 2.0, 3.0), (30.0, -20.0, 75.0))
+    np.testing.assert_allclose(tool.rotation, Rz(30) @ Ry(-20) @ Rx(75), atol=1e-15)
+    T = tool.T_flange_tool_mm
+    np.testing.assert_allclose(T[:3, :3], tool.rotation)
+    np.testing.assert_allclose(T[:3, 3], [1.0, 2.0, 3.0])
+    np.testing.assert_allclose(T[3], [0, 0, 0, 1])
+    # B = -90: tool X along flange Z (a straight pointer along the flange axis)
+    np.testing.assert_allclose(Tool("p", (0, 0, 200), (0, -90, 0)).rotation[:, 0], [0, 0, 1],
+                               atol=1e-15)
+
+
+@settings(max_examples=100, deadline=None)
+@given(st.lists(st.floats(-1, 1), min_size=4, max_size=4).filter(
+    lambda q: np.linalg.norm(q) > 0.1))
+def test_from_rotation_reproduces_any_rotation(q):
+    R = Rotation.from_quat(np.array(q) / np.linalg.norm(q)).as_matrix()
+    tool = Tool.from_rotation("t", [10.0, -20.0, 30.0], R, mass_kg=1.5)
+    np.testing.assert_allclose(tool.rotation, R, atol=1e-9)
+    assert all(-180.0 <= a <= 180.0 for a in tool.abc_deg)
+    assert -90.0 <= tool.abc_deg[1] <= 90.0
+    assert tool.mass_kg == 1.5
+
+
+def test_from_rotation_gimbal_lock_without_warning(recwarn):
+    R = Rz(40) @ Ry(90) @ Rx(10)
+    tool = Tool.from_rotation("g", (0, 0, 0), R)
+    np.testing.assert_allclose(tool.rotation, R, atol=1e-9)
+    assert tool.abc_deg[1] == pytest.approx(90.0)
+    assert not [w for w in recwarn if "Gimbal" in str(w.message)]
+
+
+def test_from_rotation_rejects_non_rotation():
+    with pytest.raises(InvalidInputError, match="orthonormal"):
+        Tool.from_rotation("t", (0, 0, 0), np.eye(3) * 2)
+
+
+def test_values_are_normalised_to_float_tuples():
+    tool = Tool("t", np.array([1, 2, 3]), [0, 0, 90], mass_kg=2)
+    assert tool.tcp_mm == (1.0, 2.0, 3.0) and isinstance(tool.tcp_mm[0], float)
+    assert tool.abc_deg == (0.0, 0.0, 90.0)
+    assert tool.mass_kg == 2.0 and isinstance(tool.mass_kg, float)
+
+
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        (dict(name=""), "empty"),
+        (dict(name="   "), "empty"),
+        (dict(name="x" * 25), "at most 24"),
+        (dict(name="a\tb"), "control character"),
+        (dict(name="new\nline"), "control character"),
+        (dict(name='say "hi"'), "double quote"),
+        (dict(name=" lead"), "spaces"),
+        (dict(name=5), "string"),
+        (dict(tcp_mm=(1.0, 2.0)), "3 numbers"),
+        (dict(tcp_mm=(1.0, float("nan"), 2.0)), r"tcp_mm\[1\] must be a finite"),
+        (dict(tcp_mm=(1.0, "2", 2.0)), "must be a number"),
+        (dict(abc_deg=(0.0, float("inf"), 0.0)), "abc_deg"),
+        (dict(abc_deg=(True, 0.0, 0.0)), "must be a number"),
+        (dict(mass_kg=0.0), "positive"),
+        (dict(mass_kg=-1.0), "positive"),
+        (dict(mass_kg=float("nan")), "finite"),
+        (dict(notes=3), "notes"),
+        (dict(calibration={"method": "x"}), "Calibration"),
+    ],
+)
+def test_invalid_tools_raise_clear_errors(kwargs, match):
+    base = dict(name="tool", tcp_mm=(0.0, 0.0, 100.0))
+    base.update(kwargs)
+    with pytest.raises(InvalidInputError, match=match):
+        Tool(**base)
+
+
+def test_name_of_24_printable_characters_is_fine():
+    name = "Gripper #2 (left) - 24ch"
+    assert len(name) == 24
+    assert Tool(name, (0, 0, 0)).name == name
+
+
+def test_error_type_is_a_value_error():
+    with pytest.raises(ValueError):
+        Tool("", (0, 0, 0))
+    assert issubclass(InvalidInputError, TcpcalError)
+
+
+def test_frozen():
+    tool = Tool("t", (0, 0, 0), calibration=Calibration.now("numeric", {"a": 1.0}))
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        tool.name = "u"  # type: ignore[misc]
+    with pytest.raises(TypeError):
+        tool.calibration.figures["a"] = 2.0  # type: ignore[index]
+    assert hash(tool) == hash(Tool("t", (0, 0, 0), calibration=tool.calibration))
+
+
+def test_calibration_validation():
+    Calibration("xyz4-lstsq", "2024-05-01T12:00:00Z", {"rms_error_mm": 0.2})
+    Calibration("xyz4-lstsq", "2024-05-01T12:00:00+00:00")
+    with pytest.raises(InvalidInputError, match="ISO 8601"):
+        Calibration("xyz4-lstsq", "yesterday")
+    with pytest.raises(InvalidInputError, match="time zone"):
+        Calibration("xyz4-lstsq", "2024-05-01T12:00:00")
+    with pytest.raises(InvalidInputError, match="non-empty"):
+        Calibration("", "2024-05-01T12:00:00Z")
+    with pytest.raises(InvalidInputError, match="finite"):
+        Calibration("x", "2024-05-01T12:00:00Z", {"ci95_mm": float("inf")})
+
+
+def test_calibration_now_is_utc_and_current():
+    before = datetime.now(timezone.utc).replace(microsecond=0)
+    cal = Calibration.now("reference", {"max_error_mm": 0.4})
+    stamp = datetime.fromisoformat(cal.calibrated_at)
+    assert stamp.utcoffset().total_seconds() == 0
+    assert before <= stamp <= datetime.now(timezone.utc)
+
+
+def test_dict_contract_keys_and_json_round_trip():
+    cal = Calibration("three-point-1", "2024-05-01T12:00:00+00:00", {"defect_deg": 0.12})
+    tool = Tool("torch", (12.5, 0.0, 180.25), (0.0, -90.0, 0.0), 2.5, "MIG 36", cal)
+    d = tool.to_dict()
+    # the documented, stable keys (a contract users script against)
+    assert d == {
+        "name": "torch",
+        "tcp_mm": [12.5, 0.0, 180.25],
+        "abc_deg": [0.0, -90.0, 0.0],
+        "mass_kg": 2.5,
+        "notes": "MIG 36",
+        "calibration": {
+            "method": "three-point-1",
+            "calibrated_at": "2024-05-01T12:00:00+00:00",
+            "figures": {"defect_deg": 0.12},
+        },
+    }
+    back = Tool.from_dict(json.loads(json.dumps(d, allow_nan=False)))
+    assert back == tool
+
+
+def test_from_dict_defaults_and_errors():
+    tool = Tool.from_dict({"name": "p", "tcp_mm": [0, 0, 100]})
+    assert tool.abc_deg == (0.0, 0.0, 0.0) and tool.mass_kg is None and tool.calibration is None
+    with pytest.raises(InvalidInputError, match=r"unknown keys \['mass'\]"):
+        Tool.from_dict({"name": "p", "tcp_mm": [0, 0, 100], "mass": 2})
+    with pytest.raises(InvalidInputError, match="lacks"):
+        Tool.from_dict({"name": "p"})
+    with pytest.raises(InvalidInputError, match="object"):
+        Tool.from_dict(["p", [0, 0, 0]])
+    with pytest.raises(InvalidInputError, match="calibration lacks"):
+        Tool.from_dict({"name": "p", "tcp_mm": [0, 0, 1], "calibration": {"method": "x"}})
