@@ -171,7 +171,9 @@ def test_outlier_flagged_and_dropped(synth):
 def test_preview_meter(synth):
     tool = synth.tools["pointer"]
     wiz = Xyz4Wizard(assumed_sigma_mm=0.5)
-    assert wiz.quality() is None and wiz.preview(np.eye(4)) is None  # nothing to compare with
+    first = wiz.preview(np.eye(4))  # nothing to compare with yet: not observable, says so
+    assert not first.too_close and first.predicted_after == np.inf and first.message
+    assert wiz.quality().n_touches == 0 and not wiz.quality().observable
     Ts = [synth.flange_pose_m(tool, synth.tool_orientation(*d)) for d in synth.directions[:4]]
     for T in Ts[:3]:
         wiz.record(T)

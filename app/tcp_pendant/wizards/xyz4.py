@@ -233,28 +233,24 @@ class Xyz4Wizard(Wizard):
                 if i != self._index or self.is_complete]
         return np.array(rots, dtype=float).reshape(-1, 3, 3)
 
-    def preview(self, T_world_flange_m: Any, *, min_angle_deg: float = 15.0) -> CandidateGain | None:
+    def preview(self, T_world_flange_m: Any, *, min_angle_deg: float = 15.0) -> CandidateGain:
         """Predicted TCP uncertainty if the current pose were recorded (tcpcal.candidate_gain).
 
         Compares the candidate flange orientation with the touches recorded so far (except the
         current step's own, which a new recording would replace), for an operator error of
         ``assumed_sigma_mm`` per axis. Figures in mm; ``too_close`` flags an orientation within
-        ``min_angle_deg`` of an earlier one. None while there is no earlier touch to compare
-        with (the first touch can be anywhere).
+        ``min_angle_deg`` of an earlier one. Before the TCP is observable the predicted figures
+        are inf and ``message`` says what is still needed.
         """
         T = check_pose_m(T_world_flange_m, what="candidate flange pose")
         others = self._other_rotations()
-        if len(others) == 0:
-            return None
         return candidate_gain(others, T[:3, :3], sigma=self.assumed_sigma_mm,
                               min_angle_deg=min_angle_deg)
 
-    def quality(self) -> PoseQuality | None:
-        """tcpcal's verdict on the touches recorded so far (None before the first touch)."""
+    def quality(self) -> PoseQuality:
+        """tcpcal's verdict on the touches recorded so far (observable? predicted uncertainty)."""
         rots = np.array([p.T_world_flange_m[:3, :3] for _, p in sorted(self._poses.items())],
                         dtype=float).reshape(-1, 3, 3)
-        if len(rots) == 0:
-            return None
         return assess_touches(rots, sigma=self.assumed_sigma_mm)
 
     # ----- result -------------------------------------------------------------------------
