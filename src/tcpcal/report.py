@@ -152,6 +152,13 @@ def _fig(x: float, unit: str = " mm", fmt: str = ".3f") -> str:
     return f"{x:{fmt}}{unit}" if math.isfinite(x) else "undefined"
 
 
+def _bullets(items: Sequence[str]) -> list[str]:
+    out: list[str] = []
+    for w in items:
+        out += textwrap.wrap(str(w), width=92, initial_indent="  - ", subsequent_indent="    ")
+    return out
+
+
 def _tcp_block(result: TcpResult) -> list[str]:
     return [
         f"TCP in FLANGE (mm):       {_xyz(result.tcp)}",
@@ -207,7 +214,7 @@ def format_tcp_report(result: TcpResult, poses: FlangePoses | None = None, *,
         lines.append("Outliers: none")
     if result.warnings:
         lines.append("Warnings:")
-        lines += [f"  - {w}" for w in result.warnings]
+        lines += _bullets(result.warnings)
     else:
         lines.append("Warnings: none")
     lines += ["", *textwrap.wrap(CAVEAT, width=92)]
@@ -221,20 +228,20 @@ def format_orientation_report(result: OrientationResult, poses: FlangePoses | No
     r = np.asarray(result.rotation, dtype=float)
     lines = [f"tcpcal {command}: method {result.method}{src}", ""]
     if tcp_mm is not None:
-        lines.append(f"TCP in FLANGE (mm, given):  {_xyz(tcp_mm)}")
+        lines.append(f"TCP in FLANGE (mm, given):     {_xyz(tcp_mm)}")
     lines += [
         f"TOOL orientation, KUKA (deg): {_abc(result.kuka_abc_deg)}",
         "R_flange_tool (columns: tool X, Y, Z in FLANGE):",
         *[f"  [{row[0]:10.6f} {row[1]:10.6f} {row[2]:10.6f}]" for row in r],
-        f"Orthogonality defect:   {_fig(result.orthogonality_defect_deg, ' deg', '.3f')}",
+        f"Orthogonality defect:         {_fig(result.orthogonality_defect_deg, ' deg', '.3f')}",
     ]
     if len(result.displacements):
-        lines.append("Displacements used:     "
+        lines.append("Displacements used:           "
                      + ", ".join(f"{float(d):.1f} mm" for d in result.displacements)
                      + "  (longer gives a smaller angular error)")
     if result.warnings:
         lines.append("Warnings:")
-        lines += [f"  - {w}" for w in result.warnings]
+        lines += _bullets(result.warnings)
     else:
         lines.append("Warnings: none")
     return "\n".join(lines)

@@ -370,3 +370,25 @@ def test_python_dash_m(tmp_path: Path) -> None:
     proc = subprocess.run([sys.executable, "-m", "tcpcal", "--help"],
                           capture_output=True, text=True, timeout=60)
     assert proc.returncode == 0 and "solve" in proc.stdout
+
+
+def test_three_point_error_names_the_row(tmp_path: Path,
+                                         capsys: pytest.CaptureFixture[str]) -> None:
+    # row 2 repeats row 1: the tip was never moved onto the tool's -X axis
+    rots, pos = three_point_poses(1)
+    p = write_csv(tmp_path / "tp_bad.csv", [rots[0], rots[0], rots[2]],
+                  [pos[0], pos[0], pos[2]])
+    assert_one_error_line(*run(["solve", "three-point", str(p), "--tcp", "-20,5.5,210",
+                                "--variant", "1"], capsys),
+                          "tp_bad.csv", r"line 3 \(data row 2\)", "-X axis")
+
+
+def test_reference_with_sigma_gives_a_radius(tmp_path: Path,
+                                             capsys: pytest.CaptureFixture[str]) -> None:
+    r1, r2 = rot((10, 20, 170)), rot((-60, -30, 160))
+    p = write_csv(tmp_path / "ref.csv", [r1, r2],
+                  [R_REF - r1 @ np.array([0.0, 0, 150]), R_REF - r2 @ T_TRUE])
+    d = run_json(["solve", "reference", str(p), "--known-tcp", "0,0,150", "--sigma", "0.3"],
+                 capsys)
+    assert d["noise_sigma_mm"] == pytest.approx(0.3)
+    assert d["ci95_mm"] is not None and d["ci95_mm"] > 0.3
