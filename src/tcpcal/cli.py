@@ -23,9 +23,16 @@ import numpy as np
 
 from tcpcal.errors import DegenerateTouchesError, TcpcalError
 from tcpcal.poses_csv import FlangePoses, accepted_layouts_text, read_poses_csv
-from tcpcal.report import (format_orientation_report, format_tcp_report, format_tool,
-                           format_tool_table, json_dumps, orientation_result_to_dict,
-                           tcp_result_to_dict, tool_to_dict)
+from tcpcal.report import (
+    format_orientation_report,
+    format_tcp_report,
+    format_tool,
+    format_tool_table,
+    json_dumps,
+    orientation_result_to_dict,
+    tcp_result_to_dict,
+    tool_to_dict,
+)
 from tcpcal.tool import rotation_from_abc_deg
 
 __all__ = ["main", "build_parser", "CliInputError"]

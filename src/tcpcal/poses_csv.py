@@ -84,8 +84,11 @@ _POSE_COLUMNS = frozenset(POSITION_COLUMNS).union(*LAYOUTS.values())
 
 def accepted_layouts_text() -> str:
     """One line listing the accepted header layouts (used in error messages and ``--help``)."""
-    parts = [f"{','.join(POSITION_COLUMNS)},{','.join(cols) if name != 'matrix' else 'r11,r12,...,r33'}"
-             f" ({_LAYOUT_UNITS[name]})" for name, cols in LAYOUTS.items()]
+    def cols_text(name: str, cols: tuple[str, ...]) -> str:
+        return "r11,r12,...,r33" if name == "matrix" else ",".join(cols)
+
+    parts = [f"{','.join(POSITION_COLUMNS)},{cols_text(name, cols)} ({_LAYOUT_UNITS[name]})"
+             for name, cols in LAYOUTS.items()]
     return "accepted headers: " + "; ".join(parts)
 
 
@@ -163,8 +166,8 @@ def _choose_layout(path: Path, line_no: int, names: Sequence[str]) -> str:
     if partial:
         lay, miss = next(iter(partial.items()))
         if complete:
-            raise _error(f"{where}: the header mixes orientation layout {complete[0]} with column(s) "
-                         f"of {lay}; keep the columns of one; {accepted_layouts_text()}")
+            raise _error(f"{where}: the header mixes orientation layout {complete[0]} with "
+                         f"column(s) of {lay}; keep the columns of one; {accepted_layouts_text()}")
         raise _error(f"{where}: orientation layout {lay} lacks column(s) {','.join(miss)}; "
                      f"{accepted_layouts_text()}")
     if not complete:
@@ -192,9 +195,9 @@ def _rotation_from_row(layout: str, v: np.ndarray, where: str, index: int) -> np
         m = v.reshape(3, 3)
         defect = float(np.max(np.abs(m.T @ m - np.eye(3))))
         if defect > ORTHONORMAL_TOL:
-            raise _error(f"{where}: rotation r11..r33 is not orthonormal within {ORTHONORMAL_TOL:g} "
-                         f"(max |R^T R - I| = {defect:.3g}); check the row-major column order and "
-                         f"print more digits", index=index)
+            raise _error(f"{where}: rotation r11..r33 is not orthonormal within "
+                         f"{ORTHONORMAL_TOL:g} (max |R^T R - I| = {defect:.3g}); check the "
+                         f"row-major column order and print more digits", index=index)
         if np.linalg.det(m) < 0:
             raise _error(f"{where}: rotation r11..r33 is a reflection (det = -1), not a rotation; "
                          f"check the row-major column order", index=index)
