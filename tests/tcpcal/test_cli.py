@@ -392,3 +392,18 @@ def test_reference_with_sigma_gives_a_radius(tmp_path: Path,
                  capsys)
     assert d["noise_sigma_mm"] == pytest.approx(0.3)
     assert d["ci95_mm"] is not None and d["ci95_mm"] > 0.3
+
+
+def test_docs_example_output_is_real(capsys: pytest.CaptureFixture[str],
+                                     monkeypatch: pytest.MonkeyPatch) -> None:
+    """docs/cli.md pastes the output of its example: it must be what tcpcal prints today, and
+    the example's known tool (85, -12, 210) mm must lie within the reported 95 % radius."""
+    root = Path(__file__).resolve().parents[2]
+    doc = (root / "docs" / "cli.md").read_text(encoding="utf-8")
+    monkeypatch.chdir(root)
+    cmd = "$ tcpcal solve xyz4 docs/examples/xyz4_poses.csv\n"
+    pasted = doc[doc.index(cmd) + len(cmd):].split("\n```", 1)[0]
+    code, out, err = run(["solve", "xyz4", "docs/examples/xyz4_poses.csv"], capsys)
+    assert code == 0 and out.rstrip("\n") == pasted
+    d = run_json(["solve", "xyz4", "docs/examples/xyz4_poses.csv"], capsys)
+    assert np.linalg.norm(np.array(d["tcp_mm"]) - [85.0, -12.0, 210.0]) < d["ci95_mm"]
