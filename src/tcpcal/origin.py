@@ -356,15 +356,18 @@ def solve_xyz4(
         raise InvalidInputError(
             f"unknown method {method!r}; choose one of {', '.join(METHODS)} (lstsq is the default)."
         )
+    try:
+        n_given = len(rotations)
+    except TypeError:
+        n_given = MIN_TOUCHES  # let as_rotations report the problem
+    if n_given < MIN_TOUCHES:
+        raise InvalidInputError(
+            f"the 4-point method needs at least {MIN_TOUCHES} touches, got {n_given}; record "
+            f"{MIN_TOUCHES - n_given} more from clearly different orientations."
+        )
     rot = as_rotations(rotations, name="rotations")
     f = as_positions(positions, n=rot.shape[0], name="positions")
     s_given = _check_sigma(sigma)
-    n = rot.shape[0]
-    if n < MIN_TOUCHES:
-        raise InvalidInputError(
-            f"the 4-point method needs at least {MIN_TOUCHES} touches, got {n}; record "
-            f"{MIN_TOUCHES - n} more from clearly different orientations."
-        )
     return _solve(rot, f, method, s_given, detect_outliers)
 
 
