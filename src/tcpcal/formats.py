@@ -18,7 +18,10 @@ rotation conversion goes through ``scipy.spatial.transform.Rotation``):
 ``abb``
     A RAPID ``tooldata`` declaration::
 
-        PERS tooldata gripper:=[TRUE,[[12.5,0,180.25],[q1,q2,q3,q4]],[mass,[0,0,0.001],[1,0,0,0],0,0,0]];
+        PERS tooldata gripper:=[TRUE,[[12.5,0,180.25],[q1,q2,q3,q4]],
+                                [mass,[0,0,0.001],[1,0,0,0],0,0,0]];
+
+    (written on one line).
 
     ``q1`` is the scalar part, written with ``q1 >= 0``. ABB requires a positive mass: the tool's
     ``mass_kg`` or, when unknown, :data:`ABB_DEFAULT_MASS_KG` = 0.001 kg with the centre of
@@ -263,7 +266,9 @@ def _parse_aggregate(text: str, start: int) -> Any:
                 if tok == "]":
                     return items
                 if tok != ",":
-                    raise InvalidInputError(f"abb: expected ',' or ']' in the tooldata, got {tok!r}.")
+                    raise InvalidInputError(
+                        f"abb: expected ',' or ']' in the tooldata, got {tok!r}."
+                    )
                 tok = token()
         if tok in ("]", ","):
             raise InvalidInputError(f"abb: unexpected {tok!r} in the tooldata.")

@@ -19,7 +19,6 @@ its measured direction and all of the inconsistency goes into Y. The defect
 from __future__ import annotations
 
 import math
-import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, Literal
@@ -76,7 +75,11 @@ class OrientationResult:
             +Y point from the tool X axis, the lever of c2); lstsq: one entry per non-touch row
             in row order (distance from t for -X rows, distance from the X axis for +Y rows);
             ABC world: ``()``.
-        warnings: plain-words warnings for the operator.
+        warnings: plain-words warnings for the operator: a displacement shorter than
+            ``min_displacement``; an orthogonality defect above ``DEFECT_WARN_DEG``; tool X
+            more than 120 deg from the TCP direction (the tip was probably put on +X, i.e.
+            Delta1 > 0); lstsq rows on the wrong side (-X row with Delta1 >= 0, +Y row with
+            negative Y); 5D: which axis tool Y was taken from.
     """
 
     method: str

@@ -46,7 +46,13 @@ from scipy.spatial.transform import Rotation
 from tcpcal.errors import InvalidInputError
 from tcpcal.validation import as_rotation
 
-__all__ = ["MAX_NAME_LENGTH", "Calibration", "Tool", "abc_deg_from_rotation", "rotation_from_abc_deg"]
+__all__ = [
+    "MAX_NAME_LENGTH",
+    "Calibration",
+    "Tool",
+    "abc_deg_from_rotation",
+    "rotation_from_abc_deg",
+]
 
 MAX_NAME_LENGTH: int = 24
 """Longest tool name, as on a KUKA controller (``TOOL_NAME[n, 24]``)."""

@@ -205,7 +205,8 @@ def test_fanuc_import_is_tolerant():
 
 @pytest.mark.parametrize(
     "text, match",
-    [("X: 1 Y: 2", "could not find Z, W, P, R"), ("X: 1 X: 2 Y 0 Z 0 W 0 P 0 R 0", "X appears twice")],
+    [("X: 1 Y: 2", "could not find Z, W, P, R"),
+     ("X: 1 X: 2 Y 0 Z 0 W 0 P 0 R 0", "X appears twice")],
 )
 def test_fanuc_import_errors(text, match):
     with pytest.raises(InvalidInputError, match=match):

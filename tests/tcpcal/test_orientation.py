@@ -271,7 +271,8 @@ def test_lstsq_flags_a_minus_x_point_on_the_wrong_side():
     R_true, t_true = random_tool(rng)
     tips = [(0, 0, 0), (-120, 0, 0), (-80, 0, 0), (40, 0, 0), (0, 90, 0)]
     R, f = make_poses(rng, R_true, t_true, tips)
-    res = solve_three_point_lstsq(R, f, t_true, ["touch", "minus_x", "minus_x", "minus_x", "plus_y"])
+    roles = ["touch", "minus_x", "minus_x", "minus_x", "plus_y"]
+    res = solve_three_point_lstsq(R, f, t_true, roles)
     np.testing.assert_allclose(res.rotation, R_true, atol=1e-9)  # the line is still right
     assert any("touch 3" in w and "Delta1 not negative" in w for w in res.warnings)
 
