@@ -131,6 +131,28 @@ def test_two_processes_saving_at_once_lose_nothing(tmp_path):
         assert tools[9 + k].name == f"B-{last}"
 
 
+def test_two_threads_sharing_one_library_object_lose_nothing(tmp_path):
+    """The app server shares one ToolLibrary between browser sessions (threads)."""
+    import threading
+
+    lib = ToolLibrary(tmp_path / "tools.json")
+    rounds = 32
+
+    def work(base: int, tag: str) -> None:
+        for i in range(rounds):
+            lib.save(base + i % 8, tool(f"{tag}-{i}", float(i)))
+
+    threads = [threading.Thread(target=work, args=(1, "A")),
+               threading.Thread(target=work, args=(9, "B"))]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join(timeout=120)
+    tools = lib.tools()
+    assert sorted(tools) == list(range(1, 17))
+    assert tools[8].name == f"A-{rounds - 1}" and tools[16].name == f"B-{rounds - 1}"
+
+
 def _endless_saver(path: str) -> None:
     lib = ToolLibrary(Path(path))
     i = 0
