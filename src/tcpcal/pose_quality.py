@@ -126,9 +126,13 @@ def _assess(rot: np.ndarray, sigma: float) -> PoseQuality:
     if not info.observable:
         axis = info.weakest_axis
         axis.setflags(write=False)
-        return PoseQuality(n, False, axis, inf, inf, ext.min_deg,
-                           f"All touches rotate about nearly the same axis (flange {fmt_vec(axis)}): "
-                           "tilt the tool about a second axis.")
+        if n == 2:  # two orientations always differ by a rotation about one axis
+            msg = (f"2 touches recorded: record 2 more, tilted about another axis than the first "
+                   f"two (not about flange {fmt_vec(axis)}).")
+        else:
+            msg = (f"All touches rotate about nearly the same axis (flange {fmt_vec(axis)}): "
+                   "tilt the tool about a second axis.")
+        return PoseQuality(n, False, axis, inf, inf, ext.min_deg, msg)
     distinct = n
     if ext.min_deg < SAME_ORIENTATION_DEG:
         distinct = n - len(duplicate_orientations(rot))
