@@ -7,6 +7,7 @@ import multiprocessing
 import os
 import random
 import signal
+import stat
 import time
 import warnings
 from pathlib import Path
@@ -153,29 +154,44 @@ def test_two_threads_sharing_one_library_object_lose_nothing(tmp_path):
     assert tools[8].name == f"A-{rounds - 1}" and tools[16].name == f"B-{rounds - 1}"
 
 
-def _endless_saver(path: str) -> None:
+def _endless_saver(path: str, slow_disk: bool) -> None:
+    # slow_disk: fsync of a regular file (the temporary file) takes 30 ms in this child only,
+    # so most kills land between writing the temporary file and os.replace. Otherwise big
+    # tools make the writes themselves long, so kills also land while bytes are written.
+    real_fsync = os.fsync
+
+    def slow_fsync(fd: int) -> None:
+        if stat.S_ISREG(os.fstat(fd).st_mode):
+            time.sleep(0.03)
+        real_fsync(fd)
+
+    if slow_disk:
+        os.fsync = slow_fsync  # type: ignore[assignment]
+    size = 20_000 if slow_disk else 300_000
     lib = ToolLibrary(Path(path))
     i = 0
     while True:
         k = i % 16
-        # large notes make each write take a while, so a kill often lands mid-write
-        lib.save(1 + k, tool(f"t{k}", float(i), notes=f"{i} " + "x" * 200_000))
+        lib.save(1 + k, tool(f"t{k}", float(i), notes=f"save {i} " + "x" * size))
         i += 1
 
 
 def test_kill_during_saves_leaves_a_valid_file(tmp_path):
     path = tmp_path / "tools.json"
     rng = random.Random(1)
-    for _ in range(6):
-        p = _fork.Process(target=_endless_saver, args=(str(path),))
+    killed_mid_save = 0
+    for round_ in range(16):
+        p = _fork.Process(target=_endless_saver, args=(str(path), round_ % 2 == 0))
         p.start()
         deadline = time.monotonic() + 30
         while not path.exists() and time.monotonic() < deadline:
             time.sleep(0.005)
-        time.sleep(rng.uniform(0.02, 0.25))
+        time.sleep(rng.uniform(0.02, 0.2))
         os.kill(p.pid, signal.SIGKILL)
         p.join(timeout=30)
         assert p.exitcode == -signal.SIGKILL
+        # a temporary file left behind proves the kill hit the middle of a save
+        killed_mid_save += bool(list(tmp_path.glob(".tools.json.*.tmp")))  # stale temp
         json.loads(path.read_text(encoding="utf-8"))  # complete JSON
         lib = ToolLibrary(path)
         with warnings.catch_warnings():
@@ -183,6 +199,8 @@ def test_kill_during_saves_leaves_a_valid_file(tmp_path):
             tools = lib.tools()
         assert lib.recovered_backup is None
         assert tools and all(t.name == f"t{s - 1}" for s, t in tools.items())
+        assert all(t.notes.startswith("save ") for t in tools.values())
+    assert killed_mid_save >= 3  # the test really exercised interrupted saves
     # the next save removes temporary files a killed writer left behind
     ToolLibrary(path).save(1, tool("t0"))
     assert not list(tmp_path.glob(".tools.json.*.tmp"))
