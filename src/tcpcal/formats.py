@@ -76,7 +76,6 @@ from __future__ import annotations
 
 import math
 import re
-import warnings
 from typing import Any
 
 import numpy as np
@@ -355,9 +354,9 @@ _FANUC_VALUE = re.compile(rf"\b([XYZWPR])\b\s*[:=]?\s*({_NUM})", re.IGNORECASE)
 
 def _export_fanuc(tool: Tool, slot: int) -> str:
     n = _check_slot(slot, _FANUC_SLOTS, "fanuc")
-    with warnings.catch_warnings():  # gimbal lock at P = +-90: scipy sets R = 0, still exact
-        warnings.simplefilter("ignore", UserWarning)
-        wpr = Rotation.from_matrix(tool.rotation).as_euler("xyz", degrees=True)
+    # from_euler("xyz", [W, P, R]) = Rz(R) Ry(P) Rx(W) = from_euler("ZYX", [R, P, W]), so
+    # (W, P, R) is (C, B, A) of KUKA; abc_deg_from_rotation stays exact near P = +-90.
+    wpr = abc_deg_from_rotation(tool.rotation)[::-1]
     values = (*tool.tcp_mm, *wpr)
     lines = [f"UTOOL[{n}] Direct Entry", f"Comment: {tool.name}"]
     lines += [f"{k}: {_fmt(v)}" for k, v in zip("XYZWPR", values)]

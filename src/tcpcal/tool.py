@@ -69,14 +69,31 @@ def rotation_from_abc_deg(abc_deg: Any) -> np.ndarray:
 def abc_deg_from_rotation(rotation: np.ndarray) -> np.ndarray:
     """Rotation matrix to KUKA A, B, C in degrees (inverse of :func:`rotation_from_abc_deg`).
 
-    At B = +-90 deg (gimbal lock) only A - C (or A + C) is defined; scipy then sets C = 0,
-    which represents the same rotation. Its gimbal-lock warning is silenced here. The angles
-    are rounded to 12 decimals (changes the rotation by < 1e-14 rad) so that e.g. -90 deg does
-    not read -89.99999999999999.
+    Uses ``Rotation.as_euler("ZYX")``. Within about 1e-7 rad of gimbal lock (B = +-90 deg)
+    scipy sets C = 0 and the angles then reproduce the rotation only to ~1e-7; in that case
+    (reconstruction error above 1e-12) the angles are recomputed by the two-step method:
+    ``A = atan2(R10, R00)``, ``B = atan2(-R20, hypot(R00, R10))``, and C from the residual
+    rotation ``(Rz(A) Ry(B))^T R = Rx(C)`` (composed with scipy), which absorbs the
+    ill-conditioning of A so that ``Rz(A) Ry(B) Rx(C)`` reproduces ``R`` to machine precision.
+    scipy's gimbal-lock warning is silenced. The angles are rounded to 12 decimals (changes the
+    rotation by < 1e-14 rad) so that e.g. -90 deg does not read -89.99999999999999.
     """
+    R = np.asarray(rotation, dtype=float)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)
-        abc = Rotation.from_matrix(rotation).as_euler("ZYX", degrees=True)
+        abc = Rotation.from_matrix(R).as_euler("ZYX", degrees=True)
+    R_input = Rotation.from_matrix(R).as_matrix()  # the rotation scipy sees (orthonormalised)
+    if np.abs(rotation_from_abc_deg(abc) - R_input).max() > 1e-12:
+        a = math.atan2(R_input[1, 0], R_input[0, 0])
+        b = math.atan2(-R_input[2, 0], math.hypot(R_input[0, 0], R_input[1, 0]))
+        residual = (
+            Rotation.from_euler("ZY", [a, b]).inv() * Rotation.from_matrix(R_input)
+        ).as_matrix()
+        c = math.atan2(residual[2, 1], residual[1, 1])
+        two_step = np.degrees([a, b, c])
+        err_two = np.abs(rotation_from_abc_deg(two_step) - R_input).max()
+        if err_two < np.abs(rotation_from_abc_deg(abc) - R_input).max():
+            abc = two_step
     return np.round(abc, 12) + 0.0  # + 0.0 turns -0.0 into 0.0
 
 

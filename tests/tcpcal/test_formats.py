@@ -48,6 +48,22 @@ def test_round_trip_at_gimbal_lock_and_identity(fmt):
         np.testing.assert_allclose(back.T_flange_tool_mm, tool.T_flange_tool_mm, atol=1e-9)
 
 
+@pytest.mark.parametrize("fmt", FORMATS)
+def test_round_trip_next_to_gimbal_lock(fmt):
+    rng = np.random.default_rng(8)
+    for offset in (1e-11, 1e-9, 1e-8, 1e-7):
+        for _ in range(10):
+            A, C = rng.uniform(-180.0, 180.0, size=2)
+            R = Rotation.from_euler("ZYX", [A, 90.0 - math.degrees(offset), C],
+                                    degrees=True).as_matrix()
+            # B = +-90 is also FANUC's lock (P = +-90): Rz(R) Ry(P) Rx(W) has the same form
+            tool = Tool.from_rotation("g", (10.0, 20.0, 30.0), R)
+            np.testing.assert_allclose(tool.rotation, R, rtol=0, atol=1e-11)
+            back = import_tool(export_tool(tool, fmt), fmt)
+            np.testing.assert_allclose(back.T_flange_tool_mm, tool.T_flange_tool_mm,
+                                       rtol=0, atol=1e-9)
+
+
 # --------------------------------------------------------------------------- KUKA
 def test_kuka_known_text_and_values():
     tool = Tool("gripper", (12.5, 0.0, 180.25), (0.0, -90.0, 0.0))

@@ -64,6 +64,22 @@ def test_from_rotation_gimbal_lock_without_warning(recwarn):
     assert not [w for w in recwarn if "Gimbal" in str(w.message)]
 
 
+@pytest.mark.parametrize("offset_rad", [0.0, 1e-12, 1e-10, 1e-9, 1e-8, 1e-7, 1e-6])
+@pytest.mark.parametrize("sign", [1.0, -1.0])
+def test_from_rotation_is_exact_next_to_gimbal_lock(offset_rad, sign):
+    # scipy's as_euler snaps to the lock within ~1e-7 rad; the tool must not lose that
+    rng = np.random.default_rng(17)
+    for _ in range(50):
+        A, C = rng.uniform(-180.0, 180.0, size=2)
+        B = sign * (90.0 - math.degrees(offset_rad))
+        R = Rz(A) @ Ry(B) @ Rx(C)
+        tool = Tool.from_rotation("g", (0, 0, 0), R)
+        np.testing.assert_allclose(tool.rotation, R, rtol=0, atol=1e-11)
+    # the hypothesis counterexample that exposed it
+    R = Rotation.from_quat(np.array([1.0, 0.0, 1.0, 1e-9]) / math.sqrt(2.0)).as_matrix()
+    np.testing.assert_allclose(Tool.from_rotation("g", (0, 0, 0), R).rotation, R, atol=1e-12)
+
+
 def test_from_rotation_rejects_non_rotation():
     with pytest.raises(InvalidInputError, match="orthonormal"):
         Tool.from_rotation("t", (0, 0, 0), np.eye(3) * 2)
