@@ -93,7 +93,15 @@ class Box:
     colour: str
 
 
-Primitive = Cyl | Cone | Box
+@dataclass(frozen=True)
+class Hull:
+    """Convex hull of several primitives (their colours are ignored): tapered, rounded links."""
+
+    parts: tuple[Cyl | Cone | Box, ...]
+    colour: str
+
+
+Primitive = Cyl | Cone | Box | Hull
 
 
 def _frame_along(p0: np.ndarray, p1: np.ndarray) -> np.ndarray:
@@ -128,6 +136,9 @@ def _frustum(r0: float, r1: float, length: float, sections: int) -> trimesh.Trim
 
 def primitive_mesh(p: Primitive) -> trimesh.Trimesh:
     """Triangle mesh of one primitive, in millimetres, in the link frame."""
+    if isinstance(p, Hull):
+        pts = np.vstack([primitive_mesh(q).vertices for q in p.parts])
+        return trimesh.convex.convex_hull(pts)
     if isinstance(p, Box):
         lo, hi = np.asarray(p.lo, float), np.asarray(p.hi, float)
         T = np.eye(4)
@@ -231,44 +242,49 @@ def kr6_model() -> Model:
     # Link frames at zero: link_1 at A2 height on A1; link_2 at A2; link_3 at A3;
     # link_4 on the A4 axis above A3; link_5 at the wrist centre; link_6 at the flange face.
     # Upper arm and forearm lie along +X at all-zero (stretched forward).
+    A2x, UA, OFF, W, FL = KR6_A2_FORWARD, KR6_UPPER_ARM, KR6_FOREARM_OFFSET, KR6_A4_TO_WRIST, KR6_WRIST_TO_FLANGE
     vis: dict[str, tuple[Primitive, ...]] = {
         "base_link": (
-            Box((-165.0, -140.0, 0.0), (135.0, 140.0, 22.0), k),  # foot plate
-            Cyl((-15.0, 0.0, 22.0), (-15.0, 0.0, 150.0), 118.0, o, 32),  # base body
-            Box((-150.0, -70.0, 40.0), (-100.0, 70.0, 120.0), k),  # connector box at the rear
+            Hull(tuple(Cyl((x, y, 0.0), (x, y, 20.0), 25.0, k, 12)
+                       for x in (-145.0, 115.0) for y in (-130.0, 130.0)), k),  # foot plate
+            Hull((Cyl((-10.0, 0.0, 20.0), (-10.0, 0.0, 60.0), 118.0, o, 32),
+                  Cyl((0.0, 0.0, 150.0), (0.0, 0.0, 185.0), 108.0, o, 32)), o),  # base body
+            Box((-150.0, -60.0, 40.0), (-110.0, 60.0, 110.0), k),  # connector box at the rear
         ),
-        "link_1": (
-            Cyl((0.0, 0.0, -250.0), (0.0, 0.0, -215.0), 122.0, o, 32),  # turntable
-            Box((-95.0, -95.0, -215.0), (70.0, 95.0, -60.0), o),  # turret body
-            Cyl((-75.0, 0.0, -200.0), (-75.0, 0.0, 40.0), 58.0, k),  # A1 motor (black, rear)
-            Cyl((25.0, -95.0, 0.0), (25.0, 95.0, 0.0), 78.0, o, 32),  # A2 hub
-            Box((-40.0, -95.0, -70.0), (90.0, 95.0, 0.0), o),  # hub support
-            Cyl((25.0, 95.0, 0.0), (25.0, 160.0, 0.0), 52.0, k),  # A2 motor (black, left)
+        "link_1": (  # frame at A2 height on the A1 axis
+            Cyl((0.0, 0.0, -215.0), (0.0, 0.0, -185.0), 112.0, o, 32),  # turntable
+            Hull((Cyl((0.0, 0.0, -185.0), (0.0, 0.0, -120.0), 100.0, o, 32),
+                  Cyl((A2x, -30.0, 0.0), (A2x, 95.0, 0.0), 80.0, o, 32)), o),  # rotating column
+            Cyl((-85.0, 0.0, -170.0), (-85.0, 0.0, -50.0), 40.0, k, 20),  # A1 motor (rear)
+            Cyl((A2x, 95.0, 0.0), (A2x, 150.0, 0.0), 50.0, k, 24),  # A2 motor (left side)
         ),
-        "link_2": (
-            Cyl((0.0, -92.0, 0.0), (0.0, -20.0, 0.0), 72.0, o, 32),  # A2 side hub
-            Cone((0.0, -56.0, 0.0), (KR6_UPPER_ARM, -56.0, 0.0), 62.0, 50.0, o, 6),
-            Cyl((KR6_UPPER_ARM, -92.0, 0.0), (KR6_UPPER_ARM, -20.0, 0.0), 58.0, o, 32),
+        "link_2": (  # frame at A2; the upper arm runs along +X at A2 = 0, beside the column
+            Hull((Cyl((0.0, -100.0, 0.0), (0.0, -35.0, 0.0), 78.0, o, 32),
+                  Cyl((UA, -100.0, 0.0), (UA, -35.0, 0.0), 60.0, o, 32)), o),  # upper arm
+            Cyl((0.0, -108.0, 0.0), (0.0, -100.0, 0.0), 55.0, k, 24),  # gear covers
+            Cyl((UA, -108.0, 0.0), (UA, -100.0, 0.0), 42.0, k, 24),
         ),
-        "link_3": (
-            Cyl((0.0, -20.0, 0.0), (0.0, 70.0, 0.0), 64.0, o, 32),  # A3 housing
-            Box((-130.0, -50.0, -45.0), (90.0, 60.0, 85.0), o),  # forearm housing
-            Cyl((-190.0, 5.0, KR6_FOREARM_OFFSET), (-130.0, 5.0, KR6_FOREARM_OFFSET), 40.0, k),
-            Cyl((0.0, 70.0, 0.0), (0.0, 110.0, 0.0), 45.0, k),  # A3 motor
+        "link_3": (  # frame at A3
+            Hull((Cyl((0.0, -95.0, 0.0), (0.0, 55.0, 0.0), 66.0, o, 32),
+                  Cyl((-130.0, 0.0, OFF), (120.0, 0.0, OFF), 52.0, o, 24)), o),  # arm housing
+            Cyl((-195.0, 0.0, OFF), (-130.0, 0.0, OFF), 40.0, k, 20),  # A4 motor (rear)
+            Cyl((0.0, 55.0, 0.0), (0.0, 68.0, 0.0), 45.0, k, 24),  # A3 cover
         ),
-        "link_4": (
-            Cyl((90.0, 0.0, 0.0), (300.0, 0.0, 0.0), 47.0, o, 24),  # forearm tube
-            Cone((300.0, 0.0, 0.0), (345.0, 0.0, 0.0), 47.0, 40.0, o, 24),
-            Box((330.0, -52.0, -36.0), (KR6_A4_TO_WRIST, -36.0, 36.0), o),  # wrist fork
-            Box((330.0, 36.0, -36.0), (KR6_A4_TO_WRIST, 52.0, 36.0), o),
+        "link_4": (  # frame on the A4 axis above A3
+            Hull((Cyl((120.0, 0.0, 0.0), (160.0, 0.0, 0.0), 48.0, o, 24),
+                  Cyl((300.0, 0.0, 0.0), (330.0, 0.0, 0.0), 40.0, o, 24)), o),  # forearm
+            Hull((Box((300.0, -50.0, -34.0), (330.0, -36.0, 34.0), o),
+                  Cyl((W, -50.0, 0.0), (W, -36.0, 0.0), 38.0, o, 24)), o),  # wrist fork
+            Hull((Box((300.0, 36.0, -34.0), (330.0, 50.0, 34.0), o),
+                  Cyl((W, 36.0, 0.0), (W, 50.0, 0.0), 38.0, o, 24)), o),
         ),
-        "link_5": (
-            Cyl((0.0, -36.0, 0.0), (0.0, 36.0, 0.0), 38.0, o, 24),  # A5 knuckle
-            Cyl((0.0, 0.0, 0.0), (KR6_WRIST_TO_FLANGE - 14.0, 0.0, 0.0), 33.0, o, 24),
+        "link_5": (  # frame at the wrist centre
+            Cyl((0.0, -36.0, 0.0), (0.0, 36.0, 0.0), 36.0, o, 24),  # A5 knuckle
+            Cone((0.0, 0.0, 0.0), (FL - 14.0, 0.0, 0.0), 34.0, 30.0, o, 24),
         ),
-        "link_6": (
-            Cyl((-14.0, 0.0, 0.0), (0.0, 0.0, 0.0), 31.5, k, 32),  # flange disc
-            Cyl((-1.0, 0.0, 22.0), (0.5, 0.0, 22.0), 3.0, "steel", 8),  # dowel-pin mark (+Xflange)
+        "link_6": (  # frame at the flange face
+            Cyl((-14.0, 0.0, 0.0), (0.0, 0.0, 0.0), 31.5, "steel", 32),  # flange disc
+            Cyl((-1.0, 0.0, 22.0), (1.0, 0.0, 22.0), 3.0, k, 8),  # dowel-pin mark (+X flange)
         ),
     }
     return Model(
@@ -335,42 +351,49 @@ def gp12_model() -> Model:
                   lower_deg=lo, upper_deg=hi, velocity_deg_s=v)
         )
     j.append(Joint("flange_joint", "link_6", "flange", (0.0, 0.0, 0.0), FLANGE_RPY_DEG))
-    L, R = GP12_UPPER_ARM, GP12_U_TO_R_UP
+    L, R, W, FL = GP12_UPPER_ARM, GP12_U_TO_R_UP, GP12_U_TO_B, GP12_B_TO_FLANGE
+    SL = GP12_S_TO_L
     vis: dict[str, tuple[Primitive, ...]] = {
         "base_link": (
-            Box((-190.0, -170.0, 0.0), (170.0, 170.0, 25.0), g),  # base plate
-            Cyl((0.0, 0.0, 25.0), (0.0, 0.0, 230.0), 135.0, b, 32),  # base drum
+            Hull(tuple(Cyl((x, y, 0.0), (x, y, 25.0), 30.0, g, 12)
+                       for x in (-160.0, 150.0) for y in (-155.0, 155.0)), g),  # base plate
+            Hull((Cyl((0.0, 0.0, 25.0), (0.0, 0.0, 60.0), 140.0, b, 32),
+                  Cyl((0.0, 0.0, 190.0), (0.0, 0.0, 220.0), 125.0, b, 32)), b),  # base drum
         ),
-        "link_1": (
-            Cyl((0.0, 0.0, -220.0), (0.0, 0.0, -150.0), 140.0, b, 32),  # S turntable
-            Box((-150.0, -120.0, -150.0), (110.0, 120.0, -40.0), b),  # S body
-            Box((40.0, -120.0, -110.0), (GP12_S_TO_L + 40.0, -60.0, 60.0), b),  # L shoulder side
-            Cyl((-110.0, 0.0, -150.0), (-110.0, 0.0, 70.0), 62.0, g),  # S motor (rear)
-            Cyl((GP12_S_TO_L, -175.0, 0.0), (GP12_S_TO_L, -120.0, 0.0), 65.0, g),  # L motor
+        "link_1": (  # frame at L height on the S axis
+            Cyl((0.0, 0.0, -230.0), (0.0, 0.0, -190.0), 132.0, b, 32),  # turntable
+            Hull((Cyl((0.0, 0.0, -190.0), (0.0, 0.0, -130.0), 125.0, b, 32),
+                  Cyl((SL, -130.0, 0.0), (SL, 40.0, 0.0), 100.0, b, 32)), b),  # S head
+            Cyl((-120.0, 0.0, -180.0), (-120.0, 0.0, -60.0), 50.0, g, 20),  # S motor (rear)
+            Cyl((SL, -190.0, 0.0), (SL, -130.0, 0.0), 62.0, g, 24),  # L motor
         ),
-        "link_2": (
-            Cyl((0.0, -60.0, 0.0), (0.0, 80.0, 0.0), 92.0, b, 32),  # L hub
-            Box((-62.0, -55.0, 0.0), (62.0, 75.0, L), b),  # upper arm
-            Cyl((0.0, -55.0, L), (0.0, 85.0, L), 80.0, b, 32),  # U hub
+        "link_2": (  # frame at L; the upper arm is vertical at L = 0
+            Hull((Cyl((0.0, 45.0, 0.0), (0.0, 125.0, 0.0), 95.0, b, 32),
+                  Cyl((0.0, 45.0, L), (0.0, 125.0, L), 78.0, b, 32)), b),  # upper arm
+            Cyl((0.0, 125.0, 0.0), (0.0, 135.0, 0.0), 70.0, g, 24),  # covers
+            Cyl((0.0, 125.0, L), (0.0, 135.0, L), 55.0, g, 24),
         ),
-        "link_3": (
-            Box((-150.0, -75.0, -60.0), (110.0, 85.0, R + 70.0), b),  # U casing / elbow
-            Cyl((0.0, 85.0, 0.0), (0.0, 140.0, 0.0), 62.0, g),  # U motor
-            Cyl((-220.0, 0.0, R), (-150.0, 0.0, R), 52.0, g),  # R motor (rear)
+        "link_3": (  # frame at U
+            Hull((Cyl((0.0, -85.0, 0.0), (0.0, 45.0, 0.0), 85.0, b, 32),
+                  Cyl((-170.0, 0.0, R), (80.0, 0.0, R), 80.0, b, 28)), b),  # U casing
+            Cyl((0.0, -140.0, 0.0), (0.0, -85.0, 0.0), 60.0, g, 24),  # U motor
+            Cyl((-250.0, 0.0, R), (-170.0, 0.0, R), 60.0, g, 24),  # R, B, T motors (rear)
         ),
-        "link_4": (
-            Cyl((-530.0, 0.0, 0.0), (-180.0, 0.0, 0.0), 68.0, b, 28),  # forearm
-            Cone((-180.0, 0.0, 0.0), (-90.0, 0.0, 0.0), 68.0, 52.0, b, 28),
-            Box((-100.0, -62.0, -48.0), (0.0, -44.0, 48.0), b),  # wrist fork
-            Box((-100.0, 44.0, -48.0), (0.0, 62.0, 48.0), b),
+        "link_4": (  # frame at the B axis (wrist centre) on the R axis
+            Hull((Cyl((80.0 - W, 0.0, 0.0), (140.0 - W, 0.0, 0.0), 72.0, b, 28),
+                  Cyl((-150.0, 0.0, 0.0), (-110.0, 0.0, 0.0), 56.0, b, 28)), b),  # forearm
+            Hull((Box((-120.0, -62.0, -45.0), (-100.0, -46.0, 45.0), b),
+                  Cyl((0.0, -62.0, 0.0), (0.0, -46.0, 0.0), 48.0, b, 24)), b),  # wrist fork
+            Hull((Box((-120.0, 46.0, -45.0), (-100.0, 62.0, 45.0), b),
+                  Cyl((0.0, 46.0, 0.0), (0.0, 62.0, 0.0), 48.0, b, 24)), b),
         ),
-        "link_5": (
-            Cyl((0.0, -44.0, 0.0), (0.0, 44.0, 0.0), 46.0, b, 28),  # B knuckle
-            Cyl((0.0, 0.0, 0.0), (GP12_B_TO_FLANGE - 14.0, 0.0, 0.0), 38.0, b, 28),
+        "link_5": (  # frame at the wrist centre
+            Cyl((0.0, -46.0, 0.0), (0.0, 46.0, 0.0), 45.0, b, 24),  # B knuckle
+            Cone((0.0, 0.0, 0.0), (FL - 14.0, 0.0, 0.0), 40.0, 36.0, b, 24),
         ),
-        "link_6": (
-            Cyl((-14.0, 0.0, 0.0), (0.0, 0.0, 0.0), 31.5, g, 32),  # flange disc
-            Cyl((-1.0, 0.0, 22.0), (0.5, 0.0, 22.0), 3.0, "steel", 8),  # dowel-pin mark
+        "link_6": (  # frame at the flange face
+            Cyl((-14.0, 0.0, 0.0), (0.0, 0.0, 0.0), 31.5, "steel", 32),  # flange disc
+            Cyl((-1.0, 0.0, 22.0), (1.0, 0.0, 22.0), 3.0, g, 8),  # dowel-pin mark (+X flange)
         ),
     }
     return Model(
