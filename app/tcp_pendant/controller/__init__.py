@@ -1,0 +1,52 @@
+"""The virtual robot controller (docs/architecture.md, ``tcp_pendant.controller``). No viser.
+
+Modules, one job each:
+
+* ``kinematics``: :class:`RobotKinematics` (URDF -> pinocchio: limits, home, FK, Jacobian).
+* ``assets``: where ``robots/`` (or the packaged ``_robots``) and example-robot-data live.
+* ``tools``: :class:`ToolModel` (physical tool with its hidden true TOOL frame),
+  :func:`builtin_tools`, :func:`builtin_robots`, the reference tip model.
+* ``jog``: Cartesian path following by damped least squares with the safety rules.
+* ``approach``: inverse kinematics and the auto-approach target.
+* ``readout``, ``touch``: the pendant's pose readout and the touch/crash geometry.
+* ``controller``: :class:`VirtualController`, the state and the commands.
+"""
+
+from tcp_pendant.controller.approach import approach_pose, approach_rotation, solve_ik
+from tcp_pendant.controller.assets import example_robot_urdf, robots_dir
+from tcp_pendant.controller.controller import VirtualController
+from tcp_pendant.controller.errors import ControllerError
+from tcp_pendant.controller.jog import JogFrame, JogResult, JogSettings
+from tcp_pendant.controller.kinematics import RobotKinematics
+from tcp_pendant.controller.readout import PoseReadout
+from tcp_pendant.controller.tools import (
+    ReferenceTipModel,
+    ToolModel,
+    builtin_robots,
+    builtin_tools,
+    load_tool,
+    reference_tip_model,
+)
+from tcp_pendant.controller.touch import TouchGeometry
+
+__all__ = [
+    "ControllerError",
+    "JogFrame",
+    "JogResult",
+    "JogSettings",
+    "PoseReadout",
+    "ReferenceTipModel",
+    "RobotKinematics",
+    "ToolModel",
+    "TouchGeometry",
+    "VirtualController",
+    "approach_pose",
+    "approach_rotation",
+    "builtin_robots",
+    "builtin_tools",
+    "example_robot_urdf",
+    "load_tool",
+    "reference_tip_model",
+    "robots_dir",
+    "solve_ik",
+]

@@ -1,0 +1,382 @@
+"""The virtual robot controller: state, jogging, readouts, touch geometry and auto-approach.
+
+Frames (metres and radians inside; the pendant-facing arguments say mm / deg in their names):
+
+* WORLD: the robot's root link frame (methods.md section 1, S0). ``T_world_flange`` is the
+  kinematics' ``T_base_flange``.
+* BASE: the work-object frame (KUKA BASE), ``T_world_base``; used for jogging and readouts.
+* FLANGE: the robot's ``flange`` link (Z out of the flange face).
+* TOOL (active TCP): what the controller *believes*: the active ``tcpcal.Tool`` data,
+  ``T_flange_tool`` from its ``tcp_mm`` and KUKA ``abc_deg``; the flange when no tool is active.
+* true TOOL: the mounted tool's hidden ``T_flange_tcp_true`` (from its URDF).
+
+Jogging follows ``jog.py`` (damped least squares, sub-stepped, safety rules); see
+:meth:`VirtualController.jog_cartesian` for the axis conventions.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Literal
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from tcpcal.tool import Tool
+from tcp_pendant.controller.approach import approach_pose, solve_ik
+from tcp_pendant.controller.errors import ControllerError
+from tcp_pendant.controller.jog import (
+    DEFAULT_SETTINGS,
+    CartesianPath,
+    JogFrame,
+    JogResult,
+    JogSettings,
+    follow_path,
+)
+from tcp_pendant.controller.kinematics import RobotKinematics
+from tcp_pendant.controller.readout import PoseReadout, pose_readout
+from tcp_pendant.controller.tools import ToolModel
+from tcp_pendant.controller.touch import TouchGeometry, touch_geometry
+
+__all__ = ["VirtualController"]
+
+_AXES = {"X": 0, "Y": 1, "Z": 2, "A": 2, "B": 1, "C": 0}
+
+
+def _check_pose(T: np.ndarray, what: str) -> np.ndarray:
+    M = np.asarray(T, dtype=float)
+    if M.shape != (4, 4) or not np.all(np.isfinite(M)):
+        raise ControllerError(f"{what} must be a finite 4x4 homogeneous matrix, got shape {M.shape}.")
+    R = M[:3, :3]
+    if np.abs(R.T @ R - np.eye(3)).max() > 1e-6 or np.linalg.det(R) <= 0.0:
+        raise ControllerError(f"{what} has no proper rotation in its upper-left 3x3 block "
+                              "(columns must be orthonormal and right-handed).")
+    if np.abs(M[3] - [0.0, 0.0, 0.0, 1.0]).max() > 1e-12:
+        raise ControllerError(f"{what} must have [0, 0, 0, 1] as its last row.")
+    return M.copy()
+
+
+def _check_point(p: Sequence[float] | np.ndarray, what: str) -> np.ndarray:
+    v = np.asarray(p, dtype=float)
+    if v.shape != (3,) or not np.all(np.isfinite(v)):
+        raise ControllerError(f"{what} must be 3 finite numbers (x, y, z in metres), got {p!r}.")
+    return v.copy()
+
+
+def _finite(value: float, what: str) -> float:
+    try:
+        out = float(value)
+    except (TypeError, ValueError):
+        raise ControllerError(f"{what} must be a number, got {value!r}.") from None
+    if not math.isfinite(out):
+        raise ControllerError(f"{what} must be finite, got {value!r}.")
+    return out
+
+
+class VirtualController:
+    """A robot controller in software (see the module docstring for the frames).
+
+    Args:
+        kinematics: the robot.
+        tool: the physical tool mounted on the flange.
+        reference_tip_world_m: the reference tip (WORLD, metres); default: below the home
+            flange position, at half its height.
+        active_tool: the tool data the controller believes (None: TCP = flange).
+        T_world_base: BASE frame (4,4, metres).
+        settings: jog tuning (``jog.JogSettings``).
+
+    Not thread-safe: the app's session serialises calls with its lock.
+    """
+
+    def __init__(self, kinematics: RobotKinematics, *, tool: ToolModel,
+                 reference_tip_world_m: Sequence[float] | np.ndarray | None = None,
+                 active_tool: Tool | None = None, T_world_base: np.ndarray | None = None,
+                 settings: JogSettings = DEFAULT_SETTINGS) -> None:
+        self.kinematics = kinematics
+        self.settings = settings
+        self._q = np.array(kinematics.home_rad, dtype=float)
+        self._sigma: tuple[np.ndarray, float] | None = None  # (q, sigma_min at q) of the last path
+        self._tool = tool
+        self._active: Tool | None = None
+        self._T_flange_tool = np.eye(4)
+        self.set_active_tool(active_tool)
+        self._T_world_base = np.eye(4) if T_world_base is None else _check_pose(T_world_base, "T_world_base")
+        if reference_tip_world_m is None:
+            p = kinematics.T_base_flange(kinematics.home_rad)[:3, 3]
+            reference_tip_world_m = (p[0], p[1], 0.5 * p[2])
+        self._tip = _check_point(reference_tip_world_m, "reference_tip_world_m")
+
+    # ----------------------------------------------------------------- state
+    @property
+    def q_rad(self) -> np.ndarray:
+        """Joint angles (rad; m for prismatic joints), a copy."""
+        return self._q.copy()
+
+    def set_q(self, q_rad: Sequence[float] | np.ndarray) -> None:
+        """Set the joint angles (teleport).
+
+        Raises:
+            ControllerError: wrong length, not finite, or outside the limits (names the axis).
+        """
+        q = self.kinematics.check_q(q_rad)
+        viol = self.kinematics.limit_violation(q, tol=1e-9)
+        if viol is not None:
+            i, side = viol
+            raise ControllerError(
+                f"{self.kinematics.joint_names[i]} = {self.kinematics.format_joint(i, q[i])} is beyond "
+                f"its {side} limit {self.kinematics.format_joint(i, (self.kinematics.lower_rad if side == 'lower' else self.kinematics.upper_rad)[i])}."
+            )
+        self._q = np.clip(q, self.kinematics.lower_rad, self.kinematics.upper_rad)
+
+    def joint_angles_deg(self) -> dict[str, float]:
+        """Joint readout: name -> degrees (mm for prismatic joints), in joint order."""
+        k = self.kinematics
+        return {name: float(math.degrees(v) if k.revolute[i] else v * 1000.0)
+                for i, (name, v) in enumerate(zip(k.joint_names, self._q))}
+
+    def go_home(self) -> None:
+        """Teleport to the home configuration."""
+        self._q = np.array(self.kinematics.home_rad, dtype=float)
+
+    @property
+    def mounted_tool(self) -> ToolModel:
+        """The physical tool on the flange."""
+        return self._tool
+
+    def mount_tool(self, tool: ToolModel) -> None:
+        """Bolt another physical tool on (the active tool data does not change)."""
+        if not isinstance(tool, ToolModel):
+            raise ControllerError(f"mount_tool expects a ToolModel, got {type(tool).__name__}.")
+        self._tool = tool
+
+    @property
+    def active_tool(self) -> Tool | None:
+        """The tool data the controller believes (None: TCP = flange)."""
+        return self._active
+
+    def set_active_tool(self, tool: Tool | None) -> None:
+        """Select the active tool data; ``T_flange_tool`` = its ``tcp_mm`` (in m) and ``abc_deg``."""
+        if tool is None:
+            self._active, self._T_flange_tool = None, np.eye(4)
+            return
+        if not isinstance(tool, Tool):
+            raise ControllerError(f"set_active_tool expects a tcpcal.Tool or None, got {type(tool).__name__}.")
+        T = np.eye(4)
+        T[:3, :3] = tool.rotation
+        T[:3, 3] = np.asarray(tool.tcp_mm, dtype=float) / 1000.0
+        self._active, self._T_flange_tool = tool, T
+
+    @property
+    def T_flange_tool(self) -> np.ndarray:
+        """Active TCP in FLANGE coordinates (4,4, metres), a copy."""
+        return self._T_flange_tool.copy()
+
+    @property
+    def reference_tip_world_m(self) -> np.ndarray:
+        """Reference tip position, WORLD, metres (a copy)."""
+        return self._tip.copy()
+
+    def set_reference_tip(self, tip_world_m: Sequence[float] | np.ndarray) -> None:
+        """Move the reference tip (WORLD, metres)."""
+        self._tip = _check_point(tip_world_m, "reference_tip_world_m")
+
+    @property
+    def T_world_base(self) -> np.ndarray:
+        """BASE (work object) frame in WORLD, (4,4) metres (a copy)."""
+        return self._T_world_base.copy()
+
+    def set_T_world_base(self, T_world_base: np.ndarray) -> None:
+        """Set the BASE frame (4,4, metres)."""
+        self._T_world_base = _check_pose(T_world_base, "T_world_base")
+
+    # ----------------------------------------------------------------- poses
+    def T_world_flange(self) -> np.ndarray:
+        """FLANGE pose in WORLD (4,4, metres)."""
+        return self.kinematics.T_base_flange(self._q)
+
+    def T_world_tcp(self) -> np.ndarray:
+        """Active TCP (tool data) pose in WORLD: ``T_world_flange @ T_flange_tool``."""
+        return self.T_world_flange() @ self._T_flange_tool
+
+    def T_world_true_tcp(self) -> np.ndarray:
+        """Hidden true TOOL pose in WORLD: ``T_world_flange @ T_flange_tcp_true``."""
+        return self.T_world_flange() @ self._tool.T_flange_tcp_true
+
+    def link_poses(self) -> dict[str, np.ndarray]:
+        """``T_world_link`` for every robot link (scene updates)."""
+        return self.kinematics.link_poses(self._q)
+
+    # ----------------------------------------------------------------- jogging
+    def jog_joint(self, index: int, delta_deg: float) -> JogResult:
+        """Turn one axis by ``delta_deg`` degrees (mm for a prismatic joint), clamped at its limit.
+
+        Args:
+            index: 0-based joint index (0 = A1).
+            delta_deg: increment, degrees.
+
+        Returns:
+            ``ok`` when the whole increment was made; at a limit the axis stops on it with
+            ``stopped_by="joint_limit"`` and e.g. "A5 at its limit +120.0 deg".
+        """
+        k = self.kinematics
+        if isinstance(index, bool) or not isinstance(index, (int, np.integer)) or not 0 <= index < k.n_joints:
+            raise ControllerError(f"Joint index must be 0..{k.n_joints - 1} ({', '.join(k.joint_names)}), "
+                                  f"got {index!r}.")
+        d = _finite(delta_deg, "delta_deg")
+        delta = math.radians(d) if k.revolute[index] else d / 1000.0
+        if delta == 0.0:
+            return JogResult(True, 1.0, None, "")
+        q = self._q.copy()
+        target = q[index] + delta
+        lo, hi = float(k.lower_rad[index]), float(k.upper_rad[index])
+        if lo <= target <= hi:
+            q[index] = target
+            self._q = q
+            return JogResult(True, 1.0, None, "")
+        side = "upper" if target > hi else "lower"
+        limit = hi if side == "upper" else lo
+        moved = max(0.0, min(1.0, (limit - q[index]) / delta))
+        q[index] = limit
+        self._q = q
+        return JogResult(False, moved, "joint_limit", k.limit_message(index, side))
+
+    def _frame_rotation(self, frame: JogFrame) -> np.ndarray:
+        if frame is JogFrame.WORLD:
+            return np.eye(3)
+        if frame is JogFrame.BASE:
+            return self._T_world_base[:3, :3].copy()
+        if frame is JogFrame.FLANGE:
+            return self.T_world_flange()[:3, :3]
+        return self.T_world_tcp()[:3, :3]
+
+    def jog_cartesian(self, frame: JogFrame | str, axis: Literal["X", "Y", "Z", "A", "B", "C"],
+                      amount: float) -> JogResult:
+        """Jog the active TCP by one increment in a jog frame.
+
+        X, Y, Z: translate the TCP by ``amount`` mm along that axis of ``frame``.
+        A, B, C: rotate the tool by ``amount`` degrees about the TCP, about the Z (A), Y (B) or
+        X (C) axis of ``frame`` (KUKA habit: A, B, C are the angles about Z, Y, X). FLANGE
+        and TOOL axes are taken at the start of the increment.
+
+        The motion follows ``jog.follow_path`` (J-1, J-2): the TCP stays on its line to
+        < 0.01 mm with the orientation held to < 0.001 deg; a rotation keeps the TCP fixed;
+        it stops at joint limits and singularities with ``stopped_by`` and the message, and
+        never jumps configuration. The app makes continuous jogging from small increments
+        (speed * override * dt).
+        """
+        try:
+            jf = JogFrame(frame.upper() if isinstance(frame, str) else frame)
+        except ValueError:
+            raise ControllerError(f"Unknown jog frame {frame!r}; use WORLD, BASE, FLANGE or TOOL.") from None
+        ax = str(axis).upper()
+        if ax not in _AXES:
+            raise ControllerError(f"Unknown jog axis {axis!r}; use X, Y, Z (mm) or A, B, C (deg).")
+        amt = _finite(amount, "jog amount")
+        if amt == 0.0:
+            return JogResult(True, 1.0, None, "")
+        direction = self._frame_rotation(jf)[:, _AXES[ax]]
+        T0 = self.T_world_tcp()
+        if ax in "XYZ":
+            path = CartesianPath(T0[:3, 3], T0[:3, :3], direction * (amt / 1000.0), np.zeros(3))
+        else:
+            path = CartesianPath(T0[:3, 3], T0[:3, :3], np.zeros(3), direction * math.radians(amt))
+        return self._follow(path, self._T_flange_tool)
+
+    def _follow(self, path: CartesianPath, T_flange_tcp: np.ndarray) -> JogResult:
+        sigma = self._sigma[1] if self._sigma is not None and np.array_equal(self._sigma[0], self._q) else None
+        out = follow_path(self.kinematics, self._q, T_flange_tcp, path, self.settings, sigma_start=sigma)
+        self._q = out.q_rad
+        self._sigma = (out.q_rad.copy(), out.sigma)
+        if out.stopped_by is None:
+            return JogResult(True, 1.0, None, "")
+        return JogResult(False, float(out.moved), out.stopped_by, out.message)
+
+    def move_tcp_to(self, T_world_tcp_target: np.ndarray) -> JogResult:
+        """Move the active TCP to a pose (gizmo drag) along a straight line, same safety rules.
+
+        Position moves linearly and orientation about one fixed axis (shortest rotation)
+        from the current TCP pose: (J-1) with ``w = log(R_target R_now^T)``.
+        """
+        T = _check_pose(T_world_tcp_target, "T_world_tcp_target")
+        T0 = self.T_world_tcp()
+        w = Rotation.from_matrix(T[:3, :3] @ T0[:3, :3].T).as_rotvec()
+        path = CartesianPath(T0[:3, 3], T0[:3, :3], T[:3, 3] - T0[:3, 3], w)
+        return self._follow(path, self._T_flange_tool)
+
+    def move_true_tool_to(self, T_world_tooltrue_target: np.ndarray) -> JogResult:
+        """Put the hidden true TOOL frame at a pose by inverse kinematics (demos, auto-touch).
+
+        A direct move (no path): the IK starts from the current configuration, so the arm keeps
+        its configuration when it can, then tries home and fixed seeds (``approach.solve_ik``).
+        Fails with ``stopped_by="unreachable"`` and leaves the robot where it was.
+        """
+        T = _check_pose(T_world_tooltrue_target, "T_world_tooltrue_target")
+        return self._ik_move(T, "the true TOOL frame")
+
+    def _ik_move(self, T_world_tooltrue: np.ndarray, what: str) -> JogResult:
+        sol = solve_ik(self.kinematics, T_world_tooltrue, self._q,
+                       T_flange_tcp=self._tool.T_flange_tcp_true)
+        if not sol.ok:
+            p = T_world_tooltrue[:3, 3] * 1000.0
+            return JogResult(False, 0.0, "unreachable",
+                             f"Cannot put {what} at ({p[0]:.1f}, {p[1]:.1f}, {p[2]:.1f}) mm with that "
+                             f"orientation: no configuration within the joint limits reaches it "
+                             f"(best miss {sol.position_error_m * 1000:.1f} mm, "
+                             f"{math.degrees(sol.rotation_error_rad):.1f} deg).")
+        self._q = sol.q_rad
+        return JogResult(True, 1.0, None, "")
+
+    def auto_approach(self, *, tilt_deg: float, azimuth_deg: float, spin_deg: float = 0.0,
+                      sigma_mm: float = 0.0, tip_offset_tool_mm: Sequence[float] = (0.0, 0.0, 0.0),
+                      rng: np.random.Generator | None = None) -> JogResult:
+        """Put the true tool on the reference tip from a direction (demos, auto-touch).
+
+        Target (AA-1, ``approach.py``): the reference tip at ``tip_offset_tool_mm`` in true TOOL
+        coordinates (0 = touching; (-50, 0, 0) = on the tool's -X axis 50 mm behind the TCP),
+        plus a Gaussian position error of ``sigma_mm`` per WORLD axis drawn from ``rng``.
+        Tool X (the working direction) points ``tilt_deg`` away from WORLD -Z (straight down),
+        turned ``azimuth_deg`` about WORLD Z; ``spin_deg`` turns the tool about its own X.
+        IK converges to 1e-12 m; fails with ``stopped_by="unreachable"`` and a clear message,
+        leaving the robot where it was.
+        """
+        tilt = _finite(tilt_deg, "tilt_deg")
+        az = _finite(azimuth_deg, "azimuth_deg")
+        spin = _finite(spin_deg, "spin_deg")
+        sigma = _finite(sigma_mm, "sigma_mm")
+        if sigma < 0.0:
+            raise ControllerError(f"sigma_mm must be >= 0, got {sigma_mm!r}.")
+        offset = np.asarray(tip_offset_tool_mm, dtype=float)
+        if offset.shape != (3,) or not np.all(np.isfinite(offset)):
+            raise ControllerError(f"tip_offset_tool_mm must be 3 finite numbers (mm), got {tip_offset_tool_mm!r}.")
+        noise = np.zeros(3)
+        if sigma > 0.0:
+            noise = (np.random.default_rng() if rng is None else rng).normal(0.0, sigma, 3)
+        T = approach_pose(self._tip, tilt_deg=tilt, azimuth_deg=az, spin_deg=spin,
+                          tip_offset_tool_mm=offset, noise_world_mm=noise)
+        res = self._ik_move(T, f"the tool (tilt {tilt:.0f} deg, azimuth {az:.0f} deg)")
+        if res.ok:
+            return res
+        return JogResult(False, 0.0, "unreachable",
+                         f"The reference tip cannot be reached from tilt {tilt:.1f} deg, azimuth "
+                         f"{az:.1f} deg, spin {spin:.1f} deg with the {self._tool.label.lower()}: "
+                         f"{res.message[0].lower()}{res.message[1:]} Try a smaller tilt or another azimuth.")
+
+    # ----------------------------------------------------------------- readouts
+    def readout(self, frame: Literal["WORLD", "BASE"] = "WORLD") -> PoseReadout:
+        """Active TCP pose as X, Y, Z (mm) and KUKA A, B, C (deg) in WORLD or BASE."""
+        f = str(frame).upper()
+        T = self.T_world_tcp()
+        if f == "BASE":
+            T = np.linalg.inv(self._T_world_base) @ T
+        elif f != "WORLD":
+            raise ControllerError(f"Readout frame must be WORLD or BASE, got {frame!r}.")
+        return pose_readout(T, f)
+
+    def touch_geometry(self) -> TouchGeometry:
+        """Mounted tool's true tip vs the reference tip (``touch.touch_geometry``)."""
+        return touch_geometry(self.T_world_true_tcp(), self._tip)
+
+    def __repr__(self) -> str:
+        return (f"VirtualController({self.kinematics.urdf_path.name}, tool={self._tool.key!r}, "
+                f"active={None if self._active is None else self._active.name!r})")
