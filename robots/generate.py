@@ -242,7 +242,8 @@ def kr6_model() -> Model:
     # Link frames at zero: link_1 at A2 height on A1; link_2 at A2; link_3 at A3;
     # link_4 on the A4 axis above A3; link_5 at the wrist centre; link_6 at the flange face.
     # Upper arm and forearm lie along +X at all-zero (stretched forward).
-    A2x, UA, OFF, W, FL = KR6_A2_FORWARD, KR6_UPPER_ARM, KR6_FOREARM_OFFSET, KR6_A4_TO_WRIST, KR6_WRIST_TO_FLANGE
+    A2x, UA, OFF = KR6_A2_FORWARD, KR6_UPPER_ARM, KR6_FOREARM_OFFSET
+    W, FL = KR6_A4_TO_WRIST, KR6_WRIST_TO_FLANGE
     vis: dict[str, tuple[Primitive, ...]] = {
         "base_link": (
             Hull(tuple(Cyl((x, y, 0.0), (x, y, 20.0), 25.0, k, 12)
@@ -499,7 +500,7 @@ def torch_model() -> Model:
 
 
 def gripper_model() -> Model:
-    H, F, T, g = GRIPPER_HOUSING, GRIPPER_FINGER, GRIPPER_TCP, GRIPPER_OPENING / 2.0
+    H, F, g = GRIPPER_HOUSING, GRIPPER_FINGER, GRIPPER_OPENING / 2.0
     tip = H + F
     vis = (
         Cyl((0.0, 0.0, 0.0), (0.0, 0.0, 12.0), 31.5, "dark_steel", 32),  # adapter plate
@@ -510,7 +511,6 @@ def gripper_model() -> Model:
         Box((-12.0, -g - 6.0, tip - 30.0), (12.0, -g, tip), "red"),  # pad -Y
         Box((-12.0, g, tip - 30.0), (12.0, g + 6.0, tip), "red"),  # pad +Y
     )
-    del T
     return _tool_model(
         "gripper", vis, (0.0, 0.0, GRIPPER_TCP), (0.0, -90.0, 0.0),
         "Two-finger parallel gripper: TCP between the fingertip pads, tool X = approach "
@@ -601,7 +601,8 @@ def urdf_text(model: Model, meshes: dict[str, tuple[str, str, trimesh.Trimesh]])
     used = sorted({c for (_, c, _) in meshes.values()})
     for c in used:
         r, g, b = (v / 255.0 for v in COLOURS[c])
-        lines.append(f'  <material name="{c}"><color rgba="{_num(r)} {_num(g)} {_num(b)} 1"/></material>')
+        rgba = f"{_num(r)} {_num(g)} {_num(b)} 1"
+        lines.append(f'  <material name="{c}"><color rgba="{rgba}"/></material>')
     for link in model.links:
         files = [(f, c) for f, (lk, c, _) in meshes.items() if lk == link]
         if not files:
