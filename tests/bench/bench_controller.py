@@ -114,7 +114,8 @@ def main(argv: list[str] | None = None) -> int:
         ]
         for name, value, target in rows:
             print(f"{key:6s} {name:44s} {value:10.1f}  {target}")
-        print(f"{key:6s} {'speed-up of pinocchio FK over yourdfpy':44s} {r['fk_yourdfpy'] / r['fk_pinocchio']:9.0f}x")
+        speedup = r["fk_yourdfpy"] / r["fk_pinocchio"]
+        print(f"{key:6s} {'speed-up of pinocchio FK over yourdfpy':44s} {speedup:9.0f}x")
     return 0
 
 

@@ -123,10 +123,10 @@ class VirtualController:
         viol = self.kinematics.limit_violation(q, tol=1e-9)
         if viol is not None:
             i, side = viol
-            raise ControllerError(
-                f"{self.kinematics.joint_names[i]} = {self.kinematics.format_joint(i, q[i])} is beyond "
-                f"its {side} limit {self.kinematics.format_joint(i, (self.kinematics.lower_rad if side == 'lower' else self.kinematics.upper_rad)[i])}."
-            )
+            k = self.kinematics
+            limit = (k.lower_rad if side == "lower" else k.upper_rad)[i]
+            raise ControllerError(f"{k.joint_names[i]} = {k.format_joint(i, q[i])} is beyond its {side} "
+                                  f"limit {k.format_joint(i, limit)}; give angles within the limits.")
         self._q = np.clip(q, self.kinematics.lower_rad, self.kinematics.upper_rad)
 
     def joint_angles_deg(self) -> dict[str, float]:
@@ -312,7 +312,7 @@ class VirtualController:
         Fails with ``stopped_by="unreachable"`` and leaves the robot where it was.
         """
         T = _check_pose(T_world_tooltrue_target, "T_world_tooltrue_target")
-        return self._ik_move(T, "the true TOOL frame")
+        return self._ik_move(T, "That pose of the true TOOL frame")
 
     def _ik_move(self, T_world_tooltrue: np.ndarray, what: str) -> JogResult:
         sol = solve_ik(self.kinematics, T_world_tooltrue, self._q,
@@ -320,10 +320,10 @@ class VirtualController:
         if not sol.ok:
             p = T_world_tooltrue[:3, 3] * 1000.0
             return JogResult(False, 0.0, "unreachable",
-                             f"Cannot put {what} at ({p[0]:.1f}, {p[1]:.1f}, {p[2]:.1f}) mm with that "
-                             f"orientation: no configuration within the joint limits reaches it "
-                             f"(best miss {sol.position_error_m * 1000:.1f} mm, "
-                             f"{math.degrees(sol.rotation_error_rad):.1f} deg).")
+                             f"{what} cannot be reached at ({p[0]:.1f}, {p[1]:.1f}, {p[2]:.1f}) mm: "
+                             f"no configuration within the joint limits gets there (closest: "
+                             f"{sol.position_error_m * 1000:.1f} mm, "
+                             f"{math.degrees(sol.rotation_error_rad):.1f} deg away).")
         self._q = sol.q_rad
         return JogResult(True, 1.0, None, "")
 
@@ -354,13 +354,12 @@ class VirtualController:
             noise = (np.random.default_rng() if rng is None else rng).normal(0.0, sigma, 3)
         T = approach_pose(self._tip, tilt_deg=tilt, azimuth_deg=az, spin_deg=spin,
                           tip_offset_tool_mm=offset, noise_world_mm=noise)
-        res = self._ik_move(T, f"the tool (tilt {tilt:.0f} deg, azimuth {az:.0f} deg)")
+        res = self._ik_move(T, f"The reference tip (with the {self._tool.label.lower()} at tilt "
+                               f"{tilt:.1f} deg, azimuth {az:.1f} deg, spin {spin:.1f} deg)")
         if res.ok:
             return res
-        return JogResult(False, 0.0, "unreachable",
-                         f"The reference tip cannot be reached from tilt {tilt:.1f} deg, azimuth "
-                         f"{az:.1f} deg, spin {spin:.1f} deg with the {self._tool.label.lower()}: "
-                         f"{res.message[0].lower()}{res.message[1:]} Try a smaller tilt or another azimuth.")
+        return JogResult(False, 0.0, "unreachable", res.message + " Try a smaller tilt or another azimuth, "
+                         "or move the reference tip closer to the robot.")
 
     # ----------------------------------------------------------------- readouts
     def readout(self, frame: Literal["WORLD", "BASE"] = "WORLD") -> PoseReadout:
