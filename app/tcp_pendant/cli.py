@@ -1,0 +1,93 @@
+"""``tcp-pendant``: start the teach-pendant web app.
+
+Examples::
+
+    tcp-pendant                                  # KR 6, pointer, http://127.0.0.1:8080
+    tcp-pendant --robot gp12 --tool torch --port 8090
+    tcp-pendant --robot /path/ur5.urdf --flange-link tool0
+    tcp-pendant --host 0.0.0.0 --shared          # classroom demo: one robot for everybody
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import sys
+import time
+from collections.abc import Sequence
+from pathlib import Path
+
+__all__ = ["build_parser", "main"]
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser (options in mm where they are lengths)."""
+    p = argparse.ArgumentParser(
+        prog="tcp-pendant",
+        description="Teach-pendant web app for TCP / TOOL frame calibration training. "
+                    "Each browser gets its own virtual robot unless --shared is given.")
+    p.add_argument("--robot", default="kr6",
+                   help="kr6 (KUKA KR 6 R900 sixx, default), gp12 (Yaskawa GP12 class) or PATH.urdf")
+    p.add_argument("--flange-link", default=None,
+                   help="link used as FLANGE (default: 'flange', else the last link of the longest chain)")
+    p.add_argument("--tool", default="pointer", choices=("pointer", "torch", "gripper"),
+                   help="physical tool mounted at start (default: pointer)")
+    p.add_argument("--host", default="127.0.0.1",
+                   help="address to bind (default 127.0.0.1; anything else lets the network connect)")
+    p.add_argument("--port", type=int, default=8080, help="port (default 8080; 0: any free port)")
+    p.add_argument("--tool-library", type=Path, default=None,
+                   help="tool library JSON file (default: the user's data directory)")
+    p.add_argument("--shared", action="store_true",
+                   help="one robot that every browser sees and drives (lecture demo)")
+    p.add_argument("--reference-tip", default=None, metavar="X,Y,Z",
+                   help="reference tip position in WORLD, mm (default: below the home flange at half "
+                        "its height, e.g. 525,0,445 on the KR 6)")
+    p.add_argument("--verbose", action="store_true", help="log debugging information")
+    return p
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Parse the options, start the server, print the URL and serve until Ctrl-C.
+
+    Returns:
+        0 after a clean stop; 2 for bad options (with the message on stderr).
+    """
+    t0 = time.perf_counter()
+    args = build_parser().parse_args(argv)
+    logging.basicConfig(level=logging.DEBUG if args.verbose else logging.WARNING,
+                        format="%(levelname)s %(name)s: %(message)s")
+    from tcp_pendant.controller import ControllerError
+    from tcp_pendant.server import AppConfig, PendantApp, is_loopback, parse_xyz_mm
+
+    if not 0 <= args.port <= 65535:
+        print(f"tcp-pendant: error: --port must be 0..65535, got {args.port}", file=sys.stderr)
+        return 2
+    try:
+        tip = None if args.reference_tip is None else parse_xyz_mm(args.reference_tip)
+        config = AppConfig(robot=args.robot, flange_link=args.flange_link, tool=args.tool, host=args.host,
+                           port=args.port, tool_library=args.tool_library, shared=args.shared,
+                           reference_tip_mm=tip)
+        app = PendantApp(config)
+    except (ControllerError, ValueError, OSError) as exc:
+        print(f"tcp-pendant: error: {exc}", file=sys.stderr)
+        return 2
+    if not is_loopback(args.host):
+        print(f"WARNING: listening on {args.host}: anyone on the network who can reach this machine "
+              "can open the pendant and save tools to the library. Use --host 127.0.0.1 to keep it local.",
+              file=sys.stderr)
+    try:
+        url = app.start()
+    except OSError as exc:
+        print(f"tcp-pendant: error: cannot listen on {args.host}:{args.port}: {exc}", file=sys.stderr)
+        return 2
+    mode = "one robot shared by every browser" if args.shared else "one robot per browser"
+    tip_mm = ", ".join(f"{v:.0f}" for v in app.reference_tip_m * 1000.0)
+    print(f"TCP Pendant ready in {time.perf_counter() - t0:.1f} s: {url}\n"
+          f"  robot {app.robot_label}, tool {app.tool.label}, reference tip ({tip_mm}) mm, {mode}\n"
+          f"  tool library {app.library.path}\n  Ctrl-C to stop.", flush=True)
+    app.serve_forever()
+    return 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

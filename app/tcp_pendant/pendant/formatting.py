@@ -1,0 +1,97 @@
+"""Text of the pendant's readouts (markdown for viser's ``add_markdown``), without viser.
+
+Units as on a pendant: positions in mm, angles in degrees, two decimals. The TCP readout
+shows the active TCP (the tool data the controller believes) as X, Y, Z and KUKA A, B, C
+(``R = Rz(A) Ry(B) Rx(C)``) in the named frame; ``-0.00`` is printed as ``0.00``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+
+import numpy as np
+
+from tcpcal.tool import Tool
+from tcp_pendant.controller import PoseReadout, TouchGeometry
+from tcp_pendant.controller.touch import TOUCH_TOLERANCE_MM
+
+__all__ = [
+    "fmt_num",
+    "joint_label",
+    "joint_readout_markdown",
+    "tcp_readout_markdown",
+    "tool_data_markdown",
+    "touch_indicator_markdown",
+    "touch_label",
+]
+
+
+def fmt_num(value: float, decimals: int = 2) -> str:
+    """``value`` with ``decimals`` decimals; ``-0.00`` becomes ``0.00``; non-finite as text."""
+    v = float(value)
+    if not math.isfinite(v):
+        return str(v)
+    text = f"{v:.{decimals}f}"
+    return text[1:] if text.startswith("-") and float(text) == 0.0 else text
+
+
+def tcp_readout_markdown(readout: PoseReadout, tool_name: str | None) -> str:
+    """The TCP readout: a title with frame and tool, then a monospace table
+    ``X 525.00 mm | A 0.00 deg`` (one line per pair)."""
+    rows = readout.rows(2)
+    width = max(len(v) for _, v, _ in rows)
+    lines = [f"{rows[i][0]} {rows[i][1]:>{width}} mm   {rows[i + 3][0]} {rows[i + 3][1]:>{width}} deg"
+             for i in range(3)]
+    tool = "FLANGE (no tool active)" if tool_name is None else f"TOOL {tool_name}"
+    return f"**TCP in {readout.frame}** · {tool}\n\n```\n" + "\n".join(lines) + "\n```"
+
+
+def joint_readout_markdown(angles_deg: Mapping[str, float]) -> str:
+    """Joint angles in degrees, three per line: ``A1 0.00  A2 -90.00  A3 90.00``."""
+    items = [f"{n} {fmt_num(v):>8}" for n, v in angles_deg.items()]
+    lines = ["  ".join(items[i:i + 3]) for i in range(0, len(items), 3)]
+    return "**Joints (deg)**\n\n```\n" + "\n".join(lines) + "\n```"
+
+
+def joint_label(name: str, lower_deg: float, upper_deg: float) -> str:
+    """Slider label with the axis name and its limits, e.g. ``A1 [-170, +170]°``."""
+    return f"{name} [{lower_deg:+.0f}, {upper_deg:+.0f}]°"
+
+
+def touch_indicator_markdown(touch: TouchGeometry, *, hide_distance: bool) -> str:
+    """The touch indicator.
+
+    * crash (tool tip driven through the reference tip): always shown, with the depth;
+    * otherwise, unless ``hide_distance``: "TOUCHING" within 0.5 mm, else the distance (mm).
+    """
+    if touch.crashed:
+        return (f"🛑 **CRASH**: the tool tip went {fmt_num(touch.penetration_mm, 1)} mm through the "
+                "reference tip. Jog back out.")
+    if hide_distance:
+        return "Distance to reference tip: *hidden (judge by eye)*"
+    if touch.touching:
+        return f"✅ **TOUCHING** the reference tip ({fmt_num(touch.distance_mm)} mm ≤ {TOUCH_TOLERANCE_MM} mm)"
+    return f"Distance to reference tip: **{fmt_num(touch.distance_mm)} mm**"
+
+
+def touch_label(index: int, T_world_flange: np.ndarray) -> str:
+    """Label of a recorded touch: ``P1  X 525.0 Y 0.0 Z 400.0 mm`` (flange origin, WORLD).
+
+    Args:
+        index: 0-based index; shown 1-based.
+        T_world_flange: (4,4) flange pose, metres.
+    """
+    p = np.asarray(T_world_flange, dtype=float)[:3, 3] * 1000.0
+    return f"P{index + 1}  X {fmt_num(p[0], 1)} Y {fmt_num(p[1], 1)} Z {fmt_num(p[2], 1)} mm"
+
+
+def tool_data_markdown(tool: Tool | None, slot: int | None = None) -> str:
+    """Active tool data: name (slot), TCP X, Y, Z mm and A, B, C deg, calibration method."""
+    if tool is None:
+        return "**Active tool:** none (TCP = flange)"
+    head = f"**Active tool:** {tool.name}" + ("" if slot is None else f" (slot {slot})")
+    x, y, z = (fmt_num(v) for v in tool.tcp_mm)
+    a, b, c = (fmt_num(v) for v in tool.abc_deg)
+    cal = "" if tool.calibration is None else f"\n\ncalibrated by {tool.calibration.method}"
+    return f"{head}\n\n```\nX {x}  Y {y}  Z {z} mm\nA {a}  B {b}  C {c} deg\n```{cal}"

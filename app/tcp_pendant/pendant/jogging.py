@@ -1,0 +1,170 @@
+"""Jog settings and the jog keys of the pendant (no viser).
+
+A real pendant jogs either one axis at a time (joint mode, A1..A6) or the TCP in a jog frame
+(Cartesian mode, X/Y/Z translations in mm and A/B/C rotations in deg about the Z/Y/X axis of
+the frame through the TCP, KUKA habit). Each -/+ key press moves
+
+* by the selected increment (100, 10, 1, 0.1 mm or deg) when the increment is not continuous;
+* in continuous mode, by ``speed * override * dt`` for every tick of the held key, where
+  ``speed`` is the manual-mode speed at 100 % override: 250 mm/s (KUKA T1 limit), 30 deg/s
+  for A/B/C and for joints, and ``dt`` (s) the time since the previous tick (clamped to
+  ``MAX_TICK_S`` so a stalled browser cannot produce a jump).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+from enum import Enum
+
+from tcp_pendant.controller import ControllerError, JogFrame, JogResult, VirtualController
+
+__all__ = [
+    "CARTESIAN_AXES",
+    "CONTINUOUS",
+    "INCREMENTS",
+    "JOG_FRAMES",
+    "JOINT_SPEED_DEG_S",
+    "LINEAR_SPEED_MM_S",
+    "MAX_TICK_S",
+    "ROTATION_SPEED_DEG_S",
+    "JogMode",
+    "JogSettings",
+    "Jogger",
+]
+
+CONTINUOUS = "Cont."
+INCREMENTS: tuple[str, ...] = (CONTINUOUS, "100", "10", "1", "0.1")
+"""Increment choices as the pendant shows them (mm for X/Y/Z, deg for A/B/C and joints)."""
+JOG_FRAMES: tuple[str, ...] = tuple(f.value for f in JogFrame)
+CARTESIAN_AXES: tuple[str, ...] = ("X", "Y", "Z", "A", "B", "C")
+LINEAR_SPEED_MM_S = 250.0
+ROTATION_SPEED_DEG_S = 30.0
+JOINT_SPEED_DEG_S = 30.0
+MAX_TICK_S = 0.15
+
+
+class JogMode(str, Enum):
+    """Joint jog (one axis at a time) or Cartesian jog (TCP in a jog frame)."""
+
+    JOINT = "Joint"
+    CARTESIAN = "Cartesian"
+
+
+@dataclass(frozen=True)
+class JogSettings:
+    """The pendant's jog selectors.
+
+    Attributes:
+        mode: joint or Cartesian.
+        frame: jog frame for Cartesian mode ("WORLD", "BASE", "FLANGE", "TOOL").
+        increment: one of :data:`INCREMENTS`.
+        override_pct: speed override, 1..100 %.
+    """
+
+    mode: JogMode = JogMode.CARTESIAN
+    frame: str = "WORLD"
+    increment: str = "10"
+    override_pct: float = 50.0
+
+    def __post_init__(self) -> None:
+        try:
+            object.__setattr__(self, "mode", JogMode(self.mode))
+        except ValueError:
+            raise ControllerError(f"Unknown jog mode {self.mode!r}; use Joint or Cartesian.") from None
+        frame = str(self.frame).upper()
+        if frame not in JOG_FRAMES:
+            raise ControllerError(f"Unknown jog frame {self.frame!r}; use one of {', '.join(JOG_FRAMES)}.")
+        object.__setattr__(self, "frame", frame)
+        if self.increment not in INCREMENTS:
+            raise ControllerError(f"Unknown increment {self.increment!r}; use one of {', '.join(INCREMENTS)}.")
+        try:
+            pct = float(self.override_pct)
+        except (TypeError, ValueError):
+            raise ControllerError(f"Speed override must be a number, got {self.override_pct!r}.") from None
+        if not math.isfinite(pct):
+            raise ControllerError(f"Speed override must be finite, got {self.override_pct!r}.")
+        object.__setattr__(self, "override_pct", min(100.0, max(1.0, pct)))
+
+    @property
+    def continuous(self) -> bool:
+        """True when the keys jog continuously while held."""
+        return self.increment == CONTINUOUS
+
+    def with_(self, **changes: object) -> JogSettings:
+        """A copy with some selectors changed (validated)."""
+        return replace(self, **changes)  # type: ignore[arg-type]
+
+    def step_amount(self, *, rotational: bool, joint: bool = False, dt_s: float | None = None) -> float:
+        """Size of one key press (mm or deg, positive).
+
+        Incremental mode: the increment. Continuous mode: ``speed * override/100 * dt_s``
+        with the speed of the module docstring and ``dt_s`` clamped to [0, MAX_TICK_S].
+        """
+        if not self.continuous:
+            return float(self.increment)
+        dt = MAX_TICK_S if dt_s is None else min(MAX_TICK_S, max(0.0, float(dt_s)))
+        speed = JOINT_SPEED_DEG_S if joint else (ROTATION_SPEED_DEG_S if rotational else LINEAR_SPEED_MM_S)
+        return speed * self.override_pct / 100.0 * dt
+
+
+class Jogger:
+    """Turns pendant key presses into controller commands.
+
+    Args:
+        controller: the session's controller (the caller holds the session lock).
+        clock: seconds, monotonic (injectable for tests).
+        tick_s: nominal hold-callback period; the first tick of a hold uses it as ``dt``.
+    """
+
+    def __init__(self, controller: VirtualController, *, clock: Callable[[], float] = time.monotonic,
+                 tick_s: float = 0.05) -> None:
+        self.controller = controller
+        self.settings = JogSettings()
+        self._clock = clock
+        self._tick_s = tick_s
+        self._last_tick: dict[str, float] = {}
+
+    def key(self, axis: str | int, sign: int, *, hold_tick: bool = False) -> JogResult | None:
+        """One press of a -/+ key.
+
+        Args:
+            axis: a joint index (0-based, joint jog) or "X".."C" (Cartesian jog in the selected
+                frame). The mode selector decides which keys the pendant shows; a key always
+                does what it says even if the mode changes while it is held.
+            sign: +1 or -1.
+            hold_tick: True when called by the held key's periodic callback. In continuous mode
+                only hold ticks move (a click is the first tick); in incremental mode only
+                clicks move (a held key does not repeat, as on a KUKA pendant).
+
+        Returns:
+            The controller's JogResult, or None when this call does not move in this mode.
+
+        Raises:
+            ControllerError: bad axis for the mode, bad sign.
+        """
+        if sign not in (1, -1):
+            raise ControllerError(f"Jog sign must be +1 or -1, got {sign!r}.")
+        s = self.settings
+        if hold_tick != s.continuous:
+            return None
+        name = f"{axis}{sign}"
+        dt = None
+        if s.continuous:
+            now = self._clock()
+            last = self._last_tick.get(name)
+            dt = self._tick_s if last is None or now - last > 2 * MAX_TICK_S else now - last
+            self._last_tick = {name: now}
+        if isinstance(axis, int) and not isinstance(axis, bool):
+            return self.controller.jog_joint(axis, sign * s.step_amount(rotational=True, joint=True, dt_s=dt))
+        ax = str(axis).upper()
+        if ax not in CARTESIAN_AXES:
+            raise ControllerError(f"Jog keys are joint indices or X, Y, Z, A, B, C; got {axis!r}.")
+        amount = s.step_amount(rotational=ax in "ABC", dt_s=dt)
+        return self.controller.jog_cartesian(s.frame, ax, sign * amount)
+
+    def release(self) -> None:
+        """Forget the hold timing (key released)."""
+        self._last_tick = {}

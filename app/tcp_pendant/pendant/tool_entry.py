@@ -1,0 +1,90 @@
+"""Numeric entry of a tool (X, Y, Z in mm; A, B, C in deg; a name), validated field by field.
+
+Nothing is built unless every field is valid: :func:`parse_tool_entry` returns either a
+:class:`tcpcal.Tool` (``calibration.method == "numeric"``) or the errors per field, so the view
+can show each error next to its field and save nothing half-way.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+from tcpcal.tool import Calibration, Tool
+
+__all__ = ["FIELDS", "MAX_ABS_MM", "ToolEntry", "ToolEntryResult", "parse_number", "parse_tool_entry"]
+
+FIELDS: tuple[str, ...] = ("X", "Y", "Z", "A", "B", "C")
+MAX_ABS_MM = 5000.0
+"""A TCP farther than 5 m from the flange is a typing error, not a tool."""
+
+
+def parse_number(text: str, what: str) -> float:
+    """A finite number from a text field; accepts a decimal comma (``"12,5"``).
+
+    Raises:
+        ValueError: with a message naming the field and what to type.
+    """
+    t = str(text).strip().replace(",", ".") if text is not None else ""
+    if not t:
+        raise ValueError(f"{what}: enter a number")
+    try:
+        v = float(t)
+    except ValueError:
+        raise ValueError(f"{what}: '{text}' is not a number") from None
+    if not math.isfinite(v):
+        raise ValueError(f"{what}: '{text}' is not a finite number")
+    return v
+
+
+@dataclass(frozen=True)
+class ToolEntry:
+    """Raw text of the entry form."""
+
+    name: str
+    values: Mapping[str, str]          # "X".."C" -> text
+
+
+@dataclass(frozen=True)
+class ToolEntryResult:
+    """Outcome of :func:`parse_tool_entry`: a tool, or the errors by field ("name", "X".."C")."""
+
+    tool: Tool | None
+    errors: Mapping[str, str] = field(default_factory=dict)
+
+    @property
+    def ok(self) -> bool:
+        """True when every field is valid."""
+        return self.tool is not None and not self.errors
+
+
+def parse_tool_entry(entry: ToolEntry) -> ToolEntryResult:
+    """Validate the form: a non-empty name, X/Y/Z in mm within +-5000, A/B/C in deg within
+    +-360 (A, B, C are KUKA angles, ``R = Rz(A) Ry(B) Rx(C)``)."""
+    errors: dict[str, str] = {}
+    name = (entry.name or "").strip()
+    if not name:
+        errors["name"] = "Name: enter a tool name"
+    nums: dict[str, float] = {}
+    for f in FIELDS:
+        unit = "mm" if f in "XYZ" else "deg"
+        try:
+            v = parse_number(entry.values.get(f, ""), f"{f} ({unit})")
+        except ValueError as exc:
+            errors[f] = str(exc)
+            continue
+        limit = MAX_ABS_MM if f in "XYZ" else 360.0
+        if abs(v) > limit:
+            errors[f] = f"{f} ({unit}): {v:g} is out of range (within ±{limit:g} {unit})"
+            continue
+        nums[f] = v
+    if errors:
+        return ToolEntryResult(None, errors)
+    try:
+        tool = Tool(name=name, tcp_mm=(nums["X"], nums["Y"], nums["Z"]),
+                    abc_deg=(nums["A"], nums["B"], nums["C"]),
+                    calibration=Calibration.now("numeric", {}))
+    except ValueError as exc:                       # tcpcal's own validation (e.g. the name)
+        return ToolEntryResult(None, {"name": f"Name: {exc}"})
+    return ToolEntryResult(tool, {})

@@ -1,0 +1,47 @@
+"""viser views of a pendant session: scene, jog panel, touch list, tool panel and the
+"Calibrate" tab where the wizard views plug in (see ``tcp_pendant.views.calibrate``).
+
+:func:`build_session_views` lays a session out as three tabs, like a pendant's menu:
+**Jog** (readouts, touch indicator, jog keys, touches), **Tool** (mounted tool, active tool
+data, library, export, numeric entry) and **Calibrate** (wizards).
+"""
+
+from __future__ import annotations
+
+from tcp_pendant.session import Session
+from tcp_pendant.views.calibrate import build_calibrate_tab, register_calibrate_view
+from tcp_pendant.views.pendant_panel import PendantPanel
+from tcp_pendant.views.scene import SceneView
+from tcp_pendant.views.tool_panel import ToolPanel
+from tcp_pendant.views.touch_list import TouchListView
+
+__all__ = [
+    "PendantPanel",
+    "SceneView",
+    "ToolPanel",
+    "TouchListView",
+    "build_calibrate_tab",
+    "build_session_views",
+    "register_calibrate_view",
+]
+
+
+def build_session_views(session: Session, *, title: str = "TCP Pendant") -> None:
+    """Build the scene and the GUI of ``session`` into ``session.target`` (under its lock).
+
+    Fills ``session.views`` with ``"scene"``, ``"pendant"``, ``"touches"``, ``"tools"`` (and
+    ``"calibrate"`` when a wizard plug-in is installed), then pushes the first state.
+    """
+    with session.lock, session.target.atomic():
+        gui = session.target.gui
+        session.views["scene"] = SceneView(session)
+        gui.add_markdown(f"### {title}")
+        tabs = gui.add_tab_group()
+        with tabs.add_tab("Jog"):
+            session.views["pendant"] = PendantPanel(session)
+            session.views["touches"] = TouchListView(session)
+        with tabs.add_tab("Tool"):
+            session.views["tools"] = ToolPanel(session)
+        build_calibrate_tab(session, tabs.add_tab("Calibrate"))
+        session.views["tabs"] = tabs
+    session.refresh()

@@ -1,0 +1,227 @@
+"""The jog panel of one session, laid out like a teach pendant (viser GUI).
+
+Top to bottom: TCP readout (frame + tool), touch indicator with "Hide distance", the status
+line (why a jog stopped), the jog selectors (mode, frame, increment, override), the jog keys
+(Cartesian -/+ X Y Z A B C, or per-joint slider and -/+ keys with the axis name and limits),
+Home, the camera buttons, and the touches ("Record point" and the list, deletable one by one).
+
+Widgets only call :class:`tcp_pendant.pendant.Jogger` and the session; all text comes from
+``tcp_pendant.pendant.formatting``. Feedback loops: setting a slider's value from Python fires
+its ``on_update`` synchronously with ``event.client is None``; those events are ignored, and
+``_syncing`` covers the same window for any other path.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from tcp_pendant.controller import JogResult
+from tcp_pendant.pendant import (
+    CARTESIAN_AXES,
+    INCREMENTS,
+    JOG_FRAMES,
+    JogMode,
+    joint_label,
+    joint_readout_markdown,
+    tcp_readout_markdown,
+    touch_indicator_markdown,
+)
+from tcp_pendant.session import Session
+
+__all__ = ["HOLD_HZ", "PendantPanel"]
+
+HOLD_HZ = 20.0
+"""Rate of the hold-to-jog callbacks (continuous jog ticks per second)."""
+
+_AXIS_HINT = {"X": "translate along X (mm)", "Y": "translate along Y (mm)", "Z": "translate along Z (mm)",
+              "A": "rotate about Z through the TCP (deg)", "B": "rotate about Y through the TCP (deg)",
+              "C": "rotate about X through the TCP (deg)"}
+
+
+class PendantPanel:
+    """Builds the jog panel in the current GUI container of ``session.target.gui``."""
+
+    def __init__(self, session: Session) -> None:
+        self.session = session
+        gui = session.target.gui
+        c = session.controller
+        k = c.kinematics
+        self._syncing = False
+        self._last_text: dict[str, str] = {}
+        self._last_stop = ""
+
+        self.readout_frame = gui.add_button_group("Readout", ("WORLD", "BASE"))
+        self.tcp_md = gui.add_markdown("")
+        self.touch_md = gui.add_markdown("")
+        self.hide_distance = gui.add_checkbox("Hide distance", False,
+                                              hint="Training: judge the touch by eye, as on a real robot.")
+        self.status_md = gui.add_markdown("")
+
+        with gui.add_folder("Jog settings"):
+            self.mode = gui.add_button_group("Mode", (JogMode.CARTESIAN.value, JogMode.JOINT.value))
+            self.frame = gui.add_dropdown("Jog frame", JOG_FRAMES, initial_value=session.jogger.settings.frame)
+            self.increment = gui.add_button_group("Increment", INCREMENTS,
+                                                  hint="mm for X/Y/Z, deg for A/B/C and joints; Cont. = hold to jog")
+            self.override = gui.add_slider("Override %", min=1, max=100, step=1,
+                                           initial_value=session.jogger.settings.override_pct)
+            self.settings_md = gui.add_markdown("")
+
+        self.cart_folder = gui.add_folder("Cartesian jog")
+        with self.cart_folder:
+            self.cart_buttons: dict[tuple[str, int], Any] = {}
+            for ax in CARTESIAN_AXES:
+                for sign, sym in ((-1, "−"), (1, "+")):
+                    b = gui.add_button(f"{ax} {sym}", hint=_AXIS_HINT[ax], color="gray" if sign < 0 else "blue")
+                    self._wire_key(b, ax, sign)
+                    self.cart_buttons[(ax, sign)] = b
+
+        self.joint_folder = gui.add_folder("Joint jog", visible=False)
+        with self.joint_folder:
+            self.joint_sliders: list[Any] = []
+            self.joint_buttons: dict[tuple[int, int], Any] = {}
+            q_deg = np.degrees(c.q_rad)
+            for i, name in enumerate(k.joint_names):
+                lo, hi = math.degrees(k.lower_rad[i]), math.degrees(k.upper_rad[i])
+                s = gui.add_slider(joint_label(name, lo, hi), min=lo, max=hi, step=0.01,
+                                   initial_value=float(np.clip(q_deg[i], lo, hi)))
+                s.on_update(self._slider_cb(i))
+                self.joint_sliders.append(s)
+                for sign, sym in ((-1, "−"), (1, "+")):
+                    b = gui.add_button(f"{name} {sym}", color="gray" if sign < 0 else "blue")
+                    self._wire_key(b, i, sign)
+                    self.joint_buttons[(i, sign)] = b
+
+        self.joints_md = gui.add_markdown("")
+        self.home = gui.add_button("Home", hint="Move to the home position (teleport).")
+        with gui.add_folder("View"):
+            self.closeup = gui.add_button("Close-up on reference tip")
+            self.overview_btn = gui.add_button("Overview")
+
+        g = session.guard
+        self.mode.on_click(g(self._setting("mode", JogMode)))
+        self.frame.on_update(g(self._setting("frame", str)))
+        self.increment.on_click(g(self._setting("increment", str)))
+        self.override.on_update(g(self._setting("override_pct", float)))
+        self.readout_frame.on_click(g(lambda _e: self.render()))
+        self.hide_distance.on_update(g(lambda _e: self.render()))
+        self.home.on_click(g(self._on_home))
+        self.closeup.on_click(g(self._on_camera(True)))
+        self.overview_btn.on_click(g(self._on_camera(False)))
+        self._show_settings()
+        session.add_renderer(self.render)
+
+    # ------------------------------------------------------------ wiring
+    def _wire_key(self, button: Any, axis: str | int, sign: int) -> None:
+        s = self.session
+
+        @s.guard
+        def click(_event: Any) -> None:
+            self._jog(axis, sign, hold_tick=False)
+
+        @s.guard
+        def hold(_event: Any) -> None:
+            self._jog(axis, sign, hold_tick=True)
+
+        button.on_click(click)
+        button.on_hold(hold, callback_hz=HOLD_HZ)
+
+    def _jog(self, axis: str | int, sign: int, *, hold_tick: bool) -> None:
+        res = self.session.jogger.key(axis, sign, hold_tick=hold_tick)
+        if hold_tick is False and self.session.jogger.settings.continuous:
+            self.session.jogger.release()            # the click that ends a hold
+        if res is None:
+            return
+        self.show_jog_result(res)
+        self.session.moved()
+
+    def _slider_cb(self, index: int) -> Any:
+        s = self.session
+
+        @s.guard
+        def cb(event: Any) -> None:
+            if self._syncing or event.client is None:
+                return                                # our own update of the slider: no loop
+            q = s.controller.q_rad
+            k = s.controller.kinematics
+            value = float(event.target.value)
+            if not math.isfinite(value):
+                return
+            q[index] = float(np.clip(math.radians(value), k.lower_rad[index], k.upper_rad[index]))
+            s.controller.set_q(q)
+            self.show_jog_result(JogResult(True, 1.0, None, ""))
+            s.moved()
+
+        return cb
+
+    def _setting(self, name: str, kind: Any) -> Any:
+        """Callback of one selector: only the selector that fired changes its setting (a button
+        group's value is the option just clicked)."""
+        def cb(event: Any) -> None:
+            js = self.session.jogger
+            js.settings = js.settings.with_(**{name: kind(event.target.value)})
+            js.release()
+            self._show_settings()
+            self.render()
+        return cb
+
+    def _show_settings(self) -> None:
+        st = self.session.jogger.settings
+        joint = st.mode is JogMode.JOINT
+        self.cart_folder.visible = not joint
+        self.joint_folder.visible = joint
+        self.frame.disabled = joint
+        unit = "deg" if joint else "mm / deg"
+        step = "continuous while held" if st.continuous else f"{st.increment} {unit} per press"
+        where = "joints" if joint else f"{st.frame} frame"
+        self._set_md(self.settings_md, "settings", f"{st.mode.value} jog in {where}, {step}, override {st.override_pct:.0f} %")
+
+    def _on_home(self, _event: Any) -> None:
+        self.session.controller.go_home()
+        self.show_jog_result(JogResult(True, 1.0, None, ""))
+        self.session.moved()
+
+    def _on_camera(self, close: bool) -> Any:
+        def cb(event: Any) -> None:
+            client = event.client
+            scene = self.session.views.get("scene")
+            if client is None or scene is None:
+                return
+            if close:
+                scene.look_at_tip(client)
+            else:
+                scene.overview(client)
+        return cb
+
+    # ------------------------------------------------------------ display
+    def show_jog_result(self, res: JogResult) -> None:
+        """Status line: the stop message of a jog (limit, singularity, unreachable), else clear."""
+        text = "" if res.ok else f"⚠ {res.message}"
+        self._set_md(self.status_md, "status", text)
+        if text and text != self._last_stop:
+            self.session.notify("Jog stopped", res.message, kind="warning")
+        self._last_stop = text
+
+    def _set_md(self, handle: Any, key: str, text: str) -> None:
+        if self._last_text.get(key) != text:
+            self._last_text[key] = text
+            handle.content = text
+
+    def render(self) -> None:
+        """Readouts, touch indicator and joint sliders from the controller (no feedback)."""
+        c = self.session.controller
+        frame = "BASE" if self.readout_frame.value == "BASE" else "WORLD"
+        tool = c.active_tool
+        self._set_md(self.tcp_md, "tcp", tcp_readout_markdown(c.readout(frame), None if tool is None else tool.name))
+        self._set_md(self.touch_md, "touch", touch_indicator_markdown(c.touch_geometry(),
+                                                                      hide_distance=bool(self.hide_distance.value)))
+        angles = c.joint_angles_deg()
+        self._set_md(self.joints_md, "joints", joint_readout_markdown(angles))
+        self._syncing = True
+        try:
+            for s, v in zip(self.joint_sliders, angles.values()):
+                s.value = round(float(v), 2)
+        finally:
+            self._syncing = False

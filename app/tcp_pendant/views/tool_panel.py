@@ -1,0 +1,219 @@
+"""The tool panel of one session (viser GUI): mounted tool, active tool data, the shared tool
+library (activate, rename, delete, export to controller text) and numeric tool entry.
+
+The library is the server's ``tcpcal.ToolLibrary`` (one file, shared by every session and
+process); :meth:`ToolPanel.reload` re-reads it, and the server calls it when the file changes,
+so a trainee sees the tools others save. Activating a tool sets the session controller's
+active tool data (and the library's active slot, as a controller's tool table would).
+
+Numeric entry: every field is validated (``tcp_pendant.pendant.tool_entry``) and its error is
+shown right under it; the tool is saved only if all fields are valid (nothing half-way).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from tcpcal.formats import FORMATS, export_tool
+from tcpcal.tool import Tool
+from tcp_pendant.controller import builtin_tools
+from tcp_pendant.pendant import FIELDS, ToolEntry, parse_tool_entry, tool_data_markdown
+from tcp_pendant.session import Session
+
+__all__ = ["NO_TOOL", "ToolPanel"]
+
+NO_TOOL = "(library empty)"
+_FORMAT_LABELS = {"kuka": "KUKA", "abb": "ABB", "fanuc": "FANUC", "ur": "UR", "matrix": "Matrix"}
+
+
+def _slot_option(slot: int, tool: Tool) -> str:
+    return f"{slot}: {tool.name}"
+
+
+def _slot_of(option: str) -> int | None:
+    head = str(option).split(":", 1)[0]
+    return int(head) if head.isdigit() else None
+
+
+class ToolPanel:
+    """Builds the tool panel in the current GUI container of ``session.target.gui``."""
+
+    def __init__(self, session: Session) -> None:
+        self.session = session
+        gui = session.target.gui
+        c = session.controller
+        self._tools = builtin_tools()
+        self._tool_key_by_label = {t.label: key for key, t in self._tools.items()}
+        labels = [t.label for t in self._tools.values()]
+        mounted = c.mounted_tool.label if c.mounted_tool.label in labels else labels[0]
+        self.mounted = gui.add_dropdown("Mounted tool", labels, initial_value=mounted,
+                                        hint="The physical tool bolted on the flange.")
+        self.active_md = gui.add_markdown("")
+        with gui.add_folder("Tool library"):
+            self.slots = gui.add_dropdown("Slot", (NO_TOOL,), initial_value=NO_TOOL)
+            self.slot_md = gui.add_markdown("")
+            self.activate = gui.add_button("Activate", color="blue")
+            self.deactivate = gui.add_button("No tool (TCP = flange)", color="gray")
+            self.new_name = gui.add_text("New name", "")
+            self.rename = gui.add_button("Rename")
+            self.delete = gui.add_button("Delete", color="red")
+        with gui.add_folder("Export", expand_by_default=False):
+            self.export_fmt = gui.add_dropdown("Format", [_FORMAT_LABELS[f] for f in FORMATS], initial_value="KUKA")
+            self.export = gui.add_button("Export")
+            self.export_text = gui.add_text("Controller text", "", multiline=True,
+                                            hint="Select and copy into the controller.")
+        with gui.add_folder("Enter tool numerically", expand_by_default=False):
+            self.entry_name = gui.add_text("Name", "")
+            self.entry_name_err = gui.add_markdown("", visible=False)
+            self.entry_fields: dict[str, Any] = {}
+            self.entry_errors: dict[str, Any] = {}
+            for f in FIELDS:
+                unit = "mm" if f in "XYZ" else "deg"
+                self.entry_fields[f] = gui.add_text(f"{f} ({unit})", "0")
+                self.entry_errors[f] = gui.add_markdown("", visible=False)
+            self.entry_slot = gui.add_dropdown("Save in slot", ("first free",), initial_value="first free")
+            self.entry_save = gui.add_button("Save to library", color="green")
+            self.entry_md = gui.add_markdown("")
+
+        g = session.guard
+        self.mounted.on_update(g(self._on_mount))
+        self.slots.on_update(g(lambda _e: self._show_slot()))
+        self.activate.on_click(g(self._on_activate))
+        self.deactivate.on_click(g(self._on_deactivate))
+        self.rename.on_click(g(self._on_rename))
+        self.delete.on_click(g(self._on_delete))
+        self.export.on_click(g(self._on_export))
+        self.entry_save.on_click(g(self._on_entry_save))
+        self._library: dict[int, Tool] = {}
+        self.reload()
+        self._show_active()
+
+    # ------------------------------------------------------------ library
+    def reload(self) -> None:
+        """Re-read the shared library and refresh the slot lists (keeps the selection)."""
+        lib = self.session.library.tools()
+        self._library = lib
+        options = tuple(_slot_option(s, t) for s, t in sorted(lib.items())) or (NO_TOOL,)
+        current = _slot_of(self.slots.value)
+        self.slots.options = options
+        pick = next((o for o in options if _slot_of(o) == current), options[0])
+        if self.slots.value != pick:
+            self.slots.value = pick
+        free = [str(s) for s in range(1, self.session.library.N_SLOTS + 1) if s not in lib]
+        entry_opts = ("first free", *free)
+        keep = self.entry_slot.value if self.entry_slot.value in entry_opts else "first free"
+        self.entry_slot.options = entry_opts
+        self.entry_slot.value = keep
+        self._show_slot()
+        self._show_active()
+
+    def _selected(self) -> tuple[int, Tool]:
+        slot = _slot_of(self.slots.value)
+        tool = None if slot is None else self._library.get(slot)
+        if slot is None or tool is None:
+            raise ValueError("Select a tool of the library first (the library is empty?).")
+        return slot, tool
+
+    def _show_slot(self) -> None:
+        slot = _slot_of(self.slots.value)
+        tool = None if slot is None else self._library.get(slot)
+        self.slot_md.content = "" if tool is None else tool_data_markdown(tool, slot).replace(
+            "**Active tool:**", "**Selected:**")
+
+    def _show_active(self) -> None:
+        self.active_md.content = tool_data_markdown(self.session.controller.active_tool, self.session.active_slot)
+
+    # ------------------------------------------------------------ callbacks
+    def _on_mount(self, event: Any) -> None:
+        key = self._tool_key_by_label.get(str(event.target.value))
+        if key is None:
+            raise ValueError(f"Unknown tool {event.target.value!r}.")
+        s = self.session
+        if key == s.controller.mounted_tool.key:
+            return
+        s.controller.mount_tool(self._tools[key])
+        scene = s.views.get("scene")
+        if scene is not None:
+            scene.set_mounted_tool(self._tools[key])
+        s.moved()
+
+    def set_active(self, slot: int | None, tool: Tool | None) -> None:
+        """Make ``tool`` the session's active tool data (from ``slot``; None: flange)."""
+        s = self.session
+        s.controller.set_active_tool(tool)
+        s.active_slot = slot if tool is not None else None
+        scene = s.views.get("scene")
+        if scene is not None:
+            scene.update_active_tool()
+        self._show_active()
+        s.moved()
+
+    def _on_activate(self, _event: Any) -> None:
+        slot, tool = self._selected()
+        self.session.library.activate(slot)
+        self.set_active(slot, tool)
+        self.session.notify("Tool activated", f"{slot}: {tool.name}", kind="success")
+
+    def _on_deactivate(self, _event: Any) -> None:
+        self.set_active(None, None)
+
+    def _on_rename(self, _event: Any) -> None:
+        slot, tool = self._selected()
+        name = str(self.new_name.value).strip()
+        if not name:
+            raise ValueError("Type the new name in 'New name' first.")
+        self.session.library.rename(slot, name)
+        self.new_name.value = ""
+        if self.session.active_slot == slot:
+            renamed = self.session.library.get(slot)
+            self.session.controller.set_active_tool(renamed)
+            scene = self.session.views.get("scene")
+            if scene is not None:
+                scene.update_active_tool()
+            self.session.refresh()
+        self.reload()
+
+    def _on_delete(self, _event: Any) -> None:
+        slot, tool = self._selected()
+        self.session.library.remove(slot)
+        self.session.notify("Tool deleted", f"{slot}: {tool.name}")
+        self.reload()
+
+    def _on_export(self, _event: Any) -> None:
+        slot, tool = self._selected()
+        label = str(self.export_fmt.value)
+        fmt = next((f for f, lab in _FORMAT_LABELS.items() if lab == label), None)
+        if fmt is None:
+            raise ValueError(f"Unknown export format {label!r}.")
+        kw = {"slot": slot} if fmt in ("kuka",) or (fmt == "fanuc" and slot <= 10) else {}
+        self.export_text.value = export_tool(tool, fmt, **kw)
+
+    def _on_entry_save(self, _event: Any) -> None:
+        entry = ToolEntry(str(self.entry_name.value), {f: str(h.value) for f, h in self.entry_fields.items()})
+        res = parse_tool_entry(entry)
+        lib = self.session.library
+        errors = dict(res.errors)
+        slot: int | None = None
+        if res.tool is not None:
+            found = lib.find(res.tool.name)
+            slot = lib.first_free_slot() if self.entry_slot.value == "first free" else int(self.entry_slot.value)
+            if found is not None:
+                errors["name"] = f"Name: '{res.tool.name}' is already in slot {found[0]}; choose another name"
+            elif slot is None:
+                errors["name"] = "Name: the library is full; delete a tool first"
+        self._show_entry_errors(errors)
+        if errors or res.tool is None or slot is None:
+            self.entry_md.content = "⚠ Not saved: correct the fields marked above."
+            return
+        lib.save(slot, res.tool)
+        self.entry_md.content = f"✅ Saved **{res.tool.name}** in slot {slot}."
+        self.reload()
+        self.slots.value = _slot_option(slot, res.tool)
+        self._show_slot()
+
+    def _show_entry_errors(self, errors: dict[str, str]) -> None:
+        pairs = [("name", self.entry_name_err), *((f, self.entry_errors[f]) for f in FIELDS)]
+        for key, handle in pairs:
+            msg = errors.get(key)
+            handle.content = "" if msg is None else f"**⚠ {msg}**"
+            handle.visible = msg is not None

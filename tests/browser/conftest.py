@@ -1,0 +1,168 @@
+"""Reusable fixtures for browser end-to-end tests (pytest + Playwright + Debian's chromium).
+
+* ``pendant_server(*extra_args)`` (factory fixture): starts ``python -m tcp_pendant`` in a
+  subprocess on a free port with a fresh tool library under ``tmp_path``, waits until the
+  HTTP port answers (up to 60 s), yields a :class:`ServerProcess` (``url``, ``library_path``,
+  ``log()``), and terminates it at the end of the test.
+* ``server``: one such server with default options.
+* ``browser``: a chromium launched once per session with ``executable_path='/usr/bin/chromium'``
+  (or ``$CHROMIUM``) and ``--no-sandbox --disable-gpu --disable-background-networking
+  --disable-component-update``.
+* ``new_page(url)`` (factory fixture): a fresh browser context + page at ``url``, waits for the
+  pendant's GUI ("Record point" button), closed at the end.
+* ``shot(page, name)``: screenshot into the test's ``tmp_path`` (returns the path).
+
+Software WebGL is slow: wait on conditions with generous timeouts, never fixed sleeps.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import socket
+import subprocess
+import sys
+import time
+import urllib.request
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import pytest
+
+CHROMIUM = os.environ.get("CHROMIUM", "/usr/bin/chromium")
+CHROMIUM_ARGS = ["--no-sandbox", "--disable-gpu", "--disable-background-networking", "--disable-component-update"]
+READY_TIMEOUT_S = 60.0
+UI_TIMEOUT_MS = 60_000
+
+
+def free_port() -> int:
+    """A TCP port that is free right now on 127.0.0.1."""
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
+        s.bind(("127.0.0.1", 0))
+        return int(s.getsockname()[1])
+
+
+@dataclass
+class ServerProcess:
+    """A pendant server running in a subprocess."""
+
+    proc: subprocess.Popen[bytes]
+    port: int
+    library_path: Path
+    log_path: Path
+    startup_s: float = field(default=float("nan"))
+
+    @property
+    def url(self) -> str:
+        return f"http://127.0.0.1:{self.port}"
+
+    def log(self) -> str:
+        return self.log_path.read_text(errors="replace") if self.log_path.exists() else ""
+
+
+def _start(tmp_path: Path, *extra: str) -> ServerProcess:
+    port = free_port()
+    lib = tmp_path / "tools.json"
+    log_path = tmp_path / f"server_{port}.log"
+    cmd = [sys.executable, "-m", "tcp_pendant", "--port", str(port), "--tool-library", str(lib), *extra]
+    t0 = time.perf_counter()
+    with open(log_path, "wb") as logf:
+        proc = subprocess.Popen(cmd, stdout=logf, stderr=subprocess.STDOUT)
+    sp = ServerProcess(proc, port, lib, log_path)
+    deadline = time.monotonic() + READY_TIMEOUT_S
+    while time.monotonic() < deadline:
+        if proc.poll() is not None:
+            raise RuntimeError(f"tcp-pendant exited with {proc.returncode}:\n{sp.log()}")
+        try:
+            with urllib.request.urlopen(sp.url, timeout=1.0) as r:
+                if r.status == 200:
+                    sp.startup_s = time.perf_counter() - t0
+                    return sp
+        except OSError:
+            time.sleep(0.05)
+    proc.kill()
+    raise RuntimeError(f"tcp-pendant did not answer on {sp.url} within {READY_TIMEOUT_S} s:\n{sp.log()}")
+
+
+def _stop(sp: ServerProcess) -> None:
+    if sp.proc.poll() is None:
+        sp.proc.terminate()
+        try:
+            sp.proc.wait(10)
+        except subprocess.TimeoutExpired:
+            sp.proc.kill()
+            sp.proc.wait(5)
+
+
+@pytest.fixture
+def pendant_server(tmp_path: Path) -> Iterator[Callable[..., ServerProcess]]:
+    """Factory: ``pendant_server("--shared", ...)`` starts a server with extra CLI options."""
+    started: list[ServerProcess] = []
+
+    def factory(*extra: str) -> ServerProcess:
+        sp = _start(tmp_path, *extra)
+        started.append(sp)
+        return sp
+
+    yield factory
+    for sp in started:
+        _stop(sp)
+
+
+@pytest.fixture
+def server(pendant_server: Callable[..., ServerProcess]) -> ServerProcess:
+    """A pendant server with default options (KR 6, pointer) and an empty tool library."""
+    return pendant_server()
+
+
+@pytest.fixture(scope="session")
+def browser() -> Iterator[object]:
+    """Chromium (Debian's) driven by Playwright, shared by the browser tests of one run."""
+    if not shutil.which(CHROMIUM) and not Path(CHROMIUM).exists():
+        pytest.fail(f"chromium not found at {CHROMIUM}; install it (apt-get install chromium) or set $CHROMIUM "
+                    "(scripts/run-tests.sh installs it).")
+    from playwright.sync_api import sync_playwright
+
+    with sync_playwright() as pw:
+        b = pw.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS, headless=True)
+        try:
+            yield b
+        finally:
+            b.close()
+
+
+@pytest.fixture
+def new_page(browser: object) -> Iterator[Callable[..., object]]:
+    """Factory: ``new_page(url)`` opens a fresh context (its own viser client) at ``url`` and
+    waits until the pendant GUI is there."""
+    contexts: list[object] = []
+
+    def factory(url: str, *, width: int = 1400, height: int = 900, wait_for: str = "Record point") -> object:
+        ctx = browser.new_context(viewport={"width": width, "height": height})  # type: ignore[attr-defined]
+        contexts.append(ctx)
+        page = ctx.new_page()
+        page.set_default_timeout(UI_TIMEOUT_MS)
+        page.goto(url)
+        if wait_for:
+            page.get_by_role("button", name=wait_for).first.wait_for(state="visible", timeout=UI_TIMEOUT_MS)
+        return page
+
+    yield factory
+    for ctx in contexts:
+        try:
+            ctx.close()  # type: ignore[attr-defined]
+        except Exception:
+            pass
+
+
+@pytest.fixture
+def shot(tmp_path: Path) -> Callable[[object, str], Path]:
+    """``shot(page, "name")`` saves ``tmp_path/name.png`` and returns its path."""
+
+    def take(page: object, name: str) -> Path:
+        path = tmp_path / f"{name}.png"
+        page.screenshot(path=str(path))  # type: ignore[attr-defined]
+        return path
+
+    return take
