@@ -34,7 +34,7 @@ from tcp_pendant.controller import (
     reference_tip_model,
 )
 from tcp_pendant.session import Session
-from tcp_pendant.views import build_session_views
+from tcp_pendant.views import SceneView, build_session_views
 from tcp_pendant.views.meshes import link_meshes, rigid_meshes
 
 __all__ = ["AppConfig", "PendantApp", "default_reference_tip_mm", "is_loopback"]
@@ -243,8 +243,12 @@ class PendantApp:
 
         host = self.config.host
         self.server = viser.ViserServer(host=host, port=self.config.port, verbose=False)
-        self.server.gui.configure_theme(control_layout="fixed", control_width="large", dark_mode=False,
-                                        show_logo=False, show_share_button=False)
+        self.server.gui.configure_theme(control_width="large", dark_mode=False, show_logo=False,
+                                        show_share_button=False)
+        self.server.gui.main_panel.dock_right()
+        position, look_at = SceneView.overview_pose(self.reference_tip_m)
+        self.server.initial_camera.position = position
+        self.server.initial_camera.look_at = look_at
         if self.config.shared:
             self.shared_session = self.make_session(None, target=self.server)
         self.server.on_client_connect(self._on_connect)

@@ -28,7 +28,7 @@ from tcp_pendant.views.meshes import MeshPart, link_meshes, rigid_meshes
 
 __all__ = ["SceneView", "wxyz_xyz"]
 
-OVERVIEW_OFFSET_M = np.array([1.6, -1.5, 0.9])
+OVERVIEW_OFFSET_M = np.array([1.15, -1.25, 0.55])
 CLOSEUP_OFFSET_M = np.array([0.22, -0.26, 0.12])
 
 
@@ -82,7 +82,7 @@ class SceneView:
         self._moving = [n for n in self.link_frames if n != k.base_link]
         fl = f"/robot/{self.flange_link}"
         scene.add_frame(f"{fl}/flange_axes", axes_length=0.09, axes_radius=0.004)
-        scene.add_label(f"{fl}/flange_axes/label", "FLANGE", position=(0.0, 0.0, 0.09))
+        scene.add_label(f"{fl}/flange_axes/label", "FLANGE", position=(0.0, 0.05, 0.0))
         self._tool_root = f"{fl}/tool"
         self._tool_frame: Any = None
         self.set_mounted_tool(c.mounted_tool)
@@ -136,7 +136,8 @@ class SceneView:
         self._active_axes.wxyz = wxyz
         self._active_axes.position = xyz
         tool = c.active_tool
-        self._active_label.text = "TOOL = FLANGE (no tool data)" if tool is None else f"TOOL {tool.name}"
+        self._active_axes.visible = tool is not None      # no tool data: TOOL = FLANGE
+        self._active_label.text = "TOOL" if tool is None else f"TOOL {tool.name}"
 
     def update_reference_tip(self) -> None:
         """Re-place the stand after the reference tip moved."""
@@ -150,17 +151,22 @@ class SceneView:
     def look_at_tip(self, client: Any) -> None:
         """Close-up camera on the reference tip (fine approach) for one browser."""
         tip = self.session.controller.reference_tip_world_m
-        with client.atomic():
-            client.camera.look_at = tip
+        with client.atomic():                    # position first: its setter shifts look_at
             client.camera.position = tip + CLOSEUP_OFFSET_M
+            client.camera.look_at = tip
 
     def overview(self, client: Any) -> None:
         """Camera on the whole cell."""
-        tip = self.session.controller.reference_tip_world_m
-        target = np.array([0.5 * tip[0], 0.0, 0.45])
-        with client.atomic():
-            client.camera.look_at = target
-            client.camera.position = target + OVERVIEW_OFFSET_M
+        position, look_at = self.overview_pose(self.session.controller.reference_tip_world_m)
+        with client.atomic():                    # position first: its setter shifts look_at
+            client.camera.position = position
+            client.camera.look_at = look_at
+
+    @staticmethod
+    def overview_pose(tip_world_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(camera position, look-at point) of the overview, WORLD metres."""
+        target = np.array([0.5 * float(tip_world_m[0]), 0.0, 0.45])
+        return target + OVERVIEW_OFFSET_M, target
 
     # ------------------------------------------------------------ gizmo
     def _on_gizmo(self, event: Any) -> None:

@@ -1,0 +1,63 @@
+"""Fixtures of the app tests: controllers on the KR 6, a tool library in tmp_path, a pendant
+server in-process on a free port (real viser server, headless websocket clients)."""
+
+from __future__ import annotations
+
+import socket
+import time
+from collections.abc import Callable, Iterator
+from pathlib import Path
+
+import pytest
+
+from tcpcal.library import ToolLibrary
+from tcp_pendant.controller import RobotKinematics, VirtualController, builtin_robots, builtin_tools
+
+
+def free_port() -> int:
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
+        s.bind(("127.0.0.1", 0))
+        return int(s.getsockname()[1])
+
+
+def wait_until(cond: Callable[[], bool], timeout: float = 20.0, what: str = "condition") -> None:
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if cond():
+            return
+        time.sleep(0.01)
+    raise AssertionError(f"timed out waiting for {what}")
+
+
+@pytest.fixture(scope="session")
+def kr6() -> RobotKinematics:
+    return RobotKinematics.from_urdf(builtin_robots()["kr6"])
+
+
+@pytest.fixture
+def controller(kr6: RobotKinematics) -> VirtualController:
+    k = RobotKinematics(kr6.model, kr6.urdf_path, kr6.flange_link, kr6.base_link)
+    return VirtualController(k, tool=builtin_tools()["pointer"])
+
+
+@pytest.fixture
+def library(tmp_path: Path) -> ToolLibrary:
+    return ToolLibrary(tmp_path / "tools.json")
+
+
+@pytest.fixture
+def app_factory(tmp_path: Path) -> Iterator[Callable[..., object]]:
+    from tcp_pendant.server import AppConfig, PendantApp
+
+    apps: list[PendantApp] = []
+
+    def make(**kw: object) -> PendantApp:
+        cfg = AppConfig(port=free_port(), tool_library=tmp_path / "tools.json", library_poll_s=0.1, **kw)  # type: ignore[arg-type]
+        app = PendantApp(cfg)
+        app.start()
+        apps.append(app)
+        return app
+
+    yield make
+    for a in apps:
+        a.stop()
