@@ -108,6 +108,30 @@ def default_reference_tip_mm(kinematics: RobotKinematics) -> tuple[float, float,
     return (float(p[0]), float(p[1]), float(0.5 * p[2]))
 
 
+def ready_configuration(kinematics: RobotKinematics) -> np.ndarray:
+    """The session's start ("ready") pose, rad: HOME with the 5th axis turned +-90 deg so the
+    flange points straight down, if that is within the limits.
+
+    KUKA HOME has A5 = 0, a wrist singularity where Cartesian jogs along Y stop at once; with
+    the flange pointing down the wrist is well conditioned and the tool hangs over the
+    reference tip, the natural start of a touch-up. Other robots (fewer than 5 axes, or no
+    such pose): HOME.
+    """
+    home = np.array(kinematics.home_rad, dtype=float)
+    if kinematics.n_joints < 5 or not kinematics.revolute[4]:
+        return home
+    best, best_dot = home, 0.9
+    for a5 in (np.pi / 2, -np.pi / 2):
+        q = home.copy()
+        q[4] = a5
+        if not kinematics.lower_rad[4] <= a5 <= kinematics.upper_rad[4]:
+            continue
+        down = -float(kinematics.T_base_flange(q)[2, 2])      # flange Z . (-WORLD Z)
+        if down > best_dot:
+            best, best_dot = q, down
+    return best
+
+
 class PendantApp:
     """The pendant server.
 
@@ -131,6 +155,7 @@ class PendantApp:
         if tip_m.shape != (3,) or not np.all(np.isfinite(tip_m)):
             raise ControllerError(f"Reference tip must be 3 finite numbers X,Y,Z in mm, got {tip!r}.")
         self.reference_tip_m = tip_m
+        self.ready_q_rad = ready_configuration(self.kinematics)
         self.library = ToolLibrary(config.tool_library)
         self.robot_label = ROBOT_LABELS.get(config.robot, urdf.stem)
         self.server: Any = None
@@ -151,13 +176,14 @@ class PendantApp:
         k = self.kinematics
         kin = RobotKinematics(k.model, k.urdf_path, k.flange_link, k.base_link)
         c = VirtualController(kin, tool=self.tool, reference_tip_world_m=self.reference_tip_m)
+        c.set_q(self.ready_q_rad)
         return c
 
     def make_session(self, client: Any | None, target: Any | None = None) -> Session:
         """Build a session drawing into ``target`` (default: ``client``), with the library's
         active tool as its active tool data."""
         c = self.new_controller()
-        session = Session(c, self.library, client=client, target=target)
+        session = Session(c, self.library, client=client, target=target, ready_q_rad=self.ready_q_rad)
         try:
             slot = self.library.active_slot()
             tool = None if slot is None else self.library.get(slot)

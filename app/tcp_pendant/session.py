@@ -83,6 +83,7 @@ class Session:
         active_slot: library slot of the active tool data (None: no tool or typed-in only).
         calibrate_container: the GUI container of the "Calibrate" tab, where wizard views plug
             in (see ``tcp_pendant.views.calibrate``); None before the views are built.
+        ready_q_rad: the "Ready pose" button's joint angles (None: the robot's HOME).
         views: named view objects (``"scene"``, ``"pendant"``, ``"tools"``, ...), for tests
             and for the wizard views.
     """
@@ -95,6 +96,7 @@ class Session:
     lock: threading.RLock = field(default_factory=threading.RLock)
     active_slot: int | None = None
     calibrate_container: Any | None = None
+    ready_q_rad: np.ndarray | None = None
     views: dict[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:

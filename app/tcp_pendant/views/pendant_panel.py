@@ -95,7 +95,10 @@ class PendantPanel:
                     self.joint_buttons[(i, sign)] = b
 
         self.joints_md = gui.add_markdown("")
-        self.home = gui.add_button("Home", hint="Move to the home position (teleport).")
+        self.home = gui.add_button("Ready pose", hint="Back to the start pose (teleport): HOME with the "
+                                   "flange pointing down.")
+        self.kuka_home = gui.add_button("HOME", hint="The robot's HOME position (teleport); on a KR 6 the "
+                                        "wrist is singular there (A5 = 0).")
         with gui.add_folder("View"):
             self.closeup = gui.add_button("Close-up on reference tip")
             self.overview_btn = gui.add_button("Overview")
@@ -108,6 +111,7 @@ class PendantPanel:
         self.readout_frame.on_click(g(lambda _e: self.render()))
         self.hide_distance.on_update(g(lambda _e: self.render()))
         self.home.on_click(g(self._on_home))
+        self.kuka_home.on_click(g(self._on_kuka_home))
         self.closeup.on_click(g(self._on_camera(True)))
         self.overview_btn.on_click(g(self._on_camera(False)))
         self._show_settings()
@@ -179,6 +183,14 @@ class PendantPanel:
         self._set_md(self.settings_md, "settings", f"{st.mode.value} jog in {where}, {step}, override {st.override_pct:.0f} %")
 
     def _on_home(self, _event: Any) -> None:
+        if self.session.ready_q_rad is None:
+            self.session.controller.go_home()
+        else:
+            self.session.controller.set_q(self.session.ready_q_rad)
+        self.show_jog_result(JogResult(True, 1.0, None, ""))
+        self.session.moved()
+
+    def _on_kuka_home(self, _event: Any) -> None:
         self.session.controller.go_home()
         self.show_jog_result(JogResult(True, 1.0, None, ""))
         self.session.moved()
