@@ -98,6 +98,8 @@ def test_slider_sync_does_not_feed_back(app_factory) -> None:
     c = _connect(app, 0)
     try:
         (s,) = app.sessions.values()
+        s.views["pendant"].mode.value = "Joint"          # sliders are synced while shown
+        assert s.views["pendant"].joint_folder.visible
         q = s.controller.q_rad
         q[1] += 0.123456789e-3
         with s.lock:

@@ -231,6 +231,8 @@ class PendantPanel:
                                                                       hide_distance=bool(self.hide_distance.value)))
         angles = c.joint_angles_deg()
         self._set_md(self.joints_md, "joints", joint_readout_markdown(angles))
+        if not self.joint_folder.visible:
+            return                      # hidden sliders are synced when joint mode is shown
         self._syncing = True
         try:
             for s, v in zip(self.joint_sliders, angles.values()):
