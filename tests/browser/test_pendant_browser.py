@@ -57,14 +57,33 @@ def field(page, label: str):
     return row.locator("input, textarea").first
 
 
-def type_into(page, label: str, text: str) -> None:
-    """Type into a text field like a user (select all, then key by key). Playwright's
-    ``fill`` sets several fields faster than viser's client throttles its updates, and an
-    update of one field can then be dropped; typing keeps every field's last value."""
+def entry_preview(page) -> str:
+    """Text of the numeric entry's live preview (what the server has received)."""
+    pattern = re.compile(r"· X .+ mm · A .+ deg\s+(✔ ready to save|⚠)")
+    block = page.locator("div").filter(has_text=pattern).last     # innermost: both lines
+    return block.inner_text(timeout=TIMEOUT_MS)
+
+
+def type_into(page, label: str, text: str, echo: str | None = None) -> None:
+    """Type into a text field like a user (select all, then key by key), then wait until the
+    server has it: ``echo`` must appear in the entry preview, which the server rewrites on every
+    field update. viser's client sends GUI updates through one 50 ms throttle slot where a newer
+    message replaces a pending one, so moving on before the echo could drop this field's last
+    keystrokes (or the click that follows)."""
     f = field(page, label)
     f.click()
     f.press("Control+a")
     f.press_sequentially(text)
+    if echo is None:
+        return
+    deadline = time.monotonic() + TIMEOUT_MS / 1000
+    last = ""
+    while time.monotonic() < deadline:
+        last = entry_preview(page)
+        if echo in last:
+            return
+        page.wait_for_timeout(50)
+    raise AssertionError(f"the server never echoed {echo!r} for {label!r}; preview: {last!r}")
 
 
 def test_two_pages_jog_record_and_tool_entry(server, new_page, shot) -> None:
@@ -100,17 +119,22 @@ def test_two_pages_jog_record_and_tool_entry(server, new_page, shot) -> None:
     # --- numeric entry with a bad number: error next to the field, nothing saved
     p1.get_by_role("tab", name="Tool").click()
     p1.get_by_text("Enter tool numerically").click()
-    type_into(p1, "Name", "Pen")
-    for label, value in (("X (mm)", "12.5"), ("Y (mm)", "-3"), ("Z (mm)", "1o0"),
-                         ("A (deg)", "0"), ("B (deg)", "90"), ("C (deg)", "0")):
-        type_into(p1, label, value)
+    type_into(p1, "Name", "Pen", "Pen")
+    for label, value, echo in (("X (mm)", "12.5", "X 12.50"), ("Y (mm)", "-3", "Y -3.00"),
+                               ("Z (mm)", "1o0", "Z ?"), ("A (deg)", "0", "A 0.00"),
+                               ("B (deg)", "90", "B 90.00"), ("C (deg)", "0", "C 0.00")):
+        type_into(p1, label, value, echo)
+    assert "'1o0' is not a number" in entry_preview(p1)       # live, before any save
     p1.get_by_role("button", name="Save to library").click()
-    p1.get_by_text("'1o0' is not a number").wait_for(timeout=TIMEOUT_MS)
+    p1.get_by_text("Not saved: correct the fields marked above").wait_for(timeout=TIMEOUT_MS)
+    p1.get_by_text("Z (mm): '1o0' is not a number").first.wait_for(timeout=TIMEOUT_MS)
     assert ToolLibrary(server.library_path).tools() == {}
     shot(p1, "tool_entry_error")
-    type_into(p1, "Z (mm)", "100")
+    type_into(p1, "Z (mm)", "100", "Z 100.00")
+    assert "Pen · X 12.50 Y -3.00 Z 100.00 mm · A 0.00 B 90.00 C 0.00 deg" in entry_preview(p1)
+    assert "ready to save" in entry_preview(p1)
     p1.get_by_role("button", name="Save to library").click()
-    p1.get_by_text("Saved").wait_for(timeout=TIMEOUT_MS)
+    p1.get_by_text(re.compile(r"Saved Pen in slot 1")).wait_for(timeout=TIMEOUT_MS)
     tools = ToolLibrary(server.library_path).tools()
     assert list(tools) == [1] and tools[1].name == "Pen" and tools[1].tcp_mm == (12.5, -3.0, 100.0)
 

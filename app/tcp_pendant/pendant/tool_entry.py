@@ -12,8 +12,17 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 from tcpcal.tool import Calibration, Tool
+from tcp_pendant.pendant.formatting import fmt_num
 
-__all__ = ["FIELDS", "MAX_ABS_MM", "ToolEntry", "ToolEntryResult", "parse_number", "parse_tool_entry"]
+__all__ = [
+    "FIELDS",
+    "MAX_ABS_MM",
+    "ToolEntry",
+    "ToolEntryResult",
+    "entry_preview_markdown",
+    "parse_number",
+    "parse_tool_entry",
+]
 
 FIELDS: tuple[str, ...] = ("X", "Y", "Z", "A", "B", "C")
 MAX_ABS_MM = 5000.0
@@ -88,3 +97,27 @@ def parse_tool_entry(entry: ToolEntry) -> ToolEntryResult:
     except ValueError as exc:                       # tcpcal's own validation (e.g. the name)
         return ToolEntryResult(None, {"name": f"Name: {exc}"})
     return ToolEntryResult(tool, {})
+
+
+def entry_preview_markdown(entry: ToolEntry) -> str:
+    """The form's live preview: what "Save" would store, as the server has received it.
+
+    One line with the name and every field as it will be stored (two decimals, mm and deg;
+    ``?`` for a field that is not a valid number), then either "ready to save" or the errors.
+    A decimal comma typed in a field shows here as the number it means, so the user sees
+    what the controller will hold before saving.
+    """
+    name = (entry.name or "").strip()
+    shown: list[str] = []
+    for f in FIELDS:
+        try:
+            v = parse_number(entry.values.get(f, ""), f)
+            text = fmt_num(v) if abs(v) <= (MAX_ABS_MM if f in "XYZ" else 360.0) else "?"
+        except ValueError:
+            text = "?"
+        shown.append(f"{f} {text}")
+    head = (f"**{name}**" if name else "*(no name)*") + \
+        f" · {' '.join(shown[:3])} mm · {' '.join(shown[3:])} deg"
+    res = parse_tool_entry(entry)
+    status = "✔ ready to save" if res.ok else "⚠ " + "; ".join(res.errors.values())
+    return f"{head}\n\n{status}"

@@ -18,6 +18,7 @@ from tcpcal.formats import FORMATS, export_tool
 from tcpcal.tool import Tool
 from tcp_pendant.controller import builtin_tools
 from tcp_pendant.pendant import FIELDS, ToolEntry, parse_tool_entry, tool_data_markdown
+from tcp_pendant.pendant.tool_entry import entry_preview_markdown
 from tcp_pendant.session import Session
 
 __all__ = ["NO_TOOL", "ToolPanel"]
@@ -72,6 +73,7 @@ class ToolPanel:
                 self.entry_fields[f] = gui.add_text(f"{f} ({unit})", "0")
                 self.entry_errors[f] = gui.add_markdown("", visible=False)
             self.entry_slot = gui.add_dropdown("Save in slot", ("first free",), initial_value="first free")
+            self.entry_preview = gui.add_markdown("")
             self.entry_save = gui.add_button("Save to library", color="green")
             self.entry_md = gui.add_markdown("")
 
@@ -84,6 +86,9 @@ class ToolPanel:
         self.delete.on_click(g(self._on_delete))
         self.export.on_click(g(self._on_export))
         self.entry_save.on_click(g(self._on_entry_save))
+        for handle in (self.entry_name, *self.entry_fields.values()):
+            handle.on_update(g(lambda _e: self._show_entry_preview()))
+        self._show_entry_preview()
         self._library: dict[int, Tool] = {}
         self.reload()
         self._show_active()
@@ -188,9 +193,15 @@ class ToolPanel:
         kw = {"slot": slot} if fmt in ("kuka",) or (fmt == "fanuc" and slot <= 10) else {}
         self.export_text.value = export_tool(tool, fmt, **kw)
 
+    def _entry(self) -> ToolEntry:
+        return ToolEntry(str(self.entry_name.value), {f: str(h.value) for f, h in self.entry_fields.items()})
+
+    def _show_entry_preview(self) -> None:
+        """Live line under the form: what Save would store, as this server has received it."""
+        self.entry_preview.content = entry_preview_markdown(self._entry())
+
     def _on_entry_save(self, _event: Any) -> None:
-        entry = ToolEntry(str(self.entry_name.value), {f: str(h.value) for f, h in self.entry_fields.items()})
-        res = parse_tool_entry(entry)
+        res = parse_tool_entry(self._entry())
         lib = self.session.library
         errors = dict(res.errors)
         slot: int | None = None
