@@ -16,8 +16,7 @@ from tcp_pendant.wizards.autotouch import auto_touch
 from tcp_pendant.wizards.session_record import WizardRun, replay, session_from_controller
 from tcp_pendant.wizards.truth import compare_with_truth
 
-controller = pytest.importorskip("tcp_pendant.controller",
-                                 reason="tcp_pendant.controller (issue 3) is not in the tree yet")
+import tcp_pendant.controller as controller
 
 ROBOTS = ("kr6", "gp12")
 TOOL_KEYS = ("pointer", "torch", "gripper")
