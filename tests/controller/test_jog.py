@@ -11,7 +11,7 @@ from scipy.spatial.transform import Rotation
 
 from tcp_pendant.controller import ControllerError, JogFrame
 
-from .conftest import angle_deg, distance_to_line_mm, make_controller
+from .conftest import WORK_Q_DEG, angle_deg, distance_to_line_mm, make_controller
 
 
 def _base_frame() -> np.ndarray:
@@ -156,6 +156,10 @@ def test_stretching_the_arm_stops_at_the_elbow_singularity():
     # A3 stopped near the stretched arm: forearm in line with the upper arm at -atan(35/420)... + 90
     # deg of KUKA zero offset is not involved: the stretched arm is A3 = atan2(35, 420) = 4.76 deg
     assert math.degrees(ctrl.q_rad[2]) == pytest.approx(math.degrees(math.atan2(35, 420)), abs=5.0)
+    q_stop = ctrl.q_rad
+    for amount in (-0.1, -1.0, -10.0):  # every increment backs out of the stretched arm
+        ctrl.set_q(q_stop)
+        assert ctrl.jog_cartesian("TOOL", "Z", amount).ok
 
 
 def test_gp12_wrist_singularity_names_b():
@@ -202,3 +206,46 @@ def test_bad_jog_input_is_rejected_with_the_controllers_error():
         ctrl.set_q(np.radians([0, -200, 90, 0, 0, 0]))
     with pytest.raises(ControllerError, match="6 joint values"):
         ctrl.set_q([0.0, 0.0])
+
+
+@pytest.mark.parametrize("frame", ["WORLD", "TOOL", "FLANGE"])
+def test_turning_the_long_torch_about_its_tip_stops_only_at_a_named_limit_or_singularity(robot, frame):
+    """The torch's TCP is 339 mm from the flange: turning it about the TCP swings the flange on
+    a 339 mm circle, so the axes move several degrees per degree. That is a legitimate motion:
+    a 100 deg rotation jog (the pendant's largest increment) either completes or stops at a
+    joint limit or a singularity that the message names, never with an unexplained stop, and
+    the TCP stays put throughout."""
+    for axis in ("A", "B", "C"):
+        for sign in (1.0, -1.0):
+            ctrl = make_controller(robot, "torch")
+            p0 = ctrl.T_world_tcp()[:3, 3]
+            res = ctrl.jog_cartesian(frame, axis, sign * 100.0)
+            assert res.stopped_by in (None, "joint_limit", "singularity"), (axis, sign, res)
+            if res.stopped_by == "joint_limit":
+                assert " at its limit " in res.message
+            elif res.stopped_by == "singularity":
+                assert "singularity" in res.message
+            assert np.linalg.norm(ctrl.T_world_tcp()[:3, 3] - p0) * 1000.0 < 0.01
+
+
+@pytest.mark.parametrize("increment", [100.0, 10.0, 1.0, 0.1])
+@pytest.mark.parametrize("frame", ["WORLD", "TOOL"])
+def test_every_pendant_increment_is_one_exact_move(robot, frame, increment):
+    """One press of each increment (100, 10, 1, 0.1 mm or deg) moves exactly that far: the TCP
+    on its line (< 0.01 mm) with the orientation held, or turned about the TCP, then back."""
+    ctrl = make_controller(robot, "pointer")
+    T0 = ctrl.T_world_tcp()
+    direction = {"WORLD": np.array([0.0, 0.0, -1.0]), "TOOL": T0[:3, 0]}[frame]
+    res = ctrl.jog_cartesian(frame, "Z" if frame == "WORLD" else "X", increment * (-1.0 if frame == "WORLD" else 1.0))
+    assert res.ok, res
+    T = ctrl.T_world_tcp()
+    assert distance_to_line_mm(T[:3, 3], T0[:3, 3], direction) < 0.01
+    assert (T[:3, 3] - T0[:3, 3]) @ direction * 1000.0 == pytest.approx(increment, abs=1e-6)
+    assert angle_deg(T[:3, :3], T0[:3, :3]) < 0.001
+    turn = increment
+    ctrl.set_q(np.radians(WORK_Q_DEG[robot]))  # back to the start, then turn about the tip
+    res = ctrl.jog_cartesian(frame, "A", turn)
+    assert res.ok, res
+    T = ctrl.T_world_tcp()
+    assert np.linalg.norm(T[:3, 3] - T0[:3, 3]) * 1000.0 < 0.01
+    assert angle_deg(T[:3, :3], T0[:3, :3]) == pytest.approx(turn, abs=0.001)

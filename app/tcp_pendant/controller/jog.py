@@ -25,13 +25,23 @@ singular value ``sigma_min`` of the scaled flange Jacobian ``W J_flange`` is bel
 
 **Safety rules** (a sub-step is *rejected*, the robot stays at the last accepted sub-step):
   * no convergence within the iteration budget (target off the reachable set);
-  * a joint change above ``max_joint_gain`` (5 deg per mm or deg of TCP motion): the
-    configuration would jump (this is what happens next to a singularity or on a flip);
+  * a joint change above ``max_joint_gain`` (5 deg per mm or deg of *flange* motion): the
+    configuration would jump (this is what happens next to a singularity or on a flip). The
+    flange motion of a sub-step is bounded by ``|dp| + |w| |t|`` (mm) plus ``|w|`` (deg): a
+    rotation about a TCP ``|t|`` away from the flange swings the flange on a circle of radius
+    ``|t|``, so a long torch turning about its tip legitimately moves the axes a lot;
   * a joint outside its limits -> ``stopped_by="joint_limit"``, e.g. "A5 at its limit +120.0 deg";
   * ``sigma_min`` below ``eps`` (sin 2 deg, i.e. A5 within about 2 deg of 0 on a KR 6) *and*
     decreasing -> ``stopped_by="singularity"``. A motion that keeps or increases
     ``sigma_min`` is allowed, so a robot sitting exactly in a singularity (KUKA HOME has A5 = 0)
-    can still jog in the directions it can follow.
+    can still jog in the directions it can follow;
+  * for a six-joint arm, a sign change of ``det J_flange`` between the start and the end of the
+    sub-step (both ``sigma_min`` above ``singular_zero``) -> ``stopped_by="singularity"``: the
+    arm would pass *through* a singularity into another configuration (wrist flip through
+    A5 = 0, elbow through the stretched arm, shoulder over the A1 axis). ``det J`` changes
+    sign exactly on the singular set, so this catches the continuous crossings that start inside
+    the ``eps`` zone (where ``sigma_min`` need not decrease: +0.5 deg -> -0.5 deg), and the
+    joint-change rule above catches the jumps.
 
 A rejected sub-step is bisected (up to 8 times) so the robot stops close to the limit or the
 singularity; ``moved`` is the fraction of the path carried out.
@@ -102,7 +112,7 @@ class JogSettings:
     max_substep_m: float = 0.002
     max_substep_rad: float = math.radians(1.0)
     max_joint_gain: float = 5.0
-    """Largest joint change per sub-step, in deg per (mm + deg) of TCP motion (rad per (m/1000 + rad))."""
+    """Largest joint change per sub-step, in deg per (mm + deg) of flange motion (see the module doc)."""
     min_joint_allowance_rad: float = math.radians(0.02)
     tol_m: float = 1e-10
     tol_rad: float = 1e-10
@@ -111,6 +121,8 @@ class JogSettings:
     singular_eps: float = math.sin(math.radians(2.0))
     lambda_max: float = 0.002
     bisections: int = 8
+    singular_zero: float = 1e-7
+    """``sigma_min`` below which a configuration counts as *on* the singularity (no det sign)."""
 
 
 DEFAULT_SETTINGS = JogSettings()
@@ -193,18 +205,29 @@ def _skew(v: np.ndarray) -> np.ndarray:
     return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
 
 
+def _det_sign(J_flange: np.ndarray) -> float:
+    """Sign of ``det J_flange`` (+1 or -1; 0 when J is not square or exactly singular)."""
+    if J_flange.shape[0] != J_flange.shape[1]:
+        return 0.0
+    return float(np.sign(np.linalg.det(J_flange)))
+
+
 @dataclass
 class _Attempt:
     q: np.ndarray
     sigma: float
     reason: StopReason | None
     message: str
+    det_sign: float = 0.0
 
 
 def _solve_substep(kin: RobotKinematics, q_start: np.ndarray, sigma_start: float,
                    t_f: np.ndarray, R_ft: np.ndarray, p_target: np.ndarray, R_target: np.ndarray,
-                   cart_amount: float, settings: JogSettings) -> _Attempt:
-    """Damped Newton (J-2) from ``q_start`` to one target pose, then the safety checks."""
+                   cart_amount: float, settings: JogSettings, det_sign_start: float = 0.0) -> _Attempt:
+    """Damped Newton (J-2) from ``q_start`` to one target pose, then the safety checks.
+
+    ``det_sign_start`` is :func:`_det_sign` at ``q_start`` (0: unknown or on a singularity).
+    """
     eps = settings.singular_eps
     lam2 = 0.0
     if sigma_start < eps:
@@ -240,9 +263,13 @@ def _solve_substep(kin: RobotKinematics, q_start: np.ndarray, sigma_start: float
     if not converged or jump > allowance:
         if sigma_start < 2.0 * eps:
             return _Attempt(q_start, sigma_start, "singularity", singularity_message(kin, q_start, settings))
-        why = "would not converge" if not converged else f"needs a joint jump of {math.degrees(jump):.1f} deg"
-        return _Attempt(q_start, sigma_start, "unreachable",
-                        f"target out of reach: the path {why}")
+        if not converged:
+            why = "target out of reach: no joint angles put the TCP on the path there"
+        else:
+            name = kin.joint_names[int(np.argmax(np.abs(q - q_start)))]
+            why = (f"{name} would have to turn too fast: the path runs into the edge of the reach "
+                   "or a singularity")
+        return _Attempt(q_start, sigma_start, "unreachable", why)
     viol = kin.limit_violation(q)
     if viol is not None:
         # the joint furthest beyond its limit is the one to name
@@ -253,7 +280,13 @@ def _solve_substep(kin: RobotKinematics, q_start: np.ndarray, sigma_start: float
     sigma = _sigma_min(J, settings)
     if sigma < eps and sigma < sigma_start * (1.0 - 1e-9) - 1e-12:
         return _Attempt(q_start, sigma_start, "singularity", singularity_message(kin, q, settings))
-    return _Attempt(q, sigma, None, "")
+    det_sign = _det_sign(J)
+    if (det_sign * det_sign_start < 0.0 and sigma > settings.singular_zero
+            and sigma_start > settings.singular_zero):
+        # passed through a singularity into another configuration: name the one at the start
+        return _Attempt(q_start, sigma_start, "singularity", singularity_message(kin, q_start, settings),
+                        det_sign_start)
+    return _Attempt(q, sigma, None, "", det_sign)
 
 
 def follow_path(kin: RobotKinematics, q_rad: np.ndarray, T_flange_tcp: np.ndarray,
@@ -278,27 +311,32 @@ def follow_path(kin: RobotKinematics, q_rad: np.ndarray, T_flange_tcp: np.ndarra
     length_m = float(np.linalg.norm(path.dp))
     angle = float(np.linalg.norm(path.w))
     n = max(1, math.ceil(max(length_m / settings.max_substep_m, angle / settings.max_substep_rad) - 1e-9))
-    # joint allowance is per unit of Cartesian motion: mm + deg, in radians of joint per ...
-    unit = length_m * 1000.0 * math.radians(1.0) + angle  # (mm -> "deg") + rad
+    # joint allowance per unit of flange motion: (mm of travel -> "deg") + rad of rotation; a
+    # rotation about the TCP swings the flange by |w| |t| (module doc)
+    lever_m = float(np.linalg.norm(t_f))
+    unit = (length_m + angle * lever_m) * 1000.0 * math.radians(1.0) + angle
 
     q = np.array(q_rad, dtype=float)
-    sigma = smallest_singular_value(kin, q, settings) if sigma_start is None else float(sigma_start)
+    J0 = kin.jacobian_flange(q)
+    sigma = _sigma_min(J0, settings) if sigma_start is None else float(sigma_start)
+    det_sign = _det_sign(J0)
     s_done = 0.0
     for k in range(1, n + 1):
         s_next = k / n
         p_t, R_t = path.at(s_next)
-        att = _solve_substep(kin, q, sigma, t_f, R_ft, p_t, R_t, unit * (s_next - s_done), settings)
+        att = _solve_substep(kin, q, sigma, t_f, R_ft, p_t, R_t, unit * (s_next - s_done), settings,
+                             det_sign)
         if att.reason is None:
-            q, sigma, s_done = att.q, att.sigma, s_next
+            q, sigma, det_sign, s_done = att.q, att.sigma, att.det_sign, s_next
             continue
         last = att
         lo, hi = s_done, s_next
         for _ in range(settings.bisections):
             mid = 0.5 * (lo + hi)
             p_t, R_t = path.at(mid)
-            a = _solve_substep(kin, q, sigma, t_f, R_ft, p_t, R_t, unit * (mid - lo), settings)
+            a = _solve_substep(kin, q, sigma, t_f, R_ft, p_t, R_t, unit * (mid - lo), settings, det_sign)
             if a.reason is None:
-                q, sigma, lo = a.q, a.sigma, mid
+                q, sigma, det_sign, lo = a.q, a.sigma, a.det_sign, mid
             else:
                 hi, last = mid, a
         return PathOutcome(q, lo, last.reason, last.message, sigma)
