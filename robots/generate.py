@@ -7,7 +7,7 @@ Run from anywhere::
     python robots/generate.py --out DIR  # writes the same tree into DIR (used by the tests)
 
 The output is deterministic: running the script again reproduces the committed files byte for
-byte (``tests/robots/test_generator.py`` checks it).
+byte (``tests/robots/test_generator_and_budget.py`` checks it).
 
 Units: every dimension in this file is in **millimetres and degrees** (as in the data sheets
 they come from); the URDF text is written in metres and radians.
