@@ -111,10 +111,14 @@ def test_stretching_never_flips_the_elbow(offset_deg):
     assert res.stopped_by == "singularity" and "elbow singularity" in res.message
 
 
-def test_wrist_centre_over_the_first_axis_stops_at_the_shoulder_singularity():
-    """KR 6, flange forward at the height of an upright arm; WORLD -X moves the wrist centre
-    towards the A1 axis: the jog stops near it with the shoulder message, never passing over."""
-    ctrl = make_controller("kr6", "pointer", active=False, q_deg=(0.0, -90.0, 30.0, 0.0, 60.0, 0.0))
+@pytest.mark.parametrize("robot, q_deg, axis_name", [
+    ("kr6", (0.0, -90.0, 30.0, 0.0, 60.0, 0.0), "A1"),
+    ("gp12", (0.0, 10.0, 80.0, 0.0, -60.0, 0.0), "S"),
+])
+def test_wrist_centre_over_the_first_axis_stops_at_the_shoulder_singularity(robot, q_deg, axis_name):
+    """Forearm raised, wrist centre in front of the first axis and high; WORLD -X moves it
+    towards that axis: the jog stops near it with the shoulder message, never passing over."""
+    ctrl = make_controller(robot, "pointer", active=False, q_deg=q_deg)
     start = configuration(ctrl)
     res = None
     for _ in range(100):
@@ -123,7 +127,7 @@ def test_wrist_centre_over_the_first_axis_stops_at_the_shoulder_singularity():
         if not res.ok:
             break
     assert res is not None and res.stopped_by == "singularity"
-    assert res.message == "wrist centre near the A1 axis: shoulder singularity"
+    assert res.message == f"wrist centre near the {axis_name} axis: shoulder singularity"
     wc = ctrl.link_poses()["link_5"][:3, 3]
     assert 0.0 < wc[0] < 0.05  # stopped in front of the axis, within 50 mm of it
     q_stop = ctrl.q_rad
