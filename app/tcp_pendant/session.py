@@ -26,6 +26,7 @@ import numpy as np
 from tcpcal.library import ToolLibrary
 from tcp_pendant.controller import ControllerError, VirtualController
 from tcp_pendant.pendant import Jogger, touch_label
+from tcp_pendant.pendant.pose_state import PoseState, pose_state, pose_state_key
 
 __all__ = ["GuiTarget", "Session", "Touch"]
 
@@ -108,6 +109,9 @@ class Session:
         self._motion_listeners: list[Callable[[], None]] = []
         self._touch_listeners: list[Callable[[], None]] = []
         self._close_callbacks: list[Callable[[], None]] = []
+        self._pose_state: PoseState | None = None
+        self._in_refresh = False             # refresh() is running its renderers
+        self._state_checked = False          # ... and the pose state was checked meanwhile
 
     # ------------------------------------------------------------ listeners
     def add_renderer(self, fn: Callable[[], None]) -> None:
@@ -127,18 +131,38 @@ class Session:
         self._close_callbacks.append(fn)
 
     # ------------------------------------------------------------ updates
+    def pose_state(self) -> PoseState:
+        """The robot's current :class:`~tcp_pendant.pendant.pose_state.PoseState` (link poses,
+        flange, TCP, true TCP, readout, touch geometry, joint angles), computed by one FK pass
+        and shared by every renderer and motion listener until the controller changes (keyed
+        by joint angles, tool data, mounted tool, reference tip and BASE; within one
+        :meth:`refresh` the key is checked once, as renderers do not move the robot)."""
+        with self.lock:
+            state = self._pose_state
+            if self._in_refresh and self._state_checked and state is not None:
+                return state
+            key = pose_state_key(self.controller)
+            if state is None or state.key != key:
+                state = self._pose_state = pose_state(self.controller, key)
+            self._state_checked = self._in_refresh
+            return state
+
     def refresh(self) -> None:
         """Push scene and readouts after a controller change, as one atomic update."""
         with self.lock:
             if self.closed:
                 return
-            if self.target is None:
-                for fn in self._renderers:
-                    fn()
-                return
-            with self.target.atomic():
-                for fn in self._renderers:
-                    fn()
+            self._in_refresh, self._state_checked = True, False
+            try:
+                if self.target is None:
+                    for fn in self._renderers:
+                        fn()
+                    return
+                with self.target.atomic():
+                    for fn in self._renderers:
+                        fn()
+            finally:
+                self._in_refresh = self._state_checked = False
 
     def moved(self) -> None:
         """After a move: :meth:`refresh`, then every motion listener (errors are logged)."""
@@ -233,6 +257,7 @@ class Session:
             except Exception:
                 log.debug("close callback failed", exc_info=True)
         self.views.clear()
+        self._pose_state = None
         self.calibrate_container = None
         self.client = None
         self.target = None

@@ -1,0 +1,130 @@
+"""One consistent picture of the robot after a move, computed once and shared by every view.
+
+A jog step redraws the scene (a pose per link, the gizmo on the TCP), the TCP readout, the
+touch indicator and the joint readout, and the wizard views' motion listeners look at the
+flange. Asking the controller for each of these separately runs forward kinematics four times
+and scipy's Euler conversion once per step; :func:`pose_state` runs pinocchio's FK once
+(``controller.link_poses()``, which includes the FLANGE link) and derives the rest from it:
+
+* ``T_world_flange = T_world_link[flange_link]`` (the same pinocchio frame placement as
+  ``controller.T_world_flange()``),
+* ``T_world_tcp = T_world_flange @ T_flange_tool`` (active tool data),
+* ``T_world_true_tcp = T_world_flange @ T_flange_tcp_true`` (mounted tool, hidden),
+* the readout (``controller.readout``) and the touch geometry (``controller.touch_geometry``)
+  from those, with the readout's A, B, C by :func:`tcp_pendant.pendant.rotations.kuka_abc_deg`.
+
+``tests/app/test_pose_state.py`` checks every field against the controller's own methods.
+No viser.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from tcp_pendant.controller import PoseReadout, TouchGeometry, VirtualController
+from tcp_pendant.controller.touch import touch_geometry
+from tcp_pendant.pendant.rotations import kuka_abc_deg
+
+__all__ = ["PoseState", "pose_state", "pose_state_key"]
+
+
+@dataclass(frozen=True, eq=False)
+class PoseState:
+    """The robot at one joint configuration (metres, radians; WORLD = the robot's root link).
+
+    Attributes:
+        key: :func:`pose_state_key` of the controller it was computed from.
+        q_rad: joint angles.
+        link_names: every URDF link (pinocchio BODY frames), in pinocchio's frame order.
+        T_world_links: (N,4,4) ``T_world_link`` of those links, stacked in that order.
+        T_world_link: the same by link name (views into ``T_world_links``).
+        T_world_flange, T_world_tcp, T_world_true_tcp: FLANGE, active TCP and the mounted
+            tool's hidden true TCP in WORLD.
+        T_world_base: the BASE (work object) frame.
+        joint_angles_deg: joint readout, name -> degrees (mm for prismatic joints).
+        touch: true tool tip vs reference tip (``controller.touch_geometry()``).
+    """
+
+    key: tuple[object, ...]
+    q_rad: np.ndarray
+    link_names: tuple[str, ...]
+    T_world_links: np.ndarray
+    T_world_link: Mapping[str, np.ndarray]
+    T_world_flange: np.ndarray
+    T_world_tcp: np.ndarray
+    T_world_true_tcp: np.ndarray
+    T_world_base: np.ndarray
+    joint_angles_deg: Mapping[str, float]
+    touch: TouchGeometry
+    _readouts: dict[str, PoseReadout] = field(default_factory=dict, repr=False)
+
+    def readout(self, frame: str = "WORLD") -> PoseReadout:
+        """The active TCP as X, Y, Z (mm) and KUKA A, B, C (deg) in WORLD or BASE
+        (``controller.readout``).
+
+        Raises:
+            ValueError: another frame.
+        """
+        f = str(frame).upper()
+        cached = self._readouts.get(f)
+        if cached is not None:
+            return cached
+        if f == "WORLD":
+            T = self.T_world_tcp
+        elif f == "BASE":
+            T = np.linalg.inv(self.T_world_base) @ self.T_world_tcp
+        else:
+            raise ValueError(f"Readout frame must be WORLD or BASE, got {frame!r}.")
+        a, b, c = kuka_abc_deg(T[:3, :3])
+        out = PoseReadout(f, float(T[0, 3]) * 1000.0, float(T[1, 3]) * 1000.0, float(T[2, 3]) * 1000.0, a, b, c)
+        self._readouts[f] = out
+        return out
+
+
+def pose_state_key(controller: VirtualController) -> tuple[object, ...]:
+    """What a :class:`PoseState` depends on: joint angles, active tool data, mounted tool,
+    reference tip, BASE frame and the robot model. Equal keys, equal states."""
+    c = controller
+    return (id(c.kinematics), c.q_rad.tobytes(), c.T_flange_tool.tobytes(), id(c.mounted_tool),
+            c.reference_tip_world_m.tobytes(), c.T_world_base.tobytes())
+
+
+def pose_state(controller: VirtualController, key: tuple[object, ...] | None = None) -> PoseState:
+    """Compute the :class:`PoseState` of ``controller`` (one pinocchio FK pass).
+
+    Args:
+        controller: the controller (the caller holds the session lock).
+        key: its :func:`pose_state_key`, if already computed.
+    """
+    c = controller
+    k = c.kinematics
+    q = c.q_rad
+    poses = c.link_poses()
+    names = tuple(poses)
+    stacked = np.array(list(poses.values()))
+    stacked.setflags(write=False)
+    links = dict(zip(names, stacked))
+    T_world_flange = links[k.flange_link]
+    T_world_tcp = T_world_flange @ c.T_flange_tool
+    T_world_true = T_world_flange @ c.mounted_tool.T_flange_tcp_true
+    angles = {name: (math.degrees(v) if k.revolute[i] else v * 1000.0)
+              for i, (name, v) in enumerate(zip(k.joint_names, q.tolist()))}
+    for T in (T_world_tcp, T_world_true):
+        T.setflags(write=False)
+    return PoseState(
+        key=pose_state_key(c) if key is None else key,
+        q_rad=q,
+        link_names=names,
+        T_world_links=stacked,
+        T_world_link=links,
+        T_world_flange=T_world_flange,
+        T_world_tcp=T_world_tcp,
+        T_world_true_tcp=T_world_true,
+        T_world_base=c.T_world_base,
+        joint_angles_deg=angles,
+        touch=touch_geometry(T_world_true, c.reference_tip_world_m),
+    )
