@@ -3,15 +3,22 @@
 Scene tree (names are per browser; ``--shared`` uses the server's scene):
 
 * ``/floor`` grid; ``/world`` the WORLD frame (the robot's root link) with its label;
-* ``/robot/<link>``: one flat frame per URDF link, posed directly from pinocchio's
-  ``link_poses`` (``T_world_link``) - no yourdfpy FK per jog step - with the link's meshes
-  as children; ``/robot/<flange>/...`` holds the FLANGE triad, the mounted tool's meshes and
-  the active TOOL triad at ``T_flange_tool`` (they ride on the flange without updates);
+* ``/robot/<base>/<link_1>/.../<link_6>``: one frame per URDF link, nested like the URDF's
+  link tree (:attr:`SceneView.link_paths`), each posed relative to its parent link from
+  pinocchio's link poses (``Session.pose_state()``, one FK pass per move; no yourdfpy FK),
+  with the link's meshes as children. Nesting makes a jog step cheap to send: a revolute
+  joint only turns its child link, so each moving link needs one orientation message (its
+  offset from the parent never changes); :class:`PoseSender` sends only poses that changed;
+* ``/robot/<flange>`` (:attr:`SceneView.flange_path`): the FLANGE link, kept at this path
+  and posed in WORLD because other views attach to it there (the wizards' COMPUTED / TRUE
+  triads); it holds the FLANGE triad, the mounted tool's meshes and the active TOOL triad at
+  ``T_flange_tool``, which ride on the flange without updates;
 * ``/reference_tip``: the stand posed so that its spike is at the reference tip;
 * ``/tcp_gizmo``: transform controls on the active TCP; dragging it moves the TCP by
   ``VirtualController.move_tcp_to`` (straight line, same safety rules as jogging).
 
-Axis colours are viser's: X red, Y green, Z blue. Quaternions (w, x, y, z) come from scipy.
+Axis colours are viser's: X red, Y green, Z blue. Quaternions (w, x, y, z) come from
+``tcp_pendant.pendant.rotations.quaternions_wxyz`` (pinocchio; checked against scipy).
 """
 
 from __future__ import annotations
@@ -23,43 +30,159 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from tcp_pendant.controller import ToolModel, reference_tip_model
+from tcp_pendant.controller.kinematics import urdf_links_and_tree
+from tcp_pendant.pendant.rotations import quaternion_wxyz, quaternions_wxyz
 from tcp_pendant.session import Session
 from tcp_pendant.views.meshes import MeshPart, link_meshes, rigid_meshes
 
-__all__ = ["SceneView", "wxyz_xyz"]
+__all__ = ["POSE_EPS", "PoseSender", "SceneView", "link_tree_paths", "relative_poses", "wxyz_xyz"]
 
 OVERVIEW_OFFSET_M = np.array([1.15, -1.25, 0.55])
 CLOSEUP_OFFSET_M = np.array([0.22, -0.26, 0.12])
 
+POSE_EPS = 1e-6
+"""A node's orientation (position) is re-sent when an entry of its rotation matrix (a
+coordinate, m) changed by more than this since the last one sent: ~1e-6 rad (0.00006 deg)
+and 1 um, a hundred times below what the pendant shows (0.01 mm, 0.01 deg) and below any
+motion it commands (the smallest increment is 0.1 mm / 0.1 deg; continuous jog at 1 %
+override moves 0.0025 mm / 0.015 deg per tick). Below it are float noise (the constant offset
+of a revolute joint recomputed from two link poses) and the drift of an orientation held
+during a translation jog. The error does not accumulate: it is measured against what was sent."""
+
+_EYE4 = np.eye(4)
+_EYE4.setflags(write=False)
+
 
 def wxyz_xyz(T: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(w, x, y, z) quaternion and position of a (4,4) pose (or stacks (N,4,4))."""
+    """(w, x, y, z) quaternion and position of a (4,4) pose, or (N,4) and (N,3) of (N,4,4)."""
     T = np.asarray(T, dtype=float)
-    q = Rotation.from_matrix(T[..., :3, :3]).as_quat()          # (x, y, z, w)
-    return np.roll(q, 1, axis=-1), T[..., :3, 3]
+    q = quaternions_wxyz(T[..., :3, :3])
+    return (q[0] if T.ndim == 2 else q), T[..., :3, 3]
 
 
-def set_poses(handles: list[Any], wxyz: np.ndarray, xyz: np.ndarray) -> None:
-    """Pose many scene nodes at once (per-jog-step hot path).
+def relative_poses(T_world_parent: np.ndarray, T_world_child: np.ndarray) -> np.ndarray:
+    """``T_parent_child = inv(T_world_parent) @ T_world_child`` for stacks (N,4,4) of rigid
+    poses (``R_p^T R_c``, ``R_p^T (p_c - p_p)``)."""
+    Rp_T = T_world_parent[:, :3, :3].transpose(0, 2, 1)
+    out = np.empty_like(T_world_child)
+    out[:, :3, :3] = Rp_T @ T_world_child[:, :3, :3]
+    out[:, :3, 3] = (Rp_T @ (T_world_child[:, :3, 3] - T_world_parent[:, :3, 3])[..., None])[..., 0]
+    out[:, 3, :] = (0.0, 0.0, 0.0, 1.0)
+    return out
 
-    Equivalent to ``h.wxyz = ...; h.position = ...`` for each handle, without the per-setter
-    validation and ``allclose`` of viser's public setters (about 4x the cost here): the node's
-    stored pose is updated in place and the same Set{Orientation,Position}Message is queued.
-    Falls back to the public setters if viser's internals differ.
+
+def link_tree_paths(urdf_path: Any, links: tuple[str, ...] | list[str],
+                    flat: tuple[str, ...] = ()) -> dict[str, tuple[str, str | None]]:
+    """Scene path and parent link of every link, nested like the URDF's link tree.
+
+    Args:
+        urdf_path: the robot's URDF (its link tree).
+        links: the links to place.
+        flat: links placed at ``/robot/<link>`` and posed in WORLD (parent None) even though
+            they have a parent link; their children nest under them.
+
+    Returns:
+        ``{link: (path, parent_link or None)}`` in parent-before-child order; links missing
+        from the tree (or whose parent is not in ``links``) hang at ``/robot`` too.
     """
+    names = set(links)
+    _, children = urdf_links_and_tree(urdf_path)
+    parent: dict[str, str] = {}
+    for p, cs in children.items():
+        for ch in cs:
+            if p in names and ch in names and ch not in flat:
+                parent.setdefault(ch, p)
+    out: dict[str, tuple[str, str | None]] = {}
+
+    def place(name: str, seen: frozenset[str]) -> None:
+        if name in out:
+            return
+        p = parent.get(name)
+        if p is None or p in seen:
+            out[name] = (f"/robot/{name.replace('/', '_')}", None)
+            return
+        place(p, seen | {name})
+        out[name] = (f"{out[p][0]}/{name.replace('/', '_')}", p)
+
+    for n in links:
+        place(n, frozenset())
+    return out
+
+
+class PoseSender:
+    """Poses a fixed list of scene nodes, sending only what changed (per-jog-step hot path).
+
+    :meth:`send` takes every node's pose relative to its scene parent, compares it with the
+    last one sent and queues a SetOrientation (SetPosition) message only for the nodes whose
+    rotation (position) moved by more than :data:`POSE_EPS`. The comparison is one numpy pass
+    over all nodes; quaternions are computed for the changed ones only. The messages are
+    viser's own, queued as its public ``handle.wxyz = ...`` setters would, minus their
+    per-call validation and ``allclose`` (4x the cost of the message here); the node's stored
+    pose is updated too. Falls back to the public setters if viser's internals differ.
+
+    Args:
+        handles: scene node handles.
+        T_parent_node: their current poses (as created), (N,4,4).
+    """
+
+    def __init__(self, handles: list[Any], T_parent_node: np.ndarray) -> None:
+        self.handles = list(handles)
+        self._sent = np.array(T_parent_node, dtype=float).reshape(len(self.handles), 4, 4)
+
+    def send(self, T_parent_node: np.ndarray, *, skip: tuple[int, ...] = (), force: tuple[int, ...] = ()) -> int:
+        """Queue the poses that changed.
+
+        Args:
+            T_parent_node: (N,4,4) new poses.
+            skip: nodes not to touch (e.g. the gizmo while the browser drags it).
+            force: nodes to send even if unchanged (e.g. the gizmo after a drag).
+
+        Returns:
+            The number of messages queued.
+        """
+        T = np.asarray(T_parent_node, dtype=float)
+        d = np.abs(T - self._sent)
+        rot = (d[:, :3, :3].max(axis=(1, 2)) > POSE_EPS).tolist()
+        pos = (d[:, :3, 3].max(axis=1) > POSE_EPS).tolist()
+        for i in force:
+            rot[i] = pos[i] = True
+        for i in skip:
+            rot[i] = pos[i] = False
+        n = 0
+        for i, (r, p) in enumerate(zip(rot, pos)):
+            if not (r or p):
+                continue
+            n += _set_pose(self.handles[i], quaternion_wxyz(T[i, :3, :3]) if r else None,
+                           T[i, :3, 3].tolist() if p else None)
+            if r:
+                self._sent[i, :3, :3] = T[i, :3, :3]
+            if p:
+                self._sent[i, :3, 3] = T[i, :3, 3]
+        return n
+
+
+def _set_pose(handle: Any, wxyz: list[float] | None, xyz: list[float] | None) -> int:
     try:
         from viser import _messages
 
-        for h, q, p in zip(handles, wxyz.tolist(), xyz.tolist()):
-            impl = h._impl
-            impl.wxyz[:] = q
-            impl.position[:] = p
-            impl.api._queue_scene_message(_messages.SetOrientationMessage(impl.name, tuple(q)))
-            impl.api._queue_scene_message(_messages.SetPositionMessage(impl.name, tuple(p)))
-    except AttributeError:
-        for h, q, p in zip(handles, wxyz, xyz):
-            h.wxyz = q
-            h.position = p
+        impl = handle._impl
+        api = impl.api
+        n = 0
+        if wxyz is not None:
+            impl.wxyz[:] = wxyz
+            api._queue_scene_message(_messages.SetOrientationMessage(impl.name, tuple(wxyz)))
+            n += 1
+        if xyz is not None:
+            impl.position[:] = xyz
+            api._queue_scene_message(_messages.SetPositionMessage(impl.name, tuple(xyz)))
+            n += 1
+        return n
+    except AttributeError:                      # viser internals changed: public setters
+        if wxyz is not None:
+            handle.wxyz = wxyz
+        if xyz is not None:
+            handle.position = xyz
+        return int(wxyz is not None) + int(xyz is not None)
 
 
 def _add_parts(scene: Any, parent: str, parts: tuple[MeshPart, ...], *, opacity: float | None = None) -> list[Any]:
@@ -96,14 +219,25 @@ class SceneView:
         scene.add_label("/world/label", "WORLD", position=(0.0, 0.0, -0.04))
 
         meshes = link_meshes(k.urdf_path)
+        state = session.pose_state()
+        # the flange stays at /robot/<flange> (posed in WORLD): views attach to it there
+        tree = link_tree_paths(k.urdf_path, state.link_names, flat=(self.flange_link,))
+        self.link_paths: dict[str, str] = {name: path for name, (path, _) in tree.items()}
         self.link_frames: dict[str, Any] = {}
-        poses = c.link_poses()
-        for name, T in poses.items():
-            wxyz, xyz = wxyz_xyz(T)
-            self.link_frames[name] = scene.add_frame(f"/robot/{name}", show_axes=False, wxyz=wxyz, position=xyz)
-            _add_parts(scene, f"/robot/{name}", meshes.get(name, ()))
-        self._moving = [n for n in self.link_frames if n != k.base_link]
-        fl = f"/robot/{self.flange_link}"
+        self._parent = {name: parent for name, (_, parent) in tree.items()}
+        # posed nodes: every link but the root (the sender skips those that did not move), then
+        # the gizmo; rows of (node, parent) in [links..., T_world_tcp, identity] (render)
+        self._moving = [n for n in tree if n != k.base_link]
+        self._index_names: tuple[str, ...] = ()
+        self._child_idx = self._parent_idx = np.zeros(0, dtype=int)
+        T_local = self._local_poses(state)
+        local = {n: T_local[i] for i, n in enumerate(self._moving)}
+        for name, (path, _) in tree.items():
+            wxyz, xyz = wxyz_xyz(local.get(name, state.T_world_link[name]))
+            self.link_frames[name] = scene.add_frame(path, show_axes=False, wxyz=wxyz, position=xyz)
+            _add_parts(scene, path, meshes.get(name, ()))
+        self.flange_path = self.link_paths[self.flange_link]
+        fl = self.flange_path
         scene.add_frame(f"{fl}/flange_axes", axes_length=0.09, axes_radius=0.004)
         scene.add_label(f"{fl}/flange_axes/label", "FLANGE", position=(0.0, 0.05, 0.0))
         self._tool_root = f"{fl}/tool"
@@ -120,29 +254,37 @@ class SceneView:
         self._tip_label = scene.add_label("/reference_tip_label", "reference tip",
                                           position=tuple(c.reference_tip_world_m + [0.0, 0.0, -0.06]))
 
-        wxyz, xyz = wxyz_xyz(c.T_world_tcp())
+        wxyz, xyz = wxyz_xyz(state.T_world_tcp)
         self.gizmo = scene.add_transform_controls("/tcp_gizmo", scale=0.14, line_width=2.0, wxyz=wxyz,
                                                   position=xyz, depth_test=False, opacity=0.85)
+        self._gizmo_row = len(self._moving)
+        self._poses = PoseSender([self.link_frames[n] for n in self._moving] + [self.gizmo], T_local)
         self.gizmo.on_update(self._on_gizmo)
         session.add_renderer(self.render)
 
     # ------------------------------------------------------------ updates
+    def _local_poses(self, state: Any) -> np.ndarray:
+        """(N+1,4,4): ``T_parent_link`` of the moving links (``T_world_link`` for the flange),
+        then ``T_world_tcp`` (the gizmo), from one pose state."""
+        if state.link_names != self._index_names:             # index rows once per link list
+            row = {n: i for i, n in enumerate(state.link_names)}
+            n_links, eye = len(state.link_names), len(state.link_names) + 1
+            self._child_idx = np.array([row[n] for n in self._moving] + [n_links])
+            self._parent_idx = np.array([eye if (p := self._parent[n]) is None else row[p]
+                                         for n in self._moving] + [eye])
+            self._index_names = state.link_names
+        poses = np.concatenate([state.T_world_links, state.T_world_tcp[None], _EYE4[None]])
+        return relative_poses(poses[self._parent_idx], poses[self._child_idx])
+
     def render(self) -> None:
-        """Pose every moving link frame from pinocchio and the gizmo on the TCP (not while dragged)."""
-        c = self.session.controller
-        poses = c.link_poses()
-        mats = [poses[n] for n in self._moving]
-        handles = [self.link_frames[n] for n in self._moving]
-        if not self._dragging:
-            mats.append(c.T_world_tcp())
-            handles.append(self.gizmo)
-        wxyz, xyz = wxyz_xyz(np.stack(mats))
-        set_poses(handles, wxyz, xyz)
+        """Pose the moving link frames and the gizmo on the TCP (not while dragged) from the
+        session's pose state; only poses that changed are sent."""
+        skip = (self._gizmo_row,) if self._dragging else ()
+        self._poses.send(self._local_poses(self.session.pose_state()), skip=skip)
 
     def _snap_gizmo(self) -> None:
-        wxyz, xyz = wxyz_xyz(self.session.controller.T_world_tcp())
-        self.gizmo.wxyz = wxyz
-        self.gizmo.position = xyz
+        # the browser moved the gizmo: always resend its pose
+        self._poses.send(self._local_poses(self.session.pose_state()), force=(self._gizmo_row,))
 
     def set_mounted_tool(self, tool: ToolModel) -> None:
         """Show another physical tool on the flange."""
