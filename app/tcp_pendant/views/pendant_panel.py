@@ -31,7 +31,7 @@ from tcp_pendant.pendant import (
 )
 from tcp_pendant.session import Session
 
-__all__ = ["HOLD_HZ", "PendantPanel"]
+__all__ = ["HOLD_HZ", "PendantPanel", "set_markdown"]
 
 HOLD_HZ = 20.0
 """Rate of the hold-to-jog callbacks (continuous jog ticks per second)."""
@@ -39,6 +39,31 @@ HOLD_HZ = 20.0
 _AXIS_HINT = {"X": "translate along X (mm)", "Y": "translate along Y (mm)", "Z": "translate along Z (mm)",
               "A": "rotate about Z through the TCP (deg)", "B": "rotate about Y through the TCP (deg)",
               "C": "rotate about X through the TCP (deg)"}
+
+
+def set_markdown(handle: Any, text: str) -> None:
+    """``handle.content = text`` for the readouts, which change on every jog step.
+
+    viser's public setter runs its generic prop machinery (type-hint casting that builds
+    ``typing`` aliases on every call: ~4x the cost of the message itself here, measured by
+    tests/bench/bench_server.py); for texts without images (nothing for viser's markdown
+    parser to inline) this stores the same ``_markdown`` prop and queues the same
+    ``GuiUpdateMessage``. Falls back to the public setter if viser's internals differ.
+    """
+    if "![" not in text:
+        try:
+            from viser._messages import GuiUpdateMessage
+
+            impl = handle._impl
+            if not impl.removed:
+                object.__setattr__(handle, "_content", text)
+                if impl.props._markdown != text:
+                    impl.props._markdown = text
+                    impl.gui_api._websock_interface.queue_message(GuiUpdateMessage(impl.uuid, {"_markdown": text}))
+                return
+        except AttributeError:
+            pass
+    handle.content = text
 
 
 class PendantPanel:
@@ -119,6 +144,11 @@ class PendantPanel:
 
     # ------------------------------------------------------------ wiring
     def _wire_key(self, button: Any, axis: str | int, sign: int) -> None:
+        """Click and hold of a jog key. The callbacks are ``async``: viser runs them on its
+        event loop instead of handing every jog tick to its thread pool (a thread wake-up and
+        GIL hand-over per tick, ~10 % of a jog step's server CPU, tests/bench/bench_server.py
+        C vs B). The step itself is synchronous, under the session lock, and never waits on
+        the event loop."""
         s = self.session
 
         @s.guard
@@ -129,8 +159,14 @@ class PendantPanel:
         def hold(_event: Any) -> None:
             self._jog(axis, sign, hold_tick=True)
 
-        button.on_click(click)
-        button.on_hold(hold, callback_hz=HOLD_HZ)
+        async def click_on_loop(event: Any) -> None:
+            click(event)
+
+        async def hold_on_loop(event: Any) -> None:
+            hold(event)
+
+        button.on_click(click_on_loop)
+        button.on_hold(hold_on_loop, callback_hz=HOLD_HZ)
 
     def _jog(self, axis: str | int, sign: int, *, hold_tick: bool) -> None:
         res = self.session.jogger.key(axis, sign, hold_tick=hold_tick)
@@ -217,25 +253,30 @@ class PendantPanel:
         self._last_stop = text
 
     def _set_md(self, handle: Any, key: str, text: str) -> None:
+        """Send ``text`` unless it is what ``handle`` shows already."""
         if self._last_text.get(key) != text:
+            set_markdown(handle, text)
             self._last_text[key] = text
-            handle.content = text
 
     def render(self) -> None:
-        """Readouts, touch indicator and joint sliders from the controller (no feedback)."""
-        c = self.session.controller
+        """Readouts, touch indicator and joint sliders from the session's pose state (no
+        feedback); only texts and slider values that changed are sent."""
+        s = self.session
+        state = s.pose_state()
         frame = "BASE" if self.readout_frame.value == "BASE" else "WORLD"
-        tool = c.active_tool
-        self._set_md(self.tcp_md, "tcp", tcp_readout_markdown(c.readout(frame), None if tool is None else tool.name))
-        self._set_md(self.touch_md, "touch", touch_indicator_markdown(c.touch_geometry(),
+        tool = s.controller.active_tool
+        self._set_md(self.tcp_md, "tcp", tcp_readout_markdown(state.readout(frame), None if tool is None else tool.name))
+        self._set_md(self.touch_md, "touch", touch_indicator_markdown(state.touch,
                                                                       hide_distance=bool(self.hide_distance.value)))
-        angles = c.joint_angles_deg()
+        angles = state.joint_angles_deg
         self._set_md(self.joints_md, "joints", joint_readout_markdown(angles))
         if not self.joint_folder.visible:
             return                      # hidden sliders are synced when joint mode is shown
         self._syncing = True
         try:
-            for s, v in zip(self.joint_sliders, angles.values()):
-                s.value = round(float(v), 2)
+            for slider, v in zip(self.joint_sliders, angles.values()):
+                value = round(float(v), 2)
+                if slider.value != value:           # a joint jog moves one slider: one update
+                    slider.value = value
         finally:
             self._syncing = False
