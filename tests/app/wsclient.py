@@ -45,3 +45,58 @@ class DrainingClient:
             self.ws.close()
         finally:
             self._thread.join(timeout=10)
+
+
+def decode_window(data: bytes) -> list[dict]:
+    """The messages of one server window (viser's wire format: 8-byte msgpack length, 8-byte
+    compressed length, zstd-compressed msgpack ``{"messages": [...], ...}``, binary buffers)."""
+    import zstandard
+
+    clen = int.from_bytes(data[8:16], "little")
+    inner = zstandard.ZstdDecompressor().decompress(data[16:16 + clen])
+    return list(msgspec.msgpack.decode(inner)["messages"])
+
+
+class ButtonClient(DrainingClient):
+    """A :class:`DrainingClient` that learns the uuids of the pendant's buttons (by label, from
+    the GUI messages it receives) and can press and hold them like a browser does (viser's
+    ``GuiButtonHoldMessage``, which the browser repeats while a button is held).
+
+    Args:
+        labels: button labels to look for; decoding stops once all are known.
+    """
+
+    def __init__(self, port: int, labels: tuple[str, ...], host: str = "127.0.0.1") -> None:
+        self.labels = tuple(labels)
+        self.button_uuids: dict[str, str] = {}
+        self.found = threading.Event()
+        self._send_lock = threading.Lock()
+        super().__init__(port, host)
+
+    def _drain(self) -> None:
+        try:
+            for msg in self.ws:
+                self.n_messages += 1
+                self.n_bytes += len(msg)
+                if not self.found.is_set() and isinstance(msg, bytes):
+                    for m in decode_window(msg):
+                        if m.get("type") == "GuiButtonMessage":
+                            label = (m.get("props") or {}).get("label")
+                            if label in self.labels:
+                                self.button_uuids.setdefault(label, m["uuid"])
+                    if len(self.button_uuids) == len(self.labels):
+                        self.found.set()
+        except Exception:
+            pass
+
+    def hold_tick(self, label: str, frequency: float) -> None:
+        """One hold message of the button ``label`` (registered hold rate ``frequency`` Hz)."""
+        msg = _messages.GuiButtonHoldMessage(self.button_uuids[label], float(frequency))
+        with self._send_lock:
+            self.ws.send(msgspec.msgpack.encode(msg.as_serializable_dict()))
+
+    def click(self, label: str) -> None:
+        """A click on the button ``label`` (the browser sends its value ``True``)."""
+        msg = _messages.GuiUpdateMessage(self.button_uuids[label], {"value": True})
+        with self._send_lock:
+            self.ws.send(msgspec.msgpack.encode(msg.as_serializable_dict()))

@@ -1,0 +1,247 @@
+"""The jog hot path's shortcuts against the definitions they replace: the readout's A, B, C and
+the scene's quaternions (pinocchio) against tcpcal/scipy, the shared pose state against the
+controller's own methods, and the scene the browser composes from the nested link frames
+against the controller's link poses."""
+
+from __future__ import annotations
+
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from tcpcal.tool import Tool, abc_deg_from_rotation
+from tcp_pendant.controller import VirtualController, builtin_tools
+from tcp_pendant.pendant.formatting import tcp_readout_markdown, touch_indicator_markdown
+from tcp_pendant.pendant.pose_state import pose_state, pose_state_key
+from tcp_pendant.pendant.rotations import GIMBAL_LOCK_COS_B, kuka_abc_deg, quaternion_wxyz, quaternions_wxyz
+
+sys.path.insert(0, str(Path(__file__).parent))
+from conftest import wait_until  # noqa: E402
+from wsclient import DrainingClient  # noqa: E402
+
+
+def _angle_diff_deg(a: float, b: float) -> float:
+    return abs((a - b + 180.0) % 360.0 - 180.0)
+
+
+def _rotations() -> np.ndarray:
+    rng = np.random.default_rng(7)
+    mats = list(Rotation.random(300, random_state=11).as_matrix())
+    # near and at gimbal lock (B = +-90 deg), on both sides of the fallback threshold
+    for b in (90.0, -90.0, 89.9999, -89.9999, 89.999, 89.99, 89.0):
+        for a, c in ((30.0, 20.0), (-170.0, 175.0), (0.0, 0.0)):
+            mats.append(Rotation.from_euler("ZYX", [a, b, c], degrees=True).as_matrix())
+    # A = +-180 and C = +-180 edges, half turns, identity
+    for abc in ((180.0, 0.0, 0.0), (-180.0, 10.0, 0.0), (0.0, 0.0, 180.0), (45.0, 0.0, -180.0), (0.0, 0.0, 0.0)):
+        mats.append(Rotation.from_euler("ZYX", abc, degrees=True).as_matrix())
+    for axis in np.eye(3):
+        mats.append(Rotation.from_rotvec(np.pi * axis).as_matrix())
+    mats.append(Rotation.from_rotvec(rng.normal(size=3) * 1e-9).as_matrix())
+    return np.array(mats)
+
+
+def test_kuka_abc_matches_tcpcal_and_rebuilds_the_rotation() -> None:
+    n_locked = 0
+    for i, R in enumerate(_rotations()):
+        a, b, c = kuka_abc_deg(R)
+        ref = abc_deg_from_rotation(R)
+        # A, B, C reproduce R (R = Rz(A) Ry(B) Rx(C)), independently of either implementation
+        np.testing.assert_allclose(Rotation.from_euler("ZYX", [a, b, c], degrees=True).as_matrix(), R,
+                                   atol=2e-9, err_msg=f"rotation {i}")
+        assert -90.0 <= b <= 90.0 and -180.0 < a <= 180.0 and -180.0 <= c <= 180.0, (i, a, b, c)
+        # and are the angles the controller's readout (tcpcal) shows, to far below 0.01 deg
+        assert _angle_diff_deg(b, ref[1]) < 1e-7, (i, (a, b, c), ref)
+        assert _angle_diff_deg(a, ref[0]) < 1e-6 and _angle_diff_deg(c, ref[2]) < 1e-6, (i, (a, b, c), ref)
+        if math.hypot(R[0, 0], R[1, 0]) < GIMBAL_LOCK_COS_B:   # at the lock: tcpcal's own split
+            n_locked += 1
+            assert (a, b, c) == tuple(float(v) for v in ref), i
+    assert n_locked >= 6                                        # the lock cases were exercised
+
+
+def test_quaternion_is_scipys_rotation() -> None:
+    for i, R in enumerate(_rotations()):
+        w, x, y, z = quaternion_wxyz(R)
+        q_ref = Rotation.from_matrix(R).as_quat()               # x, y, z, w
+        assert abs(abs(np.dot([x, y, z, w], q_ref)) - 1.0) < 1e-12, i   # same rotation (q ~ -q)
+        assert abs(w * w + x * x + y * y + z * z - 1.0) < 1e-12, i
+
+
+def test_quaternions_of_a_stack() -> None:
+    R = _rotations()[:20]
+    Q = quaternions_wxyz(R)
+    assert Q.shape == (20, 4)
+    np.testing.assert_array_equal(Q[3], quaternion_wxyz(R[3]))
+
+
+def _configurations(c: VirtualController, n: int = 12) -> list[np.ndarray]:
+    rng = np.random.default_rng(3)
+    k = c.kinematics
+    return [rng.uniform(k.lower_rad, k.upper_rad) for _ in range(n)]
+
+
+def test_pose_state_equals_the_controllers_own_answers(controller: VirtualController) -> None:
+    c = controller
+    c.set_active_tool(Tool(name="bent", tcp_mm=(20.0, -5.0, 150.0), abc_deg=(10.0, -60.0, 5.0)))
+    T_base = np.eye(4)
+    T_base[:3, :3] = Rotation.from_euler("ZYX", [30.0, 5.0, -10.0], degrees=True).as_matrix()
+    T_base[:3, 3] = [0.4, -0.2, 0.1]
+    c.set_T_world_base(T_base)
+    c.mount_tool(builtin_tools()["torch"])
+    for q in _configurations(c):
+        c.set_q(q)
+        st = pose_state(c)
+        np.testing.assert_allclose(st.T_world_flange, c.T_world_flange(), atol=1e-14)
+        np.testing.assert_allclose(st.T_world_tcp, c.T_world_tcp(), atol=1e-14)
+        np.testing.assert_allclose(st.T_world_true_tcp, c.T_world_true_tcp(), atol=1e-14)
+        links = c.link_poses()
+        assert set(st.T_world_link) == set(links) == set(st.link_names)
+        for name, T in links.items():
+            np.testing.assert_allclose(st.T_world_link[name], T, atol=1e-14)
+        assert st.joint_angles_deg == pytest.approx(c.joint_angles_deg(), abs=1e-12)
+        assert st.touch == c.touch_geometry()
+        for frame in ("WORLD", "BASE"):
+            fast, ref = st.readout(frame), c.readout(frame)
+            assert fast.frame == ref.frame
+            for f in ("x_mm", "y_mm", "z_mm"):
+                assert getattr(fast, f) == pytest.approx(getattr(ref, f), abs=1e-9)
+            for f in ("a_deg", "b_deg", "c_deg"):
+                assert _angle_diff_deg(getattr(fast, f), getattr(ref, f)) < 1e-6
+            # what the pendant shows is the same text
+            assert tcp_readout_markdown(fast, "bent") == tcp_readout_markdown(ref, "bent")
+        assert touch_indicator_markdown(st.touch, hide_distance=False) == \
+            touch_indicator_markdown(c.touch_geometry(), hide_distance=False)
+    with pytest.raises(ValueError, match="WORLD or BASE"):
+        pose_state(c).readout("TOOL")
+
+
+def test_pose_state_key_follows_every_input(controller: VirtualController) -> None:
+    c = controller
+    keys = [pose_state_key(c)]
+    c.jog_joint(1, 1.0)
+    keys.append(pose_state_key(c))
+    c.set_active_tool(Tool(name="t", tcp_mm=(0.0, 0.0, 100.0)))
+    keys.append(pose_state_key(c))
+    c.mount_tool(builtin_tools()["gripper"])
+    keys.append(pose_state_key(c))
+    c.set_reference_tip(c.reference_tip_world_m + 0.01)
+    keys.append(pose_state_key(c))
+    T = np.eye(4)
+    T[0, 3] = 0.1
+    c.set_T_world_base(T)
+    keys.append(pose_state_key(c))
+    assert len(set(keys)) == len(keys)
+    assert pose_state_key(c) == keys[-1]                      # nothing changed: same key
+
+
+# ------------------------------------------------------------------ in a served session
+def _session(app):
+    client = DrainingClient(app.port)
+    wait_until(lambda: len(app.sessions) == 1, what="session built")
+    (s,) = app.sessions.values()
+    return client, s
+
+
+def _world_pose(handle_chain: list) -> np.ndarray:
+    """Compose the local poses of nested scene nodes (root first), as the browser does."""
+    T = np.eye(4)
+    for h in handle_chain:
+        L = np.eye(4)
+        w, x, y, z = (float(v) for v in h.wxyz)
+        L[:3, :3] = Rotation.from_quat([x, y, z, w]).as_matrix()
+        L[:3, 3] = np.asarray(h.position, dtype=float)
+        T = T @ L
+    return T
+
+
+def _check_scene_matches_controller(s, tol: float) -> None:
+    view = s.views["scene"]
+    c = s.controller
+    by_path = {view.link_paths[n]: view.link_frames[n] for n in view.link_frames}
+    for name, T_ref in c.link_poses().items():
+        path = view.link_paths[name]
+        parts = path.split("/")
+        chain = [by_path["/".join(parts[:i])] for i in range(3, len(parts) + 1) if "/".join(parts[:i]) in by_path]
+        np.testing.assert_allclose(_world_pose(chain), T_ref, atol=tol, err_msg=name)
+    np.testing.assert_allclose(_world_pose([view.gizmo]), c.T_world_tcp(), atol=tol)
+
+
+def test_nested_scene_shows_the_controllers_link_poses(app_factory) -> None:
+    """What the browser composes (nested link frames, gizmo) is the controller's robot, after
+    Cartesian and joint jogs, to below the pendant's resolution (0.01 mm; poses that moved
+    less than that are not re-sent)."""
+    shown = 1e-5                                                # 0.01 mm; 1e-5 in R entries
+    app = app_factory()
+    client, s = _session(app)
+    try:
+        view = s.views["scene"]
+        k = s.controller.kinematics
+        # the arm is nested like the URDF tree; the flange stays at /robot/<flange>
+        assert view.flange_path == f"/robot/{k.flange_link}"
+        assert view.link_paths["link_6"] == "/robot/base_link/link_1/link_2/link_3/link_4/link_5/link_6"
+        _check_scene_matches_controller(s, 1e-12)
+        moves = [("X", 1, "10"), ("A", 1, "10"), ("C", -1, "1"), ("Z", -1, "100"), ("B", 1, "0.1")]
+        for axis, sign, inc in moves:
+            with s.lock:
+                s.jogger.settings = s.jogger.settings.with_(increment=inc)
+                res = s.jogger.key(axis, sign)
+                assert res is not None and res.ok, res
+                s.moved()
+            _check_scene_matches_controller(s, shown)
+        with s.lock:
+            s.controller.jog_joint(0, 5.0)
+            s.moved()
+        _check_scene_matches_controller(s, shown)
+    finally:
+        client.close()
+
+
+def test_only_changed_poses_are_sent(app_factory) -> None:
+    """A joint jog of A1 re-sends one orientation in the nested arm (link_1) plus the flange
+    and the gizmo, which hang in WORLD; nothing moves: nothing is sent."""
+    app = app_factory()
+    client, s = _session(app)
+    try:
+        view = s.views["scene"]
+        sent: list[tuple[str, bool, bool]] = []
+        import tcp_pendant.views.scene as scene_module
+
+        real = scene_module._set_pose
+
+        def spy(handle, wxyz, xyz):
+            sent.append((handle._impl.name, wxyz is not None, xyz is not None))
+            return real(handle, wxyz, xyz)
+
+        scene_module._set_pose = spy
+        try:
+            with s.lock:
+                s.moved()                                          # nothing moved
+            assert sent == []
+            with s.lock:
+                s.controller.jog_joint(0, 3.0)
+                s.moved()
+        finally:
+            scene_module._set_pose = real
+        names = {n for n, _, _ in sent}
+        assert names == {view.link_paths["link_1"], view.flange_path, "/tcp_gizmo"}, sent
+        assert (view.link_paths["link_1"], True, False) in sent   # orientation only
+    finally:
+        client.close()
+
+
+def test_session_pose_state_is_shared_until_the_robot_moves(app_factory) -> None:
+    app = app_factory()
+    client, s = _session(app)
+    try:
+        st = s.pose_state()
+        assert s.pose_state() is st
+        with s.lock:
+            s.controller.jog_joint(2, 1.0)
+        st2 = s.pose_state()
+        assert st2 is not st
+        np.testing.assert_allclose(st2.T_world_flange, s.controller.T_world_flange(), atol=1e-14)
+    finally:
+        client.close()
