@@ -14,6 +14,12 @@ so ``((A^T A)^-1)_tt = M^-1`` and the Cramer-Rao bound of methods.md section 7 i
 ``sigma^2 M^-1``. ``M`` depends on the rotations only. The eigenvalues of ``A^T A`` are
 ``N +- s_k(S)`` (``s_k`` the singular values of ``S``), which gives the condition number of
 ``A`` without forming it.
+
+Speed (the wizard calls this live; ``tests/bench/bench_solver.py`` prints the figures): per-touch
+quantities are computed as whole arrays, never in Python loops over touches, and with as few
+numpy calls as possible, because for N = 4..20 the cost is the per-call overhead, not the
+arithmetic. Per-touch 3x3 algebra (outlier test) uses the "one row per matrix entry" layout
+``(3, 3, N)`` (``soa``), whose element-wise operations run over contiguous length-N rows.
 """
 
 from __future__ import annotations
@@ -31,6 +37,29 @@ DEGENERATE_TILT_RAD: float = 1e-3
 # Two touch orientations closer than this are "the same orientation" (a duplicated pose).
 SAME_ORIENTATION_DEG: float = 0.05
 CONFIDENCE: float = 0.95
+
+_EYE3 = np.eye(3)
+_EYE3.setflags(write=False)
+_SQRT8 = 2.0 * math.sqrt(2.0)
+
+
+def soa(rotations: np.ndarray) -> np.ndarray:
+    """``(3, 3, N)`` contiguous copy of an ``(N, 3, 3)`` stack: ``soa(R)[j, k]`` holds entry
+    ``(j, k)`` of every ``R_i``, so per-touch 3x3 algebra becomes element-wise operations on
+    contiguous length-N rows (measured 3-4x faster than batched ``(N, 3, 3)`` matmul/einsum
+    at N = 1000, and fewer numpy calls at N = 8)."""
+    n = rotations.shape[0]
+    return np.ascontiguousarray(rotations.reshape(n, 9).T).reshape(3, 3, n)
+
+
+def sum_over_touches(a: np.ndarray) -> np.ndarray:
+    """``sum_i a[i]`` of an (N, ...) array: ``a.sum(axis=0)`` for small N; for large N a
+    matrix-vector product with ones (contiguous BLAS; ``sum(axis=0)`` over rows of 3 or 9
+    numbers was measured 4x slower at N = 1000)."""
+    n = a.shape[0]
+    if n <= 64:
+        return a.sum(axis=0)
+    return (np.ones(n) @ a.reshape(n, -1)).reshape(a.shape[1:])
 
 
 @dataclass(frozen=True)
@@ -84,14 +113,26 @@ class Information:
         return (n + s_max) / math.sqrt(n * mu)
 
 
-def information(rotations: np.ndarray) -> Information:
-    """Information matrix ``M`` of the TCP for touches with rotations ``R_i`` (methods.md
-    (4P-3), Schur complement of ``A^T A``): ``M = N I - S^T S / N``. O(N), no 3N x 6 matrix."""
-    n = rotations.shape[0]
-    rbar = rotations.sum(axis=0) / n
-    m = n * (np.eye(3) - rbar.T @ rbar)
+def information_from_sum(s: np.ndarray, n: int) -> Information:
+    """:class:`Information` from ``S = sum_i R_i`` (3x3) and N: ``M = N I - S^T S / N``."""
+    rbar = s / n
+    m = n * _EYE3 - s.T @ rbar
     w, v = np.linalg.eigh(m)
-    return Information(n=n, rbar=rbar, m=m, eigvals=np.maximum(w, 0.0), eigvecs=v)
+    if w[0] < 0.0:  # rounding of a (numerically) singular M
+        w = np.maximum(w, 0.0)
+    return Information(n=n, rbar=rbar, m=m, eigvals=w, eigvecs=v)
+
+
+def information(rotations: np.ndarray, rotations_soa: np.ndarray | None = None) -> Information:
+    """Information matrix ``M`` of the TCP for touches with rotations ``R_i`` (methods.md
+    (4P-3), Schur complement of ``A^T A``): ``M = N I - S^T S / N``. O(N), no 3N x 6 matrix.
+    ``rotations_soa`` (``soa(rotations)``), if given, makes the sum contiguous."""
+    n = rotations.shape[0]
+    if rotations_soa is not None:
+        s = rotations_soa.reshape(9, n).sum(axis=1).reshape(3, 3)
+    else:
+        s = sum_over_touches(rotations)
+    return information_from_sum(s, n)
 
 
 def ci_radius(cov_eigvals: np.ndarray, dof: float | None, confidence: float = CONFIDENCE) -> float:
@@ -116,13 +157,14 @@ def ci_radius(cov_eigvals: np.ndarray, dof: float | None, confidence: float = CO
     Returns:
         The radius, in the length unit of the input.
     """
-    lam = np.maximum(np.asarray(cov_eigvals, dtype=float), 0.0)
-    s1 = float(lam.sum())
+    # Three numbers: plain Python floats are several times faster than numpy calls here.
+    lam = [max(v, 0.0) for v in map(float, np.ravel(cov_eigvals))]  # max(nan, 0) stays nan
+    s1 = sum(lam)
     if not math.isfinite(s1):
         return math.inf
     if s1 <= 0.0:
         return 0.0
-    s2 = float((lam * lam).sum())
+    s2 = sum(v * v for v in lam)
     c = s2 / s1
     d = s1 * s1 / s2
     if dof is None or math.isinf(dof):
@@ -137,7 +179,7 @@ def angle_between(ra: np.ndarray, rb: np.ndarray) -> float:
     ``2 asin(|R_a - R_b|_F / (2 sqrt 2))``."""
     diff = ra - rb
     fro = math.sqrt(float((diff * diff).sum()))
-    return 2.0 * math.asin(min(fro / (2.0 * math.sqrt(2.0)), 1.0))
+    return 2.0 * math.asin(min(fro / _SQRT8, 1.0))
 
 
 @dataclass(frozen=True)
@@ -148,30 +190,83 @@ class AngleExtremes:
     max_pair: tuple[int, int]
 
 
-def angle_extremes(rotations: np.ndarray) -> AngleExtremes:
+_GRAM_SMALL = 128
+"""Up to this many touches :func:`angle_extremes` forms the whole N x N Gram matrix."""
+_GRAM_BLOCK_ENTRIES = 32768
+"""Entries per Gram block above ``_GRAM_SMALL`` (256 kB: stays in cache; and a product of
+``rows x cols x 9`` below ~5e5 multiply-adds, which OpenBLAS runs on one thread: measured on
+the 2-core machine the benchmark runs on, multi-threaded blocks of 128 x 1000 were up to 40x
+slower whenever other processes kept the second core busy)."""
+
+
+def angle_extremes(rotations: np.ndarray, rotations_soa: np.ndarray | None = None, *,
+                   gram: np.ndarray | None = None) -> AngleExtremes:
     """Smallest and largest rotation angle between two of the orientations (degrees).
 
-    Uses ``trace(R_a^T R_b) = 1 + 2 cos(angle)`` on the Gram matrix of the flattened
-    rotations (O(N^2)) to find the two pairs, then recomputes their angles with
-    :func:`angle_between`.
+    Uses ``trace(R_a^T R_b) = 1 + 2 cos(angle)`` = the dot product of the flattened rotations
+    to find the two pairs (largest trace = smallest angle and vice versa), then recomputes
+    their angles as ``2 asin(|R_a - R_b|_F / (2 sqrt 2))`` (:func:`angle_between`, accurate for
+    small angles).
+
+    This is the only O(N^2) figure of the 4-point method: every pair must be looked at (the
+    largest angle is the diameter of the set in SO(3); typical touch sets have hundreds of
+    pairs within 0.1 deg of the largest angle, so pruning schemes do not pay). Up to
+    ``_GRAM_SMALL`` touches the whole N x N Gram matrix is formed; above, its upper triangle in
+    blocks of rows (``_GRAM_BLOCK_ENTRIES``), each reduced to its minimum and maximum. Ties
+    resolve to the first pair in row-major order in both cases.
+
+    Args:
+        rotations: (N, 3, 3).
+        rotations_soa: ``soa(rotations)`` if the caller has it (saves a transposed copy).
+        gram: the N x N Gram matrix of the flattened rotations if the caller has it (small N
+            only; it is overwritten).
     """
     n = rotations.shape[0]
     if n < 2:
         return AngleExtremes(math.nan, math.nan, (0, 0), (0, 0))
     x = rotations.reshape(n, 9)
-    g = x @ x.T
-    k_max = int(np.argmin(g))  # smallest trace = largest angle (diagonal is the maximum 3)
-    g.flat[:: n + 1] = -np.inf
-    k_min = int(np.argmax(g))
-    a, b = divmod(k_max, n)
-    c, e = divmod(k_min, n)
-    if a == b:  # all orientations equal: argmin hit the diagonal
-        a, b = 0, 1
+    if n <= _GRAM_SMALL:
+        g = x @ x.T if gram is None else gram
+        k_max = int(g.argmin())  # smallest trace = largest angle (diagonal is the maximum 3)
+        g.ravel()[:: n + 1] = -np.inf
+        k_min = int(g.argmax())
+        a, b = divmod(k_max, n)
+        c, e = divmod(k_min, n)
+        if a == b:  # all orientations equal: argmin hit the diagonal
+            a, b = 0, 1
+    else:
+        xt = rotations_soa.reshape(9, n) if rotations_soa is not None else np.ascontiguousarray(x.T)
+        lo, hi = math.inf, -math.inf
+        a = b = c = e = 0
+        i = 0
+        while i < n:
+            cols = n - i  # columns i.. of rows i..: the upper triangle and the diagonal block
+            rows = min(max(_GRAM_BLOCK_ENTRIES // cols, 1), cols)
+            blk = x[i : i + rows] @ xt[:, i:]
+            diag = blk.ravel()[: rows * (cols + 1) : cols + 1]  # the pairs (i + k, i + k)
+            diag[:] = np.inf
+            k = int(blk.argmin())
+            v = blk.item(k)
+            if v < lo:
+                lo = v
+                a, b = divmod(k, cols)
+                a, b = a + i, b + i
+            diag[:] = -np.inf
+            k = int(blk.argmax())
+            v = blk.item(k)
+            if v > hi:
+                hi = v
+                c, e = divmod(k, cols)
+                c, e = c + i, e + i
+            i += rows
     a, b = min(a, b), max(a, b)
     c, e = min(c, e), max(c, e)
+    v = x[[c, a, e, b]]
+    d = v[:2] - v[2:]
+    fro2_min, fro2_max = np.einsum("ij,ij->i", d, d).tolist()
     return AngleExtremes(
-        min_deg=math.degrees(angle_between(rotations[c], rotations[e])),
-        max_deg=math.degrees(angle_between(rotations[a], rotations[b])),
+        min_deg=math.degrees(2.0 * math.asin(min(math.sqrt(fro2_min) / _SQRT8, 1.0))),
+        max_deg=math.degrees(2.0 * math.asin(min(math.sqrt(fro2_max) / _SQRT8, 1.0))),
         min_pair=(c, e),
         max_pair=(a, b),
     )

@@ -11,6 +11,7 @@ absolute entry of ``R^T R - I``) and proper (``det R > 0``, i.e. +1 within the t
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -20,6 +21,7 @@ from tcpcal.errors import InvalidInputError
 __all__ = [
     "ORTHONORMAL_TOL",
     "as_rotations",
+    "rotations_and_soa",
     "as_rotation",
     "as_positions",
     "as_vector3",
@@ -27,6 +29,10 @@ __all__ = [
 
 ORTHONORMAL_TOL: float = 1e-6
 """Largest accepted ``max |R^T R - I|`` of a rotation matrix."""
+
+_EYE = np.eye(3)
+_EYE_COLUMN = _EYE[:, :, None]
+_CYCLIC = np.array([0, 1, 2, 0, 1])
 
 
 def _as_float_array(x: Any, name: str, expected: str) -> np.ndarray:
@@ -63,6 +69,22 @@ def as_rotations(x: Any, name: str = "rotations") -> np.ndarray:
             ``ORTHONORMAL_TOL`` or has determinant -1 (a reflection). Errors about one matrix
             carry ``.index``.
     """
+    return rotations_and_soa(x, name)[0]
+
+
+SMALL_STACK = 64
+"""Up to this many matrices the checks use batched (N, 3, 3) products (fewest numpy calls);
+above, element-wise products of contiguous length-N rows (``(3, 3, N)`` layout, faster)."""
+
+
+def rotations_and_soa(x: Any, name: str = "rotations") -> tuple[np.ndarray, np.ndarray | None]:
+    """:func:`as_rotations`, also returning the ``(3, 3, N)`` layout ``y[j, k] = R[:, j, k]``
+    (``tcpcal._stats.soa``) when the check computed it (N > ``SMALL_STACK``), else None.
+
+    The clean path costs a handful of numpy calls at any N (the solvers run it on every call):
+    one sum for NaN/inf, the column dot products ``R^T R`` and the determinants; the reason of
+    a failure is looked up matrix by matrix only then (slow path, errors only).
+    """
     arr = _as_float_array(x, name, "an (N, 3, 3) array of rotation matrices")
     if arr.ndim != 3 or arr.shape[1:] != (3, 3):
         raise InvalidInputError(
@@ -72,49 +94,59 @@ def as_rotations(x: Any, name: str = "rotations") -> np.ndarray:
     if arr.shape[0] == 0:
         raise InvalidInputError(f"{name} is empty; pass at least one 3x3 rotation matrix.")
     n = arr.shape[0]
-    if not np.isfinite(arr).all():
-        i = _first_nonfinite(arr)
-        raise InvalidInputError(
-            f"{name}[{i}] contains NaN or inf; every entry of a rotation matrix must be a "
-            "finite number (re-record or remove that touch).",
-            index=i,
-        )
-    # R^T R - I entries are the column dot products c_k . c_l - delta_kl. Rows of ``y`` are the
-    # 9 matrix entries over all touches, so column k of every R is y[k::3] (3, N), contiguous.
-    y = np.ascontiguousarray(arr.reshape(n, 9).T)
-    c0, c1, c2 = y[0::3], y[1::3], y[2::3]
-    dots = np.empty((6, n))
-    for row, (u, v) in enumerate(((c0, c0), (c1, c1), (c2, c2), (c0, c1), (c0, c2), (c1, c2))):
-        np.einsum("kn,kn->n", u, v, out=dots[row])
-    dots[:3] -= 1.0
-    defect = np.abs(dots).max(axis=0)
-    bad = defect > ORTHONORMAL_TOL
-    if bad.any():
-        i = int(np.argmax(bad))
-        raise InvalidInputError(
-            f"{name}[{i}] is not a rotation matrix: it is not orthonormal within "
-            f"{ORTHONORMAL_TOL:g} (max |R^T R - I| = {defect[i]:.3g}); pass a proper rotation "
-            "(check the column order, the angle units and that enough digits were printed).",
-            index=i,
-        )
-    # Orthonormal => det = +-1 = c2 . (c0 x c1): LAPACK for small stacks, written out for large.
-    if n <= 64:
+    if not math.isfinite(float(arr.sum())):  # NaN/inf (or an overflow: then go on)
+        _raise_nonfinite(arr, name)
+    y = None
+    if n <= SMALL_STACK:
+        gram = arr.transpose(0, 2, 1) @ arr  # R^T R
+        gram -= _EYE
+        np.abs(gram, out=gram)
+        if not float(gram.max()) <= ORTHONORMAL_TOL:
+            _raise_first_bad(arr, gram.reshape(n, 9).max(axis=1), name)
         det = np.linalg.det(arr)
     else:
-        det = (
-            c2[0] * (c0[1] * c1[2] - c0[2] * c1[1])
-            + c2[1] * (c0[2] * c1[0] - c0[0] * c1[2])
-            + c2[2] * (c0[0] * c1[1] - c0[1] * c1[0])
-        )
-    bad = det < 0.0
-    if bad.any():
-        i = int(np.argmax(bad))
+        y = np.ascontiguousarray(arr.reshape(n, 9).T).reshape(3, 3, n)
+        # R^T R entries: c_k . c_l = sum_j y[j, k] y[j, l]
+        gram = np.einsum("jkn,jln->kln", y, y)
+        gram -= _EYE_COLUMN
+        np.abs(gram, out=gram)
+        defect = gram.reshape(9, n).max(axis=0)
+        if not float(defect.max()) <= ORTHONORMAL_TOL:
+            _raise_first_bad(arr, defect, name)
+        # Orthonormal => det = +-1 = sum_j c0_j (c1 x c2)_j (np.linalg.det: ~0.1 us per matrix)
+        yc = y[_CYCLIC]  # rows j, j+1, j+2 (mod 3) for the cross products
+        det = (yc[0:3, 0] * (yc[1:4, 1] * yc[2:5, 2] - yc[2:5, 1] * yc[1:4, 2])).sum(axis=0)
+    if float(det.min()) < 0.0:
+        i = int(np.argmax(det < 0.0))
         raise InvalidInputError(
             f"{name}[{i}] is a reflection (determinant {det[i]:.6g}), not a rotation; a proper "
             "rotation has determinant +1 (check for a swapped or negated axis).",
             index=i,
         )
-    return arr
+    return arr, y
+
+
+def _raise_nonfinite(arr: np.ndarray, name: str) -> None:
+    """Raise the error about the first matrix holding NaN or inf, if any."""
+    i = _first_nonfinite(arr)
+    if i is not None:
+        raise InvalidInputError(
+            f"{name}[{i}] contains NaN or inf; every entry of a rotation matrix must be a "
+            "finite number (re-record or remove that touch).",
+            index=i,
+        )
+
+
+def _raise_first_bad(arr: np.ndarray, defect: np.ndarray, name: str) -> None:
+    """Raise the error about the first matrix that is not finite or not orthonormal."""
+    _raise_nonfinite(arr, name)
+    i = int(np.argmax(~(defect <= ORTHONORMAL_TOL)))  # NaN counts as bad
+    raise InvalidInputError(
+        f"{name}[{i}] is not a rotation matrix: it is not orthonormal within "
+        f"{ORTHONORMAL_TOL:g} (max |R^T R - I| = {defect[i]:.3g}); pass a proper rotation "
+        "(check the column order, the angle units and that enough digits were printed).",
+        index=i,
+    )
 
 
 def as_rotation(x: Any, name: str = "rotation") -> np.ndarray:
@@ -171,7 +203,9 @@ def as_positions(x: Any, n: int | None = None, name: str = "positions") -> np.nd
             f"{name} has {arr.shape[0]} rows but there are {n} rotations; pass exactly one "
             "position per rotation (same touches, same order)."
         )
-    i = _first_nonfinite(arr)
+    # one reduction: the sum is finite unless an entry is NaN/inf (or the sum overflows, which
+    # the exact look-up below then clears)
+    i = None if math.isfinite(float(arr.sum())) else _first_nonfinite(arr)
     if i is not None:
         raise InvalidInputError(
             f"{name}[{i}] contains NaN or inf; every coordinate must be a finite number "

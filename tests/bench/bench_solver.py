@@ -1,20 +1,34 @@
 """Benchmark of the TCP origin solvers (tcpcal.origin, tcpcal.pose_quality).
 
-    python tests/bench/bench_solver.py [--quick]
+    python tests/bench/bench_solver.py [--quick] [--sets N] [--draws D]
 
-Prints:
-1. Efficiency: RMS TCP error of each estimator over many random touch sets divided by the
-   RMS Cramer-Rao bound ``sqrt(mean trace CRB_t)`` (methods.md section 7; CRB from the explicit
-   3N x 6 matrix A). 1.00 is the physical limit; target for the default ``lstsq``: <= 1.02.
-   Touch sets: N = 4, 8, 20; isotropic touch noise sigma = 0.5 mm; the tool leans 20-50 deg or
-   5-15 deg from vertical in a random direction, with a random spin about flange Z; TCP length
-   100-300 mm. Estimators run without outlier detection (pure estimators). The sphere fit's
-   "failed" column counts sets it refused (coplanar flange positions).
-2. Median solve time (us) of ``solve_xyz4`` (default: lstsq with every quality figure and the
-   outlier test; and the same without the outlier test) for N = 4 and N = 1000, against a
-   baseline measured in the same run: ``numpy.linalg.lstsq`` on the explicit 3N x 6 system
-   (A prebuilt, only the solve timed).
-3. Median time of ``assess_touches`` and ``candidate_gain`` for N = 20.
+Prints, and says for each target of issue 2 whether it is met:
+
+1. Efficiency: the RMS TCP error of each estimator in units of the Cramer-Rao bound
+   (methods.md section 7; the bound ``CRB_t`` from the explicit 3N x 6 matrix A of each set,
+   ``poses.crb_tcp``). Over every random touch set and noise draw,
+   ``sqrt(mean |t_hat - t|^2 / trace CRB_t(set))``: each set's squared error is measured in
+   its own bound, so that a few nearly degenerate sets (huge bounds) do not dominate the
+   figure. 1.00 is the physical limit; target for the default ``lstsq``: <= 1.02. The Monte
+   Carlo uncertainty (2 standard errors) of the lstsq figure is printed next to it: the
+   verdict is only meaningful when it is small against the 2 % margin, which is why each set
+   gets several noise draws. Touch sets: N = 4, 8, 20; isotropic touch noise sigma = 0.5 mm
+   per axis; the tool leans 20-50 deg or 5-15 deg from vertical in a random direction, with
+   a random spin about flange Z; TCP length 100-300 mm. Estimators run without the outlier
+   test (pure estimators). "sphere failed" counts solves (sets x draws) the sphere fit refused (coplanar
+   flange positions); "flat" is the median thickness / extent of the flange positions
+   (smallest / largest singular value of the centred positions), which is what ruins the
+   sphere fit at N = 4.
+2. Median wall-clock time (us) of ``solve_xyz4`` with the default lstsq estimator, the
+   outlier test and every quality figure, and the same without the outlier test, for N = 4,
+   8, 20 and 1000, against a baseline measured in the same run: ``numpy.linalg.lstsq`` on the
+   explicit 3N x 6 system (A prebuilt, only the solve timed; it gives t and r and nothing
+   else). Targets: N = 4 < 100 us, N = 1000 < 1000 us.
+3. Median time of ``assess_touches`` and ``candidate_gain`` (the wizard calls them live) for
+   N = 4 and N = 20. Target: well under 1 ms.
+
+Timings depend on the machine and on what else runs on it (the load average is printed):
+re-run when the machine is busy, and trust ratios measured in the same run.
 
 ``--quick`` runs a tiny version (used by tests/tcpcal/test_bench_solver_runs.py).
 """
@@ -23,6 +37,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 import sys
 import time
 from collections.abc import Callable
@@ -40,38 +55,56 @@ from tcpcal.pose_quality import assess_touches, candidate_gain  # noqa: E402
 SIGMA = 0.5
 NS = (4, 8, 20)
 TILTS = ((20.0, 50.0), (5.0, 15.0))
+EFFICIENCY_TARGET = 1.02
+TIME_TARGETS_US = {4: 100.0, 1000: 1000.0}
+POSE_QUALITY_TARGET_US = 1000.0
 
 
-def efficiency_table(n_sets: int, seed: int = 0) -> list[dict]:
+QUICK = False
+
+
+def verdict(ok: bool) -> str:
+    if QUICK:
+        return "(quick run: no verdict)"
+    return "met" if ok else "NOT MET"
+
+
+def efficiency_table(n_sets: int, draws: int, seed: int = 0) -> list[dict]:
     rows = []
     for tilt in TILTS:
         for n in NS:
             rng = np.random.default_rng(seed)
             seed += 1
-            sq = {m: 0.0 for m in METHODS}
-            ok = {m: 0 for m in METHODS}
-            crb_sum = {m: 0.0 for m in METHODS}
+            ratios: dict[str, list[float]] = {m: [] for m in METHODS}
             failed = {m: 0 for m in METHODS}
+            crb_traces, flatness = [], []
             for _ in range(n_sets):
                 rot = tilted_rotations(rng, n, tilt)
                 tcp = random_tcp(rng, (100.0, 300.0))
                 ref = rng.uniform(-500, 500, 3) + [800.0, 0.0, 300.0]
-                pos = touch_positions(rot, tcp, ref, rng, SIGMA)
                 trace_crb = float(np.trace(crb_tcp(rot, SIGMA)))
-                for m in METHODS:
-                    try:
-                        res = solve_xyz4(rot, pos, method=m, detect_outliers=False)
-                    except DegenerateTouchesError:
-                        failed[m] += 1
-                        continue
-                    sq[m] += float(np.sum((res.tcp - tcp) ** 2))
-                    crb_sum[m] += trace_crb
-                    ok[m] += 1
-            row = {"n": n, "tilt": tilt, "sets": n_sets,
-                   "crb_rms": math.sqrt(crb_sum["lstsq"] / max(ok["lstsq"], 1))}
+                crb_traces.append(trace_crb)
+                clean = touch_positions(rot, tcp, ref)
+                sv = np.linalg.svd(clean - clean.mean(axis=0), compute_uv=False)
+                flatness.append(sv[-1] / sv[0])
+                for _ in range(draws):
+                    pos = clean + SIGMA * rng.standard_normal(clean.shape)
+                    for m in METHODS:
+                        try:
+                            res = solve_xyz4(rot, pos, method=m, detect_outliers=False)
+                        except DegenerateTouchesError:
+                            failed[m] += 1
+                            continue
+                        ratios[m].append(float(np.sum((res.tcp - tcp) ** 2)) / trace_crb)
+            row = {"n": n, "tilt": tilt, "sets": n_sets, "draws": draws,
+                   "crb_rms": math.sqrt(np.mean(crb_traces)), "flat": float(np.median(flatness))}
             for m in METHODS:
-                row[m] = math.sqrt(sq[m] / crb_sum[m]) if ok[m] else math.nan
-                row[m + "_failed"] = failed[m]
+                r = np.asarray(ratios[m])
+                row[m] = math.sqrt(r.mean()) if r.size else math.nan
+                # 2 standard errors of sqrt(mean r) by the delta method
+                row[m + "_2se"] = (2.0 * r.std(ddof=1) / math.sqrt(r.size) / (2.0 * row[m])
+                                   if r.size > 1 else math.nan)
+                row[m + "_failed"] = failed[m]  # refused solves (sets x draws)
             rows.append(row)
     return rows
 
@@ -89,55 +122,88 @@ def median_us(fn: Callable[[], object], repeats: int) -> float:
 def timing_table(repeats: int) -> list[tuple[int, float, float, float]]:
     out = []
     rng = np.random.default_rng(99)
-    for n in (4, 1000):
+    for n in (4, 8, 20, 1000):
         rot = tilted_rotations(rng, n, (20.0, 50.0))
         pos = touch_positions(rot, random_tcp(rng, (100.0, 300.0)), np.array([800.0, 0, 300]), rng, SIGMA)
         a = stacked_a(rot)
         b = -pos.reshape(-1)
-        full = median_us(lambda: solve_xyz4(rot, pos), repeats)
-        no_outl = median_us(lambda: solve_xyz4(rot, pos, detect_outliers=False), repeats)
-        base = median_us(lambda: np.linalg.lstsq(a, b, rcond=None), repeats)
+        reps = repeats if n < 1000 else max(repeats // 4, 10)
+        full = median_us(lambda: solve_xyz4(rot, pos), reps)
+        no_outl = median_us(lambda: solve_xyz4(rot, pos, detect_outliers=False), reps)
+        base = median_us(lambda: np.linalg.lstsq(a, b, rcond=None), reps)
         out.append((n, full, no_outl, base))
     return out
 
 
-def pose_quality_timing(repeats: int) -> tuple[float, float]:
+def pose_quality_timing(repeats: int) -> list[tuple[int, float, float]]:
     rng = np.random.default_rng(7)
-    rot = tilted_rotations(rng, 20, (20.0, 50.0))
-    cand = tilted_rotations(rng, 1, (20.0, 50.0))[0]
-    return (median_us(lambda: assess_touches(rot), repeats),
-            median_us(lambda: candidate_gain(rot, cand), repeats))
+    out = []
+    for n in (4, 20):
+        rot = tilted_rotations(rng, n, (20.0, 50.0))
+        cand = tilted_rotations(rng, 1, (20.0, 50.0))[0]
+        out.append((n, median_us(lambda: assess_touches(rot), repeats),
+                    median_us(lambda: candidate_gain(rot, cand), repeats)))
+    return out
 
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="tiny run (smoke test)")
     ap.add_argument("--sets", type=int, default=None, help="random sets per row (default 2000)")
+    ap.add_argument("--draws", type=int, default=None, help="noise draws per set (default 5)")
     args = ap.parse_args(argv)
+    global QUICK
+    QUICK = args.quick
     n_sets = args.sets or (20 if args.quick else 2000)
+    draws = args.draws or (2 if args.quick else 5)
     repeats = 20 if args.quick else 2000
 
-    print(f"tcpcal solver benchmark  (sigma = {SIGMA} mm per axis, {n_sets} random sets per row)")
+    load = os.getloadavg()[0] if hasattr(os, "getloadavg") else math.nan
+    print(f"tcpcal solver benchmark  (sigma = {SIGMA} mm per axis; {n_sets} random sets per row, "
+          f"{draws} noise draws each; load average {load:.1f} on {os.cpu_count()} CPUs)")
     print()
-    print("1. RMS TCP error / Cramer-Rao bound  (1.00 = limit; target lstsq <= 1.02)")
-    hdr = f"{'tilt deg':>9} {'N':>3} {'CRB rms mm':>10} " + " ".join(f"{m:>9}" for m in METHODS) + f" {'sphere failed':>14}"
+    print("1. RMS TCP error / Cramer-Rao bound, each set's error in its own bound  "
+          f"(1.00 = limit; target lstsq <= {EFFICIENCY_TARGET})")
+    hdr = (f"{'tilt deg':>9} {'N':>3} {'CRB rms mm':>10} " + " ".join(f"{m:>9}" for m in METHODS)
+           + f" {'lstsq +-2SE':>11} {'sphere failed':>14} {'flat':>6}  lstsq target")
     print(hdr)
     print("-" * len(hdr))
-    for r in efficiency_table(n_sets):
+    table = efficiency_table(n_sets, draws)
+    all_met = True
+    for r in table:
         tilt = f"{r['tilt'][0]:.0f}-{r['tilt'][1]:.0f}"
         vals = " ".join(f"{r[m]:9.3f}" for m in METHODS)
-        print(f"{tilt:>9} {r['n']:>3} {r['crb_rms']:10.3f} {vals} {r['sphere_failed']:>14d}")
+        ok = r["lstsq"] <= EFFICIENCY_TARGET
+        all_met &= ok
+        print(f"{tilt:>9} {r['n']:>3} {r['crb_rms']:10.3f} {vals} {r['lstsq_2se']:11.3f} "
+              f"{r['sphere_failed']:>14d} {r['flat']:6.3f}  {verdict(ok)}")
+    worst_sphere = max(table, key=lambda r: r["sphere"])
+    print(f"   lstsq <= {EFFICIENCY_TARGET} in every row: {verdict(all_met)}.")
+    print(f"   The sphere fit is far from the bound when the flange positions are nearly coplanar: "
+          f"{worst_sphere['sphere']:.1f} x the bound at N = {worst_sphere['n']}, tilt "
+          f"{worst_sphere['tilt'][0]:.0f}-{worst_sphere['tilt'][1]:.0f} deg (median thickness / "
+          f"extent {worst_sphere['flat']:.3f}); pairwise differences discard information "
+          f"(~{np.mean([r['pairwise'] for r in table]):.2f} x).")
     print()
-    print(f"2. median solve time, us ({repeats} repeats)  (targets: N=4 < 100, N=1000 < 1000)")
-    hdr = f"{'N':>5} {'solve_xyz4':>11} {'no outlier test':>16} {'np.linalg.lstsq 3Nx6':>21}"
+    print(f"2. median solve time, us ({repeats} repeats; N = 1000: {max(repeats // 4, 10)})  "
+          f"(targets: N=4 < {TIME_TARGETS_US[4]:.0f}, N=1000 < {TIME_TARGETS_US[1000]:.0f})")
+    hdr = (f"{'N':>5} {'solve_xyz4':>11} {'no outlier test':>16} {'np.linalg.lstsq 3Nx6':>21} "
+           f"{'ratio':>6}  target")
     print(hdr)
     print("-" * len(hdr))
     for n, full, no_outl, base in timing_table(repeats):
-        print(f"{n:>5} {full:11.1f} {no_outl:16.1f} {base:21.1f}")
+        target = TIME_TARGETS_US.get(n)
+        tgt = f"< {target:.0f} us: {verdict(full < target)}" if target else "-"
+        print(f"{n:>5} {full:11.1f} {no_outl:16.1f} {base:21.1f} {full / base:6.1f}  {tgt}")
+    print("   solve_xyz4 includes input checks, every quality figure (residuals, noise, covariance,")
+    print("   95 % radius, condition number, the O(N^2) largest/smallest angle between touches),")
+    print("   warnings and the outlier test; np.linalg.lstsq gives t and r only.")
     print()
-    a_us, c_us = pose_quality_timing(repeats)
-    print("3. pose quality, N = 20, median us  (target well under 1000)")
-    print(f"   assess_touches {a_us:8.1f}    candidate_gain {c_us:8.1f}")
+    print(f"3. pose quality, median us  (target well under {POSE_QUALITY_TARGET_US:.0f})")
+    for n, a_us, c_us in pose_quality_timing(repeats):
+        ok = max(a_us, c_us) < POSE_QUALITY_TARGET_US
+        print(f"   N = {n:2d}   assess_touches {a_us:8.1f}    candidate_gain {c_us:8.1f}    "
+              f"{verdict(ok)}")
     return 0
 
 
