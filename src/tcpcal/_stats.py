@@ -192,11 +192,12 @@ class AngleExtremes:
 
 _GRAM_SMALL = 128
 """Up to this many touches :func:`angle_extremes` forms the whole N x N Gram matrix."""
-_GRAM_BLOCK_ENTRIES = 32768
-"""Entries per Gram block above ``_GRAM_SMALL`` (256 kB: stays in cache; and a product of
-``rows x cols x 9`` below ~5e5 multiply-adds, which OpenBLAS runs on one thread: measured on
-the 2-core machine the benchmark runs on, multi-threaded blocks of 128 x 1000 were up to 40x
-slower whenever other processes kept the second core busy)."""
+_GRAM_BLOCK_ENTRIES = 16384
+"""Entries per Gram block above ``_GRAM_SMALL`` (128 kB: stays in cache; and a product of
+``rows x cols x 9`` multiply-adds small enough that OpenBLAS runs it on one thread: measured
+on the 2-core machine the benchmark runs on, multi-threaded blocks of 128 x 1000 were up to
+40x slower whenever other processes kept the second core busy, and blocks of 16k-32k entries
+were the fastest, single- or multi-threaded)."""
 
 
 def angle_extremes(rotations: np.ndarray, rotations_soa: np.ndarray | None = None, *,
@@ -285,5 +286,7 @@ def duplicate_orientations(rotations: np.ndarray, tol_deg: float = SAME_ORIENTAT
 
 
 def fmt_vec(v: np.ndarray) -> str:
-    """``[0.00, 0.00, 1.00]``."""
-    return "[" + ", ".join(f"{float(c) + 0.0:.2f}" for c in v) + "]"
+    """``[0.00, 0.00, 1.00]`` (a component that rounds to zero prints as ``0.00``, never
+    ``-0.00``)."""
+    parts = (f"{float(c):.2f}" for c in v)
+    return "[" + ", ".join("0.00" if p == "-0.00" else p for p in parts) + "]"

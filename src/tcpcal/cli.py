@@ -219,13 +219,13 @@ def _solver_error(exc: TcpcalError, poses: FlangePoses, rows: Sequence[int] | No
     if isinstance(exc, DegenerateTouchesError):
         axis = getattr(exc, "unobservable_axis", None)
         if axis is not None:
-            u = np.asarray(axis, dtype=float) + 0.0  # + 0.0: no "-0.000"
+            u = np.asarray(axis, dtype=float)
             k = int(np.argmax(np.abs(u)))
             if abs(u[k]) > 0.9:
                 msg += f" [unobservable direction ~ flange {'XYZ'[k]} axis]"
             else:
-                msg += (f" [unobservable direction in FLANGE: ({u[0]:.3f}, {u[1]:.3f}, "
-                        f"{u[2]:.3f})]")
+                comps = ", ".join("0.000" if c == "-0.000" else c for c in (f"{v:.3f}" for v in u))
+                msg += f" [unobservable direction in FLANGE: ({comps})]"
     return f"{where}: {msg}"
 
 
@@ -274,8 +274,7 @@ def _run_solve(args: argparse.Namespace) -> int:
                                      variant=args.variant)
         except TcpcalError as exc:
             raise CliInputError(_solver_error(exc, poses)) from None
-        out = orientation_result_to_dict(ores)
-        out["tcp_mm"] = list(args.tcp)
+        out = orientation_result_to_dict(ores, tcp_mm=args.tcp)
         _emit(_with_source(out, poses) if args.json else format_orientation_report(
             ores, poses, command=f"solve three-point --variant {args.variant}", tcp_mm=args.tcp))
         return 0

@@ -125,14 +125,29 @@ def tcp_result_to_dict(result: TcpResult, *, rows: Sequence[int] | None = None) 
     return out
 
 
-def orientation_result_to_dict(result: OrientationResult) -> dict[str, Any]:
-    """The JSON object of a TOOL-orientation result (``solve three-point`` / ``abc-world``)."""
+def orientation_result_to_dict(result: OrientationResult, *,
+                               tcp_mm: Sequence[float] | None = None) -> dict[str, Any]:
+    """The JSON object of a TOOL-orientation result (``solve three-point`` / ``abc-world``).
+
+    It carries the keys every ``solve`` object has (issue 2: ``tcp_mm``, ``residuals_mm``, the
+    error figures, ``ci95_mm``, ``outliers``), so that scripts read all four commands alike:
+    ``tcp_mm`` is the TCP the method was given (``None`` for abc-world, which needs none);
+    these methods have no touch residuals, so ``residuals_mm`` and ``outliers`` are empty and
+    the figures ``None`` (JSON ``null``: not defined).
+    """
     return {
         "method": result.method,
+        "tcp_mm": None if tcp_mm is None else [float(v) for v in tcp_mm],
         "rotation_matrix": np.asarray(result.rotation, dtype=float),
         "kuka_abc_deg": np.asarray(result.kuka_abc_deg, dtype=float),
         "orthogonality_defect_deg": result.orthogonality_defect_deg,
         "displacements_mm": list(result.displacements),
+        "residuals_mm": [],
+        "mean_error_mm": None,
+        "max_error_mm": None,
+        "rms_error_mm": None,
+        "ci95_mm": None,
+        "outliers": [],
         "warnings": list(result.warnings),
     }
 

@@ -407,3 +407,47 @@ def test_docs_example_output_is_real(capsys: pytest.CaptureFixture[str],
     assert code == 0 and out.rstrip("\n") == pasted
     d = run_json(["solve", "xyz4", "docs/examples/xyz4_poses.csv"], capsys)
     assert np.linalg.norm(np.array(d["tcp_mm"]) - [85.0, -12.0, 210.0]) < d["ci95_mm"]
+
+
+def test_every_solve_json_has_the_keys_of_issue_2(tmp_path: Path,
+                                                  capsys: pytest.CaptureFixture[str]) -> None:
+    """Issue 2: every ``--json`` object has at least method, tcp_mm, residuals_mm,
+    mean/max/rms_error_mm, ci95_mm, outliers (0-based rows) and warnings; reference_mm for
+    xyz4 and reference; rotation_matrix (3x3 rows) and kuka_abc_deg for the orientation
+    methods (docs/cli.md: null / empty where a figure is not defined)."""
+    rots, pos = xyz4_poses(8, noise_mm=0.05, seed=7, offset={5: np.array([3.0, -4.0, 0.0])})
+    xyz4 = write_csv(tmp_path / "xyz4.csv", rots, pos)
+    r1, r2 = rot((10, 20, 170)), rot((-60, -30, 160))
+    ref = write_csv(tmp_path / "ref.csv", [r1, r2],
+                    [R_REF - r1 @ np.array([0.0, 0, 150]), R_REF - r2 @ T_TRUE])
+    tp = write_csv(tmp_path / "tp.csv", *three_point_poses(2))
+    abc = write_csv(tmp_path / "abc.csv", [PA1 @ rot(TP_ABC).T], [np.array([600.0, 0, 300])])
+    outputs = {
+        "xyz4": run_json(["solve", "xyz4", str(xyz4)], capsys),
+        "reference": run_json(["solve", "reference", str(ref), "--known-tcp", "0,0,150"], capsys),
+        "three-point": run_json(["solve", "three-point", str(tp), "--tcp", "-20,5.5,210",
+                                 "--variant", "2"], capsys),
+        "abc-world": run_json(["solve", "abc-world", str(abc)], capsys),
+    }
+    for cmd, d in outputs.items():
+        assert isinstance(d["method"], str)
+        assert d["tcp_mm"] is None or (len(d["tcp_mm"]) == 3
+                                       and all(isinstance(v, float) for v in d["tcp_mm"])), cmd
+        assert isinstance(d["residuals_mm"], list)
+        for key in ("mean_error_mm", "max_error_mm", "rms_error_mm", "ci95_mm"):
+            assert key in d and (d[key] is None or isinstance(d[key], float)), (cmd, key)
+        assert isinstance(d["outliers"], list) and all(isinstance(i, int) for i in d["outliers"])
+        assert isinstance(d["warnings"], list) and all(isinstance(w, str) for w in d["warnings"])
+    for cmd in ("xyz4", "reference"):
+        d = outputs[cmd]
+        assert len(d["reference_mm"]) == 3 and len(d["residuals_mm"]) == d["n_touches"]
+        assert all(isinstance(d[k], float) for k in ("mean_error_mm", "max_error_mm",
+                                                     "rms_error_mm"))
+    assert outputs["xyz4"]["outliers"] == [5] and isinstance(outputs["xyz4"]["ci95_mm"], float)
+    for cmd in ("three-point", "abc-world"):
+        d = outputs[cmd]
+        assert np.array(d["rotation_matrix"]).shape == (3, 3) and len(d["kuka_abc_deg"]) == 3
+        np.testing.assert_allclose(d["kuka_abc_deg"], TP_ABC, atol=1e-7)
+        assert d["residuals_mm"] == [] and d["outliers"] == [] and d["ci95_mm"] is None
+    assert outputs["three-point"]["tcp_mm"] == [-20.0, 5.5, 210.0]
+    assert outputs["abc-world"]["tcp_mm"] is None
