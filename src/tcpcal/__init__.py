@@ -13,7 +13,12 @@ Typical use::
 
 from tcpcal.errors import DegenerateTouchesError, InvalidInputError, TcpcalError
 from tcpcal.formats import FORMATS, export_tool, import_tool
-from tcpcal.library import ToolLibrary, ToolLibraryError, ToolLibraryWarning, default_library_path
+from tcpcal.library import (
+    ToolLibrary,
+    ToolLibraryError,
+    ToolLibraryWarning,
+    default_library_path,
+)
 from tcpcal.orientation import (
     OrientationResult,
     solve_abc_world,
@@ -21,7 +26,12 @@ from tcpcal.orientation import (
     solve_three_point_lstsq,
 )
 from tcpcal.origin import TcpResult, solve_reference, solve_xyz4
-from tcpcal.pose_quality import CandidateGain, PoseQuality, assess_touches, candidate_gain
+from tcpcal.pose_quality import (
+    CandidateGain,
+    PoseQuality,
+    assess_touches,
+    candidate_gain,
+)
 from tcpcal.tool import Calibration, Tool, abc_deg_from_rotation, rotation_from_abc_deg
 
 __version__ = "0.1.0"

@@ -35,7 +35,7 @@ from tcpcal.report import (
 )
 from tcpcal.tool import rotation_from_abc_deg
 
-__all__ = ["main", "build_parser", "CliInputError"]
+__all__ = ["CliInputError", "build_parser", "main"]
 
 FORMATS = ("kuka", "abb", "fanuc", "ur", "matrix")
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["TcpcalError", "InvalidInputError", "DegenerateTouchesError"]
+__all__ = ["DegenerateTouchesError", "InvalidInputError", "TcpcalError"]
 
 
 class TcpcalError(ValueError):

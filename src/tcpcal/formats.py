@@ -85,7 +85,7 @@ from tcpcal.errors import InvalidInputError, TcpcalError
 from tcpcal.tool import Tool, abc_deg_from_rotation
 from tcpcal.validation import as_rotation
 
-__all__ = ["FORMATS", "ABB_DEFAULT_MASS_KG", "export_tool", "import_tool"]
+__all__ = ["ABB_DEFAULT_MASS_KG", "FORMATS", "export_tool", "import_tool"]
 
 FORMATS = ("kuka", "abb", "fanuc", "ur", "matrix")
 ABB_DEFAULT_MASS_KG = 0.001

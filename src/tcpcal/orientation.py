@@ -30,9 +30,9 @@ from tcpcal.tool import abc_deg_from_rotation
 from tcpcal.validation import as_positions, as_rotation, as_rotations, as_vector3
 
 __all__ = [
-    "R_WORLD_TOOL_PARALLEL",
-    "MIN_DISPLACEMENT_DEFAULT",
     "DEFECT_WARN_DEG",
+    "MIN_DISPLACEMENT_DEFAULT",
+    "R_WORLD_TOOL_PARALLEL",
     "OrientationResult",
     "solve_abc_world",
     "solve_three_point",

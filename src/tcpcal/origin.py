@@ -38,7 +38,7 @@ from tcpcal._stats import (
 from tcpcal.errors import DegenerateTouchesError, InvalidInputError
 from tcpcal.validation import as_positions, as_rotation, as_vector3, rotations_and_soa
 
-__all__ = ["TcpResult", "solve_xyz4", "solve_reference", "METHODS"]
+__all__ = ["METHODS", "TcpResult", "solve_reference", "solve_xyz4"]
 
 Method = Literal["lstsq", "sphere", "pairwise"]
 METHODS: tuple[str, ...] = ("lstsq", "sphere", "pairwise")
@@ -594,9 +594,11 @@ def solve_reference(
     t2 = r2.T @ (ref - f2)
     angle = math.degrees(angle_between(r1, r2))
     warnings = [
-        "reference method: one touch per tool and no redundancy, so the residuals are zero by "
-        "construction; the TCP error is the sum of both touches' errors and of the known TCP's own "
-        "error. Check the result, e.g. with a 4-point calibration."
+        (
+            "reference method: one touch per tool and no redundancy, so the residuals are zero by "
+            "construction; the TCP error is the sum of both touches' errors and of the known "
+            "TCP's own error. Check the result, e.g. with a 4-point calibration."
+        )
     ]
     if s_given is None:
         cov = np.full((3, 3), math.nan)

@@ -32,7 +32,7 @@ from tcpcal._stats import (
 from tcpcal.errors import InvalidInputError
 from tcpcal.validation import as_rotation, as_rotations
 
-__all__ = ["PoseQuality", "CandidateGain", "assess_touches", "candidate_gain"]
+__all__ = ["CandidateGain", "PoseQuality", "assess_touches", "candidate_gain"]
 
 MIN_TOUCHES = 4
 WEAK_AXIS_RATIO = 5.0

@@ -178,13 +178,13 @@ def _tcp_block(result: TcpResult) -> list[str]:
     return [
         f"TCP in FLANGE (mm):       {_xyz(result.tcp)}",
         f"Reference in WORLD (mm):  {_xyz(result.reference)}",
-        f"Error (mm):               mean {_fig(result.mean_error, '')}   "
-        f"max {_fig(result.max_error, '')}   RMS {_fig(result.rms_error, '')}",
-        f"95 % radius of the TCP:   {_fig(result.ci95_radius)}   "
-        f"(estimated touch noise {_fig(result.noise_sigma)} per axis)",
-        f"Touch orientations:       largest angle {_fig(result.max_angle_deg, ' deg', '.1f')}, "
-        f"smallest {_fig(result.min_angle_deg, ' deg', '.1f')}; "
-        f"condition number {_fig(result.condition_number, '', '.1f')}",
+        (f"Error (mm):               mean {_fig(result.mean_error, '')}   "
+         f"max {_fig(result.max_error, '')}   RMS {_fig(result.rms_error, '')}"),
+        (f"95 % radius of the TCP:   {_fig(result.ci95_radius)}   "
+         f"(estimated touch noise {_fig(result.noise_sigma)} per axis)"),
+        (f"Touch orientations:       largest angle {_fig(result.max_angle_deg, ' deg', '.1f')}, "
+         f"smallest {_fig(result.min_angle_deg, ' deg', '.1f')}; "
+         f"condition number {_fig(result.condition_number, '', '.1f')}"),
     ]
 
 
@@ -294,8 +294,8 @@ def format_tool_table(tools: Mapping[int, Tool], active_slot: int | None) -> str
     """The tool table (``tcpcal tools list``): one line per used slot, ``*`` marks the active."""
     if not tools:
         return "No tools stored."
-    lines = ["  slot  name                        X mm       Y mm       Z mm      A deg     "
-             "B deg     C deg  calibration"]
+    lines = [("  slot  name                        X mm       Y mm       Z mm      A deg     "
+              "B deg     C deg  calibration")]
     for slot in sorted(tools):
         t = tools[slot]
         mark = "*" if slot == active_slot else " "

@@ -20,11 +20,11 @@ from tcpcal.errors import InvalidInputError
 
 __all__ = [
     "ORTHONORMAL_TOL",
-    "as_rotations",
-    "rotations_and_soa",
-    "as_rotation",
     "as_positions",
+    "as_rotation",
+    "as_rotations",
     "as_vector3",
+    "rotations_and_soa",
 ]
 
 ORTHONORMAL_TOL: float = 1e-6

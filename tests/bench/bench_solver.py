@@ -46,11 +46,11 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tcpcal"))
-from poses import crb_tcp, random_tcp, stacked_a, tilted_rotations, touch_positions  # noqa: E402
+from poses import crb_tcp, random_tcp, stacked_a, tilted_rotations, touch_positions
 
-from tcpcal.errors import DegenerateTouchesError  # noqa: E402
-from tcpcal.origin import METHODS, solve_xyz4  # noqa: E402
-from tcpcal.pose_quality import assess_touches, candidate_gain  # noqa: E402
+from tcpcal.errors import DegenerateTouchesError
+from tcpcal.origin import METHODS, solve_xyz4
+from tcpcal.pose_quality import assess_touches, candidate_gain
 
 SIGMA = 0.5
 NS = (4, 8, 20)
@@ -128,9 +128,9 @@ def timing_table(repeats: int) -> list[tuple[int, float, float, float]]:
         a = stacked_a(rot)
         b = -pos.reshape(-1)
         reps = repeats if n < 1000 else max(repeats // 4, 10)
-        full = median_us(lambda: solve_xyz4(rot, pos), reps)
-        no_outl = median_us(lambda: solve_xyz4(rot, pos, detect_outliers=False), reps)
-        base = median_us(lambda: np.linalg.lstsq(a, b, rcond=None), reps)
+        full = median_us(lambda rot=rot, pos=pos: solve_xyz4(rot, pos), reps)
+        no_outl = median_us(lambda rot=rot, pos=pos: solve_xyz4(rot, pos, detect_outliers=False), reps)
+        base = median_us(lambda a=a, b=b: np.linalg.lstsq(a, b, rcond=None), reps)
         out.append((n, full, no_outl, base))
     return out
 
@@ -141,8 +141,8 @@ def pose_quality_timing(repeats: int) -> list[tuple[int, float, float]]:
     for n in (4, 20):
         rot = tilted_rotations(rng, n, (20.0, 50.0))
         cand = tilted_rotations(rng, 1, (20.0, 50.0))[0]
-        out.append((n, median_us(lambda: assess_touches(rot), repeats),
-                    median_us(lambda: candidate_gain(rot, cand), repeats)))
+        out.append((n, median_us(lambda rot=rot: assess_touches(rot), repeats),
+                    median_us(lambda rot=rot, cand=cand: candidate_gain(rot, cand), repeats)))
     return out
 
 

@@ -149,9 +149,9 @@ def test_xyz4_outlier_flagged_and_result_without_it(
     sub = d["without_outliers"]
     assert sub is not None and 5 not in sub["rows"] and len(sub["rows"]) == 7
     assert np.linalg.norm(np.array(sub["tcp_mm"]) - T_TRUE) < 0.3
-    code, out, err = run(["solve", "xyz4", str(p)], capsys)
+    code, out, _err = run(["solve", "xyz4", str(p)], capsys)
     assert code == 0
-    assert re.search(r"^\s+6\s+7\s+.*<- outlier$", out, re.M), out  # data row 6 = file line 7
+    assert re.search(r"^\s+6\s+7\s+.*<- outlier$", out, re.MULTILINE), out  # data row 6 = file line 7
     assert "Outliers: data row 6 (line 7) stands out" in out
     assert "Result without it:" in out
 
@@ -171,7 +171,7 @@ def test_xyz4_human_report(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -
                  "Per-touch residuals", "Outliers: none", "does not prove an accurate TCP"):
         assert word in out, word
     # one residual line per touch, numbered by data row and file line
-    assert len(re.findall(r"^\s+\d+\s+\d+\s+0\.000\s", out, re.M)) == 6
+    assert len(re.findall(r"^\s+\d+\s+\d+\s+0\.000\s", out, re.MULTILINE)) == 6
 
 
 # ----------------------------------------------------------------------- solve reference
@@ -189,7 +189,7 @@ def test_reference_json_and_report(tmp_path: Path, capsys: pytest.CaptureFixture
     for key in ("residuals_mm", "mean_error_mm", "max_error_mm", "rms_error_mm", "ci95_mm",
                 "outliers", "warnings"):
         assert key in d
-    code, out, err = run(["solve", "reference", str(p), "--known-tcp", "0,0,150"], capsys)
+    code, out, _err = run(["solve", "reference", str(p), "--known-tcp", "0,0,150"], capsys)
     assert code == 0
     assert all(f"{v:.3f}" in out for v in T_TRUE)
 
@@ -224,7 +224,7 @@ def test_three_point(tmp_path: Path, capsys: pytest.CaptureFixture[str], variant
     assert d["displacements_mm"][0] == pytest.approx(50.0, abs=1e-9)
     assert d["tcp_mm"] == [-20.0, 5.5, 210.0]
     assert d["method"] == f"three-point-{variant}"
-    code, out, err = run(argv, capsys)
+    code, out, _err = run(argv, capsys)
     assert code == 0
     abc_line = next(ln for ln in out.splitlines() if "KUKA" in ln)
     assert all(f"{v:.3f}" in abc_line for v in TP_ABC)
@@ -247,7 +247,7 @@ def test_abc_world_6d_and_5d(tmp_path: Path, capsys: pytest.CaptureFixture[str])
     d5c = run_json(["solve", "abc-world", str(p), "--variant", "5d", "--current-abc",
                     ",".join(str(v) for v in TP_ABC)], capsys)
     np.testing.assert_allclose(d5c["rotation_matrix"], rt, atol=1e-9)
-    code, out, err = run(["solve", "abc-world", str(p)], capsys)
+    code, out, _err = run(["solve", "abc-world", str(p)], capsys)
     assert code == 0 and "R_flange_tool" in out
     assert all(f"{v:.3f}" in out for v in TP_ABC)
 
@@ -352,14 +352,14 @@ def test_console_script_subprocess(tmp_path: Path) -> None:
     p = write_csv(tmp_path / "poses.csv", rots, pos)
     exe = _console_script()
     proc = subprocess.run([str(exe), "solve", "xyz4", str(p), "--json"],
-                          capture_output=True, text=True, timeout=60)
+                          capture_output=True, text=True, timeout=60, check=False)
     assert proc.returncode == 0, proc.stderr
     np.testing.assert_allclose(json.loads(proc.stdout)["tcp_mm"], T_TRUE, atol=1e-6)
     # an error through the real entry point: exit 2, one line, no traceback
     bad = tmp_path / "bad.csv"
     bad.write_text("x,y,z,a,b,c\n1,2,3,0,0,0\n1,2,3,0,oops,0\n")
     proc = subprocess.run([str(exe), "solve", "xyz4", str(bad)],
-                          capture_output=True, text=True, timeout=60)
+                          capture_output=True, text=True, timeout=60, check=False)
     assert proc.returncode == 2
     assert proc.stdout == ""
     assert proc.stderr.count("\n") == 1 and "Traceback" not in proc.stderr
@@ -368,7 +368,7 @@ def test_console_script_subprocess(tmp_path: Path) -> None:
 
 def test_python_dash_m(tmp_path: Path) -> None:
     proc = subprocess.run([sys.executable, "-m", "tcpcal", "--help"],
-                          capture_output=True, text=True, timeout=60)
+                          capture_output=True, text=True, timeout=60, check=False)
     assert proc.returncode == 0 and "solve" in proc.stdout
 
 
@@ -403,7 +403,7 @@ def test_docs_example_output_is_real(capsys: pytest.CaptureFixture[str],
     monkeypatch.chdir(root)
     cmd = "$ tcpcal solve xyz4 docs/examples/xyz4_poses.csv\n"
     pasted = doc[doc.index(cmd) + len(cmd):].split("\n```", 1)[0]
-    code, out, err = run(["solve", "xyz4", "docs/examples/xyz4_poses.csv"], capsys)
+    code, out, _err = run(["solve", "xyz4", "docs/examples/xyz4_poses.csv"], capsys)
     assert code == 0 and out.rstrip("\n") == pasted
     d = run_json(["solve", "xyz4", "docs/examples/xyz4_poses.csv"], capsys)
     assert np.linalg.norm(np.array(d["tcp_mm"]) - [85.0, -12.0, 210.0]) < d["ci95_mm"]

@@ -63,7 +63,7 @@ def test_tools_lifecycle(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> 
     assert by_slot[5]["active"] is True
 
     out = ok(["tools", *L, "list"], capsys)
-    assert re.search(r"^\* +5 +pointer", out, re.M) and re.search(r"^  +3 +torch", out, re.M)
+    assert re.search(r"^\* +5 +pointer", out, re.MULTILINE) and re.search(r"^  +3 +torch", out, re.MULTILINE)
 
     out = ok(["tools", *L, "show", "torch"], capsys)   # by name
     assert "Slot 3: torch" in out and "12.500" in out and "-30.250" in out and "1.5 kg" in out

@@ -34,8 +34,8 @@ def console_examples(doc: Path) -> list[list[tuple[str, str]]]:
     """Fenced blocks with ``$ tcpcal`` lines: for each, the (command, expected output) pairs."""
     text = doc.read_text(encoding="utf-8")
     blocks = []
-    for body in re.findall(r"^```[a-z]*\n(.*?)^```", text, flags=re.S | re.M):
-        if not re.search(r"^\$ tcpcal ", body, flags=re.M):
+    for body in re.findall(r"^```[a-z]*\n(.*?)^```", text, flags=re.DOTALL | re.MULTILINE):
+        if not re.search(r"^\$ tcpcal ", body, flags=re.MULTILINE):
             continue
         pairs: list[tuple[str, list[str]]] = []
         for line in body.splitlines():

@@ -15,7 +15,12 @@ from pathlib import Path
 import pytest
 
 from tcpcal.errors import InvalidInputError, TcpcalError
-from tcpcal.library import ToolLibrary, ToolLibraryError, ToolLibraryWarning, default_library_path
+from tcpcal.library import (
+    ToolLibrary,
+    ToolLibraryError,
+    ToolLibraryWarning,
+    default_library_path,
+)
 from tcpcal.tool import Calibration, Tool
 
 _fork = multiprocessing.get_context("fork")

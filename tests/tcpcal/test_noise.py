@@ -11,9 +11,9 @@ import math
 
 import numpy as np
 import pytest
+from poses import crb_tcp, make_touches, touch_positions
 from scipy.spatial.transform import Rotation
 
-from poses import crb_tcp, make_touches, touch_positions
 from tcpcal._stats import ci_radius
 from tcpcal.origin import solve_xyz4
 

@@ -13,9 +13,9 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
+from poses import crb_tcp, make_touches, random_rotations, stacked_a, touch_positions
 from scipy.spatial.transform import Rotation
 
-from poses import crb_tcp, make_touches, random_rotations, stacked_a, touch_positions
 from tcpcal.errors import DegenerateTouchesError, InvalidInputError, TcpcalError
 from tcpcal.origin import METHODS, TcpResult, solve_reference, solve_xyz4
 
@@ -99,7 +99,7 @@ def test_reference_method_with_sigma() -> None:
 
 def test_quality_figures_match_independent_computation() -> None:
     rng = np.random.default_rng(11)
-    rot, pos, tcp, ref = make_touches(rng, 9, sigma=0.3)
+    rot, pos, _tcp, _ref = make_touches(rng, 9, sigma=0.3)
     res = solve_xyz4(rot, pos, detect_outliers=False)
     # Independent: explicit 3N x 6 least squares (4P-3).
     a = stacked_a(rot)
@@ -235,7 +235,7 @@ def test_duplicated_poses() -> None:
 
 def test_near_duplicate_is_warned_not_fatal() -> None:
     rng = np.random.default_rng(9)
-    rot, pos, tcp, ref = make_touches(rng, 5, tilt_deg=(30, 50))
+    rot, pos, tcp, _ref = make_touches(rng, 5, tilt_deg=(30, 50))
     rot = np.concatenate([rot, rot[2:3]])
     pos = np.concatenate([pos, pos[2:3]])
     res = solve_xyz4(rot, pos)
@@ -356,6 +356,6 @@ def test_weak_axis_warning() -> None:
     res = solve_xyz4(rot, pos)
     assert any("times less certain" in w for w in res.warnings)
     # the weak direction is the eigenvector of the largest covariance eigenvalue (independent)
-    w, v = np.linalg.eigh(crb_tcp(rot, 1.0))
+    _w, v = np.linalg.eigh(crb_tcp(rot, 1.0))
     weak = v[:, -1]
     assert abs(weak[0]) > 0.9

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
 from poses import make_touches
+
 from tcpcal.origin import solve_xyz4
 
 
@@ -17,7 +17,7 @@ def _offset(rng: np.random.Generator, length: float) -> np.ndarray:
 @pytest.mark.parametrize("method", ["lstsq", "sphere", "pairwise"])
 def test_one_touch_5mm_off_among_8_is_flagged_and_excluded(method: str) -> None:
     rng = np.random.default_rng(12)
-    rot, pos, tcp, ref = make_touches(rng, 8, tilt_deg=(30, 60), sigma=0.2)
+    rot, pos, tcp, _ref = make_touches(rng, 8, tilt_deg=(30, 60), sigma=0.2)
     pos[5] += _offset(rng, 5.0)
     res = solve_xyz4(rot, pos, method=method)
     assert res.outliers == (5,)

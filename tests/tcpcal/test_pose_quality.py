@@ -7,10 +7,10 @@ import time
 
 import numpy as np
 import pytest
+from poses import crb_tcp, random_rotations, tilted_rotations
 from scipy.spatial.transform import Rotation
 from scipy.stats import chi2
 
-from poses import crb_tcp, random_rotations, tilted_rotations
 from tcpcal.errors import InvalidInputError
 from tcpcal.pose_quality import assess_touches, candidate_gain
 

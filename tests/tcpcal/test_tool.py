@@ -95,28 +95,28 @@ def test_values_are_normalised_to_float_tuples():
 @pytest.mark.parametrize(
     "kwargs, match",
     [
-        (dict(name=""), "empty"),
-        (dict(name="   "), "empty"),
-        (dict(name="x" * 25), "at most 24"),
-        (dict(name="a\tb"), "control character"),
-        (dict(name="new\nline"), "control character"),
-        (dict(name='say "hi"'), "double quote"),
-        (dict(name=" lead"), "spaces"),
-        (dict(name=5), "string"),
-        (dict(tcp_mm=(1.0, 2.0)), "3 numbers"),
-        (dict(tcp_mm=(1.0, float("nan"), 2.0)), r"tcp_mm\[1\] must be a finite"),
-        (dict(tcp_mm=(1.0, "2", 2.0)), "must be a number"),
-        (dict(abc_deg=(0.0, float("inf"), 0.0)), "abc_deg"),
-        (dict(abc_deg=(True, 0.0, 0.0)), "must be a number"),
-        (dict(mass_kg=0.0), "positive"),
-        (dict(mass_kg=-1.0), "positive"),
-        (dict(mass_kg=float("nan")), "finite"),
-        (dict(notes=3), "notes"),
-        (dict(calibration={"method": "x"}), "Calibration"),
+        ({"name": ""}, "empty"),
+        ({"name": "   "}, "empty"),
+        ({"name": "x" * 25}, "at most 24"),
+        ({"name": "a\tb"}, "control character"),
+        ({"name": "new\nline"}, "control character"),
+        ({"name": 'say "hi"'}, "double quote"),
+        ({"name": " lead"}, "spaces"),
+        ({"name": 5}, "string"),
+        ({"tcp_mm": (1.0, 2.0)}, "3 numbers"),
+        ({"tcp_mm": (1.0, float("nan"), 2.0)}, r"tcp_mm\[1\] must be a finite"),
+        ({"tcp_mm": (1.0, "2", 2.0)}, "must be a number"),
+        ({"abc_deg": (0.0, float("inf"), 0.0)}, "abc_deg"),
+        ({"abc_deg": (True, 0.0, 0.0)}, "must be a number"),
+        ({"mass_kg": 0.0}, "positive"),
+        ({"mass_kg": -1.0}, "positive"),
+        ({"mass_kg": float("nan")}, "finite"),
+        ({"notes": 3}, "notes"),
+        ({"calibration": {"method": "x"}}, "Calibration"),
     ],
 )
 def test_invalid_tools_raise_clear_errors(kwargs, match):
-    base = dict(name="tool", tcp_mm=(0.0, 0.0, 100.0))
+    base = {"name": "tool", "tcp_mm": (0.0, 0.0, 100.0)}
     base.update(kwargs)
     with pytest.raises(InvalidInputError, match=match):
         Tool(**base)
