@@ -179,9 +179,9 @@ def test_nested_scene_shows_the_controllers_link_poses(app_factory) -> None:
     try:
         view = s.views["scene"]
         k = s.controller.kinematics
-        # the arm is nested like the URDF tree; the flange stays at /robot/<flange>
-        assert view.flange_path == f"/robot/{k.flange_link}"
+        # nested like the URDF tree
         assert view.link_paths["link_6"] == "/robot/base_link/link_1/link_2/link_3/link_4/link_5/link_6"
+        assert view.flange_path == view.link_paths[k.flange_link] == view.link_paths["link_6"] + "/flange"
         _check_scene_matches_controller(s, 1e-12)
         moves = [("X", 1, "10"), ("A", 1, "10"), ("C", -1, "1"), ("Z", -1, "100"), ("B", 1, "0.1")]
         for axis, sign, inc in moves:
@@ -200,8 +200,8 @@ def test_nested_scene_shows_the_controllers_link_poses(app_factory) -> None:
 
 
 def test_only_changed_poses_are_sent(app_factory) -> None:
-    """A joint jog of A1 re-sends one orientation in the nested arm (link_1) plus the flange
-    and the gizmo, which hang in WORLD; nothing moves: nothing is sent."""
+    """A joint jog of A1 re-sends one orientation (link_1's) and the gizmo, which hangs in
+    WORLD; nothing moves: nothing is sent."""
     app = app_factory()
     client, s = _session(app)
     try:
@@ -226,7 +226,7 @@ def test_only_changed_poses_are_sent(app_factory) -> None:
         finally:
             scene_module._set_pose = real
         names = {n for n, _, _ in sent}
-        assert names == {view.link_paths["link_1"], view.flange_path, "/tcp_gizmo"}, sent
+        assert names == {view.link_paths["link_1"], "/tcp_gizmo"}, sent
         assert (view.link_paths["link_1"], True, False) in sent   # orientation only
     finally:
         client.close()

@@ -3,16 +3,15 @@
 Scene tree (names are per browser; ``--shared`` uses the server's scene):
 
 * ``/floor`` grid; ``/world`` the WORLD frame (the robot's root link) with its label;
-* ``/robot/<base>/<link_1>/.../<link_6>``: one frame per URDF link, nested like the URDF's
-  link tree (:attr:`SceneView.link_paths`), each posed relative to its parent link from
+* ``/robot/<base>/<link_1>/.../<link_6>/<flange>``: one frame per URDF link, nested like the
+  URDF's link tree (:attr:`SceneView.link_paths`), each posed relative to its parent link from
   pinocchio's link poses (``Session.pose_state()``, one FK pass per move; no yourdfpy FK),
   with the link's meshes as children. Nesting makes a jog step cheap to send: a revolute
   joint only turns its child link, so each moving link needs one orientation message (its
-  offset from the parent never changes); :class:`PoseSender` sends only poses that changed;
-* ``/robot/<flange>`` (:attr:`SceneView.flange_path`): the FLANGE link, kept at this path
-  and posed in WORLD because other views attach to it there (the wizards' COMPUTED / TRUE
-  triads); it holds the FLANGE triad, the mounted tool's meshes and the active TOOL triad at
-  ``T_flange_tool``, which ride on the flange without updates;
+  offset from the parent never changes) and links on fixed joints (the flange) none;
+  :class:`PoseSender` sends only poses that changed. The flange frame
+  (:attr:`SceneView.flange_path`) holds the FLANGE triad, the mounted tool's meshes and the
+  active TOOL triad at ``T_flange_tool``, which ride on the flange without updates;
 * ``/reference_tip``: the stand posed so that its spike is at the reference tip;
 * ``/tcp_gizmo``: transform controls on the active TCP; dragging it moves the TCP by
   ``VirtualController.move_tcp_to`` (straight line, same safety rules as jogging).
@@ -28,6 +27,11 @@ from typing import Any
 
 import numpy as np
 from scipy.spatial.transform import Rotation
+
+try:                                   # viser's message types (hot path); public setters if absent
+    from viser import _messages
+except ImportError:                    # pragma: no cover
+    _messages = None
 
 from tcp_pendant.controller import ToolModel, reference_tip_model
 from tcp_pendant.controller.kinematics import urdf_links_and_tree
@@ -71,15 +75,12 @@ def relative_poses(T_world_parent: np.ndarray, T_world_child: np.ndarray) -> np.
     return out
 
 
-def link_tree_paths(urdf_path: Any, links: tuple[str, ...] | list[str],
-                    flat: tuple[str, ...] = ()) -> dict[str, tuple[str, str | None]]:
+def link_tree_paths(urdf_path: Any, links: tuple[str, ...] | list[str]) -> dict[str, tuple[str, str | None]]:
     """Scene path and parent link of every link, nested like the URDF's link tree.
 
     Args:
         urdf_path: the robot's URDF (its link tree).
         links: the links to place.
-        flat: links placed at ``/robot/<link>`` and posed in WORLD (parent None) even though
-            they have a parent link; their children nest under them.
 
     Returns:
         ``{link: (path, parent_link or None)}`` in parent-before-child order; links missing
@@ -90,7 +91,7 @@ def link_tree_paths(urdf_path: Any, links: tuple[str, ...] | list[str],
     parent: dict[str, str] = {}
     for p, cs in children.items():
         for ch in cs:
-            if p in names and ch in names and ch not in flat:
+            if p in names and ch in names:
                 parent.setdefault(ch, p)
     out: dict[str, tuple[str, str | None]] = {}
 
@@ -163,8 +164,6 @@ class PoseSender:
 
 def _set_pose(handle: Any, wxyz: list[float] | None, xyz: list[float] | None) -> int:
     try:
-        from viser import _messages
-
         impl = handle._impl
         api = impl.api
         n = 0
@@ -220,8 +219,7 @@ class SceneView:
 
         meshes = link_meshes(k.urdf_path)
         state = session.pose_state()
-        # the flange stays at /robot/<flange> (posed in WORLD): views attach to it there
-        tree = link_tree_paths(k.urdf_path, state.link_names, flat=(self.flange_link,))
+        tree = link_tree_paths(k.urdf_path, state.link_names)
         self.link_paths: dict[str, str] = {name: path for name, (path, _) in tree.items()}
         self.link_frames: dict[str, Any] = {}
         self._parent = {name: parent for name, (_, parent) in tree.items()}
@@ -264,8 +262,8 @@ class SceneView:
 
     # ------------------------------------------------------------ updates
     def _local_poses(self, state: Any) -> np.ndarray:
-        """(N+1,4,4): ``T_parent_link`` of the moving links (``T_world_link`` for the flange),
-        then ``T_world_tcp`` (the gizmo), from one pose state."""
+        """(N+1,4,4): ``T_parent_link`` of the moving links (``T_world_link`` for a link
+        without a parent), then ``T_world_tcp`` (the gizmo), from one pose state."""
         if state.link_names != self._index_names:             # index rows once per link list
             row = {n: i for i, n in enumerate(state.link_names)}
             n_links, eye = len(state.link_names), len(state.link_names) + 1
