@@ -133,3 +133,27 @@ def test_load_session_errors(tmp_path):
     with pytest.raises(SessionRecordError, match="Wizard 1"):
         replay({"format": "tcp-pendant-session", "version": 1, "wizards": [{"state": {"kind": "xyz4",
                 "poses": {"9": {"T_world_flange_m": np.eye(4).tolist(), "recorded_at": "x"}}}}]})
+
+
+def test_a_finished_wizard_closed_to_resume_later_keeps_its_result_in_the_record(synth):
+    """Closing a result (cancel) must not drop it from the session record a trainer grades."""
+    tool = synth.tools["pointer"]
+    wiz = Xyz4Wizard()
+    for d in synth.directions[:4]:
+        wiz.record(synth.flange_pose_m(tool, synth.tool_orientation(*d)))
+        out = wiz.next()
+    tcp = out.tcp_mm
+    wiz.cancel()
+    assert wiz.result is None and wiz.finished_result is out      # hidden, not lost
+    rec = session_to_dict([WizardRun(wiz, "pointer", tool.T_flange_tcp_true_m)], robot="kr6")
+    (entry,) = rec["wizards"]
+    assert entry["result"]["tcp_mm"] == pytest.approx(list(tcp), abs=1e-12)
+    assert entry["truth"]["position_error_mm"] < 1e-6
+    (check,) = replay(json.loads(dumps(rec)))
+    assert check.matches and check.wizard.status == "cancelled"
+    assert check.wizard.finished_result.tcp_mm == pytest.approx(tcp, abs=1e-9)
+    # never finished: no result while cancelled either
+    half = Xyz4Wizard()
+    half.record(synth.flange_pose_m(tool, synth.tool_orientation(*synth.directions[0])))
+    half.cancel()
+    assert half.finished_result is None

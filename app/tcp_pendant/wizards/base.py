@@ -317,6 +317,15 @@ class Wizard(abc.ABC):
         return self._result if self._status == "complete" else None
 
     @property
+    def finished_result(self) -> WizardResult | None:
+        """The result of a finished wizard, also while it is cancelled (closed to resume later):
+        what the session record stores and grades. None if it was never finished."""
+        if self._status == "complete" or (
+                self._status == "cancelled" and getattr(self, "_cancelled_from", None) == "complete"):
+            return self._result
+        return None
+
+    @property
     def recorded_poses(self) -> dict[int, RecordedPose]:
         """Copy of the poses recorded so far, by 0-based step index."""
         return dict(self._poses)

@@ -133,7 +133,7 @@ def _run_dict(run: WizardRun | Wizard) -> dict[str, Any]:
     if isinstance(run, Wizard):
         run = WizardRun(run)
     wiz = run.wizard
-    res = wiz.result
+    res = wiz.finished_result          # a finished wizard closed to resume later keeps its result
     truth = None
     true_tool = None
     if run.T_flange_tcp_true_m is not None:
@@ -242,7 +242,7 @@ def replay(record: Mapping[str, Any]) -> tuple[ReplayCheck, ...]:
         except (KeyError, TypeError, ValueError) as exc:
             raise SessionRecordError(f"Wizard {i + 1} of the record cannot be rebuilt: {exc}") from None
         stored = entry.get("result")
-        res = wiz.result
+        res = wiz.finished_result
         tcp_diff = rot_diff = None
         truth = None
         if stored is None:
