@@ -1,0 +1,67 @@
+"""Data of the per-touch error bar chart (viser's uPlot), without viser.
+
+viser's uPlot binding takes data and options but no JavaScript callbacks, so uPlot's own bar
+renderer (``uPlot.paths.bars``, a JS function) cannot be asked for. Each bar is therefore drawn
+as a filled outline: the x values go ``i - w, i - w, i + w, i + w`` and the heights ``0, e, e, 0``
+for touch ``i`` (1-based, as the pendant numbers touches), and the series is filled down to 0.
+Touches flagged as outliers get their own (red) series so they stand out; each series is 0
+where it has no bar, which draws along the axis.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["BAR_HALF_WIDTH", "ErrorBars", "error_bars"]
+
+BAR_HALF_WIDTH = 0.3
+"""Half the width of a bar, in touch numbers (bars are 0.6 wide, 0.4 apart)."""
+
+
+@dataclass(frozen=True, eq=False)
+class ErrorBars:
+    """Columns for ``gui.add_uplot(data=(x, normal, outliers, mean), ...)``.
+
+    Attributes:
+        x: outline x values (touch numbers +- half width), ascending.
+        normal_mm: outline heights of the touches that are not outliers (mm).
+        outlier_mm: outline heights of the outliers (mm).
+        mean_mm: the mean error as a flat line (mm), for reference.
+    """
+
+    x: np.ndarray
+    normal_mm: np.ndarray
+    outlier_mm: np.ndarray
+    mean_mm: np.ndarray
+
+    @property
+    def columns(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        return (self.x, self.normal_mm, self.outlier_mm, self.mean_mm)
+
+
+def error_bars(touch_numbers: Sequence[int], errors_mm: Sequence[float],
+               outliers: Sequence[int] = ()) -> ErrorBars:
+    """Bars of ``errors_mm[k]`` at touch ``touch_numbers[k]`` (1-based), outliers apart.
+
+    Args:
+        touch_numbers: 1-based number of each touch shown (ascending).
+        errors_mm: ``|e_i|`` of each touch, mm (finite, >= 0).
+        outliers: 1-based numbers of the touches flagged as outliers.
+    """
+    n = np.asarray(touch_numbers, dtype=float)
+    e = np.asarray(errors_mm, dtype=float)
+    if n.shape != e.shape or n.ndim != 1:
+        raise ValueError(f"touch_numbers and errors_mm must be equal-length lists, got {n.shape} and {e.shape}.")
+    if n.size and np.any(np.diff(n) <= 0):
+        raise ValueError("touch_numbers must be strictly ascending.")
+    w = BAR_HALF_WIDTH
+    x = np.stack([n - w, n - w, n + w, n + w], axis=1).reshape(-1)
+    heights = np.stack([np.zeros_like(e), e, e, np.zeros_like(e)], axis=1)
+    is_out = np.isin(n, np.asarray(outliers, dtype=float))[:, None]
+    normal = np.where(is_out, 0.0, heights).reshape(-1)
+    outlier = np.where(is_out, heights, 0.0).reshape(-1)
+    mean = np.full_like(x, float(e.mean()) if e.size else 0.0)
+    return ErrorBars(x, normal, outlier, mean)

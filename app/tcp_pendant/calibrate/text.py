@@ -1,0 +1,256 @@
+"""Words and tables of the Calibrate tab (markdown for viser's ``add_markdown``), without viser.
+
+Every number comes from a wizard (which got it from ``tcpcal``); this module only says it in
+plain words with its unit: lengths in mm, angles in degrees, as on a pendant. The error
+figures are named as tcpcal names them: *mean* error, *max* error, *RMS* error (not the same
+thing) and the *95 % radius* of the TCP.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+from tcpcal.pose_quality import CandidateGain, PoseQuality
+from tcp_pendant.pendant.formatting import fmt_num
+from tcp_pendant.wizards import ESTIMATOR_LABELS, Wizard, WizardResult, Xyz4Result
+from tcp_pendant.wizards.session_record import ReplayCheck
+from tcp_pendant.wizards.truth import TruthComparison
+
+__all__ = [
+    "METHOD_BLURBS",
+    "comparison_markdown",
+    "menu_markdown",
+    "meter_level",
+    "meter_markdown",
+    "replay_markdown",
+    "result_markdown",
+    "save_markdown",
+    "save_preview_markdown",
+    "step_markdown",
+    "steps_list_markdown",
+    "truth_markdown",
+    "warnings_markdown",
+]
+
+METHOD_BLURBS: dict[str, str] = {
+    "xyz4": ("Calibrates the **TCP** (X, Y, Z): touch the reference tip with the tool tip from "
+             "4 to 20 clearly different orientations (methods.md section 2)."),
+    "reference": ("Calibrates the **TCP** of a new tool from one touch with an already calibrated "
+                  "tool and one with the new tool (section 3). Fast; errors add up."),
+    "three-point": ("Calibrates the **orientation** (A, B, C) of a tool whose TCP is calibrated: "
+                    "a touch, then the tip on the tool's -X axis and on its +Y side (section 5)."),
+    "abc-world": ("Calibrates the **orientation** (A, B, C): align the tool with WORLD (X down, Y "
+                  "along WORLD Y, Z along WORLD X) and record once (section 4). 5D: tool X only."),
+}
+
+
+def menu_markdown(kind: str, *, library_tool: str | None, reference_tool: str, new_tool: str,
+                  mounted_tool: str) -> str:
+    """What Start will do with the options chosen (echoes every choice before Start).
+
+    Args:
+        kind: wizard kind.
+        library_tool: the chosen library entry ("1: Pointer"), None when the library is empty.
+        reference_tool, new_tool: physical tools chosen for the reference method (labels).
+        mounted_tool: label of the physical tool on the flange now.
+    """
+    mounted = mounted_tool.lower()
+    if kind == "xyz4":
+        return (f"Calibrates the TCP of the **{mounted}** now mounted; mount another tool on the "
+                "Tool tab first if that is not the one.")
+    if library_tool is None:
+        return ("⚠ The tool library is empty: calibrate a TCP first (XYZ 4-point) and save it, or "
+                "enter a tool on the Tool tab.")
+    if kind == "reference":
+        if reference_tool == new_tool:
+            return "⚠ The reference tool and the new tool must be two different physical tools."
+        return (f"Touch 1 with the data **{library_tool}** on the *{reference_tool.lower()}*; then "
+                f"the tool change and touch 2 with the *{new_tool.lower()}*, whose TCP is calibrated.")
+    return (f"Calibrates the orientation of **{library_tool}** (its TCP is used as is); the "
+            f"*{mounted}* is mounted: it must be the tool that data belongs to.")
+
+
+def save_preview_markdown(name: str, slot_choice: str, tcp_mm: Sequence[float],
+                          abc_deg: Sequence[float]) -> str:
+    """What "Save to tool library" will store (echoes the name and slot as typed)."""
+    x, y, z = (fmt_num(v) for v in tcp_mm)
+    a, b, c = (fmt_num(v) for v in abc_deg)
+    shown = f"**{name.strip()}**" if name.strip() else "*(type a name)*"
+    return f"Will save {shown} · X {x} Y {y} Z {z} mm · A {a} B {b} C {c}° · slot: {slot_choice}"
+
+
+def _mm(v: float | None, decimals: int = 2) -> str:
+    return "–" if v is None or not math.isfinite(v) else f"{fmt_num(v, decimals)} mm"
+
+
+def _deg(v: float | None, decimals: int = 2) -> str:
+    return "–" if v is None or not math.isfinite(v) else f"{fmt_num(v, decimals)}°"
+
+
+def step_markdown(wizard: Wizard) -> str:
+    """Heading ("**XYZ 4-point** · Step 2 of 4: Touch 2") and the step's instruction."""
+    if wizard.is_complete:
+        return f"**{wizard.title}** · Result\n\nThe calibration is computed: see *Result* below."
+    step = wizard.step
+    mark = " ✔ recorded" if step.recorded else ""
+    return f"**{wizard.title}** · {step.heading}: {step.title}{mark}\n\n{step.instruction}"
+
+
+def steps_list_markdown(wizard: Wizard) -> str:
+    """The steps in one line: ✔ recorded, ▶ current, · to do."""
+    parts = []
+    for s in wizard.steps:
+        here = s.index == wizard.step_index and not wizard.is_complete
+        sym = "▶" if here else ("✔" if s.recorded else "·")
+        parts.append(f"{sym} {s.title}")
+    if wizard.is_complete:
+        parts.append("▶ Result")
+    return " &nbsp; ".join(parts)
+
+
+FULL_DIVERSITY_DEG = 45.0
+"""The meter's bar is full when the nearest recorded orientation is this far (methods.md
+section 7: touches 45 degrees apart about different axes give several times smaller errors)."""
+
+
+def meter_level(gain: CandidateGain) -> tuple[float, str]:
+    """The pose-diversity meter as a bar: (0..100, colour).
+
+    The bar is the angle from the current orientation to the nearest recorded one, full at
+    ``FULL_DIVERSITY_DEG`` (full before the first touch); the colour is tcpcal's verdict on the
+    predicted TCP uncertainty: red when the orientation is too close to an earlier touch
+    (``gain.too_close``), yellow when recording would not yet make the TCP determinable or would
+    cut its predicted error by less than 10 %, green otherwise.
+    """
+    angle = gain.angle_to_nearest_deg
+    value = 100.0 if math.isinf(angle) else 100.0 * min(max(angle / FULL_DIVERSITY_DEG, 0.0), 1.0)
+    if gain.too_close:
+        return value, "red"
+    if math.isinf(gain.predicted_after) or gain.reduction < 0.1:
+        return value, "yellow"
+    return value, "green"
+
+
+def meter_markdown(gain: CandidateGain, quality: PoseQuality, sigma_mm: float) -> str:
+    """Live advice while jogging toward the next touch (all figures predicted by tcpcal from the
+    orientations alone, for an operator error of ``sigma_mm`` per axis)."""
+    head = f"**Pose diversity** (if you recorded here, operator error {fmt_num(sigma_mm, 1)} mm):"
+    if gain.too_close:
+        advice = (f"⚠ **Too close** to an earlier touch: {_deg(gain.angle_to_nearest_deg, 0)} apart. "
+                  "Tilt the tool further, about another axis, before recording.")
+    elif math.isinf(gain.predicted_after):
+        advice = f"Not determinable yet. {quality.message}"
+    elif math.isinf(gain.predicted_before):
+        advice = (f"✔ Recording here makes the TCP determinable: predicted RMS error "
+                  f"**{_mm(gain.predicted_after)}**.")
+    else:
+        word = "✔ Good pose" if gain.reduction >= 0.1 else "This pose adds little"
+        advice = (f"{word}: predicted TCP RMS error {_mm(gain.predicted_before)} → "
+                  f"**{_mm(gain.predicted_after)}** ({-100.0 * gain.reduction:+.0f} %).")
+    near = ("" if math.isinf(gain.angle_to_nearest_deg) else
+            f"\n\nNearest recorded orientation: {_deg(gain.angle_to_nearest_deg, 0)} away.")
+    return f"{head}\n\n{advice}{near}"
+
+
+def result_markdown(result: WizardResult) -> str:
+    """The calibrated frame and its quality figures (what a pendant shows after a calibration)."""
+    x, y, z = (fmt_num(v) for v in result.tcp_mm)
+    lines = [f"**TCP** X {x} · Y {y} · Z {z} mm"]
+    if result.abc_deg is not None:
+        a, b, c = (fmt_num(v) for v in result.abc_deg)
+        lines.append(f"**Orientation** A {a} · B {b} · C {c}° (KUKA: Rz(A) Ry(B) Rx(C))")
+    rows: list[tuple[str, str]] = [("method", result.method)]
+    tcp = result.tcp_result
+    if tcp is not None:
+        n = len(result.per_touch_error_mm)
+        errs = ", ".join(f"P{i + 1} {fmt_num(e)}" for i, e in zip(_touch_numbers(result), result.per_touch_error_mm))
+        rows += [
+            ("error per touch (mm)", errs if n else "–"),
+            ("mean error", _mm(result.mean_error_mm)),
+            ("max error", _mm(result.max_error_mm)),
+            ("RMS error", _mm(result.rms_error_mm)),
+            ("95 % radius of the TCP", _mm(result.ci95_mm)),
+        ]
+        if result.wizard == "reference":
+            # one touch per tool: no redundancy, so the noise is assumed, and the angle between
+            # the two touches (two different tools) says nothing about the result
+            rows.append(("assumed touch error (per axis)", _mm(float(tcp.noise_sigma))))
+        else:
+            rows.append(("touch noise estimate (per axis)", _mm(float(tcp.noise_sigma))))
+            if tcp.n_touches >= 2:
+                rows += [("angle between touches",
+                          f"{_deg(tcp.min_angle_deg, 1)} to {_deg(tcp.max_angle_deg, 1)}"),
+                         ("condition number", f"{tcp.condition_number:.1f}")]
+    if result.orthogonality_defect_deg is not None:
+        rows.append(("orthogonality defect", _deg(result.orthogonality_defect_deg, 3)))
+    if result.displacements_mm:
+        rows.append(("displacement lengths Δ", ", ".join(_mm(d, 1) for d in result.displacements_mm)))
+    table = "| figure | value |\n|---|---|\n" + "\n".join(f"| {k} | {v} |" for k, v in rows)
+    return "\n\n".join(lines) + "\n\n" + table
+
+
+def _touch_numbers(result: WizardResult) -> Sequence[int]:
+    """0-based recorded-touch index of each per-touch error (the used touches for 4-point)."""
+    if isinstance(result, Xyz4Result):
+        return result.used_indices
+    return range(len(result.per_touch_error_mm))
+
+
+def warnings_markdown(result: WizardResult) -> str:
+    """Warnings (⚠) then standing notes (ℹ), one per line; empty when there are none."""
+    lines = [f"⚠ {w}" for w in result.warnings] + [f"ℹ {n}" for n in result.notes]
+    return "\n\n".join(lines)
+
+
+def comparison_markdown(result: Xyz4Result) -> str:
+    """The three 4-point estimators side by side on the same touches (mm)."""
+    head = "| estimator | X | Y | Z | mean | max | RMS | 95 % |\n|---|---|---|---|---|---|---|---|"
+    rows = []
+    for r in result.comparison_rows():
+        label = r["label"] + (" ◀ reported" if r.get("chosen") else "")
+        if not r["ok"]:
+            rows.append(f"| {label} | cannot solve: {r['error']} ||||||| ")
+            continue
+        x, y, z = (fmt_num(v) for v in r["tcp_mm"])
+        rows.append(f"| {label} | {x} | {y} | {z} | {fmt_num(r['mean_error_mm'])} | "
+                    f"{fmt_num(r['max_error_mm'])} | {fmt_num(r['rms_error_mm'])} | {fmt_num(r['ci95_mm'])} |")
+    return (head + "\n" + "\n".join(rows) + "\n\nAll figures in mm. Same touches, three estimators: "
+            "the joint least squares (4P-3) is the maximum-likelihood one.")
+
+
+def truth_markdown(cmp: TruthComparison) -> str:
+    """Training mode: the result against the hidden true TOOL frame, with the verdict."""
+    icon = {"good": "✔", "fair": "●", "poor": "✘"}[cmp.grade]
+    lines = [f"{icon} **Against the true TOOL frame: {cmp.verdict}**",
+             f"Position error of the TCP: **{_mm(cmp.position_error_mm, 3)}**"]
+    if cmp.orientation_error_deg is not None:
+        lines.append(f"Orientation error: **{_deg(cmp.orientation_error_deg, 3)}** "
+                     f"(tool X: {_deg(cmp.x_axis_error_deg, 3)})")
+    if cmp.inside_ci95 is not None:
+        lines.append("The true TCP is " + ("inside" if cmp.inside_ci95 else "**outside**")
+                     + " the 95 % radius.")
+    return "\n\n".join(lines)
+
+
+def save_markdown(slot: int, name: str) -> str:
+    """Confirmation after "Save to tool library"."""
+    return f"✔ Saved **{name}** in slot {slot}; it is now the active tool."
+
+
+def replay_markdown(checks: Sequence[ReplayCheck]) -> str:
+    """A loaded session record, recomputed: one row per wizard (how a trainer grades)."""
+    if not checks:
+        return "The record holds no calibration."
+    head = "| # | calibration | replay | against truth |\n|---|---|---|---|"
+    rows = []
+    for c in checks:
+        truth = "–" if c.truth is None else c.truth.verdict
+        ok = "✔ " if c.matches else "✘ "
+        rows.append(f"| {c.index + 1} | {c.wizard.title} | {ok}{c.message} | {truth} |")
+    return head + "\n" + "\n".join(rows)
+
+
+def estimator_options() -> dict[str, str]:
+    """Dropdown label -> estimator key, in the wizard's order."""
+    return {label: key for key, label in ESTIMATOR_LABELS.items()}

@@ -1,0 +1,400 @@
+"""The Calibrate menu's logic, without viser: which wizard is open, the physical tool each step
+needs, training mode (truth, auto-touch), saving to the tool library and the session record.
+
+A :class:`CalibrationWorkflow` belongs to one pendant session. It owns the wizards started in
+that session (``runs``: each a :class:`~tcp_pendant.wizards.session_record.WizardRun` with the
+hidden true TOOL frame of the tool it calibrates) and acts on the session's
+:class:`~tcp_pendant.controller.VirtualController` and the server's shared
+:class:`tcpcal.ToolLibrary`. The views (``tcp_pendant.views.wizard_*``) only render it and
+forward clicks; every figure comes from the wizards, which call ``tcpcal``.
+
+Units: the controller speaks metres (``T_world_flange``); the wizards hand millimetres to
+``tcpcal``; everything shown is in mm and degrees.
+
+Nothing already saved is lost: the library is only written by :meth:`save` (one atomic
+``ToolLibrary.save``), a cancelled wizard keeps its poses and can be resumed, and starting
+another wizard only cancels (never deletes) the one that was open.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any, Literal
+
+import numpy as np
+
+from tcpcal.library import ToolLibrary
+from tcpcal.tool import Tool
+from tcp_pendant.controller import ToolModel, VirtualController, builtin_tools
+from tcp_pendant.wizards import (
+    AbcWorldWizard,
+    ReferenceWizard,
+    ThreePointWizard,
+    Wizard,
+    WizardError,
+    WizardResult,
+    WizardStateError,
+    Xyz4Wizard,
+)
+from tcp_pendant.wizards.autotouch import AutoTouchOutcome, auto_touch
+from tcp_pendant.wizards.session_record import (
+    ReplayCheck,
+    WizardRun,
+    replay,
+    session_from_controller,
+)
+from tcp_pendant.wizards.truth import TruthComparison, compare_with_truth
+
+__all__ = [
+    "AUTO_SIGMA_MAX_MM",
+    "AutoTouchRequest",
+    "CalibrationWorkflow",
+    "WIZARD_KINDS",
+    "WIZARD_LABELS",
+]
+
+WIZARD_KINDS: tuple[str, ...] = ("xyz4", "reference", "three-point", "abc-world")
+WIZARD_LABELS: dict[str, str] = {
+    "xyz4": "XYZ 4-point",
+    "reference": "XYZ reference",
+    "three-point": "Three-point orientation",
+    "abc-world": "ABC world (parallel axes)",
+}
+AUTO_SIGMA_MAX_MM = 2.0
+"""Largest simulated operator error the pendant offers (issue 5: slider 0-2 mm)."""
+
+
+@dataclass(frozen=True)
+class AutoTouchRequest:
+    """What the training-mode "Auto-touch" button asks for.
+
+    Attributes:
+        tilt_deg, azimuth_deg: approach direction (see ``VirtualController.auto_approach``:
+            tool X tilted ``tilt_deg`` from straight down, turned ``azimuth_deg`` about WORLD Z);
+            None for both: a random direction.
+        sigma_mm: simulated operator error, mm per axis (0 to ``AUTO_SIGMA_MAX_MM``).
+    """
+
+    tilt_deg: float | None = None
+    azimuth_deg: float | None = None
+    sigma_mm: float = 0.0
+
+    def __post_init__(self) -> None:
+        if (self.tilt_deg is None) != (self.azimuth_deg is None):
+            raise WizardError("Give both tilt and azimuth for a chosen direction, or neither for a random one.")
+        for what, v in (("tilt", self.tilt_deg), ("azimuth", self.azimuth_deg)):
+            if v is not None and not np.isfinite(v):
+                raise WizardError(f"The auto-touch {what} must be a finite number of degrees, got {v}.")
+        if not (np.isfinite(self.sigma_mm) and 0.0 <= self.sigma_mm <= AUTO_SIGMA_MAX_MM):
+            raise WizardError(f"The simulated operator error must be 0 to {AUTO_SIGMA_MAX_MM:g} mm, "
+                              f"got {self.sigma_mm}.")
+
+    @property
+    def direction_deg(self) -> tuple[float, float, float] | None:
+        """(tilt, azimuth, spin) for ``auto_touch``; None: random."""
+        if self.tilt_deg is None or self.azimuth_deg is None:
+            return None
+        return (float(self.tilt_deg), float(self.azimuth_deg), 0.0)
+
+
+class CalibrationWorkflow:
+    """The calibration wizards of one pendant session (see the module docstring).
+
+    Args:
+        controller: the session's virtual controller.
+        library: the server's tool library (shared by every session).
+        robot: robot name for the session record ("kr6", "gp12" or a URDF stem).
+        tools: physical tools by key (default: the built-in pointer, torch and gripper).
+        rng: random generator of auto-touch (seed it for reproducible demos and tests).
+    """
+
+    def __init__(self, controller: VirtualController, library: ToolLibrary, *, robot: str,
+                 tools: Mapping[str, ToolModel] | None = None,
+                 rng: np.random.Generator | None = None) -> None:
+        self.controller = controller
+        self.library = library
+        self.robot = robot
+        self.tools: dict[str, ToolModel] = dict(builtin_tools() if tools is None else tools)
+        self.rng = np.random.default_rng() if rng is None else rng
+        self.training = True
+        self.runs: list[WizardRun] = []
+        self._current: int | None = None
+        self.last_save: tuple[int, Tool] | None = None
+
+    # ------------------------------------------------------------ state
+    @property
+    def run(self) -> WizardRun | None:
+        """The wizard run on show (open, finished or cancelled), or None."""
+        return None if self._current is None else self.runs[self._current]
+
+    @property
+    def wizard(self) -> Wizard | None:
+        """The wizard on show, told which physical tool is mounted right now."""
+        run = self.run
+        if run is None:
+            return None
+        run.wizard.note_mounted_tool(self.controller.mounted_tool.key)
+        return run.wizard
+
+    @property
+    def is_open(self) -> bool:
+        """A wizard is on show and not cancelled (the wizard panel is visible)."""
+        w = self.wizard
+        return w is not None and w.status != "cancelled"
+
+    def resumable(self) -> list[tuple[int, str]]:
+        """Cancelled runs, newest first: (index in ``runs``, label for the Resume list)."""
+        out = []
+        for i in range(len(self.runs) - 1, -1, -1):
+            w = self.runs[i].wizard
+            if w.status == "cancelled":
+                done = sum(1 for s in w.steps if s.recorded)
+                out.append((i, f"{i + 1}: {w.title}, {done} of {w.n_steps} recorded"))
+        return out
+
+    # ------------------------------------------------------------ library
+    def library_tools(self) -> dict[int, Tool]:
+        """The shared tool library, read now: slot -> tool."""
+        return self.library.tools()
+
+    def _library_tool(self, slot: int) -> Tool:
+        tool = self.library.get(int(slot))
+        if tool is None:
+            raise WizardError(f"Slot {slot} of the tool library is empty; pick a calibrated tool.")
+        return tool
+
+    # ------------------------------------------------------------ starting wizards
+    def _open(self, wizard: Wizard, true_tool: ToolModel | None) -> Wizard:
+        current = self.wizard
+        if current is not None and current.status != "cancelled":
+            current.cancel()                  # kept in runs: resumable, nothing lost
+        T_true = None if true_tool is None else np.array(true_tool.T_flange_tcp_true, dtype=float)
+        self.runs.append(WizardRun(wizard, None if true_tool is None else true_tool.key, T_true))
+        self._current = len(self.runs) - 1
+        self.last_save = None
+        return self.wizard  # type: ignore[return-value]
+
+    def start_xyz4(self, *, n_points: int = 4, estimator: str = "lstsq") -> Xyz4Wizard:
+        """Open an XYZ 4-point wizard for the mounted tool (its truth is graded)."""
+        wiz = Xyz4Wizard(n_points=n_points, estimator=estimator)  # type: ignore[arg-type]
+        return self._open(wiz, self.controller.mounted_tool)  # type: ignore[return-value]
+
+    def start_reference(self, *, reference_slot: int, reference_tool_key: str,
+                        new_tool_key: str) -> ReferenceWizard:
+        """Open an XYZ reference wizard.
+
+        Args:
+            reference_slot: library slot of the calibrated reference tool's data.
+            reference_tool_key: the physical tool that data belongs to (mounted for step 1).
+            new_tool_key: the physical tool to calibrate (mounted for step 2; its truth is graded).
+        """
+        ref = self._library_tool(reference_slot)
+        for key in (reference_tool_key, new_tool_key):
+            if key not in self.tools:
+                raise WizardError(f"Unknown physical tool {key!r}; choose one of {', '.join(self.tools)}.")
+        new = self.tools[new_tool_key]
+        wiz = ReferenceWizard(ref, reference_tool_key=reference_tool_key, new_tool_key=new_tool_key,
+                              new_tool_label=f"the {new.label.lower()}")
+        self._open(wiz, new)
+        self.controller.set_active_tool(ref)          # "mounted and active" (step 1)
+        return wiz
+
+    def start_three_point(self, *, slot: int, variant: Literal[1, 2] = 1) -> ThreePointWizard:
+        """Open a three-point orientation wizard for the library tool in ``slot`` (its TCP must be
+        calibrated); the tool data is made active so jogs along tool X/Y use it."""
+        tool = self._library_tool(slot)
+        wiz = ThreePointWizard(tool, variant=variant)
+        self._open(wiz, self.controller.mounted_tool)
+        self.controller.set_active_tool(tool)
+        return wiz
+
+    def start_abc_world(self, *, slot: int, variant: Literal["6d", "5d"] = "6d") -> AbcWorldWizard:
+        """Open an ABC world wizard for the library tool in ``slot``; its data is made active so
+        rotations A, B, C turn about its TCP."""
+        tool = self._library_tool(slot)
+        wiz = AbcWorldWizard(tool, variant=variant)
+        self._open(wiz, self.controller.mounted_tool)
+        self.controller.set_active_tool(tool)
+        return wiz
+
+    # ------------------------------------------------------------ navigation
+    def _require(self) -> Wizard:
+        w = self.wizard
+        if w is None:
+            raise WizardStateError("No calibration is open: choose a method and press Start.")
+        return w
+
+    def cancel(self) -> None:
+        """Leave the wizard; its poses are kept and it can be resumed."""
+        self._require().cancel()
+
+    def resume(self, index: int | None = None) -> Wizard:
+        """Resume a cancelled run (default: the newest one)."""
+        options = self.resumable()
+        if not options:
+            raise WizardStateError("There is no cancelled calibration to resume.")
+        i = options[0][0] if index is None else int(index)
+        if i not in [o[0] for o in options]:
+            raise WizardStateError(f"Calibration {i + 1} is not waiting to be resumed.")
+        current = self.wizard
+        if current is not None and current.status != "cancelled":
+            current.cancel()
+        self._current = i
+        w = self.runs[i].wizard
+        w.resume()
+        self.last_save = None
+        return w
+
+    def required_tool(self) -> ToolModel | None:
+        """The physical tool the current step needs and that is not mounted (else None)."""
+        w = self.wizard
+        if w is None or w.status != "in_progress":
+            return None
+        key = w.step.mount_tool_key
+        if key is None or key == self.controller.mounted_tool.key:
+            return None
+        return self.tools.get(key)
+
+    def mount_required_tool(self) -> ToolModel:
+        """The tool change of the current step: mount the tool it needs (the app swaps the model)."""
+        tool = self.required_tool()
+        if tool is None:
+            raise WizardStateError("This step needs no tool change.")
+        self.controller.mount_tool(tool)
+        self._require()                      # tells the wizard what is mounted now
+        return tool
+
+    def record(self) -> None:
+        """Record the current flange pose for the current step."""
+        self._require().record(self.controller.T_world_flange())
+
+    def next(self) -> WizardResult | None:
+        """Next step; on the last step compute the result (returned)."""
+        out = self._require().next()
+        return out if isinstance(out, WizardResult) else None
+
+    def back(self) -> None:
+        """One step back (from the result: to the last step); nothing is deleted."""
+        self._require().back()
+
+    def auto_touch(self, request: AutoTouchRequest) -> AutoTouchOutcome:
+        """Training mode: let the controller perform the current step (mounting the tool it
+        needs), record it and go on; after the last step the result is computed, so a whole
+        4-point calibration takes four clicks.
+
+        Raises:
+            WizardStateError: training mode is off, or no wizard is in progress.
+            CalibrationFailedError: the touches cannot determine the result (e.g. four touches
+                from the same chosen direction); the wizard stays on its last step.
+        """
+        if not self.training:
+            raise WizardStateError("Auto-touch is a training-mode tool; switch training mode on.")
+        w = self._require()
+        out = auto_touch(w, self.controller, direction_deg=request.direction_deg,
+                         sigma_mm=request.sigma_mm, rng=self.rng, tools=self.tools)
+        if out.ok and w.on_last_step and all(s.recorded for s in w.steps):
+            w.finish()
+        return out
+
+    # ------------------------------------------------------------ result
+    @property
+    def result(self) -> WizardResult | None:
+        w = self.wizard
+        return None if w is None else w.result
+
+    def truth(self) -> TruthComparison | None:
+        """Training mode: the result against the hidden true TOOL frame (None otherwise)."""
+        run, res = self.run, self.result
+        if not self.training or run is None or res is None or run.T_flange_tcp_true_m is None:
+            return None
+        return compare_with_truth(res, run.T_flange_tcp_true_m)
+
+    def T_flange_tool_true_m(self) -> np.ndarray | None:
+        """Training mode, after a result: the hidden true TOOL frame (4x4, metres) to reveal."""
+        run = self.run
+        if not self.training or run is None or self.result is None:
+            return None
+        return run.T_flange_tcp_true_m
+
+    def preview_tool(self) -> Tool | None:
+        """The tool "Save" would store (named "preview"), or None before a result."""
+        w = self.wizard
+        if w is None or w.result is None:
+            return None
+        return w.to_tool("preview")
+
+    def T_flange_tool_computed_m(self) -> np.ndarray | None:
+        """The computed TOOL frame of the result (4x4, metres, FLANGE -> TOOL): the TCP and, when
+        orientation is not calibrated, the orientation the saved tool will have."""
+        tool = self.preview_tool()
+        if tool is None:
+            return None
+        T = np.array(tool.T_flange_tool_mm, dtype=float)
+        T[:3, 3] /= 1000.0
+        return T
+
+    def default_save_name(self) -> str:
+        """Name offered by "Save to tool library": the calibrated tool's own name or its label."""
+        w = self.wizard
+        if isinstance(w, (ThreePointWizard, AbcWorldWizard)):
+            return w.tool.name
+        run = self.run
+        key = None if run is None else run.true_tool_key
+        return self.tools[key].label if key in self.tools else "Tool"
+
+    def save(self, name: str, slot: int | None = None) -> tuple[int, Tool]:
+        """"Save to tool library": store the calibrated tool (slot None: the slot holding that name,
+        else the first free one), make it the library's active tool and the controller's active
+        tool data. Nothing is written if anything is wrong.
+
+        Raises:
+            WizardStateError: not finished, empty name, library full.
+            tcpcal.TcpcalError: the library refused (the name is used by another slot, ...).
+        """
+        w = self._require()
+        name = str(name).strip()
+        if not name:
+            raise WizardStateError("Type a name for the tool before saving.")
+        slot_tool = w.save_to_library(self.library, name, slot, activate=True)
+        self.controller.set_active_tool(slot_tool[1])
+        self.last_save = slot_tool
+        return slot_tool
+
+    # ------------------------------------------------------------ session record
+    def export_record(self, touches: Any = ()) -> dict[str, Any]:
+        """The session record (JSON-ready dict, ``tcp_pendant.wizards.session_record`` format):
+        every wizard of the session with its poses, result and errors against truth."""
+        return session_from_controller(self.controller, self.runs, robot=self.robot, touches=touches)
+
+    def load_record(self, source: Any) -> tuple[ReplayCheck, ...]:
+        """Load a session record (path, JSON text or dict), recompute every wizard with tcpcal and
+        add them to this session's runs (the newest finished one is put on show).
+
+        Raises:
+            SessionRecordError: unreadable record (nothing of this session is changed).
+        """
+        from tcp_pendant.wizards.session_record import load_session
+
+        data = load_session(source)
+        checks = replay(data)
+        if not checks:
+            return checks
+        current = self.wizard
+        if current is not None and current.status != "cancelled":
+            current.cancel()
+        finished: list[int] = []
+        for check, entry in zip(checks, data.get("wizards", [])):
+            true_tool = entry.get("true_tool") or {}
+            T_true = true_tool.get("T_flange_tcp_true_m")
+            self.runs.append(WizardRun(check.wizard, true_tool.get("key"),
+                                       None if T_true is None else np.array(T_true, dtype=float)))
+            if check.wizard.finished_result is not None:
+                finished.append(len(self.runs) - 1)
+            if check.wizard.status != "cancelled":
+                check.wizard.cancel()         # every loaded wizard waits in the Resume list
+        if finished:                          # ... but the newest finished one is put on show
+            self._current = finished[-1]
+            self.runs[self._current].wizard.resume()
+        self.last_save = None
+        return checks

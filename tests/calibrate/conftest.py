@@ -1,0 +1,33 @@
+"""Fixtures of the Calibrate-menu tests: a tool library in tmp_path and the workflow on a real
+controller (see ``calib_helpers``)."""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from tcpcal.library import ToolLibrary
+from tcp_pendant.calibrate import CalibrationWorkflow
+
+sys.path.insert(0, str(Path(__file__).parent))
+from calib_helpers import make_controller  # noqa: E402
+
+
+@pytest.fixture
+def library(tmp_path: Path) -> ToolLibrary:
+    return ToolLibrary(tmp_path / "tools.json")
+
+
+@pytest.fixture
+def workflow(library: ToolLibrary) -> Callable[..., CalibrationWorkflow]:
+    """Factory: ``workflow(robot="kr6", tool="pointer", seed=0)``."""
+
+    def make(robot: str = "kr6", tool: str = "pointer", seed: int = 0) -> CalibrationWorkflow:
+        return CalibrationWorkflow(make_controller(robot, tool), library, robot=robot,
+                                   rng=np.random.default_rng(seed))
+
+    return make
