@@ -12,6 +12,7 @@ shown right under it; the tool is saved only if all fields are valid (nothing ha
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 from tcpcal.formats import FORMATS, export_tool
@@ -90,6 +91,7 @@ class ToolPanel:
             handle.on_update(g(lambda _e: self._show_entry_preview()))
         self._show_entry_preview()
         self._library: dict[int, Tool] = {}
+        self._reload_listeners: list[Callable[[], None]] = []
         self.reload()
         self._show_active()
 
@@ -111,6 +113,12 @@ class ToolPanel:
         self.entry_slot.value = keep
         self._show_slot()
         self._show_active()
+        for fn in self._reload_listeners:
+            fn()
+
+    def on_reload(self, fn: Callable[[], None]) -> None:
+        """Call ``fn()`` after every reload of the library (other views list its tools too)."""
+        self._reload_listeners.append(fn)
 
     def _selected(self) -> tuple[int, Tool]:
         slot = _slot_of(self.slots.value)

@@ -1,0 +1,24 @@
+"""Small helpers shared by the wizard views."""
+
+from __future__ import annotations
+
+from typing import Any
+
+__all__ = ["set_content", "set_options"]
+
+
+def set_content(handle: Any, text: str) -> None:
+    """Set a markdown handle's content only when it changed (viser re-sends every assignment
+    of ``content``; the Calibrate tab re-renders after every click and move)."""
+    if handle.content != text:
+        handle.content = text
+
+
+def set_options(handle: Any, options: tuple[str, ...], keep: str | None = None) -> None:
+    """Give a dropdown new options, keeping ``keep`` (default: the current value) if still there."""
+    keep = handle.value if keep is None else keep
+    if tuple(handle.options) != options:
+        handle.options = options
+    value = keep if keep in options else options[0]
+    if handle.value != value:
+        handle.value = value

@@ -1,0 +1,285 @@
+"""The Calibrate tab of one session (viser GUI): the wizards' menu and their views.
+
+This is the plug-in that ``tcp_pendant.views.calibrate`` loads (``build_calibrate_views``).
+Top to bottom:
+
+* **Training mode** switch (on by default, for the classroom): reveals the true TOOL frame
+  after a result with the error against it, and offers Auto-touch;
+* **Calibrate** menu: the method (XYZ 4-point, XYZ reference, three-point orientation, ABC
+  world), its options (touches and estimator; the calibrated tool from the library; the
+  physical reference and new tools), Start, and Resume for a calibration left half-way. It is
+  hidden while a wizard is open, as on a pendant; Cancel (or Close, on a result) brings it back;
+* the open wizard's step panel (``wizard_steps``), its result panel (``wizard_result``) and
+  its scene nodes (``wizard_scene``);
+* **Session record**: export the session (touches, wizards, results, errors) as JSON and load
+  one back to replay it (how a trainer grades).
+
+All logic is in :class:`tcp_pendant.calibrate.CalibrationWorkflow` (no viser); every click goes
+through :meth:`CalibrateView.action` (the session's lock and error notifications), then the
+views are re-rendered from the workflow's state.
+"""
+
+from __future__ import annotations
+
+import contextlib
+from collections.abc import Callable, Iterator
+from typing import Any
+
+from tcpcal.tool import Tool
+from tcp_pendant.calibrate import WIZARD_KINDS, WIZARD_LABELS, CalibrationWorkflow
+from tcp_pendant.calibrate.text import METHOD_BLURBS, menu_markdown, replay_markdown
+from tcp_pendant.controller import builtin_robots
+from tcp_pendant.session import Session
+from tcp_pendant.views.gui_util import set_content, set_options
+from tcp_pendant.views.wizard_result import WizardResultView
+from tcp_pendant.views.wizard_scene import WizardSceneView
+from tcp_pendant.views.wizard_steps import WizardStepsView
+from tcp_pendant.wizards import ESTIMATOR_LABELS
+from tcp_pendant.wizards.session_record import dumps
+
+__all__ = ["CalibrateView", "NO_LIBRARY_TOOL", "SESSION_FILENAME", "build_calibrate_views"]
+
+NO_LIBRARY_TOOL = "(library empty)"
+SESSION_FILENAME = "tcp-pendant-session.json"
+_LABEL_TO_KIND = {label: kind for kind, label in WIZARD_LABELS.items()}
+
+
+def robot_name(session: Session) -> str:
+    """The robot's key for the session record ("kr6", "gp12") or its URDF file name."""
+    urdf = session.controller.kinematics.urdf_path
+    for key, path in builtin_robots().items():
+        if path.resolve() == urdf.resolve():
+            return key
+    return urdf.stem
+
+
+def build_calibrate_views(session: Session) -> CalibrateView:
+    """The plug-in entry point (see ``tcp_pendant.views.calibrate``)."""
+    return CalibrateView(session)
+
+
+class CalibrateView:
+    """The Calibrate tab of ``session`` (see the module docstring).
+
+    Attributes:
+        workflow: the wizards of this session (viser-free logic).
+        menu_*, steps, result, scene, record_*: the widgets and sub-views (for tests).
+    """
+
+    def __init__(self, session: Session) -> None:
+        self.session = session
+        self.workflow = CalibrationWorkflow(session.controller, session.library, robot=robot_name(session))
+        self._quiet = 0
+        self._menu_mounted_key: str | None = None
+        gui = session.target.gui
+        tools = self.workflow.tools
+        self._physical = {t.label: key for key, t in tools.items()}
+
+        self.training = gui.add_checkbox(
+            "Training mode", True,
+            hint="Reveals the true TOOL frame after a result, with the error against it, and offers Auto-touch.")
+        self.menu_folder = gui.add_folder("Calibrate")
+        with self.menu_folder:
+            labels = tuple(WIZARD_LABELS[k] for k in WIZARD_KINDS)
+            self.method = gui.add_dropdown("Method", labels, initial_value=labels[0])
+            self.method_md = gui.add_markdown("")
+            self.n_points = gui.add_slider("Touches", min=4, max=20, step=1, initial_value=4)
+            est = tuple(ESTIMATOR_LABELS.values())
+            self.estimator = gui.add_dropdown("Estimator", est, initial_value=est[0])
+            self.library_tool = gui.add_dropdown("Tool data", (NO_LIBRARY_TOOL,), initial_value=NO_LIBRARY_TOOL,
+                                                 hint="A tool of the library whose TCP is calibrated.")
+            physical = tuple(self._physical)
+            mounted = session.controller.mounted_tool.label
+            self.reference_physical = gui.add_dropdown(
+                "Its physical tool", physical, initial_value=mounted if mounted in physical else physical[0],
+                hint="The tool that the reference data belongs to: it is mounted for the first touch.")
+            other = next((p for p in physical if p != self.reference_physical.value), physical[0])
+            self.new_physical = gui.add_dropdown("New tool", physical, initial_value=other,
+                                                 hint="The tool to calibrate: it is mounted for the second touch.")
+            self.menu_md = gui.add_markdown("")
+            self.start = gui.add_button("Start", color="green")
+            self.resume_list = gui.add_dropdown("Left half-way", ("-",), visible=False)
+            self.resume = gui.add_button("Resume", color="blue", visible=False)
+        self.steps = WizardStepsView(self)
+        self.result = WizardResultView(self)
+        with gui.add_folder("Session record", expand_by_default=False):
+            self.export = gui.add_button("Export session (JSON)",
+                                         hint="Touches, calibrations, results and errors, for grading.")
+            self.load = gui.add_upload_button("Load session (JSON)", mime_type="application/json")
+            self.record_md = gui.add_markdown("")
+        self.scene = WizardSceneView(session, self.workflow)
+
+        act = self.action
+        self.training.on_update(act(self._on_training, user_only=True))
+        for choice in (self.method, self.library_tool, self.reference_physical, self.new_physical):
+            choice.on_update(act(lambda _e: None, user_only=True))       # re-render: echo the choice
+        self.start.on_click(act(self._on_start))
+        self.resume.on_click(act(self._on_resume))
+        self.export.on_click(act(self._on_export))
+        self.load.on_upload(act(self._on_load))
+        session.add_motion_listener(self.on_motion)
+        tool_panel = session.views.get("tools")
+        if tool_panel is not None and hasattr(tool_panel, "on_reload"):
+            tool_panel.on_reload(self.refresh_library)
+        self.refresh_library()
+        self.render()
+
+    # ------------------------------------------------------------ plumbing
+    @contextlib.contextmanager
+    def quiet(self) -> Iterator[None]:
+        """While inside, value updates fired by our own assignments are ignored."""
+        self._quiet += 1
+        try:
+            yield
+        finally:
+            self._quiet -= 1
+
+    def action(self, fn: Callable[[Any], Any], *, user_only: bool = False) -> Callable[[Any], Any]:
+        """Wrap a GUI callback: session lock and error notifications (``Session.guard``), then
+        bring the tool views and scene in line and re-render the tab.
+
+        Args:
+            fn: the callback, given the viser event.
+            user_only: ignore events fired by our own assignments to a handle's value
+                (``event.client is None``), as for on_update of dropdowns the views set.
+        """
+        def run(event: Any) -> None:
+            if user_only and (self._quiet or getattr(event, "client", None) is None):
+                return
+            try:
+                fn(event)
+            finally:
+                self.after_action()
+
+        return self.session.guard(run)
+
+    def after_action(self) -> None:
+        """After a click: show the tool the controller has mounted and the active tool data, push
+        the robot (an auto-touch moves it), then re-render the Calibrate tab."""
+        s = self.session
+        if s.closed:
+            return
+        c = s.controller
+        scene = s.views.get("scene")
+        tool_panel = s.views.get("tools")
+        if tool_panel is not None and tool_panel.mounted.value != c.mounted_tool.label:
+            if scene is not None:
+                scene.set_mounted_tool(c.mounted_tool)
+            tool_panel.mounted.value = c.mounted_tool.label   # its own handler sees no change
+        if scene is not None:
+            scene.update_active_tool()
+        if tool_panel is not None:
+            tool_panel.reload()
+        s.moved()
+        self.render()
+
+    def _set_active_slot(self, slot: int | None) -> None:
+        self.session.active_slot = slot
+
+    def saved(self, slot: int, tool: Tool) -> None:
+        """After "Save to tool library": the saved tool is the session's active tool."""
+        self._set_active_slot(slot)
+        self.session.notify("Tool saved", f"Slot {slot}: {tool.name} is now the active tool.", kind="success")
+
+    # ------------------------------------------------------------ callbacks
+    def _on_training(self, event: Any) -> None:
+        self.workflow.training = bool(event.target.value)
+
+    def _selected_slot(self) -> int:
+        head = str(self.library_tool.value).split(":", 1)[0]
+        if not head.isdigit():
+            raise ValueError("The tool library is empty: calibrate the TCP first (XYZ 4-point) and save it.")
+        return int(head)
+
+    def _on_start(self, _event: Any) -> None:
+        kind = _LABEL_TO_KIND.get(str(self.method.value))
+        wf = self.workflow
+        if kind == "xyz4":
+            est = {v: k for k, v in ESTIMATOR_LABELS.items()}[str(self.estimator.value)]
+            wf.start_xyz4(n_points=int(self.n_points.value), estimator=est)
+        elif kind == "reference":
+            slot = self._selected_slot()
+            wf.start_reference(reference_slot=slot, reference_tool_key=self._physical[self.reference_physical.value],
+                               new_tool_key=self._physical[self.new_physical.value])
+            self._set_active_slot(slot)
+        elif kind == "three-point":
+            slot = self._selected_slot()
+            wf.start_three_point(slot=slot)
+            self._set_active_slot(slot)
+        elif kind == "abc-world":
+            slot = self._selected_slot()
+            wf.start_abc_world(slot=slot)
+            self._set_active_slot(slot)
+        else:
+            raise ValueError(f"Unknown calibration method {self.method.value!r}.")
+
+    def _on_resume(self, _event: Any) -> None:
+        head = str(self.resume_list.value).split(":", 1)[0]
+        if not head.isdigit():
+            raise ValueError("There is no calibration to resume.")
+        self.workflow.resume(int(head) - 1)
+
+    def _on_export(self, _event: Any) -> None:
+        data = dumps(self.workflow.export_record(self.session.touches)).encode("utf-8")
+        target = self.session.client if self.session.client is not None else self.session.target
+        target.send_file_download(SESSION_FILENAME, data, save_immediately=True)
+        set_content(self.record_md, f"Exported {len(self.workflow.runs)} calibration(s) as {SESSION_FILENAME}.")
+
+    def _on_load(self, event: Any) -> None:
+        upload = event.target.value
+        try:
+            text = bytes(upload.content).decode("utf-8")
+        except UnicodeDecodeError:
+            raise ValueError(f"{upload.name or 'The file'} is not a text (JSON) file.") from None
+        checks = self.workflow.load_record(text)
+        set_content(self.record_md, f"**Loaded {upload.name or 'session'}**\n\n" + replay_markdown(checks))
+
+    # ------------------------------------------------------------ library and motion
+    def refresh_library(self) -> None:
+        """Re-list the library's tools (called when the library changes, by anyone)."""
+        tools = self.workflow.library_tools()
+        options = tuple(f"{s}: {t.name}" for s, t in sorted(tools.items())) or (NO_LIBRARY_TOOL,)
+        with self.quiet():
+            set_options(self.library_tool, options)
+            self.result.refresh_slots(tools)
+        self._render_menu()
+
+    def on_motion(self) -> None:
+        """After every move of the robot (and a tool change on the Tool tab): the live parts only
+        (meter, triads, ABC target), and the menu when the mounted tool changed."""
+        if self.session.closed:
+            return
+        self.steps.update_meter()
+        self.scene.on_motion()
+        if self.session.controller.mounted_tool.key != self._menu_mounted_key:
+            self._render_menu()
+
+    # ------------------------------------------------------------ render
+    def render(self) -> None:
+        """Re-render the whole tab from the workflow's state."""
+        self._render_menu()
+        self.steps.render()
+        self.result.render()
+        self.scene.render()
+
+    def _render_menu(self) -> None:
+        self._menu_mounted_key = self.session.controller.mounted_tool.key
+        kind = _LABEL_TO_KIND.get(str(self.method.value), "xyz4")
+        set_content(self.method_md, METHOD_BLURBS[kind])
+        self.n_points.visible = self.estimator.visible = kind == "xyz4"
+        needs_tool = kind != "xyz4"
+        self.library_tool.visible = needs_tool
+        self.reference_physical.visible = self.new_physical.visible = kind == "reference"
+        empty = self.library_tool.value == NO_LIBRARY_TOOL
+        set_content(self.menu_md, menu_markdown(
+            kind, library_tool=None if empty else str(self.library_tool.value),
+            reference_tool=str(self.reference_physical.value), new_tool=str(self.new_physical.value),
+            mounted_tool=self.session.controller.mounted_tool.label))
+        self.start.disabled = needs_tool and empty
+        self.menu_folder.visible = not self.workflow.is_open     # a pendant shows the wizard alone
+        waiting = self.workflow.resumable()
+        self.resume_list.visible = self.resume.visible = bool(waiting)
+        if waiting:
+            with self.quiet():
+                set_options(self.resume_list, tuple(label for _, label in waiting))
+

@@ -1,0 +1,169 @@
+"""The result panel of a finished wizard (viser GUI).
+
+Shows the calibrated frame (X, Y, Z mm; A, B, C deg when orientation is calibrated) and the
+quality figures from tcpcal (per-touch error, mean, max and RMS error, 95 % radius,
+orthogonality defect, displacement lengths), the warnings in words, and "Save to tool
+library" (name and slot; saving also makes it the active tool). For the 4-point wizard: a bar
+chart of the per-touch errors with outliers in red, "Drop outliers" / "Use all touches", the
+estimator the TCP is reported from, and a switch that compares the three estimators side by
+side. In training mode: the result against the hidden true TOOL frame with a verdict.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from tcpcal.library import ToolLibrary
+from tcp_pendant.calibrate import error_bars
+from tcp_pendant.calibrate.text import (
+    comparison_markdown,
+    estimator_options,
+    result_markdown,
+    save_markdown,
+    save_preview_markdown,
+    truth_markdown,
+    warnings_markdown,
+)
+from tcp_pendant.views.gui_util import set_content, set_options
+from tcp_pendant.wizards import ESTIMATOR_LABELS, Xyz4Result, Xyz4Wizard
+
+if TYPE_CHECKING:
+    from tcp_pendant.views.wizard_menu import CalibrateView
+
+__all__ = ["AUTO_SLOT", "WizardResultView", "slot_options"]
+
+AUTO_SLOT = "same name, else first free"
+
+
+def slot_options(tools: dict[int, Any]) -> tuple[str, ...]:
+    """The Save slot list: automatic, then every slot with the tool it holds."""
+    return (AUTO_SLOT, *(f"{s}: {tools[s].name}" if s in tools else f"{s}: (empty)"
+                         for s in range(1, ToolLibrary.N_SLOTS + 1)))
+
+
+def _slot_of(option: str) -> int | None:
+    head = str(option).split(":", 1)[0]
+    return int(head) if head.isdigit() else None
+
+
+class WizardResultView:
+    """Builds the result panel in the current GUI container (see the module docstring)."""
+
+    def __init__(self, parent: CalibrateView) -> None:
+        self.parent = parent
+        gui = parent.session.target.gui
+        self.folder = gui.add_folder("Result", visible=False)
+        with self.folder:
+            self.result_md = gui.add_markdown("")
+            self.truth_md = gui.add_markdown("", visible=False)
+            self.warnings_md = gui.add_markdown("")
+            bars = error_bars([1], [0.0])
+            self.chart = gui.add_uplot(
+                bars.columns,
+                ({"label": "touch"},
+                 {"label": "error (mm)", "stroke": "#3b6fd6", "fill": "rgba(59,111,214,0.55)", "width": 1},
+                 {"label": "outlier (mm)", "stroke": "#d62020", "fill": "rgba(214,32,32,0.6)", "width": 1},
+                 {"label": "mean (mm)", "stroke": "#444444", "dash": (4.0, 4.0), "width": 1}),
+                title="Error per touch (mm)", height=170, visible=False,
+                scales={"x": {"time": False}, "y": {"range": (0.0, 1.0)}},
+                axes=({"label": "touch"}, {"label": "mm"}),
+            )
+            self.drop = gui.add_button("Drop outliers", color="red", visible=False,
+                                       hint="Recompute without the touches flagged as outliers.")
+            self.restore = gui.add_button("Use all touches", visible=False)
+            labels = tuple(ESTIMATOR_LABELS.values())
+            self.estimator = gui.add_dropdown("Report TCP from", labels, initial_value=labels[0], visible=False)
+            self.compare = gui.add_checkbox("Compare the three estimators", False, visible=False)
+            self.compare_md = gui.add_markdown("", visible=False)
+            self.save_name = gui.add_text("Tool name", "")
+            self.save_slot = gui.add_dropdown("Slot", slot_options({}), initial_value=AUTO_SLOT)
+            self.save_preview = gui.add_markdown("")
+            self.save = gui.add_button("Save to tool library", color="green",
+                                       hint="Store the tool in the library and make it the active tool.")
+            self.save_md = gui.add_markdown("")
+        act = parent.action
+        self.drop.on_click(act(self._on_drop))
+        self.restore.on_click(act(self._on_restore))
+        self.estimator.on_update(act(self._on_estimator, user_only=True))
+        self.compare.on_update(act(lambda _e: None, user_only=True))
+        self.save.on_click(act(self._on_save))
+        self.save_name.on_update(act(lambda _e: None, user_only=True))
+        self.save_slot.on_update(act(lambda _e: None, user_only=True))
+        self._result_shown: Any = None
+
+    # ------------------------------------------------------------ callbacks
+    def _xyz4(self) -> Xyz4Wizard:
+        wiz = self.parent.workflow.wizard
+        if not isinstance(wiz, Xyz4Wizard):
+            raise ValueError("This is for the XYZ 4-point result.")
+        return wiz
+
+    def _on_drop(self, _event: Any) -> None:
+        self._xyz4().drop_outliers()
+
+    def _on_restore(self, _event: Any) -> None:
+        self._xyz4().restore_all()
+
+    def _on_estimator(self, event: Any) -> None:
+        key = estimator_options().get(str(event.target.value))
+        if key is None:
+            raise ValueError(f"Unknown estimator {event.target.value!r}.")
+        self._xyz4().set_estimator(key)  # type: ignore[arg-type]
+
+    def _on_save(self, _event: Any) -> None:
+        slot, tool = self.parent.workflow.save(str(self.save_name.value), _slot_of(self.save_slot.value))
+        self.parent.saved(slot, tool)
+
+    # ------------------------------------------------------------ render
+    def refresh_slots(self, tools: dict[int, Any]) -> None:
+        """Re-list the slots after the library changed."""
+        set_options(self.save_slot, slot_options(tools), keep=self.save_slot.value)
+
+    def render(self) -> None:
+        """Show the result of the wizard on show (hide the panel when there is none)."""
+        wf = self.parent.workflow
+        res = wf.result
+        self.folder.visible = res is not None
+        if res is None:
+            self._result_shown = None
+            return
+        if res is not self._result_shown:              # a new result: fresh name, no old message
+            self._result_shown = res
+            self.save_name.value = wf.default_save_name()
+            set_content(self.save_md, "")
+        set_content(self.result_md, result_markdown(res))
+        set_content(self.warnings_md, warnings_markdown(res))
+        truth = wf.truth()
+        self.truth_md.visible = truth is not None
+        if truth is not None:
+            set_content(self.truth_md, truth_markdown(truth))
+        tool = wf.preview_tool()
+        if tool is not None:
+            set_content(self.save_preview, save_preview_markdown(str(self.save_name.value), str(self.save_slot.value),
+                                                                 tool.tcp_mm, tool.abc_deg))
+        if wf.last_save is not None:
+            set_content(self.save_md, save_markdown(wf.last_save[0], wf.last_save[1].name))
+        self._render_xyz4(res if isinstance(res, Xyz4Result) else None)
+
+    def _render_xyz4(self, res: Xyz4Result | None) -> None:
+        for h in (self.chart, self.drop, self.restore, self.estimator, self.compare):
+            h.visible = res is not None
+        if res is None:
+            self.compare_md.visible = False
+            return
+        bars = error_bars([i + 1 for i in res.used_indices], res.per_touch_error_mm,
+                          [i + 1 for i in res.outliers])
+        self.chart.data = bars.columns
+        top = float(np.max(res.per_touch_error_mm)) if res.per_touch_error_mm else 0.0
+        self.chart.scales = {"x": {"time": False}, "y": {"range": (0.0, max(1.2 * top, 1e-3))}}
+        self.drop.disabled = not res.outliers
+        self.restore.disabled = not res.excluded
+        label = ESTIMATOR_LABELS[res.estimator]
+        with self.parent.quiet():
+            if self.estimator.value != label:
+                self.estimator.value = label
+        self.compare_md.visible = bool(self.compare.value)
+        if self.compare.value:
+            set_content(self.compare_md, comparison_markdown(res))

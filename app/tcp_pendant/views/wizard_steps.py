@@ -1,0 +1,180 @@
+"""The step panel of the open wizard (viser GUI): "Step k of n", a progress bar, the step's
+instruction, the list of steps, Record / Back / Next (Finish) / Cancel, the tool change a step
+asks for, the variant choice (three-point, ABC world), "Add point" and the live pose-diversity
+meter (4-point), and in training mode the Auto-touch controls.
+
+Record is enabled only when the wizard can record (``Wizard.can_record``); Next only when the
+step is recorded. The pose-diversity meter is updated on every move of the robot (a motion
+listener of the session) with ``Xyz4Wizard.preview`` of the current flange pose: the TCP
+uncertainty tcpcal predicts if the user recorded here.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+from tcp_pendant.calibrate import AUTO_SIGMA_MAX_MM, AutoTouchRequest
+from tcp_pendant.calibrate.text import meter_level, meter_markdown, step_markdown, steps_list_markdown
+from tcp_pendant.views.gui_util import set_content
+from tcp_pendant.wizards import AbcWorldWizard, ThreePointWizard, Xyz4Wizard
+
+if TYPE_CHECKING:
+    from tcp_pendant.views.wizard_menu import CalibrateView
+
+__all__ = ["ABC_VARIANTS", "RANDOM", "THREE_POINT_VARIANTS", "WizardStepsView"]
+
+THREE_POINT_VARIANTS = {"Variant 1: tip on the +Y axis": 1, "Variant 2: tip in the +Y half-plane": 2}
+ABC_VARIANTS = {"6D: X down, Y along WORLD Y": "6d", "5D: tool X down only": "5d"}
+RANDOM, CHOSEN = "random", "chosen (tilt, azimuth)"
+
+
+class WizardStepsView:
+    """Builds the step panel in the current GUI container (see the module docstring)."""
+
+    def __init__(self, parent: CalibrateView) -> None:
+        self.parent = parent
+        gui = parent.session.target.gui
+        self.folder = gui.add_folder("Wizard", visible=False)
+        with self.folder:
+            self.head_md = gui.add_markdown("")
+            self.progress = gui.add_progress_bar(0.0, color="blue")
+            self.steps_md = gui.add_markdown("")
+            self.variant = gui.add_dropdown("Variant", tuple(THREE_POINT_VARIANTS), visible=False)
+            self.blocked_md = gui.add_markdown("", visible=False)
+            self.mount = gui.add_button("Mount the tool", color="orange", visible=False,
+                                        hint="The tool change this step asks for (the app swaps the tool).")
+            self.record = gui.add_button("Record", color="green", hint="Store the current flange pose for this step.")
+            self.next = gui.add_button("Next", color="blue")
+            self.back = gui.add_button("Back", color="gray")
+            self.add_point = gui.add_button("Add point", visible=False,
+                                            hint="One more touch (up to 20): more touches, smaller error.")
+            self.cancel = gui.add_button("Cancel", color="red",
+                                         hint="Leave the wizard; nothing recorded is lost, Resume brings it back.")
+            self.meter_bar = gui.add_progress_bar(0.0, color="gray", visible=False)
+            self.meter_md = gui.add_markdown("", visible=False)
+            self.auto_folder = gui.add_folder("Auto-touch (training)", expand_by_default=True)
+            with self.auto_folder:
+                self.auto_direction = gui.add_dropdown("Direction", (RANDOM, CHOSEN), initial_value=RANDOM)
+                self.auto_tilt = gui.add_slider("Tilt (deg)", min=0.0, max=60.0, step=1.0, initial_value=35.0,
+                                                visible=False)
+                self.auto_azimuth = gui.add_slider("Azimuth (deg)", min=0.0, max=355.0, step=5.0,
+                                                   initial_value=0.0, visible=False)
+                self.auto_sigma = gui.add_slider("Operator error σ (mm)", min=0.0, max=AUTO_SIGMA_MAX_MM,
+                                                 step=0.05, initial_value=0.0)
+                self.auto_touch = gui.add_button("Auto-touch", color="violet",
+                                                 hint="The robot performs this step itself, with the operator error σ.")
+        act = parent.action
+        self.record.on_click(act(lambda _e: parent.workflow.record()))
+        self.next.on_click(act(lambda _e: parent.workflow.next()))
+        self.back.on_click(act(lambda _e: parent.workflow.back()))
+        self.cancel.on_click(act(self._on_cancel))
+        self.add_point.on_click(act(self._on_add_point))
+        self.mount.on_click(act(lambda _e: parent.workflow.mount_required_tool()))
+        self.variant.on_update(act(self._on_variant, user_only=True))
+        self.auto_direction.on_update(act(lambda _e: None, user_only=True))
+        self.auto_touch.on_click(act(self._on_auto_touch))
+
+    # ------------------------------------------------------------ callbacks
+    def _on_cancel(self, _event: Any) -> None:
+        wf = self.parent.workflow
+        finished = wf.result is not None
+        wf.cancel()
+        if not finished:
+            self.parent.session.notify("Calibration cancelled",
+                                       "Nothing recorded is lost: Resume it from the Calibrate menu.")
+
+    def _on_add_point(self, _event: Any) -> None:
+        wiz = self.parent.workflow.wizard
+        if not isinstance(wiz, Xyz4Wizard):
+            raise ValueError("Add point is for the XYZ 4-point wizard.")
+        wiz.add_point()
+
+    def _on_variant(self, event: Any) -> None:
+        wiz = self.parent.workflow.wizard
+        label = str(event.target.value)
+        if isinstance(wiz, ThreePointWizard) and label in THREE_POINT_VARIANTS:
+            wiz.set_variant(THREE_POINT_VARIANTS[label])  # type: ignore[arg-type]
+        elif isinstance(wiz, AbcWorldWizard) and label in ABC_VARIANTS:
+            wiz.set_variant(ABC_VARIANTS[label])  # type: ignore[arg-type]
+        else:
+            raise ValueError(f"Unknown variant {label!r}.")
+
+    def auto_request(self) -> AutoTouchRequest:
+        """The Auto-touch settings as a request (random or chosen direction, operator error)."""
+        sigma = float(self.auto_sigma.value)
+        if self.auto_direction.value == CHOSEN:
+            return AutoTouchRequest(float(self.auto_tilt.value), float(self.auto_azimuth.value), sigma)
+        return AutoTouchRequest(sigma_mm=sigma)
+
+    def _on_auto_touch(self, _event: Any) -> None:
+        out = self.parent.workflow.auto_touch(self.auto_request())
+        if not out.ok:
+            raise ValueError(out.message)
+
+    # ------------------------------------------------------------ render
+    def render(self) -> None:
+        """Show the open wizard's step (hide the panel when no wizard is open)."""
+        wf = self.parent.workflow
+        wiz = wf.wizard
+        self.folder.visible = wf.is_open
+        if wiz is None or not wf.is_open:
+            return
+        set_content(self.head_md, step_markdown(wiz))
+        self.progress.value = round(100.0 * wiz.progress, 1)
+        set_content(self.steps_md, steps_list_markdown(wiz))
+        self._render_variant(wiz)
+        needed = wf.required_tool()
+        reason = wiz.blocked_reason if not wiz.is_complete else None
+        self.blocked_md.visible = reason is not None
+        if reason is not None:
+            set_content(self.blocked_md, f"⚠ {reason}")
+        self.mount.visible = needed is not None
+        if needed is not None:
+            self.mount.label = f"Mount the {needed.label.lower()}"
+        stepping = not wiz.is_complete           # on the result only Back, Add point and Close remain
+        self.record.visible = self.next.visible = stepping
+        self.record.disabled = not wiz.can_record
+        self.next.disabled = not wiz.can_next
+        self.next.label = "Finish" if wiz.on_last_step else "Next"
+        self.back.disabled = not wiz.can_back
+        self.cancel.label = "Cancel" if stepping else "Close (resume later)"
+        is_xyz4 = isinstance(wiz, Xyz4Wizard)
+        self.add_point.visible = is_xyz4
+        self.add_point.disabled = not (is_xyz4 and wiz.can_add_point)
+        self.auto_folder.visible = wf.training and stepping
+        chosen = self.auto_direction.value == CHOSEN
+        self.auto_tilt.visible = self.auto_azimuth.visible = chosen
+        self.update_meter()
+
+    def _render_variant(self, wiz: Any) -> None:
+        if isinstance(wiz, ThreePointWizard):
+            options, current = THREE_POINT_VARIANTS, wiz.variant
+        elif isinstance(wiz, AbcWorldWizard):
+            options, current = ABC_VARIANTS, wiz.variant
+        else:
+            self.variant.visible = False
+            return
+        labels = tuple(options)
+        label = next(k for k, v in options.items() if v == current)
+        with self.parent.quiet():                 # our own assignment: not a user's choice
+            if tuple(self.variant.options) != labels:
+                self.variant.options = labels
+            if self.variant.value != label:
+                self.variant.value = label
+        self.variant.visible = True
+        self.variant.disabled = wiz.status != "in_progress"
+
+    def update_meter(self) -> None:
+        """The live pose-diversity meter (4-point wizard, while a touch is to be recorded)."""
+        wf = self.parent.workflow
+        wiz = wf.wizard
+        show = isinstance(wiz, Xyz4Wizard) and wiz.status == "in_progress"
+        self.meter_bar.visible = self.meter_md.visible = show
+        if not show:
+            return
+        assert isinstance(wiz, Xyz4Wizard)
+        gain = wiz.preview(self.parent.session.controller.T_world_flange())
+        value, color = meter_level(gain)
+        self.meter_bar.value = round(value, 1)
+        self.meter_bar.color = color
+        set_content(self.meter_md, meter_markdown(gain, wiz.quality(), wiz.assumed_sigma_mm))

@@ -1,0 +1,35 @@
+"""Drive viser GUI handles from a test the way a browser's events arrive.
+
+A browser's click or edit reaches the server as a ``GuiEvent`` whose ``client`` is the
+browser's ``ClientHandle``; the views ignore events without a client (their own assignments).
+These helpers set the value the browser would send and call the handle's callbacks with such
+an event, in the calling thread (viser would use its thread pool).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from viser._gui_handles import GuiEvent, UploadedFile
+
+
+def _fire(handle: Any, client: Any) -> None:
+    for cb in list(handle._impl.update_cb):
+        cb(GuiEvent(client=client, client_id=getattr(client, "client_id", None), target=handle))
+
+
+def click(handle: Any, client: Any) -> None:
+    """A click on a button."""
+    _fire(handle, client)
+
+
+def choose(handle: Any, value: Any, client: Any) -> None:
+    """The browser sets a dropdown, slider, checkbox or text field to ``value``."""
+    handle._impl.value = type(handle._impl.value)(value)
+    _fire(handle, client)
+
+
+def upload(handle: Any, name: str, content: bytes, client: Any) -> None:
+    """A file uploaded through an upload button."""
+    handle._impl.value = UploadedFile(name, content)
+    _fire(handle, client)

@@ -1,0 +1,264 @@
+"""The Calibrate tab in a real viser server (in-process), with a headless websocket client as the
+browser: clicks and choices reach the views as browser events do (``guiclick``)."""
+
+from __future__ import annotations
+
+import json
+import sys
+import time
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+from tcpcal.library import ToolLibrary
+from tcpcal.origin import solve_xyz4
+from tcp_pendant.calibrate import error_bars
+from tcp_pendant.server import AppConfig, PendantApp
+from tcp_pendant.views.wizard_menu import CalibrateView
+from tcp_pendant.wizards import ESTIMATOR_LABELS
+
+HERE = Path(__file__).parent
+sys.path.insert(0, str(HERE.parent / "app"))
+sys.path.insert(0, str(HERE))
+from calib_helpers import library_tool_with_true_tcp, true_frame  # noqa: E402
+from guiclick import choose, click, upload  # noqa: E402
+from wsclient import DrainingClient  # noqa: E402
+
+
+def wait_until(cond: Callable[[], bool], timeout: float = 20.0, what: str = "condition") -> None:
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if cond():
+            return
+        time.sleep(0.01)
+    raise AssertionError(f"timed out waiting for {what}")
+
+
+class Page:
+    """One connected browser: its session, Calibrate view and client."""
+
+    def __init__(self, app: PendantApp) -> None:
+        n = len(app.sessions)
+        self.ws = DrainingClient(app.port)
+        wait_until(lambda: len(app.sessions) > n, what="session built")
+        self.session = list(app.sessions.values())[-1]
+        self.view: CalibrateView = self.session.views["calibrate"]
+        self.client = self.session.client
+        self.notes: list[tuple[str, str]] = []
+        self.session.notify = lambda title, body, kind="info": self.notes.append((title, body))  # type: ignore[method-assign]
+
+    def click(self, handle: Any) -> None:
+        click(handle, self.client)
+
+    def choose(self, handle: Any, value: Any) -> None:
+        choose(handle, value, self.client)
+
+
+@pytest.fixture
+def page(tmp_path: Path) -> Iterator[Callable[..., Page]]:
+    apps: list[PendantApp] = []
+    pages: list[Page] = []
+
+    def make(tool: str = "pointer") -> Page:
+        import socket
+
+        with socket.socket() as s:
+            s.bind(("127.0.0.1", 0))
+            port = s.getsockname()[1]
+        app = PendantApp(AppConfig(port=port, tool=tool, tool_library=tmp_path / "tools.json", library_poll_s=0.1))
+        app.start()
+        apps.append(app)
+        p = Page(app)
+        p.view.workflow.rng = np.random.default_rng(5)
+        pages.append(p)
+        return p
+
+    yield make
+    for p in pages:
+        p.ws.close()
+    for a in apps:
+        a.stop()
+
+
+def test_four_auto_touches_run_a_4point_calibration_and_every_view_follows(page) -> None:
+    p = page()
+    v, s = p.view, p.session
+    assert v.menu_folder.visible and not v.steps.folder.visible and not v.result.folder.visible
+    p.click(v.start)
+    assert not v.menu_folder.visible and v.steps.folder.visible             # the wizard alone
+    assert v.steps.record.disabled is False and v.steps.next.disabled is True
+    assert v.steps.meter_bar.visible and "Pose diversity" in v.steps.meter_md.content
+    progress = [v.steps.progress.value]
+    for k in range(4):
+        assert f"Step {k + 1} of 4" in v.steps.head_md.content
+        assert v.steps.next.label == ("Finish" if k == 3 else "Next")
+        p.click(v.steps.auto_touch)
+        progress.append(v.steps.progress.value)
+    assert progress == pytest.approx([0.0, 20.0, 40.0, 60.0, 100.0])
+    res = v.workflow.result
+    assert v.result.folder.visible and not v.steps.record.visible and not v.steps.meter_bar.visible
+    assert v.steps.cancel.label == "Close (resume later)"
+    tcp_true, _, _ = true_frame("pointer")
+    assert f"X {tcp_true[0]:.2f} · Y {tcp_true[1]:.2f} · Z {tcp_true[2]:.2f} mm" in v.result.result_md.content.replace("-0.00", "0.00")
+    assert "Against the true TOOL frame: good" in v.result.truth_md.content and v.result.truth_md.visible
+    # chart: the bars of this result
+    expected = error_bars([i + 1 for i in res.used_indices], res.per_touch_error_mm)
+    for got, want in zip(v.result.chart.data, expected.columns):
+        np.testing.assert_allclose(got, want)
+    # scene: sphere at r with radius |t|; both triads at T_world_flange @ T_flange_tool
+    assert v.scene.sphere.visible
+    np.testing.assert_allclose(v.scene.sphere.position, np.asarray(res.sphere_centre_mm) / 1000, atol=1e-9)
+    assert float(np.atleast_1d(v.scene.sphere.scale)[0]) == pytest.approx(res.sphere_radius_mm / 1000)
+    T_wt = s.controller.T_world_flange() @ s.controller.mounted_tool.T_flange_tcp_true
+    np.testing.assert_allclose(v.scene.computed.position, T_wt[:3, 3], atol=1e-9)
+    np.testing.assert_allclose(v.scene.true_tool.position, T_wt[:3, 3], atol=1e-9)
+    assert v.scene.computed.visible and v.scene.true_tool.visible and v.scene.true_label.visible
+    # the triads ride with the flange on a jog
+    with s.lock:
+        s.controller.jog_joint(0, 5.0)
+        s.moved()
+    T_wt = s.controller.T_world_flange() @ s.controller.mounted_tool.T_flange_tcp_true
+    np.testing.assert_allclose(v.scene.computed.position, T_wt[:3, 3], atol=1e-9)
+
+    # training mode off: truth, ghost triad and auto-touch go away
+    p.choose(v.training, False)
+    assert not v.result.truth_md.visible and not v.scene.true_tool.visible and not v.scene.true_label.visible
+    assert v.scene.computed.visible
+
+    # save: name echoed in the preview, saved, active in the Tool tab
+    p.choose(v.result.save_name, "Pen 4P")
+    assert v.result.save_preview.content.startswith("Will save **Pen 4P** · X 0.00 Y 0.00 Z 180.00 mm")
+    p.click(v.result.save)
+    assert "Saved **Pen 4P** in slot 1" in v.result.save_md.content
+    assert s.active_slot == 1 and s.controller.active_tool.name == "Pen 4P"
+    assert "Active tool:** Pen 4P (slot 1)" in s.views["tools"].active_md.content
+    assert ToolLibrary(s.library.path).active_slot() == 1
+
+    # close: the menu is back with the run waiting to be resumed
+    p.click(v.steps.cancel)
+    assert v.menu_folder.visible and v.resume.visible and not v.scene.computed.visible
+    assert v.resume_list.value.startswith("1: XYZ 4-point, 4 of 4 recorded")
+    p.click(v.resume)
+    assert v.workflow.result is res and v.result.folder.visible
+
+
+def test_reference_wizard_disables_record_until_the_tool_change(page) -> None:
+    p = page()
+    v, s = p.view, p.session
+    s.library.save(1, library_tool_with_true_tcp("pointer", "Pointer"))
+    s.views["tools"].reload()                         # as the server's library watcher does
+    assert v.library_tool.options == ("1: Pointer",)
+    p.choose(v.method, "XYZ reference")
+    assert v.library_tool.visible and v.new_physical.visible and not v.n_points.visible
+    p.choose(v.new_physical, "Welding torch (bent neck)")
+    assert "touch 2 with the *welding torch (bent neck)*" in v.menu_md.content
+    p.click(v.start)
+    assert s.active_slot == 1 and "Active tool:** Pointer (slot 1)" in s.views["tools"].active_md.content
+    p.click(v.steps.auto_touch)
+    assert v.steps.record.disabled and v.steps.mount.visible
+    assert v.steps.mount.label == "Mount the welding torch (bent neck)"
+    assert "Mount the tool 'torch' first" in v.steps.blocked_md.content
+    p.click(v.steps.mount)
+    assert s.controller.mounted_tool.key == "torch"
+    assert s.views["tools"].mounted.value == "Welding torch (bent neck)"     # the Tool tab follows
+    assert not v.steps.record.disabled and not v.steps.mount.visible
+    p.click(v.steps.record)                           # a real Record, wherever the tip is now
+    p.click(v.steps.next)
+    assert v.workflow.result is not None and v.result.folder.visible
+
+
+def test_outliers_are_marked_and_can_be_dropped_and_estimators_compared(page) -> None:
+    p = page()
+    v, s = p.view, p.session
+    p.choose(v.n_points, 8)
+    p.click(v.start)
+    p.choose(v.steps.auto_sigma, 0.1)                 # a careful operator: 0.1 mm per axis
+    assert v.steps.auto_request().sigma_mm == pytest.approx(0.1)
+    for _ in range(7):
+        p.click(v.steps.auto_touch)
+    # touch 8: a careless one, 5 mm off the reference tip
+    with s.lock:
+        assert s.controller.auto_approach(tilt_deg=40.0, azimuth_deg=200.0, tip_offset_tool_mm=(0.0, 5.0, 0.0)).ok
+        s.moved()
+    p.click(v.steps.record)
+    p.click(v.steps.next)
+    res = v.workflow.result
+    assert res.outliers == (7,) and not v.result.drop.disabled
+    assert v.result.chart.data[2].max() == pytest.approx(res.per_touch_error_mm[7])   # red series
+    p.click(v.result.drop)
+    res2 = v.workflow.result
+    assert res2.excluded == (7,) and res2.outliers == ()
+    poses = [v.workflow.wizard.recorded_poses[i].T_world_flange_m for i in range(7)]
+    alone = solve_xyz4(np.array([T[:3, :3] for T in poses]), np.array([T[:3, 3] for T in poses]) * 1000.0)
+    np.testing.assert_allclose(res2.tcp_mm, alone.tcp, atol=1e-9)           # = the 7 good touches alone
+    assert np.linalg.norm(np.asarray(res2.tcp_mm) - true_frame("pointer")[0]) < \
+        np.linalg.norm(np.asarray(res.tcp_mm) - true_frame("pointer")[0])
+    assert not v.result.restore.disabled
+    p.choose(v.result.estimator, ESTIMATOR_LABELS["sphere"])
+    assert v.workflow.result.estimator == "sphere" and v.workflow.result.method == "xyz4-sphere"
+    p.choose(v.result.compare, True)
+    assert v.result.compare_md.visible and v.result.compare_md.content.count("\n| ") == 3
+    assert "best-fit sphere (4P-1a) ◀ reported" in v.result.compare_md.content
+
+
+def test_meter_follows_the_jog(page) -> None:
+    p = page()
+    v, s = p.view, p.session
+    p.click(v.start)
+    p.click(v.steps.auto_touch)
+    assert "Too close" in v.steps.meter_md.content and v.steps.meter_bar.color == "red"
+    with s.lock:
+        assert s.controller.auto_approach(tilt_deg=45.0, azimuth_deg=180.0, tip_offset_tool_mm=(-30.0, 0, 0)).ok
+        s.moved()                                     # the motion listener updates the meter
+    assert "Too close" not in v.steps.meter_md.content and v.steps.meter_bar.color != "red"
+
+
+def test_session_export_and_load_through_the_gui(page) -> None:
+    p = page()
+    v = p.view
+    sent: list[tuple[str, bytes]] = []
+    p.client.send_file_download = lambda name, data, *a, **k: sent.append((name, data))  # type: ignore[method-assign]
+    p.click(v.start)
+    for _ in range(4):
+        p.click(v.steps.auto_touch)
+    p.click(v.export)
+    ((name, data),) = sent
+    record = json.loads(data)
+    assert name == "tcp-pendant-session.json" and record["format"] == "tcp-pendant-session"
+    assert record["wizards"][0]["truth"]["grade"] == "good"
+    # load it in another browser: replayed, graded, shown
+    q = page()
+    upload(q.view.load, "session.json", data, q.client)
+    assert "replayed result matches the record" in q.view.record_md.content
+    np.testing.assert_allclose(q.view.workflow.result.tcp_mm, v.workflow.result.tcp_mm, atol=1e-9)
+    assert q.view.result.folder.visible
+    # a broken file: one clear notification, nothing changed
+    runs = len(q.view.workflow.runs)
+    upload(q.view.load, "bad.json", b"\xff\xfe not json", q.client)
+    upload(q.view.load, "other.json", b'{"format": "x"}', q.client)
+    assert len(q.view.workflow.runs) == runs
+    assert [t for t, _ in q.notes] == ["Not done", "Not done"]
+    assert "bad.json is not a text (JSON) file" in q.notes[0][1]
+    assert "Not a TCP Pendant session record" in q.notes[1][1]
+
+
+def test_orientation_wizards_need_a_library_tool(page) -> None:
+    p = page(tool="torch")
+    v, s = p.view, p.session
+    p.choose(v.method, "Three-point orientation")
+    assert v.start.disabled and "library is empty" in v.menu_md.content
+    s.library.save(2, library_tool_with_true_tcp("torch", "Torch"))
+    wait_until(lambda: v.library_tool.options == ("2: Torch",), what="the library watcher")  # saved "elsewhere"
+    assert not v.start.disabled and "orientation of **2: Torch**" in v.menu_md.content
+    p.click(v.start)
+    assert v.steps.variant.visible and v.steps.variant.value.startswith("Variant 1")
+    p.choose(v.steps.variant, "Variant 2: tip in the +Y half-plane")
+    assert v.workflow.wizard.variant == 2 and "+Y half-plane" in v.steps.steps_md.content
+    for _ in range(3):
+        p.click(v.steps.auto_touch)
+    _, _, abc_true = true_frame("torch")
+    np.testing.assert_allclose(v.workflow.result.abc_deg, abc_true, atol=1e-6)
+    assert v.result.save_name.value == "Torch"
