@@ -179,6 +179,8 @@ def test_outliers_are_marked_and_can_be_dropped_and_estimators_compared(page) ->
     assert v.steps.auto_request().sigma_mm == pytest.approx(0.1)
     for _ in range(7):
         p.click(v.steps.auto_touch)
+    assert v.steps.auto_md.content.startswith("Recorded touch 7 (tilt ")
+    assert v.steps.auto_md.content.endswith("Operator error σ 0.10 mm.")
     # touch 8: a careless one, 5 mm off the reference tip
     with s.lock:
         assert s.controller.auto_approach(tilt_deg=40.0, azimuth_deg=200.0, tip_offset_tool_mm=(0.0, 5.0, 0.0)).ok

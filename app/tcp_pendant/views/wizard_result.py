@@ -43,6 +43,18 @@ def slot_options(tools: dict[int, Any]) -> tuple[str, ...]:
                          for s in range(1, ToolLibrary.N_SLOTS + 1)))
 
 
+def _chart_series(*, has_outliers: bool) -> tuple[dict[str, Any], ...]:
+    """uPlot series of the error bars: touch number, errors (blue), outliers (red, shown only
+    when there are some), the mean (dashed); no point markers on the bar outlines."""
+    no_points = {"show": False}
+    return ({"label": "touch"},
+            {"label": "error (mm)", "stroke": "#3b6fd6", "fill": "rgba(59,111,214,0.55)", "width": 1,
+             "points": no_points},
+            {"label": "outlier (mm)", "stroke": "#d62020", "fill": "rgba(214,32,32,0.6)", "width": 1,
+             "points": no_points, "show": has_outliers},
+            {"label": "mean (mm)", "stroke": "#444444", "dash": (4.0, 4.0), "width": 1, "points": no_points})
+
+
 def _slot_of(option: str) -> int | None:
     head = str(option).split(":", 1)[0]
     return int(head) if head.isdigit() else None
@@ -61,11 +73,7 @@ class WizardResultView:
             self.warnings_md = gui.add_markdown("")
             bars = error_bars([1], [0.0])
             self.chart = gui.add_uplot(
-                bars.columns,
-                ({"label": "touch"},
-                 {"label": "error (mm)", "stroke": "#3b6fd6", "fill": "rgba(59,111,214,0.55)", "width": 1},
-                 {"label": "outlier (mm)", "stroke": "#d62020", "fill": "rgba(214,32,32,0.6)", "width": 1},
-                 {"label": "mean (mm)", "stroke": "#444444", "dash": (4.0, 4.0), "width": 1}),
+                bars.columns, _chart_series(has_outliers=False),
                 title="Error per touch (mm)", height=170, visible=False,
                 scales={"x": {"time": False}, "y": {"range": (0.0, 1.0)}},
                 axes=({"label": "touch"}, {"label": "mm"}),
@@ -156,6 +164,7 @@ class WizardResultView:
         bars = error_bars([i + 1 for i in res.used_indices], res.per_touch_error_mm,
                           [i + 1 for i in res.outliers])
         self.chart.data = bars.columns
+        self.chart.series = _chart_series(has_outliers=bool(res.outliers))
         top = float(np.max(res.per_touch_error_mm)) if res.per_touch_error_mm else 0.0
         self.chart.scales = {"x": {"time": False}, "y": {"range": (0.0, max(1.2 * top, 1e-3))}}
         self.drop.disabled = not res.outliers

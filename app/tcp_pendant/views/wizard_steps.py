@@ -63,6 +63,7 @@ class WizardStepsView:
                                                  step=0.05, initial_value=0.0)
                 self.auto_touch = gui.add_button("Auto-touch", color="violet",
                                                  hint="The robot performs this step itself, with the operator error σ.")
+                self.auto_md = gui.add_markdown("")
         act = parent.action
         self.record.on_click(act(lambda _e: parent.workflow.record()))
         self.next.on_click(act(lambda _e: parent.workflow.next()))
@@ -107,9 +108,11 @@ class WizardStepsView:
         return AutoTouchRequest(sigma_mm=sigma)
 
     def _on_auto_touch(self, _event: Any) -> None:
-        out = self.parent.workflow.auto_touch(self.auto_request())
+        request = self.auto_request()
+        out = self.parent.workflow.auto_touch(request)
         if not out.ok:
             raise ValueError(out.message)
+        set_content(self.auto_md, f"{out.message} Operator error σ {request.sigma_mm:.2f} mm.")
 
     # ------------------------------------------------------------ render
     def render(self) -> None:
