@@ -58,7 +58,7 @@ def sum_over_touches(a: np.ndarray) -> np.ndarray:
     numbers was measured 4x slower at N = 1000)."""
     n = a.shape[0]
     if n <= 64:
-        return a.sum(axis=0)
+        return np.add.reduce(a, axis=0)
     return (np.ones(n) @ a.reshape(n, -1)).reshape(a.shape[1:])
 
 
@@ -116,7 +116,8 @@ class Information:
 def information_from_sum(s: np.ndarray, n: int) -> Information:
     """:class:`Information` from ``S = sum_i R_i`` (3x3) and N: ``M = N I - S^T S / N``."""
     rbar = s / n
-    m = n * _EYE3 - s.T @ rbar
+    m = s.T @ rbar
+    np.subtract(_EYE3 * n, m, out=m)
     w, v = np.linalg.eigh(m)
     if w[0] < 0.0:  # rounding of a (numerically) singular M
         w = np.maximum(w, 0.0)
@@ -158,7 +159,8 @@ def ci_radius(cov_eigvals: np.ndarray, dof: float | None, confidence: float = CO
         The radius, in the length unit of the input.
     """
     # Three numbers: plain Python floats are several times faster than numpy calls here.
-    lam = [max(v, 0.0) for v in map(float, np.ravel(cov_eigvals))]  # max(nan, 0) stays nan
+    vals = cov_eigvals if isinstance(cov_eigvals, list) else np.ravel(cov_eigvals).tolist()
+    lam = [max(float(v), 0.0) for v in vals]  # max(nan, 0) stays nan
     s1 = sum(lam)
     if not math.isfinite(s1):
         return math.inf
@@ -262,7 +264,7 @@ def angle_extremes(rotations: np.ndarray, rotations_soa: np.ndarray | None = Non
             i += rows
     a, b = min(a, b), max(a, b)
     c, e = min(c, e), max(c, e)
-    v = x[[c, a, e, b]]
+    v = x.take((c, a, e, b), axis=0)
     d = v[:2] - v[2:]
     fro2_min, fro2_max = np.einsum("ij,ij->i", d, d).tolist()
     return AngleExtremes(

@@ -476,8 +476,9 @@ def _solve(rot: np.ndarray, y: np.ndarray | None, f: np.ndarray, method: str, si
     s_est = math.sqrt(sse / dof)
     noise = s_est if sigma is None else sigma
     if cov_unit is None:
-        cov = noise**2 * m_inv
-        cov_eig = [noise**2 / max(v, 1e-300) for v in info.eigvals.tolist()]
+        noise2 = noise * noise
+        cov = noise2 * m_inv
+        cov_eig = [noise2 / v for v in info.eigvals.tolist()]  # > 0: the touches are observable
     else:
         cov = noise**2 * cov_unit
         cov_eig = np.linalg.eigvalsh(cov)

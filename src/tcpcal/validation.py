@@ -32,6 +32,8 @@ ORTHONORMAL_TOL: float = 1e-6
 
 _EYE = np.eye(3)
 _EYE_COLUMN = _EYE[:, :, None]
+# ufunc reductions without the Python wrappers of ndarray.sum/max/min (the solvers' hot path)
+_add, _max, _min = np.add.reduce, np.maximum.reduce, np.minimum.reduce
 _CYCLIC = np.array([0, 1, 2, 0, 1])
 
 
@@ -94,14 +96,14 @@ def rotations_and_soa(x: Any, name: str = "rotations") -> tuple[np.ndarray, np.n
     if arr.shape[0] == 0:
         raise InvalidInputError(f"{name} is empty; pass at least one 3x3 rotation matrix.")
     n = arr.shape[0]
-    if not math.isfinite(float(arr.sum())):  # NaN/inf (or an overflow: then go on)
+    if not math.isfinite(float(_add(arr, axis=None))):  # NaN/inf (or an overflow: then go on)
         _raise_nonfinite(arr, name)
     y = None
     if n <= SMALL_STACK:
         gram = arr.transpose(0, 2, 1) @ arr  # R^T R
         gram -= _EYE
         np.abs(gram, out=gram)
-        if not float(gram.max()) <= ORTHONORMAL_TOL:
+        if not float(_max(gram, axis=None)) <= ORTHONORMAL_TOL:
             _raise_first_bad(arr, gram.reshape(n, 9).max(axis=1), name)
         det = np.linalg.det(arr)
     else:
@@ -116,7 +118,7 @@ def rotations_and_soa(x: Any, name: str = "rotations") -> tuple[np.ndarray, np.n
         # Orthonormal => det = +-1 = sum_j c0_j (c1 x c2)_j (np.linalg.det: ~0.1 us per matrix)
         yc = y[_CYCLIC]  # rows j, j+1, j+2 (mod 3) for the cross products
         det = (yc[0:3, 0] * (yc[1:4, 1] * yc[2:5, 2] - yc[2:5, 1] * yc[1:4, 2])).sum(axis=0)
-    if float(det.min()) < 0.0:
+    if float(_min(det)) < 0.0:
         i = int(np.argmax(det < 0.0))
         raise InvalidInputError(
             f"{name}[{i}] is a reflection (determinant {det[i]:.6g}), not a rotation; a proper "
@@ -205,7 +207,7 @@ def as_positions(x: Any, n: int | None = None, name: str = "positions") -> np.nd
         )
     # one reduction: the sum is finite unless an entry is NaN/inf (or the sum overflows, which
     # the exact look-up below then clears)
-    i = None if math.isfinite(float(arr.sum())) else _first_nonfinite(arr)
+    i = None if math.isfinite(float(_add(arr, axis=None))) else _first_nonfinite(arr)
     if i is not None:
         raise InvalidInputError(
             f"{name}[{i}] contains NaN or inf; every coordinate must be a finite number "
