@@ -5,15 +5,18 @@ exporting it to KUKA text. Screenshots go to the test's tmp_path."""
 from __future__ import annotations
 
 import re
+import sys
 import time
+from pathlib import Path
 
 import pytest
 
 from tcpcal.library import ToolLibrary
 
-pytestmark = pytest.mark.browser
+sys.path.insert(0, str(Path(__file__).parent))
+from pendant_page import TIMEOUT_MS, field  # noqa: E402
 
-TIMEOUT_MS = 60_000
+pytestmark = pytest.mark.browser
 
 
 def readout(page) -> str:
@@ -49,12 +52,6 @@ def wait_numbers(page, pred, what: str) -> dict[str, float]:
             return last
         page.wait_for_timeout(100)
     raise AssertionError(f"readout never showed {what}; last: {last}")
-
-
-def field(page, label: str):
-    """The input (or textarea) of a viser GUI row by its exact label."""
-    row = page.locator(".mantine-Flex-root").filter(has=page.locator(f"label:text-is('{label}')"))
-    return row.locator("input, textarea").first
 
 
 def entry_preview(page) -> str:
