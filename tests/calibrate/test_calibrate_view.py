@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
 
 from tcpcal.library import ToolLibrary
 from tcpcal.origin import solve_xyz4
@@ -264,3 +265,46 @@ def test_orientation_wizards_need_a_library_tool(page) -> None:
     _, _, abc_true = true_frame("torch")
     np.testing.assert_allclose(v.workflow.result.abc_deg, abc_true, atol=1e-6)
     assert v.result.save_name.value == "Torch"
+
+
+def test_abc_world_shows_the_world_aligned_target_at_the_tcp(page) -> None:
+    p = page(tool="torch")
+    v, s = p.view, p.session
+    s.library.save(1, library_tool_with_true_tcp("torch", "Torch"))
+    s.views["tools"].reload()
+    p.choose(v.method, "ABC world (parallel axes)")
+    assert not v.scene.abc_target.visible
+    p.click(v.start)
+    assert v.scene.abc_target.visible and v.scene.abc_label.visible
+    # (PA-1): tool X down, Y along WORLD Y, Z along WORLD X, at the TCP of the library data
+    R_target = np.array([[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]])
+    q = np.asarray(v.scene.abc_target.wxyz)
+    R_shown = Rotation.from_quat([q[1], q[2], q[3], q[0]]).as_matrix()
+    np.testing.assert_allclose(R_shown, R_target, atol=1e-9)
+    tcp_m = s.controller.T_world_flange() @ np.r_[true_frame("torch")[0] / 1000.0, 1.0]
+    np.testing.assert_allclose(v.scene.abc_target.position, tcp_m[:3], atol=1e-9)
+    with s.lock:                                      # it follows the TCP while jogging
+        s.controller.jog_joint(0, -4.0)
+        s.moved()
+    tcp_m = s.controller.T_world_flange() @ np.r_[true_frame("torch")[0] / 1000.0, 1.0]
+    np.testing.assert_allclose(v.scene.abc_target.position, tcp_m[:3], atol=1e-9)
+    p.click(v.steps.auto_touch)
+    assert v.workflow.result is not None and not v.scene.abc_target.visible
+
+
+def test_closing_the_page_loses_nothing_saved(page) -> None:
+    p = page()
+    v, s = p.view, p.session
+    p.click(v.start)
+    for _ in range(4):
+        p.click(v.steps.auto_touch)
+    p.choose(v.result.save_name, "Kept")
+    p.click(v.result.save)
+    before = s.library.path.read_bytes()
+    p.click(v.steps.cancel)                           # closed the result, then started another one
+    p.click(v.start)
+    p.click(v.steps.auto_touch)
+    p.ws.close()                                      # the browser goes away mid-session
+    wait_until(lambda: s.closed, what="session closed")
+    assert s.library.path.read_bytes() == before
+    assert ToolLibrary(s.library.path).get(1).name == "Kept"
