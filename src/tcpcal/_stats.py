@@ -247,8 +247,10 @@ def angle_extremes(rotations: np.ndarray, rotations_soa: np.ndarray | None = Non
             rows = min(max(_GRAM_BLOCK_ENTRIES // cols, 1), cols)
             blk = x[i : i + rows] @ xt[:, i:]
             diag = blk.ravel()[: rows * (cols + 1) : cols + 1]  # the pairs (i + k, i + k)
-            diag[:] = np.inf
-            k = int(blk.argmin())
+            k = int(blk.argmin())  # the diagonal (trace 3, the largest) only wins a tie
+            if k % (cols + 1) == 0:  # ... of identical orientations: look again without it
+                diag[:] = np.inf
+                k = int(blk.argmin())
             v = blk.item(k)
             if v < lo:
                 lo = v
