@@ -190,7 +190,7 @@ def _rotation_from_row(layout: str, v: np.ndarray, where: str, index: int) -> np
             raise _error(f"{where}: quaternion qw,qx,qy,qz has norm {norm:.9g}, not 1 within "
                          f"{ORTHONORMAL_TOL:g}; check the column order and print more digits",
                          index=index)
-        return Rotation.from_quat(v, scalar_first=True).as_matrix()
+        return Rotation.from_quat(v[[1, 2, 3, 0]]).as_matrix()  # scipy order x, y, z, w (any scipy)
     if layout == "matrix":
         m = v.reshape(3, 3)
         defect = float(np.max(np.abs(m.T @ m - np.eye(3))))
