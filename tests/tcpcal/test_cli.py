@@ -451,3 +451,15 @@ def test_every_solve_json_has_the_keys_of_issue_2(tmp_path: Path,
         assert d["residuals_mm"] == [] and d["outliers"] == [] and d["ci95_mm"] is None
     assert outputs["three-point"]["tcp_mm"] == [-20.0, 5.5, 210.0]
     assert outputs["abc-world"]["tcp_mm"] is None
+
+
+def test_duplicated_pose_error_names_file_line_and_row(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Five rows but only three orientations (rows 4 and 5 repeat rows 2 and 1): exit 2, one
+    line naming the file, the file line and data row of the first repeat, and what to do."""
+    rots, pos = xyz4_poses(3)
+    p = write_csv(tmp_path / "dup.csv", [rots[0], rots[1], rots[2], rots[1], rots[0]],
+                  [pos[0], pos[1], pos[2], pos[1], pos[0]])
+    assert_one_error_line(*run(["solve", "xyz4", str(p)], capsys),
+                          "dup.csv", r"line 5 \(data row 4\)", "same orientation",
+                          "at least 4", "re-record")
