@@ -58,6 +58,8 @@ COPLANAR_RATIO = 0.2
 """Sphere fit: warn when the flange positions' thickness / extent is below this."""
 _EXACT_REL = 1e-9
 """Residual noise below this fraction of the data scale counts as exact data (no outlier test)."""
+_EXACT_RESIDUAL_SHARE = 1e-12
+"""Outlier test: the other touches fit exactly when ``SSE - Q_i <= this * SSE`` (rounding)."""
 
 
 def _frozen(a: np.ndarray) -> np.ndarray:
@@ -327,19 +329,21 @@ def _find_outliers(rotations: np.ndarray, y: np.ndarray, f: np.ndarray,
         quad, det = _deleted_residual_statistics(y_now, info, fit.e)
         dof = 3 * n - 9
         k = -1
+        # The other touches fit exactly when SSE - Q_i vanishes (to rounding): then T_i is
+        # infinite, touch i alone carries all the error and is flagged (e.g. one careless touch
+        # among exact ones, as a training robot's auto-touches are).
+        exact_rest = _EXACT_RESIDUAL_SHARE * sse
         if float(det.min()) > 1e-9:  # every touch testable (the usual case)
             q = quad / det
             k = int(q.argmax())
             q_k = float(q[k])
-            if q_k < sse:
-                t_k = q_k / (3.0 * ((sse - q_k) / dof))
-            else:
-                k = -1
-        if k < 0:
+            t_k = q_k / (3.0 * ((sse - q_k) / dof)) if sse - q_k > exact_rest else math.inf
+        else:
             testable = det > 1e-9
             q = np.where(testable, quad / np.where(testable, det, 1.0), 0.0)
-            s2 = (sse - q) / dof
-            tstat = np.where(testable & (s2 > 0), q / (3.0 * np.maximum(s2, 1e-300)), 0.0)
+            rest = sse - q
+            tstat = np.where(testable & (rest > exact_rest), q / (3.0 * np.maximum(rest, 1e-300) / dof),
+                             np.where(testable & (q > 0.0), math.inf, 0.0))
             k = int(np.argmax(tstat))
             t_k = float(tstat[k])
         p = float(fdtrc(3, dof, t_k))

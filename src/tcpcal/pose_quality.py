@@ -256,7 +256,7 @@ def candidate_gain(
         nearest = math.inf
     too_close = nearest < min_angle_deg
     if too_close:
-        msg = (f"Too close to touch {k} ({nearest:.1f} deg apart, want >= {min_angle_deg:g}): "
+        msg = (f"Too close to touch {k} (0-based; {nearest:.1f} deg apart, want >= {min_angle_deg:g}): "
                "tilt further before recording.")
     elif math.isinf(b) and math.isfinite(a):
         msg = f"Recording here makes the TCP determinable (predicted RMS {a:.2f})."

@@ -86,3 +86,23 @@ def test_detect_outliers_off() -> None:
     rot, pos, *_ = make_touches(rng, 8, sigma=0.2)
     pos[5] += 5.0
     assert solve_xyz4(rot, pos, detect_outliers=False).outliers == ()
+
+
+@pytest.mark.parametrize("method", ["lstsq", "sphere", "pairwise"])
+@pytest.mark.parametrize("n", [5, 8, 12])
+def test_one_careless_touch_among_exact_ones_is_flagged(method: str, n: int) -> None:
+    """Noise-free touches (a training robot's auto-touches) and one touch 5 mm off: the others
+    fit exactly, so the deleted statistic of the bad touch is infinite - it must be flagged, and
+    the result without it is the exact TCP."""
+    rng = np.random.default_rng(40 + n)
+    rot, pos, tcp, _ref = make_touches(rng, n, tilt_deg=(30, 60), sigma=0.0)
+    bad = n - 1
+    pos[bad] += _offset(rng, 5.0)
+    res = solve_xyz4(rot, pos, method=method)
+    assert res.outliers == (bad,)
+    np.testing.assert_allclose(res.without_outliers.tcp, tcp, atol=1e-9)
+
+
+def test_exact_touches_flag_nothing() -> None:
+    rot, pos, _tcp, _ref = make_touches(np.random.default_rng(3), 8, tilt_deg=(30, 60), sigma=0.0)
+    assert solve_xyz4(rot, pos).outliers == ()
