@@ -48,7 +48,7 @@ def write_csv(path: Path, rotations: list[np.ndarray], positions: list[np.ndarra
         ori = [r.reshape(-1) for r in rotations]
     elif layout == "abb":
         head = "x,y,z,qw,qx,qy,qz"
-        ori = [Rotation.from_matrix(r).as_quat(scalar_first=True) for r in rotations]
+        ori = [np.roll(Rotation.from_matrix(r).as_quat(), 1) for r in rotations]   # (w, x, y, z), any scipy
     else:
         raise ValueError(layout)
     rows = [",".join(repr(float(v)) for v in (*p, *o)) for p, o in zip(positions, ori)]
