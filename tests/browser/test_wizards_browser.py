@@ -168,16 +168,24 @@ def test_reference_wizard_swaps_the_tool_and_saves(pendant_server, new_page, sho
     assert saved.get(1).name == "Pointer"                      # nothing else touched
 
 
-@pytest.mark.parametrize("variant", [1, 2])
-def test_three_point_wizard_calibrates_the_orientation(pendant_server, new_page, shot, tmp_path, variant) -> None:
-    tcp_true, abc_true = truth("torch")
+def start_torch_orientation(pendant_server, new_page, tmp_path: Path, method: str, n_steps: int):
+    """The torch mounted, its TCP calibrated in slot 1 (orientation not yet), ``method`` started.
+    Returns (server, page)."""
+    tcp_true, _ = truth("torch")
     seed_library(tmp_path / "tools.json", Tool(name="Torch", tcp_mm=tuple(tcp_true)))
     server = pendant_server("--tool", "torch")
     page = new_page(server.url)
     open_calibrate(page)
-    choose(page, "Method", "Three-point orientation", "Calibrates the orientation of 1: Torch")
+    choose(page, "Method", method, "Calibrates the orientation of 1: Torch")
     press(page, "Start")
-    wait_text(page, "Step 1 of 3")
+    wait_text(page, f"Step 1 of {n_steps}")
+    return server, page
+
+
+@pytest.mark.parametrize("variant", [1, 2])
+def test_three_point_wizard_calibrates_the_orientation(pendant_server, new_page, shot, tmp_path, variant) -> None:
+    tcp_true, abc_true = truth("torch")
+    server, page = start_torch_orientation(pendant_server, new_page, tmp_path, "Three-point orientation", 3)
     if variant == 2:
         choose(page, "Variant", "Variant 2: tip in the +Y half-plane", "Tip in the tool's +Y half-plane")
     auto_touch_to_result(page, 3)
@@ -194,13 +202,7 @@ def test_three_point_wizard_calibrates_the_orientation(pendant_server, new_page,
 
 def test_abc_world_wizard_calibrates_the_orientation(pendant_server, new_page, shot, tmp_path) -> None:
     tcp_true, abc_true = truth("torch")
-    seed_library(tmp_path / "tools.json", Tool(name="Torch", tcp_mm=tuple(tcp_true)))
-    server = pendant_server("--tool", "torch")
-    page = new_page(server.url)
-    open_calibrate(page)
-    choose(page, "Method", "ABC world (parallel axes)", "Calibrates the orientation of 1: Torch")
-    press(page, "Start")
-    wait_text(page, "Step 1 of 1")
+    server, page = start_torch_orientation(pendant_server, new_page, tmp_path, "ABC world (parallel axes)", 1)
     assert_not_blank(shot(page, "abc_world_target"))           # the WORLD-aligned target triad
     press(page, "Auto-touch")
     wait_text(page, "Against the true TOOL frame: good")

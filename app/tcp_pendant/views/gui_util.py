@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
-__all__ = ["set_content", "set_options"]
+__all__ = ["number_of_option", "set_content", "set_options"]
 
 
 def set_content(handle: Any, text: str) -> None:
@@ -22,3 +22,10 @@ def set_options(handle: Any, options: tuple[str, ...], keep: str | None = None) 
     value = keep if keep in options else options[0]
     if handle.value != value:
         handle.value = value
+
+
+def number_of_option(option: str) -> int | None:
+    """The leading number of a dropdown option such as ``"3: Torch"`` (a library slot, a run),
+    or None for an option without one (``"(library empty)"``, ``"first free"``)."""
+    head = str(option).split(":", 1)[0]
+    return int(head) if head.isdigit() else None

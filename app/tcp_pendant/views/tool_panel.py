@@ -21,6 +21,7 @@ from tcp_pendant.controller import builtin_tools
 from tcp_pendant.pendant import FIELDS, ToolEntry, parse_tool_entry, tool_data_markdown
 from tcp_pendant.pendant.tool_entry import entry_preview_markdown
 from tcp_pendant.session import Session
+from tcp_pendant.views.gui_util import number_of_option
 
 __all__ = ["NO_TOOL", "ToolPanel"]
 
@@ -30,11 +31,6 @@ _FORMAT_LABELS = {"kuka": "KUKA", "abb": "ABB", "fanuc": "FANUC", "ur": "UR", "m
 
 def _slot_option(slot: int, tool: Tool) -> str:
     return f"{slot}: {tool.name}"
-
-
-def _slot_of(option: str) -> int | None:
-    head = str(option).split(":", 1)[0]
-    return int(head) if head.isdigit() else None
 
 
 class ToolPanel:
@@ -101,9 +97,9 @@ class ToolPanel:
         lib = self.session.library.tools()
         self._library = lib
         options = tuple(_slot_option(s, t) for s, t in sorted(lib.items())) or (NO_TOOL,)
-        current = _slot_of(self.slots.value)
+        current = number_of_option(self.slots.value)
         self.slots.options = options
-        pick = next((o for o in options if _slot_of(o) == current), options[0])
+        pick = next((o for o in options if number_of_option(o) == current), options[0])
         if self.slots.value != pick:
             self.slots.value = pick
         free = [str(s) for s in range(1, self.session.library.N_SLOTS + 1) if s not in lib]
@@ -121,14 +117,14 @@ class ToolPanel:
         self._reload_listeners.append(fn)
 
     def _selected(self) -> tuple[int, Tool]:
-        slot = _slot_of(self.slots.value)
+        slot = number_of_option(self.slots.value)
         tool = None if slot is None else self._library.get(slot)
         if slot is None or tool is None:
             raise ValueError("Select a tool of the library first (the library is empty?).")
         return slot, tool
 
     def _show_slot(self) -> None:
-        slot = _slot_of(self.slots.value)
+        slot = number_of_option(self.slots.value)
         tool = None if slot is None else self._library.get(slot)
         self.slot_md.content = "" if tool is None else tool_data_markdown(tool, slot).replace(
             "**Active tool:**", "**Selected:**")

@@ -30,7 +30,7 @@ from tcp_pendant.calibrate import WIZARD_KINDS, WIZARD_LABELS, CalibrationWorkfl
 from tcp_pendant.calibrate.text import METHOD_BLURBS, menu_markdown, replay_markdown
 from tcp_pendant.controller import builtin_robots
 from tcp_pendant.session import Session
-from tcp_pendant.views.gui_util import set_content, set_options
+from tcp_pendant.views.gui_util import number_of_option, set_content, set_options
 from tcp_pendant.views.wizard_result import WizardResultView
 from tcp_pendant.views.wizard_scene import WizardSceneView
 from tcp_pendant.views.wizard_steps import WizardStepsView
@@ -186,10 +186,10 @@ class CalibrateView:
         self.workflow.training = bool(event.target.value)
 
     def _selected_slot(self) -> int:
-        head = str(self.library_tool.value).split(":", 1)[0]
-        if not head.isdigit():
+        slot = number_of_option(self.library_tool.value)
+        if slot is None:
             raise ValueError("The tool library is empty: calibrate the TCP first (XYZ 4-point) and save it.")
-        return int(head)
+        return slot
 
     def _on_start(self, _event: Any) -> None:
         kind = _LABEL_TO_KIND.get(str(self.method.value))
@@ -214,10 +214,10 @@ class CalibrateView:
             raise ValueError(f"Unknown calibration method {self.method.value!r}.")
 
     def _on_resume(self, _event: Any) -> None:
-        head = str(self.resume_list.value).split(":", 1)[0]
-        if not head.isdigit():
+        number = number_of_option(self.resume_list.value)
+        if number is None:
             raise ValueError("There is no calibration to resume.")
-        self.workflow.resume(int(head) - 1)
+        self.workflow.resume(number - 1)
 
     def _on_export(self, _event: Any) -> None:
         data = dumps(self.workflow.export_record(self.session.touches)).encode("utf-8")

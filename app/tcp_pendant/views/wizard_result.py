@@ -26,7 +26,7 @@ from tcp_pendant.calibrate.text import (
     truth_markdown,
     warnings_markdown,
 )
-from tcp_pendant.views.gui_util import set_content, set_options
+from tcp_pendant.views.gui_util import number_of_option, set_content, set_options
 from tcp_pendant.wizards import ESTIMATOR_LABELS, Xyz4Result, Xyz4Wizard
 
 if TYPE_CHECKING:
@@ -53,11 +53,6 @@ def _chart_series(*, has_outliers: bool) -> tuple[dict[str, Any], ...]:
             {"label": "outlier (mm)", "stroke": "#d62020", "fill": "rgba(214,32,32,0.6)", "width": 1,
              "points": no_points, "show": has_outliers},
             {"label": "mean (mm)", "stroke": "#444444", "dash": (4.0, 4.0), "width": 1, "points": no_points})
-
-
-def _slot_of(option: str) -> int | None:
-    head = str(option).split(":", 1)[0]
-    return int(head) if head.isdigit() else None
 
 
 class WizardResultView:
@@ -121,7 +116,7 @@ class WizardResultView:
         self._xyz4().set_estimator(key)  # type: ignore[arg-type]
 
     def _on_save(self, _event: Any) -> None:
-        slot, tool = self.parent.workflow.save(str(self.save_name.value), _slot_of(self.save_slot.value))
+        slot, tool = self.parent.workflow.save(str(self.save_name.value), number_of_option(self.save_slot.value))
         self.parent.saved(slot, tool)
 
     # ------------------------------------------------------------ render
