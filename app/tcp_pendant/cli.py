@@ -17,7 +17,7 @@ import time
 from collections.abc import Sequence
 from pathlib import Path
 
-__all__ = ["build_parser", "main"]
+__all__ = ["build_parser", "main", "network_warning"]
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -46,18 +46,37 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
+def network_warning(host: str) -> str | None:
+    """The warning printed when ``host`` lets other machines connect (None for loopback)."""
+    from tcp_pendant.server import is_loopback
+
+    if is_loopback(host):
+        return None
+    return (f"WARNING: listening on {host}: anyone on the network who can reach this machine "
+            "can open the pendant and save tools to the library. Use --host 127.0.0.1 to keep it local.")
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Parse the options, start the server, print the URL and serve until Ctrl-C.
 
     Returns:
-        0 after a clean stop; 2 for bad options (with the message on stderr).
+        0 after a clean stop; 2 for bad options (with the message on stderr); 130 when
+        interrupted (Ctrl-C) before the server was ready.
     """
+    try:
+        return _main(argv)
+    except KeyboardInterrupt:               # Ctrl-C while loading the robot or starting
+        print("tcp-pendant: interrupted", file=sys.stderr)
+        return 130
+
+
+def _main(argv: Sequence[str] | None) -> int:
     t0 = time.perf_counter()
     args = build_parser().parse_args(argv)
     logging.basicConfig(level=logging.DEBUG if args.verbose else logging.WARNING,
                         format="%(levelname)s %(name)s: %(message)s")
     from tcp_pendant.controller import ControllerError
-    from tcp_pendant.server import AppConfig, PendantApp, is_loopback, parse_xyz_mm
+    from tcp_pendant.server import AppConfig, PendantApp, parse_xyz_mm
 
     if not 0 <= args.port <= 65535:
         print(f"tcp-pendant: error: --port must be 0..65535, got {args.port}", file=sys.stderr)
@@ -71,15 +90,17 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (ControllerError, ValueError, OSError) as exc:
         print(f"tcp-pendant: error: {exc}", file=sys.stderr)
         return 2
-    if not is_loopback(args.host):
-        print(f"WARNING: listening on {args.host}: anyone on the network who can reach this machine "
-              "can open the pendant and save tools to the library. Use --host 127.0.0.1 to keep it local.",
-              file=sys.stderr)
+    warning = network_warning(args.host)
+    if warning is not None:
+        print(warning, file=sys.stderr)
     try:
         url = app.start()
     except OSError as exc:
         print(f"tcp-pendant: error: cannot listen on {args.host}:{args.port}: {exc}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        app.stop()
+        raise
     mode = "one robot shared by every browser" if args.shared else "one robot per browser"
     tip_mm = ", ".join(f"{v:.0f}" for v in app.reference_tip_m * 1000.0)
     print(f"TCP Pendant ready in {time.perf_counter() - t0:.1f} s: {url}\n"

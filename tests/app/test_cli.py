@@ -33,3 +33,46 @@ def test_loopback_and_tip_parsing() -> None:
 def test_ready_pose_points_flange_down(kr6) -> None:
     q = ready_configuration(kr6)
     assert kr6.T_base_flange(q)[2, 2] == pytest.approx(-1.0, abs=1e-9)
+
+
+def test_network_warning_only_off_loopback() -> None:
+    from tcp_pendant.cli import network_warning
+
+    assert network_warning("127.0.0.1") is None and network_warning("localhost") is None
+    text = network_warning("0.0.0.0")
+    assert text is not None and "anyone on the network" in text and "0.0.0.0" in text
+
+
+def _serve(tmp_path, *args: str):
+    """Start ``python -m tcp_pendant`` on a free port; returns (process, the ready line)."""
+    import subprocess
+    import sys
+
+    proc = subprocess.Popen([sys.executable, "-m", "tcp_pendant", "--port", "0", "--tool-library",
+                             str(tmp_path / "tools.json"), *args],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    assert proc.stdout is not None
+    for line in proc.stdout:
+        if "ready" in line:
+            return proc, line
+    proc.wait(30)
+    raise AssertionError(f"no ready line; exit {proc.returncode}: {proc.stderr.read() if proc.stderr else ''}")
+
+
+@pytest.mark.parametrize("host,warned", [("127.0.0.1", False), ("0.0.0.0", True)])
+def test_command_serves_prints_the_url_and_stops_on_ctrl_c(tmp_path, host: str, warned: bool) -> None:
+    """The real command: prints the URL (which answers), warns off loopback, Ctrl-C stops it (0)."""
+    import re
+    import signal
+    import urllib.request
+
+    proc, line = _serve(tmp_path, "--host", host)
+    try:
+        url = re.search(r"http://\S+", line).group(0)
+        with urllib.request.urlopen(url.replace("0.0.0.0", "127.0.0.1"), timeout=10) as r:
+            assert r.status == 200
+    finally:
+        proc.send_signal(signal.SIGINT)
+        out, err = proc.communicate(timeout=30)
+    assert proc.returncode == 0, err
+    assert ("anyone on the network" in err) is warned

@@ -112,3 +112,28 @@ def test_joint_mode_syncs_only_the_slider_that_moved(app_factory) -> None:
             assert slider.value == pytest.approx(round(v, 2), abs=1e-9)
     finally:
         client.close()
+
+
+def test_shared_mode_one_browser_jogs_every_browser_sees_it(app_factory) -> None:
+    """--shared: one robot; a click in one browser moves it and the readout every browser
+    receives is the new one."""
+    app = app_factory(shared=True)
+    c1 = ButtonClient(app.port, (PLUS_X,), record_updates=True)
+    c2 = ButtonClient(app.port, (PLUS_X,), record_updates=True)
+    try:
+        assert c1.found.wait(30) and c2.found.wait(30)
+        s = app.shared_session
+        assert s is not None and app.sessions == {}
+        with s.lock:
+            s.jogger.settings = s.jogger.settings.with_(increment="10", frame="WORLD")
+            x0 = s.controller.T_world_tcp()[0, 3]
+        c1.click(PLUS_X)
+        wait_until(lambda: abs(s.controller.T_world_tcp()[0, 3] - x0 - 0.010) < 1e-8, what="X + 10 mm")
+        md = s.views["pendant"].tcp_md
+        uuid = md._impl.uuid
+        for c in (c1, c2):
+            wait_until(lambda c=c: c.gui_props.get(uuid, {}).get("_markdown") == md.content,
+                       what="the new readout in both browsers")
+    finally:
+        c1.close()
+        c2.close()

@@ -64,11 +64,16 @@ class ButtonClient(DrainingClient):
 
     Args:
         labels: button labels to look for; decoding stops once all are known.
+        record_updates: keep decoding and record the last value of every GUI property the
+            server sends (``gui_props[uuid][prop]``), e.g. a markdown's ``_markdown``.
     """
 
-    def __init__(self, port: int, labels: tuple[str, ...], host: str = "127.0.0.1") -> None:
+    def __init__(self, port: int, labels: tuple[str, ...], host: str = "127.0.0.1",
+                 record_updates: bool = False) -> None:
         self.labels = tuple(labels)
         self.button_uuids: dict[str, str] = {}
+        self.record_updates = record_updates
+        self.gui_props: dict[str, dict] = {}
         self.found = threading.Event()
         self._send_lock = threading.Lock()
         super().__init__(port, host)
@@ -78,12 +83,15 @@ class ButtonClient(DrainingClient):
             for msg in self.ws:
                 self.n_messages += 1
                 self.n_bytes += len(msg)
-                if not self.found.is_set() and isinstance(msg, bytes):
+                if (self.record_updates or not self.found.is_set()) and isinstance(msg, bytes):
                     for m in decode_window(msg):
-                        if m.get("type") == "GuiButtonMessage":
+                        kind = m.get("type")
+                        if kind == "GuiButtonMessage":
                             label = (m.get("props") or {}).get("label")
                             if label in self.labels:
                                 self.button_uuids.setdefault(label, m["uuid"])
+                        elif kind == "GuiUpdateMessage" and self.record_updates:
+                            self.gui_props.setdefault(m["uuid"], {}).update(m["updates"])
                     if len(self.button_uuids) == len(self.labels):
                         self.found.set()
         except Exception:
