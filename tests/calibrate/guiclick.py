@@ -3,11 +3,14 @@
 A browser's click or edit reaches the server as a ``GuiEvent`` whose ``client`` is the
 browser's ``ClientHandle``; the views ignore events without a client (their own assignments).
 These helpers set the value the browser would send and call the handle's callbacks with such
-an event, in the calling thread (viser would use its thread pool).
+an event, in the calling thread (viser would use its thread pool, or its event loop for
+``async`` callbacks: those are run to completion here).
 """
 
 from __future__ import annotations
 
+import asyncio
+import inspect
 from typing import Any
 
 from viser._gui_handles import GuiEvent, UploadedFile
@@ -15,7 +18,9 @@ from viser._gui_handles import GuiEvent, UploadedFile
 
 def _fire(handle: Any, client: Any) -> None:
     for cb in list(handle._impl.update_cb):
-        cb(GuiEvent(client=client, client_id=getattr(client, "client_id", None), target=handle))
+        out = cb(GuiEvent(client=client, client_id=getattr(client, "client_id", None), target=handle))
+        if inspect.isawaitable(out):
+            asyncio.run(out)
 
 
 def click(handle: Any, client: Any) -> None:

@@ -138,6 +138,11 @@ class CalibrateView:
         """Wrap a GUI callback: session lock and error notifications (``Session.guard``), then
         bring the tool views and scene in line and re-render the tab.
 
+        The callback is ``async``, so viser runs it on its event loop, as the jog keys: viser
+        1.1's message buffer is not safe to push to from its thread pool (a rare "deque mutated
+        during iteration" was seen there), and the Calibrate actions are short (an auto-touch's
+        IK and a library save take milliseconds).
+
         Args:
             fn: the callback, given the viser event.
             user_only: ignore events fired by our own assignments to a handle's value
@@ -151,7 +156,12 @@ class CalibrateView:
             finally:
                 self.after_action()
 
-        return self.session.guard(run)
+        guarded = self.session.guard(run)
+
+        async def on_loop(event: Any) -> None:
+            guarded(event)
+
+        return on_loop
 
     def after_action(self) -> None:
         """After a click: show the tool the controller has mounted and the active tool data, push
@@ -246,13 +256,16 @@ class CalibrateView:
 
     def on_motion(self) -> None:
         """After every move of the robot (and a tool change on the Tool tab): the live parts only
-        (meter, triads, ABC target), and the menu when the mounted tool changed."""
+        (meter, triads, ABC target), and the menu when the mounted tool changed. Returns at once
+        when no wizard is on show: this runs on every jog step of every session."""
         if self.session.closed:
+            return
+        if self.session.controller.mounted_tool.key != self._menu_mounted_key:
+            self._render_menu()
+        if self.workflow.wizard is None or not (self.workflow.is_open or self.scene.showing):
             return
         self.steps.update_meter()
         self.scene.on_motion()
-        if self.session.controller.mounted_tool.key != self._menu_mounted_key:
-            self._render_menu()
 
     # ------------------------------------------------------------ render
     def render(self) -> None:

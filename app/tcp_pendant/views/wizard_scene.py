@@ -81,9 +81,14 @@ class WizardSceneView:
             self._show_sphere(res if isinstance(res, Xyz4Result) else None)
         self.on_motion()
 
+    @property
+    def showing(self) -> bool:
+        """Something of the wizards is in the scene (the triads or the ABC target)."""
+        return bool(self.computed.visible or self.true_tool.visible or self.abc_target.visible)
+
     def on_motion(self) -> None:
         """After every move: the TOOL triads follow the flange, the ABC target the TCP."""
-        T_world_flange = self.session.controller.T_world_flange()
+        T_world_flange = self.session.pose_state().T_world_flange   # the move's one FK pass
         for frame, label, T in ((self.computed, self.computed_label, self._T_flange_computed),
                                 (self.true_tool, self.true_label, self._T_flange_true)):
             self._pose(frame, label, None if T is None else T_world_flange @ T)
