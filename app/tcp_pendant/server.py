@@ -27,6 +27,7 @@ import numpy as np
 from tcpcal.library import ToolLibrary
 from tcp_pendant.controller import (
     ControllerError,
+    solve_ik,
     RobotKinematics,
     VirtualController,
     builtin_robots,
@@ -100,35 +101,69 @@ def resolve_robot(robot: str) -> Path:
     raise ControllerError(f"Unknown robot {robot!r}; use kr6, gp12 or the path of a .urdf file.")
 
 
+MIN_TIP_HEIGHT_M = 0.15
+"""The reference tip stands at least this high above the floor (its stand must be visible and
+the tool must reach it from the side)."""
+READY_HOVER_M = 0.25
+"""Generic robots start with the flange this far above the reference tip, pointing down."""
+
+
+def _sampled_reach_m(kinematics: RobotKinematics, n: int = 400) -> float:
+    """Horizontal reach of the flange (m): the 95th percentile of its distance from the base
+    axis over ``n`` deterministic random configurations within the limits."""
+    rng = np.random.default_rng(20261123)
+    lo, hi = kinematics.lower_rad, kinematics.upper_rad
+    span = np.minimum(hi - lo, 2 * np.pi)
+    mid = 0.5 * (lo + hi)
+    qs = mid + (rng.uniform(size=(n, kinematics.n_joints)) - 0.5) * span
+    p = np.array([kinematics.T_base_flange(q)[:3, 3] for q in qs])
+    return float(np.percentile(np.hypot(p[:, 0], p[:, 1]), 95))
+
+
 def default_reference_tip_mm(kinematics: RobotKinematics) -> tuple[float, float, float]:
-    """Default reference tip (WORLD, mm): below the home flange position at half its height,
-    the controller's own default - reachable from many directions (tested by the controller's
-    auto-approach tests on both robots). KR 6: (525, 0, 445); GP12: (795, 0, 582)."""
-    p = kinematics.T_base_flange(kinematics.home_rad)[:3, 3] * 1000.0
-    return (float(p[0]), float(p[1]), float(0.5 * p[2]))
+    """Default reference tip (WORLD, mm), reachable from many directions.
+
+    Below the home flange position at half its height, the controller's own default (tested by
+    the controller's auto-approach tests on both robots): KR 6 (525, 0, 445); GP12 (795, 0,
+    582). A robot whose HOME is stretched out near the floor (the UR5 of example-robot-data:
+    half its home height is below the floor) gets a point in front of it instead: at half its
+    horizontal reach, a quarter of that reach high (at least ``MIN_TIP_HEIGHT_M``).
+    """
+    p = kinematics.T_base_flange(kinematics.home_rad)[:3, 3]
+    if 0.5 * p[2] >= MIN_TIP_HEIGHT_M:
+        return (float(p[0] * 1000.0), float(p[1] * 1000.0), float(0.5 * p[2] * 1000.0))
+    reach = _sampled_reach_m(kinematics)
+    tip = np.array([0.5 * reach, 0.0, max(MIN_TIP_HEIGHT_M, 0.25 * reach)]) * 1000.0
+    return (float(tip[0]), float(tip[1]), float(tip[2]))
 
 
-def ready_configuration(kinematics: RobotKinematics) -> np.ndarray:
-    """The session's start ("ready") pose, rad: HOME with the 5th axis turned +-90 deg so the
-    flange points straight down, if that is within the limits.
+def ready_configuration(kinematics: RobotKinematics, tip_world_m: np.ndarray | None = None) -> np.ndarray:
+    """The session's start ("ready") pose, rad: the flange pointing straight down.
 
     KUKA HOME has A5 = 0, a wrist singularity where Cartesian jogs along Y stop at once; with
-    the flange pointing down the wrist is well conditioned and the tool hangs over the
-    reference tip, the natural start of a touch-up. Other robots (fewer than 5 axes, or no
-    such pose): HOME.
+    the 5th axis turned +-90 deg the flange points down, the wrist is well conditioned and the
+    tool hangs over the reference tip, the natural start of a touch-up. A robot for which that
+    does not point the flange down (the UR5) is solved by IK for the flange pointing down
+    ``READY_HOVER_M`` above ``tip_world_m``, if given and reachable; otherwise: HOME.
     """
     home = np.array(kinematics.home_rad, dtype=float)
-    if kinematics.n_joints < 5 or not kinematics.revolute[4]:
-        return home
     best, best_dot = home, 0.9
-    for a5 in (np.pi / 2, -np.pi / 2):
-        q = home.copy()
-        q[4] = a5
-        if not kinematics.lower_rad[4] <= a5 <= kinematics.upper_rad[4]:
-            continue
-        down = -float(kinematics.T_base_flange(q)[2, 2])      # flange Z . (-WORLD Z)
-        if down > best_dot:
-            best, best_dot = q, down
+    if kinematics.n_joints >= 5 and kinematics.revolute[4]:
+        for a5 in (np.pi / 2, -np.pi / 2):
+            q = home.copy()
+            q[4] = a5
+            if not kinematics.lower_rad[4] <= a5 <= kinematics.upper_rad[4]:
+                continue
+            down = -float(kinematics.T_base_flange(q)[2, 2])      # flange Z . (-WORLD Z)
+            if down > best_dot:
+                best, best_dot = q, down
+    if best is home and tip_world_m is not None:
+        T = np.eye(4)
+        T[:3, :3] = np.diag([1.0, -1.0, -1.0])                # flange Z along WORLD -Z
+        T[:3, 3] = np.asarray(tip_world_m, dtype=float) + [0.0, 0.0, READY_HOVER_M]
+        sol = solve_ik(kinematics, T, home)
+        if sol.ok:
+            return np.asarray(sol.q_rad, dtype=float)
     return best
 
 
@@ -155,7 +190,7 @@ class PendantApp:
         if tip_m.shape != (3,) or not np.all(np.isfinite(tip_m)):
             raise ControllerError(f"Reference tip must be 3 finite numbers X,Y,Z in mm, got {tip!r}.")
         self.reference_tip_m = tip_m
-        self.ready_q_rad = ready_configuration(self.kinematics)
+        self.ready_q_rad = ready_configuration(self.kinematics, tip_m)
         self.library = ToolLibrary(config.tool_library)
         self.robot_label = ROBOT_LABELS.get(config.robot, urdf.stem)
         self.server: Any = None

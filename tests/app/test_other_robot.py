@@ -1,0 +1,47 @@
+"""The pendant on a robot of someone else's URDF: the UR5 of example-robot-data (issue 3: any
+URDF given on the command line loads, flange = the last link of the longest chain)."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from tcp_pendant.calibrate import AutoTouchRequest
+from tcp_pendant.controller import JogFrame, builtin_tools, example_robot_urdf
+from tcp_pendant.server import MIN_TIP_HEIGHT_M
+
+sys.path.insert(0, str(Path(__file__).parent))
+from conftest import wait_until  # noqa: E402
+from wsclient import DrainingClient  # noqa: E402
+
+
+def test_ur5_session_starts_over_a_visible_tip_and_calibrates(app_factory) -> None:
+    app = app_factory(robot=str(example_robot_urdf()))
+    assert app.kinematics.flange_link == "tool0"
+    tip = app.reference_tip_m
+    assert tip[2] >= MIN_TIP_HEIGHT_M                        # the stand is above the floor
+    client = DrainingClient(app.port)
+    try:
+        wait_until(lambda: len(app.sessions) == 1, what="session built")
+        (s,) = app.sessions.values()
+        c = s.controller
+        T = c.T_world_flange()
+        assert T[2, 2] < -0.999                              # flange pointing down ...
+        np.testing.assert_allclose(T[:3, 3], tip + [0.0, 0.0, 0.25], atol=1e-9)   # ... above the tip
+        with s.lock:                                         # jogs like the KR 6 (not singular)
+            for axis in ("X", "Y", "Z"):
+                assert c.jog_cartesian(JogFrame.WORLD, axis, -10.0).ok, axis
+        # a 4-point calibration through the Calibrate tab's workflow gives the pointer's true TCP
+        wf = s.views["calibrate"].workflow
+        wf.rng = np.random.default_rng(1)
+        with s.lock:
+            wf.start_xyz4()
+            for _ in range(4):
+                assert wf.auto_touch(AutoTouchRequest()).ok
+        true_tcp = builtin_tools()["pointer"].T_flange_tcp_true[:3, 3] * 1000.0
+        np.testing.assert_allclose(wf.result.tcp_mm, true_tcp, atol=1e-6)
+        assert wf.export_record()["robot"]["name"] == "ur5_robot"
+    finally:
+        client.close()
