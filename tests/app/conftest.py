@@ -4,7 +4,7 @@ server in-process on a free port (real viser server, headless websocket clients)
 from __future__ import annotations
 
 import socket
-import time
+import sys
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
@@ -13,20 +13,14 @@ import pytest
 from tcpcal.library import ToolLibrary
 from tcp_pendant.controller import RobotKinematics, VirtualController, builtin_robots, builtin_tools
 
+sys.path.insert(0, str(Path(__file__).parent))
+from wsclient import wait_until  # noqa: E402,F401  (re-exported: the tests import it from here)
+
 
 def free_port() -> int:
     with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
         s.bind(("127.0.0.1", 0))
         return int(s.getsockname()[1])
-
-
-def wait_until(cond: Callable[[], bool], timeout: float = 20.0, what: str = "condition") -> None:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        if cond():
-            return
-        time.sleep(0.01)
-    raise AssertionError(f"timed out waiting for {what}")
 
 
 @pytest.fixture(scope="session")

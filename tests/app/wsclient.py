@@ -4,11 +4,23 @@ subprotocol and drains whatever the server sends (no rendering)."""
 from __future__ import annotations
 
 import threading
+import time
+from collections.abc import Callable
 
 import msgspec.msgpack
 import viser
 from viser import _messages
 from websockets.sync.client import connect
+
+
+def wait_until(cond: Callable[[], bool], timeout: float = 20.0, what: str = "condition") -> None:
+    """Poll ``cond`` every 10 ms until it holds; fail naming ``what`` after ``timeout`` s."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if cond():
+            return
+        time.sleep(0.01)
+    raise AssertionError(f"timed out waiting for {what}")
 
 
 class DrainingClient:

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import json
 import sys
-import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
@@ -26,16 +25,7 @@ sys.path.insert(0, str(HERE.parent / "app"))
 sys.path.insert(0, str(HERE))
 from calib_helpers import library_tool_with_true_tcp, true_frame  # noqa: E402
 from guiclick import choose, click, upload  # noqa: E402
-from wsclient import DrainingClient  # noqa: E402
-
-
-def wait_until(cond: Callable[[], bool], timeout: float = 20.0, what: str = "condition") -> None:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        if cond():
-            return
-        time.sleep(0.01)
-    raise AssertionError(f"timed out waiting for {what}")
+from wsclient import DrainingClient, wait_until  # noqa: E402
 
 
 class Page:
