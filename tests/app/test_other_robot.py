@@ -7,14 +7,13 @@ import sys
 from pathlib import Path
 
 import numpy as np
-
 from tcp_pendant.calibrate import AutoTouchRequest
 from tcp_pendant.controller import JogFrame, builtin_tools, example_robot_urdf
 from tcp_pendant.server import MIN_TIP_HEIGHT_M
 
 sys.path.insert(0, str(Path(__file__).parent))
-from conftest import wait_until  # noqa: E402
-from wsclient import DrainingClient  # noqa: E402
+from conftest import wait_until
+from wsclient import DrainingClient
 
 
 def test_ur5_session_starts_over_a_visible_tip_and_calibrates(app_factory) -> None:

@@ -17,13 +17,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
+from tcp_pendant.controller import builtin_tools
 
 from tcpcal.library import ToolLibrary
 from tcpcal.tool import Tool
-from tcp_pendant.controller import builtin_tools
 
 sys.path.insert(0, str(Path(__file__).parent))
-from pendant_page import (  # noqa: E402
+from pendant_page import (
     TIMEOUT_MS,
     assert_not_blank,
     choose,

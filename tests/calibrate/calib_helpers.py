@@ -7,10 +7,15 @@ import warnings
 
 import numpy as np
 from scipy.spatial.transform import Rotation
+from tcp_pendant.controller import (
+    RobotKinematics,
+    VirtualController,
+    builtin_robots,
+    builtin_tools,
+)
+from tcp_pendant.server import default_reference_tip_mm, ready_configuration
 
 from tcpcal.tool import Tool
-from tcp_pendant.controller import RobotKinematics, VirtualController, builtin_robots, builtin_tools
-from tcp_pendant.server import default_reference_tip_mm, ready_configuration
 
 _KINEMATICS: dict[str, RobotKinematics] = {}
 def make_controller(robot: str = "kr6", tool_key: str = "pointer") -> VirtualController:

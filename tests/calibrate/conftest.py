@@ -9,12 +9,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
-from tcpcal.library import ToolLibrary
 from tcp_pendant.calibrate import CalibrationWorkflow
 
+from tcpcal.library import ToolLibrary
+
 sys.path.insert(0, str(Path(__file__).parent))
-from calib_helpers import make_controller  # noqa: E402
+from calib_helpers import make_controller
 
 
 @pytest.fixture

@@ -12,20 +12,20 @@ from typing import Any
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
-
-from tcpcal.library import ToolLibrary
-from tcpcal.origin import solve_xyz4
 from tcp_pendant.calibrate import error_bars
 from tcp_pendant.server import AppConfig, PendantApp
 from tcp_pendant.views.wizard_menu import CalibrateView
 from tcp_pendant.wizards import ESTIMATOR_LABELS
 
+from tcpcal.library import ToolLibrary
+from tcpcal.origin import solve_xyz4
+
 HERE = Path(__file__).parent
 sys.path.insert(0, str(HERE.parent / "app"))
 sys.path.insert(0, str(HERE))
-from calib_helpers import library_tool_with_true_tcp, true_frame  # noqa: E402
-from guiclick import choose, click, upload  # noqa: E402
-from wsclient import DrainingClient, wait_until  # noqa: E402
+from calib_helpers import library_tool_with_true_tcp, true_frame
+from guiclick import choose, click, upload
+from wsclient import DrainingClient, wait_until
 
 
 class Page:

@@ -7,8 +7,6 @@ import re
 
 import numpy as np
 import pytest
-
-from tcpcal.pose_quality import CandidateGain, assess_touches
 from tcp_pendant.calibrate import error_bars
 from tcp_pendant.calibrate.chart import BAR_HALF_WIDTH
 from tcp_pendant.calibrate.text import (
@@ -24,6 +22,8 @@ from tcp_pendant.calibrate.text import (
 )
 from tcp_pendant.wizards import WizardResult, Xyz4Wizard
 from tcp_pendant.wizards.truth import compare_with_truth
+
+from tcpcal.pose_quality import CandidateGain, assess_touches
 
 
 # ------------------------------------------------------------------ chart

@@ -11,24 +11,29 @@ from pathlib import Path
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
+from tcp_pendant.calibrate import AutoTouchRequest, CalibrationWorkflow
+from tcp_pendant.wizards import (
+    CalibrationFailedError,
+    WizardError,
+    WizardStateError,
+    Xyz4Wizard,
+)
+from tcp_pendant.wizards.session_record import dumps
 
 from tcpcal.errors import TcpcalError
 from tcpcal.tool import Tool
-from tcp_pendant.calibrate import AutoTouchRequest, CalibrationWorkflow
-from tcp_pendant.wizards import CalibrationFailedError, WizardError, WizardStateError, Xyz4Wizard
-from tcp_pendant.wizards.session_record import dumps
 
 sys.path.insert(0, str(Path(__file__).parent))
-from calib_helpers import library_tool_with_true_tcp, true_frame  # noqa: E402
+from calib_helpers import library_tool_with_true_tcp, true_frame
 
 EXACT_MM = 1e-6
 EXACT_DEG = 1e-6
 
 
-def run_auto(wf: CalibrationWorkflow, request: AutoTouchRequest = AutoTouchRequest()) -> None:
+def run_auto(wf: CalibrationWorkflow, request: AutoTouchRequest | None = None) -> None:
     """Auto-touch until the wizard has its result (the last auto-touch computes it)."""
     for _ in range(wf.wizard.n_steps):
-        out = wf.auto_touch(request)
+        out = wf.auto_touch(request or AutoTouchRequest())
         assert out.ok, out.message
     assert wf.result is not None
 

@@ -15,10 +15,10 @@ from tcp_pendant.calibrate.workflow import (
 
 __all__ = [
     "AUTO_SIGMA_MAX_MM",
+    "WIZARD_KINDS",
+    "WIZARD_LABELS",
     "AutoTouchRequest",
     "CalibrationWorkflow",
     "ErrorBars",
-    "WIZARD_KINDS",
-    "WIZARD_LABELS",
     "error_bars",
 ]

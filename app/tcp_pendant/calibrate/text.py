@@ -11,11 +11,11 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
-from tcpcal.pose_quality import CandidateGain, PoseQuality
 from tcp_pendant.pendant.formatting import fmt_num
 from tcp_pendant.wizards import ESTIMATOR_LABELS, Wizard, WizardResult, Xyz4Result
 from tcp_pendant.wizards.session_record import ReplayCheck
 from tcp_pendant.wizards.truth import TruthComparison
+from tcpcal.pose_quality import CandidateGain, PoseQuality
 
 __all__ = [
     "METHOD_BLURBS",

@@ -24,8 +24,6 @@ from typing import Any, Literal
 
 import numpy as np
 
-from tcpcal.library import ToolLibrary
-from tcpcal.tool import Tool
 from tcp_pendant.controller import ToolModel, VirtualController, builtin_tools
 from tcp_pendant.wizards import (
     AbcWorldWizard,
@@ -45,13 +43,15 @@ from tcp_pendant.wizards.session_record import (
     session_from_controller,
 )
 from tcp_pendant.wizards.truth import TruthComparison, compare_with_truth
+from tcpcal.library import ToolLibrary
+from tcpcal.tool import Tool
 
 __all__ = [
     "AUTO_SIGMA_MAX_MM",
-    "AutoTouchRequest",
-    "CalibrationWorkflow",
     "WIZARD_KINDS",
     "WIZARD_LABELS",
+    "AutoTouchRequest",
+    "CalibrationWorkflow",
 ]
 
 WIZARD_KINDS: tuple[str, ...] = ("xyz4", "reference", "three-point", "abc-world")

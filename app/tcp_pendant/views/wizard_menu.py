@@ -25,7 +25,6 @@ import contextlib
 from collections.abc import Callable, Iterator
 from typing import Any
 
-from tcpcal.tool import Tool
 from tcp_pendant.calibrate import WIZARD_KINDS, WIZARD_LABELS, CalibrationWorkflow
 from tcp_pendant.calibrate.text import METHOD_BLURBS, menu_markdown, replay_markdown
 from tcp_pendant.controller import builtin_robots
@@ -36,8 +35,9 @@ from tcp_pendant.views.wizard_scene import WizardSceneView
 from tcp_pendant.views.wizard_steps import WizardStepsView
 from tcp_pendant.wizards import ESTIMATOR_LABELS
 from tcp_pendant.wizards.session_record import dumps
+from tcpcal.tool import Tool
 
-__all__ = ["CalibrateView", "NO_LIBRARY_TOOL", "SESSION_FILENAME", "build_calibrate_views"]
+__all__ = ["NO_LIBRARY_TOOL", "SESSION_FILENAME", "CalibrateView", "build_calibrate_views"]
 
 NO_LIBRARY_TOOL = "(library empty)"
 SESSION_FILENAME = "tcp-pendant-session.json"

@@ -15,7 +15,6 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from tcpcal.library import ToolLibrary
 from tcp_pendant.calibrate import error_bars
 from tcp_pendant.calibrate.text import (
     comparison_markdown,
@@ -27,7 +26,13 @@ from tcp_pendant.calibrate.text import (
     warnings_markdown,
 )
 from tcp_pendant.views.gui_util import number_of_option, set_content, set_options
-from tcp_pendant.wizards import ESTIMATOR_LABELS, Xyz4Result, Xyz4Wizard
+from tcp_pendant.wizards import (
+    ESTIMATOR_LABELS,
+    WizardStateError,
+    Xyz4Result,
+    Xyz4Wizard,
+)
+from tcpcal.library import ToolLibrary
 
 if TYPE_CHECKING:
     from tcp_pendant.views.wizard_menu import CalibrateView
@@ -100,7 +105,7 @@ class WizardResultView:
     def _xyz4(self) -> Xyz4Wizard:
         wiz = self.parent.workflow.wizard
         if not isinstance(wiz, Xyz4Wizard):
-            raise ValueError("This is for the XYZ 4-point result.")
+            raise WizardStateError("This is for the XYZ 4-point result.")
         return wiz
 
     def _on_drop(self, _event: Any) -> None:

@@ -14,9 +14,19 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 from tcp_pendant.calibrate import AUTO_SIGMA_MAX_MM, AutoTouchRequest
-from tcp_pendant.calibrate.text import meter_level, meter_markdown, step_markdown, steps_list_markdown
+from tcp_pendant.calibrate.text import (
+    meter_level,
+    meter_markdown,
+    step_markdown,
+    steps_list_markdown,
+)
 from tcp_pendant.views.gui_util import set_content
-from tcp_pendant.wizards import AbcWorldWizard, ThreePointWizard, Xyz4Wizard
+from tcp_pendant.wizards import (
+    AbcWorldWizard,
+    ThreePointWizard,
+    WizardStateError,
+    Xyz4Wizard,
+)
 
 if TYPE_CHECKING:
     from tcp_pendant.views.wizard_menu import CalibrateView
@@ -87,7 +97,7 @@ class WizardStepsView:
     def _on_add_point(self, _event: Any) -> None:
         wiz = self.parent.workflow.wizard
         if not isinstance(wiz, Xyz4Wizard):
-            raise ValueError("Add point is for the XYZ 4-point wizard.")
+            raise WizardStateError("Add point is for the XYZ 4-point wizard.")
         wiz.add_point()
 
     def _on_variant(self, event: Any) -> None:
