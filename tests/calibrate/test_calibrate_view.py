@@ -298,3 +298,29 @@ def test_closing_the_page_loses_nothing_saved(page) -> None:
     wait_until(lambda: s.closed, what="session closed")
     assert s.library.path.read_bytes() == before
     assert ToolLibrary(s.library.path).get(1).name == "Kept"
+
+
+def test_shared_mode_export_goes_to_the_browser_that_clicked(tmp_path: Path) -> None:
+    import socket
+
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        port = sock.getsockname()[1]
+    app = PendantApp(AppConfig(port=port, shared=True, tool_library=tmp_path / "tools.json"))
+    app.start()
+    ws = [DrainingClient(app.port), DrainingClient(app.port)]
+    try:
+        wait_until(lambda: len(app.server.get_clients()) == 2, what="two browsers")
+        a, b = app.server.get_clients().values()
+        got: dict[int, list[str]] = {a.client_id: [], b.client_id: []}
+        for c in (a, b):
+            c.send_file_download = lambda name, data, *_, _id=c.client_id, **__: got[_id].append(name)
+        view: CalibrateView = app.shared_session.views["calibrate"]
+        click(view.start, a)
+        click(view.steps.auto_touch, b)                   # one robot: anyone may drive it
+        click(view.export, b)
+        assert got == {a.client_id: [], b.client_id: ["tcp-pendant-session.json"]}
+    finally:
+        for w in ws:
+            w.close()
+        app.stop()

@@ -229,9 +229,10 @@ class CalibrateView:
             raise ValueError("There is no calibration to resume.")
         self.workflow.resume(number - 1)
 
-    def _on_export(self, _event: Any) -> None:
+    def _on_export(self, event: Any) -> None:
         data = dumps(self.workflow.export_record(self.session.touches)).encode("utf-8")
-        target = self.session.client if self.session.client is not None else self.session.target
+        # to the browser that clicked (in --shared mode the session is every browser's)
+        target = getattr(event, "client", None) or self.session.client or self.session.target
         target.send_file_download(SESSION_FILENAME, data, save_immediately=True)
         set_content(self.record_md, f"Exported {len(self.workflow.runs)} calibration(s) as {SESSION_FILENAME}.")
 
