@@ -21,8 +21,7 @@ views are re-rendered from the workflow's state.
 
 from __future__ import annotations
 
-import contextlib
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from typing import Any
 
 from tcp_pendant.calibrate import WIZARD_KINDS, WIZARD_LABELS, CalibrationWorkflow
@@ -69,7 +68,6 @@ class CalibrateView:
     def __init__(self, session: Session) -> None:
         self.session = session
         self.workflow = CalibrationWorkflow(session.controller, session.library, robot=robot_name(session))
-        self._quiet = 0
         self._menu_mounted_key: str | None = None
         gui = session.target.gui
         tools = self.workflow.tools
@@ -119,21 +117,12 @@ class CalibrateView:
         self.load.on_upload(act(self._on_load))
         session.add_motion_listener(self.on_motion)
         tool_panel = session.views.get("tools")
-        if tool_panel is not None and hasattr(tool_panel, "on_reload"):
+        if tool_panel is not None:
             tool_panel.on_reload(self.refresh_library)
         self.refresh_library()
         self.render()
 
     # ------------------------------------------------------------ plumbing
-    @contextlib.contextmanager
-    def quiet(self) -> Iterator[None]:
-        """While inside, value updates fired by our own assignments are ignored."""
-        self._quiet += 1
-        try:
-            yield
-        finally:
-            self._quiet -= 1
-
     def action(self, fn: Callable[[Any], Any], *, user_only: bool = False) -> Callable[[Any], Any]:
         """Wrap a GUI callback: session lock and error notifications (``Session.guard``), then
         bring the tool views and scene in line and re-render the tab.
@@ -145,11 +134,12 @@ class CalibrateView:
 
         Args:
             fn: the callback, given the viser event.
-            user_only: ignore events fired by our own assignments to a handle's value
-                (``event.client is None``), as for on_update of dropdowns the views set.
+            user_only: ignore events fired by our own assignments to a handle's value (viser
+                fires on_update for those too, with ``event.client is None``), as for the
+                dropdowns and checkboxes the views also set.
         """
         def run(event: Any) -> None:
-            if user_only and (self._quiet or getattr(event, "client", None) is None):
+            if user_only and getattr(event, "client", None) is None:
                 return
             try:
                 fn(event)
@@ -250,9 +240,8 @@ class CalibrateView:
         """Re-list the library's tools (called when the library changes, by anyone)."""
         tools = self.workflow.library_tools()
         options = tuple(f"{s}: {t.name}" for s, t in sorted(tools.items())) or (NO_LIBRARY_TOOL,)
-        with self.quiet():
-            set_options(self.library_tool, options)
-            self.result.refresh_slots(tools)
+        set_options(self.library_tool, options)
+        self.result.refresh_slots(tools)
         self._render_menu()
 
     def on_motion(self) -> None:
@@ -294,6 +283,5 @@ class CalibrateView:
         waiting = self.workflow.resumable()
         self.resume_list.visible = self.resume.visible = bool(waiting)
         if waiting:
-            with self.quiet():
-                set_options(self.resume_list, tuple(label for _, label in waiting))
+            set_options(self.resume_list, tuple(label for _, label in waiting))
 

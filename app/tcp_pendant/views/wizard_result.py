@@ -170,9 +170,8 @@ class WizardResultView:
         self.drop.disabled = not res.outliers
         self.restore.disabled = not res.excluded
         label = ESTIMATOR_LABELS[res.estimator]
-        with self.parent.quiet():
-            if self.estimator.value != label:
-                self.estimator.value = label
+        if self.estimator.value != label:
+            self.estimator.value = label
         self.compare_md.visible = bool(self.compare.value)
         if self.compare.value:
             set_content(self.compare_md, comparison_markdown(res))

@@ -169,11 +169,10 @@ class WizardStepsView:
             return
         labels = tuple(options)
         label = next(k for k, v in options.items() if v == current)
-        with self.parent.quiet():                 # our own assignment: not a user's choice
-            if tuple(self.variant.options) != labels:
-                self.variant.options = labels
-            if self.variant.value != label:
-                self.variant.value = label
+        if tuple(self.variant.options) != labels:    # our own assignments: the on_update
+            self.variant.options = labels            # they fire has no client and is ignored
+        if self.variant.value != label:
+            self.variant.value = label
         self.variant.visible = True
         self.variant.disabled = wiz.status != "in_progress"
 
