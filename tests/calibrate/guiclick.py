@@ -3,8 +3,8 @@
 A browser's click or edit reaches the server as a ``GuiEvent`` whose ``client`` is the
 browser's ``ClientHandle``; the views ignore events without a client (their own assignments).
 These helpers set the value the browser would send and call the handle's callbacks with such
-an event, in the calling thread (viser would use its thread pool, or its event loop for
-``async`` callbacks: those are run to completion here).
+an event: plain callbacks in the calling thread (viser would use its thread pool), ``async``
+ones on the server's own event loop, as viser does, waiting until they are done.
 """
 
 from __future__ import annotations
@@ -20,7 +20,8 @@ def _fire(handle: Any, client: Any) -> None:
     for cb in list(handle._impl.update_cb):
         out = cb(GuiEvent(client=client, client_id=getattr(client, "client_id", None), target=handle))
         if inspect.isawaitable(out):
-            asyncio.run(out)
+            loop = handle._impl.gui_api._event_loop
+            asyncio.run_coroutine_threadsafe(out, loop).result(timeout=60)
 
 
 def click(handle: Any, client: Any) -> None:
