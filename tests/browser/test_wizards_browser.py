@@ -16,13 +16,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from scipy.spatial.transform import Rotation
-from tcp_pendant.controller import builtin_tools
 
 from tcpcal.library import ToolLibrary
 from tcpcal.tool import Tool
 
+sys.path.insert(0, str(Path(__file__).parents[1] / "calibrate"))
 sys.path.insert(0, str(Path(__file__).parent))
+from calib_helpers import true_frame
 from pendant_page import (
     TIMEOUT_MS,
     assert_not_blank,
@@ -41,8 +41,8 @@ DISPLAY_TOL = 0.006     # the pendant shows two decimals
 
 def truth(key: str) -> tuple[np.ndarray, np.ndarray]:
     """(TCP mm, KUKA A, B, C deg) of a built-in tool's hidden true TOOL frame."""
-    T = builtin_tools()[key].T_flange_tcp_true
-    return T[:3, 3] * 1000.0, Rotation.from_matrix(T[:3, :3]).as_euler("ZYX", degrees=True)
+    tcp, _R, abc = true_frame(key)
+    return tcp, abc
 
 
 def shown_tcp(page) -> np.ndarray:
