@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
-__all__ = ["number_of_option", "set_content", "set_options"]
+__all__ = ["number_of_option", "set_content", "set_options", "slot_option"]
 
 
 def set_content(handle: Any, text: str) -> None:
@@ -22,6 +22,11 @@ def set_options(handle: Any, options: tuple[str, ...], keep: str | None = None) 
     value = keep if keep in options else options[0]
     if handle.value != value:
         handle.value = value
+
+
+def slot_option(slot: int, name: str) -> str:
+    """A library slot as a dropdown option: ``"3: Torch"`` (read back by :func:`number_of_option`)."""
+    return f"{slot}: {name}"
 
 
 def number_of_option(option: str) -> int | None:

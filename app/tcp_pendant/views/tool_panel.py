@@ -15,22 +15,18 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from tcpcal.formats import FORMATS, export_tool
-from tcpcal.tool import Tool
 from tcp_pendant.controller import builtin_tools
 from tcp_pendant.pendant import FIELDS, ToolEntry, parse_tool_entry, tool_data_markdown
 from tcp_pendant.pendant.tool_entry import entry_preview_markdown
 from tcp_pendant.session import Session
-from tcp_pendant.views.gui_util import number_of_option
+from tcp_pendant.views.gui_util import number_of_option, set_options, slot_option
+from tcpcal.formats import FORMATS, export_tool
+from tcpcal.tool import Tool
 
 __all__ = ["NO_TOOL", "ToolPanel"]
 
 NO_TOOL = "(library empty)"
 _FORMAT_LABELS = {"kuka": "KUKA", "abb": "ABB", "fanuc": "FANUC", "ur": "UR", "matrix": "Matrix"}
-
-
-def _slot_option(slot: int, tool: Tool) -> str:
-    return f"{slot}: {tool.name}"
 
 
 class ToolPanel:
@@ -87,7 +83,7 @@ class ToolPanel:
             handle.on_update(g(lambda _e: self._show_entry_preview()))
         self._show_entry_preview()
         self._library: dict[int, Tool] = {}
-        self._reload_listeners: list[Callable[[], None]] = []
+        self._reload_listeners: list[Callable[[dict[int, Tool]], None]] = []
         self.reload()
         self._show_active()
 
@@ -96,24 +92,22 @@ class ToolPanel:
         """Re-read the shared library and refresh the slot lists (keeps the selection)."""
         lib = self.session.library.tools()
         self._library = lib
-        options = tuple(_slot_option(s, t) for s, t in sorted(lib.items())) or (NO_TOOL,)
+        options = tuple(slot_option(s, t.name) for s, t in sorted(lib.items())) or (NO_TOOL,)
         current = number_of_option(self.slots.value)
         self.slots.options = options
         pick = next((o for o in options if number_of_option(o) == current), options[0])
         if self.slots.value != pick:
             self.slots.value = pick
         free = [str(s) for s in range(1, self.session.library.N_SLOTS + 1) if s not in lib]
-        entry_opts = ("first free", *free)
-        keep = self.entry_slot.value if self.entry_slot.value in entry_opts else "first free"
-        self.entry_slot.options = entry_opts
-        self.entry_slot.value = keep
+        set_options(self.entry_slot, ("first free", *free))
         self._show_slot()
         self._show_active()
         for fn in self._reload_listeners:
-            fn()
+            fn(lib)
 
-    def on_reload(self, fn: Callable[[], None]) -> None:
-        """Call ``fn()`` after every reload of the library (other views list its tools too)."""
+    def on_reload(self, fn: Callable[[dict[int, Tool]], None]) -> None:
+        """Call ``fn(tools)`` with the library just read (slot -> tool) after every reload, so
+        other views that list its tools need not read the file again."""
         self._reload_listeners.append(fn)
 
     def _selected(self) -> tuple[int, Tool]:
@@ -223,7 +217,7 @@ class ToolPanel:
         lib.save(slot, res.tool)
         self.entry_md.content = f"✅ Saved **{res.tool.name}** in slot {slot}."
         self.reload()
-        self.slots.value = _slot_option(slot, res.tool)
+        self.slots.value = slot_option(slot, res.tool.name)
         self._show_slot()
 
     def _show_entry_errors(self, errors: dict[str, str]) -> None:

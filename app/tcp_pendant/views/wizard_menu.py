@@ -28,7 +28,12 @@ from tcp_pendant.calibrate import WIZARD_KINDS, WIZARD_LABELS, CalibrationWorkfl
 from tcp_pendant.calibrate.text import METHOD_BLURBS, menu_markdown, replay_markdown
 from tcp_pendant.controller import builtin_robots
 from tcp_pendant.session import Session
-from tcp_pendant.views.gui_util import number_of_option, set_content, set_options
+from tcp_pendant.views.gui_util import (
+    number_of_option,
+    set_content,
+    set_options,
+    slot_option,
+)
 from tcp_pendant.views.wizard_result import WizardResultView
 from tcp_pendant.views.wizard_scene import WizardSceneView
 from tcp_pendant.views.wizard_steps import WizardStepsView
@@ -236,10 +241,11 @@ class CalibrateView:
         set_content(self.record_md, f"**Loaded {upload.name or 'session'}**\n\n" + replay_markdown(checks))
 
     # ------------------------------------------------------------ library and motion
-    def refresh_library(self) -> None:
-        """Re-list the library's tools (called when the library changes, by anyone)."""
-        tools = self.workflow.library_tools()
-        options = tuple(f"{s}: {t.name}" for s, t in sorted(tools.items())) or (NO_LIBRARY_TOOL,)
+    def refresh_library(self, tools: dict[int, Tool] | None = None) -> None:
+        """Re-list the library's tools (``tools``: as the tool panel just read them; None: read
+        now). Called when the library changes, by anyone."""
+        tools = self.workflow.library_tools() if tools is None else tools
+        options = tuple(slot_option(s, t.name) for s, t in sorted(tools.items())) or (NO_LIBRARY_TOOL,)
         set_options(self.library_tool, options)
         self.result.refresh_slots(tools)
         self._render_menu()

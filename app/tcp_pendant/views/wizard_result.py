@@ -25,7 +25,12 @@ from tcp_pendant.calibrate.text import (
     truth_markdown,
     warnings_markdown,
 )
-from tcp_pendant.views.gui_util import number_of_option, set_content, set_options
+from tcp_pendant.views.gui_util import (
+    number_of_option,
+    set_content,
+    set_options,
+    slot_option,
+)
 from tcp_pendant.wizards import (
     ESTIMATOR_LABELS,
     WizardStateError,
@@ -44,7 +49,7 @@ AUTO_SLOT = "same name, else first free"
 
 def slot_options(tools: dict[int, Any]) -> tuple[str, ...]:
     """The Save slot list: automatic, then every slot with the tool it holds."""
-    return (AUTO_SLOT, *(f"{s}: {tools[s].name}" if s in tools else f"{s}: (empty)"
+    return (AUTO_SLOT, *(slot_option(s, tools[s].name if s in tools else "(empty)")
                          for s in range(1, ToolLibrary.N_SLOTS + 1)))
 
 
