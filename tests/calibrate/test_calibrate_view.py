@@ -190,8 +190,16 @@ def test_outliers_are_marked_and_can_be_dropped_and_estimators_compared(page) ->
     assert np.linalg.norm(np.asarray(res2.tcp_mm) - true_frame("pointer")[0]) < \
         np.linalg.norm(np.asarray(res.tcp_mm) - true_frame("pointer")[0])
     assert not v.result.restore.disabled
+    reads: list[int] = []
+    real_tools = s.library.tools
+    s.library.tools = lambda: reads.append(1) or real_tools()       # type: ignore[method-assign]
+    p.choose(v.result.save_name, "Pen")                  # typing: a re-render, no file read
+    assert reads == [] and "Will save **Pen**" in v.result.save_preview.content
     p.choose(v.result.estimator, ESTIMATOR_LABELS["sphere"])
     assert v.workflow.result.estimator == "sphere" and v.workflow.result.method == "xyz4-sphere"
+    assert v.result.save_name.value == "Pen"             # a recomputed result keeps the typed name
+    bars = error_bars([i + 1 for i in v.workflow.result.used_indices], v.workflow.result.per_touch_error_mm)
+    np.testing.assert_allclose(v.result.chart.data[1], bars.normal_mm)     # the chart follows it
     p.choose(v.result.compare, True)
     assert v.result.compare_md.visible and v.result.compare_md.content.count("\n| ") == 3
     assert "best-fit sphere (4P-1a) ◀ reported" in v.result.compare_md.content

@@ -116,7 +116,7 @@ class CalibrateView:
         self.training.on_update(act(self._on_training, user_only=True))
         for choice in (self.method, self.library_tool, self.reference_physical, self.new_physical):
             choice.on_update(act(lambda _e: None, user_only=True))       # re-render: echo the choice
-        self.start.on_click(act(self._on_start))
+        self.start.on_click(act(self._on_start, sync=True))
         self.resume.on_click(act(self._on_resume))
         self.export.on_click(act(self._on_export))
         self.load.on_upload(act(self._on_load))
@@ -128,9 +128,11 @@ class CalibrateView:
         self.render()
 
     # ------------------------------------------------------------ plumbing
-    def action(self, fn: Callable[[Any], Any], *, user_only: bool = False) -> Callable[[Any], Any]:
+    def action(self, fn: Callable[[Any], Any], *, user_only: bool = False,
+               sync: bool = False) -> Callable[[Any], Any]:
         """Wrap a GUI callback: session lock and error notifications (``Session.guard``), then
-        bring the tool views and scene in line and re-render the tab.
+        re-render the tab (with ``sync``: first bring the tool views and the robot's scene in
+        line, see :meth:`after_action`).
 
         The callback is ``async``, so viser runs it on its event loop, as the jog keys: viser
         1.1's message buffer is not safe to push to from its thread pool (a rare "deque mutated
@@ -142,14 +144,19 @@ class CalibrateView:
             user_only: ignore events fired by our own assignments to a handle's value (viser
                 fires on_update for those too, with ``event.client is None``), as for the
                 dropdowns and checkboxes the views also set.
+            sync: the callback may change the controller (mounted or active tool, joints) or
+                the library: Start, Mount, Auto-touch, Save. The others (choices, typing, Next,
+                estimator ...) only re-render the tab: no library read, no scene refresh.
         """
+        done = self.after_action if sync else self.render
+
         def run(event: Any) -> None:
             if user_only and getattr(event, "client", None) is None:
                 return
             try:
                 fn(event)
             finally:
-                self.after_action()
+                done()
 
         guarded = self.session.guard(run)
 
@@ -266,6 +273,8 @@ class CalibrateView:
     # ------------------------------------------------------------ render
     def render(self) -> None:
         """Re-render the whole tab from the workflow's state."""
+        if self.session.closed:
+            return
         self._render_menu()
         self.steps.render()
         self.result.render()

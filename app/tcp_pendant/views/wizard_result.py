@@ -101,10 +101,11 @@ class WizardResultView:
         self.restore.on_click(act(self._on_restore))
         self.estimator.on_update(act(self._on_estimator, user_only=True))
         self.compare.on_update(act(lambda _e: None, user_only=True))
-        self.save.on_click(act(self._on_save))
+        self.save.on_click(act(self._on_save, sync=True))
         self.save_name.on_update(act(lambda _e: None, user_only=True))
         self.save_slot.on_update(act(lambda _e: None, user_only=True))
-        self._result_shown: Any = None
+        self._named_run: Any = None
+        self._charted: Any = None
 
     # ------------------------------------------------------------ callbacks
     def _xyz4(self) -> Xyz4Wizard:
@@ -140,10 +141,9 @@ class WizardResultView:
         res = wf.result
         self.folder.visible = res is not None
         if res is None:
-            self._result_shown = None
             return
-        if res is not self._result_shown:              # a new result: fresh name, no old message
-            self._result_shown = res
+        if wf.run is not self._named_run:              # another calibration: its name, no old message
+            self._named_run = wf.run
             self.save_name.value = wf.default_save_name()
             set_content(self.save_md, "")
         set_content(self.result_md, result_markdown(res))
@@ -166,12 +166,14 @@ class WizardResultView:
         if res is None:
             self.compare_md.visible = False
             return
-        bars = error_bars([i + 1 for i in res.used_indices], res.per_touch_error_mm,
-                          [i + 1 for i in res.outliers])
-        self.chart.data = bars.columns
-        self.chart.series = _chart_series(has_outliers=bool(res.outliers))
-        top = float(np.max(res.per_touch_error_mm)) if res.per_touch_error_mm else 0.0
-        self.chart.scales = {"x": {"time": False}, "y": {"range": (0.0, max(1.2 * top, 1e-3))}}
+        if res is not self._charted:                   # arrays and dicts: viser re-sends every assignment
+            self._charted = res
+            bars = error_bars([i + 1 for i in res.used_indices], res.per_touch_error_mm,
+                              [i + 1 for i in res.outliers])
+            self.chart.data = bars.columns
+            self.chart.series = _chart_series(has_outliers=bool(res.outliers))
+            top = float(np.max(res.per_touch_error_mm)) if res.per_touch_error_mm else 0.0
+            self.chart.scales = {"x": {"time": False}, "y": {"range": (0.0, max(1.2 * top, 1e-3))}}
         self.drop.disabled = not res.outliers
         self.restore.disabled = not res.excluded
         label = ESTIMATOR_LABELS[res.estimator]

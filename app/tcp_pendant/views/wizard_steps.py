@@ -80,10 +80,10 @@ class WizardStepsView:
         self.back.on_click(act(lambda _e: parent.workflow.back()))
         self.cancel.on_click(act(self._on_cancel))
         self.add_point.on_click(act(self._on_add_point))
-        self.mount.on_click(act(lambda _e: parent.workflow.mount_required_tool()))
+        self.mount.on_click(act(lambda _e: parent.workflow.mount_required_tool(), sync=True))
         self.variant.on_update(act(self._on_variant, user_only=True))
         self.auto_direction.on_update(act(lambda _e: None, user_only=True))
-        self.auto_touch.on_click(act(self._on_auto_touch))
+        self.auto_touch.on_click(act(self._on_auto_touch, sync=True))
 
     # ------------------------------------------------------------ callbacks
     def _on_cancel(self, _event: Any) -> None:
