@@ -39,6 +39,7 @@ from tcp_pendant.wizards.autotouch import AutoTouchOutcome, auto_touch
 from tcp_pendant.wizards.session_record import (
     ReplayCheck,
     WizardRun,
+    load_session,
     replay,
     session_from_controller,
 )
@@ -165,14 +166,19 @@ class CalibrationWorkflow:
         return tool
 
     # ------------------------------------------------------------ starting wizards
-    def _open(self, wizard: Wizard, true_tool: ToolModel | None) -> Wizard:
+    def _leave_open_wizard(self) -> None:
+        """Before another run is put on show: the open one is cancelled (kept in ``runs``,
+        resumable, nothing lost) and the last save message no longer applies."""
         current = self.wizard
         if current is not None and current.status != "cancelled":
-            current.cancel()                  # kept in runs: resumable, nothing lost
+            current.cancel()
+        self.last_save = None
+
+    def _open(self, wizard: Wizard, true_tool: ToolModel | None) -> Wizard:
+        self._leave_open_wizard()
         T_true = None if true_tool is None else np.array(true_tool.T_flange_tcp_true, dtype=float)
         self.runs.append(WizardRun(wizard, None if true_tool is None else true_tool.key, T_true))
         self._current = len(self.runs) - 1
-        self.last_save = None
         return self.wizard  # type: ignore[return-value]
 
     def start_xyz4(self, *, n_points: int = 4, estimator: str = "lstsq") -> Xyz4Wizard:
@@ -237,13 +243,10 @@ class CalibrationWorkflow:
         i = options[0][0] if index is None else int(index)
         if i not in [o[0] for o in options]:
             raise WizardStateError(f"Calibration {i + 1} is not waiting to be resumed.")
-        current = self.wizard
-        if current is not None and current.status != "cancelled":
-            current.cancel()
+        self._leave_open_wizard()
         self._current = i
         w = self.runs[i].wizard
         w.resume()
-        self.last_save = None
         return w
 
     def required_tool(self) -> ToolModel | None:
@@ -374,15 +377,11 @@ class CalibrationWorkflow:
         Raises:
             SessionRecordError: unreadable record (nothing of this session is changed).
         """
-        from tcp_pendant.wizards.session_record import load_session
-
         data = load_session(source)
         checks = replay(data)
         if not checks:
             return checks
-        current = self.wizard
-        if current is not None and current.status != "cancelled":
-            current.cancel()
+        self._leave_open_wizard()
         finished: list[int] = []
         for check, entry in zip(checks, data.get("wizards", [])):
             true_tool = entry.get("true_tool") or {}
@@ -396,5 +395,4 @@ class CalibrationWorkflow:
         if finished:                          # ... but the newest finished one is put on show
             self._current = finished[-1]
             self.runs[self._current].wizard.resume()
-        self.last_save = None
         return checks
