@@ -208,7 +208,9 @@ def test_outliers_are_marked_and_can_be_dropped_and_estimators_compared(page) ->
 def test_meter_follows_the_jog(page) -> None:
     p = page()
     v, s = p.view, p.session
+    p.choose(v.estimator, ESTIMATOR_LABELS["pairwise"])   # the menu's estimator reaches the wizard
     p.click(v.start)
+    assert v.workflow.wizard.estimator == "pairwise"
     p.click(v.steps.auto_touch)
     assert "Too close" in v.steps.meter_md.content and v.steps.meter_bar.color == "red"
     with s.lock:

@@ -25,7 +25,12 @@ from collections.abc import Callable
 from typing import Any
 
 from tcp_pendant.calibrate import WIZARD_KINDS, WIZARD_LABELS, CalibrationWorkflow
-from tcp_pendant.calibrate.text import METHOD_BLURBS, menu_markdown, replay_markdown
+from tcp_pendant.calibrate.text import (
+    METHOD_BLURBS,
+    estimator_options,
+    menu_markdown,
+    replay_markdown,
+)
 from tcp_pendant.controller import builtin_robots
 from tcp_pendant.session import Session
 from tcp_pendant.views.gui_util import (
@@ -185,12 +190,9 @@ class CalibrateView:
         s.moved()
         self.render()
 
-    def _set_active_slot(self, slot: int | None) -> None:
-        self.session.active_slot = slot
-
     def saved(self, slot: int, tool: Tool) -> None:
         """After "Save to tool library": the saved tool is the session's active tool."""
-        self._set_active_slot(slot)
+        self.session.active_slot = slot
         self.session.notify("Tool saved", f"Slot {slot}: {tool.name} is now the active tool.", kind="success")
 
     # ------------------------------------------------------------ callbacks
@@ -207,23 +209,20 @@ class CalibrateView:
         kind = _LABEL_TO_KIND.get(str(self.method.value))
         wf = self.workflow
         if kind == "xyz4":
-            est = {v: k for k, v in ESTIMATOR_LABELS.items()}[str(self.estimator.value)]
-            wf.start_xyz4(n_points=int(self.n_points.value), estimator=est)
-        elif kind == "reference":
-            slot = self._selected_slot()
+            estimator = estimator_options()[str(self.estimator.value)]
+            wf.start_xyz4(n_points=int(self.n_points.value), estimator=estimator)
+            return
+        slot = self._selected_slot()
+        if kind == "reference":
             wf.start_reference(reference_slot=slot, reference_tool_key=self._physical[self.reference_physical.value],
                                new_tool_key=self._physical[self.new_physical.value])
-            self._set_active_slot(slot)
         elif kind == "three-point":
-            slot = self._selected_slot()
             wf.start_three_point(slot=slot)
-            self._set_active_slot(slot)
         elif kind == "abc-world":
-            slot = self._selected_slot()
             wf.start_abc_world(slot=slot)
-            self._set_active_slot(slot)
         else:
             raise ValueError(f"Unknown calibration method {self.method.value!r}.")
+        self.session.active_slot = slot                # the wizard made that tool data active
 
     def _on_resume(self, _event: Any) -> None:
         number = number_of_option(self.resume_list.value)
