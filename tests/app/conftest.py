@@ -3,24 +3,22 @@ server in-process on a free port (real viser server, headless websocket clients)
 
 from __future__ import annotations
 
-import socket
 import sys
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import pytest
+from tcp_pendant.controller import (
+    RobotKinematics,
+    VirtualController,
+    builtin_robots,
+    builtin_tools,
+)
 
 from tcpcal.library import ToolLibrary
-from tcp_pendant.controller import RobotKinematics, VirtualController, builtin_robots, builtin_tools
 
 sys.path.insert(0, str(Path(__file__).parent))
-from wsclient import wait_until  # noqa: E402,F401  (re-exported: the tests import it from here)
-
-
-def free_port() -> int:
-    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
-        s.bind(("127.0.0.1", 0))
-        return int(s.getsockname()[1])
+from wsclient import free_port, wait_until  # noqa: F401  (re-exported: the tests import them from here)
 
 
 @pytest.fixture(scope="session")
