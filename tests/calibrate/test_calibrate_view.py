@@ -77,6 +77,7 @@ def test_four_auto_touches_run_a_4point_calibration_and_every_view_follows(page)
     assert not v.menu_folder.visible and v.steps.folder.visible             # the wizard alone
     assert v.steps.record.disabled is False and v.steps.next.disabled is True
     assert v.steps.meter_bar.visible and "Pose diversity" in v.steps.meter_md.content
+    assert "Not determinable yet. " in v.steps.meter_md.content         # with tcpcal's advice
     progress = [v.steps.progress.value]
     for k in range(4):
         assert f"Step {k + 1} of 4" in v.steps.head_md.content

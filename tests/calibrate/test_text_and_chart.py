@@ -76,6 +76,9 @@ def test_meter_words_give_units_and_the_figures() -> None:
     assert "0.80 mm → **0.40 mm** (-50 %)" in text and "operator error 0.5 mm" in text
     assert "Nearest recorded orientation: 30° away" in text
     assert "determinable: predicted RMS error **0.80 mm**" in meter_markdown(_gain(math.inf, 0.8, 50.0), q, 0.5)
+    stuck = _gain(math.inf, math.inf, math.inf)                 # not determinable even with this pose
+    assert "Not determinable yet. " + q.message in meter_markdown(stuck, q, 0.5)
+    assert "Not determinable yet.\n" in meter_markdown(stuck, None, 0.5) + "\n"
 
 
 # ------------------------------------------------------------------ results

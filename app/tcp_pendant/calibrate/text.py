@@ -132,15 +132,17 @@ def meter_level(gain: CandidateGain) -> tuple[float, str]:
     return value, "green"
 
 
-def meter_markdown(gain: CandidateGain, quality: PoseQuality, sigma_mm: float) -> str:
+def meter_markdown(gain: CandidateGain, quality: PoseQuality | None, sigma_mm: float) -> str:
     """Live advice while jogging toward the next touch (all figures predicted by tcpcal from the
-    orientations alone, for an operator error of ``sigma_mm`` per axis)."""
+    orientations alone, for an operator error of ``sigma_mm`` per axis). ``quality`` (tcpcal's
+    advice on the touches so far) is needed only while recording here would still not make
+    the TCP determinable (``gain.predicted_after`` infinite)."""
     head = f"**Pose diversity** (if you recorded here, operator error {fmt_num(sigma_mm, 1)} mm):"
     if gain.too_close:
         advice = (f"⚠ **Too close** to an earlier touch: {_deg(gain.angle_to_nearest_deg, 0)} apart. "
                   "Tilt the tool further, about another axis, before recording.")
     elif math.isinf(gain.predicted_after):
-        advice = f"Not determinable yet. {quality.message}"
+        advice = "Not determinable yet." + ("" if quality is None else f" {quality.message}")
     elif math.isinf(gain.predicted_before):
         advice = (f"✔ Recording here makes the TCP determinable: predicted RMS error "
                   f"**{_mm(gain.predicted_after)}**.")

@@ -11,6 +11,7 @@ uncertainty tcpcal predicts if the user recorded here.
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING, Any
 
 from tcp_pendant.calibrate import AUTO_SIGMA_MAX_MM, AutoTouchRequest
@@ -189,4 +190,5 @@ class WizardStepsView:
         value, color = meter_level(gain)
         self.meter_bar.value = round(value, 1)
         self.meter_bar.color = color
-        set_content(self.meter_md, meter_markdown(gain, wiz.quality(), wiz.assumed_sigma_mm))
+        quality = wiz.quality() if math.isinf(gain.predicted_after) else None   # only then shown
+        set_content(self.meter_md, meter_markdown(gain, quality, wiz.assumed_sigma_mm))
