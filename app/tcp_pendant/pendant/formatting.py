@@ -66,12 +66,12 @@ def touch_indicator_markdown(touch: TouchGeometry, *, hide_distance: bool) -> st
     * otherwise, unless ``hide_distance``: "TOUCHING" within 0.5 mm, else the distance (mm).
     """
     if touch.crashed:
-        return (f"🛑 **CRASH**: the tool tip went {fmt_num(touch.penetration_mm, 1)} mm through the "
+        return (f"✖ **CRASH**: the tool tip went {fmt_num(touch.penetration_mm, 1)} mm through the "
                 "reference tip. Jog back out.")
     if hide_distance:
         return "Distance to reference tip: *hidden (judge by eye)*"
     if touch.touching:
-        return f"✅ **TOUCHING** the reference tip ({fmt_num(touch.distance_mm)} mm ≤ {TOUCH_TOLERANCE_MM} mm)"
+        return f"✔ **TOUCHING** the reference tip ({fmt_num(touch.distance_mm)} mm ≤ {TOUCH_TOLERANCE_MM} mm)"
     return f"Distance to reference tip: **{fmt_num(touch.distance_mm)} mm**"
 
 

@@ -215,7 +215,7 @@ class ToolPanel:
             self.entry_md.content = "⚠ Not saved: correct the fields marked above."
             return
         lib.save(slot, res.tool)
-        self.entry_md.content = f"✅ Saved **{res.tool.name}** in slot {slot}."
+        self.entry_md.content = f"✔ Saved **{res.tool.name}** in slot {slot}."
         self.reload()
         self.slots.value = slot_option(slot, res.tool.name)
         self._show_slot()
