@@ -1,0 +1,190 @@
+"""The two commands of the README, ``scripts/run-app.sh`` and ``scripts/run-tests.sh``, run for real
+(bash) in a copy of the repository's scripts with a fake ``.venv`` and a fake ``PATH``.
+
+The fake ``.venv/bin/python`` logs every call to ``calls.log`` and answers ``-m pip`` with
+``$FAKE_PIP_RC`` (default 1: no package index) and ``-m pytest`` with ``$FAKE_PYTEST_RC``;
+``.venv/bin/tcp-pendant`` logs its arguments. ``PATH`` holds only the tools the scripts need
+(bash, coreutils), a fake ``id`` printing ``$FAKE_UID``, and whatever a test adds (``sudo``,
+``apt-get``, ``chromium``): without them the machine has no root, no sudo and no chromium.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import shutil
+import subprocess
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+REAL_TOOLS = ("bash", "sh", "env", "dirname", "cut", "sha256sum", "rm", "touch", "cat", "mkdir", "chmod")
+
+
+def _write_exe(path: Path, text: str) -> None:
+    path.write_text(text)
+    path.chmod(0o755)
+
+
+@pytest.fixture
+def repo(tmp_path: Path) -> Path:
+    """A copy of scripts/ and pyproject.toml with a complete fake .venv and a bare fake PATH."""
+    r = tmp_path / "repo"
+    (r / "scripts").mkdir(parents=True)
+    for f in (ROOT / "scripts").glob("*.sh"):
+        shutil.copy(f, r / "scripts")
+    shutil.copy(ROOT / "pyproject.toml", r)
+    venv_bin = r / ".venv" / "bin"
+    venv_bin.mkdir(parents=True)
+    log = r / "calls.log"
+    _write_exe(venv_bin / "python", f"""#!/bin/sh
+printf 'python' >> {log}; for a in "$@"; do printf ' [%s]' "$a" >> {log}; done; echo >> {log}
+if [ "$2" = pip ]; then exit "${{FAKE_PIP_RC:-1}}"; fi
+if [ "$2" = pytest ]; then echo "CHROMIUM=${{CHROMIUM:-}}" >> {log}; exit "${{FAKE_PYTEST_RC:-0}}"; fi
+exit 0
+""")
+    _write_exe(venv_bin / "tcp-pendant", f"#!/bin/sh\necho tcp-pendant \"$@\" >> {log}\n")
+    _write_exe(venv_bin / "tcpcal", "#!/bin/sh\n")
+    fake = tmp_path / "bin"
+    fake.mkdir()
+    for tool in REAL_TOOLS:
+        real = shutil.which(tool)
+        assert real is not None, tool
+        os.symlink(real, fake / tool)
+    _write_exe(fake / "id", "#!/bin/sh\necho \"${FAKE_UID:-1000}\"\n")
+    return r
+
+
+def sha(repo: Path) -> str:
+    return hashlib.sha256((repo / "pyproject.toml").read_bytes()).hexdigest()
+
+
+def run(repo: Path, script: str, *args: str, **env: str) -> subprocess.CompletedProcess[str]:
+    base = {"PATH": str(repo.parent / "bin"), "HOME": str(repo.parent)}
+    return subprocess.run(["bash", str(repo / "scripts" / script), *args], env={**base, **env},
+                          capture_output=True, text=True, timeout=60)
+
+
+def calls(repo: Path) -> list[str]:
+    log = repo / "calls.log"
+    return log.read_text().splitlines() if log.exists() else []
+
+
+def pip_calls(repo: Path) -> list[str]:
+    return [c for c in calls(repo) if c.startswith("python [-m] [pip]")]
+
+
+# ---------------------------------------------------------------- run-app.sh
+def test_run_app_starts_offline_when_the_stamp_matches(repo: Path) -> None:
+    """Issue 13: ``run-app.sh --help`` failed offline because pip ran at every start."""
+    (repo / ".venv" / f".installed-app-{sha(repo)}").touch()
+    p = run(repo, "run-app.sh", "--help")            # pip would fail (FAKE_PIP_RC=1)
+    assert p.returncode == 0, p.stderr
+    assert pip_calls(repo) == []
+    assert calls(repo) == ["tcp-pendant --help"]
+
+
+def test_run_app_installs_when_pyproject_changed(repo: Path) -> None:
+    old = repo / ".venv" / ".installed-app-0000"     # an install of another pyproject.toml
+    old.touch()
+    p = run(repo, "run-app.sh", "--port", "8090", FAKE_PIP_RC="0")
+    assert p.returncode == 0, p.stderr
+    assert pip_calls(repo) == ["python [-m] [pip] [install] [-q] [--disable-pip-version-check] [-e] [.]"]
+    assert not old.exists() and (repo / ".venv" / f".installed-app-{sha(repo)}").exists()
+    assert calls(repo)[-1] == "tcp-pendant --port 8090"
+    assert run(repo, "run-app.sh").returncode == 0 and len(pip_calls(repo)) == 1   # now stamped
+
+
+def test_run_app_offline_without_stamp_warns_and_uses_the_existing_venv(repo: Path) -> None:
+    p = run(repo, "run-app.sh", "--help")
+    assert p.returncode == 0, p.stderr
+    assert len(pip_calls(repo)) == 1 and calls(repo)[-1] == "tcp-pendant --help"
+    assert "WARNING" in p.stderr and "using the existing .venv" in p.stderr
+    assert not list((repo / ".venv").glob(".installed-*"))   # retried at the next start
+
+
+def test_run_app_without_a_venv_and_no_index_fails_with_a_hint(repo: Path) -> None:
+    (repo / ".venv" / "bin" / "tcp-pendant").unlink()
+    p = run(repo, "run-app.sh", "--help")
+    assert p.returncode != 0
+    assert "'pip install -e .' failed" in p.stderr and "package index" in p.stderr
+    assert not any(c.startswith("tcp-pendant") for c in calls(repo))
+
+
+def test_the_test_stamp_covers_the_app_but_not_the_reverse(repo: Path) -> None:
+    (repo / ".venv" / f".installed-test-{sha(repo)}").touch()
+    assert run(repo, "run-app.sh").returncode == 0 and pip_calls(repo) == []
+    (repo / ".venv" / f".installed-test-{sha(repo)}").unlink()
+    (repo / ".venv" / f".installed-app-{sha(repo)}").touch()
+    (repo.parent / "bin" / "chromium").symlink_to(shutil.which("true") or "/bin/true")
+    assert run(repo, "run-tests.sh", FAKE_PIP_RC="0").returncode == 0
+    assert pip_calls(repo) == ["python [-m] [pip] [install] [-q] [--disable-pip-version-check] [-e] [.[test]]"]
+    assert (repo / ".venv" / f".installed-test-{sha(repo)}").exists()
+
+
+# ---------------------------------------------------------------- run-tests.sh
+def pytest_calls(repo: Path) -> list[str]:
+    return [c for c in calls(repo) if c.startswith("python [-m] [pytest]")]
+
+
+@pytest.fixture
+def stamped(repo: Path) -> Path:
+    (repo / ".venv" / f".installed-test-{sha(repo)}").touch()
+    return repo
+
+
+def test_run_tests_without_root_sudo_or_chromium_runs_the_rest_and_says_so(stamped: Path) -> None:
+    """Issue 13: it stopped with ``sudo: command not found`` (127) before pytest ran."""
+    p = run(stamped, "run-tests.sh", "-q", "tests/tcpcal")
+    assert p.returncode == 0, p.stderr
+    assert pytest_calls(stamped) == ["python [-m] [pytest] [-m] [not browser] [-q] [tests/tcpcal]"]
+    lines = p.stderr.strip().splitlines()
+    assert "apt-get install chromium" in lines[0] and "neither be root nor use sudo" in lines[0]
+    assert lines[-1].startswith("!!!") and "BROWSER TESTS DID NOT RUN" in lines[-1]
+    assert "command not found" not in p.stderr
+
+
+def test_run_tests_without_chromium_keeps_a_marker_the_caller_gave(stamped: Path) -> None:
+    p = run(stamped, "run-tests.sh", "-m", "slow", "-x", FAKE_PYTEST_RC="1")
+    assert p.returncode == 1                             # pytest's own status
+    assert pytest_calls(stamped) == ["python [-m] [pytest] [-m] [not browser and (slow)] [-x]"]
+    assert "BROWSER TESTS DID NOT RUN" in p.stderr.strip().splitlines()[-1]
+
+
+def test_run_tests_under_ci_fails_when_chromium_is_missing(stamped: Path) -> None:
+    p = run(stamped, "run-tests.sh", CI="true")
+    assert p.returncode == 1
+    assert len(pytest_calls(stamped)) == 1               # the other tests still ran
+    assert "CI=true" in p.stderr and "BROWSER TESTS DID NOT RUN" in p.stderr
+
+
+def test_run_tests_as_root_installs_chromium_with_apt(stamped: Path) -> None:
+    """CI (root): apt-get installs chromium, then the whole suite runs with it."""
+    fake = stamped.parent / "bin"
+    _write_exe(fake / "apt-get", f"""#!/bin/sh
+echo "apt-get $*" >> {stamped / 'calls.log'}
+[ "$1" = install ] && printf '#!/bin/sh\\n' > {fake / 'chromium'} && chmod 755 {fake / 'chromium'}
+exit 0
+""")
+    p = run(stamped, "run-tests.sh", "-q", FAKE_UID="0", CI="true")
+    assert p.returncode == 0, p.stderr
+    assert "apt-get install -y -q chromium" in calls(stamped)
+    assert pytest_calls(stamped) == ["python [-m] [pytest] [-q]"]
+    assert f"CHROMIUM={fake / 'chromium'}" in calls(stamped)
+    assert "DID NOT RUN" not in p.stderr
+
+
+def test_run_tests_with_chromium_runs_everything(stamped: Path) -> None:
+    (stamped.parent / "bin" / "chromium").symlink_to(shutil.which("true") or "/bin/true")
+    p = run(stamped, "run-tests.sh", "-m", "browser")
+    assert p.returncode == 0, p.stderr
+    assert pytest_calls(stamped) == ["python [-m] [pytest] [-m] [browser]"]
+    assert p.stderr == ""
+
+
+def test_run_tests_with_a_bad_chromium_override_says_so(stamped: Path) -> None:
+    p = run(stamped, "run-tests.sh", CHROMIUM="/nowhere/chromium")
+    assert p.returncode == 0
+    assert "CHROMIUM=/nowhere/chromium is not an executable" in p.stderr
+    assert pytest_calls(stamped) == ["python [-m] [pytest] [-m] [not browser]"]
