@@ -23,11 +23,21 @@ Consistency rules:
   or a crash therefore sees either the previous or the new file, never a partial one, and two
   processes saving at once lose nothing. Leftover temporary files of a killed writer are
   removed by the next mutation (under the lock).
-- A file that cannot be decoded (bad UTF-8 or JSON, wrong format/version, invalid slot or
-  tool) is *moved aside* (under the lock) to ``<stem>.corrupt-<UTC timestamp>.json`` next to
-  it, never overwritten; ``recovered_backup`` then names the backup and a
-  :class:`ToolLibraryWarning` is issued. The library continues empty. A file that exists but
-  cannot be read at all (permissions, I/O error) raises :class:`ToolLibraryError` instead.
+- A damaged file never costs the valid tools. It is read entry by entry: each bad entry (a
+  slot key that is not 1..16, a tool that ``Tool.from_dict`` rejects -- NaN or inf TCP, a
+  numeric or over-long name, wrong types, unknown keys --, a name already used by an earlier
+  slot, an ``active_slot`` that is not a valid occupied slot, unknown top-level keys) is *set
+  aside*: under the lock the file as it was is copied byte for byte to a new
+  ``<stem>.corrupt-<UTC timestamp>[-n].json`` next to it (never overwriting an earlier
+  backup), then the file is rewritten atomically with the valid entries only.
+- A file that cannot be used at all (bad UTF-8, not JSON, nested so deeply that the JSON
+  parser gives up, not an object, wrong ``format``/``version``, ``tools`` not an object) is
+  moved aside whole to such a backup; the library continues empty.
+- Either way :attr:`ToolLibrary.recovery` is a :class:`LibraryRecovery` (backup path, one
+  line per problem, the slots kept; ``recovered_backup`` names the backup, for compatibility)
+  and a :class:`ToolLibraryWarning` is issued. A file that exists but cannot be read at all
+  (permissions, I/O error), or a backup that cannot be written, raises
+  :class:`ToolLibraryError` instead: nothing is rewritten without its backup.
 """
 
 from __future__ import annotations
@@ -51,6 +61,7 @@ from tcpcal.tool import Tool
 __all__ = [
     "FORMAT_NAME",
     "FORMAT_VERSION",
+    "LibraryRecovery",
     "ToolLibrary",
     "ToolLibraryError",
     "ToolLibraryWarning",
@@ -61,6 +72,7 @@ FORMAT_NAME = "tcp-pendant-tool-library"
 FORMAT_VERSION = 1
 LOCK_TIMEOUT_S = 30.0
 _NUMBER_ARRAY = re.compile(r"\[\n\s*([-+0-9.eE,\s]+?)\n\s*\]")
+_SLOT_KEY = re.compile(r"[0-9]{1,3}")  # ASCII digits only ("\u0663".isdigit() is True)
 
 
 class ToolLibraryError(TcpcalError):
@@ -68,7 +80,7 @@ class ToolLibraryError(TcpcalError):
 
 
 class ToolLibraryWarning(UserWarning):
-    """Issued when a corrupt library file was moved aside."""
+    """Issued when a damaged library file was set aside (whole, or some of its entries)."""
 
 
 class _CorruptFile(Exception):
@@ -113,49 +125,121 @@ class _State:
         return text + "\n"
 
     @classmethod
-    def from_json(cls, text: str, n_slots: int) -> _State:
+    def from_json(cls, text: str, n_slots: int) -> tuple[_State, list[str]]:
+        """Parse ``text`` entry by entry: ``(state of the valid entries, problems)``.
+
+        Raises:
+            _CorruptFile: the file cannot be used at all (not JSON, nested too deeply, not a
+                library object, wrong format or version, ``tools`` not an object).
+        """
         try:
             doc = json.loads(text)
         except json.JSONDecodeError as exc:
             raise _CorruptFile(f"not valid JSON ({exc})") from None
+        except RecursionError:
+            raise _CorruptFile("nested too deeply to be a tool library") from None
         if not isinstance(doc, dict):
             raise _CorruptFile("the top level is not a JSON object")
         if doc.get("format") != FORMAT_NAME:
-            raise _CorruptFile(f"'format' is {doc.get('format')!r}, expected {FORMAT_NAME!r}")
+            raise _CorruptFile(
+                f"'format' is {_short(repr(doc.get('format')))}, expected {FORMAT_NAME!r}"
+            )
         if doc.get("version") != FORMAT_VERSION:
             raise _CorruptFile(
-                f"'version' is {doc.get('version')!r}; this tcpcal reads version {FORMAT_VERSION}"
+                f"'version' is {_short(repr(doc.get('version')))}; this tcpcal reads version "
+                f"{FORMAT_VERSION}"
             )
-        unknown = sorted(set(doc) - {"format", "version", "active_slot", "tools"})
-        if unknown:
-            raise _CorruptFile(f"unknown top-level keys {unknown}")
         raw_tools = doc.get("tools", {})
         if not isinstance(raw_tools, dict):
             raise _CorruptFile("'tools' is not an object of slot -> tool")
+        problems: list[str] = []
+        unknown = sorted(set(doc) - {"format", "version", "active_slot", "tools"})
+        if unknown:
+            problems.append(f"unknown top-level keys {_short(repr(unknown))} dropped")
         tools: dict[int, Tool] = {}
         names: dict[str, int] = {}
         for key, value in raw_tools.items():
-            if not (isinstance(key, str) and key.isdigit() and 1 <= int(key) <= n_slots):
-                raise _CorruptFile(f"tool slot key {key!r} is not a slot number 1..{n_slots}")
+            if not (_SLOT_KEY.fullmatch(key) and 1 <= int(key) <= n_slots):
+                problems.append(
+                    f"entry {_short(repr(key))}: not a slot number 1..{n_slots}"
+                )
+                continue
             slot = int(key)
             if slot in tools:
-                raise _CorruptFile(f"slot {slot} appears twice")
+                problems.append(f"entry {key!r}: slot {slot} appears twice (first one kept)")
+                continue
             try:
                 tool = Tool.from_dict(value)
             except TcpcalError as exc:
-                raise _CorruptFile(f"slot {slot}: {exc}") from None
+                problems.append(f"slot {slot}: {_short(str(exc))}")
+                continue
+            except RecursionError:
+                problems.append(f"slot {slot}: nested too deeply to be a tool")
+                continue
             if tool.name in names:
-                raise _CorruptFile(
-                    f"tool name {tool.name!r} is used by slots {names[tool.name]} and {slot}"
+                problems.append(
+                    f"slot {slot}: the name {tool.name!r} is already used by slot "
+                    f"{names[tool.name]}"
                 )
+                continue
             names[tool.name] = slot
             tools[slot] = tool
         active = doc.get("active_slot")
         if active is not None and (
             isinstance(active, bool) or not isinstance(active, int) or active not in tools
         ):
-            raise _CorruptFile(f"'active_slot' {active!r} is not an occupied slot")
-        return cls(tools, active)
+            problems.append(
+                f"'active_slot' {_short(repr(active))} is not a valid occupied slot; no tool "
+                "is active"
+            )
+            active = None
+        return cls(tools, active), problems
+
+
+def _short(text: str, limit: int = 160) -> str:
+    """``text`` cut to ``limit`` characters (a problem line must stay one readable line)."""
+    text = " ".join(text.split())
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+@dataclasses.dataclass(frozen=True)
+class LibraryRecovery:
+    """What one load of a damaged library file set aside (``ToolLibrary.recovery``).
+
+    Attributes:
+        path: the library file.
+        backup: the copy of the file as it was found (bytes unchanged), next to it.
+        problems: one line per entry set aside, e.g. ``"slot 3: tcp_mm[0] must be a finite
+            number, got nan."``; for a file unusable as a whole, one line saying why.
+        kept_slots: slots of the valid tools kept in the library (empty if ``whole_file``).
+        whole_file: True when the file could not be used at all and the library starts empty.
+    """
+
+    path: Path
+    backup: Path
+    problems: tuple[str, ...]
+    kept_slots: tuple[int, ...] = ()
+    whole_file: bool = False
+
+    def summary(self, max_problems: int = 5) -> str:
+        """One plain-text paragraph: what was set aside, what was kept, where the backup is."""
+        shown = list(self.problems[:max_problems])
+        if len(self.problems) > max_problems:
+            shown.append(f"and {len(self.problems) - max_problems} more")
+        what = "; ".join(shown)
+        if self.whole_file:
+            return (
+                f"The tool library {self.path} could not be used ({what}); the whole file was "
+                f"moved aside to {self.backup} and the library starts empty. Repair that file by "
+                "hand to recover its tools."
+            )
+        kept = ", ".join(str(s) for s in self.kept_slots) or "none"
+        return (
+            f"The tool library {self.path} had {len(self.problems)} bad "
+            f"{'entry' if len(self.problems) == 1 else 'entries'} ({what}); "
+            f"{'it was' if len(self.problems) == 1 else 'they were'} set aside (the file as it "
+            f"was is kept in {self.backup}); the valid tools were kept (slots {kept})."
+        )
 
 
 class ToolLibrary:
@@ -167,20 +251,34 @@ class ToolLibrary:
 
     Attributes:
         path: the library file.
-        recovered_backup: where the last corrupt file seen by this object was moved, or None.
+        recovery: what the last load of a damaged file by this object set aside, or None.
+        recoveries: every such :class:`LibraryRecovery` of this object, oldest first.
+        recovered_backup: ``recovery.backup`` (where the file as it was is kept), or None.
     """
 
     N_SLOTS = 16
 
     def __init__(self, path: Path | str | None = None) -> None:
         self.path: Path = Path(path) if path is not None else default_library_path()
-        self.recovered_backup: Path | None = None
+        self.recoveries: tuple[LibraryRecovery, ...] = ()
         self._lock = filelock.FileLock(str(self.path) + ".lock", timeout=LOCK_TIMEOUT_S)
 
     # ------------------------------------------------------------------ reading
-    def _read_text(self) -> str | None:
+    @property
+    def recovery(self) -> LibraryRecovery | None:
+        """The last :class:`LibraryRecovery` of this object, or None."""
+        recoveries = self.recoveries
+        return recoveries[-1] if recoveries else None
+
+    @property
+    def recovered_backup(self) -> Path | None:
+        """Backup of the last damaged file this object set aside, or None (compatibility)."""
+        recovery = self.recovery
+        return None if recovery is None else recovery.backup
+
+    def _read_bytes(self) -> bytes | None:
         try:
-            data = self.path.read_bytes()
+            return self.path.read_bytes()
         except FileNotFoundError:
             return None
         except OSError as exc:
@@ -188,59 +286,98 @@ class ToolLibrary:
                 f"cannot read the tool library {self.path}: {exc.strerror or exc}; check the "
                 "file's permissions or pass another path."
             ) from None
+
+    def _load(self) -> tuple[_State, list[str], bytes]:
+        """Read and parse the file: ``(valid entries, problems, the bytes read)``.
+
+        Raises:
+            _CorruptFile: the file cannot be used at all.
+        """
+        data = self._read_bytes()
+        if data is None:
+            return _State(), [], b""
         try:
-            return data.decode("utf-8")
+            text = data.decode("utf-8")
         except UnicodeDecodeError as exc:
             raise _CorruptFile(f"not UTF-8 text ({exc})") from None
+        state, problems = _State.from_json(text, self.N_SLOTS)
+        return state, problems, data
 
-    def _load(self) -> _State:
-        """Read and parse the file; raises _CorruptFile when it is not a valid library."""
-        text = self._read_text()
-        if text is None:
-            return _State()
-        return _State.from_json(text, self.N_SLOTS)
+    def _backup_path(self) -> tuple[Path, int]:
+        """A new ``<stem>.corrupt-<UTC timestamp>[-n].json`` next to the file, reserved by
+        creating it empty (O_EXCL), so no earlier backup is ever overwritten."""
+        stamp = datetime.now(timezone.utc).strftime("%Y%m%dT%H%M%SZ")
+        base = f"{self.path.stem}.corrupt-{stamp}"
+        n = 0
+        while True:
+            backup = self.path.with_name(f"{base}.json" if n == 0 else f"{base}-{n}.json")
+            try:
+                fd = os.open(backup, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o644)
+            except FileExistsError:
+                n += 1
+                continue
+            return backup, fd
+
+    def _record(self, recovery: LibraryRecovery) -> None:
+        self.recoveries = (*self.recoveries, recovery)
+        warnings.warn(recovery.summary(max_problems=10), ToolLibraryWarning, stacklevel=5)
 
     def _move_aside(self, reason: str) -> None:
-        """Move the corrupt file to ``<stem>.corrupt-<timestamp>.json`` (caller holds the lock)."""
-        stamp = datetime.now(timezone.utc).strftime("%Y%m%dT%H%M%SZ")
-        base = self.path.with_name(f"{self.path.stem}.corrupt-{stamp}")
-        backup = base.with_name(base.name + ".json")
-        n = 1
-        while backup.exists():
-            backup = base.with_name(f"{base.name}-{n}.json")
-            n += 1
+        """Move the unusable file to a new backup name (caller holds the lock)."""
         try:
+            backup, fd = self._backup_path()
+            os.close(fd)
             os.replace(self.path, backup)
         except OSError as exc:
             raise ToolLibraryError(
                 f"the tool library {self.path} is corrupt ({reason}) and could not be moved "
-                f"aside to {backup}: {exc.strerror or exc}; move or repair it by hand."
+                f"aside: {exc.strerror or exc}; move or repair it by hand."
             ) from None
         self._fsync_dir()
-        self.recovered_backup = backup
-        warnings.warn(
-            f"the tool library {self.path} was corrupt ({reason}); it was moved aside to "
-            f"{backup} and the library starts empty. Repair that file by hand to recover its "
-            "tools.",
-            ToolLibraryWarning,
-            stacklevel=5,
+        self._record(LibraryRecovery(self.path, backup, (reason,), (), True))
+
+    def _set_aside_entries(self, state: _State, problems: list[str], data: bytes) -> None:
+        """Keep the file as it was in a backup, then rewrite it with the valid entries only
+        (caller holds the lock). The backup is complete before the file is replaced."""
+        try:
+            backup, fd = self._backup_path()
+            with os.fdopen(fd, "wb") as fh:
+                fh.write(data)
+                fh.flush()
+                os.fsync(fh.fileno())
+            self._fsync_dir()
+        except OSError as exc:
+            raise ToolLibraryError(
+                f"the tool library {self.path} has bad entries ({'; '.join(problems[:3])}) "
+                f"and no backup of it could be written: {exc.strerror or exc}; repair it by "
+                "hand or make its directory writable."
+            ) from None
+        self._write_or_raise(state)
+        self._record(
+            LibraryRecovery(self.path, backup, tuple(problems), tuple(sorted(state.tools)))
         )
 
     def _read_locked(self) -> _State:
-        """Read the file; caller holds the lock, so a corrupt file can be moved aside."""
+        """Read the file; caller holds the lock, so damaged parts can be set aside."""
         try:
-            return self._load()
+            state, problems, data = self._load()
         except _CorruptFile as exc:
             self._move_aside(str(exc))
             return _State()
+        if problems:
+            self._set_aside_entries(state, problems, data)
+        return state
 
     def _read(self) -> _State:
-        """Fresh read without the lock (writes are atomic); take the lock only if corrupt."""
+        """Fresh read without the lock (writes are atomic); take the lock only if damaged."""
         try:
-            return self._load()
+            state, problems, _ = self._load()
         except _CorruptFile:
-            with self._locked():
-                return self._read_locked()
+            problems = ["corrupt"]
+        if not problems:
+            return state
+        with self._locked():
+            return self._read_locked()
 
     # ------------------------------------------------------------------ writing
     def _locked(self) -> filelock.BaseFileLock:
@@ -296,18 +433,21 @@ class ToolLibrary:
             raise
         self._fsync_dir()
 
+    def _write_or_raise(self, state: _State) -> None:
+        try:
+            self._write_locked(state)
+        except OSError as exc:
+            raise ToolLibraryError(
+                f"cannot write the tool library {self.path}: {exc.strerror or exc}; check "
+                "the free space and the permissions of its directory."
+            ) from None
+
     def _mutate(self, change: Any) -> None:
         """Lock, re-read, apply ``change(state)``, write atomically, unlock."""
         with self._locked():
             state = self._read_locked()
             change(state)
-            try:
-                self._write_locked(state)
-            except OSError as exc:
-                raise ToolLibraryError(
-                    f"cannot write the tool library {self.path}: {exc.strerror or exc}; check "
-                    "the free space and the permissions of its directory."
-                ) from None
+            self._write_or_raise(state)
 
     # ------------------------------------------------------------------ public reads
     def tools(self) -> dict[int, Tool]:

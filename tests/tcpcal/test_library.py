@@ -213,25 +213,31 @@ def test_kill_during_saves_leaves_a_valid_file(tmp_path):
 
 
 # --------------------------------------------------------------------------- corrupt files
+def _doc(tools: dict, active=None, **extra) -> dict:
+    return {"format": "tcp-pendant-tool-library", "version": 1, "active_slot": active,
+            "tools": tools, **extra}
+
+
+def _entry(name, x=0.0, **kw) -> dict:
+    return {"name": name, "tcp_mm": [x, 0.0, 150.0], **kw}
+
+
 @pytest.mark.parametrize(
     "content",
     [
         b"{not json",
         b"\xff\xfe garbage",
+        b"[" * 100_000,  # json gives RecursionError, not JSONDecodeError
+        b'{"a": ' * 100_000,
+        b"[1, 2, 3]",
         json.dumps({"format": "something-else", "version": 1, "tools": {}}).encode(),
         json.dumps({"format": "tcp-pendant-tool-library", "version": 99, "tools": {}}).encode(),
-        json.dumps({"format": "tcp-pendant-tool-library", "version": 1, "active_slot": None,
-                    "tools": {"17": {"name": "a", "tcp_mm": [0, 0, 0]}}}).encode(),
-        json.dumps({"format": "tcp-pendant-tool-library", "version": 1, "active_slot": None,
-                    "tools": {"1": {"name": "a", "tcp_mm": [0, 0]}}}).encode(),
-        json.dumps({"format": "tcp-pendant-tool-library", "version": 1, "active_slot": 2,
-                    "tools": {"1": {"name": "a", "tcp_mm": [0, 0, 0]}}}).encode(),
-        json.dumps({"format": "tcp-pendant-tool-library", "version": 1, "active_slot": None,
-                    "tools": {"1": {"name": "a", "tcp_mm": [0, 0, 0]},
-                              "2": {"name": "a", "tcp_mm": [0, 0, 1]}}}).encode(),
+        json.dumps(_doc(["not", "an", "object"])).encode(),
     ],
+    ids=["not-json", "not-utf8", "deep-list", "deep-object", "top-level-list", "format",
+         "version", "tools-not-object"],
 )
-def test_corrupt_file_is_moved_aside_and_reported(tmp_path, content):
+def test_unusable_file_is_moved_aside_whole_and_reported(tmp_path, content):
     path = tmp_path / "tools.json"
     path.write_bytes(content)
     lib = ToolLibrary(path)
@@ -242,9 +248,152 @@ def test_corrupt_file_is_moved_aside_and_reported(tmp_path, content):
     assert backup.name.startswith("tools.corrupt-") and backup.suffix == ".json"
     assert backup.read_bytes() == content  # kept exactly, not rewritten
     assert not path.exists()
+    rec = lib.recovery
+    assert rec.whole_file and rec.backup == backup and rec.kept_slots == ()
+    assert len(rec.problems) == 1 and len(rec.problems[0]) < 400
+    assert str(backup) in rec.summary() and "starts empty" in rec.summary()
     lib.save(1, tool("fresh"))
     assert backup.read_bytes() == content  # the new save did not touch it
     assert list(ToolLibrary(path).tools()) == [1]
+
+
+def test_deep_nesting_is_named_as_the_reason(tmp_path):
+    path = tmp_path / "tools.json"
+    path.write_bytes(b"[" * 100_000)
+    lib = ToolLibrary(path)
+    with pytest.warns(ToolLibraryWarning):
+        assert lib.active_slot() is None
+    assert lib.recovery.problems == ("nested too deeply to be a tool library",)
+
+
+def test_nan_tcp_among_four_valid_tools_sets_aside_only_that_entry(tmp_path):
+    path = tmp_path / "tools.json"
+    entries = {str(s): _entry(f"tool{s}", float(s)) for s in (1, 2, 4, 5)}
+    entries["3"] = _entry("broken", float("nan"))
+    content = json.dumps(_doc(entries, active=2), indent=2).encode()  # writes NaN
+    assert b"NaN" in content
+    path.write_bytes(content)
+    lib = ToolLibrary(path)
+    with pytest.warns(ToolLibraryWarning, match="slot 3"):
+        tools = lib.tools()
+    assert {s: t.name for s, t in tools.items()} == {1: "tool1", 2: "tool2", 4: "tool4",
+                                                      5: "tool5"}
+    assert tools[4].tcp_mm == (4.0, 0.0, 150.0)
+    assert lib.active_slot() == 2
+    rec = lib.recovery
+    assert not rec.whole_file and rec.kept_slots == (1, 2, 4, 5)
+    assert len(rec.problems) == 1
+    assert rec.problems[0].startswith("slot 3:") and "finite" in rec.problems[0]
+    assert rec.backup.read_bytes() == content  # the bad entry survives in the backup
+    assert rec.backup.parent == tmp_path and rec.backup.name.startswith("tools.corrupt-")
+    assert str(rec.backup) in rec.summary() and "slot 3" in rec.summary()
+    # the file now holds the valid entries only: another reader sees no damage
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ToolLibraryWarning)
+        other = ToolLibrary(path)
+        assert sorted(other.tools()) == [1, 2, 4, 5]
+    assert other.recovery is None
+    assert "NaN" not in path.read_text(encoding="utf-8")
+    assert len(list(tmp_path.glob("*.corrupt-*"))) == 1
+
+
+@pytest.mark.parametrize(
+    ("bad_key", "bad_value", "active", "expect"),
+    [
+        ("3", _entry(42), None, "slot 3: tool name must be a string, got 42"),
+        ("3", _entry("x" * 30), None, "slot 3: tool name"),
+        ("3", _entry("tab\there"), None, "slot 3: tool name"),
+        ("3", {"name": "a3", "tcp_mm": [0, 0]}, None, "slot 3: tcp_mm must be 3 numbers"),
+        ("3", {"name": "a3", "tcp_mm": [0, 0, 0], "abc_deg": "0,0,0"}, None, "slot 3: abc_deg"),
+        ("3", {"name": "a3", "tcp_mm": [0, 0, 0], "colour": "red"}, None,
+         "slot 3: tool has unknown keys ['colour']"),
+        ("3", "a string", None, "slot 3: a tool must be an object"),
+        ("3", _entry("tool1"), None, "slot 3: the name 'tool1' is already used by slot 1"),
+        ("17", _entry("a17"), None, "entry '17': not a slot number 1..16"),
+        ("x", _entry("ax"), None, "entry 'x': not a slot number"),
+        ("\u00b2", _entry("sq"), None, "not a slot number"),  # '²'.isdigit() but int() fails
+        ("\u0663", _entry("arabic3"), None, "not a slot number"),
+        ("01", _entry("dup"), None, "slot 1 appears twice"),
+        (None, None, 7, "'active_slot' 7 is not a valid occupied slot"),
+        (None, None, True, "'active_slot' True"),
+    ],
+)
+def test_one_bad_entry_is_set_aside_and_the_others_kept(tmp_path, bad_key, bad_value, active,
+                                                       expect):
+    path = tmp_path / "tools.json"
+    entries = {"1": _entry("tool1", 1.0), "2": _entry("tool2", 2.0)}
+    if bad_key is not None:
+        entries[bad_key] = bad_value
+    content = json.dumps(_doc(entries, active=active), ensure_ascii=False).encode()
+    path.write_bytes(content)
+    lib = ToolLibrary(path)
+    with pytest.warns(ToolLibraryWarning, match="set aside"):
+        tools = lib.tools()
+    assert {s: t.name for s, t in tools.items()} == {1: "tool1", 2: "tool2"}
+    assert lib.recovery.problems == tuple(p for p in lib.recovery.problems if expect in p)
+    assert len(lib.recovery.problems) == 1
+    assert lib.recovered_backup.read_bytes() == content
+    assert lib.active_slot() is None
+
+
+def test_unknown_top_level_key_is_reported_and_tools_kept(tmp_path):
+    path = tmp_path / "tools.json"
+    path.write_text(json.dumps(_doc({"1": _entry("a")}, active=1, comment="mine")),
+                    encoding="utf-8")
+    lib = ToolLibrary(path)
+    with pytest.warns(ToolLibraryWarning):
+        assert lib.active_tool().name == "a"
+    assert lib.recovery.problems == ("unknown top-level keys ['comment'] dropped",)
+    assert "comment" in lib.recovered_backup.read_text(encoding="utf-8")
+
+
+def test_a_huge_bad_entry_gives_a_short_problem_line(tmp_path):
+    path = tmp_path / "tools.json"
+    notes = [[[[["x" * 1000] * 100]]]]  # not a string; its repr is ~100 kB
+    path.write_text(json.dumps(_doc({"1": _entry("a"), "2": _entry("b", notes=notes)})),
+                    encoding="utf-8")
+    lib = ToolLibrary(path)
+    with pytest.warns(ToolLibraryWarning):
+        assert list(lib.tools()) == [1]
+    (line,) = lib.recovery.problems
+    assert line.startswith("slot 2: notes must be a string") and len(line) <= 200
+
+
+def test_save_after_a_recovery_keeps_the_valid_tools_and_the_backup(tmp_path):
+    path = tmp_path / "tools.json"
+    content = json.dumps(_doc({"1": _entry("a"), "2": _entry(5), "3": _entry("c")})).encode()
+    path.write_bytes(content)
+    lib = ToolLibrary(path)
+    with pytest.warns(ToolLibraryWarning):
+        lib.save(4, tool("d"), activate=True)  # the save itself finds the damage
+    assert {s: t.name for s, t in ToolLibrary(path).tools().items()} == {1: "a", 3: "c", 4: "d"}
+    assert ToolLibrary(path).active_slot() == 4
+    assert lib.recovered_backup.read_bytes() == content
+    lib.rename(1, "a2")
+    lib.remove(3)
+    assert {s: t.name for s, t in lib.tools().items()} == {1: "a2", 4: "d"}
+    assert lib.recovered_backup.read_bytes() == content
+    assert len(lib.recoveries) == 1
+
+
+def test_two_successive_recoveries_keep_distinct_backups(tmp_path):
+    path = tmp_path / "tools.json"
+    lib = ToolLibrary(path)
+    contents = [
+        json.dumps(_doc({"1": _entry("a"), "2": _entry(1)})).encode(),
+        json.dumps(_doc({"1": _entry("a"), "2": _entry(2)})).encode(),
+        b"[" * 5000,
+        json.dumps(_doc({"1": _entry("a"), "5": _entry(float("inf"))})).encode(),
+    ]
+    for content in contents:  # within the same second: the timestamps collide
+        path.write_bytes(content)
+        with pytest.warns(ToolLibraryWarning):
+            lib.tools()
+    backups = [r.backup for r in lib.recoveries]
+    assert len(set(backups)) == 4
+    assert [b.read_bytes() for b in backups] == contents
+    assert [r.whole_file for r in lib.recoveries] == [False, False, True, False]
+    assert lib.recovery is lib.recoveries[-1]
 
 
 def test_corrupt_file_found_by_a_save_is_not_overwritten(tmp_path):
