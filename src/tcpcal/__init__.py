@@ -32,6 +32,7 @@ from tcpcal.pose_quality import (
     assess_touches,
     candidate_gain,
 )
+from tcpcal.tcp_zx import TcpZxResult, solve_tcp_zx
 from tcpcal.tool import Calibration, Tool, abc_deg_from_rotation, rotation_from_abc_deg
 
 __version__ = "0.1.0"
@@ -45,6 +46,7 @@ __all__ = [
     "OrientationResult",
     "PoseQuality",
     "TcpResult",
+    "TcpZxResult",
     "TcpcalError",
     "Tool",
     "ToolLibrary",
@@ -59,6 +61,7 @@ __all__ = [
     "rotation_from_abc_deg",
     "solve_abc_world",
     "solve_reference",
+    "solve_tcp_zx",
     "solve_three_point",
     "solve_three_point_lstsq",
     "solve_xyz4",
