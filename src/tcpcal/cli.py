@@ -26,11 +26,13 @@ from tcpcal.poses_csv import FlangePoses, accepted_layouts_text, read_poses_csv
 from tcpcal.report import (
     format_orientation_report,
     format_tcp_report,
+    format_tcp_zx_report,
     format_tool,
     format_tool_table,
     json_dumps,
     orientation_result_to_dict,
     tcp_result_to_dict,
+    tcp_zx_result_to_dict,
     tool_to_dict,
 )
 from tcpcal.tool import rotation_from_abc_deg
@@ -109,7 +111,7 @@ def build_parser() -> argparse.ArgumentParser:
                            description="Calibrate from a CSV of flange poses (one pose per "
                            "row, header row naming the columns). " + accepted_layouts_text())
     ssub = solve.add_subparsers(dest="method_cmd", required=True,
-                                metavar="{xyz4,reference,three-point,abc-world}")
+                                metavar="{xyz4,reference,three-point,abc-world,tcp-zx}")
 
     def add_common(sp: argparse.ArgumentParser) -> None:
         sp.add_argument("poses", metavar="POSES.csv", type=Path,
@@ -155,6 +157,18 @@ def build_parser() -> argparse.ArgumentParser:
     abc.add_argument("--current-abc", type=_abc_arg, metavar="A,B,C", default=None,
                      help="5d only: the tool's present KUKA A,B,C (deg) whose rotation about "
                      "tool X is kept")
+
+    zx = ssub.add_parser("tcp-zx", help="TCP and TOOL frame in one run (ABB TCP & Z, X)",
+                         description="ABB TCP & Z, X: a 'role' column says what each row is: "
+                         "touch (>= 4: the TCP on the reference point), z (the reference on "
+                         "the tool's +Z axis ahead of the TCP: back off along the tool's Z), x "
+                         "(the reference on the tool's +X axis). Several z and x rows are "
+                         "averaged; Z is kept, X orthogonalised against it.")
+    add_common(zx)
+    zx.add_argument("--sigma", type=_positive_float, metavar="MM", default=None,
+                    help="assumed touch noise per axis in mm (default: estimated)")
+    zx.add_argument("--no-outliers", dest="detect_outliers", action="store_false",
+                    help="do not flag outlying touches")
 
     # convert -------------------------------------------------------------------------------
     conv = sub.add_parser(
@@ -296,13 +310,42 @@ def _run_solve(args: argparse.Namespace) -> int:
         _emit(_with_source(out, poses) if args.json else format_orientation_report(
             ores, poses, command=f"solve abc-world --variant {args.variant}"))
         return 0
+    if cmd == "tcp-zx":
+        return _run_tcp_zx(args)
     raise AssertionError(cmd)  # pragma: no cover - argparse restricts the choices
+
+
+def _run_tcp_zx(args: argparse.Namespace) -> int:
+    """``solve tcp-zx``: ABB TCP & Z, X from a CSV with a ``role`` column."""
+    from tcpcal.tcp_zx import parse_role, solve_tcp_zx
+
+    poses = read_poses_csv(args.poses, min_rows=6, purpose="tcp-zx (at least 4 touch rows, "
+                           "1 z row and 1 x row)")
+    if poses.roles is None:
+        raise CliInputError(f"{poses.path} (header): no 'role' column; tcp-zx needs one "
+                            f"saying touch, z or x for each row")
+    roles = []
+    for i, text in enumerate(poses.roles):
+        try:
+            roles.append(parse_role(text))
+        except TcpcalError as exc:
+            raise CliInputError(f"{poses.where(i)}: {' '.join(str(exc).split())}") from None
+    try:
+        res = solve_tcp_zx(poses.rotations, poses.positions_mm, roles, sigma=args.sigma,
+                           detect_outliers=args.detect_outliers)
+    except TcpcalError as exc:
+        raise CliInputError(_solver_error(exc, poses)) from None
+    _emit(_with_source(tcp_zx_result_to_dict(res), poses) if args.json
+          else format_tcp_zx_report(res, poses))
+    return 0
 
 
 def _with_source(out: dict[str, Any], poses: FlangePoses) -> str:
     out = dict(out)
     out["input"] = {"path": str(poses.path), "layout": poses.layout, "n_rows": len(poses),
                     "line_numbers": list(poses.line_numbers)}
+    if getattr(poses, "joints_deg", None) is not None:  # j1..jK columns: kept, never solved
+        out["joints_deg"] = [list(j) for j in poses.joints_deg]
     return json_dumps(out)
 
 
@@ -385,12 +428,20 @@ def _run_tools(args: argparse.Namespace) -> int:
     try:
         with warnings.catch_warnings():  # reported below as one line, not a Python warning
             warnings.simplefilter("ignore")
-            return _tools_command(lib, args)
-    finally:
-        if getattr(lib, "recovered_backup", None) is not None:
-            print(f"tcpcal: warning: the tool library {lib.path} was corrupt; it was moved "
-                  f"aside to {lib.recovered_backup} and the library started empty",
-                  file=sys.stderr)
+            code = _tools_command(lib, args)
+    except (CliInputError, TcpcalError) as exc:  # still one line: the error, then the note
+        if not lib.recoveries:
+            raise
+        raise CliInputError(f"{exc} (note: {_recovery_line(lib)})") from None
+    if lib.recoveries:
+        print(f"tcpcal: warning: {_recovery_line(lib)}", file=sys.stderr)
+    return code
+
+
+def _recovery_line(lib: Any) -> str:
+    """What the library set aside while this command ran, and where the backup is."""
+    text = " ".join(_one_line(r.summary()) for r in lib.recoveries)
+    return text[:1].lower() + text[1:]
 
 
 def _tools_command(lib: Any, args: argparse.Namespace) -> int:

@@ -104,6 +104,12 @@ class FlangePoses:
         line_numbers: 1-based file line number of each pose (for messages).
         path: the file that was read.
         labels: the ``name`` or ``label`` column of each row if the file has one, else ``None``.
+        roles: the ``role`` column of each row (stripped, lower case; e.g. ``touch``, ``z``,
+            ``x`` for ``tcpcal solve tcp-zx``) if the file has one, else ``None``. Other
+            commands ignore it.
+        joints_deg: the joint values ``j1, j2, ...`` of each row (deg; linear axes in mm) if
+            the file has ``j1`` (then ``j1..jK``, consecutive), else ``None``; never used by a
+            solve, kept for the JSON output.
     """
 
     rotations: np.ndarray
@@ -112,6 +118,8 @@ class FlangePoses:
     line_numbers: tuple[int, ...]
     path: Path
     labels: tuple[str, ...] | None = None
+    roles: tuple[str, ...] | None = None
+    joints_deg: tuple[tuple[float, ...], ...] | None = None
 
     def __post_init__(self) -> None:
         for arr in (self.rotations, self.positions_mm):
@@ -249,11 +257,15 @@ def read_poses_csv(path: str | Path, *, min_rows: int = 1, max_rows: int | None 
     pose_cols = POSITION_COLUMNS + LAYOUTS[layout]
     col_index = [names.index(c) for c in pose_cols]
     label_col = next((names.index(c) for c in ("name", "label") if c in names), None)
+    role_col = names.index("role") if "role" in names else None
+    joint_cols = _joint_columns(names)
 
     rotations: list[np.ndarray] = []
     positions: list[np.ndarray] = []
     line_numbers: list[int] = []
     labels: list[str] = []
+    roles: list[str] = []
+    joints: list[tuple[float, ...]] = []
     for (line_no, _), cells in zip(content[1:], parsed[1:]):
         index = len(positions)
         where = f"{path}, line {line_no} (data row {index + 1})"
@@ -281,6 +293,10 @@ def read_poses_csv(path: str | Path, *, min_rows: int = 1, max_rows: int | None 
         line_numbers.append(line_no)
         if label_col is not None:
             labels.append(cells[label_col].strip())
+        if role_col is not None:
+            roles.append(cells[role_col].strip().lower())
+        if joint_cols:
+            joints.append(_joint_values(cells, joint_cols, where, index))
 
     n = len(positions)
     what = f" for {purpose}" if purpose else ""
@@ -299,4 +315,34 @@ def read_poses_csv(path: str | Path, *, min_rows: int = 1, max_rows: int | None 
         line_numbers=tuple(line_numbers),
         path=path,
         labels=tuple(labels) if label_col is not None else None,
+        roles=tuple(roles) if role_col is not None else None,
+        joints_deg=tuple(joints) if joint_cols else None,
     )
+
+
+def _joint_columns(names: Sequence[str]) -> list[tuple[str, int]]:
+    """``(name, index)`` of the joint columns ``j1, j2, ...`` (consecutive from ``j1``)."""
+    cols: list[tuple[str, int]] = []
+    while f"j{len(cols) + 1}" in names:
+        name = f"j{len(cols) + 1}"
+        cols.append((name, names.index(name)))
+    return cols
+
+
+def _joint_values(cells: Sequence[str], cols: Sequence[tuple[str, int]], where: str,
+                  index: int) -> tuple[float, ...]:
+    """The finite numbers of one row's joint columns (an error names the column)."""
+    out: list[float] = []
+    for name, j in cols:
+        cell = cells[j].strip()
+        try:
+            val = float(cell)
+        except ValueError:
+            raise _error(f"{where}: joint column '{name}' is not a number: {cell!r} (joint "
+                         f"values are optional: leave the j columns out or fill every row)",
+                         index=index) from None
+        if not math.isfinite(val):
+            raise _error(f"{where}: joint column '{name}' is {cell!r}, not a finite number",
+                         index=index)
+        out.append(val)
+    return tuple(out)

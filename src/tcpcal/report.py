@@ -19,6 +19,7 @@ if TYPE_CHECKING:  # imported for type hints only; the CLI imports the modules t
     from tcpcal.orientation import OrientationResult
     from tcpcal.origin import TcpResult
     from tcpcal.poses_csv import FlangePoses
+    from tcpcal.tcp_zx import TcpZxResult
     from tcpcal.tool import Tool
 
 __all__ = [
@@ -26,11 +27,13 @@ __all__ = [
     "METHOD_TITLES",
     "format_orientation_report",
     "format_tcp_report",
+    "format_tcp_zx_report",
     "format_tool",
     "format_tool_table",
     "json_dumps",
     "orientation_result_to_dict",
     "tcp_result_to_dict",
+    "tcp_zx_result_to_dict",
     "tool_to_dict",
 ]
 
@@ -306,4 +309,84 @@ def format_tool_table(tools: Mapping[int, Tool], active_slot: int | None) -> str
                      f"{a:9.3f} {b:9.3f} {c:9.3f}  {cal}")
     if active_slot is None:
         lines.append("No active tool (TCP = flange).")
+    return "\n".join(lines)
+
+
+def tcp_zx_result_to_dict(result: TcpZxResult) -> dict[str, Any]:
+    """The JSON object of ``solve tcp-zx`` (ABB TCP & Z, X; mm, deg).
+
+    The keys of ``solve xyz4`` for the touch rows (their ``rows``, ``outliers`` and
+    ``without_outliers`` are 0-based input rows), ``method`` = ``"tcp-zx"``, plus the keys of
+    the orientation methods (``rotation_matrix`` = ``R_flange_tool``, ``kuka_abc_deg``,
+    ``orthogonality_defect_deg``, ``displacements_mm`` = the z then the x distances) and
+    ``z_rows``, ``x_rows``, ``z_distances_mm``, ``x_distances_mm``.
+    """
+    out = tcp_result_to_dict(result.origin, rows=result.touch_rows)
+    out["method"] = "tcp-zx"
+    out["rotation_matrix"] = np.asarray(result.rotation, dtype=float)
+    out["kuka_abc_deg"] = np.asarray(result.kuka_abc_deg, dtype=float)
+    out["orthogonality_defect_deg"] = result.orthogonality_defect_deg
+    out["displacements_mm"] = [*result.z_distances, *result.x_distances]
+    out["z_rows"] = list(result.z_rows)
+    out["x_rows"] = list(result.x_rows)
+    out["z_distances_mm"] = list(result.z_distances)
+    out["x_distances_mm"] = list(result.x_distances)
+    out["warnings"] = list(result.warnings)
+    return out
+
+
+def format_tcp_zx_report(result: TcpZxResult, poses: FlangePoses | None = None, *,
+                         command: str = "solve tcp-zx") -> str:
+    """Plain-text report of ABB TCP & Z, X: the 4-point block of the touch rows, the TOOL frame
+    (KUKA A, B, C and ``R_flange_tool``), the axis distances, residuals, warnings (mm, deg)."""
+    o = result.origin
+    n = int(o.n_touches)
+    src = f" from {poses.path} (layout {poses.layout})" if poses is not None else ""
+    r = np.asarray(result.rotation, dtype=float)
+
+    def line_of(row: int) -> str:
+        return str(poses.line_numbers[row]) if poses is not None and row < len(poses) else ""
+
+    def label_of(row: int) -> str:
+        if poses is not None and poses.labels is not None and row < len(poses.labels):
+            return f"  {poses.labels[row]}" if poses.labels[row] else ""
+        return ""
+
+    lines = [f"tcpcal {command}: ABB TCP & Z, X (methods.md section 8), {n} touches, "
+             f"{len(result.z_rows)} z row(s), {len(result.x_rows)} x row(s){src}", ""]
+    lines += _tcp_block(o)
+    lines += [
+        f"TOOL orientation, KUKA (deg): {_abc(result.kuka_abc_deg)}",
+        "R_flange_tool (columns: tool X, Y, Z in FLANGE):",
+        *[f"  [{row[0]:10.6f} {row[1]:10.6f} {row[2]:10.6f}]" for row in r],
+        f"Orthogonality defect:         {_fig(result.orthogonality_defect_deg, ' deg', '.3f')}"
+        "  (X corrected, Z kept)",
+        "", "Axis rows (the reference ahead of the TCP on the tool axis):",
+        "   row  line  axis    d mm",
+    ]
+    for axis, rows, ds in (("z", result.z_rows, result.z_distances),
+                           ("x", result.x_rows, result.x_distances)):
+        for row, d in zip(rows, ds):
+            lines.append(f"  {row + 1:4d}  {line_of(row):>4}  {axis:>4}  {d:7.1f}{label_of(row)}")
+    lines += ["", "Per-touch residuals e_i = R_i t + f_i - r (mm):",
+              "   row  line      |e|       ex       ey       ez"]
+    outliers = set(o.outliers)
+    for i, row in enumerate(result.touch_rows):
+        e = np.asarray(o.residual_vectors[i], dtype=float)
+        mark = "  <- outlier" if i in outliers else ""
+        lines.append(f"  {row + 1:4d}  {line_of(row):>4}  {float(o.residuals[i]):7.3f}  "
+                     f"{e[0]:7.3f}  {e[1]:7.3f}  {e[2]:7.3f}{label_of(row)}{mark}")
+    lines.append("")
+    if outliers:
+        rows_txt = ", ".join(str(result.touch_rows[i] + 1) for i in sorted(outliers))
+        lines.append(f"Outliers: data row {rows_txt} stand(s) out; the TCP above uses every "
+                     "touch (--json: without_outliers).")
+    else:
+        lines.append("Outliers: none")
+    if result.warnings:
+        lines.append("Warnings:")
+        lines += _bullets(result.warnings)
+    else:
+        lines.append("Warnings: none")
+    lines += ["", *textwrap.wrap(CAVEAT, width=92)]
     return "\n".join(lines)
