@@ -229,7 +229,7 @@ class LibraryRecovery:
         what = "; ".join(shown)
         if self.whole_file:
             return (
-                f"The tool library {self.path} could not be used ({what}); the whole file was "
+                f"The tool library {self.path} is corrupt ({what}); the whole file was "
                 f"moved aside to {self.backup} and the library starts empty. Repair that file by "
                 "hand to recover its tools."
             )
@@ -324,11 +324,14 @@ class ToolLibrary:
 
     def _move_aside(self, reason: str) -> None:
         """Move the unusable file to a new backup name (caller holds the lock)."""
+        backup: Path | None = None
         try:
             backup, fd = self._backup_path()
             os.close(fd)
             os.replace(self.path, backup)
         except OSError as exc:
+            if backup is not None:  # the reserved name stays free
+                backup.unlink(missing_ok=True)
             raise ToolLibraryError(
                 f"the tool library {self.path} is corrupt ({reason}) and could not be moved "
                 f"aside: {exc.strerror or exc}; move or repair it by hand."

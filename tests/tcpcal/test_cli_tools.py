@@ -105,6 +105,76 @@ def test_tools_corrupt_library_is_reported(tmp_path: Path,
     assert len(backups) == 1 and backups[0].read_text() == "{ this is not json"
 
 
+def _library_text(entries: dict, active=None) -> str:
+    return json.dumps({"format": "tcp-pendant-tool-library", "version": 1,
+                       "active_slot": active, "tools": entries})
+
+
+def test_tools_bad_entry_is_set_aside_and_the_rest_listed(tmp_path: Path,
+                                                          capsys: pytest.CaptureFixture[str]) -> None:
+    lib = tmp_path / "tools.json"
+    entries = {str(s): {"name": f"tool{s}", "tcp_mm": [s, 0, 100]} for s in (1, 2, 4, 5)}
+    entries["3"] = {"name": "broken", "tcp_mm": [float("nan"), 0, 100]}
+    text = _library_text(entries, active=4)
+    lib.write_text(text)
+    code, out, err = run(["tools", "--library", str(lib), "list", "--json"], capsys)
+    assert code == 0
+    d = json.loads(out)
+    assert [t["slot"] for t in d["tools"]] == [1, 2, 4, 5] and d["active_slot"] == 4
+    (backup,) = tmp_path.glob("tools.corrupt-*")
+    assert backup.read_text() == text
+    assert err.count("\n") == 1 and err.startswith("tcpcal: warning: the tool library")
+    assert "slot 3: tcp_mm[0] must be a finite number" in err and str(backup) in err
+    assert "slots 1, 2, 4, 5" in err
+    # the next command sees a clean library: no warning any more
+    code, out, err = run(["tools", "--library", str(lib), "show", "tool4"], capsys)
+    assert code == 0 and err == "" and "Slot 4: tool4" in out
+
+
+def test_tools_error_after_a_recovery_is_still_one_line(tmp_path: Path,
+                                                        capsys: pytest.CaptureFixture[str]) -> None:
+    lib = tmp_path / "tools.json"
+    lib.write_text(_library_text({"1": {"name": "a", "tcp_mm": [0, 0, 1]},
+                                  "3": {"name": 3, "tcp_mm": [0, 0, 1]}}))
+    err = one_error_line(["tools", "--library", str(lib), "show", "3"], capsys,
+                         "slot 3 is empty", r"note: the tool library .* had 1 bad entry",
+                         "slot 3: tool name must be a string", "tools.corrupt-")
+    assert err.startswith("tcpcal: error: ")
+
+
+@pytest.mark.parametrize("content", [b"[" * 100_000, b'{"tools": ' * 100_000])
+def test_tools_deeply_nested_library_is_moved_aside_not_a_traceback(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], content: bytes) -> None:
+    lib = tmp_path / "tools.json"
+    lib.write_bytes(content)
+    code, out, err = run(["tools", "--library", str(lib), "list"], capsys)
+    assert code == 0, err
+    assert "No tools stored" in out
+    assert err.count("\n") == 1 and "nested too deeply" in err and "moved aside" in err
+    assert "Traceback" not in err and "RecursionError" not in err
+    (backup,) = tmp_path.glob("tools.corrupt-*")
+    assert backup.read_bytes() == content
+    ok(["tools", "--library", str(lib), "add", "1", "fresh", "--xyz", "0,0,100"], capsys)
+    assert backup.read_bytes() == content
+
+
+def test_tools_unmovable_corrupt_library_is_exit_2(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                   monkeypatch: pytest.MonkeyPatch) -> None:
+    import tcpcal.library
+
+    lib = tmp_path / "tools.json"
+    lib.write_bytes(b"[" * 100_000)
+
+    def refuse(src, dst):  # a read-only directory (the tests may run as root)
+        raise PermissionError(13, "Permission denied")
+
+    monkeypatch.setattr(tcpcal.library.os, "replace", refuse)
+    one_error_line(["tools", "--library", str(lib), "list"], capsys,
+                   "nested too deeply", "could not be moved aside", "Permission denied")
+    assert lib.read_bytes() == b"[" * 100_000
+    assert not list(tmp_path.glob("tools.corrupt-*"))
+
+
 # ---------------------------------------------------------------------------------- convert
 def test_convert_kuka_numbers_to_abb(capsys: pytest.CaptureFixture[str]) -> None:
     d = json.loads(ok(["convert", "--from", "kuka", "--to", "abb", "10,20,30,0,-90,0",
