@@ -17,7 +17,7 @@ import time
 from collections.abc import Sequence
 from pathlib import Path
 
-__all__ = ["build_parser", "main", "network_warning"]
+__all__ = ["build_parser", "main", "network_warning", "ready_urls"]
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -34,7 +34,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="physical tool mounted at start (default: pointer)")
     p.add_argument("--host", default="127.0.0.1",
                    help="address to bind (default 127.0.0.1; anything else lets the network connect)")
-    p.add_argument("--port", type=int, default=8080, help="port (default 8080; 0: any free port)")
+    p.add_argument("--port", type=int, default=8080,
+                   help="port (default 8080; 0: any free port; a port in use is refused, exit 2)")
     p.add_argument("--tool-library", type=Path, default=None,
                    help="tool library JSON file (default: the user's data directory)")
     p.add_argument("--shared", action="store_true",
@@ -54,6 +55,25 @@ def network_warning(host: str) -> str | None:
         return None
     return (f"WARNING: listening on {host}: anyone on the network who can reach this machine "
             "can open the pendant and save tools to the library. Use --host 127.0.0.1 to keep it local.")
+
+
+def ready_urls(local_url: str, network: Sequence[str], host: str) -> str:
+    """The URLs of the ready line: on loopback ``local_url``; listening on the network, the URLs
+    trainees can open (host name and addresses), then this machine's own URL.
+
+    Args:
+        local_url: the URL that works on this machine (``PendantApp.url``).
+        network: ``PendantApp.network_urls`` (empty on loopback, or when no address was found).
+        host: the ``--host`` given.
+    """
+    from tcp_pendant.server import is_loopback
+
+    if is_loopback(host) or list(network) == [local_url]:
+        return local_url
+    if not network:
+        return (f"{local_url}\n  no network address of this machine was found: trainees cannot connect; "
+                "check the network connection")
+    return f"{network[0]}\n  trainees open: {'  '.join(network)}   (on this machine: {local_url})"
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -76,7 +96,7 @@ def _main(argv: Sequence[str] | None) -> int:
     logging.basicConfig(level=logging.DEBUG if args.verbose else logging.WARNING,
                         format="%(levelname)s %(name)s: %(message)s")
     from tcp_pendant.controller import ControllerError
-    from tcp_pendant.server import AppConfig, PendantApp, parse_xyz_mm
+    from tcp_pendant.server import AppConfig, PendantApp, PortInUseError, parse_xyz_mm
 
     if not 0 <= args.port <= 65535:
         print(f"tcp-pendant: error: --port must be 0..65535, got {args.port}", file=sys.stderr)
@@ -95,6 +115,9 @@ def _main(argv: Sequence[str] | None) -> int:
         print(warning, file=sys.stderr)
     try:
         url = app.start()
+    except PortInUseError as exc:
+        print(f"tcp-pendant: error: {exc}", file=sys.stderr)
+        return 2
     except OSError as exc:
         print(f"tcp-pendant: error: cannot listen on {args.host}:{args.port}: {exc}", file=sys.stderr)
         return 2
@@ -103,8 +126,8 @@ def _main(argv: Sequence[str] | None) -> int:
         raise
     mode = "one robot shared by every browser" if args.shared else "one robot per browser"
     tip_mm = ", ".join(f"{v:.0f}" for v in app.reference_tip_m * 1000.0)
-    print(f"TCP Pendant ready in {time.perf_counter() - t0:.1f} s: {url}\n"
-          f"  robot {app.robot_label}, tool {app.tool.label}, reference tip ({tip_mm}) mm, {mode}\n"
+    print(f"TCP Pendant ready in {time.perf_counter() - t0:.1f} s: {ready_urls(url, app.network_urls, args.host)}"
+          f"\n  robot {app.robot_label}, tool {app.tool.label}, reference tip ({tip_mm}) mm, {mode}\n"
           f"  tool library {app.library.path}\n  Ctrl-C to stop.", flush=True)
     app.serve_forever()
     return 0

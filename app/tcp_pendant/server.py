@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from tcpcal.library import ToolLibrary
+from tcp_pendant.addresses import network_urls
 from tcp_pendant.controller import (
     ControllerError,
     solve_ik,
@@ -38,7 +39,7 @@ from tcp_pendant.session import Session
 from tcp_pendant.views import SceneView, build_session_views
 from tcp_pendant.views.meshes import link_meshes, rigid_meshes
 
-__all__ = ["AppConfig", "PendantApp", "default_reference_tip_mm", "is_loopback"]
+__all__ = ["AppConfig", "PendantApp", "PortInUseError", "default_reference_tip_mm", "is_loopback"]
 
 log = logging.getLogger(__name__)
 
@@ -69,6 +70,17 @@ class AppConfig:
     shared: bool = False
     reference_tip_mm: tuple[float, float, float] | None = None
     library_poll_s: float = 1.0
+
+
+class PortInUseError(OSError):
+    """The port asked for is taken (another program, or another pendant, listens on it)."""
+
+    def __init__(self, host: str, port: int) -> None:
+        super().__init__(f"port {port} on {host} is already in use (another tcp-pendant?); stop that "
+                         f"program, or choose another port: --port {port + 1 if port < 65535 else 8080}, "
+                         "or --port 0 for any free port")
+        self.host = host
+        self.port = port
 
 
 def is_loopback(host: str) -> bool:
@@ -304,6 +316,11 @@ class PendantApp:
 
         host = self.config.host
         self.server = viser.ViserServer(host=host, port=self.config.port, verbose=False)
+        if self.config.port != 0 and self.port != self.config.port:
+            # viser silently moves on to the next free port; the class was told this one
+            self.server.stop()
+            self.server = None
+            raise PortInUseError(host, self.config.port)
         self.server.gui.configure_theme(control_width="large", dark_mode=False, show_logo=False,
                                         show_share_button=False)
         self.server.gui.main_panel.dock_right()
@@ -324,10 +341,18 @@ class PendantApp:
         return int(self.server.get_port()) if self.server is not None else self.config.port
 
     @property
+    def network_urls(self) -> list[str]:
+        """The URLs other machines can open (``addresses.network_urls``): for ``--host 0.0.0.0``
+        the host name and every usable address; empty when serving on loopback."""
+        if is_loopback(self.config.host):
+            return []
+        return network_urls(self.config.host, self.port)
+
+    @property
     def url(self) -> str:
-        """``http://host:port``."""
+        """``http://host:port`` (for a wildcard host: ``127.0.0.1``, this machine's URL)."""
         host = self.config.host
-        shown = "127.0.0.1" if host in ("0.0.0.0", "") else host
+        shown = "127.0.0.1" if host in ("0.0.0.0", "") else "::1" if host == "::" else host
         if ":" in shown and not shown.startswith("["):
             shown = f"[{shown}]"
         return f"http://{shown}:{self.port}"

@@ -69,10 +69,52 @@ def test_command_serves_prints_the_url_and_stops_on_ctrl_c(tmp_path, host: str, 
     proc, line = _serve(tmp_path, "--host", host)
     try:
         url = re.search(r"http://\S+", line).group(0)
-        with urllib.request.urlopen(url.replace("0.0.0.0", "127.0.0.1"), timeout=10) as r:
-            assert r.status == 200
+        urls = [url]
+        if host == "0.0.0.0":                 # issue 13: the URLs trainees can open, not 127.0.0.1
+            from tcp_pendant.addresses import interface_addresses
+
+            assert proc.stdout is not None
+            more = proc.stdout.readline()
+            ips = [a for a in interface_addresses() if ":" not in a]
+            if ips:
+                listed = re.findall(r"http://\S+", more.split("(on this machine:")[0])
+                assert "trainees open:" in more and listed[0] == url
+                assert [u.rsplit(":", 1)[0][7:] for u in listed[1:]] == ips
+                assert "127.0.0.1" not in url and "0.0.0.0" not in more
+                urls = listed[1:] + re.findall(r"on this machine: (http://[^)\s]+)", more)
+            else:
+                assert "trainees cannot connect" in more
+        for u in urls:                        # each one answers (this machine's own addresses)
+            with urllib.request.urlopen(u, timeout=10) as r:
+                assert r.status == 200
     finally:
         proc.send_signal(signal.SIGINT)
         out, err = proc.communicate(timeout=30)
     assert proc.returncode == 0, err
     assert ("anyone on the network" in err) is warned
+
+
+def test_busy_port_is_refused_with_a_hint(tmp_path) -> None:
+    """Issue 13: viser moved on to the next port silently while the class had been told this one."""
+    import socket
+    import subprocess
+    import sys
+
+    with socket.socket() as busy:
+        busy.bind(("127.0.0.1", 0))
+        busy.listen()
+        port = busy.getsockname()[1]
+        proc = subprocess.Popen([sys.executable, "-m", "tcp_pendant", "--port", str(port), "--tool-library",
+                                 str(tmp_path / "tools.json")],
+                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        assert proc.stdout is not None and proc.stderr is not None
+        for line in proc.stdout:
+            if "ready" in line:
+                proc.kill()
+                proc.wait(30)
+                raise AssertionError(f"served elsewhere instead of refusing port {port}: {line}")
+        err = proc.stderr.read()
+        proc.wait(30)
+    assert proc.returncode == 2, err
+    assert f"port {port} on 127.0.0.1 is already in use" in err
+    assert "--port 0 for any free port" in err and f"--port {port + 1}" in err
