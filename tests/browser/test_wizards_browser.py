@@ -150,7 +150,7 @@ def test_reference_wizard_swaps_the_tool_and_saves(pendant_server, new_page, sho
     press(page, "Auto-touch")
     wait_text(page, "Step 2 of 2")
     # step 2 needs the torch: Record is disabled until the tool change
-    wait_text(page, "Mount the tool 'torch' first")
+    wait_text(page, "Mount the welding torch (bent neck) first: the straight pointer is mounted now.")
     assert page.get_by_role("button", name="Record", exact=True).is_disabled()
     press(page, "Mount the welding torch (bent neck)")
     wait_enabled(page, "Record")

@@ -124,12 +124,11 @@ def test_four_auto_touches_run_a_4point_calibration_and_every_view_follows(page)
     assert "Active tool:** Pen 4P (slot 1)" in s.views["tools"].active_md.content
     assert ToolLibrary(s.library.path).active_slot() == 1
 
-    # close: the menu is back with the run waiting to be resumed
+    # close: the menu is back; the saved run is done, so nothing waits in "Left half-way"
+    assert v.steps.cancel.label == "Close"
     p.click(v.steps.cancel)
-    assert v.menu_folder.visible and v.resume.visible and not v.scene.computed.visible
-    assert v.resume_list.value.startswith("1: XYZ 4-point, 4 of 4 recorded")
-    p.click(v.resume)
-    assert v.workflow.result is res and v.result.folder.visible
+    assert v.menu_folder.visible and not v.resume.visible and not v.scene.computed.visible
+    assert v.workflow.resumable() == []
 
 
 def test_reference_wizard_disables_record_until_the_tool_change(page) -> None:
@@ -147,7 +146,7 @@ def test_reference_wizard_disables_record_until_the_tool_change(page) -> None:
     p.click(v.steps.auto_touch)
     assert v.steps.record.disabled and v.steps.mount.visible
     assert v.steps.mount.label == "Mount the welding torch (bent neck)"
-    assert "Mount the tool 'torch' first" in v.steps.blocked_md.content
+    assert "Mount the welding torch (bent neck) first: the straight pointer" in v.steps.blocked_md.content
     p.click(v.steps.mount)
     assert s.controller.mounted_tool.key == "torch"
     assert s.views["tools"].mounted.value == "Welding torch (bent neck)"     # the Tool tab follows
@@ -166,7 +165,7 @@ def test_outliers_are_marked_and_can_be_dropped_and_estimators_compared(page) ->
     assert v.steps.auto_request().sigma_mm == pytest.approx(0.1)
     for _ in range(7):
         p.click(v.steps.auto_touch)
-    assert v.steps.auto_md.content.startswith("Recorded touch 7 (tilt ")
+    assert v.steps.auto_md.content.startswith("Step 7 recorded: Touch 7 (tilt ")
     assert v.steps.auto_md.content.endswith("Operator error σ 0.10 mm.")
     # touch 8: a careless one, 5 mm off the reference tip
     with s.lock:

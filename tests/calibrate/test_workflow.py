@@ -74,7 +74,7 @@ def test_reference_needs_the_tool_change_then_gives_the_new_tools_tcp(workflow, 
     wf.auto_touch(AutoTouchRequest())
     assert wiz.step_index == 1 and wf.required_tool().key == "torch"
     assert not wiz.can_record
-    with pytest.raises(WizardStateError, match="Mount the tool 'torch'"):
+    with pytest.raises(WizardStateError, match=r"Mount the welding torch \(bent neck\) first: the straight pointer is mounted now\."):
         wf.record()
     assert wf.mount_required_tool().key == "torch"
     assert wf.controller.mounted_tool.key == "torch" and wiz.can_record
@@ -147,7 +147,8 @@ def test_cancel_after_save_loses_nothing(workflow, library) -> None:
     wf.cancel()
     assert not wf.is_open and wf.result is None
     assert library.path.read_bytes() == before
-    wf.resume()
+    assert wf.resumable() == []                      # saved: nothing left half-way ...
+    wf.resume(0)                                     # ... but the run is kept and can be reopened
     assert wf.result is not None and wf.result.tcp_mm == library.get(1).tcp_mm
 
 

@@ -35,13 +35,13 @@ __all__ = [
 
 METHOD_BLURBS: dict[str, str] = {
     "xyz4": ("Calibrates the **TCP** (X, Y, Z): touch the reference tip with the tool tip from "
-             "4 to 20 clearly different orientations (methods.md section 2)."),
+             "4 to 20 clearly different orientations."),
     "reference": ("Calibrates the **TCP** of a new tool from one touch with an already calibrated "
-                  "tool and one with the new tool (section 3). Fast; errors add up."),
+                  "tool and one with the new tool. Fast; errors add up."),
     "three-point": ("Calibrates the **orientation** (A, B, C) of a tool whose TCP is calibrated: "
-                    "a touch, then the tip on the tool's -X axis and on its +Y side (section 5)."),
+                    "a touch, then the tip on the tool's -X axis and on its +Y side."),
     "abc-world": ("Calibrates the **orientation** (A, B, C): align the tool with WORLD (X down, Y "
-                  "along WORLD Y, Z along WORLD X) and record once (section 4). 5D: tool X only."),
+                  "along WORLD Y, Z along WORLD X) and record once. 5D: tool X only."),
 }
 
 

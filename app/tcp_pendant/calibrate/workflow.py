@@ -122,6 +122,7 @@ class CalibrationWorkflow:
         self.runs: list[WizardRun] = []
         self._current: int | None = None
         self.last_save: tuple[int, Tool] | None = None
+        self._saved_results: dict[int, WizardResult] = {}    # run index -> the result saved from it
 
     # ------------------------------------------------------------ state
     @property
@@ -135,7 +136,8 @@ class CalibrationWorkflow:
         run = self.run
         if run is None:
             return None
-        run.wizard.note_mounted_tool(self.controller.mounted_tool.key)
+        run.wizard.note_mounted_tool(self.controller.mounted_tool.key,
+                                     {key: t.label for key, t in self.tools.items()})
         return run.wizard
 
     @property
@@ -144,12 +146,28 @@ class CalibrationWorkflow:
         w = self.wizard
         return w is not None and w.status != "cancelled"
 
+    def _is_saved(self, index: int) -> bool:
+        """Run ``index`` is finished and its result, as it is now, was saved to the library."""
+        saved = self._saved_results.get(index)
+        return saved is not None and saved is self.runs[index].wizard.finished_result
+
+    @property
+    def result_saved(self) -> bool:
+        """The result on show was saved to the tool library (closing it leaves nothing to resume)."""
+        return self._current is not None and self._is_saved(self._current)
+
     def resumable(self) -> list[tuple[int, str]]:
-        """Cancelled runs, newest first: (index in ``runs``, label for the Resume list)."""
+        """Cancelled runs still to be done, newest first: (index in ``runs``, label for the
+        "Left half-way" list). A finished run whose result was saved is done and not listed; a
+        finished one not saved is ("finished, not saved")."""
         out = []
         for i in range(len(self.runs) - 1, -1, -1):
             w = self.runs[i].wizard
-            if w.status == "cancelled":
+            if w.status != "cancelled" or self._is_saved(i):
+                continue
+            if w.finished_result is not None:
+                out.append((i, f"{i + 1}: {w.title}, finished, not saved"))
+            else:
                 done = sum(1 for s in w.steps if s.recorded)
                 out.append((i, f"{i + 1}: {w.title}, {done} of {w.n_steps} recorded"))
         return out
@@ -236,13 +254,17 @@ class CalibrationWorkflow:
         self._require().cancel()
 
     def resume(self, index: int | None = None) -> Wizard:
-        """Resume a cancelled run (default: the newest one)."""
-        options = self.resumable()
-        if not options:
-            raise WizardStateError("There is no cancelled calibration to resume.")
-        i = options[0][0] if index is None else int(index)
-        if i not in [o[0] for o in options]:
-            raise WizardStateError(f"Calibration {i + 1} is not waiting to be resumed.")
+        """Resume a cancelled run: ``index`` (0-based in ``runs``; any cancelled run, also a
+        saved one) or, by default, the newest of :meth:`resumable`."""
+        if index is None:
+            options = self.resumable()
+            if not options:
+                raise WizardStateError("There is no calibration left half-way to resume.")
+            i = options[0][0]
+        else:
+            i = int(index)
+            if not (0 <= i < len(self.runs) and self.runs[i].wizard.status == "cancelled"):
+                raise WizardStateError(f"Calibration {i + 1} is not waiting to be resumed.")
         self._leave_open_wizard()
         self._current = i
         w = self.runs[i].wizard
@@ -362,6 +384,8 @@ class CalibrationWorkflow:
         slot_tool = w.save_to_library(self.library, name, slot, activate=True)
         self.controller.set_active_tool(slot_tool[1])
         self.last_save = slot_tool
+        if self._current is not None and w.result is not None:
+            self._saved_results[self._current] = w.result
         return slot_tool
 
     # ------------------------------------------------------------ session record

@@ -25,6 +25,7 @@ from collections.abc import Callable
 from typing import Any
 
 from tcp_pendant.calibrate import WIZARD_KINDS, WIZARD_LABELS, CalibrationWorkflow
+from tcp_pendant.calibrate.library_choice import default_library_slot
 from tcp_pendant.calibrate.text import (
     METHOD_BLURBS,
     estimator_options,
@@ -79,6 +80,8 @@ class CalibrateView:
         self.session = session
         self.workflow = CalibrationWorkflow(session.controller, session.library, robot=robot_name(session))
         self._menu_mounted_key: str | None = None
+        self._library: dict[int, Tool] = {}
+        self._library_pick: tuple[str, int | None] | None = None   # (option, active slot then)
         gui = session.target.gui
         tools = self.workflow.tools
         self._physical = {t.label: key for key, t in tools.items()}
@@ -119,7 +122,8 @@ class CalibrateView:
 
         act = self.action
         self.training.on_update(act(self._on_training, user_only=True))
-        for choice in (self.method, self.library_tool, self.reference_physical, self.new_physical):
+        self.library_tool.on_update(act(self._on_library_pick, user_only=True))
+        for choice in (self.method, self.reference_physical, self.new_physical):
             choice.on_update(act(lambda _e: None, user_only=True))       # re-render: echo the choice
         self.start.on_click(act(self._on_start, sync=True))
         self.resume.on_click(act(self._on_resume))
@@ -199,6 +203,21 @@ class CalibrateView:
     def _on_training(self, event: Any) -> None:
         self.workflow.training = bool(event.target.value)
 
+    def _on_library_pick(self, event: Any) -> None:
+        # the user's pick holds until the active tool data changes (then the default is offered)
+        self._library_pick = (str(event.target.value), self.session.active_slot)
+
+    def _library_option(self, options: tuple[str, ...]) -> str | None:
+        """The library option to show: the user's pick, else :func:`default_library_slot`."""
+        pick = self._library_pick
+        if pick is not None and pick[0] in options and pick[1] == self.session.active_slot:
+            return pick[0]
+        c = self.session.controller
+        slot = default_library_slot(self._library, active_slot=self.session.active_slot,
+                                    active_tool_name=None if c.active_tool is None else c.active_tool.name,
+                                    mounted_label=c.mounted_tool.label, mounted_key=c.mounted_tool.key)
+        return None if slot is None else slot_option(slot, self._library[slot].name)
+
     def _selected_slot(self) -> int:
         slot = number_of_option(self.library_tool.value)
         if slot is None:
@@ -251,8 +270,9 @@ class CalibrateView:
         """Re-list the library's tools (``tools``: as the tool panel just read them; None: read
         now). Called when the library changes, by anyone."""
         tools = self.workflow.library_tools() if tools is None else tools
+        self._library = dict(tools)
         options = tuple(slot_option(s, t.name) for s, t in sorted(tools.items())) or (NO_LIBRARY_TOOL,)
-        set_options(self.library_tool, options)
+        set_options(self.library_tool, options, keep=self._library_option(options))
         self.result.refresh_slots(tools)
         self._render_menu()
 
@@ -287,6 +307,9 @@ class CalibrateView:
         needs_tool = kind != "xyz4"
         self.library_tool.visible = needs_tool
         self.reference_physical.visible = self.new_physical.visible = kind == "reference"
+        wanted = self._library_option(tuple(self.library_tool.options))
+        if wanted is not None and self.library_tool.value != wanted and wanted in self.library_tool.options:
+            self.library_tool.value = wanted
         empty = self.library_tool.value == NO_LIBRARY_TOOL
         set_content(self.menu_md, menu_markdown(
             kind, library_tool=None if empty else str(self.library_tool.value),

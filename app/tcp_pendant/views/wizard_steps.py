@@ -151,7 +151,7 @@ class WizardStepsView:
         self.next.disabled = not wiz.can_next
         self.next.label = "Finish" if wiz.on_last_step else "Next"
         self.back.disabled = not wiz.can_back
-        self.cancel.label = "Cancel" if stepping else "Close (resume later)"
+        self.cancel.label = "Cancel" if stepping else ("Close" if wf.result_saved else "Close (resume later)")
         is_xyz4 = isinstance(wiz, Xyz4Wizard)
         self.add_point.visible = is_xyz4
         self.add_point.disabled = not (is_xyz4 and wiz.can_add_point)

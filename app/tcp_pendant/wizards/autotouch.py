@@ -163,8 +163,8 @@ def auto_touch(wizard: Wizard, controller: Any, *,
             if advance and not wizard.on_last_step:
                 wizard.next()
             return AutoTouchOutcome(True, step.index, step.role, tilt, azimuth, spin,
-                                    f"Recorded {step.title.lower()} (tilt {tilt:.0f} deg, azimuth "
-                                    f"{azimuth:.0f} deg).", attempts)
+                                    f"Step {step.index + 1} recorded: {step.title} (tilt {tilt:.0f}°, "
+                                    f"azimuth {azimuth:.0f}°).", attempts)
         last_message = res.message
     return AutoTouchOutcome(False, step.index, step.role, None, None, None,
                             f"Auto-touch failed after {attempts} attempt(s): {last_message}", attempts)

@@ -249,6 +249,7 @@ class Wizard(abc.ABC):
         self._status: Status = "in_progress"
         self._result: WizardResult | None = None
         self._mounted_tool_key: str | None = None
+        self._tool_labels: dict[str, str] = {}
         self.started_at = utc_now_iso()
 
     # ----- to be provided by each wizard --------------------------------------------------
@@ -335,9 +336,17 @@ class Wizard(abc.ABC):
     def mounted_tool_key(self) -> str | None:
         return self._mounted_tool_key
 
-    def note_mounted_tool(self, key: str | None) -> None:
-        """Tell the wizard which physical tool is mounted (None: unknown, no check)."""
+    def note_mounted_tool(self, key: str | None, labels: Mapping[str, str] | None = None) -> None:
+        """Tell the wizard which physical tool is mounted (None: unknown, no check).
+
+        Args:
+            key: the mounted tool's key.
+            labels: the tools' labels by key, for the words the trainee reads (kept until
+                given again; a key without a label is shown as is).
+        """
         self._mounted_tool_key = key
+        if labels is not None:
+            self._tool_labels = dict(labels)
 
     @property
     def blocked_reason(self) -> str | None:
@@ -349,7 +358,9 @@ class Wizard(abc.ABC):
         spec = self._step_specs()[self._index]
         if (spec.mount_tool_key is not None and self._mounted_tool_key is not None
                 and self._mounted_tool_key != spec.mount_tool_key):
-            return f"Mount the tool '{spec.mount_tool_key}' first (now mounted: '{self._mounted_tool_key}')."
+            need = self._tool_labels.get(spec.mount_tool_key, spec.mount_tool_key)
+            now = self._tool_labels.get(self._mounted_tool_key, self._mounted_tool_key)
+            return f"Mount the {need.lower()} first: the {now.lower()} is mounted now."
         return None
 
     @property

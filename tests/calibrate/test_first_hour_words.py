@@ -1,0 +1,145 @@
+"""Issue 13 ("Using it"): the words a trainee sees in the first hour, and the library tool the
+orientation wizards offer first."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import pytest
+from tcp_pendant.calibrate import AutoTouchRequest
+from tcp_pendant.calibrate.library_choice import default_library_slot
+from tcp_pendant.calibrate.text import METHOD_BLURBS
+from tcp_pendant.wizards import WizardStateError
+
+from tcpcal.tool import Tool
+
+sys.path.insert(0, str(Path(__file__).parent))
+from calib_helpers import library_tool_with_true_tcp
+
+
+def run_auto(wf) -> None:
+    for _ in range(wf.wizard.n_steps):
+        assert wf.auto_touch(AutoTouchRequest()).ok
+    assert wf.result is not None
+
+
+def test_method_blurbs_point_at_no_file_the_trainee_cannot_open() -> None:
+    for kind, text in METHOD_BLURBS.items():
+        assert "methods.md" not in text and "section" not in text, kind
+
+
+def test_tool_change_is_asked_for_by_the_tools_labels(workflow, library) -> None:
+    library.save(1, library_tool_with_true_tcp("pointer", "Pointer"))
+    wf = workflow(tool="pointer")
+    wiz = wf.start_reference(reference_slot=1, reference_tool_key="pointer", new_tool_key="torch")
+    wf.auto_touch(AutoTouchRequest())
+    assert wiz.blocked_reason == "Mount the welding torch (bent neck) first: the straight pointer is mounted now."
+    assert "'" not in wiz.blocked_reason and "torch'" not in wiz.blocked_reason
+
+
+def test_auto_touch_reports_a_sentence(workflow) -> None:
+    wf = workflow()
+    wf.start_xyz4()
+    out = wf.auto_touch(AutoTouchRequest())
+    assert out.message.startswith("Step 1 recorded: Touch 1 (tilt ") and out.message.endswith("°).")
+
+
+def test_three_point_auto_touch_message_reads_as_a_sentence(workflow, library) -> None:
+    library.save(1, library_tool_with_true_tcp("pointer", "Pointer"))
+    wf = workflow()
+    wf.start_three_point(slot=1)
+    out = wf.auto_touch(AutoTouchRequest())
+    assert out.message.startswith("Step 1 recorded: Touch the reference tip (tilt ")
+    assert "Recorded touch the" not in out.message
+
+
+def test_left_half_way_lists_only_runs_still_to_do(workflow) -> None:
+    wf = workflow()
+    wf.start_xyz4()
+    run_auto(wf)
+    wf.save("Pen")                                   # run 1: finished and saved
+    wf.start_xyz4()
+    run_auto(wf)                                     # run 2: finished, not saved
+    wf.start_xyz4()
+    wf.auto_touch(AutoTouchRequest())                # run 3: half-way
+    wf.start_xyz4()                                  # run 4 open: the others are cancelled
+    labels = [label for _, label in wf.resumable()]
+    assert labels == ["3: XYZ 4-point, 1 of 4 recorded", "2: XYZ 4-point, finished, not saved"]
+    assert wf.resume().kind == "xyz4" and wf.run is wf.runs[2]          # newest still to do
+    wf.resume(1)                                     # the unsaved result can be saved later
+    assert wf.result is not None and not wf.result_saved
+    wf.save("Pen 2")
+    assert wf.result_saved
+    wf.cancel()
+    assert [i for i, _ in wf.resumable()] == [3, 2]           # the two runs still to do
+    with pytest.raises(WizardStateError, match="Calibration 9 is not waiting"):
+        wf.resume(8)
+
+
+def test_a_saved_run_changed_afterwards_is_listed_again(workflow) -> None:
+    wf = workflow()
+    wf.start_xyz4()
+    run_auto(wf)
+    wf.save("Pen")
+    wf.back()                                        # a step back: the saved result no longer stands
+    wf.next()                                        # finished again: a new result, not saved
+    wf.cancel()
+    assert [label for _, label in wf.resumable()] == ["1: XYZ 4-point, finished, not saved"]
+
+
+class _T:
+    def __init__(self, name: str) -> None:
+        self.name = name
+
+
+@pytest.mark.parametrize("kwargs,expected", [
+    (dict(active_slot=3, active_tool_name="Torch", mounted_label="Straight pointer", mounted_key="pointer"), 3),
+    (dict(active_slot=None, active_tool_name="torch", mounted_label="Straight pointer", mounted_key="pointer"), 3),
+    (dict(active_slot=None, active_tool_name=None, mounted_label="Welding torch (bent neck)", mounted_key="torch"), 3),
+    (dict(active_slot=None, active_tool_name=None, mounted_label="Straight pointer", mounted_key="pointer"), 1),
+    (dict(active_slot=5, active_tool_name=None, mounted_label="Straight pointer", mounted_key="pointer"), 1),
+])
+def test_default_library_slot(kwargs, expected) -> None:
+    tools = {1: _T("Pen"), 3: _T("Torch"), 4: _T("Gripper")}
+    assert default_library_slot(tools, **kwargs) == expected
+    assert default_library_slot({}, **kwargs) is None
+
+
+def test_default_library_slot_matches_the_mounted_tools_label() -> None:
+    tools = {1: _T("Pen"), 2: _T("Welding torch (bent neck)")}
+    assert default_library_slot(tools, active_slot=None, active_tool_name=None,
+                                mounted_label="Welding torch (bent neck)", mounted_key="torch") == 2
+
+
+def test_tool_data_defaults_to_the_active_slot_not_slot_1(tmp_path) -> None:
+    """In a running app: with the torch's data active in slot 3, the orientation wizards
+    offer slot 3; a pick by the user holds until the active tool data changes."""
+    from test_calibrate_view import Page  # noqa: F401  (the in-process browser)
+    from tcp_pendant.server import AppConfig, PendantApp
+    from wsclient import free_port
+
+    from tcpcal.library import ToolLibrary
+
+    lib = ToolLibrary(tmp_path / "tools.json")
+    lib.save(1, Tool(name="Pen", tcp_mm=(0.0, 0.0, 150.0)))
+    lib.save(3, Tool(name="Torch", tcp_mm=(0.0, 0.0, 200.0)))
+    lib.save(4, Tool(name="Gripper", tcp_mm=(0.0, 0.0, 120.0)))
+    lib.activate(3)
+    app = PendantApp(AppConfig(port=free_port(), tool="torch", tool_library=tmp_path / "tools.json",
+                               library_poll_s=0.1))
+    app.start()
+    try:
+        p = Page(app)
+        v, s = p.view, p.session
+        p.choose(v.method, "ABC world (parallel axes)")
+        assert s.active_slot == 3, "the library's active tool should be the session's"
+        assert v.library_tool.value == "3: Torch"
+        p.choose(v.library_tool, "4: Gripper")       # the user's pick holds ...
+        p.choose(v.method, "Three-point orientation")
+        assert v.library_tool.value == "4: Gripper"
+        p.click(v.start)                             # ... and Start makes it active
+        assert s.active_slot == 4 and v.workflow.wizard.tool.name == "Gripper"
+    finally:
+        p.ws.close()
+        app.stop()
