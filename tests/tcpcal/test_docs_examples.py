@@ -94,6 +94,31 @@ def test_cli_md_examples_are_real(tmp_path: Path, capsys: pytest.CaptureFixture[
     assert check_document(ROOT / "docs" / "cli.md", tmp_path, capsys, monkeypatch) >= 15
 
 
+def test_examples_write_only_into_the_scratch_folder(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                                    monkeypatch: pytest.MonkeyPatch) -> None:
+    """Issue 13: the ``tcpcal tools`` example left ``my_tools.json`` and its lock in the repo root.
+
+    Run from the repository root, as a reader pasting the example would, the files land in the
+    scratch folder the examples run in, never beside README.md."""
+    monkeypatch.chdir(ROOT)
+    before = sorted(p.name for p in ROOT.iterdir())
+    check_document(ROOT / "docs" / "cli.md", tmp_path, capsys, monkeypatch)
+    assert sorted(p.name for p in ROOT.iterdir()) == before
+    assert (tmp_path / "my_tools.json").is_file()        # the example did write its library ...
+    assert (tmp_path / "my_tools.json.lock").exists()    # ... and its lock, here
+
+
+def test_gitignore_ignores_the_example_library() -> None:
+    """A belt: files of the example run by hand in the repository are never committed."""
+    import subprocess
+
+    names = ["my_tools.json", "my_tools.json.lock", "docs/my_tools.json"]
+    out = subprocess.run(["git", "check-ignore", "--no-index", *names], cwd=ROOT, capture_output=True, text=True)
+    if out.returncode == 128:
+        pytest.skip(f"not a git checkout: {out.stderr.strip()}")
+    assert out.stdout.split() == names
+
+
 def test_the_comparison_can_fail() -> None:
     assert same_output("TCP X 84.931", "TCP X 84.931")
     assert same_output('"x": 0.14101605264564931', '"x": 0.14101605264554454')
