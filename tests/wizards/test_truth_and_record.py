@@ -13,8 +13,10 @@ from tcp_pendant.wizards import AbcWorldWizard, ThreePointWizard, WizardError, W
 from tcp_pendant.wizards.session_record import (
     SessionRecordError,
     WizardRun,
+    check_session_record,
     dumps,
-    load_session,
+    parse_session_record,
+    read_session_file,
     replay,
     save_session,
     session_to_dict,
@@ -95,7 +97,7 @@ def test_session_record_round_trip_and_replay(synth, tmp_path):
     touches = [(np.eye(4), "home"), {"T_world_flange_m": np.eye(4).tolist(), "label": "p2"}]
     rec = session_to_dict(runs, robot="kr6", reference_tip_world_m=synth.reference_mm / 1000, touches=touches)
     path = save_session(tmp_path / "session.json", rec)
-    loaded = load_session(path)
+    loaded = read_session_file(path)
     assert loaded == json.loads(dumps(rec))
     assert loaded["format"] == "tcp-pendant-session" and loaded["version"] == 1
     assert [t["label"] for t in loaded["touches"]] == ["home", "p2"]
@@ -123,13 +125,13 @@ def test_session_record_round_trip_and_replay(synth, tmp_path):
 
 def test_load_session_errors(tmp_path):
     with pytest.raises(SessionRecordError, match="not valid JSON"):
-        load_session("{not json")
+        parse_session_record(b"{not json")
     with pytest.raises(SessionRecordError, match="Not a TCP Pendant"):
-        load_session({"format": "other"})
+        check_session_record({"format": "other"})
     with pytest.raises(SessionRecordError, match="version"):
-        load_session({"format": "tcp-pendant-session", "version": 99})
+        check_session_record({"format": "tcp-pendant-session", "version": 99})
     with pytest.raises(SessionRecordError, match="Cannot read"):
-        load_session(tmp_path / "missing.json")
+        read_session_file(tmp_path / "missing.json")
     with pytest.raises(SessionRecordError, match="Wizard 1"):
         replay({"format": "tcp-pendant-session", "version": 1, "wizards": [{"state": {"kind": "xyz4",
                 "poses": {"9": {"T_world_flange_m": np.eye(4).tolist(), "recorded_at": "x"}}}}]})

@@ -37,10 +37,10 @@ from tcp_pendant.wizards import (
 )
 from tcp_pendant.wizards.autotouch import AutoTouchOutcome, auto_touch
 from tcp_pendant.wizards.session_record import (
+    LoadedRecord,
     ReplayCheck,
     WizardRun,
-    load_session,
-    replay,
+    load_and_replay,
     session_from_controller,
 )
 from tcp_pendant.wizards.truth import TruthComparison, compare_with_truth
@@ -395,14 +395,20 @@ class CalibrationWorkflow:
         return session_from_controller(self.controller, self.runs, robot=self.robot, touches=touches)
 
     def load_record(self, source: Any) -> tuple[ReplayCheck, ...]:
-        """Load a session record (path, JSON text or dict), recompute every wizard with tcpcal and
-        add them to this session's runs (the newest finished one is put on show).
+        """Load a session record (its bytes, JSON text or a dict; text is never taken for a path),
+        recompute every wizard with tcpcal and add them to this session's runs (the newest
+        finished one is put on show). :func:`load_and_replay` then :meth:`add_loaded`.
 
         Raises:
-            SessionRecordError: unreadable record (nothing of this session is changed).
+            SessionRecordError: unreadable record or a limit exceeded (nothing of this session
+                is changed).
         """
-        data = load_session(source)
-        checks = replay(data)
+        return self.add_loaded(load_and_replay(source))
+
+    def add_loaded(self, loaded: LoadedRecord) -> tuple[ReplayCheck, ...]:
+        """Add a record read and replayed by :func:`load_and_replay` (the app does that in a
+        worker thread) to this session's runs; the newest finished wizard is put on show."""
+        data, checks = loaded.record, loaded.checks
         if not checks:
             return checks
         self._leave_open_wizard()

@@ -47,11 +47,29 @@ angles in degrees; poses are 4x4 row-major nested lists; times ISO 8601 UTC.
         }
       ]
     }
+
+Loading (a trainer's upload): :func:`parse_session_record` takes the file's **bytes** and parses
+them as JSON, nothing else: text is never taken for a path on the server (:func:`read_session_file`
+reads a ``pathlib.Path`` for command-line or server-side use; nothing a browser sends reaches it).
+Limits, checked before the work they bound, far above a real record (a full lesson of 13
+calibrations with up to 20 touches is about 0.09 MB and nests 8 levels):
+
+* size: at most :data:`MAX_RECORD_BYTES` (2 MB), checked on the byte count before decoding;
+* nesting: at most :data:`MAX_NESTING_DEPTH` (32) levels of arrays/objects, found by a linear
+  scan before ``json.loads`` (so a ``[[[[...`` bomb never reaches the recursive parser);
+* counts, after parsing and before any replay: :data:`MAX_WIZARDS` (200) calibrations,
+  :data:`MAX_POSES_PER_WIZARD` (100) poses each, :data:`MAX_TOUCHES` (1000) pendant touches.
+
+:func:`load_and_replay` (parse + :func:`replay`) touches no session, so the app runs it off
+viser's event loop (``tcp_pendant.views.wizard_menu``).
 """
 
 from __future__ import annotations
 
 import json
+import os
+import re
+import stat
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -67,6 +85,18 @@ FORMAT = "tcp-pendant-session"
 VERSION = 1
 REPLAY_TOLERANCE_MM = 1e-6
 REPLAY_TOLERANCE_DEG = 1e-6
+
+MAX_RECORD_BYTES = 2_000_000
+"""Largest record the pendant parses, bytes (a full training session of 13 calibrations with up
+to 20 touches exports about 0.09 MB)."""
+MAX_NESTING_DEPTH = 32
+"""Deepest nesting of JSON arrays/objects (a real record nests 8 levels)."""
+MAX_WIZARDS = 200
+"""Most calibrations per record (a lesson has a few dozen at most)."""
+MAX_POSES_PER_WIZARD = 100
+"""Most recorded poses per calibration (the XYZ 4-point wizard takes at most 20)."""
+MAX_TOUCHES = 1000
+"""Most pendant touches (``"touches"``) per record."""
 
 
 class SessionRecordError(WizardError):
@@ -198,34 +228,186 @@ def save_session(path: str | Path, record: Mapping[str, Any]) -> Path:
     return p
 
 
-def load_session(source: str | Path | Mapping[str, Any]) -> dict[str, Any]:
-    """Read a record (a path, JSON text or an already parsed dict) and check its header.
+def _limit_error(what: str, found: str, limit: str) -> SessionRecordError:
+    return SessionRecordError(
+        f"The session record {what} {found}; the pendant loads records with at most {limit} "
+        "(a full training session is far below that). Load a record exported by the pendant, "
+        "or split the session into several records.")
+
+
+def check_record_size(n_bytes: int) -> None:
+    """Refuse a record of ``n_bytes`` bytes above :data:`MAX_RECORD_BYTES` (before any parsing).
 
     Raises:
-        SessionRecordError: unreadable file, invalid JSON, wrong ``format`` or ``version``.
+        SessionRecordError: too large (the message names the limit).
     """
-    if isinstance(source, Mapping):
-        data: Any = dict(source)
-    else:
-        text = str(source)
-        if isinstance(source, Path) or not text.lstrip().startswith("{"):
-            try:
-                text = Path(source).read_text(encoding="utf-8")
-            except OSError as exc:
-                raise SessionRecordError(f"Cannot read the session record {source}: {exc}.") from None
-        try:
-            data = json.loads(text)
-        except json.JSONDecodeError as exc:
-            raise SessionRecordError(f"The session record is not valid JSON ({exc}); "
-                                     "export it again from the pendant.") from None
-    if not isinstance(data, dict) or data.get("format") != FORMAT:
+    if n_bytes > MAX_RECORD_BYTES:
+        raise _limit_error("is", f"{n_bytes:,} bytes ({n_bytes / 1e6:.1f} MB)",
+                           f"{MAX_RECORD_BYTES:,} bytes ({MAX_RECORD_BYTES / 1e6:g} MB)")
+
+
+# A string literal, or an unterminated one running to the end: every '"' starts a match, so the
+# scan never restarts inside a string (linear time, also for a run of escaped quotes).
+_JSON_STRING = re.compile(rb'"[^"\\]*(?:\\.[^"\\]*)*(?:"|\\?\Z)', re.DOTALL)
+
+
+def json_nesting_depth(data: bytes) -> int:
+    """Deepest nesting of JSON arrays and objects in ``data`` (UTF-8 JSON text), without parsing
+    it: string literals are cut out, then the brackets are counted (linear time, no recursion).
+
+    Brackets are ASCII, and no byte of a multi-byte UTF-8 character is ASCII, so the count holds
+    for any UTF-8 text; for text that is not JSON the number is only an upper-bound guess.
+    """
+    skeleton = np.frombuffer(_JSON_STRING.sub(b"", bytes(data)), dtype=np.uint8)
+    if skeleton.size == 0:
+        return 0
+    step = np.isin(skeleton, (ord("["), ord("{"))).astype(np.int32) - \
+        np.isin(skeleton, (ord("]"), ord("}"))).astype(np.int32)
+    return int(max(0, np.cumsum(step).max()))
+
+
+def check_session_record(data: Any) -> dict[str, Any]:
+    """Check a parsed record: header (``format``, ``version``), the types of ``wizards`` and
+    ``touches`` and the count limits (:data:`MAX_WIZARDS`, :data:`MAX_POSES_PER_WIZARD`,
+    :data:`MAX_TOUCHES`), which bound the cost of :func:`replay`. Returns a shallow copy.
+
+    Raises:
+        SessionRecordError: wrong format or version, bad structure, a limit exceeded.
+    """
+    if not isinstance(data, Mapping) or data.get("format") != FORMAT:
         raise SessionRecordError(f"Not a TCP Pendant session record (expected \"format\": \"{FORMAT}\").")
+    data = dict(data)
     if data.get("version") != VERSION:
         raise SessionRecordError(f"Session record version {data.get('version')!r} is not supported "
                                  f"(this pendant reads version {VERSION}).")
-    if not isinstance(data.get("wizards", []), list):
+    wizards = data.get("wizards", [])
+    if not isinstance(wizards, list):
         raise SessionRecordError("\"wizards\" must be a list.")
+    if len(wizards) > MAX_WIZARDS:
+        raise _limit_error("holds", f"{len(wizards)} calibrations", f"{MAX_WIZARDS} calibrations")
+    touches = data.get("touches", [])
+    if not isinstance(touches, list):
+        raise SessionRecordError("\"touches\" must be a list.")
+    if len(touches) > MAX_TOUCHES:
+        raise _limit_error("holds", f"{len(touches)} pendant touches", f"{MAX_TOUCHES} pendant touches")
+    for i, entry in enumerate(wizards):
+        state = entry.get("state") if isinstance(entry, Mapping) else None
+        if not isinstance(state, Mapping):
+            raise SessionRecordError(f"Wizard {i + 1} of the record has no \"state\" object.")
+        poses = state.get("poses", {})
+        if not isinstance(poses, Mapping):
+            raise SessionRecordError(f"Wizard {i + 1} of the record: \"poses\" must be an object.")
+        if len(poses) > MAX_POSES_PER_WIZARD:
+            raise _limit_error(f"has, in wizard {i + 1},", f"{len(poses)} touches",
+                               f"{MAX_POSES_PER_WIZARD} touches per calibration")
+        true_tool = entry.get("true_tool")
+        if true_tool is not None:
+            try:
+                if not isinstance(true_tool, Mapping) or not isinstance(true_tool.get("key"), (str, type(None))):
+                    raise WizardError("it must be {\"key\": text or null, \"T_flange_tcp_true_m\": 4x4}")
+                check_pose_m(true_tool.get("T_flange_tcp_true_m"), what="true TOOL frame")
+            except (WizardError, TypeError, ValueError) as exc:
+                raise SessionRecordError(f"Wizard {i + 1} of the record: bad \"true_tool\" ({exc}).") from None
     return data
+
+
+def parse_session_record(data: bytes) -> dict[str, Any]:
+    """Parse an uploaded (or read) record: bytes of UTF-8 JSON, nothing else (never a path).
+
+    The limits are checked before the work they bound: the size on ``len(data)`` before
+    decoding, the nesting depth by :func:`json_nesting_depth` before ``json.loads``, the counts
+    (:func:`check_session_record`) after parsing and before any replay.
+
+    Args:
+        data: the file's bytes (``bytes``, ``bytearray`` or ``memoryview``).
+
+    Raises:
+        SessionRecordError: too large, too deep, not UTF-8, not JSON, not a session record,
+            too many wizards or touches. The message says what is wrong and what to do.
+        TypeError: ``data`` is not bytes (a ``str`` is refused: it could be taken for a path).
+    """
+    if not isinstance(data, (bytes, bytearray, memoryview)):
+        raise TypeError(f"parse_session_record takes the record's bytes, not {type(data).__name__}.")
+    data = bytes(data)
+    check_record_size(len(data))
+    depth = json_nesting_depth(data)
+    if depth > MAX_NESTING_DEPTH:
+        raise _limit_error("nests", f"{depth} levels deep", f"{MAX_NESTING_DEPTH} levels of nesting")
+    try:
+        text = data.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        raise SessionRecordError("The session record is not a text (JSON) file; "
+                                 "export it again from the pendant.") from None
+    try:
+        parsed = json.loads(text)
+    except (json.JSONDecodeError, RecursionError) as exc:
+        raise SessionRecordError(f"The session record is not valid JSON ({exc}); "
+                                 "export it again from the pendant.") from None
+    return check_session_record(parsed)
+
+
+def read_session_file(path: Path) -> dict[str, Any]:
+    """Read a record from the server's disk (command line and server-side use only: nothing a
+    browser sends reaches this). Only regular files are read (a FIFO or device is refused
+    without blocking), at most :data:`MAX_RECORD_BYTES` + 1 bytes, then
+    :func:`parse_session_record`.
+
+    Args:
+        path: a ``pathlib.Path`` (a ``str`` is refused, so text is never taken for a path).
+
+    Raises:
+        SessionRecordError: unreadable, not a regular file, or a bad record.
+        TypeError: ``path`` is not a ``Path``.
+    """
+    if not isinstance(path, Path):
+        raise TypeError(f"read_session_file takes a pathlib.Path, not {type(path).__name__}.")
+    try:
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+    except OSError as exc:
+        raise SessionRecordError(f"Cannot read the session record {path}: {exc.strerror or exc}.") from None
+    try:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            raise SessionRecordError(f"Cannot read the session record {path}: not a regular file.")
+        with os.fdopen(fd, "rb", closefd=False) as f:
+            data = f.read(MAX_RECORD_BYTES + 1)
+    except OSError as exc:
+        raise SessionRecordError(f"Cannot read the session record {path}: {exc.strerror or exc}.") from None
+    finally:
+        os.close(fd)
+    return parse_session_record(data)
+
+
+@dataclass(frozen=True, eq=False)
+class LoadedRecord:
+    """A parsed, checked and replayed record, ready to be added to a session.
+
+    Attributes:
+        record: the record (checked by :func:`check_session_record`).
+        checks: one :class:`ReplayCheck` per wizard, in order.
+    """
+
+    record: dict[str, Any]
+    checks: tuple[ReplayCheck, ...]
+
+
+def load_and_replay(source: bytes | str | Mapping[str, Any]) -> LoadedRecord:
+    """Parse (bytes, or ``str`` as JSON text: never a path) or check (a dict) a record, then
+    :func:`replay` it. Pure: touches no session, so it can run in a worker thread.
+
+    Raises:
+        SessionRecordError: see :func:`parse_session_record` and :func:`replay`.
+        TypeError: another type (a ``Path``: use :func:`read_session_file`).
+    """
+    if isinstance(source, str):
+        source = source.encode("utf-8")
+    if isinstance(source, (bytes, bytearray, memoryview)):
+        data = parse_session_record(source)
+    elif isinstance(source, Mapping):
+        data = check_session_record(source)
+    else:
+        raise TypeError(f"A session record is bytes, JSON text or a dict, not {type(source).__name__} "
+                        "(read a file with read_session_file).")
+    return LoadedRecord(data, replay(data))
 
 
 def replay(record: Mapping[str, Any]) -> tuple[ReplayCheck, ...]:
@@ -234,40 +416,49 @@ def replay(record: Mapping[str, Any]) -> tuple[ReplayCheck, ...]:
     Raises:
         SessionRecordError: a wizard entry cannot be rebuilt (the message says which).
     """
-    data = load_session(record)
+    data = check_session_record(record)
     checks: list[ReplayCheck] = []
     for i, entry in enumerate(data.get("wizards", [])):
         try:
             wiz = Wizard.from_dict(entry["state"])
-        except (KeyError, TypeError, ValueError) as exc:
+        except (AttributeError, KeyError, TypeError, ValueError) as exc:
             raise SessionRecordError(f"Wizard {i + 1} of the record cannot be rebuilt: {exc}") from None
-        stored = entry.get("result")
-        res = wiz.finished_result
-        tcp_diff = rot_diff = None
-        truth = None
-        if stored is None:
-            matches = res is None
-            message = "unfinished wizard (no result stored)" if matches else \
-                "the record stores no result but the wizard is complete"
-        elif res is None:
-            matches, message = False, "a result is stored but the wizard could not be completed"
-        else:
-            tcp_diff = float(np.linalg.norm(np.asarray(res.tcp_mm) - np.asarray(stored["tcp_mm"], dtype=float)))
-            matches = tcp_diff <= REPLAY_TOLERANCE_MM and res.method == stored.get("method")
-            if (stored.get("abc_deg") is None) != (res.abc_deg is None):
-                matches = False
-            elif res.abc_deg is not None:
-                R_stored = Rotation.from_euler("ZYX", stored["abc_deg"], degrees=True)
-                R_now = Rotation.from_euler("ZYX", res.abc_deg, degrees=True)
-                rot_diff = float(np.degrees((R_stored.inv() * R_now).magnitude()))
-                matches = matches and rot_diff <= REPLAY_TOLERANCE_DEG
-            message = ("replayed result matches the record" if matches else
-                       f"replayed result differs from the record (TCP by {tcp_diff:.3g} mm"
-                       + (f", orientation by {rot_diff:.3g} deg" if rot_diff is not None else "") + ")")
-            true_tool = entry.get("true_tool")
-            if true_tool is not None:
-                truth = compare_with_truth(res, true_tool["T_flange_tcp_true_m"])
-        checks.append(ReplayCheck(index=i, kind=wiz.kind, wizard=wiz, matches=matches,
-                                  tcp_diff_mm=tcp_diff, rotation_diff_deg=rot_diff, truth=truth,
-                                  message=message))
+        try:
+            checks.append(_check_entry(i, entry, wiz))
+        except (AttributeError, KeyError, TypeError, ValueError, IndexError) as exc:
+            raise SessionRecordError(f"Wizard {i + 1} of the record: its stored result cannot be "
+                                     f"compared ({type(exc).__name__}: {exc}).") from None
     return tuple(checks)
+
+
+def _check_entry(i: int, entry: Mapping[str, Any], wiz: Wizard) -> ReplayCheck:
+    """Compare one rebuilt wizard with its stored result and truth (see :func:`replay`)."""
+    stored = entry.get("result")
+    res = wiz.finished_result
+    tcp_diff = rot_diff = None
+    truth = None
+    if stored is None:
+        matches = res is None
+        message = "unfinished wizard (no result stored)" if matches else \
+            "the record stores no result but the wizard is complete"
+    elif res is None:
+        matches, message = False, "a result is stored but the wizard could not be completed"
+    else:
+        tcp_diff = float(np.linalg.norm(np.asarray(res.tcp_mm) - np.asarray(stored["tcp_mm"], dtype=float)))
+        matches = tcp_diff <= REPLAY_TOLERANCE_MM and res.method == stored.get("method")
+        if (stored.get("abc_deg") is None) != (res.abc_deg is None):
+            matches = False
+        elif res.abc_deg is not None:
+            R_stored = Rotation.from_euler("ZYX", stored["abc_deg"], degrees=True)
+            R_now = Rotation.from_euler("ZYX", res.abc_deg, degrees=True)
+            rot_diff = float(np.degrees((R_stored.inv() * R_now).magnitude()))
+            matches = matches and rot_diff <= REPLAY_TOLERANCE_DEG
+        message = ("replayed result matches the record" if matches else
+                   f"replayed result differs from the record (TCP by {tcp_diff:.3g} mm"
+                   + (f", orientation by {rot_diff:.3g} deg" if rot_diff is not None else "") + ")")
+        true_tool = entry.get("true_tool")
+        if true_tool is not None:
+            truth = compare_with_truth(res, true_tool["T_flange_tcp_true_m"])
+    return ReplayCheck(index=i, kind=wiz.kind, wizard=wiz, matches=matches,
+                       tcp_diff_mm=tcp_diff, rotation_diff_deg=rot_diff, truth=truth,
+                       message=message)
