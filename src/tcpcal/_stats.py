@@ -186,10 +186,21 @@ def angle_between(ra: np.ndarray, rb: np.ndarray) -> float:
 
 @dataclass(frozen=True)
 class AngleExtremes:
+    """Smallest and largest rotation angle between two touch orientations (degrees) and the
+    pairs (0-based touch indices) that give them.
+
+    ``min_deg`` is always exact. ``max_deg`` is exact when ``max_exact``; otherwise (only above
+    ``EXACT_ANGLES_MAX_N`` touches, when the bound-and-prune step of
+    :func:`angle_extremes` could not narrow the candidates) it is a lower bound attained by
+    the pair ``max_pair`` and the true largest angle lies in ``[max_deg, max_upper_deg]``.
+    """
+
     min_deg: float
     max_deg: float
     min_pair: tuple[int, int]
     max_pair: tuple[int, int]
+    max_exact: bool = True
+    max_upper_deg: float = math.nan  # upper bound of the largest angle (= max_deg when exact)
 
 
 _GRAM_SMALL = 128
@@ -200,23 +211,34 @@ _GRAM_BLOCK_ENTRIES = 16384
 on the 2-core machine the benchmark runs on, multi-threaded blocks of 128 x 1000 were up to
 40x slower whenever other processes kept the second core busy, and blocks of 16k-32k entries
 were the fastest, single- or multi-threaded)."""
+EXACT_ANGLES_MAX_N = 2048
+"""Up to this many touches :func:`angle_extremes` looks at every pair (blocked Gram matrix,
+O(N^2) time, O(N) memory; ~5 ms at N = 2048). Above, the smallest angle comes from a
+nearest-neighbour search (exact) and the largest from a bound-and-prune search (exact when the
+pruning leaves at most this many candidate touches, else a documented estimate)."""
+_CHUNK_ROWS = 65536
+"""Rows per chunk of the O(N m) passes of the large-N path (keeps memory O(N))."""
+_N_RANDOM_CENTRES = 16
+_N_SWEEPS = 4
 
 
 def angle_extremes(rotations: np.ndarray, rotations_soa: np.ndarray | None = None, *,
                    gram: np.ndarray | None = None) -> AngleExtremes:
     """Smallest and largest rotation angle between two of the orientations (degrees).
 
-    Uses ``trace(R_a^T R_b) = 1 + 2 cos(angle)`` = the dot product of the flattened rotations
-    to find the two pairs (largest trace = smallest angle and vice versa), then recomputes
-    their angles as ``2 asin(|R_a - R_b|_F / (2 sqrt 2))`` (:func:`angle_between`, accurate for
-    small angles).
-
-    This is the only O(N^2) figure of the 4-point method: every pair must be looked at (the
-    largest angle is the diameter of the set in SO(3); typical touch sets have hundreds of
-    pairs within 0.1 deg of the largest angle, so pruning schemes do not pay). Up to
+    Up to ``EXACT_ANGLES_MAX_N`` touches every pair is looked at: ``trace(R_a^T R_b) = 1 + 2
+    cos(angle)`` = the dot product of the flattened rotations finds the two pairs (largest
+    trace = smallest angle and vice versa), whose angles are then recomputed as ``2 asin(|R_a -
+    R_b|_F / (2 sqrt 2))`` (:func:`angle_between`, accurate for small angles). Up to
     ``_GRAM_SMALL`` touches the whole N x N Gram matrix is formed; above, its upper triangle in
     blocks of rows (``_GRAM_BLOCK_ENTRIES``), each reduced to its minimum and maximum. Ties
     resolve to the first pair in row-major order in both cases.
+
+    Above ``EXACT_ANGLES_MAX_N`` touches (recorded tracker data: 1e5-1e6 poses) the cost is
+    O(N log N) time and O(N) memory (:func:`_angle_extremes_large`): the smallest angle exactly,
+    by a nearest-neighbour search over unit quaternions with sign folding; the largest angle by
+    bound-and-prune, exact in most cases and otherwise a lower bound with an upper bound
+    (``AngleExtremes.max_exact``, ``max_upper_deg``).
 
     Args:
         rotations: (N, 3, 3).
@@ -227,6 +249,8 @@ def angle_extremes(rotations: np.ndarray, rotations_soa: np.ndarray | None = Non
     n = rotations.shape[0]
     if n < 2:
         return AngleExtremes(math.nan, math.nan, (0, 0), (0, 0))
+    if n > EXACT_ANGLES_MAX_N and gram is None:
+        return _angle_extremes_large(rotations)
     x = rotations.reshape(n, 9)
     if n <= _GRAM_SMALL:
         g = x @ x.T if gram is None else gram
@@ -239,54 +263,282 @@ def angle_extremes(rotations: np.ndarray, rotations_soa: np.ndarray | None = Non
             a, b = 0, 1
     else:
         xt = rotations_soa.reshape(9, n) if rotations_soa is not None else np.ascontiguousarray(x.T)
-        lo, hi = math.inf, -math.inf
-        a = b = c = e = 0
-        i = 0
-        while i < n:
-            cols = n - i  # columns i.. of rows i..: the upper triangle and the diagonal block
-            rows = min(max(_GRAM_BLOCK_ENTRIES // cols, 1), cols)
-            blk = x[i : i + rows] @ xt[:, i:]
-            diag = blk.ravel()[: rows * (cols + 1) : cols + 1]  # the pairs (i + k, i + k)
-            k = int(blk.argmin())  # the diagonal (trace 3, the largest) only wins a tie
-            if k % (cols + 1) == 0:  # ... of identical orientations: look again without it
-                diag[:] = np.inf
-                k = int(blk.argmin())
-            v = blk.item(k)
-            if v < lo:
-                lo = v
-                a, b = divmod(k, cols)
-                a, b = a + i, b + i
-            diag[:] = -np.inf
-            k = int(blk.argmax())
-            v = blk.item(k)
-            if v > hi:
-                hi = v
-                c, e = divmod(k, cols)
-                c, e = c + i, e + i
-            i += rows
+        a, b, c, e = _blocked_gram_extremes(x, xt)
     a, b = min(a, b), max(a, b)
     c, e = min(c, e), max(c, e)
-    v = x.take((c, a, e, b), axis=0)
-    d = v[:2] - v[2:]
-    fro2_min, fro2_max = np.einsum("ij,ij->i", d, d).tolist()
-    return AngleExtremes(
-        min_deg=math.degrees(2.0 * math.asin(min(math.sqrt(fro2_min) / _SQRT8, 1.0))),
-        max_deg=math.degrees(2.0 * math.asin(min(math.sqrt(fro2_max) / _SQRT8, 1.0))),
-        min_pair=(c, e),
-        max_pair=(a, b),
-    )
+    min_deg, max_deg = _pair_angles_deg(x, (c, e), (a, b))
+    return AngleExtremes(min_deg=min_deg, max_deg=max_deg, min_pair=(c, e), max_pair=(a, b),
+                         max_upper_deg=max_deg)
 
 
-def duplicate_orientations(rotations: np.ndarray, tol_deg: float = SAME_ORIENTATION_DEG) -> list[tuple[int, int]]:
-    """Pairs ``(i, j)``, ``i < j``, where touch ``j`` has (within ``tol_deg``) the orientation
-    of an earlier touch ``i`` (the first such ``i``); one pair per duplicated ``j``."""
+def _pair_angles_deg(x: np.ndarray, *pairs: tuple[int, int]) -> list[float]:
+    """Angles (deg) of index pairs of flattened rotations ``x`` (N, 9), accurate for small angles."""
+    v = x.take([p[0] for p in pairs] + [p[1] for p in pairs], axis=0)
+    k = len(pairs)
+    d = v[:k] - v[k:]
+    fro2 = np.einsum("ij,ij->i", d, d).tolist()
+    return [math.degrees(2.0 * math.asin(min(math.sqrt(f) / _SQRT8, 1.0))) for f in fro2]
+
+
+def _blocked_gram_extremes(x: np.ndarray, xt: np.ndarray) -> tuple[int, int, int, int]:
+    """Pairs ``(a, b)`` of the smallest and ``(c, e)`` of the largest Gram entry off the
+    diagonal, the upper triangle reduced block by block (O(N^2) time, O(N) memory)."""
+    n = x.shape[0]
+    lo, hi = math.inf, -math.inf
+    a = b = c = e = 0
+    i = 0
+    while i < n:
+        cols = n - i  # columns i.. of rows i..: the upper triangle and the diagonal block
+        rows = min(max(_GRAM_BLOCK_ENTRIES // cols, 1), cols)
+        blk = x[i : i + rows] @ xt[:, i:]
+        diag = blk.ravel()[: rows * (cols + 1) : cols + 1]  # the pairs (i + k, i + k)
+        k = int(blk.argmin())  # the diagonal (trace 3, the largest) only wins a tie
+        if k % (cols + 1) == 0:  # ... of identical orientations: look again without it
+            diag[:] = np.inf
+            k = int(blk.argmin())
+        v = blk.item(k)
+        if v < lo:
+            lo = v
+            a, b = divmod(k, cols)
+            a, b = a + i, b + i
+        diag[:] = -np.inf
+        k = int(blk.argmax())
+        v = blk.item(k)
+        if v > hi:
+            hi = v
+            c, e = divmod(k, cols)
+            c, e = c + i, e + i
+        i += rows
+    return a, b, c, e
+
+
+def quaternions(rotations: np.ndarray) -> np.ndarray:
+    """Unit quaternions ``(w, x, y, z)`` of proper rotations (N, 3, 3), folded to ``w >= 0``.
+
+    Shepperd's method, element-wise (no Python loop): the largest of ``4w^2 = 1 + tr R``,
+    ``4x^2 = 1 + 2 R_00 - tr R``, ... picks the stable formula per row. ``q`` and ``-q`` are the
+    same rotation; the rotation angle between two rotations is ``2 acos |q_a . q_b|`` =
+    ``4 asin(|q_a - s q_b| / 2)`` with the sign ``s`` that makes the distance smallest.
+    """
+    n = rotations.shape[0]
+    r = rotations.reshape(n, 9)
+    r00, r01, r02, r10, r11, r12, r20, r21, r22 = (r[:, k] for k in range(9))
+    tr = r00 + r11 + r22
+    cand = np.stack([1.0 + tr, 1.0 + 2.0 * r00 - tr, 1.0 + 2.0 * r11 - tr, 1.0 + 2.0 * r22 - tr], axis=1)
+    k = cand.argmax(axis=1)
+    q = np.empty((n, 4))
+    for case in range(4):
+        m = k == case
+        if not m.any():
+            continue
+        s = 2.0 * np.sqrt(np.maximum(cand[m, case], 1e-300))  # = 4 |component|
+        if case == 0:
+            q[m] = np.stack([s / 4, (r21[m] - r12[m]) / s, (r02[m] - r20[m]) / s, (r10[m] - r01[m]) / s], 1)
+        elif case == 1:
+            q[m] = np.stack([(r21[m] - r12[m]) / s, s / 4, (r01[m] + r10[m]) / s, (r02[m] + r20[m]) / s], 1)
+        elif case == 2:
+            q[m] = np.stack([(r02[m] - r20[m]) / s, (r01[m] + r10[m]) / s, s / 4, (r12[m] + r21[m]) / s], 1)
+        else:
+            q[m] = np.stack([(r10[m] - r01[m]) / s, (r02[m] + r20[m]) / s, (r12[m] + r21[m]) / s, s / 4], 1)
+    q /= np.sqrt(np.einsum("ij,ij->i", q, q))[:, None]
+    q[q[:, 0] < 0.0] *= -1.0
+    return q
+
+
+def _exact_duplicate_pair(q: np.ndarray) -> tuple[int, int] | None:
+    """A pair of touches with bit-identical quaternions (same rotation matrix), or None.
+    O(N log N): sort by a random projection, compare neighbours with equal keys."""
+    key = q @ np.array([0.5773502691896258, 0.4472135954999579, 0.3779644730092272, 0.5773502691896257])
+    order = np.argsort(key, kind="stable")
+    ks = key[order]
+    same = np.flatnonzero(ks[1:] == ks[:-1])
+    if same.size:
+        qs0, qs1 = q[order[same]], q[order[same + 1]]
+        eq = np.flatnonzero((qs0 == qs1).all(axis=1))
+        if eq.size:
+            k = same[eq[0]]
+            i, j = int(order[k]), int(order[k + 1])
+            return (min(i, j), max(i, j))
+    return None
+
+
+def _nearest_pair(q: np.ndarray) -> tuple[int, int]:
+    """The two touches whose orientations are closest (exact), for quaternions folded to
+    ``w >= 0`` without bit-identical duplicates.
+
+    A KD-tree over the folded quaternions; an upper bound ``delta`` on the smallest chord
+    comes from the nearest neighbours of a sample of touches, then every touch's nearest
+    neighbour is searched within ``delta`` only (cheap: the search stops at ``delta``). Two
+    rotations near ``w = 0`` may be closest through the sign flip: a touch with ``w_i > delta``
+    cannot be within ``delta`` of a flipped one (``|-q_i - q_j| >= w_i + w_j``), so only touches
+    with ``w_i <= delta`` are searched again as ``-q_i``.
+    """
+    from scipy.spatial import cKDTree  # noqa: PLC0415 - only large sets need it
+
+    n = q.shape[0]
+    tree = cKDTree(q, leafsize=16, balanced_tree=False, compact_nodes=False)
+    rng = np.random.default_rng(0)
+    sample = rng.choice(n, size=min(n, 2048), replace=False)
+    d, idx = tree.query(q[sample], k=2)
+    own = idx[:, 0] == sample
+    nd = np.where(own, d[:, 1], d[:, 0])
+    ni = np.where(own, idx[:, 1], idx[:, 0])
+    k = int(nd.argmin())
+    best_d, best = float(nd[k]), (int(sample[k]), int(ni[k]))
+    bound = best_d * (1.0 + 1e-9) + 1e-300
+    for start in range(0, n, _CHUNK_ROWS):
+        rows = np.arange(start, min(start + _CHUNK_ROWS, n))
+        d, idx = tree.query(q[rows], k=2, distance_upper_bound=bound)
+        own = idx[:, 0] == rows
+        nd = np.where(own, d[:, 1], d[:, 0])
+        ni = np.where(own, idx[:, 1], idx[:, 0])
+        k = int(nd.argmin())
+        if float(nd[k]) < best_d:
+            best_d, best = float(nd[k]), (int(rows[k]), int(ni[k]))
+    edge = np.flatnonzero(q[:, 0] <= bound)
+    if edge.size:
+        d, idx = tree.query(-q[edge], k=1, distance_upper_bound=bound)
+        k = int(d.argmin())
+        if float(d[k]) < best_d:
+            best_d, best = float(d[k]), (int(edge[k]), int(idx[k]))
+    i, j = best
+    return (min(i, j), max(i, j))
+
+
+def _angles_to(q: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """Rotation angles (rad) between every row of ``q`` (N, 4) and every row of ``c`` (m, 4)."""
+    dots = np.abs(q @ c.T)
+    np.minimum(dots, 1.0, out=dots)
+    return 2.0 * np.arccos(dots)
+
+
+def _angle_extremes_large(rotations: np.ndarray) -> AngleExtremes:
+    """:func:`angle_extremes` for many touches: O(N log N) time, O(N) memory.
+
+    Smallest angle (exact): bit-identical rotations give 0 (found by sorting); otherwise the
+    nearest pair of the quaternions with sign folding (:func:`_nearest_pair`).
+
+    Largest angle (bound and prune): the rotation angle is a metric on SO(3). For a few
+    centres ``c`` (touch 0, touches found by farthest-point sweeps, random touches, and the
+    principal direction of the quaternions, which need not be a touch) one pass computes
+    every touch's angle to every centre, ``d(j, c)``, and each touch centre's eccentricity
+    ``e(c) = max_j d(c, j)``. ``L = max e(c)`` over the touch centres is attained by a pair.
+    By the triangle inequality ``d(i, j) <= d(i, c) + e(c)`` for every ``c``, so a touch can
+    belong to a pair farther apart than ``L`` only if ``u_j = min_c (d(j, c) + e(c)) > L``,
+    and ``U = max_j u_j`` bounds the largest angle from above. When at most
+    ``EXACT_ANGLES_MAX_N`` touches have ``u_j > L`` every pair among them is looked at and the
+    result is exact; otherwise ``L`` is returned as an estimate with ``max_upper_deg = U``.
+    """
     n = rotations.shape[0]
     x = rotations.reshape(n, 9)
-    g = x @ x.T
-    thr = 1.0 + 2.0 * math.cos(math.radians(tol_deg))
-    close = np.triu(g > thr, k=1)
-    js = np.flatnonzero(close.any(axis=0))
-    return [(int(np.argmax(close[:, j])), int(j)) for j in js]
+    q = quaternions(rotations)
+    dup = _exact_duplicate_pair(q)
+    min_pair = dup if dup is not None else _nearest_pair(q)
+
+    # --- largest angle: centres
+    rng = np.random.default_rng(1)
+    touch_centres = [0]
+    c = 0
+    for _ in range(_N_SWEEPS):  # farthest-point sweeps (the double-sweep heuristic)
+        c = int(np.abs(q @ q[c]).argmin())
+        if c in touch_centres:
+            break
+        touch_centres.append(c)
+    touch_centres += [int(i) for i in rng.choice(n, size=min(n, _N_RANDOM_CENTRES), replace=False)]
+    touch_centres = list(dict.fromkeys(touch_centres))
+    _, vecs = np.linalg.eigh(q.T @ q)  # sign-invariant "mean" orientation
+    centres = np.vstack([q[touch_centres], vecs[:, -1]])
+    m_touch = len(touch_centres)
+    ecc = np.zeros(len(centres))
+    far = np.zeros(len(centres), dtype=np.int64)
+    for start in range(0, n, _CHUNK_ROWS):
+        ang = _angles_to(q[start : start + _CHUNK_ROWS], centres)
+        k = ang.argmax(axis=0)
+        v = ang[k, np.arange(len(centres))]
+        better = v > ecc
+        ecc[better] = v[better]
+        far[better] = k[better] + start
+    slack = 1e-7  # rad: rounding of arccos near 1 (~1e-8) with a margin
+    k = int(ecc[:m_touch].argmax())
+    lower = float(ecc[k])
+    max_pair = (touch_centres[k], int(far[k]))
+    upper = 0.0
+    cand_parts = []
+    for start in range(0, n, _CHUNK_ROWS):
+        ang = _angles_to(q[start : start + _CHUNK_ROWS], centres)
+        ang += ecc
+        u = ang.min(axis=1)
+        upper = max(upper, float(u.max()))
+        cand_parts.append(np.flatnonzero(u > lower - slack) + start)
+    cand = np.concatenate(cand_parts)
+    upper = min(upper + slack, math.pi)
+    exact = cand.size <= EXACT_ANGLES_MAX_N
+    if exact and cand.size >= 2:
+        qc = q[cand]
+        g = np.abs(qc @ qc.T)
+        kk = int(g.argmin())
+        a, b = divmod(kk, cand.size)
+        if a != b and 2.0 * math.acos(min(float(g.item(kk)), 1.0)) > lower:
+            max_pair = (int(cand[a]), int(cand[b]))
+    a, b = min(max_pair), max(max_pair)
+    if a == b:  # every orientation the same
+        a, b = (0, 1)
+    min_deg, max_deg = _pair_angles_deg(x, min_pair, (a, b))
+    upper_deg = max_deg if exact else max(max_deg, math.degrees(upper))
+    return AngleExtremes(min_deg=min_deg, max_deg=max_deg, min_pair=min_pair, max_pair=(a, b),
+                         max_exact=exact, max_upper_deg=upper_deg)
+
+
+@dataclass(frozen=True)
+class DistinctOrientations:
+    """Result of :func:`distinct_orientations`."""
+
+    count: int  # number of distinct orientations, capped at the ``limit`` asked for
+    first_repeat: tuple[int, int] | None  # (i, j): touch j repeats the orientation of touch i
+
+
+def distinct_orientations(rotations: np.ndarray, tol_deg: float = SAME_ORIENTATION_DEG, *,
+                          limit: int = 4) -> DistinctOrientations:
+    """How many clearly different orientations the touches have (up to ``limit``).
+
+    Greedy, in recording order: touch 0 is the first distinct orientation; a later touch is a
+    new one when it is more than ``tol_deg`` from every distinct orientation found before it,
+    otherwise it repeats (the first) one of them. So the distinct orientations are pairwise
+    more than ``tol_deg`` apart and every touch is within ``tol_deg`` of one of them (a slow
+    continuous motion recorded at a high rate, each pose within ``tol_deg`` of the previous
+    one, counts as many orientations, not one). O(N) time at most (``limit`` distinct
+    orientations are usually found among the first touches), never an N x N matrix.
+
+    Args:
+        rotations: (N, 3, 3), N >= 1.
+        tol_deg: two orientations closer than this (degrees) are the same.
+        limit: stop counting here (``count`` is exact when below ``limit``).
+
+    Returns:
+        The count and the first touch ``j`` (lowest index) that repeats an orientation, with the
+        first distinct orientation ``i`` it repeats (None if no touch repeats one before the
+        count reached ``limit``).
+    """
+    n = rotations.shape[0]
+    x = rotations.reshape(n, 9)
+    thr = 1.0 + 2.0 * math.cos(math.radians(tol_deg))  # trace(R_a^T R_b) above it: same
+    leaders = [0]
+    first_repeat: tuple[int, int] | None = None
+    start = 1
+    window = 64  # rows looked at per step, doubled while no new orientation turns up
+    while start < n and len(leaders) < limit:
+        stop = min(start + window, n)
+        close = (x[start:stop] @ x[leaders].T) > thr  # (rows, k <= limit)
+        new = np.flatnonzero(~close.any(axis=1))
+        if first_repeat is None and (new.size == 0 or new[0] > 0):  # row `start` repeats
+            first_repeat = (leaders[int(np.argmax(close[0]))], start)
+        if new.size == 0:
+            start = stop
+            window *= 2
+            continue
+        leaders.append(start + int(new[0]))
+        start = leaders[-1] + 1
+    return DistinctOrientations(count=len(leaders), first_repeat=first_repeat)
 
 
 def fmt_vec(v: np.ndarray) -> str:

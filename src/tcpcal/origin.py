@@ -29,14 +29,20 @@ from tcpcal._stats import (
     angle_between,
     angle_extremes,
     ci_radius,
-    duplicate_orientations,
+    distinct_orientations,
     fmt_vec,
     information,
     soa,
     sum_over_touches,
 )
 from tcpcal.errors import DegenerateTouchesError, InvalidInputError
-from tcpcal.validation import as_positions, as_rotation, as_vector3, rotations_and_soa
+from tcpcal.validation import (
+    MAX_ABS_COORDINATE,
+    as_positions,
+    as_rotation,
+    as_vector3,
+    rotations_and_soa,
+)
 
 __all__ = ["METHODS", "TcpResult", "solve_reference", "solve_xyz4"]
 
@@ -56,6 +62,9 @@ WEAK_AXIS_RATIO = 5.0
 the strongest by this factor."""
 COPLANAR_RATIO = 0.2
 """Sphere fit: warn when the flange positions' thickness / extent is below this."""
+SIGMA_RANGE: tuple[float, float] = (1e-12, 1e9)
+"""Accepted range of a given ``sigma`` (length unit of the positions; the CLI's own range in mm
+is narrower, docs/cli.md). Outside it the squares of sigma under- or overflow."""
 _EXACT_REL = 1e-9
 """Residual noise below this fraction of the data scale counts as exact data (no outlier test)."""
 _EXACT_RESIDUAL_SHARE = 1e-12
@@ -92,7 +101,10 @@ class TcpResult:
         ci95_radius: radius of the sphere about ``tcp`` that contains the true TCP with 95 %
             probability under ``covariance`` (with the 3N - 6 degrees of freedom of ``s``
             when sigma was estimated).
-        max_angle_deg: largest rotation angle between two touch orientations.
+        max_angle_deg: largest rotation angle between two touch orientations; exact unless
+            ``max_angle_exact`` is False (possible only above ``EXACT_ANGLES_MAX_N`` = 2048
+            touches, see ``tcpcal._stats.angle_extremes``): then a lower bound attained by a
+            pair of touches (the true largest angle is at most ``max_angle_upper_deg``).
         min_angle_deg: smallest rotation angle between two touch orientations.
         condition_number: of the stacked (4P-3) matrix ``A`` (3N x 6).
         outliers: 0-based indices of touches flagged as outliers.
@@ -100,6 +112,9 @@ class TcpResult:
             order), or None if no touch was flagged.
         warnings: plain-words remarks on the data.
         n_touches: N.
+        max_angle_exact: whether ``max_angle_deg`` is exact (always for N <= 2048).
+        max_angle_upper_deg: upper bound of the largest angle (= ``max_angle_deg`` when
+            exact).
     """
 
     method: str
@@ -120,6 +135,8 @@ class TcpResult:
     without_outliers: TcpResult | None
     warnings: tuple[str, ...]
     n_touches: int
+    max_angle_exact: bool = True
+    max_angle_upper_deg: float = math.nan
 
 
 def _check_sigma(sigma: float | None) -> float | None:
@@ -133,6 +150,13 @@ def _check_sigma(sigma: float | None) -> float | None:
         raise InvalidInputError(
             f"sigma must be a finite positive number (touch noise per axis), got {sigma!r}; "
             "omit it to estimate the noise from the residuals."
+        )
+    lo, hi = SIGMA_RANGE
+    if not lo <= s <= hi:
+        raise InvalidInputError(
+            f"sigma {sigma!r} is outside {lo:g}..{hi:g} (touch noise per axis, length unit of the "
+            "positions): no touch is that precise or that poor; give a realistic value, or omit "
+            "it to estimate the noise from the residuals."
         )
     return s
 
@@ -156,10 +180,10 @@ def _check_observable(rotations: np.ndarray, info: Information, ext: AngleExtrem
             unobservable_axis=axis,
         )
     if ext.min_deg < SAME_ORIENTATION_DEG:
-        dups = duplicate_orientations(rotations)
-        distinct = n - len(dups)
-        if distinct < MIN_TOUCHES:
-            i, j = dups[0]
+        found = distinct_orientations(rotations, limit=MIN_TOUCHES)
+        distinct = found.count
+        if distinct < MIN_TOUCHES and found.first_repeat is not None:
+            i, j = found.first_repeat
             raise DegenerateTouchesError(
                 f"touches {i} and {j} (0-based) have the same orientation "
                 f"({math.degrees(angle_between(rotations[i], rotations[j])):.2f} deg apart): "
@@ -261,7 +285,13 @@ _CYCLIC = np.array([0, 1, 2, 0, 1])
 _EYE_COLUMN = np.eye(3)[:, :, None]
 
 
-def _deleted_residual_statistics(y: np.ndarray, info: Information, e: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+_STATS_CHUNK = 16384
+"""Touches per chunk of :func:`_deleted_residual_statistics` for large N (its 3x3-per-touch
+temporaries: 25 rows of N numbers; chunked they stay in cache, memory O(chunk))."""
+
+
+def _deleted_residual_statistics(y: np.ndarray, info: Information, e: np.ndarray,
+                                 n_all: int | None = None) -> tuple[np.ndarray, np.ndarray]:
     """``Q_i = e_i^T (I - H_ii)^-1 e_i`` and ``det(I - H_ii)`` of every touch (see
     :func:`_find_outliers`), without a Python loop over touches.
 
@@ -272,10 +302,15 @@ def _deleted_residual_statistics(y: np.ndarray, info: Information, e: np.ndarray
     Everything is element-wise on the (3, 3, N) layout ``y`` (entry rows of length N): a
     dozen numpy calls at any N. (Hand-written rather than ``np.linalg.solve`` on the (N, 3, 3)
     stack, which costs ~0.3 us per touch plus a determinant pass; measured 4x faster at
-    N = 1000.)
+    N = 1000.) ``n_all``: the number of touches of the fit when ``y`` and ``e`` are one chunk
+    of them.
     """
     n = e.shape[0]
-    a = 1.0 - 1.0 / n
+    if n > _STATS_CHUNK:  # same element-wise algebra chunk by chunk: temporaries stay in cache
+        parts = [_deleted_residual_statistics(y[:, :, k : k + _STATS_CHUNK], info, e[k : k + _STATS_CHUNK], n)
+                 for k in range(0, n, _STATS_CHUNK)]
+        return np.concatenate([q for q, _ in parts]), np.concatenate([d for _, d in parts])
+    a = 1.0 - 1.0 / (n if n_all is None else n_all)
     d = y - info.rbar[:, :, None]  # d[j, k] = (R_i - Rbar)_jk
     w = np.matmul((info.eigvecs / np.sqrt(info.eigvals)).T, d)  # w[j] = (D_i L)_j. rows
     b = _EYE_COLUMN * a - np.einsum("jkn,lkn->jln", w, w)  # a I - W_i W_i^T
@@ -352,6 +387,17 @@ def _find_outliers(rotations: np.ndarray, y: np.ndarray, f: np.ndarray,
         flagged.append(int(idx[k]))
         idx = np.delete(idx, k)
     return sorted(flagged)
+
+
+def _check_finite_result(t: np.ndarray, r: np.ndarray, sse: float) -> None:
+    """Raise InvalidInputError rather than return a TCP holding NaN or inf (an overflow of the
+    arithmetic on extreme numbers that the input bounds did not prevent)."""
+    if not math.isfinite(sum(t.tolist()) + sum(r.tolist()) + sse):
+        raise InvalidInputError(
+            "the TCP could not be computed in floating point (overflow: the result is not finite); "
+            "check the positions' unit and magnitude (they must be within "
+            f"+-{MAX_ABS_COORDINATE:g} length units)."
+        )
 
 
 def _fmt_idx(indices: list[int] | tuple[int, ...]) -> str:
@@ -475,6 +521,7 @@ def _solve(rot: np.ndarray, y: np.ndarray | None, f: np.ndarray, method: str, si
 
     res = np.einsum("ni,ni->n", e, e)
     sse = fit.sse if method == "lstsq" else float(_add(res))
+    _check_finite_result(t, r, sse)
     np.sqrt(res, out=res)
     dof = 3 * n - 6
     s_est = math.sqrt(sse / dof)
@@ -506,7 +553,7 @@ def _solve(rot: np.ndarray, y: np.ndarray | None, f: np.ndarray, method: str, si
         )
 
     eig = info.eigvals.tolist()
-    if ext.max_deg < SMALL_TILT_DEG:
+    if ext.max_deg < SMALL_TILT_DEG and ext.max_upper_deg < SMALL_TILT_DEG:
         warnings.append(
             f"the touch orientations differ by at most {ext.max_deg:.1f} deg: tilt the tool 30-60 deg "
             "between touches, about two different axes, for a precise TCP."
@@ -555,6 +602,8 @@ def _solve(rot: np.ndarray, y: np.ndarray | None, f: np.ndarray, method: str, si
         without_outliers=without,
         warnings=tuple(warnings),
         n_touches=n,
+        max_angle_exact=ext.max_exact,
+        max_angle_upper_deg=ext.max_upper_deg,
     )
 
 
@@ -634,4 +683,5 @@ def solve_reference(
         without_outliers=None,
         warnings=tuple(warnings),
         n_touches=2,
+        max_angle_upper_deg=angle,
     )

@@ -24,7 +24,7 @@ from tcpcal._stats import (
     Information,
     angle_extremes,
     ci_radius,
-    duplicate_orientations,
+    distinct_orientations,
     fmt_vec,
     information,
     information_from_sum,
@@ -158,7 +158,7 @@ def _assess(rot: np.ndarray, sigma: float, info: Information | None = None,
         return PoseQuality(n, False, axis, inf, inf, ext.min_deg, msg)
     distinct = n
     if ext.min_deg < SAME_ORIENTATION_DEG:
-        distinct = n - len(duplicate_orientations(rot))
+        distinct = distinct_orientations(rot, limit=MIN_TOUCHES).count
     if n < MIN_TOUCHES or distinct < MIN_TOUCHES:
         more = MIN_TOUCHES - distinct
         dup = f" ({n - distinct} of them repeat an orientation)" if distinct < n else ""

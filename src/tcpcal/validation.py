@@ -19,6 +19,7 @@ import numpy as np
 from tcpcal.errors import InvalidInputError
 
 __all__ = [
+    "MAX_ABS_COORDINATE",
     "ORTHONORMAL_TOL",
     "as_positions",
     "as_rotation",
@@ -29,6 +30,12 @@ __all__ = [
 
 ORTHONORMAL_TOL: float = 1e-6
 """Largest accepted ``max |R^T R - I|`` of a rotation matrix."""
+
+MAX_ABS_COORDINATE: float = 1e9
+"""Largest accepted ``|coordinate|`` of a position or vector, in the caller's length unit
+(unit-agnostic: a kilometre in micrometres; the CLI's own bound is 1e6 mm, docs/cli.md).
+Beyond it no robot cell is meant, and sums of squares over many touches would lose their
+meaning or overflow."""
 
 _EYE = np.eye(3)
 _EYE_COLUMN = _EYE[:, :, None]
@@ -189,8 +196,8 @@ def as_positions(x: Any, n: int | None = None, name: str = "positions") -> np.nd
         (N, 3) float64 array (a copy).
 
     Raises:
-        InvalidInputError: wrong shape, a row count different from ``n``, NaN/inf (with
-            ``.index`` of the first bad row).
+        InvalidInputError: wrong shape, a row count different from ``n``, NaN/inf or a
+            coordinate beyond ``MAX_ABS_COORDINATE`` (with ``.index`` of the first bad row).
     """
     arr = _as_float_array(x, name, "an (N, 3) array of positions")
     if arr.ndim != 2 or arr.shape[1] != 3:
@@ -205,16 +212,30 @@ def as_positions(x: Any, n: int | None = None, name: str = "positions") -> np.nd
             f"{name} has {arr.shape[0]} rows but there are {n} rotations; pass exactly one "
             "position per rotation (same touches, same order)."
         )
-    # one reduction: the sum is finite unless an entry is NaN/inf (or the sum overflows, which
-    # the exact look-up below then clears)
-    i = None if math.isfinite(float(_add(arr, axis=None))) else _first_nonfinite(arr)
+    # one reduction: the largest |entry| is NaN for a NaN (maximum propagates it), inf for an inf
+    if not float(_max(np.abs(arr), axis=None)) <= MAX_ABS_COORDINATE:
+        _raise_bad_coordinate(arr, name)
+    return arr
+
+
+def _raise_bad_coordinate(arr: np.ndarray, name: str) -> None:
+    """Raise the error about the first row holding NaN, inf or a coordinate beyond
+    ``MAX_ABS_COORDINATE`` (the caller found one)."""
+    i = _first_nonfinite(arr)
     if i is not None:
         raise InvalidInputError(
             f"{name}[{i}] contains NaN or inf; every coordinate must be a finite number "
             "(re-record or remove that touch).",
             index=i,
         )
-    return arr
+    flat = np.abs(arr.reshape(arr.shape[0], -1))
+    i = int(np.argmax((flat > MAX_ABS_COORDINATE).any(axis=1)))
+    raise InvalidInputError(
+        f"{name}[{i}] has a coordinate {float(flat[i].max()):.6g} beyond +-{MAX_ABS_COORDINATE:g} "
+        "(length units): not a position in a robot cell; check the unit and the column order, "
+        "or re-record or remove that touch.",
+        index=i,
+    )
 
 
 def as_vector3(x: Any, name: str = "vector") -> np.ndarray:
@@ -228,7 +249,7 @@ def as_vector3(x: Any, name: str = "vector") -> np.ndarray:
         (3,) float64 array (a copy).
 
     Raises:
-        InvalidInputError: not 3 numbers, or NaN/inf.
+        InvalidInputError: not 3 numbers, NaN/inf, or beyond ``MAX_ABS_COORDINATE``.
     """
     arr = _as_float_array(x, name, "a 3-vector")
     if arr.shape != (3,):
@@ -237,4 +258,9 @@ def as_vector3(x: Any, name: str = "vector") -> np.ndarray:
         )
     if not np.isfinite(arr).all():
         raise InvalidInputError(f"{name} contains NaN or inf; pass 3 finite numbers.")
+    if float(np.abs(arr).max()) > MAX_ABS_COORDINATE:
+        raise InvalidInputError(
+            f"{name} has a coordinate {float(np.abs(arr).max()):.6g} beyond +-{MAX_ABS_COORDINATE:g} "
+            "(length units): check the unit and the order of the numbers."
+        )
     return arr
