@@ -20,6 +20,7 @@ from tcp_pendant.pendant import FIELDS, ToolEntry, parse_tool_entry, tool_data_m
 from tcp_pendant.pendant.tool_entry import entry_preview_markdown
 from tcp_pendant.session import Session
 from tcp_pendant.views.gui_util import number_of_option, set_options, slot_option
+from tcpcal.errors import TcpcalError
 from tcpcal.formats import FORMATS, export_tool
 from tcpcal.tool import Tool
 
@@ -84,13 +85,30 @@ class ToolPanel:
         self._show_entry_preview()
         self._library: dict[int, Tool] = {}
         self._reload_listeners: list[Callable[[dict[int, Tool]], None]] = []
+        # a new browser hears of the library's latest recovery; later ones as they happen
+        self._recoveries_told = max(0, len(session.library.recoveries) - 1)
+        self._library_error: str | None = None
         self.reload()
         self._show_active()
 
     # ------------------------------------------------------------ library
     def reload(self) -> None:
-        """Re-read the shared library and refresh the slot lists (keeps the selection)."""
-        lib = self.session.library.tools()
+        """Re-read the shared library and refresh the slot lists (keeps the selection).
+
+        A damaged file's valid tools are listed; what the library set aside (and where its
+        backup is) is told to this browser once per recovery. An unreadable file lists no
+        tools and says why (once per reason), so the rest of the pendant still works.
+        """
+        try:
+            lib = self.session.library.tools()
+        except TcpcalError as exc:  # e.g. permissions: ToolLibraryError names the file
+            lib = {}
+            if str(exc) != self._library_error:
+                self.session.notify("Tool library unavailable", str(exc), kind="error")
+            self._library_error = str(exc)
+        else:
+            self._library_error = None
+        self._tell_recoveries()
         self._library = lib
         options = tuple(slot_option(s, t.name) for s, t in sorted(lib.items())) or (NO_TOOL,)
         current = number_of_option(self.slots.value)
@@ -104,6 +122,16 @@ class ToolPanel:
         self._show_active()
         for fn in self._reload_listeners:
             fn(lib)
+
+    def _tell_recoveries(self) -> None:
+        """Notify this browser of each library recovery it has not been told of (viser shows a
+        notification's body as plain text, so tool names and paths need no escaping)."""
+        recoveries = self.session.library.recoveries
+        for rec in recoveries[self._recoveries_told:]:
+            title = ("Tool library moved aside" if rec.whole_file
+                     else "Tool library: bad entries set aside")
+            self.session.notify(title, rec.summary(), kind="warning")
+        self._recoveries_told = len(recoveries)
 
     def on_reload(self, fn: Callable[[dict[int, Tool]], None]) -> None:
         """Call ``fn(tools)`` with the library just read (slot -> tool) after every reload, so
