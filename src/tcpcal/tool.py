@@ -5,8 +5,12 @@ A :class:`Tool` is the TOOL frame of one physical tool: its TCP ``t`` in FLANGE 
 (``R = Rz(A) Ry(B) Rx(C)`` = ``Rotation.from_euler("ZYX", [A, B, C], degrees=True)``,
 methods.md section 6), plus a name, an optional mass, free notes and how it was calibrated.
 
-Names follow a controller's tool table: 1 to :data:`MAX_NAME_LENGTH` (24) printable characters,
-no double quote (it ends a string literal in KRL and RAPID), no leading or trailing spaces.
+Names follow a controller's tool table: 1 to :data:`MAX_NAME_LENGTH` (24) printable characters
+(no control or invisible character: Unicode categories C*, line and paragraph separators, and
+spaces other than U+0020), no double quote (it ends a string literal in KRL and RAPID), no
+leading or trailing spaces. Every Tool is checked when it is made, so this holds for names
+typed in the pendant, given to ``tcpcal tools add``, set by ``ToolLibrary.rename`` or read from
+a library file. What each controller format accepts beyond that: README.md, "Tool names".
 
 Dictionary form (``Tool.to_dict`` / ``Tool.from_dict``; the tool library file stores exactly
 this, so scripts may rely on these keys; they are a stable contract)::
@@ -34,6 +38,7 @@ from __future__ import annotations
 
 import math
 import types
+import unicodedata
 import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -123,10 +128,12 @@ def _check_name(name: Any) -> str:
             f"tool name {name!r} has {len(name)} characters; a controller accepts at most "
             f"{MAX_NAME_LENGTH}: shorten it."
         )
-    if not name.isprintable():
+    if not name.isprintable():  # Unicode categories C* and separators other than the space
+        bad = next(ch for ch in name if not ch.isprintable())
+        what = unicodedata.name(bad, unicodedata.category(bad))
         raise InvalidInputError(
-            f"tool name {name!r} contains a control character (tab, newline, ...); use printable "
-            "characters only."
+            f"tool name {name!r} contains a control character, U+{ord(bad):04X} ({what}); a "
+            "controller cannot show it: use printable characters only."
         )
     if '"' in name:
         raise InvalidInputError(

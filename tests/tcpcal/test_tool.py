@@ -122,6 +122,51 @@ def test_invalid_tools_raise_clear_errors(kwargs, match):
         Tool(**base)
 
 
+@pytest.mark.parametrize(
+    ("name", "code"),
+    [
+        ("a\x7fb", "U+007F"),             # DEL (Cc)
+        ("zero\u200bwidth", "U+200B"),     # ZERO WIDTH SPACE (Cf)
+        ("evil\u202eloot", "U+202E"),      # RIGHT-TO-LEFT OVERRIDE (Cf): reverses the text shown
+        ("nb\u00a0sp", "U+00A0"),          # NO-BREAK SPACE: looks like a space, is not one
+        ("line\u2028sep", "U+2028"),       # LINE SEPARATOR (Zl)
+        ("private\ue000", "U+E000"),       # private use (Co)
+        ("esc\x1b[31m", "U+001B"),         # a terminal escape sequence
+    ],
+)
+def test_name_with_an_invisible_or_control_character_is_refused_naming_it(name, code):
+    with pytest.raises(InvalidInputError, match="control character") as err:
+        Tool(name, (0, 0, 0))
+    assert code in str(err.value)
+
+
+@pytest.mark.parametrize("name", ["trail ", "\u3000ideographic", "tab\t"])
+def test_name_with_surrounding_whitespace_is_refused(name):
+    with pytest.raises(InvalidInputError, match="space|control character"):
+        Tool(name, (0, 0, 0))
+
+
+@pytest.mark.parametrize("name", ["Greifer-Übergabe", "トーチ 2", "Ø12 drill", "spot_gun.3"])
+def test_printable_unicode_names_are_kept(name):
+    assert Tool(name, (0, 0, 0)).name == name
+
+
+def test_names_are_validated_where_they_are_made(tmp_path):
+    """The one check in Tool covers a rename in the library and a name read from its file."""
+    import dataclasses
+
+    from tcpcal.library import ToolLibrary
+
+    t = Tool("ok", (0, 0, 0))
+    with pytest.raises(InvalidInputError, match="U\\+200B"):
+        dataclasses.replace(t, name="o\u200bk")
+    lib = ToolLibrary(tmp_path / "tools.json")
+    lib.save(1, t)
+    with pytest.raises(InvalidInputError, match="at most 24"):
+        lib.rename(1, "n" * 25)
+    assert lib.get(1).name == "ok"
+
+
 def test_name_of_24_printable_characters_is_fine():
     name = "Gripper #2 (left) - 24ch"
     assert len(name) == 24
