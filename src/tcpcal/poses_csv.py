@@ -39,7 +39,8 @@ from __future__ import annotations
 
 import csv
 import math
-from collections.abc import Sequence
+import sys
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -184,33 +185,119 @@ def _choose_layout(path: Path, line_no: int, names: Sequence[str]) -> str:
     return complete[0]
 
 
-def _rotation_from_row(layout: str, v: np.ndarray, where: str, index: int) -> np.ndarray:
-    """Convert one row's orientation numbers to ``R_world_flange`` (3, 3) with scipy."""
-    if layout == "kuka":
-        return Rotation.from_euler("ZYX", v, degrees=True).as_matrix()
-    if layout == "fanuc":
-        return Rotation.from_euler("xyz", v, degrees=True).as_matrix()
-    if layout == "rotvec":
-        return Rotation.from_rotvec(v).as_matrix()
+def _rotations_from_values(layout: str, v: np.ndarray, where: Callable[[int], str]) -> np.ndarray:
+    """Convert the orientation numbers of every row (N, k) to ``R_world_flange`` (N, 3, 3)
+    with scipy, in one call per file; the first row that is not a rotation raises the error
+    naming it (``where(i)`` = file, line and data row of row i)."""
+    n = v.shape[0]
     if layout == "abb":
-        norm = float(np.linalg.norm(v))
-        if abs(norm - 1.0) > ORTHONORMAL_TOL:
-            raise _error(f"{where}: quaternion qw,qx,qy,qz has norm {norm:.9g}, not 1 within "
+        norm = np.sqrt(np.einsum("ij,ij->i", v, v))
+        bad = ~(np.abs(norm - 1.0) <= ORTHONORMAL_TOL)
+        if bad.any():
+            i = int(np.argmax(bad))
+            raise _error(f"{where(i)}: quaternion qw,qx,qy,qz has norm {norm[i]:.9g}, not 1 within "
                          f"{ORTHONORMAL_TOL:g}; check the column order and print more digits",
-                         index=index)
-        return Rotation.from_quat(v[[1, 2, 3, 0]]).as_matrix()  # scipy order x, y, z, w (any scipy)
+                         index=i)
+        return Rotation.from_quat(v[:, [1, 2, 3, 0]]).as_matrix()  # scipy order x, y, z, w
     if layout == "matrix":
-        m = v.reshape(3, 3)
-        defect = float(np.max(np.abs(m.T @ m - np.eye(3))))
-        if defect > ORTHONORMAL_TOL:
-            raise _error(f"{where}: rotation r11..r33 is not orthonormal within "
-                         f"{ORTHONORMAL_TOL:g} (max |R^T R - I| = {defect:.3g}); check the "
-                         f"row-major column order and print more digits", index=index)
-        if np.linalg.det(m) < 0:
-            raise _error(f"{where}: rotation r11..r33 is a reflection (det = -1), not a rotation; "
-                         f"check the row-major column order", index=index)
+        m = v.reshape(n, 3, 3)
+        defect = np.abs(np.einsum("nji,njk->nik", m, m) - np.eye(3)).reshape(n, 9).max(axis=1)
+        bad = ~(defect <= ORTHONORMAL_TOL)
+        if bad.any():
+            i = int(np.argmax(bad))
+            raise _error(f"{where(i)}: rotation r11..r33 is not orthonormal within "
+                         f"{ORTHONORMAL_TOL:g} (max |R^T R - I| = {defect[i]:.3g}); check the "
+                         f"row-major column order and print more digits", index=i)
+        det = np.linalg.det(m)
+        if (det < 0).any():
+            i = int(np.argmax(det < 0))
+            raise _error(f"{where(i)}: rotation r11..r33 is a reflection (det = -1), not a "
+                         f"rotation; check the row-major column order", index=i)
         return Rotation.from_matrix(m).as_matrix()
-    raise AssertionError(layout)  # pragma: no cover
+    if layout == "kuka":
+        rot = Rotation.from_euler("ZYX", v, degrees=True).as_matrix()
+    elif layout == "fanuc":
+        rot = Rotation.from_euler("xyz", v, degrees=True).as_matrix()
+    elif layout == "rotvec":
+        rot = Rotation.from_rotvec(v).as_matrix()
+    else:  # pragma: no cover
+        raise AssertionError(layout)
+    bad = ~np.isfinite(rot.reshape(n, 9)).all(axis=1)
+    if bad.any():  # e.g. a rotation vector of length 1e308 (its norm overflows)
+        i = int(np.argmax(bad))
+        cols = ",".join(LAYOUTS[layout])
+        raise _error(f"{where(i)}: {cols} = {', '.join(f'{x:g}' for x in v[i])} give no finite "
+                     f"rotation (numbers too large); check the unit ({_LAYOUT_UNITS[layout]})",
+                     index=i)
+    return rot
+
+
+MAX_ABS_MM: float = 1e6
+"""Largest accepted ``|x|``, ``|y|``, ``|z|`` in POSES.csv, mm (1 km: beyond any robot cell;
+documented in docs/cli.md)."""
+
+STDIN_NAME = "<stdin>"
+"""How messages and the JSON ``input.path`` name POSES.csv when it is read from stdin (``-``)."""
+
+
+def _read_text(path: Path) -> tuple[str, Path]:
+    """The text of ``path`` (``-``: all of stdin) and the name to use in messages."""
+    if str(path) == "-":
+        data = sys.stdin.buffer.read() if hasattr(sys.stdin, "buffer") else sys.stdin.read()
+        shown = Path(STDIN_NAME)
+        if isinstance(data, str):
+            return data.removeprefix("\ufeff"), shown
+    else:
+        data, shown = path.read_bytes(), path
+    try:
+        return data.decode("utf-8-sig"), shown
+    except UnicodeDecodeError as exc:
+        raise _error(f"{shown}: not a UTF-8 text file ({exc.reason} at byte {exc.start}); "
+                     f"save the CSV as UTF-8") from None
+
+
+def _row_values_slow(path: Path, names: list[str], pose_cols: tuple[str, ...],
+                     col_index: list[int], rows: list[tuple[int, list[str]]]) -> np.ndarray:
+    """The pose numbers of every row, cell by cell: the first bad cell raises its error
+    (file, line, data row, column). Used when the one-call conversion found a problem."""
+    values = np.empty((len(rows), len(pose_cols)))
+    for index, (line_no, cells) in enumerate(rows):
+        where = f"{path}, line {line_no} (data row {index + 1})"
+        if len(cells) > len(names) and not any(c.strip() for c in cells[len(names):]):
+            cells = cells[: len(names)]  # trailing empty cells (spreadsheet export)
+        if len(cells) != len(names):
+            raise _error(f"{where}: {len(cells)} cells but the header has {len(names)} columns",
+                         index=index)
+        for k, (col, j) in enumerate(zip(pose_cols, col_index)):
+            cell = cells[j].strip()
+            if not cell:
+                raise _error(f"{where}: column '{col}' is empty", index=index)
+            try:
+                val = float(cell)
+            except ValueError:
+                raise _error(f"{where}: column '{col}' is not a number: {cell!r}",
+                             index=index) from None
+            if not math.isfinite(val):
+                raise _error(f"{where}: column '{col}' is {cell!r}, not a finite number",
+                             index=index)
+            values[index, k] = val
+    return values
+
+
+def _row_values(path: Path, names: list[str], pose_cols: tuple[str, ...], col_index: list[int],
+                rows: list[tuple[int, list[str]]]) -> np.ndarray:
+    """(N, k) pose numbers of the data rows: one numpy conversion for a clean file (10^6 rows
+    in about a second), the cell-by-cell check only to name a problem."""
+    width = len(names)
+    if all(len(cells) == width for _, cells in rows):
+        try:
+            values = np.array([[cells[j] for j in col_index] for _, cells in rows],
+                              dtype=np.str_).astype(float).reshape(len(rows), len(pose_cols))
+        except ValueError:
+            values = None
+        if values is not None and np.isfinite(values).all():
+            return values
+    return _row_values_slow(path, names, pose_cols, col_index, rows)
 
 
 def read_poses_csv(path: str | Path, *, min_rows: int = 1, max_rows: int | None = None,
@@ -218,7 +305,8 @@ def read_poses_csv(path: str | Path, *, min_rows: int = 1, max_rows: int | None 
     """Read flange poses ``T_world_flange`` (positions in mm) from a CSV file.
 
     Args:
-        path: the CSV file (header row + one pose per row; see the module docstring).
+        path: the CSV file (header row + one pose per row; see the module docstring), or
+            ``-`` for stdin (named ``<stdin>`` in messages and in ``FlangePoses.path``).
         min_rows: fewer data rows than this is an error.
         max_rows: more data rows than this is an error (``None``: no limit).
         purpose: what the rows are for, quoted in the row-count message (e.g. ``"xyz4"``).
@@ -229,20 +317,17 @@ def read_poses_csv(path: str | Path, *, min_rows: int = 1, max_rows: int | None 
     Raises:
         InvalidInputError: unknown or ambiguous header, a cell that is not a finite number, a
             row with the wrong number of cells, a quaternion or matrix that is not orthonormal
-            within 1e-6, or too few / too many rows. The message names the file and the line.
+            within 1e-6, a position beyond +-``MAX_ABS_MM`` (1e6 mm), orientation numbers that
+            give no finite rotation, or too few / too many rows. The message names the file and the line.
         OSError: the file cannot be opened or read. ``UnicodeDecodeError`` (a ``ValueError``)
             is turned into an ``InvalidInputError``.
     """
-    path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8-sig")
-    except UnicodeDecodeError as exc:
-        raise _error(f"{path}: not a UTF-8 text file ({exc.reason} at byte {exc.start}); "
-                     f"save the CSV as UTF-8") from None
+    text, path = _read_text(Path(path))
 
     lines = text.splitlines()
     content = [(i + 1, ln) for i, ln in enumerate(lines)
                if ln.strip() and not ln.lstrip().startswith("#")]
+    del lines
     if not content:
         raise _error(f"{path}: the file is empty (no header row); {accepted_layouts_text()}")
 
@@ -260,43 +345,30 @@ def read_poses_csv(path: str | Path, *, min_rows: int = 1, max_rows: int | None 
     role_col = names.index("role") if "role" in names else None
     joint_cols = _joint_columns(names)
 
-    rotations: list[np.ndarray] = []
-    positions: list[np.ndarray] = []
-    line_numbers: list[int] = []
-    labels: list[str] = []
-    roles: list[str] = []
-    joints: list[tuple[float, ...]] = []
-    for (line_no, _), cells in zip(content[1:], parsed[1:]):
-        index = len(positions)
-        where = f"{path}, line {line_no} (data row {index + 1})"
-        if len(cells) > len(names) and not any(c.strip() for c in cells[len(names):]):
-            cells = cells[: len(names)]  # trailing empty cells (spreadsheet export)
-        if len(cells) != len(names):
-            raise _error(f"{where}: {len(cells)} cells but the header has {len(names)} columns",
-                         index=index)
-        values = np.empty(len(pose_cols))
-        for k, (col, j) in enumerate(zip(pose_cols, col_index)):
-            cell = cells[j].strip()
-            if not cell:
-                raise _error(f"{where}: column '{col}' is empty", index=index)
-            try:
-                val = float(cell)
-            except ValueError:
-                raise _error(f"{where}: column '{col}' is not a number: {cell!r}",
-                             index=index) from None
-            if not math.isfinite(val):
-                raise _error(f"{where}: column '{col}' is {cell!r}, not a finite number",
-                             index=index)
-            values[k] = val
-        rotations.append(_rotation_from_row(layout, values[3:], where, index))
-        positions.append(values[:3])
-        line_numbers.append(line_no)
-        if label_col is not None:
-            labels.append(cells[label_col].strip())
-        if role_col is not None:
-            roles.append(cells[role_col].strip().lower())
-        if joint_cols:
-            joints.append(_joint_values(cells, joint_cols, where, index))
+    rows = [(line_no, cells) for (line_no, _), cells in zip(content[1:], parsed[1:])]
+    del content, parsed
+    values = _row_values(path, names, pose_cols, col_index, rows)
+    line_numbers = [line_no for line_no, _ in rows]
+
+    def where(i: int) -> str:
+        return f"{path}, line {line_numbers[i]} (data row {i + 1})"
+
+    labels = [cells[label_col].strip() for _, cells in rows] if label_col is not None else []
+    roles = [cells[role_col].strip().lower() for _, cells in rows] if role_col is not None else []
+    joints = ([_joint_values(cells, joint_cols, where(i), i) for i, (_, cells) in enumerate(rows)]
+              if joint_cols else [])
+    del rows
+
+    big = np.abs(values[:, :3]) > MAX_ABS_MM
+    if big.any():
+        i, k = divmod(int(np.argmax(big.ravel())), 3)
+        raise _error(f"{where(i)}: column '{POSITION_COLUMNS[k]}' is {values[i, k]:g} mm, beyond "
+                     f"+-{MAX_ABS_MM:g} mm (coordinates beyond +-{MAX_ABS_MM:g} mm are not a robot "
+                     "cell); check the unit (mm) and the column order", index=i)
+
+    rotations = (_rotations_from_values(layout, values[:, 3:], where) if len(values)
+                 else np.zeros((0, 3, 3)))
+    positions = values[:, :3]
 
     n = len(positions)
     what = f" for {purpose}" if purpose else ""
@@ -309,8 +381,8 @@ def read_poses_csv(path: str | Path, *, min_rows: int = 1, max_rows: int | None 
         raise _error(f"{path}: too many rows: {n} data rows, {need} expected{what}")
 
     return FlangePoses(
-        rotations=np.array(rotations, dtype=float).reshape(n, 3, 3),
-        positions_mm=np.array(positions, dtype=float).reshape(n, 3),
+        rotations=np.ascontiguousarray(rotations, dtype=float).reshape(n, 3, 3),
+        positions_mm=np.ascontiguousarray(positions, dtype=float).reshape(n, 3),
         layout=layout,
         line_numbers=tuple(line_numbers),
         path=path,
