@@ -28,8 +28,10 @@ rotation conversion goes through ``scipy.spatial.transform.Rotation``):
     gravity ``[0, 0, 0.001]`` (the load of ABB's ``tool0``); import maps exactly that load back
     to ``mass_kg=None``. The centre of gravity of a known mass is written as ``[0, 0, 0.001]``
     too: identify the real load data on the controller before moving fast. The identifier is the
-    tool name with every character that is not a letter, digit or ``_`` replaced by ``_`` (and a
-    leading ``t`` if it does not start with a letter). Import accepts ``PERS``/``CONST``/``VAR``/
+    tool name with every character that is not an ASCII letter, digit or ``_`` replaced by ``_``
+    (and a leading ``t`` if it does not start with a letter or is a RAPID reserved word such as
+    ``IF`` or ``TRUE``): a tcpcal name (at most 24 characters) always gives a valid identifier of
+    at most 25 of RAPID's 32. Import accepts ``PERS``/``CONST``/``VAR``/
     ``TASK PERS`` declarations or the bare aggregate ``[TRUE,[[...],[...]],[...]]``; it rejects
     ``robhold`` FALSE (a stationary tool has its frame in WORLD, not FLANGE).
 ``fanuc``
@@ -47,7 +49,9 @@ rotation conversion goes through ``scipy.spatial.transform.Rotation``):
     ``R = Rz(R) Ry(P) Rx(W)`` (fixed axes) = ``from_euler("xyz", [W, P, R])``. Import finds
     ``X``, ``Y``, ``Z``, ``W``, ``P``, ``R`` each once, with ``:``, ``=`` or a space, one per
     line or all on one line (e.g. a ``$MNUTOOL`` dump ``X: 12.5 Y: 0.0 ...``); the name comes
-    from a ``Comment:`` line if present. (FANUC frame comments hold 16 characters on the pendant.)
+    from a ``Comment:`` line if present. FANUC frame comments hold 16 characters on the
+    pendant: export writes the first :data:`FANUC_COMMENT_LENGTH` (16) characters of the name
+    (trailing spaces dropped).
 ``ur``
     Universal Robots URScript::
 
@@ -85,10 +89,11 @@ from tcpcal.errors import InvalidInputError, TcpcalError
 from tcpcal.tool import Tool, abc_deg_from_rotation
 from tcpcal.validation import as_rotation
 
-__all__ = ["ABB_DEFAULT_MASS_KG", "FORMATS", "export_tool", "import_tool"]
+__all__ = ["ABB_DEFAULT_MASS_KG", "FANUC_COMMENT_LENGTH", "FORMATS", "export_tool", "import_tool"]
 
 FORMATS = ("kuka", "abb", "fanuc", "ur", "matrix")
 ABB_DEFAULT_MASS_KG = 0.001
+FANUC_COMMENT_LENGTH = 16
 _ABB_DEFAULT_COG = (0.0, 0.0, 0.001)
 _KUKA_SLOTS = 16
 _FANUC_SLOTS = 10
@@ -216,9 +221,20 @@ _ABB_DECL = re.compile(r"tooldata\s+([A-Za-z]\w*)\s*:=", re.IGNORECASE)
 _ABB_TOKEN = re.compile(rf"\s*(\[|\]|,|TRUE|FALSE|{_NUM})", re.IGNORECASE)
 
 
+# RAPID's reserved words (RAPID reference manual, "Reserved words"); identifiers ignore case.
+_RAPID_RESERVED = frozenset("""
+    ALIAS AND BACKWARD CASE CONNECT CONST DEFAULT DIV DO ELSE ELSEIF ENDFOR ENDFUNC ENDIF
+    ENDMODULE ENDPROC ENDRECORD ENDTEST ENDTRAP ENDWHILE ERROR EXIT FALSE FOR FROM FUNC GOTO IF
+    INOUT LOCAL MOD MODULE NOSTEPIN NOT NOVIEW OR PERS PROC RAISE READONLY RECORD RETRY RETURN
+    STEP SYSMODULE TEST THEN TO TRAP TRUE TRYNEXT UNDO VAR VIEWONLY WHILE WITH XOR
+""".split())
+
+
 def _abb_identifier(name: str) -> str:
+    """A RAPID identifier for ``name`` (module docstring, ``abb``): at most 32 ASCII letters,
+    digits and ``_``, a letter first, not a reserved word."""
     ident = re.sub(r"\W", "_", name, flags=re.ASCII)
-    if not re.match(r"[A-Za-z]", ident):
+    if not re.match(r"[A-Za-z]", ident) or ident.upper() in _RAPID_RESERVED:
         ident = "t" + ident
     return ident[:32]
 
@@ -358,7 +374,8 @@ def _export_fanuc(tool: Tool, slot: int) -> str:
     # (W, P, R) is (C, B, A) of KUKA; abc_deg_from_rotation stays exact near P = +-90.
     wpr = abc_deg_from_rotation(tool.rotation)[::-1]
     values = (*tool.tcp_mm, *wpr)
-    lines = [f"UTOOL[{n}] Direct Entry", f"Comment: {tool.name}"]
+    comment = tool.name[:FANUC_COMMENT_LENGTH].rstrip()  # the pendant's frame comment field
+    lines = [f"UTOOL[{n}] Direct Entry", f"Comment: {comment}"]
     lines += [f"{k}: {_fmt(v)}" for k, v in zip("XYZWPR", values)]
     return "\n".join(lines) + "\n"
 
