@@ -300,10 +300,22 @@ class PendantApp:
             if stamp == last:
                 continue
             last = stamp
-            self.library_changed()
+            self._hand_to_loop(self.library_changed)
+
+    def _hand_to_loop(self, fn: Any) -> None:
+        """Run ``fn()`` on viser's event loop, where every GUI callback runs (from the library
+        watcher: its reload pushes messages, which only the loop's thread may do)."""
+        server = self.server
+        if server is None:
+            return
+        try:
+            server.get_event_loop().call_soon_threadsafe(fn)
+        except RuntimeError:                     # the loop is closed: the server is stopping
+            log.debug("library reload dropped: server stopped")
 
     def library_changed(self) -> None:
-        """Reload the library list in every session."""
+        """Reload the library list in every session (on viser's event loop: the watcher hands
+        it over)."""
         for s in self.all_sessions():
             view = s.views.get("tools")
             if view is not None:

@@ -6,10 +6,15 @@ disconnect; in ``--shared`` mode there is one session whose GUI and scene are th
 *renderers* (push the controller state to the scene and the readouts) and the wizard views
 register *motion listeners* (called after every move).
 
-Threading: viser runs plain callbacks in a thread pool, so every state change goes through
-``with session.lock:`` (a re-entrant lock). :meth:`Session.guard` wraps a GUI callback: it takes
-the lock, ignores events after the session closed, and turns any exception into a
-notification instead of a crash (a browser can send anything).
+Threading: every GUI callback is registered through :meth:`Session.on_loop`, an ``async``
+callback, so viser runs it on its event loop, one at a time and in the order the browser's
+messages arrived, and the messages it queues are pushed from the loop's own thread (viser's
+message buffer is not safe to push to from other threads). :meth:`Session.guard` is the
+synchronous part: it takes ``session.lock`` (a re-entrant lock, still taken because a few
+things run elsewhere: the session is built in viser's thread pool, tests drive sessions from
+their own thread), ignores events after the session closed, and turns any exception into a
+notification instead of a crash (a browser can send anything). Work from another thread is
+handed to the loop (the server's library watcher: ``loop.call_soon_threadsafe``).
 """
 
 from __future__ import annotations
@@ -17,7 +22,7 @@ from __future__ import annotations
 import functools
 import logging
 import threading
-from collections.abc import Callable
+from collections.abc import Callable, Coroutine
 from dataclasses import dataclass, field
 from typing import Any, Protocol, TypeVar
 
@@ -240,6 +245,31 @@ class Session:
             return None
 
         return wrapper  # type: ignore[return-value]
+
+    def on_loop(self, fn: Callable[..., Any]) -> Callable[..., Coroutine[Any, Any, None]]:
+        """``fn`` as a GUI callback that viser runs on its event loop, under :meth:`guard`.
+
+        viser awaits an ``async`` callback on its event loop (a plain one goes to its thread
+        pool), so callbacks wrapped here run one at a time, in the order the browser sent its
+        messages: a callback reads ``event.target.value`` after the previous message was
+        handled, and every message it queues is pushed from the loop's thread. It must be
+        short (a jog step or an IK solve takes milliseconds); it never awaits. Our own
+        assignments to a handle's value fire it too, later on the loop, with
+        ``event.client is None``.
+
+        Args:
+            fn: the callback, given viser's event (it may also be called with no argument).
+
+        Returns:
+            An ``async`` function to register with ``on_click`` / ``on_update`` / ``on_hold``.
+        """
+        guarded = self.guard(fn)
+
+        @functools.wraps(fn)
+        async def callback(*args: Any, **kwargs: Any) -> None:
+            guarded(*args, **kwargs)
+
+        return callback
 
     def close(self) -> None:
         """Drop the session: no more callbacks act on it; listeners are released."""

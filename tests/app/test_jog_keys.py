@@ -99,7 +99,7 @@ def test_joint_mode_syncs_only_the_slider_that_moved(app_factory) -> None:
     try:
         p = s.views["pendant"]
         p.mode.value = "Joint"
-        assert p.joint_folder.visible
+        wait_until(lambda: p.joint_folder.visible, what="joint mode (on viser's loop)")
         updates: list[int] = []
         for i, slider in enumerate(p.joint_sliders):
             slider.on_update(lambda _e, i=i: updates.append(i))

@@ -99,7 +99,7 @@ def test_slider_sync_does_not_feed_back(app_factory) -> None:
     try:
         (s,) = app.sessions.values()
         s.views["pendant"].mode.value = "Joint"          # sliders are synced while shown
-        assert s.views["pendant"].joint_folder.visible
+        wait_until(lambda: s.views["pendant"].joint_folder.visible, what="joint mode (on viser's loop)")
         q = s.controller.q_rad
         q[1] += 0.123456789e-3
         with s.lock:

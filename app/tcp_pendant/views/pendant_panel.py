@@ -6,9 +6,14 @@ line (why a jog stopped), the jog selectors (mode, frame, increment, override), 
 Home, the camera buttons, and the touches ("Record point" and the list, deletable one by one).
 
 Widgets only call :class:`tcp_pendant.pendant.Jogger` and the session; all text comes from
-``tcp_pendant.pendant.formatting``. Feedback loops: setting a slider's value from Python fires
-its ``on_update`` synchronously with ``event.client is None``; those events are ignored, and
-``_syncing`` covers the same window for any other path.
+``tcp_pendant.pendant.formatting``. Every callback runs on viser's event loop
+(:meth:`Session.on_loop`), in the order the browser's messages arrived.
+
+Joint sliders: setting a slider's value from Python fires its ``on_update`` (later, on the
+loop) with ``event.client is None``; those events are ignored. A slider the browser is
+dragging is not echoed back: while the joint is where the browser's last value of that slider
+put it, :meth:`PendantPanel.render` leaves the slider alone (the browser shows its own,
+newer-or-equal value; writing the rounded angle back would pull its slider to an older one).
 """
 
 from __future__ import annotations
@@ -77,7 +82,7 @@ class PendantPanel:
         gui = session.target.gui
         c = session.controller
         k = c.kinematics
-        self._syncing = False
+        self._from_client: dict[int, float] = {}   # slider -> angle (deg, 0.01) its browser value set
         self._last_text: dict[str, str] = {}
         self._last_stop = ""
 
@@ -131,7 +136,7 @@ class PendantPanel:
             self.closeup = gui.add_button("Close-up on reference tip")
             self.overview_btn = gui.add_button("Overview")
 
-        g = session.guard
+        g = session.on_loop
         self.mode.on_click(g(self._setting("mode", JogMode)))
         self.frame.on_update(g(self._setting("frame", str)))
         self.increment.on_click(g(self._setting("increment", str)))
@@ -147,29 +152,14 @@ class PendantPanel:
 
     # ------------------------------------------------------------ wiring
     def _wire_key(self, button: Any, axis: str | int, sign: int) -> None:
-        """Click and hold of a jog key. The callbacks are ``async``: viser runs them on its
-        event loop instead of handing every jog tick to its thread pool (a thread wake-up and
-        GIL hand-over per tick: 10-30 % of a jog step's server CPU here, bench_server.py C vs
-        B), and the step's messages are then queued from the loop's own thread. The step itself
-        is synchronous, under the session lock, and never waits on the event loop."""
-        s = self.session
-
-        @s.guard
-        def click(_event: Any) -> None:
-            self._jog(axis, sign, hold_tick=False)
-
-        @s.guard
-        def hold(_event: Any) -> None:
-            self._jog(axis, sign, hold_tick=True)
-
-        async def click_on_loop(event: Any) -> None:
-            click(event)
-
-        async def hold_on_loop(event: Any) -> None:
-            hold(event)
-
-        button.on_click(click_on_loop)
-        button.on_hold(hold_on_loop, callback_hz=HOLD_HZ)
+        """Click and hold of a jog key, on viser's event loop like every callback
+        (:meth:`Session.on_loop`): besides thread safety, that spares every jog tick a hand-over
+        to viser's thread pool (a thread wake-up and GIL hand-over per tick: 10-30 % of a jog
+        step's server CPU, measured by bench_server.py). The step is synchronous, under the
+        session lock, and never waits on the event loop."""
+        on_loop = self.session.on_loop
+        button.on_click(on_loop(lambda _event: self._jog(axis, sign, hold_tick=False)))
+        button.on_hold(on_loop(lambda _event: self._jog(axis, sign, hold_tick=True)), callback_hz=HOLD_HZ)
 
     def _jog(self, axis: str | int, sign: int, *, hold_tick: bool) -> None:
         res = self.session.jogger.key(axis, sign, hold_tick=hold_tick)
@@ -181,11 +171,13 @@ class PendantPanel:
         self.session.moved()
 
     def _slider_cb(self, index: int) -> Any:
+        """The callback of joint slider ``index`` (0-based): set the joint to the browser's
+        value (deg, clipped to the limits) and remember it, so that :meth:`render` does not
+        echo it back."""
         s = self.session
 
-        @s.guard
         def cb(event: Any) -> None:
-            if self._syncing or event.client is None:
+            if event.client is None:
                 return                                # our own update of the slider: no loop
             q = s.controller.q_rad
             k = s.controller.kinematics
@@ -194,10 +186,15 @@ class PendantPanel:
                 return
             q[index] = float(np.clip(math.radians(value), k.lower_rad[index], k.upper_rad[index]))
             s.controller.set_q(q)
+            applied = round(math.degrees(s.controller.q_rad[index]), 2)
+            if abs(applied - value) <= 0.005:         # the browser shows the angle: no echo
+                self._from_client[index] = applied
+            else:                                     # clipped: render sends the limit
+                self._from_client.pop(index, None)
             self.show_jog_result(JogResult(True, 1.0, None, ""))
             s.moved()
 
-        return cb
+        return s.on_loop(cb)
 
     def _setting(self, name: str, kind: Any) -> Any:
         """Callback of one selector: only the selector that fired changes its setting (a button
@@ -263,7 +260,9 @@ class PendantPanel:
 
     def render(self) -> None:
         """Readouts, touch indicator and joint sliders from the session's pose state (no
-        feedback); only texts and slider values that changed are sent."""
+        feedback); only texts and slider values that changed are sent, and a slider whose
+        joint is still where the browser's own value of it put it is not written (module
+        docstring)."""
         s = self.session
         state = s.pose_state()
         frame = "BASE" if self.readout_frame.value == "BASE" else "WORLD"
@@ -275,11 +274,12 @@ class PendantPanel:
         self._set_md(self.joints_md, "joints", joint_readout_markdown(angles))
         if not self.joint_folder.visible:
             return                      # hidden sliders are synced when joint mode is shown
-        self._syncing = True
-        try:
-            for slider, v in zip(self.joint_sliders, angles.values()):
-                value = round(float(v), 2)
-                if slider.value != value:           # a joint jog moves one slider: one update
-                    slider.value = value
-        finally:
-            self._syncing = False
+        for i, (slider, v) in enumerate(zip(self.joint_sliders, angles.values())):
+            value = round(float(v), 2)
+            mine = self._from_client.get(i)
+            if mine is not None:
+                if mine == value:
+                    continue                        # the browser's own value: no echo
+                del self._from_client[i]            # moved since by a jog, Home, the gizmo ...
+            if slider.value != value:               # a joint jog moves one slider: one update
+                slider.value = value

@@ -14,7 +14,8 @@ Scene tree (names are per browser; ``--shared`` uses the server's scene):
   active TOOL triad at ``T_flange_tool``, which ride on the flange without updates;
 * ``/reference_tip``: the stand posed so that its spike is at the reference tip;
 * ``/tcp_gizmo``: transform controls on the active TCP; dragging it moves the TCP by
-  ``VirtualController.move_tcp_to`` (straight line, same safety rules as jogging).
+  ``VirtualController.move_tcp_to`` (straight line, same safety rules as jogging), on viser's
+  event loop (``Session.on_loop``), a backlog of drag messages coalesced into one move.
 
 Axis colours are viser's: X red, Y green, Z blue. Quaternions (w, x, y, z) come from
 ``tcp_pendant.pendant.rotations.quaternions_wxyz`` (pinocchio; checked against scipy).
@@ -22,7 +23,7 @@ Axis colours are viser's: X red, Y green, Z blue. Quaternions (w, x, y, z) come 
 
 from __future__ import annotations
 
-import threading
+import asyncio
 from typing import Any
 
 import numpy as np
@@ -208,8 +209,9 @@ class SceneView:
         k = c.kinematics
         self.flange_link = k.flange_link
         self._dragging = False
-        self._drag_seq = 0
-        self._drag_lock = threading.Lock()
+        self._gizmo_pending: tuple[np.ndarray, np.ndarray] | None = None  # (wxyz, xyz) not yet applied
+        self._gizmo_scheduled = False
+        self._apply_scheduled_gizmo = session.guard(self._apply_scheduled)
 
         scene.set_up_direction("+z")
         scene.add_grid("/floor", width=3.0, height=3.0, cell_size=0.1, section_size=0.5,
@@ -257,7 +259,7 @@ class SceneView:
                                                   position=xyz, depth_test=False, opacity=0.85)
         self._gizmo_row = len(self._moving)
         self._poses = PoseSender([self.link_frames[n] for n in self._moving] + [self.gizmo], T_local)
-        self.gizmo.on_update(self._on_gizmo)
+        self.gizmo.on_update(session.on_loop(self._on_gizmo))
         session.add_renderer(self.render)
 
     # ------------------------------------------------------------ updates
@@ -332,36 +334,53 @@ class SceneView:
 
     # ------------------------------------------------------------ gizmo
     def _on_gizmo(self, event: Any) -> None:
+        """A drag of the gizmo (on viser's event loop, under the session guard).
+
+        Drag updates are coalesced: the first one queues a move with ``call_soon``, which runs
+        after the messages viser has already received; the later ones only replace the pose
+        that move will use, so a backlog of drag messages costs one IK solve, towards the
+        newest pose. The end of a drag applies its pose at once and snaps the gizmo back onto
+        the TCP (where the robot could follow)."""
         phase = getattr(event, "phase", "update")
-        with self._drag_lock:
-            self._drag_seq += 1
-            seq = self._drag_seq
         if phase == "start":
             self._dragging = True
             return
         handle = event.target
-        wxyz = np.asarray(handle.wxyz, dtype=float)
-        xyz = np.asarray(handle.position, dtype=float)
+        self._gizmo_pending = (np.asarray(handle.wxyz, dtype=float), np.asarray(handle.position, dtype=float))
+        if phase == "end":
+            self._dragging = False
+            self._apply_gizmo()
+            self._snap_gizmo()
+            return
+        if self._gizmo_scheduled:
+            return
+        try:
+            loop = asyncio.get_running_loop()
+        except RuntimeError:                     # called off the loop (a test): move now
+            self._apply_gizmo()
+            return
+        self._gizmo_scheduled = True
+        loop.call_soon(self._apply_scheduled_gizmo)
+
+    def _apply_scheduled(self) -> None:
+        self._gizmo_scheduled = False
+        self._apply_gizmo()
+
+    def _apply_gizmo(self) -> None:
+        """Move the TCP to the newest dragged pose (WORLD, m), if one is pending."""
+        pending, self._gizmo_pending = self._gizmo_pending, None
+        if pending is None:
+            return
+        wxyz, xyz = pending
+        if not (np.all(np.isfinite(wxyz)) and np.all(np.isfinite(xyz))) or np.linalg.norm(wxyz) < 1e-9:
+            self._snap_gizmo()
+            return
         s = self.session
-
-        @s.guard
-        def move() -> None:
-            if phase != "end" and seq != self._drag_seq:
-                return                           # a newer drag event is queued: skip this one
-            if phase == "end":
-                self._dragging = False
-            if not (np.all(np.isfinite(wxyz)) and np.all(np.isfinite(xyz))) or np.linalg.norm(wxyz) < 1e-9:
-                self._snap_gizmo()
-                return
-            T = np.eye(4)
-            T[:3, :3] = Rotation.from_quat(np.roll(wxyz, -1)).as_matrix()
-            T[:3, 3] = xyz
-            res = s.controller.move_tcp_to(T)
-            pendant = s.views.get("pendant")
-            if pendant is not None:
-                pendant.show_jog_result(res)
-            s.moved()
-            if phase == "end":
-                self._snap_gizmo()
-
-        move()
+        T = np.eye(4)
+        T[:3, :3] = Rotation.from_quat(np.roll(wxyz, -1)).as_matrix()
+        T[:3, 3] = xyz
+        res = s.controller.move_tcp_to(T)
+        pendant = s.views.get("pendant")
+        if pendant is not None:
+            pendant.show_jog_result(res)
+        s.moved()

@@ -71,7 +71,7 @@ class ToolPanel:
             self.entry_save = gui.add_button("Save to library", color="green")
             self.entry_md = gui.add_markdown("")
 
-        g = session.guard
+        g = session.on_loop                       # every callback on viser's event loop
         self.mounted.on_update(g(self._on_mount))
         self.slots.on_update(g(lambda _e: self._show_slot()))
         self.activate.on_click(g(self._on_activate))
@@ -194,7 +194,10 @@ class ToolPanel:
         if not name:
             raise ValueError("Type the new name in 'New name' first.")
         self.session.library.rename(slot, name)
-        self.new_name.value = ""
+        if self.session.client is not None:
+            # a courtesy, per browser only: in --shared mode the box is every browser's, and
+            # another trainee may be typing in it
+            self.new_name.value = ""
         if self.session.active_slot == slot:
             renamed = self.session.library.get(slot)
             self.session.controller.set_active_tool(renamed)

@@ -21,7 +21,7 @@ class TouchListView:
         with self.folder:
             self.empty_md = gui.add_markdown("*No touch recorded.*")
         self._rows: list[Any] = []
-        self.record.on_click(session.guard(self._on_record))
+        self.record.on_click(session.on_loop(self._on_record))
         session.add_touch_listener(self.rebuild)
 
     def _on_record(self, _event: Any) -> None:
@@ -34,7 +34,7 @@ class TouchListView:
             labels = [t.label for t in self.session.touches]
             if label in labels:
                 self.session.delete_touch(labels.index(label))
-        return self.session.guard(cb)
+        return self.session.on_loop(cb)
 
     def rebuild(self) -> None:
         """Redraw the rows: one markdown line and one "Delete Pn" button per touch."""

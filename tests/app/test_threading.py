@@ -1,0 +1,319 @@
+"""Issue 15: every GUI callback runs on viser's event loop, in the order the browser's messages
+arrived, and no render writes a widget value older than the newest one the browser sent.
+
+Real viser server in-process, headless websocket clients (tests/app/wsclient.py) that send what
+a browser sends (GUI updates, clicks, gizmo drags) and record every GUI update they receive.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import math
+import sys
+import threading
+import time
+from pathlib import Path
+from typing import Any
+
+import msgspec.msgpack
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+from viser import _messages
+from viser.infra._async_message_buffer import AsyncMessageBuffer
+
+from tcpcal.library import ToolLibrary
+from tcpcal.tool import Tool
+from tcp_pendant.pendant import joint_readout_markdown
+
+sys.path.insert(0, str(Path(__file__).parent))
+from conftest import wait_until  # noqa: E402
+from wsclient import DrainingClient, decode_window  # noqa: E402
+
+
+class Browser(DrainingClient):
+    """A headless browser: sends GUI updates, clicks and gizmo drags the way viser's client
+    does, and records every ``GuiUpdateMessage`` the server sends it, in order."""
+
+    def __init__(self, port: int) -> None:
+        self.received: list[tuple[str, dict[str, Any]]] = []
+        self._send_lock = threading.Lock()
+        super().__init__(port)
+
+    def _drain(self) -> None:
+        try:
+            for msg in self.ws:
+                self.n_messages += 1
+                if isinstance(msg, bytes):
+                    for m in decode_window(msg):
+                        if m.get("type") == "GuiUpdateMessage":
+                            self.received.append((m["uuid"], dict(m["updates"])))
+        except Exception:
+            pass
+
+    def values_of(self, handle: Any) -> list[Any]:
+        """Every value the server sent this browser for ``handle``, in order."""
+        uuid = handle._impl.uuid
+        return [u["value"] for i, u in list(self.received) if i == uuid and "value" in u]
+
+    def send(self, message: Any) -> None:
+        with self._send_lock:
+            self.ws.send(msgspec.msgpack.encode(message.as_serializable_dict()))
+
+    def set(self, handle: Any, value: Any) -> None:
+        """The user sets a slider, text box, dropdown or button group to ``value``."""
+        self.send(_messages.GuiUpdateMessage(handle._impl.uuid, {"value": value}))
+
+    def click(self, button: Any) -> None:
+        self.send(_messages.GuiUpdateMessage(button._impl.uuid, {"value": True}))
+
+    def drag_gizmo(self, owner: str, positions: list[np.ndarray], wxyz: np.ndarray) -> None:
+        """A drag of the TCP gizmo through ``positions`` (WORLD, m), start to end."""
+        self.send(_messages.TransformControlsDragStartMessage(name="/tcp_gizmo", owner=owner))
+        for p in positions:
+            self.send(_messages.TransformControlsUpdateMessage(name="/tcp_gizmo", wxyz=tuple(map(float, wxyz)),
+                                                               position=tuple(map(float, p)), owner=owner))
+            time.sleep(0.01)
+        self.send(_messages.TransformControlsDragEndMessage(name="/tcp_gizmo", owner=owner))
+
+
+def _browser_session(app: Any, n_before: int = 0) -> tuple[Browser, Any]:
+    b = Browser(app.port)
+    wait_until(lambda: len(app.sessions) > n_before, what="session built")
+    session = next(s for s in app.sessions.values() if s.client is not None
+                   and s.client.client_id == max(app.sessions))
+    return b, session
+
+
+def _joint_mode(b: Browser, s: Any) -> None:
+    p = s.views["pendant"]
+    b.set(p.mode, "Joint")
+    wait_until(lambda: p.joint_folder.visible, what="joint mode")
+
+
+def _slow_first_call(obj: Any, name: str, seconds: float) -> list[Any]:
+    """Make ``obj.name`` sleep ``seconds`` on its first call; returns the list of call args."""
+    real = getattr(obj, name)
+    calls: list[Any] = []
+
+    def slow(*args: Any, **kwargs: Any) -> Any:
+        calls.append(args)
+        if len(calls) == 1:
+            time.sleep(seconds)
+        return real(*args, **kwargs)
+
+    setattr(obj, name, slow)
+    return calls
+
+
+def test_newest_slider_value_wins_when_the_first_apply_is_slow(app_factory) -> None:
+    """The issue's forced reproduction: A1 = 10.0 then 20.0 50 ms later while applying the
+    first takes 200 ms. Robot, readout and slider end at 20.0 and the server never sends the
+    browser the older 10.0 (before: both callbacks applied 10.0 and the slider jumped back)."""
+    app = app_factory()
+    b, s = _browser_session(app)
+    try:
+        _joint_mode(b, s)
+        p = s.views["pendant"]
+        a1 = p.joint_sliders[0]
+        calls = _slow_first_call(s.controller, "set_q", 0.2)
+        b.set(a1, 10.0)
+        time.sleep(0.05)
+        b.set(a1, 20.0)
+        wait_until(lambda: len(calls) >= 2, what="both slider values applied")
+        wait_until(lambda: "20.00" in p.joints_md.content, what="readout")
+        time.sleep(0.2)                                  # let the loop send what it queued
+        assert math.degrees(s.controller.q_rad[0]) == pytest.approx(20.0, abs=1e-9)
+        assert p.joints_md.content == joint_readout_markdown(s.controller.joint_angles_deg())
+        assert a1.value == pytest.approx(20.0)
+        assert 10.0 not in b.values_of(a1), b.values_of(a1)   # no stale write-back
+        assert len(calls) == 2
+    finally:
+        b.close()
+
+
+def test_a_dragged_slider_is_not_echoed_but_a_jog_is_sent(app_factory) -> None:
+    """A value between the 0.01 deg steps (what a browser may send) moves the robot exactly and
+    is not written back rounded (that pulls a dragged slider to an older value); once a jog
+    key moves the joint, the slider gets the new angle."""
+    app = app_factory()
+    b, s = _browser_session(app)
+    try:
+        _joint_mode(b, s)
+        p = s.views["pendant"]
+        a1 = p.joint_sliders[0]
+        b.set(a1, 10.004)
+        wait_until(lambda: abs(math.degrees(s.controller.q_rad[0]) - 10.004) < 1e-9, what="A1 at 10.004")
+        b.click(p.increment)                              # settle: a message after the slider's
+        b.set(p.increment, "1")
+        wait_until(lambda: s.jogger.settings.increment == "1", what="increment 1")
+        time.sleep(0.2)
+        assert b.values_of(a1) == []                      # nothing echoed
+        b.click(p.joint_buttons[(0, 1)])                  # A1 +: a jog key moves the joint
+        wait_until(lambda: abs(math.degrees(s.controller.q_rad[0]) - 11.004) < 1e-9, what="A1 + 1 deg")
+        wait_until(lambda: b.values_of(a1) == [11.0], what="the jog's angle sent to the slider")
+        b.click(p.joint_buttons[(0, -1)])                 # and back: 10.004 shown as 10.0
+        wait_until(lambda: b.values_of(a1) == [11.0, 10.0], what="the jog back sent")
+    finally:
+        b.close()
+
+
+def test_no_message_is_pushed_off_the_event_loop_under_mixed_load(app_factory, tmp_path: Path) -> None:
+    """Three browsers drive joint sliders, jog keys, the gizmo, the tool panel (type, choose,
+    activate, rename, export, numeric entry) and Record point while another process saves a
+    tool to the library file: every message the server queues is pushed from viser's event
+    loop thread (before: the pool callbacks and the library watcher pushed from theirs)."""
+    app = app_factory()
+    library = ToolLibrary(tmp_path / "tools.json")
+    library.save(1, Tool(name="Pointer cal", tcp_mm=(0.0, 0.0, 150.0)))
+    browsers: list[tuple[Browser, Any]] = []
+    try:
+        for i in range(3):
+            browsers.append(_browser_session(app, i))
+        sessions = [s for _, s in browsers]
+        for b, s in browsers:
+            wait_until(lambda s=s: "1: Pointer cal" in s.views["tools"].slots.options, what="library listed")
+            _joint_mode(b, s)
+        loop = app.server.get_event_loop()
+        loop_thread: list[int] = []
+        loop.call_soon_threadsafe(lambda: loop_thread.append(threading.get_ident()))
+        wait_until(lambda: bool(loop_thread), what="loop thread")
+        time.sleep(0.3)                                   # connect-time work done
+
+        pushes: list[tuple[int, str]] = []
+        real_push = AsyncMessageBuffer.push
+
+        def recording_push(self: Any, message: Any) -> None:
+            pushes.append((threading.get_ident(), threading.current_thread().name))
+            real_push(self, message)
+
+        AsyncMessageBuffer.push = recording_push           # type: ignore[method-assign]
+        try:
+            q0 = [s.controller.q_rad for s in sessions]
+            tcp0 = [s.controller.T_world_tcp() for s in sessions]
+
+            def drive(k: int, b: Browser, s: Any) -> None:
+                p, tools = s.views["pendant"], s.views["tools"]
+                for j in range(20):
+                    b.set(p.joint_sliders[1], float(np.degrees(q0[k][1])) + 0.5 * (j + 1))
+                    time.sleep(0.005)
+                b.click(p.joint_buttons[(2, 1)])
+                b.set(p.mode, "Cartesian")
+                T = s.controller.T_world_tcp()
+                wxyz = np.roll(Rotation.from_matrix(T[:3, :3]).as_quat(), 1)
+                b.drag_gizmo(str(s.client.client_id), [T[:3, 3] + [0.0, 0.0, -0.002 * (j + 1)] for j in range(10)],
+                             wxyz)
+                b.set(tools.slots, "1: Pointer cal")
+                b.click(tools.activate)
+                b.set(tools.new_name, f"Pointer {k}")
+                b.click(tools.rename)
+                b.click(tools.export)
+                b.set(tools.entry_name, f"Gun {k}")
+                b.set(tools.entry_fields["Z"], "120")
+                b.click(tools.entry_save)
+                b.click(s.views["touches"].record)
+
+            threads = [threading.Thread(target=drive, args=(k, b, s)) for k, (b, s) in enumerate(browsers)]
+            for t in threads:
+                t.start()
+            ToolLibrary(tmp_path / "tools.json").save(9, Tool(name="Saved elsewhere", tcp_mm=(1.0, 2.0, 3.0)))
+            for t in threads:
+                t.join()
+            for _, s in browsers:                         # the watcher's reload reached every session
+                wait_until(lambda s=s: "9: Saved elsewhere" in s.views["tools"].slots.options, what="reload")
+            wait_until(lambda: sum(t.name.startswith("Gun ") for t in library.tools().values()) == 3,
+                       what="three numeric entries saved")
+            time.sleep(0.3)
+        finally:
+            AsyncMessageBuffer.push = real_push           # type: ignore[method-assign]
+        # the load did what it says
+        for k, s in enumerate(sessions):
+            assert s.controller.q_rad[1] != q0[k][1] and s.controller.q_rad[2] != q0[k][2]
+            assert s.controller.T_world_tcp()[2, 3] < tcp0[k][2, 3] - 0.005     # the gizmo drag moved it down
+        names = {t.name for t in library.tools().values()}
+        assert any(n.startswith("Pointer ") for n in names) and "Saved elsewhere" in names
+        off = [name for ident, name in pushes if ident != loop_thread[0]]
+        assert len(pushes) > 200
+        assert off == [], f"{len(off)} of {len(pushes)} pushes off the event loop, from {sorted(set(off))}"
+    finally:
+        for b, _ in browsers:
+            b.close()
+
+
+def test_shared_rename_keeps_the_name_another_browser_typed(app_factory, tmp_path: Path) -> None:
+    """--shared: browser A renames slot 1 (the library write is slow) while browser B fills the
+    New-name box for slot 2; B's Rename then uses B's name (before: A's Rename cleared the box
+    B had just filled, and B got "Not done: Type the new name in 'New name' first.")."""
+    library = ToolLibrary(tmp_path / "tools.json")
+    library.save(1, Tool(name="T1", tcp_mm=(0.0, 0.0, 100.0)))
+    library.save(2, Tool(name="T2", tcp_mm=(0.0, 0.0, 200.0)))
+    app = app_factory(shared=True)
+    a, b = Browser(app.port), Browser(app.port)
+    try:
+        wait_until(lambda: len(app.server.get_clients()) == 2, what="two browsers")
+        s = app.shared_session
+        tools = s.views["tools"]
+        wait_until(lambda: tools.slots.options == ("1: T1", "2: T2"), what="library listed")
+        notes: list[tuple[str, str]] = []
+        real_notify = s.notify
+        s.notify = lambda title, body, **kw: (notes.append((title, body)), real_notify(title, body, **kw))
+        calls = _slow_first_call(app.library, "rename", 0.3)
+        a.set(tools.slots, "1: T1")
+        a.set(tools.new_name, "Alpha")
+        a.click(tools.rename)
+        time.sleep(0.05)
+        b.set(tools.slots, "2: T2")
+        b.set(tools.new_name, "Beta")
+        wait_until(lambda: len(calls) == 1 and tools.new_name.value == "Beta", what="A renaming, B typed")
+        time.sleep(0.4)                                   # A's rename done meanwhile
+        assert tools.new_name.value == "Beta"
+        b.click(tools.rename)
+        wait_until(lambda: len(calls) == 2 or any(t == "Not done" for t, _ in notes), what="B's rename")
+        wait_until(lambda: {t.name for t in library.tools().values()} == {"Alpha", "Beta"}, timeout=5,
+                   what=f"both renamed (notifications: {notes})")
+        assert not [n for n in notes if n[0] == "Not done"]
+        assert "" not in b.values_of(tools.new_name)      # B's box was never cleared under B
+    finally:
+        a.close()
+        b.close()
+
+
+def test_per_browser_rename_clears_the_box_of_the_browser_that_clicked(app_factory, tmp_path: Path) -> None:
+    ToolLibrary(tmp_path / "tools.json").save(1, Tool(name="T1", tcp_mm=(0.0, 0.0, 100.0)))
+    app = app_factory()
+    b, s = _browser_session(app)
+    try:
+        tools = s.views["tools"]
+        wait_until(lambda: tools.slots.value == "1: T1", what="library listed")
+        b.set(tools.new_name, "Renamed")
+        b.click(tools.rename)
+        wait_until(lambda: s.library.get(1).name == "Renamed", what="renamed")
+        wait_until(lambda: b.values_of(tools.new_name) == [""], what="the box cleared")
+        assert tools.slots.value == "1: Renamed"
+    finally:
+        b.close()
+
+
+def test_on_loop_runs_callbacks_on_the_loop_under_the_guard(app_factory) -> None:
+    """``Session.on_loop``: an ``async`` callback (viser awaits it on its loop) that holds the
+    session lock, ignores a closed session and turns an error into a notification."""
+    app = app_factory()
+    b, s = _browser_session(app)
+    try:
+        seen: list[tuple[bool, bool]] = []
+
+        def fn(_event: Any) -> None:
+            seen.append((asyncio.get_running_loop() is app.server.get_event_loop(), s.lock._is_owned()))
+            raise ValueError("no such slot")
+
+        notes: list[tuple[str, str]] = []
+        s.notify = lambda title, body, **kw: notes.append((title, body))
+        cb = s.on_loop(fn)
+        assert asyncio.iscoroutinefunction(cb)
+        asyncio.run_coroutine_threadsafe(cb(None), app.server.get_event_loop()).result(10)
+        assert seen == [(True, True)] and notes == [("Not done", "no such slot")]
+        s.close()
+        asyncio.run_coroutine_threadsafe(cb(None), app.server.get_event_loop()).result(10)
+        assert len(seen) == 1                             # closed: ignored
+    finally:
+        b.close()
