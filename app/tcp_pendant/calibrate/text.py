@@ -132,17 +132,20 @@ def meter_level(gain: CandidateGain) -> tuple[float, str]:
     return value, "green"
 
 
-def meter_markdown(gain: CandidateGain, quality: PoseQuality | None, sigma_mm: float) -> str:
+def meter_markdown(gain: CandidateGain, quality: PoseQuality | None, sigma_mm: float,
+                   advice_before_determinable: str | None = None) -> str:
     """Live advice while jogging toward the next touch (all figures predicted by tcpcal from the
-    orientations alone, for an operator error of ``sigma_mm`` per axis). ``quality`` (tcpcal's
-    advice on the touches so far) is needed only while recording here would still not make
-    the TCP determinable (``gain.predicted_after`` infinite)."""
+    orientations alone, for an operator error of ``sigma_mm`` per axis). While recording here
+    would still not make the TCP determinable (``gain.predicted_after`` infinite) the advice is
+    ``advice_before_determinable`` (``tcp_pendant.calibrate.diversity``: the angle to the
+    nearest touch and the axis still missing, in words) or else ``quality.message`` (tcpcal's)."""
     head = f"**Pose diversity** (if you recorded here, operator error {fmt_num(sigma_mm, 1)} mm):"
     if gain.too_close:
         advice = (f"⚠ **Too close** to an earlier touch: {_deg(gain.angle_to_nearest_deg, 0)} apart. "
                   "Tilt the tool further, about another axis, before recording.")
     elif math.isinf(gain.predicted_after):
-        advice = "Not determinable yet." + ("" if quality is None else f" {quality.message}")
+        extra = advice_before_determinable or ("" if quality is None else quality.message)
+        advice = "Not determinable yet." + (f" {extra}" if extra else "")
     elif math.isinf(gain.predicted_before):
         advice = (f"✔ Recording here makes the TCP determinable: predicted RMS error "
                   f"**{_mm(gain.predicted_after)}**.")
@@ -150,7 +153,7 @@ def meter_markdown(gain: CandidateGain, quality: PoseQuality | None, sigma_mm: f
         word = "✔ Good pose" if gain.reduction >= 0.1 else "This pose adds little"
         advice = (f"{word}: predicted TCP RMS error {_mm(gain.predicted_before)} → "
                   f"**{_mm(gain.predicted_after)}** ({-100.0 * gain.reduction:+.0f} %).")
-    near = ("" if math.isinf(gain.angle_to_nearest_deg) else
+    near = ("" if math.isinf(gain.angle_to_nearest_deg) or advice_before_determinable else
             f"\n\nNearest recorded orientation: {_deg(gain.angle_to_nearest_deg, 0)} away.")
     return f"{head}\n\n{advice}{near}"
 

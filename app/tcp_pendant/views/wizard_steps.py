@@ -15,6 +15,7 @@ import math
 from typing import TYPE_CHECKING, Any
 
 from tcp_pendant.calibrate import AUTO_SIGMA_MAX_MM, AutoTouchRequest
+from tcp_pendant.calibrate.diversity import diversity_advice
 from tcp_pendant.calibrate.text import (
     meter_level,
     meter_markdown,
@@ -186,9 +187,11 @@ class WizardStepsView:
         if not show:
             return
         assert isinstance(wiz, Xyz4Wizard)
-        gain = wiz.preview(self.parent.session.controller.T_world_flange())
+        T_world_flange = self.parent.session.controller.T_world_flange()
+        gain = wiz.preview(T_world_flange)
         value, color = meter_level(gain)
         self.meter_bar.value = round(value, 1)
         self.meter_bar.color = color
-        quality = wiz.quality() if math.isinf(gain.predicted_after) else None   # only then shown
-        set_content(self.meter_md, meter_markdown(gain, quality, wiz.assumed_sigma_mm))
+        advice = (diversity_advice(wiz.other_rotations(), T_world_flange[:3, :3], gain.angle_to_nearest_deg)
+                  if math.isinf(gain.predicted_after) else None)               # only then shown
+        set_content(self.meter_md, meter_markdown(gain, None, wiz.assumed_sigma_mm, advice))

@@ -233,6 +233,11 @@ class Xyz4Wizard(Wizard):
                 if i != self._index or self.is_complete]
         return np.array(rots, dtype=float).reshape(-1, 3, 3)
 
+    def other_rotations(self) -> np.ndarray:
+        """(N, 3, 3) ``R_world_flange`` of the touches a recording now would keep (all but the
+        current step's own): what :meth:`preview` compares the candidate with."""
+        return self._other_rotations()
+
     def preview(self, T_world_flange_m: Any, *, min_angle_deg: float = 15.0) -> CandidateGain:
         """Predicted TCP uncertainty if the current pose were recorded (tcpcal.candidate_gain).
 

@@ -1,0 +1,131 @@
+"""What the pose-diversity meter says before the TCP is determinable (touches 1-3), without viser.
+
+tcpcal names the axis the touches so far cannot resolve as a vector in FLANGE coordinates
+("not about flange [0.00, 1.00, 0.00]"); a trainee needs it in words. This module says:
+
+* how far the current orientation is from the nearest recorded one (degrees);
+* after one touch: tilt at least ``MIN_TILT_DEG`` from it;
+* after two or more touches that all turn about one axis (tcpcal's ``unobservable_axis``):
+  that axis in words (the flange axis, i.e. turning the tool about its own length, or a
+  horizontal / vertical WORLD direction, seen with the flange's current orientation) and the
+  axis still missing, and whether the current orientation adds it.
+
+Angles in degrees; rotations are ``R_world_flange`` (3x3), as the wizard records them.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from tcpcal.pose_quality import assess_touches
+
+__all__ = ["MIN_TILT_DEG", "axis_in_words", "diversity_advice", "missing_axis_in_words"]
+
+MIN_TILT_DEG = 30.0
+"""The tilt asked for between touches (tcpcal's advice: 30-60 deg about two axes)."""
+_FLANGE_AXIS_COS = math.cos(math.radians(25.0))   # within 25 deg of flange Z: "the flange axis"
+_HORIZONTAL_SIN = math.sin(math.radians(30.0))    # within 30 deg of the floor: "horizontal"
+_VERTICAL_COS = math.cos(math.radians(30.0))
+
+
+def _world_direction(axis_world: np.ndarray) -> str:
+    """A horizontal direction in words: "WORLD X", "WORLD Y" or between them."""
+    x, y = abs(float(axis_world[0])), abs(float(axis_world[1]))
+    if x >= 2.0 * y:
+        return "WORLD X"
+    if y >= 2.0 * x:
+        return "WORLD Y"
+    return "the diagonal between WORLD X and Y"
+
+
+def _kind(axis_flange: Any, R_world_flange: Any) -> tuple[str, np.ndarray]:
+    a = np.asarray(axis_flange, dtype=float).reshape(3)
+    a = a / np.linalg.norm(a)
+    w = np.asarray(R_world_flange, dtype=float).reshape(3, 3) @ a
+    if abs(a[2]) >= _FLANGE_AXIS_COS:
+        return "flange", w
+    if abs(w[2]) <= _HORIZONTAL_SIN:
+        return "horizontal", w
+    if abs(w[2]) >= _VERTICAL_COS:
+        return "vertical", w
+    return "slanted", w
+
+
+def axis_in_words(axis_flange: Any, R_world_flange: Any) -> str:
+    """The turn the touches share, in words ("a turn about the flange axis (the tool turned
+    about its own length)", "a tilt about a horizontal axis along WORLD Y", ...).
+
+    Args:
+        axis_flange: the axis, FLANGE coordinates (tcpcal's ``unobservable_axis``).
+        R_world_flange: the flange's orientation now, to say where the axis points in WORLD.
+    """
+    kind, w = _kind(axis_flange, R_world_flange)
+    if kind == "flange":
+        return "a turn about the flange axis (the tool turned about its own length)"
+    if kind == "horizontal":
+        return f"a tilt about a horizontal axis along {_world_direction(w)}"
+    if kind == "vertical":
+        return "a turn about the vertical (WORLD Z)"
+    return "a tilt about one slanted axis"
+
+
+def missing_axis_in_words(axis_flange: Any, R_world_flange: Any) -> str:
+    """What the next touch must add: a tilt about an axis at right angles to the shared one."""
+    kind, w = _kind(axis_flange, R_world_flange)
+    if kind == "horizontal":
+        along = _world_direction(w)
+        other = {"WORLD X": "WORLD Y", "WORLD Y": "WORLD X"}.get(along, "the other diagonal")
+        lean = {"WORLD X": "toward +Y or -Y", "WORLD Y": "toward +X or -X"}.get(other, "the other way")
+        return (f"tilt the tool about a horizontal axis along {other} (lean it {lean}), "
+                "or turn it about its own length")
+    if kind == "flange":
+        return "tilt the tool sideways (about a horizontal axis), not only about its own length"
+    return "tilt the tool about a horizontal axis (lean it sideways)"
+
+
+def _max_angle_deg(rots: np.ndarray) -> float:
+    """Largest angle between two of the orientations (degrees)."""
+    r = Rotation.from_matrix(rots)
+    return max((float(np.degrees((r[i].inv() * r[j]).magnitude())) for i in range(len(r))
+                for j in range(i + 1, len(r))), default=0.0)
+
+
+def diversity_advice(recorded: Any, candidate: Any, angle_to_nearest_deg: float) -> str:
+    """The meter's words while the TCP is not determinable yet (markdown, no user text).
+
+    Args:
+        recorded: (N, 3, 3) ``R_world_flange`` of the touches recorded so far (N may be 0).
+        candidate: (3, 3) ``R_world_flange`` now.
+        angle_to_nearest_deg: angle from ``candidate`` to the nearest recorded orientation
+            (``CandidateGain.angle_to_nearest_deg``; inf when nothing is recorded).
+    """
+    rots = np.asarray(recorded, dtype=float).reshape(-1, 3, 3)
+    cand = np.asarray(candidate, dtype=float).reshape(3, 3)
+    n = rots.shape[0]
+    if n == 0:
+        return (f"Touch 1 can have any orientation; each next one must be tilted at least "
+                f"{MIN_TILT_DEG:.0f}° from the others, about two different axes.")
+    angle = float(angle_to_nearest_deg)
+    near = f"This orientation is **{angle:.0f}°** from " + ("touch 1" if n == 1 else "the nearest touch")
+    quality = assess_touches(rots)
+    if n == 1 or _max_angle_deg(rots) < 1.0:
+        # one orientation so far (one touch, or all recorded ones alike): only the tilt counts
+        if angle >= MIN_TILT_DEG:
+            return f"{near}: ✔ far enough. Tilt about another axis for the touch after."
+        return f"{near}: tilt at least {MIN_TILT_DEG:.0f}° from it before recording."
+    axis = quality.unobservable_axis
+    if axis is None:            # two axes already: only more touches are missing
+        more = max(4 - n, 1)
+        return (f"{near}. The touches so far are tilted about two different axes: record {more} "
+                f"more, each at least {MIN_TILT_DEG:.0f}° from the others.")
+    shared = axis_in_words(axis, cand)
+    with_candidate = assess_touches(np.concatenate([rots, cand[None]]))
+    if with_candidate.unobservable_axis is None and angle >= 1.0:
+        return (f"{near}. The {n} touches so far differ only by {shared}; ✔ this orientation adds "
+                "the axis still missing.")
+    return (f"{near}. The {n} touches so far differ only by {shared}. Still missing: "
+            f"{missing_axis_in_words(axis, cand)}.")
