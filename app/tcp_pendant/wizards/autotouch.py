@@ -13,8 +13,10 @@ step role          controller call
 ``plus_y``         ``auto_approach(tip_offset_tool_mm=(0, d, 0))``   (variant 1)
 ``plus_y_half``    ``auto_approach(tip_offset_tool_mm=(-20, d, 0))`` (variant 2)
 ``parallel``       ``move_true_tool_to`` the (PA-1) orientation, tip ``hover_mm`` above the
-                   reference tip, with an optional angular error (``angle_sigma_deg`` per axis,
-                   about the tool axes); for the 5D variant a random turn about tool X.
+                   reference tip, with an angular error (``angle_sigma_deg`` per axis, about
+                   the tool axes; by default the operator error ``sigma_mm`` seen over
+                   ``ANGLE_LEVER_MM``, see :func:`operator_angle_sigma_deg`); for the 5D
+                   variant a random turn about tool X.
 =================  ===========================================================================
 
 ``d`` is ``distance_mm`` (60 mm by default). Three-point steps 2 and 3 reuse the approach
@@ -37,6 +39,16 @@ from tcp_pendant.wizards.abc_world import R_WORLD_TOOL_TARGET, AbcWorldWizard
 from tcp_pendant.wizards.base import StepInfo, Wizard, WizardError, WizardStateError
 
 DEFAULT_DISTANCE_MM = 60.0
+ANGLE_LEVER_MM = 100.0
+"""Lever over which an operator judges "parallel" by eye: an operator error of ``sigma_mm``
+(position, per axis) is taken as an alignment error of ``atan(sigma_mm / ANGLE_LEVER_MM)``
+per tool axis (1 mm: 0.57 deg; 2 mm: 1.15 deg)."""
+
+
+def operator_angle_sigma_deg(sigma_mm: float) -> float:
+    """The simulated alignment error per tool axis (deg) matching an operator error of
+    ``sigma_mm`` (mm per axis): ``atan(sigma_mm / ANGLE_LEVER_MM)``."""
+    return float(np.degrees(np.arctan2(float(sigma_mm), ANGLE_LEVER_MM)))
 _last_direction: "weakref.WeakKeyDictionary[Wizard, tuple[float, float, float]]" = weakref.WeakKeyDictionary()
 
 
@@ -90,7 +102,7 @@ def _ensure_mounted(wizard: Wizard, controller: Any, step: StepInfo,
 
 def auto_touch(wizard: Wizard, controller: Any, *,
                direction_deg: tuple[float, float, float] | None = None,
-               sigma_mm: float = 0.0, angle_sigma_deg: float = 0.0,
+               sigma_mm: float = 0.0, angle_sigma_deg: float | None = None,
                distance_mm: float = DEFAULT_DISTANCE_MM, hover_mm: float = 30.0,
                rng: np.random.Generator | None = None, advance: bool = True,
                tools: Mapping[str, Any] | None = None, max_attempts: int = 12) -> AutoTouchOutcome:
@@ -103,7 +115,8 @@ def auto_touch(wizard: Wizard, controller: Any, *,
             None: random (tilt 20-50 deg for touches, 5-30 deg for three-point steps, azimuth
             0-360, spin -90..90), retried up to ``max_attempts`` times when unreachable.
         sigma_mm: simulated operator position error, per axis (0-2 mm in the pendant).
-        angle_sigma_deg: simulated angular error per tool axis for ``parallel`` steps.
+        angle_sigma_deg: simulated angular error per tool axis for ``parallel`` steps (deg);
+            None: :func:`operator_angle_sigma_deg` of ``sigma_mm`` (0 when ``sigma_mm`` is 0).
         distance_mm: displacement of the three-point steps 2 and 3.
         hover_mm: height of the tip above the reference tip for ``parallel`` steps.
         rng: random generator (seed it for reproducible demos and tests).
@@ -113,7 +126,9 @@ def auto_touch(wizard: Wizard, controller: Any, *,
     """
     if wizard.status != "in_progress":
         raise WizardStateError(f"Cannot auto-touch: {wizard.blocked_reason}")
-    if not 0.0 <= sigma_mm <= 10.0 or not 0.0 <= angle_sigma_deg <= 30.0:
+    if angle_sigma_deg is None and np.isfinite(sigma_mm):
+        angle_sigma_deg = operator_angle_sigma_deg(sigma_mm)
+    if not 0.0 <= sigma_mm <= 10.0 or angle_sigma_deg is None or not 0.0 <= angle_sigma_deg <= 30.0:
         raise WizardError(f"sigma_mm must be in 0..10 mm and angle_sigma_deg in 0..30 deg, "
                           f"got {sigma_mm} and {angle_sigma_deg}.")
     rng = np.random.default_rng() if rng is None else rng
@@ -126,8 +141,11 @@ def auto_touch(wizard: Wizard, controller: Any, *,
         R = R_WORLD_TOOL_TARGET.copy()
         if isinstance(wizard, AbcWorldWizard) and wizard.variant == "5d":
             R = R @ Rotation.from_euler("x", rng.uniform(-60.0, 60.0), degrees=True).as_matrix()
+        misalignment_deg = 0.0
         if angle_sigma_deg > 0.0:
-            R = R @ Rotation.from_rotvec(rng.normal(0.0, angle_sigma_deg, 3), degrees=True).as_matrix()
+            rotvec_deg = rng.normal(0.0, angle_sigma_deg, 3)
+            misalignment_deg = float(np.linalg.norm(rotvec_deg))
+            R = R @ Rotation.from_rotvec(rotvec_deg, degrees=True).as_matrix()
         T = np.eye(4)
         T[:3, :3] = R
         T[:3, 3] = np.asarray(controller.reference_tip_world_m, dtype=float) + [0.0, 0.0, hover_mm / 1000.0]
@@ -138,8 +156,11 @@ def auto_touch(wizard: Wizard, controller: Any, *,
         wizard.record(controller.T_world_flange())
         if advance and not wizard.on_last_step:
             wizard.next()
+        how = ("exactly" if angle_sigma_deg == 0.0 else
+               f"by eye, {misalignment_deg:.2f}° off (σ {angle_sigma_deg:.2f}° per axis = operator error "
+               f"{sigma_mm:g} mm over {ANGLE_LEVER_MM:.0f} mm)")
         return AutoTouchOutcome(True, step.index, step.role, None, None, None,
-                                "Tool aligned with WORLD and recorded.", 1)
+                                f"Tool aligned with WORLD {how} and recorded.", 1)
 
     offset = _tip_offset(step.role, distance_mm)
     three_point = step.role != "touch" or wizard.kind == "three-point"
