@@ -22,7 +22,7 @@ from typing import Any, NoReturn
 import numpy as np
 
 from tcpcal.errors import DegenerateTouchesError, TcpcalError
-from tcpcal.poses_csv import FlangePoses, accepted_layouts_text, read_poses_csv
+from tcpcal.poses_csv import MAX_ABS_MM, FlangePoses, accepted_layouts_text, read_poses_csv
 from tcpcal.report import (
     format_orientation_report,
     format_tcp_report,
@@ -98,13 +98,34 @@ def _positive_float(text: str) -> float:
     return v
 
 
+#: ``solve --sigma`` range, mm (docs/cli.md "Number ranges").
+SIGMA_RANGE_MM = (1e-9, 1e6)
+
+
+def _sigma_mm(text: str) -> float:
+    v = _positive_float(text)
+    lo, hi = SIGMA_RANGE_MM
+    if not lo <= v <= hi:
+        raise argparse.ArgumentTypeError(f"touch noise must be within {lo:g}..{hi:g} mm, got {text!r}")
+    return v
+
+
+def _xyz_mm(text: str) -> tuple[float, float, float]:
+    """X,Y,Z of a TCP for ``solve`` (mm), each within +-``MAX_ABS_MM`` like POSES.csv."""
+    vals = _xyz_arg(text)
+    if max(abs(v) for v in vals) > MAX_ABS_MM:
+        raise argparse.ArgumentTypeError(f"X,Y,Z must be within +-{MAX_ABS_MM:g} mm, got {text!r}")
+    return vals
+
+
 # ----------------------------------------------------------------------------------- parser
 def build_parser() -> argparse.ArgumentParser:
     """The argparse tree of ``tcpcal`` (see docs/cli.md)."""
     p = _Parser(prog="tcpcal", description="TCP and TOOL-frame calibration from recorded "
                 "flange poses; controller tool-data conversion; the tool library. "
                 "Lengths in mm, angles in deg. See docs/cli.md.")
-    sub = p.add_subparsers(dest="command", required=True, metavar="{solve,convert,tools}")
+    sub = p.add_subparsers(dest="command", required=True,
+                           metavar="{solve,convert,tools,poses}")
 
     # solve ---------------------------------------------------------------------------------
     solve = sub.add_parser("solve", help="calibrate from a CSV of flange poses",
@@ -115,7 +136,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     def add_common(sp: argparse.ArgumentParser) -> None:
         sp.add_argument("poses", metavar="POSES.csv", type=Path,
-                        help="flange poses, x,y,z in mm + one orientation layout")
+                        help="flange poses, x,y,z in mm + one orientation layout ('-': read "
+                        "the CSV from stdin)")
         sp.add_argument("--json", action="store_true", help="print one JSON object")
 
     xyz4 = ssub.add_parser("xyz4", help="TCP from N >= 4 touches of one reference point",
@@ -124,7 +146,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_common(xyz4)
     xyz4.add_argument("--method", choices=("lstsq", "sphere", "pairwise"), default="lstsq",
                       help="estimator (default lstsq: joint least squares, the best)")
-    xyz4.add_argument("--sigma", type=_positive_float, metavar="MM", default=None,
+    xyz4.add_argument("--sigma", type=_sigma_mm, metavar="MM", default=None,
                       help="assumed touch noise per axis in mm (default: estimated from the "
                       "residuals)")
     xyz4.add_argument("--no-outliers", dest="detect_outliers", action="store_false",
@@ -134,9 +156,9 @@ def build_parser() -> argparse.ArgumentParser:
                           description="XYZ reference: row 1 = the calibrated tool's touch, "
                           "row 2 = the new tool's touch of the same point.")
     add_common(ref)
-    ref.add_argument("--known-tcp", type=_xyz_arg, required=True, metavar="X,Y,Z",
+    ref.add_argument("--known-tcp", type=_xyz_mm, required=True, metavar="X,Y,Z",
                      help="TCP of the calibrated tool in FLANGE, mm")
-    ref.add_argument("--sigma", type=_positive_float, metavar="MM", default=None,
+    ref.add_argument("--sigma", type=_sigma_mm, metavar="MM", default=None,
                      help="assumed touch noise per axis in mm")
 
     tp = ssub.add_parser("three-point", help="TOOL orientation from three poses",
@@ -144,7 +166,7 @@ def build_parser() -> argparse.ArgumentParser:
                          "row 2 = reference tip on the tool's -X axis, row 3 = tip on the +Y "
                          "axis (variant 1) or in the +Y half of the XY plane (variant 2).")
     add_common(tp)
-    tp.add_argument("--tcp", type=_xyz_arg, required=True, metavar="X,Y,Z",
+    tp.add_argument("--tcp", type=_xyz_mm, required=True, metavar="X,Y,Z",
                     help="calibrated TCP in FLANGE, mm")
     tp.add_argument("--variant", type=int, choices=(1, 2), required=True)
 
@@ -165,7 +187,7 @@ def build_parser() -> argparse.ArgumentParser:
                          "(the reference on the tool's +X axis). Several z and x rows are "
                          "averaged; Z is kept, X orthogonalised against it.")
     add_common(zx)
-    zx.add_argument("--sigma", type=_positive_float, metavar="MM", default=None,
+    zx.add_argument("--sigma", type=_sigma_mm, metavar="MM", default=None,
                     help="assumed touch noise per axis in mm (default: estimated)")
     zx.add_argument("--no-outliers", dest="detect_outliers", action="store_false",
                     help="do not flag outlying touches")
@@ -216,7 +238,37 @@ def build_parser() -> argparse.ArgumentParser:
     tact.add_argument("slot", metavar="SLOT", help="slot number, tool name, or 'none'")
     te = tsub.add_parser("export", parents=[lib_parent], help="print a tool as controller text")
     te.add_argument("slot", metavar="SLOT", help="slot number or tool name")
-    te.add_argument("--format", dest="fmt", choices=FORMATS, required=True)
+    te.add_argument("--format", dest="fmt", choices=(*FORMATS, "yaskawa"), required=True,
+                    help="kuka|abb|fanuc|ur|matrix print the tool data text; with --file or "
+                    "--output, the whole file the controller loads (yaskawa: always the "
+                    "TOOL.CND entry). docs/formats.md")
+    te.add_argument("--file", dest="whole_file", action="store_true",
+                    help="print the whole controller file (KUKA $config.dat lines, ABB RAPID "
+                    "module, FANUC .LS program, UR script, Yaskawa TOOL.CND entry)")
+    te.add_argument("--output", type=Path, default=None, metavar="FILE",
+                    help="write the controller file to FILE (implies --file; an existing FILE "
+                    "is refused)")
+    te.add_argument("--name", dest="file_name", default=None, metavar="NAME",
+                    help="the tool's name in the file (default: its library name; ABB needs a "
+                    "RAPID identifier)")
+    te.add_argument("--register", type=int, default=None, metavar="M",
+                    help="fanuc file: the position register the program overwrites (default 100)")
+
+    # poses ---------------------------------------------------------------------------------
+    poses_p = sub.add_parser("poses", help="touch poses from controller program files")
+    psub = poses_p.add_subparsers(dest="poses_cmd", required=True, metavar="{import}")
+    pim = psub.add_parser("import", help="print POSES.csv from a controller program file",
+                          description="Read the recorded positions of a KUKA .dat (E6POS/POS), "
+                          "ABB .mod (robtarget), FANUC .LS (/POS) or UR script (p[...]) and "
+                          "print them as POSES.csv for 'tcpcal solve'. Record the touches with "
+                          "no tool and no base active (the flange in WORLD).")
+    pim.add_argument("file", metavar="FILE", type=Path)
+    pim.add_argument("--format", dest="fmt", default="auto",
+                     choices=("auto", "kuka", "abb", "fanuc", "ur"),
+                     help="the controller (default auto: from the extension, else the content)")
+    pim.add_argument("--output", type=Path, default=None, metavar="POSES.csv",
+                     help="write the CSV to this file instead of stdout (an existing file is "
+                     "refused)")
     return p
 
 
@@ -492,11 +544,70 @@ def _tools_command(lib: Any, args: argparse.Namespace) -> int:
         lib.activate(slot)
         _emit(f"Active tool: slot {slot} {tool.name!r}")
     elif cmd == "export":
+        _run_export(tool, slot, args)
+    else:  # pragma: no cover - argparse restricts the choices
+        raise AssertionError(cmd)
+    return 0
+
+
+def _write_new(path: Path, text: str) -> None:
+    """Write ``text`` to a new file ``path`` (an existing file is never overwritten)."""
+    try:
+        with open(path, "x", encoding="utf-8", newline="\n") as fh:
+            fh.write(text)
+    except FileExistsError:
+        raise CliInputError(f"{path}: the file exists; choose another name or remove it "
+                            f"first (tcpcal never overwrites a file)") from None
+
+
+def _run_export(tool: Any, slot: int, args: argparse.Namespace) -> None:
+    """``tools export``: the tool data text (unchanged contract) or a whole controller file."""
+    whole = args.whole_file or args.output is not None or args.fmt == "yaskawa"
+    if not whole:
+        if args.file_name is not None or args.register is not None:
+            raise CliInputError("--name and --register apply to controller files: add --file "
+                                "or --output FILE")
         from tcpcal.formats import export_tool
 
         _emit(export_tool(tool, args.fmt, slot=slot))
-    else:  # pragma: no cover - argparse restricts the choices
-        raise AssertionError(cmd)
+        return
+    if args.fmt == "matrix":
+        raise CliInputError("--format matrix has no controller file; use kuka, abb, fanuc, ur "
+                            "or yaskawa with --file/--output")
+    if args.register is not None and args.fmt != "fanuc":
+        raise CliInputError("--register applies only to --format fanuc")
+    from tcpcal.controllers import export_tool_file
+
+    options = {} if args.register is None else {"register": args.register}
+    text = export_tool_file(tool, args.fmt, number=slot, name=args.file_name, **options)
+    if args.output is None:
+        _emit(text)
+    else:
+        _write_new(args.output, text)
+        _emit(f"Wrote {args.fmt} file for slot {slot} {tool.name!r} to {args.output}")
+
+
+def _run_poses(args: argparse.Namespace) -> int:
+    """``poses import FILE``: POSES.csv from a controller program file."""
+    from tcpcal.controllers import import_poses, poses_csv_text
+
+    try:
+        text = args.file.read_text(encoding="utf-8-sig", errors="strict")
+    except UnicodeDecodeError:
+        text = args.file.read_text(encoding="latin-1")  # controller files are often Latin-1
+    try:
+        imported = import_poses(text, args.fmt, filename=args.file.name)
+    except TcpcalError as exc:
+        raise CliInputError(f"{args.file}: {_one_line(str(exc))}") from None
+    for w in imported.warnings:
+        print(f"tcpcal: warning: {args.file}: {w}", file=sys.stderr)
+    csv_text = poses_csv_text(imported)
+    if args.output is None:
+        sys.stdout.write(csv_text)
+    else:
+        _write_new(args.output, csv_text)
+        print(f"Wrote {len(imported.poses)} {imported.format} poses to {args.output}",
+              file=sys.stderr)
     return 0
 
 
@@ -528,6 +639,8 @@ def main(argv: list[str] | None = None) -> int:
             return _run_convert(args)
         if args.command == "tools":
             return _run_tools(args)
+        if args.command == "poses":
+            return _run_poses(args)
         raise AssertionError(args.command)  # pragma: no cover
     except CliInputError as exc:
         print(f"tcpcal: error: {_one_line(str(exc))}", file=sys.stderr)

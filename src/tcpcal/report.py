@@ -114,6 +114,8 @@ def tcp_result_to_dict(result: TcpResult, *, rows: Sequence[int] | None = None) 
         "ci95_mm": result.ci95_radius,
         "covariance_mm2": np.asarray(result.covariance, dtype=float),
         "max_angle_deg": result.max_angle_deg,
+        "max_angle_exact": bool(getattr(result, "max_angle_exact", True)),
+        "max_angle_upper_deg": getattr(result, "max_angle_upper_deg", result.max_angle_deg),
         "min_angle_deg": result.min_angle_deg,
         "condition_number": result.condition_number,
         "outliers": [rows[i] for i in result.outliers],
@@ -121,7 +123,8 @@ def tcp_result_to_dict(result: TcpResult, *, rows: Sequence[int] | None = None) 
     }
     sub = result.without_outliers
     if sub is not None:
-        kept = [r for i, r in enumerate(rows) if i not in set(result.outliers)]
+        dropped = set(result.outliers)
+        kept = [r for i, r in enumerate(rows) if i not in dropped]
         out["without_outliers"] = tcp_result_to_dict(sub, rows=kept)
     else:
         out["without_outliers"] = None
@@ -177,6 +180,15 @@ def _bullets(items: Sequence[str]) -> list[str]:
     return out
 
 
+def _largest_angle(result: TcpResult) -> str:
+    """``174.4 deg``, or for an estimate (above 2048 touches, ``max_angle_exact`` False)
+    ``>= 179.9 deg (estimate, at most 180.0)``."""
+    if getattr(result, "max_angle_exact", True):
+        return _fig(result.max_angle_deg, " deg", ".1f")
+    return (f">= {_fig(result.max_angle_deg, ' deg', '.1f')} (estimate, at most "
+            f"{_fig(result.max_angle_upper_deg, '', '.1f')})")
+
+
 def _tcp_block(result: TcpResult) -> list[str]:
     return [
         f"TCP in FLANGE (mm):       {_xyz(result.tcp)}",
@@ -185,7 +197,7 @@ def _tcp_block(result: TcpResult) -> list[str]:
          f"max {_fig(result.max_error, '')}   RMS {_fig(result.rms_error, '')}"),
         (f"95 % radius of the TCP:   {_fig(result.ci95_radius)}   "
          f"(estimated touch noise {_fig(result.noise_sigma)} per axis)"),
-        (f"Touch orientations:       largest angle {_fig(result.max_angle_deg, ' deg', '.1f')}, "
+        (f"Touch orientations:       largest angle {_largest_angle(result)}, "
          f"smallest {_fig(result.min_angle_deg, ' deg', '.1f')}; "
          f"condition number {_fig(result.condition_number, '', '.1f')}"),
     ]
