@@ -23,8 +23,13 @@ callbacks; the jog itself (controller) is the same code in both:
 * B  paced: every session 30 steps/s for a few seconds, steps called in this process;
 * C  paced end to end: every client holds "X +" / "X −" (viser's button-hold messages, 30 per
      second per client, alternating every 5); the server receives them, runs the hold
-     callbacks in viser's thread pool, jogs (continuous mode, override set for ~1 mm per tick)
-     and sends the updates. Steps are counted by a motion listener.
+     callbacks (the app's on viser's event loop, through ``Session.on_loop`` like every GUI
+     callback since issue 15; the baseline's in viser's thread pool), jogs (continuous mode,
+     override set for ~1 mm per tick) and sends the updates. Steps are counted by a motion
+     listener. This is the path a browser's jog takes.
+
+A and B call the step from this benchmark's thread (not the event loop, where the app runs it)
+to time the step alone; C is the real path.
 
 Sessions per core at 30 steps/s = 1 / (30 * process CPU per step) (paced runs: includes the
 CPU the process spends between steps). Target (issue 4): >= 30, i.e. <= 1.11 ms per step.
