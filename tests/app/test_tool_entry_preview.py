@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from tcp_pendant.pendant.tool_entry import FIELDS, ToolEntry, entry_preview_markdown
+from tcp_pendant.views.escape import escape_markdown
 
 
 def _entry(name: str = "Pen", **vals: str) -> ToolEntry:
@@ -21,7 +22,7 @@ def test_valid_entry_previews_the_numbers_it_will_store() -> None:
 def test_invalid_fields_show_a_question_mark_and_the_reason() -> None:
     text = entry_preview_markdown(_entry(name=" ", Z="1o0", A="400"))
     assert "*(no name)* · X 0.00 Y 0.00 Z ? mm · A ? B 0.00 C 0.00 deg" in text
-    assert "Z (mm): '1o0' is not a number" in text
-    assert "A (deg): 400 is out of range" in text
+    assert escape_markdown("Z (mm): '1o0' is not a number") in text      # the reasons as text
+    assert escape_markdown("A (deg): 400 is out of range") in text
     assert "Name: enter a tool name" in text
     assert "ready to save" not in text

@@ -14,6 +14,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 from tcp_pendant.calibrate import error_bars
 from tcp_pendant.server import AppConfig, PendantApp
+from tcp_pendant.views.escape import escape_markdown
 from tcp_pendant.views.wizard_menu import CalibrateView
 from tcp_pendant.wizards import ESTIMATOR_LABELS
 
@@ -140,13 +141,14 @@ def test_reference_wizard_disables_record_until_the_tool_change(page) -> None:
     p.choose(v.method, "XYZ reference")
     assert v.library_tool.visible and v.new_physical.visible and not v.n_points.visible
     p.choose(v.new_physical, "Welding torch (bent neck)")
-    assert "touch 2 with the *welding torch (bent neck)*" in v.menu_md.content
+    assert f"touch 2 with the *{escape_markdown('welding torch (bent neck)')}*" in v.menu_md.content
     p.click(v.start)
     assert s.active_slot == 1 and "Active tool:** Pointer (slot 1)" in s.views["tools"].active_md.content
     p.click(v.steps.auto_touch)
     assert v.steps.record.disabled and v.steps.mount.visible
     assert v.steps.mount.label == "Mount the welding torch (bent neck)"
-    assert "Mount the welding torch (bent neck) first: the straight pointer" in v.steps.blocked_md.content
+    assert escape_markdown("Mount the welding torch (bent neck) first: the straight pointer") in \
+        v.steps.blocked_md.content
     p.click(v.steps.mount)
     assert s.controller.mounted_tool.key == "torch"
     assert s.views["tools"].mounted.value == "Welding torch (bent neck)"     # the Tool tab follows
@@ -165,7 +167,7 @@ def test_outliers_are_marked_and_can_be_dropped_and_estimators_compared(page) ->
     assert v.steps.auto_request().sigma_mm == pytest.approx(0.1)
     for _ in range(7):
         p.click(v.steps.auto_touch)
-    assert v.steps.auto_md.content.startswith("Step 7 recorded: Touch 7 (tilt ")
+    assert v.steps.auto_md.content.startswith(escape_markdown("Step 7 recorded: Touch 7 (tilt "))
     assert v.steps.auto_md.content.endswith("Operator error σ 0.10 mm.")
     # touch 8: a careless one, 5 mm off the reference tip
     with s.lock:
@@ -254,7 +256,7 @@ def test_orientation_wizards_need_a_library_tool(page) -> None:
     p.click(v.start)
     assert v.steps.variant.visible and v.steps.variant.value.startswith("Variant 1")
     p.choose(v.steps.variant, "Variant 2: tip in the +Y half-plane")
-    assert v.workflow.wizard.variant == 2 and "+Y half-plane" in v.steps.steps_md.content
+    assert v.workflow.wizard.variant == 2 and escape_markdown("+Y half-plane") in v.steps.steps_md.content
     for _ in range(3):
         p.click(v.steps.auto_touch)
     _, _, abc_true = true_frame("torch")

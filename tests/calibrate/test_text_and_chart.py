@@ -20,6 +20,7 @@ from tcp_pendant.calibrate.text import (
     truth_markdown,
     warnings_markdown,
 )
+from tcp_pendant.views.escape import escape_markdown
 from tcp_pendant.wizards import WizardResult, Xyz4Wizard
 from tcp_pendant.wizards.truth import compare_with_truth
 
@@ -165,7 +166,7 @@ def test_menu_and_save_echo_the_choices() -> None:
     assert "two different" in menu_markdown("reference", library_tool="1: P", reference_tool="X",
                                             new_tool="X", mounted_tool="X")
     assert save_preview_markdown("Pen", "3: (empty)", (1, 2, 3), (0, 90, -0.0)) == \
-        "Will save **Pen** · X 1.00 Y 2.00 Z 3.00 mm · A 0.00 B 90.00 C 0.00° · slot: 3: (empty)"
+        "Will save **Pen** · X 1.00 Y 2.00 Z 3.00 mm · A 0.00 B 90.00 C 0.00° · slot: 3: \\(empty\\)"
     assert "*(type a name)*" in save_preview_markdown(" ", "auto", (0, 0, 0), (0, 0, 0))
 
 
@@ -176,5 +177,5 @@ def test_replay_table_has_one_row_per_wizard() -> None:
     check = ReplayCheck(index=0, kind="xyz4", wizard=Xyz4Wizard(), matches=True, tcp_diff_mm=0.0,
                         rotation_diff_deg=None, truth=None, message="replayed result matches the record")
     rows = table_rows(replay_markdown([check]))
-    assert rows[-1] == ["1", "XYZ 4-point", "✔ replayed result matches the record", "–"]
+    assert rows[-1] == ["1", escape_markdown("XYZ 4-point"), "✔ replayed result matches the record", "–"]
     assert re.fullmatch(r"[-| ]+", replay_markdown([check]).splitlines()[1])

@@ -4,6 +4,11 @@ Every number comes from a wizard (which got it from ``tcpcal``); this module onl
 plain words with its unit: lengths in mm, angles in degrees, as on a pendant. The error
 figures are named as tcpcal names them: *mean* error, *max* error, *RMS* error (not the same
 thing) and the *95 % radius* of the TCP.
+
+Every piece of plain text that can carry what a user typed or uploaded (tool names, the
+library choice, the wizards' titles, instructions, warnings and messages, which quote tool
+names, and a loaded record's content) goes through
+:func:`tcp_pendant.views.escape.escape_markdown` here, where the markdown is composed.
 """
 
 from __future__ import annotations
@@ -12,6 +17,7 @@ import math
 from collections.abc import Sequence
 
 from tcp_pendant.pendant.formatting import fmt_num
+from tcp_pendant.views.escape import escape_markdown as _esc
 from tcp_pendant.wizards import ESTIMATOR_LABELS, Wizard, WizardResult, Xyz4Result
 from tcp_pendant.wizards.session_record import ReplayCheck
 from tcp_pendant.wizards.truth import TruthComparison
@@ -55,7 +61,8 @@ def menu_markdown(kind: str, *, library_tool: str | None, reference_tool: str, n
         reference_tool, new_tool: physical tools chosen for the reference method (labels).
         mounted_tool: label of the physical tool on the flange now.
     """
-    mounted = mounted_tool.lower()
+    mounted = _esc(mounted_tool.lower())
+    library_tool = None if library_tool is None else _esc(library_tool)
     if kind == "xyz4":
         return (f"Calibrates the TCP of the **{mounted}** now mounted; mount another tool on the "
                 "Tool tab first if that is not the one.")
@@ -65,8 +72,8 @@ def menu_markdown(kind: str, *, library_tool: str | None, reference_tool: str, n
     if kind == "reference":
         if reference_tool == new_tool:
             return "⚠ The reference tool and the new tool must be two different physical tools."
-        return (f"Touch 1 with the data **{library_tool}** on the *{reference_tool.lower()}*; then "
-                f"the tool change and touch 2 with the *{new_tool.lower()}*, whose TCP is calibrated.")
+        return (f"Touch 1 with the data **{library_tool}** on the *{_esc(reference_tool.lower())}*; then "
+                f"the tool change and touch 2 with the *{_esc(new_tool.lower())}*, whose TCP is calibrated.")
     return (f"Calibrates the orientation of **{library_tool}** (its TCP is used as is); the "
             f"*{mounted}* is mounted: it must be the tool that data belongs to.")
 
@@ -76,8 +83,8 @@ def save_preview_markdown(name: str, slot_choice: str, tcp_mm: Sequence[float],
     """What "Save to tool library" will store (echoes the name and slot as typed)."""
     x, y, z = (fmt_num(v) for v in tcp_mm)
     a, b, c = (fmt_num(v) for v in abc_deg)
-    shown = f"**{name.strip()}**" if name.strip() else "*(type a name)*"
-    return f"Will save {shown} · X {x} Y {y} Z {z} mm · A {a} B {b} C {c}° · slot: {slot_choice}"
+    shown = f"**{_esc(name.strip())}**" if name.strip() else "*(type a name)*"
+    return f"Will save {shown} · X {x} Y {y} Z {z} mm · A {a} B {b} C {c}° · slot: {_esc(slot_choice)}"
 
 
 def _mm(v: float | None, decimals: int = 2) -> str:
@@ -91,10 +98,11 @@ def _deg(v: float | None, decimals: int = 2) -> str:
 def step_markdown(wizard: Wizard) -> str:
     """Heading ("**XYZ 4-point** · Step 2 of 4: Touch 2") and the step's instruction."""
     if wizard.is_complete:
-        return f"**{wizard.title}** · Result\n\nThe calibration is computed: see *Result* below."
+        return f"**{_esc(wizard.title)}** · Result\n\nThe calibration is computed: see *Result* below."
     step = wizard.step
     mark = " ✔ recorded" if step.recorded else ""
-    return f"**{wizard.title}** · {step.heading}: {step.title}{mark}\n\n{step.instruction}"
+    return (f"**{_esc(wizard.title)}** · {_esc(step.heading)}: {_esc(step.title)}{mark}\n\n"
+            f"{_esc(step.instruction)}")
 
 
 def steps_list_markdown(wizard: Wizard) -> str:
@@ -103,7 +111,7 @@ def steps_list_markdown(wizard: Wizard) -> str:
     for s in wizard.steps:
         here = s.index == wizard.step_index and not wizard.is_complete
         sym = "▶" if here else ("✔" if s.recorded else "·")
-        parts.append(f"{sym} {s.title}")
+        parts.append(f"{sym} {_esc(s.title)}")
     if wizard.is_complete:
         parts.append("▶ Result")
     return " &nbsp; ".join(parts)
@@ -165,7 +173,7 @@ def result_markdown(result: WizardResult) -> str:
     if result.abc_deg is not None:
         a, b, c = (fmt_num(v) for v in result.abc_deg)
         lines.append(f"**Orientation** A {a} · B {b} · C {c}° (KUKA: Rz(A) Ry(B) Rx(C))")
-    rows: list[tuple[str, str]] = [("method", result.method)]
+    rows: list[tuple[str, str]] = [("method", _esc(result.method))]
     tcp = result.tcp_result
     if tcp is not None:
         n = len(result.per_touch_error_mm)
@@ -204,7 +212,7 @@ def _touch_numbers(result: WizardResult) -> Sequence[int]:
 
 def warnings_markdown(result: WizardResult) -> str:
     """Warnings (⚠) then standing notes (ℹ), one per line; empty when there are none."""
-    lines = [f"⚠ {w}" for w in result.warnings] + [f"ℹ {n}" for n in result.notes]
+    lines = [f"⚠ {_esc(w)}" for w in result.warnings] + [f"ℹ {_esc(n)}" for n in result.notes]
     return "\n\n".join(lines)
 
 
@@ -215,7 +223,7 @@ def comparison_markdown(result: Xyz4Result) -> str:
     for r in result.comparison_rows():
         label = r["label"] + (" ◀ reported" if r.get("chosen") else "")
         if not r["ok"]:
-            rows.append(f"| {label} | cannot solve: {r['error']} ||||||| ")
+            rows.append(f"| {label} | cannot solve: {_esc(r['error'])} ||||||| ")
             continue
         x, y, z = (fmt_num(v) for v in r["tcp_mm"])
         rows.append(f"| {label} | {x} | {y} | {z} | {fmt_num(r['mean_error_mm'])} | "
@@ -240,7 +248,7 @@ def truth_markdown(cmp: TruthComparison) -> str:
 
 def save_markdown(slot: int, name: str) -> str:
     """Confirmation after "Save to tool library"."""
-    return f"✔ Saved **{name}** in slot {slot}; it is now the active tool."
+    return f"✔ Saved **{_esc(name)}** in slot {slot}; it is now the active tool."
 
 
 def replay_markdown(checks: Sequence[ReplayCheck]) -> str:
@@ -250,9 +258,9 @@ def replay_markdown(checks: Sequence[ReplayCheck]) -> str:
     head = "| # | calibration | replay | against truth |\n|---|---|---|---|"
     rows = []
     for c in checks:
-        truth = "–" if c.truth is None else c.truth.verdict
+        truth = "–" if c.truth is None else _esc(c.truth.verdict)
         ok = "✔ " if c.matches else "✘ "
-        rows.append(f"| {c.index + 1} | {c.wizard.title} | {ok}{c.message} | {truth} |")
+        rows.append(f"| {c.index + 1} | {_esc(c.wizard.title)} | {ok}{_esc(c.message)} | {truth} |")
     return head + "\n" + "\n".join(rows)
 
 

@@ -43,7 +43,9 @@ def tcp_readout_markdown(readout: PoseReadout, tool_name: str | None) -> str:
     width = max(len(v) for _, v, _ in rows)
     lines = [f"{rows[i][0]} {rows[i][1]:>{width}} mm   {rows[i + 3][0]} {rows[i + 3][1]:>{width}} deg"
              for i in range(3)]
-    tool = "FLANGE (no tool active)" if tool_name is None else f"TOOL {tool_name}"
+    from tcp_pendant.views.escape import escape_markdown   # here: views imports this package
+
+    tool = "FLANGE (no tool active)" if tool_name is None else f"TOOL {escape_markdown(tool_name)}"
     return f"**TCP in {readout.frame}** · {tool}\n\n```\n" + "\n".join(lines) + "\n```"
 
 
@@ -88,10 +90,12 @@ def touch_label(index: int, T_world_flange: np.ndarray) -> str:
 
 def tool_data_markdown(tool: Tool | None, slot: int | None = None) -> str:
     """Active tool data: name (slot), TCP X, Y, Z mm and A, B, C deg, calibration method."""
+    from tcp_pendant.views.escape import escape_markdown   # here: views imports this package
+
     if tool is None:
         return "**Active tool:** none (TCP = flange)"
-    head = f"**Active tool:** {tool.name}" + ("" if slot is None else f" (slot {slot})")
+    head = f"**Active tool:** {escape_markdown(tool.name)}" + ("" if slot is None else f" (slot {slot})")
     x, y, z = (fmt_num(v) for v in tool.tcp_mm)
     a, b, c = (fmt_num(v) for v in tool.abc_deg)
-    cal = "" if tool.calibration is None else f"\n\ncalibrated by {tool.calibration.method}"
+    cal = "" if tool.calibration is None else f"\n\ncalibrated by {escape_markdown(tool.calibration.method)}"
     return f"{head}\n\n```\nX {x}  Y {y}  Z {z} mm\nA {a}  B {b}  C {c} deg\n```{cal}"

@@ -107,7 +107,9 @@ def entry_preview_markdown(entry: ToolEntry) -> str:
     A decimal comma typed in a field shows here as the number it means, so the user sees
     what the controller will hold before saving.
     """
-    name = (entry.name or "").strip()
+    from tcp_pendant.views.escape import escape_markdown   # here: views imports this package
+
+    name = escape_markdown((entry.name or "").strip())
     shown: list[str] = []
     for f in FIELDS:
         try:
@@ -119,5 +121,5 @@ def entry_preview_markdown(entry: ToolEntry) -> str:
     head = (f"**{name}**" if name else "*(no name)*") + \
         f" · {' '.join(shown[:3])} mm · {' '.join(shown[3:])} deg"
     res = parse_tool_entry(entry)
-    status = "✔ ready to save" if res.ok else "⚠ " + "; ".join(res.errors.values())
+    status = "✔ ready to save" if res.ok else "⚠ " + "; ".join(escape_markdown(e) for e in res.errors.values())
     return f"{head}\n\n{status}"

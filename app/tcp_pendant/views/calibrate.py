@@ -25,6 +25,7 @@ from collections.abc import Callable
 from typing import Any
 
 from tcp_pendant.session import Session
+from tcp_pendant.views.escape import escape_markdown
 
 __all__ = ["WIZARD_MODULE", "build_calibrate_tab", "register_calibrate_view"]
 
@@ -66,4 +67,5 @@ def build_calibrate_tab(session: Session, tab: Any) -> None:
                 session.views.setdefault("calibrate", fn(session))
             except Exception as exc:
                 log.exception("calibrate view %s failed", fn)
-                session.target.gui.add_markdown(f"⚠ The calibration view could not be built: {exc}")
+                session.target.gui.add_markdown(
+                    f"⚠ The calibration view could not be built: {escape_markdown(str(exc))}")

@@ -12,15 +12,17 @@ Rules of :func:`escape_markdown`:
 
 * the five HTML-significant characters become entities (``&amp; &lt; &gt; &quot; &#39;``), so
   the output never holds a raw ``<`` and react-markdown never sees raw HTML;
-* every other ASCII punctuation character gets a backslash (CommonMark allows a backslash before
-  any ASCII punctuation and then shows the character itself): no emphasis, link, image, code span,
-  heading, list, table cell border (``|``) or strikethrough can start inside user text;
+* every ASCII punctuation character that can start markdown syntax (``\\ ` * _ [ ] ( ) # + - . !
+  | { } ~ =``) gets a backslash (CommonMark then shows the character itself): no emphasis,
+  link, image, code span, heading, list, table cell border (``|``) or strikethrough can start
+  inside user text;
 * GFM's *autolink literals* (``www.host``, ``http://``, ``https://``, ``user@host``) are found by
   remark-gfm in the text *after* escapes are resolved, so backslashes do not stop them; a WORD
   JOINER (U+2060, invisible and zero-width) is inserted after ``www``/``http``/``https`` and
   after ``@`` so that no bare URL or e-mail address becomes a link;
 * line breaks (``\\r``, ``\\n`` and the Unicode line separators) are folded to one space: the text
-  is one line, safe inside a paragraph, a bold span or a GFM table cell.
+  is one line, safe inside a paragraph, a bold span or a GFM table cell; a leading blank becomes
+  an entity, so the text cannot start an indented code block.
 
 The result is meant for ordinary markdown text (paragraphs, ``**bold**``, table cells), not for
 the inside of a code span (backticks show entities and backslashes literally).
@@ -37,10 +39,13 @@ WORD_JOINER = "\u2060"
 
 _HTML_ENTITIES = {"&": "&amp;", "<": "&lt;", ">": "&gt;", '"': "&quot;", "'": "&#39;"}
 
-# Any ASCII punctuation may be backslash-escaped in CommonMark; the HTML five are entities instead.
-_BACKSLASHED = frozenset(
-    c for c in "!#$%()*+,-./:;=?@[\\]^_`{|}~" if c not in _HTML_ENTITIES
-)
+# The ASCII punctuation that can start markdown syntax (CommonMark lets a backslash precede any
+# ASCII punctuation and then shows the character itself): images and links ``! [ ] ( )``,
+# emphasis and code spans (``*``, ``_``, backtick), headings ``#``, list items and rules ``- + . =``, GFM tables
+# ``|`` and strikethrough ``~``, the backslash itself and ``{ }``. The HTML five are entities
+# instead; ``: / @ , ; ? $ % ^`` mean nothing in remark-gfm's markdown and stay as they are
+# (bare links are broken with a WORD JOINER, see ``_AUTOLINK_STARTS``).
+_BACKSLASHED = frozenset("!#()*+-.=[\\]_`{|}~")
 
 # Line endings of markdown plus the Unicode line/paragraph separators and NEL.
 _LINE_BREAKS = re.compile("\r\n|[\r\n\u0085\u2028\u2029\x0b\x0c]")
@@ -80,6 +85,9 @@ def escape_markdown(text: str) -> str:
         return ""
     s = _break_autolinks(_LINE_BREAKS.sub(" ", str(text)))
     out = []
+    if s[:1] in (" ", "\t"):     # as an entity, leading blanks cannot indent a code block
+        out.append(f"&#{ord(s[0])};")
+        s = s[1:]
     for c in s:
         entity = _HTML_ENTITIES.get(c)
         if entity is not None:

@@ -19,6 +19,7 @@ from tcp_pendant.controller import builtin_tools
 from tcp_pendant.pendant import FIELDS, ToolEntry, parse_tool_entry, tool_data_markdown
 from tcp_pendant.pendant.tool_entry import entry_preview_markdown
 from tcp_pendant.session import Session
+from tcp_pendant.views.escape import escape_markdown
 from tcp_pendant.views.gui_util import number_of_option, set_options, slot_option
 from tcpcal.errors import TcpcalError
 from tcpcal.formats import FORMATS, export_tool
@@ -246,7 +247,7 @@ class ToolPanel:
             self.entry_md.content = "⚠ Not saved: correct the fields marked above."
             return
         lib.save(slot, res.tool)
-        self.entry_md.content = f"✔ Saved **{res.tool.name}** in slot {slot}."
+        self.entry_md.content = f"✔ Saved **{escape_markdown(res.tool.name)}** in slot {slot}."
         self.reload()
         self.slots.value = slot_option(slot, res.tool.name)
         self._show_slot()
@@ -255,5 +256,5 @@ class ToolPanel:
         pairs = [("name", self.entry_name_err), *((f, self.entry_errors[f]) for f in FIELDS)]
         for key, handle in pairs:
             msg = errors.get(key)
-            handle.content = "" if msg is None else f"**⚠ {msg}**"
+            handle.content = "" if msg is None else f"**⚠ {escape_markdown(msg)}**"
             handle.visible = msg is not None

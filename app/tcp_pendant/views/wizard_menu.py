@@ -34,6 +34,7 @@ from tcp_pendant.calibrate.text import (
 )
 from tcp_pendant.controller import builtin_robots
 from tcp_pendant.session import Session
+from tcp_pendant.views.escape import escape_markdown
 from tcp_pendant.views.gui_util import (
     number_of_option,
     set_content,
@@ -263,7 +264,8 @@ class CalibrateView:
         except UnicodeDecodeError:
             raise ValueError(f"{upload.name or 'The file'} is not a text (JSON) file.") from None
         checks = self.workflow.load_record(text)
-        set_content(self.record_md, f"**Loaded {upload.name or 'session'}**\n\n" + replay_markdown(checks))
+        set_content(self.record_md, f"**Loaded {escape_markdown(upload.name or 'session')}**\n\n"
+                    + replay_markdown(checks))
 
     # ------------------------------------------------------------ library and motion
     def refresh_library(self, tools: dict[int, Tool] | None = None) -> None:

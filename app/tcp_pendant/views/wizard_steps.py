@@ -22,6 +22,7 @@ from tcp_pendant.calibrate.text import (
     step_markdown,
     steps_list_markdown,
 )
+from tcp_pendant.views.escape import escape_markdown
 from tcp_pendant.views.gui_util import set_content
 from tcp_pendant.wizards import (
     AbcWorldWizard,
@@ -124,7 +125,7 @@ class WizardStepsView:
         out = self.parent.workflow.auto_touch(request)
         if not out.ok:
             raise ValueError(out.message)
-        set_content(self.auto_md, f"{out.message} Operator error σ {request.sigma_mm:.2f} mm.")
+        set_content(self.auto_md, f"{escape_markdown(out.message)} Operator error σ {request.sigma_mm:.2f} mm.")
 
     # ------------------------------------------------------------ render
     def render(self) -> None:
@@ -142,7 +143,7 @@ class WizardStepsView:
         reason = wiz.blocked_reason if not wiz.is_complete else None
         self.blocked_md.visible = reason is not None
         if reason is not None:
-            set_content(self.blocked_md, f"⚠ {reason}")
+            set_content(self.blocked_md, f"⚠ {escape_markdown(reason)}")
         self.mount.visible = needed is not None
         if needed is not None:
             self.mount.label = f"Mount the {needed.label.lower()}"
