@@ -1,0 +1,112 @@
+"""Shared pieces of the controller-file modules: fixed-decimal numbers, the parsed records and
+the errors (docs/formats.md).
+
+Numbers are written as a pendant shows them: a fixed number of decimals, never an exponent,
+never ``-0.000``, never a float artefact such as ``0.33589800000000003``.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from tcpcal.errors import InvalidInputError
+
+__all__ = ["NUM", "ControllerFileError", "RecordedPose", "ToolEntry", "fixed", "line_of", "to_float"]
+
+NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
+"""A decimal number as controllers write it (``.044``, ``-12.``, ``9E+09``)."""
+
+_NUM_RE = re.compile(rf"^{NUM}$")
+
+
+class ControllerFileError(InvalidInputError):
+    """A controller file that cannot be read or written (the message names the format, what is
+    wrong and what to do)."""
+
+
+def fixed(value: float, decimals: int) -> str:
+    """``value`` with exactly ``decimals`` decimals, no exponent, no negative zero.
+
+    Raises:
+        ControllerFileError: ``value`` is NaN or infinite.
+    """
+    x = float(value)
+    if not math.isfinite(x):
+        raise ControllerFileError(f"cannot write {x!r} into a controller file: not a finite number")
+    text = f"{x:.{decimals}f}"
+    if float(text) == 0.0:
+        text = text.lstrip("-")
+    return text
+
+
+def to_float(token: str, fmt: str, what: str) -> float:
+    """A finite float from a controller file's token, or a :class:`ControllerFileError`."""
+    token = token.strip()
+    if not _NUM_RE.match(token):
+        raise ControllerFileError(f"{fmt}: {what} {token!r} is not a number")
+    value = float(token)
+    if not math.isfinite(value):
+        raise ControllerFileError(f"{fmt}: {what} is {token!r}, not a finite number")
+    return value
+
+
+@dataclass(frozen=True)
+class ToolEntry:
+    """One tool frame read from a controller file.
+
+    Attributes:
+        number: the controller's tool number (slot), or ``None`` if the file has none (UR).
+        name: the tool's name in the file ('' when it has none).
+        tcp_mm: TCP in FLANGE, mm.
+        rotation: (3, 3) ``R_flange_tool``.
+    """
+
+    number: int | None
+    name: str
+    tcp_mm: tuple[float, float, float]
+    rotation: np.ndarray
+
+    def __post_init__(self) -> None:
+        rot = np.array(self.rotation, dtype=float)
+        rot.setflags(write=False)
+        object.__setattr__(self, "rotation", rot)
+
+
+@dataclass(frozen=True)
+class RecordedPose:
+    """One robot position read from a program file (``T_world_flange`` only if it was recorded
+    with no tool and no base active; ``tool``/``base`` say what the file recorded).
+
+    Attributes:
+        name: the position's name in the file (``XP1``, ``p10``, ``P[3]``...).
+        position_mm: (3,) position, mm.
+        rotation: (3, 3) rotation matrix.
+        values: the orientation numbers as the file writes them, in the vendor's layout
+            (KUKA A, B, C deg; ABB q1..q4; FANUC W, P, R deg; UR rx, ry, rz rad).
+        tool: the tool number the file says the position was recorded with, if it says.
+        base: the base / user frame number, if the file says.
+        line: 1-based line of the position in the file.
+    """
+
+    name: str
+    position_mm: tuple[float, float, float]
+    rotation: np.ndarray
+    values: tuple[float, ...]
+    tool: int | None = None
+    base: int | None = None
+    line: int = 0
+    notes: tuple[str, ...] = field(default=())
+
+    def __post_init__(self) -> None:
+        rot = np.array(self.rotation, dtype=float)
+        rot.setflags(write=False)
+        object.__setattr__(self, "rotation", rot)
+
+
+def line_of(text: str, pos: int) -> int:
+    """1-based line number of character offset ``pos`` in ``text``."""
+    return text.count("\n", 0, pos) + 1
