@@ -1,0 +1,218 @@
+"""solve_xyz4 on recorded tracker data (issue 8, item 6): the O(N log N) angle figures and the
+O(N) duplicate check equal the exact O(N^2) ones; 1e5 touches with a repeated orientation
+fail or solve cleanly in modest memory; a slow continuous motion is not "one orientation".
+"""
+
+from __future__ import annotations
+
+import math
+import time
+import tracemalloc
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy.spatial.transform import Rotation
+
+from tcpcal import _stats
+from tcpcal._stats import (
+    EXACT_ANGLES_MAX_N,
+    _angle_extremes_large,
+    angle_extremes,
+    distinct_orientations,
+    quaternions,
+)
+from tcpcal.errors import DegenerateTouchesError
+from tcpcal.origin import solve_xyz4
+from tcpcal.report import format_tcp_report, tcp_result_to_dict
+
+
+def brute_angles_deg(rot: np.ndarray) -> tuple[float, float]:
+    """Smallest and largest angle over every pair, from the relative rotations (scipy)."""
+    n = len(rot)
+    i, j = np.triu_indices(n, 1)
+    ang = np.degrees(Rotation.from_matrix(np.einsum("nki,nkj->nij", rot[i], rot[j])).magnitude())
+    return float(ang.min()), float(ang.max())
+
+
+def brute_distinct(rot: np.ndarray, tol_deg: float) -> tuple[int, tuple[int, int] | None]:
+    """The greedy definition of distinct_orientations, touch by touch (O(N^2))."""
+    leaders: list[int] = []
+    first = None
+    for j in range(len(rot)):
+        near = [i for i in leaders
+                if np.degrees(Rotation.from_matrix(rot[i].T @ rot[j]).magnitude()) < tol_deg]
+        if near:
+            first = first or (near[0], j)
+        else:
+            leaders.append(j)
+    return len(leaders), first
+
+
+@st.composite
+def touch_sets(draw: st.DrawFn) -> np.ndarray:
+    """Random orientations with near-duplicates, exact duplicates and pairs near 180 deg
+    (quaternions on both sides of w = 0, where the sign folding matters)."""
+    seed = draw(st.integers(0, 2**32 - 1))
+    n = draw(st.integers(3, 60))
+    rng = np.random.default_rng(seed)
+    kind = draw(st.sampled_from(["uniform", "cap", "half-turns"]))
+    if kind == "uniform":
+        r = Rotation.random(n, random_state=rng)
+    elif kind == "cap":
+        r = Rotation.from_rotvec(rng.normal(size=(n, 3)) * draw(st.floats(1e-4, 0.5)))
+    else:  # rotations of ~180 deg: w ~ 0, q and -q both close to other touches
+        axes = rng.normal(size=(n, 3))
+        axes /= np.linalg.norm(axes, axis=1)[:, None]
+        r = Rotation.from_rotvec(axes * (math.pi - rng.uniform(0, 1e-3, (n, 1))))
+    rot = r.as_matrix()
+    n_near = draw(st.integers(0, 5))
+    for _ in range(n_near):  # near-duplicates, down to 1e-6 deg, and exact duplicates
+        a, b = rng.integers(0, n, 2)
+        eps = draw(st.sampled_from([0.0, 1e-8, 1e-5, 1e-3]))
+        rot[b] = (Rotation.from_matrix(rot[a]) * Rotation.from_rotvec(rng.normal(size=3) * eps)).as_matrix()
+    return rot
+
+
+@settings(max_examples=150, deadline=None)
+@given(touch_sets())
+def test_large_path_equals_every_pair(rot: np.ndarray) -> None:
+    exact = angle_extremes(rot)  # N <= 60: every pair (the Gram path of before)
+    fast = _angle_extremes_large(rot)  # the path used above EXACT_ANGLES_MAX_N touches
+    lo, hi = brute_angles_deg(rot)
+    assert fast.min_deg == pytest.approx(exact.min_deg, abs=1e-6)
+    assert fast.min_deg == pytest.approx(lo, abs=1e-5)
+    assert fast.max_exact  # a small set never needs the estimate
+    assert fast.max_deg == pytest.approx(exact.max_deg, abs=1e-6)
+    assert fast.max_deg == pytest.approx(hi, abs=1e-5)
+    # the pairs reported give the angles reported
+    for pair, deg in ((fast.min_pair, fast.min_deg), (fast.max_pair, fast.max_deg)):
+        a, b = pair
+        assert a < b
+        assert math.degrees(_stats.angle_between(rot[a], rot[b])) == pytest.approx(deg, abs=1e-9)
+
+
+@settings(max_examples=100, deadline=None)
+@given(touch_sets(), st.sampled_from([0.05, 1.0, 30.0]))
+def test_distinct_orientations_equals_the_touch_by_touch_definition(rot: np.ndarray, tol: float) -> None:
+    count, first = brute_distinct(rot, tol)
+    got = distinct_orientations(rot, tol, limit=len(rot) + 1)
+    assert got.count == count
+    assert got.first_repeat == first
+    capped = distinct_orientations(rot, tol, limit=4)
+    assert capped.count == min(count, 4)
+
+
+def test_quaternions_give_the_rotation_angle() -> None:
+    rot = Rotation.random(500, random_state=3).as_matrix()
+    q = quaternions(rot)
+    assert (q[:, 0] >= 0).all()
+    assert np.allclose(np.abs(np.einsum("ij,ij->i", q, q)), 1.0)
+    ref = Rotation.from_matrix(rot).as_quat()[:, [3, 0, 1, 2]]
+    assert np.allclose(np.abs(np.einsum("ij,ij->i", q, ref)), 1.0, atol=1e-12)
+
+
+def test_above_the_threshold_min_is_exact_and_max_bracketed() -> None:
+    """N = 3000 uniform orientations: the smallest angle exact against every pair (blocked
+    Gram of before), the largest within [max_deg, max_upper_deg] around the true one."""
+    rot = Rotation.random(3000, random_state=5).as_matrix()
+    assert len(rot) > EXACT_ANGLES_MAX_N
+    fast = angle_extremes(rot)
+    x = rot.reshape(len(rot), 9)
+    a, b, c, e = _stats._blocked_gram_extremes(x, np.ascontiguousarray(x.T))
+    min_deg, max_deg = _stats._pair_angles_deg(x, (c, e), (a, b))
+    assert fast.min_deg == pytest.approx(min_deg, abs=1e-9)
+    assert fast.max_deg <= max_deg + 1e-9 <= fast.max_upper_deg + 2e-9
+    assert max_deg - fast.max_deg < 0.5  # the estimate of a uniform set is close
+
+
+def test_tracker_like_cone_gets_an_exact_largest_angle() -> None:
+    """Pivoting inside a 30 deg cone (spin about the tool axis within +-20 deg): the prune
+    leaves few candidates, so the largest angle is exact, equal to the blocked Gram result."""
+    rng = np.random.default_rng(11)
+    n = 4000
+    tilt = np.radians(30.0) * np.sqrt(rng.uniform(0, 1, n))
+    az = rng.uniform(0, 2 * np.pi, n)
+    spin = np.radians(rng.uniform(-20, 20, n))
+    r = (Rotation.from_rotvec(np.c_[np.cos(az) * tilt, np.sin(az) * tilt, np.zeros(n)])
+         * Rotation.from_rotvec(np.c_[np.zeros((n, 2)), spin]))
+    rot = r.as_matrix()
+    fast = angle_extremes(rot)
+    x = rot.reshape(n, 9)
+    a, b, _, _ = _stats._blocked_gram_extremes(x, np.ascontiguousarray(x.T))
+    (max_deg,) = _stats._pair_angles_deg(x, (a, b))
+    assert fast.max_exact
+    assert fast.max_deg == pytest.approx(max_deg, abs=1e-7)
+
+
+def test_estimated_largest_angle_is_flagged_in_result_json_and_report() -> None:
+    rng = np.random.default_rng(2)
+    rot = Rotation.random(3000, random_state=rng).as_matrix()
+    pos = np.array([800.0, 0, 300]) - rot @ np.array([10.0, 20.0, 150.0]) + 0.1 * rng.normal(size=(3000, 3))
+    res = solve_xyz4(rot, pos)
+    assert not res.max_angle_exact
+    assert res.max_angle_deg <= res.max_angle_upper_deg <= 180.0
+    d = tcp_result_to_dict(res)
+    assert d["max_angle_exact"] is False and d["max_angle_upper_deg"] == res.max_angle_upper_deg
+    assert "largest angle >= " in format_tcp_report(res, None, command="solve xyz4")
+    assert "(estimate, at most" in format_tcp_report(res, None, command="solve xyz4")
+    assert np.allclose(res.tcp, [10.0, 20.0, 150.0], atol=0.05)
+
+
+def _continuous_sweep(n: int) -> np.ndarray:
+    """A slow continuous motion recorded at a high rate: tilt 0 -> 40 deg about X, then
+    about Y, 2 * n poses, consecutive poses ~0.02 deg apart."""
+    t = np.linspace(0.0, np.radians(40.0), n)
+    first = Rotation.from_rotvec(np.c_[t, np.zeros(n), np.zeros(n)])
+    second = Rotation.from_rotvec(np.c_[np.zeros(n), t, np.zeros(n)]) * first[-1]
+    return np.concatenate([first.as_matrix(), second.as_matrix()])
+
+
+def test_continuous_motion_counts_as_many_orientations() -> None:
+    """Before: every pose within 0.05 deg of the previous one was a duplicate, so a continuous
+    recording had "1 distinct orientation" and was refused as degenerate."""
+    rot = _continuous_sweep(2000)
+    tcp, ref = np.array([5.0, -3.0, 120.0]), np.array([700.0, 50.0, 200.0])
+    pos = ref - rot @ tcp
+    res = solve_xyz4(rot, pos)
+    assert np.allclose(res.tcp, tcp, atol=1e-6)
+    assert res.min_angle_deg < 0.05
+    assert distinct_orientations(rot, limit=4).count == 4
+
+
+def test_1e5_touches_one_orientation_fail_cleanly_in_modest_memory() -> None:
+    """All touches one orientation (the case that asked for a 74.5 GiB matrix before)."""
+    n = 100_000
+    rot = np.broadcast_to(Rotation.from_euler("ZYX", [10, 20, 170], degrees=True).as_matrix(), (n, 3, 3)).copy()
+    pos = np.tile([800.0, 0.0, 300.0], (n, 1))
+    tracemalloc.start()
+    t0 = time.perf_counter()
+    try:
+        with pytest.raises(DegenerateTouchesError, match="same orientation"):
+            solve_xyz4(rot, pos)
+    finally:
+        peak = tracemalloc.get_traced_memory()[1]
+        tracemalloc.stop()
+    assert time.perf_counter() - t0 < 20.0  # generous: a shared CI machine
+    assert peak < 300e6, peak  # O(N): the input is 7 MB, an N x N matrix 80 GB
+
+
+def test_1e5_touches_with_a_repeated_orientation_solve() -> None:
+    """Half of 1e5 touches repeat one orientation, the rest are diverse: solved, smallest
+    angle 0 (the repeated pair), no N x N matrix."""
+    n = 100_000
+    rng = np.random.default_rng(4)
+    rot = Rotation.from_rotvec(rng.normal(size=(n, 3)) * 0.5).as_matrix()
+    rot[::2] = rot[0]
+    tcp, ref = np.array([5.0, -3.0, 120.0]), np.array([700.0, 50.0, 200.0])
+    pos = ref - rot @ tcp + 0.05 * rng.normal(size=(n, 3))
+    tracemalloc.start()
+    try:
+        res = solve_xyz4(rot, pos)
+    finally:
+        peak = tracemalloc.get_traced_memory()[1]
+        tracemalloc.stop()
+    assert res.min_angle_deg == 0.0
+    assert np.allclose(res.tcp, tcp, atol=0.01)
+    assert peak < 600e6, peak
