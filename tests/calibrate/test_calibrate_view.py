@@ -240,8 +240,8 @@ def test_session_export_and_load_through_the_gui(page) -> None:
     upload(q.view.load, "bad.json", b"\xff\xfe not json", q.client)
     upload(q.view.load, "other.json", b'{"format": "x"}', q.client)
     assert len(q.view.workflow.runs) == runs
-    assert [t for t, _ in q.notes] == ["Not done", "Not done"]
-    assert "bad.json is not a text (JSON) file" in q.notes[0][1]
+    assert [t for t, _ in q.notes] == ["Session record not loaded"] * 2
+    assert "bad.json: The session record is not a text (JSON) file" in q.notes[0][1]
     assert "Not a TCP Pendant session record" in q.notes[1][1]
 
 

@@ -12,7 +12,10 @@ Top to bottom:
 * the open wizard's step panel (``wizard_steps``), its result panel (``wizard_result``) and
   its scene nodes (``wizard_scene``);
 * **Session record**: export the session (touches, wizards, results, errors) as JSON and load
-  one back to replay it (how a trainer grades).
+  one back to replay it (how a trainer grades). A loaded file is bytes: refused above
+  ``session_record.MAX_RECORD_BYTES`` as its transfer starts (``upload_guard``), then parsed and
+  replayed in a worker thread (never on viser's event loop, where it would stall every
+  browser), one load per session at a time; the result is added under the session lock.
 
 All logic is in :class:`tcp_pendant.calibrate.CalibrationWorkflow` (no viser); every click goes
 through :meth:`CalibrateView.action` (the session's lock and error notifications), then the
@@ -21,7 +24,10 @@ views are re-rendered from the workflow's state.
 
 from __future__ import annotations
 
+import asyncio
+import logging
 from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
 from tcp_pendant.calibrate import WIZARD_KINDS, WIZARD_LABELS, CalibrationWorkflow
@@ -41,11 +47,19 @@ from tcp_pendant.views.gui_util import (
     set_options,
     slot_option,
 )
+from tcp_pendant.views.upload_guard import limit_upload_size
 from tcp_pendant.views.wizard_result import WizardResultView
 from tcp_pendant.views.wizard_scene import WizardSceneView
 from tcp_pendant.views.wizard_steps import WizardStepsView
 from tcp_pendant.wizards import ESTIMATOR_LABELS
-from tcp_pendant.wizards.session_record import dumps
+from tcp_pendant.wizards.session_record import (
+    MAX_RECORD_BYTES,
+    LoadedRecord,
+    SessionRecordError,
+    check_record_size,
+    dumps,
+    load_and_replay,
+)
 from tcpcal.tool import Tool
 
 __all__ = ["NO_LIBRARY_TOOL", "SESSION_FILENAME", "CalibrateView", "build_calibrate_views"]
@@ -53,6 +67,14 @@ __all__ = ["NO_LIBRARY_TOOL", "SESSION_FILENAME", "CalibrateView", "build_calibr
 NO_LIBRARY_TOOL = "(library empty)"
 SESSION_FILENAME = "tcp-pendant-session.json"
 _LABEL_TO_KIND = {label: kind for kind, label in WIZARD_LABELS.items()}
+RECORD_REFUSED = "Session record not loaded"
+"""Title of the one notification a refused session record gets."""
+
+log = logging.getLogger(__name__)
+
+_RECORD_WORKER = ThreadPoolExecutor(max_workers=1, thread_name_prefix="session-record")
+"""Parses and replays uploaded records off viser's event loop, one at a time for the whole
+server (each is bounded by the record limits; at most ~0.3 s of CPU on the 2-core machine)."""
 
 
 def robot_name(session: Session) -> str:
@@ -129,7 +151,9 @@ class CalibrateView:
         self.start.on_click(act(self._on_start, sync=True))
         self.resume.on_click(act(self._on_resume))
         self.export.on_click(act(self._on_export))
-        self.load.on_upload(act(self._on_load))
+        self._loading_record = False
+        self.load.on_upload(self._on_upload)
+        limit_upload_size(self.load, MAX_RECORD_BYTES, self._upload_refused)
         session.add_motion_listener(self.on_motion)
         tool_panel = session.views.get("tools")
         if tool_panel is not None:
@@ -257,15 +281,59 @@ class CalibrateView:
         target.send_file_download(SESSION_FILENAME, data, save_immediately=True)
         set_content(self.record_md, f"Exported {len(self.workflow.runs)} calibration(s) as {SESSION_FILENAME}.")
 
-    def _on_load(self, event: Any) -> None:
+    async def _on_upload(self, event: Any) -> None:
+        """"Load session (JSON)": the size is checked at once, parsing and replay run in
+        ``_RECORD_WORKER`` (off viser's event loop: the other browsers keep jogging), then the
+        wizards are added under the session lock. A refused record gets one notification
+        (:data:`RECORD_REFUSED`) saying what is wrong; nothing of the session changes."""
+        session = self.session
+        if session.closed or getattr(event, "client", None) is None:
+            return
         upload = event.target.value
+        name = str(upload.name or "The file")
+        content = upload.content
+        if self._loading_record:
+            session.notify(RECORD_REFUSED, f"{name}: another session record is still being loaded here; "
+                           "wait until it is shown, then load this one.", kind="warning")
+            return
         try:
-            text = bytes(upload.content).decode("utf-8")
-        except UnicodeDecodeError:
-            raise ValueError(f"{upload.name or 'The file'} is not a text (JSON) file.") from None
-        checks = self.workflow.load_record(text)
-        set_content(self.record_md, f"**Loaded {escape_markdown(upload.name or 'session')}**\n\n"
-                    + replay_markdown(checks))
+            check_record_size(len(content))
+        except SessionRecordError as exc:
+            self._refuse_record(name, exc)
+            return
+        self._loading_record = True
+        try:
+            with session.lock:
+                set_content(self.record_md, f"Loading {escape_markdown(name)} ...")
+            loaded = await asyncio.get_running_loop().run_in_executor(_RECORD_WORKER, load_and_replay,
+                                                                      bytes(content))
+        except SessionRecordError as exc:
+            self._refuse_record(name, exc)
+            return
+        except Exception as exc:  # never let an upload kill the server
+            log.exception("loading the session record %r failed", name)
+            session.notify("Internal error", f"{type(exc).__name__}: {exc}", kind="error")
+            return
+        finally:
+            self._loading_record = False
+        await self.action(lambda _e: self._show_loaded(str(upload.name or "session"), loaded))(event)
+
+    def _show_loaded(self, name: str, loaded: LoadedRecord) -> None:
+        checks = self.workflow.add_loaded(loaded)
+        set_content(self.record_md, f"**Loaded {escape_markdown(name)}**\n\n" + replay_markdown(checks))
+
+    def _refuse_record(self, name: str, exc: Exception) -> None:
+        if not self.session.closed:
+            with self.session.lock:
+                set_content(self.record_md, "")
+            self.session.notify(RECORD_REFUSED, f"{name}: {exc}", kind="warning")
+
+    def _upload_refused(self, filename: str, size_bytes: int) -> None:
+        """``upload_guard``: a transfer above the size limit was dropped as it started."""
+        try:
+            check_record_size(size_bytes)
+        except SessionRecordError as exc:
+            self._refuse_record(filename or "The file", exc)
 
     # ------------------------------------------------------------ library and motion
     def refresh_library(self, tools: dict[int, Tool] | None = None) -> None:
