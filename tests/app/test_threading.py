@@ -144,8 +144,7 @@ def test_a_dragged_slider_is_not_echoed_but_a_jog_is_sent(app_factory) -> None:
         a1 = p.joint_sliders[0]
         b.set(a1, 10.004)
         wait_until(lambda: abs(math.degrees(s.controller.q_rad[0]) - 10.004) < 1e-9, what="A1 at 10.004")
-        b.click(p.increment)                              # settle: a message after the slider's
-        b.set(p.increment, "1")
+        b.set(p.increment, "1")                          # a message after the slider's: settled
         wait_until(lambda: s.jogger.settings.increment == "1", what="increment 1")
         time.sleep(0.2)
         assert b.values_of(a1) == []                      # nothing echoed
