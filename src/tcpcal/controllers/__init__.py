@@ -173,10 +173,20 @@ def import_poses(text: str, fmt: str = "auto", *, filename: str | None = None) -
     if based:
         warnings.append(f"{', '.join(based)} recorded in a base / user frame (not 0): record the "
                         "touches in WORLD (base 0)")
-    if name == "ur" and re.search(r"set_tcp\s*\(", text):
+    if name == "ur" and _ur_sets_a_tcp(text):
         warnings.append("the script sets a TCP: poses recorded with a TCP active are TCP poses, "
                         "not the flange; record the touches with the TCP at the flange")
     return PoseImport(name, poses, tuple(warnings))
+
+
+def _ur_sets_a_tcp(text: str) -> bool:
+    """The script sets a TCP other than the flange (``set_tcp(p[0, 0, 0, 0, 0, 0])`` is fine)."""
+    try:
+        tcps = ur.parse_tool(text)
+    except ControllerFileError:
+        return bool(re.search(r"set_tcp\s*\(", text))  # a TCP we cannot read: say so
+    return any(max(map(abs, t.tcp_mm)) > 0 or abs(t.rotation.trace() - 3.0) > 1e-12
+               for t in tcps)
 
 
 _CSV_HEADERS = {"kuka": "a,b,c", "fanuc": "w,p,r", "abb": "qw,qx,qy,qz", "rotvec": "rx,ry,rz"}

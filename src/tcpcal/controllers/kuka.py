@@ -34,7 +34,8 @@ _DATA = re.compile(r"TOOL_DATA\s*\[\s*(\d+)\s*\]\s*=\s*\{([^}]*)\}", re.IGNORECA
 _POSE = re.compile(r"(?:DECL\s+)?(?:GLOBAL\s+)?\b(E6POS|POS)\s+(\w+)\s*=\s*\{([^}]*)\}",
                    re.IGNORECASE)
 _FDAT = re.compile(r"FDAT\s+(\w+)\s*=\s*\{([^}]*)\}", re.IGNORECASE)
-_COMPONENT = re.compile(rf"^\s*([A-Z][\w\[\]]*)\s+({NUM}|'[^']*'|\"[^\"]*\"|#\w+)\s*$", re.IGNORECASE)
+_COMPONENT = re.compile(
+    rf"^\s*([A-Z][\w\[\]]*)\s+({NUM}|'[^']*'|\"[^\"]*\"|#\w+|[A-Za-z_]\w*)\s*$", re.IGNORECASE)
 
 
 def _code(text: str) -> str:
