@@ -26,18 +26,29 @@ Prints, and says for each target of issue 2 whether it is met:
    else). Targets: N = 4 < 100 us, N = 1000 < 1000 us.
 3. Median time of ``assess_touches`` and ``candidate_gain`` (the wizard calls them live) for
    N = 4 and N = 20. Target: well under 1 ms.
+4. Recorded tracker data (issue 8, item 6): ``solve_xyz4`` on 1e4, 1e5 and 1e6 touches and on
+   1e5 touches of which half repeat one orientation, each in its own subprocess (wall time of
+   the solve, peak RSS of the subprocess from its ``getrusage``), against
+   a baseline measured in the same run: the time to generate the touches in that process.
+   Targets: 1e6 touches < 10 s and < 2 GB peak RSS; the repeated orientation handled. Before
+   (O(N^2) angle figures and duplicate check, figures of the issue): 1e4 ~0.1 s, 1.6e5 75 s,
+   1e5 with a repeated orientation MemoryError (a 74.5 GiB allocation).
 
 Timings depend on the machine and on what else runs on it (the load average is printed):
 re-run when the machine is busy, and trust ratios measured in the same run.
 
-``--quick`` runs a tiny version (used by tests/tcpcal/test_bench_solver_runs.py).
+``--quick`` runs a tiny version (used by tests/tcpcal/test_bench_solver_runs.py; table 4 with
+1e4 touches and 1e4 with a repeated orientation only).
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import math
 import os
+import resource
+import subprocess
 import sys
 import time
 from collections.abc import Callable
@@ -58,6 +69,10 @@ TILTS = ((20.0, 50.0), (5.0, 15.0))
 EFFICIENCY_TARGET = 1.02
 TIME_TARGETS_US = {4: 100.0, 1000: 1000.0}
 POSE_QUALITY_TARGET_US = 1000.0
+LARGE_TARGET_S = 10.0
+LARGE_TARGET_RSS_MB = 2048.0
+LARGE_NS = (10_000, 100_000, 1_000_000)
+BEFORE_S = {10_000: "~0.1 s", 100_000: "~30 s (1.6e5: 75 s)", 1_000_000: "hours (O(N^2))"}
 
 
 QUICK = False
@@ -146,12 +161,55 @@ def pose_quality_timing(repeats: int) -> list[tuple[int, float, float]]:
     return out
 
 
+def large_case(n: int, repeated: bool) -> dict:
+    """One large solve (run in a subprocess by :func:`large_table`): touches leaning 20-50 deg,
+    0.5 mm noise; ``repeated``: every second touch has touch 0's orientation."""
+    rng = np.random.default_rng(n)
+    t0 = time.perf_counter()
+    rot = tilted_rotations(rng, n, (20.0, 50.0))
+    if repeated:
+        rot[::2] = rot[0]
+    pos = touch_positions(rot, random_tcp(rng, (100.0, 300.0)), np.array([800.0, 0, 300]), rng, SIGMA)
+    gen = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    try:
+        res = solve_xyz4(rot, pos)
+        outcome = (f"TCP found, {len(res.outliers)} outliers, min angle {res.min_angle_deg:.3f} deg, "
+                   f"max {'' if res.max_angle_exact else '>= '}{res.max_angle_deg:.2f} deg")
+    except DegenerateTouchesError as exc:
+        outcome = f"DegenerateTouchesError: {str(exc)[:60]}..."
+    return {"solve_s": time.perf_counter() - t0, "gen_s": gen, "outcome": outcome,
+            "rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0}  # kB on Linux
+
+
+def large_table(ns: tuple[int, ...], repeated_n: int) -> list[tuple[str, int, dict, float]]:
+    """Each case in a fresh subprocess, which reports its solve time and its own peak RSS (MB,
+    ``getrusage(RUSAGE_SELF).ru_maxrss``: the whole process, interpreter and touches included)."""
+    out = []
+    cases = [(f"{n:,} touches", n, False) for n in ns] + [(f"{repeated_n:,}, half repeated", repeated_n, True)]
+    for label, n, rep_ in cases:
+        proc = subprocess.run([sys.executable, __file__, "--large-case", str(n), *(["--repeated"] if rep_ else [])],
+                              capture_output=True, text=True, check=False)
+        if proc.returncode != 0:
+            row = {"solve_s": math.nan, "gen_s": math.nan, "rss_mb": math.nan,
+                   "outcome": f"FAILED: {proc.stderr.strip()[-200:]}"}
+        else:
+            row = json.loads(proc.stdout.strip().splitlines()[-1])
+        out.append((label, n, row, row["rss_mb"]))
+    return out
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="tiny run (smoke test)")
     ap.add_argument("--sets", type=int, default=None, help="random sets per row (default 2000)")
     ap.add_argument("--draws", type=int, default=None, help="noise draws per set (default 5)")
+    ap.add_argument("--large-case", type=int, default=None, help=argparse.SUPPRESS)
+    ap.add_argument("--repeated", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
+    if args.large_case is not None:  # one case of table 4, in its own process
+        print(json.dumps(large_case(args.large_case, args.repeated)))
+        return 0
     global QUICK
     QUICK = args.quick
     n_sets = args.sets or (20 if args.quick else 2000)
@@ -204,6 +262,25 @@ def main(argv: list[str] | None = None) -> int:
         ok = max(a_us, c_us) < POSE_QUALITY_TARGET_US
         print(f"   N = {n:2d}   assess_touches {a_us:8.1f}    candidate_gain {c_us:8.1f}    "
               f"{verdict(ok)}")
+    print()
+    ns = LARGE_NS[:1] if QUICK else LARGE_NS
+    rep_n = 10_000 if QUICK else 100_000
+    print(f"4. recorded tracker data: solve_xyz4 on many touches, each case in its own process "
+          f"(targets: 1e6 < {LARGE_TARGET_S:.0f} s and < {LARGE_TARGET_RSS_MB:.0f} MB peak RSS)")
+    hdr = (f"{'case':>22} {'solve s':>8} {'make touches s':>15} {'peak RSS MB':>12} "
+           f"{'before (issue 8)':>20}  outcome / target")
+    print(hdr)
+    print("-" * len(hdr))
+    for label, n, row, rss in large_table(ns, rep_n):
+        before = BEFORE_S.get(n, "") if "repeated" not in label else "1e5: MemoryError"
+        tgt = ""
+        if n == 1_000_000:
+            tgt = f"  {verdict(row['solve_s'] < LARGE_TARGET_S and rss < LARGE_TARGET_RSS_MB)}"
+        print(f"{label:>22} {row['solve_s']:8.2f} {row['gen_s']:15.2f} {rss:12.0f} {before:>20}  "
+              f"{row['outcome']}{tgt}")
+    print("   Angle figures above 2048 touches: smallest exact (nearest neighbour of quaternions),")
+    print("   largest exact when bound-and-prune leaves <= 2048 candidates, else marked as an estimate")
+    print("   ('>=' above; max_angle_exact false in the result). Memory O(N), never N x N.")
     return 0
 
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -20,3 +21,13 @@ def test_bench_solver_quick_runs() -> None:
     rows = [line.split() for line in text.splitlines() if line.strip().startswith(("20-50", "5-15"))]
     assert len(rows) == 6
     assert all(0.2 < float(r[3]) < 5.0 for r in rows)
+    # table 4 (issue 8 item 6): large touch sets, quick run = 10,000 touches and 10,000 with a
+    # repeated orientation, each solved (not a MemoryError) with a time and a peak RSS
+    assert "recorded tracker data" in text
+    large = [re.match(r"\s*10,000(?: touches|, half repeated)\s+([\d.]+)\s+([\d.]+)\s+(\d+)\s", line)
+             for line in text.splitlines() if line.strip().startswith("10,000")]
+    assert len(large) == 2 and all(large), text
+    assert text.count("TCP found") == 2
+    for m in large:
+        assert 0.0 < float(m.group(1)) < 60.0  # solve seconds
+        assert 10 < int(m.group(3)) < 2048  # peak RSS, MB
