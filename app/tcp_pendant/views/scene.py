@@ -239,7 +239,7 @@ class SceneView:
         self.flange_path = self.link_paths[self.flange_link]
         fl = self.flange_path
         scene.add_frame(f"{fl}/flange_axes", axes_length=0.09, axes_radius=0.004)
-        scene.add_label(f"{fl}/flange_axes/label", "FLANGE", position=(0.0, 0.05, 0.0))
+        self._flange_label = scene.add_label(f"{fl}/flange_axes/label", "FLANGE", position=(0.0, 0.05, 0.0))
         self._tool_root = f"{fl}/tool"
         self._tool_frame: Any = None
         self.set_mounted_tool(c.mounted_tool)
@@ -310,6 +310,11 @@ class SceneView:
         self._tip_frame.wxyz = wxyz
         self._tip_frame.position = xyz
         self._tip_label.position = tuple(c.reference_tip_world_m + [0.0, 0.0, -0.06])
+
+    def tool_labels(self) -> dict[str, Any]:
+        """The labels at the tool and the tip: FLANGE (in the flange frame), TOOL (in the active
+        TOOL frame), "reference tip" (WORLD); the wizards' scene places them apart after a result."""
+        return {"flange": self._flange_label, "tool": self._active_label, "tip": self._tip_label}
 
     # ------------------------------------------------------------ camera
     def look_at_tip(self, client: Any) -> None:

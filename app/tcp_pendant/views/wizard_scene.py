@@ -14,6 +14,12 @@
 Scene units are metres (the wizards' results are in mm and converted here). Axis colours are
 viser's: X red, Y green, Z blue.
 
+After a new result (Finish, a recomputation, a resumed or loaded result) the camera of the
+session's browser(s) is framed on it (``views.framing``: the fitted sphere, the flange
+positions, the TOOL triads, the flange and the reference tip fill the view) and the labels
+near the tip (COMPUTED, TRUE, TOOL, FLANGE, "reference tip") are moved apart as seen from that
+camera; they go back to their places when the result is gone.
+
 The two TOOL triads are posed in WORLD (``T_world_flange @ T_flange_tool``) after every move,
 like the TCP gizmo, rather than hung under the flange's scene node: in the browser, nodes
 created hidden under the flange node were seen (once in several runs) drawn with their labels
@@ -22,18 +28,23 @@ at the WORLD origin, not at the tool. Their labels are shown and hidden with the
 
 from __future__ import annotations
 
+import logging
+import math
 from typing import Any
 
 import numpy as np
 
 from tcp_pendant.calibrate import CalibrationWorkflow
 from tcp_pendant.session import Session
+from tcp_pendant.views.framing import Framing, frame_spheres, spread_labels
 from tcp_pendant.views.scene import wxyz_xyz
 from tcp_pendant.wizards import AbcWorldWizard, Xyz4Result
 
 __all__ = ["WizardSceneView"]
 
+log = logging.getLogger(__name__)
 MM_TO_M = 1e-3
+_LABEL_TEXTS = {"computed": "COMPUTED", "true": "TRUE", "tool": "TOOL", "tip": "reference tip", "flange": "FLANGE"}
 _POINT_RGB = np.array([30, 30, 30], dtype=np.uint8)
 _OUTLIER_RGB = np.array([220, 30, 30], dtype=np.uint8)
 _DROPPED_RGB = np.array([170, 170, 170], dtype=np.uint8)
@@ -68,6 +79,10 @@ class WizardSceneView:
         self._shown_result: Any = None
         self._T_flange_computed: np.ndarray | None = None
         self._T_flange_true: np.ndarray | None = None
+        self.last_framing: Framing | None = None
+        """The camera framing of the last result (None before one), for tests."""
+        self._label_defaults: dict[str, tuple[Any, tuple[float, float, float]]] = {}
+        self._labels_moved = False
 
     # ------------------------------------------------------------ result
     def render(self) -> None:
@@ -79,6 +94,10 @@ class WizardSceneView:
         if res is not self._shown_result:
             self._shown_result = res
             self._show_sphere(res if isinstance(res, Xyz4Result) else None)
+            if res is None:
+                self._restore_labels()
+            else:
+                self.frame_result()
         self.on_motion()
 
     @property
@@ -132,6 +151,110 @@ class WizardSceneView:
                                         _OUTLIER_RGB, _APPROACH_RGB)[:, None, :], 2, axis=1)
         self._lines = self.scene.add_line_segments("/calibration/approach", points=segs, colors=seg_colors,
                                                    thickness=0.003)
+
+    # ------------------------------------------------------------ camera and labels
+    def _label_nodes(self) -> dict[str, tuple[Any, np.ndarray | None]]:
+        """Label name -> (handle, T_world_parent now; None: the label is in WORLD), visible ones."""
+        T_wf = self.session.pose_state().T_world_flange
+        out: dict[str, tuple[Any, np.ndarray | None]] = {}
+        if self._T_flange_computed is not None:
+            out["computed"] = (self.computed_label, T_wf @ self._T_flange_computed)
+        if self._T_flange_true is not None:
+            out["true"] = (self.true_label, T_wf @ self._T_flange_true)
+        scene_view = self.session.views.get("scene")
+        others = scene_view.tool_labels() if hasattr(scene_view, "tool_labels") else {}
+        if "tool" in others and self.session.controller.active_tool is not None:
+            out["tool"] = (others["tool"], T_wf @ np.asarray(self.session.controller.T_flange_tool, dtype=float))
+        if "tip" in others:
+            out["tip"] = (others["tip"], None)
+        if "flange" in others:
+            out["flange"] = (others["flange"], T_wf)
+        for name, (handle, _) in out.items():
+            if name not in self._label_defaults:
+                self._label_defaults[name] = (handle, tuple(float(v) for v in np.asarray(handle.position)))
+        return out
+
+    def _restore_labels(self) -> None:
+        if not self._labels_moved:
+            return
+        for name, (handle, position) in self._label_defaults.items():
+            if name == "tip":           # the scene view re-places it when the tip moves
+                position = tuple(np.asarray(self.session.controller.reference_tip_world_m) + [0.0, 0.0, -0.06])
+            handle.position = position
+        self._labels_moved = False
+
+    def _framed_geometry(self) -> tuple[np.ndarray, np.ndarray]:
+        """(centres, radii) in WORLD m: the sphere and flange positions of a 4-point result,
+        the TOOL triads (their axis lengths), the flange and the reference tip."""
+        T_wf = self.session.pose_state().T_world_flange
+        centres = [T_wf[:3, 3], np.asarray(self.session.controller.reference_tip_world_m, dtype=float)]
+        radii = [0.09, 0.02]
+        for T, length in ((self._T_flange_computed, 0.10), (self._T_flange_true, 0.16)):
+            if T is not None:
+                centres.append((T_wf @ T)[:3, 3])
+                radii.append(length)
+        res = self._shown_result
+        if isinstance(res, Xyz4Result):
+            centres.append(np.asarray(res.sphere_centre_mm, dtype=float) * MM_TO_M)
+            radii.append(float(res.sphere_radius_mm) * MM_TO_M)
+            f_m = np.asarray(res.flange_positions_mm, dtype=float).reshape(-1, 3) * MM_TO_M
+            centres.extend(f_m)
+            radii.extend([0.012] * len(f_m))
+        return np.array(centres, dtype=float), np.array(radii, dtype=float)
+
+    def _clients(self) -> list[Any]:
+        s = self.session
+        if s.client is not None:
+            return [s.client]
+        get = getattr(s.target, "get_clients", None)
+        return list(get().values()) if callable(get) else []
+
+    @staticmethod
+    def _camera_shape(client: Any) -> tuple[float, float, float]:
+        """(fov rad, aspect, image height px) of a browser's camera; defaults before it reported."""
+        try:
+            cam = client.camera
+            fov, aspect, height = float(cam.fov), float(cam.aspect), float(cam.image_height)
+        except Exception:                    # no camera message from that browser yet
+            return math.radians(50.0), 16.0 / 9.0, 720.0
+        return fov, aspect, height
+
+    def frame_result(self) -> Framing | None:
+        """Frame every browser's camera on the result and move the labels near the tip apart
+        as seen from the (first) framed camera. Returns that framing (None: nothing to frame)."""
+        centres, radii = self._framed_geometry()
+        if not np.all(np.isfinite(centres)) or not np.all(np.isfinite(radii)):
+            return None
+        clients = self._clients()
+        framings = [frame_spheres(centres, radii, fov_rad=fov, aspect=aspect, image_height_px=height)
+                    for fov, aspect, height in (self._camera_shape(c) for c in clients)]
+        framing = framings[0] if framings else frame_spheres(centres, radii)
+        for client, f in zip(clients, framings):
+            try:
+                with client.atomic():        # position first: its setter shifts look_at
+                    client.camera.position = f.position
+                    client.camera.look_at = f.look_at
+            except Exception:                # a browser that left, or has not sent its camera yet
+                log.debug("camera of a client not framed", exc_info=True)
+        self._place_labels(framing)
+        self.last_framing = framing
+        return framing
+
+    def _place_labels(self, framing: Framing) -> None:
+        nodes = self._label_nodes()
+        anchors: dict[str, np.ndarray] = {}
+        for name, (_, T) in nodes.items():
+            local = np.asarray(self._label_defaults[name][1], dtype=float)
+            if name == "tip":
+                local = np.asarray(self.session.controller.reference_tip_world_m, dtype=float) + [0.0, 0.0, -0.06]
+            anchors[name] = local if T is None else T[:3, :3] @ local + T[:3, 3]
+        texts = {n: str(getattr(nodes[n][0], "text", None) or _LABEL_TEXTS[n]) for n in anchors}
+        placed = spread_labels(framing, anchors, texts)
+        for name, world in placed.items():
+            handle, T = nodes[name]
+            local = world if T is None else T[:3, :3].T @ (world - T[:3, 3])
+            handle.position = tuple(float(v) for v in local)
+        self._labels_moved = True
 
     # ------------------------------------------------------------ live (on every move)
     def update_abc_target(self, T_world_flange: np.ndarray) -> None:

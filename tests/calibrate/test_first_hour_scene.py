@@ -1,0 +1,135 @@
+"""Issue 13 ("Using it"): after Finish the camera is framed on the result (the fitted sphere,
+the flange positions, the frames) and the labels at the tip (COMPUTED, TRUE, TOOL, FLANGE,
+"reference tip") are placed apart so they can be read."""
+
+from __future__ import annotations
+
+import math
+import sys
+from itertools import combinations
+from pathlib import Path
+
+import numpy as np
+import pytest
+from tcp_pendant.views.framing import (
+    LABEL_HEIGHT_PX,
+    bounding_sphere,
+    frame_spheres,
+    label_box_px,
+    spread_labels,
+)
+
+sys.path.insert(0, str(Path(__file__).parent))
+
+
+def sphere_surface(c: np.ndarray, r: float, n: int = 200) -> np.ndarray:
+    rng = np.random.default_rng(0)
+    v = rng.normal(size=(n, 3))
+    return c + r * v / np.linalg.norm(v, axis=1)[:, None]
+
+
+def test_bounding_sphere_contains_every_sphere() -> None:
+    centres = np.array([[0.5, 0.0, 0.2], [0.7, 0.1, 0.3], [0.6, -0.2, 0.1]])
+    radii = np.array([0.18, 0.0, 0.05])
+    c, r = bounding_sphere(centres, radii)
+    assert np.all(np.linalg.norm(centres - c, axis=1) + radii <= r + 1e-12)
+    with pytest.raises(ValueError, match="finite point"):
+        bounding_sphere(np.array([[np.nan, 0, 0]]))
+
+
+@pytest.mark.parametrize("fov_deg,aspect", [(50.0, 16 / 9), (57.3, 1280 / 720), (75.0, 0.6)])
+def test_framing_shows_the_whole_sphere_and_fills_the_view(fov_deg, aspect) -> None:
+    centre, radius = np.array([0.62, 0.05, 0.25]), 0.18            # a 4-point sphere, 180 mm
+    flanges = sphere_surface(centre, radius, 6)
+    f = frame_spheres(np.vstack([centre, flanges]), [radius] + [0.012] * 6,
+                      fov_rad=math.radians(fov_deg), aspect=aspect, image_height_px=720)
+    xy, depth = f.project(sphere_surface(centre, radius, 2000))
+    half_h, half_w = 360.0, 360.0 * aspect
+    assert np.all(depth > 0)
+    assert np.all(np.abs(xy[:, 0]) <= half_w) and np.all(np.abs(xy[:, 1]) <= half_h)   # not cut off
+    # ... and not tiny: the sphere spans at least 60 % of the narrower side of the view
+    extent = max(np.ptp(xy[:, 0]) / (2 * half_w), np.ptp(xy[:, 1]) / (2 * half_h))
+    assert extent > 0.6
+    np.testing.assert_allclose(f.look_at, f.centre)
+
+
+def test_overlapping_labels_are_moved_apart_on_screen() -> None:
+    f = frame_spheres(np.array([[0.6, 0.0, 0.2]]), [0.2], fov_rad=1.0, image_height_px=720)
+    tip = np.array([0.6, 0.0, 0.2])
+    anchors = {"computed": tip + [0, 0, -0.001], "true": tip + [0.002, 0, 0], "tool": tip + [0, 0, 0.003],
+               "tip": tip + [0, 0, -0.004], "flange": tip + [0, 0, 0.12]}
+    texts = {"computed": "COMPUTED", "true": "TRUE", "tool": "TOOL Pen 4P", "tip": "reference tip",
+             "flange": "FLANGE"}
+    placed = spread_labels(f, anchors, texts)
+    assert list(placed) == list(anchors)
+    np.testing.assert_allclose(placed["computed"], anchors["computed"])       # the first stays
+    xy, depth = f.project(np.array(list(placed.values())))
+    names = list(placed)
+    for (i, a), (j, b) in combinations(enumerate(names), 2):
+        wa, h = label_box_px(texts[a])
+        wb, _ = label_box_px(texts[b])
+        apart_x = xy[i, 0] >= xy[j, 0] + wb or xy[j, 0] >= xy[i, 0] + wa
+        apart_y = abs(xy[i, 1] - xy[j, 1]) >= h
+        assert apart_x or apart_y, (a, b)
+        if not apart_x:                         # stacked: at least a label's height apart in WORLD
+            mm = 1000 * np.linalg.norm(placed[a] - placed[b])
+            assert mm >= 1000 * LABEL_HEIGHT_PX * f.metres_per_px(min(depth[i], depth[j])) * 0.99
+    # the labels moved only up the screen (same depth, same screen x)
+    _, _, up = f.basis()
+    for n in names:
+        d = placed[n] - anchors[n]
+        assert np.linalg.norm(d - up * (d @ up)) < 1e-9 and d @ up >= 0
+
+
+def test_labels_already_apart_stay_where_they_are() -> None:
+    f = frame_spheres(np.array([[0.6, 0.0, 0.2]]), [0.2], fov_rad=1.0, image_height_px=720)
+    anchors = {"a": np.array([0.6, 0.0, 0.35]), "b": np.array([0.6, 0.0, 0.05])}
+    placed = spread_labels(f, anchors, {"a": "COMPUTED", "b": "TRUE"})
+    for n in anchors:
+        np.testing.assert_allclose(placed[n], anchors[n])
+
+
+def test_finish_frames_the_camera_and_spreads_the_labels(page) -> None:
+    p = page()
+    v, s = p.view, p.session
+    cam_before = np.array(p.client.camera.position)
+    p.click(v.start)
+    for _ in range(4):
+        p.click(v.steps.auto_touch)                  # the 4th one finishes
+    res = v.workflow.result
+    f = v.scene.last_framing
+    assert res is not None and f is not None
+    # the camera of the browser was framed on the result
+    np.testing.assert_allclose(p.client.camera.look_at, f.look_at, atol=1e-6)
+    np.testing.assert_allclose(p.client.camera.position, f.position, atol=1e-6)
+    assert not np.allclose(cam_before, f.position)
+    # the framing holds the fitted sphere and every flange position
+    centre = np.asarray(res.sphere_centre_mm) / 1000
+    r = res.sphere_radius_mm / 1000
+    assert np.linalg.norm(centre - f.centre) + r <= f.radius_m + 1e-9
+    flanges = np.asarray(res.flange_positions_mm) / 1000
+    assert np.all(np.linalg.norm(flanges - f.centre, axis=1) <= f.radius_m + 1e-9)
+    assert f.fov_rad == pytest.approx(1.0) and f.image_height_px == 720     # the browser's camera
+    # labels of the tip cluster, in WORLD, as placed: no two boxes overlap on screen
+    T_wf = s.pose_state().T_world_flange
+    labels = {"COMPUTED": (v.scene.computed_label, T_wf @ v.workflow.T_flange_tool_computed_m()),
+              "TRUE": (v.scene.true_label, T_wf @ v.workflow.T_flange_tool_true_m())}
+    others = s.views["scene"].tool_labels()
+    labels[others["tool"].text] = (others["tool"], T_wf @ s.controller.T_flange_tool)
+    labels["reference tip"] = (others["tip"], np.eye(4))
+    labels["FLANGE"] = (others["flange"], T_wf)
+    world = {t: T[:3, :3] @ np.asarray(h.position) + T[:3, 3] for t, (h, T) in labels.items()}
+    xy, _ = f.project(np.array(list(world.values())))
+    texts = list(world)
+    for i, j in combinations(range(len(texts)), 2):
+        wa, h = label_box_px(texts[i])
+        wb, _ = label_box_px(texts[j])
+        assert (xy[i, 0] >= xy[j, 0] + wb or xy[j, 0] >= xy[i, 0] + wa
+                or abs(xy[i, 1] - xy[j, 1]) >= h - 1e-6), (texts[i], texts[j])
+    # closing the result puts the labels back where they were
+    p.click(v.steps.cancel)
+    assert tuple(v.scene.computed_label.position) == pytest.approx((0.0, 0.0, -0.03))
+    assert tuple(others["tool"].position) == pytest.approx((0.0, 0.0, 0.04))
+
+
+from test_calibrate_view import page  # noqa: E402,F401  (the in-process browser fixture)
