@@ -60,6 +60,8 @@ def _jsonable(obj: Any) -> Any:
     if isinstance(obj, Mapping):
         return {str(k): _jsonable(v) for k, v in obj.items()}
     if isinstance(obj, np.ndarray):
+        if obj.dtype.kind in "biu" or (obj.dtype.kind == "f" and bool(np.isfinite(obj).all())):
+            return obj.tolist()  # plain Python numbers already (one call for 1e6 residuals)
         return _jsonable(obj.tolist())
     if isinstance(obj, (list, tuple)):
         return [_jsonable(v) for v in obj]
