@@ -40,6 +40,10 @@ def build_parser() -> argparse.ArgumentParser:
                    help="tool library JSON file (default: the user's data directory)")
     p.add_argument("--shared", action="store_true",
                    help="one robot that every browser sees and drives (lecture demo)")
+    p.add_argument("--allow-origin", action="append", default=[], metavar="ORIGIN",
+                   help="also accept browsers on pages from ORIGIN (scheme://host[:port]; repeatable or "
+                        "comma-separated), e.g. a reverse proxy's address; pages from any other web "
+                        "site are refused")
     p.add_argument("--reference-tip", default=None, metavar="X,Y,Z",
                    help="reference tip position in WORLD, mm (default: below the home flange at half "
                         "its height, e.g. 525,0,445 on the KR 6)")
@@ -105,7 +109,7 @@ def _main(argv: Sequence[str] | None) -> int:
         tip = None if args.reference_tip is None else parse_xyz_mm(args.reference_tip)
         config = AppConfig(robot=args.robot, flange_link=args.flange_link, tool=args.tool, host=args.host,
                            port=args.port, tool_library=args.tool_library, shared=args.shared,
-                           reference_tip_mm=tip)
+                           reference_tip_mm=tip, allow_origins=tuple(args.allow_origin))
         app = PendantApp(config)
     except (ControllerError, ValueError, OSError) as exc:
         print(f"tcp-pendant: error: {exc}", file=sys.stderr)

@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from tcpcal.library import ToolLibrary
+from tcp_pendant import origin_check
 from tcp_pendant.addresses import network_urls
 from tcp_pendant.controller import (
     ControllerError,
@@ -59,6 +60,8 @@ class AppConfig:
         shared: one robot for every browser.
         reference_tip_mm: reference tip in WORLD, mm (None: :func:`default_reference_tip_mm`).
         library_poll_s: how often the library file is checked for changes by others.
+        allow_origins: web origins (``scheme://host[:port]``) whose pages may connect besides
+            the pendant's own address, e.g. a reverse proxy's (``tcp_pendant.origin_check``).
     """
 
     robot: str = "kr6"
@@ -70,6 +73,7 @@ class AppConfig:
     shared: bool = False
     reference_tip_mm: tuple[float, float, float] | None = None
     library_poll_s: float = 1.0
+    allow_origins: tuple[str, ...] = ()
 
 
 class PortInUseError(OSError):
@@ -203,6 +207,7 @@ class PendantApp:
             raise ControllerError(f"Reference tip must be 3 finite numbers X,Y,Z in mm, got {tip!r}.")
         self.reference_tip_m = tip_m
         self.ready_q_rad = ready_configuration(self.kinematics, tip_m)
+        self.allow_origins = origin_check.parse_allow_origins(config.allow_origins)
         self.library = ToolLibrary(config.tool_library)
         self.robot_label = ROBOT_LABELS.get(config.robot, urdf.stem)
         self.server: Any = None
@@ -327,7 +332,9 @@ class PendantApp:
         import viser
 
         host = self.config.host
+        origin_check.enable()               # foreign web pages' websockets are refused (403)
         self.server = viser.ViserServer(host=host, port=self.config.port, verbose=False)
+        origin_check.allow(self.port, self.allow_origins)
         if self.config.port != 0 and self.port != self.config.port:
             # viser silently moves on to the next free port; the class was told this one
             self.server.stop()
@@ -378,6 +385,7 @@ class PendantApp:
             self.sessions.clear()
         self.shared_session = None
         if self.server is not None:
+            origin_check.forget(self.port)
             self.server.stop()
 
     def serve_forever(self, poll_s: float = 0.5) -> None:
