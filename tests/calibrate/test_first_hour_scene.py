@@ -133,3 +133,47 @@ def test_finish_frames_the_camera_and_spreads_the_labels(page) -> None:
 
 
 from test_calibrate_view import page  # noqa: E402,F401  (the in-process browser fixture)
+
+
+def _boxes_apart(f, world: dict[str, np.ndarray]) -> list[tuple[str, str]]:
+    xy, _ = f.project(np.array(list(world.values())))
+    texts = list(world)
+    clashes = []
+    for i, j in combinations(range(len(texts)), 2):
+        wa, h = label_box_px(texts[i])
+        wb, _ = label_box_px(texts[j])
+        if not (xy[i, 0] >= xy[j, 0] + wb or xy[j, 0] >= xy[i, 0] + wa or abs(xy[i, 1] - xy[j, 1]) >= h - 1e-6):
+            clashes.append((texts[i], texts[j]))
+    return clashes
+
+
+def test_abc_world_target_tool_and_tip_labels_do_not_collide(page, tmp_path) -> None:
+    from calib_helpers import library_tool_with_true_tcp
+    from tcp_pendant.views.wizard_scene import WizardSceneView
+
+    p = page()
+    v, s = p.view, p.session
+    s.library.save(2, library_tool_with_true_tcp("pointer", "Pen"))
+    v.refresh_library()
+    p.choose(v.method, "ABC world (parallel axes)")
+    p.click(v.start)
+    with s.lock:                                     # the trainee jogs the tip onto the reference tip
+        assert s.controller.auto_approach(tilt_deg=0.0, azimuth_deg=0.0).ok
+        s.moved()
+    assert v.scene.abc_label.visible
+    f = WizardSceneView._camera_framing(p.client)    # the browser's camera as reported
+    assert f is not None
+    T_wf = s.pose_state().T_world_flange
+    others = s.views["scene"].tool_labels()
+    T_target = v.scene.abc_target
+    from scipy.spatial.transform import Rotation
+    R_t = Rotation.from_quat(np.roll(np.asarray(T_target.wxyz), -1)).as_matrix()
+    world = {
+        "TARGET (X down)": R_t @ np.asarray(v.scene.abc_label.position) + np.asarray(T_target.position),
+        others["tool"].text: (T_wf @ s.controller.T_flange_tool)[:3, :3] @ np.asarray(others["tool"].position)
+        + (T_wf @ s.controller.T_flange_tool)[:3, 3],
+        "reference tip": np.asarray(others["tip"].position),
+        "FLANGE": T_wf[:3, :3] @ np.asarray(others["flange"].position) + T_wf[:3, 3],
+    }
+    assert others["tool"].text == "TOOL Pen"
+    assert _boxes_apart(f, world) == []

@@ -44,7 +44,8 @@ __all__ = ["WizardSceneView"]
 
 log = logging.getLogger(__name__)
 MM_TO_M = 1e-3
-_LABEL_TEXTS = {"computed": "COMPUTED", "true": "TRUE", "tool": "TOOL", "tip": "reference tip", "flange": "FLANGE"}
+_LABEL_TEXTS = {"computed": "COMPUTED", "true": "TRUE", "target": "TARGET (X down)", "tool": "TOOL",
+                "tip": "reference tip", "flange": "FLANGE"}
 _POINT_RGB = np.array([30, 30, 30], dtype=np.uint8)
 _OUTLIER_RGB = np.array([220, 30, 30], dtype=np.uint8)
 _DROPPED_RGB = np.array([170, 170, 170], dtype=np.uint8)
@@ -83,6 +84,7 @@ class WizardSceneView:
         """The camera framing of the last result (None before one), for tests."""
         self._label_defaults: dict[str, tuple[Any, tuple[float, float, float]]] = {}
         self._labels_moved = False
+        self._target_T: np.ndarray | None = None
 
     # ------------------------------------------------------------ result
     def render(self) -> None:
@@ -94,11 +96,13 @@ class WizardSceneView:
         if res is not self._shown_result:
             self._shown_result = res
             self._show_sphere(res if isinstance(res, Xyz4Result) else None)
-            if res is None:
-                self._restore_labels()
-            else:
+            if res is not None:
                 self.frame_result()
         self.on_motion()
+        if self.workflow.is_open or res is not None:
+            self.layout_labels()
+        else:
+            self._restore_labels()
 
     @property
     def showing(self) -> bool:
@@ -112,6 +116,8 @@ class WizardSceneView:
                                 (self.true_tool, self.true_label, self._T_flange_true)):
             self._pose(frame, label, None if T is None else T_world_flange @ T)
         self.update_abc_target(T_world_flange)
+        if self._target_T is not None:      # ABC world: TARGET, TOOL and the tip cluster at the TCP
+            self.layout_labels()
 
     @staticmethod
     def _pose(handle: Any, label: Any, T: np.ndarray | None) -> None:
@@ -169,6 +175,8 @@ class WizardSceneView:
             out["tip"] = (others["tip"], None)
         if "flange" in others:
             out["flange"] = (others["flange"], T_wf)
+        if self._target_T is not None:
+            out["target"] = (self.abc_label, self._target_T)
         for name, (handle, _) in out.items():
             if name not in self._label_defaults:
                 self._label_defaults[name] = (handle, tuple(float(v) for v in np.asarray(handle.position)))
@@ -236,9 +244,35 @@ class WizardSceneView:
                     client.camera.look_at = f.look_at
             except Exception:                # a browser that left, or has not sent its camera yet
                 log.debug("camera of a client not framed", exc_info=True)
-        self._place_labels(framing)
         self.last_framing = framing
         return framing
+
+    @staticmethod
+    def _camera_framing(client: Any) -> Framing | None:
+        """The browser's camera as it is now (None before it reported one)."""
+        try:
+            cam = client.camera
+            position = np.asarray(cam.position, dtype=float)
+            look_at = np.asarray(cam.look_at, dtype=float)
+            fov, aspect, height = float(cam.fov), float(cam.aspect), float(cam.image_height)
+        except Exception:
+            return None
+        distance = float(np.linalg.norm(look_at - position))
+        if not (np.all(np.isfinite(position)) and np.all(np.isfinite(look_at)) and distance > 1e-6
+                and math.isfinite(fov) and 0.05 < fov < 3.0 and math.isfinite(aspect) and aspect > 0.05
+                and math.isfinite(height) and height > 50):
+            return None
+        return Framing(position=position, look_at=look_at, centre=look_at, radius_m=0.0, distance_m=distance,
+                       fov_rad=fov, aspect=aspect, image_height_px=height)
+
+    def layout_labels(self) -> None:
+        """Move the labels at the tip apart as seen by the (first) browser's camera now, or by
+        the last result's framing when no camera has been reported."""
+        clients = self._clients()
+        framing = self._camera_framing(clients[0]) if clients else None
+        framing = framing or self.last_framing
+        if framing is not None:
+            self._place_labels(framing)
 
     def _place_labels(self, framing: Framing) -> None:
         nodes = self._label_nodes()
@@ -253,7 +287,8 @@ class WizardSceneView:
         for name, world in placed.items():
             handle, T = nodes[name]
             local = world if T is None else T[:3, :3].T @ (world - T[:3, 3])
-            handle.position = tuple(float(v) for v in local)
+            if not np.allclose(np.asarray(handle.position, dtype=float), local, rtol=0.0, atol=1e-7):
+                handle.position = tuple(float(v) for v in local)    # only changes are sent
         self._labels_moved = True
 
     # ------------------------------------------------------------ live (on every move)
@@ -261,5 +296,5 @@ class WizardSceneView:
         """Place the (PA-1) target triad at the TCP while an ABC world wizard is open."""
         wiz = self.workflow.wizard
         open_abc = isinstance(wiz, AbcWorldWizard) and wiz.status == "in_progress"
-        self._pose(self.abc_target, self.abc_label,
-                   wiz.target_T_world_tool_m(T_world_flange) if open_abc else None)  # type: ignore[union-attr]
+        self._target_T = wiz.target_T_world_tool_m(T_world_flange) if open_abc else None  # type: ignore[union-attr]
+        self._pose(self.abc_target, self.abc_label, self._target_T)
