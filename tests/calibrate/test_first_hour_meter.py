@@ -128,3 +128,33 @@ def test_the_meter_in_the_app_speaks_of_touch_1_after_one_touch(tmp_path) -> Non
         if p is not None:
             p.ws.close()
         app.stop()
+
+
+def test_finish_failure_says_the_shared_axis_in_words(workflow) -> None:
+    """Four touches turned about the vertical only: tcpcal's "(flange [..])" becomes words."""
+    from tcp_pendant.calibrate import AutoTouchRequest
+    from tcp_pendant.wizards import CalibrationFailedError
+
+    wf = workflow()
+    wiz = wf.start_xyz4()
+    for azimuth in (0.0, 90.0, 180.0):
+        assert wf.auto_touch(AutoTouchRequest(tilt_deg=30.0, azimuth_deg=azimuth)).ok
+    with pytest.raises(CalibrationFailedError) as info:
+        wf.auto_touch(AutoTouchRequest(tilt_deg=30.0, azimuth_deg=270.0))
+    text = str(info.value)
+    assert "flange [" not in text and text.startswith("All touches rotate about nearly the same axis")
+    assert "In words: the touches differ only by a turn about the vertical (WORLD Z)." in text
+    assert "Still missing: tilt the tool about a horizontal axis (lean it sideways)." in text
+    assert info.value.cause is not None and info.value.cause.unobservable_axis is not None
+    with pytest.raises(CalibrationFailedError, match="In words"):      # Finish clicked again
+        wf.next()
+    assert wiz.status == "in_progress" and wf.result is None
+
+
+def test_failure_in_words_keeps_other_messages_readable() -> None:
+    from tcp_pendant.calibrate.diversity import failure_in_words
+
+    msg = "all touches rotate about nearly the same axis (flange [0.00, 1.00, 0.00]), so the TCP cannot"
+    out = failure_in_words(msg, (0, 1, 0), R_DOWN)
+    assert out.startswith("All touches rotate about nearly the same axis, so the TCP cannot.")
+    assert "along WORLD Y" in out and "[" not in out

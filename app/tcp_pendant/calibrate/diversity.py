@@ -16,6 +16,7 @@ Angles in degrees; rotations are ``R_world_flange`` (3x3), as the wizard records
 from __future__ import annotations
 
 import math
+import re
 from typing import Any
 
 import numpy as np
@@ -23,7 +24,7 @@ from scipy.spatial.transform import Rotation
 
 from tcpcal.pose_quality import assess_touches
 
-__all__ = ["MIN_TILT_DEG", "axis_in_words", "diversity_advice", "missing_axis_in_words"]
+__all__ = ["MIN_TILT_DEG", "axis_in_words", "diversity_advice", "failure_in_words", "missing_axis_in_words"]
 
 MIN_TILT_DEG = 30.0
 """The tilt asked for between touches (tcpcal's advice: 30-60 deg about two axes)."""
@@ -85,6 +86,20 @@ def missing_axis_in_words(axis_flange: Any, R_world_flange: Any) -> str:
     if kind == "flange":
         return "tilt the tool sideways (about a horizontal axis), not only about its own length"
     return "tilt the tool about a horizontal axis (lean it sideways)"
+
+
+_FLANGE_VECTOR = re.compile(r"\s*\((?:not about )?flange \[[^\]]*\]\)")
+
+
+def failure_in_words(message: str, axis_flange: Any, R_world_flange: Any) -> str:
+    """tcpcal's "all touches rotate about nearly the same axis (flange [..])" for a trainee:
+    the FLANGE vector dropped, the axis and the tilt still missing said in words."""
+    text = _FLANGE_VECTOR.sub("", str(message)).strip()
+    text = text[:1].upper() + text[1:]
+    if not text.endswith("."):
+        text += "."
+    return (f"{text} In words: the touches differ only by {axis_in_words(axis_flange, R_world_flange)}. "
+            f"Still missing: {missing_axis_in_words(axis_flange, R_world_flange)}.")
 
 
 def _max_angle_deg(rots: np.ndarray) -> float:

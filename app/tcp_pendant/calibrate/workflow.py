@@ -25,8 +25,10 @@ from typing import Any, Literal
 import numpy as np
 
 from tcp_pendant.controller import ToolModel, VirtualController, builtin_tools
+from tcp_pendant.calibrate.diversity import failure_in_words
 from tcp_pendant.wizards import (
     AbcWorldWizard,
+    CalibrationFailedError,
     ReferenceWizard,
     ThreePointWizard,
     Wizard,
@@ -296,8 +298,19 @@ class CalibrationWorkflow:
 
     def next(self) -> WizardResult | None:
         """Next step; on the last step compute the result (returned)."""
-        out = self._require().next()
+        try:
+            out = self._require().next()
+        except CalibrationFailedError as exc:
+            raise self._in_words(exc) from exc
         return out if isinstance(out, WizardResult) else None
+
+    def _in_words(self, exc: CalibrationFailedError) -> CalibrationFailedError:
+        """tcpcal's failure with its FLANGE axis said in words (``diversity.failure_in_words``)."""
+        axis = getattr(exc.cause, "unobservable_axis", None)
+        if axis is None:
+            return exc
+        R_world_flange = self.controller.T_world_flange()[:3, :3]
+        return CalibrationFailedError(failure_in_words(str(exc), axis, R_world_flange), exc.cause)
 
     def back(self) -> None:
         """One step back (from the result: to the last step); nothing is deleted."""
@@ -319,7 +332,10 @@ class CalibrationWorkflow:
         out = auto_touch(w, self.controller, direction_deg=request.direction_deg,
                          sigma_mm=request.sigma_mm, rng=self.rng, tools=self.tools)
         if out.ok and w.on_last_step and all(s.recorded for s in w.steps):
-            w.finish()
+            try:
+                w.finish()
+            except CalibrationFailedError as exc:
+                raise self._in_words(exc) from exc
         return out
 
     # ------------------------------------------------------------ result
