@@ -180,7 +180,10 @@ class Session:
                     log.exception("motion listener failed")
 
     def notify(self, title: str, body: str, *, kind: str = "info") -> None:
-        """Show a notification in this session's browser(s); ``kind``: info, success, warning, error."""
+        """Show a notification in this session's browser(s); ``kind``: info, success, warning, error.
+
+        ``title`` and ``body`` are plain text (viser shows them as text, not markdown): pass user
+        text as it is, never through ``views.escape.escape_markdown``."""
         if self.closed:
             return
         color = _COLORS.get(kind, "blue")
