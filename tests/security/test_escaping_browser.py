@@ -166,7 +166,7 @@ def test_raw_text_in_viser_markdown_does_harm_the_control(bare_viser, listener) 
 PAYLOADS = [STYLE, LINK, IFRAME, "<img src=x onerror=document.title='pwned'>", "<script>document.title='pwned'</script>",
             "**bold** _em_ `code` ~~del~~", "# heading", "- item", "1. item", "> quote", "a | b",
             "www.evil.example http://evil.example/x me@evil.example", "&lt;b&gt; &#60;i&#62;", "back\\slash",
-            "two\nlines", "[ref]: //evil", "    indented"]
+            "two\nlines", "[ref]: //evil", "    indented", "---", "## h2"]
 
 
 def test_escaped_payloads_render_as_their_literal_text_in_viser(bare_viser, listener, shot) -> None:
@@ -178,6 +178,7 @@ def test_escaped_payloads_render_as_their_literal_text_in_viser(bare_viser, list
     for i, p in enumerate(payloads):
         srv.gui.add_markdown(f"M{i}: {escape_markdown(p)} :E{i}")
         srv.gui.add_markdown(f"**B{i}: {escape_markdown(p)}**")
+        srv.gui.add_markdown(escape_markdown(p))             # alone: at the start of a line
     srv.gui.add_markdown("| name | slot |\n|---|---|\n" + "\n".join(f"| T{i}: {escape_markdown(p)} | {i} |"
                                                                  for i, p in enumerate(payloads)))
     last = len(payloads) - 1
@@ -196,7 +197,7 @@ def test_escaped_payloads_render_as_their_literal_text_in_viser(bare_viser, list
         .filter(e => /^(M|B|T)\\d+: /.test(e.innerText))
         .flatMap(e => [...e.querySelectorAll('*')].map(c => c.tagName.toLowerCase()))""")
     assert set(inner_tags) <= {"strong"}, inner_tags
-    assert page.locator("h1, li, blockquote, pre").count() == 0
+    assert page.locator("h1, h2, li, blockquote, pre, hr").count() == 0   # no block starts either
     page.wait_for_load_state("networkidle")
     assert_harmless(page_state(page), title, listener)
     shot(page, "escaped_payloads")
