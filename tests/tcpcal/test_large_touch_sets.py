@@ -81,7 +81,10 @@ def test_large_path_equals_every_pair(rot: np.ndarray) -> None:
     exact = angle_extremes(rot)  # N <= 60: every pair (the Gram path of before)
     fast = _angle_extremes_large(rot)  # the path used above EXACT_ANGLES_MAX_N touches
     lo, hi = brute_angles_deg(rot)
-    assert fast.min_deg == pytest.approx(exact.min_deg, abs=1e-6)
+    # The every-pair path picks the closest pair by the Gram entry trace(R_a^T R_b) = 3 - angle^2
+    # + ..., whose rounding (~6e-15) cannot tell apart pairs closer than ~8e-8 rad (4.4e-6 deg);
+    # the nearest-neighbour path can, so below that they may name different near-zero pairs.
+    assert fast.min_deg == pytest.approx(exact.min_deg, abs=5e-6)
     assert fast.min_deg == pytest.approx(lo, abs=1e-5)
     assert fast.max_exact  # a small set never needs the estimate
     assert fast.max_deg == pytest.approx(exact.max_deg, abs=1e-6)
