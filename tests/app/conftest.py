@@ -44,7 +44,7 @@ def app_factory(tmp_path: Path) -> Iterator[Callable[..., object]]:
     apps: list[PendantApp] = []
 
     def make(**kw: object) -> PendantApp:
-        cfg = AppConfig(port=free_port(), tool_library=tmp_path / "tools.json", library_poll_s=0.1, **kw)  # type: ignore[arg-type]
+        cfg = AppConfig(port=0, tool_library=tmp_path / "tools.json", library_poll_s=0.1, **kw)  # type: ignore[arg-type]
         app = PendantApp(cfg)
         app.start()
         apps.append(app)

@@ -17,8 +17,6 @@ Software WebGL is slow: wait on conditions with generous timeouts, never fixed s
 
 from __future__ import annotations
 
-import os
-import shutil
 import socket
 import subprocess
 import sys
@@ -30,8 +28,10 @@ from pathlib import Path
 
 import pytest
 
-CHROMIUM = os.environ.get("CHROMIUM", "/usr/bin/chromium")
-CHROMIUM_ARGS = ["--no-sandbox", "--disable-gpu", "--disable-background-networking", "--disable-component-update"]
+sys.path.insert(0, str(Path(__file__).parent))
+import chromium_session  # noqa: E402  (one chromium per process, shared with tests/security)
+from chromium_session import CHROMIUM, CHROMIUM_ARGS  # noqa: E402,F401  (re-exported)
+
 READY_TIMEOUT_S = 60.0
 UI_TIMEOUT_MS = 60_000
 
@@ -61,8 +61,23 @@ class ServerProcess:
         return self.log_path.read_text(errors="replace") if self.log_path.exists() else ""
 
 
-def _start(tmp_path: Path, *extra: str) -> ServerProcess:
-    port = free_port()
+def _start(tmp_path: Path, *extra: str, attempts: int = 3) -> ServerProcess:
+    """Start a server on a port free right now; another process may take that port before the
+    server binds it (tcp-pendant then refuses to start), so a few ports are tried."""
+    for attempt in range(attempts):
+        try:
+            return _start_on(tmp_path, free_port(), *extra)
+        except PortTakenError:
+            if attempt == attempts - 1:
+                raise
+    raise AssertionError("unreachable")
+
+
+class PortTakenError(RuntimeError):
+    """The free port was taken by someone else before the server bound it."""
+
+
+def _start_on(tmp_path: Path, port: int, *extra: str) -> ServerProcess:
     lib = tmp_path / "tools.json"
     log_path = tmp_path / f"server_{port}.log"
     cmd = [sys.executable, "-m", "tcp_pendant", "--port", str(port), "--tool-library", str(lib), *extra]
@@ -73,6 +88,8 @@ def _start(tmp_path: Path, *extra: str) -> ServerProcess:
     deadline = time.monotonic() + READY_TIMEOUT_S
     while time.monotonic() < deadline:
         if proc.poll() is not None:
+            if "already in use" in sp.log():
+                raise PortTakenError(sp.log())
             raise RuntimeError(f"tcp-pendant exited with {proc.returncode}:\n{sp.log()}")
         try:
             with urllib.request.urlopen(sp.url, timeout=1.0) as r:
@@ -119,17 +136,14 @@ def server(pendant_server: Callable[..., ServerProcess]) -> ServerProcess:
 @pytest.fixture(scope="session")
 def browser() -> Iterator[object]:
     """Chromium (Debian's) driven by Playwright, shared by the browser tests of one run."""
-    if not shutil.which(CHROMIUM) and not Path(CHROMIUM).exists():
-        pytest.fail(f"chromium not found at {CHROMIUM}; install it (apt-get install chromium) or set $CHROMIUM "
-                    "(scripts/run-tests.sh installs it).")
-    from playwright.sync_api import sync_playwright
-
-    with sync_playwright() as pw:
-        b = pw.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS, headless=True)
-        try:
-            yield b
-        finally:
-            b.close()
+    try:
+        b = chromium_session.acquire()
+    except FileNotFoundError as exc:
+        pytest.fail(str(exc))
+    try:
+        yield b
+    finally:
+        chromium_session.release()
 
 
 @pytest.fixture

@@ -26,7 +26,7 @@ sys.path.insert(0, str(HERE.parent / "app"))
 sys.path.insert(0, str(HERE))
 from calib_helpers import library_tool_with_true_tcp, true_frame
 from guiclick import choose, click, upload
-from wsclient import DrainingClient, free_port, wait_until
+from wsclient import DrainingClient, wait_until
 
 
 class Page:
@@ -55,7 +55,7 @@ def page(tmp_path: Path) -> Iterator[Callable[..., Page]]:
     pages: list[Page] = []
 
     def make(tool: str = "pointer") -> Page:
-        app = PendantApp(AppConfig(port=free_port(), tool=tool, tool_library=tmp_path / "tools.json", library_poll_s=0.1))
+        app = PendantApp(AppConfig(port=0, tool=tool, tool_library=tmp_path / "tools.json", library_poll_s=0.1))
         app.start()
         apps.append(app)
         p = Page(app)
@@ -308,7 +308,7 @@ def test_closing_the_page_loses_nothing_saved(page) -> None:
 
 
 def test_shared_mode_export_goes_to_the_browser_that_clicked(tmp_path: Path) -> None:
-    app = PendantApp(AppConfig(port=free_port(), shared=True, tool_library=tmp_path / "tools.json"))
+    app = PendantApp(AppConfig(port=0, shared=True, tool_library=tmp_path / "tools.json"))
     app.start()
     ws = [DrainingClient(app.port), DrainingClient(app.port)]
     try:

@@ -97,9 +97,8 @@ def test_meter_markdown_uses_the_advice_and_does_not_repeat_the_angle() -> None:
 def test_the_meter_in_the_app_speaks_of_touch_1_after_one_touch(tmp_path) -> None:
     from test_calibrate_view import Page
     from tcp_pendant.server import AppConfig, PendantApp
-    from wsclient import free_port
 
-    app = PendantApp(AppConfig(port=free_port(), tool="pointer", tool_library=tmp_path / "tools.json",
+    app = PendantApp(AppConfig(port=0, tool="pointer", tool_library=tmp_path / "tools.json",
                                library_poll_s=0.1))
     app.start()
     p = None

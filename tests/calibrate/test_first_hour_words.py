@@ -117,7 +117,6 @@ def test_tool_data_defaults_to_the_active_slot_not_slot_1(tmp_path) -> None:
     offer slot 3; a pick by the user holds until the active tool data changes."""
     from test_calibrate_view import Page  # noqa: F401  (the in-process browser)
     from tcp_pendant.server import AppConfig, PendantApp
-    from wsclient import free_port
 
     from tcpcal.library import ToolLibrary
 
@@ -126,7 +125,7 @@ def test_tool_data_defaults_to_the_active_slot_not_slot_1(tmp_path) -> None:
     lib.save(3, Tool(name="Torch", tcp_mm=(0.0, 0.0, 200.0)))
     lib.save(4, Tool(name="Gripper", tcp_mm=(0.0, 0.0, 120.0)))
     lib.activate(3)
-    app = PendantApp(AppConfig(port=free_port(), tool="torch", tool_library=tmp_path / "tools.json",
+    app = PendantApp(AppConfig(port=0, tool="torch", tool_library=tmp_path / "tools.json",
                                library_poll_s=0.1))
     app.start()
     try:

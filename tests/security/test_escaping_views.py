@@ -40,7 +40,7 @@ sys.path.insert(0, str(TESTS / "app"))
 sys.path.insert(0, str(TESTS / "calibrate"))
 from calib_helpers import library_tool_with_true_tcp, make_controller  # noqa: E402
 from guiclick import choose, click, upload  # noqa: E402
-from wsclient import DrainingClient, free_port, wait_until  # noqa: E402
+from wsclient import DrainingClient, wait_until  # noqa: E402
 
 # valid tool names (<= 24 characters, no double quote) that would do harm as markdown
 NAMES = ["<style>*{opacity:0}", "[click](//evil)", "![](//127.0.0.1:9/x)", "![](/etc/passwd)",
@@ -121,7 +121,7 @@ def test_escaped_markdown_makes_viser_read_no_file(monkeypatch) -> None:
 
     reads: list[Any] = []
     monkeypatch.setattr(iio, "imread", lambda path, *a, **k: reads.append(path) or (_ for _ in ()).throw(OSError()))
-    srv = viser.ViserServer(host="127.0.0.1", port=free_port(), verbose=False)
+    srv = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
     try:
         with pytest.warns(UserWarning):
             srv.gui.add_markdown("![](/etc/passwd)")                 # the control: raw, viser reads it
@@ -154,7 +154,7 @@ def app_with_hostile_library(tmp_path: Path) -> Iterator[Callable[[], Browser]]:
     for slot, name in enumerate(NAMES, start=1):
         lib.save(slot, Tool(name=name, tcp_mm=(0.0, 0.0, 100.0 + slot),
                             calibration=Calibration(method=name, calibrated_at=_AT)), activate=slot == 1)
-    app = PendantApp(AppConfig(port=free_port(), tool_library=tmp_path / "tools.json", library_poll_s=0.1))
+    app = PendantApp(AppConfig(port=0, tool_library=tmp_path / "tools.json", library_poll_s=0.1))
     app.start()
     browsers: list[Browser] = []
 

@@ -20,7 +20,7 @@ from websockets.exceptions import InvalidStatus
 from websockets.sync.client import ClientConnection, connect
 
 sys.path.insert(0, str(Path(__file__).parents[1] / "app"))
-from wsclient import free_port, wait_until  # noqa: E402
+from wsclient import wait_until  # noqa: E402
 
 PROXY = "https://pendant.school.example"
 CAMERA = _messages.ViewerCameraMessage(wxyz=(1.0, 0.0, 0.0, 0.0), position=(2.0, -2.0, 1.0), fov=1.0, near=0.01,
@@ -92,7 +92,7 @@ def test_two_origin_headers_are_refused_and_allowed_origins_pass() -> None:
 
 @pytest.fixture
 def app(tmp_path: Path) -> Iterator[PendantApp]:
-    a = PendantApp(AppConfig(port=free_port(), tool_library=tmp_path / "tools.json", allow_origins=(PROXY,)))
+    a = PendantApp(AppConfig(port=0, tool_library=tmp_path / "tools.json", allow_origins=(PROXY,)))
     a.start()
     yield a
     a.stop()
@@ -131,7 +131,7 @@ def test_the_page_itself_is_still_served_to_anyone(app: PendantApp) -> None:
 
 
 def test_the_allowed_origins_are_per_server_and_dropped_at_stop(tmp_path: Path) -> None:
-    plain = PendantApp(AppConfig(port=free_port(), tool_library=tmp_path / "t.json"))
+    plain = PendantApp(AppConfig(port=0, tool_library=tmp_path / "t.json"))
     plain.start()
     try:
         with pytest.raises(InvalidStatus) as err:       # another server's --allow-origin is not this one's

@@ -27,7 +27,7 @@ from viser import _messages
 from viser._gui_handles import UploadedFile
 
 sys.path.insert(0, str(Path(__file__).parents[1] / "app"))
-from wsclient import ButtonClient, DrainingClient, free_port, wait_until  # noqa: E402
+from wsclient import ButtonClient, DrainingClient, wait_until  # noqa: E402
 
 PLUS_X = "X +"
 P99_LIMIT_S = 0.5
@@ -54,7 +54,7 @@ class Browsers:
     """A pendant server with an uploading browser (A) and a jogging one (B)."""
 
     def __init__(self, tmp_path: Path) -> None:
-        self.app = PendantApp(AppConfig(port=free_port(), tool_library=tmp_path / "tools.json"))
+        self.app = PendantApp(AppConfig(port=0, tool_library=tmp_path / "tools.json"))
         self.app.start()
         self.a = DrainingClient(self.app.port)
         wait_until(lambda: len(self.app.sessions) == 1, what="session A")
