@@ -132,7 +132,7 @@ def _sampled_reach_m(kinematics: RobotKinematics, n: int = 400) -> float:
     span = np.minimum(hi - lo, 2 * np.pi)
     mid = 0.5 * (lo + hi)
     qs = mid + (rng.uniform(size=(n, kinematics.n_joints)) - 0.5) * span
-    p = np.array([kinematics.T_base_flange(q)[:3, 3] for q in qs])
+    p = np.array([kinematics.T_world_flange(q)[:3, 3] for q in qs])
     return float(np.percentile(np.hypot(p[:, 0], p[:, 1]), 95))
 
 
@@ -145,7 +145,7 @@ def default_reference_tip_mm(kinematics: RobotKinematics) -> tuple[float, float,
     half its home height is below the floor) gets a point in front of it instead: at half its
     horizontal reach, a quarter of that reach high (at least ``MIN_TIP_HEIGHT_M``).
     """
-    p = kinematics.T_base_flange(kinematics.home_rad)[:3, 3]
+    p = kinematics.T_world_flange(kinematics.home_rad)[:3, 3]
     if 0.5 * p[2] >= MIN_TIP_HEIGHT_M:
         return (float(p[0] * 1000.0), float(p[1] * 1000.0), float(0.5 * p[2] * 1000.0))
     reach = _sampled_reach_m(kinematics)
@@ -170,7 +170,7 @@ def ready_configuration(kinematics: RobotKinematics, tip_world_m: np.ndarray | N
             q[4] = a5
             if not kinematics.lower_rad[4] <= a5 <= kinematics.upper_rad[4]:
                 continue
-            down = -float(kinematics.T_base_flange(q)[2, 2])      # flange Z . (-WORLD Z)
+            down = -float(kinematics.T_world_flange(q)[2, 2])      # flange Z . (-WORLD Z)
             if down > best_dot:
                 best, best_dot = q, down
     if best is home and tip_world_m is not None:

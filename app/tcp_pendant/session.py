@@ -31,7 +31,7 @@ import numpy as np
 from tcpcal.library import ToolLibrary
 from tcp_pendant.controller import ControllerError, VirtualController
 from tcp_pendant.pendant import Jogger, touch_label
-from tcp_pendant.pendant.pose_state import PoseState, pose_state, pose_state_key
+from tcp_pendant.controller.pose_state import PoseState, pose_state, pose_state_key
 
 __all__ = ["GuiTarget", "Session", "Touch"]
 
@@ -137,7 +137,7 @@ class Session:
 
     # ------------------------------------------------------------ updates
     def pose_state(self) -> PoseState:
-        """The robot's current :class:`~tcp_pendant.pendant.pose_state.PoseState` (link poses,
+        """The robot's current :class:`~tcp_pendant.controller.pose_state.PoseState` (link poses,
         flange, TCP, true TCP, readout, touch geometry, joint angles), computed by one FK pass
         and shared by every renderer and motion listener until the controller changes (keyed
         by joint angles, tool data, mounted tool, reference tip and BASE; within one
@@ -183,7 +183,7 @@ class Session:
         """Show a notification in this session's browser(s); ``kind``: info, success, warning, error.
 
         ``title`` and ``body`` are plain text (viser shows them as text, not markdown): pass user
-        text as it is, never through ``views.escape.escape_markdown``."""
+        text as it is, never through ``text_escape.escape_markdown``."""
         if self.closed:
             return
         color = _COLORS.get(kind, "blue")

@@ -32,7 +32,7 @@ def test_loopback_and_tip_parsing() -> None:
 
 def test_ready_pose_points_flange_down(kr6) -> None:
     q = ready_configuration(kr6)
-    assert kr6.T_base_flange(q)[2, 2] == pytest.approx(-1.0, abs=1e-9)
+    assert kr6.T_world_flange(q)[2, 2] == pytest.approx(-1.0, abs=1e-9)
 
 
 def test_network_warning_only_off_loopback() -> None:

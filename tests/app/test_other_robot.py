@@ -39,7 +39,7 @@ def test_ur5_session_starts_over_a_visible_tip_and_calibrates(app_factory) -> No
             wf.start_xyz4()
             for _ in range(4):
                 assert wf.auto_touch(AutoTouchRequest()).ok
-        true_tcp = builtin_tools()["pointer"].T_flange_tcp_true[:3, 3] * 1000.0
+        true_tcp = builtin_tools()["pointer"].T_flange_tool_true[:3, 3] * 1000.0
         np.testing.assert_allclose(wf.result.tcp_mm, true_tcp, atol=1e-6)
         assert wf.export_record()["robot"]["name"] == "ur5_robot"
     finally:

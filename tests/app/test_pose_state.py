@@ -16,8 +16,8 @@ from scipy.spatial.transform import Rotation
 from tcpcal.tool import Tool, abc_deg_from_rotation
 from tcp_pendant.controller import VirtualController, builtin_tools
 from tcp_pendant.pendant.formatting import tcp_readout_markdown, touch_indicator_markdown
-from tcp_pendant.pendant.pose_state import pose_state, pose_state_key
-from tcp_pendant.pendant.rotations import GIMBAL_LOCK_COS_B, kuka_abc_deg, quaternion_wxyz, quaternions_wxyz
+from tcp_pendant.controller.pose_state import pose_state, pose_state_key
+from tcp_pendant.controller.rotations import GIMBAL_LOCK_COS_B, kuka_abc_deg, quaternion_wxyz, quaternions_wxyz
 
 sys.path.insert(0, str(Path(__file__).parent))
 from conftest import wait_until  # noqa: E402
@@ -96,7 +96,7 @@ def test_pose_state_equals_the_controllers_own_answers(controller: VirtualContro
         st = pose_state(c)
         np.testing.assert_allclose(st.T_world_flange, c.T_world_flange(), atol=1e-14)
         np.testing.assert_allclose(st.T_world_tcp, c.T_world_tcp(), atol=1e-14)
-        np.testing.assert_allclose(st.T_world_true_tcp, c.T_world_true_tcp(), atol=1e-14)
+        np.testing.assert_allclose(st.T_world_tool_true, c.T_world_tool_true(), atol=1e-14)
         links = c.link_poses()
         assert set(st.T_world_link) == set(links) == set(st.link_names)
         for name, T in links.items():

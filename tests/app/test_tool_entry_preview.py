@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from tcp_pendant.pendant.tool_entry import FIELDS, ToolEntry, entry_preview_markdown
-from tcp_pendant.views.escape import escape_markdown
+from tcp_pendant.text_escape import escape_markdown
 
 
 def _entry(name: str = "Pen", **vals: str) -> ToolEntry:

@@ -4,7 +4,7 @@
 
 Prints the median time (us) of, for each built-in robot (KR 6 R900, GP12):
 
-1. one flange FK, ``RobotKinematics.T_base_flange`` (pinocchio; target < 10 us), against a
+1. one flange FK, ``RobotKinematics.T_world_flange`` (pinocchio; target < 10 us), against a
    baseline measured in the same run: the same FK with yourdfpy (``update_cfg`` +
    ``get_transform``), and pinocchio's ``link_poses`` (every link, for the scene);
 2. one flange Jacobian, ``jacobian_flange``;
@@ -57,7 +57,7 @@ def bench_robot(key: str, repeats: int) -> dict[str, float]:
         return urdf.get_transform(frame_to=kin.flange_link, frame_from=urdf.base_link)
 
     torch = builtin_tools()["torch"]
-    T = torch.T_flange_tcp_true
+    T = torch.T_flange_tool_true
     ctrl = VirtualController(kin, tool=torch, reference_tip_world_m=TIP_M[key],
                              active_tool=Tool.from_rotation("torch", tuple(T[:3, 3] * 1000.0), T[:3, :3]))
     reset = lambda: ctrl.set_q(q)  # noqa: E731
@@ -73,7 +73,7 @@ def bench_robot(key: str, repeats: int) -> dict[str, float]:
 
     reset()
     out = {
-        "fk_pinocchio": median_us(lambda: kin.T_base_flange(q), repeats * 10),
+        "fk_pinocchio": median_us(lambda: kin.T_world_flange(q), repeats * 10),
         "fk_yourdfpy": median_us(yourdfpy_fk, max(repeats // 2, 5)),
         "link_poses": median_us(lambda: kin.link_poses(q), repeats * 10),
         "jacobian": median_us(lambda: kin.jacobian_flange(q), repeats * 10),
@@ -103,7 +103,7 @@ def main(argv: list[str] | None = None) -> int:
     for key in ("kr6", "gp12"):
         r = bench_robot(key, repeats)
         rows = [
-            ("flange FK, pinocchio (T_base_flange)", r["fk_pinocchio"], "< 10"),
+            ("flange FK, pinocchio (T_world_flange)", r["fk_pinocchio"], "< 10"),
             ("flange FK, yourdfpy baseline", r["fk_yourdfpy"], ""),
             ("all link poses, pinocchio (link_poses)", r["link_poses"], ""),
             ("flange Jacobian (jacobian_flange)", r["jacobian"], ""),

@@ -3,7 +3,7 @@
 Each test opens the page, runs its wizard through the GUI with training-mode Auto-touch (zero
 operator error), saves the tool, and checks the saved tool's numbers in the library panel and
 the library file against the tool's hidden true TOOL frame, computed here from the tool's URDF
-(``ToolModel.T_flange_tcp_true``) with scipy - not by the app. Screenshots of the result views
+(``ToolModel.T_flange_tool_true``) with scipy - not by the app. Screenshots of the result views
 go to the test's tmp_path and are checked not to be blank.
 """
 

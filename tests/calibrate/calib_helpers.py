@@ -32,7 +32,7 @@ def make_controller(robot: str = "kr6", tool_key: str = "pointer") -> VirtualCon
 
 def true_frame(tool_key: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(TCP mm, R_flange_tool, KUKA A, B, C deg) of a built-in tool's hidden truth, via scipy."""
-    T = builtin_tools()[tool_key].T_flange_tcp_true
+    T = builtin_tools()[tool_key].T_flange_tool_true
     R = T[:3, :3]
     with warnings.catch_warnings():          # the pointer has B = -90 deg: gimbal lock is expected
         warnings.simplefilter("ignore", UserWarning)

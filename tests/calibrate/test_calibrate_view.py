@@ -14,7 +14,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 from tcp_pendant.calibrate import error_bars
 from tcp_pendant.server import AppConfig, PendantApp
-from tcp_pendant.views.escape import escape_markdown
+from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.wizard_menu import CalibrateView
 from tcp_pendant.wizards import ESTIMATOR_LABELS
 
@@ -100,7 +100,7 @@ def test_four_auto_touches_run_a_4point_calibration_and_every_view_follows(page)
     assert v.scene.sphere.visible
     np.testing.assert_allclose(v.scene.sphere.position, np.asarray(res.sphere_centre_mm) / 1000, atol=1e-9)
     assert float(np.atleast_1d(v.scene.sphere.scale)[0]) == pytest.approx(res.sphere_radius_mm / 1000)
-    T_wt = s.controller.T_world_flange() @ s.controller.mounted_tool.T_flange_tcp_true
+    T_wt = s.controller.T_world_flange() @ s.controller.mounted_tool.T_flange_tool_true
     np.testing.assert_allclose(v.scene.computed.position, T_wt[:3, 3], atol=1e-9)
     np.testing.assert_allclose(v.scene.true_tool.position, T_wt[:3, 3], atol=1e-9)
     assert v.scene.computed.visible and v.scene.true_tool.visible and v.scene.true_label.visible
@@ -108,7 +108,7 @@ def test_four_auto_touches_run_a_4point_calibration_and_every_view_follows(page)
     with s.lock:
         s.controller.jog_joint(0, 5.0)
         s.moved()
-    T_wt = s.controller.T_world_flange() @ s.controller.mounted_tool.T_flange_tcp_true
+    T_wt = s.controller.T_world_flange() @ s.controller.mounted_tool.T_flange_tool_true
     np.testing.assert_allclose(v.scene.computed.position, T_wt[:3, 3], atol=1e-9)
 
     # training mode off: truth, ghost triad and auto-touch go away

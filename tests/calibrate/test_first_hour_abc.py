@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from tcp_pendant.calibrate import AutoTouchRequest
-from tcp_pendant.wizards.autotouch import ANGLE_LEVER_MM, operator_angle_sigma_deg
+from tcp_pendant.calibrate.autotouch import ANGLE_LEVER_MM, operator_angle_sigma_deg
 
 sys.path.insert(0, str(Path(__file__).parent))
 from calib_helpers import library_tool_with_true_tcp

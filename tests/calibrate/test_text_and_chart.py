@@ -20,7 +20,7 @@ from tcp_pendant.calibrate.text import (
     truth_markdown,
     warnings_markdown,
 )
-from tcp_pendant.views.escape import escape_markdown
+from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.wizards import WizardResult, Xyz4Wizard
 from tcp_pendant.wizards.truth import compare_with_truth
 

@@ -1,6 +1,6 @@
 """The Calibrate menu's workflow without a browser: every wizard driven by training-mode
 auto-touch on the real virtual controller, checked against the tools' hidden true TOOL frames
-(``ToolModel.T_flange_tcp_true``, read from the URDFs, converted with scipy in the test)."""
+(``ToolModel.T_flange_tool_true``, read from the URDFs, converted with scipy in the test)."""
 
 from __future__ import annotations
 

@@ -36,7 +36,7 @@ def kinematics(robot: str) -> RobotKinematics:
 
 def truth_tool_data(model: ToolModel, name: str | None = None) -> Tool:
     """tcpcal tool data equal to the hidden truth of a tool model."""
-    T = model.T_flange_tcp_true
+    T = model.T_flange_tool_true
     return Tool.from_rotation(name or model.key, tuple(T[:3, 3] * 1000.0), T[:3, :3])
 
 

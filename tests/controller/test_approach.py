@@ -41,7 +41,7 @@ def test_zero_error_touches_within_1e6_mm_from_10_random_directions(robot, tool_
         tilt, az, spin = rng.uniform(0, 45), bearing + rng.uniform(-90, 90), rng.uniform(-90, 90)
         res = ctrl.auto_approach(tilt_deg=tilt, azimuth_deg=az, spin_deg=spin)
         assert res.ok, res.message
-        T = ctrl.T_world_true_tcp()
+        T = ctrl.T_world_tool_true()
         assert np.linalg.norm(T[:3, 3] - tip) * 1000.0 < 1e-6
         x, y = expected_axes(tilt, az, spin)
         np.testing.assert_allclose(T[:3, 0], x, atol=1e-9)
@@ -62,11 +62,11 @@ def test_unreachable_direction_is_really_unreachable():
     res = ctrl.auto_approach(tilt_deg=44.14, azimuth_deg=246.8, spin_deg=27.08)
     assert not res.ok and res.stopped_by == "unreachable" and "cannot be reached" in res.message
     np.testing.assert_array_equal(ctrl.q_rad, q0)
-    kin, T_ft = ctrl.kinematics, ctrl.mounted_tool.T_flange_tcp_true
+    kin, T_ft = ctrl.kinematics, ctrl.mounted_tool.T_flange_tool_true
     target = approach_pose(ctrl.reference_tip_world_m, tilt_deg=44.14, azimuth_deg=246.8, spin_deg=27.08)
 
     def residual(q):
-        T = kin.T_base_flange(q) @ T_ft
+        T = kin.T_world_flange(q) @ T_ft
         return np.concatenate([(T[:3, 3] - target[:3, 3]) / 0.3, pin.log3(target[:3, :3] @ T[:3, :3].T)])
 
     rng = np.random.default_rng(9)
@@ -80,7 +80,7 @@ def test_tip_offset_puts_the_reference_tip_where_asked():
     tip = ctrl.reference_tip_world_m
     for offset in ((-50.0, 0.0, 0.0), (0.0, 60.0, 0.0), (-20.0, 60.0, 10.0)):
         assert ctrl.auto_approach(tilt_deg=15, azimuth_deg=30, spin_deg=10, tip_offset_tool_mm=offset).ok
-        T = ctrl.T_world_true_tcp()
+        T = ctrl.T_world_tool_true()
         np.testing.assert_allclose(T[:3, :3].T @ (tip - T[:3, 3]) * 1000.0, offset, atol=1e-6)
 
 
@@ -95,7 +95,7 @@ def test_operator_error_scatter_has_the_requested_sigma():
     for _ in range(200):
         res = ctrl.auto_approach(tilt_deg=30.0, azimuth_deg=45.0, sigma_mm=1.0, rng=rng)
         assert res.ok
-        errors.append((ctrl.T_world_true_tcp()[:3, 3] - tip) * 1000.0)
+        errors.append((ctrl.T_world_tool_true()[:3, 3] - tip) * 1000.0)
     e = np.array(errors)
     assert np.all(np.abs(e.mean(axis=0)) < 0.28)
     assert np.all((0.8 < e.std(axis=0, ddof=1)) & (e.std(axis=0, ddof=1) < 1.2))
@@ -106,7 +106,7 @@ def test_same_rng_seed_gives_the_same_pose():
     a, b = make_controller("gp12", "gripper"), make_controller("gp12", "gripper")
     for c in (a, b):
         assert c.auto_approach(tilt_deg=20, azimuth_deg=100, sigma_mm=0.5, rng=np.random.default_rng(7)).ok
-    np.testing.assert_allclose(a.T_world_true_tcp(), b.T_world_true_tcp(), atol=1e-9)
+    np.testing.assert_allclose(a.T_world_tool_true(), b.T_world_tool_true(), atol=1e-9)
 
 
 def test_unreachable_tip_fails_clearly_and_leaves_the_robot_alone():
@@ -127,7 +127,7 @@ def test_move_true_tool_to_and_tool_swap_keep_the_truth_hidden_from_the_active_t
     T[:3, :3] = np.array([[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]])  # tool X down (PA-1)
     T[:3, 3] = [0.5, 0.1, 0.3]
     assert ctrl.move_true_tool_to(T).ok
-    np.testing.assert_allclose(ctrl.T_world_true_tcp(), T, atol=1e-9)
+    np.testing.assert_allclose(ctrl.T_world_tool_true(), T, atol=1e-9)
     # no active tool: the TCP the controller believes is the flange
     np.testing.assert_allclose(ctrl.T_world_tcp(), ctrl.T_world_flange())
-    np.testing.assert_allclose(ctrl.T_world_flange() @ tools["torch"].T_flange_tcp_true, T, atol=1e-9)
+    np.testing.assert_allclose(ctrl.T_world_flange() @ tools["torch"].T_flange_tool_true, T, atol=1e-9)

@@ -18,7 +18,7 @@ from .conftest import kinematics
 
 
 def flange_mm(robot: str, q_deg) -> np.ndarray:
-    return kinematics(robot).T_base_flange(np.radians(q_deg))[:3, 3] * 1000.0
+    return kinematics(robot).T_world_flange(np.radians(q_deg))[:3, 3] * 1000.0
 
 
 # KR 6 R900 sixx figures (issue 3): A2 400 mm up and 25 mm forward of A1, upper arm 455,
@@ -47,7 +47,7 @@ def test_kr6_a1_turns_about_the_vertical_and_flange_z_points_out_of_the_face():
         assert abs(math.degrees(math.atan2(p[1], p[0]))) == pytest.approx(abs(a1), abs=1e-9)
     # flange Z out of the face: at HOME the flange looks forward (+X)
     kin = kinematics("kr6")
-    np.testing.assert_allclose(kin.T_base_flange(kin.home_rad)[:3, 2], [1.0, 0.0, 0.0], atol=1e-12)
+    np.testing.assert_allclose(kin.T_world_flange(kin.home_rad)[:3, 2], [1.0, 0.0, 0.0], atol=1e-12)
 
 
 def test_gp12_zero_pose_from_its_urdf_dimensions():
@@ -63,7 +63,7 @@ def test_joint_names_limits_and_homes():
     np.testing.assert_allclose(np.degrees(kr6.upper_rad), (170, 45, 156, 185, 120, 350), atol=1e-9)
     np.testing.assert_allclose(np.degrees(kr6.home_rad), (0, -90, 90, 0, 0, 0), atol=1e-12)
     # GP12 home: flange straight down, inside the limits
-    T = gp12.T_base_flange(gp12.home_rad)
+    T = gp12.T_world_flange(gp12.home_rad)
     np.testing.assert_allclose(T[:3, 2], [0.0, 0.0, -1.0], atol=1e-12)
     assert np.all(gp12.home_rad >= gp12.lower_rad) and np.all(gp12.home_rad <= gp12.upper_rad)
     assert kr6.flange_link == "flange" and gp12.flange_link == "flange"
@@ -80,7 +80,7 @@ def test_pinocchio_matches_yourdfpy_for_random_configurations(robot):
         q = rng.uniform(kin.lower_rad, kin.upper_rad)
         urdf.update_cfg(q)
         T_yourdfpy = urdf.get_transform(frame_to=kin.flange_link, frame_from=urdf.base_link)
-        np.testing.assert_allclose(kin.T_base_flange(q), T_yourdfpy, atol=1e-9, rtol=0)
+        np.testing.assert_allclose(kin.T_world_flange(q), T_yourdfpy, atol=1e-9, rtol=0)
         poses = kin.link_poses(q)
         assert set(poses) == set(urdf.link_map)
         for link, T in poses.items():
@@ -96,16 +96,16 @@ def test_jacobian_matches_finite_differences_of_fk(robot):
     for _ in range(5):
         q = rng.uniform(kin.lower_rad, kin.upper_rad)
         J = kin.jacobian_flange(q)
-        T0 = kin.T_base_flange(q)
+        T0 = kin.T_world_flange(q)
         for j in range(kin.n_joints):
             dq = np.zeros(kin.n_joints)
             dq[j] = h
-            Tp, Tm = kin.T_base_flange(q + dq), kin.T_base_flange(q - dq)
+            Tp, Tm = kin.T_world_flange(q + dq), kin.T_world_flange(q - dq)
             v = (Tp[:3, 3] - Tm[:3, 3]) / (2 * h)
             w = Rotation.from_matrix(Tp[:3, :3] @ Tm[:3, :3].T).as_rotvec() / (2 * h)
             np.testing.assert_allclose(J[:3, j], v, atol=1e-7)
             np.testing.assert_allclose(J[3:, j], w, atol=1e-7)
-        np.testing.assert_allclose(kin.T_base_flange(q), T0)  # no state leaks between calls
+        np.testing.assert_allclose(kin.T_world_flange(q), T0)  # no state leaks between calls
 
 
 def test_ur5_from_example_robot_data_default_and_named_flange():
@@ -121,7 +121,7 @@ def test_ur5_from_example_robot_data_default_and_named_flange():
     urdf.update_cfg(q)
     named = RobotKinematics.from_urdf(path, flange_link="ee_link")
     assert named.flange_link == "ee_link"
-    np.testing.assert_allclose(named.T_base_flange(q), urdf.get_transform("ee_link", urdf.base_link), atol=1e-9)
+    np.testing.assert_allclose(named.T_world_flange(q), urdf.get_transform("ee_link", urdf.base_link), atol=1e-9)
     with pytest.raises(ControllerError, match="no link 'nope'.*tool0"):
         RobotKinematics.from_urdf(path, flange_link="nope")
 
@@ -147,7 +147,7 @@ def test_other_urdf_home_is_zero_clipped_to_limits_and_flange_is_deepest_leaf(tm
     q = np.array([1.0, -0.5])
     r = 0.2 + 0.1 * math.cos(-0.5)
     expected = [r * math.cos(1.0), r * math.sin(1.0), 0.1 - 0.1 * math.sin(-0.5)]
-    np.testing.assert_allclose(kin.T_base_flange(q)[:3, 3], expected, atol=1e-12)
+    np.testing.assert_allclose(kin.T_world_flange(q)[:3, 3], expected, atol=1e-12)
 
 
 def test_bad_urdfs_give_clear_errors(tmp_path: Path):

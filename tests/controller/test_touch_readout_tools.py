@@ -54,12 +54,12 @@ def test_tools_read_their_true_tcp_from_the_urdf():
     tools = builtin_tools()
     assert set(tools) == {"pointer", "torch", "gripper"}
     for key, model in tools.items():
-        np.testing.assert_allclose(model.T_flange_tcp_true, origin_chain(model.urdf_path, "tcp"), atol=1e-12)
-        assert not model.T_flange_tcp_true.flags.writeable
+        np.testing.assert_allclose(model.T_flange_tool_true, origin_chain(model.urdf_path, "tcp"), atol=1e-12)
+        assert not model.T_flange_tool_true.flags.writeable
         assert model.key == key and model.label
     # the pointer's TCP is on the flange axis; the torch's is off-axis and turned about two axes
-    assert np.linalg.norm(tools["pointer"].T_flange_tcp_true[:2, 3]) < 1e-12
-    torch = tools["torch"].T_flange_tcp_true
+    assert np.linalg.norm(tools["pointer"].T_flange_tool_true[:2, 3]) < 1e-12
+    torch = tools["torch"].T_flange_tool_true
     assert np.linalg.norm(torch[:2, 3]) > 0.01
     assert np.count_nonzero(np.abs(torch[:3, :3] - np.eye(3)).max(axis=0) > 1e-6) == 3
 

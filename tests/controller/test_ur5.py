@@ -66,7 +66,7 @@ def test_ur5_auto_approach_touches_exactly():
         tilt, az = rng.uniform(0.0, 40.0), rng.uniform(0.0, 360.0)
         res = ctrl.auto_approach(tilt_deg=tilt, azimuth_deg=az)
         assert res.ok, res.message
-        T = ctrl.T_world_true_tcp()
+        T = ctrl.T_world_tool_true()
         assert np.linalg.norm(T[:3, 3] - tip) * 1000.0 < 1e-6
         t, a = math.radians(tilt), math.radians(az)
         np.testing.assert_allclose(T[:3, 0], [math.sin(t) * math.cos(a), math.sin(t) * math.sin(a), -math.cos(t)],

@@ -1,6 +1,6 @@
 """Issue 8 item 2: everything users type is shown as text, everywhere (the escaping helper).
 
-``tcp_pendant.views.escape.escape_markdown`` turns user text into markdown that renders as
+``tcp_pendant.text_escape.escape_markdown`` turns user text into markdown that renders as
 exactly that text in viser (whose markdown passes raw HTML unsanitised and autolinks bare
 URLs). These tests check its output as text (no raw ``<``, every markdown character escaped)
 and as rendered by a CommonMark renderer (markdown-it-py, installed with viser's ``rich``):
@@ -17,7 +17,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from markdown_it import MarkdownIt
-from tcp_pendant.views.escape import WORD_JOINER, escape_html, escape_markdown
+from tcp_pendant.text_escape import WORD_JOINER, escape_html, escape_markdown
 
 # The payloads of the issue, and a few more of the same kinds.
 STYLE = "<style>*{opacity:0}"

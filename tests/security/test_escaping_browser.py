@@ -26,7 +26,7 @@ import pytest
 import viser
 from pendant_page import TIMEOUT_MS, choose, type_text, wait_text
 from tcp_pendant.calibrate import AutoTouchRequest, CalibrationWorkflow
-from tcp_pendant.views.escape import WORD_JOINER, escape_markdown
+from tcp_pendant.text_escape import WORD_JOINER, escape_markdown
 from tcp_pendant.wizards.session_record import dumps
 
 from tcpcal.library import ToolLibrary

@@ -29,7 +29,7 @@ class SynthTool:
     R_flange_tool: np.ndarray
 
     @property
-    def T_flange_tcp_true_m(self) -> np.ndarray:
+    def T_flange_tool_true_m(self) -> np.ndarray:
         T = np.eye(4)
         T[:3, :3] = self.R_flange_tool
         T[:3, 3] = self.tcp_mm / 1000.0

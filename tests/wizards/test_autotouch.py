@@ -24,7 +24,7 @@ from tcp_pendant.wizards import (
     WizardStateError,
     Xyz4Wizard,
 )
-from tcp_pendant.wizards.autotouch import auto_touch
+from tcp_pendant.calibrate.autotouch import auto_touch
 from tcp_pendant.wizards.truth import compare_with_truth
 
 
@@ -73,7 +73,7 @@ class FakeController:
 
 
 def models(synth):
-    return {k: SimpleNamespace(key=k, label=k, T_flange_tcp_true=t.T_flange_tcp_true_m)
+    return {k: SimpleNamespace(key=k, label=k, T_flange_tool_true=t.T_flange_tool_true_m)
             for k, t in synth.tools.items()}
 
 
@@ -97,7 +97,7 @@ def test_four_clicks_give_a_4_point_calibration(synth):
         assert 20.0 <= out.tilt_deg <= 50.0
     assert wiz.on_last_step and wiz.step.recorded and wiz.status == "in_progress"  # Finish is a click
     res = wiz.next()
-    assert compare_with_truth(res, synth.tools["torch"].T_flange_tcp_true_m).position_error_mm < 1e-6
+    assert compare_with_truth(res, synth.tools["torch"].T_flange_tool_true_m).position_error_mm < 1e-6
     assert all(c[4] == (0.0, 0.0, 0.0) for c in ctrl.calls)
 
 
@@ -125,7 +125,7 @@ def test_three_point_offsets_and_same_orientation(synth, variant, third):
     assert offsets == [(0.0, 0.0, 0.0), (-60.0, 0.0, 0.0), third]
     assert len({c[1:4] for c in ctrl.calls}) == 1  # steps 2 and 3 keep step 1's orientation
     res = wiz.next()
-    assert compare_with_truth(res, synth.tools["gripper"].T_flange_tcp_true_m).orientation_error_deg < 1e-6
+    assert compare_with_truth(res, synth.tools["gripper"].T_flange_tool_true_m).orientation_error_deg < 1e-6
 
 
 def test_reference_swaps_the_tool(synth):
@@ -137,7 +137,7 @@ def test_reference_swaps_the_tool(synth):
     auto_touch(wiz, ctrl, rng=rng, tools=ctrl.tools)
     assert ctrl.mounted_tool.key == "torch"
     res = wiz.next()
-    assert compare_with_truth(res, synth.tools["torch"].T_flange_tcp_true_m).position_error_mm < 1e-6
+    assert compare_with_truth(res, synth.tools["torch"].T_flange_tool_true_m).position_error_mm < 1e-6
 
 
 @pytest.mark.parametrize("variant", ["6d", "5d"])
@@ -150,7 +150,7 @@ def test_abc_world_moves_to_prescribed_orientation(synth, variant):
     np.testing.assert_allclose(T_target[:3, 3], synth.reference_mm / 1000 + [0, 0, 0.03])
     assert T_target[:3, 0] == pytest.approx([0.0, 0.0, -1.0])  # tool X down in both variants
     res = wiz.next()
-    cmp = compare_with_truth(res, synth.tools["torch"].T_flange_tcp_true_m)
+    cmp = compare_with_truth(res, synth.tools["torch"].T_flange_tool_true_m)
     assert cmp.x_axis_error_deg < 1e-6
     if variant == "6d":
         assert cmp.orientation_error_deg < 1e-6
@@ -162,7 +162,7 @@ def test_abc_world_angular_error_shows_in_the_result(synth):
     for seed in range(30):
         wiz = AbcWorldWizard(exact_tool(synth, "pointer"))
         auto_touch(wiz, ctrl, rng=np.random.default_rng(seed), angle_sigma_deg=1.0)
-        errs.append(compare_with_truth(wiz.next(), synth.tools["pointer"].T_flange_tcp_true_m).orientation_error_deg)
+        errs.append(compare_with_truth(wiz.next(), synth.tools["pointer"].T_flange_tool_true_m).orientation_error_deg)
     # |rotvec| with 1 deg per axis: chi with 3 dof, mean 1.60 deg
     assert 1.2 < np.mean(errs) < 2.0
 

@@ -1,7 +1,7 @@
 """Every wizard driven by the virtual controller's auto-approach (no browser).
 
 On both robots and with every built-in tool, auto-touch with zero operator error recovers the
-hidden true TOOL frame (``ToolModel.T_flange_tcp_true``) to 1e-6 mm / 1e-6 deg; with sigma
+hidden true TOOL frame (``ToolModel.T_flange_tool_true``) to 1e-6 mm / 1e-6 deg; with sigma
 0.5 mm the error against truth is consistent with the reported 95 % radius.
 """
 
@@ -12,7 +12,7 @@ import pytest
 
 from tcpcal.tool import Tool
 from tcp_pendant.wizards import AbcWorldWizard, ReferenceWizard, ThreePointWizard, Xyz4Wizard
-from tcp_pendant.wizards.autotouch import auto_touch
+from tcp_pendant.calibrate.autotouch import auto_touch
 from tcp_pendant.wizards.session_record import WizardRun, replay, session_from_controller
 from tcp_pendant.wizards.truth import compare_with_truth
 
@@ -31,7 +31,7 @@ def make_controller(robot: str, tool_key: str):
 
 def true_tool_data(model, name="calibrated") -> Tool:
     """Library data equal to the hidden truth (for the orientation wizards' TCP)."""
-    T = model.T_flange_tcp_true
+    T = model.T_flange_tool_true
     return Tool.from_rotation(name, tuple(T[:3, 3] * 1000.0), T[:3, :3])
 
 
@@ -62,7 +62,7 @@ def test_xyz4_exact(controllers, robot, tool_key):
     ctrl = controllers(robot, tool_key)
     wiz = Xyz4Wizard()
     res = run(wiz, ctrl, np.random.default_rng(1))
-    cmp = compare_with_truth(res, ctrl.mounted_tool.T_flange_tcp_true)
+    cmp = compare_with_truth(res, ctrl.mounted_tool.T_flange_tool_true)
     assert cmp.position_error_mm < 1e-6 and cmp.grade == "good"
 
 
@@ -73,7 +73,7 @@ def test_three_point_exact(controllers, robot, tool_key, variant):
     ctrl = controllers(robot, tool_key)
     wiz = ThreePointWizard(true_tool_data(ctrl.mounted_tool), variant=variant)
     res = run(wiz, ctrl, np.random.default_rng(2))
-    cmp = compare_with_truth(res, ctrl.mounted_tool.T_flange_tcp_true)
+    cmp = compare_with_truth(res, ctrl.mounted_tool.T_flange_tool_true)
     assert cmp.orientation_error_deg < 1e-6
     assert min(res.displacements_mm) > 20.0
 
@@ -85,7 +85,7 @@ def test_abc_world_exact(controllers, robot, tool_key, variant):
     ctrl = controllers(robot, tool_key)
     wiz = AbcWorldWizard(true_tool_data(ctrl.mounted_tool), variant=variant)
     res = run(wiz, ctrl, np.random.default_rng(3))
-    cmp = compare_with_truth(res, ctrl.mounted_tool.T_flange_tcp_true)
+    cmp = compare_with_truth(res, ctrl.mounted_tool.T_flange_tool_true)
     if variant == "6d":
         assert cmp.orientation_error_deg < 1e-6
     else:
@@ -101,7 +101,7 @@ def test_reference_exact_with_tool_swap(controllers, robot, new_key):
                           new_tool_key=new_key)
     res = run(wiz, ctrl, np.random.default_rng(4))
     assert ctrl.mounted_tool.key == new_key  # auto-touch swapped the tool for step 2
-    cmp = compare_with_truth(res, tools[new_key].T_flange_tcp_true)
+    cmp = compare_with_truth(res, tools[new_key].T_flange_tool_true)
     assert cmp.position_error_mm < 1e-6
 
 
@@ -112,7 +112,7 @@ def test_autotouch_three_point_offsets_put_the_tip_where_asked(controllers):
     tip = np.asarray(ctrl.reference_tip_world_m)
     for expected in ((0.0, 0.0, 0.0), (-60.0, 0.0, 0.0), (-20.0, 60.0, 0.0)):
         auto_touch(wiz, ctrl, rng=rng)
-        T = ctrl.T_world_true_tcp()
+        T = ctrl.T_world_tool_true()
         in_tool_mm = (T[:3, :3].T @ (tip - T[:3, 3])) * 1000.0
         np.testing.assert_allclose(in_tool_mm, expected, atol=1e-6)
 
@@ -127,7 +127,7 @@ def test_xyz4_sigma_coverage_with_controller(controllers):
     for _ in range(trials):
         wiz = Xyz4Wizard(n_points=5)
         res = run(wiz, ctrl, rng, sigma_mm=0.5)
-        inside += bool(compare_with_truth(res, ctrl.mounted_tool.T_flange_tcp_true).inside_ci95)
+        inside += bool(compare_with_truth(res, ctrl.mounted_tool.T_flange_tool_true).inside_ci95)
     assert 0.87 <= inside / trials <= 1.0, inside / trials
 
 
@@ -136,7 +136,7 @@ def test_session_record_from_controller_replays(controllers, tmp_path):
     rng = np.random.default_rng(6)
     wiz = Xyz4Wizard()
     run(wiz, ctrl, rng, sigma_mm=0.3)
-    rec = session_from_controller(ctrl, [WizardRun(wiz, "gripper", ctrl.mounted_tool.T_flange_tcp_true)],
+    rec = session_from_controller(ctrl, [WizardRun(wiz, "gripper", ctrl.mounted_tool.T_flange_tool_true)],
                                   robot="gp12")
     assert rec["mounted_tool"]["key"] == "gripper"
     checks = replay(rec)

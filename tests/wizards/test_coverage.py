@@ -32,7 +32,7 @@ def test_xyz4_ci95_coverage(synth, n_points):
             wiz.record(synth.flange_pose_m(tool, synth.tool_orientation(*d),
                                            noise_mm=rng.normal(0.0, SIGMA_MM, 3)))
             res = wiz.next()
-        cmp = compare_with_truth(res, tool.T_flange_tcp_true_m)
+        cmp = compare_with_truth(res, tool.T_flange_tool_true_m)
         inside += bool(cmp.inside_ci95)
     print(f"coverage {inside / TRIALS:.3f}")
     assert 0.90 <= inside / TRIALS <= 0.99, inside / TRIALS
@@ -52,6 +52,6 @@ def test_reference_ci95_coverage_with_assumed_sigma(synth):
             wiz.record(synth.flange_pose_m(tool, synth.tool_orientation(*d),
                                            noise_mm=rng.normal(0.0, SIGMA_MM, 3)))
             res = wiz.next()
-        inside += bool(compare_with_truth(res, new.T_flange_tcp_true_m).inside_ci95)
+        inside += bool(compare_with_truth(res, new.T_flange_tool_true_m).inside_ci95)
     print(f"coverage {inside / TRIALS:.3f}")
     assert 0.90 <= inside / TRIALS <= 0.99, inside / TRIALS

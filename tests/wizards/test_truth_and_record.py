@@ -88,8 +88,8 @@ def _session(synth, rng):
         tp.record(synth.flange_pose_m(tool, R_wt, offset_tool_mm=off, noise_mm=rng.normal(0, 0.3, 3)))
         tp.next()
     half = AbcWorldWizard(lib_tool)  # left unfinished
-    return tool, [WizardRun(xyz, "torch", tool.T_flange_tcp_true_m),
-                  WizardRun(tp, "torch", tool.T_flange_tcp_true_m), WizardRun(half)]
+    return tool, [WizardRun(xyz, "torch", tool.T_flange_tool_true_m),
+                  WizardRun(tp, "torch", tool.T_flange_tool_true_m), WizardRun(half)]
 
 
 def test_session_record_round_trip_and_replay(synth, tmp_path):
@@ -147,7 +147,7 @@ def test_a_finished_wizard_closed_to_resume_later_keeps_its_result_in_the_record
     tcp = out.tcp_mm
     wiz.cancel()
     assert wiz.result is None and wiz.finished_result is out      # hidden, not lost
-    rec = session_to_dict([WizardRun(wiz, "pointer", tool.T_flange_tcp_true_m)], robot="kr6")
+    rec = session_to_dict([WizardRun(wiz, "pointer", tool.T_flange_tool_true_m)], robot="kr6")
     (entry,) = rec["wizards"]
     assert entry["result"]["tcp_mm"] == pytest.approx(list(tcp), abs=1e-12)
     assert entry["truth"]["position_error_mm"] < 1e-6

@@ -8,7 +8,7 @@ thing) and the *95 % radius* of the TCP.
 Every piece of plain text that can carry what a user typed or uploaded (tool names, the
 library choice, the wizards' titles, instructions, warnings and messages, which quote tool
 names, and a loaded record's content) goes through
-:func:`tcp_pendant.views.escape.escape_markdown` here, where the markdown is composed.
+:func:`tcp_pendant.text_escape.escape_markdown` here, where the markdown is composed.
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ import math
 from collections.abc import Sequence
 
 from tcp_pendant.pendant.formatting import fmt_num
-from tcp_pendant.views.escape import escape_markdown as _esc
+from tcp_pendant.text_escape import escape_markdown as _esc
 from tcp_pendant.wizards import ESTIMATOR_LABELS, Wizard, WizardResult, Xyz4Result
 from tcp_pendant.wizards.session_record import ReplayCheck
 from tcp_pendant.wizards.truth import TruthComparison

@@ -37,7 +37,7 @@ from tcp_pendant.wizards import (
     WizardStateError,
     Xyz4Wizard,
 )
-from tcp_pendant.wizards.autotouch import AutoTouchOutcome, auto_touch
+from tcp_pendant.calibrate.autotouch import AutoTouchOutcome, auto_touch
 from tcp_pendant.wizards.session_record import (
     LoadedRecord,
     ReplayCheck,
@@ -196,7 +196,7 @@ class CalibrationWorkflow:
 
     def _open(self, wizard: Wizard, true_tool: ToolModel | None) -> Wizard:
         self._leave_open_wizard()
-        T_true = None if true_tool is None else np.array(true_tool.T_flange_tcp_true, dtype=float)
+        T_true = None if true_tool is None else np.array(true_tool.T_flange_tool_true, dtype=float)
         self.runs.append(WizardRun(wizard, None if true_tool is None else true_tool.key, T_true))
         self._current = len(self.runs) - 1
         return self.wizard  # type: ignore[return-value]
@@ -347,16 +347,16 @@ class CalibrationWorkflow:
     def truth(self) -> TruthComparison | None:
         """Training mode: the result against the hidden true TOOL frame (None otherwise)."""
         run, res = self.run, self.result
-        if not self.training or run is None or res is None or run.T_flange_tcp_true_m is None:
+        if not self.training or run is None or res is None or run.T_flange_tool_true_m is None:
             return None
-        return compare_with_truth(res, run.T_flange_tcp_true_m)
+        return compare_with_truth(res, run.T_flange_tool_true_m)
 
     def T_flange_tool_true_m(self) -> np.ndarray | None:
         """Training mode, after a result: the hidden true TOOL frame (4x4, metres) to reveal."""
         run = self.run
         if not self.training or run is None or self.result is None:
             return None
-        return run.T_flange_tcp_true_m
+        return run.T_flange_tool_true_m
 
     def preview_tool(self) -> Tool | None:
         """The tool "Save" would store (named "preview"), or None before a result."""

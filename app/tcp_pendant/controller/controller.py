@@ -3,12 +3,12 @@
 Frames (metres and radians inside; the pendant-facing arguments say mm / deg in their names):
 
 * WORLD: the robot's root link frame (methods.md section 1, S0). ``T_world_flange`` is the
-  kinematics' ``T_base_flange``.
+  kinematics' ``T_world_flange`` at the current joint angles.
 * BASE: the work-object frame (KUKA BASE), ``T_world_base``; used for jogging and readouts.
 * FLANGE: the robot's ``flange`` link (Z out of the flange face).
 * TOOL (active TCP): what the controller *believes*: the active ``tcpcal.Tool`` data,
   ``T_flange_tool`` from its ``tcp_mm`` and KUKA ``abc_deg``; the flange when no tool is active.
-* true TOOL: the mounted tool's hidden ``T_flange_tcp_true`` (from its URDF).
+* true TOOL: the mounted tool's hidden ``T_flange_tool_true`` (from its URDF).
 
 Jogging follows ``jog.py`` (damped least squares, sub-stepped, safety rules); see
 :meth:`VirtualController.jog_cartesian` for the axis conventions.
@@ -103,7 +103,7 @@ class VirtualController:
         self.set_active_tool(active_tool)
         self._T_world_base = np.eye(4) if T_world_base is None else _check_pose(T_world_base, "T_world_base")
         if reference_tip_world_m is None:
-            p = kinematics.T_base_flange(kinematics.home_rad)[:3, 3]
+            p = kinematics.T_world_flange(kinematics.home_rad)[:3, 3]
             reference_tip_world_m = (p[0], p[1], 0.5 * p[2])
         self._tip = _check_point(reference_tip_world_m, "reference_tip_world_m")
 
@@ -193,15 +193,15 @@ class VirtualController:
     # ----------------------------------------------------------------- poses
     def T_world_flange(self) -> np.ndarray:
         """FLANGE pose in WORLD (4,4, metres)."""
-        return self.kinematics.T_base_flange(self._q)
+        return self.kinematics.T_world_flange(self._q)
 
     def T_world_tcp(self) -> np.ndarray:
         """Active TCP (tool data) pose in WORLD: ``T_world_flange @ T_flange_tool``."""
         return self.T_world_flange() @ self._T_flange_tool
 
-    def T_world_true_tcp(self) -> np.ndarray:
-        """Hidden true TOOL pose in WORLD: ``T_world_flange @ T_flange_tcp_true``."""
-        return self.T_world_flange() @ self._tool.T_flange_tcp_true
+    def T_world_tool_true(self) -> np.ndarray:
+        """Hidden true TOOL pose in WORLD: ``T_world_flange @ T_flange_tool_true``."""
+        return self.T_world_flange() @ self._tool.T_flange_tool_true
 
     def link_poses(self) -> dict[str, np.ndarray]:
         """``T_world_link`` for every robot link (scene updates)."""
@@ -316,7 +316,7 @@ class VirtualController:
 
     def _ik_move(self, T_world_tooltrue: np.ndarray, what: str) -> JogResult:
         sol = solve_ik(self.kinematics, T_world_tooltrue, self._q,
-                       T_flange_tcp=self._tool.T_flange_tcp_true)
+                       T_flange_tcp=self._tool.T_flange_tool_true)
         if not sol.ok:
             p = T_world_tooltrue[:3, 3] * 1000.0
             return JogResult(False, 0.0, "unreachable",
@@ -374,7 +374,7 @@ class VirtualController:
 
     def touch_geometry(self) -> TouchGeometry:
         """Mounted tool's true tip vs the reference tip (``touch.touch_geometry``)."""
-        return touch_geometry(self.T_world_true_tcp(), self._tip)
+        return touch_geometry(self.T_world_tool_true(), self._tip)
 
     def __repr__(self) -> str:
         return (f"VirtualController({self.kinematics.urdf_path.name}, tool={self._tool.key!r}, "

@@ -156,7 +156,7 @@ class PathOutcome:
 
 def tcp_pose(kin: RobotKinematics, q_rad: np.ndarray, T_flange_tcp: np.ndarray) -> np.ndarray:
     """``T_world_tcp = T_world_flange(q) @ T_flange_tcp`` (WORLD = root frame), metres."""
-    return kin.T_base_flange(q_rad) @ T_flange_tcp
+    return kin.T_world_flange(q_rad) @ T_flange_tcp
 
 
 def smallest_singular_value(kin: RobotKinematics, q_rad: np.ndarray,

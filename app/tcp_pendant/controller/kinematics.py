@@ -1,8 +1,8 @@
 """Robot kinematics from a URDF with pinocchio: joint limits, home, FK, Jacobian, link poses.
 
 Metres and radians throughout. "base" here is the URDF's root link (the robot's own base,
-which the controller calls WORLD, methods.md section 1); ``T_base_flange`` maps FLANGE
-coordinates to root-link coordinates.
+which the controller calls WORLD, methods.md section 1); ``T_world_flange`` maps FLANGE
+coordinates to root-link (WORLD) coordinates.
 
 Why pinocchio and not yourdfpy for the motion: one flange FK is about 1 us in pinocchio and
 0.2-0.7 ms in yourdfpy (``tests/bench/bench_controller.py``); the app's scene updates use
@@ -205,8 +205,8 @@ class RobotKinematics:
         value = self.upper_rad[index] if side == "upper" else self.lower_rad[index]
         return f"{self.joint_names[index]} at its limit {self.format_joint(index, value)}"
 
-    def T_base_flange(self, q_rad: np.ndarray) -> np.ndarray:
-        """FLANGE pose in the root-link frame, (4,4), metres (pinocchio frame placement)."""
+    def T_world_flange(self, q_rad: np.ndarray) -> np.ndarray:
+        """FLANGE pose in WORLD (the root-link frame), (4,4), metres (pinocchio frame placement)."""
         pin.forwardKinematics(self.model, self.data, q_rad)
         return pin.updateFramePlacement(self.model, self.data, self._flange_id).homogeneous
 

@@ -2,7 +2,7 @@
 
 A tool is a URDF fragment whose root link ``tool_mount`` is bolted to the robot's ``flange``
 (same frame) and whose link ``tcp`` is the tool's **true TOOL frame**: origin at the true TCP,
-X along the working direction (KUKA, methods.md section 1). ``T_flange_tcp_true`` is read from
+X along the working direction (KUKA, methods.md section 1). ``T_flange_tool_true`` is read from
 the URDF with yourdfpy, so the URDF is the one source of truth for both the drawing and the
 hidden answer the trainee's calibration is graded against.
 
@@ -55,24 +55,24 @@ class ToolModel:
         key: "pointer" | "torch" | "gripper" (or the key given to :func:`load_tool`).
         label: name shown to the user.
         urdf_path: the tool's URDF (root link ``tool_mount`` = FLANGE frame).
-        T_flange_tcp_true: (4,4) true TOOL frame in FLANGE coordinates, metres; hidden from
+        T_flange_tool_true: (4,4) true TOOL frame in FLANGE coordinates, metres; hidden from
             the trainee (read-only array).
     """
 
     key: str
     label: str
     urdf_path: Path
-    T_flange_tcp_true: np.ndarray
+    T_flange_tool_true: np.ndarray
 
     def __post_init__(self) -> None:
-        T = np.asarray(self.T_flange_tcp_true, dtype=float)
+        T = np.asarray(self.T_flange_tool_true, dtype=float)
         if T.shape != (4, 4) or not np.all(np.isfinite(T)):
-            raise ControllerError(f"Tool {self.key!r}: T_flange_tcp_true must be a finite 4x4 "
+            raise ControllerError(f"Tool {self.key!r}: T_flange_tool_true must be a finite 4x4 "
                                   f"matrix, got shape {T.shape}.")
         R = T[:3, :3]
         if np.abs(R.T @ R - np.eye(3)).max() > 1e-9 or np.linalg.det(R) < 0:
-            raise ControllerError(f"Tool {self.key!r}: T_flange_tcp_true has no proper rotation.")
-        object.__setattr__(self, "T_flange_tcp_true", _readonly(T))
+            raise ControllerError(f"Tool {self.key!r}: T_flange_tool_true has no proper rotation.")
+        object.__setattr__(self, "T_flange_tool_true", _readonly(T))
         object.__setattr__(self, "urdf_path", Path(self.urdf_path))
 
     def __repr__(self) -> str:
@@ -99,14 +99,14 @@ def urdf_transform(urdf_path: Path, frame_from: str, frame_to: str) -> np.ndarra
 
 def load_tool(urdf_path: Path | str, *, key: str | None = None, label: str | None = None,
               mount_link: str = "tool_mount", tcp_link: str = "tcp") -> ToolModel:
-    """A :class:`ToolModel` from a tool URDF: ``T_flange_tcp_true`` = pose of ``tcp_link`` in
+    """A :class:`ToolModel` from a tool URDF: ``T_flange_tool_true`` = pose of ``tcp_link`` in
     ``mount_link`` (the mount link is the FLANGE frame)."""
     path = Path(urdf_path)
     if not path.is_file():
         raise ControllerError(f"Tool URDF not found: {path}.")
     key = path.stem if key is None else key
     return ToolModel(key=key, label=TOOL_LABELS.get(key, key) if label is None else label,
-                     urdf_path=path, T_flange_tcp_true=urdf_transform(path, mount_link, tcp_link))
+                     urdf_path=path, T_flange_tool_true=urdf_transform(path, mount_link, tcp_link))
 
 
 @lru_cache(maxsize=4)

@@ -7,10 +7,9 @@ Modules, one job each:
   which turns a -/+ key press (or one hold tick) into a controller command.
 * ``formatting``: the text of the TCP/joint readouts, the touch indicator and the touch list.
 * ``tool_entry``: parse and validate the numeric tool entry (X, Y, Z mm; A, B, C deg).
-* ``pose_state``: :class:`PoseState`, the robot after a move from one FK pass (link poses,
-  flange, TCP, true TCP, readout, touch geometry), shared by the views of a session.
-* ``rotations``: the hot path's rotation conversions (KUKA A, B, C; quaternions) by pinocchio,
-  checked against tcpcal/scipy.
+
+The robot's state after a move (``PoseState``) and the hot path's rotation conversions are
+controller math: ``tcp_pendant.controller.pose_state`` and ``tcp_pendant.controller.rotations``.
 """
 
 from tcp_pendant.pendant.formatting import (
@@ -29,7 +28,7 @@ from tcp_pendant.pendant.jogging import (
     Jogger,
     JogSettings,
 )
-from tcp_pendant.pendant.pose_state import PoseState, pose_state
+from tcp_pendant.controller.pose_state import PoseState, pose_state
 from tcp_pendant.pendant.tool_entry import FIELDS, ToolEntry, ToolEntryResult, parse_number, parse_tool_entry
 
 __all__ = [
@@ -40,14 +39,12 @@ __all__ = [
     "JogMode",
     "JogSettings",
     "Jogger",
-    "PoseState",
     "ToolEntry",
     "ToolEntryResult",
     "joint_label",
     "joint_readout_markdown",
     "parse_number",
     "parse_tool_entry",
-    "pose_state",
     "tcp_readout_markdown",
     "tool_data_markdown",
     "touch_indicator_markdown",

@@ -15,6 +15,7 @@ import numpy as np
 from tcpcal.tool import Tool
 from tcp_pendant.controller import PoseReadout, TouchGeometry
 from tcp_pendant.controller.touch import TOUCH_TOLERANCE_MM
+from tcp_pendant.text_escape import escape_markdown
 
 __all__ = [
     "fmt_num",
@@ -43,7 +44,6 @@ def tcp_readout_markdown(readout: PoseReadout, tool_name: str | None) -> str:
     width = max(len(v) for _, v, _ in rows)
     lines = [f"{rows[i][0]} {rows[i][1]:>{width}} mm   {rows[i + 3][0]} {rows[i + 3][1]:>{width}} deg"
              for i in range(3)]
-    from tcp_pendant.views.escape import escape_markdown   # here: views imports this package
 
     tool = "FLANGE (no tool active)" if tool_name is None else f"TOOL {escape_markdown(tool_name)}"
     return f"**TCP in {readout.frame}** · {tool}\n\n```\n" + "\n".join(lines) + "\n```"
@@ -90,7 +90,6 @@ def touch_label(index: int, T_world_flange: np.ndarray) -> str:
 
 def tool_data_markdown(tool: Tool | None, slot: int | None = None) -> str:
     """Active tool data: name (slot), TCP X, Y, Z mm and A, B, C deg, calibration method."""
-    from tcp_pendant.views.escape import escape_markdown   # here: views imports this package
 
     if tool is None:
         return "**Active tool:** none (TCP = flange)"

@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 
 from tcpcal.tool import Calibration, Tool
 from tcp_pendant.pendant.formatting import fmt_num
+from tcp_pendant.text_escape import escape_markdown
 
 __all__ = [
     "FIELDS",
@@ -107,7 +108,6 @@ def entry_preview_markdown(entry: ToolEntry) -> str:
     A decimal comma typed in a field shows here as the number it means, so the user sees
     what the controller will hold before saving.
     """
-    from tcp_pendant.views.escape import escape_markdown   # here: views imports this package
 
     name = escape_markdown((entry.name or "").strip())
     shown: list[str] = []

@@ -25,7 +25,7 @@ from collections.abc import Callable
 from typing import Any
 
 from tcp_pendant.session import Session
-from tcp_pendant.views.escape import escape_markdown
+from tcp_pendant.text_escape import escape_markdown
 
 __all__ = ["WIZARD_MODULE", "build_calibrate_tab", "register_calibrate_view"]
 

@@ -18,7 +18,7 @@ Scene tree (names are per browser; ``--shared`` uses the server's scene):
   event loop (``Session.on_loop``), a backlog of drag messages coalesced into one move.
 
 Axis colours are viser's: X red, Y green, Z blue. Quaternions (w, x, y, z) come from
-``tcp_pendant.pendant.rotations.quaternions_wxyz`` (pinocchio; checked against scipy).
+``tcp_pendant.controller.rotations.quaternions_wxyz`` (pinocchio; checked against scipy).
 """
 
 from __future__ import annotations
@@ -36,7 +36,7 @@ except ImportError:                    # pragma: no cover
 
 from tcp_pendant.controller import ToolModel, reference_tip_model
 from tcp_pendant.controller.kinematics import urdf_links_and_tree
-from tcp_pendant.pendant.rotations import quaternion_wxyz, quaternions_wxyz
+from tcp_pendant.controller.rotations import quaternion_wxyz, quaternions_wxyz
 from tcp_pendant.session import Session
 from tcp_pendant.views.meshes import MeshPart, link_meshes, rigid_meshes
 

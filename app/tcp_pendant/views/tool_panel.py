@@ -19,7 +19,7 @@ from tcp_pendant.controller import builtin_tools
 from tcp_pendant.pendant import FIELDS, ToolEntry, parse_tool_entry, tool_data_markdown
 from tcp_pendant.pendant.tool_entry import entry_preview_markdown
 from tcp_pendant.session import Session
-from tcp_pendant.views.escape import escape_markdown
+from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.gui_util import number_of_option, set_options, slot_option
 from tcpcal.errors import TcpcalError
 from tcpcal.formats import FORMATS, export_tool

@@ -40,7 +40,7 @@ from tcp_pendant.calibrate.text import (
 )
 from tcp_pendant.controller import builtin_robots
 from tcp_pendant.session import Session
-from tcp_pendant.views.escape import escape_markdown
+from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.gui_util import (
     number_of_option,
     set_content,

@@ -79,7 +79,7 @@ class WizardSceneView:
         self._lines: Any = None
         self._shown_result: Any = None
         self._T_flange_computed: np.ndarray | None = None
-        self._T_flange_true: np.ndarray | None = None
+        self._T_flange_tool_true: np.ndarray | None = None
         self.last_framing: Framing | None = None
         """The camera framing of the last result (None before one), for tests."""
         self._label_defaults: dict[str, tuple[Any, tuple[float, float, float]]] = {}
@@ -91,7 +91,7 @@ class WizardSceneView:
         """Show what belongs to the workflow's current state (call after every action)."""
         wf = self.workflow
         self._T_flange_computed = wf.T_flange_tool_computed_m()
-        self._T_flange_true = wf.T_flange_tool_true_m()
+        self._T_flange_tool_true = wf.T_flange_tool_true_m()
         res = wf.result
         if res is not self._shown_result:
             self._shown_result = res
@@ -113,7 +113,7 @@ class WizardSceneView:
         """After every move: the TOOL triads follow the flange, the ABC target the TCP."""
         T_world_flange = self.session.pose_state().T_world_flange   # the move's one FK pass
         for frame, label, T in ((self.computed, self.computed_label, self._T_flange_computed),
-                                (self.true_tool, self.true_label, self._T_flange_true)):
+                                (self.true_tool, self.true_label, self._T_flange_tool_true)):
             self._pose(frame, label, None if T is None else T_world_flange @ T)
         self.update_abc_target(T_world_flange)
         if self._target_T is not None:      # ABC world: TARGET, TOOL and the tip cluster at the TCP
@@ -165,8 +165,8 @@ class WizardSceneView:
         out: dict[str, tuple[Any, np.ndarray | None]] = {}
         if self._T_flange_computed is not None:
             out["computed"] = (self.computed_label, T_wf @ self._T_flange_computed)
-        if self._T_flange_true is not None:
-            out["true"] = (self.true_label, T_wf @ self._T_flange_true)
+        if self._T_flange_tool_true is not None:
+            out["true"] = (self.true_label, T_wf @ self._T_flange_tool_true)
         scene_view = self.session.views.get("scene")
         others = scene_view.tool_labels() if hasattr(scene_view, "tool_labels") else {}
         if "tool" in others and self.session.controller.active_tool is not None:
@@ -197,7 +197,7 @@ class WizardSceneView:
         T_wf = self.session.pose_state().T_world_flange
         centres = [T_wf[:3, 3], np.asarray(self.session.controller.reference_tip_world_m, dtype=float)]
         radii = [0.09, 0.02]
-        for T, length in ((self._T_flange_computed, 0.10), (self._T_flange_true, 0.16)):
+        for T, length in ((self._T_flange_computed, 0.10), (self._T_flange_tool_true, 0.16)):
             if T is not None:
                 centres.append((T_wf @ T)[:3, 3])
                 radii.append(length)

@@ -22,7 +22,7 @@ from tcp_pendant.calibrate.text import (
     step_markdown,
     steps_list_markdown,
 )
-from tcp_pendant.views.escape import escape_markdown
+from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.gui_util import set_content
 from tcp_pendant.wizards import (
     AbcWorldWizard,

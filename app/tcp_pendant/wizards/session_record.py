@@ -5,7 +5,9 @@ rebuilds each wizard and recomputes its result with ``tcpcal``; :func:`replay` c
 recomputed result matches the stored one and recomputes the errors against the true tool.
 
 JSON contract (version 1). Lengths: metres in ``*_m`` keys, millimetres in ``*_mm`` keys;
-angles in degrees; poses are 4x4 row-major nested lists; times ISO 8601 UTC.
+angles in degrees; poses are 4x4 row-major nested lists; times ISO 8601 UTC. The key
+``"T_flange_tcp_true_m"`` keeps its version-1 spelling (a contract); in code the same frame is
+``T_flange_tool_true_m`` (the hidden true TOOL frame, FLANGE -> TOOL, metres).
 
 .. code-block:: text
 
@@ -111,12 +113,12 @@ class WizardRun:
         wizard: the wizard (finished or not).
         true_tool_key: key of the physical tool whose truth applies (the new tool for the
             reference wizard).
-        T_flange_tcp_true_m: (4,4) true FLANGE -> TOOL of that tool, metres; None: no truth.
+        T_flange_tool_true_m: (4,4) true FLANGE -> TOOL of that tool, metres; None: no truth.
     """
 
     wizard: Wizard
     true_tool_key: str | None = None
-    T_flange_tcp_true_m: np.ndarray | None = None
+    T_flange_tool_true_m: np.ndarray | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -166,10 +168,10 @@ def _run_dict(run: WizardRun | Wizard) -> dict[str, Any]:
     res = wiz.finished_result          # a finished wizard closed to resume later keeps its result
     truth = None
     true_tool = None
-    if run.T_flange_tcp_true_m is not None:
-        true_tool = {"key": run.true_tool_key, "T_flange_tcp_true_m": _pose_list(run.T_flange_tcp_true_m)}
+    if run.T_flange_tool_true_m is not None:
+        true_tool = {"key": run.true_tool_key, "T_flange_tcp_true_m": _pose_list(run.T_flange_tool_true_m)}
         if res is not None:
-            truth = compare_with_truth(res, run.T_flange_tcp_true_m).to_dict()
+            truth = compare_with_truth(res, run.T_flange_tool_true_m).to_dict()
     return {"state": wiz.to_dict(), "result": None if res is None else res.summary(),
             "true_tool": true_tool, "truth": truth}
 
@@ -184,7 +186,7 @@ def session_to_dict(runs: Sequence[WizardRun | Wizard], *, robot: str, urdf: str
         robot: robot name ("kr6", "gp12" or the URDF stem).
         urdf: URDF path, if known.
         T_world_base_m: (4,4) base frame, metres (identity if None).
-        mounted_tool: the ``ToolModel`` mounted at export time (key, label, T_flange_tcp_true).
+        mounted_tool: the ``ToolModel`` mounted at export time (key, label, T_flange_tool_true).
         reference_tip_world_m: reference tip position, metres.
         touches: the pendant's captured touches (``Touch`` objects, ``(T, label)`` tuples or
             dicts with ``T_world_flange_m`` and ``label``).
@@ -192,7 +194,7 @@ def session_to_dict(runs: Sequence[WizardRun | Wizard], *, robot: str, urdf: str
     tool = None
     if mounted_tool is not None:
         tool = {"key": mounted_tool.key, "label": getattr(mounted_tool, "label", mounted_tool.key),
-                "T_flange_tcp_true_m": _pose_list(mounted_tool.T_flange_tcp_true)}
+                "T_flange_tcp_true_m": _pose_list(mounted_tool.T_flange_tool_true)}
     tip = None
     if reference_tip_world_m is not None:
         tip = [float(v) for v in np.asarray(reference_tip_world_m, dtype=float).reshape(3)]
@@ -304,7 +306,7 @@ def check_session_record(data: Any) -> dict[str, Any]:
         if true_tool is not None:
             try:
                 if not isinstance(true_tool, Mapping) or not isinstance(true_tool.get("key"), (str, type(None))):
-                    raise WizardError("it must be {\"key\": text or null, \"T_flange_tcp_true_m\": 4x4}")
+                    raise WizardError("it must be {\"key\": text or null, \"T_flange_tool_true_m\": 4x4}")
                 check_pose_m(true_tool.get("T_flange_tcp_true_m"), what="true TOOL frame")
             except (WizardError, TypeError, ValueError) as exc:
                 raise SessionRecordError(f"Wizard {i + 1} of the record: bad \"true_tool\" ({exc}).") from None

@@ -1,6 +1,6 @@
 """Training mode: compare a wizard result with the hidden true TOOL frame of the mounted tool.
 
-The truth is ``ToolModel.T_flange_tcp_true`` (4x4, metres, FLANGE -> true TOOL). Errors are
+The truth is ``ToolModel.T_flange_tool_true`` (4x4, metres, FLANGE -> true TOOL). Errors are
 reported in mm and degrees:
 
 - position error: ``|t_result - t_true|`` (mm), the TCP in FLANGE coordinates;
@@ -77,16 +77,16 @@ def _phrase(grade: Grade, what: str, value: float, unit: str, thresholds: tuple[
     return f"{what} {value:.2f} {unit} >= {thresholds[1]:g} {unit}"
 
 
-def compare_with_truth(result: WizardResult, T_flange_tcp_true_m: Any) -> TruthComparison:
+def compare_with_truth(result: WizardResult, T_flange_tool_true_m: Any) -> TruthComparison:
     """Errors of ``result`` against the true TOOL frame (see the module docstring).
 
     Args:
         result: a finished wizard's result (mm, deg).
-        T_flange_tcp_true_m: (4,4) true FLANGE -> TOOL transform in metres.
+        T_flange_tool_true_m: (4,4) true FLANGE -> TOOL transform in metres.
     """
     if not isinstance(result, WizardResult):
         raise WizardError(f"compare_with_truth needs a wizard result, got {type(result).__name__}.")
-    T_true = check_pose_m(T_flange_tcp_true_m, what="true tool frame")
+    T_true = check_pose_m(T_flange_tool_true_m, what="true tool frame")
     t_true_mm = T_true[:3, 3] * 1000.0
     dvec = np.asarray(result.tcp_mm, dtype=float) - t_true_mm
     pos_err = float(np.linalg.norm(dvec))

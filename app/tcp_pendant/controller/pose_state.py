@@ -9,9 +9,9 @@ and scipy's Euler conversion once per step; :func:`pose_state` runs pinocchio's 
 * ``T_world_flange = T_world_link[flange_link]`` (the same pinocchio frame placement as
   ``controller.T_world_flange()``),
 * ``T_world_tcp = T_world_flange @ T_flange_tool`` (active tool data),
-* ``T_world_true_tcp = T_world_flange @ T_flange_tcp_true`` (mounted tool, hidden),
+* ``T_world_tool_true = T_world_flange @ T_flange_tool_true`` (mounted tool, hidden),
 * the readout (``controller.readout``) and the touch geometry (``controller.touch_geometry``)
-  from those, with the readout's A, B, C by :func:`tcp_pendant.pendant.rotations.kuka_abc_deg`.
+  from those, with the readout's A, B, C by :func:`tcp_pendant.controller.rotations.kuka_abc_deg`.
 
 ``tests/app/test_pose_state.py`` checks every field against the controller's own methods.
 No viser.
@@ -25,9 +25,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from tcp_pendant.controller import PoseReadout, TouchGeometry, VirtualController
-from tcp_pendant.controller.touch import touch_geometry
-from tcp_pendant.pendant.rotations import kuka_abc_deg
+from tcp_pendant.controller.controller import VirtualController
+from tcp_pendant.controller.readout import PoseReadout
+from tcp_pendant.controller.touch import TouchGeometry, touch_geometry
+from tcp_pendant.controller.rotations import kuka_abc_deg
 
 __all__ = ["PoseState", "pose_state", "pose_state_key"]
 
@@ -42,7 +43,7 @@ class PoseState:
         link_names: every URDF link (pinocchio BODY frames), in pinocchio's frame order.
         T_world_links: (N,4,4) ``T_world_link`` of those links, stacked in that order.
         T_world_link: the same by link name (views into ``T_world_links``).
-        T_world_flange, T_world_tcp, T_world_true_tcp: FLANGE, active TCP and the mounted
+        T_world_flange, T_world_tcp, T_world_tool_true: FLANGE, active TCP and the mounted
             tool's hidden true TCP in WORLD.
         T_world_base: the BASE (work object) frame.
         joint_angles_deg: joint readout, name -> degrees (mm for prismatic joints).
@@ -56,7 +57,7 @@ class PoseState:
     T_world_link: Mapping[str, np.ndarray]
     T_world_flange: np.ndarray
     T_world_tcp: np.ndarray
-    T_world_true_tcp: np.ndarray
+    T_world_tool_true: np.ndarray
     T_world_base: np.ndarray
     joint_angles_deg: Mapping[str, float]
     touch: TouchGeometry
@@ -110,7 +111,7 @@ def pose_state(controller: VirtualController, key: tuple[object, ...] | None = N
     links = dict(zip(names, stacked))
     T_world_flange = links[k.flange_link]
     T_world_tcp = T_world_flange @ c.T_flange_tool
-    T_world_true = T_world_flange @ c.mounted_tool.T_flange_tcp_true
+    T_world_true = T_world_flange @ c.mounted_tool.T_flange_tool_true
     angles = {name: (math.degrees(v) if k.revolute[i] else v * 1000.0)
               for i, (name, v) in enumerate(zip(k.joint_names, q.tolist()))}
     for T in (T_world_tcp, T_world_true):
@@ -123,7 +124,7 @@ def pose_state(controller: VirtualController, key: tuple[object, ...] | None = N
         T_world_link=links,
         T_world_flange=T_world_flange,
         T_world_tcp=T_world_tcp,
-        T_world_true_tcp=T_world_true,
+        T_world_tool_true=T_world_true,
         T_world_base=c.T_world_base,
         joint_angles_deg=angles,
         touch=touch_geometry(T_world_true, c.reference_tip_world_m),
