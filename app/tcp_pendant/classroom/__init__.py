@@ -1,0 +1,10 @@
+"""Classroom support (issue 11) without a GUI: the SQLite gradebook, ``tcp-pendant grades``,
+per-trainee mystery tools and trainee names.
+
+Modules (one job each): :mod:`~tcp_pendant.classroom.gradebook` (the database),
+:mod:`~tcp_pendant.classroom.grades_cli` (the ``grades`` command),
+:mod:`~tcp_pendant.classroom.mystery` (mystery tools), :mod:`~tcp_pendant.classroom.names`
+(the "Your name" check). Nothing here imports viser.
+"""
+
+from __future__ import annotations

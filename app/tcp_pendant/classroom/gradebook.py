@@ -1,0 +1,739 @@
+"""The class gradebook: every trainee, session, calibration, touch and crash, in one SQLite file.
+
+The server writes each wizard event as it happens (issue 11 item 2); ``tcp-pendant grades``
+reads it back (:mod:`tcp_pendant.classroom.grades_cli`). Standard library ``sqlite3`` only.
+
+Durability ("a kill -9 of the server loses nothing that was acknowledged on screen"):
+
+- Every public write is one transaction (``BEGIN IMMEDIATE`` ... ``COMMIT``) that has
+  committed when the method returns, so the GUI acknowledges *after* the call.
+- The file is in WAL mode with ``synchronous=FULL`` (the default here). A kill -9 alone would
+  already be survived with ``NORMAL``: SQLite has ``write()``-n the transaction into the ``-wal``
+  file before ``COMMIT`` returns and the kernel keeps it after the process dies. ``FULL``
+  also fsyncs the WAL at every commit, so an acknowledged touch survives a power cut or a
+  kernel crash of the classroom PC too; it costs one fsync per event (human-paced: a touch
+  every few seconds per trainee), measured by ``tests/bench/bench_gradebook.py``.
+  ``synchronous="NORMAL"`` is accepted for machines whose disk makes the fsync slow.
+
+Safety of the file: the schema is versioned (table ``meta``: ``application`` and
+``schema_version``). Opening checks the file before writing anything to it
+(``PRAGMA quick_check``, then ``meta``): a file that is not SQLite, is damaged, is another
+program's database or was written by a newer TCP Pendant raises one :class:`GradebookError`
+naming the file and what to do; the file is never overwritten or "repaired".
+
+Threads: one connection guarded by a lock (``check_same_thread=False``), so any thread may
+call; calls run one at a time. Several processes may share the file (WAL; a writer waits up to
+``busy_timeout_s`` for another).
+
+Units: poses in metres (``T_world_flange_m``), joints and angles in degrees, distances and
+errors in mm, durations in seconds; times are UTC ISO 8601 with milliseconds
+(``2025-01-31T09:15:02.125+00:00``).
+
+Schema (version 1)::
+
+    meta(key PRIMARY KEY, value)                 application='tcp-pendant gradebook', schema_version='1'
+    trainees(id, name UNIQUE, created_at)
+    sessions(id, trainee_id, mode, started_at, ended_at)
+    calibrations(id, session_id, method, tool_key, exercise_id, truth_json, status, started_at,
+                 finished_at, cancelled_at, figures_json, tcp_mm_json, abc_deg_json,
+                 position_error_mm, orientation_error_deg, grade)
+        status: 'in_progress' | 'finished' | 'cancelled'
+    touches(id, calibration_id, step_index, recorded_at, T_world_flange_m_json, joints_deg_json,
+            distance_mm, auto, overwrites_touch_id, overwritten_by_touch_id)
+    crashes(id, session_id, calibration_id, at, penetration_mm, note)
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+import sqlite3
+import threading
+from collections.abc import Iterator, Mapping, Sequence
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from datetime import datetime, timezone
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+import platformdirs
+
+from tcp_pendant.classroom.names import validate_trainee_name
+
+__all__ = [
+    "APPLICATION",
+    "CSV_COLUMNS",
+    "GRADES",
+    "SCHEMA_VERSION",
+    "GradeRow",
+    "Gradebook",
+    "GradebookError",
+    "default_gradebook_path",
+    "to_csv",
+]
+
+APPLICATION = "tcp-pendant gradebook"
+SCHEMA_VERSION = 1
+GRADES = ("good", "fair", "poor")
+_STATUS = ("in_progress", "finished", "cancelled")
+_MAX_TEXT = 200          # method, tool key, exercise id, mode, crash note: short labels
+
+
+class GradebookError(Exception):
+    """The gradebook cannot be opened or a call is refused; the message names the file or the
+    value and says what to do."""
+
+
+def default_gradebook_path() -> Path:
+    """``platformdirs.user_data_dir("tcp-pendant")/class.sqlite3`` (next to the tool library)."""
+    return Path(platformdirs.user_data_dir("tcp-pendant", appauthor=False)) / "class.sqlite3"
+
+
+def _now() -> str:
+    return datetime.now(timezone.utc).isoformat(timespec="milliseconds")
+
+
+_SCHEMA = """
+CREATE TABLE meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
+CREATE TABLE trainees (
+    id INTEGER PRIMARY KEY,
+    name TEXT NOT NULL UNIQUE,
+    created_at TEXT NOT NULL);
+CREATE TABLE sessions (
+    id INTEGER PRIMARY KEY,
+    trainee_id INTEGER NOT NULL REFERENCES trainees(id),
+    mode TEXT NOT NULL,
+    started_at TEXT NOT NULL,
+    ended_at TEXT);
+CREATE TABLE calibrations (
+    id INTEGER PRIMARY KEY,
+    session_id INTEGER NOT NULL REFERENCES sessions(id),
+    method TEXT NOT NULL,
+    tool_key TEXT NOT NULL,
+    exercise_id TEXT,
+    truth_json TEXT NOT NULL,
+    status TEXT NOT NULL CHECK (status IN ('in_progress', 'finished', 'cancelled')),
+    started_at TEXT NOT NULL,
+    finished_at TEXT,
+    cancelled_at TEXT,
+    figures_json TEXT,
+    tcp_mm_json TEXT,
+    abc_deg_json TEXT,
+    position_error_mm REAL,
+    orientation_error_deg REAL,
+    grade TEXT CHECK (grade IS NULL OR grade IN ('good', 'fair', 'poor')));
+CREATE TABLE touches (
+    id INTEGER PRIMARY KEY,
+    calibration_id INTEGER NOT NULL REFERENCES calibrations(id),
+    step_index INTEGER NOT NULL,
+    recorded_at TEXT NOT NULL,
+    T_world_flange_m_json TEXT NOT NULL,
+    joints_deg_json TEXT NOT NULL,
+    distance_mm REAL,
+    auto INTEGER NOT NULL CHECK (auto IN (0, 1)),
+    overwrites_touch_id INTEGER REFERENCES touches(id),
+    overwritten_by_touch_id INTEGER REFERENCES touches(id));
+CREATE INDEX touches_by_calibration ON touches(calibration_id);
+CREATE TABLE crashes (
+    id INTEGER PRIMARY KEY,
+    session_id INTEGER NOT NULL REFERENCES sessions(id),
+    calibration_id INTEGER REFERENCES calibrations(id),
+    at TEXT NOT NULL,
+    penetration_mm REAL,
+    note TEXT NOT NULL DEFAULT '');
+CREATE INDEX crashes_by_session ON crashes(session_id);
+CREATE INDEX calibrations_by_session ON calibrations(session_id);
+"""
+
+
+@dataclass(frozen=True)
+class GradeRow:
+    """One finished calibration as the trainer sees it (``Gradebook.grades``).
+
+    Attributes:
+        calibration_id: its id in the gradebook.
+        trainee: the trainee's name (raw text: escape before showing it as markdown).
+        session_id: the browser session it was done in.
+        mode: the session's mode (as given to ``start_session``).
+        method: the calibration method (e.g. "xyz4", "abc-world").
+        tool_key: the physical tool calibrated.
+        exercise_id: the exercise it belonged to, or None.
+        started_at / finished_at: UTC ISO 8601.
+        duration_s: finished_at - started_at, seconds (wall clock, a cancel/resume pause included).
+        touches: touches that count (recorded and not overwritten by a later one).
+        hand / auto: how many of those were jogged by hand / done by Auto-touch.
+        overwritten: touches recorded and then overwritten.
+        crashes: crashes during this calibration.
+        figures: the result's quality figures by name (e.g. ``mean_error_mm``).
+        tcp_mm / abc_deg: the computed TOOL frame (mm, KUKA A, B, C deg) or None.
+        position_error_mm / orientation_error_deg: error against the true TOOL frame, or None.
+        grade: "good" | "fair" | "poor" | None.
+    """
+
+    calibration_id: int
+    trainee: str
+    session_id: int
+    mode: str
+    method: str
+    tool_key: str
+    exercise_id: str | None
+    started_at: str
+    finished_at: str
+    duration_s: float
+    touches: int
+    hand: int
+    auto: int
+    overwritten: int
+    crashes: int
+    figures: Mapping[str, float] = field(default_factory=dict)
+    tcp_mm: tuple[float, float, float] | None = None
+    abc_deg: tuple[float, float, float] | None = None
+    position_error_mm: float | None = None
+    orientation_error_deg: float | None = None
+    grade: str | None = None
+
+
+CSV_FIGURES = ("mean_error_mm", "max_error_mm", "rms_error_mm", "ci95_mm", "orthogonality_defect_deg")
+CSV_COLUMNS: tuple[str, ...] = (
+    "calibration_id", "trainee", "session_id", "mode", "method", "tool", "exercise",
+    "started_at", "finished_at", "duration_s", "touches", "hand", "auto", "overwritten", "crashes",
+    "tcp_x_mm", "tcp_y_mm", "tcp_z_mm", "a_deg", "b_deg", "c_deg",
+    *CSV_FIGURES, "position_error_mm", "orientation_error_deg", "grade", "figures_json",
+)
+"""Columns of :func:`to_csv` (a contract: docs/cli.md "tcp-pendant grades")."""
+
+
+def _cell(value: Any) -> str:
+    if value is None:
+        return ""
+    if isinstance(value, float):
+        return repr(round(value, 6))
+    return str(value)
+
+
+def _csv_safe(text: str) -> str:
+    # A spreadsheet runs a cell that starts with = + - @ as a formula (CSV injection): a name
+    # typed by a browser is data, so such a cell gets a leading apostrophe.
+    return "'" + text if text[:1] in ("=", "+", "-", "@", "\t", "\r") else text
+
+
+def to_csv(rows: Sequence[GradeRow]) -> str:
+    """The rows as CSV text (header :data:`CSV_COLUMNS`, ``\\r\\n`` line ends, empty cell = none).
+
+    Text typed by trainees (the name) starting with ``= + - @`` gets a leading ``'`` so that a
+    spreadsheet does not run it as a formula.
+    """
+    out = io.StringIO()
+    writer = csv.writer(out)
+    writer.writerow(CSV_COLUMNS)
+    for r in rows:
+        tcp = r.tcp_mm or (None, None, None)
+        abc = r.abc_deg or (None, None, None)
+        writer.writerow([_cell(v) for v in (
+            r.calibration_id, _csv_safe(r.trainee), r.session_id, _csv_safe(r.mode), _csv_safe(r.method),
+            _csv_safe(r.tool_key), None if r.exercise_id is None else _csv_safe(r.exercise_id),
+            r.started_at, r.finished_at, round(r.duration_s, 3), r.touches, r.hand, r.auto,
+            r.overwritten, r.crashes, *tcp, *abc, *(r.figures.get(k) for k in CSV_FIGURES),
+            r.position_error_mm, r.orientation_error_deg, r.grade,
+            json.dumps(dict(r.figures), sort_keys=True))])
+    return out.getvalue()
+
+
+# --------------------------------------------------------------------------- input checks
+
+def _label(value: Any, what: str, *, optional: bool = False) -> str | None:
+    if value is None and optional:
+        return None
+    if not isinstance(value, str) or not value.strip():
+        raise GradebookError(f"{what} must be a non-empty text, got {value!r}.")
+    if len(value) > _MAX_TEXT or not value.isprintable():
+        raise GradebookError(f"{what} must be at most {_MAX_TEXT} printable characters, got {value!r:.80}.")
+    return value
+
+
+def _finite(value: Any, what: str, *, optional: bool = False) -> float | None:
+    if value is None and optional:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise GradebookError(f"{what} must be a number, got {value!r:.80}.")
+    out = float(value)
+    if not math.isfinite(out):
+        raise GradebookError(f"{what} must be finite, got {out!r}.")
+    return out
+
+
+def _matrix4(value: Any, what: str) -> list[list[float]]:
+    try:
+        T = np.asarray(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise GradebookError(f"{what} must be a 4x4 matrix of numbers: {exc}.") from None
+    if T.shape != (4, 4) or not np.all(np.isfinite(T)):
+        raise GradebookError(f"{what} must be a finite 4x4 matrix, got shape {T.shape}.")
+    return T.tolist()
+
+
+def _vector(value: Any, what: str, n: int | None = None) -> list[float]:
+    try:
+        v = np.asarray(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise GradebookError(f"{what} must be numbers: {exc}.") from None
+    if v.ndim != 1 or (n is not None and v.shape[0] != n) or not np.all(np.isfinite(v)):
+        want = f"{n} finite numbers" if n is not None else "a list of finite numbers"
+        raise GradebookError(f"{what} must be {want}, got shape {v.shape}.")
+    return v.tolist()
+
+
+def _json_value(value: Any, what: str, depth: int = 0) -> Any:
+    """A copy of ``value`` made of JSON types only (finite numbers, str keys), at most 8 deep."""
+    if depth > 8:
+        raise GradebookError(f"{what} nests more than 8 levels.")
+    if isinstance(value, Mapping):
+        out = {}
+        for k, v in value.items():
+            if not isinstance(k, str):
+                raise GradebookError(f"{what} keys must be text, got {k!r:.40}.")
+            out[k] = _json_value(v, f"{what}[{k!r}]", depth + 1)
+        return out
+    if isinstance(value, np.ndarray):
+        value = value.tolist()
+    if isinstance(value, (list, tuple)):
+        return [_json_value(v, f"{what}[{i}]", depth + 1) for i, v in enumerate(value)]
+    if value is None or isinstance(value, (bool, str)):
+        return value
+    return _finite(value, what)
+
+
+def _truth_json(truth: Any) -> str:
+    if isinstance(truth, Mapping):
+        if not truth:
+            raise GradebookError("the truth must not be empty: give T_flange_tool_true_m (4x4, m) "
+                                 "or a dict describing the true TOOL frame.")
+        return json.dumps(_json_value(truth, "truth"), sort_keys=True)
+    return json.dumps({"T_flange_tool_true_m": _matrix4(truth, "T_flange_tool_true_m")})
+
+
+def _duration_s(start: str, end: str) -> float:
+    return (datetime.fromisoformat(end) - datetime.fromisoformat(start)).total_seconds()
+
+
+# --------------------------------------------------------------------------- the gradebook
+
+class Gradebook:
+    """The class gradebook in one SQLite file (see the module docstring).
+
+    Args:
+        path: the database file; None = :func:`default_gradebook_path` (its folder is created).
+        create: make a new gradebook if the file does not exist (False: :class:`GradebookError`,
+            as ``tcp-pendant grades`` wants).
+        synchronous: "FULL" (default: every commit fsynced, survives a power cut) or "NORMAL"
+            (survives a kill -9 of the server but maybe not a power cut; no fsync per commit).
+        busy_timeout_s: how long a write waits for another process holding the file.
+
+    Raises:
+        GradebookError: the file is not an SQLite database, is damaged, is another program's
+            database, was written by a newer TCP Pendant, or cannot be opened; the message
+            names the file and what to do. Nothing is written to such a file.
+    """
+
+    def __init__(self, path: Path | str | None = None, *, create: bool = True,
+                 synchronous: Literal["FULL", "NORMAL"] = "FULL", busy_timeout_s: float = 5.0) -> None:
+        if synchronous not in ("FULL", "NORMAL"):
+            raise GradebookError(f"synchronous must be 'FULL' or 'NORMAL', got {synchronous!r}.")
+        self.path = Path(default_gradebook_path() if path is None else path)
+        self._lock = threading.Lock()
+        self._closed = False
+        if self.path.is_dir():
+            raise GradebookError(f"Gradebook {self.path} is a folder; give a file name such as "
+                                 f"{self.path / 'class.sqlite3'}.")
+        exists = self.path.exists()
+        if not exists and not create:
+            raise GradebookError(f"No gradebook at {self.path}: check the path (the server writes it "
+                                 "where --class-db says, by default in the user data folder).")
+        if not exists and path is None:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+        try:
+            self._db = sqlite3.connect(str(self.path), isolation_level=None, check_same_thread=False,
+                                       timeout=float(busy_timeout_s))
+        except sqlite3.Error as exc:
+            raise GradebookError(f"Cannot open the gradebook {self.path}: {exc}; check the path and "
+                                 "its folder's permissions.") from exc
+        try:
+            self._open(exists, synchronous)
+        except BaseException:
+            self._db.close()
+            raise
+
+    # -- opening ----------------------------------------------------------------------
+
+    def _fail(self, what: str) -> GradebookError:
+        return GradebookError(
+            f"Gradebook {self.path} {what}. Nothing was changed in it; keep it for the record, move it "
+            "aside or give another file with --class-db.")
+
+    def _open(self, existed: bool, synchronous: str) -> None:
+        db = self._db
+        try:
+            tables = {r[0] for r in db.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
+        except sqlite3.DatabaseError as exc:
+            raise self._fail(f"is not a readable SQLite database ({exc})") from exc
+        if tables:
+            try:
+                check = [r[0] for r in db.execute("PRAGMA quick_check")]
+            except sqlite3.DatabaseError as exc:
+                raise self._fail(f"is damaged ({exc})") from exc
+            if check != ["ok"]:
+                raise self._fail(f"is damaged (SQLite quick_check: {'; '.join(check[:3])})")
+            if "meta" not in tables:
+                raise self._fail("is an SQLite database of another program (no 'meta' table)")
+            try:
+                meta = dict(db.execute("SELECT key, value FROM meta"))
+            except sqlite3.DatabaseError as exc:
+                raise self._fail(f"has an unreadable 'meta' table ({exc})") from exc
+            if meta.get("application") != APPLICATION:
+                raise self._fail("is an SQLite database of another program (its meta table does not "
+                                 f"say {APPLICATION!r})")
+            try:
+                version = int(meta.get("schema_version", ""))
+            except ValueError:
+                raise self._fail(f"has no valid schema_version ({meta.get('schema_version')!r})") from None
+            if version > SCHEMA_VERSION:
+                raise GradebookError(
+                    f"Gradebook {self.path} was written by a newer TCP Pendant (schema version {version}; "
+                    f"this one reads up to {SCHEMA_VERSION}). Nothing was changed in it: upgrade "
+                    "tcp-pendant to read it, or give another file with --class-db.")
+            if version < 1 or not {"trainees", "sessions", "calibrations", "touches", "crashes"} <= tables:
+                raise self._fail(f"is incomplete (schema version {version}, tables {sorted(tables)})")
+        try:
+            mode = db.execute("PRAGMA journal_mode = WAL").fetchone()[0]
+            db.execute(f"PRAGMA synchronous = {synchronous}")
+            db.execute("PRAGMA foreign_keys = ON")
+            if not tables:
+                with self._transaction():
+                    for statement in _SCHEMA.split(";"):
+                        if statement.strip():
+                            db.execute(statement)
+                    db.executemany("INSERT INTO meta (key, value) VALUES (?, ?)",
+                                   [("application", APPLICATION), ("schema_version", str(SCHEMA_VERSION)),
+                                    ("created_at", _now())])
+        except sqlite3.Error as exc:
+            raise GradebookError(f"Cannot write the gradebook {self.path}: {exc}; check that its folder "
+                                 "is writable and the disk is not full.") from exc
+        if str(mode).lower() != "wal":
+            raise GradebookError(f"Gradebook {self.path}: SQLite refused WAL mode (got {mode!r}); put the "
+                                 "file on a local disk (WAL needs shared memory, network folders lack it).")
+
+    # -- plumbing ---------------------------------------------------------------------
+
+    @contextmanager
+    def _transaction(self) -> Iterator[sqlite3.Connection]:
+        """One write transaction, committed (and, with FULL, fsynced) on leaving."""
+        db = self._db
+        db.execute("BEGIN IMMEDIATE")
+        try:
+            yield db
+        except BaseException:
+            db.execute("ROLLBACK")
+            raise
+        db.execute("COMMIT")
+
+    @contextmanager
+    def _write(self) -> Iterator[sqlite3.Connection]:
+        with self._lock:
+            if self._closed:
+                raise GradebookError(f"Gradebook {self.path} is closed.")
+            try:
+                with self._transaction() as db:
+                    yield db
+            except sqlite3.Error as exc:
+                raise GradebookError(f"Cannot write the gradebook {self.path}: {exc}. Nothing of this "
+                                     "event was stored; check the disk (full? removed?).") from exc
+
+    @contextmanager
+    def _read(self) -> Iterator[sqlite3.Connection]:
+        with self._lock:
+            if self._closed:
+                raise GradebookError(f"Gradebook {self.path} is closed.")
+            try:
+                yield self._db
+            except sqlite3.Error as exc:
+                raise GradebookError(f"Cannot read the gradebook {self.path}: {exc}.") from exc
+
+    def close(self) -> None:
+        """Close the connection (idempotent); later calls raise :class:`GradebookError`."""
+        with self._lock:
+            if not self._closed:
+                self._closed = True
+                self._db.close()
+
+    def __enter__(self) -> Gradebook:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def __repr__(self) -> str:
+        return f"Gradebook({str(self.path)!r})"
+
+    @staticmethod
+    def _id(value: Any, what: str) -> int:
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+            raise GradebookError(f"{what} must be a whole number (an id this gradebook returned), got {value!r:.40}.")
+        return int(value)
+
+    def _calibration(self, db: sqlite3.Connection, calibration_id: Any) -> tuple[int, int, str]:
+        cid = self._id(calibration_id, "calibration_id")
+        row = db.execute("SELECT id, session_id, status FROM calibrations WHERE id = ?", (cid,)).fetchone()
+        if row is None:
+            raise GradebookError(f"No calibration {cid} in the gradebook {self.path}; start it with "
+                                 "start_calibration first.")
+        return row
+
+    # -- writes -----------------------------------------------------------------------
+
+    def add_trainee(self, name: str) -> int:
+        """The id of the trainee called ``name``, added if new (a reconnect with the same name
+        gets the same id).
+
+        Raises:
+            GradebookError: the name is refused (``TraineeNameError``'s words: why, what to type).
+        """
+        from tcp_pendant.classroom.names import TraineeNameError
+
+        try:
+            clean = validate_trainee_name(name)
+        except TraineeNameError as exc:
+            raise GradebookError(str(exc)) from exc
+        with self._write() as db:
+            row = db.execute("SELECT id FROM trainees WHERE name = ?", (clean,)).fetchone()
+            if row is not None:
+                return int(row[0])
+            return int(db.execute("INSERT INTO trainees (name, created_at) VALUES (?, ?)",
+                                  (clean, _now())).lastrowid)
+
+    def start_session(self, trainee_id: int, mode: str) -> int:
+        """A new session (one browser connection) of a trainee; ``mode`` e.g. "own" or "shared"."""
+        tid = self._id(trainee_id, "trainee_id")
+        mode = _label(mode, "mode")
+        with self._write() as db:
+            if db.execute("SELECT 1 FROM trainees WHERE id = ?", (tid,)).fetchone() is None:
+                raise GradebookError(f"No trainee {tid} in the gradebook {self.path}; add_trainee first.")
+            return int(db.execute("INSERT INTO sessions (trainee_id, mode, started_at) VALUES (?, ?, ?)",
+                                  (tid, mode, _now())).lastrowid)
+
+    def end_session(self, session_id: int) -> None:
+        """Mark a session ended (browser gone); its calibrations stay as they are."""
+        sid = self._id(session_id, "session_id")
+        with self._write() as db:
+            cur = db.execute("UPDATE sessions SET ended_at = ? WHERE id = ? AND ended_at IS NULL",
+                             (_now(), sid))
+            if cur.rowcount == 0 and db.execute("SELECT 1 FROM sessions WHERE id = ?", (sid,)).fetchone() is None:
+                raise GradebookError(f"No session {sid} in the gradebook {self.path}.")
+
+    def start_calibration(self, session_id: int, method: str, tool_key: str, truth: Any,
+                          exercise_id: str | None = None) -> int:
+        """A calibration started in a session.
+
+        Args:
+            session_id: from :meth:`start_session`.
+            method: wizard kind or method name (e.g. "xyz4", "abc-world").
+            tool_key: the physical tool being calibrated (e.g. "pointer", "mystery-…").
+            truth: ``T_flange_tool_true_m`` (4x4, metres) or a JSON-able dict describing the
+                true TOOL frame; kept on the server only (never in a trainee's export).
+            exercise_id: the exercise this belongs to, or None.
+        """
+        sid = self._id(session_id, "session_id")
+        method = _label(method, "method")
+        tool_key = _label(tool_key, "tool_key")
+        exercise = _label(exercise_id, "exercise_id", optional=True)
+        truth_text = _truth_json(truth)
+        with self._write() as db:
+            if db.execute("SELECT 1 FROM sessions WHERE id = ?", (sid,)).fetchone() is None:
+                raise GradebookError(f"No session {sid} in the gradebook {self.path}; start_session first.")
+            return int(db.execute(
+                "INSERT INTO calibrations (session_id, method, tool_key, exercise_id, truth_json, status, "
+                "started_at) VALUES (?, ?, ?, ?, ?, 'in_progress', ?)",
+                (sid, method, tool_key, exercise, truth_text, _now())).lastrowid)
+
+    def record_touch(self, calibration_id: int, step_index: int, T_world_flange_m: Any, joints_deg: Any,
+                     distance_mm: float | None, auto: bool, overwritten_touch_id: int | None = None) -> int:
+        """Store one recorded touch (as it is recorded, hidden distance or not).
+
+        Args:
+            calibration_id: from :meth:`start_calibration` (not cancelled).
+            step_index: 0-based wizard step.
+            T_world_flange_m: (4,4) flange pose, metres.
+            joints_deg: joint values, degrees.
+            distance_mm: tool tip to reference tip at record, mm (stored even when the
+                trainee had it hidden); None if unknown.
+            auto: True for Auto-touch, False for a hand-jogged touch.
+            overwritten_touch_id: the earlier touch of this calibration this one replaces.
+
+        Returns:
+            The touch id.
+        """
+        step = self._id(step_index, "step_index")
+        if step < 0:
+            raise GradebookError(f"step_index must be >= 0, got {step}.")
+        if not isinstance(auto, (bool, np.bool_)):
+            raise GradebookError(f"auto must be True (Auto-touch) or False (by hand), got {auto!r:.40}.")
+        T = json.dumps(_matrix4(T_world_flange_m, "T_world_flange_m"))
+        q = json.dumps(_vector(joints_deg, "joints_deg"))
+        d = _finite(distance_mm, "distance_mm", optional=True)
+        old = None if overwritten_touch_id is None else self._id(overwritten_touch_id, "overwritten_touch_id")
+        with self._write() as db:
+            cid, _, status = self._calibration(db, calibration_id)
+            if status == "cancelled":
+                raise GradebookError(f"Calibration {cid} was cancelled; resume_calibration({cid}) before "
+                                     "recording touches in it.")
+            if old is not None:
+                row = db.execute("SELECT calibration_id, overwritten_by_touch_id FROM touches WHERE id = ?",
+                                 (old,)).fetchone()
+                if row is None or row[0] != cid:
+                    raise GradebookError(f"Touch {old} is not a touch of calibration {cid}; pass the id "
+                                         "record_touch returned for the touch being replaced.")
+                if row[1] is not None:
+                    raise GradebookError(f"Touch {old} was already overwritten by touch {row[1]}; pass "
+                                         f"{row[1]} instead.")
+            new = int(db.execute(
+                "INSERT INTO touches (calibration_id, step_index, recorded_at, T_world_flange_m_json, "
+                "joints_deg_json, distance_mm, auto, overwrites_touch_id) VALUES (?, ?, ?, ?, ?, ?, ?, ?)",
+                (cid, step, _now(), T, q, d, int(bool(auto)), old)).lastrowid)
+            if old is not None:
+                db.execute("UPDATE touches SET overwritten_by_touch_id = ? WHERE id = ?", (new, old))
+            return new
+
+    def record_crash(self, calibration_id: int | None = None, *, session_id: int | None = None,
+                     penetration_mm: float | None = None, note: str = "") -> int:
+        """Store a crash (the tool went through the reference tip), in a calibration or, outside
+        any calibration, in a session.
+
+        Args:
+            calibration_id: the calibration running, or None.
+            session_id: the session (required without ``calibration_id``; if both are given
+                they must match).
+            penetration_mm: how deep the tool went, mm, or None.
+            note: short free text (e.g. "jog", "auto-touch").
+        """
+        if calibration_id is None and session_id is None:
+            raise GradebookError("record_crash needs the calibration_id or the session_id it happened in.")
+        depth = _finite(penetration_mm, "penetration_mm", optional=True)
+        if not isinstance(note, str) or len(note) > _MAX_TEXT or not note.isprintable():
+            raise GradebookError(f"note must be at most {_MAX_TEXT} printable characters.")
+        sid = None if session_id is None else self._id(session_id, "session_id")
+        with self._write() as db:
+            cid = None
+            if calibration_id is not None:
+                cid, cal_session, _ = self._calibration(db, calibration_id)
+                if sid is not None and sid != cal_session:
+                    raise GradebookError(f"Calibration {cid} belongs to session {cal_session}, not {sid}.")
+                sid = cal_session
+            elif db.execute("SELECT 1 FROM sessions WHERE id = ?", (sid,)).fetchone() is None:
+                raise GradebookError(f"No session {sid} in the gradebook {self.path}.")
+            return int(db.execute("INSERT INTO crashes (session_id, calibration_id, at, penetration_mm, note) "
+                                  "VALUES (?, ?, ?, ?, ?)", (sid, cid, _now(), depth, note)).lastrowid)
+
+    def finish_calibration(self, calibration_id: int, figures: Mapping[str, float], *,
+                           position_error_mm: float | None, orientation_error_deg: float | None,
+                           grade: str | None, tcp_mm: Any = None, abc_deg: Any = None) -> None:
+        """Store a calibration's result. Called again (the trainee went back and finished once
+        more), the newest result replaces the stored one.
+
+        Args:
+            figures: quality figures by name (``WizardResult.figures``: mm, deg, counts).
+            position_error_mm / orientation_error_deg: error against the truth (None: not known).
+            grade: "good" | "fair" | "poor" | None.
+            tcp_mm: computed TCP (3, mm) or None; abc_deg: computed KUKA A, B, C (3, deg) or None.
+        """
+        if not isinstance(figures, Mapping):
+            raise GradebookError(f"figures must be a mapping name -> number, got {type(figures).__name__}.")
+        figs = {_label(k, "figure name"): _finite(v, f"figures[{k!r}]") for k, v in figures.items()}
+        pos = _finite(position_error_mm, "position_error_mm", optional=True)
+        ori = _finite(orientation_error_deg, "orientation_error_deg", optional=True)
+        if grade is not None and grade not in GRADES:
+            raise GradebookError(f"grade must be one of {', '.join(GRADES)} or None, got {grade!r:.40}.")
+        tcp = None if tcp_mm is None else json.dumps(_vector(tcp_mm, "tcp_mm", 3))
+        abc = None if abc_deg is None else json.dumps(_vector(abc_deg, "abc_deg", 3))
+        with self._write() as db:
+            cid, _, status = self._calibration(db, calibration_id)
+            if status == "cancelled":
+                raise GradebookError(f"Calibration {cid} was cancelled; resume_calibration({cid}) before "
+                                     "finishing it.")
+            db.execute("UPDATE calibrations SET status = 'finished', finished_at = ?, figures_json = ?, "
+                       "tcp_mm_json = ?, abc_deg_json = ?, position_error_mm = ?, orientation_error_deg = ?, "
+                       "grade = ? WHERE id = ?",
+                       (_now(), json.dumps(figs, sort_keys=True), tcp, abc, pos, ori, grade, cid))
+
+    def cancel_calibration(self, calibration_id: int) -> None:
+        """Mark a calibration cancelled (its touches stay; a finished one stays finished)."""
+        with self._write() as db:
+            cid, _, status = self._calibration(db, calibration_id)
+            if status == "in_progress":
+                db.execute("UPDATE calibrations SET status = 'cancelled', cancelled_at = ? WHERE id = ?",
+                           (_now(), cid))
+
+    def resume_calibration(self, calibration_id: int) -> None:
+        """Put a cancelled calibration back in progress (the wizard's Resume)."""
+        with self._write() as db:
+            cid, _, status = self._calibration(db, calibration_id)
+            if status == "cancelled":
+                db.execute("UPDATE calibrations SET status = 'in_progress', cancelled_at = NULL WHERE id = ?",
+                           (cid,))
+
+    # -- reads ------------------------------------------------------------------------
+
+    def calibration_status(self, calibration_id: int) -> str:
+        """"in_progress" | "finished" | "cancelled"."""
+        with self._read() as db:
+            return self._calibration(db, calibration_id)[2]
+
+    def touches(self, calibration_id: int) -> list[dict[str, Any]]:
+        """Every touch of a calibration in recording order, overwritten ones included: dicts with
+        id, step_index, recorded_at, T_world_flange_m (4x4 list), joints_deg, distance_mm, auto,
+        overwrites_touch_id, overwritten_by_touch_id."""
+        with self._read() as db:
+            cid = self._calibration(db, calibration_id)[0]
+            rows = db.execute("SELECT id, step_index, recorded_at, T_world_flange_m_json, joints_deg_json, "
+                              "distance_mm, auto, overwrites_touch_id, overwritten_by_touch_id FROM touches "
+                              "WHERE calibration_id = ? ORDER BY id", (cid,)).fetchall()
+        return [{"id": r[0], "step_index": r[1], "recorded_at": r[2], "T_world_flange_m": json.loads(r[3]),
+                 "joints_deg": json.loads(r[4]), "distance_mm": r[5], "auto": bool(r[6]),
+                 "overwrites_touch_id": r[7], "overwritten_by_touch_id": r[8]} for r in rows]
+
+    def truth(self, calibration_id: int) -> dict[str, Any]:
+        """The truth stored by :meth:`start_calibration` (server side only)."""
+        with self._read() as db:
+            cid = self._calibration(db, calibration_id)[0]
+            return json.loads(db.execute("SELECT truth_json FROM calibrations WHERE id = ?", (cid,)).fetchone()[0])
+
+    def grades(self) -> list[GradeRow]:
+        """One row per finished calibration, oldest start first."""
+        query = """
+            SELECT c.id, t.name, s.id, s.mode, c.method, c.tool_key, c.exercise_id, c.started_at,
+                   c.finished_at, c.figures_json, c.tcp_mm_json, c.abc_deg_json, c.position_error_mm,
+                   c.orientation_error_deg, c.grade,
+                   (SELECT COUNT(*) FROM touches x WHERE x.calibration_id = c.id AND x.overwritten_by_touch_id IS NULL),
+                   (SELECT COUNT(*) FROM touches x WHERE x.calibration_id = c.id AND x.overwritten_by_touch_id IS NULL AND x.auto = 1),
+                   (SELECT COUNT(*) FROM touches x WHERE x.calibration_id = c.id AND x.overwritten_by_touch_id IS NOT NULL),
+                   (SELECT COUNT(*) FROM crashes k WHERE k.calibration_id = c.id)
+            FROM calibrations c JOIN sessions s ON s.id = c.session_id JOIN trainees t ON t.id = s.trainee_id
+            WHERE c.status = 'finished' ORDER BY c.started_at, c.id"""
+        with self._read() as db:
+            rows = db.execute(query).fetchall()
+        out = []
+        for (cid, name, sid, mode, method, tool, exercise, started, finished, figs, tcp, abc, pos, ori, grade,
+             n, n_auto, n_over, n_crash) in rows:
+            out.append(GradeRow(
+                calibration_id=cid, trainee=name, session_id=sid, mode=mode, method=method, tool_key=tool,
+                exercise_id=exercise, started_at=started, finished_at=finished,
+                duration_s=_duration_s(started, finished), touches=n, hand=n - n_auto, auto=n_auto,
+                overwritten=n_over, crashes=n_crash, figures=json.loads(figs) if figs else {},
+                tcp_mm=tuple(json.loads(tcp)) if tcp else None, abc_deg=tuple(json.loads(abc)) if abc else None,
+                position_error_mm=pos, orientation_error_deg=ori, grade=grade))
+        return out
+
+    def to_csv(self, rows: Sequence[GradeRow] | None = None) -> str:
+        """:func:`to_csv` of ``rows`` (default: :meth:`grades`)."""
+        return to_csv(self.grades() if rows is None else rows)
