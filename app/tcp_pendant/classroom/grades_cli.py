@@ -1,0 +1,111 @@
+"""``tcp-pendant grades``: print the class gradebook.
+
+Usage::
+
+    tcp-pendant grades [--class-db PATH] [--csv]
+
+One row per finished calibration (oldest first): trainee, method, tool, touches (hand / auto),
+overwritten touches, crashes, duration, result figures, error against the true TOOL frame and
+the grade. Without ``--csv`` a table for the terminal; with ``--csv`` the columns of
+:data:`tcp_pendant.classroom.gradebook.CSV_COLUMNS` (docs/cli.md). The gradebook is read where
+the server writes it (``--class-db``, default ``user_data_dir("tcp-pendant")/class.sqlite3``);
+it may be read while the server runs.
+
+Exit codes: 0 printed (also when no calibration is finished yet); 2 bad options, or the file
+is missing, not a gradebook, damaged or from a newer TCP Pendant (one line on stderr; the file
+is left as it is).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+
+from tcp_pendant.classroom.gradebook import GradeRow, Gradebook, GradebookError, default_gradebook_path
+
+__all__ = ["build_parser", "format_table", "main"]
+
+_NAME_WIDTH = 24
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The parser of ``tcp-pendant grades``."""
+    p = argparse.ArgumentParser(
+        prog="tcp-pendant grades",
+        description="Print the class gradebook: one row per finished calibration.")
+    p.add_argument("--class-db", type=Path, default=None, metavar="PATH",
+                   help=f"the gradebook the server writes (default: {default_gradebook_path()})")
+    p.add_argument("--csv", action="store_true",
+                   help="print CSV (columns in docs/cli.md) instead of a table")
+    return p
+
+
+def _terminal_text(text: str, width: int) -> str:
+    # The gradebook refuses control characters, but the file may come from elsewhere: nothing a
+    # trainee typed may reach the terminal as an escape sequence.
+    clean = "".join(ch if ch.isprintable() else "?" for ch in text)
+    return clean if len(clean) <= width else clean[: width - 1] + "…"
+
+
+def _num(value: float | None, fmt: str) -> str:
+    return "-" if value is None else format(value, fmt)
+
+
+def _duration(seconds: float) -> str:
+    m, s = divmod(int(round(seconds)), 60)
+    h, m = divmod(m, 60)
+    return f"{h}:{m:02d}:{s:02d}" if h else f"{m}:{s:02d}"
+
+
+def format_table(rows: Sequence[GradeRow]) -> str:
+    """The rows as a fixed-width table (mm, deg; "-" where a figure does not apply)."""
+    header = ("id", "trainee", "method", "tool", "touches", "hand", "auto", "overwr.", "crashes",
+              "duration", "mean mm", "ci95 mm", "pos err mm", "ori err deg", "grade")
+    body = [(str(r.calibration_id), _terminal_text(r.trainee, _NAME_WIDTH), _terminal_text(r.method, 16),
+             _terminal_text(r.tool_key, 16), str(r.touches), str(r.hand), str(r.auto), str(r.overwritten),
+             str(r.crashes), _duration(r.duration_s), _num(r.figures.get("mean_error_mm"), ".3f"),
+             _num(r.figures.get("ci95_mm"), ".3f"), _num(r.position_error_mm, ".3f"),
+             _num(r.orientation_error_deg, ".2f"), r.grade or "-") for r in rows]
+    widths = [max(len(cells[i]) for cells in (header, *body)) for i in range(len(header))]
+    left = {1, 2, 3, 14}
+
+    def line(cells: Sequence[str]) -> str:
+        return "  ".join(c.ljust(w) if i in left else c.rjust(w)
+                         for i, (c, w) in enumerate(zip(cells, widths))).rstrip()
+
+    return "\n".join([line(header), line(["-" * w for w in widths]), *(line(c) for c in body)])
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run ``tcp-pendant grades`` (``argv``: the arguments after ``grades``).
+
+    Returns:
+        0 printed; 2 bad options or an unreadable gradebook (one line on stderr).
+    """
+    try:
+        args = build_parser().parse_args(argv)
+    except SystemExit as exc:        # argparse printed its usage line and message
+        return 0 if exc.code == 0 else 2
+    path = default_gradebook_path() if args.class_db is None else args.class_db
+    try:
+        with Gradebook(path, create=False) as book:
+            rows = book.grades()
+            text = book.to_csv(rows) if args.csv else None
+    except GradebookError as exc:
+        print(f"tcp-pendant grades: error: {' '.join(str(exc).split())}", file=sys.stderr)
+        return 2
+    if args.csv:
+        sys.stdout.write(text)
+        return 0
+    if not rows:
+        print(f"No finished calibration in {path} yet.")
+        return 0
+    print(f"Gradebook {path}: {len(rows)} finished calibration{'s' if len(rows) != 1 else ''}")
+    print(format_table(rows))
+    return 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())
