@@ -21,6 +21,7 @@ from typing import Any, NoReturn
 
 import numpy as np
 
+from tcpcal.controllers import formats as registered_formats
 from tcpcal.errors import DegenerateTouchesError, TcpcalError
 from tcpcal.poses_csv import MAX_ABS_MM, FlangePoses, accepted_layouts_text, read_poses_csv
 from tcpcal.report import (
@@ -39,11 +40,8 @@ from tcpcal.tool import rotation_from_abc_deg
 
 __all__ = ["CliInputError", "build_parser", "main"]
 
-FORMATS = ("kuka", "abb", "fanuc", "ur", "matrix")
-
-#: Numbers of ``tcpcal convert --from FMT VALUES``, per format.
-VALUE_COUNTS: dict[str, tuple[int, ...]] = {"kuka": (6,), "fanuc": (6,), "ur": (6,),
-                                            "abb": (7,), "matrix": (12, 16)}
+# The formats, their choices, value counts and help come from tcpcal.controllers.REGISTRY,
+# read when the parser is built (docs/architecture.md "Controller formats").
 
 
 class CliInputError(Exception):
@@ -193,15 +191,18 @@ def build_parser() -> argparse.ArgumentParser:
                     help="do not flag outlying touches")
 
     # convert -------------------------------------------------------------------------------
+    text_fmts = registered_formats(lambda f: f.has_text)
+    text_names = tuple(f.name for f in text_fmts)
+    file_only = tuple(f.name for f in registered_formats(lambda f: f.has_file and not f.has_text))
+    pose_names = tuple(f.name for f in registered_formats(lambda f: f.parse_poses is not None))
+    numbers = "; ".join(f"{f.name}: {f.numbers}" for f in text_fmts)
     conv = sub.add_parser(
         "convert", help="convert tool data between controller formats",
         description="Convert one tool frame between controller formats. VALUES is either the "
-        "numbers (kuka: X,Y,Z,A,B,C mm/deg; fanuc: X,Y,Z,W,P,R mm/deg; abb: x,y,z,q1,q2,q3,q4 "
-        "mm/unit quaternion scalar first; ur: x,y,z,rx,ry,rz m/rad; matrix: 12 or 16 numbers of "
-        "the 4x4 T_flange_tool row-major, mm), or the controller text as the controller writes "
+        f"numbers ({numbers}), or the controller text as the controller writes "
         "it (quote it), or '-' to read that text from stdin.")
-    conv.add_argument("--from", dest="from_fmt", choices=FORMATS, required=True)
-    conv.add_argument("--to", dest="to_fmt", choices=FORMATS, required=True)
+    conv.add_argument("--from", dest="from_fmt", choices=text_names, required=True)
+    conv.add_argument("--to", dest="to_fmt", choices=text_names, required=True)
     conv.add_argument("--name", default="tool", help="tool name used in the output text")
     conv.add_argument("--slot", type=int, default=1, help="tool number in the output text")
     conv.add_argument("--json", action="store_true", help="print one JSON object")
@@ -238,13 +239,14 @@ def build_parser() -> argparse.ArgumentParser:
     tact.add_argument("slot", metavar="SLOT", help="slot number, tool name, or 'none'")
     te = tsub.add_parser("export", parents=[lib_parent], help="print a tool as controller text")
     te.add_argument("slot", metavar="SLOT", help="slot number or tool name")
-    te.add_argument("--format", dest="fmt", choices=(*FORMATS, "yaskawa"), required=True,
-                    help="kuka|abb|fanuc|ur|matrix print the tool data text; with --file or "
-                    "--output, the whole file the controller loads (yaskawa: always the "
-                    "TOOL.CND entry). docs/formats.md")
+    te.add_argument("--format", dest="fmt", choices=(*text_names, *file_only), required=True,
+                    help=f"{'|'.join(text_names)} print the tool data text; with --file or "
+                    "--output, the whole file the controller loads"
+                    + "".join(f" ({n}: always the file)" for n in file_only) + ". docs/formats.md")
     te.add_argument("--file", dest="whole_file", action="store_true",
-                    help="print the whole controller file (KUKA $config.dat lines, ABB RAPID "
-                    "module, FANUC .LS program, UR script, Yaskawa TOOL.CND entry)")
+                    help="print the whole controller file ("
+                    + ", ".join(f.controller for f in registered_formats(lambda f: f.has_file))
+                    + ")")
     te.add_argument("--output", type=Path, default=None, metavar="FILE",
                     help="write the controller file to FILE (implies --file; an existing FILE "
                     "is refused)")
@@ -252,19 +254,20 @@ def build_parser() -> argparse.ArgumentParser:
                     help="the tool's name in the file (default: its library name; ABB needs a "
                     "RAPID identifier)")
     te.add_argument("--register", type=int, default=None, metavar="M",
-                    help="fanuc file: the position register the program overwrites (default 100)")
+                    help=f"{'|'.join(_option_formats('register'))} file: the position register "
+                    "the program overwrites (default 100)")
 
     # poses ---------------------------------------------------------------------------------
     poses_p = sub.add_parser("poses", help="touch poses from controller program files")
     psub = poses_p.add_subparsers(dest="poses_cmd", required=True, metavar="{import}")
     pim = psub.add_parser("import", help="print POSES.csv from a controller program file",
-                          description="Read the recorded positions of a KUKA .dat (E6POS/POS), "
-                          "ABB .mod (robtarget), FANUC .LS (/POS) or UR script (p[...]) and "
+                          description="Read the recorded positions of a controller program "
+                          f"file ({', '.join(pose_names)}: docs/formats.md) and "
                           "print them as POSES.csv for 'tcpcal solve'. Record the touches with "
                           "no tool and no base active (the flange in WORLD).")
     pim.add_argument("file", metavar="FILE", type=Path)
     pim.add_argument("--format", dest="fmt", default="auto",
-                     choices=("auto", "kuka", "abb", "fanuc", "ur"),
+                     choices=("auto", *pose_names),
                      help="the controller (default auto: from the extension, else the content)")
     pim.add_argument("--output", type=Path, default=None, metavar="POSES.csv",
                      help="write the CSV to this file instead of stdout (an existing file is "
@@ -402,27 +405,8 @@ def _with_source(out: dict[str, Any], poses: FlangePoses) -> str:
 
 
 # ---------------------------------------------------------------------------- convert path
-def _values_as_controller_text(values: Sequence[float], fmt: str) -> str:
-    """The bare numbers of ``convert --from FMT`` written in FMT's own syntax, so that
-    :func:`tcpcal.formats.import_tool` alone interprets them (one place for the conventions of
-    methods.md section 6)."""
-    v = [repr(float(x)) for x in values]
-    if fmt == "kuka":    # X, Y, Z mm; A, B, C deg
-        return "TOOL_DATA[1]={" + ",".join(f"{k} {x}" for k, x in zip("XYZABC", v)) + "}"
-    if fmt == "fanuc":   # X, Y, Z mm; W, P, R deg
-        return " ".join(f"{k}: {x}" for k, x in zip("XYZWPR", v))
-    if fmt == "abb":     # x, y, z mm; q1..q4 (q1 scalar); unknown load as ABB's tool0
-        return (f"[TRUE,[[{v[0]},{v[1]},{v[2]}],[{','.join(v[3:7])}]],"
-                f"[0.001,[0,0,0.001],[1,0,0,0],0,0,0]]")
-    if fmt == "ur":      # x, y, z m; rx, ry, rz rad
-        return "p[" + ",".join(v) + "]"
-    if fmt == "matrix":  # 16 (or 12) numbers row-major, mm
-        return " ".join(v)
-    raise AssertionError(fmt)  # pragma: no cover
-
-
 def _run_convert(args: argparse.Namespace) -> int:
-    from tcpcal.formats import export_tool, import_tool
+    from tcpcal.formats import export_tool, import_tool, text_format
 
     if args.values == ["-"]:
         raw = sys.stdin.read()
@@ -434,7 +418,8 @@ def _run_convert(args: argparse.Namespace) -> int:
     except ValueError:
         numbers = None
     if numbers is not None:
-        counts = VALUE_COUNTS[args.from_fmt]
+        source = text_format(args.from_fmt)
+        counts = source.value_counts
         if len(numbers) not in counts:
             raise CliInputError(f"convert --from {args.from_fmt}: {len(numbers)} numbers given, "
                                 f"{' or '.join(map(str, counts))} expected "
@@ -442,7 +427,7 @@ def _run_convert(args: argparse.Namespace) -> int:
         if not all(np.isfinite(numbers)):
             raise CliInputError(f"convert --from {args.from_fmt}: the values must be finite "
                                 f"numbers")
-        raw = _values_as_controller_text(numbers, args.from_fmt)
+        raw = source.values_to_text(numbers)  # type: ignore[misc]  # its own syntax
     try:
         tool = import_tool(raw, args.from_fmt, name=args.name)
     except TcpcalError as exc:
@@ -562,7 +547,10 @@ def _write_new(path: Path, text: str) -> None:
 
 def _run_export(tool: Any, slot: int, args: argparse.Namespace) -> None:
     """``tools export``: the tool data text (unchanged contract) or a whole controller file."""
-    whole = args.whole_file or args.output is not None or args.fmt == "yaskawa"
+    from tcpcal.controllers import REGISTRY, export_tool_file
+
+    fmt = REGISTRY[args.fmt]
+    whole = args.whole_file or args.output is not None or not fmt.has_text
     if not whole:
         if args.file_name is not None or args.register is not None:
             raise CliInputError("--name and --register apply to controller files: add --file "
@@ -571,13 +559,13 @@ def _run_export(tool: Any, slot: int, args: argparse.Namespace) -> None:
 
         _emit(export_tool(tool, args.fmt, slot=slot))
         return
-    if args.fmt == "matrix":
-        raise CliInputError("--format matrix has no controller file; use kuka, abb, fanuc, ur "
-                            "or yaskawa with --file/--output")
-    if args.register is not None and args.fmt != "fanuc":
-        raise CliInputError("--register applies only to --format fanuc")
-    from tcpcal.controllers import export_tool_file
-
+    if not fmt.has_file:
+        files = [f.name for f in registered_formats(lambda f: f.has_file)]
+        raise CliInputError(f"--format {fmt.name} has no controller file; use "
+                            f"{', '.join(files[:-1])} or {files[-1]} with --file/--output")
+    if args.register is not None and "register" not in fmt.file_options:
+        raise CliInputError(f"--register applies only to --format "
+                            f"{' or '.join(_option_formats('register'))}")
     options = {} if args.register is None else {"register": args.register}
     text = export_tool_file(tool, args.fmt, number=slot, name=args.file_name, **options)
     if args.output is None:
@@ -585,6 +573,11 @@ def _run_export(tool: Any, slot: int, args: argparse.Namespace) -> None:
     else:
         _write_new(args.output, text)
         _emit(f"Wrote {args.fmt} file for slot {slot} {tool.name!r} to {args.output}")
+
+
+def _option_formats(option: str) -> list[str]:
+    """The formats whose controller file takes ``option`` (``ControllerFormat.file_options``)."""
+    return [f.name for f in registered_formats(lambda f: option in f.file_options)]
 
 
 def _run_poses(args: argparse.Namespace) -> int:

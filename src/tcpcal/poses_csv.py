@@ -15,7 +15,9 @@ layout       columns                     meaning
 ===========  ==========================  ==================================================
 
 (methods.md section 6 and docs/architecture.md "Conventions"; every conversion goes through
-``scipy.spatial.transform.Rotation``.)
+``scipy.spatial.transform.Rotation``.) The table is not kept here: each format module of
+:mod:`tcpcal.controllers` declares its layout (``ControllerFormat.csv``: columns, units, the
+conversion), and :data:`LAYOUTS` and :func:`accepted_layouts_text` read the registry.
 
 Leniency, all documented in docs/cli.md: header names are case-insensitive and may carry
 surrounding whitespace; blank lines and lines starting with ``#`` are skipped; the delimiter is
@@ -40,13 +42,12 @@ from __future__ import annotations
 import csv
 import math
 import sys
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from scipy.spatial.transform import Rotation
-
+from tcpcal.controllers import csv_layouts
 from tcpcal.errors import InvalidInputError
 from tcpcal.validation import ORTHONORMAL_TOL
 
@@ -63,33 +64,33 @@ __all__ = [
 
 POSITION_COLUMNS: tuple[str, ...] = ("x", "y", "z")
 
-#: Orientation layouts: name -> column names, in the order the converter expects them.
-LAYOUTS: dict[str, tuple[str, ...]] = {
-    "kuka": ("a", "b", "c"),
-    "fanuc": ("w", "p", "r"),
-    "abb": ("qw", "qx", "qy", "qz"),
-    "rotvec": ("rx", "ry", "rz"),
-    "matrix": tuple(f"r{i}{j}" for i in (1, 2, 3) for j in (1, 2, 3)),
-}
 
-_LAYOUT_UNITS: dict[str, str] = {
-    "kuka": "KUKA A,B,C in deg",
-    "fanuc": "FANUC W,P,R in deg",
-    "abb": "unit quaternion, scalar first",
-    "rotvec": "rotation vector in rad",
-    "matrix": "rotation matrix, row-major",
-}
+class _Layouts(Mapping[str, tuple[str, ...]]):
+    """Orientation layouts: name -> column names, in the order the converter expects them.
 
-_POSE_COLUMNS = frozenset(POSITION_COLUMNS).union(*LAYOUTS.values())
+    A live view of the ``csv`` layouts the formats of :data:`tcpcal.controllers.REGISTRY`
+    declare (``ControllerFormat.csv``), in the accepted-headers order."""
+
+    def __getitem__(self, name: str) -> tuple[str, ...]:
+        return csv_layouts()[name].columns
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(csv_layouts())
+
+    def __len__(self) -> int:
+        return len(csv_layouts())
+
+    def __repr__(self) -> str:
+        return repr(dict(self))
+
+
+LAYOUTS: Mapping[str, tuple[str, ...]] = _Layouts()
 
 
 def accepted_layouts_text() -> str:
     """One line listing the accepted header layouts (used in error messages and ``--help``)."""
-    def cols_text(name: str, cols: tuple[str, ...]) -> str:
-        return "r11,r12,...,r33" if name == "matrix" else ",".join(cols)
-
-    parts = [f"{','.join(POSITION_COLUMNS)},{cols_text(name, cols)} ({_LAYOUT_UNITS[name]})"
-             for name, cols in LAYOUTS.items()]
+    parts = [f"{','.join(POSITION_COLUMNS)},{lay.header_text or ','.join(lay.columns)} "
+             f"({lay.units})" for lay in csv_layouts().values()]
     return "accepted headers: " + "; ".join(parts)
 
 
@@ -156,15 +157,17 @@ def _detect_delimiter(header_line: str) -> str:
 def _choose_layout(path: Path, line_no: int, names: Sequence[str]) -> str:
     """Return the single orientation layout named by the header ``names``."""
     where = f"{path}, line {line_no} (header)"
+    layouts = {name: lay.columns for name, lay in csv_layouts().items()}
+    pose_columns = frozenset(POSITION_COLUMNS).union(*layouts.values())
     seen: set[str] = set()
     for name in names:
-        if name and name in seen and name in _POSE_COLUMNS:
+        if name and name in seen and name in pose_columns:
             raise _error(f"{where}: column '{name}' appears twice")
         seen.add(name)
     missing_pos = [c for c in POSITION_COLUMNS if c not in seen]
-    complete = [lay for lay, cols in LAYOUTS.items() if all(c in seen for c in cols)]
+    complete = [lay for lay, cols in layouts.items() if all(c in seen for c in cols)]
     partial = {lay: [c for c in cols if c not in seen]
-               for lay, cols in LAYOUTS.items()
+               for lay, cols in layouts.items()
                if any(c in seen for c in cols) and lay not in complete}
     if missing_pos:
         raise _error(f"{where}: missing position column(s) {','.join(missing_pos)} (mm); "
@@ -187,47 +190,18 @@ def _choose_layout(path: Path, line_no: int, names: Sequence[str]) -> str:
 
 def _rotations_from_values(layout: str, v: np.ndarray, where: Callable[[int], str]) -> np.ndarray:
     """Convert the orientation numbers of every row (N, k) to ``R_world_flange`` (N, 3, 3)
-    with scipy, in one call per file; the first row that is not a rotation raises the error
-    naming it (``where(i)`` = file, line and data row of row i)."""
+    with the layout's own conversion (``CsvLayout.to_rotations``, scipy), in one call per file;
+    the first row that is not a rotation raises the error naming it (``where(i)`` = file, line
+    and data row of row i)."""
+    lay = csv_layouts()[layout]
+    rot = lay.to_rotations(v, where)
     n = v.shape[0]
-    if layout == "abb":
-        norm = np.sqrt(np.einsum("ij,ij->i", v, v))
-        bad = ~(np.abs(norm - 1.0) <= ORTHONORMAL_TOL)
-        if bad.any():
-            i = int(np.argmax(bad))
-            raise _error(f"{where(i)}: quaternion qw,qx,qy,qz has norm {norm[i]:.9g}, not 1 within "
-                         f"{ORTHONORMAL_TOL:g}; check the column order and print more digits",
-                         index=i)
-        return Rotation.from_quat(v[:, [1, 2, 3, 0]]).as_matrix()  # scipy order x, y, z, w
-    if layout == "matrix":
-        m = v.reshape(n, 3, 3)
-        defect = np.abs(np.einsum("nji,njk->nik", m, m) - np.eye(3)).reshape(n, 9).max(axis=1)
-        bad = ~(defect <= ORTHONORMAL_TOL)
-        if bad.any():
-            i = int(np.argmax(bad))
-            raise _error(f"{where(i)}: rotation r11..r33 is not orthonormal within "
-                         f"{ORTHONORMAL_TOL:g} (max |R^T R - I| = {defect[i]:.3g}); check the "
-                         f"row-major column order and print more digits", index=i)
-        det = np.linalg.det(m)
-        if (det < 0).any():
-            i = int(np.argmax(det < 0))
-            raise _error(f"{where(i)}: rotation r11..r33 is a reflection (det = -1), not a "
-                         f"rotation; check the row-major column order", index=i)
-        return Rotation.from_matrix(m).as_matrix()
-    if layout == "kuka":
-        rot = Rotation.from_euler("ZYX", v, degrees=True).as_matrix()
-    elif layout == "fanuc":
-        rot = Rotation.from_euler("xyz", v, degrees=True).as_matrix()
-    elif layout == "rotvec":
-        rot = Rotation.from_rotvec(v).as_matrix()
-    else:  # pragma: no cover
-        raise AssertionError(layout)
     bad = ~np.isfinite(rot.reshape(n, 9)).all(axis=1)
     if bad.any():  # e.g. a rotation vector of length 1e308 (its norm overflows)
         i = int(np.argmax(bad))
-        cols = ",".join(LAYOUTS[layout])
+        cols = ",".join(lay.columns)
         raise _error(f"{where(i)}: {cols} = {', '.join(f'{x:g}' for x in v[i])} give no finite "
-                     f"rotation (numbers too large); check the unit ({_LAYOUT_UNITS[layout]})",
+                     f"rotation (numbers too large); check the unit ({lay.units})",
                      index=i)
     return rot
 
@@ -339,7 +313,7 @@ def read_poses_csv(path: str | Path, *, min_rows: int = 1, max_rows: int | None 
         raise _error(f"{path}: CSV syntax error: {exc}") from None
     names = [h.strip().lower() for h in parsed[0]]
     layout = _choose_layout(path, header_no, names)
-    pose_cols = POSITION_COLUMNS + LAYOUTS[layout]
+    pose_cols = POSITION_COLUMNS + csv_layouts()[layout].columns
     col_index = [names.index(c) for c in pose_cols]
     label_col = next((names.index(c) for c in ("name", "label") if c in names), None)
     role_col = names.index("role") if "role" in names else None

@@ -1,99 +1,175 @@
-"""Controller files: tool data as files a controller loads, and touch poses read back from
-program files (docs/formats.md).
+"""Controller formats: tool data text, files a controller loads, touch poses read back from
+program files, and the POSES.csv layouts (docs/formats.md, docs/architecture.md "Controller
+formats").
 
-One module per controller (``kuka``, ``abb``, ``fanuc``, ``ur``, ``yaskawa``); this registry
-names each format, its file name, value layout and angle convention, and its functions: adding
-a format touches one module, its tests and the :data:`CONTROLLER_FORMATS` entry. Lengths are
-mm (UR files: m), angles deg (UR: rad); every rotation goes through scipy's ``Rotation``.
+One module per format (``kuka``, ``abb``, ``fanuc``, ``ur``, ``yaskawa`` and the ``matrix``
+pseudo-format); each ends with ``FORMAT = ControllerFormat(...)`` declaring its name, label,
+value layout, angle convention, slot and name rules, and its render/parse functions. Every
+module of this package whose name does not start with ``_`` and that defines ``FORMAT`` is
+registered in :data:`REGISTRY` when the package is imported: adding a format touches one module
+(and its tests). Lengths are mm (UR: m), angles deg (UR: rad); every rotation goes through
+scipy's ``Rotation``.
 """
 
 from __future__ import annotations
 
+import importlib
+import pkgutil
 import re
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
-from pathlib import PurePath
+from typing import overload
 
-from tcpcal.controllers import abb, fanuc, kuka, ur, yaskawa
 from tcpcal.controllers._common import ControllerFileError, RecordedPose, ToolEntry, fixed
+from tcpcal.controllers._format import ControllerFormat, CsvLayout
+from tcpcal.errors import InvalidInputError
 from tcpcal.tool import Tool
 
 __all__ = [
     "CONTROLLER_FORMATS",
     "POSE_FORMATS",
+    "REGISTRY",
     "ControllerFileError",
     "ControllerFormat",
+    "CsvLayout",
     "PoseImport",
     "RecordedPose",
     "ToolEntry",
+    "csv_layouts",
     "detect_pose_format",
     "export_tool_file",
+    "formats",
+    "get_format",
     "import_poses",
     "parse_tool_file",
     "poses_csv_text",
+    "register",
+    "unregister",
 ]
 
+REGISTRY: dict[str, ControllerFormat] = {}
+"""Every format by name (filled from this package's modules at import; :func:`register`)."""
 
-@dataclass(frozen=True)
-class ControllerFormat:
-    """One controller's files.
+_RESERVED_NAMES = frozenset({"auto"})
+_RESERVED_COLUMNS = frozenset({"x", "y", "z", "name", "label", "role"})
 
-    Attributes:
-        name: the ``--format`` value.
-        label: the controller, in words.
-        filename: the default file name of an exported tool (``{n}`` = tool number).
-        values: the value layout of the tool frame, with units.
-        angle_convention: the rotation convention, in words and as a formula.
-        pose_extensions: file extensions of program files with poses (empty: no pose import).
-        csv_layout: the POSES.csv layout its poses are printed in (docs/cli.md "POSES.csv").
+
+def register(fmt: ControllerFormat, *, replace: bool = False) -> ControllerFormat:
+    """Add ``fmt`` to :data:`REGISTRY` (the format modules do this through ``FORMAT``).
+
+    Raises:
+        InvalidInputError: the name is not a lower-case word or is taken (unless
+            ``replace``), or its POSES.csv layout reuses a name or column of another layout.
     """
+    if not re.fullmatch(r"[a-z][a-z0-9_]*", fmt.name) or fmt.name in _RESERVED_NAMES:
+        raise InvalidInputError(f"format name {fmt.name!r} must be a lower-case word, not "
+                                f"{', '.join(sorted(_RESERVED_NAMES))}")
+    if fmt.name in REGISTRY and not replace:
+        raise InvalidInputError(f"format {fmt.name!r} is registered already")
+    if fmt.csv is not None:
+        others = [f.csv for n, f in REGISTRY.items() if f.csv is not None and n != fmt.name]
+        for other in others:
+            clash = set(other.columns) & set(fmt.csv.columns)
+            if other.name == fmt.csv.name or clash:
+                raise InvalidInputError(
+                    f"format {fmt.name!r}: POSES.csv layout {fmt.csv.name!r} clashes with "
+                    f"layout {other.name!r} ({', '.join(sorted(clash)) or 'same name'})")
+        bad = [c for c in fmt.csv.columns
+               if c in _RESERVED_COLUMNS or re.fullmatch(r"j\d+", c) or c != c.lower()]
+        if bad:
+            raise InvalidInputError(f"format {fmt.name!r}: POSES.csv columns {bad} are taken "
+                                    "(x, y, z, name, label, role, j1..) or not lower case")
+    REGISTRY[fmt.name] = fmt
+    return fmt
 
-    name: str
-    label: str
-    filename: str
-    values: str
-    angle_convention: str
-    render_tool: Callable[..., str]
-    parse_tool: Callable[[str], list[ToolEntry]]
-    parse_poses: Callable[[str], list[RecordedPose]] | None = None
-    render_poses: Callable[[Sequence[RecordedPose]], str] | None = None
-    pose_extensions: tuple[str, ...] = ()
-    csv_layout: str = ""
+
+def unregister(name: str) -> None:
+    """Remove the format ``name`` from :data:`REGISTRY` (tests of a toy format)."""
+    REGISTRY.pop(name, None)
 
 
-CONTROLLER_FORMATS: dict[str, ControllerFormat] = {f.name: f for f in (
-    ControllerFormat("kuka", "KUKA KR C ($config.dat lines)", "tool{n}_config.dat",
-                     "TOOL_DATA[n]={X,Y,Z mm, A,B,C deg}, TOOL_NAME[n,]",
-                     "R = Rz(A) Ry(B) Rx(C) (A about Z, B about the new Y, C about the newest X)",
-                     kuka.render_tool, kuka.parse_tool, kuka.parse_poses, kuka.render_poses,
-                     (".dat",), "kuka"),
-    ControllerFormat("abb", "ABB RAPID module", "tool{n}.mod",
-                     "PERS tooldata name:=[TRUE,[[x,y,z mm],[q1,q2,q3,q4]],[load]]",
-                     "unit quaternion of R_flange_tool, q1 the scalar part",
-                     abb.render_tool, abb.parse_tool, abb.parse_poses, abb.render_poses,
-                     (".mod", ".modx", ".prg", ".sys"), "abb"),
-    ControllerFormat("fanuc", "FANUC TP program (.LS)", "TCPCAL_UT{n}.LS",
-                     "P[1] X,Y,Z mm, W,P,R deg -> PR[m] -> UTOOL[n]",
-                     "R = Rz(R) Ry(P) Rx(W) (W about X, P about Y, R about Z, fixed axes)",
-                     fanuc.render_tool, fanuc.parse_tool, fanuc.parse_poses, fanuc.render_poses,
-                     (".ls",), "fanuc"),
-    ControllerFormat("ur", "Universal Robots URScript", "tcp{n}.script",
-                     "p[x,y,z m, rx,ry,rz rad]",
-                     "rotation vector (axis times angle, rad) of R_flange_tool",
-                     ur.render_tool, ur.parse_tool, ur.parse_poses, ur.render_poses,
-                     (".script", ".urscript", ".urp.script"), "rotvec"),
-    ControllerFormat("yaskawa", "Yaskawa Motoman TOOL.CND entry", "TOOL{n}.CND",
-                     "//TOOL n, ///NAME, X,Y,Z mm, Rx,Ry,Rz deg, load lines",
-                     "R = Rz(Rz) Ry(Ry) Rx(Rx) (about the fixed flange X, then Y, then Z)",
-                     yaskawa.render_tool, yaskawa.parse_tool),
-)}
+def formats(where: Callable[[ControllerFormat], bool] | None = None) -> list[ControllerFormat]:
+    """The registered formats (those for which ``where`` is true), in ``rank`` order."""
+    return sorted((f for f in REGISTRY.values() if where is None or where(f)),
+                  key=lambda f: (f.rank, f.name))
 
-POSE_FORMATS: tuple[str, ...] = tuple(n for n, f in CONTROLLER_FORMATS.items() if f.parse_poses)
+
+def csv_layouts() -> dict[str, CsvLayout]:
+    """The POSES.csv orientation layouts by name, in ``CsvLayout.rank`` order."""
+    lays = sorted((f.csv for f in REGISTRY.values() if f.csv is not None),
+                  key=lambda lay: (lay.rank, lay.name))
+    return {lay.name: lay for lay in lays}
+
+
+class _Formats(Mapping[str, ControllerFormat]):
+    """A live, read-only view of the registered formats that have something (rank order)."""
+
+    def __init__(self, where: Callable[[ControllerFormat], bool]) -> None:
+        self._where = where
+
+    def __getitem__(self, name: str) -> ControllerFormat:
+        fmt = REGISTRY.get(name)
+        if fmt is None or not self._where(fmt):
+            raise KeyError(name)
+        return fmt
+
+    def __iter__(self) -> Iterator[str]:
+        return iter([f.name for f in formats(self._where)])
+
+    def __len__(self) -> int:
+        return len(formats(self._where))
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}({list(self)})"
+
+
+class _Names(Sequence[str]):
+    """A live, read-only tuple-like view of the names of the formats that have something."""
+
+    def __init__(self, where: Callable[[ControllerFormat], bool]) -> None:
+        self._where = where
+
+    def _names(self) -> tuple[str, ...]:
+        return tuple(f.name for f in formats(self._where))
+
+    @overload
+    def __getitem__(self, i: int) -> str: ...
+    @overload
+    def __getitem__(self, i: slice) -> tuple[str, ...]: ...
+    def __getitem__(self, i: int | slice) -> str | tuple[str, ...]:
+        return self._names()[i]
+
+    def __len__(self) -> int:
+        return len(self._names())
+
+    def __eq__(self, other: object) -> bool:
+        return self._names() == (tuple(other) if isinstance(other, Sequence) else other)
+
+    def __hash__(self) -> int:
+        return hash(self._names())
+
+    def __repr__(self) -> str:
+        return repr(self._names())
+
+
+CONTROLLER_FORMATS: Mapping[str, ControllerFormat] = _Formats(lambda f: f.has_file)
+"""The formats with a controller file (``tools export --file``), by name."""
+POSE_FORMATS: Sequence[str] = _Names(lambda f: f.parse_poses is not None)
+"""The names of the formats ``poses import`` reads."""
+
+
+def get_format(name: str) -> ControllerFormat:
+    """The registered format ``name`` (any kind), or an ``InvalidInputError`` listing them."""
+    fmt = REGISTRY.get(name) if isinstance(name, str) else None
+    if fmt is None:
+        raise InvalidInputError(f"unknown format {name!r}; use one of "
+                                f"{', '.join(f.name for f in formats())}")
+    return fmt
 
 
 def _format(name: str) -> ControllerFormat:
-    fmt = CONTROLLER_FORMATS.get(name)
-    if fmt is None:
+    fmt = REGISTRY.get(name)
+    if fmt is None or not fmt.has_file:
         raise ControllerFileError(f"unknown controller format {name!r}; use one of "
                                   f"{', '.join(CONTROLLER_FORMATS)}")
     return fmt
@@ -108,12 +184,12 @@ def export_tool_file(tool: Tool, fmt: str, *, number: int = 1, name: str | None 
         ControllerFileError: unknown format, a number out of the controller's range, a name the
             controller refuses (ABB: ``tool0``, not a RAPID identifier; KUKA > 24 characters).
     """
-    return _format(fmt).render_tool(tool, number, name, **options)
+    return _format(fmt).render_file(tool, number, name, **options)  # type: ignore[misc]
 
 
 def parse_tool_file(text: str, fmt: str) -> list[ToolEntry]:
     """The tool frames in a controller file (the inverse of :func:`export_tool_file`)."""
-    return _format(fmt).parse_tool(text)
+    return _format(fmt).parse_file(text)  # type: ignore[misc]
 
 
 @dataclass(frozen=True)
@@ -125,28 +201,32 @@ class PoseImport:
     warnings: tuple[str, ...]
 
 
+def _or_list(items: Sequence[str]) -> str:
+    return items[0] if len(items) == 1 else f"{', '.join(items[:-1])} or {items[-1]}"
+
+
 def detect_pose_format(text: str, filename: str | None = None) -> str:
     """The controller of a program file: from its extension, else from its content."""
+    readers = formats(lambda f: f.parse_poses is not None)
     if filename:
+        from pathlib import PurePath
+
         suffix = PurePath(filename).suffix.lower()
-        for name in POSE_FORMATS:
-            if suffix in CONTROLLER_FORMATS[name].pose_extensions:
-                return name
-    if re.search(r"\b(E6POS|POS)\s+\w+\s*=\s*\{", text, re.I):
-        return "kuka"
-    if re.search(r"\brobtarget\b", text, re.I):
-        return "abb"
-    if re.search(r"^/POS\b", text, re.M):
-        return "fanuc"
-    if re.search(r"\bp\[", text):
-        return "ur"
+        for fmt in readers:
+            if suffix in fmt.pose_extensions:
+                return fmt.name
+    for fmt in readers:
+        if fmt.detect is not None and fmt.detect.search(text):
+            return fmt.name
     raise ControllerFileError(
-        "cannot tell which controller wrote this file (no KUKA E6POS/POS, ABB robtarget, "
-        "FANUC /POS or UR p[...] found); pass --format kuka|abb|fanuc|ur")
+        "cannot tell which controller wrote this file (no "
+        f"{_or_list([f.detect_text for f in readers if f.detect is not None])} found); pass "
+        f"--format {'|'.join(f.name for f in readers)}")
 
 
 def import_poses(text: str, fmt: str = "auto", *, filename: str | None = None) -> PoseImport:
-    """Read the recorded positions of a KUKA ``.dat``, ABB ``.mod``, FANUC ``.LS`` or UR script.
+    """Read the recorded positions of a program file (KUKA ``.dat``, ABB ``.mod``, FANUC
+    ``.LS``, UR script: every format with ``parse_poses``).
 
     The solver needs flange poses in WORLD: positions recorded with no tool (KUKA TOOL_NO 0,
     FANUC UT 0, ABB tool0, UR TCP = flange) and no base / user frame. Where the file says which
@@ -173,38 +253,37 @@ def import_poses(text: str, fmt: str = "auto", *, filename: str | None = None) -
     if based:
         warnings.append(f"{', '.join(based)} recorded in a base / user frame (not 0): record the "
                         "touches in WORLD (base 0)")
-    if name == "ur" and _ur_sets_a_tcp(text):
-        warnings.append("the script sets a TCP: poses recorded with a TCP active are TCP poses, "
-                        "not the flange; record the touches with the TCP at the flange")
+    if cf.pose_warnings is not None:
+        warnings.extend(cf.pose_warnings(text))
     return PoseImport(name, poses, tuple(warnings))
-
-
-def _ur_sets_a_tcp(text: str) -> bool:
-    """The script sets a TCP other than the flange (``set_tcp(p[0, 0, 0, 0, 0, 0])`` is fine)."""
-    try:
-        tcps = ur.parse_tool(text)
-    except ControllerFileError:
-        return bool(re.search(r"set_tcp\s*\(", text))  # a TCP we cannot read: say so
-    return any(max(map(abs, t.tcp_mm)) > 0 or abs(t.rotation.trace() - 3.0) > 1e-12
-               for t in tcps)
-
-
-_CSV_HEADERS = {"kuka": "a,b,c", "fanuc": "w,p,r", "abb": "qw,qx,qy,qz", "rotvec": "rx,ry,rz"}
-_CSV_DECIMALS = {"kuka": 6, "fanuc": 6, "abb": 9, "rotvec": 9}
 
 
 def poses_csv_text(imported: PoseImport) -> str:
     """POSES.csv (docs/cli.md) of imported poses: ``name,x,y,z`` and the controller's own
-    orientation layout, numbers with fixed decimals (mm 4)."""
-    layout = CONTROLLER_FORMATS[imported.format].csv_layout
-    rows = [f"name,x,y,z,{_CSV_HEADERS[layout]}"]
+    orientation layout (``ControllerFormat.csv``), numbers with fixed decimals (mm 4)."""
+    layout = REGISTRY[imported.format].csv
+    if layout is None:
+        raise ControllerFileError(f"{imported.format}: the format has no POSES.csv layout")
+    rows = [f"name,x,y,z,{','.join(layout.columns)}"]
     for p in imported.poses:
-        values: Sequence[float] = p.values
-        if layout == "abb":  # normalised, so the CSV reader's 1e-6 check passes
-            q = [float(v) for v in p.values]
-            n = sum(v * v for v in q) ** 0.5
-            values = [v / n for v in q]
+        values = p.values if layout.row_values is None else layout.row_values(p)
         name = p.name.replace(",", "_").replace('"', "")
         rows.append(",".join([name, *(fixed(v, 4) for v in p.position_mm),
-                              *(fixed(v, _CSV_DECIMALS[layout]) for v in values)]))
+                              *(fixed(v, layout.decimals) for v in values)]))
     return "\n".join(rows) + "\n"
+
+
+def _discover() -> None:
+    """Register the ``FORMAT`` of every public module of this package."""
+    for info in sorted(pkgutil.iter_modules(__path__), key=lambda m: m.name):
+        if info.name.startswith("_"):
+            continue
+        module = importlib.import_module(f"{__name__}.{info.name}")
+        fmt = getattr(module, "FORMAT", None)
+        if isinstance(fmt, ControllerFormat):
+            register(fmt)
+
+
+_discover()
+
+from tcpcal.controllers import abb, fanuc, kuka, matrix, ur, yaskawa  # noqa: E402  (modules)

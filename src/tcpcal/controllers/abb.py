@@ -7,12 +7,18 @@ orientation ``R_flange_tool`` as a unit quaternion, ``q1`` the scalar part (writ
 letter, then letters, digits, ``_``; at most 32 characters), not a reserved word and not the
 predefined ``tool0``. Positions: ``robtarget`` declarations ``[[x,y,z],[q1..q4],[cf..],[eax..]]``.
 docs/formats.md cites the public examples.
+
+Tool data text (``tcpcal.formats``, ``tcpcal convert``): the one-line ``PERS tooldata``
+declaration with ``repr`` numbers and the tool name made a RAPID identifier (module docstring
+of :mod:`tcpcal.formats`). POSES.csv layout ``abb``: columns ``qw, qx, qy, qz``. :data:`FORMAT`
+declares all of it.
 """
 
 from __future__ import annotations
 
 import re
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from typing import Any
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -26,10 +32,21 @@ from tcpcal.controllers._common import (
     line_of,
     to_float,
 )
+from tcpcal.controllers._format import (
+    TEXT_NUM,
+    ControllerFormat,
+    CsvLayout,
+    text_float,
+    text_number,
+    tool_from_rotation,
+)
+from tcpcal.errors import InvalidInputError
 from tcpcal.tool import Tool
+from tcpcal.validation import ORTHONORMAL_TOL
 
-__all__ = ["RESERVED", "check_identifier", "parse_poses", "parse_tool", "render_poses",
-           "render_tool"]
+__all__ = ["DEFAULT_MASS_KG", "FORMAT", "RESERVED", "check_identifier", "parse_poses",
+           "parse_text", "parse_tool", "render_poses", "render_text", "render_tool",
+           "text_identifier"]
 
 DEFAULT_MASS_KG = 0.001
 QUAT_TOL = 1e-3
@@ -154,3 +171,194 @@ def render_poses(poses: Sequence[RecordedPose], module: str = "touches") -> str:
                      "[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]];")
     lines.append("ENDMODULE")
     return "\n".join(lines) + "\n"
+
+
+# ------------------------------------------------------------------ tool data text
+_DEFAULT_COG = (0.0, 0.0, 0.001)
+_TEXT_DECL = re.compile(r"tooldata\s+([A-Za-z]\w*)\s*:=", re.IGNORECASE)
+_TEXT_TOKEN = re.compile(rf"\s*(\[|\]|,|TRUE|FALSE|{TEXT_NUM})", re.IGNORECASE)
+_TEXT_RESERVED = RESERVED - {"TASK"}
+"""The reserved words the tool data text has always avoided (``TASK`` is not among them)."""
+
+
+def text_identifier(name: str) -> str:
+    """A RAPID identifier for ``name`` (the tool data text): every character that is not an
+    ASCII letter, digit or ``_`` becomes ``_``, a ``t`` is put first if it does not start with
+    a letter or is a reserved word; at most 32 characters."""
+    ident = re.sub(r"\W", "_", name, flags=re.ASCII)
+    if not re.match(r"[A-Za-z]", ident) or ident.upper() in _TEXT_RESERVED:
+        ident = "t" + ident
+    return ident[:32]
+
+
+def render_text(tool: Tool, slot: int = 1) -> str:
+    """``PERS tooldata <identifier>:=[TRUE,[[x,y,z],[q1,q2,q3,q4]],[mass,[0,0,0.001],
+    [1,0,0,0],0,0,0]];`` on one line (mm; ``q1 >= 0``; unknown mass as tool0's 0.001 kg;
+    ``slot`` is not written)."""
+    q1234 = _quaternion(tool.rotation)
+    mass = DEFAULT_MASS_KG if tool.mass_kg is None else tool.mass_kg
+    cog = _DEFAULT_COG  # tcpcal knows no centre of gravity (tcpcal.formats docstring)
+
+    def lst(v: Sequence[float]) -> str:
+        return "[" + ",".join(text_number(x, True) for x in v) + "]"
+
+    return (
+        f"PERS tooldata {text_identifier(tool.name)}:=[TRUE,[{lst(tool.tcp_mm)},{lst(q1234)}],"
+        f"[{text_number(mass, True)},{lst(cog)},[1,0,0,0],0,0,0]];\n"
+    )
+
+
+def _parse_aggregate(text: str, start: int) -> Any:
+    """Parse a RAPID aggregate ``[a,[b,c],...]`` beginning at ``text[start] == '['``."""
+    pos = start
+
+    def token() -> str:
+        nonlocal pos
+        m = _TEXT_TOKEN.match(text, pos)
+        if not m:
+            snippet = text[pos:pos + 20].strip() or "end of text"
+            raise InvalidInputError(f"abb: could not parse the tooldata near {snippet!r}.")
+        pos = m.end()
+        return m.group(1)
+
+    def value(tok: str) -> Any:
+        if tok == "[":
+            items: list[Any] = []
+            tok = token()
+            if tok == "]":
+                return items
+            while True:
+                items.append(value(tok))
+                tok = token()
+                if tok == "]":
+                    return items
+                if tok != ",":
+                    raise InvalidInputError(
+                        f"abb: expected ',' or ']' in the tooldata, got {tok!r}."
+                    )
+                tok = token()
+        if tok in ("]", ","):
+            raise InvalidInputError(f"abb: unexpected {tok!r} in the tooldata.")
+        if tok.upper() in ("TRUE", "FALSE"):
+            return tok.upper() == "TRUE"
+        return text_float(tok, "abb", "value")
+
+    return value(token())
+
+
+def _aggregate_numbers(v: Any, n: int, what: str) -> list[float]:
+    if (
+        not isinstance(v, list) or len(v) != n
+        or any(isinstance(x, (bool, list)) for x in v)
+    ):
+        raise InvalidInputError(f"abb: {what} must be [{n} numbers], got {v!r}.")
+    return [float(x) for x in v]
+
+
+def parse_text(text: str, name: str | None) -> Tool:
+    """One ``tooldata`` declaration (``PERS``/``CONST``/``VAR``/``TASK PERS``) or the bare
+    aggregate; ``robhold`` FALSE is refused; tool0's load maps back to ``mass_kg=None``."""
+    decls = _TEXT_DECL.findall(text)
+    if len(decls) > 1:
+        raise InvalidInputError(
+            f"abb: found {len(decls)} tooldata declarations ({', '.join(decls)}); paste only "
+            "the one to import."
+        )
+    m = _TEXT_DECL.search(text)
+    found_name = m.group(1) if m else None
+    start = text.find("[", m.end() if m else 0)
+    if start < 0:
+        raise InvalidInputError(
+            "abb: no tooldata found; paste a line like PERS tooldata t1:=[TRUE,[[x,y,z],"
+            "[q1,q2,q3,q4]],[mass,[cx,cy,cz],[1,0,0,0],0,0,0]];"
+        )
+    agg = _parse_aggregate(text, start)
+    if not (isinstance(agg, list) and len(agg) == 3):
+        raise InvalidInputError(
+            "abb: tooldata must have 3 parts [robhold, tframe, tload], got "
+            f"{len(agg) if isinstance(agg, list) else agg!r} parts."
+        )
+    robhold, tframe, tload = agg
+    if not isinstance(robhold, bool):
+        raise InvalidInputError(f"abb: robhold must be TRUE or FALSE, got {robhold!r}.")
+    if not robhold:
+        raise InvalidInputError(
+            "abb: robhold is FALSE (a stationary tool, its frame is in WORLD); tcpcal imports "
+            "robot-held tools only."
+        )
+    if not (isinstance(tframe, list) and len(tframe) == 2):
+        raise InvalidInputError(f"abb: tframe must be [[x,y,z],[q1,q2,q3,q4]], got {tframe!r}.")
+    trans = _aggregate_numbers(tframe[0], 3, "tframe.trans")
+    q = np.array(_aggregate_numbers(tframe[1], 4, "tframe.rot (quaternion q1..q4)"))
+    norm = float(np.linalg.norm(q))
+    if abs(norm - 1.0) > 1e-3:
+        raise InvalidInputError(
+            f"abb: the quaternion {q.tolist()} has norm {norm:.6g}; a rotation quaternion has "
+            "norm 1 (check that all four values were copied)."
+        )
+    if not (isinstance(tload, list) and len(tload) == 6):
+        raise InvalidInputError(
+            "abb: tload must be [mass,[cx,cy,cz],[q1,q2,q3,q4],ix,iy,iz], got "
+            f"{tload!r}."
+        )
+    if isinstance(tload[0], (bool, list)):
+        raise InvalidInputError(f"abb: tload mass must be a number, got {tload[0]!r}.")
+    mass = float(tload[0])
+    cog = _aggregate_numbers(tload[1], 3, "tload.cog")
+    if mass <= 0:
+        raise InvalidInputError(f"abb: tload mass must be positive (kg), got {mass!r}.")
+    mass_kg = None if (mass == DEFAULT_MASS_KG and tuple(cog) == _DEFAULT_COG) else mass
+    R = Rotation.from_quat([q[1], q[2], q[3], q[0]]).as_matrix()  # scipy order x, y, z, w
+    return tool_from_rotation(
+        "abb", name or found_name or "imported", name is not None, trans, R, mass_kg=mass_kg
+    )
+
+
+def _values_to_text(values: Sequence[float]) -> str:
+    """x, y, z mm; q1..q4 (q1 scalar) as a bare tooldata aggregate, unknown load as tool0's."""
+    v = [repr(float(x)) for x in values]
+    return (f"[TRUE,[[{v[0]},{v[1]},{v[2]}],[{','.join(v[3:7])}]],"
+            f"[0.001,[0,0,0.001],[1,0,0,0],0,0,0]]")
+
+
+def _rotation_from_q(q: Sequence[float]) -> np.ndarray:
+    q = np.asarray(q, dtype=float)
+    return Rotation.from_quat(np.stack([q[..., 1], q[..., 2], q[..., 3], q[..., 0]], axis=-1)
+                              ).as_matrix()
+
+
+def _csv_rotations(v: np.ndarray, where: Callable[[int], str]) -> np.ndarray:
+    norm = np.sqrt(np.einsum("ij,ij->i", v, v))
+    bad = ~(np.abs(norm - 1.0) <= ORTHONORMAL_TOL)
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise InvalidInputError(
+            f"{where(i)}: quaternion qw,qx,qy,qz has norm {norm[i]:.9g}, not 1 within "
+            f"{ORTHONORMAL_TOL:g}; check the column order and print more digits", index=i)
+    return Rotation.from_quat(v[:, [1, 2, 3, 0]]).as_matrix()  # scipy order x, y, z, w
+
+
+def _csv_row(pose: RecordedPose) -> list[float]:
+    """The quaternion of a pose normalised, so the CSV reader's 1e-6 check passes."""
+    q = [float(v) for v in pose.values]
+    n = sum(v * v for v in q) ** 0.5
+    return [v / n for v in q]
+
+
+FORMAT = ControllerFormat(
+    name="abb", label="ABB", rank=20,
+    angle_convention="unit quaternion of R_flange_tool, q1 the scalar part",
+    rotation_from_angles=_rotation_from_q,
+    angles_from_rotation=lambda rot: tuple(float(v) for v in _quaternion(rot)),
+    numbers="x,y,z,q1,q2,q3,q4 mm/unit quaternion scalar first", value_counts=(7,),
+    values_to_text=_values_to_text, render_text=render_text, parse_text=parse_text,
+    name_rule="a RAPID identifier (a letter, then letters, digits or _, at most 32), not a "
+              "reserved word, not tool0",
+    controller="ABB RAPID module", filename="tool{n}.mod",
+    values="PERS tooldata name:=[TRUE,[[x,y,z mm],[q1,q2,q3,q4]],[load]]",
+    render_file=render_tool, parse_file=parse_tool, parse_poses=parse_poses,
+    render_poses=render_poses, pose_extensions=(".mod", ".modx", ".prg", ".sys"),
+    detect=re.compile(r"\brobtarget\b", re.I), detect_text="ABB robtarget",
+    csv=CsvLayout("abb", ("qw", "qx", "qy", "qz"), "unit quaternion, scalar first",
+                  _csv_rotations, decimals=9, rank=30, row_values=_csv_row),
+)

@@ -7,6 +7,11 @@ write a frame from constants). ``R = Rz(R) Ry(P) Rx(W)``: W about X, P about Y, 
 fixed axes (scipy ``from_euler("xyz", [W, P, R])``). Sections ``/PROG``, ``/ATTR``, ``/MN``,
 ``/POS``, ``/END``. Positions: ``P[n]{ GP1: UF : u, UT : t, CONFIG : '...', X = .. mm, ...
 R = .. deg };`` in ``/POS``. docs/formats.md cites the public examples.
+
+Tool data text (``tcpcal.formats``, ``tcpcal convert``): the *Tool Frame / Direct Entry*
+screen, ``UTOOL[n] Direct Entry``, ``Comment:`` (16 characters), ``X: ..`` ... ``R: ..``
+(module docstring of :mod:`tcpcal.formats`). POSES.csv layout ``fanuc``: columns ``w, p, r``
+(deg). :data:`FORMAT` declares all of it.
 """
 
 from __future__ import annotations
@@ -26,11 +31,25 @@ from tcpcal.controllers._common import (
     line_of,
     to_float,
 )
+from tcpcal.controllers._format import (
+    TEXT_NUM,
+    ControllerFormat,
+    CsvLayout,
+    check_slot,
+    text_float,
+    text_number,
+    tool_from_rotation,
+)
+from tcpcal.errors import InvalidInputError
 from tcpcal.tool import Tool, abc_deg_from_rotation
 
-__all__ = ["parse_poses", "parse_tool", "render_poses", "render_tool"]
+__all__ = ["COMMENT_LENGTH", "FORMAT", "parse_poses", "parse_text", "parse_tool",
+           "render_poses", "render_text", "render_tool"]
 
 N_TOOLS = 10
+TOOL_NUMBERS = range(1, N_TOOLS + 1)
+COMMENT_LENGTH = 16
+"""Characters of a tool frame comment on the pendant (the text writes the first 16)."""
 N_REGISTERS = 100
 DEFAULT_REGISTER = 100
 _P = re.compile(r"^\s*P\[\s*(\d+)\s*(?::\s*\"([^\"]*)\")?\s*\]\s*\{(.*?)\}\s*;", re.S | re.M)
@@ -76,7 +95,7 @@ def render_tool(tool: Tool, number: int, name: str | None = None, *,
                 register: int = DEFAULT_REGISTER) -> str:
     """A TP program ``TCPCAL_UT<n>`` that writes the frame to ``PR[register]`` and sets
     ``UTOOL[number]`` from it."""
-    if not 1 <= number <= N_TOOLS:
+    if number not in TOOL_NUMBERS:
         raise ControllerFileError(f"fanuc: tool frame number must be 1..{N_TOOLS}, got {number}")
     if not 1 <= register <= N_REGISTERS:
         raise ControllerFileError(f"fanuc: position register must be 1..{N_REGISTERS}, got "
@@ -164,3 +183,93 @@ def render_poses(poses: Sequence[RecordedPose], program: str = "TOUCHES") -> str
                     for k, p in enumerate(poses, 1))
     return (f"/PROG  {program}\n" + _ATTR.format(comment="tcpcal touches", lines=len(mn))
             + f"/MN\n{body}\n/POS\n{pos}\n/END\n")
+
+
+# ------------------------------------------------------------------ tool data text
+_TEXT_COMMENT = re.compile(r"^[ \t]*(?:\d+[ \t]+)?Comment[ \t]*:[ \t]*(.*?)[ \t]*$",
+                           re.IGNORECASE | re.MULTILINE)
+_TEXT_FRAME = re.compile(r"(?:UTOOL\s*\[\s*(\d+)\s*\]|Frame\s+Number\s*:\s*(\d+))",
+                         re.IGNORECASE)
+_TEXT_VALUE = re.compile(rf"\b([XYZWPR])\b\s*[:=]?\s*({TEXT_NUM})", re.IGNORECASE)
+
+
+def render_text(tool: Tool, slot: int = 1) -> str:
+    """``UTOOL[n] Direct Entry``, ``Comment: <16 characters>``, ``X: ..`` to ``R: ..`` (mm,
+    deg), as the *Tool Frame / Direct Entry* screen shows it."""
+    n = check_slot(slot, TOOL_NUMBERS, "fanuc")
+    # from_euler("xyz", [W, P, R]) = Rz(R) Ry(P) Rx(W) = from_euler("ZYX", [R, P, W]), so
+    # (W, P, R) is (C, B, A) of KUKA; abc_deg_from_rotation stays exact near P = +-90.
+    wpr = abc_deg_from_rotation(tool.rotation)[::-1]
+    values = (*tool.tcp_mm, *wpr)
+    comment = tool.name[:COMMENT_LENGTH].rstrip()  # the pendant's frame comment field
+    lines = [f"UTOOL[{n}] Direct Entry", f"Comment: {comment}"]
+    lines += [f"{k}: {text_number(v)}" for k, v in zip("XYZWPR", values)]
+    return "\n".join(lines) + "\n"
+
+
+def parse_text(text: str, name: str | None) -> Tool:
+    """``X``, ``Y``, ``Z``, ``W``, ``P``, ``R`` once each (``:``, ``=`` or a space), the name
+    from a ``Comment:`` line, the frame number from ``UTOOL[n]`` or ``Frame Number: n``."""
+    m = _TEXT_COMMENT.search(text)
+    found_name = m.group(1) if m and m.group(1) else None
+    body = _TEXT_COMMENT.sub("", text)
+    frame = _TEXT_FRAME.search(body)
+    frame_no = None
+    if frame:
+        frame_no = int(frame.group(1) or frame.group(2))
+    body = _TEXT_FRAME.sub(" ", body)
+    values: dict[str, float] = {}
+    for key, token in _TEXT_VALUE.findall(body):
+        key = key.upper()
+        if key in values:
+            raise InvalidInputError(
+                f"fanuc: {key} appears twice; paste one tool frame (X, Y, Z, W, P, R once each)."
+            )
+        values[key] = text_float(token, "fanuc", key)
+    missing = [k for k in "XYZWPR" if k not in values]
+    if missing:
+        raise InvalidInputError(
+            f"fanuc: could not find {', '.join(missing)} in the text; a tool frame needs "
+            "X, Y, Z (mm) and W, P, R (deg), e.g. 'X: 12.5' on its own line."
+        )
+    R = Rotation.from_euler(
+        "xyz", [values["W"], values["P"], values["R"]], degrees=True
+    ).as_matrix()
+    default = f"utool{frame_no}" if frame_no is not None else "utool"
+    return tool_from_rotation(
+        "fanuc", name or found_name or default, name is not None,
+        (values["X"], values["Y"], values["Z"]), R,
+    )
+
+
+def _values_to_text(values: Sequence[float]) -> str:
+    """X, Y, Z mm; W, P, R deg as ``X: .. Y: ..`` on one line."""
+    v = [repr(float(x)) for x in values]
+    return " ".join(f"{k}: {x}" for k, x in zip("XYZWPR", v))
+
+
+def rotation_from_wpr(wpr_deg: Sequence[float]) -> np.ndarray:
+    """``R = Rz(R) Ry(P) Rx(W)`` of W, P, R (deg): ``(3, 3)``, or ``(N, 3, 3)`` for ``(N, 3)``."""
+    return Rotation.from_euler("xyz", np.asarray(wpr_deg, dtype=float), degrees=True).as_matrix()
+
+
+def _csv_rotations(values: np.ndarray, where: object) -> np.ndarray:
+    return rotation_from_wpr(values)
+
+
+FORMAT = ControllerFormat(
+    name="fanuc", label="FANUC", rank=30,
+    angle_convention="R = Rz(R) Ry(P) Rx(W) (W about X, P about Y, R about Z, fixed axes)",
+    rotation_from_angles=rotation_from_wpr,
+    angles_from_rotation=lambda rot: tuple(_wpr(rot)),
+    numbers="X,Y,Z,W,P,R mm/deg", value_counts=(6,), values_to_text=_values_to_text,
+    render_text=render_text, parse_text=parse_text, tool_numbers=TOOL_NUMBERS,
+    name_rule=f"a frame comment of {COMMENT_LENGTH} characters",
+    controller="FANUC TP program (.LS)", filename="TCPCAL_UT{n}.LS",
+    values="P[1] X,Y,Z mm, W,P,R deg -> PR[m] -> UTOOL[n]",
+    render_file=render_tool, parse_file=parse_tool, file_options=("register",),
+    parse_poses=parse_poses, render_poses=render_poses, pose_extensions=(".ls",),
+    detect=re.compile(r"^/POS\b", re.M), detect_text="FANUC /POS",
+    csv=CsvLayout("fanuc", ("w", "p", "r"), "FANUC W,P,R in deg", _csv_rotations, decimals=6,
+                  rank=20),
+)

@@ -6,6 +6,10 @@ B about the new Y, C about the newest X; scipy ``from_euler("ZYX", [A, B, C])``)
 decimals, degrees with 4. Positions: ``DECL E6POS XP1={X ..,Y ..,Z ..,A ..,B ..,C ..,S ..,T ..,
 E1 ..}`` and ``DECL POS ...`` in a ``.dat`` file, with the ``FDAT`` of the same point giving
 ``TOOL_NO`` and ``BASE_NO``. docs/formats.md cites the public examples.
+
+Tool data text (``tcpcal.formats``, ``tcpcal convert``): the two lines without comments, numbers
+as ``repr`` (module docstring of :mod:`tcpcal.formats`). POSES.csv layout ``kuka``: columns
+``a, b, c`` (deg). :data:`FORMAT` declares all of it.
 """
 
 from __future__ import annotations
@@ -13,6 +17,7 @@ from __future__ import annotations
 import re
 from collections.abc import Sequence
 
+import numpy as np
 from scipy.spatial.transform import Rotation
 
 from tcpcal.controllers._common import (
@@ -24,11 +29,23 @@ from tcpcal.controllers._common import (
     line_of,
     to_float,
 )
+from tcpcal.controllers._format import (
+    TEXT_NUM,
+    ControllerFormat,
+    CsvLayout,
+    check_slot,
+    make_tool,
+    text_float,
+    text_number,
+)
+from tcpcal.errors import InvalidInputError
 from tcpcal.tool import Tool, abc_deg_from_rotation
 
-__all__ = ["parse_poses", "parse_tool", "render_poses", "render_tool"]
+__all__ = ["FORMAT", "parse_poses", "parse_text", "parse_tool", "render_poses", "render_text",
+           "render_tool"]
 
 N_TOOLS = 16
+TOOL_NUMBERS = range(1, N_TOOLS + 1)
 NAME_CHARS = 24
 _DATA = re.compile(r"TOOL_DATA\s*\[\s*(\d+)\s*\]\s*=\s*\{([^}]*)\}", re.IGNORECASE)
 _POSE = re.compile(r"(?:DECL\s+)?(?:GLOBAL\s+)?\b(E6POS|POS)\s+(\w+)\s*=\s*\{([^}]*)\}",
@@ -137,3 +154,103 @@ def render_poses(poses: Sequence[RecordedPose], module: str = "touches") -> str:
                      "TQ_STATE FALSE}")
     lines.append("ENDDAT")
     return "\n".join(lines) + "\n"
+
+
+# ------------------------------------------------------------------ tool data text
+_TEXT_COMPONENT = re.compile(rf"^\s*([XYZABC])\s*({TEXT_NUM})\s*$", re.IGNORECASE)
+
+
+def render_text(tool: Tool, slot: int = 1) -> str:
+    """``TOOL_DATA[n]={X ..,Y ..,Z ..,A ..,B ..,C ..}`` and ``TOOL_NAME[n,]="name"`` (mm, deg;
+    A, B, C exactly as stored in the tool)."""
+    n = check_slot(slot, TOOL_NUMBERS, "kuka")
+    values = (*tool.tcp_mm, *tool.abc_deg)
+    body = ",".join(f"{k} {text_number(v, True)}" for k, v in zip("XYZABC", values))
+    return f'TOOL_DATA[{n}]={{{body}}}\nTOOL_NAME[{n},]="{tool.name}"\n'
+
+
+def parse_text(text: str, name: str | None) -> Tool:
+    """One ``TOOL_DATA[n]`` (any surrounding declaration), its ``TOOL_NAME[n,]`` and
+    ``LOAD_DATA[n]={M ..}`` mass (``M <= 0``: unknown)."""
+    matches = _DATA.findall(text)
+    if not matches:
+        raise InvalidInputError(
+            "kuka: no TOOL_DATA[n]={X ..,Y ..,Z ..,A ..,B ..,C ..} found; paste the line of "
+            "the tool from $config.dat."
+        )
+    if len(matches) > 1:
+        found = ", ".join(f"TOOL_DATA[{m[0]}]" for m in matches)
+        raise InvalidInputError(
+            f"kuka: found {len(matches)} tools ({found}); paste only the line of the one to "
+            "import."
+        )
+    index, body = matches[0]
+    values: dict[str, float] = {}
+    for piece in body.split(","):
+        m = _TEXT_COMPONENT.match(piece)
+        if not m:
+            raise InvalidInputError(
+                f"kuka: could not parse {piece.strip()!r} in TOOL_DATA[{index}]; each component "
+                "is a letter X, Y, Z, A, B or C, a space and a number."
+            )
+        key = m.group(1).upper()
+        if key in values:
+            raise InvalidInputError(f"kuka: component {key} appears twice in TOOL_DATA[{index}].")
+        values[key] = text_float(m.group(2), "kuka", key)
+    missing = [k for k in "XYZABC" if k not in values]
+    if missing:
+        raise InvalidInputError(
+            f"kuka: TOOL_DATA[{index}] lacks {', '.join(missing)}; a tool frame needs X, Y, Z, "
+            "A, B and C."
+        )
+    found_name = None
+    m = re.search(
+        rf'TOOL_NAME\s*\[\s*{int(index)}\s*,\s*\]\s*=\s*"([^"]*)"', text, re.IGNORECASE
+    )
+    if m:
+        found_name = m.group(1).strip()
+    mass = None
+    m = re.search(
+        rf"LOAD_DATA\s*\[\s*{int(index)}\s*\]\s*=\s*\{{\s*M\s*({TEXT_NUM})", text, re.IGNORECASE
+    )
+    if m:
+        value = text_float(m.group(1), "kuka", "LOAD_DATA mass M")
+        mass = value if value > 0 else None
+    return make_tool(
+        "kuka", name or found_name or f"tool{int(index)}", name is not None,
+        tcp_mm=(values["X"], values["Y"], values["Z"]),
+        abc_deg=(values["A"], values["B"], values["C"]), mass_kg=mass,
+    )
+
+
+def _values_to_text(values: Sequence[float]) -> str:
+    """X, Y, Z mm; A, B, C deg as a ``TOOL_DATA[1]`` line."""
+    v = [repr(float(x)) for x in values]
+    return "TOOL_DATA[1]={" + ",".join(f"{k} {x}" for k, x in zip("XYZABC", v)) + "}"
+
+
+def rotation_from_abc(abc_deg: Sequence[float]) -> np.ndarray:
+    """``R = Rz(A) Ry(B) Rx(C)`` of A, B, C (deg): ``(3, 3)``, or ``(N, 3, 3)`` for ``(N, 3)``."""
+    return Rotation.from_euler("ZYX", np.asarray(abc_deg, dtype=float), degrees=True).as_matrix()
+
+
+def _csv_rotations(values: np.ndarray, where: object) -> np.ndarray:
+    return rotation_from_abc(values)
+
+
+FORMAT = ControllerFormat(
+    name="kuka", label="KUKA", rank=10,
+    angle_convention="R = Rz(A) Ry(B) Rx(C) (A about Z, B about the new Y, C about the newest X)",
+    rotation_from_angles=rotation_from_abc,
+    angles_from_rotation=lambda rot: tuple(float(v) for v in abc_deg_from_rotation(rot)),
+    numbers="X,Y,Z,A,B,C mm/deg", value_counts=(6,), values_to_text=_values_to_text,
+    render_text=render_text, parse_text=parse_text, tool_numbers=TOOL_NUMBERS,
+    name_rule=f"TOOL_NAME holds {NAME_CHARS} characters, no '\"'",
+    controller="KUKA KR C ($config.dat lines)", filename="tool{n}_config.dat",
+    values="TOOL_DATA[n]={X,Y,Z mm, A,B,C deg}, TOOL_NAME[n,]",
+    render_file=render_tool, parse_file=parse_tool, parse_poses=parse_poses,
+    render_poses=render_poses, pose_extensions=(".dat",),
+    detect=re.compile(r"\b(E6POS|POS)\s+\w+\s*=\s*\{", re.I), detect_text="KUKA E6POS/POS",
+    csv=CsvLayout("kuka", ("a", "b", "c"), "KUKA A,B,C in deg", _csv_rotations, decimals=6,
+                  rank=10),
+)

@@ -6,6 +6,11 @@ installation's named TCP (Installation > General > TCP) takes them, in a comment
 global ``tcp_<name>`` that programs can pass to ``set_tcp``. Positions: every 6-number pose
 ``p[...]`` of a script (``global name = p[...]``, ``movel(p[...])``), except the TCP of
 ``set_tcp``; metres are converted to mm. docs/formats.md cites the public examples.
+
+Tool data text (``tcpcal.formats``, ``tcpcal convert``): ``set_tcp(p[x, y, z, rx, ry, rz])``
+with ``repr`` numbers (module docstring of :mod:`tcpcal.formats`). POSES.csv layout
+``rotvec``: columns ``rx, ry, rz`` (rad; positions in mm like every layout). :data:`FORMAT`
+declares all of it.
 """
 
 from __future__ import annotations
@@ -24,9 +29,18 @@ from tcpcal.controllers._common import (
     line_of,
     to_float,
 )
+from tcpcal.controllers._format import (
+    ControllerFormat,
+    CsvLayout,
+    text_float,
+    text_number,
+    tool_from_rotation,
+)
+from tcpcal.errors import InvalidInputError
 from tcpcal.tool import Tool
 
-__all__ = ["parse_poses", "parse_tool", "render_poses", "render_tool"]
+__all__ = ["FORMAT", "parse_poses", "parse_text", "parse_tool", "render_poses", "render_text",
+           "render_tool"]
 
 _POSE = re.compile(r"p\[([^\[\]]*)\]")
 _ASSIGN = re.compile(r"(?:global\s+)?([A-Za-z_]\w*)\s*=\s*$")
@@ -122,3 +136,82 @@ def render_poses(poses: Sequence[RecordedPose]) -> str:
     for k, p in enumerate(poses, 1):
         lines.append(f"global touch_{k} = {_pose_text(p.position_mm, p.rotation)}")
     return "\n".join(lines) + "\n"
+
+
+# ------------------------------------------------------------------ tool data text
+_TEXT_POSE = re.compile(r"\[([^\[\]]*)\]")
+
+
+def render_text(tool: Tool, slot: int = 1) -> str:
+    """``set_tcp(p[x, y, z, rx, ry, rz])``: metres and the rotation vector in radians
+    (``slot`` is not written)."""
+    rotvec = Rotation.from_matrix(tool.rotation).as_rotvec()
+    values = [v / 1000.0 for v in tool.tcp_mm] + list(rotvec)
+    return "set_tcp(p[" + ", ".join(text_number(v) for v in values) + "])\n"
+
+
+def parse_text(text: str, name: str | None) -> Tool:
+    """The one pose ``p[...]`` or ``[...]`` of the text, alone or inside any statement."""
+    poses = _TEXT_POSE.findall(text)
+    if len(poses) != 1:
+        raise InvalidInputError(
+            f"ur: expected one pose p[x, y, z, rx, ry, rz] (metres, rotation vector in rad), "
+            f"found {len(poses)} bracketed lists."
+        )
+    pieces = [p.strip() for p in poses[0].split(",")]
+    if len(pieces) != 6:
+        raise InvalidInputError(
+            f"ur: the pose has {len(pieces)} values; it needs 6: x, y, z (m), rx, ry, rz (rad)."
+        )
+    labels = ("x", "y", "z", "rx", "ry", "rz")
+    values = [text_float(p, "ur", lab) for p, lab in zip(pieces, labels)]
+    R = Rotation.from_rotvec(values[3:]).as_matrix()
+    tcp_mm = [v * 1000.0 for v in values[:3]]
+    return tool_from_rotation("ur", name or "ur_tcp", name is not None, tcp_mm, R)
+
+
+def _pose_warnings(text: str) -> list[str]:
+    """A script that sets a TCP other than the flange (``set_tcp(p[0, 0, 0, 0, 0, 0])`` is
+    fine): its poses may be TCP poses."""
+    try:
+        tcps = parse_tool(text)
+    except ControllerFileError:
+        sets = bool(re.search(r"set_tcp\s*\(", text))  # a TCP we cannot read: say so
+    else:
+        sets = any(max(map(abs, t.tcp_mm)) > 0 or abs(t.rotation.trace() - 3.0) > 1e-12
+                   for t in tcps)
+    return (["the script sets a TCP: poses recorded with a TCP active are TCP poses, not the "
+             "flange; record the touches with the TCP at the flange"] if sets else [])
+
+
+def _values_to_text(values: Sequence[float]) -> str:
+    """x, y, z m; rx, ry, rz rad as ``p[...]``."""
+    return "p[" + ",".join(repr(float(x)) for x in values) + "]"
+
+
+def rotation_from_rotvec(rotvec: Sequence[float]) -> np.ndarray:
+    """The rotation of a rotation vector (rad): ``(3, 3)``, or ``(N, 3, 3)`` for ``(N, 3)``."""
+    return Rotation.from_rotvec(np.asarray(rotvec, dtype=float)).as_matrix()
+
+
+def _csv_rotations(values: np.ndarray, where: object) -> np.ndarray:
+    return rotation_from_rotvec(values)
+
+
+FORMAT = ControllerFormat(
+    name="ur", label="UR", rank=40,
+    angle_convention="rotation vector (axis times angle, rad) of R_flange_tool",
+    rotation_from_angles=rotation_from_rotvec,
+    angles_from_rotation=lambda rot: tuple(
+        float(v) for v in Rotation.from_matrix(rot).as_rotvec()),
+    numbers="x,y,z,rx,ry,rz m/rad", value_counts=(6,), values_to_text=_values_to_text,
+    render_text=render_text, parse_text=parse_text,
+    name_rule="no name in the pose; the file names a global tcp_<name>",
+    controller="Universal Robots URScript", filename="tcp{n}.script",
+    values="p[x,y,z m, rx,ry,rz rad]",
+    render_file=render_tool, parse_file=parse_tool, parse_poses=parse_poses,
+    render_poses=render_poses, pose_extensions=(".script", ".urscript", ".urp.script"),
+    detect=re.compile(r"\bp\["), detect_text="UR p[...]", pose_warnings=_pose_warnings,
+    csv=CsvLayout("rotvec", ("rx", "ry", "rz"), "rotation vector in rad", _csv_rotations,
+                  decimals=9, rank=40),
+)

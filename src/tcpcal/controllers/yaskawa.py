@@ -6,20 +6,26 @@ moments of inertia ``Ix,Iy,Iz`` kg m^2, mass ``W`` kg, two flags), all zero here
 load on the controller. ``R = Rz(Rz) Ry(Ry) Rx(Rx)``, rotations about the fixed flange axes X,
 then Y, then Z (the FANUC W, P, R convention). The file format has no comment syntax, so the
 convention is stated here and in docs/formats.md only. docs/formats.md cites the sources.
+Yaskawa has no tool data text (``convert``) and no pose import: :data:`FORMAT` declares the
+file only.
 """
 
 from __future__ import annotations
 
 import re
+from collections.abc import Sequence
 
+import numpy as np
 from scipy.spatial.transform import Rotation
 
 from tcpcal.controllers._common import ControllerFileError, ToolEntry, fixed, to_float
+from tcpcal.controllers._format import ControllerFormat
 from tcpcal.tool import Tool, abc_deg_from_rotation
 
-__all__ = ["parse_tool", "render_tool"]
+__all__ = ["FORMAT", "parse_tool", "render_tool"]
 
 N_TOOLS = 64
+TOOL_NUMBERS = range(0, N_TOOLS)
 NAME_CHARS = 16
 _ENTRY = re.compile(r"^//TOOL\s+(\d+)\s*$", re.M)
 
@@ -67,3 +73,24 @@ def parse_tool(text: str) -> list[ToolEntry]:
     if not out:
         raise ControllerFileError("yaskawa: no '//TOOL n' entry found")
     return out
+
+
+def _rotation(rxyz_deg: Sequence[float]) -> np.ndarray:
+    return Rotation.from_euler("xyz", np.asarray(rxyz_deg, dtype=float), degrees=True).as_matrix()
+
+
+def _angles(rotation: np.ndarray) -> tuple[float, ...]:
+    rz, ry, rx = abc_deg_from_rotation(rotation)
+    return (float(rx), float(ry), float(rz))
+
+
+FORMAT = ControllerFormat(
+    name="yaskawa", label="Yaskawa", rank=60,
+    angle_convention="R = Rz(Rz) Ry(Ry) Rx(Rx) (about the fixed flange X, then Y, then Z)",
+    rotation_from_angles=_rotation, angles_from_rotation=_angles,
+    tool_numbers=TOOL_NUMBERS,
+    name_rule=f"at most {NAME_CHARS} ASCII characters, no comma",
+    controller="Yaskawa Motoman TOOL.CND entry", filename="TOOL{n}.CND",
+    values="//TOOL n, ///NAME, X,Y,Z mm, Rx,Ry,Rz deg, load lines",
+    render_file=render_tool, parse_file=parse_tool,
+)
