@@ -11,6 +11,7 @@ Typical use::
     result.tcp, result.rms_error, result.ci95_radius
 """
 
+from tcpcal.beam import BeamAxisResult, BeamResult, solve_beam, solve_beam_axis
 from tcpcal.errors import DegenerateTouchesError, InvalidInputError, TcpcalError
 from tcpcal.formats import FORMATS, export_tool, import_tool
 from tcpcal.library import (
@@ -38,6 +39,8 @@ from tcpcal.tool import Calibration, Tool, abc_deg_from_rotation, rotation_from_
 __version__ = "0.1.0"
 
 __all__ = [
+    "BeamAxisResult",
+    "BeamResult",
     "FORMATS",
     "Calibration",
     "CandidateGain",
@@ -60,6 +63,8 @@ __all__ = [
     "import_tool",
     "rotation_from_abc_deg",
     "solve_abc_world",
+    "solve_beam",
+    "solve_beam_axis",
     "solve_reference",
     "solve_tcp_zx",
     "solve_three_point",
