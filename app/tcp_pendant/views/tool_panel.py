@@ -22,13 +22,12 @@ from tcp_pendant.session import Session
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.gui_util import number_of_option, set_options, slot_option
 from tcpcal.errors import TcpcalError
-from tcpcal.formats import FORMATS, export_tool
+from tcpcal.formats import FORMATS, export_tool, text_format
 from tcpcal.tool import Tool
 
 __all__ = ["NO_TOOL", "ToolPanel"]
 
 NO_TOOL = "(library empty)"
-_FORMAT_LABELS = {"kuka": "KUKA", "abb": "ABB", "fanuc": "FANUC", "ur": "UR", "matrix": "Matrix"}
 
 
 class ToolPanel:
@@ -54,7 +53,7 @@ class ToolPanel:
             self.rename = gui.add_button("Rename")
             self.delete = gui.add_button("Delete", color="red")
         with gui.add_folder("Export", expand_by_default=False):
-            self.export_fmt = gui.add_dropdown("Format", [_FORMAT_LABELS[f] for f in FORMATS], initial_value="KUKA")
+            self.export_fmt = gui.add_dropdown("Format", [text_format(f).label for f in FORMATS], initial_value="KUKA")
             self.export = gui.add_button("Export")
             self.export_text = gui.add_text("Controller text", "", multiline=True,
                                             hint="Select and copy into the controller.")
@@ -217,10 +216,11 @@ class ToolPanel:
     def _on_export(self, _event: Any) -> None:
         slot, tool = self._selected()
         label = str(self.export_fmt.value)
-        fmt = next((f for f, lab in _FORMAT_LABELS.items() if lab == label), None)
+        fmt = next((f for f in FORMATS if text_format(f).label == label), None)
         if fmt is None:
             raise ValueError(f"Unknown export format {label!r}.")
-        kw = {"slot": slot} if fmt in ("kuka",) or (fmt == "fanuc" and slot <= 10) else {}
+        number = text_format(fmt).slot_for(slot)  # the controller's tool numbers, else its default
+        kw = {} if number is None else {"slot": number}
         self.export_text.value = export_tool(tool, fmt, **kw)
 
     def _entry(self) -> ToolEntry:
