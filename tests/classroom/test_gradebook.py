@@ -284,6 +284,13 @@ def test_create_false_does_not_make_a_file(tmp_path: Path) -> None:
         Gradebook(tmp_path)
 
 
+def test_a_path_in_a_missing_folder_says_so(tmp_path: Path) -> None:
+    path = tmp_path / "no-such-folder" / "c.sqlite3"
+    with pytest.raises(GradebookError, match="Cannot open the gradebook .*folder exist"):
+        Gradebook(path)
+    assert not path.parent.exists()
+
+
 def test_default_path_is_in_the_user_data_folder() -> None:
     expected = Path(platformdirs.user_data_dir("tcp-pendant", appauthor=False)) / "class.sqlite3"
     assert default_gradebook_path() == expected

@@ -358,10 +358,10 @@ class Gradebook:
             self._db = sqlite3.connect(str(self.path), isolation_level=None, check_same_thread=False,
                                        timeout=float(busy_timeout_s))
         except sqlite3.Error as exc:
-            raise GradebookError(f"Cannot open the gradebook {self.path}: {exc}; check the path and "
-                                 "its folder's permissions.") from exc
+            raise GradebookError(f"Cannot open the gradebook {self.path}: {exc}; check that the path and "
+                                 "its folder exist and are readable and writable.") from exc
         try:
-            self._open(exists, synchronous)
+            self._open(synchronous)
         except BaseException:
             self._db.close()
             raise
@@ -373,10 +373,14 @@ class Gradebook:
             f"Gradebook {self.path} {what}. Nothing was changed in it; keep it for the record, move it "
             "aside or give another file with --class-db.")
 
-    def _open(self, existed: bool, synchronous: str) -> None:
+    def _open(self, synchronous: str) -> None:
         db = self._db
         try:
             tables = {r[0] for r in db.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
+        except sqlite3.OperationalError as exc:      # cannot open / locked / I/O: not the content
+            raise GradebookError(f"Cannot open the gradebook {self.path}: {exc}; check that the path and "
+                                 "its folder exist and are readable and writable, and that no other "
+                                 "program holds it locked.") from exc
         except sqlite3.DatabaseError as exc:
             raise self._fail(f"is not a readable SQLite database ({exc})") from exc
         if tables:
