@@ -116,6 +116,16 @@ def _xyz_mm(text: str) -> tuple[float, float, float]:
     return vals
 
 
+def _beam_dir(text: str) -> tuple[float, float, float]:
+    """U,V,W of ``solve beam --beam-dir``: 3 finite numbers, not all zero (any length)."""
+    vals = _floats(text, 3, "U,V,W")
+    if not any(vals):
+        raise argparse.ArgumentTypeError(f"the beam direction must not be zero, got {text!r}")
+    if max(abs(v) for v in vals) > MAX_ABS_MM:
+        raise argparse.ArgumentTypeError(f"U,V,W must be within +-{MAX_ABS_MM:g}, got {text!r}")
+    return vals  # type: ignore[return-value]
+
+
 # ----------------------------------------------------------------------------------- parser
 def build_parser() -> argparse.ArgumentParser:
     """The argparse tree of ``tcpcal`` (see docs/cli.md)."""
@@ -130,7 +140,7 @@ def build_parser() -> argparse.ArgumentParser:
                            description="Calibrate from a CSV of flange poses (one pose per "
                            "row, header row naming the columns). " + accepted_layouts_text())
     ssub = solve.add_subparsers(dest="method_cmd", required=True,
-                                metavar="{xyz4,reference,three-point,abc-world,tcp-zx}")
+                                metavar="{xyz4,reference,three-point,abc-world,tcp-zx,beam}")
 
     def add_common(sp: argparse.ArgumentParser) -> None:
         sp.add_argument("poses", metavar="POSES.csv", type=Path,
@@ -189,6 +199,21 @@ def build_parser() -> argparse.ArgumentParser:
                     help="assumed touch noise per axis in mm (default: estimated)")
     zx.add_argument("--no-outliers", dest="detect_outliers", action="store_false",
                     help="do not flag outlying touches")
+
+    beam = ssub.add_parser("beam", help="TCP from beam-sensor tip events (BullsEye / TRACC)",
+                           description="Beam sensor: each row is the flange pose at which the "
+                           "tool tip was on the light beam's centre line (a tip event); the "
+                           "beam is the line through --beam-point along --beam-dir in WORLD. "
+                           "At least 2 events whose tool orientations differ other than by a "
+                           "turn about the beam (methods.md section 9).")
+    add_common(beam)
+    beam.add_argument("--beam-point", type=_xyz_mm, required=True, metavar="X,Y,Z",
+                      help="a point of the beam line in WORLD, mm")
+    beam.add_argument("--beam-dir", type=_beam_dir, required=True, metavar="U,V,W",
+                      help="the beam's direction in WORLD (any length, not zero)")
+    beam.add_argument("--sigma", type=_sigma_mm, metavar="MM", default=None,
+                      help="assumed event noise per axis across the beam in mm (default: "
+                      "estimated from the residuals)")
 
     # convert -------------------------------------------------------------------------------
     text_fmts = registered_formats(lambda f: f.has_text)
@@ -367,6 +392,8 @@ def _run_solve(args: argparse.Namespace) -> int:
         return 0
     if cmd == "tcp-zx":
         return _run_tcp_zx(args)
+    if cmd == "beam":
+        return _run_beam(args)
     raise AssertionError(cmd)  # pragma: no cover - argparse restricts the choices
 
 
@@ -392,6 +419,27 @@ def _run_tcp_zx(args: argparse.Namespace) -> int:
         raise CliInputError(_solver_error(exc, poses)) from None
     _emit(_with_source(tcp_zx_result_to_dict(res), poses) if args.json
           else format_tcp_zx_report(res, poses))
+    return 0
+
+
+def _run_beam(args: argparse.Namespace) -> int:
+    """``solve beam``: the TCP from beam-sensor tip events (methods.md section 9)."""
+    from tcpcal.beam import MIN_EVENTS, solve_beam
+    from tcpcal.report import beam_result_to_dict, format_beam_report
+
+    poses = read_poses_csv(args.poses, min_rows=MIN_EVENTS, purpose="beam (one tip event per "
+                           "row)")
+    try:
+        res = solve_beam(poses.rotations, poses.positions_mm, np.array(args.beam_point),
+                         np.array(args.beam_dir), sigma=args.sigma)
+    except TcpcalError as exc:
+        raise CliInputError(_solver_error(exc, poses)) from None
+    if args.json:
+        _emit(_with_source(beam_result_to_dict(res, beam_point_mm=args.beam_point,
+                                               beam_dir=args.beam_dir), poses))
+    else:
+        _emit(format_beam_report(res, poses, beam_point_mm=args.beam_point,
+                                 beam_dir=args.beam_dir))
     return 0
 
 

@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 if TYPE_CHECKING:  # imported for type hints only; the CLI imports the modules themselves
+    from tcpcal.beam import BeamResult
     from tcpcal.orientation import OrientationResult
     from tcpcal.origin import TcpResult
     from tcpcal.poses_csv import FlangePoses
@@ -25,6 +26,8 @@ if TYPE_CHECKING:  # imported for type hints only; the CLI imports the modules t
 __all__ = [
     "CAVEAT",
     "METHOD_TITLES",
+    "beam_result_to_dict",
+    "format_beam_report",
     "format_orientation_report",
     "format_tcp_report",
     "format_tcp_zx_report",
@@ -397,6 +400,87 @@ def format_tcp_zx_report(result: TcpZxResult, poses: FlangePoses | None = None, 
                      "touch (--json: without_outliers).")
     else:
         lines.append("Outliers: none")
+    if result.warnings:
+        lines.append("Warnings:")
+        lines += _bullets(result.warnings)
+    else:
+        lines.append("Warnings: none")
+    lines += ["", *textwrap.wrap(CAVEAT, width=92)]
+    return "\n".join(lines)
+
+
+def _unit3(v: Sequence[float]) -> list[float]:
+    a = np.asarray(v, dtype=float)
+    return (a / float(np.linalg.norm(a))).tolist()
+
+
+def beam_result_to_dict(result: BeamResult, *, beam_point_mm: Sequence[float],
+                        beam_dir: Sequence[float]) -> dict[str, Any]:
+    """The JSON object of ``solve beam`` (beam-sensor tip events, methods.md section 9; mm).
+
+    The keys of ``solve xyz4`` that apply (``method`` = ``"beam"``, ``n_touches`` = the number
+    of events, ``rows``, ``tcp_mm``, ``residuals_mm`` = each computed tip's distance from the
+    beam line, ``residual_vectors_mm``, the error figures, ``noise_sigma_mm``, ``ci95_mm``,
+    ``covariance_mm2``, ``condition_number``, ``outliers`` (always empty: no outlier test),
+    ``warnings``), plus ``n_events``, ``beam_point_mm``, ``beam_dir`` (unit, WORLD),
+    ``beam_positions_mm`` (where along the beam each tip crossed it, from ``beam_point_mm``)
+    and ``weakest_axis`` (FLANGE direction of the largest TCP uncertainty).
+    """
+    n = int(result.n_events)
+    return {
+        "method": "beam",
+        "n_touches": n,
+        "n_events": n,
+        "rows": list(range(n)),
+        "tcp_mm": np.asarray(result.tcp, dtype=float),
+        "beam_point_mm": [float(v) for v in beam_point_mm],
+        "beam_dir": _unit3(beam_dir),
+        "residuals_mm": np.asarray(result.residuals, dtype=float),
+        "residual_vectors_mm": np.asarray(result.residual_vectors, dtype=float),
+        "beam_positions_mm": np.asarray(result.beam_positions, dtype=float),
+        "mean_error_mm": result.mean_error,
+        "max_error_mm": result.max_error,
+        "rms_error_mm": result.rms_error,
+        "noise_sigma_mm": result.noise_sigma,
+        "ci95_mm": result.ci95_radius,
+        "covariance_mm2": np.asarray(result.covariance, dtype=float),
+        "condition_number": result.condition_number,
+        "weakest_axis": np.asarray(result.weakest_axis, dtype=float),
+        "outliers": [],
+        "warnings": list(result.warnings),
+    }
+
+
+def format_beam_report(result: BeamResult, poses: FlangePoses | None = None, *,
+                       beam_point_mm: Sequence[float], beam_dir: Sequence[float],
+                       command: str = "solve beam") -> str:
+    """Plain-text report of ``solve beam``: the beam, the TCP, error figures, the 95 % radius,
+    each event's distance from the beam line, warnings and :data:`CAVEAT` (mm)."""
+    n = int(result.n_events)
+    src = f" from {poses.path} (layout {poses.layout})" if poses is not None else ""
+    u = _unit3(beam_dir)
+    lines = [f"tcpcal {command}: beam sensor (methods.md section 9), {n} tip events{src}", "",
+             f"Beam in WORLD (mm):       point {_xyz(beam_point_mm)}",
+             f"                          direction {_xyz(u, '8.5f')}",
+             f"TCP in FLANGE (mm):       {_xyz(result.tcp)}",
+             (f"Tip to beam line (mm):    mean {_fig(result.mean_error, '')}   "
+              f"max {_fig(result.max_error, '')}   RMS {_fig(result.rms_error, '')}"),
+             (f"95 % radius of the TCP:   {_fig(result.ci95_radius)}   (event noise "
+              f"{_fig(result.noise_sigma)} per axis across the beam)"),
+             (f"Weakest flange direction: {_xyz(result.weakest_axis, '7.3f')}; condition number "
+              f"{_fig(result.condition_number, '', '.1f')}"),
+             "", "Per-event distance of the tip from the beam line e_i = P (R_i t + f_i - b) (mm):",
+             "   row  line      |e|       ex       ey       ez   along beam"]
+    for i in range(n):
+        line_no = poses.line_numbers[i] if poses is not None and i < len(poses) else ""
+        e = np.asarray(result.residual_vectors[i], dtype=float)
+        label = ""
+        if poses is not None and poses.labels is not None and i < len(poses.labels):
+            label = f"  {poses.labels[i]}" if poses.labels[i] else ""
+        lines.append(f"  {i + 1:4d}  {line_no:>4}  {float(result.residuals[i]):7.3f}  "
+                     f"{e[0]:7.3f}  {e[1]:7.3f}  {e[2]:7.3f}  "
+                     f"{float(result.beam_positions[i]):11.3f}{label}")
+    lines += ["", "Outliers: not tested for beam events"]
     if result.warnings:
         lines.append("Warnings:")
         lines += _bullets(result.warnings)
