@@ -7,7 +7,7 @@ Usage::
 One row per finished calibration (oldest first): trainee, method, tool, touches (hand / auto),
 overwritten touches, crashes, duration, result figures, error against the true TOOL frame and
 the grade. Without ``--csv`` a table for the terminal; with ``--csv`` the columns of
-:data:`tcp_pendant.classroom.gradebook.CSV_COLUMNS` (docs/cli.md). The gradebook is read where
+:data:`tcp_pendant.classroom.gradebook.CSV_COLUMNS` (docs/architecture.md, "Classroom (gradebook)"). The gradebook is read where
 the server writes it (``--class-db``, default ``user_data_dir("tcp-pendant")/class.sqlite3``);
 it may be read while the server runs.
 
@@ -38,7 +38,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--class-db", type=Path, default=None, metavar="PATH",
                    help=f"the gradebook the server writes (default: {default_gradebook_path()})")
     p.add_argument("--csv", action="store_true",
-                   help="print CSV (columns in docs/cli.md) instead of a table")
+                   help="print CSV (columns in docs/architecture.md) instead of a table")
     return p
 
 
