@@ -6,8 +6,12 @@ Per-browser: ``on_client_connect`` builds a session in the client's own scene an
 ``on_client_disconnect`` closes it and drops every reference (no leak: tested over 100
 cycles). All sessions share the robot's pinocchio *model* (read-only) but each has its own
 pinocchio *data*, so sessions never race in FK. The tool library is shared (one
-``tcpcal.ToolLibrary``); a watcher thread re-reads it when its file changes so every session
-sees tools saved by others.
+``tcpcal.ToolLibrary``); a watcher thread notices when its file changes and every session
+re-reads it (``Session.reload_library``, on viser's event loop) so it sees tools saved by others.
+
+Start tool: a per-browser session starts with no active tool (TCP = flange), whatever other
+trainees activated or saved; the ``--shared`` session starts with the library's active slot
+(the CLI's ``tcpcal tools activate``), see ``tcp_pendant.session``.
 """
 
 from __future__ import annotations
@@ -37,7 +41,8 @@ from tcp_pendant.controller import (
     reference_tip_model,
 )
 from tcp_pendant.session import Session
-from tcp_pendant.views import SceneView, build_session_views
+from tcp_pendant.views import build_session_views
+from tcp_pendant.views.scene import overview_camera, overview_pose
 from tcp_pendant.views.meshes import link_meshes, rigid_meshes
 
 __all__ = ["AppConfig", "PendantApp", "PortInUseError", "default_reference_tip_mm", "is_loopback"]
@@ -231,20 +236,23 @@ class PendantApp:
         c.set_q(self.ready_q_rad)
         return c
 
-    def make_session(self, client: Any | None, target: Any | None = None) -> Session:
-        """Build a session drawing into ``target`` (default: ``client``), with the library's
-        active tool as its active tool data."""
+    def make_session(self, client: Any | None, target: Any | None = None, *, shared: bool = False) -> Session:
+        """Build a session drawing into ``target`` (default: ``client``). A per-browser session
+        starts with no active tool (TCP = flange); the shared one (``shared``) with the
+        library's active tool (module docstring)."""
         c = self.new_controller()
-        session = Session(c, self.library, client=client, target=target, ready_q_rad=self.ready_q_rad)
-        try:
-            slot = self.library.active_slot()
-            tool = None if slot is None else self.library.get(slot)
-        except Exception:  # an unreadable library must not keep the pendant from starting
-            log.exception("tool library unreadable")
-            slot, tool = None, None
-        if tool is not None:
-            c.set_active_tool(tool)
-            session.active_slot = slot
+        session = Session(c, self.library, client=client, target=target, ready_q_rad=self.ready_q_rad,
+                          shared=shared)
+        session.reload_library()
+        if shared:
+            try:
+                slot = self.library.active_slot()
+            except Exception:  # an unreadable library must not keep the pendant from starting
+                log.exception("tool library unreadable")
+                slot = None
+            tool = None if slot is None else session.library_tools.get(slot)
+            if tool is not None:
+                session.set_active_data(tool, slot)
         build_session_views(session, title=f"TCP Pendant · {self.robot_label}")
         return session
 
@@ -258,7 +266,7 @@ class PendantApp:
         with self._sessions_lock:
             self.sessions[client.client_id] = session
         try:
-            session.views["scene"].overview(client)
+            overview_camera(client, self.reference_tip_m)
         except Exception:
             log.debug("camera of a leaving client", exc_info=True)
         return session
@@ -274,7 +282,7 @@ class PendantApp:
         if self.config.shared:
             if self.shared_session is not None:
                 try:
-                    self.shared_session.views["scene"].overview(client)
+                    overview_camera(client, self.reference_tip_m)
                 except Exception:
                     log.debug("camera of a leaving client", exc_info=True)
             return
@@ -319,12 +327,10 @@ class PendantApp:
             log.debug("library reload dropped: server stopped")
 
     def library_changed(self) -> None:
-        """Reload the library list in every session (on viser's event loop: the watcher hands
-        it over)."""
+        """Every session re-reads the library (on viser's event loop: the watcher hands it
+        over); their views re-render on the change signal."""
         for s in self.all_sessions():
-            view = s.views.get("tools")
-            if view is not None:
-                s.guard(view.reload)()
+            s.guard(s.reload_library)()
 
     # ------------------------------------------------------------ life cycle
     def start(self) -> str:
@@ -343,11 +349,11 @@ class PendantApp:
         self.server.gui.configure_theme(control_width="large", dark_mode=False, show_logo=False,
                                         show_share_button=False)
         self.server.gui.main_panel.dock_right()
-        position, look_at = SceneView.overview_pose(self.reference_tip_m)
+        position, look_at = overview_pose(self.reference_tip_m)
         self.server.initial_camera.position = position
         self.server.initial_camera.look_at = look_at
         if self.config.shared:
-            self.shared_session = self.make_session(None, target=self.server)
+            self.shared_session = self.make_session(None, target=self.server, shared=True)
         self.server.on_client_connect(self._on_connect)
         self.server.on_client_disconnect(self._on_disconnect)
         self._watcher = threading.Thread(target=self._watch_library, name="library-watcher", daemon=True)

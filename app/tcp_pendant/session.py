@@ -2,9 +2,29 @@
 
 The server makes one :class:`Session` per browser (``on_client_connect``) and drops it on
 disconnect; in ``--shared`` mode there is one session whose GUI and scene are the server's
-(every browser sees and drives the same robot). Views (``tcp_pendant.views``) register
-*renderers* (push the controller state to the scene and the readouts) and the wizard views
-register *motion listeners* (called after every move).
+(every browser sees and drives the same robot).
+
+State and its one owner each (docs/architecture.md, "State owners and the change signal"):
+
+* the session owns its robot (``controller``: joints, mounted physical tool, active tool data),
+  its active library slot (``active_slot``), its touches and its copy of the library's list
+  (``library_tools``, re-read by :meth:`Session.reload_library`);
+* the library (``tcpcal.ToolLibrary``, one file shared by every session and process) owns only
+  the stored tools; its ``active_slot`` is the CLI's ``tools activate`` and the ``--shared``
+  mode's start tool: a per-browser session starts with no active tool (TCP = flange), never
+  reads it and never writes it; the ``--shared`` session starts with it and writes it when a
+  tool is activated or saved there.
+
+Commands change that state in one place - :meth:`Session.mount_tool`, :meth:`Session.activate`,
+:meth:`Session.deactivate`, :meth:`Session.set_active_data`, :meth:`Session.apply_saved`,
+:meth:`Session.record_touch`, :meth:`Session.delete_touch`, :meth:`Session.reload_library`,
+:meth:`Session.moved` (after a move of the robot) - and each ends in ONE change signal: every
+function given to :meth:`Session.subscribe` is called with a :class:`SessionChange` saying what
+changed (pose, tool, touches, wizard, library) and carrying the robot's
+:class:`~tcp_pendant.controller.pose_state.PoseState`, computed once for all of them. Views
+subscribe and re-render from state; they never call each other. Inside :meth:`Session.batch`
+the changes of several commands are merged into one signal (a Calibrate click that mounts a
+tool, moves the robot and saves emits once, at its end).
 
 Threading: every GUI callback is registered through :meth:`Session.on_loop`, an ``async``
 callback, so viser runs it on its event loop, one at a time and in the order the browser's
@@ -22,18 +42,21 @@ from __future__ import annotations
 import functools
 import logging
 import threading
-from collections.abc import Callable, Coroutine
-from dataclasses import dataclass, field
+from collections.abc import Callable, Coroutine, Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass, field, replace
 from typing import Any, Protocol, TypeVar
 
 import numpy as np
 
 from tcpcal.library import ToolLibrary
-from tcp_pendant.controller import ControllerError, VirtualController
-from tcp_pendant.pendant import Jogger, touch_label
+from tcpcal.errors import TcpcalError
+from tcpcal.tool import Tool
+from tcp_pendant.controller import ControllerError, JogResult, ToolModel, VirtualController
 from tcp_pendant.controller.pose_state import PoseState, pose_state, pose_state_key
+from tcp_pendant.pendant import Jogger, touch_label
 
-__all__ = ["GuiTarget", "Session", "Touch"]
+__all__ = ["GuiTarget", "Session", "SessionChange", "Touch"]
 
 log = logging.getLogger(__name__)
 F = TypeVar("F", bound=Callable[..., Any])
@@ -74,6 +97,38 @@ class Touch:
         object.__setattr__(self, "T_world_flange", T)
 
 
+@dataclass(frozen=True, eq=False)
+class SessionChange:
+    """What one command changed (the session's change signal; see the module docstring).
+
+    Attributes:
+        pose: the robot moved, or something its pose state depends on changed (joints, mounted
+            tool, active tool data): the scene and the readouts re-render.
+        tool: the mounted tool, the active tool data or the active slot changed.
+        touches: a touch was recorded or deleted.
+        wizard: the Calibrate workflow's state changed (a click in the Calibrate tab).
+        library: the session's copy of the library's list was re-read.
+        jog: the outcome of the move, for the status line (None: not a jog, or unchanged).
+        state: the robot's pose state after the change (computed once, for every subscriber),
+            None when neither ``pose`` nor ``tool`` is set.
+    """
+
+    pose: bool = False
+    tool: bool = False
+    touches: bool = False
+    wizard: bool = False
+    library: bool = False
+    jog: JogResult | None = None
+    state: PoseState | None = None
+
+    def merged(self, other: "SessionChange") -> "SessionChange":
+        """Both changes as one (flags or-ed; the newer jog outcome; the state is recomputed)."""
+        return SessionChange(pose=self.pose or other.pose, tool=self.tool or other.tool,
+                             touches=self.touches or other.touches, wizard=self.wizard or other.wizard,
+                             library=self.library or other.library,
+                             jog=other.jog if other.jog is not None else self.jog)
+
+
 @dataclass(eq=False)
 class Session:
     """State of one pendant (see the module docstring).
@@ -86,12 +141,17 @@ class Session:
         touches: recorded flange poses, in order.
         lock: guards every state change.
         jogger: the jog keys' logic (settings + continuous timing).
-        active_slot: library slot of the active tool data (None: no tool or typed-in only).
+        active_slot: library slot of the active tool data (None: no tool or typed-in only);
+            change it with the commands, never directly.
+        shared: the ``--shared`` session (activating or saving a tool also sets the library's
+            active slot, its start tool).
         calibrate_container: the GUI container of the "Calibrate" tab, where wizard views plug
             in (see ``tcp_pendant.views.calibrate``); None before the views are built.
         ready_q_rad: the "Ready pose" button's joint angles (None: the robot's HOME).
         views: named view objects (``"scene"``, ``"pendant"``, ``"tools"``, ...), for tests
-            and for the wizard views.
+            only: views never reach each other through it.
+        scene_labels: the scene's labels at the tool and the tip (``"flange"``, ``"tool"``,
+            ``"tip"``: viser label handles), which the wizards' scene places apart.
     """
 
     controller: VirtualController
@@ -101,35 +161,84 @@ class Session:
     touches: list[Touch] = field(default_factory=list)
     lock: threading.RLock = field(default_factory=threading.RLock)
     active_slot: int | None = None
+    shared: bool = False
     calibrate_container: Any | None = None
     ready_q_rad: np.ndarray | None = None
     views: dict[str, Any] = field(default_factory=dict)
+    scene_labels: dict[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         if self.target is None:
             self.target = self.client
         self.jogger = Jogger(self.controller)
         self.closed = False
-        self._renderers: list[Callable[[], None]] = []
-        self._motion_listeners: list[Callable[[], None]] = []
-        self._touch_listeners: list[Callable[[], None]] = []
+        self._subscribers: list[Callable[[SessionChange], None]] = []
         self._close_callbacks: list[Callable[[], None]] = []
         self._pose_state: PoseState | None = None
-        self._in_refresh = False             # refresh() is running its renderers
-        self._state_checked = False          # ... and the pose state was checked meanwhile
+        self._batch_depth = 0
+        self._pending: SessionChange | None = None
+        self.library_tools: dict[int, Tool] = {}
+        """The library's tools as this session last read them (slot -> tool)."""
+        self.library_error: str | None = None
+        """Why the library could not be read at the last :meth:`reload_library` (None: it was)."""
 
-    # ------------------------------------------------------------ listeners
-    def add_renderer(self, fn: Callable[[], None]) -> None:
-        """Register a function that pushes controller state to the browser (called by refresh)."""
-        self._renderers.append(fn)
+    # ------------------------------------------------------------ the change signal
+    def subscribe(self, fn: Callable[[SessionChange], None]) -> None:
+        """Call ``fn(change)`` after every change of this session's state (under its lock, in one
+        atomic GUI update with the other subscribers, in the order they subscribed)."""
+        self._subscribers.append(fn)
 
     def add_motion_listener(self, fn: Callable[[], None]) -> None:
-        """Register ``fn()``, called (under the lock) after every move, after the refresh."""
-        self._motion_listeners.append(fn)
+        """Call ``fn()`` after every change that moved the robot or its TCP (a subscription to
+        :class:`SessionChange` ``pose``)."""
+        def on_change(change: SessionChange) -> None:
+            if change.pose:
+                fn()
+        on_change.__qualname__ = getattr(fn, "__qualname__", "motion listener")
+        self.subscribe(on_change)
 
-    def add_touch_listener(self, fn: Callable[[], None]) -> None:
-        """Register ``fn()``, called after a touch was recorded or deleted."""
-        self._touch_listeners.append(fn)
+    @contextmanager
+    def batch(self) -> Iterator[None]:
+        """Merge the changes of the commands run inside into one signal, emitted at the end
+        (also when a command raised: what it changed before is shown)."""
+        with self.lock:
+            self._batch_depth += 1
+            try:
+                yield
+            finally:
+                self._batch_depth -= 1
+                if self._batch_depth == 0 and self._pending is not None:
+                    pending, self._pending = self._pending, None
+                    self._emit(pending)
+
+    def changed(self, change: SessionChange | None = None, **what: Any) -> None:
+        """Emit the change signal: ``changed(pose=True, jog=res)`` or a :class:`SessionChange`.
+
+        Commands call it; so does a view after a command of its own model (the Calibrate tab,
+        whose workflow drove the robot). Inside :meth:`batch` it is merged and emitted later."""
+        change = SessionChange(**what) if change is None else change
+        with self.lock:
+            if self._batch_depth:
+                self._pending = change if self._pending is None else self._pending.merged(change)
+                return
+            self._emit(change)
+
+    def _emit(self, change: SessionChange) -> None:
+        if self.closed:
+            return
+        if change.pose or change.tool:
+            change = replace(change, pose=True, state=self.pose_state())
+        subscribers = list(self._subscribers)
+        if self.target is None:
+            for fn in subscribers:
+                fn(change)
+            return
+        with self.target.atomic():
+            for fn in subscribers:
+                try:
+                    fn(change)
+                except Exception:  # one view must not keep the others from showing the change
+                    log.exception("session subscriber %s failed", getattr(fn, "__qualname__", fn))
 
     def on_close(self, fn: Callable[[], None]) -> None:
         """Register ``fn()``, called once when the session closes."""
@@ -139,45 +248,84 @@ class Session:
     def pose_state(self) -> PoseState:
         """The robot's current :class:`~tcp_pendant.controller.pose_state.PoseState` (link poses,
         flange, TCP, true TCP, readout, touch geometry, joint angles), computed by one FK pass
-        and shared by every renderer and motion listener until the controller changes (keyed
-        by joint angles, tool data, mounted tool, reference tip and BASE; within one
-        :meth:`refresh` the key is checked once, as renderers do not move the robot)."""
+        when the controller changed (keyed by joint angles, tool data, mounted tool, reference
+        tip and BASE). The change signal carries it (``SessionChange.state``): subscribers read
+        that, not the controller."""
         with self.lock:
             state = self._pose_state
-            if self._in_refresh and self._state_checked and state is not None:
-                return state
             key = pose_state_key(self.controller)
             if state is None or state.key != key:
                 state = self._pose_state = pose_state(self.controller, key)
-            self._state_checked = self._in_refresh
             return state
 
-    def refresh(self) -> None:
-        """Push scene and readouts after a controller change, as one atomic update."""
-        with self.lock:
-            if self.closed:
-                return
-            self._in_refresh, self._state_checked = True, False
-            try:
-                if self.target is None:
-                    for fn in self._renderers:
-                        fn()
-                    return
-                with self.target.atomic():
-                    for fn in self._renderers:
-                        fn()
-            finally:
-                self._in_refresh = self._state_checked = False
+    def moved(self, jog: JogResult | None = None) -> None:
+        """After a move of the robot (a jog, the gizmo, Home, an auto-touch): the change signal
+        with ``pose`` (and the move's outcome ``jog`` for the status line)."""
+        self.changed(pose=True, jog=jog)
 
-    def moved(self) -> None:
-        """After a move: :meth:`refresh`, then every motion listener (errors are logged)."""
+    def refresh(self) -> None:
+        """Re-render everything that shows the robot (the same signal as :meth:`moved`)."""
+        self.changed(pose=True)
+
+    # ------------------------------------------------------------ tools (state owner)
+    def mount_tool(self, tool: ToolModel) -> None:
+        """Bolt another physical tool on (the active tool data does not change)."""
         with self.lock:
-            self.refresh()
-            for fn in list(self._motion_listeners):
-                try:
-                    fn()
-                except Exception:  # a listener must not break jogging
-                    log.exception("motion listener failed")
+            if tool is self.controller.mounted_tool:
+                return
+            self.controller.mount_tool(tool)
+            self.changed(tool=True)
+
+    def set_active_data(self, tool: Tool | None, slot: int | None = None) -> None:
+        """Make ``tool`` the active tool data (typed in, a wizard's, or the library's ``slot``);
+        None: no tool (TCP = flange). The library file is not written."""
+        with self.lock:
+            self.controller.set_active_tool(tool)
+            self.active_slot = slot if tool is not None else None
+            self.changed(tool=True)
+
+    def activate(self, slot: int) -> Tool:
+        """"Activate": the library tool in ``slot`` (as last read) becomes the active tool data.
+        In ``--shared`` mode the library's active slot is set too (the shared start tool).
+
+        Raises:
+            ValueError: the slot is empty.
+        """
+        with self.lock:
+            tool = self.library_tools.get(int(slot))
+            if tool is None:
+                raise ControllerError(f"Slot {slot} of the tool library is empty; pick a stored tool.")
+            if self.shared:
+                self.library.activate(int(slot))
+            self.set_active_data(tool, int(slot))
+            return tool
+
+    def deactivate(self) -> None:
+        """"No tool": TCP = flange (this session only; the library file is not written)."""
+        self.set_active_data(None)
+
+    def apply_saved(self, slot: int, tool: Tool) -> None:
+        """After ``tool`` was saved in ``slot`` of the library: it is the active tool data, and
+        the session's list of tools is re-read (``--shared``: the library's active slot too)."""
+        with self.lock, self.batch():
+            if self.shared:
+                self.library.activate(int(slot))
+            self.reload_library()
+            self.set_active_data(tool, int(slot))
+
+    def reload_library(self) -> dict[int, Tool]:
+        """Re-read the library's tools into :attr:`library_tools` (an unreadable file gives no
+        tools and :attr:`library_error` says why) and signal ``library``."""
+        with self.lock:
+            try:
+                tools = self.library.tools()
+            except TcpcalError as exc:  # e.g. permissions: ToolLibraryError names the file
+                tools, self.library_error = {}, str(exc)
+            else:
+                self.library_error = None
+            self.library_tools = dict(tools)
+            self.changed(library=True)
+            return self.library_tools
 
     def notify(self, title: str, body: str, *, kind: str = "info") -> None:
         """Show a notification in this session's browser(s); ``kind``: info, success, warning, error.
@@ -205,7 +353,7 @@ class Session:
             T = self.controller.T_world_flange()
             touch = Touch(T, touch_label(len(self.touches), T), self.controller.touch_geometry().distance_mm)
             self.touches.append(touch)
-            self._touches_changed()
+            self.changed(touches=True)
             return touch
 
     def delete_touch(self, index: int) -> None:
@@ -221,11 +369,7 @@ class Session:
             del self.touches[index]
             self.touches[:] = [Touch(t.T_world_flange, touch_label(i, t.T_world_flange), t.distance_mm)
                                for i, t in enumerate(self.touches)]
-            self._touches_changed()
-
-    def _touches_changed(self) -> None:
-        for fn in list(self._touch_listeners):
-            fn()
+            self.changed(touches=True)
 
     # ------------------------------------------------------------ callbacks
     def guard(self, fn: F) -> F:
@@ -281,15 +425,14 @@ class Session:
                 return
             self.closed = True
             callbacks, self._close_callbacks = self._close_callbacks, []
-            self._renderers.clear()
-            self._motion_listeners.clear()
-            self._touch_listeners.clear()
+            self._subscribers.clear()
         for fn in callbacks:
             try:
                 fn()
             except Exception:
                 log.debug("close callback failed", exc_info=True)
         self.views.clear()
+        self.scene_labels.clear()
         self._pose_state = None
         self.calibrate_container = None
         self.client = None

@@ -124,15 +124,17 @@ def test_tool_data_defaults_to_the_active_slot_not_slot_1(tmp_path) -> None:
     lib.save(1, Tool(name="Pen", tcp_mm=(0.0, 0.0, 150.0)))
     lib.save(3, Tool(name="Torch", tcp_mm=(0.0, 0.0, 200.0)))
     lib.save(4, Tool(name="Gripper", tcp_mm=(0.0, 0.0, 120.0)))
-    lib.activate(3)
     app = PendantApp(AppConfig(port=0, tool="torch", tool_library=tmp_path / "tools.json",
                                library_poll_s=0.1))
     app.start()
     try:
         p = Page(app)
         v, s = p.view, p.session
+        tools = s.views["tools"]                     # the trainee activates slot 3 on the Tool tab
+        p.choose(tools.slots, "3: Torch")
+        p.click(tools.activate)
         p.choose(v.method, "ABC world (parallel axes)")
-        assert s.active_slot == 3, "the library's active tool should be the session's"
+        assert s.active_slot == 3, "the session's active tool should be offered"
         assert v.library_tool.value == "3: Torch"
         p.choose(v.library_tool, "4: Gripper")       # the user's pick holds ...
         p.choose(v.method, "Three-point orientation")

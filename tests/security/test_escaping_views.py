@@ -182,6 +182,8 @@ def _all_markdown(b: Browser) -> str:
 def test_every_view_shows_hostile_library_names_as_text(app_with_hostile_library) -> None:
     b = app_with_hostile_library()
     s, tools = b.session, b.session.views["tools"]
+    choose(tools.slots, f"1: {NAMES[0]}", b.client)   # a browser's session starts with no active tool
+    click(tools.activate, b.client)
     assert shows(s.views["pendant"].tcp_md.content, f"TOOL {NAMES[0]}")
     assert shows(tools.active_md.content, NAMES[0])
     for slot, name in enumerate(NAMES, start=1):

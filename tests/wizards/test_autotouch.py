@@ -119,13 +119,31 @@ def test_three_point_offsets_and_same_orientation(synth, variant, third):
     ctrl = fake(synth, "gripper")
     wiz = ThreePointWizard(exact_tool(synth, "gripper"), variant=variant)
     rng = np.random.default_rng(2)
+    previous = None
     for _ in range(3):
-        assert auto_touch(wiz, ctrl, rng=rng).ok
+        out = auto_touch(wiz, ctrl, rng=rng, previous_direction_deg=previous)
+        assert out.ok
+        previous = out.direction_deg                 # the caller (the workflow) keeps it
     offsets = [c[4] for c in ctrl.calls]
     assert offsets == [(0.0, 0.0, 0.0), (-60.0, 0.0, 0.0), third]
     assert len({c[1:4] for c in ctrl.calls}) == 1  # steps 2 and 3 keep step 1's orientation
     res = wiz.next()
     assert compare_with_truth(res, synth.tools["gripper"].T_flange_tool_true_m).orientation_error_deg < 1e-6
+
+
+def test_auto_touch_keeps_no_hidden_state(synth):
+    """The direction of a wizard's previous auto-touch is the caller's to give back (the
+    workflow keeps it per run): without it, step 2 draws a new direction."""
+    import tcp_pendant.calibrate.autotouch as module
+
+    assert not any(isinstance(v, dict) or type(v).__name__ == "WeakKeyDictionary" for k, v in vars(module).items()
+                   if not k.startswith("__"))
+    ctrl = fake(synth, "gripper")
+    wiz = ThreePointWizard(exact_tool(synth, "gripper"), variant=1)
+    rng = np.random.default_rng(2)
+    first = auto_touch(wiz, ctrl, rng=rng)
+    second = auto_touch(wiz, ctrl, rng=rng)
+    assert first.ok and second.ok and first.direction_deg != second.direction_deg
 
 
 def test_reference_swaps_the_tool(synth):

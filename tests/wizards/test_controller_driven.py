@@ -36,9 +36,11 @@ def true_tool_data(model, name="calibrated") -> Tool:
 
 
 def run(wiz, ctrl, rng, *, sigma_mm=0.0, **kw):
+    previous = None
     while True:
-        out = auto_touch(wiz, ctrl, sigma_mm=sigma_mm, rng=rng, **kw)
+        out = auto_touch(wiz, ctrl, sigma_mm=sigma_mm, rng=rng, previous_direction_deg=previous, **kw)
         assert out.ok, out.message
+        previous = out.direction_deg
         if wiz.on_last_step and wiz.step.recorded:
             return wiz.next()
 
@@ -110,8 +112,9 @@ def test_autotouch_three_point_offsets_put_the_tip_where_asked(controllers):
     wiz = ThreePointWizard(true_tool_data(ctrl.mounted_tool), variant=2)
     rng = np.random.default_rng(5)
     tip = np.asarray(ctrl.reference_tip_world_m)
+    previous = None
     for expected in ((0.0, 0.0, 0.0), (-60.0, 0.0, 0.0), (-20.0, 60.0, 0.0)):
-        auto_touch(wiz, ctrl, rng=rng)
+        previous = auto_touch(wiz, ctrl, rng=rng, previous_direction_deg=previous).direction_deg
         T = ctrl.T_world_tool_true()
         in_tool_mm = (T[:3, :3].T @ (tip - T[:3, 3])) * 1000.0
         np.testing.assert_allclose(in_tool_mm, expected, atol=1e-6)

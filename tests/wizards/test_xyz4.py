@@ -245,23 +245,27 @@ def test_to_tool_and_serialisation(synth):
         Wizard.from_dict({"kind": "nope"})
 
 
-def test_save_to_library(synth, tmp_path):
+def test_save_result_writes_the_library_but_not_its_active_slot(synth, tmp_path):
+    """Saving lives in calibrate/ (the wizard only computes); it never sets the library's
+    active slot (the session's business)."""
     from tcpcal.errors import TcpcalError
     from tcpcal.library import ToolLibrary
+    from tcp_pendant.calibrate.library_save import save_result
 
+    assert not hasattr(Xyz4Wizard(), "save_to_library")          # no file I/O in the state machine
     tool = synth.tools["pointer"]
     lib = ToolLibrary(tmp_path / "tools.json")
     wiz = Xyz4Wizard()
     with pytest.raises(WizardStateError, match="Finish"):
-        wiz.save_to_library(lib, "pointer")
+        save_result(wiz, lib, "pointer")
     run_xyz4(wiz, synth, tool, synth.directions[:4])
-    slot, saved = wiz.save_to_library(lib, "pointer")
-    assert slot == 1 and lib.active_slot() == 1
+    slot, saved = save_result(wiz, lib, "pointer")
+    assert slot == 1 and lib.active_slot() is None
     assert lib.get(1).tcp_mm == pytest.approx(tuple(tool.tcp_mm), abs=1e-6)
     assert lib.get(1).calibration.method == "xyz4-lstsq"
     # same name again: same slot, overwritten; explicit slot elsewhere with that name: refused
-    assert wiz.save_to_library(lib, "pointer")[0] == 1
+    assert save_result(wiz, lib, "pointer")[0] == 1
     with pytest.raises(TcpcalError):
-        wiz.save_to_library(lib, "pointer", slot=5)
-    assert wiz.save_to_library(lib, "pointer 2", slot=5, activate=False)[0] == 5
-    assert lib.active_slot() == 1
+        save_result(wiz, lib, "pointer", slot=5)
+    assert save_result(wiz, lib, "pointer 2", slot=5)[0] == 5
+    assert lib.active_slot() is None

@@ -20,15 +20,17 @@ step role          controller call
 =================  ===========================================================================
 
 ``d`` is ``distance_mm`` (60 mm by default). Three-point steps 2 and 3 reuse the approach
-direction of the wizard's previous auto-touch unless one is given, as an operator jogging
-along tool axes keeps the orientation. The controller must have the physical tool the step
-asks for mounted: auto-touch mounts it (from ``tools``, default ``builtin_tools()``).
+direction of the wizard's previous auto-touch (``previous_direction_deg``, which the caller
+keeps: the workflow, per run; the outcome says the direction used) unless one is given, as an
+operator jogging along tool axes keeps the orientation. The controller must have the
+physical tool the step asks for mounted: auto-touch mounts it (from ``tools``, default
+``builtin_tools()``, through ``mount``: the session's command in the app) and tells the
+wizard. This module keeps no state of its own.
 """
 
 from __future__ import annotations
 
-import weakref
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -49,7 +51,6 @@ def operator_angle_sigma_deg(sigma_mm: float) -> float:
     """The simulated alignment error per tool axis (deg) matching an operator error of
     ``sigma_mm`` (mm per axis): ``atan(sigma_mm / ANGLE_LEVER_MM)``."""
     return float(np.degrees(np.arctan2(float(sigma_mm), ANGLE_LEVER_MM)))
-_last_direction: "weakref.WeakKeyDictionary[Wizard, tuple[float, float, float]]" = weakref.WeakKeyDictionary()
 
 
 @dataclass(frozen=True)
@@ -74,6 +75,14 @@ class AutoTouchOutcome:
     message: str
     attempts: int
 
+    @property
+    def direction_deg(self) -> tuple[float, float, float] | None:
+        """(tilt, azimuth, spin) used, deg (None for ``parallel`` or a failure): give it back as
+        ``previous_direction_deg`` for the wizard's next step."""
+        if self.tilt_deg is None or self.azimuth_deg is None or self.spin_deg is None:
+            return None
+        return (self.tilt_deg, self.azimuth_deg, self.spin_deg)
+
 
 def _tip_offset(role: str, distance_mm: float) -> tuple[float, float, float]:
     if role == "touch":
@@ -88,7 +97,7 @@ def _tip_offset(role: str, distance_mm: float) -> tuple[float, float, float]:
 
 
 def _ensure_mounted(wizard: Wizard, controller: Any, step: StepInfo,
-                    tools: Mapping[str, Any] | None) -> None:
+                    tools: Mapping[str, Any] | None, mount: Callable[[Any], None] | None) -> None:
     key = step.mount_tool_key
     if key is not None and getattr(controller.mounted_tool, "key", None) != key:
         if tools is None:
@@ -96,7 +105,7 @@ def _ensure_mounted(wizard: Wizard, controller: Any, step: StepInfo,
             tools = builtin_tools()
         if key not in tools:
             raise WizardError(f"The step needs the tool '{key}', which is not among {sorted(tools)}.")
-        controller.mount_tool(tools[key])
+        (controller.mount_tool if mount is None else mount)(tools[key])
     wizard.note_mounted_tool(getattr(controller.mounted_tool, "key", None))
 
 
@@ -105,7 +114,9 @@ def auto_touch(wizard: Wizard, controller: Any, *,
                sigma_mm: float = 0.0, angle_sigma_deg: float | None = None,
                distance_mm: float = DEFAULT_DISTANCE_MM, hover_mm: float = 30.0,
                rng: np.random.Generator | None = None, advance: bool = True,
-               tools: Mapping[str, Any] | None = None, max_attempts: int = 12) -> AutoTouchOutcome:
+               tools: Mapping[str, Any] | None = None, max_attempts: int = 12,
+               previous_direction_deg: tuple[float, float, float] | None = None,
+               mount: Callable[[Any], None] | None = None) -> AutoTouchOutcome:
     """Perform the wizard's current step with the controller and record the flange pose.
 
     Args:
@@ -123,6 +134,10 @@ def auto_touch(wizard: Wizard, controller: Any, *,
         advance: after recording, go to the next step (never finishes the wizard: Finish is
             the user's click).
         tools: physical tools by key, to mount the one the step needs.
+        previous_direction_deg: the direction of this wizard's previous auto-touch
+            (``AutoTouchOutcome.direction_deg``), reused by three-point steps 2 and 3.
+        mount: how to mount a tool (default ``controller.mount_tool``; the app passes the
+            session's command, which signals the change).
     """
     if wizard.status != "in_progress":
         raise WizardStateError(f"Cannot auto-touch: {wizard.blocked_reason}")
@@ -133,7 +148,7 @@ def auto_touch(wizard: Wizard, controller: Any, *,
                           f"got {sigma_mm} and {angle_sigma_deg}.")
     rng = np.random.default_rng() if rng is None else rng
     step = wizard.step
-    _ensure_mounted(wizard, controller, step, tools)
+    _ensure_mounted(wizard, controller, step, tools, mount)
     if not wizard.can_record:
         raise WizardStateError(f"Cannot auto-touch: {wizard.blocked_reason}")
 
@@ -166,7 +181,7 @@ def auto_touch(wizard: Wizard, controller: Any, *,
     three_point = step.role != "touch" or wizard.kind == "three-point"
     fixed = direction_deg
     if fixed is None and three_point and step.index > 0:
-        fixed = _last_direction.get(wizard)
+        fixed = previous_direction_deg
     attempts = 0
     last_message = ""
     while attempts < (1 if fixed is not None else max_attempts):
@@ -180,7 +195,6 @@ def auto_touch(wizard: Wizard, controller: Any, *,
                                        sigma_mm=sigma_mm, tip_offset_tool_mm=offset, rng=rng)
         if res.ok:
             wizard.record(controller.T_world_flange())
-            _last_direction[wizard] = (tilt, azimuth, spin)
             if advance and not wizard.on_last_step:
                 wizard.next()
             return AutoTouchOutcome(True, step.index, step.role, tilt, azimuth, spin,

@@ -3,9 +3,15 @@ needs, training mode (truth, auto-touch), saving to the tool library and the ses
 
 A :class:`CalibrationWorkflow` belongs to one pendant session. It owns the wizards started in
 that session (``runs``: each a :class:`~tcp_pendant.wizards.session_record.WizardRun` with the
-hidden true TOOL frame of the tool it calibrates) and acts on the session's
-:class:`~tcp_pendant.controller.VirtualController` and the server's shared
-:class:`tcpcal.ToolLibrary`. The views (``tcp_pendant.views.wizard_*``) only render it and
+hidden true TOOL frame of the tool it calibrates) and the auto-touch memory of each run; it
+reads the session's :class:`~tcp_pendant.controller.VirtualController`, drives it for
+auto-touch, and writes the server's shared :class:`tcpcal.ToolLibrary` only in :meth:`save`.
+The mounted tool and the active tool data are not its own: it changes them through a
+:class:`ToolState` (the app's ``Session``, whose commands emit the change signal; without one,
+:class:`ControllerToolState` writes the controller directly). The open wizard is told which
+tool is mounted explicitly, by the commands that may have changed it
+(:meth:`CalibrationWorkflow.note_mounted_tool`; the app also calls it on the session's ``tool``
+change): reading :attr:`CalibrationWorkflow.wizard` has no side effect. The views (``tcp_pendant.views.wizard_*``) only render it and
 forward clicks; every figure comes from the wizards, which call ``tcpcal``.
 
 Units: the controller speaks metres (``T_world_flange``); the wizards hand millimetres to
@@ -20,12 +26,14 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any, Literal
+from typing import Any, Literal, Protocol
 
 import numpy as np
 
 from tcp_pendant.controller import ToolModel, VirtualController, builtin_tools
+from tcp_pendant.calibrate.autotouch import AutoTouchOutcome, auto_touch
 from tcp_pendant.calibrate.diversity import failure_in_words
+from tcp_pendant.calibrate.library_save import save_result
 from tcp_pendant.wizards import (
     AbcWorldWizard,
     CalibrationFailedError,
@@ -37,7 +45,6 @@ from tcp_pendant.wizards import (
     WizardStateError,
     Xyz4Wizard,
 )
-from tcp_pendant.calibrate.autotouch import AutoTouchOutcome, auto_touch
 from tcp_pendant.wizards.session_record import (
     LoadedRecord,
     ReplayCheck,
@@ -55,6 +62,8 @@ __all__ = [
     "WIZARD_LABELS",
     "AutoTouchRequest",
     "CalibrationWorkflow",
+    "ControllerToolState",
+    "ToolState",
 ]
 
 WIZARD_KINDS: tuple[str, ...] = ("xyz4", "reference", "three-point", "abc-world")
@@ -101,6 +110,35 @@ class AutoTouchRequest:
         return (float(self.tilt_deg), float(self.azimuth_deg), 0.0)
 
 
+class ToolState(Protocol):
+    """Who owns the mounted tool and the active tool data (the app's ``Session``)."""
+
+    def mount_tool(self, tool: ToolModel) -> None:
+        """Bolt the physical ``tool`` on."""
+
+    def set_active_data(self, tool: Tool | None, slot: int | None = None) -> None:
+        """Make ``tool`` (from library ``slot``) the active tool data."""
+
+    def apply_saved(self, slot: int, tool: Tool) -> None:
+        """``tool`` was just saved in ``slot``: make it the active tool data."""
+
+
+class ControllerToolState:
+    """:class:`ToolState` without a session: writes the controller (scripts and tests)."""
+
+    def __init__(self, controller: VirtualController) -> None:
+        self.controller = controller
+
+    def mount_tool(self, tool: ToolModel) -> None:
+        self.controller.mount_tool(tool)
+
+    def set_active_data(self, tool: Tool | None, slot: int | None = None) -> None:
+        self.controller.set_active_tool(tool)
+
+    def apply_saved(self, slot: int, tool: Tool) -> None:
+        self.controller.set_active_tool(tool)
+
+
 class CalibrationWorkflow:
     """The calibration wizards of one pendant session (see the module docstring).
 
@@ -110,13 +148,16 @@ class CalibrationWorkflow:
         robot: robot name for the session record ("kr6", "gp12" or a URDF stem).
         tools: physical tools by key (default: the built-in pointer, torch and gripper).
         rng: random generator of auto-touch (seed it for reproducible demos and tests).
+        state: the owner of the mounted tool and the active tool data (default: a
+            :class:`ControllerToolState` of ``controller``).
     """
 
     def __init__(self, controller: VirtualController, library: ToolLibrary, *, robot: str,
                  tools: Mapping[str, ToolModel] | None = None,
-                 rng: np.random.Generator | None = None) -> None:
+                 rng: np.random.Generator | None = None, state: ToolState | None = None) -> None:
         self.controller = controller
         self.library = library
+        self.state: ToolState = ControllerToolState(controller) if state is None else state
         self.robot = robot
         self.tools: dict[str, ToolModel] = dict(builtin_tools() if tools is None else tools)
         self.rng = np.random.default_rng() if rng is None else rng
@@ -125,6 +166,7 @@ class CalibrationWorkflow:
         self._current: int | None = None
         self.last_save: tuple[int, Tool] | None = None
         self._saved_results: dict[int, WizardResult] = {}    # run index -> the result saved from it
+        self._auto_directions: dict[int, tuple[float, float, float]] = {}   # run -> last auto-touch
 
     # ------------------------------------------------------------ state
     @property
@@ -134,13 +176,17 @@ class CalibrationWorkflow:
 
     @property
     def wizard(self) -> Wizard | None:
-        """The wizard on show, told which physical tool is mounted right now."""
+        """The wizard on show (a plain getter)."""
         run = self.run
-        if run is None:
-            return None
-        run.wizard.note_mounted_tool(self.controller.mounted_tool.key,
-                                     {key: t.label for key, t in self.tools.items()})
-        return run.wizard
+        return None if run is None else run.wizard
+
+    def note_mounted_tool(self) -> None:
+        """Tell the wizard on show which physical tool is mounted now (the commands that may
+        change it call this; so does the app on the session's ``tool`` change)."""
+        run = self.run
+        if run is not None:
+            run.wizard.note_mounted_tool(self.controller.mounted_tool.key,
+                                         {key: t.label for key, t in self.tools.items()})
 
     @property
     def is_open(self) -> bool:
@@ -199,7 +245,8 @@ class CalibrationWorkflow:
         T_true = None if true_tool is None else np.array(true_tool.T_flange_tool_true, dtype=float)
         self.runs.append(WizardRun(wizard, None if true_tool is None else true_tool.key, T_true))
         self._current = len(self.runs) - 1
-        return self.wizard  # type: ignore[return-value]
+        self.note_mounted_tool()
+        return wizard
 
     def start_xyz4(self, *, n_points: int = 4, estimator: str = "lstsq") -> Xyz4Wizard:
         """Open an XYZ 4-point wizard for the mounted tool (its truth is graded)."""
@@ -223,7 +270,7 @@ class CalibrationWorkflow:
         wiz = ReferenceWizard(ref, reference_tool_key=reference_tool_key, new_tool_key=new_tool_key,
                               new_tool_label=f"the {new.label.lower()}")
         self._open(wiz, new)
-        self.controller.set_active_tool(ref)          # "mounted and active" (step 1)
+        self.state.set_active_data(ref, int(reference_slot))    # "mounted and active" (step 1)
         return wiz
 
     def start_three_point(self, *, slot: int, variant: Literal[1, 2] = 1) -> ThreePointWizard:
@@ -232,7 +279,7 @@ class CalibrationWorkflow:
         tool = self._library_tool(slot)
         wiz = ThreePointWizard(tool, variant=variant)
         self._open(wiz, self.controller.mounted_tool)
-        self.controller.set_active_tool(tool)
+        self.state.set_active_data(tool, int(slot))
         return wiz
 
     def start_abc_world(self, *, slot: int, variant: Literal["6d", "5d"] = "6d") -> AbcWorldWizard:
@@ -241,7 +288,7 @@ class CalibrationWorkflow:
         tool = self._library_tool(slot)
         wiz = AbcWorldWizard(tool, variant=variant)
         self._open(wiz, self.controller.mounted_tool)
-        self.controller.set_active_tool(tool)
+        self.state.set_active_data(tool, int(slot))
         return wiz
 
     # ------------------------------------------------------------ navigation
@@ -270,6 +317,7 @@ class CalibrationWorkflow:
         self._leave_open_wizard()
         self._current = i
         w = self.runs[i].wizard
+        self.note_mounted_tool()
         w.resume()
         return w
 
@@ -288,13 +336,15 @@ class CalibrationWorkflow:
         tool = self.required_tool()
         if tool is None:
             raise WizardStateError("This step needs no tool change.")
-        self.controller.mount_tool(tool)
-        self._require()                      # tells the wizard what is mounted now
+        self.state.mount_tool(tool)
+        self.note_mounted_tool()
         return tool
 
     def record(self) -> None:
         """Record the current flange pose for the current step."""
-        self._require().record(self.controller.T_world_flange())
+        w = self._require()
+        self.note_mounted_tool()
+        w.record(self.controller.T_world_flange())
 
     def next(self) -> WizardResult | None:
         """Next step; on the last step compute the result (returned)."""
@@ -329,8 +379,15 @@ class CalibrationWorkflow:
         if not self.training:
             raise WizardStateError("Auto-touch is a training-mode tool; switch training mode on.")
         w = self._require()
+        run_index = self._current
+        self.note_mounted_tool()
         out = auto_touch(w, self.controller, direction_deg=request.direction_deg,
-                         sigma_mm=request.sigma_mm, rng=self.rng, tools=self.tools)
+                         sigma_mm=request.sigma_mm, rng=self.rng, tools=self.tools,
+                         previous_direction_deg=self._auto_directions.get(run_index),  # type: ignore[arg-type]
+                         mount=self.state.mount_tool)
+        self.note_mounted_tool()
+        if out.direction_deg is not None and run_index is not None:
+            self._auto_directions[run_index] = out.direction_deg
         if out.ok and w.on_last_step and all(s.recorded for s in w.steps):
             try:
                 w.finish()
@@ -386,8 +443,9 @@ class CalibrationWorkflow:
 
     def save(self, name: str, slot: int | None = None) -> tuple[int, Tool]:
         """"Save to tool library": store the calibrated tool (slot None: the slot holding that name,
-        else the first free one), make it the library's active tool and the controller's active
-        tool data. Nothing is written if anything is wrong.
+        else the first free one) and make it the session's active tool data
+        (``ToolState.apply_saved``; the library's active slot is not this method's business).
+        Nothing is written if anything is wrong.
 
         Raises:
             WizardStateError: not finished, empty name, library full.
@@ -397,8 +455,8 @@ class CalibrationWorkflow:
         name = str(name).strip()
         if not name:
             raise WizardStateError("Type a name for the tool before saving.")
-        slot_tool = w.save_to_library(self.library, name, slot, activate=True)
-        self.controller.set_active_tool(slot_tool[1])
+        slot_tool = save_result(w, self.library, name, slot)
+        self.state.apply_saved(*slot_tool)
         self.last_save = slot_tool
         if self._current is not None and w.result is not None:
             self._saved_results[self._current] = w.result

@@ -30,7 +30,8 @@ def build_session_views(session: Session, *, title: str = "TCP Pendant") -> None
     """Build the scene and the GUI of ``session`` into ``session.target`` (under its lock).
 
     Fills ``session.views`` with ``"scene"``, ``"pendant"``, ``"touches"``, ``"tools"`` (and
-    ``"calibrate"`` when a wizard plug-in is installed), then pushes the first state.
+    ``"calibrate"`` when a wizard plug-in is installed; for tests: the views never reach each
+    other), each subscribed to the session's change signal, then pushes the first state.
     """
     with session.lock, session.target.atomic():
         gui = session.target.gui
@@ -44,4 +45,4 @@ def build_session_views(session: Session, *, title: str = "TCP Pendant") -> None
             session.views["tools"] = ToolPanel(session)
         build_calibrate_tab(session, tabs.add_tab("Calibrate"))
         session.views["tabs"] = tabs
-    session.refresh()
+    session.changed(pose=True, tool=True)

@@ -34,7 +34,8 @@ from tcp_pendant.pendant import (
     tcp_readout_markdown,
     touch_indicator_markdown,
 )
-from tcp_pendant.session import Session
+from tcp_pendant.session import Session, SessionChange
+from tcp_pendant.views.scene import closeup_camera, overview_camera
 
 try:                                   # viser's message type (hot path); public setter if absent
     from viser._messages import GuiUpdateMessage
@@ -148,7 +149,15 @@ class PendantPanel:
         self.closeup.on_click(g(self._on_camera(True)))
         self.overview_btn.on_click(g(self._on_camera(False)))
         self._show_settings()
-        session.add_renderer(self.render)
+        session.subscribe(self.on_change)
+
+    def on_change(self, change: SessionChange) -> None:
+        """The change signal: the status line from the move's outcome, the readouts from the
+        change's pose state."""
+        if change.jog is not None:
+            self.show_jog_result(change.jog)
+        if change.pose:
+            self.render(change.state)
 
     # ------------------------------------------------------------ wiring
     def _wire_key(self, button: Any, axis: str | int, sign: int) -> None:
@@ -167,8 +176,7 @@ class PendantPanel:
             self.session.jogger.release()            # the click that ends a hold
         if res is None:
             return
-        self.show_jog_result(res)
-        self.session.moved()
+        self.session.moved(res)
 
     def _slider_cb(self, index: int) -> Any:
         """The callback of joint slider ``index`` (0-based): set the joint to the browser's
@@ -191,8 +199,7 @@ class PendantPanel:
                 self._from_client[index] = applied
             else:                                     # clipped: render sends the limit
                 self._from_client.pop(index, None)
-            self.show_jog_result(JogResult(True, 1.0, None, ""))
-            s.moved()
+            s.moved(JogResult(True, 1.0, None, ""))
 
         return s.on_loop(cb)
 
@@ -223,24 +230,18 @@ class PendantPanel:
             self.session.controller.go_home()
         else:
             self.session.controller.set_q(self.session.ready_q_rad)
-        self.show_jog_result(JogResult(True, 1.0, None, ""))
-        self.session.moved()
+        self.session.moved(JogResult(True, 1.0, None, ""))
 
     def _on_kuka_home(self, _event: Any) -> None:
         self.session.controller.go_home()
-        self.show_jog_result(JogResult(True, 1.0, None, ""))
-        self.session.moved()
+        self.session.moved(JogResult(True, 1.0, None, ""))
 
     def _on_camera(self, close: bool) -> Any:
         def cb(event: Any) -> None:
             client = event.client
-            scene = self.session.views.get("scene")
-            if client is None or scene is None:
+            if client is None:
                 return
-            if close:
-                scene.look_at_tip(client)
-            else:
-                scene.overview(client)
+            (closeup_camera if close else overview_camera)(client, self.session.controller.reference_tip_world_m)
         return cb
 
     # ------------------------------------------------------------ display
@@ -258,13 +259,13 @@ class PendantPanel:
             set_markdown(handle, text)
             self._last_text[key] = text
 
-    def render(self) -> None:
-        """Readouts, touch indicator and joint sliders from the session's pose state (no
-        feedback); only texts and slider values that changed are sent, and a slider whose
-        joint is still where the browser's own value of it put it is not written (module
-        docstring)."""
+    def render(self, state: Any = None) -> None:
+        """Readouts, touch indicator and joint sliders from the session's pose state (``state``:
+        the change signal's; None: the session's now; no feedback); only texts and slider
+        values that changed are sent, and a slider whose joint is still where the browser's own
+        value of it put it is not written (module docstring)."""
         s = self.session
-        state = s.pose_state()
+        state = s.pose_state() if state is None else state
         frame = "BASE" if self.readout_frame.value == "BASE" else "WORLD"
         tool = s.controller.active_tool
         self._set_md(self.tcp_md, "tcp", tcp_readout_markdown(state.readout(frame), None if tool is None else tool.name))

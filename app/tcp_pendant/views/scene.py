@@ -13,6 +13,11 @@ Scene tree (names are per browser; ``--shared`` uses the server's scene):
   (:attr:`SceneView.flange_path`) holds the FLANGE triad, the mounted tool's meshes and the
   active TOOL triad at ``T_flange_tool``, which ride on the flange without updates;
 * ``/reference_tip``: the stand posed so that its spike is at the reference tip;
+The scene reconciles from the session's state: it subscribes to the session's change signal
+(``Session.subscribe``) and, on a ``tool`` change, swaps the mounted tool's meshes and moves the
+TOOL triad when they differ from what the session now has; on a ``pose`` change it poses the
+links and the gizmo from the change's pose state. No other view tells it anything.
+
 * ``/tcp_gizmo``: transform controls on the active TCP; dragging it moves the TCP by
   ``VirtualController.move_tcp_to`` (straight line, same safety rules as jogging), on viser's
   event loop (``Session.on_loop``), a backlog of drag messages coalesced into one move.
@@ -37,10 +42,11 @@ except ImportError:                    # pragma: no cover
 from tcp_pendant.controller import ToolModel, reference_tip_model
 from tcp_pendant.controller.kinematics import urdf_links_and_tree
 from tcp_pendant.controller.rotations import quaternion_wxyz, quaternions_wxyz
-from tcp_pendant.session import Session
+from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.views.meshes import MeshPart, link_meshes, rigid_meshes
 
-__all__ = ["POSE_EPS", "PoseSender", "SceneView", "link_tree_paths", "relative_poses", "wxyz_xyz"]
+__all__ = ["POSE_EPS", "PoseSender", "SceneView", "closeup_camera", "link_tree_paths", "overview_camera",
+           "overview_pose", "relative_poses", "wxyz_xyz"]
 
 OVERVIEW_OFFSET_M = np.array([1.15, -1.25, 0.55])
 CLOSEUP_OFFSET_M = np.array([0.22, -0.26, 0.12])
@@ -185,6 +191,28 @@ def _set_pose(handle: Any, wxyz: list[float] | None, xyz: list[float] | None) ->
         return int(wxyz is not None) + int(xyz is not None)
 
 
+def overview_pose(tip_world_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(camera position, look-at point) of the overview of the cell, WORLD metres."""
+    target = np.array([0.5 * float(tip_world_m[0]), 0.0, 0.45])
+    return target + OVERVIEW_OFFSET_M, target
+
+
+def overview_camera(client: Any, tip_world_m: np.ndarray) -> None:
+    """One browser's camera on the whole cell."""
+    position, look_at = overview_pose(tip_world_m)
+    with client.atomic():                    # position first: its setter shifts look_at
+        client.camera.position = position
+        client.camera.look_at = look_at
+
+
+def closeup_camera(client: Any, tip_world_m: np.ndarray) -> None:
+    """One browser's close-up camera on the reference tip (fine approach)."""
+    tip = np.asarray(tip_world_m, dtype=float)
+    with client.atomic():                    # position first: its setter shifts look_at
+        client.camera.position = tip + CLOSEUP_OFFSET_M
+        client.camera.look_at = tip
+
+
 def _add_parts(scene: Any, parent: str, parts: tuple[MeshPart, ...], *, opacity: float | None = None) -> list[Any]:
     out = []
     for i, p in enumerate(parts):
@@ -242,6 +270,8 @@ class SceneView:
         self._flange_label = scene.add_label(f"{fl}/flange_axes/label", "FLANGE", position=(0.0, 0.05, 0.0))
         self._tool_root = f"{fl}/tool"
         self._tool_frame: Any = None
+        self._shown_mounted: ToolModel | None = None
+        self._shown_active: tuple[Any, bytes] | None = None       # (active tool, T_flange_tool)
         self.set_mounted_tool(c.mounted_tool)
         self._active_axes = scene.add_frame(f"{fl}/active_tool", axes_length=0.12, axes_radius=0.005)
         self._active_label = scene.add_label(f"{fl}/active_tool/label", "TOOL", position=(0.0, 0.0, 0.04))
@@ -253,6 +283,7 @@ class SceneView:
         _add_parts(scene, "/reference_tip", rigid_meshes(tip.urdf_path))
         self._tip_label = scene.add_label("/reference_tip_label", "reference tip",
                                           position=tuple(c.reference_tip_world_m + [0.0, 0.0, -0.06]))
+        session.scene_labels.update(self.tool_labels())     # the wizards' scene moves them apart
 
         wxyz, xyz = wxyz_xyz(state.T_world_tcp)
         self.gizmo = scene.add_transform_controls("/tcp_gizmo", scale=0.14, line_width=2.0, wxyz=wxyz,
@@ -260,7 +291,24 @@ class SceneView:
         self._gizmo_row = len(self._moving)
         self._poses = PoseSender([self.link_frames[n] for n in self._moving] + [self.gizmo], T_local)
         self.gizmo.on_update(session.on_loop(self._on_gizmo))
-        session.add_renderer(self.render)
+        session.subscribe(self.on_change)
+
+    def on_change(self, change: SessionChange) -> None:
+        """The change signal: reconcile the tool meshes and the TOOL triad (``tool``), pose the
+        links and the gizmo (``pose``), from the session's state."""
+        if change.tool:
+            self.reconcile_tools()
+        if change.pose and change.state is not None:
+            skip = (self._gizmo_row,) if self._dragging else ()
+            self._poses.send(self._local_poses(change.state), skip=skip)
+
+    def reconcile_tools(self) -> None:
+        """Show the session's mounted tool and active TOOL frame if they are not shown yet."""
+        c = self.session.controller
+        if c.mounted_tool is not self._shown_mounted:
+            self.set_mounted_tool(c.mounted_tool)
+        if self._shown_active != (c.active_tool, c.T_flange_tool.tobytes()):
+            self.update_active_tool()
 
     # ------------------------------------------------------------ updates
     def _local_poses(self, state: Any) -> np.ndarray:
@@ -287,7 +335,8 @@ class SceneView:
         self._poses.send(self._local_poses(self.session.pose_state()), force=(self._gizmo_row,))
 
     def set_mounted_tool(self, tool: ToolModel) -> None:
-        """Show another physical tool on the flange."""
+        """Show another physical tool on the flange (:meth:`reconcile_tools` calls it)."""
+        self._shown_mounted = tool
         if self._tool_frame is not None:
             self._tool_frame.remove()
         self._tool_frame = self.scene.add_frame(self._tool_root, show_axes=False)
@@ -296,6 +345,7 @@ class SceneView:
     def update_active_tool(self) -> None:
         """Move the TOOL triad to the active tool data (``T_flange_tool``) and relabel it."""
         c = self.session.controller
+        self._shown_active = (c.active_tool, c.T_flange_tool.tobytes())
         wxyz, xyz = wxyz_xyz(c.T_flange_tool)
         self._active_axes.wxyz = wxyz
         self._active_axes.position = xyz
@@ -319,23 +369,13 @@ class SceneView:
     # ------------------------------------------------------------ camera
     def look_at_tip(self, client: Any) -> None:
         """Close-up camera on the reference tip (fine approach) for one browser."""
-        tip = self.session.controller.reference_tip_world_m
-        with client.atomic():                    # position first: its setter shifts look_at
-            client.camera.position = tip + CLOSEUP_OFFSET_M
-            client.camera.look_at = tip
+        closeup_camera(client, self.session.controller.reference_tip_world_m)
 
     def overview(self, client: Any) -> None:
         """Camera on the whole cell."""
-        position, look_at = self.overview_pose(self.session.controller.reference_tip_world_m)
-        with client.atomic():                    # position first: its setter shifts look_at
-            client.camera.position = position
-            client.camera.look_at = look_at
+        overview_camera(client, self.session.controller.reference_tip_world_m)
 
-    @staticmethod
-    def overview_pose(tip_world_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(camera position, look-at point) of the overview, WORLD metres."""
-        target = np.array([0.5 * float(tip_world_m[0]), 0.0, 0.45])
-        return target + OVERVIEW_OFFSET_M, target
+    overview_pose = staticmethod(overview_pose)
 
     # ------------------------------------------------------------ gizmo
     def _on_gizmo(self, event: Any) -> None:
@@ -384,8 +424,4 @@ class SceneView:
         T = np.eye(4)
         T[:3, :3] = Rotation.from_quat(np.roll(wxyz, -1)).as_matrix()
         T[:3, 3] = xyz
-        res = s.controller.move_tcp_to(T)
-        pendant = s.views.get("pendant")
-        if pendant is not None:
-            pendant.show_jog_result(res)
-        s.moved()
+        s.moved(s.controller.move_tcp_to(T))

@@ -2,9 +2,12 @@
 library (activate, rename, delete, export to controller text) and numeric tool entry.
 
 The library is the server's ``tcpcal.ToolLibrary`` (one file, shared by every session and
-process); :meth:`ToolPanel.reload` re-reads it, and the server calls it when the file changes,
-so a trainee sees the tools others save. Activating a tool sets the session controller's
-active tool data (and the library's active slot, as a controller's tool table would).
+process); the session keeps the list it last read (``Session.reload_library``, also called by
+the server's watcher when the file changes, so a trainee sees the tools others save) and this
+panel re-renders it on the session's ``library`` change. Mount, Activate and "No tool" are the
+session's commands (``Session.mount_tool`` / ``activate`` / ``deactivate``): this session only
+(in ``--shared`` mode Activate also sets the library's active slot, the shared start tool);
+the panel re-renders the mounted tool and the active data on the session's ``tool`` change.
 
 Numeric entry: every field is validated (``tcp_pendant.pendant.tool_entry``) and its error is
 shown right under it; the tool is saved only if all fields are valid (nothing half-way).
@@ -18,10 +21,9 @@ from typing import Any
 from tcp_pendant.controller import builtin_tools
 from tcp_pendant.pendant import FIELDS, ToolEntry, parse_tool_entry, tool_data_markdown
 from tcp_pendant.pendant.tool_entry import entry_preview_markdown
-from tcp_pendant.session import Session
+from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.gui_util import number_of_option, set_options, slot_option
-from tcpcal.errors import TcpcalError
 from tcpcal.formats import FORMATS, export_tool, text_format
 from tcpcal.tool import Tool
 
@@ -84,44 +86,52 @@ class ToolPanel:
             handle.on_update(g(lambda _e: self._show_entry_preview()))
         self._show_entry_preview()
         self._library: dict[int, Tool] = {}
-        self._reload_listeners: list[Callable[[dict[int, Tool]], None]] = []
         # a new browser hears of the library's latest recovery; later ones as they happen
         self._recoveries_told = max(0, len(session.library.recoveries) - 1)
         self._library_error: str | None = None
-        self.reload()
+        self.show_library()
         self._show_active()
+        session.subscribe(self.on_change)
+
+    def on_change(self, change: SessionChange) -> None:
+        """The change signal: the list on ``library``, the mounted tool and the active data on
+        ``tool``."""
+        if change.library:
+            self.show_library()
+        if change.tool:
+            self._show_mounted()
+            self._show_active()
 
     # ------------------------------------------------------------ library
     def reload(self) -> None:
-        """Re-read the shared library and refresh the slot lists (keeps the selection).
+        """Re-read the shared library (``Session.reload_library``; the panel re-renders on its
+        change signal)."""
+        self.session.reload_library()
+
+    def show_library(self) -> None:
+        """Render the session's list of the library's tools (keeps the selection).
 
         A damaged file's valid tools are listed; what the library set aside (and where its
         backup is) is told to this browser once per recovery. An unreadable file lists no
         tools and says why (once per reason), so the rest of the pendant still works.
         """
-        try:
-            lib = self.session.library.tools()
-        except TcpcalError as exc:  # e.g. permissions: ToolLibraryError names the file
-            lib = {}
-            if str(exc) != self._library_error:
-                self.session.notify("Tool library unavailable", str(exc), kind="error")
-            self._library_error = str(exc)
-        else:
-            self._library_error = None
+        s = self.session
+        error = s.library_error
+        if error is not None and error != self._library_error:
+            s.notify("Tool library unavailable", error, kind="error")
+        self._library_error = error
         self._tell_recoveries()
+        lib = s.library_tools
         self._library = lib
-        options = tuple(slot_option(s, t.name) for s, t in sorted(lib.items())) or (NO_TOOL,)
+        options = tuple(slot_option(slot, t.name) for slot, t in sorted(lib.items())) or (NO_TOOL,)
         current = number_of_option(self.slots.value)
         self.slots.options = options
         pick = next((o for o in options if number_of_option(o) == current), options[0])
         if self.slots.value != pick:
             self.slots.value = pick
-        free = [str(s) for s in range(1, self.session.library.N_SLOTS + 1) if s not in lib]
+        free = [str(n) for n in range(1, s.library.N_SLOTS + 1) if n not in lib]
         set_options(self.entry_slot, ("first free", *free))
         self._show_slot()
-        self._show_active()
-        for fn in self._reload_listeners:
-            fn(lib)
 
     def _tell_recoveries(self) -> None:
         """Notify this browser of each library recovery it has not been told of (viser shows a
@@ -132,11 +142,6 @@ class ToolPanel:
                      else "Tool library: bad entries set aside")
             self.session.notify(title, rec.summary(), kind="warning")
         self._recoveries_told = len(recoveries)
-
-    def on_reload(self, fn: Callable[[dict[int, Tool]], None]) -> None:
-        """Call ``fn(tools)`` with the library just read (slot -> tool) after every reload, so
-        other views that list its tools need not read the file again."""
-        self._reload_listeners.append(fn)
 
     def _selected(self) -> tuple[int, Tool]:
         slot = number_of_option(self.slots.value)
@@ -151,6 +156,11 @@ class ToolPanel:
         self.slot_md.content = "" if tool is None else tool_data_markdown(tool, slot).replace(
             "**Active tool:**", "**Selected:**")
 
+    def _show_mounted(self) -> None:
+        label = self.session.controller.mounted_tool.label
+        if label in self._tool_key_by_label and self.mounted.value != label:
+            self.mounted.value = label              # its own handler then sees no change
+
     def _show_active(self) -> None:
         self.active_md.content = tool_data_markdown(self.session.controller.active_tool, self.session.active_slot)
 
@@ -159,59 +169,39 @@ class ToolPanel:
         key = self._tool_key_by_label.get(str(event.target.value))
         if key is None:
             raise ValueError(f"Unknown tool {event.target.value!r}.")
-        s = self.session
-        if key == s.controller.mounted_tool.key:
-            return
-        s.controller.mount_tool(self._tools[key])
-        scene = s.views.get("scene")
-        if scene is not None:
-            scene.set_mounted_tool(self._tools[key])
-        s.moved()
-
-    def set_active(self, slot: int | None, tool: Tool | None) -> None:
-        """Make ``tool`` the session's active tool data (from ``slot``; None: flange)."""
-        s = self.session
-        s.controller.set_active_tool(tool)
-        s.active_slot = slot if tool is not None else None
-        scene = s.views.get("scene")
-        if scene is not None:
-            scene.update_active_tool()
-        self._show_active()
-        s.moved()
+        if key != self.session.controller.mounted_tool.key:
+            self.session.mount_tool(self._tools[key])
 
     def _on_activate(self, _event: Any) -> None:
-        slot, tool = self._selected()
-        self.session.library.activate(slot)
-        self.set_active(slot, tool)
+        slot, _ = self._selected()
+        tool = self.session.activate(slot)
         self.session.notify("Tool activated", f"{slot}: {tool.name}", kind="success")
 
     def _on_deactivate(self, _event: Any) -> None:
-        self.set_active(None, None)
+        self.session.deactivate()
 
     def _on_rename(self, _event: Any) -> None:
         slot, tool = self._selected()
         name = str(self.new_name.value).strip()
         if not name:
             raise ValueError("Type the new name in 'New name' first.")
-        self.session.library.rename(slot, name)
-        if self.session.client is not None:
+        s = self.session
+        s.library.rename(slot, name)
+        if s.client is not None:
             # a courtesy, per browser only: in --shared mode the box is every browser's, and
             # another trainee may be typing in it
             self.new_name.value = ""
-        if self.session.active_slot == slot:
-            renamed = self.session.library.get(slot)
-            self.session.controller.set_active_tool(renamed)
-            scene = self.session.views.get("scene")
-            if scene is not None:
-                scene.update_active_tool()
-            self.session.refresh()
-        self.reload()
+        with s.batch():
+            s.reload_library()
+            renamed = s.library_tools.get(slot)
+            if s.active_slot == slot and renamed is not None:
+                s.set_active_data(renamed, slot)        # the active data carries the new name
 
     def _on_delete(self, _event: Any) -> None:
         slot, tool = self._selected()
         self.session.library.remove(slot)
         self.session.notify("Tool deleted", f"{slot}: {tool.name}")
-        self.reload()
+        self.session.reload_library()
 
     def _on_export(self, _event: Any) -> None:
         slot, tool = self._selected()
@@ -248,7 +238,7 @@ class ToolPanel:
             return
         lib.save(slot, res.tool)
         self.entry_md.content = f"✔ Saved **{escape_markdown(res.tool.name)}** in slot {slot}."
-        self.reload()
+        self.session.reload_library()
         self.slots.value = slot_option(slot, res.tool.name)
         self._show_slot()
 

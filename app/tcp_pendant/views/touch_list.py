@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from tcp_pendant.session import Session
+from tcp_pendant.session import Session, SessionChange
 
 __all__ = ["TouchListView"]
 
@@ -22,7 +22,12 @@ class TouchListView:
             self.empty_md = gui.add_markdown("*No touch recorded.*")
         self._rows: list[Any] = []
         self.record.on_click(session.on_loop(self._on_record))
-        session.add_touch_listener(self.rebuild)
+        session.subscribe(self.on_change)
+
+    def on_change(self, change: SessionChange) -> None:
+        """The change signal: redraw the rows when the touches changed."""
+        if change.touches:
+            self.rebuild()
 
     def _on_record(self, _event: Any) -> None:
         t = self.session.record_touch()

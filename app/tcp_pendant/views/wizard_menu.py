@@ -17,9 +17,12 @@ Top to bottom:
   replayed in a worker thread (never on viser's event loop, where it would stall every
   browser), one load per session at a time; the result is added under the session lock.
 
-All logic is in :class:`tcp_pendant.calibrate.CalibrationWorkflow` (no viser); every click goes
-through :meth:`CalibrateView.action` (the session's lock and error notifications), then the
-views are re-rendered from the workflow's state.
+All logic is in :class:`tcp_pendant.calibrate.CalibrationWorkflow` (no viser), which changes
+the mounted tool and the active tool data through the session's commands (the session is its
+``ToolState``); every click goes through :meth:`CalibrateView.action` (``Session.on_loop``: the
+event loop, the session's lock and error notifications) inside ``Session.batch``, so a click
+ends in one change signal; the tab re-renders from the workflow's state on that signal
+(:meth:`CalibrateView.on_change`), as the scene and the Tool tab do.
 """
 
 from __future__ import annotations
@@ -39,7 +42,7 @@ from tcp_pendant.calibrate.text import (
     replay_markdown,
 )
 from tcp_pendant.controller import builtin_robots
-from tcp_pendant.session import Session
+from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.gui_util import (
     number_of_option,
@@ -101,7 +104,8 @@ class CalibrateView:
 
     def __init__(self, session: Session) -> None:
         self.session = session
-        self.workflow = CalibrationWorkflow(session.controller, session.library, robot=robot_name(session))
+        self.workflow = CalibrationWorkflow(session.controller, session.library, robot=robot_name(session),
+                                            state=session)
         self._menu_mounted_key: str | None = None
         self._library: dict[int, Tool] = {}
         self._library_pick: tuple[str, int | None] | None = None   # (option, active slot then)
@@ -154,74 +158,55 @@ class CalibrateView:
         self._loading_record = False
         self.load.on_upload(self._on_upload)
         limit_upload_size(self.load, MAX_RECORD_BYTES, self._upload_refused)
-        session.add_motion_listener(self.on_motion)
-        tool_panel = session.views.get("tools")
-        if tool_panel is not None:
-            tool_panel.on_reload(self.refresh_library)
-        self.refresh_library()
+        session.subscribe(self.on_change)
+        self.refresh_library()      # the session's list: no file read here (an unreadable file is told once)
         self.render()
+
+    def on_change(self, change: SessionChange) -> None:
+        """The change signal: the live parts after a move; the library list when it was
+        re-read; the whole tab after a Calibrate click or a tool change (the open wizard is
+        told which tool is mounted first)."""
+        if change.tool:
+            self.workflow.note_mounted_tool()
+        if change.library:
+            self.refresh_library(render=False)
+        if change.pose:
+            self.on_motion()
+        if change.wizard or change.tool or change.library:
+            self.render()
 
     # ------------------------------------------------------------ plumbing
     def action(self, fn: Callable[[Any], Any], *, user_only: bool = False,
                sync: bool = False) -> Callable[[Any], Any]:
-        """Wrap a GUI callback: session lock and error notifications (``Session.guard``), then
-        re-render the tab (with ``sync``: first bring the tool views and the robot's scene in
-        line, see :meth:`after_action`).
-
-        The callback is ``async``, so viser runs it on its event loop, as the jog keys: viser
-        1.1's message buffer is not safe to push to from its thread pool (a rare "deque mutated
-        during iteration" was seen there), and the Calibrate actions are short (an auto-touch's
-        IK and a library save take milliseconds).
+        """Wrap a GUI callback: ``Session.on_loop`` (viser's event loop, session lock, error
+        notifications), inside ``Session.batch``, ending in one change signal with ``wizard``
+        (with ``sync`` also ``pose``: the click may have moved the robot, as auto-touch does).
+        Tool and library changes the click made through the session's commands join that
+        signal; every view re-renders on it.
 
         Args:
             fn: the callback, given the viser event.
             user_only: ignore events fired by our own assignments to a handle's value (viser
                 fires on_update for those too, with ``event.client is None``), as for the
                 dropdowns and checkboxes the views also set.
-            sync: the callback may change the controller (mounted or active tool, joints) or
-                the library: Start, Mount, Auto-touch, Save. The others (choices, typing, Next,
-                estimator ...) only re-render the tab: no library read, no scene refresh.
+            sync: the callback may move the robot: Start, Mount, Auto-touch, Save.
         """
-        done = self.after_action if sync else self.render
+        s = self.session
 
         def run(event: Any) -> None:
             if user_only and getattr(event, "client", None) is None:
                 return
-            try:
-                fn(event)
-            finally:
-                done()
+            with s.batch():
+                try:
+                    fn(event)
+                finally:
+                    s.changed(wizard=True, pose=sync)
 
-        guarded = self.session.guard(run)
-
-        async def on_loop(event: Any) -> None:
-            guarded(event)
-
-        return on_loop
-
-    def after_action(self) -> None:
-        """After a click: show the tool the controller has mounted and the active tool data, push
-        the robot (an auto-touch moves it), then re-render the Calibrate tab."""
-        s = self.session
-        if s.closed:
-            return
-        c = s.controller
-        scene = s.views.get("scene")
-        tool_panel = s.views.get("tools")
-        if tool_panel is not None and tool_panel.mounted.value != c.mounted_tool.label:
-            if scene is not None:
-                scene.set_mounted_tool(c.mounted_tool)
-            tool_panel.mounted.value = c.mounted_tool.label   # its own handler sees no change
-        if scene is not None:
-            scene.update_active_tool()
-        if tool_panel is not None:
-            tool_panel.reload()
-        s.moved()
-        self.render()
+        run.__qualname__ = getattr(fn, "__qualname__", "action")
+        return s.on_loop(run)
 
     def saved(self, slot: int, tool: Tool) -> None:
-        """After "Save to tool library": the saved tool is the session's active tool."""
-        self.session.active_slot = slot
+        """After "Save to tool library" (the session made it the active tool)."""
         self.session.notify("Tool saved", f"Slot {slot}: {tool.name} is now the active tool.", kind="success")
 
     # ------------------------------------------------------------ callbacks
@@ -266,7 +251,6 @@ class CalibrateView:
             wf.start_abc_world(slot=slot)
         else:
             raise ValueError(f"Unknown calibration method {self.method.value!r}.")
-        self.session.active_slot = slot                # the wizard made that tool data active
 
     def _on_resume(self, _event: Any) -> None:
         number = number_of_option(self.resume_list.value)
@@ -336,15 +320,16 @@ class CalibrateView:
             self._refuse_record(filename or "The file", exc)
 
     # ------------------------------------------------------------ library and motion
-    def refresh_library(self, tools: dict[int, Tool] | None = None) -> None:
-        """Re-list the library's tools (``tools``: as the tool panel just read them; None: read
-        now). Called when the library changes, by anyone."""
-        tools = self.workflow.library_tools() if tools is None else tools
+    def refresh_library(self, *, render: bool = True) -> None:
+        """Re-list the library's tools as the session last read them (``Session.library_tools``;
+        the file is not read here). Called on the session's ``library`` change."""
+        tools = self.session.library_tools
         self._library = dict(tools)
         options = tuple(slot_option(s, t.name) for s, t in sorted(tools.items())) or (NO_LIBRARY_TOOL,)
         set_options(self.library_tool, options, keep=self._library_option(options))
         self.result.refresh_slots(tools)
-        self._render_menu()
+        if render:
+            self._render_menu()
 
     def on_motion(self) -> None:
         """After every move of the robot (and a tool change on the Tool tab): the live parts only

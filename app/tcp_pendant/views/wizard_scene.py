@@ -58,7 +58,7 @@ class WizardSceneView:
     def __init__(self, session: Session, workflow: CalibrationWorkflow) -> None:
         self.session = session
         self.workflow = workflow
-        scene = session.views["scene"].scene
+        scene = session.target.scene
         self.scene = scene
         self.computed = scene.add_frame("/calibration/computed_tool", axes_length=0.10, axes_radius=0.0045,
                                         visible=False)
@@ -167,8 +167,7 @@ class WizardSceneView:
             out["computed"] = (self.computed_label, T_wf @ self._T_flange_computed)
         if self._T_flange_tool_true is not None:
             out["true"] = (self.true_label, T_wf @ self._T_flange_tool_true)
-        scene_view = self.session.views.get("scene")
-        others = scene_view.tool_labels() if hasattr(scene_view, "tool_labels") else {}
+        others = self.session.scene_labels          # the robot scene's labels at the tool and tip
         if "tool" in others and self.session.controller.active_tool is not None:
             out["tool"] = (others["tool"], T_wf @ np.asarray(self.session.controller.T_flange_tool, dtype=float))
         if "tip" in others:

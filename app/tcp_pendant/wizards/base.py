@@ -490,33 +490,6 @@ class Wizard(abc.ABC):
     def to_tool(self, name: str) -> Tool:
         """The calibrated tool (for "Save to tool library"), with its Calibration record."""
 
-    def save_to_library(self, library: Any, name: str, slot: int | None = None, *,
-                        activate: bool = True) -> tuple[int, Tool]:
-        """"Save to tool library": store ``to_tool(name)`` in ``slot`` (default: the slot that
-        already holds a tool of that name, else the first free one) and make it active.
-
-        Args:
-            library: a ``tcpcal.ToolLibrary``.
-            name: the tool's logical name.
-            slot: 1..16, or None for the default above.
-            activate: make it the active tool (the pendant's "Save" does).
-
-        Returns:
-            (slot, tool) as saved. The caller also sets it as the controller's active tool.
-
-        Raises:
-            WizardStateError: the wizard is not finished, or the library is full.
-            tcpcal.TcpcalError: the library refused (bad slot, name used by another slot).
-        """
-        tool = self.to_tool(name)
-        if slot is None:
-            found = library.find(name)
-            slot = found[0] if found is not None else library.first_free_slot()
-            if slot is None:
-                raise WizardStateError("The tool library is full: pick a slot to overwrite.")
-        library.save(slot, tool, activate=activate)
-        return slot, tool
-
     def _require_result(self) -> WizardResult:
         if self.result is None:
             raise WizardStateError("Finish the wizard before saving the tool.")

@@ -1,0 +1,42 @@
+""""Save to tool library": a finished wizard's tool written to the shared ``tcpcal.ToolLibrary``.
+
+The file I/O of saving lives here, in ``calibrate/``, not in the wizards (state machines that
+only compute): :func:`save_result` picks the slot and writes one atomic ``ToolLibrary.save``.
+It never sets the library's active slot: which tool is active is the session's (the app's
+``Session.apply_saved``; in ``--shared`` mode that also sets the library's active slot).
+"""
+
+from __future__ import annotations
+
+from tcp_pendant.wizards import Wizard, WizardStateError
+from tcpcal.library import ToolLibrary
+from tcpcal.tool import Tool
+
+__all__ = ["save_result"]
+
+
+def save_result(wizard: Wizard, library: ToolLibrary, name: str, slot: int | None = None) -> tuple[int, Tool]:
+    """Store ``wizard.to_tool(name)`` in ``slot`` of ``library``.
+
+    Args:
+        wizard: a finished wizard.
+        library: the tool library.
+        name: the tool's logical name.
+        slot: 1..16, or None: the slot that already holds a tool of that name, else the first
+            free one.
+
+    Returns:
+        (slot, tool) as saved.
+
+    Raises:
+        WizardStateError: the wizard is not finished, or the library is full.
+        tcpcal.TcpcalError: the library refused (bad slot, name used by another slot).
+    """
+    tool = wizard.to_tool(name)
+    if slot is None:
+        found = library.find(name)
+        slot = found[0] if found is not None else library.first_free_slot()
+        if slot is None:
+            raise WizardStateError("The tool library is full: pick a slot to overwrite.")
+    library.save(slot, tool, activate=False)
+    return slot, tool
