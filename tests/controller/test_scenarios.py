@@ -121,6 +121,7 @@ def test_bent_tool_moves_the_tip_sideways_and_tilts_its_axis(tool_key, seed):
     world = realize(Scenario("bent_tool", seed), kinematics("kr6"), tool)
     bend, bent = world.tool_bend, world.tool_true
     assert (bent.key, bent.label, bent.urdf_path) == (tool.key, tool.label, tool.urdf_path)
+    np.testing.assert_array_equal(bent_tool(tool, bend).T_flange_tool_true, bent.T_flange_tool_true)
     np.testing.assert_array_equal(tool.T_flange_tool_true, T_before)  # the library's tool unchanged
     T0, T1 = tool.T_flange_tool_true, bent.T_flange_tool_true
     x_old, shift = T0[:3, 0], (T1[:3, 3] - T0[:3, 3]) * 1000.0
