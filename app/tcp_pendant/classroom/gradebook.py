@@ -61,7 +61,7 @@ from typing import Any, Literal
 import numpy as np
 import platformdirs
 
-from tcp_pendant.classroom.names import validate_trainee_name
+from tcp_pendant.classroom.names import TraineeNameError, validate_trainee_name
 
 __all__ = [
     "APPLICATION",
@@ -504,8 +504,6 @@ class Gradebook:
         Raises:
             GradebookError: the name is refused (``TraineeNameError``'s words: why, what to type).
         """
-        from tcp_pendant.classroom.names import TraineeNameError
-
         try:
             clean = validate_trainee_name(name)
         except TraineeNameError as exc:
