@@ -199,6 +199,86 @@ def large_table(ns: tuple[int, ...], repeated_n: int) -> list[tuple[str, int, di
     return out
 
 
+BEAM_SIGMA = 0.02  # mm: the sensor repeatability of issue 14
+BEAM_NS = (2, 4, 8, 16)
+BEAM_PATTERNS = ("spin only", "spin + tilt 10-30")
+
+
+def beam_efficiency_table(n_sets: int, draws: int, seed: int = 100) -> list[dict]:
+    """Table 5: tcpcal.solve_beam's RMS TCP error over the Cramer-Rao bound of the
+    line-constraint model (methods.md section 9), sigma^2 (sum_i R_i^T P R_i)^-1 computed here
+    event by event, and how often the true TCP lies in the 95 % radius (noise estimated).
+
+    Events: the tool pointing down at a horizontal beam (WORLD Y), turned about its own axis by
+    a random angle ("spin only"), or also tilted 10-30 deg about a random horizontal axis; the
+    tip on the beam line plus isotropic noise BEAM_SIGMA per axis on the flange position.
+    """
+    from scipy.spatial.transform import Rotation
+
+    from tcpcal.beam import solve_beam
+
+    b, u = np.array([900.0, 150.0, 400.0]), np.array([0.0, 1.0, 0.0])
+    p = np.eye(3) - np.outer(u, u)
+    down = Rotation.from_euler("y", 180.0, degrees=True)
+    rows = []
+    for pattern in BEAM_PATTERNS:
+        for n in BEAM_NS:
+            rng = np.random.default_rng(seed)
+            seed += 1
+            ratios, inside, refused, traces = [], 0, 0, []
+            for _ in range(n_sets):
+                spin = Rotation.from_euler("z", rng.uniform(-180.0, 180.0, (n, 1)), degrees=True)
+                rot = down * spin
+                if pattern != "spin only":
+                    az = rng.uniform(0.0, 2.0 * np.pi, n)
+                    tilt = np.radians(rng.uniform(10.0, 30.0, n))
+                    axes = np.stack([np.cos(az), np.sin(az), np.zeros(n)], axis=1)
+                    rot = Rotation.from_rotvec(axes * tilt[:, None]) * rot
+                rm = rot.as_matrix()
+                tcp = random_tcp(rng, (100.0, 300.0))
+                m = sum(r.T @ p @ r for r in rm)
+                crb = BEAM_SIGMA**2 * np.linalg.inv(m)
+                traces.append(float(np.trace(crb)))
+                clean = b + rng.uniform(-10.0, 10.0, n)[:, None] * u - rm @ tcp
+                for _ in range(draws):
+                    pos = clean + BEAM_SIGMA * rng.standard_normal(clean.shape)
+                    try:
+                        res = solve_beam(rm, pos, b, u)
+                    except DegenerateTouchesError:
+                        refused += 1
+                        continue
+                    err2 = float(np.sum((res.tcp - tcp) ** 2))
+                    ratios.append(err2 / traces[-1])
+                    inside += math.sqrt(err2) <= res.ci95_radius
+            r = np.asarray(ratios)
+            eff = math.sqrt(r.mean()) if r.size else math.nan
+            rows.append({"pattern": pattern, "n": n, "crb_rms": math.sqrt(np.median(traces)),
+                         "efficiency": eff,
+                         "eff_2se": (2.0 * r.std(ddof=1) / math.sqrt(r.size) / (2.0 * eff)
+                                     if r.size > 1 else math.nan),
+                         "coverage": inside / r.size if r.size else math.nan,
+                         "refused": refused})
+    return rows
+
+
+def print_beam_table(n_sets: int, draws: int) -> None:
+    print(f"5. beam: efficiency vs the Cramer-Rao bound of the line-constraint model  "
+          f"(sigma = {BEAM_SIGMA} mm; 1.00 = limit; target: 1 within 2 SE or {EFFICIENCY_TARGET})")
+    hdr = (f"{'pattern':>18} {'N':>3} {'CRB rms mm':>10} {'RMS/CRB':>8} {'+-2SE':>6} "
+           f"{'in 95 % radius':>15} {'refused':>8}  target")
+    print(hdr)
+    print("-" * len(hdr))
+    for r in beam_efficiency_table(n_sets, draws):
+        ok = abs(r["efficiency"] - 1.0) <= max(r["eff_2se"], EFFICIENCY_TARGET - 1.0)
+        print(f"{r['pattern']:>18} {r['n']:>3} {r['crb_rms']:10.4f} {r['efficiency']:8.3f} "
+              f"{r['eff_2se']:6.3f} {r['coverage']:15.3f} {r['refused']:>8d}  {verdict(ok)}")
+    print("   solve_beam is linear least squares on a linear Gaussian model: it reaches the bound")
+    print("   (ratio 1 within the sampling error); N = 2 events leave 1 degree of freedom for the")
+    print("   noise, so its 95 % radius is wide but still covers 95 %. Turning the tool about its")
+    print("   own axis alone observes the TCP (the beam direction seen in FLANGE turns with it);")
+    print("   turning it only about the beam would not (methods.md section 9).")
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="tiny run (smoke test)")
@@ -281,6 +361,8 @@ def main(argv: list[str] | None = None) -> int:
     print("   Angle figures above 2048 touches: smallest exact (nearest neighbour of quaternions),")
     print("   largest exact when bound-and-prune leaves <= 2048 candidates, else marked as an estimate")
     print("   ('>=' above; max_angle_exact false in the result). Memory O(N), never N x N.")
+    print()
+    print_beam_table(n_sets, draws)
     return 0
 
 

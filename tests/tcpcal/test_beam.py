@@ -327,3 +327,21 @@ def test_axis_refuses_one_event_and_a_crossing_at_the_tcp():
     with pytest.raises(InvalidInputError, match="through the TCP") as info:
         solve_beam_axis(rot, axis_events(rot, np.array([30.0, 0.0])), B, U, T_TRUE)
     assert info.value.index == 1
+
+
+# ------------------------------------------------------------------------ benchmark table 5
+def test_bench_solver_beam_table_runs_and_reaches_the_bound():
+    """tests/bench/bench_solver.py table 5 (issue 14): a small run of its beam rows."""
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "bench" / "bench_solver.py"
+    spec = importlib.util.spec_from_file_location("bench_solver_beam", path)
+    bench = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(bench)
+    rows = bench.beam_efficiency_table(n_sets=60, draws=5)
+    assert [(r["pattern"], r["n"]) for r in rows] == [
+        (p, n) for p in bench.BEAM_PATTERNS for n in bench.BEAM_NS]
+    for r in rows:  # 300 draws: the RMS ratio's 2 SE is about 8 %
+        assert 0.8 < r["efficiency"] < 1.2 and r["refused"] == 0
+        assert 0.88 < r["coverage"] <= 1.0
