@@ -14,8 +14,9 @@ straightforward implementation: per move ``ViserUrdf.update_cfg`` (yourdfpy FK, 
 joint), the gizmo and the three readouts through viser's public setters, each from its own
 controller call (scipy conversions), and plain jog-key callbacks (viser's thread pool) - so
 that the app is reported as a ratio to a yardstick measured in the same run on the same
-(shared, noisy) machine. The baseline replaces the session's renderers and the X keys' hold
-callbacks; the jog itself (controller) is the same code in both:
+(shared, noisy) machine. The baseline replaces the scene's and the jog panel's subscriptions
+to the session's change signal and the X keys' hold callbacks; the jog itself (controller) is
+the same code in both:
 
 * A  hot loop: steps back to back, round robin over the sessions, called in this process
      (``Jogger.key`` + ``Session.moved``): CPU of the calling thread per step (median, p95)
@@ -113,12 +114,20 @@ def free_port() -> int:
 
 
 def install_baseline(session: Any) -> None:
-    """Swap the session's renderers for :class:`NaiveRenderer` and its X jog keys' hold
+    """Swap the scene's and jog panel's subscriptions for :class:`NaiveRenderer` and its X jog keys' hold
     callbacks for plain ones (viser runs those in its thread pool: the straightforward way)."""
     from tcp_pendant.views.pendant_panel import HOLD_HZ
 
     with session.lock:
-        session._renderers[:] = [NaiveRenderer(session)]   # the views' renderers out, the baseline in
+        naive = NaiveRenderer(session)
+
+        def baseline(change: Any) -> None:
+            if change.pose:
+                naive()
+        # the scene's and the jog panel's subscriptions out, the baseline in
+        session._subscribers[:] = [baseline] + [f for f in session._subscribers
+                                                if type(getattr(f, "__self__", None)).__name__
+                                                not in ("SceneView", "PendantPanel")]
         pendant = session.views["pendant"]
         for sign in (1, -1):
             def hold(_event: Any, sign: int = sign) -> None:
@@ -199,7 +208,7 @@ def hot_loop(sessions: list[Any], steps: int) -> dict[str, float]:
 
 def breakdown(sessions: list[Any], steps: int) -> tuple[list[tuple[str, float]], float, float]:
     """Where the thread's time goes in a hot-loop step (instrumented pass, not used for the
-    figures above): per-step thread CPU of the jog, of each renderer and motion listener, the
+    figures above): per-step thread CPU of the jog, of each subscriber to the change signal, the
     rest of ``Session.moved``; plus viser messages queued per step and process CPU per step."""
     from viser.infra._async_message_buffer import AsyncMessageBuffer
 
@@ -221,9 +230,8 @@ def breakdown(sessions: list[Any], steps: int) -> tuple[list[tuple[str, float]],
 
     saved = []
     for s in sessions:
-        saved.append((s, list(s._renderers), list(s._motion_listeners), s.jogger.key))
-        s._renderers[:] = [timed(label(f, "renderer"), f) for f in s._renderers]
-        s._motion_listeners[:] = [timed(label(f, "motion listener"), f) for f in s._motion_listeners]
+        saved.append((s, list(s._subscribers), s.jogger.key))
+        s._subscribers[:] = [timed(label(f, "subscriber"), f) for f in s._subscribers]
         s.jogger.key = timed("jog (controller)", s.jogger.key)
     real_push = AsyncMessageBuffer.push
 
@@ -249,14 +257,13 @@ def breakdown(sessions: list[Any], steps: int) -> tuple[list[tuple[str, float]],
         process = time.process_time() - p0
     finally:
         AsyncMessageBuffer.push = real_push  # type: ignore[method-assign]
-        for s, renderers, listeners, key in saved:
-            s._renderers[:] = renderers
-            s._motion_listeners[:] = listeners
+        for s, subscribers, key in saved:
+            s._subscribers[:] = subscribers
             s.jogger.key = key
     n = steps * len(sessions)
     parts = [(k, v / n * 1e3) for k, v in acc.items()]
     inside = sum(v for k, v in acc.items() if not k.startswith("jog")) / n * 1e3
-    parts.append(("rest of Session.moved (lock, atomic block, listener loop)", moved / n * 1e3 - inside))
+    parts.append(("rest of Session.moved (lock, pose state, atomic block, subscriber loop)", moved / n * 1e3 - inside))
     return parts, pushes[0] / n, process / n * 1e3
 
 
@@ -385,8 +392,8 @@ def main(argv: list[str] | None = None) -> int:
                   f"baseline {base_r[key]['rate']:.1f} (asked {STEP_HZ:.0f})")
         total = sum(v for _, v in parts)
         print(f"  where a hot-loop step of the app goes (instrumented pass; thread CPU per step; "
-              f"{msgs:.1f} viser messages queued per step; the first renderer also computes the "
-              f"session's pose state, one FK pass):")
+              f"{msgs:.1f} viser messages queued per step; the session computes the pose state, one "
+              f"FK pass, once per change signal, in 'rest of Session.moved'):")
         for name, v in parts:
             print(f"    {name:<72} {v:6.3f} ms")
         print(f"    {'viser event loop and other threads (process - thread: serialise, compress, send)':<72} "
