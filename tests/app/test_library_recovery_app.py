@@ -129,6 +129,10 @@ def test_unreadable_library_leaves_the_tool_panel_working_and_says_why(app_facto
     c, session = _open(app)
     try:
         assert session.views["tools"].slots.options == ("(library empty)",)
+        # the Calibrate menu is built too (it lists the session's copy, it does not read the file)
+        assert "calibrate" in session.views
+        assert session.views["calibrate"].library_tool.options == ("(library empty)",)
+        assert session.views["calibrate"].menu_folder.visible
         wait_until(lambda: c.titled("Tool library unavailable"), what="the error notification")
         (note,) = c.titled("Tool library unavailable")
         assert "cannot read the tool library" in note["body"]

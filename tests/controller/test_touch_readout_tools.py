@@ -152,9 +152,12 @@ def test_readout_in_base_and_text_format():
     R_base_tcp = Rz(math.radians(-90.0)) @ ctrl.T_world_flange()[:3, :3]
     rebuilt = Rz(math.radians(b.a_deg)) @ Ry(math.radians(b.b_deg)) @ Rx(math.radians(b.c_deg))
     np.testing.assert_allclose(rebuilt, R_base_tcp, atol=1e-9)
-    assert world.rows()[0] == ("X", "525.00", "mm") and world.rows()[1] == ("Y", "0.00", "mm")
-    assert world.text().startswith("WORLD X 525.00 Y 0.00 Z 890.00 mm  A ")
-    assert world.text().endswith(" deg") and "-0.00" not in world.text()
+    from tcp_pendant.pendant.formatting import readout_rows, readout_text   # the one place of the text
+
+    assert readout_rows(world)[0] == ("X", "525.00", "mm") and readout_rows(world)[1] == ("Y", "0.00", "mm")
+    assert readout_text(world).startswith("WORLD X 525.00 Y 0.00 Z 890.00 mm  A ")
+    assert readout_text(world).endswith(" deg") and "-0.00" not in readout_text(world)
+    assert not hasattr(world, "rows") and not hasattr(world, "text")       # numbers only
     with pytest.raises(ControllerError, match="WORLD or BASE"):
         ctrl.readout("TOOL")
 

@@ -35,7 +35,7 @@ from tcp_pendant.controller.jog import (
     follow_path,
 )
 from tcp_pendant.controller.kinematics import RobotKinematics
-from tcp_pendant.controller.readout import PoseReadout, pose_readout
+from tcp_pendant.controller.readout import PoseReadout, readout_in_frame
 from tcp_pendant.controller.tools import ToolModel
 from tcp_pendant.controller.touch import TouchGeometry, touch_geometry
 
@@ -363,14 +363,9 @@ class VirtualController:
 
     # ----------------------------------------------------------------- readouts
     def readout(self, frame: Literal["WORLD", "BASE"] = "WORLD") -> PoseReadout:
-        """Active TCP pose as X, Y, Z (mm) and KUKA A, B, C (deg) in WORLD or BASE."""
-        f = str(frame).upper()
-        T = self.T_world_tcp()
-        if f == "BASE":
-            T = np.linalg.inv(self._T_world_base) @ T
-        elif f != "WORLD":
-            raise ControllerError(f"Readout frame must be WORLD or BASE, got {frame!r}.")
-        return pose_readout(T, f)
+        """Active TCP pose as X, Y, Z (mm) and KUKA A, B, C (deg) in WORLD or BASE
+        (``readout.readout_in_frame``, the one path the pose state uses too)."""
+        return readout_in_frame(self.T_world_tcp(), self._T_world_base, frame)
 
     def touch_geometry(self) -> TouchGeometry:
         """Mounted tool's true tip vs the reference tip (``touch.touch_geometry``)."""

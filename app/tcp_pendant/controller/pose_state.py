@@ -26,9 +26,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from tcp_pendant.controller.controller import VirtualController
-from tcp_pendant.controller.readout import PoseReadout
+from tcp_pendant.controller.readout import PoseReadout, readout_in_frame
 from tcp_pendant.controller.touch import TouchGeometry, touch_geometry
-from tcp_pendant.controller.rotations import kuka_abc_deg
 
 __all__ = ["PoseState", "pose_state", "pose_state_key"]
 
@@ -68,20 +67,13 @@ class PoseState:
         (``controller.readout``).
 
         Raises:
-            ValueError: another frame.
+            ControllerError: another frame (a ValueError).
         """
         f = str(frame).upper()
         cached = self._readouts.get(f)
         if cached is not None:
             return cached
-        if f == "WORLD":
-            T = self.T_world_tcp
-        elif f == "BASE":
-            T = np.linalg.inv(self.T_world_base) @ self.T_world_tcp
-        else:
-            raise ValueError(f"Readout frame must be WORLD or BASE, got {frame!r}.")
-        a, b, c = kuka_abc_deg(T[:3, :3])
-        out = PoseReadout(f, float(T[0, 3]) * 1000.0, float(T[1, 3]) * 1000.0, float(T[2, 3]) * 1000.0, a, b, c)
+        out = readout_in_frame(self.T_world_tcp, self.T_world_base, f)
         self._readouts[f] = out
         return out
 

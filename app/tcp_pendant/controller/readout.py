@@ -1,8 +1,11 @@
-"""Pose readout as a pendant shows it: X, Y, Z in mm and KUKA A, B, C in degrees.
+"""Pose readout as a pendant shows it: X, Y, Z in mm and KUKA A, B, C in degrees (numbers).
 
 ``R = Rz(A) Ry(B) Rx(C)`` (intrinsic Z, Y', X''; scipy ``from_euler("ZYX", [A, B, C])``,
-methods.md section 6); the conversion is tcpcal's :func:`tcpcal.tool.abc_deg_from_rotation`,
-which stays exact next to gimbal lock (B = +-90 deg).
+methods.md section 6). One path computes it: :func:`readout_in_frame`, used by both
+``VirtualController.readout`` and ``PoseState.readout`` (the jog's hot path), with the angles
+by :func:`tcp_pendant.controller.rotations.kuka_abc_deg` (pinocchio, checked against tcpcal's
+``abc_deg_from_rotation`` in tests/app/test_pose_state.py, exact next to gimbal lock too). The
+text the pendant shows is made from these numbers in one place, ``tcp_pendant.pendant.formatting``.
 """
 
 from __future__ import annotations
@@ -11,9 +14,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tcpcal.tool import abc_deg_from_rotation
+from tcp_pendant.controller.errors import ControllerError
+from tcp_pendant.controller.rotations import kuka_abc_deg
 
-__all__ = ["PoseReadout", "pose_readout"]
+__all__ = ["READOUT_FRAMES", "PoseReadout", "readout_in_frame"]
+
+READOUT_FRAMES = ("WORLD", "BASE")
 
 
 @dataclass(frozen=True)
@@ -35,32 +41,19 @@ class PoseReadout:
     b_deg: float
     c_deg: float
 
-    def rows(self, decimals: int = 2) -> tuple[tuple[str, str, str], ...]:
-        """``(label, value, unit)`` rows for the pendant, e.g. ``("X", "525.00", "mm")``.
 
-        Values are rounded to ``decimals`` and ``-0.00`` is shown as ``0.00``.
-        """
-        def fmt(v: float) -> str:
-            text = f"{v:.{decimals}f}"
-            return text[1:] if text.startswith("-") and float(text) == 0.0 else text
+def readout_in_frame(T_world_tcp: np.ndarray, T_world_base: np.ndarray, frame: str) -> PoseReadout:
+    """The readout of the TCP pose ``T_world_tcp`` (4x4, metres) in WORLD or BASE.
 
-        return (("X", fmt(self.x_mm), "mm"), ("Y", fmt(self.y_mm), "mm"), ("Z", fmt(self.z_mm), "mm"),
-                ("A", fmt(self.a_deg), "deg"), ("B", fmt(self.b_deg), "deg"), ("C", fmt(self.c_deg), "deg"))
-
-    def text(self, decimals: int = 2) -> str:
-        """One line, e.g. ``"WORLD X 525.00 Y 0.00 Z 890.00 mm  A 0.00 B 90.00 C 0.00 deg"``."""
-        r = self.rows(decimals)
-        pos = " ".join(f"{lab} {val}" for lab, val, _ in r[:3])
-        rot = " ".join(f"{lab} {val}" for lab, val, _ in r[3:])
-        return f"{self.frame} {pos} mm  {rot} deg"
-
-    def __str__(self) -> str:
-        return self.text()
-
-
-def pose_readout(T_frame_tcp: np.ndarray, frame: str) -> PoseReadout:
-    """The readout of a (4,4) pose in metres, expressed in ``frame`` (label only)."""
-    T = np.asarray(T_frame_tcp, dtype=float)
-    x, y, z = (float(v) * 1000.0 for v in T[:3, 3])
-    a, b, c = (float(v) for v in abc_deg_from_rotation(T[:3, :3]))
-    return PoseReadout(frame, x, y, z, a, b, c)
+    Raises:
+        ControllerError: another frame.
+    """
+    f = str(frame).upper()
+    if f == "WORLD":
+        T = np.asarray(T_world_tcp, dtype=float)
+    elif f == "BASE":
+        T = np.linalg.inv(np.asarray(T_world_base, dtype=float)) @ np.asarray(T_world_tcp, dtype=float)
+    else:
+        raise ControllerError(f"Readout frame must be WORLD or BASE, got {frame!r}.")
+    a, b, c = kuka_abc_deg(T[:3, :3])
+    return PoseReadout(f, float(T[0, 3]) * 1000.0, float(T[1, 3]) * 1000.0, float(T[2, 3]) * 1000.0, a, b, c)

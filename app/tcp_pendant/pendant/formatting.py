@@ -20,6 +20,8 @@ from tcp_pendant.text_escape import escape_markdown
 __all__ = [
     "fmt_num",
     "joint_label",
+    "readout_rows",
+    "readout_text",
     "joint_readout_markdown",
     "tcp_readout_markdown",
     "tool_data_markdown",
@@ -37,10 +39,27 @@ def fmt_num(value: float, decimals: int = 2) -> str:
     return text[1:] if text.startswith("-") and float(text) == 0.0 else text
 
 
+def readout_rows(readout: PoseReadout, decimals: int = 2) -> tuple[tuple[str, str, str], ...]:
+    """``(label, value, unit)`` rows of a readout, e.g. ``("X", "525.00", "mm")`` (values with
+    ``decimals`` decimals, ``-0.00`` shown as ``0.00``)."""
+    r = readout
+    return (("X", fmt_num(r.x_mm, decimals), "mm"), ("Y", fmt_num(r.y_mm, decimals), "mm"),
+            ("Z", fmt_num(r.z_mm, decimals), "mm"), ("A", fmt_num(r.a_deg, decimals), "deg"),
+            ("B", fmt_num(r.b_deg, decimals), "deg"), ("C", fmt_num(r.c_deg, decimals), "deg"))
+
+
+def readout_text(readout: PoseReadout, decimals: int = 2) -> str:
+    """One line, e.g. ``"WORLD X 525.00 Y 0.00 Z 890.00 mm  A 0.00 B 90.00 C 0.00 deg"``."""
+    r = readout_rows(readout, decimals)
+    pos = " ".join(f"{lab} {val}" for lab, val, _ in r[:3])
+    rot = " ".join(f"{lab} {val}" for lab, val, _ in r[3:])
+    return f"{readout.frame} {pos} mm  {rot} deg"
+
+
 def tcp_readout_markdown(readout: PoseReadout, tool_name: str | None) -> str:
     """The TCP readout: a title with frame and tool, then a monospace table
     ``X 525.00 mm | A 0.00 deg`` (one line per pair)."""
-    rows = readout.rows(2)
+    rows = readout_rows(readout, 2)
     width = max(len(v) for _, v, _ in rows)
     lines = [f"{rows[i][0]} {rows[i][1]:>{width}} mm   {rows[i + 3][0]} {rows[i + 3][1]:>{width}} deg"
              for i in range(3)]
