@@ -132,7 +132,7 @@ def test_xyz4_wizard_auto_touch_save_export_and_replay(pendant_server, new_page,
     assert_not_blank(shot(page, "xyz4_saved"))
     check_library_panel(page, "Pointer 4P", 1, tcp_true, np.zeros(3))
     saved = ToolLibrary(server.library_path)
-    assert saved.active_slot() == 1
+    assert saved.active_slot() is None       # active in this browser only (the page says so above)
     np.testing.assert_allclose(saved.get(1).tcp_mm, tcp_true, atol=1e-6)
     shot(page, "xyz4_library_panel")
 
