@@ -3,29 +3,26 @@
 For demos ("a full 4-point calibration in four clicks"): the controller's ``auto_approach``
 moves the hidden true TOOL frame onto the reference tip from a chosen or random direction,
 with a simulated operator error (Gaussian, ``sigma_mm`` per axis, 0-2 mm), then the flange pose
-is recorded into the wizard. What each step role asks of the controller:
+is recorded into the wizard. What a step asks of the controller is not known here: each wizard
+declares its step roles with an auto-touch role (``tcp_pendant.wizards.describe.AutoRole``,
+read through ``Wizard.auto_role(step)``):
 
-=================  ===========================================================================
-step role          controller call
-=================  ===========================================================================
-``touch``          ``auto_approach(tip_offset_tool_mm=(0, 0, 0))``
-``minus_x``        ``auto_approach(tip_offset_tool_mm=(-d, 0, 0))``  (tip on tool -X axis)
-``plus_y``         ``auto_approach(tip_offset_tool_mm=(0, d, 0))``   (variant 1)
-``plus_y_half``    ``auto_approach(tip_offset_tool_mm=(-20, d, 0))`` (variant 2)
-``parallel``       ``move_true_tool_to`` the (PA-1) orientation, tip ``hover_mm`` above the
-                   reference tip, with an angular error (``angle_sigma_deg`` per axis, about
-                   the tool axes; by default the operator error ``sigma_mm`` seen over
-                   ``ANGLE_LEVER_MM``, see :func:`operator_angle_sigma_deg`); for the 5D
-                   variant a random turn about tool X.
-=================  ===========================================================================
+* ``reference_in_tool_mm(distance_mm)``: ``auto_approach(tip_offset_tool_mm=...)`` puts the
+  reference tip there in true TOOL coordinates ((0, 0, 0): a touch; (-d, 0, 0): on the tool's
+  -X axis; (0, 0, d): on its +Z axis ahead of the TCP; ...);
+* ``tilt_range_deg``: the tilt of a random direction; ``keeps_orientation``: after the first
+  step, the direction of the wizard's previous auto-touch is reused (``previous_direction_deg``,
+  which the caller keeps: the workflow, per run; the outcome says the direction used), as an
+  operator jogging along tool axes keeps the orientation;
+* ``align_world``: ``move_true_tool_to`` the (PA-1) orientation, tip ``hover_mm`` above the
+  reference tip, with an angular error (``angle_sigma_deg`` per axis, about the tool axes; by
+  default the operator error ``sigma_mm`` seen over ``ANGLE_LEVER_MM``, see
+  :func:`operator_angle_sigma_deg`); ``free_turn_about_x``: a random turn about tool X (5D).
 
-``d`` is ``distance_mm`` (60 mm by default). Three-point steps 2 and 3 reuse the approach
-direction of the wizard's previous auto-touch (``previous_direction_deg``, which the caller
-keeps: the workflow, per run; the outcome says the direction used) unless one is given, as an
-operator jogging along tool axes keeps the orientation. The controller must have the
-physical tool the step asks for mounted: auto-touch mounts it (from ``tools``, default
-``builtin_tools()``, through ``mount``: the session's command in the app) and tells the
-wizard. This module keeps no state of its own.
+``d`` is ``distance_mm`` (60 mm by default). The controller must have the physical tool the
+step asks for mounted: auto-touch mounts it (from ``tools``, default ``builtin_tools()``,
+through ``mount``: the session's command in the app) and tells the wizard. This module keeps
+no state of its own.
 """
 
 from __future__ import annotations
@@ -37,7 +34,7 @@ from typing import Any
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from tcp_pendant.wizards.abc_world import R_WORLD_TOOL_TARGET, AbcWorldWizard
+from tcp_pendant.wizards.abc_world import R_WORLD_TOOL_TARGET
 from tcp_pendant.wizards.base import StepInfo, Wizard, WizardError, WizardStateError
 
 DEFAULT_DISTANCE_MM = 60.0
@@ -84,18 +81,6 @@ class AutoTouchOutcome:
         return (self.tilt_deg, self.azimuth_deg, self.spin_deg)
 
 
-def _tip_offset(role: str, distance_mm: float) -> tuple[float, float, float]:
-    if role == "touch":
-        return (0.0, 0.0, 0.0)
-    if role == "minus_x":
-        return (-distance_mm, 0.0, 0.0)
-    if role == "plus_y":
-        return (0.0, distance_mm, 0.0)
-    if role == "plus_y_half":
-        return (-20.0, distance_mm, 0.0)
-    raise WizardError(f"Auto-touch does not know the step role {role!r}.")
-
-
 def _ensure_mounted(wizard: Wizard, controller: Any, step: StepInfo,
                     tools: Mapping[str, Any] | None, mount: Callable[[Any], None] | None) -> None:
     key = step.mount_tool_key
@@ -123,19 +108,21 @@ def auto_touch(wizard: Wizard, controller: Any, *,
         wizard: any wizard, in progress.
         controller: a ``tcp_pendant.controller.VirtualController``.
         direction_deg: (tilt, azimuth, spin) in degrees (see ``VirtualController.auto_approach``);
-            None: random (tilt 20-50 deg for touches, 5-30 deg for three-point steps, azimuth
-            0-360, spin -90..90), retried up to ``max_attempts`` times when unreachable.
+            None: random (tilt in the role's ``tilt_range_deg``: 20-50 deg for touches, 5-30 deg
+            for steps that keep the orientation, azimuth 0-360, spin -90..90), retried up to
+            ``max_attempts`` times when unreachable.
         sigma_mm: simulated operator position error, per axis (0-2 mm in the pendant).
         angle_sigma_deg: simulated angular error per tool axis for ``parallel`` steps (deg);
             None: :func:`operator_angle_sigma_deg` of ``sigma_mm`` (0 when ``sigma_mm`` is 0).
-        distance_mm: displacement of the three-point steps 2 and 3.
+        distance_mm: displacement of the steps off the touch (three-point, TCP & Z, X).
         hover_mm: height of the tip above the reference tip for ``parallel`` steps.
         rng: random generator (seed it for reproducible demos and tests).
         advance: after recording, go to the next step (never finishes the wizard: Finish is
             the user's click).
         tools: physical tools by key, to mount the one the step needs.
         previous_direction_deg: the direction of this wizard's previous auto-touch
-            (``AutoTouchOutcome.direction_deg``), reused by three-point steps 2 and 3.
+            (``AutoTouchOutcome.direction_deg``), reused by the steps whose role keeps the
+            orientation (three-point steps 2 and 3, TCP & Z, X's z and x).
         mount: how to mount a tool (default ``controller.mount_tool``; the app passes the
             session's command, which signals the change).
     """
@@ -152,9 +139,10 @@ def auto_touch(wizard: Wizard, controller: Any, *,
     if not wizard.can_record:
         raise WizardStateError(f"Cannot auto-touch: {wizard.blocked_reason}")
 
-    if step.role == "parallel":
+    role = wizard.auto_role(step)
+    if role.align_world:
         R = R_WORLD_TOOL_TARGET.copy()
-        if isinstance(wizard, AbcWorldWizard) and wizard.variant == "5d":
+        if role.free_turn_about_x:
             R = R @ Rotation.from_euler("x", rng.uniform(-60.0, 60.0), degrees=True).as_matrix()
         misalignment_deg = 0.0
         if angle_sigma_deg > 0.0:
@@ -177,10 +165,9 @@ def auto_touch(wizard: Wizard, controller: Any, *,
         return AutoTouchOutcome(True, step.index, step.role, None, None, None,
                                 f"Tool aligned with WORLD {how} and recorded.", 1)
 
-    offset = _tip_offset(step.role, distance_mm)
-    three_point = step.role != "touch" or wizard.kind == "three-point"
+    offset = role.reference_in_tool_mm(distance_mm)
     fixed = direction_deg
-    if fixed is None and three_point and step.index > 0:
+    if fixed is None and role.keeps_orientation and step.index > 0:
         fixed = previous_direction_deg
     attempts = 0
     last_message = ""
@@ -189,7 +176,7 @@ def auto_touch(wizard: Wizard, controller: Any, *,
         if fixed is not None:
             tilt, azimuth, spin = (float(v) for v in fixed)
         else:
-            lo, hi = (5.0, 30.0) if three_point else (20.0, 50.0)
+            lo, hi = role.tilt_range_deg
             tilt, azimuth, spin = rng.uniform(lo, hi), rng.uniform(0.0, 360.0), rng.uniform(-90.0, 90.0)
         res = controller.auto_approach(tilt_deg=tilt, azimuth_deg=azimuth, spin_deg=spin,
                                        sigma_mm=sigma_mm, tip_offset_tool_mm=offset, rng=rng)

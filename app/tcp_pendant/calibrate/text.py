@@ -18,7 +18,8 @@ from collections.abc import Sequence
 
 from tcp_pendant.pendant.formatting import fmt_num
 from tcp_pendant.text_escape import escape_markdown as _esc
-from tcp_pendant.wizards import ESTIMATOR_LABELS, Wizard, WizardResult, Xyz4Result
+from tcp_pendant.wizards import ESTIMATOR_LABELS, Wizard, WizardResult, Xyz4Result, wizard_class
+from tcp_pendant.wizards.registry import LiveAttribute
 from tcp_pendant.wizards.session_record import ReplayCheck
 from tcp_pendant.wizards.truth import TruthComparison
 from tcpcal.pose_quality import CandidateGain, PoseQuality
@@ -39,21 +40,14 @@ __all__ = [
     "warnings_markdown",
 ]
 
-METHOD_BLURBS: dict[str, str] = {
-    "xyz4": ("Calibrates the **TCP** (X, Y, Z): touch the reference tip with the tool tip from "
-             "4 to 20 clearly different orientations."),
-    "reference": ("Calibrates the **TCP** of a new tool from one touch with an already calibrated "
-                  "tool and one with the new tool. Fast; errors add up."),
-    "three-point": ("Calibrates the **orientation** (A, B, C) of a tool whose TCP is calibrated: "
-                    "a touch, then the tip on the tool's -X axis and on its +Y side."),
-    "abc-world": ("Calibrates the **orientation** (A, B, C): align the tool with WORLD (X down, Y "
-                  "along WORLD Y, Z along WORLD X) and record once. 5D: tool X only."),
-}
+METHOD_BLURBS: LiveAttribute = LiveAttribute("blurb")
+"""Kind -> what the method calibrates and how (each wizard class's ``blurb``; live view)."""
 
 
 def menu_markdown(kind: str, *, library_tool: str | None, reference_tool: str, new_tool: str,
                   mounted_tool: str) -> str:
-    """What Start will do with the options chosen (echoes every choice before Start).
+    """What Start will do with the options chosen (echoes every choice before Start), from what
+    the wizard class declares (``needs_tool``, ``calibrates``, its physical-tool options).
 
     Args:
         kind: wizard kind.
@@ -61,20 +55,21 @@ def menu_markdown(kind: str, *, library_tool: str | None, reference_tool: str, n
         reference_tool, new_tool: physical tools chosen for the reference method (labels).
         mounted_tool: label of the physical tool on the flange now.
     """
+    cls = wizard_class(kind)
     mounted = _esc(mounted_tool.lower())
     library_tool = None if library_tool is None else _esc(library_tool)
-    if kind == "xyz4":
-        return (f"Calibrates the TCP of the **{mounted}** now mounted; mount another tool on the "
-                "Tool tab first if that is not the one.")
+    if cls.needs_tool == "mounted":
+        return (f"Calibrates {_esc(cls.calibrates)} of the **{mounted}** now mounted; mount another "
+                "tool on the Tool tab first if that is not the one.")
     if library_tool is None:
         return ("⚠ The tool library is empty: calibrate a TCP first (XYZ 4-point) and save it, or "
                 "enter a tool on the Tool tab.")
-    if kind == "reference":
+    if any(o.kind == "physical_tool" for o in cls.options):
         if reference_tool == new_tool:
             return "⚠ The reference tool and the new tool must be two different physical tools."
         return (f"Touch 1 with the data **{library_tool}** on the *{_esc(reference_tool.lower())}*; then "
                 f"the tool change and touch 2 with the *{_esc(new_tool.lower())}*, whose TCP is calibrated.")
-    return (f"Calibrates the orientation of **{library_tool}** (its TCP is used as is); the "
+    return (f"Calibrates {_esc(cls.calibrates)} of **{library_tool}** (its TCP is used as is); the "
             f"*{mounted}* is mounted: it must be the tool that data belongs to.")
 
 

@@ -38,13 +38,16 @@ from tcp_pendant.wizards import (
     AbcWorldWizard,
     CalibrationFailedError,
     ReferenceWizard,
+    TcpZxWizard,
     ThreePointWizard,
     Wizard,
     WizardError,
     WizardResult,
     WizardStateError,
     Xyz4Wizard,
+    wizard_class,
 )
+from tcp_pendant.wizards.registry import LiveAttribute, LiveKinds
 from tcp_pendant.wizards.session_record import (
     LoadedRecord,
     ReplayCheck,
@@ -66,13 +69,10 @@ __all__ = [
     "ToolState",
 ]
 
-WIZARD_KINDS: tuple[str, ...] = ("xyz4", "reference", "three-point", "abc-world")
-WIZARD_LABELS: dict[str, str] = {
-    "xyz4": "XYZ 4-point",
-    "reference": "XYZ reference",
-    "three-point": "Three-point orientation",
-    "abc-world": "ABC world (parallel axes)",
-}
+WIZARD_KINDS: LiveKinds = LiveKinds()
+"""The registered wizard kinds in menu order (a live view of ``tcp_pendant.wizards.registry``)."""
+WIZARD_LABELS: LiveAttribute = LiveAttribute("title")
+"""Kind -> the method's label (live view of the registry)."""
 AUTO_SIGMA_MAX_MM = 2.0
 """Largest simulated operator error the pendant offers (issue 5: slider 0-2 mm)."""
 
@@ -167,6 +167,8 @@ class CalibrationWorkflow:
         self.last_save: tuple[int, Tool] | None = None
         self._saved_results: dict[int, WizardResult] = {}    # run index -> the result saved from it
         self._auto_directions: dict[int, tuple[float, float, float]] = {}   # run -> last auto-touch
+        self.auto_touches = 0
+        """Auto-touch clicks so far (the classroom recorder tells Auto-touch from hand touches)."""
 
     # ------------------------------------------------------------ state
     @property
@@ -248,48 +250,50 @@ class CalibrationWorkflow:
         self.note_mounted_tool()
         return wizard
 
+    def start(self, kind: str, **options: Any) -> Wizard:
+        """Open a wizard of the registered ``kind`` with its start options (the class's
+        ``options``, and ``variant``); the open wizard is cancelled, kept. The class says which
+        physical tool's truth grades it and which library tool data it makes active.
+
+        Raises:
+            WizardError: unknown kind or option, a value out of its choices, an empty slot.
+        """
+        cls = wizard_class(kind)
+        started = cls.start(_StartContext(self), cls.parse_options(options))
+        self._open(started.wizard, started.true_tool)
+        if started.active_data is not None:
+            self.state.set_active_data(started.active_data[0], int(started.active_data[1]))
+        return started.wizard
+
     def start_xyz4(self, *, n_points: int = 4, estimator: str = "lstsq") -> Xyz4Wizard:
         """Open an XYZ 4-point wizard for the mounted tool (its truth is graded)."""
-        wiz = Xyz4Wizard(n_points=n_points, estimator=estimator)  # type: ignore[arg-type]
-        return self._open(wiz, self.controller.mounted_tool)  # type: ignore[return-value]
+        return self.start("xyz4", n_points=n_points, estimator=estimator)  # type: ignore[return-value]
 
     def start_reference(self, *, reference_slot: int, reference_tool_key: str,
                         new_tool_key: str) -> ReferenceWizard:
-        """Open an XYZ reference wizard.
+        """Open an XYZ reference wizard (activates the reference data).
 
         Args:
             reference_slot: library slot of the calibrated reference tool's data.
             reference_tool_key: the physical tool that data belongs to (mounted for step 1).
             new_tool_key: the physical tool to calibrate (mounted for step 2; its truth is graded).
         """
-        ref = self._library_tool(reference_slot)
-        for key in (reference_tool_key, new_tool_key):
-            if key not in self.tools:
-                raise WizardError(f"Unknown physical tool {key!r}; choose one of {', '.join(self.tools)}.")
-        new = self.tools[new_tool_key]
-        wiz = ReferenceWizard(ref, reference_tool_key=reference_tool_key, new_tool_key=new_tool_key,
-                              new_tool_label=f"the {new.label.lower()}")
-        self._open(wiz, new)
-        self.state.set_active_data(ref, int(reference_slot))    # "mounted and active" (step 1)
-        return wiz
+        return self.start("reference", slot=reference_slot, reference_tool_key=reference_tool_key,  # type: ignore[return-value]
+                          new_tool_key=new_tool_key)
+
+    def start_tcp_zx(self, *, n_points: int = 4) -> TcpZxWizard:
+        """Open a TCP & Z, X wizard for the mounted tool (its truth is graded)."""
+        return self.start("tcp-zx", n_points=n_points)  # type: ignore[return-value]
 
     def start_three_point(self, *, slot: int, variant: Literal[1, 2] = 1) -> ThreePointWizard:
         """Open a three-point orientation wizard for the library tool in ``slot`` (its TCP must be
         calibrated); the tool data is made active so jogs along tool X/Y use it."""
-        tool = self._library_tool(slot)
-        wiz = ThreePointWizard(tool, variant=variant)
-        self._open(wiz, self.controller.mounted_tool)
-        self.state.set_active_data(tool, int(slot))
-        return wiz
+        return self.start("three-point", slot=slot, variant=variant)  # type: ignore[return-value]
 
     def start_abc_world(self, *, slot: int, variant: Literal["6d", "5d"] = "6d") -> AbcWorldWizard:
         """Open an ABC world wizard for the library tool in ``slot``; its data is made active so
         rotations A, B, C turn about its TCP."""
-        tool = self._library_tool(slot)
-        wiz = AbcWorldWizard(tool, variant=variant)
-        self._open(wiz, self.controller.mounted_tool)
-        self.state.set_active_data(tool, int(slot))
-        return wiz
+        return self.start("abc-world", slot=slot, variant=variant)  # type: ignore[return-value]
 
     # ------------------------------------------------------------ navigation
     def _require(self) -> Wizard:
@@ -380,6 +384,7 @@ class CalibrationWorkflow:
             raise WizardStateError("Auto-touch is a training-mode tool; switch training mode on.")
         w = self._require()
         run_index = self._current
+        self.auto_touches += 1
         self.note_mounted_tool()
         out = auto_touch(w, self.controller, direction_deg=request.direction_deg,
                          sigma_mm=request.sigma_mm, rng=self.rng, tools=self.tools,
@@ -435,8 +440,8 @@ class CalibrationWorkflow:
     def default_save_name(self) -> str:
         """Name offered by "Save to tool library": the calibrated tool's own name or its label."""
         w = self.wizard
-        if isinstance(w, (ThreePointWizard, AbcWorldWizard)):
-            return w.tool.name
+        if w is not None and w.library_tool_name is not None:
+            return w.library_tool_name
         run = self.run
         key = None if run is None else run.true_tool_key
         return self.tools[key].label if key in self.tools else "Tool"
@@ -500,3 +505,21 @@ class CalibrationWorkflow:
             self._current = finished[-1]
             self.runs[self._current].wizard.resume()
         return checks
+
+
+class _StartContext:
+    """What a wizard class reads when the workflow starts it (``describe.StartContext``)."""
+
+    def __init__(self, workflow: CalibrationWorkflow) -> None:
+        self._workflow = workflow
+
+    @property
+    def tools(self) -> Mapping[str, ToolModel]:
+        return self._workflow.tools
+
+    @property
+    def mounted_tool(self) -> ToolModel:
+        return self._workflow.controller.mounted_tool
+
+    def library_tool(self, slot: int) -> Tool:
+        return self._workflow._library_tool(slot)

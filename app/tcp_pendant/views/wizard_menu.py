@@ -5,10 +5,13 @@ Top to bottom:
 
 * **Training mode** switch (on by default, for the classroom): reveals the true TOOL frame
   after a result with the error against it, and offers Auto-touch;
-* **Calibrate** menu: the method (XYZ 4-point, XYZ reference, three-point orientation, ABC
-  world), its options (touches and estimator; the calibrated tool from the library; the
-  physical reference and new tools), Start, and Resume for a calibration left half-way. It is
-  hidden while a wizard is open, as on a pendant; Cancel (or Close, on a result) brings it back;
+* **Calibrate** menu: the method (every registered wizard class, ``tcp_pendant.wizards.registry``,
+  in its ``rank`` order: XYZ 4-point, XYZ reference, TCP & Z, X, three-point orientation, ABC
+  world), the options the chosen method declares (``Wizard.options``: one widget per option
+  name, shared by the methods that declare it: touches and estimator; the calibrated tool from
+  the library; the physical reference and new tools), Start (``CalibrationWorkflow.start(kind,
+  **options)``), and Resume for a calibration left half-way. It is hidden while a wizard is
+  open, as on a pendant; Cancel (or Close, on a result) brings it back;
 * the open wizard's step panel (``wizard_steps``), its result panel (``wizard_result``) and
   its scene nodes (``wizard_scene``);
 * **Session record**: export the session (touches, wizards, results, errors) as JSON and load
@@ -33,11 +36,10 @@ from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
-from tcp_pendant.calibrate import WIZARD_KINDS, WIZARD_LABELS, CalibrationWorkflow
+from tcp_pendant.calibrate import CalibrationWorkflow
 from tcp_pendant.calibrate.library_choice import default_library_slot
 from tcp_pendant.calibrate.text import (
     METHOD_BLURBS,
-    estimator_options,
     menu_markdown,
     replay_markdown,
 )
@@ -54,7 +56,8 @@ from tcp_pendant.views.upload_guard import limit_upload_size
 from tcp_pendant.views.wizard_result import WizardResultView
 from tcp_pendant.views.wizard_scene import WizardSceneView
 from tcp_pendant.views.wizard_steps import WizardStepsView
-from tcp_pendant.wizards import ESTIMATOR_LABELS
+from tcp_pendant.wizards import Wizard, wizard_classes
+from tcp_pendant.wizards.describe import WizardOption
 from tcp_pendant.wizards.session_record import (
     MAX_RECORD_BYTES,
     LoadedRecord,
@@ -69,7 +72,6 @@ __all__ = ["NO_LIBRARY_TOOL", "SESSION_FILENAME", "CalibrateView", "build_calibr
 
 NO_LIBRARY_TOOL = "(library empty)"
 SESSION_FILENAME = "tcp-pendant-session.json"
-_LABEL_TO_KIND = {label: kind for kind, label in WIZARD_LABELS.items()}
 RECORD_REFUSED = "Session record not loaded"
 """Title of the one notification a refused session record gets."""
 
@@ -116,28 +118,31 @@ class CalibrateView:
         self.training = gui.add_checkbox(
             "Training mode", True,
             hint="Reveals the true TOOL frame after a result, with the error against it, and offers Auto-touch.")
+        self._classes: dict[str, type[Wizard]] = {c.title: c for c in wizard_classes()}
         self.menu_folder = gui.add_folder("Calibrate")
         with self.menu_folder:
-            labels = tuple(WIZARD_LABELS[k] for k in WIZARD_KINDS)
+            labels = tuple(self._classes)
             self.method = gui.add_dropdown("Method", labels, initial_value=labels[0])
             self.method_md = gui.add_markdown("")
-            self.n_points = gui.add_slider("Touches", min=4, max=20, step=1, initial_value=4)
-            est = tuple(ESTIMATOR_LABELS.values())
-            self.estimator = gui.add_dropdown("Estimator", est, initial_value=est[0])
-            self.library_tool = gui.add_dropdown("Tool data", (NO_LIBRARY_TOOL,), initial_value=NO_LIBRARY_TOOL,
-                                                 hint="A tool of the library whose TCP is calibrated.")
-            physical = tuple(self._physical)
-            mounted = session.controller.mounted_tool.label
-            self.reference_physical = gui.add_dropdown(
-                "Its physical tool", physical, initial_value=mounted if mounted in physical else physical[0],
-                hint="The tool that the reference data belongs to: it is mounted for the first touch.")
-            other = next((p for p in physical if p != self.reference_physical.value), physical[0])
-            self.new_physical = gui.add_dropdown("New tool", physical, initial_value=other,
-                                                 hint="The tool to calibrate: it is mounted for the second touch.")
+            self.option_widgets: dict[str, Any] = {}
+            self._option_specs: dict[str, WizardOption] = {}
+            for cls in self._classes.values():
+                for opt in cls.options:
+                    if opt.name not in self.option_widgets:
+                        self._option_specs[opt.name] = opt
+                        self.option_widgets[opt.name] = self._add_option_widget(gui, opt)
             self.menu_md = gui.add_markdown("")
             self.start = gui.add_button("Start", color="green")
             self.resume_list = gui.add_dropdown("Left half-way", ("-",), visible=False)
             self.resume = gui.add_button("Resume", color="blue", visible=False)
+        widgets = self.option_widgets
+        self._slot_widgets = [widgets[n] for n, o in self._option_specs.items() if o.kind == "library_slot"]
+        # the built-in methods' widgets by their old names (tests and views read them)
+        self.n_points = widgets.get("n_points")
+        self.estimator = widgets.get("estimator")
+        self.library_tool = self._slot_widgets[0] if self._slot_widgets else None
+        self.reference_physical = widgets.get("reference_tool_key")
+        self.new_physical = widgets.get("new_tool_key")
         self.steps = WizardStepsView(self)
         self.result = WizardResultView(self)
         with gui.add_folder("Session record", expand_by_default=False):
@@ -149,8 +154,11 @@ class CalibrateView:
 
         act = self.action
         self.training.on_update(act(self._on_training, user_only=True))
-        self.library_tool.on_update(act(self._on_library_pick, user_only=True))
-        for choice in (self.method, self.reference_physical, self.new_physical):
+        for widget in self._slot_widgets:
+            widget.on_update(act(self._on_library_pick, user_only=True))
+        echoed = [self.method] + [self.option_widgets[n] for n, o in self._option_specs.items()
+                                  if o.kind in ("choice", "physical_tool")]
+        for choice in echoed:
             choice.on_update(act(lambda _e: None, user_only=True))       # re-render: echo the choice
         self.start.on_click(act(self._on_start, sync=True))
         self.resume.on_click(act(self._on_resume))
@@ -161,6 +169,46 @@ class CalibrateView:
         session.subscribe(self.on_change)
         self.refresh_library()      # the session's list: no file read here (an unreadable file is told once)
         self.render()
+
+    def _add_option_widget(self, gui: Any, opt: WizardOption) -> Any:
+        """The menu widget of a declared start option (hidden until a method that takes it is
+        chosen)."""
+        hint = opt.hint or None
+        if opt.kind == "int":
+            lo, hi = int(opt.minimum if opt.minimum is not None else 0), int(opt.maximum if opt.maximum is not None else 100)
+            return gui.add_slider(opt.label, min=lo, max=hi, step=1,
+                                  initial_value=int(opt.default if opt.default is not None else lo), hint=hint)
+        if opt.kind == "choice":
+            labels = tuple(label for _, label in opt.choices)
+            initial = next((label for v, label in opt.choices if v == opt.default), labels[0])
+            return gui.add_dropdown(opt.label, labels, initial_value=initial, hint=hint)
+        if opt.kind == "library_slot":
+            return gui.add_dropdown(opt.label, (NO_LIBRARY_TOOL,), initial_value=NO_LIBRARY_TOOL, hint=hint)
+        physical = tuple(self._physical)
+        mounted = self.session.controller.mounted_tool.label
+        initial = mounted if mounted in physical else physical[0]
+        if opt.default == "other":
+            initial = next((p for p in physical if p != initial), physical[0])
+        return gui.add_dropdown(opt.label, physical, initial_value=initial, hint=hint)
+
+    def _option_value(self, opt: WizardOption) -> Any:
+        """The value of ``opt`` as chosen in its widget (checked by the wizard class at Start)."""
+        widget = self.option_widgets[opt.name]
+        if opt.kind == "int":
+            return int(widget.value)
+        if opt.kind == "choice":
+            values = {label: v for v, label in self._option_specs[opt.name].choices}
+            if widget.value not in values:
+                raise ValueError(f"{opt.label}: unknown choice {widget.value!r}.")
+            return values[widget.value]
+        if opt.kind == "library_slot":
+            return self._selected_slot(widget)
+        if widget.value not in self._physical:
+            raise ValueError(f"{opt.label}: unknown physical tool {widget.value!r}.")
+        return self._physical[widget.value]
+
+    def _chosen_class(self) -> type[Wizard]:
+        return self._classes.get(str(self.method.value), next(iter(self._classes.values())))
 
     def on_change(self, change: SessionChange) -> None:
         """The change signal: the live parts after a move; the library list when it was
@@ -228,29 +276,17 @@ class CalibrateView:
                                     mounted_label=c.mounted_tool.label, mounted_key=c.mounted_tool.key)
         return None if slot is None else slot_option(slot, self._library[slot].name)
 
-    def _selected_slot(self) -> int:
-        slot = number_of_option(self.library_tool.value)
+    def _selected_slot(self, widget: Any = None) -> int:
+        slot = number_of_option((widget or self.library_tool).value)
         if slot is None:
             raise ValueError("The tool library is empty: calibrate the TCP first (XYZ 4-point) and save it.")
         return slot
 
     def _on_start(self, _event: Any) -> None:
-        kind = _LABEL_TO_KIND.get(str(self.method.value))
-        wf = self.workflow
-        if kind == "xyz4":
-            estimator = estimator_options()[str(self.estimator.value)]
-            wf.start_xyz4(n_points=int(self.n_points.value), estimator=estimator)
-            return
-        slot = self._selected_slot()
-        if kind == "reference":
-            wf.start_reference(reference_slot=slot, reference_tool_key=self._physical[self.reference_physical.value],
-                               new_tool_key=self._physical[self.new_physical.value])
-        elif kind == "three-point":
-            wf.start_three_point(slot=slot)
-        elif kind == "abc-world":
-            wf.start_abc_world(slot=slot)
-        else:
+        if str(self.method.value) not in self._classes:
             raise ValueError(f"Unknown calibration method {self.method.value!r}.")
+        cls = self._chosen_class()
+        self.workflow.start(cls.kind, **{opt.name: self._option_value(opt) for opt in cls.options})
 
     def _on_resume(self, _event: Any) -> None:
         number = number_of_option(self.resume_list.value)
@@ -326,7 +362,8 @@ class CalibrateView:
         tools = self.session.library_tools
         self._library = dict(tools)
         options = tuple(slot_option(s, t.name) for s, t in sorted(tools.items())) or (NO_LIBRARY_TOOL,)
-        set_options(self.library_tool, options, keep=self._library_option(options))
+        for widget in self._slot_widgets:
+            set_options(widget, options, keep=self._library_option(options))
         self.result.refresh_slots(tools)
         if render:
             self._render_menu()
@@ -356,24 +393,28 @@ class CalibrateView:
 
     def _render_menu(self) -> None:
         self._menu_mounted_key = self.session.controller.mounted_tool.key
-        kind = _LABEL_TO_KIND.get(str(self.method.value), "xyz4")
-        set_content(self.method_md, METHOD_BLURBS[kind])
-        self.n_points.visible = self.estimator.visible = kind == "xyz4"
-        needs_tool = kind != "xyz4"
-        self.library_tool.visible = needs_tool
-        self.reference_physical.visible = self.new_physical.visible = kind == "reference"
-        wanted = self._library_option(tuple(self.library_tool.options))
-        if wanted is not None and self.library_tool.value != wanted and wanted in self.library_tool.options:
-            self.library_tool.value = wanted
-        empty = self.library_tool.value == NO_LIBRARY_TOOL
+        cls = self._chosen_class()
+        set_content(self.method_md, METHOD_BLURBS[cls.kind])
+        taken = {o.name for o in cls.options}
+        for name, widget in self.option_widgets.items():
+            widget.visible = name in taken
+        library_widget = next((self.option_widgets[o.name] for o in cls.options if o.kind == "library_slot"), None)
+        needs_tool = library_widget is not None
+        for widget in self._slot_widgets:
+            wanted = self._library_option(tuple(widget.options))
+            if wanted is not None and widget.value != wanted and wanted in widget.options:
+                widget.value = wanted
+        empty = library_widget is None or library_widget.value == NO_LIBRARY_TOOL
+        physical = [self.option_widgets[o.name].value for o in cls.options if o.kind == "physical_tool"]
+        mounted = self.session.controller.mounted_tool.label
         set_content(self.menu_md, menu_markdown(
-            kind, library_tool=None if empty else str(self.library_tool.value),
-            reference_tool=str(self.reference_physical.value), new_tool=str(self.new_physical.value),
-            mounted_tool=self.session.controller.mounted_tool.label))
+            cls.kind, library_tool=None if empty else str(library_widget.value),   # type: ignore[union-attr]
+            reference_tool=str(physical[0]) if physical else mounted,
+            new_tool=str(physical[1]) if len(physical) > 1 else mounted,
+            mounted_tool=mounted))
         self.start.disabled = needs_tool and empty
         self.menu_folder.visible = not self.workflow.is_open     # a pendant shows the wizard alone
         waiting = self.workflow.resumable()
         self.resume_list.visible = self.resume.visible = bool(waiting)
         if waiting:
             set_options(self.resume_list, tuple(label for _, label in waiting))
-

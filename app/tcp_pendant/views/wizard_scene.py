@@ -8,7 +8,8 @@
   and radius ``|t|`` (4P-1a), with the flange origins ``f_i`` on it (``flange_points``, red for
   outliers, grey for dropped touches) and each touch's approach direction, the line from
   ``f_i`` to ``r`` along the tool (``approach``);
-* ``/calibration/abc_target`` (ABC world wizard): the prescribed orientation (PA-1) drawn at
+* ``/calibration/abc_target`` (ABC world wizard, or any wizard whose
+  ``scene_target_T_world_tool_m`` gives a pose): the prescribed orientation (PA-1) drawn at
   the TCP, updated on every move, for the operator to align the tool with.
 
 Scene units are metres (the wizards' results are in mm and converted here). Axis colours are
@@ -38,7 +39,7 @@ from tcp_pendant.calibrate import CalibrationWorkflow
 from tcp_pendant.session import Session
 from tcp_pendant.views.framing import Framing, frame_spheres, spread_labels
 from tcp_pendant.views.scene import wxyz_xyz
-from tcp_pendant.wizards import AbcWorldWizard, Xyz4Result
+from tcp_pendant.wizards import Xyz4Result
 
 __all__ = ["WizardSceneView"]
 
@@ -292,8 +293,8 @@ class WizardSceneView:
 
     # ------------------------------------------------------------ live (on every move)
     def update_abc_target(self, T_world_flange: np.ndarray) -> None:
-        """Place the (PA-1) target triad at the TCP while an ABC world wizard is open."""
+        """Place the target triad the open wizard asks for (``Wizard.scene_target_T_world_tool_m``:
+        the (PA-1) orientation at the TCP while an ABC world wizard is in progress)."""
         wiz = self.workflow.wizard
-        open_abc = isinstance(wiz, AbcWorldWizard) and wiz.status == "in_progress"
-        self._target_T = wiz.target_T_world_tool_m(T_world_flange) if open_abc else None  # type: ignore[union-attr]
+        self._target_T = None if wiz is None else wiz.scene_target_T_world_tool_m(T_world_flange)
         self._pose(self.abc_target, self.abc_label, self._target_T)

@@ -1,11 +1,13 @@
 """The step panel of the open wizard (viser GUI): "Step k of n", a progress bar, the step's
 instruction, the list of steps, Record / Back / Next (Finish) / Cancel, the tool change a step
-asks for, the variant choice (three-point, ABC world), "Add point" and the live pose-diversity
-meter (4-point), and in training mode the Auto-touch controls.
+asks for, the variant choice (the wizard class's ``variants``: three-point, ABC world), "Add
+point" (``supports_add_point``: 4-point) and the live pose-diversity meter (``meter_active``:
+the touch steps of 4-point and TCP & Z, X), and in training mode the Auto-touch controls. No
+wizard class is named here: what is shown is what the wizard declares.
 
 Record is enabled only when the wizard can record (``Wizard.can_record``); Next only when the
 step is recorded. The pose-diversity meter is updated on every move of the robot (a motion
-listener of the session) with ``Xyz4Wizard.preview`` of the current flange pose: the TCP
+listener of the session) with the wizard's ``preview`` of the current flange pose: the TCP
 uncertainty tcpcal predicts if the user recorded here.
 """
 
@@ -24,20 +26,15 @@ from tcp_pendant.calibrate.text import (
 )
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.gui_util import set_content
-from tcp_pendant.wizards import (
-    AbcWorldWizard,
-    ThreePointWizard,
-    WizardStateError,
-    Xyz4Wizard,
-)
+from tcp_pendant.wizards import AbcWorldWizard, ThreePointWizard, Wizard, WizardStateError
 
 if TYPE_CHECKING:
     from tcp_pendant.views.wizard_menu import CalibrateView
 
 __all__ = ["ABC_VARIANTS", "RANDOM", "THREE_POINT_VARIANTS", "WizardStepsView"]
 
-THREE_POINT_VARIANTS = {"Variant 1: tip on the +Y axis": 1, "Variant 2: tip in the +Y half-plane": 2}
-ABC_VARIANTS = {"6D: X down, Y along WORLD Y": "6d", "5D: tool X down only": "5d"}
+THREE_POINT_VARIANTS = {label: value for value, label in ThreePointWizard.variants}
+ABC_VARIANTS = {label: value for value, label in AbcWorldWizard.variants}
 RANDOM, CHOSEN = "random", "chosen (tilt, azimuth)"
 
 
@@ -52,7 +49,7 @@ class WizardStepsView:
             self.head_md = gui.add_markdown("")
             self.progress = gui.add_progress_bar(0.0, color="blue")
             self.steps_md = gui.add_markdown("")
-            self.variant = gui.add_dropdown("Variant", tuple(THREE_POINT_VARIANTS), visible=False)
+            self.variant = gui.add_dropdown("Variant", ("-",), visible=False)
             self.blocked_md = gui.add_markdown("", visible=False)
             self.mount = gui.add_button("Mount the tool", color="orange", visible=False,
                                         hint="The tool change this step asks for (the app swaps the tool).")
@@ -99,19 +96,17 @@ class WizardStepsView:
 
     def _on_add_point(self, _event: Any) -> None:
         wiz = self.parent.workflow.wizard
-        if not isinstance(wiz, Xyz4Wizard):
-            raise WizardStateError("Add point is for the XYZ 4-point wizard.")
+        if wiz is None:
+            raise WizardStateError("No calibration is open.")
         wiz.add_point()
 
     def _on_variant(self, event: Any) -> None:
         wiz = self.parent.workflow.wizard
         label = str(event.target.value)
-        if isinstance(wiz, ThreePointWizard) and label in THREE_POINT_VARIANTS:
-            wiz.set_variant(THREE_POINT_VARIANTS[label])  # type: ignore[arg-type]
-        elif isinstance(wiz, AbcWorldWizard) and label in ABC_VARIANTS:
-            wiz.set_variant(ABC_VARIANTS[label])  # type: ignore[arg-type]
-        else:
+        values = {} if wiz is None else {lab: v for v, lab in type(wiz).variants}
+        if label not in values:
             raise ValueError(f"Unknown variant {label!r}.")
+        wiz.set_variant(values[label])  # type: ignore[union-attr]
 
     def auto_request(self) -> AutoTouchRequest:
         """The Auto-touch settings as a request (random or chosen direction, operator error)."""
@@ -154,24 +149,20 @@ class WizardStepsView:
         self.next.label = "Finish" if wiz.on_last_step else "Next"
         self.back.disabled = not wiz.can_back
         self.cancel.label = "Cancel" if stepping else ("Close" if wf.result_saved else "Close (resume later)")
-        is_xyz4 = isinstance(wiz, Xyz4Wizard)
-        self.add_point.visible = is_xyz4
-        self.add_point.disabled = not (is_xyz4 and wiz.can_add_point)
+        self.add_point.visible = wiz.supports_add_point
+        self.add_point.disabled = not wiz.can_add_point
         self.auto_folder.visible = wf.training and stepping
         chosen = self.auto_direction.value == CHOSEN
         self.auto_tilt.visible = self.auto_azimuth.visible = chosen
         self.update_meter()
 
-    def _render_variant(self, wiz: Any) -> None:
-        if isinstance(wiz, ThreePointWizard):
-            options, current = THREE_POINT_VARIANTS, wiz.variant
-        elif isinstance(wiz, AbcWorldWizard):
-            options, current = ABC_VARIANTS, wiz.variant
-        else:
+    def _render_variant(self, wiz: Wizard) -> None:
+        variants = type(wiz).variants
+        if not variants:
             self.variant.visible = False
             return
-        labels = tuple(options)
-        label = next(k for k, v in options.items() if v == current)
+        labels = tuple(label for _, label in variants)
+        label = next(lab for v, lab in variants if v == wiz.variant)
         if tuple(self.variant.options) != labels:    # our own assignments: the on_update
             self.variant.options = labels            # they fire has no client and is ignored
         if self.variant.value != label:
@@ -180,14 +171,14 @@ class WizardStepsView:
         self.variant.disabled = wiz.status != "in_progress"
 
     def update_meter(self) -> None:
-        """The live pose-diversity meter (4-point wizard, while a touch is to be recorded)."""
+        """The live pose-diversity meter (while a touch is to be recorded, for the wizards that
+        declare it: ``Wizard.meter_active``)."""
         wf = self.parent.workflow
-        wiz = wf.wizard
-        show = isinstance(wiz, Xyz4Wizard) and wiz.status == "in_progress"
+        wiz: Any = wf.wizard
+        show = wiz is not None and wiz.meter_active
         self.meter_bar.visible = self.meter_md.visible = show
         if not show:
             return
-        assert isinstance(wiz, Xyz4Wizard)
         T_world_flange = self.parent.session.controller.T_world_flange()
         gain = wiz.preview(T_world_flange)
         value, color = meter_level(gain)

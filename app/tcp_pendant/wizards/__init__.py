@@ -1,5 +1,7 @@
-"""Calibration wizards as state machines (no viser): XYZ 4-point, XYZ reference, three-point
-orientation and ABC world (methods.md sections 2-5). Views render them; all math is tcpcal's.
+"""Calibration wizards as state machines (no viser): XYZ 4-point, XYZ reference, TCP & Z, X,
+three-point orientation and ABC world (methods.md sections 2-5, 8). Views render them; all math
+is tcpcal's. Each wizard class describes itself and is registered here (``registry``): the
+Calibrate menu, auto-touch, the session record and the workflow read only the registry.
 
 Public API: see each module. Poses are fed in metres (``T_world_flange_m``, from the virtual
 controller) and handed to tcpcal in millimetres; every ``*_mm`` figure is in mm.
@@ -23,17 +25,16 @@ from tcp_pendant.wizards.reference import ReferenceWizard
 from tcp_pendant.wizards.three_point import MIN_DISPLACEMENT_MM, ThreePointWizard
 from tcp_pendant.wizards.xyz4 import ESTIMATORS, ESTIMATOR_LABELS, Xyz4Result, Xyz4Wizard
 
-WIZARD_TYPES: dict[str, type[Wizard]] = {
-    Xyz4Wizard.kind: Xyz4Wizard,
-    ReferenceWizard.kind: ReferenceWizard,
-    ThreePointWizard.kind: ThreePointWizard,
-    AbcWorldWizard.kind: AbcWorldWizard,
-}
-"""Wizard kind (as in ``Wizard.to_dict()["kind"]``) -> class."""
+from tcp_pendant.wizards.tcp_zx import TcpZxWizard
+from tcp_pendant.wizards.registry import WIZARD_TYPES, register, unregister, wizard_class, wizard_classes
+
+for _cls in (Xyz4Wizard, ReferenceWizard, TcpZxWizard, ThreePointWizard, AbcWorldWizard):
+    register(_cls)
 
 __all__ = [
     "AbcWorldWizard", "CalibrationFailedError", "ESTIMATORS", "ESTIMATOR_LABELS",
     "InvalidPoseError", "MIN_DISPLACEMENT_MM", "R_WORLD_TOOL_TARGET", "RecordedPose",
-    "ReferenceWizard", "StepInfo", "StepSpec", "ThreePointWizard", "WIZARD_TYPES", "Wizard",
-    "WizardError", "WizardResult", "WizardStateError", "Xyz4Result", "Xyz4Wizard",
+    "ReferenceWizard", "StepInfo", "StepSpec", "TcpZxWizard", "ThreePointWizard", "WIZARD_TYPES",
+    "Wizard", "WizardError", "WizardResult", "WizardStateError", "Xyz4Result", "Xyz4Wizard",
+    "register", "unregister", "wizard_class", "wizard_classes",
 ]

@@ -9,6 +9,7 @@ fixes only tool X; the rotation about it is kept from the tool's current data.
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import replace
 from typing import Any, ClassVar, Literal
 
 import numpy as np
@@ -22,7 +23,16 @@ from tcp_pendant.wizards.base import (
     WizardError,
     WizardResult,
     check_pose_m,
+    StepInfo,
     mm3,
+)
+from tcp_pendant.wizards.describe import (
+    ALIGN_WORLD,
+    AutoRole,
+    StartContext,
+    StepRole,
+    WizardOption,
+    WizardStart,
 )
 
 R_WORLD_TOOL_TARGET: np.ndarray = R_WORLD_TOOL_PARALLEL
@@ -40,6 +50,36 @@ class AbcWorldWizard(Wizard):
 
     kind: ClassVar[str] = "abc-world"
     title: ClassVar[str] = "ABC world (parallel axes)"
+    blurb: ClassVar[str] = ("Calibrates the **orientation** (A, B, C): align the tool with WORLD (X down, Y "
+                            "along WORLD Y, Z along WORLD X) and record once. 5D: tool X only.")
+    calibrates: ClassVar[str] = "the orientation"
+    rank: ClassVar[int] = 50
+    step_roles = (StepRole("parallel", "the tool axes parallel to WORLD as (PA-1) prescribes", ALIGN_WORLD),)
+    options = (WizardOption("slot", "Tool data", "library_slot",
+                            hint="A tool of the library whose TCP is calibrated."),)
+    variants = (("6d", "6D: X down, Y along WORLD Y"), ("5d", "5D: tool X down only"))
+    needs_tool = "library"
+
+    @classmethod
+    def start(cls, ctx: StartContext, options: Mapping[str, Any]) -> WizardStart:
+        """For the library tool in ``slot``; its data is made active so rotations A, B, C turn
+        about its TCP."""
+        tool = ctx.library_tool(options["slot"])
+        return WizardStart(cls(tool, variant=options.get("variant", "6d")), true_tool=ctx.mounted_tool,
+                           active_data=(tool, int(options["slot"])))
+
+    def auto_role(self, step: StepInfo) -> AutoRole:
+        """5D: only tool X is prescribed, so auto-touch turns the tool about X at random."""
+        role = super().auto_role(step)
+        return replace(role, free_turn_about_x=True) if self._variant == "5d" else role
+
+    @property
+    def library_tool_name(self) -> str | None:
+        return self.tool.name
+
+    def scene_target_T_world_tool_m(self, T_world_flange_m: np.ndarray) -> np.ndarray | None:
+        """The (PA-1) target triad while the wizard is in progress."""
+        return self.target_T_world_tool_m(T_world_flange_m) if self.status == "in_progress" else None
 
     def __init__(self, tool: Tool, *, variant: Literal["6d", "5d"] = "6d") -> None:
         super().__init__()

@@ -34,6 +34,15 @@ from tcpcal.origin import TcpResult
 from tcpcal.orientation import OrientationResult
 from tcpcal.tool import Calibration, Tool
 
+from tcp_pendant.wizards.describe import (
+    AutoRole,
+    OptionError,
+    StartContext,
+    StepRole,
+    WizardOption,
+    WizardStart,
+)
+
 M_TO_MM = 1000.0
 """Metres (controller) to millimetres (tcpcal input and every ``*_mm`` figure)."""
 
@@ -236,12 +245,123 @@ class WizardResult:
 class Wizard(abc.ABC):
     """Base state machine of a calibration wizard (see the module docstring for the life cycle).
 
-    Subclasses define ``kind``, ``_step_specs()``, ``_compute()``, ``_params()`` and
-    ``_from_params()``.
+    Subclasses define ``_step_specs()``, ``_compute()``, ``_params()``, ``_from_params()`` and
+    ``to_tool()``, and describe themselves (``tcp_pendant.wizards.registry``) by the class
+    attributes below and :meth:`start`; ``registry.register`` makes them a Calibrate method.
+
+    Class attributes:
+        kind: key in session records and the registry ("xyz4").
+        title: the method's label in the menu ("XYZ 4-point").
+        blurb: what the method calibrates and how, one or two sentences (markdown).
+        calibrates: what the menu says Start will calibrate ("the TCP").
+        rank: order in the menu.
+        step_roles: every step role its steps use, each with its auto-touch role.
+        options: the options it takes at start, with their choices.
+        variants: (value, label) of its variants, switchable during the wizard (``set_variant``).
+        needs_tool: "mounted" (calibrates the mounted tool, graded against its truth) or
+            "library" (works on a library tool's data, made active at start).
+        supports_add_point: "Add point" adds a touch (``add_point``).
+        diversity_meter: the live pose-diversity meter is shown on touch steps (``preview``,
+            ``other_rotations``, ``assumed_sigma_mm``).
     """
 
     kind: ClassVar[str]
     title: ClassVar[str]
+    blurb: ClassVar[str] = ""
+    calibrates: ClassVar[str] = "the TCP"
+    rank: ClassVar[int] = 100
+    step_roles: ClassVar[tuple[StepRole, ...]] = ()
+    options: ClassVar[tuple[WizardOption, ...]] = ()
+    variants: ClassVar[tuple[tuple[Any, str], ...]] = ()
+    needs_tool: ClassVar[Literal["mounted", "library"]] = "mounted"
+    supports_add_point: ClassVar[bool] = False
+    diversity_meter: ClassVar[bool] = False
+
+    # ----- self-description (the registry, the menu and the workflow read these) -----------
+    @classmethod
+    def step_role(cls, name: str) -> StepRole:
+        """The declared step role ``name`` (a ``WizardError`` if the class did not declare it)."""
+        for role in cls.step_roles:
+            if role.name == name:
+                return role
+        raise WizardError(f"The {cls.title} wizard declares no step role {name!r}.")
+
+    def auto_role(self, step: StepInfo) -> AutoRole:
+        """How auto-touch performs ``step`` (its declared role's; a variant may change it)."""
+        return type(self).step_role(step.role).auto
+
+    @classmethod
+    def parse_options(cls, options: Mapping[str, Any]) -> dict[str, Any]:
+        """The start options checked against :attr:`options` (and ``variant`` against
+        :attr:`variants`); defaults filled in.
+
+        Raises:
+            WizardError: an unknown option, a value out of its choices, a missing required one.
+        """
+        declared = {o.name: o for o in cls.options}
+        allowed = set(declared) | ({"variant"} if cls.variants else set())
+        unknown = sorted(set(options) - allowed)
+        if unknown:
+            raise WizardError(f"The {cls.title} wizard takes no option {', '.join(unknown)}; "
+                              f"it takes {', '.join(sorted(allowed)) or 'none'}.")
+        out: dict[str, Any] = {}
+        try:
+            for name, opt in declared.items():
+                if name in options and options[name] is not None:
+                    out[name] = opt.parse(options[name])
+                elif opt.required:
+                    raise OptionError(f"{opt.label}: choose one before Start.")
+                else:
+                    out[name] = opt.default
+        except OptionError as exc:
+            raise WizardError(str(exc)) from None
+        if cls.variants:
+            values = [v for v, _ in cls.variants]
+            variant = options.get("variant", values[0])
+            if variant not in values:
+                raise WizardError(f"The {cls.title} variant is one of {values}, got {variant!r}.")
+            out["variant"] = variant
+        return out
+
+    @classmethod
+    def start(cls, ctx: StartContext, options: Mapping[str, Any]) -> WizardStart:
+        """Build the wizard from checked ``options`` (:meth:`parse_options`)."""
+        raise NotImplementedError(f"{cls.__name__} does not say how to start it.")
+
+    # ----- capabilities the views ask for (defaults: none) ------------------------------
+    @property
+    def variant(self) -> Any:
+        """The variant in use (None when the wizard has none)."""
+        return None
+
+    def set_variant(self, variant: Any) -> None:
+        """Switch the variant (wizards with :attr:`variants` override this)."""
+        raise WizardStateError(f"The {self.title} wizard has no variants.")
+
+    @property
+    def can_add_point(self) -> bool:
+        """"Add point" is possible now (only wizards with ``supports_add_point``)."""
+        return False
+
+    def add_point(self) -> None:
+        """Add one touch step (only wizards with ``supports_add_point``)."""
+        raise WizardStateError(f"Add point is not part of the {self.title} wizard.")
+
+    @property
+    def meter_active(self) -> bool:
+        """The pose-diversity meter applies now: a touch step of a wizard in progress that
+        declares ``diversity_meter``."""
+        return (self.diversity_meter and self._status == "in_progress"
+                and self.step.role == "touch")
+
+    @property
+    def library_tool_name(self) -> str | None:
+        """Name of the library tool this wizard works on (the name Save offers), or None."""
+        return None
+
+    def scene_target_T_world_tool_m(self, T_world_flange_m: np.ndarray) -> np.ndarray | None:
+        """A target TOOL pose (4x4, metres, WORLD) the scene should draw now, or None."""
+        return None
 
     def __init__(self) -> None:
         self._poses: dict[int, RecordedPose] = {}
@@ -517,7 +637,7 @@ class Wizard(abc.ABC):
 
         Called on the base class, dispatches on ``d["kind"]``.
         """
-        from tcp_pendant.wizards import WIZARD_TYPES  # local import: registry lives in __init__
+        from tcp_pendant.wizards.registry import WIZARD_TYPES  # local: the registry imports this module
 
         kind = d.get("kind")
         target = cls

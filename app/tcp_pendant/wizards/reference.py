@@ -14,7 +14,8 @@ import numpy as np
 from tcpcal.origin import solve_reference
 from tcpcal.tool import Tool
 
-from tcp_pendant.wizards.base import StepSpec, Wizard, WizardError, WizardResult, mm3
+from tcp_pendant.wizards.base import StartContext, StepSpec, Wizard, WizardError, WizardResult, mm3
+from tcp_pendant.wizards.describe import TOUCH, StepRole, WizardOption, WizardStart
 
 ERRORS_ADD_UP = (
     "The reference method uses one touch per tool: the new TCP carries the error of both "
@@ -39,6 +40,33 @@ class ReferenceWizard(Wizard):
 
     kind: ClassVar[str] = "reference"
     title: ClassVar[str] = "XYZ reference"
+    blurb: ClassVar[str] = ("Calibrates the **TCP** of a new tool from one touch with an already calibrated "
+                            "tool and one with the new tool. Fast; errors add up.")
+    calibrates: ClassVar[str] = "the TCP of the new tool"
+    rank: ClassVar[int] = 20
+    step_roles = (StepRole("touch", "the tool tip on the reference tip", TOUCH),)
+    options = (
+        WizardOption("slot", "Tool data", "library_slot",
+                     hint="A tool of the library whose TCP is calibrated."),
+        WizardOption("reference_tool_key", "Its physical tool", "physical_tool", default="mounted",
+                     hint="The tool that the reference data belongs to: it is mounted for the first touch."),
+        WizardOption("new_tool_key", "New tool", "physical_tool", default="other",
+                     hint="The tool to calibrate: it is mounted for the second touch."),
+    )
+    needs_tool = "library"
+
+    @classmethod
+    def start(cls, ctx: StartContext, options: Mapping[str, Any]) -> WizardStart:
+        """The reference tool's data from the library slot (made active: "mounted and active"
+        for step 1); the new physical tool's truth grades the result."""
+        ref = ctx.library_tool(options["slot"])
+        for key in (options["reference_tool_key"], options["new_tool_key"]):
+            if key not in ctx.tools:
+                raise WizardError(f"Unknown physical tool {key!r}; choose one of {', '.join(ctx.tools)}.")
+        new = ctx.tools[options["new_tool_key"]]
+        wiz = cls(ref, reference_tool_key=options["reference_tool_key"], new_tool_key=options["new_tool_key"],
+                  new_tool_label=f"the {new.label.lower()}")
+        return WizardStart(wiz, true_tool=new, active_data=(ref, int(options["slot"])))
 
     def __init__(self, reference_tool: Tool, *, reference_tool_key: str | None = None,
                  new_tool_key: str | None = None, new_tool_label: str | None = None,

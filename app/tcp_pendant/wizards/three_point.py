@@ -23,6 +23,16 @@ from tcp_pendant.wizards.base import (
     WizardStateError,
     mm3,
 )
+from tcp_pendant.wizards.describe import (
+    IN_PLUS_Y_HALF,
+    ON_MINUS_X,
+    ON_PLUS_Y,
+    TOUCH_KEEP_ORIENTATION,
+    StartContext,
+    StepRole,
+    WizardOption,
+    WizardStart,
+)
 
 MIN_DISPLACEMENT_MM = 20.0
 """Displacements shorter than this give a poor orientation; the wizard warns (issue 5)."""
@@ -40,6 +50,32 @@ class ThreePointWizard(Wizard):
 
     kind: ClassVar[str] = "three-point"
     title: ClassVar[str] = "Three-point orientation"
+    blurb: ClassVar[str] = ("Calibrates the **orientation** (A, B, C) of a tool whose TCP is calibrated: "
+                            "a touch, then the tip on the tool's -X axis and on its +Y side.")
+    calibrates: ClassVar[str] = "the orientation"
+    rank: ClassVar[int] = 40
+    step_roles = (
+        StepRole("touch", "the tool tip on the reference tip", TOUCH_KEEP_ORIENTATION),
+        StepRole("minus_x", "the reference tip on the tool's -X axis", ON_MINUS_X),
+        StepRole("plus_y", "the reference tip on the tool's +Y axis", ON_PLUS_Y),
+        StepRole("plus_y_half", "the reference tip in the +Y half of the tool XY plane", IN_PLUS_Y_HALF),
+    )
+    options = (WizardOption("slot", "Tool data", "library_slot",
+                            hint="A tool of the library whose TCP is calibrated."),)
+    variants = ((1, "Variant 1: tip on the +Y axis"), (2, "Variant 2: tip in the +Y half-plane"))
+    needs_tool = "library"
+
+    @classmethod
+    def start(cls, ctx: StartContext, options: Mapping[str, Any]) -> WizardStart:
+        """For the library tool in ``slot`` (its TCP must be calibrated); its data is made
+        active so jogs along tool X/Y use it."""
+        tool = ctx.library_tool(options["slot"])
+        return WizardStart(cls(tool, variant=options.get("variant", 1)), true_tool=ctx.mounted_tool,
+                           active_data=(tool, int(options["slot"])))
+
+    @property
+    def library_tool_name(self) -> str | None:
+        return self.tool.name
 
     def __init__(self, tool: Tool, *, variant: Literal[1, 2] = 1) -> None:
         super().__init__()

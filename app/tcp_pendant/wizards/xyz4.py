@@ -19,6 +19,7 @@ from tcpcal.pose_quality import CandidateGain, PoseQuality, assess_touches, cand
 from tcpcal.tool import Tool
 
 from tcp_pendant.wizards.base import (
+    StartContext,
     StepSpec,
     Wizard,
     WizardError,
@@ -28,6 +29,7 @@ from tcp_pendant.wizards.base import (
     mm3,
     rotation_and_position_mm,
 )
+from tcp_pendant.wizards.describe import TOUCH, StepRole, WizardOption, WizardStart
 
 Estimator = Literal["lstsq", "sphere", "pairwise"]
 ESTIMATORS: tuple[Estimator, ...] = ("lstsq", "sphere", "pairwise")
@@ -104,8 +106,28 @@ class Xyz4Wizard(Wizard):
 
     kind: ClassVar[str] = "xyz4"
     title: ClassVar[str] = "XYZ 4-point"
+    blurb: ClassVar[str] = ("Calibrates the **TCP** (X, Y, Z): touch the reference tip with the tool tip "
+                            "from 4 to 20 clearly different orientations.")
+    calibrates: ClassVar[str] = "the TCP"
+    rank: ClassVar[int] = 10
     MIN_POINTS: ClassVar[int] = 4
     MAX_POINTS: ClassVar[int] = 20
+    step_roles = (StepRole("touch", "the tool tip on the reference tip", TOUCH),)
+    options = (
+        WizardOption("n_points", "Touches", "int", default=4, minimum=MIN_POINTS, maximum=MAX_POINTS,
+                     hint="Touches to start with; Add point adds more (up to 20)."),
+        WizardOption("estimator", "Estimator", "choice", default="lstsq",
+                     choices=tuple(ESTIMATOR_LABELS.items())),
+    )
+    needs_tool = "mounted"
+    supports_add_point = True
+    diversity_meter = True
+
+    @classmethod
+    def start(cls, ctx: StartContext, options: Mapping[str, Any]) -> WizardStart:
+        """A 4-point wizard for the mounted tool (its truth grades the result)."""
+        return WizardStart(cls(n_points=options["n_points"], estimator=options["estimator"]),
+                           true_tool=ctx.mounted_tool)
 
     def __init__(self, *, n_points: int = 4, estimator: Estimator = "lstsq",
                  assumed_sigma_mm: float = 0.5, base_tool: Tool | None = None) -> None:
