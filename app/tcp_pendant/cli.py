@@ -6,6 +6,8 @@ Examples::
     tcp-pendant --robot gp12 --tool torch --port 8090
     tcp-pendant --robot /path/ur5.urdf --flange-link tool0
     tcp-pendant --host 0.0.0.0 --shared          # classroom demo: one robot for everybody
+    tcp-pendant --host 0.0.0.0 --exercise mystery --exercise-seed 7   # a class: names, gradebook
+    tcp-pendant grades --csv > grades.csv        # the class gradebook (see classroom.grades_cli)
 """
 
 from __future__ import annotations
@@ -47,6 +49,16 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--reference-tip", default=None, metavar="X,Y,Z",
                    help="reference tip position in WORLD, mm (default: below the home flange at half "
                         "its height, e.g. 525,0,445 on the KR 6)")
+    p.add_argument("--class-db", type=Path, default=None, metavar="PATH",
+                   help="the class gradebook, an SQLite file every trainee's calibrations are stored in "
+                        "(default: the user's data directory, class.sqlite3; not used with --shared)")
+    p.add_argument("--trainer-token", default=None, metavar="TOKEN",
+                   help="the token that opens the trainer view (default: a random one, printed at start)")
+    p.add_argument("--exercise", default=None, choices=("mystery",),
+                   help="start an exercise: mystery = each trainee calibrates a tool of their own whose "
+                        "true TCP and orientation only the gradebook knows")
+    p.add_argument("--exercise-seed", type=int, default=0, metavar="N",
+                   help="seed of the mystery tools (default 0; another seed, other tools)")
     p.add_argument("--verbose", action="store_true", help="log debugging information")
     return p
 
@@ -87,8 +99,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         0 after a clean stop; 2 for bad options (with the message on stderr); 130 when
         interrupted (Ctrl-C) before the server was ready.
     """
+    args_list = list(sys.argv[1:] if argv is None else argv)
+    if args_list[:1] == ["grades"]:
+        from tcp_pendant.classroom.grades_cli import main as grades_main
+
+        return grades_main(args_list[1:])
     try:
-        return _main(argv)
+        return _main(args_list)
     except KeyboardInterrupt:               # Ctrl-C while loading the robot or starting
         print("tcp-pendant: interrupted", file=sys.stderr)
         return 130
@@ -99,19 +116,39 @@ def _main(argv: Sequence[str] | None) -> int:
     args = build_parser().parse_args(argv)
     logging.basicConfig(level=logging.DEBUG if args.verbose else logging.WARNING,
                         format="%(levelname)s %(name)s: %(message)s")
+    from tcp_pendant.classroom.gradebook import GradebookError, default_gradebook_path
     from tcp_pendant.controller import ControllerError
     from tcp_pendant.server import AppConfig, PendantApp, PortInUseError, parse_xyz_mm
 
     if not 0 <= args.port <= 65535:
         print(f"tcp-pendant: error: --port must be 0..65535, got {args.port}", file=sys.stderr)
         return 2
+    if args.trainer_token is not None and not (8 <= len(args.trainer_token) <= 200
+                                               and args.trainer_token.isprintable()):
+        print("tcp-pendant: error: --trainer-token must be 8 to 200 printable characters", file=sys.stderr)
+        return 2
+    if args.shared and (args.exercise or args.class_db or args.trainer_token):
+        print("tcp-pendant: error: --shared is a lecture demo without names or gradebook; drop "
+              "--class-db / --exercise / --trainer-token, or drop --shared", file=sys.stderr)
+        return 2
+    class_db = None if args.shared else args.class_db
+    if class_db is None and not args.shared:
+        class_db = default_gradebook_path()
+        try:
+            class_db.parent.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            print(f"tcp-pendant: error: cannot make the folder of the class gradebook {class_db.parent}: "
+                  f"{exc}; give another file with --class-db PATH", file=sys.stderr)
+            return 2
     try:
         tip = None if args.reference_tip is None else parse_xyz_mm(args.reference_tip)
         config = AppConfig(robot=args.robot, flange_link=args.flange_link, tool=args.tool, host=args.host,
                            port=args.port, tool_library=args.tool_library, shared=args.shared,
-                           reference_tip_mm=tip, allow_origins=tuple(args.allow_origin))
+                           reference_tip_mm=tip, allow_origins=tuple(args.allow_origin), class_db=class_db,
+                           trainer_token=args.trainer_token, exercise=args.exercise,
+                           exercise_seed=args.exercise_seed)
         app = PendantApp(config)
-    except (ControllerError, ValueError, OSError) as exc:
+    except (ControllerError, ValueError, OSError, GradebookError) as exc:
         print(f"tcp-pendant: error: {exc}", file=sys.stderr)
         return 2
     warning = network_warning(args.host)
@@ -132,9 +169,20 @@ def _main(argv: Sequence[str] | None) -> int:
     tip_mm = ", ".join(f"{v:.0f}" for v in app.reference_tip_m * 1000.0)
     print(f"TCP Pendant ready in {time.perf_counter() - t0:.1f} s: {ready_urls(url, app.network_urls, args.host)}"
           f"\n  robot {app.robot_label}, tool {app.tool.label}, reference tip ({tip_mm}) mm, {mode}\n"
-          f"  tool library {app.library.path}\n  Ctrl-C to stop.", flush=True)
+          f"  tool library {app.library.path}\n{_class_lines(app)}  Ctrl-C to stop.", flush=True)
     app.serve_forever()
     return 0
+
+
+def _class_lines(app: object) -> str:
+    """The classroom lines of the ready message (empty without a gradebook)."""
+    room = getattr(app, "classroom", None)
+    if room is None:
+        return ""
+    exercise = "mystery tools" if room.exercise == "mystery" else "free practice"
+    return (f"  class gradebook {room.gradebook.path} ({exercise})\n"
+            f"Trainer view: {app.trainer_url}  trainer token: {room.trainer_token}\n"
+            "  (open the page, type the token in \"Trainer token\" of the welcome window; keep it secret)\n")
 
 
 if __name__ == "__main__":  # pragma: no cover

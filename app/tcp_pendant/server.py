@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import ipaddress
 import logging
+import secrets
 import socket
 import threading
 import time
@@ -31,6 +32,8 @@ import numpy as np
 from tcpcal.library import ToolLibrary
 from tcp_pendant import origin_check
 from tcp_pendant.addresses import network_urls
+from tcp_pendant.classroom.class_room import ClassRoom
+from tcp_pendant.classroom.gradebook import Gradebook
 from tcp_pendant.controller import (
     ControllerError,
     solve_ik,
@@ -67,6 +70,11 @@ class AppConfig:
         library_poll_s: how often the library file is checked for changes by others.
         allow_origins: web origins (``scheme://host[:port]``) whose pages may connect besides
             the pendant's own address, e.g. a reverse proxy's (``tcp_pendant.origin_check``).
+        class_db: the class gradebook (SQLite file); None: no classroom (no name prompt, nothing
+            recorded). The CLI passes its default path. Ignored with ``shared``.
+        trainer_token: the token that opens the trainer view (None: a random one).
+        exercise: None (free practice) or "mystery" (each trainee gets a mystery tool).
+        exercise_seed: seed of the mystery tools.
     """
 
     robot: str = "kr6"
@@ -79,6 +87,10 @@ class AppConfig:
     reference_tip_mm: tuple[float, float, float] | None = None
     library_poll_s: float = 1.0
     allow_origins: tuple[str, ...] = ()
+    class_db: Path | None = None
+    trainer_token: str | None = None
+    exercise: str | None = None
+    exercise_seed: int = 0
 
 
 class PortInUseError(OSError):
@@ -226,6 +238,14 @@ class PendantApp:
         for t in tools.values():
             rigid_meshes(t.urdf_path)
         rigid_meshes(reference_tip_model().urdf_path)
+        self.gradebook: Gradebook | None = None
+        self.classroom: ClassRoom | None = None
+        if config.class_db is not None and not config.shared:
+            self.gradebook = Gradebook(config.class_db)         # GradebookError: one clear message
+            self.classroom = ClassRoom(self.gradebook, tools,
+                                       trainer_token=config.trainer_token or secrets.token_urlsafe(16),
+                                       exercise=config.exercise, exercise_seed=config.exercise_seed,
+                                       hand_to_loop=self._hand_to_loop)
 
     # ------------------------------------------------------------ sessions
     def new_controller(self) -> VirtualController:
@@ -254,6 +274,8 @@ class PendantApp:
             if tool is not None:
                 session.set_active_data(tool, slot)
         build_session_views(session, title=f"TCP Pendant · {self.robot_label}")
+        if self.classroom is not None and not shared:
+            self.classroom.attach(session)
         return session
 
     def open_session(self, client: Any) -> Session | None:
@@ -361,6 +383,12 @@ class PendantApp:
         return self.url
 
     @property
+    def trainer_url(self) -> str | None:
+        """The page of the trainer view (None without a classroom); its token goes in the
+        "Trainer token" field of the welcome prompt (viser drops a page's query string)."""
+        return None if self.classroom is None else self.url
+
+    @property
     def port(self) -> int:
         """The port actually served."""
         return int(self.server.get_port()) if self.server is not None else self.config.port
@@ -393,6 +421,8 @@ class PendantApp:
         if self.server is not None:
             origin_check.forget(self.port)
             self.server.stop()
+        if self.gradebook is not None:
+            self.gradebook.close()
 
     def serve_forever(self, poll_s: float = 0.5) -> None:
         """Block until interrupted (Ctrl-C), then stop."""
