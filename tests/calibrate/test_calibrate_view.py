@@ -251,8 +251,9 @@ def test_orientation_wizards_need_a_library_tool(page) -> None:
     p.choose(v.method, "Three-point orientation")
     assert v.start.disabled and "library is empty" in v.menu_md.content
     s.library.save(2, library_tool_with_true_tcp("torch", "Torch"))
-    wait_until(lambda: v.library_tool.options == ("2: Torch",), what="the library watcher")  # saved "elsewhere"
-    assert not v.start.disabled and "orientation of **2: Torch**" in v.menu_md.content
+    # saved "elsewhere": the watcher re-lists the library, then the menu is rendered
+    wait_until(lambda: v.library_tool.options == ("2: Torch",) and not v.start.disabled, what="the library watcher")
+    assert "orientation of **2: Torch**" in v.menu_md.content
     p.click(v.start)
     assert v.steps.variant.visible and v.steps.variant.value.startswith("Variant 1")
     p.choose(v.steps.variant, "Variant 2: tip in the +Y half-plane")
