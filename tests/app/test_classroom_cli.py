@@ -1,0 +1,64 @@
+"""``tcp-pendant grades`` and the classroom options of ``tcp-pendant`` (issue 11 item 2)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from tcp_pendant.classroom.gradebook import CSV_COLUMNS, Gradebook
+from tcp_pendant.cli import build_parser, main
+
+
+def _book_with_one_row(path: Path) -> None:
+    with Gradebook(path, synchronous="NORMAL") as g:
+        sid = g.start_session(g.add_trainee("=Anna"), "per-browser")
+        cal = g.start_calibration(sid, "xyz4", "pointer", np.eye(4))
+        g.record_touch(cal, 0, np.eye(4), [0.0] * 6, 0.1, False)
+        g.finish_calibration(cal, {"mean_error_mm": 0.2}, position_error_mm=0.3, orientation_error_deg=None,
+                             grade="good", tcp_mm=(1.0, 2.0, 3.0))
+
+
+def test_grades_subcommand_prints_the_csv(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    db = tmp_path / "class.sqlite3"
+    _book_with_one_row(db)
+    assert main(["grades", "--class-db", str(db), "--csv"]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].split(",") == list(CSV_COLUMNS)
+    assert out[1].split(",")[1] == "'=Anna"             # a formula-looking name is defused
+    assert main(["grades", "--class-db", str(db)]) == 0
+    table = capsys.readouterr().out
+    assert "=Anna" in table and "good" in table and "0.300" in table
+
+
+def test_grades_of_a_missing_or_foreign_file_is_one_error(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["grades", "--class-db", str(tmp_path / "none.sqlite3")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("tcp-pendant grades: error:") and len(err.strip().splitlines()) == 1
+    foreign = tmp_path / "notes.txt"
+    foreign.write_text("not a database")
+    assert main(["grades", "--class-db", str(foreign)]) == 2
+    assert foreign.read_text() == "not a database"
+
+
+def test_server_refuses_a_damaged_gradebook_and_classroom_options_with_shared(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    bad = tmp_path / "class.sqlite3"
+    bad.write_bytes(b"garbage" * 100)
+    assert main(["--port", "0", "--tool-library", str(tmp_path / "t.json"), "--class-db", str(bad)]) == 2
+    err = capsys.readouterr().err
+    assert "gradebook" in err.lower() and str(bad) in err
+    assert bad.read_bytes() == b"garbage" * 100
+    assert main(["--shared", "--exercise", "mystery"]) == 2
+    assert "--shared" in capsys.readouterr().err
+    assert main(["--trainer-token", "short"]) == 2
+    assert "--trainer-token" in capsys.readouterr().err
+
+
+def test_parser_knows_the_classroom_options() -> None:
+    args = build_parser().parse_args(["--class-db", "x.sqlite3", "--exercise", "mystery", "--exercise-seed", "7",
+                                      "--trainer-token", "abcdefgh"])
+    assert (args.class_db, args.exercise, args.exercise_seed, args.trainer_token) == \
+        (Path("x.sqlite3"), "mystery", 7, "abcdefgh")
+    with pytest.raises(SystemExit):
+        build_parser().parse_args(["--exercise", "other"])
