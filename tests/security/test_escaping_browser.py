@@ -205,7 +205,8 @@ def test_escaped_payloads_render_as_their_literal_text_in_viser(bare_viser, list
 
 # ---------------------------------------------------------------------------------------------
 def seed_hostile_library(path: Path, listener: Listener) -> dict[int, str]:
-    """The shared library as a trainee could leave it: hostile names, the style one active."""
+    """The shared library as a trainee could leave it: hostile names, the style one active (the
+    file's active slot: the CLI's and --shared mode's start tool)."""
     names = {1: STYLE, 2: LINK, 3: listener.image_name()}
     lib = ToolLibrary(path)
     for slot, name in names.items():
@@ -219,12 +220,17 @@ def test_hostile_tool_names_are_shown_as_text_in_the_pendant(pendant_server, new
     server = pendant_server()
     page = new_page(server.url)
     title = page.title()
+    # a browser's robot starts with no active tool (issue 9): activate the style one on the Tool tab
+    page.get_by_role("tab", name="Tool").click()
+    choose(page, "Slot", f"1: {STYLE}")
+    page.get_by_role("button", name="Activate", exact=True).click()
+    wait_text(page, f"Active tool: {STYLE} (slot 1)")
     # Jog tab: the TCP readout names the active tool
+    page.get_by_role("tab", name="Jog").click()
     wait_js(page, "() => document.body.innerText.includes('TOOL <style>*{opacity:0}')", "the active tool's name as text")
     assert_harmless(page_state(page), title, listener)
 
     page.get_by_role("tab", name="Tool").click()
-    wait_text(page, f"Active tool: {STYLE} (slot 1)")
     for slot in (2, 3):
         choose(page, "Slot", f"{slot}: {names[slot]}")
         wait_text(page, f"Selected: {names[slot]} (slot {slot})")
@@ -237,9 +243,16 @@ def test_hostile_tool_names_are_shown_as_text_in_the_pendant(pendant_server, new
     png = shot(page, "hostile_tool_names")
     assert png.exists()
 
-    # a new browser: the library's active tool is the image one now; activate the style one again
-    ToolLibrary(server.library_path).activate(1)
+    # a new browser starts with no active tool, whatever the first one activated; it activates
+    # the style one itself
     fresh = new_page(server.url)
+    wait_js(fresh, "() => document.body.innerText.includes('FLANGE (no tool active)')", "no active tool")
+    fresh.get_by_role("tab", name="Tool").click()
+    choose(fresh, "Slot", f"2: {names[2]}")
+    choose(fresh, "Slot", f"1: {STYLE}")
+    fresh.get_by_role("button", name="Activate", exact=True).click()
+    wait_text(fresh, f"Active tool: {STYLE} (slot 1)")
+    fresh.get_by_role("tab", name="Jog").click()
     wait_js(fresh, "() => document.body.innerText.includes('TOOL <style>*{opacity:0}')", "the active tool's name")
     fresh.wait_for_load_state("networkidle")
     assert_harmless(page_state(fresh), title, listener)
