@@ -221,6 +221,7 @@ def test_hostile_tool_names_are_shown_as_text_in_the_pendant(pendant_server, new
     page = new_page(server.url)
     title = page.title()
     # a browser's robot starts with no active tool (issue 9): activate the style one on the Tool tab
+    wait_js(page, "() => document.body.innerText.includes('FLANGE (no tool active)')", "no active tool")
     page.get_by_role("tab", name="Tool").click()
     choose(page, "Slot", f"1: {STYLE}")
     page.get_by_role("button", name="Activate", exact=True).click()
