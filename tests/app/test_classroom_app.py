@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 sys.path.insert(0, str(Path(__file__).parents[1] / "calibrate"))
-from guiclick import choose, click  # noqa: E402
+from guiclick import choose, click, upload  # noqa: E402
 from wsclient import DrainingClient, wait_until  # noqa: E402
 
 from tcp_pendant.classroom.gradebook import Gradebook
@@ -103,6 +103,19 @@ def test_trainer_view_needs_the_token_and_shows_the_class_escaped(app_factory, t
         click(view.push, trainer.client)
         assert trainee.controller.mounted_tool.key == "torch"
         assert "1 trainee" in view.push_md.content
+        # the trainee finishes; the trainer grades the trainee's exported record by its record id
+        for _ in range(6):
+            if cal.workflow.result is not None:
+                break
+            click(cal.steps.auto_touch, trainee.client)
+        import json
+
+        record = json.dumps(cal.workflow.export_record()).encode()
+        assert b"T_flange_tcp_true_m" not in record
+        upload(view.grade_upload, "eve.json", record, trainer.client)
+        wait_until(lambda: "Record id" in view.grade_md.content, what="the record's grades")
+        grade = cal.workflow.truth().grade
+        assert f"| {grade} |" in view.grade_md.content and "matches the gradebook" in view.grade_md.content
     finally:
         a.close()
         t.close()

@@ -99,7 +99,7 @@ def test_session_record_round_trip_and_replay(synth, tmp_path):
     path = save_session(tmp_path / "session.json", rec)
     loaded = read_session_file(path)
     assert loaded == json.loads(dumps(rec))
-    assert loaded["format"] == "tcp-pendant-session" and loaded["version"] == 1
+    assert loaded["format"] == "tcp-pendant-session" and loaded["version"] == 2
     assert [t["label"] for t in loaded["touches"]] == ["home", "p2"]
     w0 = loaded["wizards"][0]
     assert w0["state"]["kind"] == "xyz4" and len(w0["state"]["poses"]) == 5

@@ -169,6 +169,10 @@ class CalibrationWorkflow:
         self._auto_directions: dict[int, tuple[float, float, float]] = {}   # run -> last auto-touch
         self.auto_touches = 0
         """Auto-touch clicks so far (the classroom recorder tells Auto-touch from hand touches)."""
+        self.honest_records = False
+        """A classroom session: the exported record carries no truth (``session_record`` honest)."""
+        self.record_ids: dict[int, int] = {}
+        """Run index -> gradebook calibration id (the classroom recorder fills it; exported)."""
 
     # ------------------------------------------------------------ state
     @property
@@ -471,7 +475,8 @@ class CalibrationWorkflow:
     def export_record(self, touches: Any = ()) -> dict[str, Any]:
         """The session record (JSON-ready dict, ``tcp_pendant.wizards.session_record`` format):
         every wizard of the session with its poses, result and errors against truth."""
-        return session_from_controller(self.controller, self.runs, robot=self.robot, touches=touches)
+        return session_from_controller(self.controller, self.runs, robot=self.robot, touches=touches,
+                                       honest=self.honest_records, record_ids=self.record_ids)
 
     def load_record(self, source: Any) -> tuple[ReplayCheck, ...]:
         """Load a session record (its bytes, JSON text or a dict; text is never taken for a path),

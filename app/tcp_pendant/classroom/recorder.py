@@ -99,6 +99,8 @@ class TraineeRecorder:
         self.exercise_id = exercise_id
         self._runs: dict[int, _RunState] = {}
         self._auto_seen = int(getattr(workflow, "auto_touches", 0))
+        if workflow is not None:
+            workflow.honest_records = True      # the trainee's export carries no answer key
         self._crashed = False
         self._lock = threading.Lock()
         self._status = TraineeStatus(name=name, exercise=exercise_id or "")
@@ -168,6 +170,8 @@ class TraineeRecorder:
                     self.session_id, w.kind, run.true_tool_key or self.controller.mounted_tool.key, truth,
                     exercise_id=self.exercise_id)
                 st = self._runs[i] = _RunState(cal)
+                if isinstance(getattr(wf, "record_ids", None), dict):
+                    wf.record_ids[i] = cal             # the export names it: the trainer grades by it
             if st.calibration_id is None:
                 continue
             self._sync_poses(st, w, auto)

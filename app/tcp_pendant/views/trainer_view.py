@@ -9,13 +9,23 @@ text a trainee typed (names) goes through ``escape_markdown``; callbacks through
 
 from __future__ import annotations
 
+import asyncio
+import logging
 from collections.abc import Sequence
+from concurrent.futures import ThreadPoolExecutor
 from typing import Any, Protocol
 
-from tcp_pendant.classroom.gradebook import GradeRow
+from tcp_pendant.classroom.gradebook import GradeRow, Gradebook
+from tcp_pendant.classroom.grading import RecordGrade, grade_record
 from tcp_pendant.classroom.recorder import TraineeStatus
 from tcp_pendant.session import Session
 from tcp_pendant.text_escape import escape_markdown
+from tcp_pendant.views.upload_guard import limit_upload_size
+from tcp_pendant.wizards.session_record import MAX_RECORD_BYTES, SessionRecordError, check_record_size, load_and_replay
+
+log = logging.getLogger(__name__)
+_GRADE_WORKER = ThreadPoolExecutor(max_workers=1, thread_name_prefix="record-grading")
+"""Parses, replays and grades uploaded records off viser's event loop, one at a time."""
 
 __all__ = ["EXERCISES", "ClassControl", "TrainerView", "grades_markdown", "trainees_markdown"]
 
@@ -29,6 +39,7 @@ class ClassControl(Protocol):
     """What the trainer view needs of the server."""
 
     tool_keys: Sequence[str]
+    gradebook: Gradebook
 
     def trainee_statuses(self) -> list[TraineeStatus]: ...
 
@@ -71,6 +82,19 @@ def grades_markdown(rows: Sequence[GradeRow]) -> str:
     return "\n".join(lines)
 
 
+def record_grades_markdown(name: str, grades: Sequence[RecordGrade]) -> str:
+    """The grades of an uploaded record (markdown; the file name escaped)."""
+    lines = [f"**{escape_markdown(name)}**", "",
+             "| # | Record id | Trainee | Method | Pos. err. mm | Grade | Check |", "|---|---|---|---|---|---|---|"]
+    for g in grades:
+        err = "-" if g.position_error_mm is None else f"{g.position_error_mm:.3f}"
+        lines.append(f"| {g.index + 1} | {g.record_id if g.record_id is not None else '-'} | {_cell(g.trainee)} | "
+                     f"{_cell(g.method)} | {err} | {_cell(g.grade or '')} | {_cell(g.message)} |")
+    if not grades:
+        lines.append("| - | - | - | - | - | - | the record holds no calibration |")
+    return "\n".join(lines)
+
+
 class TrainerView:
     """The trainer's panel in one browser (see the module docstring).
 
@@ -94,6 +118,14 @@ class TrainerView:
             self.tool = gui.add_dropdown("Tool for all", tools, initial_value=tools[0])
             self.push = gui.add_button("Push to all trainees", color="blue")
             self.push_md = gui.add_markdown("")
+            self.grade_upload = gui.add_upload_button(
+                "Grade a trainee's record (JSON)", mime_type="application/json",
+                hint="A trainee's exported session: each calibration is replayed and graded against "
+                     "the truth this gradebook keeps (by its record id).")
+            self.grade_md = gui.add_markdown("")
+        self._grading = False
+        self.grade_upload.on_upload(self._on_grade_upload)
+        limit_upload_size(self.grade_upload, MAX_RECORD_BYTES, self._refused)
         self.download.on_click(session.on_loop(self._download))
         self.push.on_click(session.on_loop(self._push))
         self.render()
@@ -107,6 +139,32 @@ class TrainerView:
         client = self.session.client
         if client is not None:
             client.send_file_download("grades.csv", self.control.grades_csv().encode("utf-8"))
+
+    def _refused(self, filename: str, size_bytes: int) -> None:
+        self.session.notify("Record not graded", f"{filename or 'The file'}: {size_bytes} bytes is more than "
+                            f"{MAX_RECORD_BYTES} bytes; a session record is far smaller.", kind="warning")
+
+    async def _on_grade_upload(self, event: Any) -> None:
+        """The record's bytes are parsed, replayed and graded in ``_GRADE_WORKER`` (off the loop)."""
+        if self.session.closed or getattr(event, "client", None) is None or self._grading:
+            return
+        upload = event.target.value
+        name = str(upload.name or "record")
+        self._grading = True
+        try:
+            check_record_size(len(upload.content))
+            grades = await asyncio.get_running_loop().run_in_executor(
+                _GRADE_WORKER, lambda: grade_record(load_and_replay(bytes(upload.content)), self.control.gradebook))
+        except SessionRecordError as exc:
+            self.session.notify("Record not graded", f"{name}: {exc}", kind="warning")
+            return
+        except Exception as exc:  # never let an upload kill the server
+            log.exception("grading the record %r failed", name)
+            self.session.notify("Internal error", f"{type(exc).__name__}: {exc}", kind="error")
+            return
+        finally:
+            self._grading = False
+        self.session.guard(lambda: setattr(self.grade_md, "content", record_grades_markdown(name, grades)))()
 
     def _push(self, _event: Any = None) -> None:
         exercise = EXERCISES.get(str(self.exercise.value))

@@ -4,7 +4,8 @@ A trainer grades from this file: every wizard's recorded flange poses are in it,
 rebuilds each wizard and recomputes its result with ``tcpcal``; :func:`replay` checks that the
 recomputed result matches the stored one and recomputes the errors against the true tool.
 
-JSON contract (version 1). Lengths: metres in ``*_m`` keys, millimetres in ``*_mm`` keys;
+JSON contract (version 2; version 1 records are still read: they have no ``honest`` and no
+``record_id`` keys). Lengths: metres in ``*_m`` keys, millimetres in ``*_mm`` keys;
 angles in degrees; poses are 4x4 row-major nested lists; times ISO 8601 UTC. The key
 ``"T_flange_tcp_true_m"`` keeps its version-1 spelling (a contract); in code the same frame is
 ``T_flange_tool_true_m`` (the hidden true TOOL frame, FLANGE -> TOOL, metres).
@@ -13,7 +14,8 @@ angles in degrees; poses are 4x4 row-major nested lists; times ISO 8601 UTC. The
 
     {
       "format": "tcp-pendant-session",          # constant
-      "version": 1,
+      "version": 2,
+      "honest": false,                          # true: a classroom trainee's record, no truth
       "exported_at": "2026-11-22T19:00:00Z",
       "robot": {"name": "kr6",                  # robot key or URDF stem
                 "urdf": "/path/kr6.urdf" | null,
@@ -43,6 +45,8 @@ angles in degrees; poses are 4x4 row-major nested lists; times ISO 8601 UTC. The
             "computed_at": str
           } | null,
           "true_tool": {"key": str | null, "T_flange_tcp_true_m": 4x4} | null,
+                                                  # honest: {"key": str} (no frame), "truth": null
+          "record_id": int | null,                # the gradebook's calibration id (classroom)
           "truth": TruthComparison.to_dict() | null   # position_error_mm, orientation_error_deg,
                                                       # x_axis_error_deg, inside_ci95, graded,
                                                       # grade, verdict, position_error_vector_mm
@@ -84,7 +88,9 @@ from tcp_pendant.wizards.base import Wizard, WizardError, check_pose_m, utc_now_
 from tcp_pendant.wizards.truth import TruthComparison, compare_with_truth
 
 FORMAT = "tcp-pendant-session"
-VERSION = 1
+VERSION = 2
+READ_VERSIONS = (1, 2)
+"""Versions :func:`check_session_record` reads (version 1 has no ``record_id`` and no ``honest``)."""
 REPLAY_TOLERANCE_MM = 1e-6
 REPLAY_TOLERANCE_DEG = 1e-6
 
@@ -161,24 +167,29 @@ def _touch_dict(touch: Any) -> dict[str, Any]:
     return {"label": str(label), "T_world_flange_m": _pose_list(T)}
 
 
-def _run_dict(run: WizardRun | Wizard) -> dict[str, Any]:
+def _run_dict(run: WizardRun | Wizard, honest: bool = False, record_id: int | None = None) -> dict[str, Any]:
     if isinstance(run, Wizard):
         run = WizardRun(run)
     wiz = run.wizard
     res = wiz.finished_result          # a finished wizard closed to resume later keeps its result
     truth = None
     true_tool = None
+    if honest:                         # a trainee's homework: no answer key (graded by the gradebook)
+        return {"state": wiz.to_dict(), "result": None if res is None else res.summary(),
+                "true_tool": None if run.true_tool_key is None else {"key": run.true_tool_key},
+                "truth": None, "record_id": record_id}
     if run.T_flange_tool_true_m is not None:
         true_tool = {"key": run.true_tool_key, "T_flange_tcp_true_m": _pose_list(run.T_flange_tool_true_m)}
         if res is not None:
             truth = compare_with_truth(res, run.T_flange_tool_true_m).to_dict()
     return {"state": wiz.to_dict(), "result": None if res is None else res.summary(),
-            "true_tool": true_tool, "truth": truth}
+            "true_tool": true_tool, "truth": truth, "record_id": record_id}
 
 
 def session_to_dict(runs: Sequence[WizardRun | Wizard], *, robot: str, urdf: str | Path | None = None,
                     T_world_base_m: Any = None, mounted_tool: Any = None,
-                    reference_tip_world_m: Any = None, touches: Sequence[Any] = ()) -> dict[str, Any]:
+                    reference_tip_world_m: Any = None, touches: Sequence[Any] = (), honest: bool = False,
+                    record_ids: Mapping[int, int] | None = None) -> dict[str, Any]:
     """The session as a JSON-ready dict (see the module docstring for the keys).
 
     Args:
@@ -190,32 +201,42 @@ def session_to_dict(runs: Sequence[WizardRun | Wizard], *, robot: str, urdf: str
         reference_tip_world_m: reference tip position, metres.
         touches: the pendant's captured touches (``Touch`` objects, ``(T, label)`` tuples or
             dicts with ``T_world_flange_m`` and ``label``).
+        honest: a trainee's record in a class (issue 11): no true TOOL frame anywhere, no
+            errors against it, no server path (``robot.urdf`` null); the trainer grades it
+            against the gradebook by each wizard's ``record_id``.
+        record_ids: run index -> gradebook calibration id (``record_id`` of each wizard).
     """
+    ids = {} if record_ids is None else dict(record_ids)
     tool = None
     if mounted_tool is not None:
-        tool = {"key": mounted_tool.key, "label": getattr(mounted_tool, "label", mounted_tool.key),
-                "T_flange_tcp_true_m": _pose_list(mounted_tool.T_flange_tool_true)}
+        tool = {"key": mounted_tool.key, "label": getattr(mounted_tool, "label", mounted_tool.key)}
+        if not honest:
+            tool["T_flange_tcp_true_m"] = _pose_list(mounted_tool.T_flange_tool_true)
     tip = None
     if reference_tip_world_m is not None:
         tip = [float(v) for v in np.asarray(reference_tip_world_m, dtype=float).reshape(3)]
     return {
         "format": FORMAT, "version": VERSION, "exported_at": utc_now_iso(),
-        "robot": {"name": str(robot), "urdf": None if urdf is None else str(urdf),
+        "honest": bool(honest),
+        "robot": {"name": str(robot), "urdf": None if urdf is None or honest else str(urdf),
                   "T_world_base_m": _pose_list(np.eye(4) if T_world_base_m is None else T_world_base_m)},
         "mounted_tool": tool, "reference_tip_world_m": tip,
         "touches": [_touch_dict(t) for t in touches],
-        "wizards": [_run_dict(r) for r in runs],
+        "wizards": [_run_dict(r, honest, ids.get(i)) for i, r in enumerate(runs)],
     }
 
 
 def session_from_controller(controller: Any, runs: Sequence[WizardRun | Wizard], *, robot: str,
-                            touches: Sequence[Any] = ()) -> dict[str, Any]:
-    """``session_to_dict`` filled from a ``VirtualController`` (base, tool, reference tip, URDF)."""
+                            touches: Sequence[Any] = (), honest: bool = False,
+                            record_ids: Mapping[int, int] | None = None) -> dict[str, Any]:
+    """``session_to_dict`` filled from a ``VirtualController`` (base, tool, reference tip, URDF;
+    ``honest`` and ``record_ids`` as there)."""
     kin = getattr(controller, "kinematics", None)
     urdf = getattr(kin, "urdf_path", None)
     return session_to_dict(runs, robot=robot, urdf=urdf, T_world_base_m=controller.T_world_base,
                            mounted_tool=controller.mounted_tool,
-                           reference_tip_world_m=controller.reference_tip_world_m, touches=touches)
+                           reference_tip_world_m=controller.reference_tip_world_m, touches=touches,
+                           honest=honest, record_ids=record_ids)
 
 
 def dumps(record: Mapping[str, Any]) -> str:
@@ -279,9 +300,10 @@ def check_session_record(data: Any) -> dict[str, Any]:
     if not isinstance(data, Mapping) or data.get("format") != FORMAT:
         raise SessionRecordError(f"Not a TCP Pendant session record (expected \"format\": \"{FORMAT}\").")
     data = dict(data)
-    if data.get("version") != VERSION:
-        raise SessionRecordError(f"Session record version {data.get('version')!r} is not supported "
-                                 f"(this pendant reads version {VERSION}).")
+    version = data.get("version")
+    if isinstance(version, bool) or version not in READ_VERSIONS:
+        raise SessionRecordError(f"Session record version {version!r} is not supported "
+                                 f"(this pendant reads versions {', '.join(map(str, READ_VERSIONS))}).")
     wizards = data.get("wizards", [])
     if not isinstance(wizards, list):
         raise SessionRecordError("\"wizards\" must be a list.")
@@ -294,6 +316,10 @@ def check_session_record(data: Any) -> dict[str, Any]:
         raise _limit_error("holds", f"{len(touches)} pendant touches", f"{MAX_TOUCHES} pendant touches")
     for i, entry in enumerate(wizards):
         state = entry.get("state") if isinstance(entry, Mapping) else None
+        rid = entry.get("record_id") if isinstance(entry, Mapping) else None
+        if rid is not None and (isinstance(rid, bool) or not isinstance(rid, int) or rid < 1):
+            raise SessionRecordError(f"Wizard {i + 1} of the record: \"record_id\" must be a whole "
+                                     f"number >= 1 or null, got {rid!r:.40}.")
         if not isinstance(state, Mapping):
             raise SessionRecordError(f"Wizard {i + 1} of the record has no \"state\" object.")
         poses = state.get("poses", {})
@@ -307,7 +333,8 @@ def check_session_record(data: Any) -> dict[str, Any]:
             try:
                 if not isinstance(true_tool, Mapping) or not isinstance(true_tool.get("key"), (str, type(None))):
                     raise WizardError("it must be {\"key\": text or null, \"T_flange_tool_true_m\": 4x4}")
-                check_pose_m(true_tool.get("T_flange_tcp_true_m"), what="true TOOL frame")
+                if version == 1 or "T_flange_tcp_true_m" in true_tool:   # version 2: honest records have none
+                    check_pose_m(true_tool.get("T_flange_tcp_true_m"), what="true TOOL frame")
             except (WizardError, TypeError, ValueError) as exc:
                 raise SessionRecordError(f"Wizard {i + 1} of the record: bad \"true_tool\" ({exc}).") from None
     return data
@@ -459,7 +486,7 @@ def _check_entry(i: int, entry: Mapping[str, Any], wiz: Wizard) -> ReplayCheck:
                    f"replayed result differs from the record (TCP by {tcp_diff:.3g} mm"
                    + (f", orientation by {rot_diff:.3g} deg" if rot_diff is not None else "") + ")")
         true_tool = entry.get("true_tool")
-        if true_tool is not None:
+        if true_tool is not None and true_tool.get("T_flange_tcp_true_m") is not None:
             truth = compare_with_truth(res, true_tool["T_flange_tcp_true_m"])
     return ReplayCheck(index=i, kind=wiz.kind, wizard=wiz, matches=matches,
                        tcp_diff_mm=tcp_diff, rotation_diff_deg=rot_diff, truth=truth,
