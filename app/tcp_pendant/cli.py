@@ -6,7 +6,8 @@ Examples::
     tcp-pendant --robot gp12 --tool torch --port 8090
     tcp-pendant --robot /path/ur5.urdf --flange-link tool0
     tcp-pendant --host 0.0.0.0 --shared          # classroom demo: one robot for everybody
-    tcp-pendant --host 0.0.0.0 --exercise mystery --exercise-seed 7   # a class: names, gradebook
+    tcp-pendant --host 0.0.0.0 --class           # a class: names, gradebook, trainer view
+    tcp-pendant --host 0.0.0.0 --exercise mystery --exercise-seed 7   # a class with mystery tools
     tcp-pendant grades --csv > grades.csv        # the class gradebook (see classroom.grades_cli)
 """
 
@@ -49,9 +50,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--reference-tip", default=None, metavar="X,Y,Z",
                    help="reference tip position in WORLD, mm (default: below the home flange at half "
                         "its height, e.g. 525,0,445 on the KR 6)")
+    p.add_argument("--class", dest="classroom", action="store_true",
+                   help="run a class: each browser gives a name, every calibration is stored in the class "
+                        "gradebook, and a trainer view (token) shows the class; implied by --class-db, "
+                        "--exercise and --trainer-token")
     p.add_argument("--class-db", type=Path, default=None, metavar="PATH",
                    help="the class gradebook, an SQLite file every trainee's calibrations are stored in "
-                        "(default: the user's data directory, class.sqlite3; not used with --shared)")
+                        "(default with --class: the user's data directory, class.sqlite3)")
     p.add_argument("--trainer-token", default=None, metavar="TOKEN",
                    help="the token that opens the trainer view (default: a random one, printed at start)")
     p.add_argument("--exercise", default=None, choices=("mystery",),
@@ -127,12 +132,13 @@ def _main(argv: Sequence[str] | None) -> int:
                                                and args.trainer_token.isprintable()):
         print("tcp-pendant: error: --trainer-token must be 8 to 200 printable characters", file=sys.stderr)
         return 2
-    if args.shared and (args.exercise or args.class_db or args.trainer_token):
+    classroom = bool(args.classroom or args.class_db or args.exercise or args.trainer_token)
+    if args.shared and classroom:
         print("tcp-pendant: error: --shared is a lecture demo without names or gradebook; drop "
-              "--class-db / --exercise / --trainer-token, or drop --shared", file=sys.stderr)
+              "--class / --class-db / --exercise / --trainer-token, or drop --shared", file=sys.stderr)
         return 2
-    class_db = None if args.shared else args.class_db
-    if class_db is None and not args.shared:
+    class_db = args.class_db
+    if classroom and class_db is None:
         class_db = default_gradebook_path()
         try:
             class_db.parent.mkdir(parents=True, exist_ok=True)

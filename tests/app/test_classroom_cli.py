@@ -62,3 +62,30 @@ def test_parser_knows_the_classroom_options() -> None:
         (Path("x.sqlite3"), "mystery", 7, "abcdefgh")
     with pytest.raises(SystemExit):
         build_parser().parse_args(["--exercise", "other"])
+
+
+def test_the_class_is_opt_in(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Without --class (or a class option) no gradebook is opened and no name is asked; with
+    --class the default gradebook path is used."""
+    import tcp_pendant.server as server
+
+    seen: list[object] = []
+
+    class Stop(Exception):
+        pass
+
+    class FakeApp:
+        def __init__(self, config: object) -> None:
+            seen.append(config)
+            raise Stop
+
+    monkeypatch.setattr(server, "PendantApp", FakeApp)
+    import tcp_pendant.classroom.gradebook as gb
+
+    monkeypatch.setattr(gb, "default_gradebook_path", lambda: tmp_path / "data" / "class.sqlite3")
+    for argv in (["--port", "0"], ["--port", "0", "--class"], ["--port", "0", "--exercise", "mystery"]):
+        with pytest.raises(Stop):
+            main(argv)
+    assert [c.class_db for c in seen] == [None, tmp_path / "data" / "class.sqlite3",
+                                          tmp_path / "data" / "class.sqlite3"]
+    assert seen[2].exercise == "mystery"
