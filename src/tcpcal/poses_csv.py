@@ -40,8 +40,10 @@ error convention).
 from __future__ import annotations
 
 import csv
+import itertools
 import math
 import sys
+import warnings
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -297,41 +299,12 @@ def read_poses_csv(path: str | Path, *, min_rows: int = 1, max_rows: int | None 
             is turned into an ``InvalidInputError``.
     """
     text, path = _read_text(Path(path))
-
-    lines = text.splitlines()
-    content = [(i + 1, ln) for i, ln in enumerate(lines)
-               if ln.strip() and not ln.lstrip().startswith("#")]
-    del lines
-    if not content:
-        raise _error(f"{path}: the file is empty (no header row); {accepted_layouts_text()}")
-
-    header_no, header_line = content[0]
-    delim = _detect_delimiter(header_line)
-    try:
-        parsed = list(csv.reader([ln for _, ln in content], delimiter=delim, strict=True))
-    except csv.Error as exc:
-        raise _error(f"{path}: CSV syntax error: {exc}") from None
-    names = [h.strip().lower() for h in parsed[0]]
-    layout = _choose_layout(path, header_no, names)
-    pose_cols = POSITION_COLUMNS + csv_layouts()[layout].columns
-    col_index = [names.index(c) for c in pose_cols]
-    label_col = next((names.index(c) for c in ("name", "label") if c in names), None)
-    role_col = names.index("role") if "role" in names else None
-    joint_cols = _joint_columns(names)
-
-    rows = [(line_no, cells) for (line_no, _), cells in zip(content[1:], parsed[1:])]
-    del content, parsed
-    values = _row_values(path, names, pose_cols, col_index, rows)
-    line_numbers = [line_no for line_no, _ in rows]
+    body = _parse_body(text, path)
+    del text
+    layout, values, line_numbers = body.layout, body.values, body.line_numbers
 
     def where(i: int) -> str:
         return f"{path}, line {line_numbers[i]} (data row {i + 1})"
-
-    labels = [cells[label_col].strip() for _, cells in rows] if label_col is not None else []
-    roles = [cells[role_col].strip().lower() for _, cells in rows] if role_col is not None else []
-    joints = ([_joint_values(cells, joint_cols, where(i), i) for i, (_, cells) in enumerate(rows)]
-              if joint_cols else [])
-    del rows
 
     big = np.abs(values[:, :3]) > MAX_ABS_MM
     if big.any():
@@ -360,10 +333,139 @@ def read_poses_csv(path: str | Path, *, min_rows: int = 1, max_rows: int | None 
         layout=layout,
         line_numbers=tuple(line_numbers),
         path=path,
-        labels=tuple(labels) if label_col is not None else None,
-        roles=tuple(roles) if role_col is not None else None,
-        joints_deg=tuple(joints) if joint_cols else None,
+        labels=body.labels,
+        roles=body.roles,
+        joints_deg=body.joints,
     )
+
+
+@dataclass(frozen=True)
+class _Body:
+    """What the data rows of a file hold (internal; see :class:`FlangePoses`)."""
+
+    layout: str
+    values: np.ndarray  # (N, 3 + k) x, y, z (mm) then the layout's orientation columns
+    line_numbers: Sequence[int]
+    labels: tuple[str, ...] | None
+    roles: tuple[str, ...] | None
+    joints: tuple[tuple[float, ...], ...] | None
+
+
+def _content_lines(text: str, lines: list[str]) -> tuple[list[str], Sequence[int]]:
+    """The lines that are neither blank nor ``#`` comments, and their 1-based line numbers."""
+    if "#" not in text and "" not in lines and not any(map(str.isspace, lines)):
+        return lines, range(1, len(lines) + 1)  # the usual file: every line is content
+    keep = [i for i, ln in enumerate(lines) if (s := ln.strip()) and s[0] != "#"]
+    return [lines[i] for i in keep], [i + 1 for i in keep]
+
+
+def _parse_body(text: str, path: Path) -> _Body:
+    """Header, layout and every data row of the file's ``text`` (errors name file and line).
+
+    A file without quotes or NUL characters is split at its delimiter and converted a block of
+    rows at a time (:func:`_fast_rows`; 10^6 rows in about a second); any other file, or a row
+    that fast path does not take, goes through :mod:`csv` and the cell-by-cell checks, which
+    raise the error naming the first problem.
+    """
+    lines = text.splitlines()
+    content, line_nos = _content_lines(text, lines)
+    del lines
+    if not content:
+        raise _error(f"{path}: the file is empty (no header row); {accepted_layouts_text()}")
+    header_no = line_nos[0]
+    delim = _detect_delimiter(content[0])
+    if '"' not in text and "\0" not in text:
+        # no quoting: csv.reader splits each line at every delimiter, nothing else, and cannot
+        # fail; so the header splits alike and its errors come first, as they do below
+        names = [h.strip().lower() for h in content[0].split(delim)]
+        layout = _choose_layout(path, header_no, names)
+        fast = _fast_rows(content, delim, names, layout)
+        if fast is not None:
+            values, labels, roles, joints = fast
+            return _Body(layout, values, line_nos[1:], labels, roles, joints)
+    return _csv_body(path, content, line_nos, delim)
+
+
+_FAST_CHUNK = 65_536  # rows converted per block by _fast_rows (bounds the transient memory)
+
+
+def _fast_rows(content: list[str], delim: str, names: list[str], layout: str) -> tuple[
+        np.ndarray, tuple[str, ...] | None, tuple[str, ...] | None,
+        tuple[tuple[float, ...], ...] | None] | None:
+    """Values, labels, roles and joints of the data rows ``content[1:]`` when every row has the
+    header's number of cells and every pose and joint cell is a finite number; ``None``
+    otherwise (the slow path then names the problem).
+
+    The numbers are converted a block of rows at a time by :func:`numpy.loadtxt` (its C
+    parser; Python's own ``float`` parsing without underscores, so a cell it takes is a cell
+    :func:`_row_values_slow` and :func:`_joint_values` take, with the same value; a cell it
+    refuses, e.g. ``1_000``, sends the file to the slow path, which decides)."""
+    width = len(names)
+    data = content[1:]
+    n = len(data)
+    pose_cols = POSITION_COLUMNS + csv_layouts()[layout].columns
+    num_index = [names.index(c) for c in pose_cols] + [j for _, j in _joint_columns(names)]
+    label_col = next((names.index(c) for c in ("name", "label") if c in names), None)
+    role_col = names.index("role") if "role" in names else None
+    numbers = np.empty((n, len(num_index)))
+    labels: list[str] = []
+    roles: list[str] = []
+    for start in range(0, n, _FAST_CHUNK):
+        block = data[start:start + _FAST_CHUNK]
+        m = len(block)
+        if set(map(str.count, block, itertools.repeat(delim, m))) != {width - 1}:
+            return None  # a row with another number of cells (or trailing empty cells)
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("error")
+                numbers[start:start + m] = np.loadtxt(
+                    block, dtype=float, delimiter=delim, comments=None, usecols=num_index,
+                    ndmin=2, encoding=None)
+        except (ValueError, Warning):
+            return None
+        if label_col is not None or role_col is not None:
+            cells = delim.join(block).split(delim)  # m * width cells, row by row
+            if label_col is not None:
+                labels += map(str.strip, cells[label_col::width])
+            if role_col is not None:
+                roles += map(str.lower, map(str.strip, cells[role_col::width]))
+    if not np.isfinite(numbers).all():
+        return None
+    k = len(pose_cols)
+    return (numbers[:, :k],
+            tuple(labels) if label_col is not None else None,
+            tuple(roles) if role_col is not None else None,
+            tuple(map(tuple, numbers[:, k:].tolist())) if len(num_index) > k else None)
+
+
+def _csv_body(path: Path, content: list[str], line_nos: Sequence[int], delim: str) -> _Body:
+    """The rows through :mod:`csv` (quoted cells) and the cell-by-cell checks."""
+    try:
+        parsed = list(csv.reader(content, delimiter=delim, strict=True))
+    except csv.Error as exc:
+        raise _error(f"{path}: CSV syntax error: {exc}") from None
+    names = [h.strip().lower() for h in parsed[0]]
+    layout = _choose_layout(path, line_nos[0], names)
+    pose_cols = POSITION_COLUMNS + csv_layouts()[layout].columns
+    col_index = [names.index(c) for c in pose_cols]
+    label_col = next((names.index(c) for c in ("name", "label") if c in names), None)
+    role_col = names.index("role") if "role" in names else None
+    joint_cols = _joint_columns(names)
+
+    rows = list(zip(line_nos[1:], parsed[1:]))
+    del parsed
+    values = _row_values(path, names, pose_cols, col_index, rows)
+
+    def where(i: int) -> str:
+        return f"{path}, line {rows[i][0]} (data row {i + 1})"
+
+    labels = (tuple(cells[label_col].strip() for _, cells in rows) if label_col is not None
+              else None)
+    roles = (tuple(cells[role_col].strip().lower() for _, cells in rows)
+             if role_col is not None else None)
+    joints = (tuple(_joint_values(cells, joint_cols, where(i), i)
+                    for i, (_, cells) in enumerate(rows)) if joint_cols else None)
+    return _Body(layout, values, [line_no for line_no, _ in rows], labels, roles, joints)
 
 
 def _joint_columns(names: Sequence[str]) -> list[tuple[str, int]]:
