@@ -114,3 +114,18 @@ def test_auto_touch_performs_every_step_and_z_x_keep_the_last_touch_orientation(
     res = wiz.next()
     cmp = compare_with_truth(res, synth.tools["torch"].T_flange_tool_true_m)
     assert cmp.position_error_mm < 1e-9 and cmp.orientation_error_deg < 1e-6
+
+
+def test_truth_grades_both_the_tcp_and_the_frame(synth) -> None:
+    """TCP & Z, X calibrates both: a TCP 3 mm off the truth is poor even with an exact frame
+    (an orientation-only verdict would have called it good)."""
+    tool = synth.tools["torch"]
+    wiz = TcpZxWizard()
+    record_exact(wiz, tool, synth)
+    res = wiz.next()
+    T_true = tool.T_flange_tool_true_m.copy()
+    T_true[:3, 3] += np.array([0.0, 0.003, 0.0])                    # the truth 3 mm aside
+    cmp = compare_with_truth(res, T_true)
+    assert cmp.graded == ("position", "orientation") and cmp.grade == "poor"
+    assert cmp.position_error_mm == pytest.approx(3.0, abs=1e-9) and cmp.orientation_error_deg < 1e-6
+    assert "position error" in cmp.verdict and "TCP used" not in cmp.verdict

@@ -11,7 +11,8 @@ reported in mm and degrees:
 
 Verdict thresholds (``POSITION_THRESHOLDS_MM``, ``ORIENTATION_THRESHOLDS_DEG``):
 good below 0.5 mm / 0.5 deg, fair below 2 mm / 2 deg, poor otherwise. Only what the wizard
-calibrated is graded (position for the XYZ wizards, orientation for the orientation wizards);
+calibrated is graded (position for the XYZ wizards, orientation for the orientation wizards,
+both for TCP & Z, X, whose result has a TCP result and an orientation: the worse grade counts);
 the other figure is still reported.
 """
 
@@ -100,10 +101,13 @@ def compare_with_truth(result: WizardResult, T_flange_tool_true_m: Any) -> Truth
 
     parts: list[tuple[Grade, str]] = []
     graded: list[str] = []
-    if not result.orientation_calibrated:
+    calibrates_tcp = result.tcp_result is not None or not result.orientation_calibrated
+    if calibrates_tcp:          # XYZ wizards, and TCP & Z, X (TCP and orientation both graded)
         g = _grade(pos_err, POSITION_THRESHOLDS_MM)
         parts.append((g, _phrase(g, "position error", pos_err, "mm", POSITION_THRESHOLDS_MM)))
         graded.append("position")
+    if not result.orientation_calibrated:
+        pass
     elif result.method == "abc-world-5d":
         assert x_err is not None
         g = _grade(x_err, ORIENTATION_THRESHOLDS_DEG)
@@ -116,7 +120,7 @@ def compare_with_truth(result: WizardResult, T_flange_tool_true_m: Any) -> Truth
         graded.append("orientation")
     grade = max((g for g, _ in parts), key=_ORDER.__getitem__)
     verdict = f"{grade}: " + "; ".join(p for _, p in parts)
-    if result.orientation_calibrated:
+    if result.orientation_calibrated and not calibrates_tcp:
         verdict += f" (TCP used is {pos_err:.2f} mm off the true one)"
     return TruthComparison(position_error_mm=pos_err,
                            position_error_vector_mm=(float(dvec[0]), float(dvec[1]), float(dvec[2])),
