@@ -27,7 +27,7 @@ angles in degrees; poses are 4x4 row-major nested lists; times ISO 8601 UTC. The
       "wizards": [
         {
           "state": {                              # Wizard.to_dict()
-            "kind": "xyz4" | "reference" | "three-point" | "abc-world",
+            "kind": "xyz4" | "reference" | "tcp-zx" | "three-point" | "abc-world" (any registered),
             "params": {...},                      # constructor options of that wizard:
                 # xyz4: n_points, estimator, assumed_sigma_mm, base_tool (Tool.to_dict or null),
                 #       excluded (0-based touch indices)
