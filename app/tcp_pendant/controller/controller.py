@@ -10,6 +10,14 @@ Frames (metres and radians inside; the pendant-facing arguments say mm / deg in 
   ``T_flange_tool`` from its ``tcp_mm`` and KUKA ``abc_deg``; the flange when no tool is active.
 * true TOOL: the mounted tool's hidden ``T_flange_tool_true`` (from its URDF).
 
+Two robot models: ``kinematics`` is the controller's NOMINAL model (readouts, recorded flange
+poses, jogs, the TCP check's motion); ``true_kinematics`` is the PHYSICAL robot (default the
+same object), which differs in the absolute-accuracy scenario (``scenarios.py``): where the
+true tool tip really is (:meth:`VirtualController.T_world_tool_true`,
+:meth:`VirtualController.touch_geometry`) and where auto-approach and
+:meth:`VirtualController.move_true_tool_to` put it (their IK runs on the physical robot, as a
+technician's eye does) come from it.
+
 Jogging follows ``jog.py`` (damped least squares, sub-stepped, safety rules); see
 :meth:`VirtualController.jog_cartesian` for the axis conventions.
 """
@@ -85,6 +93,8 @@ class VirtualController:
         active_tool: the tool data the controller believes (None: TCP = flange).
         T_world_base: BASE frame (4,4, metres).
         settings: jog tuning (``jog.JogSettings``).
+        true_kinematics: the physical robot when it differs from the model (the
+            absolute-accuracy scenario); default ``kinematics`` itself. Same joints.
 
     Not thread-safe: the app's session serialises calls with its lock.
     """
@@ -92,8 +102,11 @@ class VirtualController:
     def __init__(self, kinematics: RobotKinematics, *, tool: ToolModel,
                  reference_tip_world_m: Sequence[float] | np.ndarray | None = None,
                  active_tool: Tool | None = None, T_world_base: np.ndarray | None = None,
-                 settings: JogSettings = DEFAULT_SETTINGS) -> None:
+                 settings: JogSettings = DEFAULT_SETTINGS,
+                 true_kinematics: RobotKinematics | None = None) -> None:
         self.kinematics = kinematics
+        self._true_kin = kinematics
+        self.set_true_kinematics(true_kinematics)
         self.settings = settings
         self._q = np.array(kinematics.home_rad, dtype=float)
         self._sigma: tuple[np.ndarray, float] | None = None  # (q, sigma_min at q) of the last path
@@ -138,6 +151,27 @@ class VirtualController:
     def go_home(self) -> None:
         """Teleport to the home configuration."""
         self._q = np.array(self.kinematics.home_rad, dtype=float)
+
+    @property
+    def true_kinematics(self) -> RobotKinematics:
+        """The physical robot (``kinematics`` itself unless a scenario perturbed it)."""
+        return self._true_kin
+
+    def set_true_kinematics(self, true_kinematics: RobotKinematics | None) -> None:
+        """Set the physical robot (None: the nominal model itself).
+
+        Raises:
+            ControllerError: a robot with other joints than the nominal model.
+        """
+        if true_kinematics is None:
+            self._true_kin = self.kinematics
+            return
+        if not isinstance(true_kinematics, RobotKinematics):
+            raise ControllerError(f"true_kinematics must be a RobotKinematics, got {type(true_kinematics).__name__}.")
+        if tuple(true_kinematics.joint_names) != tuple(self.kinematics.joint_names):
+            raise ControllerError(f"true_kinematics has joints {', '.join(true_kinematics.joint_names)} but the "
+                                  f"model has {', '.join(self.kinematics.joint_names)}; give the same robot.")
+        self._true_kin = true_kinematics
 
     @property
     def mounted_tool(self) -> ToolModel:
@@ -199,9 +233,14 @@ class VirtualController:
         """Active TCP (tool data) pose in WORLD: ``T_world_flange @ T_flange_tool``."""
         return self.T_world_flange() @ self._T_flange_tool
 
+    def T_world_flange_true(self) -> np.ndarray:
+        """Where the physical robot's flange really is (``true_kinematics``), (4,4) metres."""
+        return self._true_kin.T_world_flange(self._q)
+
     def T_world_tool_true(self) -> np.ndarray:
-        """Hidden true TOOL pose in WORLD: ``T_world_flange @ T_flange_tool_true``."""
-        return self.T_world_flange() @ self._tool.T_flange_tool_true
+        """Hidden true TOOL pose in WORLD on the physical robot:
+        ``true_kinematics.T_world_flange(q) @ T_flange_tool_true``."""
+        return self.T_world_flange_true() @ self._tool.T_flange_tool_true
 
     def link_poses(self) -> dict[str, np.ndarray]:
         """``T_world_link`` for every robot link (scene updates)."""
@@ -315,7 +354,7 @@ class VirtualController:
         return self._ik_move(T, "That pose of the true TOOL frame")
 
     def _ik_move(self, T_world_tooltrue: np.ndarray, what: str) -> JogResult:
-        sol = solve_ik(self.kinematics, T_world_tooltrue, self._q,
+        sol = solve_ik(self._true_kin, T_world_tooltrue, self._q,
                        T_flange_tcp=self._tool.T_flange_tool_true)
         if not sol.ok:
             p = T_world_tooltrue[:3, 3] * 1000.0

@@ -9,7 +9,8 @@ and scipy's Euler conversion once per step; :func:`pose_state` runs pinocchio's 
 * ``T_world_flange = T_world_link[flange_link]`` (the same pinocchio frame placement as
   ``controller.T_world_flange()``),
 * ``T_world_tcp = T_world_flange @ T_flange_tool`` (active tool data),
-* ``T_world_tool_true = T_world_flange @ T_flange_tool_true`` (mounted tool, hidden),
+* ``T_world_tool_true = T_world_flange @ T_flange_tool_true`` (mounted tool, hidden; on the
+  physical robot ``controller.true_kinematics`` when it differs from the model: one more FK),
 * the readout (``controller.readout``) and the touch geometry (``controller.touch_geometry``)
   from those, with the readout's A, B, C by :func:`tcp_pendant.controller.rotations.kuka_abc_deg`.
 
@@ -82,7 +83,7 @@ def pose_state_key(controller: VirtualController) -> tuple[object, ...]:
     """What a :class:`PoseState` depends on: joint angles, active tool data, mounted tool,
     reference tip, BASE frame and the robot model. Equal keys, equal states."""
     c = controller
-    return (id(c.kinematics), c.q_rad.tobytes(), c.T_flange_tool.tobytes(), id(c.mounted_tool),
+    return (id(c.kinematics), id(c.true_kinematics), c.q_rad.tobytes(), c.T_flange_tool.tobytes(), id(c.mounted_tool),
             c.reference_tip_world_m.tobytes(), c.T_world_base.tobytes())
 
 
@@ -103,7 +104,8 @@ def pose_state(controller: VirtualController, key: tuple[object, ...] | None = N
     links = dict(zip(names, stacked))
     T_world_flange = links[k.flange_link]
     T_world_tcp = T_world_flange @ c.T_flange_tool
-    T_world_true = T_world_flange @ c.mounted_tool.T_flange_tool_true
+    T_true_flange = T_world_flange if c.true_kinematics is k else c.T_world_flange_true()
+    T_world_true = T_true_flange @ c.mounted_tool.T_flange_tool_true
     angles = {name: (math.degrees(v) if k.revolute[i] else v * 1000.0)
               for i, (name, v) in enumerate(zip(k.joint_names, q.tolist()))}
     for T in (T_world_tcp, T_world_true):
