@@ -337,3 +337,23 @@ def test_cli_solves_1e5_rows_in_process(tmp_path: Path, capsys: pytest.CaptureFi
     # 0.5 mm noise on 10^5 touches: the TCP within a few hundredths of a millimetre
     assert np.linalg.norm(np.array(out["tcp_mm"]) - tcp) < 0.05
     assert out["rms_error_mm"] == pytest.approx(0.5 * math.sqrt(3), rel=0.05)
+
+
+def test_bench_cli_table_runs_the_command(capsys: pytest.CaptureFixture[str]) -> None:
+    """Table 6 of tests/bench/bench_solver.py (a small file here): both outputs exit 0 and get a
+    time, a CPU time, a peak RSS and an output size."""
+    import importlib.util
+
+    bench = Path(__file__).resolve().parents[1] / "bench" / "bench_solver.py"
+    spec = importlib.util.spec_from_file_location("bench_solver_cli_table", bench)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    module.print_cli_table((2_000,))
+    rows = [ln.split() for ln in capsys.readouterr().out.splitlines()
+            if ln.split()[:2] in (["text", "2,000"], ["--json", "2,000"])]
+    assert [r[0] for r in rows] == ["text", "--json"], rows
+    for r in rows:
+        wall, cpu, rss, size = map(float, r[2:6])
+        assert wall > 0 and cpu > 0 and 10 < rss < 2048 and size > 0.05
+        assert "EXIT" not in r
