@@ -46,7 +46,7 @@ def test_name_prompt_records_the_trainee_and_escapes_the_name(app_factory, tmp_p
             assert db.execute("SELECT mode, ended_at FROM sessions").fetchall() == [("per-browser", None)]
     finally:
         c.close()
-    wait_until(lambda: not app.sessions, what="the session closed")
+    wait_until(lambda: app.classroom.trainee_statuses()[0].connected is False, what="the session closed")
     with Gradebook(tmp_path / "class.sqlite3") as book, book._read() as db:
         assert db.execute("SELECT ended_at FROM sessions").fetchone()[0] is not None
 

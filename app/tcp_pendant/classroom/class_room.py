@@ -113,14 +113,15 @@ class ClassRoom:
     def detach(self, session: Session) -> None:
         """The session closed (its browser left)."""
         with self._lock:
-            entry = self._trainees.pop(id(session), None)
+            entry = self._trainees.get(id(session))
             self._trainer_views.pop(id(session), None)
         if entry is not None:
             try:
                 entry[1].disconnected()
             except Exception:
                 log.exception("ending the gradebook session of %r failed", entry[2])
-            with self._lock:
+            with self._lock:                 # one step: the row is never missing from the table
+                self._trainees.pop(id(session), None)
                 self._left.append(entry[1].status)
         self._hand_to_loop(self.refresh_trainers)
 

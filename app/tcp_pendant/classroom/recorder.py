@@ -53,7 +53,7 @@ class TraineeStatus:
         step: "Step k of n", "result", "cancelled" or "".
         touches: touches stored in this session (overwritten ones included).
         crashes: crashes in this session.
-        last_result: the last result in words ("TCP 12.0, 0.1, 180.3 mm") or "".
+        last_result: the last result's TCP, mm ("12.0, 0.1, 180.3") or "".
         grade: the last grade ("good" | "fair" | "poor") or "".
         exercise: the exercise of the session ("" none, "mystery").
     """
@@ -115,8 +115,8 @@ class TraineeRecorder:
     def disconnected(self) -> None:
         """The browser left: the gradebook session ends, the row says "not connected"."""
         with self._lock:
-            self._status = TraineeStatus(**{**self._status.__dict__, "connected": False})
             self.gradebook.end_session(self.session_id)
+            self._status = TraineeStatus(**{**self._status.__dict__, "connected": False})
 
     # ------------------------------------------------------------ the change signal
     def on_change(self, change: Any) -> None:
@@ -216,7 +216,7 @@ class TraineeRecorder:
         st.result = result
         st.status = "finished"
         tcp = ", ".join(f"{v:.1f}" for v in result.tcp_mm)
-        self._status = TraineeStatus(**{**self._status.__dict__, "last_result": f"TCP {tcp} mm",
+        self._status = TraineeStatus(**{**self._status.__dict__, "last_result": tcp,
                                         "grade": grade or ""})
 
     def _update_status(self) -> None:

@@ -83,5 +83,3 @@ class IdentityPrompt:
             self.message.content = "⚠ That trainer token is not right; type the token the server printed."
             return
         self.modal.close()
-        self.banner.content = "**Trainer view**"
-        self.banner.visible = True

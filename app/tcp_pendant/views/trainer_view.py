@@ -40,6 +40,7 @@ class ClassControl(Protocol):
 
     tool_keys: Sequence[str]
     gradebook: Gradebook
+    exercise: str | None
 
     def trainee_statuses(self) -> list[TraineeStatus]: ...
 
@@ -58,11 +59,12 @@ def trainees_markdown(rows: Sequence[TraineeStatus]) -> str:
     """The live table of trainees (markdown, every text escaped)."""
     if not rows:
         return "*No trainee has given a name yet.*"
-    lines = ["| Trainee | Connected | Method | Step | Touches | Crashes | Last result | Grade |",
-             "|---|---|---|---|---|---|---|---|"]
+    lines = ["| Trainee | On | Method: step | Touches | Crashes | Last TCP mm | Grade |",
+             "|---|---|---|---|---|---|---|"]
     for r in rows:
-        lines.append(f"| {_cell(r.name)} | {'yes' if r.connected else 'no'} | {_cell(r.method)} | "
-                     f"{_cell(r.step)} | {r.touches} | {r.crashes} | {_cell(r.last_result)} | {_cell(r.grade)} |")
+        doing = f"{r.method}: {r.step}" if r.method else ""
+        lines.append(f"| {_cell(r.name)} | {'yes' if r.connected else 'no'} | {_cell(doing)} | "
+                     f"{r.touches} | {r.crashes} | {_cell(r.last_result)} | {_cell(r.grade)} |")
     return "\n".join(lines)
 
 
@@ -113,7 +115,8 @@ class TrainerView:
             gui.add_markdown("**Gradebook**")
             self.grades_md = gui.add_markdown("")
             self.download = gui.add_button("Download grades (CSV)")
-            self.exercise = gui.add_dropdown("Exercise", tuple(EXERCISES), initial_value=tuple(EXERCISES)[0])
+            current = next((label for label, ex in EXERCISES.items() if ex == control.exercise), "Free practice")
+            self.exercise = gui.add_dropdown("Exercise", tuple(EXERCISES), initial_value=current)
             tools = ("(keep)", *control.tool_keys)
             self.tool = gui.add_dropdown("Tool for all", tools, initial_value=tools[0])
             self.push = gui.add_button("Push to all trainees", color="blue")
