@@ -125,10 +125,10 @@ class TraineeRecorder:
             state = getattr(change, "state", None)
             if state is not None:
                 self._check_crash(bool(state.touch.crashed), float(state.touch.penetration_mm))
-            if self.workflow is not None and (getattr(change, "wizard", False) or getattr(change, "touches", False)
-                                              or getattr(change, "pose", False)):
+            # a jog step (pose only) costs the crash check alone: every wizard event comes with `wizard`
+            if self.workflow is not None and (getattr(change, "wizard", False) or getattr(change, "touches", False)):
                 self._sync_runs()
-            self._update_status()
+                self._update_status()
 
     def _current_calibration(self) -> int | None:
         run = None if self.workflow is None else self.workflow.run
