@@ -152,6 +152,11 @@ class Session:
             only: views never reach each other through it.
         scene_labels: the scene's labels at the tool and the tip (``"flange"``, ``"tool"``,
             ``"tip"``: viser label handles), which the wizards' scene places apart.
+        workflow: the session's ``CalibrationWorkflow`` (the Calibrate tab's wizards), set once
+            when the views are built (None without the wizards plug-in); the Jog tab's wizard
+            dock renders its state and calls its commands.
+        hide_distance: "Hide distance" (training: judge the touch by eye); change it with
+            :meth:`set_hide_distance`.
     """
 
     controller: VirtualController
@@ -166,6 +171,8 @@ class Session:
     ready_q_rad: np.ndarray | None = None
     views: dict[str, Any] = field(default_factory=dict)
     scene_labels: dict[str, Any] = field(default_factory=dict)
+    workflow: Any | None = None
+    hide_distance: bool = False
 
     def __post_init__(self) -> None:
         if self.target is None:
@@ -262,6 +269,14 @@ class Session:
         """After a move of the robot (a jog, the gizmo, Home, an auto-touch): the change signal
         with ``pose`` (and the move's outcome ``jog`` for the status line)."""
         self.changed(pose=True, jog=jog)
+
+    def set_hide_distance(self, hide: bool) -> None:
+        """"Hide distance" on or off: the readouts re-render (a ``pose`` change)."""
+        with self.lock:
+            if bool(hide) == self.hide_distance:
+                return
+            self.hide_distance = bool(hide)
+            self.changed(pose=True)
 
     def refresh(self) -> None:
         """Re-render everything that shows the robot (the same signal as :meth:`moved`)."""
@@ -435,5 +450,6 @@ class Session:
         self.scene_labels.clear()
         self._pose_state = None
         self.calibrate_container = None
+        self.workflow = None
         self.client = None
         self.target = None

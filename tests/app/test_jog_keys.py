@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import re
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -59,8 +60,9 @@ def test_holding_a_key_jogs_continuously_and_the_click_that_ends_it_does_not(app
             x0 = s.controller.T_world_tcp()[0, 3]
         moves: list[int] = []
         s.add_motion_listener(lambda: moves.append(1))
-        for _ in range(3):
+        for _ in range(3):                                 # a browser's ticks, 1/HOLD_HZ apart
             client.hold_tick(PLUS_X, HOLD_HZ)
+            time.sleep(1.0 / HOLD_HZ)
         wait_until(lambda: len(moves) == 3, what="three hold ticks")
         x3 = s.controller.T_world_tcp()[0, 3]
         assert x3 > x0                                    # moved along +X while held

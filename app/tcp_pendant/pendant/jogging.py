@@ -7,8 +7,16 @@ the frame through the TCP, KUKA habit). Each -/+ key press moves
 * by the selected increment (100, 10, 1, 0.1 mm or deg) when the increment is not continuous;
 * in continuous mode, by ``speed * override * dt`` for every tick of the held key, where
   ``speed`` is the manual-mode speed at 100 % override: 250 mm/s (KUKA T1 limit), 30 deg/s
-  for A/B/C and for joints, and ``dt`` (s) the time since the previous tick (clamped to
-  ``MAX_TICK_S`` so a stalled browser cannot produce a jump).
+  for A/B/C and for joints, and ``dt`` (s) the time since the previous executed tick, clamped
+  to ``MAX_TICK_S`` (one 20 Hz tick: no step is larger than the speed allows at 20 Hz, even
+  after a stall). A tick that arrives less than half a tick after the previous executed one
+  is a backlog (the server fell behind the browser's 20 Hz): it is skipped, so the key stops
+  within one tick of its release instead of working off queued ticks.
+
+Stop at contact (a real touch-up): a Cartesian X/Y/Z press or tick whose tool-tip path would
+pass through the reference tip (closer than ``guidance.CONTACT_RADIUS_MM`` to it, beyond the
+closest point) stops at the closest point and says so (``JogResult.stopped_by == "contact"``);
+the next press in the same direction goes on (the tip is touching; that is the warning).
 """
 
 from __future__ import annotations
@@ -19,7 +27,10 @@ from collections.abc import Callable
 from dataclasses import dataclass, replace
 from enum import Enum
 
+import numpy as np
+
 from tcp_pendant.controller import ControllerError, JogFrame, JogResult, VirtualController
+from tcp_pendant.pendant.guidance import contact_stop
 
 __all__ = [
     "CARTESIAN_AXES",
@@ -43,7 +54,8 @@ CARTESIAN_AXES: tuple[str, ...] = ("X", "Y", "Z", "A", "B", "C")
 LINEAR_SPEED_MM_S = 250.0
 ROTATION_SPEED_DEG_S = 30.0
 JOINT_SPEED_DEG_S = 30.0
-MAX_TICK_S = 0.15
+MAX_TICK_S = 0.05
+"""Largest ``dt`` of one continuous tick (s): one tick at the pendant's 20 Hz."""
 
 
 class JogMode(str, Enum):
@@ -126,6 +138,7 @@ class Jogger:
         self._clock = clock
         self._tick_s = tick_s
         self._last_tick: dict[str, float] = {}
+        self._held_at_contact: str | None = None
 
     def key(self, axis: str | int, sign: int, *, hold_tick: bool = False) -> JogResult | None:
         """One press of a -/+ key.
@@ -153,18 +166,55 @@ class Jogger:
         name = f"{axis}{sign}"
         dt = None
         if s.continuous:
+            if self._held_at_contact == name:
+                return None
             now = self._clock()
             last = self._last_tick.get(name)
-            dt = self._tick_s if last is None or now - last > 2 * MAX_TICK_S else now - last
+            if last is not None and now - last < 0.5 * self._tick_s:
+                return None                          # a queued tick of a server behind: skipped
+            dt = self._tick_s if last is None or now - last > 4 * self._tick_s else now - last
             self._last_tick = {name: now}
         if isinstance(axis, int) and not isinstance(axis, bool):
             return self.controller.jog_joint(axis, sign * s.step_amount(rotational=True, joint=True, dt_s=dt))
         ax = str(axis).upper()
         if ax not in CARTESIAN_AXES:
             raise ControllerError(f"Jog keys are joint indices or X, Y, Z, A, B, C; got {axis!r}.")
-        amount = s.step_amount(rotational=ax in "ABC", dt_s=dt)
-        return self.controller.jog_cartesian(s.frame, ax, sign * amount)
+        amount = sign * s.step_amount(rotational=ax in "ABC", dt_s=dt)
+        if ax in "XYZ":
+            res = self._translate(ax, amount)
+            if s.continuous and res.stopped_by == "contact":
+                self._held_at_contact = name         # this hold stays stopped until released
+            return res
+        return self.controller.jog_cartesian(s.frame, ax, amount)
+
+    def frame_rotation(self) -> np.ndarray:
+        """``R_world_frame`` of the selected jog frame now (the axes the X/Y/Z keys move along)."""
+        c = self.controller
+        f = self.settings.frame
+        if f == "WORLD":
+            return np.eye(3)
+        if f == "BASE":
+            return np.asarray(c.T_world_base)[:3, :3]
+        if f == "FLANGE":
+            return c.T_world_flange()[:3, :3]
+        return c.T_world_tcp()[:3, :3]
+
+    def _translate(self, ax: str, amount_mm: float) -> JogResult:
+        """A translation of ``amount_mm`` along axis ``ax`` of the jog frame, stopped at contact
+        (module docstring)."""
+        c = self.controller
+        step_m = self.frame_rotation()[:, "XYZ".index(ax)] * (amount_mm / 1000.0)
+        stop = contact_stop(c.T_world_tool_true()[:3, 3], step_m, c.reference_tip_world_m)
+        if stop is None:
+            return c.jog_cartesian(self.settings.frame, ax, amount_mm)
+        res = c.jog_cartesian(self.settings.frame, ax, amount_mm * stop.fraction)
+        if not res.ok:
+            return res
+        return JogResult(False, stop.fraction, "contact",
+                         f"Stopped at the reference tip after {abs(amount_mm) * stop.fraction:.2f} of "
+                         f"{abs(amount_mm):g} mm (touch-up: the tool tip touches it). Press again to go on.")
 
     def release(self) -> None:
-        """Forget the hold timing (key released)."""
+        """Forget the hold timing and a stop at contact (key released)."""
         self._last_tick = {}
+        self._held_at_contact = None

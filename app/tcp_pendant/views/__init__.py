@@ -2,7 +2,7 @@
 "Calibrate" tab where the wizard views plug in (see ``tcp_pendant.views.calibrate``).
 
 :func:`build_session_views` lays a session out as three tabs, like a pendant's menu:
-**Jog** (readouts, touch indicator, jog keys, touches), **Tool** (mounted tool, active tool
+**Jog** (the running wizard's step dock, readouts, touch indicator, jog keys, touches), **Tool** (mounted tool, active tool
 data, library, export, numeric entry) and **Calibrate** (wizards).
 """
 
@@ -14,12 +14,14 @@ from tcp_pendant.views.pendant_panel import PendantPanel
 from tcp_pendant.views.scene import SceneView
 from tcp_pendant.views.tool_panel import ToolPanel
 from tcp_pendant.views.touch_list import TouchListView
+from tcp_pendant.views.wizard_dock import WizardDock
 
 __all__ = [
     "PendantPanel",
     "SceneView",
     "ToolPanel",
     "TouchListView",
+    "WizardDock",
     "build_calibrate_tab",
     "build_session_views",
     "register_calibrate_view",
@@ -39,10 +41,12 @@ def build_session_views(session: Session, *, title: str = "TCP Pendant") -> None
         gui.add_markdown(f"### {title}")
         tabs = gui.add_tab_group()
         with tabs.add_tab("Jog"):
+            session.views["dock"] = WizardDock(session)      # the running wizard's step, on top
             session.views["pendant"] = PendantPanel(session)
             session.views["touches"] = TouchListView(session)
         with tabs.add_tab("Tool"):
             session.views["tools"] = ToolPanel(session)
         build_calibrate_tab(session, tabs.add_tab("Calibrate"))
+        session.workflow = getattr(session.views.get("calibrate"), "workflow", None)
         session.views["tabs"] = tabs
     session.changed(pose=True, tool=True)

@@ -1,9 +1,15 @@
 """The jog panel of one session, laid out like a teach pendant (viser GUI).
 
-Top to bottom: TCP readout (frame + tool), touch indicator with "Hide distance", the status
-line (why a jog stopped), the jog selectors (mode, frame, increment, override), the jog keys
-(Cartesian -/+ X Y Z A B C, or per-joint slider and -/+ keys with the axis name and limits),
-Home, the camera buttons, and the touches ("Record point" and the list, deletable one by one).
+Top to bottom (below the wizard dock, ``views.wizard_dock``): TCP readout (frame + tool), the
+touch indicator with the offset "ΔX ΔY ΔZ mm" of the reference tip along the jog frame's axes
+(both hidden by "Hide distance"), the status line (why a jog stopped), the increment, the jog
+keys - one row per axis with − and + side by side (X Y Z A B C, or A1..A6; in continuous mode
+the hold-to-jog keys, two per axis, since only single buttons report a hold) - then the jog
+settings (mode, frame, override, readout frame), the magnified close-up of the tips, the
+joints, Home and the camera buttons; the touches ("Record point" and the list) follow.
+Every button group marks its selected option with "✓ " (viser's button groups show no
+selection); a click's value is read without the mark. viser has no keyboard events for the
+GUI panel, so there are no keyboard shortcuts (README).
 
 Widgets only call :class:`tcp_pendant.pendant.Jogger` and the session; all text comes from
 ``tcp_pendant.pendant.formatting``. Every callback runs on viser's event loop
@@ -34,6 +40,7 @@ from tcp_pendant.pendant import (
     tcp_readout_markdown,
     touch_indicator_markdown,
 )
+from tcp_pendant.pendant.guidance import offset_markdown, side_view_markdown, tip_offset_mm
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.views.scene import closeup_camera, overview_camera
 
@@ -42,7 +49,7 @@ try:                                   # viser's message type (hot path); public
 except ImportError:                    # pragma: no cover
     GuiUpdateMessage = None
 
-__all__ = ["HOLD_HZ", "PendantPanel", "set_markdown"]
+__all__ = ["HOLD_HZ", "MARK", "PendantPanel", "marked", "set_markdown", "unmarked"]
 
 HOLD_HZ = 20.0
 """Rate of the hold-to-jog callbacks (continuous jog ticks per second)."""
@@ -50,6 +57,20 @@ HOLD_HZ = 20.0
 _AXIS_HINT = {"X": "translate along X (mm)", "Y": "translate along Y (mm)", "Z": "translate along Z (mm)",
               "A": "rotate about Z through the TCP (deg)", "B": "rotate about Y through the TCP (deg)",
               "C": "rotate about X through the TCP (deg)"}
+
+
+MARK = "✓ "
+"""Prefix of the selected option of a button group."""
+
+
+def marked(options: tuple[str, ...], selected: str) -> tuple[str, ...]:
+    """``options`` with the selected one marked (``"✓ 10"``)."""
+    return tuple(MARK + o if o == selected else o for o in options)
+
+
+def unmarked(label: str) -> str:
+    """A button group's value without the selection mark."""
+    return label[len(MARK):] if label.startswith(MARK) else label
 
 
 def set_markdown(handle: Any, text: str) -> None:
@@ -86,24 +107,33 @@ class PendantPanel:
         self._from_client: dict[int, float] = {}   # slider -> angle (deg, 0.01) its browser value set
         self._last_text: dict[str, str] = {}
         self._last_stop = ""
+        self._stop_key: Any = None
 
-        self.readout_frame = gui.add_button_group("Readout", ("WORLD", "BASE"))
+        st = session.jogger.settings
+        self._readout = "WORLD"
         self.tcp_md = gui.add_markdown("")
         self.touch_md = gui.add_markdown("")
-        self.hide_distance = gui.add_checkbox("Hide distance", False,
-                                              hint="Training: judge the touch by eye, as on a real robot.")
+        self.hide_distance = gui.add_checkbox("Hide distance", session.hide_distance,
+                                              hint="Training: judge the touch by eye, as on a real robot "
+                                                   "(hides the distance, the Δ offsets and the close-up).")
         self.status_md = gui.add_markdown("")
+        self.increment = gui.add_button_group("Increment", marked(INCREMENTS, st.increment),
+                                              hint="mm for X/Y/Z, deg for A/B/C and joints; Cont. = hold to jog")
 
-        with gui.add_folder("Jog settings"):
-            self.mode = gui.add_button_group("Mode", (JogMode.CARTESIAN.value, JogMode.JOINT.value))
-            self.frame = gui.add_dropdown("Jog frame", JOG_FRAMES, initial_value=session.jogger.settings.frame)
-            self.increment = gui.add_button_group("Increment", INCREMENTS,
-                                                  hint="mm for X/Y/Z, deg for A/B/C and joints; Cont. = hold to jog")
-            self.override = gui.add_slider("Override %", min=1, max=100, step=1,
-                                           initial_value=session.jogger.settings.override_pct)
-            self.settings_md = gui.add_markdown("")
+        # compact keys: one row per axis (− and + side by side); clicks only
+        self.cart_rows: dict[str, Any] = {}
+        for ax in CARTESIAN_AXES:
+            row = gui.add_button_group(ax, (f"{ax} −", f"{ax} +"), hint=_AXIS_HINT[ax])
+            row.on_click(session.on_loop(self._row_cb(ax)))
+            self.cart_rows[ax] = row
+        self.joint_rows: list[Any] = []
+        for i, name in enumerate(k.joint_names):
+            row = gui.add_button_group(name, (f"{name} −", f"{name} +"), visible=False)
+            row.on_click(session.on_loop(self._row_cb(i)))
+            self.joint_rows.append(row)
 
-        self.cart_folder = gui.add_folder("Cartesian jog")
+        # hold-to-jog keys (continuous mode): viser reports holds of single buttons only
+        self.cart_folder = gui.add_folder("Cartesian jog (hold)", visible=False)
         with self.cart_folder:
             self.cart_buttons: dict[tuple[str, int], Any] = {}
             for ax in CARTESIAN_AXES:
@@ -128,6 +158,14 @@ class PendantPanel:
                     self._wire_key(b, i, sign)
                     self.joint_buttons[(i, sign)] = b
 
+        with gui.add_folder("Jog settings"):
+            self.mode = gui.add_button_group("Mode", marked((JogMode.CARTESIAN.value, JogMode.JOINT.value),
+                                                            st.mode.value))
+            self.frame = gui.add_dropdown("Jog frame", JOG_FRAMES, initial_value=st.frame)
+            self.override = gui.add_slider("Override %", min=1, max=100, step=1, initial_value=st.override_pct)
+            self.readout_frame = gui.add_button_group("Readout", marked(("WORLD", "BASE"), self._readout))
+            self.settings_md = gui.add_markdown("")
+        self.closeup_md = gui.add_markdown("")
         self.joints_md = gui.add_markdown("")
         self.home = gui.add_button("Ready pose", hint="Back to the start pose (teleport): HOME with the "
                                    "flange pointing down.")
@@ -142,8 +180,8 @@ class PendantPanel:
         self.frame.on_update(g(self._setting("frame", str)))
         self.increment.on_click(g(self._setting("increment", str)))
         self.override.on_update(g(self._setting("override_pct", float)))
-        self.readout_frame.on_click(g(lambda _e: self.render()))
-        self.hide_distance.on_update(g(lambda _e: self.render()))
+        self.readout_frame.on_click(g(self._on_readout_frame))
+        self.hide_distance.on_update(g(self._on_hide_distance))
         self.home.on_click(g(self._on_home))
         self.kuka_home.on_click(g(self._on_kuka_home))
         self.closeup.on_click(g(self._on_camera(True)))
@@ -152,10 +190,14 @@ class PendantPanel:
         session.subscribe(self.on_change)
 
     def on_change(self, change: SessionChange) -> None:
-        """The change signal: the status line from the move's outcome, the readouts from the
-        change's pose state."""
+        """The change signal: the status line from the move's outcome (a move that is not a
+        jog - auto-touch, Home, a wizard's tool change - clears a stop message it made stale),
+        the readouts from the change's pose state."""
         if change.jog is not None:
             self.show_jog_result(change.jog)
+            self._stop_key = None if change.state is None else change.state.key
+        elif change.pose and self._last_stop and change.state is not None and change.state.key != self._stop_key:
+            self.show_jog_result(JogResult(True, 1.0, None, ""))
         if change.pose:
             self.render(change.state)
 
@@ -177,6 +219,26 @@ class PendantPanel:
         if res is None:
             return
         self.session.moved(res)
+
+    def _row_cb(self, axis: str | int) -> Any:
+        """Click on a compact key row: the value is the key's label ("X +", "A3 −")."""
+        def cb(event: Any) -> None:
+            sign = 1 if str(event.target.value).endswith("+") else -1
+            self._jog(axis, sign, hold_tick=False)
+        return cb
+
+    def _on_readout_frame(self, event: Any) -> None:
+        value = unmarked(str(event.target.value))
+        if value not in ("WORLD", "BASE"):
+            raise ValueError(f"Unknown readout frame {value!r}; use WORLD or BASE.")
+        self._readout = value
+        self.readout_frame.options = marked(("WORLD", "BASE"), value)
+        self.render()
+
+    def _on_hide_distance(self, event: Any) -> None:
+        if event is not None and getattr(event, "client", 1) is None:
+            return                                   # our own assignment
+        self.session.set_hide_distance(bool(self.hide_distance.value))
 
     def _slider_cb(self, index: int) -> Any:
         """The callback of joint slider ``index`` (0-based): set the joint to the browser's
@@ -208,7 +270,8 @@ class PendantPanel:
         group's value is the option just clicked)."""
         def cb(event: Any) -> None:
             js = self.session.jogger
-            js.settings = js.settings.with_(**{name: kind(event.target.value)})
+            value = event.target.value
+            js.settings = js.settings.with_(**{name: kind(unmarked(value) if isinstance(value, str) else value)})
             js.release()
             self._show_settings()
             self.render()
@@ -217,9 +280,21 @@ class PendantPanel:
     def _show_settings(self) -> None:
         st = self.session.jogger.settings
         joint = st.mode is JogMode.JOINT
-        self.cart_folder.visible = not joint
+        hold = st.continuous
+        for row in self.cart_rows.values():
+            row.visible = not joint and not hold
+        for row in self.joint_rows:
+            row.visible = joint and not hold
+        self.cart_folder.visible = not joint and hold
         self.joint_folder.visible = joint
+        for b in self.joint_buttons.values():
+            b.visible = hold
         self.frame.disabled = joint
+        for group, options, value in ((self.increment, INCREMENTS, st.increment),
+                                      (self.mode, (JogMode.CARTESIAN.value, JogMode.JOINT.value), st.mode.value)):
+            want = marked(options, value)
+            if tuple(group.options) != want:
+                group.options = want
         unit = "deg" if joint else "mm / deg"
         step = "continuous while held" if st.continuous else f"{st.increment} {unit} per press"
         where = "joints" if joint else f"{st.frame} frame"
@@ -266,11 +341,23 @@ class PendantPanel:
         value of it put it is not written (module docstring)."""
         s = self.session
         state = s.pose_state() if state is None else state
-        frame = "BASE" if self.readout_frame.value == "BASE" else "WORLD"
+        frame = self._readout
         tool = s.controller.active_tool
         self._set_md(self.tcp_md, "tcp", tcp_readout_markdown(state.readout(frame), None if tool is None else tool.name))
-        self._set_md(self.touch_md, "touch", touch_indicator_markdown(state.touch,
-                                                                      hide_distance=bool(self.hide_distance.value)))
+        hide = s.hide_distance
+        if bool(self.hide_distance.value) != hide:
+            self.hide_distance.value = hide
+        touch = touch_indicator_markdown(state.touch, hide_distance=hide)
+        closeup = ""
+        if not hide:
+            jf = s.jogger.settings.frame
+            delta = tip_offset_mm(state, s.controller.reference_tip_world_m, jf)
+            touch += "\n\n" + offset_markdown(delta, jf)
+            closeup = side_view_markdown(delta, jf)
+        self._set_md(self.touch_md, "touch", touch)
+        self._set_md(self.closeup_md, "closeup", closeup)
+        if self.closeup_md.visible != bool(closeup):
+            self.closeup_md.visible = bool(closeup)
         angles = state.joint_angles_deg
         self._set_md(self.joints_md, "joints", joint_readout_markdown(angles))
         if not self.joint_folder.visible:

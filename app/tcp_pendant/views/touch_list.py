@@ -25,9 +25,13 @@ class TouchListView:
         session.subscribe(self.on_change)
 
     def on_change(self, change: SessionChange) -> None:
-        """The change signal: redraw the rows when the touches changed."""
+        """The change signal: redraw the rows when the touches changed; "Record point" is
+        hidden while a wizard is open (one Record concept: the wizard dock's Record then)."""
         if change.touches:
             self.rebuild()
+        if change.wizard:
+            wf = self.session.workflow
+            self.record.visible = not (wf is not None and wf.is_open)
 
     def _on_record(self, _event: Any) -> None:
         t = self.session.record_touch()

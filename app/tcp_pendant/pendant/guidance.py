@@ -1,0 +1,157 @@
+"""Touch guidance of the pendant (no viser): where the reference tip is, seen from the tool tip.
+
+* :func:`jog_frame_rotation`: ``R_world_frame`` of a jog frame (WORLD, BASE, FLANGE, TOOL) for a
+  robot's :class:`~tcp_pendant.controller.pose_state.PoseState` (the axes the X/Y/Z keys move
+  along; TOOL is the active TCP's frame, as ``VirtualController.jog_cartesian`` uses).
+* :func:`tip_offset_mm`: the reference tip relative to the mounted tool's true tip along the
+  jog frame's axes (mm): jogging X by ``dx``, Y by ``dy`` and Z by ``dz`` brings the tips together
+  (a translation moves every point of the tool alike).
+* :func:`offset_markdown` and :func:`side_view_markdown`: the "ΔX n ΔY n ΔZ n mm" line and a
+  magnified two-view drawing of the tips (text in a code block, auto-scaled so that 0.5 mm is
+  several characters when close).
+* :func:`contact_stop`: the fraction of a translation after which the tool tip meets the
+  reference tip (stop at contact, like a real touch-up), or None when the step does not pass
+  through it.
+
+Units: metres in, millimetres out (names say which).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from tcp_pendant.controller.pose_state import PoseState
+from tcp_pendant.controller.touch import CRASH_RADIUS_MM, TOUCH_TOLERANCE_MM
+
+__all__ = [
+    "CONTACT_RADIUS_MM",
+    "ContactStop",
+    "contact_stop",
+    "direction_words",
+    "jog_frame_rotation",
+    "offset_markdown",
+    "side_view_markdown",
+    "tip_offset_mm",
+]
+
+CONTACT_RADIUS_MM = CRASH_RADIUS_MM
+"""A translation whose tool-tip path passes closer than this to the reference tip stops where
+it is closest (the tip touches); farther, the tip passes beside the spike."""
+
+_SCALES_MM = (0.1, 0.25, 0.5, 1.0, 2.5, 5.0, 10.0, 25.0, 50.0, 100.0)
+_HALF_W, _HALF_H = 7, 3          # characters either side of the tool tip in the drawing
+
+
+def jog_frame_rotation(state: PoseState, frame: str) -> np.ndarray:
+    """``R_world_frame`` (3,3) of jog frame ``frame`` at ``state``.
+
+    Raises:
+        ValueError: an unknown frame.
+    """
+    f = str(frame).upper()
+    if f == "WORLD":
+        return np.eye(3)
+    if f == "BASE":
+        return np.asarray(state.T_world_base)[:3, :3]
+    if f == "FLANGE":
+        return np.asarray(state.T_world_flange)[:3, :3]
+    if f == "TOOL":
+        return np.asarray(state.T_world_tcp)[:3, :3]
+    raise ValueError(f"Unknown jog frame {frame!r}; use WORLD, BASE, FLANGE or TOOL.")
+
+
+def tip_offset_mm(state: PoseState, reference_tip_world_m: np.ndarray, frame: str) -> np.ndarray:
+    """Reference tip minus the true tool tip, along the axes of jog frame ``frame`` (mm, (3,))."""
+    d_world_m = np.asarray(reference_tip_world_m, dtype=float) - np.asarray(state.T_world_tool_true)[:3, 3]
+    return jog_frame_rotation(state, frame).T @ d_world_m * 1000.0
+
+
+def _n(v: float) -> str:
+    text = f"{v:+.2f}" if abs(v) < 100 else f"{v:+.1f}"
+    return "0.00" if float(text) == 0.0 else text
+
+
+def offset_markdown(delta_mm: np.ndarray, frame: str) -> str:
+    """``ΔX +1.20  ΔY -0.40  ΔZ -3.00 mm (TOOL)``: the jog along each axis that brings the tool
+    tip onto the reference tip."""
+    d = np.asarray(delta_mm, dtype=float)
+    return (f"`ΔX {_n(d[0])}  ΔY {_n(d[1])}  ΔZ {_n(d[2])} mm` ({frame}: jog this far to touch)")
+
+
+def direction_words(delta_mm: np.ndarray, frame: str) -> str:
+    """Where the reference tip is from the tool tip, largest component first, e.g.
+    ``"2.10 mm −X, 0.60 mm +Z (WORLD)"`` (components under 0.05 mm left out)."""
+    d = np.asarray(delta_mm, dtype=float)
+    parts = [f"{abs(d[i]):.2f} mm {'+' if d[i] > 0 else '−'}{'XYZ'[i]}"
+             for i in np.argsort(-np.abs(d)) if abs(d[i]) >= 0.05]
+    return (", ".join(parts) or "0.00 mm") + f" ({frame})"
+
+
+def _scale(delta_mm: np.ndarray) -> float:
+    need = max(abs(float(delta_mm[0])) / _HALF_W, abs(float(delta_mm[1])) / _HALF_W,
+               abs(float(delta_mm[2])) / _HALF_H)
+    return next((s for s in _SCALES_MM if s >= need), _SCALES_MM[-1])
+
+
+def side_view_markdown(delta_mm: np.ndarray, frame: str) -> str:
+    """Two magnified views of the tips around the tool tip ``+``: the reference tip ``o``
+    (``@`` when they share a character; at the border when it is out of range). Left: X
+    across, Z up; right: Y across, Z up (the jog frame's axes). The scale (mm per
+    character) shrinks as the tips close in: 0.1 mm at the finest."""
+    d = np.asarray(delta_mm, dtype=float)
+    s = _scale(d)
+
+    def panel(h: float, v: float) -> list[str]:
+        col = int(np.clip(round(h / s), -_HALF_W, _HALF_W)) + _HALF_W
+        row = _HALF_H - int(np.clip(round(v / s), -_HALF_H, _HALF_H))
+        grid = [["·"] * (2 * _HALF_W + 1) for _ in range(2 * _HALF_H + 1)]
+        grid[_HALF_H][_HALF_W] = "+"
+        grid[row][col] = "@" if (row, col) == (_HALF_H, _HALF_W) else "o"
+        return ["".join(r) for r in grid]
+
+    left, right = panel(d[0], d[2]), panel(d[1], d[2])
+    width = 2 * _HALF_W + 1
+    head = f"{'X→  Z↑':<{width}}   {'Y→  Z↑':<{width}}"
+    lines = [head] + [f"{a}   {b}" for a, b in zip(left, right)]
+    return (f"Close-up ({frame}, 1 char = {s:g} mm; + tool tip, o reference tip):\n\n```\n"
+            + "\n".join(lines) + "\n```")
+
+
+@dataclass(frozen=True)
+class ContactStop:
+    """Where a translation meets the reference tip.
+
+    Attributes:
+        fraction: part of the step to carry out (0..1) to stop at contact.
+        miss_mm: how far the tool tip's path passes from the reference tip (mm).
+    """
+
+    fraction: float
+    miss_mm: float
+
+
+def contact_stop(tip_world_m: np.ndarray, step_world_m: np.ndarray,
+                 reference_tip_world_m: np.ndarray) -> ContactStop | None:
+    """The stop of a straight translation ``step_world_m`` of the tool tip at ``tip_world_m``
+    (both metres) at the reference tip: the step would carry the tip *past* its closest point
+    to the reference tip, and that point is within :data:`CONTACT_RADIUS_MM` of it, and the tip
+    is not touching already (then it may go on: the trainee was warned at contact). None: the
+    step goes on (it ends before the reference tip, passes beside it, or starts at it)."""
+    p = np.asarray(tip_world_m, dtype=float)
+    step = np.asarray(step_world_m, dtype=float)
+    r = np.asarray(reference_tip_world_m, dtype=float)
+    length2 = float(step @ step)
+    if length2 <= 0.0:
+        return None
+    if np.linalg.norm(r - p) * 1000.0 <= TOUCH_TOLERANCE_MM:
+        return None                                   # at contact already: the next press goes on
+    t = float((r - p) @ step) / length2
+    if not 0.0 < t < 1.0:
+        return None                                   # the closest point is not inside this step
+    miss_mm = float(np.linalg.norm(p + t * step - r)) * 1000.0
+    if miss_mm > CONTACT_RADIUS_MM or not math.isfinite(miss_mm):
+        return None
+    return ContactStop(t, miss_mm)

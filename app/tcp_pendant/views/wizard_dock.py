@@ -1,0 +1,189 @@
+"""The wizard dock of the Jog tab (viser GUI): the running wizard's step beside the jog keys.
+
+While a calibration wizard is open, the top of the Jog tab shows its current step ("Step k
+of N", what to do), **Record** (the step's, checked: ``pendant.record_check``), a row
+"◀ Back · Next ▶ (Finish) · Cancel", the tool change a step asks for, and the pose-diversity
+meter (bar and one line), so a trainee jogs, watches and records on one screen; the Calibrate
+tab stays the place to choose a method and review the result. Outside a wizard the dock is
+hidden and the touch list's "Record point" records into the free list (one Record concept).
+
+The dock renders from the session's workflow (``Session.workflow``: the Calibrate tab's
+``CalibrationWorkflow``) on the change signal and calls only the workflow's public commands
+(``record``, ``next``, ``back``, ``cancel``, ``mount_required_tool``); it never calls another
+view. Each click runs through ``Session.on_loop`` inside ``Session.batch`` and ends in one
+change signal with ``wizard`` (as the Calibrate tab's clicks), so the Calibrate tab, the scene
+and the classroom recorder see it too. Every text from a wizard goes through the escaping
+``calibrate.text`` helpers.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from typing import Any
+
+from tcp_pendant.calibrate.text import meter_level, step_markdown
+from tcp_pendant.pendant.guidance import direction_words, tip_offset_mm
+from tcp_pendant.pendant.record_check import RecordCheck
+from tcp_pendant.session import Session, SessionChange
+from tcp_pendant.views.gui_util import set_content
+
+__all__ = ["BACK", "CANCEL", "CLOSE", "FINISH", "NEXT", "WizardDock"]
+
+BACK, NEXT, FINISH, CANCEL, CLOSE = "◀ Back", "Next ▶", "Finish ▶", "Cancel", "Close"
+
+
+class WizardDock:
+    """Builds the dock in the current GUI container (the top of the Jog tab)."""
+
+    def __init__(self, session: Session, *, check: RecordCheck | None = None) -> None:
+        self.session = session
+        self.check = RecordCheck() if check is None else check
+        self._note = ""                       # the last click's line, for this run and step only
+        self._note_at: tuple[int, int, int] | None = None
+        gui = session.target.gui
+        self.folder = gui.add_folder("Calibration step", visible=False)
+        with self.folder:
+            self.step_md = gui.add_markdown("")
+            self.note_md = gui.add_markdown("", visible=False)
+            self.mount = gui.add_button("Mount the tool", color="orange", visible=False,
+                                        hint="The tool change this step asks for (the app swaps the tool).")
+            self.record = gui.add_button("Record", color="green",
+                                         hint="Record this step at the current pose (a touch farther than "
+                                              "0.5 mm asks first, unless the distance is hidden).")
+            self.nav = gui.add_button_group("Step", (BACK, NEXT, CANCEL))
+            self.meter_bar = gui.add_progress_bar(0.0, color="gray", visible=False)
+            self.meter_md = gui.add_markdown("", visible=False)
+        self.record.on_click(self._action(self._on_record))
+        self.nav.on_click(self._action(self._on_nav))
+        self.mount.on_click(self._action(lambda _e: self._workflow().mount_required_tool(), sync=True))
+        session.subscribe(self.on_change)
+
+    # ------------------------------------------------------------ plumbing
+    def _workflow(self) -> Any:
+        wf = self.session.workflow
+        if wf is None:
+            raise ValueError("Calibration wizards are not installed in this build.")
+        return wf
+
+    def _action(self, fn: Callable[[Any], Any], *, sync: bool = False) -> Any:
+        s = self.session
+
+        def run(event: Any) -> None:
+            with s.batch():
+                try:
+                    fn(event)
+                finally:
+                    s.changed(wizard=True, pose=sync)
+
+        run.__qualname__ = getattr(fn, "__qualname__", "dock action")
+        return s.on_loop(run)
+
+    def _where(self) -> tuple[int, int, int]:
+        wf = self.session.workflow
+        wiz = None if wf is None else wf.wizard
+        if wiz is None:
+            return (-1, -1, -1)
+        return (id(wiz), wiz.step.index if not wiz.is_complete else -2, len(wf.runs))
+
+    def _say(self, text: str) -> None:
+        self._note, self._note_at = text, self._where()
+
+    # ------------------------------------------------------------ callbacks
+    def _on_record(self, _event: Any) -> None:
+        wf = self._workflow()
+        s = self.session
+        state = s.pose_state()
+        frame = s.jogger.settings.frame
+        delta = tip_offset_mm(state, s.controller.reference_tip_world_m, frame)
+        decision = self.check.decide(state.touch.distance_mm, hidden=s.hide_distance, q_rad=state.q_rad,
+                                     where=direction_words(delta, frame))
+        if not decision.record:
+            self._say(decision.message)
+            return
+        wiz = wf.wizard
+        index = None if wiz is None else wiz.step.index
+        wf.record()
+        shown = "" if s.hide_distance else f", {state.touch.distance_mm:.2f} mm from the tip"
+        self._say(f"✔ Step {index + 1 if index is not None else '?'} recorded{shown}.")
+
+    def _on_nav(self, event: Any) -> None:
+        wf = self._workflow()
+        choice = str(event.target.value)
+        self.check.clear()
+        if choice == BACK:
+            wf.back()
+        elif choice in (NEXT, FINISH):
+            wf.next()
+        elif choice in (CANCEL, CLOSE):
+            finished = wf.result is not None
+            wf.cancel()
+            if not finished:
+                self.session.notify("Calibration cancelled",
+                                    "Nothing recorded is lost: Resume it from the Calibrate menu.")
+        else:
+            raise ValueError(f"Unknown step command {choice!r}; use {BACK}, {NEXT} or {CANCEL}.")
+
+    # ------------------------------------------------------------ render
+    def on_change(self, change: SessionChange) -> None:
+        """The change signal: the whole dock after a wizard, tool or touches change; the meter
+        after a move."""
+        if change.wizard or change.tool or change.touches:
+            self.render()
+        elif change.pose and self.folder.visible:
+            self.update_meter()
+
+    def render(self) -> None:
+        """Show the open wizard's step (hide the dock when no wizard is open)."""
+        if self.session.closed:
+            return
+        wf = self.session.workflow
+        wiz = None if wf is None else wf.wizard
+        open_ = wf is not None and wiz is not None and wf.is_open
+        self.folder.visible = open_
+        if not open_:
+            self._note, self._note_at = "", None
+            return
+        set_content(self.step_md, step_markdown(wiz))
+        note = self._note if self._note_at == self._where() else ""
+        self.note_md.visible = bool(note)
+        if note:
+            set_content(self.note_md, note)
+        stepping = not wiz.is_complete
+        needed = wf.required_tool() if stepping else None
+        self.mount.visible = needed is not None
+        if needed is not None:
+            self.mount.label = f"Mount the {needed.label.lower()}"
+        self.record.visible = stepping
+        self.record.disabled = not wiz.can_record
+        if stepping:
+            options = (BACK, FINISH if wiz.on_last_step else NEXT, CANCEL)
+        else:
+            options = (BACK, CLOSE)
+        if tuple(self.nav.options) != options:
+            self.nav.options = options
+        self.update_meter()
+
+    def update_meter(self) -> None:
+        """The pose-diversity meter (the wizards that declare it: ``Wizard.meter_active``)."""
+        wf = self.session.workflow
+        wiz: Any = None if wf is None else wf.wizard
+        show = wiz is not None and bool(wiz.meter_active)
+        self.meter_bar.visible = self.meter_md.visible = show
+        if not show:
+            return
+        gain = wiz.preview(self.session.controller.T_world_flange())
+        value, color = meter_level(gain)
+        self.meter_bar.value = round(value, 1)
+        self.meter_bar.color = color
+        angle = gain.angle_to_nearest_deg
+        if math.isinf(angle):
+            text = "Pose diversity: first touch, any orientation."
+        elif gain.too_close:
+            text = f"Pose diversity: ⚠ **too close**, {angle:.0f}° from an earlier touch: tilt further."
+        elif math.isinf(gain.predicted_after):
+            text = f"Pose diversity: {angle:.0f}° from the nearest touch; not yet determinable."
+        else:
+            text = (f"Pose diversity: {angle:.0f}° from the nearest touch; predicted TCP error "
+                    f"{gain.predicted_after:.2f} mm if recorded here.")
+        set_content(self.meter_md, text)              # numbers and our words only

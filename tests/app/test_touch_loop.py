@@ -1,0 +1,251 @@
+"""Issue 10: the trainee's touch loop on one screen (in-process server, headless websocket
+clients as browsers; clicks arrive as a browser's do, ``guiclick``).
+
+* the wizard dock on the Jog tab shows the running wizard's step and records it (one Record
+  concept: "Record point" is hidden meanwhile), Back / Next / Cancel and the meter;
+* Record checks the touch: farther than 0.5 mm asks first (how far, which direction), a second
+  Record at the same pose within the window records; "Hide distance" records at once;
+* the Δ readout is the jog that brings the tips together, in the jog frame's axes;
+* an increment stops at contact and says so; the next press goes on;
+* continuous jog: the override's speed (mm/s measured on the server), no step larger than
+  one 20 Hz tick allows, nothing after the release;
+* the status line's stop message does not outlive a move that was not a jog (auto-touch);
+* every button group marks its selected option.
+"""
+
+from __future__ import annotations
+
+import re
+import sys
+import time
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+HERE = Path(__file__).parent
+sys.path.insert(0, str(HERE))
+sys.path.insert(0, str(HERE.parent / "calibrate"))
+from guiclick import choose, click  # noqa: E402
+from wsclient import ButtonClient, DrainingClient, wait_until  # noqa: E402
+
+from tcp_pendant.pendant.guidance import tip_offset_mm  # noqa: E402
+from tcp_pendant.pendant.jogging import LINEAR_SPEED_MM_S  # noqa: E402
+from tcp_pendant.server import AppConfig, PendantApp  # noqa: E402
+from tcp_pendant.views.pendant_panel import HOLD_HZ, MARK  # noqa: E402
+from tcp_pendant.views.wizard_dock import BACK, CANCEL, NEXT  # noqa: E402
+
+
+class Page:
+    """One connected browser: its session and views."""
+
+    def __init__(self, app: PendantApp) -> None:
+        n = len(app.sessions)
+        self.ws = DrainingClient(app.port)
+        wait_until(lambda: len(app.sessions) > n, what="session built")
+        self.session = list(app.sessions.values())[-1]
+        self.client = self.session.client
+        self.notes: list[tuple[str, str]] = []
+        self.session.notify = lambda title, body, kind="info": self.notes.append((title, body))  # type: ignore
+        self.dock = self.session.views["dock"]
+        self.pendant = self.session.views["pendant"]
+        self.calibrate = self.session.views["calibrate"]
+
+    def click(self, handle: Any) -> None:
+        click(handle, self.client)
+
+    def choose(self, handle: Any, value: Any) -> None:
+        choose(handle, value, self.client)
+
+    def tip_at(self, offset_mm: tuple[float, float, float]) -> None:
+        """Teleport the true tool tip to the reference tip + ``offset_mm`` (WORLD), same
+        orientation, and signal the move (as the gizmo would)."""
+        s = self.session
+        with s.lock:
+            c = s.controller
+            T = c.T_world_tool_true().copy()
+            T[:3, 3] = c.reference_tip_world_m + np.asarray(offset_mm) / 1000.0
+            res = c.move_true_tool_to(T)
+            assert res.ok, res.message
+            s.moved()
+
+
+@pytest.fixture
+def page(tmp_path: Path) -> Iterator[Callable[..., Page]]:
+    apps: list[PendantApp] = []
+    pages: list[Page] = []
+
+    def make() -> Page:
+        app = PendantApp(AppConfig(port=0, tool_library=tmp_path / "tools.json", library_poll_s=0.1))
+        app.start()
+        apps.append(app)
+        p = Page(app)
+        p.calibrate.workflow.rng = np.random.default_rng(3)
+        pages.append(p)
+        return p
+
+    yield make
+    for p in pages:
+        p.ws.close()
+    for a in apps:
+        a.stop()
+
+
+def test_the_dock_shows_the_wizards_step_on_the_jog_tab_and_records_it(page) -> None:
+    p = page()
+    s, dock = p.session, p.dock
+    touches = s.views["touches"]
+    assert s.workflow is p.calibrate.workflow
+    assert not dock.folder.visible and touches.record.visible       # no wizard: Record point
+    p.click(p.calibrate.start)                                      # XYZ 4-point (the first method)
+    assert dock.folder.visible and not touches.record.visible       # one Record: the dock's
+    assert "Step 1 of 4" in dock.step_md.content
+    assert tuple(dock.nav.options) == (BACK, NEXT, CANCEL)
+    assert dock.meter_bar.visible and "Pose diversity" in dock.meter_md.content
+    p.tip_at((0.0, 0.0, 0.2))                                       # 0.2 mm above the tip
+    p.click(dock.record)
+    wiz = p.calibrate.workflow.wizard
+    assert wiz.steps[0].recorded and not s.touches                  # the wizard's step, not the free list
+    assert "✔ Step 1 recorded, 0.20 mm from the tip" in dock.note_md.content
+    assert "recorded" in dock.step_md.content
+    p.choose(dock.nav, NEXT)
+    assert "Step 2 of 4" in dock.step_md.content and not dock.note_md.visible   # no stale line
+    p.choose(dock.nav, BACK)
+    assert "Step 1 of 4" in dock.step_md.content
+    p.choose(dock.nav, CANCEL)
+    assert not dock.folder.visible and touches.record.visible
+    assert any("cancelled" in t for t, _ in p.notes)
+    p.click(p.calibrate.resume)                                     # the Calibrate tab resumes it
+    assert dock.folder.visible and not dock.note_md.visible         # the old line did not carry over
+
+
+def test_record_far_from_the_tip_asks_first_and_hide_distance_records(page) -> None:
+    p = page()
+    dock, wf = p.dock, p.calibrate.workflow
+    p.click(p.calibrate.start)
+    p.tip_at((-3.0, 0.0, 0.0))                                      # the reference tip is 3 mm +X of the tool tip
+    p.click(dock.record)
+    assert not wf.wizard.steps[0].recorded
+    note = dock.note_md.content
+    assert "3.00 mm" in note and "3.00 mm +X (WORLD)" in note and "Record" in note
+    p.click(dock.record)                                            # the second Record, same pose
+    assert wf.wizard.steps[0].recorded
+    p.choose(dock.nav, NEXT)
+    p.tip_at((0.0, -2.0, 0.0))
+    p.click(dock.record)                                            # asks ...
+    p.tip_at((0.0, -1.0, 0.0))
+    p.click(dock.record)                                            # ... and asks again after a move
+    assert not wf.wizard.steps[1].recorded and "1.00 mm" in dock.note_md.content
+    p.choose(p.pendant.hide_distance, True)                         # the exercise: judged by eye
+    assert p.session.hide_distance and "hidden" in p.pendant.touch_md.content
+    assert "ΔX" not in p.pendant.touch_md.content and not p.pendant.closeup_md.visible
+    p.click(dock.record)
+    assert wf.wizard.steps[1].recorded
+    assert "mm from the tip" not in dock.note_md.content            # the distance stays hidden
+
+
+@pytest.mark.parametrize("frame", ["WORLD", "TOOL"])
+def test_the_delta_readout_is_the_jog_that_brings_the_tips_together(page, frame: str) -> None:
+    p = page()
+    s = p.session
+    p.choose(p.pendant.frame, frame)
+    p.tip_at((4.3, -2.6, 7.1))
+    text = p.pendant.touch_md.content
+    m = re.search(r"ΔX (\S+)  ΔY (\S+)  ΔZ (\S+) mm` \(" + frame, text)
+    assert m, text
+    delta = [float(v) for v in m.groups()]
+    with s.lock:
+        expected = tip_offset_mm(s.pose_state(), s.controller.reference_tip_world_m, frame)
+    np.testing.assert_allclose(delta, expected, atol=0.006)
+    if frame == "WORLD":
+        np.testing.assert_allclose(delta, (-4.3, 2.6, -7.1), atol=0.006)
+    with s.lock:                                                    # jog exactly by the readout
+        for ax, d in zip("XYZ", delta):
+            s.controller.jog_cartesian(frame, ax, d)
+        s.moved()
+    assert s.pose_state().touch.distance_mm < 0.05                   # the tips meet
+    assert "TOUCHING" in p.pendant.touch_md.content
+    assert "@" in p.pendant.closeup_md.content                      # one point in the close-up
+
+
+def test_an_increment_stops_at_contact_and_the_next_press_goes_on(page) -> None:
+    p = page()
+    s, pendant = p.session, p.pendant
+    p.tip_at((0.0, 0.0, 4.0))                                       # 4 mm above the reference tip
+    p.choose(pendant.increment, "10")
+    p.choose(pendant.cart_rows["Z"], "Z −")                         # 10 mm down: through the tip?
+    st = s.pose_state()
+    assert st.touch.distance_mm < 0.01 and not st.touch.crashed     # stopped where it touches
+    assert "Stopped at the reference tip after 4.00 of 10 mm" in pendant.status_md.content
+    assert any(t == "Jog stopped" for t, _ in p.notes)
+    p.choose(pendant.cart_rows["Z"], "Z −")                         # the trainee insists: goes on
+    assert s.pose_state().touch.crashed and "CRASH" in pendant.touch_md.content
+    p.choose(pendant.cart_rows["Z"], "Z +")
+    p.choose(pendant.cart_rows["X"], "X +")                         # beside the tip: no stop
+    assert pendant.status_md.content == ""
+
+
+def test_a_stop_message_does_not_outlive_an_auto_touch(page) -> None:
+    p = page()
+    s, pendant = p.session, p.pendant
+    p.tip_at((0.0, 0.0, 4.0))
+    p.choose(pendant.increment, "10")
+    p.choose(pendant.cart_rows["Z"], "Z −")
+    assert "Stopped" in pendant.status_md.content
+    p.click(p.calibrate.start)
+    p.click(p.calibrate.steps.auto_touch)                           # moves, not a jog
+    assert pendant.status_md.content == ""
+
+
+def test_every_button_group_marks_its_selected_option(page) -> None:
+    p = page()
+    pendant = p.pendant
+    assert MARK + "10" in pendant.increment.options and MARK + "Cartesian" in pendant.mode.options
+    assert MARK + "WORLD" in pendant.readout_frame.options
+    p.choose(pendant.increment, "1")                                # a browser sends the label ...
+    assert MARK + "1" in pendant.increment.options and "10" in pendant.increment.options
+    p.choose(pendant.increment, MARK + "1")                         # ... also the marked one
+    assert p.session.jogger.settings.increment == "1"
+    p.choose(pendant.readout_frame, "BASE")
+    assert MARK + "BASE" in pendant.readout_frame.options and "TCP in BASE" in pendant.tcp_md.content
+    p.choose(pendant.mode, "Joint")
+    assert MARK + "Joint" in pendant.mode.options
+    assert all(r.visible for r in pendant.joint_rows) and not any(r.visible for r in pendant.cart_rows.values())
+    p.choose(pendant.increment, "Cont.")                            # hold keys in continuous mode
+    assert not any(r.visible for r in pendant.joint_rows) and pendant.joint_buttons[(0, 1)].visible
+
+
+def test_continuous_jog_moves_at_the_override_speed_and_stops_at_release(app_factory) -> None:
+    app = app_factory()
+    client = ButtonClient(app.port, ("X +",))
+    assert client.found.wait(30)
+    wait_until(lambda: len(app.sessions) == 1, what="session built")
+    (s,) = app.sessions.values()
+    try:
+        with s.lock:
+            s.jogger.settings = s.jogger.settings.with_(increment="Cont.", override_pct=50, frame="WORLD")
+        xs: list[tuple[float, float]] = []
+        s.add_motion_listener(lambda: xs.append((time.monotonic(), float(s.controller.T_world_tcp()[0, 3]))))
+        x0 = float(s.controller.T_world_tcp()[0, 3])
+        period = 1.0 / HOLD_HZ
+        t_start = time.monotonic()
+        n = 30                                                      # 1.5 s held, like a browser
+        for i in range(n):
+            client.hold_tick("X +", HOLD_HZ)
+            time.sleep(max(0.0, t_start + (i + 1) * period - time.monotonic()))
+        client.click("X +")                                         # the release
+        wait_until(lambda: len(xs) >= n - 3, what="the hold ticks")
+        time.sleep(0.3)
+        x_end = float(s.controller.T_world_tcp()[0, 3])
+        held_s = n * period
+        speed = (x_end - x0) * 1000.0 / held_s
+        expected = LINEAR_SPEED_MM_S * 0.5                          # 125 mm/s at 50 %
+        print(f"continuous jog: {speed:.1f} mm/s over {held_s:.2f} s (set {expected:.0f} mm/s), {len(xs)} ticks moved")
+        assert speed == pytest.approx(expected, rel=0.2)
+        steps = np.diff([x0] + [x for _, x in xs]) * 1000.0
+        assert steps.max() <= expected / HOLD_HZ * 1.001            # no jump beyond one 20 Hz tick
+        assert xs[-1][1] == x_end                                   # the release click did not move
+    finally:
+        client.close()
