@@ -9,6 +9,7 @@ Examples::
     tcp-pendant --host 0.0.0.0 --class           # a class: names, gradebook, trainer view
     tcp-pendant --host 0.0.0.0 --exercise mystery --exercise-seed 7   # a class with mystery tools
     tcp-pendant grades --csv > grades.csv        # the class gradebook (see classroom.grades_cli)
+    tcp-pendant --scenario bent-tool --scenario-seed 3   # training: a systematic error to find
 """
 
 from __future__ import annotations
@@ -20,7 +21,11 @@ import time
 from collections.abc import Sequence
 from pathlib import Path
 
-__all__ = ["build_parser", "main", "network_warning", "ready_urls"]
+__all__ = ["SCENARIO_CHOICES", "build_parser", "main", "network_warning", "ready_urls"]
+
+SCENARIO_CHOICES = ("off", "bent-tool", "robot-accuracy", "moved-reference")
+"""``--scenario`` names: ``controller.scenarios.SCENARIO_KINDS`` with hyphens (no pinocchio import
+for ``--help``)."""
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -64,6 +69,12 @@ def build_parser() -> argparse.ArgumentParser:
                         "true TCP and orientation only the gradebook knows")
     p.add_argument("--exercise-seed", type=int, default=0, metavar="N",
                    help="seed of the mystery tools (default 0; another seed, other tools)")
+    p.add_argument("--scenario", default="off", choices=SCENARIO_CHOICES, metavar="NAME",
+                   help="training: a systematic error every pendant starts with (off, bent-tool, "
+                        "robot-accuracy, moved-reference; default off); the trainer can change it in the "
+                        "Calibrate tab")
+    p.add_argument("--scenario-seed", type=int, default=0, metavar="N",
+                   help="seed that draws the scenario's errors (default 0; >= 0)")
     p.add_argument("--verbose", action="store_true", help="log debugging information")
     return p
 
@@ -152,7 +163,8 @@ def _main(argv: Sequence[str] | None) -> int:
                            port=args.port, tool_library=args.tool_library, shared=args.shared,
                            reference_tip_mm=tip, allow_origins=tuple(args.allow_origin), class_db=class_db,
                            trainer_token=args.trainer_token, exercise=args.exercise,
-                           exercise_seed=args.exercise_seed)
+                           exercise_seed=args.exercise_seed, scenario=args.scenario.replace("-", "_"),
+                           scenario_seed=args.scenario_seed)
         app = PendantApp(config)
     except (ControllerError, ValueError, OSError, GradebookError) as exc:
         print(f"tcp-pendant: error: {exc}", file=sys.stderr)

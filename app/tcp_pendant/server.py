@@ -43,6 +43,7 @@ from tcp_pendant.controller import (
     builtin_tools,
     reference_tip_model,
 )
+from tcp_pendant.controller.scenarios import Scenario
 from tcp_pendant.session import Session
 from tcp_pendant.views import build_session_views
 from tcp_pendant.views.scene import overview_camera, overview_pose
@@ -75,6 +76,10 @@ class AppConfig:
         trainer_token: the token that opens the trainer view (None: a random one).
         exercise: None (free practice) or "mystery" (each trainee gets a mystery tool).
         exercise_seed: seed of the mystery tools.
+        scenario: the systematic error every session starts with (training;
+            ``controller.scenarios``: "off", "bent_tool", "robot_accuracy", "moved_reference");
+            the trainer changes it per pendant in the Calibrate tab.
+        scenario_seed: seed of the scenario's errors (>= 0).
     """
 
     robot: str = "kr6"
@@ -91,6 +96,8 @@ class AppConfig:
     trainer_token: str | None = None
     exercise: str | None = None
     exercise_seed: int = 0
+    scenario: str = "off"
+    scenario_seed: int = 0
 
 
 class PortInUseError(OSError):
@@ -218,6 +225,7 @@ class PendantApp:
         if config.tool not in tools:
             raise ControllerError(f"Unknown tool {config.tool!r}; use one of {', '.join(tools)}.")
         self.tool = tools[config.tool]
+        Scenario(config.scenario, seed=config.scenario_seed)  # type: ignore[arg-type]  # ControllerError: names the choices
         tip = config.reference_tip_mm or default_reference_tip_mm(self.kinematics)
         tip_m = np.asarray(tip, dtype=float) / 1000.0
         if tip_m.shape != (3,) or not np.all(np.isfinite(tip_m)):
@@ -273,6 +281,8 @@ class PendantApp:
             tool = None if slot is None else session.library_tools.get(slot)
             if tool is not None:
                 session.set_active_data(tool, slot)
+        if self.config.scenario != "off":
+            session.set_scenario(self.config.scenario, self.config.scenario_seed)
         build_session_views(session, title=f"TCP Pendant · {self.robot_label}")
         if self.classroom is not None and not shared:
             self.classroom.attach(session)

@@ -54,6 +54,7 @@ from tcpcal.errors import TcpcalError
 from tcpcal.tool import Tool
 from tcp_pendant.controller import ControllerError, JogResult, ToolModel, VirtualController
 from tcp_pendant.controller.pose_state import PoseState, pose_state, pose_state_key
+from tcp_pendant.controller.scenarios import Scenario, ScenarioWorld, bent_tool, realize
 from tcp_pendant.pendant import Jogger, touch_label
 
 __all__ = ["GuiTarget", "Session", "SessionChange", "Touch"]
@@ -83,11 +84,14 @@ class Touch:
         label: text of the touch list, e.g. ``"P1  X 525.0 Y 0.0 Z 400.0 mm"``.
         distance_mm: true tool tip to reference tip when recorded (for the trainer; not shown
             when the distance is hidden).
+        joints_deg: the joint values when recorded, degrees (mm for a prismatic joint), in
+            joint order (as RoboDK and ABB store touches); () when not known.
     """
 
     T_world_flange: np.ndarray
     label: str
     distance_mm: float = float("nan")
+    joints_deg: tuple[float, ...] = ()
 
     def __post_init__(self) -> None:
         T = np.array(self.T_world_flange, dtype=float)
@@ -95,6 +99,10 @@ class Touch:
             raise ControllerError(f"A touch needs a finite 4x4 flange pose, got shape {T.shape}.")
         T.setflags(write=False)
         object.__setattr__(self, "T_world_flange", T)
+        joints = tuple(float(v) for v in self.joints_deg)
+        if not all(np.isfinite(joints)):
+            raise ControllerError(f"A touch's joint values must be finite, got {joints}.")
+        object.__setattr__(self, "joints_deg", joints)
 
 
 @dataclass(frozen=True, eq=False)
@@ -188,6 +196,16 @@ class Session:
         """The library's tools as this session last read them (slot -> tool)."""
         self.library_error: str | None = None
         """Why the library could not be read at the last :meth:`reload_library` (None: it was)."""
+        self.scenario: Scenario = Scenario()
+        """The systematic error played (training; off by default); change it with :meth:`set_scenario`."""
+        self.scenario_world: ScenarioWorld | None = None
+        """The drawn errors of :attr:`scenario` (None while it is off)."""
+        self._scenario_tip0: np.ndarray | None = None   # the reference tip before a scenario moved it
+        self._bent: dict[str, ToolModel] = {}           # tool key -> its bent version (bent_tool)
+        self._unbent: dict[int, ToolModel] = {}         # id(bent version) -> the tool as it was
+        self._free_records = 0                          # "Record point" clicks (free touches)
+        self._scenario_base = 0                         # touches recorded before the scenario was set
+        self._scenario_touches = 0                      # touches recorded since (never decreases)
 
     # ------------------------------------------------------------ the change signal
     def subscribe(self, fn: Callable[[SessionChange], None]) -> None:
@@ -233,6 +251,8 @@ class Session:
     def _emit(self, change: SessionChange) -> None:
         if self.closed:
             return
+        if self._play_moved_reference():
+            change = replace(change, pose=True)
         if change.pose or change.tool:
             change = replace(change, pose=True, state=self.pose_state())
         subscribers = list(self._subscribers)
@@ -284,8 +304,10 @@ class Session:
 
     # ------------------------------------------------------------ tools (state owner)
     def mount_tool(self, tool: ToolModel) -> None:
-        """Bolt another physical tool on (the active tool data does not change)."""
+        """Bolt another physical tool on (the active tool data does not change). While the
+        "bent tool" scenario plays, the tool bolted on is the bent version of ``tool``."""
         with self.lock:
+            tool = self._physical(tool)
             if tool is self.controller.mounted_tool:
                 return
             self.controller.mount_tool(tool)
@@ -361,13 +383,92 @@ class Session:
         get = getattr(self.target, "get_clients", None)
         return list(get().values()) if callable(get) else []
 
+    # ------------------------------------------------------------ scenarios (training)
+    def set_scenario(self, kind: str, seed: int = 0) -> ScenarioWorld:
+        """Play a systematic error (``controller.scenarios``; training): "off", "bent_tool",
+        "robot_accuracy" or "moved_reference", its errors drawn from ``seed``.
+
+        The physical world changes, the controller's beliefs do not: ``robot_accuracy`` sets the
+        controller's ``true_kinematics`` (readouts, recorded poses and jogs stay on the model);
+        ``bent_tool`` bolts on the bent version of the mounted tool (and of any tool mounted
+        later; the library data stay as they were); ``moved_reference`` knocks the reference tip
+        after the scenario's touch ``k`` counted from now (free touches and wizard touches). The
+        previous scenario is undone first (the tip back where it was, the unbent tool). Ends in
+        one change signal (``tool``).
+
+        Raises:
+            ControllerError: unknown kind or a bad seed (names what to choose).
+        """
+        with self.lock:
+            scenario = Scenario(kind, seed=seed)  # type: ignore[arg-type]
+            c = self.controller
+            # undo the previous one
+            if self._scenario_tip0 is not None:
+                c.set_reference_tip(self._scenario_tip0)
+            unbent = self._unbent.get(id(c.mounted_tool), c.mounted_tool)
+            self._bent.clear()
+            self._unbent.clear()
+            self._scenario_tip0 = c.reference_tip_world_m
+            world = realize(scenario, c.kinematics, unbent)
+            self.scenario = scenario
+            self.scenario_world = None if scenario.kind == "off" else world
+            c.set_true_kinematics(None if world.true_kinematics is c.kinematics else world.true_kinematics)
+            if scenario.kind == "bent_tool":
+                self._bent[unbent.key] = world.tool_true
+                self._unbent[id(world.tool_true)] = unbent
+            c.mount_tool(self._physical(unbent))
+            self._scenario_base = self._records_total()
+            self._scenario_touches = 0
+            self._play_moved_reference()
+            self.changed(tool=True)
+            return world
+
+    def _physical(self, tool: ToolModel) -> ToolModel:
+        """The tool as it physically is under the scenario (bent_tool: its bent version)."""
+        tool = self._unbent.get(id(tool), tool)
+        world = self.scenario_world
+        if world is None or world.tool_bend is None:
+            return tool
+        bent = self._bent.get(tool.key)
+        if bent is None:
+            bent = self._bent[tool.key] = bent_tool(tool, world.tool_bend)
+            self._unbent[id(bent)] = tool
+        return bent
+
+    def _records_total(self) -> int:
+        """Touches recorded in this session so far: free ones and the wizards' poses."""
+        total = self._free_records
+        wf = self.workflow
+        for run in getattr(wf, "runs", ()) or ():
+            try:
+                total += len(run.wizard.recorded_poses)
+            except Exception:  # a plug-in's run without poses
+                continue
+        return total
+
+    def _play_moved_reference(self) -> bool:
+        """Moved reference tip: place the tip for the touches recorded since the scenario was
+        set (the count never decreases: a knocked tip stays knocked). True if it moved."""
+        world = self.scenario_world
+        if world is None or world.reference_move is None or self._scenario_tip0 is None:
+            return False
+        self._scenario_touches = max(self._scenario_touches, self._records_total() - self._scenario_base)
+        tip = world.reference_move.tip_world_m(self._scenario_tip0, self._scenario_touches)
+        if np.array_equal(tip, self.controller.reference_tip_world_m):
+            return False
+        self.controller.set_reference_tip(tip)
+        return True
+
     # ------------------------------------------------------------ touches
     def record_touch(self) -> Touch:
-        """Store the current flange pose as a touch (labelled P1, P2, ...)."""
+        """Store the current flange pose as a touch (labelled P1, P2, ...), with the joint
+        values (degrees) and the true distance."""
         with self.lock:
             T = self.controller.T_world_flange()
-            touch = Touch(T, touch_label(len(self.touches), T), self.controller.touch_geometry().distance_mm)
+            touch = Touch(T, touch_label(len(self.touches), T), self.controller.touch_geometry().distance_mm,
+                          tuple(self.controller.joint_angles_deg().values()))
             self.touches.append(touch)
+            self._free_records += 1
             self.changed(touches=True)
             return touch
 
@@ -382,8 +483,8 @@ class Session:
                 raise ControllerError(f"There is no touch P{index + 1 if isinstance(index, int) else index}; "
                                       f"{len(self.touches)} recorded.")
             del self.touches[index]
-            self.touches[:] = [Touch(t.T_world_flange, touch_label(i, t.T_world_flange), t.distance_mm)
-                               for i, t in enumerate(self.touches)]
+            self.touches[:] = [Touch(t.T_world_flange, touch_label(i, t.T_world_flange), t.distance_mm,
+                                     t.joints_deg) for i, t in enumerate(self.touches)]
             self.changed(touches=True)
 
     # ------------------------------------------------------------ callbacks

@@ -81,10 +81,11 @@ class PoseState:
 
 def pose_state_key(controller: VirtualController) -> tuple[object, ...]:
     """What a :class:`PoseState` depends on: joint angles, active tool data, mounted tool,
-    reference tip, BASE frame and the robot model. Equal keys, equal states."""
+    reference tip, BASE frame and the robot model (nominal first, the physical robot last).
+    Equal keys, equal states."""
     c = controller
-    return (id(c.kinematics), id(c.true_kinematics), c.q_rad.tobytes(), c.T_flange_tool.tobytes(), id(c.mounted_tool),
-            c.reference_tip_world_m.tobytes(), c.T_world_base.tobytes())
+    return (id(c.kinematics), c.q_rad.tobytes(), c.T_flange_tool.tobytes(), id(c.mounted_tool),
+            c.reference_tip_world_m.tobytes(), c.T_world_base.tobytes(), id(c.true_kinematics))
 
 
 def pose_state(controller: VirtualController, key: tuple[object, ...] | None = None) -> PoseState:

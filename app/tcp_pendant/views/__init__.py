@@ -3,7 +3,8 @@
 
 :func:`build_session_views` lays a session out as three tabs, like a pendant's menu:
 **Jog** (the running wizard's step dock, readouts, touch indicator, jog keys, touches), **Tool** (mounted tool, active tool
-data, library, export, numeric entry) and **Calibrate** (wizards).
+data, library, export, controller files, TCP check, numeric entry) and **Calibrate** (wizards,
+then the trainer's "Systematic error" panel).
 """
 
 from __future__ import annotations
@@ -11,6 +12,7 @@ from __future__ import annotations
 from tcp_pendant.session import Session
 from tcp_pendant.views.calibrate import build_calibrate_tab, register_calibrate_view
 from tcp_pendant.views.pendant_panel import PendantPanel
+from tcp_pendant.views.scenario_panel import ScenarioPanel
 from tcp_pendant.views.scene import SceneView
 from tcp_pendant.views.tool_panel import ToolPanel
 from tcp_pendant.views.touch_list import TouchListView
@@ -18,6 +20,7 @@ from tcp_pendant.views.wizard_dock import WizardDock
 
 __all__ = [
     "PendantPanel",
+    "ScenarioPanel",
     "SceneView",
     "ToolPanel",
     "TouchListView",
@@ -46,7 +49,10 @@ def build_session_views(session: Session, *, title: str = "TCP Pendant") -> None
             session.views["touches"] = TouchListView(session)
         with tabs.add_tab("Tool"):
             session.views["tools"] = ToolPanel(session)
-        build_calibrate_tab(session, tabs.add_tab("Calibrate"))
+        calibrate_tab = tabs.add_tab("Calibrate")
+        build_calibrate_tab(session, calibrate_tab)
         session.workflow = getattr(session.views.get("calibrate"), "workflow", None)
+        with calibrate_tab:
+            session.views["scenario"] = ScenarioPanel(session)
         session.views["tabs"] = tabs
     session.changed(pose=True, tool=True)

@@ -23,7 +23,9 @@ angles in degrees; poses are 4x4 row-major nested lists; times ISO 8601 UTC. The
       "mounted_tool": {"key": "pointer", "label": "Pointer",
                        "T_flange_tcp_true_m": 4x4} | null,    # at export time
       "reference_tip_world_m": [x, y, z] | null,
-      "touches": [ {"label": str, "T_world_flange_m": 4x4} ],  # the pendant's free touches
+      "touches": [ {"label": str, "T_world_flange_m": 4x4,   # the pendant's free touches
+                    "joints_deg": [j1, ..., jN]} ],          # optional (issue 12): the joint values
+                                                             # when recorded, deg (mm for linear axes)
       "wizards": [
         {
           "state": {                              # Wizard.to_dict()
@@ -73,6 +75,7 @@ viser's event loop (``tcp_pendant.views.wizard_menu``).
 from __future__ import annotations
 
 import json
+import math
 import os
 import re
 import stat
@@ -105,6 +108,8 @@ MAX_POSES_PER_WIZARD = 100
 """Most recorded poses per calibration (the XYZ 4-point wizard takes at most 20)."""
 MAX_TOUCHES = 1000
 """Most pendant touches (``"touches"``) per record."""
+MAX_JOINTS = 32
+"""Most joint values of one touch (``"joints_deg"``)."""
 
 
 class SessionRecordError(WizardError):
@@ -162,9 +167,13 @@ def _touch_dict(touch: Any) -> dict[str, Any]:
         T, label = touch["T_world_flange_m"], touch.get("label", "")
     elif isinstance(touch, tuple):
         T, label = touch
-    else:  # tcp_pendant.session.Touch: T_world_flange (metres), label
+    else:  # tcp_pendant.session.Touch: T_world_flange (metres), label, joints_deg
         T, label = touch.T_world_flange, touch.label
-    return {"label": str(label), "T_world_flange_m": _pose_list(T)}
+    out: dict[str, Any] = {"label": str(label), "T_world_flange_m": _pose_list(T)}
+    joints = touch.get("joints_deg") if isinstance(touch, Mapping) else getattr(touch, "joints_deg", ())
+    if joints:
+        out["joints_deg"] = [float(v) for v in joints]
+    return out
 
 
 def _run_dict(run: WizardRun | Wizard, honest: bool = False, record_id: int | None = None) -> dict[str, Any]:
@@ -314,6 +323,12 @@ def check_session_record(data: Any) -> dict[str, Any]:
         raise SessionRecordError("\"touches\" must be a list.")
     if len(touches) > MAX_TOUCHES:
         raise _limit_error("holds", f"{len(touches)} pendant touches", f"{MAX_TOUCHES} pendant touches")
+    for i, touch in enumerate(touches):          # "joints_deg" is optional (records before issue 12)
+        joints = touch.get("joints_deg") if isinstance(touch, Mapping) else None
+        if joints is not None and not (isinstance(joints, list) and len(joints) <= MAX_JOINTS and all(
+                isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in joints)):
+            raise SessionRecordError(f"Touch {i + 1} of the record: \"joints_deg\" must be a list of at most "
+                                     f"{MAX_JOINTS} finite numbers (degrees), got {joints!r:.60}.")
     for i, entry in enumerate(wizards):
         state = entry.get("state") if isinstance(entry, Mapping) else None
         rid = entry.get("record_id") if isinstance(entry, Mapping) else None

@@ -1,0 +1,263 @@
+"""Issue 12 item 3 in the app: systematic-error scenarios as session state (``Session.set_scenario``,
+one change signal), played by the controller (physical robot, bent tool, knocked reference tip),
+chosen in the Calibrate tab's "Systematic error" panel (training only; the explanation after a
+result, escaped), and as the start options ``--scenario`` / ``--scenario-seed``. Item 4: touches
+carry their joint values, in the session and its record. In-process server, headless websocket
+clients as browsers (``guiclick``)."""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+HERE = Path(__file__).parent
+sys.path.insert(0, str(HERE))
+sys.path.insert(0, str(HERE.parent / "calibrate"))
+from guiclick import choose, click  # noqa: E402
+from wsclient import DrainingClient, wait_until  # noqa: E402
+
+from tcp_pendant.cli import SCENARIO_CHOICES, build_parser  # noqa: E402
+from tcp_pendant.controller import ControllerError, builtin_tools  # noqa: E402
+from tcp_pendant.controller.scenarios import SCENARIO_KINDS, explain  # noqa: E402
+from tcp_pendant.server import AppConfig, PendantApp  # noqa: E402
+from tcp_pendant.session import SessionChange  # noqa: E402
+from tcp_pendant.text_escape import escape_markdown  # noqa: E402
+from tcp_pendant.views.scenario_panel import SCENARIO_CHOICES as PANEL_CHOICES  # noqa: E402
+from tcp_pendant.views.scenario_panel import scenario_markdown  # noqa: E402
+from tcp_pendant.wizards.session_record import (  # noqa: E402
+    SessionRecordError,
+    check_session_record,
+    session_from_controller,
+)
+
+
+class Page:
+    """One connected browser: its session and views."""
+
+    def __init__(self, app: PendantApp) -> None:
+        n = len(app.sessions)
+        self.ws = DrainingClient(app.port)
+        wait_until(lambda: len(app.sessions) > n, what="session built")
+        self.session = list(app.sessions.values())[-1]
+        self.client = self.session.client
+        self.notes: list[tuple[str, str]] = []
+        self.session.notify = lambda title, body, kind="info": self.notes.append((title, body))  # type: ignore
+        self.panel = self.session.views["scenario"]
+        self.calibrate = self.session.views["calibrate"]
+        self.tools = self.session.views["tools"]
+        self.touches = self.session.views["touches"]
+        self.changes: list[SessionChange] = []
+        self.session.subscribe(self.changes.append)
+
+    def click(self, handle: Any) -> None:
+        click(handle, self.client)
+
+    def choose(self, handle: Any, value: Any) -> None:
+        choose(handle, value, self.client)
+
+
+@pytest.fixture
+def page(tmp_path: Path) -> Iterator[Callable[..., Page]]:
+    apps: list[PendantApp] = []
+    pages: list[Page] = []
+
+    def make(**kw: Any) -> Page:
+        app = PendantApp(AppConfig(port=0, tool_library=tmp_path / "tools.json", library_poll_s=0.1, **kw))
+        app.start()
+        apps.append(app)
+        p = Page(app)
+        p.calibrate.workflow.rng = np.random.default_rng(5)
+        pages.append(p)
+        return p
+
+    yield make
+    for p in pages:
+        p.ws.close()
+    for a in apps:
+        a.stop()
+
+
+def auto_xyz4(p: Page) -> None:
+    v = p.calibrate
+    p.click(v.start)
+    for _ in range(4):
+        p.click(v.steps.auto_touch)
+    assert v.workflow.result is not None
+
+
+# ----------------------------------------------------------------------------- session state
+def test_robot_accuracy_puts_a_physical_robot_under_the_readouts(page) -> None:
+    p = page()
+    s, c = p.session, p.session.controller
+    readout = c.readout()
+    tip_before = c.T_world_tool_true()
+    s.set_scenario("robot_accuracy", 4)
+    assert c.true_kinematics is not c.kinematics
+    assert c.readout() == readout                                    # the controller's belief
+    moved_mm = np.linalg.norm(c.T_world_tool_true()[:3, 3] - tip_before[:3, 3]) * 1000.0
+    assert 0.05 < moved_mm < 5.0                                     # where the tip really is
+    assert p.changes[-1].tool and p.changes[-1].state is not None   # one signal, with the state
+    np.testing.assert_allclose(p.changes[-1].state.T_world_tool_true, c.T_world_tool_true(), atol=1e-15)
+    s.set_scenario("off")
+    assert c.true_kinematics is c.kinematics
+    np.testing.assert_allclose(c.T_world_tool_true(), tip_before, atol=1e-15)
+
+
+def test_bent_tool_is_bolted_on_and_stays_bent_across_mounts_library_untouched(page) -> None:
+    p = page()
+    s, c = p.session, p.session.controller
+    pointer = builtin_tools()["pointer"]
+    s.set_scenario("bent_tool", 2)
+    bend_mm = np.linalg.norm(c.mounted_tool.T_flange_tool_true[:3, 3] - pointer.T_flange_tool_true[:3, 3]) * 1000
+    assert c.mounted_tool.key == "pointer" and 2.0 <= bend_mm <= 5.5
+    p.choose(p.tools.mounted, builtin_tools()["torch"].label)       # another tool: bent too
+    torch = builtin_tools()["torch"]
+    assert c.mounted_tool.key == "torch"
+    assert np.linalg.norm(c.mounted_tool.T_flange_tool_true[:3, 3] - torch.T_flange_tool_true[:3, 3]) * 1000 > 2.0
+    p.choose(p.tools.mounted, pointer.label)
+    first = c.mounted_tool
+    p.choose(p.tools.mounted, torch.label)
+    p.choose(p.tools.mounted, pointer.label)
+    assert c.mounted_tool is first                                   # the same bent pointer
+    s.set_scenario("off")
+    np.testing.assert_allclose(c.mounted_tool.T_flange_tool_true, pointer.T_flange_tool_true, atol=1e-15)
+    assert s.library.tools() == {}
+
+
+def test_a_bent_tool_calibrated_anew_is_graded_against_the_bent_truth(page) -> None:
+    p = page()
+    p.session.set_scenario("bent_tool", 1)
+    auto_xyz4(p)
+    truth = p.calibrate.workflow.truth()
+    assert truth is not None and truth.position_error_mm < 0.01      # the new TCP is right
+    bent = p.session.controller.mounted_tool.T_flange_tool_true[:3, 3] * 1000.0
+    np.testing.assert_allclose(p.calibrate.workflow.result.tcp_mm, bent, atol=0.01)
+
+
+def test_moved_reference_is_knocked_after_touch_k_and_stays(page) -> None:
+    p = page()
+    s, c = p.session, p.session.controller
+    tip0 = c.reference_tip_world_m
+    world = s.set_scenario("moved_reference", 3)
+    k = world.reference_move.after_touch
+    for n in range(k):
+        np.testing.assert_allclose(c.reference_tip_world_m, tip0)
+        p.click(p.touches.record)
+    shift = np.asarray(world.reference_move.shift_mm) / 1000.0
+    np.testing.assert_allclose(c.reference_tip_world_m, tip0 + shift, atol=1e-15)
+    assert p.changes[-1].pose and p.changes[-1].state.touch is not None
+    s.delete_touch(0)                                                # a knocked tip stays knocked
+    np.testing.assert_allclose(c.reference_tip_world_m, tip0 + shift, atol=1e-15)
+    s.set_scenario("off")
+    np.testing.assert_allclose(c.reference_tip_world_m, tip0)
+
+
+def test_wizard_touches_count_for_the_moved_reference(page) -> None:
+    p = page()
+    s, c = p.session, p.session.controller
+    tip0 = c.reference_tip_world_m
+    world = s.set_scenario("moved_reference", 3)
+    v = p.calibrate
+    p.click(v.start)
+    for n in range(4):
+        expected = tip0 if n < world.reference_move.after_touch else tip0 + np.asarray(world.reference_move.shift_mm) / 1000
+        np.testing.assert_allclose(c.reference_tip_world_m, expected, atol=1e-15)
+        p.click(v.steps.auto_touch)
+    res = v.workflow.result
+    assert res is not None and res.max_error_mm > 0.5                # the touches disagree
+
+
+def test_bad_scenarios_are_refused_by_name_and_change_nothing(page) -> None:
+    p = page()
+    s = p.session
+    with pytest.raises(ControllerError, match="Unknown scenario"):
+        s.set_scenario("wobbly")
+    with pytest.raises(ControllerError, match="seed"):
+        s.set_scenario("bent_tool", -1)
+    assert s.scenario.kind == "off" and s.scenario_world is None
+
+
+# ----------------------------------------------------------------------------- the panel
+def test_panel_chooses_the_scenario_and_explains_it_after_a_result(page) -> None:
+    p = page()
+    panel, s = p.panel, p.session
+    assert tuple(PANEL_CHOICES) == SCENARIO_KINDS
+    assert panel.kind.value == "Off" and "No systematic error" in panel.md.content
+    p.choose(panel.seed, 7)
+    p.choose(panel.kind, "Robot accuracy")
+    assert s.scenario.kind == "robot_accuracy" and s.scenario.seed == 7
+    assert "Playing **Robot accuracy** (seed 7)" in panel.md.content
+    assert "How this result shows it" not in panel.md.content
+    auto_xyz4(p)
+    expected = escape_markdown(explain(s.scenario_world))
+    assert expected in panel.md.content and panel.md.content == scenario_markdown(s)
+    res = p.calibrate.workflow.result
+    assert 0.02 < res.max_error_mm < 1.0                               # the arm's inaccuracy shows
+    p.choose(panel.kind, "Off")
+    assert s.scenario.kind == "off" and s.controller.true_kinematics is s.controller.kinematics
+
+
+def test_panel_shows_in_training_mode_only(page) -> None:
+    p = page()
+    v = p.calibrate
+    assert p.panel.folder.visible
+    p.choose(v.training, False)
+    assert not p.panel.folder.visible
+    p.choose(v.training, True)
+    assert p.panel.folder.visible
+
+
+def test_a_bad_seed_from_the_browser_is_one_notification(page) -> None:
+    p = page()
+    p.choose(p.panel.kind, "Bent tool")
+    p.choose(p.panel.seed, -3)
+    assert p.session.scenario.kind == "bent_tool" and p.session.scenario.seed == 0
+    assert len(p.notes) == 1 and "seed" in p.notes[0][1]
+    assert p.panel.seed.value == 0 and p.panel.kind.value == "Bent tool"   # shows what is played
+
+
+# ----------------------------------------------------------------------------- start options
+def test_start_option_scenario_every_session_starts_with_it(page) -> None:
+    p = page(scenario="bent_tool", scenario_seed=5)
+    assert p.session.scenario.kind == "bent_tool" and p.session.scenario.seed == 5
+    assert p.panel.kind.value == "Bent tool"
+    pointer = builtin_tools()["pointer"]
+    assert not np.allclose(p.session.controller.mounted_tool.T_flange_tool_true, pointer.T_flange_tool_true)
+
+
+def test_cli_scenario_names_and_a_bad_one(tmp_path: Path) -> None:
+    assert tuple(n.replace("-", "_") for n in SCENARIO_CHOICES) == SCENARIO_KINDS
+    args = build_parser().parse_args(["--scenario", "robot-accuracy", "--scenario-seed", "9"])
+    assert (args.scenario, args.scenario_seed) == ("robot-accuracy", 9)
+    with pytest.raises(SystemExit):
+        build_parser().parse_args(["--scenario", "wobbly"])
+    with pytest.raises(ControllerError, match="seed"):
+        PendantApp(AppConfig(port=0, tool_library=tmp_path / "t.json", scenario="bent_tool", scenario_seed=-1))
+
+
+# ----------------------------------------------------------------------------- joints (item 4)
+def test_touches_carry_their_joint_values_into_the_session_record(page) -> None:
+    p = page()
+    s, c = p.session, p.session.controller
+    p.click(p.touches.record)
+    c.jog_joint(0, 5.0)
+    s.moved()
+    p.click(p.touches.record)
+    joints = [tuple(t.joints_deg) for t in s.touches]
+    assert len(joints[0]) == 6 and joints[1][0] == pytest.approx(joints[0][0] + 5.0)
+    assert joints[1] == pytest.approx(tuple(c.joint_angles_deg().values()))
+    s.delete_touch(0)
+    assert s.touches[0].joints_deg == joints[1] and s.touches[0].label.startswith("P1")
+    record = session_from_controller(c, [], robot="kr6", touches=s.touches)
+    assert record["touches"][0]["joints_deg"] == pytest.approx(list(joints[1]))
+    check_session_record(record)
+    old = dict(record, touches=[{k: v for k, v in t.items() if k != "joints_deg"} for t in record["touches"]])
+    check_session_record(old)                                        # records before issue 12
+    bad = dict(record, touches=[dict(record["touches"][0], joints_deg=["x"])])
+    with pytest.raises(SessionRecordError, match="joints_deg"):
+        check_session_record(bad)
