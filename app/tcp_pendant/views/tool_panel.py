@@ -9,13 +9,26 @@ session's commands (``Session.mount_tool`` / ``activate`` / ``deactivate``): thi
 (in ``--shared`` mode Activate also sets the library's active slot, the shared start tool);
 the panel re-renders the mounted tool and the active data on the session's ``tool`` change.
 
+Check (TCP check, spin test; issue 12): "Check" turns the selected library tool (or "Check
+active tool": the active data) about its TCP by +-A, +-B, +-C at the chosen angle and shows how
+far the TRUE tip moves per rotation and the implied TCP error (``views.tool_check``; the six
+rotations run in a worker thread on a copy of the robot model, the robot does not move).
+
+Controller files (issue 12 item 5): "Download file" renders the selected tool as a whole
+controller file of the chosen format (``tcpcal.controllers.export_tool_file``, tool number =
+the slot, as ``tcpcal tools export SLOT --format F --output FILE``) and sends it to the browser
+that clicked; a refusal (e.g. ABB's reserved ``tool0``) is one notification.
+
 Numeric entry: every field is validated (``tcp_pendant.pendant.tool_entry``) and its error is
 shown right under it; the tool is saved only if all fields are valid (nothing half-way).
 """
 
 from __future__ import annotations
 
+import asyncio
+import logging
 from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
 from tcp_pendant.controller import builtin_tools
@@ -23,13 +36,39 @@ from tcp_pendant.pendant import FIELDS, ToolEntry, parse_tool_entry, tool_data_m
 from tcp_pendant.pendant.tool_entry import entry_preview_markdown
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.text_escape import escape_markdown
+from tcp_pendant.controller.spin import DEFAULT_SPIN_ANGLE_DEG, MAX_SPIN_ANGLE_DEG
 from tcp_pendant.views.gui_util import number_of_option, set_options, slot_option
+from tcp_pendant.views.tool_check import CheckJob, check_job, check_markdown
+from tcpcal.controllers import CONTROLLER_FORMATS, export_tool_file
+from tcpcal.errors import TcpcalError
 from tcpcal.formats import FORMATS, export_tool, text_format
 from tcpcal.tool import Tool
 
-__all__ = ["NO_TOOL", "ToolPanel"]
+__all__ = ["CONTROLLER_FILE_REFUSED", "NO_TOOL", "ToolPanel", "controller_file"]
+
+log = logging.getLogger(__name__)
 
 NO_TOOL = "(library empty)"
+CONTROLLER_FILE_REFUSED = "Controller file not written"
+"""Title of the one notification when a controller refuses the tool (name, number)."""
+
+_CHECK_WORKER = ThreadPoolExecutor(max_workers=1, thread_name_prefix="tcp-check")
+"""Runs the TCP checks off viser's event loop (one at a time across sessions)."""
+
+
+def controller_file(tool: Tool, slot: int, label: str) -> tuple[str, str]:
+    """(file name, text) of ``tool`` as the whole controller file of the format labelled
+    ``label`` in the menu, tool number ``slot`` (``tcpcal tools export SLOT --format F``).
+
+    Raises:
+        ValueError: unknown format; the controller refuses the tool (tcpcal's message).
+    """
+    fmt = next((f for f in CONTROLLER_FORMATS.values() if f.label == label), None)
+    if fmt is None:
+        raise ValueError(f"Unknown controller format {label!r}; choose one of "
+                         f"{', '.join(f.label for f in CONTROLLER_FORMATS.values())}.")
+    text = export_tool_file(tool, fmt.name, number=int(slot))
+    return fmt.filename.format(n=int(slot)) or f"tool{int(slot)}.txt", text
 
 
 class ToolPanel:
@@ -59,6 +98,19 @@ class ToolPanel:
             self.export = gui.add_button("Export")
             self.export_text = gui.add_text("Controller text", "", multiline=True,
                                             hint="Select and copy into the controller.")
+            file_labels = [f.label for f in CONTROLLER_FORMATS.values()]
+            self.file_fmt = gui.add_dropdown("Controller file", file_labels, initial_value=file_labels[0],
+                                             hint="A whole file the controller loads (tool number = slot).")
+            self.download = gui.add_button("Download file", hint="Sent to this browser.")
+        with gui.add_folder("TCP check"):
+            self.check_angle = gui.add_number("Angle (deg)", DEFAULT_SPIN_ANGLE_DEG, min=1.0,
+                                              max=MAX_SPIN_ANGLE_DEG, step=1.0,
+                                              hint="The tool turns about its TCP by +-A, +-B, +-C.")
+            self.check = gui.add_button("Check", color="blue",
+                                        hint="Check the selected library tool on the mounted tool.")
+            self.check_active = gui.add_button("Check active tool",
+                                               hint="Check the active tool data on the mounted tool.")
+            self.check_md = gui.add_markdown("")
         with gui.add_folder("Enter tool numerically", expand_by_default=False):
             self.entry_name = gui.add_text("Name", "")
             self.entry_name_err = gui.add_markdown("", visible=False)
@@ -81,6 +133,11 @@ class ToolPanel:
         self.rename.on_click(g(self._on_rename))
         self.delete.on_click(g(self._on_delete))
         self.export.on_click(g(self._on_export))
+        self.download.on_click(g(self._on_download))
+        self.check.on_click(self._check_callback(self._selected_for_check))
+        self.check_active.on_click(self._check_callback(self._active_for_check))
+        self._checking = False
+        self.last_check: tuple[CheckJob, Any] | None = None
         self.entry_save.on_click(g(self._on_entry_save))
         for handle in (self.entry_name, *self.entry_fields.values()):
             handle.on_update(g(lambda _e: self._show_entry_preview()))
@@ -212,6 +269,68 @@ class ToolPanel:
         number = text_format(fmt).slot_for(slot)  # the controller's tool numbers, else its default
         kw = {} if number is None else {"slot": number}
         self.export_text.value = export_tool(tool, fmt, **kw)
+
+    def _on_download(self, event: Any) -> None:
+        slot, tool = self._selected()
+        try:
+            filename, text = controller_file(tool, slot, str(self.file_fmt.value))
+        except (TcpcalError, ValueError) as exc:
+            self.session.notify(CONTROLLER_FILE_REFUSED, str(exc), kind="warning")
+            return
+        # to the browser that clicked (in --shared mode the session is every browser's)
+        target = getattr(event, "client", None) or self.session.client or self.session.target
+        target.send_file_download(filename, text.encode("utf-8"), save_immediately=True)
+
+    # ------------------------------------------------------------ TCP check
+    def _selected_for_check(self) -> tuple[str, Tool]:
+        slot, tool = self._selected()
+        return f"slot {slot}: {tool.name}", tool
+
+    def _active_for_check(self) -> tuple[str, Tool]:
+        tool = self.session.controller.active_tool
+        if tool is None:
+            raise ValueError("No tool data is active (TCP = flange): activate a tool or pick one in the "
+                             "library and press Check.")
+        slot = self.session.active_slot
+        return (tool.name if slot is None else f"slot {slot}: {tool.name}"), tool
+
+    def _check_callback(self, which: Callable[[], tuple[str, Tool]]) -> Callable[[Any], Any]:
+        async def callback(_event: Any) -> None:
+            await self.run_check(which)
+        return callback
+
+    async def run_check(self, which: Callable[[], tuple[str, Tool]]) -> None:
+        """Run the TCP check of ``which()`` (title, tool): the job is taken under the session
+        lock on the loop, the six rotations run in ``_CHECK_WORKER``, the result is shown on
+        the loop. One check at a time per session; errors become one notification."""
+        s = self.session
+        if s.closed:
+            return
+        if self._checking:
+            s.notify("Check running", "A TCP check is still running here; wait for its result.", kind="info")
+            return
+        try:
+            with s.lock:
+                title, tool = which()
+                job = check_job(s.controller, tool, title, self.check_angle.value)
+                self.check_md.content = f"Checking {escape_markdown(title)} ..."
+        except ValueError as exc:
+            s.notify("Not done", str(exc), kind="warning")
+            return
+        self._checking = True
+        try:
+            result = await asyncio.get_running_loop().run_in_executor(_CHECK_WORKER, job.run)
+        except Exception as exc:  # a browser's click must never kill the server
+            log.exception("TCP check failed")
+            s.notify("TCP check failed", f"{type(exc).__name__}: {exc}", kind="error")
+            return
+        finally:
+            self._checking = False
+        with s.lock:
+            if s.closed:
+                return
+            self.last_check = (job, result)
+            self.check_md.content = check_markdown(job, result)
 
     def _entry(self) -> ToolEntry:
         return ToolEntry(str(self.entry_name.value), {f: str(h.value) for f, h in self.entry_fields.items()})

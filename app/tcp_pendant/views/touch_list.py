@@ -1,12 +1,44 @@
-""""Record point" and the list of captured touches, each deletable (viser GUI)."""
+""""Record point" and the list of captured touches, each deletable (viser GUI), and "Export
+CSV": the touches as POSES.csv (docs/cli.md; ``name,x,y,z,a,b,c,j1..jN``: the flange pose in
+WORLD, mm and KUKA A, B, C in degrees, and the joint values in degrees / mm) sent to the browser
+that clicked, ready for ``tcpcal solve xyz4``."""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any
 
-from tcp_pendant.session import Session, SessionChange
+import numpy as np
+from scipy.spatial.transform import Rotation
 
-__all__ = ["TouchListView"]
+from tcp_pendant.session import Session, SessionChange, Touch
+
+__all__ = ["TOUCHES_FILENAME", "TouchListView", "touches_csv_text"]
+
+TOUCHES_FILENAME = "touches.csv"
+
+
+def touches_csv_text(touches: Sequence[Touch]) -> str:
+    """POSES.csv of the touches (layout ``kuka``): ``name,x,y,z,a,b,c`` and ``j1..jN`` when
+    every touch has N joint values. Numbers written in full (``repr``), so a solve of the file
+    reproduces the session's poses exactly; names are the touch labels' first word (P1, P2, ...).
+
+    Raises:
+        ValueError: no touch recorded.
+    """
+    if not touches:
+        raise ValueError("No touch recorded yet: record points first (Record point), then export them.")
+    n_joints = {len(t.joints_deg) for t in touches}
+    joints = n_joints.pop() if len(n_joints) == 1 else 0
+    header = ["name", "x", "y", "z", "a", "b", "c", *(f"j{i + 1}" for i in range(joints))]
+    rows = [",".join(header)]
+    for i, t in enumerate(touches):
+        T = np.asarray(t.T_world_flange, dtype=float)
+        abc = Rotation.from_matrix(T[:3, :3]).as_euler("ZYX", degrees=True)
+        values = [*(T[:3, 3] * 1000.0), *abc, *(t.joints_deg if joints else ())]
+        name = (t.label.split() or [f"P{i + 1}"])[0].replace(",", "_").replace('"', "")
+        rows.append(",".join([name, *(repr(float(v)) for v in values)]))
+    return "\n".join(rows) + "\n"
 
 
 class TouchListView:
@@ -20,8 +52,11 @@ class TouchListView:
         self.folder = gui.add_folder("Touches")
         with self.folder:
             self.empty_md = gui.add_markdown("*No touch recorded.*")
+            self.export_csv = gui.add_button("Export CSV", hint="The touches as POSES.csv with joint values "
+                                             "(tcpcal solve xyz4), sent to this browser.")
         self._rows: list[Any] = []
         self.record.on_click(session.on_loop(self._on_record))
+        self.export_csv.on_click(session.on_loop(self._on_export_csv))
         session.subscribe(self.on_change)
 
     def on_change(self, change: SessionChange) -> None:
@@ -36,6 +71,12 @@ class TouchListView:
     def _on_record(self, _event: Any) -> None:
         t = self.session.record_touch()
         self.session.notify("Point recorded", t.label, kind="success")
+
+    def _on_export_csv(self, event: Any) -> None:
+        data = touches_csv_text(self.session.touches).encode("utf-8")
+        # to the browser that clicked (in --shared mode the session is every browser's)
+        target = getattr(event, "client", None) or self.session.client or self.session.target
+        target.send_file_download(TOUCHES_FILENAME, data, save_immediately=True)
 
     def _delete_cb(self, index: int, label: str) -> Any:
         def cb(_event: Any) -> None:

@@ -1,0 +1,116 @@
+"""The Tool tab's "Check" (TCP check, spin test) without the wizard: the job and its words.
+
+:func:`check_job` takes what the check needs from the session's controller (under the session
+lock, on viser's event loop) into a :class:`CheckJob` with its OWN pinocchio data (copies of
+the nominal and the physical robot model's ``RobotKinematics``), so :meth:`CheckJob.run` (six
+sub-stepped rotations, 0.1-0.3 s) can run in a worker thread while the loop keeps jogging;
+the controller is not moved. :func:`check_markdown` makes the result's text (the tool's name
+escaped: it is user text). No viser here.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from tcp_pendant.controller import RobotKinematics, VirtualController
+from tcp_pendant.controller.jog import JogSettings
+from tcp_pendant.controller.spin import MAX_SPIN_ANGLE_DEG, SpinCheckResult, spin_check
+from tcp_pendant.text_escape import escape_markdown
+from tcpcal.tool import Tool
+
+__all__ = ["CheckJob", "check_job", "check_markdown", "check_verdict"]
+
+GOOD_CHECK_MM = 0.5
+"""Implied TCP error up to which the check calls the TCP good (a careful touch's accuracy)."""
+
+
+def _own_copy(kin: RobotKinematics) -> RobotKinematics:
+    """The same robot with its own pinocchio data (safe in another thread)."""
+    return RobotKinematics(kin.model, kin.urdf_path, kin.flange_link, kin.base_link)
+
+
+@dataclass(frozen=True, eq=False)
+class CheckJob:
+    """Everything one TCP check needs, detached from the session (metres, radians).
+
+    Attributes:
+        title: what is checked, plain text (e.g. "slot 2: Torch").
+        tool: the tool data checked.
+        mounted_label: the physical tool on the flange (plain text).
+        angle_deg: the rotation angle, degrees.
+    """
+
+    title: str
+    tool: Tool
+    mounted_label: str
+    angle_deg: float
+    kinematics: RobotKinematics
+    true_kinematics: RobotKinematics
+    q_rad: np.ndarray
+    T_flange_tool_true: np.ndarray
+    settings: JogSettings
+
+    def run(self) -> SpinCheckResult:
+        """The check (``spin.spin_check``): the nominal model plans the motion about the tool
+        data's TCP, the physical robot and tool say where the true tip goes."""
+        T = np.eye(4)
+        T[:3, :3] = self.tool.rotation
+        T[:3, 3] = np.asarray(self.tool.tcp_mm, dtype=float) / 1000.0
+        return spin_check(self.kinematics, self.q_rad, T, self.T_flange_tool_true, angle_deg=self.angle_deg,
+                          true_kinematics=self.true_kinematics, settings=self.settings)
+
+
+def check_job(controller: VirtualController, tool: Tool, title: str, angle_deg: float) -> CheckJob:
+    """A :class:`CheckJob` of ``tool`` from the controller's current state.
+
+    Raises:
+        ValueError: an angle outside (0, 90] degrees (names the range).
+    """
+    try:
+        angle = float(angle_deg)
+    except (TypeError, ValueError):
+        raise ValueError(f"The check angle must be a number of degrees, got {angle_deg!r}.") from None
+    if not math.isfinite(angle) or not 0.0 < angle <= MAX_SPIN_ANGLE_DEG:
+        raise ValueError(f"The check angle must be above 0 and at most {MAX_SPIN_ANGLE_DEG:g} degrees "
+                         f"(technicians use 10-45), got {angle_deg!r}.")
+    c = controller
+    nominal = _own_copy(c.kinematics)
+    physical = nominal if c.true_kinematics is c.kinematics else _own_copy(c.true_kinematics)
+    return CheckJob(title=title, tool=tool, mounted_label=c.mounted_tool.label, angle_deg=angle,
+                    kinematics=nominal, true_kinematics=physical, q_rad=c.q_rad,
+                    T_flange_tool_true=np.array(c.mounted_tool.T_flange_tool_true, dtype=float),
+                    settings=c.settings)
+
+
+def check_verdict(result: SpinCheckResult) -> str:
+    """One line: good / off by how much / undetermined (plain text)."""
+    err = result.implied_tcp_error_mm
+    if err is None:
+        return "Not determined: fewer than two of A, B, C were reached; move away from limits and check again."
+    if err <= GOOD_CHECK_MM:
+        return f"TCP good: implied error {err:.3f} mm (at most {GOOD_CHECK_MM:g} mm)."
+    return f"TCP off by {err:.3f} mm: calibrate again (or the tool is bent)."
+
+
+def check_markdown(job: CheckJob, result: SpinCheckResult) -> str:
+    """The result as markdown: per rotation the tip's deviation (mm), then the implied TCP
+    error and the correction (user text escaped)."""
+    lines = [f"**TCP check of {escape_markdown(job.title)}** at ±{result.angle_deg:g}° "
+             f"(mounted: {escape_markdown(job.mounted_label)})", "",
+             "| Rotation | Tip moved (mm) | |", "|---|---:|---|"]
+    for r in result.rotations:
+        status = "✔" if r.reached else f"stopped: {escape_markdown(r.message or str(r.stopped_by))}"
+        lines.append(f"| {r.label} | {r.deviation_mm:.3f} | {status} |")
+    lines.append("")
+    err = result.implied_tcp_error_mm
+    if err is not None and result.implied_offset_flange_mm is not None:
+        dx, dy, dz = (float(v) for v in result.implied_offset_flange_mm)
+        lines.append(f"**Implied TCP error: {err:.3f} mm** (the true tip is at TCP + "
+                     f"({dx:+.3f}, {dy:+.3f}, {dz:+.3f}) mm in FLANGE axes); "
+                     f"what no TCP explains: {result.fit_rms_mm:.3f} mm RMS.")
+    lines.append("")
+    lines.append(f"**{check_verdict(result)}**")             # our own words, no user text
+    return "\n".join(lines)
