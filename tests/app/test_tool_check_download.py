@@ -104,6 +104,7 @@ def test_check_of_the_true_data_stays_put_and_a_1mm_error_shows(page) -> None:
     assert res.angle_deg == 20.0 and res.all_reached
     assert res.implied_tcp_error_mm == pytest.approx(1.0, abs=0.01)
     assert "TCP off by 1.000 mm" in p.tools.check_md.content
+    assert "(+0.000, -1.000, +0.000) mm in FLANGE axes" in p.tools.check_md.content   # no "-0.000"
     np.testing.assert_array_equal(p.session.controller.q_rad, q)    # the robot did not move
     assert p.notes == []
 

@@ -107,7 +107,7 @@ def check_markdown(job: CheckJob, result: SpinCheckResult) -> str:
     lines.append("")
     err = result.implied_tcp_error_mm
     if err is not None and result.implied_offset_flange_mm is not None:
-        dx, dy, dz = (float(v) for v in result.implied_offset_flange_mm)
+        dx, dy, dz = (0.0 if abs(v) < 5e-4 else float(v) for v in result.implied_offset_flange_mm)  # no "-0.000"
         lines.append(f"**Implied TCP error: {err:.3f} mm** (the true tip is at TCP + "
                      f"({dx:+.3f}, {dy:+.3f}, {dz:+.3f}) mm in FLANGE axes); "
                      f"what no TCP explains: {result.fit_rms_mm:.3f} mm RMS.")
