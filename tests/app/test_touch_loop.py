@@ -153,7 +153,7 @@ def test_the_delta_readout_is_the_jog_that_brings_the_tips_together(page, frame:
     p.choose(p.pendant.frame, frame)
     p.tip_at((4.3, -2.6, 7.1))
     text = p.pendant.touch_md.content
-    m = re.search(r"ΔX (\S+)  ΔY (\S+)  ΔZ (\S+) mm` \(" + frame, text)
+    m = re.search(r"ΔX (\S+)  ΔY (\S+)  ΔZ (\S+) mm` to the tip \(" + frame, text)
     assert m, text
     delta = [float(v) for v in m.groups()]
     with s.lock:
@@ -249,3 +249,15 @@ def test_continuous_jog_moves_at_the_override_speed_and_stops_at_release(app_fac
         assert xs[-1][1] == x_end                                   # the release click did not move
     finally:
         client.close()
+
+
+def test_the_scripted_trainee_touches_in_at_most_30_clicks() -> None:
+    """tests/bench/bench_trainee.py's trainee (only what the page shows) finishes the 4-point
+    calibration within 0.5 mm per touch, in at most 30 clicks per touch (issue 10's goal)."""
+    sys.path.insert(0, str(HERE.parent / "bench"))
+    from bench_trainee import run
+
+    out = run()
+    assert len(out["clicks"]) == 4 and max(out["distance_mm"]) <= 0.5
+    assert max(out["clicks"]) <= 30, out["clicks"]
+    assert out["tcp_error_mm"] and out["tcp_error_mm"][0] < 1.0       # a usable result

@@ -19,6 +19,11 @@ from pendant_page import TIMEOUT_MS, field  # noqa: E402
 pytestmark = pytest.mark.browser
 
 
+def option(page, name: str):
+    """The button of a button-group option, marked as selected ("✓ 10") or not ("10")."""
+    return page.get_by_role("button", name=re.compile(rf"^(✓ )?{re.escape(name)}$")).first
+
+
 def readout(page) -> str:
     """Text of the TCP readout (the monospace block under "TCP in ...")."""
     block = page.locator("pre").filter(has_text=re.compile(r"X\s+-?\d+\.\d\d mm")).first
@@ -91,14 +96,14 @@ def test_two_pages_jog_record_and_tool_entry(server, new_page, shot) -> None:
     assert r1 == r2                                        # both start at the ready pose
 
     # --- jog page 1 with the buttons: Z- then X- by 10 mm (increment 10, WORLD)
-    p1.get_by_role("button", name="10", exact=True).click()
+    option(p1, "10").click()                              # the selected increment already: "✓ 10"
     p1.get_by_role("button", name="Z −", exact=True).click()
     wait_numbers(p1, lambda n: abs(n["Z"] - (r1["Z"] - 10.0)) < 0.011, "Z - 10 mm")
     p1.get_by_role("button", name="X −", exact=True).click()
     j1 = wait_numbers(p1, lambda n: abs(n["X"] - (r1["X"] - 10.0)) < 0.011, "X - 10 mm")
     assert abs(j1["Y"] - r1["Y"]) < 0.011 and abs(j1["Z"] - (r1["Z"] - 10.0)) < 0.011
     # page 2 did not move: after a jog of its own (1 mm up) only that shows
-    p2.get_by_role("button", name="1", exact=True).click()
+    option(p2, "1").click()
     p2.get_by_role("button", name="Z +", exact=True).click()
     j2 = wait_numbers(p2, lambda n: abs(n["Z"] - (r2["Z"] + 1.0)) < 0.011, "Z + 1 mm")
     assert abs(j2["X"] - r2["X"]) < 0.011 and abs(j2["Y"] - r2["Y"]) < 0.011
@@ -150,3 +155,49 @@ def test_two_pages_jog_record_and_tool_entry(server, new_page, shot) -> None:
     p2.get_by_role("tab", name="Tool").click()
     p2.get_by_text("Selected: Pen").or_(p2.get_by_text("Pen (slot 1)")).first.wait_for(timeout=TIMEOUT_MS)
     shot(p2, "page2_sees_library")
+
+
+def _in_view(page, locator, what: str, height: int) -> None:
+    box = locator.bounding_box(timeout=TIMEOUT_MS)
+    assert box is not None, f"{what} is not shown"
+    assert box["y"] >= 0 and box["y"] + box["height"] <= height, f"{what} is below the fold: {box}"
+
+
+def delta(page) -> tuple[float, float, float]:
+    """The Δ readout's three numbers (mm)."""
+    loc = page.locator("code").filter(has_text=re.compile(r"ΔX")).first
+    m = re.search(r"ΔX (\S+)\s+ΔY (\S+)\s+ΔZ (\S+) mm", loc.inner_text(timeout=TIMEOUT_MS))
+    assert m, "no Δ readout"
+    return tuple(float(v) for v in m.groups())  # type: ignore[return-value]
+
+
+@pytest.mark.parametrize("size", [(1400, 900), (1024, 768)])
+def test_touch_loop_on_one_screen(server, new_page, shot, size) -> None:
+    """Issue 10: with a wizard running, the Jog tab shows its step, Record, Back/Next/Cancel,
+    the meter, the Δ readout and every jog key row without scrolling (1400x900); a far Record
+    asks first; the selected increment is marked."""
+    width, height = size
+    page = new_page(server.url, width=width, height=height)
+    page.get_by_role("tab", name="Calibrate").click()
+    page.get_by_role("button", name="Start", exact=True).click()
+    page.get_by_role("tab", name="Jog").click()
+    page.get_by_text("Step 1 of 4").first.wait_for(timeout=TIMEOUT_MS)
+    assert page.get_by_role("button", name="Record point").count() == 0 or \
+        not page.get_by_role("button", name="Record point").first.is_visible()   # one Record
+    d0 = delta(page)
+    shot(page, f"touch_loop_{width}x{height}")
+    if (width, height) == (1400, 900):
+        for name in ("Record", "◀ Back", "Next ▶", "Cancel", "X −", "X +", "C −", "C +", "✓ 10"):
+            _in_view(page, page.get_by_role("button", name=name, exact=True).first, name, height)
+        _in_view(page, page.get_by_text("Step 1 of 4").first, "the step", height)
+        _in_view(page, page.get_by_text("Pose diversity").first, "the meter", height)
+        _in_view(page, page.locator("code").filter(has_text="ΔX").first, "the Δ readout", height)
+    # a 10 mm X+ jog changes ΔX by -10 (the reference tip is 10 mm less ahead)
+    page.get_by_role("button", name="X +", exact=True).click()
+    deadline = time.monotonic() + TIMEOUT_MS / 1000
+    while abs(delta(page)[0] - (d0[0] - 10.0)) > 0.02:
+        assert time.monotonic() < deadline, f"Δ readout never followed the jog: {delta(page)} from {d0}"
+        page.wait_for_timeout(100)
+    page.get_by_role("button", name="Record", exact=True).click()          # far from the tip: asks
+    page.get_by_text(re.compile(r"Record\*?\*? again within")).first.wait_for(timeout=TIMEOUT_MS)
+    shot(page, f"record_asks_{width}x{height}")

@@ -27,6 +27,7 @@ from tcp_pendant.controller.pose_state import PoseState
 from tcp_pendant.controller.touch import CRASH_RADIUS_MM, TOUCH_TOLERANCE_MM
 
 __all__ = [
+    "CLOSEUP_WITHIN_MM",
     "CONTACT_RADIUS_MM",
     "ContactStop",
     "contact_stop",
@@ -37,12 +38,14 @@ __all__ = [
     "tip_offset_mm",
 ]
 
+CLOSEUP_WITHIN_MM = 20.0
+"""The close-up is shown when the tips are closer than this (farther, the Δ line says enough)."""
 CONTACT_RADIUS_MM = CRASH_RADIUS_MM
 """A translation whose tool-tip path passes closer than this to the reference tip stops where
 it is closest (the tip touches); farther, the tip passes beside the spike."""
 
 _SCALES_MM = (0.1, 0.25, 0.5, 1.0, 2.5, 5.0, 10.0, 25.0, 50.0, 100.0)
-_HALF_W, _HALF_H = 7, 3          # characters either side of the tool tip in the drawing
+_HALF_W, _HALF_H = 7, 2          # characters either side of the tool tip in the drawing
 
 
 def jog_frame_rotation(state: PoseState, frame: str) -> np.ndarray:
@@ -75,10 +78,10 @@ def _n(v: float) -> str:
 
 
 def offset_markdown(delta_mm: np.ndarray, frame: str) -> str:
-    """``ΔX +1.20  ΔY -0.40  ΔZ -3.00 mm (TOOL)``: the jog along each axis that brings the tool
-    tip onto the reference tip."""
+    """``ΔX +1.20  ΔY -0.40  ΔZ -3.00 mm`` to the tip (TOOL): the jog along each axis of the jog
+    frame that brings the tool tip onto the reference tip."""
     d = np.asarray(delta_mm, dtype=float)
-    return (f"`ΔX {_n(d[0])}  ΔY {_n(d[1])}  ΔZ {_n(d[2])} mm` ({frame}: jog this far to touch)")
+    return f"`ΔX {_n(d[0])}  ΔY {_n(d[1])}  ΔZ {_n(d[2])} mm` to the tip ({frame})"
 
 
 def direction_words(delta_mm: np.ndarray, frame: str) -> str:
@@ -97,10 +100,10 @@ def _scale(delta_mm: np.ndarray) -> float:
 
 
 def side_view_markdown(delta_mm: np.ndarray, frame: str) -> str:
-    """Two magnified views of the tips around the tool tip ``+``: the reference tip ``o``
-    (``@`` when they share a character; at the border when it is out of range). Left: X
-    across, Z up; right: Y across, Z up (the jog frame's axes). The scale (mm per
-    character) shrinks as the tips close in: 0.1 mm at the finest."""
+    """Two magnified views of the tips around the tool tip ``+`` (a code block): the reference
+    tip ``o`` (``@`` when they share a character; at the border when it is out of range). Left:
+    X across, Z up; right: Y across, Z up (the jog frame's axes). The scale (mm per character,
+    on the last line) shrinks as the tips close in: 0.1 mm at the finest."""
     d = np.asarray(delta_mm, dtype=float)
     s = _scale(d)
 
@@ -113,11 +116,10 @@ def side_view_markdown(delta_mm: np.ndarray, frame: str) -> str:
         return ["".join(r) for r in grid]
 
     left, right = panel(d[0], d[2]), panel(d[1], d[2])
-    width = 2 * _HALF_W + 1
-    head = f"{'X→  Z↑':<{width}}   {'Y→  Z↑':<{width}}"
-    lines = [head] + [f"{a}   {b}" for a, b in zip(left, right)]
-    return (f"Close-up ({frame}, 1 char = {s:g} mm; + tool tip, o reference tip):\n\n```\n"
-            + "\n".join(lines) + "\n```")
+    lines = [f"{a}   {b}" for a, b in zip(left, right)]
+    lines[0] += "  Z↑"
+    lines.append(f"{'X→':^{2 * _HALF_W + 1}}   {'Y→':^{2 * _HALF_W + 1}}  {s:g} mm/char")
+    return "```\n" + "\n".join(lines) + "\n```"
 
 
 @dataclass(frozen=True)

@@ -2,11 +2,10 @@
 
 Top to bottom (below the wizard dock, ``views.wizard_dock``): TCP readout (frame + tool), the
 touch indicator with the offset "ΔX ΔY ΔZ mm" of the reference tip along the jog frame's axes
-(both hidden by "Hide distance"), the status line (why a jog stopped), the increment, the jog
+and, within 20 mm, a magnified close-up of the two tips (all hidden by "Hide distance"), the status line (why a jog stopped), the increment, the jog
 keys - one row per axis with − and + side by side (X Y Z A B C, or A1..A6; in continuous mode
 the hold-to-jog keys, two per axis, since only single buttons report a hold) - then the jog
-settings (mode, frame, override, readout frame), the magnified close-up of the tips, the
-joints, Home and the camera buttons; the touches ("Record point" and the list) follow.
+settings (mode, frame, override, readout frame), the joints, Home and the camera buttons; the touches ("Record point" and the list) follow.
 Every button group marks its selected option with "✓ " (viser's button groups show no
 selection); a click's value is read without the mark. viser has no keyboard events for the
 GUI panel, so there are no keyboard shortcuts (README).
@@ -40,7 +39,7 @@ from tcp_pendant.pendant import (
     tcp_readout_markdown,
     touch_indicator_markdown,
 )
-from tcp_pendant.pendant.guidance import offset_markdown, side_view_markdown, tip_offset_mm
+from tcp_pendant.pendant.guidance import CLOSEUP_WITHIN_MM, offset_markdown, side_view_markdown, tip_offset_mm
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.views.scene import closeup_camera, overview_camera
 
@@ -113,6 +112,7 @@ class PendantPanel:
         self._readout = "WORLD"
         self.tcp_md = gui.add_markdown("")
         self.touch_md = gui.add_markdown("")
+        self.closeup_md = gui.add_markdown("", visible=False)
         self.hide_distance = gui.add_checkbox("Hide distance", session.hide_distance,
                                               hint="Training: judge the touch by eye, as on a real robot "
                                                    "(hides the distance, the Δ offsets and the close-up).")
@@ -165,7 +165,6 @@ class PendantPanel:
             self.override = gui.add_slider("Override %", min=1, max=100, step=1, initial_value=st.override_pct)
             self.readout_frame = gui.add_button_group("Readout", marked(("WORLD", "BASE"), self._readout))
             self.settings_md = gui.add_markdown("")
-        self.closeup_md = gui.add_markdown("")
         self.joints_md = gui.add_markdown("")
         self.home = gui.add_button("Ready pose", hint="Back to the start pose (teleport): HOME with the "
                                    "flange pointing down.")
@@ -353,7 +352,8 @@ class PendantPanel:
             jf = s.jogger.settings.frame
             delta = tip_offset_mm(state, s.controller.reference_tip_world_m, jf)
             touch += "\n\n" + offset_markdown(delta, jf)
-            closeup = side_view_markdown(delta, jf)
+            if state.touch.distance_mm <= CLOSEUP_WITHIN_MM:
+                closeup = side_view_markdown(delta, jf)
         self._set_md(self.touch_md, "touch", touch)
         self._set_md(self.closeup_md, "closeup", closeup)
         if self.closeup_md.visible != bool(closeup):

@@ -1,0 +1,176 @@
+"""The scripted trainee of issue 10: clicks and wall time per touch of one XYZ 4-point calibration.
+
+A trainee who follows only what the Jog tab shows: the wizard dock's step, the Δ readout
+("ΔX n ΔY n ΔZ n mm" to the tip, WORLD jog frame), the increment buttons and the compact jog
+key rows. No Auto-touch, no scripting of the robot. The pendant server runs in this process
+(a real viser server); one headless websocket client is the browser (tests/app/wsclient.py),
+and every click reaches the views as a browser's event does (tests/calibrate/guiclick.py), so
+each click is served exactly as in a browser (rendering, change signal, messages sent); what
+is not measured is a human's reading time and the browser's own rendering.
+
+Per touch k of the 4 standard orientations (the tool tilted with the B and C keys by 10 deg
+steps about the TCP, which is the flange: no tool is active yet):
+
+    1: as the ready pose (flange down)   2: B +30    3: B 0, C +30    4: C 0, B -30
+
+the trainee turns the tool (increment 10, B/C keys), then moves the tip onto the reference
+tip axis by axis, X and Y first and Z (the approach) last, like a person reading the Δ line:
+for each axis, from the largest increment down (100, 10, 1, 0.1 mm), it presses the key
+round(|Δ| / increment) times, re-reading the Δ line after every press, until the distance is
+within 0.5 mm (an axis within 0.25 mm is left alone); then Record and Next (Finish). A
+selection of an increment is a click. The figures printed: clicks and wall time per touch,
+next to the issue's figure before this work (464 clicks for the 4 touches, ~116 per touch,
+about 17 minutes on this machine driven in chromium).
+
+Run: ``.venv/bin/python tests/bench/bench_trainee.py`` (about 10-30 s).
+"""
+
+from __future__ import annotations
+
+import re
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE.parent / "app"))
+sys.path.insert(0, str(HERE.parent / "calibrate"))
+from guiclick import choose, click  # noqa: E402
+from wsclient import DrainingClient, wait_until  # noqa: E402
+
+from tcp_pendant.server import AppConfig, PendantApp  # noqa: E402
+from tcp_pendant.views.pendant_panel import MARK  # noqa: E402
+from tcp_pendant.views.wizard_dock import FINISH, NEXT  # noqa: E402
+
+BEFORE_CLICKS_PER_TOUCH = 116.0
+"""Issue 10's measurement before this work (464 clicks for one 4-point calibration)."""
+GOAL_CLICKS_PER_TOUCH = 30.0
+ORIENTATIONS_DEG: tuple[tuple[int, int], ...] = ((0, 0), (30, 0), (0, 30), (-30, 0))
+"""(B, C) of each touch relative to the ready pose, degrees."""
+INCREMENTS = ("100", "10", "1", "0.1")
+_DELTA = re.compile(r"ΔX (\S+)  ΔY (\S+)  ΔZ (\S+) mm")
+
+
+class Trainee:
+    """Clicks the page like a person reading it; counts the clicks."""
+
+    def __init__(self, app: PendantApp) -> None:
+        self.ws = DrainingClient(app.port)
+        wait_until(lambda: len(app.sessions) == 1, what="session built")
+        (self.session,) = app.sessions.values()
+        self.client = self.session.client
+        self.session.notify = lambda *a, **k: None      # type: ignore[method-assign]
+        self.pendant = self.session.views["pendant"]
+        self.dock = self.session.views["dock"]
+        self.clicks = 0
+
+    # what the page shows
+    def delta(self) -> np.ndarray:
+        m = _DELTA.search(self.pendant.touch_md.content)
+        assert m, f"no Δ readout on the page: {self.pendant.touch_md.content!r}"
+        return np.array([float(v) for v in m.groups()])
+
+    def distance(self) -> float:
+        m = re.search(r"(\d+\.\d\d) mm", self.pendant.touch_md.content)
+        assert m
+        return float(m.group(1))
+
+    def selected_increment(self) -> str:
+        return next(o[len(MARK):] for o in self.pendant.increment.options if o.startswith(MARK))
+
+    # clicks
+    def press_option(self, group, value: str) -> None:
+        choose(group, value, self.client)
+        self.clicks += 1
+
+    def press(self, handle) -> None:
+        click(handle, self.client)
+        self.clicks += 1
+
+    def increment(self, value: str) -> None:
+        if self.selected_increment() != value:
+            self.press_option(self.pendant.increment, value)
+
+    def key(self, axis: str, sign: int) -> None:
+        self.press_option(self.pendant.cart_rows[axis], f"{axis} {'+' if sign > 0 else '−'}")
+
+    # the skill
+    def turn(self, axis: str, degrees: int) -> None:
+        if degrees:
+            self.increment("10")
+        for _ in range(abs(degrees) // 10):
+            self.key(axis, 1 if degrees > 0 else -1)
+
+    def bring_tips_together(self, max_clicks: int = 400) -> None:
+        start = self.clicks
+        while self.distance() > 0.5:
+            if self.clicks - start > max_clicks:
+                raise RuntimeError(f"no touch after {max_clicks} clicks; Δ {self.delta()}")
+            for i, axis in enumerate("XYZ"):       # X, Y first; Z (the approach) last
+                for inc in INCREMENTS:
+                    step = float(inc)
+                    n = round(abs(self.delta()[i]) / step)
+                    if n == 0 or abs(self.delta()[i]) <= 0.25:
+                        continue
+                    self.increment(inc)
+                    for _ in range(int(n)):
+                        d = self.delta()[i]
+                        if abs(d) <= 0.25 or abs(d) < step / 2:
+                            break
+                        self.key(axis, 1 if d > 0 else -1)
+                if self.distance() <= 0.5:
+                    break
+
+
+def run() -> dict[str, list[float]]:
+    with tempfile.TemporaryDirectory() as tmp:
+        app = PendantApp(AppConfig(port=0, tool_library=Path(tmp) / "tools.json", library_poll_s=1.0))
+        app.start()
+        try:
+            t = Trainee(app)
+            calibrate = t.session.views["calibrate"]
+            click(calibrate.start, t.client)             # Calibrate tab: XYZ 4-point, Start (not counted)
+            clicks, seconds, dist = [], [], []
+            b = c = 0
+            for k, (b_deg, c_deg) in enumerate(ORIENTATIONS_DEG):
+                t.clicks = 0
+                t0 = time.perf_counter()
+                t.turn("B", b_deg - b)
+                t.turn("C", c_deg - c)
+                b, c = b_deg, c_deg
+                t.bring_tips_together()
+                dist.append(t.distance())
+                t.press(t.dock.record)
+                t.press_option(t.dock.nav, FINISH if k == len(ORIENTATIONS_DEG) - 1 else NEXT)
+                seconds.append(time.perf_counter() - t0)
+                clicks.append(float(t.clicks))
+            wf = calibrate.workflow
+            assert wf.result is not None, "the calibration did not finish"
+            truth = wf.truth()
+            err = None if truth is None else truth.position_error_mm
+            t.ws.ws.close()
+            return {"clicks": clicks, "seconds": seconds, "distance_mm": dist,
+                    "tcp_error_mm": [] if err is None else [float(err)]}
+        finally:
+            app.stop()
+
+
+def main() -> None:
+    out = run()
+    print("Scripted trainee, XYZ 4-point, 4 standard orientations, KR 6 + pointer (issue 10)")
+    print(f"{'touch':>5} {'(B, C) deg':>11} {'clicks':>7} {'wall s':>7} {'distance mm':>12}")
+    for k, ((b, c), n, s, d) in enumerate(zip(ORIENTATIONS_DEG, out["clicks"], out["seconds"],
+                                              out["distance_mm"])):
+        print(f"{k + 1:>5} {f'({b}, {c})':>11} {n:>7.0f} {s:>7.2f} {d:>12.2f}")
+    mean = float(np.mean(out["clicks"]))
+    print(f"clicks per touch: {mean:.1f} (before: ~{BEFORE_CLICKS_PER_TOUCH:.0f}; goal <= "
+          f"{GOAL_CLICKS_PER_TOUCH:.0f}), wall time per touch {np.mean(out['seconds']):.2f} s in-process")
+    if out["tcp_error_mm"]:
+        print(f"TCP error of the result vs the hidden truth: {out['tcp_error_mm'][0]:.3f} mm")
+
+
+if __name__ == "__main__":
+    main()
