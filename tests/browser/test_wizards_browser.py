@@ -12,6 +12,7 @@ from __future__ import annotations
 import json
 import re
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -23,20 +24,44 @@ from tcpcal.tool import Tool
 sys.path.insert(0, str(Path(__file__).parents[1] / "calibrate"))
 sys.path.insert(0, str(Path(__file__).parent))
 from calib_helpers import true_frame
-from pendant_page import (
-    TIMEOUT_MS,
-    assert_not_blank,
-    choose,
-    press,
-    text_of,
-    type_text,
-    wait_enabled,
-    wait_text,
-)
+from pendant_page import TIMEOUT_MS, assert_not_blank, choose, type_text
 
 pytestmark = pytest.mark.browser
 
 DISPLAY_TOL = 0.006     # the pendant shows two decimals
+
+
+# The Jog tab's wizard dock repeats the step's words and buttons (hidden while the Calibrate tab
+# is shown): these helpers look at what is visible only.
+def wait_text(page, pattern: str | re.Pattern[str], what: str | None = None) -> None:
+    """Wait until some visible element shows ``pattern`` (substring, or a regex)."""
+    loc = page.get_by_text(pattern) if isinstance(pattern, re.Pattern) else page.get_by_text(pattern, exact=False)
+    try:
+        loc.filter(visible=True).first.wait_for(state="visible", timeout=TIMEOUT_MS)
+    except Exception as exc:  # a clearer failure than Playwright's
+        raise AssertionError(f"never saw {what or pattern!r} on the page") from exc
+
+
+def press(page, name: str) -> None:
+    """Click the visible button named exactly ``name``."""
+    page.get_by_role("button", name=name, exact=True).filter(visible=True).first.click()
+
+
+def wait_enabled(page, name: str) -> None:
+    """Wait until a visible button ``name`` is enabled."""
+    btn = page.get_by_role("button", name=name, exact=True).filter(visible=True).first
+    btn.wait_for(state="visible", timeout=TIMEOUT_MS)
+    deadline = time.monotonic() + TIMEOUT_MS / 1000.0
+    while btn.is_disabled():
+        if time.monotonic() > deadline:
+            raise AssertionError(f"button {name!r} stayed disabled")
+        page.wait_for_timeout(50)
+
+
+def text_of(page, pattern: str | re.Pattern[str]) -> str:
+    """Inner text of the innermost visible element showing ``pattern``."""
+    loc = page.locator("div, p, td, span").filter(has_text=pattern).filter(visible=True).last
+    return str(loc.inner_text(timeout=TIMEOUT_MS))
 
 
 def truth(key: str) -> tuple[np.ndarray, np.ndarray]:
@@ -165,7 +190,7 @@ def test_reference_wizard_swaps_the_tool_and_saves(pendant_server, new_page, sho
     wait_text(page, "Step 2 of 2")
     # step 2 needs the torch: Record is disabled until the tool change
     wait_text(page, "Mount the welding torch (bent neck) first: the straight pointer is mounted now.")
-    assert page.get_by_role("button", name="Record", exact=True).is_disabled()
+    assert page.get_by_role("button", name="Record", exact=True).filter(visible=True).first.is_disabled()
     press(page, "Mount the welding torch (bent neck)")
     wait_enabled(page, "Record")
     shot(page, "reference_tool_swapped")
