@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 sys.path.insert(0, str(Path(__file__).parent))
-from pendant_page import TIMEOUT_MS, assert_not_blank, choose, wait_text  # noqa: E402
+from pendant_page import TIMEOUT_MS, assert_not_blank, choose, press, wait_enabled, wait_text  # noqa: E402
 
 from tcp_pendant.controller import builtin_tools  # noqa: E402
 from tcpcal.controllers import parse_tool_file  # noqa: E402
@@ -58,3 +58,15 @@ def test_check_a_saved_tool_download_its_abb_file_and_pick_a_scenario(server, ne
     page.get_by_text("Systematic error (training)").first.click()
     choose(page, "Systematic error", "Bent tool", echo=re.compile(r"Playing\s+Bent tool"))
     shot(page, "scenario_panel")
+    # a new calibration of the bent tool, then the panel explains how the bend shows
+    page.keyboard.press("Escape")                                 # the dropdown's list closed
+    wait_enabled(page, "Start")
+    press(page, "Start")
+    for k in range(1, 5):                   # the Calibrate tab's step (the Jog tab's dock is hidden)
+        page.locator(f"text=Step {k} of 4 >> visible=true").first.wait_for(timeout=TIMEOUT_MS)
+        press(page, "Auto-touch")
+    wait_text(page, "Against the true TOOL frame: good")            # the new TCP is the bent truth
+    page.get_by_text("Systematic error (training)").first.scroll_into_view_if_needed()
+    wait_text(page, "How this result shows it", "the scenario's explanation after the result")
+    wait_text(page, "The tool was bent in a crash")
+    shot(page, "scenario_explained")
