@@ -16,13 +16,14 @@ trainees activated or saved; the ``--shared`` session starts with the library's 
 
 from __future__ import annotations
 
+import asyncio
 import ipaddress
 import logging
 import secrets
 import socket
 import threading
 import time
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -45,7 +46,7 @@ from tcp_pendant.controller import (
 )
 from tcp_pendant.controller.scenarios import Scenario
 from tcp_pendant.session import Session
-from tcp_pendant.views import build_session_views
+from tcp_pendant.views import session_view_steps
 from tcp_pendant.views.scene import overview_camera, overview_pose
 from tcp_pendant.views.meshes import link_meshes, rigid_meshes
 
@@ -268,6 +269,16 @@ class PendantApp:
         """Build a session drawing into ``target`` (default: ``client``). A per-browser session
         starts with no active tool (TCP = flange); the shared one (``shared``) with the
         library's active tool (module docstring)."""
+        *_, session = self.session_steps(client, target, shared=shared)
+        assert session is not None
+        return session
+
+    def session_steps(self, client: Any | None, target: Any | None = None, *,
+                      shared: bool = False) -> Iterator[Session | None]:
+        """:meth:`make_session` step by step: yields None after each step (a view, a few to a few
+        tens of ms) and the finished session last (``on_client_connect`` awaits between the
+        steps on viser's event loop). Closing the generator early closes the half-built session.
+        """
         c = self.new_controller()
         session = Session(c, self.library, client=client, target=target, ready_q_rad=self.ready_q_rad,
                           shared=shared)
@@ -283,25 +294,15 @@ class PendantApp:
                 session.set_active_data(tool, slot)
         if self.config.scenario != "off":
             session.set_scenario(self.config.scenario, self.config.scenario_seed)
-        build_session_views(session, title=f"TCP Pendant · {self.robot_label}")
+        try:
+            for _ in session_view_steps(session, title=f"TCP Pendant · {self.robot_label}"):
+                yield None
+        except GeneratorExit:
+            session.close()
+            raise
         if self.classroom is not None and not shared:
             self.classroom.attach(session)
-        return session
-
-    def open_session(self, client: Any) -> Session | None:
-        """``on_client_connect``: a new session for this browser (None if it left meanwhile)."""
-        try:
-            session = self.make_session(client)
-        except Exception:
-            log.exception("building the session of client %s failed", getattr(client, "client_id", "?"))
-            return None
-        with self._sessions_lock:
-            self.sessions[client.client_id] = session
-        try:
-            overview_camera(client, self.reference_tip_m)
-        except Exception:
-            log.debug("camera of a leaving client", exc_info=True)
-        return session
+        yield session
 
     def close_session(self, client: Any) -> None:
         """``on_client_disconnect``: close and forget the browser's session."""
@@ -310,7 +311,10 @@ class PendantApp:
         if session is not None:
             session.close()
 
-    def _on_connect(self, client: Any) -> None:
+    async def _on_connect(self, client: Any) -> None:
+        """``on_client_connect``, on viser's event loop (every push from the loop's thread): the
+        browser's session is built a view at a time, other browsers' callbacks run in between;
+        a browser that left meanwhile gets nothing registered."""
         if self.config.shared:
             if self.shared_session is not None:
                 try:
@@ -318,9 +322,30 @@ class PendantApp:
                 except Exception:
                     log.debug("camera of a leaving client", exc_info=True)
             return
-        self.open_session(client)
+        steps = self.session_steps(client)
+        session: Session | None = None
+        try:
+            for session in steps:
+                if session is not None:
+                    break
+                await asyncio.sleep(0)
+                if self.server is None or client.client_id not in self.server.get_clients():
+                    steps.close()                       # left while its session was built
+                    return
+        except Exception:
+            log.exception("building the session of client %s failed", getattr(client, "client_id", "?"))
+            return
+        if session is None:
+            return
+        with self._sessions_lock:
+            self.sessions[client.client_id] = session
+        try:
+            overview_camera(client, self.reference_tip_m)
+        except Exception:
+            log.debug("camera of a leaving client", exc_info=True)
 
-    def _on_disconnect(self, client: Any) -> None:
+    async def _on_disconnect(self, client: Any) -> None:
+        """``on_client_disconnect``, on viser's event loop like every other callback."""
         if not self.config.shared:
             self.close_session(client)
 

@@ -31,8 +31,9 @@ callback, so viser runs it on its event loop, one at a time and in the order the
 messages arrived, and the messages it queues are pushed from the loop's own thread (viser's
 message buffer is not safe to push to from other threads). :meth:`Session.guard` is the
 synchronous part: it takes ``session.lock`` (a re-entrant lock, still taken because a few
-things run elsewhere: the session is built in viser's thread pool, tests drive sessions from
-their own thread), ignores events after the session closed, and turns any exception into a
+things run elsewhere: workers copy state under it (Check, record replay), tests drive
+sessions from their own thread; the session itself is built on the loop, see
+``PendantApp.session_steps``), ignores events after the session closed, and turns any exception into a
 notification instead of a crash (a browser can send anything). Work from another thread is
 handed to the loop (the server's library watcher: ``loop.call_soon_threadsafe``).
 """

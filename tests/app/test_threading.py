@@ -316,3 +316,74 @@ def test_on_loop_runs_callbacks_on_the_loop_under_the_guard(app_factory) -> None
         assert len(seen) == 1                             # closed: ignored
     finally:
         b.close()
+
+
+def test_sessions_are_built_and_closed_on_the_event_loop_while_others_jog(app_factory) -> None:
+    """Browsers that connect and leave while another one jogs: every message of the new
+    sessions' builds (scene, panels, first state) and of the closes is pushed from viser's
+    event loop thread (before: ``on_client_connect`` built the session in viser's thread pool),
+    the build is spread over several loop turns, and a browser that leaves mid-build leaves no
+    session behind."""
+    app = app_factory()
+    jogger, session = _browser_session(app)
+    _joint_mode(jogger, session)
+    loop = app.server.get_event_loop()
+    loop_thread: list[int] = []
+    loop.call_soon_threadsafe(lambda: loop_thread.append(threading.get_ident()))
+    wait_until(lambda: bool(loop_thread), what="loop thread")
+
+    pushes: list[int] = []
+    real_push = AsyncMessageBuffer.push
+
+    def recording_push(self: Any, message: Any) -> None:
+        pushes.append(threading.get_ident())
+        real_push(self, message)
+
+    turns = 0
+    stop_ticks = threading.Event()
+
+    def tick() -> None:                                   # counts loop turns during the builds
+        nonlocal turns
+        turns += 1
+        if not stop_ticks.is_set():
+            loop.call_soon(tick)
+
+    AsyncMessageBuffer.push = recording_push              # type: ignore[method-assign]
+    visitors: list[Browser] = []
+    try:
+        loop.call_soon_threadsafe(tick)
+        q0 = float(np.degrees(session.controller.q_rad[1]))
+        stop = threading.Event()
+
+        def jog() -> None:
+            j = 0
+            while not stop.is_set() and j < 400:
+                j += 1
+                jogger.set(session.views["pendant"].joint_sliders[1], q0 + 0.05 * (j % 40))
+                time.sleep(0.01)
+
+        t = threading.Thread(target=jog)
+        t.start()
+        try:
+            for i in range(3):
+                visitors.append(Browser(app.port))
+                wait_until(lambda i=i: len(app.sessions) == 2 + i, what="visitor session built")
+            leaver = Browser(app.port)                    # leaves at once, likely mid-build
+            leaver.close()
+            for b in visitors:
+                b.close()
+            wait_until(lambda: len(app.sessions) == 1, what="visitors' sessions closed")
+        finally:
+            stop.set()
+            t.join()
+        time.sleep(0.3)
+    finally:
+        stop_ticks.set()
+        AsyncMessageBuffer.push = real_push               # type: ignore[method-assign]
+        for b in visitors:
+            b.close()
+    assert list(app.sessions.values()) == [session]
+    assert len(pushes) > 100
+    off = [ident for ident in pushes if ident != loop_thread[0]]
+    assert off == [], f"{len(off)} of {len(pushes)} pushes off the event loop"
+    assert turns > 10                                      # the loop kept turning meanwhile

@@ -9,7 +9,10 @@ then the trainer's "Systematic error" panel).
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+
 from tcp_pendant.session import Session
+from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.calibrate import build_calibrate_tab, register_calibrate_view
 from tcp_pendant.views.pendant_panel import PendantPanel
 from tcp_pendant.views.scenario_panel import ScenarioPanel
@@ -27,6 +30,7 @@ __all__ = [
     "WizardDock",
     "build_calibrate_tab",
     "build_session_views",
+    "session_view_steps",
     "register_calibrate_view",
 ]
 
@@ -38,21 +42,39 @@ def build_session_views(session: Session, *, title: str = "TCP Pendant") -> None
     ``"calibrate"`` when a wizard plug-in is installed; for tests: the views never reach each
     other), each subscribed to the session's change signal, then pushes the first state.
     """
+    for _ in session_view_steps(session, title=title):
+        pass
+
+
+def session_view_steps(session: Session, *, title: str = "TCP Pendant") -> Iterator[str]:
+    """:func:`build_session_views` one view at a time: yields the name of each view built.
+
+    The server builds a browser's session on viser's event loop and awaits between the steps
+    (each a few to a few tens of ms), so other browsers are not stalled for a whole build. The
+    lock and the GUI's ``atomic()`` are held from the first step to the last: nothing built is
+    sent to the browser before the whole GUI is there, so no browser event can reach a
+    half-built session. Closing the generator early (the browser left) leaves the context
+    managers properly; the caller closes the session.
+    """
     with session.lock, session.target.atomic():
         gui = session.target.gui
         session.views["scene"] = SceneView(session)
-        gui.add_markdown(f"### {title}")
+        yield "scene"
+        gui.add_markdown(f"### {escape_markdown(title)}")
         tabs = gui.add_tab_group()
         with tabs.add_tab("Jog"):
             session.views["dock"] = WizardDock(session)      # the running wizard's step, on top
             session.views["pendant"] = PendantPanel(session)
             session.views["touches"] = TouchListView(session)
+        yield "jog"
         with tabs.add_tab("Tool"):
             session.views["tools"] = ToolPanel(session)
+        yield "tool"
         calibrate_tab = tabs.add_tab("Calibrate")
         build_calibrate_tab(session, calibrate_tab)
         session.workflow = getattr(session.views.get("calibrate"), "workflow", None)
         with calibrate_tab:
             session.views["scenario"] = ScenarioPanel(session)
         session.views["tabs"] = tabs
+        yield "calibrate"
     session.changed(pose=True, tool=True)
