@@ -92,3 +92,69 @@ def test_a_held_key_stops_at_contact_until_released(controller: VirtualControlle
     jog.release()
     clock.t += 1.0
     assert jog.key("X", 1, hold_tick=True).ok        # a new hold goes on
+
+
+class _Scheduler:
+    """A fake ``call_later``: runs the due callbacks when the test advances the clock."""
+
+    def __init__(self, clock: FakeClock) -> None:
+        self.clock = clock
+        self.pending: list[tuple[float, object]] = []
+
+    def __call__(self, delay_s: float, fn):
+        entry = [self.clock.t + delay_s, fn, False]
+
+        class Handle:
+            def cancel(self_inner) -> None:
+                entry[2] = True
+
+        self.pending.append(entry)  # type: ignore[arg-type]
+        return Handle()
+
+    def advance(self, seconds: float) -> None:
+        end = self.clock.t + seconds
+        while True:
+            due = [e for e in self.pending if e[0] <= end and not e[2]]
+            if not due:
+                break
+            e = min(due, key=lambda e: e[0])
+            self.pending.remove(e)
+            self.clock.t = max(self.clock.t, e[0])
+            e[1]()
+        self.clock.t = end
+
+
+def test_hold_driver_ticks_at_20hz_until_release_or_deadman() -> None:
+    from tcp_pendant.controller import JogResult
+    from tcp_pendant.pendant.hold import DEADMAN_S, HoldDriver
+
+    clock = FakeClock()
+    sched = _Scheduler(clock)
+    steps: list[float] = []
+    driver = HoldDriver(lambda axis, sign: steps.append(clock.t) or JogResult(True, 1.0, None, ""),
+                        sched, clock=clock)
+    driver.held("X", 1)                              # one message, then silence
+    sched.advance(0.5)
+    assert len(steps) == 11                          # now + every 50 ms
+    driver.held("X", 1)                              # a late message keeps it going
+    sched.advance(0.5)
+    assert len(steps) == 21
+    driver.release()
+    sched.advance(1.0)
+    assert len(steps) == 21                          # nothing after the release
+    driver.held("Y", -1)
+    sched.advance(DEADMAN_S + 0.5)                   # the browser went quiet: the deadman stops it
+    assert driver.key is None and len(steps) <= 21 + int(DEADMAN_S / 0.05) + 2
+
+
+def test_hold_driver_stops_when_a_jog_stops_short() -> None:
+    from tcp_pendant.controller import JogResult
+    from tcp_pendant.pendant.hold import HoldDriver
+
+    clock = FakeClock()
+    sched = _Scheduler(clock)
+    results = iter([JogResult(True, 1.0, None, ""), JogResult(False, 0.3, "contact", "Stopped")])
+    driver = HoldDriver(lambda a, s: next(results), sched, clock=clock)
+    driver.held("Z", -1)
+    sched.advance(0.2)
+    assert driver.key is None

@@ -261,3 +261,35 @@ def test_the_scripted_trainee_touches_in_at_most_30_clicks() -> None:
     assert len(out["clicks"]) == 4 and max(out["distance_mm"]) <= 0.5
     assert max(out["clicks"]) <= 30, out["clicks"]
     assert out["tcp_error_mm"] and out["tcp_error_mm"][0] < 1.0       # a usable result
+
+
+def test_continuous_jog_keeps_its_speed_when_the_browser_sends_few_hold_messages(app_factory) -> None:
+    """A busy browser (software WebGL here) sends its 20 Hz hold messages 0.4-0.6 s apart; the
+    server's own 20 Hz ticks keep the set speed, in steps no larger than one tick's."""
+    app = app_factory()
+    client = ButtonClient(app.port, ("X +",))
+    assert client.found.wait(30)
+    wait_until(lambda: len(app.sessions) == 1, what="session built")
+    (s,) = app.sessions.values()
+    try:
+        with s.lock:
+            s.jogger.settings = s.jogger.settings.with_(increment="Cont.", override_pct=50, frame="WORLD")
+        xs: list[float] = []
+        s.add_motion_listener(lambda: xs.append(float(s.controller.T_world_tcp()[0, 3])))
+        x0 = float(s.controller.T_world_tcp()[0, 3])
+        t0 = time.monotonic()
+        for _ in range(3):
+            client.hold_tick("X +", HOLD_HZ)
+            time.sleep(0.5)
+        client.click("X +")
+        held_s = time.monotonic() - t0
+        time.sleep(0.3)
+        x_end = float(s.controller.T_world_tcp()[0, 3])
+        speed = (x_end - x0) * 1000.0 / held_s
+        print(f"sparse hold messages: {speed:.1f} mm/s over {held_s:.2f} s, {len(xs)} ticks")
+        assert speed == pytest.approx(125.0, rel=0.2)
+        assert np.diff([x0] + xs).max() * 1000.0 <= 125.0 / HOLD_HZ * 1.001
+        time.sleep(0.2)
+        assert float(s.controller.T_world_tcp()[0, 3]) == x_end      # stopped at the release
+    finally:
+        client.close()

@@ -201,3 +201,63 @@ def test_touch_loop_on_one_screen(server, new_page, shot, size) -> None:
     page.get_by_role("button", name="Record", exact=True).click()          # far from the tip: asks
     page.get_by_text(re.compile(r"Record\*?\*? again within")).first.wait_for(timeout=TIMEOUT_MS)
     shot(page, f"record_asks_{width}x{height}")
+
+
+def _click_until_close(page, height: int) -> None:
+    """Bring the tool tip onto the reference tip with the keys, reading only the Δ line."""
+    for _ in range(40):
+        d = delta(page)
+        if max(abs(v) for v in d) <= 0.25:
+            return
+        i = max(range(3), key=lambda k: abs(d[k]))
+        inc = next(v for v in ("100", "10", "1", "0.1") if abs(d[i]) >= float(v) / 2)
+        option(page, inc).click()
+        page.get_by_role("button", name=re.compile(rf"^✓ {re.escape(inc)}$")).first.wait_for(timeout=TIMEOUT_MS)
+        before = d
+        page.get_by_role("button", name=f"{'XYZ'[i]} {'+' if d[i] > 0 else '−'}", exact=True).click()
+        deadline = time.monotonic() + TIMEOUT_MS / 1000
+        while delta(page) == before:
+            assert time.monotonic() < deadline, "the Δ line did not follow the key"
+            page.wait_for_timeout(50)
+    raise AssertionError(f"not at the tip after 40 clicks: {delta(page)}")
+
+
+def test_close_up_and_contact_stop_in_the_browser(server, new_page, shot) -> None:
+    """Issue 10 item 3: following only the Δ line, the tip reaches the reference tip; on the way
+    an increment that would have passed through it stopped there and said so; the close-up
+    shows under the Δ line and every key row is still above the fold at 1400x900."""
+    page = new_page(server.url)
+    _click_until_close(page, 900)
+    page.get_by_text(re.compile(r"mm/char")).first.wait_for(timeout=TIMEOUT_MS)
+    _in_view(page, page.get_by_role("button", name="C +", exact=True).first, "C +", 900)
+    _in_view(page, page.get_by_text(re.compile(r"mm/char")).first, "the close-up", 900)
+    assert page.get_by_text("TOUCHING").count() >= 1
+    assert page.get_by_text(re.compile(r"Stopped at the reference tip after")).count() >= 1
+    shot(page, "closeup_touching_1400x900")
+
+
+def test_continuous_jog_speed_in_the_browser(server, new_page) -> None:
+    """Issue 10 item 5, in chromium: holding X + for about 1 s at 50 % moves at about 125 mm/s
+    (the server's 20 Hz ticks, whatever the rate of the browser's hold messages), and stops."""
+    page = new_page(server.url)
+    r0 = wait_numbers(page, lambda n: True, "a readout")
+    option(page, "Cont.").click()
+    key = page.get_by_role("button", name="X +", exact=True).first
+    key.wait_for(state="visible", timeout=TIMEOUT_MS)
+    box = key.bounding_box()
+    page.mouse.move(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)
+    page.mouse.down()
+    t0 = time.monotonic()
+    page.wait_for_timeout(1000)
+    page.mouse.up()
+    held = time.monotonic() - t0
+    page.wait_for_timeout(1000)
+    r1 = numbers(readout(page))
+    page.wait_for_timeout(700)
+    r2 = numbers(readout(page))
+    speed = (r1["X"] - r0["X"]) / held
+    print(f"browser continuous jog: {speed:.1f} mm/s (set 125) over {held:.2f} s held")
+    # the release reaches the server when this (software-rendering) browser sends it: the
+    # figure includes that latency; before issue 10 it was 9-14 mm/s here
+    assert 0.6 * 125 <= speed <= 1.3 * 125
+    assert r2["X"] == r1["X"]                              # it stopped (within a tick: test_touch_loop)

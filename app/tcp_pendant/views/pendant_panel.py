@@ -23,6 +23,7 @@ newer-or-equal value; writing the rounded angle back would pull its slider to an
 
 from __future__ import annotations
 
+import asyncio
 import math
 from typing import Any
 
@@ -39,6 +40,7 @@ from tcp_pendant.pendant import (
     tcp_readout_markdown,
     touch_indicator_markdown,
 )
+from tcp_pendant.pendant.hold import HoldDriver
 from tcp_pendant.pendant.guidance import CLOSEUP_WITHIN_MM, offset_markdown, side_view_markdown, tip_offset_mm
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.views.scene import closeup_camera, overview_camera
@@ -51,7 +53,8 @@ except ImportError:                    # pragma: no cover
 __all__ = ["HOLD_HZ", "MARK", "PendantPanel", "marked", "set_markdown", "unmarked"]
 
 HOLD_HZ = 20.0
-"""Rate of the hold-to-jog callbacks (continuous jog ticks per second)."""
+"""Rate the browser is asked to send hold messages at; the jog itself ticks on the server's
+20 Hz clock (``pendant.hold.HoldDriver``) while they keep coming."""
 
 _AXIS_HINT = {"X": "translate along X (mm)", "Y": "translate along Y (mm)", "Z": "translate along Z (mm)",
               "A": "rotate about Z through the TCP (deg)", "B": "rotate about Y through the TCP (deg)",
@@ -107,6 +110,7 @@ class PendantPanel:
         self._last_text: dict[str, str] = {}
         self._last_stop = ""
         self._stop_key: Any = None
+        self._hold: HoldDriver | None = None
 
         st = session.jogger.settings
         self._readout = "WORLD"
@@ -209,15 +213,49 @@ class PendantPanel:
         session lock, and never waits on the event loop."""
         on_loop = self.session.on_loop
         button.on_click(on_loop(lambda _event: self._jog(axis, sign, hold_tick=False)))
-        button.on_hold(on_loop(lambda _event: self._jog(axis, sign, hold_tick=True)), callback_hz=HOLD_HZ)
+        button.on_hold(on_loop(lambda _event: self._on_hold(axis, sign)), callback_hz=HOLD_HZ)
 
     def _jog(self, axis: str | int, sign: int, *, hold_tick: bool) -> None:
-        res = self.session.jogger.key(axis, sign, hold_tick=hold_tick)
         if hold_tick is False and self.session.jogger.settings.continuous:
-            self.session.jogger.release()            # the click that ends a hold
+            self._stop_hold()                        # the click that ends a hold: no move
+            return
+        res = self.session.jogger.key(axis, sign, hold_tick=hold_tick)
         if res is None:
             return
         self.session.moved(res)
+
+    # hold-to-jog on the server's 20 Hz clock (pendant/hold.py)
+    def _on_hold(self, axis: str | int, sign: int) -> None:
+        """A browser's hold message: the first starts the server's ticks, later ones keep them
+        alive (the browser may send them far slower than 20 Hz)."""
+        if not self.session.jogger.settings.continuous:
+            return
+        if self._hold is None:
+            loop = asyncio.get_running_loop()
+            guard = self.session.guard
+
+            def schedule(delay_s: float, fn: Any) -> Any:
+                return loop.call_later(delay_s, guard(fn))
+
+            self._hold = HoldDriver(self._hold_step, schedule)
+            self.session.on_close(self._hold.stop)
+        self._hold.held(axis, sign)
+
+    def _hold_step(self, axis: str | int, sign: int) -> JogResult | None:
+        """One server tick of the held key (under the session lock, on the loop)."""
+        s = self.session
+        if s.closed or not s.jogger.settings.continuous:
+            self._stop_hold()
+            return None
+        res = s.jogger.key(axis, sign, hold_tick=True)
+        if res is not None:
+            s.moved(res)
+        return res
+
+    def _stop_hold(self) -> None:
+        if self._hold is not None:
+            self._hold.stop()
+        self.session.jogger.release()
 
     def _row_cb(self, axis: str | int) -> Any:
         """Click on a compact key row: the value is the key's label ("X +", "A3 −")."""
@@ -271,7 +309,7 @@ class PendantPanel:
             js = self.session.jogger
             value = event.target.value
             js.settings = js.settings.with_(**{name: kind(unmarked(value) if isinstance(value, str) else value)})
-            js.release()
+            self._stop_hold()
             self._show_settings()
             self.render()
         return cb

@@ -1,0 +1,110 @@
+"""Hold-to-jog driven by the server's own 20 Hz clock (no viser, no asyncio).
+
+A browser reports a held key by hold messages it means to send at 20 Hz; a busy browser (this
+project's 2-core machine renders WebGL in software) sends them 0.4-0.6 s apart. Jogging once per
+message then moves at a fraction of the set speed, in bursts. So the server moves on its own
+clock instead: the first hold message of a key starts a tick every ``period_s`` that jogs one
+tick's worth (``Jogger.key(..., hold_tick=True)``: ``speed * override * dt``, ``dt`` capped at
+one tick), the browser's later hold messages only say the key is still held, and the key stops
+
+* at the release (the click the browser sends when the key is let go): at once, so the robot
+  stops within one tick of the release reaching the server;
+* when no hold message came for ``deadman_s`` (the browser went away or froze: an enabling
+  switch let go);
+* when a jog stops short (limit, singularity, contact).
+
+:class:`HoldDriver` is told how to schedule (``schedule(delay_s, fn)``: the app passes viser
+event loop's ``call_later`` so every tick runs on the loop, like every GUI callback).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from typing import Any
+
+from tcp_pendant.controller import JogResult
+
+__all__ = ["DEADMAN_S", "HOLD_PERIOD_S", "HoldDriver"]
+
+HOLD_PERIOD_S = 0.05
+"""The server's jog tick while a key is held (20 Hz)."""
+DEADMAN_S = 1.0
+"""A held key stops when no hold message came for this long (s)."""
+
+Key = tuple[Any, int]
+
+
+class HoldDriver:
+    """Moves a held key on the server's clock (see the module docstring).
+
+    Args:
+        step: jog one tick of ``(axis, sign)``; returns the move's result (None: no move).
+        schedule: ``schedule(delay_s, fn)`` calls ``fn()`` later; returns a handle with
+            ``cancel()``.
+        clock: seconds, monotonic.
+        period_s, deadman_s: see the module constants.
+    """
+
+    def __init__(self, step: Callable[[Any, int], JogResult | None],
+                 schedule: Callable[[float, Callable[[], None]], Any], *,
+                 clock: Callable[[], float] = time.monotonic, period_s: float = HOLD_PERIOD_S,
+                 deadman_s: float = DEADMAN_S) -> None:
+        self._step = step
+        self._schedule = schedule
+        self._clock = clock
+        self.period_s = period_s
+        self.deadman_s = deadman_s
+        self.key: Key | None = None
+        self._last_message = 0.0
+        self._next_at = 0.0
+        self._timer: Any = None
+
+    @property
+    def active(self) -> bool:
+        """A key is being held (its ticks are scheduled)."""
+        return self.key is not None
+
+    def held(self, axis: Any, sign: int) -> JogResult | None:
+        """A hold message of key ``(axis, sign)``: start moving (first tick now) or keep going.
+        Another key's message takes over from the one held before."""
+        now = self._clock()
+        self._last_message = now
+        if self.key == (axis, sign):
+            return None
+        self.stop()
+        self.key = (axis, sign)
+        self._next_at = now
+        return self._tick()
+
+    def release(self) -> None:
+        """The key was let go."""
+        self.stop()
+
+    def stop(self) -> None:
+        """Stop moving (no further tick)."""
+        self.key = None
+        if self._timer is not None:
+            try:
+                self._timer.cancel()
+            except Exception:
+                pass
+            self._timer = None
+
+    def _tick(self) -> JogResult | None:
+        self._timer = None
+        key = self.key
+        if key is None:
+            return None
+        now = self._clock()
+        if now - self._last_message > self.deadman_s:
+            self.stop()
+            return None
+        res = self._step(*key)
+        if res is not None and not res.ok:
+            self.stop()
+            return res
+        if self.key == key:
+            self._next_at = max(self._next_at + self.period_s, now + 0.2 * self.period_s)
+            self._timer = self._schedule(self._next_at - now, self._tick)
+        return res
