@@ -207,6 +207,7 @@ class Session:
         self._free_records = 0                          # "Record point" clicks (free touches)
         self._scenario_base = 0                         # touches recorded before the scenario was set
         self._scenario_touches = 0                      # touches recorded since (never decreases)
+        self._wizard_stamps: dict[tuple[int, int], str] = {}  # (id(run), step) -> recorded_at seen
 
     # ------------------------------------------------------------ the change signal
     def subscribe(self, fn: Callable[[SessionChange], None]) -> None:
@@ -252,6 +253,8 @@ class Session:
     def _emit(self, change: SessionChange) -> None:
         if self.closed:
             return
+        if change.wizard:
+            self._note_wizard_joints()
         if self._play_moved_reference():
             change = replace(change, pose=True)
         if change.pose or change.tool:
@@ -459,6 +462,30 @@ class Session:
             return False
         self.controller.set_reference_tip(tip)
         return True
+
+    def _note_wizard_joints(self) -> None:
+        """After a wizard change: the joint values of each step the open run recorded since the
+        last signal (``WizardRun.joints_deg``, exported in the session record), taken only when
+        the robot is still at the recorded flange pose (else that step has none)."""
+        run = getattr(self.workflow, "run", None)
+        joints = getattr(run, "joints_deg", None)
+        if run is None or joints is None:
+            return
+        poses = run.wizard.recorded_poses
+        for step in [k for k in joints if k not in poses]:
+            del joints[step]
+        T_now: np.ndarray | None = None
+        for step, pose in poses.items():
+            key = (id(run), step)
+            if self._wizard_stamps.get(key) == pose.recorded_at:
+                continue
+            self._wizard_stamps[key] = pose.recorded_at
+            if T_now is None:
+                T_now = self.controller.T_world_flange()
+            if np.allclose(T_now, pose.T_world_flange_m, rtol=0.0, atol=1e-12):
+                joints[step] = tuple(self.controller.joint_angles_deg().values())
+            else:
+                joints.pop(step, None)
 
     # ------------------------------------------------------------ touches
     def record_touch(self) -> Touch:

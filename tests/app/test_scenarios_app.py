@@ -261,3 +261,27 @@ def test_touches_carry_their_joint_values_into_the_session_record(page) -> None:
     bad = dict(record, touches=[dict(record["touches"][0], joints_deg=["x"])])
     with pytest.raises(SessionRecordError, match="joints_deg"):
         check_session_record(bad)
+
+
+def test_wizard_touches_carry_their_joint_values_into_the_session_record(page) -> None:
+    from tcp_pendant.wizards.session_record import load_and_replay
+
+    p = page()
+    c = p.session.controller
+    auto_xyz4(p)
+    wf = p.calibrate.workflow
+    record = wf.export_record(p.session.touches)
+    entry = record["wizards"][0]
+    joints = entry["joints_deg"]
+    assert sorted(joints) == ["0", "1", "2", "3"]
+    for step, q_deg in joints.items():
+        q = np.radians(q_deg)
+        pose = np.array(entry["state"]["poses"][step]["T_world_flange_m"])
+        np.testing.assert_allclose(c.kinematics.T_world_flange(q), pose, atol=1e-12)   # the recorded pose
+    check_session_record(record)
+    assert load_and_replay(record).checks[0].message                    # still replays
+    del entry["joints_deg"]
+    check_session_record(record)                                         # records before issue 12
+    entry["joints_deg"] = {"0": [float("inf")]}
+    with pytest.raises(SessionRecordError, match="joints_deg"):
+        check_session_record(record)

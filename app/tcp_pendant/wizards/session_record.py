@@ -49,6 +49,8 @@ angles in degrees; poses are 4x4 row-major nested lists; times ISO 8601 UTC. The
           "true_tool": {"key": str | null, "T_flange_tcp_true_m": 4x4} | null,
                                                   # honest: {"key": str} (no frame), "truth": null
           "record_id": int | null,                # the gradebook's calibration id (classroom)
+          "joints_deg": {"0": [j1, ..., jN], ...},  # optional (issue 12): joint values of the
+                                                  # recorded steps (deg; mm linear), by step
           "truth": TruthComparison.to_dict() | null   # position_error_mm, orientation_error_deg,
                                                       # x_axis_error_deg, inside_ci95, graded,
                                                       # grade, verdict, position_error_vector_mm
@@ -80,7 +82,7 @@ import os
 import re
 import stat
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -125,11 +127,15 @@ class WizardRun:
         true_tool_key: key of the physical tool whose truth applies (the new tool for the
             reference wizard).
         T_flange_tool_true_m: (4,4) true FLANGE -> TOOL of that tool, metres; None: no truth.
+        joints_deg: joint values (deg; mm linear) of the recorded steps, by 0-based step index,
+            filled by the app's session as steps are recorded (issue 12); exported as the
+            wizard's ``"joints_deg"`` for the steps still recorded.
     """
 
     wizard: Wizard
     true_tool_key: str | None = None
     T_flange_tool_true_m: np.ndarray | None = None
+    joints_deg: dict[int, tuple[float, ...]] = field(default_factory=dict)
 
 
 @dataclass(frozen=True, eq=False)
@@ -179,6 +185,15 @@ def _touch_dict(touch: Any) -> dict[str, Any]:
 def _run_dict(run: WizardRun | Wizard, honest: bool = False, record_id: int | None = None) -> dict[str, Any]:
     if isinstance(run, Wizard):
         run = WizardRun(run)
+    out = _run_entry(run, honest, record_id)
+    steps = run.wizard.recorded_poses
+    joints = {str(k): [float(v) for v in q] for k, q in sorted(run.joints_deg.items()) if k in steps}
+    if joints:                         # optional (issue 12): the joint values of the recorded steps
+        out["joints_deg"] = joints
+    return out
+
+
+def _run_entry(run: WizardRun, honest: bool, record_id: int | None) -> dict[str, Any]:
     wiz = run.wizard
     res = wiz.finished_result          # a finished wizard closed to resume later keeps its result
     truth = None
@@ -298,6 +313,12 @@ def json_nesting_depth(data: bytes) -> int:
     return int(max(0, np.cumsum(step).max()))
 
 
+def _joint_list(value: Any) -> bool:
+    """A list of at most :data:`MAX_JOINTS` finite numbers (a touch's joint values)."""
+    return isinstance(value, list) and len(value) <= MAX_JOINTS and all(
+        isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in value)
+
+
 def check_session_record(data: Any) -> dict[str, Any]:
     """Check a parsed record: header (``format``, ``version``), the types of ``wizards`` and
     ``touches`` and the count limits (:data:`MAX_WIZARDS`, :data:`MAX_POSES_PER_WIZARD`,
@@ -325,8 +346,7 @@ def check_session_record(data: Any) -> dict[str, Any]:
         raise _limit_error("holds", f"{len(touches)} pendant touches", f"{MAX_TOUCHES} pendant touches")
     for i, touch in enumerate(touches):          # "joints_deg" is optional (records before issue 12)
         joints = touch.get("joints_deg") if isinstance(touch, Mapping) else None
-        if joints is not None and not (isinstance(joints, list) and len(joints) <= MAX_JOINTS and all(
-                isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in joints)):
+        if joints is not None and not _joint_list(joints):
             raise SessionRecordError(f"Touch {i + 1} of the record: \"joints_deg\" must be a list of at most "
                                      f"{MAX_JOINTS} finite numbers (degrees), got {joints!r:.60}.")
     for i, entry in enumerate(wizards):
@@ -343,6 +363,11 @@ def check_session_record(data: Any) -> dict[str, Any]:
         if len(poses) > MAX_POSES_PER_WIZARD:
             raise _limit_error(f"has, in wizard {i + 1},", f"{len(poses)} touches",
                                f"{MAX_POSES_PER_WIZARD} touches per calibration")
+        joints = entry.get("joints_deg")
+        if joints is not None and not (isinstance(joints, Mapping) and len(joints) <= MAX_POSES_PER_WIZARD
+                                       and all(_joint_list(v) for v in joints.values())):
+            raise SessionRecordError(f"Wizard {i + 1} of the record: \"joints_deg\" must map steps to lists of "
+                                     f"at most {MAX_JOINTS} finite numbers (degrees).")
         true_tool = entry.get("true_tool")
         if true_tool is not None:
             try:
