@@ -22,7 +22,7 @@ from guiclick import choose, click  # noqa: E402
 from wsclient import DrainingClient, wait_until  # noqa: E402
 
 from tcp_pendant.cli import SCENARIO_CHOICES, build_parser  # noqa: E402
-from tcp_pendant.controller import ControllerError, builtin_tools  # noqa: E402
+from tcp_pendant.controller import ControllerError, builtin_tools, reference_tip_model  # noqa: E402
 from tcp_pendant.controller.scenarios import SCENARIO_KINDS, explain  # noqa: E402
 from tcp_pendant.server import AppConfig, PendantApp  # noqa: E402
 from tcp_pendant.session import SessionChange  # noqa: E402
@@ -151,6 +151,9 @@ def test_moved_reference_is_knocked_after_touch_k_and_stays(page) -> None:
     shift = np.asarray(world.reference_move.shift_mm) / 1000.0
     np.testing.assert_allclose(c.reference_tip_world_m, tip0 + shift, atol=1e-15)
     assert p.changes[-1].pose and p.changes[-1].state.touch is not None
+    scene = s.views["scene"]                                         # the stand is drawn where the tip is
+    stand = reference_tip_model().T_world_stand(tip0 + shift)[:3, 3]
+    np.testing.assert_allclose(scene._tip_frame.position, stand, atol=1e-9)
     s.delete_touch(0)                                                # a knocked tip stays knocked
     np.testing.assert_allclose(c.reference_tip_world_m, tip0 + shift, atol=1e-15)
     s.set_scenario("off")

@@ -280,6 +280,7 @@ class SceneView:
         tip = reference_tip_model()
         wxyz, xyz = wxyz_xyz(tip.T_world_stand(c.reference_tip_world_m))
         self._tip_frame = scene.add_frame("/reference_tip", show_axes=False, wxyz=wxyz, position=xyz)
+        self._shown_tip = np.array(c.reference_tip_world_m, dtype=float)
         _add_parts(scene, "/reference_tip", rigid_meshes(tip.urdf_path))
         self._tip_label = scene.add_label("/reference_tip_label", "reference tip",
                                           position=tuple(c.reference_tip_world_m + [0.0, 0.0, -0.06]))
@@ -298,6 +299,9 @@ class SceneView:
         links and the gizmo (``pose``), from the session's state."""
         if change.tool:
             self.reconcile_tools()
+        tip = self.session.controller.reference_tip_world_m
+        if not np.array_equal(tip, self._shown_tip):     # knocked (a scenario) or set anew
+            self.update_reference_tip()
         if change.pose and change.state is not None:
             skip = (self._gizmo_row,) if self._dragging else ()
             self._poses.send(self._local_poses(change.state), skip=skip)
@@ -354,8 +358,9 @@ class SceneView:
         self._active_label.text = "TOOL" if tool is None else f"TOOL {tool.name}"
 
     def update_reference_tip(self) -> None:
-        """Re-place the stand after the reference tip moved."""
+        """Re-place the stand after the reference tip moved (:meth:`on_change` calls it)."""
         c = self.session.controller
+        self._shown_tip = np.array(c.reference_tip_world_m, dtype=float)
         wxyz, xyz = wxyz_xyz(reference_tip_model().T_world_stand(c.reference_tip_world_m))
         self._tip_frame.wxyz = wxyz
         self._tip_frame.position = xyz
