@@ -84,6 +84,7 @@ class WizardStepsView:
         self.variant.on_update(act(self._on_variant, user_only=True))
         self.auto_direction.on_update(act(lambda _e: None, user_only=True))
         self.auto_touch.on_click(act(self._on_auto_touch, sync=True))
+        self._auto_line: tuple[tuple[Any, ...], str, Any] | None = None  # (where it belongs, text, poses)
 
     # ------------------------------------------------------------ callbacks
     def _on_cancel(self, _event: Any) -> None:
@@ -120,7 +121,27 @@ class WizardStepsView:
         out = self.parent.workflow.auto_touch(request)
         if not out.ok:
             raise ValueError(out.message)
-        set_content(self.auto_md, f"{escape_markdown(out.message)} Operator error σ {request.sigma_mm:.2f} mm.")
+        wiz = self.parent.workflow.wizard
+        self._auto_line = (self._auto_where(),       # the poses are kept alive: their ids stay unique
+                           f"{escape_markdown(out.message)} Operator error σ {request.sigma_mm:.2f} mm.",
+                           None if wiz is None else wiz.recorded_poses)
+
+    def _auto_where(self) -> tuple[Any, ...]:
+        """Where the Auto-touch line belongs: the wizard on show, its step and status and its
+        recorded poses (a new record, a step change or another wizard makes the line stale)."""
+        wiz = self.parent.workflow.wizard
+        if wiz is None:
+            return ()
+        poses = wiz.recorded_poses
+        return (id(wiz), wiz.step_index, wiz.status, tuple((i, id(poses[i])) for i in sorted(poses)))
+
+    def _render_auto_line(self) -> None:
+        """The Auto-touch line, only while it still describes the wizard's state (item 6 of
+        issue 10: no \"Recorded touch 3\" after touch 4, nothing carried into another wizard)."""
+        line = self._auto_line
+        if line is not None and line[0] != self._auto_where():
+            self._auto_line = line = None
+        set_content(self.auto_md, "" if line is None else line[1])
 
     # ------------------------------------------------------------ render
     def render(self) -> None:
@@ -154,6 +175,7 @@ class WizardStepsView:
         self.auto_folder.visible = wf.training and stepping
         chosen = self.auto_direction.value == CHOSEN
         self.auto_tilt.visible = self.auto_azimuth.visible = chosen
+        self._render_auto_line()
         self.update_meter()
 
     def _render_variant(self, wiz: Wizard) -> None:
