@@ -7,6 +7,11 @@ subscribed to the session's change signal (and, in the mystery exercise, mounts 
 mystery tool); a right trainer token builds a :class:`~tcp_pendant.views.trainer_view.TrainerView`
 in that browser. Every trainer view re-renders when a trainee's row changes.
 
+In an exercise the trainee sees no truth: the workflow's ``hide_truth`` is set (the result
+panel shows no error against the true TOOL frame and no grade, the scene no TRUE triad); the
+gradebook keeps them for the trainer. The settings a trainer pushes (exercise, tool, "Hide
+distance") apply to every named trainee and to those who name themselves later.
+
 Threads: the session callbacks run on viser's event loop (``Session.on_loop``); connects and
 disconnects come from viser's thread pool and hand their trainer-view refresh to the loop
 (``hand_to_loop``). The class's own lists are guarded by one lock.
@@ -64,6 +69,8 @@ class ClassRoom:
         self._trainees: dict[int, tuple[Session, TraineeRecorder, str]] = {}   # id(session) -> ...
         self._left: list[TraineeStatus] = []        # rows of trainees who left (connected=False)
         self._trainer_views: dict[int, Any] = {}    # id(session) -> TrainerView
+        self.hide_distance: bool | None = None
+        """"Hide distance" as the trainer last pushed it (None: each trainee's own choice)."""
 
     # ------------------------------------------------------------ sessions
     def attach(self, session: Session) -> Any:
@@ -96,10 +103,19 @@ class ClassRoom:
             session.subscribe(on_change)
             with self._lock:
                 self._trainees[id(session)] = (session, recorder, name)
+            self._hide_truth(workflow, self.exercise)
             if self.exercise == "mystery":
                 self._mount_mystery(session, recorder, name)
+            if self.hide_distance is not None:
+                session.set_hide_distance(self.hide_distance)
         self.refresh_trainers()
         return recorder
+
+    @staticmethod
+    def _hide_truth(workflow: Any | None, exercise: str | None) -> None:
+        """In an exercise the trainee's result shows no truth (free practice: training mode's)."""
+        if workflow is not None:
+            workflow.hide_truth = exercise is not None
 
     def _mount_mystery(self, session: Session, recorder: TraineeRecorder, name: str) -> None:
         base = self.tools.get("pointer") or next(iter(self.tools.values()))
@@ -162,22 +178,31 @@ class ClassRoom:
     def grades_csv(self) -> str:
         return self.gradebook.to_csv()
 
-    def push_settings(self, exercise: str | None, tool_key: str | None) -> int:
-        """Set the exercise (None: free practice; "mystery": each trainee gets a mystery tool)
-        and/or mount ``tool_key`` on every named trainee's robot. Returns how many trainees."""
+    def push_settings(self, exercise: str | None, tool_key: str | None, hide_distance: bool | None = None) -> int:
+        """Set the exercise (None: free practice; "mystery": each trainee gets a mystery tool),
+        mount ``tool_key`` (None: keep) and set "Hide distance" (None: keep) on every named
+        trainee's pendant; later trainees get the exercise and "Hide distance" when they name
+        themselves. Returns how many trainees."""
         if exercise is not None and exercise not in EXERCISE_IDS:
             raise ValueError(f"Unknown exercise {exercise!r}; use one of {', '.join(EXERCISE_IDS)}.")
         if tool_key is not None and tool_key not in self.tools:
             raise ValueError(f"Unknown tool {tool_key!r}; use one of {', '.join(self.tools)}.")
         self.exercise = exercise
+        if hide_distance is not None:
+            self.hide_distance = bool(hide_distance)
         with self._lock:
             trainees = list(self._trainees.values())
         for session, recorder, name in trainees:
             def apply(session: Session = session, recorder: TraineeRecorder = recorder, name: str = name) -> None:
-                recorder.exercise_id = exercise
-                if exercise == "mystery":
-                    self._mount_mystery(session, recorder, name)
-                elif tool_key is not None:
-                    session.mount_tool(self.tools[tool_key])
+                with session.batch():
+                    recorder.exercise_id = exercise
+                    self._hide_truth(recorder.workflow, exercise)
+                    if exercise == "mystery":
+                        self._mount_mystery(session, recorder, name)
+                    elif tool_key is not None:
+                        session.mount_tool(self.tools[tool_key])
+                    if hide_distance is not None:
+                        session.set_hide_distance(bool(hide_distance))
+                    session.changed(wizard=True)      # the result panel shows or hides the truth
             session.guard(apply)()
         return len(trainees)

@@ -27,10 +27,12 @@ log = logging.getLogger(__name__)
 _GRADE_WORKER = ThreadPoolExecutor(max_workers=1, thread_name_prefix="record-grading")
 """Parses, replays and grades uploaded records off viser's event loop, one at a time."""
 
-__all__ = ["EXERCISES", "ClassControl", "TrainerView", "grades_markdown", "trainees_markdown"]
+__all__ = ["EXERCISES", "HIDE_DISTANCE", "ClassControl", "TrainerView", "grades_markdown", "trainees_markdown"]
 
 EXERCISES: dict[str, str | None] = {"Free practice": None, "Mystery tool": "mystery"}
 """Exercise choices of the trainer view: label -> exercise id."""
+HIDE_DISTANCE: dict[str, bool | None] = {"(keep)": None, "on": True, "off": False}
+"""'Hide distance' choices of the trainer view: label -> the setting pushed (None: keep)."""
 MAX_GRADE_ROWS = 50
 """The gradebook table shows the newest rows only (the CSV has them all)."""
 
@@ -48,7 +50,8 @@ class ClassControl(Protocol):
 
     def grades_csv(self) -> str: ...
 
-    def push_settings(self, exercise: str | None, tool_key: str | None) -> int: ...
+    def push_settings(self, exercise: str | None, tool_key: str | None,
+                      hide_distance: bool | None = None) -> int: ...
 
 
 def _cell(text: str) -> str:
@@ -101,7 +104,7 @@ class TrainerView:
     """The trainer's panel in one browser (see the module docstring).
 
     Attributes:
-        trainees_md, grades_md, download, exercise, tool, push: the widgets (for tests).
+        trainees_md, grades_md, download, exercise, tool, hide_distance, push: the widgets (for tests).
     """
 
     def __init__(self, session: Session, control: ClassControl) -> None:
@@ -119,6 +122,9 @@ class TrainerView:
             self.exercise = gui.add_dropdown("Exercise", tuple(EXERCISES), initial_value=current)
             tools = ("(keep)", *control.tool_keys)
             self.tool = gui.add_dropdown("Tool for all", tools, initial_value=tools[0])
+            self.hide_distance = gui.add_dropdown(
+                "Hide distance for all", tuple(HIDE_DISTANCE), initial_value="(keep)",
+                hint="on: trainees judge the touch by eye (no distance, no close-up); off: shown again.")
             self.push = gui.add_button("Push to all trainees", color="blue")
             self.push_md = gui.add_markdown("")
             self.grade_upload = gui.add_upload_button(
@@ -174,6 +180,9 @@ class TrainerView:
         tool = None if self.tool.value == "(keep)" else str(self.tool.value)
         if tool is not None and tool not in self.control.tool_keys:
             raise ValueError(f"Unknown tool {tool!r}; choose one of {', '.join(self.control.tool_keys)}.")
-        n = self.control.push_settings(exercise, tool)
+        label = str(self.hide_distance.value)
+        if label not in HIDE_DISTANCE:
+            raise ValueError(f"Unknown Hide distance choice {label!r}; choose one of {', '.join(HIDE_DISTANCE)}.")
+        n = self.control.push_settings(exercise, tool, HIDE_DISTANCE[label])
         self.push_md.content = f"Pushed to {n} trainee{'s' if n != 1 else ''}."
         self.render()

@@ -148,7 +148,7 @@ class WizardResultView:
             set_content(self.save_md, "")
         set_content(self.result_md, result_markdown(res))
         set_content(self.warnings_md, warnings_markdown(res))
-        truth = wf.truth()
+        truth = None if getattr(wf, "hide_truth", False) else wf.truth()   # an exercise: no answer shown
         self.truth_md.visible = truth is not None
         if truth is not None:
             set_content(self.truth_md, truth_markdown(truth))

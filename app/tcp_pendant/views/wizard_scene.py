@@ -92,7 +92,8 @@ class WizardSceneView:
         """Show what belongs to the workflow's current state (call after every action)."""
         wf = self.workflow
         self._T_flange_computed = wf.T_flange_tool_computed_m()
-        self._T_flange_tool_true = wf.T_flange_tool_true_m()
+        # an exercise (classroom: ``hide_truth``) shows no TRUE triad: it would give the answer
+        self._T_flange_tool_true = None if getattr(wf, "hide_truth", False) else wf.T_flange_tool_true_m()
         res = wf.result
         if res is not self._shown_result:
             self._shown_result = res

@@ -1,0 +1,152 @@
+"""Issue 11 leftovers: the trainer pushes "Hide distance" to every trainee, and a trainee in an
+exercise sees no truth (no error against the true TOOL frame, no grade, no TRUE triad) while
+the trainer's gradebook keeps it."""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Callable, Iterator
+from pathlib import Path
+
+import pytest
+
+TESTS = Path(__file__).parents[1]
+sys.path.insert(0, str(TESTS / "app"))
+sys.path.insert(0, str(TESTS / "calibrate"))
+from guiclick import choose, click  # noqa: E402
+from wsclient import DrainingClient, wait_until  # noqa: E402
+
+from tcp_pendant.pendant.formatting import touch_indicator_markdown
+
+
+@pytest.fixture
+def app_factory(tmp_path: Path) -> Iterator[Callable[..., object]]:
+    from tcp_pendant.server import AppConfig, PendantApp
+
+    apps: list[PendantApp] = []
+
+    def make(**kw: object) -> PendantApp:
+        app = PendantApp(AppConfig(port=0, tool_library=tmp_path / "tools.json", library_poll_s=0.1, **kw))  # type: ignore[arg-type]
+        app.start()
+        apps.append(app)
+        return app
+
+    yield make
+    for a in apps:
+        a.stop()
+
+
+def _class(app, n: int) -> tuple[list[DrainingClient], list]:
+    clients = []
+    for i in range(n):
+        clients.append(DrainingClient(app.port))
+        wait_until(lambda: len(app.sessions) == i + 1, what=f"session {i + 1}")
+    wait_until(lambda: all("identity" in s.views for s in app.sessions.values()), what="name prompts")
+    return clients, list(app.sessions.values())
+
+
+def _name(session, name: str) -> None:
+    p = session.views["identity"]
+    choose(p.name_field, name, session.client)
+    click(p.start, session.client)
+
+
+def _trainer(session, token: str):
+    q = session.views["identity"]
+    choose(q.token_field, token, session.client)
+    click(q.open_trainer, session.client)
+    return session.views["trainer"]
+
+
+def test_hide_distance_pushed_to_every_trainee_and_to_later_ones(app_factory, tmp_path: Path) -> None:
+    app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token="tok-1")
+    clients, (anna, ben, trainer) = _class(app, 3)
+    try:
+        _name(anna, "Anna")
+        _name(ben, "Ben")
+        ben.set_hide_distance(True)                 # Ben's own choice, before the push
+        view = _trainer(trainer, "tok-1")
+        choose(view.hide_distance, "on", trainer.client)
+        click(view.push, trainer.client)
+        assert anna.hide_distance and ben.hide_distance and not trainer.hide_distance
+        assert "2 trainees" in view.push_md.content
+        # the trainee's own checkbox and readout follow (the session command's change signal)
+        panel = anna.views["pendant"]
+        assert panel.hide_distance.value is True
+        touch = anna.pose_state().touch
+        assert panel.touch_md.content == touch_indicator_markdown(touch, hide_distance=True)
+        assert f"{touch.distance_mm:.2f} mm" not in panel.touch_md.content
+        # "(keep)" keeps it; "off" shows the distance again
+        choose(view.hide_distance, "(keep)", trainer.client)
+        click(view.push, trainer.client)
+        assert anna.hide_distance and ben.hide_distance
+        choose(view.hide_distance, "off", trainer.client)
+        click(view.push, trainer.client)
+        assert not anna.hide_distance and not ben.hide_distance and panel.hide_distance.value is False
+        assert f"{touch.distance_mm:.2f} mm" in panel.touch_md.content
+        # a trainee who names themselves after a push gets the pushed setting
+        choose(view.hide_distance, "on", trainer.client)
+        click(view.push, trainer.client)
+        clients.append(DrainingClient(app.port))
+        wait_until(lambda: len(app.sessions) == 4 and all("identity" in s.views for s in app.sessions.values()),
+                   what="a late trainee")
+        late = list(app.sessions.values())[-1]
+        assert not late.hide_distance
+        _name(late, "Cleo")
+        assert late.hide_distance
+    finally:
+        for c in clients:
+            c.close()
+
+
+def _finish_xyz4(session) -> None:
+    cal = session.views["calibrate"]
+    click(cal.start, session.client)
+    for _ in range(8):
+        if cal.workflow.result is not None:
+            return
+        click(cal.steps.auto_touch, session.client)
+    assert cal.workflow.result is not None, "the 4-point wizard did not finish"
+
+
+def test_an_exercise_shows_the_trainee_no_truth_but_the_gradebook_keeps_it(app_factory, tmp_path: Path) -> None:
+    app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token="tok-1",
+                      exercise="mystery", exercise_seed=3)
+    clients, (anna,) = _class(app, 1)
+    try:
+        _name(anna, "Anna")
+        _finish_xyz4(anna)
+        cal = anna.views["calibrate"]
+        result, scene = cal.result, cal.scene
+        assert cal.workflow.truth() is not None                 # the workflow knows it (training mode) ...
+        assert result.folder.visible and not result.truth_md.visible       # ... the trainee does not see it
+        assert not scene.true_tool.visible and not scene.true_label.visible
+        assert scene.computed.visible                           # the computed triad is still shown
+        row = app.gradebook.grades()[0]                         # the trainer's gradebook has the error
+        assert row.position_error_mm == pytest.approx(cal.workflow.truth().position_error_mm)
+        assert row.grade
+    finally:
+        for c in clients:
+            c.close()
+
+
+def test_free_practice_shows_the_truth_and_a_pushed_exercise_hides_it(app_factory, tmp_path: Path) -> None:
+    app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token="tok-1")
+    clients, (anna, trainer) = _class(app, 2)
+    try:
+        _name(anna, "Anna")
+        _finish_xyz4(anna)
+        cal = anna.views["calibrate"]
+        assert cal.result.truth_md.visible and cal.scene.true_tool.visible     # training: the answer
+        assert "true TOOL frame" in cal.result.truth_md.content
+        view = _trainer(trainer, "tok-1")
+        choose(view.exercise, "Mystery tool", trainer.client)
+        click(view.push, trainer.client)
+        _finish_xyz4(anna)                                       # a new calibration in the exercise
+        assert not cal.result.truth_md.visible and not cal.scene.true_tool.visible
+        choose(view.exercise, "Free practice", trainer.client)
+        click(view.push, trainer.client)
+        assert cal.result.truth_md.visible and cal.scene.true_tool.visible
+    finally:
+        for c in clients:
+            c.close()
