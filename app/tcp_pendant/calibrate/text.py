@@ -14,12 +14,13 @@ names, and a loaded record's content) goes through
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Collection, Mapping, Sequence
 
 from tcp_pendant.pendant.formatting import fmt_num
 from tcp_pendant.text_escape import escape_markdown as _esc
 from tcp_pendant.wizards import ESTIMATOR_LABELS, Wizard, WizardResult, Xyz4Result, wizard_class
 from tcp_pendant.wizards.registry import LiveAttribute
+from tcp_pendant.wizards.tcp_check import TcpCheckResult, tcp_check_markdown
 from tcp_pendant.wizards.session_record import ReplayCheck
 from tcp_pendant.wizards.truth import TruthComparison
 from tcpcal.pose_quality import CandidateGain, PoseQuality
@@ -69,6 +70,9 @@ def menu_markdown(kind: str, *, library_tool: str | None, reference_tool: str, n
             return "⚠ The reference tool and the new tool must be two different physical tools."
         return (f"Touch 1 with the data **{library_tool}** on the *{_esc(reference_tool.lower())}*; then "
                 f"the tool change and touch 2 with the *{_esc(new_tool.lower())}*, whose TCP is calibrated.")
+    if not getattr(cls, "saves_to_library", True):         # the TCP check: calibrates nothing
+        return (f"Checks the TCP of **{library_tool}** (made active; nothing is changed or saved); the "
+                f"*{mounted}* is mounted: it must be the tool that data belongs to.")
     return (f"Calibrates {_esc(cls.calibrates)} of **{library_tool}** (its TCP is used as is); the "
             f"*{mounted}* is mounted: it must be the tool that data belongs to.")
 
@@ -162,7 +166,10 @@ def meter_markdown(gain: CandidateGain, quality: PoseQuality | None, sigma_mm: f
 
 
 def result_markdown(result: WizardResult) -> str:
-    """The calibrated frame and its quality figures (what a pendant shows after a calibration)."""
+    """The calibrated frame and its quality figures (what a pendant shows after a calibration);
+    a TCP check's result: its rotations, implied error, correction and verdict."""
+    if isinstance(result, TcpCheckResult):
+        return tcp_check_markdown(result)
     x, y, z = (fmt_num(v) for v in result.tcp_mm)
     lines = [f"**TCP** X {x} · Y {y} · Z {z} mm"]
     if result.abc_deg is not None:
@@ -262,3 +269,24 @@ def replay_markdown(checks: Sequence[ReplayCheck]) -> str:
 def estimator_options() -> dict[str, str]:
     """Dropdown label -> estimator key, in the wizard's order."""
     return {label: key for key, label in ESTIMATOR_LABELS.items()}
+
+
+def hidden_touches_markdown(result: WizardResult, distance_mm: Mapping[int, float],
+                            hidden: Collection[int]) -> str:
+    """The lesson of \"Hide distance\": for each touch recorded with the distance hidden, how far
+    the tool tip really was from the reference tip then (mm), next to that touch's error in the
+    result (mm; \"not used\" for a touch left out). Empty when no touch was recorded hidden.
+
+    Args:
+        result: the wizard's result.
+        distance_mm: distance-at-record by 0-based step (``WizardRun.distance_mm``).
+        hidden: steps recorded while \"Hide distance\" was on (``WizardRun.distance_hidden``).
+    """
+    steps = sorted(i for i in hidden if i in distance_mm)
+    if not steps:
+        return ""
+    errors = dict(zip(_touch_numbers(result), result.per_touch_error_mm))
+    rows = [f"| P{i + 1} | {_mm(distance_mm[i])} | {_mm(errors[i]) if i in errors else 'not used'} |"
+            for i in steps]
+    return ("**Recorded with the distance hidden**: how far each tip really was\n\n"
+            "| touch | distance at record | error in the result |\n|---|---|---|\n" + "\n".join(rows))

@@ -24,13 +24,15 @@ another wizard only cancels (never deletes) the one that was open.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from dataclasses import dataclass
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
 from typing import Any, Literal, Protocol
 
 import numpy as np
 
-from tcp_pendant.controller import ToolModel, VirtualController, builtin_tools
+from tcp_pendant.controller import RobotKinematics, ToolModel, VirtualController, builtin_tools
+from tcp_pendant.controller.jog import JogSettings
+from tcp_pendant.controller.spin import SpinCheckResult, spin_check
 from tcp_pendant.calibrate.autotouch import AutoTouchOutcome, auto_touch
 from tcp_pendant.calibrate.diversity import failure_in_words
 from tcp_pendant.calibrate.library_save import save_result
@@ -38,6 +40,7 @@ from tcp_pendant.wizards import (
     AbcWorldWizard,
     CalibrationFailedError,
     ReferenceWizard,
+    TcpCheckWizard,
     TcpZxWizard,
     ThreePointWizard,
     Wizard,
@@ -54,6 +57,7 @@ from tcp_pendant.wizards.session_record import (
     WizardRun,
     load_and_replay,
     session_from_controller,
+    step_distances,
 )
 from tcp_pendant.wizards.truth import TruthComparison, compare_with_truth
 from tcpcal.library import ToolLibrary
@@ -66,6 +70,7 @@ __all__ = [
     "AutoTouchRequest",
     "CalibrationWorkflow",
     "ControllerToolState",
+    "TcpCheckJob",
     "ToolState",
 ]
 
@@ -108,6 +113,33 @@ class AutoTouchRequest:
         if self.tilt_deg is None or self.azimuth_deg is None:
             return None
         return (float(self.tilt_deg), float(self.azimuth_deg), 0.0)
+
+
+@dataclass(frozen=True, eq=False)
+class TcpCheckJob:
+    """The six rotations a TCP check wizard waits for, detached from the session: its own
+    copies of the robot models, so :meth:`run` (0.1-0.3 s) may run in a worker thread while the
+    loop keeps jogging. Metres and radians; the controller is not moved."""
+
+    wizard: TcpCheckWizard
+    pose: Any                     # the RecordedPose the check starts from
+    kinematics: RobotKinematics
+    true_kinematics: RobotKinematics
+    q_rad: np.ndarray
+    T_flange_tool_active: np.ndarray
+    T_flange_tool_true: np.ndarray
+    settings: JogSettings = field(repr=False)
+
+    def run(self) -> SpinCheckResult:
+        """``controller.spin.spin_check`` from the recorded touch's joint angles."""
+        return spin_check(self.kinematics, self.q_rad, self.T_flange_tool_active, self.T_flange_tool_true,
+                          angle_deg=self.wizard.angle_deg, true_kinematics=self.true_kinematics,
+                          settings=self.settings)
+
+
+def _own_copy(kin: RobotKinematics) -> RobotKinematics:
+    """The same robot with its own pinocchio data (safe in another thread)."""
+    return RobotKinematics(kin.model, kin.urdf_path, kin.flange_link, kin.base_link)
 
 
 class ToolState(Protocol):
@@ -173,6 +205,7 @@ class CalibrationWorkflow:
         """A classroom session: the exported record carries no truth (``session_record`` honest)."""
         self.record_ids: dict[int, int] = {}
         """Run index -> gradebook calibration id (the classroom recorder fills it; exported)."""
+        self._check_q: dict[int, tuple[Any, np.ndarray]] = {}   # run -> (recorded touch, joints there)
 
     # ------------------------------------------------------------ state
     @property
@@ -273,6 +306,42 @@ class CalibrationWorkflow:
         """Open an XYZ 4-point wizard for the mounted tool (its truth is graded)."""
         return self.start("xyz4", n_points=n_points, estimator=estimator)  # type: ignore[return-value]
 
+    def start_from_touches(self, touches: Sequence[Any], *, estimator: str = "lstsq") -> Xyz4Wizard:
+        """Open an XYZ 4-point wizard whose first steps are ``touches`` already recorded (the
+        pendant's free "Record point" list, in order): ``max(4, N)`` touch steps, the N given
+        recorded, the wizard on the first step left (on the last one, Finish, when N >= 4).
+        Each touch's ``distance_mm`` (if known) is kept as its distance-at-record.
+
+        Args:
+            touches: ``tcp_pendant.session.Touch`` (``T_world_flange``, metres; ``distance_mm``)
+                or 4x4 flange poses in WORLD, metres.
+            estimator: as for :meth:`start_xyz4`.
+
+        Raises:
+            WizardError: no touches, more than the wizard's 20, a pose that is not rigid; then
+                nothing is opened (the wizard on show stays as it was).
+        """
+        touches = list(touches)
+        n_max = Xyz4Wizard.MAX_POINTS
+        if not touches:
+            raise WizardStateError("There are no recorded points: press Record point on the Jog tab first.")
+        if len(touches) > n_max:
+            raise WizardStateError(f"{len(touches)} points are recorded; the XYZ 4-point wizard takes at most "
+                                   f"{n_max}: delete some in the touch list first.")
+        poses = [np.asarray(getattr(t, "T_world_flange", t), dtype=float) for t in touches]
+        Xyz4Wizard(n_points=max(Xyz4Wizard.MIN_POINTS, len(poses))).prefill(poses)   # checked before opening
+        w = self.start("xyz4", n_points=max(Xyz4Wizard.MIN_POINTS, len(poses)), estimator=estimator)
+        w.prefill(poses)
+        run = self.run
+        hidden = bool(getattr(self.state, "hide_distance", False))
+        for i, t in enumerate(touches):
+            d = float(getattr(t, "distance_mm", float("nan")))
+            if run is not None and np.isfinite(d) and d >= 0.0:
+                run.distance_mm[i] = d
+                if hidden:
+                    run.distance_hidden.add(i)
+        return w  # type: ignore[return-value]
+
     def start_reference(self, *, reference_slot: int, reference_tool_key: str,
                         new_tool_key: str) -> ReferenceWizard:
         """Open an XYZ reference wizard (activates the reference data).
@@ -300,6 +369,19 @@ class CalibrationWorkflow:
         return self.start("abc-world", slot=slot, variant=variant)  # type: ignore[return-value]
 
     # ------------------------------------------------------------ navigation
+    def _note_distance(self, step: int) -> None:
+        """Keep the true tool tip to reference tip distance (mm) of the touch step just recorded
+        at the robot's pose (``WizardRun.distance_mm``; the session record exports it), and
+        whether the distance was hidden then (``ToolState.hide_distance``, when the owner has it)."""
+        run = self.run
+        if run is None or not 0 <= step < run.wizard.n_steps or run.wizard.steps[step].role != "touch":
+            return
+        run.distance_mm[step] = float(self.controller.touch_geometry().distance_mm)
+        if getattr(self.state, "hide_distance", False):
+            run.distance_hidden.add(step)
+        else:
+            run.distance_hidden.discard(step)
+
     def _require(self) -> Wizard:
         w = self.wizard
         if w is None:
@@ -352,12 +434,18 @@ class CalibrationWorkflow:
         """Record the current flange pose for the current step."""
         w = self._require()
         self.note_mounted_tool()
+        step = w.step_index
         w.record(self.controller.T_world_flange())
+        self._note_distance(step)
+        self._note_check_joints(w)
 
     def next(self) -> WizardResult | None:
         """Next step; on the last step compute the result (returned)."""
+        w = self._require()
+        if isinstance(w, TcpCheckWizard) and w.check_pending and w.on_last_step:
+            return self.run_tcp_check()
         try:
-            out = self._require().next()
+            out = w.next()
         except CalibrationFailedError as exc:
             raise self._in_words(exc) from exc
         return out if isinstance(out, WizardResult) else None
@@ -395,8 +483,13 @@ class CalibrationWorkflow:
                          previous_direction_deg=self._auto_directions.get(run_index),  # type: ignore[arg-type]
                          mount=self.state.mount_tool)
         self.note_mounted_tool()
+        if out.ok:                            # the robot stands at the touch it recorded
+            self._note_distance(out.step_index)
+        self._note_check_joints(w)
         if out.direction_deg is not None and run_index is not None:
             self._auto_directions[run_index] = out.direction_deg
+        if isinstance(w, TcpCheckWizard):     # Finish runs the check (off the loop in the app)
+            return out
         if out.ok and w.on_last_step and all(s.recorded for s in w.steps):
             try:
                 w.finish()
@@ -427,7 +520,7 @@ class CalibrationWorkflow:
     def preview_tool(self) -> Tool | None:
         """The tool "Save" would store (named "preview"), or None before a result."""
         w = self.wizard
-        if w is None or w.result is None:
+        if w is None or w.result is None or not getattr(w, "saves_to_library", True):
             return None
         return w.to_tool("preview")
 
@@ -461,6 +554,8 @@ class CalibrationWorkflow:
             tcpcal.TcpcalError: the library refused (the name is used by another slot, ...).
         """
         w = self._require()
+        if not getattr(w, "saves_to_library", True):
+            raise WizardStateError(f"The {w.title} saves nothing to the library: it only checks the tool data.")
         name = str(name).strip()
         if not name:
             raise WizardStateError("Type a name for the tool before saving.")
@@ -470,6 +565,57 @@ class CalibrationWorkflow:
         if self._current is not None and w.result is not None:
             self._saved_results[self._current] = w.result
         return slot_tool
+
+    # ------------------------------------------------------------ TCP check wizard
+    def _note_check_joints(self, w: Wizard) -> None:
+        """Remember the joints of a TCP check's recorded touch (the check starts there)."""
+        if isinstance(w, TcpCheckWizard) and w.recorded_pose is not None and self._current is not None:
+            known = self._check_q.get(self._current)
+            if known is None or known[0] is not w.recorded_pose:
+                self._check_q[self._current] = (w.recorded_pose, self.controller.q_rad.copy())
+
+    def tcp_check_job(self) -> TcpCheckJob | None:
+        """The check the TCP check wizard on show waits for (None: nothing to check), from its
+        recorded touch with the checked tool data as the active TCP and the mounted tool's truth.
+
+        Raises:
+            WizardStateError: the touch's joint angles are unknown (a resumed record) and the
+                robot is no longer there: record the touch again.
+        """
+        w = self.wizard
+        if not isinstance(w, TcpCheckWizard) or not w.check_pending:
+            return None
+        pose, c = w.recorded_pose, self.controller
+        known = None if self._current is None else self._check_q.get(self._current)
+        if known is not None and known[0] is pose:
+            q = known[1]
+        elif np.allclose(c.T_world_flange(), pose.T_world_flange_m, atol=1e-7):
+            q = c.q_rad.copy()
+        else:
+            raise WizardStateError("The robot is not at the recorded touch any more: press Record again "
+                                   "with the tool tip on the reference tip, then Finish.")
+        T_active = np.array(w.tool.T_flange_tool_mm, dtype=float)
+        T_active[:3, 3] /= 1000.0
+        nominal = _own_copy(c.kinematics)
+        physical = nominal if c.true_kinematics is c.kinematics else _own_copy(c.true_kinematics)
+        return TcpCheckJob(w, pose, nominal, physical, np.array(q, dtype=float), T_active,
+                           np.array(c.mounted_tool.T_flange_tool_true, dtype=float), c.settings)
+
+    def give_tcp_check(self, job: TcpCheckJob, result: SpinCheckResult) -> WizardResult | None:
+        """Hand a finished check to its wizard and finish it (the wizard may have been left
+        meanwhile: then it keeps the check and shows it when resumed and finished)."""
+        job.wizard.give_check(result, job.pose)
+        if job.wizard.status == "in_progress":
+            return job.wizard.finish()
+        return None
+
+    def run_tcp_check(self) -> WizardResult | None:
+        """Run the waiting TCP check here (synchronously; the app runs :meth:`tcp_check_job`
+        in a worker instead) and finish the wizard."""
+        job = self.tcp_check_job()
+        if job is None:
+            raise WizardStateError("No TCP check is waiting: record the touch first.")
+        return self.give_tcp_check(job, job.run())
 
     # ------------------------------------------------------------ session record
     def export_record(self, touches: Any = ()) -> dict[str, Any]:
@@ -501,7 +647,8 @@ class CalibrationWorkflow:
             true_tool = entry.get("true_tool") or {}
             T_true = true_tool.get("T_flange_tcp_true_m")
             self.runs.append(WizardRun(check.wizard, true_tool.get("key"),
-                                       None if T_true is None else np.array(T_true, dtype=float)))
+                                       None if T_true is None else np.array(T_true, dtype=float),
+                                       distance_mm=step_distances(entry)))
             if check.wizard.finished_result is not None:
                 finished.append(len(self.runs) - 1)
             if check.wizard.status != "cancelled":

@@ -7,6 +7,10 @@ library" (name and slot; saving also makes it the active tool). For the 4-point 
 chart of the per-touch errors with outliers in red, "Drop outliers" / "Use all touches", the
 estimator the TCP is reported from, and a switch that compares the three estimators side by
 side. In training mode: the result against the hidden true TOOL frame with a verdict.
+Touches recorded with "Hide distance" on are listed with their distance-at-record next to
+their error (``hidden_touches_markdown``: the lesson of judging by eye).
+A TCP check's result (``saves_to_library`` False) shows no Save; a saved calibration's result
+offers "Check this TCP", which starts the TCP check wizard on the slot just saved.
 """
 
 from __future__ import annotations
@@ -19,6 +23,7 @@ from tcp_pendant.calibrate import error_bars
 from tcp_pendant.calibrate.text import (
     comparison_markdown,
     estimator_options,
+    hidden_touches_markdown,
     result_markdown,
     save_markdown,
     save_preview_markdown,
@@ -76,6 +81,7 @@ class WizardResultView:
             self.result_md = gui.add_markdown("")
             self.truth_md = gui.add_markdown("", visible=False)
             self.warnings_md = gui.add_markdown("")
+            self.hidden_md = gui.add_markdown("", visible=False)   # touches recorded with the distance hidden
             bars = error_bars([1], [0.0])
             self.chart = gui.add_uplot(
                 bars.columns, _chart_series(has_outliers=False),
@@ -96,12 +102,15 @@ class WizardResultView:
             self.save = gui.add_button("Save to tool library", color="green",
                                        hint="Store the tool in the library and make it the active tool.")
             self.save_md = gui.add_markdown("")
+            self.check_tcp = gui.add_button("Check this TCP", color="violet", visible=False,
+                                            hint="Start the TCP check (spin test) on the tool just saved.")
         act = parent.action
         self.drop.on_click(act(self._on_drop))
         self.restore.on_click(act(self._on_restore))
         self.estimator.on_update(act(self._on_estimator, user_only=True))
         self.compare.on_update(act(lambda _e: None, user_only=True))
         self.save.on_click(act(self._on_save, sync=True))
+        self.check_tcp.on_click(act(self._on_check_tcp, sync=True))
         self.save_name.on_update(act(lambda _e: None, user_only=True))
         self.save_slot.on_update(act(lambda _e: None, user_only=True))
         self._named_run: Any = None
@@ -130,6 +139,12 @@ class WizardResultView:
         slot, tool = self.parent.workflow.save(str(self.save_name.value), number_of_option(self.save_slot.value))
         self.parent.saved(slot, tool)
 
+    def _on_check_tcp(self, _event: Any) -> None:
+        wf = self.parent.workflow
+        if wf.last_save is None:
+            raise WizardStateError("Save the tool first: the TCP check works on a tool of the library.")
+        wf.start("tcp-check", slot=wf.last_save[0])
+
     # ------------------------------------------------------------ render
     def refresh_slots(self, tools: dict[int, Any]) -> None:
         """Re-list the slots after the library changed."""
@@ -142,12 +157,21 @@ class WizardResultView:
         self.folder.visible = res is not None
         if res is None:
             return
+        saves = getattr(wf.wizard, "saves_to_library", True)
+        for h in (self.save_name, self.save_slot, self.save_preview, self.save, self.save_md):
+            h.visible = saves                          # a TCP check saves nothing
+        self.check_tcp.visible = saves and wf.last_save is not None and wf.result_saved
         if wf.run is not self._named_run:              # another calibration: its name, no old message
             self._named_run = wf.run
             self.save_name.value = wf.default_save_name()
             set_content(self.save_md, "")
         set_content(self.result_md, result_markdown(res))
         set_content(self.warnings_md, warnings_markdown(res))
+        run = wf.run
+        hidden = "" if run is None else hidden_touches_markdown(res, run.distance_mm, run.distance_hidden)
+        self.hidden_md.visible = bool(hidden)
+        if hidden:
+            set_content(self.hidden_md, hidden)
         truth = None if getattr(wf, "hide_truth", False) else wf.truth()   # an exercise: no answer shown
         self.truth_md.visible = truth is not None
         if truth is not None:

@@ -13,7 +13,10 @@ uncertainty tcpcal predicts if the user recorded here.
 
 from __future__ import annotations
 
+import asyncio
+import logging
 import math
+from concurrent.futures import ThreadPoolExecutor
 from typing import TYPE_CHECKING, Any
 
 from tcp_pendant.calibrate import AUTO_SIGMA_MAX_MM, AutoTouchRequest
@@ -36,6 +39,9 @@ __all__ = ["ABC_VARIANTS", "RANDOM", "THREE_POINT_VARIANTS", "WizardStepsView"]
 THREE_POINT_VARIANTS = {label: value for value, label in ThreePointWizard.variants}
 ABC_VARIANTS = {label: value for value, label in AbcWorldWizard.variants}
 RANDOM, CHOSEN = "random", "chosen (tilt, azimuth)"
+_CHECK_WORKER = ThreadPoolExecutor(max_workers=1, thread_name_prefix="tcp-check-wizard")
+"""Runs a TCP check wizard's six rotations (0.1-0.3 s) off viser's event loop."""
+log = logging.getLogger(__name__)
 
 
 class WizardStepsView:
@@ -76,7 +82,8 @@ class WizardStepsView:
                 self.auto_md = gui.add_markdown("")
         act = parent.action
         self.record.on_click(act(lambda _e: parent.workflow.record()))
-        self.next.on_click(act(lambda _e: parent.workflow.next()))
+        self.next.on_click(self._on_next)
+        self._checking = False
         self.back.on_click(act(lambda _e: parent.workflow.back()))
         self.cancel.on_click(act(self._on_cancel))
         self.add_point.on_click(act(self._on_add_point))
@@ -94,6 +101,38 @@ class WizardStepsView:
         if not finished:
             self.parent.session.notify("Calibration cancelled",
                                        "Nothing recorded is lost: Resume it from the Calibrate menu.")
+
+    async def _on_next(self, event: Any) -> None:
+        """Next / Finish. A TCP check wizard's Finish runs its check: the job is taken on the
+        loop (under the session lock), the six rotations run in ``_CHECK_WORKER``, the result is
+        handed to the wizard on the loop; one check at a time."""
+        wf, act = self.parent.workflow, self.parent.action
+        jobs: list[Any] = []
+
+        def take(_e: Any) -> None:
+            if self._checking:
+                raise WizardStateError("The TCP check is running; wait for its result.")
+            job = wf.tcp_check_job()
+            if job is None:
+                wf.next()
+            else:
+                jobs.append(job)
+                self._checking = True                  # render shows "Checking" and disables Finish
+
+        await act(take)(event)
+        if not jobs:
+            return
+        try:
+            result = await asyncio.get_running_loop().run_in_executor(_CHECK_WORKER, jobs[0].run)
+        except Exception as exc:  # a browser's click must never kill the server
+            log.exception("TCP check wizard failed")
+            self._checking = False
+            self.parent.session.notify("TCP check failed", f"{type(exc).__name__}: {exc}", kind="error")
+            await act(lambda _e: None)(event)          # re-render the step as it was
+            return
+        finally:
+            self._checking = False
+        await act(lambda _e: wf.give_tcp_check(jobs[0], result))(event)
 
     def _on_add_point(self, _event: Any) -> None:
         wiz = self.parent.workflow.wizard
@@ -151,7 +190,8 @@ class WizardStepsView:
         self.folder.visible = wf.is_open
         if wiz is None or not wf.is_open:
             return
-        set_content(self.head_md, step_markdown(wiz))
+        set_content(self.head_md, step_markdown(wiz) + (
+            "\n\n**Checking:** the controller turns the tool ±A, ±B, ±C about the TCP ..." if self._checking else ""))
         self.progress.value = round(100.0 * wiz.progress, 1)
         set_content(self.steps_md, steps_list_markdown(wiz))
         self._render_variant(wiz)
@@ -166,7 +206,7 @@ class WizardStepsView:
         stepping = not wiz.is_complete           # on the result only Back, Add point and Close remain
         self.record.visible = self.next.visible = stepping
         self.record.disabled = not wiz.can_record
-        self.next.disabled = not wiz.can_next
+        self.next.disabled = not wiz.can_next or self._checking
         self.next.label = "Finish" if wiz.on_last_step else "Next"
         self.back.disabled = not wiz.can_back
         self.cancel.label = "Cancel" if stepping else ("Close" if wf.result_saved else "Close (resume later)")

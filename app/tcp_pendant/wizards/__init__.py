@@ -26,15 +26,16 @@ from tcp_pendant.wizards.three_point import MIN_DISPLACEMENT_MM, ThreePointWizar
 from tcp_pendant.wizards.xyz4 import ESTIMATORS, ESTIMATOR_LABELS, Xyz4Result, Xyz4Wizard
 
 from tcp_pendant.wizards.tcp_zx import TcpZxWizard
+from tcp_pendant.wizards.tcp_check import TcpCheckResult, TcpCheckWizard
 from tcp_pendant.wizards.registry import WIZARD_TYPES, register, unregister, wizard_class, wizard_classes
 
-for _cls in (Xyz4Wizard, ReferenceWizard, TcpZxWizard, ThreePointWizard, AbcWorldWizard):
+for _cls in (Xyz4Wizard, ReferenceWizard, TcpZxWizard, ThreePointWizard, AbcWorldWizard, TcpCheckWizard):
     register(_cls)
 
 __all__ = [
     "AbcWorldWizard", "CalibrationFailedError", "ESTIMATORS", "ESTIMATOR_LABELS",
     "InvalidPoseError", "MIN_DISPLACEMENT_MM", "R_WORLD_TOOL_TARGET", "RecordedPose",
-    "ReferenceWizard", "StepInfo", "StepSpec", "TcpZxWizard", "ThreePointWizard", "WIZARD_TYPES",
+    "ReferenceWizard", "StepInfo", "StepSpec", "TcpCheckResult", "TcpCheckWizard", "TcpZxWizard", "ThreePointWizard", "WIZARD_TYPES",
     "Wizard", "WizardError", "WizardResult", "WizardStateError", "Xyz4Result", "Xyz4Wizard",
     "register", "unregister", "wizard_class", "wizard_classes",
 ]
