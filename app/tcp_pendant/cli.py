@@ -6,6 +6,7 @@ Examples::
     tcp-pendant --robot gp12 --tool torch --port 8090
     tcp-pendant --robot /path/ur5.urdf --flange-link tool0
     tcp-pendant --host 0.0.0.0 --shared          # classroom demo: one robot for everybody
+    tcp-pendant --shared --presenter             # the lecture on a projector: large readout
     tcp-pendant --host 0.0.0.0 --class           # a class: names, gradebook, trainer view
     tcp-pendant --host 0.0.0.0 --exercise mystery --exercise-seed 7   # a class with mystery tools
     tcp-pendant grades --csv > grades.csv        # the class gradebook (see classroom.grades_cli)
@@ -48,6 +49,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="tool library JSON file (default: the user's data directory)")
     p.add_argument("--shared", action="store_true",
                    help="one robot that every browser sees and drives (lecture demo)")
+    p.add_argument("--presenter", action="store_true",
+                   help="start in presenter mode (projector: 32 px readout, the wizard's step list, a "
+                        "large error chart, a narrower panel); each pendant can switch it in its GUI")
     p.add_argument("--allow-origin", action="append", default=[], metavar="ORIGIN",
                    help="also accept browsers on pages from ORIGIN (scheme://host[:port]; repeatable or "
                         "comma-separated), e.g. a reverse proxy's address; pages from any other web "
@@ -164,7 +168,7 @@ def _main(argv: Sequence[str] | None) -> int:
                            reference_tip_mm=tip, allow_origins=tuple(args.allow_origin), class_db=class_db,
                            trainer_token=args.trainer_token, exercise=args.exercise,
                            exercise_seed=args.exercise_seed, scenario=args.scenario.replace("-", "_"),
-                           scenario_seed=args.scenario_seed)
+                           scenario_seed=args.scenario_seed, presenter=args.presenter)
         app = PendantApp(config)
     except (ControllerError, ValueError, OSError, GradebookError) as exc:
         print(f"tcp-pendant: error: {exc}", file=sys.stderr)

@@ -47,6 +47,7 @@ from tcp_pendant.controller import (
 from tcp_pendant.controller.scenarios import Scenario
 from tcp_pendant.session import Session
 from tcp_pendant.views import session_view_steps
+from tcp_pendant.views.presenter import PresenterView
 from tcp_pendant.views.scene import overview_camera, overview_pose
 from tcp_pendant.views.meshes import link_meshes, rigid_meshes
 
@@ -81,6 +82,7 @@ class AppConfig:
             ``controller.scenarios``: "off", "bent_tool", "robot_accuracy", "moved_reference");
             the trainer changes it per pendant in the Calibrate tab.
         scenario_seed: seed of the scenario's errors (>= 0).
+        presenter: every session starts in presenter mode (``views.presenter``; projector).
     """
 
     robot: str = "kr6"
@@ -99,6 +101,7 @@ class AppConfig:
     exercise_seed: int = 0
     scenario: str = "off"
     scenario_seed: int = 0
+    presenter: bool = False
 
 
 class PortInUseError(OSError):
@@ -297,6 +300,8 @@ class PendantApp:
         try:
             for _ in session_view_steps(session, title=f"TCP Pendant · {self.robot_label}"):
                 yield None
+            with session.lock, session.target.atomic():    # "Presenter mode", above the tabs
+                session.views["presenter"] = PresenterView(session, on=self.config.presenter)
         except GeneratorExit:
             session.close()
             raise
