@@ -10,7 +10,9 @@ Top to bottom:
   world), the options the chosen method declares (``Wizard.options``: one widget per option
   name, shared by the methods that declare it: touches and estimator; the calibrated tool from
   the library; the physical reference and new tools), Start (``CalibrationWorkflow.start(kind,
-  **options)``), and Resume for a calibration left half-way. It is hidden while a wizard is
+  **options)``), "Start from the N recorded points" (XYZ 4-point, when the Jog tab's Record point
+  stored touches: they become its first steps, ``CalibrationWorkflow.start_from_touches``), and
+  Resume for a calibration left half-way. It is hidden while a wizard is
   open, as on a pendant; Cancel (or Close, on a result) brings it back;
 * the open wizard's step panel (``wizard_steps``), its result panel (``wizard_result``) and
   its scene nodes (``wizard_scene``);
@@ -133,6 +135,9 @@ class CalibrateView:
                         self.option_widgets[opt.name] = self._add_option_widget(gui, opt)
             self.menu_md = gui.add_markdown("")
             self.start = gui.add_button("Start", color="green")
+            self.start_from_points = gui.add_button(
+                "Start from the recorded points", color="blue", visible=False,
+                hint="XYZ 4-point from the touches of the Jog tab's Record point: they become its first steps.")
             self.resume_list = gui.add_dropdown("Left half-way", ("-",), visible=False)
             self.resume = gui.add_button("Resume", color="blue", visible=False)
         widgets = self.option_widgets
@@ -161,6 +166,7 @@ class CalibrateView:
         for choice in echoed:
             choice.on_update(act(lambda _e: None, user_only=True))       # re-render: echo the choice
         self.start.on_click(act(self._on_start, sync=True))
+        self.start_from_points.on_click(act(self._on_start_from_points, sync=True))
         self.resume.on_click(act(self._on_resume))
         self.export.on_click(act(self._on_export))
         self._loading_record = False
@@ -220,6 +226,8 @@ class CalibrateView:
             self.refresh_library(render=False)
         if change.pose:
             self.on_motion()
+        if change.touches and not (change.wizard or change.tool or change.library):
+            self._render_menu()                # "Start from the N recorded points"
         if change.wizard or change.tool or change.library:
             self.render()
 
@@ -287,6 +295,15 @@ class CalibrateView:
             raise ValueError(f"Unknown calibration method {self.method.value!r}.")
         cls = self._chosen_class()
         self.workflow.start(cls.kind, **{opt.name: self._option_value(opt) for opt in cls.options})
+
+    def _on_start_from_points(self, _event: Any) -> None:
+        """XYZ 4-point from the free touches (``CalibrationWorkflow.start_from_touches``)."""
+        cls = self._chosen_class()
+        if cls.kind != "xyz4":
+            raise ValueError("Only the XYZ 4-point method starts from the recorded points; choose it first.")
+        spec = self._option_specs.get("estimator")
+        estimator = "lstsq" if spec is None else self._option_value(spec)
+        self.workflow.start_from_touches(list(self.session.touches), estimator=estimator)
 
     def _on_resume(self, _event: Any) -> None:
         number = number_of_option(self.resume_list.value)
@@ -413,6 +430,11 @@ class CalibrateView:
             new_tool=str(physical[1]) if len(physical) > 1 else mounted,
             mounted_tool=mounted))
         self.start.disabled = needs_tool and empty
+        n_points = len(self.session.touches)
+        self.start_from_points.visible = cls.kind == "xyz4" and n_points >= 1
+        label = f"Start from the {n_points} recorded point{'' if n_points == 1 else 's'}"
+        if n_points and self.start_from_points.label != label:
+            self.start_from_points.label = label
         self.menu_folder.visible = not self.workflow.is_open     # a pendant shows the wizard alone
         waiting = self.workflow.resumable()
         self.resume_list.visible = self.resume.visible = bool(waiting)

@@ -519,6 +519,29 @@ class Wizard(abc.ABC):
         self._poses[self._index] = RecordedPose(T, utc_now_iso())
         return self.step
 
+    def prefill(self, poses_m: Sequence[Any]) -> StepInfo:
+        """Record ``poses_m`` (4x4 flange poses in WORLD, metres) as the first steps of a wizard
+        just started, then stand on the first step left to record (the last step when all are).
+        Every pose is checked before any is stored.
+
+        Raises:
+            WizardStateError: the wizard is not fresh (in progress with nothing recorded), more
+                poses than steps, or a step that cannot be recorded now (``blocked_reason``).
+            InvalidPoseError: a pose is not a rigid transform (names which one).
+        """
+        if self._status != "in_progress" or self._poses:
+            raise WizardStateError("Only a wizard just started, with nothing recorded, takes touches recorded before.")
+        if len(poses_m) > self.n_steps:
+            raise WizardStateError(f"{len(poses_m)} touches do not fit the {self.n_steps} steps of this wizard.")
+        checked = [check_pose_m(T, what=f"flange pose of touch {i + 1}") for i, T in enumerate(poses_m)]
+        reason = self.blocked_reason
+        if reason is not None:
+            raise WizardStateError(f"Cannot record now: {reason}")
+        now = utc_now_iso()
+        self._poses = {i: RecordedPose(T, now) for i, T in enumerate(checked)}
+        self._index = min(len(checked), self.n_steps - 1)
+        return self.step
+
     def clear_step(self) -> None:
         """Forget the pose of the current step (only while in progress)."""
         if self._status != "in_progress":

@@ -5,7 +5,9 @@ rebuilds each wizard and recomputes its result with ``tcpcal``; :func:`replay` c
 recomputed result matches the stored one and recomputes the errors against the true tool.
 
 JSON contract (version 2; version 1 records are still read: they have no ``honest`` and no
-``record_id`` keys). Lengths: metres in ``*_m`` keys, millimetres in ``*_mm`` keys;
+``record_id`` keys). Optional keys added later (``joints_deg``, ``distance_mm``) need no new
+version: a record without them reads as before, and an older pendant ignores them.
+Lengths: metres in ``*_m`` keys, millimetres in ``*_mm`` keys;
 angles in degrees; poses are 4x4 row-major nested lists; times ISO 8601 UTC. The key
 ``"T_flange_tcp_true_m"`` keeps its version-1 spelling (a contract); in code the same frame is
 ``T_flange_tool_true_m`` (the hidden true TOOL frame, FLANGE -> TOOL, metres).
@@ -51,6 +53,9 @@ angles in degrees; poses are 4x4 row-major nested lists; times ISO 8601 UTC. The
           "record_id": int | null,                # the gradebook's calibration id (classroom)
           "joints_deg": {"0": [j1, ..., jN], ...},  # optional (issue 12): joint values of the
                                                   # recorded steps (deg; mm linear), by step
+          "distance_mm": {"0": 0.42, ...},        # optional (issue 10): true tool tip to
+                                                  # reference tip when each touch step was
+                                                  # recorded, mm (>= 0), by step
           "truth": TruthComparison.to_dict() | null   # position_error_mm, orientation_error_deg,
                                                       # x_axis_error_deg, inside_ci95, graded,
                                                       # grade, verdict, position_error_vector_mm
@@ -130,12 +135,19 @@ class WizardRun:
         joints_deg: joint values (deg; mm linear) of the recorded steps, by 0-based step index,
             filled by the app's session as steps are recorded (issue 12); exported as the
             wizard's ``"joints_deg"`` for the steps still recorded.
+        distance_mm: true tool tip to reference tip (mm) when each touch step was recorded, by
+            0-based step index, filled by the workflow as steps are recorded (issue 10);
+            exported as the wizard's ``"distance_mm"`` for the steps still recorded.
+        distance_hidden: steps recorded while "Hide distance" was on (the result shows their
+            distance-at-record next to their error; not exported).
     """
 
     wizard: Wizard
     true_tool_key: str | None = None
     T_flange_tool_true_m: np.ndarray | None = None
     joints_deg: dict[int, tuple[float, ...]] = field(default_factory=dict)
+    distance_mm: dict[int, float] = field(default_factory=dict)
+    distance_hidden: set[int] = field(default_factory=set)
 
 
 @dataclass(frozen=True, eq=False)
@@ -190,7 +202,24 @@ def _run_dict(run: WizardRun | Wizard, honest: bool = False, record_id: int | No
     joints = {str(k): [float(v) for v in q] for k, q in sorted(run.joints_deg.items()) if k in steps}
     if joints:                         # optional (issue 12): the joint values of the recorded steps
         out["joints_deg"] = joints
+    distances = {str(k): float(d) for k, d in sorted(run.distance_mm.items()) if k in steps}
+    if distances:                      # optional (issue 10): distance-at-record of the touch steps
+        out["distance_mm"] = distances
     return out
+
+
+def step_distances(entry: Mapping[str, Any]) -> dict[int, float]:
+    """A checked record entry's ``"distance_mm"`` by 0-based step index ({} when absent)."""
+    raw = entry.get("distance_mm") or {}
+    return {int(k): float(v) for k, v in raw.items()}
+
+
+def _distance_map(value: Any) -> bool:
+    """Step index ("0"..) -> finite distance >= 0 mm, at most :data:`MAX_POSES_PER_WIZARD` steps."""
+    return isinstance(value, Mapping) and len(value) <= MAX_POSES_PER_WIZARD and all(
+        isinstance(k, str) and k.isdigit() and len(k) <= 3
+        and isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and v >= 0.0
+        for k, v in value.items())
 
 
 def _run_entry(run: WizardRun, honest: bool, record_id: int | None) -> dict[str, Any]:
@@ -368,6 +397,11 @@ def check_session_record(data: Any) -> dict[str, Any]:
                                        and all(_joint_list(v) for v in joints.values())):
             raise SessionRecordError(f"Wizard {i + 1} of the record: \"joints_deg\" must map steps to lists of "
                                      f"at most {MAX_JOINTS} finite numbers (degrees).")
+        distances = entry.get("distance_mm")     # optional (issue 10)
+        if distances is not None and not _distance_map(distances):
+            raise SessionRecordError(f"Wizard {i + 1} of the record: \"distance_mm\" must map step numbers "
+                                     f"(\"0\", \"1\", ...) to distances in mm (finite, 0 or more), "
+                                     f"got {distances!r:.60}.")
         true_tool = entry.get("true_tool")
         if true_tool is not None:
             try:
