@@ -138,3 +138,16 @@ def test_the_session_record_replays_the_check_without_a_robot(workflow, library)
     with pytest.raises(WizardError, match="deviation"):
         other.load_record(json.dumps(bad))
     assert wizard_class("tcp-check") is TcpCheckWizard
+
+
+def test_a_finished_check_is_done_not_left_half_way(workflow, library) -> None:
+    wf = workflow("kr6", "pointer", seed=6)
+    slot = saved_tool(library, "pointer")
+    check(wf, slot)
+    assert wf.result_saved                                # "Close", nothing to resume later
+    wf.cancel()
+    assert wf.resumable() == []
+    wf.start("tcp-check", slot=slot)
+    wf.auto_touch(AutoTouchRequest())
+    wf.cancel()                                           # an unfinished one waits to be resumed
+    assert [label for _, label in wf.resumable()] == ["2: TCP check (spin test), 1 of 1 recorded"]

@@ -124,3 +124,8 @@ def test_the_markdown_shows_six_rows_the_error_the_correction_and_escapes_the_na
     assert sum(1 for line in text.splitlines() if line.startswith("| ") and "30°" in line) == 6
     assert "Implied TCP error: 0.800 mm" in text and "X +0.800 · Y +0.000 · Z +0.000 mm" in text
     assert "off by 0.800" in text
+    good = wizard()
+    good.record(POSE)
+    good.give_check(spin(err=0.2))
+    assert "TCP good" in tcp_check_markdown(good.next()) and good.result.notes == ()
+    assert wiz.result.notes and "changes no tool data" in wiz.result.notes[0]

@@ -97,7 +97,8 @@ def _deg(v: float | None, decimals: int = 2) -> str:
 def step_markdown(wizard: Wizard) -> str:
     """Heading ("**XYZ 4-point** · Step 2 of 4: Touch 2") and the step's instruction."""
     if wizard.is_complete:
-        return f"**{_esc(wizard.title)}** · Result\n\nThe calibration is computed: see *Result* below."
+        done = "The calibration is computed" if getattr(wizard, "saves_to_library", True) else "The check is done"
+        return f"**{_esc(wizard.title)}** · Result\n\n{done}: see *Result* below."
     step = wizard.step
     mark = " ✔ recorded" if step.recorded else ""
     return (f"**{_esc(wizard.title)}** · {_esc(step.heading)}: {_esc(step.title)}{mark}\n\n"

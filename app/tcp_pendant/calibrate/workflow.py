@@ -234,7 +234,11 @@ class CalibrationWorkflow:
         return w is not None and w.status != "cancelled"
 
     def _is_saved(self, index: int) -> bool:
-        """Run ``index`` is finished and its result, as it is now, was saved to the library."""
+        """Run ``index`` is finished and its result, as it is now, was saved to the library (a
+        finished check, which saves nothing, is done as it is)."""
+        w = self.runs[index].wizard
+        if not getattr(w, "saves_to_library", True) and w.finished_result is not None:
+            return True
         saved = self._saved_results.get(index)
         return saved is not None and saved is self.runs[index].wizard.finished_result
 

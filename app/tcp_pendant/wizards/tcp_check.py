@@ -276,7 +276,7 @@ class TcpCheckWizard(Wizard):
             max_error_mm=check.max_deviation_mm,
             per_touch_error_mm=tuple(r.deviation_mm for r in check.rows),
             warnings=tuple(f"{r.label} not reached: {r.message}" for r in check.rows if not r.reached),
-            notes=notes if off is not None else (),
+            notes=notes if off is not None and (check.implied_tcp_error_mm or 0.0) > GOOD_CHECK_MM else (),
             check=check, tool_name=self.tool.name, slot=self.slot)
 
     def to_tool(self, name: str) -> Tool:
