@@ -104,7 +104,10 @@ def visible_text(page: Any) -> str:
 
 def assert_harmless(state: dict[str, Any], title: str, listener: Listener) -> None:
     assert state["title"] == title
-    assert state["bodyOpacity"] == "1" and state["buttonOpacities"] == ["1"], state
+    # enabled buttons are drawn at opacity 1, disabled ones (Record before a touch, ...) at 0.6 by
+    # viser's theme; the injected style would make every one 0
+    assert state["bodyOpacity"] == "1" and "1" in state["buttonOpacities"], state
+    assert set(state["buttonOpacities"]) <= {"1", "0.6"}, state
     assert state["userStyles"] == 0
     assert not [h for h in state["hrefs"] if "evil" in h or "127.0.0.1" in h], state["hrefs"]
     assert not [s for s in state["imgs"] if "127.0.0.1" in s or s == "x"], state["imgs"]

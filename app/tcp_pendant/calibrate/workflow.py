@@ -194,6 +194,7 @@ class CalibrationWorkflow:
         self.tools: dict[str, ToolModel] = dict(builtin_tools() if tools is None else tools)
         self.rng = np.random.default_rng() if rng is None else rng
         self.training = True
+        self.hide_truth = False   # an exercise (classroom): no true frame or error vs truth shown
         self.runs: list[WizardRun] = []
         self._current: int | None = None
         self.last_save: tuple[int, Tool] | None = None

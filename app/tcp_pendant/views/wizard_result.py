@@ -172,7 +172,7 @@ class WizardResultView:
         self.hidden_md.visible = bool(hidden)
         if hidden:
             set_content(self.hidden_md, hidden)
-        truth = None if getattr(wf, "hide_truth", False) else wf.truth()   # an exercise: no answer shown
+        truth = None if wf.hide_truth else wf.truth()   # an exercise: no answer shown
         self.truth_md.visible = truth is not None
         if truth is not None:
             set_content(self.truth_md, truth_markdown(truth))
