@@ -21,6 +21,8 @@ sys.path.insert(0, str(HERE.parent / "calibrate"))
 from guiclick import choose, click  # noqa: E402
 from wsclient import DrainingClient, wait_until  # noqa: E402
 
+from tcpcal.tool import Tool  # noqa: E402
+from tcp_pendant.calibrate.workflow import AutoTouchRequest  # noqa: E402
 from tcp_pendant.cli import SCENARIO_CHOICES, build_parser  # noqa: E402
 from tcp_pendant.controller import ControllerError, builtin_tools, reference_tip_model  # noqa: E402
 from tcp_pendant.controller.scenarios import SCENARIO_KINDS, explain  # noqa: E402
@@ -288,3 +290,28 @@ def test_wizard_touches_carry_their_joint_values_into_the_session_record(page) -
     entry["joints_deg"] = {"0": [float("inf")]}
     with pytest.raises(SessionRecordError, match="joints_deg"):
         check_session_record(record)
+
+
+def test_reference_wizard_under_a_bent_tool_is_graded_against_the_bent_new_tool(page) -> None:
+    """The XYZ reference wizard's truth is the new tool mounted at its tool change: with the
+    bent-tool scenario that is the bent torch, not the catalogue's (it was graded against the
+    unbent frame, a TCP off by the bend called wrong)."""
+    p = page()
+    s, c = p.session, p.session.controller
+    s.set_scenario("bent_tool", 2)
+    pointer = c.mounted_tool                                         # the bent pointer, as bolted on
+    T = pointer.T_flange_tool_true
+    s.library.save(1, Tool.from_rotation("Pointer", tuple(T[:3, 3] * 1000.0), T[:3, :3]))
+    s.reload_library()
+    wf = p.calibrate.workflow
+    wf.start_reference(reference_slot=1, reference_tool_key="pointer", new_tool_key="torch")
+    wf.auto_touch(AutoTouchRequest())
+    wf.mount_required_tool()
+    torch = c.mounted_tool
+    bent_mm = np.linalg.norm(torch.T_flange_tool_true[:3, 3] - builtin_tools()["torch"].T_flange_tool_true[:3, 3])
+    assert torch.key == "torch" and bent_mm * 1000.0 > 2.0           # the bent torch is on the flange
+    wf.auto_touch(AutoTouchRequest())
+    res, truth = wf.result, wf.truth()
+    assert res is not None and truth is not None
+    np.testing.assert_allclose(res.tcp_mm, torch.T_flange_tool_true[:3, 3] * 1000.0, atol=1e-6)
+    assert truth.position_error_mm < 1e-6                            # graded against the bent torch

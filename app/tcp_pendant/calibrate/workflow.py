@@ -25,7 +25,7 @@ another wizard only cancels (never deletes) the one that was open.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, Literal, Protocol
 
 import numpy as np
@@ -432,6 +432,11 @@ class CalibrationWorkflow:
         if tool is None:
             raise WizardStateError("This step needs no tool change.")
         self.state.mount_tool(tool)
+        mounted = self.controller.mounted_tool          # a scenario may mount a bent version
+        run = self.run
+        if run is not None and self._current is not None and run.true_tool_key == mounted.key:
+            self.runs[self._current] = replace(   # grade against what is on the flange now
+                run, T_flange_tool_true_m=np.array(mounted.T_flange_tool_true, dtype=float))
         self.note_mounted_tool()
         return tool
 
