@@ -95,7 +95,7 @@ def test_meter_markdown_uses_the_advice_and_does_not_repeat_the_angle() -> None:
 
 
 def test_the_meter_in_the_app_speaks_of_touch_1_after_one_touch(tmp_path) -> None:
-    from test_calibrate_view import Page
+    from calib_page import Page
     from tcp_pendant.server import AppConfig, PendantApp
 
     app = PendantApp(AppConfig(port=0, tool="pointer", tool_library=tmp_path / "tools.json",

@@ -132,8 +132,6 @@ def test_finish_frames_the_camera_and_spreads_the_labels(page) -> None:
     assert tuple(others["tool"].position) == pytest.approx((0.0, 0.0, 0.04))
 
 
-from test_calibrate_view import page  # noqa: E402,F401  (the in-process browser fixture)
-
 
 def _boxes_apart(f, world: dict[str, np.ndarray]) -> list[tuple[str, str]]:
     xy, _ = f.project(np.array(list(world.values())))

@@ -28,7 +28,7 @@ from tcp_pendant.controller import builtin_tools
 from tcp_pendant.server import AppConfig, PendantApp
 from tcp_pendant.session import SessionChange
 
-from test_calibrate_view import Page
+from calib_page import Page
 
 
 @pytest.fixture

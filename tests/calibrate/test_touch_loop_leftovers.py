@@ -7,16 +7,12 @@ from __future__ import annotations
 
 import json
 import sys
-from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import pytest
 from tcp_pendant.calibrate import AutoTouchRequest
-from tcp_pendant.server import AppConfig, PendantApp
 from tcp_pendant.session import Touch
-from tcp_pendant.views.wizard_menu import CalibrateView
 from tcp_pendant.wizards import WizardError
 from tcp_pendant.wizards.session_record import SessionRecordError, dumps, load_and_replay
 
@@ -26,48 +22,6 @@ HERE = Path(__file__).parent
 sys.path.insert(0, str(HERE.parent / "app"))
 sys.path.insert(0, str(HERE))
 from guiclick import choose, click
-from wsclient import DrainingClient, wait_until
-
-
-class Page:
-    """One connected browser: its session, Calibrate view and client."""
-
-    def __init__(self, app: PendantApp) -> None:
-        n = len(app.sessions)
-        self.ws = DrainingClient(app.port)
-        wait_until(lambda: len(app.sessions) > n, what="session built")
-        self.session = list(app.sessions.values())[-1]
-        self.view: CalibrateView = self.session.views["calibrate"]
-        self.client = self.session.client
-        self.notes: list[tuple[str, str]] = []
-        self.session.notify = lambda title, body, kind="info": self.notes.append((title, body))  # type: ignore[method-assign]
-
-    def click(self, handle: Any) -> None:
-        click(handle, self.client)
-
-    def choose(self, handle: Any, value: Any) -> None:
-        choose(handle, value, self.client)
-
-
-@pytest.fixture
-def page(tmp_path: Path) -> Iterator[Callable[..., Page]]:
-    apps: list[PendantApp] = []
-    pages: list[Page] = []
-
-    def make(tool: str = "pointer") -> Page:
-        app = PendantApp(AppConfig(port=0, tool=tool, tool_library=tmp_path / "tools.json", library_poll_s=0.1))
-        app.start()
-        apps.append(app)
-        p = Page(app)
-        p.view.workflow.rng = np.random.default_rng(5)
-        pages.append(p)
-        return p
-
-    yield make
-    for p in pages:
-        p.ws.close()
-    for a in apps:
-        a.stop()
 
 
 # ---------------------------------------------------------------- item 6: stale texts
