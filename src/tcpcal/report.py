@@ -216,6 +216,11 @@ def _fig(x: float, unit: str = " mm", fmt: str = ".3f") -> str:
     return f"{x:{fmt}}{unit}" if math.isfinite(x) else "undefined"
 
 
+def _warning_lines(warnings: Sequence[str]) -> list[str]:
+    """``Warnings:`` and one bullet per warning, or ``Warnings: none`` (every report ends so)."""
+    return ["Warnings:", *_bullets(warnings)] if warnings else ["Warnings: none"]
+
+
 def _bullets(items: Sequence[str]) -> list[str]:
     out: list[str] = []
     for w in items:
@@ -305,11 +310,7 @@ def format_tcp_report(result: TcpResult, poses: FlangePoses | None = None, *,
             lines += ["  " + s for s in _tcp_block(sub)]
     else:
         lines.append("Outliers: none")
-    if result.warnings:
-        lines.append("Warnings:")
-        lines += _bullets(result.warnings)
-    else:
-        lines.append("Warnings: none")
+    lines += _warning_lines(result.warnings)
     lines += ["", *textwrap.wrap(CAVEAT, width=92)]
     return "\n".join(lines)
 
@@ -332,11 +333,7 @@ def format_orientation_report(result: OrientationResult, poses: FlangePoses | No
         lines.append("Displacements used:           "
                      + ", ".join(f"{float(d):.1f} mm" for d in result.displacements)
                      + "  (longer gives a smaller angular error)")
-    if result.warnings:
-        lines.append("Warnings:")
-        lines += _bullets(result.warnings)
-    else:
-        lines.append("Warnings: none")
+    lines += _warning_lines(result.warnings)
     return "\n".join(lines)
 
 
@@ -458,11 +455,7 @@ def format_tcp_zx_report(result: TcpZxResult, poses: FlangePoses | None = None, 
                      "touch (--json: without_outliers).")
     else:
         lines.append("Outliers: none")
-    if result.warnings:
-        lines.append("Warnings:")
-        lines += _bullets(result.warnings)
-    else:
-        lines.append("Warnings: none")
+    lines += _warning_lines(result.warnings)
     lines += ["", *textwrap.wrap(CAVEAT, width=92)]
     return "\n".join(lines)
 
@@ -539,10 +532,6 @@ def format_beam_report(result: BeamResult, poses: FlangePoses | None = None, *,
                      f"{e[0]:7.3f}  {e[1]:7.3f}  {e[2]:7.3f}  "
                      f"{float(result.beam_positions[i]):11.3f}{label}")
     lines += ["", "Outliers: not tested for beam events"]
-    if result.warnings:
-        lines.append("Warnings:")
-        lines += _bullets(result.warnings)
-    else:
-        lines.append("Warnings: none")
+    lines += _warning_lines(result.warnings)
     lines += ["", *textwrap.wrap(CAVEAT, width=92)]
     return "\n".join(lines)
