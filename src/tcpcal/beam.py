@@ -27,7 +27,7 @@ from scipy.special import chdtrc
 from tcpcal._stats import DEGENERATE_TILT_RAD, ci_radius, fmt_vec
 from tcpcal.errors import DegenerateTouchesError, InvalidInputError
 from tcpcal.origin import SIGMA_RANGE
-from tcpcal.validation import as_positions, as_rotations, as_vector3
+from tcpcal.validation import as_positions, as_rotations, as_vector3, read_only_array
 
 __all__ = [
     "MIN_AXIS_EVENTS",
@@ -52,12 +52,6 @@ _AXIS_DEGENERATE_SHARE = DEGENERATE_TILT_RAD ** 2
 """Axis events: the planes through the TCP are 'the same' when the second-smallest eigenvalue
 of their normal matrix is below this share of its trace (planes within ~1e-3 rad)."""
 _IRLS_STEPS = 4
-
-
-def _frozen(a: np.ndarray) -> np.ndarray:
-    a = np.array(a, dtype=float)
-    a.setflags(write=False)
-    return a
 
 
 @dataclass(frozen=True)
@@ -304,11 +298,11 @@ def solve_beam(rotations: Any, positions: Any, beam_point: Any, beam_dir: Any, *
             "position or direction, the tool or the robot is not what the model says.")
 
     return BeamResult(
-        tcp=_frozen(t), residual_vectors=_frozen(e), residuals=_frozen(res),
-        beam_positions=_frozen(along), mean_error=float(res.mean()),
+        tcp=read_only_array(t), residual_vectors=read_only_array(e), residuals=read_only_array(res),
+        beam_positions=read_only_array(along), mean_error=float(res.mean()),
         max_error=float(res.max()), rms_error=math.sqrt(sse / n), noise_sigma=float(noise),
-        covariance=_frozen(cov), ci95_radius=ci95,
-        condition_number=math.sqrt(mu[2] / mu[0]), weakest_axis=_frozen(weakest),
+        covariance=read_only_array(cov), ci95_radius=ci95,
+        condition_number=math.sqrt(mu[2] / mu[0]), weakest_axis=read_only_array(weakest),
         outliers=(), warnings=tuple(warnings), n_events=n)
 
 
@@ -441,7 +435,7 @@ def solve_beam_axis(rotations: Any, positions: Any, beam_point: Any, beam_dir: A
             f"axis event {i}: the beam met the tool axis {lam[i]:.3g} ahead of the TCP, beyond "
             "the tip; the crossings should be on the shaft behind the tip.")
     return BeamAxisResult(
-        direction=_frozen(d + 0.0), axis_points=_frozen(points), axis_distances=_frozen(lam),
-        residuals=_frozen(resid), rms_error=math.sqrt(sse / k), noise_sigma=float(noise),
-        covariance=_frozen(cov), ci95_angle_deg=ci_deg, warnings=tuple(warnings), n_events=k)
+        direction=read_only_array(d + 0.0), axis_points=read_only_array(points), axis_distances=read_only_array(lam),
+        residuals=read_only_array(resid), rms_error=math.sqrt(sse / k), noise_sigma=float(noise),
+        covariance=read_only_array(cov), ci95_angle_deg=ci_deg, warnings=tuple(warnings), n_events=k)
 

@@ -41,6 +41,7 @@ from tcpcal.validation import (
     as_positions,
     as_rotation,
     as_vector3,
+    read_only_array,
     rotations_and_soa,
 )
 
@@ -69,12 +70,6 @@ _EXACT_REL = 1e-9
 """Residual noise below this fraction of the data scale counts as exact data (no outlier test)."""
 _EXACT_RESIDUAL_SHARE = 1e-12
 """Outlier test: the other touches fit exactly when ``SSE - Q_i <= this * SSE`` (rounding)."""
-
-
-def _frozen(a: np.ndarray) -> np.ndarray:
-    a = np.array(a, dtype=float)
-    a.setflags(write=False)
-    return a
 
 
 @dataclass(frozen=True)
@@ -666,15 +661,15 @@ def solve_reference(
     zeros = np.zeros((2, 3))
     return TcpResult(
         method="reference",
-        tcp=_frozen(t2),
-        reference=_frozen(ref),
-        residual_vectors=_frozen(zeros),
-        residuals=_frozen(np.zeros(2)),
+        tcp=read_only_array(t2),
+        reference=read_only_array(ref),
+        residual_vectors=read_only_array(zeros),
+        residuals=read_only_array(np.zeros(2)),
         mean_error=0.0,
         max_error=0.0,
         rms_error=0.0,
         noise_sigma=noise,
-        covariance=_frozen(cov),
+        covariance=read_only_array(cov),
         ci95_radius=ci95,
         max_angle_deg=angle,
         min_angle_deg=angle,

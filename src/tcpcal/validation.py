@@ -25,6 +25,7 @@ __all__ = [
     "as_rotation",
     "as_rotations",
     "as_vector3",
+    "read_only_array",
     "rotations_and_soa",
 ]
 
@@ -42,6 +43,13 @@ _EYE_COLUMN = _EYE[:, :, None]
 # ufunc reductions without the Python wrappers of ndarray.sum/max/min (the solvers' hot path)
 _add, _max, _min = np.add.reduce, np.maximum.reduce, np.minimum.reduce
 _CYCLIC = np.array([0, 1, 2, 0, 1])
+
+
+def read_only_array(a: Any) -> np.ndarray:
+    """A float copy of ``a`` that cannot be written (the arrays of frozen result dataclasses)."""
+    out = np.array(a, dtype=float)
+    out.setflags(write=False)
+    return out
 
 
 def _as_float_array(x: Any, name: str, expected: str) -> np.ndarray:

@@ -37,6 +37,7 @@ from typing import Literal
 import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
+from tcpcal.validation import read_only_array
 from tcp_pendant.controller.errors import ControllerError
 
 __all__ = [
@@ -53,12 +54,6 @@ DEFAULT_WIDTH_M: float = 0.5e-3
 """Beam diameter: through-beam barriers of TCP devices use beams of a fraction of a mm."""
 DEFAULT_SIGMA_M: float = 2e-5
 """Repeatability of a recorded event: 0.02 mm per axis (issue 14's default)."""
-
-
-def _readonly(a: np.ndarray) -> np.ndarray:
-    out = np.array(a, dtype=float)
-    out.setflags(write=False)
-    return out
 
 
 def _unit(v: object, name: str) -> np.ndarray:
@@ -96,9 +91,9 @@ class BeamSensor:
         if p.shape != (3,) or not np.isfinite(p).all():
             raise ControllerError(f"Beam sensor: point must be 3 finite numbers (m), got "
                                   f"{self.point!r}.")
-        object.__setattr__(self, "point", _readonly(p))
+        object.__setattr__(self, "point", read_only_array(p))
         u = _unit(self.direction, "direction")
-        object.__setattr__(self, "direction", _readonly(u))
+        object.__setattr__(self, "direction", read_only_array(u))
         for name in ("width", "sigma"):
             v = float(getattr(self, name))
             if not (math.isfinite(v) and v >= 0.0):
@@ -110,7 +105,7 @@ class BeamSensor:
             if float(np.linalg.norm(np.cross(u, u2))) < 1e-3:
                 raise ControllerError("Beam sensor: the second beam is parallel to the first; "
                                       "crossed beams need different directions.")
-            object.__setattr__(self, "second_direction", _readonly(u2))
+            object.__setattr__(self, "second_direction", read_only_array(u2))
 
     @property
     def beams(self) -> tuple[tuple[np.ndarray, np.ndarray], ...]:
@@ -142,7 +137,7 @@ class ToolShape:
         R = T[:3, :3]
         if np.abs(R.T @ R - np.eye(3)).max() > 1e-9 or np.linalg.det(R) < 0:
             raise ControllerError("ToolShape: T_flange_tool has no proper rotation.")
-        object.__setattr__(self, "T_flange_tool", _readonly(T))
+        object.__setattr__(self, "T_flange_tool", read_only_array(T))
         for name, low in (("radius", 0.0), ("length", 1e-9)):
             v = float(getattr(self, name))
             if not (math.isfinite(v) and v >= low):
@@ -223,7 +218,7 @@ def _record(T_start: np.ndarray, m: np.ndarray, travel: float, sigma: float,
     noisy = exact.copy()
     if rng is not None and sigma > 0.0:
         noisy[:3, 3] += rng.normal(0.0, sigma, (n_avg, 3)).mean(axis=0)
-    return _readonly(exact), _readonly(noisy)
+    return read_only_array(exact), read_only_array(noisy)
 
 
 def tip_on_beam(T_world_flange_start: object, direction: object, sensor: BeamSensor,

@@ -37,6 +37,7 @@ from typing import TYPE_CHECKING, Literal
 import numpy as np
 import pinocchio as pin
 
+from tcpcal.validation import read_only_array
 from tcp_pendant.controller.errors import ControllerError
 from tcp_pendant.controller.jog import DEFAULT_SETTINGS, CartesianPath, JogSettings, follow_path
 from tcp_pendant.controller.kinematics import RobotKinematics
@@ -59,12 +60,6 @@ MAX_SPIN_ANGLE_DEG = 90.0
 SpinAxis = Literal["A", "B", "C"]
 SPIN_AXES: dict[str, int] = {"A": 2, "B": 1, "C": 0}
 """Spin axis -> index of the active TOOL frame axis it turns about (A: Z, B: Y, C: X)."""
-
-
-def _readonly(a: np.ndarray) -> np.ndarray:
-    out = np.array(a, dtype=float)
-    out.setflags(write=False)
-    return out
 
 
 @dataclass(frozen=True)
@@ -241,8 +236,8 @@ def spin_check(kinematics: RobotKinematics, q_rad: Sequence[float] | np.ndarray,
             rotations.append(SpinRotation(
                 label=_label(sign, axis, angle), axis=axis, angle_deg=sign * angle, reached=reached,
                 moved=float(out.moved), stopped_by=out.stopped_by, message=out.message,
-                deviation_mm=float(np.linalg.norm(d_world)), deviation_world_mm=_readonly(d_world),
-                deviation_tool_mm=_readonly(d_tool), q_rad=_readonly(out.q_rad)))
+                deviation_mm=float(np.linalg.norm(d_world)), deviation_world_mm=read_only_array(d_world),
+                deviation_tool_mm=read_only_array(d_tool), q_rad=read_only_array(out.q_rad)))
             if reached:
                 axis_tool = np.zeros(3)
                 axis_tool[k] = sign * theta
@@ -257,13 +252,13 @@ def spin_check(kinematics: RobotKinematics, q_rad: Sequence[float] | np.ndarray,
         b = np.concatenate(rhs)
         e, _, rank, _ = np.linalg.lstsq(A, b, rcond=None)
         if rank == 3:
-            e_tool = _readonly(e)
-            e_flange = _readonly(T_active[:3, :3] @ e)
+            e_tool = read_only_array(e)
+            e_flange = read_only_array(T_active[:3, :3] @ e)
             err = float(np.linalg.norm(e))
             rms = float(np.sqrt(np.mean((A @ e - b) ** 2)))
     return SpinCheckResult(angle_deg=angle, rotations=tuple(rotations), max_deviation_mm=float(max_dev),
                            implied_offset_tool_mm=e_tool, implied_offset_flange_mm=e_flange,
-                           implied_tcp_error_mm=err, fit_rms_mm=rms, q_start_rad=_readonly(q0))
+                           implied_tcp_error_mm=err, fit_rms_mm=rms, q_start_rad=read_only_array(q0))
 
 
 def spin_check_of(controller: "VirtualController", *, angle_deg: float = DEFAULT_SPIN_ANGLE_DEG,
