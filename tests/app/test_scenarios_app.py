@@ -10,7 +10,6 @@ from __future__ import annotations
 import sys
 from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import pytest
@@ -18,8 +17,7 @@ import pytest
 HERE = Path(__file__).parent
 sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(HERE.parent / "calibrate"))
-from guiclick import choose, click  # noqa: E402
-from wsclient import DrainingClient, wait_until  # noqa: E402
+from app_page import AppPage, app_pages  # noqa: E402
 
 from tcpcal.tool import Tool  # noqa: E402
 from tcp_pendant.calibrate.workflow import AutoTouchRequest  # noqa: E402
@@ -38,17 +36,11 @@ from tcp_pendant.wizards.session_record import (  # noqa: E402
 )
 
 
-class Page:
-    """One connected browser: its session and views."""
+class Page(AppPage):
+    """One connected browser: its session, views and every change signal it saw."""
 
     def __init__(self, app: PendantApp) -> None:
-        n = len(app.sessions)
-        self.ws = DrainingClient(app.port)
-        wait_until(lambda: len(app.sessions) > n, what="session built")
-        self.session = list(app.sessions.values())[-1]
-        self.client = self.session.client
-        self.notes: list[tuple[str, str]] = []
-        self.session.notify = lambda title, body, kind="info": self.notes.append((title, body))  # type: ignore
+        super().__init__(app)
         self.panel = self.session.views["scenario"]
         self.calibrate = self.session.views["calibrate"]
         self.tools = self.session.views["tools"]
@@ -56,32 +48,11 @@ class Page:
         self.changes: list[SessionChange] = []
         self.session.subscribe(self.changes.append)
 
-    def click(self, handle: Any) -> None:
-        click(handle, self.client)
-
-    def choose(self, handle: Any, value: Any) -> None:
-        choose(handle, value, self.client)
-
 
 @pytest.fixture
 def page(tmp_path: Path) -> Iterator[Callable[..., Page]]:
-    apps: list[PendantApp] = []
-    pages: list[Page] = []
-
-    def make(**kw: Any) -> Page:
-        app = PendantApp(AppConfig(port=0, tool_library=tmp_path / "tools.json", library_poll_s=0.1, **kw))
-        app.start()
-        apps.append(app)
-        p = Page(app)
-        p.calibrate.workflow.rng = np.random.default_rng(5)
-        pages.append(p)
-        return p
-
-    yield make
-    for p in pages:
-        p.ws.close()
-    for a in apps:
-        a.stop()
+    with app_pages(tmp_path, Page, seed=5) as make:
+        yield make
 
 
 def auto_xyz4(p: Page) -> None:

@@ -10,7 +10,6 @@ import json
 import sys
 from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import pytest
@@ -18,7 +17,8 @@ import pytest
 HERE = Path(__file__).parent
 sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(HERE.parent / "calibrate"))
-from guiclick import choose, click  # noqa: E402
+from app_page import AppPage, app_pages  # noqa: E402
+from guiclick import click  # noqa: E402
 from wsclient import DrainingClient, wait_until  # noqa: E402
 
 from tcp_pendant.controller import builtin_tools  # noqa: E402
@@ -37,27 +37,15 @@ def truth_tool(key: str, name: str, offset_mm=(0.0, 0.0, 0.0)) -> Tool:
     return Tool.from_rotation(name, tuple(T[:3, 3] * 1000.0 + np.asarray(offset_mm)), T[:3, :3])
 
 
-class Page:
+class Page(AppPage):
     """One connected browser: its session, views and what was sent to it."""
 
     def __init__(self, app: PendantApp) -> None:
-        n = len(app.sessions)
-        self.ws = DrainingClient(app.port)
-        wait_until(lambda: len(app.sessions) > n, what="session built")
-        self.session = list(app.sessions.values())[-1]
-        self.client = self.session.client
-        self.notes: list[tuple[str, str]] = []
-        self.session.notify = lambda title, body, kind="info": self.notes.append((title, body))  # type: ignore
+        super().__init__(app)
         self.sent: list[tuple[str, bytes]] = []
         self.client.send_file_download = lambda name, data, *a, **k: self.sent.append((name, data))  # type: ignore
         self.tools = self.session.views["tools"]
         self.touches = self.session.views["touches"]
-
-    def click(self, handle: Any) -> None:
-        click(handle, self.client)
-
-    def choose(self, handle: Any, value: Any) -> None:
-        choose(handle, value, self.client)
 
     def select_slot(self, slot: int) -> None:
         opt = next(o for o in self.tools.slots.options if o.startswith(f"{slot}:") or o.startswith(f"{slot} "))
@@ -66,24 +54,8 @@ class Page:
 
 @pytest.fixture
 def page(tmp_path: Path) -> Iterator[Callable[..., Page]]:
-    apps: list[PendantApp] = []
-    pages: list[Page] = []
-
-    def make(tools: dict[int, Tool] | None = None, **kw: Any) -> Page:
-        app = PendantApp(AppConfig(port=0, tool_library=tmp_path / "tools.json", library_poll_s=0.1, **kw))
-        for slot, tool in (tools or {}).items():
-            app.library.save(slot, tool)
-        app.start()
-        apps.append(app)
-        p = Page(app)
-        pages.append(p)
-        return p
-
-    yield make
-    for p in pages:
-        p.ws.close()
-    for a in apps:
-        a.stop()
+    with app_pages(tmp_path, Page) as make:
+        yield make
 
 
 # ----------------------------------------------------------------------------- Check

@@ -20,7 +20,6 @@ import sys
 import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import pytest
@@ -28,36 +27,25 @@ import pytest
 HERE = Path(__file__).parent
 sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(HERE.parent / "calibrate"))
-from guiclick import choose, click  # noqa: E402
-from wsclient import ButtonClient, DrainingClient, wait_until  # noqa: E402
+from app_page import AppPage, app_pages  # noqa: E402
+from guiclick import click  # noqa: E402
+from wsclient import ButtonClient, wait_until  # noqa: E402
 
 from tcp_pendant.pendant.guidance import tip_offset_mm  # noqa: E402
 from tcp_pendant.pendant.jogging import LINEAR_SPEED_MM_S  # noqa: E402
-from tcp_pendant.server import AppConfig, PendantApp  # noqa: E402
+from tcp_pendant.server import PendantApp  # noqa: E402
 from tcp_pendant.views.pendant_panel import HOLD_HZ, MARK  # noqa: E402
 from tcp_pendant.views.wizard_dock import BACK, CANCEL, NEXT  # noqa: E402
 
 
-class Page:
+class Page(AppPage):
     """One connected browser: its session and views."""
 
     def __init__(self, app: PendantApp) -> None:
-        n = len(app.sessions)
-        self.ws = DrainingClient(app.port)
-        wait_until(lambda: len(app.sessions) > n, what="session built")
-        self.session = list(app.sessions.values())[-1]
-        self.client = self.session.client
-        self.notes: list[tuple[str, str]] = []
-        self.session.notify = lambda title, body, kind="info": self.notes.append((title, body))  # type: ignore
+        super().__init__(app)
         self.dock = self.session.views["dock"]
         self.pendant = self.session.views["pendant"]
         self.calibrate = self.session.views["calibrate"]
-
-    def click(self, handle: Any) -> None:
-        click(handle, self.client)
-
-    def choose(self, handle: Any, value: Any) -> None:
-        choose(handle, value, self.client)
 
     def tip_at(self, offset_mm: tuple[float, float, float]) -> None:
         """Teleport the true tool tip to the reference tip + ``offset_mm`` (WORLD), same
@@ -74,23 +62,8 @@ class Page:
 
 @pytest.fixture
 def page(tmp_path: Path) -> Iterator[Callable[..., Page]]:
-    apps: list[PendantApp] = []
-    pages: list[Page] = []
-
-    def make() -> Page:
-        app = PendantApp(AppConfig(port=0, tool_library=tmp_path / "tools.json", library_poll_s=0.1))
-        app.start()
-        apps.append(app)
-        p = Page(app)
-        p.calibrate.workflow.rng = np.random.default_rng(3)
-        pages.append(p)
-        return p
-
-    yield make
-    for p in pages:
-        p.ws.close()
-    for a in apps:
-        a.stop()
+    with app_pages(tmp_path, Page, seed=3) as make:
+        yield make
 
 
 def test_the_dock_shows_the_wizards_step_on_the_jog_tab_and_records_it(page) -> None:

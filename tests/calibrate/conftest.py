@@ -11,13 +11,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 from tcp_pendant.calibrate import CalibrationWorkflow
-from tcp_pendant.server import AppConfig, PendantApp
 
 from tcpcal.library import ToolLibrary
 
 sys.path.insert(0, str(Path(__file__).parent))
 from calib_helpers import make_controller
 from calib_page import Page
+from app_page import app_pages
 
 
 @pytest.fixture
@@ -39,21 +39,7 @@ def workflow(library: ToolLibrary) -> Callable[..., CalibrationWorkflow]:
 @pytest.fixture
 def page(tmp_path: Path) -> Iterator[Callable[..., Page]]:
     """Factory: ``page(tool="pointer")`` starts a pendant (port 0, library in tmp_path) and
-    connects a browser to it; its workflow's auto-touch generator is seeded."""
-    apps: list[PendantApp] = []
-    pages: list[Page] = []
-
-    def make(tool: str = "pointer") -> Page:
-        app = PendantApp(AppConfig(port=0, tool=tool, tool_library=tmp_path / "tools.json", library_poll_s=0.1))
-        app.start()
-        apps.append(app)
-        p = Page(app)
-        p.view.workflow.rng = np.random.default_rng(5)
-        pages.append(p)
-        return p
-
-    yield make
-    for p in pages:
-        p.ws.close()
-    for a in apps:
-        a.stop()
+    connects a browser to it; its workflow's auto-touch generator is seeded
+    (``app_page.app_pages``)."""
+    with app_pages(tmp_path, Page, seed=5) as make:
+        yield make

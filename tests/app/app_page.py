@@ -1,0 +1,70 @@
+"""One connected browser on an in-process pendant, shared by the app and Calibrate tests: its
+session, client and notifications (``AppPage``), and ``app_pages``, the factory behind each
+test file's ``page`` fixture (a server on port 0 with its library in ``tmp_path``). A test file
+subclasses ``AppPage`` for the views and helpers it needs."""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any, TypeVar
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).parents[1] / "calibrate"))
+from guiclick import choose, click  # noqa: E402
+from tcp_pendant.server import AppConfig, PendantApp  # noqa: E402
+from tcpcal.tool import Tool  # noqa: E402
+from wsclient import DrainingClient, wait_until  # noqa: E402
+
+P = TypeVar("P", bound="AppPage")
+
+
+class AppPage:
+    """One connected browser: its session, client and the notifications it was shown."""
+
+    def __init__(self, app: PendantApp) -> None:
+        n = len(app.sessions)
+        self.ws = DrainingClient(app.port)
+        wait_until(lambda: len(app.sessions) > n, what="session built")
+        self.session = list(app.sessions.values())[-1]
+        self.client = self.session.client
+        self.notes: list[tuple[str, str]] = []
+        self.session.notify = lambda title, body, kind="info": self.notes.append((title, body))  # type: ignore[method-assign]
+
+    def click(self, handle: Any) -> None:
+        click(handle, self.client)
+
+    def choose(self, handle: Any, value: Any) -> None:
+        choose(handle, value, self.client)
+
+
+@contextmanager
+def app_pages(tmp_path: Path, page_cls: type[P], *, seed: int | None = None) -> Iterator[Callable[..., P]]:
+    """``make(tools=None, **config)``: start a pendant (``AppConfig`` options, the library in
+    ``tmp_path`` holding ``tools`` {slot: Tool}) and connect a ``page_cls`` browser to it; the
+    workflow's auto-touch generator seeded with ``seed`` (if given). Everything stops at exit."""
+    apps: list[PendantApp] = []
+    pages: list[P] = []
+
+    def make(tools: dict[int, Tool] | None = None, **config: Any) -> P:
+        app = PendantApp(AppConfig(port=0, tool_library=tmp_path / "tools.json", library_poll_s=0.1, **config))
+        for slot, tool in (tools or {}).items():
+            app.library.save(slot, tool)
+        app.start()
+        apps.append(app)
+        p = page_cls(app)
+        if seed is not None:
+            p.session.views["calibrate"].workflow.rng = np.random.default_rng(seed)
+        pages.append(p)
+        return p
+
+    try:
+        yield make
+    finally:
+        for p in pages:
+            p.ws.close()
+        for a in apps:
+            a.stop()
