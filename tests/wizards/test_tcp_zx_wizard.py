@@ -129,3 +129,48 @@ def test_truth_grades_both_the_tcp_and_the_frame(synth) -> None:
     assert cmp.graded == ("position", "orientation") and cmp.grade == "poor"
     assert cmp.position_error_mm == pytest.approx(3.0, abs=1e-9) and cmp.orientation_error_deg < 1e-6
     assert "position error" in cmp.verdict and "TCP used" not in cmp.verdict
+
+
+def test_auto_touch_z_step_out_of_reach_retries_shorter_then_a_new_orientation(synth) -> None:
+    """The kept orientation may be out of reach for the back-off along tool +Z (about 2 % of
+    random runs on the KR 6 with the torch): auto-touch tries half and a quarter of the distance
+    in the same orientation, then, since TCP & Z, X solves with each row's own rotation, a new
+    direction; the result is still the true frame."""
+    ctrl = fake(synth, "torch")
+    wiz = TcpZxWizard()
+    rng = np.random.default_rng(4)
+    previous = None
+    for _ in range(wiz.n_points):
+        out = auto_touch(wiz, ctrl, rng=rng, previous_direction_deg=previous)
+        assert out.ok, out.message
+        previous = out.direction_deg
+    n_calls = len(ctrl.calls)
+    ctrl.fail_first = 3                                   # 60, 30 and 20 mm in the kept orientation
+    out = auto_touch(wiz, ctrl, rng=rng, previous_direction_deg=previous)
+    assert out.ok and out.attempts == 4 and "new one was drawn" in out.message
+    tried = ctrl.calls[n_calls:]
+    assert [c[4] for c in tried] == [(0.0, 0.0, 60.0), (0.0, 0.0, 30.0), (0.0, 0.0, 20.0), (0.0, 0.0, 60.0)]
+    assert all(c[1:4] == tuple(previous) for c in tried[:3]) and tried[3][1:4] != tuple(previous)
+    assert 5.0 <= tried[3][1] <= 30.0
+    ctrl.fail_first = 1                                   # the x step: half distance, same orientation
+    out = auto_touch(wiz, ctrl, rng=rng, previous_direction_deg=out.direction_deg)
+    assert out.ok and out.attempts == 2 and "30 mm off the tip" in out.message
+    res = wiz.next()
+    cmp = compare_with_truth(res, synth.tools["torch"].T_flange_tool_true_m)
+    assert cmp.position_error_mm < 1e-9 and cmp.orientation_error_deg < 1e-6
+
+
+def test_three_point_keeps_its_orientation_and_never_draws_a_new_one(synth) -> None:
+    from test_autotouch import exact_tool
+
+    from tcp_pendant.calibrate.autotouch import MIN_RETRY_DISTANCE_MM
+    from tcp_pendant.wizards import MIN_DISPLACEMENT_MM, ThreePointWizard
+    assert MIN_RETRY_DISTANCE_MM >= MIN_DISPLACEMENT_MM          # a retry is still a valid step
+    ctrl = fake(synth, "gripper")
+    wiz = ThreePointWizard(exact_tool(synth, "gripper"), variant=1)
+    out = auto_touch(wiz, ctrl, rng=np.random.default_rng(2))
+    assert out.ok
+    ctrl.fail_first = 10
+    failed = auto_touch(wiz, ctrl, rng=np.random.default_rng(2), previous_direction_deg=out.direction_deg)
+    assert not failed.ok and failed.attempts == 3                  # 60, 30, 20 mm; no new direction
+

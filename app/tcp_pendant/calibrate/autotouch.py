@@ -38,6 +38,9 @@ from tcp_pendant.wizards.abc_world import R_WORLD_TOOL_TARGET
 from tcp_pendant.wizards.base import StepInfo, Wizard, WizardError, WizardStateError
 
 DEFAULT_DISTANCE_MM = 60.0
+MIN_RETRY_DISTANCE_MM = 20.0
+"""Shortest distance off the tip a retried axis step uses (mm): the three-point wizard's
+minimum displacement (``three_point.MIN_DISPLACEMENT_MM``), so the retry is still accepted."""
 ANGLE_LEVER_MM = 100.0
 """Lever over which an operator judges "parallel" by eye: an operator error of ``sigma_mm``
 (position, per axis) is taken as an alignment error of ``atan(sigma_mm / ANGLE_LEVER_MM)``
@@ -165,28 +168,46 @@ def auto_touch(wizard: Wizard, controller: Any, *,
         return AutoTouchOutcome(True, step.index, step.role, None, None, None,
                                 f"Tool aligned with WORLD {how} and recorded.", 1)
 
-    offset = role.reference_in_tool_mm(distance_mm)
     fixed = direction_deg
     if fixed is None and role.keeps_orientation and step.index > 0:
         fixed = previous_direction_deg
+    # A fixed direction gets one try per distance. A step that keeps the orientation and puts the
+    # reference off the tip (TCP & Z, X's z and x, three-point's axes) may be out of reach at the
+    # full distance while a shorter back-off along the same axis is not (a ~2 % case at 60 mm on
+    # the KR 6 with the torch): as an operator would, it retries at half the distance and at
+    # MIN_RETRY_DISTANCE_MM.
+    # Where the solve takes each pose's own rotation (``any_orientation_solves``), new random
+    # directions at the full distance come last.
+    plan: list[tuple[float, bool]] = [(distance_mm, fixed is not None)]
+    if fixed is not None and any(role.reference_in_tool_mm(1.0)):
+        shorter_mm = sorted({max(distance_mm / 2.0, MIN_RETRY_DISTANCE_MM), MIN_RETRY_DISTANCE_MM}, reverse=True)
+        plan += [(d, True) for d in shorter_mm if d < distance_mm]
+    if fixed is not None and direction_deg is None and role.any_orientation_solves:
+        plan.append((distance_mm, False))
     attempts = 0
     last_message = ""
-    while attempts < (1 if fixed is not None else max_attempts):
-        attempts += 1
-        if fixed is not None:
-            tilt, azimuth, spin = (float(v) for v in fixed)
-        else:
-            lo, hi = role.tilt_range_deg
-            tilt, azimuth, spin = rng.uniform(lo, hi), rng.uniform(0.0, 360.0), rng.uniform(-90.0, 90.0)
-        res = controller.auto_approach(tilt_deg=tilt, azimuth_deg=azimuth, spin_deg=spin,
-                                       sigma_mm=sigma_mm, tip_offset_tool_mm=offset, rng=rng)
-        if res.ok:
-            wizard.record(controller.T_world_flange())
-            if advance and not wizard.on_last_step:
-                wizard.next()
-            return AutoTouchOutcome(True, step.index, step.role, tilt, azimuth, spin,
-                                    f"Step {step.index + 1} recorded: {step.title} (tilt {tilt:.0f}°, "
-                                    f"azimuth {azimuth:.0f}°).", attempts)
-        last_message = res.message
+    for d_mm, use_fixed in plan:
+        offset = role.reference_in_tool_mm(d_mm)
+        for _ in range(1 if use_fixed else max_attempts):
+            attempts += 1
+            if use_fixed and fixed is not None:
+                tilt, azimuth, spin = (float(v) for v in fixed)
+            else:
+                lo, hi = role.tilt_range_deg
+                tilt, azimuth, spin = rng.uniform(lo, hi), rng.uniform(0.0, 360.0), rng.uniform(-90.0, 90.0)
+            res = controller.auto_approach(tilt_deg=tilt, azimuth_deg=azimuth, spin_deg=spin,
+                                           sigma_mm=sigma_mm, tip_offset_tool_mm=offset, rng=rng)
+            if res.ok:
+                wizard.record(controller.T_world_flange())
+                if advance and not wizard.on_last_step:
+                    wizard.next()
+                shorter = (f" The reference is {d_mm:g} mm off the tip: {distance_mm:g} mm was out of "
+                           f"reach." if d_mm != distance_mm else
+                           " The previous orientation was out of reach: a new one was drawn."
+                           if fixed is not None and not use_fixed else "")
+                return AutoTouchOutcome(True, step.index, step.role, tilt, azimuth, spin,
+                                        f"Step {step.index + 1} recorded: {step.title} (tilt {tilt:.0f}°, "
+                                        f"azimuth {azimuth:.0f}°).{shorter}", attempts)
+            last_message = res.message
     return AutoTouchOutcome(False, step.index, step.role, None, None, None,
                             f"Auto-touch failed after {attempts} attempt(s): {last_message}", attempts)

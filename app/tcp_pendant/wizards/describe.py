@@ -43,6 +43,9 @@ class AutoRole:
             auto-touch (the operator jogs along tool axes and keeps the orientation).
         align_world: move the tool to the (PA-1) orientation above the reference tip instead.
         free_turn_about_x: with ``align_world``: a random turn about tool X (5D).
+        any_orientation_solves: the solve uses each pose's own rotation (TCP & Z, X,
+            methods.md (ZX-1), (ZX-2)), so when the kept orientation is out of reach, auto-touch
+            may draw a new direction in ``tilt_range_deg``; False where the method needs the orientation kept (three-point).
     """
 
     reference_per_distance: tuple[float, float, float] = (0.0, 0.0, 0.0)
@@ -51,6 +54,7 @@ class AutoRole:
     keeps_orientation: bool = False
     align_world: bool = False
     free_turn_about_x: bool = False
+    any_orientation_solves: bool = False
 
     def reference_in_tool_mm(self, distance_mm: float) -> tuple[float, float, float]:
         """The reference tip in true TOOL coordinates (mm) for an auto-touch ``distance_mm``."""
@@ -66,9 +70,11 @@ ON_MINUS_X = AutoRole((-1.0, 0.0, 0.0), tilt_range_deg=(5.0, 30.0), keeps_orient
 ON_PLUS_Y = AutoRole((0.0, 1.0, 0.0), tilt_range_deg=(5.0, 30.0), keeps_orientation=True)
 IN_PLUS_Y_HALF = AutoRole((0.0, 1.0, 0.0), (-20.0, 0.0, 0.0), tilt_range_deg=(5.0, 30.0),
                           keeps_orientation=True)
-AHEAD_PLUS_Z = AutoRole((0.0, 0.0, 1.0), tilt_range_deg=(5.0, 30.0), keeps_orientation=True)
+AHEAD_PLUS_Z = AutoRole((0.0, 0.0, 1.0), tilt_range_deg=(5.0, 30.0), keeps_orientation=True,
+                        any_orientation_solves=True)
 """The reference tip on the tool's +Z axis ahead of the TCP (backed off along tool -Z)."""
-AHEAD_PLUS_X = AutoRole((1.0, 0.0, 0.0), tilt_range_deg=(5.0, 30.0), keeps_orientation=True)
+AHEAD_PLUS_X = AutoRole((1.0, 0.0, 0.0), tilt_range_deg=(5.0, 30.0), keeps_orientation=True,
+                        any_orientation_solves=True)
 """The reference tip on the tool's +X axis ahead of the TCP (moved along tool -X)."""
 ALIGN_WORLD = AutoRole(align_world=True)
 """Tool axes parallel to WORLD as (PA-1) prescribes, hovering above the reference tip."""
