@@ -13,6 +13,9 @@ Scene tree (names are per browser; ``--shared`` uses the server's scene):
   (:attr:`SceneView.flange_path`) holds the FLANGE triad, the mounted tool's meshes and the
   active TOOL triad at ``T_flange_tool``, which ride on the flange without updates;
 * ``/reference_tip``: the stand posed so that its spike is at the reference tip;
+* ``/beam_sensor``: the beam sensor's stand (a fork, emitter and receiver) with the beam(s) as
+  thin bright lines (``views.beam_stand``), redrawn when ``controller.beam_sensor`` changes;
+  a scan's replay (the broken beam in red, event markers) is ``views.beam_replay``'s ``/beam_scan``;
 The scene reconciles from the session's state: it subscribes to the session's change signal
 (``Session.subscribe``) and, on a ``tool`` change, swaps the mounted tool's meshes and moves the
 TOOL triad when they differ from what the session now has; on a ``pose`` change it poses the
@@ -43,6 +46,7 @@ from tcp_pendant.controller import ToolModel, reference_tip_model
 from tcp_pendant.controller.kinematics import urdf_links_and_tree
 from tcp_pendant.controller.rotations import quaternion_wxyz, quaternions_wxyz
 from tcp_pendant.session import Session, SessionChange
+from tcp_pendant.views.beam_stand import BeamStandNodes
 from tcp_pendant.views.meshes import MeshPart, link_meshes, rigid_meshes
 
 __all__ = ["POSE_EPS", "PoseSender", "SceneView", "closeup_camera", "link_tree_paths", "overview_camera",
@@ -285,6 +289,7 @@ class SceneView:
         self._tip_label = scene.add_label("/reference_tip_label", "reference tip",
                                           position=tuple(c.reference_tip_world_m + [0.0, 0.0, -0.06]))
         session.scene_labels.update(self.tool_labels())     # the wizards' scene moves them apart
+        self.beam_stand = BeamStandNodes(scene, getattr(c, 'beam_sensor', None))  # BEAM-PENDING
 
         wxyz, xyz = wxyz_xyz(state.T_world_tcp)
         self.gizmo = scene.add_transform_controls("/tcp_gizmo", scale=0.14, line_width=2.0, wxyz=wxyz,
@@ -302,6 +307,7 @@ class SceneView:
         tip = self.session.controller.reference_tip_world_m
         if not np.array_equal(tip, self._shown_tip):     # knocked (a scenario) or set anew
             self.update_reference_tip()
+        self.beam_stand.show(getattr(self.session.controller, 'beam_sensor', None))  # BEAM-PENDING   # redraws only a changed sensor
         if change.pose and change.state is not None:
             skip = (self._gizmo_row,) if self._dragging else ()
             self._poses.send(self._local_poses(change.state), skip=skip)
