@@ -135,7 +135,8 @@ def test_the_menu_lists_are_live_views_of_the_registry(toy) -> None:
     assert METHOD_BLURBS["toy-tap"] == toy.blurb
     unregister("toy-tap")
     assert "toy-tap" not in WIZARD_KINDS and "toy-tap" not in METHOD_BLURBS
-    assert list(WIZARD_KINDS) == ["xyz4", "reference", "tcp-zx", "three-point", "abc-world", "tcp-check"]
+    assert list(WIZARD_KINDS) == ["xyz4", "reference", "tcp-zx", "three-point", "abc-world", "beam",
+                                 "tcp-check"]
 
 
 def test_start_options_are_checked_against_the_declaration(toy, library) -> None:

@@ -27,14 +27,15 @@ from tcp_pendant.wizards.xyz4 import ESTIMATORS, ESTIMATOR_LABELS, Xyz4Result, X
 
 from tcp_pendant.wizards.tcp_zx import TcpZxWizard
 from tcp_pendant.wizards.tcp_check import TcpCheckResult, TcpCheckWizard
+from tcp_pendant.wizards.beam import BeamWizard, BeamWizardResult, ManualComparison
 from tcp_pendant.wizards.registry import WIZARD_TYPES, register, unregister, wizard_class, wizard_classes
 
-for _cls in (Xyz4Wizard, ReferenceWizard, TcpZxWizard, ThreePointWizard, AbcWorldWizard, TcpCheckWizard):
+for _cls in (Xyz4Wizard, ReferenceWizard, TcpZxWizard, ThreePointWizard, AbcWorldWizard, BeamWizard, TcpCheckWizard):
     register(_cls)
 
 __all__ = [
-    "AbcWorldWizard", "CalibrationFailedError", "ESTIMATORS", "ESTIMATOR_LABELS",
-    "InvalidPoseError", "MIN_DISPLACEMENT_MM", "R_WORLD_TOOL_TARGET", "RecordedPose",
+    "AbcWorldWizard", "BeamWizard", "BeamWizardResult", "CalibrationFailedError", "ESTIMATORS", "ESTIMATOR_LABELS",
+    "InvalidPoseError", "MIN_DISPLACEMENT_MM", "ManualComparison", "R_WORLD_TOOL_TARGET", "RecordedPose",
     "ReferenceWizard", "StepInfo", "StepSpec", "TcpCheckResult", "TcpCheckWizard", "TcpZxWizard", "ThreePointWizard", "WIZARD_TYPES",
     "Wizard", "WizardError", "WizardResult", "WizardStateError", "Xyz4Result", "Xyz4Wizard",
     "register", "unregister", "wizard_class", "wizard_classes",

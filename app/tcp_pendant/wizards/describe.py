@@ -19,7 +19,7 @@ if TYPE_CHECKING:
     from tcpcal.tool import Tool
 
 __all__ = [
-    "AHEAD_PLUS_X", "AHEAD_PLUS_Z", "ALIGN_WORLD", "AutoRole", "IN_PLUS_Y_HALF", "ON_MINUS_X",
+    "AHEAD_PLUS_X", "AHEAD_PLUS_Z", "ALIGN_WORLD", "AutoRole", "BY_CONTROLLER", "IN_PLUS_Y_HALF", "ON_MINUS_X",
     "ON_PLUS_Y", "OptionError", "StartContext", "StepRole", "TOUCH", "TOUCH_KEEP_ORIENTATION",
     "WizardOption", "WizardStart",
 ]
@@ -46,6 +46,9 @@ class AutoRole:
         any_orientation_solves: the solve uses each pose's own rotation (TCP & Z, X,
             methods.md (ZX-1), (ZX-2)), so when the kept orientation is out of reach, auto-touch
             may draw a new direction in ``tilt_range_deg``; False where the method needs the orientation kept (three-point).
+        by_controller: the controller performs the step itself (the beam wizard's scan): no
+            Record and no auto-touch; Finish runs the wizard's controller job
+            (``CalibrationWorkflow.controller_job``).
     """
 
     reference_per_distance: tuple[float, float, float] = (0.0, 0.0, 0.0)
@@ -55,6 +58,7 @@ class AutoRole:
     align_world: bool = False
     free_turn_about_x: bool = False
     any_orientation_solves: bool = False
+    by_controller: bool = False
 
     def reference_in_tool_mm(self, distance_mm: float) -> tuple[float, float, float]:
         """The reference tip in true TOOL coordinates (mm) for an auto-touch ``distance_mm``."""
@@ -78,6 +82,8 @@ AHEAD_PLUS_X = AutoRole((1.0, 0.0, 0.0), tilt_range_deg=(5.0, 30.0), keeps_orien
 """The reference tip on the tool's +X axis ahead of the TCP (moved along tool -X)."""
 ALIGN_WORLD = AutoRole(align_world=True)
 """Tool axes parallel to WORLD as (PA-1) prescribes, hovering above the reference tip."""
+BY_CONTROLLER = AutoRole(by_controller=True)
+"""No touch: the controller runs the step itself (a beam scan); nothing to record by hand."""
 
 
 @dataclass(frozen=True)

@@ -39,6 +39,15 @@ angles in degrees; poses are 4x4 row-major nested lists; times ISO 8601 UTC. The
                 #       new_tool_label
                 # three-point: tool (Tool.to_dict), variant (1 | 2)
                 # abc-world: tool (Tool.to_dict), variant ("6d" | "5d")
+                # tcp-check: tool (Tool.to_dict), slot, angle_deg, check (figures or null)
+                # beam: n_orientations (3..5), scan_speed_mm_s, R_flange_tool_base (3x3, the
+                #       planning orientation) | null, manual ({title, kind, run_number,
+                #       wall_time_s, truth: {position_error_mm, direction_error_deg, grade} |
+                #       null}) | null, scan ({events: [{kind: "tip" | "axis",
+                #       T_world_flange_m, beam, beam_point_m, beam_dir, on_shaft,
+                #       orientation}] (at most 100), duration_s, path_length_m,
+                #       skipped: [str] (at most 10)}) | null
+                # an honest record sets every "truth" inside params to null
             "poses": {"0": {"T_world_flange_m": 4x4, "recorded_at": str}, ...},  # by step
             "step_index": int, "status": "in_progress" | "complete" | "cancelled",
             "resume_status": "in_progress" | "complete", "started_at": str
@@ -222,13 +231,25 @@ def _distance_map(value: Any) -> bool:
         for k, v in value.items())
 
 
+def _without_truth(state: dict[str, Any]) -> dict[str, Any]:
+    """A wizard state for an honest record: every ``"truth"`` key inside its params (where a
+    wizard keeps figures derived from the hidden truth, e.g. the beam wizard's manual
+    comparison) set to null."""
+    def strip(value: Any, depth: int = 0) -> Any:
+        if isinstance(value, Mapping) and depth < 8:
+            return {k: (None if k == "truth" else strip(v, depth + 1)) for k, v in value.items()}
+        return value
+
+    return {**state, "params": strip(state.get("params", {}))}
+
+
 def _run_entry(run: WizardRun, honest: bool, record_id: int | None) -> dict[str, Any]:
     wiz = run.wizard
     res = wiz.finished_result          # a finished wizard closed to resume later keeps its result
     truth = None
     true_tool = None
     if honest:                         # a trainee's homework: no answer key (graded by the gradebook)
-        return {"state": wiz.to_dict(), "result": None if res is None else res.summary(),
+        return {"state": _without_truth(wiz.to_dict()), "result": None if res is None else res.summary(),
                 "true_tool": None if run.true_tool_key is None else {"key": run.true_tool_key},
                 "truth": None, "record_id": record_id}
     if run.T_flange_tool_true_m is not None:

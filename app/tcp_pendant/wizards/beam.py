@@ -1,0 +1,650 @@
+"""The "Automatic (beam)" wizard (issue 14 item 3; methods.md section 9).
+
+A BullsEye / TRACC style calibration: the controller itself moves the mounted tool through a
+light barrier at 3 to 5 tool orientations (sideways passes that cross the shaft, approaches
+until the tip breaks the beam) and records the flange pose at each beam event. Tip events give
+the TCP (``tcpcal.solve_beam``), axis events the tool direction (``tcpcal.solve_beam_axis``).
+
+The state machine stays free of viser and of the controller (wizards import tcpcal only): it
+has one step, run by the controller (role "scan", ``describe.BY_CONTROLLER``: no Record, no
+auto-touch). Finish makes the caller run the scan (``CalibrationWorkflow.controller_job``; the
+app runs it in a worker thread) and hand it in with :meth:`BeamWizard.give_scan` (any object
+shaped like ``controller.beam_scan.BeamScan``), together with the rotation of the tool data the
+controller planned with and the trainee's last manual calibration of the same tool (for the
+comparison the result shows); only then can the wizard finish.
+
+The beam measures the TCP and the tool's working direction (TOOL X), not the turn of the tool
+about that direction: the TOOL frame the result saves is the planning (nominal) orientation
+turned by the smallest rotation that brings its X onto the measured direction, and says so.
+
+The session record stores the scan's events (recorded flange poses, beams), its duration and
+path length, the planning rotation and the manual comparison in the wizard's params, so a
+replay rebuilds the same result without a robot; all of it is checked and bounded on load (a
+record is untrusted input). Figures derived from the hidden truth are kept under a ``"truth"``
+key, which an honest (classroom) record drops.
+
+Units: poses and beams in metres (as the controller gives them), fed to tcpcal in mm; every
+``*_mm`` figure in mm, angles in degrees, times in seconds.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any, ClassVar, Literal
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from tcpcal.beam import BeamAxisResult, BeamResult, solve_beam, solve_beam_axis
+from tcpcal.errors import TcpcalError
+from tcpcal.tool import Tool, abc_deg_from_rotation
+
+from tcp_pendant.wizards.base import (
+    M_TO_MM,
+    CalibrationFailedError,
+    RecordedPose,
+    StartContext,
+    StepSpec,
+    Wizard,
+    WizardError,
+    WizardResult,
+    WizardStateError,
+    check_pose_m,
+    mm3,
+    utc_now_iso,
+)
+from tcp_pendant.wizards.describe import BY_CONTROLLER, StepRole, WizardOption, WizardStart
+
+__all__ = [
+    "BeamWizard",
+    "BeamWizardResult",
+    "MAX_SCAN_EVENTS",
+    "ManualComparison",
+    "RecordedScan",
+    "ScanEvent",
+]
+
+MAX_SCAN_EVENTS = 100
+"""Most events a stored scan may hold (5 orientations x 3 events x 2 crossed beams is 30)."""
+MAX_SKIPPED = 10
+"""Most skipped-orientation reasons a stored scan may hold."""
+MAX_BEAM_COORD_M = 100.0
+"""Largest beam point coordinate a stored scan may give, metres (a cell is a few metres)."""
+MAX_DURATION_S = 1e5
+MAX_PATH_M = 1e4
+MAX_WALL_TIME_S = 1e7
+_MAX_TEXT = 200          # characters kept of a stored text (the record is untrusted input)
+_GRADES = ("good", "fair", "poor")
+
+
+def _finite(value: Any, what: str, *, low: float | None = None, high: float | None = None) -> float:
+    if isinstance(value, bool):
+        raise WizardError(f"The beam scan's {what} must be a number, got {value!r:.40}.")
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise WizardError(f"The beam scan's {what} must be a number, got {value!r:.40}.") from None
+    if not math.isfinite(x) or (low is not None and x < low) or (high is not None and x > high):
+        raise WizardError(f"The beam scan's {what} must be a finite number in "
+                          f"{'-inf' if low is None else f'{low:g}'}..{'inf' if high is None else f'{high:g}'}"
+                          f", got {value!r:.40}.")
+    return x
+
+
+def _vector(value: Any, what: str, *, limit: float) -> np.ndarray:
+    if not (isinstance(value, (list, tuple, np.ndarray)) and len(value) == 3):
+        raise WizardError(f"The beam scan's {what} must be 3 numbers, got {value!r:.60}.")
+    return np.array([_finite(v, what, low=-limit, high=limit) for v in value], dtype=float)
+
+
+def _rotation(value: Any, what: str) -> np.ndarray:
+    try:
+        R = np.array(value, dtype=float)
+    except (TypeError, ValueError):
+        raise WizardError(f"The {what} must be a 3x3 rotation matrix.") from None
+    if R.shape != (3, 3) or not np.isfinite(R).all() or not np.allclose(R.T @ R, np.eye(3), atol=1e-6) \
+            or np.linalg.det(R) < 0.0:
+        raise WizardError(f"The {what} must be a proper 3x3 rotation matrix (orthonormal, det +1).")
+    return R
+
+
+def _readonly(a: np.ndarray) -> np.ndarray:
+    a = np.array(a, dtype=float)
+    a.setflags(write=False)
+    return a
+
+
+@dataclass(frozen=True, eq=False)
+class ScanEvent:
+    """One beam event of a scan, as the controller recorded it (names as ``BeamEvent``'s).
+
+    Attributes:
+        kind: "tip" (the tool tip on the beam line) or "axis" (the shaft crossed sideways,
+            entry and exit averaged).
+        T_world_flange: (4,4) recorded flange pose, WORLD, metres.
+        beam: index of the beam that broke (0, or 1 for a second, crossed beam).
+        beam_point: (3,) a point of that beam's line, WORLD, metres.
+        beam_dir: (3,) its unit direction, WORLD.
+        on_shaft: axis events: the beam crossed the cylindrical shaft (the average is on the
+            tool axis; only these are used); tip events: True.
+        orientation: the scan orientation (0-based) the event belongs to.
+    """
+
+    kind: Literal["tip", "axis"]
+    T_world_flange: np.ndarray
+    beam: int
+    beam_point: np.ndarray
+    beam_dir: np.ndarray
+    on_shaft: bool
+    orientation: int
+
+    @classmethod
+    def of(cls, event: Any, orientation: int) -> "ScanEvent":
+        """From a ``controller.beam.BeamEvent`` (duck-typed: no controller import here)."""
+        return cls.from_dict({"kind": event.kind, "T_world_flange_m": np.asarray(event.T_world_flange).tolist(),
+                              "beam": int(event.beam), "beam_point_m": list(np.asarray(event.beam_point, float)),
+                              "beam_dir": list(np.asarray(event.beam_dir, float)),
+                              "on_shaft": bool(event.on_shaft), "orientation": int(orientation)})
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"kind": self.kind, "T_world_flange_m": self.T_world_flange.tolist(), "beam": self.beam,
+                "beam_point_m": self.beam_point.tolist(), "beam_dir": self.beam_dir.tolist(),
+                "on_shaft": self.on_shaft, "orientation": self.orientation}
+
+    @classmethod
+    def from_dict(cls, d: Any) -> "ScanEvent":
+        """Inverse of :meth:`to_dict`, checked (kind, a rigid pose, a finite beam point within
+        100 m, a nonzero direction, beam 0 or 1, orientation 0..99).
+
+        Raises:
+            WizardError: naming what is wrong.
+        """
+        if not isinstance(d, Mapping):
+            raise WizardError("Each stored beam event must be an object.")
+        kind = d.get("kind")
+        if kind not in ("tip", "axis"):
+            raise WizardError(f"A stored beam event's kind must be \"tip\" or \"axis\", got {kind!r:.40}.")
+        T = check_pose_m(d.get("T_world_flange_m"), what="flange pose of a beam event")
+        beam = d.get("beam", 0)
+        if isinstance(beam, bool) or beam not in (0, 1):
+            raise WizardError(f"A stored beam event's beam must be 0 or 1, got {beam!r:.40}.")
+        orientation = d.get("orientation", 0)
+        if isinstance(orientation, bool) or not isinstance(orientation, int) or not 0 <= orientation < 100:
+            raise WizardError(f"A stored beam event's orientation must be a whole number 0..99, got "
+                              f"{orientation!r:.40}.")
+        b = _vector(d.get("beam_point_m"), "beam point (m)", limit=MAX_BEAM_COORD_M)
+        u = _vector(d.get("beam_dir"), "beam direction", limit=1e6)
+        n = float(np.linalg.norm(u))
+        if not n > 1e-9:
+            raise WizardError("A stored beam event's beam direction is the zero vector.")
+        return cls(kind, _readonly(T), int(beam), _readonly(b), _readonly(u / n), bool(d.get("on_shaft", True)),
+                   int(orientation))
+
+
+@dataclass(frozen=True, eq=False)
+class RecordedScan:
+    """What the wizard keeps of a scan (and what a replay rebuilds): its events, how long it
+    takes on a real robot and what could not be run. Attribute names follow
+    ``controller.beam_scan.BeamScan`` where they exist; ``moves`` is empty (a record keeps no
+    motion to animate).
+
+    Attributes:
+        events: the events in order.
+        duration_s: time the scan takes on a real robot (sum of move length / speed), s.
+        path_length_m: the flange's path length, m.
+        skipped: plain-words reasons for orientations that could not be run.
+    """
+
+    events: tuple[ScanEvent, ...]
+    duration_s: float
+    path_length_m: float
+    skipped: tuple[str, ...] = ()
+    moves: tuple[Any, ...] = field(default=())
+    q_end_rad: Any = None
+
+    @property
+    def orientation_index(self) -> tuple[int, ...]:
+        """The scan orientation of each event (0-based)."""
+        return tuple(e.orientation for e in self.events)
+
+    @classmethod
+    def of(cls, scan: Any) -> "RecordedScan":
+        """From a ``controller.beam_scan.BeamScan`` (duck-typed), checked as a stored one."""
+        if isinstance(scan, RecordedScan):
+            return scan
+        events = tuple(scan.events)
+        index = tuple(getattr(scan, "orientation_index", ())) or (0,) * len(events)
+        if len(index) != len(events):
+            raise WizardError("The scan gives an orientation for each event; it does not here.")
+        out = cls.from_dict({"events": [ScanEvent.of(e, int(k)).to_dict() for e, k in zip(events, index)],
+                             "duration_s": float(scan.duration_s), "path_length_m": float(scan.path_length_m),
+                             "skipped": [str(s) for s in getattr(scan, "skipped", ())]})
+        return out
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"events": [e.to_dict() for e in self.events], "duration_s": self.duration_s,
+                "path_length_m": self.path_length_m, "skipped": list(self.skipped)}
+
+    @classmethod
+    def from_dict(cls, d: Any) -> "RecordedScan":
+        """Inverse of :meth:`to_dict`, checked and bounded (at most :data:`MAX_SCAN_EVENTS`
+        events, :data:`MAX_SKIPPED` reasons of at most 200 characters, finite times).
+
+        Raises:
+            WizardError: naming what is wrong.
+        """
+        if not isinstance(d, Mapping):
+            raise WizardError("The stored beam scan must be an object.")
+        events = d.get("events")
+        if not isinstance(events, list) or len(events) > MAX_SCAN_EVENTS:
+            raise WizardError(f"The stored beam scan's events must be a list of at most {MAX_SCAN_EVENTS}.")
+        skipped = d.get("skipped", [])
+        if not isinstance(skipped, list) or len(skipped) > MAX_SKIPPED:
+            raise WizardError(f"The stored beam scan's skipped orientations must be a list of at most {MAX_SKIPPED}.")
+        return cls(tuple(ScanEvent.from_dict(e) for e in events),
+                   _finite(d.get("duration_s"), "duration (s)", low=0.0, high=MAX_DURATION_S),
+                   _finite(d.get("path_length_m"), "path length (m)", low=0.0, high=MAX_PATH_M),
+                   tuple(str(s)[:_MAX_TEXT] for s in skipped))
+
+
+def _parse_time(text: str) -> _dt.datetime | None:
+    try:
+        t = _dt.datetime.fromisoformat(str(text).replace("Z", "+00:00"))
+    except ValueError:
+        return None
+    return t if t.tzinfo is not None else t.replace(tzinfo=_dt.timezone.utc)
+
+
+def wall_time_s(started_at: str, finished_at: str) -> float | None:
+    """Seconds from ``started_at`` to ``finished_at`` (ISO 8601), None if unreadable."""
+    a, b = _parse_time(started_at), _parse_time(finished_at)
+    if a is None or b is None:
+        return None
+    return max((b - a).total_seconds(), 0.0)
+
+
+@dataclass(frozen=True)
+class ManualComparison:
+    """The trainee's last finished manual calibration of the same physical tool in the session,
+    for the result's "automatic vs manual" lesson.
+
+    Attributes:
+        title: its method's label ("XYZ 4-point").
+        kind: its wizard kind.
+        run_number: its number in the session (1-based, as the Resume list counts).
+        wall_time_s: wall time from its start to its result, s.
+        position_error_mm: its TCP error against the true tool, mm (None: no truth known).
+        direction_error_deg: the error of its tool X (working direction), deg (None: it
+            calibrated no orientation, or no truth).
+        grade: its grade against the truth ("good" | "fair" | "poor"), or None.
+    """
+
+    title: str
+    kind: str
+    run_number: int
+    wall_time_s: float
+    position_error_mm: float | None = None
+    direction_error_deg: float | None = None
+    grade: str | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready; the truth-derived figures under ``"truth"`` (an honest record drops it)."""
+        truth = None
+        if self.position_error_mm is not None:
+            truth = {"position_error_mm": self.position_error_mm,
+                     "direction_error_deg": self.direction_error_deg, "grade": self.grade}
+        return {"title": self.title, "kind": self.kind, "run_number": self.run_number,
+                "wall_time_s": self.wall_time_s, "truth": truth}
+
+    @classmethod
+    def from_dict(cls, d: Any) -> "ManualComparison":
+        """Inverse of :meth:`to_dict`, checked (texts cut to 200 characters, finite figures).
+
+        Raises:
+            WizardError: naming what is wrong.
+        """
+        if not isinstance(d, Mapping):
+            raise WizardError("The stored manual calibration must be an object.")
+        n = d.get("run_number")
+        if isinstance(n, bool) or not isinstance(n, int) or not 1 <= n <= 100_000:
+            raise WizardError(f"The stored manual calibration's number must be a whole number >= 1, got {n!r:.40}.")
+        truth = d.get("truth")
+        pos = ang = grade = None
+        if truth is not None:
+            if not isinstance(truth, Mapping):
+                raise WizardError("The stored manual calibration's truth must be an object or null.")
+            pos = _finite(truth.get("position_error_mm"), "manual position error (mm)", low=0.0, high=1e6)
+            if truth.get("direction_error_deg") is not None:
+                ang = _finite(truth.get("direction_error_deg"), "manual direction error (deg)", low=0.0, high=180.0)
+            grade = truth.get("grade")
+            if grade is not None and grade not in _GRADES:
+                raise WizardError(f"The stored manual calibration's grade must be one of {_GRADES}, got {grade!r:.40}.")
+        return cls(str(d.get("title", ""))[:_MAX_TEXT], str(d.get("kind", ""))[:_MAX_TEXT], n,
+                   _finite(d.get("wall_time_s"), "manual wall time (s)", low=0.0, high=MAX_WALL_TIME_S),
+                   pos, ang, grade)
+
+
+@dataclass(frozen=True, eq=False, kw_only=True)
+class BeamWizardResult(WizardResult):
+    """The beam wizard's result. Lengths in mm (FLANGE), angles in degrees, times in seconds.
+
+    ``tcp_mm`` and ``ci95_mm`` are the TCP solve's; ``per_touch_error_mm`` its residual per tip
+    event (distance of the computed tip from the beam line); ``rotation`` / ``abc_deg`` the
+    TOOL frame to save (see the module docstring).
+
+    Attributes:
+        scan: the scan (the controller's ``BeamScan`` when run here; a :class:`RecordedScan`,
+            without moves, after a replay).
+        events: the scan's events as the wizard used them.
+        beam_result: ``tcpcal.solve_beam``'s result (tip events).
+        axis_result: ``tcpcal.solve_beam_axis``'s result (axis events), None when the tool
+            direction could not be measured.
+        direction_flange: the measured tool direction (unit, FLANGE), None as above.
+        direction_ci95_deg: its 95 % cone half-angle (NaN without redundancy), None as above.
+        direction_turn_deg: the angle the planning orientation's X was turned by.
+        R_flange_tool_base: (3,3) the planning (nominal) orientation the saved frame starts from.
+        tip_event_indices, axis_event_indices: indices into ``events`` of the events used.
+        duration_s: the scan's time on a real robot.
+        path_length_m: its path length, m.
+        manual: the trainee's last manual calibration of the same tool, or None.
+    """
+
+    scan: Any
+    events: tuple[ScanEvent, ...]
+    beam_result: BeamResult
+    axis_result: BeamAxisResult | None
+    direction_flange: tuple[float, float, float] | None
+    direction_ci95_deg: float | None
+    direction_turn_deg: float | None
+    R_flange_tool_base: np.ndarray
+    tip_event_indices: tuple[int, ...]
+    axis_event_indices: tuple[int, ...]
+    duration_s: float
+    path_length_m: float
+    manual: ManualComparison | None = None
+
+    @property
+    def figures(self) -> dict[str, float]:
+        """The base figures plus the beam's: events, direction 95 % cone, scan time."""
+        out = super().figures
+        out["n_tip_events"] = float(len(self.tip_event_indices))
+        out["n_axis_events"] = float(len(self.axis_event_indices))
+        if self.direction_ci95_deg is not None and math.isfinite(self.direction_ci95_deg):
+            out["direction_ci95_deg"] = float(self.direction_ci95_deg)
+        out["scan_duration_s"] = float(self.duration_s)
+        return out
+
+    def event_points_world_m(self) -> tuple[np.ndarray, ...]:
+        """Where each event met the beam by the measured tool (WORLD, metres), for a marker:
+        tip events the computed tip; axis events the point of the measured tool axis closest to
+        the beam line (the computed tip when the direction was not measured)."""
+        t = np.asarray(self.tcp_mm, dtype=float) / M_TO_MM
+        d = None if self.direction_flange is None else np.asarray(self.direction_flange, dtype=float)
+        out = []
+        for e in self.events:
+            R, f = e.T_world_flange[:3, :3], e.T_world_flange[:3, 3]
+            tip = R @ t + f
+            if e.kind == "axis" and d is not None:
+                a = R @ d                                  # the tool axis tip + lam a vs the beam line
+                w, g = e.beam_dir, tip - e.beam_point
+                den = 1.0 - float(a @ w) ** 2
+                if den > 1e-12:
+                    lam = (float(g @ w) * float(a @ w) - float(g @ a)) / den
+                    tip = tip + lam * a
+            out.append(tip)
+        return tuple(out)
+
+
+def _minimal_turn(x_from: np.ndarray, x_to: np.ndarray) -> Rotation:
+    """The smallest rotation taking unit ``x_from`` onto unit ``x_to``."""
+    axis = np.cross(x_from, x_to)
+    s, c = float(np.linalg.norm(axis)), float(x_from @ x_to)
+    if s < 1e-15:
+        if c > 0.0:
+            return Rotation.identity()
+        perp = np.cross(x_from, [1.0, 0.0, 0.0] if abs(x_from[0]) < 0.9 else [0.0, 1.0, 0.0])
+        return Rotation.from_rotvec(math.pi * perp / np.linalg.norm(perp))
+    return Rotation.from_rotvec(axis / s * math.atan2(s, c))
+
+
+class BeamWizard(Wizard):
+    """Automatic (beam) calibration of the mounted tool (see the module docstring).
+
+    Args:
+        n_orientations: tool orientations the scan runs (3..5).
+        scan_speed_mm_s: speed of the measuring motions, mm/s (5..250).
+    """
+
+    kind: ClassVar[str] = "beam"
+    title: ClassVar[str] = "Automatic (beam)"
+    blurb: ClassVar[str] = ("Calibrates the **TCP and the tool direction** automatically, as BullsEye / "
+                            "TRACC: the controller moves the tool through a light beam at 3 to 5 "
+                            "orientations and records the flange pose at every beam break. Shows the "
+                            "events, the time the scan takes on a real robot and your manual "
+                            "calibration of the same tool side by side.")
+    calibrates: ClassVar[str] = "the TCP and the tool direction"
+    rank: ClassVar[int] = 60
+    MIN_ORIENTATIONS: ClassVar[int] = 3
+    MAX_ORIENTATIONS: ClassVar[int] = 5
+    step_roles = (StepRole("scan", "the controller runs the beam scan itself", BY_CONTROLLER),)
+    options = (
+        WizardOption("n_orientations", "Scan orientations", "int", default=4, minimum=MIN_ORIENTATIONS,
+                     maximum=MAX_ORIENTATIONS,
+                     hint="Tool orientations the scan runs (each: two sideways passes and one tip approach)."),
+        WizardOption("scan_speed_mm_s", "Scan speed (mm/s)", "int", default=50, minimum=5, maximum=250,
+                     hint="Speed of the measuring motions through the beam (real devices: 20-100 mm/s)."),
+    )
+    needs_tool = "mounted"
+
+    def __init__(self, *, n_orientations: int = 4, scan_speed_mm_s: float = 50.0) -> None:
+        super().__init__()
+        n = _finite(n_orientations, "number of orientations")
+        if n != int(n) or not self.MIN_ORIENTATIONS <= n <= self.MAX_ORIENTATIONS:
+            raise WizardError(f"The beam scan runs {self.MIN_ORIENTATIONS} to {self.MAX_ORIENTATIONS} "
+                              f"orientations, got {n_orientations!r:.40}.")
+        speed = _finite(scan_speed_mm_s, "scan speed (mm/s)")
+        if not 5.0 <= speed <= 250.0:
+            raise WizardError(f"The scan speed must be 5 to 250 mm/s, got {scan_speed_mm_s!r:.40}.")
+        self.n_orientations = int(n)
+        self.scan_speed_mm_s = speed
+        self._scan: RecordedScan | None = None
+        self._live_scan: Any = None
+        self._R_base: np.ndarray | None = None
+        self._manual: ManualComparison | None = None
+
+    @classmethod
+    def start(cls, ctx: StartContext, options: Mapping[str, Any]) -> WizardStart:
+        """For the mounted tool (its truth grades the TCP and the tool direction)."""
+        return WizardStart(cls(n_orientations=options.get("n_orientations", 4),
+                               scan_speed_mm_s=options.get("scan_speed_mm_s", 50)),
+                           true_tool=ctx.mounted_tool)
+
+    # ----- the one step: the controller's ----------------------------------------------------
+    def _step_specs(self) -> list[StepSpec]:
+        return [StepSpec(role="scan", title="Beam scan",
+                         instruction=(f"Nothing to touch: press Finish and the controller runs the scan "
+                                      f"itself. At {self.n_orientations} tool orientations it passes the "
+                                      "shaft sideways through the beam twice and approaches until the tip "
+                                      "breaks it, recording the flange pose at every event "
+                                      f"(measuring motions at {self.scan_speed_mm_s:g} mm/s)."))]
+
+    @property
+    def blocked_reason(self) -> str | None:
+        """Record is never possible: the controller records the scan's events itself."""
+        base = super().blocked_reason
+        if base is not None or self._status != "in_progress":
+            return base
+        return "The controller runs this step itself: press Finish to run the scan (nothing to record by hand)."
+
+    @property
+    def can_next(self) -> bool:
+        """Finish is possible while in progress (it runs the scan when none is handed in yet)."""
+        return self._status == "in_progress"
+
+    @property
+    def scan_pending(self) -> bool:
+        """In progress without a scan: Finish must run one first (the workflow's controller job)."""
+        return self._status == "in_progress" and self._scan is None
+
+    @property
+    def scan(self) -> RecordedScan | None:
+        """The scan handed in (what the wizard keeps of it), or None."""
+        return self._scan
+
+    @property
+    def R_flange_tool_base(self) -> np.ndarray | None:
+        """The planning (nominal) orientation handed in with the scan, or None."""
+        return None if self._R_base is None else self._R_base.copy()
+
+    @property
+    def manual(self) -> ManualComparison | None:
+        return self._manual
+
+    def give_scan(self, scan: Any, *, R_flange_tool_base: Any,
+                  manual: ManualComparison | None = None) -> None:
+        """Hand in the scan the controller ran (a ``BeamScan`` or :class:`RecordedScan`).
+
+        Args:
+            scan: the scan.
+            R_flange_tool_base: (3,3) the orientation of the tool data the controller planned
+                with (the saved frame is this one turned onto the measured direction).
+            manual: the trainee's last manual calibration of the same tool, or None.
+
+        Raises:
+            WizardStateError: the wizard is not in progress.
+            WizardError: a malformed scan (names what).
+        """
+        if self._status != "in_progress":
+            raise WizardStateError("The beam scan was handed in to a wizard that is not in progress.")
+        recorded = RecordedScan.of(scan)
+        R = _rotation(R_flange_tool_base, "planning tool orientation")
+        if manual is not None and not isinstance(manual, ManualComparison):
+            raise WizardError("The manual calibration to compare with must be a ManualComparison.")
+        self._scan, self._live_scan, self._R_base, self._manual = recorded, scan, R, manual
+        first = recorded.events[0].T_world_flange if recorded.events else np.eye(4)
+        self._poses[0] = RecordedPose(check_pose_m(first), utc_now_iso())
+
+    def next(self) -> Any:
+        """Finish (the only step); refused with words before a scan was handed in."""
+        if self.scan_pending:
+            raise WizardStateError("Run the scan first: press Finish (the controller moves the tool "
+                                   "through the beam).")
+        return super().next()
+
+    def finish(self) -> WizardResult:
+        """Compute the result from the scan handed in; refused with words before one was."""
+        if self.scan_pending:
+            raise WizardStateError("Run the scan first: press Finish (the controller moves the tool "
+                                   "through the beam).")
+        return super().finish()
+
+    def clear_step(self) -> None:
+        """Forget the scan (a new Finish runs another one)."""
+        super().clear_step()
+        self._scan = self._live_scan = None
+
+    # ----- result -------------------------------------------------------------------------
+    def _compute(self, poses: list[np.ndarray]) -> WizardResult:
+        scan, R_base = self._scan, self._R_base
+        if scan is None or R_base is None:
+            raise WizardStateError("Run the scan first: press Finish (the controller moves the tool "
+                                   "through the beam).")
+        events = scan.events
+        tips = tuple(i for i, e in enumerate(events) if e.kind == "tip")
+        if len(tips) < 2:
+            skipped = "; ".join(scan.skipped)
+            raise CalibrationFailedError(
+                f"The scan gave {len(tips)} tip event(s); the TCP needs at least 2 at orientations turned "
+                "about the tool axis. Move the robot so the beam device is within reach and scan again"
+                + (f" (skipped: {skipped})." if skipped else "."))
+
+        def arrays(idx: Sequence[int]) -> tuple[np.ndarray, ...]:
+            T = np.array([events[i].T_world_flange for i in idx])
+            return (T[:, :3, :3], T[:, :3, 3] * M_TO_MM, np.array([events[i].beam_point for i in idx]) * M_TO_MM,
+                    np.array([events[i].beam_dir for i in idx]))
+
+        res = solve_beam(*arrays(tips))
+        warnings = list(res.warnings)
+        axes = tuple(i for i, e in enumerate(events) if e.kind == "axis" and e.on_shaft)
+        axis_res: BeamAxisResult | None = None
+        if len(axes) >= 2:
+            try:
+                axis_res = solve_beam_axis(*arrays(axes), res.tcp)
+                warnings.extend(axis_res.warnings)
+            except TcpcalError as exc:
+                warnings.append(f"The tool direction could not be measured: {exc}")
+        else:
+            warnings.append(f"The scan gave {len(axes)} usable sideways crossing(s); the tool direction "
+                            "needs 2 at orientations turned about the tool axis.")
+        for reason in scan.skipped:
+            warnings.append(f"Skipped: {reason}")
+        R_new, turn = R_base, None
+        direction = ci_deg = None
+        if axis_res is not None:
+            d = np.asarray(axis_res.direction, dtype=float)
+            x0 = R_base[:, 0] / np.linalg.norm(R_base[:, 0])
+            R_new = _minimal_turn(x0, d).as_matrix() @ R_base
+            turn = float(np.degrees(math.atan2(float(np.linalg.norm(np.cross(x0, d))), float(x0 @ d))))
+            direction, ci_deg = mm3(d), float(axis_res.ci95_angle_deg)
+        notes = ("The beam measures the TCP and the tool direction (TOOL X), not the turn about it: the "
+                 "TOOL frame to save is the planning orientation turned "
+                 + ("by the smallest rotation that puts its X on the measured direction." if turn is not None
+                    else "by nothing (the direction was not measured)."),)
+        scan_obj = self._live_scan if self._live_scan is not None else scan
+        return BeamWizardResult(
+            wizard=self.kind, method="beam", tcp_mm=mm3(res.tcp),
+            abc_deg=mm3(abc_deg_from_rotation(R_new)), rotation=np.array(R_new), tcp_result=res,  # type: ignore[arg-type]
+            per_touch_error_mm=tuple(float(e) for e in res.residuals),
+            mean_error_mm=float(res.mean_error), max_error_mm=float(res.max_error),
+            rms_error_mm=float(res.rms_error), ci95_mm=float(res.ci95_radius),
+            warnings=tuple(warnings), notes=notes,
+            scan=scan_obj, events=events, beam_result=res, axis_result=axis_res,
+            direction_flange=direction, direction_ci95_deg=ci_deg, direction_turn_deg=turn,
+            R_flange_tool_base=_readonly(R_base), tip_event_indices=tips, axis_event_indices=axes,
+            duration_s=scan.duration_s, path_length_m=scan.path_length_m, manual=self._manual)
+
+    def to_tool(self, name: str) -> Tool:
+        """The tool with the measured TCP and the planning orientation turned onto the measured
+        direction (calibration method "beam")."""
+        res = self._require_result()
+        assert res.abc_deg is not None
+        return Tool(name=name, tcp_mm=res.tcp_mm, abc_deg=res.abc_deg,
+                    calibration=self._calibration(res, res.figures))
+
+    # ----- serialisation ------------------------------------------------------------------
+    def _params(self) -> dict[str, Any]:
+        return {"n_orientations": self.n_orientations, "scan_speed_mm_s": self.scan_speed_mm_s,
+                "scan": None if self._scan is None else self._scan.to_dict(),
+                "R_flange_tool_base": None if self._R_base is None else self._R_base.tolist(),
+                "manual": None if self._manual is None else self._manual.to_dict()}
+
+    @classmethod
+    def _from_params(cls, params: Mapping[str, Any]) -> "BeamWizard":
+        if not isinstance(params, Mapping):
+            raise WizardError("The beam wizard's stored params must be an object.")
+        return cls(n_orientations=params.get("n_orientations", 4),
+                   scan_speed_mm_s=params.get("scan_speed_mm_s", 50.0))
+
+    def _load_state(self, d: Mapping[str, Any]) -> None:
+        """The stored scan is handed in before the base class finishes a complete wizard (a
+        replay runs no robot); scan, planning orientation and manual comparison are checked."""
+        params = d.get("params")
+        stored = params.get("scan") if isinstance(params, Mapping) else None
+        if stored is None:
+            super()._load_state({**d, "poses": {}, "resume_status": "in_progress",
+                                 "status": d.get("status") if d.get("status") == "cancelled" else "in_progress"})
+            return
+        assert isinstance(params, Mapping)
+        scan = RecordedScan.from_dict(stored)
+        R = _rotation(params.get("R_flange_tool_base"), "stored planning tool orientation")
+        manual = params.get("manual")
+        super()._load_state({**d, "poses": {}, "resume_status": "in_progress", "status": "in_progress"})
+        self.give_scan(scan, R_flange_tool_base=R,
+                       manual=None if manual is None else ManualComparison.from_dict(manual))
+        if d.get("resume_status", d.get("status")) == "complete":
+            self.finish()
+        if d.get("status") == "cancelled":
+            self.cancel()
