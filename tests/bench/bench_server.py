@@ -39,6 +39,18 @@ go cold), so B and C, paced like real use, are the honest figures; A is the cost
 in a hot loop. Browsers send hold messages through one 50 ms slot (viser's client throttle),
 so a real browser jogs at most 20 steps/s (HOLD_HZ): 30/s is the issue's, harder, load.
 
+Classroom (issue 11: "gradebook writes do not raise the jog step cost"). A second server in the
+same process runs in ``--class`` mode (a gradebook in a temporary folder), its N clients' sessions
+each named through the "Your name" prompt's own callback, so ``ClassRoom.named`` subscribes a
+``TraineeRecorder`` to each session's change signal exactly as for a browser. A, B and C are
+measured on both servers in the order off on on off (``--rounds``; the means are printed) and
+shown side by side with the ratio on/off; then every session of each server opens an XYZ 4-point
+wizard and presses Record ``--touches`` times (the Calibrate tab's click path: lock, batch, one
+change signal; with the class on, each press is a committed ``record_touch``): thread CPU, wall
+time (the event loop is blocked that long) and process CPU per recorded touch, on and off. The
+ratios are the figures (no timed assertion); ``--quick`` is run by
+tests/app/test_bench_server_runs.py.
+
     .venv/bin/python tests/bench/bench_server.py                # 30 sessions (the target)
     .venv/bin/python tests/bench/bench_server.py --sessions 8 --seconds 3
     .venv/bin/python tests/bench/bench_server.py --quick        # smoke test (2 sessions)
@@ -48,6 +60,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -321,60 +334,179 @@ def per_core(process_ms: float) -> float:
     return 1.0 / (STEP_HZ * process_ms / 1e3)
 
 
+class Rig:
+    """One pendant server in this process and its headless clients (a separate process).
+
+    Args:
+        n: sessions (= websocket clients).
+        tmp: folder of the tool library (and of the gradebook).
+        class_db: the gradebook file: ``--class`` mode, every session named by its "Your name"
+            prompt (the server's own wiring: ``ClassRoom.attach`` at connect, the prompt's Join
+            calls ``ClassRoom.named``, which subscribes the session's ``TraineeRecorder``);
+            None: the app as it runs without a class.
+    """
+
+    def __init__(self, n: int, tmp: Path, class_db: Path | None = None) -> None:
+        from tcp_pendant.server import AppConfig, PendantApp
+
+        tmp.mkdir(parents=True, exist_ok=True)
+        self.app = PendantApp(AppConfig(port=free_port(), tool_library=tmp / "tools.json", class_db=class_db))
+        self.app.start()
+        script = CLIENTS_SCRIPT.format(app_tests=str(APP_TESTS), port=self.app.port, n=n, plus=PLUS, minus=MINUS)
+        self.clients = subprocess.Popen([sys.executable, "-c", script], stdin=subprocess.PIPE,
+                                        stdout=subprocess.PIPE, text=True)
+        self.counts: dict[int, int] = {}
+        self.sessions: list[Any] = []
+        assert self.clients.stdout is not None
+        if self.clients.stdout.readline().strip() != "ready":
+            raise RuntimeError("the clients did not connect")
+        deadline = time.monotonic() + 60
+        while len(self.app.sessions) < n and time.monotonic() < deadline:
+            time.sleep(0.02)
+        self.sessions = list(self.app.sessions.values())
+        if len(self.sessions) != n:
+            raise RuntimeError(f"only {len(self.sessions)} of {n} sessions connected")
+        lock = threading.Lock()
+        for i, s in enumerate(self.sessions):
+            self.counts[i] = 0
+
+            def count(i: int = i) -> None:
+                with lock:
+                    self.counts[i] += 1
+            s.add_motion_listener(count)
+        if class_db is not None:
+            self._name_trainees()
+
+    def _name_trainees(self) -> None:
+        """Every session types a name and joins the class (the prompt's own callback)."""
+        classroom = self.app.classroom
+        if classroom is None:
+            raise RuntimeError("the server did not start its classroom")
+        for i, s in enumerate(self.sessions):
+            prompt = s.views["identity"]
+            with s.lock:
+                prompt.name_field.value = f"Trainee {i + 1:02d}"
+                prompt._start()
+            if prompt.name is None:
+                raise RuntimeError(f"session {i + 1} was not named: {prompt.message.content}")
+        named = [row for row in classroom.trainee_statuses() if row.connected]
+        if len(named) != len(self.sessions):
+            raise RuntimeError(f"{len(named)} of {len(self.sessions)} sessions have a recorder")
+
+    def measure(self, steps: int, seconds: float) -> dict[str, dict[str, float]]:
+        """A, B and C on this rig's sessions."""
+        return {"A": hot_loop(self.sessions, steps), "B": paced_direct(self.sessions, seconds),
+                "C": paced_end_to_end(self.sessions, self.clients, seconds, self.counts)}
+
+    def close(self) -> None:
+        if self.clients.stdin is not None:
+            try:
+                self.clients.stdin.write("quit\n")
+                self.clients.stdin.flush()
+            except OSError:
+                pass
+        try:
+            self.clients.wait(30)
+        except subprocess.TimeoutExpired:
+            self.clients.kill()
+        self.app.stop()
+
+
+def _in_action(s: Any, fn: Any) -> None:
+    """``fn()`` the way a Calibrate click runs (``WizardMenuView.action``): session lock, one
+    batch, one change signal with ``wizard``."""
+    with s.lock:
+        with s.batch():
+            try:
+                fn()
+            finally:
+                s.changed(wizard=True)
+
+
+def wizard_touches(sessions: list[Any], per_session: int) -> dict[str, float]:
+    """CPU of a recorded wizard touch: every session opens an XYZ 4-point wizard and presses
+    Record ``per_session`` times (each press stores a new pose for the step: a new touch),
+    round robin; then the wizards are cancelled (so the later runs jog without one).
+
+    Returns thread CPU per touch (median; the Record click: workflow, every view's re-render,
+    with the classroom the recorder's gradebook write), its wall time (median, p95: the event
+    loop is blocked that long; includes the write's fsync) and process CPU per touch."""
+    workflows = [s.views["calibrate"].workflow for s in sessions]
+    for s, wf in zip(sessions, workflows):
+        _in_action(s, lambda wf=wf: wf.start_xyz4())
+    time.sleep(0.3)
+    cpu: list[float] = []
+    wall: list[float] = []
+    p0 = time.process_time()
+    for _ in range(per_session):
+        for s, wf in zip(sessions, workflows):
+            t0, w0 = time.thread_time(), time.perf_counter()
+            _in_action(s, wf.record)
+            cpu.append(time.thread_time() - t0)
+            wall.append(time.perf_counter() - w0)
+    time.sleep(0.3)
+    process = time.process_time() - p0
+    for s, wf in zip(sessions, workflows):
+        _in_action(s, wf.cancel)
+    time.sleep(0.3)
+    n = len(cpu)
+    return {"thread_ms": float(np.median(cpu)) * 1e3, "wall_ms": float(np.median(wall)) * 1e3,
+            "wall_p95_ms": float(np.percentile(wall, 95)) * 1e3, "process_ms": process / n * 1e3}
+
+
+def mean_of(rounds: list[dict[str, dict[str, float]]]) -> dict[str, dict[str, float]]:
+    """Mean of each figure over the rounds."""
+    return {k: {f: float(np.mean([r[k][f] for r in rounds])) for f in rounds[0][k]} for k in rounds[0]}
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--quick", action="store_true", help="2 sessions, short runs: smoke test")
     ap.add_argument("--sessions", type=int, default=TARGET_SESSIONS)
     ap.add_argument("--seconds", type=float, default=4.0, help="length of each paced run")
     ap.add_argument("--steps", type=int, default=40, help="hot-loop steps per session")
+    ap.add_argument("--touches", type=int, default=10, help="wizard touches per session")
+    ap.add_argument("--rounds", type=int, default=2,
+                    help="classroom off/on rounds, in the order off on on off ... (2: ABBA, cancels a drift)")
     args = ap.parse_args(argv)
-    n, seconds, steps = (2, 1.0, 10) if args.quick else (args.sessions, args.seconds, args.steps)
-
-    from tcp_pendant.server import AppConfig, PendantApp
+    n, seconds, steps, touches, rounds = ((2, 1.0, 10, 3, 1) if args.quick else
+                                          (args.sessions, args.seconds, args.steps, args.touches,
+                                           max(1, args.rounds)))
 
     tmp = Path(tempfile.mkdtemp(prefix="bench_server_"))
-    app = PendantApp(AppConfig(port=free_port(), tool_library=tmp / "tools.json"))
-    app.start()
-    script = CLIENTS_SCRIPT.format(app_tests=str(APP_TESTS), port=app.port, n=n, plus=PLUS, minus=MINUS)
-    clients = subprocess.Popen([sys.executable, "-c", script], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-                               text=True)
+    rigs: dict[str, Rig] = {}
     try:
-        assert clients.stdout is not None
-        if clients.stdout.readline().strip() != "ready":
-            raise RuntimeError("the clients did not connect")
-        deadline = time.monotonic() + 60
-        while len(app.sessions) < n and time.monotonic() < deadline:
-            time.sleep(0.02)
-        sessions = list(app.sessions.values())
-        if len(sessions) != n:
-            raise RuntimeError(f"only {len(sessions)} of {n} sessions connected")
-        counts: dict[int, int] = {}
-        lock = threading.Lock()
-        for i, s in enumerate(sessions):
-            counts[i] = 0
-
-            def count(i: int = i) -> None:
-                with lock:
-                    counts[i] += 1
-            s.add_motion_listener(count)
-
+        rigs["off"] = Rig(n, tmp / "off")
+        rigs["on"] = Rig(n, tmp / "on", class_db=tmp / "on" / "class.db")
         load = os.getloadavg()
         print(f"bench_server: {n} sessions built by on_client_connect for {n} real websocket clients (headless, "
               f"viser protocol, separate process: their CPU is not counted; no browser); server in this "
               f"process, pid {os.getpid()}; a step = 1 mm Cartesian jog WORLD X of the KR 6 + pointer and "
               f"every update sent; load average {load[0]:.1f} {load[1]:.1f} {load[2]:.1f} on "
               f"{os.cpu_count()} CPUs (shared: trust the ratios)")
-        results: dict[str, dict[str, dict[str, float]]] = {}
-        for label in ("app", "baseline"):
-            if label == "baseline":
-                for s in sessions:
-                    install_baseline(s)
-                time.sleep(1.0)
-            results[label] = {"A": hot_loop(sessions, steps), "B": paced_direct(sessions, seconds),
-                              "C": paced_end_to_end(sessions, clients, seconds, counts)}
-            if label == "app":
-                parts, msgs, process = breakdown(sessions, max(5, steps // 4))
-        app_r, base_r = results["app"], results["baseline"]
+        print(f"  two servers in this process, each with {n} clients: the app as today (no class) and "
+              f"--class (a gradebook in a temporary folder, every session a named trainee with its "
+              f"recorder); measured in the order {' '.join(['off on', 'on off'][r % 2] for r in range(rounds))}")
+        measured: dict[str, list[dict[str, dict[str, float]]]] = {"off": [], "on": []}
+        touch_runs: dict[str, list[dict[str, float]]] = {"off": [], "on": []}
+        for r in range(rounds):
+            for which in (("off", "on") if r % 2 == 0 else ("on", "off")):
+                measured[which].append(rigs[which].measure(steps, seconds))
+        for which in ("off", "on"):
+            touch_runs[which].append(wizard_touches(rigs[which].sessions, touches))
+        parts, msgs, process = breakdown(rigs["off"].sessions, max(5, steps // 4))
+        parts_on, _, _ = breakdown(rigs["on"].sessions, max(5, steps // 4))
+        app_r = mean_of(measured["off"])
+        class_r = mean_of(measured["on"])
+        book = rigs["on"].app.gradebook
+        assert book is not None
+        rigs["on"].close()
+        del rigs["on"]
+        time.sleep(1.0)
+        for s in rigs["off"].sessions:
+            install_baseline(s)
+        time.sleep(1.0)
+        base_r = rigs["off"].measure(steps, seconds)
 
         def row(name: str, a: float, b: float, unit: str = "ms") -> None:
             print(f"  {name:<58} {a:8.3f} {unit}  {b:8.3f} {unit}   {a / b:6.2f}")
@@ -402,6 +534,9 @@ def main(argv: list[str] | None = None) -> int:
         for key, what in (("A", "hot loop"), ("B", "paced, direct"), ("C", "paced, end to end")):
             a, b = per_core(app_r[key]["process_ms"]), per_core(base_r[key]["process_ms"])
             print(f"  sessions per core at {STEP_HZ:.0f} steps/s ({key}, {what}): app {a:.1f}, baseline {b:.1f}")
+
+        print_classroom(n, app_r, class_r, touch_runs, parts, parts_on, book_rows=book_touches(tmp / "on" / "class.db"))
+
         c_sessions = per_core(app_r["C"]["process_ms"])
         met = c_sessions >= TARGET_SESSIONS
         verdict = ("MET" if met else "NOT MET") if n >= TARGET_SESSIONS else \
@@ -411,19 +546,58 @@ def main(argv: list[str] | None = None) -> int:
               f"the baseline's); hot loop {app_r['A']['median_ms']:.3f} ms median, {app_r['A']['p95_ms']:.3f} ms p95 "
               f"per step (thread). Target >= {TARGET_SESSIONS} sessions/core (<= {budget:.2f} ms per step): "
               f"{verdict}")
+        jog = class_r["C"]["process_ms"] / app_r["C"]["process_ms"]
+        print(f"RESULT classroom: a jog step with the gradebook on costs {jog:.2f}x the app's without (C, end to "
+              f"end, {n} sessions); a recorded wizard touch {touch_ratio(touch_runs):.2f}x (process CPU)")
     finally:
-        if clients.stdin is not None:
-            try:
-                clients.stdin.write("quit\n")
-                clients.stdin.flush()
-            except OSError:
-                pass
-        try:
-            clients.wait(30)
-        except subprocess.TimeoutExpired:
-            clients.kill()
-        app.stop()
+        for rig in rigs.values():
+            rig.close()
+        shutil.rmtree(tmp, ignore_errors=True)
     return 0
+
+
+def book_touches(db: Path) -> int:
+    """Touches in the gradebook file (the writes really happened)."""
+    import sqlite3
+
+    with sqlite3.connect(db) as con:
+        return int(con.execute("SELECT COUNT(*) FROM touches").fetchone()[0])
+
+
+def touch_ratio(touch_runs: dict[str, list[dict[str, float]]]) -> float:
+    on = float(np.mean([t["process_ms"] for t in touch_runs["on"]]))
+    off = float(np.mean([t["process_ms"] for t in touch_runs["off"]]))
+    return on / off
+
+
+def print_classroom(n: int, app_r: dict[str, dict[str, float]], class_r: dict[str, dict[str, float]],
+                    touch_runs: dict[str, list[dict[str, float]]], parts: list[tuple[str, float]],
+                    parts_on: list[tuple[str, float]], book_rows: int) -> None:
+    """The classroom table: the same figures with the gradebook on and off, and their ratio."""
+    print(f"  classroom (--class: gradebook on, {n} named trainees) against the app as today (no class), "
+          f"same run, same session count:")
+    print(f"  {'':<58} {'class on':>11}  {'class off':>11}   on/off")
+
+    def row(name: str, a: float, b: float, unit: str = "ms") -> None:
+        print(f"  {name:<58} {a:8.3f} {unit}  {b:8.3f} {unit}   {a / b:6.2f}")
+
+    row("A hot loop: thread CPU per step, median", class_r["A"]["median_ms"], app_r["A"]["median_ms"])
+    row("A hot loop: thread CPU per step, p95", class_r["A"]["p95_ms"], app_r["A"]["p95_ms"])
+    row("A hot loop: process CPU per step", class_r["A"]["process_ms"], app_r["A"]["process_ms"])
+    row(f"B paced {STEP_HZ:.0f}/s per session, direct: process CPU per step",
+        class_r["B"]["process_ms"], app_r["B"]["process_ms"])
+    row(f"C paced {STEP_HZ:.0f}/s per session, end to end: process CPU/step",
+        class_r["C"]["process_ms"], app_r["C"]["process_ms"])
+    on = {f: float(np.mean([t[f] for t in touch_runs["on"]])) for f in touch_runs["on"][0]}
+    off = {f: float(np.mean([t[f] for t in touch_runs["off"]])) for f in touch_runs["off"][0]}
+    row("wizard touch (Record): thread CPU, median", on["thread_ms"], off["thread_ms"])
+    row("wizard touch (Record): wall (loop blocked), median", on["wall_ms"], off["wall_ms"])
+    row("wizard touch (Record): wall (loop blocked), p95", on["wall_p95_ms"], off["wall_p95_ms"])
+    row("wizard touch (Record): process CPU per touch", on["process_ms"], off["process_ms"])
+    extra = [(name, v) for name, v in parts_on if name not in dict(parts)]
+    for name, v in extra:
+        print(f"    classroom's own subscriber in a hot-loop step: {name:<40} {v:6.3f} ms")
+    print(f"  gradebook: {book_rows} touches written (every Record press of the class-on run)")
 
 
 if __name__ == "__main__":

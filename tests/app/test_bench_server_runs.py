@@ -1,0 +1,51 @@
+"""Smoke test: the server benchmark still runs (``--quick``) and prints its tables, the
+classroom one (gradebook on / off) included, with finite figures."""
+
+from __future__ import annotations
+
+import math
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+BENCH = Path(__file__).resolve().parents[1] / "bench" / "bench_server.py"
+ROW = re.compile(r"^  (\S.+?)\s+(\S+) ms\s+(\S+) ms\s+(\S+)$", re.MULTILINE)
+
+CLASSROOM_ROWS = {
+    "A hot loop: thread CPU per step, median", "A hot loop: thread CPU per step, p95",
+    "A hot loop: process CPU per step", "B paced 30/s per session, direct: process CPU per step",
+    "C paced 30/s per session, end to end: process CPU/step", "wizard touch (Record): thread CPU, median",
+    "wizard touch (Record): wall (loop blocked), median", "wizard touch (Record): wall (loop blocked), p95",
+    "wizard touch (Record): process CPU per touch",
+}
+
+
+def table(text: str) -> dict[str, tuple[float, float, float]]:
+    return {m.group(1).strip(): (float(m.group(2)), float(m.group(3)), float(m.group(4)))
+            for m in ROW.finditer(text)}
+
+
+def test_bench_server_quick_prints_the_classroom_table() -> None:
+    out = subprocess.run([sys.executable, str(BENCH), "--quick"], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr[-3000:]
+    text = out.stdout
+    assert "app/baseline" in text and "RESULT:" in text
+    head, sep, classroom = text.partition("classroom (--class: gradebook on, 2 named trainees)")
+    assert sep, text
+    app_rows = table(head)
+    assert {"A hot loop: thread CPU per step, median", "C paced 30/s per session, end to end: process CPU/step"} \
+        <= set(app_rows)
+    rows = table(classroom.split("RESULT:")[0])
+    assert set(rows) == CLASSROOM_ROWS
+    for name, (on, off, ratio) in rows.items():
+        assert all(math.isfinite(v) and v > 0 for v in (on, off, ratio)), name
+        assert ratio == round(on / off, 2) or abs(ratio - on / off) <= 0.006, name
+    # the class-off column is the app's own figure of the first table
+    for name in ("A hot loop: thread CPU per step, median", "C paced 30/s per session, end to end: process CPU/step"):
+        assert rows[name][1] == app_rows[name][0]
+    # every Record press of the class-on run went into the gradebook (2 sessions x 3 touches)
+    assert re.search(r"gradebook: 6 touches written", classroom)
+    m = re.search(r"RESULT classroom: a jog step with the gradebook on costs (\S+)x .* a recorded wizard touch "
+                  r"(\S+)x", text)
+    assert m and all(math.isfinite(float(v)) and float(v) > 0 for v in m.groups())
