@@ -80,6 +80,8 @@ class WizardResultView:
         with self.folder:
             self.result_md = gui.add_markdown("")
             self.truth_md = gui.add_markdown("", visible=False)
+            self.replay_scan = gui.add_button("Replay scan", visible=False,   # a beam result's scan
+                                              hint="Show the robot going through the beam scan again.")
             self.warnings_md = gui.add_markdown("")
             self.hidden_md = gui.add_markdown("", visible=False)   # touches recorded with the distance hidden
             bars = error_bars([1], [0.0])
@@ -111,6 +113,7 @@ class WizardResultView:
         self.compare.on_update(act(lambda _e: None, user_only=True))
         self.save.on_click(act(self._on_save, sync=True))
         self.check_tcp.on_click(act(self._on_check_tcp, sync=True))
+        self.replay_scan.on_click(act(lambda _e: self.parent.scene.replay_scan()))
         self.save_name.on_update(act(lambda _e: None, user_only=True))
         self.save_slot.on_update(act(lambda _e: None, user_only=True))
         self._named_run: Any = None
@@ -166,6 +169,7 @@ class WizardResultView:
             self.save_name.value = wf.default_save_name()
             set_content(self.save_md, "")
         set_content(self.result_md, result_markdown(res))
+        self.replay_scan.visible = getattr(res, "scan", None) is not None
         set_content(self.warnings_md, warnings_markdown(res))
         run = wf.run
         hidden = "" if run is None else hidden_touches_markdown(res, run.distance_mm, run.distance_hidden)

@@ -12,6 +12,12 @@
   ``scene_target_T_world_tool_m`` gives a pose): the prescribed orientation (PA-1) drawn at
   the TCP, updated on every move, for the operator to align the tool with.
 
+* the "Automatic (beam)" wizard's result (a result with a ``scan``): the scan replayed on the
+  robot (``views.beam_replay.ScanPlayer``: the robot goes through the scan's moves, the beam
+  red at each event, a marker where each event met the beam), then the robot stays at the
+  scan's end; "Replay scan" (result panel) plays it again. The camera frames the events, the
+  flange poses at the events and the sensor.
+
 Scene units are metres (the wizards' results are in mm and converted here). Axis colours are
 viser's: X red, Y green, Z blue.
 
@@ -37,6 +43,7 @@ import numpy as np
 
 from tcp_pendant.calibrate import CalibrationWorkflow
 from tcp_pendant.session import Session
+from tcp_pendant.views.beam_replay import ScanPlayer, event_points_world
 from tcp_pendant.views.framing import Framing, frame_spheres, spread_labels
 from tcp_pendant.views.scene import wxyz_xyz
 from tcp_pendant.wizards import Xyz4Result
@@ -98,6 +105,7 @@ class WizardSceneView:
         if res is not self._shown_result:
             self._shown_result = res
             self._show_sphere(res if isinstance(res, Xyz4Result) else None)
+            self._show_scan(res)
             if res is not None:
                 self.frame_result()
         self.on_motion()
@@ -105,6 +113,22 @@ class WizardSceneView:
             self.layout_labels()
         else:
             self._restore_labels()
+
+    def _show_scan(self, res: Any) -> None:
+        """A beam result: replay its scan (its markers stay); otherwise clear our replay."""
+        player = ScanPlayer.of(self.session)
+        scan = getattr(res, "scan", None)
+        if scan is None:
+            player.clear(owner=self)
+        else:
+            player.play(scan, owner=self)
+
+    def replay_scan(self) -> None:
+        """"Replay scan": the result's scan again, from its first move."""
+        scan = getattr(self.workflow.result, "scan", None)
+        if scan is None:
+            raise ValueError("This result has no beam scan to replay.")
+        ScanPlayer.of(self.session).play(scan, owner=self)
 
     @property
     def showing(self) -> bool:
@@ -196,8 +220,15 @@ class WizardSceneView:
         """(centres, radii) in WORLD m: the sphere and flange positions of a 4-point result,
         the TOOL triads (their axis lengths), the flange and the reference tip."""
         T_wf = self.session.pose_state().T_world_flange
-        centres = [T_wf[:3, 3], np.asarray(self.session.controller.reference_tip_world_m, dtype=float)]
-        radii = [0.09, 0.02]
+        scan = getattr(self._shown_result, "scan", None)
+        if scan is not None and len(scan.events):   # a beam scan: its events and the sensor, not the tip
+            T_wf = np.asarray(scan.events[-1].T_world_flange_exact, dtype=float)   # where the film ends
+            centres = [np.asarray(ev.T_world_flange_exact, dtype=float)[:3, 3] for ev in scan.events]
+            centres += [*event_points_world(scan), np.asarray(scan.events[0].beam_point, dtype=float)]
+            radii = [0.06] * len(scan.events) + [0.01] * len(scan.events) + [0.1]
+        else:
+            centres = [T_wf[:3, 3], np.asarray(self.session.controller.reference_tip_world_m, dtype=float)]
+            radii = [0.09, 0.02]
         for T, length in ((self._T_flange_computed, 0.10), (self._T_flange_tool_true, 0.16)):
             if T is not None:
                 centres.append((T_wf @ T)[:3, 3])

@@ -1,0 +1,329 @@
+"""Replaying a beam scan in the 3D scene (issue 14): the robot goes through the scan's moves, the
+beam turns red while the tool breaks it, a marker stays where each event met the beam.
+
+:func:`replay_frames` is pure: from a ``BeamScan`` (``controller.beam_scan``: its ``moves``
+with their joint values and the events each move produced) it makes a short film of joint
+values, a few per move in proportion to the time the move takes on the real robot, with a
+held frame at each event, whose beam is then broken. :func:`event_points_world` gives the
+markers' points (on the beam line).
+
+:class:`ScanPlayer` (one per session, :meth:`ScanPlayer.of`) plays such a film on viser's event
+loop at :attr:`ScanPlayer.rate_hz`: each frame sets the controller's joints
+(``VirtualController.set_q``, the model's joint values the scan planned) and emits the
+session's ``pose`` change, so every view shows the robot where the scan had it; the red
+beam and the markers are its own nodes under ``/beam_scan``. The controller is left at the
+scan's end (or where the caller asked it to return). A jog, the gizmo or a new scan during the
+replay stops it (the robot stays where the user put it); without a running event loop (a
+test calling from its own thread) the last frame is applied at once.
+
+The player is shared by the Calibrate tab's scene (the "Automatic (beam)" wizard's result) and
+the Tool tab's TCP service ("Check with beam"): one robot, one film at a time.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import logging
+import threading
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from tcp_pendant.session import Session
+from tcp_pendant.views.beam_stand import HALF_GAP_M
+
+__all__ = ["BROKEN_RGB", "ReplayFrame", "ScanPlayer", "event_points_world", "replay_frames"]
+
+log = logging.getLogger(__name__)
+
+BROKEN_RGB = (255, 40, 40)
+TIP_EVENT_RGB = (255, 150, 0)
+AXIS_EVENT_RGB = (210, 60, 230)
+MAX_FRAMES = 140
+"""Longest film, frames (14 s at 10 Hz); holds at the events included."""
+HOLD_FRAMES = 3
+"""Frames an event's broken beam is held (0.3 s at 10 Hz)."""
+RETURN_FRAMES = 8
+
+
+@dataclass(frozen=True, eq=False)
+class ReplayFrame:
+    """One frame of a scan's replay.
+
+    Attributes:
+        q_rad: the robot's joints (model), rad.
+        broken_event: the event whose beam is broken in this frame (index into ``scan.events``),
+            or None (every beam clear).
+        shown: the events that have happened by this frame (their markers are shown).
+    """
+
+    q_rad: np.ndarray
+    broken_event: int | None
+    shown: tuple[int, ...]
+
+
+def _event_fraction(move: Any, event: Any) -> tuple[float, float, float]:
+    """(fraction of the move where the event was recorded, where the beam broke, where it was
+    clear again) along the move's straight flange line; the exit is 1 for a tip event (the
+    tip stays in the beam until the next move pulls it out)."""
+    p0 = np.asarray(move.T_world_flange_start, dtype=float)[:3, 3]
+    p1 = np.asarray(move.T_world_flange_end, dtype=float)[:3, 3]
+    d = p1 - p0
+    length = float(np.linalg.norm(d))
+    if length < 1e-9:
+        return 1.0, 1.0, 1.0
+    pe = np.asarray(event.T_world_flange_exact, dtype=float)[:3, 3]
+    f = float(np.clip((pe - p0) @ d / (length * length), 0.0, 1.0))
+    entry = float(np.clip(f - max(float(event.travel) - float(event.entry_travel), 0.0) / length, 0.0, f))
+    if event.kind == "axis" and np.isfinite(event.exit_travel):
+        exit_ = float(np.clip(f + max(float(event.exit_travel) - float(event.travel), 0.0) / length, f, 1.0))
+    else:
+        exit_ = 1.0
+    return f, entry, exit_
+
+
+def _move_seconds(move: Any) -> float:
+    speed = float(move.speed_mm_s)
+    return float(move.length_m) * 1000.0 / speed if speed > 0 else 0.0
+
+
+def replay_frames(scan: Any, *, max_frames: int = MAX_FRAMES, hold_frames: int = HOLD_FRAMES,
+                  return_to: np.ndarray | None = None) -> tuple[ReplayFrame, ...]:
+    """The film of ``scan`` (see the module docstring).
+
+    Each move gets frames in proportion to its real duration (length / speed), at least one
+    (its end); within a move the joints are interpolated linearly (the scan's approaches and
+    passes are short straight lines at a fixed orientation). Each event gets ``hold_frames``
+    frames at its recorded position with its beam broken; frames between an axis event's entry
+    and exit (and after a tip event's entry in its move) show the beam broken too.
+
+    Args:
+        scan: a ``BeamScan``.
+        max_frames: the most frames (events' holds and the return included).
+        hold_frames: frames per event.
+        return_to: joints to go back to after the scan (rad), or None (stay at its end).
+
+    Returns:
+        The frames in order (at least one: the scan's end, or ``return_to``).
+    """
+    moves = tuple(scan.moves)
+    events = tuple(scan.events)
+    q_end = np.asarray(scan.q_end_rad, dtype=float)
+    n_return = RETURN_FRAMES if return_to is not None else 0
+    budget = max(max_frames - hold_frames * len(events) - n_return - 1, len(moves))
+    seconds = np.array([_move_seconds(m) for m in moves], dtype=float)
+    total = float(seconds.sum())
+    if moves and total > 0:
+        per_move = np.maximum(1, np.floor(seconds / total * budget)).astype(int)
+    else:
+        per_move = np.ones(len(moves), dtype=int)
+    while per_move.sum() > budget and per_move.max() > 1:
+        per_move[int(np.argmax(per_move))] -= 1
+    frames: list[ReplayFrame] = []
+    shown: tuple[int, ...] = ()
+    if moves:
+        frames.append(ReplayFrame(np.asarray(moves[0].q_start_rad, dtype=float).copy(), None, shown))
+    for m, n in zip(moves, per_move):
+        q0 = np.asarray(m.q_start_rad, dtype=float)
+        q1 = np.asarray(m.q_end_rad, dtype=float)
+        spans = {int(i): _event_fraction(m, events[int(i)]) for i in m.event_indices if 0 <= int(i) < len(events)}
+        stops = [(k / n, None) for k in range(1, n + 1)] + [(f, i) for i, (f, _, _) in spans.items()]
+        stops.sort(key=lambda s: (s[0], s[1] is None))
+        for f, event in stops:
+            q = q0 + (q1 - q0) * f
+            if event is not None:
+                if event not in shown:
+                    shown = tuple(sorted((*shown, event)))
+                frames.extend(ReplayFrame(q, event, shown) for _ in range(max(hold_frames, 1)))
+                continue
+            broken = next((i for i, (_, a, b) in spans.items() if a <= f <= b), None)
+            if broken is not None and broken not in shown:
+                shown = tuple(sorted((*shown, broken)))
+            frames.append(ReplayFrame(q, broken, shown))
+    all_events = tuple(range(len(events)))
+    if not frames or not np.allclose(frames[-1].q_rad, q_end, atol=1e-12):
+        frames.append(ReplayFrame(q_end.copy(), None, all_events))
+    if return_to is not None:
+        back = np.asarray(return_to, dtype=float)
+        frames.extend(ReplayFrame(q_end + (back - q_end) * (k / n_return), None, all_events)
+                      for k in range(1, n_return + 1))
+    last = frames[-1]
+    frames[-1] = ReplayFrame(last.q_rad, None, all_events)   # the film ends clear, every marker shown
+    return tuple(frames)
+
+
+def _on_beam(point: np.ndarray, b: np.ndarray, u: np.ndarray) -> np.ndarray:
+    return b + float((point - b) @ u) * u
+
+
+def event_points_world(scan: Any) -> np.ndarray:
+    """(N, 3) where each event met its beam (WORLD, m): the scan's point for the event
+    (``BeamScan.tip_world_m(i)``) projected onto the event's beam line."""
+    out = np.zeros((len(scan.events), 3))
+    for i, ev in enumerate(scan.events):
+        b = np.asarray(ev.beam_point, dtype=float)
+        u = np.asarray(ev.beam_dir, dtype=float)
+        out[i] = _on_beam(np.asarray(scan.tip_world_m(i), dtype=float), b, u)
+    return out
+
+
+class ScanPlayer:
+    """Plays scans in one session's scene (see the module docstring). Get it with :meth:`of`."""
+
+    KEY = "beam_player"
+    ROOT = "/beam_scan"
+    rate_hz: float = 10.0
+    """Frames per second of the replay (tests may raise it)."""
+
+    def __init__(self, session: Session) -> None:
+        self.session = session
+        scene = session.target.scene
+        self.scene = scene
+        self.broken_beam = scene.add_line_segments(
+            f"{self.ROOT}/broken_beam", points=np.zeros((1, 2, 3)), colors=BROKEN_RGB, thickness=6.0,
+            thickness_units="screen", visible=False)
+        self.break_point = scene.add_icosphere(f"{self.ROOT}/break_point", radius=0.004, color=BROKEN_RGB,
+                                               visible=False, cast_shadow=False, receive_shadow=False)
+        self._markers: Any = None
+        self._scan: Any = None
+        self._points = np.zeros((0, 3))
+        self._task: asyncio.Task[None] | None = None
+        self._generation = 0
+        self._last_q: np.ndarray | None = None
+        self.owner: object | None = None
+        """Who started the film on show (the views clear only their own)."""
+        self.frames: tuple[ReplayFrame, ...] = ()
+        self.frames_played = 0
+        self.done = threading.Event()
+        """Set when the film on show has ended (played out, stopped or cleared)."""
+        self.done.set()
+        self._shown_state: tuple[int | None, tuple[int, ...]] | None = None
+        session.on_close(self.stop)
+
+    @classmethod
+    def of(cls, session: Session) -> "ScanPlayer":
+        """The session's player (made on first use; kept in ``session.views``)."""
+        player = session.views.get(cls.KEY)
+        if player is None:
+            player = session.views[cls.KEY] = cls(session)
+        return player
+
+    @property
+    def playing(self) -> bool:
+        return not self.done.is_set()
+
+    @property
+    def scan(self) -> Any:
+        """The scan on show (None: nothing shown)."""
+        return self._scan
+
+    # ------------------------------------------------------------ commands
+    def play(self, scan: Any, *, owner: object | None = None, return_to: np.ndarray | None = None) -> None:
+        """Replay ``scan`` from its first move (on the loop: a task at :attr:`rate_hz`; off the
+        loop: its last frame at once). A film already playing stops first."""
+        self.stop()
+        self._generation += 1
+        self._scan, self.owner = scan, owner
+        self._points = event_points_world(scan)
+        self.frames = replay_frames(scan, return_to=return_to)
+        self.frames_played = 0
+        self._shown_state = None
+        self.done.clear()
+        try:
+            loop = asyncio.get_running_loop()
+        except RuntimeError:
+            loop = None
+        if loop is None:
+            self._apply(len(self.frames) - 1)
+            self._finish()
+            return
+        self._last_q = None
+        self._task = loop.create_task(self._run(self._generation))
+
+    def stop(self) -> None:
+        """Stop the film where it is (the markers of the events so far stay)."""
+        self._generation += 1
+        task, self._task = self._task, None
+        if task is not None and not task.done():
+            task.cancel()
+        self._finish()
+
+    def clear(self, owner: object | None = None) -> None:
+        """Stop and remove the red beam and the markers (only ``owner``'s film, if given)."""
+        if owner is not None and owner is not self.owner:
+            return
+        self.stop()
+        self._scan, self.owner = None, None
+        self._points = np.zeros((0, 3))
+        self._show(None, ())
+
+    # ------------------------------------------------------------ the film
+    def _finish(self) -> None:
+        if self._scan is not None and self.frames:
+            self._show(None, self.frames[-1].shown if self.frames_played >= len(self.frames) else self._shown())
+        self.done.set()
+
+    def _shown(self) -> tuple[int, ...]:
+        return () if self._shown_state is None else self._shown_state[1]
+
+    async def _run(self, generation: int) -> None:
+        s = self.session
+        try:
+            for i in range(len(self.frames)):
+                if generation != self._generation or s.closed:
+                    return
+                with s.lock:
+                    if generation != self._generation or s.closed:
+                        return
+                    if self._last_q is not None and not np.array_equal(s.controller.q_rad, self._last_q):
+                        return                          # the user moved the robot: the film stops
+                    self._apply(i)
+                await asyncio.sleep(1.0 / max(self.rate_hz, 1e-3))
+        except asyncio.CancelledError:
+            raise
+        except Exception:  # the film must never take the server down
+            log.exception("beam scan replay failed")
+        finally:
+            if generation == self._generation:
+                self._task = None
+                with s.lock:
+                    self._finish()
+
+    def _apply(self, i: int) -> None:
+        frame = self.frames[i]
+        s = self.session
+        s.controller.set_q(frame.q_rad)
+        self._last_q = s.controller.q_rad
+        self.frames_played = i + 1
+        s.moved()
+        self._show(frame.broken_event, frame.shown)
+
+    def _show(self, broken: int | None, shown: tuple[int, ...]) -> None:
+        """The red beam of event ``broken`` (None: hidden) and the markers of ``shown``."""
+        state = (broken, shown)
+        if state == self._shown_state:
+            return
+        self._shown_state = state
+        scan = self._scan
+        if broken is None or scan is None:
+            self.broken_beam.visible = False
+            self.break_point.visible = False
+        else:
+            ev = scan.events[broken]
+            b = np.asarray(ev.beam_point, dtype=float)
+            u = np.asarray(ev.beam_dir, dtype=float)
+            self.broken_beam.points = np.array([[b - HALF_GAP_M * u, b + HALF_GAP_M * u]])
+            self.broken_beam.visible = True
+            self.break_point.position = tuple(float(v) for v in self._points[broken])
+            self.break_point.visible = True
+        if self._markers is not None:
+            self._markers.remove()
+            self._markers = None
+        if shown and scan is not None:
+            idx = list(shown)
+            colors = np.array([TIP_EVENT_RGB if scan.events[i].kind == "tip" else AXIS_EVENT_RGB for i in idx],
+                              dtype=np.uint8)
+            self._markers = self.scene.add_point_cloud(f"{self.ROOT}/events", points=self._points[idx],
+                                                       colors=colors, point_size=0.005, point_shape="circle",
+                                                       precision="float32")
