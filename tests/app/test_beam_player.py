@@ -111,3 +111,17 @@ def test_off_the_loop_the_last_frame_is_shown_at_once(page) -> None:
     assert not player.playing and player.frames_played == len(player.frames)
     np.testing.assert_allclose(p.session.controller.q_rad, home)
     assert player._markers is not None and not player.broken_beam.visible
+
+
+def test_a_stored_scan_without_moves_only_shows_its_markers(page) -> None:
+    p = page()
+    player = ScanPlayer.of(p.session)
+    live = fake_scan(p)
+    q = p.session.controller.q_rad
+    stored = SimpleNamespace(events=live.events, moves=(), q_end_rad=None)     # a record's RecordedScan
+    points = np.array([[0.5, 0.1, 0.4]])
+    p.on_loop(lambda: player.play(stored, points=points))
+    assert not player.playing and player.frames == ()
+    np.testing.assert_array_equal(p.session.controller.q_rad, q)              # the robot did not move
+    b = live.events[0].beam_point
+    np.testing.assert_allclose(player._markers.points, [[b[0], 0.1, b[2]]], atol=1e-6)   # on the beam line

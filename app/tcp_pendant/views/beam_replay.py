@@ -73,14 +73,23 @@ def _event_fraction(move: Any, event: Any) -> tuple[float, float, float]:
     length = float(np.linalg.norm(d))
     if length < 1e-9:
         return 1.0, 1.0, 1.0
-    pe = np.asarray(event.T_world_flange_exact, dtype=float)[:3, 3]
+    pe = _flange(event)[:3, 3]
     f = float(np.clip((pe - p0) @ d / (length * length), 0.0, 1.0))
-    entry = float(np.clip(f - max(float(event.travel) - float(event.entry_travel), 0.0) / length, 0.0, f))
-    if event.kind == "axis" and np.isfinite(event.exit_travel):
-        exit_ = float(np.clip(f + max(float(event.exit_travel) - float(event.travel), 0.0) / length, f, 1.0))
+    travel = float(getattr(event, "travel", 0.0))
+    entry = float(np.clip(f - max(travel - float(getattr(event, "entry_travel", travel)), 0.0) / length, 0.0, f))
+    exit_travel = float(getattr(event, "exit_travel", np.nan))
+    if event.kind == "axis" and np.isfinite(exit_travel):
+        exit_ = float(np.clip(f + max(exit_travel - travel, 0.0) / length, f, 1.0))
     else:
         exit_ = 1.0
     return f, entry, exit_
+
+
+def _flange(event: Any) -> np.ndarray:
+    """The event's flange pose without the recording noise when it has one (a live
+    ``BeamEvent``), else the recorded one (a stored scan's event)."""
+    T = getattr(event, "T_world_flange_exact", None)
+    return np.asarray(event.T_world_flange if T is None else T, dtype=float)
 
 
 def _move_seconds(move: Any) -> float:
@@ -105,10 +114,13 @@ def replay_frames(scan: Any, *, max_frames: int = MAX_FRAMES, hold_frames: int =
         return_to: joints to go back to after the scan (rad), or None (stay at its end).
 
     Returns:
-        The frames in order (at least one: the scan's end, or ``return_to``).
+        The frames in order (at least one: the scan's end, or ``return_to``); none for a stored
+        scan (no moves and no end joints: nothing to play).
     """
-    moves = tuple(scan.moves)
+    moves = tuple(getattr(scan, "moves", ()))
     events = tuple(scan.events)
+    if not moves and getattr(scan, "q_end_rad", None) is None:
+        return ()
     q_end = np.asarray(scan.q_end_rad, dtype=float)
     n_return = RETURN_FRAMES if return_to is not None else 0
     budget = max(max_frames - hold_frames * len(events) - n_return - 1, len(moves))
@@ -157,14 +169,21 @@ def _on_beam(point: np.ndarray, b: np.ndarray, u: np.ndarray) -> np.ndarray:
     return b + float((point - b) @ u) * u
 
 
-def event_points_world(scan: Any) -> np.ndarray:
-    """(N, 3) where each event met its beam (WORLD, m): the scan's point for the event
-    (``BeamScan.tip_world_m(i)``) projected onto the event's beam line."""
-    out = np.zeros((len(scan.events), 3))
-    for i, ev in enumerate(scan.events):
+def event_points_world(scan: Any, points: Any = None) -> np.ndarray:
+    """(N, 3) where each event met its beam (WORLD, m), projected onto the event's beam line:
+    ``points`` (N, 3) if given, else the scan's point for the event (``BeamScan.tip_world_m(i)``:
+    where the physical tool met the beam), else (a stored scan) the flange's position."""
+    events = tuple(scan.events)
+    out = np.zeros((len(events), 3))
+    tip = getattr(scan, "tip_world_m", None)
+    for i, ev in enumerate(events):
         b = np.asarray(ev.beam_point, dtype=float)
         u = np.asarray(ev.beam_dir, dtype=float)
-        out[i] = _on_beam(np.asarray(scan.tip_world_m(i), dtype=float), b, u)
+        if points is not None:
+            p = np.asarray(points[i], dtype=float)
+        else:
+            p = np.asarray(tip(i), dtype=float) if callable(tip) else _flange(ev)[:3, 3]
+        out[i] = _on_beam(p, b, u)
     return out
 
 
@@ -219,16 +238,22 @@ class ScanPlayer:
         return self._scan
 
     # ------------------------------------------------------------ commands
-    def play(self, scan: Any, *, owner: object | None = None, return_to: np.ndarray | None = None) -> None:
+    def play(self, scan: Any, *, owner: object | None = None, return_to: np.ndarray | None = None,
+             points: Any = None) -> None:
         """Replay ``scan`` from its first move (on the loop: a task at :attr:`rate_hz`; off the
-        loop: its last frame at once). A film already playing stops first."""
+        loop: its last frame at once). A film already playing stops first. A stored scan (no
+        moves) only shows its markers; ``points``: the markers' points (see
+        :func:`event_points_world`)."""
         self.stop()
         self._generation += 1
         self._scan, self.owner = scan, owner
-        self._points = event_points_world(scan)
+        self._points = event_points_world(scan, points)
         self.frames = replay_frames(scan, return_to=return_to)
         self.frames_played = 0
         self._shown_state = None
+        if not self.frames:
+            self._show(None, tuple(range(len(scan.events))))
+            return
         self.done.clear()
         try:
             loop = asyncio.get_running_loop()

@@ -121,14 +121,22 @@ class WizardSceneView:
         if scan is None:
             player.clear(owner=self)
         else:
-            player.play(scan, owner=self)
+            player.play(scan, owner=self, points=self._scan_points(res))
+
+    @staticmethod
+    def _scan_points(res: Any) -> Any:
+        """The markers' points: the scan's own (where the physical tool met the beam) when it
+        has them, else (a stored scan) where the result's tool met it."""
+        if callable(getattr(res.scan, "tip_world_m", None)) or not callable(getattr(res, "event_points_world_m", None)):
+            return None
+        return np.asarray(res.event_points_world_m(), dtype=float).reshape(-1, 3)
 
     def replay_scan(self) -> None:
         """"Replay scan": the result's scan again, from its first move."""
         scan = getattr(self.workflow.result, "scan", None)
         if scan is None:
             raise ValueError("This result has no beam scan to replay.")
-        ScanPlayer.of(self.session).play(scan, owner=self)
+        ScanPlayer.of(self.session).play(scan, owner=self, points=self._scan_points(self.workflow.result))
 
     @property
     def showing(self) -> bool:
@@ -222,9 +230,10 @@ class WizardSceneView:
         T_wf = self.session.pose_state().T_world_flange
         scan = getattr(self._shown_result, "scan", None)
         if scan is not None and len(scan.events):   # a beam scan: its events and the sensor, not the tip
-            T_wf = np.asarray(scan.events[-1].T_world_flange_exact, dtype=float)   # where the film ends
-            centres = [np.asarray(ev.T_world_flange_exact, dtype=float)[:3, 3] for ev in scan.events]
-            centres += [*event_points_world(scan), np.asarray(scan.events[0].beam_point, dtype=float)]
+            T_wf = np.asarray(scan.events[-1].T_world_flange, dtype=float)   # where the film ends
+            centres = [np.asarray(ev.T_world_flange, dtype=float)[:3, 3] for ev in scan.events]
+            centres += [*event_points_world(scan, self._scan_points(self._shown_result)),
+                        np.asarray(scan.events[0].beam_point, dtype=float)]
             radii = [0.06] * len(scan.events) + [0.01] * len(scan.events) + [0.1]
         else:
             centres = [T_wf[:3, 3], np.asarray(self.session.controller.reference_tip_world_m, dtype=float)]
