@@ -9,11 +9,22 @@ Modules, one job each:
 * ``jog``: Cartesian path following by damped least squares with the safety rules.
 * ``approach``: inverse kinematics and the auto-approach target.
 * ``readout``, ``touch``: the pendant's pose readout and the touch/crash geometry.
+* ``beam``, ``beam_scan``: the virtual beam sensor (BullsEye / TRACC style) and its automatic
+  scan (:func:`run_beam_scan`).
 * ``controller``: :class:`VirtualController`, the state and the commands.
 """
 
 from tcp_pendant.controller.approach import approach_pose, approach_rotation, solve_ik
 from tcp_pendant.controller.assets import example_robot_urdf, robots_dir
+from tcp_pendant.controller.beam import BeamEvent, BeamSensor, ToolShape
+from tcp_pendant.controller.beam_scan import (
+    BeamScan,
+    BeamScanConfig,
+    ScanMove,
+    default_beam_sensor,
+    run_beam_scan,
+    tool_shape,
+)
 from tcp_pendant.controller.controller import VirtualController
 from tcp_pendant.controller.errors import ControllerError
 from tcp_pendant.controller.jog import JogFrame, JogResult, JogSettings
@@ -30,6 +41,12 @@ from tcp_pendant.controller.tools import (
 from tcp_pendant.controller.touch import TouchGeometry
 
 __all__ = [
+    "BeamEvent",
+    "BeamScan",
+    "BeamScanConfig",
+    "BeamSensor",
+    "ScanMove",
+    "ToolShape",
     "ControllerError",
     "JogFrame",
     "JogResult",
@@ -44,9 +61,12 @@ __all__ = [
     "approach_rotation",
     "builtin_robots",
     "builtin_tools",
+    "default_beam_sensor",
     "example_robot_urdf",
     "load_tool",
     "reference_tip_model",
     "robots_dir",
+    "run_beam_scan",
     "solve_ik",
+    "tool_shape",
 ]

@@ -33,6 +33,8 @@ from scipy.spatial.transform import Rotation
 
 from tcpcal.tool import Tool
 from tcp_pendant.controller.approach import approach_pose, solve_ik
+from tcp_pendant.controller.beam import BeamSensor
+from tcp_pendant.controller.beam_scan import default_beam_sensor
 from tcp_pendant.controller.errors import ControllerError
 from tcp_pendant.controller.jog import (
     DEFAULT_SETTINGS,
@@ -119,6 +121,7 @@ class VirtualController:
             p = kinematics.T_world_flange(kinematics.home_rad)[:3, 3]
             reference_tip_world_m = (p[0], p[1], 0.5 * p[2])
         self._tip = _check_point(reference_tip_world_m, "reference_tip_world_m")
+        self._beam: BeamSensor | None = None  # None: default_beam_sensor(reference tip)
 
     # ----------------------------------------------------------------- state
     @property
@@ -214,6 +217,29 @@ class VirtualController:
     def set_reference_tip(self, tip_world_m: Sequence[float] | np.ndarray) -> None:
         """Move the reference tip (WORLD, metres)."""
         self._tip = _check_point(tip_world_m, "reference_tip_world_m")
+
+    @property
+    def beam_sensor(self) -> BeamSensor:
+        """The beam sensor (issue 14): the one set with :meth:`set_beam_sensor`, else
+        ``beam_scan.default_beam_sensor`` of the current reference tip (it follows the tip when
+        that is moved)."""
+        return default_beam_sensor(self._tip) if self._beam is None else self._beam
+
+    @property
+    def beam_sensor_is_default(self) -> bool:
+        """True while the beam sensor follows the reference tip (none set explicitly)."""
+        return self._beam is None
+
+    def set_beam_sensor(self, sensor: BeamSensor | None) -> None:
+        """Place the beam sensor (WORLD, m); None: back to the default, which follows the
+        reference tip.
+
+        Raises:
+            ControllerError: not a ``BeamSensor``.
+        """
+        if sensor is not None and not isinstance(sensor, BeamSensor):
+            raise ControllerError(f"set_beam_sensor expects a BeamSensor or None, got {type(sensor).__name__}.")
+        self._beam = sensor
 
     @property
     def T_world_base(self) -> np.ndarray:
