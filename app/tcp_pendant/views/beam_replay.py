@@ -40,10 +40,10 @@ log = logging.getLogger(__name__)
 BROKEN_RGB = (255, 40, 40)
 TIP_EVENT_RGB = (255, 150, 0)
 AXIS_EVENT_RGB = (210, 60, 230)
-MAX_FRAMES = 140
-"""Longest film, frames (14 s at 10 Hz); holds at the events included."""
+MAX_FRAMES = 110
+"""Longest film, frames (9 s at 12 Hz); holds at the events included."""
 HOLD_FRAMES = 3
-"""Frames an event's broken beam is held (0.3 s at 10 Hz)."""
+"""Frames an event's broken beam is held (0.25 s at 12 Hz)."""
 RETURN_FRAMES = 8
 
 
@@ -192,7 +192,7 @@ class ScanPlayer:
 
     KEY = "beam_player"
     ROOT = "/beam_scan"
-    rate_hz: float = 10.0
+    rate_hz: float = 12.0
     """Frames per second of the replay (tests may raise it)."""
 
     def __init__(self, session: Session) -> None:

@@ -289,7 +289,7 @@ class SceneView:
         self._tip_label = scene.add_label("/reference_tip_label", "reference tip",
                                           position=tuple(c.reference_tip_world_m + [0.0, 0.0, -0.06]))
         session.scene_labels.update(self.tool_labels())     # the wizards' scene moves them apart
-        self.beam_stand = BeamStandNodes(scene, getattr(c, 'beam_sensor', None))  # BEAM-PENDING
+        self.beam_stand = BeamStandNodes(scene, c.beam_sensor)
 
         wxyz, xyz = wxyz_xyz(state.T_world_tcp)
         self.gizmo = scene.add_transform_controls("/tcp_gizmo", scale=0.14, line_width=2.0, wxyz=wxyz,
@@ -307,7 +307,7 @@ class SceneView:
         tip = self.session.controller.reference_tip_world_m
         if not np.array_equal(tip, self._shown_tip):     # knocked (a scenario) or set anew
             self.update_reference_tip()
-        self.beam_stand.show(getattr(self.session.controller, 'beam_sensor', None))  # BEAM-PENDING   # redraws only a changed sensor
+        self.beam_stand.show(self.session.controller.beam_sensor)   # redraws only a changed sensor
         if change.pose and change.state is not None:
             skip = (self._gizmo_row,) if self._dragging else ()
             self._poses.send(self._local_poses(change.state), skip=skip)
