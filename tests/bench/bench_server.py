@@ -536,6 +536,11 @@ def main(argv: list[str] | None = None) -> int:
             print(f"  sessions per core at {STEP_HZ:.0f} steps/s ({key}, {what}): app {a:.1f}, baseline {b:.1f}")
 
         print_classroom(n, app_r, class_r, touch_runs, parts, parts_on, book_rows=book_touches(tmp / "on" / "class.db"))
+        print("  the same figures round by round (process CPU per step, ms; the spread is the noise the ratios "
+              "above sit in):")
+        for key in ("A", "B", "C"):
+            print(f"    {key}: class off " + ", ".join(f"{r[key]['process_ms']:.3f}" for r in measured["off"])
+                  + "; class on " + ", ".join(f"{r[key]['process_ms']:.3f}" for r in measured["on"]))
 
         c_sessions = per_core(app_r["C"]["process_ms"])
         met = c_sessions >= TARGET_SESSIONS
