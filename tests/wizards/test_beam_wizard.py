@@ -305,3 +305,13 @@ def test_stored_texts_are_cut() -> None:
     ev = ScanEvent.from_dict({"kind": "tip", "T_world_flange_m": np.eye(4).tolist(), "beam_point_m": [0, 0, 0],
                               "beam_dir": [0, 2, 0]})
     assert np.allclose(ev.beam_dir, [0, 1, 0]) and ev.orientation == 0
+
+
+def test_back_from_the_result_scans_again() -> None:
+    wiz = finished(POINTER)
+    with pytest.raises(WizardStateError, match="press Back to scan again"):
+        wiz.give_scan(make_scan(POINTER), R_flange_tool_base=np.eye(3))
+    wiz.back()
+    assert wiz.scan_pending and wiz.status == "in_progress" and not wiz.step.recorded
+    wiz.give_scan(make_scan(TORCH), R_flange_tool_base=TORCH[:3, :3])
+    assert np.allclose(wiz.finish().tcp_mm, TORCH[:3, 3] * 1000.0, atol=1e-6)

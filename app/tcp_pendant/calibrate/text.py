@@ -18,7 +18,14 @@ from collections.abc import Collection, Mapping, Sequence
 
 from tcp_pendant.pendant.formatting import fmt_num
 from tcp_pendant.text_escape import escape_markdown as _esc
-from tcp_pendant.wizards import ESTIMATOR_LABELS, Wizard, WizardResult, Xyz4Result, wizard_class
+from tcp_pendant.wizards import (
+    ESTIMATOR_LABELS,
+    BeamWizardResult,
+    Wizard,
+    WizardResult,
+    Xyz4Result,
+    wizard_class,
+)
 from tcp_pendant.wizards.registry import LiveAttribute
 from tcp_pendant.wizards.tcp_check import TcpCheckResult, tcp_check_markdown
 from tcp_pendant.wizards.session_record import ReplayCheck
@@ -27,6 +34,8 @@ from tcpcal.pose_quality import CandidateGain, PoseQuality
 
 __all__ = [
     "METHOD_BLURBS",
+    "beam_result_markdown",
+    "duration_words",
     "comparison_markdown",
     "menu_markdown",
     "meter_level",
@@ -166,11 +175,16 @@ def meter_markdown(gain: CandidateGain, quality: PoseQuality | None, sigma_mm: f
     return f"{head}\n\n{advice}{near}"
 
 
-def result_markdown(result: WizardResult) -> str:
+def result_markdown(result: WizardResult, truth: TruthComparison | None = None) -> str:
     """The calibrated frame and its quality figures (what a pendant shows after a calibration);
-    a TCP check's result: its rotations, implied error, correction and verdict."""
+    a TCP check's result: its rotations, implied error, correction and verdict; a beam
+    result: :func:`beam_result_markdown` (``truth``: its comparison with the true tool, given
+    only where the truth may be shown).
+    """
     if isinstance(result, TcpCheckResult):
         return tcp_check_markdown(result)
+    if isinstance(result, BeamWizardResult):
+        return beam_result_markdown(result, truth)
     x, y, z = (fmt_num(v) for v in result.tcp_mm)
     lines = [f"**TCP** X {x} · Y {y} · Z {z} mm"]
     if result.abc_deg is not None:
@@ -204,6 +218,95 @@ def result_markdown(result: WizardResult) -> str:
         rows.append(("displacement lengths Δ", ", ".join(_mm(d, 1) for d in result.displacements_mm)))
     table = "| figure | value |\n|---|---|\n" + "\n".join(f"| {k} | {v} |" for k, v in rows)
     return "\n\n".join(lines) + "\n\n" + table
+
+
+def duration_words(seconds: float) -> str:
+    """A duration as a pendant says it: "23.4 s", "3 min 12 s", "1 h 02 min"."""
+    if not math.isfinite(seconds) or seconds < 0.0:
+        return "–"
+    if seconds < 60.0:
+        return f"{seconds:.1f} s"
+    whole = int(round(seconds))
+    if whole < 3600:
+        return f"{whole // 60} min {whole % 60:02d} s"
+    return f"{whole // 3600} h {whole % 3600 // 60:02d} min"
+
+
+def beam_result_markdown(result: BeamWizardResult, truth: TruthComparison | None = None) -> str:
+    """An Automatic (beam) result: the TCP with its 95 % radius, the measured tool direction,
+    the TOOL frame to save (and that it is the planning orientation turned onto the measured
+    direction), the figures, the events with their residuals, the time the scan takes on a real
+    robot, and the lesson: automatic vs the trainee's last manual calibration of the same tool
+    (times; errors against the true tool only with ``truth``, the beam run's own comparison,
+    which the caller gives only where the truth may be shown).
+    """
+    x, y, z = (fmt_num(v) for v in result.tcp_mm)
+    lines = [f"**TCP** X {x} · Y {y} · Z {z} mm (FLANGE) · 95 % radius {_mm(result.ci95_mm, 3)}"]
+    if result.direction_flange is not None:
+        dx, dy, dz = (f"{v:+.4f}" for v in result.direction_flange)
+        cone = result.direction_ci95_deg
+        lines.append(f"**Tool direction** (TOOL X in FLANGE) {dx} · {dy} · {dz} · 95 % cone "
+                     + (_deg(cone, 3) if cone is not None and math.isfinite(cone) else "– (no redundancy)"))
+    else:
+        lines.append("**Tool direction** not measured (see the warnings)")
+    if result.abc_deg is not None:
+        a, b, c = (fmt_num(v) for v in result.abc_deg)
+        how = (f"the planning orientation turned by {_deg(result.direction_turn_deg, 3)} so that its X is the "
+               "measured direction" if result.direction_turn_deg is not None else "the planning orientation as it is")
+        lines.append(f"**TOOL frame to save** A {a} · B {b} · C {c}° (KUKA): {how}; the beam does not see the "
+                     "turn about the tool's X, which is kept from the planning data.")
+    beam = result.beam_result
+    rows = [("method", _esc(result.method)),
+            ("tip events (TCP)", str(len(result.tip_event_indices))),
+            ("sideways crossings used (direction)", str(len(result.axis_event_indices))),
+            ("mean error (tip off the beam line)", _mm(result.mean_error_mm, 3)),
+            ("max error", _mm(result.max_error_mm, 3)),
+            ("RMS error", _mm(result.rms_error_mm, 3)),
+            ("95 % radius of the TCP", _mm(result.ci95_mm, 3)),
+            ("event noise estimate (per axis)", _mm(float(beam.noise_sigma), 4)),
+            ("scan on a real robot", f"{duration_words(result.duration_s)} (path {fmt_num(result.path_length_m, 2)} m)")]
+    table = "| figure | value |\n|---|---|\n" + "\n".join(f"| {k} | {v} |" for k, v in rows)
+    return "\n\n".join([*lines, table, _beam_events_markdown(result), _beam_lesson_markdown(result, truth)])
+
+
+def _beam_events_markdown(result: BeamWizardResult) -> str:
+    """The events: orientation, kind, beam, and the residual of each event used (mm)."""
+    tips = dict(zip(result.tip_event_indices, result.beam_result.residuals))
+    axes = {} if result.axis_result is None else dict(zip(result.axis_event_indices,
+                                                          (abs(float(r)) for r in result.axis_result.residuals)))
+    rows = []
+    for i, e in enumerate(result.events):
+        kind = "tip on the beam" if e.kind == "tip" else "shaft crossed sideways"
+        if i in tips:
+            used = f"{fmt_num(float(tips[i]), 4)} mm from the beam line"
+        elif i in axes:
+            used = f"axis {fmt_num(axes[i], 4)} mm from the beam line"
+        else:
+            used = "not used" + ("" if e.on_shaft else " (off the shaft)")
+        rows.append(f"| {i + 1} | {e.orientation + 1} | {kind} | {e.beam + 1} | {used} |")
+    return (f"**Events** ({len(result.events)})\n\n| # | orientation | event | beam | residual |\n"
+            "|---|---|---|---|---|\n" + "\n".join(rows))
+
+
+def _beam_lesson_markdown(result: BeamWizardResult, truth: TruthComparison | None) -> str:
+    """Automatic vs by hand, on the same tool: time (and errors against the truth, with it)."""
+    manual = result.manual
+    if manual is None:
+        return ("**Automatic vs by hand:** no manual calibration of this tool in this session yet. "
+                f"The scan takes {duration_words(result.duration_s)} on a real robot; calibrate the tool by hand "
+                "(e.g. XYZ 4-point) and scan again to compare.")
+    name = f"{manual.run_number}: {_esc(manual.title)} (by hand)"
+    if truth is None:
+        return ("**Automatic vs by hand** (same tool)\n\n| calibration | time |\n|---|---|\n"
+                f"| Automatic (beam) | {duration_words(result.duration_s)} on a real robot |\n"
+                f"| {name} | {duration_words(manual.wall_time_s)} (your time) |")
+    head = ("**Automatic vs by hand** (same tool, against the true tool)\n\n"
+            "| calibration | time | TCP error | direction error |\n|---|---|---|---|")
+    beam = (f"| Automatic (beam) | {duration_words(result.duration_s)} on a real robot | "
+            f"{_mm(truth.position_error_mm, 3)} | {_deg(truth.x_axis_error_deg, 3)} |")
+    hand = (f"| {name} | {duration_words(manual.wall_time_s)} (your time) | {_mm(manual.position_error_mm, 3)} | "
+            f"{_deg(manual.direction_error_deg, 3)} |")
+    return "\n".join([head, beam, hand])
 
 
 def _touch_numbers(result: WizardResult) -> Sequence[int]:

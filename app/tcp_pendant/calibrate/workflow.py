@@ -26,11 +26,14 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
-from typing import Any, Literal, Protocol
+from typing import Any, ClassVar, Literal, Protocol
 
 import numpy as np
 
 from tcp_pendant.controller import RobotKinematics, ToolModel, VirtualController, builtin_tools
+from tcp_pendant.controller.beam import BeamSensor, ToolShape
+from tcp_pendant.controller.beam_scan import BeamScan, BeamScanConfig, run_beam_scan, tool_shape
+from tcp_pendant.controller.errors import ControllerError
 from tcp_pendant.controller.jog import JogSettings
 from tcp_pendant.controller.spin import SpinCheckResult, spin_check
 from tcp_pendant.calibrate.autotouch import AutoTouchOutcome, auto_touch
@@ -38,7 +41,9 @@ from tcp_pendant.calibrate.diversity import failure_in_words
 from tcp_pendant.calibrate.library_save import save_result
 from tcp_pendant.wizards import (
     AbcWorldWizard,
+    BeamWizard,
     CalibrationFailedError,
+    ManualComparison,
     ReferenceWizard,
     TcpCheckWizard,
     TcpZxWizard,
@@ -59,6 +64,7 @@ from tcp_pendant.wizards.session_record import (
     session_from_controller,
     step_distances,
 )
+from tcp_pendant.wizards.beam import wall_time_s
 from tcp_pendant.wizards.truth import TruthComparison, compare_with_truth
 from tcpcal.library import ToolLibrary
 from tcpcal.tool import Tool
@@ -68,7 +74,9 @@ __all__ = [
     "WIZARD_KINDS",
     "WIZARD_LABELS",
     "AutoTouchRequest",
+    "BeamScanJob",
     "CalibrationWorkflow",
+    "ControllerJob",
     "ControllerToolState",
     "TcpCheckJob",
     "ToolState",
@@ -115,11 +123,34 @@ class AutoTouchRequest:
         return (float(self.tilt_deg), float(self.azimuth_deg), 0.0)
 
 
+class ControllerJob(Protocol):
+    """What a wizard on show waits for the controller to do (its step role is
+    ``by_controller``, or it checks a touch), detached from the session: taken on the loop
+    (:meth:`CalibrationWorkflow.controller_job`), :meth:`run` in a worker thread (pure: its
+    own copies of the robot models; the controller is not moved), the outcome handed back on
+    the loop (:meth:`CalibrationWorkflow.give_controller_job`)."""
+
+    wizard: Wizard
+
+    @property
+    def busy_text(self) -> str:
+        """What the steps view says while the job runs (markdown, our words only)."""
+
+    def run(self) -> Any:
+        """Do the work (worker thread)."""
+
+    def hand_in(self, outcome: Any) -> WizardResult | None:
+        """Give ``outcome`` to the wizard and finish it (None when the wizard was left meanwhile:
+        it keeps the outcome and shows it when resumed and finished)."""
+
+
 @dataclass(frozen=True, eq=False)
 class TcpCheckJob:
     """The six rotations a TCP check wizard waits for, detached from the session: its own
     copies of the robot models, so :meth:`run` (0.1-0.3 s) may run in a worker thread while the
     loop keeps jogging. Metres and radians; the controller is not moved."""
+
+    busy_text: ClassVar[str] = "**Checking:** the controller turns the tool ±A, ±B, ±C about the TCP ..."
 
     wizard: TcpCheckWizard
     pose: Any                     # the RecordedPose the check starts from
@@ -135,6 +166,64 @@ class TcpCheckJob:
         return spin_check(self.kinematics, self.q_rad, self.T_flange_tool_active, self.T_flange_tool_true,
                           angle_deg=self.wizard.angle_deg, true_kinematics=self.true_kinematics,
                           settings=self.settings)
+
+    def hand_in(self, outcome: SpinCheckResult) -> WizardResult | None:
+        """The check to its wizard (from the recorded touch it started at), then Finish."""
+        self.wizard.give_check(outcome, self.pose)
+        if self.wizard.status == "in_progress":
+            return self.wizard.finish()
+        return None
+
+
+@dataclass(frozen=True, eq=False)
+class BeamScanJob:
+    """The scan an Automatic (beam) wizard waits for, detached from the session: the robot
+    models (own copies), the joints where it starts, the beam sensor, the tool data the
+    controller plans with and the physical tool the beam sees, so :meth:`run` may run in a
+    worker thread. Metres and radians; the controller is not moved.
+
+    Attributes:
+        wizard: the beam wizard.
+        kinematics: the controller's (nominal) model; true_kinematics: the physical robot.
+        q_start_rad: joints where the scan starts.
+        sensor: the beam device; shape: the physical (true) tool the beam sees.
+        T_flange_tool_plan: (4,4) the tool data the controller plans with, m.
+        config: the scan's speeds and orientations (from the wizard's options).
+        seed: seed of the sensor's repeatability noise (None: exact events).
+        manual: the trainee's last manual calibration of the same tool, or None.
+    """
+
+    busy_text: ClassVar[str] = ("**Scanning:** the controller moves the tool through the beam at each "
+                                "orientation and records every beam event ...")
+
+    wizard: BeamWizard
+    kinematics: RobotKinematics
+    true_kinematics: RobotKinematics
+    q_start_rad: np.ndarray
+    sensor: BeamSensor
+    shape: ToolShape
+    T_flange_tool_plan: np.ndarray
+    config: BeamScanConfig
+    seed: int | None = None
+    manual: ManualComparison | None = None
+
+    def run(self) -> BeamScan:
+        """``controller.beam_scan.run_beam_scan`` from the start joints.
+
+        Raises:
+            ControllerError: nothing could be scanned (the reasons in words).
+        """
+        rng = None if self.seed is None else np.random.default_rng(self.seed)
+        return run_beam_scan(self.kinematics, self.q_start_rad, self.sensor, self.T_flange_tool_plan,
+                             self.shape, true_kinematics=self.true_kinematics, config=self.config, rng=rng)
+
+    def hand_in(self, outcome: BeamScan) -> WizardResult | None:
+        """The scan to its wizard (with the planning orientation and the manual comparison),
+        then Finish (a ``CalibrationFailedError`` when the events cannot give a TCP)."""
+        self.wizard.give_scan(outcome, R_flange_tool_base=self.T_flange_tool_plan[:3, :3], manual=self.manual)
+        if self.wizard.status == "in_progress":
+            return self.wizard.finish()
+        return None
 
 
 def _own_copy(kin: RobotKinematics) -> RobotKinematics:
@@ -452,8 +541,9 @@ class CalibrationWorkflow:
     def next(self) -> WizardResult | None:
         """Next step; on the last step compute the result (returned)."""
         w = self._require()
-        if isinstance(w, TcpCheckWizard) and w.check_pending and w.on_last_step:
-            return self.run_tcp_check()
+        job = self.controller_job() if w.on_last_step else None
+        if job is not None:
+            return self.run_controller_job(job)
         try:
             out = w.next()
         except CalibrationFailedError as exc:
@@ -485,6 +575,9 @@ class CalibrationWorkflow:
         if not self.training:
             raise WizardStateError("Auto-touch is a training-mode tool; switch training mode on.")
         w = self._require()
+        if w.status == "in_progress" and w.auto_role(w.step).by_controller:
+            raise WizardStateError(f"The {w.title} wizard has nothing to touch: the controller runs this "
+                                   "step itself; press Finish.")
         run_index = self._current
         self.auto_touches += 1
         self.note_mounted_tool()
@@ -614,10 +707,7 @@ class CalibrationWorkflow:
     def give_tcp_check(self, job: TcpCheckJob, result: SpinCheckResult) -> WizardResult | None:
         """Hand a finished check to its wizard and finish it (the wizard may have been left
         meanwhile: then it keeps the check and shows it when resumed and finished)."""
-        job.wizard.give_check(result, job.pose)
-        if job.wizard.status == "in_progress":
-            return job.wizard.finish()
-        return None
+        return self.give_controller_job(job, result)
 
     def run_tcp_check(self) -> WizardResult | None:
         """Run the waiting TCP check here (synchronously; the app runs :meth:`tcp_check_job`
@@ -626,6 +716,115 @@ class CalibrationWorkflow:
         if job is None:
             raise WizardStateError("No TCP check is waiting: record the touch first.")
         return self.give_tcp_check(job, job.run())
+
+    # ------------------------------------------------------------ controller jobs (any wizard)
+    def controller_job(self) -> ControllerJob | None:
+        """What the wizard on show waits for the controller to do before it can finish (None:
+        nothing): a TCP check's six rotations (:meth:`tcp_check_job`) or a beam wizard's scan
+        (:meth:`beam_scan_job`). Taken on the loop; the app runs ``job.run()`` in a worker and
+        hands the outcome back with :meth:`give_controller_job`.
+
+        Raises:
+            WizardStateError: the job cannot be taken now (the message says what to do).
+        """
+        w = self.wizard
+        if isinstance(w, TcpCheckWizard):
+            return self.tcp_check_job()
+        if isinstance(w, BeamWizard):
+            return self.beam_scan_job()
+        return None
+
+    def give_controller_job(self, job: ControllerJob, outcome: Any) -> WizardResult | None:
+        """Hand a job's outcome to its wizard and finish it (None when the wizard was left
+        meanwhile: it keeps the outcome)."""
+        try:
+            return job.hand_in(outcome)
+        except CalibrationFailedError as exc:
+            raise self._in_words(exc) from exc
+
+    def run_controller_job(self, job: ControllerJob | None = None) -> WizardResult | None:
+        """Run the waiting controller job (``job``, default :meth:`controller_job`) here,
+        synchronously (scripts and tests; the app runs it in a worker), and finish the wizard.
+
+        Raises:
+            WizardStateError: no job is waiting, or the controller could not do it (in words).
+        """
+        job = self.controller_job() if job is None else job
+        if job is None:
+            raise WizardStateError("Nothing is waiting for the controller: record the step first.")
+        try:
+            outcome = job.run()
+        except ControllerError as exc:
+            raise WizardStateError(str(exc)) from exc
+        return self.give_controller_job(job, outcome)
+
+    # ------------------------------------------------------------ Automatic (beam) wizard
+    def beam_scan_job(self) -> BeamScanJob | None:
+        """The scan the beam wizard on show waits for (None: none waiting), from the robot's
+        joints now, on the session's beam sensor, planned with the mounted tool's nominal
+        (catalogue) data for a built-in tool, else with the active tool data; the beam sees
+        the physical tool (its true frame, bent by a scenario). The noise seed comes from the
+        workflow's ``rng`` (a seeded workflow scans reproducibly).
+
+        Raises:
+            WizardStateError: the beam cannot measure the mounted tool (the gripper), or no tool
+                data to plan with (a tool of no catalogue and no active tool data).
+        """
+        w = self.wizard
+        if not isinstance(w, BeamWizard) or not w.scan_pending:
+            return None
+        c = self.controller
+        mounted = c.mounted_tool
+        try:
+            shape = tool_shape(mounted)
+        except ControllerError as exc:
+            raise WizardStateError(f"{exc} Mount the pointer or the torch on the Tool tab.") from exc
+        catalogue = builtin_tools().get(mounted.key)
+        if catalogue is not None:
+            T_plan = np.array(catalogue.T_flange_tool_true, dtype=float)
+        elif c.active_tool is not None:
+            T_plan = np.array(c.active_tool.T_flange_tool_mm, dtype=float)
+            T_plan[:3, 3] /= 1000.0
+        else:
+            raise WizardStateError(f"The controller needs approximate tool data of the {mounted.label.lower()} "
+                                   "to plan the scan: calibrate it by hand or enter its data on the Tool tab, "
+                                   "make it active, then press Finish again.")
+        nominal = _own_copy(c.kinematics)
+        physical = nominal if c.true_kinematics is c.kinematics else _own_copy(c.true_kinematics)
+        try:
+            config = BeamScanConfig(n_orientations=w.n_orientations, scan_speed_mm_s=w.scan_speed_mm_s)
+        except ControllerError as exc:
+            raise WizardStateError(str(exc)) from exc
+        return BeamScanJob(w, nominal, physical, c.q_rad.copy(), c.beam_sensor, shape, T_plan, config,
+                           seed=int(self.rng.integers(2**31)), manual=self.manual_comparison())
+
+    def manual_comparison(self, index: int | None = None) -> ManualComparison | None:
+        """The trainee's last finished manual calibration of the same physical tool as run
+        ``index`` (default: the one on show) in this session, for the beam wizard's lesson: its
+        method, number, wall time from start to result, and in training mode (no exercise) its
+        errors against its own true tool. Manual: a method with steps done by hand (no step the
+        controller runs) that calibrates a TCP. None when there is none.
+        """
+        i = self._current if index is None else int(index)
+        if i is None or not 0 <= i < len(self.runs):
+            return None
+        key = self.runs[i].true_tool_key
+        if key is None:
+            return None
+        for j in range(len(self.runs) - 1, -1, -1):
+            run = self.runs[j]
+            w, res = run.wizard, run.wizard.finished_result
+            if (j == i or res is None or run.true_tool_key != key or res.tcp_result is None
+                    or not getattr(w, "saves_to_library", True)
+                    or any(r.auto.by_controller for r in type(w).step_roles)):
+                continue
+            seconds = wall_time_s(w.started_at, res.computed_at)
+            pos = ang = grade = None
+            if self.training and not self.hide_truth and run.T_flange_tool_true_m is not None:
+                cmp = compare_with_truth(res, run.T_flange_tool_true_m)
+                pos, ang, grade = cmp.position_error_mm, cmp.x_axis_error_deg, cmp.grade
+            return ManualComparison(w.title, w.kind, j + 1, 0.0 if seconds is None else seconds, pos, ang, grade)
+        return None
 
     # ------------------------------------------------------------ session record
     def export_record(self, touches: Any = ()) -> dict[str, Any]:

@@ -6,6 +6,9 @@ of N", what to do), **Record** (the step's, checked: ``pendant.record_check``), 
 meter (bar and one line), so a trainee jogs, watches and records on one screen; the Calibrate
 tab stays the place to choose a method and review the result. Outside a wizard the dock is
 hidden and the touch list's "Record point" records into the free list (one Record concept).
+A step the controller runs itself (``AutoRole.by_controller``: the beam wizard's scan) shows no
+Record; its Finish runs the wizard's controller job through ``CalibrationWorkflow.next`` on the
+loop (bounded: a beam scan of at most 5 orientations takes well under a second to compute).
 
 The dock renders from the session's workflow (``Session.workflow``: the Calibrate tab's
 ``CalibrationWorkflow``) on the change signal and calls only the workflow's public commands
@@ -154,7 +157,7 @@ class WizardDock:
         self.mount.visible = needed is not None
         if needed is not None:
             self.mount.label = f"Mount the {needed.label.lower()}"
-        self.record.visible = stepping
+        self.record.visible = stepping and not wiz.auto_role(wiz.step).by_controller   # a scan: no Record
         self.record.disabled = not wiz.can_record
         if stepping:
             options = (BACK, FINISH if wiz.on_last_step else NEXT, CANCEL)

@@ -3,7 +3,10 @@ instruction, the list of steps, Record / Back / Next (Finish) / Cancel, the tool
 asks for, the variant choice (the wizard class's ``variants``: three-point, ABC world), "Add
 point" (``supports_add_point``: 4-point) and the live pose-diversity meter (``meter_active``:
 the touch steps of 4-point and TCP & Z, X), and in training mode the Auto-touch controls. No
-wizard class is named here: what is shown is what the wizard declares.
+wizard class is named here: what is shown is what the wizard declares. A step the controller
+runs itself (its role's ``AutoRole.by_controller``: the beam wizard's scan) shows neither Record
+nor Auto-touch; its Finish runs the wizard's controller job (``CalibrationWorkflow.controller_job``)
+in a worker thread, as a TCP check's Finish runs its six rotations.
 
 Record is enabled only when the wizard can record (``Wizard.can_record``); Next only when the
 step is recorded. The pose-diversity meter is updated on every move of the robot (a motion
@@ -39,8 +42,9 @@ __all__ = ["ABC_VARIANTS", "RANDOM", "THREE_POINT_VARIANTS", "WizardStepsView"]
 THREE_POINT_VARIANTS = {label: value for value, label in ThreePointWizard.variants}
 ABC_VARIANTS = {label: value for value, label in AbcWorldWizard.variants}
 RANDOM, CHOSEN = "random", "chosen (tilt, azimuth)"
-_CHECK_WORKER = ThreadPoolExecutor(max_workers=1, thread_name_prefix="tcp-check-wizard")
-"""Runs a TCP check wizard's six rotations (0.1-0.3 s) off viser's event loop."""
+_CHECK_WORKER = ThreadPoolExecutor(max_workers=1, thread_name_prefix="wizard-controller-job")
+"""Runs a wizard's controller job off viser's event loop: a TCP check's six rotations (0.1-0.3
+s), a beam scan (3 to 5 orientations, well under a second)."""
 log = logging.getLogger(__name__)
 
 
@@ -84,6 +88,7 @@ class WizardStepsView:
         self.record.on_click(act(lambda _e: parent.workflow.record()))
         self.next.on_click(self._on_next)
         self._checking = False
+        self._busy_text = ""
         self.back.on_click(act(lambda _e: parent.workflow.back()))
         self.cancel.on_click(act(self._on_cancel))
         self.add_point.on_click(act(self._on_add_point))
@@ -103,36 +108,42 @@ class WizardStepsView:
                                        "Nothing recorded is lost: Resume it from the Calibrate menu.")
 
     async def _on_next(self, event: Any) -> None:
-        """Next / Finish. A TCP check wizard's Finish runs its check: the job is taken on the
-        loop (under the session lock), the six rotations run in ``_CHECK_WORKER``, the result is
-        handed to the wizard on the loop; one check at a time."""
+        """Next / Finish. A wizard waiting for its controller job (a TCP check's rotations, a
+        beam scan) runs it on Finish: the job is taken on the loop (under the session lock), run
+        in ``_CHECK_WORKER``, its outcome handed to the wizard on the loop; one job at a time."""
         wf, act = self.parent.workflow, self.parent.action
         jobs: list[Any] = []
 
         def take(_e: Any) -> None:
             if self._checking:
-                raise WizardStateError("The TCP check is running; wait for its result.")
-            job = wf.tcp_check_job()
+                raise WizardStateError("The controller is still at work; wait for its result.")
+            wiz = wf.wizard
+            job = wf.controller_job() if wiz is not None and wiz.on_last_step else None
             if job is None:
                 wf.next()
             else:
                 jobs.append(job)
-                self._checking = True                  # render shows "Checking" and disables Finish
+                self._busy_text = job.busy_text
+                self._checking = True                  # render shows the busy text and disables Finish
 
         await act(take)(event)
         if not jobs:
             return
+        title = jobs[0].wizard.title
         try:
             result = await asyncio.get_running_loop().run_in_executor(_CHECK_WORKER, jobs[0].run)
         except Exception as exc:  # a browser's click must never kill the server
-            log.exception("TCP check wizard failed")
             self._checking = False
-            self.parent.session.notify("TCP check failed", f"{type(exc).__name__}: {exc}", kind="error")
+            if isinstance(exc, ValueError):            # the controller's words (ControllerError)
+                self.parent.session.notify(f"{title}: not possible", str(exc), kind="error")
+            else:
+                log.exception("%s: controller job failed", title)
+                self.parent.session.notify(f"{title} failed", f"{type(exc).__name__}: {exc}", kind="error")
             await act(lambda _e: None)(event)          # re-render the step as it was
             return
         finally:
             self._checking = False
-        await act(lambda _e: wf.give_tcp_check(jobs[0], result))(event)
+        await act(lambda _e: wf.give_controller_job(jobs[0], result), sync=True)(event)
 
     def _on_add_point(self, _event: Any) -> None:
         wiz = self.parent.workflow.wizard
@@ -190,13 +201,12 @@ class WizardStepsView:
         self.folder.visible = wf.is_open
         if wiz is None or not wf.is_open:
             return
-        set_content(self.head_md, step_markdown(wiz) + (
-            "\n\n**Checking:** the controller turns the tool ±A, ±B, ±C about the TCP ..." if self._checking else ""))
+        set_content(self.head_md, step_markdown(wiz) + (f"\n\n{self._busy_text}" if self._checking else ""))
         self.progress.value = round(100.0 * wiz.progress, 1)
         set_content(self.steps_md, steps_list_markdown(wiz))
         self._render_variant(wiz)
         needed = wf.required_tool()
-        reason = wiz.blocked_reason if not wiz.is_complete else None
+        reason = wiz.blocked_reason if not wiz.is_complete and not wiz.auto_role(wiz.step).by_controller else None
         self.blocked_md.visible = reason is not None
         if reason is not None:
             set_content(self.blocked_md, f"⚠ {escape_markdown(reason)}")
@@ -204,7 +214,9 @@ class WizardStepsView:
         if needed is not None:
             self.mount.label = f"Mount the {needed.label.lower()}"
         stepping = not wiz.is_complete           # on the result only Back, Add point and Close remain
-        self.record.visible = self.next.visible = stepping
+        by_controller = stepping and wiz.auto_role(wiz.step).by_controller   # no Record, no Auto-touch
+        self.record.visible = stepping and not by_controller
+        self.next.visible = stepping
         self.record.disabled = not wiz.can_record
         self.next.disabled = not wiz.can_next or self._checking
         self.next.label = "Finish" if wiz.on_last_step else "Next"
@@ -212,7 +224,7 @@ class WizardStepsView:
         self.cancel.label = "Cancel" if stepping else ("Close" if wf.result_saved else "Close (resume later)")
         self.add_point.visible = wiz.supports_add_point
         self.add_point.disabled = not wiz.can_add_point
-        self.auto_folder.visible = wf.training and stepping
+        self.auto_folder.visible = wf.training and stepping and not by_controller
         chosen = self.auto_direction.value == CHOSEN
         self.auto_tilt.visible = self.auto_azimuth.visible = chosen
         self._render_auto_line()

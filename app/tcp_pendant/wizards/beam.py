@@ -514,11 +514,12 @@ class BeamWizard(Wizard):
             manual: the trainee's last manual calibration of the same tool, or None.
 
         Raises:
-            WizardStateError: the wizard is not in progress.
+            WizardStateError: the wizard is finished (a wizard cancelled half-way keeps the scan
+                and shows it when resumed and finished).
             WizardError: a malformed scan (names what).
         """
-        if self._status != "in_progress":
-            raise WizardStateError("The beam scan was handed in to a wizard that is not in progress.")
+        if self.finished_result is not None:
+            raise WizardStateError("The beam wizard is finished already; press Back to scan again.")
         recorded = RecordedScan.of(scan)
         R = _rotation(R_flange_tool_base, "planning tool orientation")
         if manual is not None and not isinstance(manual, ManualComparison):
@@ -545,6 +546,15 @@ class BeamWizard(Wizard):
         """Forget the scan (a new Finish runs another one)."""
         super().clear_step()
         self._scan = self._live_scan = None
+
+    def back(self) -> Any:
+        """From the result back to the scan step, forgetting the scan: Finish scans again (the
+        scan is the controller's, nothing the trainee recorded is lost)."""
+        was_complete = self._status == "complete"
+        step = super().back()
+        if was_complete:
+            self.clear_step()
+        return step
 
     # ----- result -------------------------------------------------------------------------
     def _compute(self, poses: list[np.ndarray]) -> WizardResult:
