@@ -226,6 +226,7 @@ class BeamScan:
             axis): the markers of the scene.
         sensor: the sensor the scan ran on.
         n_orientations_planned: orientations asked for.
+        config: the configuration the scan ran with.
     """
 
     events: tuple[BeamEvent, ...]
@@ -238,6 +239,25 @@ class BeamScan:
     beam_points_world_m: np.ndarray
     sensor: BeamSensor
     n_orientations_planned: int = 4
+    config: BeamScanConfig = field(default_factory=BeamScanConfig)
+
+    @property
+    def tip_sigma_m(self) -> float:
+        """Effective repeatability of a tip event across the beam, m.
+
+        A tip event's recorded pose has the sensor's ``sigma`` per axis; besides, the approach
+        is aimed along the line through the two (noisy) axis events, extrapolated from the
+        heights ``h1 < h2`` to the tip, so the tip misses the beam's centre by the aiming error
+        ``(1 + r) e1 - r e2`` (``r = h1 / (h2 - h1)``, ``e_i`` of ``sigma / sqrt(2)`` per axis),
+        and the reported tip is off the line by that miss. Both together::
+
+            sigma_tip = sigma sqrt(1 + ((1 + r)^2 + r^2) / 2)
+
+        (1.35 sigma for the default heights 8 and 40 mm): the sigma to give ``solve_beam``.
+        """
+        h1, h2 = sorted(self.config.pass_heights_mm)
+        r = h1 / (h2 - h1)
+        return self.sensor.sigma * math.sqrt(1.0 + ((1.0 + r) ** 2 + r * r) / 2.0)
 
     def tip_world_m(self, i: int) -> np.ndarray:
         """(3,) WORLD point (m) where event ``i`` broke the beam (a copy)."""
@@ -582,4 +602,4 @@ def run_beam_scan(kinematics: RobotKinematics, q_start_rad: np.ndarray, sensor: 
         events=tuple(P.events), orientation_index=tuple(P.orient), moves=tuple(P.moves),
         path_length_m=length, duration_s=duration, skipped=tuple(skipped),
         q_end_rad=read_only_array(P.q), beam_points_world_m=read_only_array(np.array(P.points)),
-        sensor=sensor, n_orientations_planned=n)
+        sensor=sensor, n_orientations_planned=n, config=c)

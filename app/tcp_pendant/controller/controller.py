@@ -122,6 +122,7 @@ class VirtualController:
             reference_tip_world_m = (p[0], p[1], 0.5 * p[2])
         self._tip = _check_point(reference_tip_world_m, "reference_tip_world_m")
         self._beam: BeamSensor | None = None  # None: default_beam_sensor(reference tip)
+        self._default_beam: tuple[np.ndarray, BeamSensor] | None = None  # (tip, its default sensor)
 
     # ----------------------------------------------------------------- state
     @property
@@ -222,8 +223,12 @@ class VirtualController:
     def beam_sensor(self) -> BeamSensor:
         """The beam sensor (issue 14): the one set with :meth:`set_beam_sensor`, else
         ``beam_scan.default_beam_sensor`` of the current reference tip (it follows the tip when
-        that is moved)."""
-        return default_beam_sensor(self._tip) if self._beam is None else self._beam
+        that is moved). The same object until it changes (views may compare by identity)."""
+        if self._beam is not None:
+            return self._beam
+        if self._default_beam is None or not np.array_equal(self._default_beam[0], self._tip):
+            self._default_beam = (self._tip.copy(), default_beam_sensor(self._tip))
+        return self._default_beam[1]
 
     @property
     def beam_sensor_is_default(self) -> bool:
