@@ -10,7 +10,9 @@ from tcp_pendant.calibrate.workflow import (
     WIZARD_KINDS,
     WIZARD_LABELS,
     AutoTouchRequest,
+    BeamScanJob,
     CalibrationWorkflow,
+    ControllerJob,
 )
 
 __all__ = [
@@ -18,7 +20,9 @@ __all__ = [
     "WIZARD_KINDS",
     "WIZARD_LABELS",
     "AutoTouchRequest",
+    "BeamScanJob",
     "CalibrationWorkflow",
+    "ControllerJob",
     "ErrorBars",
     "error_bars",
 ]
