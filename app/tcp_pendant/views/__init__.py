@@ -3,7 +3,8 @@
 
 :func:`build_session_views` lays a session out as three tabs, like a pendant's menu:
 **Jog** (the running wizard's step dock, readouts, touch indicator, jog keys, touches), **Tool** (mounted tool, active tool
-data, library, export, controller files, TCP check, numeric entry) and **Calibrate** (wizards,
+data, library, export, controller files, TCP check, numeric entry, then the TCP service with the beam
+sensor) and **Calibrate** (wizards,
 then the trainer's "Systematic error" panel).
 """
 
@@ -13,6 +14,7 @@ from collections.abc import Iterator
 
 from tcp_pendant.session import Session
 from tcp_pendant.text_escape import escape_markdown
+from tcp_pendant.views.beam_check import BeamCheckView
 from tcp_pendant.views.calibrate import build_calibrate_tab, register_calibrate_view
 from tcp_pendant.views.pendant_panel import PendantPanel
 from tcp_pendant.views.scenario_panel import ScenarioPanel
@@ -22,6 +24,7 @@ from tcp_pendant.views.touch_list import TouchListView
 from tcp_pendant.views.wizard_dock import WizardDock
 
 __all__ = [
+    "BeamCheckView",
     "PendantPanel",
     "ScenarioPanel",
     "SceneView",
@@ -69,6 +72,7 @@ def session_view_steps(session: Session, *, title: str = "TCP Pendant") -> Itera
         yield "jog"
         with tabs.add_tab("Tool"):
             session.views["tools"] = ToolPanel(session)
+            session.views["beam_check"] = BeamCheckView(session)   # TCP service with the beam sensor
         yield "tool"
         calibrate_tab = tabs.add_tab("Calibrate")
         build_calibrate_tab(session, calibrate_tab)

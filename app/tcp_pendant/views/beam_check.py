@@ -1,0 +1,184 @@
+"""The Tool tab's TCP service with the beam sensor (issue 14 item 4): "Check with beam" measures
+the ACTIVE tool's TCP now, "Update" writes the measured TCP into the library.
+
+The industrial loop after a crash: the tool is bent, "Check with beam" finds the deviation
+between the stored TCP and the tip the beam sees, "Update" stores the measured TCP (calibration
+method "beam", today's date) and makes it the active tool data, and the spin test ("TCP
+check" above) verifies it.
+
+Check: the job (``calibrate.beam_service.beam_check_job``: a snapshot of the robot model, the
+joints, the sensor, the active tool data and its slot, the physical tool) is taken on viser's
+event loop under the session lock; the scan (a few hundred milliseconds of geometry and two
+solves) runs in :data:`_BEAM_WORKER`; its result is shown on the loop and the scan is replayed
+in the scene (``views.beam_replay``), the robot going back to where it was. One check at a
+time per session. Update: ``beam_service.update_tool_from_beam`` (it refuses when the slot
+changed since the check), then ``Session.apply_saved`` (the library re-read, the updated tool
+the active data); refused when the active tool is no longer the one checked. Tool names reach
+the markdown escaped (``beam_check_markdown`` escapes its own), notifications as plain text.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import logging
+from concurrent.futures import ThreadPoolExecutor
+from typing import Any
+
+from tcp_pendant.calibrate.beam_service import (
+    BeamCheck,
+    beam_check_job,
+    beam_check_markdown,
+    update_tool_from_beam,
+)
+from tcp_pendant.session import Session, SessionChange
+from tcp_pendant.text_escape import escape_markdown
+from tcp_pendant.views.beam_replay import ScanPlayer
+from tcpcal.tool import Tool
+
+__all__ = ["BeamCheckView", "update_markdown"]
+
+log = logging.getLogger(__name__)
+
+_BEAM_WORKER = ThreadPoolExecutor(max_workers=1, thread_name_prefix="tcp-beam")
+"""Runs the beam scans of the TCP service off viser's event loop (one at a time)."""
+
+INTRO = ("The robot moves the ACTIVE tool through the beam sensor by itself and measures its TCP. "
+         "After a crash: **Check with beam**, then **Update** stores the measured TCP.")
+
+
+def _fmt3(v: Any) -> str:
+    return ", ".join(f"{0.0 if abs(float(x)) < 5e-4 else float(x):.3f}" for x in v)
+
+
+def update_markdown(slot: int, before: Tool, after: Tool) -> str:
+    """What Update did (tool name escaped)."""
+    return (f"✔ **Updated slot {slot}: {escape_markdown(after.name)}**: TCP ({_fmt3(after.tcp_mm)}) mm "
+            f"(was ({_fmt3(before.tcp_mm)}) mm), calibration method "
+            f"{escape_markdown(after.calibration.method if after.calibration else 'beam')}. It is the active "
+            "tool data now; verify it with the TCP check (spin test) above.")
+
+
+class BeamCheckView:
+    """The "TCP service (beam sensor)" folder of the Tool tab (see the module docstring)."""
+
+    def __init__(self, session: Session) -> None:
+        self.session = session
+        gui = session.target.gui
+        with gui.add_folder("TCP service (beam sensor)"):
+            self.intro_md = gui.add_markdown(INTRO)
+            self.check = gui.add_button("Check with beam", color="blue",
+                                        hint="Measure the active tool's TCP with the beam sensor now.")
+            self.update = gui.add_button("Update", color="green", disabled=True,
+                                         hint="Write the measured TCP into the library slot of the active tool.")
+            self.replay = gui.add_button("Replay scan", disabled=True,
+                                         hint="Show the last check's scan again in the 3D view.")
+            self.result_md = gui.add_markdown("")
+        self._checking = False
+        self.last_check: BeamCheck | None = None
+        """The last check's result (None before one, and after its Update)."""
+        self._q_before: Any = None
+        self.check.on_click(self._on_check)
+        g = session.on_loop
+        self.update.on_click(g(self._on_update))
+        self.replay.on_click(g(self._on_replay))
+        session.subscribe(self.on_change)
+
+    def on_change(self, change: SessionChange) -> None:
+        """The change signal: Update is offered only while the active tool is the one checked."""
+        if change.tool or change.library:
+            self._render_buttons()
+
+    def _still_checked(self) -> bool:
+        chk = self.last_check
+        s = self.session
+        tool = s.controller.active_tool
+        return chk is not None and tool is not None and s.active_slot == chk.slot and tool == chk.stored_tool
+
+    def _render_buttons(self) -> None:
+        self.check.disabled = self._checking
+        self.update.disabled = self._checking or not self._still_checked() or self.last_check.slot is None  # type: ignore[union-attr]
+        self.replay.disabled = self._checking or self.last_check is None
+
+    # ------------------------------------------------------------ Check with beam
+    async def _on_check(self, _event: Any) -> None:
+        await self.run_check()
+
+    async def run_check(self) -> None:
+        """The check of the active tool: job on the loop, scan in the worker, result on the loop."""
+        s = self.session
+        if s.closed:
+            return
+        if self._checking:
+            s.notify("Check running", "A beam check is still running here; wait for its result.", kind="info")
+            return
+        try:
+            with s.lock:
+                tool = s.controller.active_tool
+                if tool is None:
+                    raise ValueError("No tool data is active (TCP = flange): activate the tool to check in the "
+                                     "Tool library first.")
+                job = beam_check_job(s.controller, s.active_slot, tool)
+                self._q_before = s.controller.q_rad
+                self._checking = True
+                self.result_md.content = f"Scanning **{escape_markdown(tool.name)}** with the beam sensor ..."
+                self._render_buttons()
+        except ValueError as exc:          # ControllerError and tcpcal's errors are ValueErrors
+            s.notify("Not done", str(exc), kind="warning")
+            return
+        try:
+            check = await asyncio.get_running_loop().run_in_executor(_BEAM_WORKER, job.run)
+        except ValueError as exc:          # nothing could be scanned: plain words from the controller
+            self._failed("Beam check not done", str(exc), kind="warning")
+            return
+        except Exception as exc:           # a browser's click must never kill the server
+            log.exception("beam check failed")
+            self._failed("Beam check failed", f"{type(exc).__name__}: {exc}", kind="error")
+            return
+        with s.lock:
+            self._checking = False
+            if s.closed:
+                return
+            self.last_check = check
+            self.result_md.content = beam_check_markdown(check)
+            self._render_buttons()
+            ScanPlayer.of(s).play(check.scan, owner=self, return_to=self._q_before)
+        s.notify("Beam check done", f"{check.tool_name}: deviation {check.deviation_norm_mm:.3f} mm", kind="info")
+
+    def _failed(self, title: str, body: str, *, kind: str) -> None:
+        s = self.session
+        with s.lock:
+            self._checking = False
+            if s.closed:
+                return
+            self.result_md.content = f"⚠ {escape_markdown(body)}"
+            self._render_buttons()
+        s.notify(title, body, kind=kind)
+
+    # ------------------------------------------------------------ Update
+    def _on_update(self, _event: Any) -> None:
+        s = self.session
+        check = self.last_check
+        if check is None:
+            raise ValueError("Check with beam first: Update writes the TCP the check measured.")
+        if check.slot is None:
+            raise ValueError("The checked tool data is not in the library (typed in or an unsaved result): "
+                             "save it to a slot first, then check again.")
+        if not self._still_checked():
+            raise ValueError("The active tool changed since the check; check the active tool again before "
+                             "Update.")
+        before = check.stored_tool
+        tool = update_tool_from_beam(s.library, check.slot, check)
+        ScanPlayer.of(s).stop()
+        self.last_check = None
+        s.apply_saved(check.slot, tool)                    # one signal: library re-read, active data
+        self.result_md.content = beam_check_markdown(check) + "\n\n" + update_markdown(check.slot, before, tool)
+        self._render_buttons()
+        s.notify("TCP updated", f"Slot {check.slot}: {tool.name} now has the TCP the beam measured.",
+                 kind="success")
+
+    def _on_replay(self, _event: Any) -> None:
+        check = self.last_check
+        player = ScanPlayer.of(self.session)
+        if check is None:
+            raise ValueError("No beam check to replay: press Check with beam first.")
+        player.play(check.scan, owner=self, return_to=self._q_before)

@@ -1,0 +1,124 @@
+"""Issue 14 item 4 in the Tool tab: the TCP service with the beam sensor ("Check with beam",
+"Update", ``views.beam_check``). The industrial loop: a tool bent in a crash (the scenario of
+issue 10) -> Check with beam finds the bend -> Update writes the measured TCP into the library
+(method "beam") and makes it the active data -> the spin test says good. In-process server,
+headless websocket client as the browser (``guiclick``)."""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Callable, Iterator
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+HERE = Path(__file__).parent
+sys.path.insert(0, str(HERE))
+sys.path.insert(0, str(HERE.parent / "calibrate"))
+from app_page import AppPage, app_pages  # noqa: E402
+from wsclient import wait_until  # noqa: E402
+
+from tcp_pendant.controller import builtin_tools  # noqa: E402
+from tcp_pendant.text_escape import escape_markdown  # noqa: E402
+from tcp_pendant.views.beam_replay import ScanPlayer  # noqa: E402
+from tcpcal.tool import Tool  # noqa: E402
+
+
+def truth_tool(key: str, name: str, offset_mm=(0.0, 0.0, 0.0)) -> Tool:
+    T = builtin_tools()[key].T_flange_tool_true
+    return Tool.from_rotation(name, tuple(T[:3, 3] * 1000.0 + np.asarray(offset_mm)), T[:3, :3])
+
+
+class Page(AppPage):
+    def __init__(self, app) -> None:
+        super().__init__(app)
+        self.tools = self.session.views["tools"]
+        self.beam = self.session.views["beam_check"]
+        ScanPlayer.of(self.session).rate_hz = 400.0                  # the film, fast
+
+    def activate(self, slot: int) -> None:
+        opt = next(o for o in self.tools.slots.options if o.startswith(f"{slot}:") or o.startswith(f"{slot} "))
+        self.choose(self.tools.slots, opt)
+        self.click(self.tools.activate)
+
+    def film_done(self) -> None:
+        wait_until(lambda: not ScanPlayer.of(self.session).playing, timeout=60, what="the scan's film")
+
+
+@pytest.fixture
+def page(tmp_path: Path) -> Iterator[Callable[..., Page]]:
+    with app_pages(tmp_path, Page) as make:
+        yield make
+
+
+def test_check_with_beam_needs_an_active_tool(page) -> None:
+    p = page()
+    p.click(p.beam.check)
+    assert p.notes and "No tool data is active" in p.notes[-1][1]
+    assert p.beam.last_check is None and p.beam.update.disabled
+
+
+def test_the_industrial_loop_crash_check_update_verify(page) -> None:
+    p = page({1: truth_tool("pointer", "Pointer")})
+    s, c = p.session, p.session.controller
+    p.activate(1)
+    q_before = c.q_rad
+    world = s.set_scenario("bent_tool", 6)                          # the crash: the tool is bent
+    bent_tip_mm = c.mounted_tool.T_flange_tool_true[:3, 3] * 1000.0
+    stored_mm = np.asarray(s.library.get(1).tcp_mm)
+    assert p.beam.update.disabled                                   # nothing measured yet
+
+    p.click(p.beam.check)                                           # Check with beam
+    check = p.beam.last_check
+    assert check is not None and check.slot == 1 and check.tool_name == "Pointer"
+    np.testing.assert_allclose(check.stored_tcp_mm, stored_mm, atol=1e-9)
+    np.testing.assert_allclose(check.measured_tcp_mm, bent_tip_mm, atol=0.05)    # the beam sees the bent tip
+    assert check.deviation_norm_mm == pytest.approx(world.tool_bend.shift_mm, abs=0.05)
+    md = p.beam.result_md.content
+    assert "Pointer" in md and f"{check.deviation_norm_mm:.2f}" in md
+    assert not p.beam.update.disabled and not p.beam.replay.disabled
+    assert ScanPlayer.of(s).scan is check.scan                      # the scan plays in the scene
+    p.film_done()
+    np.testing.assert_allclose(c.q_rad, q_before, atol=1e-12)       # and the robot is back where it was
+
+    p.click(p.beam.update)                                          # Update
+    stored = s.library.get(1)
+    np.testing.assert_allclose(stored.tcp_mm, check.measured_tcp_mm, atol=1e-6)
+    assert stored.calibration is not None and stored.calibration.method == "beam"
+    assert c.active_tool == stored and s.active_slot == 1           # the updated data is active
+    assert p.notes[-1][0] == "TCP updated"
+    assert "Updated slot 1: Pointer" in p.beam.result_md.content
+    assert p.beam.update.disabled                                   # one check, one update
+
+    p.click(p.tools.check_active)                                   # verify: the spin test
+    _, spin = p.tools.last_check
+    assert spin.implied_tcp_error_mm < 0.1
+    assert "TCP good" in p.tools.check_md.content
+
+
+def test_update_is_refused_when_the_active_tool_changed_since_the_check(page) -> None:
+    p = page({1: truth_tool("pointer", "Pointer"), 2: truth_tool("pointer", "Other", (0.0, 0.0, 2.0))})
+    p.activate(1)
+    p.click(p.beam.check)
+    p.film_done()
+    assert not p.beam.update.disabled
+    p.activate(2)
+    assert p.beam.update.disabled                                   # the button says so at once
+    before = p.session.library.tools()
+    p.click(p.beam.update)                                          # a click that arrives anyway
+    assert "active tool changed since the check" in p.notes[-1][1]
+    assert p.session.library.tools() == before                      # nothing written
+
+
+def test_a_hostile_tool_name_is_escaped(page) -> None:
+    hostile = "<img src=x>**b**[a](j:x)"
+    p = page({1: truth_tool("pointer", hostile)})
+    p.activate(1)
+    p.click(p.beam.check)
+    p.film_done()
+    md = p.beam.result_md.content
+    assert escape_markdown(hostile) in md and "<img" not in md
+    p.click(p.beam.update)
+    md = p.beam.result_md.content
+    assert "<img" not in md and escape_markdown(hostile) in md
