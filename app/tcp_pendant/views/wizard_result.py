@@ -168,7 +168,8 @@ class WizardResultView:
             self._named_run = wf.run
             self.save_name.value = wf.default_save_name()
             set_content(self.save_md, "")
-        set_content(self.result_md, result_markdown(res))
+        truth = None if wf.hide_truth else wf.truth()   # an exercise: no answer shown
+        set_content(self.result_md, result_markdown(res, truth))   # a beam result: errors of both vs truth
         self.replay_scan.visible = getattr(res, "scan", None) is not None
         set_content(self.warnings_md, warnings_markdown(res))
         run = wf.run
@@ -176,7 +177,6 @@ class WizardResultView:
         self.hidden_md.visible = bool(hidden)
         if hidden:
             set_content(self.hidden_md, hidden)
-        truth = None if wf.hide_truth else wf.truth()   # an exercise: no answer shown
         self.truth_md.visible = truth is not None
         if truth is not None:
             set_content(self.truth_md, truth_markdown(truth))

@@ -1,0 +1,115 @@
+"""Issue 14 item 3 in the scene and the result panel: the "Automatic (beam)" wizard's result is
+replayed on the robot (the film of its scan, the robot left at the scan's end, a marker per event
+on the beam), the camera frames the sensor, "Replay scan" plays it again, another calibration
+clears it, and the result text sets automatic against by hand with the errors of both against the
+truth (training) or without them (an exercise). In-process server, headless websocket client."""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Callable, Iterator
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+HERE = Path(__file__).parent
+sys.path.insert(0, str(HERE))
+sys.path.insert(0, str(HERE.parent / "calibrate"))
+from app_page import AppPage, app_pages  # noqa: E402
+from wsclient import wait_until  # noqa: E402
+
+from tcp_pendant.views.beam_replay import ScanPlayer  # noqa: E402
+
+
+class Page(AppPage):
+    def __init__(self, app) -> None:
+        super().__init__(app)
+        self.view = self.session.views["calibrate"]
+        self.player = ScanPlayer.of(self.session)
+        self.player.rate_hz = 400.0
+
+    def xyz4_by_hand(self) -> None:
+        v = self.view
+        self.choose(v.method, "XYZ 4-point")
+        self.click(v.start)
+        for _ in range(4):
+            self.click(v.steps.auto_touch)
+        assert v.workflow.result is not None
+
+    def beam(self) -> None:
+        v = self.view
+        self.choose(v.method, "Automatic (beam)")
+        self.click(v.start)
+        self.click(v.steps.next)                                 # Finish runs the scan in a worker
+        wait_until(lambda: v.result.folder.visible and v.workflow.result is not None
+                   and hasattr(v.workflow.result, "scan"), timeout=60, what="the beam result")
+
+    def film_done(self) -> None:
+        wait_until(lambda: not self.player.playing, timeout=60, what="the scan's film")
+
+
+@pytest.fixture
+def page(tmp_path: Path) -> Iterator[Callable[..., Page]]:
+    with app_pages(tmp_path, Page, seed=3) as make:
+        yield make
+
+
+def _in_view(framing, point: np.ndarray) -> bool:
+    forward = framing.look_at - framing.position
+    v = np.asarray(point, dtype=float) - framing.position
+    angle = np.arccos(float(v @ forward) / (np.linalg.norm(v) * np.linalg.norm(forward)))
+    return bool(angle < framing.fov_rad / 2.0)
+
+
+def test_the_beam_result_is_replayed_framed_and_compared_with_the_manual_one(page) -> None:
+    p = page()
+    s, c, v = p.session, p.session.controller, p.view
+    p.xyz4_by_hand()
+    p.beam()
+    res = v.workflow.result
+    scan = res.scan
+    assert p.player.scan is scan and p.player.owner is v.scene        # the wizard's film
+    p.film_done()
+    assert p.player.frames_played == len(p.player.frames) > len(scan.moves)
+    np.testing.assert_allclose(c.q_rad, scan.q_end_rad, atol=1e-12)    # the robot stays at the scan's end
+    markers = np.asarray(p.player._markers.points, dtype=float)
+    assert len(markers) == len(scan.events)
+    for m, ev, truth_point in zip(markers, scan.events, scan.beam_points_world_m):
+        d = m - ev.beam_point
+        assert np.linalg.norm(d - (d @ ev.beam_dir) * ev.beam_dir) < 1e-6   # on the beam line
+        assert np.linalg.norm(m - truth_point) < 1e-3                      # where the tool met it
+    assert v.scene.computed.visible                                   # the TOOL triad of the result
+    assert _in_view(v.scene.last_framing, c.beam_sensor.point)         # the camera sees the sensor
+    assert all(_in_view(v.scene.last_framing, m) for m in markers)
+    # the result: events, real-robot time next to the manual time, the errors of both vs truth
+    text = v.result.result_md.content
+    assert f"**Events** ({len(scan.events)})" in text
+    assert "on a real robot" in text and "(your time)" in text
+    assert "| calibration | time | TCP error | direction error |" in text
+    assert v.result.replay_scan.visible
+
+    # Replay scan: the film again from the first move, ending at the scan's end
+    with s.lock:
+        c.set_q(scan.moves[0].q_start_rad)
+        s.moved()
+    p.click(v.result.replay_scan)
+    assert p.player.scan is scan
+    p.film_done()
+    np.testing.assert_allclose(c.q_rad, scan.q_end_rad, atol=1e-12)
+
+    # another calibration: the wizard's markers go
+    p.click(v.steps.cancel)
+    p.choose(v.method, "XYZ 4-point")
+    p.click(v.start)
+    assert p.player.scan is None and p.player._markers is None
+
+
+def test_in_an_exercise_the_comparison_shows_no_errors(page) -> None:
+    p = page()
+    p.view.workflow.hide_truth = True                                 # the classroom's exercise
+    p.xyz4_by_hand()
+    p.beam()
+    text = p.view.result.result_md.content
+    assert "(your time)" in text and "TCP error" not in text
+    assert not p.view.result.truth_md.visible
