@@ -380,3 +380,24 @@ def test_tip_sigma_makes_the_95_percent_radius_hold():
         inside_bare += err <= solve_beam(rot[ti], pos[ti], b[ti], u[ti], sigma=0.02).ci95_radius
     assert 0.90 <= inside / n <= 0.99, inside / n
     assert inside_bare / n < 0.85, inside_bare / n
+
+
+@pytest.mark.parametrize("robot", ROBOTS)
+def test_crossed_beams_give_axis_events_of_both_and_the_exact_tcp(robot):
+    q0, tip = ready(robot)
+    model = builtin_tools()["torch"]
+    T_true = model.T_flange_tool_true
+    single = default_beam_sensor(tip)
+    crossed = BeamSensor(single.point, single.direction, second_direction=np.array([0.0, 1.0, 0.0]))
+    scan = run_beam_scan(kinematics(robot), q0, crossed, believed_off(T_true), tool_shape(model))
+    assert scan.skipped == ()
+    beams = [scan.events[i].beam for i in scan.axis_indices]
+    assert beams.count(0) == 8 and beams.count(1) == 8  # each pass crosses both beams
+    # the passes run at 45 deg to both beams: W / sin 45
+    W = (0.012 + 0.00025 + 0.015) / math.sqrt(0.5)
+    assert [mv.length_m for mv in scan.moves if mv.kind == "pass"] == pytest.approx([2 * W] * 8)
+    tcp, d = solve(scan)
+    assert np.linalg.norm(tcp - T_true[:3, 3] * 1000.0) < 1e-6
+    assert angle_between_deg(d, T_true[:3, 0]) < 1e-6
+    for i in scan.tip_indices:  # the tip meets the crossing point
+        assert np.linalg.norm(scan.tip_world_m(i) - crossed.point) < 1e-9

@@ -22,11 +22,15 @@ and the tool direction):
   best conditioned tool direction). The alternating tilt about ``u`` changes neither ``w`` nor
   the planes (section 9: a turn about the beam adds nothing); it spreads the arm's wrist
   configurations, so an absolute-accuracy error of one configuration does not repeat in all.
+  An orientation with a pose out of reach at its tilt is tried at the opposite tilt and at 0.
 * Two **sideways passes** (``pass``) across the beam, horizontally along ``a = unit(Z x u)``,
   from ``-W`` to ``+W`` and back, with the (believed) tool axis crossing the beam
   ``pass_heights_mm`` behind the believed tip: two **axis events** (``crossing_events``, entry
   and exit averaged). ``W = radius + width / 2 + pass_margin_mm``: a pass clears the shaft
-  however wrong the believed tool data is within the margin.
+  however wrong the believed tool data is within the margin. Two crossed beams: the passes run
+  along the horizontal bisector that crosses both at the largest angle (45 deg for beams at
+  right angles; ``W`` divided by that angle's sine) and record the axis events of both beams;
+  the approach aims at the crossing point.
 * At both axis events the PHYSICAL tool axis met the beam line, at the same flange orientation
   and the same position along ``u``. The flange positions at which the axis meets the beam form
   a straight line (in the plane across the beam, the flange offset is linear in the height of
@@ -42,9 +46,13 @@ and the tool direction):
 
 Each motion is a :class:`ScanMove` with its joint values at start and end (inverse kinematics
 on the MODEL, ``approach.solve_ik``, seeded from the previous pose so the arm keeps its
-configuration); an orientation with an unreachable pose, a joint jump of more than
+configuration); an orientation with an unreachable pose, a main axis swinging by more than
+``MAX_ARM_SWING_DEG`` (another arm configuration), a joint jump of more than
 ``MAX_JOINT_STEP_DEG`` within one straight motion, or a pass / approach that sees no event is
-skipped, with the reason in plain words in :attr:`BeamScan.skipped`.
+skipped, with the reason in plain words in :attr:`BeamScan.skipped`; its moves and events are
+dropped and the next orientation starts where the last complete one ended. Collisions of the
+moves between the steps with the device are not checked: they keep ``W`` sideways or
+``clearance_mm`` above the beam.
 
 **Absolute accuracy** (``true_kinematics`` differs): a local linearisation. During one straight
 motion from joint values ``q0``, the physical flange follows the model's straight motion moved
@@ -326,6 +334,58 @@ def default_beam_sensor(reference_tip_world_m: np.ndarray) -> BeamSensor:
     return BeamSensor(tip + DEFAULT_BEAM_OFFSET_M, np.array([1.0, 0.0, 0.0]))
 
 
+def _pass_direction(sensor: BeamSensor) -> tuple[np.ndarray, float]:
+    """The horizontal direction of the sideways passes and the least sine of its angle with a
+    beam: across the beam (``unit(Z x u)``); for crossed beams the horizontal bisector that
+    crosses both at the largest angle (45 deg for beams at right angles)."""
+    up = np.array([0.0, 0.0, 1.0])
+    flat = []
+    for _, u_k in sensor.beams:
+        h = u_k - (u_k @ up) * up
+        flat.append(h / np.linalg.norm(h))
+    if len(flat) == 1:
+        candidates = [np.cross(up, flat[0])]
+    else:
+        candidates = [flat[0] + flat[1], flat[0] - flat[1], np.cross(up, flat[0])]
+    best, best_sin = candidates[0], -1.0
+    for cand in candidates:
+        n = float(np.linalg.norm(cand))
+        if n < 1e-9:
+            continue
+        cand = cand / n
+        sin_min = min(float(np.linalg.norm(np.cross(cand, u_k))) for _, u_k in sensor.beams)
+        if sin_min > best_sin + 1e-12:
+            best, best_sin = cand, sin_min
+    return best, best_sin
+
+
+def _aim_at_crossing(f1: np.ndarray, f2: np.ndarray, e1: np.ndarray, e2: np.ndarray,
+                     sensor: BeamSensor, f_start: np.ndarray, m: np.ndarray
+                     ) -> tuple[np.ndarray, np.ndarray]:
+    """Crossed beams: the approach line on which the tool axis goes through both beams.
+
+    At one orientation the flange positions at which the tool axis meets beam k fill a plane
+    (spanned by the beam direction ``u_k`` and the tool axis); the two axis events of beam k lie
+    in it. The two planes meet in the line of flange positions that keep the axis through the
+    crossing point. Returns the approach start projected onto that line and its direction
+    (the beam-0 line's start and direction when the planes are nearly parallel).
+    """
+    (_, u0), (_, u1) = sensor.beams
+    n0 = np.cross(u0, f2 - f1)
+    n1 = np.cross(u1, e2 - e1)
+    if min(float(np.linalg.norm(n0)), float(np.linalg.norm(n1))) < 1e-9:
+        return f_start, m
+    n0, n1 = n0 / np.linalg.norm(n0), n1 / np.linalg.norm(n1)
+    d = np.cross(n0, n1)
+    if float(np.linalg.norm(d)) < 0.1:
+        return f_start, m
+    d /= np.linalg.norm(d)
+    if float(d @ m) < 0.0:
+        d = -d
+    p = np.linalg.solve(np.array([n0, n1, d]), np.array([n0 @ f1, n1 @ e1, d @ f_start]))
+    return p, d
+
+
 def _rot(axis: np.ndarray, angle: float) -> np.ndarray:
     """Rotation matrix about a unit axis (Rodrigues)."""
     k = axis / np.linalg.norm(axis)
@@ -457,6 +517,7 @@ def _scan_orientation(P: _Planner, k: int, spin: float, tilt: float,
     T_p1 = flange(b + h1 * x_w - W * a)
     P.move_to(T_p1, k, "The start of the first pass")
     f_axis: list[np.ndarray] = []
+    f_second: list[np.ndarray] = []  # the second beam's axis events (crossed beams)
     for j, (h, sgn) in enumerate(((h1, 1.0), (h2, -1.0))):
         if j == 1:
             P.move_to(flange(b + h * x_w + W * a), k, "The start of the second pass")
@@ -472,13 +533,15 @@ def _scan_orientation(P: _Planner, k: int, spin: float, tilt: float,
             raise _Skip(f"the {'first' if j == 0 else 'second'} pass did not "
                         f"cross the beam cleanly ({exc})") from None
         mine = [ev for ev in found if ev.beam == 0]
+        found = [ev for ev in found if ev.on_shaft]  # a crossing beyond the shaft is no axis event
         if not mine or not mine[0].on_shaft:
             raise _Skip(f"the {'first' if j == 0 else 'second'} pass "
                         + ("did not break the beam: the tool data is too far off for a "
                            "pass margin of " f"{c.pass_margin_mm:g} mm" if not mine else
                            "crossed the beam beyond the tool's shaft"))
         idx = tuple(P.record(ev, T0, m, k) for ev in found)
-        f_axis.append(P.events[idx[[ev.beam for ev in found].index(0)]].T_world_flange[:3, 3].copy())
+        for i in idx:
+            (f_axis if P.events[i].beam == 0 else f_second).append(P.events[i].T_world_flange[:3, 3].copy())
         P.add_move("pass", T_end, q_end, k, length=2.0 * W, events=idx)
     # the line of flange positions that keeps the tool axis on the beam:
     # f(h) = f1 + (h - h1) / (h2 - h1) (f2 - f1)
@@ -486,11 +549,13 @@ def _scan_orientation(P: _Planner, k: int, spin: float, tilt: float,
     g = (f2 - f1) / (h2 - h1)  # flange motion per unit of forward travel
     glen = float(np.linalg.norm(g))
     if glen < 0.5:
-        raise _Skip(f"the passes put the tool axis along the beam")
+        raise _Skip("the passes put the tool axis along the beam")
     m = g / glen
+    f_start = f1 + (-clear - h1) * g
+    if len(f_second) == 2:
+        f_start, m = _aim_at_crossing(f1, f2, f_second[0], f_second[1], sensor, f_start, m)
     # retract beside the beam, then over to the approach start
     P.move_to(flange(b - W * a - clear * x_w), k, "The retract after the passes")
-    f_start = f1 + (-clear - h1) * g
     T_start = P.T.copy()
     T_start[:3, 3] = f_start
     T_start[:3, :3] = R_tool @ T_ft_inv[:3, :3]
@@ -553,13 +618,14 @@ def run_beam_scan(kinematics: RobotKinematics, q_start_rad: np.ndarray, sensor: 
 
     b, u = np.array(sensor.point), np.array(sensor.direction)
     up = np.array([0.0, 0.0, 1.0])
-    a = np.cross(up, u)
-    if float(np.linalg.norm(a)) < 0.5:
-        raise ControllerError("The beam must be roughly horizontal for the scan (it is within 30 "
-                              "deg of vertical); set the beam sensor's direction across WORLD Z.")
-    a /= np.linalg.norm(a)
+    for k_beam, (_, u_k) in enumerate(sensor.beams):
+        if float(np.linalg.norm(np.cross(up, u_k))) < 0.5:
+            raise ControllerError(f"Beam {k_beam} must be roughly horizontal for the scan (it is within "
+                                  "30 deg of vertical); set the beam sensor's direction across WORLD Z.")
+    a, sin_min = _pass_direction(sensor)
     c = config
-    W = shape.radius + sensor.width / 2.0 + c.pass_margin_mm / 1000.0
+    # half a pass: the shaft's radius, half the beam and the margin, measured across every beam
+    W = (shape.radius + sensor.width / 2.0 + c.pass_margin_mm / 1000.0) / sin_min
     h1, h2 = (v / 1000.0 for v in c.pass_heights_mm)
     clear = c.clearance_mm / 1000.0
     # tool X down, tool Y along the beam, tool Z = X x Y
