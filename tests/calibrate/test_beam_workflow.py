@@ -257,6 +257,7 @@ def test_bad_start_options_are_refused(workflow) -> None:
 def test_steps_view_runs_the_scan_in_its_worker(page) -> None:
     """In-process pendant, websocket client: the beam step shows no Record and no Auto-touch,
     Finish runs the scan off the loop and the result panel shows the events and the lesson."""
+    from tcp_pendant.views.wizard_dock import BACK, CANCEL, FINISH
     from wsclient import wait_until
 
     p = page()
@@ -267,12 +268,18 @@ def test_steps_view_runs_the_scan_in_its_worker(page) -> None:
     assert steps.folder.visible and "Beam scan" in steps.head_md.content
     assert not steps.record.visible and not steps.auto_folder.visible and not steps.blocked_md.visible
     assert steps.next.label == "Finish" and not steps.next.disabled
-    dock = p.session.views.get("wizard_dock")
-    if dock is not None:
-        assert not dock.record.visible
+    dock = p.session.views["dock"]                        # the Jog tab's dock: no Record either
+    assert dock.folder.visible and not dock.record.visible and tuple(dock.nav.options) == (BACK, FINISH, CANCEL)
     p.click(steps.next)
     wait_until(lambda: v.result.folder.visible, what="the beam result")
     text = v.result.result_md.content
     assert "**Events** (12)" in text and "on a real robot" in text and "Automatic vs by hand" in text
-    assert isinstance(v.workflow.result, BeamWizardResult)
+    first = v.workflow.result
+    assert isinstance(first, BeamWizardResult)
     assert "Against the true TOOL frame: good" in v.result.truth_md.content
+    # the dock: Back forgets the scan, Finish scans again (on the loop, through the workflow)
+    p.choose(dock.nav, BACK)
+    assert v.workflow.wizard.scan_pending and not dock.record.visible
+    p.choose(dock.nav, FINISH)
+    wait_until(lambda: isinstance(v.workflow.result, BeamWizardResult), what="the second scan's result")
+    assert v.workflow.result is not first and not p.notes
