@@ -121,6 +121,7 @@ def test_registered_and_described() -> None:
 def test_no_record_no_finish_without_a_scan() -> None:
     wiz = BeamWizard(n_orientations=3)
     assert wiz.n_steps == 1 and wiz.scan_pending and wiz.can_next and not wiz.can_record
+    assert wiz.progress == 0.0 and not wiz.step.recorded
     assert "3 tool orientations" in wiz.step.instruction
     with pytest.raises(WizardStateError, match="controller runs this step itself"):
         wiz.record(np.eye(4))
@@ -130,6 +131,16 @@ def test_no_record_no_finish_without_a_scan() -> None:
         wiz.finish()
     with pytest.raises(WizardStateError, match="Finish the wizard"):
         wiz.to_tool("x")
+
+
+def test_the_scan_is_no_recorded_touch() -> None:
+    """The classroom counts recorded poses as touches: a scan records none, the step is done."""
+    wiz = BeamWizard()
+    wiz.give_scan(make_scan(POINTER), R_flange_tool_base=POINTER[:3, :3])
+    assert wiz.recorded_poses == {} and wiz.step.recorded and wiz.progress == 0.5
+    assert isinstance(wiz.next(), BeamWizardResult)
+    assert wiz.recorded_poses == {} and wiz.progress == 1.0 and wiz.is_complete
+    assert wiz.to_dict()["poses"] == {}
 
 
 @pytest.mark.parametrize("bad", [{"n_orientations": 2}, {"n_orientations": 3.5}, {"scan_speed_mm_s": 0},

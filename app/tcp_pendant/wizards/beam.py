@@ -32,7 +32,7 @@ from __future__ import annotations
 import datetime as _dt
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, ClassVar, Literal
 
 import numpy as np
@@ -45,8 +45,8 @@ from tcpcal.tool import Tool, abc_deg_from_rotation
 from tcp_pendant.wizards.base import (
     M_TO_MM,
     CalibrationFailedError,
-    RecordedPose,
     StartContext,
+    StepInfo,
     StepSpec,
     Wizard,
     WizardError,
@@ -54,7 +54,6 @@ from tcp_pendant.wizards.base import (
     WizardStateError,
     check_pose_m,
     mm3,
-    utc_now_iso,
 )
 from tcp_pendant.wizards.describe import BY_CONTROLLER, StepRole, WizardOption, WizardStart
 
@@ -525,22 +524,41 @@ class BeamWizard(Wizard):
         if manual is not None and not isinstance(manual, ManualComparison):
             raise WizardError("The manual calibration to compare with must be a ManualComparison.")
         self._scan, self._live_scan, self._R_base, self._manual = recorded, scan, R, manual
-        first = recorded.events[0].T_world_flange if recorded.events else np.eye(4)
-        self._poses[0] = RecordedPose(check_pose_m(first), utc_now_iso())
+
+    # No pose is ever recorded (``recorded_poses`` stays empty: the classroom counts no touch);
+    # the step counts as done once a scan is handed in.
+    def _info(self, i: int, spec: StepSpec, n: int) -> StepInfo:
+        return replace(super()._info(i, spec, n), recorded=self._scan is not None)
+
+    @property
+    def progress(self) -> float:
+        """0 before the scan, 0.5 with the scan handed in, 1 with the result."""
+        return ((self._scan is not None) + (self._status == "complete")) / 2.0
 
     def next(self) -> Any:
         """Finish (the only step); refused with words before a scan was handed in."""
-        if self.scan_pending:
-            raise WizardStateError("Run the scan first: press Finish (the controller moves the tool "
-                                   "through the beam).")
-        return super().next()
+        if self._status != "in_progress":
+            raise WizardStateError(f"Next is not possible: the wizard is {self._status.replace('_', ' ')}.")
+        return self.finish()
 
     def finish(self) -> WizardResult:
-        """Compute the result from the scan handed in; refused with words before one was."""
-        if self.scan_pending:
+        """Compute the result from the scan handed in; refused with words before one was.
+
+        Raises:
+            WizardStateError: no scan yet, or the wizard was cancelled.
+            CalibrationFailedError: the events cannot give a TCP (the wizard stays on its step).
+        """
+        if self._status == "cancelled":
+            raise WizardStateError("The wizard was cancelled; resume it first.")
+        if self._scan is None:
             raise WizardStateError("Run the scan first: press Finish (the controller moves the tool "
                                    "through the beam).")
-        return super().finish()
+        try:
+            result = self._compute([])
+        except TcpcalError as exc:
+            raise CalibrationFailedError(str(exc), exc) from exc
+        self._result, self._status, self._index = result, "complete", 0
+        return result
 
     def clear_step(self) -> None:
         """Forget the scan (a new Finish runs another one)."""
