@@ -401,3 +401,28 @@ def test_crossed_beams_give_axis_events_of_both_and_the_exact_tcp(robot):
     assert angle_between_deg(d, T_true[:3, 0]) < 1e-6
     for i in scan.tip_indices:  # the tip meets the crossing point
         assert np.linalg.norm(scan.tip_world_m(i) - crossed.point) < 1e-9
+
+
+def test_an_orientation_out_of_reach_is_tried_turned_a_third_of_the_way():
+    """Turns only need to differ: orientation 3 (180 deg) out of reach at every tilt is run at
+    210 deg instead; orientation 4 is out of reach at all its tries and skipped with words."""
+    q0, tip = ready("kr6")
+    model = builtin_tools()["pointer"]
+    full = run_beam_scan(kinematics("kr6"), q0, default_beam_sensor(tip), model.T_flange_tool_true,
+                         tool_shape(model))
+    a4 = np.degrees([mv.q_end_rad[3] for mv in full.moves if mv.kind == "approach"][:2])
+    kin = limited("kr6", {3: (a4.min() - 25.0, a4.max() + 25.0), 5: (-45.0, 145.0)})
+    scan = run_beam_scan(kin, q0, default_beam_sensor(tip), model.T_flange_tool_true, tool_shape(model))
+    assert scan.orientation_index == (0, 0, 0, 1, 1, 1, 2, 2, 2)
+    assert len(scan.skipped) == 1 and scan.skipped[0].startswith("Orientation 4 (turned 270 deg")
+    assert "turns of 240 and 300 deg" in scan.skipped[0]
+
+    def turn_deg(i: int) -> float:  # the flange's turn about WORLD Z (the tool points down)
+        R = scan.events[i].T_world_flange[:3, :3]
+        return math.degrees(math.atan2(R[1, 0], R[0, 0]))
+
+    first, _, third = scan.tip_indices
+    assert (turn_deg(third) - turn_deg(first)) % 360.0 == pytest.approx(210.0, abs=1e-6)
+    tcp, d = solve(scan)
+    assert np.linalg.norm(tcp - model.T_flange_tool_true[:3, 3] * 1000.0) < 1e-6
+    assert angle_between_deg(d, model.T_flange_tool_true[:3, 0]) < 1e-6

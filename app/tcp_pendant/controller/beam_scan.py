@@ -22,7 +22,9 @@ and the tool direction):
   best conditioned tool direction). The alternating tilt about ``u`` changes neither ``w`` nor
   the planes (section 9: a turn about the beam adds nothing); it spreads the arm's wrist
   configurations, so an absolute-accuracy error of one configuration does not repeat in all.
-  An orientation with a pose out of reach at its tilt is tried at the opposite tilt and at 0.
+  An orientation with a pose out of reach at its tilt is tried at the opposite tilt and at 0,
+  then turned a third of the way towards either neighbour (30 deg for n = 4): the turns only
+  need to differ.
 * Two **sideways passes** (``pass``) across the beam, horizontally along ``a = unit(Z x u)``,
   from ``-W`` to ``+W`` and back, with the (believed) tool axis crossing the beam
   ``pass_heights_mm`` behind the believed tip: two **axis events** (``crossing_events``, entry
@@ -401,7 +403,12 @@ def _pose(R: np.ndarray, p: np.ndarray) -> np.ndarray:
 
 
 class _Skip(Exception):
-    """An orientation cannot be run (message in plain words)."""
+    """An orientation cannot be run (message in plain words); ``reach``: a pose out of reach,
+    which another tilt or turn may avoid."""
+
+    def __init__(self, message: str, *, reach: bool = False) -> None:
+        super().__init__(message)
+        self.reach = reach
 
 
 @dataclass
@@ -428,10 +435,10 @@ class _Planner:
         where = f"TCP at {p[0]:.0f}, {p[1]:.0f}, {p[2]:.0f} mm"
         if not sol.ok:
             raise _Skip(f"{what} is out of reach ({where}: no configuration within the joint "
-                        "limits gets there)")
+                        "limits gets there)", reach=True)
         if self.moves and float(np.abs(sol.q_rad[:3] - self.q[:3]).max()) > math.radians(MAX_ARM_SWING_DEG):
             raise _Skip(f"{what} is out of reach without swinging the arm into another "
-                        f"configuration ({where})")
+                        f"configuration ({where})", reach=True)
         return sol.q_rad
 
     def tcp(self, T: np.ndarray) -> np.ndarray:
@@ -494,7 +501,7 @@ class _Planner:
         """IK of a straight pass / approach end; refuses a configuration flip on the way."""
         q_end = self.ik(T_end, what)
         if float(np.abs(q_end - self.q).max()) > math.radians(MAX_JOINT_STEP_DEG):
-            raise _Skip(f"{what} would flip the arm's configuration on the way")
+            raise _Skip(f"{what} would flip the arm's configuration on the way", reach=True)
         return q_end
 
 
@@ -640,24 +647,33 @@ def run_beam_scan(kinematics: RobotKinematics, q_start_rad: np.ndarray, sensor: 
         spin = 360.0 * k / n
         sign = 1.0 if k % 2 == 0 else -1.0
         label = f"orientation {k + 1} (turned {spin:.0f} deg about the tool axis)"
-        # the tilt about the beam observes nothing (module docstring): when a pose of this
-        # orientation is out of reach at one tilt, the others are tried before it is skipped
+        # the tilt about the beam observes nothing (module docstring) and the turns only need to
+        # differ: when a pose of this orientation is out of reach, the other tilts and then turns
+        # a third of the way to the neighbours are tried before it is skipped
         tilts = (sign * c.tilt_deg, -sign * c.tilt_deg, 0.0) if c.tilt_deg > 0.0 else (0.0,)
+        step = 120.0 / n
+        tries = [(tilt, spin) for tilt in tilts] + [(0.0, spin + step), (0.0, spin - step)]
         saved = (P.q.copy(), P.T.copy(), len(P.moves), len(P.events))
-        first_reason = ""
-        for tilt in tilts:
+        first_reason, done = "", False
+        for tilt, turn in tries:
             try:
-                _scan_orientation(P, k, spin, tilt, R_base, T_ft_inv, a, W, h1, h2, clear)
+                _scan_orientation(P, k, turn, tilt, R_base, T_ft_inv, a, W, h1, h2, clear)
+                done = True
                 break
             except _Skip as exc:
                 P.q, P.T = saved[0].copy(), saved[1].copy()
                 del P.moves[saved[2]:]
                 del P.events[saved[3]:], P.points[saved[3]:], P.orient[saved[3]:]
+                if not exc.reach:  # the tool data or the beam: another pose does not help
+                    first_reason = str(exc)
+                    break
                 first_reason = first_reason or str(exc)
-        else:
+        if not done:
             tried = ", ".join(f"{t:+.0f}" for t in tilts)
+            more = (f" (tried tilts of {tried} deg about the beam and turns of {spin - step:.0f} and "
+                    f"{spin + step:.0f} deg)") if "out of reach" in first_reason else ""
             skipped.append(f"{label[0].upper()}{label[1:]} was skipped: {first_reason[0].lower()}"
-                           f"{first_reason[1:]} (tried tilts of {tried} deg about the beam).")
+                           f"{first_reason[1:]}{more}.")
     if not P.events:
         raise ControllerError("The beam scan could not run at any tool orientation: "
                               + " ".join(skipped) + " Move the beam sensor closer to the robot or "
