@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import sys
 from pathlib import Path
 
@@ -283,3 +284,19 @@ def test_steps_view_runs_the_scan_in_its_worker(page) -> None:
     p.choose(dock.nav, FINISH)
     wait_until(lambda: isinstance(v.workflow.result, BeamWizardResult), what="the second scan's result")
     assert v.workflow.result is not first and not p.notes
+
+
+def test_crossed_beams(workflow) -> None:
+    """Two beams crossing at right angles: events of both beams, each solved on its own beam."""
+    wf = workflow("kr6", "torch", seed=5)
+    s = wf.controller.beam_sensor
+    second = np.cross([0.0, 0.0, 1.0], s.direction)
+    wf.controller.set_beam_sensor(BeamSensor(s.point, s.direction, sigma=0.0, second_direction=second))
+    res = scan(wf)
+    assert {e.beam for e in res.events} == {0, 1}
+    T_true = builtin_tools()["torch"].T_flange_tool_true
+    np.testing.assert_allclose(res.tcp_mm, T_true[:3, 3] * 1000.0, atol=1e-6)
+    assert direction_error_deg(res, T_true) < 1e-6
+    events_table = result_markdown(res).split("**Events**")[1]
+    beams = re.findall(r"^\| \d+ \| \d \| [^|]+ \| (\d) \|", events_table, flags=re.M)
+    assert len(beams) == len(res.events) and set(beams) == {"1", "2"}     # the beam column: 1-based
