@@ -64,6 +64,7 @@ __all__ = [
     "ManualComparison",
     "RecordedScan",
     "ScanEvent",
+    "wall_time_s",
 ]
 
 MAX_SCAN_EVENTS = 100
