@@ -66,6 +66,8 @@ def test_stored_truth_checks_good(robot, tool_key):
     assert check.direction_deviation_deg is not None and check.direction_deviation_deg < 0.2
     assert check.tool_name == "Tool A" and check.slot == 2 and check.seed == 5
     assert check.scan.skipped == () and len(check.scan.tip_indices) == 4
+    assert check.consistent and check.residual_rms_mm < 3 * 0.027
+    assert "absolute accuracy" not in check.verdict
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2, 3])
@@ -187,3 +189,22 @@ def test_markdown_escapes_the_tool_name():
     assert escape_markdown(name) in md and name not in md
     assert "slot 2" in md and f"{check.deviation_norm_mm:.3f} mm" in md
     assert "✔" in md and check.verdict in md.replace("\\", "")
+
+
+@pytest.mark.parametrize(("robot", "seed"), [("gp12", 1), ("kr6", 3)])
+def test_robot_accuracy_shows_as_disagreeing_events(robot, seed):
+    """The absolute-accuracy scenario: the recorded poses are the model's, the beam sees the real
+    arm; the tip events disagree by tenths of a mm (far beyond 0.02 mm) and the verdict says
+    that the robot, not the tool, limits the measurement."""
+    c = make_controller(robot, "torch")
+    stored = truth_tool("torch", "Torch")
+    c.set_active_tool(stored)
+    world = realize(Scenario("robot_accuracy", seed=seed), c.kinematics, c.mounted_tool)
+    c.set_true_kinematics(world.true_kinematics)
+    check = beam_check_job(c, 1, stored, rng_seed=seed).run()
+    assert check.residual_rms_mm > 0.3
+    assert not check.consistent
+    assert "the robot's absolute accuracy" in check.verdict
+    assert f"{check.residual_rms_mm:.3f} mm RMS" in check.verdict
+    # the physical tool is exactly the stored one: what the check reports is the robot's error
+    assert 0.1 < check.deviation_norm_mm < 2.0

@@ -50,6 +50,10 @@ GOOD_BEAM_MM = 0.5
 """Deviation of the measured TCP from the stored one up to which the check calls the TCP good
 (the spin test's tolerance, ``views.tool_check.GOOD_CHECK_MM``)."""
 DIRECTION_NOTE_DEG = 0.5
+CONSISTENT_FACTOR = 3.0
+"""The tip events agree when their RMS distance from the beam line is at most this many times
+their repeatability (``BeamScan.tip_sigma_m``); beyond, the verdict names the robot's absolute
+accuracy (methods.md section 11)."""
 """Above this the verdict says that the tool direction differs from the stored X axis."""
 BEAM_METHOD = "beam"
 """The calibration method :func:`update_tool_from_beam` writes."""
@@ -83,6 +87,9 @@ class BeamCheck:
         deviation_norm_mm: its length.
         ci95_mm: 95 % radius of the measured TCP (``solve_beam`` with the tip events'
             repeatability, ``BeamScan.tip_sigma_m``).
+        residual_rms_mm: RMS distance of the computed tip from the beam line over the tip
+            events (``BeamResult.rms_error``): about the repeatability when the events agree.
+        consistent: the residual is at most :data:`CONSISTENT_FACTOR` times the repeatability.
         direction_deviation_deg: angle between the measured tool direction and the stored tool
             X axis, or None when the axis events did not determine it.
         measured_direction: (3,) the measured unit tool direction in FLANGE, or None.
@@ -102,6 +109,8 @@ class BeamCheck:
     deviation_mm: np.ndarray
     deviation_norm_mm: float
     ci95_mm: float
+    residual_rms_mm: float
+    consistent: bool
     direction_deviation_deg: float | None
     measured_direction: np.ndarray | None
     scan: BeamScan
@@ -203,12 +212,19 @@ def evaluate_check(tool: Tool, slot: int | None, scan: BeamScan, seed: int = 0) 
         verdict += (f" The tool direction differs by {dir_dev:.2f} deg from the stored X axis; "
                     "Update keeps the stored orientation (calibrate it with TCP & Z, X if the work "
                     "depends on it).")
+    consistent = beam.rms_error <= CONSISTENT_FACTOR * max(tip_sigma_mm, 1e-4)
+    if not consistent:
+        verdict += (f" The tip events disagree by {beam.rms_error:.3f} mm RMS, far more than the "
+                    f"sensor's repeatability ({tip_sigma_mm:.3f} mm): the robot's absolute accuracy "
+                    "(its model is not the real arm) or a moved sensor limits this measurement, and "
+                    "an Update would store part of that error in the tool data.")
     if scan.skipped:
         verdict += f" {len(scan.skipped)} of {scan.n_orientations_planned} orientations were skipped."
     return BeamCheck(
         tool_name=tool.name, slot=slot, stored_tool=tool, stored_tcp_mm=read_only_array(stored),
         measured_tcp_mm=read_only_array(measured), deviation_mm=read_only_array(dev),
-        deviation_norm_mm=norm, ci95_mm=float(beam.ci95_radius), direction_deviation_deg=dir_dev,
+        deviation_norm_mm=norm, ci95_mm=float(beam.ci95_radius),
+        residual_rms_mm=float(beam.rms_error), consistent=consistent, direction_deviation_deg=dir_dev,
         measured_direction=None if direction is None else read_only_array(direction), scan=scan,
         beam_result=beam, axis_result=axis, verdict=verdict, good=good, seed=int(seed))
 
@@ -266,6 +282,7 @@ def beam_check_markdown(check: BeamCheck) -> str:
         "",
         f"Deviation **{check.deviation_norm_mm:.3f} mm** (95 % radius of the measurement "
         f"{check.ci95_mm:.3f} mm), FLANGE coordinates, measured - stored.",
+        f"The tip events fit the beam to {check.residual_rms_mm:.3f} mm RMS.",
     ]
     if check.direction_deviation_deg is not None:
         lines.append(f"Tool direction: {check.direction_deviation_deg:.2f} deg from the stored X axis.")
