@@ -282,6 +282,12 @@ def test_config_and_tool_checks():
     model = builtin_tools()["pointer"]
     with pytest.raises(ControllerError, match="roughly horizontal"):
         run_beam_scan(kinematics("kr6"), q0, vertical, model.T_flange_tool_true, tool_shape(model))
+    with pytest.raises(ControllerError, match="true_kinematics must be the same robot"):
+        run_beam_scan(kinematics("kr6"), q0, default_beam_sensor(tip), model.T_flange_tool_true,
+                      tool_shape(model), true_kinematics=kinematics("gp12"))
+    with pytest.raises(ControllerError, match="no proper rotation"):
+        run_beam_scan(kinematics("kr6"), q0, default_beam_sensor(tip), np.diag([1.0, 1.0, -1.0, 1.0]),
+                      tool_shape(model))
 
 
 @pytest.mark.parametrize("n", [3, 5])

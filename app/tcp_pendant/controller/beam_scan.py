@@ -611,6 +611,9 @@ def run_beam_scan(kinematics: RobotKinematics, q_start_rad: np.ndarray, sensor: 
     if not isinstance(kinematics, RobotKinematics):
         raise ControllerError("run_beam_scan: kinematics must be a RobotKinematics.")
     true_kin = kinematics if true_kinematics is None else true_kinematics
+    if not isinstance(true_kin, RobotKinematics) or tuple(true_kin.joint_names) != tuple(kinematics.joint_names):
+        raise ControllerError("run_beam_scan: true_kinematics must be the same robot as the model (a "
+                              "RobotKinematics with the same joints).")
     if not isinstance(sensor, BeamSensor) or not isinstance(shape, ToolShape):
         raise ControllerError("run_beam_scan: give a BeamSensor and a ToolShape.")
     if not isinstance(config, BeamScanConfig):
