@@ -432,3 +432,21 @@ def test_an_orientation_out_of_reach_is_tried_turned_a_third_of_the_way():
     tcp, d = solve(scan)
     assert np.linalg.norm(tcp - model.T_flange_tool_true[:3, 3] * 1000.0) < 1e-6
     assert angle_between_deg(d, model.T_flange_tool_true[:3, 0]) < 1e-6
+
+
+def test_an_inclined_beam_scans_exactly():
+    """A beam 25 deg off horizontal (a device on a sloping fixture): the tool still points
+    straight down (its frame stays orthonormal), the passes run horizontally across the beam."""
+    q0, tip = ready("kr6")
+    model = builtin_tools()["torch"]
+    T_true = model.T_flange_tool_true
+    u = np.array([math.cos(math.radians(25.0)), 0.0, math.sin(math.radians(25.0))])
+    sensor = BeamSensor(default_beam_sensor(tip).point, u)
+    scan = run_beam_scan(kinematics("kr6"), q0, sensor, believed_off(T_true), tool_shape(model))
+    assert scan.skipped == ()
+    for mv in scan.moves:
+        R = mv.T_world_flange_end[:3, :3]
+        assert np.allclose(R.T @ R, np.eye(3), atol=1e-9)
+    tcp, d = solve(scan)
+    assert np.linalg.norm(tcp - T_true[:3, 3] * 1000.0) < 1e-6
+    assert angle_between_deg(d, T_true[:3, 0]) < 1e-6

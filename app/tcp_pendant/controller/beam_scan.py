@@ -638,8 +638,9 @@ def run_beam_scan(kinematics: RobotKinematics, q_start_rad: np.ndarray, sensor: 
     W = (shape.radius + sensor.width / 2.0 + c.pass_margin_mm / 1000.0) / sin_min
     h1, h2 = (v / 1000.0 for v in c.pass_heights_mm)
     clear = c.clearance_mm / 1000.0
-    # tool X down, tool Y along the beam, tool Z = X x Y
-    R_base = np.column_stack((-up, u, np.cross(-up, u)))
+    # tool X down, tool Y along the beam's horizontal direction, tool Z = X x Y
+    u_flat = (u - (u @ up) * up) / np.linalg.norm(u - (u @ up) * up)
+    R_base = np.column_stack((-up, u_flat, np.cross(-up, u_flat)))
     T_ft_inv = np.linalg.inv(T_ft)
 
     P = _Planner(kin=kinematics, true_kin=true_kin, T_ft_plan=T_ft, sensor=sensor, shape=shape,
