@@ -204,7 +204,8 @@ def _class_lines(app: object) -> str:
     exercise = "mystery tools" if room.exercise == "mystery" else "free practice"
     return (f"  class gradebook {room.gradebook.path} ({exercise})\n"
             f"Trainer view: {app.trainer_url}  trainer token: {room.trainer_token}\n"
-            "  (open the page, type the token in \"Trainer token\" of the welcome window; keep it secret)\n")
+            "  (open that address: the page fills in the token and drops it from the address bar; or open the "
+            "page and type the token in \"Trainer token\" of the welcome window; keep both secret)\n")
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -27,7 +27,7 @@ from typing import Any
 from urllib.parse import urlsplit
 
 __all__ = ["OriginError", "allow", "enable", "forget", "normalize_origin", "origin_refusal",
-           "parse_allow_origins"]
+           "parse_allow_origins", "set_http_layer"]
 
 log = logging.getLogger(__name__)
 
@@ -35,6 +35,7 @@ _DEFAULT_PORTS = {"http": 80, "https": 443}
 _lock = threading.Lock()
 _allowed_by_port: dict[int, frozenset[str]] = {}
 _original_handshake: Any = None
+_http_layer: Any = None
 
 
 class OriginError(ValueError):
@@ -150,12 +151,24 @@ def enable() -> None:
                 if refusal is not None:
                     log.warning("websocket from %s: %s", request.headers.get("Origin"), refusal)
                     return connection.respond(http.HTTPStatus.FORBIDDEN, refusal + "\n")
+            layer = _http_layer
+            if layer is not None and not _is_upgrade(request):
+                return layer(connection, request, process_request)
             return None if process_request is None else process_request(connection, request)
 
         return await original(self, checked, *args, **kwargs)
 
     handshake.__doc__ = original.__doc__
     ServerConnection.handshake = handshake  # type: ignore[method-assign]
+
+
+def set_http_layer(layer: Any) -> None:
+    """Answer plain HTTP requests (not upgrades) with ``layer(connection, request,
+    process_request)`` in front of viser's static server (``tcp_pendant.client_script.serve``;
+    None: viser alone). The origin check above is unchanged."""
+    global _http_layer
+    with _lock:
+        _http_layer = layer
 
 
 def allow(port: int, origins: Sequence[str]) -> None:

@@ -27,11 +27,12 @@ from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
+from urllib.parse import quote
 
 import numpy as np
 
 from tcpcal.library import ToolLibrary
-from tcp_pendant import origin_check
+from tcp_pendant import client_script, origin_check
 from tcp_pendant.addresses import network_urls
 from tcp_pendant.classroom.class_room import ClassRoom
 from tcp_pendant.classroom.gradebook import Gradebook
@@ -401,6 +402,8 @@ class PendantApp:
 
         host = self.config.host
         origin_check.enable()               # foreign web pages' websockets are refused (403)
+        client_script.script_asset()        # the page's own script (keys, name, trainer URL): packaged?
+        origin_check.set_http_layer(client_script.serve)
         self.server = viser.ViserServer(host=host, port=self.config.port, verbose=False)
         origin_check.allow(self.port, self.allow_origins)
         if self.config.port != 0 and self.port != self.config.port:
@@ -424,9 +427,13 @@ class PendantApp:
 
     @property
     def trainer_url(self) -> str | None:
-        """The page of the trainer view (None without a classroom); its token goes in the
-        "Trainer token" field of the welcome prompt (viser drops a page's query string)."""
-        return None if self.classroom is None else self.url
+        """The trainer view's address, ``URL/?trainer=TOKEN`` (None without a classroom): the
+        page's script (``client_script``) types the token into "Trainer token" and drops it
+        from the address bar; the token is percent-encoded (``--trainer-token`` may hold any
+        printable character)."""
+        if self.classroom is None:
+            return None
+        return f"{self.url}/?trainer={quote(self.classroom.trainer_token, safe='')}"
 
     @property
     def port(self) -> int:

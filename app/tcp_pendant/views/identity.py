@@ -7,10 +7,13 @@ modal) and handed to ``on_name``. Below it, a **Trainer token** field and an **O
 view** button: the token is handed to ``on_token``, which says whether it was right (compared
 with ``secrets.compare_digest`` by the server).
 
-Reconnects: viser 1.1 gives the server no per-browser storage (no cookie, no localStorage)
-and its client drops the page's query string from the websocket URL, so the browser cannot
-carry the name to a new connection; after a reconnect the trainee types the name again, and
-the gradebook files the new session under the same trainee (the same name, the same id).
+Reconnects: viser 1.1 gives the server no per-browser storage, so the page's own script
+(``static/pendant.js``, ``client_script``) keeps an accepted name in the browser's
+``localStorage`` and, when a new welcome window appears (reload, reconnect), types it into
+"Your name" and presses **Join the class** like the trainee would: the server validates and
+escapes it exactly as a typed name, and the gradebook files the new session under the same
+trainee (the same name, the same id). The same script types the token of a ``/?trainer=TOKEN``
+address into "Trainer token" (``PendantApp.trainer_url``).
 
 Every callback runs through ``Session.on_loop``; the name is shown through ``escape_markdown``.
 """
@@ -53,11 +56,13 @@ class IdentityPrompt:
         gui = session.target.gui
         self.modal = gui.add_modal("Welcome to the TCP Pendant")
         with self.modal:
-            gui.add_markdown("Type the name your trainer should see in the class list.")
+            gui.add_markdown("Type the name your trainer should see in the class list "
+                             "(this browser remembers it for reconnects).")
             self.name_field = gui.add_text(NAME_LABEL, "")
             self.start = gui.add_button("Join the class", color="green")
             self.message = gui.add_markdown("")
-            gui.add_markdown("---\n*Trainer:* type the token printed by the server.")
+            gui.add_markdown("---\n*Trainer:* open the trainer address the server printed, or type "
+                             "its token here.")
             self.token_field = gui.add_text(TOKEN_LABEL, "")
             self.open_trainer = gui.add_button("Open trainer view")
         self.banner = gui.add_markdown("", order=-1000.0, visible=False)

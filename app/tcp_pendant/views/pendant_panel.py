@@ -7,8 +7,10 @@ keys - one row per axis with − and + side by side (X Y Z A B C, or A1..A6; in 
 the hold-to-jog keys, two per axis, since only single buttons report a hold) - then the jog
 settings (mode, frame, override, readout frame), the joints, Home and the camera buttons; the touches ("Record point" and the list) follow.
 Every button group marks its selected option with "✓ " (viser's button groups show no
-selection); a click's value is read without the mark. viser has no keyboard events for the
-GUI panel, so there are no keyboard shortcuts (README).
+selection); a click's value is read without the mark. Keyboard shortcuts come from the page's
+own script (``static/pendant.js``, served by ``client_script``): it clicks these buttons, so a
+key is a click; every jog, increment and Record hint names its key and :data:`KEYS_LINE` sums
+them up below the jog keys.
 
 Widgets only call :class:`tcp_pendant.pendant.Jogger` and the session; all text comes from
 ``tcp_pendant.pendant.formatting``. Every callback runs on viser's event loop
@@ -50,7 +52,7 @@ try:                                   # viser's message type (hot path); public
 except ImportError:                    # pragma: no cover
     GuiUpdateMessage = None
 
-__all__ = ["HOLD_HZ", "MARK", "PendantPanel", "marked", "set_markdown", "unmarked"]
+__all__ = ["HOLD_HZ", "KEYS_LINE", "MARK", "PendantPanel", "jog_key_hint", "marked", "set_markdown", "unmarked"]
 
 HOLD_HZ = 20.0
 """Rate the browser is asked to send hold messages at; the jog itself ticks on the server's
@@ -63,6 +65,21 @@ _AXIS_HINT = {"X": "translate along X (mm)", "Y": "translate along Y (mm)", "Z":
 
 MARK = "✓ "
 """Prefix of the selected option of a button group."""
+
+KEYS_LINE = ("Keys: `1`…`6` jog **+** on the rows above, `Shift`+`1`…`6` jog **−**, "
+             "`[` `]` smaller / larger increment, `R` Record")
+"""The keyboard shortcuts (``static/pendant.js``), shown below the jog keys."""
+INCREMENT_KEYS = "keys [ smaller, ] larger"
+
+
+def jog_key_hint(row: int) -> str:
+    """The keys of jog-key row ``row`` (0-based) as its hint says them ("" past the 9th row)."""
+    return f"keys {row + 1} (+) and Shift+{row + 1} (−)" if 0 <= row < 9 else ""
+
+
+def _with_keys(hint: str, row: int) -> str:
+    keys = jog_key_hint(row)
+    return f"{hint}; {keys}" if hint and keys else hint or keys
 
 
 def marked(options: tuple[str, ...], selected: str) -> tuple[str, ...]:
@@ -122,17 +139,19 @@ class PendantPanel:
                                                    "(hides the distance, the Δ offsets and the close-up).")
         self.status_md = gui.add_markdown("")
         self.increment = gui.add_button_group("Increment", marked(INCREMENTS, st.increment),
-                                              hint="mm for X/Y/Z, deg for A/B/C and joints; Cont. = hold to jog")
+                                              hint="mm for X/Y/Z, deg for A/B/C and joints; Cont. = hold to jog; "
+                                                   + INCREMENT_KEYS)
 
         # compact keys: one row per axis (− and + side by side); clicks only
         self.cart_rows: dict[str, Any] = {}
-        for ax in CARTESIAN_AXES:
-            row = gui.add_button_group(ax, (f"{ax} −", f"{ax} +"), hint=_AXIS_HINT[ax])
+        for r, ax in enumerate(CARTESIAN_AXES):
+            row = gui.add_button_group(ax, (f"{ax} −", f"{ax} +"), hint=_with_keys(_AXIS_HINT[ax], r))
             row.on_click(session.on_loop(self._row_cb(ax)))
             self.cart_rows[ax] = row
         self.joint_rows: list[Any] = []
         for i, name in enumerate(k.joint_names):
-            row = gui.add_button_group(name, (f"{name} −", f"{name} +"), visible=False)
+            row = gui.add_button_group(name, (f"{name} −", f"{name} +"), visible=False,
+                                       hint=_with_keys(f"jog {name} (deg)", i))
             row.on_click(session.on_loop(self._row_cb(i)))
             self.joint_rows.append(row)
 
@@ -140,11 +159,14 @@ class PendantPanel:
         self.cart_folder = gui.add_folder("Cartesian jog (hold)", visible=False)
         with self.cart_folder:
             self.cart_buttons: dict[tuple[str, int], Any] = {}
-            for ax in CARTESIAN_AXES:
+            for r, ax in enumerate(CARTESIAN_AXES):
                 for sign, sym in ((-1, "−"), (1, "+")):
-                    b = gui.add_button(f"{ax} {sym}", hint=_AXIS_HINT[ax], color="gray" if sign < 0 else "blue")
+                    b = gui.add_button(f"{ax} {sym}", hint=_with_keys(_AXIS_HINT[ax], r),
+                                       color="gray" if sign < 0 else "blue")
                     self._wire_key(b, ax, sign)
                     self.cart_buttons[(ax, sign)] = b
+
+        self.keys_md = gui.add_markdown(KEYS_LINE)
 
         self.joint_folder = gui.add_folder("Joint jog", visible=False)
         with self.joint_folder:
@@ -158,7 +180,8 @@ class PendantPanel:
                 s.on_update(self._slider_cb(i))
                 self.joint_sliders.append(s)
                 for sign, sym in ((-1, "−"), (1, "+")):
-                    b = gui.add_button(f"{name} {sym}", color="gray" if sign < 0 else "blue")
+                    b = gui.add_button(f"{name} {sym}", color="gray" if sign < 0 else "blue",
+                                       hint=_with_keys(f"hold to jog {name} (deg)", i))
                     self._wire_key(b, i, sign)
                     self.joint_buttons[(i, sign)] = b
 

@@ -48,7 +48,7 @@ class TouchListView:
         self.session = session
         gui = session.target.gui
         self.record = gui.add_button("Record point", color="green", icon=None,
-                                     hint="Store the current flange pose as a touch.")
+                                     hint="Store the current flange pose as a touch; key R.")
         self.folder = gui.add_folder("Touches")
         with self.folder:
             self.empty_md = gui.add_markdown("*No touch recorded.*")

@@ -53,7 +53,7 @@ class WizardDock:
                                         hint="The tool change this step asks for (the app swaps the tool).")
             self.record = gui.add_button("Record", color="green",
                                          hint="Record this step at the current pose (a touch farther than "
-                                              "0.5 mm asks first, unless the distance is hidden).")
+                                              "0.5 mm asks first, unless the distance is hidden); key R.")
             self.nav = gui.add_button_group("Step", (BACK, NEXT, CANCEL))
             self.meter_bar = gui.add_progress_bar(0.0, color="gray", visible=False)
             self.meter_md = gui.add_markdown("", visible=False)

@@ -1,0 +1,270 @@
+/* TCP Pendant's own page script (served at /tcp-pendant/pendant.js by tcp_pendant/client_script.py).
+ *
+ * A static file: no server state, request or user text is ever written into it. It only reads the
+ * page's DOM and clicks viser's own GUI buttons, so the server sees exactly what a mouse click
+ * sends (no new server API). User text (a trainee's name, a trainer token) is only ever put into
+ * an input's .value, never into HTML.
+ *
+ * 1. Keyboard shortcuts (ignored while typing in a field, with Ctrl/Alt/Meta held, or while a
+ *    dialog such as the welcome window is open):
+ *      1..6          jog + on jog-key row 1..6 (X Y Z A B C; in Joint mode the joints A1..A6)
+ *      Shift+1..6    jog - on that row
+ *      [  ]          next smaller / larger increment (the Increment row, toward 0.1 / Cont.)
+ *      R, Enter      Record: the running wizard's step, else "Record point" (Enter only when no
+ *                    button or field has the focus)
+ *    Incremental mode: one step per key press (a held key does not repeat, as on a pendant).
+ *    Cont. mode: the key is held like the mouse button on a hold-to-jog key (press, release).
+ *    viser's own keys (W A S D Q E, the arrows: camera; Space) are not used.
+ * 2. "Your name" is remembered in this browser's localStorage once the class accepted it, and
+ *    typed and submitted again when a new welcome window appears (reload, reconnect).
+ * 3. /?trainer=TOKEN: the token is taken from the address, dropped from the address bar at once
+ *    (history.replaceState) and typed into "Trainer token" + "Open trainer view" of each welcome
+ *    window of this page (kept in memory only, for reconnects).
+ */
+(function () {
+  "use strict";
+  if (window.__tcpPendantScript) return;
+  window.__tcpPendantScript = true;
+
+  var MINUS = "\u2212";
+  var MARK = "\u2713";
+  var L = {
+    name: "Your name", join: "Join the class", token: "Trainer token", openTrainer: "Open trainer view",
+    increment: "Increment", record: "Record", recordPoint: "Record point", banner: "Trainee:"
+  };
+  var CARTESIAN = ["X", "Y", "Z", "A", "B", "C"];
+  var NAME_KEY = "tcpPendant.traineeName";
+  var MAX_TEXT = 200;
+  var SETTLE_MS = 400;          // viser sends a field's value in its own message slot: wait before the click
+  var JOG_RE = /^(.+) ([\u2212+])$/;
+
+  // ------------------------------------------------------------------ the DOM
+  function text(el) { return (el && el.textContent || "").trim(); }
+  function laidOut(el) { return el.getClientRects().length > 0; }   // not in a hidden tab
+  function allButtons() { return Array.prototype.slice.call(document.querySelectorAll("button")); }
+  function buttonsNamed(name) { return allButtons().filter(function (b) { return text(b) === name; }); }
+  function pick(list) {                     // enabled, the one on show first
+    var ok = list.filter(function (b) { return !b.disabled; });
+    return ok.filter(laidOut)[0] || ok[0] || null;
+  }
+  function labelled(name) {                 // the row (label + control) of viser's input labelled `name`
+    var labels = document.querySelectorAll("label");
+    for (var i = 0; i < labels.length; i++) {
+      if (text(labels[i]) !== name) continue;
+      var row = labels[i];
+      while (row && !row.querySelector("input, textarea, button")) row = row.parentElement;
+      if (row) return row;
+    }
+    return null;
+  }
+  function field(name) { var row = labelled(name); return row ? row.querySelector("input, textarea") : null; }
+  function editable(el) {
+    if (!el || el.nodeType !== 1) return false;
+    if (el.isContentEditable) return true;
+    var tag = el.tagName;
+    return tag === "TEXTAREA" || tag === "SELECT" || (tag === "INPUT" && !el.readOnly);
+  }
+  function interactive(el) {
+    return !!(el && el.nodeType === 1 && el !== document.body &&
+      (editable(el) || el.closest("button, a, input, select, textarea, [role=button], [role=tab], [role=slider], " +
+                                  "[role=option], [role=checkbox], [tabindex]")));
+  }
+  function dialogOpen() {
+    var d = document.querySelectorAll(".mantine-Modal-content, [role=dialog][aria-modal=true]");
+    for (var i = 0; i < d.length; i++) if (laidOut(d[i])) return true;
+    return false;
+  }
+  function typeInto(input, value) {         // React listens for the native setter + an input event
+    var proto = input.tagName === "TEXTAREA" ? HTMLTextAreaElement.prototype : HTMLInputElement.prototype;
+    Object.getOwnPropertyDescriptor(proto, "value").set.call(input, value);
+    input.dispatchEvent(new Event("input", { bubbles: true }));
+  }
+
+  // ------------------------------------------------------------------ 1. keys
+  function jogRows() {
+    var rows = [], byName = {};
+    allButtons().forEach(function (b) {
+      var m = JOG_RE.exec(text(b));
+      if (!m) return;
+      var row = byName[m[1]];
+      if (!row) { row = byName[m[1]] = { name: m[1], minus: null, plus: null }; rows.push(row); }
+      if (m[2] === "+") row.plus = row.plus || b; else row.minus = row.minus || b;
+    });
+    rows = rows.filter(function (r) { return r.minus && r.plus; });
+    var cart = CARTESIAN.map(function (n) { return byName[n]; });
+    if (cart.every(function (r) { return r && r.minus && r.plus; })) return cart;   // X..C in that order
+    return rows;                                                                     // joints, in page order
+  }
+
+  function incrementButtons() {
+    var row = labelled(L.increment);
+    return row ? Array.prototype.slice.call(row.querySelectorAll("button")) : [];
+  }
+  var pendingIncrement = null;              // {index, at}: clicked, the server's mark not yet back
+  function stepIncrement(direction) {       // +1: smaller (to the right), -1: larger (toward Cont.)
+    var bs = incrementButtons();
+    if (!bs.length) return;
+    var marked = -1;
+    bs.forEach(function (b, i) { if (text(b).indexOf(MARK) === 0) marked = i; });
+    var base = marked;
+    if (pendingIncrement && pendingIncrement.index !== marked && Date.now() - pendingIncrement.at < 1500) {
+      base = pendingIncrement.index;
+    }
+    if (base < 0) return;
+    var next = Math.max(0, Math.min(bs.length - 1, base + direction));
+    if (next === base || bs[next].disabled) return;
+    pendingIncrement = { index: next, at: Date.now() };
+    bs[next].click();
+  }
+
+  function continuous() {
+    var selected = incrementButtons().filter(function (b) { return text(b).indexOf(MARK) === 0; })[0];
+    return !!selected && text(selected).indexOf("Cont.") >= 0;
+  }
+
+  function record() {
+    var free = buttonsNamed(L.recordPoint);          // shown outside a wizard only
+    var b = free.length ? pick(free) : pick(buttonsNamed(L.record));
+    if (b) b.click();
+  }
+
+  var held = {};                            // key code -> the hold-to-jog button it holds
+  function pointer(type, b) {
+    b.dispatchEvent(new PointerEvent(type, {
+      bubbles: true, cancelable: true, composed: true, button: 0, buttons: type === "pointerdown" ? 1 : 0,
+      pointerId: 1, pointerType: "mouse", isPrimary: true
+    }));
+  }
+  function hold(code, b) {
+    releaseAll();
+    held[code] = b;
+    pointer("pointerdown", b);
+  }
+  function release(code) {
+    var b = held[code];
+    if (!b) return;
+    delete held[code];
+    pointer("pointerup", b);
+    if (b.isConnected) b.click();           // the release click: the server stops at once
+  }
+  function releaseAll() { Object.keys(held).forEach(release); }
+
+  function jog(index, sign, code) {
+    var row = jogRows()[index];
+    if (!row) return;
+    var b = sign > 0 ? row.plus : row.minus;
+    if (b.disabled) return;
+    if (b.id && continuous()) {
+      hold(code, b);                        // a single hold-to-jog button (Cont.)
+    } else {
+      b.click();
+    }
+  }
+
+  function onKeyDown(e) {
+    if (e.defaultPrevented || e.ctrlKey || e.altKey || e.metaKey || e.isComposing) return;
+    if (editable(e.target) || editable(document.activeElement) || dialogOpen()) return;
+    var digit = /^(?:Digit|Numpad)([1-9])$/.exec(e.code || "");
+    var key = e.key || "";
+    if (digit) {
+      e.preventDefault();
+      if (!e.repeat) jog(Number(digit[1]) - 1, e.shiftKey ? -1 : 1, e.code);
+    } else if (key === "[" || key === "]") {
+      e.preventDefault();
+      if (!e.repeat) stepIncrement(key === "[" ? 1 : -1);
+    } else if (key === "r" || key === "R" || (key === "Enter" && !interactive(e.target))) {
+      e.preventDefault();
+      if (!e.repeat) record();
+    }
+  }
+  document.addEventListener("keydown", onKeyDown);
+  document.addEventListener("keyup", function (e) { release(e.code); });
+  window.addEventListener("blur", releaseAll);
+  document.addEventListener("visibilitychange", function () { if (document.hidden) releaseAll(); });
+
+  // ------------------------------------------------------------------ 3. the trainer URL
+  var trainerToken = null;
+  try {
+    var url = new URL(window.location.href);
+    if (url.searchParams.has("trainer")) {
+      var t = url.searchParams.get("trainer") || "";
+      url.searchParams.delete("trainer");
+      window.history.replaceState(window.history.state, "", url.pathname + url.search + url.hash);
+      if (t.length > 0 && t.length <= MAX_TEXT) trainerToken = t;
+    }
+  } catch (err) { /* no URL API: the typed token still works */ }
+
+  // ------------------------------------------------------------------ 2. the name
+  function storage() { try { return window.localStorage; } catch (err) { return null; } }
+  function storedName() {
+    var s = storage();
+    try {
+      var v = s && s.getItem(NAME_KEY);
+      return typeof v === "string" && v.trim().length > 0 && v.length <= MAX_TEXT ? v : null;
+    } catch (err) { return null; }
+  }
+  function rememberName(v) {
+    var s = storage();
+    try { if (s && v.trim().length > 0 && v.length <= MAX_TEXT) s.setItem(NAME_KEY, v); } catch (err) { /* full */ }
+  }
+
+  var joining = null;                       // {value, input, at}: "Join the class" clicked, not yet accepted
+  document.addEventListener("click", function (e) {
+    var b = e.target && e.target.closest ? e.target.closest("button") : null;
+    if (!b || text(b) !== L.join) return;
+    var input = field(L.name);
+    if (input) joining = { value: String(input.value), input: input, at: Date.now() };
+  }, true);
+
+  function bannerShown() {                  // "Trainee: NAME" appears once the server took the name
+    var ps = document.querySelectorAll("p, div, span");
+    for (var i = 0; i < ps.length; i++) {
+      if (ps[i].children.length <= 2 && text(ps[i]).indexOf(L.banner) === 0) return true;
+    }
+    return false;
+  }
+
+  var tried = typeof WeakSet === "function" ? new WeakSet() : null;
+  function once(input) {                    // each welcome window is filled at most once
+    if (!tried || tried.has(input)) return false;
+    tried.add(input);
+    return true;
+  }
+  function fillAndPress(input, value, buttonName) {
+    typeInto(input, value);
+    window.setTimeout(function () {
+      if (!input.isConnected) return;
+      var b = pick(buttonsNamed(buttonName));
+      if (b) b.click();
+    }, SETTLE_MS);
+  }
+
+  function scan() {
+    if (!joining && !trainerToken && storedName() === null) return;   // nothing to fill or to remember
+    if (joining && !joining.input.isConnected) {
+      if (bannerShown()) { rememberName(joining.value); joining = null; }
+      else if (Date.now() - joining.at > 30000) joining = null;
+    }
+    var tokenInput = trainerToken ? field(L.token) : null;
+    if (tokenInput) {
+      if (once(tokenInput)) fillAndPress(tokenInput, trainerToken, L.openTrainer);
+      return;                               // the trainer's page: no trainee name
+    }
+    var nameInput = field(L.name);
+    var name = nameInput ? storedName() : null;
+    if (nameInput && name !== null && once(nameInput)) fillAndPress(nameInput, name, L.join);
+  }
+
+  var scheduled = false;
+  function schedule() {
+    if (scheduled) return;
+    scheduled = true;
+    window.setTimeout(function () { scheduled = false; scan(); }, 150);
+  }
+  function start() {
+    new MutationObserver(schedule).observe(document.documentElement, { childList: true, subtree: true });
+    document.documentElement.setAttribute("data-tcp-pendant-script", "1");
+    schedule();
+  }
+  if (document.readyState === "loading") document.addEventListener("DOMContentLoaded", start); else start();
+})();
