@@ -282,14 +282,15 @@ def beam_check_markdown(check: BeamCheck) -> str:
         "",
         f"Deviation **{check.deviation_norm_mm:.3f} mm** (95 % radius of the measurement "
         f"{check.ci95_mm:.3f} mm), FLANGE coordinates, measured - stored.",
-        f"The tip events fit the beam to {check.residual_rms_mm:.3f} mm RMS.",
+        "",
+        f"- the tip events fit the beam to {check.residual_rms_mm:.3f} mm RMS",
     ]
     if check.direction_deviation_deg is not None:
-        lines.append(f"Tool direction: {check.direction_deviation_deg:.2f} deg from the stored X axis.")
+        lines.append(f"- tool direction: {check.direction_deviation_deg:.2f} deg from the stored X axis")
     s = check.scan
-    lines.append(f"{len(s.tip_indices)} tip and {len(s.axis_indices)} axis events at "
+    lines.append(f"- {len(s.tip_indices)} tip and {len(s.axis_indices)} axis events at "
                  f"{s.n_orientations_done} orientations; the scan takes {s.duration_s:.1f} s on the "
-                 f"robot ({s.path_length_m * 1000.0:.0f} mm of path).")
+                 f"robot ({s.path_length_m * 1000.0:.0f} mm of path)")
     for reason in s.skipped:
         lines.append(f"- {escape_markdown(reason)}")
     lines += ["", ("✔ " if check.good else "⚠ ") + escape_markdown(check.verdict)]
