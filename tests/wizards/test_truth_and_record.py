@@ -65,6 +65,22 @@ def test_5d_is_graded_on_tool_x():
     assert cmp.orientation_error_deg == pytest.approx(30.0)
 
 
+def test_beam_is_graded_on_tcp_and_tool_x():
+    """The beam scan measures the TCP and the direction of tool X, not the turn about it: a
+    result turned 30 deg about tool X is good; one whose X is 3 deg off is poor."""
+    R_true = Rotation.from_euler("ZYX", [10.0, -80.0, 5.0], degrees=True)
+    truth = T_true((1.0, 2.0, 150.0), R_true.as_euler("ZYX", degrees=True))
+    for turn, tilt, grade in ((30.0, 0.0, "good"), (0.0, 3.0, "poor")):
+        R_res = R_true * Rotation.from_euler("xy", [turn, tilt], degrees=True)
+        res = WizardResult(wizard="beam", method="beam", tcp_mm=(1.0, 2.0, 150.0),
+                           abc_deg=tuple(R_res.as_euler("ZYX", degrees=True)), rotation=R_res.as_matrix(),
+                           tcp_result=object())  # type: ignore[arg-type]
+        cmp = compare_with_truth(res, truth)
+        assert cmp.graded == ("position", "x_axis") and cmp.grade == grade
+        assert cmp.x_axis_error_deg == pytest.approx(tilt, abs=1e-6)
+        assert "tool X error" in cmp.verdict
+
+
 def test_truth_rejects_bad_input():
     with pytest.raises(WizardError):
         compare_with_truth("result", np.eye(4))  # type: ignore[arg-type]

@@ -5,9 +5,10 @@ reported in mm and degrees:
 
 - position error: ``|t_result - t_true|`` (mm), the TCP in FLANGE coordinates;
 - orientation error: the angle of ``R_true^T R_result`` (deg, the geodesic distance between the
-  two tool orientations, via ``scipy.spatial.transform.Rotation.magnitude``); for the 5D ABC
-  world variant, which calibrates only tool X, the angle between the true and the computed
-  tool X axes is the graded figure (``x_axis_error_deg``).
+  two tool orientations, via ``scipy.spatial.transform.Rotation.magnitude``); for the methods
+  that calibrate only the direction of tool X (``X_AXIS_METHODS``: the 5D ABC world variant and
+  the automatic beam scan, which cannot see a turn about the tool's axis), the angle between the
+  true and the computed tool X axes is the graded figure (``x_axis_error_deg``).
 
 Verdict thresholds (``POSITION_THRESHOLDS_MM``, ``ORIENTATION_THRESHOLDS_DEG``):
 good below 0.5 mm / 0.5 deg, fair below 2 mm / 2 deg, poor otherwise. Only what the wizard
@@ -78,6 +79,10 @@ def _phrase(grade: Grade, what: str, value: float, unit: str, thresholds: tuple[
     return f"{what} {value:.2f} {unit} >= {thresholds[1]:g} {unit}"
 
 
+X_AXIS_METHODS: frozenset[str] = frozenset({"abc-world-5d", "beam"})
+"""Methods whose orientation is only the direction of tool X (graded on ``x_axis_error_deg``)."""
+
+
 def compare_with_truth(result: WizardResult, T_flange_tool_true_m: Any) -> TruthComparison:
     """Errors of ``result`` against the true TOOL frame (see the module docstring).
 
@@ -108,7 +113,7 @@ def compare_with_truth(result: WizardResult, T_flange_tool_true_m: Any) -> Truth
         graded.append("position")
     if not result.orientation_calibrated:
         pass
-    elif result.method == "abc-world-5d":
+    elif result.method in X_AXIS_METHODS:
         assert x_err is not None
         g = _grade(x_err, ORIENTATION_THRESHOLDS_DEG)
         parts.append((g, _phrase(g, "tool X error", x_err, "deg", ORIENTATION_THRESHOLDS_DEG)))
