@@ -130,6 +130,7 @@ def test_recorded_poses_are_the_model_poses_of_the_moves():
                                mv.T_world_flange_start[:3, 3] + ev.travel * m, atol=1e-12)
             assert np.allclose(ev.T_world_flange_exact[:3, :3], mv.T_world_flange_start[:3, :3])
         if mv.kind == "approach":  # the robot stops at the tip event
+            assert len(mv.event_indices) == 1
             assert np.allclose(scan.events[mv.event_indices[0]].T_world_flange_exact,
                                mv.T_world_flange_end, atol=1e-12)
 
@@ -405,8 +406,19 @@ def test_crossed_beams_give_axis_events_of_both_and_the_exact_tcp(robot):
     tcp, d = solve(scan)
     assert np.linalg.norm(tcp - T_true[:3, 3] * 1000.0) < 1e-6
     assert angle_between_deg(d, T_true[:3, 0]) < 1e-6
-    for i in scan.tip_indices:  # the tip meets the crossing point
+    # the tip meets the crossing point and breaks both beams: a tip event on each
+    tip_beams = [scan.events[i].beam for i in scan.tip_indices]
+    assert all(sorted(tip_beams[j:j + 2]) == [0, 1] for j in range(0, 8, 2))
+    for i in scan.tip_indices:
         assert np.linalg.norm(scan.tip_world_m(i) - crossed.point) < 1e-9
+        assert scan.events[i].miss_distance < 1e-9
+    approach = [mv for mv in scan.moves if mv.kind == "approach"]
+    assert [len(mv.event_indices) for mv in approach] == [2] * 4
+    # so one orientation already fixes the TCP (two beams seen along different flange directions)
+    rot, pos, b, u = scan_arrays_mm(scan.events)
+    first = list(scan.tip_indices[:2])
+    one = solve_beam(rot[first], pos[first], b[first], u[first]).tcp
+    assert np.linalg.norm(np.asarray(one) - T_true[:3, 3] * 1000.0) < 1e-6
 
 
 def test_an_orientation_out_of_reach_is_tried_turned_a_third_of_the_way():

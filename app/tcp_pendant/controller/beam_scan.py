@@ -32,7 +32,8 @@ and the tool direction):
   however wrong the believed tool data is within the margin. Two crossed beams: the passes run
   along the horizontal bisector that crosses both at the largest angle (45 deg for beams at
   right angles; ``W`` divided by that angle's sine) and record the axis events of both beams;
-  the approach aims at the crossing point.
+  the approach aims at the crossing point and records a tip event on each beam (so one
+  orientation already fixes the TCP).
 * At both axis events the PHYSICAL tool axis met the beam line, at the same flange orientation
   and the same position along ``u``. The flange positions at which the axis meets the beam form
   a straight line (in the plane across the beam, the flange offset is linear in the height of
@@ -74,6 +75,7 @@ tool) the longer of the flange's and the believed TCP's straight-line displaceme
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 from typing import Literal
@@ -192,7 +194,7 @@ class ScanMove:
 
     Attributes:
         kind: ``"move"`` (between the steps, at move speed), ``"approach"`` (the tip towards the
-            beam, at scan speed; ends at the tip event) or ``"pass"`` (sideways across the beam,
+            beam, at scan speed; ends at the (last) tip event) or ``"pass"`` (sideways across the beam,
             at scan speed).
         q_start_rad, q_end_rad: joint values at the start and end (rad; model IK).
         T_world_flange_start, T_world_flange_end: (4, 4) model flange poses, m.
@@ -576,11 +578,25 @@ def _scan_orientation(P: _Planner, k: int, spin: float, tilt: float,
     if ev is None:
         raise _Skip(f"the tip did not reach the beam on the approach: the tool "
                     f"data is more than {c.clearance_mm:g} mm off along the tool axis")
+    tips = [ev]
+    if sensor.second_direction is not None:
+        # crossed beams: the tip aimed at the crossing point breaks the other beam too; the
+        # controller records both (two constraints across two beams: methods.md section 9)
+        other = 1 - ev.beam
+        b_o, u_o = sensor.beams[other]
+        one = BeamSensor(b_o, u_o, width=sensor.width, sigma=sensor.sigma)
+        try:
+            ev2 = tip_on_beam(Tp, mp, one, shape, max_travel=max_travel, rng=rng)
+        except ControllerError:
+            ev2 = None
+        if ev2 is not None and ev2.miss_distance <= sensor.width / 4.0:
+            tips.append(dataclasses.replace(ev2, beam=other))
     T_ev = T_start.copy()
-    T_ev[:3, 3] += ev.travel * m
+    travel = max(e.travel for e in tips)  # the robot stops when the last beam broke
+    T_ev[:3, 3] += travel * m
     q_ev = P.straight("approach", T_ev, k, "The approach")
-    i_ev = P.record(ev, T_start, m, k)
-    P.add_move("approach", T_ev, q_ev, k, length=ev.travel, events=(i_ev,))
+    idx = tuple(P.record(e, T_start, m, k) for e in sorted(tips, key=lambda e: e.travel))
+    P.add_move("approach", T_ev, q_ev, k, length=travel, events=idx)
     P.move_to(T_start, k, "The retract after the approach")
 
 
