@@ -14,7 +14,9 @@ to it, so the thinnest layer that sees the handshake is ``websockets``' own
 origin check in front of the ``process_request`` that viser passes (its static-file server),
 so a refused upgrade is answered 403 before viser sees it. Policies are per listening port
 (:func:`allow`); a port without one gets the plain same-origin rule, so the check holds from the
-first connection even before the server's port is known.
+first connection even before the server's port is known. A port may also have an HTTP layer
+(:func:`set_http_layer`: ``client_script.serve``, the page's own script) that answers plain
+HTTP requests, behind the check and in front of viser's static server.
 """
 
 from __future__ import annotations
@@ -35,7 +37,7 @@ _DEFAULT_PORTS = {"http": 80, "https": 443}
 _lock = threading.Lock()
 _allowed_by_port: dict[int, frozenset[str]] = {}
 _original_handshake: Any = None
-_http_layer: Any = None
+_http_layers: dict[int, Any] = {}
 
 
 class OriginError(ValueError):
@@ -123,13 +125,14 @@ def _is_upgrade(request: Any) -> bool:
     return str(request.headers.get("Upgrade", "")).lower() == "websocket"
 
 
-def _allowed_for(connection: Any) -> frozenset[str]:
+def _allowed_for(connection: Any) -> tuple[frozenset[str], Any]:
+    """The extra origins and the HTTP layer of the port ``connection`` came to."""
     try:
         port = int(connection.local_address[1])
     except Exception:  # no socket address: same-origin rule only
-        return frozenset()
+        return frozenset(), None
     with _lock:
-        return _allowed_by_port.get(port, frozenset())
+        return _allowed_by_port.get(port, frozenset()), _http_layers.get(port)
 
 
 def enable() -> None:
@@ -143,7 +146,7 @@ def enable() -> None:
         original = _original_handshake = ServerConnection.handshake
 
     async def handshake(self: Any, process_request: Any = None, *args: Any, **kwargs: Any) -> None:
-        allowed = _allowed_for(self)
+        allowed, layer = _allowed_for(self)
 
         def checked(connection: Any, request: Any) -> Any:
             if _is_upgrade(request):
@@ -151,7 +154,6 @@ def enable() -> None:
                 if refusal is not None:
                     log.warning("websocket from %s: %s", request.headers.get("Origin"), refusal)
                     return connection.respond(http.HTTPStatus.FORBIDDEN, refusal + "\n")
-            layer = _http_layer
             if layer is not None and not _is_upgrade(request):
                 return layer(connection, request, process_request)
             return None if process_request is None else process_request(connection, request)
@@ -162,13 +164,15 @@ def enable() -> None:
     ServerConnection.handshake = handshake  # type: ignore[method-assign]
 
 
-def set_http_layer(layer: Any) -> None:
-    """Answer plain HTTP requests (not upgrades) with ``layer(connection, request,
-    process_request)`` in front of viser's static server (``tcp_pendant.client_script.serve``;
-    None: viser alone). The origin check above is unchanged."""
-    global _http_layer
+def set_http_layer(port: int, layer: Any) -> None:
+    """On the server listening on ``port``, answer plain HTTP requests (not upgrades) with
+    ``layer(connection, request, process_request)`` in front of viser's static server
+    (``tcp_pendant.client_script.serve``; None: viser alone). The origin check is unchanged."""
     with _lock:
-        _http_layer = layer
+        if layer is None:
+            _http_layers.pop(int(port), None)
+        else:
+            _http_layers[int(port)] = layer
 
 
 def allow(port: int, origins: Sequence[str]) -> None:
@@ -178,6 +182,7 @@ def allow(port: int, origins: Sequence[str]) -> None:
 
 
 def forget(port: int) -> None:
-    """Drop the extra origins of ``port`` (the server stopped)."""
+    """Drop the extra origins and the HTTP layer of ``port`` (the server stopped)."""
     with _lock:
         _allowed_by_port.pop(int(port), None)
+        _http_layers.pop(int(port), None)

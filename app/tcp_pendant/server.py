@@ -403,9 +403,9 @@ class PendantApp:
         host = self.config.host
         origin_check.enable()               # foreign web pages' websockets are refused (403)
         client_script.script_asset()        # the page's own script (keys, name, trainer URL): packaged?
-        origin_check.set_http_layer(client_script.serve)
         self.server = viser.ViserServer(host=host, port=self.config.port, verbose=False)
         origin_check.allow(self.port, self.allow_origins)
+        origin_check.set_http_layer(self.port, client_script.serve)
         if self.config.port != 0 and self.port != self.config.port:
             # viser silently moves on to the next free port; the class was told this one
             self.server.stop()

@@ -157,7 +157,25 @@ def test_the_origin_check_still_refuses_foreign_pages_in_front_of_the_script(app
         wait_until(lambda: len(app.sessions) == 1, what="the own page's session")
     finally:
         ws.close()
-    assert origin_check._http_layer is client_script.serve
+    assert origin_check._http_layers[port] is client_script.serve
+
+
+def test_the_layer_is_the_pendants_port_only(tmp_path: Path) -> None:
+    """A bare viser server in the same process serves its page untouched; a stopped pendant's
+    port forgets the layer."""
+    a = PendantApp(AppConfig(port=0, tool_library=tmp_path / "tools.json"))
+    a.start()
+    bare = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
+    try:
+        assert get(a.port, "/")[2].count(SCRIPT_TAG) == 1
+        status, _, body = get(bare.get_port(), "/")
+        assert status == 200 and body == VISER_INDEX
+        assert get(bare.get_port(), SCRIPT_PATH)[0] == 404
+    finally:
+        bare.stop()
+        port = a.port
+        a.stop()
+    assert port not in origin_check._http_layers
 
 
 def test_index_paths_and_injection() -> None:

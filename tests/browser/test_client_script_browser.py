@@ -203,10 +203,15 @@ def test_the_name_is_remembered_across_a_reload(pendant, new_page, tmp_path: Pat
     page, s = open_page(app, new_page)
     welcome = page.get_by_text("Welcome to the TCP Pendant")
     welcome.wait_for(state="visible", timeout=TIMEOUT_MS)
-    page.keyboard.press("Digit1")                         # the welcome window is open: keys do nothing
-    type_text(page, "Your name", "Anna 12")               # digits typed in the name do not jog either
-    page.wait_for_timeout(400)
     T0 = pose(s)
+    page.evaluate("document.activeElement && document.activeElement.blur()")
+    assert page.evaluate("!document.activeElement || document.activeElement === document.body")
+    page.keyboard.press("Digit1")                         # the welcome window is open: keys do nothing
+    page.keyboard.press("r")
+    type_text(page, "Your name", "Anna 12")               # digits typed in the name do not jog either
+    page.wait_for_timeout(1000)
+    np.testing.assert_allclose(pose(s), T0, atol=1e-12)
+    assert len(s.touches) == 0
     page.get_by_role("button", name="Join the class", exact=True).click()
     welcome.wait_for(state="hidden", timeout=TIMEOUT_MS)
     wait_text(page, "Trainee: Anna 12")
