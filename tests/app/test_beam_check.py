@@ -76,7 +76,7 @@ def test_the_industrial_loop_crash_check_update_verify(page) -> None:
     np.testing.assert_allclose(check.measured_tcp_mm, bent_tip_mm, atol=0.05)    # the beam sees the bent tip
     assert check.deviation_norm_mm == pytest.approx(world.tool_bend.shift_mm, abs=0.05)
     md = p.beam.result_md.content
-    assert "Pointer" in md and f"{check.deviation_norm_mm:.2f}" in md
+    assert "Beam check of Pointer" in md and f"Deviation **{check.deviation_norm_mm:.3f} mm**" in md
     assert not p.beam.update.disabled and not p.beam.replay.disabled
     assert ScanPlayer.of(s).scan is check.scan                      # the scan plays in the scene
     p.film_done()

@@ -76,11 +76,11 @@ def test_the_film_moves_the_robot_through_the_scan_and_leaves_it_at_the_end(page
     assert len(seen) >= len(player.frames)                       # one pose signal per frame
     assert any(red for _, red in seen)                            # the beam was red at the event
     assert not player.broken_beam.visible                         # and clear at the end
-    np.testing.assert_allclose(player._markers.points, [scan.tip_world_m(0) - [0.003, 0.0, 0.0]], atol=1e-6)   # on the beam
+    np.testing.assert_allclose(player.markers.points, [scan.tip_world_m(0) - [0.003, 0.0, 0.0]], atol=1e-6)   # on the beam
     player.clear(owner="someone else")                            # not theirs: stays
-    assert player._markers is not None and player.scan is scan
+    assert player.markers is not None and player.scan is scan
     player.clear(owner="me")
-    assert player._markers is None and player.scan is None
+    assert player.markers is None and player.scan is None
 
 
 def test_a_jog_during_the_film_stops_it_where_the_user_put_the_robot(page) -> None:
@@ -110,7 +110,7 @@ def test_off_the_loop_the_last_frame_is_shown_at_once(page) -> None:
     player.play(scan, return_to=home)                             # a test's own thread: no running loop
     assert not player.playing and player.frames_played == len(player.frames)
     np.testing.assert_allclose(p.session.controller.q_rad, home)
-    assert player._markers is not None and not player.broken_beam.visible
+    assert player.markers is not None and not player.broken_beam.visible
 
 
 def test_a_stored_scan_without_moves_only_shows_its_markers(page) -> None:
@@ -124,4 +124,4 @@ def test_a_stored_scan_without_moves_only_shows_its_markers(page) -> None:
     assert not player.playing and player.frames == ()
     np.testing.assert_array_equal(p.session.controller.q_rad, q)              # the robot did not move
     b = live.events[0].beam_point
-    np.testing.assert_allclose(player._markers.points, [[b[0], 0.1, b[2]]], atol=1e-6)   # on the beam line
+    np.testing.assert_allclose(player.markers.points, [[b[0], 0.1, b[2]]], atol=1e-6)   # on the beam line

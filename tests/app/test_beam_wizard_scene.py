@@ -73,12 +73,15 @@ def test_the_beam_result_is_replayed_framed_and_compared_with_the_manual_one(pag
     p.film_done()
     assert p.player.frames_played == len(p.player.frames) > len(scan.moves)
     np.testing.assert_allclose(c.q_rad, scan.q_end_rad, atol=1e-12)    # the robot stays at the scan's end
-    markers = np.asarray(p.player._markers.points, dtype=float)
+    markers = np.asarray(p.player.markers.points, dtype=float)
     assert len(markers) == len(scan.events)
     for m, ev, truth_point in zip(markers, scan.events, scan.beam_points_world_m):
         d = m - ev.beam_point
         assert np.linalg.norm(d - (d @ ev.beam_dir) * ev.beam_dir) < 1e-6   # on the beam line
         assert np.linalg.norm(m - truth_point) < 1e-3                      # where the tool met it
+    rays = np.asarray(p.player.rays.points, dtype=float)               # flange -> beam, per event
+    np.testing.assert_allclose(rays[:, 0], [ev.T_world_flange_exact[:3, 3] for ev in scan.events], atol=1e-5)
+    np.testing.assert_allclose(rays[:, 1], markers, atol=1e-5)
     assert v.scene.computed.visible                                   # the TOOL triad of the result
     assert _in_view(v.scene.last_framing, c.beam_sensor.point)         # the camera sees the sensor
     assert all(_in_view(v.scene.last_framing, m) for m in markers)
@@ -102,7 +105,7 @@ def test_the_beam_result_is_replayed_framed_and_compared_with_the_manual_one(pag
     p.click(v.steps.cancel)
     p.choose(v.method, "XYZ 4-point")
     p.click(v.start)
-    assert p.player.scan is None and p.player._markers is None
+    assert p.player.scan is None and p.player.markers is None and p.player.rays is None
 
 
 def test_in_an_exercise_the_comparison_shows_no_errors(page) -> None:

@@ -202,9 +202,12 @@ class ScanPlayer:
         self.broken_beam = scene.add_line_segments(
             f"{self.ROOT}/broken_beam", points=np.zeros((1, 2, 3)), colors=BROKEN_RGB, thickness=6.0,
             thickness_units="screen", visible=False)
-        self.break_point = scene.add_icosphere(f"{self.ROOT}/break_point", radius=0.004, color=BROKEN_RGB,
+        self.break_point = scene.add_icosphere(f"{self.ROOT}/break_point", radius=0.005, color=BROKEN_RGB,
                                                visible=False, cast_shadow=False, receive_shadow=False)
-        self._markers: Any = None
+        self.markers: Any = None
+        """The event markers (a point cloud on the beam; None: none shown)."""
+        self.rays: Any = None
+        """Each shown event's ray, flange -> marker (line segments; None: none shown)."""
         self._scan: Any = None
         self._points = np.zeros((0, 3))
         self._task: asyncio.Task[None] | None = None
@@ -302,6 +305,8 @@ class ScanPlayer:
                     if generation != self._generation or s.closed:
                         return
                     if self._last_q is not None and not np.array_equal(s.controller.q_rad, self._last_q):
+                        log.info("beam scan replay stopped at frame %d of %d: the robot was moved",
+                                 i, len(self.frames))
                         return                          # the user moved the robot: the film stops
                     self._apply(i)
                 await asyncio.sleep(1.0 / max(self.rate_hz, 1e-3))
@@ -342,13 +347,21 @@ class ScanPlayer:
             self.broken_beam.visible = True
             self.break_point.position = tuple(float(v) for v in self._points[broken])
             self.break_point.visible = True
-        if self._markers is not None:
-            self._markers.remove()
-            self._markers = None
+        for h in (self.markers, self.rays):
+            if h is not None:
+                h.remove()
+        self.markers = self.rays = None
         if shown and scan is not None:
             idx = list(shown)
             colors = np.array([TIP_EVENT_RGB if scan.events[i].kind == "tip" else AXIS_EVENT_RGB for i in idx],
                               dtype=np.uint8)
-            self._markers = self.scene.add_point_cloud(f"{self.ROOT}/events", points=self._points[idx],
-                                                       colors=colors, point_size=0.005, point_shape="circle",
+            self.markers = self.scene.add_point_cloud(f"{self.ROOT}/events", points=self._points[idx],
+                                                       colors=colors, point_size=0.008, point_shape="circle",
                                                        precision="float32")
+            # each event's ray: from the flange where the controller recorded it to where the tool met
+            # the beam, a fan of the scan's orientations converging on the beam
+            flanges = np.array([_flange(scan.events[i])[:3, 3] for i in idx])
+            segs = np.stack([flanges, self._points[idx]], axis=1)
+            self.rays = self.scene.add_line_segments(f"{self.ROOT}/rays", points=segs,
+                                                      colors=np.repeat(colors[:, None, :], 2, axis=1),
+                                                      thickness=1.5, thickness_units="screen")

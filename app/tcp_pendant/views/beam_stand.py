@@ -37,11 +37,11 @@ POST_THICKNESS_M = 0.016
 POST_WIDTH_M = 0.03
 BAR_HEIGHT_M = 0.016
 COLUMN_RADIUS_M = 0.018
-BEAM_RGB = (0, 215, 90)
+BEAM_RGB = (0, 190, 60)
 """The intact beam: bright green (red is kept for a broken beam)."""
 STAND_RGB = (70, 82, 104)
 HEAD_RGB = (28, 28, 32)
-BEAM_PX = 4.0
+BEAM_PX = 5.0
 """Line width of the beam, screen pixels."""
 
 

@@ -232,9 +232,10 @@ class WizardSceneView:
         if scan is not None and len(scan.events):   # a beam scan: its events and the sensor, not the tip
             T_wf = np.asarray(scan.events[-1].T_world_flange, dtype=float)   # where the film ends
             centres = [np.asarray(ev.T_world_flange, dtype=float)[:3, 3] for ev in scan.events]
-            centres += [*event_points_world(scan, self._scan_points(self._shown_result)),
-                        np.asarray(scan.events[0].beam_point, dtype=float)]
-            radii = [0.06] * len(scan.events) + [0.01] * len(scan.events) + [0.1]
+            b = np.asarray(scan.events[0].beam_point, dtype=float)
+            centres += [*event_points_world(scan, self._scan_points(self._shown_result)), b,
+                        b - [0.0, 0.0, 0.12]]                          # the beam and the fork below it
+            radii = [0.06] * len(scan.events) + [0.01] * len(scan.events) + [0.1, 0.06]
         else:
             centres = [T_wf[:3, 3], np.asarray(self.session.controller.reference_tip_world_m, dtype=float)]
             radii = [0.09, 0.02]
@@ -275,9 +276,10 @@ class WizardSceneView:
         if not np.all(np.isfinite(centres)) or not np.all(np.isfinite(radii)):
             return None
         clients = self._clients()
-        framings = [frame_spheres(centres, radii, fov_rad=fov, aspect=aspect, image_height_px=height)
+        kw = {} if (d := self._view_direction()) is None else {"direction": d}
+        framings = [frame_spheres(centres, radii, fov_rad=fov, aspect=aspect, image_height_px=height, **kw)
                     for fov, aspect, height in (self._camera_shape(c) for c in clients)]
-        framing = framings[0] if framings else frame_spheres(centres, radii)
+        framing = framings[0] if framings else frame_spheres(centres, radii, **kw)
         for client, f in zip(clients, framings):
             try:
                 with client.atomic():        # position first: its setter shifts look_at
@@ -287,6 +289,23 @@ class WizardSceneView:
                 log.debug("camera of a client not framed", exc_info=True)
         self.last_framing = framing
         return framing
+
+    def _view_direction(self) -> np.ndarray | None:
+        """A beam result: look at the beam broadside (across it, from the side away from the
+        robot's base, from above), so the passes and the events are seen side by side; None: the
+        overview's direction."""
+        scan = getattr(self._shown_result, "scan", None)
+        if scan is None or not len(scan.events):
+            return None
+        b = np.asarray(scan.events[0].beam_point, dtype=float)
+        u = np.asarray(scan.events[0].beam_dir, dtype=float)
+        side = np.cross([0.0, 0.0, 1.0], u)
+        if np.linalg.norm(side) < 1e-6:                 # a vertical beam: any horizontal side
+            side = np.array([0.0, -1.0, 0.0])
+        side /= np.linalg.norm(side)
+        if float(side @ b) < 0.0:                      # WORLD's origin is the robot's root link
+            side = -side
+        return side + 0.35 * u * (1.0 if float(u @ b) >= 0.0 else -1.0) + np.array([0.0, 0.0, 0.5])
 
     @staticmethod
     def _camera_framing(client: Any) -> Framing | None:
