@@ -22,6 +22,7 @@ from tcp_pendant.controller import (
     run_beam_scan,
     tool_shape,
 )
+from tcp_pendant.controller.approach import solve_ik
 from tcp_pendant.controller.beam_scan import scan_arrays_mm
 from tcp_pendant.controller.scenarios import Scenario, draw_kinematic_errors, perturbed_kinematics
 
@@ -319,12 +320,21 @@ def test_absolute_accuracy_records_model_poses_and_hits_the_physical_beam(robot)
             if ev.kind == "tip":  # recorded: the MODEL pose where the robot stopped
                 assert np.allclose(ev.T_world_flange, kin.T_world_flange(mv.q_end_rad), atol=1e-9)
                 # the PHYSICAL tip at those joint values is on the beam: off its centre by the
-                # aiming error (the model's line is not quite the physical one) and the
-                # linearisation over the approach, hundredths of a mm, well inside the beam
+                # aiming error (the model's line is not quite the physical one): hundredths of a
+                # mm, well inside the beam; the linearisation adds less than a micrometre
                 assert ev.miss_distance < 1e-4
                 T_phys = true_kin.T_world_flange(mv.q_end_rad)
                 p = T_phys[:3, :3] @ T_true[:3, 3] + T_phys[:3, 3] - ev.beam_point
-                assert np.linalg.norm(p - (p @ ev.beam_dir) * ev.beam_dir) < ev.miss_distance + 2e-5
+                assert np.linalg.norm(p - (p @ ev.beam_dir) * ev.beam_dir) == pytest.approx(
+                    ev.miss_distance, abs=1e-6)
+                assert np.allclose(scan.tip_world_m(i), T_phys[:3, :3] @ T_true[:3, 3] + T_phys[:3, 3], atol=1e-6)
+            else:  # the PHYSICAL tool axis at the event's joint values meets the beam line
+                q_ev = solve_ik(kin, ev.T_world_flange_exact, mv.q_start_rad).q_rad
+                T_phys = true_kin.T_world_flange(q_ev)
+                tip_w = T_phys[:3, :3] @ T_true[:3, 3] + T_phys[:3, 3]
+                d_w = T_phys[:3, :3] @ T_true[:3, 0]
+                n = np.cross(d_w, ev.beam_dir)
+                assert abs((tip_w - ev.beam_point) @ n) / np.linalg.norm(n) < 1e-6
     tcp, _ = solve(scan)
     err = np.linalg.norm(tcp - T_true[:3, 3] * 1000.0)
     # the model's poses are not the physical ones: tenths of a mm off, no more

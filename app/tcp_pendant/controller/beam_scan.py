@@ -58,14 +58,18 @@ moves between the steps with the device are not checked: they keep ``W`` sideway
 ``clearance_mm`` above the beam.
 
 **Absolute accuracy** (``true_kinematics`` differs): a local linearisation. During one straight
-motion from joint values ``q0``, the physical flange follows the model's straight motion moved
-rigidly by the start pose's discrepancy ``D = T_true(q0) T_model(q0)^-1``: it starts at
-``T_true(q0)`` and moves along ``R_D m`` (``m`` the model's direction). Over the few mm to cm of
-a pass the change of ``D`` is far below the sensor's repeatability. The event's travel found
-on the physical motion is recorded on the model's: ``T_model(q0)`` moved by ``travel m``.
+motion of the model, the physical flange follows it moved rigidly by the discrepancy
+``D = T_true(q) T_model(q)^-1`` at the joints ``q`` of the travel where the event happens: a
+straight line that touches the real (slightly curved) path there. ``D`` is first taken at the
+motion's start, the event found, then ``D`` taken at the event and the event found again until
+its travel settles (to 1e-11 m in two or three rounds). With ``D`` of the start alone the error
+was up to 0.2 mm over a 55 mm pass: ``D`` turns by hundredths of a degree about the robot's
+base, a metre away. The event's travel is recorded on the model's motion: ``T_model(q0)`` moved
+by ``travel m``. The tip events' ``miss_distance`` and the markers are the physical ones.
 
 **Repeatability**: the sensor's ``sigma`` per axis on each recorded position (``rng``; None:
-exact data). The noise drawn for the physical event is added to the recorded model pose.
+exact data), drawn when the event is recorded and added to the recorded model pose (the average
+of two recordings for a crossing's entry and exit).
 
 **Duration** (what the scan takes on a real robot): ``sum(length_m / speed)`` over the moves,
 passes and approaches at ``scan_speed_mm_s``, the others at ``move_speed_mm_s``. The length of
@@ -78,6 +82,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass, field
+from collections.abc import Callable
 from typing import Literal
 
 import numpy as np
@@ -120,6 +125,7 @@ BEAM_TOOL_SHAPES: dict[str, tuple[float, float]] = {
 """Shaft capsules of the built-in tools a beam can measure (the gripper has no tip)."""
 
 _DEFAULT_SHAPE = (0.005, 0.10)
+_REFINE_ROUNDS = 4
 _NO_TIP_TOOLS = {"gripper": "the two-finger gripper has no tip the beam could see (its TCP is "
                             "in the air between the fingers); calibrate it with a touch method"}
 
@@ -461,22 +467,49 @@ class _Planner:
     def move_to(self, T_end: np.ndarray, k: int, what: str) -> None:
         self.add_move("move", T_end, self.ik(T_end, what), k)
 
-    def physical_start(self, q0: np.ndarray, T_model: np.ndarray, m: np.ndarray
-                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Physical start pose and direction of a straight model motion (the linearisation),
-        and the discrepancy ``D``."""
+    def physical_line(self, q0: np.ndarray, T_model0: np.ndarray, m: np.ndarray, tau: float
+                      ) -> tuple[np.ndarray, np.ndarray]:
+        """The physical flange's straight motion that touches the real one at travel ``tau`` of
+        the model's straight motion (``T_model0``, direction ``m``, from joints ``q0``): start
+        pose (at travel 0) and direction, ``D T_model(s)`` with ``D = T_true(q) T_model(q)^-1``
+        at the joints ``q`` of travel ``tau`` (the linearisation of the module docstring)."""
         if self.true_kin is self.kin:
-            return T_model, m, np.eye(4)
-        T_true = self.true_kin.T_world_flange(q0)
-        D = T_true @ np.linalg.inv(T_model)
-        return T_true, D[:3, :3] @ m, D
+            return T_model0, m
+        q = q0
+        if tau != 0.0:
+            T_tau = T_model0.copy()
+            T_tau[:3, 3] += tau * m
+            sol = solve_ik(self.kin, T_tau, q0)
+            if sol.ok:
+                q = sol.q_rad
+        D = self.true_kin.T_world_flange(q) @ np.linalg.inv(self.kin.T_world_flange(q))
+        return D @ T_model0, D[:3, :3] @ m
+
+    def refine(self, ev: BeamEvent, q0: np.ndarray, T_model0: np.ndarray, m: np.ndarray,
+               find: Callable[[np.ndarray, np.ndarray], BeamEvent | None]) -> BeamEvent:
+        """An event found on the line linearised at the motion's start, found again on the line
+        linearised at the event itself until its travel settles (absolute accuracy only; two or
+        three rounds: the linearisation error shrinks by ~1e-2 a round)."""
+        if self.true_kin is self.kin:
+            return ev
+        for _ in range(_REFINE_ROUNDS):
+            again = find(*self.physical_line(q0, T_model0, m, ev.travel))
+            if again is None:
+                break
+            settled = abs(again.travel - ev.travel) < 1e-11
+            ev = again
+            if settled:
+                break
+        return ev
 
     def record(self, ev: BeamEvent, T_model0: np.ndarray, m: np.ndarray, k: int) -> int:
         """Turn an event on the physical motion into the recorded model event."""
         exact = T_model0.copy()
         exact[:3, 3] = T_model0[:3, 3] + ev.travel * m
         noisy = exact.copy()
-        noisy[:3, 3] += ev.T_world_flange[:3, 3] - ev.T_world_flange_exact[:3, 3]
+        if self.rng is not None and self.sensor.sigma > 0.0:  # entry and exit of a crossing averaged
+            n_avg = 2 if ev.kind == "axis" else 1
+            noisy[:3, 3] += self.rng.normal(0.0, self.sensor.sigma, (n_avg, 3)).mean(axis=0)
         T_phys = ev.T_world_flange_exact
         if ev.kind == "tip":
             point = T_phys[:3, :3] @ self.shape.tip + T_phys[:3, 3]
@@ -508,11 +541,24 @@ class _Planner:
 
 
 # ------------------------------------------------------------------------------ the scan
+def _same_beam(beam: int, detect: Callable[..., object], sensor: BeamSensor, shape: ToolShape,
+               max_travel: float) -> Callable[[np.ndarray, np.ndarray], BeamEvent | None]:
+    """``find(T_start, direction)`` for :meth:`_Planner.refine`: the event of ``beam`` that
+    ``detect`` (``crossing_events`` or ``tip_on_beam``) finds on that line, exact."""
+
+    def find(T_start: np.ndarray, direction: np.ndarray) -> BeamEvent | None:
+        out = detect(T_start, direction, sensor, shape, max_travel=max_travel)
+        events = out if isinstance(out, tuple) else (out,)
+        return next((ev for ev in events if ev is not None and ev.beam == beam), None)
+
+    return find
+
+
 def _scan_orientation(P: _Planner, k: int, spin: float, tilt: float,
                       R_base: np.ndarray, T_ft_inv: np.ndarray, a: np.ndarray, W: float,
                       h1: float, h2: float, clear: float) -> None:
     """One orientation of the scan (module docstring); raises _Skip with the reason."""
-    sensor, shape, c, rng = P.sensor, P.shape, P.config, P.rng
+    sensor, shape, c = P.sensor, P.shape, P.config
     b, u = np.array(sensor.point), np.array(sensor.direction)
     R_tool = _rot(u, math.radians(tilt)) @ R_base @ _rot(np.array([1.0, 0.0, 0.0]), math.radians(spin))
     x_w = R_tool[:, 0]  # believed working direction in WORLD (down-ish)
@@ -535,9 +581,10 @@ def _scan_orientation(P: _Planner, k: int, spin: float, tilt: float,
         T_end = T0.copy()
         T_end[:3, 3] += 2.0 * W * m
         q_end = P.straight("pass", T_end, k, f"The {'first' if j == 0 else 'second'} pass")
-        Tp, mp, _ = P.physical_start(P.q, T0, m)
         try:
-            found = crossing_events(Tp, mp, sensor, shape, max_travel=2.0 * W, rng=rng)
+            found = crossing_events(*P.physical_line(P.q, T0, m, 0.0), sensor, shape, max_travel=2.0 * W)
+            found = tuple(P.refine(ev, P.q, T0, m, _same_beam(ev.beam, crossing_events, sensor, shape, 2.0 * W))
+                          for ev in found)
         except ControllerError as exc:
             raise _Skip(f"the {'first' if j == 0 else 'second'} pass did not "
                         f"cross the beam cleanly ({exc})") from None
@@ -570,9 +617,10 @@ def _scan_orientation(P: _Planner, k: int, spin: float, tilt: float,
     T_start[:3, :3] = R_tool @ T_ft_inv[:3, :3]
     P.move_to(T_start, k, "The approach start")
     max_travel = 2.0 * clear * glen
-    Tp, mp, _ = P.physical_start(P.q, T_start, m)
     try:
-        ev = tip_on_beam(Tp, mp, sensor, shape, max_travel=max_travel, rng=rng)
+        ev = tip_on_beam(*P.physical_line(P.q, T_start, m, 0.0), sensor, shape, max_travel=max_travel)
+        if ev is not None:
+            ev = P.refine(ev, P.q, T_start, m, _same_beam(ev.beam, tip_on_beam, sensor, shape, max_travel))
     except ControllerError as exc:
         raise _Skip(f"the approach could not start clear of the beam ({exc})") from None
     if ev is None:
@@ -586,7 +634,9 @@ def _scan_orientation(P: _Planner, k: int, spin: float, tilt: float,
         b_o, u_o = sensor.beams[other]
         one = BeamSensor(b_o, u_o, width=sensor.width, sigma=sensor.sigma)
         try:
-            ev2 = tip_on_beam(Tp, mp, one, shape, max_travel=max_travel, rng=rng)
+            ev2 = tip_on_beam(*P.physical_line(P.q, T_start, m, 0.0), one, shape, max_travel=max_travel)
+            if ev2 is not None:
+                ev2 = P.refine(ev2, P.q, T_start, m, _same_beam(0, tip_on_beam, one, shape, max_travel))
         except ControllerError:
             ev2 = None
         if ev2 is not None and ev2.miss_distance <= sensor.width / 4.0:
