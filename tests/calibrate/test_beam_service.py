@@ -208,3 +208,31 @@ def test_robot_accuracy_shows_as_disagreeing_events(robot, seed):
     assert f"{check.residual_rms_mm:.3f} mm RMS" in check.verdict
     # the physical tool is exactly the stored one: what the check reports is the robot's error
     assert 0.1 < check.deviation_norm_mm < 2.0
+
+
+def test_one_orientation_is_too_few_for_a_check():
+    """A wrist narrowed so that only the first orientation is in reach: one tip event cannot
+    give a TCP; the check says so in words with the skip reasons (no crash, no number)."""
+    from tcp_pendant.calibrate.beam_service import evaluate_check
+    from tcp_pendant.controller import RobotKinematics, run_beam_scan, tool_shape
+
+    c = make_controller("kr6", "pointer")
+    stored = truth_tool("pointer", "Pointer")
+    full = run_beam_scan(c.kinematics, c.q_rad, c.beam_sensor, _plan_m(stored), tool_shape(c.mounted_tool))
+    q = np.degrees([mv.q_end_rad for mv in full.moves if mv.kind == "approach"][0])
+    kin = RobotKinematics(c.kinematics.model, c.kinematics.urdf_path, c.kinematics.flange_link, c.kinematics.base_link)
+    kin.lower_rad, kin.upper_rad = kin.lower_rad.copy(), kin.upper_rad.copy()
+    for j in (3, 5):
+        kin.lower_rad[j], kin.upper_rad[j] = np.radians(q[j] - 20.0), np.radians(q[j] + 20.0)
+    scan = run_beam_scan(kin, c.q_rad, c.beam_sensor, _plan_m(stored), tool_shape(c.mounted_tool))
+    assert len(scan.tip_indices) == 1 and len(scan.skipped) == 3
+    with pytest.raises(ControllerError, match=r"too few tip events for a TCP: 1 of 4 orientations.*"
+                                              r"Orientation 2 \(turned 90 deg about the tool axis\) was skipped.*"
+                                              r"Place the beam sensor where the robot reaches it"):
+        evaluate_check(stored, 1, scan)
+
+
+def _plan_m(tool: Tool) -> np.ndarray:
+    T = np.array(tool.T_flange_tool_mm)
+    T[:3, 3] /= 1000.0
+    return T

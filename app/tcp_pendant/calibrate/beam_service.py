@@ -184,12 +184,16 @@ def evaluate_check(tool: Tool, slot: int | None, scan: BeamScan, seed: int = 0) 
     axis_sigma_mm = scan.sensor.sigma * 1000.0 / math.sqrt(2.0)  # entry and exit averaged
     tip_sigma = tip_sigma_mm if lo <= tip_sigma_mm <= hi else None
     axis_sigma = axis_sigma_mm if lo <= axis_sigma_mm <= hi else None
+    if len(ti) < 2:
+        raise ControllerError(
+            f"The beam check found too few tip events for a TCP: {len(ti)} of "
+            f"{scan.n_orientations_planned} orientations could be scanned, at least 2 are needed. "
+            + " ".join(scan.skipped) + " Place the beam sensor where the robot reaches it with the "
+            "tool turned about its own axis (nearer the robot, or lower), or start from another pose.")
     try:
         beam = solve_beam(rot[ti], pos[ti], b[ti], u[ti], sigma=tip_sigma)
     except TcpcalError as exc:
-        raise ControllerError(
-            f"The beam check found too few tip events for a TCP ({len(ti)} of "
-            f"{scan.n_orientations_planned} orientations): {exc} " + " ".join(scan.skipped)) from None
+        raise ControllerError(f"The beam check's tip events do not determine a TCP: {exc}") from None
     axis: BeamAxisResult | None
     try:
         axis = solve_beam_axis(rot[ai], pos[ai], b[ai], u[ai], beam.tcp, sigma=axis_sigma)
