@@ -171,6 +171,9 @@ def test_the_record_key_records_a_free_touch_and_a_wizard_step(pendant, new_page
     page.get_by_role("tab", name="Jog").click()
     page.get_by_text("Step 1 of 4").filter(visible=True).first.wait_for(timeout=TIMEOUT_MS)
     assert len(wf.wizard.recorded_poses) == 0
+    T0 = pose(s)
+    page.keyboard.press("Digit3")                          # the jog keys work while the wizard runs
+    assert_moved(T0, settled(s, T0), "Z", 1, 10.0)
     page.keyboard.press("r")
     wait_text(page, "mm from the reference tip")        # the check's question, nothing recorded
     assert len(wf.wizard.recorded_poses) == 0 and len(s.touches) == 2
