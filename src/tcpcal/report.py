@@ -62,7 +62,7 @@ def _finite_or_none(x: float) -> float | None:
 def _jsonable(obj: Any) -> Any:
     """Convert numpy values and non-finite floats (-> ``None``) for strict JSON."""
     if isinstance(obj, Mapping):
-        return {str(k): _jsonable(v) for k, v in obj.items()}
+        return {str(k): _FloatArray(v) if _FloatArray.takes(v) else _jsonable(v) for k, v in obj.items()}
     if isinstance(obj, np.ndarray):
         if obj.dtype.kind in "biu" or (obj.dtype.kind == "f" and bool(np.isfinite(obj).all())):
             return obj.tolist()  # plain Python numbers already (one call for 1e6 residuals)
@@ -107,10 +107,108 @@ def _plain_list(obj: list[Any] | tuple[Any, ...]) -> list[Any] | None:
     return [list(v) for v in obj] if rows else list(obj)
 
 
-def _dump(obj: Any, level: int) -> str:
+PARALLEL_MIN_VALUES = 300_000
+"""A float array of at least this many values is formatted by :func:`json_dumps` in ``workers``
+processes (below it, handing it to another process costs more than it saves)."""
+
+
+def _format_block(array: np.ndarray, row: str, sep: str) -> str:
+    """The rows of a 2-D float array, each ``row % values`` (``row``: ``%r`` per column), joined
+    by ``sep``: one ``%`` pass over the flat values. ``%r`` is ``repr``, which is what
+    ``json.dumps`` writes for a finite float."""
+    return sep.join([row] * array.shape[0]) % tuple(array.ravel().tolist())
+
+
+class _Formatter:
+    """Formats the float arrays of one :func:`json_dumps` call: alone, or with ``workers - 1``
+    forked processes (one pool for the call, started at the first large array)."""
+
+    def __init__(self, workers: int) -> None:
+        self.workers = max(1, int(workers))
+        self._pool: Any = None
+
+    def format(self, array: np.ndarray, row: str, sep: str) -> str:
+        """:func:`_format_block` of ``array`` (2-D), large arrays by blocks of rows in the pool."""
+        if self.workers > 1 and array.size >= PARALLEL_MIN_VALUES:
+            text = self._in_processes(array, row, sep)
+            if text is not None:
+                return text
+        return _format_block(array, row, sep)
+
+    def _in_processes(self, array: np.ndarray, row: str, sep: str) -> str | None:
+        import warnings
+        from concurrent.futures import ProcessPoolExecutor
+        from concurrent.futures.process import BrokenProcessPool
+
+        blocks = [b for b in np.array_split(array, self.workers) if len(b)]
+        try:
+            with warnings.catch_warnings():   # Python >= 3.12 warns of fork() next to threads:
+                warnings.simplefilter("ignore", DeprecationWarning)  # the children only format
+                if self._pool is None:
+                    ctx = _fork_context()
+                    if ctx is None:
+                        self.workers = 1
+                        return None
+                    self._pool = ProcessPoolExecutor(self.workers - 1, mp_context=ctx)
+                futures = [self._pool.submit(_format_block, b, row, sep) for b in blocks[:-1]]
+                last = _format_block(blocks[-1], row, sep)
+                return sep.join([f.result() for f in futures] + [last])
+        except (OSError, BrokenProcessPool):   # no process: this one formats alone
+            self.close()
+            self.workers = 1
+            return None
+
+    def close(self) -> None:
+        if self._pool is not None:
+            self._pool.shutdown()
+            self._pool = None
+
+
+def _fork_context() -> Any:
+    """The ``fork`` multiprocessing context, or None where there is none (Windows)."""
+    import multiprocessing
+
+    return (multiprocessing.get_context("fork") if "fork" in multiprocessing.get_all_start_methods()
+            else None)
+
+
+class _FloatArray:
+    """A dict value that is a finite float array, 1-D or of n >= 1 rows (10^6 residuals and
+    residual vectors): :func:`_dump` prints it in one ``%`` format pass over the flat values
+    (a row a line for 2-D), without the Python lists ``tolist()`` builds and one JSON encoding
+    pass of them; large ones in several processes (:class:`_Formatter`).
+
+    Same bytes as the list path: ``json.dumps`` writes a finite float as its ``repr`` (as ``%r``
+    does), a list as ``[a, b, c]``; tests/tcpcal/test_json_fast_path.py compares both.
+    """
+
+    __slots__ = ("array",)
+
+    def __init__(self, array: np.ndarray) -> None:
+        self.array = array
+
+    @staticmethod
+    def takes(obj: Any) -> bool:
+        """``obj`` is a float array this class prints (else :func:`_jsonable` converts it)."""
+        return (isinstance(obj, np.ndarray) and obj.dtype.kind == "f"
+                and (obj.ndim == 1 or (obj.ndim == 2 and obj.shape[0] > 0))
+                and bool(np.isfinite(obj).all()))
+
+    def dump(self, level: int, fmt: _Formatter) -> str:
+        a = self.array
+        if a.ndim == 1:
+            return "[" + fmt.format(a.reshape(-1, 1), "%r", ", ") + "]"
+        pad = "  " * (level + 1)
+        row = "[" + ", ".join(["%r"] * a.shape[1]) + "]"
+        return "[\n" + pad + fmt.format(a, row, ",\n" + pad) + "\n" + "  " * level + "]"
+
+
+def _dump(obj: Any, level: int, fmt: _Formatter) -> str:
+    if isinstance(obj, _FloatArray):
+        return obj.dump(level, fmt)
     if isinstance(obj, dict) and obj:
         pad = "  " * (level + 1)
-        items = [f"{pad}{json.dumps(k)}: {_dump(v, level + 1)}" for k, v in obj.items()]
+        items = [f"{pad}{json.dumps(k)}: {_dump(v, level + 1, fmt)}" for k, v in obj.items()]
         return "{\n" + ",\n".join(items) + "\n" + "  " * level + "}"
     if isinstance(obj, list) and obj:
         types = set(map(type, obj))
@@ -122,14 +220,26 @@ def _dump(obj: Any, level: int) -> str:
                     # no string, dict or deeper list inside: "], [" only separates the rows
                     return ("[\n" + pad + flat[1:-1].replace("], [", "],\n" + pad + "[")
                             + "\n" + "  " * level + "]")
-            return ("[\n" + ",\n".join(pad + _dump(v, level + 1) for v in obj) + "\n"
+            return ("[\n" + ",\n".join(pad + _dump(v, level + 1, fmt) for v in obj) + "\n"
                     + "  " * level + "]")
     return json.dumps(obj, allow_nan=False)
 
 
-def json_dumps(obj: Any) -> str:
-    """Strict JSON (no NaN/Infinity tokens): one key per line, number lists on one line."""
-    return _dump(_jsonable(obj), 0)
+def json_dumps(obj: Any, *, workers: int = 1) -> str:
+    """Strict JSON (no NaN/Infinity tokens): one key per line, number lists on one line.
+
+    Args:
+        obj: dicts, lists, numbers, strings, None and numpy arrays/numbers.
+        workers: processes that format a large float array (a dict value of at least
+            ``PARALLEL_MIN_VALUES`` values, e.g. 10^6 residual vectors) together, this one and
+            ``workers - 1`` forked; 1 (default): no process is started. Same text either way.
+            For a command-line process only (not a server with threads of its own).
+    """
+    fmt = _Formatter(workers)
+    try:
+        return _dump(_jsonable(obj), 0, fmt)
+    finally:
+        fmt.close()
 
 
 def tcp_result_to_dict(result: TcpResult, *, rows: Sequence[int] | None = None) -> dict[str, Any]:
