@@ -144,6 +144,13 @@ def test_cont_mode_holds_the_key_like_the_mouse_button(pendant, new_page) -> Non
     page.keyboard.press("BracketRight")                   # 100 -> Cont.
     wait_until(lambda: increment(s) == "Cont.", "continuous mode")
     page.get_by_role("button", name="X +", exact=True).first.wait_for(state="visible", timeout=TIMEOUT_MS)
+    # viser shows no tooltip for single buttons: the script names their keys in the native one
+    page.wait_for_function("""() => {
+        const b = [...document.querySelectorAll('button')];
+        const t = n => (b.find(x => x.textContent.trim() === n) || {}).title;
+        return t('X +') === 'Key 1' && t('X \u2212') === 'Key Shift+1' && t('C +') === 'Key 6'
+            && t('Record point') === 'Key R';
+    }""", timeout=TIMEOUT_MS)
     T0 = pose(s)
     page.keyboard.down("Digit1")
     wait_until(lambda: (pose(s)[0, 3] - T0[0, 3]) * 1000.0 > 20.0, "X to move 20 mm while the key is held")

@@ -255,11 +255,27 @@
     if (nameInput && name !== null && once(nameInput)) fillAndPress(nameInput, name, L.join);
   }
 
+  // viser 1.1 shows the hint of a button group as a tooltip, not a single button's: name the key
+  // in the native tooltip (a constant text) of the single jog, hold-to-jog and Record buttons
+  function setTitle(b, title) { if (b && b.id && b.getAttribute("title") !== title) b.setAttribute("title", title); }
+  function keyTitles() {
+    jogRows().forEach(function (r, i) {
+      if (i >= 9) return;
+      setTitle(r.plus, "Key " + (i + 1));
+      setTitle(r.minus, "Key Shift+" + (i + 1));
+    });
+    buttonsNamed(L.record).concat(buttonsNamed(L.recordPoint)).forEach(function (b) { setTitle(b, "Key R"); });
+  }
+
   var scheduled = false;
   function schedule() {
     if (scheduled) return;
     scheduled = true;
-    window.setTimeout(function () { scheduled = false; scan(); }, 150);
+    window.setTimeout(function () {
+      scheduled = false;
+      keyTitles();
+      scan();
+    }, 150);
   }
   function start() {
     new MutationObserver(schedule).observe(document.documentElement, { childList: true, subtree: true });
