@@ -66,11 +66,16 @@ def test_the_beam_result_is_replayed_framed_and_compared_with_the_manual_one(pag
     p = page()
     s, c, v = p.session, p.session.controller, p.view
     p.xyz4_by_hand()
+    p.player.rate_hz = 5.0                                            # slow, to look at the film
     p.beam()
     res = v.workflow.result
     scan = res.scan
     assert p.player.scan is scan and p.player.owner is v.scene        # the wizard's film
+    wait_until(lambda: p.player.frames_played >= 2, what="the film running")
+    assert not v.scene.computed.visible and not v.scene.computed_label.visible   # the beam not hidden
+    p.player.rate_hz = 400.0
     p.film_done()
+    wait_until(lambda: v.scene.computed.visible, what="the triads back after the film")
     assert p.player.frames_played == len(p.player.frames) > len(scan.moves)
     np.testing.assert_allclose(c.q_rad, scan.q_end_rad, atol=1e-12)    # the robot stays at the scan's end
     markers = np.asarray(p.player.markers.points, dtype=float)
@@ -82,7 +87,7 @@ def test_the_beam_result_is_replayed_framed_and_compared_with_the_manual_one(pag
     rays = np.asarray(p.player.rays.points, dtype=float)               # flange -> beam, per event
     np.testing.assert_allclose(rays[:, 0], [ev.T_world_flange_exact[:3, 3] for ev in scan.events], atol=1e-5)
     np.testing.assert_allclose(rays[:, 1], markers, atol=1e-5)
-    assert v.scene.computed.visible                                   # the TOOL triad of the result
+    assert v.scene.computed.visible and v.scene.true_tool.visible     # the TOOL triads of the result
     assert _in_view(v.scene.last_framing, c.beam_sensor.point)         # the camera sees the sensor
     assert all(_in_view(v.scene.last_framing, m) for m in markers)
     # the result: events, real-robot time next to the manual time, the errors of both vs truth

@@ -12,7 +12,8 @@ loop at :attr:`ScanPlayer.rate_hz`: each frame sets the controller's joints
 (``VirtualController.set_q``, the model's joint values the scan planned) and emits the
 session's ``pose`` change, so every view shows the robot where the scan had it; the red
 beam and the markers are its own nodes under ``/beam_scan``. The controller is left at the
-scan's end (or where the caller asked it to return). A jog, the gizmo or a new scan during the
+scan's end (or where the caller asked it to return), and the film's end is one more ``pose``
+change (``Session.refresh``: the wizard scene shows its TOOL triads again). A jog, the gizmo or a new scan during the
 replay stops it (the robot stays where the user put it); without a running event loop (a
 test calling from its own thread) the last frame is applied at once.
 
@@ -319,6 +320,7 @@ class ScanPlayer:
                 self._task = None
                 with s.lock:
                     self._finish()
+                    s.refresh()                         # the views see the film's end (triads back)
 
     def _apply(self, i: int) -> None:
         frame = self.frames[i]

@@ -140,15 +140,25 @@ class WizardSceneView:
 
     @property
     def showing(self) -> bool:
-        """Something of the wizards is in the scene (the triads or the ABC target)."""
-        return bool(self.computed.visible or self.true_tool.visible or self.abc_target.visible)
+        """Something of the wizards is in the scene (the triads, the ABC target, a beam result's
+        film or markers)."""
+        return bool(self.computed.visible or self.true_tool.visible or self.abc_target.visible
+                    or self._film_playing())
+
+    def _film_playing(self) -> bool:
+        """Our beam scan's film is playing (its end re-renders: ``Session.refresh``)."""
+        film = self.session.views.get(ScanPlayer.KEY)
+        return film is not None and film.owner is self and film.playing
 
     def on_motion(self) -> None:
-        """After every move: the TOOL triads follow the flange, the ABC target the TCP."""
+        """After every move: the TOOL triads follow the flange, the ABC target the TCP. While a
+        beam result's film plays the triads are hidden: on the tool they would hide the beam
+        (a triad's axis can lie along it) and its break."""
         T_world_flange = self.session.pose_state().T_world_flange   # the move's one FK pass
+        film = self._film_playing()
         for frame, label, T in ((self.computed, self.computed_label, self._T_flange_computed),
                                 (self.true_tool, self.true_label, self._T_flange_tool_true)):
-            self._pose(frame, label, None if T is None else T_world_flange @ T)
+            self._pose(frame, label, None if T is None or film else T_world_flange @ T)
         self.update_abc_target(T_world_flange)
         if self._target_T is not None:      # ABC world: TARGET, TOOL and the tip cluster at the TCP
             self.layout_labels()
@@ -197,9 +207,10 @@ class WizardSceneView:
         """Label name -> (handle, T_world_parent now; None: the label is in WORLD), visible ones."""
         T_wf = self.session.pose_state().T_world_flange
         out: dict[str, tuple[Any, np.ndarray | None]] = {}
-        if self._T_flange_computed is not None:
+        film = self._film_playing()                 # the triads and their labels step aside
+        if self._T_flange_computed is not None and not film:
             out["computed"] = (self.computed_label, T_wf @ self._T_flange_computed)
-        if self._T_flange_tool_true is not None:
+        if self._T_flange_tool_true is not None and not film:
             out["true"] = (self.true_label, T_wf @ self._T_flange_tool_true)
         others = self.session.scene_labels          # the robot scene's labels at the tool and tip
         if "tool" in others and self.session.controller.active_tool is not None:
