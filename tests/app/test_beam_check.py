@@ -79,6 +79,11 @@ def test_the_industrial_loop_crash_check_update_verify(page) -> None:
     assert "Beam check of Pointer" in md and f"Deviation **{check.deviation_norm_mm:.3f} mm**" in md
     assert not p.beam.update.disabled and not p.beam.replay.disabled
     assert ScanPlayer.of(s).scan is check.scan                      # the scan plays in the scene
+    f = p.beam.framing                                              # and the camera looks at it
+    to_sensor = np.asarray(c.beam_sensor.point) - f.position
+    forward = (f.look_at - f.position) / np.linalg.norm(f.look_at - f.position)
+    assert np.degrees(np.arccos(to_sensor @ forward / np.linalg.norm(to_sensor))) < 10.0
+    assert f.distance_m < 1.5                                       # closer than the overview
     p.film_done()
     np.testing.assert_allclose(c.q_rad, q_before, atol=1e-12)       # and the robot is back where it was
 

@@ -10,7 +10,8 @@ Check: the job (``calibrate.beam_service.beam_check_job``: a snapshot of the rob
 joints, the sensor, the active tool data and its slot, the physical tool) is taken on viser's
 event loop under the session lock; the scan (a few hundred milliseconds of geometry and two
 solves) runs in :data:`_BEAM_WORKER`; its result is shown on the loop and the scan is replayed
-in the scene (``views.beam_replay``), the robot going back to where it was. One check at a
+in the scene (``views.beam_replay``), the robot going back to where it was, the camera turned
+to the sensor. One check at a
 time per session. Update: ``beam_service.update_tool_from_beam`` (it refuses when the slot
 changed since the check), then ``Session.apply_saved`` (the library re-read, the updated tool
 the active data); refused when the active tool is no longer the one checked. Tool names reach
@@ -32,7 +33,8 @@ from tcp_pendant.calibrate.beam_service import (
 )
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.text_escape import escape_markdown
-from tcp_pendant.views.beam_replay import ScanPlayer
+from tcp_pendant.views.beam_replay import ScanPlayer, beam_view_direction, scan_spheres
+from tcp_pendant.views.framing import Framing, frame_spheres
 from tcpcal.tool import Tool
 
 __all__ = ["BeamCheckView", "update_markdown"]
@@ -77,6 +79,8 @@ class BeamCheckView:
         self.last_check: BeamCheck | None = None
         """The last check's result (None before one, and after its Update)."""
         self._q_before: Any = None
+        self.framing: Framing | None = None
+        """The camera framing of the last check's scan (None before one), for tests."""
         self.check.on_click(self._on_check)
         g = session.on_loop
         self.update.on_click(g(self._on_update))
@@ -142,7 +146,29 @@ class BeamCheckView:
             self.result_md.content = beam_check_markdown(check)
             self._render_buttons()
             ScanPlayer.of(s).play(check.scan, owner=self, return_to=self._q_before)
+            self.frame_scan(check.scan)
         s.notify("Beam check done", f"{check.tool_name}: deviation {check.deviation_norm_mm:.3f} mm", kind="info")
+
+    def frame_scan(self, scan: Any) -> None:
+        """Turn the session's camera(s) to the beam sensor, the scan's events and the flange
+        there, seen across the beam (as the wizard's result is framed)."""
+        if not len(scan.events):
+            return
+        centres, radii = scan_spheres(scan)
+        direction = beam_view_direction(scan.events[0].beam_point, scan.events[0].beam_dir)
+        s = self.session
+        clients = [s.client] if s.client is not None else list(getattr(s.target, "get_clients", dict)().values())
+        for client in clients:
+            try:
+                cam = client.camera
+                f = frame_spheres(centres, radii, fov_rad=float(cam.fov), aspect=float(cam.aspect),
+                                  direction=direction, margin=1.4)
+                with client.atomic():                  # position first: its setter shifts look_at
+                    cam.position = f.position
+                    cam.look_at = f.look_at
+            except Exception:                          # a browser that left, or no camera reported yet
+                log.debug("camera not framed on the beam scan", exc_info=True)
+        self.framing = frame_spheres(centres, radii, direction=direction, margin=1.4)
 
     def _failed(self, title: str, body: str, *, kind: str) -> None:
         s = self.session
@@ -168,7 +194,6 @@ class BeamCheckView:
                              "Update.")
         before = check.stored_tool
         tool = update_tool_from_beam(s.library, check.slot, check)
-        ScanPlayer.of(s).stop()
         self.last_check = None
         s.apply_saved(check.slot, tool)                    # one signal: library re-read, active data
         self.result_md.content = beam_check_markdown(check) + "\n\n" + update_markdown(check.slot, before, tool)

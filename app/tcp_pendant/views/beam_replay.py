@@ -34,7 +34,8 @@ import numpy as np
 from tcp_pendant.session import Session
 from tcp_pendant.views.beam_stand import HALF_GAP_M
 
-__all__ = ["BROKEN_RGB", "ReplayFrame", "ScanPlayer", "event_points_world", "replay_frames"]
+__all__ = ["BROKEN_RGB", "ReplayFrame", "ScanPlayer", "beam_view_direction", "event_points_world", "replay_frames",
+           "scan_spheres"]
 
 log = logging.getLogger(__name__)
 
@@ -186,6 +187,31 @@ def event_points_world(scan: Any, points: Any = None) -> np.ndarray:
             p = np.asarray(tip(i), dtype=float) if callable(tip) else _flange(ev)[:3, 3]
         out[i] = _on_beam(p, b, u)
     return out
+
+
+def beam_view_direction(beam_point: np.ndarray, beam_dir: np.ndarray) -> np.ndarray:
+    """From the scan toward the camera (WORLD, not normalised) to see a beam broadside: across
+    it from the side away from the robot's root (WORLD's origin), a little along it, from above."""
+    b = np.asarray(beam_point, dtype=float)
+    u = np.asarray(beam_dir, dtype=float)
+    side = np.cross([0.0, 0.0, 1.0], u)
+    if np.linalg.norm(side) < 1e-6:                     # a vertical beam: any horizontal side
+        side = np.array([0.0, -1.0, 0.0])
+    side /= np.linalg.norm(side)
+    if float(side @ b) < 0.0:
+        side = -side
+    return side + 0.35 * u * (1.0 if float(u @ b) >= 0.0 else -1.0) + np.array([0.0, 0.0, 0.5])
+
+
+def scan_spheres(scan: Any, points: Any = None) -> tuple[np.ndarray, np.ndarray]:
+    """(centres, radii) in WORLD m of what a camera should show of a scan: the flange at each
+    event (with room for the wrist), the event points, the beam and the fork below it."""
+    events = tuple(scan.events)
+    b = np.asarray(events[0].beam_point, dtype=float)
+    centres = [_flange(ev)[:3, 3] for ev in events]
+    centres += [*event_points_world(scan, points), b, b - [0.0, 0.0, 0.12]]
+    radii = [0.06] * len(events) + [0.01] * len(events) + [0.1, 0.06]
+    return np.array(centres, dtype=float), np.array(radii, dtype=float)
 
 
 class ScanPlayer:

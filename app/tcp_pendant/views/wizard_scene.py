@@ -43,7 +43,7 @@ import numpy as np
 
 from tcp_pendant.calibrate import CalibrationWorkflow
 from tcp_pendant.session import Session
-from tcp_pendant.views.beam_replay import ScanPlayer, event_points_world
+from tcp_pendant.views.beam_replay import ScanPlayer, beam_view_direction, scan_spheres
 from tcp_pendant.views.framing import Framing, frame_spheres, spread_labels
 from tcp_pendant.views.scene import wxyz_xyz
 from tcp_pendant.wizards import Xyz4Result
@@ -242,11 +242,8 @@ class WizardSceneView:
         scan = getattr(self._shown_result, "scan", None)
         if scan is not None and len(scan.events):   # a beam scan: its events and the sensor, not the tip
             T_wf = np.asarray(scan.events[-1].T_world_flange, dtype=float)   # where the film ends
-            centres = [np.asarray(ev.T_world_flange, dtype=float)[:3, 3] for ev in scan.events]
-            b = np.asarray(scan.events[0].beam_point, dtype=float)
-            centres += [*event_points_world(scan, self._scan_points(self._shown_result)), b,
-                        b - [0.0, 0.0, 0.12]]                          # the beam and the fork below it
-            radii = [0.06] * len(scan.events) + [0.01] * len(scan.events) + [0.1, 0.06]
+            c, r = scan_spheres(scan, self._scan_points(self._shown_result))
+            centres, radii = list(c), list(r)
         else:
             centres = [T_wf[:3, 3], np.asarray(self.session.controller.reference_tip_world_m, dtype=float)]
             radii = [0.09, 0.02]
@@ -302,21 +299,12 @@ class WizardSceneView:
         return framing
 
     def _view_direction(self) -> np.ndarray | None:
-        """A beam result: look at the beam broadside (across it, from the side away from the
-        robot's base, from above), so the passes and the events are seen side by side; None: the
-        overview's direction."""
+        """A beam result: look at the beam broadside (``beam_replay.beam_view_direction``), so the
+        passes and the events are seen side by side; None: the overview's direction."""
         scan = getattr(self._shown_result, "scan", None)
         if scan is None or not len(scan.events):
             return None
-        b = np.asarray(scan.events[0].beam_point, dtype=float)
-        u = np.asarray(scan.events[0].beam_dir, dtype=float)
-        side = np.cross([0.0, 0.0, 1.0], u)
-        if np.linalg.norm(side) < 1e-6:                 # a vertical beam: any horizontal side
-            side = np.array([0.0, -1.0, 0.0])
-        side /= np.linalg.norm(side)
-        if float(side @ b) < 0.0:                      # WORLD's origin is the robot's root link
-            side = -side
-        return side + 0.35 * u * (1.0 if float(u @ b) >= 0.0 else -1.0) + np.array([0.0, 0.0, 0.5])
+        return beam_view_direction(scan.events[0].beam_point, scan.events[0].beam_dir)
 
     @staticmethod
     def _camera_framing(client: Any) -> Framing | None:
