@@ -9,8 +9,10 @@ What this module serves, in front of viser's static-file server (``process_reque
 ``websockets`` server, reached through :func:`tcp_pendant.origin_check.set_http_layer`):
 
 * ``GET /`` and ``GET /index.html`` (and the paths viser maps to them): viser's own response
-  with one ``<script src="/tcp-pendant/pendant.js" defer></script>`` inserted right after
-  ``<head>``; headers as viser's (the length recomputed; gzip kept when viser used it).
+  with one ``<script src="tcp-pendant/pendant.js" defer></script>`` inserted right after
+  ``<head>``; headers as viser's (the length recomputed; gzip kept when viser used it). The
+  ``src`` is relative, so a reverse proxy that serves the pendant under a path prefix
+  (``https://school.example/pendant/``) still finds the script.
 * ``GET /tcp-pendant/pendant.js``: the script's bytes, read once from the package at import of
   :func:`script_asset` (never a path from the request), ``text/javascript``, gzip when the
   browser accepts it.
@@ -45,7 +47,7 @@ PREFIX = "tcp-pendant"
 """The first path segment of everything this module answers."""
 SCRIPT_PATH = f"/{PREFIX}/pendant.js"
 """Where the page loads the script from."""
-SCRIPT_TAG = f'<script src="{SCRIPT_PATH}" defer></script>'.encode("ascii")
+SCRIPT_TAG = f'<script src="{SCRIPT_PATH[1:]}" defer></script>'.encode("ascii")
 """The one tag inserted into viser's index.html."""
 JS_CONTENT_TYPE = "text/javascript; charset=utf-8"
 

@@ -178,6 +178,15 @@ def test_the_layer_is_the_pendants_port_only(tmp_path: Path) -> None:
     assert port not in origin_check._http_layers
 
 
+def test_the_tag_finds_the_script_from_the_page_and_behind_a_path_prefix_proxy() -> None:
+    from urllib.parse import urljoin
+
+    src = re.search(rb'src="([^"]+)"', SCRIPT_TAG).group(1).decode()
+    for page in ("http://h:8080/", "http://h:8080/index.html", "http://h:8080/?trainer=x"):
+        assert urljoin(page, src) == f"http://h:8080{SCRIPT_PATH}"
+    assert urljoin("https://school.example/pendant/", src) == f"https://school.example/pendant{SCRIPT_PATH}"
+
+
 def test_index_paths_and_injection() -> None:
     assert all(is_index_path(p) for p in ("/", "", "/index.html", "//", "/./index.html", "/?a=b", "/%69ndex.html"))
     assert not any(is_index_path(p) for p in ("/x", "/index.htm", "/a/index.html", "/tcp-pendant/pendant.js"))
