@@ -125,3 +125,19 @@ def test_a_stored_scan_without_moves_only_shows_its_markers(page) -> None:
     np.testing.assert_array_equal(p.session.controller.q_rad, q)              # the robot did not move
     b = live.events[0].beam_point
     np.testing.assert_allclose(player.markers.points, [[b[0], 0.1, b[2]]], atol=1e-6)   # on the beam line
+
+
+def test_the_gizmo_and_the_tool_triad_step_aside_while_the_film_plays(page) -> None:
+    p = page()
+    scene = p.session.views["scene"]
+    player = ScanPlayer.of(p.session)
+    player.rate_hz = 5.0
+    scan = fake_scan(p)
+    assert scene.gizmo.visible
+    p.on_loop(lambda: player.play(scan))
+    wait_until(lambda: player.frames_played >= 1, what="the first frame")
+    assert not scene.gizmo.visible and not scene._active_label.visible   # they would hide the beam
+    player.rate_hz = 400.0
+    wait_until(lambda: not player.playing, what="the film's end")
+    wait_until(lambda: scene.gizmo.visible, what="the gizmo back")
+    assert scene._active_label.visible

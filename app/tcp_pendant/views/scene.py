@@ -15,7 +15,8 @@ Scene tree (names are per browser; ``--shared`` uses the server's scene):
 * ``/reference_tip``: the stand posed so that its spike is at the reference tip;
 * ``/beam_sensor``: the beam sensor's stand (a fork, emitter and receiver) with the beam(s) as
   thin bright lines (``views.beam_stand``), redrawn when ``controller.beam_sensor`` changes;
-  a scan's replay (the broken beam in red, event markers) is ``views.beam_replay``'s ``/beam_scan``;
+  a scan's replay (the broken beam in red, event markers) is ``views.beam_replay``'s ``/beam_scan``,
+  during which the gizmo and the TOOL triad step aside;
 The scene reconciles from the session's state: it subscribes to the session's change signal
 (``Session.subscribe``) and, on a ``tool`` change, swaps the mounted tool's meshes and moves the
 TOOL triad when they differ from what the session now has; on a ``pose`` change it poses the
@@ -46,6 +47,7 @@ from tcp_pendant.controller import ToolModel, reference_tip_model
 from tcp_pendant.controller.kinematics import urdf_links_and_tree
 from tcp_pendant.controller.rotations import quaternion_wxyz, quaternions_wxyz
 from tcp_pendant.session import Session, SessionChange
+from tcp_pendant.views.beam_replay import ScanPlayer
 from tcp_pendant.views.beam_stand import BeamStandNodes
 from tcp_pendant.views.meshes import MeshPart, link_meshes, rigid_meshes
 
@@ -241,6 +243,7 @@ class SceneView:
         k = c.kinematics
         self.flange_link = k.flange_link
         self._dragging = False
+        self._aside = False                     # gizmo and TOOL triad hidden for a beam scan's film
         self._gizmo_pending: tuple[np.ndarray, np.ndarray] | None = None  # (wxyz, xyz) not yet applied
         self._gizmo_scheduled = False
         self._apply_scheduled_gizmo = session.guard(self._apply_scheduled)
@@ -308,6 +311,8 @@ class SceneView:
         if not np.array_equal(tip, self._shown_tip):     # knocked (a scenario) or set anew
             self.update_reference_tip()
         self.beam_stand.show(self.session.controller.beam_sensor)   # redraws only a changed sensor
+        film = self.session.views.get(ScanPlayer.KEY)
+        self._step_aside(film is not None and film.playing)
         if change.pose and change.state is not None:
             skip = (self._gizmo_row,) if self._dragging else ()
             self._poses.send(self._local_poses(change.state), skip=skip)
@@ -352,6 +357,17 @@ class SceneView:
         self._tool_frame = self.scene.add_frame(self._tool_root, show_axes=False)
         _add_parts(self.scene, self._tool_root, rigid_meshes(tool.urdf_path))
 
+    def _step_aside(self, aside: bool) -> None:
+        """While a beam scan's film plays (``views.beam_replay``) the TCP gizmo and the TOOL
+        triad on the tool are hidden: they sit where the tool meets the beam and would hide it
+        and its break; the film's end (a ``pose`` change) shows them again."""
+        if aside == self._aside:
+            return
+        self._aside = aside
+        self.gizmo.visible = not aside
+        self._active_axes.visible = not aside and self.session.controller.active_tool is not None
+        self._active_label.visible = not aside
+
     def update_active_tool(self) -> None:
         """Move the TOOL triad to the active tool data (``T_flange_tool``) and relabel it."""
         c = self.session.controller
@@ -360,7 +376,7 @@ class SceneView:
         self._active_axes.wxyz = wxyz
         self._active_axes.position = xyz
         tool = c.active_tool
-        self._active_axes.visible = tool is not None      # no tool data: TOOL = FLANGE
+        self._active_axes.visible = tool is not None and not self._aside   # no tool data: TOOL = FLANGE
         self._active_label.text = "TOOL" if tool is None else f"TOOL {tool.name}"
 
     def update_reference_tip(self) -> None:
