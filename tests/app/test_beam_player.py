@@ -68,14 +68,16 @@ def test_the_film_moves_the_robot_through_the_scan_and_leaves_it_at_the_end(page
     player.rate_hz = 200.0
     scan = fake_scan(p)
     seen: list[tuple[np.ndarray, bool]] = []
-    p.session.subscribe(lambda ch: seen.append((p.session.controller.q_rad, player.broken_beam.visible)))
+    stand = p.session.views["scene"].beam_stand
+    p.session.subscribe(lambda ch: seen.append((p.session.controller.q_rad, stand.broken is not None)))
     p.on_loop(lambda: player.play(scan, owner="me"))
     wait_until(lambda: not player.playing, what="the film played out")
     np.testing.assert_allclose(p.session.controller.q_rad, scan.q_end_rad)
     assert player.frames_played == len(player.frames) >= 4
     assert len(seen) >= len(player.frames)                       # one pose signal per frame
     assert any(red for _, red in seen)                            # the beam was red at the event
-    assert not player.broken_beam.visible                         # and clear at the end
+    assert stand.broken is None and not player.break_point.visible   # and clear at the end
+    np.testing.assert_array_equal(np.asarray(stand.beam_handle.colors)[0, 0], (0, 190, 60))
     np.testing.assert_allclose(player.markers.points, [scan.tip_world_m(0) - [0.003, 0.0, 0.0]], atol=1e-6)   # on the beam
     player.clear(owner="someone else")                            # not theirs: stays
     assert player.markers is not None and player.scan is scan
@@ -110,7 +112,7 @@ def test_off_the_loop_the_last_frame_is_shown_at_once(page) -> None:
     player.play(scan, return_to=home)                             # a test's own thread: no running loop
     assert not player.playing and player.frames_played == len(player.frames)
     np.testing.assert_allclose(p.session.controller.q_rad, home)
-    assert player.markers is not None and not player.broken_beam.visible
+    assert player.markers is not None and p.session.views["scene"].beam_stand.broken is None
 
 
 def test_a_stored_scan_without_moves_only_shows_its_markers(page) -> None:

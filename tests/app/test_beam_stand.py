@@ -10,6 +10,8 @@ import pytest
 
 from tcp_pendant.controller.beam import BeamSensor
 from tcp_pendant.views.beam_stand import (
+    BEAM_RGB,
+    BROKEN_RGB,
     FORK_DEPTH_M,
     HALF_GAP_M,
     BeamStandNodes,
@@ -126,3 +128,17 @@ def test_the_nodes_are_redrawn_only_when_the_sensor_changed() -> None:
     removed = {n for w, n in scene.log[n_log:] if w == "remove"}
     assert removed == set(added)                       # the old nodes went, new ones came
     assert nodes.show(None) is True and nodes.geometry is None
+
+
+def test_a_broken_beam_is_drawn_red_and_only_that_one() -> None:
+    sensor = BeamSensor(point=(0.6, 0.0, 0.3), direction=(1.0, 1.0, 0.0), second_direction=(1.0, -1.0, 0.0))
+    nodes = BeamStandNodes(_Scene(), sensor)
+    nodes.set_broken(1)                                    # the fake handle keeps what is assigned
+    colors = np.asarray(nodes.beam_handle.colors)
+    np.testing.assert_array_equal(colors[1], [BROKEN_RGB, BROKEN_RGB])
+    np.testing.assert_array_equal(colors[0], [BEAM_RGB, BEAM_RGB])
+    nodes.set_broken(None)
+    assert (np.asarray(nodes.beam_handle.colors) == BEAM_RGB).all()
+    nodes.set_broken(0)
+    nodes.show(BeamSensor(point=(0.6, 0.1, 0.3), direction=(1.0, 0.0, 0.0)))   # a new sensor: drawn intact
+    assert nodes.broken is None

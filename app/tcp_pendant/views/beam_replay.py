@@ -10,8 +10,9 @@ markers' points (on the beam line).
 :class:`ScanPlayer` (one per session, :meth:`ScanPlayer.of`) plays such a film on viser's event
 loop at :attr:`ScanPlayer.rate_hz`: each frame sets the controller's joints
 (``VirtualController.set_q``, the model's joint values the scan planned) and emits the
-session's ``pose`` change, so every view shows the robot where the scan had it; the red
-beam and the markers are its own nodes under ``/beam_scan``. The controller is left at the
+session's ``pose`` change, so every view shows the robot where the scan had it; the broken
+beam turns red (the scene's stand, ``BeamStandNodes.set_broken``), the break point, the markers
+and each event's ray are the player's own nodes under ``/beam_scan``. The controller is left at the
 scan's end (or where the caller asked it to return), and the film's end is one more ``pose``
 change (``Session.refresh``: the wizard scene shows its TOOL triads again). A jog, the gizmo or a new scan during the
 replay stops it (the robot stays where the user put it); without a running event loop (a
@@ -32,14 +33,13 @@ from typing import Any
 import numpy as np
 
 from tcp_pendant.session import Session
-from tcp_pendant.views.beam_stand import HALF_GAP_M
+from tcp_pendant.views.beam_stand import BROKEN_RGB
 
 __all__ = ["BROKEN_RGB", "ReplayFrame", "ScanPlayer", "beam_view_direction", "event_points_world", "replay_frames",
            "scan_spheres"]
 
 log = logging.getLogger(__name__)
 
-BROKEN_RGB = (255, 40, 40)
 TIP_EVENT_RGB = (255, 150, 0)
 AXIS_EVENT_RGB = (210, 60, 230)
 MAX_FRAMES = 110
@@ -226,9 +226,6 @@ class ScanPlayer:
         self.session = session
         scene = session.target.scene
         self.scene = scene
-        self.broken_beam = scene.add_line_segments(
-            f"{self.ROOT}/broken_beam", points=np.zeros((1, 2, 3)), colors=BROKEN_RGB, thickness=6.0,
-            thickness_units="screen", visible=False)
         self.break_point = scene.add_icosphere(f"{self.ROOT}/break_point", radius=0.005, color=BROKEN_RGB,
                                                visible=False, cast_shadow=False, receive_shadow=False)
         self.markers: Any = None
@@ -357,6 +354,10 @@ class ScanPlayer:
         s.moved()
         self._show(frame.broken_event, frame.shown)
 
+    def _stand(self) -> Any:
+        """The scene's beam stand (``SceneView.beam_stand``: its beam turns red), or None."""
+        return getattr(self.session.views.get("scene"), "beam_stand", None)
+
     def _show(self, broken: int | None, shown: tuple[int, ...]) -> None:
         """The red beam of event ``broken`` (None: hidden) and the markers of ``shown``."""
         state = (broken, shown)
@@ -364,15 +365,14 @@ class ScanPlayer:
             return
         self._shown_state = state
         scan = self._scan
+        stand = self._stand()
         if broken is None or scan is None:
-            self.broken_beam.visible = False
+            if stand is not None:
+                stand.set_broken(None)
             self.break_point.visible = False
         else:
-            ev = scan.events[broken]
-            b = np.asarray(ev.beam_point, dtype=float)
-            u = np.asarray(ev.beam_dir, dtype=float)
-            self.broken_beam.points = np.array([[b - HALF_GAP_M * u, b + HALF_GAP_M * u]])
-            self.broken_beam.visible = True
+            if stand is not None:
+                stand.set_broken(int(getattr(scan.events[broken], "beam", 0)))
             self.break_point.position = tuple(float(v) for v in self._points[broken])
             self.break_point.visible = True
         for h in (self.markers, self.rays):

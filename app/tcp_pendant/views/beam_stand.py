@@ -11,7 +11,8 @@ tip and shaft below the beam during the scan's sideways passes, so the posts rea
 
 :class:`BeamStandNodes` puts that geometry into a viser scene under ``/beam_sensor`` and redraws
 it when the sensor changes (compared by value: the controller may hand out a new but equal
-sensor object). The beam is drawn in screen pixels, so it stays visible in the overview.
+sensor object). The beam is drawn in screen pixels, so it stays visible in the overview; it
+turns red while it is broken (:meth:`BeamStandNodes.set_broken`, a scan's film).
 """
 
 from __future__ import annotations
@@ -24,7 +25,7 @@ import numpy as np
 from tcp_pendant.controller.beam import BeamSensor
 from tcp_pendant.controller.rotations import quaternion_wxyz
 
-__all__ = ["BEAM_RGB", "FORK_DEPTH_M", "HALF_GAP_M", "BeamStandNodes", "StandBox", "StandGeometry",
+__all__ = ["BEAM_RGB", "BROKEN_RGB", "FORK_DEPTH_M", "HALF_GAP_M", "BeamStandNodes", "StandBox", "StandGeometry",
            "sensor_key", "stand_frame", "stand_geometry"]
 
 HALF_GAP_M = 0.05
@@ -39,6 +40,8 @@ BAR_HEIGHT_M = 0.016
 COLUMN_RADIUS_M = 0.018
 BEAM_RGB = (0, 190, 60)
 """The intact beam: bright green (red is kept for a broken beam)."""
+BROKEN_RGB = (255, 40, 40)
+"""A broken beam (:meth:`BeamStandNodes.set_broken`)."""
 STAND_RGB = (70, 82, 104)
 HEAD_RGB = (28, 28, 32)
 BEAM_PX = 5.0
@@ -148,7 +151,24 @@ class BeamStandNodes:
         self.geometry: StandGeometry | None = None
         self.beam_handle: Any = None
         self.label: Any = None
+        self.broken: int | None = None
+        """The beam drawn red (broken; ``views.beam_replay``), or None."""
         self.show(sensor)
+
+    def _colors(self) -> np.ndarray:
+        n = 0 if self.geometry is None else len(self.geometry.beams)
+        colors = np.tile(np.array(BEAM_RGB, dtype=np.uint8), (n, 2, 1))
+        if self.broken is not None and 0 <= self.broken < n:
+            colors[self.broken] = BROKEN_RGB
+        return colors
+
+    def set_broken(self, beam: int | None) -> None:
+        """Draw beam ``beam`` (0, or 1 for a second beam) red, the others green; None: all green."""
+        if beam == self.broken:
+            return
+        self.broken = beam
+        if self.beam_handle is not None:
+            self.beam_handle.colors = self._colors()
 
     def show(self, sensor: BeamSensor | None) -> bool:
         """Draw ``sensor`` if it differs from what is drawn (returns whether it redrew)."""
@@ -159,6 +179,7 @@ class BeamStandNodes:
             h.remove()
         self._nodes = []
         self.beam_handle = self.label = None
+        self.broken = None
         self.shown_key = key
         self.geometry = None
         if sensor is None:
@@ -175,8 +196,7 @@ class BeamStandNodes:
                                               height=float(top[2] - bottom[2]), color=STAND_RGB,
                                               position=(bottom + top) / 2.0, cast_shadow=False,
                                               receive_shadow=False))
-        colors = np.tile(np.array(BEAM_RGB, dtype=np.uint8), (len(g.beams), 2, 1))
-        self.beam_handle = s.add_line_segments(f"{root}/beam", points=g.beams, colors=colors,
+        self.beam_handle = s.add_line_segments(f"{root}/beam", points=g.beams, colors=self._colors(),
                                                thickness=BEAM_PX, thickness_units="screen")
         self.label = s.add_label(f"{root}/label", "beam sensor", position=g.label_position)
         self._nodes.extend([self.beam_handle, self.label])
