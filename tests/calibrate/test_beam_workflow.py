@@ -71,7 +71,7 @@ def test_exact_scan_gives_the_true_tcp_and_direction(workflow, robot, tool) -> N
     assert direction_error_deg(res, T_true) < 1e-6
     truth = wf.truth()
     assert truth is not None and truth.position_error_mm < 1e-6 and truth.orientation_error_deg < 1e-6
-    assert truth.grade == "good" and set(truth.graded) == {"position", "orientation"}
+    assert truth.grade == "good" and set(truth.graded) == {"position", "x_axis"}
     assert len(res.tip_event_indices) == 4 and len(res.axis_event_indices) == 8 and not res.scan.skipped
     # the real-robot time is the scan's, and it is the sum of its moves' length / speed
     assert res.duration_s == pytest.approx(sum(m.length_m * 1000.0 / m.speed_mm_s for m in res.scan.moves))
