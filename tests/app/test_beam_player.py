@@ -77,7 +77,7 @@ def test_the_film_moves_the_robot_through_the_scan_and_leaves_it_at_the_end(page
     assert len(seen) >= len(player.frames)                       # one pose signal per frame
     assert any(red for _, red in seen)                            # the beam was red at the event
     assert stand.broken is None and not player.break_point.visible   # and clear at the end
-    np.testing.assert_array_equal(np.asarray(stand.beam_handle.colors)[0, 0], (0, 190, 60))
+    np.testing.assert_array_equal(np.asarray(stand.beam_handle.colors)[0, 0], (0, 160, 40))
     np.testing.assert_allclose(player.markers.points, [scan.tip_world_m(0) - [0.003, 0.0, 0.0]], atol=1e-6)   # on the beam
     player.clear(owner="someone else")                            # not theirs: stays
     assert player.markers is not None and player.scan is scan

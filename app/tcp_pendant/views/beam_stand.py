@@ -38,9 +38,9 @@ POST_THICKNESS_M = 0.016
 POST_WIDTH_M = 0.03
 BAR_HEIGHT_M = 0.016
 COLUMN_RADIUS_M = 0.018
-BEAM_RGB = (0, 190, 60)
+BEAM_RGB = (0, 160, 40)
 """The intact beam: bright green (red is kept for a broken beam)."""
-BROKEN_RGB = (255, 40, 40)
+BROKEN_RGB = (225, 0, 0)
 """A broken beam (:meth:`BeamStandNodes.set_broken`)."""
 STAND_RGB = (70, 82, 104)
 HEAD_RGB = (28, 28, 32)
