@@ -324,7 +324,9 @@ def _solver_error(exc: TcpcalError, poses: FlangePoses, rows: Sequence[int] | No
 
 
 def _emit(text: str) -> None:
-    sys.stdout.write(text if text.endswith("\n") else text + "\n")
+    sys.stdout.write(text)
+    if not text.endswith("\n"):          # not text + "\n": a copy of 100 MB of --json
+        sys.stdout.write("\n")
 
 
 def _run_solve(args: argparse.Namespace) -> int:

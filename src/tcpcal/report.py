@@ -121,26 +121,37 @@ def _format_block(array: np.ndarray, row: str, sep: str) -> str:
 
 class _Formatter:
     """Formats the float arrays of one :func:`json_dumps` call: alone, or with ``workers - 1``
-    forked processes (one pool for the call, started at the first large array)."""
+    forked processes. :meth:`start` hands every large array's blocks of rows but the last to
+    the pool at once (one pool for the call), so the pool formats while this process writes the
+    rest of the text and the last block of each array; :meth:`blocks` collects them in order."""
 
     def __init__(self, workers: int) -> None:
         self.workers = max(1, int(workers))
         self._pool: Any = None
+        self._pending: dict[int, tuple[list[Any], np.ndarray]] = {}  # id(_FloatArray) -> futures, last block
 
-    def format(self, array: np.ndarray, row: str, sep: str) -> str:
-        """:func:`_format_block` of ``array`` (2-D), large arrays by blocks of rows in the pool."""
-        if self.workers > 1 and array.size >= PARALLEL_MIN_VALUES:
-            text = self._in_processes(array, row, sep)
-            if text is not None:
-                return text
-        return _format_block(array, row, sep)
+    def start(self, tree: Any, level: int = 0) -> None:
+        """Submit the large float arrays found in ``tree`` (from :func:`_jsonable`) at ``level``."""
+        if self.workers == 1:
+            return
+        values = tree.values() if isinstance(tree, dict) else tree if isinstance(tree, list) else ()
+        for v in values:
+            if not isinstance(v, _FloatArray):
+                self.start(v, level + 1)
+                continue
+            array, row, sep, _, _ = v.layout(level + 1)
+            if array.size < PARALLEL_MIN_VALUES:
+                continue
+            blocks = [b for b in np.array_split(array, self.workers) if len(b)]
+            futures = self._submit(blocks[:-1], row, sep)
+            if futures is None:
+                return
+            self._pending[id(v)] = (futures, blocks[-1])
 
-    def _in_processes(self, array: np.ndarray, row: str, sep: str) -> str | None:
+    def _submit(self, blocks: list[np.ndarray], row: str, sep: str) -> list[Any] | None:
         import warnings
         from concurrent.futures import ProcessPoolExecutor
-        from concurrent.futures.process import BrokenProcessPool
 
-        blocks = [b for b in np.array_split(array, self.workers) if len(b)]
         try:
             with warnings.catch_warnings():   # Python >= 3.12 warns of fork() next to threads:
                 warnings.simplefilter("ignore", DeprecationWarning)  # the children only format
@@ -150,17 +161,33 @@ class _Formatter:
                         self.workers = 1
                         return None
                     self._pool = ProcessPoolExecutor(self.workers - 1, mp_context=ctx)
-                futures = [self._pool.submit(_format_block, b, row, sep) for b in blocks[:-1]]
-                last = _format_block(blocks[-1], row, sep)
-                return sep.join([f.result() for f in futures] + [last])
-        except (OSError, BrokenProcessPool):   # no process: this one formats alone
-            self.close()
+                return [self._pool.submit(_format_block, b, row, sep) for b in blocks]
+        except OSError:                          # no process: this one formats alone
             self.workers = 1
             return None
 
+    def blocks(self, value: _FloatArray, level: int) -> list[str]:
+        """The rows of ``value`` at ``level`` as pieces to concatenate (blocks of rows and the
+        separator between them): the pool's blocks and the last one formatted here, or all
+        formatted here (a small array, or the pool failed)."""
+        from concurrent.futures.process import BrokenProcessPool
+
+        array, row, sep, _, _ = value.layout(level)
+        pending = self._pending.pop(id(value), None)
+        if pending is not None:
+            futures, last = pending
+            last_text = _format_block(last, row, sep)
+            try:
+                texts = [f.result() for f in futures] + [last_text]
+            except (OSError, BrokenProcessPool):
+                pass                           # a child died: this one formats the array
+            else:
+                return [piece for text in texts for piece in (sep, text)][1:]
+        return [_format_block(array, row, sep)]
+
     def close(self) -> None:
         if self._pool is not None:
-            self._pool.shutdown()
+            self._pool.shutdown(cancel_futures=True)
             self._pool = None
 
 
@@ -194,22 +221,44 @@ class _FloatArray:
                 and (obj.ndim == 1 or (obj.ndim == 2 and obj.shape[0] > 0))
                 and bool(np.isfinite(obj).all()))
 
-    def dump(self, level: int, fmt: _Formatter) -> str:
+    def layout(self, level: int) -> tuple[np.ndarray, str, str, str, str]:
+        """(the values as rows, a row's ``%`` format, the separator of rows, the text before
+        them, the text after them) of the array printed at ``level``; 1-D: one value a row."""
         a = self.array
         if a.ndim == 1:
-            return "[" + fmt.format(a.reshape(-1, 1), "%r", ", ") + "]"
+            return a.reshape(-1, 1), "%r", ", ", "[", "]"
         pad = "  " * (level + 1)
         row = "[" + ", ".join(["%r"] * a.shape[1]) + "]"
-        return "[\n" + pad + fmt.format(a, row, ",\n" + pad) + "\n" + "  " * level + "]"
+        return a, row, ",\n" + pad, "[\n" + pad, "\n" + "  " * level + "]"
+
+    def parts(self, level: int, fmt: _Formatter) -> list[str]:
+        """The array's JSON text as pieces to concatenate."""
+        _, _, _, head, tail = self.layout(level)
+        return [head, *fmt.blocks(self, level), tail]
+
+
+def _dump_parts(obj: Any, level: int, fmt: _Formatter, parts: list[str]) -> None:
+    """Append the JSON text of ``obj`` to ``parts`` in pieces (a dict's values and large float
+    arrays are not copied into one string per level: :func:`json_dumps` joins once)."""
+    if isinstance(obj, _FloatArray):
+        parts += obj.parts(level, fmt)
+    elif isinstance(obj, dict) and obj:
+        pad = "  " * (level + 1)
+        sep = "{\n"
+        for k, v in obj.items():
+            parts.append(f"{sep}{pad}{json.dumps(k)}: ")
+            sep = ",\n"
+            _dump_parts(v, level + 1, fmt, parts)
+        parts.append("\n" + "  " * level + "}")
+    else:
+        parts.append(_dump(obj, level, fmt))
 
 
 def _dump(obj: Any, level: int, fmt: _Formatter) -> str:
-    if isinstance(obj, _FloatArray):
-        return obj.dump(level, fmt)
-    if isinstance(obj, dict) and obj:
-        pad = "  " * (level + 1)
-        items = [f"{pad}{json.dumps(k)}: {_dump(v, level + 1, fmt)}" for k, v in obj.items()]
-        return "{\n" + ",\n".join(items) + "\n" + "  " * level + "}"
+    if isinstance(obj, _FloatArray) or (isinstance(obj, dict) and obj):
+        parts: list[str] = []
+        _dump_parts(obj, level, fmt, parts)
+        return "".join(parts)
     if isinstance(obj, list) and obj:
         types = set(map(type, obj))
         if any(issubclass(t, (dict, list)) for t in types):
@@ -237,7 +286,11 @@ def json_dumps(obj: Any, *, workers: int = 1) -> str:
     """
     fmt = _Formatter(workers)
     try:
-        return _dump(_jsonable(obj), 0, fmt)
+        tree = _jsonable(obj)
+        fmt.start(tree)
+        parts: list[str] = []
+        _dump_parts(tree, 0, fmt, parts)
+        return "".join(parts)
     finally:
         fmt.close()
 

@@ -13,6 +13,7 @@ from __future__ import annotations
 import concurrent.futures
 import json
 import math
+import os
 from pathlib import Path
 from typing import Any
 
@@ -150,6 +151,24 @@ def test_parallel_falls_back_to_one_process(monkeypatch: pytest.MonkeyPatch) -> 
     monkeypatch.undo()
     monkeypatch.setattr(report, "PARALLEL_MIN_VALUES", 6)
     monkeypatch.setattr(concurrent.futures, "ProcessPoolExecutor", NoProcess)
+    assert json_dumps(obj, workers=2) == json_dumps(as_lists(obj))
+
+
+def test_a_dying_formatting_process_changes_nothing(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A child that dies (killed, out of memory) breaks the pool: this process formats the
+    arrays itself, the text is the same."""
+    real = report._format_block
+    parent = os.getpid()
+
+    def dying(array: np.ndarray, row: str, sep: str) -> str:
+        if os.getpid() != parent:
+            os._exit(3)
+        return real(array, row, sep)
+
+    dying.__module__, dying.__qualname__ = "tcpcal.report", "_format_block"   # pickled by name
+    monkeypatch.setattr(report, "_format_block", dying)
+    monkeypatch.setattr(report, "PARALLEL_MIN_VALUES", 6)
+    obj = mixed()
     assert json_dumps(obj, workers=2) == json_dumps(as_lists(obj))
 
 
