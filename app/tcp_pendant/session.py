@@ -202,6 +202,7 @@ class Session:
         self.scenario_world: ScenarioWorld | None = None
         """The drawn errors of :attr:`scenario` (None while it is off)."""
         self._scenario_tip0: np.ndarray | None = None   # the reference tip before a scenario moved it
+        self._beam_pinned = False  # the moved-reference scenario pinned the default beam sensor
         self._bent: dict[str, ToolModel] = {}           # tool key -> its bent version (bent_tool)
         self._unbent: dict[int, ToolModel] = {}         # id(bent version) -> the tool as it was
         self._free_records = 0                          # "Record point" clicks (free touches)
@@ -409,6 +410,9 @@ class Session:
             # undo the previous one
             if self._scenario_tip0 is not None:
                 c.set_reference_tip(self._scenario_tip0)
+            if self._beam_pinned:                   # the default beam follows the tip again
+                c.set_beam_sensor(None)
+                self._beam_pinned = False
             unbent = self._unbent.get(id(c.mounted_tool), c.mounted_tool)
             self._bent.clear()
             self._unbent.clear()
@@ -460,7 +464,12 @@ class Session:
         tip = world.reference_move.tip_world_m(self._scenario_tip0, self._scenario_touches)
         if np.array_equal(tip, self.controller.reference_tip_world_m):
             return False
-        self.controller.set_reference_tip(tip)
+        c = self.controller
+        if c.beam_sensor_is_default and not self._beam_pinned:
+            # the knock moves the spike, not the beam device that stands beside it
+            c.set_beam_sensor(c.beam_sensor)
+            self._beam_pinned = True
+        c.set_reference_tip(tip)
         return True
 
     def _note_wizard_joints(self) -> None:

@@ -116,6 +116,7 @@ def test_moved_reference_is_knocked_after_touch_k_and_stays(page) -> None:
     p = page()
     s, c = p.session, p.session.controller
     tip0 = c.reference_tip_world_m
+    beam0 = c.beam_sensor
     world = s.set_scenario("moved_reference", 3)
     k = world.reference_move.after_touch
     for n in range(k):
@@ -127,10 +128,13 @@ def test_moved_reference_is_knocked_after_touch_k_and_stays(page) -> None:
     scene = s.views["scene"]                                         # the stand is drawn where the tip is
     stand = reference_tip_model().T_world_stand(tip0 + shift)[:3, 3]
     np.testing.assert_allclose(scene._tip_frame.position, stand, atol=1e-9)
+    np.testing.assert_array_equal(c.beam_sensor.point, beam0.point)  # the knock leaves the beam device
     s.delete_touch(0)                                                # a knocked tip stays knocked
     np.testing.assert_allclose(c.reference_tip_world_m, tip0 + shift, atol=1e-15)
     s.set_scenario("off")
     np.testing.assert_allclose(c.reference_tip_world_m, tip0)
+    assert c.beam_sensor_is_default                                  # and it follows the tip again
+    np.testing.assert_array_equal(c.beam_sensor.point, beam0.point)
 
 
 def test_wizard_touches_count_for_the_moved_reference(page) -> None:
