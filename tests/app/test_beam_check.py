@@ -127,3 +127,24 @@ def test_a_hostile_tool_name_is_escaped(page) -> None:
     p.click(p.beam.update)
     md = p.beam.result_md.content
     assert "<img" not in md and escape_markdown(hostile) in md
+
+
+def test_a_tool_the_beam_cannot_see_and_an_unreachable_beam_are_told_in_words(page) -> None:
+    from tcp_pendant.controller.beam import BeamSensor
+
+    p = page({1: truth_tool("pointer", "Pointer")})
+    p.activate(1)
+    gripper = builtin_tools()["gripper"]
+    p.choose(p.tools.mounted, gripper.label)                        # no tip to see
+    p.click(p.beam.check)
+    assert p.notes[-1][0] == "Not done" and "cannot measure this tool" in p.notes[-1][1]
+    assert p.beam.last_check is None and not p.beam.check.disabled
+    p.choose(p.tools.mounted, builtin_tools()["pointer"].label)
+    q = p.session.controller.q_rad
+    with p.session.lock:                                            # a beam far out of reach
+        p.session.controller.set_beam_sensor(BeamSensor(point=(4.0, 4.0, 0.3), direction=(1.0, 0.0, 0.0)))
+    p.click(p.beam.check)                                           # the scan fails in the worker
+    assert p.notes[-1][0] == "Beam check not done", p.notes[-1]
+    assert p.beam.result_md.content.startswith("⚠") and p.beam.last_check is None
+    assert not p.beam.check.disabled and p.beam.update.disabled     # ready for another try
+    np.testing.assert_array_equal(p.session.controller.q_rad, q)    # nothing moved
