@@ -148,3 +148,20 @@ def test_a_tool_the_beam_cannot_see_and_an_unreachable_beam_are_told_in_words(pa
     assert p.beam.result_md.content.startswith("⚠") and p.beam.last_check is None
     assert not p.beam.check.disabled and p.beam.update.disabled     # ready for another try
     np.testing.assert_array_equal(p.session.controller.q_rad, q)    # nothing moved
+
+
+def test_a_second_check_during_the_film_returns_to_where_the_first_started(page) -> None:
+    p = page({1: truth_tool("pointer", "Pointer")})
+    p.activate(1)
+    c = p.session.controller
+    q_home = c.q_rad
+    player = ScanPlayer.of(p.session)
+    player.rate_hz = 4.0                                            # the first film, slow
+    p.click(p.beam.check)
+    wait_until(lambda: player.frames_played >= 3, what="the first film under way")
+    assert not np.allclose(c.q_rad, q_home)
+    player.rate_hz = 400.0
+    p.click(p.beam.check)                                           # again, from mid-film
+    np.testing.assert_allclose(p.beam.last_check.scan.moves[0].q_start_rad, player.frames[0].q_rad)
+    p.film_done()
+    np.testing.assert_allclose(c.q_rad, q_home, atol=1e-12)         # home, not the mid-film pose

@@ -121,8 +121,11 @@ class BeamCheckView:
                 if tool is None:
                     raise ValueError("No tool data is active (TCP = flange): activate the tool to check in the "
                                      "Tool library first.")
+                player = ScanPlayer.of(s)
+                if not (player.playing and player.owner is self):   # a check during our film: back to
+                    self._q_before = s.controller.q_rad             # where the first one started
+                player.stop()                                       # the robot stays where the job sees it
                 job = beam_check_job(s.controller, s.active_slot, tool)
-                self._q_before = s.controller.q_rad
                 self._checking = True
                 self.result_md.content = f"Scanning **{escape_markdown(tool.name)}** with the beam sensor ..."
                 self._render_buttons()
