@@ -55,14 +55,21 @@ def test_the_scene_draws_the_controllers_beam_and_follows_it(page) -> None:
     np.testing.assert_allclose(segs.mean(axis=1), [crossed.point, crossed.point], atol=1e-6)
 
 
-def test_the_overview_sees_the_beam_sensor(page) -> None:
-    p = page()
+@pytest.mark.parametrize("robot", ["kr6", "gp12"])
+def test_the_overview_sees_the_beam_sensor(page, robot) -> None:
+    p = page(robot=robot)
     c = p.session.controller
     position, look_at = overview_pose(c.reference_tip_world_m)
     g = p.session.views["scene"].beam_stand.geometry
-    # every corner of the beam and the stand's column lies inside the overview camera's view cone
+    # every end of the beam and of the stand's column is well inside the overview camera's view:
+    # within 25 deg of its axis up/down and sideways (viser's field of view is 75 deg; the panel
+    # covers the right of the canvas)
     forward = (look_at - position) / np.linalg.norm(look_at - position)
+    right = np.cross(forward, [0.0, 0.0, 1.0])
+    right /= np.linalg.norm(right)
+    up = np.cross(right, forward)
     for point in [*g.beams.reshape(-1, 3), *g.column]:
         v = point - position
-        angle = np.degrees(np.arccos(float(v @ forward) / np.linalg.norm(v)))
-        assert angle < 20.0, f"{point} is {angle:.1f} deg off the overview's axis"
+        vertical = np.degrees(np.arctan2(v @ up, v @ forward))
+        sideways = np.degrees(np.arctan2(v @ right, v @ forward))
+        assert abs(vertical) < 25.0 and abs(sideways) < 25.0, (point, vertical, sideways)
