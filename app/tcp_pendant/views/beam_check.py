@@ -100,7 +100,8 @@ class BeamCheckView:
 
     def _render_buttons(self) -> None:
         self.check.disabled = self._checking
-        self.update.disabled = self._checking or not self._still_checked() or self.last_check.slot is None  # type: ignore[union-attr]
+        checked = self.last_check
+        self.update.disabled = self._checking or not self._still_checked() or checked is None or checked.slot is None
         self.replay.disabled = self._checking or self.last_check is None
 
     # ------------------------------------------------------------ Check with beam

@@ -14,9 +14,9 @@ session's ``pose`` change, so every view shows the robot where the scan had it; 
 beam turns red (the scene's stand, ``BeamStandNodes.set_broken``), the break point, the markers
 and each event's ray are the player's own nodes under ``/beam_scan``. The controller is left at the
 scan's end (or where the caller asked it to return), and the film's end is one more ``pose``
-change (``Session.refresh``: the wizard scene shows its TOOL triads again). A jog, the gizmo or a new scan during the
-replay stops it (the robot stays where the user put it); without a running event loop (a
-test calling from its own thread) the last frame is applied at once.
+change (``Session.refresh``: the scene shows its gizmo and TOOL triads again). A jog, the gizmo
+or a new scan during the replay stops it (the robot stays where the user put it); without a
+running event loop (a test calling from its own thread) the last frame is applied at once.
 
 The player is shared by the Calibrate tab's scene (the "Automatic (beam)" wizard's result) and
 the Tool tab's TCP service ("Check with beam"): one robot, one film at a time.
@@ -245,7 +245,7 @@ class ScanPlayer:
         """Set when the film on show has ended (played out, stopped or cleared)."""
         self.done.set()
         self._shown_state: tuple[int | None, tuple[int, ...]] | None = None
-        session.on_close(self.stop)
+        session.on_close(self._on_close)
 
     @classmethod
     def of(cls, session: Session) -> "ScanPlayer":
@@ -300,6 +300,14 @@ class ScanPlayer:
         if task is not None and not task.done():
             task.cancel()
         self._finish()
+
+    def _on_close(self) -> None:
+        """The session closed: the film's task ends, nothing more is drawn."""
+        self._generation += 1
+        task, self._task = self._task, None
+        if task is not None and not task.done():
+            task.cancel()
+        self.done.set()
 
     def clear(self, owner: object | None = None) -> None:
         """Stop and remove the red beam and the markers (only ``owner``'s film, if given)."""
