@@ -165,3 +165,20 @@ def test_a_second_check_during_the_film_returns_to_where_the_first_started(page)
     np.testing.assert_allclose(p.beam.last_check.scan.moves[0].q_start_rad, player.frames[0].q_rad)
     p.film_done()
     np.testing.assert_allclose(c.q_rad, q_home, atol=1e-12)         # home, not the mid-film pose
+
+
+def test_an_unexpected_failure_is_one_notification_and_the_view_stays_usable(page, monkeypatch) -> None:
+    import tcp_pendant.views.beam_check as beam_check
+
+    p = page({1: truth_tool("pointer", "Pointer")})
+    p.activate(1)
+
+    def broken(*_a, **_k):
+        raise RuntimeError("boom")
+    monkeypatch.setattr(beam_check, "beam_check_job", broken)
+    p.click(p.beam.check)
+    assert p.notes[-1] == ("Beam check failed", "RuntimeError: boom")
+    assert not p.beam.check.disabled
+    monkeypatch.undo()
+    p.click(p.beam.check)                                           # and the next check works
+    assert p.beam.last_check is not None

@@ -106,7 +106,11 @@ class BeamCheckView:
 
     # ------------------------------------------------------------ Check with beam
     async def _on_check(self, _event: Any) -> None:
-        await self.run_check()
+        try:
+            await self.run_check()
+        except Exception as exc:           # a browser's click must never kill the server
+            log.exception("beam check failed")
+            self._failed("Beam check failed", f"{type(exc).__name__}: {exc}", kind="error")
 
     async def run_check(self) -> None:
         """The check of the active tool: job on the loop, scan in the worker, result on the loop."""
