@@ -130,14 +130,15 @@ class _Formatter:
         self._pool: Any = None
         self._pending: dict[int, tuple[list[Any], np.ndarray]] = {}  # id(_FloatArray) -> futures, last block
 
-    def start(self, tree: Any, level: int = 0) -> None:
-        """Submit the large float arrays found in ``tree`` (from :func:`_jsonable`) at ``level``."""
+    def start(self, tree: dict[str, Any], level: int = 0) -> None:
+        """Submit the large float arrays of the dict ``tree`` (from :func:`_jsonable`) printed at
+        ``level`` and of the dicts in it (not of dicts inside lists: those are formatted here)."""
         if self.workers == 1:
             return
-        values = tree.values() if isinstance(tree, dict) else tree if isinstance(tree, list) else ()
-        for v in values:
-            if not isinstance(v, _FloatArray):
+        for v in tree.values():
+            if isinstance(v, dict):
                 self.start(v, level + 1)
+            if not isinstance(v, _FloatArray):
                 continue
             array, row, sep, _, _ = v.layout(level + 1)
             if array.size < PARALLEL_MIN_VALUES:
@@ -287,7 +288,8 @@ def json_dumps(obj: Any, *, workers: int = 1) -> str:
     fmt = _Formatter(workers)
     try:
         tree = _jsonable(obj)
-        fmt.start(tree)
+        if isinstance(tree, dict):
+            fmt.start(tree)
         parts: list[str] = []
         _dump_parts(tree, 0, fmt, parts)
         return "".join(parts)

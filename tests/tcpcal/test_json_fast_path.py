@@ -154,6 +154,27 @@ def test_parallel_falls_back_to_one_process(monkeypatch: pytest.MonkeyPatch) -> 
     assert json_dumps(obj, workers=2) == json_dumps(as_lists(obj))
 
 
+class NoWalk(list):  # type: ignore[type-arg]
+    """A list that must not be walked item by item (10^6 row numbers)."""
+
+    def __iter__(self) -> Any:
+        raise AssertionError("the list was walked")
+
+
+def test_handing_arrays_to_the_pool_walks_dicts_only(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Finding the large arrays to hand to the pool looks at dict values, never at every item
+    of the 10^6-item lists next to them (a walk that cost ~0.5 s on 10^6 rows)."""
+    monkeypatch.setattr(report, "PARALLEL_MIN_VALUES", 6)
+    fmt = report._Formatter(2)
+    vec = report._FloatArray(np.ones((10, 3)))
+    try:
+        fmt.start({"rows": NoWalk([1, 2]), "nested": {"line_numbers": NoWalk([3]), "v": vec}})
+        assert list(fmt._pending) == [id(vec)]
+        assert "".join(fmt.blocks(vec, 2)) == ",\n      ".join(["[1.0, 1.0, 1.0]"] * 10)
+    finally:
+        fmt.close()
+
+
 def test_a_dying_formatting_process_changes_nothing(monkeypatch: pytest.MonkeyPatch) -> None:
     """A child that dies (killed, out of memory) breaks the pool: this process formats the
     arrays itself, the text is the same."""
