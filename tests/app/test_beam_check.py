@@ -182,3 +182,32 @@ def test_an_unexpected_failure_is_one_notification_and_the_view_stays_usable(pag
     monkeypatch.undo()
     p.click(p.beam.check)                                           # and the next check works
     assert p.beam.last_check is not None
+
+
+def test_shared_mode_checks_and_updates_the_one_robot(tmp_path: Path) -> None:
+    from guiclick import click
+    from tcp_pendant.server import AppConfig, PendantApp
+    from wsclient import DrainingClient
+
+    app = PendantApp(AppConfig(port=0, tool_library=tmp_path / "tools.json", shared=True, library_poll_s=0.1))
+    app.library.save(1, truth_tool("pointer", "Pointer", (0.0, 1.0, 0.0)), activate=True)   # 1 mm off
+    app.start()
+    ws = [DrainingClient(app.port), DrainingClient(app.port)]
+    try:
+        wait_until(lambda: len(app.server.get_clients()) == 2, what="two browsers")
+        s = app.shared_session
+        ScanPlayer.of(s).rate_hz = 400.0
+        view = s.views["beam_check"]
+        a, _b = app.server.get_clients().values()
+        s.notify = lambda *args, **kw: None                          # type: ignore[method-assign]
+        assert s.active_slot == 1
+        click(view.check, a)
+        assert view.last_check.deviation_norm_mm == pytest.approx(1.0, abs=0.05)
+        wait_until(lambda: not ScanPlayer.of(s).playing, timeout=60, what="the film")
+        click(view.update, a)
+        np.testing.assert_allclose(app.library.get(1).tcp_mm, truth_tool("pointer", "x").tcp_mm, atol=0.05)
+        assert app.library.active_slot() == 1                        # --shared: the library's active slot
+    finally:
+        for w in ws:
+            w.close()
+        app.stop()
