@@ -121,3 +121,24 @@ def test_in_an_exercise_the_comparison_shows_no_errors(page) -> None:
     text = p.view.result.result_md.content
     assert "(your time)" in text and "TCP error" not in text
     assert not p.view.result.truth_md.visible
+
+
+def test_a_loaded_beam_record_shows_its_markers_without_moving_the_robot(page) -> None:
+    p = page()
+    s, c, v = p.session, p.session.controller, p.view
+    p.beam()
+    p.film_done()
+    record = v.workflow.export_record(s.touches)
+    with s.lock:                                                    # jog away, then load the record
+        c.set_q(c.q_rad + np.radians([5, 0, 0, 0, 0, 0]))
+        s.moved()
+    q = c.q_rad
+    with s.lock, s.batch():
+        v.workflow.load_record(record)
+        s.changed(wizard=True)
+    res = v.workflow.result
+    assert res is not None and not res.scan.moves                   # a stored scan: events only
+    assert p.player.scan is res.scan and not p.player.playing
+    assert len(np.asarray(p.player.markers.points)) == len(res.events)
+    np.testing.assert_array_equal(c.q_rad, q)                       # the robot stays
+    assert not v.result.replay_scan.visible                         # nothing to replay

@@ -170,7 +170,7 @@ class WizardResultView:
             set_content(self.save_md, "")
         truth = None if wf.hide_truth else wf.truth()   # an exercise: no answer shown
         set_content(self.result_md, result_markdown(res, truth))   # a beam result: errors of both vs truth
-        self.replay_scan.visible = getattr(res, "scan", None) is not None
+        self.replay_scan.visible = bool(getattr(getattr(res, "scan", None), "moves", ()))   # a stored scan: none
         set_content(self.warnings_md, warnings_markdown(res))
         run = wf.run
         hidden = "" if run is None else hidden_touches_markdown(res, run.distance_mm, run.distance_hidden)
