@@ -153,6 +153,7 @@ class BeamStandNodes:
         self.label: Any = None
         self.broken: int | None = None
         """The beam drawn red (broken; ``views.beam_replay``), or None."""
+        self._shown_sensor: BeamSensor | None = None
         self.show(sensor)
 
     def _colors(self) -> np.ndarray:
@@ -171,7 +172,11 @@ class BeamStandNodes:
             self.beam_handle.colors = self._colors()
 
     def show(self, sensor: BeamSensor | None) -> bool:
-        """Draw ``sensor`` if it differs from what is drawn (returns whether it redrew)."""
+        """Draw ``sensor`` if it differs from what is drawn (returns whether it redrew). Called on
+        every change signal (each jog step): the same sensor object returns at once."""
+        if sensor is self._shown_sensor and sensor is not None:
+            return False
+        self._shown_sensor = sensor
         key = sensor_key(sensor)
         if key == self.shown_key:
             return False
