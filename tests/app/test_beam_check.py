@@ -59,6 +59,24 @@ def test_check_with_beam_needs_an_active_tool(page) -> None:
     assert p.beam.last_check is None and p.beam.update.disabled
 
 
+def test_check_with_beam_is_off_in_an_exercise(page) -> None:
+    """In a classroom exercise (the workflow hides the truth) the beam would measure the mystery
+    tool for the trainee: Check with beam and the Automatic (beam) wizard are refused in words."""
+    from tcp_pendant.wizards import WizardError
+    p = page({1: truth_tool("pointer", "Pointer")})
+    p.activate(1)
+    p.session.workflow.hide_truth = True
+    p.click(p.beam.check)
+    assert p.notes[-1][0] == "Not done" and "off during the trainer's exercise" in p.notes[-1][1]
+    assert p.beam.last_check is None and not ScanPlayer.of(p.session).playing
+    with pytest.raises(WizardError, match="Automatic \\(beam\\) wizard is off during the trainer's exercise"):
+        p.session.workflow.start("beam")
+    assert p.session.workflow.start("xyz4").kind == "xyz4"          # touching is the exercise
+    p.session.workflow.hide_truth = False
+    p.click(p.beam.check)
+    assert p.beam.last_check is not None
+
+
 def test_the_industrial_loop_crash_check_update_verify(page) -> None:
     p = page({1: truth_tool("pointer", "Pointer")})
     s, c = p.session, p.session.controller

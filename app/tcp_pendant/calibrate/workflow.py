@@ -71,6 +71,7 @@ from tcpcal.tool import Tool
 
 __all__ = [
     "AUTO_SIGMA_MAX_MM",
+    "EXERCISE_REFUSAL",
     "WIZARD_KINDS",
     "WIZARD_LABELS",
     "AutoTouchRequest",
@@ -88,6 +89,10 @@ WIZARD_LABELS: LiveAttribute = LiveAttribute("title")
 """Kind -> the method's label (live view of the registry)."""
 AUTO_SIGMA_MAX_MM = 2.0
 """Largest simulated operator error the pendant offers (issue 5: slider 0-2 mm)."""
+EXERCISE_REFUSAL = ("{what} is off during the trainer's exercise: the beam sensor would measure the "
+                    "exercise's tool for you. Calibrate it by touching the reference tip (XYZ 4-point, "
+                    "XYZ reference or TCP & Z, X).")
+"""Why a method that measures the tool by itself is refused in an exercise (``hide_truth``)."""
 
 
 @dataclass(frozen=True)
@@ -390,6 +395,8 @@ class CalibrationWorkflow:
             WizardError: unknown kind or option, a value out of its choices, an empty slot.
         """
         cls = wizard_class(kind)
+        if self.hide_truth and not cls.in_exercises:
+            raise WizardError(EXERCISE_REFUSAL.format(what=f"The {cls.title} wizard"))
         started = cls.start(_StartContext(self), cls.parse_options(options))
         self._open(started.wizard, started.true_tool)
         if started.active_data is not None:

@@ -31,6 +31,7 @@ from tcp_pendant.calibrate.beam_service import (
     beam_check_markdown,
     update_tool_from_beam,
 )
+from tcp_pendant.calibrate.workflow import EXERCISE_REFUSAL
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.beam_replay import ScanPlayer, beam_view_direction, scan_spheres
@@ -123,6 +124,8 @@ class BeamCheckView:
         try:
             with s.lock:
                 tool = s.controller.active_tool
+                if getattr(s.workflow, "hide_truth", False):
+                    raise ValueError(EXERCISE_REFUSAL.format(what="Check with beam"))
                 if tool is None:
                     raise ValueError("No tool data is active (TCP = flange): activate the tool to check in the "
                                      "Tool library first.")

@@ -263,6 +263,9 @@ class Wizard(abc.ABC):
         supports_add_point: "Add point" adds a touch (``add_point``).
         diversity_meter: the live pose-diversity meter is shown on touch steps (``preview``,
             ``other_rotations``, ``assumed_sigma_mm``).
+        in_exercises: may be started in a classroom exercise (``workflow.hide_truth``); False
+            for a method that measures the tool by itself (the beam sensor): it would hand the
+            trainee the mystery tool's answer the exercise asks them to find by touching.
     """
 
     kind: ClassVar[str]
@@ -276,6 +279,7 @@ class Wizard(abc.ABC):
     needs_tool: ClassVar[Literal["mounted", "library"]] = "mounted"
     supports_add_point: ClassVar[bool] = False
     diversity_meter: ClassVar[bool] = False
+    in_exercises: ClassVar[bool] = True
 
     # ----- self-description (the registry, the menu and the workflow read these) -----------
     @classmethod

@@ -427,6 +427,8 @@ class BeamWizard(Wizard):
                             "calibration of the same tool side by side.")
     calibrates: ClassVar[str] = "the TCP and the tool direction"
     rank: ClassVar[int] = 60
+    in_exercises: ClassVar[bool] = False
+    """The scan measures the tool by itself: refused in a classroom exercise."""
     MIN_ORIENTATIONS: ClassVar[int] = 3
     MAX_ORIENTATIONS: ClassVar[int] = 5
     step_roles = (StepRole("scan", "the controller runs the beam scan itself", BY_CONTROLLER),)
