@@ -113,14 +113,18 @@ def test_the_beam_result_is_replayed_framed_and_compared_with_the_manual_one(pag
     assert p.player.scan is None and p.player.markers is None and p.player.rays is None
 
 
-def test_in_an_exercise_the_comparison_shows_no_errors(page) -> None:
+def test_in_an_exercise_the_beam_is_off_and_says_why(page) -> None:
+    """The classroom's exercise hides the truth and asks for a calibration by touching: the
+    Automatic (beam) wizard would measure the mystery tool, so Start refuses it in words."""
     p = page()
     p.view.workflow.hide_truth = True                                 # the classroom's exercise
     p.xyz4_by_hand()
-    p.beam()
-    text = p.view.result.result_md.content
-    assert "(your time)" in text and "TCP error" not in text
-    assert not p.view.result.truth_md.visible
+    n_runs = len(p.view.workflow.runs)
+    p.choose(p.view.method, "Automatic (beam)")
+    p.click(p.view.start)
+    assert p.notes and "off during the trainer's exercise" in p.notes[-1][1]
+    assert len(p.view.workflow.runs) == n_runs and p.view.workflow.wizard.kind == "xyz4"
+    assert not p.player.playing
 
 
 def test_a_loaded_beam_record_shows_its_markers_without_moving_the_robot(page) -> None:

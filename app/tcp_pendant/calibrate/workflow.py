@@ -774,12 +774,15 @@ class CalibrationWorkflow:
         workflow's ``rng`` (a seeded workflow scans reproducibly).
 
         Raises:
-            WizardStateError: the beam cannot measure the mounted tool (the gripper), or no tool
-                data to plan with (a tool of no catalogue and no active tool data).
+            WizardStateError: the beam cannot measure the mounted tool (the gripper), no tool
+                data to plan with (a tool of no catalogue and no active tool data), or a
+                classroom exercise runs (``hide_truth``: the scan would measure its tool).
         """
         w = self.wizard
         if not isinstance(w, BeamWizard) or not w.scan_pending:
             return None
+        if self.hide_truth:     # an exercise began after the wizard was opened
+            raise WizardStateError(EXERCISE_REFUSAL.format(what="The Automatic (beam) scan"))
         c = self.controller
         mounted = c.mounted_tool
         try:
