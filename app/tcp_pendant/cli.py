@@ -79,6 +79,14 @@ def build_parser() -> argparse.ArgumentParser:
                         "Calibrate tab")
     p.add_argument("--scenario-seed", type=int, default=0, metavar="N",
                    help="seed that draws the scenario's errors (default 0; >= 0)")
+    p.add_argument("--beam-width", type=float, default=0.5, metavar="MM",
+                   help="the beam sensor's beam diameter, mm (0.05 to 5; default 0.5)")
+    p.add_argument("--beam-repeatability", type=float, default=0.02, metavar="MM",
+                   help="the beam sensor's repeatability per axis of a recorded event, mm (0 to 1; "
+                        "default 0.02)")
+    p.add_argument("--beam-crossed", action="store_true",
+                   help="a second beam along WORLD Y crosses the first (crossed beams, as on TRACC-type "
+                        "devices)")
     p.add_argument("--verbose", action="store_true", help="log debugging information")
     return p
 
@@ -168,7 +176,9 @@ def _main(argv: Sequence[str] | None) -> int:
                            reference_tip_mm=tip, allow_origins=tuple(args.allow_origin), class_db=class_db,
                            trainer_token=args.trainer_token, exercise=args.exercise,
                            exercise_seed=args.exercise_seed, scenario=args.scenario.replace("-", "_"),
-                           scenario_seed=args.scenario_seed, presenter=args.presenter)
+                           scenario_seed=args.scenario_seed, presenter=args.presenter,
+                           beam_width_mm=args.beam_width, beam_repeatability_mm=args.beam_repeatability,
+                           beam_crossed=args.beam_crossed)
         app = PendantApp(config)
     except (ControllerError, ValueError, OSError, GradebookError) as exc:
         print(f"tcp-pendant: error: {exc}", file=sys.stderr)

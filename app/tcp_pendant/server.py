@@ -37,6 +37,7 @@ from tcp_pendant.addresses import network_urls
 from tcp_pendant.classroom.class_room import ClassRoom
 from tcp_pendant.classroom.gradebook import Gradebook
 from tcp_pendant.controller import (
+    BeamDevice,
     ControllerError,
     solve_ik,
     RobotKinematics,
@@ -84,6 +85,10 @@ class AppConfig:
             the trainer changes it per pendant in the Calibrate tab.
         scenario_seed: seed of the scenario's errors (>= 0).
         presenter: every session starts in presenter mode (``views.presenter``; projector).
+        beam_width_mm, beam_repeatability_mm, beam_crossed: the beam sensor beside the reference
+            tip (``controller.beam_scan.BeamDevice``): beam diameter (0.05-5 mm, default 0.5),
+            repeatability of an event per axis (0-1 mm, default 0.02), a second beam along
+            WORLD Y crossing it.
     """
 
     robot: str = "kr6"
@@ -103,6 +108,9 @@ class AppConfig:
     scenario: str = "off"
     scenario_seed: int = 0
     presenter: bool = False
+    beam_width_mm: float = 0.5
+    beam_repeatability_mm: float = 0.02
+    beam_crossed: bool = False
 
 
 class PortInUseError(OSError):
@@ -236,6 +244,9 @@ class PendantApp:
         if tip_m.shape != (3,) or not np.all(np.isfinite(tip_m)):
             raise ControllerError(f"Reference tip must be 3 finite numbers X,Y,Z in mm, got {tip!r}.")
         self.reference_tip_m = tip_m
+        self.beam_device = BeamDevice(width_m=config.beam_width_mm / 1000.0,      # ControllerError: says
+                                      sigma_m=config.beam_repeatability_mm / 1000.0,  # the allowed range
+                                      crossed=config.beam_crossed)
         self.ready_q_rad = ready_configuration(self.kinematics, tip_m)
         self.allow_origins = origin_check.parse_allow_origins(config.allow_origins)
         self.library = ToolLibrary(config.tool_library)
@@ -266,6 +277,7 @@ class PendantApp:
         k = self.kinematics
         kin = RobotKinematics(k.model, k.urdf_path, k.flange_link, k.base_link)
         c = VirtualController(kin, tool=self.tool, reference_tip_world_m=self.reference_tip_m)
+        c.set_beam_device(self.beam_device)
         c.set_q(self.ready_q_rad)
         return c
 

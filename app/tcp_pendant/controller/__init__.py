@@ -18,6 +18,7 @@ from tcp_pendant.controller.approach import approach_pose, approach_rotation, so
 from tcp_pendant.controller.assets import example_robot_urdf, robots_dir
 from tcp_pendant.controller.beam import BeamEvent, BeamSensor, ToolShape
 from tcp_pendant.controller.beam_scan import (
+    BeamDevice,
     BeamScan,
     BeamScanConfig,
     ScanMove,
@@ -42,6 +43,7 @@ from tcp_pendant.controller.touch import TouchGeometry
 
 __all__ = [
     "BeamEvent",
+    "BeamDevice",
     "BeamScan",
     "BeamScanConfig",
     "BeamSensor",

@@ -89,7 +89,15 @@ import numpy as np
 
 from tcpcal.validation import read_only_array
 from tcp_pendant.controller.approach import solve_ik
-from tcp_pendant.controller.beam import BeamEvent, BeamSensor, ToolShape, crossing_events, tip_on_beam
+from tcp_pendant.controller.beam import (
+    DEFAULT_SIGMA_M,
+    DEFAULT_WIDTH_M,
+    BeamEvent,
+    BeamSensor,
+    ToolShape,
+    crossing_events,
+    tip_on_beam,
+)
 from tcp_pendant.controller.errors import ControllerError
 from tcp_pendant.controller.kinematics import RobotKinematics
 from tcp_pendant.controller.tools import ToolModel
@@ -98,6 +106,7 @@ __all__ = [
     "BEAM_TOOL_SHAPES",
     "MAX_ARM_SWING_DEG",
     "MAX_JOINT_STEP_DEG",
+    "BeamDevice",
     "BeamScan",
     "BeamScanConfig",
     "ScanMove",
@@ -329,19 +338,49 @@ def tool_shape(tool_model: ToolModel, T_flange_tool_true: np.ndarray | None = No
     return ToolShape(np.asarray(T, dtype=float), radius=radius, length=length)
 
 
-def default_beam_sensor(reference_tip_world_m: np.ndarray) -> BeamSensor:
+@dataclass(frozen=True)
+class BeamDevice:
+    """What kind of beam device stands beside the reference tip (the start options
+    ``--beam-width``, ``--beam-repeatability``, ``--beam-crossed``).
+
+    Attributes:
+        width_m: beam diameter, m (0.05 to 5 mm).
+        sigma_m: repeatability of a recorded event per axis, m (0 to 1 mm).
+        crossed: a second beam along WORLD Y through the same point (crossed beams).
+    """
+
+    width_m: float = DEFAULT_WIDTH_M
+    sigma_m: float = DEFAULT_SIGMA_M
+    crossed: bool = False
+
+    def __post_init__(self) -> None:
+        w, sg = float(self.width_m), float(self.sigma_m)
+        if not (math.isfinite(w) and 0.05e-3 <= w <= 5e-3):
+            raise ControllerError(f"The beam width must be 0.05 to 5 mm, got {w * 1000:g} mm.")
+        if not (math.isfinite(sg) and 0.0 <= sg <= 1e-3):
+            raise ControllerError(f"The beam repeatability must be 0 to 1 mm, got {sg * 1000:g} mm.")
+        object.__setattr__(self, "width_m", w)
+        object.__setattr__(self, "sigma_m", sg)
+        object.__setattr__(self, "crossed", bool(self.crossed))
+
+
+def default_beam_sensor(reference_tip_world_m: np.ndarray, device: BeamDevice = BeamDevice()) -> BeamSensor:
     """The beam device where it stands by default: a horizontal beam along WORLD X (away from
     the robot), :data:`DEFAULT_BEAM_OFFSET_M` from the reference tip (clear of its stand,
     reachable for the whole scan on the KR 6 and the GP12 with the default reference tip).
 
     Args:
         reference_tip_world_m: (3,) the reference tip, WORLD, m.
+        device: the beam's width, repeatability and whether a second beam along WORLD Y
+            crosses it (default: one 0.5 mm beam, 0.02 mm).
     """
     tip = np.asarray(reference_tip_world_m, dtype=float)
     if tip.shape != (3,) or not np.isfinite(tip).all():
         raise ControllerError(f"reference_tip_world_m must be 3 finite numbers (m), got "
                               f"{reference_tip_world_m!r}.")
-    return BeamSensor(tip + DEFAULT_BEAM_OFFSET_M, np.array([1.0, 0.0, 0.0]))
+    return BeamSensor(tip + DEFAULT_BEAM_OFFSET_M, np.array([1.0, 0.0, 0.0]), width=device.width_m,
+                      sigma=device.sigma_m,
+                      second_direction=np.array([0.0, 1.0, 0.0]) if device.crossed else None)
 
 
 def _pass_direction(sensor: BeamSensor) -> tuple[np.ndarray, float]:

@@ -34,7 +34,7 @@ from scipy.spatial.transform import Rotation
 from tcpcal.tool import Tool
 from tcp_pendant.controller.approach import approach_pose, solve_ik
 from tcp_pendant.controller.beam import BeamSensor
-from tcp_pendant.controller.beam_scan import default_beam_sensor
+from tcp_pendant.controller.beam_scan import BeamDevice, default_beam_sensor
 from tcp_pendant.controller.errors import ControllerError
 from tcp_pendant.controller.jog import (
     DEFAULT_SETTINGS,
@@ -123,6 +123,7 @@ class VirtualController:
         self._tip = _check_point(reference_tip_world_m, "reference_tip_world_m")
         self._beam: BeamSensor | None = None  # None: default_beam_sensor(reference tip)
         self._default_beam: tuple[np.ndarray, BeamSensor] | None = None  # (tip, its default sensor)
+        self._beam_device = BeamDevice()  # the default sensor's width, repeatability, crossing
 
     # ----------------------------------------------------------------- state
     @property
@@ -227,8 +228,24 @@ class VirtualController:
         if self._beam is not None:
             return self._beam
         if self._default_beam is None or not np.array_equal(self._default_beam[0], self._tip):
-            self._default_beam = (self._tip.copy(), default_beam_sensor(self._tip))
+            self._default_beam = (self._tip.copy(), default_beam_sensor(self._tip, self._beam_device))
         return self._default_beam[1]
+
+    @property
+    def beam_device(self) -> BeamDevice:
+        """The default beam sensor's width, repeatability and crossing (``--beam-*`` options)."""
+        return self._beam_device
+
+    def set_beam_device(self, device: BeamDevice) -> None:
+        """Choose the default beam sensor's width, repeatability and crossing.
+
+        Raises:
+            ControllerError: not a ``BeamDevice``.
+        """
+        if not isinstance(device, BeamDevice):
+            raise ControllerError(f"set_beam_device expects a BeamDevice, got {type(device).__name__}.")
+        self._beam_device = device
+        self._default_beam = None
 
     @property
     def beam_sensor_is_default(self) -> bool:
