@@ -22,6 +22,7 @@ import yourdfpy
 
 from tcp_pendant.controller.assets import REFERENCE_TIP_URDF, ROBOT_URDFS, TOOL_URDFS, asset_path, robots_dir
 from tcp_pendant.controller.errors import ControllerError
+from tcpcal.validation import read_only_array
 
 __all__ = [
     "TOOL_LABELS",
@@ -39,12 +40,6 @@ TOOL_LABELS: dict[str, str] = {
     "torch": "Welding torch (bent neck)",
     "gripper": "Two-finger gripper",
 }
-
-
-def _readonly(T: np.ndarray) -> np.ndarray:
-    out = np.array(T, dtype=float)
-    out.setflags(write=False)
-    return out
 
 
 @dataclass(frozen=True, eq=False)
@@ -72,7 +67,7 @@ class ToolModel:
         R = T[:3, :3]
         if np.abs(R.T @ R - np.eye(3)).max() > 1e-9 or np.linalg.det(R) < 0:
             raise ControllerError(f"Tool {self.key!r}: T_flange_tool_true has no proper rotation.")
-        object.__setattr__(self, "T_flange_tool_true", _readonly(T))
+        object.__setattr__(self, "T_flange_tool_true", read_only_array(T))
         object.__setattr__(self, "urdf_path", Path(self.urdf_path))
 
     def __repr__(self) -> str:
@@ -146,4 +141,4 @@ class ReferenceTipModel:
 def reference_tip_model() -> ReferenceTipModel:
     """The built-in reference tip, read from ``robots/reference_tip/reference_tip.urdf``."""
     path = asset_path(REFERENCE_TIP_URDF)
-    return ReferenceTipModel(path, _readonly(urdf_transform(path, "stand_base", "tip")))
+    return ReferenceTipModel(path, read_only_array(urdf_transform(path, "stand_base", "tip")))

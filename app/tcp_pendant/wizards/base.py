@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import abc
 import datetime as _dt
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any, ClassVar, Literal
@@ -72,6 +73,33 @@ class CalibrationFailedError(WizardError):
 def utc_now_iso() -> str:
     """Current time, ISO 8601 UTC with seconds (``2026-11-22T18:55:17Z``)."""
     return _dt.datetime.now(_dt.timezone.utc).replace(microsecond=0).isoformat().replace("+00:00", "Z")
+
+
+def finite_number(value: Any, what: str, *, low: float | None = None, high: float | None = None) -> float:
+    """A number from untrusted input (a session record's stored figures, a start option), checked.
+
+    Args:
+        value: what was given.
+        what: its name in the message ("TCP check's angle": "The TCP check's angle must ...").
+        low, high: inclusive bounds (None: none).
+
+    Raises:
+        WizardError: a bool, not a number, not finite, or out of the bounds (naming ``what``).
+    """
+    if isinstance(value, bool):
+        raise WizardError(f"The {what} must be a number, got {value!r:.40}.")
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise WizardError(f"The {what} must be a number, got {value!r:.40}.") from None
+    if low is None and high is None:
+        if not math.isfinite(x):
+            raise WizardError(f"The {what} must be finite, got {value!r:.40}.")
+    elif not math.isfinite(x) or (low is not None and x < low) or (high is not None and x > high):
+        raise WizardError(f"The {what} must be a finite number in "
+                          f"{'-inf' if low is None else f'{low:g}'}..{'inf' if high is None else f'{high:g}'}"
+                          f", got {value!r:.40}.")
+    return x
 
 
 def check_pose_m(T_world_flange_m: Any, *, what: str = "flange pose") -> np.ndarray:

@@ -41,6 +41,7 @@ from scipy.spatial.transform import Rotation
 from tcpcal.beam import BeamAxisResult, BeamResult, solve_beam, solve_beam_axis
 from tcpcal.errors import TcpcalError
 from tcpcal.tool import Tool, abc_deg_from_rotation
+from tcpcal.validation import read_only_array
 
 from tcp_pendant.wizards.base import (
     M_TO_MM,
@@ -53,6 +54,7 @@ from tcp_pendant.wizards.base import (
     WizardResult,
     WizardStateError,
     check_pose_m,
+    finite_number,
     mm3,
 )
 from tcp_pendant.wizards.describe import BY_CONTROLLER, StepRole, WizardOption, WizardStart
@@ -80,24 +82,10 @@ _MAX_TEXT = 200          # characters kept of a stored text (the record is untru
 _GRADES = ("good", "fair", "poor")
 
 
-def _finite(value: Any, what: str, *, low: float | None = None, high: float | None = None) -> float:
-    if isinstance(value, bool):
-        raise WizardError(f"The beam scan's {what} must be a number, got {value!r:.40}.")
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise WizardError(f"The beam scan's {what} must be a number, got {value!r:.40}.") from None
-    if not math.isfinite(x) or (low is not None and x < low) or (high is not None and x > high):
-        raise WizardError(f"The beam scan's {what} must be a finite number in "
-                          f"{'-inf' if low is None else f'{low:g}'}..{'inf' if high is None else f'{high:g}'}"
-                          f", got {value!r:.40}.")
-    return x
-
-
 def _vector(value: Any, what: str, *, limit: float) -> np.ndarray:
     if not (isinstance(value, (list, tuple, np.ndarray)) and len(value) == 3):
         raise WizardError(f"The beam scan's {what} must be 3 numbers, got {value!r:.60}.")
-    return np.array([_finite(v, what, low=-limit, high=limit) for v in value], dtype=float)
+    return np.array([finite_number(v, f"beam scan's {what}", low=-limit, high=limit) for v in value], dtype=float)
 
 
 def _rotation(value: Any, what: str) -> np.ndarray:
@@ -109,12 +97,6 @@ def _rotation(value: Any, what: str) -> np.ndarray:
             or np.linalg.det(R) < 0.0:
         raise WizardError(f"The {what} must be a proper 3x3 rotation matrix (orthonormal, det +1).")
     return R
-
-
-def _readonly(a: np.ndarray) -> np.ndarray:
-    a = np.array(a, dtype=float)
-    a.setflags(write=False)
-    return a
 
 
 @dataclass(frozen=True, eq=False)
@@ -180,7 +162,7 @@ class ScanEvent:
         n = float(np.linalg.norm(u))
         if not n > 1e-9:
             raise WizardError("A stored beam event's beam direction is the zero vector.")
-        return cls(kind, _readonly(T), int(beam), _readonly(b), _readonly(u / n), bool(d.get("on_shaft", True)),
+        return cls(kind, read_only_array(T), int(beam), read_only_array(b), read_only_array(u / n), bool(d.get("on_shaft", True)),
                    int(orientation))
 
 
@@ -245,8 +227,8 @@ class RecordedScan:
         if not isinstance(skipped, list) or len(skipped) > MAX_SKIPPED:
             raise WizardError(f"The stored beam scan's skipped orientations must be a list of at most {MAX_SKIPPED}.")
         return cls(tuple(ScanEvent.from_dict(e) for e in events),
-                   _finite(d.get("duration_s"), "duration (s)", low=0.0, high=MAX_DURATION_S),
-                   _finite(d.get("path_length_m"), "path length (m)", low=0.0, high=MAX_PATH_M),
+                   finite_number(d.get("duration_s"), "beam scan's duration (s)", low=0.0, high=MAX_DURATION_S),
+                   finite_number(d.get("path_length_m"), "beam scan's path length (m)", low=0.0, high=MAX_PATH_M),
                    tuple(str(s)[:_MAX_TEXT] for s in skipped))
 
 
@@ -316,14 +298,14 @@ class ManualComparison:
         if truth is not None:
             if not isinstance(truth, Mapping):
                 raise WizardError("The stored manual calibration's truth must be an object or null.")
-            pos = _finite(truth.get("position_error_mm"), "manual position error (mm)", low=0.0, high=1e6)
+            pos = finite_number(truth.get("position_error_mm"), "beam scan's manual position error (mm)", low=0.0, high=1e6)
             if truth.get("direction_error_deg") is not None:
-                ang = _finite(truth.get("direction_error_deg"), "manual direction error (deg)", low=0.0, high=180.0)
+                ang = finite_number(truth.get("direction_error_deg"), "beam scan's manual direction error (deg)", low=0.0, high=180.0)
             grade = truth.get("grade")
             if grade is not None and grade not in _GRADES:
                 raise WizardError(f"The stored manual calibration's grade must be one of {_GRADES}, got {grade!r:.40}.")
         return cls(str(d.get("title", ""))[:_MAX_TEXT], str(d.get("kind", ""))[:_MAX_TEXT], n,
-                   _finite(d.get("wall_time_s"), "manual wall time (s)", low=0.0, high=MAX_WALL_TIME_S),
+                   finite_number(d.get("wall_time_s"), "beam scan's manual wall time (s)", low=0.0, high=MAX_WALL_TIME_S),
                    pos, ang, grade)
 
 
@@ -443,11 +425,11 @@ class BeamWizard(Wizard):
 
     def __init__(self, *, n_orientations: int = 4, scan_speed_mm_s: float = 50.0) -> None:
         super().__init__()
-        n = _finite(n_orientations, "number of orientations")
+        n = finite_number(n_orientations, "beam scan's number of orientations")
         if n != int(n) or not self.MIN_ORIENTATIONS <= n <= self.MAX_ORIENTATIONS:
             raise WizardError(f"The beam scan runs {self.MIN_ORIENTATIONS} to {self.MAX_ORIENTATIONS} "
                               f"orientations, got {n_orientations!r:.40}.")
-        speed = _finite(scan_speed_mm_s, "scan speed (mm/s)")
+        speed = finite_number(scan_speed_mm_s, "beam scan's scan speed (mm/s)")
         if not 5.0 <= speed <= 250.0:
             raise WizardError(f"The scan speed must be 5 to 250 mm/s, got {scan_speed_mm_s!r:.40}.")
         self.n_orientations = int(n)
@@ -634,7 +616,7 @@ class BeamWizard(Wizard):
             warnings=tuple(warnings), notes=notes,
             scan=scan_obj, events=events, beam_result=res, axis_result=axis_res,
             direction_flange=direction, direction_ci95_deg=ci_deg, direction_turn_deg=turn,
-            R_flange_tool_base=_readonly(R_base), tip_event_indices=tips, axis_event_indices=axes,
+            R_flange_tool_base=read_only_array(R_base), tip_event_indices=tips, axis_event_indices=axes,
             duration_s=scan.duration_s, path_length_m=scan.path_length_m, manual=self._manual)
 
     def to_tool(self, name: str) -> Tool:

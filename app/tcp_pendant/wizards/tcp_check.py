@@ -20,7 +20,6 @@ Units: mm and degrees throughout.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, ClassVar
@@ -38,6 +37,7 @@ from tcp_pendant.wizards.base import (
     WizardError,
     WizardResult,
     WizardStateError,
+    finite_number,
     mm3,
 )
 from tcp_pendant.wizards.describe import TOUCH, StepRole, WizardOption, WizardStart
@@ -48,18 +48,6 @@ __all__ = ["CheckFigures", "CheckRow", "GOOD_CHECK_MM", "TcpCheckResult", "TcpCh
 GOOD_CHECK_MM = 0.5
 """Implied TCP error up to which the check calls the TCP good (a careful touch's accuracy), mm."""
 _MAX_TEXT = 200          # characters kept of a stored message (the record is untrusted input)
-
-
-def _finite(value: Any, what: str) -> float:
-    if isinstance(value, bool):
-        raise WizardError(f"The TCP check's {what} must be a number, got {value!r:.40}.")
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise WizardError(f"The TCP check's {what} must be a number, got {value!r:.40}.") from None
-    if not math.isfinite(x):
-        raise WizardError(f"The TCP check's {what} must be finite, got {value!r:.40}.")
-    return x
 
 
 @dataclass(frozen=True)
@@ -146,16 +134,16 @@ class CheckFigures:
                 raise WizardError("Each stored TCP check row must be an object.")
             rows.append(CheckRow(str(r.get("label", ""))[:_MAX_TEXT], bool(r.get("reached")),
                                  str(r.get("message", ""))[:_MAX_TEXT],
-                                 _finite(r.get("deviation_mm"), "deviation")))
+                                 finite_number(r.get("deviation_mm"), "TCP check's deviation")))
         err = d.get("implied_tcp_error_mm")
         off = d.get("correction_flange_mm")
         rms = d.get("fit_rms_mm")
         if off is not None and not (isinstance(off, list) and len(off) == 3):
             raise WizardError("The TCP check's stored correction must be 3 numbers (mm).")
-        return cls(_finite(d.get("angle_deg"), "angle"), tuple(rows),
-                   None if err is None else _finite(err, "implied error"),
-                   None if off is None else mm3([_finite(v, "correction") for v in off]),
-                   None if rms is None else _finite(rms, "fit RMS"))
+        return cls(finite_number(d.get("angle_deg"), "TCP check's angle"), tuple(rows),
+                   None if err is None else finite_number(err, "TCP check's implied error"),
+                   None if off is None else mm3([finite_number(v, "TCP check's correction") for v in off]),
+                   None if rms is None else finite_number(rms, "TCP check's fit RMS"))
 
 
 @dataclass(frozen=True, eq=False, kw_only=True)
@@ -199,7 +187,7 @@ class TcpCheckWizard(Wizard):
         super().__init__()
         if not isinstance(tool, Tool):
             raise WizardError("The TCP check needs a tool of the library (its TCP data).")
-        a = _finite(angle_deg, "angle")
+        a = finite_number(angle_deg, "TCP check's angle")
         if not 0.0 < a <= 90.0:
             raise WizardError(f"The check angle must be above 0 and at most 90 degrees, got {angle_deg!r}.")
         self.tool = tool
