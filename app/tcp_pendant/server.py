@@ -274,9 +274,8 @@ class PendantApp:
     # ------------------------------------------------------------ sessions
     def new_controller(self) -> VirtualController:
         """A controller with its own pinocchio data (the model is shared, read-only)."""
-        k = self.kinematics
-        kin = RobotKinematics(k.model, k.urdf_path, k.flange_link, k.base_link)
-        c = VirtualController(kin, tool=self.tool, reference_tip_world_m=self.reference_tip_m)
+        c = VirtualController(self.kinematics.own_copy(), tool=self.tool,
+                              reference_tip_world_m=self.reference_tip_m)
         c.set_beam_device(self.beam_device)
         c.set_q(self.ready_q_rad)
         return c

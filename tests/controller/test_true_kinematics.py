@@ -139,3 +139,19 @@ def test_truth_helper_used_above_is_the_tool():
     model = builtin_tools()["pointer"]
     np.testing.assert_allclose(truth_tool_data(model).T_flange_tool_mm[:3, 3] / 1000.0,
                                model.T_flange_tool_true[:3, 3], atol=1e-12)
+
+
+def test_kinematics_for_worker_are_own_copies_of_both_robots():
+    """A job in a worker thread gets the nominal and the physical robot with their own pinocchio
+    data (the models shared), the physical one being the nominal copy without accuracy error."""
+    plain = make_controller("kr6")
+    nominal, physical = plain.kinematics_for_worker()
+    assert physical is nominal and nominal is not plain.kinematics
+    assert nominal.model is plain.kinematics.model and nominal.data is not plain.kinematics.data
+    c, true_kin = accuracy_controller()
+    nominal, physical = c.kinematics_for_worker()
+    assert nominal.model is c.kinematics.model and physical.model is true_kin.model
+    assert physical.data is not true_kin.data and nominal.data is not c.kinematics.data
+    q = c.q_rad
+    np.testing.assert_array_equal(physical.T_world_flange(q), true_kin.T_world_flange(q))
+    np.testing.assert_array_equal(nominal.T_world_flange(q), c.kinematics.T_world_flange(q))

@@ -63,11 +63,6 @@ class BeamServiceError(ControllerError):
     """The TCP service refused (a check that cannot be written, a slot that changed)."""
 
 
-def _own_copy(kin: RobotKinematics) -> RobotKinematics:
-    """The same robot with its own pinocchio data (safe in another thread)."""
-    return RobotKinematics(kin.model, kin.urdf_path, kin.flange_link, kin.base_link)
-
-
 def _angle_deg(a: np.ndarray, b: np.ndarray) -> float:
     """Angle between two vectors, degrees (accurate for tiny angles)."""
     return math.degrees(math.atan2(float(np.linalg.norm(np.cross(a, b))), float(np.dot(a, b))))
@@ -259,8 +254,7 @@ def beam_check_job(controller: VirtualController, slot: int | None, tool: Tool, 
     else:
         seed = int(rng_seed)
     c = controller
-    nominal = _own_copy(c.kinematics)
-    physical = nominal if c.true_kinematics is c.kinematics else _own_copy(c.true_kinematics)
+    nominal, physical = c.kinematics_for_worker()
     shape = tool_shape(c.mounted_tool)
     return BeamCheckJob(tool=tool, slot=None if slot is None else int(slot), kinematics=nominal,
                         true_kinematics=physical, q_rad=c.q_rad, sensor=c.beam_sensor, shape=shape,

@@ -231,11 +231,6 @@ class BeamScanJob:
         return None
 
 
-def _own_copy(kin: RobotKinematics) -> RobotKinematics:
-    """The same robot with its own pinocchio data (safe in another thread)."""
-    return RobotKinematics(kin.model, kin.urdf_path, kin.flange_link, kin.base_link)
-
-
 class ToolState(Protocol):
     """Who owns the mounted tool and the active tool data (the app's ``Session``)."""
 
@@ -706,8 +701,7 @@ class CalibrationWorkflow:
                                    "with the tool tip on the reference tip, then Finish.")
         T_active = np.array(w.tool.T_flange_tool_mm, dtype=float)
         T_active[:3, 3] /= 1000.0
-        nominal = _own_copy(c.kinematics)
-        physical = nominal if c.true_kinematics is c.kinematics else _own_copy(c.true_kinematics)
+        nominal, physical = c.kinematics_for_worker()
         return TcpCheckJob(w, pose, nominal, physical, np.array(q, dtype=float), T_active,
                            np.array(c.mounted_tool.T_flange_tool_true, dtype=float), c.settings)
 
@@ -799,8 +793,7 @@ class CalibrationWorkflow:
             raise WizardStateError(f"The controller needs approximate tool data of the {mounted.label.lower()} "
                                    "to plan the scan: calibrate it by hand or enter its data on the Tool tab, "
                                    "make it active, then press Finish again.")
-        nominal = _own_copy(c.kinematics)
-        physical = nominal if c.true_kinematics is c.kinematics else _own_copy(c.true_kinematics)
+        nominal, physical = c.kinematics_for_worker()
         try:
             config = BeamScanConfig(n_orientations=w.n_orientations, scan_speed_mm_s=w.scan_speed_mm_s)
         except ControllerError as exc:

@@ -178,6 +178,13 @@ class VirtualController:
                                   f"model has {', '.join(self.kinematics.joint_names)}; give the same robot.")
         self._true_kin = true_kinematics
 
+    def kinematics_for_worker(self) -> tuple[RobotKinematics, RobotKinematics]:
+        """(nominal, physical) robots with their own pinocchio data, for a job in a worker thread
+        (a check, a scan); physical is the nominal copy itself when there is no accuracy error."""
+        nominal = self.kinematics.own_copy()
+        physical = nominal if self._true_kin is self.kinematics else self._true_kin.own_copy()
+        return nominal, physical
+
     @property
     def mounted_tool(self) -> ToolModel:
         """The physical tool on the flange."""

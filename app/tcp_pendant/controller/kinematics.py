@@ -138,6 +138,11 @@ class RobotKinematics:
                                   for j in model.joints[1:]], dtype=bool)
         """True for revolute joints (radians), False for prismatic ones (metres)."""
 
+    def own_copy(self) -> "RobotKinematics":
+        """The same robot (the model is shared, read-only) with its own pinocchio data, safe to
+        use in another thread."""
+        return RobotKinematics(self.model, self.urdf_path, self.flange_link, self.base_link)
+
     @classmethod
     def from_urdf(cls, urdf_path: Path | str, *, flange_link: str | None = None) -> "RobotKinematics":
         """Load a URDF.

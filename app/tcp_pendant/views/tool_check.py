@@ -27,11 +27,6 @@ GOOD_CHECK_MM = 0.5
 """Implied TCP error up to which the check calls the TCP good (a careful touch's accuracy)."""
 
 
-def _own_copy(kin: RobotKinematics) -> RobotKinematics:
-    """The same robot with its own pinocchio data (safe in another thread)."""
-    return RobotKinematics(kin.model, kin.urdf_path, kin.flange_link, kin.base_link)
-
-
 @dataclass(frozen=True, eq=False)
 class CheckJob:
     """Everything one TCP check needs, detached from the session (metres, radians).
@@ -77,8 +72,7 @@ def check_job(controller: VirtualController, tool: Tool, title: str, angle_deg: 
         raise ValueError(f"The check angle must be above 0 and at most {MAX_SPIN_ANGLE_DEG:g} degrees "
                          f"(technicians use 10-45), got {angle_deg!r}.")
     c = controller
-    nominal = _own_copy(c.kinematics)
-    physical = nominal if c.true_kinematics is c.kinematics else _own_copy(c.true_kinematics)
+    nominal, physical = c.kinematics_for_worker()
     return CheckJob(title=title, tool=tool, mounted_label=c.mounted_tool.label, angle_deg=angle,
                     kinematics=nominal, true_kinematics=physical, q_rad=c.q_rad,
                     T_flange_tool_true=np.array(c.mounted_tool.T_flange_tool_true, dtype=float),
