@@ -171,3 +171,18 @@ def test_active_tool_data_defines_the_jogged_tcp():
     joints = ctrl.joint_angles_deg()
     assert list(joints) == ["A1", "A2", "A3", "A4", "A5", "A6"]
     np.testing.assert_allclose(list(joints.values()), (10.0, -80.0, 100.0, 20.0, 40.0, 30.0), atol=1e-9)
+
+
+def test_tool_data_as_the_apps_flange_tool_transform_in_metres():
+    from scipy.spatial.transform import Rotation
+
+    from tcp_pendant.controller import T_flange_tool_m
+
+    tool = Tool("T", (12.5, -3.0, 180.0), (30.0, -20.0, 10.0))
+    T = T_flange_tool_m(tool)
+    np.testing.assert_allclose(T[:3, 3], [0.0125, -0.003, 0.18], atol=1e-15)
+    np.testing.assert_allclose(T[:3, :3], Rotation.from_euler("ZYX", [30.0, -20.0, 10.0], degrees=True).as_matrix(),
+                               atol=1e-15)
+    np.testing.assert_array_equal(T[3], [0.0, 0.0, 0.0, 1.0])
+    T[0, 3] = 9.0                                                    # a new array each time
+    assert T_flange_tool_m(tool)[0, 3] == 0.0125

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tcp_pendant.controller import RobotKinematics, VirtualController
+from tcp_pendant.controller import RobotKinematics, T_flange_tool_m, VirtualController
 from tcp_pendant.controller.beam import BeamSensor, ToolShape
 from tcp_pendant.controller.beam_scan import BeamScan, BeamScanConfig, run_beam_scan, scan_arrays_mm, tool_shape
 from tcp_pendant.controller.errors import ControllerError
@@ -147,10 +147,7 @@ class BeamCheckJob:
     @property
     def T_flange_tool_plan(self) -> np.ndarray:
         """The checked tool data as ``T_flange_tool`` (4, 4), m."""
-        T = np.eye(4)
-        T[:3, :3] = self.tool.rotation
-        T[:3, 3] = np.asarray(self.tool.tcp_mm, dtype=float) / 1000.0
-        return T
+        return T_flange_tool_m(self.tool)
 
     def run(self) -> BeamCheck:
         """The scan and the two solves (pure; for a worker thread).

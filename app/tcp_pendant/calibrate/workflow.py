@@ -30,7 +30,7 @@ from typing import Any, ClassVar, Literal, Protocol
 
 import numpy as np
 
-from tcp_pendant.controller import RobotKinematics, ToolModel, VirtualController, builtin_tools
+from tcp_pendant.controller import RobotKinematics, T_flange_tool_m, ToolModel, VirtualController, builtin_tools
 from tcp_pendant.controller.beam import BeamSensor, ToolShape
 from tcp_pendant.controller.beam_scan import BeamScan, BeamScanConfig, run_beam_scan, tool_shape
 from tcp_pendant.controller.errors import ControllerError
@@ -635,9 +635,7 @@ class CalibrationWorkflow:
         tool = self.preview_tool()
         if tool is None:
             return None
-        T = np.array(tool.T_flange_tool_mm, dtype=float)
-        T[:3, 3] /= 1000.0
-        return T
+        return T_flange_tool_m(tool)
 
     def default_save_name(self) -> str:
         """Name offered by "Save to tool library": the calibrated tool's own name or its label."""
@@ -699,8 +697,7 @@ class CalibrationWorkflow:
         else:
             raise WizardStateError("The robot is not at the recorded touch any more: press Record again "
                                    "with the tool tip on the reference tip, then Finish.")
-        T_active = np.array(w.tool.T_flange_tool_mm, dtype=float)
-        T_active[:3, 3] /= 1000.0
+        T_active = T_flange_tool_m(w.tool)
         nominal, physical = c.kinematics_for_worker()
         return TcpCheckJob(w, pose, nominal, physical, np.array(q, dtype=float), T_active,
                            np.array(c.mounted_tool.T_flange_tool_true, dtype=float), c.settings)
@@ -787,8 +784,7 @@ class CalibrationWorkflow:
         if catalogue is not None:
             T_plan = np.array(catalogue.T_flange_tool_true, dtype=float)
         elif c.active_tool is not None:
-            T_plan = np.array(c.active_tool.T_flange_tool_mm, dtype=float)
-            T_plan[:3, 3] /= 1000.0
+            T_plan = T_flange_tool_m(c.active_tool)
         else:
             raise WizardStateError(f"The controller needs approximate tool data of the {mounted.label.lower()} "
                                    "to plan the scan: calibrate it by hand or enter its data on the Tool tab, "

@@ -33,6 +33,7 @@ from tcp_pendant.controller.kinematics import RobotKinematics
 from tcp_pendant.controller.readout import PoseReadout
 from tcp_pendant.controller.tools import (
     ReferenceTipModel,
+    T_flange_tool_m,
     ToolModel,
     builtin_robots,
     builtin_tools,
@@ -56,6 +57,7 @@ __all__ = [
     "PoseReadout",
     "ReferenceTipModel",
     "RobotKinematics",
+    "T_flange_tool_m",
     "ToolModel",
     "TouchGeometry",
     "VirtualController",

@@ -46,7 +46,7 @@ from tcp_pendant.controller.jog import (
 )
 from tcp_pendant.controller.kinematics import RobotKinematics
 from tcp_pendant.controller.readout import PoseReadout, readout_in_frame
-from tcp_pendant.controller.tools import ToolModel
+from tcp_pendant.controller.tools import T_flange_tool_m, ToolModel
 from tcp_pendant.controller.touch import TouchGeometry, touch_geometry
 
 __all__ = ["VirtualController"]
@@ -208,10 +208,7 @@ class VirtualController:
             return
         if not isinstance(tool, Tool):
             raise ControllerError(f"set_active_tool expects a tcpcal.Tool or None, got {type(tool).__name__}.")
-        T = np.eye(4)
-        T[:3, :3] = tool.rotation
-        T[:3, 3] = np.asarray(tool.tcp_mm, dtype=float) / 1000.0
-        self._active, self._T_flange_tool = tool, T
+        self._active, self._T_flange_tool = tool, T_flange_tool_m(tool)
 
     @property
     def T_flange_tool(self) -> np.ndarray:

@@ -22,11 +22,13 @@ import yourdfpy
 
 from tcp_pendant.controller.assets import REFERENCE_TIP_URDF, ROBOT_URDFS, TOOL_URDFS, asset_path, robots_dir
 from tcp_pendant.controller.errors import ControllerError
+from tcpcal.tool import Tool
 from tcpcal.validation import read_only_array
 
 __all__ = [
     "TOOL_LABELS",
     "ReferenceTipModel",
+    "T_flange_tool_m",
     "ToolModel",
     "builtin_robots",
     "builtin_tools",
@@ -40,6 +42,14 @@ TOOL_LABELS: dict[str, str] = {
     "torch": "Welding torch (bent neck)",
     "gripper": "Two-finger gripper",
 }
+
+
+def T_flange_tool_m(tool: Tool) -> np.ndarray:
+    """Tool data (``tcpcal.Tool``: TCP in mm, A, B, C) as the app's ``T_flange_tool`` (4, 4,
+    metres), a new array."""
+    T = np.array(tool.T_flange_tool_mm, dtype=float)
+    T[:3, 3] /= 1000.0
+    return T
 
 
 @dataclass(frozen=True, eq=False)

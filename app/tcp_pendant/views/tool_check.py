@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tcp_pendant.controller import RobotKinematics, VirtualController
+from tcp_pendant.controller import RobotKinematics, T_flange_tool_m, VirtualController
 from tcp_pendant.controller.jog import JogSettings
 from tcp_pendant.controller.spin import MAX_SPIN_ANGLE_DEG, SpinCheckResult, spin_check
 from tcp_pendant.text_escape import escape_markdown
@@ -51,10 +51,7 @@ class CheckJob:
     def run(self) -> SpinCheckResult:
         """The check (``spin.spin_check``): the nominal model plans the motion about the tool
         data's TCP, the physical robot and tool say where the true tip goes."""
-        T = np.eye(4)
-        T[:3, :3] = self.tool.rotation
-        T[:3, 3] = np.asarray(self.tool.tcp_mm, dtype=float) / 1000.0
-        return spin_check(self.kinematics, self.q_rad, T, self.T_flange_tool_true, angle_deg=self.angle_deg,
+        return spin_check(self.kinematics, self.q_rad, T_flange_tool_m(self.tool), self.T_flange_tool_true, angle_deg=self.angle_deg,
                           true_kinematics=self.true_kinematics, settings=self.settings)
 
 
