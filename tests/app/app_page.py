@@ -22,6 +22,15 @@ from wsclient import DrainingClient, wait_until  # noqa: E402
 P = TypeVar("P", bound="AppPage")
 
 
+def truth_tool(key: str, name: str, offset_mm: Any = (0.0, 0.0, 0.0)) -> Tool:
+    """Tool data equal to a built-in tool's (unbent) hidden true frame, its TCP moved by
+    ``offset_mm`` (FLANGE, mm)."""
+    from tcp_pendant.controller import builtin_tools
+
+    T = builtin_tools()[key].T_flange_tool_true
+    return Tool.from_rotation(name, tuple(T[:3, 3] * 1000.0 + np.asarray(offset_mm)), T[:3, :3])
+
+
 class AppPage:
     """One connected browser: its session, client and the notifications it was shown."""
 

@@ -16,18 +16,12 @@ import pytest
 HERE = Path(__file__).parent
 sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(HERE.parent / "calibrate"))
-from app_page import AppPage, app_pages  # noqa: E402
+from app_page import AppPage, app_pages, truth_tool  # noqa: E402
 from wsclient import wait_until  # noqa: E402
 
 from tcp_pendant.controller import builtin_tools  # noqa: E402
 from tcp_pendant.text_escape import escape_markdown  # noqa: E402
 from tcp_pendant.views.beam_replay import ScanPlayer  # noqa: E402
-from tcpcal.tool import Tool  # noqa: E402
-
-
-def truth_tool(key: str, name: str, offset_mm=(0.0, 0.0, 0.0)) -> Tool:
-    T = builtin_tools()[key].T_flange_tool_true
-    return Tool.from_rotation(name, tuple(T[:3, 3] * 1000.0 + np.asarray(offset_mm)), T[:3, :3])
 
 
 class Page(AppPage):

@@ -17,7 +17,7 @@ import pytest
 HERE = Path(__file__).parent
 sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(HERE.parent / "calibrate"))
-from app_page import AppPage, app_pages  # noqa: E402
+from app_page import AppPage, app_pages, truth_tool  # noqa: E402
 from guiclick import click  # noqa: E402
 from wsclient import DrainingClient, wait_until  # noqa: E402
 
@@ -30,11 +30,6 @@ from tcpcal.cli import main as tcpcal_main  # noqa: E402
 from tcpcal.controllers import CONTROLLER_FORMATS, parse_tool_file  # noqa: E402
 from tcpcal.origin import solve_xyz4  # noqa: E402
 from tcpcal.tool import Tool  # noqa: E402
-
-
-def truth_tool(key: str, name: str, offset_mm=(0.0, 0.0, 0.0)) -> Tool:
-    T = builtin_tools()[key].T_flange_tool_true
-    return Tool.from_rotation(name, tuple(T[:3, 3] * 1000.0 + np.asarray(offset_mm)), T[:3, :3])
 
 
 class Page(AppPage):
