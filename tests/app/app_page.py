@@ -51,29 +51,44 @@ class AppPage:
 
 
 @contextmanager
-def app_pages(tmp_path: Path, page_cls: type[P], *, seed: int | None = None) -> Iterator[Callable[..., P]]:
-    """``make(tools=None, **config)``: start a pendant (``AppConfig`` options, the library in
-    ``tmp_path`` holding ``tools`` {slot: Tool}) and connect a ``page_cls`` browser to it; the
-    workflow's auto-touch generator seeded with ``seed`` (if given). Everything stops at exit."""
+def running_pendants(tmp_path: Path) -> Iterator[Callable[..., PendantApp]]:
+    """``start(tools=None, **config)``: a pendant in this process on a free port (``AppConfig``
+    options, the library ``tmp_path/tools.json`` holding ``tools`` {slot: Tool}, polled every
+    0.1 s); every one stopped at exit."""
     apps: list[PendantApp] = []
-    pages: list[P] = []
 
-    def make(tools: dict[int, Tool] | None = None, **config: Any) -> P:
+    def start(tools: dict[int, Tool] | None = None, **config: Any) -> PendantApp:
         app = PendantApp(AppConfig(port=0, tool_library=tmp_path / "tools.json", library_poll_s=0.1, **config))
         for slot, tool in (tools or {}).items():
             app.library.save(slot, tool)
         app.start()
         apps.append(app)
-        p = page_cls(app)
-        if seed is not None:
-            p.session.views["calibrate"].workflow.rng = np.random.default_rng(seed)
-        pages.append(p)
-        return p
+        return app
 
     try:
-        yield make
+        yield start
     finally:
-        for p in pages:
-            p.ws.close()
         for a in apps:
             a.stop()
+
+
+@contextmanager
+def app_pages(tmp_path: Path, page_cls: type[P], *, seed: int | None = None) -> Iterator[Callable[..., P]]:
+    """``make(tools=None, **config)``: start a pendant (:func:`running_pendants`) and connect a
+    ``page_cls`` browser to it; the workflow's auto-touch generator seeded with ``seed`` (if
+    given). Everything stops at exit."""
+    pages: list[P] = []
+    with running_pendants(tmp_path) as start:
+
+        def make(tools: dict[int, Tool] | None = None, **config: Any) -> P:
+            p = page_cls(start(tools, **config))
+            if seed is not None:
+                p.session.views["calibrate"].workflow.rng = np.random.default_rng(seed)
+            pages.append(p)
+            return p
+
+        try:
+            yield make
+        finally:
+            for p in pages:
+                p.ws.close()

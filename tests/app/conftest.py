@@ -19,6 +19,7 @@ from tcpcal.library import ToolLibrary
 
 sys.path.insert(0, str(Path(__file__).parent))
 from wsclient import free_port, wait_until  # noqa: F401  (re-exported: the tests import them from here)
+from app_page import running_pendants  # noqa: E402
 
 
 @pytest.fixture(scope="session")
@@ -28,8 +29,7 @@ def kr6() -> RobotKinematics:
 
 @pytest.fixture
 def controller(kr6: RobotKinematics) -> VirtualController:
-    k = RobotKinematics(kr6.model, kr6.urdf_path, kr6.flange_link, kr6.base_link)
-    return VirtualController(k, tool=builtin_tools()["pointer"])
+    return VirtualController(kr6.own_copy(), tool=builtin_tools()["pointer"])
 
 
 @pytest.fixture
@@ -39,17 +39,6 @@ def library(tmp_path: Path) -> ToolLibrary:
 
 @pytest.fixture
 def app_factory(tmp_path: Path) -> Iterator[Callable[..., object]]:
-    from tcp_pendant.server import AppConfig, PendantApp
-
-    apps: list[PendantApp] = []
-
-    def make(**kw: object) -> PendantApp:
-        cfg = AppConfig(port=0, tool_library=tmp_path / "tools.json", library_poll_s=0.1, **kw)  # type: ignore[arg-type]
-        app = PendantApp(cfg)
-        app.start()
-        apps.append(app)
-        return app
-
-    yield make
-    for a in apps:
-        a.stop()
+    """``app_factory(**AppConfig options)``: a started pendant in this process (``app_page.running_pendants``)."""
+    with running_pendants(tmp_path) as start:
+        yield start

@@ -17,9 +17,11 @@ from typing import Any
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
-from tcp_pendant.server import AppConfig, PendantApp
+from tcp_pendant.server import PendantApp
 
 sys.path.insert(0, str(Path(__file__).parent))
+sys.path.insert(0, str(Path(__file__).parents[1] / "app"))
+from app_page import running_pendants  # noqa: E402
 from pendant_page import TIMEOUT_MS, assert_not_blank, type_text, wait_text  # noqa: E402
 
 pytestmark = pytest.mark.browser
@@ -41,17 +43,8 @@ def wait_until(cond: Callable[[], Any], what: str, timeout: float = 60.0) -> Any
 @pytest.fixture
 def pendant(tmp_path: Path) -> Iterator[Callable[..., PendantApp]]:
     """``pendant(**AppConfig options)``: a pendant in this process on a free port."""
-    apps: list[PendantApp] = []
-
-    def make(**config: Any) -> PendantApp:
-        app = PendantApp(AppConfig(port=0, tool_library=tmp_path / "tools.json", library_poll_s=0.1, **config))
-        app.start()
-        apps.append(app)
-        return app
-
-    yield make
-    for a in apps:
-        a.stop()
+    with running_pendants(tmp_path) as start:
+        yield start
 
 
 def open_page(app: PendantApp, new_page: Callable[..., Any], url: str | None = None, **kw: Any) -> tuple[Any, Any]:
