@@ -98,15 +98,21 @@ def test_the_meter_watches_the_touches_only(synth) -> None:
     assert wiz.other_rotations().shape == (4, 3, 3)
 
 
-def test_auto_touch_performs_every_step_and_z_x_keep_the_last_touch_orientation(synth) -> None:
-    ctrl = fake(synth, "torch")
-    wiz = TcpZxWizard()
-    rng = np.random.default_rng(4)
+def auto_touch_steps(wiz: Wizard, ctrl, rng: np.random.Generator, n: int) -> tuple[float, float, float] | None:
+    """Auto-touch the next ``n`` steps as the workflow does (each step given the previous
+    step's direction); the last direction used."""
     previous = None
-    for _ in range(wiz.n_steps):
+    for _ in range(n):
         out = auto_touch(wiz, ctrl, rng=rng, previous_direction_deg=previous)
         assert out.ok, out.message
         previous = out.direction_deg
+    return previous
+
+
+def test_auto_touch_performs_every_step_and_z_x_keep_the_last_touch_orientation(synth) -> None:
+    ctrl = fake(synth, "torch")
+    wiz = TcpZxWizard()
+    auto_touch_steps(wiz, ctrl, np.random.default_rng(4), wiz.n_steps)
     offsets = [c[4] for c in ctrl.calls]
     assert offsets == [(0.0, 0.0, 0.0)] * 4 + [(0.0, 0.0, 60.0), (60.0, 0.0, 0.0)]
     assert ctrl.calls[3][1:4] == ctrl.calls[4][1:4] == ctrl.calls[5][1:4]
@@ -133,17 +139,13 @@ def test_truth_grades_both_the_tcp_and_the_frame(synth) -> None:
 
 def test_auto_touch_z_step_out_of_reach_retries_shorter_then_a_new_orientation(synth) -> None:
     """The kept orientation may be out of reach for the back-off along tool +Z (about 2 % of
-    random runs on the KR 6 with the torch): auto-touch tries half and a quarter of the distance
-    in the same orientation, then, since TCP & Z, X solves with each row's own rotation, a new
+    random runs on the KR 6 with the torch): auto-touch tries half the distance and 20 mm in the
+    same orientation, then, since TCP & Z, X solves with each row's own rotation, a new
     direction; the result is still the true frame."""
     ctrl = fake(synth, "torch")
     wiz = TcpZxWizard()
     rng = np.random.default_rng(4)
-    previous = None
-    for _ in range(wiz.n_points):
-        out = auto_touch(wiz, ctrl, rng=rng, previous_direction_deg=previous)
-        assert out.ok, out.message
-        previous = out.direction_deg
+    previous = auto_touch_steps(wiz, ctrl, rng, wiz.n_points)
     n_calls = len(ctrl.calls)
     ctrl.fail_first = 3                                   # 60, 30 and 20 mm in the kept orientation
     out = auto_touch(wiz, ctrl, rng=rng, previous_direction_deg=previous)
