@@ -461,6 +461,22 @@ def median_of(rounds: list[dict[str, dict[str, float]]]) -> dict[str, dict[str, 
     return {k: {f: float(np.median([r[k][f] for r in rounds])) for f in rounds[0][k]} for k in rounds[0]}
 
 
+
+def row(name: str, a: float, b: float, unit: str = "ms") -> None:
+    """One line of a comparison table: ``a``, ``b`` and their ratio ``a / b``."""
+    print(f"  {name:<58} {a:8.3f} {unit}  {b:8.3f} {unit}   {a / b:6.2f}")
+
+
+def step_rows(a: dict[str, dict[str, float]], b: dict[str, dict[str, float]]) -> None:
+    """The jog-step rows (A hot loop, B paced, C end to end) of two measured variants."""
+    row("A hot loop: thread CPU per step, median", a["A"]["median_ms"], b["A"]["median_ms"])
+    row("A hot loop: thread CPU per step, p95", a["A"]["p95_ms"], b["A"]["p95_ms"])
+    row("A hot loop: process CPU per step", a["A"]["process_ms"], b["A"]["process_ms"])
+    row(f"B paced {STEP_HZ:.0f}/s per session, direct: process CPU per step",
+        a["B"]["process_ms"], b["B"]["process_ms"])
+    row(f"C paced {STEP_HZ:.0f}/s per session, end to end: process CPU/step",
+        a["C"]["process_ms"], b["C"]["process_ms"])
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--quick", action="store_true", help="2 sessions, short runs: smoke test")
@@ -511,17 +527,8 @@ def main(argv: list[str] | None = None) -> int:
         time.sleep(1.0)
         base_r = rigs["off"].measure(steps, seconds)
 
-        def row(name: str, a: float, b: float, unit: str = "ms") -> None:
-            print(f"  {name:<58} {a:8.3f} {unit}  {b:8.3f} {unit}   {a / b:6.2f}")
-
         print(f"  {'':<58} {'app':>11}  {'baseline':>11}   app/baseline")
-        row("A hot loop: thread CPU per step, median", app_r["A"]["median_ms"], base_r["A"]["median_ms"])
-        row("A hot loop: thread CPU per step, p95", app_r["A"]["p95_ms"], base_r["A"]["p95_ms"])
-        row("A hot loop: process CPU per step", app_r["A"]["process_ms"], base_r["A"]["process_ms"])
-        row(f"B paced {STEP_HZ:.0f}/s per session, direct: process CPU per step",
-            app_r["B"]["process_ms"], base_r["B"]["process_ms"])
-        row(f"C paced {STEP_HZ:.0f}/s per session, end to end: process CPU/step",
-            app_r["C"]["process_ms"], base_r["C"]["process_ms"])
+        step_rows(app_r, base_r)
         for key, what in (("B", "direct"), ("C", "end to end")):
             print(f"  {key} achieved steps/s per session ({what}): app {app_r[key]['rate']:.1f}, "
                   f"baseline {base_r[key]['rate']:.1f} (asked {STEP_HZ:.0f})")
@@ -586,16 +593,7 @@ def print_classroom(n: int, app_r: dict[str, dict[str, float]], class_r: dict[st
           f"same run, same session count:")
     print(f"  {'':<58} {'class on':>11}  {'class off':>11}   on/off")
 
-    def row(name: str, a: float, b: float, unit: str = "ms") -> None:
-        print(f"  {name:<58} {a:8.3f} {unit}  {b:8.3f} {unit}   {a / b:6.2f}")
-
-    row("A hot loop: thread CPU per step, median", class_r["A"]["median_ms"], app_r["A"]["median_ms"])
-    row("A hot loop: thread CPU per step, p95", class_r["A"]["p95_ms"], app_r["A"]["p95_ms"])
-    row("A hot loop: process CPU per step", class_r["A"]["process_ms"], app_r["A"]["process_ms"])
-    row(f"B paced {STEP_HZ:.0f}/s per session, direct: process CPU per step",
-        class_r["B"]["process_ms"], app_r["B"]["process_ms"])
-    row(f"C paced {STEP_HZ:.0f}/s per session, end to end: process CPU/step",
-        class_r["C"]["process_ms"], app_r["C"]["process_ms"])
+    step_rows(class_r, app_r)
     on = {f: float(np.mean([t[f] for t in touch_runs["on"]])) for f in touch_runs["on"][0]}
     off = {f: float(np.mean([t[f] for t in touch_runs["off"]])) for f in touch_runs["off"][0]}
     row("wizard touch (Record): thread CPU, median", on["thread_ms"], off["thread_ms"])
