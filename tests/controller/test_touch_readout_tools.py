@@ -186,3 +186,30 @@ def test_tool_data_as_the_apps_flange_tool_transform_in_metres():
     np.testing.assert_array_equal(T[3], [0.0, 0.0, 0.0, 1.0])
     T[0, 3] = 9.0                                                    # a new array each time
     assert T_flange_tool_m(tool)[0, 3] == 0.0125
+
+
+def test_one_pose_check_for_the_controller_spin_and_beam():
+    """controller, spin check and beam sensor refuse a bad pose with the same words."""
+    from tcp_pendant.controller.beam import BeamSensor, ToolShape, tip_on_beam
+    from tcp_pendant.controller.checks import check_pose
+    from tcp_pendant.controller.spin import spin_check
+
+    bad_row = np.eye(4)
+    bad_row[3, 0] = 0.5
+    for T, words in ((np.eye(3), "must be a finite 4x4 homogeneous matrix"),
+                     (np.diag([1.0, 1.0, -1.0, 1.0]), "has no proper rotation"),
+                     (bad_row, r"must have \[0, 0, 0, 1\] as its last row")):
+        with pytest.raises(ControllerError, match="T_x " + words):
+            check_pose(T, "T_x")
+        with pytest.raises(ControllerError, match="T_world_flange_start " + words):
+            tip_on_beam(T, (0.0, 0.0, -1.0), BeamSensor((0.0, 0.0, 0.0), (1.0, 0.0, 0.0)),
+                        ToolShape(np.eye(4)))
+        c = make_controller("kr6")
+        with pytest.raises(ControllerError, match="T_flange_tool_true " + words):
+            spin_check(c.kinematics, c.q_rad, np.eye(4), T)
+        with pytest.raises(ControllerError, match="T_world_base " + words):
+            c.set_T_world_base(T)
+    T = np.eye(4)
+    out = check_pose(T, "T")
+    out[0, 3] = 1.0                                                   # a copy
+    assert T[0, 3] == 0.0

@@ -38,6 +38,7 @@ import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
 from tcpcal.validation import read_only_array
+from tcp_pendant.controller.checks import check_pose
 from tcp_pendant.controller.errors import ControllerError
 
 __all__ = [
@@ -191,16 +192,6 @@ class BeamEvent:
     on_shaft: bool
 
 
-def _pose(T: object, name: str) -> np.ndarray:
-    arr = np.asarray(T, dtype=float)
-    if arr.shape != (4, 4) or not np.isfinite(arr).all():
-        raise ControllerError(f"{name} must be a finite 4x4 pose (m).")
-    R = arr[:3, :3]
-    if np.abs(R.T @ R - np.eye(3)).max() > 1e-6 or np.linalg.det(R) < 0:
-        raise ControllerError(f"{name} has no proper rotation.")
-    return arr
-
-
 def _direction(direction: object) -> np.ndarray:
     d = np.asarray(direction, dtype=float)
     if d.shape != (3,) or not np.isfinite(d).all() or float(np.linalg.norm(d)) == 0.0:
@@ -248,7 +239,7 @@ def tip_on_beam(T_world_flange_start: object, direction: object, sensor: BeamSen
     Raises:
         ControllerError: bad poses or directions, or the tip already in a beam at the start.
     """
-    T0 = _pose(T_world_flange_start, "T_world_flange_start")
+    T0 = check_pose(T_world_flange_start, "T_world_flange_start")
     m = _direction(direction)
     tip0 = T0[:3, :3] @ tool.tip + T0[:3, 3]
     half = sensor.width / 2.0
@@ -329,7 +320,7 @@ def crossing_events(T_world_flange_start: object, direction: object, sensor: Bea
         ControllerError: bad poses or directions; the shaft in a beam at the start or still in
             it at the end of the pass.
     """
-    T0 = _pose(T_world_flange_start, "T_world_flange_start")
+    T0 = check_pose(T_world_flange_start, "T_world_flange_start")
     m = _direction(direction)
     R = T0[:3, :3]
     back = R @ (tool.tip - tool.length * tool.axis) + T0[:3, 3]  # segment start at tau = 0

@@ -35,6 +35,7 @@ from tcpcal.tool import Tool
 from tcp_pendant.controller.approach import approach_pose, solve_ik
 from tcp_pendant.controller.beam import BeamSensor
 from tcp_pendant.controller.beam_scan import BeamDevice, default_beam_sensor
+from tcp_pendant.controller.checks import check_pose
 from tcp_pendant.controller.errors import ControllerError
 from tcp_pendant.controller.jog import (
     DEFAULT_SETTINGS,
@@ -52,19 +53,6 @@ from tcp_pendant.controller.touch import TouchGeometry, touch_geometry
 __all__ = ["VirtualController"]
 
 _AXES = {"X": 0, "Y": 1, "Z": 2, "A": 2, "B": 1, "C": 0}
-
-
-def _check_pose(T: np.ndarray, what: str) -> np.ndarray:
-    M = np.asarray(T, dtype=float)
-    if M.shape != (4, 4) or not np.all(np.isfinite(M)):
-        raise ControllerError(f"{what} must be a finite 4x4 homogeneous matrix, got shape {M.shape}.")
-    R = M[:3, :3]
-    if np.abs(R.T @ R - np.eye(3)).max() > 1e-6 or np.linalg.det(R) <= 0.0:
-        raise ControllerError(f"{what} has no proper rotation in its upper-left 3x3 block "
-                              "(columns must be orthonormal and right-handed).")
-    if np.abs(M[3] - [0.0, 0.0, 0.0, 1.0]).max() > 1e-12:
-        raise ControllerError(f"{what} must have [0, 0, 0, 1] as its last row.")
-    return M.copy()
 
 
 def _check_point(p: Sequence[float] | np.ndarray, what: str) -> np.ndarray:
@@ -116,7 +104,7 @@ class VirtualController:
         self._active: Tool | None = None
         self._T_flange_tool = np.eye(4)
         self.set_active_tool(active_tool)
-        self._T_world_base = np.eye(4) if T_world_base is None else _check_pose(T_world_base, "T_world_base")
+        self._T_world_base = np.eye(4) if T_world_base is None else check_pose(T_world_base, "T_world_base")
         if reference_tip_world_m is None:
             p = kinematics.T_world_flange(kinematics.home_rad)[:3, 3]
             reference_tip_world_m = (p[0], p[1], 0.5 * p[2])
@@ -274,7 +262,7 @@ class VirtualController:
 
     def set_T_world_base(self, T_world_base: np.ndarray) -> None:
         """Set the BASE frame (4,4, metres)."""
-        self._T_world_base = _check_pose(T_world_base, "T_world_base")
+        self._T_world_base = check_pose(T_world_base, "T_world_base")
 
     # ----------------------------------------------------------------- poses
     def T_world_flange(self) -> np.ndarray:
@@ -389,7 +377,7 @@ class VirtualController:
         Position moves linearly and orientation about one fixed axis (shortest rotation)
         from the current TCP pose: (J-1) with ``w = log(R_target R_now^T)``.
         """
-        T = _check_pose(T_world_tcp_target, "T_world_tcp_target")
+        T = check_pose(T_world_tcp_target, "T_world_tcp_target")
         T0 = self.T_world_tcp()
         w = Rotation.from_matrix(T[:3, :3] @ T0[:3, :3].T).as_rotvec()
         path = CartesianPath(T0[:3, 3], T0[:3, :3], T[:3, 3] - T0[:3, 3], w)
@@ -402,7 +390,7 @@ class VirtualController:
         its configuration when it can, then tries home and fixed seeds (``approach.solve_ik``).
         Fails with ``stopped_by="unreachable"`` and leaves the robot where it was.
         """
-        T = _check_pose(T_world_tooltrue_target, "T_world_tooltrue_target")
+        T = check_pose(T_world_tooltrue_target, "T_world_tooltrue_target")
         return self._ik_move(T, "That pose of the true TOOL frame")
 
     def _ik_move(self, T_world_tooltrue: np.ndarray, what: str) -> JogResult:

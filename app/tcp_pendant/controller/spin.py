@@ -38,6 +38,7 @@ import numpy as np
 import pinocchio as pin
 
 from tcpcal.validation import read_only_array
+from tcp_pendant.controller.checks import check_pose
 from tcp_pendant.controller.errors import ControllerError
 from tcp_pendant.controller.jog import DEFAULT_SETTINGS, CartesianPath, JogSettings, follow_path
 from tcp_pendant.controller.kinematics import RobotKinematics
@@ -145,17 +146,6 @@ class SpinCheckResult:
         return "\n".join(lines)
 
 
-def _check_T(T: np.ndarray, what: str) -> np.ndarray:
-    M = np.asarray(T, dtype=float)
-    if M.shape != (4, 4) or not np.all(np.isfinite(M)):
-        raise ControllerError(f"{what} must be a finite 4x4 homogeneous matrix (metres), got shape {M.shape}.")
-    R = M[:3, :3]
-    if np.abs(R.T @ R - np.eye(3)).max() > 1e-6 or np.linalg.det(R) <= 0.0:
-        raise ControllerError(f"{what} has no proper rotation in its upper-left 3x3 block "
-                              "(columns must be orthonormal and right-handed).")
-    return M.copy()
-
-
 def _check_angle(angle_deg: float) -> float:
     try:
         a = float(angle_deg)
@@ -207,8 +197,8 @@ def spin_check(kinematics: RobotKinematics, q_rad: Sequence[float] | np.ndarray,
     if true_kin.joint_names != kin.joint_names:
         raise ControllerError(f"true_kinematics has joints {', '.join(true_kin.joint_names)} but the "
                               f"model has {', '.join(kin.joint_names)}; give the same robot.")
-    T_active = _check_T(T_flange_tool_active, "T_flange_tool_active")
-    T_true = _check_T(T_flange_tool_true, "T_flange_tool_true")
+    T_active = check_pose(T_flange_tool_active, "T_flange_tool_active")
+    T_true = check_pose(T_flange_tool_true, "T_flange_tool_true")
     q0 = kin.check_q(q_rad).copy()
     viol = kin.limit_violation(q0, tol=1e-9)
     if viol is not None:
