@@ -27,7 +27,6 @@ from tcp_pendant.calibrate.text import (
 )
 from tcp_pendant.pendant.formatting import tcp_readout_markdown, tool_data_markdown
 from tcp_pendant.pendant.tool_entry import ToolEntry, entry_preview_markdown
-from tcp_pendant.server import AppConfig, PendantApp
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.wizards import ThreePointWizard
 from tcp_pendant.wizards.session_record import dumps, load_and_replay
@@ -40,7 +39,8 @@ sys.path.insert(0, str(TESTS / "app"))
 sys.path.insert(0, str(TESTS / "calibrate"))
 from calib_helpers import library_tool_with_true_tcp, make_controller  # noqa: E402
 from guiclick import choose, click, upload  # noqa: E402
-from wsclient import DrainingClient, wait_until  # noqa: E402
+from app_page import AppPage, running_pendants  # noqa: E402
+from wsclient import wait_until  # noqa: E402
 
 # valid tool names (<= 24 characters, no double quote) that would do harm as markdown
 NAMES = ["<style>*{opacity:0}", "[click](//evil)", "![](//127.0.0.1:9/x)", "![](/etc/passwd)",
@@ -135,41 +135,29 @@ def test_escaped_markdown_makes_viser_read_no_file(monkeypatch) -> None:
 
 
 # --------------------------------------------------------------------------- the app's views
-class Browser:
-    """One connected (headless) browser and its session."""
-
-    def __init__(self, app: PendantApp) -> None:
-        n = len(app.sessions)
-        self.ws = DrainingClient(app.port)
-        wait_until(lambda: len(app.sessions) > n, what="session built")
-        self.session = list(app.sessions.values())[-1]
-        self.client = self.session.client
-        self.notes: list[tuple[str, str]] = []
-        self.session.notify = lambda title, body, kind="info": self.notes.append((title, body))  # type: ignore[method-assign]
-
-
 @pytest.fixture
-def app_with_hostile_library(tmp_path: Path) -> Iterator[Callable[[], Browser]]:
+def app_with_hostile_library(tmp_path: Path) -> Iterator[Callable[[], AppPage]]:
     lib = ToolLibrary(tmp_path / "tools.json")
     for slot, name in enumerate(NAMES, start=1):
         lib.save(slot, Tool(name=name, tcp_mm=(0.0, 0.0, 100.0 + slot),
                             calibration=Calibration(method=name, calibrated_at=_AT)), activate=slot == 1)
-    app = PendantApp(AppConfig(port=0, tool_library=tmp_path / "tools.json", library_poll_s=0.1))
-    app.start()
-    browsers: list[Browser] = []
+    browsers: list[AppPage] = []
+    with running_pendants(tmp_path) as start:
+        app = start()
 
-    def connect() -> Browser:
-        b = Browser(app)
-        browsers.append(b)
-        return b
+        def connect() -> AppPage:
+            b = AppPage(app)
+            browsers.append(b)
+            return b
 
-    yield connect
-    for b in browsers:
-        b.ws.close()
-    app.stop()
+        try:
+            yield connect
+        finally:
+            for b in browsers:
+                b.ws.close()
 
 
-def _all_markdown(b: Browser) -> str:
+def _all_markdown(b: AppPage) -> str:
     s = b.session
     handles = [s.views["pendant"].tcp_md, s.views["tools"].active_md, s.views["tools"].slot_md,
                s.views["tools"].entry_preview, s.views["tools"].entry_md, s.views["tools"].entry_name_err]
