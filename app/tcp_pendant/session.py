@@ -377,14 +377,16 @@ class Session:
         if self.closed:
             return
         color = _COLORS.get(kind, "blue")
-        clients = [self.client] if self.client is not None else self._all_clients()
-        for c in clients:
+        for c in self.clients():
             try:
                 c.add_notification(title, body, color=color, auto_close_seconds=6.0 if kind != "error" else 12.0)
             except Exception:  # the browser may have gone
                 log.debug("notification to a closed client dropped", exc_info=True)
 
-    def _all_clients(self) -> list[Any]:
+    def clients(self) -> list[Any]:
+        """The browser(s) that show this session: its own, or every browser of the shared GUI."""
+        if self.client is not None:
+            return [self.client]
         get = getattr(self.target, "get_clients", None)
         return list(get().values()) if callable(get) else []
 

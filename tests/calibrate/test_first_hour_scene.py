@@ -175,3 +175,42 @@ def test_abc_world_target_tool_and_tip_labels_do_not_collide(page, tmp_path) -> 
     }
     assert others["tool"].text == "TOOL Pen"
     assert _boxes_apart(f, world) == []
+
+
+def test_frame_cameras_frames_each_browser_with_its_own_camera() -> None:
+    """``scene.frame_cameras``: every browser framed with its camera's shape, a browser that has
+    not reported a camera yet (or left) is skipped without failing; the first one's framing back."""
+    from types import SimpleNamespace
+
+    from tcp_pendant.views.scene import camera_shape, frame_cameras
+
+    class Client:
+        def __init__(self, camera: object) -> None:
+            self.camera = camera
+
+        def atomic(self):
+            from contextlib import nullcontext
+            return nullcontext()
+
+    class NoCamera:
+        @property
+        def camera(self):
+            raise RuntimeError("no camera message yet")
+
+        def atomic(self):
+            from contextlib import nullcontext
+            return nullcontext()
+
+    wide = Client(SimpleNamespace(fov=1.2, aspect=2.0, image_height=900.0, position=None, look_at=None))
+    narrow = Client(SimpleNamespace(fov=0.5, aspect=1.0, image_height=600.0, position=None, look_at=None))
+    centres, radii = np.array([[0.5, 0.0, 0.4], [0.7, 0.1, 0.3]]), np.array([0.05, 0.05])
+    f = frame_cameras([wide, NoCamera(), narrow], centres, radii, margin=1.4)
+    expect = [frame_spheres(centres, radii, fov_rad=c.camera.fov, aspect=c.camera.aspect,
+                            image_height_px=c.camera.image_height, margin=1.4) for c in (wide, narrow)]
+    for client, e in zip((wide, narrow), expect):
+        np.testing.assert_allclose(client.camera.position, e.position)
+        np.testing.assert_allclose(client.camera.look_at, e.look_at)
+    np.testing.assert_allclose(f.position, expect[0].position)
+    assert expect[1].distance_m > expect[0].distance_m                # the narrow camera stands back
+    assert camera_shape(NoCamera()) == (pytest.approx(np.radians(50.0)), pytest.approx(16 / 9), 720.0)
+    np.testing.assert_allclose(frame_cameras([], centres, radii).position, frame_spheres(centres, radii).position)

@@ -35,7 +35,8 @@ from tcp_pendant.calibrate.workflow import EXERCISE_REFUSAL
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.beam_replay import ScanPlayer, beam_view_direction, scan_spheres
-from tcp_pendant.views.framing import Framing, frame_spheres
+from tcp_pendant.views.framing import Framing
+from tcp_pendant.views.scene import frame_cameras
 from tcpcal.tool import Tool
 
 __all__ = ["BeamCheckView", "update_markdown"]
@@ -167,19 +168,7 @@ class BeamCheckView:
             return
         centres, radii = scan_spheres(scan)
         direction = beam_view_direction(scan.events[0].beam_point, scan.events[0].beam_dir)
-        s = self.session
-        clients = [s.client] if s.client is not None else list(getattr(s.target, "get_clients", dict)().values())
-        for client in clients:
-            try:
-                cam = client.camera
-                f = frame_spheres(centres, radii, fov_rad=float(cam.fov), aspect=float(cam.aspect),
-                                  direction=direction, margin=1.4)
-                with client.atomic():                  # position first: its setter shifts look_at
-                    cam.position = f.position
-                    cam.look_at = f.look_at
-            except Exception:                          # a browser that left, or no camera reported yet
-                log.debug("camera not framed on the beam scan", exc_info=True)
-        self.framing = frame_spheres(centres, radii, direction=direction, margin=1.4)
+        self.framing = frame_cameras(self.session.clients(), centres, radii, direction=direction, margin=1.4)
 
     def _failed(self, title: str, body: str, *, kind: str) -> None:
         s = self.session

@@ -33,6 +33,8 @@ Axis colours are viser's: X red, Y green, Z blue. Quaternions (w, x, y, z) come 
 from __future__ import annotations
 
 import asyncio
+import logging
+import math
 from typing import Any
 
 import numpy as np
@@ -49,10 +51,13 @@ from tcp_pendant.controller.rotations import quaternion_wxyz, quaternions_wxyz
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.views.beam_replay import ScanPlayer
 from tcp_pendant.views.beam_stand import BeamStandNodes
+from tcp_pendant.views.framing import Framing, frame_spheres
 from tcp_pendant.views.meshes import MeshPart, link_meshes, rigid_meshes
 
-__all__ = ["POSE_EPS", "PoseSender", "SceneView", "closeup_camera", "link_tree_paths", "overview_camera",
-           "overview_pose", "relative_poses", "wxyz_xyz"]
+__all__ = ["POSE_EPS", "PoseSender", "SceneView", "camera_shape", "closeup_camera", "frame_cameras",
+           "link_tree_paths", "overview_camera", "overview_pose", "relative_poses", "wxyz_xyz"]
+
+log = logging.getLogger(__name__)
 
 OVERVIEW_OFFSET_M = np.array([1.15, -1.25, 0.55])
 CLOSEUP_OFFSET_M = np.array([0.22, -0.26, 0.12])
@@ -209,6 +214,31 @@ def overview_camera(client: Any, tip_world_m: np.ndarray) -> None:
     with client.atomic():                    # position first: its setter shifts look_at
         client.camera.position = position
         client.camera.look_at = look_at
+
+
+def camera_shape(client: Any) -> tuple[float, float, float]:
+    """(fov rad, aspect, image height px) of a browser's camera; defaults before it reported."""
+    try:
+        cam = client.camera
+        return float(cam.fov), float(cam.aspect), float(cam.image_height)
+    except Exception:                    # no camera message from that browser yet
+        return math.radians(50.0), 16.0 / 9.0, 720.0
+
+
+def frame_cameras(clients: list[Any], centres: np.ndarray, radii: np.ndarray, **framing: Any) -> Framing:
+    """Frame each browser's camera on the spheres (``framing.frame_spheres`` with that camera's
+    shape and the ``framing`` options: ``direction``, ``margin``). Returns the first browser's
+    framing (a default camera's when there is none)."""
+    framings = [frame_spheres(centres, radii, fov_rad=fov, aspect=aspect, image_height_px=height, **framing)
+                for fov, aspect, height in (camera_shape(c) for c in clients)]
+    for client, f in zip(clients, framings):
+        try:
+            with client.atomic():        # position first: its setter shifts look_at
+                client.camera.position = f.position
+                client.camera.look_at = f.look_at
+        except Exception:                # a browser that left, or has not sent its camera yet
+            log.debug("camera of a client not framed", exc_info=True)
+    return framings[0] if framings else frame_spheres(centres, radii, **framing)
 
 
 def closeup_camera(client: Any, tip_world_m: np.ndarray) -> None:

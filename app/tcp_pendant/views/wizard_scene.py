@@ -44,8 +44,8 @@ import numpy as np
 from tcp_pendant.calibrate import CalibrationWorkflow
 from tcp_pendant.session import Session
 from tcp_pendant.views.beam_replay import ScanPlayer, beam_view_direction, scan_spheres
-from tcp_pendant.views.framing import Framing, frame_spheres, spread_labels
-from tcp_pendant.views.scene import wxyz_xyz
+from tcp_pendant.views.framing import Framing, spread_labels
+from tcp_pendant.views.scene import frame_cameras, wxyz_xyz
 from tcp_pendant.wizards import Xyz4Result
 
 __all__ = ["WizardSceneView"]
@@ -260,41 +260,14 @@ class WizardSceneView:
             radii.extend([0.012] * len(f_m))
         return np.array(centres, dtype=float), np.array(radii, dtype=float)
 
-    def _clients(self) -> list[Any]:
-        s = self.session
-        if s.client is not None:
-            return [s.client]
-        get = getattr(s.target, "get_clients", None)
-        return list(get().values()) if callable(get) else []
-
-    @staticmethod
-    def _camera_shape(client: Any) -> tuple[float, float, float]:
-        """(fov rad, aspect, image height px) of a browser's camera; defaults before it reported."""
-        try:
-            cam = client.camera
-            fov, aspect, height = float(cam.fov), float(cam.aspect), float(cam.image_height)
-        except Exception:                    # no camera message from that browser yet
-            return math.radians(50.0), 16.0 / 9.0, 720.0
-        return fov, aspect, height
-
     def frame_result(self) -> Framing | None:
         """Frame every browser's camera on the result and move the labels near the tip apart
         as seen from the (first) framed camera. Returns that framing (None: nothing to frame)."""
         centres, radii = self._framed_geometry()
         if not np.all(np.isfinite(centres)) or not np.all(np.isfinite(radii)):
             return None
-        clients = self._clients()
         kw = {} if (d := self._view_direction()) is None else {"direction": d}
-        framings = [frame_spheres(centres, radii, fov_rad=fov, aspect=aspect, image_height_px=height, **kw)
-                    for fov, aspect, height in (self._camera_shape(c) for c in clients)]
-        framing = framings[0] if framings else frame_spheres(centres, radii, **kw)
-        for client, f in zip(clients, framings):
-            try:
-                with client.atomic():        # position first: its setter shifts look_at
-                    client.camera.position = f.position
-                    client.camera.look_at = f.look_at
-            except Exception:                # a browser that left, or has not sent its camera yet
-                log.debug("camera of a client not framed", exc_info=True)
+        framing = frame_cameras(self.session.clients(), centres, radii, **kw)
         self.last_framing = framing
         return framing
 
@@ -327,7 +300,7 @@ class WizardSceneView:
     def layout_labels(self) -> None:
         """Move the labels at the tip apart as seen by the (first) browser's camera now, or by
         the last result's framing when no camera has been reported."""
-        clients = self._clients()
+        clients = self.session.clients()
         framing = self._camera_framing(clients[0]) if clients else None
         framing = framing or self.last_framing
         if framing is not None:
