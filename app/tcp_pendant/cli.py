@@ -87,6 +87,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--beam-crossed", action="store_true",
                    help="a second beam along WORLD Y crosses the first (crossed beams, as on TRACC-type "
                         "devices)")
+    p.add_argument("--seed", type=int, default=None, metavar="N",
+                   help="one seed for every pendant's randomness (Auto-touch's operator error and "
+                        "directions, the beam sensor's noise): a seeded lesson replays the same way "
+                        "(default: fresh randomness; >= 0)")
     p.add_argument("--verbose", action="store_true", help="log debugging information")
     return p
 
@@ -178,7 +182,7 @@ def _main(argv: Sequence[str] | None) -> int:
                            exercise_seed=args.exercise_seed, scenario=args.scenario.replace("-", "_"),
                            scenario_seed=args.scenario_seed, presenter=args.presenter,
                            beam_width_mm=args.beam_width, beam_repeatability_mm=args.beam_repeatability,
-                           beam_crossed=args.beam_crossed)
+                           beam_crossed=args.beam_crossed, seed=args.seed)
         app = PendantApp(config)
     except (ControllerError, ValueError, OSError, GradebookError) as exc:
         print(f"tcp-pendant: error: {exc}", file=sys.stderr)

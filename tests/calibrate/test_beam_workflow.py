@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 from tcp_pendant.calibrate import AutoTouchRequest, CalibrationWorkflow
 from tcp_pendant.calibrate.text import duration_words, result_markdown
-from tcp_pendant.calibrate.workflow import BeamScanJob, TcpCheckJob
+from tcp_pendant.calibrate.jobs import BeamScanJob, TcpCheckJob
 from tcp_pendant.controller import builtin_tools
 from tcp_pendant.controller.beam import BeamSensor
 from tcp_pendant.controller.scenarios import ToolBend, bent_tool

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 from tcp_pendant.calibrate import AutoTouchRequest
 from tcp_pendant.calibrate.library_choice import default_library_slot
-from tcp_pendant.calibrate.text import METHOD_BLURBS
+from tcp_pendant.wizards import wizard_classes
 from tcp_pendant.wizards import WizardStateError
 
 from tcpcal.tool import Tool
@@ -25,14 +25,14 @@ def run_auto(wf) -> None:
 
 
 def test_method_blurbs_point_at_no_file_the_trainee_cannot_open() -> None:
-    for kind, text in METHOD_BLURBS.items():
-        assert "methods.md" not in text and "section" not in text, kind
+    for cls in wizard_classes():
+        assert "methods.md" not in cls.blurb and "section" not in cls.blurb, cls.kind
 
 
 def test_tool_change_is_asked_for_by_the_tools_labels(workflow, library) -> None:
     library.save(1, library_tool_with_true_tcp("pointer", "Pointer"))
     wf = workflow(tool="pointer")
-    wiz = wf.start_reference(reference_slot=1, reference_tool_key="pointer", new_tool_key="torch")
+    wiz = wf.start("reference", slot=1, reference_tool_key="pointer", new_tool_key="torch")
     wf.auto_touch(AutoTouchRequest())
     assert wiz.blocked_reason == "Mount the welding torch (bent neck) first: the straight pointer is mounted now."
     assert "'" not in wiz.blocked_reason and "torch'" not in wiz.blocked_reason
@@ -40,7 +40,7 @@ def test_tool_change_is_asked_for_by_the_tools_labels(workflow, library) -> None
 
 def test_auto_touch_reports_a_sentence(workflow) -> None:
     wf = workflow()
-    wf.start_xyz4()
+    wf.start("xyz4")
     out = wf.auto_touch(AutoTouchRequest())
     assert out.message.startswith("Step 1 recorded: Touch 1 (tilt ") and out.message.endswith("°).")
 
@@ -48,7 +48,7 @@ def test_auto_touch_reports_a_sentence(workflow) -> None:
 def test_three_point_auto_touch_message_reads_as_a_sentence(workflow, library) -> None:
     library.save(1, library_tool_with_true_tcp("pointer", "Pointer"))
     wf = workflow()
-    wf.start_three_point(slot=1)
+    wf.start("three-point", slot=1)
     out = wf.auto_touch(AutoTouchRequest())
     assert out.message.startswith("Step 1 recorded: Touch the reference tip (tilt ")
     assert "Recorded touch the" not in out.message
@@ -56,14 +56,14 @@ def test_three_point_auto_touch_message_reads_as_a_sentence(workflow, library) -
 
 def test_left_half_way_lists_only_runs_still_to_do(workflow) -> None:
     wf = workflow()
-    wf.start_xyz4()
+    wf.start("xyz4")
     run_auto(wf)
     wf.save("Pen")                                   # run 1: finished and saved
-    wf.start_xyz4()
+    wf.start("xyz4")
     run_auto(wf)                                     # run 2: finished, not saved
-    wf.start_xyz4()
+    wf.start("xyz4")
     wf.auto_touch(AutoTouchRequest())                # run 3: half-way
-    wf.start_xyz4()                                  # run 4 open: the others are cancelled
+    wf.start("xyz4")                                  # run 4 open: the others are cancelled
     labels = [label for _, label in wf.resumable()]
     assert labels == ["3: XYZ 4-point, 1 of 4 recorded", "2: XYZ 4-point, finished, not saved"]
     assert wf.resume().kind == "xyz4" and wf.run is wf.runs[2]          # newest still to do
@@ -79,7 +79,7 @@ def test_left_half_way_lists_only_runs_still_to_do(workflow) -> None:
 
 def test_a_saved_run_changed_afterwards_is_listed_again(workflow) -> None:
     wf = workflow()
-    wf.start_xyz4()
+    wf.start("xyz4")
     run_auto(wf)
     wf.save("Pen")
     wf.back()                                        # a step back: the saved result no longer stands

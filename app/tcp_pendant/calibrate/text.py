@@ -26,14 +26,13 @@ from tcp_pendant.wizards import (
     Xyz4Result,
     wizard_class,
 )
-from tcp_pendant.wizards.registry import LiveAttribute
-from tcp_pendant.wizards.tcp_check import TcpCheckResult, tcp_check_markdown
+from tcp_pendant.wizards.registry import wizard_class
+from tcp_pendant.wizards.tcp_check import tcp_check_markdown
 from tcp_pendant.wizards.session_record import ReplayCheck
 from tcp_pendant.wizards.truth import TruthComparison
 from tcpcal.pose_quality import CandidateGain, PoseQuality
 
 __all__ = [
-    "METHOD_BLURBS",
     "beam_result_markdown",
     "duration_words",
     "comparison_markdown",
@@ -50,8 +49,6 @@ __all__ = [
     "warnings_markdown",
 ]
 
-METHOD_BLURBS: LiveAttribute = LiveAttribute("blurb")
-"""Kind -> what the method calibrates and how (each wizard class's ``blurb``; live view)."""
 
 
 def menu_markdown(kind: str, *, library_tool: str | None, reference_tool: str, new_tool: str,
@@ -176,15 +173,22 @@ def meter_markdown(gain: CandidateGain, quality: PoseQuality | None, sigma_mm: f
 
 
 def result_markdown(result: WizardResult, truth: TruthComparison | None = None) -> str:
-    """The calibrated frame and its quality figures (what a pendant shows after a calibration);
-    a TCP check's result: its rotations, implied error, correction and verdict; a beam
-    result: :func:`beam_result_markdown` (``truth``: its comparison with the true tool, given
-    only where the truth may be shown).
+    """What the result panel shows of ``result``, by how its wizard class shows results
+    (``Wizard.result_view``): the calibrated frame and its quality figures (what a pendant shows
+    after a calibration); a check's rotations, implied error, correction and verdict
+    (:func:`tcp_check_markdown`); a scan's events and lesson (:func:`beam_result_markdown`;
+    ``truth``: its comparison with the true tool, given only where the truth may be shown).
     """
-    if isinstance(result, TcpCheckResult):
-        return tcp_check_markdown(result)
-    if isinstance(result, BeamWizardResult):
-        return beam_result_markdown(result, truth)
+    view = wizard_class(result.wizard).result_view
+    if view == "spin_check":
+        return tcp_check_markdown(result)  # type: ignore[arg-type]  # its wizard's result type
+    if view == "beam_scan":
+        return beam_result_markdown(result, truth)  # type: ignore[arg-type]  # its wizard's result type
+    return touches_result_markdown(result)
+
+
+def touches_result_markdown(result: WizardResult) -> str:
+    """A result computed from recorded touches: the TCP (and orientation) with its figures."""
     x, y, z = (fmt_num(v) for v in result.tcp_mm)
     lines = [f"**TCP** X {x} · Y {y} · Z {z} mm"]
     if result.abc_deg is not None:
@@ -310,10 +314,10 @@ def _beam_lesson_markdown(result: BeamWizardResult, truth: TruthComparison | Non
 
 
 def _touch_numbers(result: WizardResult) -> Sequence[int]:
-    """0-based recorded-touch index of each per-touch error (the used touches for 4-point)."""
-    if isinstance(result, Xyz4Result):
-        return result.used_indices
-    return range(len(result.per_touch_error_mm))
+    """0-based recorded-touch index of each per-touch error (a result that leaves touches out,
+    the 4-point's, says which it used: ``used_indices``)."""
+    used = getattr(result, "used_indices", None)
+    return range(len(result.per_touch_error_mm)) if used is None else used
 
 
 def warnings_markdown(result: WizardResult) -> str:

@@ -410,6 +410,8 @@ class BeamWizard(Wizard):
     calibrates: ClassVar[str] = "the TCP and the tool direction"
     rank: ClassVar[int] = 60
     in_exercises: ClassVar[bool] = False
+    controller_job: ClassVar[str | None] = "beam_scan"
+    result_view: ClassVar[Literal["touches", "spin_check", "beam_scan"]] = "beam_scan"
     """The scan measures the tool by itself: refused in a classroom exercise."""
     MIN_ORIENTATIONS: ClassVar[int] = 3
     MAX_ORIENTATIONS: ClassVar[int] = 5

@@ -110,6 +110,7 @@ class Xyz4Wizard(Wizard):
                             "from 4 to 20 clearly different orientations.")
     calibrates: ClassVar[str] = "the TCP"
     rank: ClassVar[int] = 10
+    result_extras: ClassVar[frozenset[str]] = frozenset({"estimators", "sphere"})
     MIN_POINTS: ClassVar[int] = 4
     MAX_POINTS: ClassVar[int] = 20
     step_roles = (StepRole("touch", "the tool tip on the reference tip", TOUCH),)
