@@ -24,6 +24,7 @@ another wizard only cancels (never deletes) the one that was open.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any, ClassVar, Literal, Protocol
@@ -77,6 +78,8 @@ __all__ = [
     "ToolState",
 ]
 
+_ANGLE_APART = re.compile(r"\(([0-9.]+) deg apart\)")
+"""The angle in tcpcal's "touches i and j (0-based) have the same orientation (x deg apart)"."""
 AUTO_SIGMA_MAX_MM = 2.0
 """Largest simulated operator error the pendant offers (its slider runs 0-2 mm)."""
 
@@ -178,6 +181,7 @@ class CalibrationWorkflow:
         """Run index -> gradebook calibration id (the classroom recorder fills it; exported)."""
         self._record_q: dict[int, tuple[RecordedPose, np.ndarray]] = {}   # id(pose) -> (pose, joints rad)
         self._events: list[SessionEvent] = []
+        self._failure: tuple[int, str] | None = None   # (run, why its Finish failed); dropped on a change
 
     # ------------------------------------------------------------ events
     def take_events(self) -> tuple[SessionEvent, ...]:
@@ -206,6 +210,7 @@ class CalibrationWorkflow:
         pose = run.wizard.recorded_poses.get(step)
         if pose is None:
             return
+        self._failure = None                       # a new touch: the failed Finish no longer applies
         c = self.controller
         joints = tuple(c.joint_angles_deg().values())
         run.joints_deg[step] = joints
@@ -479,16 +484,46 @@ class CalibrationWorkflow:
         return self._finished(w, out) if isinstance(out, WizardResult) else None
 
     def _in_words(self, exc: CalibrationFailedError) -> CalibrationFailedError:
-        """tcpcal's failure with its FLANGE axis said in words (``diversity.failure_in_words``)."""
-        axis = getattr(exc.cause, "unobservable_axis", None)
-        if axis is None:
-            return exc
-        R_world_flange = self.controller.T_world_flange()[:3, :3]
-        return CalibrationFailedError(failure_in_words(str(exc), axis, R_world_flange), exc.cause)
+        """tcpcal's failure in the trainee's words, with what to do: the touches it is about
+        as step numbers (two with the same orientation: go back to the later one), its FLANGE
+        axis in words (``diversity.failure_in_words``). Kept as :attr:`finish_failure` for the
+        step panels until the wizard changes."""
+        w, cause = self.wizard, exc.cause
+        axis = getattr(cause, "unobservable_axis", None)
+        pair = tuple(getattr(cause, "indices", ()))
+        steps = () if w is None else w.solver_touch_steps()
+        if len(pair) == 2 and all(0 <= k < len(steps) for k in pair):
+            a, b = (steps[k] + 1 for k in pair)
+            angle = _ANGLE_APART.search(str(exc))
+            apart = f" ({angle.group(1)}° apart)" if angle else ""
+            todo = (f"record step {b} again" if w is not None and w.step_index == b - 1
+                    else f"go Back to step {b} and record it again")
+            text = (f"Touches {a} and {b} have the same orientation{apart}: the method needs clearly "
+                    f"different orientations. Tilt the tool 30-60° about another axis and {todo}.")
+            out = CalibrationFailedError(text, cause)
+        elif axis is not None:
+            R_world_flange = self.controller.T_world_flange()[:3, :3]
+            out = CalibrationFailedError(failure_in_words(str(exc), axis, R_world_flange) +
+                                         " Go Back to a step and record it tilted about that axis.", cause)
+        else:
+            out = exc
+        if self._current is not None:
+            self._failure = (self._current, str(out))
+        return out
+
+    @property
+    def finish_failure(self) -> str | None:
+        """Why the last Finish of the run on show could not compute, and what to do (plain
+        text, our words and numbers), while the run is still where it failed; else None."""
+        failure, w = self._failure, self.wizard
+        if failure is None or failure[0] != self._current or w is None or w.status != "in_progress":
+            return None
+        return failure[1]
 
     def back(self) -> None:
         """One step back (from the result: to the last step); nothing is deleted."""
         self._require().back()
+        self._failure = None
 
     def auto_touch(self, request: AutoTouchRequest) -> AutoTouchOutcome:
         """Training mode: let the controller perform the current step (mounting the tool it

@@ -26,6 +26,7 @@ from typing import Any
 
 from tcp_pendant.calibrate.text import meter_level, step_markdown
 from tcp_pendant.pendant.guidance import direction_words, tip_offset_mm
+from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.pendant.record_check import RecordCheck
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.views.gui_util import set_content
@@ -140,6 +141,9 @@ class WizardDock:
             return
         set_content(self.step_md, step_markdown(wiz))
         note = self._note if self._note_at == self._where() else ""
+        failure = wf.finish_failure
+        if failure is not None:                  # Finish could not compute: why, and what to do
+            note = f"⚠ Finish not possible: {escape_markdown(failure)}" + (f"\n\n{note}" if note else "")
         self.note_md.visible = bool(note)
         if note:
             set_content(self.note_md, note)

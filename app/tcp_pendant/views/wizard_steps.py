@@ -200,6 +200,9 @@ class WizardStepsView:
         self._render_variant(wiz)
         needed = wf.required_tool()
         reason = wiz.blocked_reason if not wiz.is_complete and not wiz.auto_role(wiz.step).by_controller else None
+        failure = wf.finish_failure
+        if failure is not None:                  # Finish could not compute: why, and what to do
+            reason = f"Finish not possible: {failure}" if reason is None else f"{reason}\n\n{failure}"
         self.blocked_md.visible = reason is not None
         if reason is not None:
             set_content(self.blocked_md, f"⚠ {escape_markdown(reason)}")

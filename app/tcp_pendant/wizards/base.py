@@ -391,6 +391,11 @@ class Wizard(abc.ABC):
         """"Add point" is possible now (only wizards with ``supports_add_point``)."""
         return False
 
+    def solver_touch_steps(self) -> tuple[int, ...]:
+        """The 0-based steps whose poses are the solver's touch rows, in row order (tcpcal's
+        touch indices in an error map to these steps): every step of role "touch"."""
+        return tuple(i for i, spec in enumerate(self._step_specs()) if spec.role == "touch")
+
     def add_point(self) -> None:
         """Add one touch step (only wizards with ``supports_add_point``)."""
         raise WizardStateError(f"Add point is not part of the {self.title} wizard.")

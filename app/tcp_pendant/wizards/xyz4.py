@@ -216,6 +216,10 @@ class Xyz4Wizard(Wizard):
         """0-based indices of recorded touches left out of the computation."""
         return self._excluded
 
+    def solver_touch_steps(self) -> tuple[int, ...]:
+        """The touches tcpcal is given: every step but the ones dropped."""
+        return tuple(i for i in range(self.n_steps) if i not in self._excluded)
+
     def set_excluded(self, indices: Iterable[int]) -> WizardResult | None:
         """Leave these touches out (0-based); recompute if finished. At least 4 must remain."""
         idx = tuple(sorted({int(i) for i in indices}))
