@@ -144,3 +144,55 @@ def test_tool_data_defaults_to_the_active_slot_not_slot_1(tmp_path) -> None:
     finally:
         p.ws.close()
         app.stop()
+
+
+def test_the_4_point_steps_ask_for_what_the_meter_can_reward() -> None:
+    """Touch 2 is the first tilt (no 'different axis than before' when nothing was tilted),
+    touch 3 asks for another axis, and every tilt asked for is the least the meter calls far
+    enough (``MIN_TILT_DEG``)."""
+    from tcp_pendant.calibrate.diversity import MIN_TILT_DEG
+    from tcp_pendant.wizards import Xyz4Wizard
+
+    steps = Xyz4Wizard(n_points=4).steps
+    assert "about one axis" in steps[1].instruction and "before" not in steps[1].instruction
+    assert "another axis than for touch 2" in steps[2].instruction
+    for step in steps[1:]:
+        assert f"{MIN_TILT_DEG:.0f} to 60 degrees" in step.instruction, step.index
+
+
+def test_the_touch_list_points_at_the_wizards_touches(tmp_path) -> None:
+    """With no free touch but four wizard touches the Jog tab's Touches list does not say
+    'No touch recorded' (it did): it says where they are."""
+    from calib_helpers import make_session
+    from tcp_pendant.calibrate.text import empty_touches_markdown
+
+    s = make_session(tmp_path / "tools.json", seed=4)
+    assert empty_touches_markdown(s.workflow.wizard) == "*No touch recorded.*"
+    s.start_wizard("xyz4")
+    for _ in range(4):
+        s.auto_touch(AutoTouchRequest())
+    text = empty_touches_markdown(s.workflow.wizard)
+    assert "No touch recorded with Record point" in text and "has 4 touches of its own" in text
+    s.cancel_wizard()
+    assert empty_touches_markdown(s.workflow.wizard) == "*No touch recorded.*"
+
+
+def test_exact_touches_are_not_called_outside_the_95_percent_radius(tmp_path) -> None:
+    """sigma 0: an error of ~1e-12 mm next to a radius of ~1e-13 mm was 'outside the 95 %
+    radius' beside '0.000 mm, good'."""
+    from calib_helpers import make_session
+    from tcp_pendant.calibrate.text import truth_markdown
+
+    s = make_session(tmp_path / "tools.json", seed=6)
+    s.start_wizard("xyz4")
+    while s.workflow.result is None:
+        s.auto_touch(AutoTouchRequest(sigma_mm=0.0))
+    truth = s.workflow.truth()
+    assert truth.position_error_mm < 1e-6 and truth.inside_ci95 is True and truth.grade == "good"
+    md = truth_markdown(truth)
+    assert "outside" not in md and "the computed TCP is the true one" in md
+    s.back()                                     # a touch 2 mm off: a real error, judged as before
+    s.auto_touch(AutoTouchRequest(sigma_mm=2.0))
+    noisy = s.workflow.truth()
+    assert noisy.position_error_mm > 1e-3
+    assert ("inside" if noisy.inside_ci95 else "**outside**") in truth_markdown(noisy)

@@ -29,7 +29,7 @@ from tcp_pendant.wizards import (
 from tcp_pendant.wizards.registry import wizard_class
 from tcp_pendant.wizards.tcp_check import tcp_check_markdown
 from tcp_pendant.wizards.session_record import ReplayCheck
-from tcp_pendant.wizards.truth import TruthComparison
+from tcp_pendant.wizards.truth import NUMERICAL_NOISE_MM, TruthComparison
 from tcpcal.pose_quality import CandidateGain, PoseQuality
 
 __all__ = [
@@ -46,6 +46,7 @@ __all__ = [
     "step_markdown",
     "steps_list_markdown",
     "truth_markdown",
+    "empty_touches_markdown",
     "warnings_markdown",
 ]
 
@@ -320,6 +321,16 @@ def _touch_numbers(result: WizardResult) -> Sequence[int]:
     return range(len(result.per_touch_error_mm)) if used is None else used
 
 
+def empty_touches_markdown(wizard: Wizard | None) -> str:
+    """What the Touches list says with no free touch (Record point): "No touch recorded", or,
+    while a wizard on show has recorded steps, that they are its (our words and numbers)."""
+    n = 0 if wizard is None or wizard.status == "cancelled" else len(wizard.recorded_poses)
+    if n == 0:
+        return "*No touch recorded.*"
+    return (f"*No touch recorded with Record point. The {_esc(wizard.title)} wizard has {n} "
+            f"touch{'es' if n != 1 else ''} of its own: they are in its step list above.*")
+
+
 def warnings_markdown(result: WizardResult) -> str:
     """Warnings (⚠) then standing notes (ℹ), one per line; empty when there are none."""
     lines = [f"⚠ {_esc(w)}" for w in result.warnings] + [f"ℹ {_esc(n)}" for n in result.notes]
@@ -351,8 +362,11 @@ def truth_markdown(cmp: TruthComparison) -> str:
         lines.append(f"Orientation error: **{_deg(cmp.orientation_error_deg, 3)}** "
                      f"(tool X: {_deg(cmp.x_axis_error_deg, 3)})")
     if cmp.inside_ci95 is not None:
-        lines.append("The true TCP is " + ("inside" if cmp.inside_ci95 else "**outside**")
-                     + " the 95 % radius.")
+        if cmp.position_error_mm < NUMERICAL_NOISE_MM:
+            lines.append("The touches were exact (no operator error): the computed TCP is the true one.")
+        else:
+            lines.append("The true TCP is " + ("inside" if cmp.inside_ci95 else "**outside**")
+                         + " the 95 % radius.")
     return "\n\n".join(lines)
 
 

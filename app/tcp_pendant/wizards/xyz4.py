@@ -156,10 +156,17 @@ class Xyz4Wizard(Wizard):
             if i == 0:
                 text = ("Jog the tool tip onto the reference tip, approaching from any direction; "
                         "then press Record.")
-            elif i < 4:
-                text = (f"Back off, tilt the tool 30 to 60 degrees about a different axis than "
-                        f"before, and touch the reference tip again from this new orientation "
-                        f"(touch {i + 1}); then press Record.")
+            elif i == 1:
+                text = ("Back off, tilt the tool 45 to 60 degrees about one axis (A, B or C), and touch "
+                        "the reference tip again from this new orientation (touch 2); then press Record.")
+            elif i == 2:
+                text = ("Back off, tilt the tool 45 to 60 degrees about another axis than for touch 2, "
+                        "and touch the reference tip again (touch 3); then press Record.")
+            elif i == 3:
+                text = ("Back off and touch the reference tip from an orientation 45 to 60 degrees away "
+                        "from all three earlier ones, e.g. tilted the other way than touch 2 (touch 4); "
+                        "then press Record. Smaller tilts leave the TCP uncertain: the meter below "
+                        "predicts the error.")
             else:
                 text = (f"Extra touch {i + 1}: touch the reference tip from an orientation unlike "
                         f"the earlier ones (watch the pose-diversity meter); then press Record.")
