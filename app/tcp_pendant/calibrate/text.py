@@ -300,16 +300,22 @@ def _beam_lesson_markdown(result: BeamWizardResult, truth: TruthComparison | Non
         return ("**Automatic vs by hand:** no manual calibration of this tool in this session yet. "
                 f"The scan takes {duration_words(result.duration_s)} on a real robot; calibrate the tool by hand "
                 "(e.g. XYZ 4-point) and scan again to compare.")
-    name = f"{manual.run_number}: {_esc(manual.title)} (by hand)"
+    if manual.auto_touches == 0:
+        who, whose = "by hand", "your time"
+    elif manual.auto_touches >= manual.touches:
+        who, whose = "by Auto-touch", "Auto-touch's clicks"
+    else:
+        who, whose = f"{manual.auto_touches} of {manual.touches} touches by Auto-touch", "your time"
+    name = f"{manual.run_number}: {_esc(manual.title)} ({who})"
     if truth is None:
         return ("**Automatic vs by hand** (same tool)\n\n| calibration | time |\n|---|---|\n"
                 f"| Automatic (beam) | {duration_words(result.duration_s)} on a real robot |\n"
-                f"| {name} | {duration_words(manual.wall_time_s)} (your time) |")
+                f"| {name} | {duration_words(manual.wall_time_s)} ({whose}) |")
     head = ("**Automatic vs by hand** (same tool, against the true tool)\n\n"
             "| calibration | time | TCP error | direction error |\n|---|---|---|---|")
     beam = (f"| Automatic (beam) | {duration_words(result.duration_s)} on a real robot | "
             f"{_mm(truth.position_error_mm, 3)} | {_deg(truth.x_axis_error_deg, 3)} |")
-    hand = (f"| {name} | {duration_words(manual.wall_time_s)} (your time) | {_mm(manual.position_error_mm, 3)} | "
+    hand = (f"| {name} | {duration_words(manual.wall_time_s)} ({whose}) | {_mm(manual.position_error_mm, 3)} | "
             f"{_deg(manual.direction_error_deg, 3)} |")
     return "\n".join([head, beam, hand])
 

@@ -182,6 +182,7 @@ class CalibrationWorkflow:
         self._record_q: dict[int, tuple[RecordedPose, np.ndarray]] = {}   # id(pose) -> (pose, joints rad)
         self._events: list[SessionEvent] = []
         self._failure: tuple[int, str] | None = None   # (run, why its Finish failed); dropped on a change
+        self._auto_steps: dict[int, set[int]] = {}     # run -> steps whose pose Auto-touch recorded
 
     # ------------------------------------------------------------ events
     def take_events(self) -> tuple[SessionEvent, ...]:
@@ -214,6 +215,11 @@ class CalibrationWorkflow:
         c = self.controller
         joints = tuple(c.joint_angles_deg().values())
         run.joints_deg[step] = joints
+        auto_steps = self._auto_steps.setdefault(i, set())
+        if auto:
+            auto_steps.add(step)
+        else:
+            auto_steps.discard(step)
         self._record_q[id(pose)] = (pose, c.q_rad.copy())
         self._note_distance(step)
         self._events.append(TouchRecorded(i, step, pose.T_world_flange_m, joints,
@@ -695,7 +701,9 @@ class CalibrationWorkflow:
             if self.training and not self.hide_truth and run.T_flange_tool_true_m is not None:
                 cmp = compare_with_truth(res, run.T_flange_tool_true_m)
                 pos, ang, grade = cmp.position_error_mm, cmp.x_axis_error_deg, cmp.grade
-            return ManualComparison(w.title, w.kind, j + 1, 0.0 if seconds is None else seconds, pos, ang, grade)
+            auto = len(self._auto_steps.get(j, set()) & set(w.recorded_poses))
+            return ManualComparison(w.title, w.kind, j + 1, 0.0 if seconds is None else seconds, pos, ang, grade,
+                                    touches=len(w.recorded_poses), auto_touches=auto)
         return None
 
     # ------------------------------------------------------------ session record
