@@ -118,8 +118,6 @@ def test_a_ur_script_with_a_tcp_set_warns() -> None:
     ("kuka", "DECL E6POS XP1={X 1,Y 2,Z 3,A 0,B 0}", "line 1: E6POS XP1 lacks C"),
     ("abb", "CONST robtarget p1:=[[1,2,3],[0.9,0,0,0],[0,0,0,0],[9E9,9E9,9E9,9E9,9E9,9E9]];",
      "quaternion norm 0.9"),
-    ("fanuc", "/POS\nP[1]{\n   GP1:\n\tUF : 0, UT : 0,\n\tJ1= 0.0 deg, J2 = 1 deg\n};\n/END\n",
-     "joint representation"),
     ("ur", "movel(p[0.1, 0.2, 0.3, 0, 0])", "needs 6 numbers"),
 ])
 def test_errors(fmt: str, text: str, needle: str) -> None:
