@@ -28,6 +28,7 @@ import argparse
 import sys
 from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -41,6 +42,9 @@ from tcpcal.controllers import (
     poses_csv_text,
 )
 from tcpcal.errors import TcpcalError
+
+if TYPE_CHECKING:
+    from tcp_pendant.controller import RobotKinematics
 
 __all__ = ["build_parser", "flange_poses_of_joint_points", "main"]
 
@@ -65,22 +69,23 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
-def flange_poses_of_joint_points(points: Sequence[JointPoint], kinematics: object, fmt: str
-                                 ) -> tuple[list[RecordedPose], list[str]]:
-    """Each joint point as the flange pose of ``kinematics`` (a ``RobotKinematics``), with the
+def flange_poses_of_joint_points(points: Sequence[JointPoint], kinematics: RobotKinematics,
+                                 fmt: str) -> tuple[list[RecordedPose], list[str]]:
+    """Each joint point as the flange pose of the robot ``kinematics``, with the
     orientation numbers of format ``fmt``; and the warnings (points outside the joint limits).
 
     Args:
         points: the file's joint points (deg for revolute joints, mm for prismatic ones).
-        kinematics: the robot (``n_joints``, ``revolute``, ``T_world_flange(q_rad)`` in m).
+        kinematics: the robot (``T_world_flange(q_rad)`` in m; ``revolute`` says which axis
+            values are degrees, the others mm).
         fmt: the format whose orientation numbers the poses carry (``RecordedPose.values``).
 
     Raises:
         ValueError: a point whose number of axis values is not the robot's.
     """
     kin = kinematics
-    n = int(kin.n_joints)  # type: ignore[attr-defined]
-    revolute = np.asarray(kin.revolute, dtype=bool)  # type: ignore[attr-defined]
+    n = kin.n_joints
+    revolute = np.asarray(kin.revolute)
     angles = REGISTRY[fmt].angles_from_rotation
     poses: list[RecordedPose] = []
     outside: list[str] = []
@@ -88,13 +93,13 @@ def flange_poses_of_joint_points(points: Sequence[JointPoint], kinematics: objec
         if len(p.joints_deg) != n:
             raise ValueError(
                 f"line {p.line}: {p.name} has {len(p.joints_deg)} axis values but the robot has "
-                f"{n} joints ({', '.join(kin.joint_names)}); give the robot that recorded "  # type: ignore[attr-defined]
+                f"{n} joints ({', '.join(kin.joint_names)}); give the robot that recorded "
                 "the file with --robot")
         v = np.asarray(p.joints_deg, dtype=float)
         q = np.where(revolute, np.radians(v), v / 1000.0)
-        if kin.limit_violation(q) is not None:  # type: ignore[attr-defined]
+        if kin.limit_violation(q) is not None:
             outside.append(p.name)
-        T = np.asarray(kin.T_world_flange(q))  # type: ignore[attr-defined]
+        T = np.asarray(kin.T_world_flange(q))
         R = T[:3, :3]
         xyz = tuple(float(c) * 1000.0 for c in T[:3, 3])
         poses.append(RecordedPose(p.name, xyz, R, tuple(float(a) for a in angles(R)),  # type: ignore[arg-type]
