@@ -279,3 +279,43 @@ def test_fanuc_orderfil_dat_is_recognised_as_fanuc(tmp_path: Path,
     assert detect_pose_format(path.read_text(), path.name) == "fanuc"
     code, _, err = run(capsys, "poses", "import", str(path))
     assert code == 2 and "fanuc: this is ORDERFIL.DAT" in err and "kuka" not in err
+
+
+def test_an_excerpt_of_a_public_multi_group_program() -> None:
+    """Two points of layers_splitter/output_data/layer_2.ls of Creearc/welding_project, as
+    published (a space before the brace, CONFIG: without a space, GP2 in joints)."""
+    text = """/PROG layer_2
+/ATTR
+DEFAULT_GROUP   = 1,1,*,*,*;
+/MN
+1: L P[1] 240cm/min CNT100 COORD ;
+2: L P[2] WELD_SPEED CNT100 COORD PTH ;
+/POS
+P[1] {
+    GP1:
+        UF : 6, UT : 5,     CONFIG: 'N U T, 0, 0, 0',
+       X = 45.4 mm, Y = -124.0 mm, Z = 56.6 mm,
+       W = 0.0 deg, P = 0.0 deg, R = 0.0 deg
+    GP2:
+        UF : 1, UT : 2,
+       J1 = 0.0 deg, J2 = 0.0 deg 
+ };
+P[2] {
+    GP1:
+        UF : 6, UT : 5,     CONFIG: 'N U T, 0, 0, 0',
+       X = -48.8 mm, Y = -124.0 mm, Z = 56.6 mm,
+       W = 0.0 deg, P = 0.0 deg, R = 0.0 deg
+    GP2:
+        UF : 1, UT : 2,
+       J1 = 0.0 deg, J2 = 0.0 deg 
+ };
+/END
+"""
+    imported = import_poses(text, filename="layer_2.ls")
+    assert [(p.name, p.position_mm, p.tool, p.base) for p in imported.poses] == [
+        ("P[1]", (45.4, -124.0, 56.6), 5, 6), ("P[2]", (-48.8, -124.0, 56.6), 5, 6)]
+    assert imported.joint_points == ()
+    assert [w.split(" (")[0] for w in imported.warnings] == [
+        "P[1], P[2] recorded with a tool active", "P[1], P[2] recorded in a base / user frame",
+        "2 points"]
+    assert "also hold motion group GP2" in imported.warnings[2]
