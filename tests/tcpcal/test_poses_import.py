@@ -319,3 +319,24 @@ P[2] {
         "P[1], P[2] recorded with a tool active", "P[1], P[2] recorded in a base / user frame",
         "2 points"]
     assert "also hold motion group GP2" in imported.warnings[2]
+
+
+def test_fanuc_integrated_extended_axis_values_are_said() -> None:
+    ls = (DATA / "touches.ls").read_text().replace(
+        "R =     30.000 deg\n};", "R =     30.000 deg,\n\tE1 =  1500.000  mm\n};", 1)
+    imported = import_poses(ls, "fanuc")
+    assert len(imported.poses) == 6
+    assert imported.warnings == (
+        "touch 2 (E1 1500): extended-axis values are not part of the pose; tcpcal ignores them, "
+        "so the poses are right only if no extended axis moves the robot or the reference "
+        "between touches",)
+
+
+def test_a_tool_cnd_in_another_layout_is_a_clear_error() -> None:
+    from tcpcal.controllers import parse_tool_file
+
+    text = ("//TOOL 1\n///NAME T\n1.000,2.000,3.000,0.0000,0.0000,0.0000\n0.000,0.000,0.000\n"
+            "0.000,0.000,0.000\n0.000\n0,0\n")
+    with pytest.raises(ControllerFileError, match=r"line 5: //TOOL 1: the line after the centre "
+                       r"of gravity is the mass W \(1 number\), got '0.000,0.000,0.000'"):
+        parse_tool_file(text, "yaskawa")

@@ -120,6 +120,8 @@ def render_tool(tool: Tool, number: int, name: str | None = None, *,
 
 _GROUP = re.compile(r"\bGP(\d+)\s*:")
 _JOINT = re.compile(rf"\bJ(\d+)\s*=\s*({NUM})")
+_EXTENDED = re.compile(rf"\bE(\d+)\s*=\s*({NUM})")
+"""An integrated extended axis of group 1 (``E1 = 1500.000 mm``: a track the robot rides)."""
 
 
 @dataclass(frozen=True)
@@ -134,6 +136,7 @@ class _Point:
     uf: int | None
     ut: int | None
     other_groups: tuple[int, ...]
+    extended: tuple[tuple[int, float], ...] = ()
 
 
 def _groups(body: str) -> dict[int, str]:
@@ -176,7 +179,9 @@ def _points(text: str) -> list[_Point]:
         missing = [c for c in "XYZWPR" if c not in vals]
         if missing:
             raise ControllerFileError(f"fanuc: line {line}: P[{k}] lacks {', '.join(missing)}")
-        out.append(_Point(k, m.group(2) or "", line, vals, None, uf, ut, others))
+        ext = tuple((int(e.group(1)), to_float(e.group(2), "fanuc", f"P[{k}] E{e.group(1)}"))
+                    for e in _EXTENDED.finditer(gp1))
+        out.append(_Point(k, m.group(2) or "", line, vals, None, uf, ut, others, ext))
     return out
 
 
@@ -241,16 +246,26 @@ def parse_joint_points(text: str) -> list[JointPoint]:
 
 
 def pose_warnings(text: str) -> list[str]:
-    """The points that also hold other motion groups (``GP2:`` ...): only group 1 is read."""
-    pts = [p for p in _points(text) if p.other_groups]
-    if not pts:
-        return []
-    groups = sorted({g for p in pts for g in p.other_groups})
-    names = ", ".join(_name(p) for p in pts[:8]) + (", ..." if len(pts) > 8 else "")
-    return [f"{len(pts)} point{'s' if len(pts) != 1 else ''} ({names}) also hold motion group "
-            f"{', '.join(f'GP{g}' for g in groups)} (an extended axis or another robot): only "
-            "group 1 (GP1, the robot) was read; its poses are valid only if the other groups "
-            "do not carry the robot or the reference"]
+    """The points that also hold other motion groups (``GP2:`` ...): only group 1 is read;
+    and those whose group 1 has extended-axis values (``E1 = ..``) not 0."""
+    points = _points(text)
+    out = []
+    pts = [p for p in points if p.other_groups]
+    if pts:
+        groups = sorted({g for p in pts for g in p.other_groups})
+        names = ", ".join(_name(p) for p in pts[:8]) + (", ..." if len(pts) > 8 else "")
+        out.append(f"{len(pts)} point{'s' if len(pts) != 1 else ''} ({names}) also hold motion "
+                   f"group {', '.join(f'GP{g}' for g in groups)} (an extended axis or another "
+                   "robot): only group 1 (GP1, the robot) was read; its poses are valid only if "
+                   "the other groups do not carry the robot or the reference")
+    moved = [p for p in points if any(v != 0.0 for _, v in p.extended)]
+    if moved:
+        names = ", ".join(f"{_name(p)} ({', '.join(f'E{i} {v:g}' for i, v in p.extended if v)})"
+                          for p in moved[:8]) + (", ..." if len(moved) > 8 else "")
+        out.append(f"{names}: extended-axis values are not part of the pose; tcpcal ignores "
+                   "them, so the poses are right only if no extended axis moves the robot or "
+                   "the reference between touches")
+    return out
 
 
 def render_poses(poses: Sequence[RecordedPose], program: str = "TOUCHES") -> str:

@@ -95,6 +95,11 @@ def parse_tool(text: str) -> list[ToolEntry]:
         load = [ln for ln in lines[j + 1:j + 3]]
         if len(load) == 2 and not load[0].startswith("//") and not load[1].startswith("//"):
             g = _numbers(load[0], 3, f"//TOOL {n} centre of gravity Xg,Yg,Zg", j + 2)
+            if len(load[1].split(",")) != 1:
+                raise ControllerFileError(
+                    f"yaskawa: line {j + 3}: //TOOL {n}: the line after the centre of gravity is "
+                    f"the mass W (1 number), got {load[1].strip()!r}; a TOOL.CND entry is X,Y,Z,"
+                    "Rx,Ry,Rz / Xg,Yg,Zg / W / Ix,Iy,Iz / 3 fields (DX100, YRC1000)")
             w = _numbers(load[1], 1, f"//TOOL {n} mass W", j + 3)[0]
             if w < 0:
                 raise ControllerFileError(f"yaskawa: line {j + 3}: //TOOL {n} mass {w} kg is "
