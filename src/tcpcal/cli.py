@@ -305,7 +305,9 @@ def build_parser() -> argparse.ArgumentParser:
                           description="Read the recorded positions of a controller program "
                           f"file ({', '.join(pose_names)}: docs/formats.md) and "
                           "print them as POSES.csv for 'tcpcal solve'. Record the touches with "
-                          "no tool and no base active (the flange in WORLD).")
+                          "no tool and no base active (the flange in WORLD). Points in joint "
+                          "representation are skipped (tcpcal has no robot model): 'tcp-pendant "
+                          "poses import FILE --robot ...' converts them.")
     pim.add_argument("file", metavar="FILE", type=Path)
     pim.add_argument("--format", dest="fmt", default="auto",
                      choices=("auto", *pose_names),

@@ -35,6 +35,7 @@ __all__ = [
     "CONTROLLER_FORMATS",
     "POSE_FORMATS",
     "REGISTRY",
+    "ROBOT_HINT",
     "ControllerFileError",
     "ControllerFormat",
     "CsvLayout",
@@ -222,6 +223,7 @@ class PoseImport:
 
 ROBOT_HINT = ("tcp-pendant poses import FILE --robot kr6|gp12|PATH.urdf converts them with "
               "the robot's forward kinematics")
+"""How to turn joint points into flange poses (the app has the robot model tcpcal lacks)."""
 
 
 def skipped_joints_warning(imported: PoseImport) -> str | None:
