@@ -340,3 +340,12 @@ def test_a_tool_cnd_in_another_layout_is_a_clear_error() -> None:
     with pytest.raises(ControllerFileError, match=r"line 5: //TOOL 1: the line after the centre "
                        r"of gravity is the mass W \(1 number\), got '0.000,0.000,0.000'"):
         parse_tool_file(text, "yaskawa")
+
+
+def test_kuka_frame_data_without_a_whole_pose_is_skipped_and_said() -> None:
+    text = (DATA / "touches_extra.dat").read_text().replace(
+        "ENDDAT", "DECL FRAME XOFFSET={X 0.0,Y 0.0,Z 50.0}\nENDDAT")
+    imported = import_poses(text, "kuka")
+    assert [p.name for p in imported.poses] == REAL["kuka"][1]
+    assert imported.warnings[-1] == ("XOFFSET: FRAME data without all of X, Y, Z, A, B, C "
+                                     "skipped (not a pose)")

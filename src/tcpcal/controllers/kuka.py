@@ -154,7 +154,8 @@ def _declared(text: str) -> list[tuple[str, str, str, int]]:
 
 def parse_poses(text: str) -> list[RecordedPose]:
     """``E6POS`` / ``POS`` / ``FRAME`` declarations of a KRL ``.dat`` file and the elements of
-    such arrays (``XPA[2]={...}``), in file order. External axes ``E1``..``E6`` are not part
+    such arrays (``XPA[2]={...}``), in file order (a ``FRAME`` only where it holds a whole
+    pose, X to C). External axes ``E1``..``E6`` are not part
     of the pose (:func:`pose_warnings` names the points whose values are not 0)."""
     text = _code(text)
     fdat: dict[str, dict[str, str]] = {}
@@ -168,7 +169,10 @@ def parse_poses(text: str) -> list[RecordedPose]:
         if kind in ("E6AXIS", "AXIS"):
             continue
         what = f"line {line_of(text, at)}: {kind} {name}"
-        vals = _xyzabc(_components(body, what), what)
+        comp = _components(body, what)
+        if kind == "FRAME" and not _whole_frame(comp):
+            continue  # a FRAME that holds no whole pose (an offset of some components)
+        vals = _xyzabc(comp, what)
         rot = Rotation.from_euler("ZYX", vals[3:], degrees=True).as_matrix()
         key = "F" + name[1:].upper() if name.upper().startswith("X") else ""
         fd = fdat.get(key, {})
@@ -199,7 +203,7 @@ def parse_joint_points(text: str) -> list[JointPoint]:
 def pose_warnings(text: str) -> list[str]:
     """Points with external-axis values (``E1``..``E6`` not 0) and ``FRAME`` data."""
     code = _code(text)
-    extax, frames = [], []
+    extax, frames, partial = [], [], []
     for kind, name, body, at in _declared(code):
         try:
             comp = _components(body, name)
@@ -209,7 +213,7 @@ def pose_warnings(text: str) -> list[str]:
         if moved:
             extax.append(f"{name} ({', '.join(f'{k} {comp[k]}' for k in moved)})")
         if kind == "FRAME":
-            frames.append(name)
+            (frames if _whole_frame(comp) else partial).append(name)
     out = []
     if extax:
         out.append(f"{', '.join(extax)}: external-axis values are not part of the pose; tcpcal "
@@ -219,7 +223,14 @@ def pose_warnings(text: str) -> list[str]:
         out.append(f"{', '.join(frames)} read from FRAME data (X, Y, Z, A, B, C, no status "
                    "and turn): check that they are recorded flange positions, not a base or "
                    "tool frame")
+    if partial:
+        out.append(f"{', '.join(partial)}: FRAME data without all of X, Y, Z, A, B, C skipped "
+                   "(not a pose)")
     return out
+
+
+def _whole_frame(comp: dict[str, str]) -> bool:
+    return all(k in comp for k in "XYZABC")
 
 
 def _nonzero(token: str) -> bool:
