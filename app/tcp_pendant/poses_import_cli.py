@@ -122,6 +122,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     from tcp_pendant.server import resolve_robot
 
     try:
+        urdf = resolve_robot(args.robot)
+    except ControllerError as exc:
+        return _error(str(exc))
+    try:
         text = read_controller_text(args.file)
         imported = import_poses(text, args.fmt, filename=args.file.name)
     except OSError as exc:
@@ -132,7 +136,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     poses = list(imported.poses)
     if imported.joint_points:
         try:
-            kin = RobotKinematics.from_urdf(resolve_robot(args.robot), flange_link=args.flange_link)
+            kin = RobotKinematics.from_urdf(urdf, flange_link=args.flange_link)
             converted, more = flange_poses_of_joint_points(imported.joint_points, kin,
                                                            imported.format)
         except (ControllerError, ValueError) as exc:

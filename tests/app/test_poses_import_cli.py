@@ -136,3 +136,9 @@ def test_a_point_with_another_axis_count_is_one_error_line(
     err = capsys.readouterr().err
     assert err.count("\n") == 1
     assert "P[4] has 7 axis values but the robot has 6 joints (J1, J2, J3, J4, J5, J6)" in err
+
+
+def test_an_unknown_robot_is_one_error_line(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["poses", "import", str(DATA / "touches.mod"), "--robot", "nope"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Unknown robot 'nope'" in err
