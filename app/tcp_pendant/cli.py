@@ -10,6 +10,7 @@ Examples::
     tcp-pendant --host 0.0.0.0 --class           # a class: names, gradebook, trainer view
     tcp-pendant --host 0.0.0.0 --exercise mystery --exercise-seed 7   # a class with mystery tools
     tcp-pendant grades --csv > grades.csv        # the class gradebook (see classroom.grades_cli)
+    tcp-pendant poses import touch.ls --robot kr6 > POSES.csv   # joint points by the robot's FK
     tcp-pendant --scenario bent-tool --scenario-seed 3   # training: a systematic error to find
 """
 
@@ -136,6 +137,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         from tcp_pendant.classroom.grades_cli import main as grades_main
 
         return grades_main(args_list[1:])
+    if args_list[:2] == ["poses", "import"]:
+        from tcp_pendant.poses_import_cli import main as poses_import_main
+
+        return poses_import_main(args_list[2:])
     try:
         return _main(args_list)
     except KeyboardInterrupt:               # Ctrl-C while loading the robot or starting

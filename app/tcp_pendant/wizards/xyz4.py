@@ -340,7 +340,8 @@ class Xyz4Wizard(Wizard):
         abc = (0.0, 0.0, 0.0)
         if self.base_tool is not None:
             abc = tuple(float(v) for v in self.base_tool.abc_deg)  # type: ignore[assignment]
-            kw = {"mass_kg": self.base_tool.mass_kg, "notes": self.base_tool.notes}
+            kw = {"mass_kg": self.base_tool.mass_kg, "cog_mm": self.base_tool.cog_mm,
+                  "notes": self.base_tool.notes}
         return Tool(name=name, tcp_mm=res.tcp_mm, abc_deg=abc,
                     calibration=self._calibration(res, res.figures), **kw)
 
