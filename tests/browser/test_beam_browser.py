@@ -46,7 +46,7 @@ def test_automatic_beam_wizard_next_to_the_manual_calibration(server, new_page, 
     open_calibrate(page)
     press(page, "Start")                                      # XYZ 4-point by Auto-touch
     auto_touch_to_result(page, 4)
-    press(page, "Close (resume later)")
+    press(page, "Close (not saved)")
 
     choose(page, "Method", "Automatic (beam)", "BullsEye")
     wait_enabled(page, "Start")

@@ -3,7 +3,9 @@ orientation wizards offer first."""
 
 from __future__ import annotations
 
+import re
 import sys
+from datetime import datetime
 from pathlib import Path
 
 import pytest
@@ -64,8 +66,11 @@ def test_left_half_way_lists_only_runs_still_to_do(workflow) -> None:
     wf.start("xyz4")
     wf.auto_touch(AutoTouchRequest())                # run 3: half-way
     wf.start("xyz4")                                  # run 4 open: the others are cancelled
-    labels = [label for _, label in wf.resumable()]
-    assert labels == ["3: XYZ 4-point, 1 of 4 recorded", "2: XYZ 4-point, finished, not saved"]
+    labels = [re.sub(r"started \d\d:\d\d$", "started HH:MM", label) for _, label in wf.resumable()]
+    assert labels == ["3: XYZ 4-point, at step 2 of 4 (1 recorded), started HH:MM",
+                      "2: XYZ 4-point, result not saved, started HH:MM"]
+    started = datetime.fromisoformat(wf.runs[2].wizard.started_at.replace("Z", "+00:00")).astimezone()
+    assert wf.resumable()[0][1].endswith(started.strftime("%H:%M"))      # the server's local time
     assert wf.resume().kind == "xyz4" and wf.run is wf.runs[2]          # newest still to do
     wf.resume(1)                                     # the unsaved result can be saved later
     assert wf.result is not None and not wf.result_saved
@@ -85,7 +90,7 @@ def test_a_saved_run_changed_afterwards_is_listed_again(workflow) -> None:
     wf.back()                                        # a step back: the saved result no longer stands
     wf.next()                                        # finished again: a new result, not saved
     wf.cancel()
-    assert [label for _, label in wf.resumable()] == ["1: XYZ 4-point, finished, not saved"]
+    assert [label.split(", started")[0] for _, label in wf.resumable()] == ["1: XYZ 4-point, result not saved"]
 
 
 class _T:

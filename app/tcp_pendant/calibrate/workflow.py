@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import Mapping, Sequence
+from datetime import datetime
 from dataclasses import dataclass, field, replace
 from typing import Any, ClassVar, Literal, Protocol
 
@@ -278,18 +279,22 @@ class CalibrationWorkflow:
 
     def resumable(self) -> list[tuple[int, str]]:
         """Cancelled runs still to be done, newest first: (index in ``runs``, label for the
-        "Left half-way" list). A finished run whose result was saved is done and not listed; a
-        finished one not saved is ("finished, not saved")."""
+        Resume list) naming the calibration, where it was left and when it started (the
+        server's local time): "3: XYZ 4-point, at step 2 of 4 (1 recorded), started 14:02". A
+        finished run whose result was saved is done and not listed; a finished one not saved is
+        "result not saved" (it is not half-way: only its Save is missing)."""
         out = []
         for i in range(len(self.runs) - 1, -1, -1):
             w = self.runs[i].wizard
             if w.status != "cancelled" or self._is_saved(i):
                 continue
+            started = _clock(w.started_at)
             if w.finished_result is not None:
-                out.append((i, f"{i + 1}: {w.title}, finished, not saved"))
+                out.append((i, f"{i + 1}: {w.title}, result not saved, started {started}"))
             else:
                 done = sum(1 for s in w.steps if s.recorded)
-                out.append((i, f"{i + 1}: {w.title}, {done} of {w.n_steps} recorded"))
+                out.append((i, f"{i + 1}: {w.title}, at step {w.step_index + 1} of {w.n_steps} "
+                               f"({done} recorded), started {started}"))
         return out
 
     # ------------------------------------------------------------ library
@@ -746,6 +751,14 @@ class CalibrationWorkflow:
             self._current = finished[-1]
             self.runs[self._current].wizard.resume()
         return checks
+
+
+def _clock(iso_utc: str) -> str:
+    """An ISO 8601 UTC time as the server's local HH:MM ("?" when unreadable)."""
+    try:
+        return datetime.fromisoformat(iso_utc.replace("Z", "+00:00")).astimezone().strftime("%H:%M")
+    except ValueError:
+        return "?"
 
 
 class _StartContext:

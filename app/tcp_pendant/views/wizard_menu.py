@@ -97,6 +97,7 @@ class CalibrateView:
         self._menu_mounted_key: str | None = None
         self._library: dict[int, Tool] = {}
         self._library_pick: tuple[str, int | None] | None = None   # (option, active slot then)
+        self._resume_runs: tuple[int, ...] = ()                    # the runs the Resume list offered
         gui = session.target.gui
         tools = self.workflow.tools
         self._physical = {t.label: key for key, t in tools.items()}
@@ -122,7 +123,8 @@ class CalibrateView:
             self.start_from_points = gui.add_button(
                 "Start from the recorded points", color="blue", visible=False,
                 hint="XYZ 4-point from the touches of the Jog tab's Record point: they become its first steps.")
-            self.resume_list = gui.add_dropdown("Left half-way", ("-",), visible=False)
+            self.resume_list = gui.add_dropdown("To resume", ("-",), visible=False,
+                                                hint="Calibrations you left: where, and when they started.")
             self.resume = gui.add_button("Resume", color="blue", visible=False)
         widgets = self.option_widgets
         self._slot_widgets = [widgets[n] for n, o in self._option_specs.items() if o.kind == "library_slot"]
@@ -152,6 +154,7 @@ class CalibrateView:
         self.start.on_click(act(self._on_start, sync=True))
         self.start_from_points.on_click(act(self._on_start_from_points, sync=True))
         self.resume.on_click(act(self._on_resume))
+        self.resume_list.on_update(act(lambda _e: None, user_only=True))   # the button names the pick
         self.export.on_click(act(self._on_export))
         self._loading_record = False
         self.load.on_upload(self._on_upload)
@@ -291,6 +294,9 @@ class CalibrateView:
         number = number_of_option(self.resume_list.value)
         if number is None:
             raise ValueError("There is no calibration to resume.")
+        if number - 1 not in {i for i, _ in self.workflow.resumable()}:
+            raise ValueError(f"Calibration {number} is not waiting to be resumed any more; choose one in "
+                             "'To resume'.")
         self.session.resume_wizard(number - 1)
 
     def _on_export(self, event: Any) -> None:
@@ -421,4 +427,15 @@ class CalibrateView:
         waiting = self.workflow.resumable()
         self.resume_list.visible = self.resume.visible = bool(waiting)
         if waiting:
-            set_options(self.resume_list, tuple(label for _, label in waiting))
+            runs = tuple(i for i, _ in waiting)
+            picked = number_of_option(self.resume_list.value)
+            # the user's pick (by run number) holds until another run is left: then the newest
+            keep = next((label for i, label in waiting if i + 1 == picked), None) \
+                if set(runs) <= set(self._resume_runs) else None
+            self._resume_runs = runs
+            set_options(self.resume_list, tuple(label for _, label in waiting), keep=keep or waiting[0][1])
+            number = number_of_option(self.resume_list.value)
+            chosen = next((label for i, label in waiting if number == i + 1), waiting[0][1])
+            label = f"Resume {chosen.split(', started')[0]}"      # names what the click brings back
+            if self.resume.label != label:
+                self.resume.label = label

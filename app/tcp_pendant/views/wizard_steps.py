@@ -217,7 +217,7 @@ class WizardStepsView:
         self.next.disabled = not wiz.can_next or self._checking
         self.next.label = "Finish" if wiz.on_last_step else "Next"
         self.back.disabled = not wiz.can_back
-        self.cancel.label = "Cancel" if stepping else ("Close" if wf.result_saved else "Close (resume later)")
+        self.cancel.label = "Cancel" if stepping else ("Close" if wf.result_saved else "Close (not saved)")
         self.add_point.visible = wiz.supports_add_point
         self.add_point.disabled = not wiz.can_add_point
         self.auto_folder.visible = wf.training and stepping and not by_controller
