@@ -35,7 +35,7 @@ import numpy as np
 from tcp_pendant.controller import T_flange_tool_m, ToolModel, VirtualController, builtin_tools
 from tcp_pendant.controller.errors import ControllerError
 from tcp_pendant.calibrate.autotouch import AutoTouchOutcome, auto_touch
-from tcp_pendant.calibrate.jobs import EXERCISE_REFUSAL, JOBS, ControllerJob
+from tcp_pendant.calibrate.jobs import EXERCISE_REFUSAL, JOBS, POSE_CHECKS, ControllerJob
 from tcp_pendant.calibrate.diversity import failure_in_words
 from tcp_pendant.calibrate.library_save import save_result
 from tcp_pendant.events import (
@@ -555,10 +555,12 @@ class CalibrationWorkflow:
         run_index = self._current
         self.note_mounted_tool()
         had_pose = set(w.recorded_poses) if w.status == "in_progress" else set()
+        job = type(w).controller_job
+        pose_check = POSE_CHECKS[job](self, w) if job in POSE_CHECKS else None
         out = auto_touch(w, self.controller, direction_deg=request.direction_deg,
                          sigma_mm=request.sigma_mm, rng=self.rng, tools=self.tools,
                          previous_direction_deg=None if run_index is None else self._auto_directions.get(run_index),
-                         mount=self.state.mount_tool)
+                         mount=self.state.mount_tool, pose_check=pose_check)
         self.note_mounted_tool()
         if out.ok:                            # the robot stands at the touch it recorded
             self._recorded(out.step_index, auto=True, had_pose=out.step_index in had_pose)
