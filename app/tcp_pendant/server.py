@@ -330,6 +330,7 @@ class PendantApp:
                               reference_tip_world_m=self.reference_tip_m)
         c.set_beam_device(self.beam_device)
         c.set_q(self.ready_q_rad)
+        c.set_rest_configuration(self.ready_q_rad)
         return c
 
     def make_session(self, client: Any | None, target: Any | None = None, *, shared: bool = False) -> Session:

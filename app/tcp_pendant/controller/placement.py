@@ -6,8 +6,9 @@ any other robot gets them computed from its model here:
 
 * **Reach test** (:func:`unreachable_directions`): a reference tip is reachable when the
   mounted tool's true TCP can be put on it from every direction of :data:`XYZ4_DIRECTIONS`
-  (tool X tilted 25-45 deg from straight down, eight azimuths: the spread of the XYZ 4-point's
-  auto-touch, ``calibrate.autotouch``), each an IK solution within the joint limits
+  (tool X tilted 35 deg from straight down at four azimuths and 20 deg at the four between: the
+  middle of the XYZ 4-point auto-touch's tilts, 20-50 deg at any azimuth, ``calibrate.autotouch``,
+  which draws again when one is out of reach), each an IK solution within the joint limits
   (``approach.solve_ik``), and the flange can hover pointing down ``READY_HOVER_M`` above it.
 * **Default tip** (:func:`reachable_reference_tip`): the first point of a grid in front of the
   robot (``+X`` of its root frame, ``y = 0``) that passes the reach test, tried nearest first to
@@ -60,8 +61,8 @@ LIMIT_MARGIN_RAD = math.radians(10.0)
 prismatic joint, or of a narrower range)."""
 
 XYZ4_DIRECTIONS: tuple[tuple[float, float], ...] = (
-    (45.0, 0.0), (45.0, 90.0), (45.0, 180.0), (45.0, 270.0),
-    (25.0, 45.0), (25.0, 135.0), (25.0, 225.0), (25.0, 315.0),
+    (35.0, 0.0), (35.0, 90.0), (35.0, 180.0), (35.0, 270.0),
+    (20.0, 45.0), (20.0, 135.0), (20.0, 225.0), (20.0, 315.0),
 )
 """(tilt, azimuth) in degrees of the reach test (``approach.approach_pose``, spin 0)."""
 
@@ -168,15 +169,18 @@ def best_hover_configuration(kinematics: RobotKinematics, tip_world_m: np.ndarra
 
 def unreachable_directions(kinematics: RobotKinematics, tip_world_m: np.ndarray,
                            T_flange_tool: np.ndarray, *, n_random_seeds: int = 24,
-                           stop_at_first: bool = False) -> TipReach:
+                           stop_at_first: bool = False, max_iterations: int = 150,
+                           order: tuple[tuple[float, float], ...] = XYZ4_DIRECTIONS) -> TipReach:
     """The reach test of the module doc for one tip (WORLD, m) with the tool ``T_flange_tool``
-    (its true TCP in FLANGE, (4,4) m)."""
+    (its true TCP in FLANGE, (4,4) m); ``stop_at_first``: stop at the first failure (a search),
+    trying the directions in ``order``."""
     tip = np.asarray(tip_world_m, dtype=float)
     q_home = np.asarray(kinematics.home_rad, dtype=float)
     q_mid = 0.5 * (kinematics.lower_rad + kinematics.upper_rad)   # HOME may be stretched out
     hover = None
     for yaw in (0.0, 90.0, 180.0, 270.0):
-        sol = solve_ik(kinematics, hover_pose(tip, yaw), q_mid, n_random_seeds=max(2, n_random_seeds // 4))
+        sol = solve_ik(kinematics, hover_pose(tip, yaw), q_mid, n_random_seeds=max(2, n_random_seeds // 4),
+                       max_iterations=max_iterations)
         if sol.ok:
             hover = np.asarray(sol.q_rad, dtype=float)
             break
@@ -184,9 +188,10 @@ def unreachable_directions(kinematics: RobotKinematics, tip_world_m: np.ndarray,
         return TipReach(False, (), None)
     seed = hover if hover is not None else q_home
     failed = []
-    for tilt, azimuth in XYZ4_DIRECTIONS:
+    for tilt, azimuth in order:
         T = approach_pose(tip, tilt_deg=tilt, azimuth_deg=azimuth)
-        sol = solve_ik(kinematics, T, seed, T_flange_tcp=T_flange_tool, n_random_seeds=n_random_seeds)
+        sol = solve_ik(kinematics, T, seed, T_flange_tcp=T_flange_tool, n_random_seeds=n_random_seeds,
+                       max_iterations=max_iterations)
         if not sol.ok:
             failed.append((tilt, azimuth))
             if stop_at_first:
@@ -207,14 +212,38 @@ def _candidates(kinematics: RobotKinematics) -> list[np.ndarray]:
     return sorted(unique.values(), key=lambda p: float(np.linalg.norm(p - target)))
 
 
+_TIP_MEMO: dict[tuple[str, str, bytes], np.ndarray] = {}
+"""Default tips already searched, by (URDF text, flange link, tool): a pendant started twice on
+one robot (tests, a restart in one process) does not search again."""
+
+
 def reachable_reference_tip(kinematics: RobotKinematics, T_flange_tool: np.ndarray) -> np.ndarray:
-    """The default tip of the module doc (WORLD, m); when no grid point passes, the one that
-    failed the fewest directions."""
-    best: tuple[int, np.ndarray] | None = None
+    """The default tip of the module doc (WORLD, m); when no grid point passes, the first whose
+    hover pose has a solution (the start then warns).
+
+    The search tries each point with few IK seeds and iterations and stops at its first failing
+    direction, the directions that failed most often so far first (a robot that cannot reach a
+    point from one side usually cannot reach its neighbours from it either)."""
+    key = (kinematics.description.urdf_xml, kinematics.flange_link,
+           np.asarray(T_flange_tool, dtype=float).tobytes())
+    if key in _TIP_MEMO:
+        return _TIP_MEMO[key].copy()
+    fails = {d: 0 for d in XYZ4_DIRECTIONS}
+    first_hover: np.ndarray | None = None
+    found: np.ndarray | None = None
     for p in _candidates(kinematics):
-        reach = unreachable_directions(kinematics, p, T_flange_tool, n_random_seeds=8, stop_at_first=True)
+        order = tuple(sorted(XYZ4_DIRECTIONS, key=lambda d: -fails[d]))
+        reach = unreachable_directions(kinematics, p, T_flange_tool, n_random_seeds=6, stop_at_first=True,
+                                       max_iterations=60, order=order)
         if reach.ok:
-            return p
-        if reach.hover_ok and best is None:
-            best = (len(reach.failed), p)
-    return best[1] if best is not None else _candidates(kinematics)[0]
+            found = p
+            break
+        for d in reach.failed:
+            fails[d] += 1
+        if reach.hover_ok and first_hover is None:
+            first_hover = p
+    tip = found if found is not None else first_hover if first_hover is not None else _candidates(kinematics)[0]
+    if len(_TIP_MEMO) > 8:
+        _TIP_MEMO.clear()
+    _TIP_MEMO[key] = tip
+    return tip.copy()
