@@ -241,7 +241,9 @@ def tip_reach_warning(kinematics: RobotKinematics, tip_world_m: np.ndarray, T_fl
                       robot_label: str, tool_label: str) -> str | None:
     """The start warning for a ``--reference-tip`` the mounted tool cannot reach from the XYZ
     4-point's directions (``placement.unreachable_directions``), or None when it can."""
-    reach = unreachable_directions(kinematics, tip_world_m, T_flange_tool)
+    # a few seeds per direction (the hover pose's and home first): the start stays within about
+    # a second when the tip is far out of reach
+    reach = unreachable_directions(kinematics, tip_world_m, T_flange_tool, n_random_seeds=8, max_iterations=100)
     if reach.ok:
         return None
     tip = ", ".join(f"{v:.0f}" for v in np.asarray(tip_world_m) * 1000.0)
