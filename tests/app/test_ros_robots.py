@@ -5,9 +5,11 @@ missing is still drawn and says so; a reference tip out of reach is said at star
 
 from __future__ import annotations
 
+import re
 import signal
 import subprocess
 import sys
+import urllib.request
 from pathlib import Path
 
 import numpy as np
@@ -169,14 +171,20 @@ def test_command_prints_a_warning_line_for_each_missing_mesh(tmp_path) -> None:
                              "--package-path", str(tmp_path / "src"), "--reference-tip", "1768,0,320"],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     assert proc.stdout is not None
+    seen = []
     try:
         for line in proc.stdout:
-            if "ready" in line:
+            seen.append(line)
+            if line.startswith("TCP Pendant ready"):
                 break
+        url = re.search(r"http://\S+", seen[-1])
+        assert url is not None, seen
+        with urllib.request.urlopen(url.group(0), timeout=10) as r:   # serving (Ctrl-C now stops it)
+            assert r.status == 200
     finally:
         proc.send_signal(signal.SIGINT)
         out, err = proc.communicate(timeout=60)
     lines = [line for line in err.splitlines() if line.startswith("WARNING: ")]
     assert len([x for x in lines if x.startswith("WARNING: robot mesh not found: package://kuka_kr16_support/")]) == 7
     assert any(x.startswith("WARNING: the reference tip (1768, 0, 320) mm is out of reach") for x in lines)
-    assert proc.returncode == 0, err
+    assert proc.returncode == 0, (seen, out, err)

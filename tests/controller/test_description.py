@@ -183,3 +183,18 @@ def test_builtin_descriptions_are_unchanged_by_loading(tmp_path: Path) -> None:
                                    atol=1e-15)
         assert kin.known_home and not kin.description.missing_meshes
         assert math.isclose(float(np.abs(kin.lower_rad - model.lowerPositionLimit).max()), 0.0)
+
+
+def test_pinocchio_errors_reach_the_user_in_urdf_words() -> None:
+    """pinocchio's own text (here its refusal of a continuous joint mimicking a revolute one, as
+    pinocchio 4.1 words it) loses the C++ location and its joint model names."""
+    from tcp_pendant.controller.kinematics import _pinocchio_words
+
+    text = ("From file: /project/include/pinocchio/src/multibody/joint/joint-mimic.hxx\n"
+            "in function: pinocchio::JointModelMimicTpl<Scalar, Options, JointCollectionTpl>::JointModelMimicTpl("
+            "...) [with JointModelMimicking = pinocchio::JointModelRevoluteUnboundedTpl<double, 0, 1>]\n"
+            "at line: 589\nmessage:\nwrong argument size: expected 1, got 2\n"
+            "hint: Mimicking and mimicked configuration spaces have different sizes\n")
+    assert _pinocchio_words(text) == ("wrong argument size: expected 1, got 2 (Mimicking and mimicked "
+                                      "configuration spaces have different sizes)")
+    assert _pinocchio_words("a JointModelRUBY and a JointModelPZ") == "a continuous joint and a prismatic joint"

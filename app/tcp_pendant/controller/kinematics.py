@@ -108,6 +108,28 @@ _JOINT_WORDS = {
 """pinocchio's joint model names in the URDF's words (messages never show pinocchio's names)."""
 
 
+def _pinocchio_words(text: str) -> str:
+    """pinocchio's error text for the user: its ``message:`` and ``hint:`` lines (not the C++
+    location), joint model names in the URDF's words."""
+    flat = " ".join(text.split())
+    m = re.search(r"message:\s*(.*?)(?:\s*hint:\s*(.*))?$", flat)
+    out = flat if m is None else m.group(1) + (f" ({m.group(2)})" if m.group(2) else "")
+
+    def word(m: re.Match[str]) -> str:
+        name = m.group(0)
+        if "RUBY" in name or "RevoluteUnbounded" in name:
+            return "continuous joint"
+        if re.search(r"Prismatic|JointModelP[XYZ]", name):
+            return "prismatic joint"
+        if re.search(r"Revolute|JointModelR[XYZ]", name):
+            return "revolute joint"
+        if "Mimic" in name:
+            return "mimic joint"
+        return _JOINT_WORDS.get(name, "joint") + (" joint" if name in _JOINT_WORDS else "")
+
+    return re.sub(r"(pinocchio::)?JointModel\w*", word, out)
+
+
 def _is_mimic(joint: pin.JointModel) -> bool:
     return bool(joint.shortname() == "JointModelMimic")
 
@@ -225,7 +247,7 @@ class RobotKinematics:
         try:
             model = pin.buildModelFromXML(description.urdf_xml, mimic=True)
         except Exception as exc:  # pinocchio raises RuntimeError/ValueError with its own text
-            raise ControllerError(f"pinocchio cannot load {path}: {exc}") from exc
+            raise ControllerError(f"pinocchio cannot load {path}: {_pinocchio_words(str(exc))}") from exc
         if model.nq == 0:
             raise ControllerError(f"The URDF {path.name} has no movable joint.")
         is_child = {c for cs in children.values() for c in cs}

@@ -13,6 +13,7 @@ no geometry at all is drawn as link shapes.
 from __future__ import annotations
 
 import io
+import threading
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from functools import lru_cache
@@ -112,15 +113,35 @@ def link_shapes(description: RobotDescription, link: str) -> tuple[MeshPart, ...
     return tuple(out)
 
 
-@lru_cache(maxsize=16)
+_LINK_MESHES: dict[tuple[str, str], dict[str, tuple[MeshPart, ...]]] = {}
+_LINK_MESHES_LOCK = threading.Lock()
+
+
 def link_meshes(source: Path | RobotDescription) -> dict[str, tuple[MeshPart, ...]]:
     """Meshes by link name, each in its link's frame (metres): the visual geometry, or what
     stands in for a missing mesh (module doc).
+
+    Kept (the last 16) by the description's resolved URDF text: pendants started one after the
+    other on one robot share them; a mesh found since is a new text, so it is loaded.
 
     Args:
         source: the robot's description (``RobotKinematics.description``), or a URDF file.
     """
     description = source if isinstance(source, RobotDescription) else load_description(Path(source))
+    key = (description.urdf_xml, str(description.source.parent))
+    with _LINK_MESHES_LOCK:
+        hit = _LINK_MESHES.get(key)
+    if hit is not None:
+        return hit
+    out = _link_meshes(description)
+    with _LINK_MESHES_LOCK:
+        if len(_LINK_MESHES) >= 16:
+            _LINK_MESHES.pop(next(iter(_LINK_MESHES)))
+        _LINK_MESHES[key] = out
+    return out
+
+
+def _link_meshes(description: RobotDescription) -> dict[str, tuple[MeshPart, ...]]:
     plan = {link: description.drawing(link) for link in description.links}
     need_collision = any(how != "visual" for how in plan.values())
     try:
