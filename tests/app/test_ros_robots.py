@@ -62,7 +62,7 @@ def notifications(client: RecordingClient) -> list[tuple[str, str]]:
 def test_seven_axis_xacro_starts_draws_jogs_and_auto_touch_finds_the_tcp(app_factory, tmp_path, monkeypatch) -> None:
     ws = acme7_workspace(tmp_path / "robot")
     monkeypatch.setenv("ROS_PACKAGE_PATH", str(ws.ros_package_path))       # acme_description
-    app = app_factory(robot=str(ws.xacro), package_paths=(ws.package_path,))  # acme_meshes
+    app = app_factory(robot=str(ws.xacro), package_paths=(ws.package_path,), seed=3)  # acme_meshes
     assert app.warnings == [] and app.robot_label == "acme7"
     kin = app.kinematics
     assert kin.n_joints == 7 and ACME7_MIMIC[0] in kin.mimic_joints
@@ -98,16 +98,15 @@ def test_seven_axis_xacro_starts_draws_jogs_and_auto_touch_finds_the_tcp(app_fac
             state = s.pose_state()
             R = state.T_world_link["acme_link_1"][:3, :3].T @ state.T_world_link["acme_link_guide"][:3, :3]
             np.testing.assert_allclose(R, Rotation.from_euler("y", -0.5 * c.q_rad[1] + 0.1).as_matrix(), atol=1e-9)
-        # Auto-touch XYZ 4-point through the Calibrate tab's workflow: the pointer's true TCP
-        wf = s.views["calibrate"].workflow
-        wf.rng = np.random.default_rng(3)
+        # Auto-touch XYZ 4-point by the session's commands: the pointer's true TCP
         with s.lock:
-            wf.start_xyz4()
+            s.start_wizard("xyz4")
             for _ in range(4):
-                out = wf.auto_touch(AutoTouchRequest())
+                out = s.auto_touch(AutoTouchRequest())
                 assert out.ok, out.message
         true_tcp = builtin_tools()["pointer"].T_flange_tool_true[:3, 3] * 1000.0
-        np.testing.assert_allclose(wf.result.tcp_mm, true_tcp, atol=1e-6)
+        np.testing.assert_allclose(s.workflow.result.tcp_mm, true_tcp, atol=1e-6)
+        assert s.workflow.export_record()["robot"]["name"] == "acme7"
     finally:
         client.close()
 
