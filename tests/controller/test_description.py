@@ -198,3 +198,17 @@ def test_pinocchio_errors_reach_the_user_in_urdf_words() -> None:
     assert _pinocchio_words(text) == ("wrong argument size: expected 1, got 2 (Mimicking and mimicked "
                                       "configuration spaces have different sizes)")
     assert _pinocchio_words("a JointModelRUBY and a JointModelPZ") == "a continuous joint and a prismatic joint"
+
+
+def test_find_in_a_plain_urdf_mesh_filename(acme, tmp_path: Path) -> None:
+    """A URDF (not xacro) that kept ``$(find pkg)/...`` in a mesh filename, as some exported
+    descriptions do, finds the file through the same package path."""
+    urdf = tmp_path / "plain.urdf"
+    urdf.write_text("""<robot name="plain"><link name="a"><visual><geometry>
+      <mesh filename="$(find acme_meshes)/meshes/acme7/visual/link_0.stl"/></geometry></visual></link>
+      <link name="b"/><joint name="j" type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/>
+      <limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>""")
+    (mesh,) = load_description(urdf, [acme.package_path]).meshes
+    assert mesh.path == acme.meshes["acme_link_0"].resolve()
+    (mesh,) = load_description(urdf).meshes                     # without the path: said, not found
+    assert mesh.path is None and "no ROS package 'acme_meshes' was found" in mesh.reason
