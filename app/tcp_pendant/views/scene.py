@@ -286,9 +286,9 @@ class SceneView:
         scene.add_frame("/world", axes_length=0.25, axes_radius=0.006)
         scene.add_label("/world/label", "WORLD", position=(0.0, 0.0, -0.04))
 
-        meshes = link_meshes(k.urdf_path)
+        meshes = link_meshes(k.description)
         state = session.pose_state()
-        tree = link_tree_paths(k.urdf_path, state.link_names)
+        tree = link_tree_paths(k.description, state.link_names)
         self.link_paths: dict[str, str] = {name: path for name, (path, _) in tree.items()}
         self.link_frames: dict[str, Any] = {}
         self._parent = {name: parent for name, (_, parent) in tree.items()}
