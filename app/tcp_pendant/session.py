@@ -736,6 +736,12 @@ class Session:
         with self._wizard_command(moves=True):
             return self.workflow.give_controller_job(job, outcome)
 
+    def restore_runs(self, runs: Any) -> list[int]:
+        """The calibrations this trainee had in progress before a restart, back on screen
+        (``CalibrationWorkflow.restore``); one ``wizard`` signal."""
+        with self._wizard_command(moves=True):
+            return self.workflow.restore(runs)
+
     def load_record(self, loaded: Any) -> Any:
         """A session record read and replayed off the loop (``session_record.load_and_replay``)
         added to the runs; returns its replay checks."""

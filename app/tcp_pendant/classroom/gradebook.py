@@ -82,6 +82,17 @@ _STATUS = ("in_progress", "finished", "cancelled")
 _MAX_TEXT = 200          # method, tool key, exercise id, mode, crash note: short labels
 
 
+_RUN_STATES = """CREATE TABLE IF NOT EXISTS run_states (
+    calibration_id INTEGER PRIMARY KEY REFERENCES calibrations(id),
+    entry_json TEXT NOT NULL,
+    updated_at TEXT NOT NULL)"""
+"""What a restart gives back: each calibration's wizard as it was last acknowledged (a session
+record entry without truth, ``session_record.run_entry``). Added to every file when it is
+opened; a TCP Pendant that does not know it ignores it, so it needs no schema version."""
+MAX_RUN_STATE_BYTES = 200_000
+"""A wizard's stored state is refused above this (20 poses with joints take ~12 kB)."""
+
+
 class GradebookError(Exception):
     """The gradebook cannot be opened or a call is refused; the message names the file or the
     value and says what to do."""
@@ -431,6 +442,12 @@ class Gradebook:
         if str(mode).lower() != "wal":
             raise GradebookError(f"Gradebook {self.path}: SQLite refused WAL mode (got {mode!r}); put the "
                                  "file on a local disk (WAL needs shared memory, network folders lack it).")
+        try:                                         # additive: an older reader ignores the table
+            with self._transaction():
+                db.execute(_RUN_STATES)
+        except sqlite3.Error as exc:
+            raise GradebookError(f"Cannot write the gradebook {self.path}: {exc}; check that its folder "
+                                 "is writable and the disk is not full.") from exc
 
     # -- plumbing ---------------------------------------------------------------------
 
@@ -712,6 +729,61 @@ class Gradebook:
         with self._read() as db:
             cid = self._calibration(db, calibration_id)[0]
             return json.loads(db.execute("SELECT truth_json FROM calibrations WHERE id = ?", (cid,)).fetchone()[0])
+
+    # -- what a restart gives back ------------------------------------------------------
+
+    def save_run_state(self, calibration_id: int, entry: Mapping[str, Any]) -> None:
+        """Keep the wizard of calibration ``calibration_id`` as it is now (a session record
+        entry, ``session_record.run_entry``, JSON-ready, without truth); replaces the last.
+
+        Raises:
+            GradebookError: no such calibration, not JSON, or above :data:`MAX_RUN_STATE_BYTES`.
+        """
+        try:
+            text = json.dumps(entry, sort_keys=True, allow_nan=False)
+        except (TypeError, ValueError) as exc:
+            raise GradebookError(f"A wizard's state must be plain JSON: {exc}.") from exc
+        if len(text) > MAX_RUN_STATE_BYTES:
+            raise GradebookError(f"A wizard's state of {len(text):,} bytes is above {MAX_RUN_STATE_BYTES:,}.")
+        with self._write() as db:
+            cid = self._calibration(db, calibration_id)[0]
+            db.execute("INSERT INTO run_states (calibration_id, entry_json, updated_at) VALUES (?, ?, ?) "
+                       "ON CONFLICT(calibration_id) DO UPDATE SET entry_json = excluded.entry_json, "
+                       "updated_at = excluded.updated_at", (cid, text, _now()))
+
+    def open_runs(self, trainee: str) -> list[dict[str, Any]]:
+        """The calibrations of ``trainee`` still in progress that have a stored wizard, oldest
+        first: ``{"calibration_id", "method", "tool_key", "exercise_id", "truth", "entry",
+        "touch_ids"}`` (``touch_ids``: step -> the id of its touch that counts, to link the next
+        overwrite); for a restart to give them back."""
+        with self._read() as db:
+            rows = db.execute(
+                "SELECT c.id, c.method, c.tool_key, c.exercise_id, c.truth_json, r.entry_json FROM calibrations c "
+                "JOIN sessions s ON s.id = c.session_id JOIN trainees t ON t.id = s.trainee_id "
+                "JOIN run_states r ON r.calibration_id = c.id "
+                "WHERE t.name = ? AND c.status = 'in_progress' ORDER BY c.started_at, c.id", (str(trainee),)).fetchall()
+            out = []
+            for cid, method, tool, exercise, truth, entry in rows:
+                touch_ids = {int(step): int(tid) for tid, step in db.execute(
+                    "SELECT id, step_index FROM touches WHERE calibration_id = ? AND overwritten_by_touch_id IS NULL",
+                    (cid,))}
+                out.append({"calibration_id": cid, "method": method, "tool_key": tool, "exercise_id": exercise,
+                            "truth": json.loads(truth), "entry": json.loads(entry), "touch_ids": touch_ids})
+        return out
+
+    def class_setting(self, key: str) -> Any:
+        """A class setting kept across restarts (``set_class_setting``), None when never set."""
+        with self._read() as db:
+            row = db.execute("SELECT value FROM meta WHERE key = ?", (f"class:{key}",)).fetchone()
+        return None if row is None else json.loads(row[0])
+
+    def set_class_setting(self, key: str, value: Any) -> None:
+        """Keep a class setting (JSON-ready; the pushed exercise, the distance-aid lock, the
+        trainer token's hash) across restarts of the server."""
+        text = json.dumps(value, sort_keys=True, allow_nan=False)
+        with self._write() as db:
+            db.execute("INSERT INTO meta (key, value) VALUES (?, ?) ON CONFLICT(key) DO UPDATE SET value = "
+                       "excluded.value", (f"class:{_label(key, 'setting name')}", text))
 
     def grades(self, *, include_in_progress: bool = False) -> list[GradeRow]:
         """One row per finished calibration, oldest start first; with ``include_in_progress``

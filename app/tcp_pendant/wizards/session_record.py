@@ -217,6 +217,20 @@ def _run_dict(run: WizardRun | Wizard, honest: bool = False, record_id: int | No
     return out
 
 
+def run_entry(run: WizardRun, *, honest: bool = True, record_id: int | None = None) -> dict[str, Any]:
+    """One wizard run as a session record's entry (``"state"``, ``"result"``, ``"true_tool"``,
+    ``"truth"``, ``"record_id"``, and ``"joints_deg"`` / ``"distance_mm"`` of its recorded
+    steps); ``honest``: no truth in it (the classroom keeps the truth apart, in the gradebook).
+    The gradebook stores it for each calibration in progress, so a restart gives it back."""
+    return _run_dict(run, honest, record_id)
+
+
+def step_joints(entry: Mapping[str, Any]) -> dict[int, tuple[float, ...]]:
+    """A checked record entry's ``"joints_deg"`` by 0-based step index ({} when absent)."""
+    raw = entry.get("joints_deg") or {}
+    return {int(k): tuple(float(v) for v in q) for k, q in raw.items()}
+
+
 def step_distances(entry: Mapping[str, Any]) -> dict[int, float]:
     """A checked record entry's ``"distance_mm"`` by 0-based step index ({} when absent)."""
     raw = entry.get("distance_mm") or {}
