@@ -54,7 +54,7 @@ METHOD_TITLES: dict[str, str] = {
 }
 
 
-def _finite_or_none(x: float) -> float | None:
+def _finite_or_none(x: float | np.floating) -> float | None:
     x = float(x)
     return x if math.isfinite(x) else None
 
@@ -627,7 +627,8 @@ def format_tcp_zx_report(result: TcpZxResult, poses: FlangePoses | None = None, 
 
 def _unit3(v: Sequence[float]) -> list[float]:
     a = np.asarray(v, dtype=float)
-    return (a / float(np.linalg.norm(a))).tolist()
+    unit: list[float] = (a / float(np.linalg.norm(a))).tolist()
+    return unit
 
 
 def beam_result_to_dict(result: BeamResult, *, beam_point_mm: Sequence[float],

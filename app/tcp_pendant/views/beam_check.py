@@ -37,6 +37,7 @@ from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.beam_replay import ScanPlayer, beam_view_direction, scan_spheres
 from tcp_pendant.views.framing import Framing
 from tcp_pendant.views.scene import frame_cameras
+from tcp_pendant.views.gui_util import target_of
 from tcpcal.tool import Tool
 
 __all__ = ["BeamCheckView", "update_markdown"]
@@ -67,7 +68,7 @@ class BeamCheckView:
 
     def __init__(self, session: Session) -> None:
         self.session = session
-        gui = session.target.gui
+        gui = target_of(session).gui
         with gui.add_folder("TCP service (beam sensor)"):
             self.intro_md = gui.add_markdown(INTRO)
             self.check = gui.add_button("Check with beam", color="blue",

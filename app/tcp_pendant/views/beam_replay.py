@@ -34,6 +34,7 @@ import numpy as np
 
 from tcp_pendant.session import Session
 from tcp_pendant.views.beam_stand import BROKEN_RGB
+from tcp_pendant.views.gui_util import target_of
 
 __all__ = ["BROKEN_RGB", "ReplayFrame", "ScanPlayer", "beam_view_direction", "event_points_world", "replay_frames",
            "scan_spheres"]
@@ -224,7 +225,7 @@ class ScanPlayer:
 
     def __init__(self, session: Session) -> None:
         self.session = session
-        scene = session.target.scene
+        scene = target_of(session).scene
         self.scene = scene
         self.break_point = scene.add_icosphere(f"{self.ROOT}/break_point", radius=0.005, color=BROKEN_RGB,
                                                visible=False, cast_shadow=False, receive_shadow=False)

@@ -26,6 +26,7 @@ from typing import Any
 
 from tcp_pendant.session import Session
 from tcp_pendant.text_escape import escape_markdown
+from tcp_pendant.views.gui_util import target_of
 
 __all__ = ["WIZARD_MODULE", "build_calibrate_tab", "register_calibrate_view"]
 
@@ -60,12 +61,12 @@ def build_calibrate_tab(session: Session, tab: Any) -> None:
     with tab:
         factories = _factories()
         if not factories:
-            session.target.gui.add_markdown("*Calibration wizards are not installed in this build.*")
+            target_of(session).gui.add_markdown("*Calibration wizards are not installed in this build.*")
             return
         for fn in factories:
             try:
                 session.views.setdefault("calibrate", fn(session))
             except Exception as exc:
                 log.exception("calibrate view %s failed", fn)
-                session.target.gui.add_markdown(
+                target_of(session).gui.add_markdown(
                     f"⚠ The calibration view could not be built: {escape_markdown(str(exc))}")

@@ -2,9 +2,38 @@
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any, Protocol, TypeVar
 
-__all__ = ["number_of_option", "set_content", "set_options", "slot_option"]
+if TYPE_CHECKING:
+    from tcp_pendant.session import GuiTarget, Session
+
+__all__ = ["number_of_option", "set_content", "set_options", "set_value", "slot_option", "target_of"]
+
+_T = TypeVar("_T")
+_T_co = TypeVar("_T_co", covariant=True)
+
+
+class _Input(Protocol[_T_co]):
+    """A viser input handle (slider, dropdown, text, checkbox, progress bar...)."""
+
+    @property
+    def value(self) -> _T_co: ...
+
+
+def set_value(handle: _Input[_T], value: _T) -> None:
+    """``handle.value = value``: viser's input handles define the ``value`` setter apart from
+    its getter, which mypy reads as a read-only property; the assignment is viser's documented
+    way to set an input (and sends it to the browser)."""
+    handle.value = value  # type: ignore[misc]  # viser's setter is not next to its getter
+
+
+def target_of(session: Session) -> GuiTarget:
+    """Where ``session``'s views draw (``session.target``): None only for a session made
+    without a browser (it has no views) or after it closed."""
+    target = session.target
+    if target is None:
+        raise RuntimeError("this session has no browser to draw in (none given, or it was closed)")
+    return target
 
 
 def set_content(handle: Any, text: str) -> None:

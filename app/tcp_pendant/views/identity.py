@@ -26,6 +26,7 @@ from typing import Any
 from tcp_pendant.classroom.names import TraineeNameError, validate_trainee_name
 from tcp_pendant.session import Session
 from tcp_pendant.text_escape import escape_markdown
+from tcp_pendant.views.gui_util import set_value, target_of
 
 __all__ = ["IdentityPrompt", "NAME_LABEL", "TOKEN_LABEL"]
 
@@ -53,7 +54,7 @@ class IdentityPrompt:
         self.name: str | None = None
         self._on_name = on_name
         self._on_token = on_token
-        gui = session.target.gui
+        gui = target_of(session).gui
         self.modal = gui.add_modal("Welcome to the TCP Pendant")
         with self.modal:
             gui.add_markdown("Type the name your trainer should see in the class list "
@@ -83,7 +84,7 @@ class IdentityPrompt:
 
     def _trainer(self, _event: Any = None) -> None:
         token = str(self.token_field.value)[:_MAX_TOKEN_CHARS]
-        self.token_field.value = ""
+        set_value(self.token_field, "")
         if not self._on_token(token):
             self.message.content = "⚠ That trainer token is not right; type the token the server printed."
             return

@@ -46,6 +46,7 @@ from tcp_pendant.pendant.hold import HoldDriver
 from tcp_pendant.pendant.guidance import CLOSEUP_WITHIN_MM, offset_markdown, side_view_markdown, tip_offset_mm
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.views.scene import closeup_camera, overview_camera
+from tcp_pendant.views.gui_util import set_value, target_of
 
 try:                                   # viser's message type (hot path); public setter if absent
     from viser._messages import GuiUpdateMessage
@@ -120,7 +121,7 @@ class PendantPanel:
 
     def __init__(self, session: Session) -> None:
         self.session = session
-        gui = session.target.gui
+        gui = target_of(session).gui
         c = session.controller
         k = c.kinematics
         self._from_client: dict[int, float] = {}   # slider -> angle (deg, 0.01) its browser value set
@@ -406,7 +407,7 @@ class PendantPanel:
         self._set_md(self.tcp_md, "tcp", tcp_readout_markdown(state.readout(frame), None if tool is None else tool.name))
         hide = s.hide_distance
         if bool(self.hide_distance.value) != hide:
-            self.hide_distance.value = hide
+            set_value(self.hide_distance, hide)
         touch = touch_indicator_markdown(state.touch, hide_distance=hide)
         closeup = ""
         if not hide:

@@ -30,6 +30,7 @@ from tcp_pendant.calibrate import error_bars
 from tcp_pendant.controller.readout import PoseReadout
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.text_escape import escape_html, escape_markdown
+from tcp_pendant.views.gui_util import target_of
 
 __all__ = [
     "CHART_HEIGHT_PX",
@@ -132,7 +133,7 @@ class PresenterView:
 
     def __init__(self, session: Session, *, on: bool = False) -> None:
         self.session = session
-        gui = session.target.gui
+        gui = target_of(session).gui
         self.toggle = gui.add_checkbox("Presenter mode", bool(on), order=-950.0,
                                        hint="Large readout, step list and error chart for a projector.")
         self.folder = gui.add_folder("Presenter", order=-949.0, visible=bool(on))
@@ -167,7 +168,7 @@ class PresenterView:
         self.render()
 
     def _apply_width(self, on: bool) -> None:
-        gui = self.session.target.gui
+        gui = target_of(self.session).gui
         self.panel_width_px = PRESENTER_WIDTH_PX if on else NORMAL_WIDTH_PX
         gui.configure_theme(control_width="medium" if on else "large", **_THEME)
         panel = getattr(gui, "main_panel", None)

@@ -53,6 +53,7 @@ from tcp_pendant.views.beam_replay import ScanPlayer
 from tcp_pendant.views.beam_stand import BeamStandNodes
 from tcp_pendant.views.framing import Framing, frame_spheres
 from tcp_pendant.views.meshes import MeshPart, link_meshes, rigid_meshes
+from tcp_pendant.views.gui_util import target_of
 
 __all__ = ["POSE_EPS", "PoseSender", "SceneView", "camera_shape", "closeup_camera", "frame_cameras",
            "link_tree_paths", "overview_camera", "overview_pose", "relative_poses", "wxyz_xyz"]
@@ -268,7 +269,7 @@ class SceneView:
     def __init__(self, session: Session) -> None:
         self.session = session
         c = session.controller
-        scene = session.target.scene
+        scene = target_of(session).scene
         self.scene = scene
         k = c.kinematics
         self.flange_link = k.flange_link

@@ -37,7 +37,7 @@ from tcp_pendant.pendant.tool_entry import entry_preview_markdown
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.controller.spin import DEFAULT_SPIN_ANGLE_DEG, MAX_SPIN_ANGLE_DEG
-from tcp_pendant.views.gui_util import number_of_option, set_options, slot_option
+from tcp_pendant.views.gui_util import number_of_option, set_options, set_value, slot_option, target_of
 from tcp_pendant.views.tool_check import CheckJob, check_job, check_markdown
 from tcpcal.controllers import CONTROLLER_FORMATS, export_tool_file
 from tcpcal.errors import TcpcalError
@@ -76,7 +76,7 @@ class ToolPanel:
 
     def __init__(self, session: Session) -> None:
         self.session = session
-        gui = session.target.gui
+        gui = target_of(session).gui
         c = session.controller
         self._tools = builtin_tools()
         self._tool_key_by_label = {t.label: key for key, t in self._tools.items()}
@@ -185,7 +185,7 @@ class ToolPanel:
         self.slots.options = options
         pick = next((o for o in options if number_of_option(o) == current), options[0])
         if self.slots.value != pick:
-            self.slots.value = pick
+            set_value(self.slots, pick)
         free = [str(n) for n in range(1, s.library.N_SLOTS + 1) if n not in lib]
         set_options(self.entry_slot, ("first free", *free))
         self._show_slot()
@@ -216,7 +216,7 @@ class ToolPanel:
     def _show_mounted(self) -> None:
         label = self.session.controller.mounted_tool.label
         if label in self._tool_key_by_label and self.mounted.value != label:
-            self.mounted.value = label              # its own handler then sees no change
+            set_value(self.mounted, label)              # its own handler then sees no change
 
     def _show_active(self) -> None:
         self.active_md.content = tool_data_markdown(self.session.controller.active_tool, self.session.active_slot)
@@ -247,7 +247,7 @@ class ToolPanel:
         if s.client is not None:
             # a courtesy, per browser only: in --shared mode the box is every browser's, and
             # another trainee may be typing in it
-            self.new_name.value = ""
+            set_value(self.new_name, "")
         with s.batch():
             s.reload_library()
             renamed = s.library_tools.get(slot)
@@ -268,7 +268,7 @@ class ToolPanel:
             raise ValueError(f"Unknown export format {label!r}.")
         number = text_format(fmt).slot_for(slot)  # the controller's tool numbers, else its default
         kw = {} if number is None else {"slot": number}
-        self.export_text.value = export_tool(tool, fmt, **kw)
+        set_value(self.export_text, export_tool(tool, fmt, **kw))
 
     def _on_download(self, event: Any) -> None:
         slot, tool = self._selected()
@@ -278,7 +278,7 @@ class ToolPanel:
             self.session.notify(CONTROLLER_FILE_REFUSED, str(exc), kind="warning")
             return
         # to the browser that clicked (in --shared mode the session is every browser's)
-        target = getattr(event, "client", None) or self.session.client or self.session.target
+        target = getattr(event, "client", None) or self.session.client or target_of(self.session)
         target.send_file_download(filename, text.encode("utf-8"), save_immediately=True)
 
     # ------------------------------------------------------------ TCP check
@@ -358,7 +358,7 @@ class ToolPanel:
         lib.save(slot, res.tool)
         self.entry_md.content = f"✔ Saved **{escape_markdown(res.tool.name)}** in slot {slot}."
         self.session.reload_library()
-        self.slots.value = slot_option(slot, res.tool.name)
+        set_value(self.slots, slot_option(slot, res.tool.name))
         self._show_slot()
 
     def _show_entry_errors(self, errors: dict[str, str]) -> None:

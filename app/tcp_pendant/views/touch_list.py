@@ -12,6 +12,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from tcp_pendant.session import Session, SessionChange, Touch
+from tcp_pendant.views.gui_util import target_of
 
 __all__ = ["TOUCHES_FILENAME", "TouchListView", "touches_csv_text"]
 
@@ -46,7 +47,7 @@ class TouchListView:
 
     def __init__(self, session: Session) -> None:
         self.session = session
-        gui = session.target.gui
+        gui = target_of(session).gui
         self.record = gui.add_button("Record point", color="green", icon=None,
                                      hint="Store the current flange pose as a touch; key R.")
         self.folder = gui.add_folder("Touches")
@@ -75,7 +76,7 @@ class TouchListView:
     def _on_export_csv(self, event: Any) -> None:
         data = touches_csv_text(self.session.touches).encode("utf-8")
         # to the browser that clicked (in --shared mode the session is every browser's)
-        target = getattr(event, "client", None) or self.session.client or self.session.target
+        target = getattr(event, "client", None) or self.session.client or target_of(self.session)
         target.send_file_download(TOUCHES_FILENAME, data, save_immediately=True)
 
     def _delete_cb(self, index: int, label: str) -> Any:
@@ -88,7 +89,7 @@ class TouchListView:
 
     def rebuild(self) -> None:
         """Redraw the rows: one markdown line and one "Delete Pn" button per touch."""
-        gui = self.session.target.gui
+        gui = target_of(self.session).gui
         for h in self._rows:
             h.remove()
         self._rows = []

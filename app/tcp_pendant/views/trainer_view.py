@@ -22,6 +22,7 @@ from tcp_pendant.session import Session
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.upload_guard import limit_upload_size
 from tcp_pendant.wizards.session_record import MAX_RECORD_BYTES, SessionRecordError, check_record_size, load_and_replay
+from tcp_pendant.views.gui_util import target_of
 
 log = logging.getLogger(__name__)
 _GRADE_WORKER = ThreadPoolExecutor(max_workers=1, thread_name_prefix="record-grading")
@@ -110,7 +111,7 @@ class TrainerView:
     def __init__(self, session: Session, control: ClassControl) -> None:
         self.session = session
         self.control = control
-        gui = session.target.gui
+        gui = target_of(session).gui
         self.folder = gui.add_folder("Trainer view", order=-900.0)
         with self.folder:
             gui.add_markdown("**Trainees**")

@@ -29,7 +29,7 @@ from tcp_pendant.calibrate.text import meter_level, step_markdown
 from tcp_pendant.pendant.guidance import direction_words, tip_offset_mm
 from tcp_pendant.pendant.record_check import RecordCheck
 from tcp_pendant.session import Session, SessionChange
-from tcp_pendant.views.gui_util import set_content
+from tcp_pendant.views.gui_util import set_content, set_value, target_of
 
 __all__ = ["BACK", "CANCEL", "CLOSE", "FINISH", "NEXT", "WizardDock"]
 
@@ -44,7 +44,7 @@ class WizardDock:
         self.check = RecordCheck() if check is None else check
         self._note = ""                       # the last click's line, for this run and step only
         self._note_at: tuple[int, int, int] | None = None
-        gui = session.target.gui
+        gui = target_of(session).gui
         self.folder = gui.add_folder("Calibration step", visible=False)
         with self.folder:
             self.step_md = gui.add_markdown("")
@@ -177,7 +177,7 @@ class WizardDock:
             return
         gain = wiz.preview(self.session.controller.T_world_flange())
         value, color = meter_level(gain)
-        self.meter_bar.value = round(value, 1)
+        set_value(self.meter_bar, round(value, 1))
         self.meter_bar.color = color
         angle = gain.angle_to_nearest_deg
         if math.isinf(angle):

@@ -53,6 +53,7 @@ from tcp_pendant.views.gui_util import (
     set_content,
     set_options,
     slot_option,
+    target_of,
 )
 from tcp_pendant.views.upload_guard import limit_upload_size
 from tcp_pendant.views.wizard_result import WizardResultView
@@ -113,7 +114,7 @@ class CalibrateView:
         self._menu_mounted_key: str | None = None
         self._library: dict[int, Tool] = {}
         self._library_pick: tuple[str, int | None] | None = None   # (option, active slot then)
-        gui = session.target.gui
+        gui = target_of(session).gui
         tools = self.workflow.tools
         self._physical = {t.label: key for key, t in tools.items()}
 
@@ -314,7 +315,7 @@ class CalibrateView:
     def _on_export(self, event: Any) -> None:
         data = dumps(self.workflow.export_record(self.session.touches)).encode("utf-8")
         # to the browser that clicked (in --shared mode the session is every browser's)
-        target = getattr(event, "client", None) or self.session.client or self.session.target
+        target = getattr(event, "client", None) or self.session.client or target_of(self.session)
         target.send_file_download(SESSION_FILENAME, data, save_immediately=True)
         set_content(self.record_md, f"Exported {len(self.workflow.runs)} calibration(s) as {SESSION_FILENAME}.")
 

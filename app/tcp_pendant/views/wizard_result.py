@@ -34,7 +34,9 @@ from tcp_pendant.views.gui_util import (
     number_of_option,
     set_content,
     set_options,
+    set_value,
     slot_option,
+    target_of,
 )
 from tcp_pendant.wizards import (
     ESTIMATOR_LABELS,
@@ -75,7 +77,7 @@ class WizardResultView:
 
     def __init__(self, parent: CalibrateView) -> None:
         self.parent = parent
-        gui = parent.session.target.gui
+        gui = target_of(parent.session).gui
         self.folder = gui.add_folder("Result", visible=False)
         with self.folder:
             self.result_md = gui.add_markdown("")
@@ -166,7 +168,7 @@ class WizardResultView:
         self.check_tcp.visible = saves and wf.last_save is not None and wf.result_saved
         if wf.run is not self._named_run:              # another calibration: its name, no old message
             self._named_run = wf.run
-            self.save_name.value = wf.default_save_name()
+            set_value(self.save_name, wf.default_save_name())
             set_content(self.save_md, "")
         truth = None if wf.hide_truth else wf.truth()   # an exercise: no answer shown
         set_content(self.result_md, result_markdown(res, truth))   # a beam result: errors of both vs truth
@@ -206,7 +208,7 @@ class WizardResultView:
         self.restore.disabled = not res.excluded
         label = ESTIMATOR_LABELS[res.estimator]
         if self.estimator.value != label:
-            self.estimator.value = label
+            set_value(self.estimator, label)
         self.compare_md.visible = bool(self.compare.value)
         if self.compare.value:
             set_content(self.compare_md, comparison_markdown(res))

@@ -47,6 +47,7 @@ from tcp_pendant.views.beam_replay import ScanPlayer, beam_view_direction, scan_
 from tcp_pendant.views.framing import Framing, spread_labels
 from tcp_pendant.views.scene import frame_cameras, wxyz_xyz
 from tcp_pendant.wizards import Xyz4Result
+from tcp_pendant.views.gui_util import target_of
 
 __all__ = ["WizardSceneView"]
 
@@ -66,7 +67,7 @@ class WizardSceneView:
     def __init__(self, session: Session, workflow: CalibrationWorkflow) -> None:
         self.session = session
         self.workflow = workflow
-        scene = session.target.scene
+        scene = target_of(session).scene
         self.scene = scene
         self.computed = scene.add_frame("/calibration/computed_tool", axes_length=0.10, axes_radius=0.0045,
                                         visible=False)

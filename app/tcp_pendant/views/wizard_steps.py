@@ -31,7 +31,7 @@ from tcp_pendant.calibrate.text import (
     steps_list_markdown,
 )
 from tcp_pendant.text_escape import escape_markdown
-from tcp_pendant.views.gui_util import set_content
+from tcp_pendant.views.gui_util import set_content, set_value, target_of
 from tcp_pendant.wizards import AbcWorldWizard, ThreePointWizard, Wizard, WizardStateError
 
 if TYPE_CHECKING:
@@ -53,7 +53,7 @@ class WizardStepsView:
 
     def __init__(self, parent: CalibrateView) -> None:
         self.parent = parent
-        gui = parent.session.target.gui
+        gui = target_of(parent.session).gui
         self.folder = gui.add_folder("Wizard", visible=False)
         with self.folder:
             self.head_md = gui.add_markdown("")
@@ -202,7 +202,7 @@ class WizardStepsView:
         if wiz is None or not wf.is_open:
             return
         set_content(self.head_md, step_markdown(wiz) + (f"\n\n{self._busy_text}" if self._checking else ""))
-        self.progress.value = round(100.0 * wiz.progress, 1)
+        set_value(self.progress, round(100.0 * wiz.progress, 1))
         set_content(self.steps_md, steps_list_markdown(wiz))
         self._render_variant(wiz)
         needed = wf.required_tool()
@@ -240,7 +240,7 @@ class WizardStepsView:
         if tuple(self.variant.options) != labels:    # our own assignments: the on_update
             self.variant.options = labels            # they fire has no client and is ignored
         if self.variant.value != label:
-            self.variant.value = label
+            set_value(self.variant, label)
         self.variant.visible = True
         self.variant.disabled = wiz.status != "in_progress"
 
@@ -256,7 +256,7 @@ class WizardStepsView:
         T_world_flange = self.parent.session.controller.T_world_flange()
         gain = wiz.preview(T_world_flange)
         value, color = meter_level(gain)
-        self.meter_bar.value = round(value, 1)
+        set_value(self.meter_bar, round(value, 1))
         self.meter_bar.color = color
         advice = (diversity_advice(wiz.other_rotations(), T_world_flange[:3, :3], gain.angle_to_nearest_deg)
                   if math.isinf(gain.predicted_after) else None)               # only then shown

@@ -18,6 +18,7 @@ import re
 from collections.abc import Sequence
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy.spatial.transform import Rotation
 
 from tcpcal.controllers._common import (
@@ -229,7 +230,7 @@ def _values_to_text(values: Sequence[float]) -> str:
     return "TOOL_DATA[1]={" + ",".join(f"{k} {x}" for k, x in zip("XYZABC", v)) + "}"
 
 
-def rotation_from_abc(abc_deg: Sequence[float]) -> np.ndarray:
+def rotation_from_abc(abc_deg: ArrayLike) -> np.ndarray:
     """``R = Rz(A) Ry(B) Rx(C)`` of A, B, C (deg): ``(3, 3)``, or ``(N, 3, 3)`` for ``(N, 3)``."""
     return Rotation.from_euler("ZYX", np.asarray(abc_deg, dtype=float), degrees=True).as_matrix()
 
