@@ -23,7 +23,7 @@ import secrets
 import socket
 import threading
 import time
-from collections.abc import Iterator, Sequence
+from collections.abc import Generator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -49,6 +49,7 @@ from tcp_pendant.controller import (
 from tcp_pendant.controller.scenarios import Scenario
 from tcp_pendant.session import Session
 from tcp_pendant.views import session_view_steps
+from tcp_pendant.views.gui_util import target_of
 from tcp_pendant.views.presenter import PresenterView
 from tcp_pendant.views.scene import overview_camera, overview_pose
 from tcp_pendant.views.meshes import link_meshes, rigid_meshes
@@ -289,7 +290,7 @@ class PendantApp:
         return session
 
     def session_steps(self, client: Any | None, target: Any | None = None, *,
-                      shared: bool = False) -> Iterator[Session | None]:
+                      shared: bool = False) -> Generator[Session | None, None, None]:
         """:meth:`make_session` step by step: yields None after each step (a view, a few to a few
         tens of ms) and the finished session last (``on_client_connect`` awaits between the
         steps on viser's event loop). Closing the generator early closes the half-built session.
@@ -312,7 +313,7 @@ class PendantApp:
         try:
             for _ in session_view_steps(session, title=f"TCP Pendant · {self.robot_label}"):
                 yield None
-            with session.lock, session.target.atomic():    # "Presenter mode", above the tabs
+            with session.lock, target_of(session).atomic():    # "Presenter mode", above the tabs
                 session.views["presenter"] = PresenterView(session, on=self.config.presenter)
         except GeneratorExit:
             session.close()
@@ -506,4 +507,4 @@ def parse_xyz_mm(text: str | Sequence[float]) -> tuple[float, float, float]:
         raise ControllerError(f"Expected X,Y,Z in mm (three numbers separated by commas), got {text!r}.") from None
     if len(vals) != 3 or not all(np.isfinite(vals)):
         raise ControllerError(f"Expected X,Y,Z in mm (three finite numbers separated by commas), got {text!r}.")
-    return vals  # type: ignore[return-value]
+    return vals

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Collection, Mapping, Sequence
+from typing import Literal
 
 from tcp_pendant.pendant.formatting import fmt_num
 from tcp_pendant.text_escape import escape_markdown as _esc
@@ -131,7 +132,7 @@ FULL_DIVERSITY_DEG = 45.0
 section 7: touches 45 degrees apart about different axes give several times smaller errors)."""
 
 
-def meter_level(gain: CandidateGain) -> tuple[float, str]:
+def meter_level(gain: CandidateGain) -> tuple[float, Literal["red", "yellow", "green"]]:
     """The pose-diversity meter as a bar: (0..100, colour).
 
     The bar is the angle from the current orientation to the nearest recorded one, full at

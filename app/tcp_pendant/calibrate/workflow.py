@@ -135,7 +135,9 @@ class ControllerJob(Protocol):
     own copies of the robot models; the controller is not moved), the outcome handed back on
     the loop (:meth:`CalibrationWorkflow.give_controller_job`)."""
 
-    wizard: Wizard
+    @property
+    def wizard(self) -> Wizard:
+        """The wizard that waits for the job."""
 
     @property
     def busy_text(self) -> str:
@@ -686,7 +688,7 @@ class CalibrationWorkflow:
                 robot is no longer there: record the touch again.
         """
         w = self.wizard
-        if not isinstance(w, TcpCheckWizard) or not w.check_pending:
+        if not isinstance(w, TcpCheckWizard) or not w.check_pending or w.recorded_pose is None:
             return None
         pose, c = w.recorded_pose, self.controller
         known = None if self._current is None else self._check_q.get(self._current)

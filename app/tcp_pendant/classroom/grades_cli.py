@@ -96,7 +96,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except GradebookError as exc:
         print(f"tcp-pendant grades: error: {' '.join(str(exc).split())}", file=sys.stderr)
         return 2
-    if args.csv:
+    if text is not None:                                # --csv
         sys.stdout.write(text)
         return 0
     if not rows:

@@ -37,6 +37,7 @@ import warnings
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
+from typing import cast
 
 import numpy as np
 import platformdirs
@@ -191,7 +192,7 @@ def _body_mesh(T_flange_tool: np.ndarray) -> trimesh.Trimesh:
                                       sections=_SECTIONS)
     joint = trimesh.creation.icosphere(subdivisions=1, radius=_SHAFT_RADIUS_M)
     joint.apply_translation(neck)
-    return trimesh.util.concatenate([mount, shaft, joint])
+    return cast(trimesh.Trimesh, trimesh.util.concatenate([mount, shaft, joint]))  # meshes give a mesh
 
 
 def _xyz(v: np.ndarray) -> str:

@@ -131,10 +131,11 @@ class TraineeRecorder:
                 self._update_status()
 
     def _current_calibration(self) -> int | None:
-        run = None if self.workflow is None else self.workflow.run
-        if run is None:
+        wf = self.workflow
+        run = None if wf is None else wf.run
+        if wf is None or run is None:
             return None
-        for i, r in enumerate(self.workflow.runs):
+        for i, r in enumerate(wf.runs):
             if r is run:
                 st = self._runs.get(i)
                 return None if st is None else st.calibration_id
@@ -154,6 +155,8 @@ class TraineeRecorder:
 
     def _sync_runs(self) -> None:
         wf = self.workflow
+        if wf is None:
+            return
         auto_now = int(getattr(wf, "auto_touches", 0))
         auto = auto_now != self._auto_seen
         self._auto_seen = auto_now
@@ -178,6 +181,7 @@ class TraineeRecorder:
             self._sync_status(st, run)
 
     def _sync_poses(self, st: _RunState, w: Any, auto: bool) -> None:
+        assert st.calibration_id is not None  # runs without a calibration are skipped
         for step, pose in sorted(w.recorded_poses.items()):
             if st.poses.get(step) is pose:
                 continue
@@ -191,6 +195,7 @@ class TraineeRecorder:
             self._status = TraineeStatus(**{**self._status.__dict__, "touches": self._status.touches + 1})
 
     def _sync_status(self, st: _RunState, run: Any) -> None:
+        assert st.calibration_id is not None  # runs without a calibration are skipped
         w = run.wizard
         result = w.finished_result
         if result is not None and result is not st.result:
@@ -204,6 +209,7 @@ class TraineeRecorder:
             st.status = "in_progress"
 
     def _finish(self, st: _RunState, run: Any, result: Any) -> None:
+        assert st.calibration_id is not None  # runs without a calibration are skipped
         from tcp_pendant.wizards.truth import compare_with_truth
 
         pos = ori = grade = None

@@ -47,7 +47,7 @@ class HoldDriver:
     """
 
     def __init__(self, step: Callable[[Any, int], JogResult | None],
-                 schedule: Callable[[float, Callable[[], None]], Any], *,
+                 schedule: Callable[[float, Callable[[], object]], Any], *,
                  clock: Callable[[], float] = time.monotonic, period_s: float = HOLD_PERIOD_S,
                  deadman_s: float = DEADMAN_S) -> None:
         self._step = step

@@ -382,7 +382,8 @@ class ScanPlayer:
         else:
             if stand is not None:
                 stand.set_broken(int(getattr(scan.events[broken], "beam", 0)))
-            self.break_point.position = tuple(float(v) for v in self._points[broken])
+            x, y, z = (float(v) for v in self._points[broken])
+            self.break_point.position = (x, y, z)
             self.break_point.visible = True
         for h in (self.markers, self.rays):
             if h is not None:

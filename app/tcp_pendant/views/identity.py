@@ -48,7 +48,7 @@ class IdentityPrompt:
         modal, name_field, start, message, token_field, open_trainer: the widgets (for tests).
     """
 
-    def __init__(self, session: Session, on_name: Callable[[str], None],
+    def __init__(self, session: Session, on_name: Callable[[str], object],
                  on_token: Callable[[str], bool]) -> None:
         self.session = session
         self.name: str | None = None

@@ -51,7 +51,7 @@ from tcp_pendant.views.gui_util import set_value, target_of
 try:                                   # viser's message type (hot path); public setter if absent
     from viser._messages import GuiUpdateMessage
 except ImportError:                    # pragma: no cover
-    GuiUpdateMessage = None
+    GuiUpdateMessage = None  # type: ignore[assignment, misc]
 
 __all__ = ["HOLD_HZ", "KEYS_LINE", "MARK", "PendantPanel", "jog_key_hint", "marked", "set_markdown", "unmarked"]
 

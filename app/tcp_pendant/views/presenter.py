@@ -22,7 +22,7 @@ degrees on screen.
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import TYPE_CHECKING, Any, TypedDict
 
 import numpy as np
 
@@ -31,6 +31,9 @@ from tcp_pendant.controller.readout import PoseReadout
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.text_escape import escape_html, escape_markdown
 from tcp_pendant.views.gui_util import target_of
+
+if TYPE_CHECKING:
+    from viser import uplot
 
 __all__ = [
     "CHART_HEIGHT_PX",
@@ -53,7 +56,13 @@ PRESENTER_WIDTH_PX = 320
 """Panel width in presenter mode (viser's "medium"): 31 % of a 1024 px projector."""
 NORMAL_WIDTH_PX = 384
 """Panel width otherwise (viser's "large", as ``PendantApp.start`` sets it)."""
-_THEME = {"dark_mode": False, "show_logo": False, "show_share_button": False}   # as PendantApp.start
+class _Theme(TypedDict):
+    dark_mode: bool
+    show_logo: bool
+    show_share_button: bool
+
+
+_THEME: _Theme = {"dark_mode": False, "show_logo": False, "show_share_button": False}   # as PendantApp.start
 
 
 def _num(value: float, decimals: int = 2) -> str:
@@ -109,8 +118,8 @@ def presenter_steps_markdown(wizard: Any | None, *, font_px: int = STEPS_FONT_PX
             f"<u>{title}</u><br>" + "<br>".join(lines) + "</div>")
 
 
-def _chart_series() -> tuple[dict[str, Any], ...]:
-    no_points = {"show": False}
+def _chart_series() -> tuple[uplot.Series, ...]:
+    no_points: uplot.Series_Points = {"show": False}
     return ({"label": "touch"},
             {"label": "error (mm)", "stroke": "#3b6fd6", "fill": "rgba(59,111,214,0.55)", "width": 2,
              "points": no_points},
@@ -209,7 +218,7 @@ class PresenterView:
         show = errors is not None and used is not None and len(errors) > 0
         if self.chart.visible != show:
             self.chart.visible = show
-        if not show or res is self._charted:
+        if not show or errors is None or used is None or res is self._charted:
             return
         self._charted = res
         bars = error_bars([i + 1 for i in used], errors, [i + 1 for i in getattr(res, "outliers", ())])

@@ -43,7 +43,7 @@ from scipy.spatial.transform import Rotation
 try:                                   # viser's message types (hot path); public setters if absent
     from viser import _messages
 except ImportError:                    # pragma: no cover
-    _messages = None
+    _messages = None  # type: ignore[assignment]
 
 from tcp_pendant.controller import ToolModel, reference_tip_model
 from tcp_pendant.controller.kinematics import urdf_links_and_tree
@@ -188,11 +188,11 @@ def _set_pose(handle: Any, wxyz: list[float] | None, xyz: list[float] | None) ->
         n = 0
         if wxyz is not None:
             impl.wxyz[:] = wxyz
-            api._queue_scene_message(_messages.SetOrientationMessage(impl.name, tuple(wxyz)))
+            api._queue_scene_message(_messages.SetOrientationMessage(impl.name, (wxyz[0], wxyz[1], wxyz[2], wxyz[3])))
             n += 1
         if xyz is not None:
             impl.position[:] = xyz
-            api._queue_scene_message(_messages.SetPositionMessage(impl.name, tuple(xyz)))
+            api._queue_scene_message(_messages.SetPositionMessage(impl.name, (xyz[0], xyz[1], xyz[2])))
             n += 1
         return n
     except AttributeError:                      # viser internals changed: public setters

@@ -41,7 +41,9 @@ MAX_GRADE_ROWS = 50
 class ClassControl(Protocol):
     """What the trainer view needs of the server."""
 
-    tool_keys: Sequence[str]
+    @property
+    def tool_keys(self) -> Sequence[str]: ...
+
     gradebook: Gradebook
     exercise: str | None
 

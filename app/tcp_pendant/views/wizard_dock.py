@@ -85,7 +85,7 @@ class WizardDock:
     def _where(self) -> tuple[int, int, int]:
         wf = self.session.workflow
         wiz = None if wf is None else wf.wizard
-        if wiz is None:
+        if wf is None or wiz is None:
             return (-1, -1, -1)
         return (id(wiz), wiz.step.index if not wiz.is_complete else -2, len(wf.runs))
 
@@ -144,7 +144,7 @@ class WizardDock:
         wiz = None if wf is None else wf.wizard
         open_ = wf is not None and wiz is not None and wf.is_open
         self.folder.visible = open_
-        if not open_:
+        if wf is None or wiz is None or not open_:
             self._note, self._note_at = "", None
             return
         set_content(self.step_md, step_markdown(wiz))
@@ -159,6 +159,7 @@ class WizardDock:
             self.mount.label = f"Mount the {needed.label.lower()}"
         self.record.visible = stepping and not wiz.auto_role(wiz.step).by_controller   # a scan: no Record
         self.record.disabled = not wiz.can_record
+        options: tuple[str, ...]
         if stepping:
             options = (BACK, FINISH if wiz.on_last_step else NEXT, CANCEL)
         else:

@@ -286,7 +286,8 @@ class CalibrateView:
         return None if slot is None else slot_option(slot, self._library[slot].name)
 
     def _selected_slot(self, widget: Any = None) -> int:
-        slot = number_of_option((widget or self.library_tool).value)
+        picked = widget or self.library_tool                     # None: the library is empty
+        slot = None if picked is None else number_of_option(picked.value)
         if slot is None:
             raise ValueError("The tool library is empty: calibrate the TCP first (XYZ 4-point) and save it.")
         return slot

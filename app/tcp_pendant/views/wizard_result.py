@@ -47,6 +47,8 @@ from tcp_pendant.wizards import (
 from tcpcal.library import ToolLibrary
 
 if TYPE_CHECKING:
+    from viser import uplot
+
     from tcp_pendant.views.wizard_menu import CalibrateView
 
 __all__ = ["AUTO_SLOT", "WizardResultView", "slot_options"]
@@ -60,10 +62,10 @@ def slot_options(tools: dict[int, Any]) -> tuple[str, ...]:
                          for s in range(1, ToolLibrary.N_SLOTS + 1)))
 
 
-def _chart_series(*, has_outliers: bool) -> tuple[dict[str, Any], ...]:
+def _chart_series(*, has_outliers: bool) -> tuple[uplot.Series, ...]:
     """uPlot series of the error bars: touch number, errors (blue), outliers (red, shown only
     when there are some), the mean (dashed); no point markers on the bar outlines."""
-    no_points = {"show": False}
+    no_points: uplot.Series_Points = {"show": False}
     return ({"label": "touch"},
             {"label": "error (mm)", "stroke": "#3b6fd6", "fill": "rgba(59,111,214,0.55)", "width": 1,
              "points": no_points},

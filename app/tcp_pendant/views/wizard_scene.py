@@ -224,7 +224,8 @@ class WizardSceneView:
             out["target"] = (self.abc_label, self._target_T)
         for name, (handle, _) in out.items():
             if name not in self._label_defaults:
-                self._label_defaults[name] = (handle, tuple(float(v) for v in np.asarray(handle.position)))
+                x, y, z = (float(v) for v in np.asarray(handle.position))
+                self._label_defaults[name] = (handle, (x, y, z))
         return out
 
     def _restore_labels(self) -> None:

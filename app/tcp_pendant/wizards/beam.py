@@ -574,7 +574,7 @@ class BeamWizard(Wizard):
                 "about the tool axis. Move the robot so the beam device is within reach and scan again"
                 + (f" (skipped: {skipped})." if skipped else "."))
 
-        def arrays(idx: Sequence[int]) -> tuple[np.ndarray, ...]:
+        def arrays(idx: Sequence[int]) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
             T = np.array([events[i].T_world_flange for i in idx])
             return (T[:, :3, :3], T[:, :3, 3] * M_TO_MM, np.array([events[i].beam_point for i in idx]) * M_TO_MM,
                     np.array([events[i].beam_dir for i in idx]))
