@@ -343,7 +343,7 @@ def orientation_result_to_dict(result: OrientationResult, *,
                                tcp_mm: Sequence[float] | None = None) -> dict[str, Any]:
     """The JSON object of a TOOL-orientation result (``solve three-point`` / ``abc-world``).
 
-    It carries the keys every ``solve`` object has (issue 2: ``tcp_mm``, ``residuals_mm``, the
+    It carries the keys every ``solve`` object has (``tcp_mm``, ``residuals_mm``, the
     error figures, ``ci95_mm``, ``outliers``), so that scripts read all four commands alike:
     ``tcp_mm`` is the TCP the method was given (``None`` for abc-world, which needs none);
     these methods have no touch residuals, so ``residuals_mm`` and ``outliers`` are empty and

@@ -1,4 +1,4 @@
-"""Issue 13 ("Using it"): the status icons must render in Debian's chromium without an emoji
+"""The status icons must render in Debian's chromium without an emoji
 font. The app's strings may use only symbols that the DejaVu fonts (Debian's default) draw:
 no code point of the emoji ranges except an explicit list that DejaVu Sans covers."""
 

@@ -77,7 +77,7 @@ def pip_calls(repo: Path) -> list[str]:
 
 # ---------------------------------------------------------------- run-app.sh
 def test_run_app_starts_offline_when_the_stamp_matches(repo: Path) -> None:
-    """Issue 13: ``run-app.sh --help`` failed offline because pip ran at every start."""
+    """``run-app.sh --help`` starts offline: pip runs only when pyproject.toml changed."""
     (repo / ".venv" / f".installed-app-{sha(repo)}").touch()
     p = run(repo, "run-app.sh", "--help")            # pip would fail (FAKE_PIP_RC=1)
     assert p.returncode == 0, p.stderr
@@ -135,7 +135,8 @@ def stamped(repo: Path) -> Path:
 
 
 def test_run_tests_without_root_sudo_or_chromium_runs_the_rest_and_says_so(stamped: Path) -> None:
-    """Issue 13: it stopped with ``sudo: command not found`` (127) before pytest ran."""
+    """Without root, sudo or chromium the script runs the rest of the suite (it must not stop at
+    ``sudo: command not found`` before pytest) and says that the browser tests did not run."""
     p = run(stamped, "run-tests.sh", "-q", "tests/tcpcal")
     assert p.returncode == 0, p.stderr
     assert pytest_calls(stamped) == ["python [-m] [pytest] [-m] [not browser] [-q] [tests/tcpcal]"]

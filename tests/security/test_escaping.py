@@ -1,4 +1,4 @@
-"""Issue 8 item 2: everything users type is shown as text, everywhere (the escaping helper).
+"""Everything users type is shown as text, everywhere (the escaping helper).
 
 ``tcp_pendant.text_escape.escape_markdown`` turns user text into markdown that renders as
 exactly that text in viser (whose markdown passes raw HTML unsanitised and autolinks bare

@@ -1,4 +1,4 @@
-"""The TCP service with the beam sensor (issue 14 item 4): "Check with beam" and "Update".
+"""The TCP service with the beam sensor: "Check with beam" and "Update".
 
 The industrial loop after a crash: the tool is bent, the stored tool data is stale. "Check
 with beam" runs the automatic scan (``controller.beam_scan``) with the tool data the

@@ -88,7 +88,7 @@ WIZARD_KINDS: LiveKinds = LiveKinds()
 WIZARD_LABELS: LiveAttribute = LiveAttribute("title")
 """Kind -> the method's label (live view of the registry)."""
 AUTO_SIGMA_MAX_MM = 2.0
-"""Largest simulated operator error the pendant offers (issue 5: slider 0-2 mm)."""
+"""Largest simulated operator error the pendant offers (slider 0-2 mm)."""
 EXERCISE_REFUSAL = ("{what} is off during the trainer's exercise: the beam sensor would measure the "
                     "exercise's tool for you. Calibrate it by touching the reference tip (XYZ 4-point, "
                     "XYZ reference or TCP & Z, X).")

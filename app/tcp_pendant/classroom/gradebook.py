@@ -1,6 +1,6 @@
 """The class gradebook: every trainee, session, calibration, touch and crash, in one SQLite file.
 
-The server writes each wizard event as it happens (issue 11 item 2); ``tcp-pendant grades``
+The server writes each wizard event as it happens; ``tcp-pendant grades``
 reads it back (:mod:`tcp_pendant.classroom.grades_cli`). Standard library ``sqlite3`` only.
 
 Durability ("a kill -9 of the server loses nothing that was acknowledged on screen"):

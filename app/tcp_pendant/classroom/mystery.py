@@ -1,4 +1,4 @@
-"""Mystery tools (issue 11 item 4): a tool per trainee whose true TCP and orientation are drawn
+"""Mystery tools: a tool per trainee whose true TCP and orientation are drawn
 from the exercise seed and the trainee's name, so answers differ between trainees.
 
 :func:`draw_mystery_tool` draws (deterministically: same seed, name and base tool, same tool on

@@ -1,4 +1,4 @@
-"""Store a trainee's wizard events in the gradebook as they happen (issue 11 item 2; no viser).
+"""Store a trainee's wizard events in the gradebook as they happen (no viser).
 
 A :class:`TraineeRecorder` belongs to one named per-browser session. The server subscribes
 :meth:`TraineeRecorder.on_change` to the session's change signal; on every signal it compares

@@ -1,4 +1,4 @@
-"""The beam sensor's automatic scan (issue 14): the motion a BullsEye / TRACC style device runs.
+"""The beam sensor's automatic scan: the motion a BullsEye / TRACC style device runs.
 
 Pure functions of their arguments (no controller is read or changed), so a scan can run in a
 worker thread on snapshots taken on the event loop. Metres and radians inside; the

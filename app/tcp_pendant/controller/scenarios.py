@@ -86,7 +86,7 @@ def _check_range(value: tuple[float, float], what: str, unit: str, upper: float)
 
 @dataclass(frozen=True)
 class Scenario:
-    """What the trainer chose (the defaults are the realistic ranges of issue 12).
+    """What the trainer chose (the defaults are realistic ranges).
 
     Attributes:
         kind: "off" (default), "bent_tool", "robot_accuracy" or "moved_reference".

@@ -1,4 +1,4 @@
-"""The Tool tab's TCP service with the beam sensor (issue 14 item 4): "Check with beam" measures
+"""The Tool tab's TCP service with the beam sensor: "Check with beam" measures
 the ACTIVE tool's TCP now, "Update" writes the measured TCP into the library.
 
 The industrial loop after a crash: the tool is bent, "Check with beam" finds the deviation

@@ -1,4 +1,4 @@
-"""Replaying a beam scan in the 3D scene (issue 14): the robot goes through the scan's moves, the
+"""Replaying a beam scan in the 3D scene: the robot goes through the scan's moves, the
 beam turns red while the tool breaks it, a marker stays where each event met the beam.
 
 :func:`replay_frames` is pure: from a ``BeamScan`` (``controller.beam_scan``: its ``moves``

@@ -1,4 +1,4 @@
-"""The beam sensor's stand in the 3D scene (issue 14): a fork whose two posts carry the emitter
+"""The beam sensor's stand in the 3D scene: a fork whose two posts carry the emitter
 and the receiver, the beam a thin bright line between them.
 
 :func:`stand_geometry` is pure numpy: from a :class:`~tcp_pendant.controller.beam.BeamSensor`

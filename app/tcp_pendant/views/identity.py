@@ -1,4 +1,4 @@
-"""The name prompt of a classroom session: a modal that asks "Your name" (issue 11 item 1).
+"""The name prompt of a classroom session: a modal that asks "Your name".
 
 Shown to each browser of a per-browser server with a gradebook (``--shared`` has none). The
 modal holds a text field labelled **"Your name"** and a **Join the class** button; the name is checked by

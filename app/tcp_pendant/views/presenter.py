@@ -1,4 +1,4 @@
-"""Presenter mode (issue 11 item 6): the lecture's view of a pendant, readable on a projector.
+"""Presenter mode: the lecture's view of a pendant, readable on a projector.
 
 A "Presenter mode" checkbox on top of the panel (per session; in ``--shared`` mode the shared
 GUI's, so every browser follows it; ``tcp-pendant --presenter`` starts with it on) shows the

@@ -1,4 +1,4 @@
-"""The "Systematic error" panel of the Calibrate tab (training; issue 12 item 3).
+"""The "Systematic error" panel of the Calibrate tab (training).
 
 A trainer picks a systematic error for this pendant: Off (default), Bent tool, Robot accuracy
 or Moved reference tip (``controller.scenarios``), and a seed that draws its concrete errors.

@@ -9,12 +9,12 @@ session's commands (``Session.mount_tool`` / ``activate`` / ``deactivate``): thi
 (in ``--shared`` mode Activate also sets the library's active slot, the shared start tool);
 the panel re-renders the mounted tool and the active data on the session's ``tool`` change.
 
-Check (TCP check, spin test; issue 12): "Check" turns the selected library tool (or "Check
+Check (TCP check, spin test): "Check" turns the selected library tool (or "Check
 active tool": the active data) about its TCP by +-A, +-B, +-C at the chosen angle and shows how
 far the TRUE tip moves per rotation and the implied TCP error (``views.tool_check``; the six
 rotations run in a worker thread on a copy of the robot model, the robot does not move).
 
-Controller files (issue 12 item 5): "Download file" renders the selected tool as a whole
+Controller files: "Download file" renders the selected tool as a whole
 controller file of the chosen format (``tcpcal.controllers.export_tool_file``, tool number =
 the slot, as ``tcpcal tools export SLOT --format F --output FILE``) and sends it to the browser
 that clicked; a refusal (e.g. ABB's reserved ``tool0``) is one notification.

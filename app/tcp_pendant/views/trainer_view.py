@@ -1,4 +1,4 @@
-"""The trainer view (issue 11 item 3): the class's live table, the gradebook, a CSV download and
+"""The trainer view: the class's live table, the gradebook, a CSV download and
 settings pushed to every trainee.
 
 Built in a browser's own GUI once its "Trainer token" was right (``views.identity``); the

@@ -186,8 +186,8 @@ class WizardStepsView:
         return (id(wiz), wiz.step_index, wiz.status, tuple((i, id(poses[i])) for i in sorted(poses)))
 
     def _render_auto_line(self) -> None:
-        """The Auto-touch line, only while it still describes the wizard's state (item 6 of
-        issue 10: no \"Recorded touch 3\" after touch 4, nothing carried into another wizard)."""
+        """The Auto-touch line, only while it still describes the wizard's state (no
+        \"Recorded touch 3\" after touch 4, nothing carried into another wizard)."""
         line = self._auto_line
         if line is not None and line[0] != self._auto_where():
             self._auto_line = line = None

@@ -1,4 +1,4 @@
-"""The "Automatic (beam)" wizard (issue 14 item 3; methods.md section 9).
+"""The "Automatic (beam)" wizard (methods.md section 9).
 
 A BullsEye / TRACC style calibration: the controller itself moves the mounted tool through a
 light barrier at 3 to 5 tool orientations (sideways passes that cross the shaft, approaches
