@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Collection, Mapping, Sequence
-from typing import Literal
+from typing import TYPE_CHECKING, Literal
 
 from tcp_pendant.pendant.formatting import fmt_num
 from tcp_pendant.text_escape import escape_markdown as _esc
@@ -28,6 +28,9 @@ from tcp_pendant.wizards import (
     wizard_class,
 )
 from tcp_pendant.wizards.registry import LiveAttribute
+
+if TYPE_CHECKING:
+    from tcp_pendant.wizards.xyz4 import Estimator
 from tcp_pendant.wizards.tcp_check import TcpCheckResult, tcp_check_markdown
 from tcp_pendant.wizards.session_record import ReplayCheck
 from tcp_pendant.wizards.truth import TruthComparison
@@ -371,7 +374,7 @@ def replay_markdown(checks: Sequence[ReplayCheck]) -> str:
     return head + "\n" + "\n".join(rows)
 
 
-def estimator_options() -> dict[str, str]:
+def estimator_options() -> dict[str, Estimator]:
     """Dropdown label -> estimator key, in the wizard's order."""
     return {label: key for key, label in ESTIMATOR_LABELS.items()}
 

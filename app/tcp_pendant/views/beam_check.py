@@ -37,7 +37,7 @@ from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.beam_replay import ScanPlayer, beam_view_direction, scan_spheres
 from tcp_pendant.views.framing import Framing
 from tcp_pendant.views.scene import frame_cameras
-from tcp_pendant.views.gui_util import target_of
+from tcp_pendant.views.gui_util import ButtonEvent, target_of
 from tcpcal.tool import Tool
 
 __all__ = ["BeamCheckView", "update_markdown"]
@@ -108,7 +108,7 @@ class BeamCheckView:
         self.replay.disabled = self._checking or self.last_check is None
 
     # ------------------------------------------------------------ Check with beam
-    async def _on_check(self, _event: Any) -> None:
+    async def _on_check(self, _event: ButtonEvent) -> None:
         try:
             await self.run_check()
         except Exception as exc:           # a browser's click must never kill the server
@@ -182,7 +182,7 @@ class BeamCheckView:
         s.notify(title, body, kind=kind)
 
     # ------------------------------------------------------------ Update
-    def _on_update(self, _event: Any) -> None:
+    def _on_update(self, _event: ButtonEvent) -> None:
         s = self.session
         check = self.last_check
         if check is None:
@@ -202,7 +202,7 @@ class BeamCheckView:
         s.notify("TCP updated", f"Slot {check.slot}: {tool.name} now has the TCP the beam measured.",
                  kind="success")
 
-    def _on_replay(self, _event: Any) -> None:
+    def _on_replay(self, _event: ButtonEvent) -> None:
         check = self.last_check
         player = ScanPlayer.of(self.session)
         if check is None:

@@ -4,10 +4,21 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any, Protocol, TypeVar
 
+import viser
+
 if TYPE_CHECKING:
     from tcp_pendant.session import GuiTarget, Session
 
-__all__ = ["number_of_option", "set_content", "set_options", "set_value", "slot_option", "target_of"]
+__all__ = ["ButtonEvent", "ButtonGroupEvent", "CheckboxEvent", "DropdownEvent", "UploadEvent",
+           "number_of_option", "set_content", "set_options", "set_value", "slot_option", "target_of"]
+
+# The events viser hands to a widget's callback (``event.target`` is the widget, ``event.client``
+# the browser that sent it, None for a change made by the server).
+ButtonEvent = viser.GuiEvent[viser.GuiButtonHandle]
+ButtonGroupEvent = viser.GuiEvent[viser.GuiButtonGroupHandle]
+CheckboxEvent = viser.GuiEvent[viser.GuiCheckboxHandle]
+DropdownEvent = viser.GuiEvent[viser.GuiDropdownHandle[str]]
+UploadEvent = viser.GuiEvent[viser.GuiUploadButtonHandle]
 
 _T = TypeVar("_T")
 _T_co = TypeVar("_T_co", covariant=True)

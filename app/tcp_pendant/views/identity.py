@@ -26,7 +26,7 @@ from typing import Any
 from tcp_pendant.classroom.names import TraineeNameError, validate_trainee_name
 from tcp_pendant.session import Session
 from tcp_pendant.text_escape import escape_markdown
-from tcp_pendant.views.gui_util import set_value, target_of
+from tcp_pendant.views.gui_util import ButtonEvent, set_value, target_of
 
 __all__ = ["IdentityPrompt", "NAME_LABEL", "TOKEN_LABEL"]
 
@@ -70,7 +70,7 @@ class IdentityPrompt:
         self.start.on_click(session.on_loop(self._start))
         self.open_trainer.on_click(session.on_loop(self._trainer))
 
-    def _start(self, _event: Any = None) -> None:
+    def _start(self, _event: ButtonEvent | None = None) -> None:
         try:
             name = validate_trainee_name(self.name_field.value)
             self._on_name(name)
@@ -82,7 +82,7 @@ class IdentityPrompt:
         self.banner.content = f"Trainee: **{escape_markdown(name)}**"
         self.banner.visible = True
 
-    def _trainer(self, _event: Any = None) -> None:
+    def _trainer(self, _event: ButtonEvent | None = None) -> None:
         token = str(self.token_field.value)[:_MAX_TOKEN_CHARS]
         set_value(self.token_field, "")
         if not self._on_token(token):

@@ -30,7 +30,7 @@ from tcp_pendant.calibrate import error_bars
 from tcp_pendant.controller.readout import PoseReadout
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.text_escape import escape_html, escape_markdown
-from tcp_pendant.views.gui_util import target_of
+from tcp_pendant.views.gui_util import CheckboxEvent, target_of
 
 if TYPE_CHECKING:
     from viser import uplot
@@ -170,7 +170,7 @@ class PresenterView:
         return bool(self.toggle.value)
 
     # ------------------------------------------------------------ callbacks
-    def _on_toggle(self, _event: Any = None) -> None:
+    def _on_toggle(self, _event: CheckboxEvent | None = None) -> None:
         on = self.on
         self.folder.visible = on
         self._apply_width(on)

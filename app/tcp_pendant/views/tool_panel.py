@@ -31,13 +31,23 @@ from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
+import viser
+
 from tcp_pendant.controller import builtin_tools
 from tcp_pendant.pendant import FIELDS, ToolEntry, parse_tool_entry, tool_data_markdown
 from tcp_pendant.pendant.tool_entry import entry_preview_markdown
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.controller.spin import DEFAULT_SPIN_ANGLE_DEG, MAX_SPIN_ANGLE_DEG
-from tcp_pendant.views.gui_util import number_of_option, set_options, set_value, slot_option, target_of
+from tcp_pendant.views.gui_util import (
+    ButtonEvent,
+    DropdownEvent,
+    number_of_option,
+    set_options,
+    set_value,
+    slot_option,
+    target_of,
+)
 from tcp_pendant.views.tool_check import CheckJob, check_job, check_markdown
 from tcpcal.controllers import CONTROLLER_FORMATS, export_tool_file
 from tcpcal.errors import TcpcalError
@@ -114,8 +124,8 @@ class ToolPanel:
         with gui.add_folder("Enter tool numerically", expand_by_default=False):
             self.entry_name = gui.add_text("Name", "")
             self.entry_name_err = gui.add_markdown("", visible=False)
-            self.entry_fields: dict[str, Any] = {}
-            self.entry_errors: dict[str, Any] = {}
+            self.entry_fields: dict[str, viser.GuiTextHandle] = {}
+            self.entry_errors: dict[str, viser.GuiMarkdownHandle] = {}
             for f in FIELDS:
                 unit = "mm" if f in "XYZ" else "deg"
                 self.entry_fields[f] = gui.add_text(f"{f} ({unit})", "0")
@@ -222,22 +232,22 @@ class ToolPanel:
         self.active_md.content = tool_data_markdown(self.session.controller.active_tool, self.session.active_slot)
 
     # ------------------------------------------------------------ callbacks
-    def _on_mount(self, event: Any) -> None:
+    def _on_mount(self, event: DropdownEvent) -> None:
         key = self._tool_key_by_label.get(str(event.target.value))
         if key is None:
             raise ValueError(f"Unknown tool {event.target.value!r}.")
         if key != self.session.controller.mounted_tool.key:
             self.session.mount_tool(self._tools[key])
 
-    def _on_activate(self, _event: Any) -> None:
+    def _on_activate(self, _event: ButtonEvent) -> None:
         slot, _ = self._selected()
         tool = self.session.activate(slot)
         self.session.notify("Tool activated", f"{slot}: {tool.name}", kind="success")
 
-    def _on_deactivate(self, _event: Any) -> None:
+    def _on_deactivate(self, _event: ButtonEvent) -> None:
         self.session.deactivate()
 
-    def _on_rename(self, _event: Any) -> None:
+    def _on_rename(self, _event: ButtonEvent) -> None:
         slot, tool = self._selected()
         name = str(self.new_name.value).strip()
         if not name:
@@ -254,13 +264,13 @@ class ToolPanel:
             if s.active_slot == slot and renamed is not None:
                 s.set_active_data(renamed, slot)        # the active data carries the new name
 
-    def _on_delete(self, _event: Any) -> None:
+    def _on_delete(self, _event: ButtonEvent) -> None:
         slot, tool = self._selected()
         self.session.library.remove(slot)
         self.session.notify("Tool deleted", f"{slot}: {tool.name}")
         self.session.reload_library()
 
-    def _on_export(self, _event: Any) -> None:
+    def _on_export(self, _event: ButtonEvent) -> None:
         slot, tool = self._selected()
         label = str(self.export_fmt.value)
         fmt = next((f for f in FORMATS if text_format(f).label == label), None)
@@ -270,7 +280,7 @@ class ToolPanel:
         kw = {} if number is None else {"slot": number}
         set_value(self.export_text, export_tool(tool, fmt, **kw))
 
-    def _on_download(self, event: Any) -> None:
+    def _on_download(self, event: ButtonEvent) -> None:
         slot, tool = self._selected()
         try:
             filename, text = controller_file(tool, slot, str(self.file_fmt.value))
@@ -278,7 +288,7 @@ class ToolPanel:
             self.session.notify(CONTROLLER_FILE_REFUSED, str(exc), kind="warning")
             return
         # to the browser that clicked (in --shared mode the session is every browser's)
-        target = getattr(event, "client", None) or self.session.client or target_of(self.session)
+        target = event.client or self.session.client or target_of(self.session)
         target.send_file_download(filename, text.encode("utf-8"), save_immediately=True)
 
     # ------------------------------------------------------------ TCP check
@@ -339,7 +349,7 @@ class ToolPanel:
         """Live line under the form: what Save would store, as this server has received it."""
         self.entry_preview.content = entry_preview_markdown(self._entry())
 
-    def _on_entry_save(self, _event: Any) -> None:
+    def _on_entry_save(self, _event: ButtonEvent) -> None:
         res = parse_tool_entry(self._entry())
         lib = self.session.library
         errors = dict(res.errors)

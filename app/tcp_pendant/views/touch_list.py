@@ -12,7 +12,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from tcp_pendant.session import Session, SessionChange, Touch
-from tcp_pendant.views.gui_util import target_of
+from tcp_pendant.views.gui_util import ButtonEvent, target_of
 
 __all__ = ["TOUCHES_FILENAME", "TouchListView", "touches_csv_text"]
 
@@ -69,14 +69,14 @@ class TouchListView:
             wf = self.session.workflow
             self.record.visible = not (wf is not None and wf.is_open)
 
-    def _on_record(self, _event: Any) -> None:
+    def _on_record(self, _event: ButtonEvent) -> None:
         t = self.session.record_touch()
         self.session.notify("Point recorded", t.label, kind="success")
 
-    def _on_export_csv(self, event: Any) -> None:
+    def _on_export_csv(self, event: ButtonEvent) -> None:
         data = touches_csv_text(self.session.touches).encode("utf-8")
         # to the browser that clicked (in --shared mode the session is every browser's)
-        target = getattr(event, "client", None) or self.session.client or target_of(self.session)
+        target = event.client or self.session.client or target_of(self.session)
         target.send_file_download(TOUCHES_FILENAME, data, save_immediately=True)
 
     def _delete_cb(self, index: int, label: str) -> Any:

@@ -29,7 +29,7 @@ from tcp_pendant.calibrate.text import meter_level, step_markdown
 from tcp_pendant.pendant.guidance import direction_words, tip_offset_mm
 from tcp_pendant.pendant.record_check import RecordCheck
 from tcp_pendant.session import Session, SessionChange
-from tcp_pendant.views.gui_util import set_content, set_value, target_of
+from tcp_pendant.views.gui_util import ButtonEvent, ButtonGroupEvent, set_content, set_value, target_of
 
 __all__ = ["BACK", "CANCEL", "CLOSE", "FINISH", "NEXT", "WizardDock"]
 
@@ -93,7 +93,7 @@ class WizardDock:
         self._note, self._note_at = text, self._where()
 
     # ------------------------------------------------------------ callbacks
-    def _on_record(self, _event: Any) -> None:
+    def _on_record(self, _event: ButtonEvent) -> None:
         wf = self._workflow()
         s = self.session
         state = s.pose_state()
@@ -110,7 +110,7 @@ class WizardDock:
         shown = "" if s.hide_distance else f", {state.touch.distance_mm:.2f} mm from the tip"
         self._say(f"✔ Step {index + 1 if index is not None else '?'} recorded{shown}.")
 
-    def _on_nav(self, event: Any) -> None:
+    def _on_nav(self, event: ButtonGroupEvent) -> None:
         wf = self._workflow()
         choice = str(event.target.value)
         self.check.clear()

@@ -31,6 +31,8 @@ from tcp_pendant.calibrate.text import (
     warnings_markdown,
 )
 from tcp_pendant.views.gui_util import (
+    ButtonEvent,
+    DropdownEvent,
     number_of_option,
     set_content,
     set_options,
@@ -130,23 +132,23 @@ class WizardResultView:
             raise WizardStateError("This is for the XYZ 4-point result.")
         return wiz
 
-    def _on_drop(self, _event: Any) -> None:
+    def _on_drop(self, _event: ButtonEvent) -> None:
         self._xyz4().drop_outliers()
 
-    def _on_restore(self, _event: Any) -> None:
+    def _on_restore(self, _event: ButtonEvent) -> None:
         self._xyz4().restore_all()
 
-    def _on_estimator(self, event: Any) -> None:
+    def _on_estimator(self, event: DropdownEvent) -> None:
         key = estimator_options().get(str(event.target.value))
         if key is None:
             raise ValueError(f"Unknown estimator {event.target.value!r}.")
-        self._xyz4().set_estimator(key)  # type: ignore[arg-type]
+        self._xyz4().set_estimator(key)
 
-    def _on_save(self, _event: Any) -> None:
+    def _on_save(self, _event: ButtonEvent) -> None:
         slot, tool = self.parent.workflow.save(str(self.save_name.value), number_of_option(self.save_slot.value))
         self.parent.saved(slot, tool)
 
-    def _on_check_tcp(self, _event: Any) -> None:
+    def _on_check_tcp(self, _event: ButtonEvent) -> None:
         wf = self.parent.workflow
         if wf.last_save is None:
             raise WizardStateError("Save the tool first: the TCP check works on a tool of the library.")

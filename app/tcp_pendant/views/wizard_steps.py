@@ -31,7 +31,7 @@ from tcp_pendant.calibrate.text import (
     steps_list_markdown,
 )
 from tcp_pendant.text_escape import escape_markdown
-from tcp_pendant.views.gui_util import set_content, set_value, target_of
+from tcp_pendant.views.gui_util import ButtonEvent, DropdownEvent, set_content, set_value, target_of
 from tcp_pendant.wizards import AbcWorldWizard, ThreePointWizard, Wizard, WizardStateError
 
 if TYPE_CHECKING:
@@ -99,7 +99,7 @@ class WizardStepsView:
         self._auto_line: tuple[tuple[Any, ...], str, Any] | None = None  # (where it belongs, text, poses)
 
     # ------------------------------------------------------------ callbacks
-    def _on_cancel(self, _event: Any) -> None:
+    def _on_cancel(self, _event: ButtonEvent) -> None:
         wf = self.parent.workflow
         finished = wf.result is not None
         wf.cancel()
@@ -107,7 +107,7 @@ class WizardStepsView:
             self.parent.session.notify("Calibration cancelled",
                                        "Nothing recorded is lost: Resume it from the Calibrate menu.")
 
-    async def _on_next(self, event: Any) -> None:
+    async def _on_next(self, event: ButtonEvent) -> None:
         """Next / Finish. A wizard waiting for its controller job (a TCP check's rotations, a
         beam scan) runs it on Finish: the job is taken on the loop (under the session lock), run
         in ``_CHECK_WORKER``, its outcome handed to the wizard on the loop; one job at a time."""
@@ -145,19 +145,19 @@ class WizardStepsView:
             self._checking = False
         await act(lambda _e: wf.give_controller_job(jobs[0], result), sync=True)(event)
 
-    def _on_add_point(self, _event: Any) -> None:
+    def _on_add_point(self, _event: ButtonEvent) -> None:
         wiz = self.parent.workflow.wizard
         if wiz is None:
             raise WizardStateError("No calibration is open.")
         wiz.add_point()
 
-    def _on_variant(self, event: Any) -> None:
+    def _on_variant(self, event: DropdownEvent) -> None:
         wiz = self.parent.workflow.wizard
         label = str(event.target.value)
         values = {} if wiz is None else {lab: v for v, lab in type(wiz).variants}
-        if label not in values:
+        if wiz is None or label not in values:
             raise ValueError(f"Unknown variant {label!r}.")
-        wiz.set_variant(values[label])  # type: ignore[union-attr]
+        wiz.set_variant(values[label])
 
     def auto_request(self) -> AutoTouchRequest:
         """The Auto-touch settings as a request (random or chosen direction, operator error)."""
@@ -166,7 +166,7 @@ class WizardStepsView:
             return AutoTouchRequest(float(self.auto_tilt.value), float(self.auto_azimuth.value), sigma)
         return AutoTouchRequest(sigma_mm=sigma)
 
-    def _on_auto_touch(self, _event: Any) -> None:
+    def _on_auto_touch(self, _event: ButtonEvent) -> None:
         request = self.auto_request()
         out = self.parent.workflow.auto_touch(request)
         if not out.ok:
