@@ -22,8 +22,11 @@ from __future__ import annotations
 
 import asyncio
 import logging
+from collections.abc import Iterable
 from concurrent.futures import ThreadPoolExecutor
-from typing import Any
+from typing import TYPE_CHECKING
+
+import numpy as np
 
 from tcp_pendant.calibrate.beam_service import (
     BeamCheck,
@@ -40,6 +43,10 @@ from tcp_pendant.views.scene import frame_cameras
 from tcp_pendant.views.gui_util import ButtonEvent, target_of
 from tcpcal.tool import Tool
 
+if TYPE_CHECKING:
+    from tcp_pendant.controller.beam_scan import BeamScan
+    from tcp_pendant.wizards.beam import RecordedScan
+
 __all__ = ["BeamCheckView", "update_markdown"]
 
 log = logging.getLogger(__name__)
@@ -51,7 +58,7 @@ INTRO = ("The robot moves the ACTIVE tool through the beam sensor by itself and 
          "After a crash: **Check with beam**, then **Update** stores the measured TCP.")
 
 
-def _fmt3(v: Any) -> str:
+def _fmt3(v: Iterable[float]) -> str:
     return ", ".join(f"{0.0 if abs(float(x)) < 5e-4 else float(x):.3f}" for x in v)
 
 
@@ -81,7 +88,7 @@ class BeamCheckView:
         self._checking = False
         self.last_check: BeamCheck | None = None
         """The last check's result (None before one, and after its Update)."""
-        self._q_before: Any = None
+        self._q_before: np.ndarray | None = None
         self.framing: Framing | None = None
         """The camera framing of the last check's scan (None before one), for tests."""
         self.check.on_click(self._on_check)
@@ -162,7 +169,7 @@ class BeamCheckView:
             self.frame_scan(check.scan)
         s.notify("Beam check done", f"{check.tool_name}: deviation {check.deviation_norm_mm:.3f} mm", kind="info")
 
-    def frame_scan(self, scan: Any) -> None:
+    def frame_scan(self, scan: BeamScan | RecordedScan) -> None:
         """Turn the session's camera(s) to the beam sensor, the scan's events and the flange
         there, seen across the beam (as the wizard's result is framed)."""
         if not len(scan.events):

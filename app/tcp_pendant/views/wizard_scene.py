@@ -40,13 +40,14 @@ import math
 from typing import Any
 
 import numpy as np
+import viser
 
 from tcp_pendant.calibrate import CalibrationWorkflow
 from tcp_pendant.session import Session
 from tcp_pendant.views.beam_replay import ScanPlayer, beam_view_direction, scan_spheres
 from tcp_pendant.views.framing import Framing, spread_labels
 from tcp_pendant.views.scene import frame_cameras, wxyz_xyz
-from tcp_pendant.wizards import Xyz4Result
+from tcp_pendant.wizards import WizardResult, Xyz4Result
 from tcp_pendant.views.gui_util import target_of
 
 __all__ = ["WizardSceneView"]
@@ -84,14 +85,14 @@ class WizardSceneView:
                                           origin_color=(255, 255, 255), visible=False)
         self.abc_label = scene.add_label("/calibration/abc_target/label", "TARGET (X down)",
                                          position=(0.0, 0.03, 0.0), visible=False)
-        self._points: Any = None
-        self._lines: Any = None
-        self._shown_result: Any = None
+        self._points: viser.PointCloudHandle | None = None
+        self._lines: viser.LineSegmentsHandle | None = None
+        self._shown_result: WizardResult | None = None
         self._T_flange_computed: np.ndarray | None = None
         self._T_flange_tool_true: np.ndarray | None = None
         self.last_framing: Framing | None = None
         """The camera framing of the last result (None before one), for tests."""
-        self._label_defaults: dict[str, tuple[Any, tuple[float, float, float]]] = {}
+        self._label_defaults: dict[str, tuple[viser.LabelHandle, tuple[float, float, float]]] = {}
         self._labels_moved = False
         self._target_T: np.ndarray | None = None
 
@@ -115,7 +116,7 @@ class WizardSceneView:
         else:
             self._restore_labels()
 
-    def _show_scan(self, res: Any) -> None:
+    def _show_scan(self, res: WizardResult | None) -> None:
         """A beam result: replay its scan (its markers stay); otherwise clear our replay."""
         player = ScanPlayer.of(self.session)
         scan = getattr(res, "scan", None)
@@ -165,7 +166,7 @@ class WizardSceneView:
             self.layout_labels()
 
     @staticmethod
-    def _pose(handle: Any, label: Any, T: np.ndarray | None) -> None:
+    def _pose(handle: viser.FrameHandle, label: viser.LabelHandle | None, T: np.ndarray | None) -> None:
         if T is None:
             handle.visible = False
             if label is not None:
@@ -204,10 +205,10 @@ class WizardSceneView:
                                                    thickness=0.003)
 
     # ------------------------------------------------------------ camera and labels
-    def _label_nodes(self) -> dict[str, tuple[Any, np.ndarray | None]]:
+    def _label_nodes(self) -> dict[str, tuple[viser.LabelHandle, np.ndarray | None]]:
         """Label name -> (handle, T_world_parent now; None: the label is in WORLD), visible ones."""
         T_wf = self.session.pose_state().T_world_flange
-        out: dict[str, tuple[Any, np.ndarray | None]] = {}
+        out: dict[str, tuple[viser.LabelHandle, np.ndarray | None]] = {}
         film = self._film_playing()                 # the triads and their labels step aside
         if self._T_flange_computed is not None and not film:
             out["computed"] = (self.computed_label, T_wf @ self._T_flange_computed)
@@ -282,7 +283,7 @@ class WizardSceneView:
         return beam_view_direction(scan.events[0].beam_point, scan.events[0].beam_dir)
 
     @staticmethod
-    def _camera_framing(client: Any) -> Framing | None:
+    def _camera_framing(client: viser.ClientHandle) -> Framing | None:
         """The browser's camera as it is now (None before it reported one)."""
         try:
             cam = client.camera
@@ -322,7 +323,8 @@ class WizardSceneView:
             handle, T = nodes[name]
             local = world if T is None else T[:3, :3].T @ (world - T[:3, 3])
             if not np.allclose(np.asarray(handle.position, dtype=float), local, rtol=0.0, atol=1e-7):
-                handle.position = tuple(float(v) for v in local)    # only changes are sent
+                x, y, z = (float(v) for v in local)
+                handle.position = (x, y, z)                          # only changes are sent
         self._labels_moved = True
 
     # ------------------------------------------------------------ live (on every move)
