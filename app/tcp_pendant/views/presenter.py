@@ -33,7 +33,10 @@ from tcp_pendant.text_escape import escape_html, escape_markdown
 from tcp_pendant.views.gui_util import CheckboxEvent, target_of
 
 if TYPE_CHECKING:
+    import viser
     from viser import uplot
+
+    from tcp_pendant.controller.pose_state import PoseState
 
 __all__ = [
     "CHART_HEIGHT_PX",
@@ -191,12 +194,12 @@ class PresenterView:
             self.render(change.state)
 
     # ------------------------------------------------------------ render
-    def _set(self, handle: Any, key: str, text: str) -> None:
+    def _set(self, handle: viser.GuiMarkdownHandle, key: str, text: str) -> None:
         if self._shown.get(key) != text:
             self._shown[key] = text
             handle.content = text
 
-    def render(self, state: Any = None) -> None:
+    def render(self, state: PoseState | None = None) -> None:
         """Show the session's state (nothing while presenter mode is off)."""
         if not self.on:
             return

@@ -5,10 +5,11 @@ that clicked, ready for ``tcpcal solve xyz4``."""
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Coroutine, Sequence
 from typing import Any
 
 import numpy as np
+import viser
 from scipy.spatial.transform import Rotation
 
 from tcp_pendant.session import Session, SessionChange, Touch
@@ -55,7 +56,7 @@ class TouchListView:
             self.empty_md = gui.add_markdown("*No touch recorded.*")
             self.export_csv = gui.add_button("Export CSV", hint="The touches as POSES.csv with joint values "
                                              "(tcpcal solve xyz4), sent to this browser.")
-        self._rows: list[Any] = []
+        self._rows: list[viser.GuiMarkdownHandle | viser.GuiButtonHandle] = []
         self.record.on_click(session.on_loop(self._on_record))
         self.export_csv.on_click(session.on_loop(self._on_export_csv))
         session.subscribe(self.on_change)
@@ -79,8 +80,8 @@ class TouchListView:
         target = event.client or self.session.client or target_of(self.session)
         target.send_file_download(TOUCHES_FILENAME, data, save_immediately=True)
 
-    def _delete_cb(self, index: int, label: str) -> Any:
-        def cb(_event: Any) -> None:
+    def _delete_cb(self, index: int, label: str) -> Callable[..., Coroutine[Any, Any, None]]:
+        def cb(_event: ButtonEvent) -> None:
             # the list may have changed since the button was drawn: delete by label
             labels = [t.label for t in self.session.touches]
             if label in labels:

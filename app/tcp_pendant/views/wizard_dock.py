@@ -22,14 +22,17 @@ and the classroom recorder see it too. Every text from a wizard goes through the
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
-from typing import Any
+from collections.abc import Callable, Coroutine
+from typing import TYPE_CHECKING, Any
 
 from tcp_pendant.calibrate.text import meter_level, step_markdown
 from tcp_pendant.pendant.guidance import direction_words, tip_offset_mm
 from tcp_pendant.pendant.record_check import RecordCheck
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.views.gui_util import ButtonEvent, ButtonGroupEvent, set_content, set_value, target_of
+
+if TYPE_CHECKING:
+    from tcp_pendant.calibrate import CalibrationWorkflow
 
 __all__ = ["BACK", "CANCEL", "CLOSE", "FINISH", "NEXT", "WizardDock"]
 
@@ -63,13 +66,14 @@ class WizardDock:
         session.subscribe(self.on_change)
 
     # ------------------------------------------------------------ plumbing
-    def _workflow(self) -> Any:
+    def _workflow(self) -> CalibrationWorkflow:
         wf = self.session.workflow
         if wf is None:
             raise ValueError("Calibration wizards are not installed in this build.")
         return wf
 
-    def _action(self, fn: Callable[[Any], Any], *, sync: bool = False) -> Any:
+    def _action(self, fn: Callable[[Any], object], *,
+                sync: bool = False) -> Callable[..., Coroutine[Any, Any, None]]:
         s = self.session
 
         def run(event: Any) -> None:
@@ -171,7 +175,7 @@ class WizardDock:
     def update_meter(self) -> None:
         """The pose-diversity meter (the wizards that declare it: ``Wizard.meter_active``)."""
         wf = self.session.workflow
-        wiz: Any = None if wf is None else wf.wizard
+        wiz: Any = None if wf is None else wf.wizard  # a meter wizard (duck-typed: preview(), ...)
         show = wiz is not None and bool(wiz.meter_active)
         self.meter_bar.visible = self.meter_md.visible = show
         if not show:

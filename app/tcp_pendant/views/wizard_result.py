@@ -47,6 +47,7 @@ from tcp_pendant.wizards import (
     Xyz4Wizard,
 )
 from tcpcal.library import ToolLibrary
+from tcpcal.tool import Tool
 
 if TYPE_CHECKING:
     from viser import uplot
@@ -58,7 +59,7 @@ __all__ = ["AUTO_SLOT", "WizardResultView", "slot_options"]
 AUTO_SLOT = "same name, else first free"
 
 
-def slot_options(tools: dict[int, Any]) -> tuple[str, ...]:
+def slot_options(tools: dict[int, Tool]) -> tuple[str, ...]:
     """The Save slot list: automatic, then every slot with the tool it holds."""
     return (AUTO_SLOT, *(slot_option(s, tools[s].name if s in tools else "(empty)")
                          for s in range(1, ToolLibrary.N_SLOTS + 1)))
@@ -155,7 +156,7 @@ class WizardResultView:
         wf.start("tcp-check", slot=wf.last_save[0])
 
     # ------------------------------------------------------------ render
-    def refresh_slots(self, tools: dict[int, Any]) -> None:
+    def refresh_slots(self, tools: dict[int, Tool]) -> None:
         """Re-list the slots after the library changed."""
         set_options(self.save_slot, slot_options(tools), keep=self.save_slot.value)
 

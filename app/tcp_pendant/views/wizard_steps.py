@@ -35,6 +35,7 @@ from tcp_pendant.views.gui_util import ButtonEvent, DropdownEvent, set_content, 
 from tcp_pendant.wizards import AbcWorldWizard, ThreePointWizard, Wizard, WizardStateError
 
 if TYPE_CHECKING:
+    from tcp_pendant.calibrate.workflow import ControllerJob
     from tcp_pendant.views.wizard_menu import CalibrateView
 
 __all__ = ["ABC_VARIANTS", "RANDOM", "THREE_POINT_VARIANTS", "WizardStepsView"]
@@ -112,9 +113,9 @@ class WizardStepsView:
         beam scan) runs it on Finish: the job is taken on the loop (under the session lock), run
         in ``_CHECK_WORKER``, its outcome handed to the wizard on the loop; one job at a time."""
         wf, act = self.parent.workflow, self.parent.action
-        jobs: list[Any] = []
+        jobs: list[ControllerJob] = []
 
-        def take(_e: Any) -> None:
+        def take(_e: ButtonEvent) -> None:
             if self._checking:
                 raise WizardStateError("The controller is still at work; wait for its result.")
             wiz = wf.wizard
@@ -248,7 +249,7 @@ class WizardStepsView:
         """The live pose-diversity meter (while a touch is to be recorded, for the wizards that
         declare it: ``Wizard.meter_active``)."""
         wf = self.parent.workflow
-        wiz: Any = wf.wizard
+        wiz: Any = wf.wizard                          # a meter wizard (duck-typed: preview(), ...)
         show = wiz is not None and wiz.meter_active
         self.meter_bar.visible = self.meter_md.visible = show
         if not show:
