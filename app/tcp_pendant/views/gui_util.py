@@ -1,4 +1,5 @@
-"""Small helpers shared by the wizard views."""
+"""Small helpers shared by the views: where a session draws (:func:`target_of`), setting a
+widget only when its value changed, and the types of viser's GUI events."""
 
 from __future__ import annotations
 
@@ -47,21 +48,36 @@ def target_of(session: Session) -> GuiTarget:
     return target
 
 
-def set_content(handle: Any, text: str) -> None:
+class _Content(Protocol):
+    """A widget with markdown or HTML ``content`` (viser's markdown and HTML handles)."""
+
+    content: str
+
+
+class _Options(Protocol):
+    """A widget with ``options`` and a ``value`` among them (viser's dropdown)."""
+
+    options: tuple[str, ...]
+
+    @property
+    def value(self) -> str: ...
+
+
+def set_content(handle: _Content, text: str) -> None:
     """Set a markdown handle's content only when it changed (viser re-sends every assignment
     of ``content``; the Calibrate tab re-renders after every click and move)."""
     if handle.content != text:
         handle.content = text
 
 
-def set_options(handle: Any, options: tuple[str, ...], keep: str | None = None) -> None:
+def set_options(handle: _Options, options: tuple[str, ...], keep: str | None = None) -> None:
     """Give a dropdown new options, keeping ``keep`` (default: the current value) if still there."""
     keep = handle.value if keep is None else keep
     if tuple(handle.options) != options:
         handle.options = options
     value = keep if keep in options else options[0]
     if handle.value != value:
-        handle.value = value
+        set_value(handle, value)
 
 
 def slot_option(slot: int, name: str) -> str:
