@@ -38,6 +38,7 @@ import math
 from typing import Any
 
 import numpy as np
+import viser
 from scipy.spatial.transform import Rotation
 
 try:                                   # viser's message types (hot path); public setters if absent
@@ -209,7 +210,7 @@ def overview_pose(tip_world_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return target + OVERVIEW_OFFSET_M, target
 
 
-def overview_camera(client: Any, tip_world_m: np.ndarray) -> None:
+def overview_camera(client: viser.ClientHandle, tip_world_m: np.ndarray) -> None:
     """One browser's camera on the whole cell."""
     position, look_at = overview_pose(tip_world_m)
     with client.atomic():                    # position first: its setter shifts look_at
@@ -217,7 +218,7 @@ def overview_camera(client: Any, tip_world_m: np.ndarray) -> None:
         client.camera.look_at = look_at
 
 
-def camera_shape(client: Any) -> tuple[float, float, float]:
+def camera_shape(client: viser.ClientHandle) -> tuple[float, float, float]:
     """(fov rad, aspect, image height px) of a browser's camera; defaults before it reported."""
     try:
         cam = client.camera
@@ -226,7 +227,7 @@ def camera_shape(client: Any) -> tuple[float, float, float]:
         return math.radians(50.0), 16.0 / 9.0, 720.0
 
 
-def frame_cameras(clients: list[Any], centres: np.ndarray, radii: np.ndarray, **framing: Any) -> Framing:
+def frame_cameras(clients: list[viser.ClientHandle], centres: np.ndarray, radii: np.ndarray, **framing: Any) -> Framing:
     """Frame each browser's camera on the spheres (``framing.frame_spheres`` with that camera's
     shape and the ``framing`` options: ``direction``, ``margin``). Returns the first browser's
     framing (a default camera's when there is none)."""
@@ -242,7 +243,7 @@ def frame_cameras(clients: list[Any], centres: np.ndarray, radii: np.ndarray, **
     return framings[0] if framings else frame_spheres(centres, radii, **framing)
 
 
-def closeup_camera(client: Any, tip_world_m: np.ndarray) -> None:
+def closeup_camera(client: viser.ClientHandle, tip_world_m: np.ndarray) -> None:
     """One browser's close-up camera on the reference tip (fine approach)."""
     tip = np.asarray(tip_world_m, dtype=float)
     with client.atomic():                    # position first: its setter shifts look_at
@@ -250,12 +251,12 @@ def closeup_camera(client: Any, tip_world_m: np.ndarray) -> None:
         client.camera.look_at = tip
 
 
-def _add_parts(scene: Any, parent: str, parts: tuple[MeshPart, ...], *, opacity: float | None = None) -> list[Any]:
+def _add_parts(scene: viser.SceneApi, parent: str, parts: tuple[MeshPart, ...], *,
+               opacity: float | None = None) -> list[viser.MeshHandle]:
     out = []
     for i, p in enumerate(parts):
-        kw = {} if opacity is None else {"opacity": opacity}
         out.append(scene.add_mesh_simple(f"{parent}/mesh_{i}", p.vertices, p.faces, color=p.rgb,
-                                         flat_shading=False, **kw))
+                                         flat_shading=False, opacity=opacity))
     return out
 
 
@@ -289,7 +290,7 @@ class SceneView:
         state = session.pose_state()
         tree = link_tree_paths(k.urdf_path, state.link_names)
         self.link_paths: dict[str, str] = {name: path for name, (path, _) in tree.items()}
-        self.link_frames: dict[str, Any] = {}
+        self.link_frames: dict[str, viser.FrameHandle] = {}
         self._parent = {name: parent for name, (_, parent) in tree.items()}
         # posed nodes: every link but the root (the sender skips those that did not move), then
         # the gizmo; rows of (node, parent) in [links..., T_world_tcp, identity] (render)
@@ -419,24 +420,24 @@ class SceneView:
         self._tip_frame.position = xyz
         self._tip_label.position = tuple(c.reference_tip_world_m + [0.0, 0.0, -0.06])
 
-    def tool_labels(self) -> dict[str, Any]:
+    def tool_labels(self) -> dict[str, viser.LabelHandle]:
         """The labels at the tool and the tip: FLANGE (in the flange frame), TOOL (in the active
         TOOL frame), "reference tip" (WORLD); the wizards' scene places them apart after a result."""
         return {"flange": self._flange_label, "tool": self._active_label, "tip": self._tip_label}
 
     # ------------------------------------------------------------ camera
-    def look_at_tip(self, client: Any) -> None:
+    def look_at_tip(self, client: viser.ClientHandle) -> None:
         """Close-up camera on the reference tip (fine approach) for one browser."""
         closeup_camera(client, self.session.controller.reference_tip_world_m)
 
-    def overview(self, client: Any) -> None:
+    def overview(self, client: viser.ClientHandle) -> None:
         """Camera on the whole cell."""
         overview_camera(client, self.session.controller.reference_tip_world_m)
 
     overview_pose = staticmethod(overview_pose)
 
     # ------------------------------------------------------------ gizmo
-    def _on_gizmo(self, event: Any) -> None:
+    def _on_gizmo(self, event: viser.TransformControlsEvent) -> None:
         """A drag of the gizmo (on viser's event loop, under the session guard).
 
         Drag updates are coalesced: the first one queues a move with ``call_soon``, which runs
