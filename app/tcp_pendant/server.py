@@ -23,10 +23,10 @@ import secrets
 import socket
 import threading
 import time
-from collections.abc import Generator, Sequence
+from collections.abc import Callable, Generator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 from urllib.parse import quote
 
 import numpy as np
@@ -47,12 +47,15 @@ from tcp_pendant.controller import (
     reference_tip_model,
 )
 from tcp_pendant.controller.scenarios import Scenario
-from tcp_pendant.session import Session
+from tcp_pendant.session import GuiTarget, Session
 from tcp_pendant.views import session_view_steps
 from tcp_pendant.views.gui_util import target_of
 from tcp_pendant.views.presenter import PresenterView
 from tcp_pendant.views.scene import overview_camera, overview_pose
 from tcp_pendant.views.meshes import link_meshes, rigid_meshes
+
+if TYPE_CHECKING:
+    import viser
 
 __all__ = ["AppConfig", "PendantApp", "PortInUseError", "default_reference_tip_mm", "is_loopback"]
 
@@ -252,7 +255,7 @@ class PendantApp:
         self.allow_origins = origin_check.parse_allow_origins(config.allow_origins)
         self.library = ToolLibrary(config.tool_library)
         self.robot_label = ROBOT_LABELS.get(config.robot, urdf.stem)
-        self.server: Any = None
+        self.server: viser.ViserServer | None = None
         self.sessions: dict[int, Session] = {}
         self.shared_session: Session | None = None
         self._sessions_lock = threading.Lock()
@@ -281,7 +284,8 @@ class PendantApp:
         c.set_q(self.ready_q_rad)
         return c
 
-    def make_session(self, client: Any | None, target: Any | None = None, *, shared: bool = False) -> Session:
+    def make_session(self, client: viser.ClientHandle | None, target: GuiTarget | None = None, *,
+                     shared: bool = False) -> Session:
         """Build a session drawing into ``target`` (default: ``client``). A per-browser session
         starts with no active tool (TCP = flange); the shared one (``shared``) with the
         library's active tool (module docstring)."""
@@ -289,7 +293,7 @@ class PendantApp:
         assert session is not None
         return session
 
-    def session_steps(self, client: Any | None, target: Any | None = None, *,
+    def session_steps(self, client: viser.ClientHandle | None, target: GuiTarget | None = None, *,
                       shared: bool = False) -> Generator[Session | None, None, None]:
         """:meth:`make_session` step by step: yields None after each step (a view, a few to a few
         tens of ms) and the finished session last (``on_client_connect`` awaits between the
@@ -322,14 +326,14 @@ class PendantApp:
             self.classroom.attach(session)
         yield session
 
-    def close_session(self, client: Any) -> None:
+    def close_session(self, client: viser.ClientHandle) -> None:
         """``on_client_disconnect``: close and forget the browser's session."""
         with self._sessions_lock:
             session = self.sessions.pop(client.client_id, None)
         if session is not None:
             session.close()
 
-    async def _on_connect(self, client: Any) -> None:
+    async def _on_connect(self, client: viser.ClientHandle) -> None:
         """``on_client_connect``, on viser's event loop (every push from the loop's thread): the
         browser's session is built a view at a time, other browsers' callbacks run in between;
         a browser that left meanwhile gets nothing registered."""
@@ -362,7 +366,7 @@ class PendantApp:
         except Exception:
             log.debug("camera of a leaving client", exc_info=True)
 
-    async def _on_disconnect(self, client: Any) -> None:
+    async def _on_disconnect(self, client: viser.ClientHandle) -> None:
         """``on_client_disconnect``, on viser's event loop like every other callback."""
         if not self.config.shared:
             self.close_session(client)
@@ -390,7 +394,7 @@ class PendantApp:
             last = stamp
             self._hand_to_loop(self.library_changed)
 
-    def _hand_to_loop(self, fn: Any) -> None:
+    def _hand_to_loop(self, fn: Callable[[], object]) -> None:
         """Run ``fn()`` on viser's event loop, where every GUI callback runs (from the library
         watcher: its reload pushes messages, which only the loop's thread may do)."""
         server = self.server
