@@ -66,7 +66,8 @@ __all__ = ["GuiTarget", "Session", "SessionChange", "Touch"]
 log = logging.getLogger(__name__)
 F = TypeVar("F", bound=Callable[..., Any])
 
-_COLORS: dict[str, Literal["blue", "green", "yellow", "red"]] = {"info": "blue", "success": "green", "warning": "yellow", "error": "red"}
+_COLORS: dict[str, Literal["blue", "green", "yellow", "red"]] = {
+    "info": "blue", "success": "green", "warning": "yellow", "error": "red"}
 
 
 class GuiTarget(Protocol):

@@ -525,7 +525,8 @@ def _solve(rot: np.ndarray, y: np.ndarray | None, f: np.ndarray, method: str, si
     if cov_unit is None:
         noise2 = noise * noise
         cov = noise2 * m_inv
-        cov_eig: list[float] | np.ndarray = [noise2 / v for v in info.eigvals.tolist()]  # > 0: the touches are observable
+        # > 0: the touches are observable
+        cov_eig: list[float] | np.ndarray = [noise2 / v for v in info.eigvals.tolist()]
     else:
         cov = noise**2 * cov_unit
         cov_eig = np.linalg.eigvalsh(cov)

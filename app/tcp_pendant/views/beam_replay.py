@@ -272,7 +272,8 @@ class ScanPlayer:
         return self._scan
 
     # ------------------------------------------------------------ commands
-    def play(self, scan: BeamScan | RecordedScan, *, owner: object | None = None, return_to: np.ndarray | None = None,
+    def play(self, scan: BeamScan | RecordedScan, *, owner: object | None = None,
+             return_to: np.ndarray | None = None,
              points: Any = None) -> None:
         """Replay ``scan`` from its first move (on the loop: a task at :attr:`rate_hz`; off the
         loop: its last frame at once). A film already playing stops first. A stored scan (no

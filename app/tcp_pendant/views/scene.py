@@ -189,7 +189,8 @@ def _set_pose(handle: Any, wxyz: list[float] | None, xyz: list[float] | None) ->
         n = 0
         if wxyz is not None:
             impl.wxyz[:] = wxyz
-            api._queue_scene_message(_messages.SetOrientationMessage(impl.name, (wxyz[0], wxyz[1], wxyz[2], wxyz[3])))
+            w, x, y, z = wxyz
+            api._queue_scene_message(_messages.SetOrientationMessage(impl.name, (w, x, y, z)))
             n += 1
         if xyz is not None:
             impl.position[:] = xyz
@@ -227,7 +228,8 @@ def camera_shape(client: viser.ClientHandle) -> tuple[float, float, float]:
         return math.radians(50.0), 16.0 / 9.0, 720.0
 
 
-def frame_cameras(clients: list[viser.ClientHandle], centres: np.ndarray, radii: np.ndarray, **framing: Any) -> Framing:
+def frame_cameras(clients: list[viser.ClientHandle], centres: np.ndarray, radii: np.ndarray,
+                  **framing: Any) -> Framing:
     """Frame each browser's camera on the spheres (``framing.frame_spheres`` with that camera's
     shape and the ``framing`` options: ``direction``, ``margin``). Returns the first browser's
     framing (a default camera's when there is none)."""
