@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import asyncio
 import logging
-from collections.abc import Callable
+from collections.abc import Callable, Coroutine
 from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
@@ -38,7 +38,7 @@ from tcp_pendant.pendant import FIELDS, ToolEntry, parse_tool_entry, tool_data_m
 from tcp_pendant.pendant.tool_entry import entry_preview_markdown
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.text_escape import escape_markdown
-from tcp_pendant.controller.spin import DEFAULT_SPIN_ANGLE_DEG, MAX_SPIN_ANGLE_DEG
+from tcp_pendant.controller.spin import DEFAULT_SPIN_ANGLE_DEG, MAX_SPIN_ANGLE_DEG, SpinCheckResult
 from tcp_pendant.views.gui_util import (
     ButtonEvent,
     DropdownEvent,
@@ -147,7 +147,7 @@ class ToolPanel:
         self.check.on_click(self._check_callback(self._selected_for_check))
         self.check_active.on_click(self._check_callback(self._active_for_check))
         self._checking = False
-        self.last_check: tuple[CheckJob, Any] | None = None
+        self.last_check: tuple[CheckJob, SpinCheckResult] | None = None
         self.entry_save.on_click(g(self._on_entry_save))
         for handle in (self.entry_name, *self.entry_fields.values()):
             handle.on_update(g(lambda _e: self._show_entry_preview()))
@@ -304,8 +304,9 @@ class ToolPanel:
         slot = self.session.active_slot
         return (tool.name if slot is None else f"slot {slot}: {tool.name}"), tool
 
-    def _check_callback(self, which: Callable[[], tuple[str, Tool]]) -> Callable[[Any], Any]:
-        async def callback(_event: Any) -> None:
+    def _check_callback(self, which: Callable[[], tuple[str, Tool]]
+                        ) -> Callable[[ButtonEvent], Coroutine[Any, Any, None]]:
+        async def callback(_event: ButtonEvent) -> None:
             await self.run_check(which)
         return callback
 
