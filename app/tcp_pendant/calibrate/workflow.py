@@ -28,7 +28,7 @@ import re
 from collections.abc import Mapping, Sequence
 from datetime import datetime
 from dataclasses import dataclass, field, replace
-from typing import Any, ClassVar, Literal, Protocol
+from typing import Any, ClassVar, Literal, Protocol, cast
 
 import numpy as np
 
@@ -393,7 +393,7 @@ class CalibrationWorkflow:
             if index is not None and i in recorded:
                 self._events.append(TouchRecorded(index, i, recorded[i].T_world_flange_m, joints, d,
                                                   auto=False, overwrite=False))
-        return w
+        return cast(Xyz4Wizard, w)
 
     # ------------------------------------------------------------ navigation
     def _note_distance(self, step: int) -> None:

@@ -1,6 +1,6 @@
 """The class gradebook: every trainee, session, calibration, touch and crash, in one SQLite file.
 
-The server writes each wizard event as it happens (issue 11 item 2); ``tcp-pendant grades``
+The server writes each wizard event as it happens; ``tcp-pendant grades``
 reads it back (:mod:`tcp_pendant.classroom.grades_cli`). Standard library ``sqlite3`` only.
 
 Durability ("a kill -9 of the server loses nothing that was acknowledged on screen"):
@@ -56,7 +56,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass, field
 from datetime import datetime, timezone
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any, Literal, overload
 
 import numpy as np
 import platformdirs
@@ -258,6 +258,10 @@ def to_csv(rows: Sequence[GradeRow]) -> str:
 
 # --------------------------------------------------------------------------- input checks
 
+@overload
+def _label(value: Any, what: str, *, optional: Literal[False] = False) -> str: ...
+@overload
+def _label(value: Any, what: str, *, optional: bool) -> str | None: ...
 def _label(value: Any, what: str, *, optional: bool = False) -> str | None:
     if value is None and optional:
         return None
@@ -266,6 +270,14 @@ def _label(value: Any, what: str, *, optional: bool = False) -> str | None:
     if len(value) > _MAX_TEXT or not value.isprintable():
         raise GradebookError(f"{what} must be at most {_MAX_TEXT} printable characters, got {value!r:.80}.")
     return value
+
+
+def _new_id(cur: sqlite3.Cursor) -> int:
+    """The id of the row an INSERT just added (``lastrowid``, None only before any insert)."""
+    rowid = cur.lastrowid
+    if rowid is None:
+        raise GradebookError("the gradebook added no row")
+    return rowid
 
 
 def _finite(value: Any, what: str, *, optional: bool = False) -> float | None:
@@ -532,8 +544,8 @@ class Gradebook:
             row = db.execute("SELECT id FROM trainees WHERE name = ?", (clean,)).fetchone()
             if row is not None:
                 return int(row[0])
-            return int(db.execute("INSERT INTO trainees (name, created_at) VALUES (?, ?)",
-                                  (clean, _now())).lastrowid)
+            return _new_id(db.execute("INSERT INTO trainees (name, created_at) VALUES (?, ?)",
+                                      (clean, _now())))
 
     def start_session(self, trainee_id: int, mode: str) -> int:
         """A new session (one browser connection) of a trainee; ``mode`` e.g. "own" or "shared"."""
@@ -542,8 +554,8 @@ class Gradebook:
         with self._write() as db:
             if db.execute("SELECT 1 FROM trainees WHERE id = ?", (tid,)).fetchone() is None:
                 raise GradebookError(f"No trainee {tid} in the gradebook {self.path}; add_trainee first.")
-            return int(db.execute("INSERT INTO sessions (trainee_id, mode, started_at) VALUES (?, ?, ?)",
-                                  (tid, mode, _now())).lastrowid)
+            return _new_id(db.execute("INSERT INTO sessions (trainee_id, mode, started_at) VALUES (?, ?, ?)",
+                                      (tid, mode, _now())))
 
     def end_session(self, session_id: int) -> None:
         """Mark a session ended (browser gone); its calibrations stay as they are."""
@@ -574,10 +586,10 @@ class Gradebook:
         with self._write() as db:
             if db.execute("SELECT 1 FROM sessions WHERE id = ?", (sid,)).fetchone() is None:
                 raise GradebookError(f"No session {sid} in the gradebook {self.path}; start_session first.")
-            return int(db.execute(
+            return _new_id(db.execute(
                 "INSERT INTO calibrations (session_id, method, tool_key, exercise_id, truth_json, status, "
                 "started_at) VALUES (?, ?, ?, ?, ?, 'in_progress', ?)",
-                (sid, method, tool_key, exercise, truth_text, _now())).lastrowid)
+                (sid, method, tool_key, exercise, truth_text, _now())))
 
     def record_touch(self, calibration_id: int, step_index: int, T_world_flange_m: Any, joints_deg: Any,
                      distance_mm: float | None, auto: bool, overwritten_touch_id: int | None = None) -> int:
@@ -619,10 +631,10 @@ class Gradebook:
                 if row[1] is not None:
                     raise GradebookError(f"Touch {old} was already overwritten by touch {row[1]}; pass "
                                          f"{row[1]} instead.")
-            new = int(db.execute(
+            new = _new_id(db.execute(
                 "INSERT INTO touches (calibration_id, step_index, recorded_at, T_world_flange_m_json, "
                 "joints_deg_json, distance_mm, auto, overwrites_touch_id) VALUES (?, ?, ?, ?, ?, ?, ?, ?)",
-                (cid, step, _now(), T, q, d, int(bool(auto)), old)).lastrowid)
+                (cid, step, _now(), T, q, d, int(bool(auto)), old)))
             if old is not None:
                 db.execute("UPDATE touches SET overwritten_by_touch_id = ? WHERE id = ?", (new, old))
             return new
@@ -654,8 +666,8 @@ class Gradebook:
                 sid = cal_session
             elif db.execute("SELECT 1 FROM sessions WHERE id = ?", (sid,)).fetchone() is None:
                 raise GradebookError(f"No session {sid} in the gradebook {self.path}.")
-            return int(db.execute("INSERT INTO crashes (session_id, calibration_id, at, penetration_mm, note) "
-                                  "VALUES (?, ?, ?, ?, ?)", (sid, cid, _now(), depth, note)).lastrowid)
+            return _new_id(db.execute("INSERT INTO crashes (session_id, calibration_id, at, penetration_mm, note) "
+                                      "VALUES (?, ?, ?, ?, ?)", (sid, cid, _now(), depth, note)))
 
     def finish_calibration(self, calibration_id: int, figures: Mapping[str, float], *,
                            position_error_mm: float | None, orientation_error_deg: float | None,

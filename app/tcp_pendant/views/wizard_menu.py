@@ -51,6 +51,7 @@ from tcp_pendant.views.gui_util import (
     set_content,
     set_options,
     slot_option,
+    target_of,
 )
 from tcp_pendant.views.beam_replay import ScanPlayer
 from tcp_pendant.views.upload_guard import limit_upload_size
@@ -98,7 +99,7 @@ class CalibrateView:
         self._library: dict[int, Tool] = {}
         self._library_pick: tuple[str, int | None] | None = None   # (option, active slot then)
         self._resume_runs: tuple[int, ...] = ()                    # the runs the Resume list offered
-        gui = session.target.gui
+        gui = target_of(session).gui
         tools = self.workflow.tools
         self._physical = {t.label: key for key, t in tools.items()}
 
@@ -270,7 +271,8 @@ class CalibrateView:
         return None if slot is None else slot_option(slot, self._library[slot].name)
 
     def _selected_slot(self, widget: Any = None) -> int:
-        slot = number_of_option((widget or self.library_tool).value)
+        picked = widget or self.library_tool                     # None: the library is empty
+        slot = None if picked is None else number_of_option(picked.value)
         if slot is None:
             raise ValueError("The tool library is empty: calibrate the TCP first (XYZ 4-point) and save it.")
         return slot
@@ -302,7 +304,7 @@ class CalibrateView:
     def _on_export(self, event: Any) -> None:
         data = dumps(self.workflow.export_record(self.session.touches)).encode("utf-8")
         # to the browser that clicked (in --shared mode the session is every browser's)
-        target = getattr(event, "client", None) or self.session.client or self.session.target
+        target = getattr(event, "client", None) or self.session.client or target_of(self.session)
         target.send_file_download(SESSION_FILENAME, data, save_immediately=True)
         set_content(self.record_md, f"Exported {len(self.workflow.runs)} calibration(s) as {SESSION_FILENAME}.")
 

@@ -675,7 +675,7 @@ class Wizard(abc.ABC):
         if self._status != "cancelled":
             raise WizardStateError("Only a cancelled wizard can be resumed.")
         self._status = getattr(self, "_cancelled_from", "in_progress")
-        return self.result if self._status == "complete" and self._result is not None else self.step
+        return self._result if self._status == "complete" and self._result is not None else self.step
 
     # ----- saving to the library ----------------------------------------------------------
     def _calibration(self, result: WizardResult, figures: Mapping[str, float]) -> Calibration:

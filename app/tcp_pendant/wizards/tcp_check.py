@@ -1,4 +1,4 @@
-"""The TCP check (spin test) as a wizard (issue 12 item 2; methods.md "TCP check").
+"""The TCP check (spin test) as a wizard (methods.md "TCP check").
 
 A technician checks a TCP by putting the tool tip on a fixed spike and reorienting the tool
 about the active TCP by +-A, +-B, +-C: a correct TCP stays on the spike. This wizard takes a

@@ -35,7 +35,7 @@ from tcp_pendant.wizards.describe import (
 )
 
 MIN_DISPLACEMENT_MM = 20.0
-"""Displacements shorter than this give a poor orientation; the wizard warns (issue 5)."""
+"""Displacements shorter than this give a poor orientation; the wizard warns."""
 
 
 class ThreePointWizard(Wizard):
