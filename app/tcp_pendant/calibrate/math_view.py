@@ -49,6 +49,7 @@ from tcp_pendant.text_escape import escape_html, escape_markdown
 
 __all__ = [
     "MATH_FONT_PX",
+    "MAX_LINE",
     "MATH_VIEWS",
     "MathBlock",
     "MathSheet",
@@ -60,6 +61,8 @@ __all__ = [
 
 MATH_FONT_PX = 17
 """Font size of the monospace equations, pixels (28 characters fit the 320 px presenter panel)."""
+MAX_LINE = 25
+"""Longest monospace line, characters: 25 at ``MATH_FONT_PX`` fit the 320 px presenter panel."""
 RANK_TOL = 1e-6
 """A singular value below this times the largest counts as zero (numerical rank)."""
 
@@ -164,36 +167,44 @@ class _Block:
 
     def text(self, line: str) -> None:
         """A line of words or symbols (no decimal number: numbers go through the helpers)."""
-        if _DECIMAL.search(line):
-            raise ValueError(f"block {self.key}: a number in a text line: {line!r}")
+        if _DECIMAL.search(line) or len(line) > MAX_LINE:
+            raise ValueError(f"block {self.key}: a number in a text line, or a line too long: {line!r}")
         self.lines.append(line)
+
+    def _column(self, symbol: str, rows: list[str], unit: str) -> None:
+        """Three bracketed rows with ``symbol =`` on the middle one (or on a line of its own
+        above them when that would pass ``MAX_LINE``), the unit after the middle row."""
+        tail = f" {unit}" if unit else ""
+        head = f"{symbol} = "
+        if len(head) + max(len(r) for r in rows) + 2 + len(tail) > MAX_LINE:   # 2: the brackets
+            self.lines.append(f"{symbol} =")
+            head = "  "
+        pad = " " * len(head)
+        for k, (row, (lb, rb)) in enumerate(zip(rows, (("⎡", "⎤"), ("⎢", "⎥"), ("⎣", "⎦")))):
+            self.lines.append((head if k == 1 else pad) + lb + row + rb + (tail if k == 1 else ""))
 
     def matrix(self, name: str, symbol: str, M: np.ndarray, decimals: int = 3, unit: str = "") -> None:
         """A 3x3 matrix with its symbol on the middle row: ``R₁ = ⎡ ... ⎤``."""
         shown = self._keep(name, M, decimals, unit)
         cells = [[fmt(float(v), decimals) for v in row] for row in shown.value]
         w = max(len(c) for row in cells for c in row)
-        head = f"{symbol} = "
-        pad = " " * len(head)
-        for k, (row, (lb, rb)) in enumerate(zip(cells, (("⎡", "⎤"), ("⎢", "⎥"), ("⎣", "⎦")))):
-            body = lb + " ".join(c.rjust(w) for c in row) + rb
-            self.lines.append((head if k == 1 else pad) + body + (f" {unit}" if unit and k == 1 else ""))
+        self._column(symbol, [" ".join(c.rjust(w) for c in row) for row in cells], unit)
 
     def vector(self, name: str, symbol: str, v: np.ndarray, decimals: int = 2, unit: str = "mm") -> None:
         """A 3-vector as a column, its symbol and unit on the middle row."""
         shown = self._keep(name, v, decimals, unit)
         cells = [fmt(float(x), decimals) for x in shown.value]
         w = max(len(c) for c in cells)
-        head = f"{symbol} = "
-        pad = " " * len(head)
-        for k, (c, (lb, rb)) in enumerate(zip(cells, (("⎡", "⎤"), ("⎢", "⎥"), ("⎣", "⎦")))):
-            self.lines.append((head if k == 1 else pad) + lb + c.rjust(w) + rb
-                              + (f" {unit}" if unit and k == 1 else ""))
+        self._column(symbol, [c.rjust(w) for c in cells], unit)
 
     def scalar(self, name: str, symbol: str, x: float, decimals: int = 2, unit: str = "mm") -> None:
         shown = self._keep(name, x, decimals, unit)
         u = {"deg": "°", "": ""}.get(unit, f" {unit}")
-        self.lines.append(f"{symbol} = {fmt(float(shown.value), decimals)}{u}")
+        text = f"{fmt(float(shown.value), decimals)}{u}"
+        if len(symbol) + 3 + len(text) > MAX_LINE:
+            self.lines += [f"{symbol} =", f"  {text}"]
+        else:
+            self.lines.append(f"{symbol} = {text}")
 
     def numbers(self, name: str, symbol: str, xs: Sequence[float], decimals: int = 3) -> None:
         """A short list on one line: ``σ = 1.234  0.567  0.000``."""
@@ -250,7 +261,7 @@ def _pair_block(a: int, b_: int, Ra: np.ndarray, Rb: np.ndarray, fa: np.ndarray,
     rank, s, u = rank_and_singular_values(D)
     blk = _Block("pair", "(4P-2) · lecture Eq. (7)",
                  f"one pair, touches {A} and {B}")
-    blk.text(f"(R{sub(A)} − R{sub(B)}) t = −(f{sub(A)} − f{sub(B)})")
+    blk.text(f"(R{sub(A)}−R{sub(B)}) t = −(f{sub(A)}−f{sub(B)})")
     blk.matrix("R_a-R_b", f"R{sub(A)}−R{sub(B)}", D)
     blk.vector("-(f_a-f_b)", f"−(f{sub(A)}−f{sub(B)})", y)
     blk.numbers("sigma", "σ", s)
@@ -296,7 +307,7 @@ def _stack_block(steps: Sequence[int], R: np.ndarray, f: np.ndarray) -> tuple[Ma
                      "be determined; tilt the tool about a second axis.")
     else:
         t_pinv = np.linalg.pinv(D) @ y          # t = -[R_a - R_b]^+ [f_a - f_b]   (Eq. 8)
-        blk.text("t = −[R_a − R_b]† [f_a − f_b]")
+        blk.text("t = −[R_a−R_b]†[f_a−f_b]")
         blk.vector("t_pinv", "t", t_pinv)
         blk.note("Eq. (8): the pseudo-inverse of the stacked differences (tcpcal's pairwise "
                  "estimator uses these same consecutive pairs).")
@@ -419,9 +430,9 @@ def reference_sheet(wizard: Any) -> MathSheet:
                        "the new tool touches the same point")
             b.matrix("R_2", "R₂", R[j])
             b.vector("f_2", "f₂", f[j])
-            b.text("t₂ = r − f₂  (WORLD)")
+            b.text("t₂ = r − f₂  WORLD")
             b.vector("t_2_world", "t₂", r - f[j])
-            b.text("ᶠt₂ = R₂ᵀ (r − f₂)  (FLANGE)")
+            b.text("ᶠt₂ = R₂ᵀ(r − f₂) FLANGE")
             b.vector("t_2", "ᶠt₂", R[j].T @ (r - f[j]))
             b.note("One touch per tool: the new TCP carries the errors of both touches and of t₁.")
             blocks.append(b.build())
@@ -459,7 +470,8 @@ def three_point_sheet(wizard: Any) -> MathSheet:
         b.scalar("delta1", "Δ1", delta1)
         if delta1 < 0:
             c1 = d1 / delta1
-            b.text("(c11, c21, c31) = (V(1) − t) / Δ1")
+            b.text("c1 = (c11, c21, c31)")
+            b.text("   = (V(1) − t) / Δ1")
             b.vector("c1", "c1", c1, decimals=3, unit="")
         else:
             b.note("The tip was not moved off the TCP: Δ1 = 0, tool X is undefined.")
@@ -478,7 +490,8 @@ def three_point_sheet(wizard: Any) -> MathSheet:
             b.scalar("delta2", "Δ2", delta2)
             if delta2 > 0:
                 c2_raw = w / delta2
-                b.text("(c12, c22, c32) = (V(2) − t) / Δ2")
+                b.text("c2 = (c12, c22, c32)")
+                b.text("   = (V(2) − t) / Δ2")
                 b.vector("c2", "c2", c2_raw, decimals=3, unit="")
                 cos = float(c1 @ c2_raw)
                 b.scalar("c1.c2", "c1 · c2", cos, decimals=3, unit="")
@@ -504,7 +517,8 @@ def three_point_sheet(wizard: Any) -> MathSheet:
             b.scalar("delta4", "Δ4", delta4)
             c2 = p / delta4 if delta4 > 0 else None
             if c2 is not None:
-                b.text("(c12, c22, c32) = (V(3) − t − Δ3 c1) / Δ4")
+                b.text("c2 = (c12, c22, c32)")
+                b.text("   = (V(3)−t−Δ3 c1)/Δ4")
                 b.vector("c2", "c2", c2, decimals=3, unit="")
                 b.scalar("c1.c2", "c1 · c2", float(c1 @ c2), decimals=3, unit="")
                 b.scalar("defect", "defect", 0.0, unit="deg")
