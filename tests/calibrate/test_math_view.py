@@ -25,7 +25,8 @@ from tcp_pendant.calibrate.math_view import MAX_LINE, MathSheet, math_sheet
 from tcp_pendant.text_escape import escape_markdown
 
 sys.path.insert(0, str(Path(__file__).parent))
-from calib_helpers import library_tool_with_true_tcp  # noqa: E402
+from calib_helpers import library_tool_with_true_tcp, true_frame  # noqa: E402
+from tcpcal.tool import Tool  # noqa: E402
 
 P_PARALLEL = np.array([[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]])   # (PA-1)
 _BLOCK = re.compile(r'<div class="math-block" data-key="([^"]+)"[^>]*>(.*?)</div>', re.S)
@@ -414,3 +415,27 @@ def test_a_wizard_without_a_math_view_has_no_sheet() -> None:
         title = "Plain"
 
     assert math_sheet(Plain()) is None
+
+
+# ------------------------------------------------------------------ TCP check (spin test)
+def test_spin_check_math_bounds_the_drifts_by_the_tcp_error(page) -> None:
+    p = page(tool="torch")
+    v, s = p.view, p.session
+    tcp, _, abc = true_frame("torch")
+    off = np.array([0.6, -0.48, 0.64])                              # 1 mm off in FLANGE
+    s.library.save(1, Tool(name="Off", tcp_mm=tuple(float(x) for x in tcp + off),
+                           abc_deg=tuple(float(x) for x in abc)))
+    with s.lock:
+        s.start_wizard("tcp-check", slot=1)
+        assert s.auto_touch(AutoTouchRequest(tilt_deg=25.0, azimuth_deg=30.0)).ok
+        s.next_step()                                               # the six spins, here synchronously
+    check = s.workflow.result.check
+    sheet, md = v.math.sheet, math_md(v)
+    drifts = [r.deviation_mm for r in check.rows if r.reached]
+    np.testing.assert_allclose(value(sheet, "spin", "drifts"), drifts, atol=0)
+    e = check.implied_tcp_error_mm
+    assert e == pytest.approx(1.0, abs=0.05)
+    bound = float(value(sheet, "spin", "bound"))
+    assert bound == pytest.approx(2.0 * math.sin(math.radians(15.0)) * e, abs=1e-12)
+    assert max(drifts) <= bound + 0.01                              # methods.md section 10
+    assert_text_is_the_numbers(md, sheet)

@@ -2,7 +2,8 @@
 
 For the wizard on show, :func:`math_sheet` computes the equations that its method solves
 (``docs/methods.md`` and the course's lecture and paper, with their labels: (4P-1) ... (4P-3),
-the lecture's Eqs. (7) and (8), (REF-1), (PA-1)/(PA-2), the paper's (7) ... (30), (BEAM-1)),
+the lecture's Eqs. (1)-(3), (7) and (8), (REF-1), (PA-1)/(PA-2) (the paper's Eqs. 4-6), the
+paper's (7) ... (30), (ZX-1) ... (ZX-3), (BEAM-1)/(BEAM-2), (SC-1)/(SC-2)),
 from the **same recorded poses the solver uses**: ``T_world_flange_m[:3, :3]`` and
 ``T_world_flange_m[:3, 3] * 1000`` (metres to mm), in step order, as each wizard's
 ``_compute`` hands them to ``tcpcal``. Where the method's result is a ``tcpcal`` solve, the
@@ -209,7 +210,19 @@ class _Block:
     def numbers(self, name: str, symbol: str, xs: Sequence[float], decimals: int = 3) -> None:
         """A short list on one line: ``σ = 1.234  0.567  0.000``."""
         shown = self._keep(name, np.asarray(xs, dtype=float), decimals, "")
-        self.lines.append(f"{symbol} = " + "  ".join(fmt(x, decimals) for x in shown.flat()))
+        items = [fmt(x, decimals) for x in shown.flat()]
+        one = f"{symbol} = " + "  ".join(items)
+        if len(one) <= MAX_LINE:
+            self.lines.append(one)
+            return
+        self.lines.append(f"{symbol} =")              # then as many a line as fit
+        line = " "
+        for item in items:
+            if len(line) + 2 + len(item) > MAX_LINE:
+                self.lines.append(line)
+                line = " "
+            line += "  " + item
+        self.lines.append(line)
 
     def note(self, words: str) -> None:
         self.notes.append(words)
@@ -587,7 +600,7 @@ def tcp_zx_sheet(wizard: Any, pair: tuple[int, int] | None = None) -> MathSheet:
                 _, Rk, fk = _poses_mm(wizard, rows[:1])
                 v = Rk[0].T @ (r - fk[0]) - t
                 d = float(np.linalg.norm(v))
-                b = _Block(f"axis-{role}", "methods.md §8",
+                b = _Block(f"axis-{role}", "(ZX-1) · (ZX-3)" if role == "z" else "(ZX-2) · (ZX-3)",
                            f"the reference on the tool's +{role.upper()} axis: R_kᵀ (r − f_k) − t = d_k {role}")
                 b.matrix("R_k", "R_k", Rk[0])
                 b.vector("f_k", "f_k", fk[0])
@@ -603,7 +616,8 @@ def tcp_zx_sheet(wizard: Any, pair: tuple[int, int] | None = None) -> MathSheet:
                 x = xm - (xm @ z) * z
                 x = x / np.linalg.norm(x)
                 y = np.cross(z, x)
-                b = _Block("frame", "methods.md §8", "z kept, x orthogonalised (Gram-Schmidt), y = z × x")
+                b = _Block("frame", "methods.md §8 step 5", "z defines, x only completes: x orthogonalised "
+                           "(Gram-Schmidt keeping z), y = z × x")
                 b.scalar("defect", "|90° − ∠(x, z)|", abs(90.0 - angle), unit="deg")
                 Rt = np.column_stack([x, y, z])
                 b.matrix("R_flange_tool", "[x y z]", Rt)
@@ -638,7 +652,7 @@ def beam_sheet(wizard: Any) -> MathSheet:
     if tips:
         A = np.vstack(rows)
         rank, s, _ = rank_and_singular_values(A)
-        b = _Block("stack", "(BEAM-1) stacked", f"{len(tips)} tip events: (P R_i) t = −P (f_i − b)")
+        b = _Block("stack", "(BEAM-1) stacked · (BEAM-2)", f"{len(tips)} tip events: (P R_i) t = −P (f_i − b)")
         b.numbers("sigma", "σ", s)
         b.text(f"rank {rank} of 3")
         res = wizard.result
@@ -656,14 +670,14 @@ def spin_check_sheet(wizard: Any) -> MathSheet:
     check = getattr(wizard, "check", None)
     if check is None:
         return MathSheet("spin_check", wizard.title, (), "No check run yet.")
-    b = _Block("spin", "methods.md §10", "drift |(R_new − R_old)(t − t_s)| ≤ 2 sin(θ/2) |t − t_s|")
+    b = _Block("spin", "(SC-1), (SC-2)", "drift |d_i| = 2 |sin(θ/2)| |e_⊥| ≤ 2 sin(θ/2) |e|, e = t − t_s")
     b.scalar("theta", "θ", float(check.angle_deg), unit="deg")
     devs = [float(r.deviation_mm) for r in check.rows if r.reached]
-    b.numbers("drifts", "drift (mm)", devs, decimals=2)
+    b.numbers("drifts", "drifts (mm)", devs, decimals=2)
     if check.implied_tcp_error_mm is not None:
         e = float(check.implied_tcp_error_mm)
-        b.scalar("error", "|t − t_s|", e)
-        b.scalar("bound", "2 sin(θ/2) |t − t_s|", 2.0 * math.sin(math.radians(float(check.angle_deg)) / 2.0) * e)
+        b.scalar("error", "|e| (SC-2)", e)
+        b.scalar("bound", "2 sin(θ/2) |e|", 2.0 * math.sin(math.radians(float(check.angle_deg)) / 2.0) * e)
     return MathSheet("spin_check", wizard.title, (b.build(),))
 
 
