@@ -207,7 +207,7 @@ class _Block:
         else:
             self.lines.append(f"{symbol} = {text}")
 
-    def numbers(self, name: str, symbol: str, xs: Sequence[float], decimals: int = 3) -> None:
+    def numbers(self, name: str, symbol: str, xs: Sequence[float] | np.ndarray, decimals: int = 3) -> None:
         """A short list on one line: ``σ = 1.234  0.567  0.000``."""
         shown = self._keep(name, np.asarray(xs, dtype=float), decimals, "")
         items = [fmt(x, decimals) for x in shown.flat()]
@@ -331,7 +331,7 @@ def _lstsq_block(R: np.ndarray, f: np.ndarray, t_pinv: np.ndarray | None) -> tup
     """(4P-3) by tcpcal's solve_xyz4 (the solver), set beside the pseudo-inverse."""
     blk = _Block("lstsq", "(4P-3)", "joint least squares, x = (t, r): [R_i  −I] x = −f_i")
     try:
-        res = solve_xyz4(R, f, method="lstsq")
+        res = solve_xyz4(R, f, method="lstsq", detect_outliers=False)   # t, r: the same; cheaper
     except TcpcalError as exc:
         blk.text("no solution yet")
         blk.note(f"tcpcal: {exc}")

@@ -41,7 +41,9 @@ class MathView:
 
     def __init__(self, session: Session) -> None:
         self.session = session
-        gui = session.target.gui
+        target = session.target
+        assert target is not None, "The math view needs the session's GUI (a browser or the shared GUI)."
+        gui = target.gui
         self.folder = gui.add_folder("The math", visible=False)
         with self.folder:
             self.pair = gui.add_dropdown("Pair (4P-2)", (LATEST_PAIR,), initial_value=LATEST_PAIR, visible=False,
