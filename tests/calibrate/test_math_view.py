@@ -148,6 +148,7 @@ def test_xyz4_math_is_live_from_the_first_touch_and_matches_numpy(page) -> None:
     np.testing.assert_allclose(t_pinv, res.estimators["pairwise"].tcp, atol=1e-9)     # tcpcal's pairwise
     # (4P-3): the solver's number, and numpy's
     t, r = lstsq_4p3(R, f)
+    np.testing.assert_allclose(value(sheet, "lstsq", "t_pinv"), t_pinv, atol=1e-9)        # side by side
     np.testing.assert_allclose(value(sheet, "lstsq", "t_lstsq"), res.tcp_mm, atol=1e-12)
     np.testing.assert_allclose(value(sheet, "lstsq", "t_lstsq"), t, atol=1e-8)
     np.testing.assert_allclose(value(sheet, "lstsq", "r_lstsq"), r, atol=1e-8)

@@ -337,7 +337,9 @@ def _lstsq_block(R: np.ndarray, f: np.ndarray, t_pinv: np.ndarray | None) -> tup
         blk.note(f"tcpcal: {exc}")
         return blk.build(), None
     t = np.asarray(res.tcp, dtype=float)
-    blk.vector("t_lstsq", "t", t)
+    if t_pinv is not None:                       # side by side: Eq. (8), then (4P-3)
+        blk.vector("t_pinv", "t (Eq. 8)", t_pinv)
+    blk.vector("t_lstsq", "t (4P-3)", t)
     blk.vector("r_lstsq", "r", np.asarray(res.reference, dtype=float))
     blk.scalar("ci95", "95 % radius", float(res.ci95_radius))
     if t_pinv is not None:
