@@ -1,4 +1,4 @@
-"""Issue 14 item 3 in the scene and the result panel: the "Automatic (beam)" wizard's result is
+"""In the scene and the result panel: the "Automatic (beam)" wizard's result is
 replayed on the robot (the film of its scan, the robot left at the scan's end, a marker per event
 on the beam), the camera frames the sensor, "Replay scan" plays it again, another calibration
 clears it, and the result text sets automatic against by hand with the errors of both against the
@@ -93,7 +93,7 @@ def test_the_beam_result_is_replayed_framed_and_compared_with_the_manual_one(pag
     # the result: events, real-robot time next to the manual time, the errors of both vs truth
     text = v.result.result_md.content
     assert f"**Events** ({len(scan.events)})" in text
-    assert "on a real robot" in text and "(your time)" in text
+    assert "on a real robot" in text and "(by Auto-touch)" in text and "(Auto-touch's clicks)" in text
     assert "| calibration | time | TCP error | direction error |" in text
     assert v.result.replay_scan.visible
 

@@ -12,13 +12,15 @@ def test_defaults() -> None:
     a = build_parser().parse_args([])
     assert (a.robot, a.tool, a.host, a.port, a.shared, a.reference_tip) == ("kr6", "pointer", "127.0.0.1", 8080,
                                                                              False, None)
+    assert a.seed is None and build_parser().parse_args(["--seed", "42"]).seed == 42
 
 
 @pytest.mark.parametrize("argv,needle", [(["--robot", "nope"], "Unknown robot"),
                                          (["--robot", "/no/such.urdf"], "not found"),
                                          (["--reference-tip", "1,2"], "X,Y,Z"),
                                          (["--flange-link", "hand"], "no link 'hand'"),
-                                         (["--port", "70000"], "--port")])
+                                         (["--port", "70000"], "--port"),
+                                         (["--seed", "-3"], "seed must be a whole number >= 0")])
 def test_bad_options_exit_2_with_message(argv: list[str], needle: str, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(argv) == 2
     assert needle in capsys.readouterr().err
@@ -70,7 +72,7 @@ def test_command_serves_prints_the_url_and_stops_on_ctrl_c(tmp_path, host: str, 
     try:
         url = re.search(r"http://\S+", line).group(0)
         urls = [url]
-        if host == "0.0.0.0":                 # issue 13: the URLs trainees can open, not 127.0.0.1
+        if host == "0.0.0.0":                 # the URLs trainees can open, not 127.0.0.1
             from tcp_pendant.addresses import interface_addresses
 
             assert proc.stdout is not None
@@ -95,7 +97,8 @@ def test_command_serves_prints_the_url_and_stops_on_ctrl_c(tmp_path, host: str, 
 
 
 def test_busy_port_is_refused_with_a_hint(tmp_path) -> None:
-    """Issue 13: viser moved on to the next port silently while the class had been told this one."""
+    """A busy port is refused: viser must not move on to the next port silently while the class
+    was told this one."""
     import socket
     import subprocess
     import sys

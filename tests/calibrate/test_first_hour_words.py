@@ -1,9 +1,11 @@
-"""Issue 13 ("Using it"): the words a trainee sees in the first hour, and the library tool the
+"""The words a trainee sees in the first hour, and the library tool the
 orientation wizards offer first."""
 
 from __future__ import annotations
 
+import re
 import sys
+from datetime import datetime
 from pathlib import Path
 
 import pytest
@@ -64,8 +66,11 @@ def test_left_half_way_lists_only_runs_still_to_do(workflow) -> None:
     wf.start("xyz4")
     wf.auto_touch(AutoTouchRequest())                # run 3: half-way
     wf.start("xyz4")                                  # run 4 open: the others are cancelled
-    labels = [label for _, label in wf.resumable()]
-    assert labels == ["3: XYZ 4-point, 1 of 4 recorded", "2: XYZ 4-point, finished, not saved"]
+    labels = [re.sub(r"started \d\d:\d\d$", "started HH:MM", label) for _, label in wf.resumable()]
+    assert labels == ["3: XYZ 4-point, at step 2 of 4 (1 recorded), started HH:MM",
+                      "2: XYZ 4-point, result not saved, started HH:MM"]
+    started = datetime.fromisoformat(wf.runs[2].wizard.started_at.replace("Z", "+00:00")).astimezone()
+    assert wf.resumable()[0][1].endswith(started.strftime("%H:%M"))      # the server's local time
     assert wf.resume().kind == "xyz4" and wf.run is wf.runs[2]          # newest still to do
     wf.resume(1)                                     # the unsaved result can be saved later
     assert wf.result is not None and not wf.result_saved
@@ -85,7 +90,7 @@ def test_a_saved_run_changed_afterwards_is_listed_again(workflow) -> None:
     wf.back()                                        # a step back: the saved result no longer stands
     wf.next()                                        # finished again: a new result, not saved
     wf.cancel()
-    assert [label for _, label in wf.resumable()] == ["1: XYZ 4-point, finished, not saved"]
+    assert [label.split(", started")[0] for _, label in wf.resumable()] == ["1: XYZ 4-point, result not saved"]
 
 
 class _T:
@@ -144,3 +149,55 @@ def test_tool_data_defaults_to_the_active_slot_not_slot_1(tmp_path) -> None:
     finally:
         p.ws.close()
         app.stop()
+
+
+def test_the_4_point_steps_ask_for_what_the_meter_can_reward() -> None:
+    """Touch 2 is the first tilt (no 'different axis than before' when nothing was tilted),
+    touch 3 asks for another axis, and every tilt asked for is the least the meter calls far
+    enough (``MIN_TILT_DEG``)."""
+    from tcp_pendant.calibrate.diversity import MIN_TILT_DEG
+    from tcp_pendant.wizards import Xyz4Wizard
+
+    steps = Xyz4Wizard(n_points=4).steps
+    assert "about one axis" in steps[1].instruction and "before" not in steps[1].instruction
+    assert "another axis than for touch 2" in steps[2].instruction
+    for step in steps[1:]:
+        assert f"{MIN_TILT_DEG:.0f} to 60 degrees" in step.instruction, step.index
+
+
+def test_the_touch_list_points_at_the_wizards_touches(tmp_path) -> None:
+    """With no free touch but four wizard touches the Jog tab's Touches list does not say
+    'No touch recorded' (it did): it says where they are."""
+    from calib_helpers import make_session
+    from tcp_pendant.calibrate.text import empty_touches_markdown
+
+    s = make_session(tmp_path / "tools.json", seed=4)
+    assert empty_touches_markdown(s.workflow.wizard) == "*No touch recorded.*"
+    s.start_wizard("xyz4")
+    for _ in range(4):
+        s.auto_touch(AutoTouchRequest())
+    text = empty_touches_markdown(s.workflow.wizard)
+    assert "No touch recorded with Record point" in text and "has 4 touches of its own" in text
+    s.cancel_wizard()
+    assert empty_touches_markdown(s.workflow.wizard) == "*No touch recorded.*"
+
+
+def test_exact_touches_are_not_called_outside_the_95_percent_radius(tmp_path) -> None:
+    """sigma 0: an error of ~1e-12 mm next to a radius of ~1e-13 mm was 'outside the 95 %
+    radius' beside '0.000 mm, good'."""
+    from calib_helpers import make_session
+    from tcp_pendant.calibrate.text import truth_markdown
+
+    s = make_session(tmp_path / "tools.json", seed=6)
+    s.start_wizard("xyz4")
+    while s.workflow.result is None:
+        s.auto_touch(AutoTouchRequest(sigma_mm=0.0))
+    truth = s.workflow.truth()
+    assert truth.position_error_mm < 1e-6 and truth.inside_ci95 is True and truth.grade == "good"
+    md = truth_markdown(truth)
+    assert "outside" not in md and "the computed TCP is the true one" in md
+    s.back()                                     # a touch 2 mm off: a real error, judged as before
+    s.auto_touch(AutoTouchRequest(sigma_mm=2.0))
+    noisy = s.workflow.truth()
+    assert noisy.position_error_mm > 1e-3
+    assert ("inside" if noisy.inside_ci95 else "**outside**") in truth_markdown(noisy)

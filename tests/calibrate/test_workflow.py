@@ -128,7 +128,7 @@ def test_starting_another_wizard_keeps_the_open_one_resumable(workflow) -> None:
     poses = {i: p.T_world_flange_m.copy() for i, p in first.recorded_poses.items()}
     wf.start("xyz4", n_points=5)
     assert first.status == "cancelled" and [i for i, _ in wf.resumable()] == [0]
-    assert "2 of 4 recorded" in wf.resumable()[0][1]
+    assert "at step 3 of 4 (2 recorded), started " in wf.resumable()[0][1]
     wf.resume(0)
     assert wf.wizard is first and first.status == "in_progress" and first.step_index == 2
     for i, T in poses.items():

@@ -29,8 +29,8 @@ from tcp_pendant.wizards import BeamWizard, ManualComparison, TcpCheckWizard, Wi
 if TYPE_CHECKING:
     from tcp_pendant.calibrate.workflow import CalibrationWorkflow
 
-__all__ = ["EXERCISE_REFUSAL", "JOBS", "BeamScanJob", "ControllerJob", "TcpCheckJob", "beam_scan_job",
-           "spin_check_job"]
+__all__ = ["EXERCISE_REFUSAL", "JOBS", "POSE_CHECKS", "BeamScanJob", "ControllerJob", "TcpCheckJob",
+           "beam_scan_job", "spin_check_job", "spin_clearance"]
 
 EXERCISE_REFUSAL = ("{what} is off during the trainer's exercise: the beam sensor would measure the "
                     "exercise's tool for you. Calibrate it by touching the reference tip (XYZ 4-point, "
@@ -45,7 +45,9 @@ class ControllerJob(Protocol):
     own copies of the robot models; the controller is not moved), the outcome handed back on
     the loop (:meth:`CalibrationWorkflow.give_controller_job`)."""
 
-    wizard: Wizard
+    @property
+    def wizard(self) -> Wizard:
+        """The wizard that waits for the job."""
 
     @property
     def busy_text(self) -> str:
@@ -205,6 +207,29 @@ def beam_scan_job(workflow: CalibrationWorkflow, wizard: Wizard) -> BeamScanJob 
         raise WizardStateError(str(exc)) from exc
     return BeamScanJob(beam, nominal, physical, c.q_rad.copy(), c.beam_sensor, shape, T_plan, config,
                        seed=int(workflow.rng.integers(2**31)), manual=workflow.manual_comparison())
+
+
+def spin_clearance(workflow: CalibrationWorkflow, wizard: Wizard) -> Callable[[], str | None]:
+    """For Auto-touch of a TCP check: a pose serves only when all six rotations of the check
+    can be made from it (a rotation stopped at a joint limit proves nothing). The probe runs
+    the check's rotations on the controller's model from its joints now (0.05-0.3 s; the
+    controller is not moved) and names the rotations that cannot be made."""
+    check = cast(TcpCheckWizard, wizard)          # the class that names this job ("spin_check")
+    c = workflow.controller
+
+    def probe() -> str | None:
+        result = spin_check(c.kinematics, c.q_rad, T_flange_tool_m(check.tool), c.mounted_tool.T_flange_tool_true,
+                            angle_deg=check.angle_deg, settings=c.settings)
+        missing = [r.label for r in result.rotations if not r.reached]
+        return None if not missing else f"{', '.join(missing)} of the check could not be made from that pose"
+
+    return probe
+
+
+POSE_CHECKS: dict[str, Callable[[CalibrationWorkflow, Wizard], Callable[[], str | None]]] = {
+    "spin_check": spin_clearance,
+}
+"""``Wizard.controller_job`` name -> a check that Auto-touch's pose serves that job."""
 
 
 JOBS: dict[str, Callable[[CalibrationWorkflow, Wizard], ControllerJob | None]] = {

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Collection, Mapping, Sequence
+from typing import TYPE_CHECKING, Literal
 
 from tcp_pendant.pendant.formatting import fmt_num
 from tcp_pendant.text_escape import escape_markdown as _esc
@@ -27,9 +28,12 @@ from tcp_pendant.wizards import (
     wizard_class,
 )
 from tcp_pendant.wizards.registry import wizard_class
+
+if TYPE_CHECKING:
+    from tcp_pendant.wizards.xyz4 import Estimator
 from tcp_pendant.wizards.tcp_check import tcp_check_markdown
 from tcp_pendant.wizards.session_record import ReplayCheck
-from tcp_pendant.wizards.truth import TruthComparison
+from tcp_pendant.wizards.truth import NUMERICAL_NOISE_MM, TruthComparison
 from tcpcal.pose_quality import CandidateGain, PoseQuality
 
 __all__ = [
@@ -46,6 +50,7 @@ __all__ = [
     "step_markdown",
     "steps_list_markdown",
     "truth_markdown",
+    "empty_touches_markdown",
     "warnings_markdown",
 ]
 
@@ -128,7 +133,7 @@ FULL_DIVERSITY_DEG = 45.0
 section 7: touches 45 degrees apart about different axes give several times smaller errors)."""
 
 
-def meter_level(gain: CandidateGain) -> tuple[float, str]:
+def meter_level(gain: CandidateGain) -> tuple[float, Literal["red", "yellow", "green"]]:
     """The pose-diversity meter as a bar: (0..100, colour).
 
     The bar is the angle from the current orientation to the nearest recorded one, full at
@@ -299,16 +304,22 @@ def _beam_lesson_markdown(result: BeamWizardResult, truth: TruthComparison | Non
         return ("**Automatic vs by hand:** no manual calibration of this tool in this session yet. "
                 f"The scan takes {duration_words(result.duration_s)} on a real robot; calibrate the tool by hand "
                 "(e.g. XYZ 4-point) and scan again to compare.")
-    name = f"{manual.run_number}: {_esc(manual.title)} (by hand)"
+    if manual.auto_touches == 0:
+        who, whose = "by hand", "your time"
+    elif manual.auto_touches >= manual.touches:
+        who, whose = "by Auto-touch", "Auto-touch's clicks"
+    else:
+        who, whose = f"{manual.auto_touches} of {manual.touches} touches by Auto-touch", "your time"
+    name = f"{manual.run_number}: {_esc(manual.title)} ({who})"
     if truth is None:
         return ("**Automatic vs by hand** (same tool)\n\n| calibration | time |\n|---|---|\n"
                 f"| Automatic (beam) | {duration_words(result.duration_s)} on a real robot |\n"
-                f"| {name} | {duration_words(manual.wall_time_s)} (your time) |")
+                f"| {name} | {duration_words(manual.wall_time_s)} ({whose}) |")
     head = ("**Automatic vs by hand** (same tool, against the true tool)\n\n"
             "| calibration | time | TCP error | direction error |\n|---|---|---|---|")
     beam = (f"| Automatic (beam) | {duration_words(result.duration_s)} on a real robot | "
             f"{_mm(truth.position_error_mm, 3)} | {_deg(truth.x_axis_error_deg, 3)} |")
-    hand = (f"| {name} | {duration_words(manual.wall_time_s)} (your time) | {_mm(manual.position_error_mm, 3)} | "
+    hand = (f"| {name} | {duration_words(manual.wall_time_s)} ({whose}) | {_mm(manual.position_error_mm, 3)} | "
             f"{_deg(manual.direction_error_deg, 3)} |")
     return "\n".join([head, beam, hand])
 
@@ -318,6 +329,16 @@ def _touch_numbers(result: WizardResult) -> Sequence[int]:
     the 4-point's, says which it used: ``used_indices``)."""
     used = getattr(result, "used_indices", None)
     return range(len(result.per_touch_error_mm)) if used is None else used
+
+
+def empty_touches_markdown(wizard: Wizard | None) -> str:
+    """What the Touches list says with no free touch (Record point): "No touch recorded", or,
+    while a wizard on show has recorded steps, that they are its (our words and numbers)."""
+    n = 0 if wizard is None or wizard.status == "cancelled" else len(wizard.recorded_poses)
+    if wizard is None or n == 0:
+        return "*No touch recorded.*"
+    return (f"*No touch recorded with Record point. The {_esc(wizard.title)} wizard has {n} "
+            f"touch{'es' if n != 1 else ''} of its own: they are in its step list above.*")
 
 
 def warnings_markdown(result: WizardResult) -> str:
@@ -351,8 +372,11 @@ def truth_markdown(cmp: TruthComparison) -> str:
         lines.append(f"Orientation error: **{_deg(cmp.orientation_error_deg, 3)}** "
                      f"(tool X: {_deg(cmp.x_axis_error_deg, 3)})")
     if cmp.inside_ci95 is not None:
-        lines.append("The true TCP is " + ("inside" if cmp.inside_ci95 else "**outside**")
-                     + " the 95 % radius.")
+        if cmp.position_error_mm < NUMERICAL_NOISE_MM:
+            lines.append("The touches were exact (no operator error): the computed TCP is the true one.")
+        else:
+            lines.append("The true TCP is " + ("inside" if cmp.inside_ci95 else "**outside**")
+                         + " the 95 % radius.")
     return "\n\n".join(lines)
 
 
@@ -374,7 +398,7 @@ def replay_markdown(checks: Sequence[ReplayCheck]) -> str:
     return head + "\n" + "\n".join(rows)
 
 
-def estimator_options() -> dict[str, str]:
+def estimator_options() -> dict[str, Estimator]:
     """Dropdown label -> estimator key, in the wizard's order."""
     return {label: key for key, label in ESTIMATOR_LABELS.items()}
 

@@ -24,16 +24,18 @@ another wizard only cancels (never deletes) the one that was open.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping, Sequence
+from datetime import datetime
 from dataclasses import dataclass, field, replace
-from typing import Any, ClassVar, Literal, Protocol
+from typing import Any, ClassVar, Literal, Protocol, cast
 
 import numpy as np
 
 from tcp_pendant.controller import T_flange_tool_m, ToolModel, VirtualController, builtin_tools
 from tcp_pendant.controller.errors import ControllerError
 from tcp_pendant.calibrate.autotouch import AutoTouchOutcome, auto_touch
-from tcp_pendant.calibrate.jobs import EXERCISE_REFUSAL, JOBS, ControllerJob
+from tcp_pendant.calibrate.jobs import EXERCISE_REFUSAL, JOBS, POSE_CHECKS, ControllerJob
 from tcp_pendant.calibrate.diversity import failure_in_words
 from tcp_pendant.calibrate.library_save import save_result
 from tcp_pendant.events import (
@@ -77,6 +79,8 @@ __all__ = [
     "ToolState",
 ]
 
+_ANGLE_APART = re.compile(r"\(([0-9.]+) deg apart\)")
+"""The angle in tcpcal's "touches i and j (0-based) have the same orientation (x deg apart)"."""
 AUTO_SIGMA_MAX_MM = 2.0
 """Largest simulated operator error the pendant offers (its slider runs 0-2 mm)."""
 
@@ -178,6 +182,8 @@ class CalibrationWorkflow:
         """Run index -> gradebook calibration id (the classroom recorder fills it; exported)."""
         self._record_q: dict[int, tuple[RecordedPose, np.ndarray]] = {}   # id(pose) -> (pose, joints rad)
         self._events: list[SessionEvent] = []
+        self._failure: tuple[int, str] | None = None   # (run, why its Finish failed); dropped on a change
+        self._auto_steps: dict[int, set[int]] = {}     # run -> steps whose pose Auto-touch recorded
 
     # ------------------------------------------------------------ events
     def take_events(self) -> tuple[SessionEvent, ...]:
@@ -206,9 +212,15 @@ class CalibrationWorkflow:
         pose = run.wizard.recorded_poses.get(step)
         if pose is None:
             return
+        self._failure = None                       # a new touch: the failed Finish no longer applies
         c = self.controller
         joints = tuple(c.joint_angles_deg().values())
         run.joints_deg[step] = joints
+        auto_steps = self._auto_steps.setdefault(i, set())
+        if auto:
+            auto_steps.add(step)
+        else:
+            auto_steps.discard(step)
         self._record_q[id(pose)] = (pose, c.q_rad.copy())
         self._note_distance(step)
         self._events.append(TouchRecorded(i, step, pose.T_world_flange_m, joints,
@@ -267,18 +279,22 @@ class CalibrationWorkflow:
 
     def resumable(self) -> list[tuple[int, str]]:
         """Cancelled runs still to be done, newest first: (index in ``runs``, label for the
-        "Left half-way" list). A finished run whose result was saved is done and not listed; a
-        finished one not saved is ("finished, not saved")."""
+        Resume list) naming the calibration, where it was left and when it started (the
+        server's local time): "3: XYZ 4-point, at step 2 of 4 (1 recorded), started 14:02". A
+        finished run whose result was saved is done and not listed; a finished one not saved is
+        "result not saved" (it is not half-way: only its Save is missing)."""
         out = []
         for i in range(len(self.runs) - 1, -1, -1):
             w = self.runs[i].wizard
             if w.status != "cancelled" or self._is_saved(i):
                 continue
+            started = _clock(w.started_at)
             if w.finished_result is not None:
-                out.append((i, f"{i + 1}: {w.title}, finished, not saved"))
+                out.append((i, f"{i + 1}: {w.title}, result not saved, started {started}"))
             else:
                 done = sum(1 for s in w.steps if s.recorded)
-                out.append((i, f"{i + 1}: {w.title}, {done} of {w.n_steps} recorded"))
+                out.append((i, f"{i + 1}: {w.title}, at step {w.step_index + 1} of {w.n_steps} "
+                               f"({done} recorded), started {started}"))
         return out
 
     # ------------------------------------------------------------ library
@@ -377,7 +393,7 @@ class CalibrationWorkflow:
             if index is not None and i in recorded:
                 self._events.append(TouchRecorded(index, i, recorded[i].T_world_flange_m, joints, d,
                                                   auto=False, overwrite=False))
-        return w
+        return cast(Xyz4Wizard, w)
 
     # ------------------------------------------------------------ navigation
     def _note_distance(self, step: int) -> None:
@@ -479,16 +495,46 @@ class CalibrationWorkflow:
         return self._finished(w, out) if isinstance(out, WizardResult) else None
 
     def _in_words(self, exc: CalibrationFailedError) -> CalibrationFailedError:
-        """tcpcal's failure with its FLANGE axis said in words (``diversity.failure_in_words``)."""
-        axis = getattr(exc.cause, "unobservable_axis", None)
-        if axis is None:
-            return exc
-        R_world_flange = self.controller.T_world_flange()[:3, :3]
-        return CalibrationFailedError(failure_in_words(str(exc), axis, R_world_flange), exc.cause)
+        """tcpcal's failure in the trainee's words, with what to do: the touches it is about
+        as step numbers (two with the same orientation: go back to the later one), its FLANGE
+        axis in words (``diversity.failure_in_words``). Kept as :attr:`finish_failure` for the
+        step panels until the wizard changes."""
+        w, cause = self.wizard, exc.cause
+        axis = getattr(cause, "unobservable_axis", None)
+        pair = tuple(getattr(cause, "indices", ()))
+        steps = () if w is None else w.solver_touch_steps()
+        if len(pair) == 2 and all(0 <= k < len(steps) for k in pair):
+            a, b = (steps[k] + 1 for k in pair)
+            angle = _ANGLE_APART.search(str(exc))
+            apart = f" ({angle.group(1)}° apart)" if angle else ""
+            todo = (f"record step {b} again" if w is not None and w.step_index == b - 1
+                    else f"go Back to step {b} and record it again")
+            text = (f"Touches {a} and {b} have the same orientation{apart}: the method needs clearly "
+                    f"different orientations. Tilt the tool 30-60° about another axis and {todo}.")
+            out = CalibrationFailedError(text, cause)
+        elif axis is not None:
+            R_world_flange = self.controller.T_world_flange()[:3, :3]
+            out = CalibrationFailedError(failure_in_words(str(exc), axis, R_world_flange) +
+                                         " Go Back to a step and record it tilted about that axis.", cause)
+        else:
+            out = exc
+        if self._current is not None:
+            self._failure = (self._current, str(out))
+        return out
+
+    @property
+    def finish_failure(self) -> str | None:
+        """Why the last Finish of the run on show could not compute, and what to do (plain
+        text, our words and numbers), while the run is still where it failed; else None."""
+        failure, w = self._failure, self.wizard
+        if failure is None or failure[0] != self._current or w is None or w.status != "in_progress":
+            return None
+        return failure[1]
 
     def back(self) -> None:
         """One step back (from the result: to the last step); nothing is deleted."""
         self._require().back()
+        self._failure = None
 
     def auto_touch(self, request: AutoTouchRequest) -> AutoTouchOutcome:
         """Training mode: let the controller perform the current step (mounting the tool it
@@ -509,10 +555,12 @@ class CalibrationWorkflow:
         run_index = self._current
         self.note_mounted_tool()
         had_pose = set(w.recorded_poses) if w.status == "in_progress" else set()
+        job = type(w).controller_job
+        pose_check = POSE_CHECKS[job](self, w) if job in POSE_CHECKS else None
         out = auto_touch(w, self.controller, direction_deg=request.direction_deg,
                          sigma_mm=request.sigma_mm, rng=self.rng, tools=self.tools,
                          previous_direction_deg=None if run_index is None else self._auto_directions.get(run_index),
-                         mount=self.state.mount_tool)
+                         mount=self.state.mount_tool, pose_check=pose_check)
         self.note_mounted_tool()
         if out.ok:                            # the robot stands at the touch it recorded
             self._recorded(out.step_index, auto=True, had_pose=out.step_index in had_pose)
@@ -660,7 +708,9 @@ class CalibrationWorkflow:
             if self.training and not self.hide_truth and run.T_flange_tool_true_m is not None:
                 cmp = compare_with_truth(res, run.T_flange_tool_true_m)
                 pos, ang, grade = cmp.position_error_mm, cmp.x_axis_error_deg, cmp.grade
-            return ManualComparison(w.title, w.kind, j + 1, 0.0 if seconds is None else seconds, pos, ang, grade)
+            auto = len(self._auto_steps.get(j, set()) & set(w.recorded_poses))
+            return ManualComparison(w.title, w.kind, j + 1, 0.0 if seconds is None else seconds, pos, ang, grade,
+                                    touches=len(w.recorded_poses), auto_touches=auto)
         return None
 
     # ------------------------------------------------------------ session record
@@ -680,6 +730,26 @@ class CalibrationWorkflow:
                 is changed).
         """
         return self.add_loaded(load_and_replay(source))
+
+    def restore(self, runs: Sequence[WizardRun]) -> list[int]:
+        """Give back runs this session's trainee had in progress when the server stopped (kept
+        in the gradebook, ``classroom.restore``): appended to :attr:`runs` with their truth,
+        joints and distances; the newest is put on show where it was, the others wait in the
+        Resume list. Makes no events: they are in the gradebook already. Returns their indices.
+        """
+        if not runs:
+            return []
+        self._leave_open_wizard()
+        indices = []
+        for run in runs:
+            if run.wizard.status != "cancelled":
+                run.wizard.cancel()
+            self.runs.append(run)
+            indices.append(len(self.runs) - 1)
+        self._current = indices[-1]
+        self.runs[self._current].wizard.resume()
+        self.note_mounted_tool()
+        return indices
 
     def add_loaded(self, loaded: LoadedRecord) -> tuple[ReplayCheck, ...]:
         """Add a record read and replayed by :func:`load_and_replay` (the app does that in a
@@ -703,6 +773,14 @@ class CalibrationWorkflow:
             self._current = finished[-1]
             self.runs[self._current].wizard.resume()
         return checks
+
+
+def _clock(iso_utc: str) -> str:
+    """An ISO 8601 UTC time as the server's local HH:MM ("?" when unreadable)."""
+    try:
+        return datetime.fromisoformat(iso_utc.replace("Z", "+00:00")).astimezone().strftime("%H:%M")
+    except ValueError:
+        return "?"
 
 
 class _StartContext:

@@ -1,6 +1,6 @@
 """The class gradebook: every trainee, session, calibration, touch and crash, in one SQLite file.
 
-The server writes each wizard event as it happens (issue 11 item 2); ``tcp-pendant grades``
+The server writes each wizard event as it happens; ``tcp-pendant grades``
 reads it back (:mod:`tcp_pendant.classroom.grades_cli`). Standard library ``sqlite3`` only.
 
 Durability ("a kill -9 of the server loses nothing that was acknowledged on screen"):
@@ -56,7 +56,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass, field
 from datetime import datetime, timezone
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any, Literal, overload
 
 import numpy as np
 import platformdirs
@@ -80,6 +80,17 @@ SCHEMA_VERSION = 1
 GRADES = ("good", "fair", "poor")
 _STATUS = ("in_progress", "finished", "cancelled")
 _MAX_TEXT = 200          # method, tool key, exercise id, mode, crash note: short labels
+
+
+_RUN_STATES = """CREATE TABLE IF NOT EXISTS run_states (
+    calibration_id INTEGER PRIMARY KEY REFERENCES calibrations(id),
+    entry_json TEXT NOT NULL,
+    updated_at TEXT NOT NULL)"""
+"""What a restart gives back: each calibration's wizard as it was last acknowledged (a session
+record entry without truth, ``session_record.run_entry``). Added to every file when it is
+opened; a TCP Pendant that does not know it ignores it, so it needs no schema version."""
+MAX_RUN_STATE_BYTES = 200_000
+"""A wizard's stored state is refused above this (20 poses with joints take ~12 kB)."""
 
 
 class GradebookError(Exception):
@@ -171,6 +182,8 @@ class GradeRow:
         tcp_mm / abc_deg: the computed TOOL frame (mm, KUKA A, B, C deg) or None.
         position_error_mm / orientation_error_deg: error against the true TOOL frame, or None.
         grade: "good" | "fair" | "poor" | None.
+        status: "finished", or "in_progress" (``grades(include_in_progress=True)``: no result
+            yet, ``finished_at`` empty, ``duration_s`` up to now).
     """
 
     calibration_id: int
@@ -194,6 +207,7 @@ class GradeRow:
     position_error_mm: float | None = None
     orientation_error_deg: float | None = None
     grade: str | None = None
+    status: str = "finished"
 
 
 CSV_FIGURES = ("mean_error_mm", "max_error_mm", "rms_error_mm", "ci95_mm", "orthogonality_defect_deg")
@@ -201,7 +215,7 @@ CSV_COLUMNS: tuple[str, ...] = (
     "calibration_id", "trainee", "session_id", "mode", "method", "tool", "exercise",
     "started_at", "finished_at", "duration_s", "touches", "hand", "auto", "overwritten", "crashes",
     "tcp_x_mm", "tcp_y_mm", "tcp_z_mm", "a_deg", "b_deg", "c_deg",
-    *CSV_FIGURES, "position_error_mm", "orientation_error_deg", "grade", "figures_json",
+    *CSV_FIGURES, "position_error_mm", "orientation_error_deg", "grade", "figures_json", "status",
 )
 """Columns of :func:`to_csv` (a contract: docs/architecture.md "Classroom (gradebook)")."""
 
@@ -238,12 +252,16 @@ def to_csv(rows: Sequence[GradeRow]) -> str:
             r.started_at, r.finished_at, round(r.duration_s, 3), r.touches, r.hand, r.auto,
             r.overwritten, r.crashes, *tcp, *abc, *(r.figures.get(k) for k in CSV_FIGURES),
             r.position_error_mm, r.orientation_error_deg, r.grade,
-            json.dumps(dict(r.figures), sort_keys=True))])
+            json.dumps(dict(r.figures), sort_keys=True), r.status)])
     return out.getvalue()
 
 
 # --------------------------------------------------------------------------- input checks
 
+@overload
+def _label(value: Any, what: str, *, optional: Literal[False] = False) -> str: ...
+@overload
+def _label(value: Any, what: str, *, optional: bool) -> str | None: ...
 def _label(value: Any, what: str, *, optional: bool = False) -> str | None:
     if value is None and optional:
         return None
@@ -252,6 +270,14 @@ def _label(value: Any, what: str, *, optional: bool = False) -> str | None:
     if len(value) > _MAX_TEXT or not value.isprintable():
         raise GradebookError(f"{what} must be at most {_MAX_TEXT} printable characters, got {value!r:.80}.")
     return value
+
+
+def _new_id(cur: sqlite3.Cursor) -> int:
+    """The id of the row an INSERT just added (``lastrowid``, None only before any insert)."""
+    rowid = cur.lastrowid
+    if rowid is None:
+        raise GradebookError("the gradebook added no row")
+    return rowid
 
 
 def _finite(value: Any, what: str, *, optional: bool = False) -> float | None:
@@ -428,6 +454,12 @@ class Gradebook:
         if str(mode).lower() != "wal":
             raise GradebookError(f"Gradebook {self.path}: SQLite refused WAL mode (got {mode!r}); put the "
                                  "file on a local disk (WAL needs shared memory, network folders lack it).")
+        try:                                         # additive: an older reader ignores the table
+            with self._transaction():
+                db.execute(_RUN_STATES)
+        except sqlite3.Error as exc:
+            raise GradebookError(f"Cannot write the gradebook {self.path}: {exc}; check that its folder "
+                                 "is writable and the disk is not full.") from exc
 
     # -- plumbing ---------------------------------------------------------------------
 
@@ -512,8 +544,8 @@ class Gradebook:
             row = db.execute("SELECT id FROM trainees WHERE name = ?", (clean,)).fetchone()
             if row is not None:
                 return int(row[0])
-            return int(db.execute("INSERT INTO trainees (name, created_at) VALUES (?, ?)",
-                                  (clean, _now())).lastrowid)
+            return _new_id(db.execute("INSERT INTO trainees (name, created_at) VALUES (?, ?)",
+                                      (clean, _now())))
 
     def start_session(self, trainee_id: int, mode: str) -> int:
         """A new session (one browser connection) of a trainee; ``mode`` e.g. "own" or "shared"."""
@@ -522,8 +554,8 @@ class Gradebook:
         with self._write() as db:
             if db.execute("SELECT 1 FROM trainees WHERE id = ?", (tid,)).fetchone() is None:
                 raise GradebookError(f"No trainee {tid} in the gradebook {self.path}; add_trainee first.")
-            return int(db.execute("INSERT INTO sessions (trainee_id, mode, started_at) VALUES (?, ?, ?)",
-                                  (tid, mode, _now())).lastrowid)
+            return _new_id(db.execute("INSERT INTO sessions (trainee_id, mode, started_at) VALUES (?, ?, ?)",
+                                      (tid, mode, _now())))
 
     def end_session(self, session_id: int) -> None:
         """Mark a session ended (browser gone); its calibrations stay as they are."""
@@ -554,10 +586,10 @@ class Gradebook:
         with self._write() as db:
             if db.execute("SELECT 1 FROM sessions WHERE id = ?", (sid,)).fetchone() is None:
                 raise GradebookError(f"No session {sid} in the gradebook {self.path}; start_session first.")
-            return int(db.execute(
+            return _new_id(db.execute(
                 "INSERT INTO calibrations (session_id, method, tool_key, exercise_id, truth_json, status, "
                 "started_at) VALUES (?, ?, ?, ?, ?, 'in_progress', ?)",
-                (sid, method, tool_key, exercise, truth_text, _now())).lastrowid)
+                (sid, method, tool_key, exercise, truth_text, _now())))
 
     def record_touch(self, calibration_id: int, step_index: int, T_world_flange_m: Any, joints_deg: Any,
                      distance_mm: float | None, auto: bool, overwritten_touch_id: int | None = None) -> int:
@@ -599,10 +631,10 @@ class Gradebook:
                 if row[1] is not None:
                     raise GradebookError(f"Touch {old} was already overwritten by touch {row[1]}; pass "
                                          f"{row[1]} instead.")
-            new = int(db.execute(
+            new = _new_id(db.execute(
                 "INSERT INTO touches (calibration_id, step_index, recorded_at, T_world_flange_m_json, "
                 "joints_deg_json, distance_mm, auto, overwrites_touch_id) VALUES (?, ?, ?, ?, ?, ?, ?, ?)",
-                (cid, step, _now(), T, q, d, int(bool(auto)), old)).lastrowid)
+                (cid, step, _now(), T, q, d, int(bool(auto)), old)))
             if old is not None:
                 db.execute("UPDATE touches SET overwritten_by_touch_id = ? WHERE id = ?", (new, old))
             return new
@@ -634,8 +666,8 @@ class Gradebook:
                 sid = cal_session
             elif db.execute("SELECT 1 FROM sessions WHERE id = ?", (sid,)).fetchone() is None:
                 raise GradebookError(f"No session {sid} in the gradebook {self.path}.")
-            return int(db.execute("INSERT INTO crashes (session_id, calibration_id, at, penetration_mm, note) "
-                                  "VALUES (?, ?, ?, ?, ?)", (sid, cid, _now(), depth, note)).lastrowid)
+            return _new_id(db.execute("INSERT INTO crashes (session_id, calibration_id, at, penetration_mm, note) "
+                                      "VALUES (?, ?, ?, ?, ?)", (sid, cid, _now(), depth, note)))
 
     def finish_calibration(self, calibration_id: int, figures: Mapping[str, float], *,
                            position_error_mm: float | None, orientation_error_deg: float | None,
@@ -710,30 +742,88 @@ class Gradebook:
             cid = self._calibration(db, calibration_id)[0]
             return json.loads(db.execute("SELECT truth_json FROM calibrations WHERE id = ?", (cid,)).fetchone()[0])
 
-    def grades(self) -> list[GradeRow]:
-        """One row per finished calibration, oldest start first."""
+    # -- what a restart gives back ------------------------------------------------------
+
+    def save_run_state(self, calibration_id: int, entry: Mapping[str, Any]) -> None:
+        """Keep the wizard of calibration ``calibration_id`` as it is now (a session record
+        entry, ``session_record.run_entry``, JSON-ready, without truth); replaces the last.
+
+        Raises:
+            GradebookError: no such calibration, not JSON, or above :data:`MAX_RUN_STATE_BYTES`.
+        """
+        try:
+            text = json.dumps(entry, sort_keys=True, allow_nan=False)
+        except (TypeError, ValueError) as exc:
+            raise GradebookError(f"A wizard's state must be plain JSON: {exc}.") from exc
+        if len(text) > MAX_RUN_STATE_BYTES:
+            raise GradebookError(f"A wizard's state of {len(text):,} bytes is above {MAX_RUN_STATE_BYTES:,}.")
+        with self._write() as db:
+            cid = self._calibration(db, calibration_id)[0]
+            db.execute("INSERT INTO run_states (calibration_id, entry_json, updated_at) VALUES (?, ?, ?) "
+                       "ON CONFLICT(calibration_id) DO UPDATE SET entry_json = excluded.entry_json, "
+                       "updated_at = excluded.updated_at", (cid, text, _now()))
+
+    def open_runs(self, trainee: str) -> list[dict[str, Any]]:
+        """The calibrations of ``trainee`` still in progress that have a stored wizard, oldest
+        first: ``{"calibration_id", "method", "tool_key", "exercise_id", "truth", "entry",
+        "touch_ids"}`` (``touch_ids``: step -> the id of its touch that counts, to link the next
+        overwrite); for a restart to give them back."""
+        with self._read() as db:
+            rows = db.execute(
+                "SELECT c.id, c.method, c.tool_key, c.exercise_id, c.truth_json, r.entry_json FROM calibrations c "
+                "JOIN sessions s ON s.id = c.session_id JOIN trainees t ON t.id = s.trainee_id "
+                "JOIN run_states r ON r.calibration_id = c.id "
+                "WHERE t.name = ? AND c.status = 'in_progress' ORDER BY c.started_at, c.id", (str(trainee),)).fetchall()
+            out = []
+            for cid, method, tool, exercise, truth, entry in rows:
+                touch_ids = {int(step): int(tid) for tid, step in db.execute(
+                    "SELECT id, step_index FROM touches WHERE calibration_id = ? AND overwritten_by_touch_id IS NULL",
+                    (cid,))}
+                out.append({"calibration_id": cid, "method": method, "tool_key": tool, "exercise_id": exercise,
+                            "truth": json.loads(truth), "entry": json.loads(entry), "touch_ids": touch_ids})
+        return out
+
+    def class_setting(self, key: str) -> Any:
+        """A class setting kept across restarts (``set_class_setting``), None when never set."""
+        with self._read() as db:
+            row = db.execute("SELECT value FROM meta WHERE key = ?", (f"class:{key}",)).fetchone()
+        return None if row is None else json.loads(row[0])
+
+    def set_class_setting(self, key: str, value: Any) -> None:
+        """Keep a class setting (JSON-ready; the pushed exercise, the distance-aid lock, the
+        trainer token's hash) across restarts of the server."""
+        text = json.dumps(value, sort_keys=True, allow_nan=False)
+        with self._write() as db:
+            db.execute("INSERT INTO meta (key, value) VALUES (?, ?) ON CONFLICT(key) DO UPDATE SET value = "
+                       "excluded.value", (f"class:{_label(key, 'setting name')}", text))
+
+    def grades(self, *, include_in_progress: bool = False) -> list[GradeRow]:
+        """One row per finished calibration, oldest start first; with ``include_in_progress``
+        also the calibrations still in progress (``GradeRow.status``)."""
+        statuses = "('finished', 'in_progress')" if include_in_progress else "('finished')"
         query = """
             SELECT c.id, t.name, s.id, s.mode, c.method, c.tool_key, c.exercise_id, c.started_at,
                    c.finished_at, c.figures_json, c.tcp_mm_json, c.abc_deg_json, c.position_error_mm,
-                   c.orientation_error_deg, c.grade,
+                   c.orientation_error_deg, c.grade, c.status,
                    (SELECT COUNT(*) FROM touches x WHERE x.calibration_id = c.id AND x.overwritten_by_touch_id IS NULL),
                    (SELECT COUNT(*) FROM touches x WHERE x.calibration_id = c.id AND x.overwritten_by_touch_id IS NULL AND x.auto = 1),
                    (SELECT COUNT(*) FROM touches x WHERE x.calibration_id = c.id AND x.overwritten_by_touch_id IS NOT NULL),
                    (SELECT COUNT(*) FROM crashes k WHERE k.calibration_id = c.id)
             FROM calibrations c JOIN sessions s ON s.id = c.session_id JOIN trainees t ON t.id = s.trainee_id
-            WHERE c.status = 'finished' ORDER BY c.started_at, c.id"""
+            WHERE c.status IN """ + statuses + """ ORDER BY c.started_at, c.id"""
         with self._read() as db:
             rows = db.execute(query).fetchall()
         out = []
+        now = _now()
         for (cid, name, sid, mode, method, tool, exercise, started, finished, figs, tcp, abc, pos, ori, grade,
-             n, n_auto, n_over, n_crash) in rows:
+             status, n, n_auto, n_over, n_crash) in rows:
             out.append(GradeRow(
                 calibration_id=cid, trainee=name, session_id=sid, mode=mode, method=method, tool_key=tool,
-                exercise_id=exercise, started_at=started, finished_at=finished,
-                duration_s=_duration_s(started, finished), touches=n, hand=n - n_auto, auto=n_auto,
+                exercise_id=exercise, started_at=started, finished_at=finished or "",
+                duration_s=_duration_s(started, finished or now), touches=n, hand=n - n_auto, auto=n_auto,
                 overwritten=n_over, crashes=n_crash, figures=json.loads(figs) if figs else {},
                 tcp_mm=tuple(json.loads(tcp)) if tcp else None, abc_deg=tuple(json.loads(abc)) if abc else None,
-                position_error_mm=pos, orientation_error_deg=ori, grade=grade))
+                position_error_mm=pos, orientation_error_deg=ori, grade=grade, status=status))
         return out
 
     def to_csv(self, rows: Sequence[GradeRow] | None = None) -> str:

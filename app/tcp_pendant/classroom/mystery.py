@@ -1,4 +1,4 @@
-"""Mystery tools (issue 11 item 4): a tool per trainee whose true TCP and orientation are drawn
+"""Mystery tools: a tool per trainee whose true TCP and orientation are drawn
 from the exercise seed and the trainee's name, so answers differ between trainees.
 
 :func:`draw_mystery_tool` draws (deterministically: same seed, name and base tool, same tool on
@@ -37,6 +37,7 @@ import warnings
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
+from typing import cast
 
 import numpy as np
 import platformdirs
@@ -191,7 +192,7 @@ def _body_mesh(T_flange_tool: np.ndarray) -> trimesh.Trimesh:
                                       sections=_SECTIONS)
     joint = trimesh.creation.icosphere(subdivisions=1, radius=_SHAFT_RADIUS_M)
     joint.apply_translation(neck)
-    return trimesh.util.concatenate([mount, shaft, joint])
+    return cast(trimesh.Trimesh, trimesh.util.concatenate([mount, shaft, joint]))  # meshes give a mesh
 
 
 def _xyz(v: np.ndarray) -> str:

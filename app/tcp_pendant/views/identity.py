@@ -1,4 +1,4 @@
-"""The name prompt of a classroom session: a modal that asks "Your name" (issue 11 item 1).
+"""The name prompt of a classroom session: a modal that asks "Your name".
 
 Shown to each browser of a per-browser server with a gradebook (``--shared`` has none). The
 modal holds a text field labelled **"Your name"** and a **Join the class** button; the name is checked by
@@ -26,6 +26,7 @@ from typing import Any
 from tcp_pendant.classroom.names import TraineeNameError, validate_trainee_name
 from tcp_pendant.session import Session
 from tcp_pendant.text_escape import escape_markdown
+from tcp_pendant.views.gui_util import ButtonEvent, set_value, target_of
 
 __all__ = ["IdentityPrompt", "NAME_LABEL", "TOKEN_LABEL"]
 
@@ -47,13 +48,13 @@ class IdentityPrompt:
         modal, name_field, start, message, token_field, open_trainer: the widgets (for tests).
     """
 
-    def __init__(self, session: Session, on_name: Callable[[str], None],
+    def __init__(self, session: Session, on_name: Callable[[str], object],
                  on_token: Callable[[str], bool]) -> None:
         self.session = session
         self.name: str | None = None
         self._on_name = on_name
         self._on_token = on_token
-        gui = session.target.gui
+        gui = target_of(session).gui
         self.modal = gui.add_modal("Welcome to the TCP Pendant")
         with self.modal:
             gui.add_markdown("Type the name your trainer should see in the class list "
@@ -69,7 +70,7 @@ class IdentityPrompt:
         self.start.on_click(session.on_loop(self._start))
         self.open_trainer.on_click(session.on_loop(self._trainer))
 
-    def _start(self, _event: Any = None) -> None:
+    def _start(self, _event: ButtonEvent | None = None) -> None:
         try:
             name = validate_trainee_name(self.name_field.value)
             self._on_name(name)
@@ -81,9 +82,9 @@ class IdentityPrompt:
         self.banner.content = f"Trainee: **{escape_markdown(name)}**"
         self.banner.visible = True
 
-    def _trainer(self, _event: Any = None) -> None:
+    def _trainer(self, _event: ButtonEvent | None = None) -> None:
         token = str(self.token_field.value)[:_MAX_TOKEN_CHARS]
-        self.token_field.value = ""
+        set_value(self.token_field, "")
         if not self._on_token(token):
             self.message.content = "⚠ That trainer token is not right; type the token the server printed."
             return

@@ -15,11 +15,9 @@ the 320 px presenter panel on a 1024x768 projector.
 
 from __future__ import annotations
 
-from typing import Any
-
 from tcp_pendant.calibrate.math_view import PAIR_VIEWS, MathSheet, math_markdown, math_sheet
 from tcp_pendant.session import Session, SessionChange
-from tcp_pendant.views.gui_util import set_content, set_options
+from tcp_pendant.views.gui_util import DropdownEvent, set_content, set_options, target_of
 
 __all__ = ["LATEST_PAIR", "MathView"]
 
@@ -41,9 +39,7 @@ class MathView:
 
     def __init__(self, session: Session) -> None:
         self.session = session
-        target = session.target
-        assert target is not None, "The math view needs the session's GUI (a browser or the shared GUI)."
-        gui = target.gui
+        gui = target_of(session).gui
         self.folder = gui.add_folder("The math", visible=False)
         with self.folder:
             self.pair = gui.add_dropdown("Pair (4P-2)", (LATEST_PAIR,), initial_value=LATEST_PAIR, visible=False,
@@ -56,7 +52,7 @@ class MathView:
         session.subscribe(self.on_change)
         self.render()
 
-    def _on_pair(self, event: Any) -> None:
+    def _on_pair(self, event: DropdownEvent) -> None:
         if getattr(event, "client", None) is not None:      # not our own assignment's echo
             self.render()
 

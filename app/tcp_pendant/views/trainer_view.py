@@ -1,4 +1,4 @@
-"""The trainer view (issue 11 item 3): the class's live table, the gradebook, a CSV download and
+"""The trainer view: the class's live table, the gradebook, a CSV download and
 settings pushed to every trainee.
 
 Built in a browser's own GUI once its "Trainer token" was right (``views.identity``); the
@@ -22,6 +22,7 @@ from tcp_pendant.session import Session
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.upload_guard import limit_upload_size
 from tcp_pendant.wizards.session_record import MAX_RECORD_BYTES, SessionRecordError, check_record_size, load_and_replay
+from tcp_pendant.views.gui_util import ButtonEvent, UploadEvent, target_of
 
 log = logging.getLogger(__name__)
 _GRADE_WORKER = ThreadPoolExecutor(max_workers=1, thread_name_prefix="record-grading")
@@ -40,7 +41,9 @@ MAX_GRADE_ROWS = 50
 class ClassControl(Protocol):
     """What the trainer view needs of the server."""
 
-    tool_keys: Sequence[str]
+    @property
+    def tool_keys(self) -> Sequence[str]: ...
+
     gradebook: Gradebook
     exercise: str | None
 
@@ -110,7 +113,7 @@ class TrainerView:
     def __init__(self, session: Session, control: ClassControl) -> None:
         self.session = session
         self.control = control
-        gui = session.target.gui
+        gui = target_of(session).gui
         self.folder = gui.add_folder("Trainer view", order=-900.0)
         with self.folder:
             gui.add_markdown("**Trainees**")
@@ -144,7 +147,7 @@ class TrainerView:
         self.trainees_md.content = trainees_markdown(self.control.trainee_statuses())
         self.grades_md.content = grades_markdown(self.control.grade_rows())
 
-    def _download(self, _event: Any = None) -> None:
+    def _download(self, _event: ButtonEvent | None = None) -> None:
         client = self.session.client
         if client is not None:
             client.send_file_download("grades.csv", self.control.grades_csv().encode("utf-8"))
@@ -153,7 +156,7 @@ class TrainerView:
         self.session.notify("Record not graded", f"{filename or 'The file'}: {size_bytes} bytes is more than "
                             f"{MAX_RECORD_BYTES} bytes; a session record is far smaller.", kind="warning")
 
-    async def _on_grade_upload(self, event: Any) -> None:
+    async def _on_grade_upload(self, event: UploadEvent) -> None:
         """The record's bytes are parsed, replayed and graded in ``_GRADE_WORKER`` (off the loop)."""
         if self.session.closed or getattr(event, "client", None) is None or self._grading:
             return
@@ -175,7 +178,7 @@ class TrainerView:
             self._grading = False
         self.session.guard(lambda: setattr(self.grade_md, "content", record_grades_markdown(name, grades)))()
 
-    def _push(self, _event: Any = None) -> None:
+    def _push(self, _event: ButtonEvent | None = None) -> None:
         exercise = EXERCISES.get(str(self.exercise.value))
         tool = None if self.tool.value == "(keep)" else str(self.tool.value)
         if tool is not None and tool not in self.control.tool_keys:

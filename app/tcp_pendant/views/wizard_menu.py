@@ -51,6 +51,7 @@ from tcp_pendant.views.gui_util import (
     set_content,
     set_options,
     slot_option,
+    target_of,
 )
 from tcp_pendant.views.beam_replay import ScanPlayer
 from tcp_pendant.views.math_panel import MathView
@@ -98,7 +99,8 @@ class CalibrateView:
         self._menu_mounted_key: str | None = None
         self._library: dict[int, Tool] = {}
         self._library_pick: tuple[str, int | None] | None = None   # (option, active slot then)
-        gui = session.target.gui
+        self._resume_runs: tuple[int, ...] = ()                    # the runs the Resume list offered
+        gui = target_of(session).gui
         tools = self.workflow.tools
         self._physical = {t.label: key for key, t in tools.items()}
 
@@ -123,7 +125,8 @@ class CalibrateView:
             self.start_from_points = gui.add_button(
                 "Start from the recorded points", color="blue", visible=False,
                 hint="XYZ 4-point from the touches of the Jog tab's Record point: they become its first steps.")
-            self.resume_list = gui.add_dropdown("Left half-way", ("-",), visible=False)
+            self.resume_list = gui.add_dropdown("To resume", ("-",), visible=False,
+                                                hint="Calibrations you left: where, and when they started.")
             self.resume = gui.add_button("Resume", color="blue", visible=False)
         widgets = self.option_widgets
         self._slot_widgets = [widgets[n] for n, o in self._option_specs.items() if o.kind == "library_slot"]
@@ -154,6 +157,7 @@ class CalibrateView:
         self.start.on_click(act(self._on_start, sync=True))
         self.start_from_points.on_click(act(self._on_start_from_points, sync=True))
         self.resume.on_click(act(self._on_resume))
+        self.resume_list.on_update(act(lambda _e: None, user_only=True))   # the button names the pick
         self.export.on_click(act(self._on_export))
         self._loading_record = False
         self.load.on_upload(self._on_upload)
@@ -269,7 +273,8 @@ class CalibrateView:
         return None if slot is None else slot_option(slot, self._library[slot].name)
 
     def _selected_slot(self, widget: Any = None) -> int:
-        slot = number_of_option((widget or self.library_tool).value)
+        picked = widget or self.library_tool                     # None: the library is empty
+        slot = None if picked is None else number_of_option(picked.value)
         if slot is None:
             raise ValueError("The tool library is empty: calibrate the TCP first (XYZ 4-point) and save it.")
         return slot
@@ -293,12 +298,15 @@ class CalibrateView:
         number = number_of_option(self.resume_list.value)
         if number is None:
             raise ValueError("There is no calibration to resume.")
+        if number - 1 not in {i for i, _ in self.workflow.resumable()}:
+            raise ValueError(f"Calibration {number} is not waiting to be resumed any more; choose one in "
+                             "'To resume'.")
         self.session.resume_wizard(number - 1)
 
     def _on_export(self, event: Any) -> None:
         data = dumps(self.workflow.export_record(self.session.touches)).encode("utf-8")
         # to the browser that clicked (in --shared mode the session is every browser's)
-        target = getattr(event, "client", None) or self.session.client or self.session.target
+        target = getattr(event, "client", None) or self.session.client or target_of(self.session)
         target.send_file_download(SESSION_FILENAME, data, save_immediately=True)
         set_content(self.record_md, f"Exported {len(self.workflow.runs)} calibration(s) as {SESSION_FILENAME}.")
 
@@ -423,4 +431,15 @@ class CalibrateView:
         waiting = self.workflow.resumable()
         self.resume_list.visible = self.resume.visible = bool(waiting)
         if waiting:
-            set_options(self.resume_list, tuple(label for _, label in waiting))
+            runs = tuple(i for i, _ in waiting)
+            picked = number_of_option(self.resume_list.value)
+            # the user's pick (by run number) holds until another run is left: then the newest
+            keep = next((label for i, label in waiting if i + 1 == picked), None) \
+                if set(runs) <= set(self._resume_runs) else None
+            self._resume_runs = runs
+            set_options(self.resume_list, tuple(label for _, label in waiting), keep=keep or waiting[0][1])
+            number = number_of_option(self.resume_list.value)
+            chosen = next((label for i, label in waiting if number == i + 1), waiting[0][1])
+            label = f"Resume {chosen.split(', started')[0]}"      # names what the click brings back
+            if self.resume.label != label:
+                self.resume.label = label

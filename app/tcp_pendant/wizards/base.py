@@ -395,6 +395,11 @@ class Wizard(abc.ABC):
         """"Add point" is possible now (only wizards with ``supports_add_point``)."""
         return False
 
+    def solver_touch_steps(self) -> tuple[int, ...]:
+        """The 0-based steps whose poses are the solver's touch rows, in row order (tcpcal's
+        touch indices in an error map to these steps): every step of role "touch"."""
+        return tuple(i for i, spec in enumerate(self._step_specs()) if spec.role == "touch")
+
     def add_point(self) -> None:
         """Add one touch step (only wizards with ``supports_add_point``)."""
         raise WizardStateError(f"Add point is not part of the {self.title} wizard.")
@@ -674,7 +679,7 @@ class Wizard(abc.ABC):
         if self._status != "cancelled":
             raise WizardStateError("Only a cancelled wizard can be resumed.")
         self._status = getattr(self, "_cancelled_from", "in_progress")
-        return self.result if self._status == "complete" and self._result is not None else self.step
+        return self._result if self._status == "complete" and self._result is not None else self.step
 
     # ----- saving to the library ----------------------------------------------------------
     def _calibration(self, result: WizardResult, figures: Mapping[str, float]) -> Calibration:

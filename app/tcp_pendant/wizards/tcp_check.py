@@ -1,4 +1,4 @@
-"""The TCP check (spin test) as a wizard (issue 12 item 2; methods.md "TCP check").
+"""The TCP check (spin test) as a wizard (methods.md "TCP check").
 
 A technician checks a TCP by putting the tool tip on a fixed spike and reorienting the tool
 about the active TCP by +-A, +-B, +-C: a correct TCP stays on the spike. This wizard takes a
@@ -98,14 +98,21 @@ class CheckFigures:
 
     @property
     def verdict(self) -> str:
-        """One line: good / off by how much / not determined (plain text)."""
+        """One line: good / off by how much / not determined (plain text). "Good" needs every
+        rotation: one that could not be made proves nothing about its axis, so the verdict stays
+        open (an error already found among the others stands)."""
         err = self.implied_tcp_error_mm
+        missing = [r.label for r in self.rows if not r.reached]
+        if err is not None and err > GOOD_CHECK_MM:
+            return f"TCP off by {err:.3f} mm: calibrate the tool again (or it is bent)."
+        if missing:
+            return (f"Not determined: {', '.join(missing)} could not be made from this pose (joint limit or "
+                    "singularity), so the check proves nothing about them. Touch the reference tip from "
+                    "an orientation farther from the joint limits, record again and check again.")
         if err is None:
             return ("Not determined: fewer than two of A, B, C were reached; move away from the joint "
                     "limits, record again and check again.")
-        if err <= GOOD_CHECK_MM:
-            return f"TCP good: implied error {err:.3f} mm (at most {GOOD_CHECK_MM:g} mm)."
-        return f"TCP off by {err:.3f} mm: calibrate the tool again (or it is bent)."
+        return f"TCP good: implied error {err:.3f} mm (at most {GOOD_CHECK_MM:g} mm)."
 
     def to_dict(self) -> dict[str, Any]:
         return {"angle_deg": self.angle_deg,
@@ -309,8 +316,10 @@ def tcp_check_markdown(result: TcpCheckResult) -> str:
     lines = [f"**TCP check of {escape_markdown(where + result.tool_name)}** at ±{c.angle_deg:g}°", "",
              "| Rotation | Tip moved (mm) | |", "|---|---:|---|"]
     for r in c.rows:
-        status = "✔" if r.reached else f"stopped: {escape_markdown(r.message)}"
-        lines.append(f"| {escape_markdown(r.label)} | {r.deviation_mm:.3f} | {status} |")
+        if r.reached:
+            lines.append(f"| {escape_markdown(r.label)} | {r.deviation_mm:.3f} | ✔ |")
+        else:                                   # no figure: the rotation was not made
+            lines.append(f"| {escape_markdown(r.label)} | not made | stopped: {escape_markdown(r.message)} |")
     lines.append("")
     if c.implied_tcp_error_mm is not None and c.correction_flange_mm is not None:
         dx, dy, dz = (0.0 if abs(v) < 5e-4 else v for v in c.correction_flange_mm)
