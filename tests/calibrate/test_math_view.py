@@ -46,14 +46,12 @@ def assert_text_is_the_numbers(md: str, sheet: MathSheet) -> None:
     assert list(blocks) == [b.key for b in sheet.blocks]
     too_long = [line for lines in blocks.values() for line in lines if len(line) > MAX_LINE]
     assert not too_long, too_long                                   # fits the presenter panel
-    total = 0
     for b in sheet.blocks:
         got = [float(x) for line in blocks[b.key] for x in _NUMBER.findall(line)]
         want = [(x, s.decimals) for s in b.values.values() for x in s.flat()]
         assert len(got) == len(want), (b.key, got, want)
         for g, (w, d) in zip(got, want):
             assert abs(g - w) <= 0.5001 * 10.0 ** -d, (b.key, g, w)
-        total += len(got)
     outside = _BLOCK.sub("", md)
     assert not _NUMBER.findall(outside.replace("\\.", ".")), "a decimal number outside the blocks"
 

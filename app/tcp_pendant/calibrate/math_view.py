@@ -36,7 +36,7 @@ from __future__ import annotations
 import math
 import re
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -546,7 +546,7 @@ def three_point_sheet(wizard: Any) -> MathSheet:
             Rt = np.column_stack([c1, c2, c3])
             b = _Block("eq30", "paper Eq. (30)", "c3 = c1 × c2, R_n,n* = [c1 c2 c3]")
             b.vector("c3", "c3", c3, decimals=3, unit="")
-            b.matrix("R_n,n*", "R", Rt)
+            b.matrix("R_n,n*", "R_n,n*", Rt)
             b.vector("abc", "A,B,C", np.asarray(abc_deg_from_rotation(Rt), dtype=float), unit="°")
             res = wizard.result
             if res is not None and res.orthogonality_defect_deg is not None:
