@@ -14,8 +14,8 @@ Built by ``tcp_pendant.views.calibrate.build_calibrate_tab`` for the session's w
   stored touches: they become its first steps, ``CalibrationWorkflow.start_from_touches``), and
   Resume for a calibration left half-way. It is hidden while a wizard is
   open, as on a pendant; Cancel (or Close, on a result) brings it back;
-* the open wizard's step panel (``wizard_steps``), its result panel (``wizard_result``) and
-  its scene nodes (``wizard_scene``);
+* the open wizard's step panel (``wizard_steps``), its result panel (``wizard_result``), its
+  worked equations ("The math", ``math_panel``) and its scene nodes (``wizard_scene``);
 * **Session record**: export the session (touches, wizards, results, errors) as JSON and load
   one back to replay it (how a trainer grades). A loaded file is bytes: refused above
   ``session_record.MAX_RECORD_BYTES`` as its transfer starts (``upload_guard``), then parsed and
@@ -54,6 +54,7 @@ from tcp_pendant.views.gui_util import (
     target_of,
 )
 from tcp_pendant.views.beam_replay import ScanPlayer
+from tcp_pendant.views.math_panel import MathView
 from tcp_pendant.views.upload_guard import limit_upload_size
 from tcp_pendant.views.wizard_result import WizardResultView
 from tcp_pendant.views.wizard_scene import WizardSceneView
@@ -137,6 +138,7 @@ class CalibrateView:
         self.new_physical = widgets.get("new_tool_key")
         self.steps = WizardStepsView(self)
         self.result = WizardResultView(self)
+        self.math = MathView(session)          # renders itself on the session's wizard signal
         with gui.add_folder("Session record", expand_by_default=False):
             self.export = gui.add_button("Export session (JSON)",
                                          hint="Touches, calibrations, results and errors, for grading.")

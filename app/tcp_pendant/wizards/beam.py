@@ -421,6 +421,7 @@ class BeamWizard(Wizard):
                             "calibration of the same tool side by side.")
     calibrates: ClassVar[str] = "the TCP and the tool direction"
     rank: ClassVar[int] = 60
+    math_view: ClassVar[str | None] = "beam"
     in_exercises: ClassVar[bool] = False
     controller_job: ClassVar[str | None] = "beam_scan"
     result_view: ClassVar[Literal["touches", "spin_check", "beam_scan"]] = "beam_scan"

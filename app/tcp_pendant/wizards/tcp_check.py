@@ -180,6 +180,7 @@ class TcpCheckWizard(Wizard):
                             "TCP error and the correction. Calibrates nothing, saves nothing.")
     calibrates: ClassVar[str] = "nothing (it checks the TCP)"
     rank: ClassVar[int] = 90
+    math_view: ClassVar[str | None] = "spin_check"
     step_roles = (StepRole("touch", "the tool tip on the reference tip", TOUCH),)
     options = (
         WizardOption("slot", "Tool data", "library_slot", hint="The library tool whose TCP is checked."),

@@ -111,6 +111,7 @@ class Xyz4Wizard(Wizard):
     calibrates: ClassVar[str] = "the TCP"
     rank: ClassVar[int] = 10
     result_extras: ClassVar[frozenset[str]] = frozenset({"estimators", "sphere"})
+    math_view: ClassVar[str | None] = "xyz4"
     MIN_POINTS: ClassVar[int] = 4
     MAX_POINTS: ClassVar[int] = 20
     step_roles = (StepRole("touch", "the tool tip on the reference tip", TOUCH),)
