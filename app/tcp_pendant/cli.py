@@ -64,6 +64,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--presenter", action="store_true",
                    help="start in presenter mode (projector: 32 px readout, the wizard's step list, a "
                         "large error chart, a narrower panel); each pendant can switch it in its GUI")
+    p.add_argument("--hide-truth", action="store_true",
+                   help="show no truth (the TRUE triad, the error and grade against the true TOOL frame) "
+                        "on any pendant: for a projector in front of a class that calibrates the same tool")
     p.add_argument("--allow-origin", action="append", default=[], metavar="ORIGIN",
                    help="also accept browsers on pages from ORIGIN (scheme://host[:port]; repeatable or "
                         "comma-separated), e.g. a reverse proxy's address; pages from any other web "
@@ -199,6 +202,7 @@ def _main(argv: Sequence[str] | None) -> int:
                            trainer_token=args.trainer_token, exercise=args.exercise,
                            exercise_seed=args.exercise_seed, scenario=args.scenario.replace("-", "_"),
                            scenario_seed=args.scenario_seed, presenter=args.presenter,
+                           hide_truth=args.hide_truth,
                            beam_width_mm=args.beam_width, beam_repeatability_mm=args.beam_repeatability,
                            beam_crossed=args.beam_crossed, seed=args.seed)
         app = PendantApp(config)

@@ -107,6 +107,8 @@ class AppConfig:
             tip (``controller.beam_scan.BeamDevice``): beam diameter (0.05-5 mm, default 0.5),
             repeatability of an event per axis (0-1 mm, default 0.02), a second beam along
             WORLD Y crossing it.
+        hide_truth: no pendant shows the truth (the TRUE triad, the error and the grade against
+            the true TOOL frame), as in an exercise: a ``--shared`` projector in front of a class.
         seed: the one seed of every session's randomness (``Session.rng``: Auto-touch's operator
             error and directions, the beam's repeatability noise); session k of the server draws
             from ``(seed, k)``, so a seeded lesson or test replays the same way. None: fresh
@@ -135,6 +137,7 @@ class AppConfig:
     beam_repeatability_mm: float = 0.02
     beam_crossed: bool = False
     seed: int | None = None
+    hide_truth: bool = False
 
 
 class PortInUseError(OSError):
@@ -391,6 +394,8 @@ class PendantApp:
                 session.set_active_data(tool, slot)
         if self.config.scenario != "off":
             session.set_scenario(self.config.scenario, self.config.scenario_seed)
+        if self.config.hide_truth:
+            session.set_hide_truth(True, always=True)
         try:
             for _ in session_view_steps(session, title=f"TCP Pendant · {self.robot_label}"):
                 yield None

@@ -244,6 +244,7 @@ class Session:
         self._scenario_base = 0                         # touches recorded before the scenario was set
         self._scenario_touches = 0                      # touches recorded since (never decreases)
         self._crashed = False                           # the touch geometry's crash state at the last signal
+        self._truth_hidden_always = False               # --hide-truth: no exercise's end shows it
 
     # ------------------------------------------------------------ the change signal
     def subscribe(self, fn: Callable[[SessionChange], None]) -> None:
@@ -712,11 +713,14 @@ class Session:
         with self._wizard_command(moves=moves):
             pass
 
-    def set_hide_truth(self, hide: bool) -> None:
+    def set_hide_truth(self, hide: bool, *, always: bool = False) -> None:
         """A classroom exercise (True): no result shows the true TOOL frame or the error
-        against it, and the methods that measure the tool by themselves are refused."""
+        against it, and the methods that measure the tool by themselves are refused. ``always``
+        (the server's ``--hide-truth``, a projector): from now on the truth stays hidden, whatever
+        an exercise's end says."""
         with self._wizard_command():
-            self.workflow.hide_truth = bool(hide)
+            self._truth_hidden_always = self._truth_hidden_always or always
+            self.workflow.hide_truth = bool(hide) or self._truth_hidden_always
 
     def keep_honest_records(self) -> None:
         """A classroom session: the session record this session exports carries no truth."""

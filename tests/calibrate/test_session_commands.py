@@ -149,3 +149,35 @@ def test_a_seeded_session_auto_touches_reproducibly(tmp_path: Path) -> None:
     for x, y in zip(first, again):
         np.testing.assert_array_equal(x, y)
     assert not np.allclose(first[0], other[0])
+
+
+def test_hide_truth_always_outlasts_an_exercise(tmp_path: Path) -> None:
+    """--hide-truth (a projector): the truth stays off even when an exercise ends."""
+    s = make_session(tmp_path / "tools.json", seed=5)
+    s.set_hide_truth(True, always=True)
+    s.set_hide_truth(False)                       # an exercise ends: the projector still hides it
+    assert s.workflow.hide_truth is True
+    free = make_session(tmp_path / "t2.json", seed=5)
+    free.set_hide_truth(True)
+    free.set_hide_truth(False)
+    assert free.workflow.hide_truth is False
+
+
+def test_the_hide_truth_option_reaches_every_session(tmp_path: Path) -> None:
+    from tcp_pendant.cli import build_parser
+
+    assert build_parser().parse_args(["--hide-truth"]).hide_truth is True
+    assert build_parser().parse_args([]).hide_truth is False
+    app = PendantApp(AppConfig(port=0, tool_library=tmp_path / "tools.json", hide_truth=True, shared=True))
+    try:
+        app.start()
+        s = app.shared_session
+        assert s is not None and s.workflow.hide_truth
+        s.start_wizard("xyz4")
+        while s.workflow.result is None:
+            s.auto_touch(AutoTouchRequest())
+        view = s.views["calibrate"]
+        assert not view.result.truth_md.visible and not view.scene.true_tool.visible
+        assert "Against the true TOOL frame" not in view.result.result_md.content
+    finally:
+        app.stop()
