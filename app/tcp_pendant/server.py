@@ -48,7 +48,7 @@ from tcp_pendant.controller import (
 )
 from tcp_pendant.controller.scenarios import Scenario
 from tcp_pendant.session import Session
-from tcp_pendant.views import session_view_steps
+from tcp_pendant.views import session_view_steps, viser_adapter
 from tcp_pendant.views.presenter import PresenterView
 from tcp_pendant.views.scene import overview_camera, overview_pose
 from tcp_pendant.views.meshes import link_meshes, rigid_meshes
@@ -413,6 +413,7 @@ class PendantApp:
 
         host = self.config.host
         origin_check.enable()               # foreign web pages' websockets are refused (403)
+        viser_adapter.install()             # every browser message checked before viser's handlers
         client_script.script_asset()        # the page's own script (keys, name, trainer URL): packaged?
         self.server = viser.ViserServer(host=host, port=self.config.port, verbose=False)
         origin_check.allow(self.port, self.allow_origins)

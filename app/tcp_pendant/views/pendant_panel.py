@@ -46,11 +46,7 @@ from tcp_pendant.pendant.hold import HoldDriver
 from tcp_pendant.pendant.guidance import CLOSEUP_WITHIN_MM, offset_markdown, side_view_markdown, tip_offset_mm
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.views.scene import closeup_camera, overview_camera
-
-try:                                   # viser's message type (hot path); public setter if absent
-    from viser._messages import GuiUpdateMessage
-except ImportError:                    # pragma: no cover
-    GuiUpdateMessage = None
+from tcp_pendant.views.viser_adapter import queue_markdown
 
 __all__ = ["HOLD_HZ", "KEYS_LINE", "MARK", "PendantPanel", "jog_key_hint", "marked", "set_markdown", "unmarked"]
 
@@ -99,20 +95,11 @@ def set_markdown(handle: Any, text: str) -> None:
     ``typing`` aliases on every call: ~4x the cost of the message itself here, measured by
     tests/bench/bench_server.py); for texts without images (nothing for viser's markdown
     parser to inline) this stores the same ``_markdown`` prop and queues the same
-    ``GuiUpdateMessage``. Falls back to the public setter if viser's internals differ.
+    ``GuiUpdateMessage`` (``views.viser_adapter.queue_markdown``). Falls back to the public
+    setter for a removed handle or if viser's internals differ.
     """
-    if "![" not in text and GuiUpdateMessage is not None:
-        try:
-            impl = handle._impl
-            if not impl.removed:
-                object.__setattr__(handle, "_content", text)
-                if impl.props._markdown != text:
-                    impl.props._markdown = text
-                    impl.gui_api._websock_interface.queue_message(GuiUpdateMessage(impl.uuid, {"_markdown": text}))
-                return
-        except AttributeError:
-            pass
-    handle.content = text
+    if "![" in text or not queue_markdown(handle, text):
+        handle.content = text
 
 
 class PendantPanel:

@@ -1,0 +1,528 @@
+"""Every use of viser's private API, in one place (viser ``>=1.1,<1.2``, see pyproject.toml).
+
+viser's public API is enough to build the pendant, but not to make it fast or safe on a class
+network. What this module reaches into, and why:
+
+* **Fast paths** (the readouts and the robot pose change on every jog step):
+  :func:`queue_markdown` stores a markdown's ``_markdown`` prop and queues viser's
+  ``GuiUpdateMessage`` itself (``handle._impl``, ``gui_api._websock_interface``), skipping the
+  public setter's per-call typing machinery; :func:`queue_pose` writes a scene node's
+  ``wxyz`` / ``position`` and queues ``SetOrientationMessage`` / ``SetPositionMessage``
+  (``api._queue_scene_message``). Each returns False when viser's internals differ, and the
+  caller then uses the public setter. Which path ran is counted (:func:`path_counts`); the first
+  fallback of each path logs a warning, and with ``TCP_PENDANT_STRICT_VISER=1`` in the
+  environment (the tests' flag) a fallback raises :class:`ViserInternalsChanged` instead.
+* **Uploads** (:func:`upload_hook`): the file-transfer messages and ``GuiApi``'s
+  ``_current_file_upload_states``, for the per-button size limit of ``views.upload_guard``.
+* **Incoming messages** (:func:`install`): viser decodes each websocket message and hands it to
+  its handlers in a task of its own, with no check of the values' types; a bad message raised in
+  that task ("Task exception was never retrieved", quoting the value) or, when it could not
+  even be decoded, closed the sender's socket. :func:`install` wraps viser's message consumer
+  (``infra._infra._message_consumer``: a frame that does not decode is dropped) and
+  ``WebsockMessageHandler._handle_incoming_message`` (each message is checked, then its
+  handlers run under one ``try``): :func:`message_refusal` checks every field against the
+  message class's annotations (types, finite numbers), refuses the share-URL requests (a
+  trainee must not publish the class server on viser's share tunnel), and for a
+  ``GuiUpdateMessage`` :func:`gui_value_refusal` checks the value against its handle (only
+  ``value`` may change; type, finite, the handle's min / max, its options, a text length
+  limit; nothing for a disabled input). Uploads are bounded per client and per server
+  (:class:`UploadLimits`). A refused or failing message is logged in one line, user values cut
+  at :data:`LOG_VALUE_CHARS` characters; the socket stays open.
+
+Moving viser up a minor version: run ``tests/security`` and ``tests/app/test_viser_adapter.py``
+with ``TCP_PENDANT_STRICT_VISER=1`` (the README's test command sets it), then re-read in
+viser's source each name used here: ``_GuiHandleState`` (``uuid``, ``value``, ``props``,
+``removed``, ``gui_api``), ``GuiApi._gui_input_handle_from_uuid`` /
+``_current_file_upload_states`` / ``_websock_interface``, ``SceneApi._queue_scene_message``,
+the scene handle's ``_impl`` (``name``, ``wxyz``, ``position``, ``api``),
+``WebsockMessageHandler._handle_incoming_message`` / ``_incoming_handlers``,
+``infra._infra._message_consumer`` (its signature and its ``deserialize`` call), the message
+classes named below, and the props classes' ``min`` / ``max`` / ``options`` / ``disabled``.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import dataclasses
+import logging
+import math
+import os
+import threading
+import time
+import types
+import typing
+from collections import Counter
+from collections.abc import Callable
+from typing import Any
+
+__all__ = ["LOG_VALUE_CHARS", "MAX_TEXT_CHARS", "UploadHook", "UploadLimits", "ViserInternalsChanged",
+           "gui_value_refusal", "install", "message_refusal", "path_counts", "queue_markdown",
+           "queue_pose", "reset_path_counts", "short", "upload_hook", "upload_limits",
+           "uploads_in_flight"]
+
+log = logging.getLogger(__name__)
+
+LOG_VALUE_CHARS = 200
+"""User values are cut to this many characters in log lines."""
+
+MAX_TEXT_CHARS = 10_000
+"""Longest text a browser may send for a text field (the longest the app writes itself, a
+controller file's text, is a few kB)."""
+
+STRICT_ENV = "TCP_PENDANT_STRICT_VISER"
+"""Environment variable: ``1`` makes a fast path's fallback raise (tests)."""
+
+REFUSED_MESSAGES = ("ShareUrlRequest", "ShareUrlDisconnect")
+"""Client messages never handled: they would open (or close) viser's public share tunnel."""
+
+
+class ViserInternalsChanged(RuntimeError):
+    """A fast path had to fall back while ``TCP_PENDANT_STRICT_VISER=1``."""
+
+
+def short(value: Any, limit: int = LOG_VALUE_CHARS) -> str:
+    """``repr(value)`` cut to ``limit`` characters (with the full length) for log lines."""
+    try:
+        text = repr(value)
+    except Exception:                           # a value whose repr fails is still logged
+        text = f"<{type(value).__name__}>"
+    return text if len(text) <= limit else f"{text[:limit]}... ({len(text)} chars)"
+
+
+# ------------------------------------------------------------------ fast paths
+_counts: Counter[tuple[str, str]] = Counter()
+_warned: set[str] = set()
+
+
+def path_counts() -> dict[tuple[str, str], int]:
+    """How often each fast path ran: ``{(path, "fast" | "fallback"): n}``."""
+    return dict(_counts)
+
+
+def reset_path_counts() -> None:
+    """Forget the counts (tests)."""
+    _counts.clear()
+
+
+def _fast(path: str) -> bool:
+    _counts[(path, "fast")] += 1
+    return True
+
+
+def _fallback(path: str, exc: BaseException) -> bool:
+    _counts[(path, "fallback")] += 1
+    if os.environ.get(STRICT_ENV) == "1":
+        raise ViserInternalsChanged(f"viser fast path {path!r} fell back: {type(exc).__name__}: {exc}") from exc
+    if path not in _warned:
+        _warned.add(path)
+        log.warning("viser's internals differ (%s: %s): %s uses viser's public setters from now on "
+                    "(slower); see tcp_pendant.views.viser_adapter", type(exc).__name__, exc, path)
+    return False
+
+
+def queue_markdown(handle: Any, text: str) -> bool:
+    """Set a markdown handle's content to ``text`` without viser's public setter.
+
+    Stores ``_content`` and the ``_markdown`` prop and queues the one ``GuiUpdateMessage`` the
+    setter would (nothing when the text is unchanged). Only for text without images (viser's
+    setter inlines those). Returns False when the caller must use ``handle.content = text``
+    (a removed handle, or viser's internals differ).
+    """
+    try:
+        from viser._messages import GuiUpdateMessage
+
+        impl = handle._impl
+        if impl.removed:
+            return False
+        object.__setattr__(handle, "_content", text)
+        if impl.props._markdown != text:
+            impl.props._markdown = text
+            impl.gui_api._websock_interface.queue_message(GuiUpdateMessage(impl.uuid, {"_markdown": text}))
+    except (AttributeError, ImportError) as exc:
+        return _fallback("markdown", exc)
+    return _fast("markdown")
+
+
+def queue_pose(handle: Any, wxyz: list[float] | None, xyz: list[float] | None) -> bool:
+    """Set a scene node's orientation (``wxyz``) and/or position (``xyz``, metres) and queue
+    viser's ``SetOrientationMessage`` / ``SetPositionMessage`` without its public setters.
+    Returns False when the caller must use ``handle.wxyz`` / ``handle.position``."""
+    try:
+        from viser import _messages
+
+        impl = handle._impl
+        api = impl.api
+        if wxyz is not None:
+            impl.wxyz[:] = wxyz
+            api._queue_scene_message(_messages.SetOrientationMessage(impl.name, tuple(wxyz)))
+        if xyz is not None:
+            impl.position[:] = xyz
+            api._queue_scene_message(_messages.SetPositionMessage(impl.name, tuple(xyz)))
+    except (AttributeError, ImportError) as exc:
+        return _fallback("pose", exc)
+    return _fast("pose")
+
+
+# ------------------------------------------------------------------ uploads
+@dataclasses.dataclass(frozen=True)
+class UploadHook:
+    """viser's file-transfer internals for one upload button.
+
+    Attributes:
+        uuid: the button's uuid (``source_component_uuid`` of its transfers).
+        states: ``GuiApi._current_file_upload_states`` (transfer uuid -> state dict with
+            ``filename``, ``transferred_bytes``, ...); dropping an entry drops the transfer.
+        register: ``register(on_start, on_part)`` adds handlers ``(client_id, message)`` for the
+            start and part messages, run after viser's own.
+    """
+
+    uuid: str
+    states: dict[str, Any]
+    register: Callable[[Callable[[Any, Any], None], Callable[[Any, Any], None]], None]
+
+
+def upload_hook(handle: Any) -> UploadHook | None:
+    """The :class:`UploadHook` of a ``viser.GuiUploadButtonHandle`` (None: viser lacks it)."""
+    try:
+        from viser import _messages
+
+        impl = handle._impl
+        gui_api = impl.gui_api
+        ws = gui_api._websock_interface
+        states = gui_api._current_file_upload_states
+        start_cls, part_cls = _messages.FileTransferStartUpload, _messages.FileTransferPart
+        uuid = str(impl.uuid)
+        if not isinstance(states, dict):
+            raise AttributeError("_current_file_upload_states is not a dict")
+    except (AttributeError, ImportError) as exc:
+        _fallback("upload", exc)
+        return None
+
+    def register(on_start: Callable[[Any, Any], None], on_part: Callable[[Any, Any], None]) -> None:
+        ws.register_handler(start_cls, on_start)
+        ws.register_handler(part_cls, on_part)
+
+    _fast("upload")
+    return UploadHook(uuid, states, register)
+
+
+@dataclasses.dataclass(frozen=True)
+class UploadLimits:
+    """Bounds of the uploads a server holds in memory before they are complete.
+
+    Attributes:
+        client_bytes: the most one browser may announce for its upload in flight; a browser has
+            one upload in flight at a time (a new one drops its unfinished one).
+        server_bytes: the most all browsers of one server may have in flight together; an
+            upload that would pass it is refused.
+        max_parts: the most parts one upload may announce.
+        idle_s: an upload that received no part for this long is dropped (its memory freed).
+    """
+
+    client_bytes: int = 4_000_000
+    server_bytes: int = 32_000_000
+    max_parts: int = 4096
+    idle_s: float = 30.0
+
+
+_limits = UploadLimits()
+
+
+def upload_limits(limits: UploadLimits | None = None) -> UploadLimits:
+    """The upload limits of this process; ``limits`` replaces them (returns the old ones)."""
+    global _limits
+    old = _limits
+    if limits is not None:
+        _limits = limits
+    return old
+
+
+@dataclasses.dataclass
+class _Transfer:
+    client: tuple[int, int]          # (id of the server's event loop, viser client id)
+    size: int
+    states: dict[str, Any]
+    last_part: float
+
+
+# transfer uuid -> transfer, per server event loop (each viser server runs its own loop)
+_transfers: dict[int, dict[str, _Transfer]] = {}
+
+
+def _live(loop_key: int) -> dict[str, _Transfer]:
+    """The transfers of one server still held by viser (finished and dropped ones forgotten)."""
+    table = _transfers.setdefault(loop_key, {})
+    for tid in [t for t, tr in table.items() if t not in tr.states]:
+        del table[tid]
+    return table
+
+
+def uploads_in_flight(loop: asyncio.AbstractEventLoop | None = None) -> list[tuple[int, int]]:
+    """``(viser client id, announced bytes)`` of the unfinished uploads viser holds (every
+    server's when ``loop`` is None)."""
+    keys = list(_transfers) if loop is None else [id(loop)]
+    return [(tr.client[1], tr.size) for k in keys for tr in list(_live(k).values())]
+
+
+def _drop(table: dict[str, _Transfer], tid: str, why: str) -> None:
+    tr = table.pop(tid, None)
+    if tr is not None and tr.states.pop(tid, None) is not None:
+        log.warning("upload from client %s dropped: %s", tr.client[1], why)
+
+
+def _expire(loop: asyncio.AbstractEventLoop, tid: str) -> None:
+    table = _live(id(loop))
+    tr = table.get(tid)
+    if tr is None:
+        return
+    idle = time.monotonic() - tr.last_part
+    if idle >= _limits.idle_s:
+        _drop(table, tid, f"no part for {idle:.0f} s")
+    else:
+        loop.call_later(_limits.idle_s - idle, _expire, loop, tid)
+
+
+def _upload_start_refusal(gui_api: Any, client_id: Any, message: Any) -> str | None:
+    """Admit an upload start (registering its transfer) or say why it is refused."""
+    if message.source_component_uuid not in getattr(gui_api, "_gui_input_handle_from_uuid", {}):
+        return None                                   # not this GUI's button: viser ignores it
+    limits = _limits
+    size, parts = int(message.size_bytes), int(message.part_count)
+    if size < 0 or parts < 0 or parts > limits.max_parts or (size > 0 and parts == 0) or parts > max(size, 1):
+        return f"an upload of {size} bytes in {parts} parts is not a file a browser sends"
+    if size > limits.client_bytes:
+        return f"an upload of {size} bytes is larger than {limits.client_bytes} bytes"
+    loop = asyncio.get_running_loop()
+    table = _live(id(loop))
+    client = (id(loop), int(client_id))
+    for tid in [t for t, tr in table.items() if tr.client == client]:
+        _drop(table, tid, "the same browser started another upload")
+    held = sum(tr.size for tr in table.values())
+    if held + size > limits.server_bytes:
+        return f"the server holds {held} bytes of unfinished uploads (limit {limits.server_bytes})"
+    states = gui_api._current_file_upload_states
+    table[str(message.transfer_uuid)] = _Transfer(client, size, states, time.monotonic())
+    loop.call_later(limits.idle_s, _expire, loop, str(message.transfer_uuid))
+    return None
+
+
+def _upload_part_refusal(gui_api: Any, message: Any) -> str | None:
+    """A part of an admitted upload: count it; refuse it when it passes the announced size."""
+    table = _live(id(asyncio.get_running_loop()))
+    tid = str(message.transfer_uuid)
+    tr = table.get(tid)
+    if tr is None:
+        return None
+    state = tr.states.get(tid)
+    got = 0 if state is None else int(state.get("transferred_bytes", 0))
+    tr.last_part = time.monotonic()
+    if got + len(message.content) > tr.size:
+        _drop(table, tid, f"its parts pass the announced {tr.size} bytes")
+        return "the parts pass the announced size"
+    return None
+
+
+# ------------------------------------------------------------------ value checks
+def _finite_number(v: Any) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+
+
+def _type_ok(value: Any, hint: Any) -> bool:
+    """``value`` (decoded msgpack) fits the annotation ``hint``; unknown annotations pass."""
+    if hint is Any or hint is object:
+        return True
+    origin = typing.get_origin(hint)
+    args = typing.get_args(hint)
+    if origin in (typing.Union, types.UnionType):
+        return any(_type_ok(value, a) for a in args)
+    if hint is type(None):
+        return value is None
+    if origin is typing.Literal:
+        return value in args
+    if hint is bool:
+        return isinstance(value, bool)
+    if hint is int:                             # a browser's numbers are doubles: 720.0 is an int
+        return _finite_number(value) and float(value).is_integer()
+    if hint is float:
+        return _finite_number(value)
+    if hint is str:
+        return isinstance(value, str)
+    if hint is bytes:
+        return isinstance(value, (bytes, bytearray, memoryview))
+    if origin is tuple:
+        if not isinstance(value, (tuple, list)):
+            return False
+        if len(args) == 2 and args[1] is Ellipsis:
+            return all(_type_ok(v, args[0]) for v in value)
+        return len(value) == len(args) and all(_type_ok(v, a) for v, a in zip(value, args))
+    if origin in (dict, typing.Dict):                  # noqa: UP006  (the annotation viser writes)
+        return isinstance(value, dict) and all(_type_ok(k, args[0]) for k in value) if args else isinstance(value, dict)
+    if origin in (list, typing.List):                  # noqa: UP006
+        return isinstance(value, list) and (not args or all(_type_ok(v, args[0]) for v in value))
+    return True
+
+
+_hints: dict[type, dict[str, Any]] = {}
+
+
+def _fields_of(cls: type) -> dict[str, Any]:
+    hints = _hints.get(cls)
+    if hints is None:
+        try:
+            all_hints = typing.get_type_hints(cls)
+            hints = {f.name: all_hints.get(f.name, Any) for f in dataclasses.fields(cls)}
+        except Exception:                       # an annotation this Python cannot resolve: no check
+            hints = {}
+        _hints[cls] = hints
+    return hints
+
+
+def message_refusal(message: Any) -> str | None:
+    """Why a decoded client message is refused (wrong field types, a share-URL request), or
+    None. The value of a ``GuiUpdateMessage`` is checked against its handle separately."""
+    name = type(message).__name__
+    if name in REFUSED_MESSAGES:
+        return f"{name} is not accepted from a browser"
+    for field, hint in _fields_of(type(message)).items():
+        value = getattr(message, field, None)
+        if not _type_ok(value, hint):
+            return f"{name}.{field} = {short(value)} is not {_hint_name(hint)}"
+    return None
+
+
+def _hint_name(hint: Any) -> str:
+    return "a finite number" if hint is float else getattr(hint, "__name__", None) or str(hint)
+
+
+def gui_value_refusal(handle: Any, updates: Any) -> str | None:
+    """Why a browser's ``GuiUpdateMessage.updates`` for the GUI input ``handle`` is refused, or
+    None: only ``value`` may be sent; it must have the type of the handle's value, be finite,
+    lie within the handle's ``min`` / ``max``, be one of its ``options``, or be a text of at most
+    :data:`MAX_TEXT_CHARS` characters; a disabled, removed or upload input takes no update."""
+    impl = handle._impl
+    props = impl.props
+    label = short(getattr(props, "label", "?"), 60)
+    if not isinstance(updates, dict) or set(updates) != {"value"}:
+        return f"{label}: only a value may be sent, got {short(updates)}"
+    if impl.removed or getattr(props, "disabled", False):
+        return f"{label} is disabled"
+    value = updates["value"]
+    current = impl.value
+    if getattr(impl, "is_button", False):
+        return None if value is True else f"{label}: a button sends true, got {short(value)}"
+    if isinstance(current, bool):
+        return None if isinstance(value, bool) else f"{label}: {short(value)} is not true or false"
+    if isinstance(current, (int, float)):
+        return _number_refusal(label, value, getattr(props, "min", None), getattr(props, "max", None),
+                               isinstance(current, int))
+    if isinstance(current, str):
+        if not isinstance(value, str):
+            return f"{label}: {short(value)} is not a text"
+        options = getattr(props, "options", None)
+        if options is not None:
+            return None if value in tuple(options) else f"{label}: {short(value)} is not one of its options"
+        if len(value) > MAX_TEXT_CHARS:
+            return f"{label}: a text of {len(value)} characters is longer than {MAX_TEXT_CHARS}"
+        return None
+    if isinstance(current, tuple):
+        if not isinstance(value, (list, tuple)) or len(value) != len(current):
+            return f"{label}: {short(value)} is not {len(current)} numbers"
+        lo, hi = getattr(props, "min", None), getattr(props, "max", None)
+        for i, v in enumerate(value):
+            why = _number_refusal(label, v, lo[i] if isinstance(lo, tuple) else lo,
+                                  hi[i] if isinstance(hi, tuple) else hi,
+                                  bool(current) and isinstance(current[i], int) and not isinstance(current[i], bool))
+            if why is not None:
+                return why
+        return None
+    return f"{label}: this input takes no value from a browser"
+
+
+def _number_refusal(label: str, value: Any, lo: Any, hi: Any, integer: bool) -> str | None:
+    if not _finite_number(value):
+        return f"{label}: {short(value)} is not a finite number"
+    if integer and value != int(value):
+        return f"{label}: {short(value)} is not a whole number"
+    if lo is not None and value < lo or hi is not None and value > hi:
+        return f"{label}: {short(value)} is outside {lo}..{hi}"
+    return None
+
+
+# ------------------------------------------------------------------ message dispatch
+def _gui_apis(interface: Any) -> list[Any]:
+    """The ``GuiApi`` objects whose handlers are registered on a websocket interface."""
+    from viser._messages import GuiUpdateMessage
+
+    handlers = getattr(interface, "_incoming_handlers", {}).get(GuiUpdateMessage, [])
+    return [h.__self__ for h in handlers if hasattr(getattr(h, "__self__", None), "_gui_input_handle_from_uuid")]
+
+
+def _refusal(interface: Any, client_id: Any, message: Any) -> str | None:
+    """Why ``message`` is not handed to the handlers of ``interface``, or None."""
+    why = message_refusal(message)
+    if why is not None:
+        return why
+    name = type(message).__name__
+    if name == "GuiUpdateMessage":
+        for api in _gui_apis(interface):
+            handle = api._gui_input_handle_from_uuid.get(message.uuid)
+            if handle is not None:
+                return gui_value_refusal(handle, message.updates)
+    elif name == "FileTransferStartUpload":
+        for api in _gui_apis(interface):
+            why = _upload_start_refusal(api, client_id, message)
+            if why is not None:
+                return why
+    elif name == "FileTransferPart" and message.source_component_uuid is not None:
+        for api in _gui_apis(interface):
+            why = _upload_part_refusal(api, message)
+            if why is not None:
+                return why
+    return None
+
+
+_install_lock = threading.Lock()
+_installed = False
+
+
+def install() -> None:
+    """Check and guard every message viser receives, in this process (idempotent; see the
+    module docstring)."""
+    global _installed
+    with _install_lock:
+        if _installed:
+            return
+        from viser.infra import _infra
+
+        original_handle = _infra.WebsockMessageHandler._handle_incoming_message
+        original_consumer = _infra._message_consumer
+
+        async def handle_incoming_message(self: Any, client_id: Any, message: Any) -> None:
+            try:
+                why = _refusal(self, client_id, message)
+                if why is not None:
+                    log.warning("message from client %s refused: %s", client_id, why)
+                    return
+                await original_handle(self, client_id, message)
+            except Exception as exc:             # never a traceback, never a closed socket
+                log.warning("message %s from client %s failed: %s: %s", type(message).__name__, client_id,
+                            type(exc).__name__, short(str(exc)))
+
+        async def message_consumer(websocket: Any, handle_message: Callable[[Any], None],
+                                   message_class: Any) -> None:
+            while True:
+                raw = await websocket.recv()
+                try:
+                    if not isinstance(raw, bytes):
+                        raise TypeError("a text frame; viser speaks binary msgpack")
+                    message = message_class.deserialize(raw)
+                except Exception as exc:
+                    log.warning("undecodable message from %s dropped: %s: %s",
+                                getattr(websocket, "remote_address", "?"), type(exc).__name__, short(str(exc)))
+                    continue
+                handle_message(message)
+
+        message_consumer.__wrapped__ = original_consumer  # type: ignore[attr-defined]
+        _infra.WebsockMessageHandler._handle_incoming_message = handle_incoming_message  # type: ignore[method-assign]
+        _infra._message_consumer = message_consumer  # type: ignore[assignment]
+        _installed = True
