@@ -30,7 +30,7 @@ network. What this module reaches into, and why:
   at :data:`LOG_VALUE_CHARS` characters; the socket stays open.
 
 Moving viser up a minor version: run ``tests/security`` and ``tests/app/test_viser_adapter.py``
-with ``TCP_PENDANT_STRICT_VISER=1`` (the README's test command sets it), then re-read in
+(their conftest sets ``TCP_PENDANT_STRICT_VISER=1``: a fallback fails the test), then re-read in
 viser's source each name used here: ``_GuiHandleState`` (``uuid``, ``value``, ``props``,
 ``removed``, ``gui_api``), ``GuiApi._gui_input_handle_from_uuid`` /
 ``_current_file_upload_states`` / ``_websock_interface``, ``SceneApi._queue_scene_message``,
@@ -55,8 +55,10 @@ from collections import Counter
 from collections.abc import Callable
 from typing import Any
 
-__all__ = ["LOG_VALUE_CHARS", "MAX_TEXT_CHARS", "UploadHook", "UploadLimits", "ViserInternalsChanged",
-           "gui_value_refusal", "install", "message_refusal", "path_counts", "queue_markdown",
+import msgspec
+
+__all__ = ["LOG_VALUE_CHARS", "MAX_ABS_NUMBER", "MAX_TEXT_CHARS", "UploadHook", "UploadLimits",
+           "ViserInternalsChanged", "gui_value_refusal", "install", "message_refusal", "path_counts", "queue_markdown",
            "queue_pose", "reset_path_counts", "short", "upload_hook", "upload_limits",
            "uploads_in_flight"]
 
@@ -68,6 +70,10 @@ LOG_VALUE_CHARS = 200
 MAX_TEXT_CHARS = 10_000
 """Longest text a browser may send for a text field (the longest the app writes itself, a
 controller file's text, is a few kB)."""
+
+MAX_ABS_NUMBER = 1e12
+"""Largest magnitude a browser may send for a number, also for an input without min / max (no
+pendant quantity comes near it; ``-1e308`` would overflow the app's arithmetic)."""
 
 STRICT_ENV = "TCP_PENDANT_STRICT_VISER"
 """Environment variable: ``1`` makes a fast path's fallback raise (tests)."""
@@ -377,16 +383,30 @@ def _fields_of(cls: type) -> dict[str, Any]:
     return hints
 
 
-def message_refusal(message: Any) -> str | None:
-    """Why a decoded client message is refused (wrong field types, a share-URL request), or
-    None. The value of a ``GuiUpdateMessage`` is checked against its handle separately."""
-    name = type(message).__name__
+def message_refusal(mapping: Any) -> str | None:
+    """Why a decoded client message (the msgpack mapping, before viser builds its message
+    object) is refused, or None: not a known message, a missing, extra or wrongly typed field
+    (by the message class's annotations; numbers finite), or a share-URL request. The value of a
+    ``GuiUpdateMessage`` is checked against its handle later (:func:`gui_value_refusal`)."""
+    from viser.infra._messages import Message
+
+    if not isinstance(mapping, dict) or not isinstance(mapping.get("type"), str):
+        return f"{short(mapping, 60)} is not a viser message"
+    name = mapping["type"]
+    cls = Message._subclass_from_type_string().get(name)
+    if cls is None:
+        return f"{short(name, 60)} is not a viser message"
     if name in REFUSED_MESSAGES:
         return f"{name} is not accepted from a browser"
-    for field, hint in _fields_of(type(message)).items():
-        value = getattr(message, field, None)
-        if not _type_ok(value, hint):
-            return f"{name}.{field} = {short(value)} is not {_hint_name(hint)}"
+    fields = _fields_of(cls)
+    extra = set(mapping) - set(fields) - {"type"}
+    if extra:
+        return f"{name} has no field {short(sorted(map(str, extra))[0], 60)}"
+    for field, hint in fields.items():
+        if field not in mapping:
+            return f"{name}.{field} is missing"
+        if not _type_ok(mapping[field], hint):
+            return f"{name}.{field} = {short(mapping[field])} is not {_hint_name(hint)}"
     return None
 
 
@@ -397,8 +417,8 @@ def _hint_name(hint: Any) -> str:
 def gui_value_refusal(handle: Any, updates: Any) -> str | None:
     """Why a browser's ``GuiUpdateMessage.updates`` for the GUI input ``handle`` is refused, or
     None: only ``value`` may be sent; it must have the type of the handle's value, be finite,
-    lie within the handle's ``min`` / ``max``, be one of its ``options``, or be a text of at most
-    :data:`MAX_TEXT_CHARS` characters; a disabled, removed or upload input takes no update."""
+    lie within the handle's ``min`` / ``max`` (and :data:`MAX_ABS_NUMBER`), be one of its
+    ``options``, or be a text of at most :data:`MAX_TEXT_CHARS` characters; a disabled, removed or upload input takes no update."""
     impl = handle._impl
     props = impl.props
     label = short(getattr(props, "label", "?"), 60)
@@ -439,8 +459,8 @@ def gui_value_refusal(handle: Any, updates: Any) -> str | None:
 
 
 def _number_refusal(label: str, value: Any, lo: Any, hi: Any, integer: bool) -> str | None:
-    if not _finite_number(value):
-        return f"{label}: {short(value)} is not a finite number"
+    if not _finite_number(value) or abs(value) > MAX_ABS_NUMBER:
+        return f"{label}: {short(value)} is not a finite number of at most {MAX_ABS_NUMBER:g}"
     if integer and value != int(value):
         return f"{label}: {short(value)} is not a whole number"
     if lo is not None and value < lo or hi is not None and value > hi:
@@ -459,9 +479,6 @@ def _gui_apis(interface: Any) -> list[Any]:
 
 def _refusal(interface: Any, client_id: Any, message: Any) -> str | None:
     """Why ``message`` is not handed to the handlers of ``interface``, or None."""
-    why = message_refusal(message)
-    if why is not None:
-        return why
     name = type(message).__name__
     if name == "GuiUpdateMessage":
         for api in _gui_apis(interface):
@@ -479,6 +496,14 @@ def _refusal(interface: Any, client_id: Any, message: Any) -> str | None:
             if why is not None:
                 return why
     return None
+
+
+def _peer(websocket: Any) -> str:
+    try:
+        host, port = websocket.remote_address[:2]
+        return f"{host}:{port}"
+    except Exception:
+        return "?"
 
 
 _install_lock = threading.Lock()
@@ -515,10 +540,12 @@ def install() -> None:
                 try:
                     if not isinstance(raw, bytes):
                         raise TypeError("a text frame; viser speaks binary msgpack")
-                    message = message_class.deserialize(raw)
+                    why = message_refusal(msgspec.msgpack.decode(raw))
+                    message = None if why is not None else message_class.deserialize(raw)
                 except Exception as exc:
-                    log.warning("undecodable message from %s dropped: %s: %s",
-                                getattr(websocket, "remote_address", "?"), type(exc).__name__, short(str(exc)))
+                    why = f"it does not decode: {type(exc).__name__}: {short(str(exc))}"
+                if why is not None:
+                    log.warning("message from %s refused: %s", _peer(websocket), why)
                     continue
                 handle_message(message)
 
