@@ -416,7 +416,8 @@ class PendantApp:
         viser_adapter.install()             # every browser message checked before viser's handlers
         client_script.script_asset()        # the page's own script (keys, name, trainer URL): packaged?
         self.server = viser.ViserServer(host=host, port=self.config.port, verbose=False)
-        origin_check.allow(self.port, self.allow_origins)
+        origin_check.allow(self.port, self.allow_origins,
+                           origin_check.served_hosts(host, self.network_urls, self.allow_origins))
         origin_check.set_http_layer(self.port, client_script.serve)
         if self.config.port != 0 and self.port != self.config.port:
             # viser silently moves on to the next free port; the class was told this one
