@@ -9,60 +9,18 @@ import logging
 import math
 import random
 import sys
-import threading
 from pathlib import Path
 from typing import Any
 
 import msgspec.msgpack
 import pytest
-import viser
 from tcp_pendant.server import AppConfig, PendantApp
 from tcp_pendant.views.viser_adapter import LOG_VALUE_CHARS
-from viser import _messages
-from websockets.sync.client import connect
 
 sys.path.insert(0, str(Path(__file__).parents[1] / "app"))
-from wsclient import decode_window, wait_until  # noqa: E402
+from wsclient import CAMERA, InputsClient, wait_until  # noqa: E402
 
-INPUTS = {"GuiButtonMessage", "GuiUploadButtonMessage", "GuiSliderMessage", "GuiMultiSliderMessage",
-          "GuiNumberMessage", "GuiRgbMessage", "GuiRgbaMessage", "GuiCheckboxMessage", "GuiVector2Message",
-          "GuiVector3Message", "GuiTextMessage", "GuiDropdownMessage", "GuiButtonGroupMessage"}
 HUGE = "x" * 100_000
-CAMERA = dict(type="ViewerCameraMessage", wxyz=[1.0, 0.0, 0.0, 0.0], position=[2.0, -2.0, 1.0], fov=1.0,
-              near=0.01, far=100.0, image_height=720, image_width=1280, look_at=[0.0, 0.0, 0.5],
-              up_direction=[0.0, 0.0, 1.0])
-
-
-class FuzzClient:
-    """A raw viser websocket that records the GUI inputs the server creates (uuid -> kind,
-    label, props) and sends whatever it is given."""
-
-    def __init__(self, port: int) -> None:
-        self.ws = connect(f"ws://127.0.0.1:{port}", subprotocols=[f"viser-v{viser.__version__}"],  # type: ignore[list-item]
-                          max_size=None, open_timeout=20)
-        self.inputs: dict[str, tuple[str, str, dict[str, Any]]] = {}
-        self.closed = threading.Event()
-        self._thread = threading.Thread(target=self._drain, daemon=True)
-        self._thread.start()
-        self.send(CAMERA)
-
-    def _drain(self) -> None:
-        try:
-            for msg in self.ws:
-                if isinstance(msg, bytes):
-                    for m in decode_window(msg):
-                        if m.get("type") in INPUTS:
-                            props = m.get("props") or {}
-                            self.inputs[m["uuid"]] = (m["type"], str(props.get("label")), props)
-        except Exception:
-            pass
-        self.closed.set()
-
-    def send(self, message: dict[str, Any] | bytes | str) -> None:
-        self.ws.send(message if isinstance(message, (bytes, str)) else msgspec.msgpack.encode(message))
-
-    def uuid_of(self, label: str) -> str:
-        return next(u for u, (_, lab, _) in self.inputs.items() if lab == label)
 
 
 def bad_values(kind: str, props: dict[str, Any]) -> list[Any]:
@@ -136,7 +94,7 @@ def _values(app: PendantApp) -> dict[str, Any]:
 
 def test_fuzzed_messages_leave_no_traceback_and_the_socket_open(app: PendantApp, caplog: pytest.LogCaptureFixture,
                                                                capfd: pytest.CaptureFixture[str]) -> None:
-    client = FuzzClient(app.port)
+    client = InputsClient(app.port)
     try:
         wait_until(lambda: len(app.sessions) == 1, what="the session")
         wait_until(lambda: {"X +", "Load session (JSON)"} <= {lab for _, lab, _ in client.inputs.values()},

@@ -217,8 +217,8 @@ class UploadLimits:
     """Bounds of the uploads a server holds in memory before they are complete.
 
     Attributes:
-        client_bytes: the most one browser may announce for its upload in flight; a browser has
-            one upload in flight at a time (a new one drops its unfinished one).
+        client_bytes: the most one browser may announce or send for its upload in flight; a
+            browser has one upload in flight at a time (a new one drops its unfinished one).
         server_bytes: the most all browsers of one server may have in flight together; an
             upload that would pass it is refused.
         max_parts: the most parts one upload may announce.
@@ -246,9 +246,16 @@ def upload_limits(limits: UploadLimits | None = None) -> UploadLimits:
 @dataclasses.dataclass
 class _Transfer:
     client: tuple[int, int]          # (id of the server's event loop, viser client id)
-    size: int
-    states: dict[str, Any]
-    last_part: float
+    size: int                        # announced, bytes
+    states: dict[str, Any]           # viser's buffers (the GuiApi's)
+    last_part: float                 # time.monotonic() of the start or the last part
+    seen: list[bool]                 # part received, by index
+    received: int = 0                # bytes of the parts received
+
+    @property
+    def held(self) -> int:
+        """Bytes this upload may hold: its announced size, or more when it sent more."""
+        return max(self.size, self.received)
 
 
 # transfer uuid -> transfer, per server event loop (each viser server runs its own loop)
@@ -303,28 +310,38 @@ def _upload_start_refusal(gui_api: Any, client_id: Any, message: Any) -> str | N
     client = (id(loop), int(client_id))
     for tid in [t for t, tr in table.items() if tr.client == client]:
         _drop(table, tid, "the same browser started another upload")
-    held = sum(tr.size for tr in table.values())
+    held = sum(tr.held for tr in table.values())
     if held + size > limits.server_bytes:
         return f"the server holds {held} bytes of unfinished uploads (limit {limits.server_bytes})"
     states = gui_api._current_file_upload_states
-    table[str(message.transfer_uuid)] = _Transfer(client, size, states, time.monotonic())
+    table[str(message.transfer_uuid)] = _Transfer(client, size, states, time.monotonic(), [False] * parts)
     loop.call_later(limits.idle_s, _expire, loop, str(message.transfer_uuid))
     return None
 
 
 def _upload_part_refusal(gui_api: Any, message: Any) -> str | None:
-    """A part of an admitted upload: count it; refuse it when it passes the announced size."""
+    """A part of an admitted upload: count it; refuse it (dropping the upload) when the bytes
+    received pass the per-browser limit or, counted with every other upload in flight, the
+    server's. (A client may understate its size: an upload button's own limit,
+    ``views.upload_guard``, then tells its session.)"""
     table = _live(id(asyncio.get_running_loop()))
     tid = str(message.transfer_uuid)
     tr = table.get(tid)
-    if tr is None:
-        return None
-    state = tr.states.get(tid)
-    got = 0 if state is None else int(state.get("transferred_bytes", 0))
+    index = message.part_index
+    if tr is None or tr.states is not getattr(gui_api, "_current_file_upload_states", None) \
+            or not 0 <= index < len(tr.seen) or tr.seen[index]:
+        return None                             # another GUI's, or a part viser ignores
     tr.last_part = time.monotonic()
-    if got + len(message.content) > tr.size:
-        _drop(table, tid, f"its parts pass the announced {tr.size} bytes")
-        return "the parts pass the announced size"
+    received = tr.received + len(message.content)
+    if received > _limits.client_bytes:
+        _drop(table, tid, f"its parts pass {_limits.client_bytes} bytes")
+        return "the parts pass the per-browser limit"
+    others = sum(t.held for k, t in table.items() if k != tid)
+    if others + max(tr.size, received) > _limits.server_bytes:
+        _drop(table, tid, f"the server holds {others} bytes of other unfinished uploads")
+        return "the parts pass the server's limit"
+    tr.seen[index] = True                       # viser ignores a repeated part: counted once
+    tr.received = received
     return None
 
 
