@@ -77,7 +77,8 @@ class AppConfig:
             the pendant's own address, e.g. a reverse proxy's (``tcp_pendant.origin_check``).
         class_db: the class gradebook (SQLite file); None: no classroom (no name prompt, nothing
             recorded). The CLI passes its default path. Ignored with ``shared``.
-        trainer_token: the token that opens the trainer view (None: a random one).
+        trainer_token: the token that opens the trainer view, 16 to 200 printable characters
+            (None: a random one).
         exercise: None (free practice) or "mystery" (each trainee gets a mystery tool).
         exercise_seed: seed of the mystery tools.
         scenario: the systematic error every session starts with (training;

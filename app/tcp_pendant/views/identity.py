@@ -40,7 +40,8 @@ class IdentityPrompt:
     Args:
         session: the browser's session (its target is the client).
         on_name: called with the validated name; it may raise ``ValueError`` (shown in the modal).
-        on_token: called with the typed token; returns True when it opened the trainer view.
+        on_token: called with the typed token; returns True when it opened the trainer view; it
+            may raise ``ValueError`` (too many wrong tokens: shown in the modal).
 
     Attributes:
         name: the accepted name (None until then).
@@ -84,7 +85,12 @@ class IdentityPrompt:
     def _trainer(self, _event: Any = None) -> None:
         token = str(self.token_field.value)[:_MAX_TOKEN_CHARS]
         self.token_field.value = ""
-        if not self._on_token(token):
+        try:
+            opened = self._on_token(token)
+        except ValueError as exc:                  # too many wrong tokens: wait
+            self.message.content = f"⚠ {escape_markdown(str(exc))}"
+            return
+        if not opened:
             self.message.content = "⚠ That trainer token is not right; type the token the server printed."
             return
         self.modal.close()
