@@ -108,3 +108,34 @@ def test_a_fallback_raises_under_the_strict_flag() -> None:
         set_markdown(_Other(), "a")
     with pytest.raises(ViserInternalsChanged, match="viser fast path 'upload' fell back"):
         viser_adapter.upload_hook(_Other())
+
+
+def test_the_value_check_of_each_kind_of_input(server) -> None:
+    """What each GUI input accepts from a browser (what viser's own widgets send) and refuses."""
+    from tcp_pendant.views.viser_adapter import MAX_TEXT_CHARS, gui_value_refusal
+
+    gui = server.gui
+    cases = [
+        (gui.add_button("B"), [True], [False, 1, "x"]),
+        (gui.add_button_group("G", ("a", "b")), ["a", "b"], ["c", True, 1]),
+        (gui.add_dropdown("D", ("a", "b")), ["b"], ["c", None]),
+        (gui.add_checkbox("C", False), [True, False], [1, "true", None]),
+        (gui.add_slider("S", min=0.0, max=10.0, step=0.1, initial_value=1.0), [0, 10.0, 5.55],
+         [-0.1, 10.1, float("nan"), "5", True]),
+        (gui.add_number("N", 3, min=0, step=1), [0, 7, 8.0, 10**9], [-1, 2.5, -1e308, 1e308, float("inf")]),
+        (gui.add_number("F", 1.0, step=0.1), [-1e6, 1e6], [1e13, -1e308]),
+        (gui.add_text("T", ""), ["", "a" * MAX_TEXT_CHARS], ["a" * (MAX_TEXT_CHARS + 1), 12, None]),
+        (gui.add_vector3("V", (0.0, 0.0, 0.0), min=(-1.0, -1.0, -1.0), max=(1.0, 1.0, 1.0)),
+         [[0.5, -0.5, 1.0], (0, 0, 0)], [[0.0, 0.0], [2.0, 0.0, 0.0], [0.0, "0", 0.0]]),
+        (gui.add_rgb("R", (1, 2, 3)), [[0, 128, 255]], [[0, 0], [0.5, 0, 0], [256, 0, 0], [-1, 0, 0]]),
+        (gui.add_upload_button("U"), [], [{"name": "x"}, "x", b"x"]),
+    ]
+    for handle, good, bad in cases:
+        for v in good:
+            assert gui_value_refusal(handle, {"value": v}) is None, (handle.label, v)
+        for v in bad:
+            assert gui_value_refusal(handle, {"value": v}) is not None, (handle.label, v)
+        assert gui_value_refusal(handle, {"value": None, "disabled": False}) is not None
+        assert gui_value_refusal(handle, {"removed": True}) is not None
+    off = gui.add_button("Off", disabled=True)
+    assert gui_value_refusal(off, {"value": True}) == "'Off' is disabled"

@@ -445,6 +445,10 @@ def gui_value_refusal(handle: Any, updates: Any) -> str | None:
         return f"{label} is disabled"
     value = updates["value"]
     current = impl.value
+    options = getattr(props, "options", None)
+    if options is not None:                     # dropdown, button group (a button too)
+        return None if isinstance(value, str) and value in tuple(options) else \
+            f"{label}: {short(value)} is not one of its options"
     if getattr(impl, "is_button", False):
         return None if value is True else f"{label}: a button sends true, got {short(value)}"
     if isinstance(current, bool):
@@ -455,9 +459,6 @@ def gui_value_refusal(handle: Any, updates: Any) -> str | None:
     if isinstance(current, str):
         if not isinstance(value, str):
             return f"{label}: {short(value)} is not a text"
-        options = getattr(props, "options", None)
-        if options is not None:
-            return None if value in tuple(options) else f"{label}: {short(value)} is not one of its options"
         if len(value) > MAX_TEXT_CHARS:
             return f"{label}: a text of {len(value)} characters is longer than {MAX_TEXT_CHARS}"
         return None
@@ -465,6 +466,8 @@ def gui_value_refusal(handle: Any, updates: Any) -> str | None:
         if not isinstance(value, (list, tuple)) or len(value) != len(current):
             return f"{label}: {short(value)} is not {len(current)} numbers"
         lo, hi = getattr(props, "min", None), getattr(props, "max", None)
+        if type(props).__name__ in ("GuiRgbProps", "GuiRgbaProps"):
+            lo, hi = 0, 255
         for i, v in enumerate(value):
             why = _number_refusal(label, v, lo[i] if isinstance(lo, tuple) else lo,
                                   hi[i] if isinstance(hi, tuple) else hi,
