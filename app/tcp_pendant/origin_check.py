@@ -223,6 +223,14 @@ def enable() -> None:
         allowed, layer, hosts = _allowed_for(self)
 
         def checked(connection: Any, request: Any) -> Any:
+            try:
+                return answer(connection, request)
+            except Exception as exc:                # a request nobody foresaw: one line, no traceback
+                log.warning("request from %s for %s failed: %s: %s", _peer(connection),
+                            _shown(str(getattr(request, "path", "?"))), type(exc).__name__, _shown(str(exc)))
+                return connection.respond(http.HTTPStatus.BAD_REQUEST, "Bad request.\n")
+
+        def answer(connection: Any, request: Any) -> Any:
             refusal = host_refusal(request.headers, hosts)
             if refusal is None and _is_upgrade(request):
                 refusal = origin_refusal(request.headers, allowed)

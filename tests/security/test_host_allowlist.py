@@ -125,3 +125,20 @@ def test_the_served_names_are_per_server_and_dropped_at_stop(tmp_path: Path) -> 
     finally:
         a.stop()
     assert port not in origin_check._hosts_by_port
+
+
+def test_a_request_that_breaks_a_page_handler_is_a_400_without_traceback(app: PendantApp, monkeypatch, caplog) -> None:
+    """Whatever raises while a request is answered (here: the page script's layer) gives 400
+    and one log line, not websockets' 500 and a traceback."""
+    import logging
+
+    def broken(connection, request, process_request):
+        raise KeyError("x" * 1000)
+
+    monkeypatch.setitem(origin_check._http_layers, app.port, broken)
+    with caplog.at_level(logging.WARNING):
+        status, body = raw_request(app.port, [("Host", f"127.0.0.1:{app.port}")], upgrade=False)
+    assert (status, body) == (400, b"Bad request.\n")
+    assert not [r for r in caplog.records if r.exc_info]
+    line = next(r.getMessage() for r in caplog.records if "failed: KeyError" in r.getMessage())
+    assert len(line) < 300
