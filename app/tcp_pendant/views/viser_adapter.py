@@ -160,10 +160,12 @@ def queue_pose(handle: Any, wxyz: list[float] | None, xyz: list[float] | None) -
         api = impl.api
         if wxyz is not None:
             impl.wxyz[:] = wxyz
-            api._queue_scene_message(_messages.SetOrientationMessage(impl.name, tuple(wxyz)))
+            api._queue_scene_message(_messages.SetOrientationMessage(
+                impl.name, typing.cast("tuple[float, float, float, float]", tuple(wxyz))))
         if xyz is not None:
             impl.position[:] = xyz
-            api._queue_scene_message(_messages.SetPositionMessage(impl.name, tuple(xyz)))
+            api._queue_scene_message(_messages.SetPositionMessage(
+                impl.name, typing.cast("tuple[float, float, float]", tuple(xyz))))
     except (AttributeError, ImportError) as exc:
         return _fallback("pose", exc)
     return _fast("pose")
