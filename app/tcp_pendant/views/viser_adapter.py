@@ -27,7 +27,8 @@ network. What this module reaches into, and why:
   ``value`` may change; type, finite, the handle's min / max, its options, a text length
   limit; nothing for a disabled input). Uploads are bounded per client and per server
   (:class:`UploadLimits`). A refused or failing message is logged in one line, user values cut
-  at :data:`LOG_VALUE_CHARS` characters; the socket stays open.
+  at :data:`LOG_VALUE_CHARS` characters, at most :data:`LOG_BUDGET` lines at a time (the rest
+  counted: :func:`message_counts`); the socket stays open.
 
 Moving viser up a minor version: run ``tests/security`` and ``tests/app/test_viser_adapter.py``
 (their conftest sets ``TCP_PENDANT_STRICT_VISER=1``: a fallback fails the test), then re-read in
@@ -51,6 +52,7 @@ import threading
 import time
 import types
 import typing
+import weakref
 from collections import Counter
 from collections.abc import Callable
 from typing import Any
@@ -59,7 +61,7 @@ import msgspec
 
 __all__ = ["LOG_VALUE_CHARS", "MAX_ABS_NUMBER", "MAX_TEXT_CHARS", "UploadHook", "UploadLimits",
            "ViserInternalsChanged", "gui_value_refusal", "install", "message_refusal", "path_counts", "queue_markdown",
-           "queue_pose", "reset_path_counts", "short", "upload_hook", "upload_limits",
+           "message_counts", "queue_pose", "reset_path_counts", "short", "upload_hook", "upload_limits",
            "uploads_in_flight"]
 
 log = logging.getLogger(__name__)
@@ -261,12 +263,12 @@ class _Transfer:
 
 
 # transfer uuid -> transfer, per server event loop (each viser server runs its own loop)
-_transfers: dict[int, dict[str, _Transfer]] = {}
+_transfers: weakref.WeakKeyDictionary[asyncio.AbstractEventLoop, dict[str, _Transfer]] = weakref.WeakKeyDictionary()
 
 
-def _live(loop_key: int) -> dict[str, _Transfer]:
+def _live(loop: asyncio.AbstractEventLoop) -> dict[str, _Transfer]:
     """The transfers of one server still held by viser (finished and dropped ones forgotten)."""
-    table = _transfers.setdefault(loop_key, {})
+    table = _transfers.setdefault(loop, {})
     for tid in [t for t, tr in table.items() if t not in tr.states]:
         del table[tid]
     return table
@@ -275,8 +277,8 @@ def _live(loop_key: int) -> dict[str, _Transfer]:
 def uploads_in_flight(loop: asyncio.AbstractEventLoop | None = None) -> list[tuple[int, int]]:
     """``(viser client id, announced bytes)`` of the unfinished uploads viser holds (every
     server's when ``loop`` is None)."""
-    keys = list(_transfers) if loop is None else [id(loop)]
-    return [(tr.client[1], tr.size) for k in keys for tr in list(_live(k).values())]
+    loops = list(_transfers) if loop is None else [loop]
+    return [(tr.client[1], tr.size) for lp in loops for tr in list(_live(lp).values())]
 
 
 def _drop(table: dict[str, _Transfer], tid: str, why: str) -> None:
@@ -286,7 +288,7 @@ def _drop(table: dict[str, _Transfer], tid: str, why: str) -> None:
 
 
 def _expire(loop: asyncio.AbstractEventLoop, tid: str) -> None:
-    table = _live(id(loop))
+    table = _live(loop)
     tr = table.get(tid)
     if tr is None:
         return
@@ -308,7 +310,7 @@ def _upload_start_refusal(gui_api: Any, client_id: Any, message: Any) -> str | N
     if size > limits.client_bytes:
         return f"an upload of {size} bytes is larger than {limits.client_bytes} bytes"
     loop = asyncio.get_running_loop()
-    table = _live(id(loop))
+    table = _live(loop)
     client = (id(loop), int(client_id))
     for tid in [t for t, tr in table.items() if tr.client == client]:
         _drop(table, tid, "the same browser started another upload")
@@ -326,7 +328,7 @@ def _upload_part_refusal(gui_api: Any, message: Any) -> str | None:
     received pass the per-browser limit or, counted with every other upload in flight, the
     server's. (A client may understate its size: an upload button's own limit,
     ``views.upload_guard``, then tells its session.)"""
-    table = _live(id(asyncio.get_running_loop()))
+    table = _live(asyncio.get_running_loop())
     tid = str(message.transfer_uuid)
     tr = table.get(tid)
     index = message.part_index
@@ -520,6 +522,47 @@ def _refusal(interface: Any, client_id: Any, message: Any) -> str | None:
     return None
 
 
+LOG_BUDGET = (50, 10.0)
+"""At most this many refused or failed messages of one browser are logged per this many
+seconds (a flood of bad messages must not fill the disk); the others are counted, and the
+count is logged when the next window opens."""
+
+_message_counts: Counter[str] = Counter()
+# per server loop: sender ("client N" or the socket's peer address) -> [window start, logged, skipped]
+_log_windows: weakref.WeakKeyDictionary[asyncio.AbstractEventLoop, dict[str, list[float]]] = \
+    weakref.WeakKeyDictionary()
+_log_lock = threading.Lock()
+
+
+def message_counts() -> dict[str, int]:
+    """How many browser messages were ``refused`` (checks) or ``failed`` (viser raised)."""
+    with _log_lock:
+        return dict(_message_counts)
+
+
+def _log_message(kind: str, sender: str, fmt: str, *args: Any) -> None:
+    """Count a refused / failed message of ``sender`` and log it within :data:`LOG_BUDGET`."""
+    lines, window_s = LOG_BUDGET
+    now = time.monotonic()
+    with _log_lock:
+        _message_counts[kind] += 1
+        windows = _log_windows.setdefault(asyncio.get_running_loop(), {})
+        if len(windows) > 1000:                     # forget the senders of closed windows
+            for key in [k for k, w in windows.items() if now - w[0] >= window_s]:
+                del windows[key]
+        w = windows.setdefault(sender, [now, 0, 0])
+        skipped = 0
+        if now - w[0] >= window_s:
+            skipped = int(w[2])
+            w[:] = [now, 0, 0]
+        log_it = w[1] < lines
+        w[1 if log_it else 2] += 1
+    if skipped:
+        log.warning("%d more refused or failed messages from %s were not logged", skipped, sender)
+    if log_it:
+        log.warning(fmt, *args)
+
+
 def _peer(websocket: Any) -> str:
     try:
         host, port = websocket.remote_address[:2]
@@ -548,12 +591,13 @@ def install() -> None:
             try:
                 why = _refusal(self, client_id, message)
                 if why is not None:
-                    log.warning("message from client %s refused: %s", client_id, why)
+                    _log_message("refused", f"client {client_id}", "message from client %s refused: %s",
+                                 client_id, why)
                     return
                 await original_handle(self, client_id, message)
             except Exception as exc:             # never a traceback, never a closed socket
-                log.warning("message %s from client %s failed: %s: %s", type(message).__name__, client_id,
-                            type(exc).__name__, short(str(exc)))
+                _log_message("failed", f"client {client_id}", "message %s from client %s failed: %s: %s",
+                             type(message).__name__, client_id, type(exc).__name__, short(str(exc)))
 
         async def message_consumer(websocket: Any, handle_message: Callable[[Any], None],
                                    message_class: Any) -> None:
@@ -567,7 +611,8 @@ def install() -> None:
                 except Exception as exc:
                     why = f"it does not decode: {type(exc).__name__}: {short(str(exc))}"
                 if why is not None:
-                    log.warning("message from %s refused: %s", _peer(websocket), why)
+                    peer = _peer(websocket)
+                    _log_message("refused", peer, "message from %s refused: %s", peer, why)
                     continue
                 handle_message(message)
 
