@@ -10,6 +10,7 @@ Examples::
     tcp-pendant --host 0.0.0.0 --class           # a class: names, gradebook, trainer view
     tcp-pendant --host 0.0.0.0 --exercise mystery --exercise-seed 7   # a class with mystery tools
     tcp-pendant grades --csv > grades.csv        # the class gradebook (see classroom.grades_cli)
+    tcp-pendant poses import touch.ls --robot kr6 > POSES.csv   # joint points by the robot's FK
     tcp-pendant --scenario bent-tool --scenario-seed 3   # training: a systematic error to find
 """
 
@@ -92,6 +93,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--beam-crossed", action="store_true",
                    help="a second beam along WORLD Y crosses the first (crossed beams, as on TRACC-type "
                         "devices)")
+    p.add_argument("--seed", type=int, default=None, metavar="N",
+                   help="one seed for every pendant's randomness (Auto-touch's operator error and "
+                        "directions, the beam sensor's noise): a seeded lesson replays the same way "
+                        "(default: fresh randomness; >= 0)")
     p.add_argument("--verbose", action="store_true", help="log debugging information")
     return p
 
@@ -137,6 +142,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         from tcp_pendant.classroom.grades_cli import main as grades_main
 
         return grades_main(args_list[1:])
+    if args_list[:2] == ["poses", "import"]:
+        from tcp_pendant.poses_import_cli import main as poses_import_main
+
+        return poses_import_main(args_list[2:])
     try:
         return _main(args_list)
     except KeyboardInterrupt:               # Ctrl-C while loading the robot or starting
@@ -191,7 +200,7 @@ def _main(argv: Sequence[str] | None) -> int:
                            exercise_seed=args.exercise_seed, scenario=args.scenario.replace("-", "_"),
                            scenario_seed=args.scenario_seed, presenter=args.presenter,
                            beam_width_mm=args.beam_width, beam_repeatability_mm=args.beam_repeatability,
-                           beam_crossed=args.beam_crossed)
+                           beam_crossed=args.beam_crossed, seed=args.seed)
         app = PendantApp(config)
     except (ControllerError, ValueError, OSError, GradebookError) as exc:
         print(f"tcp-pendant: error: {exc}", file=sys.stderr)

@@ -33,6 +33,7 @@ import numpy as np
 
 from tcpcal.library import ToolLibrary
 from tcp_pendant import client_script, origin_check
+from tcp_pendant.calibrate import CalibrationWorkflow
 from tcp_pendant.addresses import network_urls
 from tcp_pendant.classroom.class_room import ClassRoom
 from tcp_pendant.classroom.gradebook import Gradebook
@@ -90,6 +91,10 @@ class AppConfig:
             tip (``controller.beam_scan.BeamDevice``): beam diameter (0.05-5 mm, default 0.5),
             repeatability of an event per axis (0-1 mm, default 0.02), a second beam along
             WORLD Y crossing it.
+        seed: the one seed of every session's randomness (``Session.rng``: Auto-touch's operator
+            error and directions, the beam's repeatability noise); session k of the server draws
+            from ``(seed, k)``, so a seeded lesson or test replays the same way. None: fresh
+            randomness.
     """
 
     robot: str = "kr6"
@@ -112,6 +117,7 @@ class AppConfig:
     beam_width_mm: float = 0.5
     beam_repeatability_mm: float = 0.02
     beam_crossed: bool = False
+    seed: int | None = None
 
 
 class PortInUseError(OSError):
@@ -252,6 +258,12 @@ class PendantApp:
         self.allow_origins = origin_check.parse_allow_origins(config.allow_origins)
         self.library = ToolLibrary(config.tool_library)
         self.robot_label = ROBOT_LABELS.get(config.robot, urdf.stem)
+        self.robot_key = config.robot if config.robot in builtin_robots() else urdf.stem
+        """The robot's name in session records: "kr6", "gp12" or the URDF's file name."""
+        if config.seed is not None and (isinstance(config.seed, bool) or not isinstance(config.seed, int)
+                                        or config.seed < 0):
+            raise ControllerError(f"The seed must be a whole number >= 0, got {config.seed!r}.")
+        self._sessions_made = 0
         self.server: Any = None
         self.sessions: dict[int, Session] = {}
         self.shared_session: Session | None = None
@@ -281,6 +293,13 @@ class PendantApp:
         c.set_q(self.ready_q_rad)
         return c
 
+    def session_rng(self) -> np.random.Generator:
+        """The next session's random generator: from ``(seed, k)`` for the server's k-th session
+        when a seed was given (``AppConfig.seed``), else fresh."""
+        k, self._sessions_made = self._sessions_made, self._sessions_made + 1
+        seed = self.config.seed
+        return np.random.default_rng() if seed is None else np.random.default_rng([int(seed), k])
+
     def make_session(self, client: Any | None, target: Any | None = None, *, shared: bool = False) -> Session:
         """Build a session drawing into ``target`` (default: ``client``). A per-browser session
         starts with no active tool (TCP = flange); the shared one (``shared``) with the
@@ -296,8 +315,10 @@ class PendantApp:
         steps on viser's event loop). Closing the generator early closes the half-built session.
         """
         c = self.new_controller()
-        session = Session(c, self.library, client=client, target=target, ready_q_rad=self.ready_q_rad,
-                          shared=shared)
+        rng = self.session_rng()
+        workflow = CalibrationWorkflow(c, self.library, robot=self.robot_key, rng=rng)
+        session = Session(c, self.library, workflow, client=client, target=target, ready_q_rad=self.ready_q_rad,
+                          shared=shared, rng=rng)
         session.reload_library()
         if shared:
             try:

@@ -82,9 +82,9 @@ def test_the_check_starts_from_the_recorded_pose_not_where_the_robot_is_now(work
     q_touch = wf.controller.q_rad.copy()
     assert wf.controller.jog_cartesian("WORLD", "Z", 50.0).stopped_by is None     # backed off 50 mm
     assert not np.allclose(wf.controller.q_rad, q_touch)
-    job = wf.tcp_check_job()
+    job = wf.controller_job()
     np.testing.assert_allclose(job.q_rad, q_touch)
-    res = wf.give_tcp_check(job, job.run())
+    res = wf.give_controller_job(job, job.run())
     assert res.check.implied_tcp_error_mm == pytest.approx(1.0, abs=0.01)
 
 
@@ -113,11 +113,11 @@ def test_finish_before_the_check_and_bad_options_say_what_to_do(workflow, librar
     wf.auto_touch(AutoTouchRequest())
     with pytest.raises(WizardStateError, match="Run the check first"):
         wiz.finish()                                    # the state machine alone cannot check
-    job = wf.tcp_check_job()
+    job = wf.controller_job()
     wf.record()                                         # recorded again while the check "ran"
     with pytest.raises(WizardStateError, match="recorded again"):
-        wf.give_tcp_check(job, job.run())
-    assert wiz.check_pending and wf.run_tcp_check() is wf.result
+        wf.give_controller_job(job, job.run())
+    assert wiz.check_pending and wf.run_controller_job() is wf.result
 
 
 def test_the_session_record_replays_the_check_without_a_robot(workflow, library) -> None:
@@ -150,4 +150,5 @@ def test_a_finished_check_is_done_not_left_half_way(workflow, library) -> None:
     wf.start("tcp-check", slot=slot)
     wf.auto_touch(AutoTouchRequest())
     wf.cancel()                                           # an unfinished one waits to be resumed
-    assert [label for _, label in wf.resumable()] == ["2: TCP check (spin test), 1 of 1 recorded"]
+    assert [label.split(", started")[0] for _, label in wf.resumable()] == [
+        "2: TCP check (spin test), at step 1 of 1 (1 recorded)"]

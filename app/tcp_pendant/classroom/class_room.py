@@ -97,10 +97,8 @@ class ClassRoom:
         with session.lock:
             trainee = self.gradebook.add_trainee(name)
             sid = self.gradebook.start_session(trainee, "per-browser")
-            calibrate = session.views.get("calibrate")
-            workflow = getattr(calibrate, "workflow", None)
-            recorder = TraineeRecorder(self.gradebook, sid, name, session.controller, workflow,
-                                       exercise_id=self.exercise)
+            session.keep_honest_records()             # the trainee's export carries no answer key
+            recorder = TraineeRecorder(self.gradebook, sid, name, session.workflow, exercise_id=self.exercise)
 
             def on_change(change: SessionChange) -> None:
                 before = recorder.status
@@ -111,7 +109,7 @@ class ClassRoom:
             session.subscribe(on_change)
             with self._lock:
                 self._trainees[id(session)] = (session, recorder, name)
-            self._hide_truth(workflow, self.exercise)
+            session.set_hide_truth(self.exercise is not None)
             if self.exercise == "mystery":
                 self._mount_mystery(session, recorder, name)
             if self.hide_distance is not None:
@@ -119,19 +117,11 @@ class ClassRoom:
         self.refresh_trainers()
         return recorder
 
-    @staticmethod
-    def _hide_truth(workflow: Any | None, exercise: str | None) -> None:
-        """In an exercise the trainee's result shows no truth (free practice: training mode's)."""
-        if workflow is not None:
-            workflow.hide_truth = exercise is not None
-
     def _mount_mystery(self, session: Session, recorder: TraineeRecorder, name: str) -> None:
         base = self.tools.get("pointer") or next(iter(self.tools.values()))
         tool = draw_mystery_tool(self.exercise_seed, name, base)
-        workflow = recorder.workflow
-        if workflow is not None:
-            workflow.tools[tool.key] = tool          # its label in the wizard's tool-change words
         recorder.exercise_id = "mystery"
+        session.add_physical_tool(tool)              # its label in the wizard's tool-change words
         session.mount_tool(tool)
 
     def detach(self, session: Session) -> None:
@@ -216,7 +206,7 @@ class ClassRoom:
             def apply(session: Session = session, recorder: TraineeRecorder = recorder, name: str = name) -> None:
                 with session.batch():
                     recorder.exercise_id = exercise
-                    self._hide_truth(recorder.workflow, exercise)
+                    session.set_hide_truth(exercise is not None)
                     if exercise == "mystery":
                         self._mount_mystery(session, recorder, name)
                     elif tool_key is not None:

@@ -7,7 +7,7 @@ Record), and on Finish shows how far the TRUE tip moved per rotation, the implie
 and the correction (FLANGE, mm), with a verdict.
 
 The state machine stays free of viser and of the controller: the six rotations are run by the
-caller (``CalibrationWorkflow.tcp_check_job``; the app runs it in a worker thread) from the
+caller (``calibrate.jobs.spin_check_job``; the app runs it in a worker thread) from the
 recorded pose, and the outcome is handed in with :meth:`TcpCheckWizard.give_check` (any
 object shaped like ``controller.spin.SpinCheckResult``); only then can the wizard finish.
 A check is not a calibration: nothing is graded against truth (no true tool at start) and
@@ -22,7 +22,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any, ClassVar
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 
@@ -181,6 +181,8 @@ class TcpCheckWizard(Wizard):
     )
     needs_tool = "library"
     saves_to_library: ClassVar[bool] = False
+    controller_job: ClassVar[str | None] = "spin_check"
+    result_view: ClassVar[Literal["touches", "spin_check", "beam_scan"]] = "spin_check"
     """No Save: a check changes no tool data (the result view hides Save, the workflow refuses)."""
 
     def __init__(self, tool: Tool, *, slot: int | None = None, angle_deg: float = 30.0) -> None:
