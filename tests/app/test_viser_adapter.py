@@ -118,6 +118,8 @@ def test_the_value_check_of_each_kind_of_input(server) -> None:
     cases = [
         (gui.add_button("B"), [True], [False, 1, "x"]),
         (gui.add_button_group("G", ("a", "b")), ["a", "b"], ["c", True, 1]),
+        # the selected option marked in its label: a click sent before the mark moved still counts
+        (gui.add_button_group("M", ("✓ 10", "1", "0.1")), ["✓ 10", "10", "1", "✓ 1"], ["100", "0", "✓ 5", ""]),
         (gui.add_dropdown("D", ("a", "b")), ["b"], ["c", None]),
         (gui.add_checkbox("C", False), [True, False], [1, "true", None]),
         (gui.add_slider("S", min=0.0, max=10.0, step=0.1, initial_value=1.0), [0, 10.0, 5.55],

@@ -48,6 +48,7 @@ import dataclasses
 import logging
 import math
 import os
+import re
 import threading
 import time
 import types
@@ -439,7 +440,8 @@ def gui_value_refusal(handle: Any, updates: Any) -> str | None:
     """Why a browser's ``GuiUpdateMessage.updates`` for the GUI input ``handle`` is refused, or
     None: only ``value`` may be sent; it must have the type of the handle's value, be finite,
     lie within the handle's ``min`` / ``max`` (and :data:`MAX_ABS_NUMBER`), be one of its
-    ``options``, or be a text of at most :data:`MAX_TEXT_CHARS` characters; a disabled, removed or upload input takes no update."""
+    ``options`` (with or without a leading mark such as ``"✓ "``), or be a text of at most
+    :data:`MAX_TEXT_CHARS` characters; a disabled, removed or upload input takes no update."""
     impl = handle._impl
     props = impl.props
     label = short(getattr(props, "label", "?"), 60)
@@ -451,8 +453,9 @@ def gui_value_refusal(handle: Any, updates: Any) -> str | None:
     current = impl.value
     options = getattr(props, "options", None)
     if options is not None:                     # dropdown, button group (a button too)
-        return None if isinstance(value, str) and value in tuple(options) else \
-            f"{label}: {short(value)} is not one of its options"
+        if isinstance(value, str) and (value in tuple(options) or _bare(value) in {_bare(o) for o in options}):
+            return None
+        return f"{label}: {short(value)} is not one of its options"
     if getattr(impl, "is_button", False):
         return None if value is True else f"{label}: a button sends true, got {short(value)}"
     if isinstance(current, bool):
@@ -480,6 +483,16 @@ def gui_value_refusal(handle: Any, updates: Any) -> str | None:
                 return why
         return None
     return f"{label}: this input takes no value from a browser"
+
+
+_DECORATION = re.compile(r"^[^\w.+\-]+\s*")
+
+
+def _bare(option: str) -> str:
+    """An option's label without a leading mark (``"✓ 10"`` -> ``"10"``): a view may mark the
+    selected option in its label, and a click the browser sent before the marks moved names
+    the option as it was shown then."""
+    return _DECORATION.sub("", option, count=1)
 
 
 def _number_refusal(label: str, value: Any, lo: Any, hi: Any, integer: bool) -> str | None:
