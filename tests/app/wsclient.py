@@ -151,6 +151,7 @@ class InputsClient:
         self.ws = connect(f"ws://127.0.0.1:{port}", subprotocols=[f"viser-v{viser.__version__}"],  # type: ignore[list-item]
                           max_size=None, open_timeout=20)
         self.inputs: dict[str, tuple[str, str, dict[str, Any]]] = {}
+        self.updates: list[tuple[str, dict[str, Any]]] = []     # (uuid, updates) the server sent
         self.closed = threading.Event()
         self._thread = threading.Thread(target=self._drain, daemon=True)
         self._thread.start()
@@ -164,6 +165,8 @@ class InputsClient:
                         if m.get("type") in INPUTS:
                             props = m.get("props") or {}
                             self.inputs[m["uuid"]] = (m["type"], str(props.get("label")), props)
+                        elif m.get("type") == "GuiUpdateMessage":
+                            self.updates.append((m["uuid"], m["updates"]))
         except Exception:
             pass
         self.closed.set()

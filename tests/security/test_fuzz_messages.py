@@ -135,3 +135,20 @@ def test_fuzzed_messages_leave_no_traceback_and_the_socket_open(app: PendantApp,
         assert longest < 2 * LOG_VALUE_CHARS + 200, max((r.getMessage() for r in caplog.records), key=len)[:400]
     finally:
         client.ws.close()
+
+
+def test_a_refused_value_is_sent_back_as_the_server_holds_it(app: PendantApp) -> None:
+    """-1e308 typed into the override slider's field: refused, and the browser gets the value
+    the server kept, so its widget does not show a number the pendant never took."""
+    client = InputsClient(app.port)
+    try:
+        wait_until(lambda: "Override %" in client.labels(), what="the override slider")
+        uuid = client.uuid_of("Override %")
+        (session,) = app.sessions.values()
+        kept = session.jogger.settings.override_pct
+        client.send({"type": "GuiUpdateMessage", "uuid": uuid, "updates": {"value": -1e308}})
+        wait_until(lambda: (uuid, {"value": kept}) in client.updates, what="the kept value sent back")
+        assert session.jogger.settings.override_pct == kept
+        assert not client.closed.is_set()
+    finally:
+        client.ws.close()

@@ -25,7 +25,8 @@ network. What this module reaches into, and why:
   trainee must not publish the class server on viser's share tunnel), and for a
   ``GuiUpdateMessage`` :func:`gui_value_refusal` checks the value against its handle (only
   ``value`` may change; type, finite, the handle's min / max, its options, a text length
-  limit; nothing for a disabled input). Uploads are bounded per client and per server
+  limit; nothing for a disabled input; a refused value is sent back as the server holds it).
+  Uploads are bounded per client and per server
   (:class:`UploadLimits`). A refused or failing message is logged in one line, user values cut
   at :data:`LOG_VALUE_CHARS` characters, at most :data:`LOG_BUDGET` lines at a time (the rest
   counted: :func:`message_counts`); the socket stays open.
@@ -514,6 +515,17 @@ def _gui_apis(interface: Any) -> list[Any]:
     return [h.__self__ for h in handlers if hasattr(getattr(h, "__self__", None), "_gui_input_handle_from_uuid")]
 
 
+def _resend_value(gui_api: Any, handle: Any) -> None:
+    """Send an input's value back after a refused update, so the browser's widget shows what
+    the server holds again (not for buttons: their value is a click, not a state)."""
+    from viser._messages import GuiUpdateMessage
+
+    impl = handle._impl
+    if impl.removed or getattr(impl, "is_button", False) or not isinstance(impl.value, (bool, int, float, str, tuple)):
+        return
+    gui_api._websock_interface.queue_message(GuiUpdateMessage(impl.uuid, {"value": impl.value}))
+
+
 def _refusal(interface: Any, client_id: Any, message: Any) -> str | None:
     """Why ``message`` is not handed to the handlers of ``interface``, or None."""
     name = type(message).__name__
@@ -521,7 +533,10 @@ def _refusal(interface: Any, client_id: Any, message: Any) -> str | None:
         for api in _gui_apis(interface):
             handle = api._gui_input_handle_from_uuid.get(message.uuid)
             if handle is not None:
-                return gui_value_refusal(handle, message.updates)
+                why = gui_value_refusal(handle, message.updates)
+                if why is not None:
+                    _resend_value(api, handle)
+                return why
     elif name == "FileTransferStartUpload":
         for api in _gui_apis(interface):
             why = _upload_start_refusal(api, client_id, message)
