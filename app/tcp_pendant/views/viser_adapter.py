@@ -356,54 +356,61 @@ def _finite_number(v: Any) -> bool:
     return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
 
 
-def _type_ok(value: Any, hint: Any) -> bool:
-    """``value`` (decoded msgpack) fits the annotation ``hint``; unknown annotations pass."""
+def _checker(hint: Any) -> Callable[[Any], bool]:
+    """A function telling whether a decoded msgpack value fits the annotation ``hint``
+    (numbers finite; a browser's numbers are doubles, so ``720.0`` is an int); unknown
+    annotations pass. Built once per message field (:func:`_fields_of`)."""
     if hint is Any or hint is object:
-        return True
-    origin = typing.get_origin(hint)
-    args = typing.get_args(hint)
+        return lambda v: True
+    origin, args = typing.get_origin(hint), typing.get_args(hint)
     if origin in (typing.Union, types.UnionType):
-        return any(_type_ok(value, a) for a in args)
+        alts = [_checker(a) for a in args]
+        return lambda v: any(c(v) for c in alts)
     if hint is type(None):
-        return value is None
+        return lambda v: v is None
     if origin is typing.Literal:
-        return value in args
+        return lambda v: v in args
     if hint is bool:
-        return isinstance(value, bool)
-    if hint is int:                             # a browser's numbers are doubles: 720.0 is an int
-        return _finite_number(value) and float(value).is_integer()
+        return lambda v: isinstance(v, bool)
+    if hint is int:
+        return lambda v: _finite_number(v) and float(v).is_integer()
     if hint is float:
-        return _finite_number(value)
+        return _finite_number
     if hint is str:
-        return isinstance(value, str)
+        return lambda v: isinstance(v, str)
     if hint is bytes:
-        return isinstance(value, (bytes, bytearray, memoryview))
+        return lambda v: isinstance(v, (bytes, bytearray, memoryview))
     if origin is tuple:
-        if not isinstance(value, (tuple, list)):
-            return False
         if len(args) == 2 and args[1] is Ellipsis:
-            return all(_type_ok(v, args[0]) for v in value)
-        return len(value) == len(args) and all(_type_ok(v, a) for v, a in zip(value, args))
-    if origin in (dict, typing.Dict):                  # noqa: UP006  (the annotation viser writes)
-        return isinstance(value, dict) and all(_type_ok(k, args[0]) for k in value) if args else isinstance(value, dict)
-    if origin in (list, typing.List):                  # noqa: UP006
-        return isinstance(value, list) and (not args or all(_type_ok(v, args[0]) for v in value))
-    return True
+            each = _checker(args[0])
+            return lambda v: isinstance(v, (tuple, list)) and all(each(x) for x in v)
+        items = [_checker(a) for a in args]
+        n = len(items)
+        return lambda v: isinstance(v, (tuple, list)) and len(v) == n and all(c(x) for c, x in zip(items, v))
+    if origin is dict:
+        key = _checker(args[0]) if args else (lambda k: True)
+        return lambda v: isinstance(v, dict) and all(key(k) for k in v)
+    if origin is list:
+        each = _checker(args[0]) if args else (lambda x: True)
+        return lambda v: isinstance(v, list) and all(each(x) for x in v)
+    return lambda v: True
 
 
-_hints: dict[type, dict[str, Any]] = {}
+_fields: dict[type, dict[str, tuple[Any, Callable[[Any], bool]]]] = {}
 
 
-def _fields_of(cls: type) -> dict[str, Any]:
-    hints = _hints.get(cls)
-    if hints is None:
+def _fields_of(cls: type) -> dict[str, tuple[Any, Callable[[Any], bool]]]:
+    """A message class's fields: name -> (annotation, its checker)."""
+    fields = _fields.get(cls)
+    if fields is None:
         try:
-            all_hints = typing.get_type_hints(cls)
-            hints = {f.name: all_hints.get(f.name, Any) for f in dataclasses.fields(cls)}
+            hints = typing.get_type_hints(cls)
+            fields = {f.name: (hints.get(f.name, Any), _checker(hints.get(f.name, Any)))
+                      for f in dataclasses.fields(cls)}
         except Exception:                       # an annotation this Python cannot resolve: no check
-            hints = {}
-        _hints[cls] = hints
-    return hints
+            fields = {}
+        _fields[cls] = fields
+    return fields
 
 
 def message_refusal(mapping: Any) -> str | None:
@@ -422,13 +429,14 @@ def message_refusal(mapping: Any) -> str | None:
     if name in REFUSED_MESSAGES:
         return f"{name} is not accepted from a browser"
     fields = _fields_of(cls)
-    extra = set(mapping) - set(fields) - {"type"}
-    if extra:
-        return f"{name} has no field {short(sorted(map(str, extra))[0], 60)}"
-    for field, hint in fields.items():
+    if len(mapping) != len(fields) + 1:
+        extra = set(mapping) - set(fields) - {"type"}
+        if extra:
+            return f"{name} has no field {short(sorted(map(str, extra))[0], 60)}"
+    for field, (hint, fits) in fields.items():
         if field not in mapping:
             return f"{name}.{field} is missing"
-        if not _type_ok(mapping[field], hint):
+        if not fits(mapping[field]):
             return f"{name}.{field} = {short(mapping[field])} is not {_hint_name(hint)}"
     return None
 
