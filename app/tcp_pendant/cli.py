@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import argparse
 import logging
+import os
 import sys
 import time
 from collections.abc import Sequence
@@ -167,13 +168,14 @@ def _main(argv: Sequence[str] | None) -> int:
         return 2
     from tcp_pendant.classroom.trainer_token import TrainerTokenError, resolve_trainer_token
 
-    try:
-        trainer_token = resolve_trainer_token(args.trainer_token, args.trainer_token_file)
+    classroom = bool(args.classroom or args.class_db or args.exercise or args.trainer_token
+                     or args.trainer_token_file)
+    try:                                    # the environment's token only matters for a class
+        trainer_token = resolve_trainer_token(args.trainer_token, args.trainer_token_file,
+                                              os.environ if classroom else {})
     except TrainerTokenError as exc:
         print(f"tcp-pendant: error: {exc}", file=sys.stderr)
         return 2
-    classroom = bool(args.classroom or args.class_db or args.exercise or args.trainer_token
-                     or args.trainer_token_file)
     if args.shared and classroom:
         print("tcp-pendant: error: --shared is a lecture demo without names or gradebook; drop "
               "--class / --class-db / --exercise / --trainer-token / --trainer-token-file, or drop --shared",

@@ -134,3 +134,9 @@ def test_guessing_over_a_websocket_is_locked_out_after_five_and_logged_short(app
         wait_until(lambda: len(app.classroom._trainer_views) == 1, what="the trainer view")
     finally:
         c.ws.close()
+
+
+def test_a_bad_environment_token_is_refused_for_a_class(tmp_path: Path, monkeypatch, capsys) -> None:
+    monkeypatch.setenv(TOKEN_ENV, "short")
+    assert main(["--port", "0", "--class", "--class-db", str(tmp_path / "c.sqlite3")]) == 2
+    assert f"{TOKEN_ENV} must be 16 to 200 printable characters" in capsys.readouterr().err
