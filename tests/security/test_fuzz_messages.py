@@ -152,3 +152,23 @@ def test_a_refused_value_is_sent_back_as_the_server_holds_it(app: PendantApp) ->
         assert not client.closed.is_set()
     finally:
         client.ws.close()
+
+
+def test_a_disabled_button_takes_no_click_and_no_hold(app: PendantApp, caplog: pytest.LogCaptureFixture) -> None:
+    """viser runs a button's hold callbacks even when the button is disabled; a raw client
+    could hold a key the pendant has disabled. Both messages are refused."""
+    client = InputsClient(app.port)
+    try:
+        wait_until(lambda: "X +" in client.labels(), what="the jog keys")
+        (session,) = app.sessions.values()
+        key = session.client.gui._gui_input_handle_from_uuid[client.uuid_of("X +")]
+        key.disabled = True
+        uuid = client.uuid_of("X +")
+        before = message_counts().get("refused", 0)
+        with caplog.at_level(logging.WARNING):
+            client.send({"type": "GuiButtonHoldMessage", "uuid": uuid, "frequency": 20.0})
+            client.send({"type": "GuiUpdateMessage", "uuid": uuid, "updates": {"value": True}})
+            wait_until(lambda: message_counts().get("refused", 0) - before == 2, what="both refused")
+        assert "'X +' is disabled: no hold" in caplog.text and "'X +' is disabled" in caplog.text
+    finally:
+        client.ws.close()

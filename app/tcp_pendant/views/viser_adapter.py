@@ -25,7 +25,8 @@ network. What this module reaches into, and why:
   trainee must not publish the class server on viser's share tunnel), and for a
   ``GuiUpdateMessage`` :func:`gui_value_refusal` checks the value against its handle (only
   ``value`` may change; type, finite, the handle's min / max, its options, a text length
-  limit; nothing for a disabled input; a refused value is sent back as the server holds it).
+  limit; nothing for a disabled input, not even a button hold; a refused value is sent back as
+  the server holds it).
   Uploads are bounded per client and per server
   (:class:`UploadLimits`). A refused or failing message is logged in one line, user values cut
   at :data:`LOG_VALUE_CHARS` characters, at most :data:`LOG_BUDGET` lines at a time (the rest
@@ -545,6 +546,11 @@ def _refusal(interface: Any, client_id: Any, message: Any) -> str | None:
                 if why is not None:
                     _resend_value(api, handle)
                 return why
+    elif name == "GuiButtonHoldMessage":
+        for api in _gui_apis(interface):
+            handle = api._gui_input_handle_from_uuid.get(message.uuid)
+            if handle is not None and (handle._impl.removed or getattr(handle._impl.props, "disabled", False)):
+                return f"{short(getattr(handle._impl.props, 'label', '?'), 60)} is disabled: no hold"
     elif name == "FileTransferStartUpload":
         for api in _gui_apis(interface):
             why = _upload_start_refusal(api, client_id, message)
