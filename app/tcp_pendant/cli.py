@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import argparse
 import logging
+import os
 import sys
 import time
 from collections.abc import Sequence
@@ -84,7 +85,12 @@ def build_parser() -> argparse.ArgumentParser:
                    help="the class gradebook, an SQLite file every trainee's calibrations are stored in "
                         "(default with --class: the user's data directory, class.sqlite3)")
     p.add_argument("--trainer-token", default=None, metavar="TOKEN",
-                   help="the token that opens the trainer view (default: a random one, printed at start)")
+                   help="the token that opens the trainer view, 16 to 200 printable characters (default: "
+                        "$TCP_PENDANT_TRAINER_TOKEN, else a random one, printed at start); a token given "
+                        "here shows in the process list: prefer --trainer-token-file")
+    p.add_argument("--trainer-token-file", type=Path, default=None, metavar="PATH",
+                   help="read the trainer token from the first line of PATH (like --trainer-token, "
+                        "but not shown in the process list)")
     p.add_argument("--exercise", default=None, choices=("mystery",),
                    help="start an exercise: mystery = each trainee calibrates a tool of their own whose "
                         "true TCP and orientation only the gradebook knows")
@@ -176,15 +182,24 @@ def _main(argv: Sequence[str] | None) -> int:
     if not 0 <= args.port <= 65535:
         print(f"tcp-pendant: error: --port must be 0..65535, got {args.port}", file=sys.stderr)
         return 2
-    if args.trainer_token is not None and not (8 <= len(args.trainer_token) <= 200
-                                               and args.trainer_token.isprintable()):
-        print("tcp-pendant: error: --trainer-token must be 8 to 200 printable characters", file=sys.stderr)
+    from tcp_pendant.classroom.trainer_token import TrainerTokenError, resolve_trainer_token
+
+    classroom = bool(args.classroom or args.class_db or args.exercise or args.trainer_token
+                     or args.trainer_token_file)
+    try:                                    # the environment's token only matters for a class
+        trainer_token = resolve_trainer_token(args.trainer_token, args.trainer_token_file,
+                                              os.environ if classroom else {})
+    except TrainerTokenError as exc:
+        print(f"tcp-pendant: error: {exc}", file=sys.stderr)
         return 2
-    classroom = bool(args.classroom or args.class_db or args.exercise or args.trainer_token)
     if args.shared and classroom:
         print("tcp-pendant: error: --shared is a lecture demo without names or gradebook; drop "
-              "--class / --class-db / --exercise / --trainer-token, or drop --shared", file=sys.stderr)
+              "--class / --class-db / --exercise / --trainer-token / --trainer-token-file, or drop --shared",
+              file=sys.stderr)
         return 2
+    if args.trainer_token is not None:
+        print("tcp-pendant: note: a --trainer-token on the command line shows in the process list; "
+              "--trainer-token-file PATH or TCP_PENDANT_TRAINER_TOKEN keep it out", file=sys.stderr)
     class_db = args.class_db
     if classroom and class_db is None:
         class_db = default_gradebook_path()
@@ -199,7 +214,7 @@ def _main(argv: Sequence[str] | None) -> int:
         config = AppConfig(robot=args.robot, package_paths=tuple(args.package_path), flange_link=args.flange_link, tool=args.tool, host=args.host,
                            port=args.port, tool_library=args.tool_library, shared=args.shared,
                            reference_tip_mm=tip, allow_origins=tuple(args.allow_origin), class_db=class_db,
-                           trainer_token=args.trainer_token, exercise=args.exercise,
+                           trainer_token=trainer_token, exercise=args.exercise,
                            exercise_seed=args.exercise_seed, scenario=args.scenario.replace("-", "_"),
                            scenario_seed=args.scenario_seed, presenter=args.presenter,
                            hide_truth=args.hide_truth,

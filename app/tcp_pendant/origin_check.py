@@ -1,22 +1,32 @@
-"""Foreign web pages cannot connect: refuse websocket upgrades from another origin.
+"""Foreign web pages cannot connect: an allow-list of host names and an Origin check.
 
-A browser lets any web page open a websocket to any address, loopback included, and says which
-page asked in the ``Origin`` header. viser 1.1 accepts every upgrade, so a page a trainee opens
-could drive the pendant. This module refuses, with HTTP 403, every websocket upgrade whose
-``Origin`` is present and is neither the origin the page was served from (its host and port equal
-the ``Host`` header the request came to) nor listed with ``--allow-origin`` (a reverse proxy
-that rewrites ``Host``). Requests without ``Origin`` (non-browser clients, the tests' websocket
-clients) and plain HTTP requests (the page itself) are not affected.
+**Host names.** A web site can make a browser's page talk to any address by pointing its own
+name at it (DNS rebinding): the page's requests then carry ``Host: evil.example`` and
+``Origin: http://evil.example``, which agree with each other. So every request, plain HTTP
+and websocket upgrade alike, is answered only when its one ``Host`` header names a host this
+server serves (:func:`served_hosts`: its bind address, the names and addresses it prints at
+start, ``localhost`` / ``127.0.0.1`` / ``::1``, and the ``--allow-origin`` hosts); anything
+else, a ``Host`` with userinfo (``x@``), or more than one ``Host`` header, gets HTTP 403
+(:func:`host_refusal`). The port of ``Host`` is not compared (a reverse proxy may drop it).
+
+**Origin.** A browser lets any web page open a websocket to any address, loopback included,
+and says which page asked in the ``Origin`` header. Every websocket upgrade whose ``Origin`` is
+present and is neither the origin the page was served from (its host and port equal the
+``Host`` header the request came to) nor listed with ``--allow-origin`` (a reverse proxy that
+rewrites ``Host``) is refused with 403, and so is an upgrade with more than one ``Origin``.
+Requests without ``Origin`` (non-browser clients, the tests' websocket clients) and plain HTTP
+requests (the page itself) pass this check.
 
 Where: viser builds its ``websockets`` server inside its background thread and passes no hook
 to it, so the thinnest layer that sees the handshake is ``websockets``' own
 ``ServerConnection.handshake``. :func:`enable` wraps it once per process: the wrapper puts the
-origin check in front of the ``process_request`` that viser passes (its static-file server),
-so a refused upgrade is answered 403 before viser sees it. Policies are per listening port
-(:func:`allow`); a port without one gets the plain same-origin rule, so the check holds from the
-first connection even before the server's port is known. A port may also have an HTTP layer
-(:func:`set_http_layer`: ``client_script.serve``, the page's own script) that answers plain
-HTTP requests, behind the check and in front of viser's static server.
+checks in front of the ``process_request`` that viser passes (its static-file server), so a
+refused request is answered 403 before viser sees it. Policies are per listening port
+(:func:`allow`); a port without one serves the loopback names only, with the plain
+same-origin rule, so the checks hold from the first connection even before the server's port
+is known. A port may also have an HTTP layer (:func:`set_http_layer`:
+``client_script.serve``, the page's own script) that answers plain HTTP requests, behind the
+checks and in front of viser's static server.
 """
 
 from __future__ import annotations
@@ -28,16 +38,23 @@ from collections.abc import Iterable, Sequence
 from typing import Any
 from urllib.parse import urlsplit
 
-__all__ = ["OriginError", "allow", "enable", "forget", "normalize_origin", "origin_refusal",
-           "parse_allow_origins", "set_http_layer"]
+__all__ = ["LOOPBACK_HOSTS", "OriginError", "allow", "enable", "forget", "host_refusal", "normalize_origin",
+           "origin_refusal", "parse_allow_origins", "served_hosts", "set_http_layer"]
 
 log = logging.getLogger(__name__)
 
 _DEFAULT_PORTS = {"http": 80, "https": 443}
 _lock = threading.Lock()
 _allowed_by_port: dict[int, frozenset[str]] = {}
+_hosts_by_port: dict[int, frozenset[str]] = {}
 _original_handshake: Any = None
 _http_layers: dict[int, Any] = {}
+
+
+LOOPBACK_HOSTS = frozenset({"localhost", "127.0.0.1", "::1"})
+"""Host names every server answers to (only this machine reaches them)."""
+
+_WILDCARD_BINDS = ("0.0.0.0", "::", "")
 
 
 class OriginError(ValueError):
@@ -86,6 +103,61 @@ def parse_allow_origins(values: Iterable[str]) -> tuple[str, ...]:
     return tuple(out)
 
 
+def _header_values(headers: Any, name: str) -> list[str]:
+    get_all = getattr(headers, "get_all", None)
+    return [str(v) for v in get_all(name)] if callable(get_all) else ([str(headers[name])] if name in headers else [])
+
+
+def _host_name(value: str) -> str | None:
+    """The host name of a ``Host`` header value (lower case, IPv6 without brackets), or None
+    when it is not ``host[:port]``."""
+    value = value.strip()
+    if not value or any(c in value for c in "@/?#\\ \t"):
+        return None
+    try:
+        parts = urlsplit("//" + value)
+        parts.port                                      # noqa: B018  (ValueError for a bad port)
+    except ValueError:
+        return None
+    return (parts.hostname or "").lower() or None
+
+
+def _shown(value: str) -> str:
+    return repr(value if len(value) <= 100 else value[:100] + "...")
+
+
+def served_hosts(bind_host: str, urls: Iterable[str] = (), allow_origins: Iterable[str] = ()) -> frozenset[str]:
+    """The host names a server answers to: :data:`LOOPBACK_HOSTS`, ``bind_host`` (unless it is
+    a wildcard such as ``0.0.0.0``), and the hosts of ``urls`` (the network URLs it prints) and
+    of ``allow_origins`` (normalized ``--allow-origin`` values)."""
+    hosts = set(LOOPBACK_HOSTS)
+    bind = bind_host.strip().strip("[]").lower()
+    if bind not in _WILDCARD_BINDS:
+        hosts.add(bind)
+    for url in (*urls, *allow_origins):
+        name = urlsplit(url).hostname
+        if name:
+            hosts.add(name.lower())
+    return frozenset(hosts)
+
+
+def host_refusal(headers: Any, hosts: Iterable[str] = LOOPBACK_HOSTS) -> str | None:
+    """Why a request with these headers is refused for its ``Host``, or None to answer it.
+
+    Args:
+        headers: the request's headers (``websockets`` ``Headers`` or a mapping).
+        hosts: the host names served (:func:`served_hosts`).
+    """
+    values = _header_values(headers, "Host")
+    if len(values) != 1:
+        return "Refused: a request needs exactly one Host header."
+    name = _host_name(values[0])
+    if name is None or name not in set(hosts):
+        return (f"Refused: this pendant is not served as {_shown(values[0])}. Open one of the addresses it "
+                "printed at start, or start it with --allow-origin for a reverse proxy.")
+    return None
+
+
 def origin_refusal(headers: Any, allowed: Iterable[str] = ()) -> str | None:
     """Why a websocket upgrade with these request headers is refused, or None to accept it.
 
@@ -93,9 +165,7 @@ def origin_refusal(headers: Any, allowed: Iterable[str] = ()) -> str | None:
         headers: the request's headers (``websockets`` ``Headers`` or a mapping).
         allowed: normalized extra origins (:func:`parse_allow_origins`).
     """
-    get_all = getattr(headers, "get_all", None)
-    origins = list(get_all("Origin")) if callable(get_all) else \
-        ([headers["Origin"]] if "Origin" in headers else [])
+    origins = _header_values(headers, "Origin")
     if not origins:
         return None                                   # not a browser: nothing to compare
     if len(origins) > 1:
@@ -104,10 +174,11 @@ def origin_refusal(headers: Any, allowed: Iterable[str] = ()) -> str | None:
     try:
         scheme, host, port = _split(origin)
     except ValueError:
-        return f"Refused: the page's origin {origin!r} is not a web page served by this pendant."
+        return f"Refused: the page's origin {_shown(origin)} is not a web page served by this pendant."
     if normalize_origin(origin) in set(allowed):
         return None
-    host_header = headers.get("Host") if hasattr(headers, "get") else None
+    host_headers = _header_values(headers, "Host")
+    host_header = host_headers[0] if len(host_headers) == 1 else None
     if host_header:
         try:
             target = urlsplit("//" + str(host_header).strip())
@@ -117,26 +188,29 @@ def origin_refusal(headers: Any, allowed: Iterable[str] = ()) -> str | None:
             t_host, t_port = "", -1
         if t_host == host and t_port == port:
             return None
-    return (f"Refused: a page from {origin} may not connect to this pendant (served as {host_header}). "
-            "Open the pendant's own address, or start it with --allow-origin for a reverse proxy.")
+    return (f"Refused: a page from {_shown(origin)} may not connect to this pendant (served as "
+            f"{_shown(str(host_header))}). Open the pendant's own address, or start it with --allow-origin "
+            "for a reverse proxy.")
 
 
 def _is_upgrade(request: Any) -> bool:
-    return str(request.headers.get("Upgrade", "")).lower() == "websocket"
+    return any(v.lower() == "websocket" for v in _header_values(request.headers, "Upgrade"))
 
 
-def _allowed_for(connection: Any) -> tuple[frozenset[str], Any]:
-    """The extra origins and the HTTP layer of the port ``connection`` came to."""
+def _allowed_for(connection: Any) -> tuple[frozenset[str], Any, frozenset[str]]:
+    """The extra origins, the HTTP layer and the served host names of the port ``connection``
+    came to."""
     try:
         port = int(connection.local_address[1])
-    except Exception:  # no socket address: same-origin rule only
-        return frozenset(), None
+    except Exception:  # no socket address: same-origin rule, loopback names only
+        return frozenset(), None, LOOPBACK_HOSTS
     with _lock:
-        return _allowed_by_port.get(port, frozenset()), _http_layers.get(port)
+        return (_allowed_by_port.get(port, frozenset()), _http_layers.get(port),
+                _hosts_by_port.get(port, LOOPBACK_HOSTS))
 
 
 def enable() -> None:
-    """Put the origin check in front of every websocket handshake of this process (idempotent)."""
+    """Put the host and origin checks in front of every request of this process (idempotent)."""
     global _original_handshake
     from websockets.asyncio.server import ServerConnection
 
@@ -146,14 +220,23 @@ def enable() -> None:
         original = _original_handshake = ServerConnection.handshake
 
     async def handshake(self: Any, process_request: Any = None, *args: Any, **kwargs: Any) -> None:
-        allowed, layer = _allowed_for(self)
+        allowed, layer, hosts = _allowed_for(self)
 
         def checked(connection: Any, request: Any) -> Any:
-            if _is_upgrade(request):
+            try:
+                return answer(connection, request)
+            except Exception as exc:                # a request nobody foresaw: one line, no traceback
+                log.warning("request from %s for %s failed: %s: %s", _peer(connection),
+                            _shown(str(getattr(request, "path", "?"))), type(exc).__name__, _shown(str(exc)))
+                return connection.respond(http.HTTPStatus.BAD_REQUEST, "Bad request.\n")
+
+        def answer(connection: Any, request: Any) -> Any:
+            refusal = host_refusal(request.headers, hosts)
+            if refusal is None and _is_upgrade(request):
                 refusal = origin_refusal(request.headers, allowed)
-                if refusal is not None:
-                    log.warning("websocket from %s: %s", request.headers.get("Origin"), refusal)
-                    return connection.respond(http.HTTPStatus.FORBIDDEN, refusal + "\n")
+            if refusal is not None:
+                log.warning("request from %s: %s", _peer(connection), refusal)
+                return connection.respond(http.HTTPStatus.FORBIDDEN, refusal + "\n")
             if layer is not None and not _is_upgrade(request):
                 return layer(connection, request, process_request)
             return None if process_request is None else process_request(connection, request)
@@ -162,6 +245,13 @@ def enable() -> None:
 
     handshake.__doc__ = original.__doc__
     ServerConnection.handshake = handshake  # type: ignore[method-assign]
+
+
+def _peer(connection: Any) -> str:
+    try:
+        return f"{connection.remote_address[0]}:{connection.remote_address[1]}"
+    except Exception:
+        return "?"
 
 
 def set_http_layer(port: int, layer: Any) -> None:
@@ -175,14 +265,17 @@ def set_http_layer(port: int, layer: Any) -> None:
             _http_layers[int(port)] = layer
 
 
-def allow(port: int, origins: Sequence[str]) -> None:
-    """Also accept pages from ``origins`` (normalized) on the server listening on ``port``."""
+def allow(port: int, origins: Sequence[str], hosts: Iterable[str] = LOOPBACK_HOSTS) -> None:
+    """On the server listening on ``port``, answer requests for ``hosts`` (:func:`served_hosts`)
+    and also accept pages from ``origins`` (normalized)."""
     with _lock:
         _allowed_by_port[int(port)] = frozenset(origins)
+        _hosts_by_port[int(port)] = frozenset(h.lower() for h in hosts)
 
 
 def forget(port: int) -> None:
-    """Drop the extra origins and the HTTP layer of ``port`` (the server stopped)."""
+    """Drop the extra origins, the host names and the HTTP layer of ``port`` (the server stopped)."""
     with _lock:
         _allowed_by_port.pop(int(port), None)
+        _hosts_by_port.pop(int(port), None)
         _http_layers.pop(int(port), None)

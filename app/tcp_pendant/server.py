@@ -58,7 +58,7 @@ from tcp_pendant.controller.placement import (
 )
 from tcp_pendant.controller.scenarios import Scenario
 from tcp_pendant.session import GuiTarget, Session
-from tcp_pendant.views import session_view_steps
+from tcp_pendant.views import session_view_steps, viser_adapter
 from tcp_pendant.views.gui_util import target_of
 from tcp_pendant.views.presenter import PresenterView
 from tcp_pendant.views.scene import overview_camera, overview_pose
@@ -95,7 +95,8 @@ class AppConfig:
             the pendant's own address, e.g. a reverse proxy's (``tcp_pendant.origin_check``).
         class_db: the class gradebook (SQLite file); None: no classroom (no name prompt, nothing
             recorded). The CLI passes its default path. Ignored with ``shared``.
-        trainer_token: the token that opens the trainer view (None: a random one).
+        trainer_token: the token that opens the trainer view, 16 to 200 printable characters
+            (None: a random one).
         exercise: None (free practice) or "mystery" (each trainee gets a mystery tool).
         exercise_seed: seed of the mystery tools.
         scenario: the systematic error every session starts with (training;
@@ -523,9 +524,11 @@ class PendantApp:
 
         host = self.config.host
         origin_check.enable()               # foreign web pages' websockets are refused (403)
+        viser_adapter.install()             # every browser message checked before viser's handlers
         client_script.script_asset()        # the page's own script (keys, name, trainer URL): packaged?
         self.server = viser.ViserServer(host=host, port=self.config.port, verbose=False)
-        origin_check.allow(self.port, self.allow_origins)
+        origin_check.allow(self.port, self.allow_origins,
+                           origin_check.served_hosts(host, self.network_urls, self.allow_origins))
         origin_check.set_http_layer(self.port, client_script.serve)
         if self.config.port != 0 and self.port != self.config.port:
             # viser silently moves on to the next free port; the class was told this one

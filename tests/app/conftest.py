@@ -3,6 +3,7 @@ server in-process on a free port (real viser server, headless websocket clients)
 
 from __future__ import annotations
 
+import os
 import sys
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -20,6 +21,9 @@ from tcpcal.library import ToolLibrary
 sys.path.insert(0, str(Path(__file__).parent))
 from wsclient import free_port, wait_until  # noqa: F401  (re-exported: the tests import them from here)
 from app_page import running_pendants  # noqa: E402
+
+# a fast path into viser's private API that falls back raises (views.viser_adapter)
+os.environ.setdefault("TCP_PENDANT_STRICT_VISER", "1")
 
 
 @pytest.fixture(scope="session")

@@ -28,7 +28,7 @@ def _browser(session):
 
 
 def test_name_prompt_records_the_trainee_and_escapes_the_name(app_factory, tmp_path: Path) -> None:
-    app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token="secret-token-1")
+    app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token="secret-token-1-of-16")
     c = DrainingClient(app.port)
     try:
         s = _session(app, c)
@@ -52,7 +52,7 @@ def test_name_prompt_records_the_trainee_and_escapes_the_name(app_factory, tmp_p
 
 
 def test_wizard_events_reach_the_gradebook_through_the_gui(app_factory, tmp_path: Path) -> None:
-    app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token="secret-token-1")
+    app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token="secret-token-1-of-16")
     c = DrainingClient(app.port)
     try:
         s = _session(app, c)
@@ -73,7 +73,7 @@ def test_wizard_events_reach_the_gradebook_through_the_gui(app_factory, tmp_path
 
 
 def test_trainer_view_needs_the_token_and_shows_the_class_escaped(app_factory, tmp_path: Path) -> None:
-    app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token="secret-token-1")
+    app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token="secret-token-1-of-16")
     a = DrainingClient(app.port)
     wait_until(lambda: len(app.sessions) == 1, what="trainee session")
     t = DrainingClient(app.port)
@@ -88,7 +88,7 @@ def test_trainer_view_needs_the_token_and_shows_the_class_escaped(app_factory, t
         choose(q.token_field, "secret-token-2", trainer.client)
         click(q.open_trainer, trainer.client)
         assert "trainer" not in trainer.views and "not right" in q.message.content
-        choose(q.token_field, "secret-token-1", trainer.client)
+        choose(q.token_field, "secret-token-1-of-16", trainer.client)
         click(q.open_trainer, trainer.client)
         view = trainer.views["trainer"]
         md = view.trainees_md.content
@@ -122,7 +122,7 @@ def test_trainer_view_needs_the_token_and_shows_the_class_escaped(app_factory, t
 
 
 def test_mystery_exercise_mounts_a_tool_per_trainee_and_grades_against_it(app_factory, tmp_path: Path) -> None:
-    app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token="secret-token-1",
+    app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token="secret-token-1-of-16",
                       exercise="mystery", exercise_seed=7)
     a = DrainingClient(app.port)
     wait_until(lambda: len(app.sessions) == 1, what="first session")

@@ -57,9 +57,9 @@ def test_server_refuses_a_damaged_gradebook_and_classroom_options_with_shared(
 
 def test_parser_knows_the_classroom_options() -> None:
     args = build_parser().parse_args(["--class-db", "x.sqlite3", "--exercise", "mystery", "--exercise-seed", "7",
-                                      "--trainer-token", "abcdefgh"])
+                                      "--trainer-token", "abcdefgh-16chars"])
     assert (args.class_db, args.exercise, args.exercise_seed, args.trainer_token) == \
-        (Path("x.sqlite3"), "mystery", 7, "abcdefgh")
+        (Path("x.sqlite3"), "mystery", 7, "abcdefgh-16chars")
     with pytest.raises(SystemExit):
         build_parser().parse_args(["--exercise", "other"])
 

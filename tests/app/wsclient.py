@@ -7,6 +7,7 @@ import socket
 import threading
 import time
 from collections.abc import Callable
+from typing import Any
 
 import msgspec.msgpack
 import viser
@@ -128,3 +129,54 @@ class ButtonClient(DrainingClient):
         msg = _messages.GuiUpdateMessage(self.button_uuids[label], {"value": True})
         with self._send_lock:
             self.ws.send(msgspec.msgpack.encode(msg.as_serializable_dict()))
+
+
+INPUTS = {"GuiButtonMessage", "GuiUploadButtonMessage", "GuiSliderMessage", "GuiMultiSliderMessage",
+          "GuiNumberMessage", "GuiRgbMessage", "GuiRgbaMessage", "GuiCheckboxMessage", "GuiVector2Message",
+          "GuiVector3Message", "GuiTextMessage", "GuiDropdownMessage", "GuiButtonGroupMessage"}
+"""viser's messages that create a GUI input."""
+
+CAMERA = dict(type="ViewerCameraMessage", wxyz=[1.0, 0.0, 0.0, 0.0], position=[2.0, -2.0, 1.0], fov=1.0,
+              near=0.01, far=100.0, image_height=720, image_width=1280, look_at=[0.0, 0.0, 0.5],
+              up_direction=[0.0, 0.0, 1.0])
+"""The camera message a browser sends first (as a msgpack mapping)."""
+
+
+class InputsClient:
+    """A raw viser websocket that records the GUI inputs the server creates (uuid -> kind,
+    label, props) and sends whatever it is given (a msgpack mapping, raw bytes or a text
+    frame), as a hostile browser could. ``closed`` is set when the server closed it."""
+
+    def __init__(self, port: int) -> None:
+        self.ws = connect(f"ws://127.0.0.1:{port}", subprotocols=[f"viser-v{viser.__version__}"],  # type: ignore[list-item]
+                          max_size=None, open_timeout=20)
+        self.inputs: dict[str, tuple[str, str, dict[str, Any]]] = {}
+        self.updates: list[tuple[str, dict[str, Any]]] = []     # (uuid, updates) the server sent
+        self.closed = threading.Event()
+        self._thread = threading.Thread(target=self._drain, daemon=True)
+        self._thread.start()
+        self.send(CAMERA)
+
+    def _drain(self) -> None:
+        try:
+            for msg in self.ws:
+                if isinstance(msg, bytes):
+                    for m in decode_window(msg):
+                        if m.get("type") in INPUTS:
+                            props = m.get("props") or {}
+                            self.inputs[m["uuid"]] = (m["type"], str(props.get("label")), props)
+                        elif m.get("type") == "GuiUpdateMessage":
+                            self.updates.append((m["uuid"], m["updates"]))
+        except Exception:
+            pass
+        self.closed.set()
+
+    def send(self, message: dict[str, Any] | bytes | str) -> None:
+        self.ws.send(message if isinstance(message, (bytes, str)) else msgspec.msgpack.encode(message))
+
+    def uuid_of(self, label: str) -> str:
+        """The uuid of the input labelled ``label``."""
+        return next(u for u, (_, lab, _) in self.inputs.items() if lab == label)
+
+    def labels(self) -> set[str]:
+        return {lab for _, lab, _ in self.inputs.values()}

@@ -14,7 +14,7 @@ from pendant_page import TIMEOUT_MS, assert_not_blank, press, type_text, wait_en
 
 pytestmark = pytest.mark.browser
 
-TOKEN = "trainer-secret-42"
+TOKEN = "trainer-secret-4242"
 
 
 def join(page, name: str) -> None:

@@ -26,7 +26,7 @@ from pendant_page import TIMEOUT_MS, assert_not_blank, type_text, wait_text  # n
 
 pytestmark = pytest.mark.browser
 
-TOKEN = "trainer-secret-42"
+TOKEN = "trainer-secret-4242"
 AXES = ("X", "Y", "Z", "A", "B", "C")
 
 

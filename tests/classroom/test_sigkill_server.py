@@ -66,7 +66,7 @@ def test_sigkill_of_the_server_keeps_every_acknowledged_touch(tmp_path: Path) ->
     db = tmp_path / "class.sqlite3"
     proc = subprocess.Popen([sys.executable, "-m", "tcp_pendant", "--port", "0", "--tool-library",
                              str(tmp_path / "tools.json"), "--class-db", str(db), "--trainer-token",
-                             "trainer-secret"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                             "trainer-secret-of-16"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     client = None
     try:
         lines: list[str] = []

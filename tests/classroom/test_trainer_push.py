@@ -59,13 +59,13 @@ def _trainer(session, token: str):
 
 
 def test_hide_distance_pushed_to_every_trainee_and_to_later_ones(app_factory, tmp_path: Path) -> None:
-    app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token="tok-1")
+    app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token="trainer-token-of-16")
     clients, (anna, ben, trainer) = _class(app, 3)
     try:
         _name(anna, "Anna")
         _name(ben, "Ben")
         ben.set_hide_distance(True)                 # Ben's own choice, before the push
-        view = _trainer(trainer, "tok-1")
+        view = _trainer(trainer, "trainer-token-of-16")
         choose(view.hide_distance, "on", trainer.client)
         click(view.push, trainer.client)
         assert anna.hide_distance and ben.hide_distance and not trainer.hide_distance
@@ -110,7 +110,7 @@ def _finish_xyz4(session) -> None:
 
 
 def test_an_exercise_shows_the_trainee_no_truth_but_the_gradebook_keeps_it(app_factory, tmp_path: Path) -> None:
-    app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token="tok-1",
+    app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token="trainer-token-of-16",
                       exercise="mystery", exercise_seed=3)
     clients, (anna,) = _class(app, 1)
     try:
@@ -131,7 +131,7 @@ def test_an_exercise_shows_the_trainee_no_truth_but_the_gradebook_keeps_it(app_f
 
 
 def test_free_practice_shows_the_truth_and_a_pushed_exercise_hides_it(app_factory, tmp_path: Path) -> None:
-    app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token="tok-1")
+    app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token="trainer-token-of-16")
     clients, (anna, trainer) = _class(app, 2)
     try:
         _name(anna, "Anna")
@@ -139,7 +139,7 @@ def test_free_practice_shows_the_truth_and_a_pushed_exercise_hides_it(app_factor
         cal = anna.views["calibrate"]
         assert cal.result.truth_md.visible and cal.scene.true_tool.visible     # training: the answer
         assert "true TOOL frame" in cal.result.truth_md.content
-        view = _trainer(trainer, "tok-1")
+        view = _trainer(trainer, "trainer-token-of-16")
         choose(view.exercise, "Mystery tool", trainer.client)
         click(view.push, trainer.client)
         _finish_xyz4(anna)                                       # a new calibration in the exercise

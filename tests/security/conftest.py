@@ -7,9 +7,13 @@ and its fixtures are re-exported, so both folders start servers and chromium the
 
 from __future__ import annotations
 
+import os
 import importlib.util
 import sys
 from pathlib import Path
+
+# a fast path into viser's private API that falls back raises (views.viser_adapter)
+os.environ.setdefault("TCP_PENDANT_STRICT_VISER", "1")
 
 _BROWSER_DIR = Path(__file__).parents[1] / "browser"
 if str(_BROWSER_DIR) not in sys.path:

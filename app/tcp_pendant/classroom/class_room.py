@@ -22,6 +22,7 @@ from __future__ import annotations
 import logging
 import secrets
 import threading
+import time
 from collections.abc import Callable
 from typing import Any
 
@@ -29,6 +30,7 @@ from tcp_pendant.classroom.gradebook import Gradebook, GradeRow
 from tcp_pendant.classroom.mystery import draw_mystery_tool
 from tcp_pendant.classroom.recorder import TraineeRecorder, TraineeStatus
 from tcp_pendant.classroom.restore import runs_to_restore
+from tcp_pendant.classroom.trainer_token import TokenAttempts, validate_trainer_token
 from tcp_pendant.controller import ToolModel
 from tcp_pendant.session import Session, SessionChange
 
@@ -46,19 +48,23 @@ class ClassRoom:
     Args:
         gradebook: the class gradebook (opened by the server at start).
         tools: the physical tools by key (the built-in ones).
-        trainer_token: the token that opens the trainer view.
+        trainer_token: the token that opens the trainer view (16 to 200 printable characters).
         exercise: None (free practice) or "mystery".
         exercise_seed: the seed of the mystery tools.
         hand_to_loop: runs a function on viser's event loop.
+        clock: seconds of a monotonic clock (the token's lockout windows; tests set it).
+
+    Raises:
+        TrainerTokenError: a token that breaks the rules.
     """
 
     def __init__(self, gradebook: Gradebook, tools: dict[str, ToolModel], *, trainer_token: str,
                  exercise: str | None = None, exercise_seed: int = 0,
-                 hand_to_loop: Callable[[Callable[[], None]], None] = lambda fn: fn()) -> None:
+                 hand_to_loop: Callable[[Callable[[], None]], None] = lambda fn: fn(),
+                 clock: Callable[[], float] = time.monotonic) -> None:
         if exercise is not None and exercise not in EXERCISE_IDS:
             raise ValueError(f"Unknown exercise {exercise!r}; use one of {', '.join(EXERCISE_IDS)}.")
-        if not trainer_token:
-            raise ValueError("The trainer token must not be empty.")
+        validate_trainer_token(trainer_token, "The trainer token")
         self.gradebook = gradebook
         self.tools = dict(tools)
         self.tool_keys = tuple(self.tools)
@@ -70,6 +76,8 @@ class ClassRoom:
         self._trainees: dict[int, tuple[Session, TraineeRecorder, str]] = {}   # id(session) -> ...
         self._left: list[TraineeStatus] = []        # rows of trainees who left (connected=False)
         self._trainer_views: dict[int, Any] = {}    # id(session) -> TrainerView
+        self._token_attempts: dict[int, TokenAttempts] = {}   # id(session) -> its wrong tokens
+        self.clock = clock
         self.hide_distance: bool | None = None
         """"Hide distance" as the trainer last pushed it (None: each trainee's own choice)."""
 
@@ -137,6 +145,7 @@ class ClassRoom:
         with self._lock:
             entry = self._trainees.get(id(session))
             self._trainer_views.pop(id(session), None)
+            self._token_attempts.pop(id(session), None)
         if entry is not None:
             try:
                 entry[1].disconnected()
@@ -149,8 +158,19 @@ class ClassRoom:
 
     # ------------------------------------------------------------ trainer
     def open_trainer(self, session: Session, token: str) -> bool:
-        """A browser typed ``token``: if it is the trainer token, build the trainer view there."""
+        """A browser typed ``token``: if it is the trainer token, build the trainer view there.
+        Wrong tokens are counted per browser (``classroom.trainer_token.TokenAttempts``).
+
+        Raises:
+            TrainerTokenLocked: this browser typed too many wrong tokens; the token was not tried.
+        """
+        now = self.clock()
+        with self._lock:
+            attempts = self._token_attempts.setdefault(id(session), TokenAttempts())
+        attempts.check(now)
         if not secrets.compare_digest(token.encode("utf-8"), self.trainer_token.encode("utf-8")):
+            client_id = getattr(session.client, "client_id", None)
+            attempts.failed(now, "a shared page" if client_id is None else f"browser {client_id}", token)
             return False
         from tcp_pendant.views.trainer_view import TrainerView
 

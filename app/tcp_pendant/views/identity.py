@@ -26,7 +26,7 @@ from typing import Any
 from tcp_pendant.classroom.names import TraineeNameError, validate_trainee_name
 from tcp_pendant.session import Session
 from tcp_pendant.text_escape import escape_markdown
-from tcp_pendant.views.gui_util import ButtonEvent, set_value, target_of
+from tcp_pendant.views.gui_util import ButtonEvent, set_content, set_value, target_of
 
 __all__ = ["IdentityPrompt", "NAME_LABEL", "TOKEN_LABEL"]
 
@@ -41,7 +41,8 @@ class IdentityPrompt:
     Args:
         session: the browser's session (its target is the client).
         on_name: called with the validated name; it may raise ``ValueError`` (shown in the modal).
-        on_token: called with the typed token; returns True when it opened the trainer view.
+        on_token: called with the typed token; returns True when it opened the trainer view; it
+            may raise ``ValueError`` (too many wrong tokens: shown in the modal).
 
     Attributes:
         name: the accepted name (None until then).
@@ -85,7 +86,12 @@ class IdentityPrompt:
     def _trainer(self, _event: ButtonEvent | None = None) -> None:
         token = str(self.token_field.value)[:_MAX_TOKEN_CHARS]
         set_value(self.token_field, "")
-        if not self._on_token(token):
+        try:
+            opened = self._on_token(token)
+        except ValueError as exc:                  # too many wrong tokens: wait
+            set_content(self.message, f"⚠ {escape_markdown(str(exc))}")
+            return
+        if not opened:
             self.message.content = "⚠ That trainer token is not right; type the token the server printed."
             return
         self.modal.close()

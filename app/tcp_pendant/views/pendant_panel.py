@@ -49,14 +49,10 @@ from tcp_pendant.pendant.guidance import CLOSEUP_WITHIN_MM, offset_markdown, sid
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.views.scene import closeup_camera, overview_camera
 from tcp_pendant.views.gui_util import ButtonEvent, ButtonGroupEvent, CheckboxEvent, set_value, target_of
+from tcp_pendant.views.viser_adapter import queue_markdown
 
 if TYPE_CHECKING:
     from tcp_pendant.controller.pose_state import PoseState
-
-try:                                   # viser's message type (hot path); public setter if absent
-    from viser._messages import GuiUpdateMessage
-except ImportError:                    # pragma: no cover
-    GuiUpdateMessage = None  # type: ignore[assignment, misc]
 
 __all__ = ["HOLD_HZ", "KEYS_LINE", "MARK", "PendantPanel", "jog_key_hint", "marked", "set_markdown", "unmarked"]
 
@@ -105,20 +101,11 @@ def set_markdown(handle: viser.GuiMarkdownHandle, text: str) -> None:
     ``typing`` aliases on every call: ~4x the cost of the message itself here, measured by
     tests/bench/bench_server.py); for texts without images (nothing for viser's markdown
     parser to inline) this stores the same ``_markdown`` prop and queues the same
-    ``GuiUpdateMessage``. Falls back to the public setter if viser's internals differ.
+    ``GuiUpdateMessage`` (``views.viser_adapter.queue_markdown``). Falls back to the public
+    setter for a removed handle or if viser's internals differ.
     """
-    if "![" not in text and GuiUpdateMessage is not None:
-        try:
-            impl: Any = handle._impl          # viser's internals: checked at run time (AttributeError)
-            if not impl.removed:
-                object.__setattr__(handle, "_content", text)
-                if impl.props._markdown != text:
-                    impl.props._markdown = text
-                    impl.gui_api._websock_interface.queue_message(GuiUpdateMessage(impl.uuid, {"_markdown": text}))
-                return
-        except AttributeError:
-            pass
-    handle.content = text
+    if "![" in text or not queue_markdown(handle, text):
+        handle.content = text
 
 
 class PendantPanel:

@@ -41,11 +41,6 @@ import numpy as np
 import viser
 from scipy.spatial.transform import Rotation
 
-try:                                   # viser's message types (hot path); public setters if absent
-    from viser import _messages
-except ImportError:                    # pragma: no cover
-    _messages = None  # type: ignore[assignment]
-
 from tcp_pendant.controller import ToolModel, reference_tip_model
 from tcp_pendant.controller.kinematics import urdf_links_and_tree
 from tcp_pendant.controller.rotations import quaternion_wxyz, quaternions_wxyz
@@ -55,6 +50,7 @@ from tcp_pendant.views.beam_stand import BeamStandNodes
 from tcp_pendant.views.framing import Framing, frame_spheres
 from tcp_pendant.views.meshes import MeshPart, link_meshes, rigid_meshes
 from tcp_pendant.views.gui_util import target_of
+from tcp_pendant.views.viser_adapter import queue_pose
 
 __all__ = ["POSE_EPS", "PoseSender", "SceneView", "camera_shape", "closeup_camera", "frame_cameras",
            "link_tree_paths", "overview_camera", "overview_pose", "relative_poses", "wxyz_xyz"]
@@ -183,26 +179,14 @@ class PoseSender:
 
 
 def _set_pose(handle: Any, wxyz: list[float] | None, xyz: list[float] | None) -> int:
-    try:
-        impl = handle._impl
-        api = impl.api
-        n = 0
-        if wxyz is not None:
-            impl.wxyz[:] = wxyz
-            w, x, y, z = wxyz
-            api._queue_scene_message(_messages.SetOrientationMessage(impl.name, (w, x, y, z)))
-            n += 1
-        if xyz is not None:
-            impl.position[:] = xyz
-            api._queue_scene_message(_messages.SetPositionMessage(impl.name, (xyz[0], xyz[1], xyz[2])))
-            n += 1
-        return n
-    except AttributeError:                      # viser internals changed: public setters
+    """Send a node's orientation and/or position (``views.viser_adapter.queue_pose``; the public
+    setters if viser's internals differ); returns how many messages."""
+    if not queue_pose(handle, wxyz, xyz):
         if wxyz is not None:
             handle.wxyz = wxyz
         if xyz is not None:
             handle.position = xyz
-        return int(wxyz is not None) + int(xyz is not None)
+    return int(wxyz is not None) + int(xyz is not None)
 
 
 def overview_pose(tip_world_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

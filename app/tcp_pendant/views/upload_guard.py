@@ -11,9 +11,10 @@ interface as viser's own ``GuiApi`` (``register_handler`` appends, so they run r
 viser's): when the announced size is above the limit the transfer's state is dropped at once
 (viser then ignores the following parts), and a transfer whose parts add up to more than the
 limit (a client lying about its size) is dropped as soon as it does. Either way the session
-is told once. This uses two private viser names (``_websock_interface``,
-``_current_file_upload_states``); if a viser version lacks them the guard is skipped (logged)
-and the size check in the upload callback still runs before any parsing.
+is told once. viser's internals are reached through ``views.viser_adapter.upload_hook``; if a
+viser version lacks them the guard is skipped (logged) and the size check in the upload callback
+still runs before any parsing. Every upload, guarded here or not, is also bounded per browser
+and per server, and times out (``views.viser_adapter.UploadLimits``).
 """
 
 from __future__ import annotations
@@ -21,6 +22,8 @@ from __future__ import annotations
 import logging
 from collections.abc import Callable
 from typing import Any
+
+from tcp_pendant.views.viser_adapter import upload_hook
 
 __all__ = ["limit_upload_size"]
 
@@ -40,18 +43,11 @@ def limit_upload_size(handle: Any, max_bytes: int, on_refused: Callable[[str, in
         True when the guard is installed; False when this viser lacks the hook (then only the
         callback's own check applies).
     """
-    from viser import _messages
-
-    impl = getattr(handle, "_impl", None)
-    gui_api = getattr(impl, "gui_api", None)
-    ws = getattr(gui_api, "_websock_interface", None)
-    states = getattr(gui_api, "_current_file_upload_states", None)
-    uuid = getattr(impl, "uuid", None)
-    start_cls = getattr(_messages, "FileTransferStartUpload", None)
-    part_cls = getattr(_messages, "FileTransferPart", None)
-    if ws is None or not isinstance(states, dict) or uuid is None or start_cls is None or part_cls is None:
+    hook = upload_hook(handle)
+    if hook is None:
         log.warning("viser has no file-transfer hook: uploads are size-checked only after they arrived")
         return False
+    uuid, states = hook.uuid, hook.states
 
     def on_start(_client_id: Any, message: Any) -> None:
         if message.source_component_uuid != uuid:
@@ -68,6 +64,5 @@ def limit_upload_size(handle: Any, max_bytes: int, on_refused: Callable[[str, in
             states.pop(message.transfer_uuid, None)
             on_refused(str(state.get("filename", "")), int(state["transferred_bytes"]))
 
-    ws.register_handler(start_cls, on_start)
-    ws.register_handler(part_cls, on_part)
+    hook.register(on_start, on_part)
     return True

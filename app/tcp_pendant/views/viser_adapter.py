@@ -1,0 +1,664 @@
+"""Every use of viser's private API, in one place (viser ``>=1.1,<1.2``, see pyproject.toml).
+
+viser's public API is enough to build the pendant, but not to make it fast or safe on a class
+network. What this module reaches into, and why:
+
+* **Fast paths** (the readouts and the robot pose change on every jog step):
+  :func:`queue_markdown` stores a markdown's ``_markdown`` prop and queues viser's
+  ``GuiUpdateMessage`` itself (``handle._impl``, ``gui_api._websock_interface``), skipping the
+  public setter's per-call typing machinery; :func:`queue_pose` writes a scene node's
+  ``wxyz`` / ``position`` and queues ``SetOrientationMessage`` / ``SetPositionMessage``
+  (``api._queue_scene_message``). Each returns False when viser's internals differ, and the
+  caller then uses the public setter. Which path ran is counted (:func:`path_counts`); the first
+  fallback of each path logs a warning, and with ``TCP_PENDANT_STRICT_VISER=1`` in the
+  environment (the tests' flag) a fallback raises :class:`ViserInternalsChanged` instead.
+* **Uploads** (:func:`upload_hook`): the file-transfer messages and ``GuiApi``'s
+  ``_current_file_upload_states``, for the per-button size limit of ``views.upload_guard``.
+* **Incoming messages** (:func:`install`): viser decodes each websocket message and hands it to
+  its handlers in a task of its own, with no check of the values' types; a bad message raised in
+  that task ("Task exception was never retrieved", quoting the value) or, when it could not
+  even be decoded, closed the sender's socket. :func:`install` wraps viser's message consumer
+  (``infra._infra._message_consumer``: a frame that does not decode is dropped) and
+  ``WebsockMessageHandler._handle_incoming_message`` (each message is checked, then its
+  handlers run under one ``try``): :func:`message_refusal` checks every field against the
+  message class's annotations (types, finite numbers), refuses the share-URL requests (a
+  trainee must not publish the class server on viser's share tunnel), and for a
+  ``GuiUpdateMessage`` :func:`gui_value_refusal` checks the value against its handle (only
+  ``value`` may change; type, finite, the handle's min / max, its options, a text length
+  limit; nothing for a disabled input, not even a button hold; a refused value is sent back as
+  the server holds it).
+  Uploads are bounded per client and per server
+  (:class:`UploadLimits`). A refused or failing message is logged in one line, user values cut
+  at :data:`LOG_VALUE_CHARS` characters, at most :data:`LOG_BUDGET` lines at a time (the rest
+  counted: :func:`message_counts`); the socket stays open.
+
+Moving viser up a minor version: run ``tests/security`` and ``tests/app/test_viser_adapter.py``
+(their conftest sets ``TCP_PENDANT_STRICT_VISER=1``: a fallback fails the test), then re-read in
+viser's source each name used here: ``_GuiHandleState`` (``uuid``, ``value``, ``props``,
+``removed``, ``gui_api``), ``GuiApi._gui_input_handle_from_uuid`` /
+``_current_file_upload_states`` / ``_websock_interface``, ``SceneApi._queue_scene_message``,
+the scene handle's ``_impl`` (``name``, ``wxyz``, ``position``, ``api``),
+``WebsockMessageHandler._handle_incoming_message`` / ``_incoming_handlers``,
+``infra._infra._message_consumer`` (its signature and its ``deserialize`` call), the message
+classes named below, and the props classes' ``min`` / ``max`` / ``options`` / ``disabled``.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import dataclasses
+import logging
+import math
+import os
+import re
+import threading
+import time
+import types
+import typing
+import weakref
+from collections import Counter
+from collections.abc import Callable
+from typing import Any
+
+import msgspec
+
+__all__ = ["LOG_VALUE_CHARS", "MAX_ABS_NUMBER", "MAX_TEXT_CHARS", "UploadHook", "UploadLimits",
+           "ViserInternalsChanged", "gui_value_refusal", "install", "message_refusal", "path_counts", "queue_markdown",
+           "message_counts", "queue_pose", "reset_path_counts", "short", "upload_hook", "upload_limits",
+           "uploads_in_flight"]
+
+log = logging.getLogger(__name__)
+
+LOG_VALUE_CHARS = 200
+"""User values are cut to this many characters in log lines."""
+
+MAX_TEXT_CHARS = 10_000
+"""Longest text a browser may send for a text field (the longest the app writes itself, a
+controller file's text, is a few kB)."""
+
+MAX_ABS_NUMBER = 1e12
+"""Largest magnitude a browser may send for a number, also for an input without min / max (no
+pendant quantity comes near it; ``-1e308`` would overflow the app's arithmetic)."""
+
+STRICT_ENV = "TCP_PENDANT_STRICT_VISER"
+"""Environment variable: ``1`` makes a fast path's fallback raise (tests)."""
+
+REFUSED_MESSAGES = ("ShareUrlRequest", "ShareUrlDisconnect")
+"""Client messages never handled: they would open (or close) viser's public share tunnel."""
+
+
+class ViserInternalsChanged(RuntimeError):
+    """A fast path had to fall back while ``TCP_PENDANT_STRICT_VISER=1``."""
+
+
+def short(value: Any, limit: int = LOG_VALUE_CHARS) -> str:
+    """``repr(value)`` cut to ``limit`` characters (with the full length) for log lines."""
+    try:
+        text = repr(value)
+    except Exception:                           # a value whose repr fails is still logged
+        text = f"<{type(value).__name__}>"
+    return text if len(text) <= limit else f"{text[:limit]}... ({len(text)} chars)"
+
+
+# ------------------------------------------------------------------ fast paths
+_counts: Counter[tuple[str, str]] = Counter()
+_warned: set[str] = set()
+
+
+def path_counts() -> dict[tuple[str, str], int]:
+    """How often each fast path ran: ``{(path, "fast" | "fallback"): n}``."""
+    return dict(_counts)
+
+
+def reset_path_counts() -> None:
+    """Forget the counts (tests)."""
+    _counts.clear()
+
+
+def _fast(path: str) -> bool:
+    _counts[(path, "fast")] += 1
+    return True
+
+
+def _fallback(path: str, exc: BaseException) -> bool:
+    _counts[(path, "fallback")] += 1
+    if os.environ.get(STRICT_ENV) == "1":
+        raise ViserInternalsChanged(f"viser fast path {path!r} fell back: {type(exc).__name__}: {exc}") from exc
+    if path not in _warned:
+        _warned.add(path)
+        log.warning("viser's internals differ (%s: %s): %s uses viser's public setters from now on "
+                    "(slower); see tcp_pendant.views.viser_adapter", type(exc).__name__, exc, path)
+    return False
+
+
+def queue_markdown(handle: Any, text: str) -> bool:
+    """Set a markdown handle's content to ``text`` without viser's public setter.
+
+    Stores ``_content`` and the ``_markdown`` prop and queues the one ``GuiUpdateMessage`` the
+    setter would (nothing when the text is unchanged). Only for text without images (viser's
+    setter inlines those). Returns False when the caller must use ``handle.content = text``
+    (a removed handle, or viser's internals differ).
+    """
+    try:
+        from viser._messages import GuiUpdateMessage
+
+        impl = handle._impl
+        if impl.removed:
+            return False
+        object.__setattr__(handle, "_content", text)
+        if impl.props._markdown != text:
+            impl.props._markdown = text
+            impl.gui_api._websock_interface.queue_message(GuiUpdateMessage(impl.uuid, {"_markdown": text}))
+    except (AttributeError, ImportError) as exc:
+        return _fallback("markdown", exc)
+    return _fast("markdown")
+
+
+def queue_pose(handle: Any, wxyz: list[float] | None, xyz: list[float] | None) -> bool:
+    """Set a scene node's orientation (``wxyz``) and/or position (``xyz``, metres) and queue
+    viser's ``SetOrientationMessage`` / ``SetPositionMessage`` without its public setters.
+    Returns False when the caller must use ``handle.wxyz`` / ``handle.position``."""
+    try:
+        from viser import _messages
+
+        impl = handle._impl
+        api = impl.api
+        if wxyz is not None:
+            impl.wxyz[:] = wxyz
+            api._queue_scene_message(_messages.SetOrientationMessage(
+                impl.name, typing.cast("tuple[float, float, float, float]", tuple(wxyz))))
+        if xyz is not None:
+            impl.position[:] = xyz
+            api._queue_scene_message(_messages.SetPositionMessage(
+                impl.name, typing.cast("tuple[float, float, float]", tuple(xyz))))
+    except (AttributeError, ImportError) as exc:
+        return _fallback("pose", exc)
+    return _fast("pose")
+
+
+# ------------------------------------------------------------------ uploads
+@dataclasses.dataclass(frozen=True)
+class UploadHook:
+    """viser's file-transfer internals for one upload button.
+
+    Attributes:
+        uuid: the button's uuid (``source_component_uuid`` of its transfers).
+        states: ``GuiApi._current_file_upload_states`` (transfer uuid -> state dict with
+            ``filename``, ``transferred_bytes``, ...); dropping an entry drops the transfer.
+        register: ``register(on_start, on_part)`` adds handlers ``(client_id, message)`` for the
+            start and part messages, run after viser's own.
+    """
+
+    uuid: str
+    states: dict[str, Any]
+    register: Callable[[Callable[[Any, Any], None], Callable[[Any, Any], None]], None]
+
+
+def upload_hook(handle: Any) -> UploadHook | None:
+    """The :class:`UploadHook` of a ``viser.GuiUploadButtonHandle`` (None: viser lacks it)."""
+    try:
+        from viser import _messages
+
+        impl = handle._impl
+        gui_api = impl.gui_api
+        ws = gui_api._websock_interface
+        states = gui_api._current_file_upload_states
+        start_cls, part_cls = _messages.FileTransferStartUpload, _messages.FileTransferPart
+        uuid = str(impl.uuid)
+        if not isinstance(states, dict):
+            raise AttributeError("_current_file_upload_states is not a dict")
+    except (AttributeError, ImportError) as exc:
+        _fallback("upload", exc)
+        return None
+
+    def register(on_start: Callable[[Any, Any], None], on_part: Callable[[Any, Any], None]) -> None:
+        ws.register_handler(start_cls, on_start)
+        ws.register_handler(part_cls, on_part)
+
+    _fast("upload")
+    return UploadHook(uuid, states, register)
+
+
+@dataclasses.dataclass(frozen=True)
+class UploadLimits:
+    """Bounds of the uploads a server holds in memory before they are complete.
+
+    Attributes:
+        client_bytes: the most one browser may announce or send for its upload in flight; a
+            browser has one upload in flight at a time (a new one drops its unfinished one).
+        server_bytes: the most all browsers of one server may have in flight together; an
+            upload that would pass it is refused.
+        max_parts: the most parts one upload may announce.
+        idle_s: an upload that received no part for this long is dropped (its memory freed).
+    """
+
+    client_bytes: int = 4_000_000
+    server_bytes: int = 32_000_000
+    max_parts: int = 4096
+    idle_s: float = 30.0
+
+
+_limits = UploadLimits()
+
+
+def upload_limits(limits: UploadLimits | None = None) -> UploadLimits:
+    """The upload limits of this process; ``limits`` replaces them (returns the old ones)."""
+    global _limits
+    old = _limits
+    if limits is not None:
+        _limits = limits
+    return old
+
+
+@dataclasses.dataclass
+class _Transfer:
+    client: tuple[int, int]          # (id of the server's event loop, viser client id)
+    size: int                        # announced, bytes
+    states: dict[str, Any]           # viser's buffers (the GuiApi's)
+    last_part: float                 # time.monotonic() of the start or the last part
+    seen: list[bool]                 # part received, by index
+    received: int = 0                # bytes of the parts received
+
+    @property
+    def held(self) -> int:
+        """Bytes this upload may hold: its announced size, or more when it sent more."""
+        return max(self.size, self.received)
+
+
+# transfer uuid -> transfer, per server event loop (each viser server runs its own loop)
+_transfers: weakref.WeakKeyDictionary[asyncio.AbstractEventLoop, dict[str, _Transfer]] = weakref.WeakKeyDictionary()
+
+
+def _live(loop: asyncio.AbstractEventLoop) -> dict[str, _Transfer]:
+    """The transfers of one server still held by viser (finished and dropped ones forgotten)."""
+    table = _transfers.setdefault(loop, {})
+    for tid in [t for t, tr in table.items() if t not in tr.states]:
+        del table[tid]
+    return table
+
+
+def uploads_in_flight(loop: asyncio.AbstractEventLoop | None = None) -> list[tuple[int, int]]:
+    """``(viser client id, announced bytes)`` of the unfinished uploads viser holds (every
+    server's when ``loop`` is None)."""
+    loops = list(_transfers) if loop is None else [loop]
+    return [(tr.client[1], tr.size) for lp in loops for tr in list(_live(lp).values())]
+
+
+def _drop(table: dict[str, _Transfer], tid: str, why: str) -> None:
+    tr = table.pop(tid, None)
+    if tr is not None and tr.states.pop(tid, None) is not None:
+        log.warning("upload from client %s dropped: %s", tr.client[1], why)
+
+
+def _expire(loop: asyncio.AbstractEventLoop, tid: str) -> None:
+    table = _live(loop)
+    tr = table.get(tid)
+    if tr is None:
+        return
+    idle = time.monotonic() - tr.last_part
+    if idle >= _limits.idle_s:
+        _drop(table, tid, f"no part for {idle:.0f} s")
+    else:
+        loop.call_later(_limits.idle_s - idle, _expire, loop, tid)
+
+
+def _upload_start_refusal(gui_api: Any, client_id: Any, message: Any) -> str | None:
+    """Admit an upload start (registering its transfer) or say why it is refused."""
+    if message.source_component_uuid not in getattr(gui_api, "_gui_input_handle_from_uuid", {}):
+        return None                                   # not this GUI's button: viser ignores it
+    limits = _limits
+    size, parts = int(message.size_bytes), int(message.part_count)
+    if size < 0 or parts < 0 or parts > limits.max_parts or (size > 0 and parts == 0) or parts > max(size, 1):
+        return f"an upload of {size} bytes in {parts} parts is not a file a browser sends"
+    if size > limits.client_bytes:
+        return f"an upload of {size} bytes is larger than {limits.client_bytes} bytes"
+    loop = asyncio.get_running_loop()
+    table = _live(loop)
+    client = (id(loop), int(client_id))
+    for tid in [t for t, tr in table.items() if tr.client == client]:
+        _drop(table, tid, "the same browser started another upload")
+    held = sum(tr.held for tr in table.values())
+    if held + size > limits.server_bytes:
+        return f"the server holds {held} bytes of unfinished uploads (limit {limits.server_bytes})"
+    states = gui_api._current_file_upload_states
+    table[str(message.transfer_uuid)] = _Transfer(client, size, states, time.monotonic(), [False] * parts)
+    loop.call_later(limits.idle_s, _expire, loop, str(message.transfer_uuid))
+    return None
+
+
+def _upload_part_refusal(gui_api: Any, message: Any) -> str | None:
+    """A part of an admitted upload: count it; refuse it (dropping the upload) when the bytes
+    received pass the per-browser limit or, counted with every other upload in flight, the
+    server's. (A client may understate its size: an upload button's own limit,
+    ``views.upload_guard``, then tells its session.)"""
+    table = _live(asyncio.get_running_loop())
+    tid = str(message.transfer_uuid)
+    tr = table.get(tid)
+    index = message.part_index
+    if tr is None or tr.states is not getattr(gui_api, "_current_file_upload_states", None) \
+            or not 0 <= index < len(tr.seen) or tr.seen[index]:
+        return None                             # another GUI's, or a part viser ignores
+    tr.last_part = time.monotonic()
+    received = tr.received + len(message.content)
+    if received > _limits.client_bytes:
+        _drop(table, tid, f"its parts pass {_limits.client_bytes} bytes")
+        return "the parts pass the per-browser limit"
+    others = sum(t.held for k, t in table.items() if k != tid)
+    if others + max(tr.size, received) > _limits.server_bytes:
+        _drop(table, tid, f"the server holds {others} bytes of other unfinished uploads")
+        return "the parts pass the server's limit"
+    tr.seen[index] = True                       # viser ignores a repeated part: counted once
+    tr.received = received
+    return None
+
+
+# ------------------------------------------------------------------ value checks
+def _finite_number(v: Any) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+
+
+def _checker(hint: Any) -> Callable[[Any], bool]:
+    """A function telling whether a decoded msgpack value fits the annotation ``hint``
+    (numbers finite; a browser's numbers are doubles, so ``720.0`` is an int); unknown
+    annotations pass. Built once per message field (:func:`_fields_of`)."""
+    if hint is Any or hint is object:
+        return lambda v: True
+    origin, args = typing.get_origin(hint), typing.get_args(hint)
+    if origin in (typing.Union, types.UnionType):
+        alts = [_checker(a) for a in args]
+        return lambda v: any(c(v) for c in alts)
+    if hint is type(None):
+        return lambda v: v is None
+    if origin is typing.Literal:
+        return lambda v: v in args
+    if hint is bool:
+        return lambda v: isinstance(v, bool)
+    if hint is int:
+        return lambda v: _finite_number(v) and float(v).is_integer()
+    if hint is float:
+        return _finite_number
+    if hint is str:
+        return lambda v: isinstance(v, str)
+    if hint is bytes:
+        return lambda v: isinstance(v, (bytes, bytearray, memoryview))
+    if origin is tuple:
+        if len(args) == 2 and args[1] is Ellipsis:
+            each = _checker(args[0])
+            return lambda v: isinstance(v, (tuple, list)) and all(each(x) for x in v)
+        items = [_checker(a) for a in args]
+        n = len(items)
+        return lambda v: isinstance(v, (tuple, list)) and len(v) == n and all(c(x) for c, x in zip(items, v))
+    if origin is dict:
+        key = _checker(args[0]) if args else (lambda k: True)
+        return lambda v: isinstance(v, dict) and all(key(k) for k in v)
+    if origin is list:
+        each = _checker(args[0]) if args else (lambda x: True)
+        return lambda v: isinstance(v, list) and all(each(x) for x in v)
+    return lambda v: True
+
+
+_fields: dict[type, dict[str, tuple[Any, Callable[[Any], bool]]]] = {}
+
+
+def _fields_of(cls: type) -> dict[str, tuple[Any, Callable[[Any], bool]]]:
+    """A message class's fields: name -> (annotation, its checker)."""
+    fields = _fields.get(cls)
+    if fields is None:
+        try:
+            hints = typing.get_type_hints(cls)
+            fields = {f.name: (hints.get(f.name, Any), _checker(hints.get(f.name, Any)))
+                      for f in dataclasses.fields(cls)}
+        except Exception:                       # an annotation this Python cannot resolve: no check
+            fields = {}
+        _fields[cls] = fields
+    return fields
+
+
+def message_refusal(mapping: Any) -> str | None:
+    """Why a decoded client message (the msgpack mapping, before viser builds its message
+    object) is refused, or None: not a known message, a missing, extra or wrongly typed field
+    (by the message class's annotations; numbers finite), or a share-URL request. The value of a
+    ``GuiUpdateMessage`` is checked against its handle later (:func:`gui_value_refusal`)."""
+    from viser.infra._messages import Message
+
+    if not isinstance(mapping, dict) or not isinstance(mapping.get("type"), str):
+        return f"{short(mapping, 60)} is not a viser message"
+    name = mapping["type"]
+    cls = Message._subclass_from_type_string().get(name)
+    if cls is None:
+        return f"{short(name, 60)} is not a viser message"
+    if name in REFUSED_MESSAGES:
+        return f"{name} is not accepted from a browser"
+    fields = _fields_of(cls)
+    if len(mapping) != len(fields) + 1:
+        extra = set(mapping) - set(fields) - {"type"}
+        if extra:
+            return f"{name} has no field {short(sorted(map(str, extra))[0], 60)}"
+    for field, (hint, fits) in fields.items():
+        if field not in mapping:
+            return f"{name}.{field} is missing"
+        if not fits(mapping[field]):
+            return f"{name}.{field} = {short(mapping[field])} is not {_hint_name(hint)}"
+    return None
+
+
+def _hint_name(hint: Any) -> str:
+    return "a finite number" if hint is float else getattr(hint, "__name__", None) or str(hint)
+
+
+def gui_value_refusal(handle: Any, updates: Any) -> str | None:
+    """Why a browser's ``GuiUpdateMessage.updates`` for the GUI input ``handle`` is refused, or
+    None: only ``value`` may be sent; it must have the type of the handle's value, be finite,
+    lie within the handle's ``min`` / ``max`` (and :data:`MAX_ABS_NUMBER`), be one of its
+    ``options`` (with or without a leading mark such as ``"✓ "``), or be a text of at most
+    :data:`MAX_TEXT_CHARS` characters; a disabled, removed or upload input takes no update."""
+    impl = handle._impl
+    props = impl.props
+    label = short(getattr(props, "label", "?"), 60)
+    if not isinstance(updates, dict) or set(updates) != {"value"}:
+        return f"{label}: only a value may be sent, got {short(updates)}"
+    if impl.removed or getattr(props, "disabled", False):
+        return f"{label} is disabled"
+    value = updates["value"]
+    current = impl.value
+    options = getattr(props, "options", None)
+    if options is not None:                     # dropdown, button group (a button too)
+        if isinstance(value, str) and (value in tuple(options) or _bare(value) in {_bare(o) for o in options}):
+            return None
+        return f"{label}: {short(value)} is not one of its options"
+    if getattr(impl, "is_button", False):
+        return None if value is True else f"{label}: a button sends true, got {short(value)}"
+    if isinstance(current, bool):
+        return None if isinstance(value, bool) else f"{label}: {short(value)} is not true or false"
+    if isinstance(current, (int, float)):
+        return _number_refusal(label, value, getattr(props, "min", None), getattr(props, "max", None),
+                               isinstance(current, int))
+    if isinstance(current, str):
+        if not isinstance(value, str):
+            return f"{label}: {short(value)} is not a text"
+        if len(value) > MAX_TEXT_CHARS:
+            return f"{label}: a text of {len(value)} characters is longer than {MAX_TEXT_CHARS}"
+        return None
+    if isinstance(current, tuple):
+        if not isinstance(value, (list, tuple)) or len(value) != len(current):
+            return f"{label}: {short(value)} is not {len(current)} numbers"
+        lo, hi = getattr(props, "min", None), getattr(props, "max", None)
+        if type(props).__name__ in ("GuiRgbProps", "GuiRgbaProps"):
+            lo, hi = 0, 255
+        for i, v in enumerate(value):
+            why = _number_refusal(label, v, lo[i] if isinstance(lo, tuple) else lo,
+                                  hi[i] if isinstance(hi, tuple) else hi,
+                                  bool(current) and isinstance(current[i], int) and not isinstance(current[i], bool))
+            if why is not None:
+                return why
+        return None
+    return f"{label}: this input takes no value from a browser"
+
+
+_DECORATION = re.compile(r"^[^\w.+\-]+\s*")
+
+
+def _bare(option: str) -> str:
+    """An option's label without a leading mark (``"✓ 10"`` -> ``"10"``): a view may mark the
+    selected option in its label, and a click the browser sent before the marks moved names
+    the option as it was shown then."""
+    return _DECORATION.sub("", option, count=1)
+
+
+def _number_refusal(label: str, value: Any, lo: Any, hi: Any, integer: bool) -> str | None:
+    if not _finite_number(value) or abs(value) > MAX_ABS_NUMBER:
+        return f"{label}: {short(value)} is not a finite number of at most {MAX_ABS_NUMBER:g}"
+    if integer and value != int(value):
+        return f"{label}: {short(value)} is not a whole number"
+    if lo is not None and value < lo or hi is not None and value > hi:
+        return f"{label}: {short(value)} is outside {lo}..{hi}"
+    return None
+
+
+# ------------------------------------------------------------------ message dispatch
+def _gui_apis(interface: Any) -> list[Any]:
+    """The ``GuiApi`` objects whose handlers are registered on a websocket interface."""
+    from viser._messages import GuiUpdateMessage
+
+    handlers = getattr(interface, "_incoming_handlers", {}).get(GuiUpdateMessage, [])
+    return [h.__self__ for h in handlers if hasattr(getattr(h, "__self__", None), "_gui_input_handle_from_uuid")]
+
+
+def _resend_value(gui_api: Any, handle: Any) -> None:
+    """Send an input's value back after a refused update, so the browser's widget shows what
+    the server holds again (not for buttons: their value is a click, not a state)."""
+    from viser._messages import GuiUpdateMessage
+
+    impl = handle._impl
+    if impl.removed or getattr(impl, "is_button", False) or not isinstance(impl.value, (bool, int, float, str, tuple)):
+        return
+    gui_api._websock_interface.queue_message(GuiUpdateMessage(impl.uuid, {"value": impl.value}))
+
+
+def _refusal(interface: Any, client_id: Any, message: Any) -> str | None:
+    """Why ``message`` is not handed to the handlers of ``interface``, or None."""
+    name = type(message).__name__
+    if name == "GuiUpdateMessage":
+        for api in _gui_apis(interface):
+            handle = api._gui_input_handle_from_uuid.get(message.uuid)
+            if handle is not None:
+                why = gui_value_refusal(handle, message.updates)
+                if why is not None:
+                    _resend_value(api, handle)
+                return why
+    elif name == "GuiButtonHoldMessage":
+        for api in _gui_apis(interface):
+            handle = api._gui_input_handle_from_uuid.get(message.uuid)
+            if handle is not None and (handle._impl.removed or getattr(handle._impl.props, "disabled", False)):
+                return f"{short(getattr(handle._impl.props, 'label', '?'), 60)} is disabled: no hold"
+    elif name == "FileTransferStartUpload":
+        for api in _gui_apis(interface):
+            why = _upload_start_refusal(api, client_id, message)
+            if why is not None:
+                return why
+    elif name == "FileTransferPart" and message.source_component_uuid is not None:
+        for api in _gui_apis(interface):
+            why = _upload_part_refusal(api, message)
+            if why is not None:
+                return why
+    return None
+
+
+LOG_BUDGET = (50, 10.0)
+"""At most this many refused or failed messages of one browser are logged per this many
+seconds (a flood of bad messages must not fill the disk); the others are counted, and the
+count is logged when the next window opens."""
+
+_message_counts: Counter[str] = Counter()
+# per server loop: sender ("client N" or the socket's peer address) -> [window start, logged, skipped]
+_log_windows: weakref.WeakKeyDictionary[asyncio.AbstractEventLoop, dict[str, list[float]]] = \
+    weakref.WeakKeyDictionary()
+_log_lock = threading.Lock()
+
+
+def message_counts() -> dict[str, int]:
+    """How many browser messages were ``refused`` (checks) or ``failed`` (viser raised)."""
+    with _log_lock:
+        return dict(_message_counts)
+
+
+def _log_message(kind: str, sender: str, fmt: str, *args: Any) -> None:
+    """Count a refused / failed message of ``sender`` and log it within :data:`LOG_BUDGET`."""
+    lines, window_s = LOG_BUDGET
+    now = time.monotonic()
+    with _log_lock:
+        _message_counts[kind] += 1
+        windows = _log_windows.setdefault(asyncio.get_running_loop(), {})
+        if len(windows) > 1000:                     # forget the senders of closed windows
+            for key in [k for k, w in windows.items() if now - w[0] >= window_s]:
+                del windows[key]
+        w = windows.setdefault(sender, [now, 0, 0])
+        skipped = 0
+        if now - w[0] >= window_s:
+            skipped = int(w[2])
+            w[:] = [now, 0, 0]
+        log_it = w[1] < lines
+        w[1 if log_it else 2] += 1
+    if skipped:
+        log.warning("%d more refused or failed messages from %s were not logged", skipped, sender)
+    if log_it:
+        log.warning(fmt, *args)
+
+
+def _peer(websocket: Any) -> str:
+    try:
+        host, port = websocket.remote_address[:2]
+        return f"{host}:{port}"
+    except Exception:
+        return "?"
+
+
+_install_lock = threading.Lock()
+_installed = False
+
+
+def install() -> None:
+    """Check and guard every message viser receives, in this process (idempotent; see the
+    module docstring)."""
+    global _installed
+    with _install_lock:
+        if _installed:
+            return
+        from viser.infra import _infra
+
+        original_handle = _infra.WebsockMessageHandler._handle_incoming_message
+        original_consumer = _infra._message_consumer
+
+        async def handle_incoming_message(self: Any, client_id: Any, message: Any) -> None:
+            try:
+                why = _refusal(self, client_id, message)
+                if why is not None:
+                    _log_message("refused", f"client {client_id}", "message from client %s refused: %s",
+                                 client_id, why)
+                    return
+                await original_handle(self, client_id, message)
+            except Exception as exc:             # never a traceback, never a closed socket
+                _log_message("failed", f"client {client_id}", "message %s from client %s failed: %s: %s",
+                             type(message).__name__, client_id, type(exc).__name__, short(str(exc)))
+
+        async def message_consumer(websocket: Any, handle_message: Callable[[Any], None],
+                                   message_class: Any) -> None:
+            while True:
+                raw = await websocket.recv()
+                try:
+                    if not isinstance(raw, bytes):
+                        raise TypeError("a text frame; viser speaks binary msgpack")
+                    why = message_refusal(msgspec.msgpack.decode(raw))
+                    message = None if why is not None else message_class.deserialize(raw)
+                except Exception as exc:
+                    why = f"it does not decode: {type(exc).__name__}: {short(str(exc))}"
+                if why is not None:
+                    peer = _peer(websocket)
+                    _log_message("refused", peer, "message from %s refused: %s", peer, why)
+                    continue
+                handle_message(message)
+
+        message_consumer.__wrapped__ = original_consumer  # type: ignore[attr-defined]
+        _infra.WebsockMessageHandler._handle_incoming_message = handle_incoming_message  # type: ignore[method-assign]
+        _infra._message_consumer = message_consumer
+        _installed = True
