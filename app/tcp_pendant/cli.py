@@ -255,6 +255,10 @@ def _class_lines(app: PendantApp) -> str:
     if room is None:
         return ""
     exercise = "mystery tools" if room.exercise == "mystery" else "free practice"
+    if room.trainer_token is None:
+        return (f"  class gradebook {room.gradebook.path} ({exercise})\n"
+                f"Trainer view: {app.url} with the trainer token this class began with (kept hashed in the "
+                "gradebook, so an open trainer page reconnects); give --trainer-token to set a new one\n")
     return (f"  class gradebook {room.gradebook.path} ({exercise})\n"
             f"Trainer view: {app.trainer_url}  trainer token: {room.trainer_token}\n"
             "  (open that address: the page fills in the token and drops it from the address bar; or open the "

@@ -19,7 +19,6 @@ from __future__ import annotations
 import asyncio
 import ipaddress
 import logging
-import secrets
 import socket
 import threading
 import time
@@ -335,7 +334,7 @@ class PendantApp:
         if config.class_db is not None and not config.shared:
             self.gradebook = Gradebook(config.class_db)         # GradebookError: one clear message
             self.classroom = ClassRoom(self.gradebook, tools,
-                                       trainer_token=config.trainer_token or secrets.token_urlsafe(16),
+                                       trainer_token=config.trainer_token,
                                        exercise=config.exercise, exercise_seed=config.exercise_seed,
                                        hand_to_loop=self._hand_to_loop)
 
@@ -555,8 +554,8 @@ class PendantApp:
         page's script (``client_script``) types the token into "Trainer token" and drops it
         from the address bar; the token is percent-encoded (``--trainer-token`` may hold any
         printable character)."""
-        if self.classroom is None:
-            return None
+        if self.classroom is None or self.classroom.trainer_token is None:
+            return None                       # the class's kept token: only its hash is known
         return f"{self.url}/?trainer={quote(self.classroom.trainer_token, safe='')}"
 
     @property

@@ -83,3 +83,59 @@ def test_a_trainee_without_work_in_progress_starts_clean(app_factory, tmp_path: 
         assert not s.workflow.runs and not s.workflow.is_open
     finally:
         c.close()
+
+
+def test_the_trainer_token_outlives_a_restart_as_a_hash(app_factory, tmp_path: Path) -> None:
+    """Started without --trainer-token again, the class keeps the token it began with: the
+    trainer's page reconnects; the gradebook keeps only its SHA-256, and the address is not
+    printed (it cannot be rebuilt)."""
+    import hashlib
+
+    db = tmp_path / "class.sqlite3"
+    first = app_factory(class_db=db)                           # a random token, printed at start
+    token = first.classroom.trainer_token
+    assert token is not None and first.trainer_url.endswith(token)
+    first.stop()
+    with Gradebook(db) as book:
+        assert book.class_setting("trainer_token_sha256") == hashlib.sha256(token.encode()).hexdigest()
+        with book._read() as sql:
+            assert token not in repr(sql.execute("SELECT * FROM meta").fetchall())
+    again = app_factory(class_db=db)
+    room = again.classroom
+    assert room.trainer_token is None and again.trainer_url is None
+    c = DrainingClient(again.port)
+    try:
+        wait_until(lambda: len(again.sessions) == 1 and all("identity" in s.views for s in again.sessions.values()),
+                   what="a session with its name prompt")
+        s = next(iter(again.sessions.values()))
+        assert room.open_trainer(s, "not-the-token-at-all-0000") is False
+        assert room.open_trainer(s, token) is True                # the old page's token still opens it
+    finally:
+        c.close()
+    renewed = app_factory(class_db=db, trainer_token=TOKEN)       # a new token replaces it
+    assert renewed.classroom.trainer_token == TOKEN
+    with Gradebook(db) as book:
+        assert book.class_setting("trainer_token_sha256") == hashlib.sha256(TOKEN.encode()).hexdigest()
+
+
+def test_pushed_settings_outlive_a_restart(app_factory, tmp_path: Path) -> None:
+    """A pushed exercise and 'Hide distance' were gone after a restart unless the server was
+    started with --exercise again."""
+    db = tmp_path / "class.sqlite3"
+    first = app_factory(class_db=db, trainer_token=TOKEN)
+    assert first.classroom.exercise is None
+    first.classroom.push_settings("mystery", None, hide_distance=True)
+    first.stop()
+    again = app_factory(class_db=db, trainer_token=TOKEN)
+    room = again.classroom
+    assert room.exercise == "mystery" and room.hide_distance is True
+    c = DrainingClient(again.port)
+    try:
+        s = _join(again, c, "Cleo")
+        assert s.hide_distance and s.workflow.hide_truth and s.controller.mounted_tool.key.startswith("mystery")
+    finally:
+        c.close()
+    room.push_settings(None, None, hide_distance=False)       # free practice again: also kept
+    again.stop()
+    third = app_factory(class_db=db, trainer_token=TOKEN)
+    assert third.classroom.exercise is None and third.classroom.hide_distance is False

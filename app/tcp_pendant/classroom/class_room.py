@@ -20,6 +20,7 @@ disconnects come from viser's thread pool and hand their trainer-view refresh to
 from __future__ import annotations
 
 import logging
+import hashlib
 import secrets
 import threading
 import time
@@ -42,6 +43,19 @@ EXERCISE_IDS = ("mystery",)
 """Exercises a trainer can start (``--exercise``; None: free practice)."""
 
 
+PUSHED_SETTING = "pushed"
+"""The class setting that keeps what the trainer pushed (exercise, "Hide distance", tool)."""
+TOKEN_SETTING = "trainer_token_sha256"
+"""The class setting that keeps the trainer token's SHA-256 (hex) in the gradebook, so the
+trainer's address keeps working after a restart without the token being stored."""
+
+
+def _token_digest(token: str) -> str:
+    # A random token has 128 bits and a given one at least 16 characters: a plain SHA-256 is
+    # enough for a file that holds the class's answers anyway.
+    return hashlib.sha256(str(token).encode("utf-8")).hexdigest()
+
+
 class ClassRoom:
     """Names, recorders and trainer views of one server (see the module docstring).
 
@@ -58,17 +72,25 @@ class ClassRoom:
         TrainerTokenError: a token that breaks the rules.
     """
 
-    def __init__(self, gradebook: Gradebook, tools: dict[str, ToolModel], *, trainer_token: str,
+    def __init__(self, gradebook: Gradebook, tools: dict[str, ToolModel], *, trainer_token: str | None,
                  exercise: str | None = None, exercise_seed: int = 0,
                  hand_to_loop: Callable[[Callable[[], None]], None] = lambda fn: fn(),
                  clock: Callable[[], float] = time.monotonic) -> None:
         if exercise is not None and exercise not in EXERCISE_IDS:
             raise ValueError(f"Unknown exercise {exercise!r}; use one of {', '.join(EXERCISE_IDS)}.")
-        validate_trainer_token(trainer_token, "The trainer token")
+        stored = gradebook.class_setting(TOKEN_SETTING)
+        if trainer_token is None and isinstance(stored, str):
+            self.trainer_token: str | None = None      # the class's token, kept (hashed) in the gradebook
+            self._token_sha256 = stored
+        else:
+            token = secrets.token_urlsafe(16) if trainer_token is None else trainer_token
+            validate_trainer_token(token, "The trainer token")
+            self.trainer_token = token
+            self._token_sha256 = _token_digest(token)
+            gradebook.set_class_setting(TOKEN_SETTING, self._token_sha256)
         self.gradebook = gradebook
         self.tools = dict(tools)
         self.tool_keys = tuple(self.tools)
-        self.trainer_token = trainer_token
         self.exercise = exercise
         self.exercise_seed = int(exercise_seed)
         self._hand_to_loop = hand_to_loop
@@ -80,6 +102,9 @@ class ClassRoom:
         self.clock = clock
         self.hide_distance: bool | None = None
         """"Hide distance" as the trainer last pushed it (None: each trainee's own choice)."""
+        self.pushed_tool: str | None = None
+        """The tool the trainer last pushed (kept across restarts)."""
+        self._apply_kept(exercise_given=exercise is not None)   # what the trainer pushed before a restart
 
     # ------------------------------------------------------------ sessions
     def attach(self, session: Session) -> Any:
@@ -168,7 +193,7 @@ class ClassRoom:
         with self._lock:
             attempts = self._token_attempts.setdefault(id(session), TokenAttempts())
         attempts.check(now)
-        if not secrets.compare_digest(token.encode("utf-8"), self.trainer_token.encode("utf-8")):
+        if not secrets.compare_digest(_token_digest(token), self._token_sha256):
             client_id = getattr(session.client, "client_id", None)
             attempts.failed(now, "a shared page" if client_id is None else f"browser {client_id}", token)
             return False
@@ -204,6 +229,29 @@ class ClassRoom:
     def grades_csv(self) -> str:
         return self.gradebook.to_csv()
 
+    def _keep_pushed(self, tool_key: str | None) -> None:
+        """Keep what the trainer pushed in the gradebook (``PUSHED_SETTING``), so a restart with
+        this gradebook applies it again (:meth:`_apply_kept`)."""
+        kept = self.gradebook.class_setting(PUSHED_SETTING)
+        kept = dict(kept) if isinstance(kept, dict) else {}
+        kept.update({"exercise": self.exercise, "hide_distance": self.hide_distance})
+        if tool_key is not None:
+            kept["tool_key"] = tool_key
+        self.gradebook.set_class_setting(PUSHED_SETTING, kept)
+
+    def _apply_kept(self, exercise_given: bool) -> None:
+        """At start: the settings the trainer pushed before a restart (an ``--exercise`` given
+        at start wins over a kept one)."""
+        kept = self.gradebook.class_setting(PUSHED_SETTING)
+        if not isinstance(kept, dict):
+            return
+        if not exercise_given and kept.get("exercise") in (None, *EXERCISE_IDS):
+            self.exercise = kept.get("exercise")
+        if isinstance(kept.get("hide_distance"), bool):
+            self.hide_distance = kept["hide_distance"]
+        tool = kept.get("tool_key")
+        self.pushed_tool = tool if isinstance(tool, str) and tool in self.tools else None
+
     def push_settings(self, exercise: str | None, tool_key: str | None, hide_distance: bool | None = None) -> int:
         """Set the exercise (None: free practice; "mystery": each trainee gets a mystery tool),
         mount ``tool_key`` (None: keep) and set "Hide distance" (None: keep) on every named
@@ -216,6 +264,7 @@ class ClassRoom:
         self.exercise = exercise
         if hide_distance is not None:
             self.hide_distance = bool(hide_distance)
+        self._keep_pushed(tool_key)
         with self._lock:
             trainees = list(self._trainees.values())
         for session, recorder, name in trainees:
