@@ -69,8 +69,9 @@ class IdentityPrompt:
     Attributes:
         name: the accepted name (None until then, and again after :meth:`reopen`).
         modal, name_field, key_field, start, message, token_field, open_trainer: the widgets of
-            the modal on show (for tests); key_html: the element holding the last issued key
-            (None: none issued to this session).
+            the modal on show (for tests); marker_html: its hold or forget element (None: a
+            first welcome window); key_html: the element holding the last issued key (None:
+            none issued to this session).
     """
 
     def __init__(self, session: Session, on_name: Callable[[Any, str], tuple[str, str | None]],
@@ -95,12 +96,12 @@ class IdentityPrompt:
                                           "joined before; leave it empty.")
             self.start = gui.add_button("Join the class", color="green")
             self.message = gui.add_markdown("")
-            if marker:
-                gui.add_html(f"<div hidden {marker}></div>")
+            self.marker_html = gui.add_html(f"<div hidden {marker}></div>") if marker else None
             gui.add_markdown("---\n*Trainer:* open the trainer address the server printed, or type "
                              "its token here.")
             self.token_field = gui.add_text(TOKEN_LABEL, "")
             self.open_trainer = gui.add_button("Open trainer view")
+        self._modal_open = True
         self.start.on_click(self.session.on_loop(self._start))
         self.open_trainer.on_click(self.session.on_loop(self._trainer))
 
@@ -120,7 +121,7 @@ class IdentityPrompt:
         """The class took the browser as ``name``: close the modal, show the banner, and hand a
         newly issued key to the page script."""
         self.name = name
-        self.modal.close()
+        self._close_modal()
         self.banner.content = f"Trainee: **{escape_markdown(name)}**"
         self.banner.visible = True
         if new_key is not None:
@@ -139,10 +140,7 @@ class IdentityPrompt:
         if self.key_html is not None:
             self.key_html.remove()
             self.key_html = None
-        try:
-            self.modal.close()
-        except Exception:  # already closed: a new one is built either way
-            pass
+        self._close_modal()
         self._build(FORGET_ATTRIBUTE if forget else HOLD_ATTRIBUTE)
         self.message.content = f"⚠ {escape_markdown(message)}"
 
@@ -152,4 +150,9 @@ class IdentityPrompt:
         if not self._on_token(token):
             self.message.content = "⚠ That trainer token is not right; type the token the server printed."
             return
-        self.modal.close()
+        self._close_modal()
+
+    def _close_modal(self) -> None:
+        if self._modal_open:
+            self._modal_open = False
+            self.modal.close()
