@@ -5,11 +5,14 @@ Examples::
     tcp-pendant                                  # KR 6, pointer, http://127.0.0.1:8080
     tcp-pendant --robot gp12 --tool torch --port 8090
     tcp-pendant --robot /path/ur5.urdf --flange-link tool0
+    tcp-pendant --robot ~/ws/src/kuka_experimental/kuka_kr16_support/urdf/kr16_2.xacro \
+        --package-path ~/ws/src/kuka_experimental        # a ROS-Industrial description
     tcp-pendant --host 0.0.0.0 --shared          # classroom demo: one robot for everybody
     tcp-pendant --shared --presenter             # the lecture on a projector: large readout
     tcp-pendant --host 0.0.0.0 --class           # a class: names, gradebook, trainer view
     tcp-pendant --host 0.0.0.0 --exercise mystery --exercise-seed 7   # a class with mystery tools
     tcp-pendant grades --csv > grades.csv        # the class gradebook (see classroom.grades_cli)
+    tcp-pendant poses import touch.ls --robot kr6 > POSES.csv   # joint points by the robot's FK
     tcp-pendant --scenario bent-tool --scenario-seed 3   # training: a systematic error to find
 """
 
@@ -36,7 +39,12 @@ def build_parser() -> argparse.ArgumentParser:
         description="Teach-pendant web app for TCP / TOOL frame calibration training. "
                     "Each browser gets its own virtual robot unless --shared is given.")
     p.add_argument("--robot", default="kr6",
-                   help="kr6 (KUKA KR 6 R900 sixx, default), gp12 (Yaskawa GP12 class) or PATH.urdf")
+                   help="kr6 (KUKA KR 6 R900 sixx, default), gp12 (Yaskawa GP12 class), PATH.urdf or "
+                        "PATH.xacro (a ROS description: package:// meshes are found through --package-path "
+                        "and ROS_PACKAGE_PATH)")
+    p.add_argument("--package-path", action="append", default=[], type=Path, metavar="DIR",
+                   help="a folder holding ROS packages (or a package itself), searched for the robot's "
+                        "package:// meshes and xacro's $(find pkg) before ROS_PACKAGE_PATH (repeatable)")
     p.add_argument("--flange-link", default=None,
                    help="link used as FLANGE (default: 'flange', else the last link of the longest chain)")
     p.add_argument("--tool", default="pointer", choices=("pointer", "torch", "gripper"),
@@ -58,7 +66,9 @@ def build_parser() -> argparse.ArgumentParser:
                         "site are refused")
     p.add_argument("--reference-tip", default=None, metavar="X,Y,Z",
                    help="reference tip position in WORLD, mm (default: below the home flange at half "
-                        "its height, e.g. 525,0,445 on the KR 6)")
+                        "its height on kr6 and gp12, e.g. 525,0,445 on the KR 6; for another robot a point "
+                        "in front of it that the tool reaches from the XYZ 4-point's directions); a tip out "
+                        "of reach is warned about at start")
     p.add_argument("--class", dest="classroom", action="store_true",
                    help="run a class: each browser gives a name, every calibration is stored in the class "
                         "gradebook, and a trainer view (token) shows the class; implied by --class-db, "
@@ -88,6 +98,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--beam-crossed", action="store_true",
                    help="a second beam along WORLD Y crosses the first (crossed beams, as on TRACC-type "
                         "devices)")
+    p.add_argument("--seed", type=int, default=None, metavar="N",
+                   help="one seed for every pendant's randomness (Auto-touch's operator error and "
+                        "directions, the beam sensor's noise): a seeded lesson replays the same way "
+                        "(default: fresh randomness; >= 0)")
     p.add_argument("--verbose", action="store_true", help="log debugging information")
     return p
 
@@ -133,6 +147,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         from tcp_pendant.classroom.grades_cli import main as grades_main
 
         return grades_main(args_list[1:])
+    if args_list[:2] == ["poses", "import"]:
+        from tcp_pendant.poses_import_cli import main as poses_import_main
+
+        return poses_import_main(args_list[2:])
     try:
         return _main(args_list)
     except KeyboardInterrupt:               # Ctrl-C while loading the robot or starting
@@ -172,18 +190,20 @@ def _main(argv: Sequence[str] | None) -> int:
             return 2
     try:
         tip = None if args.reference_tip is None else parse_xyz_mm(args.reference_tip)
-        config = AppConfig(robot=args.robot, flange_link=args.flange_link, tool=args.tool, host=args.host,
+        config = AppConfig(robot=args.robot, package_paths=tuple(args.package_path), flange_link=args.flange_link, tool=args.tool, host=args.host,
                            port=args.port, tool_library=args.tool_library, shared=args.shared,
                            reference_tip_mm=tip, allow_origins=tuple(args.allow_origin), class_db=class_db,
                            trainer_token=args.trainer_token, exercise=args.exercise,
                            exercise_seed=args.exercise_seed, scenario=args.scenario.replace("-", "_"),
                            scenario_seed=args.scenario_seed, presenter=args.presenter,
                            beam_width_mm=args.beam_width, beam_repeatability_mm=args.beam_repeatability,
-                           beam_crossed=args.beam_crossed)
+                           beam_crossed=args.beam_crossed, seed=args.seed)
         app = PendantApp(config)
     except (ControllerError, ValueError, OSError, GradebookError) as exc:
         print(f"tcp-pendant: error: {exc}", file=sys.stderr)
         return 2
+    for line in app.warnings:
+        print(f"WARNING: {line}", file=sys.stderr)
     warning = network_warning(args.host)
     if warning is not None:
         print(warning, file=sys.stderr)

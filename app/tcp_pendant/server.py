@@ -33,6 +33,7 @@ import numpy as np
 
 from tcpcal.library import ToolLibrary
 from tcp_pendant import client_script, origin_check
+from tcp_pendant.calibrate import CalibrationWorkflow
 from tcp_pendant.addresses import network_urls
 from tcp_pendant.classroom.class_room import ClassRoom
 from tcp_pendant.classroom.gradebook import Gradebook
@@ -46,6 +47,15 @@ from tcp_pendant.controller import (
     builtin_tools,
     reference_tip_model,
 )
+from tcp_pendant.controller.placement import (
+    MIN_TIP_HEIGHT_M,
+    READY_HOVER_M,
+    XYZ4_DIRECTIONS,
+    best_hover_configuration,
+    reachable_reference_tip,
+    sampled_reach_m,
+    unreachable_directions,
+)
 from tcp_pendant.controller.scenarios import Scenario
 from tcp_pendant.session import Session
 from tcp_pendant.views import session_view_steps
@@ -53,7 +63,9 @@ from tcp_pendant.views.presenter import PresenterView
 from tcp_pendant.views.scene import overview_camera, overview_pose
 from tcp_pendant.views.meshes import link_meshes, rigid_meshes
 
-__all__ = ["AppConfig", "PendantApp", "PortInUseError", "default_reference_tip_mm", "is_loopback"]
+__all__ = ["AppConfig", "MIN_TIP_HEIGHT_M", "READY_HOVER_M", "PendantApp", "PortInUseError",
+           "default_reference_tip_mm", "is_loopback", "ready_configuration", "resolve_robot",
+           "tip_reach_warning"]
 
 log = logging.getLogger(__name__)
 
@@ -65,7 +77,9 @@ class AppConfig:
     """Start-up options (the CLI's; mm for the reference tip).
 
     Attributes:
-        robot: "kr6", "gp12" or the path of a URDF.
+        robot: "kr6", "gp12" or the path of a URDF or xacro file.
+        package_paths: folders holding ROS packages (``--package-path``), searched before
+            ``ROS_PACKAGE_PATH`` for the description's ``package://`` and ``$(find pkg)``.
         flange_link: link used as FLANGE (None: ``flange`` / last link of the longest chain).
         tool: mounted tool key ("pointer", "torch", "gripper").
         host, port: where to serve (port 0: a free port).
@@ -90,9 +104,14 @@ class AppConfig:
             tip (``controller.beam_scan.BeamDevice``): beam diameter (0.05-5 mm, default 0.5),
             repeatability of an event per axis (0-1 mm, default 0.02), a second beam along
             WORLD Y crossing it.
+        seed: the one seed of every session's randomness (``Session.rng``: Auto-touch's operator
+            error and directions, the beam's repeatability noise); session k of the server draws
+            from ``(seed, k)``, so a seeded lesson or test replays the same way. None: fresh
+            randomness.
     """
 
     robot: str = "kr6"
+    package_paths: tuple[Path, ...] = ()
     flange_link: str | None = None
     tool: str = "pointer"
     host: str = "127.0.0.1"
@@ -112,6 +131,7 @@ class AppConfig:
     beam_width_mm: float = 0.5
     beam_repeatability_mm: float = 0.02
     beam_crossed: bool = False
+    seed: int | None = None
 
 
 class PortInUseError(OSError):
@@ -139,7 +159,7 @@ def is_loopback(host: str) -> bool:
 
 
 def resolve_robot(robot: str) -> Path:
-    """URDF path of "kr6", "gp12" or a path.
+    """Description file of "kr6", "gp12" or a path (``.urdf`` or ``.xacro``).
 
     Raises:
         ControllerError: unknown name or missing file.
@@ -148,45 +168,40 @@ def resolve_robot(robot: str) -> Path:
     if robot in robots:
         return robots[robot]
     path = Path(robot).expanduser()
-    if path.suffix.lower() == ".urdf" or path.exists():
+    if path.suffix.lower() in (".urdf", ".xacro") or path.exists():
         if not path.is_file():
-            raise ControllerError(f"Robot URDF not found: {path}. Give kr6, gp12 or the path of a .urdf file.")
+            raise ControllerError(f"Robot description not found: {path}. Give kr6, gp12 or the path of a "
+                                  ".urdf or .xacro file.")
         return path.resolve()
-    raise ControllerError(f"Unknown robot {robot!r}; use kr6, gp12 or the path of a .urdf file.")
+    raise ControllerError(f"Unknown robot {robot!r}; use kr6, gp12 or the path of a .urdf or .xacro file.")
 
 
-MIN_TIP_HEIGHT_M = 0.15
-"""The reference tip stands at least this high above the floor (its stand must be visible and
-the tool must reach it from the side)."""
-READY_HOVER_M = 0.25
-"""Generic robots start with the flange this far above the reference tip, pointing down."""
+def _pointer_T_flange_tool() -> np.ndarray:
+    return np.asarray(builtin_tools()["pointer"].T_flange_tool_true, dtype=float)
 
 
-def _sampled_reach_m(kinematics: RobotKinematics, n: int = 400) -> float:
-    """Horizontal reach of the flange (m): the 95th percentile of its distance from the base
-    axis over ``n`` deterministic random configurations within the limits."""
-    rng = np.random.default_rng(20261123)
-    lo, hi = kinematics.lower_rad, kinematics.upper_rad
-    span = np.minimum(hi - lo, 2 * np.pi)
-    mid = 0.5 * (lo + hi)
-    qs = mid + (rng.uniform(size=(n, kinematics.n_joints)) - 0.5) * span
-    p = np.array([kinematics.T_world_flange(q)[:3, 3] for q in qs])
-    return float(np.percentile(np.hypot(p[:, 0], p[:, 1]), 95))
-
-
-def default_reference_tip_mm(kinematics: RobotKinematics) -> tuple[float, float, float]:
+def default_reference_tip_mm(kinematics: RobotKinematics,
+                             T_flange_tool: np.ndarray | None = None) -> tuple[float, float, float]:
     """Default reference tip (WORLD, mm), reachable from many directions.
 
-    Below the home flange position at half its height, the controller's own default (tested by
-    the controller's auto-approach tests on both robots): KR 6 (525, 0, 445); GP12 (795, 0,
-    582). A robot whose HOME is stretched out near the floor (the UR5 of example-robot-data:
-    half its home height is below the floor) gets a point in front of it instead: at half its
-    horizontal reach, a quarter of that reach high (at least ``MIN_TIP_HEIGHT_M``).
+    Our robots (a known home, ``RobotKinematics.known_home``): below the home flange position at
+    half its height, the controller's own default (tested by the controller's auto-approach
+    tests on both robots): KR 6 (525, 0, 445); GP12 (795, 0, 582); one whose home flange is
+    lower than ``2 MIN_TIP_HEIGHT_M`` gets a point in front of it instead, at half its
+    horizontal reach, a quarter of that reach high.
+
+    Any other robot: computed from its model, the first point in front of it that the mounted
+    tool (``T_flange_tool``, default the pointer's true TCP) reaches from every direction of the
+    XYZ 4-point's reach test (``controller.placement.reachable_reference_tip``).
     """
+    if not kinematics.known_home:
+        T = _pointer_T_flange_tool() if T_flange_tool is None else np.asarray(T_flange_tool, dtype=float)
+        tip = reachable_reference_tip(kinematics, T) * 1000.0
+        return (float(tip[0]), float(tip[1]), float(tip[2]))
     p = kinematics.T_world_flange(kinematics.home_rad)[:3, 3]
     if 0.5 * p[2] >= MIN_TIP_HEIGHT_M:
         return (float(p[0] * 1000.0), float(p[1] * 1000.0), float(0.5 * p[2] * 1000.0))
-    reach = _sampled_reach_m(kinematics)
+    reach = sampled_reach_m(kinematics)
     tip = np.array([0.5 * reach, 0.0, max(MIN_TIP_HEIGHT_M, 0.25 * reach)]) * 1000.0
     return (float(tip[0]), float(tip[1]), float(tip[2]))
 
@@ -194,13 +209,21 @@ def default_reference_tip_mm(kinematics: RobotKinematics) -> tuple[float, float,
 def ready_configuration(kinematics: RobotKinematics, tip_world_m: np.ndarray | None = None) -> np.ndarray:
     """The session's start ("ready") pose, rad: the flange pointing straight down.
 
-    KUKA HOME has A5 = 0, a wrist singularity where Cartesian jogs along Y stop at once; with
-    the 5th axis turned +-90 deg the flange points down, the wrist is well conditioned and the
-    tool hangs over the reference tip, the natural start of a touch-up. A robot for which that
-    does not point the flange down (the UR5) is solved by IK for the flange pointing down
-    ``READY_HOVER_M`` above ``tip_world_m``, if given and reachable; otherwise: HOME.
+    Our robots (a known home): KUKA HOME has A5 = 0, a wrist singularity where Cartesian jogs
+    along Y stop at once; with the 5th axis turned +-90 deg the flange points down, the wrist is
+    well conditioned and the tool hangs over the reference tip, the natural start of a touch-up.
+
+    Any other robot, given ``tip_world_m``: the best-conditioned configuration with the flange
+    pointing down ``READY_HOVER_M`` above the tip (``controller.placement``:
+    largest manipulability, clear of singularities and joint limits; for a 7-axis arm over its
+    self-motion too). Without a tip, or when that hover pose has no solution: the 5th-axis turn
+    above if it points the flange down, else HOME.
     """
     home = np.array(kinematics.home_rad, dtype=float)
+    if not kinematics.known_home and tip_world_m is not None:
+        q = best_hover_configuration(kinematics, np.asarray(tip_world_m, dtype=float))
+        if q is not None:
+            return q
     best, best_dot = home, 0.9
     if kinematics.n_joints >= 5 and kinematics.revolute[4]:
         for a5 in (np.pi / 2, -np.pi / 2):
@@ -221,6 +244,29 @@ def ready_configuration(kinematics: RobotKinematics, tip_world_m: np.ndarray | N
     return best
 
 
+def tip_reach_warning(kinematics: RobotKinematics, tip_world_m: np.ndarray, T_flange_tool: np.ndarray,
+                      robot_label: str, tool_label: str) -> str | None:
+    """The start warning for a ``--reference-tip`` the mounted tool cannot reach from the XYZ
+    4-point's directions (``placement.unreachable_directions``), or None when it can."""
+    # a few seeds per direction (the hover pose's and home first): the start stays within about
+    # a second when the tip is far out of reach
+    reach = unreachable_directions(kinematics, tip_world_m, T_flange_tool, n_random_seeds=8, max_iterations=100)
+    if reach.ok:
+        return None
+    tip = ", ".join(f"{v:.0f}" for v in np.asarray(tip_world_m) * 1000.0)
+    what = []
+    if not reach.hover_ok:
+        what.append(f"the flange cannot hover pointing down {READY_HOVER_M * 1000:.0f} mm above it")
+    if reach.failed:
+        dirs = ", ".join(f"tilt {t:.0f}° azimuth {a:.0f}°" for t, a in reach.failed)
+        what.append(f"the {tool_label.lower()} cannot touch it from {len(reach.failed)} of "
+                    f"{len(XYZ4_DIRECTIONS)} test directions ({dirs})")
+    default = ",".join(f"{v:.0f}" for v in default_reference_tip_mm(kinematics, T_flange_tool))
+    return (f"the reference tip ({tip}) mm is out of reach of the {robot_label}: {'; '.join(what)}. "
+            f"Auto-touch and touch-ups there will fail; give a nearer --reference-tip, e.g. "
+            f"--reference-tip {default} (this robot's default).")
+
+
 class PendantApp:
     """The pendant server.
 
@@ -234,24 +280,38 @@ class PendantApp:
     def __init__(self, config: AppConfig) -> None:
         self.config = config
         urdf = resolve_robot(config.robot)
-        self.kinematics = RobotKinematics.from_urdf(urdf, flange_link=config.flange_link)
+        self.kinematics = RobotKinematics.from_urdf(urdf, flange_link=config.flange_link,
+                                                    package_paths=config.package_paths)
+        self.robot_label = ROBOT_LABELS.get(config.robot, self.kinematics.description.name)
         tools = builtin_tools()
         if config.tool not in tools:
             raise ControllerError(f"Unknown tool {config.tool!r}; use one of {', '.join(tools)}.")
         self.tool = tools[config.tool]
         Scenario(config.scenario, seed=config.scenario_seed)  # type: ignore[arg-type]  # ControllerError: names the choices
-        tip = config.reference_tip_mm or default_reference_tip_mm(self.kinematics)
+        self.tip_warning: str | None = None
+        """:func:`tip_reach_warning` of a ``--reference-tip`` given (None: reachable, or the default)."""
+        T_flange_tool = np.asarray(self.tool.T_flange_tool_true, dtype=float)
+        tip = config.reference_tip_mm or default_reference_tip_mm(self.kinematics, T_flange_tool)
         tip_m = np.asarray(tip, dtype=float) / 1000.0
         if tip_m.shape != (3,) or not np.all(np.isfinite(tip_m)):
             raise ControllerError(f"Reference tip must be 3 finite numbers X,Y,Z in mm, got {tip!r}.")
         self.reference_tip_m = tip_m
+        if config.reference_tip_mm is not None:
+            self.tip_warning = tip_reach_warning(self.kinematics, tip_m, T_flange_tool, self.robot_label,
+                                                 self.tool.label)
         self.beam_device = BeamDevice(width_m=config.beam_width_mm / 1000.0,      # ControllerError: says
                                       sigma_m=config.beam_repeatability_mm / 1000.0,  # the allowed range
                                       crossed=config.beam_crossed)
         self.ready_q_rad = ready_configuration(self.kinematics, tip_m)
         self.allow_origins = origin_check.parse_allow_origins(config.allow_origins)
         self.library = ToolLibrary(config.tool_library)
-        self.robot_label = ROBOT_LABELS.get(config.robot, urdf.stem)
+        self.robot_key = config.robot if config.robot in builtin_robots() else self.kinematics.description.name
+        """The robot's name in session records: "kr6", "gp12" or the description's file name
+        (without ``.urdf`` / ``.xacro``)."""
+        if config.seed is not None and (isinstance(config.seed, bool) or not isinstance(config.seed, int)
+                                        or config.seed < 0):
+            raise ControllerError(f"The seed must be a whole number >= 0, got {config.seed!r}.")
+        self._sessions_made = 0
         self.server: Any = None
         self.sessions: dict[int, Session] = {}
         self.shared_session: Session | None = None
@@ -259,7 +319,7 @@ class PendantApp:
         self._stop = threading.Event()
         self._watcher: threading.Thread | None = None
         # warm the mesh caches so the first browser does not wait for STL parsing
-        link_meshes(self.kinematics.urdf_path)
+        link_meshes(self.kinematics.description)
         for t in tools.values():
             rigid_meshes(t.urdf_path)
         rigid_meshes(reference_tip_model().urdf_path)
@@ -272,6 +332,13 @@ class PendantApp:
                                        exercise=config.exercise, exercise_seed=config.exercise_seed,
                                        hand_to_loop=self._hand_to_loop)
 
+    @property
+    def warnings(self) -> list[str]:
+        """What the start says on stderr (the CLI prints each as a ``WARNING:`` line) and every
+        pendant shows (:meth:`start_notices`): each visual mesh not found (which, why, what to do,
+        how its link is drawn instead), a ``--reference-tip`` out of reach."""
+        return self.kinematics.description.mesh_warnings() + ([self.tip_warning] if self.tip_warning else [])
+
     # ------------------------------------------------------------ sessions
     def new_controller(self) -> VirtualController:
         """A controller with its own pinocchio data (the model is shared, read-only)."""
@@ -279,7 +346,15 @@ class PendantApp:
                               reference_tip_world_m=self.reference_tip_m)
         c.set_beam_device(self.beam_device)
         c.set_q(self.ready_q_rad)
+        c.set_rest_configuration(self.ready_q_rad)
         return c
+
+    def session_rng(self) -> np.random.Generator:
+        """The next session's random generator: from ``(seed, k)`` for the server's k-th session
+        when a seed was given (``AppConfig.seed``), else fresh."""
+        k, self._sessions_made = self._sessions_made, self._sessions_made + 1
+        seed = self.config.seed
+        return np.random.default_rng() if seed is None else np.random.default_rng([int(seed), k])
 
     def make_session(self, client: Any | None, target: Any | None = None, *, shared: bool = False) -> Session:
         """Build a session drawing into ``target`` (default: ``client``). A per-browser session
@@ -296,8 +371,10 @@ class PendantApp:
         steps on viser's event loop). Closing the generator early closes the half-built session.
         """
         c = self.new_controller()
-        session = Session(c, self.library, client=client, target=target, ready_q_rad=self.ready_q_rad,
-                          shared=shared)
+        rng = self.session_rng()
+        workflow = CalibrationWorkflow(c, self.library, robot=self.robot_key, rng=rng)
+        session = Session(c, self.library, workflow, client=client, target=target, ready_q_rad=self.ready_q_rad,
+                          shared=shared, rng=rng)
         session.reload_library()
         if shared:
             try:
@@ -337,6 +414,7 @@ class PendantApp:
             if self.shared_session is not None:
                 try:
                     overview_camera(client, self.reference_tip_m)
+                    self.show_start_notices(client)
                 except Exception:
                     log.debug("camera of a leaving client", exc_info=True)
             return
@@ -359,8 +437,30 @@ class PendantApp:
             self.sessions[client.client_id] = session
         try:
             overview_camera(client, self.reference_tip_m)
+            self.show_start_notices(client)
         except Exception:
             log.debug("camera of a leaving client", exc_info=True)
+
+    def start_notices(self) -> list[tuple[str, str]]:
+        """(title, body) of the notifications every browser gets when it connects: the start
+        warnings (:attr:`warnings`) in plain text (viser shows them as text)."""
+        out = []
+        missing = [m for m in self.kinematics.description.missing_meshes if m.kind == "visual"]
+        if missing:
+            names = ", ".join(Path(m.uri).name for m in missing[:6]) + (" ..." if len(missing) > 6 else "")
+            out.append(("Robot meshes not found",
+                        f"{len(missing)} mesh(es) of the robot were not found ({names}): those links are drawn "
+                        "from their collision geometry or as simple shapes. The terminal that started the "
+                        "pendant says where each was looked for (--package-path, ROS_PACKAGE_PATH)."))
+        if self.tip_warning is not None:
+            out.append(("Reference tip out of reach", self.tip_warning))
+        return out
+
+    def show_start_notices(self, client: Any) -> None:
+        """Show :meth:`start_notices` in ``client``'s browser (they stay until closed)."""
+        for title, body in self.start_notices():
+            client.add_notification(title, body, color="yellow", with_close_button=True,
+                                    auto_close_seconds=None)
 
     async def _on_disconnect(self, client: Any) -> None:
         """``on_client_disconnect``, on viser's event loop like every other callback."""

@@ -15,12 +15,22 @@ State and its one owner each (docs/architecture.md, "State owners and the change
   reads it and never writes it; the ``--shared`` session starts with it and writes it when a
   tool is activated or saved there.
 
-Commands change that state in one place - :meth:`Session.mount_tool`, :meth:`Session.activate`,
-:meth:`Session.deactivate`, :meth:`Session.set_active_data`, :meth:`Session.apply_saved`,
-:meth:`Session.record_touch`, :meth:`Session.delete_touch`, :meth:`Session.reload_library`,
-:meth:`Session.moved` (after a move of the robot) - and each ends in ONE change signal: every
-function given to :meth:`Session.subscribe` is called with a :class:`SessionChange` saying what
-changed (pose, tool, touches, wizard, library) and carrying the robot's
+The session is the only command surface of its state. Its commands: the robot's motion
+(:meth:`Session.jog`, :meth:`Session.set_joints`, :meth:`Session.set_joint`,
+:meth:`Session.ready`, :meth:`Session.home`, :meth:`Session.move_tcp_to`), the tools
+(:meth:`Session.mount_tool`, :meth:`Session.activate`, :meth:`Session.deactivate`,
+:meth:`Session.set_active_data`, :meth:`Session.apply_saved`, :meth:`Session.reload_library`),
+the free touches (:meth:`Session.record_touch`, :meth:`Session.delete_touch`) and the
+calibration wizards of its :class:`~tcp_pendant.calibrate.CalibrationWorkflow`
+(:attr:`Session.workflow`, built by the server with the session and owned by it:
+:meth:`Session.start_wizard`, :meth:`Session.start_from_touches`, :meth:`Session.record_step`,
+:meth:`Session.auto_touch`, :meth:`Session.back`, :meth:`Session.next_step` (Next, or Finish on
+the last step), :meth:`Session.cancel_wizard`, :meth:`Session.resume_wizard`,
+:meth:`Session.save_result`, ...). Views never change the controller or the workflow
+themselves. Each command ends in ONE change signal: every function given to
+:meth:`Session.subscribe` is called with a :class:`SessionChange` saying what to re-render
+(pose, tool, touches, wizard, library), what happened (``events``: typed facts taken when it
+happened, ``tcp_pendant.events``) and carrying the robot's
 :class:`~tcp_pendant.controller.pose_state.PoseState`, computed once for all of them. Views
 subscribe and re-render from state; they never call each other. Inside :meth:`Session.batch`
 the changes of several commands are merged into one signal (a Calibrate click that mounts a
@@ -53,10 +63,14 @@ import numpy as np
 from tcpcal.library import ToolLibrary
 from tcpcal.errors import TcpcalError
 from tcpcal.tool import Tool
+from tcp_pendant.calibrate.autotouch import AutoTouchOutcome
+from tcp_pendant.calibrate.workflow import AutoTouchRequest, CalibrationWorkflow, ControllerToolState
 from tcp_pendant.controller import ControllerError, JogResult, ToolModel, VirtualController
 from tcp_pendant.controller.pose_state import PoseState, pose_state, pose_state_key
 from tcp_pendant.controller.scenarios import Scenario, ScenarioWorld, bent_tool, realize
+from tcp_pendant.events import Crash, SessionEvent
 from tcp_pendant.pendant import Jogger, touch_label
+from tcp_pendant.wizards import Wizard, WizardResult, WizardStateError
 
 __all__ = ["GuiTarget", "Session", "SessionChange", "Touch"]
 
@@ -120,6 +134,9 @@ class SessionChange:
         jog: the outcome of the move, for the status line (None: not a jog, or unchanged).
         state: the robot's pose state after the change (computed once, for every subscriber),
             None when neither ``pose`` nor ``tool`` is set.
+        events: what happened, in order (``tcp_pendant.events``: a run started, a touch
+            recorded with its facts at record time, a run finished or cancelled, a crash, a
+            tool saved); empty for a change that only re-renders.
     """
 
     pose: bool = False
@@ -129,13 +146,16 @@ class SessionChange:
     library: bool = False
     jog: JogResult | None = None
     state: PoseState | None = None
+    events: tuple[SessionEvent, ...] = ()
 
     def merged(self, other: "SessionChange") -> "SessionChange":
-        """Both changes as one (flags or-ed; the newer jog outcome; the state is recomputed)."""
+        """Both changes as one (flags or-ed; the newer jog outcome; events in order; the state
+        is recomputed)."""
         return SessionChange(pose=self.pose or other.pose, tool=self.tool or other.tool,
                              touches=self.touches or other.touches, wizard=self.wizard or other.wizard,
                              library=self.library or other.library,
-                             jog=other.jog if other.jog is not None else self.jog)
+                             jog=other.jog if other.jog is not None else self.jog,
+                             events=self.events + other.events)
 
 
 @dataclass(eq=False)
@@ -145,6 +165,9 @@ class Session:
     Attributes:
         controller: the session's virtual controller.
         library: the server's shared tool library.
+        workflow: the session's calibration wizards (``CalibrationWorkflow``; the server builds
+            it with the session, which binds itself as its ``ToolState``); change it only with
+            the session's wizard commands.
         client: the browser (None in ``--shared`` mode).
         target: where the views draw (the client, or the server in ``--shared`` mode).
         touches: recorded flange poses, in order.
@@ -158,18 +181,19 @@ class Session:
             in (see ``tcp_pendant.views.calibrate``); None before the views are built.
         ready_q_rad: the "Ready pose" button's joint angles (None: the robot's HOME).
         views: named view objects (``"scene"``, ``"pendant"``, ``"tools"``, ...), for tests
-            only: views never reach each other through it.
+            only: app code never looks a view up through it.
         scene_labels: the scene's labels at the tool and the tip (``"flange"``, ``"tool"``,
             ``"tip"``: viser label handles), which the wizards' scene places apart.
-        workflow: the session's ``CalibrationWorkflow`` (the Calibrate tab's wizards), set once
-            when the views are built (None without the wizards plug-in); the Jog tab's wizard
-            dock renders its state and calls its commands.
         hide_distance: "Hide distance" (training: judge the touch by eye); change it with
             :meth:`set_hide_distance`.
+        rng: the session's random generator (Auto-touch's operator error and directions, the
+            beam's repeatability, the scenarios the trainer plays): the server draws it from its
+            one seed (``--seed``), so a seeded lesson replays the same way.
     """
 
     controller: VirtualController
     library: ToolLibrary
+    workflow: CalibrationWorkflow
     client: Any | None = None
     target: Any | None = None
     touches: list[Touch] = field(default_factory=list)
@@ -180,12 +204,15 @@ class Session:
     ready_q_rad: np.ndarray | None = None
     views: dict[str, Any] = field(default_factory=dict)
     scene_labels: dict[str, Any] = field(default_factory=dict)
-    workflow: Any | None = None
     hide_distance: bool = False
+    rng: np.random.Generator = field(default_factory=np.random.default_rng)
 
     def __post_init__(self) -> None:
         if self.target is None:
             self.target = self.client
+        if self.workflow.controller is not self.controller:
+            raise ControllerError("A session's workflow must drive the session's own controller.")
+        self.workflow.state = self              # the workflow mounts tools and sets data through us
         self.jogger = Jogger(self.controller)
         self.closed = False
         self._subscribers: list[Callable[[SessionChange], None]] = []
@@ -208,7 +235,7 @@ class Session:
         self._free_records = 0                          # "Record point" clicks (free touches)
         self._scenario_base = 0                         # touches recorded before the scenario was set
         self._scenario_touches = 0                      # touches recorded since (never decreases)
-        self._wizard_stamps: dict[tuple[int, int], str] = {}  # (id(run), step) -> recorded_at seen
+        self._crashed = False                           # the touch geometry's crash state at the last signal
 
     # ------------------------------------------------------------ the change signal
     def subscribe(self, fn: Callable[[SessionChange], None]) -> None:
@@ -254,12 +281,21 @@ class Session:
     def _emit(self, change: SessionChange) -> None:
         if self.closed:
             return
-        if change.wizard:
-            self._note_wizard_joints()
+        if change.tool:                           # the open wizard checks its steps' tool changes
+            self.workflow.note_mounted_tool()
+        events = self.workflow.take_events()      # whoever drove the workflow, nothing is lost
+        if events:
+            change = replace(change, events=change.events + events)
         if self._play_moved_reference():
             change = replace(change, pose=True)
         if change.pose or change.tool:
-            change = replace(change, pose=True, state=self.pose_state())
+            state = self.pose_state()
+            change = replace(change, pose=True, state=state)
+            crashed = bool(state.touch.crashed)
+            if crashed and not self._crashed:
+                run = self.workflow.run_index if self.workflow.is_open else None
+                change = replace(change, events=change.events + (Crash(float(state.touch.penetration_mm), run),))
+            self._crashed = crashed
         subscribers = list(self._subscribers)
         if self.target is None:
             for fn in subscribers:
@@ -369,6 +405,32 @@ class Session:
             self.changed(library=True)
             return self.library_tools
 
+    def store_tool(self, slot: int, tool: Tool) -> None:
+        """Write ``tool`` into ``slot`` of the library (numeric entry) and re-read the list.
+
+        Raises:
+            tcpcal.TcpcalError: the library refused (the name is in another slot, ...).
+        """
+        with self.lock:
+            self.library.save(int(slot), tool)
+            self.reload_library()
+
+    def rename_tool(self, slot: int, name: str) -> None:
+        """Rename the library tool in ``slot``; the active data carries the new name when it is
+        that slot's. One signal."""
+        with self.lock, self.batch():
+            self.library.rename(int(slot), name)
+            self.reload_library()
+            renamed = self.library_tools.get(int(slot))
+            if self.active_slot == int(slot) and renamed is not None:
+                self.set_active_data(renamed, int(slot))
+
+    def delete_tool(self, slot: int) -> None:
+        """Delete the library tool in ``slot`` and re-read the list."""
+        with self.lock:
+            self.library.remove(int(slot))
+            self.reload_library()
+
     def notify(self, title: str, body: str, *, kind: str = "info") -> None:
         """Show a notification in this session's browser(s); ``kind``: info, success, warning, error.
 
@@ -447,14 +509,7 @@ class Session:
 
     def _records_total(self) -> int:
         """Touches recorded in this session so far: free ones and the wizards' poses."""
-        total = self._free_records
-        wf = self.workflow
-        for run in getattr(wf, "runs", ()) or ():
-            try:
-                total += len(run.wizard.recorded_poses)
-            except Exception:  # a plug-in's run without poses
-                continue
-        return total
+        return self._free_records + sum(len(run.wizard.recorded_poses) for run in self.workflow.runs)
 
     def _play_moved_reference(self) -> bool:
         """Moved reference tip: place the tip for the touches recorded since the scenario was
@@ -474,29 +529,218 @@ class Session:
         c.set_reference_tip(tip)
         return True
 
-    def _note_wizard_joints(self) -> None:
-        """After a wizard change: the joint values of each step the open run recorded since the
-        last signal (``WizardRun.joints_deg``, exported in the session record), taken only when
-        the robot is still at the recorded flange pose (else that step has none)."""
-        run = getattr(self.workflow, "run", None)
-        joints = getattr(run, "joints_deg", None)
-        if run is None or joints is None:
-            return
-        poses = run.wizard.recorded_poses
-        for step in [k for k in joints if k not in poses]:
-            del joints[step]
-        T_now: np.ndarray | None = None
-        for step, pose in poses.items():
-            key = (id(run), step)
-            if self._wizard_stamps.get(key) == pose.recorded_at:
-                continue
-            self._wizard_stamps[key] = pose.recorded_at
-            if T_now is None:
-                T_now = self.controller.T_world_flange()
-            if np.allclose(T_now, pose.T_world_flange_m, rtol=0.0, atol=1e-12):
-                joints[step] = tuple(self.controller.joint_angles_deg().values())
-            else:
-                joints.pop(step, None)
+    # ------------------------------------------------------------ motion (commands)
+    def jog(self, axis: str | int, sign: int, *, hold_tick: bool = False) -> JogResult | None:
+        """One jog key: a press (one increment, or nothing in continuous mode) or a tick of a held
+        key (``hold_tick``), by the session's :class:`~tcp_pendant.pendant.Jogger`; ends in one
+        ``pose`` signal carrying the move's outcome. None: nothing moved (a skipped tick)."""
+        with self.lock:
+            res = self.jogger.key(axis, sign, hold_tick=hold_tick)
+            if res is not None:
+                self.moved(res)
+            return res
+
+    def set_jog_setting(self, name: str, value: Any) -> None:
+        """One jog setting of the Jog tab (``JogSettings`` field ``name``: mode, frame,
+        increment, override_pct); the readouts re-render (a ``pose`` signal: the offset to the
+        tip is given in the jog frame).
+
+        Raises:
+            ControllerError: an unknown setting or value (names the choices).
+        """
+        with self.lock:
+            self.jogger.settings = self.jogger.settings.with_(**{name: value})
+            self.changed(pose=True)
+
+    def release_jog(self) -> None:
+        """The held key was released (or the hold stopped): no more continuous motion."""
+        with self.lock:
+            self.jogger.release()
+
+    def set_joints(self, q_rad: np.ndarray, *, status: bool = True) -> JogResult:
+        """Put the robot at the joint angles ``q_rad`` (rad; m for a prismatic joint), clipped to
+        the limits by the controller; one ``pose`` signal, which carries the move's outcome for
+        the status line unless ``status`` is False (a scan's film: the status line stays)."""
+        with self.lock:
+            self.controller.set_q(np.asarray(q_rad, dtype=float))
+            res = JogResult(True, 1.0, None, "")
+            self.moved(res if status else None)
+            return res
+
+    def set_joint(self, index: int, value_deg: float) -> float:
+        """Joint ``index`` (0-based) to ``value_deg``: the joint sliders' unit, the joint
+        variable in degrees (``degrees(q_rad)``, as their limits are), clipped to its limits;
+        returns the value applied in that unit.
+
+        Raises:
+            ControllerError: no such joint, or a value that is not a finite number.
+        """
+        with self.lock:
+            k = self.controller.kinematics
+            if isinstance(index, bool) or not isinstance(index, int) or not 0 <= index < k.n_joints:
+                raise ControllerError(f"There is no joint {index!r}; the robot has {k.n_joints}.")
+            value = float(value_deg)
+            if not np.isfinite(value):
+                raise ControllerError(f"Joint A{index + 1} needs a finite value, got {value_deg!r}.")
+            q = self.controller.q_rad
+            q[index] = float(np.clip(np.radians(value), k.lower_rad[index], k.upper_rad[index]))
+            self.set_joints(q)
+            return float(np.degrees(self.controller.q_rad[index]))
+
+    def ready(self) -> JogResult:
+        """"Ready pose": the session's start pose (``ready_q_rad``), or HOME when it has none."""
+        with self.lock:
+            if self.ready_q_rad is None:
+                return self.home()
+            return self.set_joints(self.ready_q_rad)
+
+    def home(self) -> JogResult:
+        """The robot's HOME position (the controller's); one ``pose`` signal."""
+        with self.lock:
+            self.controller.go_home()
+            res = JogResult(True, 1.0, None, "")
+            self.moved(res)
+            return res
+
+    def move_tcp_to(self, T_world_tcp_m: np.ndarray) -> JogResult:
+        """Move the active TCP to ``T_world_tcp_m`` ((4,4), WORLD, m; the gizmo), by the
+        controller's Cartesian motion rules; one ``pose`` signal with the outcome."""
+        with self.lock:
+            res = self.controller.move_tcp_to(np.asarray(T_world_tcp_m, dtype=float))
+            self.moved(res)
+            return res
+
+    # ------------------------------------------------------------ wizards (commands)
+    @contextmanager
+    def _wizard_command(self, *, moves: bool = False) -> Iterator[None]:
+        """Run a wizard command in one batch that ends in one ``wizard`` signal (``pose`` too
+        when the command may have moved the robot), also when it raised."""
+        with self.lock, self.batch():
+            try:
+                yield
+            finally:
+                self.changed(wizard=True, pose=moves)
+
+    def start_wizard(self, kind: str, **options: Any) -> Wizard:
+        """Open a wizard of the registered ``kind`` with its start options (the open one is
+        cancelled and kept; ``CalibrationWorkflow.start``)."""
+        with self._wizard_command(moves=True):
+            return self.workflow.start(kind, **options)
+
+    def start_from_touches(self, *, estimator: str = "lstsq") -> Wizard:
+        """XYZ 4-point from the free touches recorded with Record point, in order."""
+        with self._wizard_command(moves=True):
+            return self.workflow.start_from_touches(list(self.touches), estimator=estimator)
+
+    def record_step(self) -> None:
+        """Record the current flange pose for the open wizard's step."""
+        with self._wizard_command():
+            self.workflow.record()
+
+    def auto_touch(self, request: AutoTouchRequest) -> AutoTouchOutcome:
+        """Training mode: the controller performs the current step (``CalibrationWorkflow.auto_touch``)."""
+        with self._wizard_command(moves=True):
+            return self.workflow.auto_touch(request)
+
+    def back(self) -> None:
+        """One step back (from the result: to the last step); nothing is deleted."""
+        with self._wizard_command():
+            self.workflow.back()
+
+    def next_step(self) -> WizardResult | None:
+        """Next step, or on the last step Finish: the result (a wizard with a controller job runs
+        it here, synchronously; the views take the job and run it in a worker instead)."""
+        with self._wizard_command(moves=True):
+            return self.workflow.next()
+
+    def cancel_wizard(self) -> bool:
+        """Leave the open wizard (kept, resumable). True when it had no result yet (the caller
+        may say that nothing recorded is lost)."""
+        with self._wizard_command():
+            unfinished = self.workflow.result is None
+            self.workflow.cancel()
+            return unfinished
+
+    def resume_wizard(self, index: int | None = None) -> Wizard:
+        """Resume a calibration left half-way (``index`` in the runs; default the newest)."""
+        with self._wizard_command(moves=True):
+            return self.workflow.resume(index)
+
+    def mount_required_tool(self) -> ToolModel:
+        """The tool change the current step asks for."""
+        with self._wizard_command(moves=True):
+            return self.workflow.mount_required_tool()
+
+    def add_point(self) -> None:
+        """One more touch step (the wizards that declare ``supports_add_point``)."""
+        with self._wizard_command():
+            self.workflow.require_wizard().add_point()
+
+    def set_variant(self, variant: Any) -> None:
+        """Switch the open wizard's variant (one of its class's ``variants`` values)."""
+        with self._wizard_command():
+            self.workflow.require_wizard().set_variant(variant)
+
+    def set_training(self, on: bool) -> None:
+        """Training mode on or off (truth after a result, Auto-touch)."""
+        with self._wizard_command():
+            self.workflow.training = bool(on)
+
+    def save_result(self, name: str, slot: int | None = None) -> tuple[int, Tool]:
+        """"Save to tool library": the result on show as tool ``name`` (slot None: the slot with
+        that name, else the first free one); it becomes the active tool data."""
+        with self._wizard_command(moves=True):
+            return self.workflow.save(name, slot)
+
+    def edit_result(self, fn: Callable[[Wizard], Any]) -> Any:
+        """A change of the result on show that its wizard offers (the 4-point's estimator,
+        outlier drop, restore): ``fn(wizard)`` inside one ``wizard`` signal."""
+        with self._wizard_command():
+            return fn(self.workflow.require_wizard())
+
+    def wizard_signal(self, *, moves: bool = False) -> None:
+        """A ``wizard`` signal for a change the views keep themselves (a re-render after a
+        choice in a menu, a controller job's busy text)."""
+        with self._wizard_command(moves=moves):
+            pass
+
+    def set_hide_truth(self, hide: bool) -> None:
+        """A classroom exercise (True): no result shows the true TOOL frame or the error
+        against it, and the methods that measure the tool by themselves are refused."""
+        with self._wizard_command():
+            self.workflow.hide_truth = bool(hide)
+
+    def keep_honest_records(self) -> None:
+        """A classroom session: the session record this session exports carries no truth."""
+        with self.lock:
+            self.workflow.honest_records = True
+
+    def add_physical_tool(self, tool: ToolModel) -> None:
+        """Make ``tool`` one of the physical tools the wizards know (a classroom's mystery tool:
+        its label in a step's tool-change words)."""
+        with self._wizard_command():
+            self.workflow.tools[tool.key] = tool
+
+    def take_controller_job(self) -> Any:
+        """The controller job the wizard on show waits for before it can finish (None: none);
+        taken on the loop, run by the caller in a worker, handed back with
+        :meth:`hand_in_controller_job`."""
+        with self.lock:
+            wiz = self.workflow.wizard
+            if wiz is None or not wiz.on_last_step:
+                return None
+            return self.workflow.controller_job()
+
+    def hand_in_controller_job(self, job: Any, outcome: Any) -> WizardResult | None:
+        """The outcome of a controller job to its wizard (its result, if it finished)."""
+        with self._wizard_command(moves=True):
+            return self.workflow.give_controller_job(job, outcome)
+
+    def load_record(self, loaded: Any) -> Any:
+        """A session record read and replayed off the loop (``session_record.load_and_replay``)
+        added to the runs; returns its replay checks."""
+        with self._wizard_command():
+            return self.workflow.add_loaded(loaded)
 
     # ------------------------------------------------------------ touches
     def record_touch(self) -> Touch:
@@ -590,6 +834,6 @@ class Session:
         self.scene_labels.clear()
         self._pose_state = None
         self.calibrate_container = None
-        self.workflow = None
+        self.workflow.state = ControllerToolState(self.controller)   # no cycle back to the closed session
         self.client = None
         self.target = None

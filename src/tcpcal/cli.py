@@ -241,7 +241,7 @@ def build_parser() -> argparse.ArgumentParser:
     lib_parent.add_argument("--library", type=Path, default=argparse.SUPPRESS, metavar="PATH",
                             help=lib_help)
     tsub = tools.add_subparsers(dest="tools_cmd", required=True,
-                                metavar="{list,show,add,remove,activate,export}")
+                                metavar="{list,show,add,remove,activate,export,import}")
     tl = tsub.add_parser("list", parents=[lib_parent], help="the tool table")
     tl.add_argument("--json", action="store_true")
     ts = tsub.add_parser("show", parents=[lib_parent], help="one tool in detail")
@@ -282,6 +282,22 @@ def build_parser() -> argparse.ArgumentParser:
                     help=f"{'|'.join(_option_formats('register'))} file: the position register "
                     "the program overwrites (default 100)")
 
+    tool_readers = tuple(f.name for f in registered_formats(lambda f: f.parse_file is not None))
+    timp = tsub.add_parser("import", parents=[lib_parent],
+                           help="read a controller file's tool table into the library",
+                           description="Read the tool table of a controller file (KUKA "
+                           "$config.dat, ABB RAPID module, FANUC UTOOL program, URScript "
+                           "set_tcp, Yaskawa TOOL.CND: docs/formats.md) into the library. "
+                           "Slots are the controller's tool numbers (a file without numbers: "
+                           "the free slots in file order); names are kept (an entry without a "
+                           "name becomes tool<n>); unused entries (no name, all zero) are "
+                           "skipped. An occupied slot is never overwritten without --replace.")
+    timp.add_argument("file", metavar="FILE", type=Path)
+    timp.add_argument("--format", dest="fmt", default="auto", choices=("auto", *tool_readers),
+                      help="the controller (default auto: from the extension, else the content)")
+    timp.add_argument("--replace", action="store_true",
+                      help="overwrite the occupied slots the file's tools go into")
+
     # poses ---------------------------------------------------------------------------------
     poses_p = sub.add_parser("poses", help="touch poses from controller program files")
     psub = poses_p.add_subparsers(dest="poses_cmd", required=True, metavar="{import}")
@@ -289,7 +305,9 @@ def build_parser() -> argparse.ArgumentParser:
                           description="Read the recorded positions of a controller program "
                           f"file ({', '.join(pose_names)}: docs/formats.md) and "
                           "print them as POSES.csv for 'tcpcal solve'. Record the touches with "
-                          "no tool and no base active (the flange in WORLD).")
+                          "no tool and no base active (the flange in WORLD). Points in joint "
+                          "representation are skipped (tcpcal has no robot model): 'tcp-pendant "
+                          "poses import FILE --robot ...' converts them.")
     pim.add_argument("file", metavar="FILE", type=Path)
     pim.add_argument("--format", dest="fmt", default="auto",
                      choices=("auto", *pose_names),
@@ -569,6 +587,16 @@ def _tools_command(lib: Any, args: argparse.Namespace) -> int:
         _emit(f"Stored {args.name!r} in slot {args.slot}"
               f"{' (active)' if args.activate else ''} of {lib.path}")
         return 0
+    if cmd == "import":
+        from tcpcal.tools_import import import_tool_file
+
+        report = import_tool_file(lib, read_controller_text(args.file), args.fmt,
+                                  filename=args.file.name, replace=args.replace,
+                                  where=str(args.file))
+        for w in report.warnings:
+            print(f"tcpcal: warning: {args.file}: {w}", file=sys.stderr)
+        _emit(report.summary(lib.path))
+        return 0
     if cmd == "activate" and args.slot.strip().lower() in ("none", "0"):
         lib.activate(None)
         _emit("No active tool (TCP = flange).")
@@ -640,19 +668,36 @@ def _option_formats(option: str) -> list[str]:
     return [f.name for f in registered_formats(lambda f: option in f.file_options)]
 
 
+def read_controller_text(path: Path) -> str:
+    """A controller file's text: UTF-8 (a BOM dropped), else Latin-1 (controllers often write
+    it)."""
+    try:
+        return path.read_text(encoding="utf-8-sig", errors="strict")
+    except UnicodeDecodeError:
+        return path.read_text(encoding="latin-1")
+
+
 def _run_poses(args: argparse.Namespace) -> int:
     """``poses import FILE``: POSES.csv from a controller program file."""
-    from tcpcal.controllers import import_poses, poses_csv_text
+    from tcpcal.controllers import (
+        ROBOT_HINT,
+        import_poses,
+        poses_csv_text,
+        skipped_joints_warning,
+    )
 
-    try:
-        text = args.file.read_text(encoding="utf-8-sig", errors="strict")
-    except UnicodeDecodeError:
-        text = args.file.read_text(encoding="latin-1")  # controller files are often Latin-1
+    text = read_controller_text(args.file)
     try:
         imported = import_poses(text, args.fmt, filename=args.file.name)
     except TcpcalError as exc:
         raise CliInputError(f"{args.file}: {_one_line(str(exc))}") from None
-    for w in imported.warnings:
+    if not imported.poses:
+        n = len(imported.joint_points)
+        raise CliInputError(f"{args.file}: all {n} position{'s' if n != 1 else ''} of the file "
+                            f"{'are' if n != 1 else 'is'} in joint representation and tcpcal "
+                            f"has no robot model; {ROBOT_HINT}")
+    skipped = skipped_joints_warning(imported)
+    for w in (*imported.warnings, *([skipped] if skipped else [])):
         print(f"tcpcal: warning: {args.file}: {w}", file=sys.stderr)
     csv_text = poses_csv_text(imported)
     if args.output is None:

@@ -41,9 +41,12 @@ class DegenerateTouchesError(TcpcalError):
         unobservable_axis: unit vector in FLANGE coordinates along which the TCP cannot be
             observed (e.g. the common rotation axis of all touches), or ``None`` when no single
             axis describes the defect (e.g. all touches have the same orientation).
+        indices: the 0-based touches the defect is about (e.g. the two with the same
+            orientation), empty when it is about all of them.
     """
 
     unobservable_axis: np.ndarray | None
+    indices: tuple[int, ...]
 
     def __init__(
         self,
@@ -51,8 +54,10 @@ class DegenerateTouchesError(TcpcalError):
         *,
         unobservable_axis: np.ndarray | None = None,
         index: int | None = None,
+        indices: tuple[int, ...] = (),
     ) -> None:
         super().__init__(message, index=index)
+        self.indices = tuple(int(i) for i in indices)
         if unobservable_axis is None:
             self.unobservable_axis = None
         else:

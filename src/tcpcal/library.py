@@ -49,6 +49,7 @@ import re
 import tempfile
 import warnings
 from datetime import datetime, timezone
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -505,6 +506,46 @@ class ToolLibrary:
                 state.active = slot
 
         self._mutate(change)
+
+    def save_many(self, tools: Mapping[int, Tool]
+                  | Callable[[dict[int, Tool]], Mapping[int, Tool]]) -> dict[int, Tool]:
+        """Store several tools at once, in one locked change (all or nothing): each slot's
+        tool replaced; names must be unique in the table that results.
+
+        Args:
+            tools: slot -> tool, or a function that computes them under the lock from the
+                table as it is (slot -> tool); raising there changes nothing.
+
+        Returns:
+            The slots and tools stored.
+
+        Raises:
+            InvalidInputError: a bad slot number or not a Tool.
+            ToolLibraryError: two slots of the resulting table would hold the same name.
+        """
+        stored: dict[int, Tool] = {}
+
+        def change(state: _State) -> None:
+            given = tools(dict(state.tools)) if callable(tools) else tools
+            items = {_check_slot(slot, self.N_SLOTS): tool for slot, tool in given.items()}
+            for tool in items.values():
+                if not isinstance(tool, Tool):
+                    raise InvalidInputError(
+                        f"save_many() needs tcpcal.Tool values, got {type(tool).__name__}.")
+            result = {**state.tools, **items}
+            seen: dict[str, int] = {}
+            for slot in sorted(result):
+                name = result[slot].name
+                if name in seen:
+                    raise ToolLibraryError(
+                        f"the name {name!r} would be in slot {seen[name]} and slot {slot}; "
+                        "rename one of them first.")
+                seen[name] = slot
+            state.tools = result
+            stored.update(items)
+
+        self._mutate(change)
+        return stored
 
     def remove(self, slot: int) -> None:
         """Empty ``slot``; if it was the active tool, no tool is active afterwards.

@@ -186,6 +186,7 @@ def _check_observable(rotations: np.ndarray, info: Information, ext: AngleExtrem
                 f"4-point method needs at least {MIN_TOUCHES}; re-record touch {j} from a "
                 "different orientation.",
                 index=j,
+                indices=(i, j),
             )
 
 

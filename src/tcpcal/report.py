@@ -518,6 +518,8 @@ def format_tool(tool: Tool, *, slot: int | None = None, active: bool = False) ->
              f"  Orientation KUKA (deg): {_abc(tool.abc_deg)}"]
     if tool.mass_kg is not None:
         lines.append(f"  Mass: {tool.mass_kg:g} kg")
+    if tool.cog_mm is not None:
+        lines.append(f"  Centre of gravity in FLANGE (mm): {_xyz(tool.cog_mm)}")
     if tool.notes:
         lines.append(f"  Notes: {tool.notes}")
     cal = tool.calibration

@@ -20,6 +20,8 @@ this, so scripts may rely on these keys; they are a stable contract)::
       "tcp_mm": [12.5, 0.0, 180.25],        # TCP in FLANGE, mm
       "abc_deg": [0.0, -90.0, 0.0],         # KUKA A, B, C of R_flange_tool, degrees
       "mass_kg": 2.5,                       # float > 0, or null when unknown
+      "cog_mm": [0.0, 0.0, 80.0],           # optional: centre of gravity in FLANGE, mm
+                                            #   (written only when known)
       "notes": "",                          # str
       "calibration": null | {
         "method": "xyz4-lstsq",             # e.g. "xyz4-lstsq", "reference", "three-point-1",
@@ -29,9 +31,11 @@ this, so scripts may rely on these keys; they are a stable contract)::
       }
     }
 
-``from_dict`` accepts missing optional keys (``abc_deg``, ``mass_kg``, ``notes``,
+``from_dict`` accepts missing optional keys (``abc_deg``, ``mass_kg``, ``cog_mm``, ``notes``,
 ``calibration``) and rejects unknown keys, so a typo in a hand-edited file is reported instead
-of silently dropped. Every number must be finite (JSON has no NaN).
+of silently dropped. Every number must be finite (JSON has no NaN). ``cog_mm`` is written only
+for a tool that has one, so the file of a tool without it is the same as before the key
+existed.
 """
 
 from __future__ import annotations
@@ -62,7 +66,7 @@ __all__ = [
 MAX_NAME_LENGTH: int = 24
 """Longest tool name, as on a KUKA controller (``TOOL_NAME[n, 24]``)."""
 
-_TOOL_KEYS = ("name", "tcp_mm", "abc_deg", "mass_kg", "notes", "calibration")
+_TOOL_KEYS = ("name", "tcp_mm", "abc_deg", "mass_kg", "cog_mm", "notes", "calibration")
 _CALIBRATION_KEYS = ("method", "calibrated_at", "figures")
 
 
@@ -251,6 +255,8 @@ class Tool:
         tcp_mm: TCP in FLANGE coordinates, mm (3 finite floats).
         abc_deg: KUKA A, B, C of ``R_flange_tool``, degrees (3 finite floats).
         mass_kg: tool mass in kg (> 0) or None when unknown.
+        cog_mm: the tool's centre of gravity in FLANGE coordinates, mm (3 finite floats), or
+            None when unknown (a controller's load data: Yaskawa ``TOOL.CND``, ABB ``tload``).
         notes: free text.
         calibration: how and when it was calibrated, or None (e.g. typed in).
 
@@ -264,6 +270,7 @@ class Tool:
     mass_kg: float | None = None
     notes: str = ""
     calibration: Calibration | None = None
+    cog_mm: tuple[float, float, float] | None = None
 
     def __post_init__(self) -> None:
         _check_name(self.name)
@@ -276,6 +283,8 @@ class Tool:
                     f"mass_kg must be positive (kg) or None when unknown, got {mass!r}."
                 )
             object.__setattr__(self, "mass_kg", mass)
+        if self.cog_mm is not None:
+            object.__setattr__(self, "cog_mm", _triple(self.cog_mm, "cog_mm"))
         if not isinstance(self.notes, str):
             raise InvalidInputError(f"notes must be a string, got {self.notes!r}.")
         if self.calibration is not None and not isinstance(self.calibration, Calibration):
@@ -307,7 +316,7 @@ class Tool:
             tcp_mm: TCP in FLANGE, mm.
             rotation: ``R_flange_tool``; checked with :func:`tcpcal.validation.as_rotation`
                 (orthonormal within 1e-6, det +1).
-            **kw: ``mass_kg``, ``notes``, ``calibration``.
+            **kw: ``mass_kg``, ``cog_mm``, ``notes``, ``calibration``.
         """
         R = as_rotation(rotation, name="rotation")
         abc = abc_deg_from_rotation(R)
@@ -316,14 +325,17 @@ class Tool:
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dict with the stable keys documented in the module docstring."""
-        return {
+        out: dict[str, Any] = {
             "name": self.name,
             "tcp_mm": list(self.tcp_mm),
             "abc_deg": list(self.abc_deg),
             "mass_kg": self.mass_kg,
-            "notes": self.notes,
-            "calibration": None if self.calibration is None else self.calibration.to_dict(),
         }
+        if self.cog_mm is not None:
+            out["cog_mm"] = list(self.cog_mm)
+        out["notes"] = self.notes
+        out["calibration"] = None if self.calibration is None else self.calibration.to_dict()
+        return out
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> Tool:
@@ -349,6 +361,7 @@ class Tool:
             tcp_mm=d["tcp_mm"],
             abc_deg=d.get("abc_deg", (0.0, 0.0, 0.0)),
             mass_kg=d.get("mass_kg"),
+            cog_mm=d.get("cog_mm"),
             notes=d.get("notes", ""),
             calibration=None if cal is None else Calibration.from_dict(cal),
         )

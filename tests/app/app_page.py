@@ -75,15 +75,15 @@ def running_pendants(tmp_path: Path) -> Iterator[Callable[..., PendantApp]]:
 @contextmanager
 def app_pages(tmp_path: Path, page_cls: type[P], *, seed: int | None = None) -> Iterator[Callable[..., P]]:
     """``make(tools=None, **config)``: start a pendant (:func:`running_pendants`) and connect a
-    ``page_cls`` browser to it; the workflow's auto-touch generator seeded with ``seed`` (if
-    given). Everything stops at exit."""
+    ``page_cls`` browser to it; the server started with ``seed`` (``AppConfig.seed``, the
+    ``--seed`` option: every session's randomness), if given. Everything stops at exit."""
     pages: list[P] = []
     with running_pendants(tmp_path) as start:
 
         def make(tools: dict[int, Tool] | None = None, **config: Any) -> P:
-            p = page_cls(start(tools, **config))
             if seed is not None:
-                p.session.views["calibrate"].workflow.rng = np.random.default_rng(seed)
+                config.setdefault("seed", seed)
+            p = page_cls(start(tools, **config))
             pages.append(p)
             return p
 

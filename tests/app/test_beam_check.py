@@ -29,7 +29,7 @@ class Page(AppPage):
         super().__init__(app)
         self.tools = self.session.views["tools"]
         self.beam = self.session.views["beam_check"]
-        ScanPlayer.of(self.session).rate_hz = 400.0                  # the film, fast
+        self.session.views["beam_player"].rate_hz = 400.0                  # the film, fast
 
     def activate(self, slot: int) -> None:
         opt = next(o for o in self.tools.slots.options if o.startswith(f"{slot}:") or o.startswith(f"{slot} "))
@@ -37,7 +37,7 @@ class Page(AppPage):
         self.click(self.tools.activate)
 
     def film_done(self) -> None:
-        wait_until(lambda: not ScanPlayer.of(self.session).playing, timeout=60, what="the scan's film")
+        wait_until(lambda: not self.session.views["beam_player"].playing, timeout=60, what="the scan's film")
 
 
 @pytest.fixture
@@ -59,14 +59,14 @@ def test_check_with_beam_is_off_in_an_exercise(page) -> None:
     from tcp_pendant.wizards import WizardError
     p = page({1: truth_tool("pointer", "Pointer")})
     p.activate(1)
-    p.session.workflow.hide_truth = True
+    p.session.set_hide_truth(True)
     p.click(p.beam.check)
     assert p.notes[-1][0] == "Not done" and "off during the trainer's exercise" in p.notes[-1][1]
-    assert p.beam.last_check is None and not ScanPlayer.of(p.session).playing
+    assert p.beam.last_check is None and not p.session.views["beam_player"].playing
     with pytest.raises(WizardError, match="Automatic \\(beam\\) wizard is off during the trainer's exercise"):
-        p.session.workflow.start("beam")
-    assert p.session.workflow.start("xyz4").kind == "xyz4"          # touching is the exercise
-    p.session.workflow.hide_truth = False
+        p.session.start_wizard("beam")
+    assert p.session.start_wizard("xyz4").kind == "xyz4"            # touching is the exercise
+    p.session.set_hide_truth(False)
     p.click(p.beam.check)
     assert p.beam.last_check is not None
 
@@ -90,7 +90,7 @@ def test_the_industrial_loop_crash_check_update_verify(page) -> None:
     md = p.beam.result_md.content
     assert "Beam check of Pointer" in md and f"Deviation **{check.deviation_norm_mm:.3f} mm**" in md
     assert not p.beam.update.disabled and not p.beam.replay.disabled
-    assert ScanPlayer.of(s).scan is check.scan                      # the scan plays in the scene
+    assert s.views["beam_player"].scan is check.scan                      # the scan plays in the scene
     f = p.beam.framing                                              # and the camera looks at it
     to_sensor = np.asarray(c.beam_sensor.point) - f.position
     forward = (f.look_at - f.position) / np.linalg.norm(f.look_at - f.position)
@@ -167,7 +167,7 @@ def test_a_second_check_during_the_film_returns_to_where_the_first_started(page)
     p.activate(1)
     c = p.session.controller
     q_home = c.q_rad
-    player = ScanPlayer.of(p.session)
+    player = p.session.views["beam_player"]
     player.rate_hz = 4.0                                            # the first film, slow
     p.click(p.beam.check)
     wait_until(lambda: player.frames_played >= 3, what="the first film under way")
@@ -208,14 +208,14 @@ def test_shared_mode_checks_and_updates_the_one_robot(tmp_path: Path) -> None:
     try:
         wait_until(lambda: len(app.server.get_clients()) == 2, what="two browsers")
         s = app.shared_session
-        ScanPlayer.of(s).rate_hz = 400.0
+        s.views["beam_player"].rate_hz = 400.0
         view = s.views["beam_check"]
         a, _b = app.server.get_clients().values()
         s.notify = lambda *args, **kw: None                          # type: ignore[method-assign]
         assert s.active_slot == 1
         click(view.check, a)
         assert view.last_check.deviation_norm_mm == pytest.approx(1.0, abs=0.05)
-        wait_until(lambda: not ScanPlayer.of(s).playing, timeout=60, what="the film")
+        wait_until(lambda: not s.views["beam_player"].playing, timeout=60, what="the film")
         click(view.update, a)
         np.testing.assert_allclose(app.library.get(1).tcp_mm, truth_tool("pointer", "x").tcp_mm, atol=0.05)
         assert app.library.active_slot() == 1                        # --shared: the library's active slot

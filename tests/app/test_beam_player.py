@@ -63,8 +63,10 @@ def fake_scan(p: Page) -> SimpleNamespace:
 
 def test_the_film_moves_the_robot_through_the_scan_and_leaves_it_at_the_end(page) -> None:
     p = page()
-    player = ScanPlayer.of(p.session)
-    assert ScanPlayer.of(p.session) is player                     # one per session
+    player = p.session.views["beam_player"]
+    views = p.session.views                                          # one per session, handed to each
+    assert views["scene"].player is player and views["beam_check"].player is player
+    assert views["calibrate"].scene.player is player
     player.rate_hz = 200.0
     scan = fake_scan(p)
     seen: list[tuple[np.ndarray, bool]] = []
@@ -87,7 +89,7 @@ def test_the_film_moves_the_robot_through_the_scan_and_leaves_it_at_the_end(page
 
 def test_a_jog_during_the_film_stops_it_where_the_user_put_the_robot(page) -> None:
     p = page()
-    player = ScanPlayer.of(p.session)
+    player = p.session.views["beam_player"]
     player.rate_hz = 4.0
     scan = fake_scan(p)
     p.on_loop(lambda: player.play(scan))
@@ -106,7 +108,7 @@ def test_a_jog_during_the_film_stops_it_where_the_user_put_the_robot(page) -> No
 
 def test_off_the_loop_the_last_frame_is_shown_at_once(page) -> None:
     p = page()
-    player = ScanPlayer.of(p.session)
+    player = p.session.views["beam_player"]
     scan = fake_scan(p)
     home = p.session.controller.q_rad
     player.play(scan, return_to=home)                             # a test's own thread: no running loop
@@ -117,7 +119,7 @@ def test_off_the_loop_the_last_frame_is_shown_at_once(page) -> None:
 
 def test_a_stored_scan_without_moves_only_shows_its_markers(page) -> None:
     p = page()
-    player = ScanPlayer.of(p.session)
+    player = p.session.views["beam_player"]
     live = fake_scan(p)
     q = p.session.controller.q_rad
     stored = SimpleNamespace(events=live.events, moves=(), q_end_rad=None)     # a record's RecordedScan
@@ -132,7 +134,7 @@ def test_a_stored_scan_without_moves_only_shows_its_markers(page) -> None:
 def test_the_gizmo_and_the_tool_triad_step_aside_while_the_film_plays(page) -> None:
     p = page()
     scene = p.session.views["scene"]
-    player = ScanPlayer.of(p.session)
+    player = p.session.views["beam_player"]
     player.rate_hz = 5.0
     scan = fake_scan(p)
     assert scene.gizmo.visible

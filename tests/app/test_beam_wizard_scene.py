@@ -26,7 +26,7 @@ class Page(AppPage):
     def __init__(self, app) -> None:
         super().__init__(app)
         self.view = self.session.views["calibrate"]
-        self.player = ScanPlayer.of(self.session)
+        self.player = self.session.views["beam_player"]
         self.player.rate_hz = 400.0
 
     def xyz4_by_hand(self) -> None:
@@ -93,7 +93,7 @@ def test_the_beam_result_is_replayed_framed_and_compared_with_the_manual_one(pag
     # the result: events, real-robot time next to the manual time, the errors of both vs truth
     text = v.result.result_md.content
     assert f"**Events** ({len(scan.events)})" in text
-    assert "on a real robot" in text and "(your time)" in text
+    assert "on a real robot" in text and "(by Auto-touch)" in text and "(Auto-touch's clicks)" in text
     assert "| calibration | time | TCP error | direction error |" in text
     assert v.result.replay_scan.visible
 
@@ -117,7 +117,7 @@ def test_in_an_exercise_the_beam_is_off_and_says_why(page) -> None:
     """The classroom's exercise hides the truth and asks for a calibration by touching: the
     Automatic (beam) wizard would measure the mystery tool, so Start refuses it in words."""
     p = page()
-    p.view.workflow.hide_truth = True                                 # the classroom's exercise
+    p.session.set_hide_truth(True)                                    # the classroom's exercise
     p.xyz4_by_hand()
     n_runs = len(p.view.workflow.runs)
     p.choose(p.view.method, "Automatic (beam)")

@@ -12,13 +12,15 @@ def test_defaults() -> None:
     a = build_parser().parse_args([])
     assert (a.robot, a.tool, a.host, a.port, a.shared, a.reference_tip) == ("kr6", "pointer", "127.0.0.1", 8080,
                                                                              False, None)
+    assert a.seed is None and build_parser().parse_args(["--seed", "42"]).seed == 42
 
 
 @pytest.mark.parametrize("argv,needle", [(["--robot", "nope"], "Unknown robot"),
                                          (["--robot", "/no/such.urdf"], "not found"),
                                          (["--reference-tip", "1,2"], "X,Y,Z"),
                                          (["--flange-link", "hand"], "no link 'hand'"),
-                                         (["--port", "70000"], "--port")])
+                                         (["--port", "70000"], "--port"),
+                                         (["--seed", "-3"], "seed must be a whole number >= 0")])
 def test_bad_options_exit_2_with_message(argv: list[str], needle: str, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(argv) == 2
     assert needle in capsys.readouterr().err

@@ -17,7 +17,7 @@ from wsclient import DrainingClient
 
 
 def test_ur5_session_starts_over_a_visible_tip_and_calibrates(app_factory) -> None:
-    app = app_factory(robot=str(example_robot_urdf()))
+    app = app_factory(robot=str(example_robot_urdf()), seed=1)
     assert app.kinematics.flange_link == "tool0"
     tip = app.reference_tip_m
     assert tip[2] >= MIN_TIP_HEIGHT_M                        # the stand is above the floor
@@ -32,13 +32,12 @@ def test_ur5_session_starts_over_a_visible_tip_and_calibrates(app_factory) -> No
         with s.lock:                                         # jogs like the KR 6 (not singular)
             for axis in ("X", "Y", "Z"):
                 assert c.jog_cartesian(JogFrame.WORLD, axis, -10.0).ok, axis
-        # a 4-point calibration through the Calibrate tab's workflow gives the pointer's true TCP
-        wf = s.views["calibrate"].workflow
-        wf.rng = np.random.default_rng(1)
+        # a 4-point calibration by the session's commands gives the pointer's true TCP
+        wf = s.workflow
         with s.lock:
-            wf.start_xyz4()
+            s.start_wizard("xyz4")
             for _ in range(4):
-                assert wf.auto_touch(AutoTouchRequest()).ok
+                assert s.auto_touch(AutoTouchRequest()).ok
         true_tcp = builtin_tools()["pointer"].T_flange_tool_true[:3, 3] * 1000.0
         np.testing.assert_allclose(wf.result.tcp_mm, true_tcp, atol=1e-6)
         assert wf.export_record()["robot"]["name"] == "ur5_robot"

@@ -279,13 +279,13 @@ def test_reference_wizard_under_a_bent_tool_is_graded_against_the_bent_new_tool(
     s.library.save(1, Tool.from_rotation("Pointer", tuple(T[:3, 3] * 1000.0), T[:3, :3]))
     s.reload_library()
     wf = p.calibrate.workflow
-    wf.start_reference(reference_slot=1, reference_tool_key="pointer", new_tool_key="torch")
-    wf.auto_touch(AutoTouchRequest())
-    wf.mount_required_tool()
+    s.start_wizard("reference", slot=1, reference_tool_key="pointer", new_tool_key="torch")
+    s.auto_touch(AutoTouchRequest())
+    s.mount_required_tool()
     torch = c.mounted_tool
     bent_mm = np.linalg.norm(torch.T_flange_tool_true[:3, 3] - builtin_tools()["torch"].T_flange_tool_true[:3, 3])
     assert torch.key == "torch" and bent_mm * 1000.0 > 2.0           # the bent torch is on the flange
-    wf.auto_touch(AutoTouchRequest())
+    s.auto_touch(AutoTouchRequest())
     res, truth = wf.result, wf.truth()
     assert res is not None and truth is not None
     np.testing.assert_allclose(res.tcp_mm, torch.T_flange_tool_true[:3, 3] * 1000.0, atol=1e-6)

@@ -432,23 +432,22 @@ def wizard_touches(sessions: list[Any], per_session: int) -> dict[str, float]:
     Returns thread CPU per touch (median; the Record click: workflow, every view's re-render,
     with the classroom the recorder's gradebook write), its wall time (median, p95: the event
     loop is blocked that long; includes the write's fsync) and process CPU per touch."""
-    workflows = [s.views["calibrate"].workflow for s in sessions]
-    for s, wf in zip(sessions, workflows):
-        _in_action(s, lambda wf=wf: wf.start_xyz4())
+    for s in sessions:
+        _in_action(s, lambda s=s: s.start_wizard("xyz4"))
     time.sleep(0.3)
     cpu: list[float] = []
     wall: list[float] = []
     p0 = time.process_time()
     for _ in range(per_session):
-        for s, wf in zip(sessions, workflows):
+        for s in sessions:
             t0, w0 = time.thread_time(), time.perf_counter()
-            _in_action(s, wf.record)
+            _in_action(s, s.record_step)
             cpu.append(time.thread_time() - t0)
             wall.append(time.perf_counter() - w0)
     time.sleep(0.3)
     process = time.process_time() - p0
-    for s, wf in zip(sessions, workflows):
-        _in_action(s, wf.cancel)
+    for s in sessions:
+        _in_action(s, s.cancel_wizard)
     time.sleep(0.3)
     n = len(cpu)
     return {"thread_ms": float(np.median(cpu)) * 1e3, "wall_ms": float(np.median(wall)) * 1e3,

@@ -44,9 +44,9 @@ def row_text(page, first_cell: str) -> str:
 def test_automatic_beam_wizard_next_to_the_manual_calibration(server, new_page, shot) -> None:
     page = new_page(server.url)
     open_calibrate(page)
-    press(page, "Start")                                      # XYZ 4-point by hand (Auto-touch)
+    press(page, "Start")                                      # XYZ 4-point by Auto-touch
     auto_touch_to_result(page, 4)
-    press(page, "Close (resume later)")
+    press(page, "Close (not saved)")
 
     choose(page, "Method", "Automatic (beam)", "BullsEye")
     wait_enabled(page, "Start")
@@ -67,8 +67,8 @@ def test_automatic_beam_wizard_next_to_the_manual_calibration(server, new_page, 
     assert m, beam_row
     assert 5.0 < float(m.group(1)) < 60.0                     # seconds, as a BullsEye takes
     assert float(m.group(2)) < 0.1, beam_row                  # the beam's TCP error vs truth
-    hand_row = row_text(page, "XYZ 4-point (by hand)")
-    assert "(your time)" in hand_row and re.search(r"\d+\.\d+ mm", hand_row), hand_row
+    hand_row = row_text(page, "XYZ 4-point (by Auto-touch)")     # the four touches were Auto-touch's
+    assert "(Auto-touch's clicks)" in hand_row and re.search(r"\d+\.\d+ mm", hand_row), hand_row
     wait_text(page, "Against the true TOOL frame: good")
     press(page, "Replay scan")                                # the film again (the robot goes through it)
     page.wait_for_timeout(1500)

@@ -44,3 +44,17 @@ def library_tool_with_true_tcp(tool_key: str, name: str) -> Tool:
     """Library data of a tool whose TCP was calibrated exactly (orientation not yet: A=B=C=0)."""
     tcp, _, _ = true_frame(tool_key)
     return Tool(name=name, tcp_mm=tuple(float(v) for v in tcp))
+
+
+def make_session(library_path, *, robot: str = "kr6", tool_key: str = "pointer", seed: int = 0):
+    """A pendant session without a browser (no views; ``target`` None): a controller as
+    :func:`make_controller`, its workflow seeded with ``seed``; every command is the session's."""
+    from tcp_pendant.calibrate import CalibrationWorkflow
+    from tcp_pendant.session import Session
+
+    from tcpcal.library import ToolLibrary
+
+    c = make_controller(robot, tool_key)
+    library = ToolLibrary(library_path)
+    rng = np.random.default_rng(seed)
+    return Session(c, library, CalibrationWorkflow(c, library, robot=robot, rng=rng), rng=rng)

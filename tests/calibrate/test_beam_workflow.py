@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 from tcp_pendant.calibrate import AutoTouchRequest, CalibrationWorkflow
 from tcp_pendant.calibrate.text import duration_words, result_markdown
-from tcp_pendant.calibrate.workflow import BeamScanJob, TcpCheckJob
+from tcp_pendant.calibrate.jobs import BeamScanJob, TcpCheckJob
 from tcp_pendant.controller import builtin_tools
 from tcp_pendant.controller.beam import BeamSensor
 from tcp_pendant.controller.scenarios import ToolBend, bent_tool
@@ -121,10 +121,20 @@ def test_compared_with_the_last_manual_calibration_of_the_same_tool(workflow) ->
     assert m.position_error_mm == pytest.approx(manual_truth.position_error_mm, abs=1e-12)
     assert m.direction_error_deg is None and m.grade == manual_truth.grade and m.wall_time_s >= 0.0
     text = result_markdown(res, wf.truth())
-    assert f"| 2: {escape_markdown('XYZ 4-point')} (by hand) |" in text and f"{manual_truth.position_error_mm:.3f} mm" in text
+    # Auto-touch did the four touches: the lesson says so (it called them "by hand", "your time")
+    assert m.touches == 4 and m.auto_touches == 4
+    assert f"| 2: {escape_markdown('XYZ 4-point')} (by Auto-touch) |" in text and f"{manual_truth.position_error_mm:.3f} mm" in text
+    assert "(Auto-touch's clicks)" in text and "by hand)" not in text and "your time" not in text
     assert f"| Automatic (beam) | {duration_words(res.duration_s)} on a real robot | 0.000 mm |" in text
     no_truth = result_markdown(res)                       # where the truth may not be shown
-    assert "TCP error" not in no_truth and "(your time)" in no_truth
+    assert "TCP error" not in no_truth and "(Auto-touch's clicks)" in no_truth
+    wf.resume(1)                                          # touch 4 again, by hand: a mixed run
+    wf.back()
+    wf.record()
+    wf.next()
+    mixed = scan(wf).manual
+    assert (mixed.touches, mixed.auto_touches) == (4, 3)
+    assert "(3 of 4 touches by Auto-touch)" in result_markdown(scan(wf)) and "(your time)" in result_markdown(scan(wf))
     # another tool's manual calibration does not count; an exercise computes no errors
     wf.controller.mount_tool(builtin_tools()["torch"])
     assert scan(wf).manual is None

@@ -45,7 +45,7 @@ def test_four_auto_touches_run_a_4point_calibration_and_every_view_follows(page)
     assert progress == pytest.approx([0.0, 20.0, 40.0, 60.0, 100.0])
     res = v.workflow.result
     assert v.result.folder.visible and not v.steps.record.visible and not v.steps.meter_bar.visible
-    assert v.steps.cancel.label == "Close (resume later)"
+    assert v.steps.cancel.label == "Close (not saved)"
     tcp_true, _, _ = true_frame("pointer")
     assert f"X {tcp_true[0]:.2f} · Y {tcp_true[1]:.2f} · Z {tcp_true[2]:.2f} mm" in v.result.result_md.content.replace("-0.00", "0.00")
     assert "Against the true TOOL frame: good" in v.result.truth_md.content and v.result.truth_md.visible
@@ -82,7 +82,7 @@ def test_four_auto_touches_run_a_4point_calibration_and_every_view_follows(page)
     assert "Active tool:** Pen 4P (slot 1)" in s.views["tools"].active_md.content
     assert ToolLibrary(s.library.path).active_slot() is None     # per-browser: the file's is not touched
 
-    # close: the menu is back; the saved run is done, so nothing waits in "Left half-way"
+    # close: the menu is back; the saved run is done, so nothing waits to be resumed
     assert v.steps.cancel.label == "Close"
     p.click(v.steps.cancel)
     assert v.menu_folder.visible and not v.resume.visible and not v.scene.computed.visible
@@ -284,3 +284,25 @@ def test_shared_mode_export_goes_to_the_browser_that_clicked(tmp_path: Path) -> 
         for w in ws:
             w.close()
         app.stop()
+
+
+def test_resume_names_what_it_brings_back_and_offers_the_choice(page) -> None:
+    """Resume said neither which calibration nor where; with two left, the button names the
+    chosen one and brings back exactly that one."""
+    p = page()
+    v, s = p.view, p.session
+    p.click(v.start)                                              # 1: XYZ 4-point, one touch
+    p.click(v.steps.auto_touch)
+    p.click(v.steps.cancel)
+    assert v.resume.visible and v.resume.label == "Resume 1: XYZ 4-point, at step 2 of 4 (1 recorded)"
+    p.choose(v.method, "TCP & Z, X (ABB)")
+    p.click(v.start)                                              # 2: TCP & Z, X, nothing recorded
+    p.click(v.steps.cancel)
+    options = tuple(v.resume_list.options)
+    assert [o.split(", started")[0] for o in options] == [
+        "2: TCP & Z, X (ABB), at step 1 of 6 (0 recorded)", "1: XYZ 4-point, at step 2 of 4 (1 recorded)"]
+    assert v.resume.label == "Resume 2: TCP & Z, X (ABB), at step 1 of 6 (0 recorded)"
+    p.choose(v.resume_list, options[1])
+    assert v.resume.label == "Resume 1: XYZ 4-point, at step 2 of 4 (1 recorded)"
+    p.click(v.resume)
+    assert s.workflow.run is s.workflow.runs[0] and s.workflow.wizard.step_index == 1

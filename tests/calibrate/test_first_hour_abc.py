@@ -21,7 +21,7 @@ def abc_errors(workflow, library, sigma_mm: float, n: int, tool: str = "torch") 
     wf = workflow(tool=tool, seed=11)
     errs, messages = [], []
     for _ in range(n):
-        wf.start_abc_world(slot=1)
+        wf.start("abc-world", slot=1)
         out = wf.auto_touch(AutoTouchRequest(sigma_mm=sigma_mm))
         assert out.ok, out.message
         messages.append(out.message)

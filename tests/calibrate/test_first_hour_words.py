@@ -3,13 +3,15 @@ orientation wizards offer first."""
 
 from __future__ import annotations
 
+import re
 import sys
+from datetime import datetime
 from pathlib import Path
 
 import pytest
 from tcp_pendant.calibrate import AutoTouchRequest
 from tcp_pendant.calibrate.library_choice import default_library_slot
-from tcp_pendant.calibrate.text import METHOD_BLURBS
+from tcp_pendant.wizards import wizard_classes
 from tcp_pendant.wizards import WizardStateError
 
 from tcpcal.tool import Tool
@@ -25,14 +27,14 @@ def run_auto(wf) -> None:
 
 
 def test_method_blurbs_point_at_no_file_the_trainee_cannot_open() -> None:
-    for kind, text in METHOD_BLURBS.items():
-        assert "methods.md" not in text and "section" not in text, kind
+    for cls in wizard_classes():
+        assert "methods.md" not in cls.blurb and "section" not in cls.blurb, cls.kind
 
 
 def test_tool_change_is_asked_for_by_the_tools_labels(workflow, library) -> None:
     library.save(1, library_tool_with_true_tcp("pointer", "Pointer"))
     wf = workflow(tool="pointer")
-    wiz = wf.start_reference(reference_slot=1, reference_tool_key="pointer", new_tool_key="torch")
+    wiz = wf.start("reference", slot=1, reference_tool_key="pointer", new_tool_key="torch")
     wf.auto_touch(AutoTouchRequest())
     assert wiz.blocked_reason == "Mount the bent-neck welding torch first: the straight pointer is mounted now."
     assert "'" not in wiz.blocked_reason and "torch'" not in wiz.blocked_reason
@@ -40,7 +42,7 @@ def test_tool_change_is_asked_for_by_the_tools_labels(workflow, library) -> None
 
 def test_auto_touch_reports_a_sentence(workflow) -> None:
     wf = workflow()
-    wf.start_xyz4()
+    wf.start("xyz4")
     out = wf.auto_touch(AutoTouchRequest())
     assert out.message.startswith("Step 1 recorded: Touch 1 (tilt ") and out.message.endswith("°).")
 
@@ -48,7 +50,7 @@ def test_auto_touch_reports_a_sentence(workflow) -> None:
 def test_three_point_auto_touch_message_reads_as_a_sentence(workflow, library) -> None:
     library.save(1, library_tool_with_true_tcp("pointer", "Pointer"))
     wf = workflow()
-    wf.start_three_point(slot=1)
+    wf.start("three-point", slot=1)
     out = wf.auto_touch(AutoTouchRequest())
     assert out.message.startswith("Step 1 recorded: Touch the reference tip (tilt ")
     assert "Recorded touch the" not in out.message
@@ -56,16 +58,19 @@ def test_three_point_auto_touch_message_reads_as_a_sentence(workflow, library) -
 
 def test_left_half_way_lists_only_runs_still_to_do(workflow) -> None:
     wf = workflow()
-    wf.start_xyz4()
+    wf.start("xyz4")
     run_auto(wf)
     wf.save("Pen")                                   # run 1: finished and saved
-    wf.start_xyz4()
+    wf.start("xyz4")
     run_auto(wf)                                     # run 2: finished, not saved
-    wf.start_xyz4()
+    wf.start("xyz4")
     wf.auto_touch(AutoTouchRequest())                # run 3: half-way
-    wf.start_xyz4()                                  # run 4 open: the others are cancelled
-    labels = [label for _, label in wf.resumable()]
-    assert labels == ["3: XYZ 4-point, 1 of 4 recorded", "2: XYZ 4-point, finished, not saved"]
+    wf.start("xyz4")                                  # run 4 open: the others are cancelled
+    labels = [re.sub(r"started \d\d:\d\d$", "started HH:MM", label) for _, label in wf.resumable()]
+    assert labels == ["3: XYZ 4-point, at step 2 of 4 (1 recorded), started HH:MM",
+                      "2: XYZ 4-point, result not saved, started HH:MM"]
+    started = datetime.fromisoformat(wf.runs[2].wizard.started_at.replace("Z", "+00:00")).astimezone()
+    assert wf.resumable()[0][1].endswith(started.strftime("%H:%M"))      # the server's local time
     assert wf.resume().kind == "xyz4" and wf.run is wf.runs[2]          # newest still to do
     wf.resume(1)                                     # the unsaved result can be saved later
     assert wf.result is not None and not wf.result_saved
@@ -79,13 +84,13 @@ def test_left_half_way_lists_only_runs_still_to_do(workflow) -> None:
 
 def test_a_saved_run_changed_afterwards_is_listed_again(workflow) -> None:
     wf = workflow()
-    wf.start_xyz4()
+    wf.start("xyz4")
     run_auto(wf)
     wf.save("Pen")
     wf.back()                                        # a step back: the saved result no longer stands
     wf.next()                                        # finished again: a new result, not saved
     wf.cancel()
-    assert [label for _, label in wf.resumable()] == ["1: XYZ 4-point, finished, not saved"]
+    assert [label.split(", started")[0] for _, label in wf.resumable()] == ["1: XYZ 4-point, result not saved"]
 
 
 class _T:
@@ -144,3 +149,55 @@ def test_tool_data_defaults_to_the_active_slot_not_slot_1(tmp_path) -> None:
     finally:
         p.ws.close()
         app.stop()
+
+
+def test_the_4_point_steps_ask_for_what_the_meter_can_reward() -> None:
+    """Touch 2 is the first tilt (no 'different axis than before' when nothing was tilted),
+    touch 3 asks for another axis, and every tilt asked for is the least the meter calls far
+    enough (``MIN_TILT_DEG``)."""
+    from tcp_pendant.calibrate.diversity import MIN_TILT_DEG
+    from tcp_pendant.wizards import Xyz4Wizard
+
+    steps = Xyz4Wizard(n_points=4).steps
+    assert "about one axis" in steps[1].instruction and "before" not in steps[1].instruction
+    assert "another axis than for touch 2" in steps[2].instruction
+    for step in steps[1:]:
+        assert f"{MIN_TILT_DEG:.0f} to 60 degrees" in step.instruction, step.index
+
+
+def test_the_touch_list_points_at_the_wizards_touches(tmp_path) -> None:
+    """With no free touch but four wizard touches the Jog tab's Touches list does not say
+    'No touch recorded' (it did): it says where they are."""
+    from calib_helpers import make_session
+    from tcp_pendant.calibrate.text import empty_touches_markdown
+
+    s = make_session(tmp_path / "tools.json", seed=4)
+    assert empty_touches_markdown(s.workflow.wizard) == "*No touch recorded.*"
+    s.start_wizard("xyz4")
+    for _ in range(4):
+        s.auto_touch(AutoTouchRequest())
+    text = empty_touches_markdown(s.workflow.wizard)
+    assert "No touch recorded with Record point" in text and "has 4 touches of its own" in text
+    s.cancel_wizard()
+    assert empty_touches_markdown(s.workflow.wizard) == "*No touch recorded.*"
+
+
+def test_exact_touches_are_not_called_outside_the_95_percent_radius(tmp_path) -> None:
+    """sigma 0: an error of ~1e-12 mm next to a radius of ~1e-13 mm was 'outside the 95 %
+    radius' beside '0.000 mm, good'."""
+    from calib_helpers import make_session
+    from tcp_pendant.calibrate.text import truth_markdown
+
+    s = make_session(tmp_path / "tools.json", seed=6)
+    s.start_wizard("xyz4")
+    while s.workflow.result is None:
+        s.auto_touch(AutoTouchRequest(sigma_mm=0.0))
+    truth = s.workflow.truth()
+    assert truth.position_error_mm < 1e-6 and truth.inside_ci95 is True and truth.grade == "good"
+    md = truth_markdown(truth)
+    assert "outside" not in md and "the computed TCP is the true one" in md
+    s.back()                                     # a touch 2 mm off: a real error, judged as before
+    s.auto_touch(AutoTouchRequest(sigma_mm=2.0))
+    noisy = s.workflow.truth()
+    assert noisy.position_error_mm > 1e-3
+    assert ("inside" if noisy.inside_ci95 else "**outside**") in truth_markdown(noisy)

@@ -37,6 +37,7 @@ def server(tmp_path: Path) -> Iterator[Callable[..., PendantApp]]:
     pages: list[Page] = []
 
     def make(**kw: Any) -> PendantApp:
+        kw.setdefault("seed", 5)
         app = PendantApp(AppConfig(port=0, tool_library=tmp_path / "tools.json", library_poll_s=0.1, **kw))
         app.start()
         apps.append(app)
@@ -52,7 +53,6 @@ def server(tmp_path: Path) -> Iterator[Callable[..., PendantApp]]:
 
 def _page(server: Any, app: PendantApp) -> Page:
     p = Page(app)
-    p.view.workflow.rng = np.random.default_rng(5)
     server.pages.append(p)
     return p
 

@@ -6,6 +6,8 @@ not graded against truth, not saveable, and the session record replays it."""
 
 from __future__ import annotations
 
+from tcp_pendant.text_escape import escape_markdown
+
 import json
 import sys
 from pathlib import Path
@@ -82,9 +84,9 @@ def test_the_check_starts_from_the_recorded_pose_not_where_the_robot_is_now(work
     q_touch = wf.controller.q_rad.copy()
     assert wf.controller.jog_cartesian("WORLD", "Z", 50.0).stopped_by is None     # backed off 50 mm
     assert not np.allclose(wf.controller.q_rad, q_touch)
-    job = wf.tcp_check_job()
+    job = wf.controller_job()
     np.testing.assert_allclose(job.q_rad, q_touch)
-    res = wf.give_tcp_check(job, job.run())
+    res = wf.give_controller_job(job, job.run())
     assert res.check.implied_tcp_error_mm == pytest.approx(1.0, abs=0.01)
 
 
@@ -113,11 +115,11 @@ def test_finish_before_the_check_and_bad_options_say_what_to_do(workflow, librar
     wf.auto_touch(AutoTouchRequest())
     with pytest.raises(WizardStateError, match="Run the check first"):
         wiz.finish()                                    # the state machine alone cannot check
-    job = wf.tcp_check_job()
+    job = wf.controller_job()
     wf.record()                                         # recorded again while the check "ran"
     with pytest.raises(WizardStateError, match="recorded again"):
-        wf.give_tcp_check(job, job.run())
-    assert wiz.check_pending and wf.run_tcp_check() is wf.result
+        wf.give_controller_job(job, job.run())
+    assert wiz.check_pending and wf.run_controller_job() is wf.result
 
 
 def test_the_session_record_replays_the_check_without_a_robot(workflow, library) -> None:
@@ -150,4 +152,42 @@ def test_a_finished_check_is_done_not_left_half_way(workflow, library) -> None:
     wf.start("tcp-check", slot=slot)
     wf.auto_touch(AutoTouchRequest())
     wf.cancel()                                           # an unfinished one waits to be resumed
-    assert [label for _, label in wf.resumable()] == ["2: TCP check (spin test), 1 of 1 recorded"]
+    assert [label.split(", started")[0] for _, label in wf.resumable()] == [
+        "2: TCP check (spin test), at step 1 of 1 (1 recorded)"]
+
+
+def _figures(reached: tuple[bool, ...], err_mm: float):
+    from tcp_pendant.wizards.tcp_check import CheckFigures, CheckRow
+
+    labels = ("+A 30°", "−A 30°", "+B 30°", "−B 30°", "+C 30°", "−C 30°")
+    rows = tuple(CheckRow(lab, ok, "" if ok else "A5 at its limit 120.0 deg", 0.0 if not ok else 0.1)
+                 for lab, ok in zip(labels, reached))
+    return CheckFigures(30.0, rows, err_mm, (0.0, 0.0, err_mm), 0.0)
+
+
+def test_a_rotation_that_could_not_be_made_keeps_the_verdict_open() -> None:
+    """Two rotations stopped at A5's limit showed '0.000 mm' moved and 'TCP good'."""
+    from tcp_pendant.wizards.tcp_check import TcpCheckResult, tcp_check_markdown
+
+    open_ = _figures((False, True, True, False, True, True), 0.05)
+    assert open_.verdict.startswith("Not determined: +A 30°, −B 30° could not be made from this pose")
+    assert "TCP good" not in open_.verdict
+    assert _figures((True,) * 6, 0.05).verdict.startswith("TCP good")
+    # an error found by the rotations that were made stands
+    assert _figures((False, True, True, True, True, True), 1.5).verdict.startswith("TCP off by 1.500 mm")
+    res = TcpCheckResult(wizard="tcp-check", method="tcp-check", tcp_mm=(0.0, 0.0, 180.0), check=open_,
+                         tool_name="Pen", slot=1)
+    md = tcp_check_markdown(res)
+    plus_a = escape_markdown("+A 30°")
+    assert f"| {plus_a} | not made | stopped: {escape_markdown('A5 at its limit 120.0 deg')} |" in md and f"| {plus_a} | 0.000" not in md
+
+
+def test_auto_touch_for_a_check_picks_a_pose_from_which_all_six_rotations_can_be_made(workflow, library) -> None:
+    slot = saved_tool(library, "torch", (0.0, 0.0, 0.0))
+    for seed in range(4):
+        wf = workflow("kr6", "torch", seed=seed)
+        wf.start("tcp-check", slot=slot)
+        assert wf.auto_touch(AutoTouchRequest()).ok
+        res = wf.run_controller_job()
+        assert all(r.reached for r in res.check.rows), (seed, [r.message for r in res.check.rows])
+        assert res.check.verdict.startswith("TCP good"), seed

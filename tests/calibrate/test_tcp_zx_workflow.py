@@ -69,7 +69,7 @@ def test_auto_touch_tcp_zx_gives_the_true_frame_and_saves_it(workflow, library, 
 
 def test_operator_error_gives_plausible_errors_and_the_record_replays(workflow) -> None:
     wf = workflow("kr6", "torch", seed=11)
-    wf.start_tcp_zx(n_points=6)
+    wf.start("tcp-zx", n_points=6)
     run_auto(wf, AutoTouchRequest(sigma_mm=0.3))
     res, truth = wf.result, wf.truth()
     assert 0.0 < res.rms_error_mm < 1.5 and 0.0 < truth.position_error_mm < 3.0 * res.ci95_mm
@@ -95,7 +95,7 @@ def test_start_options_are_checked_and_named(workflow) -> None:
 
 def test_a_z_pose_at_the_touch_fails_in_words_and_keeps_the_poses(workflow) -> None:
     wf = workflow("kr6", "torch", seed=2)
-    wf.start_tcp_zx()
+    wf.start("tcp-zx")
     for _ in range(4):
         wf.auto_touch(AutoTouchRequest())
     wf.record()                      # "z" recorded without backing off: the reference at the TCP

@@ -107,7 +107,7 @@ def test_two_free_touches_fill_the_first_steps_of_four(workflow) -> None:
 
 def test_too_many_or_bad_free_touches_open_nothing(workflow) -> None:
     wf = workflow()
-    wf.start_xyz4()
+    wf.start("xyz4")
     open_before = wf.wizard
     with pytest.raises(WizardError, match="at most 20: delete some"):
         wf.start_from_touches(free_touches(wf, 21, sigma_mm=0.0))
@@ -123,7 +123,7 @@ def test_too_many_or_bad_free_touches_open_nothing(workflow) -> None:
 # ---------------------------------------------------------------- item 4: distance at record
 def test_wizard_touches_keep_their_distance_at_record_in_the_session_record(workflow) -> None:
     wf = workflow()
-    wf.start_xyz4()
+    wf.start("xyz4")
     c = wf.controller
     out = wf.auto_touch(AutoTouchRequest(sigma_mm=0.8))          # step 1, about 1 mm off
     assert out.ok
@@ -143,7 +143,7 @@ def test_wizard_touches_keep_their_distance_at_record_in_the_session_record(work
 
 def test_records_without_distances_still_load_and_bad_distances_are_refused(workflow) -> None:
     wf = workflow()
-    wf.start_xyz4()
+    wf.start("xyz4")
     wf.auto_touch(AutoTouchRequest())
     record = json.loads(dumps(wf.export_record()))
     old = json.loads(json.dumps(record))

@@ -13,8 +13,7 @@ from typing import Any
 
 import numpy as np
 import pytest
-from tcp_pendant.calibrate import WIZARD_KINDS, WIZARD_LABELS, AutoTouchRequest, CalibrationWorkflow
-from tcp_pendant.calibrate.text import METHOD_BLURBS
+from tcp_pendant.calibrate import JOBS, AutoTouchRequest, CalibrationWorkflow
 from tcp_pendant.server import AppConfig, PendantApp
 from tcp_pendant.wizards import (
     StepSpec,
@@ -24,6 +23,7 @@ from tcp_pendant.wizards import (
     register,
     unregister,
     wizard_class,
+    wizard_classes,
 )
 from tcp_pendant.wizards.describe import TOUCH, StartContext, StepRole, WizardOption, WizardStart
 from tcp_pendant.wizards.session_record import dumps
@@ -130,13 +130,25 @@ def test_a_registered_kind_is_offered_started_performed_recorded_and_replayed(to
     assert other.result.tcp_mm == pytest.approx(res.tcp_mm, abs=1e-12)
 
 
-def test_the_menu_lists_are_live_views_of_the_registry(toy) -> None:
-    assert WIZARD_KINDS[-1] == "toy-tap" and WIZARD_LABELS["toy-tap"] == "Toy tap"
-    assert METHOD_BLURBS["toy-tap"] == toy.blurb
+def test_the_menu_lists_the_registry_in_rank_order(toy) -> None:
+    kinds = [c.kind for c in wizard_classes()]
+    assert kinds[-1] == "toy-tap" and wizard_class("toy-tap").title == "Toy tap"
+    assert wizard_class("toy-tap").blurb == toy.blurb
     unregister("toy-tap")
-    assert "toy-tap" not in WIZARD_KINDS and "toy-tap" not in METHOD_BLURBS
-    assert list(WIZARD_KINDS) == ["xyz4", "reference", "tcp-zx", "three-point", "abc-world", "beam",
-                                 "tcp-check"]
+    assert [c.kind for c in wizard_classes()] == ["xyz4", "reference", "tcp-zx", "three-point", "abc-world",
+                                                  "beam", "tcp-check"]
+
+
+def test_each_class_declares_its_controller_job_and_result_view() -> None:
+    """Only the methods the controller runs name a job, and each name has its job; how a result
+    is shown and what its panel offers are declared, not found by class."""
+    declared = {c.kind: (c.controller_job, c.result_view, c.result_extras) for c in wizard_classes()}
+    assert declared["tcp-check"][:2] == ("spin_check", "spin_check")
+    assert declared["beam"][:2] == ("beam_scan", "beam_scan")
+    assert declared["xyz4"] == (None, "touches", frozenset({"estimators", "sphere"}))
+    for kind in ("reference", "tcp-zx", "three-point", "abc-world"):
+        assert declared[kind] == (None, "touches", frozenset()), kind
+    assert {job for job, _, _ in declared.values() if job is not None} == set(JOBS)
 
 
 def test_start_options_are_checked_against_the_declaration(toy, library) -> None:

@@ -42,7 +42,7 @@ def run_auto(wf: CalibrationWorkflow, request: AutoTouchRequest | None = None) -
                                         ("gp12", "pointer"), ("gp12", "torch")])
 def test_xyz4_four_auto_touches_give_the_true_tcp_and_save_it(workflow, library, robot, tool) -> None:
     wf = workflow(robot, tool)
-    wf.start_xyz4()
+    wf.start("xyz4")
     run_auto(wf)                                    # four clicks, no Finish needed
     tcp_true, _, _ = true_frame(tool)
     np.testing.assert_allclose(wf.result.tcp_mm, tcp_true, atol=EXACT_MM)
@@ -58,7 +58,7 @@ def test_xyz4_four_auto_touches_give_the_true_tcp_and_save_it(workflow, library,
 def test_xyz4_with_operator_error_reports_an_error_inside_a_plausible_radius(workflow) -> None:
     """sigma 0.5 mm: the error against truth is non-zero and of the size of the 95 % radius."""
     wf = workflow(seed=7)
-    wf.start_xyz4(n_points=8)
+    wf.start("xyz4", n_points=8)
     run_auto(wf, AutoTouchRequest(sigma_mm=0.5))
     res, truth = wf.result, wf.truth()
     assert 0.0 < res.mean_error_mm < 2.0
@@ -68,7 +68,7 @@ def test_xyz4_with_operator_error_reports_an_error_inside_a_plausible_radius(wor
 def test_reference_needs_the_tool_change_then_gives_the_new_tools_tcp(workflow, library) -> None:
     library.save(1, library_tool_with_true_tcp("pointer", "Pointer"))
     wf = workflow(tool="pointer")
-    wiz = wf.start_reference(reference_slot=1, reference_tool_key="pointer", new_tool_key="torch")
+    wiz = wf.start("reference", slot=1, reference_tool_key="pointer", new_tool_key="torch")
     assert wf.controller.active_tool.name == "Pointer"     # "mounted and active"
     assert wf.required_tool() is None
     wf.auto_touch(AutoTouchRequest())
@@ -93,9 +93,9 @@ def test_orientation_wizards_give_the_true_orientation(workflow, library, robot,
     library.save(1, library_tool_with_true_tcp("torch", "Torch"))
     wf = workflow(robot, "torch")
     if kind == "three-point":
-        wf.start_three_point(slot=1, variant=variant)
+        wf.start("three-point", slot=1, variant=variant)
     else:
-        wf.start_abc_world(slot=1, variant=variant)
+        wf.start("abc-world", slot=1, variant=variant)
     assert wf.controller.active_tool.name == "Torch"
     run_auto(wf)
     tcp_true, R_true, abc_true = true_frame("torch")
@@ -112,7 +112,7 @@ def test_orientation_wizards_give_the_true_orientation(workflow, library, robot,
 def test_abc_world_5d_calibrates_tool_x(workflow, library) -> None:
     library.save(1, library_tool_with_true_tcp("torch", "Torch"))
     wf = workflow("kr6", "torch")
-    wf.start_abc_world(slot=1, variant="5d")
+    wf.start("abc-world", slot=1, variant="5d")
     run_auto(wf)
     _, R_true, _ = true_frame("torch")
     x = wf.result.rotation[:, 0]
@@ -122,13 +122,13 @@ def test_abc_world_5d_calibrates_tool_x(workflow, library) -> None:
 
 def test_starting_another_wizard_keeps_the_open_one_resumable(workflow) -> None:
     wf = workflow()
-    first = wf.start_xyz4()
+    first = wf.start("xyz4")
     wf.auto_touch(AutoTouchRequest())
     wf.auto_touch(AutoTouchRequest())
     poses = {i: p.T_world_flange_m.copy() for i, p in first.recorded_poses.items()}
-    wf.start_xyz4(n_points=5)
+    wf.start("xyz4", n_points=5)
     assert first.status == "cancelled" and [i for i, _ in wf.resumable()] == [0]
-    assert "2 of 4 recorded" in wf.resumable()[0][1]
+    assert "at step 3 of 4 (2 recorded), started " in wf.resumable()[0][1]
     wf.resume(0)
     assert wf.wizard is first and first.status == "in_progress" and first.step_index == 2
     for i, T in poses.items():
@@ -140,7 +140,7 @@ def test_starting_another_wizard_keeps_the_open_one_resumable(workflow) -> None:
 
 def test_cancel_after_save_loses_nothing(workflow, library) -> None:
     wf = workflow()
-    wf.start_xyz4()
+    wf.start("xyz4")
     run_auto(wf)
     wf.save("Pen")
     before = library.path.read_bytes()
@@ -156,7 +156,7 @@ def test_save_refusals_write_nothing(workflow, library) -> None:
     library.save(3, Tool(name="Taken", tcp_mm=(1.0, 2.0, 3.0)))
     before = library.path.read_bytes()
     wf = workflow()
-    wf.start_xyz4()
+    wf.start("xyz4")
     with pytest.raises(WizardStateError):
         wf.save("Early")                             # not finished
     run_auto(wf)
@@ -170,7 +170,7 @@ def test_save_refusals_write_nothing(workflow, library) -> None:
 
 def test_auto_touch_is_a_training_tool_and_checks_its_request(workflow) -> None:
     wf = workflow()
-    wf.start_xyz4()
+    wf.start("xyz4")
     wf.training = False
     with pytest.raises(WizardStateError, match="training mode"):
         wf.auto_touch(AutoTouchRequest())
@@ -186,7 +186,7 @@ def test_auto_touch_is_a_training_tool_and_checks_its_request(workflow) -> None:
 def test_same_chosen_direction_four_times_is_degenerate_and_keeps_the_touches(workflow) -> None:
     """The lesson of pose diversity: four touches from one direction cannot give a TCP."""
     wf = workflow()
-    wiz = wf.start_xyz4()
+    wiz = wf.start("xyz4")
     same = AutoTouchRequest(tilt_deg=30.0, azimuth_deg=90.0)
     for _ in range(3):
         assert wf.auto_touch(same).ok
@@ -199,11 +199,11 @@ def test_same_chosen_direction_four_times_is_degenerate_and_keeps_the_touches(wo
 def test_session_record_round_trip_replays_every_wizard(workflow, library) -> None:
     library.save(1, library_tool_with_true_tcp("pointer", "Pointer"))
     wf = workflow(seed=3)
-    wf.start_xyz4(n_points=5)
+    wf.start("xyz4", n_points=5)
     run_auto(wf, AutoTouchRequest(sigma_mm=0.5))
     tcp_first = wf.result.tcp_mm
     truth_first = wf.truth().position_error_mm
-    wf.start_reference(reference_slot=1, reference_tool_key="pointer", new_tool_key="gripper")
+    wf.start("reference", slot=1, reference_tool_key="pointer", new_tool_key="gripper")
     wf.auto_touch(AutoTouchRequest())                # left half-way
     text = dumps(wf.export_record())
     record = json.loads(text)
@@ -223,7 +223,7 @@ def test_session_record_round_trip_replays_every_wizard(workflow, library) -> No
 
 def test_a_bad_record_changes_nothing(workflow) -> None:
     wf = workflow()
-    wf.start_xyz4()
+    wf.start("xyz4")
     wf.auto_touch(AutoTouchRequest())
     with pytest.raises(WizardError, match="not valid JSON"):
         wf.load_record("{not json")
@@ -235,10 +235,10 @@ def test_a_bad_record_changes_nothing(workflow) -> None:
 def test_unknown_choices_are_refused_with_the_options(workflow, library) -> None:
     wf = workflow()
     with pytest.raises(WizardError, match="Slot 4 of the tool library is empty"):
-        wf.start_three_point(slot=4)
+        wf.start("three-point", slot=4)
     library.save(1, library_tool_with_true_tcp("pointer", "Pointer"))
     with pytest.raises(WizardError, match="pointer, torch, gripper"):
-        wf.start_reference(reference_slot=1, reference_tool_key="pointer", new_tool_key="hammer")
+        wf.start("reference", slot=1, reference_tool_key="pointer", new_tool_key="hammer")
     with pytest.raises(WizardError, match="same physical tool"):
-        wf.start_reference(reference_slot=1, reference_tool_key="pointer", new_tool_key="pointer")
+        wf.start("reference", slot=1, reference_tool_key="pointer", new_tool_key="pointer")
     assert wf.runs == []

@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 from tcp_pendant.classroom import grades_cli
 from tcp_pendant.classroom.gradebook import CSV_COLUMNS, SCHEMA_VERSION, Gradebook
+from tcp_pendant.classroom.lms import MOODLE_POINTS, PER_TRAINEE_COLUMNS
 
 POSE = np.eye(4)
 JOINTS = [0.0] * 6
@@ -30,26 +31,31 @@ def _make(path: Path) -> None:
         g.record_touch(cid, 0, POSE, JOINTS, None, True)
         g.finish_calibration(cid, {"orthogonality_defect_deg": 0.0}, position_error_mm=None,
                              orientation_error_deg=1.234, grade="fair")
-        left = g.start_calibration(ben, "xyz4", "pointer", np.eye(4))      # never finished: no row
+        left = g.start_calibration(ben, "xyz4", "pointer", np.eye(4))      # still in progress
         g.record_touch(left, 0, POSE, JOINTS, 0.1, False)
+        gone = g.start_calibration(ben, "xyz4", "pointer", np.eye(4))      # cancelled: no row
+        g.cancel_calibration(gone)
 
 
-def test_table_has_one_row_per_finished_calibration(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_table_has_one_row_per_calibration_with_its_status(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     path = tmp_path / "class.sqlite3"
     _make(path)
     assert grades_cli.main(["--class-db", str(path)]) == 0
     out = capsys.readouterr().out.splitlines()
-    assert out[0] == f"Gradebook {path}: 2 finished calibrations"
+    assert out[0] == f"Gradebook {path}: 2 finished calibrations, 1 in progress"
     assert out[1].split()[:5] == ["id", "trainee", "method", "tool", "touches"]
     anna = out[3].split()
-    # id, name (2 words), method, tool, touches, hand, auto, overwritten, crashes, duration, mean, ci95, pos, ori, grade
+    # id, name (2 words), method, tool, touches, hand, auto, overwritten, crashes, duration, mean, ci95, pos, ori,
+    # grade, status
     assert anna[:3] == ["1", "Anna", "Meier"] and anna[3:5] == ["xyz4", "pointer"]
     assert anna[5:10] == ["4", "3", "1", "0", "1"]
-    assert anna[11:] == ["0.210", "0.840", "0.231", "-", "good"]
+    assert anna[11:] == ["0.210", "0.840", "0.231", "-", "good", "finished"]
     ben = out[4].split()
     assert ben[:4] == ["2", "Ben", "<b>", "abc-world"]
-    assert ben[-5:] == ["-", "-", "-", "1.23", "fair"]
-    assert len(out) == 5
+    assert ben[-6:] == ["-", "-", "-", "1.23", "fair", "finished"]
+    left = out[5].split()
+    assert left[:4] == ["3", "Ben", "<b>", "xyz4"] and left[-3:] == ["-", "in", "progress"]
+    assert len(out) == 6
 
 
 def test_csv_output(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -58,15 +64,63 @@ def test_csv_output(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert grades_cli.main(["--class-db", str(path), "--csv"]) == 0
     rows = list(csv.DictReader(io.StringIO(capsys.readouterr().out)))
     assert tuple(rows[0]) == CSV_COLUMNS
-    assert [(r["trainee"], r["method"], r["touches"], r["auto"], r["grade"]) for r in rows] == [
-        ("Anna Meier", "xyz4", "4", "1", "good"), ("Ben <b>", "abc-world", "1", "1", "fair")]
+    assert [(r["trainee"], r["method"], r["touches"], r["auto"], r["grade"], r["status"]) for r in rows] == [
+        ("Anna Meier", "xyz4", "4", "1", "good", "finished"), ("Ben <b>", "abc-world", "1", "1", "fair", "finished"),
+        ("Ben <b>", "xyz4", "1", "0", "", "in_progress")]
+    assert rows[2]["finished_at"] == "" and float(rows[2]["duration_s"]) >= 0.0
+
+
+def _two_attempts(path: Path) -> None:
+    """Anna: fair (1.9 mm) then good (0.3 mm) then poor (4.0 mm), and one in progress; Ben: none."""
+    with Gradebook(path) as g:
+        anna = g.start_session(g.add_trainee("Anna"), "own")
+        for grade, err in (("fair", 1.9), ("good", 0.3), ("poor", 4.0)):
+            cid = g.start_calibration(anna, "xyz4", "pointer", np.eye(4))
+            g.finish_calibration(cid, {}, position_error_mm=err, orientation_error_deg=None, grade=grade)
+        g.start_calibration(anna, "xyz4", "pointer", np.eye(4))
+        ben = g.start_session(g.add_trainee("=Ben"), "own")
+        g.start_calibration(ben, "xyz4", "pointer", np.eye(4))
+
+
+def test_one_row_per_trainee_with_the_best_and_the_last_grade(tmp_path: Path,
+                                                              capsys: pytest.CaptureFixture[str]) -> None:
+    path = tmp_path / "class.sqlite3"
+    _two_attempts(path)
+    assert grades_cli.main(["--class-db", str(path), "--per-trainee", "--csv"]) == 0
+    rows = list(csv.DictReader(io.StringIO(capsys.readouterr().out)))
+    assert tuple(rows[0]) == PER_TRAINEE_COLUMNS
+    anna, ben = (next(r for r in rows if r["trainee"] == n) for n in ("Anna", "'=Ben"))
+    assert (anna["trainee"], anna["attempts"], anna["in_progress"]) == ("Anna", "3", "1")
+    assert (anna["best_grade"], float(anna["best_position_error_mm"])) == ("good", 0.3)
+    assert (anna["last_grade"], float(anna["last_position_error_mm"])) == ("poor", 4.0)
+    assert (ben["trainee"], ben["attempts"], ben["in_progress"], ben["best_grade"]) == ("'=Ben", "0", "1", "")
+    assert grades_cli.main(["--class-db", str(path), "--per-trainee"]) == 0
+    table = capsys.readouterr().out.splitlines()
+    assert table[0] == f"Gradebook {path}: 2 trainees"
+    assert ["Anna", "3", "1", "good"] in [line.split()[:4] for line in table[3:]]
+
+
+def test_the_moodle_csv_is_the_layout_moodles_grade_import_reads(tmp_path: Path,
+                                                                  capsys: pytest.CaptureFixture[str]) -> None:
+    """Moodle's CSV grade import (docs.moodle.org/en/Grade_import): a header row, one row per
+    learner, a column to map to the user, a numeric column per grade item (within the item's
+    0..100) and its feedback column; an empty grade leaves the learner's grade as it is."""
+    path = tmp_path / "class.sqlite3"
+    _two_attempts(path)
+    assert grades_cli.main(["--class-db", str(path), "--moodle"]) == 0
+    text = capsys.readouterr().out
+    assert text.splitlines()[0] == "Username,TCP calibration,TCP calibration feedback"
+    rows = sorted(list(csv.reader(io.StringIO(text)))[1:], key=lambda r: r[0] != "Anna")
+    assert rows[0][:2] == ["Anna", str(MOODLE_POINTS["good"])] and 0 <= int(rows[0][1]) <= 100
+    assert "best: good, TCP 0.30 mm off; 3 attempts; last: poor" == rows[0][2]
+    assert rows[1] == ["'=Ben", "", "no finished calibration yet"]
 
 
 def test_empty_gradebook(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     path = tmp_path / "class.sqlite3"
     Gradebook(path).close()
     assert grades_cli.main(["--class-db", str(path)]) == 0
-    assert capsys.readouterr().out == f"No finished calibration in {path} yet.\n"
+    assert capsys.readouterr().out == f"No calibration in {path} yet.\n"
 
 
 def _newer(path: Path) -> None:

@@ -14,27 +14,24 @@ from tcp_pendant.calibrate import AutoTouchRequest, CalibrationWorkflow
 from tcp_pendant.classroom.gradebook import Gradebook
 from tcp_pendant.classroom.grading import grade_record
 from tcp_pendant.classroom.recorder import TraineeRecorder
-from tcp_pendant.controller.pose_state import pose_state, pose_state_key
-from tcp_pendant.session import SessionChange
 from tcp_pendant.wizards.session_record import VERSION, load_and_replay
 
 from tcpcal.library import ToolLibrary
 
 sys.path.insert(0, str(Path(__file__).parents[1] / "calibrate"))
-from calib_helpers import make_controller  # noqa: E402
+from calib_helpers import make_controller, make_session  # noqa: E402
 
 
 def _finished_class_session(tmp_path: Path, name: str = "Anna", sigma: float = 0.3):
     book = Gradebook(tmp_path / "class.sqlite3", synchronous="NORMAL")
-    c = make_controller("kr6", "pointer")
-    wf = CalibrationWorkflow(c, ToolLibrary(tmp_path / "tools.json"), robot="kr6", rng=np.random.default_rng(5))
-    rec = TraineeRecorder(book, book.start_session(book.add_trainee(name), "per-browser"), name, c, wf)
-    wf.start_xyz4()
-    rec.on_change(SessionChange(wizard=True, state=pose_state(c, pose_state_key(c))))
-    while wf.result is None:
-        wf.auto_touch(AutoTouchRequest(sigma_mm=sigma))
-        rec.on_change(SessionChange(wizard=True, pose=True, state=pose_state(c, pose_state_key(c))))
-    return book, wf
+    s = make_session(tmp_path / "tools.json", seed=5)
+    s.keep_honest_records()
+    rec = TraineeRecorder(book, book.start_session(book.add_trainee(name), "per-browser"), name, s.workflow)
+    s.subscribe(rec.on_change)
+    s.start_wizard("xyz4")
+    while s.workflow.result is None:
+        s.auto_touch(AutoTouchRequest(sigma_mm=sigma))
+    return book, s.workflow
 
 
 def test_a_classroom_export_holds_no_truth_and_no_server_path(tmp_path: Path) -> None:
@@ -50,7 +47,7 @@ def test_a_classroom_export_holds_no_truth_and_no_server_path(tmp_path: Path) ->
     # outside a class the record still carries the truth (self-study), now with record_id null
     c2 = make_controller()
     free = CalibrationWorkflow(c2, ToolLibrary(tmp_path / "t2.json"), robot="kr6")
-    free.start_xyz4()
+    free.start("xyz4")
     out = free.export_record()
     assert out["honest"] is False and "T_flange_tcp_true_m" in json.dumps(out)
     assert out["wizards"][0]["record_id"] is None
@@ -89,7 +86,7 @@ def test_version_1_records_are_still_read_and_bad_record_ids_refused(tmp_path: P
 
     c = make_controller()
     free = CalibrationWorkflow(c, ToolLibrary(tmp_path / "t.json"), robot="kr6", rng=np.random.default_rng(2))
-    free.start_xyz4()
+    free.start("xyz4")
     for _ in range(4):
         free.auto_touch(AutoTouchRequest())
     v1 = free.export_record()

@@ -7,45 +7,36 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from tcp_pendant.calibrate import AutoTouchRequest, CalibrationWorkflow
+from tcp_pendant.calibrate import AutoTouchRequest
 from tcp_pendant.classroom.gradebook import Gradebook
 from tcp_pendant.classroom.recorder import TraineeRecorder
-from tcp_pendant.controller.pose_state import pose_state, pose_state_key
-from tcp_pendant.session import SessionChange
-
-from tcpcal.library import ToolLibrary
+from tcp_pendant.wizards.session_record import load_and_replay
 
 sys.path.insert(0, str(Path(__file__).parents[1] / "calibrate"))
-from calib_helpers import make_controller  # noqa: E402
+from calib_helpers import make_session  # noqa: E402
 
 
 @pytest.fixture
 def setup(tmp_path: Path):
     book = Gradebook(tmp_path / "class.sqlite3", synchronous="NORMAL")
-    c = make_controller("kr6", "pointer")
-    wf = CalibrationWorkflow(c, ToolLibrary(tmp_path / "tools.json"), robot="kr6", rng=np.random.default_rng(3))
+    s = make_session(tmp_path / "tools.json", seed=3)
     sid = book.start_session(book.add_trainee("Anna"), "per-browser")
-    rec = TraineeRecorder(book, sid, "Anna", c, wf)
-    yield book, c, wf, rec
+    rec = TraineeRecorder(book, sid, "Anna", s.workflow)
+    s.subscribe(rec.on_change)
+    yield book, s, rec
     book.close()
 
 
-def signal(rec: TraineeRecorder, c, **what) -> None:
-    rec.on_change(SessionChange(**what, state=pose_state(c, pose_state_key(c))))
-
-
 def test_auto_and_hand_touches_overwrite_and_finish_are_stored(setup) -> None:
-    book, c, wf, rec = setup
-    wf.start_xyz4()
-    signal(rec, c, wizard=True)
+    book, s, rec = setup
+    c, wf = s.controller, s.workflow
+    s.start_wizard("xyz4")
     cal = rec._runs[0].calibration_id
     assert book.calibration_status(cal) == "in_progress"
-    wf.auto_touch(AutoTouchRequest())             # step 1 by Auto-touch
-    signal(rec, c, wizard=True, pose=True)
-    wf.back()                                      # Auto-touch went on to step 2: back to step 1
-    wf.record()                                    # step 1 again, by hand: overwrites the auto touch
-    wf.next()
-    signal(rec, c, wizard=True)
+    s.auto_touch(AutoTouchRequest())               # step 1 by Auto-touch
+    s.back()                                       # Auto-touch went on to step 2: back to step 1
+    s.record_step()                                # step 1 again, by hand: overwrites the auto touch
+    s.next_step()
     touches = book.touches(cal)
     assert [t["auto"] for t in touches] == [True, False]
     assert touches[1]["overwrites_touch_id"] == touches[0]["id"]
@@ -54,8 +45,7 @@ def test_auto_and_hand_touches_overwrite_and_finish_are_stored(setup) -> None:
     np.testing.assert_allclose(touches[1]["joints_deg"], np.degrees(c.q_rad))
     assert touches[0]["distance_mm"] is not None and touches[0]["distance_mm"] < 3.0
     for _ in range(4):
-        wf.auto_touch(AutoTouchRequest())
-        signal(rec, c, wizard=True, pose=True)
+        s.auto_touch(AutoTouchRequest())
         if wf.result is not None:
             break
     assert wf.result is not None
@@ -71,42 +61,60 @@ def test_auto_and_hand_touches_overwrite_and_finish_are_stored(setup) -> None:
     assert rec.status.touches == 5
 
 
+def test_a_touch_is_stored_with_the_joints_and_distance_of_its_record_not_of_the_signal(setup) -> None:
+    """A Record and a jog in one signal (one batch): the gradebook keeps the joints and the
+    distance the robot had at Record, not those after the jog."""
+    book, s, rec = setup
+    s.start_wizard("xyz4")
+    s.auto_touch(AutoTouchRequest())                # the tool tip on the reference tip
+    s.back()
+    q_at_record = np.degrees(s.controller.q_rad)
+    d_at_record = s.controller.touch_geometry().distance_mm
+    with s.batch():
+        s.record_step()
+        s.jogger.settings = s.jogger.settings.with_(increment="10")
+        s.jog("Z", 1)
+        s.jog("Z", 1)
+    assert s.controller.touch_geometry().distance_mm > d_at_record + 15.0     # the robot moved away
+    touches = book.touches(rec._runs[0].calibration_id)
+    last = touches[-1]
+    assert last["auto"] is False and last["overwrites_touch_id"] == touches[0]["id"]
+    np.testing.assert_allclose(last["joints_deg"], q_at_record, atol=1e-9)
+    assert last["distance_mm"] == pytest.approx(d_at_record, abs=1e-9)
+
+
 def test_cancel_resume_and_loaded_runs(setup, tmp_path: Path) -> None:
-    book, c, wf, rec = setup
-    wf.start_xyz4()
-    wf.record()
-    signal(rec, c, wizard=True)
+    book, s, rec = setup
+    s.start_wizard("xyz4")
+    s.record_step()
     cal = rec._runs[0].calibration_id
-    wf.cancel()
-    signal(rec, c, wizard=True)
+    s.cancel_wizard()
     assert book.calibration_status(cal) == "cancelled"
-    wf.resume(0)
-    signal(rec, c, wizard=True)
+    s.resume_wizard(0)
     assert book.calibration_status(cal) == "in_progress"
     # a record loaded from a file arrives cancelled: not this session's work, not stored
-    other = CalibrationWorkflow(make_controller(), ToolLibrary(tmp_path / "t2.json"), robot="kr6",
-                                rng=np.random.default_rng(1))
-    other.start_xyz4()
-    other.record()
-    wf.load_record(other.export_record())
-    signal(rec, c, wizard=True)
-    assert rec._runs[1].calibration_id is None
+    other = make_session(tmp_path / "t2.json", seed=1)
+    other.start_wizard("xyz4")
+    other.record_step()
+    s.load_record(load_and_replay(other.workflow.export_record()))
+    assert len(s.workflow.runs) == 2 and 1 not in rec._runs
     with book._read() as db:
         assert db.execute("SELECT COUNT(*) FROM calibrations").fetchone()[0] == 1
 
 
 def test_crash_transitions_are_counted_once(setup) -> None:
-    book, c, wf, rec = setup
-    wf.start_xyz4()
-    signal(rec, c, wizard=True)
+    book, s, rec = setup
+    c = s.controller
+    s.start_wizard("xyz4")
     assert not c.touch_geometry().crashed
     # drive the true tool 5 mm through the tip along its own X (the approach direction)
     T_true = c.T_world_tool_true()
     T_true[:3, 3] = c.reference_tip_world_m + 0.005 * T_true[:3, 0]
     c.move_true_tool_to(T_true)
     assert c.touch_geometry().crashed, c.touch_geometry()
-    signal(rec, c, pose=True)
-    signal(rec, c, pose=True)          # still crashed: the same crash
+    s.moved()
+    s.moved()                          # still crashed: the same crash
     with book._read() as db:
         assert db.execute("SELECT COUNT(*) FROM crashes").fetchone()[0] == 1
+        assert db.execute("SELECT calibration_id FROM crashes").fetchone()[0] == rec._runs[0].calibration_id
     assert rec.status.crashes == 1

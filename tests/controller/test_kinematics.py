@@ -157,10 +157,21 @@ def test_bad_urdfs_give_clear_errors(tmp_path: Path):
     bad.write_text("<robot><link name='a'>")
     with pytest.raises(ControllerError, match="Cannot read the URDF"):
         RobotKinematics.from_urdf(bad)
+    floating = tmp_path / "floating.urdf"
+    floating.write_text(CHAIN.replace('<joint name="s" type="fixed">', '<joint name="s" type="floating">'))
+    with pytest.raises(ControllerError, match="'s'.*floating joint") as err:
+        RobotKinematics.from_urdf(floating)
+    assert "JointModel" not in str(err.value)                    # pinocchio's names stay inside
+
+
+def test_continuous_joint_is_revolute_with_one_turn_either_way(tmp_path: Path):
     cont = tmp_path / "cont.urdf"
     cont.write_text(CHAIN.replace('type="revolute"><parent link="a"', 'type="continuous"><parent link="a"'))
-    with pytest.raises(ControllerError, match="j2.*continuous|j2.*revolute"):
-        RobotKinematics.from_urdf(cont)
+    kin = RobotKinematics.from_urdf(cont)
+    assert kin.joint_names == ("j1", "j2") and kin.n_joints == 2
+    np.testing.assert_allclose(kin.lower_rad, [0.5, -2 * math.pi])
+    np.testing.assert_allclose(kin.upper_rad, [1.5, 2 * math.pi])
+    assert kin.description.continuous_joints == ("j2",)
 
 
 def test_builtin_robots_are_in_robots_dir():

@@ -268,7 +268,7 @@ def _record_with_hostile_tool(tmp_path: Path) -> bytes:
     lib = ToolLibrary(tmp_path / "trainee_tools.json")
     lib.save(1, library_tool_with_true_tcp("pointer", STYLE))
     wf = CalibrationWorkflow(make_controller("kr6", "pointer"), lib, robot="kr6", rng=np.random.default_rng(3))
-    wf.start_three_point(slot=1)
+    wf.start("three-point", slot=1)
     while wf.result is None:
         assert wf.auto_touch(AutoTouchRequest(sigma_mm=0.0)).ok
     assert any(STYLE in w for w in wf.result.warnings)       # the name reaches the result's words

@@ -86,7 +86,7 @@ def hostile_three_point(tmp_path_factory: pytest.TempPathFactory) -> tuple[Calib
     lib = ToolLibrary(tmp_path_factory.mktemp("lib") / "tools.json")
     lib.save(1, library_tool_with_true_tcp("pointer", NAMES[0]))
     wf = CalibrationWorkflow(make_controller("kr6", "pointer"), lib, robot="kr6", rng=np.random.default_rng(2))
-    wf.start_three_point(slot=1)
+    wf.start("three-point", slot=1)
     assert isinstance(wf.wizard, ThreePointWizard)
     steps = [step_markdown(wf.wizard), steps_list_markdown(wf.wizard)]
     while wf.result is None:

@@ -48,7 +48,7 @@ def real_record(tmp_path_factory: pytest.TempPathFactory) -> bytes:
     """A record exported after a lesson's worth of XYZ 4-point runs (4 to 20 touches)."""
     wf = _workflow(tmp_path_factory.mktemp("lib"), seed=1)
     for n in (4, 8, 12, 20, 20, 6):
-        wf.start_xyz4(n_points=n)
+        wf.start("xyz4", n_points=n)
         while wf.result is None:
             assert wf.auto_touch(AutoTouchRequest(sigma_mm=0.3)).ok
     return dumps(wf.export_record([(np.eye(4), f"P{i}") for i in range(30)])).encode()
@@ -223,7 +223,7 @@ def test_at_the_count_limits_a_record_is_accepted() -> None:
 ])
 def test_malformed_entries_are_clear_errors_and_change_nothing(tmp_path: Path, entry: dict, match: str) -> None:
     wf = _workflow(tmp_path)
-    wf.start_xyz4()
+    wf.start("xyz4")
     wf.auto_touch(AutoTouchRequest())
     rec = {"format": "tcp-pendant-session", "version": 1, "wizards": [entry]}
     with pytest.raises(SessionRecordError, match=match):

@@ -138,13 +138,6 @@ def test_fanuc_program_sections_and_register() -> None:
     assert "W =     -0.242 deg,\tP =     45.000 deg,\tR =    180.000 deg" in text
 
 
-def test_yaskawa_entry() -> None:
-    tool = Tool(name="TORCH", tcp_mm=(12.345, 0, 350), abc_deg=(180, -45, 0))
-    text = export_tool_file(tool, "yaskawa", number=1)
-    assert text.splitlines()[:3] == ["//TOOL 1", "///NAME TORCH",
-                                     "12.345,0.000,350.000,0.0000,-45.0000,180.0000"]
-
-
 @pytest.mark.parametrize(("fmt", "kwargs", "needle"), [
     ("kuka", {"number": 17}, "tool number must be 1..16"),
     ("kuka", {"name": "n" * 25}, "at most 24 characters"),
@@ -185,14 +178,49 @@ def test_reads_a_fanuc_program_setting_utool() -> None:
     assert angle_deg(entry.rotation, expect) < 1e-9
 
 
-def test_reads_a_yaskawa_tool_file() -> None:
-    entries = parse_tool_file((DATA / "tool.cnd").read_text(), "yaskawa")
-    assert [(e.number, e.name) for e in entries] == [(0, "FLANGE"), (1, "TORCH")]
+def test_reads_a_yrc1000_tool_file_with_crc_lines() -> None:
+    """TOOL_YRC1000.CND has the layout of a YRC1000's saved file (a ``///CRC`` line before
+    ``///NAME``, CRLF lines; docs/formats.md cites the public file): every name is kept."""
+    entries = parse_tool_file((DATA / "TOOL_YRC1000.CND").read_text(), "yaskawa")
+    assert [(e.number, e.name) for e in entries][:4] == [
+        (0, "R1 STANDARD TOOL"), (1, "TORCH"), (2, ""), (3, "SPINDLE 2")]
+    assert len(entries) == 8
     # Rx, Ry, Rz about the fixed X, Y, Z: R = Rz(180) Ry(-45), by hand
     c = math.sqrt(0.5)
     expect = np.array([[-1, 0, 0], [0, -1, 0], [0, 0, 1.0]]) @ np.array(
         [[c, 0, -c], [0, 1, 0], [c, 0, c]])
     assert angle_deg(entries[1].rotation, expect) < 1e-9
+    # the line after the pose is the centre of gravity, then the mass (not the inertia)
+    assert entries[1].mass_kg == 3.5 and entries[1].cog_mm == (0.0, -4.5, 120.0)
+    assert entries[3].mass_kg == 48.2 and entries[3].cog_mm == (-10.25, 15.0, -95.0)
+    assert entries[0].mass_kg is None and entries[0].cog_mm is None  # mass 0.000: unset
+
+
+def test_reads_a_dx100_tool_file() -> None:
+    entries = parse_tool_file((DATA / "TOOL_DX100.CND").read_text(), "yaskawa")
+    assert [(e.number, e.name, e.mass_kg) for e in entries] == [(0, "FLANGE", None),
+                                                               (1, "TORCH", 3.5)]
+    np.testing.assert_allclose(entries[1].tcp_mm, (12.345, 0, 350))
+
+
+def test_yaskawa_entry_writes_the_public_layout_with_the_tools_load() -> None:
+    """After the pose: Xg,Yg,Zg; W; Ix,Iy,Iz; the 3-field line, as the public files."""
+    tool = Tool(name="TORCH", tcp_mm=(12.345, 0, 350), abc_deg=(180, -45, 0), mass_kg=1.5,
+                cog_mm=(0, -4.5, 120))
+    lines = export_tool_file(tool, "yaskawa", number=1).splitlines()
+    assert lines == ["//TOOL 1", "///NAME TORCH", "12.345,0.000,350.000,0.0000,-45.0000,180.0000",
+                     "0.000,-4.500,120.000", "1.500", "0.000,0.000,0.000", "0.000,0,1"]
+    (entry,) = parse_tool_file("\n".join(lines), "yaskawa")
+    assert entry.mass_kg == 1.5 and entry.cog_mm == (0.0, -4.5, 120.0)
+    # the public file's layout, line by line: same count and field counts as our fixture
+    public = (DATA / "TOOL_DX100.CND").read_text().splitlines()[7:14]
+    assert [len(ln.split(",")) for ln in lines[1:]] == [len(ln.split(",")) for ln in public[1:]]
+
+
+def test_yaskawa_entry_of_a_tool_without_load_writes_the_unset_load() -> None:
+    tool = Tool(name="P", tcp_mm=(1, 2, 3))
+    lines = export_tool_file(tool, "yaskawa", number=2).splitlines()
+    assert lines[3:] == ["0.000,0.000,0.000", "0.000", "0.000,0.000,0.000", "0.000,0,1"]
 
 
 def test_the_ur_tcp_is_read_in_metres() -> None:

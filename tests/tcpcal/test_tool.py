@@ -230,6 +230,22 @@ def test_dict_contract_keys_and_json_round_trip():
     assert back == tool
 
 
+def test_centre_of_gravity_key_only_when_known():
+    """``cog_mm`` (FLANGE, mm) is written only for a tool that has one: the file of a tool
+    without it keeps the keys it always had, and an old file without it still loads."""
+    plain = Tool("p", (0, 0, 100), mass_kg=1.0)
+    assert "cog_mm" not in plain.to_dict() and plain.cog_mm is None
+    loaded = Tool("g", (0, 0, 100), mass_kg=2.0, cog_mm=(0, -4.5, 60))
+    d = loaded.to_dict()
+    assert list(d) == ["name", "tcp_mm", "abc_deg", "mass_kg", "cog_mm", "notes", "calibration"]
+    assert d["cog_mm"] == [0.0, -4.5, 60.0]
+    assert Tool.from_dict(json.loads(json.dumps(d))) == loaded
+    for bad, needle in (((0, 1), "cog_mm must be 3 numbers"), ((0, float("nan"), 1), "finite"),
+                        ("abc", "cog_mm must be 3 numbers")):
+        with pytest.raises(InvalidInputError, match=needle):
+            Tool("g", (0, 0, 100), cog_mm=bad)
+
+
 def test_from_dict_defaults_and_errors():
     tool = Tool.from_dict({"name": "p", "tcp_mm": [0, 0, 100]})
     assert tool.abc_deg == (0.0, 0.0, 0.0) and tool.mass_kg is None and tool.calibration is None

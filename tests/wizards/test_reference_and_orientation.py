@@ -21,7 +21,8 @@ from tcp_pendant.wizards import (
 
 def library_tool(synth_tool, name="tool", *, calibrated=True) -> Tool:
     cal = Calibration("xyz4-lstsq", "2026-01-01T00:00:00Z", {"ci95_mm": 0.3}) if calibrated else None
-    return Tool(name=name, tcp_mm=tuple(synth_tool.tcp_mm), calibration=cal)
+    return Tool(name=name, tcp_mm=tuple(synth_tool.tcp_mm), calibration=cal, mass_kg=2.0,
+                cog_mm=(1.0, 2.0, 50.0))
 
 
 def angle_deg(R1, R2) -> float:
@@ -90,6 +91,7 @@ def test_three_point_exact(synth, synth_tool, variant, third):
     assert t.calibration.figures["tcp_ci95_mm"] == pytest.approx(0.3)
     np.testing.assert_allclose(t.tcp_mm, synth_tool.tcp_mm)
     assert angle_deg(t.rotation, synth_tool.R_flange_tool) < 1e-6
+    assert (t.mass_kg, t.cog_mm) == (2.0, (1.0, 2.0, 50.0))  # the tool's load is kept
 
 
 def test_three_point_warns_on_short_displacement(synth):
@@ -132,6 +134,7 @@ def test_abc_world_6d_exact(synth, synth_tool):
     assert angle_deg(res.rotation, synth_tool.R_flange_tool) < 1e-6
     assert res.method == "abc-world-6d"
     assert wiz.to_tool("x").calibration.method == "abc-world-6d"
+    assert (wiz.to_tool("x").mass_kg, wiz.to_tool("x").cog_mm) == (2.0, (1.0, 2.0, 50.0))
 
 
 def test_abc_world_5d_fixes_tool_x_only(synth):

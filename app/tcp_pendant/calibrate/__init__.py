@@ -1,28 +1,26 @@
 """The Calibrate menu without viser: the workflow of the wizards in one pendant session
-(``workflow``), the words and tables it shows (``text``) and the per-touch error chart's data
-(``chart``). The viser views (``tcp_pendant.views.wizard_*``) render these; the math is tcpcal's,
-reached through the wizards (``tcp_pendant.wizards``).
+(``workflow``), the jobs the controller runs for a wizard (``jobs``), the words and tables it
+shows (``text``) and the per-touch error chart's data (``chart``). The viser views
+(``tcp_pendant.views.wizard_*``) render these; the math is tcpcal's, reached through the wizards
+(``tcp_pendant.wizards``).
 """
 
 from tcp_pendant.calibrate.chart import ErrorBars, error_bars
+from tcp_pendant.calibrate.jobs import JOBS, BeamScanJob, ControllerJob, TcpCheckJob
 from tcp_pendant.calibrate.workflow import (
     AUTO_SIGMA_MAX_MM,
-    WIZARD_KINDS,
-    WIZARD_LABELS,
     AutoTouchRequest,
-    BeamScanJob,
     CalibrationWorkflow,
-    ControllerJob,
 )
 
 __all__ = [
     "AUTO_SIGMA_MAX_MM",
-    "WIZARD_KINDS",
-    "WIZARD_LABELS",
+    "JOBS",
     "AutoTouchRequest",
     "BeamScanJob",
     "CalibrationWorkflow",
     "ControllerJob",
     "ErrorBars",
+    "TcpCheckJob",
     "error_bars",
 ]

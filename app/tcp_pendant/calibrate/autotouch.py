@@ -104,7 +104,8 @@ def auto_touch(wizard: Wizard, controller: Any, *,
                rng: np.random.Generator | None = None, advance: bool = True,
                tools: Mapping[str, Any] | None = None, max_attempts: int = 12,
                previous_direction_deg: tuple[float, float, float] | None = None,
-               mount: Callable[[Any], None] | None = None) -> AutoTouchOutcome:
+               mount: Callable[[Any], None] | None = None,
+               pose_check: Callable[[], str | None] | None = None) -> AutoTouchOutcome:
     """Perform the wizard's current step with the controller and record the flange pose.
 
     Args:
@@ -128,6 +129,9 @@ def auto_touch(wizard: Wizard, controller: Any, *,
             orientation (three-point steps 2 and 3, TCP & Z, X's z and x).
         mount: how to mount a tool (default ``controller.mount_tool``; the app passes the
             session's command, which signals the change).
+        pose_check: after a reached approach, why that pose does not serve the step (None: it
+            does), e.g. a TCP check's rotations that cannot be made from it; such a pose is not
+            recorded and the next direction is tried (``calibrate.jobs.POSE_CHECKS``).
     """
     if wizard.status != "in_progress":
         raise WizardStateError(f"Cannot auto-touch: {wizard.blocked_reason}")
@@ -197,6 +201,10 @@ def auto_touch(wizard: Wizard, controller: Any, *,
                 tilt, azimuth, spin = rng.uniform(lo, hi), rng.uniform(0.0, 360.0), rng.uniform(-90.0, 90.0)
             res = controller.auto_approach(tilt_deg=tilt, azimuth_deg=azimuth, spin_deg=spin,
                                            sigma_mm=sigma_mm, tip_offset_tool_mm=offset, rng=rng)
+            refused = None if not res.ok or pose_check is None else pose_check()
+            if refused is not None:            # reached, but unfit for what the step is for
+                last_message = refused
+                continue
             if res.ok:
                 wizard.record(controller.T_world_flange())
                 if advance and not wizard.on_last_step:

@@ -336,7 +336,7 @@ def update_tool_from_beam(library: ToolLibrary, slot: int, check: BeamCheck) -> 
         figures["direction_deviation_deg"] = check.direction_deviation_deg
     measured = tuple(float(v) for v in check.measured_tcp_mm)
     tool = Tool(name=current.name, tcp_mm=measured, abc_deg=current.abc_deg,  # type: ignore[arg-type]
-                mass_kg=current.mass_kg, notes=current.notes,
+                mass_kg=current.mass_kg, cog_mm=current.cog_mm, notes=current.notes,
                 calibration=Calibration.now(BEAM_METHOD, figures))
     library.save(slot, tool, activate=False)
     return tool

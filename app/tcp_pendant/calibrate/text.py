@@ -26,14 +26,13 @@ from tcp_pendant.wizards import (
     Xyz4Result,
     wizard_class,
 )
-from tcp_pendant.wizards.registry import LiveAttribute
-from tcp_pendant.wizards.tcp_check import TcpCheckResult, tcp_check_markdown
+from tcp_pendant.wizards.registry import wizard_class
+from tcp_pendant.wizards.tcp_check import tcp_check_markdown
 from tcp_pendant.wizards.session_record import ReplayCheck
-from tcp_pendant.wizards.truth import TruthComparison
+from tcp_pendant.wizards.truth import NUMERICAL_NOISE_MM, TruthComparison
 from tcpcal.pose_quality import CandidateGain, PoseQuality
 
 __all__ = [
-    "METHOD_BLURBS",
     "beam_result_markdown",
     "duration_words",
     "comparison_markdown",
@@ -47,11 +46,10 @@ __all__ = [
     "step_markdown",
     "steps_list_markdown",
     "truth_markdown",
+    "empty_touches_markdown",
     "warnings_markdown",
 ]
 
-METHOD_BLURBS: LiveAttribute = LiveAttribute("blurb")
-"""Kind -> what the method calibrates and how (each wizard class's ``blurb``; live view)."""
 
 
 def menu_markdown(kind: str, *, library_tool: str | None, reference_tool: str, new_tool: str,
@@ -176,15 +174,22 @@ def meter_markdown(gain: CandidateGain, quality: PoseQuality | None, sigma_mm: f
 
 
 def result_markdown(result: WizardResult, truth: TruthComparison | None = None) -> str:
-    """The calibrated frame and its quality figures (what a pendant shows after a calibration);
-    a TCP check's result: its rotations, implied error, correction and verdict; a beam
-    result: :func:`beam_result_markdown` (``truth``: its comparison with the true tool, given
-    only where the truth may be shown).
+    """What the result panel shows of ``result``, by how its wizard class shows results
+    (``Wizard.result_view``): the calibrated frame and its quality figures (what a pendant shows
+    after a calibration); a check's rotations, implied error, correction and verdict
+    (:func:`tcp_check_markdown`); a scan's events and lesson (:func:`beam_result_markdown`;
+    ``truth``: its comparison with the true tool, given only where the truth may be shown).
     """
-    if isinstance(result, TcpCheckResult):
-        return tcp_check_markdown(result)
-    if isinstance(result, BeamWizardResult):
-        return beam_result_markdown(result, truth)
+    view = wizard_class(result.wizard).result_view
+    if view == "spin_check":
+        return tcp_check_markdown(result)  # type: ignore[arg-type]  # its wizard's result type
+    if view == "beam_scan":
+        return beam_result_markdown(result, truth)  # type: ignore[arg-type]  # its wizard's result type
+    return touches_result_markdown(result)
+
+
+def touches_result_markdown(result: WizardResult) -> str:
+    """A result computed from recorded touches: the TCP (and orientation) with its figures."""
     x, y, z = (fmt_num(v) for v in result.tcp_mm)
     lines = [f"**TCP** X {x} · Y {y} · Z {z} mm"]
     if result.abc_deg is not None:
@@ -295,25 +300,41 @@ def _beam_lesson_markdown(result: BeamWizardResult, truth: TruthComparison | Non
         return ("**Automatic vs by hand:** no manual calibration of this tool in this session yet. "
                 f"The scan takes {duration_words(result.duration_s)} on a real robot; calibrate the tool by hand "
                 "(e.g. XYZ 4-point) and scan again to compare.")
-    name = f"{manual.run_number}: {_esc(manual.title)} (by hand)"
+    if manual.auto_touches == 0:
+        who, whose = "by hand", "your time"
+    elif manual.auto_touches >= manual.touches:
+        who, whose = "by Auto-touch", "Auto-touch's clicks"
+    else:
+        who, whose = f"{manual.auto_touches} of {manual.touches} touches by Auto-touch", "your time"
+    name = f"{manual.run_number}: {_esc(manual.title)} ({who})"
     if truth is None:
         return ("**Automatic vs by hand** (same tool)\n\n| calibration | time |\n|---|---|\n"
                 f"| Automatic (beam) | {duration_words(result.duration_s)} on a real robot |\n"
-                f"| {name} | {duration_words(manual.wall_time_s)} (your time) |")
+                f"| {name} | {duration_words(manual.wall_time_s)} ({whose}) |")
     head = ("**Automatic vs by hand** (same tool, against the true tool)\n\n"
             "| calibration | time | TCP error | direction error |\n|---|---|---|---|")
     beam = (f"| Automatic (beam) | {duration_words(result.duration_s)} on a real robot | "
             f"{_mm(truth.position_error_mm, 3)} | {_deg(truth.x_axis_error_deg, 3)} |")
-    hand = (f"| {name} | {duration_words(manual.wall_time_s)} (your time) | {_mm(manual.position_error_mm, 3)} | "
+    hand = (f"| {name} | {duration_words(manual.wall_time_s)} ({whose}) | {_mm(manual.position_error_mm, 3)} | "
             f"{_deg(manual.direction_error_deg, 3)} |")
     return "\n".join([head, beam, hand])
 
 
 def _touch_numbers(result: WizardResult) -> Sequence[int]:
-    """0-based recorded-touch index of each per-touch error (the used touches for 4-point)."""
-    if isinstance(result, Xyz4Result):
-        return result.used_indices
-    return range(len(result.per_touch_error_mm))
+    """0-based recorded-touch index of each per-touch error (a result that leaves touches out,
+    the 4-point's, says which it used: ``used_indices``)."""
+    used = getattr(result, "used_indices", None)
+    return range(len(result.per_touch_error_mm)) if used is None else used
+
+
+def empty_touches_markdown(wizard: Wizard | None) -> str:
+    """What the Touches list says with no free touch (Record point): "No touch recorded", or,
+    while a wizard on show has recorded steps, that they are its (our words and numbers)."""
+    n = 0 if wizard is None or wizard.status == "cancelled" else len(wizard.recorded_poses)
+    if n == 0:
+        return "*No touch recorded.*"
+    return (f"*No touch recorded with Record point. The {_esc(wizard.title)} wizard has {n} "
+            f"touch{'es' if n != 1 else ''} of its own: they are in its step list above.*")
 
 
 def warnings_markdown(result: WizardResult) -> str:
@@ -347,8 +368,11 @@ def truth_markdown(cmp: TruthComparison) -> str:
         lines.append(f"Orientation error: **{_deg(cmp.orientation_error_deg, 3)}** "
                      f"(tool X: {_deg(cmp.x_axis_error_deg, 3)})")
     if cmp.inside_ci95 is not None:
-        lines.append("The true TCP is " + ("inside" if cmp.inside_ci95 else "**outside**")
-                     + " the 95 % radius.")
+        if cmp.position_error_mm < NUMERICAL_NOISE_MM:
+            lines.append("The touches were exact (no operator error): the computed TCP is the true one.")
+        else:
+            lines.append("The true TCP is " + ("inside" if cmp.inside_ci95 else "**outside**")
+                         + " the 95 % radius.")
     return "\n\n".join(lines)
 
 

@@ -24,30 +24,32 @@ another wizard only cancels (never deletes) the one that was open.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping, Sequence
+from datetime import datetime
 from dataclasses import dataclass, field, replace
 from typing import Any, ClassVar, Literal, Protocol
 
 import numpy as np
 
-from tcp_pendant.controller import RobotKinematics, T_flange_tool_m, ToolModel, VirtualController, builtin_tools
-from tcp_pendant.controller.beam import BeamSensor, ToolShape
-from tcp_pendant.controller.beam_scan import BeamScan, BeamScanConfig, run_beam_scan, tool_shape
+from tcp_pendant.controller import T_flange_tool_m, ToolModel, VirtualController, builtin_tools
 from tcp_pendant.controller.errors import ControllerError
-from tcp_pendant.controller.jog import JogSettings
-from tcp_pendant.controller.spin import SpinCheckResult, spin_check
 from tcp_pendant.calibrate.autotouch import AutoTouchOutcome, auto_touch
+from tcp_pendant.calibrate.jobs import EXERCISE_REFUSAL, JOBS, POSE_CHECKS, ControllerJob
 from tcp_pendant.calibrate.diversity import failure_in_words
 from tcp_pendant.calibrate.library_save import save_result
+from tcp_pendant.events import (
+    RunCancelled,
+    RunFinished,
+    RunResumed,
+    RunStarted,
+    SessionEvent,
+    ToolSaved,
+    TouchRecorded,
+)
 from tcp_pendant.wizards import (
-    AbcWorldWizard,
-    BeamWizard,
     CalibrationFailedError,
     ManualComparison,
-    ReferenceWizard,
-    TcpCheckWizard,
-    TcpZxWizard,
-    ThreePointWizard,
     Wizard,
     WizardError,
     WizardResult,
@@ -55,7 +57,7 @@ from tcp_pendant.wizards import (
     Xyz4Wizard,
     wizard_class,
 )
-from tcp_pendant.wizards.registry import LiveAttribute, LiveKinds
+from tcp_pendant.wizards.base import RecordedPose
 from tcp_pendant.wizards.session_record import (
     LoadedRecord,
     ReplayCheck,
@@ -71,28 +73,16 @@ from tcpcal.tool import Tool
 
 __all__ = [
     "AUTO_SIGMA_MAX_MM",
-    "EXERCISE_REFUSAL",
-    "WIZARD_KINDS",
-    "WIZARD_LABELS",
     "AutoTouchRequest",
-    "BeamScanJob",
     "CalibrationWorkflow",
-    "ControllerJob",
     "ControllerToolState",
-    "TcpCheckJob",
     "ToolState",
 ]
 
-WIZARD_KINDS: LiveKinds = LiveKinds()
-"""The registered wizard kinds in menu order (a live view of ``tcp_pendant.wizards.registry``)."""
-WIZARD_LABELS: LiveAttribute = LiveAttribute("title")
-"""Kind -> the method's label (live view of the registry)."""
+_ANGLE_APART = re.compile(r"\(([0-9.]+) deg apart\)")
+"""The angle in tcpcal's "touches i and j (0-based) have the same orientation (x deg apart)"."""
 AUTO_SIGMA_MAX_MM = 2.0
-"""Largest simulated operator error the pendant offers (issue 5: slider 0-2 mm)."""
-EXERCISE_REFUSAL = ("{what} is off during the trainer's exercise: the beam sensor would measure the "
-                    "exercise's tool for you. Calibrate it by touching the reference tip (XYZ 4-point, "
-                    "XYZ reference or TCP & Z, X).")
-"""Why a method that measures the tool by itself is refused in an exercise (``hide_truth``)."""
+"""Largest simulated operator error the pendant offers (its slider runs 0-2 mm)."""
 
 
 @dataclass(frozen=True)
@@ -126,109 +116,6 @@ class AutoTouchRequest:
         if self.tilt_deg is None or self.azimuth_deg is None:
             return None
         return (float(self.tilt_deg), float(self.azimuth_deg), 0.0)
-
-
-class ControllerJob(Protocol):
-    """What a wizard on show waits for the controller to do (its step role is
-    ``by_controller``, or it checks a touch), detached from the session: taken on the loop
-    (:meth:`CalibrationWorkflow.controller_job`), :meth:`run` in a worker thread (pure: its
-    own copies of the robot models; the controller is not moved), the outcome handed back on
-    the loop (:meth:`CalibrationWorkflow.give_controller_job`)."""
-
-    wizard: Wizard
-
-    @property
-    def busy_text(self) -> str:
-        """What the steps view says while the job runs (markdown, our words only)."""
-
-    def run(self) -> Any:
-        """Do the work (worker thread)."""
-
-    def hand_in(self, outcome: Any) -> WizardResult | None:
-        """Give ``outcome`` to the wizard and finish it (None when the wizard was left meanwhile:
-        it keeps the outcome and shows it when resumed and finished)."""
-
-
-@dataclass(frozen=True, eq=False)
-class TcpCheckJob:
-    """The six rotations a TCP check wizard waits for, detached from the session: its own
-    copies of the robot models, so :meth:`run` (0.1-0.3 s) may run in a worker thread while the
-    loop keeps jogging. Metres and radians; the controller is not moved."""
-
-    busy_text: ClassVar[str] = "**Checking:** the controller turns the tool ±A, ±B, ±C about the TCP ..."
-
-    wizard: TcpCheckWizard
-    pose: Any                     # the RecordedPose the check starts from
-    kinematics: RobotKinematics
-    true_kinematics: RobotKinematics
-    q_rad: np.ndarray
-    T_flange_tool_active: np.ndarray
-    T_flange_tool_true: np.ndarray
-    settings: JogSettings = field(repr=False)
-
-    def run(self) -> SpinCheckResult:
-        """``controller.spin.spin_check`` from the recorded touch's joint angles."""
-        return spin_check(self.kinematics, self.q_rad, self.T_flange_tool_active, self.T_flange_tool_true,
-                          angle_deg=self.wizard.angle_deg, true_kinematics=self.true_kinematics,
-                          settings=self.settings)
-
-    def hand_in(self, outcome: SpinCheckResult) -> WizardResult | None:
-        """The check to its wizard (from the recorded touch it started at), then Finish."""
-        self.wizard.give_check(outcome, self.pose)
-        if self.wizard.status == "in_progress":
-            return self.wizard.finish()
-        return None
-
-
-@dataclass(frozen=True, eq=False)
-class BeamScanJob:
-    """The scan an Automatic (beam) wizard waits for, detached from the session: the robot
-    models (own copies), the joints where it starts, the beam sensor, the tool data the
-    controller plans with and the physical tool the beam sees, so :meth:`run` may run in a
-    worker thread. Metres and radians; the controller is not moved.
-
-    Attributes:
-        wizard: the beam wizard.
-        kinematics: the controller's (nominal) model; true_kinematics: the physical robot.
-        q_start_rad: joints where the scan starts.
-        sensor: the beam device; shape: the physical (true) tool the beam sees.
-        T_flange_tool_plan: (4,4) the tool data the controller plans with, m.
-        config: the scan's speeds and orientations (from the wizard's options).
-        seed: seed of the sensor's repeatability noise (None: exact events).
-        manual: the trainee's last manual calibration of the same tool, or None.
-    """
-
-    busy_text: ClassVar[str] = ("**Scanning:** the controller moves the tool through the beam at each "
-                                "orientation and records every beam event ...")
-
-    wizard: BeamWizard
-    kinematics: RobotKinematics
-    true_kinematics: RobotKinematics
-    q_start_rad: np.ndarray
-    sensor: BeamSensor
-    shape: ToolShape
-    T_flange_tool_plan: np.ndarray
-    config: BeamScanConfig
-    seed: int | None = None
-    manual: ManualComparison | None = None
-
-    def run(self) -> BeamScan:
-        """``controller.beam_scan.run_beam_scan`` from the start joints.
-
-        Raises:
-            ControllerError: nothing could be scanned (the reasons in words).
-        """
-        rng = None if self.seed is None else np.random.default_rng(self.seed)
-        return run_beam_scan(self.kinematics, self.q_start_rad, self.sensor, self.T_flange_tool_plan,
-                             self.shape, true_kinematics=self.true_kinematics, config=self.config, rng=rng)
-
-    def hand_in(self, outcome: BeamScan) -> WizardResult | None:
-        """The scan to its wizard (with the planning orientation and the manual comparison),
-        then Finish (a ``CalibrationFailedError`` when the events cannot give a TCP)."""
-        self.wizard.give_scan(outcome, R_flange_tool_base=self.T_flange_tool_plan[:3, :3], manual=self.manual)
-        if self.wizard.status == "in_progress":
-            return self.wizard.finish()
-        return None
 
 
 class ToolState(Protocol):
@@ -289,19 +176,72 @@ class CalibrationWorkflow:
         self.last_save: tuple[int, Tool] | None = None
         self._saved_results: dict[int, WizardResult] = {}    # run index -> the result saved from it
         self._auto_directions: dict[int, tuple[float, float, float]] = {}   # run -> last auto-touch
-        self.auto_touches = 0
-        """Auto-touch clicks so far (the classroom recorder tells Auto-touch from hand touches)."""
         self.honest_records = False
         """A classroom session: the exported record carries no truth (``session_record`` honest)."""
         self.record_ids: dict[int, int] = {}
         """Run index -> gradebook calibration id (the classroom recorder fills it; exported)."""
-        self._check_q: dict[int, tuple[Any, np.ndarray]] = {}   # run -> (recorded touch, joints there)
+        self._record_q: dict[int, tuple[RecordedPose, np.ndarray]] = {}   # id(pose) -> (pose, joints rad)
+        self._events: list[SessionEvent] = []
+        self._failure: tuple[int, str] | None = None   # (run, why its Finish failed); dropped on a change
+        self._auto_steps: dict[int, set[int]] = {}     # run -> steps whose pose Auto-touch recorded
+
+    # ------------------------------------------------------------ events
+    def take_events(self) -> tuple[SessionEvent, ...]:
+        """The events of the commands since the last call, in order (``tcp_pendant.events``);
+        the session puts them into its change signal."""
+        events, self._events = tuple(self._events), []
+        return events
+
+    def _index_of(self, wizard: Wizard) -> int | None:
+        """The run index of ``wizard`` (None: not one of this workflow's runs)."""
+        return next((i for i, r in enumerate(self.runs) if r.wizard is wizard), None)
+
+    def _finished(self, wizard: Wizard, result: WizardResult | None) -> WizardResult | None:
+        """Note a result just computed (:class:`RunFinished`); returns it."""
+        i = self._index_of(wizard)
+        if result is not None and i is not None:
+            self._events.append(RunFinished(i, result, self.runs[i].T_flange_tool_true_m))
+        return result
+
+    def _recorded(self, step: int, *, auto: bool, had_pose: bool) -> None:
+        """Facts of the pose just recorded at ``step`` of the run on show, taken now (the robot
+        stands at it): its joints and distance, kept in the run and in a :class:`TouchRecorded`."""
+        run, i = self.run, self._current
+        if run is None or i is None:
+            return
+        pose = run.wizard.recorded_poses.get(step)
+        if pose is None:
+            return
+        self._failure = None                       # a new touch: the failed Finish no longer applies
+        c = self.controller
+        joints = tuple(c.joint_angles_deg().values())
+        run.joints_deg[step] = joints
+        auto_steps = self._auto_steps.setdefault(i, set())
+        if auto:
+            auto_steps.add(step)
+        else:
+            auto_steps.discard(step)
+        self._record_q[id(pose)] = (pose, c.q_rad.copy())
+        self._note_distance(step)
+        self._events.append(TouchRecorded(i, step, pose.T_world_flange_m, joints,
+                                          float(c.touch_geometry().distance_mm), auto, had_pose))
+
+    def joints_at_record(self, pose: RecordedPose) -> np.ndarray | None:
+        """The joints (rad) where ``pose`` was recorded in this session (None: not known, e.g.
+        a pose loaded from a record)."""
+        known = self._record_q.get(id(pose))
+        return None if known is None or known[0] is not pose else known[1].copy()
 
     # ------------------------------------------------------------ state
     @property
     def run(self) -> WizardRun | None:
         """The wizard run on show (open, finished or cancelled), or None."""
         return None if self._current is None else self.runs[self._current]
+
+    @property
+    def run_index(self) -> int | None:
+        """The index in :attr:`runs` of the run on show, or None."""
+        return self._current
 
     @property
     def wizard(self) -> Wizard | None:
@@ -327,7 +267,7 @@ class CalibrationWorkflow:
         """Run ``index`` is finished and its result, as it is now, was saved to the library (a
         finished check, which saves nothing, is done as it is)."""
         w = self.runs[index].wizard
-        if not getattr(w, "saves_to_library", True) and w.finished_result is not None:
+        if not w.saves_to_library and w.finished_result is not None:
             return True
         saved = self._saved_results.get(index)
         return saved is not None and saved is self.runs[index].wizard.finished_result
@@ -339,18 +279,22 @@ class CalibrationWorkflow:
 
     def resumable(self) -> list[tuple[int, str]]:
         """Cancelled runs still to be done, newest first: (index in ``runs``, label for the
-        "Left half-way" list). A finished run whose result was saved is done and not listed; a
-        finished one not saved is ("finished, not saved")."""
+        Resume list) naming the calibration, where it was left and when it started (the
+        server's local time): "3: XYZ 4-point, at step 2 of 4 (1 recorded), started 14:02". A
+        finished run whose result was saved is done and not listed; a finished one not saved is
+        "result not saved" (it is not half-way: only its Save is missing)."""
         out = []
         for i in range(len(self.runs) - 1, -1, -1):
             w = self.runs[i].wizard
             if w.status != "cancelled" or self._is_saved(i):
                 continue
+            started = _clock(w.started_at)
             if w.finished_result is not None:
-                out.append((i, f"{i + 1}: {w.title}, finished, not saved"))
+                out.append((i, f"{i + 1}: {w.title}, result not saved, started {started}"))
             else:
                 done = sum(1 for s in w.steps if s.recorded)
-                out.append((i, f"{i + 1}: {w.title}, {done} of {w.n_steps} recorded"))
+                out.append((i, f"{i + 1}: {w.title}, at step {w.step_index + 1} of {w.n_steps} "
+                               f"({done} recorded), started {started}"))
         return out
 
     # ------------------------------------------------------------ library
@@ -370,14 +314,24 @@ class CalibrationWorkflow:
         resumable, nothing lost) and the last save message no longer applies."""
         current = self.wizard
         if current is not None and current.status != "cancelled":
-            current.cancel()
+            self._cancel(current)
         self.last_save = None
+
+    def _cancel(self, wizard: Wizard) -> None:
+        finished = wizard.finished_result is not None
+        wizard.cancel()
+        i = self._index_of(wizard)
+        if i is not None:
+            self._events.append(RunCancelled(i, finished))
 
     def _open(self, wizard: Wizard, true_tool: ToolModel | None) -> Wizard:
         self._leave_open_wizard()
         T_true = None if true_tool is None else np.array(true_tool.T_flange_tool_true, dtype=float)
-        self.runs.append(WizardRun(wizard, None if true_tool is None else true_tool.key, T_true))
+        key = None if true_tool is None else true_tool.key
+        self.runs.append(WizardRun(wizard, key, T_true))
         self._current = len(self.runs) - 1
+        self._events.append(RunStarted(self._current, wizard.kind, wizard.title,
+                                       key if key is not None else self.controller.mounted_tool.key, T_true))
         self.note_mounted_tool()
         return wizard
 
@@ -397,10 +351,6 @@ class CalibrationWorkflow:
         if started.active_data is not None:
             self.state.set_active_data(started.active_data[0], int(started.active_data[1]))
         return started.wizard
-
-    def start_xyz4(self, *, n_points: int = 4, estimator: str = "lstsq") -> Xyz4Wizard:
-        """Open an XYZ 4-point wizard for the mounted tool (its truth is graded)."""
-        return self.start("xyz4", n_points=n_points, estimator=estimator)  # type: ignore[return-value]
 
     def start_from_touches(self, touches: Sequence[Any], *, estimator: str = "lstsq") -> Xyz4Wizard:
         """Open an XYZ 4-point wizard whose first steps are ``touches`` already recorded (the
@@ -428,41 +378,22 @@ class CalibrationWorkflow:
         Xyz4Wizard(n_points=max(Xyz4Wizard.MIN_POINTS, len(poses))).prefill(poses)   # checked before opening
         w = self.start("xyz4", n_points=max(Xyz4Wizard.MIN_POINTS, len(poses)), estimator=estimator)
         w.prefill(poses)
-        run = self.run
+        run, index = self.run, self._current
         hidden = bool(getattr(self.state, "hide_distance", False))
+        recorded = w.recorded_poses
         for i, t in enumerate(touches):
             d = float(getattr(t, "distance_mm", float("nan")))
+            joints = tuple(float(v) for v in getattr(t, "joints_deg", ()))
             if run is not None and np.isfinite(d) and d >= 0.0:
                 run.distance_mm[i] = d
                 if hidden:
                     run.distance_hidden.add(i)
-        return w  # type: ignore[return-value]
-
-    def start_reference(self, *, reference_slot: int, reference_tool_key: str,
-                        new_tool_key: str) -> ReferenceWizard:
-        """Open an XYZ reference wizard (activates the reference data).
-
-        Args:
-            reference_slot: library slot of the calibrated reference tool's data.
-            reference_tool_key: the physical tool that data belongs to (mounted for step 1).
-            new_tool_key: the physical tool to calibrate (mounted for step 2; its truth is graded).
-        """
-        return self.start("reference", slot=reference_slot, reference_tool_key=reference_tool_key,  # type: ignore[return-value]
-                          new_tool_key=new_tool_key)
-
-    def start_tcp_zx(self, *, n_points: int = 4) -> TcpZxWizard:
-        """Open a TCP & Z, X wizard for the mounted tool (its truth is graded)."""
-        return self.start("tcp-zx", n_points=n_points)  # type: ignore[return-value]
-
-    def start_three_point(self, *, slot: int, variant: Literal[1, 2] = 1) -> ThreePointWizard:
-        """Open a three-point orientation wizard for the library tool in ``slot`` (its TCP must be
-        calibrated); the tool data is made active so jogs along tool X/Y use it."""
-        return self.start("three-point", slot=slot, variant=variant)  # type: ignore[return-value]
-
-    def start_abc_world(self, *, slot: int, variant: Literal["6d", "5d"] = "6d") -> AbcWorldWizard:
-        """Open an ABC world wizard for the library tool in ``slot``; its data is made active so
-        rotations A, B, C turn about its TCP."""
-        return self.start("abc-world", slot=slot, variant=variant)  # type: ignore[return-value]
+            if run is not None and joints:
+                run.joints_deg[i] = joints
+            if index is not None and i in recorded:
+                self._events.append(TouchRecorded(index, i, recorded[i].T_world_flange_m, joints, d,
+                                                  auto=False, overwrite=False))
+        return w
 
     # ------------------------------------------------------------ navigation
     def _note_distance(self, step: int) -> None:
@@ -478,6 +409,14 @@ class CalibrationWorkflow:
         else:
             run.distance_hidden.discard(step)
 
+    def require_wizard(self) -> Wizard:
+        """The wizard on show.
+
+        Raises:
+            WizardStateError: none is open (says how to start one).
+        """
+        return self._require()
+
     def _require(self) -> Wizard:
         w = self.wizard
         if w is None:
@@ -486,7 +425,9 @@ class CalibrationWorkflow:
 
     def cancel(self) -> None:
         """Leave the wizard; its poses are kept and it can be resumed."""
-        self._require().cancel()
+        w = self._require()
+        if w.status != "cancelled":
+            self._cancel(w)
 
     def resume(self, index: int | None = None) -> Wizard:
         """Resume a cancelled run: ``index`` (0-based in ``runs``; any cancelled run, also a
@@ -505,6 +446,7 @@ class CalibrationWorkflow:
         w = self.runs[i].wizard
         self.note_mounted_tool()
         w.resume()
+        self._events.append(RunResumed(i))
         return w
 
     def required_tool(self) -> ToolModel | None:
@@ -536,9 +478,9 @@ class CalibrationWorkflow:
         w = self._require()
         self.note_mounted_tool()
         step = w.step_index
+        had_pose = step in w.recorded_poses
         w.record(self.controller.T_world_flange())
-        self._note_distance(step)
-        self._note_check_joints(w)
+        self._recorded(step, auto=False, had_pose=had_pose)
 
     def next(self) -> WizardResult | None:
         """Next step; on the last step compute the result (returned)."""
@@ -550,19 +492,49 @@ class CalibrationWorkflow:
             out = w.next()
         except CalibrationFailedError as exc:
             raise self._in_words(exc) from exc
-        return out if isinstance(out, WizardResult) else None
+        return self._finished(w, out) if isinstance(out, WizardResult) else None
 
     def _in_words(self, exc: CalibrationFailedError) -> CalibrationFailedError:
-        """tcpcal's failure with its FLANGE axis said in words (``diversity.failure_in_words``)."""
-        axis = getattr(exc.cause, "unobservable_axis", None)
-        if axis is None:
-            return exc
-        R_world_flange = self.controller.T_world_flange()[:3, :3]
-        return CalibrationFailedError(failure_in_words(str(exc), axis, R_world_flange), exc.cause)
+        """tcpcal's failure in the trainee's words, with what to do: the touches it is about
+        as step numbers (two with the same orientation: go back to the later one), its FLANGE
+        axis in words (``diversity.failure_in_words``). Kept as :attr:`finish_failure` for the
+        step panels until the wizard changes."""
+        w, cause = self.wizard, exc.cause
+        axis = getattr(cause, "unobservable_axis", None)
+        pair = tuple(getattr(cause, "indices", ()))
+        steps = () if w is None else w.solver_touch_steps()
+        if len(pair) == 2 and all(0 <= k < len(steps) for k in pair):
+            a, b = (steps[k] + 1 for k in pair)
+            angle = _ANGLE_APART.search(str(exc))
+            apart = f" ({angle.group(1)}° apart)" if angle else ""
+            todo = (f"record step {b} again" if w is not None and w.step_index == b - 1
+                    else f"go Back to step {b} and record it again")
+            text = (f"Touches {a} and {b} have the same orientation{apart}: the method needs clearly "
+                    f"different orientations. Tilt the tool 30-60° about another axis and {todo}.")
+            out = CalibrationFailedError(text, cause)
+        elif axis is not None:
+            R_world_flange = self.controller.T_world_flange()[:3, :3]
+            out = CalibrationFailedError(failure_in_words(str(exc), axis, R_world_flange) +
+                                         " Go Back to a step and record it tilted about that axis.", cause)
+        else:
+            out = exc
+        if self._current is not None:
+            self._failure = (self._current, str(out))
+        return out
+
+    @property
+    def finish_failure(self) -> str | None:
+        """Why the last Finish of the run on show could not compute, and what to do (plain
+        text, our words and numbers), while the run is still where it failed; else None."""
+        failure, w = self._failure, self.wizard
+        if failure is None or failure[0] != self._current or w is None or w.status != "in_progress":
+            return None
+        return failure[1]
 
     def back(self) -> None:
         """One step back (from the result: to the last step); nothing is deleted."""
         self._require().back()
+        self._failure = None
 
     def auto_touch(self, request: AutoTouchRequest) -> AutoTouchOutcome:
         """Training mode: let the controller perform the current step (mounting the tool it
@@ -581,23 +553,24 @@ class CalibrationWorkflow:
             raise WizardStateError(f"The {w.title} wizard has nothing to touch: the controller runs this "
                                    "step itself; press Finish.")
         run_index = self._current
-        self.auto_touches += 1
         self.note_mounted_tool()
+        had_pose = set(w.recorded_poses) if w.status == "in_progress" else set()
+        job = type(w).controller_job
+        pose_check = POSE_CHECKS[job](self, w) if job in POSE_CHECKS else None
         out = auto_touch(w, self.controller, direction_deg=request.direction_deg,
                          sigma_mm=request.sigma_mm, rng=self.rng, tools=self.tools,
-                         previous_direction_deg=self._auto_directions.get(run_index),  # type: ignore[arg-type]
-                         mount=self.state.mount_tool)
+                         previous_direction_deg=None if run_index is None else self._auto_directions.get(run_index),
+                         mount=self.state.mount_tool, pose_check=pose_check)
         self.note_mounted_tool()
         if out.ok:                            # the robot stands at the touch it recorded
-            self._note_distance(out.step_index)
-        self._note_check_joints(w)
+            self._recorded(out.step_index, auto=True, had_pose=out.step_index in had_pose)
         if out.direction_deg is not None and run_index is not None:
             self._auto_directions[run_index] = out.direction_deg
-        if isinstance(w, TcpCheckWizard):     # Finish runs the check (off the loop in the app)
+        if type(w).controller_job is not None:    # Finish runs the controller's job (off the loop in the app)
             return out
         if out.ok and w.on_last_step and all(s.recorded for s in w.steps):
             try:
-                w.finish()
+                self._finished(w, w.finish())
             except CalibrationFailedError as exc:
                 raise self._in_words(exc) from exc
         return out
@@ -625,7 +598,7 @@ class CalibrationWorkflow:
     def preview_tool(self) -> Tool | None:
         """The tool "Save" would store (named "preview"), or None before a result."""
         w = self.wizard
-        if w is None or w.result is None or not getattr(w, "saves_to_library", True):
+        if w is None or w.result is None or not w.saves_to_library:
             return None
         return w.to_tool("preview")
 
@@ -657,7 +630,7 @@ class CalibrationWorkflow:
             tcpcal.TcpcalError: the library refused (the name is used by another slot, ...).
         """
         w = self._require()
-        if not getattr(w, "saves_to_library", True):
+        if not w.saves_to_library:
             raise WizardStateError(f"The {w.title} saves nothing to the library: it only checks the tool data.")
         name = str(name).strip()
         if not name:
@@ -667,76 +640,31 @@ class CalibrationWorkflow:
         self.last_save = slot_tool
         if self._current is not None and w.result is not None:
             self._saved_results[self._current] = w.result
+        self._events.append(ToolSaved(self._current, slot_tool[0], slot_tool[1].name))
         return slot_tool
-
-    # ------------------------------------------------------------ TCP check wizard
-    def _note_check_joints(self, w: Wizard) -> None:
-        """Remember the joints of a TCP check's recorded touch (the check starts there)."""
-        if isinstance(w, TcpCheckWizard) and w.recorded_pose is not None and self._current is not None:
-            known = self._check_q.get(self._current)
-            if known is None or known[0] is not w.recorded_pose:
-                self._check_q[self._current] = (w.recorded_pose, self.controller.q_rad.copy())
-
-    def tcp_check_job(self) -> TcpCheckJob | None:
-        """The check the TCP check wizard on show waits for (None: nothing to check), from its
-        recorded touch with the checked tool data as the active TCP and the mounted tool's truth.
-
-        Raises:
-            WizardStateError: the touch's joint angles are unknown (a resumed record) and the
-                robot is no longer there: record the touch again.
-        """
-        w = self.wizard
-        if not isinstance(w, TcpCheckWizard) or not w.check_pending:
-            return None
-        pose, c = w.recorded_pose, self.controller
-        known = None if self._current is None else self._check_q.get(self._current)
-        if known is not None and known[0] is pose:
-            q = known[1]
-        elif np.allclose(c.T_world_flange(), pose.T_world_flange_m, atol=1e-7):
-            q = c.q_rad.copy()
-        else:
-            raise WizardStateError("The robot is not at the recorded touch any more: press Record again "
-                                   "with the tool tip on the reference tip, then Finish.")
-        T_active = T_flange_tool_m(w.tool)
-        nominal, physical = c.kinematics_for_worker()
-        return TcpCheckJob(w, pose, nominal, physical, np.array(q, dtype=float), T_active,
-                           np.array(c.mounted_tool.T_flange_tool_true, dtype=float), c.settings)
-
-    def give_tcp_check(self, job: TcpCheckJob, result: SpinCheckResult) -> WizardResult | None:
-        """Hand a finished check to its wizard and finish it (the wizard may have been left
-        meanwhile: then it keeps the check and shows it when resumed and finished)."""
-        return self.give_controller_job(job, result)
-
-    def run_tcp_check(self) -> WizardResult | None:
-        """Run the waiting TCP check here (synchronously; the app runs :meth:`tcp_check_job`
-        in a worker instead) and finish the wizard."""
-        job = self.tcp_check_job()
-        if job is None:
-            raise WizardStateError("No TCP check is waiting: record the touch first.")
-        return self.give_tcp_check(job, job.run())
 
     # ------------------------------------------------------------ controller jobs (any wizard)
     def controller_job(self) -> ControllerJob | None:
         """What the wizard on show waits for the controller to do before it can finish (None:
-        nothing): a TCP check's six rotations (:meth:`tcp_check_job`) or a beam wizard's scan
-        (:meth:`beam_scan_job`). Taken on the loop; the app runs ``job.run()`` in a worker and
-        hands the outcome back with :meth:`give_controller_job`.
+        nothing): the job its class names (``Wizard.controller_job``, built by
+        ``calibrate.jobs.JOBS``: a TCP check's six rotations, a beam wizard's scan). Taken on
+        the loop; the app runs ``job.run()`` in a worker and hands the outcome back with
+        :meth:`give_controller_job`.
 
         Raises:
             WizardStateError: the job cannot be taken now (the message says what to do).
         """
         w = self.wizard
-        if isinstance(w, TcpCheckWizard):
-            return self.tcp_check_job()
-        if isinstance(w, BeamWizard):
-            return self.beam_scan_job()
-        return None
+        name = None if w is None else type(w).controller_job
+        if w is None or name is None:
+            return None
+        return JOBS[name](self, w)
 
     def give_controller_job(self, job: ControllerJob, outcome: Any) -> WizardResult | None:
         """Hand a job's outcome to its wizard and finish it (None when the wizard was left
         meanwhile: it keeps the outcome)."""
         try:
-            return job.hand_in(outcome)
+            return self._finished(job.wizard, job.hand_in(outcome))
         except CalibrationFailedError as exc:
             raise self._in_words(exc) from exc
 
@@ -756,47 +684,6 @@ class CalibrationWorkflow:
             raise WizardStateError(str(exc)) from exc
         return self.give_controller_job(job, outcome)
 
-    # ------------------------------------------------------------ Automatic (beam) wizard
-    def beam_scan_job(self) -> BeamScanJob | None:
-        """The scan the beam wizard on show waits for (None: none waiting), from the robot's
-        joints now, on the session's beam sensor, planned with the mounted tool's nominal
-        (catalogue) data for a built-in tool, else with the active tool data; the beam sees
-        the physical tool (its true frame, bent by a scenario). The noise seed comes from the
-        workflow's ``rng`` (a seeded workflow scans reproducibly).
-
-        Raises:
-            WizardStateError: the beam cannot measure the mounted tool (the gripper), no tool
-                data to plan with (a tool of no catalogue and no active tool data), or a
-                classroom exercise runs (``hide_truth``: the scan would measure its tool).
-        """
-        w = self.wizard
-        if not isinstance(w, BeamWizard) or not w.scan_pending:
-            return None
-        if self.hide_truth:     # an exercise began after the wizard was opened
-            raise WizardStateError(EXERCISE_REFUSAL.format(what="The Automatic (beam) scan"))
-        c = self.controller
-        mounted = c.mounted_tool
-        try:
-            shape = tool_shape(mounted)
-        except ControllerError as exc:
-            raise WizardStateError(f"{exc} Mount the pointer or the torch on the Tool tab.") from exc
-        catalogue = builtin_tools().get(mounted.key)
-        if catalogue is not None:
-            T_plan = np.array(catalogue.T_flange_tool_true, dtype=float)
-        elif c.active_tool is not None:
-            T_plan = T_flange_tool_m(c.active_tool)
-        else:
-            raise WizardStateError(f"The controller needs approximate tool data of the {mounted.label.lower()} "
-                                   "to plan the scan: calibrate it by hand or enter its data on the Tool tab, "
-                                   "make it active, then press Finish again.")
-        nominal, physical = c.kinematics_for_worker()
-        try:
-            config = BeamScanConfig(n_orientations=w.n_orientations, scan_speed_mm_s=w.scan_speed_mm_s)
-        except ControllerError as exc:
-            raise WizardStateError(str(exc)) from exc
-        return BeamScanJob(w, nominal, physical, c.q_rad.copy(), c.beam_sensor, shape, T_plan, config,
-                           seed=int(self.rng.integers(2**31)), manual=self.manual_comparison())
-
     def manual_comparison(self, index: int | None = None) -> ManualComparison | None:
         """The trainee's last finished manual calibration of the same physical tool as run
         ``index`` (default: the one on show) in this session, for the beam wizard's lesson: its
@@ -814,15 +701,16 @@ class CalibrationWorkflow:
             run = self.runs[j]
             w, res = run.wizard, run.wizard.finished_result
             if (j == i or res is None or run.true_tool_key != key or res.tcp_result is None
-                    or not getattr(w, "saves_to_library", True)
-                    or any(r.auto.by_controller for r in type(w).step_roles)):
+                    or not w.saves_to_library or type(w).controller_job is not None):
                 continue
             seconds = wall_time_s(w.started_at, res.computed_at)
             pos = ang = grade = None
             if self.training and not self.hide_truth and run.T_flange_tool_true_m is not None:
                 cmp = compare_with_truth(res, run.T_flange_tool_true_m)
                 pos, ang, grade = cmp.position_error_mm, cmp.x_axis_error_deg, cmp.grade
-            return ManualComparison(w.title, w.kind, j + 1, 0.0 if seconds is None else seconds, pos, ang, grade)
+            auto = len(self._auto_steps.get(j, set()) & set(w.recorded_poses))
+            return ManualComparison(w.title, w.kind, j + 1, 0.0 if seconds is None else seconds, pos, ang, grade,
+                                    touches=len(w.recorded_poses), auto_touches=auto)
         return None
 
     # ------------------------------------------------------------ session record
@@ -865,6 +753,14 @@ class CalibrationWorkflow:
             self._current = finished[-1]
             self.runs[self._current].wizard.resume()
         return checks
+
+
+def _clock(iso_utc: str) -> str:
+    """An ISO 8601 UTC time as the server's local HH:MM ("?" when unreadable)."""
+    try:
+        return datetime.fromisoformat(iso_utc.replace("Z", "+00:00")).astimezone().strftime("%H:%M")
+    except ValueError:
+        return "?"
 
 
 class _StartContext:

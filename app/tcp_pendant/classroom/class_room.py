@@ -150,9 +150,8 @@ class ClassRoom:
     def _start(self, session: Session, join: TraineeJoin) -> TraineeRecorder:
         with session.lock:
             sid = self.gradebook.start_session(join.trainee_id, "per-browser")
-            calibrate = session.views.get("calibrate")
-            workflow = getattr(calibrate, "workflow", None)
-            recorder = TraineeRecorder(self.gradebook, sid, join.name, session.controller, workflow,
+            session.keep_honest_records()             # the trainee's export carries no answer key
+            recorder = TraineeRecorder(self.gradebook, sid, join.name, session.workflow,
                                        exercise_id=self.exercise)
             with self._lock:
                 self._trainees[id(session)] = (session, recorder, join.name)
@@ -160,7 +159,7 @@ class ClassRoom:
                 self._subscribed.add(id(session))
             if follow:
                 session.subscribe(lambda change: self._on_change(session, change))
-            self._hide_truth(workflow, self.exercise)
+            session.set_hide_truth(self.exercise is not None)
             if self.exercise == "mystery":
                 self._mount_mystery(session, recorder, join.name)
             if self.hide_distance is not None:
@@ -220,19 +219,11 @@ class ClassRoom:
         """Names a browser holds (the trainer view's "Release a name" choices)."""
         return self.gradebook.held_names()
 
-    @staticmethod
-    def _hide_truth(workflow: Any | None, exercise: str | None) -> None:
-        """In an exercise the trainee's result shows no truth (free practice: training mode's)."""
-        if workflow is not None:
-            workflow.hide_truth = exercise is not None
-
     def _mount_mystery(self, session: Session, recorder: TraineeRecorder, name: str) -> None:
         base = self.tools.get("pointer") or next(iter(self.tools.values()))
         tool = draw_mystery_tool(self._seed(), name, base)
-        workflow = recorder.workflow
-        if workflow is not None:
-            workflow.tools[tool.key] = tool          # its label in the wizard's tool-change words
         recorder.exercise_id = "mystery"
+        session.add_physical_tool(tool)              # its label in the wizard's tool-change words
         session.mount_tool(tool)
 
     def detach(self, session: Session) -> None:
@@ -309,7 +300,7 @@ class ClassRoom:
             def apply(session: Session = session, recorder: TraineeRecorder = recorder, name: str = name) -> None:
                 with session.batch():
                     recorder.exercise_id = exercise
-                    self._hide_truth(recorder.workflow, exercise)
+                    session.set_hide_truth(exercise is not None)
                     if exercise == "mystery":
                         self._mount_mystery(session, recorder, name)
                     elif tool_key is not None:

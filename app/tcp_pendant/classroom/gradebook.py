@@ -181,6 +181,8 @@ class GradeRow:
         tcp_mm / abc_deg: the computed TOOL frame (mm, KUKA A, B, C deg) or None.
         position_error_mm / orientation_error_deg: error against the true TOOL frame, or None.
         grade: "good" | "fair" | "poor" | None.
+        status: "finished", or "in_progress" (``grades(include_in_progress=True)``: no result
+            yet, ``finished_at`` empty, ``duration_s`` up to now).
     """
 
     calibration_id: int
@@ -204,6 +206,7 @@ class GradeRow:
     position_error_mm: float | None = None
     orientation_error_deg: float | None = None
     grade: str | None = None
+    status: str = "finished"
 
 
 @dataclass(frozen=True)
@@ -250,7 +253,7 @@ CSV_COLUMNS: tuple[str, ...] = (
     "calibration_id", "trainee", "session_id", "mode", "method", "tool", "exercise",
     "started_at", "finished_at", "duration_s", "touches", "hand", "auto", "overwritten", "crashes",
     "tcp_x_mm", "tcp_y_mm", "tcp_z_mm", "a_deg", "b_deg", "c_deg",
-    *CSV_FIGURES, "position_error_mm", "orientation_error_deg", "grade", "figures_json",
+    *CSV_FIGURES, "position_error_mm", "orientation_error_deg", "grade", "figures_json", "status",
 )
 """Columns of :func:`to_csv` (a contract: docs/architecture.md "Classroom (gradebook)")."""
 
@@ -287,7 +290,7 @@ def to_csv(rows: Sequence[GradeRow]) -> str:
             r.started_at, r.finished_at, round(r.duration_s, 3), r.touches, r.hand, r.auto,
             r.overwritten, r.crashes, *tcp, *abc, *(r.figures.get(k) for k in CSV_FIGURES),
             r.position_error_mm, r.orientation_error_deg, r.grade,
-            json.dumps(dict(r.figures), sort_keys=True))])
+            json.dumps(dict(r.figures), sort_keys=True), r.status)])
     return out.getvalue()
 
 
@@ -859,30 +862,33 @@ class Gradebook:
             cid = self._calibration(db, calibration_id)[0]
             return json.loads(db.execute("SELECT truth_json FROM calibrations WHERE id = ?", (cid,)).fetchone()[0])
 
-    def grades(self) -> list[GradeRow]:
-        """One row per finished calibration, oldest start first."""
+    def grades(self, *, include_in_progress: bool = False) -> list[GradeRow]:
+        """One row per finished calibration, oldest start first; with ``include_in_progress``
+        also the calibrations still in progress (``GradeRow.status``)."""
+        statuses = "('finished', 'in_progress')" if include_in_progress else "('finished')"
         query = """
             SELECT c.id, t.name, s.id, s.mode, c.method, c.tool_key, c.exercise_id, c.started_at,
                    c.finished_at, c.figures_json, c.tcp_mm_json, c.abc_deg_json, c.position_error_mm,
-                   c.orientation_error_deg, c.grade,
+                   c.orientation_error_deg, c.grade, c.status,
                    (SELECT COUNT(*) FROM touches x WHERE x.calibration_id = c.id AND x.overwritten_by_touch_id IS NULL),
                    (SELECT COUNT(*) FROM touches x WHERE x.calibration_id = c.id AND x.overwritten_by_touch_id IS NULL AND x.auto = 1),
                    (SELECT COUNT(*) FROM touches x WHERE x.calibration_id = c.id AND x.overwritten_by_touch_id IS NOT NULL),
                    (SELECT COUNT(*) FROM crashes k WHERE k.calibration_id = c.id)
             FROM calibrations c JOIN sessions s ON s.id = c.session_id JOIN trainees t ON t.id = s.trainee_id
-            WHERE c.status = 'finished' ORDER BY c.started_at, c.id"""
+            WHERE c.status IN """ + statuses + """ ORDER BY c.started_at, c.id"""
         with self._read() as db:
             rows = db.execute(query).fetchall()
         out = []
+        now = _now()
         for (cid, name, sid, mode, method, tool, exercise, started, finished, figs, tcp, abc, pos, ori, grade,
-             n, n_auto, n_over, n_crash) in rows:
+             status, n, n_auto, n_over, n_crash) in rows:
             out.append(GradeRow(
                 calibration_id=cid, trainee=name, session_id=sid, mode=mode, method=method, tool_key=tool,
-                exercise_id=exercise, started_at=started, finished_at=finished,
-                duration_s=_duration_s(started, finished), touches=n, hand=n - n_auto, auto=n_auto,
+                exercise_id=exercise, started_at=started, finished_at=finished or "",
+                duration_s=_duration_s(started, finished or now), touches=n, hand=n - n_auto, auto=n_auto,
                 overwritten=n_over, crashes=n_crash, figures=json.loads(figs) if figs else {},
                 tcp_mm=tuple(json.loads(tcp)) if tcp else None, abc_deg=tuple(json.loads(abc)) if abc else None,
-                position_error_mm=pos, orientation_error_deg=ori, grade=grade))
+                position_error_mm=pos, orientation_error_deg=ori, grade=grade, status=status))
         return out
 
     def to_csv(self, rows: Sequence[GradeRow] | None = None) -> str:

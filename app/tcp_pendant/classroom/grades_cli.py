@@ -2,12 +2,15 @@
 
 Usage::
 
-    tcp-pendant grades [--class-db PATH] [--csv]
+    tcp-pendant grades [--class-db PATH] [--csv] [--per-trainee] [--moodle]
 
-One row per finished calibration (oldest first): trainee, method, tool, touches (hand / auto),
-overwritten touches, crashes, duration, result figures, error against the true TOOL frame and
-the grade. Without ``--csv`` a table for the terminal; with ``--csv`` the columns of
-:data:`tcp_pendant.classroom.gradebook.CSV_COLUMNS` (docs/architecture.md, "Classroom (gradebook)"). The gradebook is read where
+One row per calibration, finished or still in progress (oldest first): trainee, method, tool,
+touches (hand / auto), overwritten touches, crashes, duration, result figures, error against
+the true TOOL frame, the grade and the status. Without ``--csv`` a table for the terminal; with
+``--csv`` the columns of :data:`tcp_pendant.classroom.gradebook.CSV_COLUMNS`
+(docs/architecture.md, "Classroom (gradebook)"). ``--per-trainee``: one row per trainee
+(``classroom.lms``: attempts, best and last grade); ``--moodle``: that as the CSV Moodle's
+gradebook imports. The gradebook is read where
 the server writes it (``--class-db``, default ``user_data_dir("tcp-pendant")/class.sqlite3``);
 it may be read while the server runs.
 
@@ -24,6 +27,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from tcp_pendant.classroom.gradebook import GradeRow, Gradebook, GradebookError, default_gradebook_path
+from tcp_pendant.classroom.lms import TraineeGrade, moodle_csv, per_trainee, per_trainee_csv
 
 __all__ = ["build_parser", "format_table", "main"]
 
@@ -34,11 +38,17 @@ def build_parser() -> argparse.ArgumentParser:
     """The parser of ``tcp-pendant grades``."""
     p = argparse.ArgumentParser(
         prog="tcp-pendant grades",
-        description="Print the class gradebook: one row per finished calibration.")
+        description="Print the class gradebook: one row per calibration (finished or in progress), "
+                    "or one per trainee.")
     p.add_argument("--class-db", type=Path, default=None, metavar="PATH",
                    help=f"the gradebook the server writes (default: {default_gradebook_path()})")
     p.add_argument("--csv", action="store_true",
                    help="print CSV (columns in docs/architecture.md) instead of a table")
+    p.add_argument("--per-trainee", action="store_true",
+                   help="one row per trainee: attempts, best and last grade and position error")
+    p.add_argument("--moodle", action="store_true",
+                   help="one row per trainee as CSV for Moodle's grade import (Username, points of the "
+                        "best grade out of 100, feedback)")
     return p
 
 
@@ -62,17 +72,32 @@ def _duration(seconds: float) -> str:
 def format_table(rows: Sequence[GradeRow]) -> str:
     """The rows as a fixed-width table (mm, deg; "-" where a figure does not apply)."""
     header = ("id", "trainee", "method", "tool", "touches", "hand", "auto", "overwr.", "crashes",
-              "duration", "mean mm", "ci95 mm", "pos err mm", "ori err deg", "grade")
+              "duration", "mean mm", "ci95 mm", "pos err mm", "ori err deg", "grade", "status")
     body = [(str(r.calibration_id), _terminal_text(r.trainee, _NAME_WIDTH), _terminal_text(r.method, 16),
              _terminal_text(r.tool_key, 16), str(r.touches), str(r.hand), str(r.auto), str(r.overwritten),
              str(r.crashes), _duration(r.duration_s), _num(r.figures.get("mean_error_mm"), ".3f"),
              _num(r.figures.get("ci95_mm"), ".3f"), _num(r.position_error_mm, ".3f"),
-             _num(r.orientation_error_deg, ".2f"), r.grade or "-") for r in rows]
+             _num(r.orientation_error_deg, ".2f"), r.grade or "-", r.status.replace("_", " ")) for r in rows]
     widths = [max(len(cells[i]) for cells in (header, *body)) for i in range(len(header))]
-    left = {1, 2, 3, 14}
+    left = {1, 2, 3, 14, 15}
 
     def line(cells: Sequence[str]) -> str:
         return "  ".join(c.ljust(w) if i in left else c.rjust(w)
+                         for i, (c, w) in enumerate(zip(cells, widths))).rstrip()
+
+    return "\n".join([line(header), line(["-" * w for w in widths]), *(line(c) for c in body)])
+
+
+def format_trainee_table(grades: Sequence[TraineeGrade]) -> str:
+    """One line per trainee (mm; "-" where nothing is finished)."""
+    header = ("trainee", "attempts", "in progress", "best", "best pos err mm", "last", "last pos err mm")
+    body = [(_terminal_text(g.trainee, _NAME_WIDTH), str(g.attempts), str(g.in_progress), g.best_grade or "-",
+             _num(g.best_position_error_mm, ".3f"), g.last_grade or "-", _num(g.last_position_error_mm, ".3f"))
+            for g in grades]
+    widths = [max(len(cells[i]) for cells in (header, *body)) for i in range(len(header))]
+
+    def line(cells: Sequence[str]) -> str:
+        return "  ".join(c.ljust(w) if i in (0, 3, 5) else c.rjust(w)
                          for i, (c, w) in enumerate(zip(cells, widths))).rstrip()
 
     return "\n".join([line(header), line(["-" * w for w in widths]), *(line(c) for c in body)])
@@ -91,18 +116,31 @@ def main(argv: Sequence[str] | None = None) -> int:
     path = default_gradebook_path() if args.class_db is None else args.class_db
     try:
         with Gradebook(path, create=False) as book:
-            rows = book.grades()
+            rows = book.grades(include_in_progress=True)
             text = book.to_csv(rows) if args.csv else None
     except GradebookError as exc:
         print(f"tcp-pendant grades: error: {' '.join(str(exc).split())}", file=sys.stderr)
         return 2
+    if args.per_trainee or args.moodle:
+        trainees = per_trainee(rows)
+        if args.moodle:
+            sys.stdout.write(moodle_csv(trainees))
+        elif args.csv:
+            sys.stdout.write(per_trainee_csv(trainees))
+        elif not trainees:
+            print(f"No calibration in {path} yet.")
+        else:
+            print(f"Gradebook {path}: {len(trainees)} trainee{'s' if len(trainees) != 1 else ''}")
+            print(format_trainee_table(trainees))
+        return 0
     if args.csv:
-        sys.stdout.write(text)
+        sys.stdout.write(text or "")
         return 0
     if not rows:
-        print(f"No finished calibration in {path} yet.")
+        print(f"No calibration in {path} yet.")
         return 0
-    print(f"Gradebook {path}: {len(rows)} finished calibration{'s' if len(rows) != 1 else ''}")
+    done = sum(1 for r in rows if r.status == "finished")
+    print(f"Gradebook {path}: {done} finished calibration{'s' if done != 1 else ''}, {len(rows) - done} in progress")
     print(format_table(rows))
     return 0
 

@@ -1,28 +1,27 @@
-"""Store a trainee's wizard events in the gradebook as they happen (issue 11 item 2; no viser).
+"""Store a trainee's wizard events in the gradebook as they happen (no viser).
 
-A :class:`TraineeRecorder` belongs to one named per-browser session. The server subscribes
-:meth:`TraineeRecorder.on_change` to the session's change signal; on every signal it compares
-the session's calibration workflow with what it stored last and writes the difference:
+A :class:`TraineeRecorder` belongs to one named per-browser session. The class room subscribes
+:meth:`TraineeRecorder.on_change` to the session's change signal, whose ``events``
+(``tcp_pendant.events``) say what happened, with the facts taken when it happened; each maps
+onto one gradebook write, in order:
 
-- a run the workflow opened -> ``start_calibration`` (method, physical tool, its true TOOL frame);
-- a pose recorded at a step (new, or replacing the step's earlier pose) -> ``record_touch``
-  (flange pose, joint angles, distance tool tip - reference tip, Auto-touch or hand, and the id
-  of the touch it overwrote);
-- the robot driven into the reference tip (``touch_geometry().crashed`` turning true) ->
-  ``record_crash``;
-- a result -> ``finish_calibration`` (figures, TCP, A B C, error against the truth, grade; a
-  new result of the same run replaces it), a cancel -> ``cancel_calibration`` (a finished run
-  stays finished), a resume -> ``resume_calibration``.
+- :class:`~tcp_pendant.events.RunStarted` -> ``start_calibration`` (method, physical tool, its
+  true TOOL frame);
+- :class:`~tcp_pendant.events.TouchRecorded` -> ``record_touch`` (flange pose, joint angles and
+  distance tool tip - reference tip at Record, Auto-touch or hand, and the id of the touch it
+  overwrote);
+- :class:`~tcp_pendant.events.Crash` -> ``record_crash`` (of the calibration open then);
+- :class:`~tcp_pendant.events.RunFinished` -> ``finish_calibration`` (figures, TCP, A B C, error
+  against the truth, grade; a new result of the same run replaces it);
+- :class:`~tcp_pendant.events.RunCancelled` -> ``cancel_calibration`` (a finished run stays
+  finished), :class:`~tcp_pendant.events.RunResumed` -> ``resume_calibration``.
 
-Runs that arrive already cancelled (loaded from a session record file) are somebody's earlier
-work, not this session's: they are not stored.
+Runs loaded from a session record file are somebody's earlier work, not this session's: the
+workflow makes no events for them, so they are not stored.
 
 Acknowledgement: the change signal is emitted inside ``target.atomic()``, so the GUI messages of
 the same signal are pushed after every subscriber returned; each gradebook write has committed
 when it returns (``Gradebook``), so a touch is in the file before the screen shows it.
-
-Auto-touch or hand: the workflow counts its auto-touches (``CalibrationWorkflow.auto_touches``);
-poses that appear in a signal during which that count grew were recorded by Auto-touch.
 """
 
 from __future__ import annotations
@@ -30,12 +29,13 @@ from __future__ import annotations
 import logging
 import math
 import threading
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
 
 from tcp_pendant.classroom.gradebook import Gradebook
+from tcp_pendant.events import Crash, RunCancelled, RunFinished, RunResumed, RunStarted, SessionEvent, TouchRecorded
 
 __all__ = ["TraineeRecorder", "TraineeStatus"]
 
@@ -71,11 +71,9 @@ class TraineeStatus:
 
 @dataclass
 class _RunState:
-    calibration_id: int | None            # None: not stored (a loaded run)
-    poses: dict[int, Any] = field(default_factory=dict)         # step -> RecordedPose object seen
+    calibration_id: int
     touch_ids: dict[int, int] = field(default_factory=dict)     # step -> gradebook touch id
     status: str = "in_progress"
-    result: Any = None
 
 
 class TraineeRecorder:
@@ -85,23 +83,19 @@ class TraineeRecorder:
         gradebook: the class gradebook.
         session_id: the gradebook session (``Gradebook.start_session``).
         name: the trainee's name (validated).
-        controller: the session's virtual controller (joints, distance, crash state).
-        workflow: the session's ``CalibrationWorkflow`` (or None: only crashes are stored).
+        workflow: the session's ``CalibrationWorkflow``: the run on show, for the trainer's
+            table, and where the gradebook ids of the runs are noted (the exported record names
+            them); None: only crashes are stored.
         exercise_id: the exercise the calibrations belong to (None: free practice).
     """
 
-    def __init__(self, gradebook: Gradebook, session_id: int, name: str, controller: Any,
-                 workflow: Any | None, *, exercise_id: str | None = None) -> None:
+    def __init__(self, gradebook: Gradebook, session_id: int, name: str, workflow: Any | None, *,
+                 exercise_id: str | None = None) -> None:
         self.gradebook = gradebook
         self.session_id = session_id
-        self.controller = controller
         self.workflow = workflow
         self.exercise_id = exercise_id
         self._runs: dict[int, _RunState] = {}
-        self._auto_seen = int(getattr(workflow, "auto_touches", 0))
-        if workflow is not None:
-            workflow.honest_records = True      # the trainee's export carries no answer key
-        self._crashed = False
         self._lock = threading.Lock()
         self._status = TraineeStatus(name=name, exercise=exercise_id or "")
         self.errors = 0
@@ -116,108 +110,74 @@ class TraineeRecorder:
         """The browser left: the gradebook session ends, the row says "not connected"."""
         with self._lock:
             self.gradebook.end_session(self.session_id)
-            self._status = TraineeStatus(**{**self._status.__dict__, "connected": False})
+            self._status = replace(self._status, connected=False)
 
     # ------------------------------------------------------------ the change signal
     def on_change(self, change: Any) -> None:
-        """Subscriber of the session's change signal (see the module docstring)."""
+        """Subscriber of the session's change signal: its events to the gradebook, in order
+        (see the module docstring); the trainer's row after a wizard change."""
         with self._lock:
-            state = getattr(change, "state", None)
-            if state is not None:
-                self._check_crash(bool(state.touch.crashed), float(state.touch.penetration_mm))
-            # a jog step (pose only) costs the crash check alone: every wizard event comes with `wizard`
-            if self.workflow is not None and (getattr(change, "wizard", False) or getattr(change, "touches", False)):
-                self._sync_runs()
+            for event in getattr(change, "events", ()):
+                self._store(event)
+            if getattr(change, "wizard", False) or getattr(change, "events", ()):
                 self._update_status()
 
-    def _current_calibration(self) -> int | None:
-        run = None if self.workflow is None else self.workflow.run
-        if run is None:
-            return None
-        for i, r in enumerate(self.workflow.runs):
-            if r is run:
-                st = self._runs.get(i)
-                return None if st is None else st.calibration_id
-        return None
-
-    def _check_crash(self, crashed: bool, penetration_mm: float) -> None:
-        if crashed and not self._crashed:
-            cal = self._current_calibration()
-            pen = penetration_mm if math.isfinite(penetration_mm) else None
-            if cal is None:
+    def _store(self, event: SessionEvent) -> None:
+        if isinstance(event, RunStarted):
+            truth: Any = ({"T_flange_tool_true_m": None} if event.T_flange_tool_true_m is None
+                          else np.asarray(event.T_flange_tool_true_m, dtype=float))
+            cal = self.gradebook.start_calibration(self.session_id, event.kind, event.tool_key or "", truth,
+                                                   exercise_id=self.exercise_id)
+            self._runs[event.run_index] = _RunState(cal)
+            if self.workflow is not None:
+                self.workflow.record_ids[event.run_index] = cal    # the export names it: the trainer grades by it
+            return
+        if isinstance(event, Crash):
+            pen = event.penetration_mm if math.isfinite(event.penetration_mm) else None
+            st = None if event.run_index is None else self._runs.get(event.run_index)
+            if st is None:
                 self.gradebook.record_crash(session_id=self.session_id, penetration_mm=pen,
                                             note="reference tip hit")
             else:
-                self.gradebook.record_crash(cal, penetration_mm=pen, note="reference tip hit")
-            self._status = TraineeStatus(**{**self._status.__dict__, "crashes": self._status.crashes + 1})
-        self._crashed = crashed
-
-    def _sync_runs(self) -> None:
-        wf = self.workflow
-        auto_now = int(getattr(wf, "auto_touches", 0))
-        auto = auto_now != self._auto_seen
-        self._auto_seen = auto_now
-        for i, run in enumerate(wf.runs):
-            st = self._runs.get(i)
-            w = run.wizard
-            if st is None:
-                if w.status == "cancelled":          # loaded from a record file: not this session's work
-                    st = self._runs[i] = _RunState(None, status="cancelled")
-                    continue
-                truth: Any = ({"T_flange_tool_true_m": None} if run.T_flange_tool_true_m is None
-                              else np.asarray(run.T_flange_tool_true_m, dtype=float))
-                cal = self.gradebook.start_calibration(
-                    self.session_id, w.kind, run.true_tool_key or self.controller.mounted_tool.key, truth,
-                    exercise_id=self.exercise_id)
-                st = self._runs[i] = _RunState(cal)
-                if isinstance(getattr(wf, "record_ids", None), dict):
-                    wf.record_ids[i] = cal             # the export names it: the trainer grades by it
-            if st.calibration_id is None:
-                continue
-            self._sync_poses(st, w, auto)
-            self._sync_status(st, run)
-
-    def _sync_poses(self, st: _RunState, w: Any, auto: bool) -> None:
-        for step, pose in sorted(w.recorded_poses.items()):
-            if st.poses.get(step) is pose:
-                continue
-            q_deg = np.degrees(np.asarray(self.controller.q_rad, dtype=float))
-            dist = float(self.controller.touch_geometry().distance_mm)
+                self.gradebook.record_crash(st.calibration_id, penetration_mm=pen, note="reference tip hit")
+            self._status = replace(self._status, crashes=self._status.crashes + 1)
+            return
+        run_index = getattr(event, "run_index", None)
+        st = None if run_index is None else self._runs.get(run_index)
+        if st is None:                      # a run of a loaded record, or started before the name
+            return
+        if isinstance(event, TouchRecorded):
+            dist = event.distance_mm if math.isfinite(event.distance_mm) else None
             touch_id = self.gradebook.record_touch(
-                st.calibration_id, int(step), pose.T_world_flange_m, q_deg,
-                dist if math.isfinite(dist) else None, auto, overwritten_touch_id=st.touch_ids.get(step))
-            st.poses[step] = pose
-            st.touch_ids[step] = touch_id
-            self._status = TraineeStatus(**{**self._status.__dict__, "touches": self._status.touches + 1})
+                st.calibration_id, event.step, event.T_world_flange_m, np.asarray(event.joints_deg, dtype=float),
+                dist, event.auto, overwritten_touch_id=st.touch_ids.get(event.step))
+            st.touch_ids[event.step] = touch_id
+            self._status = replace(self._status, touches=self._status.touches + 1)
+        elif isinstance(event, RunFinished):
+            self._finish(st, event)
+        elif isinstance(event, RunCancelled):
+            if st.status == "in_progress" and not event.finished:
+                self.gradebook.cancel_calibration(st.calibration_id)
+                st.status = "cancelled"
+        elif isinstance(event, RunResumed):
+            if st.status == "cancelled":
+                self.gradebook.resume_calibration(st.calibration_id)
+                st.status = "in_progress"
 
-    def _sync_status(self, st: _RunState, run: Any) -> None:
-        w = run.wizard
-        result = w.finished_result
-        if result is not None and result is not st.result:
-            self._finish(st, run, result)
-        status = w.status
-        if status == "cancelled" and st.status == "in_progress" and result is None:
-            self.gradebook.cancel_calibration(st.calibration_id)
-            st.status = "cancelled"
-        elif status == "in_progress" and st.status == "cancelled":
-            self.gradebook.resume_calibration(st.calibration_id)
-            st.status = "in_progress"
-
-    def _finish(self, st: _RunState, run: Any, result: Any) -> None:
+    def _finish(self, st: _RunState, event: RunFinished) -> None:
         from tcp_pendant.wizards.truth import compare_with_truth
 
+        result: Any = event.result
         pos = ori = grade = None
-        if run.T_flange_tool_true_m is not None:
-            cmp = compare_with_truth(result, run.T_flange_tool_true_m)
+        if event.T_flange_tool_true_m is not None:
+            cmp = compare_with_truth(result, event.T_flange_tool_true_m)
             pos, ori, grade = cmp.position_error_mm, cmp.orientation_error_deg, cmp.grade
         self.gradebook.finish_calibration(
             st.calibration_id, result.figures, position_error_mm=pos, orientation_error_deg=ori, grade=grade,
             tcp_mm=tuple(result.tcp_mm), abc_deg=None if result.abc_deg is None else tuple(result.abc_deg))
-        st.result = result
         st.status = "finished"
         tcp = ", ".join(f"{v:.1f}" for v in result.tcp_mm)
-        self._status = TraineeStatus(**{**self._status.__dict__, "last_result": tcp,
-                                        "grade": grade or ""})
+        self._status = replace(self._status, last_result=tcp, grade=grade or "")
 
     def _update_status(self) -> None:
         w = None if self.workflow is None else self.workflow.wizard
@@ -227,4 +187,4 @@ class TraineeRecorder:
             method = w.title
             step = ("result" if w.status == "complete" else "cancelled" if w.status == "cancelled"
                     else w.step.heading)
-        self._status = TraineeStatus(**{**self._status.__dict__, "method": method, "step": step})
+        self._status = replace(self._status, method=method, step=step)

@@ -2,7 +2,10 @@
 
 Modules, one job each:
 
+* ``description``: a robot description as ROS packages ship it (xacro, ``package://``, missing
+  meshes, mimic and continuous joints) -> one resolved URDF text.
 * ``kinematics``: :class:`RobotKinematics` (URDF -> pinocchio: limits, home, FK, Jacobian).
+* ``placement``: a foreign robot's reference tip and ready pose, computed from its model.
 * ``assets``: where ``robots/`` (or the packaged ``_robots``) and example-robot-data live.
 * ``tools``: :class:`ToolModel` (physical tool with its hidden true TOOL frame),
   :func:`builtin_tools`, :func:`builtin_robots`, the reference tip model.

@@ -99,6 +99,7 @@ class VirtualController:
         self.set_true_kinematics(true_kinematics)
         self.settings = settings
         self._q = np.array(kinematics.home_rad, dtype=float)
+        self._rest_q = np.array(kinematics.home_rad, dtype=float)
         self._sigma: tuple[np.ndarray, float] | None = None  # (q, sigma_min at q) of the last path
         self._tool = tool
         self._active: Tool | None = None
@@ -144,6 +145,16 @@ class VirtualController:
     def go_home(self) -> None:
         """Teleport to the home configuration."""
         self._q = np.array(self.kinematics.home_rad, dtype=float)
+
+    @property
+    def rest_q_rad(self) -> np.ndarray:
+        """The rest configuration a redundant (7-axis) arm's Cartesian jogs keep its self-motion
+        near (``jog`` J-3; default HOME, the app sets its ready pose), a copy."""
+        return self._rest_q.copy()
+
+    def set_rest_configuration(self, q_rad: Sequence[float] | np.ndarray) -> None:
+        """Set :attr:`rest_q_rad` (rad; checked like :meth:`set_q`)."""
+        self._rest_q = np.array(self.kinematics.check_q(q_rad), dtype=float)
 
     @property
     def true_kinematics(self) -> RobotKinematics:
@@ -364,7 +375,8 @@ class VirtualController:
 
     def _follow(self, path: CartesianPath, T_flange_tcp: np.ndarray) -> JogResult:
         sigma = self._sigma[1] if self._sigma is not None and np.array_equal(self._sigma[0], self._q) else None
-        out = follow_path(self.kinematics, self._q, T_flange_tcp, path, self.settings, sigma_start=sigma)
+        out = follow_path(self.kinematics, self._q, T_flange_tcp, path, self.settings, sigma_start=sigma,
+                          q_rest=self._rest_q)
         self._q = out.q_rad
         self._sigma = (out.q_rad.copy(), out.sigma)
         if out.stopped_by is None:

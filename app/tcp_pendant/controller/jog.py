@@ -23,6 +23,20 @@ Iterations stop at 1e-10 m / 1e-10 rad, so every accepted sub-step puts the TCP 
 singular value ``sigma_min`` of the scaled flange Jacobian ``W J_flange`` is below
 ``eps`` (Nakamura-Chiaverini), so far from singularities (J-2) is the Newton step.
 
+**Redundant arms** (more than six joints, e.g. a 7-axis KUKA iiwa). (J-2) is then the
+damped least-squares step of minimum joint norm: it moves only as much as the TCP needs, which
+leaves the arm's self-motion (the elbow turning about the shoulder-wrist line) to drift. The
+first Newton iteration of each sub-step adds a null-space step towards the *rest*
+configuration ``q_rest`` (the session's ready pose)
+
+    dq += N k (q_rest - q),    N = I - J^+ J,   J^+ = J^T (J J^T)^-1                  (J-3)
+
+with ``k = null_space_gain`` (0.05), scaled down so that no joint moves more than a quarter of the
+sub-step's joint allowance (the jump rule below); ``N`` projects it onto the joint motions the TCP
+does not feel, so the path is unchanged and the later iterations (pure J-2) converge as before.
+The elbow thus stays near where the arm started (well conditioned, clear of the limits) however
+long one jogs. Six-joint arms have no null space and skip (J-3).
+
 **Safety rules** (a sub-step is *rejected*, the robot stays at the last accepted sub-step):
   * no convergence within the iteration budget (target off the reachable set);
   * a joint change above ``max_joint_gain`` (5 deg per mm or deg of *flange* motion): the
@@ -125,6 +139,9 @@ class JogSettings:
     bisections: int = 8
     singular_zero: float = 1e-7
     """``sigma_min`` below which a configuration counts as *on* the singularity (no det sign)."""
+    null_space_gain: float = 0.05
+    """``k`` of (J-3): the share of the way to the rest configuration a redundant arm's
+    self-motion goes per sub-step (at most a quarter of the joint allowance)."""
 
 
 DEFAULT_SETTINGS = JogSettings()
@@ -223,12 +240,27 @@ class _Attempt:
     det_sign: float = 0.0
 
 
+def _null_space_step(Jt: np.ndarray, q: np.ndarray, q_rest: np.ndarray, gain: float,
+                     cap: float) -> np.ndarray:
+    """(J-3): ``N k (q_rest - q)``, its largest joint change at most ``cap`` (rad)."""
+    z = gain * (q_rest - q)
+    try:
+        pinv = Jt.T @ np.linalg.solve(Jt @ Jt.T, Jt)
+    except np.linalg.LinAlgError:
+        return np.zeros_like(q)
+    dq = z - pinv @ z
+    biggest = float(np.abs(dq).max())
+    return dq * (cap / biggest) if biggest > cap else dq
+
+
 def _solve_substep(kin: RobotKinematics, q_start: np.ndarray, sigma_start: float,
                    t_f: np.ndarray, R_ft: np.ndarray, p_target: np.ndarray, R_target: np.ndarray,
-                   cart_amount: float, settings: JogSettings, det_sign_start: float = 0.0) -> _Attempt:
+                   cart_amount: float, settings: JogSettings, det_sign_start: float = 0.0,
+                   q_rest: np.ndarray | None = None) -> _Attempt:
     """Damped Newton (J-2) from ``q_start`` to one target pose, then the safety checks.
 
-    ``det_sign_start`` is :func:`_det_sign` at ``q_start`` (0: unknown or on a singularity).
+    ``det_sign_start`` is :func:`_det_sign` at ``q_start`` (0: unknown or on a singularity);
+    ``q_rest``: the rest configuration of a redundant arm's null-space step (J-3), None: none.
     """
     eps = settings.singular_eps
     lam2 = 0.0
@@ -239,7 +271,8 @@ def _solve_substep(kin: RobotKinematics, q_start: np.ndarray, sigma_start: float
     q = q_start.copy()
     J = None
     converged = False
-    for _ in range(settings.max_iterations + 1):
+    allowance = max(settings.max_joint_gain * cart_amount, settings.min_joint_allowance_rad)
+    for iteration in range(settings.max_iterations + 1):
         J, R_wf, p_wf = kin.jacobian_and_pose(q)
         r = R_wf @ t_f
         e_p = p_target - (p_wf + r)
@@ -257,10 +290,11 @@ def _solve_substep(kin: RobotKinematics, q_start: np.ndarray, sigma_start: float
             dq = Jt.T @ np.linalg.solve(A, e)
         except np.linalg.LinAlgError:
             dq = Jt.T @ np.linalg.lstsq(A, e, rcond=None)[0]
+        if iteration == 0 and q_rest is not None:
+            dq = dq + _null_space_step(Jt, q, q_rest, settings.null_space_gain, 0.25 * allowance)
         q = q + dq
         if not np.all(np.isfinite(q)):
             break
-    allowance = max(settings.max_joint_gain * cart_amount, settings.min_joint_allowance_rad)
     jump = float(np.abs(q - q_start).max()) if np.all(np.isfinite(q)) else math.inf
     if not converged or jump > allowance:
         if sigma_start < 2.0 * eps:
@@ -293,7 +327,7 @@ def _solve_substep(kin: RobotKinematics, q_start: np.ndarray, sigma_start: float
 
 def follow_path(kin: RobotKinematics, q_rad: np.ndarray, T_flange_tcp: np.ndarray,
                 path: CartesianPath, settings: JogSettings = DEFAULT_SETTINGS, *,
-                sigma_start: float | None = None) -> PathOutcome:
+                sigma_start: float | None = None, q_rest: np.ndarray | None = None) -> PathOutcome:
     """Move the TCP along ``path`` (J-1) from configuration ``q_rad`` under the safety rules.
 
     Args:
@@ -303,6 +337,7 @@ def follow_path(kin: RobotKinematics, q_rad: np.ndarray, T_flange_tcp: np.ndarra
         path: the Cartesian path.
         sigma_start: :func:`smallest_singular_value` at ``q_rad`` if the caller knows it
             (saves one SVD per jog step: the controller keeps it from the previous step).
+        q_rest: rest configuration of a redundant arm (J-3); ignored for six joints or fewer.
 
     Returns:
         The configuration reached, the fraction ``moved`` of the path, the stop reason and
@@ -319,6 +354,7 @@ def follow_path(kin: RobotKinematics, q_rad: np.ndarray, T_flange_tcp: np.ndarra
     unit = (length_m + angle * lever_m) * 1000.0 * math.radians(1.0) + angle
 
     q = np.array(q_rad, dtype=float)
+    rest = np.asarray(q_rest, dtype=float) if q_rest is not None and kin.n_joints > 6 else None
     J0 = kin.jacobian_flange(q)
     sigma = _sigma_min(J0, settings) if sigma_start is None else float(sigma_start)
     det_sign = _det_sign(J0)
@@ -327,7 +363,7 @@ def follow_path(kin: RobotKinematics, q_rad: np.ndarray, T_flange_tcp: np.ndarra
         s_next = k / n
         p_t, R_t = path.at(s_next)
         att = _solve_substep(kin, q, sigma, t_f, R_ft, p_t, R_t, unit * (s_next - s_done), settings,
-                             det_sign)
+                             det_sign, rest)
         if att.reason is None:
             q, sigma, det_sign, s_done = att.q, att.sigma, att.det_sign, s_next
             continue
@@ -336,7 +372,8 @@ def follow_path(kin: RobotKinematics, q_rad: np.ndarray, T_flange_tcp: np.ndarra
         for _ in range(settings.bisections):
             mid = 0.5 * (lo + hi)
             p_t, R_t = path.at(mid)
-            a = _solve_substep(kin, q, sigma, t_f, R_ft, p_t, R_t, unit * (mid - lo), settings, det_sign)
+            a = _solve_substep(kin, q, sigma, t_f, R_ft, p_t, R_t, unit * (mid - lo), settings, det_sign,
+                               rest)
             if a.reason is None:
                 q, sigma, det_sign, lo = a.q, a.sigma, a.det_sign, mid
             else:

@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
+from tcp_pendant.controller.description import RobotDescription, load_description
 from tcp_pendant.controller.errors import ControllerError
 
 __all__ = ["KNOWN_HOMES_DEG", "RobotKinematics", "default_flange_link", "urdf_links_and_tree"]
@@ -40,12 +41,19 @@ Any other robot's home is the all-zero configuration clipped to its limits.
 _PREFERRED_FLANGE_NAMES = ("flange", "tool0")
 
 
-def urdf_links_and_tree(urdf_path: Path) -> tuple[list[str], dict[str, list[str]]]:
-    """Link names in file order and the child lists of the link tree (from the URDF XML).
+def urdf_links_and_tree(source: Path | RobotDescription) -> tuple[list[str], dict[str, list[str]]]:
+    """Link names in file order and the child lists of the link tree.
+
+    Args:
+        source: a URDF file, or a loaded :class:`~tcp_pendant.controller.description.RobotDescription`
+            (a xacro file is expanded only by ``load_description``).
 
     Raises:
         ControllerError: the file is not valid URDF XML.
     """
+    if isinstance(source, RobotDescription):
+        return list(source.links), {k: list(v) for k, v in source.children.items()}
+    urdf_path = source
     try:
         root = ET.parse(urdf_path).getroot()
     except (ET.ParseError, OSError) as exc:
@@ -63,7 +71,7 @@ def urdf_links_and_tree(urdf_path: Path) -> tuple[list[str], dict[str, list[str]
     return links, children
 
 
-def default_flange_link(urdf_path: Path) -> str:
+def default_flange_link(urdf_path: Path | RobotDescription) -> str:
     """The last link of the longest chain of the URDF's link tree.
 
     Ties (e.g. the UR5's ``ee_link`` and ``tool0``, both children of ``wrist_3_link``) go to a
@@ -90,33 +98,83 @@ def default_flange_link(urdf_path: Path) -> str:
     return candidates[0]
 
 
+_JOINT_WORDS = {
+    "JointModelFreeFlyer": "floating",
+    "JointModelPlanar": "planar",
+    "JointModelSpherical": "spherical",
+    "JointModelSphericalZYX": "spherical",
+    "JointModelTranslation": "3-D translation",
+}
+"""pinocchio's joint model names in the URDF's words (messages never show pinocchio's names)."""
+
+
+def _pinocchio_words(text: str) -> str:
+    """pinocchio's error text for the user: its ``message:`` and ``hint:`` lines (not the C++
+    location), joint model names in the URDF's words."""
+    flat = " ".join(text.split())
+    m = re.search(r"message:\s*(.*?)(?:\s*hint:\s*(.*))?$", flat)
+    out = flat if m is None else m.group(1) + (f" ({m.group(2)})" if m.group(2) else "")
+
+    def word(m: re.Match[str]) -> str:
+        name = m.group(0)
+        if "RUBY" in name or "RevoluteUnbounded" in name:
+            return "continuous joint"
+        if re.search(r"Prismatic|JointModelP[XYZ]", name):
+            return "prismatic joint"
+        if re.search(r"Revolute|JointModelR[XYZ]", name):
+            return "revolute joint"
+        if "Mimic" in name:
+            return "mimic joint"
+        return _JOINT_WORDS.get(name, "joint") + (" joint" if name in _JOINT_WORDS else "")
+
+    return re.sub(r"(pinocchio::)?JointModel\w*", word, out)
+
+
+def _is_mimic(joint: pin.JointModel) -> bool:
+    return bool(joint.shortname() == "JointModelMimic")
+
+
 class RobotKinematics:
-    """The pinocchio model of one URDF (serial or tree, revolute/prismatic joints).
+    """The pinocchio model of one robot description (serial or tree, revolute/prismatic joints,
+    mimic joints following their leader).
 
     Attributes:
-        urdf_path: the URDF file.
+        urdf_path: the description file given (``.urdf`` or ``.xacro``).
+        description: the expanded, resolved description (``controller.description``).
         flange_link: the link used as FLANGE (Z out of the flange face for our robots).
         base_link: the URDF's root link; poses are given in its frame.
-        joint_names: actuated joints in pinocchio order (depth-first, as in the URDF tree).
+        joint_names: actuated joints in pinocchio order (depth-first, as in the URDF tree); a
+            mimic joint is not one of them: pinocchio moves it with its leader,
+            ``q_mimic = multiplier * q_leader + offset`` (``mimic_joints``), in FK, Jacobians
+            and the link poses the scene draws.
+        mimic_joints: ``{joint: (leader, multiplier, offset)}`` from the description.
         lower_rad, upper_rad: joint limits (rad, or m for prismatic joints).
         home_rad: home configuration (see :data:`KNOWN_HOMES_DEG`).
+        known_home: the joint names are in :data:`KNOWN_HOMES_DEG` (our built-in robots and
+            their kind); otherwise the app computes a ready pose and a reference tip from the
+            model (``controller.placement``).
         link_names: every URDF link, in pinocchio frame order.
     """
 
-    def __init__(self, model: pin.Model, urdf_path: Path, flange_link: str, base_link: str) -> None:
+    def __init__(self, model: pin.Model, urdf_path: Path, flange_link: str, base_link: str,
+                 description: RobotDescription | None = None) -> None:
         self.model = model
         self.data = model.createData()
         self.urdf_path = Path(urdf_path)
+        self._description = description
         self.flange_link = flange_link
         self.base_link = base_link
-        self.joint_names: tuple[str, ...] = tuple(model.names[1:])
-        for j, name in zip(model.joints[1:], self.joint_names):
+        actuated = [(j, name) for j, name in zip(model.joints[1:], model.names[1:]) if not _is_mimic(j)]
+        self.joint_names: tuple[str, ...] = tuple(name for _, name in actuated)
+        for j, name in actuated:
             if j.nq != 1 or j.nv != 1:
+                kind = _JOINT_WORDS.get(j.shortname(), f"{j.nq}-variable")
                 raise ControllerError(
-                    f"Joint {name!r} of {self.urdf_path.name} is a {j.shortname()} joint with "
-                    f"{j.nq} position variables; only revolute and prismatic joints with limits "
-                    "are supported (make continuous joints revolute with limits)."
+                    f"Joint {name!r} of {self.urdf_path.name} is a {kind} joint with {j.nq} position "
+                    "variables; only revolute, continuous, prismatic and mimic joints are supported."
                 )
+        self.mimic_joints: dict[str, tuple[str, float, float]] = (
+            dict(description.mimic_joints) if description is not None else {})
         self.lower_rad = np.array(model.lowerPositionLimit, dtype=float)
         self.upper_rad = np.array(model.upperPositionLimit, dtype=float)
         if np.any(self.lower_rad > self.upper_rad):
@@ -126,6 +184,7 @@ class RobotKinematics:
         self.lower_rad.setflags(write=False)
         self.upper_rad.setflags(write=False)
         home_deg = KNOWN_HOMES_DEG.get(self.joint_names)
+        self.known_home = home_deg is not None
         home = np.radians(home_deg) if home_deg is not None else np.zeros(self.n_joints)
         self.home_rad = np.clip(home, self.lower_rad, self.upper_rad)
         self.home_rad.setflags(write=False)
@@ -135,45 +194,65 @@ class RobotKinematics:
         )
         self.link_names: tuple[str, ...] = tuple(name for name, _ in self._body_frames)
         self.revolute = np.array([re.search(r"Prismatic|JointModelP[XYZ]$", j.shortname()) is None
-                                  for j in model.joints[1:]], dtype=bool)
+                                  for j, _ in actuated], dtype=bool)
         """True for revolute joints (radians), False for prismatic ones (metres)."""
+
+    @property
+    def description(self) -> RobotDescription:
+        """The expanded, resolved description (loaded from ``urdf_path`` on first use when the
+        model was built elsewhere)."""
+        if self._description is None:
+            self._description = load_description(self.urdf_path)
+        return self._description
 
     def own_copy(self) -> "RobotKinematics":
         """The same robot (the model is shared, read-only) with its own pinocchio data, safe to
         use in another thread."""
-        return RobotKinematics(self.model, self.urdf_path, self.flange_link, self.base_link)
+        return RobotKinematics(self.model, self.urdf_path, self.flange_link, self.base_link,
+                               self._description)
 
     @classmethod
-    def from_urdf(cls, urdf_path: Path | str, *, flange_link: str | None = None) -> "RobotKinematics":
-        """Load a URDF.
+    def from_urdf(cls, urdf_path: Path | str, *, flange_link: str | None = None,
+                  package_paths: Sequence[Path | str] = ()) -> "RobotKinematics":
+        """Load a robot description (``.urdf`` or ``.xacro``, ``controller.description``).
 
         Args:
-            urdf_path: the URDF file (meshes are not needed for kinematics).
+            urdf_path: the file (meshes are not needed for kinematics).
             flange_link: link to use as FLANGE; default :func:`default_flange_link` (the last
                 link of the longest chain).
+            package_paths: folders holding ROS packages (``--package-path``), searched before
+                ``ROS_PACKAGE_PATH`` for ``package://`` and ``$(find pkg)``.
 
         Raises:
-            ControllerError: missing or unreadable file, unknown flange link, unsupported joint.
+            ControllerError: missing or unreadable file, xacro error, unknown flange link,
+                unsupported joint.
         """
         path = Path(urdf_path)
         if not path.is_file():
-            raise ControllerError(f"URDF not found: {path}. Give the path of a .urdf file.")
-        links, children = urdf_links_and_tree(path)
-        flange = default_flange_link(path) if flange_link is None else flange_link
+            raise ControllerError(f"URDF not found: {path}. Give the path of a .urdf or .xacro file.")
+        description = load_description(path, package_paths)
+        links, children = urdf_links_and_tree(description)
+        if not links:
+            raise ControllerError(f"The URDF {path.name} has no <link>.")
+        flange = default_flange_link(description) if flange_link is None else flange_link
         if flange not in links:
             raise ControllerError(
                 f"The URDF {path.name} has no link {flange!r}; its links are {', '.join(links)}. "
                 "Choose one of them as the flange."
             )
+        for joint, (leader, _, _) in description.mimic_joints.items():
+            if leader in description.mimic_joints:
+                raise ControllerError(f"Mimic joint {joint!r} of {path.name} follows {leader!r}, itself a "
+                                      "mimic joint; make it follow the actuated joint directly.")
         try:
-            model = pin.buildModelFromUrdf(str(path))
+            model = pin.buildModelFromXML(description.urdf_xml, mimic=True)
         except Exception as exc:  # pinocchio raises RuntimeError/ValueError with its own text
-            raise ControllerError(f"pinocchio cannot load {path}: {exc}") from exc
+            raise ControllerError(f"pinocchio cannot load {path}: {_pinocchio_words(str(exc))}") from exc
         if model.nq == 0:
             raise ControllerError(f"The URDF {path.name} has no movable joint.")
         is_child = {c for cs in children.values() for c in cs}
         base = next(name for name in links if name not in is_child)
-        return cls(model, path, flange, base)
+        return cls(model, path, flange, base, description)
 
     @property
     def n_joints(self) -> int:

@@ -201,27 +201,35 @@ def draw_kinematic_errors(scenario: Scenario, kinematics: RobotKinematics) -> Ki
     lengths = sign[0] * rng.uniform(*scenario.link_length_mm, size=n)
     zeros = sign[1] * rng.uniform(*scenario.joint_zero_deg, size=n)
     placements = kinematics.model.jointPlacements
-    lengths = [float(v) if np.linalg.norm(placements[i + 1].translation) > _MIN_LENGTH_M else 0.0
+    ids = _actuated_joint_ids(kinematics.model)
+    lengths = [float(v) if np.linalg.norm(placements[ids[i]].translation) > _MIN_LENGTH_M else 0.0
                for i, v in enumerate(lengths)]
     return KinematicErrors(tuple(lengths), tuple(float(v) for v in zeros))
+
+
+def _actuated_joint_ids(model: pin.Model) -> list[int]:
+    """pinocchio indices of the joints with a variable of their own (a mimic joint has none: it
+    follows its leader and keeps its placement)."""
+    return [j for j in range(1, model.njoints) if model.joints[j].shortname() != "JointModelMimic"]
 
 
 def perturbed_model(model: pin.Model, errors: KinematicErrors) -> pin.Model:
     """A copy of ``model`` with ``errors`` built into its joint placements (``model`` unchanged).
 
-    Joint ``j`` (1-based, pinocchio order) gets ``M_j' = (R_j, t_j (1 + dL_j / |t_j|)) *
+    Actuated joint ``j`` (1-based, pinocchio order; mimic joints keep their placement) gets ``M_j' = (R_j, t_j (1 + dL_j / |t_j|)) *
     X_j(dq_j)``: its placement lengthened by ``dL_j`` along itself, then its own joint motion
     at the zero offset ``dq_j``, so ``FK'(q) = FK(q + dq)`` when every ``dL`` is zero.
 
     Raises:
         ControllerError: the error lists do not have one entry per joint.
     """
-    n = model.njoints - 1
+    ids = _actuated_joint_ids(model)
+    n = len(ids)
     if len(errors.length_offsets_mm) != n or len(errors.joint_zero_offsets_deg) != n:
         raise ControllerError(f"The kinematic errors have {len(errors.length_offsets_mm)} lengths and "
                               f"{len(errors.joint_zero_offsets_deg)} zero offsets; the robot has {n} joints.")
     out = model.copy()
-    for j in range(1, model.njoints):
+    for k, j in enumerate(ids, start=1):
         joint = out.joints[j]
         if joint.nq != 1:
             raise ControllerError(f"Joint {out.names[j]!r} has {joint.nq} position variables; only "
@@ -229,11 +237,11 @@ def perturbed_model(model: pin.Model, errors: KinematicErrors) -> pin.Model:
         P = out.jointPlacements[j]
         t = np.array(P.translation)
         L = float(np.linalg.norm(t))
-        dL = errors.length_offsets_mm[j - 1] / 1000.0
+        dL = errors.length_offsets_mm[k - 1] / 1000.0
         if L > _MIN_LENGTH_M:
             t = t * (1.0 + dL / L)
         # the joint's own motion at q = offset; calc reads q at the joint's index in a full vector
-        dq = errors.joint_zero_offsets_deg[j - 1]
+        dq = errors.joint_zero_offsets_deg[k - 1]
         q = np.zeros(out.nq)
         prismatic = re.search(r"Prismatic|JointModelP[XYZ]$", joint.shortname()) is not None
         q[joint.idx_q] = dq / 1000.0 if prismatic else math.radians(dq)
@@ -246,7 +254,7 @@ def perturbed_model(model: pin.Model, errors: KinematicErrors) -> pin.Model:
 def perturbed_kinematics(kinematics: RobotKinematics, errors: KinematicErrors) -> RobotKinematics:
     """The physical robot: ``kinematics`` with :func:`perturbed_model` (same URDF, links, limits)."""
     return RobotKinematics(perturbed_model(kinematics.model, errors), kinematics.urdf_path,
-                           kinematics.flange_link, kinematics.base_link)
+                           kinematics.flange_link, kinematics.base_link, kinematics.description)
 
 
 # ----------------------------------------------------------------------------- moved reference

@@ -15,7 +15,8 @@ from collections.abc import Iterator
 from tcp_pendant.session import Session
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.beam_check import BeamCheckView
-from tcp_pendant.views.calibrate import build_calibrate_tab, register_calibrate_view
+from tcp_pendant.views.beam_replay import ScanPlayer
+from tcp_pendant.views.calibrate import build_calibrate_tab
 from tcp_pendant.views.pendant_panel import PendantPanel
 from tcp_pendant.views.scenario_panel import ScenarioPanel
 from tcp_pendant.views.scene import SceneView
@@ -34,16 +35,16 @@ __all__ = [
     "build_calibrate_tab",
     "build_session_views",
     "session_view_steps",
-    "register_calibrate_view",
 ]
 
 
 def build_session_views(session: Session, *, title: str = "TCP Pendant") -> None:
     """Build the scene and the GUI of ``session`` into ``session.target`` (under its lock).
 
-    Fills ``session.views`` with ``"scene"``, ``"pendant"``, ``"touches"``, ``"tools"`` (and
-    ``"calibrate"`` when a wizard plug-in is installed; for tests: the views never reach each
-    other), each subscribed to the session's change signal, then pushes the first state.
+    Fills ``session.views`` with ``"scene"``, ``"pendant"``, ``"touches"``, ``"tools"``,
+    ``"calibrate"``, ... (for tests: the views never reach each other), each subscribed to the
+    session's change signal, then pushes the first state. The views that play a beam scan's
+    film are handed the session's one :class:`~tcp_pendant.views.beam_replay.ScanPlayer`.
     """
     for _ in session_view_steps(session, title=title):
         pass
@@ -61,7 +62,9 @@ def session_view_steps(session: Session, *, title: str = "TCP Pendant") -> Itera
     """
     with session.lock, session.target.atomic():
         gui = session.target.gui
-        session.views["scene"] = SceneView(session)
+        scene = session.views["scene"] = SceneView(session)
+        player = session.views["beam_player"] = ScanPlayer(session, stand=scene.beam_stand)
+        scene.player = player
         yield "scene"
         gui.add_markdown(f"### {escape_markdown(title)}")
         tabs = gui.add_tab_group()
@@ -72,11 +75,10 @@ def session_view_steps(session: Session, *, title: str = "TCP Pendant") -> Itera
         yield "jog"
         with tabs.add_tab("Tool"):
             session.views["tools"] = ToolPanel(session)
-            session.views["beam_check"] = BeamCheckView(session)   # TCP service with the beam sensor
+            session.views["beam_check"] = BeamCheckView(session, player)   # TCP service with the beam sensor
         yield "tool"
         calibrate_tab = tabs.add_tab("Calibrate")
-        build_calibrate_tab(session, calibrate_tab)
-        session.workflow = getattr(session.views.get("calibrate"), "workflow", None)
+        session.views["calibrate"] = build_calibrate_tab(session, calibrate_tab, player)
         with calibrate_tab:
             session.views["scenario"] = ScenarioPanel(session)
         session.views["tabs"] = tabs

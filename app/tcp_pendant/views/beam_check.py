@@ -31,7 +31,7 @@ from tcp_pendant.calibrate.beam_service import (
     beam_check_markdown,
     update_tool_from_beam,
 )
-from tcp_pendant.calibrate.workflow import EXERCISE_REFUSAL
+from tcp_pendant.calibrate.jobs import EXERCISE_REFUSAL
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.beam_replay import ScanPlayer, beam_view_direction, scan_spheres
@@ -65,8 +65,9 @@ def update_markdown(slot: int, before: Tool, after: Tool) -> str:
 class BeamCheckView:
     """The "TCP service (beam sensor)" folder of the Tool tab (see the module docstring)."""
 
-    def __init__(self, session: Session) -> None:
+    def __init__(self, session: Session, player: ScanPlayer) -> None:
         self.session = session
+        self.player = player
         gui = session.target.gui
         with gui.add_folder("TCP service (beam sensor)"):
             self.intro_md = gui.add_markdown(INTRO)
@@ -125,16 +126,16 @@ class BeamCheckView:
         try:
             with s.lock:
                 tool = s.controller.active_tool
-                if getattr(s.workflow, "hide_truth", False):
+                if s.workflow.hide_truth:
                     raise ValueError(EXERCISE_REFUSAL.format(what="Check with beam"))
                 if tool is None:
                     raise ValueError("No tool data is active (TCP = flange): activate the tool to check in the "
                                      "Tool library first.")
-                player = ScanPlayer.of(s)
+                player = self.player
                 if not (player.playing and player.owner is self):   # a check during our film: back to
                     self._q_before = s.controller.q_rad             # where the first one started
                 player.stop()                                       # the robot stays where the job sees it
-                job = beam_check_job(s.controller, s.active_slot, tool)
+                job = beam_check_job(s.controller, s.active_slot, tool, rng_seed=int(s.rng.integers(2**31)))
                 self._checking = True
                 self.result_md.content = f"Scanning **{escape_markdown(tool.name)}** with the beam sensor ..."
                 self._render_buttons()
@@ -157,7 +158,7 @@ class BeamCheckView:
             self.last_check = check
             self.result_md.content = beam_check_markdown(check)
             self._render_buttons()
-            ScanPlayer.of(s).play(check.scan, owner=self, return_to=self._q_before)
+            self.player.play(check.scan, owner=self, return_to=self._q_before)
             self.frame_scan(check.scan)
         s.notify("Beam check done", f"{check.tool_name}: deviation {check.deviation_norm_mm:.3f} mm", kind="info")
 
@@ -203,7 +204,7 @@ class BeamCheckView:
 
     def _on_replay(self, _event: Any) -> None:
         check = self.last_check
-        player = ScanPlayer.of(self.session)
+        player = self.player
         if check is None:
             raise ValueError("No beam check to replay: press Check with beam first.")
         player.play(check.scan, owner=self, return_to=self._q_before)

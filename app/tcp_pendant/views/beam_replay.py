@@ -7,7 +7,7 @@ values, a few per move in proportion to the time the move takes on the real robo
 held frame at each event, whose beam is then broken. :func:`event_points_world` gives the
 markers' points (on the beam line).
 
-:class:`ScanPlayer` (one per session, :meth:`ScanPlayer.of`) plays such a film on viser's event
+:class:`ScanPlayer` (one per session, built with its views and handed to those that play films) plays such a film on viser's event
 loop at :attr:`ScanPlayer.rate_hz`: each frame sets the controller's joints
 (``VirtualController.set_q``, the model's joint values the scan planned) and emits the
 session's ``pose`` change, so every view shows the robot where the scan had it; the broken
@@ -217,13 +217,14 @@ def scan_spheres(scan: Any, points: Any = None) -> tuple[np.ndarray, np.ndarray]
 class ScanPlayer:
     """Plays scans in one session's scene (see the module docstring). Get it with :meth:`of`."""
 
-    KEY = "beam_player"
     ROOT = "/beam_scan"
     rate_hz: float = 12.0
     """Frames per second of the replay (tests may raise it)."""
 
-    def __init__(self, session: Session) -> None:
+    def __init__(self, session: Session, stand: Any = None) -> None:
         self.session = session
+        self.stand = stand
+        """The scene's beam stand (``views.beam_stand.BeamStand``: its beam turns red), or None."""
         scene = session.target.scene
         self.scene = scene
         self.break_point = scene.add_icosphere(f"{self.ROOT}/break_point", radius=0.005, color=BROKEN_RGB,
@@ -246,14 +247,6 @@ class ScanPlayer:
         self.done.set()
         self._shown_state: tuple[int | None, tuple[int, ...]] | None = None
         session.on_close(self._on_close)
-
-    @classmethod
-    def of(cls, session: Session) -> "ScanPlayer":
-        """The session's player (made on first use; kept in ``session.views``)."""
-        player = session.views.get(cls.KEY)
-        if player is None:
-            player = session.views[cls.KEY] = cls(session)
-        return player
 
     @property
     def playing(self) -> bool:
@@ -356,15 +349,13 @@ class ScanPlayer:
     def _apply(self, i: int) -> None:
         frame = self.frames[i]
         s = self.session
-        s.controller.set_q(frame.q_rad)
+        s.set_joints(frame.q_rad, status=False)
         self._last_q = s.controller.q_rad
         self.frames_played = i + 1
-        s.moved()
         self._show(frame.broken_event, frame.shown)
 
     def _stand(self) -> Any:
-        """The scene's beam stand (``SceneView.beam_stand``: its beam turns red), or None."""
-        return getattr(self.session.views.get("scene"), "beam_stand", None)
+        return self.stand
 
     def _show(self, broken: int | None, shown: tuple[int, ...]) -> None:
         """The red beam of event ``broken`` (None: hidden) and the markers of ``shown``."""

@@ -242,10 +242,7 @@ class PendantPanel:
         if hold_tick is False and self.session.jogger.settings.continuous:
             self._stop_hold()                        # the click that ends a hold: no move
             return
-        res = self.session.jogger.key(axis, sign, hold_tick=hold_tick)
-        if res is None:
-            return
-        self.session.moved(res)
+        self.session.jog(axis, sign, hold_tick=hold_tick)
 
     # hold-to-jog on the server's 20 Hz clock (pendant/hold.py)
     def _on_hold(self, axis: str | int, sign: int) -> None:
@@ -270,15 +267,12 @@ class PendantPanel:
         if s.closed or not s.jogger.settings.continuous:
             self._stop_hold()
             return None
-        res = s.jogger.key(axis, sign, hold_tick=True)
-        if res is not None:
-            s.moved(res)
-        return res
+        return s.jog(axis, sign, hold_tick=True)
 
     def _stop_hold(self) -> None:
         if self._hold is not None:
             self._hold.stop()
-        self.session.jogger.release()
+        self.session.release_jog()
 
     def _row_cb(self, axis: str | int) -> Any:
         """Click on a compact key row: the value is the key's label ("X +", "A3 −")."""
@@ -309,19 +303,15 @@ class PendantPanel:
         def cb(event: Any) -> None:
             if event.client is None:
                 return                                # our own update of the slider: no loop
-            q = s.controller.q_rad
-            k = s.controller.kinematics
             value = float(event.target.value)
             if not math.isfinite(value):
                 return
-            q[index] = float(np.clip(math.radians(value), k.lower_rad[index], k.upper_rad[index]))
-            s.controller.set_q(q)
-            applied = round(math.degrees(s.controller.q_rad[index]), 2)
-            if abs(applied - value) <= 0.005:         # the browser shows the angle: no echo
-                self._from_client[index] = applied
-            else:                                     # clipped: render sends the limit
-                self._from_client.pop(index, None)
-            s.moved(JogResult(True, 1.0, None, ""))
+            with s.batch():                           # the echo rule is set before the one signal
+                applied = round(s.set_joint(index, value), 2)
+                if abs(applied - value) <= 0.005:     # the browser shows the angle: no echo
+                    self._from_client[index] = applied
+                else:                                 # clipped: render sends the limit
+                    self._from_client.pop(index, None)
 
         return s.on_loop(cb)
 
@@ -329,10 +319,9 @@ class PendantPanel:
         """Callback of one selector: only the selector that fired changes its setting (a button
         group's value is the option just clicked)."""
         def cb(event: Any) -> None:
-            js = self.session.jogger
             value = event.target.value
-            js.settings = js.settings.with_(**{name: kind(unmarked(value) if isinstance(value, str) else value)})
             self._stop_hold()
+            self.session.set_jog_setting(name, kind(unmarked(value) if isinstance(value, str) else value))
             self._show_settings()
             self.render()
         return cb
@@ -361,15 +350,10 @@ class PendantPanel:
         self._set_md(self.settings_md, "settings", f"{st.mode.value} jog in {where}, {step}, override {st.override_pct:.0f} %")
 
     def _on_home(self, _event: Any) -> None:
-        if self.session.ready_q_rad is None:
-            self.session.controller.go_home()
-        else:
-            self.session.controller.set_q(self.session.ready_q_rad)
-        self.session.moved(JogResult(True, 1.0, None, ""))
+        self.session.ready()
 
     def _on_kuka_home(self, _event: Any) -> None:
-        self.session.controller.go_home()
-        self.session.moved(JogResult(True, 1.0, None, ""))
+        self.session.home()
 
     def _on_camera(self, close: bool) -> Any:
         def cb(event: Any) -> None:

@@ -267,6 +267,8 @@ class SceneView:
 
     def __init__(self, session: Session) -> None:
         self.session = session
+        self.player: ScanPlayer | None = None
+        """The session's scan film (set once the views are built): the scene steps aside while it plays."""
         c = session.controller
         scene = session.target.scene
         self.scene = scene
@@ -284,9 +286,9 @@ class SceneView:
         scene.add_frame("/world", axes_length=0.25, axes_radius=0.006)
         scene.add_label("/world/label", "WORLD", position=(0.0, 0.0, -0.04))
 
-        meshes = link_meshes(k.urdf_path)
+        meshes = link_meshes(k.description)
         state = session.pose_state()
-        tree = link_tree_paths(k.urdf_path, state.link_names)
+        tree = link_tree_paths(k.description, state.link_names)
         self.link_paths: dict[str, str] = {name: path for name, (path, _) in tree.items()}
         self.link_frames: dict[str, Any] = {}
         self._parent = {name: parent for name, (_, parent) in tree.items()}
@@ -341,7 +343,7 @@ class SceneView:
         if not np.array_equal(tip, self._shown_tip):     # knocked (a scenario) or set anew
             self.update_reference_tip()
         self.beam_stand.show(self.session.controller.beam_sensor)   # redraws only a changed sensor
-        film = self.session.views.get(ScanPlayer.KEY)
+        film = self.player
         self._step_aside(film is not None and film.playing)
         if change.pose and change.state is not None:
             skip = (self._gizmo_row,) if self._dragging else ()
@@ -481,4 +483,4 @@ class SceneView:
         T = np.eye(4)
         T[:3, :3] = Rotation.from_quat(np.roll(wxyz, -1)).as_matrix()
         T[:3, 3] = xyz
-        s.moved(s.controller.move_tcp_to(T))
+        s.move_tcp_to(T)

@@ -243,22 +243,17 @@ class ToolPanel:
         if not name:
             raise ValueError("Type the new name in 'New name' first.")
         s = self.session
-        s.library.rename(slot, name)
-        if s.client is not None:
-            # a courtesy, per browser only: in --shared mode the box is every browser's, and
-            # another trainee may be typing in it
-            self.new_name.value = ""
         with s.batch():
-            s.reload_library()
-            renamed = s.library_tools.get(slot)
-            if s.active_slot == slot and renamed is not None:
-                s.set_active_data(renamed, slot)        # the active data carries the new name
+            s.rename_tool(slot, name)
+            if s.client is not None:
+                # a courtesy, per browser only: in --shared mode the box is every browser's, and
+                # another trainee may be typing in it
+                self.new_name.value = ""
 
     def _on_delete(self, _event: Any) -> None:
         slot, tool = self._selected()
-        self.session.library.remove(slot)
+        self.session.delete_tool(slot)
         self.session.notify("Tool deleted", f"{slot}: {tool.name}")
-        self.session.reload_library()
 
     def _on_export(self, _event: Any) -> None:
         slot, tool = self._selected()
@@ -355,9 +350,8 @@ class ToolPanel:
         if errors or res.tool is None or slot is None:
             self.entry_md.content = "⚠ Not saved: correct the fields marked above."
             return
-        lib.save(slot, res.tool)
+        self.session.store_tool(slot, res.tool)
         self.entry_md.content = f"✔ Saved **{escape_markdown(res.tool.name)}** in slot {slot}."
-        self.session.reload_library()
         self.slots.value = slot_option(slot, res.tool.name)
         self._show_slot()
 

@@ -11,7 +11,9 @@ from typing import Any
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from tcp_pendant.calibrate.text import empty_touches_markdown
 from tcp_pendant.session import Session, SessionChange, Touch
+from tcp_pendant.views.gui_util import set_content
 
 __all__ = ["TOUCHES_FILENAME", "TouchListView", "touches_csv_text"]
 
@@ -65,8 +67,16 @@ class TouchListView:
         if change.touches:
             self.rebuild()
         if change.wizard:
-            wf = self.session.workflow
-            self.record.visible = not (wf is not None and wf.is_open)
+            self.record.visible = not self.session.workflow.is_open
+        if change.touches or change.wizard:
+            self._render_empty()
+
+    def _render_empty(self) -> None:
+        """The line shown when no free touch is recorded: while a wizard has touches, where
+        they are (its step list), not "No touch recorded"."""
+        if self.session.touches:
+            return
+        set_content(self.empty_md, empty_touches_markdown(self.session.workflow.wizard))
 
     def _on_record(self, _event: Any) -> None:
         t = self.session.record_touch()

@@ -7,13 +7,12 @@ meter (bar and one line), so a trainee jogs, watches and records on one screen; 
 tab stays the place to choose a method and review the result. Outside a wizard the dock is
 hidden and the touch list's "Record point" records into the free list (one Record concept).
 A step the controller runs itself (``AutoRole.by_controller``: the beam wizard's scan) shows no
-Record; its Finish runs the wizard's controller job through ``CalibrationWorkflow.next`` on the
+Record; its Finish runs the wizard's controller job through ``Session.next_step`` on the
 loop (bounded: a beam scan of at most 5 orientations takes well under a second to compute).
 
-The dock renders from the session's workflow (``Session.workflow``: the Calibrate tab's
-``CalibrationWorkflow``) on the change signal and calls only the workflow's public commands
-(``record``, ``next``, ``back``, ``cancel``, ``mount_required_tool``); it never calls another
-view. Each click runs through ``Session.on_loop`` inside ``Session.batch`` and ends in one
+The dock renders from the session's workflow (``Session.workflow``) on the change signal and
+changes it only through the session's commands (``record_step``, ``next_step``, ``back``,
+``cancel_wizard``, ``mount_required_tool``); it never calls another view. Each click runs through ``Session.on_loop`` inside ``Session.batch`` and ends in one
 change signal with ``wizard`` (as the Calibrate tab's clicks), so the Calibrate tab, the scene
 and the classroom recorder see it too. Every text from a wizard goes through the escaping
 ``calibrate.text`` helpers.
@@ -27,6 +26,7 @@ from typing import Any
 
 from tcp_pendant.calibrate.text import meter_level, step_markdown
 from tcp_pendant.pendant.guidance import direction_words, tip_offset_mm
+from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.pendant.record_check import RecordCheck
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.views.gui_util import set_content
@@ -59,16 +59,10 @@ class WizardDock:
             self.meter_md = gui.add_markdown("", visible=False)
         self.record.on_click(self._action(self._on_record))
         self.nav.on_click(self._action(self._on_nav))
-        self.mount.on_click(self._action(lambda _e: self._workflow().mount_required_tool(), sync=True))
+        self.mount.on_click(self._action(lambda _e: self.session.mount_required_tool(), sync=True))
         session.subscribe(self.on_change)
 
     # ------------------------------------------------------------ plumbing
-    def _workflow(self) -> Any:
-        wf = self.session.workflow
-        if wf is None:
-            raise ValueError("Calibration wizards are not installed in this build.")
-        return wf
-
     def _action(self, fn: Callable[[Any], Any], *, sync: bool = False) -> Any:
         s = self.session
 
@@ -84,7 +78,7 @@ class WizardDock:
 
     def _where(self) -> tuple[int, int, int]:
         wf = self.session.workflow
-        wiz = None if wf is None else wf.wizard
+        wiz = wf.wizard
         if wiz is None:
             return (-1, -1, -1)
         return (id(wiz), wiz.step.index if not wiz.is_complete else -2, len(wf.runs))
@@ -94,7 +88,7 @@ class WizardDock:
 
     # ------------------------------------------------------------ callbacks
     def _on_record(self, _event: Any) -> None:
-        wf = self._workflow()
+        wf = self.session.workflow
         s = self.session
         state = s.pose_state()
         frame = s.jogger.settings.frame
@@ -106,22 +100,20 @@ class WizardDock:
             return
         wiz = wf.wizard
         index = None if wiz is None else wiz.step.index
-        wf.record()
+        s.record_step()
         shown = "" if s.hide_distance else f", {state.touch.distance_mm:.2f} mm from the tip"
         self._say(f"✔ Step {index + 1 if index is not None else '?'} recorded{shown}.")
 
     def _on_nav(self, event: Any) -> None:
-        wf = self._workflow()
+        s = self.session
         choice = str(event.target.value)
         self.check.clear()
         if choice == BACK:
-            wf.back()
+            s.back()
         elif choice in (NEXT, FINISH):
-            wf.next()
+            s.next_step()
         elif choice in (CANCEL, CLOSE):
-            finished = wf.result is not None
-            wf.cancel()
-            if not finished:
+            if s.cancel_wizard():
                 self.session.notify("Calibration cancelled",
                                     "Nothing recorded is lost: Resume it from the Calibrate menu.")
         else:
@@ -141,14 +133,17 @@ class WizardDock:
         if self.session.closed:
             return
         wf = self.session.workflow
-        wiz = None if wf is None else wf.wizard
-        open_ = wf is not None and wiz is not None and wf.is_open
+        wiz = wf.wizard
+        open_ = wiz is not None and wf.is_open
         self.folder.visible = open_
         if not open_:
             self._note, self._note_at = "", None
             return
         set_content(self.step_md, step_markdown(wiz))
         note = self._note if self._note_at == self._where() else ""
+        failure = wf.finish_failure
+        if failure is not None:                  # Finish could not compute: why, and what to do
+            note = f"⚠ Finish not possible: {escape_markdown(failure)}" + (f"\n\n{note}" if note else "")
         self.note_md.visible = bool(note)
         if note:
             set_content(self.note_md, note)
@@ -170,7 +165,7 @@ class WizardDock:
     def update_meter(self) -> None:
         """The pose-diversity meter (the wizards that declare it: ``Wizard.meter_active``)."""
         wf = self.session.workflow
-        wiz: Any = None if wf is None else wf.wizard
+        wiz: Any = wf.wizard
         show = wiz is not None and bool(wiz.meter_active)
         self.meter_bar.visible = self.meter_md.visible = show
         if not show:

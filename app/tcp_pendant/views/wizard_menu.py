@@ -1,7 +1,7 @@
 """The Calibrate tab of one session (viser GUI): the wizards' menu and their views.
 
-This is the plug-in that ``tcp_pendant.views.calibrate`` loads (``build_calibrate_views``).
-Top to bottom:
+Built by ``tcp_pendant.views.calibrate.build_calibrate_tab`` for the session's workflow
+(``Session.workflow``). Top to bottom:
 
 * **Training mode** switch (on by default, for the classroom): reveals the true TOOL frame
   after a result with the error against it, and offers Auto-touch;
@@ -22,12 +22,12 @@ Top to bottom:
   replayed in a worker thread (never on viser's event loop, where it would stall every
   browser), one load per session at a time; the result is added under the session lock.
 
-All logic is in :class:`tcp_pendant.calibrate.CalibrationWorkflow` (no viser), which changes
-the mounted tool and the active tool data through the session's commands (the session is its
-``ToolState``); every click goes through :meth:`CalibrateView.action` (``Session.on_loop``: the
-event loop, the session's lock and error notifications) inside ``Session.batch``, so a click
-ends in one change signal; the tab re-renders from the workflow's state on that signal
-(:meth:`CalibrateView.on_change`), as the scene and the Tool tab do.
+All logic is in :class:`tcp_pendant.calibrate.CalibrationWorkflow` (no viser), owned by the
+session, whose commands (``Session.start_wizard``, ``record_step``, ``save_result``, ...) are
+the only way a click changes it; every click goes through :meth:`CalibrateView.action`
+(``Session.on_loop``: the event loop, the session's lock and error notifications) inside
+``Session.batch``, so a click ends in one change signal; the tab re-renders from the workflow's
+state on that signal (:meth:`CalibrateView.on_change`), as the scene and the Tool tab do.
 """
 
 from __future__ import annotations
@@ -41,11 +41,9 @@ from typing import Any
 from tcp_pendant.calibrate import CalibrationWorkflow
 from tcp_pendant.calibrate.library_choice import default_library_slot
 from tcp_pendant.calibrate.text import (
-    METHOD_BLURBS,
     menu_markdown,
     replay_markdown,
 )
-from tcp_pendant.controller import builtin_robots
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.gui_util import (
@@ -54,6 +52,7 @@ from tcp_pendant.views.gui_util import (
     set_options,
     slot_option,
 )
+from tcp_pendant.views.beam_replay import ScanPlayer
 from tcp_pendant.views.upload_guard import limit_upload_size
 from tcp_pendant.views.wizard_result import WizardResultView
 from tcp_pendant.views.wizard_scene import WizardSceneView
@@ -70,7 +69,7 @@ from tcp_pendant.wizards.session_record import (
 )
 from tcpcal.tool import Tool
 
-__all__ = ["NO_LIBRARY_TOOL", "SESSION_FILENAME", "CalibrateView", "build_calibrate_views"]
+__all__ = ["NO_LIBRARY_TOOL", "SESSION_FILENAME", "CalibrateView"]
 
 NO_LIBRARY_TOOL = "(library empty)"
 SESSION_FILENAME = "tcp-pendant-session.json"
@@ -84,35 +83,21 @@ _RECORD_WORKER = ThreadPoolExecutor(max_workers=1, thread_name_prefix="session-r
 server (each is bounded by the record limits; at most ~0.3 s of CPU on the 2-core machine)."""
 
 
-def robot_name(session: Session) -> str:
-    """The robot's key for the session record ("kr6", "gp12") or its URDF file name."""
-    urdf = session.controller.kinematics.urdf_path
-    for key, path in builtin_robots().items():
-        if path.resolve() == urdf.resolve():
-            return key
-    return urdf.stem
-
-
-def build_calibrate_views(session: Session) -> CalibrateView:
-    """The plug-in entry point (see ``tcp_pendant.views.calibrate``)."""
-    return CalibrateView(session)
-
-
 class CalibrateView:
     """The Calibrate tab of ``session`` (see the module docstring).
 
     Attributes:
-        workflow: the wizards of this session (viser-free logic).
+        workflow: the session's wizards (``Session.workflow``; viser-free logic), rendered here.
         menu_*, steps, result, scene, record_*: the widgets and sub-views (for tests).
     """
 
-    def __init__(self, session: Session) -> None:
+    def __init__(self, session: Session, player: ScanPlayer) -> None:
         self.session = session
-        self.workflow = CalibrationWorkflow(session.controller, session.library, robot=robot_name(session),
-                                            state=session)
+        self.workflow: CalibrationWorkflow = session.workflow
         self._menu_mounted_key: str | None = None
         self._library: dict[int, Tool] = {}
         self._library_pick: tuple[str, int | None] | None = None   # (option, active slot then)
+        self._resume_runs: tuple[int, ...] = ()                    # the runs the Resume list offered
         gui = session.target.gui
         tools = self.workflow.tools
         self._physical = {t.label: key for key, t in tools.items()}
@@ -138,7 +123,8 @@ class CalibrateView:
             self.start_from_points = gui.add_button(
                 "Start from the recorded points", color="blue", visible=False,
                 hint="XYZ 4-point from the touches of the Jog tab's Record point: they become its first steps.")
-            self.resume_list = gui.add_dropdown("Left half-way", ("-",), visible=False)
+            self.resume_list = gui.add_dropdown("To resume", ("-",), visible=False,
+                                                hint="Calibrations you left: where, and when they started.")
             self.resume = gui.add_button("Resume", color="blue", visible=False)
         widgets = self.option_widgets
         self._slot_widgets = [widgets[n] for n, o in self._option_specs.items() if o.kind == "library_slot"]
@@ -155,7 +141,7 @@ class CalibrateView:
                                          hint="Touches, calibrations, results and errors, for grading.")
             self.load = gui.add_upload_button("Load session (JSON)", mime_type="application/json")
             self.record_md = gui.add_markdown("")
-        self.scene = WizardSceneView(session, self.workflow)
+        self.scene = WizardSceneView(session, self.workflow, player)
 
         act = self.action
         self.training.on_update(act(self._on_training, user_only=True))
@@ -168,6 +154,7 @@ class CalibrateView:
         self.start.on_click(act(self._on_start, sync=True))
         self.start_from_points.on_click(act(self._on_start_from_points, sync=True))
         self.resume.on_click(act(self._on_resume))
+        self.resume_list.on_update(act(lambda _e: None, user_only=True))   # the button names the pick
         self.export.on_click(act(self._on_export))
         self._loading_record = False
         self.load.on_upload(self._on_upload)
@@ -220,8 +207,6 @@ class CalibrateView:
         """The change signal: the live parts after a move; the library list when it was
         re-read; the whole tab after a Calibrate click or a tool change (the open wizard is
         told which tool is mounted first)."""
-        if change.tool:
-            self.workflow.note_mounted_tool()
         if change.library:
             self.refresh_library(render=False)
         if change.pose:
@@ -267,7 +252,7 @@ class CalibrateView:
 
     # ------------------------------------------------------------ callbacks
     def _on_training(self, event: Any) -> None:
-        self.workflow.training = bool(event.target.value)
+        self.session.set_training(bool(event.target.value))
 
     def _on_library_pick(self, event: Any) -> None:
         # the user's pick holds until the active tool data changes (then the default is offered)
@@ -294,7 +279,7 @@ class CalibrateView:
         if str(self.method.value) not in self._classes:
             raise ValueError(f"Unknown calibration method {self.method.value!r}.")
         cls = self._chosen_class()
-        self.workflow.start(cls.kind, **{opt.name: self._option_value(opt) for opt in cls.options})
+        self.session.start_wizard(cls.kind, **{opt.name: self._option_value(opt) for opt in cls.options})
 
     def _on_start_from_points(self, _event: Any) -> None:
         """XYZ 4-point from the free touches (``CalibrationWorkflow.start_from_touches``)."""
@@ -303,13 +288,16 @@ class CalibrateView:
             raise ValueError("Only the XYZ 4-point method starts from the recorded points; choose it first.")
         spec = self._option_specs.get("estimator")
         estimator = "lstsq" if spec is None else self._option_value(spec)
-        self.workflow.start_from_touches(list(self.session.touches), estimator=estimator)
+        self.session.start_from_touches(estimator=estimator)
 
     def _on_resume(self, _event: Any) -> None:
         number = number_of_option(self.resume_list.value)
         if number is None:
             raise ValueError("There is no calibration to resume.")
-        self.workflow.resume(number - 1)
+        if number - 1 not in {i for i, _ in self.workflow.resumable()}:
+            raise ValueError(f"Calibration {number} is not waiting to be resumed any more; choose one in "
+                             "'To resume'.")
+        self.session.resume_wizard(number - 1)
 
     def _on_export(self, event: Any) -> None:
         data = dumps(self.workflow.export_record(self.session.touches)).encode("utf-8")
@@ -356,7 +344,7 @@ class CalibrateView:
         await self.action(lambda _e: self._show_loaded(str(upload.name or "session"), loaded))(event)
 
     def _show_loaded(self, name: str, loaded: LoadedRecord) -> None:
-        checks = self.workflow.add_loaded(loaded)
+        checks = self.session.load_record(loaded)
         set_content(self.record_md, f"**Loaded {escape_markdown(name)}**\n\n" + replay_markdown(checks))
 
     def _refuse_record(self, name: str, exc: Exception) -> None:
@@ -411,7 +399,7 @@ class CalibrateView:
     def _render_menu(self) -> None:
         self._menu_mounted_key = self.session.controller.mounted_tool.key
         cls = self._chosen_class()
-        set_content(self.method_md, METHOD_BLURBS[cls.kind])
+        set_content(self.method_md, cls.blurb)
         taken = {o.name for o in cls.options}
         for name, widget in self.option_widgets.items():
             widget.visible = name in taken
@@ -439,4 +427,15 @@ class CalibrateView:
         waiting = self.workflow.resumable()
         self.resume_list.visible = self.resume.visible = bool(waiting)
         if waiting:
-            set_options(self.resume_list, tuple(label for _, label in waiting))
+            runs = tuple(i for i, _ in waiting)
+            picked = number_of_option(self.resume_list.value)
+            # the user's pick (by run number) holds until another run is left: then the newest
+            keep = next((label for i, label in waiting if i + 1 == picked), None) \
+                if set(runs) <= set(self._resume_runs) else None
+            self._resume_runs = runs
+            set_options(self.resume_list, tuple(label for _, label in waiting), keep=keep or waiting[0][1])
+            number = number_of_option(self.resume_list.value)
+            chosen = next((label for i, label in waiting if number == i + 1), waiting[0][1])
+            label = f"Resume {chosen.split(', started')[0]}"      # names what the click brings back
+            if self.resume.label != label:
+                self.resume.label = label

@@ -15,6 +15,7 @@ offers "Check this TCP", which starts the TCP check wizard on the slot just save
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -38,9 +39,8 @@ from tcp_pendant.views.gui_util import (
 )
 from tcp_pendant.wizards import (
     ESTIMATOR_LABELS,
+    Wizard,
     WizardStateError,
-    Xyz4Result,
-    Xyz4Wizard,
 )
 from tcpcal.library import ToolLibrary
 
@@ -120,33 +120,37 @@ class WizardResultView:
         self._charted: Any = None
 
     # ------------------------------------------------------------ callbacks
-    def _xyz4(self) -> Xyz4Wizard:
-        wiz = self.parent.workflow.wizard
-        if not isinstance(wiz, Xyz4Wizard):
-            raise WizardStateError("This is for the XYZ 4-point result.")
-        return wiz
+    def _with_estimators(self, fn: Callable[[Any], Any]) -> None:
+        """``fn(wizard)`` on the result on show, for the wizards whose result panel offers the
+        estimators (``Wizard.result_extras``), as one command of the session."""
+        def edit(wiz: Wizard) -> Any:
+            if "estimators" not in type(wiz).result_extras:
+                raise WizardStateError(f"The {wiz.title} result has no estimators to choose.")
+            return fn(wiz)
+        self.parent.session.edit_result(edit)
 
     def _on_drop(self, _event: Any) -> None:
-        self._xyz4().drop_outliers()
+        self._with_estimators(lambda wiz: wiz.drop_outliers())
 
     def _on_restore(self, _event: Any) -> None:
-        self._xyz4().restore_all()
+        self._with_estimators(lambda wiz: wiz.restore_all())
 
     def _on_estimator(self, event: Any) -> None:
         key = estimator_options().get(str(event.target.value))
         if key is None:
             raise ValueError(f"Unknown estimator {event.target.value!r}.")
-        self._xyz4().set_estimator(key)  # type: ignore[arg-type]
+        self._with_estimators(lambda wiz: wiz.set_estimator(key))
 
     def _on_save(self, _event: Any) -> None:
-        slot, tool = self.parent.workflow.save(str(self.save_name.value), number_of_option(self.save_slot.value))
+        slot, tool = self.parent.session.save_result(str(self.save_name.value),
+                                                     number_of_option(self.save_slot.value))
         self.parent.saved(slot, tool)
 
     def _on_check_tcp(self, _event: Any) -> None:
         wf = self.parent.workflow
         if wf.last_save is None:
             raise WizardStateError("Save the tool first: the TCP check works on a tool of the library.")
-        wf.start("tcp-check", slot=wf.last_save[0])
+        self.parent.session.start_wizard("tcp-check", slot=wf.last_save[0])
 
     # ------------------------------------------------------------ render
     def refresh_slots(self, tools: dict[int, Any]) -> None:
@@ -160,7 +164,7 @@ class WizardResultView:
         self.folder.visible = res is not None
         if res is None:
             return
-        saves = getattr(wf.wizard, "saves_to_library", True)
+        saves = wf.wizard is not None and wf.wizard.saves_to_library
         for h in (self.save_name, self.save_slot, self.save_preview, self.save, self.save_md):
             h.visible = saves                          # a TCP check saves nothing
         self.check_tcp.visible = saves and wf.last_save is not None and wf.result_saved
@@ -186,9 +190,12 @@ class WizardResultView:
                                                                  tool.tcp_mm, tool.abc_deg))
         if wf.last_save is not None:
             set_content(self.save_md, save_markdown(wf.last_save[0], wf.last_save[1].name))
-        self._render_xyz4(res if isinstance(res, Xyz4Result) else None)
+        extras = set() if wf.wizard is None else type(wf.wizard).result_extras
+        self._render_estimators(res if "estimators" in extras else None)
 
-    def _render_xyz4(self, res: Xyz4Result | None) -> None:
+    def _render_estimators(self, res: Any) -> None:
+        """The 4-point's estimator parts (``result_extras`` "estimators"): the per-touch chart,
+        outlier drop and restore, the estimator choice and their comparison."""
         for h in (self.chart, self.drop, self.restore, self.estimator, self.compare):
             h.visible = res is not None
         if res is None:

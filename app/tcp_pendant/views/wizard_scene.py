@@ -63,9 +63,10 @@ _APPROACH_RGB = np.array([60, 110, 220], dtype=np.uint8)
 class WizardSceneView:
     """The wizards' scene nodes of one session (see the module docstring); all start hidden."""
 
-    def __init__(self, session: Session, workflow: CalibrationWorkflow) -> None:
+    def __init__(self, session: Session, workflow: CalibrationWorkflow, player: ScanPlayer) -> None:
         self.session = session
         self.workflow = workflow
+        self.player = player
         scene = session.target.scene
         self.scene = scene
         self.computed = scene.add_frame("/calibration/computed_tool", axes_length=0.10, axes_radius=0.0045,
@@ -95,6 +96,11 @@ class WizardSceneView:
         self._target_T: np.ndarray | None = None
 
     # ------------------------------------------------------------ result
+    def _has_sphere(self) -> bool:
+        """The wizard on show draws its result's sphere fit (``Wizard.result_extras``)."""
+        wiz = self.workflow.wizard
+        return wiz is not None and "sphere" in type(wiz).result_extras
+
     def render(self) -> None:
         """Show what belongs to the workflow's current state (call after every action)."""
         wf = self.workflow
@@ -104,7 +110,7 @@ class WizardSceneView:
         res = wf.result
         if res is not self._shown_result:
             self._shown_result = res
-            self._show_sphere(res if isinstance(res, Xyz4Result) else None)
+            self._show_sphere(res if self._has_sphere() else None)
             self._show_scan(res)
             if res is not None:
                 self.frame_result()
@@ -116,7 +122,7 @@ class WizardSceneView:
 
     def _show_scan(self, res: Any) -> None:
         """A beam result: replay its scan (its markers stay); otherwise clear our replay."""
-        player = ScanPlayer.of(self.session)
+        player = self.player
         scan = getattr(res, "scan", None)
         if scan is None:
             player.clear(owner=self)
@@ -136,7 +142,7 @@ class WizardSceneView:
         scan = getattr(self.workflow.result, "scan", None)
         if scan is None:
             raise ValueError("This result has no beam scan to replay.")
-        ScanPlayer.of(self.session).play(scan, owner=self, points=self._scan_points(self.workflow.result))
+        self.player.play(scan, owner=self, points=self._scan_points(self.workflow.result))
 
     @property
     def showing(self) -> bool:
@@ -147,8 +153,8 @@ class WizardSceneView:
 
     def _film_playing(self) -> bool:
         """Our beam scan's film is playing (its end re-renders: ``Session.refresh``)."""
-        film = self.session.views.get(ScanPlayer.KEY)
-        return film is not None and film.owner is self and film.playing
+        film = self.player
+        return film.owner is self and film.playing
 
     def on_motion(self) -> None:
         """After every move: the TOOL triads follow the flange, the ABC target the TCP. While a
@@ -252,7 +258,7 @@ class WizardSceneView:
                 centres.append((T_wf @ T)[:3, 3])
                 radii.append(length)
         res = self._shown_result
-        if isinstance(res, Xyz4Result):
+        if res is not None and self._has_sphere():
             centres.append(np.asarray(res.sphere_centre_mm, dtype=float) * MM_TO_M)
             radii.append(float(res.sphere_radius_mm) * MM_TO_M)
             f_m = np.asarray(res.flange_positions_mm, dtype=float).reshape(-1, 3) * MM_TO_M

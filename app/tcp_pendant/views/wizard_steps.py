@@ -5,8 +5,9 @@ point" (``supports_add_point``: 4-point) and the live pose-diversity meter (``me
 the touch steps of 4-point and TCP & Z, X), and in training mode the Auto-touch controls. No
 wizard class is named here: what is shown is what the wizard declares. A step the controller
 runs itself (its role's ``AutoRole.by_controller``: the beam wizard's scan) shows neither Record
-nor Auto-touch; its Finish runs the wizard's controller job (``CalibrationWorkflow.controller_job``)
-in a worker thread, as a TCP check's Finish runs its six rotations.
+nor Auto-touch; its Finish runs the wizard's controller job (``Session.take_controller_job``: the
+job its class names) in a worker thread, as a TCP check's Finish runs its six rotations. Every
+click is a command of the session (``Session.record_step``, ``back``, ``next_step``, ...).
 
 Record is enabled only when the wizard can record (``Wizard.can_record``); Next only when the
 step is recorded. The pose-diversity meter is updated on every move of the robot (a motion
@@ -32,15 +33,13 @@ from tcp_pendant.calibrate.text import (
 )
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.gui_util import set_content
-from tcp_pendant.wizards import AbcWorldWizard, ThreePointWizard, Wizard, WizardStateError
+from tcp_pendant.wizards import Wizard, WizardStateError
 
 if TYPE_CHECKING:
     from tcp_pendant.views.wizard_menu import CalibrateView
 
-__all__ = ["ABC_VARIANTS", "RANDOM", "THREE_POINT_VARIANTS", "WizardStepsView"]
+__all__ = ["RANDOM", "WizardStepsView"]
 
-THREE_POINT_VARIANTS = {label: value for value, label in ThreePointWizard.variants}
-ABC_VARIANTS = {label: value for value, label in AbcWorldWizard.variants}
 RANDOM, CHOSEN = "random", "chosen (tilt, azimuth)"
 _CHECK_WORKER = ThreadPoolExecutor(max_workers=1, thread_name_prefix="wizard-controller-job")
 """Runs a wizard's controller job off viser's event loop: a TCP check's six rotations (0.1-0.3
@@ -85,14 +84,15 @@ class WizardStepsView:
                                                  hint="The robot performs this step itself, with the operator error σ.")
                 self.auto_md = gui.add_markdown("")
         act = parent.action
-        self.record.on_click(act(lambda _e: parent.workflow.record()))
+        session = parent.session
+        self.record.on_click(act(lambda _e: session.record_step()))
         self.next.on_click(self._on_next)
         self._checking = False
         self._busy_text = ""
-        self.back.on_click(act(lambda _e: parent.workflow.back()))
+        self.back.on_click(act(lambda _e: session.back()))
         self.cancel.on_click(act(self._on_cancel))
         self.add_point.on_click(act(self._on_add_point))
-        self.mount.on_click(act(lambda _e: parent.workflow.mount_required_tool(), sync=True))
+        self.mount.on_click(act(lambda _e: session.mount_required_tool(), sync=True))
         self.variant.on_update(act(self._on_variant, user_only=True))
         self.auto_direction.on_update(act(lambda _e: None, user_only=True))
         self.auto_touch.on_click(act(self._on_auto_touch, sync=True))
@@ -100,10 +100,7 @@ class WizardStepsView:
 
     # ------------------------------------------------------------ callbacks
     def _on_cancel(self, _event: Any) -> None:
-        wf = self.parent.workflow
-        finished = wf.result is not None
-        wf.cancel()
-        if not finished:
+        if self.parent.session.cancel_wizard():
             self.parent.session.notify("Calibration cancelled",
                                        "Nothing recorded is lost: Resume it from the Calibrate menu.")
 
@@ -111,16 +108,15 @@ class WizardStepsView:
         """Next / Finish. A wizard waiting for its controller job (a TCP check's rotations, a
         beam scan) runs it on Finish: the job is taken on the loop (under the session lock), run
         in ``_CHECK_WORKER``, its outcome handed to the wizard on the loop; one job at a time."""
-        wf, act = self.parent.workflow, self.parent.action
+        session, act = self.parent.session, self.parent.action
         jobs: list[Any] = []
 
         def take(_e: Any) -> None:
             if self._checking:
                 raise WizardStateError("The controller is still at work; wait for its result.")
-            wiz = wf.wizard
-            job = wf.controller_job() if wiz is not None and wiz.on_last_step else None
+            job = session.take_controller_job()
             if job is None:
-                wf.next()
+                session.next_step()
             else:
                 jobs.append(job)
                 self._busy_text = job.busy_text
@@ -143,13 +139,10 @@ class WizardStepsView:
             return
         finally:
             self._checking = False
-        await act(lambda _e: wf.give_controller_job(jobs[0], result), sync=True)(event)
+        await act(lambda _e: session.hand_in_controller_job(jobs[0], result), sync=True)(event)
 
     def _on_add_point(self, _event: Any) -> None:
-        wiz = self.parent.workflow.wizard
-        if wiz is None:
-            raise WizardStateError("No calibration is open.")
-        wiz.add_point()
+        self.parent.session.add_point()
 
     def _on_variant(self, event: Any) -> None:
         wiz = self.parent.workflow.wizard
@@ -157,7 +150,7 @@ class WizardStepsView:
         values = {} if wiz is None else {lab: v for v, lab in type(wiz).variants}
         if label not in values:
             raise ValueError(f"Unknown variant {label!r}.")
-        wiz.set_variant(values[label])  # type: ignore[union-attr]
+        self.parent.session.set_variant(values[label])
 
     def auto_request(self) -> AutoTouchRequest:
         """The Auto-touch settings as a request (random or chosen direction, operator error)."""
@@ -168,7 +161,7 @@ class WizardStepsView:
 
     def _on_auto_touch(self, _event: Any) -> None:
         request = self.auto_request()
-        out = self.parent.workflow.auto_touch(request)
+        out = self.parent.session.auto_touch(request)
         if not out.ok:
             raise ValueError(out.message)
         wiz = self.parent.workflow.wizard
@@ -207,6 +200,9 @@ class WizardStepsView:
         self._render_variant(wiz)
         needed = wf.required_tool()
         reason = wiz.blocked_reason if not wiz.is_complete and not wiz.auto_role(wiz.step).by_controller else None
+        failure = wf.finish_failure
+        if failure is not None:                  # Finish could not compute: why, and what to do
+            reason = f"Finish not possible: {failure}" if reason is None else f"{reason}\n\n{failure}"
         self.blocked_md.visible = reason is not None
         if reason is not None:
             set_content(self.blocked_md, f"⚠ {escape_markdown(reason)}")
@@ -221,7 +217,7 @@ class WizardStepsView:
         self.next.disabled = not wiz.can_next or self._checking
         self.next.label = "Finish" if wiz.on_last_step else "Next"
         self.back.disabled = not wiz.can_back
-        self.cancel.label = "Cancel" if stepping else ("Close" if wf.result_saved else "Close (resume later)")
+        self.cancel.label = "Cancel" if stepping else ("Close" if wf.result_saved else "Close (not saved)")
         self.add_point.visible = wiz.supports_add_point
         self.add_point.disabled = not wiz.can_add_point
         self.auto_folder.visible = wf.training and stepping and not by_controller

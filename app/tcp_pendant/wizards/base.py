@@ -294,6 +294,18 @@ class Wizard(abc.ABC):
         in_exercises: may be started in a classroom exercise (``workflow.hide_truth``); False
             for a method that measures the tool by itself (the beam sensor): it would hand the
             trainee the mystery tool's answer the exercise asks them to find by touching.
+        saves_to_library: its result is a tool to save ("Save to tool library"); False for a
+            check, which only measures the tool data it was given.
+        controller_job: the name of the job the controller runs for it before it can finish
+            (``calibrate.jobs.JOBS``: "spin_check", "beam_scan"), None when every step is
+            recorded by hand and Finish only computes.
+        result_view: how its result is shown (``calibrate.text.result_markdown`` and the result
+            and scene views dispatch on it): "touches" (a TCP and/or orientation from recorded
+            touches), "spin_check" (a check's rotations and verdict), "beam_scan" (a scan's
+            events and the automatic-vs-manual lesson).
+        result_extras: what more its result panel offers: "estimators" (the 4-point's
+            estimator choice, outlier drop, estimator comparison and per-touch chart), "sphere"
+            (the sphere fit drawn in 3D).
     """
 
     kind: ClassVar[str]
@@ -308,6 +320,10 @@ class Wizard(abc.ABC):
     supports_add_point: ClassVar[bool] = False
     diversity_meter: ClassVar[bool] = False
     in_exercises: ClassVar[bool] = True
+    saves_to_library: ClassVar[bool] = True
+    controller_job: ClassVar[str | None] = None
+    result_view: ClassVar[Literal["touches", "spin_check", "beam_scan"]] = "touches"
+    result_extras: ClassVar[frozenset[str]] = frozenset()
 
     # ----- self-description (the registry, the menu and the workflow read these) -----------
     @classmethod
@@ -374,6 +390,11 @@ class Wizard(abc.ABC):
     def can_add_point(self) -> bool:
         """"Add point" is possible now (only wizards with ``supports_add_point``)."""
         return False
+
+    def solver_touch_steps(self) -> tuple[int, ...]:
+        """The 0-based steps whose poses are the solver's touch rows, in row order (tcpcal's
+        touch indices in an error map to these steps): every step of role "touch"."""
+        return tuple(i for i, spec in enumerate(self._step_specs()) if spec.role == "touch")
 
     def add_point(self) -> None:
         """Add one touch step (only wizards with ``supports_add_point``)."""

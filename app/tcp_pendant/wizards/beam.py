@@ -262,6 +262,8 @@ class ManualComparison:
         direction_error_deg: the error of its tool X (working direction), deg (None: it
             calibrated no orientation, or no truth).
         grade: its grade against the truth ("good" | "fair" | "poor"), or None.
+        touches / auto_touches: its recorded touches, and how many of them Auto-touch made
+            (0: all by hand; the lesson says who did the work).
     """
 
     title: str
@@ -271,6 +273,8 @@ class ManualComparison:
     position_error_mm: float | None = None
     direction_error_deg: float | None = None
     grade: str | None = None
+    touches: int = 0
+    auto_touches: int = 0
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready; the truth-derived figures under ``"truth"`` (an honest record drops it)."""
@@ -279,7 +283,8 @@ class ManualComparison:
             truth = {"position_error_mm": self.position_error_mm,
                      "direction_error_deg": self.direction_error_deg, "grade": self.grade}
         return {"title": self.title, "kind": self.kind, "run_number": self.run_number,
-                "wall_time_s": self.wall_time_s, "truth": truth}
+                "wall_time_s": self.wall_time_s, "touches": self.touches, "auto_touches": self.auto_touches,
+                "truth": truth}
 
     @classmethod
     def from_dict(cls, d: Any) -> "ManualComparison":
@@ -304,9 +309,16 @@ class ManualComparison:
             grade = truth.get("grade")
             if grade is not None and grade not in _GRADES:
                 raise WizardError(f"The stored manual calibration's grade must be one of {_GRADES}, got {grade!r:.40}.")
+        counts = []
+        for key in ("touches", "auto_touches"):          # optional: records before they were kept
+            v = d.get(key, 0)
+            if isinstance(v, bool) or not isinstance(v, int) or not 0 <= v <= 1000:
+                raise WizardError(f"The stored manual calibration's {key} must be a whole number 0..1000, "
+                                  f"got {v!r:.40}.")
+            counts.append(v)
         return cls(str(d.get("title", ""))[:_MAX_TEXT], str(d.get("kind", ""))[:_MAX_TEXT], n,
                    finite_number(d.get("wall_time_s"), "beam scan's manual wall time (s)", low=0.0, high=MAX_WALL_TIME_S),
-                   pos, ang, grade)
+                   pos, ang, grade, counts[0], min(counts[1], counts[0]))
 
 
 @dataclass(frozen=True, eq=False, kw_only=True)
@@ -410,6 +422,8 @@ class BeamWizard(Wizard):
     calibrates: ClassVar[str] = "the TCP and the tool direction"
     rank: ClassVar[int] = 60
     in_exercises: ClassVar[bool] = False
+    controller_job: ClassVar[str | None] = "beam_scan"
+    result_view: ClassVar[Literal["touches", "spin_check", "beam_scan"]] = "beam_scan"
     """The scan measures the tool by itself: refused in a classroom exercise."""
     MIN_ORIENTATIONS: ClassVar[int] = 3
     MAX_ORIENTATIONS: ClassVar[int] = 5

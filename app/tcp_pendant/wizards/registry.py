@@ -11,8 +11,6 @@ new method is the solver, one wizard module (registered here) and its tests, plu
 from __future__ import annotations
 
 import re
-from collections.abc import Iterator, Mapping, Sequence
-from typing import overload
 
 from tcp_pendant.wizards.base import Wizard, WizardError
 
@@ -75,51 +73,3 @@ def wizard_class(kind: str) -> type[Wizard]:
         raise WizardError(f"Unknown calibration method {kind!r}; choose one of "
                           f"{', '.join(c.kind for c in wizard_classes())}.")
     return cls
-
-
-class LiveKinds(Sequence[str]):
-    """A live, read-only tuple-like view of the registered kinds in menu order."""
-
-    def _kinds(self) -> tuple[str, ...]:
-        return tuple(c.kind for c in wizard_classes())
-
-    @overload
-    def __getitem__(self, i: int) -> str: ...
-    @overload
-    def __getitem__(self, i: slice) -> tuple[str, ...]: ...
-    def __getitem__(self, i: int | slice) -> str | tuple[str, ...]:
-        return self._kinds()[i]
-
-    def __len__(self) -> int:
-        return len(WIZARD_TYPES)
-
-    def __eq__(self, other: object) -> bool:
-        return tuple(self) == (tuple(other) if isinstance(other, (tuple, list, LiveKinds)) else other)
-
-    def __hash__(self) -> int:
-        return hash(self._kinds())
-
-    def __repr__(self) -> str:
-        return repr(self._kinds())
-
-
-class LiveAttribute(Mapping[str, str]):
-    """A live, read-only view kind -> one declared class attribute (``title``, ``blurb``)."""
-
-    def __init__(self, attribute: str) -> None:
-        self._attribute = attribute
-
-    def __getitem__(self, kind: str) -> str:
-        cls = WIZARD_TYPES.get(kind)
-        if cls is None:
-            raise KeyError(kind)
-        return str(getattr(cls, self._attribute))
-
-    def __iter__(self) -> Iterator[str]:
-        return iter([c.kind for c in wizard_classes()])
-
-    def __len__(self) -> int:
-        return len(WIZARD_TYPES)
-
-    def __repr__(self) -> str:
-        return f"{type(self).__name__}({dict(self)!r})"

@@ -7,7 +7,7 @@ Record), and on Finish shows how far the TRUE tip moved per rotation, the implie
 and the correction (FLANGE, mm), with a verdict.
 
 The state machine stays free of viser and of the controller: the six rotations are run by the
-caller (``CalibrationWorkflow.tcp_check_job``; the app runs it in a worker thread) from the
+caller (``calibrate.jobs.spin_check_job``; the app runs it in a worker thread) from the
 recorded pose, and the outcome is handed in with :meth:`TcpCheckWizard.give_check` (any
 object shaped like ``controller.spin.SpinCheckResult``); only then can the wizard finish.
 A check is not a calibration: nothing is graded against truth (no true tool at start) and
@@ -22,7 +22,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any, ClassVar
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 
@@ -98,14 +98,21 @@ class CheckFigures:
 
     @property
     def verdict(self) -> str:
-        """One line: good / off by how much / not determined (plain text)."""
+        """One line: good / off by how much / not determined (plain text). "Good" needs every
+        rotation: one that could not be made proves nothing about its axis, so the verdict stays
+        open (an error already found among the others stands)."""
         err = self.implied_tcp_error_mm
+        missing = [r.label for r in self.rows if not r.reached]
+        if err is not None and err > GOOD_CHECK_MM:
+            return f"TCP off by {err:.3f} mm: calibrate the tool again (or it is bent)."
+        if missing:
+            return (f"Not determined: {', '.join(missing)} could not be made from this pose (joint limit or "
+                    "singularity), so the check proves nothing about them. Touch the reference tip from "
+                    "an orientation farther from the joint limits, record again and check again.")
         if err is None:
             return ("Not determined: fewer than two of A, B, C were reached; move away from the joint "
                     "limits, record again and check again.")
-        if err <= GOOD_CHECK_MM:
-            return f"TCP good: implied error {err:.3f} mm (at most {GOOD_CHECK_MM:g} mm)."
-        return f"TCP off by {err:.3f} mm: calibrate the tool again (or it is bent)."
+        return f"TCP good: implied error {err:.3f} mm (at most {GOOD_CHECK_MM:g} mm)."
 
     def to_dict(self) -> dict[str, Any]:
         return {"angle_deg": self.angle_deg,
@@ -181,6 +188,8 @@ class TcpCheckWizard(Wizard):
     )
     needs_tool = "library"
     saves_to_library: ClassVar[bool] = False
+    controller_job: ClassVar[str | None] = "spin_check"
+    result_view: ClassVar[Literal["touches", "spin_check", "beam_scan"]] = "spin_check"
     """No Save: a check changes no tool data (the result view hides Save, the workflow refuses)."""
 
     def __init__(self, tool: Tool, *, slot: int | None = None, angle_deg: float = 30.0) -> None:
@@ -306,8 +315,10 @@ def tcp_check_markdown(result: TcpCheckResult) -> str:
     lines = [f"**TCP check of {escape_markdown(where + result.tool_name)}** at ±{c.angle_deg:g}°", "",
              "| Rotation | Tip moved (mm) | |", "|---|---:|---|"]
     for r in c.rows:
-        status = "✔" if r.reached else f"stopped: {escape_markdown(r.message)}"
-        lines.append(f"| {escape_markdown(r.label)} | {r.deviation_mm:.3f} | {status} |")
+        if r.reached:
+            lines.append(f"| {escape_markdown(r.label)} | {r.deviation_mm:.3f} | ✔ |")
+        else:                                   # no figure: the rotation was not made
+            lines.append(f"| {escape_markdown(r.label)} | not made | stopped: {escape_markdown(r.message)} |")
     lines.append("")
     if c.implied_tcp_error_mm is not None and c.correction_flange_mm is not None:
         dx, dy, dz = (0.0 if abs(v) < 5e-4 else v for v in c.correction_flange_mm)

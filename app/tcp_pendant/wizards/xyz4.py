@@ -110,6 +110,7 @@ class Xyz4Wizard(Wizard):
                             "from 4 to 20 clearly different orientations.")
     calibrates: ClassVar[str] = "the TCP"
     rank: ClassVar[int] = 10
+    result_extras: ClassVar[frozenset[str]] = frozenset({"estimators", "sphere"})
     MIN_POINTS: ClassVar[int] = 4
     MAX_POINTS: ClassVar[int] = 20
     step_roles = (StepRole("touch", "the tool tip on the reference tip", TOUCH),)
@@ -155,10 +156,17 @@ class Xyz4Wizard(Wizard):
             if i == 0:
                 text = ("Jog the tool tip onto the reference tip, approaching from any direction; "
                         "then press Record.")
-            elif i < 4:
-                text = (f"Back off, tilt the tool 30 to 60 degrees about a different axis than "
-                        f"before, and touch the reference tip again from this new orientation "
-                        f"(touch {i + 1}); then press Record.")
+            elif i == 1:
+                text = ("Back off, tilt the tool 45 to 60 degrees about one axis (A, B or C), and touch "
+                        "the reference tip again from this new orientation (touch 2); then press Record.")
+            elif i == 2:
+                text = ("Back off, tilt the tool 45 to 60 degrees about another axis than for touch 2, "
+                        "and touch the reference tip again (touch 3); then press Record.")
+            elif i == 3:
+                text = ("Back off and touch the reference tip from an orientation 45 to 60 degrees away "
+                        "from all three earlier ones, e.g. tilted the other way than touch 2 (touch 4); "
+                        "then press Record. Smaller tilts leave the TCP uncertain: the meter below "
+                        "predicts the error.")
             else:
                 text = (f"Extra touch {i + 1}: touch the reference tip from an orientation unlike "
                         f"the earlier ones (watch the pose-diversity meter); then press Record.")
@@ -214,6 +222,10 @@ class Xyz4Wizard(Wizard):
     def excluded(self) -> tuple[int, ...]:
         """0-based indices of recorded touches left out of the computation."""
         return self._excluded
+
+    def solver_touch_steps(self) -> tuple[int, ...]:
+        """The touches tcpcal is given: every step but the ones dropped."""
+        return tuple(i for i in range(self.n_steps) if i not in self._excluded)
 
     def set_excluded(self, indices: Iterable[int]) -> WizardResult | None:
         """Leave these touches out (0-based); recompute if finished. At least 4 must remain."""
@@ -328,7 +340,8 @@ class Xyz4Wizard(Wizard):
         abc = (0.0, 0.0, 0.0)
         if self.base_tool is not None:
             abc = tuple(float(v) for v in self.base_tool.abc_deg)  # type: ignore[assignment]
-            kw = {"mass_kg": self.base_tool.mass_kg, "notes": self.base_tool.notes}
+            kw = {"mass_kg": self.base_tool.mass_kg, "cog_mm": self.base_tool.cog_mm,
+                  "notes": self.base_tool.notes}
         return Tool(name=name, tcp_mm=res.tcp_mm, abc_deg=abc,
                     calibration=self._calibration(res, res.figures), **kw)
 

@@ -20,7 +20,13 @@ from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from typing import overload
 
-from tcpcal.controllers._common import ControllerFileError, RecordedPose, ToolEntry, fixed
+from tcpcal.controllers._common import (
+    ControllerFileError,
+    JointPoint,
+    RecordedPose,
+    ToolEntry,
+    fixed,
+)
 from tcpcal.controllers._format import ControllerFormat, CsvLayout
 from tcpcal.errors import InvalidInputError
 from tcpcal.tool import Tool
@@ -29,14 +35,17 @@ __all__ = [
     "CONTROLLER_FORMATS",
     "POSE_FORMATS",
     "REGISTRY",
+    "ROBOT_HINT",
     "ControllerFileError",
     "ControllerFormat",
     "CsvLayout",
+    "JointPoint",
     "PoseImport",
     "RecordedPose",
     "ToolEntry",
     "csv_layouts",
     "detect_pose_format",
+    "detect_tool_format",
     "export_tool_file",
     "formats",
     "get_format",
@@ -44,6 +53,7 @@ __all__ = [
     "parse_tool_file",
     "poses_csv_text",
     "register",
+    "skipped_joints_warning",
     "unregister",
 ]
 
@@ -194,11 +204,38 @@ def parse_tool_file(text: str, fmt: str) -> list[ToolEntry]:
 
 @dataclass(frozen=True)
 class PoseImport:
-    """Poses read from a program file and what the technician should know about them."""
+    """Poses read from a program file and what the technician should know about them.
+
+    Attributes:
+        format: the format's name.
+        poses: the Cartesian positions, in file order.
+        warnings: what the technician should know (one sentence each).
+        joint_points: the positions in joint representation (axis values, deg), in file
+            order: not in ``poses`` (tcpcal has no robot model); see
+            :func:`skipped_joints_warning`.
+    """
 
     format: str
     poses: tuple[RecordedPose, ...]
     warnings: tuple[str, ...]
+    joint_points: tuple[JointPoint, ...] = ()
+
+
+ROBOT_HINT = ("tcp-pendant poses import FILE --robot kr6|gp12|PATH.urdf converts them with "
+              "the robot's forward kinematics")
+"""How to turn joint points into flange poses (the app has the robot model tcpcal lacks)."""
+
+
+def skipped_joints_warning(imported: PoseImport) -> str | None:
+    """The sentence ``tcpcal poses import`` prints when it skips joint-representation points
+    (``None`` when there are none): how many, which, and the hint to use ``--robot``."""
+    joints = imported.joint_points
+    if not joints:
+        return None
+    names = ", ".join(p.name for p in joints[:8]) + (", ..." if len(joints) > 8 else "")
+    return (f"skipped {len(joints)} point{'s' if len(joints) != 1 else ''} in joint "
+            f"representation ({names}): tcpcal has no robot model to turn axis values into "
+            f"flange poses; {ROBOT_HINT}, or record the touches in Cartesian")
 
 
 def _or_list(items: Sequence[str]) -> str:
@@ -206,8 +243,12 @@ def _or_list(items: Sequence[str]) -> str:
 
 
 def detect_pose_format(text: str, filename: str | None = None) -> str:
-    """The controller of a program file: from its extension, else from its content."""
+    """The controller of a program file: a content only one controller writes
+    (``ControllerFormat.claim``), else its extension, else its content."""
     readers = formats(lambda f: f.parse_poses is not None)
+    for fmt in readers:
+        if fmt.claim is not None and fmt.claim.search(text):
+            return fmt.name
     if filename:
         from pathlib import PurePath
 
@@ -224,6 +265,25 @@ def detect_pose_format(text: str, filename: str | None = None) -> str:
         f"--format {'|'.join(f.name for f in readers)}")
 
 
+def detect_tool_format(text: str, filename: str | None = None) -> str:
+    """The controller of a tool file (``tools import --format auto``): from its extension,
+    else from its content (``ControllerFormat.tool_file_detect``, in ``rank`` order)."""
+    readers = formats(lambda f: f.parse_file is not None)
+    if filename:
+        from pathlib import PurePath
+
+        suffix = PurePath(filename).suffix.lower()
+        for fmt in readers:
+            if suffix in fmt.tool_file_extensions:
+                return fmt.name
+    for fmt in readers:
+        if fmt.tool_file_detect is not None and fmt.tool_file_detect.search(text):
+            return fmt.name
+    raise ControllerFileError(
+        "cannot tell which controller wrote this tool file; pass "
+        f"--format {'|'.join(f.name for f in readers)}")
+
+
 def import_poses(text: str, fmt: str = "auto", *, filename: str | None = None) -> PoseImport:
     """Read the recorded positions of a program file (KUKA ``.dat``, ABB ``.mod``, FANUC
     ``.LS``, UR script: every format with ``parse_poses``).
@@ -231,6 +291,9 @@ def import_poses(text: str, fmt: str = "auto", *, filename: str | None = None) -
     The solver needs flange poses in WORLD: positions recorded with no tool (KUKA TOOL_NO 0,
     FANUC UT 0, ABB tool0, UR TCP = flange) and no base / user frame. Where the file says which
     tool or base a position was recorded with and it is not 0, a warning names it.
+
+    Positions in joint representation are not poses: they are returned in
+    ``PoseImport.joint_points`` (not an error, even when they are all the file has).
 
     Raises:
         ControllerFileError: unknown format, a position that cannot be read (the message
@@ -242,7 +305,8 @@ def import_poses(text: str, fmt: str = "auto", *, filename: str | None = None) -
         raise ControllerFileError(f"{name}: tcpcal reads poses only from "
                                   f"{', '.join(POSE_FORMATS)} files")
     poses = tuple(cf.parse_poses(text))
-    if not poses:
+    joints = tuple(cf.parse_joint_points(text)) if cf.parse_joint_points is not None else ()
+    if not poses and not joints:
         raise ControllerFileError(f"{name}: no recorded position found in the file")
     warnings: list[str] = []
     tooled = [p.name for p in poses if p.tool not in (None, 0)]
@@ -255,7 +319,7 @@ def import_poses(text: str, fmt: str = "auto", *, filename: str | None = None) -
                         "touches in WORLD (base 0)")
     if cf.pose_warnings is not None:
         warnings.extend(cf.pose_warnings(text))
-    return PoseImport(name, poses, tuple(warnings))
+    return PoseImport(name, poses, tuple(warnings), joints)
 
 
 def poses_csv_text(imported: PoseImport) -> str:

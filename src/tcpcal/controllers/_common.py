@@ -15,7 +15,8 @@ import numpy as np
 
 from tcpcal.errors import InvalidInputError
 
-__all__ = ["NUM", "ControllerFileError", "RecordedPose", "ToolEntry", "fixed", "line_of", "to_float"]
+__all__ = ["NUM", "ControllerFileError", "JointPoint", "RecordedPose", "ToolEntry", "fixed",
+           "line_of", "to_float"]
 
 NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
 """A decimal number as controllers write it (``.044``, ``-12.``, ``9E+09``)."""
@@ -63,12 +64,16 @@ class ToolEntry:
         name: the tool's name in the file ('' when it has none).
         tcp_mm: TCP in FLANGE, mm.
         rotation: (3, 3) ``R_flange_tool``.
+        mass_kg: the load's mass the file gives, kg, or ``None`` (not in the file, or 0: unset).
+        cog_mm: the load's centre of gravity in FLANGE, mm, or ``None`` (not in the file).
     """
 
     number: int | None
     name: str
     tcp_mm: tuple[float, float, float]
     rotation: np.ndarray
+    mass_kg: float | None = None
+    cog_mm: tuple[float, float, float] | None = None
 
     def __post_init__(self) -> None:
         rot = np.array(self.rotation, dtype=float)
@@ -105,6 +110,34 @@ class RecordedPose:
         rot = np.array(self.rotation, dtype=float)
         rot.setflags(write=False)
         object.__setattr__(self, "rotation", rot)
+
+
+@dataclass(frozen=True)
+class JointPoint:
+    """One robot position a program file records in joint representation (axis values, not a
+    Cartesian pose): FANUC ``J1 = ..`` points, ABB ``jointtarget``, KUKA ``E6AXIS``/``AXIS``.
+
+    tcpcal has no robot model, so it cannot turn these into flange poses; ``tcpcal poses
+    import`` skips them and says how many. A caller with forward kinematics (the app's
+    ``tcp-pendant poses import --robot``) converts ``joints_deg`` itself.
+
+    Attributes:
+        name: the position's name in the file (``P[2]``, ``jHome``, ``XHOME``).
+        joints_deg: the robot's axis values in file order (A1/J1/rax_1 first), **degrees**
+            (revolute axes; the vendors write them so).
+        line: 1-based line of the position in the file.
+        tool: the tool number the file says the position was recorded with, if it says.
+        base: the base / user frame number, if the file says.
+        kind: the file's name for the representation (``"FANUC J"``, ``"jointtarget"``,
+            ``"E6AXIS"``, ``"AXIS"``).
+    """
+
+    name: str
+    joints_deg: tuple[float, ...]
+    line: int = 0
+    tool: int | None = None
+    base: int | None = None
+    kind: str = ""
 
 
 def line_of(text: str, pos: int) -> int:

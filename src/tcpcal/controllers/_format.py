@@ -96,6 +96,14 @@ class ControllerFormat:
         pose_warnings: ``text -> [warning]``: what else the technician should know about a
             program file's poses (e.g. a UR script that sets a TCP).
         csv: the POSES.csv layout of its poses (``None``: none).
+        parse_joint_points: ``text -> [JointPoint]``: the positions the program file records
+            in joint representation (``None``: the format has none); ``poses import`` skips
+            them (tcpcal has no robot model) and the app converts them.
+        claim: content that only this controller's files have (FANUC's ``A05B-`` order
+            numbers of ``ORDERFIL.DAT``): it wins over the file extension in ``--format auto``.
+        tool_file_extensions: extensions (lower case) of the files ``tools import`` reads.
+        tool_file_detect: content found in this controller's tool files (``tools import
+            --format auto`` tries the formats in ``rank`` order).
     """
 
     name: str
@@ -124,6 +132,10 @@ class ControllerFormat:
     detect_text: str = ""
     pose_warnings: Callable[[str], list[str]] | None = None
     csv: CsvLayout | None = None
+    parse_joint_points: Callable[[str], list[Any]] | None = None
+    claim: re.Pattern[str] | None = None
+    tool_file_extensions: tuple[str, ...] = ()
+    tool_file_detect: re.Pattern[str] | None = None
 
     # The names the file functions had before the registries were one (tests, callers).
     @property

@@ -26,6 +26,7 @@ from scipy.spatial.transform import Rotation
 from tcpcal.controllers._common import (
     NUM,
     ControllerFileError,
+    JointPoint,
     RecordedPose,
     ToolEntry,
     fixed,
@@ -44,7 +45,8 @@ from tcpcal.errors import InvalidInputError
 from tcpcal.tool import Tool
 from tcpcal.validation import ORTHONORMAL_TOL
 
-__all__ = ["DEFAULT_MASS_KG", "FORMAT", "RESERVED", "check_identifier", "parse_poses",
+__all__ = ["DEFAULT_MASS_KG", "FORMAT", "RESERVED", "check_identifier", "parse_joint_points",
+           "parse_poses", "pose_warnings",
            "parse_text", "parse_tool", "render_poses", "render_text", "render_tool",
            "text_identifier"]
 
@@ -106,13 +108,15 @@ def render_tool(tool: Tool, number: int = 1, name: str | None = None) -> str:
     pos = ",".join(fixed(v, 3) for v in tool.tcp_mm)
     quat = ",".join(fixed(v, 6) for v in q)
     module = f"tcpcal_{ident}"[:32]
+    cog = ("0,0,0.001" if tool.cog_mm is None or tool.mass_kg is None
+           else ",".join(fixed(v, 3) for v in tool.cog_mm))
     return (f"MODULE {module}\n"
             f"    ! tcpcal: tool {ident} (library slot {number}) for ABB RAPID\n"
             "    ! tframe: TCP [x,y,z] in mm in the wrist (flange) frame; orientation R_flange_tool\n"
             "    ! as a unit quaternion [q1,q2,q3,q4], q1 the scalar part\n"
             "    ! tload: placeholder load; identify the real one (LoadIdentify) before use\n"
             f"    PERS tooldata {ident}:=[TRUE,[[{pos}],[{quat}]],"
-            f"[{fixed(mass, 3)},[0,0,0.001],[1,0,0,0],0,0,0]];\n"
+            f"[{fixed(mass, 3)},[{cog}],[1,0,0,0],0,0,0]];\n"
             "ENDMODULE\n")
 
 
@@ -121,6 +125,20 @@ def _numbers(text: str, n: int, what: str) -> list[float]:
     if len(toks) != n:
         raise ControllerFileError(f"abb: {what} needs {n} numbers, got {len(toks)}")
     return [to_float(t, "abb", what) for t in toks]
+
+
+def _load(body: str, name: str) -> tuple[float | None, tuple[float, float, float] | None]:
+    """Mass (kg) and centre of gravity (mm) of a tooldata's ``tload``; ``(None, None)`` for
+    tool0's placeholder load ``[0.001,[0,0,0.001],...]`` or a load that cannot be read."""
+    try:
+        agg = _parse_aggregate(body, 0)
+        mass = float(agg[2][0])
+        cog = tuple(float(v) for v in agg[2][1])
+    except (InvalidInputError, IndexError, TypeError, ValueError):
+        return None, None
+    if mass <= 0 or (mass == DEFAULT_MASS_KG and cog == _DEFAULT_COG) or len(cog) != 3:
+        return None, None
+    return mass, (cog[0], cog[1], cog[2])
 
 
 def parse_tool(text: str) -> list[ToolEntry]:
@@ -140,7 +158,9 @@ def parse_tool(text: str) -> list[ToolEntry]:
         pos = _numbers(inner.group(2), 3, f"tooldata {name} position")
         rot = _rotation(_numbers(inner.group(3), 4, f"tooldata {name} orientation"),
                         f"tooldata {name}")
-        out.append(ToolEntry(None, name, tuple(pos), rot))  # type: ignore[arg-type]
+        mass, cog = _load(body, name)
+        out.append(ToolEntry(None, name, tuple(pos), rot,  # type: ignore[arg-type]
+                             mass_kg=mass, cog_mm=cog))
     if not out:
         raise ControllerFileError("abb: no 'PERS tooldata name:=[...];' declaration found")
     return out
@@ -156,6 +176,108 @@ def parse_poses(text: str) -> list[RecordedPose]:
         q = _numbers(m.group(3), 4, f"{what} orientation")
         out.append(RecordedPose(name, tuple(pos), _rotation(q, what), tuple(q),  # type: ignore[arg-type]
                                 line=line_of(text, m.start())))
+    return out
+
+
+_JOINTTARGET = re.compile(r"jointtarget\s+(\w+)\s*:=\s*\[\s*\[([^\]]*)\]\s*,\s*\[([^\]]*)\]",
+                          re.IGNORECASE)
+_MOVE = re.compile(r"^[ \t]*(Move(?:L|J|C|AbsJ|LDO|JDO|CDO|LSync|JSync|CSync|LAO|JAO|CAO|"
+                   r"LGO|JGO|CGO))\b([^;]*);", re.IGNORECASE | re.MULTILINE)
+"""Move instructions whose positional arguments are ToPoint (MoveC: CirPoint, ToPoint),
+Speed, Zone, Tool (ABB RAPID reference manual)."""
+_WOBJ = re.compile(r"\\WObj\s*:=\s*(\w+)", re.IGNORECASE)
+_UNSET_EXTAX = 9e8
+"""An external axis value at or above this (RAPID writes 9E+09) is 'no axis'."""
+
+
+def _comment_free(text: str) -> str:
+    """``text`` with RAPID ``!`` comments blanked (same length: offsets and lines hold)."""
+    return re.sub(r"![^\n]*", lambda m: " " * len(m.group(0)), text)
+
+
+def _arguments(args: str) -> list[str]:
+    """The positional arguments of a RAPID instruction: split at top-level commas, optional
+    arguments (``\\Conc``, ``\\WObj:=w``, ``v100\\T:=2``) removed."""
+    parts, depth, cur = [], 0, ""
+    for ch in args:
+        depth += {"[": 1, "(": 1, "]": -1, ")": -1}.get(ch, 0)
+        if ch == "," and depth == 0:
+            parts.append(cur)
+            cur = ""
+        else:
+            cur += ch
+    parts.append(cur)
+    out = []
+    for part in parts:
+        bare = re.sub(r"\\\w+(?:\s*:=\s*[^\\]*)?", "", part).strip()
+        if bare:
+            out.append(bare)
+    return out
+
+
+def _moves(text: str) -> list[tuple[str, list[str], str, str | None, int]]:
+    """Every move instruction: ``(instruction, its target names, tool, work object, line)``."""
+    code = _comment_free(text)
+    out = []
+    for m in _MOVE.finditer(code):
+        instr = m.group(1)
+        args = _arguments(m.group(2))
+        n_points = 2 if instr.upper().startswith("MOVEC") else 1
+        tool_at = n_points + 2
+        if len(args) <= tool_at:
+            continue
+        targets = [a for a in args[:n_points] if re.fullmatch(r"[A-Za-z]\w*", a)]
+        wobj = _WOBJ.search(m.group(2))
+        out.append((instr, targets, args[tool_at], wobj.group(1) if wobj else None,
+                    line_of(text, m.start(1))))
+    return out
+
+
+def pose_warnings(text: str) -> list[str]:
+    """Moves whose tool is not ``tool0`` or that name a work object (``\\WObj:=``): the
+    positions they reach are TCP poses, or poses in that work object, not the flange in WORLD.
+    Also named: robtargets whose external axes hold values (not 9E+09)."""
+    out: list[str] = []
+    tooled: dict[str, list[str]] = {}
+    based: dict[str, list[str]] = {}
+    for _, targets, tool, wobj, line in _moves(text):
+        names = targets or [f"line {line}"]
+        if tool.upper() != "TOOL0":
+            tooled.setdefault(tool, []).extend(n for n in names if n not in tooled.get(tool, []))
+        if wobj is not None and wobj.upper() != "WOBJ0":
+            based.setdefault(wobj, []).extend(n for n in names if n not in based.get(wobj, []))
+    for tool, names in tooled.items():
+        out.append(f"{', '.join(names)} reached by moves with tool {tool} (not tool0): those "
+                   "are TCP poses, not the flange; record the touches with tool0")
+    for wobj, names in based.items():
+        out.append(f"{', '.join(names)} reached by moves in work object {wobj}: those "
+                   "positions are in the work object, not WORLD; record the touches with wobj0")
+    extax = []
+    for m in _ROBTARGET.finditer(text):
+        rest = text[m.end():text.find(";", m.end())]
+        groups = re.findall(r"\[([^\[\]]*)\]", rest)
+        if len(groups) >= 2:
+            vals = [t for t in re.split(r"[\s,]+", groups[1].strip()) if t]
+            try:
+                if any(abs(float(v)) < _UNSET_EXTAX for v in vals):
+                    extax.append(m.group(1))
+            except ValueError:
+                continue
+    if extax:
+        out.append(f"{', '.join(extax)} hold external axis values (eax not 9E+09): tcpcal "
+                   "ignores them; the poses are right only if no external axis moves the robot "
+                   "or the reference")
+    return out
+
+
+def parse_joint_points(text: str) -> list[JointPoint]:
+    """``jointtarget`` declarations ``[[rax_1..rax_6],[eax_a..eax_f]]`` (deg), file order."""
+    out: list[JointPoint] = []
+    for m in _JOINTTARGET.finditer(text):
+        what = f"line {line_of(text, m.start())}: jointtarget {m.group(1)}"
+        axes = _numbers(m.group(2), 6, f"{what} robot axes")
+        out.append(JointPoint(m.group(1), tuple(axes), line_of(text, m.start()),
+                              kind="jointtarget"))
     return out
 
 
@@ -197,7 +319,7 @@ def render_text(tool: Tool, slot: int = 1) -> str:
     ``slot`` is not written)."""
     q1234 = _quaternion(tool.rotation)
     mass = DEFAULT_MASS_KG if tool.mass_kg is None else tool.mass_kg
-    cog = _DEFAULT_COG  # tcpcal knows no centre of gravity (tcpcal.formats docstring)
+    cog = _DEFAULT_COG if tool.cog_mm is None or tool.mass_kg is None else tool.cog_mm
 
     def lst(v: Sequence[float]) -> str:
         return "[" + ",".join(text_number(x, True) for x in v) + "]"
@@ -309,8 +431,10 @@ def parse_text(text: str, name: str | None) -> Tool:
         raise InvalidInputError(f"abb: tload mass must be positive (kg), got {mass!r}.")
     mass_kg = None if (mass == DEFAULT_MASS_KG and tuple(cog) == _DEFAULT_COG) else mass
     R = Rotation.from_quat([q[1], q[2], q[3], q[0]]).as_matrix()  # scipy order x, y, z, w
+    cog_mm = None if mass_kg is None else (cog[0], cog[1], cog[2])
     return tool_from_rotation(
-        "abb", name or found_name or "imported", name is not None, trans, R, mass_kg=mass_kg
+        "abb", name or found_name or "imported", name is not None, trans, R, mass_kg=mass_kg,
+        cog_mm=cog_mm,
     )
 
 
@@ -358,7 +482,10 @@ FORMAT = ControllerFormat(
     values="PERS tooldata name:=[TRUE,[[x,y,z mm],[q1,q2,q3,q4]],[load]]",
     render_file=render_tool, parse_file=parse_tool, parse_poses=parse_poses,
     render_poses=render_poses, pose_extensions=(".mod", ".modx", ".prg", ".sys"),
-    detect=re.compile(r"\brobtarget\b", re.I), detect_text="ABB robtarget",
+    detect=re.compile(r"\b(robtarget|jointtarget)\b", re.I), detect_text="ABB robtarget",
+    pose_warnings=pose_warnings, parse_joint_points=parse_joint_points,
+    tool_file_extensions=(".mod", ".modx", ".sys", ".prg"),
+    tool_file_detect=re.compile(r"\btooldata\s+\w+\s*:=", re.I),
     csv=CsvLayout("abb", ("qw", "qx", "qy", "qz"), "unit quaternion, scalar first",
                   _csv_rotations, decimals=9, rank=30, row_values=_csv_row),
 )

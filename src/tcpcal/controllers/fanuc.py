@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -25,6 +26,7 @@ from scipy.spatial.transform import Rotation
 from tcpcal.controllers._common import (
     NUM,
     ControllerFileError,
+    JointPoint,
     RecordedPose,
     ToolEntry,
     fixed,
@@ -43,7 +45,8 @@ from tcpcal.controllers._format import (
 from tcpcal.errors import InvalidInputError
 from tcpcal.tool import Tool, abc_deg_from_rotation
 
-__all__ = ["COMMENT_LENGTH", "FORMAT", "parse_poses", "parse_text", "parse_tool",
+__all__ = ["COMMENT_LENGTH", "FORMAT", "parse_joint_points", "parse_poses", "parse_text",
+           "parse_tool", "pose_warnings",
            "render_poses", "render_text", "render_tool"]
 
 N_TOOLS = 10
@@ -55,6 +58,8 @@ DEFAULT_REGISTER = 100
 _P = re.compile(r"^\s*P\[\s*(\d+)\s*(?::\s*\"([^\"]*)\")?\s*\]\s*\{(.*?)\}\s*;", re.S | re.M)
 _FIELD = re.compile(rf"\b([XYZWPR])\s*=\s*({NUM})")
 _UF_UT = re.compile(r"\bUF\s*:\s*(\d+)\s*,\s*UT\s*:\s*(\d+)")
+_ORDERFIL = re.compile(r"^\s*\d?A05B-\d{4}-[A-Z]\d{3}\b", re.M)
+"""A FANUC software option order number (``1A05B-2500-J601``), the lines of ORDERFIL.DAT."""
 _ATTR = """/ATTR
 OWNER\t\t= MNEDITOR;
 COMMENT\t\t= "{comment}";
@@ -113,31 +118,81 @@ def render_tool(tool: Tool, number: int, name: str | None = None, *,
             + _pos_block(1, tool.tcp_mm, _wpr(tool.rotation)) + "\n/END\n")
 
 
-def _positions(text: str) -> list[tuple[int, str, dict[str, float], int | None, int | None, int]]:
+_GROUP = re.compile(r"\bGP(\d+)\s*:")
+_JOINT = re.compile(rf"\bJ(\d+)\s*=\s*({NUM})")
+_EXTENDED = re.compile(rf"\bE(\d+)\s*=\s*({NUM})")
+"""An integrated extended axis of group 1 (``E1 = 1500.000 mm``: a track the robot rides)."""
+
+
+@dataclass(frozen=True)
+class _Point:
+    """One ``P[n]`` of ``/POS``: group 1's values (Cartesian or joints) and its other groups."""
+
+    k: int
+    comment: str
+    line: int
+    cartesian: dict[str, float] | None
+    joints: tuple[float, ...] | None
+    uf: int | None
+    ut: int | None
+    other_groups: tuple[int, ...]
+    extended: tuple[tuple[int, float], ...] = ()
+
+
+def _groups(body: str) -> dict[int, str]:
+    """The text of each ``GPn:`` section of a point's braces (``{1: body}`` if there is none)."""
+    marks = list(_GROUP.finditer(body))
+    if not marks:
+        return {1: body}
+    return {int(m.group(1)): body[m.end():(marks[i + 1].start() if i + 1 < len(marks)
+                                           else len(body))]
+            for i, m in enumerate(marks)}
+
+
+def _points(text: str) -> list[_Point]:
+    """Every ``P[n]{...}`` of the ``/POS`` section: group 1 read, the other groups named."""
     pos_at = text.find("/POS")
     section = text[pos_at:] if pos_at >= 0 else text
     offset = pos_at if pos_at >= 0 else 0
     out = []
     for m in _P.finditer(section):
         k = int(m.group(1))
-        body = m.group(3)
         line = line_of(text, offset + m.start())
-        if re.search(r"\bJ1\s*=", body):
-            raise ControllerFileError(
-                f"fanuc: line {line}: P[{k}] is in joint representation; record the touches "
-                "in Cartesian (WORLD, UFRAME 0) or convert them on the pendant (REPRE)")
-        gp1 = body.split("GP2:")[0]
+        groups = _groups(m.group(3))
+        gp1 = groups.get(1)
+        others = tuple(sorted(g for g in groups if g != 1))
+        if gp1 is None:
+            out.append(_Point(k, m.group(2) or "", line, None, None, None, None, others))
+            continue
+        uf_ut = _UF_UT.search(gp1)
+        uf = int(uf_ut.group(1)) if uf_ut else None
+        ut = int(uf_ut.group(2)) if uf_ut else None
+        joints = [(int(j.group(1)), to_float(j.group(2), "fanuc", f"P[{k}] J{j.group(1)}"))
+                  for j in _JOINT.finditer(gp1)]
+        if joints:
+            values = tuple(v for _, v in sorted(joints))
+            out.append(_Point(k, m.group(2) or "", line, None, values, uf, ut, others))
+            continue
         vals: dict[str, float] = {}
         for f in _FIELD.finditer(gp1):
             vals[f.group(1)] = to_float(f.group(2), "fanuc", f"P[{k}] {f.group(1)}")
         missing = [c for c in "XYZWPR" if c not in vals]
         if missing:
             raise ControllerFileError(f"fanuc: line {line}: P[{k}] lacks {', '.join(missing)}")
-        uf_ut = _UF_UT.search(gp1)
-        uf = int(uf_ut.group(1)) if uf_ut else None
-        ut = int(uf_ut.group(2)) if uf_ut else None
-        out.append((k, m.group(2) or "", vals, uf, ut, line))
+        ext = tuple((int(e.group(1)), to_float(e.group(2), "fanuc", f"P[{k}] E{e.group(1)}"))
+                    for e in _EXTENDED.finditer(gp1))
+        out.append(_Point(k, m.group(2) or "", line, vals, None, uf, ut, others, ext))
     return out
+
+
+def _positions(text: str) -> list[tuple[int, str, dict[str, float], int | None, int | None, int]]:
+    """The points whose group 1 is Cartesian: ``(k, comment, X..R, UF, UT, line)``."""
+    return [(p.k, p.comment, p.cartesian, p.uf, p.ut, p.line) for p in _points(text)
+            if p.cartesian is not None]
+
+
+def _name(p: _Point) -> str:
+    return p.comment or f"P[{p.k}]"
 
 
 def parse_tool(text: str) -> list[ToolEntry]:
@@ -162,14 +217,54 @@ def parse_tool(text: str) -> list[ToolEntry]:
     return out
 
 
+def _check_program(text: str) -> None:
+    """A FANUC file that holds no positions by nature says so (``ORDERFIL.DAT``)."""
+    if "/POS" not in text and _ORDERFIL.search(text):
+        raise ControllerFileError(
+            "fanuc: this is ORDERFIL.DAT, the controller's list of software options (A05B-... "
+            "order numbers): it holds no position; import a TP program (.LS) instead")
+
+
 def parse_poses(text: str) -> list[RecordedPose]:
-    """The Cartesian positions ``P[n]`` of a ``.LS`` file's ``/POS`` section (group 1)."""
+    """The Cartesian positions ``P[n]`` of a ``.LS`` file's ``/POS`` section (group 1; the
+    other motion groups are named by :func:`pose_warnings`, joint points by
+    :func:`parse_joint_points`)."""
+    _check_program(text)
     out: list[RecordedPose] = []
     for k, comment, v, uf, ut, line in _positions(text):
         wpr = (v["W"], v["P"], v["R"])
         rot = Rotation.from_euler("xyz", wpr, degrees=True).as_matrix()
         out.append(RecordedPose(comment or f"P[{k}]", (v["X"], v["Y"], v["Z"]), rot, wpr,
                                 tool=ut, base=uf, line=line))
+    return out
+
+
+def parse_joint_points(text: str) -> list[JointPoint]:
+    """The points whose group 1 is in joint representation (``J1 = .. deg`` ...)."""
+    return [JointPoint(_name(p), p.joints, p.line, p.ut, p.uf, "FANUC J")
+            for p in _points(text) if p.joints is not None]
+
+
+def pose_warnings(text: str) -> list[str]:
+    """The points that also hold other motion groups (``GP2:`` ...): only group 1 is read;
+    and those whose group 1 has extended-axis values (``E1 = ..``) not 0."""
+    points = _points(text)
+    out = []
+    pts = [p for p in points if p.other_groups]
+    if pts:
+        groups = sorted({g for p in pts for g in p.other_groups})
+        names = ", ".join(_name(p) for p in pts[:8]) + (", ..." if len(pts) > 8 else "")
+        out.append(f"{len(pts)} point{'s' if len(pts) != 1 else ''} ({names}) also hold motion "
+                   f"group {', '.join(f'GP{g}' for g in groups)} (an extended axis or another "
+                   "robot): only group 1 (GP1, the robot) was read; its poses are valid only if "
+                   "the other groups do not carry the robot or the reference")
+    moved = [p for p in points if any(v != 0.0 for _, v in p.extended)]
+    if moved:
+        names = ", ".join(f"{_name(p)} ({', '.join(f'E{i} {v:g}' for i, v in p.extended if v)})"
+                          for p in moved[:8]) + (", ..." if len(moved) > 8 else "")
+        out.append(f"{names}: extended-axis values are not part of the pose; tcpcal ignores "
+                   "them, so the poses are right only if no extended axis moves the robot or "
+                   "the reference between touches")
     return out
 
 
@@ -270,6 +365,8 @@ FORMAT = ControllerFormat(
     render_file=render_tool, parse_file=parse_tool, file_options=("register",),
     parse_poses=parse_poses, render_poses=render_poses, pose_extensions=(".ls",),
     detect=re.compile(r"^/POS\b", re.M), detect_text="FANUC /POS",
+    pose_warnings=pose_warnings, parse_joint_points=parse_joint_points, claim=_ORDERFIL,
+    tool_file_extensions=(".ls",), tool_file_detect=re.compile(r"\bUTOOL\[\s*\d+\s*\]\s*=\s*PR\["),
     csv=CsvLayout("fanuc", ("w", "p", "r"), "FANUC W,P,R in deg", _csv_rotations, decimals=6,
                   rank=20),
 )

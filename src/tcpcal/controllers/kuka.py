@@ -23,6 +23,7 @@ from scipy.spatial.transform import Rotation
 from tcpcal.controllers._common import (
     NUM,
     ControllerFileError,
+    JointPoint,
     RecordedPose,
     ToolEntry,
     fixed,
@@ -41,15 +42,21 @@ from tcpcal.controllers._format import (
 from tcpcal.errors import InvalidInputError
 from tcpcal.tool import Tool, abc_deg_from_rotation
 
-__all__ = ["FORMAT", "parse_poses", "parse_text", "parse_tool", "render_poses", "render_text",
-           "render_tool"]
+__all__ = ["FORMAT", "parse_joint_points", "parse_poses", "parse_text", "parse_tool",
+           "pose_warnings", "render_poses", "render_text", "render_tool"]
 
 N_TOOLS = 16
 TOOL_NUMBERS = range(1, N_TOOLS + 1)
 NAME_CHARS = 24
 _DATA = re.compile(r"TOOL_DATA\s*\[\s*(\d+)\s*\]\s*=\s*\{([^}]*)\}", re.IGNORECASE)
-_POSE = re.compile(r"(?:DECL\s+)?(?:GLOBAL\s+)?\b(E6POS|POS)\s+(\w+)\s*=\s*\{([^}]*)\}",
+_POSE = re.compile(r"(?:DECL\s+)?(?:GLOBAL\s+)?\b(E6POS|POS|FRAME)\s+(\w+)\s*=\s*\{([^}]*)\}",
                    re.IGNORECASE)
+_AXIS = re.compile(r"(?:DECL\s+)?(?:GLOBAL\s+)?\b(E6AXIS|AXIS)\s+(\w+)\s*=\s*\{([^}]*)\}",
+                   re.IGNORECASE)
+_ARRAY = re.compile(r"\bDECL\s+(?:GLOBAL\s+)?(E6POS|POS|FRAME|E6AXIS|AXIS)\s+(\w+)\s*\[",
+                    re.IGNORECASE)
+_ELEMENT = re.compile(r"^[ \t]*(\w+)\s*\[\s*(\d+)\s*\]\s*=\s*\{([^}]*)\}", re.MULTILINE)
+_EXTERNAL = tuple(f"E{i}" for i in range(1, 7))
 _FDAT = re.compile(r"FDAT\s+(\w+)\s*=\s*\{([^}]*)\}", re.IGNORECASE)
 _COMPONENT = re.compile(
     rf"^\s*([A-Z][\w\[\]]*)\s+({NUM}|'[^']*'|\"[^\"]*\"|#\w+|[A-Za-z_]\w*)\s*$", re.IGNORECASE)
@@ -100,6 +107,19 @@ def render_tool(tool: Tool, number: int, name: str | None = None) -> str:
             f'TOOL_NAME[{number},]="{label}"\n')
 
 
+def _load(text: str, n: int) -> tuple[float | None, tuple[float, float, float] | None]:
+    """Mass (kg) and centre of gravity (mm) of ``LOAD_DATA[n]={M ..,CM {X ..,Y ..,Z ..,..},..}``
+    (``M`` <= 0, e.g. KUKA's -1 "default": unknown)."""
+    m = re.search(rf"LOAD_DATA\s*\[\s*{n}\s*\]\s*=\s*\{{\s*M\s+({NUM})(.*)$", text,
+                  re.IGNORECASE | re.MULTILINE)
+    if not m or float(m.group(1)) <= 0:
+        return None, None
+    cm = re.search(rf"CM\s*\{{\s*X\s+({NUM})\s*,\s*Y\s+({NUM})\s*,\s*Z\s+({NUM})", m.group(2),
+                   re.IGNORECASE)
+    cog = None if not cm else (float(cm.group(1)), float(cm.group(2)), float(cm.group(3)))
+    return float(m.group(1)), cog
+
+
 def parse_tool(text: str) -> list[ToolEntry]:
     """Every ``TOOL_DATA[n]`` of ``text`` with its ``TOOL_NAME[n,]`` (file order)."""
     text = _code(text)
@@ -110,14 +130,33 @@ def parse_tool(text: str) -> list[ToolEntry]:
         vals = _xyzabc(_components(m.group(2), what), what)
         nm = re.search(rf'TOOL_NAME\s*\[\s*{n}\s*,\s*\]\s*=\s*"([^"]*)"', text, re.IGNORECASE)
         rot = Rotation.from_euler("ZYX", vals[3:], degrees=True).as_matrix()
-        out.append(ToolEntry(n, nm.group(1).strip() if nm else "", vals[:3], rot))  # type: ignore[arg-type]
+        mass, cog = _load(text, n)
+        out.append(ToolEntry(n, nm.group(1).strip() if nm else "", vals[:3], rot,  # type: ignore[arg-type]
+                             mass_kg=mass, cog_mm=cog))
     if not out:
         raise ControllerFileError("kuka: no TOOL_DATA[n]={X ..,Y ..,Z ..,A ..,B ..,C ..} found")
     return out
 
 
+def _declared(text: str) -> list[tuple[str, str, str, int]]:
+    """``(type, name, body, offset)`` of every position declaration of a ``.dat`` text: single
+    ``DECL E6POS XP1={...}`` and the elements ``XPA[2]={...}`` of declared arrays, file order."""
+    arrays = {m.group(2).upper(): m.group(1).upper() for m in _ARRAY.finditer(text)}
+    found = [(m.group(1).upper(), m.group(2), m.group(3), m.start()) for m in _POSE.finditer(text)]
+    found += [(m.group(1).upper(), m.group(2), m.group(3), m.start())
+              for m in _AXIS.finditer(text)]
+    for m in _ELEMENT.finditer(text):
+        kind = arrays.get(m.group(1).upper())
+        if kind is not None:
+            found.append((kind, f"{m.group(1)}[{int(m.group(2))}]", m.group(3), m.start()))
+    return sorted(found, key=lambda f: f[3])
+
+
 def parse_poses(text: str) -> list[RecordedPose]:
-    """``E6POS`` / ``POS`` declarations of a KRL ``.dat`` file, in file order."""
+    """``E6POS`` / ``POS`` / ``FRAME`` declarations of a KRL ``.dat`` file and the elements of
+    such arrays (``XPA[2]={...}``), in file order (a ``FRAME`` only where it holds a whole
+    pose, X to C). External axes ``E1``..``E6`` are not part
+    of the pose (:func:`pose_warnings` names the points whose values are not 0)."""
     text = _code(text)
     fdat: dict[str, dict[str, str]] = {}
     for m in _FDAT.finditer(text):
@@ -126,18 +165,79 @@ def parse_poses(text: str) -> list[RecordedPose]:
         except ControllerFileError:
             continue  # an FDAT with a structure we do not read (POINT2[] " ") only informs
     out: list[RecordedPose] = []
-    for m in _POSE.finditer(text):
-        name = m.group(2)
-        what = f"line {line_of(text, m.start())}: {m.group(1).upper()} {name}"
-        vals = _xyzabc(_components(m.group(3), what), what)
+    for kind, name, body, at in _declared(text):
+        if kind in ("E6AXIS", "AXIS"):
+            continue
+        what = f"line {line_of(text, at)}: {kind} {name}"
+        comp = _components(body, what)
+        if kind == "FRAME" and not _whole_frame(comp):
+            continue  # a FRAME that holds no whole pose (an offset of some components)
+        vals = _xyzabc(comp, what)
         rot = Rotation.from_euler("ZYX", vals[3:], degrees=True).as_matrix()
         key = "F" + name[1:].upper() if name.upper().startswith("X") else ""
         fd = fdat.get(key, {})
         tool = int(float(fd["TOOL_NO"])) if "TOOL_NO" in fd else None
         base = int(float(fd["BASE_NO"])) if "BASE_NO" in fd else None
         out.append(RecordedPose(name, vals[:3], rot, vals[3:], tool, base,  # type: ignore[arg-type]
-                                line_of(text, m.start())))
+                                line_of(text, at)))
     return out
+
+
+def parse_joint_points(text: str) -> list[JointPoint]:
+    """``E6AXIS`` / ``AXIS`` declarations (``A1``..``A6`` deg) and elements of such arrays."""
+    text = _code(text)
+    out: list[JointPoint] = []
+    for kind, name, body, at in _declared(text):
+        if kind not in ("E6AXIS", "AXIS"):
+            continue
+        what = f"line {line_of(text, at)}: {kind} {name}"
+        comp = _components(body, what)
+        axes = sorted((int(k[1:]), v) for k, v in comp.items() if re.fullmatch(r"A\d", k))
+        if not axes:
+            raise ControllerFileError(f"kuka: {what} has no axis value A1..A6")
+        out.append(JointPoint(name, tuple(to_float(v, "kuka", f"{what} A{i}") for i, v in axes),
+                              line_of(text, at), kind=kind))
+    return out
+
+
+def pose_warnings(text: str) -> list[str]:
+    """Points with external-axis values (``E1``..``E6`` not 0) and ``FRAME`` data."""
+    code = _code(text)
+    extax, frames, partial = [], [], []
+    for kind, name, body, at in _declared(code):
+        try:
+            comp = _components(body, name)
+        except ControllerFileError:
+            continue
+        moved = [k for k in _EXTERNAL if k in comp and _nonzero(comp[k])]
+        if moved:
+            extax.append(f"{name} ({', '.join(f'{k} {comp[k]}' for k in moved)})")
+        if kind == "FRAME":
+            (frames if _whole_frame(comp) else partial).append(name)
+    out = []
+    if extax:
+        out.append(f"{', '.join(extax)}: external-axis values are not part of the pose; tcpcal "
+                   "ignores them, so the poses are right only if no external axis (a linear "
+                   "track, a turntable) moves the robot or the reference between touches")
+    if frames:
+        out.append(f"{', '.join(frames)} read from FRAME data (X, Y, Z, A, B, C, no status "
+                   "and turn): check that they are recorded flange positions, not a base or "
+                   "tool frame")
+    if partial:
+        out.append(f"{', '.join(partial)}: FRAME data without all of X, Y, Z, A, B, C skipped "
+                   "(not a pose)")
+    return out
+
+
+def _whole_frame(comp: dict[str, str]) -> bool:
+    return all(k in comp for k in "XYZABC")
+
+
+def _nonzero(token: str) -> bool:
+    try:
+        return float(token) != 0.0
+    except ValueError:
+        return False
 
 
 def render_poses(poses: Sequence[RecordedPose], module: str = "touches") -> str:
@@ -250,7 +350,10 @@ FORMAT = ControllerFormat(
     values="TOOL_DATA[n]={X,Y,Z mm, A,B,C deg}, TOOL_NAME[n,]",
     render_file=render_tool, parse_file=parse_tool, parse_poses=parse_poses,
     render_poses=render_poses, pose_extensions=(".dat",),
-    detect=re.compile(r"\b(E6POS|POS)\s+\w+\s*=\s*\{", re.I), detect_text="KUKA E6POS/POS",
+    pose_warnings=pose_warnings, parse_joint_points=parse_joint_points,
+    tool_file_extensions=(".dat",), tool_file_detect=re.compile(r"\bTOOL_DATA\s*\[", re.I),
+    detect=re.compile(r"\b(E6POS|POS|E6AXIS|AXIS|FRAME)\s+\w+\s*=\s*\{", re.I),
+    detect_text="KUKA E6POS/POS",
     csv=CsvLayout("kuka", ("a", "b", "c"), "KUKA A,B,C in deg", _csv_rotations, decimals=6,
                   rank=10),
 )

@@ -22,6 +22,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from tcpcal.controllers._common import (
+    NUM,
     ControllerFileError,
     RecordedPose,
     ToolEntry,
@@ -42,7 +43,10 @@ from tcpcal.tool import Tool
 __all__ = ["FORMAT", "parse_poses", "parse_text", "parse_tool", "render_poses", "render_text",
            "render_tool"]
 
-_POSE = re.compile(r"p\[([^\[\]]*)\]")
+_POSE = re.compile(r"(?<![\w.\]])p\[([^\[\]]*)\]")
+"""A pose literal: ``p[`` at the start of a token (``clamp[i]``, ``Kp[0]``, ``a.p[1]`` are
+indexing, not poses)."""
+_DEF = re.compile(r"^[ \t]*def[ \t]+\w+[ \t]*\(", re.M)
 _ASSIGN = re.compile(r"(?:global\s+)?([A-Za-z_]\w*)\s*=\s*$")
 
 
@@ -88,6 +92,31 @@ def _numbers(body: str, what: str) -> list[float]:
     return [to_float(t, "ur", what) for t in toks]
 
 
+def _default_spans(text: str) -> list[tuple[int, int]]:
+    """The parameter lists of ``def name(...)`` headers (default values are not positions)."""
+    spans = []
+    for m in _DEF.finditer(text):
+        depth, i = 1, m.end()
+        while i < len(text) and depth:
+            depth += {"(": 1, ")": -1}.get(text[i], 0)
+            i += 1
+        spans.append((m.end(), i))
+    return spans
+
+
+def _literal_poses(text: str) -> list[re.Match[str]]:
+    """The pose literals of code ``text`` outside function headers' default arguments."""
+    spans = _default_spans(text)
+    return [m for m in _POSE.finditer(text)
+            if not any(a <= m.start() < b for a, b in spans)]
+
+
+def _is_numeric(body: str) -> bool:
+    """Every element of the pose is a number (a pose of expressions is computed, not recorded;
+    a count other than 6 is then an error of :func:`_numbers`)."""
+    return all(re.fullmatch(rf"\s*{NUM}\s*", t) for t in body.split(","))
+
+
 def _is_tcp(text: str, start: int) -> bool:
     """The pose at ``start`` is a TCP (inside ``set_tcp(``) or a ``tcp_`` variable."""
     before = text[text.rfind("\n", 0, start) + 1:start]
@@ -98,7 +127,7 @@ def parse_tool(text: str) -> list[ToolEntry]:
     """The TCP poses of ``set_tcp(p[...])`` calls and ``tcp_*`` globals (file order)."""
     text = _code(text)
     out: list[ToolEntry] = []
-    for m in _POSE.finditer(text):
+    for m in _literal_poses(text):
         if not _is_tcp(text, m.start()):
             continue
         v = _numbers(m.group(1), f"line {line_of(text, m.start())}: TCP")
@@ -113,11 +142,14 @@ def parse_tool(text: str) -> list[ToolEntry]:
 
 
 def parse_poses(text: str) -> list[RecordedPose]:
-    """Every ``p[x, y, z, rx, ry, rz]`` of a script except TCPs, positions converted m -> mm."""
+    """Every pose literal ``p[x, y, z, rx, ry, rz]`` of six numbers in a script, read by
+    tokens (``p[`` starts a token), except TCPs and functions' default arguments; positions
+    converted m -> mm. A pose of expressions (``p[x, y, 0.3, 0, 0, 0]``) is not a recorded
+    position: skipped, and :func:`_pose_warnings` names it."""
     text = _code(text)
     out: list[RecordedPose] = []
-    for m in _POSE.finditer(text):
-        if _is_tcp(text, m.start()):
+    for m in _literal_poses(text):
+        if _is_tcp(text, m.start()) or not _is_numeric(m.group(1)):
             continue
         line = line_of(text, m.start())
         v = _numbers(m.group(1), f"line {line}: pose")
@@ -180,8 +212,20 @@ def _pose_warnings(text: str) -> list[str]:
     else:
         sets = any(max(map(abs, t.tcp_mm)) > 0 or abs(t.rotation.trace() - 3.0) > 1e-12
                    for t in tcps)
-    return (["the script sets a TCP: poses recorded with a TCP active are TCP poses, not the "
-             "flange; record the touches with the TCP at the flange"] if sets else [])
+    out = (["the script sets a TCP: poses recorded with a TCP active are TCP poses, not the "
+            "flange; record the touches with the TCP at the flange"] if sets else [])
+    code = _code(text)
+    computed = [line_of(code, m.start()) for m in _literal_poses(code)
+                if not _is_tcp(code, m.start()) and not _is_numeric(m.group(1))]
+    if computed:
+        out.append(f"{len(computed)} pose{'s' if len(computed) != 1 else ''} on line"
+                   f"{'s' if len(computed) != 1 else ''} {', '.join(map(str, computed))} "
+                   "computed from variables (not numbers): not recorded positions, skipped")
+    defaults = sum(1 for a, b in _default_spans(code) for m in _POSE.finditer(code, a, b))
+    if defaults:
+        out.append(f"{defaults} pose{'s' if defaults != 1 else ''} in function default "
+                   "arguments (def f(x=p[...])) skipped: a default is not a touch")
+    return out
 
 
 def _values_to_text(values: Sequence[float]) -> str:
@@ -211,7 +255,8 @@ FORMAT = ControllerFormat(
     values="p[x,y,z m, rx,ry,rz rad]",
     render_file=render_tool, parse_file=parse_tool, parse_poses=parse_poses,
     render_poses=render_poses, pose_extensions=(".script", ".urscript", ".urp.script"),
-    detect=re.compile(r"\bp\["), detect_text="UR p[...]", pose_warnings=_pose_warnings,
+    tool_file_extensions=(".script", ".urscript"), tool_file_detect=re.compile(r"\bset_tcp\s*\("),
+    detect=re.compile(r"(?<![\w.\]])p\["), detect_text="UR p[...]", pose_warnings=_pose_warnings,
     csv=CsvLayout("rotvec", ("rx", "ry", "rz"), "rotation vector in rad", _csv_rotations,
                   decimals=9, rank=40),
 )

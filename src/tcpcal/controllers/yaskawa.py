@@ -1,11 +1,23 @@
-"""Yaskawa Motoman (DX/YRC): one entry of the tool file ``TOOL.CND``.
+"""Yaskawa Motoman (DX/YRC): the tool file ``TOOL.CND``.
 
-``//TOOL n``, ``///NAME name``, then the line ``X,Y,Z,Rx,Ry,Rz`` (mm with 3 decimals, deg with
-4), then the load lines as the controller writes them (centre of gravity ``Xg,Yg,Zg`` mm,
-moments of inertia ``Ix,Iy,Iz`` kg m^2, mass ``W`` kg, two flags), all zero here: identify the
-load on the controller. ``R = Rz(Rz) Ry(Ry) Rx(Rx)``, rotations about the fixed flange axes X,
-then Y, then Z (the FANUC W, P, R convention). The file format has no comment syntax, so the
-convention is stated here and in docs/formats.md only. docs/formats.md cites the sources.
+One entry per tool, as DX100 and YRC1000 controllers save it:
+
+    //TOOL n
+    ///CRC 381761669              (YRC1000 only: a checksum line; tcpcal reads past it)
+    ///NAME name
+    X,Y,Z,Rx,Ry,Rz                (TCP mm 3 decimals, orientation deg 4 decimals)
+    Xg,Yg,Zg                      (centre of gravity in FLANGE, mm)
+    W                             (mass, kg)
+    Ix,Iy,Iz                      (moments of inertia about the centre of gravity, kg m^2)
+    0.000,0,1                     (a line of three fields whose meaning tcpcal does not know)
+
+``R = Rz(Rz) Ry(Ry) Rx(Rx)``, rotations about the fixed flange axes X, then Y, then Z (the
+FANUC W, P, R convention). The load is written from the tool's ``mass_kg`` and ``cog_mm``;
+a tool without them gets 0.000 (the value of an unset load in the controller's own files):
+set the load on the controller. Inertia is always written 0.000 (tcpcal does not know it);
+the last line as the public files have it for a tool with no special setting, ``0.000,0,1``.
+The file format has no comment syntax, so the convention is stated here and in
+docs/formats.md only. docs/formats.md cites the public files this layout is taken from.
 Yaskawa has no tool data text (``convert``) and no pose import: :data:`FORMAT` declares the
 file only.
 """
@@ -28,6 +40,8 @@ N_TOOLS = 64
 TOOL_NUMBERS = range(0, N_TOOLS)
 NAME_CHARS = 16
 _ENTRY = re.compile(r"^//TOOL\s+(\d+)\s*$", re.M)
+LAST_LINE = "0.000,0,1"
+"""The last line of an entry as the public files write it for a tool with no setting."""
 
 
 def render_tool(tool: Tool, number: int, name: str | None = None) -> str:
@@ -41,12 +55,24 @@ def render_tool(tool: Tool, number: int, name: str | None = None) -> str:
             f"{label!r} does not fit: pass a shorter name")
     rz, ry, rx = abc_deg_from_rotation(tool.rotation)  # Rz Ry Rx = KUKA's A, B, C order
     vals = [fixed(v, 3) for v in tool.tcp_mm] + [fixed(v, 4) for v in (rx, ry, rz)]
+    cog = (0.0, 0.0, 0.0) if tool.cog_mm is None else tool.cog_mm
+    mass = 0.0 if tool.mass_kg is None else tool.mass_kg
     return (f"//TOOL {number}\n///NAME {label}\n{','.join(vals)}\n"
-            "0.000,0.000,0.000\n0.000,0.000,0.000\n0.000\n0,0\n")
+            f"{','.join(fixed(v, 3) for v in cog)}\n{fixed(mass, 3)}\n"
+            f"0.000,0.000,0.000\n{LAST_LINE}\n")
+
+
+def _numbers(line: str, n: int, what: str, lineno: int) -> list[float]:
+    toks = line.split(",")
+    if len(toks) != n:
+        raise ControllerFileError(f"yaskawa: line {lineno}: {what} needs {n} numbers, got "
+                                  f"{len(toks)} ({line.strip()!r})")
+    return [to_float(t, "yaskawa", what) for t in toks]
 
 
 def parse_tool(text: str) -> list[ToolEntry]:
-    """Every ``//TOOL n`` entry of a ``TOOL.CND`` text (file order)."""
+    """Every ``//TOOL n`` entry of a ``TOOL.CND`` text (file order), with its name (also
+    after a YRC1000 ``///CRC`` line), mass and centre of gravity (a mass of 0: unset)."""
     out: list[ToolEntry] = []
     lines = text.splitlines()
     for i, line in enumerate(lines):
@@ -56,20 +82,31 @@ def parse_tool(text: str) -> list[ToolEntry]:
         n = int(m.group(1))
         j = i + 1
         name = ""
-        if j < len(lines) and lines[j].startswith("///NAME"):
-            name = lines[j][len("///NAME"):].strip()
-            j += 1
         while j < len(lines) and lines[j].startswith("///"):
+            if lines[j].startswith("///NAME"):
+                name = lines[j][len("///NAME"):].strip()
             j += 1
         if j >= len(lines):
             raise ControllerFileError(f"yaskawa: //TOOL {n} has no X,Y,Z,Rx,Ry,Rz line")
-        toks = lines[j].split(",")
-        if len(toks) != 6:
-            raise ControllerFileError(f"yaskawa: line {j + 1}: //TOOL {n} needs 6 numbers "
-                                      f"X,Y,Z,Rx,Ry,Rz, got {len(toks)}")
-        v = [to_float(t, "yaskawa", f"//TOOL {n} value") for t in toks]
+        v = _numbers(lines[j], 6, f"//TOOL {n} X,Y,Z,Rx,Ry,Rz", j + 1)
         rot = Rotation.from_euler("xyz", v[3:], degrees=True).as_matrix()
-        out.append(ToolEntry(n, name, (v[0], v[1], v[2]), rot))
+        mass: float | None = None
+        cog: tuple[float, float, float] | None = None
+        load = [ln for ln in lines[j + 1:j + 3]]
+        if len(load) == 2 and not load[0].startswith("//") and not load[1].startswith("//"):
+            g = _numbers(load[0], 3, f"//TOOL {n} centre of gravity Xg,Yg,Zg", j + 2)
+            if len(load[1].split(",")) != 1:
+                raise ControllerFileError(
+                    f"yaskawa: line {j + 3}: //TOOL {n}: the line after the centre of gravity is "
+                    f"the mass W (1 number), got {load[1].strip()!r}; a TOOL.CND entry is X,Y,Z,"
+                    "Rx,Ry,Rz / Xg,Yg,Zg / W / Ix,Iy,Iz / 3 fields (DX100, YRC1000)")
+            w = _numbers(load[1], 1, f"//TOOL {n} mass W", j + 3)[0]
+            if w < 0:
+                raise ControllerFileError(f"yaskawa: line {j + 3}: //TOOL {n} mass {w} kg is "
+                                          "negative")
+            if w > 0:
+                mass, cog = w, (g[0], g[1], g[2])
+        out.append(ToolEntry(n, name, (v[0], v[1], v[2]), rot, mass_kg=mass, cog_mm=cog))
     if not out:
         raise ControllerFileError("yaskawa: no '//TOOL n' entry found")
     return out
@@ -91,6 +128,7 @@ FORMAT = ControllerFormat(
     tool_numbers=TOOL_NUMBERS,
     name_rule=f"at most {NAME_CHARS} ASCII characters, no comma",
     controller="Yaskawa Motoman TOOL.CND entry", filename="TOOL{n}.CND",
-    values="//TOOL n, ///NAME, X,Y,Z mm, Rx,Ry,Rz deg, load lines",
+    values="//TOOL n, ///NAME, X,Y,Z mm, Rx,Ry,Rz deg, Xg,Yg,Zg mm, W kg, Ix,Iy,Iz, 0.000,0,1",
     render_file=render_tool, parse_file=parse_tool,
+    tool_file_extensions=(".cnd",), tool_file_detect=re.compile(r"^//TOOL\s+\d+", re.M),
 )

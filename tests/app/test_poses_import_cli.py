@@ -1,0 +1,144 @@
+"""``tcp-pendant poses import FILE --robot``: joint-representation points become flange poses by
+forward kinematics, checked against a hand-made URDF whose chain is composed by hand here."""
+
+from __future__ import annotations
+
+import csv
+import io
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from tcp_pendant.cli import main
+from tcpcal.cli import main as tcpcal_main
+
+DATA = Path(__file__).resolve().parents[1] / "data" / "controller_files"
+
+# joint: (parent, child, origin xyz m, axis)
+CHAIN = [("base_link", "l1", (0, 0, 0.4), "z"), ("l1", "l2", (0.1, 0, 0), "y"),
+         ("l2", "l3", (0, 0, 0.5), "y"), ("l3", "l4", (0.4, 0, 0), "x"),
+         ("l4", "l5", (0, 0, 0), "y"), ("l5", "flange", (0.1, 0, 0), "x")]
+
+
+def write_urdf(path: Path) -> Path:
+    links = "".join(f'<link name="{n}"/>' for n in ["base_link"] + [c[1] for c in CHAIN])
+    axis = {"x": "1 0 0", "y": "0 1 0", "z": "0 0 1"}
+    joints = "".join(
+        f'<joint name="J{k}" type="revolute"><parent link="{p}"/><child link="{c}"/>'
+        f'<origin xyz="{" ".join(map(str, o))}" rpy="0 0 0"/><axis xyz="{axis[a]}"/>'
+        f'<limit lower="-3" upper="3" effort="1" velocity="1"/></joint>'
+        for k, (p, c, o, a) in enumerate(CHAIN, 1))
+    path.write_text(f'<robot name="hand">{links}{joints}</robot>')
+    return path
+
+
+def hand_fk(q_deg: list[float]) -> tuple[np.ndarray, np.ndarray]:
+    """T_world_flange composed joint by joint: translate by the origin, rotate about the axis."""
+    R, p = np.eye(3), np.zeros(3)
+    for (_, _, origin, axis), q in zip(CHAIN, q_deg):
+        p = p + R @ np.array(origin, dtype=float)
+        R = R @ Rotation.from_euler(axis, q, degrees=True).as_matrix()
+    return R, p * 1000.0
+
+
+Q2 = [10.0, -20.0, 35.0, 5.0, -60.0, 15.0]
+Q4 = [-30.0, 10.0, -5.0, 40.0, 25.0, -90.0]
+LS = f"""/PROG  MIXED
+/ATTR
+DEFAULT_GROUP	= 1,*,*,*,*;
+/MN
+   1:J P[1] 10% FINE ;
+   2:J P[2] 10% FINE ;
+   3:J P[3] 10% FINE ;
+   4:J P[4] 10% FINE ;
+/POS
+P[1]{{
+   GP1:
+	UF : 0, UT : 0,		CONFIG : 'N U T, 0, 0, 0',
+	X =    815.103  mm,	Y =   -161.836  mm,	Z =    560.115  mm,
+	W =    180.000 deg,	P =       .000 deg,	R =      0.000 deg
+}};
+P[2]{{
+   GP1:
+	UF : 0, UT : 0,
+	J1=  {Q2[0]:.3f} deg,	J2=  {Q2[1]:.3f} deg,	J3=  {Q2[2]:.3f} deg,
+	J4=  {Q2[3]:.3f} deg,	J5=  {Q2[4]:.3f} deg,	J6=  {Q2[5]:.3f} deg
+}};
+P[3]{{
+   GP1:
+	UF : 0, UT : 0,		CONFIG : 'N U T, 0, 0, 0',
+	X =    880.280  mm,	Y =   -133.007  mm,	Z =    575.374  mm,
+	W =    170.000 deg,	P =     20.000 deg,	R =     30.000 deg
+}};
+P[4]{{
+   GP1:
+	UF : 0, UT : 0,
+	J1=  {Q4[0]:.3f} deg,	J2=  {Q4[1]:.3f} deg,	J3=  {Q4[2]:.3f} deg,
+	J4=  {Q4[3]:.3f} deg,	J5=  {Q4[4]:.3f} deg,	J6=  {Q4[5]:.3f} deg
+}};
+/END
+"""
+
+
+def rows(text: str) -> list[dict[str, str]]:
+    return list(csv.DictReader(io.StringIO(text)))
+
+
+def test_joint_points_become_the_flange_poses_of_the_forward_kinematics(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    urdf = write_urdf(tmp_path / "hand.urdf")
+    program = tmp_path / "mixed.ls"
+    program.write_text(LS)
+    assert main(["poses", "import", str(program), "--robot", str(urdf)]) == 0
+    out, err = capsys.readouterr()
+    assert "2 points in joint representation converted to flange poses of hand.urdf" in err
+    got = rows(out)
+    assert [r["name"] for r in got] == ["P[1]", "P[2]", "P[3]", "P[4]"]  # file order
+    assert list(got[0]) == ["name", "x", "y", "z", "w", "p", "r"]
+    for r, q in ((got[1], Q2), (got[3], Q4)):
+        R, p = hand_fk(q)
+        np.testing.assert_allclose([float(r[k]) for k in "xyz"], p, atol=1e-4)
+        R_csv = Rotation.from_euler("xyz", [float(r[k]) for k in "wpr"], degrees=True)
+        assert np.degrees((R_csv.inv() * Rotation.from_matrix(R)).magnitude()) < 1e-5
+    assert float(got[0]["x"]) == 815.103 and float(got[2]["w"]) == 170.0
+
+
+def test_without_joint_points_the_csv_is_tcpcals(tmp_path: Path,
+                                                  capsys: pytest.CaptureFixture[str]) -> None:
+    assert tcpcal_main(["poses", "import", str(DATA / "touches.mod")]) == 0
+    expect = capsys.readouterr().out
+    assert main(["poses", "import", str(DATA / "touches.mod"), "--robot", "kr6"]) == 0
+    assert capsys.readouterr().out == expect
+
+
+def test_abb_jointtarget_on_the_builtin_kr6(kr6, capsys: pytest.CaptureFixture[str]) -> None:
+    """jHome of touches_tool_wobj.mod: the KR 6's flange at those axis values."""
+    assert main(["poses", "import", str(DATA / "touches_tool_wobj.mod"), "--robot", "kr6"]) == 0
+    out, err = capsys.readouterr()
+    got = {r["name"]: r for r in rows(out)}
+    assert list(got)[-1] == "jHome" and len(got) == 7  # file order: declared last
+    T = kr6.T_world_flange(np.radians([0, -30, 15, 0, 75, 90]))
+    np.testing.assert_allclose([float(got["jHome"][k]) for k in "xyz"], T[:3, 3] * 1000, atol=1e-4)
+    q = [float(got["jHome"][k]) for k in ("qw", "qx", "qy", "qz")]
+    R = Rotation.from_quat([q[1], q[2], q[3], q[0]]).as_matrix()
+    assert np.degrees(Rotation.from_matrix(R.T @ T[:3, :3]).magnitude()) < 1e-6
+    assert "reached by moves with tool HeatGun" in err  # tcpcal's warnings still shown
+
+
+def test_a_point_with_another_axis_count_is_one_error_line(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    urdf = write_urdf(tmp_path / "hand.urdf")
+    program = tmp_path / "seven.ls"
+    program.write_text(LS.replace(f"J6=  {Q4[5]:.3f} deg", f"J6=  {Q4[5]:.3f} deg, J7 = 1 deg"))
+    assert main(["poses", "import", str(program), "--robot", str(urdf)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert "P[4] has 7 axis values but the robot has 6 joints (J1, J2, J3, J4, J5, J6)" in err
+
+
+def test_an_unknown_robot_is_one_error_line(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["poses", "import", str(DATA / "touches.mod"), "--robot", "nope"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Unknown robot 'nope'" in err

@@ -1,0 +1,151 @@
+"""The session is its state's one command surface: every command ends in one change signal, and
+the signal carries typed events with the facts of the moment they happened."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from tcp_pendant.calibrate import AutoTouchRequest
+from tcp_pendant.events import Crash, RunCancelled, RunFinished, RunResumed, RunStarted, ToolSaved, TouchRecorded
+from tcp_pendant.server import AppConfig, PendantApp
+from tcp_pendant.session import SessionChange
+
+sys.path.insert(0, str(Path(__file__).parent))
+from calib_helpers import make_session  # noqa: E402
+
+
+def recording(session) -> list[SessionChange]:
+    changes: list[SessionChange] = []
+    session.subscribe(changes.append)
+    return changes
+
+
+def only(changes: list[SessionChange]) -> SessionChange:
+    assert len(changes) == 1, f"one signal per command, got {len(changes)}"
+    out = changes[0]
+    changes.clear()
+    return out
+
+
+def test_each_wizard_command_is_one_signal_with_its_events(tmp_path: Path) -> None:
+    s = make_session(tmp_path / "tools.json", seed=3)
+    changes = recording(s)
+    s.start_wizard("xyz4")
+    change = only(changes)
+    assert change.wizard and [type(e) for e in change.events] == [RunStarted]
+    started = change.events[0]
+    assert (started.run_index, started.kind, started.tool_key) == (0, "xyz4", "pointer")
+    np.testing.assert_array_equal(started.T_flange_tool_true_m, s.controller.mounted_tool.T_flange_tool_true)
+
+    out = s.auto_touch(AutoTouchRequest())                 # step 1 by the controller
+    change = only(changes)
+    (touch,) = change.events
+    assert isinstance(touch, TouchRecorded) and touch.auto and not touch.overwrite and touch.step == 0
+    assert out.ok and change.pose and change.state is not None
+    pose = s.workflow.wizard.recorded_poses[0]
+    np.testing.assert_array_equal(touch.T_world_flange_m, pose.T_world_flange_m)
+    np.testing.assert_allclose(touch.joints_deg, np.degrees(s.controller.q_rad))
+    assert touch.distance_mm == pytest.approx(s.controller.touch_geometry().distance_mm)
+
+    s.back()
+    assert only(changes).events == ()
+    s.record_step()                                        # the same step again, by hand
+    (again,) = only(changes).events
+    assert isinstance(again, TouchRecorded) and not again.auto and again.overwrite and again.step == 0
+
+    while s.workflow.result is None:
+        s.auto_touch(AutoTouchRequest())
+    finished = [e for c in changes for e in c.events if isinstance(e, RunFinished)]
+    assert len(finished) == 1 and finished[0].result is s.workflow.result
+    changes.clear()
+
+    slot, tool = s.save_result("Pointer calibrated")
+    saved = [e for e in only(changes).events if isinstance(e, ToolSaved)]
+    assert saved == [ToolSaved(0, slot, tool.name)]
+    s.cancel_wizard()                                      # Close on a saved result
+    assert only(changes).events == (RunCancelled(0, finished=True),)
+
+
+def test_starting_another_cancels_the_open_run_and_resume_brings_it_back(tmp_path: Path) -> None:
+    s = make_session(tmp_path / "tools.json", seed=1)
+    s.start_wizard("xyz4")
+    changes = recording(s)
+    s.start_wizard("tcp-zx")
+    events = only(changes).events
+    assert [type(e) for e in events] == [RunCancelled, RunStarted]
+    assert events[0] == RunCancelled(0, finished=False) and events[1].run_index == 1
+    s.resume_wizard(0)
+    assert only(changes).events == (RunCancelled(1, finished=False), RunResumed(0))
+
+
+def test_a_crash_is_one_event_of_the_run_open_then(tmp_path: Path) -> None:
+    s = make_session(tmp_path / "tools.json", seed=2)
+    s.start_wizard("xyz4")
+    changes = recording(s)
+    c = s.controller
+    T_true = c.T_world_tool_true()
+    T_true[:3, 3] = c.reference_tip_world_m + 0.004 * T_true[:3, 0]     # 4 mm through the tip
+    c.move_true_tool_to(T_true)
+    s.moved()
+    s.moved()                                                           # still in: no second crash
+    crashes = [e for ch in changes for e in ch.events if isinstance(e, Crash)]
+    assert len(crashes) == 1 and crashes[0].run_index == 0
+    assert crashes[0].penetration_mm == pytest.approx(c.touch_geometry().penetration_mm)
+
+
+def test_motion_commands_signal_once_and_never_leave_the_limits(tmp_path: Path) -> None:
+    s = make_session(tmp_path / "tools.json")
+    changes = recording(s)
+    k = s.controller.kinematics
+    applied = s.set_joint(0, 1e4)                                       # far past the limit: clipped
+    change = only(changes)
+    assert change.pose and change.jog is not None and change.jog.ok
+    assert applied == pytest.approx(np.degrees(k.upper_rad[0]))
+    with pytest.raises(ValueError, match="no joint"):
+        s.set_joint(k.n_joints, 0.0)
+    with pytest.raises(ValueError, match="finite"):
+        s.set_joint(1, float("nan"))
+    assert changes == []
+    s.ready()
+    np.testing.assert_allclose(s.controller.q_rad, s.ready_q_rad if s.ready_q_rad is not None else k.home_rad)
+    only(changes)
+    s.home()
+    np.testing.assert_allclose(s.controller.q_rad, k.home_rad)
+    only(changes)
+
+
+def test_the_server_seed_makes_every_session_replay_the_same_way(tmp_path: Path) -> None:
+    """One seed (``--seed``) gives session k of every server the same random stream, and each
+    session of a server its own."""
+    def streams(seed: int | None) -> list[np.ndarray]:
+        app = PendantApp(AppConfig(port=0, tool_library=tmp_path / f"tools-{seed}.json", seed=seed))
+        try:
+            return [app.session_rng().normal(size=4) for _ in range(3)]
+        finally:
+            app.stop()
+
+    a, b, other = streams(7), streams(7), streams(8)
+    for x, y in zip(a, b):
+        np.testing.assert_array_equal(x, y)
+    assert not np.allclose(a[0], a[1]) and not np.allclose(a[0], other[0])
+    unseeded = streams(None), streams(None)
+    assert not np.allclose(unseeded[0][0], unseeded[1][0])
+    with pytest.raises(ValueError, match="seed"):
+        PendantApp(AppConfig(port=0, tool_library=tmp_path / "t.json", seed=-1))
+
+
+def test_a_seeded_session_auto_touches_reproducibly(tmp_path: Path) -> None:
+    def touches(seed: int) -> list[np.ndarray]:
+        s = make_session(tmp_path / f"tools-{seed}.json", seed=seed)
+        s.start_wizard("xyz4")
+        for _ in range(4):
+            s.auto_touch(AutoTouchRequest(sigma_mm=0.5))
+        return [p.T_world_flange_m for _, p in sorted(s.workflow.wizard.recorded_poses.items())]
+
+    first, again, other = touches(11), touches(11), touches(12)
+    for x, y in zip(first, again):
+        np.testing.assert_array_equal(x, y)
+    assert not np.allclose(first[0], other[0])
