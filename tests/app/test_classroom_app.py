@@ -11,7 +11,7 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).parents[1] / "calibrate"))
 from guiclick import choose, click, upload  # noqa: E402
-from wsclient import DrainingClient, wait_until  # noqa: E402
+from wsclient import DrainingClient, RecordingClient, wait_until  # noqa: E402
 
 from tcp_pendant.classroom.gradebook import Gradebook
 from tcp_pendant.classroom.mystery import true_frame
@@ -335,3 +335,40 @@ def test_the_same_browser_in_a_second_tab_takes_the_name_and_the_first_tab_holds
     finally:
         for c in clients:
             c.close()
+
+
+def test_the_mystery_mesh_sent_to_the_browser_shows_the_tip_and_the_shaft_but_not_tool_y(
+        app_factory, tmp_path: Path) -> None:
+    """What the browser gets of the mystery tool (the MeshMessages under the flange, float32,
+    FLANGE coordinates): the nozzle's apex is the TCP (as a real tool's tip is there to see),
+    and no vertex of the nozzle ring lies on tool Y or Z about tool X (before: one on tool Y)."""
+    app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token="tok-1", exercise="mystery",
+                      exercise_seed=7)
+    c = RecordingClient(app.port)
+    try:
+        (s,) = _sessions(app, 1)
+        assert _join(s, "Anna").name == "Anna"
+        T = np.array(true_frame(s.controller.mounted_tool))
+        x, y, z, tcp = T[:3, 0], T[:3, 1], T[:3, 2], T[:3, 3]
+
+        def sent_tool_meshes() -> list:
+            return [np.asarray(m["props"]["vertices"], dtype=float).reshape(-1, 3)
+                    for m in c.of_type("MeshMessage") if "/flange/tool/" in str(m.get("name"))]
+
+        def nozzle() -> np.ndarray | None:
+            with_apex = [v for v in sent_tool_meshes() if np.min(np.linalg.norm(v - tcp, axis=1)) < 1e-6]
+            return with_apex[-1] if with_apex else None
+
+        wait_until(lambda: nozzle() is not None, what="the mystery tool's nozzle sent")
+        v = nozzle()
+        assert v is not None
+        r = v - tcp
+        radial = r - np.outer(r @ x, x)
+        ring = radial[np.linalg.norm(radial, axis=1) > 1e-4]
+        assert len(ring) == 24
+        angles = np.degrees(np.arctan2(ring @ z, ring @ y))
+        assert np.abs((angles + 45.0) % 90.0 - 45.0).min() > 1e-3          # none on +-Y, +-Z
+        axial = r[np.linalg.norm(radial, axis=1) > 1e-4] @ x
+        assert np.allclose(axial, axial[0], atol=1e-6) and axial[0] < -0.01   # a ring behind the tip, about X
+    finally:
+        c.close()
