@@ -10,8 +10,8 @@ free port and drives it in Debian's chromium with Playwright like a trainer woul
   approach lines, COMPUTED and TRUE triads) and the result panel in view.
 
 Every random source is seeded: Auto-touch draws its directions and operator errors from the
-session's ``CalibrationWorkflow.rng``, which is replaced by ``np.random.default_rng(SEED)``
-before the first click. :func:`seeded_figures` computes the same calibration without a browser
+session's generator, which a server started with ``--seed SEED`` draws for each session
+(``PendantApp.session_rng``). :func:`seeded_figures` computes the same calibration without a browser
 (the same controller, workflow and auto-touch calls); the script checks that the browser shows
 those figures, then writes them into the README caption (:func:`update_caption`).
 ``tests/scripts/test_readme_screenshots.py`` compares the caption with :func:`seeded_figures`.
@@ -65,10 +65,13 @@ class CaptionFigures:
 
 
 def seeded_workflow(app: Any, controller: Any, library: Any) -> Any:
-    """A session's ``CalibrationWorkflow`` as the Calibrate tab builds it, with the seeded rng."""
+    """The ``CalibrationWorkflow`` of the browser that shoots ``xyz4_result.png`` as a server
+    started with ``--seed SEED`` builds it: the second session (``PendantApp.session_rng``: the
+    first browser shoots ``pendant.png``)."""
     from tcp_pendant.calibrate import CalibrationWorkflow
 
-    return CalibrationWorkflow(controller, library, robot=app.config.robot, rng=np.random.default_rng(SEED))
+    app.session_rng()                                   # session 0: the pendant.png browser
+    return CalibrationWorkflow(controller, library, robot=app.robot_key, rng=app.session_rng())
 
 
 def seeded_figures() -> CaptionFigures:
@@ -82,9 +85,9 @@ def seeded_figures() -> CaptionFigures:
     from tcp_pendant.server import AppConfig, PendantApp
 
     with tempfile.TemporaryDirectory() as tmp:
-        app = PendantApp(AppConfig(tool_library=Path(tmp) / "tools.json"))
+        app = PendantApp(AppConfig(tool_library=Path(tmp) / "tools.json", seed=SEED))
         workflow = seeded_workflow(app, app.new_controller(), app.library)
-        workflow.start_xyz4(n_points=N_TOUCHES)
+        workflow.start("xyz4", n_points=N_TOUCHES)
         for _ in range(N_TOUCHES):
             out = workflow.auto_touch(AutoTouchRequest(sigma_mm=SIGMA_MM))
             if not out.ok:
@@ -159,8 +162,7 @@ def shoot_xyz4(page: Any, url: str, app: Any, out: Path) -> CaptionFigures:
     """``xyz4_result.png``: the seeded 6-touch calibration; returns the session's figures."""
     page.goto(url)
     session = _only_session(app)
-    view = session.views["calibrate"]
-    view.workflow.rng = np.random.default_rng(SEED)  # before any auto-touch
+    view = session.views["calibrate"]                # the server runs with --seed SEED
     page.get_by_role("button", name="Close-up on reference tip").click()
     page.get_by_role("tab", name="Calibrate").click()
     fill(page, "Touches", str(N_TOUCHES))
@@ -198,7 +200,7 @@ def main() -> None:
     expected = seeded_figures()
     args.out_dir.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory() as tmp:
-        app = PendantApp(AppConfig(port=0, tool_library=Path(tmp) / "tools.json"))
+        app = PendantApp(AppConfig(port=0, tool_library=Path(tmp) / "tools.json", seed=SEED))
         url = app.start()
         try:
             with urllib.request.urlopen(url, timeout=30):

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Set up everything the test suite needs on a fresh machine, then run it.
-#   bash scripts/run-tests.sh            # whole suite (unit, property, CLI, browser)
+# Set up everything the test suite needs on a fresh machine, type-check the code (mypy), then run
+# the tests.
+#   bash scripts/run-tests.sh            # mypy, then the whole suite (unit, property, CLI, browser)
 #   bash scripts/run-tests.sh -m browser # only the browser end-to-end tests
 # The browser tests drive Debian's chromium (Playwright cannot download its own browser here):
 # when it is missing it is installed with apt-get as root (or through sudo). A user who can do
@@ -10,6 +11,13 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 . scripts/venv.sh
 ensure_venv test
+
+# The type check first (pyproject.toml [tool.mypy]: strict on src/tcpcal, standard on app/):
+# a type error fails the run before any test.
+if ! .venv/bin/python -m mypy; then
+  echo "run-tests.sh: mypy found the type errors listed above; no test ran." >&2
+  exit 1
+fi
 
 install_chromium() {
   local cmd='apt-get update -q && DEBIAN_FRONTEND=noninteractive apt-get install -y -q chromium'

@@ -41,7 +41,7 @@ def usable_address(address: str) -> bool:
 
 def _psutil_addresses() -> list[str] | None:
     try:
-        import psutil  # type: ignore[import-untyped]
+        import psutil
     except ImportError:
         return None
     out = []

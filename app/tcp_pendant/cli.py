@@ -24,6 +24,10 @@ import sys
 import time
 from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:                       # the server is imported in main() only (no pinocchio for --help)
+    from tcp_pendant.server import PendantApp
 
 __all__ = ["SCENARIO_CHOICES", "build_parser", "main", "network_warning", "ready_urls"]
 
@@ -227,7 +231,7 @@ def _main(argv: Sequence[str] | None) -> int:
     return 0
 
 
-def _class_lines(app: object) -> str:
+def _class_lines(app: PendantApp) -> str:
     """The classroom lines of the ready message (empty without a gradebook)."""
     room = getattr(app, "classroom", None)
     if room is None:

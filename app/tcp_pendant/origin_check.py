@@ -1,4 +1,4 @@
-"""Foreign web pages cannot connect: refuse websocket upgrades from another origin (issue 8 item 4).
+"""Foreign web pages cannot connect: refuse websocket upgrades from another origin.
 
 A browser lets any web page open a websocket to any address, loopback included, and says which
 page asked in the ``Origin`` header. viser 1.1 accepts every upgrade, so a page a trainee opens

@@ -23,10 +23,10 @@ import secrets
 import socket
 import threading
 import time
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Generator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 from urllib.parse import quote
 
 import numpy as np
@@ -57,11 +57,15 @@ from tcp_pendant.controller.placement import (
     unreachable_directions,
 )
 from tcp_pendant.controller.scenarios import Scenario
-from tcp_pendant.session import Session
+from tcp_pendant.session import GuiTarget, Session
 from tcp_pendant.views import session_view_steps
+from tcp_pendant.views.gui_util import target_of
 from tcp_pendant.views.presenter import PresenterView
 from tcp_pendant.views.scene import overview_camera, overview_pose
 from tcp_pendant.views.meshes import link_meshes, rigid_meshes
+
+if TYPE_CHECKING:
+    import viser
 
 __all__ = ["AppConfig", "MIN_TIP_HEIGHT_M", "READY_HOVER_M", "PendantApp", "PortInUseError",
            "default_reference_tip_mm", "is_loopback", "ready_configuration", "resolve_robot",
@@ -312,7 +316,7 @@ class PendantApp:
                                         or config.seed < 0):
             raise ControllerError(f"The seed must be a whole number >= 0, got {config.seed!r}.")
         self._sessions_made = 0
-        self.server: Any = None
+        self.server: viser.ViserServer | None = None
         self.sessions: dict[int, Session] = {}
         self.shared_session: Session | None = None
         self._sessions_lock = threading.Lock()
@@ -356,7 +360,8 @@ class PendantApp:
         seed = self.config.seed
         return np.random.default_rng() if seed is None else np.random.default_rng([int(seed), k])
 
-    def make_session(self, client: Any | None, target: Any | None = None, *, shared: bool = False) -> Session:
+    def make_session(self, client: viser.ClientHandle | None, target: GuiTarget | None = None, *,
+                     shared: bool = False) -> Session:
         """Build a session drawing into ``target`` (default: ``client``). A per-browser session
         starts with no active tool (TCP = flange); the shared one (``shared``) with the
         library's active tool (module docstring)."""
@@ -364,8 +369,8 @@ class PendantApp:
         assert session is not None
         return session
 
-    def session_steps(self, client: Any | None, target: Any | None = None, *,
-                      shared: bool = False) -> Iterator[Session | None]:
+    def session_steps(self, client: viser.ClientHandle | None, target: GuiTarget | None = None, *,
+                      shared: bool = False) -> Generator[Session | None, None, None]:
         """:meth:`make_session` step by step: yields None after each step (a view, a few to a few
         tens of ms) and the finished session last (``on_client_connect`` awaits between the
         steps on viser's event loop). Closing the generator early closes the half-built session.
@@ -390,7 +395,7 @@ class PendantApp:
         try:
             for _ in session_view_steps(session, title=f"TCP Pendant · {self.robot_label}"):
                 yield None
-            with session.lock, session.target.atomic():    # "Presenter mode", above the tabs
+            with session.lock, target_of(session).atomic():    # "Presenter mode", above the tabs
                 session.views["presenter"] = PresenterView(session, on=self.config.presenter)
         except GeneratorExit:
             session.close()
@@ -399,14 +404,14 @@ class PendantApp:
             self.classroom.attach(session)
         yield session
 
-    def close_session(self, client: Any) -> None:
+    def close_session(self, client: viser.ClientHandle) -> None:
         """``on_client_disconnect``: close and forget the browser's session."""
         with self._sessions_lock:
             session = self.sessions.pop(client.client_id, None)
         if session is not None:
             session.close()
 
-    async def _on_connect(self, client: Any) -> None:
+    async def _on_connect(self, client: viser.ClientHandle) -> None:
         """``on_client_connect``, on viser's event loop (every push from the loop's thread): the
         browser's session is built a view at a time, other browsers' callbacks run in between;
         a browser that left meanwhile gets nothing registered."""
@@ -456,13 +461,13 @@ class PendantApp:
             out.append(("Reference tip out of reach", self.tip_warning))
         return out
 
-    def show_start_notices(self, client: Any) -> None:
+    def show_start_notices(self, client: viser.ClientHandle) -> None:
         """Show :meth:`start_notices` in ``client``'s browser (they stay until closed)."""
         for title, body in self.start_notices():
             client.add_notification(title, body, color="yellow", with_close_button=True,
                                     auto_close_seconds=None)
 
-    async def _on_disconnect(self, client: Any) -> None:
+    async def _on_disconnect(self, client: viser.ClientHandle) -> None:
         """``on_client_disconnect``, on viser's event loop like every other callback."""
         if not self.config.shared:
             self.close_session(client)
@@ -490,7 +495,7 @@ class PendantApp:
             last = stamp
             self._hand_to_loop(self.library_changed)
 
-    def _hand_to_loop(self, fn: Any) -> None:
+    def _hand_to_loop(self, fn: Callable[[], object]) -> None:
         """Run ``fn()`` on viser's event loop, where every GUI callback runs (from the library
         watcher: its reload pushes messages, which only the loop's thread may do)."""
         server = self.server
@@ -607,4 +612,4 @@ def parse_xyz_mm(text: str | Sequence[float]) -> tuple[float, float, float]:
         raise ControllerError(f"Expected X,Y,Z in mm (three numbers separated by commas), got {text!r}.") from None
     if len(vals) != 3 or not all(np.isfinite(vals)):
         raise ControllerError(f"Expected X,Y,Z in mm (three finite numbers separated by commas), got {text!r}.")
-    return vals  # type: ignore[return-value]
+    return vals

@@ -56,7 +56,7 @@ import threading
 from collections.abc import Callable, Coroutine, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
-from typing import Any, Protocol, TypeVar
+from typing import TYPE_CHECKING, Any, ContextManager, Literal, Protocol, TypeVar
 
 import numpy as np
 
@@ -72,22 +72,30 @@ from tcp_pendant.events import Crash, SessionEvent
 from tcp_pendant.pendant import Jogger, touch_label
 from tcp_pendant.wizards import Wizard, WizardResult, WizardStateError
 
+if TYPE_CHECKING:
+    import viser
+
 __all__ = ["GuiTarget", "Session", "SessionChange", "Touch"]
 
 log = logging.getLogger(__name__)
 F = TypeVar("F", bound=Callable[..., Any])
 
-_COLORS = {"info": "blue", "success": "green", "warning": "yellow", "error": "red"}
+_COLORS: dict[str, Literal["blue", "green", "yellow", "red"]] = {
+    "info": "blue", "success": "green", "warning": "yellow", "error": "red"}
 
 
 class GuiTarget(Protocol):
     """What views draw into: a ``viser.ClientHandle`` (one browser) or a ``viser.ViserServer``
-    (every browser, ``--shared``). Both have ``.scene``, ``.gui`` and ``.atomic()``."""
+    (every browser, ``--shared``). Both have ``.scene``, ``.gui``, ``.atomic()`` and
+    ``.send_file_download()``."""
 
-    scene: Any
-    gui: Any
+    scene: viser.SceneApi
+    gui: viser.GuiApi
 
-    def atomic(self) -> Any: ...
+    def atomic(self) -> ContextManager[None]: ...
+
+    def send_file_download(self, filename: str, content: bytes, chunk_size: int = ...,
+                           save_immediately: bool = False) -> None: ...
 
 
 @dataclass(frozen=True)
@@ -194,8 +202,8 @@ class Session:
     controller: VirtualController
     library: ToolLibrary
     workflow: CalibrationWorkflow
-    client: Any | None = None
-    target: Any | None = None
+    client: viser.ClientHandle | None = None
+    target: GuiTarget | None = None
     touches: list[Touch] = field(default_factory=list)
     lock: threading.RLock = field(default_factory=threading.RLock)
     active_slot: int | None = None
@@ -445,7 +453,7 @@ class Session:
             except Exception:  # the browser may have gone
                 log.debug("notification to a closed client dropped", exc_info=True)
 
-    def clients(self) -> list[Any]:
+    def clients(self) -> list[viser.ClientHandle]:
         """The browser(s) that show this session: its own, or every browser of the shared GUI."""
         if self.client is not None:
             return [self.client]
@@ -735,6 +743,12 @@ class Session:
         """The outcome of a controller job to its wizard (its result, if it finished)."""
         with self._wizard_command(moves=True):
             return self.workflow.give_controller_job(job, outcome)
+
+    def restore_runs(self, runs: Any) -> list[int]:
+        """The calibrations this trainee had in progress before a restart, back on screen
+        (``CalibrationWorkflow.restore``); one ``wizard`` signal."""
+        with self._wizard_command(moves=True):
+            return self.workflow.restore(runs)
 
     def load_record(self, loaded: Any) -> Any:
         """A session record read and replayed off the loop (``session_record.load_and_replay``)

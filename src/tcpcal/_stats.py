@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 from scipy.special import chdtri, fdtri
@@ -58,8 +59,10 @@ def sum_over_touches(a: np.ndarray) -> np.ndarray:
     numbers was measured 4x slower at N = 1000)."""
     n = a.shape[0]
     if n <= 64:
-        return np.add.reduce(a, axis=0)
-    return (np.ones(n) @ a.reshape(n, -1)).reshape(a.shape[1:])
+        total: np.ndarray = np.add.reduce(a, axis=0)
+        return total
+    total = np.ones(n) @ a.reshape(n, -1)
+    return total.reshape(a.shape[1:])
 
 
 @dataclass(frozen=True)
@@ -85,7 +88,8 @@ class Information:
         v = self.eigvecs[:, 0].copy()
         if v[np.argmax(np.abs(v))] < 0:
             v = -v
-        return v + 0.0  # no negative zeros in messages
+        axis: np.ndarray = v + 0.0  # no negative zeros in messages
+        return axis
 
     @property
     def observable(self) -> bool:
@@ -95,7 +99,8 @@ class Information:
     def m_inv(self) -> np.ndarray:
         """``M^-1 = ((A^T A)^-1)_tt`` from the eigen-decomposition (observable sets only)."""
         v = self.eigvecs
-        return (v / self.eigvals) @ v.T
+        m_inv: np.ndarray = (v / self.eigvals) @ v.T
+        return m_inv
 
     @property
     def condition_number(self) -> float:
@@ -136,7 +141,7 @@ def information(rotations: np.ndarray, rotations_soa: np.ndarray | None = None) 
     return information_from_sum(s, n)
 
 
-def ci_radius(cov_eigvals: np.ndarray, dof: float | None, confidence: float = CONFIDENCE) -> float:
+def ci_radius(cov_eigvals: np.ndarray | list[float], dof: float | None, confidence: float = CONFIDENCE) -> float:
     """Radius of the sphere about the estimate that holds the true TCP with probability
     ``confidence``.
 
@@ -379,7 +384,8 @@ def _nearest_pair(q: np.ndarray) -> tuple[int, int]:
     tree = cKDTree(q, leafsize=16, balanced_tree=False, compact_nodes=False)
     rng = np.random.default_rng(0)
     sample = rng.choice(n, size=min(n, 2048), replace=False)
-    d, idx = tree.query(q[sample], k=2)
+    # A 2-D query gives (m, k) arrays (the stubs also allow the scalars of a 1-D query).
+    d, idx = cast("tuple[np.ndarray, np.ndarray]", tree.query(q[sample], k=2))
     own = idx[:, 0] == sample
     nd = np.where(own, d[:, 1], d[:, 0])
     ni = np.where(own, idx[:, 1], idx[:, 0])
@@ -388,7 +394,7 @@ def _nearest_pair(q: np.ndarray) -> tuple[int, int]:
     bound = best_d * (1.0 + 1e-9) + 1e-300
     for start in range(0, n, _CHUNK_ROWS):
         rows = np.arange(start, min(start + _CHUNK_ROWS, n))
-        d, idx = tree.query(q[rows], k=2, distance_upper_bound=bound)
+        d, idx = cast("tuple[np.ndarray, np.ndarray]", tree.query(q[rows], k=2, distance_upper_bound=bound))
         own = idx[:, 0] == rows
         nd = np.where(own, d[:, 1], d[:, 0])
         ni = np.where(own, idx[:, 1], idx[:, 0])
@@ -397,7 +403,7 @@ def _nearest_pair(q: np.ndarray) -> tuple[int, int]:
             best_d, best = float(nd[k]), (int(rows[k]), int(ni[k]))
     edge = np.flatnonzero(q[:, 0] <= bound)
     if edge.size:
-        d, idx = tree.query(-q[edge], k=1, distance_upper_bound=bound)
+        d, idx = cast("tuple[np.ndarray, np.ndarray]", tree.query(-q[edge], k=1, distance_upper_bound=bound))
         k = int(d.argmin())
         if float(d[k]) < best_d:
             best_d, best = float(d[k]), (int(edge[k]), int(idx[k]))
@@ -409,7 +415,8 @@ def _angles_to(q: np.ndarray, c: np.ndarray) -> np.ndarray:
     """Rotation angles (rad) between every row of ``q`` (N, 4) and every row of ``c`` (m, 4)."""
     dots = np.abs(q @ c.T)
     np.minimum(dots, 1.0, out=dots)
-    return 2.0 * np.arccos(dots)
+    angles: np.ndarray = 2.0 * np.arccos(dots)
+    return angles
 
 
 def _angle_extremes_large(rotations: np.ndarray) -> AngleExtremes:

@@ -324,7 +324,7 @@ def _solver_error(exc: TcpcalError, poses: FlangePoses, rows: Sequence[int] | No
     msg = " ".join(str(exc).split())
     index = getattr(exc, "index", None)
     if isinstance(index, (int, np.integer)) and index >= 0:
-        row = int(rows[index]) if rows is not None and index < len(rows) else int(index)
+        row = int(rows[int(index)]) if rows is not None and index < len(rows) else int(index)
         where = poses.where(row) if row < len(poses) else str(poses.path)
     else:
         where = f"{poses.path}, data rows 1-{len(poses)}" if len(poses) > 1 else str(poses.path)
@@ -467,7 +467,7 @@ def _with_source(out: dict[str, Any], poses: FlangePoses) -> str:
     out = dict(out)
     out["input"] = {"path": str(poses.path), "layout": poses.layout, "n_rows": len(poses),
                     "line_numbers": list(poses.line_numbers)}
-    if getattr(poses, "joints_deg", None) is not None:  # j1..jK columns: kept, never solved
+    if poses.joints_deg is not None:  # j1..jK columns: kept, never solved
         out["joints_deg"] = [list(j) for j in poses.joints_deg]
     return json_dumps(out, workers=_json_workers())
 

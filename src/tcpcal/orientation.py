@@ -100,7 +100,8 @@ class OrientationResult:
 
 
 def _unit(v: np.ndarray) -> np.ndarray:
-    return v / np.linalg.norm(v)
+    unit: np.ndarray = v / np.linalg.norm(v)
+    return unit
 
 
 def _angle_deg(a: np.ndarray, b: np.ndarray) -> float:

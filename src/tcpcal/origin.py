@@ -500,6 +500,7 @@ def _solve(rot: np.ndarray, y: np.ndarray | None, f: np.ndarray, method: str, si
 
     fit = _lstsq_core(info, m_inv, rot, f) if method == "lstsq" or test_outliers else None
     if method == "lstsq":
+        assert fit is not None  # made above for "lstsq"
         t, r, e = fit.t, fit.r, fit.e
         cov_unit = None
     else:
@@ -516,7 +517,7 @@ def _solve(rot: np.ndarray, y: np.ndarray | None, f: np.ndarray, method: str, si
         e = rot @ t + (f - r)
 
     res = np.einsum("ni,ni->n", e, e)
-    sse = fit.sse if method == "lstsq" else float(_add(res))
+    sse = fit.sse if method == "lstsq" and fit is not None else float(_add(res))
     _check_finite_result(t, r, sse)
     np.sqrt(res, out=res)
     dof = 3 * n - 6
@@ -525,13 +526,15 @@ def _solve(rot: np.ndarray, y: np.ndarray | None, f: np.ndarray, method: str, si
     if cov_unit is None:
         noise2 = noise * noise
         cov = noise2 * m_inv
-        cov_eig = [noise2 / v for v in info.eigvals.tolist()]  # > 0: the touches are observable
+        # > 0: the touches are observable
+        cov_eig: list[float] | np.ndarray = [noise2 / v for v in info.eigvals.tolist()]
     else:
         cov = noise**2 * cov_unit
         cov_eig = np.linalg.eigvalsh(cov)
     ci95 = ci_radius(cov_eig, None if sigma is not None else dof)
 
-    outliers: list[int] = _find_outliers(rot, y, f, (info, fit)) if test_outliers else []
+    outliers: list[int] = (_find_outliers(rot, y, f, (info, fit))
+                           if test_outliers and y is not None and fit is not None else [])  # both made above
     without: TcpResult | None = None
     if outliers:
         keep = np.setdiff1d(np.arange(n), outliers)

@@ -54,7 +54,7 @@ METHOD_TITLES: dict[str, str] = {
 }
 
 
-def _finite_or_none(x: float) -> float | None:
+def _finite_or_none(x: float | np.floating) -> float | None:
     x = float(x)
     return x if math.isfinite(x) else None
 
@@ -343,7 +343,7 @@ def orientation_result_to_dict(result: OrientationResult, *,
                                tcp_mm: Sequence[float] | None = None) -> dict[str, Any]:
     """The JSON object of a TOOL-orientation result (``solve three-point`` / ``abc-world``).
 
-    It carries the keys every ``solve`` object has (issue 2: ``tcp_mm``, ``residuals_mm``, the
+    It carries the keys every ``solve`` object has (``tcp_mm``, ``residuals_mm``, the
     error figures, ``ci95_mm``, ``outliers``), so that scripts read all four commands alike:
     ``tcp_mm`` is the TCP the method was given (``None`` for abc-world, which needs none);
     these methods have no touch residuals, so ``residuals_mm`` and ``outliers`` are empty and
@@ -629,7 +629,8 @@ def format_tcp_zx_report(result: TcpZxResult, poses: FlangePoses | None = None, 
 
 def _unit3(v: Sequence[float]) -> list[float]:
     a = np.asarray(v, dtype=float)
-    return (a / float(np.linalg.norm(a))).tolist()
+    unit: list[float] = (a / float(np.linalg.norm(a))).tolist()
+    return unit
 
 
 def beam_result_to_dict(result: BeamResult, *, beam_point_mm: Sequence[float],

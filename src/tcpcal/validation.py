@@ -186,7 +186,8 @@ def as_rotation(x: Any, name: str = "rotation") -> np.ndarray:
             f"{name} must be a 3x3 rotation matrix, got shape {arr.shape}."
         )
     try:
-        return as_rotations(arr[None], name=name)[0]
+        rotation: np.ndarray = as_rotations(arr[None], name=name)[0]
+        return rotation
     except InvalidInputError as exc:
         # Drop the "[0]" index of the one-element stack from the message.
         raise InvalidInputError(str(exc).replace(f"{name}[0]", name, 1)) from None

@@ -1,6 +1,6 @@
-"""Issue 14 item 4 in the Tool tab: the TCP service with the beam sensor ("Check with beam",
-"Update", ``views.beam_check``). The industrial loop: a tool bent in a crash (the scenario of
-issue 10) -> Check with beam finds the bend -> Update writes the measured TCP into the library
+"""In the Tool tab: the TCP service with the beam sensor ("Check with beam",
+"Update", ``views.beam_check``). The industrial loop: a tool bent in a crash (the bent-tool
+scenario) -> Check with beam finds the bend -> Update writes the measured TCP into the library
 (method "beam") and makes it the active data -> the spin test says good. In-process server,
 headless websocket client as the browser (``guiclick``)."""
 

@@ -1,4 +1,4 @@
-"""The beam sensor's start options (issue 14 item 1: a configurable repeatability, a finite
+"""The beam sensor's start options (a configurable repeatability, a finite
 beam width, optionally two crossed beams): ``--beam-width``, ``--beam-repeatability``,
 ``--beam-crossed`` reach every session's controller, bad values are refused in words, and a
 check on crossed beams measures the TCP on both."""

@@ -1,4 +1,4 @@
-"""Issue 14 items 1-2 in a session: ``views.beam_replay.ScanPlayer`` plays a scan's film on
+"""In a session: ``views.beam_replay.ScanPlayer`` plays a scan's film on
 viser's event loop (the controller goes through the frames and stays at the scan's end, the red
 beam shows at the events, the markers stay), stops when the user moves the robot, and clears
 only its owner's film. In-process server, headless websocket client as the browser."""

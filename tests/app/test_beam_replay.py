@@ -1,4 +1,4 @@
-"""Issue 14 items 1-2 in the scene: the film of a beam scan (``views.beam_replay.replay_frames``)
+"""In the scene: the film of a beam scan (``views.beam_replay.replay_frames``)
 and the event markers' points. The scan here is built from the sensor's own geometry
 (``controller.beam``: ``tip_on_beam``, ``crossing_events``) on straight flange moves whose
 "joints" are the flange position itself, so a frame's joints say exactly where the flange is."""

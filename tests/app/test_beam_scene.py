@@ -1,4 +1,4 @@
-"""Issue 14 item 1 in a session: the scene draws the controller's beam sensor (its default
+"""In a session: the scene draws the controller's beam sensor (its default
 place beside the reference tip), follows it when the reference tip is knocked or another sensor
 is set, and the overview camera sees it. In-process server, headless websocket client."""
 

@@ -1,4 +1,4 @@
-"""Issue 14 item 1 in the scene: the beam sensor's stand (``views.beam_stand``): the beam drawn on
+"""In the scene: the beam sensor's stand (``views.beam_stand``): the beam drawn on
 the sensor's line between the heads, the fork open and clear around the beam (the tool plunges
 into it), a column down to the floor, crossed beams with a second pair of posts, and the scene
 nodes redrawn only when the sensor's geometry changed."""

@@ -1,4 +1,4 @@
-"""Issue 14 item 3 in the scene and the result panel: the "Automatic (beam)" wizard's result is
+"""In the scene and the result panel: the "Automatic (beam)" wizard's result is
 replayed on the robot (the film of its scan, the robot left at the scan's end, a marker per event
 on the beam), the camera frames the sensor, "Replay scan" plays it again, another calibration
 clears it, and the result text sets automatic against by hand with the errors of both against the

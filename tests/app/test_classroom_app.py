@@ -1,4 +1,4 @@
-"""The classroom wired into the app (issue 11): the "Your name" prompt, the gradebook recorder,
+"""The classroom wired into the app: the "Your name" prompt, the gradebook recorder,
 the trainer view behind its token, the mystery exercise and the settings the trainer pushes."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""``tcp-pendant grades`` and the classroom options of ``tcp-pendant`` (issue 11 item 2)."""
+"""``tcp-pendant grades`` and the classroom options of ``tcp-pendant``."""
 
 from __future__ import annotations
 

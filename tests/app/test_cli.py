@@ -72,7 +72,7 @@ def test_command_serves_prints_the_url_and_stops_on_ctrl_c(tmp_path, host: str, 
     try:
         url = re.search(r"http://\S+", line).group(0)
         urls = [url]
-        if host == "0.0.0.0":                 # issue 13: the URLs trainees can open, not 127.0.0.1
+        if host == "0.0.0.0":                 # the URLs trainees can open, not 127.0.0.1
             from tcp_pendant.addresses import interface_addresses
 
             assert proc.stdout is not None
@@ -97,7 +97,8 @@ def test_command_serves_prints_the_url_and_stops_on_ctrl_c(tmp_path, host: str, 
 
 
 def test_busy_port_is_refused_with_a_hint(tmp_path) -> None:
-    """Issue 13: viser moved on to the next port silently while the class had been told this one."""
+    """A busy port is refused: viser must not move on to the next port silently while the class
+    was told this one."""
     import socket
     import subprocess
     import sys

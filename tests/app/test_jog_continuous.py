@@ -1,4 +1,4 @@
-"""Issue 10 item 5 and item 3 (no viser): continuous jog timing and the stop at contact of the
+"""No viser: continuous jog timing and the stop at contact of the
 Jogger, on a fake clock.
 
 * every executed tick moves ``speed * override * dt`` with ``dt`` capped at one 20 Hz tick

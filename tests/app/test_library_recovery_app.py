@@ -1,4 +1,4 @@
-"""A damaged tool library in the running pendant (issue 8, item 5): every browser still gets its
+"""A damaged tool library in the running pendant: every browser still gets its
 Calibrate tab and the valid tools, and is told, by a notification it really receives, what
 was set aside and where the backup is -- once per recovery, not on every reload."""
 

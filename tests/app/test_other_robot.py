@@ -1,4 +1,4 @@
-"""The pendant on a robot of someone else's URDF: the UR5 of example-robot-data (issue 3: any
+"""The pendant on a robot of someone else's URDF: the UR5 of example-robot-data (any
 URDF given on the command line loads, flange = the last link of the longest chain)."""
 
 from __future__ import annotations

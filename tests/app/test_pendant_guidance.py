@@ -1,5 +1,5 @@
-"""Issue 10 item 3 (no viser): the Δ offset, its words and the magnified close-up of the tips,
-and Record's check of the touch (item 4) on a fake clock."""
+"""No viser: the Δ offset, its words and the magnified close-up of the tips,
+and Record's check of the touch on a fake clock."""
 
 from __future__ import annotations
 

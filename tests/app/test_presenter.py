@@ -1,4 +1,4 @@
-"""Presenter mode (issue 11 item 6): the GUI checkbox and ``--presenter`` change what is
+"""Presenter mode: the GUI checkbox and ``--presenter`` change what is
 rendered: a readout in >= 28 px monospace numbers, the running wizard's step list with the
 current step marked, the per-touch error chart tall, a narrower panel; user text escaped."""
 

@@ -1,4 +1,4 @@
-"""Issue 12 item 3 in the app: systematic-error scenarios as session state (``Session.set_scenario``,
+"""In the app: systematic-error scenarios as session state (``Session.set_scenario``,
 one change signal), played by the controller (physical robot, bent tool, knocked reference tip),
 chosen in the Calibrate tab's "Systematic error" panel (training only; the explanation after a
 result, escaped), and as the start options ``--scenario`` / ``--scenario-seed``. Item 4: touches
@@ -220,7 +220,7 @@ def test_cli_scenario_names_and_a_bad_one(tmp_path: Path) -> None:
         PendantApp(AppConfig(port=0, tool_library=tmp_path / "t.json", scenario="bent_tool", scenario_seed=-1))
 
 
-# ----------------------------------------------------------------------------- joints (item 4)
+# ----------------------------------------------------------------------------- joints
 def test_touches_carry_their_joint_values_into_the_session_record(page) -> None:
     p = page()
     s, c = p.session, p.session.controller
@@ -237,7 +237,7 @@ def test_touches_carry_their_joint_values_into_the_session_record(page) -> None:
     assert record["touches"][0]["joints_deg"] == pytest.approx(list(joints[1]))
     check_session_record(record)
     old = dict(record, touches=[{k: v for k, v in t.items() if k != "joints_deg"} for t in record["touches"]])
-    check_session_record(old)                                        # records before issue 12
+    check_session_record(old)                                        # older records: no joints
     bad = dict(record, touches=[dict(record["touches"][0], joints_deg=["x"])])
     with pytest.raises(SessionRecordError, match="joints_deg"):
         check_session_record(bad)
@@ -261,7 +261,7 @@ def test_wizard_touches_carry_their_joint_values_into_the_session_record(page) -
     check_session_record(record)
     assert load_and_replay(record).checks[0].message                    # still replays
     del entry["joints_deg"]
-    check_session_record(record)                                         # records before issue 12
+    check_session_record(record)                                         # older records: no joints
     entry["joints_deg"] = {"0": [float("inf")]}
     with pytest.raises(SessionRecordError, match="joints_deg"):
         check_session_record(record)

@@ -1,4 +1,4 @@
-"""Issue 15: every GUI callback runs on viser's event loop, in the order the browser's messages
+"""Every GUI callback runs on viser's event loop, in the order the browser's messages
 arrived, and no render writes a widget value older than the newest one the browser sent.
 
 Real viser server in-process, headless websocket clients (tests/app/wsclient.py) that send what

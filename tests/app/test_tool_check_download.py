@@ -1,4 +1,4 @@
-"""Issue 12 in the Tool tab and the touch list: "Check" (the TCP check of a saved or the active
+"""The Tool tab and the touch list: "Check" (the TCP check of a saved or the active
 tool: deviation per rotation, implied TCP error; the robot does not move), controller files
 downloaded to the clicking browser (each parsed back by tcpcal's own parser; a refusal is one
 notification), and "Export CSV" of the touches with joint values, solved by ``tcpcal solve xyz4``.

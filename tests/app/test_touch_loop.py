@@ -1,4 +1,4 @@
-"""Issue 10: the trainee's touch loop on one screen (in-process server, headless websocket
+"""The trainee's touch loop on one screen (in-process server, headless websocket
 clients as browsers; clicks arrive as a browser's do, ``guiclick``).
 
 * the wizard dock on the Jog tab shows the running wizard's step and records it (one Record
@@ -226,7 +226,7 @@ def test_continuous_jog_moves_at_the_override_speed_and_stops_at_release(app_fac
 
 def test_the_scripted_trainee_touches_in_at_most_30_clicks() -> None:
     """tests/bench/bench_trainee.py's trainee (only what the page shows) finishes the 4-point
-    calibration within 0.5 mm per touch, in at most 30 clicks per touch (issue 10's goal)."""
+    calibration within 0.5 mm per touch, in at most 30 clicks per touch (the goal)."""
     sys.path.insert(0, str(HERE.parent / "bench"))
     from bench_trainee import run
 

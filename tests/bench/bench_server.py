@@ -25,7 +25,7 @@ the same code in both:
 * C  paced end to end: every client holds "X +" / "X −" (viser's button-hold messages, 30 per
      second per client, alternating every 5); the server receives them, runs the hold
      callbacks (the app's on viser's event loop, through ``Session.on_loop`` like every GUI
-     callback since issue 15; the baseline's in viser's thread pool), jogs (continuous mode,
+     callback; the baseline's in viser's thread pool), jogs (continuous mode,
      override set for ~1 mm per tick) and sends the updates. Steps are counted by a motion
      listener. This is the path a browser's jog takes.
 
@@ -33,13 +33,13 @@ A and B call the step from this benchmark's thread (not the event loop, where th
 to time the step alone; C is the real path.
 
 Sessions per core at 30 steps/s = 1 / (30 * process CPU per step) (paced runs: includes the
-CPU the process spends between steps). Target (issue 4): >= 30, i.e. <= 1.11 ms per step.
+CPU the process spends between steps). Target: >= 30, i.e. <= 1.11 ms per step.
 On this machine a step costs more CPU when the process idles between steps (caches and vCPU
 go cold), so B and C, paced like real use, are the honest figures; A is the cost of a step
 in a hot loop. Browsers send hold messages through one 50 ms slot (viser's client throttle),
 so a real browser jogs at most 20 steps/s (HOLD_HZ): 30/s is the issue's, harder, load.
 
-Classroom (issue 11: "gradebook writes do not raise the jog step cost"). A second server in the
+Classroom ("gradebook writes do not raise the jog step cost"). A second server in the
 same process runs in ``--class`` mode (a gradebook in a temporary folder), its N clients' sessions
 each named through the "Your name" prompt's own callback, so ``ClassRoom.named`` subscribes a
 ``TraineeRecorder`` to each session's change signal exactly as for a browser. A, B and C are

@@ -2,7 +2,7 @@
 
     python tests/bench/bench_solver.py [--quick] [--sets N] [--draws D]
 
-Prints, and says for each target of issue 2 whether it is met:
+Prints, and says for each target whether it is met:
 
 1. Efficiency: the RMS TCP error of each estimator in units of the Cramer-Rao bound
    (methods.md section 7; the bound ``CRB_t`` from the explicit 3N x 6 matrix A of each set,
@@ -26,19 +26,19 @@ Prints, and says for each target of issue 2 whether it is met:
    else). Targets: N = 4 < 100 us, N = 1000 < 1000 us.
 3. Median time of ``assess_touches`` and ``candidate_gain`` (the wizard calls them live) for
    N = 4 and N = 20. Target: well under 1 ms.
-4. Recorded tracker data (issue 8, item 6): ``solve_xyz4`` on 1e4, 1e5 and 1e6 touches and on
+4. Recorded tracker data: ``solve_xyz4`` on 1e4, 1e5 and 1e6 touches and on
    1e5 touches of which half repeat one orientation, each in its own subprocess (wall time of
    the solve, peak RSS of the subprocess from its ``getrusage``), against
    a baseline measured in the same run: the time to generate the touches in that process.
    Targets: 1e6 touches < 10 s and < 2 GB peak RSS; the repeated orientation handled. Before
    (O(N^2) angle figures and duplicate check, figures of the issue): 1e4 ~0.1 s, 1.6e5 75 s,
    1e5 with a repeated orientation MemoryError (a 74.5 GiB allocation).
-5. Beam sensor (issue 14, methods.md section 9): ``tcpcal.solve_beam``'s RMS TCP error over
+5. Beam sensor (methods.md section 9): ``tcpcal.solve_beam``'s RMS TCP error over
    the Cramer-Rao bound of the line-constraint model, ``sigma^2 (sum R_i^T P R_i)^-1`` computed
    event by event, and the share of draws whose true TCP lies in the 95 % radius, for 2-16
    tip events (sigma = 0.02 mm) with the tool turned about its own axis, with and without a
    10-30 deg tilt. Target: 1 within 2 standard errors (or 2 %).
-6. CLI end to end (issue 8, item 6): ``tcpcal solve xyz4 FILE.csv`` and ``--json`` on a
+6. CLI end to end: ``tcpcal solve xyz4 FILE.csv`` and ``--json`` on a
    generated 1e6-row kuka CSV (written to a temporary directory), each in its own subprocess:
    wall seconds (reading the file, solving, formatting, writing stdout to a file) and peak RSS
    (``os.wait4``), against a baseline measured in the same run: starting the interpreter and
@@ -210,7 +210,7 @@ def large_table(ns: tuple[int, ...], repeated_n: int) -> list[tuple[str, int, di
     return out
 
 
-BEAM_SIGMA = 0.02  # mm: the sensor repeatability of issue 14
+BEAM_SIGMA = 0.02  # mm: the sensor's default repeatability
 BEAM_NS = (2, 4, 8, 16)
 BEAM_PATTERNS = ("spin only", "spin + tilt 10-30")
 
@@ -437,7 +437,7 @@ def main(argv: list[str] | None = None) -> int:
     print(f"4. recorded tracker data: solve_xyz4 on many touches, each case in its own process "
           f"(targets: 1e6 < {LARGE_TARGET_S:.0f} s and < {LARGE_TARGET_RSS_MB:.0f} MB peak RSS)")
     hdr = (f"{'case':>22} {'solve s':>8} {'make touches s':>15} {'peak RSS MB':>12} "
-           f"{'before (issue 8)':>20}  outcome / target")
+           f"{'before':>20}  outcome / target")
     print(hdr)
     print("-" * len(hdr))
     for label, n, row, rss in large_table(ns, rep_n):

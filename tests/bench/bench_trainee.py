@@ -1,4 +1,4 @@
-"""The scripted trainee of issue 10: clicks and wall time per touch of one XYZ 4-point calibration.
+"""The scripted trainee: clicks and wall time per touch of one XYZ 4-point calibration.
 
 A trainee who follows only what the Jog tab shows: the wizard dock's step, the Δ readout
 ("ΔX n ΔY n ΔZ n mm" to the tip, WORLD jog frame), the increment buttons and the compact jog
@@ -46,7 +46,7 @@ from tcp_pendant.views.pendant_panel import MARK  # noqa: E402
 from tcp_pendant.views.wizard_dock import FINISH, NEXT  # noqa: E402
 
 BEFORE_CLICKS_PER_TOUCH = 116.0
-"""Issue 10's measurement before this work (464 clicks for one 4-point calibration)."""
+"""The pendant's figure before the one-screen touch loop (464 clicks for one 4-point calibration)."""
 GOAL_CLICKS_PER_TOUCH = 30.0
 ORIENTATIONS_DEG: tuple[tuple[int, int], ...] = ((0, 0), (30, 0), (0, 30), (-30, 0))
 """(B, C) of each touch relative to the ready pose, degrees."""
@@ -160,7 +160,7 @@ def run() -> dict[str, list[float]]:
 
 def main() -> None:
     out = run()
-    print("Scripted trainee, XYZ 4-point, 4 standard orientations, KR 6 + pointer (issue 10)")
+    print("Scripted trainee, XYZ 4-point, 4 standard orientations, KR 6 + pointer")
     print(f"{'touch':>5} {'(B, C) deg':>11} {'clicks':>7} {'wall s':>7} {'distance mm':>12}")
     for k, ((b, c), n, s, d) in enumerate(zip(ORIENTATIONS_DEG, out["clicks"], out["seconds"],
                                               out["distance_mm"])):

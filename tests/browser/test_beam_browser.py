@@ -1,4 +1,4 @@
-"""Issue 14 in a real browser (Debian's chromium, Playwright), on the default KR 6 with the pointer:
+"""The beam sensor in a real browser (Debian's chromium, Playwright), on the default KR 6 with the pointer:
 
 * the "Automatic (beam)" wizard from the Calibrate menu after a manual XYZ 4-point of the same
   tool: the scan runs, the events list shows, the result sets the beam's real-robot time next to

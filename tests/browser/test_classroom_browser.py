@@ -1,4 +1,4 @@
-"""A class in real browsers (issue 11): two named trainees with mystery tools and the trainer
+"""A class in real browsers: two named trainees with mystery tools and the trainer
 view (Playwright, three contexts: each its own viser client); the browser key the page script
 keeps in localStorage, across a reload and a server restart."""
 

@@ -1,4 +1,4 @@
-"""Presenter mode in a real browser at a projector's 1024x768 (issue 11 item 6): the readout's
+"""Presenter mode in a real browser at a projector's 1024x768: the readout's
 numbers are >= 28 px by computed style, the panel leaves the scene about 70 % of the width, the
 step list marks the running wizard's step; switched off in the GUI, the panel is wide again."""
 

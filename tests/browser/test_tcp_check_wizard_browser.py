@@ -1,4 +1,4 @@
-"""Issue 12 item 2 in a real browser: the TCP check (spin test) wizard of the Calibrate tab on
+"""In a real browser: the TCP check (spin test) wizard of the Calibrate tab on
 a saved tool 1 mm off (auto-touch, Finish, six rows and the implied error; no Save), and the
 "Check this TCP" offer on a saved calibration's result."""
 

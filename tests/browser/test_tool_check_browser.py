@@ -1,4 +1,4 @@
-"""Issue 12 in a real browser: the Tool tab's "Check" of a saved tool (its deviation table and
+"""In a real browser: the Tool tab's "Check" of a saved tool (its deviation table and
 the implied TCP error), one controller file downloaded by the browser and parsed back by
 tcpcal, and the trainer's "Systematic error" panel in the Calibrate tab."""
 

@@ -1,4 +1,4 @@
-"""The TCP service with the beam sensor (tcp_pendant.calibrate.beam_service, issue 14 item 4):
+"""The TCP service with the beam sensor (tcp_pendant.calibrate.beam_service):
 "Check with beam" against the hidden truth, the bent-tool loop (crash, check, deviation,
 Update, spin test says good) and Update's refusals. No browser."""
 

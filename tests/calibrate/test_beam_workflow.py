@@ -1,5 +1,5 @@
 """The Automatic (beam) wizard through the Calibrate workflow on the real virtual controller of
-both robots (issue 14 item 3): Finish runs the controller's scan (``controller_job`` ->
+both robots: Finish runs the controller's scan (``controller_job`` ->
 ``run`` -> ``give_controller_job``), the result is graded against the mounted tool's truth (also
 a bent one), compared with the trainee's manual calibration of the same tool, saved to the
 library, exported and replayed; Record and Auto-touch are refused in words. One in-process

@@ -1,4 +1,4 @@
-"""Issue 13 ("Using it"): with Auto-touch σ > 0, the ABC world result is no longer exact: the
+"""With Auto-touch σ > 0, the ABC world result is no longer exact: the
 operator error is applied to the alignment step as an angle, atan(σ / 100 mm) per tool axis."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Issue 13 ("Using it"): the status icons must render in Debian's chromium without an emoji
+"""The status icons must render in Debian's chromium without an emoji
 font. The app's strings may use only symbols that the DejaVu fonts (Debian's default) draw:
 no code point of the emoji ranges except an explicit list that DejaVu Sans covers."""
 
@@ -26,7 +26,7 @@ def _offending(text: str) -> list[str]:
     return sorted({ch for ch in text if _is_emoji(ch) and ch not in DEJAVU_SYMBOLS})
 
 
-def test_the_check_catches_the_icons_of_the_issue() -> None:
+def test_the_check_catches_the_icons_that_showed_as_empty_boxes() -> None:
     # the two icons seen as empty boxes, and a variation selector that asks for emoji style
     assert _offending("✅ **TOUCHING** and 🛑 **CRASH** ⚠\ufe0f") == sorted("✅🛑\ufe0f")
     assert _offending("✔ **TOUCHING** and ✖ **CRASH** ⚠ ✘ ● ▶ ℹ") == []

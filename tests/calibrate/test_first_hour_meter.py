@@ -1,4 +1,4 @@
-"""Issue 13 ("Using it"): before the fourth touch the pose-diversity meter says how far the
+"""Before the fourth touch the pose-diversity meter says how far the
 orientation is from the recorded ones and what the next touch must add, in words (not
 "not about flange [0.00, 1.00, 0.00]")."""
 

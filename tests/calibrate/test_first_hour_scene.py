@@ -1,4 +1,4 @@
-"""Issue 13 ("Using it"): after Finish the camera is framed on the result (the fitted sphere,
+"""After Finish the camera is framed on the result (the fitted sphere,
 the flange positions, the frames) and the labels at the tip (COMPUTED, TRUE, TOOL, FLANGE,
 "reference tip") are placed apart so they can be read."""
 

@@ -1,4 +1,4 @@
-"""Issue 13 ("Using it"): the words a trainee sees in the first hour, and the library tool the
+"""The words a trainee sees in the first hour, and the library tool the
 orientation wizards offer first."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Issue 9: one owner of each piece of session state and one change signal.
+"""One owner of each piece of session state and one change signal.
 
 In-process server and headless websocket clients (the browsers); clicks arrive as a browser's
 would (``guiclick``). What is checked:

@@ -1,5 +1,5 @@
 """The TCP check (spin test) wizard through the Calibrate workflow on the real virtual controller
-of both robots (issue 12 item 2): auto-touch puts the tip on the reference tip, Finish runs the
+of both robots: auto-touch puts the tip on the reference tip, Finish runs the
 six rotations about the active TCP from the recorded pose; exact tool data -> the tip stays put,
 data 1 mm off -> an implied error of 1 mm and the correction back onto the true TCP. A check is
 not graded against truth, not saveable, and the session record replays it."""

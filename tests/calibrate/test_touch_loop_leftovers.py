@@ -1,7 +1,7 @@
-"""Issue 10's leftovers on the Calibrate tab, in a real viser server (in-process) with a
-headless websocket client as the browser (``guiclick``): the Auto-touch line never goes stale
-(item 6), wizard touches keep their distance-at-record for the session record and the result
-(item 4), and an XYZ 4-point wizard can start from the free "Record point" touches (item 1)."""
+"""The touch loop on the Calibrate tab, in a real viser server (in-process) with a
+headless websocket client as the browser (``guiclick``): the Auto-touch line never goes stale,
+wizard touches keep their distance-at-record for the session record and the result, and an XYZ
+4-point wizard can start from the free "Record point" touches."""
 
 from __future__ import annotations
 
@@ -24,7 +24,7 @@ sys.path.insert(0, str(HERE))
 from guiclick import choose, click
 
 
-# ---------------------------------------------------------------- item 6: stale texts
+# ---------------------------------------------------------------- stale texts
 def test_auto_touch_line_goes_when_a_step_is_recorded_by_hand(page) -> None:
     p = page()
     v = p.view
@@ -79,7 +79,7 @@ def free_touches(wf, n: int, sigma_mm: float = 0.3) -> list[Touch]:
     return out
 
 
-# ---------------------------------------------------------------- item 1: a wizard from the free touches
+# ---------------------------------------------------------------- a wizard from the free touches
 def test_five_free_touches_start_an_xyz4_wizard_that_equals_solve_xyz4(workflow) -> None:
     wf = workflow()
     touches = free_touches(wf, 5)
@@ -120,7 +120,7 @@ def test_too_many_or_bad_free_touches_open_nothing(workflow) -> None:
     assert len(wf.runs) == 1 and wf.wizard is open_before and open_before.status == "in_progress"
 
 
-# ---------------------------------------------------------------- item 4: distance at record
+# ---------------------------------------------------------------- distance at record
 def test_wizard_touches_keep_their_distance_at_record_in_the_session_record(workflow) -> None:
     wf = workflow()
     wf.start("xyz4")
@@ -147,7 +147,7 @@ def test_records_without_distances_still_load_and_bad_distances_are_refused(work
     wf.auto_touch(AutoTouchRequest())
     record = json.loads(dumps(wf.export_record()))
     old = json.loads(json.dumps(record))
-    del old["wizards"][0]["distance_mm"]                        # a record from before issue 10
+    del old["wizards"][0]["distance_mm"]                        # an older record: no distances
     assert len(load_and_replay(json.dumps(old).encode()).checks) == 1
     for bad in ({"0": -1.0}, {"zero": 0.5}, {"0": "0.5"}, [0.5], {"0": True}):
         broken = json.loads(json.dumps(record))

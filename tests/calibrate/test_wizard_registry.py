@@ -1,4 +1,4 @@
-"""Wizards that describe themselves (issue 9 item 3): a toy calibration method, declared and
+"""Wizards that describe themselves: a toy calibration method, declared and
 registered here in the test and nowhere else, is offered by the Calibrate menu with its own
 option, starts, is performed by auto-touch, recorded and replayed from a session record: no
 other change to the app. Plus the registry's own checks of what a wizard declares."""

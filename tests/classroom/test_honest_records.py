@@ -1,4 +1,4 @@
-"""Honest records (issue 11 item 5): a classroom trainee's export holds no truth and no server
+"""Honest records: a classroom trainee's export holds no truth and no server
 path; the trainer grades it against the gradebook by the record id each wizard carries."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""A kill -9 of the writer loses nothing that was acknowledged (issue 11 item 2)."""
+"""A kill -9 of the writer loses nothing that was acknowledged."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""A kill -9 of the *server* mid-exercise loses no touch acknowledged on screen (issue 11 item 2).
+"""A kill -9 of the *server* mid-exercise loses no touch acknowledged on screen.
 
 A real ``tcp-pendant`` process with a gradebook; a headless websocket client behaves as a
 browser: it types a name in "Your name", joins, starts an XYZ 4-point calibration and presses

@@ -1,4 +1,4 @@
-"""Issue 11 leftovers: the trainer pushes "Hide distance" to every trainee, and a trainee in an
+"""The trainer pushes "Hide distance" to every trainee, and a trainee in an
 exercise sees no truth (no error against the true TOOL frame, no grade, no TRUE triad) while
 the trainer's gradebook keeps it."""
 

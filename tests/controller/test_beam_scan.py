@@ -1,4 +1,4 @@
-"""The automatic beam scan (tcp_pendant.controller.beam_scan, issue 14) and the controller's beam
+"""The automatic beam scan (tcp_pendant.controller.beam_scan) and the controller's beam
 sensor: the scan's events against the hidden truth through tcpcal's beam solves (methods.md
 section 9), its durations, skips and purity. Metres inside, mm for tcpcal."""
 

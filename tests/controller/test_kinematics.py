@@ -21,7 +21,7 @@ def flange_mm(robot: str, q_deg) -> np.ndarray:
     return kinematics(robot).T_world_flange(np.radians(q_deg))[:3, 3] * 1000.0
 
 
-# KR 6 R900 sixx figures (issue 3): A2 400 mm up and 25 mm forward of A1, upper arm 455,
+# KR 6 R900 sixx figures: A2 400 mm up and 25 mm forward of A1, upper arm 455,
 # forearm offset 35, A4..wrist centre 420, wrist centre..flange 80.
 @pytest.mark.parametrize("q_deg, expected_mm", [
     # all zero: everything forward and horizontal: x = 25 + 455 + 420 + 80, z = 400 + 35

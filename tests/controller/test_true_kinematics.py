@@ -1,4 +1,4 @@
-"""The controller with a physical robot next to its model (issue 12 item 3): the true tip, the
+"""The controller with a physical robot next to its model: the true tip, the
 touch geometry, auto-approach and ``move_true_tool_to`` use ``true_kinematics``; readouts,
 recorded flange poses, ``T_world_tcp`` and jogs use the nominal ``kinematics``; the pose state
 agrees with the controller; the bent tool and the moved reference tip play on a controller."""

@@ -1,5 +1,5 @@
 """Any URDF drives the controller: the UR5 of example-robot-data jogs and auto-approaches like
-the built-in robots (issue 3: "any other URDF given on the command line must also load")."""
+the built-in robots ("any other URDF given on the command line must also load")."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""robots/README.md: our ``flange`` against ROS-Industrial's ``tool0`` (issue 13).
+"""robots/README.md: our ``flange`` against ROS-Industrial's ``tool0``.
 
 ``tool0`` is built here from the joint origins, axes and the ``tool0`` joint of ROS-Industrial's
 macros, copied as numbers (no ROS package is needed): [R] ``kuka_experimental``

@@ -1,7 +1,7 @@
 """The robot URDFs against an independent forward kinematics written here by hand.
 
 Each robot's flange pose is the product of elementary translations and rotations built from
-the published figures (issue 3, robots/README.md: mm, degrees) and the makers' rotation
+the published figures (robots/README.md: mm, degrees) and the makers' rotation
 directions, written out below in words. Nothing is read from robots/generate.py or the URDF
 files; pinocchio and yourdfpy load the URDFs and must agree with the hand product to 1e-12 m
 over random configurations, so a wrong length, axis, sign or zero in the URDF fails here.

@@ -1,6 +1,6 @@
 """The authored robot URDFs: loading, joint names and limits, and forward kinematics.
 
-Expected numbers are written from the specification (issue 3 / robots/README.md), in mm and
+Expected numbers are written from the specification (robots/README.md), in mm and
 degrees, never read from robots/generate.py.
 """
 

@@ -1,5 +1,5 @@
 """The README caption under the 4-point screenshot quotes the seeded run of
-``scripts/readme_screenshots.py`` (issue 13: regenerating gave 0.72 mm while the caption said
+``scripts/readme_screenshots.py`` (regenerating gave 0.72 mm while the caption said
 0.51 mm). The calibration is computed here without a browser, by the function the script
 itself uses for the caption and checks the browser's page against."""
 

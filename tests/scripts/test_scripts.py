@@ -2,7 +2,8 @@
 (bash) in a copy of the repository's scripts with a fake ``.venv`` and a fake ``PATH``.
 
 The fake ``.venv/bin/python`` logs every call to ``calls.log`` and answers ``-m pip`` with
-``$FAKE_PIP_RC`` (default 1: no package index) and ``-m pytest`` with ``$FAKE_PYTEST_RC``;
+``$FAKE_PIP_RC`` (default 1: no package index), ``-m pytest`` with ``$FAKE_PYTEST_RC`` and
+``-m mypy`` with ``$FAKE_MYPY_OUT`` on stdout and ``$FAKE_MYPY_RC`` (default 0: no type error);
 ``.venv/bin/tcp-pendant`` logs its arguments. ``PATH`` holds only the tools the scripts need
 (bash, coreutils), a fake ``id`` printing ``$FAKE_UID``, and whatever a test adds (``sudo``,
 ``apt-get``, ``chromium``): without them the machine has no root, no sudo and no chromium.
@@ -14,6 +15,7 @@ import hashlib
 import os
 import shutil
 import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -42,6 +44,7 @@ def repo(tmp_path: Path) -> Path:
 printf 'python' >> {log}; for a in "$@"; do printf ' [%s]' "$a" >> {log}; done; echo >> {log}
 if [ "$2" = pip ]; then exit "${{FAKE_PIP_RC:-1}}"; fi
 if [ "$2" = pytest ]; then echo "CHROMIUM=${{CHROMIUM:-}}" >> {log}; exit "${{FAKE_PYTEST_RC:-0}}"; fi
+if [ "$2" = mypy ]; then echo "${{FAKE_MYPY_OUT:-Success: no issues found}}"; exit "${{FAKE_MYPY_RC:-0}}"; fi
 exit 0
 """)
     _write_exe(venv_bin / "tcp-pendant", f"#!/bin/sh\necho tcp-pendant \"$@\" >> {log}\n")
@@ -77,7 +80,7 @@ def pip_calls(repo: Path) -> list[str]:
 
 # ---------------------------------------------------------------- run-app.sh
 def test_run_app_starts_offline_when_the_stamp_matches(repo: Path) -> None:
-    """Issue 13: ``run-app.sh --help`` failed offline because pip ran at every start."""
+    """``run-app.sh --help`` starts offline: pip runs only when pyproject.toml changed."""
     (repo / ".venv" / f".installed-app-{sha(repo)}").touch()
     p = run(repo, "run-app.sh", "--help")            # pip would fail (FAKE_PIP_RC=1)
     assert p.returncode == 0, p.stderr
@@ -135,7 +138,8 @@ def stamped(repo: Path) -> Path:
 
 
 def test_run_tests_without_root_sudo_or_chromium_runs_the_rest_and_says_so(stamped: Path) -> None:
-    """Issue 13: it stopped with ``sudo: command not found`` (127) before pytest ran."""
+    """Without root, sudo or chromium the script runs the rest of the suite (it must not stop at
+    ``sudo: command not found`` before pytest) and says that the browser tests did not run."""
     p = run(stamped, "run-tests.sh", "-q", "tests/tcpcal")
     assert p.returncode == 0, p.stderr
     assert pytest_calls(stamped) == ["python [-m] [pytest] [-m] [not browser] [-q] [tests/tcpcal]"]
@@ -188,3 +192,42 @@ def test_run_tests_with_a_bad_chromium_override_says_so(stamped: Path) -> None:
     assert p.returncode == 0
     assert "CHROMIUM=/nowhere/chromium is not an executable" in p.stderr
     assert pytest_calls(stamped) == ["python [-m] [pytest] [-m] [not browser]"]
+
+
+# ---------------------------------------------------------------- the type check
+def test_run_tests_type_checks_before_the_tests(stamped: Path) -> None:
+    (stamped.parent / "bin" / "chromium").symlink_to(shutil.which("true") or "/bin/true")
+    p = run(stamped, "run-tests.sh", "-q")
+    assert p.returncode == 0, p.stderr
+    assert [c for c in calls(stamped) if c.startswith("python")] == [
+        "python [-m] [mypy]", "python [-m] [pytest] [-q]"]
+
+
+def test_run_tests_fails_on_a_type_error_with_mypy_s_output_and_runs_no_test(stamped: Path) -> None:
+    (stamped.parent / "bin" / "chromium").symlink_to(shutil.which("true") or "/bin/true")
+    error = 'app/tcp_pendant/x.py:3: error: Incompatible return value type (got "str", expected "int")'
+    p = run(stamped, "run-tests.sh", "-q", FAKE_MYPY_RC="1", FAKE_MYPY_OUT=error, CI="true")
+    assert p.returncode == 1
+    assert error in p.stdout
+    assert "mypy found the type errors listed above; no test ran" in p.stderr
+    assert pytest_calls(stamped) == []
+
+
+def test_the_mypy_configuration_is_strict_on_tcpcal_and_standard_on_the_app(tmp_path: Path) -> None:
+    """The real mypy with the repository's ``[tool.mypy]`` on a two-module tree: an unannotated
+    function is an error in tcpcal only (strict there, not leaking to the app), and a wrong
+    return type is an error in the app; mypy exits 1, which fails run-tests.sh."""
+    shutil.copy(ROOT / "pyproject.toml", tmp_path)
+    untyped = "def scaled(x):\n    return 2 * x\n"
+    (tmp_path / "src" / "tcpcal").mkdir(parents=True)
+    (tmp_path / "src" / "tcpcal" / "__init__.py").write_text(untyped)
+    (tmp_path / "app" / "tcp_pendant").mkdir(parents=True)
+    (tmp_path / "app" / "tcp_pendant" / "__init__.py").write_text(
+        untyped + "\n\ndef length_mm() -> float:\n    return \"12.5 mm\"\n")
+    p = subprocess.run([sys.executable, "-m", "mypy", "--cache-dir", str(tmp_path / "cache")],
+                       cwd=tmp_path, capture_output=True, text=True, timeout=300)
+    errors = sorted(line for line in p.stdout.splitlines() if ": error: " in line)
+    assert p.returncode == 1, p.stdout + p.stderr
+    assert len(errors) == 2, p.stdout
+    assert errors[0].startswith("app/tcp_pendant/__init__.py:6: error: Incompatible return value type")
+    assert errors[1].startswith("src/tcpcal/__init__.py:1: error: Function is missing a type annotation")

@@ -1,4 +1,4 @@
-"""Issue 8 item 2: everything users type is shown as text, everywhere (the escaping helper).
+"""Everything users type is shown as text, everywhere (the escaping helper).
 
 ``tcp_pendant.text_escape.escape_markdown`` turns user text into markdown that renders as
 exactly that text in viser (whose markdown passes raw HTML unsanitised and autolinks bare
@@ -64,7 +64,7 @@ def test_each_payload_renders_as_one_paragraph_of_its_literal_text(text: str) ->
     assert shown == folded(text).rstrip(" ")          # a paragraph drops trailing blanks only
 
 
-def test_the_issue_payloads_exactly() -> None:
+def test_the_attack_payloads_exactly() -> None:
     assert escape_markdown(STYLE) == r"&lt;style&gt;\*\{opacity:0\}"
     assert escape_markdown(IMAGE) == r"\!\[\]\(//127\.0\.0\.1:8/x\)"
     assert escape_markdown(LINK) == r"\[click\]\(//evil\)"

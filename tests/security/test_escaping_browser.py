@@ -1,4 +1,4 @@
-"""Issue 8 item 2 in a browser: what users type is shown as text, never run (chromium + viser).
+"""In a browser: what users type is shown as text, never run (chromium + viser).
 
 viser's markdown passes raw HTML through unsanitised, so the harm of an unescaped name is in
 the browser: a ``<style>`` restyles the page (computed opacity), an image fetches a URL (a
@@ -223,7 +223,7 @@ def test_hostile_tool_names_are_shown_as_text_in_the_pendant(pendant_server, new
     server = pendant_server()
     page = new_page(server.url)
     title = page.title()
-    # a browser's robot starts with no active tool (issue 9): activate the style one on the Tool tab
+    # a browser's robot starts with no active tool: activate the style one on the Tool tab
     wait_js(page, "() => document.body.innerText.includes('FLANGE (no tool active)')", "no active tool")
     page.get_by_role("tab", name="Tool").click()
     choose(page, "Slot", f"1: {STYLE}")

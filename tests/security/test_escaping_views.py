@@ -1,4 +1,4 @@
-"""Issue 8 item 2, view by view: every markdown a view composes from user text holds no raw
+"""View by view: every markdown a view composes from user text holds no raw
 ``<`` and no live markdown (tool names from the shared library, names typed in the Save and
 numeric-entry fields, a loaded record's file name and tool names, error messages quoting
 input). In-process: a real pendant server and headless websocket clients, as tests/app and

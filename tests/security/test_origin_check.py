@@ -1,4 +1,4 @@
-"""Issue 8 item 4: foreign web pages cannot connect. A websocket upgrade whose Origin is present
+"""Foreign web pages cannot connect. A websocket upgrade whose Origin is present
 and is not the page's own address (nor an --allow-origin one) is refused with HTTP 403."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Issue 8 item 3: no browser can stall the others. A session record is uploaded over a real
+"""No browser can stall the others. A session record is uploaded over a real
 websocket (viser's file-transfer messages, as a browser sends them) while a second browser jogs:
 its jog latency stays below 0.5 s (p99), a record over the limit is dropped as its transfer
 starts with one notification, and one session loads one record at a time."""

@@ -1,4 +1,4 @@
-"""Issue 8 items 1 and 3 (parsing): an uploaded session record is bytes parsed as JSON, never a
+"""Parsing: an uploaded session record is bytes parsed as JSON, never a
 server path, and the limits (size, nesting depth, counts) are checked before the work they bound.
 """
 

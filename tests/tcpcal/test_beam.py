@@ -331,7 +331,7 @@ def test_axis_refuses_one_event_and_a_crossing_at_the_tcp():
 
 # ------------------------------------------------------------------------ benchmark table 5
 def test_bench_solver_beam_table_runs_and_reaches_the_bound():
-    """tests/bench/bench_solver.py table 5 (issue 14): a small run of its beam rows."""
+    """tests/bench/bench_solver.py table 5: a small run of its beam rows."""
     import importlib.util
     from pathlib import Path
 

@@ -21,7 +21,7 @@ def test_bench_solver_quick_runs() -> None:
     rows = [line.split() for line in text.splitlines() if line.strip().startswith(("20-50", "5-15"))]
     assert len(rows) == 6
     assert all(0.2 < float(r[3]) < 5.0 for r in rows)
-    # table 4 (issue 8 item 6): large touch sets, quick run = 10,000 touches and 10,000 with a
+    # table 4: large touch sets, quick run = 10,000 touches and 10,000 with a
     # repeated orientation, each solved (not a MemoryError) with a time and a peak RSS
     assert "recorded tracker data" in text
     large = [re.match(r"\s*10,000(?: touches|, half repeated)\s+([\d.]+)\s+([\d.]+)\s+(\d+)\s", line)

@@ -409,9 +409,9 @@ def test_docs_example_output_is_real(capsys: pytest.CaptureFixture[str],
     assert np.linalg.norm(np.array(d["tcp_mm"]) - [85.0, -12.0, 210.0]) < d["ci95_mm"]
 
 
-def test_every_solve_json_has_the_keys_of_issue_2(tmp_path: Path,
-                                                  capsys: pytest.CaptureFixture[str]) -> None:
-    """Issue 2: every ``--json`` object has at least method, tcp_mm, residuals_mm,
+def test_every_solve_json_has_the_contract_keys(tmp_path: Path,
+                                                capsys: pytest.CaptureFixture[str]) -> None:
+    """Every ``--json`` object has at least method, tcp_mm, residuals_mm,
     mean/max/rms_error_mm, ci95_mm, outliers (0-based rows) and warnings; reference_mm for
     xyz4 and reference; rotation_matrix (3x3 rows) and kuka_abc_deg for the orientation
     methods (docs/cli.md: null / empty where a figure is not defined)."""

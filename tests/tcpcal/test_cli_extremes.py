@@ -1,4 +1,4 @@
-"""The CLI keeps its contract on extreme numbers and on stdin (issue 8, item 6).
+"""The CLI keeps its contract on extreme numbers and on stdin.
 
 Each case was an internal error (exit 1: OverflowError, ZeroDivisionError) or a NaN TCP with
 exit 0 before: now exit 2 with one line naming the problem (docs/cli.md "Number ranges").

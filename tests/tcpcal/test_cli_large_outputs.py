@@ -1,4 +1,4 @@
-"""`tcpcal solve xyz4` on large files (issue 8 item 6): same bytes, same errors, no per-row
+"""`tcpcal solve xyz4` on large files: same bytes, same errors, no per-row
 Python work.
 
 The fast CSV reader (``tcpcal.poses_csv._fast_rows``), the column-wise residual table

@@ -96,7 +96,7 @@ def test_cli_md_examples_are_real(tmp_path: Path, capsys: pytest.CaptureFixture[
 
 def test_examples_write_only_into_the_scratch_folder(tmp_path: Path, capsys: pytest.CaptureFixture[str],
                                                     monkeypatch: pytest.MonkeyPatch) -> None:
-    """Issue 13: the ``tcpcal tools`` example left ``my_tools.json`` and its lock in the repo root.
+    """The ``tcpcal tools`` example must not leave ``my_tools.json`` and its lock in the repo root.
 
     Run from the repository root, as a reader pasting the example would, the files land in the
     scratch folder the examples run in, never beside README.md."""

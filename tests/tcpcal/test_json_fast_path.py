@@ -1,4 +1,4 @@
-"""The float-array fast path of ``tcpcal.report.json_dumps`` (issue 8 item 6 leftover: ``tcpcal
+"""The float-array fast path of ``tcpcal.report.json_dumps`` (``tcpcal
 solve xyz4 --json`` on 10^6 rows).
 
 A finite float array that is a dict value is printed by one ``%r`` format pass over its flat

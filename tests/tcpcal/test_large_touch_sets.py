@@ -1,4 +1,4 @@
-"""solve_xyz4 on recorded tracker data (issue 8, item 6): the O(N log N) angle figures and the
+"""solve_xyz4 on recorded tracker data: the O(N log N) angle figures and the
 O(N) duplicate check equal the exact O(N^2) ones; 1e5 touches with a repeated orientation
 fail or solve cleanly in modest memory; a slow continuous motion is not "one orientation".
 """

@@ -1,4 +1,4 @@
-"""The TCP check (spin test) wizard's state machine without a controller (issue 12 item 2): what
+"""The TCP check (spin test) wizard's state machine without a controller: what
 it declares to the registry, that Finish needs the check of the touch as recorded, that nothing
 can be saved, that the record round trip keeps the check, that a stored check is checked, and
 that the tool's name reaches the markdown only escaped."""

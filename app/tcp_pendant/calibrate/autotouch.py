@@ -29,13 +29,16 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
 from tcp_pendant.wizards.abc_world import R_WORLD_TOOL_TARGET
 from tcp_pendant.wizards.base import StepInfo, Wizard, WizardError, WizardStateError
+
+if TYPE_CHECKING:
+    from tcp_pendant.controller import ToolModel, VirtualController
 
 DEFAULT_DISTANCE_MM = 60.0
 MIN_RETRY_DISTANCE_MM = 20.0
@@ -84,8 +87,8 @@ class AutoTouchOutcome:
         return (self.tilt_deg, self.azimuth_deg, self.spin_deg)
 
 
-def _ensure_mounted(wizard: Wizard, controller: Any, step: StepInfo,
-                    tools: Mapping[str, Any] | None, mount: Callable[[Any], None] | None) -> None:
+def _ensure_mounted(wizard: Wizard, controller: VirtualController, step: StepInfo,
+                    tools: Mapping[str, ToolModel] | None, mount: Callable[[ToolModel], None] | None) -> None:
     key = step.mount_tool_key
     if key is not None and getattr(controller.mounted_tool, "key", None) != key:
         if tools is None:
@@ -97,14 +100,14 @@ def _ensure_mounted(wizard: Wizard, controller: Any, step: StepInfo,
     wizard.note_mounted_tool(getattr(controller.mounted_tool, "key", None))
 
 
-def auto_touch(wizard: Wizard, controller: Any, *,
+def auto_touch(wizard: Wizard, controller: VirtualController, *,
                direction_deg: tuple[float, float, float] | None = None,
                sigma_mm: float = 0.0, angle_sigma_deg: float | None = None,
                distance_mm: float = DEFAULT_DISTANCE_MM, hover_mm: float = 30.0,
                rng: np.random.Generator | None = None, advance: bool = True,
-               tools: Mapping[str, Any] | None = None, max_attempts: int = 12,
+               tools: Mapping[str, ToolModel] | None = None, max_attempts: int = 12,
                previous_direction_deg: tuple[float, float, float] | None = None,
-               mount: Callable[[Any], None] | None = None,
+               mount: Callable[[ToolModel], None] | None = None,
                pose_check: Callable[[], str | None] | None = None) -> AutoTouchOutcome:
     """Perform the wizard's current step with the controller and record the flange pose.
 

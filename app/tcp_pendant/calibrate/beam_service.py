@@ -1,4 +1,4 @@
-"""The TCP service with the beam sensor (issue 14 item 4): "Check with beam" and "Update".
+"""The TCP service with the beam sensor: "Check with beam" and "Update".
 
 The industrial loop after a crash: the tool is bent, the stored tool data is stale. "Check
 with beam" runs the automatic scan (``controller.beam_scan``) with the tool data the
@@ -334,8 +334,9 @@ def update_tool_from_beam(library: ToolLibrary, slot: int, check: BeamCheck) -> 
                "n_axis_events": float(len(check.scan.axis_indices))}
     if check.direction_deviation_deg is not None:
         figures["direction_deviation_deg"] = check.direction_deviation_deg
-    measured = tuple(float(v) for v in check.measured_tcp_mm)
-    tool = Tool(name=current.name, tcp_mm=measured, abc_deg=current.abc_deg,  # type: ignore[arg-type]
+    x, y, z = (float(v) for v in check.measured_tcp_mm)
+    measured = (x, y, z)
+    tool = Tool(name=current.name, tcp_mm=measured, abc_deg=current.abc_deg,
                 mass_kg=current.mass_kg, cog_mm=current.cog_mm, notes=current.notes,
                 calibration=Calibration.now(BEAM_METHOD, figures))
     library.save(slot, tool, activate=False)

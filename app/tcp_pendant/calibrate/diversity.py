@@ -17,9 +17,8 @@ from __future__ import annotations
 
 import math
 import re
-from typing import Any
-
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy.spatial.transform import Rotation
 
 from tcpcal.pose_quality import assess_touches
@@ -45,7 +44,7 @@ def _world_direction(axis_world: np.ndarray) -> str:
     return "the diagonal between WORLD X and Y"
 
 
-def _kind(axis_flange: Any, R_world_flange: Any) -> tuple[str, np.ndarray]:
+def _kind(axis_flange: ArrayLike, R_world_flange: ArrayLike) -> tuple[str, np.ndarray]:
     a = np.asarray(axis_flange, dtype=float).reshape(3)
     a = a / np.linalg.norm(a)
     w = np.asarray(R_world_flange, dtype=float).reshape(3, 3) @ a
@@ -58,7 +57,7 @@ def _kind(axis_flange: Any, R_world_flange: Any) -> tuple[str, np.ndarray]:
     return "slanted", w
 
 
-def axis_in_words(axis_flange: Any, R_world_flange: Any) -> str:
+def axis_in_words(axis_flange: ArrayLike, R_world_flange: ArrayLike) -> str:
     """The turn the touches share, in words ("a turn about the flange axis (the tool turned
     about its own length)", "a tilt about a horizontal axis along WORLD Y", ...).
 
@@ -76,7 +75,7 @@ def axis_in_words(axis_flange: Any, R_world_flange: Any) -> str:
     return "a tilt about one slanted axis"
 
 
-def missing_axis_in_words(axis_flange: Any, R_world_flange: Any) -> str:
+def missing_axis_in_words(axis_flange: ArrayLike, R_world_flange: ArrayLike) -> str:
     """What the next touch must add: a tilt about an axis at right angles to the shared one."""
     kind, w = _kind(axis_flange, R_world_flange)
     if kind == "horizontal":
@@ -93,7 +92,7 @@ def missing_axis_in_words(axis_flange: Any, R_world_flange: Any) -> str:
 _FLANGE_VECTOR = re.compile(r"\s*\((?:not about )?flange \[[^\]]*\]\)")
 
 
-def failure_in_words(message: str, axis_flange: Any, R_world_flange: Any) -> str:
+def failure_in_words(message: str, axis_flange: ArrayLike, R_world_flange: ArrayLike) -> str:
     """tcpcal's "all touches rotate about nearly the same axis (flange [..])" for a trainee:
     the FLANGE vector dropped, the axis and the tilt still missing said in words."""
     text = _FLANGE_VECTOR.sub("", str(message)).strip()
@@ -111,7 +110,7 @@ def _max_angle_deg(rots: np.ndarray) -> float:
                 for j in range(i + 1, len(r))), default=0.0)
 
 
-def diversity_advice(recorded: Any, candidate: Any, angle_to_nearest_deg: float) -> str:
+def diversity_advice(recorded: ArrayLike, candidate: ArrayLike, angle_to_nearest_deg: float) -> str:
     """The meter's words while the TCP is not determinable yet (markdown, no user text).
 
     Args:

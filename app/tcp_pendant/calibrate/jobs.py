@@ -45,7 +45,9 @@ class ControllerJob(Protocol):
     own copies of the robot models; the controller is not moved), the outcome handed back on
     the loop (:meth:`CalibrationWorkflow.give_controller_job`)."""
 
-    wizard: Wizard
+    @property
+    def wizard(self) -> Wizard:
+        """The wizard that waits for the job."""
 
     @property
     def busy_text(self) -> str:

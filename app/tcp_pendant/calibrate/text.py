@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Collection, Mapping, Sequence
+from typing import TYPE_CHECKING, Literal
 
 from tcp_pendant.pendant.formatting import fmt_num
 from tcp_pendant.text_escape import escape_markdown as _esc
@@ -27,6 +28,9 @@ from tcp_pendant.wizards import (
     wizard_class,
 )
 from tcp_pendant.wizards.registry import wizard_class
+
+if TYPE_CHECKING:
+    from tcp_pendant.wizards.xyz4 import Estimator
 from tcp_pendant.wizards.tcp_check import tcp_check_markdown
 from tcp_pendant.wizards.session_record import ReplayCheck
 from tcp_pendant.wizards.truth import NUMERICAL_NOISE_MM, TruthComparison
@@ -129,7 +133,7 @@ FULL_DIVERSITY_DEG = 45.0
 section 7: touches 45 degrees apart about different axes give several times smaller errors)."""
 
 
-def meter_level(gain: CandidateGain) -> tuple[float, str]:
+def meter_level(gain: CandidateGain) -> tuple[float, Literal["red", "yellow", "green"]]:
     """The pose-diversity meter as a bar: (0..100, colour).
 
     The bar is the angle from the current orientation to the nearest recorded one, full at
@@ -331,7 +335,7 @@ def empty_touches_markdown(wizard: Wizard | None) -> str:
     """What the Touches list says with no free touch (Record point): "No touch recorded", or,
     while a wizard on show has recorded steps, that they are its (our words and numbers)."""
     n = 0 if wizard is None or wizard.status == "cancelled" else len(wizard.recorded_poses)
-    if n == 0:
+    if wizard is None or n == 0:
         return "*No touch recorded.*"
     return (f"*No touch recorded with Record point. The {_esc(wizard.title)} wizard has {n} "
             f"touch{'es' if n != 1 else ''} of its own: they are in its step list above.*")
@@ -394,7 +398,7 @@ def replay_markdown(checks: Sequence[ReplayCheck]) -> str:
     return head + "\n" + "\n".join(rows)
 
 
-def estimator_options() -> dict[str, str]:
+def estimator_options() -> dict[str, Estimator]:
     """Dropdown label -> estimator key, in the wizard's order."""
     return {label: key for key, label in ESTIMATOR_LABELS.items()}
 

@@ -28,7 +28,7 @@ import re
 from collections.abc import Mapping, Sequence
 from datetime import datetime
 from dataclasses import dataclass, field, replace
-from typing import Any, ClassVar, Literal, Protocol
+from typing import Any, ClassVar, Literal, Protocol, cast
 
 import numpy as np
 
@@ -393,7 +393,7 @@ class CalibrationWorkflow:
             if index is not None and i in recorded:
                 self._events.append(TouchRecorded(index, i, recorded[i].T_world_flange_m, joints, d,
                                                   auto=False, overwrite=False))
-        return w
+        return cast(Xyz4Wizard, w)
 
     # ------------------------------------------------------------ navigation
     def _note_distance(self, step: int) -> None:
@@ -730,6 +730,26 @@ class CalibrationWorkflow:
                 is changed).
         """
         return self.add_loaded(load_and_replay(source))
+
+    def restore(self, runs: Sequence[WizardRun]) -> list[int]:
+        """Give back runs this session's trainee had in progress when the server stopped (kept
+        in the gradebook, ``classroom.restore``): appended to :attr:`runs` with their truth,
+        joints and distances; the newest is put on show where it was, the others wait in the
+        Resume list. Makes no events: they are in the gradebook already. Returns their indices.
+        """
+        if not runs:
+            return []
+        self._leave_open_wizard()
+        indices = []
+        for run in runs:
+            if run.wizard.status != "cancelled":
+                run.wizard.cancel()
+            self.runs.append(run)
+            indices.append(len(self.runs) - 1)
+        self._current = indices[-1]
+        self.runs[self._current].wizard.resume()
+        self.note_mounted_tool()
+        return indices
 
     def add_loaded(self, loaded: LoadedRecord) -> tuple[ReplayCheck, ...]:
         """Add a record read and replayed by :func:`load_and_replay` (the app does that in a

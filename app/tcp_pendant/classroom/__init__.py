@@ -1,4 +1,4 @@
-"""Classroom support (issue 11) without a GUI: the SQLite gradebook, ``tcp-pendant grades``,
+"""Classroom support without a GUI: the SQLite gradebook, ``tcp-pendant grades``,
 per-trainee mystery tools and trainee names.
 
 Modules (one job each): :mod:`~tcp_pendant.classroom.gradebook` (the database),

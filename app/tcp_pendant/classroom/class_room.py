@@ -43,6 +43,7 @@ from tcp_pendant.classroom.gradebook import Gradebook, GradeRow, TraineeJoin
 from tcp_pendant.classroom.mystery import draw_mystery_tool
 from tcp_pendant.classroom.names import TraineeNameError, validate_trainee_name
 from tcp_pendant.classroom.recorder import TraineeRecorder, TraineeStatus
+from tcp_pendant.classroom.restore import runs_to_restore
 from tcp_pendant.controller import ToolModel
 from tcp_pendant.session import Session, SessionChange
 
@@ -164,6 +165,7 @@ class ClassRoom:
                 self._mount_mystery(session, recorder, join.name)
             if self.hide_distance is not None:
                 session.set_hide_distance(self.hide_distance)
+            self._restore(session, recorder, join.name)
         return recorder
 
     def _on_change(self, session: Session, change: SessionChange) -> None:
@@ -218,6 +220,20 @@ class ClassRoom:
     def held_names(self) -> list[str]:
         """Names a browser holds (the trainer view's "Release a name" choices)."""
         return self.gradebook.held_names()
+
+    def _restore(self, session: Session, recorder: TraineeRecorder, name: str) -> None:
+        """The calibrations ``name`` had in progress (a reload, a restart of the server with this
+        gradebook): back on the trainee's screen at their step, written on into the same
+        calibrations (``classroom.restore``)."""
+        restored = runs_to_restore(self.gradebook, name)
+        if not restored:
+            return
+        indices = session.restore_runs([r.run for r in restored])
+        for index, r in zip(indices, restored):
+            recorder.adopt(index, r.calibration_id, r.touch_ids)
+        n = len(restored)
+        session.notify("Calibration restored", f"{n} calibration{'s' if n != 1 else ''} you had in progress "
+                       "came back, each at its step with its touches.", kind="info")
 
     def _mount_mystery(self, session: Session, recorder: TraineeRecorder, name: str) -> None:
         base = self.tools.get("pointer") or next(iter(self.tools.values()))

@@ -1,6 +1,6 @@
 """The class gradebook: every trainee, session, calibration, touch and crash, in one SQLite file.
 
-The server writes each wizard event as it happens (issue 11 item 2); ``tcp-pendant grades``
+The server writes each wizard event as it happens; ``tcp-pendant grades``
 reads it back (:mod:`tcp_pendant.classroom.grades_cli`). Standard library ``sqlite3`` only.
 
 Durability ("a kill -9 of the server loses nothing that was acknowledged on screen"):
@@ -64,7 +64,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass, field
 from datetime import datetime, timezone
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any, Literal, overload
 
 import numpy as np
 import platformdirs
@@ -89,6 +89,17 @@ SCHEMA_VERSION = 2
 GRADES = ("good", "fair", "poor")
 _STATUS = ("in_progress", "finished", "cancelled")
 _MAX_TEXT = 200          # method, tool key, exercise id, mode, crash note: short labels
+
+
+_RUN_STATES = """CREATE TABLE IF NOT EXISTS run_states (
+    calibration_id INTEGER PRIMARY KEY REFERENCES calibrations(id),
+    entry_json TEXT NOT NULL,
+    updated_at TEXT NOT NULL)"""
+"""What a restart gives back: each calibration's wizard as it was last acknowledged (a session
+record entry without truth, ``session_record.run_entry``). Added to every file when it is
+opened; a TCP Pendant that does not know it ignores it, so it needs no schema version."""
+MAX_RUN_STATE_BYTES = 200_000
+"""A wizard's stored state is refused above this (20 poses with joints take ~12 kB)."""
 
 
 class GradebookError(Exception):
@@ -296,6 +307,10 @@ def to_csv(rows: Sequence[GradeRow]) -> str:
 
 # --------------------------------------------------------------------------- input checks
 
+@overload
+def _label(value: Any, what: str, *, optional: Literal[False] = False) -> str: ...
+@overload
+def _label(value: Any, what: str, *, optional: bool) -> str | None: ...
 def _label(value: Any, what: str, *, optional: bool = False) -> str | None:
     if value is None and optional:
         return None
@@ -304,6 +319,14 @@ def _label(value: Any, what: str, *, optional: bool = False) -> str | None:
     if len(value) > _MAX_TEXT or not value.isprintable():
         raise GradebookError(f"{what} must be at most {_MAX_TEXT} printable characters, got {value!r:.80}.")
     return value
+
+
+def _new_id(cur: sqlite3.Cursor) -> int:
+    """The id of the row an INSERT just added (``lastrowid``, None only before any insert)."""
+    rowid = cur.lastrowid
+    if rowid is None:
+        raise GradebookError("the gradebook added no row")
+    return rowid
 
 
 def _finite(value: Any, what: str, *, optional: bool = False) -> float | None:
@@ -484,6 +507,12 @@ class Gradebook:
         if str(mode).lower() != "wal":
             raise GradebookError(f"Gradebook {self.path}: SQLite refused WAL mode (got {mode!r}); put the "
                                  "file on a local disk (WAL needs shared memory, network folders lack it).")
+        try:                                         # additive: an older reader ignores the table
+            with self._transaction():
+                db.execute(_RUN_STATES)
+        except sqlite3.Error as exc:
+            raise GradebookError(f"Cannot write the gradebook {self.path}: {exc}; check that its folder "
+                                 "is writable and the disk is not full.") from exc
 
     def _migrate(self, version: int) -> None:
         """Bring a file of an older schema version to :data:`SCHEMA_VERSION` (one transaction)."""
@@ -577,8 +606,8 @@ class Gradebook:
             row = db.execute("SELECT id FROM trainees WHERE name = ?", (clean,)).fetchone()
             if row is not None:
                 return int(row[0])
-            return int(db.execute("INSERT INTO trainees (name, created_at) VALUES (?, ?)",
-                                  (clean, _now())).lastrowid)
+            return _new_id(db.execute("INSERT INTO trainees (name, created_at) VALUES (?, ?)",
+                                      (clean, _now())))
 
     def join_trainee(self, name: str, key: Any = None) -> TraineeJoin:
         """A browser joins the class as ``name``, showing the browser key it kept (or none).
@@ -674,8 +703,8 @@ class Gradebook:
         with self._write() as db:
             if db.execute("SELECT 1 FROM trainees WHERE id = ?", (tid,)).fetchone() is None:
                 raise GradebookError(f"No trainee {tid} in the gradebook {self.path}; add_trainee first.")
-            return int(db.execute("INSERT INTO sessions (trainee_id, mode, started_at) VALUES (?, ?, ?)",
-                                  (tid, mode, _now())).lastrowid)
+            return _new_id(db.execute("INSERT INTO sessions (trainee_id, mode, started_at) VALUES (?, ?, ?)",
+                                      (tid, mode, _now())))
 
     def end_session(self, session_id: int) -> None:
         """Mark a session ended (browser gone); its calibrations stay as they are."""
@@ -706,10 +735,10 @@ class Gradebook:
         with self._write() as db:
             if db.execute("SELECT 1 FROM sessions WHERE id = ?", (sid,)).fetchone() is None:
                 raise GradebookError(f"No session {sid} in the gradebook {self.path}; start_session first.")
-            return int(db.execute(
+            return _new_id(db.execute(
                 "INSERT INTO calibrations (session_id, method, tool_key, exercise_id, truth_json, status, "
                 "started_at) VALUES (?, ?, ?, ?, ?, 'in_progress', ?)",
-                (sid, method, tool_key, exercise, truth_text, _now())).lastrowid)
+                (sid, method, tool_key, exercise, truth_text, _now())))
 
     def record_touch(self, calibration_id: int, step_index: int, T_world_flange_m: Any, joints_deg: Any,
                      distance_mm: float | None, auto: bool, overwritten_touch_id: int | None = None) -> int:
@@ -751,10 +780,10 @@ class Gradebook:
                 if row[1] is not None:
                     raise GradebookError(f"Touch {old} was already overwritten by touch {row[1]}; pass "
                                          f"{row[1]} instead.")
-            new = int(db.execute(
+            new = _new_id(db.execute(
                 "INSERT INTO touches (calibration_id, step_index, recorded_at, T_world_flange_m_json, "
                 "joints_deg_json, distance_mm, auto, overwrites_touch_id) VALUES (?, ?, ?, ?, ?, ?, ?, ?)",
-                (cid, step, _now(), T, q, d, int(bool(auto)), old)).lastrowid)
+                (cid, step, _now(), T, q, d, int(bool(auto)), old)))
             if old is not None:
                 db.execute("UPDATE touches SET overwritten_by_touch_id = ? WHERE id = ?", (new, old))
             return new
@@ -786,8 +815,8 @@ class Gradebook:
                 sid = cal_session
             elif db.execute("SELECT 1 FROM sessions WHERE id = ?", (sid,)).fetchone() is None:
                 raise GradebookError(f"No session {sid} in the gradebook {self.path}.")
-            return int(db.execute("INSERT INTO crashes (session_id, calibration_id, at, penetration_mm, note) "
-                                  "VALUES (?, ?, ?, ?, ?)", (sid, cid, _now(), depth, note)).lastrowid)
+            return _new_id(db.execute("INSERT INTO crashes (session_id, calibration_id, at, penetration_mm, note) "
+                                      "VALUES (?, ?, ?, ?, ?)", (sid, cid, _now(), depth, note)))
 
     def finish_calibration(self, calibration_id: int, figures: Mapping[str, float], *,
                            position_error_mm: float | None, orientation_error_deg: float | None,
@@ -861,6 +890,61 @@ class Gradebook:
         with self._read() as db:
             cid = self._calibration(db, calibration_id)[0]
             return json.loads(db.execute("SELECT truth_json FROM calibrations WHERE id = ?", (cid,)).fetchone()[0])
+
+    # -- what a restart gives back ------------------------------------------------------
+
+    def save_run_state(self, calibration_id: int, entry: Mapping[str, Any]) -> None:
+        """Keep the wizard of calibration ``calibration_id`` as it is now (a session record
+        entry, ``session_record.run_entry``, JSON-ready, without truth); replaces the last.
+
+        Raises:
+            GradebookError: no such calibration, not JSON, or above :data:`MAX_RUN_STATE_BYTES`.
+        """
+        try:
+            text = json.dumps(entry, sort_keys=True, allow_nan=False)
+        except (TypeError, ValueError) as exc:
+            raise GradebookError(f"A wizard's state must be plain JSON: {exc}.") from exc
+        if len(text) > MAX_RUN_STATE_BYTES:
+            raise GradebookError(f"A wizard's state of {len(text):,} bytes is above {MAX_RUN_STATE_BYTES:,}.")
+        with self._write() as db:
+            cid = self._calibration(db, calibration_id)[0]
+            db.execute("INSERT INTO run_states (calibration_id, entry_json, updated_at) VALUES (?, ?, ?) "
+                       "ON CONFLICT(calibration_id) DO UPDATE SET entry_json = excluded.entry_json, "
+                       "updated_at = excluded.updated_at", (cid, text, _now()))
+
+    def open_runs(self, trainee: str) -> list[dict[str, Any]]:
+        """The calibrations of ``trainee`` still in progress that have a stored wizard, oldest
+        first: ``{"calibration_id", "method", "tool_key", "exercise_id", "truth", "entry",
+        "touch_ids"}`` (``touch_ids``: step -> the id of its touch that counts, to link the next
+        overwrite); for a restart to give them back."""
+        with self._read() as db:
+            rows = db.execute(
+                "SELECT c.id, c.method, c.tool_key, c.exercise_id, c.truth_json, r.entry_json FROM calibrations c "
+                "JOIN sessions s ON s.id = c.session_id JOIN trainees t ON t.id = s.trainee_id "
+                "JOIN run_states r ON r.calibration_id = c.id "
+                "WHERE t.name = ? AND c.status = 'in_progress' ORDER BY c.started_at, c.id", (str(trainee),)).fetchall()
+            out = []
+            for cid, method, tool, exercise, truth, entry in rows:
+                touch_ids = {int(step): int(tid) for tid, step in db.execute(
+                    "SELECT id, step_index FROM touches WHERE calibration_id = ? AND overwritten_by_touch_id IS NULL",
+                    (cid,))}
+                out.append({"calibration_id": cid, "method": method, "tool_key": tool, "exercise_id": exercise,
+                            "truth": json.loads(truth), "entry": json.loads(entry), "touch_ids": touch_ids})
+        return out
+
+    def class_setting(self, key: str) -> Any:
+        """A class setting kept across restarts (``set_class_setting``), None when never set."""
+        with self._read() as db:
+            row = db.execute("SELECT value FROM meta WHERE key = ?", (f"class:{key}",)).fetchone()
+        return None if row is None else json.loads(row[0])
+
+    def set_class_setting(self, key: str, value: Any) -> None:
+        """Keep a class setting (JSON-ready; the pushed exercise, the distance-aid lock, the
+        trainer token's hash) across restarts of the server."""
+        text = json.dumps(value, sort_keys=True, allow_nan=False)
+        with self._write() as db:
+            db.execute("INSERT INTO meta (key, value) VALUES (?, ?) ON CONFLICT(key) DO UPDATE SET value = "
+                       "excluded.value", (f"class:{_label(key, 'setting name')}", text))
 
     def grades(self, *, include_in_progress: bool = False) -> list[GradeRow]:
         """One row per finished calibration, oldest start first; with ``include_in_progress``

@@ -1,4 +1,4 @@
-"""Grade a trainee's honest session record against the gradebook (issue 11 item 5; no viser).
+"""Grade a trainee's honest session record against the gradebook (no viser).
 
 A trainee's export in a class carries no truth (``session_record`` version 2, ``honest``), but
 each wizard carries its ``record_id``: the gradebook's calibration id. :func:`grade_record`

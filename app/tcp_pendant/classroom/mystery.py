@@ -1,4 +1,4 @@
-"""Mystery tools (issue 11 item 4): a tool per trainee whose true TCP and orientation are drawn
+"""Mystery tools: a tool per trainee whose true TCP and orientation are drawn
 from the exercise seed and the trainee's name, so answers differ between trainees. The seed of
 a class is a secret (``Gradebook.exercise_seed``: random, kept in the gradebook): this code is
 public, so whoever knows the seed and a name computes that trainee's tool.
@@ -46,6 +46,7 @@ import warnings
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
+from typing import cast
 
 import numpy as np
 import platformdirs
@@ -205,7 +206,7 @@ def _body_mesh(T_flange_tool: np.ndarray) -> trimesh.Trimesh:
                                       sections=_SECTIONS)
     joint = trimesh.creation.icosphere(subdivisions=1, radius=_SHAFT_RADIUS_M)
     joint.apply_translation(neck)
-    return trimesh.util.concatenate([mount, shaft, joint])
+    return cast(trimesh.Trimesh, trimesh.util.concatenate([mount, shaft, joint]))  # meshes give a mesh
 
 
 def _xyz(v: np.ndarray) -> str:

@@ -19,6 +19,11 @@ onto one gradebook write, in order:
 Runs loaded from a session record file are somebody's earlier work, not this session's: the
 workflow makes no events for them, so they are not stored.
 
+What a restart gives back: after the events of a signal, each calibration they touched (and the
+one on show, when its step or status changed) is kept as its wizard is now
+(``Gradebook.save_run_state``, a session record entry without truth), so a server started again
+with the same gradebook rebuilds it for the trainee (``classroom.restore``, :meth:`adopt`).
+
 Acknowledgement: the change signal is emitted inside ``target.atomic()``, so the GUI messages of
 the same signal are pushed after every subscriber returned; each gradebook write has committed
 when it returns (``Gradebook``), so a touch is in the file before the screen shows it.
@@ -36,6 +41,7 @@ import numpy as np
 
 from tcp_pendant.classroom.gradebook import Gradebook
 from tcp_pendant.events import Crash, RunCancelled, RunFinished, RunResumed, RunStarted, SessionEvent, TouchRecorded
+from tcp_pendant.wizards.session_record import run_entry
 
 __all__ = ["TraineeRecorder", "TraineeStatus"]
 
@@ -74,6 +80,7 @@ class _RunState:
     calibration_id: int
     touch_ids: dict[int, int] = field(default_factory=dict)     # step -> gradebook touch id
     status: str = "in_progress"
+    shown: tuple[Any, ...] = ()                                 # the wizard's place when last kept
 
 
 class TraineeRecorder:
@@ -117,10 +124,46 @@ class TraineeRecorder:
         """Subscriber of the session's change signal: its events to the gradebook, in order
         (see the module docstring); the trainer's row after a wizard change."""
         with self._lock:
-            for event in getattr(change, "events", ()):
+            events = tuple(getattr(change, "events", ()))
+            for event in events:
                 self._store(event)
-            if getattr(change, "wizard", False) or getattr(change, "events", ()):
+            if getattr(change, "wizard", False) or events:
                 self._update_status()
+                touched = {i for i in (getattr(e, "run_index", None) for e in events) if i is not None}
+                current = None if self.workflow is None else self.workflow.run_index
+                if current is not None:
+                    touched.add(current)
+                for i in sorted(touched):
+                    self._keep_state(i)
+
+    def adopt(self, run_index: int, calibration_id: int, touch_ids: dict[int, int]) -> None:
+        """Go on writing run ``run_index`` (restored after a restart) into its calibration;
+        ``touch_ids``: step -> the touch that counts there (the next overwrite links it)."""
+        with self._lock:
+            self._runs[int(run_index)] = _RunState(int(calibration_id), dict(touch_ids))
+            if self.workflow is not None:
+                self.workflow.record_ids[int(run_index)] = int(calibration_id)
+            self._status = replace(self._status, touches=self._status.touches + len(touch_ids))
+            self._update_status()
+
+    def _keep_state(self, run_index: int) -> None:
+        """Keep run ``run_index``'s wizard in the gradebook when its place changed (a new pose,
+        another step or status, an edited option): what a restart gives back."""
+        st = self._runs.get(run_index)
+        if st is None or self.workflow is None or not 0 <= run_index < len(self.workflow.runs):
+            return
+        run = self.workflow.runs[run_index]
+        w = run.wizard
+        shown = (w.status, w.step_index, w.n_steps, tuple((k, id(p)) for k, p in sorted(w.recorded_poses.items())),
+                 repr(w.to_dict().get("params")))
+        if shown == st.shown:
+            return
+        try:
+            self.gradebook.save_run_state(st.calibration_id, run_entry(run, honest=True))
+            st.shown = shown
+        except Exception:            # a state that cannot be kept must not stop the lesson
+            self.errors += 1
+            log.exception("keeping the wizard of calibration %s failed", st.calibration_id)
 
     def _store(self, event: SessionEvent) -> None:
         if isinstance(event, RunStarted):

@@ -92,7 +92,7 @@ def example_robot_data_dir() -> Path | None:
                 if candidate.is_dir():
                     return candidate
     try:  # pragma: no cover - only with the pip build of example-robot-data
-        import example_robot_data  # type: ignore[import-not-found]
+        import example_robot_data
 
         return Path(example_robot_data.getModelPath("ur_description/urdf/ur5_robot.urdf")) / "robots"
     except Exception:

@@ -1,4 +1,4 @@
-"""The virtual beam sensor (issue 14): a BullsEye / TRACC style through-beam light barrier.
+"""The virtual beam sensor: a BullsEye / TRACC style through-beam light barrier.
 
 Pure numpy geometry, no viser and no controller class: it takes flange poses
 (``T_world_flange``, 4x4, metres) and a tool description (:class:`ToolShape`: the true TOOL
@@ -54,7 +54,7 @@ __all__ = [
 DEFAULT_WIDTH_M: float = 0.5e-3
 """Beam diameter: through-beam barriers of TCP devices use beams of a fraction of a mm."""
 DEFAULT_SIGMA_M: float = 2e-5
-"""Repeatability of a recorded event: 0.02 mm per axis (issue 14's default)."""
+"""Repeatability of a recorded event: 0.02 mm per axis (the default)."""
 
 
 def _unit(v: object, name: str) -> np.ndarray:

@@ -1,4 +1,4 @@
-"""The beam sensor's automatic scan (issue 14): the motion a BullsEye / TRACC style device runs.
+"""The beam sensor's automatic scan: the motion a BullsEye / TRACC style device runs.
 
 Pure functions of their arguments (no controller is read or changed), so a scan can run in a
 worker thread on snapshots taken on the event loop. Metres and radians inside; the
@@ -491,7 +491,7 @@ class _Planner:
     def tcp(self, T: np.ndarray) -> np.ndarray:
         return T[:3, :3] @ self.T_ft_plan[:3, 3] + T[:3, 3]
 
-    def add_move(self, kind: str, T_end: np.ndarray, q_end: np.ndarray, k: int, *,
+    def add_move(self, kind: Literal["move", "approach", "pass"], T_end: np.ndarray, q_end: np.ndarray, k: int, *,
                  length: float | None = None, events: tuple[int, ...] = ()) -> None:
         if length is None:
             length = max(float(np.linalg.norm(T_end[:3, 3] - self.T[:3, 3])),
@@ -628,7 +628,7 @@ def _scan_orientation(P: _Planner, k: int, spin: float, tilt: float,
             raise _Skip(f"the {'first' if j == 0 else 'second'} pass did not "
                         f"cross the beam cleanly ({exc})") from None
         mine = [ev for ev in found if ev.beam == 0]
-        found = [ev for ev in found if ev.on_shaft]  # a crossing beyond the shaft is no axis event
+        found = tuple(ev for ev in found if ev.on_shaft)  # a crossing beyond the shaft is no axis event
         if not mine or not mine[0].on_shaft:
             raise _Skip(f"the {'first' if j == 0 else 'second'} pass "
                         + ("did not break the beam: the tool data is too far off for a "

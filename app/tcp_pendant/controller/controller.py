@@ -225,7 +225,7 @@ class VirtualController:
 
     @property
     def beam_sensor(self) -> BeamSensor:
-        """The beam sensor (issue 14): the one set with :meth:`set_beam_sensor`, else
+        """The beam sensor: the one set with :meth:`set_beam_sensor`, else
         ``beam_scan.default_beam_sensor`` of the current reference tip (it follows the tip when
         that is moved). The same object until it changes (views may compare by identity)."""
         if self._beam is not None:

@@ -384,7 +384,7 @@ def load_description(path: Path | str, package_paths: Iterable[Path | str] = ())
                 for mesh in element.iter("mesh"):
                     uri = mesh.get("filename", "")
                     found, reason = _resolve_uri(uri, base_dir, finder)
-                    meshes.append(MeshRef(name, kind, uri, found, reason))  # type: ignore[arg-type]
+                    meshes.append(MeshRef(name, kind, uri, found, reason))
                     if found is not None:
                         mesh.set("filename", str(found))
 

@@ -313,6 +313,7 @@ def _solve_substep(kin: RobotKinematics, q_start: np.ndarray, sigma_start: float
         i = int(np.argmax(over))
         side = "lower" if q[i] < kin.lower_rad[i] else "upper"
         return _Attempt(q_start, sigma_start, "joint_limit", kin.limit_message(i, side))
+    assert J is not None  # the Newton loop runs at least once
     sigma = _sigma_min(J, settings)
     if sigma < eps and sigma < sigma_start * (1.0 - 1e-9) - 1e-12:
         return _Attempt(q_start, sigma_start, "singularity", singularity_message(kin, q, settings))

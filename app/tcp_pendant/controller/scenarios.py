@@ -86,7 +86,7 @@ def _check_range(value: tuple[float, float], what: str, unit: str, upper: float)
 
 @dataclass(frozen=True)
 class Scenario:
-    """What the trainer chose (the defaults are the realistic ranges of issue 12).
+    """What the trainer chose (the defaults are realistic ranges).
 
     Attributes:
         kind: "off" (default), "bent_tool", "robot_accuracy" or "moved_reference".
@@ -325,7 +325,7 @@ def explain(world: ScenarioWorld | Scenario) -> str:
     """Plain words for after a result: the error, how it shows in the result, how the TCP check
     reveals it. Numbers when given a :class:`ScenarioWorld`. Escape before markdown."""
     w = world if isinstance(world, ScenarioWorld) else None
-    kind = world.scenario.kind if w is not None else world.kind
+    kind = world.scenario.kind if isinstance(world, ScenarioWorld) else world.kind
     if kind == "bent_tool":
         what = "The tool was bent in a crash"
         if w is not None and w.tool_bend is not None:

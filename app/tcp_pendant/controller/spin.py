@@ -59,7 +59,7 @@ __all__ = [
 DEFAULT_SPIN_ANGLE_DEG = 30.0
 MAX_SPIN_ANGLE_DEG = 90.0
 SpinAxis = Literal["A", "B", "C"]
-SPIN_AXES: dict[str, int] = {"A": 2, "B": 1, "C": 0}
+SPIN_AXES: dict[SpinAxis, int] = {"A": 2, "B": 1, "C": 0}
 """Spin axis -> index of the active TOOL frame axis it turns about (A: Z, B: Y, C: X)."""
 
 

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from typing import Any
+from typing import Protocol
 
 from tcp_pendant.controller import JogResult
 
@@ -32,7 +32,14 @@ HOLD_PERIOD_S = 0.05
 DEADMAN_S = 1.0
 """A held key stops when no hold message came for this long (s)."""
 
-Key = tuple[Any, int]
+Key = tuple[str | int, int]
+"""A jog key: (axis, sign), the axis a joint index or "X" .. "C"."""
+
+
+class Timer(Protocol):
+    """What ``schedule`` returns (an ``asyncio.TimerHandle``)."""
+
+    def cancel(self) -> None: ...
 
 
 class HoldDriver:
@@ -46,8 +53,8 @@ class HoldDriver:
         period_s, deadman_s: see the module constants.
     """
 
-    def __init__(self, step: Callable[[Any, int], JogResult | None],
-                 schedule: Callable[[float, Callable[[], None]], Any], *,
+    def __init__(self, step: Callable[[str | int, int], JogResult | None],
+                 schedule: Callable[[float, Callable[[], object]], Timer], *,
                  clock: Callable[[], float] = time.monotonic, period_s: float = HOLD_PERIOD_S,
                  deadman_s: float = DEADMAN_S) -> None:
         self._step = step
@@ -58,14 +65,14 @@ class HoldDriver:
         self.key: Key | None = None
         self._last_message = 0.0
         self._next_at = 0.0
-        self._timer: Any = None
+        self._timer: Timer | None = None
 
     @property
     def active(self) -> bool:
         """A key is being held (its ticks are scheduled)."""
         return self.key is not None
 
-    def held(self, axis: Any, sign: int) -> JogResult | None:
+    def held(self, axis: str | int, sign: int) -> JogResult | None:
         """A hold message of key ``(axis, sign)``: start moving (first tick now) or keep going.
         Another key's message takes over from the one held before."""
         now = self._clock()

@@ -26,6 +26,7 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 from enum import Enum
+from typing import Literal
 
 import numpy as np
 
@@ -50,7 +51,8 @@ CONTINUOUS = "Cont."
 INCREMENTS: tuple[str, ...] = (CONTINUOUS, "100", "10", "1", "0.1")
 """Increment choices as the pendant shows them (mm for X/Y/Z, deg for A/B/C and joints)."""
 JOG_FRAMES: tuple[str, ...] = tuple(f.value for f in JogFrame)
-CARTESIAN_AXES: tuple[str, ...] = ("X", "Y", "Z", "A", "B", "C")
+CartesianAxis = Literal["X", "Y", "Z", "A", "B", "C"]
+CARTESIAN_AXES: tuple[CartesianAxis, ...] = ("X", "Y", "Z", "A", "B", "C")
 LINEAR_SPEED_MM_S = 250.0
 ROTATION_SPEED_DEG_S = 30.0
 JOINT_SPEED_DEG_S = 30.0
@@ -199,7 +201,7 @@ class Jogger:
             return c.T_world_flange()[:3, :3]
         return c.T_world_tcp()[:3, :3]
 
-    def _translate(self, ax: str, amount_mm: float) -> JogResult:
+    def _translate(self, ax: CartesianAxis, amount_mm: float) -> JogResult:
         """A translation of ``amount_mm`` along axis ``ax`` of the jog frame, stopped at contact
         (module docstring)."""
         c = self.controller

@@ -23,6 +23,7 @@ from tcp_pendant.views.scene import SceneView
 from tcp_pendant.views.tool_panel import ToolPanel
 from tcp_pendant.views.touch_list import TouchListView
 from tcp_pendant.views.wizard_dock import WizardDock
+from tcp_pendant.views.gui_util import target_of
 
 __all__ = [
     "BeamCheckView",
@@ -60,8 +61,8 @@ def session_view_steps(session: Session, *, title: str = "TCP Pendant") -> Itera
     half-built session. Closing the generator early (the browser left) leaves the context
     managers properly; the caller closes the session.
     """
-    with session.lock, session.target.atomic():
-        gui = session.target.gui
+    with session.lock, target_of(session).atomic():
+        gui = target_of(session).gui
         scene = session.views["scene"] = SceneView(session)
         player = session.views["beam_player"] = ScanPlayer(session, stand=scene.beam_stand)
         scene.player = player

@@ -1,4 +1,4 @@
-"""The Tool tab's TCP service with the beam sensor (issue 14 item 4): "Check with beam" measures
+"""The Tool tab's TCP service with the beam sensor: "Check with beam" measures
 the ACTIVE tool's TCP now, "Update" writes the measured TCP into the library.
 
 The industrial loop after a crash: the tool is bent, "Check with beam" finds the deviation
@@ -22,8 +22,11 @@ from __future__ import annotations
 
 import asyncio
 import logging
+from collections.abc import Iterable
 from concurrent.futures import ThreadPoolExecutor
-from typing import Any
+from typing import TYPE_CHECKING
+
+import numpy as np
 
 from tcp_pendant.calibrate.beam_service import (
     BeamCheck,
@@ -37,7 +40,12 @@ from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.beam_replay import ScanPlayer, beam_view_direction, scan_spheres
 from tcp_pendant.views.framing import Framing
 from tcp_pendant.views.scene import frame_cameras
+from tcp_pendant.views.gui_util import ButtonEvent, target_of
 from tcpcal.tool import Tool
+
+if TYPE_CHECKING:
+    from tcp_pendant.controller.beam_scan import BeamScan
+    from tcp_pendant.wizards.beam import RecordedScan
 
 __all__ = ["BeamCheckView", "update_markdown"]
 
@@ -50,7 +58,7 @@ INTRO = ("The robot moves the ACTIVE tool through the beam sensor by itself and 
          "After a crash: **Check with beam**, then **Update** stores the measured TCP.")
 
 
-def _fmt3(v: Any) -> str:
+def _fmt3(v: Iterable[float]) -> str:
     return ", ".join(f"{0.0 if abs(float(x)) < 5e-4 else float(x):.3f}" for x in v)
 
 
@@ -68,7 +76,7 @@ class BeamCheckView:
     def __init__(self, session: Session, player: ScanPlayer) -> None:
         self.session = session
         self.player = player
-        gui = session.target.gui
+        gui = target_of(session).gui
         with gui.add_folder("TCP service (beam sensor)"):
             self.intro_md = gui.add_markdown(INTRO)
             self.check = gui.add_button("Check with beam", color="blue",
@@ -81,7 +89,7 @@ class BeamCheckView:
         self._checking = False
         self.last_check: BeamCheck | None = None
         """The last check's result (None before one, and after its Update)."""
-        self._q_before: Any = None
+        self._q_before: np.ndarray | None = None
         self.framing: Framing | None = None
         """The camera framing of the last check's scan (None before one), for tests."""
         self.check.on_click(self._on_check)
@@ -108,7 +116,7 @@ class BeamCheckView:
         self.replay.disabled = self._checking or self.last_check is None
 
     # ------------------------------------------------------------ Check with beam
-    async def _on_check(self, _event: Any) -> None:
+    async def _on_check(self, _event: ButtonEvent) -> None:
         try:
             await self.run_check()
         except Exception as exc:           # a browser's click must never kill the server
@@ -162,7 +170,7 @@ class BeamCheckView:
             self.frame_scan(check.scan)
         s.notify("Beam check done", f"{check.tool_name}: deviation {check.deviation_norm_mm:.3f} mm", kind="info")
 
-    def frame_scan(self, scan: Any) -> None:
+    def frame_scan(self, scan: BeamScan | RecordedScan) -> None:
         """Turn the session's camera(s) to the beam sensor, the scan's events and the flange
         there, seen across the beam (as the wizard's result is framed)."""
         if not len(scan.events):
@@ -182,7 +190,7 @@ class BeamCheckView:
         s.notify(title, body, kind=kind)
 
     # ------------------------------------------------------------ Update
-    def _on_update(self, _event: Any) -> None:
+    def _on_update(self, _event: ButtonEvent) -> None:
         s = self.session
         check = self.last_check
         if check is None:
@@ -202,7 +210,7 @@ class BeamCheckView:
         s.notify("TCP updated", f"Slot {check.slot}: {tool.name} now has the TCP the beam measured.",
                  kind="success")
 
-    def _on_replay(self, _event: Any) -> None:
+    def _on_replay(self, _event: ButtonEvent) -> None:
         check = self.last_check
         player = self.player
         if check is None:

@@ -1,4 +1,4 @@
-"""Replaying a beam scan in the 3D scene (issue 14): the robot goes through the scan's moves, the
+"""Replaying a beam scan in the 3D scene: the robot goes through the scan's moves, the
 beam turns red while the tool breaks it, a marker stays where each event met the beam.
 
 :func:`replay_frames` is pure: from a ``BeamScan`` (``controller.beam_scan``: its ``moves``
@@ -28,12 +28,19 @@ import asyncio
 import logging
 import threading
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+import viser
 
 from tcp_pendant.session import Session
-from tcp_pendant.views.beam_stand import BROKEN_RGB
+from tcp_pendant.views.beam_stand import BROKEN_RGB, BeamStandNodes
+from tcp_pendant.views.gui_util import target_of
+
+if TYPE_CHECKING:
+    from tcp_pendant.controller.beam import BeamEvent
+    from tcp_pendant.controller.beam_scan import BeamScan, ScanMove
+    from tcp_pendant.wizards.beam import RecordedScan, ScanEvent
 
 __all__ = ["BROKEN_RGB", "ReplayFrame", "ScanPlayer", "beam_view_direction", "event_points_world", "replay_frames",
            "scan_spheres"]
@@ -65,7 +72,7 @@ class ReplayFrame:
     shown: tuple[int, ...]
 
 
-def _event_fraction(move: Any, event: Any) -> tuple[float, float, float]:
+def _event_fraction(move: ScanMove, event: BeamEvent | ScanEvent) -> tuple[float, float, float]:
     """(fraction of the move where the event was recorded, where the beam broke, where it was
     clear again) along the move's straight flange line; the exit is 1 for a tip event (the
     tip stays in the beam until the next move pulls it out)."""
@@ -87,19 +94,19 @@ def _event_fraction(move: Any, event: Any) -> tuple[float, float, float]:
     return f, entry, exit_
 
 
-def _flange(event: Any) -> np.ndarray:
+def _flange(event: BeamEvent | ScanEvent) -> np.ndarray:
     """The event's flange pose without the recording noise when it has one (a live
     ``BeamEvent``), else the recorded one (a stored scan's event)."""
     T = getattr(event, "T_world_flange_exact", None)
     return np.asarray(event.T_world_flange if T is None else T, dtype=float)
 
 
-def _move_seconds(move: Any) -> float:
+def _move_seconds(move: ScanMove) -> float:
     speed = float(move.speed_mm_s)
     return float(move.length_m) * 1000.0 / speed if speed > 0 else 0.0
 
 
-def replay_frames(scan: Any, *, max_frames: int = MAX_FRAMES, hold_frames: int = HOLD_FRAMES,
+def replay_frames(scan: BeamScan | RecordedScan, *, max_frames: int = MAX_FRAMES, hold_frames: int = HOLD_FRAMES,
                   return_to: np.ndarray | None = None) -> tuple[ReplayFrame, ...]:
     """The film of ``scan`` (see the module docstring).
 
@@ -120,7 +127,7 @@ def replay_frames(scan: Any, *, max_frames: int = MAX_FRAMES, hold_frames: int =
         scan (no moves and no end joints: nothing to play).
     """
     moves = tuple(getattr(scan, "moves", ()))
-    events = tuple(scan.events)
+    events: tuple[BeamEvent | ScanEvent, ...] = tuple(scan.events)
     if not moves and getattr(scan, "q_end_rad", None) is None:
         return ()
     q_end = np.asarray(scan.q_end_rad, dtype=float)
@@ -171,11 +178,11 @@ def _on_beam(point: np.ndarray, b: np.ndarray, u: np.ndarray) -> np.ndarray:
     return b + float((point - b) @ u) * u
 
 
-def event_points_world(scan: Any, points: Any = None) -> np.ndarray:
+def event_points_world(scan: BeamScan | RecordedScan, points: Any = None) -> np.ndarray:
     """(N, 3) where each event met its beam (WORLD, m), projected onto the event's beam line:
     ``points`` (N, 3) if given, else the scan's point for the event (``BeamScan.tip_world_m(i)``:
     where the physical tool met the beam), else (a stored scan) the flange's position."""
-    events = tuple(scan.events)
+    events: tuple[BeamEvent | ScanEvent, ...] = tuple(scan.events)
     out = np.zeros((len(events), 3))
     tip = getattr(scan, "tip_world_m", None)
     for i, ev in enumerate(events):
@@ -203,10 +210,10 @@ def beam_view_direction(beam_point: np.ndarray, beam_dir: np.ndarray) -> np.ndar
     return side + 0.35 * u * (1.0 if float(u @ b) >= 0.0 else -1.0) + np.array([0.0, 0.0, 0.5])
 
 
-def scan_spheres(scan: Any, points: Any = None) -> tuple[np.ndarray, np.ndarray]:
+def scan_spheres(scan: BeamScan | RecordedScan, points: Any = None) -> tuple[np.ndarray, np.ndarray]:
     """(centres, radii) in WORLD m of what a camera should show of a scan: the flange at each
     event (with room for the wrist), the event points, the beam and the fork below it."""
-    events = tuple(scan.events)
+    events: tuple[BeamEvent | ScanEvent, ...] = tuple(scan.events)
     b = np.asarray(events[0].beam_point, dtype=float)
     centres = [_flange(ev)[:3, 3] for ev in events]
     centres += [*event_points_world(scan, points), b, b - [0.0, 0.0, 0.12]]
@@ -221,19 +228,19 @@ class ScanPlayer:
     rate_hz: float = 12.0
     """Frames per second of the replay (tests may raise it)."""
 
-    def __init__(self, session: Session, stand: Any = None) -> None:
+    def __init__(self, session: Session, stand: BeamStandNodes | None = None) -> None:
         self.session = session
         self.stand = stand
-        """The scene's beam stand (``views.beam_stand.BeamStand``: its beam turns red), or None."""
-        scene = session.target.scene
+        """The scene's beam stand (``views.beam_stand.BeamStandNodes``: its beam turns red), or None."""
+        scene = target_of(session).scene
         self.scene = scene
         self.break_point = scene.add_icosphere(f"{self.ROOT}/break_point", radius=0.005, color=BROKEN_RGB,
                                                visible=False, cast_shadow=False, receive_shadow=False)
-        self.markers: Any = None
+        self.markers: viser.PointCloudHandle | None = None
         """The event markers (a point cloud on the beam; None: none shown)."""
-        self.rays: Any = None
+        self.rays: viser.LineSegmentsHandle | None = None
         """Each shown event's ray, flange -> marker (line segments; None: none shown)."""
-        self._scan: Any = None
+        self._scan: BeamScan | RecordedScan | None = None
         self._points = np.zeros((0, 3))
         self._task: asyncio.Task[None] | None = None
         self._generation = 0
@@ -253,12 +260,13 @@ class ScanPlayer:
         return not self.done.is_set()
 
     @property
-    def scan(self) -> Any:
+    def scan(self) -> BeamScan | RecordedScan | None:
         """The scan on show (None: nothing shown)."""
         return self._scan
 
     # ------------------------------------------------------------ commands
-    def play(self, scan: Any, *, owner: object | None = None, return_to: np.ndarray | None = None,
+    def play(self, scan: BeamScan | RecordedScan, *, owner: object | None = None,
+             return_to: np.ndarray | None = None,
              points: Any = None) -> None:
         """Replay ``scan`` from its first move (on the loop: a task at :attr:`rate_hz`; off the
         loop: its last frame at once). A film already playing stops first. A stored scan (no
@@ -354,7 +362,7 @@ class ScanPlayer:
         self.frames_played = i + 1
         self._show(frame.broken_event, frame.shown)
 
-    def _stand(self) -> Any:
+    def _stand(self) -> BeamStandNodes | None:
         return self.stand
 
     def _show(self, broken: int | None, shown: tuple[int, ...]) -> None:
@@ -372,7 +380,8 @@ class ScanPlayer:
         else:
             if stand is not None:
                 stand.set_broken(int(getattr(scan.events[broken], "beam", 0)))
-            self.break_point.position = tuple(float(v) for v in self._points[broken])
+            x, y, z = (float(v) for v in self._points[broken])
+            self.break_point.position = (x, y, z)
             self.break_point.visible = True
         for h in (self.markers, self.rays):
             if h is not None:

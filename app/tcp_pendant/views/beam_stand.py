@@ -1,4 +1,4 @@
-"""The beam sensor's stand in the 3D scene (issue 14): a fork whose two posts carry the emitter
+"""The beam sensor's stand in the 3D scene: a fork whose two posts carry the emitter
 and the receiver, the beam a thin bright line between them.
 
 :func:`stand_geometry` is pure numpy: from a :class:`~tcp_pendant.controller.beam.BeamSensor`
@@ -18,9 +18,8 @@ turns red while it is broken (:meth:`BeamStandNodes.set_broken`, a scan's film).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
-
 import numpy as np
+import viser
 
 from tcp_pendant.controller.beam import BeamSensor
 from tcp_pendant.controller.rotations import quaternion_wxyz
@@ -144,13 +143,13 @@ class BeamStandNodes:
 
     ROOT = "/beam_sensor"
 
-    def __init__(self, scene: Any, sensor: BeamSensor | None) -> None:
+    def __init__(self, scene: viser.SceneApi, sensor: BeamSensor | None) -> None:
         self.scene = scene
-        self._nodes: list[Any] = []
+        self._nodes: list[viser.SceneNodeHandle] = []
         self.shown_key: bytes | None = None
         self.geometry: StandGeometry | None = None
-        self.beam_handle: Any = None
-        self.label: Any = None
+        self.beam_handle: viser.LineSegmentsHandle | None = None
+        self.label: viser.LabelHandle | None = None
         self.broken: int | None = None
         """The beam drawn red (broken; ``views.beam_replay``), or None."""
         self._shown_sensor: BeamSensor | None = None
@@ -193,7 +192,7 @@ class BeamStandNodes:
         s, root = self.scene, self.ROOT
         for box in g.boxes:
             self._nodes.append(s.add_box(f"{root}/{box.name}", color=box.rgb, dimensions=box.dimensions,
-                                         wxyz=quaternion_wxyz(box.R_world_box), position=box.centre,
+                                         wxyz=np.array(quaternion_wxyz(box.R_world_box)), position=box.centre,
                                          cast_shadow=False, receive_shadow=False))
         if g.column is not None:
             bottom, top = g.column

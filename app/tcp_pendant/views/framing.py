@@ -170,7 +170,7 @@ def spread_labels(framing: Framing, anchors: Mapping[str, np.ndarray],
     for name, anchor in anchors.items():
         p = np.asarray(anchor, dtype=float).reshape(3)
         xy, depth = framing.project(p)
-        xy, depth = xy[0].copy(), float(depth[0])
+        xy, px_depth = xy[0].copy(), float(depth[0])
         w, h = label_box_px(texts[name])
         start = xy[1]
         for _ in range(4 * len(anchors) + 4):
@@ -179,5 +179,5 @@ def spread_labels(framing: Framing, anchors: Mapping[str, np.ndarray],
                 break
             xy[1] = hit[1] + h + 1.0                    # just above the box it hit
         placed.append((xy, w))
-        out[name] = p + up * (xy[1] - start) * framing.metres_per_px(depth)
+        out[name] = p + up * (xy[1] - start) * framing.metres_per_px(px_depth)
     return out

@@ -1,4 +1,4 @@
-"""The name prompt of a classroom session: a modal that asks "Your name" (issue 11 item 1).
+"""The name prompt of a classroom session: a modal that asks "Your name".
 
 Shown to each browser of a per-browser server with a gradebook (``--shared`` has none). The
 modal holds a text field labelled **"Your name"** and a **Join the class** button; the name is
@@ -38,6 +38,7 @@ from typing import Any
 from tcp_pendant.classroom.names import TraineeNameError
 from tcp_pendant.session import Session
 from tcp_pendant.text_escape import escape_markdown
+from tcp_pendant.views.gui_util import ButtonEvent, set_value, target_of
 
 __all__ = ["HOLD_ATTRIBUTE", "FORGET_ATTRIBUTE", "IdentityPrompt", "KEY_ATTRIBUTE", "KEY_LABEL", "NAME_LABEL",
            "TOKEN_LABEL"]
@@ -80,13 +81,14 @@ class IdentityPrompt:
         self.name: str | None = None
         self._on_name = on_name
         self._on_token = on_token
-        gui = session.target.gui
+        gui = target_of(session).gui
         self.banner = gui.add_markdown("", order=-1000.0, visible=False)
         self.key_html: Any = None
+        self.marker_html: Any = None
         self._build("")
 
     def _build(self, marker: str) -> None:
-        gui = self.session.target.gui
+        gui = target_of(self.session).gui
         self.modal = gui.add_modal("Welcome to the TCP Pendant")
         with self.modal:
             gui.add_markdown("Type the name your trainer should see in the class list "
@@ -105,7 +107,7 @@ class IdentityPrompt:
         self.start.on_click(self.session.on_loop(self._start))
         self.open_trainer.on_click(self.session.on_loop(self._trainer))
 
-    def _start(self, _event: Any = None) -> None:
+    def _start(self, _event: ButtonEvent | None = None) -> None:
         if self.name is not None:
             return
         key = str(self.key_field.value or "")[:_MAX_KEY_CHARS]
@@ -114,7 +116,7 @@ class IdentityPrompt:
         except (TraineeNameError, ValueError) as exc:
             self.message.content = f"⚠ {escape_markdown(str(exc))}"
             return
-        self.key_field.value = ""
+        set_value(self.key_field, "")
         self.accepted(name, new_key)
 
     def accepted(self, name: str, new_key: str | None) -> None:
@@ -129,8 +131,8 @@ class IdentityPrompt:
                 raise ValueError("a browser key must be letters, digits, '-' and '_' only")
             if self.key_html is not None:
                 self.key_html.remove()
-            self.key_html = self.session.target.gui.add_html(f'<div hidden {KEY_ATTRIBUTE}="{new_key}"></div>',
-                                                             order=-1001.0)
+            self.key_html = target_of(self.session).gui.add_html(f'<div hidden {KEY_ATTRIBUTE}="{new_key}"></div>',
+                                                                 order=-1001.0)
 
     def reopen(self, message: str, *, forget: bool) -> None:
         """Show the welcome window again with ``message`` (plain text): the session is no longer
@@ -144,9 +146,9 @@ class IdentityPrompt:
         self._build(FORGET_ATTRIBUTE if forget else HOLD_ATTRIBUTE)
         self.message.content = f"⚠ {escape_markdown(message)}"
 
-    def _trainer(self, _event: Any = None) -> None:
+    def _trainer(self, _event: ButtonEvent | None = None) -> None:
         token = str(self.token_field.value)[:_MAX_TOKEN_CHARS]
-        self.token_field.value = ""
+        set_value(self.token_field, "")
         if not self._on_token(token):
             self.message.content = "⚠ That trainer token is not right; type the token the server printed."
             return

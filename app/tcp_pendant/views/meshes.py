@@ -52,8 +52,9 @@ def _part(name: str, mesh: trimesh.Trimesh, T: np.ndarray) -> MeshPart:
     m.apply_transform(T)
     rgb = (170, 174, 180)
     try:
-        color = np.asarray(m.visual.main_color)[:3]
-        rgb = (int(color[0]), int(color[1]), int(color[2]))
+        if isinstance(m.visual, trimesh.visual.ColorVisuals):   # a texture keeps the grey
+            color = np.asarray(m.visual.main_color)[:3]
+            rgb = (int(color[0]), int(color[1]), int(color[2]))
     except Exception:
         pass
     v = np.ascontiguousarray(m.vertices, dtype=np.float32)

@@ -27,9 +27,11 @@ from __future__ import annotations
 
 import asyncio
 import math
-from typing import Any
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+import viser
 
 from tcp_pendant.controller import JogResult
 from tcp_pendant.pendant import (
@@ -46,11 +48,15 @@ from tcp_pendant.pendant.hold import HoldDriver
 from tcp_pendant.pendant.guidance import CLOSEUP_WITHIN_MM, offset_markdown, side_view_markdown, tip_offset_mm
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.views.scene import closeup_camera, overview_camera
+from tcp_pendant.views.gui_util import ButtonEvent, ButtonGroupEvent, CheckboxEvent, set_value, target_of
+
+if TYPE_CHECKING:
+    from tcp_pendant.controller.pose_state import PoseState
 
 try:                                   # viser's message type (hot path); public setter if absent
     from viser._messages import GuiUpdateMessage
 except ImportError:                    # pragma: no cover
-    GuiUpdateMessage = None
+    GuiUpdateMessage = None  # type: ignore[assignment, misc]
 
 __all__ = ["HOLD_HZ", "KEYS_LINE", "MARK", "PendantPanel", "jog_key_hint", "marked", "set_markdown", "unmarked"]
 
@@ -92,7 +98,7 @@ def unmarked(label: str) -> str:
     return label[len(MARK):] if label.startswith(MARK) else label
 
 
-def set_markdown(handle: Any, text: str) -> None:
+def set_markdown(handle: viser.GuiMarkdownHandle, text: str) -> None:
     """``handle.content = text`` for the readouts, which change on every jog step.
 
     viser's public setter runs its generic prop machinery (type-hint casting that builds
@@ -103,7 +109,7 @@ def set_markdown(handle: Any, text: str) -> None:
     """
     if "![" not in text and GuiUpdateMessage is not None:
         try:
-            impl = handle._impl
+            impl: Any = handle._impl          # viser's internals: checked at run time (AttributeError)
             if not impl.removed:
                 object.__setattr__(handle, "_content", text)
                 if impl.props._markdown != text:
@@ -120,7 +126,7 @@ class PendantPanel:
 
     def __init__(self, session: Session) -> None:
         self.session = session
-        gui = session.target.gui
+        gui = target_of(session).gui
         c = session.controller
         k = c.kinematics
         self._from_client: dict[int, float] = {}   # slider -> angle (deg, 0.01) its browser value set
@@ -143,12 +149,12 @@ class PendantPanel:
                                                    + INCREMENT_KEYS)
 
         # compact keys: one row per axis (− and + side by side); clicks only
-        self.cart_rows: dict[str, Any] = {}
+        self.cart_rows: dict[str, viser.GuiButtonGroupHandle] = {}
         for r, ax in enumerate(CARTESIAN_AXES):
             row = gui.add_button_group(ax, (f"{ax} −", f"{ax} +"), hint=_with_keys(_AXIS_HINT[ax], r))
             row.on_click(session.on_loop(self._row_cb(ax)))
             self.cart_rows[ax] = row
-        self.joint_rows: list[Any] = []
+        self.joint_rows: list[viser.GuiButtonGroupHandle] = []
         for i, name in enumerate(k.joint_names):
             row = gui.add_button_group(name, (f"{name} −", f"{name} +"), visible=False,
                                        hint=_with_keys(f"jog {name} (deg)", i))
@@ -158,7 +164,7 @@ class PendantPanel:
         # hold-to-jog keys (continuous mode): viser reports holds of single buttons only
         self.cart_folder = gui.add_folder("Cartesian jog (hold)", visible=False)
         with self.cart_folder:
-            self.cart_buttons: dict[tuple[str, int], Any] = {}
+            self.cart_buttons: dict[tuple[str, int], viser.GuiButtonHandle] = {}
             for r, ax in enumerate(CARTESIAN_AXES):
                 for sign, sym in ((-1, "−"), (1, "+")):
                     b = gui.add_button(f"{ax} {sym}", hint=_with_keys(_AXIS_HINT[ax], r),
@@ -170,8 +176,8 @@ class PendantPanel:
 
         self.joint_folder = gui.add_folder("Joint jog", visible=False)
         with self.joint_folder:
-            self.joint_sliders: list[Any] = []
-            self.joint_buttons: dict[tuple[int, int], Any] = {}
+            self.joint_sliders: list[viser.GuiSliderHandle[float]] = []
+            self.joint_buttons: dict[tuple[int, int], viser.GuiButtonHandle] = {}
             q_deg = np.degrees(c.q_rad)
             for i, name in enumerate(k.joint_names):
                 lo, hi = math.degrees(k.lower_rad[i]), math.degrees(k.upper_rad[i])
@@ -228,7 +234,7 @@ class PendantPanel:
             self.render(change.state)
 
     # ------------------------------------------------------------ wiring
-    def _wire_key(self, button: Any, axis: str | int, sign: int) -> None:
+    def _wire_key(self, button: viser.GuiButtonHandle, axis: str | int, sign: int) -> None:
         """Click and hold of a jog key, on viser's event loop like every callback
         (:meth:`Session.on_loop`): besides thread safety, that spares every jog tick a hand-over
         to viser's thread pool (a thread wake-up and GIL hand-over per tick: 10-30 % of a jog
@@ -274,14 +280,14 @@ class PendantPanel:
             self._hold.stop()
         self.session.release_jog()
 
-    def _row_cb(self, axis: str | int) -> Any:
+    def _row_cb(self, axis: str | int) -> Callable[[ButtonGroupEvent], None]:
         """Click on a compact key row: the value is the key's label ("X +", "A3 −")."""
-        def cb(event: Any) -> None:
+        def cb(event: ButtonGroupEvent) -> None:
             sign = 1 if str(event.target.value).endswith("+") else -1
             self._jog(axis, sign, hold_tick=False)
         return cb
 
-    def _on_readout_frame(self, event: Any) -> None:
+    def _on_readout_frame(self, event: ButtonGroupEvent) -> None:
         value = unmarked(str(event.target.value))
         if value not in ("WORLD", "BASE"):
             raise ValueError(f"Unknown readout frame {value!r}; use WORLD or BASE.")
@@ -289,7 +295,7 @@ class PendantPanel:
         self.readout_frame.options = marked(("WORLD", "BASE"), value)
         self.render()
 
-    def _on_hide_distance(self, event: Any) -> None:
+    def _on_hide_distance(self, event: CheckboxEvent | None) -> None:
         if event is not None and getattr(event, "client", 1) is None:
             return                                   # our own assignment
         self.session.set_hide_distance(bool(self.hide_distance.value))
@@ -349,10 +355,10 @@ class PendantPanel:
         where = "joints" if joint else f"{st.frame} frame"
         self._set_md(self.settings_md, "settings", f"{st.mode.value} jog in {where}, {step}, override {st.override_pct:.0f} %")
 
-    def _on_home(self, _event: Any) -> None:
+    def _on_home(self, _event: ButtonEvent) -> None:
         self.session.ready()
 
-    def _on_kuka_home(self, _event: Any) -> None:
+    def _on_kuka_home(self, _event: ButtonEvent) -> None:
         self.session.home()
 
     def _on_camera(self, close: bool) -> Any:
@@ -372,13 +378,13 @@ class PendantPanel:
             self.session.notify("Jog stopped", res.message, kind="warning")
         self._last_stop = text
 
-    def _set_md(self, handle: Any, key: str, text: str) -> None:
+    def _set_md(self, handle: viser.GuiMarkdownHandle, key: str, text: str) -> None:
         """Send ``text`` unless it is what ``handle`` shows already."""
         if self._last_text.get(key) != text:
             set_markdown(handle, text)
             self._last_text[key] = text
 
-    def render(self, state: Any = None) -> None:
+    def render(self, state: PoseState | None = None) -> None:
         """Readouts, touch indicator and joint sliders from the session's pose state (``state``:
         the change signal's; None: the session's now; no feedback); only texts and slider
         values that changed are sent, and a slider whose joint is still where the browser's own
@@ -390,7 +396,7 @@ class PendantPanel:
         self._set_md(self.tcp_md, "tcp", tcp_readout_markdown(state.readout(frame), None if tool is None else tool.name))
         hide = s.hide_distance
         if bool(self.hide_distance.value) != hide:
-            self.hide_distance.value = hide
+            set_value(self.hide_distance, hide)
         touch = touch_indicator_markdown(state.touch, hide_distance=hide)
         closeup = ""
         if not hide:
@@ -415,4 +421,4 @@ class PendantPanel:
                     continue                        # the browser's own value: no echo
                 del self._from_client[i]            # moved since by a jog, Home, the gizmo ...
             if slider.value != value:               # a joint jog moves one slider: one update
-                slider.value = value
+                set_value(slider, value)

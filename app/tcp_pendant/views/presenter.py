@@ -1,4 +1,4 @@
-"""Presenter mode (issue 11 item 6): the lecture's view of a pendant, readable on a projector.
+"""Presenter mode: the lecture's view of a pendant, readable on a projector.
 
 A "Presenter mode" checkbox on top of the panel (per session; in ``--shared`` mode the shared
 GUI's, so every browser follows it; ``tcp-pendant --presenter`` starts with it on) shows the
@@ -22,7 +22,7 @@ degrees on screen.
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import TYPE_CHECKING, Any, TypedDict
 
 import numpy as np
 
@@ -30,6 +30,13 @@ from tcp_pendant.calibrate import error_bars
 from tcp_pendant.controller.readout import PoseReadout
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.text_escape import escape_html, escape_markdown
+from tcp_pendant.views.gui_util import CheckboxEvent, target_of
+
+if TYPE_CHECKING:
+    import viser
+    from viser import uplot
+
+    from tcp_pendant.controller.pose_state import PoseState
 
 __all__ = [
     "CHART_HEIGHT_PX",
@@ -52,7 +59,13 @@ PRESENTER_WIDTH_PX = 320
 """Panel width in presenter mode (viser's "medium"): 31 % of a 1024 px projector."""
 NORMAL_WIDTH_PX = 384
 """Panel width otherwise (viser's "large", as ``PendantApp.start`` sets it)."""
-_THEME = {"dark_mode": False, "show_logo": False, "show_share_button": False}   # as PendantApp.start
+class _Theme(TypedDict):
+    dark_mode: bool
+    show_logo: bool
+    show_share_button: bool
+
+
+_THEME: _Theme = {"dark_mode": False, "show_logo": False, "show_share_button": False}   # as PendantApp.start
 
 
 def _num(value: float, decimals: int = 2) -> str:
@@ -108,8 +121,8 @@ def presenter_steps_markdown(wizard: Any | None, *, font_px: int = STEPS_FONT_PX
             f"<u>{title}</u><br>" + "<br>".join(lines) + "</div>")
 
 
-def _chart_series() -> tuple[dict[str, Any], ...]:
-    no_points = {"show": False}
+def _chart_series() -> tuple[uplot.Series, ...]:
+    no_points: uplot.Series_Points = {"show": False}
     return ({"label": "touch"},
             {"label": "error (mm)", "stroke": "#3b6fd6", "fill": "rgba(59,111,214,0.55)", "width": 2,
              "points": no_points},
@@ -132,7 +145,7 @@ class PresenterView:
 
     def __init__(self, session: Session, *, on: bool = False) -> None:
         self.session = session
-        gui = session.target.gui
+        gui = target_of(session).gui
         self.toggle = gui.add_checkbox("Presenter mode", bool(on), order=-950.0,
                                        hint="Large readout, step list and error chart for a projector.")
         self.folder = gui.add_folder("Presenter", order=-949.0, visible=bool(on))
@@ -160,14 +173,14 @@ class PresenterView:
         return bool(self.toggle.value)
 
     # ------------------------------------------------------------ callbacks
-    def _on_toggle(self, _event: Any = None) -> None:
+    def _on_toggle(self, _event: CheckboxEvent | None = None) -> None:
         on = self.on
         self.folder.visible = on
         self._apply_width(on)
         self.render()
 
     def _apply_width(self, on: bool) -> None:
-        gui = self.session.target.gui
+        gui = target_of(self.session).gui
         self.panel_width_px = PRESENTER_WIDTH_PX if on else NORMAL_WIDTH_PX
         gui.configure_theme(control_width="medium" if on else "large", **_THEME)
         panel = getattr(gui, "main_panel", None)
@@ -181,12 +194,12 @@ class PresenterView:
             self.render(change.state)
 
     # ------------------------------------------------------------ render
-    def _set(self, handle: Any, key: str, text: str) -> None:
+    def _set(self, handle: viser.GuiMarkdownHandle, key: str, text: str) -> None:
         if self._shown.get(key) != text:
             self._shown[key] = text
             handle.content = text
 
-    def render(self, state: Any = None) -> None:
+    def render(self, state: PoseState | None = None) -> None:
         """Show the session's state (nothing while presenter mode is off)."""
         if not self.on:
             return
@@ -208,7 +221,7 @@ class PresenterView:
         show = errors is not None and used is not None and len(errors) > 0
         if self.chart.visible != show:
             self.chart.visible = show
-        if not show or res is self._charted:
+        if not show or errors is None or used is None or res is self._charted:
             return
         self._charted = res
         bars = error_bars([i + 1 for i in used], errors, [i + 1 for i in getattr(res, "outliers", ())])

@@ -1,4 +1,4 @@
-"""The "Systematic error" panel of the Calibrate tab (training; issue 12 item 3).
+"""The "Systematic error" panel of the Calibrate tab (training).
 
 A trainer picks a systematic error for this pendant: Off (default), Bent tool, Robot accuracy
 or Moved reference tip (``controller.scenarios``), and a seed that draws its concrete errors.
@@ -16,6 +16,7 @@ from typing import Any
 from tcp_pendant.controller.scenarios import DEFAULT_SEED_RANGE, SCENARIO_KINDS, explain
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.text_escape import escape_markdown
+from tcp_pendant.views.gui_util import set_value, target_of
 
 __all__ = ["SCENARIO_CHOICES", "ScenarioPanel", "scenario_markdown"]
 
@@ -49,7 +50,7 @@ class ScenarioPanel:
 
     def __init__(self, session: Session) -> None:
         self.session = session
-        gui = session.target.gui
+        gui = target_of(session).gui
         self.folder = gui.add_folder("Systematic error (training)", expand_by_default=False)
         with self.folder:
             labels = list(SCENARIO_CHOICES.values())
@@ -80,9 +81,9 @@ class ScenarioPanel:
         self.folder.visible = wf is None or bool(getattr(wf, "training", True))
         label = SCENARIO_CHOICES[s.scenario.kind]
         if self.kind.value != label:
-            self.kind.value = label
+            set_value(self.kind, label)
         if int(self.seed.value or 0) != int(s.scenario.seed):
-            self.seed.value = int(s.scenario.seed)
+            set_value(self.seed, int(s.scenario.seed))
         self.md.content = scenario_markdown(s)
 
     def _on_choose(self, event: Any) -> None:

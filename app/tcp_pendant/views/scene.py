@@ -38,12 +38,13 @@ import math
 from typing import Any
 
 import numpy as np
+import viser
 from scipy.spatial.transform import Rotation
 
 try:                                   # viser's message types (hot path); public setters if absent
     from viser import _messages
 except ImportError:                    # pragma: no cover
-    _messages = None
+    _messages = None  # type: ignore[assignment]
 
 from tcp_pendant.controller import ToolModel, reference_tip_model
 from tcp_pendant.controller.kinematics import urdf_links_and_tree
@@ -53,6 +54,7 @@ from tcp_pendant.views.beam_replay import ScanPlayer
 from tcp_pendant.views.beam_stand import BeamStandNodes
 from tcp_pendant.views.framing import Framing, frame_spheres
 from tcp_pendant.views.meshes import MeshPart, link_meshes, rigid_meshes
+from tcp_pendant.views.gui_util import target_of
 
 __all__ = ["POSE_EPS", "PoseSender", "SceneView", "camera_shape", "closeup_camera", "frame_cameras",
            "link_tree_paths", "overview_camera", "overview_pose", "relative_poses", "wxyz_xyz"]
@@ -187,11 +189,12 @@ def _set_pose(handle: Any, wxyz: list[float] | None, xyz: list[float] | None) ->
         n = 0
         if wxyz is not None:
             impl.wxyz[:] = wxyz
-            api._queue_scene_message(_messages.SetOrientationMessage(impl.name, tuple(wxyz)))
+            w, x, y, z = wxyz
+            api._queue_scene_message(_messages.SetOrientationMessage(impl.name, (w, x, y, z)))
             n += 1
         if xyz is not None:
             impl.position[:] = xyz
-            api._queue_scene_message(_messages.SetPositionMessage(impl.name, tuple(xyz)))
+            api._queue_scene_message(_messages.SetPositionMessage(impl.name, (xyz[0], xyz[1], xyz[2])))
             n += 1
         return n
     except AttributeError:                      # viser internals changed: public setters
@@ -208,7 +211,7 @@ def overview_pose(tip_world_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return target + OVERVIEW_OFFSET_M, target
 
 
-def overview_camera(client: Any, tip_world_m: np.ndarray) -> None:
+def overview_camera(client: viser.ClientHandle, tip_world_m: np.ndarray) -> None:
     """One browser's camera on the whole cell."""
     position, look_at = overview_pose(tip_world_m)
     with client.atomic():                    # position first: its setter shifts look_at
@@ -216,7 +219,7 @@ def overview_camera(client: Any, tip_world_m: np.ndarray) -> None:
         client.camera.look_at = look_at
 
 
-def camera_shape(client: Any) -> tuple[float, float, float]:
+def camera_shape(client: viser.ClientHandle) -> tuple[float, float, float]:
     """(fov rad, aspect, image height px) of a browser's camera; defaults before it reported."""
     try:
         cam = client.camera
@@ -225,7 +228,8 @@ def camera_shape(client: Any) -> tuple[float, float, float]:
         return math.radians(50.0), 16.0 / 9.0, 720.0
 
 
-def frame_cameras(clients: list[Any], centres: np.ndarray, radii: np.ndarray, **framing: Any) -> Framing:
+def frame_cameras(clients: list[viser.ClientHandle], centres: np.ndarray, radii: np.ndarray,
+                  **framing: Any) -> Framing:
     """Frame each browser's camera on the spheres (``framing.frame_spheres`` with that camera's
     shape and the ``framing`` options: ``direction``, ``margin``). Returns the first browser's
     framing (a default camera's when there is none)."""
@@ -241,7 +245,7 @@ def frame_cameras(clients: list[Any], centres: np.ndarray, radii: np.ndarray, **
     return framings[0] if framings else frame_spheres(centres, radii, **framing)
 
 
-def closeup_camera(client: Any, tip_world_m: np.ndarray) -> None:
+def closeup_camera(client: viser.ClientHandle, tip_world_m: np.ndarray) -> None:
     """One browser's close-up camera on the reference tip (fine approach)."""
     tip = np.asarray(tip_world_m, dtype=float)
     with client.atomic():                    # position first: its setter shifts look_at
@@ -249,12 +253,12 @@ def closeup_camera(client: Any, tip_world_m: np.ndarray) -> None:
         client.camera.look_at = tip
 
 
-def _add_parts(scene: Any, parent: str, parts: tuple[MeshPart, ...], *, opacity: float | None = None) -> list[Any]:
+def _add_parts(scene: viser.SceneApi, parent: str, parts: tuple[MeshPart, ...], *,
+               opacity: float | None = None) -> list[viser.MeshHandle]:
     out = []
     for i, p in enumerate(parts):
-        kw = {} if opacity is None else {"opacity": opacity}
         out.append(scene.add_mesh_simple(f"{parent}/mesh_{i}", p.vertices, p.faces, color=p.rgb,
-                                         flat_shading=False, **kw))
+                                         flat_shading=False, opacity=opacity))
     return out
 
 
@@ -270,7 +274,7 @@ class SceneView:
         self.player: ScanPlayer | None = None
         """The session's scan film (set once the views are built): the scene steps aside while it plays."""
         c = session.controller
-        scene = session.target.scene
+        scene = target_of(session).scene
         self.scene = scene
         k = c.kinematics
         self.flange_link = k.flange_link
@@ -290,7 +294,7 @@ class SceneView:
         state = session.pose_state()
         tree = link_tree_paths(k.description, state.link_names)
         self.link_paths: dict[str, str] = {name: path for name, (path, _) in tree.items()}
-        self.link_frames: dict[str, Any] = {}
+        self.link_frames: dict[str, viser.FrameHandle] = {}
         self._parent = {name: parent for name, (_, parent) in tree.items()}
         # posed nodes: every link but the root (the sender skips those that did not move), then
         # the gizmo; rows of (node, parent) in [links..., T_world_tcp, identity] (render)
@@ -420,24 +424,24 @@ class SceneView:
         self._tip_frame.position = xyz
         self._tip_label.position = tuple(c.reference_tip_world_m + [0.0, 0.0, -0.06])
 
-    def tool_labels(self) -> dict[str, Any]:
+    def tool_labels(self) -> dict[str, viser.LabelHandle]:
         """The labels at the tool and the tip: FLANGE (in the flange frame), TOOL (in the active
         TOOL frame), "reference tip" (WORLD); the wizards' scene places them apart after a result."""
         return {"flange": self._flange_label, "tool": self._active_label, "tip": self._tip_label}
 
     # ------------------------------------------------------------ camera
-    def look_at_tip(self, client: Any) -> None:
+    def look_at_tip(self, client: viser.ClientHandle) -> None:
         """Close-up camera on the reference tip (fine approach) for one browser."""
         closeup_camera(client, self.session.controller.reference_tip_world_m)
 
-    def overview(self, client: Any) -> None:
+    def overview(self, client: viser.ClientHandle) -> None:
         """Camera on the whole cell."""
         overview_camera(client, self.session.controller.reference_tip_world_m)
 
     overview_pose = staticmethod(overview_pose)
 
     # ------------------------------------------------------------ gizmo
-    def _on_gizmo(self, event: Any) -> None:
+    def _on_gizmo(self, event: viser.TransformControlsEvent) -> None:
         """A drag of the gizmo (on viser's event loop, under the session guard).
 
         Drag updates are coalesced: the first one queues a move with ``call_soon``, which runs

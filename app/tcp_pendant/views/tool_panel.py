@@ -9,12 +9,12 @@ session's commands (``Session.mount_tool`` / ``activate`` / ``deactivate``): thi
 (in ``--shared`` mode Activate also sets the library's active slot, the shared start tool);
 the panel re-renders the mounted tool and the active data on the session's ``tool`` change.
 
-Check (TCP check, spin test; issue 12): "Check" turns the selected library tool (or "Check
+Check (TCP check, spin test): "Check" turns the selected library tool (or "Check
 active tool": the active data) about its TCP by +-A, +-B, +-C at the chosen angle and shows how
 far the TRUE tip moves per rotation and the implied TCP error (``views.tool_check``; the six
 rotations run in a worker thread on a copy of the robot model, the robot does not move).
 
-Controller files (issue 12 item 5): "Download file" renders the selected tool as a whole
+Controller files: "Download file" renders the selected tool as a whole
 controller file of the chosen format (``tcpcal.controllers.export_tool_file``, tool number =
 the slot, as ``tcpcal tools export SLOT --format F --output FILE``) and sends it to the browser
 that clicked; a refusal (e.g. ABB's reserved ``tool0``) is one notification.
@@ -27,17 +27,27 @@ from __future__ import annotations
 
 import asyncio
 import logging
-from collections.abc import Callable
+from collections.abc import Callable, Coroutine
 from concurrent.futures import ThreadPoolExecutor
 from typing import Any
+
+import viser
 
 from tcp_pendant.controller import builtin_tools
 from tcp_pendant.pendant import FIELDS, ToolEntry, parse_tool_entry, tool_data_markdown
 from tcp_pendant.pendant.tool_entry import entry_preview_markdown
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.text_escape import escape_markdown
-from tcp_pendant.controller.spin import DEFAULT_SPIN_ANGLE_DEG, MAX_SPIN_ANGLE_DEG
-from tcp_pendant.views.gui_util import number_of_option, set_options, slot_option
+from tcp_pendant.controller.spin import DEFAULT_SPIN_ANGLE_DEG, MAX_SPIN_ANGLE_DEG, SpinCheckResult
+from tcp_pendant.views.gui_util import (
+    ButtonEvent,
+    DropdownEvent,
+    number_of_option,
+    set_options,
+    set_value,
+    slot_option,
+    target_of,
+)
 from tcp_pendant.views.tool_check import CheckJob, check_job, check_markdown
 from tcpcal.controllers import CONTROLLER_FORMATS, export_tool_file
 from tcpcal.errors import TcpcalError
@@ -76,7 +86,7 @@ class ToolPanel:
 
     def __init__(self, session: Session) -> None:
         self.session = session
-        gui = session.target.gui
+        gui = target_of(session).gui
         c = session.controller
         self._tools = builtin_tools()
         self._tool_key_by_label = {t.label: key for key, t in self._tools.items()}
@@ -114,8 +124,8 @@ class ToolPanel:
         with gui.add_folder("Enter tool numerically", expand_by_default=False):
             self.entry_name = gui.add_text("Name", "")
             self.entry_name_err = gui.add_markdown("", visible=False)
-            self.entry_fields: dict[str, Any] = {}
-            self.entry_errors: dict[str, Any] = {}
+            self.entry_fields: dict[str, viser.GuiTextHandle] = {}
+            self.entry_errors: dict[str, viser.GuiMarkdownHandle] = {}
             for f in FIELDS:
                 unit = "mm" if f in "XYZ" else "deg"
                 self.entry_fields[f] = gui.add_text(f"{f} ({unit})", "0")
@@ -137,7 +147,7 @@ class ToolPanel:
         self.check.on_click(self._check_callback(self._selected_for_check))
         self.check_active.on_click(self._check_callback(self._active_for_check))
         self._checking = False
-        self.last_check: tuple[CheckJob, Any] | None = None
+        self.last_check: tuple[CheckJob, SpinCheckResult] | None = None
         self.entry_save.on_click(g(self._on_entry_save))
         for handle in (self.entry_name, *self.entry_fields.values()):
             handle.on_update(g(lambda _e: self._show_entry_preview()))
@@ -185,7 +195,7 @@ class ToolPanel:
         self.slots.options = options
         pick = next((o for o in options if number_of_option(o) == current), options[0])
         if self.slots.value != pick:
-            self.slots.value = pick
+            set_value(self.slots, pick)
         free = [str(n) for n in range(1, s.library.N_SLOTS + 1) if n not in lib]
         set_options(self.entry_slot, ("first free", *free))
         self._show_slot()
@@ -216,28 +226,28 @@ class ToolPanel:
     def _show_mounted(self) -> None:
         label = self.session.controller.mounted_tool.label
         if label in self._tool_key_by_label and self.mounted.value != label:
-            self.mounted.value = label              # its own handler then sees no change
+            set_value(self.mounted, label)              # its own handler then sees no change
 
     def _show_active(self) -> None:
         self.active_md.content = tool_data_markdown(self.session.controller.active_tool, self.session.active_slot)
 
     # ------------------------------------------------------------ callbacks
-    def _on_mount(self, event: Any) -> None:
+    def _on_mount(self, event: DropdownEvent) -> None:
         key = self._tool_key_by_label.get(str(event.target.value))
         if key is None:
             raise ValueError(f"Unknown tool {event.target.value!r}.")
         if key != self.session.controller.mounted_tool.key:
             self.session.mount_tool(self._tools[key])
 
-    def _on_activate(self, _event: Any) -> None:
+    def _on_activate(self, _event: ButtonEvent) -> None:
         slot, _ = self._selected()
         tool = self.session.activate(slot)
         self.session.notify("Tool activated", f"{slot}: {tool.name}", kind="success")
 
-    def _on_deactivate(self, _event: Any) -> None:
+    def _on_deactivate(self, _event: ButtonEvent) -> None:
         self.session.deactivate()
 
-    def _on_rename(self, _event: Any) -> None:
+    def _on_rename(self, _event: ButtonEvent) -> None:
         slot, tool = self._selected()
         name = str(self.new_name.value).strip()
         if not name:
@@ -248,14 +258,14 @@ class ToolPanel:
             if s.client is not None:
                 # a courtesy, per browser only: in --shared mode the box is every browser's, and
                 # another trainee may be typing in it
-                self.new_name.value = ""
+                set_value(self.new_name, "")
 
-    def _on_delete(self, _event: Any) -> None:
+    def _on_delete(self, _event: ButtonEvent) -> None:
         slot, tool = self._selected()
         self.session.delete_tool(slot)
         self.session.notify("Tool deleted", f"{slot}: {tool.name}")
 
-    def _on_export(self, _event: Any) -> None:
+    def _on_export(self, _event: ButtonEvent) -> None:
         slot, tool = self._selected()
         label = str(self.export_fmt.value)
         fmt = next((f for f in FORMATS if text_format(f).label == label), None)
@@ -263,9 +273,9 @@ class ToolPanel:
             raise ValueError(f"Unknown export format {label!r}.")
         number = text_format(fmt).slot_for(slot)  # the controller's tool numbers, else its default
         kw = {} if number is None else {"slot": number}
-        self.export_text.value = export_tool(tool, fmt, **kw)
+        set_value(self.export_text, export_tool(tool, fmt, **kw))
 
-    def _on_download(self, event: Any) -> None:
+    def _on_download(self, event: ButtonEvent) -> None:
         slot, tool = self._selected()
         try:
             filename, text = controller_file(tool, slot, str(self.file_fmt.value))
@@ -273,7 +283,7 @@ class ToolPanel:
             self.session.notify(CONTROLLER_FILE_REFUSED, str(exc), kind="warning")
             return
         # to the browser that clicked (in --shared mode the session is every browser's)
-        target = getattr(event, "client", None) or self.session.client or self.session.target
+        target = event.client or self.session.client or target_of(self.session)
         target.send_file_download(filename, text.encode("utf-8"), save_immediately=True)
 
     # ------------------------------------------------------------ TCP check
@@ -289,8 +299,9 @@ class ToolPanel:
         slot = self.session.active_slot
         return (tool.name if slot is None else f"slot {slot}: {tool.name}"), tool
 
-    def _check_callback(self, which: Callable[[], tuple[str, Tool]]) -> Callable[[Any], Any]:
-        async def callback(_event: Any) -> None:
+    def _check_callback(self, which: Callable[[], tuple[str, Tool]]
+                        ) -> Callable[[ButtonEvent], Coroutine[Any, Any, None]]:
+        async def callback(_event: ButtonEvent) -> None:
             await self.run_check(which)
         return callback
 
@@ -334,7 +345,7 @@ class ToolPanel:
         """Live line under the form: what Save would store, as this server has received it."""
         self.entry_preview.content = entry_preview_markdown(self._entry())
 
-    def _on_entry_save(self, _event: Any) -> None:
+    def _on_entry_save(self, _event: ButtonEvent) -> None:
         res = parse_tool_entry(self._entry())
         lib = self.session.library
         errors = dict(res.errors)
@@ -352,7 +363,7 @@ class ToolPanel:
             return
         self.session.store_tool(slot, res.tool)
         self.entry_md.content = f"✔ Saved **{escape_markdown(res.tool.name)}** in slot {slot}."
-        self.slots.value = slot_option(slot, res.tool.name)
+        set_value(self.slots, slot_option(slot, res.tool.name))
         self._show_slot()
 
     def _show_entry_errors(self, errors: dict[str, str]) -> None:

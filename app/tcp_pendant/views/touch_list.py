@@ -5,15 +5,16 @@ that clicked, ready for ``tcpcal solve xyz4``."""
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Coroutine, Sequence
 from typing import Any
 
 import numpy as np
+import viser
 from scipy.spatial.transform import Rotation
 
 from tcp_pendant.calibrate.text import empty_touches_markdown
 from tcp_pendant.session import Session, SessionChange, Touch
-from tcp_pendant.views.gui_util import set_content
+from tcp_pendant.views.gui_util import ButtonEvent, set_content, target_of
 
 __all__ = ["TOUCHES_FILENAME", "TouchListView", "touches_csv_text"]
 
@@ -48,7 +49,7 @@ class TouchListView:
 
     def __init__(self, session: Session) -> None:
         self.session = session
-        gui = session.target.gui
+        gui = target_of(session).gui
         self.record = gui.add_button("Record point", color="green", icon=None,
                                      hint="Store the current flange pose as a touch; key R.")
         self.folder = gui.add_folder("Touches")
@@ -56,7 +57,7 @@ class TouchListView:
             self.empty_md = gui.add_markdown("*No touch recorded.*")
             self.export_csv = gui.add_button("Export CSV", hint="The touches as POSES.csv with joint values "
                                              "(tcpcal solve xyz4), sent to this browser.")
-        self._rows: list[Any] = []
+        self._rows: list[viser.GuiMarkdownHandle | viser.GuiButtonHandle] = []
         self.record.on_click(session.on_loop(self._on_record))
         self.export_csv.on_click(session.on_loop(self._on_export_csv))
         session.subscribe(self.on_change)
@@ -78,18 +79,18 @@ class TouchListView:
             return
         set_content(self.empty_md, empty_touches_markdown(self.session.workflow.wizard))
 
-    def _on_record(self, _event: Any) -> None:
+    def _on_record(self, _event: ButtonEvent) -> None:
         t = self.session.record_touch()
         self.session.notify("Point recorded", t.label, kind="success")
 
-    def _on_export_csv(self, event: Any) -> None:
+    def _on_export_csv(self, event: ButtonEvent) -> None:
         data = touches_csv_text(self.session.touches).encode("utf-8")
         # to the browser that clicked (in --shared mode the session is every browser's)
-        target = getattr(event, "client", None) or self.session.client or self.session.target
+        target = event.client or self.session.client or target_of(self.session)
         target.send_file_download(TOUCHES_FILENAME, data, save_immediately=True)
 
-    def _delete_cb(self, index: int, label: str) -> Any:
-        def cb(_event: Any) -> None:
+    def _delete_cb(self, index: int, label: str) -> Callable[..., Coroutine[Any, Any, None]]:
+        def cb(_event: ButtonEvent) -> None:
             # the list may have changed since the button was drawn: delete by label
             labels = [t.label for t in self.session.touches]
             if label in labels:
@@ -98,7 +99,7 @@ class TouchListView:
 
     def rebuild(self) -> None:
         """Redraw the rows: one markdown line and one "Delete Pn" button per touch."""
-        gui = self.session.target.gui
+        gui = target_of(self.session).gui
         for h in self._rows:
             h.remove()
         self._rows = []

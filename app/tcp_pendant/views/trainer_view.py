@@ -1,5 +1,5 @@
-"""The trainer view (issue 11 item 3): the class's live table, the gradebook, a CSV download,
-settings pushed to every trainee, and releasing a name.
+"""The trainer view: the class's live table, the gradebook, a CSV download, settings pushed to
+every trainee, and releasing a name.
 
 "Release a name" lists the names a browser holds (``ClassRoom.held_names``); **Release name**
 forgets that name's browser key and sends a browser connected under it back to the welcome
@@ -27,6 +27,7 @@ from tcp_pendant.session import Session
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.upload_guard import limit_upload_size
 from tcp_pendant.wizards.session_record import MAX_RECORD_BYTES, SessionRecordError, check_record_size, load_and_replay
+from tcp_pendant.views.gui_util import ButtonEvent, UploadEvent, set_options, target_of
 
 log = logging.getLogger(__name__)
 _GRADE_WORKER = ThreadPoolExecutor(max_workers=1, thread_name_prefix="record-grading")
@@ -48,7 +49,9 @@ MAX_GRADE_ROWS = 50
 class ClassControl(Protocol):
     """What the trainer view needs of the server."""
 
-    tool_keys: Sequence[str]
+    @property
+    def tool_keys(self) -> Sequence[str]: ...
+
     gradebook: Gradebook
     exercise: str | None
 
@@ -122,7 +125,7 @@ class TrainerView:
     def __init__(self, session: Session, control: ClassControl) -> None:
         self.session = session
         self.control = control
-        gui = session.target.gui
+        gui = target_of(session).gui
         self.folder = gui.add_folder("Trainer view", order=-900.0)
         with self.folder:
             gui.add_markdown("**Trainees**")
@@ -162,13 +165,9 @@ class TrainerView:
         """Re-read the class and the gradebook."""
         self.trainees_md.content = trainees_markdown(self.control.trainee_statuses())
         self.grades_md.content = grades_markdown(self.control.grade_rows())
-        names = (NO_NAME, *self.control.held_names())     # plain option text, not markdown
-        if tuple(self.release_name.options) != names:
-            keep = self.release_name.value if self.release_name.value in names else NO_NAME
-            self.release_name.options = names
-            self.release_name.value = keep
+        set_options(self.release_name, (NO_NAME, *self.control.held_names()))   # option text, not markdown
 
-    def _release(self, _event: Any = None) -> None:
+    def _release(self, _event: ButtonEvent | None = None) -> None:
         name = str(self.release_name.value)
         if name == NO_NAME or name not in self.control.held_names():
             self.release_md.content = "Choose the name to release first."
@@ -176,7 +175,7 @@ class TrainerView:
         self.release_md.content = escape_markdown(self.control.release(name))
         self.render()
 
-    def _download(self, _event: Any = None) -> None:
+    def _download(self, _event: ButtonEvent | None = None) -> None:
         client = self.session.client
         if client is not None:
             client.send_file_download("grades.csv", self.control.grades_csv().encode("utf-8"))
@@ -185,7 +184,7 @@ class TrainerView:
         self.session.notify("Record not graded", f"{filename or 'The file'}: {size_bytes} bytes is more than "
                             f"{MAX_RECORD_BYTES} bytes; a session record is far smaller.", kind="warning")
 
-    async def _on_grade_upload(self, event: Any) -> None:
+    async def _on_grade_upload(self, event: UploadEvent) -> None:
         """The record's bytes are parsed, replayed and graded in ``_GRADE_WORKER`` (off the loop)."""
         if self.session.closed or getattr(event, "client", None) is None or self._grading:
             return
@@ -207,7 +206,7 @@ class TrainerView:
             self._grading = False
         self.session.guard(lambda: setattr(self.grade_md, "content", record_grades_markdown(name, grades)))()
 
-    def _push(self, _event: Any = None) -> None:
+    def _push(self, _event: ButtonEvent | None = None) -> None:
         exercise = EXERCISES.get(str(self.exercise.value))
         tool = None if self.tool.value == "(keep)" else str(self.tool.value)
         if tool is not None and tool not in self.control.tool_keys:

@@ -21,15 +21,18 @@ and the classroom recorder see it too. Every text from a wizard goes through the
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
-from typing import Any
+from collections.abc import Callable, Coroutine
+from typing import TYPE_CHECKING, Any
 
 from tcp_pendant.calibrate.text import meter_level, step_markdown
 from tcp_pendant.pendant.guidance import direction_words, tip_offset_mm
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.pendant.record_check import RecordCheck
 from tcp_pendant.session import Session, SessionChange
-from tcp_pendant.views.gui_util import set_content
+from tcp_pendant.views.gui_util import ButtonEvent, ButtonGroupEvent, set_content, set_value, target_of
+
+if TYPE_CHECKING:
+    from tcp_pendant.calibrate import CalibrationWorkflow
 
 __all__ = ["BACK", "CANCEL", "CLOSE", "FINISH", "NEXT", "WizardDock"]
 
@@ -44,7 +47,7 @@ class WizardDock:
         self.check = RecordCheck() if check is None else check
         self._note = ""                       # the last click's line, for this run and step only
         self._note_at: tuple[int, int, int] | None = None
-        gui = session.target.gui
+        gui = target_of(session).gui
         self.folder = gui.add_folder("Calibration step", visible=False)
         with self.folder:
             self.step_md = gui.add_markdown("")
@@ -63,7 +66,8 @@ class WizardDock:
         session.subscribe(self.on_change)
 
     # ------------------------------------------------------------ plumbing
-    def _action(self, fn: Callable[[Any], Any], *, sync: bool = False) -> Any:
+    def _action(self, fn: Callable[[Any], object], *,
+                sync: bool = False) -> Callable[..., Coroutine[Any, Any, None]]:
         s = self.session
 
         def run(event: Any) -> None:
@@ -87,7 +91,7 @@ class WizardDock:
         self._note, self._note_at = text, self._where()
 
     # ------------------------------------------------------------ callbacks
-    def _on_record(self, _event: Any) -> None:
+    def _on_record(self, _event: ButtonEvent) -> None:
         wf = self.session.workflow
         s = self.session
         state = s.pose_state()
@@ -104,7 +108,7 @@ class WizardDock:
         shown = "" if s.hide_distance else f", {state.touch.distance_mm:.2f} mm from the tip"
         self._say(f"✔ Step {index + 1 if index is not None else '?'} recorded{shown}.")
 
-    def _on_nav(self, event: Any) -> None:
+    def _on_nav(self, event: ButtonGroupEvent) -> None:
         s = self.session
         choice = str(event.target.value)
         self.check.clear()
@@ -136,7 +140,7 @@ class WizardDock:
         wiz = wf.wizard
         open_ = wiz is not None and wf.is_open
         self.folder.visible = open_
-        if not open_:
+        if wf is None or wiz is None or not open_:
             self._note, self._note_at = "", None
             return
         set_content(self.step_md, step_markdown(wiz))
@@ -154,6 +158,7 @@ class WizardDock:
             self.mount.label = f"Mount the {needed.label.lower()}"
         self.record.visible = stepping and not wiz.auto_role(wiz.step).by_controller   # a scan: no Record
         self.record.disabled = not wiz.can_record
+        options: tuple[str, ...]
         if stepping:
             options = (BACK, FINISH if wiz.on_last_step else NEXT, CANCEL)
         else:
@@ -165,14 +170,14 @@ class WizardDock:
     def update_meter(self) -> None:
         """The pose-diversity meter (the wizards that declare it: ``Wizard.meter_active``)."""
         wf = self.session.workflow
-        wiz: Any = wf.wizard
+        wiz: Any = wf.wizard  # a meter wizard (duck-typed: preview(), ...)
         show = wiz is not None and bool(wiz.meter_active)
         self.meter_bar.visible = self.meter_md.visible = show
         if not show:
             return
         gain = wiz.preview(self.session.controller.T_world_flange())
         value, color = meter_level(gain)
-        self.meter_bar.value = round(value, 1)
+        set_value(self.meter_bar, round(value, 1))
         self.meter_bar.color = color
         angle = gain.angle_to_nearest_deg
         if math.isinf(angle):

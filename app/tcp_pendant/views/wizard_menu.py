@@ -14,8 +14,8 @@ Built by ``tcp_pendant.views.calibrate.build_calibrate_tab`` for the session's w
   stored touches: they become its first steps, ``CalibrationWorkflow.start_from_touches``), and
   Resume for a calibration left half-way. It is hidden while a wizard is
   open, as on a pendant; Cancel (or Close, on a result) brings it back;
-* the open wizard's step panel (``wizard_steps``), its result panel (``wizard_result``) and
-  its scene nodes (``wizard_scene``);
+* the open wizard's step panel (``wizard_steps``), its result panel (``wizard_result``), its
+  worked equations ("The math", ``math_panel``) and its scene nodes (``wizard_scene``);
 * **Session record**: export the session (touches, wizards, results, errors) as JSON and load
   one back to replay it (how a trainer grades). A loaded file is bytes: refused above
   ``session_record.MAX_RECORD_BYTES`` as its transfer starts (``upload_guard``), then parsed and
@@ -51,8 +51,10 @@ from tcp_pendant.views.gui_util import (
     set_content,
     set_options,
     slot_option,
+    target_of,
 )
 from tcp_pendant.views.beam_replay import ScanPlayer
+from tcp_pendant.views.math_panel import MathView
 from tcp_pendant.views.upload_guard import limit_upload_size
 from tcp_pendant.views.wizard_result import WizardResultView
 from tcp_pendant.views.wizard_scene import WizardSceneView
@@ -98,7 +100,7 @@ class CalibrateView:
         self._library: dict[int, Tool] = {}
         self._library_pick: tuple[str, int | None] | None = None   # (option, active slot then)
         self._resume_runs: tuple[int, ...] = ()                    # the runs the Resume list offered
-        gui = session.target.gui
+        gui = target_of(session).gui
         tools = self.workflow.tools
         self._physical = {t.label: key for key, t in tools.items()}
 
@@ -136,6 +138,7 @@ class CalibrateView:
         self.new_physical = widgets.get("new_tool_key")
         self.steps = WizardStepsView(self)
         self.result = WizardResultView(self)
+        self.math = MathView(session)          # renders itself on the session's wizard signal
         with gui.add_folder("Session record", expand_by_default=False):
             self.export = gui.add_button("Export session (JSON)",
                                          hint="Touches, calibrations, results and errors, for grading.")
@@ -270,7 +273,8 @@ class CalibrateView:
         return None if slot is None else slot_option(slot, self._library[slot].name)
 
     def _selected_slot(self, widget: Any = None) -> int:
-        slot = number_of_option((widget or self.library_tool).value)
+        picked = widget or self.library_tool                     # None: the library is empty
+        slot = None if picked is None else number_of_option(picked.value)
         if slot is None:
             raise ValueError("The tool library is empty: calibrate the TCP first (XYZ 4-point) and save it.")
         return slot
@@ -302,7 +306,7 @@ class CalibrateView:
     def _on_export(self, event: Any) -> None:
         data = dumps(self.workflow.export_record(self.session.touches)).encode("utf-8")
         # to the browser that clicked (in --shared mode the session is every browser's)
-        target = getattr(event, "client", None) or self.session.client or self.session.target
+        target = getattr(event, "client", None) or self.session.client or target_of(self.session)
         target.send_file_download(SESSION_FILENAME, data, save_immediately=True)
         set_content(self.record_md, f"Exported {len(self.workflow.runs)} calibration(s) as {SESSION_FILENAME}.")
 

@@ -32,10 +32,14 @@ from tcp_pendant.calibrate.text import (
     warnings_markdown,
 )
 from tcp_pendant.views.gui_util import (
+    ButtonEvent,
+    DropdownEvent,
     number_of_option,
     set_content,
     set_options,
+    set_value,
     slot_option,
+    target_of,
 )
 from tcp_pendant.wizards import (
     ESTIMATOR_LABELS,
@@ -43,8 +47,11 @@ from tcp_pendant.wizards import (
     WizardStateError,
 )
 from tcpcal.library import ToolLibrary
+from tcpcal.tool import Tool
 
 if TYPE_CHECKING:
+    from viser import uplot
+
     from tcp_pendant.views.wizard_menu import CalibrateView
 
 __all__ = ["AUTO_SLOT", "WizardResultView", "slot_options"]
@@ -52,16 +59,16 @@ __all__ = ["AUTO_SLOT", "WizardResultView", "slot_options"]
 AUTO_SLOT = "same name, else first free"
 
 
-def slot_options(tools: dict[int, Any]) -> tuple[str, ...]:
+def slot_options(tools: dict[int, Tool]) -> tuple[str, ...]:
     """The Save slot list: automatic, then every slot with the tool it holds."""
     return (AUTO_SLOT, *(slot_option(s, tools[s].name if s in tools else "(empty)")
                          for s in range(1, ToolLibrary.N_SLOTS + 1)))
 
 
-def _chart_series(*, has_outliers: bool) -> tuple[dict[str, Any], ...]:
+def _chart_series(*, has_outliers: bool) -> tuple[uplot.Series, ...]:
     """uPlot series of the error bars: touch number, errors (blue), outliers (red, shown only
     when there are some), the mean (dashed); no point markers on the bar outlines."""
-    no_points = {"show": False}
+    no_points: uplot.Series_Points = {"show": False}
     return ({"label": "touch"},
             {"label": "error (mm)", "stroke": "#3b6fd6", "fill": "rgba(59,111,214,0.55)", "width": 1,
              "points": no_points},
@@ -75,7 +82,7 @@ class WizardResultView:
 
     def __init__(self, parent: CalibrateView) -> None:
         self.parent = parent
-        gui = parent.session.target.gui
+        gui = target_of(parent.session).gui
         self.folder = gui.add_folder("Result", visible=False)
         with self.folder:
             self.result_md = gui.add_markdown("")
@@ -129,31 +136,31 @@ class WizardResultView:
             return fn(wiz)
         self.parent.session.edit_result(edit)
 
-    def _on_drop(self, _event: Any) -> None:
+    def _on_drop(self, _event: ButtonEvent) -> None:
         self._with_estimators(lambda wiz: wiz.drop_outliers())
 
-    def _on_restore(self, _event: Any) -> None:
+    def _on_restore(self, _event: ButtonEvent) -> None:
         self._with_estimators(lambda wiz: wiz.restore_all())
 
-    def _on_estimator(self, event: Any) -> None:
+    def _on_estimator(self, event: DropdownEvent) -> None:
         key = estimator_options().get(str(event.target.value))
         if key is None:
             raise ValueError(f"Unknown estimator {event.target.value!r}.")
         self._with_estimators(lambda wiz: wiz.set_estimator(key))
 
-    def _on_save(self, _event: Any) -> None:
+    def _on_save(self, _event: ButtonEvent) -> None:
         slot, tool = self.parent.session.save_result(str(self.save_name.value),
                                                      number_of_option(self.save_slot.value))
         self.parent.saved(slot, tool)
 
-    def _on_check_tcp(self, _event: Any) -> None:
+    def _on_check_tcp(self, _event: ButtonEvent) -> None:
         wf = self.parent.workflow
         if wf.last_save is None:
             raise WizardStateError("Save the tool first: the TCP check works on a tool of the library.")
         self.parent.session.start_wizard("tcp-check", slot=wf.last_save[0])
 
     # ------------------------------------------------------------ render
-    def refresh_slots(self, tools: dict[int, Any]) -> None:
+    def refresh_slots(self, tools: dict[int, Tool]) -> None:
         """Re-list the slots after the library changed."""
         set_options(self.save_slot, slot_options(tools), keep=self.save_slot.value)
 
@@ -170,7 +177,7 @@ class WizardResultView:
         self.check_tcp.visible = saves and wf.last_save is not None and wf.result_saved
         if wf.run is not self._named_run:              # another calibration: its name, no old message
             self._named_run = wf.run
-            self.save_name.value = wf.default_save_name()
+            set_value(self.save_name, wf.default_save_name())
             set_content(self.save_md, "")
         truth = None if wf.hide_truth else wf.truth()   # an exercise: no answer shown
         set_content(self.result_md, result_markdown(res, truth))   # a beam result: errors of both vs truth
@@ -213,7 +220,7 @@ class WizardResultView:
         self.restore.disabled = not res.excluded
         label = ESTIMATOR_LABELS[res.estimator]
         if self.estimator.value != label:
-            self.estimator.value = label
+            set_value(self.estimator, label)
         self.compare_md.visible = bool(self.compare.value)
         if self.compare.value:
             set_content(self.compare_md, comparison_markdown(res))

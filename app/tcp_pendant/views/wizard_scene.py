@@ -37,16 +37,18 @@ from __future__ import annotations
 
 import logging
 import math
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
+import viser
 
 from tcp_pendant.calibrate import CalibrationWorkflow
 from tcp_pendant.session import Session
 from tcp_pendant.views.beam_replay import ScanPlayer, beam_view_direction, scan_spheres
 from tcp_pendant.views.framing import Framing, spread_labels
 from tcp_pendant.views.scene import frame_cameras, wxyz_xyz
-from tcp_pendant.wizards import Xyz4Result
+from tcp_pendant.wizards import WizardResult, Xyz4Result
+from tcp_pendant.views.gui_util import target_of
 
 __all__ = ["WizardSceneView"]
 
@@ -67,7 +69,7 @@ class WizardSceneView:
         self.session = session
         self.workflow = workflow
         self.player = player
-        scene = session.target.scene
+        scene = target_of(session).scene
         self.scene = scene
         self.computed = scene.add_frame("/calibration/computed_tool", axes_length=0.10, axes_radius=0.0045,
                                         visible=False)
@@ -84,14 +86,14 @@ class WizardSceneView:
                                           origin_color=(255, 255, 255), visible=False)
         self.abc_label = scene.add_label("/calibration/abc_target/label", "TARGET (X down)",
                                          position=(0.0, 0.03, 0.0), visible=False)
-        self._points: Any = None
-        self._lines: Any = None
-        self._shown_result: Any = None
+        self._points: viser.PointCloudHandle | None = None
+        self._lines: viser.LineSegmentsHandle | None = None
+        self._shown_result: WizardResult | None = None
         self._T_flange_computed: np.ndarray | None = None
         self._T_flange_tool_true: np.ndarray | None = None
         self.last_framing: Framing | None = None
         """The camera framing of the last result (None before one), for tests."""
-        self._label_defaults: dict[str, tuple[Any, tuple[float, float, float]]] = {}
+        self._label_defaults: dict[str, tuple[viser.LabelHandle, tuple[float, float, float]]] = {}
         self._labels_moved = False
         self._target_T: np.ndarray | None = None
 
@@ -110,7 +112,7 @@ class WizardSceneView:
         res = wf.result
         if res is not self._shown_result:
             self._shown_result = res
-            self._show_sphere(res if self._has_sphere() else None)
+            self._show_sphere(cast(Xyz4Result, res) if res is not None and self._has_sphere() else None)
             self._show_scan(res)
             if res is not None:
                 self.frame_result()
@@ -120,7 +122,7 @@ class WizardSceneView:
         else:
             self._restore_labels()
 
-    def _show_scan(self, res: Any) -> None:
+    def _show_scan(self, res: WizardResult | None) -> None:
         """A beam result: replay its scan (its markers stay); otherwise clear our replay."""
         player = self.player
         scan = getattr(res, "scan", None)
@@ -170,7 +172,7 @@ class WizardSceneView:
             self.layout_labels()
 
     @staticmethod
-    def _pose(handle: Any, label: Any, T: np.ndarray | None) -> None:
+    def _pose(handle: viser.FrameHandle, label: viser.LabelHandle | None, T: np.ndarray | None) -> None:
         if T is None:
             handle.visible = False
             if label is not None:
@@ -209,10 +211,10 @@ class WizardSceneView:
                                                    thickness=0.003)
 
     # ------------------------------------------------------------ camera and labels
-    def _label_nodes(self) -> dict[str, tuple[Any, np.ndarray | None]]:
+    def _label_nodes(self) -> dict[str, tuple[viser.LabelHandle, np.ndarray | None]]:
         """Label name -> (handle, T_world_parent now; None: the label is in WORLD), visible ones."""
         T_wf = self.session.pose_state().T_world_flange
-        out: dict[str, tuple[Any, np.ndarray | None]] = {}
+        out: dict[str, tuple[viser.LabelHandle, np.ndarray | None]] = {}
         film = self._film_playing()                 # the triads and their labels step aside
         if self._T_flange_computed is not None and not film:
             out["computed"] = (self.computed_label, T_wf @ self._T_flange_computed)
@@ -229,7 +231,8 @@ class WizardSceneView:
             out["target"] = (self.abc_label, self._target_T)
         for name, (handle, _) in out.items():
             if name not in self._label_defaults:
-                self._label_defaults[name] = (handle, tuple(float(v) for v in np.asarray(handle.position)))
+                x, y, z = (float(v) for v in np.asarray(handle.position))
+                self._label_defaults[name] = (handle, (x, y, z))
         return out
 
     def _restore_labels(self) -> None:
@@ -257,7 +260,7 @@ class WizardSceneView:
             if T is not None:
                 centres.append((T_wf @ T)[:3, 3])
                 radii.append(length)
-        res = self._shown_result
+        res = cast(Xyz4Result | None, self._shown_result)   # the sphere's figures: a "sphere" result
         if res is not None and self._has_sphere():
             centres.append(np.asarray(res.sphere_centre_mm, dtype=float) * MM_TO_M)
             radii.append(float(res.sphere_radius_mm) * MM_TO_M)
@@ -286,7 +289,7 @@ class WizardSceneView:
         return beam_view_direction(scan.events[0].beam_point, scan.events[0].beam_dir)
 
     @staticmethod
-    def _camera_framing(client: Any) -> Framing | None:
+    def _camera_framing(client: viser.ClientHandle) -> Framing | None:
         """The browser's camera as it is now (None before it reported one)."""
         try:
             cam = client.camera
@@ -326,7 +329,8 @@ class WizardSceneView:
             handle, T = nodes[name]
             local = world if T is None else T[:3, :3].T @ (world - T[:3, 3])
             if not np.allclose(np.asarray(handle.position, dtype=float), local, rtol=0.0, atol=1e-7):
-                handle.position = tuple(float(v) for v in local)    # only changes are sent
+                x, y, z = (float(v) for v in local)
+                handle.position = (x, y, z)                          # only changes are sent
         self._labels_moved = True
 
     # ------------------------------------------------------------ live (on every move)

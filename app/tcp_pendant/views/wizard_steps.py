@@ -32,10 +32,11 @@ from tcp_pendant.calibrate.text import (
     steps_list_markdown,
 )
 from tcp_pendant.text_escape import escape_markdown
-from tcp_pendant.views.gui_util import set_content
+from tcp_pendant.views.gui_util import ButtonEvent, DropdownEvent, set_content, set_value, target_of
 from tcp_pendant.wizards import Wizard, WizardStateError
 
 if TYPE_CHECKING:
+    from tcp_pendant.calibrate.workflow import ControllerJob
     from tcp_pendant.views.wizard_menu import CalibrateView
 
 __all__ = ["RANDOM", "WizardStepsView"]
@@ -52,7 +53,7 @@ class WizardStepsView:
 
     def __init__(self, parent: CalibrateView) -> None:
         self.parent = parent
-        gui = parent.session.target.gui
+        gui = target_of(parent.session).gui
         self.folder = gui.add_folder("Wizard", visible=False)
         with self.folder:
             self.head_md = gui.add_markdown("")
@@ -99,19 +100,19 @@ class WizardStepsView:
         self._auto_line: tuple[tuple[Any, ...], str, Any] | None = None  # (where it belongs, text, poses)
 
     # ------------------------------------------------------------ callbacks
-    def _on_cancel(self, _event: Any) -> None:
+    def _on_cancel(self, _event: ButtonEvent) -> None:
         if self.parent.session.cancel_wizard():
             self.parent.session.notify("Calibration cancelled",
                                        "Nothing recorded is lost: Resume it from the Calibrate menu.")
 
-    async def _on_next(self, event: Any) -> None:
+    async def _on_next(self, event: ButtonEvent) -> None:
         """Next / Finish. A wizard waiting for its controller job (a TCP check's rotations, a
         beam scan) runs it on Finish: the job is taken on the loop (under the session lock), run
         in ``_CHECK_WORKER``, its outcome handed to the wizard on the loop; one job at a time."""
         session, act = self.parent.session, self.parent.action
-        jobs: list[Any] = []
+        jobs: list[ControllerJob] = []
 
-        def take(_e: Any) -> None:
+        def take(_e: ButtonEvent) -> None:
             if self._checking:
                 raise WizardStateError("The controller is still at work; wait for its result.")
             job = session.take_controller_job()
@@ -141,14 +142,14 @@ class WizardStepsView:
             self._checking = False
         await act(lambda _e: session.hand_in_controller_job(jobs[0], result), sync=True)(event)
 
-    def _on_add_point(self, _event: Any) -> None:
+    def _on_add_point(self, _event: ButtonEvent) -> None:
         self.parent.session.add_point()
 
-    def _on_variant(self, event: Any) -> None:
+    def _on_variant(self, event: DropdownEvent) -> None:
         wiz = self.parent.workflow.wizard
         label = str(event.target.value)
         values = {} if wiz is None else {lab: v for v, lab in type(wiz).variants}
-        if label not in values:
+        if wiz is None or label not in values:
             raise ValueError(f"Unknown variant {label!r}.")
         self.parent.session.set_variant(values[label])
 
@@ -159,7 +160,7 @@ class WizardStepsView:
             return AutoTouchRequest(float(self.auto_tilt.value), float(self.auto_azimuth.value), sigma)
         return AutoTouchRequest(sigma_mm=sigma)
 
-    def _on_auto_touch(self, _event: Any) -> None:
+    def _on_auto_touch(self, _event: ButtonEvent) -> None:
         request = self.auto_request()
         out = self.parent.session.auto_touch(request)
         if not out.ok:
@@ -179,8 +180,8 @@ class WizardStepsView:
         return (id(wiz), wiz.step_index, wiz.status, tuple((i, id(poses[i])) for i in sorted(poses)))
 
     def _render_auto_line(self) -> None:
-        """The Auto-touch line, only while it still describes the wizard's state (item 6 of
-        issue 10: no \"Recorded touch 3\" after touch 4, nothing carried into another wizard)."""
+        """The Auto-touch line, only while it still describes the wizard's state (no
+        \"Recorded touch 3\" after touch 4, nothing carried into another wizard)."""
         line = self._auto_line
         if line is not None and line[0] != self._auto_where():
             self._auto_line = line = None
@@ -195,7 +196,7 @@ class WizardStepsView:
         if wiz is None or not wf.is_open:
             return
         set_content(self.head_md, step_markdown(wiz) + (f"\n\n{self._busy_text}" if self._checking else ""))
-        self.progress.value = round(100.0 * wiz.progress, 1)
+        set_value(self.progress, round(100.0 * wiz.progress, 1))
         set_content(self.steps_md, steps_list_markdown(wiz))
         self._render_variant(wiz)
         needed = wf.required_tool()
@@ -236,7 +237,7 @@ class WizardStepsView:
         if tuple(self.variant.options) != labels:    # our own assignments: the on_update
             self.variant.options = labels            # they fire has no client and is ignored
         if self.variant.value != label:
-            self.variant.value = label
+            set_value(self.variant, label)
         self.variant.visible = True
         self.variant.disabled = wiz.status != "in_progress"
 
@@ -244,7 +245,7 @@ class WizardStepsView:
         """The live pose-diversity meter (while a touch is to be recorded, for the wizards that
         declare it: ``Wizard.meter_active``)."""
         wf = self.parent.workflow
-        wiz: Any = wf.wizard
+        wiz: Any = wf.wizard                          # a meter wizard (duck-typed: preview(), ...)
         show = wiz is not None and wiz.meter_active
         self.meter_bar.visible = self.meter_md.visible = show
         if not show:
@@ -252,7 +253,7 @@ class WizardStepsView:
         T_world_flange = self.parent.session.controller.T_world_flange()
         gain = wiz.preview(T_world_flange)
         value, color = meter_level(gain)
-        self.meter_bar.value = round(value, 1)
+        set_value(self.meter_bar, round(value, 1))
         self.meter_bar.color = color
         advice = (diversity_advice(wiz.other_rotations(), T_world_flange[:3, :3], gain.angle_to_nearest_deg)
                   if math.isinf(gain.predicted_after) else None)               # only then shown

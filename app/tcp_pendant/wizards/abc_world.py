@@ -54,6 +54,7 @@ class AbcWorldWizard(Wizard):
                             "along WORLD Y, Z along WORLD X) and record once. 5D: tool X only.")
     calibrates: ClassVar[str] = "the orientation"
     rank: ClassVar[int] = 50
+    math_view: ClassVar[str | None] = "abc_world"
     step_roles = (StepRole("parallel", "the tool axes parallel to WORLD as (PA-1) prescribes", ALIGN_WORLD),)
     options = (WizardOption("slot", "Tool data", "library_slot",
                             hint="A tool of the library whose TCP is calibrated."),)

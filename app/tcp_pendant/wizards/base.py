@@ -306,6 +306,9 @@ class Wizard(abc.ABC):
         result_extras: what more its result panel offers: "estimators" (the 4-point's
             estimator choice, outlier drop, estimator comparison and per-touch chart), "sphere"
             (the sphere fit drawn in 3D).
+        math_view: the name of its worked equations ("The math" view, built by
+            ``calibrate.math_view.MATH_VIEWS[name]``: "xyz4", "reference", "three_point",
+            "abc_world", "tcp_zx", "beam", "spin_check"), None for a method without them.
     """
 
     kind: ClassVar[str]
@@ -324,6 +327,7 @@ class Wizard(abc.ABC):
     controller_job: ClassVar[str | None] = None
     result_view: ClassVar[Literal["touches", "spin_check", "beam_scan"]] = "touches"
     result_extras: ClassVar[frozenset[str]] = frozenset()
+    math_view: ClassVar[str | None] = None
 
     # ----- self-description (the registry, the menu and the workflow read these) -----------
     @classmethod
@@ -675,7 +679,7 @@ class Wizard(abc.ABC):
         if self._status != "cancelled":
             raise WizardStateError("Only a cancelled wizard can be resumed.")
         self._status = getattr(self, "_cancelled_from", "in_progress")
-        return self.result if self._status == "complete" and self._result is not None else self.step
+        return self._result if self._status == "complete" and self._result is not None else self.step
 
     # ----- saving to the library ----------------------------------------------------------
     def _calibration(self, result: WizardResult, figures: Mapping[str, float]) -> Calibration:

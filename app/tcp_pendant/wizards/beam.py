@@ -1,4 +1,4 @@
-"""The "Automatic (beam)" wizard (issue 14 item 3; methods.md section 9).
+"""The "Automatic (beam)" wizard (methods.md section 9).
 
 A BullsEye / TRACC style calibration: the controller itself moves the mounted tool through a
 light barrier at 3 to 5 tool orientations (sideways passes that cross the shaft, approaches
@@ -421,6 +421,7 @@ class BeamWizard(Wizard):
                             "calibration of the same tool side by side.")
     calibrates: ClassVar[str] = "the TCP and the tool direction"
     rank: ClassVar[int] = 60
+    math_view: ClassVar[str | None] = "beam"
     in_exercises: ClassVar[bool] = False
     controller_job: ClassVar[str | None] = "beam_scan"
     result_view: ClassVar[Literal["touches", "spin_check", "beam_scan"]] = "beam_scan"
@@ -588,7 +589,7 @@ class BeamWizard(Wizard):
                 "about the tool axis. Move the robot so the beam device is within reach and scan again"
                 + (f" (skipped: {skipped})." if skipped else "."))
 
-        def arrays(idx: Sequence[int]) -> tuple[np.ndarray, ...]:
+        def arrays(idx: Sequence[int]) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
             T = np.array([events[i].T_world_flange for i in idx])
             return (T[:, :3, :3], T[:, :3, 3] * M_TO_MM, np.array([events[i].beam_point for i in idx]) * M_TO_MM,
                     np.array([events[i].beam_dir for i in idx]))

@@ -1,4 +1,4 @@
-"""What a wizard class declares about itself (issue 9 item 3): its step roles with the way the
+"""What a wizard class declares about itself: its step roles with the way the
 robot performs each in auto-touch, the options it takes at start with their choices, and what
 starting it needs. No viser, no controller: plain frozen data read by the menu, the steps view,
 auto-touch, the session record and the workflow (``tcp_pendant.wizards.registry``).

@@ -44,6 +44,7 @@ class ReferenceWizard(Wizard):
                             "tool and one with the new tool. Fast; errors add up.")
     calibrates: ClassVar[str] = "the TCP of the new tool"
     rank: ClassVar[int] = 20
+    math_view: ClassVar[str | None] = "reference"
     step_roles = (StepRole("touch", "the tool tip on the reference tip", TOUCH),)
     options = (
         WizardOption("slot", "Tool data", "library_slot",

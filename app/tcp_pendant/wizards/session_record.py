@@ -26,7 +26,7 @@ angles in degrees; poses are 4x4 row-major nested lists; times ISO 8601 UTC. The
                        "T_flange_tcp_true_m": 4x4} | null,    # at export time
       "reference_tip_world_m": [x, y, z] | null,
       "touches": [ {"label": str, "T_world_flange_m": 4x4,   # the pendant's free touches
-                    "joints_deg": [j1, ..., jN]} ],          # optional (issue 12): the joint values
+                    "joints_deg": [j1, ..., jN]} ],          # optional: the joint values
                                                              # when recorded, deg (mm for linear axes)
       "wizards": [
         {
@@ -60,9 +60,9 @@ angles in degrees; poses are 4x4 row-major nested lists; times ISO 8601 UTC. The
           "true_tool": {"key": str | null, "T_flange_tcp_true_m": 4x4} | null,
                                                   # honest: {"key": str} (no frame), "truth": null
           "record_id": int | null,                # the gradebook's calibration id (classroom)
-          "joints_deg": {"0": [j1, ..., jN], ...},  # optional (issue 12): joint values of the
+          "joints_deg": {"0": [j1, ..., jN], ...},  # optional: joint values of the
                                                   # recorded steps (deg; mm linear), by step
-          "distance_mm": {"0": 0.42, ...},        # optional (issue 10): true tool tip to
+          "distance_mm": {"0": 0.42, ...},        # optional: true tool tip to
                                                   # reference tip when each touch step was
                                                   # recorded, mm (>= 0), by step
           "truth": TruthComparison.to_dict() | null   # position_error_mm, orientation_error_deg,
@@ -142,10 +142,10 @@ class WizardRun:
             reference wizard).
         T_flange_tool_true_m: (4,4) true FLANGE -> TOOL of that tool, metres; None: no truth.
         joints_deg: joint values (deg; mm linear) of the recorded steps, by 0-based step index,
-            filled by the app's session as steps are recorded (issue 12); exported as the
+            filled by the app's session as steps are recorded; exported as the
             wizard's ``"joints_deg"`` for the steps still recorded.
         distance_mm: true tool tip to reference tip (mm) when each touch step was recorded, by
-            0-based step index, filled by the workflow as steps are recorded (issue 10);
+            0-based step index, filled by the workflow as steps are recorded;
             exported as the wizard's ``"distance_mm"`` for the steps still recorded.
         distance_hidden: steps recorded while "Hide distance" was on (the result shows their
             distance-at-record next to their error; not exported).
@@ -209,12 +209,26 @@ def _run_dict(run: WizardRun | Wizard, honest: bool = False, record_id: int | No
     out = _run_entry(run, honest, record_id)
     steps = run.wizard.recorded_poses
     joints = {str(k): [float(v) for v in q] for k, q in sorted(run.joints_deg.items()) if k in steps}
-    if joints:                         # optional (issue 12): the joint values of the recorded steps
+    if joints:                         # optional: the joint values of the recorded steps
         out["joints_deg"] = joints
     distances = {str(k): float(d) for k, d in sorted(run.distance_mm.items()) if k in steps}
-    if distances:                      # optional (issue 10): distance-at-record of the touch steps
+    if distances:                      # optional: distance-at-record of the touch steps
         out["distance_mm"] = distances
     return out
+
+
+def run_entry(run: WizardRun, *, honest: bool = True, record_id: int | None = None) -> dict[str, Any]:
+    """One wizard run as a session record's entry (``"state"``, ``"result"``, ``"true_tool"``,
+    ``"truth"``, ``"record_id"``, and ``"joints_deg"`` / ``"distance_mm"`` of its recorded
+    steps); ``honest``: no truth in it (the classroom keeps the truth apart, in the gradebook).
+    The gradebook stores it for each calibration in progress, so a restart gives it back."""
+    return _run_dict(run, honest, record_id)
+
+
+def step_joints(entry: Mapping[str, Any]) -> dict[int, tuple[float, ...]]:
+    """A checked record entry's ``"joints_deg"`` by 0-based step index ({} when absent)."""
+    raw = entry.get("joints_deg") or {}
+    return {int(k): tuple(float(v) for v in q) for k, q in raw.items()}
 
 
 def step_distances(entry: Mapping[str, Any]) -> dict[int, float]:
@@ -275,7 +289,7 @@ def session_to_dict(runs: Sequence[WizardRun | Wizard], *, robot: str, urdf: str
         reference_tip_world_m: reference tip position, metres.
         touches: the pendant's captured touches (``Touch`` objects, ``(T, label)`` tuples or
             dicts with ``T_world_flange_m`` and ``label``).
-        honest: a trainee's record in a class (issue 11): no true TOOL frame anywhere, no
+        honest: a trainee's record in a class: no true TOOL frame anywhere, no
             errors against it, no server path (``robot.urdf`` null); the trainer grades it
             against the gradebook by each wizard's ``record_id``.
         record_ids: run index -> gradebook calibration id (``record_id`` of each wizard).
@@ -394,7 +408,7 @@ def check_session_record(data: Any) -> dict[str, Any]:
         raise SessionRecordError("\"touches\" must be a list.")
     if len(touches) > MAX_TOUCHES:
         raise _limit_error("holds", f"{len(touches)} pendant touches", f"{MAX_TOUCHES} pendant touches")
-    for i, touch in enumerate(touches):          # "joints_deg" is optional (records before issue 12)
+    for i, touch in enumerate(touches):          # "joints_deg" is optional (older records lack it)
         joints = touch.get("joints_deg") if isinstance(touch, Mapping) else None
         if joints is not None and not _joint_list(joints):
             raise SessionRecordError(f"Touch {i + 1} of the record: \"joints_deg\" must be a list of at most "
@@ -418,7 +432,7 @@ def check_session_record(data: Any) -> dict[str, Any]:
                                        and all(_joint_list(v) for v in joints.values())):
             raise SessionRecordError(f"Wizard {i + 1} of the record: \"joints_deg\" must map steps to lists of "
                                      f"at most {MAX_JOINTS} finite numbers (degrees).")
-        distances = entry.get("distance_mm")     # optional (issue 10)
+        distances = entry.get("distance_mm")     # optional
         if distances is not None and not _distance_map(distances):
             raise SessionRecordError(f"Wizard {i + 1} of the record: \"distance_mm\" must map step numbers "
                                      f"(\"0\", \"1\", ...) to distances in mm (finite, 0 or more), "

@@ -1,4 +1,4 @@
-"""The TCP check (spin test) as a wizard (issue 12 item 2; methods.md "TCP check").
+"""The TCP check (spin test) as a wizard (methods.md "TCP check").
 
 A technician checks a TCP by putting the tool tip on a fixed spike and reorienting the tool
 about the active TCP by +-A, +-B, +-C: a correct TCP stays on the spike. This wizard takes a
@@ -180,6 +180,7 @@ class TcpCheckWizard(Wizard):
                             "TCP error and the correction. Calibrates nothing, saves nothing.")
     calibrates: ClassVar[str] = "nothing (it checks the TCP)"
     rank: ClassVar[int] = 90
+    math_view: ClassVar[str | None] = "spin_check"
     step_roles = (StepRole("touch", "the tool tip on the reference tip", TOUCH),)
     options = (
         WizardOption("slot", "Tool data", "library_slot", hint="The library tool whose TCP is checked."),

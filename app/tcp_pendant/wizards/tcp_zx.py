@@ -60,6 +60,7 @@ class TcpZxWizard(Wizard):
                             "axis ahead of the TCP, then on its +X axis.")
     calibrates: ClassVar[str] = "the TCP and the orientation"
     rank: ClassVar[int] = 30
+    math_view: ClassVar[str | None] = "tcp_zx"
     MIN_POINTS: ClassVar[int] = 4
     MAX_POINTS: ClassVar[int] = 20
     step_roles = (

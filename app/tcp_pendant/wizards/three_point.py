@@ -35,7 +35,7 @@ from tcp_pendant.wizards.describe import (
 )
 
 MIN_DISPLACEMENT_MM = 20.0
-"""Displacements shorter than this give a poor orientation; the wizard warns (issue 5)."""
+"""Displacements shorter than this give a poor orientation; the wizard warns."""
 
 
 class ThreePointWizard(Wizard):
@@ -54,6 +54,7 @@ class ThreePointWizard(Wizard):
                             "a touch, then the tip on the tool's -X axis and on its +Y side.")
     calibrates: ClassVar[str] = "the orientation"
     rank: ClassVar[int] = 40
+    math_view: ClassVar[str | None] = "three_point"
     step_roles = (
         StepRole("touch", "the tool tip on the reference tip", TOUCH_KEEP_ORIENTATION),
         StepRole("minus_x", "the reference tip on the tool's -X axis", ON_MINUS_X),

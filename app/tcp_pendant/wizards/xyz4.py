@@ -33,7 +33,7 @@ from tcp_pendant.wizards.describe import TOUCH, StepRole, WizardOption, WizardSt
 
 Estimator = Literal["lstsq", "sphere", "pairwise"]
 ESTIMATORS: tuple[Estimator, ...] = ("lstsq", "sphere", "pairwise")
-ESTIMATOR_LABELS: dict[str, str] = {
+ESTIMATOR_LABELS: dict[Estimator, str] = {
     "lstsq": "joint least squares (4P-3), default",
     "sphere": "best-fit sphere (4P-1a)",
     "pairwise": "pairwise differences (4P-2)",
@@ -64,7 +64,7 @@ class Xyz4Result(WizardResult):
         estimator_errors: estimator -> tcpcal's message, for those that could not solve.
     """
 
-    estimator: str
+    estimator: Estimator
     used_indices: tuple[int, ...]
     excluded: tuple[int, ...]
     outliers: tuple[int, ...]
@@ -111,6 +111,7 @@ class Xyz4Wizard(Wizard):
     calibrates: ClassVar[str] = "the TCP"
     rank: ClassVar[int] = 10
     result_extras: ClassVar[frozenset[str]] = frozenset({"estimators", "sphere"})
+    math_view: ClassVar[str | None] = "xyz4"
     MIN_POINTS: ClassVar[int] = 4
     MAX_POINTS: ClassVar[int] = 20
     step_roles = (StepRole("touch", "the tool tip on the reference tip", TOUCH),)
@@ -339,7 +340,8 @@ class Xyz4Wizard(Wizard):
         kw: dict[str, Any] = {}
         abc = (0.0, 0.0, 0.0)
         if self.base_tool is not None:
-            abc = tuple(float(v) for v in self.base_tool.abc_deg)  # type: ignore[assignment]
+            a, b, c = (float(v) for v in self.base_tool.abc_deg)
+            abc = (a, b, c)
             kw = {"mass_kg": self.base_tool.mass_kg, "cog_mm": self.base_tool.cog_mm,
                   "notes": self.base_tool.notes}
         return Tool(name=name, tcp_mm=res.tcp_mm, abc_deg=abc,

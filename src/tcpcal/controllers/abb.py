@@ -17,10 +17,11 @@ declares all of it.
 from __future__ import annotations
 
 import re
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy.spatial.transform import Rotation
 
 from tcpcal.controllers._common import (
@@ -91,7 +92,7 @@ def _quaternion(rotation: np.ndarray) -> np.ndarray:
     return -q if q[0] < 0 else q
 
 
-def _rotation(q: Sequence[float], what: str) -> np.ndarray:
+def _rotation(q: ArrayLike, what: str) -> np.ndarray:
     q = np.asarray(q, dtype=float)
     norm = float(np.linalg.norm(q))
     if abs(norm - 1.0) > QUAT_TOL:
@@ -321,7 +322,7 @@ def render_text(tool: Tool, slot: int = 1) -> str:
     mass = DEFAULT_MASS_KG if tool.mass_kg is None else tool.mass_kg
     cog = _DEFAULT_COG if tool.cog_mm is None or tool.mass_kg is None else tool.cog_mm
 
-    def lst(v: Sequence[float]) -> str:
+    def lst(v: Iterable[float]) -> str:
         return "[" + ",".join(text_number(x, True) for x in v) + "]"
 
     return (
@@ -445,7 +446,7 @@ def _values_to_text(values: Sequence[float]) -> str:
             f"[0.001,[0,0,0.001],[1,0,0,0],0,0,0]]")
 
 
-def _rotation_from_q(q: Sequence[float]) -> np.ndarray:
+def _rotation_from_q(q: ArrayLike) -> np.ndarray:
     q = np.asarray(q, dtype=float)
     return Rotation.from_quat(np.stack([q[..., 1], q[..., 2], q[..., 3], q[..., 0]], axis=-1)
                               ).as_matrix()

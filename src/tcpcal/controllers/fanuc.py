@@ -21,6 +21,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy.spatial.transform import Rotation
 
 from tcpcal.controllers._common import (
@@ -343,7 +344,7 @@ def _values_to_text(values: Sequence[float]) -> str:
     return " ".join(f"{k}: {x}" for k, x in zip("XYZWPR", v))
 
 
-def rotation_from_wpr(wpr_deg: Sequence[float]) -> np.ndarray:
+def rotation_from_wpr(wpr_deg: ArrayLike) -> np.ndarray:
     """``R = Rz(R) Ry(P) Rx(W)`` of W, P, R (deg): ``(3, 3)``, or ``(N, 3, 3)`` for ``(N, 3)``."""
     return Rotation.from_euler("xyz", np.asarray(wpr_deg, dtype=float), degrees=True).as_matrix()
 

@@ -18,6 +18,7 @@ import re
 from collections.abc import Sequence
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy.spatial.transform import Rotation
 
 from tcpcal.controllers._common import (
@@ -203,7 +204,9 @@ def parse_joint_points(text: str) -> list[JointPoint]:
 def pose_warnings(text: str) -> list[str]:
     """Points with external-axis values (``E1``..``E6`` not 0) and ``FRAME`` data."""
     code = _code(text)
-    extax, frames, partial = [], [], []
+    extax: list[str] = []
+    frames: list[str] = []
+    partial: list[str] = []
     for kind, name, body, at in _declared(code):
         try:
             comp = _components(body, name)
@@ -329,7 +332,7 @@ def _values_to_text(values: Sequence[float]) -> str:
     return "TOOL_DATA[1]={" + ",".join(f"{k} {x}" for k, x in zip("XYZABC", v)) + "}"
 
 
-def rotation_from_abc(abc_deg: Sequence[float]) -> np.ndarray:
+def rotation_from_abc(abc_deg: ArrayLike) -> np.ndarray:
     """``R = Rz(A) Ry(B) Rx(C)`` of A, B, C (deg): ``(3, 3)``, or ``(N, 3, 3)`` for ``(N, 3)``."""
     return Rotation.from_euler("ZYX", np.asarray(abc_deg, dtype=float), degrees=True).as_matrix()
 

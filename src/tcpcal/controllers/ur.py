@@ -19,6 +19,7 @@ import re
 from collections.abc import Sequence
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy.spatial.transform import Rotation
 
 from tcpcal.controllers._common import (
@@ -233,7 +234,7 @@ def _values_to_text(values: Sequence[float]) -> str:
     return "p[" + ",".join(repr(float(x)) for x in values) + "]"
 
 
-def rotation_from_rotvec(rotvec: Sequence[float]) -> np.ndarray:
+def rotation_from_rotvec(rotvec: ArrayLike) -> np.ndarray:
     """The rotation of a rotation vector (rad): ``(3, 3)``, or ``(N, 3, 3)`` for ``(N, 3)``."""
     return Rotation.from_rotvec(np.asarray(rotvec, dtype=float)).as_matrix()
 

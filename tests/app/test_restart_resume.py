@@ -1,0 +1,95 @@
+"""A restart of a class server gives back what trainees saw acknowledged: the calibration in
+progress, at its step, with its touches, and written on into the same gradebook calibration."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).parents[1] / "calibrate"))
+from guiclick import choose, click  # noqa: E402
+from wsclient import DrainingClient, wait_until  # noqa: E402
+
+from tcp_pendant.classroom.gradebook import Gradebook
+
+TOKEN = "trainer-token-for-tests-0001"
+
+
+def _join(app, client: DrainingClient, name: str, key: str = ""):
+    """Join as ``name`` showing the browser key ``key`` (what the page script sends back after
+    a restart)."""
+    wait_until(lambda: len(app.sessions) >= 1 and all("identity" in s.views for s in app.sessions.values()),
+               what="a session with its name prompt")
+    s = next(iter(app.sessions.values()))
+    prompt = s.views["identity"]
+    choose(prompt.name_field, name, s.client)
+    choose(prompt.key_field, key, s.client)
+    click(prompt.start, s.client)
+    assert prompt.name == name, prompt.message.content
+    return s
+
+
+def _key(session) -> str:
+    """The browser key the server handed to this session's page script."""
+    html = session.views["identity"].key_html.content
+    return html.split('data-tcp-pendant-key="', 1)[1].split('"', 1)[0]
+
+
+def test_a_restart_gives_the_wizard_back_at_its_step_with_its_touches(app_factory, tmp_path: Path) -> None:
+    db = tmp_path / "class.sqlite3"
+    app = app_factory(class_db=db, trainer_token=TOKEN, seed=3)
+    c = DrainingClient(app.port)
+    try:
+        s = _join(app, c, "Anna")
+        key = _key(s)
+        cal = s.views["calibrate"]
+        p_choose = cal.option_widgets["n_points"]
+        choose(p_choose, 5, s.client)                        # a 5-point run: options come back too
+        click(cal.start, s.client)
+        for _ in range(3):
+            click(cal.steps.auto_touch, s.client)
+        before = s.workflow.wizard
+        poses = {k: p.T_world_flange_m.copy() for k, p in before.recorded_poses.items()}
+        step, n_steps = before.step_index, before.n_steps
+        (cid,) = [r.calibration_id for r in app.gradebook.grades(include_in_progress=True)]
+    finally:
+        c.close()
+    app.stop()                                               # the server goes down mid-calibration
+
+    again = app_factory(class_db=db, trainer_token=TOKEN, seed=4)
+    c2 = DrainingClient(again.port)
+    try:
+        s2 = _join(again, c2, "Anna", key)                 # the same browser: its key
+        wf = s2.workflow
+        w = wf.wizard
+        assert wf.is_open and w.kind == "xyz4" and (w.step_index, w.n_steps) == (step, n_steps) == (3, 5)
+        assert sorted(w.recorded_poses) == sorted(poses)
+        for k, T in poses.items():
+            np.testing.assert_array_equal(w.recorded_poses[k].T_world_flange_m, T)
+        assert s2.views["calibrate"].steps.folder.visible and "Step 4 of 5" in s2.views["dock"].step_md.content
+        assert wf.record_ids == {len(wf.runs) - 1: cid}
+        # the trainee goes on: the touches land in the same calibration, which then finishes
+        cal2 = s2.views["calibrate"]
+        for _ in range(2):
+            click(cal2.steps.auto_touch, s2.client)
+        assert wf.result is not None
+        rows = again.gradebook.grades()
+        assert [(r.calibration_id, r.trainee, r.touches, r.status) for r in rows] == [(cid, "Anna", 5, "finished")]
+        assert rows[0].grade == wf.truth().grade
+    finally:
+        c2.close()
+    with Gradebook(db) as book:
+        assert book.open_runs("Anna") == []                  # finished: nothing left to give back
+
+
+def test_a_trainee_without_work_in_progress_starts_clean(app_factory, tmp_path: Path) -> None:
+    db = tmp_path / "class.sqlite3"
+    app = app_factory(class_db=db, trainer_token=TOKEN)
+    c = DrainingClient(app.port)
+    try:
+        s = _join(app, c, "Ben")
+        assert not s.workflow.runs and not s.workflow.is_open
+    finally:
+        c.close()
