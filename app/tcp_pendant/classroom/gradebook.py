@@ -653,8 +653,8 @@ class Gradebook:
                         f"{other}, type your name exactly as before; otherwise pick a name that "
                         "looks different (add an initial or your surname).")
             new_key = secrets.token_urlsafe(BROWSER_KEY_BYTES)
-            tid = int(db.execute("INSERT INTO trainees (name, created_at, key_sha256) VALUES (?, ?, ?)",
-                                 (clean, _now(), _key_digest(new_key))).lastrowid)
+            tid = _new_id(db.execute("INSERT INTO trainees (name, created_at, key_sha256) VALUES (?, ?, ?)",
+                                     (clean, _now(), _key_digest(new_key))))
             return TraineeJoin(tid, clean, new_key)
 
     def holds_key(self, name: str, key: Any) -> bool:
