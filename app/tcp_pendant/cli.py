@@ -94,8 +94,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--exercise", default=None, choices=("mystery",),
                    help="start an exercise: mystery = each trainee calibrates a tool of their own whose "
                         "true TCP and orientation only the gradebook knows")
-    p.add_argument("--exercise-seed", type=int, default=0, metavar="N",
-                   help="seed of the mystery tools (default 0; another seed, other tools)")
+    p.add_argument("--exercise-seed", type=int, default=None, metavar="N",
+                   help="seed of the mystery tools, for a reproducible demo (default: the class's own "
+                        "secret seed, drawn at random once and kept in the gradebook)")
     p.add_argument("--scenario", default="off", choices=SCENARIO_CHOICES, metavar="NAME",
                    help="training: a systematic error every pendant starts with (off, bent-tool, "
                         "robot-accuracy, moved-reference; default off); the trainer can change it in the "

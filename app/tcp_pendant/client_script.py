@@ -1,9 +1,12 @@
-"""Our own static script in the page: keyboard shortcuts, the remembered name, the trainer URL.
+"""Our own static script in the page: keyboard shortcuts, the remembered name and browser key,
+the trainer URL.
 
 viser 1.1 gives the Python side no keyboard events, no browser storage and no page URL. A few
 lines of JavaScript in the page can (``static/pendant.js``): keys click the pendant's own GUI
-buttons (so the server path is exactly the click path), "Your name" is remembered in the
-browser's ``localStorage``, and ``/?trainer=TOKEN`` fills the trainer token.
+buttons (so the server path is exactly the click path), "Your name" and the browser key the
+server issued at the join (``views.identity``) are remembered in the browser's
+``localStorage`` and typed into the next welcome window, and ``/?trainer=TOKEN`` fills the
+trainer token.
 
 What this module serves, in front of viser's static-file server (``process_request`` of its
 ``websockets`` server, reached through :func:`tcp_pendant.origin_check.set_http_layer`):

@@ -97,7 +97,8 @@ class AppConfig:
         trainer_token: the token that opens the trainer view, 16 to 200 printable characters
             (None: a random one).
         exercise: None (free practice) or "mystery" (each trainee gets a mystery tool).
-        exercise_seed: seed of the mystery tools.
+        exercise_seed: seed of the mystery tools (None: the class's secret seed, drawn once and
+            kept in the gradebook; a number: that seed, for a reproducible demo).
         scenario: the systematic error every session starts with (training;
             ``controller.scenarios``: "off", "bent_tool", "robot_accuracy", "moved_reference");
             the trainer changes it per pendant in the Calibrate tab.
@@ -129,7 +130,7 @@ class AppConfig:
     class_db: Path | None = None
     trainer_token: str | None = None
     exercise: str | None = None
-    exercise_seed: int = 0
+    exercise_seed: int | None = None
     scenario: str = "off"
     scenario_seed: int = 0
     presenter: bool = False

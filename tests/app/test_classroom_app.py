@@ -11,7 +11,7 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).parents[1] / "calibrate"))
 from guiclick import choose, click, upload  # noqa: E402
-from wsclient import DrainingClient, wait_until  # noqa: E402
+from wsclient import DrainingClient, RecordingClient, wait_until  # noqa: E402
 
 from tcp_pendant.classroom.gradebook import Gradebook
 from tcp_pendant.classroom.mystery import true_frame
@@ -158,5 +158,217 @@ def test_without_class_db_there_is_no_prompt(app_factory) -> None:
         wait_until(lambda: len(app.sessions) == 1 and "pendant" in next(iter(app.sessions.values())).views,
                    what="session")
         assert "identity" not in next(iter(app.sessions.values())).views and app.classroom is None
+    finally:
+        c.close()
+
+
+# ------------------------------------------------------------------- names and the exercise seed
+
+def _sessions(app, n: int) -> list:
+    wait_until(lambda: len(app.sessions) == n and all("identity" in s.views for s in app.sessions.values()),
+               what=f"{n} sessions with their name prompts")
+    return list(app.sessions.values())
+
+
+def _join(session, name: str, key: str = "") -> object:
+    p = session.views["identity"]
+    choose(p.name_field, name, session.client)
+    choose(p.key_field, key, session.client)
+    click(p.start, session.client)
+    return p
+
+
+def _issued_key(prompt) -> str:
+    import re
+
+    assert prompt.key_html is not None, "no browser key handed to the page"
+    m = re.fullmatch(r'<div hidden data-tcp-pendant-key="([A-Za-z0-9_-]+)"></div>', prompt.key_html.content)
+    assert m is not None, prompt.key_html.content
+    return m.group(1)
+
+
+def test_a_connected_name_and_its_look_alikes_are_refused_until_the_trainer_releases_it(
+        app_factory, tmp_path: Path) -> None:
+    app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token="tok-1")
+    clients = [DrainingClient(app.port)]
+    _sessions(app, 1)
+    clients.append(DrainingClient(app.port))
+    _sessions(app, 2)
+    clients.append(DrainingClient(app.port))
+    try:
+        alice, other, trainer = _sessions(app, 3)
+        pa = _join(alice, "Alice")
+        assert pa.name == "Alice"
+        key = _issued_key(pa)
+        po = _join(other, "Alice")
+        assert po.name is None
+        assert ("Alice is already connected in another browser; pick another name or ask the trainer to "
+                "release it") in po.message.content
+        for look_alike in ("\u0410lice", "ＡＬＩＣＥ", "A\u013aice"):
+            _join(other, look_alike)
+            assert po.name is None and "looks like Alice, a name already in this class" in po.message.content
+        assert [t.name for t in app.classroom.trainee_statuses()] == ["Alice"]
+        # the trainer releases Alice: her browser goes back to the welcome window (its script told to forget)
+        q = trainer.views["identity"]
+        choose(q.token_field, "tok-1", trainer.client)
+        click(q.open_trainer, trainer.client)
+        view = trainer.views["trainer"]
+        assert "Alice" in view.release_name.options
+        choose(view.release_name, "Alice", trainer.client)
+        click(view.release, trainer.client)
+        assert "Released Alice" in view.release_md.content
+        wait_until(lambda: pa.name is None and "released the name Alice" in pa.message.content,
+                   what="Alice's welcome window again")
+        assert pa.key_html is None and pa.marker_html.content == "<div hidden data-tcp-pendant-forget></div>"
+        assert not app.gradebook.holds_key("Alice", key)
+        # the released browser cannot take it straight back; another browser now can, with her records
+        _join(alice, "Alice", key)
+        assert pa.name is None and "released the name Alice from this browser" in pa.message.content
+        _join(other, "Alice")
+        assert po.name == "Alice" and _issued_key(po) != key
+        with app.gradebook._read() as db:
+            assert db.execute("SELECT COUNT(*) FROM trainees").fetchone()[0] == 1
+            assert db.execute("SELECT COUNT(*), COUNT(ended_at) FROM sessions").fetchone() == (2, 1)
+        assert [(t.name, t.connected) for t in app.classroom.trainee_statuses()] == [("Alice", True), ("Alice", False)]
+    finally:
+        for c in clients:
+            c.close()
+
+
+def test_a_browser_that_comes_back_proves_itself_with_its_key(app_factory, tmp_path: Path) -> None:
+    db = tmp_path / "class.sqlite3"
+    app = app_factory(class_db=db, trainer_token="tok-1", exercise="mystery")
+    c = DrainingClient(app.port)
+    (s,) = _sessions(app, 1)
+    p = _join(s, "Anna")
+    key = _issued_key(p)
+    tool = s.controller.mounted_tool
+    c.close()
+    wait_until(lambda: not app.sessions, what="the browser gone")
+    # a reload: a new connection; without the key the name is refused, with it Anna is back
+    c = DrainingClient(app.port)
+    try:
+        (s,) = _sessions(app, 1)
+        p = _join(s, "Anna")
+        assert p.name is None and "joined from another browser" in p.message.content
+        p = _join(s, "Anna", key)
+        assert p.name == "Anna" and p.key_html is None          # no new key: the browser kept its own
+        assert s.controller.mounted_tool.key == tool.key
+    finally:
+        c.close()
+    app.stop()
+    # a server restart on the same gradebook: the same key works, and Anna's mystery tool is the same
+    app2 = app_factory(class_db=db, trainer_token="tok-1", exercise="mystery")
+    c = DrainingClient(app2.port)
+    try:
+        (s,) = _sessions(app2, 1)
+        p = _join(s, "Anna", key)
+        assert p.name == "Anna"
+        np.testing.assert_array_equal(true_frame(s.controller.mounted_tool), true_frame(tool))
+        with app2.gradebook._read() as book:
+            assert book.execute("SELECT COUNT(*) FROM trainees").fetchone()[0] == 1
+    finally:
+        c.close()
+
+
+def _mystery_frame_of(app_factory, db: Path, name: str, **config) -> np.ndarray:
+    app = app_factory(class_db=db, trainer_token="tok-1", exercise="mystery", **config)
+    c = DrainingClient(app.port)
+    try:
+        (s,) = _sessions(app, 1)
+        assert _join(s, name).name == name
+        return np.array(true_frame(s.controller.mounted_tool))
+    finally:
+        c.close()
+        app.stop()
+
+
+def test_two_classes_started_alike_draw_different_tools_for_the_same_name(app_factory, tmp_path: Path) -> None:
+    a = _mystery_frame_of(app_factory, tmp_path / "a.sqlite3", "Anna")
+    b = _mystery_frame_of(app_factory, tmp_path / "b.sqlite3", "Anna")
+    assert np.linalg.norm(a[:3, 3] - b[:3, 3]) * 1000.0 > 1.0
+    # the seed that was public before (0) draws neither
+    from tcp_pendant.classroom.mystery import draw_mystery_frame
+    from tcp_pendant.controller import builtin_tools
+
+    public = draw_mystery_frame(0, "Anna", builtin_tools()["pointer"]).T_flange_tool
+    assert not np.allclose(public, a) and not np.allclose(public, b)
+
+
+def test_an_explicit_exercise_seed_wins_for_a_demo(app_factory, tmp_path: Path) -> None:
+    from tcp_pendant.classroom.mystery import draw_mystery_frame
+    from tcp_pendant.controller import builtin_tools
+
+    a = _mystery_frame_of(app_factory, tmp_path / "a.sqlite3", "Anna", exercise_seed=7)
+    b = _mystery_frame_of(app_factory, tmp_path / "b.sqlite3", "Anna", exercise_seed=7)
+    np.testing.assert_allclose(a, b, atol=1e-12)
+    np.testing.assert_allclose(a, draw_mystery_frame(7, "Anna", builtin_tools()["pointer"]).T_flange_tool,
+                               atol=1e-9)
+
+
+def test_the_same_browser_in_a_second_tab_takes_the_name_and_the_first_tab_holds(app_factory, tmp_path: Path) -> None:
+    """The key proves it is the same browser (a reload whose old connection is not closed yet,
+    a second tab): the newer session gets the name; the older one's welcome window opens again
+    with the hold marker, so its script does not join by itself and take it back."""
+    app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token="tok-1")
+    clients = [DrainingClient(app.port)]
+    _sessions(app, 1)
+    clients.append(DrainingClient(app.port))
+    try:
+        first, second = _sessions(app, 2)
+        p1 = _join(first, "Anna")
+        key = _issued_key(p1)
+        p2 = _join(second, "Anna", key)
+        assert p2.name == "Anna"
+        wait_until(lambda: p1.name is None and "joined from another tab or window of this browser"
+                   in p1.message.content, what="the first tab's welcome window")
+        assert p1.marker_html.content == "<div hidden data-tcp-pendant-hold></div>"
+        assert app.gradebook.holds_key("Anna", key)                   # the key stays the browser's
+        assert [(t.name, t.connected) for t in app.classroom.trainee_statuses()] == [("Anna", True), ("Anna", False)]
+        # the first tab's changes are no longer Anna's: a touch there is not recorded
+        cal = first.views["calibrate"]
+        click(cal.start, first.client)
+        click(cal.steps.auto_touch, first.client)
+        assert app.gradebook.grades() == [] and app.classroom.trainee_statuses()[0].touches == 0
+        with app.gradebook._read() as db:
+            assert db.execute("SELECT COUNT(*) FROM touches").fetchone()[0] == 0
+    finally:
+        for c in clients:
+            c.close()
+
+
+def test_the_mystery_mesh_sent_to_the_browser_shows_the_tip_and_the_shaft_but_not_tool_y(
+        app_factory, tmp_path: Path) -> None:
+    """What the browser gets of the mystery tool (the MeshMessages under the flange, float32,
+    FLANGE coordinates): the nozzle's apex is the TCP (as a real tool's tip is there to see),
+    and no vertex of the nozzle ring lies on tool Y or Z about tool X (before: one on tool Y)."""
+    app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token="tok-1", exercise="mystery",
+                      exercise_seed=7)
+    c = RecordingClient(app.port)
+    try:
+        (s,) = _sessions(app, 1)
+        assert _join(s, "Anna").name == "Anna"
+        T = np.array(true_frame(s.controller.mounted_tool))
+        x, y, z, tcp = T[:3, 0], T[:3, 1], T[:3, 2], T[:3, 3]
+
+        def sent_tool_meshes() -> list:
+            return [np.asarray(m["props"]["vertices"], dtype=float).reshape(-1, 3)
+                    for m in c.of_type("MeshMessage") if "/flange/tool/" in str(m.get("name"))]
+
+        def nozzle() -> np.ndarray | None:
+            with_apex = [v for v in sent_tool_meshes() if np.min(np.linalg.norm(v - tcp, axis=1)) < 1e-6]
+            return with_apex[-1] if with_apex else None
+
+        wait_until(lambda: nozzle() is not None, what="the mystery tool's nozzle sent")
+        v = nozzle()
+        assert v is not None
+        r = v - tcp
+        radial = r - np.outer(r @ x, x)
+        ring = radial[np.linalg.norm(radial, axis=1) > 1e-4]
+        assert len(ring) == 24
+        angles = np.degrees(np.arctan2(ring @ z, ring @ y))
+        assert np.abs((angles + 45.0) % 90.0 - 45.0).min() > 1e-3          # none on +-Y, +-Z
+        axial = r[np.linalg.norm(radial, axis=1) > 1e-4] @ x
+        assert np.allclose(axial, axial[0], atol=1e-6) and axial[0] < -0.01   # a ring behind the tip, about X
     finally:
         c.close()

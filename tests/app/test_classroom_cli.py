@@ -89,3 +89,22 @@ def test_the_class_is_opt_in(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) ->
     assert [c.class_db for c in seen] == [None, tmp_path / "data" / "class.sqlite3",
                                           tmp_path / "data" / "class.sqlite3"]
     assert seen[2].exercise == "mystery"
+
+
+def test_the_exercise_seed_is_the_classs_unless_given_and_never_printed(tmp_path: Path) -> None:
+    """No --exercise-seed: None (the gradebook's secret seed); the ready message shows the
+    gradebook and the trainer address but not the seed."""
+    from types import SimpleNamespace
+
+    from tcp_pendant.classroom.class_room import ClassRoom
+    from tcp_pendant.cli import _class_lines
+
+    assert build_parser().parse_args(["--exercise", "mystery"]).exercise_seed is None
+    with Gradebook(tmp_path / "class.sqlite3") as book:
+        room = ClassRoom(book, {}, trainer_token="tok-12345678", exercise="mystery")
+        seed = room._seed()
+        assert seed == book.exercise_seed() and seed.bit_length() > 20
+        lines = _class_lines(SimpleNamespace(classroom=room, trainer_url="http://127.0.0.1:1/?trainer=tok-12345678"))
+        assert "class gradebook" in lines and str(seed) not in lines
+        assert ClassRoom(book, {}, trainer_token="tok-12345678", exercise_seed=7)._seed() == 7   # a demo's
+        assert book.exercise_seed() == seed                                                   # kept

@@ -17,15 +17,24 @@ from tcp_pendant.classroom.gradebook import Gradebook
 TOKEN = "trainer-token-for-tests-0001"
 
 
-def _join(app, client: DrainingClient, name: str):
+def _join(app, client: DrainingClient, name: str, key: str = ""):
+    """Join as ``name`` showing the browser key ``key`` (what the page script sends back after
+    a restart)."""
     wait_until(lambda: len(app.sessions) >= 1 and all("identity" in s.views for s in app.sessions.values()),
                what="a session with its name prompt")
     s = next(iter(app.sessions.values()))
     prompt = s.views["identity"]
     choose(prompt.name_field, name, s.client)
+    choose(prompt.key_field, key, s.client)
     click(prompt.start, s.client)
-    assert prompt.name == name
+    assert prompt.name == name, prompt.message.content
     return s
+
+
+def _key(session) -> str:
+    """The browser key the server handed to this session's page script."""
+    html = session.views["identity"].key_html.content
+    return html.split('data-tcp-pendant-key="', 1)[1].split('"', 1)[0]
 
 
 def test_a_restart_gives_the_wizard_back_at_its_step_with_its_touches(app_factory, tmp_path: Path) -> None:
@@ -34,6 +43,7 @@ def test_a_restart_gives_the_wizard_back_at_its_step_with_its_touches(app_factor
     c = DrainingClient(app.port)
     try:
         s = _join(app, c, "Anna")
+        key = _key(s)
         cal = s.views["calibrate"]
         p_choose = cal.option_widgets["n_points"]
         choose(p_choose, 5, s.client)                        # a 5-point run: options come back too
@@ -51,7 +61,7 @@ def test_a_restart_gives_the_wizard_back_at_its_step_with_its_touches(app_factor
     again = app_factory(class_db=db, trainer_token=TOKEN, seed=4)
     c2 = DrainingClient(again.port)
     try:
-        s2 = _join(again, c2, "Anna")
+        s2 = _join(again, c2, "Anna", key)                 # the same browser: its key
         wf = s2.workflow
         w = wf.wizard
         assert wf.is_open and w.kind == "xyz4" and (w.step_index, w.n_steps) == (step, n_steps) == (3, 5)

@@ -10,6 +10,7 @@ from collections.abc import Callable
 from typing import Any
 
 import msgspec.msgpack
+import numpy as np
 import viser
 from viser import _messages
 from websockets.sync.client import connect
@@ -76,6 +77,33 @@ def decode_window(data: bytes) -> list[dict]:
     clen = int.from_bytes(data[8:16], "little")
     inner = zstandard.ZstdDecompressor().decompress(data[16:16 + clen])
     return list(msgspec.msgpack.decode(inner)["messages"])
+
+
+def decode_window_arrays(data: bytes) -> list[dict]:
+    """:func:`decode_window` with every binary placeholder (``{"__binary_index": i, "dtype": ...,
+    "shape": ...}``, e.g. a mesh's vertices) replaced by its numpy array from the window's
+    8-byte aligned buffers."""
+    import zstandard
+
+    clen = int.from_bytes(data[8:16], "little")
+    inner = msgspec.msgpack.decode(zstandard.ZstdDecompressor().decompress(data[16:16 + clen]))
+    buffers, offset = [], 16 + clen
+    for n in inner.get("binaryBufferLengths", ()):
+        offset += (8 - offset % 8) % 8
+        buffers.append(data[offset:offset + n])
+        offset += n
+
+    def resolve(obj: Any) -> Any:
+        if isinstance(obj, dict):
+            if "__binary_index" in obj:
+                arr = np.frombuffer(buffers[obj["__binary_index"]], dtype=np.dtype(obj["dtype"]))
+                return arr.reshape(obj["shape"]) if "shape" in obj else arr
+            return {k: resolve(v) for k, v in obj.items()}
+        if isinstance(obj, list):
+            return [resolve(v) for v in obj]
+        return obj
+
+    return [resolve(m) for m in inner["messages"]]
 
 
 class ButtonClient(DrainingClient):
@@ -180,3 +208,25 @@ class InputsClient:
 
     def labels(self) -> set[str]:
         return {lab for _, lab, _ in self.inputs.values()}
+
+
+class RecordingClient(DrainingClient):
+    """A :class:`DrainingClient` that keeps every decoded message the server sent (binary
+    arrays as numpy arrays, :func:`decode_window_arrays`)."""
+
+    def __init__(self, port: int, host: str = "127.0.0.1") -> None:
+        self.messages: list[dict] = []
+        super().__init__(port, host)
+
+    def _drain(self) -> None:
+        try:
+            for msg in self.ws:
+                self.n_messages += 1
+                self.n_bytes += len(msg)
+                if isinstance(msg, bytes):
+                    self.messages.extend(decode_window_arrays(msg))
+        except Exception:
+            pass
+
+    def of_type(self, name: str) -> list[dict]:
+        return [m for m in list(self.messages) if m.get("type") == name]

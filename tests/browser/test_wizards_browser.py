@@ -183,15 +183,15 @@ def test_reference_wizard_swaps_the_tool_and_saves(pendant_server, new_page, sho
     page = new_page(server.url)
     open_calibrate(page)
     choose(page, "Method", "XYZ reference", "Touch 1 with the data 1: Pointer on the straight pointer")
-    choose(page, "New tool", "Welding torch (bent neck)", "touch 2 with the welding torch (bent neck)")
+    choose(page, "New tool", "Bent-neck welding torch", "touch 2 with the bent-neck welding torch")
     press(page, "Start")
     wait_text(page, "Step 1 of 2")
     press(page, "Auto-touch")
     wait_text(page, "Step 2 of 2")
     # step 2 needs the torch: Record is disabled until the tool change
-    wait_text(page, "Mount the welding torch (bent neck) first: the straight pointer is mounted now.")
+    wait_text(page, "Mount the bent-neck welding torch first: the straight pointer is mounted now.")
     assert page.get_by_role("button", name="Record", exact=True).filter(visible=True).first.is_disabled()
-    press(page, "Mount the welding torch (bent neck)")
+    press(page, "Mount the bent-neck welding torch")
     wait_enabled(page, "Record")
     shot(page, "reference_tool_swapped")
     press(page, "Auto-touch")
@@ -259,7 +259,7 @@ def test_tcp_zx_wizard_calibrates_tcp_and_frame_in_one_go(pendant_server, new_pa
     page = new_page(server.url)
     open_calibrate(page)
     choose(page, "Method", "TCP & Z, X (ABB)",
-           "Calibrates the TCP and the orientation of the welding torch (bent neck) now mounted")
+           "Calibrates the TCP and the orientation of the bent-neck welding torch now mounted")
     wait_text(page, "then the reference tip on the tool's +Z axis ahead of the TCP")     # the blurb
     press(page, "Start")
     wait_text(page, "Pose diversity")                          # the meter on the touches

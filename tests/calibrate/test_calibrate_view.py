@@ -97,18 +97,18 @@ def test_reference_wizard_disables_record_until_the_tool_change(page) -> None:
     assert v.library_tool.options == ("1: Pointer",)
     p.choose(v.method, "XYZ reference")
     assert v.library_tool.visible and v.new_physical.visible and not v.n_points.visible
-    p.choose(v.new_physical, "Welding torch (bent neck)")
-    assert f"touch 2 with the *{escape_markdown('welding torch (bent neck)')}*" in v.menu_md.content
+    p.choose(v.new_physical, "Bent-neck welding torch")
+    assert f"touch 2 with the *{escape_markdown('bent-neck welding torch')}*" in v.menu_md.content
     p.click(v.start)
     assert s.active_slot == 1 and "Active tool:** Pointer (slot 1)" in s.views["tools"].active_md.content
     p.click(v.steps.auto_touch)
     assert v.steps.record.disabled and v.steps.mount.visible
-    assert v.steps.mount.label == "Mount the welding torch (bent neck)"
-    assert escape_markdown("Mount the welding torch (bent neck) first: the straight pointer") in \
+    assert v.steps.mount.label == "Mount the bent-neck welding torch"
+    assert escape_markdown("Mount the bent-neck welding torch first: the straight pointer") in \
         v.steps.blocked_md.content
     p.click(v.steps.mount)
     assert s.controller.mounted_tool.key == "torch"
-    assert s.views["tools"].mounted.value == "Welding torch (bent neck)"     # the Tool tab follows
+    assert s.views["tools"].mounted.value == "Bent-neck welding torch"     # the Tool tab follows
     assert not v.steps.record.disabled and not v.steps.mount.visible
     p.click(v.steps.record)                           # a real Record, wherever the tip is now
     p.click(v.steps.next)

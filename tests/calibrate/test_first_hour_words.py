@@ -36,7 +36,7 @@ def test_tool_change_is_asked_for_by_the_tools_labels(workflow, library) -> None
     wf = workflow(tool="pointer")
     wiz = wf.start("reference", slot=1, reference_tool_key="pointer", new_tool_key="torch")
     wf.auto_touch(AutoTouchRequest())
-    assert wiz.blocked_reason == "Mount the welding torch (bent neck) first: the straight pointer is mounted now."
+    assert wiz.blocked_reason == "Mount the bent-neck welding torch first: the straight pointer is mounted now."
     assert "'" not in wiz.blocked_reason and "torch'" not in wiz.blocked_reason
 
 
@@ -101,7 +101,7 @@ class _T:
 @pytest.mark.parametrize("kwargs,expected", [
     (dict(active_slot=3, active_tool_name="Torch", mounted_label="Straight pointer", mounted_key="pointer"), 3),
     (dict(active_slot=None, active_tool_name="torch", mounted_label="Straight pointer", mounted_key="pointer"), 3),
-    (dict(active_slot=None, active_tool_name=None, mounted_label="Welding torch (bent neck)", mounted_key="torch"), 3),
+    (dict(active_slot=None, active_tool_name=None, mounted_label="Bent-neck welding torch", mounted_key="torch"), 3),
     (dict(active_slot=None, active_tool_name=None, mounted_label="Straight pointer", mounted_key="pointer"), 1),
     (dict(active_slot=5, active_tool_name=None, mounted_label="Straight pointer", mounted_key="pointer"), 1),
 ])
@@ -112,9 +112,9 @@ def test_default_library_slot(kwargs, expected) -> None:
 
 
 def test_default_library_slot_matches_the_mounted_tools_label() -> None:
-    tools = {1: _T("Pen"), 2: _T("Welding torch (bent neck)")}
+    tools = {1: _T("Pen"), 2: _T("Bent-neck welding torch")}
     assert default_library_slot(tools, active_slot=None, active_tool_name=None,
-                                mounted_label="Welding torch (bent neck)", mounted_key="torch") == 2
+                                mounted_label="Bent-neck welding torch", mounted_key="torch") == 2
 
 
 def test_tool_data_defaults_to_the_active_slot_not_slot_1(tmp_path) -> None:

@@ -74,7 +74,7 @@ def test_reference_needs_the_tool_change_then_gives_the_new_tools_tcp(workflow, 
     wf.auto_touch(AutoTouchRequest())
     assert wiz.step_index == 1 and wf.required_tool().key == "torch"
     assert not wiz.can_record
-    with pytest.raises(WizardStateError, match=r"Mount the welding torch \(bent neck\) first: the straight pointer is mounted now\."):
+    with pytest.raises(WizardStateError, match=r"Mount the bent-neck welding torch first: the straight pointer is mounted now\."):
         wf.record()
     assert wf.mount_required_tool().key == "torch"
     assert wf.controller.mounted_tool.key == "torch" and wiz.can_record
@@ -82,7 +82,7 @@ def test_reference_needs_the_tool_change_then_gives_the_new_tools_tcp(workflow, 
     tcp_true, _, _ = true_frame("torch")
     np.testing.assert_allclose(wf.result.tcp_mm, tcp_true, atol=EXACT_MM)
     assert any("sum of both touches' errors" in w for w in wf.result.warnings)
-    assert wf.default_save_name() == "Welding torch (bent neck)"
+    assert wf.default_save_name() == "Bent-neck welding torch"
     slot, _ = wf.save("Torch")
     assert slot == 2 and library.get(1).name == "Pointer"
 

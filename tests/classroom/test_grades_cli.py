@@ -134,7 +134,7 @@ def _newer(path: Path) -> None:
 @pytest.mark.parametrize("prepare, words", [
     (lambda p: None, "No gradebook at"),
     (lambda p: p.write_text("not a database at all\n" * 50), "is not a readable SQLite database"),
-    (_newer, "newer TCP Pendant (schema version 4"),
+    (_newer, f"newer TCP Pendant (schema version {SCHEMA_VERSION + 3}"),
 ])
 def test_bad_gradebook_is_one_line_and_exit_2(tmp_path: Path, capsys: pytest.CaptureFixture[str],
                                                prepare, words: str) -> None:

@@ -64,6 +64,15 @@ def test_tools_read_their_true_tcp_from_the_urdf():
     assert np.count_nonzero(np.abs(torch[:3, :3] - np.eye(3)).max(axis=0) > 1e-6) == 3
 
 
+@pytest.mark.parametrize("key", sorted(builtin_tools()))
+def test_every_builtin_tool_name_is_a_name_a_controller_takes(key):
+    """A calibration of a built-in tool is saved under its label (the default save name): the
+    label must pass tcpcal's tool name check (1..24 printable characters, no double quote), or
+    every Save of that tool is refused."""
+    label = builtin_tools()[key].label
+    assert Tool(name=label, tcp_mm=(0.0, 0.0, 100.0)).name == label
+
+
 def test_reference_tip_model_puts_the_spike_where_asked():
     ref = reference_tip_model()
     np.testing.assert_allclose(ref.T_stand_tip, origin_chain(ref.urdf_path, "tip"), atol=1e-12)

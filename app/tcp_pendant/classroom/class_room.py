@@ -7,6 +7,20 @@ subscribed to the session's change signal (and, in the mystery exercise, mounts 
 mystery tool); a right trainer token builds a :class:`~tcp_pendant.views.trainer_view.TrainerView`
 in that browser. Every trainer view re-renders when a trainee's row changes.
 
+Names are for the one browser that joined under them (``Gradebook.join_trainee``): a browser
+gets a browser key when it joins (its page script keeps it, ``views.identity``) and comes back
+with it after a reload or a server restart. A name connected in another browser is refused in
+words, unless the browser shows that name's key (the same browser: then the newer tab takes
+the name and the older one's welcome window opens again, without joining by itself); a
+look-alike of a classmate's name is refused naming it (``classroom.names``). The trainer
+releases a name (:meth:`ClassRoom.release`): its key is forgotten and a browser connected
+under it is shown the welcome window again, so the next browser that joins under it gets the
+trainee's records.
+
+The exercise seed (the mystery tools) is the gradebook's, drawn at random for the class the
+first time a mystery tool is drawn and kept there (``Gradebook.exercise_seed``); an explicit
+``exercise_seed`` (``--exercise-seed``, reproducible demos) is used instead. It is never shown.
+
 In an exercise the trainee sees no truth: the workflow's ``hide_truth`` is set (the result
 panel shows no error against the true TOOL frame and no grade, the scene no TRUE triad); the
 gradebook keeps them for the trainer. The settings a trainer pushes (exercise, tool, "Hide
@@ -27,8 +41,9 @@ import time
 from collections.abc import Callable
 from typing import Any
 
-from tcp_pendant.classroom.gradebook import Gradebook, GradeRow
+from tcp_pendant.classroom.gradebook import Gradebook, GradeRow, TraineeJoin
 from tcp_pendant.classroom.mystery import draw_mystery_tool
+from tcp_pendant.classroom.names import TraineeNameError, validate_trainee_name
 from tcp_pendant.classroom.recorder import TraineeRecorder, TraineeStatus
 from tcp_pendant.classroom.restore import runs_to_restore
 from tcp_pendant.classroom.trainer_token import TokenAttempts, validate_trainer_token
@@ -64,7 +79,8 @@ class ClassRoom:
         tools: the physical tools by key (the built-in ones).
         trainer_token: the token that opens the trainer view (16 to 200 printable characters).
         exercise: None (free practice) or "mystery".
-        exercise_seed: the seed of the mystery tools.
+        exercise_seed: the seed of the mystery tools; None: the class's own secret seed, kept in
+            the gradebook.
         hand_to_loop: runs a function on viser's event loop.
         clock: seconds of a monotonic clock (the token's lockout windows; tests set it).
 
@@ -73,7 +89,7 @@ class ClassRoom:
     """
 
     def __init__(self, gradebook: Gradebook, tools: dict[str, ToolModel], *, trainer_token: str | None,
-                 exercise: str | None = None, exercise_seed: int = 0,
+                 exercise: str | None = None, exercise_seed: int | None = None,
                  hand_to_loop: Callable[[Callable[[], None]], None] = lambda fn: fn(),
                  clock: Callable[[], float] = time.monotonic) -> None:
         if exercise is not None and exercise not in EXERCISE_IDS:
@@ -92,10 +108,16 @@ class ClassRoom:
         self.tools = dict(tools)
         self.tool_keys = tuple(self.tools)
         self.exercise = exercise
-        self.exercise_seed = int(exercise_seed)
+        if exercise_seed is not None and (isinstance(exercise_seed, bool) or not isinstance(exercise_seed, int)):
+            raise ValueError(f"The exercise seed must be a whole number, got {exercise_seed!r:.40}.")
+        self._exercise_seed = exercise_seed      # None: the gradebook's, read when first needed
         self._hand_to_loop = hand_to_loop
         self._lock = threading.Lock()
+        self._join_lock = threading.Lock()       # one join or release at a time
         self._trainees: dict[int, tuple[Session, TraineeRecorder, str]] = {}   # id(session) -> ...
+        self._subscribed: set[int] = set()          # id(session) of sessions whose changes we follow
+        self._prompts: dict[int, Any] = {}           # id(session) -> its IdentityPrompt
+        self._released: dict[int, str] = {}          # id(session) -> the name the trainer released there
         self._left: list[TraineeStatus] = []        # rows of trainees who left (connected=False)
         self._trainer_views: dict[int, Any] = {}    # id(session) -> TrainerView
         self._token_attempts: dict[int, TokenAttempts] = {}   # id(session) -> its wrong tokens
@@ -111,38 +133,126 @@ class ClassRoom:
         """Show the "Your name" prompt in a new per-browser session (returns the prompt)."""
         from tcp_pendant.views.identity import IdentityPrompt
 
-        prompt = IdentityPrompt(session, lambda name: self.named(session, name),
+        prompt = IdentityPrompt(session, lambda name, key: self._joined(self.named(session, name, key)),
                                 lambda token: self.open_trainer(session, token))
         session.views["identity"] = prompt
+        with self._lock:
+            self._prompts[id(session)] = prompt
         session.on_close(lambda: self.detach(session))
         return prompt
 
-    def named(self, session: Session, name: str) -> TraineeRecorder:
-        """The trainee of ``session`` typed ``name`` (validated): a gradebook session, its
-        recorder, and the exercise's tool."""
+    @staticmethod
+    def _joined(join: TraineeJoin) -> tuple[str, str | None]:
+        return join.name, join.new_key
+
+    def _seed(self) -> int:
+        if self._exercise_seed is None:
+            self._exercise_seed = self.gradebook.exercise_seed()
+        return self._exercise_seed
+
+    def _holder(self, name: str, other_than: Session) -> tuple[Session, TraineeRecorder, str] | None:
+        with self._lock:
+            return next((e for e in self._trainees.values() if e[2] == name and e[0] is not other_than), None)
+
+    def named(self, session: Session, name: Any, key: Any = None) -> TraineeJoin:
+        """The browser of ``session`` joins as ``name`` showing the browser key ``key`` (or
+        none): the gradebook's check (``Gradebook.join_trainee``), then a gradebook session, its
+        recorder, and the exercise's tool.
+
+        Raises:
+            TraineeNameError: the name is refused (invalid, a look-alike of a classmate's,
+                connected in another browser, held by another browser); the words say why.
+        """
+        clean = validate_trainee_name(name)
+        with self._join_lock:
+            if self._released.get(id(session)) == clean:
+                raise TraineeNameError(f"The trainer released the name {clean} from this browser; join "
+                                       "under your own name.")
+            holder = self._holder(clean, session)
+            if holder is not None and not self.gradebook.holds_key(clean, key):
+                raise TraineeNameError(f"{clean} is already connected in another browser; pick another "
+                                       "name or ask the trainer to release it.")
+            join = self.gradebook.join_trainee(clean, key)
+            if holder is not None:         # the same browser (its key): the newer tab takes the name
+                self._leave(holder, f"{clean} joined from another tab or window of this browser, so this "
+                            "one left the class. Close it, or join here again (the other one then leaves).",
+                            forget=False)
+            self._start(session, join)
+        self.refresh_trainers()
+        return join
+
+    def _start(self, session: Session, join: TraineeJoin) -> TraineeRecorder:
         with session.lock:
-            trainee = self.gradebook.add_trainee(name)
-            sid = self.gradebook.start_session(trainee, "per-browser")
+            sid = self.gradebook.start_session(join.trainee_id, "per-browser")
             session.keep_honest_records()             # the trainee's export carries no answer key
-            recorder = TraineeRecorder(self.gradebook, sid, name, session.workflow, exercise_id=self.exercise)
-
-            def on_change(change: SessionChange) -> None:
-                before = recorder.status
-                recorder.on_change(change)
-                if recorder.status != before:
-                    self.refresh_trainers()
-
-            session.subscribe(on_change)
+            recorder = TraineeRecorder(self.gradebook, sid, join.name, session.workflow,
+                                       exercise_id=self.exercise)
             with self._lock:
-                self._trainees[id(session)] = (session, recorder, name)
+                self._trainees[id(session)] = (session, recorder, join.name)
+                follow = id(session) not in self._subscribed
+                self._subscribed.add(id(session))
+            if follow:
+                session.subscribe(lambda change: self._on_change(session, change))
             session.set_hide_truth(self.exercise is not None)
             if self.exercise == "mystery":
-                self._mount_mystery(session, recorder, name)
+                self._mount_mystery(session, recorder, join.name)
             if self.hide_distance is not None:
                 session.set_hide_distance(self.hide_distance)
-            self._restore(session, recorder, name)
-        self.refresh_trainers()
+            self._restore(session, recorder, join.name)
         return recorder
+
+    def _on_change(self, session: Session, change: SessionChange) -> None:
+        with self._lock:
+            entry = self._trainees.get(id(session))
+        if entry is None:                  # not (or no longer) a named trainee: nothing to store
+            return
+        recorder = entry[1]
+        before = recorder.status
+        recorder.on_change(change)
+        if recorder.status != before:
+            self.refresh_trainers()
+
+    def _leave(self, entry: tuple[Session, TraineeRecorder, str], message: str, *, forget: bool) -> None:
+        """The session of ``entry`` is no longer its trainee: its gradebook session ends, its row
+        moves to those who left, and its welcome window opens again with ``message``."""
+        session, recorder, name = entry
+        with self._lock:
+            if self._trainees.get(id(session)) is not entry:
+                return
+            self._trainees.pop(id(session), None)
+            prompt = self._prompts.get(id(session))
+        try:
+            recorder.disconnected()
+        except Exception:
+            log.exception("ending the gradebook session of %r failed", name)
+        with self._lock:
+            self._left.append(recorder.status)
+        if prompt is not None:         # on the loop, after this callback: no two sessions' locks at once
+            self._hand_to_loop(session.guard(lambda: prompt.reopen(message, forget=forget)))
+
+    def release(self, name: str) -> str:
+        """The trainer releases ``name``: the gradebook forgets its browser key and a browser
+        connected under it leaves the class (its welcome window opens again and its page script
+        forgets the name). Returns what happened, in words for the trainer (plain text)."""
+        if not isinstance(name, str):
+            raise ValueError("Choose the name to release.")
+        with self._join_lock:
+            held = self.gradebook.release_trainee(name)
+            with self._lock:
+                holders = [e for e in self._trainees.values() if e[2] == name]
+            for entry in holders:
+                self._released[id(entry[0])] = name
+                self._leave(entry, f"The trainer released the name {name}: this browser left the class. "
+                            "Join under your own name.", forget=True)
+        self.refresh_trainers()
+        if not held and not holders:
+            return f"{name} was not held by any browser."
+        where = " and its browser left the class" if holders else ""
+        return f"Released {name}{where}: the next browser that joins as {name} gets the trainee's records."
+
+    def held_names(self) -> list[str]:
+        """Names a browser holds (the trainer view's "Release a name" choices)."""
+        return self.gradebook.held_names()
 
     def _restore(self, session: Session, recorder: TraineeRecorder, name: str) -> None:
         """The calibrations ``name`` had in progress (a reload, a restart of the server with this
@@ -160,7 +270,7 @@ class ClassRoom:
 
     def _mount_mystery(self, session: Session, recorder: TraineeRecorder, name: str) -> None:
         base = self.tools.get("pointer") or next(iter(self.tools.values()))
-        tool = draw_mystery_tool(self.exercise_seed, name, base)
+        tool = draw_mystery_tool(self._seed(), name, base)
         recorder.exercise_id = "mystery"
         session.add_physical_tool(tool)              # its label in the wizard's tool-change words
         session.mount_tool(tool)
@@ -171,14 +281,18 @@ class ClassRoom:
             entry = self._trainees.get(id(session))
             self._trainer_views.pop(id(session), None)
             self._token_attempts.pop(id(session), None)
+            self._prompts.pop(id(session), None)
+            self._released.pop(id(session), None)
+            self._subscribed.discard(id(session))
         if entry is not None:
             try:
                 entry[1].disconnected()
             except Exception:
                 log.exception("ending the gradebook session of %r failed", entry[2])
             with self._lock:                 # one step: the row is never missing from the table
-                self._trainees.pop(id(session), None)
-                self._left.append(entry[1].status)
+                if self._trainees.get(id(session)) is entry:
+                    self._trainees.pop(id(session), None)
+                    self._left.append(entry[1].status)
         self._hand_to_loop(self.refresh_trainers)
 
     # ------------------------------------------------------------ trainer

@@ -16,7 +16,9 @@ Durability ("a kill -9 of the server loses nothing that was acknowledged on scre
   ``synchronous="NORMAL"`` is accepted for machines whose disk makes the fsync slow.
 
 Safety of the file: the schema is versioned (table ``meta``: ``application`` and
-``schema_version``). Opening checks the file before writing anything to it
+``schema_version``). A version 1 file (before browser keys) is brought to version 2 when it is
+opened (one transaction: the column ``trainees.key_sha256`` is added, every trainee without a
+key); a TCP Pendant that reads only version 1 then refuses it as newer. Opening checks the file before writing anything to it
 (``PRAGMA quick_check``, then ``meta``): a file that is not SQLite, is damaged, is another
 program's database or was written by a newer TCP Pendant raises one :class:`GradebookError`
 naming the file and what to do; the file is never overwritten or "repaired".
@@ -29,10 +31,14 @@ Units: poses in metres (``T_world_flange_m``), joints and angles in degrees, dis
 errors in mm, durations in seconds; times are UTC ISO 8601 with milliseconds
 (``2025-01-31T09:15:02.125+00:00``).
 
-Schema (version 1)::
+Schema (version 2)::
 
-    meta(key PRIMARY KEY, value)                 application='tcp-pendant gradebook', schema_version='1'
-    trainees(id, name UNIQUE, created_at)
+    meta(key PRIMARY KEY, value)                 application='tcp-pendant gradebook', schema_version='2',
+                                                 created_at, exercise_seed (drawn when first asked for)
+    trainees(id, name UNIQUE, created_at, key_sha256)
+        key_sha256: hex SHA-256 of the browser key issued when a browser joined under the name
+                    (NULL: no browser holds the name: never joined, released by the trainer, or
+                    a trainee of a version 1 file)
     sessions(id, trainee_id, mode, started_at, ended_at)
     calibrations(id, session_id, method, tool_key, exercise_id, truth_json, status, started_at,
                  finished_at, cancelled_at, figures_json, tcp_mm_json, abc_deg_json,
@@ -46,9 +52,11 @@ Schema (version 1)::
 from __future__ import annotations
 
 import csv
+import hashlib
 import io
 import json
 import math
+import secrets
 import sqlite3
 import threading
 from collections.abc import Iterator, Mapping, Sequence
@@ -61,7 +69,7 @@ from typing import Any, Literal, overload
 import numpy as np
 import platformdirs
 
-from tcp_pendant.classroom.names import TraineeNameError, validate_trainee_name
+from tcp_pendant.classroom.names import TraineeNameError, looks_alike, validate_trainee_name
 
 __all__ = [
     "APPLICATION",
@@ -71,12 +79,13 @@ __all__ = [
     "GradeRow",
     "Gradebook",
     "GradebookError",
+    "TraineeJoin",
     "default_gradebook_path",
     "to_csv",
 ]
 
 APPLICATION = "tcp-pendant gradebook"
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
 GRADES = ("good", "fair", "poor")
 _STATUS = ("in_progress", "finished", "cancelled")
 _MAX_TEXT = 200          # method, tool key, exercise id, mode, crash note: short labels
@@ -112,7 +121,8 @@ CREATE TABLE meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
 CREATE TABLE trainees (
     id INTEGER PRIMARY KEY,
     name TEXT NOT NULL UNIQUE,
-    created_at TEXT NOT NULL);
+    created_at TEXT NOT NULL,
+    key_sha256 TEXT);
 CREATE TABLE sessions (
     id INTEGER PRIMARY KEY,
     trainee_id INTEGER NOT NULL REFERENCES trainees(id),
@@ -208,6 +218,45 @@ class GradeRow:
     orientation_error_deg: float | None = None
     grade: str | None = None
     status: str = "finished"
+
+
+@dataclass(frozen=True)
+class TraineeJoin:
+    """A browser accepted under a trainee's name (``Gradebook.join_trainee``).
+
+    Attributes:
+        trainee_id: the trainee's id (the same on every return of the same browser).
+        name: the name as stored.
+        new_key: the browser key issued now, to be kept by that browser and shown to nobody
+            else; None when the browser proved itself with the key it already had.
+    """
+
+    trainee_id: int
+    name: str
+    new_key: str | None
+
+
+BROWSER_KEY_BYTES = 32
+"""Random bytes of a browser key (``secrets.token_urlsafe``: 43 characters)."""
+MAX_BROWSER_KEY_CHARS = 200
+"""A longer "key" from a browser is not looked at."""
+_KEY_CHARS = frozenset("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789-_")
+
+
+def _key_digest(key: str) -> str:
+    # A browser key is 256 random bits, so a plain SHA-256 keeps it as safe as a slow password
+    # hash would: there is no dictionary to try.
+    return hashlib.sha256(key.encode("utf-8")).hexdigest()
+
+
+def _clean_key(key: Any) -> str | None:
+    """The browser key a browser sent, or None (none, or not the shape of a key we issue)."""
+    if not isinstance(key, str):
+        return None
+    key = key.strip()
+    if not key or len(key) > MAX_BROWSER_KEY_CHARS or not set(key) <= _KEY_CHARS:
+        return None
+    return key
 
 
 CSV_FIGURES = ("mean_error_mm", "max_error_mm", "rms_error_mm", "ci95_mm", "orthogonality_defect_deg")
@@ -436,6 +485,8 @@ class Gradebook:
                     "tcp-pendant to read it, or give another file with --class-db.")
             if version < 1 or not {"trainees", "sessions", "calibrations", "touches", "crashes"} <= tables:
                 raise self._fail(f"is incomplete (schema version {version}, tables {sorted(tables)})")
+        else:
+            version = SCHEMA_VERSION
         try:
             mode = db.execute("PRAGMA journal_mode = WAL").fetchone()[0]
             db.execute(f"PRAGMA synchronous = {synchronous}")
@@ -448,6 +499,8 @@ class Gradebook:
                     db.executemany("INSERT INTO meta (key, value) VALUES (?, ?)",
                                    [("application", APPLICATION), ("schema_version", str(SCHEMA_VERSION)),
                                     ("created_at", _now())])
+            elif version < SCHEMA_VERSION:
+                self._migrate(version)
         except sqlite3.Error as exc:
             raise GradebookError(f"Cannot write the gradebook {self.path}: {exc}; check that its folder "
                                  "is writable and the disk is not full.") from exc
@@ -460,6 +513,15 @@ class Gradebook:
         except sqlite3.Error as exc:
             raise GradebookError(f"Cannot write the gradebook {self.path}: {exc}; check that its folder "
                                  "is writable and the disk is not full.") from exc
+
+    def _migrate(self, version: int) -> None:
+        """Bring a file of an older schema version to :data:`SCHEMA_VERSION` (one transaction)."""
+        with self._transaction() as db:
+            if version < 2:       # browser keys: every trainee so far has none
+                columns = {r[1] for r in db.execute("PRAGMA table_info(trainees)")}
+                if "key_sha256" not in columns:
+                    db.execute("ALTER TABLE trainees ADD COLUMN key_sha256 TEXT")
+            db.execute("UPDATE meta SET value = ? WHERE key = 'schema_version'", (str(SCHEMA_VERSION),))
 
     # -- plumbing ---------------------------------------------------------------------
 
@@ -546,6 +608,93 @@ class Gradebook:
                 return int(row[0])
             return _new_id(db.execute("INSERT INTO trainees (name, created_at) VALUES (?, ?)",
                                       (clean, _now())))
+
+    def join_trainee(self, name: str, key: Any = None) -> TraineeJoin:
+        """A browser joins the class as ``name``, showing the browser key it kept (or none).
+
+        - A name no trainee has: refused if it looks like one (``names.looks_alike``: the words
+          name the existing name); otherwise the trainee is added with a new browser key.
+        - A trainee's name whose key is held by a browser: accepted only with that key (the same
+          browser after a reload or a server restart); otherwise refused.
+        - A trainee's name no browser holds (released by the trainer, or from a version 1
+          file): accepted, with a new browser key.
+
+        Args:
+            name: what the browser typed (validated and normalised here).
+            key: the browser key the browser kept, or None; anything that is not a key we issue
+                counts as none.
+
+        Returns:
+            The trainee and, when one was issued, the new key (only its SHA-256 is stored).
+
+        Raises:
+            TraineeNameError: the name is refused; the message says why and what to do.
+        """
+        clean = validate_trainee_name(name)
+        shown = _clean_key(key)
+        with self._write() as db:
+            row = db.execute("SELECT id, key_sha256 FROM trainees WHERE name = ?", (clean,)).fetchone()
+            if row is not None:
+                tid, digest = int(row[0]), row[1]
+                if digest is not None:
+                    if shown is None or not secrets.compare_digest(_key_digest(shown), str(digest)):
+                        raise TraineeNameError(
+                            f"{clean} is already a trainee of this class, joined from another browser; "
+                            "use that browser, or ask the trainer to release the name; if you are "
+                            "someone else, pick another name.")
+                    return TraineeJoin(tid, clean, None)
+                new_key = secrets.token_urlsafe(BROWSER_KEY_BYTES)
+                db.execute("UPDATE trainees SET key_sha256 = ? WHERE id = ?", (_key_digest(new_key), tid))
+                return TraineeJoin(tid, clean, new_key)
+            for (other,) in db.execute("SELECT name FROM trainees"):
+                if looks_alike(clean, other):
+                    raise TraineeNameError(
+                        f"{clean} looks like {other}, a name already in this class: if you are "
+                        f"{other}, type your name exactly as before; otherwise pick a name that "
+                        "looks different (add an initial or your surname).")
+            new_key = secrets.token_urlsafe(BROWSER_KEY_BYTES)
+            tid = _new_id(db.execute("INSERT INTO trainees (name, created_at, key_sha256) VALUES (?, ?, ?)",
+                                     (clean, _now(), _key_digest(new_key))))
+            return TraineeJoin(tid, clean, new_key)
+
+    def holds_key(self, name: str, key: Any) -> bool:
+        """Whether ``key`` is the browser key of the trainee called ``name`` (False: no such
+        trainee, no key held, or another key)."""
+        shown = _clean_key(key)
+        if shown is None or not isinstance(name, str):
+            return False
+        with self._read() as db:
+            row = db.execute("SELECT key_sha256 FROM trainees WHERE name = ?", (name,)).fetchone()
+        return row is not None and row[0] is not None and secrets.compare_digest(_key_digest(shown), str(row[0]))
+
+    def release_trainee(self, name: str) -> bool:
+        """Forget the browser key of the trainee called ``name`` (the trainer's "Release"): the
+        next browser that joins under the name gets the trainee's records. Returns whether a
+        key was held."""
+        with self._write() as db:
+            return db.execute("UPDATE trainees SET key_sha256 = NULL WHERE name = ? AND key_sha256 IS NOT NULL",
+                              (name,)).rowcount > 0
+
+    def held_names(self) -> list[str]:
+        """Names whose browser key a browser holds, sorted (the names a trainer can release)."""
+        with self._read() as db:
+            return [r[0] for r in db.execute("SELECT name FROM trainees WHERE key_sha256 IS NOT NULL ORDER BY name")]
+
+    def exercise_seed(self) -> int:
+        """The class's exercise seed: drawn with ``secrets`` the first time it is asked for and
+        kept in ``meta`` (so a restart with the same gradebook gives every trainee the same
+        mystery tool again). A secret: whoever knows it can compute every mystery tool, so it is
+        never printed, logged or sent to a browser."""
+        with self._write() as db:
+            row = db.execute("SELECT value FROM meta WHERE key = 'exercise_seed'").fetchone()
+            if row is not None:
+                try:
+                    return int(row[0])
+                except ValueError:
+                    raise self._fail("has an exercise_seed that is not a whole number in its meta table") from None
+            seed = secrets.randbits(63)
+            db.execute("INSERT INTO meta (key, value) VALUES ('exercise_seed', ?)", (str(seed),))
+            return seed
 
     def start_session(self, trainee_id: int, mode: str) -> int:
         """A new session (one browser connection) of a trainee; ``mode`` e.g. "own" or "shared"."""

@@ -1,5 +1,7 @@
 """Mystery tools: a tool per trainee whose true TCP and orientation are drawn
-from the exercise seed and the trainee's name, so answers differ between trainees.
+from the exercise seed and the trainee's name, so answers differ between trainees. The seed of
+a class is a secret (``Gradebook.exercise_seed``: random, kept in the gradebook): this code is
+public, so whoever knows the seed and a name computes that trainee's tool.
 
 :func:`draw_mystery_tool` draws (deterministically: same seed, name and base tool, same tool on
 every run and machine) a true TOOL frame within realistic bounds:
@@ -24,6 +26,13 @@ The mesh is neutral: a mount disc on the flange, a shaft from the flange face to
 cone, the nozzle, whose apex is the TCP. The nozzle is defined in the URDF's ``tcp`` link with
 its apex at that link's origin (vertex exactly (0, 0, 0)), so the tip of the mesh is at the
 true TCP up to the float64 transform (well below 1e-9 m), not at float32 STL precision.
+
+What the drawing gives away is what a real tool shows: the tip and the shaft. The browser gets
+the meshes in FLANGE coordinates (``rigid_meshes``), so the apex is the TCP and the nozzle's
+axis is tool X, as the wire of a real torch is. Tool Y and Z (the spin about X) are not in it:
+the nozzle is a cone, a surface of revolution about X, and the first of its ring's
+``_SECTIONS`` vertices sits at ``ring_phase_deg``, drawn with the secret seed (uniform on
+0..360 deg), not on tool Y; every other part is built from the flange and the shaft line alone.
 """
 
 from __future__ import annotations
@@ -66,7 +75,7 @@ X_TILT_DEG: tuple[float, float] = (0.0, 30.0)
 SPIN_DEG: tuple[float, float] = (-180.0, 180.0)
 MYSTERY_LABEL = "Mystery tool"
 
-_VERSION = "mystery-1"           # part of the seed material: change it and every tool changes
+_VERSION = "mystery-2"           # part of the seed material: change it and every tool (and cache folder) changes
 _MOUNT_RADIUS_M = 0.030
 _MOUNT_HEIGHT_M = 0.012
 _SHAFT_RADIUS_M = 0.010
@@ -98,6 +107,8 @@ class MysteryFrame:
         cone_angle_deg: angle between the TCP direction and the base tool's direction.
         x_tilt_deg: angle between tool X and the TCP direction.
         spin_deg: turn about tool X.
+        ring_phase_deg: where the nozzle ring's first vertex sits about tool X, from tool Y
+            towards tool Z (the drawing's phase, so that no vertex marks tool Y).
     """
 
     digest: str
@@ -106,6 +117,7 @@ class MysteryFrame:
     cone_angle_deg: float
     x_tilt_deg: float
     spin_deg: float
+    ring_phase_deg: float
 
 
 def _perpendicular(v: np.ndarray) -> np.ndarray:
@@ -155,6 +167,7 @@ def draw_mystery_frame(seed: int, trainee_name: str, base: ToolModel) -> Mystery
     x_tilt_rad = float(np.radians(rng.uniform(*X_TILT_DEG)))
     x_axis = _tilt(direction, x_tilt_rad, float(rng.uniform(0.0, 2.0 * np.pi)))
     spin_deg = float(rng.uniform(*SPIN_DEG))
+    ring_phase_deg = float(rng.uniform(0.0, 360.0))
     y0 = _perpendicular(x_axis)
     y_axis = Rotation.from_rotvec(np.radians(spin_deg) * x_axis).apply(y0)
     R = np.column_stack([x_axis, y_axis, np.cross(x_axis, y_axis)])
@@ -162,12 +175,13 @@ def draw_mystery_frame(seed: int, trainee_name: str, base: ToolModel) -> Mystery
     T[:3, :3] = R
     T[:3, 3] = direction * distance_mm / 1000.0
     return MysteryFrame(digest, T, distance_mm, float(np.degrees(cone_rad)), float(np.degrees(x_tilt_rad)),
-                        spin_deg)
+                        spin_deg, ring_phase_deg)
 
 
-def _nozzle_mesh() -> trimesh.Trimesh:
-    """A cone in the TOOL frame: apex exactly at the origin (the TCP), base at x = -L."""
-    a = np.linspace(0.0, 2.0 * np.pi, _SECTIONS, endpoint=False)
+def _nozzle_mesh(phase_deg: float) -> trimesh.Trimesh:
+    """A cone in the TOOL frame: apex exactly at the origin (the TCP), base at x = -L, its ring's
+    first vertex at ``phase_deg`` about X from +Y (towards +Z)."""
+    a = np.radians(phase_deg) + np.linspace(0.0, 2.0 * np.pi, _SECTIONS, endpoint=False)
     ring = np.column_stack([np.full(_SECTIONS, -_NOZZLE_LENGTH_M), _NOZZLE_RADIUS_M * np.cos(a),
                             _NOZZLE_RADIUS_M * np.sin(a)])
     vertices = np.vstack([[0.0, 0.0, 0.0], ring, [-_NOZZLE_LENGTH_M, 0.0, 0.0]])
@@ -231,7 +245,7 @@ def _urdf_text(name: str, T_flange_tool: np.ndarray) -> str:
 """
 
 
-def _write_tool(folder: Path, name: str, T_flange_tool: np.ndarray) -> Path:
+def _write_tool(folder: Path, name: str, T_flange_tool: np.ndarray, ring_phase_deg: float) -> Path:
     """The tool's URDF in ``folder`` (made if missing: temp folder, then rename)."""
     urdf = folder / "tool.urdf"
     if urdf.is_file():
@@ -240,7 +254,7 @@ def _write_tool(folder: Path, name: str, T_flange_tool: np.ndarray) -> Path:
     tmp = Path(tempfile.mkdtemp(prefix=".tmp-", dir=folder.parent))
     try:
         _body_mesh(T_flange_tool).export(tmp / "body.stl")
-        _nozzle_mesh().export(tmp / "nozzle.stl")
+        _nozzle_mesh(ring_phase_deg).export(tmp / "nozzle.stl")
         (tmp / "tool.urdf").write_text(_urdf_text(name, T_flange_tool), encoding="utf-8")
         try:
             os.replace(tmp, folder)
@@ -256,7 +270,8 @@ def _write_tool(folder: Path, name: str, T_flange_tool: np.ndarray) -> Path:
 def _cached_tool(seed: int, name: str, base: ToolModel, cache_dir: Path) -> ToolModel:
     frame = draw_mystery_frame(seed, name, base)
     key = f"mystery-{frame.digest[:10]}"
-    urdf = _write_tool(cache_dir / frame.digest[:32], key.replace("-", "_"), frame.T_flange_tool)
+    urdf = _write_tool(cache_dir / frame.digest[:32], key.replace("-", "_"), frame.T_flange_tool,
+                       frame.ring_phase_deg)
     return load_tool(urdf, key=key, label=MYSTERY_LABEL)
 
 

@@ -12,6 +12,32 @@ surrounding spaces instead of stripping them). The rule both share is Python's
 on top of it this module refuses the few *letters* that draw nothing (Hangul fillers, the
 braille blank), which ``isprintable`` lets through.
 
+Look-alikes (:func:`name_keys`, :func:`looks_alike`): two different names that a reader cannot
+tell apart ("Alice" and "Аlice" with a Cyrillic А, "ＡＬＩＣＥ", "Aĺice") would let a second
+browser pass for a trainee in the trainer's table. Names are compared by a confusable skeleton
+after Unicode TR39 (UTS #39, section 4, "Confusable Detection"): NFKC, then TR39's skeleton
+(NFD, every character replaced by its prototype from Unicode's ``confusables.txt``, NFD again),
+once with the letters' case kept and once case-folded. Two names look alike when either skeleton
+is the same. On top of TR39 the diacritics of the Combining Diacritical Marks blocks are
+dropped (after NFD): TR39 keeps "Aĺice" (l with acute) apart from "Alice", but at the size of a
+table row the acute is a dot over the l, so here they look alike, and so do "José" and "Jose"
+(a class with both asks one of them to add an initial). Marks that are vowels of their own
+script (Devanagari, Thai, Hebrew and Arabic points ...) are not in those blocks and stay.
+
+The confusable data: ``confusable-homoglyphs`` (PyPI; pure Python, a wheel on every platform a
+classroom PC runs), which ships Unicode's ``confusables.txt`` as a table. Chosen over PyICU's
+``SpoofChecker.getSkeleton`` (ICU's own TR39 skeleton) because PyICU has no wheels and must be
+compiled against an installed ICU, which a trainer's Windows or macOS PC does not have. The
+package has no skeleton function, and its table lists each mapping both ways (a source
+character under its prototype and the prototype under the source), so :func:`_prototypes`
+rebuilds the direction: in ``confusables.txt`` a source is one character mapped to exactly one
+prototype and a prototype is never a source, so a character listed with several others, or
+with a string of several characters, is a prototype; a character listed with exactly one
+other that is listed with it alone is one of a pair, and the pair gets its smaller code point as
+the shared prototype (the same classes: only which member names a class differs). Checked when
+written against PyICU 2.17 / ICU 72: the classes of the table's 8167 characters are ICU's
+skeleton classes but for one pair where the two Unicode versions differ (U+1E9A).
+
 Names are data: the views must still show them through ``escape_markdown``.
 """
 
@@ -19,9 +45,13 @@ from __future__ import annotations
 
 import re
 import unicodedata
+from functools import lru_cache
 from typing import Any
 
-__all__ = ["MAX_TRAINEE_NAME_LENGTH", "TraineeNameError", "validate_trainee_name"]
+from confusable_homoglyphs import confusables
+
+__all__ = ["MAX_TRAINEE_NAME_LENGTH", "TraineeNameError", "looks_alike", "name_keys", "skeleton",
+           "validate_trainee_name"]
 
 MAX_TRAINEE_NAME_LENGTH: int = 40
 """Longest trainee name, in characters (after normalisation)."""
@@ -64,3 +94,66 @@ def validate_trainee_name(text: Any) -> str:
         raise TraineeNameError(f"your name has {len(name)} characters; shorten it to at most "
                                f"{MAX_TRAINEE_NAME_LENGTH}.")
     return name
+
+
+# --------------------------------------------------------------------------- look-alikes
+
+#: The Combining Diacritical Marks blocks (and Extended, Supplement, for Symbols, Half Marks):
+#: accents on Latin, Greek and Cyrillic letters, dropped when names are compared.
+_DIACRITIC_BLOCKS = ((0x0300, 0x036F), (0x1AB0, 0x1AFF), (0x1DC0, 0x1DFF), (0x20D0, 0x20FF), (0xFE20, 0xFE2F))
+_BIDI_MARKS = dict.fromkeys(map(ord, "\u200e\u200f"))    # the table wraps right-to-left text in them
+
+
+@lru_cache(maxsize=1)
+def _prototypes() -> dict[str, str]:
+    """Source character -> its prototype string (the direction rebuilt: module docstring)."""
+    table = {key.translate(_BIDI_MARKS): [e["c"].translate(_BIDI_MARKS) for e in entries]
+             for key, entries in confusables.confusables_data.items()}
+    out: dict[str, str] = {}
+    for key, others in table.items():
+        if len(key) > 1 or len(others) > 1:          # a prototype: each other is one of its sources
+            for other in others:
+                if len(other) == 1:
+                    out.setdefault(other, key)
+        else:
+            other = others[0]
+            if len(other) > 1 or len(table.get(other, ())) > 1:
+                out.setdefault(key, other)            # a source of the prototype ``other``
+            else:                                     # a pair: the smaller code point names it
+                small, large = sorted((key, other))
+                out.setdefault(large, small)
+    return out
+
+
+def _is_diacritic(ch: str) -> bool:
+    o = ord(ch)
+    return any(lo <= o <= hi for lo, hi in _DIACRITIC_BLOCKS)
+
+
+def skeleton(text: str) -> str:
+    """TR39's skeleton of ``text``: NFD, each character replaced by its confusable prototype,
+    NFD again (the prototypes as :func:`_prototypes` names them)."""
+    table = _prototypes()
+    mapped = "".join(table.get(ch, ch) for ch in unicodedata.normalize("NFD", text))
+    return unicodedata.normalize("NFD", mapped)
+
+
+@lru_cache(maxsize=4096)
+def name_keys(name: str) -> tuple[str, str]:
+    """The two comparison keys of a name: its skeleton with the case kept ("Ivan" and "lvan"
+    look alike: capital I and small l) and case-folded ("ALICE" and "Alice"), each of NFKC
+    text and with the diacritics dropped (module docstring)."""
+    text = unicodedata.normalize("NFKC", name)
+    cased = skeleton(text)
+    folded = skeleton(skeleton(text.casefold()).casefold())   # a prototype may be a capital letter
+
+    def bare(s: str) -> str:
+        return "".join(ch for ch in s if not _is_diacritic(ch))
+
+    return bare(cased), bare(folded)
+
+
+def looks_alike(a: str, b: str) -> bool:
+    """Whether two names cannot be told apart by eye (either of :func:`name_keys` is equal)."""
+    ka, kb = name_keys(a), name_keys(b)
+    return ka[0] == kb[0] or ka[1] == kb[1]

@@ -39,9 +39,12 @@ __all__ = [
 
 TOOL_LABELS: dict[str, str] = {
     "pointer": "Straight pointer",
-    "torch": "Welding torch (bent neck)",
+    "torch": "Bent-neck welding torch",
     "gripper": "Two-finger gripper",
 }
+"""The built-in tools' labels. A label is also the name a calibration of that tool is saved
+under by default, so each one passes ``tcpcal.tool``'s name check (at most
+``tcpcal.tool.MAX_NAME_LENGTH`` = 24 characters, no double quote)."""
 
 
 def T_flange_tool_m(tool: Tool) -> np.ndarray:

@@ -16,7 +16,14 @@
  *    Cont. mode: the key is held like the mouse button on a hold-to-jog key (press, release).
  *    viser's own keys (W A S D Q E, the arrows: camera; Space) are not used.
  * 2. "Your name" is remembered in this browser's localStorage once the class accepted it, and
- *    typed and submitted again when a new welcome window appears (reload, reconnect).
+ *    typed and submitted again when a new welcome window appears (reload, reconnect, server
+ *    restart), with the browser key the server issued at the join: the server hands a new key
+ *    over in a hidden <div data-tcp-pendant-key="KEY"> (letters, digits, - and _ only; kept in
+ *    localStorage), and the script types it into the "Browser key" field (whose row it hides) of
+ *    each welcome window, so the server knows it is the same browser. A welcome window holding
+ *    <div data-tcp-pendant-hold> is not joined by the script (the name went to another tab of
+ *    this browser: no tug of war); one holding <div data-tcp-pendant-forget> (the trainer
+ *    released the name) also makes it forget the name and key.
  * 3. /?trainer=TOKEN: the token is taken from the address, dropped from the address bar at once
  *    (history.replaceState) and typed into "Trainer token" + "Open trainer view" of each welcome
  *    window of this page (kept in memory only, for reconnects).
@@ -29,11 +36,14 @@
   var MINUS = "\u2212";
   var MARK = "\u2713";
   var L = {
-    name: "Your name", join: "Join the class", token: "Trainer token", openTrainer: "Open trainer view",
+    name: "Your name", key: "Browser key", join: "Join the class", token: "Trainer token",
+    openTrainer: "Open trainer view",
     increment: "Increment", record: "Record", recordPoint: "Record point", banner: "Trainee:"
   };
   var CARTESIAN = ["X", "Y", "Z", "A", "B", "C"];
   var NAME_KEY = "tcpPendant.traineeName";
+  var BROWSER_KEY = "tcpPendant.browserKey";
+  var KEY_RE = /^[A-Za-z0-9_-]{20,200}$/;
   var MAX_TEXT = 200;
   var SETTLE_MS = 400;          // viser sends a field's value in its own message slot: wait before the click
   var JOG_RE = /^(.+) ([\u2212+])$/;
@@ -207,6 +217,21 @@
     var s = storage();
     try { if (s && v.trim().length > 0 && v.length <= MAX_TEXT) s.setItem(NAME_KEY, v); } catch (err) { /* full */ }
   }
+  function storedKey() {
+    var s = storage();
+    try {
+      var v = s && s.getItem(BROWSER_KEY);
+      return typeof v === "string" && KEY_RE.test(v) ? v : null;
+    } catch (err) { return null; }
+  }
+  function rememberKey(v) {
+    var s = storage();
+    try { if (s && KEY_RE.test(v)) s.setItem(BROWSER_KEY, v); } catch (err) { /* full */ }
+  }
+  function forgetAll() {
+    var s = storage();
+    try { if (s) { s.removeItem(NAME_KEY); s.removeItem(BROWSER_KEY); } } catch (err) { /* nothing kept */ }
+  }
 
   var joining = null;                       // {value, input, at}: "Join the class" clicked, not yet accepted
   document.addEventListener("click", function (e) {
@@ -230,8 +255,9 @@
     tried.add(input);
     return true;
   }
-  function fillAndPress(input, value, buttonName) {
+  function fillAndPress(input, value, buttonName, keyInput, key) {
     typeInto(input, value);
+    if (keyInput && key) typeInto(keyInput, key);
     window.setTimeout(function () {
       if (!input.isConnected) return;
       var b = pick(buttonsNamed(buttonName));
@@ -239,8 +265,27 @@
     }, SETTLE_MS);
   }
 
+  var seen = typeof WeakSet === "function" ? new WeakSet() : null;
+  function first(el) {                      // each marker element is acted on once
+    if (!el || !seen || seen.has(el)) return false;
+    seen.add(el);
+    return true;
+  }
+
+  function browserKey() {                   // a key the server handed over: keep it
+    var el = document.querySelector("[data-tcp-pendant-key]");
+    if (!first(el)) return;
+    var k = el.getAttribute("data-tcp-pendant-key") || "";
+    if (KEY_RE.test(k)) rememberKey(k);
+  }
+
   function scan() {
-    if (!joining && !trainerToken && storedName() === null) return;   // nothing to fill or to remember
+    browserKey();
+    var forget = document.querySelector("[data-tcp-pendant-forget]");
+    if (first(forget)) { forgetAll(); joining = null; }
+    var keyRow = labelled(L.key);
+    if (keyRow && keyRow.style.display !== "none") keyRow.style.display = "none";   // the script's own field
+    if (!joining && !trainerToken && storedName() === null && storedKey() === null) return;
     if (joining && !joining.input.isConnected) {
       if (bannerShown()) { rememberName(joining.value); joining = null; }
       else if (Date.now() - joining.at > 30000) joining = null;
@@ -251,8 +296,16 @@
       return;                               // the trainer's page: no trainee name
     }
     var nameInput = field(L.name);
-    var name = nameInput ? storedName() : null;
-    if (nameInput && name !== null && once(nameInput)) fillAndPress(nameInput, name, L.join);
+    if (!nameInput || !once(nameInput)) return;
+    var keyInput = field(L.key);
+    var key = storedKey();
+    var held = document.querySelector("[data-tcp-pendant-hold], [data-tcp-pendant-forget]");
+    var name = storedName();
+    if (held || name === null) {            // no join by the script: the key still goes with a typed name
+      if (keyInput && key) typeInto(keyInput, key);
+      return;
+    }
+    fillAndPress(nameInput, name, L.join, keyInput, key);
   }
 
   // viser 1.1 shows the hint of a button group as a tooltip, not a single button's: name the key

@@ -1,5 +1,10 @@
-"""The trainer view: the class's live table, the gradebook, a CSV download and
-settings pushed to every trainee.
+"""The trainer view: the class's live table, the gradebook, a CSV download, settings pushed to
+every trainee, and releasing a name.
+
+"Release a name" lists the names a browser holds (``ClassRoom.held_names``); **Release name**
+forgets that name's browser key and sends a browser connected under it back to the welcome
+window (``ClassRoom.release``), so the trainee can join from another browser with the same
+records (a laptop that died), or the name is taken back from a browser that had no right to it.
 
 Built in a browser's own GUI once its "Trainer token" was right (``views.identity``); the
 server (``PendantApp``) re-renders every open trainer view when a trainee's row changes. Every
@@ -22,7 +27,7 @@ from tcp_pendant.session import Session
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.upload_guard import limit_upload_size
 from tcp_pendant.wizards.session_record import MAX_RECORD_BYTES, SessionRecordError, check_record_size, load_and_replay
-from tcp_pendant.views.gui_util import ButtonEvent, UploadEvent, target_of
+from tcp_pendant.views.gui_util import ButtonEvent, UploadEvent, set_options, target_of
 
 log = logging.getLogger(__name__)
 _GRADE_WORKER = ThreadPoolExecutor(max_workers=1, thread_name_prefix="record-grading")
@@ -34,6 +39,9 @@ EXERCISES: dict[str, str | None] = {"Free practice": None, "Mystery tool": "myst
 """Exercise choices of the trainer view: label -> exercise id."""
 HIDE_DISTANCE: dict[str, bool | None] = {"(keep)": None, "on": True, "off": False}
 """'Hide distance' choices of the trainer view: label -> the setting pushed (None: keep)."""
+NO_NAME = "(choose a name) "
+"""The first choice of "Release a name" (releases nothing; its trailing space keeps it apart from every
+stored name, which is stripped)."""
 MAX_GRADE_ROWS = 50
 """The gradebook table shows the newest rows only (the CSV has them all)."""
 
@@ -55,6 +63,10 @@ class ClassControl(Protocol):
 
     def push_settings(self, exercise: str | None, tool_key: str | None,
                       hide_distance: bool | None = None) -> int: ...
+
+    def held_names(self) -> list[str]: ...
+
+    def release(self, name: str) -> str: ...
 
 
 def _cell(text: str) -> str:
@@ -130,6 +142,12 @@ class TrainerView:
                 hint="on: trainees judge the touch by eye (no distance, no close-up); off: shown again.")
             self.push = gui.add_button("Push to all trainees", color="blue")
             self.push_md = gui.add_markdown("")
+            self.release_name = gui.add_dropdown(
+                "Release a name", (NO_NAME,), initial_value=NO_NAME,
+                hint="A name stays with the browser it joined from. Release it so that the trainee can "
+                     "join from another browser, or to send a browser that took it back to the welcome window.")
+            self.release = gui.add_button("Release name")
+            self.release_md = gui.add_markdown("")
             self.grade_upload = gui.add_upload_button(
                 "Grade a trainee's record (JSON)", mime_type="application/json",
                 hint="A trainee's exported session: each calibration is replayed and graded against "
@@ -140,12 +158,22 @@ class TrainerView:
         limit_upload_size(self.grade_upload, MAX_RECORD_BYTES, self._refused)
         self.download.on_click(session.on_loop(self._download))
         self.push.on_click(session.on_loop(self._push))
+        self.release.on_click(session.on_loop(self._release))
         self.render()
 
     def render(self) -> None:
         """Re-read the class and the gradebook."""
         self.trainees_md.content = trainees_markdown(self.control.trainee_statuses())
         self.grades_md.content = grades_markdown(self.control.grade_rows())
+        set_options(self.release_name, (NO_NAME, *self.control.held_names()))   # option text, not markdown
+
+    def _release(self, _event: ButtonEvent | None = None) -> None:
+        name = str(self.release_name.value)
+        if name == NO_NAME or name not in self.control.held_names():
+            self.release_md.content = "Choose the name to release first."
+            return
+        self.release_md.content = escape_markdown(self.control.release(name))
+        self.render()
 
     def _download(self, _event: ButtonEvent | None = None) -> None:
         client = self.session.client

@@ -1,0 +1,107 @@
+"""Names kept for the browser that joined under them (browser keys, hashed in the gradebook),
+look-alike names refused, the class's secret exercise seed, and a version 1 gradebook brought to
+version 2 when it is opened."""
+
+from __future__ import annotations
+
+import hashlib
+import sqlite3
+from pathlib import Path
+
+import numpy as np
+import pytest
+from tcp_pendant.classroom.gradebook import SCHEMA_VERSION, Gradebook
+from tcp_pendant.classroom.names import TraineeNameError
+
+
+@pytest.fixture
+def book(tmp_path: Path) -> Gradebook:
+    with Gradebook(tmp_path / "class.sqlite3") as g:
+        yield g
+
+
+def test_a_name_is_kept_for_the_browser_that_joined_under_it(book: Gradebook) -> None:
+    first = book.join_trainee("Alice")
+    assert first.name == "Alice" and first.new_key is not None and len(first.new_key) >= 43
+    # another browser (no key, a wrong key, a key-shaped guess) is refused, in words
+    for key in (None, "", "x" * 43, first.new_key[:-1] + ("A" if first.new_key[-1] != "A" else "B"), 7):
+        with pytest.raises(TraineeNameError, match="Alice is already a trainee of this class, joined from "
+                                                   "another browser.*ask the trainer to release"):
+            book.join_trainee("Alice", key)
+    # the same browser (its key): the same trainee, no new key
+    again = book.join_trainee("  Alice ", first.new_key)
+    assert (again.trainee_id, again.name, again.new_key) == (first.trainee_id, "Alice", None)
+    assert book.holds_key("Alice", first.new_key) and not book.holds_key("Alice", "nope")
+    assert book.held_names() == ["Alice"]
+
+
+def test_only_a_hash_of_the_key_is_stored(tmp_path: Path) -> None:
+    path = tmp_path / "class.sqlite3"
+    with Gradebook(path) as g:
+        key = g.join_trainee("Bo").new_key
+    assert key is not None
+    with sqlite3.connect(path) as db:
+        stored = db.execute("SELECT key_sha256 FROM trainees WHERE name = 'Bo'").fetchone()[0]
+        dump = "\n".join(db.iterdump())
+    assert stored == hashlib.sha256(key.encode()).hexdigest()
+    assert key not in dump
+
+
+def test_released_names_go_to_the_next_browser(book: Gradebook) -> None:
+    old = book.join_trainee("Alice").new_key
+    assert book.release_trainee("Alice") is True
+    assert book.held_names() == [] and not book.holds_key("Alice", old)
+    new = book.join_trainee("Alice")                      # another browser, no key
+    assert new.new_key is not None and new.new_key != old
+    with pytest.raises(TraineeNameError, match="joined from another browser"):
+        book.join_trainee("Alice", old)                   # the released browser's key no longer works
+    assert book.release_trainee("Nobody") is False
+
+
+@pytest.mark.parametrize("look_alike", ["\u0410lice", "ＡＬＩＣＥ", "A\u013aice", "alice"])
+def test_a_look_alike_of_a_name_in_the_class_is_refused_naming_it(book: Gradebook, look_alike: str) -> None:
+    book.join_trainee("Alice")
+    with pytest.raises(TraineeNameError) as info:
+        book.join_trainee(look_alike)
+    assert str(info.value).startswith(f"{look_alike} looks like Alice, a name already in this class")
+    assert "pick a name that looks different" in str(info.value)
+    with book._read() as db:
+        assert [r[0] for r in db.execute("SELECT name FROM trainees")] == ["Alice"]
+    assert book.join_trainee("Alice B.").new_key is not None          # a different name is fine
+
+
+def test_the_exercise_seed_is_random_per_class_and_kept(tmp_path: Path) -> None:
+    with Gradebook(tmp_path / "a.sqlite3") as a, Gradebook(tmp_path / "b.sqlite3") as b:
+        seed_a, seed_b = a.exercise_seed(), b.exercise_seed()
+        assert seed_a != seed_b and seed_a >= 0 and seed_a.bit_length() > 20     # not 0, not small
+        assert a.exercise_seed() == seed_a
+        a.join_trainee("Anna")
+        assert str(seed_a) not in a.to_csv()
+    with Gradebook(tmp_path / "a.sqlite3") as again:                # a restart with the same file
+        assert again.exercise_seed() == seed_a
+
+
+def _version_1_file(path: Path) -> None:
+    """A gradebook as version 1 wrote it: no browser keys in ``trainees``."""
+    with Gradebook(path) as g:
+        sid = g.start_session(g.add_trainee("Anna"), "per-browser")
+        cid = g.start_calibration(sid, "xyz4", "pointer", np.eye(4))
+        g.finish_calibration(cid, {}, position_error_mm=0.2, orientation_error_deg=None, grade="good")
+    with sqlite3.connect(path) as db:
+        db.execute("ALTER TABLE trainees DROP COLUMN key_sha256")
+        db.execute("UPDATE meta SET value = '1' WHERE key = 'schema_version'")
+    db.close()
+
+
+def test_a_version_1_gradebook_still_opens_and_keeps_its_records(tmp_path: Path) -> None:
+    path = tmp_path / "class.sqlite3"
+    _version_1_file(path)
+    with Gradebook(path) as g:
+        (row,) = g.grades()
+        assert (row.trainee, row.grade) == ("Anna", "good")
+        with g._read() as db:
+            assert dict(db.execute("SELECT key, value FROM meta"))["schema_version"] == str(SCHEMA_VERSION) == "2"
+        claim = g.join_trainee("Anna")               # a trainee of a version 1 file: no browser holds it yet
+        assert claim.new_key is not None and claim.trainee_id == g.add_trainee("Anna")
+    with Gradebook(path) as g:                       # opened again: nothing to migrate, the key kept
+        assert g.holds_key("Anna", claim.new_key)
