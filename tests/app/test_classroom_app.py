@@ -189,7 +189,7 @@ def _issued_key(prompt) -> str:
 
 def test_a_connected_name_and_its_look_alikes_are_refused_until_the_trainer_releases_it(
         app_factory, tmp_path: Path) -> None:
-    app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token="tok-1")
+    app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token="trainer-token-tok-1")
     clients = [DrainingClient(app.port)]
     _sessions(app, 1)
     clients.append(DrainingClient(app.port))
@@ -210,7 +210,7 @@ def test_a_connected_name_and_its_look_alikes_are_refused_until_the_trainer_rele
         assert [t.name for t in app.classroom.trainee_statuses()] == ["Alice"]
         # the trainer releases Alice: her browser goes back to the welcome window (its script told to forget)
         q = trainer.views["identity"]
-        choose(q.token_field, "tok-1", trainer.client)
+        choose(q.token_field, "trainer-token-tok-1", trainer.client)
         click(q.open_trainer, trainer.client)
         view = trainer.views["trainer"]
         assert "Alice" in view.release_name.options
@@ -237,7 +237,7 @@ def test_a_connected_name_and_its_look_alikes_are_refused_until_the_trainer_rele
 
 def test_a_browser_that_comes_back_proves_itself_with_its_key(app_factory, tmp_path: Path) -> None:
     db = tmp_path / "class.sqlite3"
-    app = app_factory(class_db=db, trainer_token="tok-1", exercise="mystery")
+    app = app_factory(class_db=db, trainer_token="trainer-token-tok-1", exercise="mystery")
     c = DrainingClient(app.port)
     (s,) = _sessions(app, 1)
     p = _join(s, "Anna")
@@ -258,7 +258,7 @@ def test_a_browser_that_comes_back_proves_itself_with_its_key(app_factory, tmp_p
         c.close()
     app.stop()
     # a server restart on the same gradebook: the same key works, and Anna's mystery tool is the same
-    app2 = app_factory(class_db=db, trainer_token="tok-1", exercise="mystery")
+    app2 = app_factory(class_db=db, trainer_token="trainer-token-tok-1", exercise="mystery")
     c = DrainingClient(app2.port)
     try:
         (s,) = _sessions(app2, 1)
@@ -272,7 +272,7 @@ def test_a_browser_that_comes_back_proves_itself_with_its_key(app_factory, tmp_p
 
 
 def _mystery_frame_of(app_factory, db: Path, name: str, **config) -> np.ndarray:
-    app = app_factory(class_db=db, trainer_token="tok-1", exercise="mystery", **config)
+    app = app_factory(class_db=db, trainer_token="trainer-token-tok-1", exercise="mystery", **config)
     c = DrainingClient(app.port)
     try:
         (s,) = _sessions(app, 1)
@@ -310,7 +310,7 @@ def test_the_same_browser_in_a_second_tab_takes_the_name_and_the_first_tab_holds
     """The key proves it is the same browser (a reload whose old connection is not closed yet,
     a second tab): the newer session gets the name; the older one's welcome window opens again
     with the hold marker, so its script does not join by itself and take it back."""
-    app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token="tok-1")
+    app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token="trainer-token-tok-1")
     clients = [DrainingClient(app.port)]
     _sessions(app, 1)
     clients.append(DrainingClient(app.port))
@@ -342,7 +342,7 @@ def test_the_mystery_mesh_sent_to_the_browser_shows_the_tip_and_the_shaft_but_no
     """What the browser gets of the mystery tool (the MeshMessages under the flange, float32,
     FLANGE coordinates): the nozzle's apex is the TCP (as a real tool's tip is there to see),
     and no vertex of the nozzle ring lies on tool Y or Z about tool X (before: one on tool Y)."""
-    app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token="tok-1", exercise="mystery",
+    app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token="trainer-token-tok-1", exercise="mystery",
                       exercise_seed=7)
     c = RecordingClient(app.port)
     try:
