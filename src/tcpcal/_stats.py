@@ -31,6 +31,8 @@ from typing import cast
 import numpy as np
 from scipy.special import chdtri, fdtri
 
+from tcpcal import _lapack
+
 # A set of touches whose orientations spread by less than this RMS angle (radians) about some
 # flange direction cannot determine the TCP along that direction (predicted uncertainty
 # > 1000 x the touch noise for 1 touch, ~500 x for 4): treated as degenerate, not just weak.
@@ -123,7 +125,7 @@ def information_from_sum(s: np.ndarray, n: int) -> Information:
     rbar = s / n
     m = s.T @ rbar
     np.subtract(_EYE3 * n, m, out=m)
-    w, v = np.linalg.eigh(m)
+    w, v = _lapack.eigh(m)
     if w[0] < 0.0:  # rounding of a (numerically) singular M
         w = np.maximum(w, 0.0)
     return Information(n=n, rbar=rbar, m=m, eigvals=w, eigvecs=v)
