@@ -386,25 +386,32 @@ def press_to_readout(rig: Any, hz: float, seconds: float) -> dict[str, Any]:
     the latency of a press is from the client's click to the first TCP readout the client
     receives that shows it (both stamped with the machine's monotonic clock, in the clients'
     process). Which presses the server carried out (in order) and which its deadman dropped
-    is recorded on the server (``Jogger.key``); the m-th press carried out is shown once the
+    is recorded on the server (``Jogger.key``, ``PressGate.admit``); the m-th press carried out is shown once the
     readout is ``m * 0.1 mm`` past where it was. Unanswered: presses not shown within
     ``ANSWER_WAIT_S`` of the last press (dropped, never reached, or not yet shown).
     Returns the latencies (ms) and the counts."""
     sessions = [rig.app.sessions[k] for k in sorted(rig.app.sessions)]   # client id = connection order
     set_increment(sessions, str(PRESS_MM), 50.0)
-    outcomes: list[list[bool | None]] = [[] for _ in sessions]
+    outcomes: list[list[bool | None]] = [[] for _ in sessions]   # per press: moved fully, or None: dropped
     saved = []
     for s, out in zip(sessions, outcomes):
-        key = s.jogger.key
+        key, admit = s.jogger.key, s.jogger.gate.admit
 
-        def recording(axis: Any, sign: int, *, hold_tick: bool = False, arrived_s: float | None = None,
-                      key: Any = key, out: list[bool | None] = out) -> Any:
-            res = key(axis, sign, hold_tick=hold_tick, arrived_s=arrived_s)
+        def recording(axis: Any, sign: int, *, hold_tick: bool = False, key: Any = key,
+                      out: list[bool | None] = out) -> Any:
+            res = key(axis, sign, hold_tick=hold_tick)
             if not hold_tick:
-                out.append(None if res is None else bool(res.ok))
+                out.append(res is not None and bool(res.ok))
             return res
+
+        def gate(arrived_s: float | None, admit: Any = admit, out: list[bool | None] = out) -> bool:
+            ok = bool(admit(arrived_s))
+            if not ok:
+                out.append(None)
+            return ok
         s.jogger.key = recording
-        saved.append((s, key))
+        s.jogger.gate.admit = gate
+        saved.append((s, key, admit))
     time.sleep(0.3)
     clients = rig.clients
     assert clients.stdin is not None and clients.stdout is not None
@@ -415,8 +422,9 @@ def press_to_readout(rig: Any, hz: float, seconds: float) -> dict[str, Any]:
         clients.stdin.flush()
         data = json.loads(clients.stdout.readline())
     finally:
-        for s, key in saved:
+        for s, key, admit in saved:
             s.jogger.key = key
+            s.jogger.gate.admit = admit
     process = time.process_time() - p0
     latencies: list[float] = []
     asked = answered = dropped = 0
