@@ -36,7 +36,8 @@ def test_bench_solver_quick_runs() -> None:
                    re.MULTILINE)
     assert m4, text
     full, bare, ratio = float(m4.group(1)), float(m4.group(5)), float(m4.group(6))
-    assert bare > 0 and abs(ratio - full / bare) <= 0.006
+    # printed to 0.1 us and 0.01: the ratio of the printed times agrees up to their rounding
+    assert bare > 0 and abs(ratio - full / bare) <= 0.005 + 0.05 * (1.0 + full / bare) / bare
     assert "x bare" in text
 
 
