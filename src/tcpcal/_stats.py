@@ -31,6 +31,8 @@ from typing import cast
 import numpy as np
 from scipy.special import chdtri, fdtri
 
+from tcpcal import _lapack
+
 # A set of touches whose orientations spread by less than this RMS angle (radians) about some
 # flange direction cannot determine the TCP along that direction (predicted uncertainty
 # > 1000 x the touch noise for 1 touch, ~500 x for 4): treated as degenerate, not just weak.
@@ -123,7 +125,7 @@ def information_from_sum(s: np.ndarray, n: int) -> Information:
     rbar = s / n
     m = s.T @ rbar
     np.subtract(_EYE3 * n, m, out=m)
-    w, v = np.linalg.eigh(m)
+    w, v = _lapack.eigh(m)
     if w[0] < 0.0:  # rounding of a (numerically) singular M
         w = np.maximum(w, 0.0)
     return Information(n=n, rbar=rbar, m=m, eigvals=w, eigvecs=v)
@@ -194,10 +196,12 @@ class AngleExtremes:
     """Smallest and largest rotation angle between two touch orientations (degrees) and the
     pairs (0-based touch indices) that give them.
 
-    ``min_deg`` is always exact. ``max_deg`` is exact when ``max_exact``; otherwise (only above
-    ``EXACT_ANGLES_MAX_N`` touches, when the bound-and-prune step of
-    :func:`angle_extremes` could not narrow the candidates) it is a lower bound attained by
-    the pair ``max_pair`` and the true largest angle lies in ``[max_deg, max_upper_deg]``.
+    ``min_deg`` is exact when ``min_exact`` (always up to ``SAMPLED_ANGLES_ABOVE_N`` touches);
+    otherwise it is the angle of the actual pair ``min_pair``, an upper bound of the smallest.
+    ``max_deg`` is exact when ``max_exact``; otherwise (only above ``EXACT_ANGLES_MAX_N``
+    touches, when the bound-and-prune step of :func:`angle_extremes` could not narrow the
+    candidates, or above ``SAMPLED_ANGLES_ABOVE_N``) it is a lower bound attained by the pair
+    ``max_pair`` and the true largest angle lies in ``[max_deg, max_upper_deg]``.
     """
 
     min_deg: float
@@ -206,6 +210,7 @@ class AngleExtremes:
     max_pair: tuple[int, int]
     max_exact: bool = True
     max_upper_deg: float = math.nan  # upper bound of the largest angle (= max_deg when exact)
+    min_exact: bool = True
 
 
 _GRAM_SMALL = 128
@@ -221,6 +226,16 @@ EXACT_ANGLES_MAX_N = 2048
 O(N^2) time, O(N) memory; ~5 ms at N = 2048). Above, the smallest angle comes from a
 nearest-neighbour search (exact) and the largest from a bound-and-prune search (exact when the
 pruning leaves at most this many candidate touches, else a documented estimate)."""
+SAMPLED_ANGLES_ABOVE_N = 100_000
+"""Above this many touches :func:`angle_extremes` estimates both angles from a sample and one
+pass over the touches (:func:`_angle_extremes_sampled`: a few tens of ms at 10^6 touches, no
+more than the least-squares solve itself) instead of the nearest-neighbour and bound-and-prune
+searches (seconds at 10^6)."""
+_SAMPLE_PAIRS = 512
+"""Consecutive pairs of touches in the sample of :func:`_angle_extremes_sampled`."""
+_PASS_ROWS = 8192
+"""Rows per block of the one pass of :func:`_angle_extremes_sampled` (a block's product with
+the two centres stays single-threaded in OpenBLAS and in cache)."""
 _CHUNK_ROWS = 65536
 """Rows per chunk of the O(N m) passes of the large-N path (keeps memory O(N))."""
 _N_RANDOM_CENTRES = 16
@@ -239,11 +254,15 @@ def angle_extremes(rotations: np.ndarray, rotations_soa: np.ndarray | None = Non
     blocks of rows (``_GRAM_BLOCK_ENTRIES``), each reduced to its minimum and maximum. Ties
     resolve to the first pair in row-major order in both cases.
 
-    Above ``EXACT_ANGLES_MAX_N`` touches (recorded tracker data: 1e5-1e6 poses) the cost is
+    Above ``EXACT_ANGLES_MAX_N`` touches (recorded tracker data: 1e4-1e5 poses) the cost is
     O(N log N) time and O(N) memory (:func:`_angle_extremes_large`): the smallest angle exactly,
     by a nearest-neighbour search over unit quaternions with sign folding; the largest angle by
     bound-and-prune, exact in most cases and otherwise a lower bound with an upper bound
     (``AngleExtremes.max_exact``, ``max_upper_deg``).
+
+    Above ``SAMPLED_ANGLES_ABOVE_N`` touches (1e6 poses) both are estimates from a sample and
+    one O(N) pass (:func:`_angle_extremes_sampled`), marked as such (``min_exact`` unless the
+    sample holds two identical orientations, ``max_exact`` False unless the bound closes).
 
     Args:
         rotations: (N, 3, 3).
@@ -254,6 +273,8 @@ def angle_extremes(rotations: np.ndarray, rotations_soa: np.ndarray | None = Non
     n = rotations.shape[0]
     if n < 2:
         return AngleExtremes(math.nan, math.nan, (0, 0), (0, 0))
+    if n > SAMPLED_ANGLES_ABOVE_N and gram is None:
+        return _angle_extremes_sampled(rotations)
     if n > EXACT_ANGLES_MAX_N and gram is None:
         return _angle_extremes_large(rotations)
     x = rotations.reshape(n, 9)
@@ -494,6 +515,52 @@ def _angle_extremes_large(rotations: np.ndarray) -> AngleExtremes:
     upper_deg = max_deg if exact else max(max_deg, math.degrees(upper))
     return AngleExtremes(min_deg=min_deg, max_deg=max_deg, min_pair=min_pair, max_pair=(a, b),
                          max_exact=exact, max_upper_deg=upper_deg)
+
+
+def _angle_extremes_sampled(rotations: np.ndarray) -> AngleExtremes:
+    """:func:`angle_extremes` for very many touches: estimates in O(N) time, one pass.
+
+    The sample: ``_SAMPLE_PAIRS`` consecutive pairs ``(i, i + 1)``, ``i`` spread evenly over
+    the touches (a recording's closest orientations are usually consecutive ones); every pair
+    of the sample is looked at (:func:`_blocked_gram_extremes`). Smallest angle: the sample's,
+    the angle of an actual pair, so an upper bound of the true smallest (exact when it is 0:
+    two identical orientations). Largest angle: with ``a, b`` the sample's farthest pair, one
+    pass over every touch finds the touch farthest from ``a`` and from ``b`` (smallest trace
+    ``x_j . x_a`` of the flattened rotations), so their eccentricities ``e(a), e(b)`` are
+    exact; ``L`` = the largest of the three pairs' angles is attained by a pair, and by the
+    triangle inequality every pair is at most ``U = 2 min(e(a), e(b))`` apart (capped at 180
+    deg). Exact when ``L`` reaches ``U``, else an estimate in ``[L, U]``.
+    """
+    n = rotations.shape[0]
+    x = rotations.reshape(n, 9)
+    starts = np.linspace(0, n - 2, _SAMPLE_PAIRS).round().astype(np.intp)
+    idx = np.unique(np.concatenate([starts, starts + 1]))
+    xs = x[idx]
+    a, b, c, e = (int(idx[k]) for k in _blocked_gram_extremes(xs, np.ascontiguousarray(xs.T)))
+    centres = np.ascontiguousarray(x[[a, b]].T)  # (9, 2)
+    lowest = [math.inf, math.inf]
+    far = [a, b]
+    for start in range(0, n, _PASS_ROWS):
+        tr = x[start : start + _PASS_ROWS] @ centres
+        k = tr.argmin(axis=0)
+        for col in (0, 1):
+            v = float(tr[k[col], col])
+            if v < lowest[col]:
+                lowest[col] = v
+                far[col] = int(k[col]) + start
+    pairs = [(min(a, b), max(a, b)), (min(a, far[0]), max(a, far[0])), (min(b, far[1]), max(b, far[1]))]
+    min_pair = (min(c, e), max(c, e))
+    min_deg, *max_degs = _pair_angles_deg(x, min_pair, *pairs)
+    k = int(np.argmax(max_degs))
+    max_deg, max_pair = float(max_degs[k]), pairs[k]
+    if max_pair[0] == max_pair[1]:  # every orientation the same
+        max_pair = (0, 1)
+    slack_deg = math.degrees(1e-7)  # rounding of the traces and angles, with a margin
+    upper_deg = min(2.0 * min(max_degs[1], max_degs[2]) + slack_deg, 180.0)
+    max_exact = max_deg >= upper_deg - slack_deg
+    return AngleExtremes(min_deg=min_deg, max_deg=max_deg, min_pair=min_pair, max_pair=max_pair,
+                         max_exact=max_exact, max_upper_deg=max_deg if max_exact else upper_deg,
+                         min_exact=min_deg == 0.0)
 
 
 @dataclass(frozen=True)

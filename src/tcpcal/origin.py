@@ -100,7 +100,9 @@ class TcpResult:
             ``max_angle_exact`` is False (possible only above ``EXACT_ANGLES_MAX_N`` = 2048
             touches, see ``tcpcal._stats.angle_extremes``): then a lower bound attained by a
             pair of touches (the true largest angle is at most ``max_angle_upper_deg``).
-        min_angle_deg: smallest rotation angle between two touch orientations.
+        min_angle_deg: smallest rotation angle between two touch orientations; exact unless
+            ``min_angle_exact`` is False (possible only above ``SAMPLED_ANGLES_ABOVE_N`` =
+            100,000 touches): then the angle of an actual pair, an upper bound of the smallest.
         condition_number: of the stacked (4P-3) matrix ``A`` (3N x 6).
         outliers: 0-based indices of touches flagged as outliers.
         without_outliers: the same method on the other touches (indices renumbered in
@@ -110,6 +112,7 @@ class TcpResult:
         max_angle_exact: whether ``max_angle_deg`` is exact (always for N <= 2048).
         max_angle_upper_deg: upper bound of the largest angle (= ``max_angle_deg`` when
             exact).
+        min_angle_exact: whether ``min_angle_deg`` is exact (always for N <= 100,000).
     """
 
     method: str
@@ -132,6 +135,7 @@ class TcpResult:
     n_touches: int
     max_angle_exact: bool = True
     max_angle_upper_deg: float = math.nan
+    min_angle_exact: bool = True
 
 
 def _check_sigma(sigma: float | None) -> float | None:
@@ -159,7 +163,7 @@ def _check_sigma(sigma: float | None) -> float | None:
 def _check_observable(rotations: np.ndarray, info: Information, ext: AngleExtremes) -> None:
     """Raise DegenerateTouchesError when the touches cannot determine the TCP."""
     n = rotations.shape[0]
-    if ext.max_deg < SAME_ORIENTATION_DEG:
+    if ext.max_upper_deg < SAME_ORIENTATION_DEG:  # = max_deg unless it is an estimate
         raise DegenerateTouchesError(
             f"all {n} touches have the same orientation (at most {ext.max_deg:.2f} deg apart), so "
             "the TCP cannot be determined; the 4-point method needs clearly different "
@@ -603,6 +607,7 @@ def _solve(rot: np.ndarray, y: np.ndarray | None, f: np.ndarray, method: str, si
         n_touches=n,
         max_angle_exact=ext.max_exact,
         max_angle_upper_deg=ext.max_upper_deg,
+        min_angle_exact=ext.min_exact,
     )
 
 

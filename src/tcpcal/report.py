@@ -325,6 +325,7 @@ def tcp_result_to_dict(result: TcpResult, *, rows: Sequence[int] | None = None) 
         "max_angle_exact": bool(getattr(result, "max_angle_exact", True)),
         "max_angle_upper_deg": getattr(result, "max_angle_upper_deg", result.max_angle_deg),
         "min_angle_deg": result.min_angle_deg,
+        "min_angle_exact": bool(getattr(result, "min_angle_exact", True)),
         "condition_number": result.condition_number,
         "outliers": [rows[i] for i in result.outliers],
         "warnings": list(result.warnings),
@@ -402,6 +403,14 @@ def _largest_angle(result: TcpResult) -> str:
             f"{_fig(result.max_angle_upper_deg, '', '.1f')})")
 
 
+def _smallest_angle(result: TcpResult) -> str:
+    """``12.3 deg``, or for an estimate (above 100,000 touches, ``min_angle_exact`` False)
+    ``<= 0.4 deg (estimate)``."""
+    if getattr(result, "min_angle_exact", True):
+        return _fig(result.min_angle_deg, " deg", ".1f")
+    return f"<= {_fig(result.min_angle_deg, ' deg', '.1f')} (estimate)"
+
+
 def _tcp_block(result: TcpResult) -> list[str]:
     return [
         f"TCP in FLANGE (mm):       {_xyz(result.tcp)}",
@@ -411,7 +420,7 @@ def _tcp_block(result: TcpResult) -> list[str]:
         (f"95 % radius of the TCP:   {_fig(result.ci95_radius)}   "
          f"(estimated touch noise {_fig(result.noise_sigma)} per axis)"),
         (f"Touch orientations:       largest angle {_largest_angle(result)}, "
-         f"smallest {_fig(result.min_angle_deg, ' deg', '.1f')}; "
+         f"smallest {_smallest_angle(result)}; "
          f"condition number {_fig(result.condition_number, '', '.1f')}"),
     ]
 

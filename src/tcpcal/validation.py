@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from tcpcal import _lapack
 from tcpcal.errors import InvalidInputError
 
 __all__ = [
@@ -120,7 +121,7 @@ def rotations_and_soa(x: Any, name: str = "rotations") -> tuple[np.ndarray, np.n
         np.abs(gram, out=gram)
         if not float(_max(gram, axis=None)) <= ORTHONORMAL_TOL:
             _raise_first_bad(arr, gram.reshape(n, 9).max(axis=1), name)
-        det = np.linalg.det(arr)
+        det = _lapack.det(arr)
     else:
         y = np.ascontiguousarray(arr.reshape(n, 9).T).reshape(3, 3, n)
         # R^T R entries: c_k . c_l = sum_j y[j, k] y[j, l]

@@ -1,5 +1,6 @@
 """Smoke test: the server benchmark still runs (``--quick``) and prints its tables, the
-classroom one (gradebook on / off) included, with finite figures."""
+classroom one (gradebook on / off) included, with finite figures, and a verdict that follows
+from the steps achieved and the press-to-readout latency."""
 
 from __future__ import annotations
 
@@ -46,6 +47,15 @@ def test_bench_server_quick_prints_the_classroom_table() -> None:
         assert rows[name][1] == app_rows[name][0]
     # every Record press of the class-on run went into the gradebook (2 sessions x 3 touches)
     assert re.search(r"gradebook: 6 touches written", classroom)
+    # the verdict is the steps achieved and the latency from press to readout
+    v = re.search(r"RESULT: 2 sessions asked (\S+) jog presses/s each: achieved (\S+) steps/s per session, press to "
+                  r"readout p50 (\S+) ms, p95 (\S+) ms, p99 (\S+) ms, (\d+) of (\d+) presses unanswered "
+                  r"\((\d+) dropped by the deadman\).*: (MET|NOT MET)$", text, re.MULTILINE)
+    assert v, text
+    asked, achieved, p50, p95, p99 = (float(x) for x in v.groups()[:5])
+    unanswered, presses, dropped = (int(x) for x in v.groups()[5:8])
+    assert 0 < achieved <= asked and 0 < p50 <= p95 <= p99 and presses > 0 and dropped <= unanswered <= presses
+    assert (v.group(9) == "MET") == (p99 < 100 and unanswered == 0 and achieved >= 0.95 * asked)
     m = re.search(r"RESULT classroom: a jog step with the gradebook on costs (\S+)x .* a recorded wizard touch "
                   r"(\S+)x", text)
     assert m and all(math.isfinite(float(v)) and float(v) > 0 for v in m.groups())

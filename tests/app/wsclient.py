@@ -3,6 +3,7 @@ subprotocol and drains whatever the server sends (no rendering)."""
 
 from __future__ import annotations
 
+import re
 import socket
 import threading
 import time
@@ -230,3 +231,40 @@ class RecordingClient(DrainingClient):
 
     def of_type(self, name: str) -> list[dict]:
         return [m for m in list(self.messages) if m.get("type") == name]
+
+
+class ReadoutClient(ButtonClient):
+    """A :class:`ButtonClient` that notes when the TCP readout changed and the X it shows:
+    ``readouts`` is a list of ``(time.monotonic() at receipt, X mm)`` (the clock is the
+    machine's, so a server in another process can compare with its own stamps)."""
+
+    X_MM = re.compile(r"\bX\s+(-?\d+\.\d\d) mm")
+
+    def __init__(self, port: int, labels: tuple[str, ...], host: str = "127.0.0.1") -> None:
+        self.readouts: list[tuple[float, float]] = []
+        super().__init__(port, labels, host)
+
+    def _drain(self) -> None:
+        try:
+            for msg in self.ws:
+                t = time.monotonic()
+                self.n_messages += 1
+                self.n_bytes += len(msg)
+                if not isinstance(msg, bytes):
+                    continue
+                for m in decode_window(msg):
+                    kind = m.get("type")
+                    if kind == "GuiButtonMessage" and not self.found.is_set():
+                        label = (m.get("props") or {}).get("label")
+                        if label in self.labels:
+                            self.button_uuids.setdefault(label, m["uuid"])
+                            if len(self.button_uuids) == len(self.labels):
+                                self.found.set()
+                    elif kind == "GuiUpdateMessage":
+                        text = (m.get("updates") or {}).get("_markdown")
+                        if isinstance(text, str) and text.startswith("**TCP in "):
+                            x = self.X_MM.search(text)
+                            if x:
+                                self.readouts.append((t, float(x.group(1))))
+        except Exception:
+            pass

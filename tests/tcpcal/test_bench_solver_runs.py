@@ -31,3 +31,32 @@ def test_bench_solver_quick_runs() -> None:
     for m in large:
         assert 0.0 < float(m.group(1)) < 60.0  # solve seconds
         assert 10 < int(m.group(3)) < 2048  # peak RSS, MB
+    # table 2: the bare SVD solve and solve_xyz4's ratio to it, N = 4 row
+    m4 = re.search(r"^\s+4\s+([\d.]+)\s+([\d.]+)\s+([\d.]+)\s+([\d.]+)\s+([\d.]+)\s+([\d.]+)\s+< 100 us", text,
+                   re.MULTILINE)
+    assert m4, text
+    full, bare, ratio = float(m4.group(1)), float(m4.group(5)), float(m4.group(6))
+    # printed to 0.1 us and 0.01: the ratio of the printed times agrees up to their rounding
+    assert bare > 0 and abs(ratio - full / bare) <= 0.005 + 0.05 * (1.0 + full / bare) / bare
+    assert "x bare" in text
+
+
+def test_the_bare_svd_yardstick_solves_the_same_problem() -> None:
+    """The yardstick of table 2 gives the TCP, reference and residuals of solve_xyz4."""
+    import numpy as np
+
+    sys.path.insert(0, str(BENCH.parent))
+    from bench_solver import bare_svd_solve
+    from poses import random_tcp, tilted_rotations, touch_positions
+
+    from tcpcal.origin import solve_xyz4
+
+    rng = np.random.default_rng(3)
+    for n in (4, 8, 20):
+        rot = tilted_rotations(rng, n, (20.0, 50.0))
+        pos = touch_positions(rot, random_tcp(rng, (100.0, 300.0)), np.array([800.0, 0, 300]), rng, 0.5)
+        x, res = bare_svd_solve(rot, pos)
+        ref = solve_xyz4(rot, pos, detect_outliers=False)
+        np.testing.assert_allclose(x[:3], ref.tcp, atol=1e-9)
+        np.testing.assert_allclose(x[3:], ref.reference, atol=1e-9)
+        np.testing.assert_allclose(res, ref.residuals, atol=1e-9)

@@ -18,7 +18,9 @@ from scipy.spatial.transform import Rotation
 from tcpcal import _stats
 from tcpcal._stats import (
     EXACT_ANGLES_MAX_N,
+    SAMPLED_ANGLES_ABOVE_N,
     _angle_extremes_large,
+    _angle_extremes_sampled,
     angle_extremes,
     distinct_orientations,
     quaternions,
@@ -222,3 +224,57 @@ def test_1e5_touches_with_a_repeated_orientation_solve() -> None:
     assert res.min_angle_deg == 0.0
     assert np.allclose(res.tcp, tcp, atol=0.01)
     assert peak < 600e6, peak
+
+
+@settings(max_examples=150, deadline=None)
+@given(touch_sets())
+def test_sampled_estimates_bracket_the_true_angles(rot: np.ndarray) -> None:
+    """The estimates used above SAMPLED_ANGLES_ABOVE_N touches, against every pair: the smallest
+    is the angle of its (actual) pair and at least the true smallest, exact when it says so;
+    the largest is the angle of its pair, in [true largest - ..., max_upper_deg]."""
+    est = _angle_extremes_sampled(rot)
+    lo, hi = brute_angles_deg(rot)
+    assert est.min_deg >= lo - 1e-5
+    assert est.max_deg <= hi + 1e-5 and hi <= est.max_upper_deg + 1e-5
+    if est.min_exact:
+        assert est.min_deg == 0.0 and lo == pytest.approx(0.0, abs=1e-5)
+    if est.max_exact:
+        assert est.max_deg == pytest.approx(hi, abs=1e-5) and est.max_upper_deg == est.max_deg
+    for pair, deg in ((est.min_pair, est.min_deg), (est.max_pair, est.max_deg)):
+        a, b = pair
+        assert a < b
+        half = _stats.angle_between(rot[a], rot[b]) / 2.0
+        assert math.sin(math.radians(deg) / 2.0) == pytest.approx(math.sin(half), abs=1e-12)
+
+
+def test_above_the_sampling_threshold_both_angles_are_flagged_estimates() -> None:
+    """120,000 uniform orientations: both figures estimated (the smallest an upper bound of the
+    true one, said so in the result, the JSON and the report), the TCP as without them."""
+    n = SAMPLED_ANGLES_ABOVE_N + 20_000
+    rng = np.random.default_rng(8)
+    rot = Rotation.random(n, random_state=rng).as_matrix()
+    tcp = np.array([10.0, 20.0, 150.0])
+    pos = np.array([800.0, 0, 300]) - rot @ tcp + 0.1 * rng.normal(size=(n, 3))
+    res = solve_xyz4(rot, pos)
+    assert not res.min_angle_exact and not res.max_angle_exact
+    exact = _angle_extremes_large(rot)                   # the exact search of up to 1e5 touches
+    assert exact.min_deg <= res.min_angle_deg < 5.0      # uniform: the sample's closest pair is close
+    assert res.max_angle_deg <= exact.max_upper_deg and res.max_angle_deg > 170.0
+    assert res.max_angle_deg <= res.max_angle_upper_deg <= 180.0
+    d = tcp_result_to_dict(res)
+    assert d["min_angle_exact"] is False and d["max_angle_exact"] is False
+    text = format_tcp_report(res, None, command="solve xyz4")
+    assert "smallest <= " in text and "deg (estimate)" in text
+    assert np.allclose(res.tcp, tcp, atol=0.01)
+
+
+def test_above_the_sampling_threshold_a_repeated_orientation_is_exact() -> None:
+    """Half the touches one orientation: the sample holds the repeated pair, so the smallest
+    angle is 0 and exact."""
+    n = SAMPLED_ANGLES_ABOVE_N + 20_000
+    rng = np.random.default_rng(9)
+    rot = Rotation.from_rotvec(rng.normal(size=(n, 3)) * 0.5).as_matrix()
+    rot[::2] = rot[0]
+    ext = angle_extremes(rot)
+    assert ext.min_exact and ext.min_deg == 0.0
+    assert ext.max_deg <= ext.max_upper_deg

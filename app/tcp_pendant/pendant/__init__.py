@@ -13,6 +13,7 @@ controller math: ``tcp_pendant.controller.pose_state`` and ``tcp_pendant.control
 """
 
 from tcp_pendant.pendant.formatting import (
+    dropped_presses_text,
     joint_label,
     joint_readout_markdown,
     tcp_readout_markdown,
@@ -41,6 +42,7 @@ __all__ = [
     "Jogger",
     "ToolEntry",
     "ToolEntryResult",
+    "dropped_presses_text",
     "joint_label",
     "joint_readout_markdown",
     "parse_number",

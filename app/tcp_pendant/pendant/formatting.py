@@ -18,6 +18,7 @@ from tcp_pendant.controller.touch import TOUCH_TOLERANCE_MM
 from tcp_pendant.text_escape import escape_markdown
 
 __all__ = [
+    "dropped_presses_text",
     "fmt_num",
     "joint_label",
     "readout_rows",
@@ -94,6 +95,12 @@ def touch_indicator_markdown(touch: TouchGeometry, *, hide_distance: bool) -> st
     if touch.touching:
         return f"✔ **TOUCHING** the reference tip ({fmt_num(touch.distance_mm)} mm ≤ {TOUCH_TOLERANCE_MM} mm)"
     return f"Distance to reference tip: **{fmt_num(touch.distance_mm)} mm**"
+
+
+def dropped_presses_text(n: int) -> str:
+    """What the trainee is told when ``n`` jog presses (or hold starts, or joint-slider moves)
+    came too late to be carried out (``pendant.jogging.PressGate``)."""
+    return f"{n} jog press{'' if n == 1 else 'es'} dropped: the server was busy"
 
 
 def touch_label(index: int, T_world_flange: np.ndarray) -> str:

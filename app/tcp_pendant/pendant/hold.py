@@ -10,8 +10,15 @@ one tick), the browser's later hold messages only say the key is still held, and
 * at the release (the click the browser sends when the key is let go): at once, so the robot
   stops within one tick of the release reaching the server;
 * when no hold message came for ``deadman_s`` (the browser went away or froze: an enabling
-  switch let go);
+  switch let go), counted from the messages' arrival at the server (``arrived_s``, stamped when
+  viser decodes them, ``views.arrival``), not from when the busy server got round to them: a
+  tick never moves later than ``deadman_s`` after the last hold message arrived, at any load;
 * when a jog stops short (limit, singularity, contact).
+
+A hold message that is older than ``start_bound_s`` when the server reaches it does not start a
+hold (like a stale increment press, ``pendant.jogging.PressGate``; counted in ``dropped``), and
+a hold of another key stops; it still keeps a running hold of the same key alive until
+``deadman_s`` after its arrival.
 
 :class:`HoldDriver` is told how to schedule (``schedule(delay_s, fn)``: the app passes viser
 event loop's ``call_later`` so every tick runs on the loop, like every GUI callback).
@@ -24,6 +31,7 @@ from collections.abc import Callable
 from typing import Protocol
 
 from tcp_pendant.controller import JogResult
+from tcp_pendant.pendant.jogging import PRESS_BOUND_S
 
 __all__ = ["DEADMAN_S", "HOLD_PERIOD_S", "HoldDriver"]
 
@@ -51,17 +59,20 @@ class HoldDriver:
             ``cancel()``.
         clock: seconds, monotonic.
         period_s, deadman_s: see the module constants.
+        start_bound_s: the largest age of a hold message that starts a hold (s).
     """
 
     def __init__(self, step: Callable[[str | int, int], JogResult | None],
                  schedule: Callable[[float, Callable[[], object]], Timer], *,
                  clock: Callable[[], float] = time.monotonic, period_s: float = HOLD_PERIOD_S,
-                 deadman_s: float = DEADMAN_S) -> None:
+                 deadman_s: float = DEADMAN_S, start_bound_s: float = PRESS_BOUND_S) -> None:
         self._step = step
         self._schedule = schedule
         self._clock = clock
         self.period_s = period_s
         self.deadman_s = deadman_s
+        self.start_bound_s = start_bound_s
+        self.dropped = 0
         self.key: Key | None = None
         self._last_message = 0.0
         self._next_at = 0.0
@@ -72,13 +83,22 @@ class HoldDriver:
         """A key is being held (its ticks are scheduled)."""
         return self.key is not None
 
-    def held(self, axis: str | int, sign: int) -> JogResult | None:
-        """A hold message of key ``(axis, sign)``: start moving (first tick now) or keep going.
-        Another key's message takes over from the one held before."""
+    def held(self, axis: str | int, sign: int, arrived_s: float | None = None) -> JogResult | None:
+        """A hold message of key ``(axis, sign)`` that reached the server at ``arrived_s``
+        (``clock`` seconds; None: now): start moving (first tick now) or keep going. Another
+        key's message takes over from the one held before. A message older than
+        ``start_bound_s`` does not start a hold (it is counted in ``dropped``) and stops the one
+        held before."""
         now = self._clock()
-        self._last_message = now
+        arrived = now if arrived_s is None else min(float(arrived_s), now)
         if self.key == (axis, sign):
+            self._last_message = max(self._last_message, arrived)
             return None
+        if now - arrived > self.start_bound_s:
+            self.stop()                              # the safe side: the key held before stops too
+            self.dropped += 1
+            return None
+        self._last_message = arrived
         self.stop()
         self.key = (axis, sign)
         self._next_at = now

@@ -13,6 +13,13 @@ the frame through the TCP, KUKA habit). Each -/+ key press moves
   is a backlog (the server fell behind the browser's 20 Hz): it is skipped, so the key stops
   within one tick of its release instead of working off queued ticks.
 
+The deadman of increment presses (:class:`PressGate`): a press is carried out only if the server
+reaches it within ``PRESS_BOUND_S`` (250 ms) of its arrival (stamped when viser decodes the
+browser's message, ``views.arrival``); an older one is dropped and counted, so that the trainee
+can be told. A server that falls behind therefore never works off a backlog of presses: every
+press it carries out is at most ``PRESS_BOUND_S`` old, and the robot stands still within that
+(plus one step) of the last press reaching the server, at any load.
+
 Stop at contact (a real touch-up): a Cartesian X/Y/Z press or tick whose tool-tip path would
 pass through the reference tip (closer than ``guidance.CONTACT_RADIUS_MM`` to it, beyond the
 closest point) stops at the closest point and says so (``JogResult.stopped_by == "contact"``);
@@ -41,10 +48,12 @@ __all__ = [
     "JOINT_SPEED_DEG_S",
     "LINEAR_SPEED_MM_S",
     "MAX_TICK_S",
+    "PRESS_BOUND_S",
     "ROTATION_SPEED_DEG_S",
     "JogMode",
     "JogSettings",
     "Jogger",
+    "PressGate",
 ]
 
 CONTINUOUS = "Cont."
@@ -58,6 +67,8 @@ ROTATION_SPEED_DEG_S = 30.0
 JOINT_SPEED_DEG_S = 30.0
 MAX_TICK_S = 0.05
 """Largest ``dt`` of one continuous tick (s): one tick at the pendant's 20 Hz."""
+PRESS_BOUND_S = 0.25
+"""A key press older than this when the server reaches it is dropped (s, since its arrival)."""
 
 
 class JogMode(str, Enum):
@@ -124,6 +135,39 @@ class JogSettings:
         return speed * self.override_pct / 100.0 * dt
 
 
+class PressGate:
+    """The deadman of key presses: lets a press through only while it is fresh.
+
+    Args:
+        clock: seconds, monotonic (the clock the arrival stamps are in; injectable for tests).
+        bound_s: the largest age of a press that is still carried out (s).
+
+    Attributes:
+        dropped: presses dropped since the last :meth:`take_dropped`.
+        dropped_total: every press dropped so far.
+    """
+
+    def __init__(self, *, clock: Callable[[], float] = time.monotonic, bound_s: float = PRESS_BOUND_S) -> None:
+        self._clock = clock
+        self.bound_s = bound_s
+        self.dropped = 0
+        self.dropped_total = 0
+
+    def admit(self, arrived_s: float | None) -> bool:
+        """True when a press that arrived at ``arrived_s`` (None: unknown, taken as now) may be
+        carried out now; otherwise it is counted as dropped."""
+        if arrived_s is None or self._clock() - arrived_s <= self.bound_s:
+            return True
+        self.dropped += 1
+        self.dropped_total += 1
+        return False
+
+    def take_dropped(self) -> int:
+        """The number of presses dropped since the last call (and reset it)."""
+        n, self.dropped = self.dropped, 0
+        return n
+
+
 class Jogger:
     """Turns pendant key presses into controller commands.
 
@@ -131,6 +175,10 @@ class Jogger:
         controller: the session's controller (the caller holds the session lock).
         clock: seconds, monotonic (injectable for tests).
         tick_s: nominal hold-callback period; the first tick of a hold uses it as ``dt``.
+
+    Attributes:
+        gate: the deadman of this pendant's presses (:class:`PressGate`, on ``clock``): the
+            views ask it whether a press is still fresh before they jog.
     """
 
     def __init__(self, controller: VirtualController, *, clock: Callable[[], float] = time.monotonic,
@@ -141,6 +189,7 @@ class Jogger:
         self._tick_s = tick_s
         self._last_tick: dict[str, float] = {}
         self._held_at_contact: str | None = None
+        self.gate = PressGate(clock=clock)
 
     def key(self, axis: str | int, sign: int, *, hold_tick: bool = False) -> JogResult | None:
         """One press of a -/+ key.

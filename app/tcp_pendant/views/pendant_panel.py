@@ -12,6 +12,11 @@ own script (``static/pendant.js``, served by ``client_script``): it clicks these
 key is a click; every jog, increment and Record hint names its key and :data:`KEYS_LINE` sums
 them up below the jog keys.
 
+The deadman: a jog click, the start of a hold and a joint slider's move are carried out only
+while fresh (``pendant.jogging.PressGate``, ``PRESS_BOUND_S`` after their arrival as
+``views.arrival`` stamps it); the ones dropped are counted and reported once per burst, on the
+status line and as a notification ("N jog presses dropped: the server was busy").
+
 Widgets only call :class:`tcp_pendant.pendant.Jogger` and the session; all text comes from
 ``tcp_pendant.pendant.formatting``. Every callback runs on viser's event loop
 (:meth:`Session.on_loop`), in the order the browser's messages arrived.
@@ -36,6 +41,7 @@ import viser
 from tcp_pendant.controller import JogResult
 from tcp_pendant.pendant import (
     CARTESIAN_AXES,
+    dropped_presses_text,
     INCREMENTS,
     JOG_FRAMES,
     JogMode,
@@ -47,6 +53,7 @@ from tcp_pendant.pendant import (
 from tcp_pendant.pendant.hold import HoldDriver
 from tcp_pendant.pendant.guidance import CLOSEUP_WITHIN_MM, offset_markdown, side_view_markdown, tip_offset_mm
 from tcp_pendant.session import Session, SessionChange
+from tcp_pendant.views import arrival
 from tcp_pendant.views.scene import closeup_camera, overview_camera
 from tcp_pendant.views.gui_util import ButtonEvent, ButtonGroupEvent, CheckboxEvent, set_value, target_of
 from tcp_pendant.views.viser_adapter import queue_markdown
@@ -121,6 +128,8 @@ class PendantPanel:
         self._last_stop = ""
         self._stop_key: Any = None
         self._hold: HoldDriver | None = None
+        self._drop_report_due = False
+        arrival.install()
 
         st = session.jogger.settings
         self._readout = "WORLD"
@@ -235,6 +244,9 @@ class PendantPanel:
         if hold_tick is False and self.session.jogger.settings.continuous:
             self._stop_hold()                        # the click that ends a hold: no move
             return
+        if not hold_tick and not self.session.jogger.gate.admit(arrival.arrived_s()):
+            self._report_drops_soon()                # a stale press: dropped, never carried out late
+            return
         self.session.jog(axis, sign, hold_tick=hold_tick)
 
     # hold-to-jog on the server's 20 Hz clock (pendant/hold.py)
@@ -252,7 +264,9 @@ class PendantPanel:
 
             self._hold = HoldDriver(self._hold_step, schedule)
             self.session.on_close(self._hold.stop)
-        self._hold.held(axis, sign)
+        self._hold.held(axis, sign, arrival.arrived_s())
+        if self._hold.dropped:
+            self._report_drops_soon()
 
     def _hold_step(self, axis: str | int, sign: int) -> JogResult | None:
         """One server tick of the held key (under the session lock, on the loop)."""
@@ -261,6 +275,25 @@ class PendantPanel:
             self._stop_hold()
             return None
         return s.jog(axis, sign, hold_tick=True)
+
+    def _report_drops_soon(self) -> None:
+        """Report the dropped presses once the loop has worked through what is queued now (one
+        report per burst: a busy server is not sent a notification per press)."""
+        if self._drop_report_due:
+            return
+        self._drop_report_due = True
+        asyncio.get_running_loop().call_soon(self.session.guard(self._report_drops))
+
+    def _report_drops(self) -> None:
+        self._drop_report_due = False
+        n = self.session.jogger.gate.take_dropped()
+        if self._hold is not None:
+            n, self._hold.dropped = n + self._hold.dropped, 0
+        if n:
+            text = dropped_presses_text(n)
+            self._set_md(self.status_md, "status", f"⚠ {text}.")
+            self.session.notify("Jog presses dropped", f"{text}; press again.", kind="warning")
+            self.render()                            # a dropped slider move: the slider shows the joint
 
     def _stop_hold(self) -> None:
         if self._hold is not None:
@@ -296,6 +329,10 @@ class PendantPanel:
         def cb(event: Any) -> None:
             if event.client is None:
                 return                                # our own update of the slider: no loop
+            if not s.jogger.gate.admit(arrival.arrived_s()):
+                self._from_client.pop(index, None)    # render writes the joint's angle back
+                self._report_drops_soon()
+                return
             value = float(event.target.value)
             if not math.isfinite(value):
                 return
