@@ -101,10 +101,10 @@ def test_the_exercise_seed_is_the_classs_unless_given_and_never_printed(tmp_path
 
     assert build_parser().parse_args(["--exercise", "mystery"]).exercise_seed is None
     with Gradebook(tmp_path / "class.sqlite3") as book:
-        room = ClassRoom(book, {}, trainer_token="tok-12345678", exercise="mystery")
+        room = ClassRoom(book, {}, trainer_token="trainer-tok-12345678", exercise="mystery")
         seed = room._seed()
         assert seed == book.exercise_seed() and seed.bit_length() > 20
         lines = _class_lines(SimpleNamespace(classroom=room, trainer_url="http://127.0.0.1:1/?trainer=tok-12345678"))
         assert "class gradebook" in lines and str(seed) not in lines
-        assert ClassRoom(book, {}, trainer_token="tok-12345678", exercise_seed=7)._seed() == 7   # a demo's
+        assert ClassRoom(book, {}, trainer_token="trainer-tok-12345678", exercise_seed=7)._seed() == 7   # a demo's
         assert book.exercise_seed() == seed                                                   # kept
