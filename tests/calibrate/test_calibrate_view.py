@@ -306,3 +306,22 @@ def test_resume_names_what_it_brings_back_and_offers_the_choice(page) -> None:
     assert v.resume.label == "Resume 1: XYZ 4-point, at step 2 of 4 (1 recorded)"
     p.click(v.resume)
     assert s.workflow.run is s.workflow.runs[0] and s.workflow.wizard.step_index == 1
+
+
+def test_a_refused_save_says_so_in_the_result_panel(page) -> None:
+    """A Save the library refuses (here a name longer than a controller takes, as the torch's
+    built-in label was) was said only in a toast; the panel kept offering Save as if nothing
+    had happened."""
+    p = page()
+    v, s = p.view, p.session
+    p.click(v.start)
+    for _ in range(4):
+        p.click(v.steps.auto_touch)
+    p.choose(v.result.save_name, "A tool name of thirty chars")
+    p.click(v.result.save)
+    assert "**Not saved:**" in v.result.save_md.content and "24" in v.result.save_md.content
+    assert p.notes and p.notes[-1][0] == "Not done"
+    assert s.library.tools() == {} and s.workflow.last_save is None
+    p.choose(v.result.save_name, "Pen 4P")
+    p.click(v.result.save)                            # a good name: saved, the refusal is gone
+    assert "Not saved" not in v.result.save_md.content and "Saved **Pen 4P**" in v.result.save_md.content

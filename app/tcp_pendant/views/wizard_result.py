@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from tcp_pendant.calibrate import error_bars
+from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.calibrate.text import (
     comparison_markdown,
     estimator_options,
@@ -124,6 +125,7 @@ class WizardResultView:
         self.save_name.on_update(act(lambda _e: None, user_only=True))
         self.save_slot.on_update(act(lambda _e: None, user_only=True))
         self._named_run: Any = None
+        self._refused: tuple[Any, str] | None = None   # (run, why its last Save was refused)
         self._charted: Any = None
 
     # ------------------------------------------------------------ callbacks
@@ -149,8 +151,16 @@ class WizardResultView:
         self._with_estimators(lambda wiz: wiz.set_estimator(key))
 
     def _on_save(self, _event: ButtonEvent) -> None:
-        slot, tool = self.parent.session.save_result(str(self.save_name.value),
-                                                     number_of_option(self.save_slot.value))
+        """Save; a refusal is said in the panel (it stays until the next Save or another
+        result), not only in the toast the session's guard shows."""
+        run = self.parent.workflow.run
+        try:
+            slot, tool = self.parent.session.save_result(str(self.save_name.value),
+                                                         number_of_option(self.save_slot.value))
+        except ValueError as exc:
+            self._refused = (run, str(exc))
+            raise
+        self._refused = None
         self.parent.saved(slot, tool)
 
     def _on_check_tcp(self, _event: ButtonEvent) -> None:
@@ -197,6 +207,9 @@ class WizardResultView:
                                                                  tool.tcp_mm, tool.abc_deg))
         if wf.last_save is not None:
             set_content(self.save_md, save_markdown(wf.last_save[0], wf.last_save[1].name))
+        refused = self._refused
+        if refused is not None and refused[0] is wf.run and wf.last_save is None:
+            set_content(self.save_md, f"⚠ **Not saved:** {escape_markdown(refused[1])}")
         extras = set() if wf.wizard is None else type(wf.wizard).result_extras
         self._render_estimators(res if "estimators" in extras else None)
 
