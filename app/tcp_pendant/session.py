@@ -57,6 +57,7 @@ from tcp_pendant.controller import ControllerError, JogResult, ToolModel, Virtua
 from tcp_pendant.controller.pose_state import PoseState, pose_state, pose_state_key
 from tcp_pendant.controller.scenarios import Scenario, ScenarioWorld, bent_tool, realize
 from tcp_pendant.pendant import Jogger, touch_label
+from tcp_pendant.pendant.exercise_rules import FREE_PRACTICE, ExerciseRules
 
 __all__ = ["GuiTarget", "Session", "SessionChange", "Touch"]
 
@@ -165,7 +166,9 @@ class Session:
             when the views are built (None without the wizards plug-in); the Jog tab's wizard
             dock renders its state and calls its commands.
         hide_distance: "Hide distance" (training: judge the touch by eye); change it with
-            :meth:`set_hide_distance`.
+            :meth:`set_hide_distance`. While it is on, a jog does not stop at the reference tip.
+        rules: what the trainer's exercise allows (``pendant.exercise_rules``); change it with
+            :meth:`set_rules`.
     """
 
     controller: VirtualController
@@ -182,11 +185,13 @@ class Session:
     scene_labels: dict[str, Any] = field(default_factory=dict)
     workflow: Any | None = None
     hide_distance: bool = False
+    rules: ExerciseRules = FREE_PRACTICE
 
     def __post_init__(self) -> None:
         if self.target is None:
             self.target = self.client
         self.jogger = Jogger(self.controller)
+        self.jogger.stop_at_contact = not self.hide_distance
         self.closed = False
         self._subscribers: list[Callable[[SessionChange], None]] = []
         self._close_callbacks: list[Callable[[], None]] = []
@@ -296,12 +301,28 @@ class Session:
         self.changed(pose=True, jog=jog)
 
     def set_hide_distance(self, hide: bool) -> None:
-        """"Hide distance" on or off: the readouts re-render (a ``pose`` change)."""
+        """"Hide distance" on or off: the readouts re-render (a ``pose`` change); while it is
+        on, a jog goes through the reference tip instead of stopping there.
+
+        Raises:
+            RuleRefusal: the exercise's rules lock the distance aids and ``hide`` is False.
+        """
         with self.lock:
+            self.rules.check_hide_distance(bool(hide))
             if bool(hide) == self.hide_distance:
                 return
             self.hide_distance = bool(hide)
+            self.jogger.stop_at_contact = not self.hide_distance
             self.changed(pose=True)
+
+    def set_rules(self, rules: ExerciseRules) -> None:
+        """The exercise's rules (the classroom sets them): locked distance aids switch "Hide
+        distance" on; the views re-render (``pose`` and ``wizard``: the checkbox, Auto-touch)."""
+        with self.lock, self.batch():
+            self.rules = rules
+            if rules.distance_locked:
+                self.set_hide_distance(True)
+            self.changed(pose=True, wizard=True)
 
     def refresh(self) -> None:
         """Re-render everything that shows the robot (the same signal as :meth:`moved`)."""

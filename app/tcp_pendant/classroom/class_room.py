@@ -9,8 +9,13 @@ in that browser. Every trainer view re-renders when a trainee's row changes.
 
 In an exercise the trainee sees no truth: the workflow's ``hide_truth`` is set (the result
 panel shows no error against the true TOOL frame and no grade, the scene no TRUE triad); the
-gradebook keeps them for the trainer. The settings a trainer pushes (exercise, tool, "Hide
-distance") apply to every named trainee and to those who name themselves later.
+gradebook keeps them for the trainer. The settings a trainer pushes (exercise, tool, distance
+aids, Auto-touch) apply to every named trainee and to those who name themselves later.
+
+Each trainee's pendant follows the class's :class:`~tcp_pendant.pendant.exercise_rules.ExerciseRules`
+(``Session.set_rules``): in an exercise the distance aids are hidden and locked and Auto-touch
+is off unless the trainer unlocked or allowed them (``class_rules``); a change of exercise goes
+back to those defaults unless the same push sets them.
 
 Threads: the session callbacks run on viser's event loop (``Session.on_loop``); connects and
 disconnects come from viser's thread pool and hand their trainer-view refresh to the loop
@@ -29,6 +34,7 @@ from tcp_pendant.classroom.gradebook import Gradebook, GradeRow
 from tcp_pendant.classroom.mystery import draw_mystery_tool
 from tcp_pendant.classroom.recorder import TraineeRecorder, TraineeStatus
 from tcp_pendant.controller import ToolModel
+from tcp_pendant.pendant.exercise_rules import DistanceAids, ExerciseRules, class_rules
 from tcp_pendant.session import Session, SessionChange
 
 __all__ = ["EXERCISE_IDS", "ClassRoom"]
@@ -69,8 +75,31 @@ class ClassRoom:
         self._trainees: dict[int, tuple[Session, TraineeRecorder, str]] = {}   # id(session) -> ...
         self._left: list[TraineeStatus] = []        # rows of trainees who left (connected=False)
         self._trainer_views: dict[int, Any] = {}    # id(session) -> TrainerView
-        self.hide_distance: bool | None = None
-        """"Hide distance" as the trainer last pushed it (None: each trainee's own choice)."""
+        self.distance_aids: DistanceAids | None = None
+        """The distance aids as the trainer last pushed them (None: the exercise's default -
+        locked in an exercise, each trainee's own choice in free practice)."""
+        self.auto_touch: bool | None = None
+        """Auto-touch as the trainer last allowed it (None: the default - off in an exercise)."""
+
+    @property
+    def rules(self) -> ExerciseRules:
+        """The rules every trainee's pendant follows now."""
+        return class_rules(self.exercise, self.distance_aids, self.auto_touch)
+
+    def _apply_rules(self, session: Session, *, aids_too: bool = True) -> None:
+        """The class's rules on one trainee's pendant (under its lock), and with ``aids_too``
+        its distance aids (else a trainee's own "Hide distance" choice is kept where the rules
+        allow it)."""
+        rules = self.rules
+        aids = self.distance_aids or ("locked" if rules.in_exercise else None)
+        if not aids_too:
+            aids = "locked" if rules.distance_locked else None
+        with session.batch():
+            if not rules.distance_locked:
+                session.set_rules(rules)            # unlock first: "shown" may then switch it off
+            if aids is not None:
+                session.set_hide_distance(aids != "shown")
+            session.set_rules(rules)
 
     # ------------------------------------------------------------ sessions
     def attach(self, session: Session) -> Any:
@@ -106,8 +135,7 @@ class ClassRoom:
             self._hide_truth(workflow, self.exercise)
             if self.exercise == "mystery":
                 self._mount_mystery(session, recorder, name)
-            if self.hide_distance is not None:
-                session.set_hide_distance(self.hide_distance)
+            self._apply_rules(session)
         self.refresh_trainers()
         return recorder
 
@@ -178,18 +206,29 @@ class ClassRoom:
     def grades_csv(self) -> str:
         return self.gradebook.to_csv()
 
-    def push_settings(self, exercise: str | None, tool_key: str | None, hide_distance: bool | None = None) -> int:
+    def push_settings(self, exercise: str | None, tool_key: str | None,
+                      hide_distance: bool | DistanceAids | None = None, auto_touch: bool | None = None) -> int:
         """Set the exercise (None: free practice; "mystery": each trainee gets a mystery tool),
-        mount ``tool_key`` (None: keep) and set "Hide distance" (None: keep) on every named
-        trainee's pendant; later trainees get the exercise and "Hide distance" when they name
-        themselves. Returns how many trainees."""
+        mount ``tool_key`` (None: keep), set the distance aids (``hide_distance``: "locked",
+        "hidden" or "shown"; True means "hidden", False "shown"; None: keep) and allow
+        Auto-touch or not (None: keep) on every named trainee's pendant; later trainees get
+        them when they name themselves. A new exercise starts from its default rules (module
+        docstring) except what this push sets. Returns how many trainees."""
         if exercise is not None and exercise not in EXERCISE_IDS:
             raise ValueError(f"Unknown exercise {exercise!r}; use one of {', '.join(EXERCISE_IDS)}.")
         if tool_key is not None and tool_key not in self.tools:
             raise ValueError(f"Unknown tool {tool_key!r}; use one of {', '.join(self.tools)}.")
+        aids: DistanceAids | None = ({True: "hidden", False: "shown"}[hide_distance]   # type: ignore[assignment]
+                                     if isinstance(hide_distance, bool) else hide_distance)
+        class_rules(exercise, aids, auto_touch)         # ValueError: an unknown aids setting
+        new_exercise = exercise != self.exercise
+        if new_exercise:
+            self.distance_aids = self.auto_touch = None
         self.exercise = exercise
-        if hide_distance is not None:
-            self.hide_distance = bool(hide_distance)
+        if aids is not None:
+            self.distance_aids = aids
+        if auto_touch is not None:
+            self.auto_touch = bool(auto_touch)
         with self._lock:
             trainees = list(self._trainees.values())
         for session, recorder, name in trainees:
@@ -201,8 +240,7 @@ class ClassRoom:
                         self._mount_mystery(session, recorder, name)
                     elif tool_key is not None:
                         session.mount_tool(self.tools[tool_key])
-                    if hide_distance is not None:
-                        session.set_hide_distance(bool(hide_distance))
+                    self._apply_rules(session, aids_too=new_exercise or aids is not None)
                     session.changed(wizard=True)      # the result panel shows or hides the truth
             session.guard(apply)()
         return len(trainees)

@@ -298,7 +298,11 @@ class PendantPanel:
     def _on_hide_distance(self, event: Any) -> None:
         if event is not None and getattr(event, "client", 1) is None:
             return                                   # our own assignment
-        self.session.set_hide_distance(bool(self.hide_distance.value))
+        try:
+            self.session.set_hide_distance(bool(self.hide_distance.value))
+        except ValueError:                           # refused (an exercise's lock): undo the tick
+            self.hide_distance.value = self.session.hide_distance
+            raise
 
     def _slider_cb(self, index: int) -> Any:
         """The callback of joint slider ``index`` (0-based): set the joint to the browser's
@@ -407,6 +411,8 @@ class PendantPanel:
         hide = s.hide_distance
         if bool(self.hide_distance.value) != hide:
             self.hide_distance.value = hide
+        if self.hide_distance.disabled != s.rules.distance_locked:     # locked by the trainer
+            self.hide_distance.disabled = s.rules.distance_locked
         touch = touch_indicator_markdown(state.touch, hide_distance=hide)
         closeup = ""
         if not hide:
