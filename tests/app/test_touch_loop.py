@@ -160,6 +160,26 @@ def test_an_increment_stops_at_contact_and_the_next_press_goes_on(page) -> None:
     assert pendant.status_md.content == ""
 
 
+def test_with_the_distance_hidden_a_jog_goes_through_the_tip_silently_and_crashes(page) -> None:
+    """Judged by eye: no stop at the tip, no message, no toast - "press until it stops" would
+    tell the trainee where the tip is; driven through it, the tool crashes."""
+    p = page()
+    s, pendant = p.session, p.pendant
+    p.choose(pendant.hide_distance, True)
+    p.tip_at((0.0, 0.0, 4.0))                                       # 4 mm above the reference tip
+    p.notes.clear()
+    p.choose(pendant.increment, "10")
+    p.choose(pendant.cart_rows["Z"], "Z −")                         # 10 mm down: through the tip
+    st = s.pose_state()
+    assert st.touch.crashed and st.touch.penetration_mm == pytest.approx(6.0, abs=0.01)
+    assert pendant.status_md.content == "" and p.notes == []        # not a word before the crash ...
+    assert "CRASH" in pendant.touch_md.content                      # ... then the crash, as on a robot
+    p.choose(pendant.hide_distance, False)                          # shown again: the stop is back
+    p.tip_at((0.0, 0.0, 4.0))
+    p.choose(pendant.cart_rows["Z"], "Z −")
+    assert "Stopped at the reference tip" in pendant.status_md.content
+
+
 def test_a_stop_message_does_not_outlive_an_auto_touch(page) -> None:
     p = page()
     s, pendant = p.session, p.pendant

@@ -151,3 +151,18 @@ def test_a_finished_check_is_done_not_left_half_way(workflow, library) -> None:
     wf.auto_touch(AutoTouchRequest())
     wf.cancel()                                           # an unfinished one waits to be resumed
     assert [label for _, label in wf.resumable()] == ["2: TCP check (spin test), 1 of 1 recorded"]
+
+
+def test_in_an_exercise_the_check_reads_the_tip_by_eye_and_gives_no_correction(workflow, library) -> None:
+    wf = workflow("kr6", "pointer", seed=5)
+    wf.hide_truth = True                                     # the classroom's exercise
+    slot = saved_tool(library, "pointer", OFFSET_FLANGE_MM, name="Pointer off")
+    res = check(wf, slot, angle_deg=30)
+    c = res.check
+    assert c.implied_tcp_error_mm is None and c.correction_flange_mm is None and c.fit_rms_mm is None
+    assert all(r.deviation_mm % 0.5 == 0.0 for r in c.rows) and max(r.deviation_mm for r in c.rows) >= 0.5
+    text = result_markdown(res)
+    assert "Implied TCP error" not in text and "suggested correction" not in text
+    assert "0.600" not in text and "-0.60" not in text and "by eye" in text
+    record = json.dumps(wf.export_record())
+    assert "correction_flange_mm\": null" in record and "-0.6" not in record

@@ -65,6 +65,7 @@ from tcp_pendant.wizards.session_record import (
     step_distances,
 )
 from tcp_pendant.wizards.beam import wall_time_s
+from tcp_pendant.wizards.tcp_check import CheckFigures
 from tcp_pendant.wizards.truth import TruthComparison, compare_with_truth
 from tcpcal.library import ToolLibrary
 from tcpcal.tool import Tool
@@ -165,6 +166,8 @@ class TcpCheckJob:
     T_flange_tool_active: np.ndarray
     T_flange_tool_true: np.ndarray
     settings: JogSettings = field(repr=False)
+    reading_only: bool = False
+    """An exercise: the wizard gets a technician's reading only (``CheckFigures.as_reading``)."""
 
     def run(self) -> SpinCheckResult:
         """``controller.spin.spin_check`` from the recorded touch's joint angles."""
@@ -173,8 +176,10 @@ class TcpCheckJob:
                           settings=self.settings)
 
     def hand_in(self, outcome: SpinCheckResult) -> WizardResult | None:
-        """The check to its wizard (from the recorded touch it started at), then Finish."""
-        self.wizard.give_check(outcome, self.pose)
+        """The check to its wizard (from the recorded touch it started at), then Finish; in an
+        exercise the reading only (no implied TCP error, no correction)."""
+        figures = CheckFigures.of(outcome)
+        self.wizard.give_check(figures.as_reading() if self.reading_only else figures, self.pose)
         if self.wizard.status == "in_progress":
             return self.wizard.finish()
         return None
@@ -710,7 +715,8 @@ class CalibrationWorkflow:
         T_active = T_flange_tool_m(w.tool)
         nominal, physical = c.kinematics_for_worker()
         return TcpCheckJob(w, pose, nominal, physical, np.array(q, dtype=float), T_active,
-                           np.array(c.mounted_tool.T_flange_tool_true, dtype=float), c.settings)
+                           np.array(c.mounted_tool.T_flange_tool_true, dtype=float), c.settings,
+                           reading_only=self.hide_truth)
 
     def give_tcp_check(self, job: TcpCheckJob, result: SpinCheckResult) -> WizardResult | None:
         """Hand a finished check to its wizard and finish it (the wizard may have been left

@@ -330,7 +330,7 @@ class ToolPanel:
             if s.closed:
                 return
             self.last_check = (job, result)
-            self.check_md.content = check_markdown(job, result)
+            self.check_md.content = check_markdown(job, result, reading=s.rules.in_exercise)
 
     def _entry(self) -> ToolEntry:
         return ToolEntry(str(self.entry_name.value), {f: str(h.value) for f, h in self.entry_fields.items()})
