@@ -166,3 +166,16 @@ def test_in_an_exercise_the_check_reads_the_tip_by_eye_and_gives_no_correction(w
     assert "0.600" not in text and "-0.60" not in text and "by eye" in text
     record = json.dumps(wf.export_record())
     assert "correction_flange_mm\": null" in record and "-0.6" not in record
+
+
+def test_in_an_exercise_a_check_recorded_away_from_the_reference_tip_is_refused(workflow, library) -> None:
+    """A Record from anywhere with a made-up TCP would measure the tool without a touch."""
+    wf = workflow("kr6", "pointer", seed=5)
+    wf.hide_truth = True
+    slot = saved_tool(library, "pointer", OFFSET_FLANGE_MM)
+    wf.start("tcp-check", slot=slot)
+    assert wf.controller.touch_geometry().distance_mm > 50.0         # the ready pose hovers
+    wf.record()
+    with pytest.raises(WizardStateError, match="bring the tool tip to the reference tip"):
+        wf.next()
+    assert wf.result is None

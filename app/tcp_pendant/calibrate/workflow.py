@@ -65,6 +65,7 @@ from tcp_pendant.wizards.session_record import (
     step_distances,
 )
 from tcp_pendant.wizards.beam import wall_time_s
+from tcp_pendant.wizards.check_reading import check_readable
 from tcp_pendant.wizards.tcp_check import CheckFigures
 from tcp_pendant.wizards.truth import TruthComparison, compare_with_truth
 from tcpcal.library import ToolLibrary
@@ -714,6 +715,12 @@ class CalibrationWorkflow:
                                    "with the tool tip on the reference tip, then Finish.")
         T_active = T_flange_tool_m(w.tool)
         nominal, physical = c.kinematics_for_worker()
+        if self.hide_truth:                    # an exercise: read against the reference tip
+            tip = (physical.T_world_flange(q) @ np.asarray(c.mounted_tool.T_flange_tool_true))[:3, 3]
+            try:
+                check_readable(float(np.linalg.norm(tip - c.reference_tip_world_m)) * 1000.0)
+            except ValueError as exc:
+                raise WizardStateError(f"{exc} Record the touch there, then Finish.") from None
         return TcpCheckJob(w, pose, nominal, physical, np.array(q, dtype=float), T_active,
                            np.array(c.mounted_tool.T_flange_tool_true, dtype=float), c.settings,
                            reading_only=self.hide_truth)

@@ -39,6 +39,7 @@ from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.controller.spin import DEFAULT_SPIN_ANGLE_DEG, MAX_SPIN_ANGLE_DEG
 from tcp_pendant.views.gui_util import number_of_option, set_options, slot_option
 from tcp_pendant.views.tool_check import CheckJob, check_job, check_markdown
+from tcp_pendant.wizards.check_reading import check_readable
 from tcpcal.controllers import CONTROLLER_FORMATS, export_tool_file
 from tcpcal.errors import TcpcalError
 from tcpcal.formats import FORMATS, export_tool, text_format
@@ -312,6 +313,8 @@ class ToolPanel:
         try:
             with s.lock:
                 title, tool = which()
+                if s.rules.in_exercise:                 # read against the spike, as on a robot
+                    check_readable(s.pose_state().touch.distance_mm)
                 job = check_job(s.controller, tool, title, self.check_angle.value)
                 self.check_md.content = f"Checking {escape_markdown(title)} ..."
         except ValueError as exc:

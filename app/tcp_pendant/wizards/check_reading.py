@@ -13,8 +13,14 @@ give). It is also the exercise's "good" threshold and the touch tolerance, so "0
 rotation" means what the technician means by "the tip stays put". At the default 30° a
 reading of 0.0 allows up to 0.25 mm of swing, i.e. up to 0.48 mm of TCP error off each
 rotation axis (``|d| = 2 sin(θ/2) |e_perp|``, methods.md "TCP check"), so one Check cannot be
-inverted into a TCP closer than "good". (Repeating the Check with typed-in TCPs and watching
-the readings is a hand calibration by spin test: it costs a click per guess, like touches do.)
+inverted into a TCP closer than "good".
+
+A technician reads the swing against the spike, so in an exercise the Check needs the tool
+tip near the reference tip (:data:`READ_WITHIN_MM`, about what the eye sees in the scene
+anyway): a Check from anywhere with a made-up TCP (say X = Y = Z = 0) would otherwise measure
+the tool without a touch. Repeating the Check from there with typed-in TCPs and watching the
+readings is a hand calibration by spin test, as on a real robot: it needs the tip brought to
+the spike first and costs a click per guess.
 
 Units: mm and degrees.
 """
@@ -24,13 +30,33 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable, Sequence
 
-__all__ = ["CHECK_READING_MM", "READING_NOTE", "read_mm", "reading_verdict"]
+__all__ = ["CHECK_READING_MM", "NOT_AT_TIP", "READING_NOTE", "READ_WITHIN_MM", "check_readable", "read_mm",
+           "reading_verdict"]
 
 CHECK_READING_MM = 0.5
 """Resolution a technician reads the tip's swing to, by eye against a spike (mm)."""
 READING_NOTE = ("*In the exercise the check shows what a technician sees on a real robot: how far the "
                 f"tip swung off the reference tip, read to {CHECK_READING_MM:g} mm by eye; no TCP error, no "
                 "correction.*")
+
+
+READ_WITHIN_MM = 5.0
+"""In an exercise the Check is read against the reference tip: the tool tip must be this close (mm)."""
+NOT_AT_TIP = ("In the exercise the Check is read against the reference tip, as on a real robot: bring the "
+              "tool tip to the reference tip first (within a few millimetres), then check.")
+
+
+def check_readable(distance_mm: float) -> None:
+    """Refuse an exercise's Check that has no reference tip to read the swing against.
+
+    Args:
+        distance_mm: true tool tip to reference tip where the check starts (mm).
+
+    Raises:
+        ValueError: farther than :data:`READ_WITHIN_MM` (or not finite).
+    """
+    if not math.isfinite(float(distance_mm)) or float(distance_mm) > READ_WITHIN_MM:
+        raise ValueError(NOT_AT_TIP)
 
 
 def read_mm(value_mm: float) -> float:
