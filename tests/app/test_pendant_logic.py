@@ -203,3 +203,13 @@ def test_invalid_entry_reports_each_bad_field_and_builds_nothing() -> None:
     assert "out of range" in res.errors["Z"]
     with pytest.raises(ValueError, match="enter a number"):
         parse_number("", "X (mm)")
+
+
+def test_touch_feedback_says_how_far_and_which_way_the_tool_tip_was() -> None:
+    from tcp_pendant.pendant.touch_feedback import touch_feedback
+
+    # the reference tip 0.72 mm +Z of the tool tip: the tool tip was below it (−Z)
+    assert touch_feedback(np.array([-0.3, 0.2, 0.72]), "WORLD") == (
+        "0.8 mm off, mostly −Z (WORLD): the tool tip was 0.7 mm −Z of the reference tip")
+    assert touch_feedback(np.array([2.0, 0.0, 0.1]), "TOOL").startswith("2.0 mm off, mostly −X (TOOL)")
+    assert touch_feedback(np.zeros(3), "WORLD") == "the touch was spot on (0.0 mm off)"

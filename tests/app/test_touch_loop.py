@@ -119,6 +119,27 @@ def test_record_far_from_the_tip_asks_first_and_hide_distance_records(page) -> N
     assert "mm from the tip" not in dock.note_md.content            # the distance stays hidden
 
 
+def test_free_practice_by_eye_each_record_says_how_far_the_touch_really_was(page) -> None:
+    """Judged by eye, a trainee learns only if told afterwards: in free practice the step says
+    how far the touch was and which way; in an exercise it says nothing."""
+    from tcp_pendant.pendant.exercise_rules import class_rules
+
+    p = page()
+    dock, wf = p.dock, p.calibrate.workflow
+    p.click(p.calibrate.start)
+    p.choose(p.pendant.hide_distance, True)
+    p.tip_at((0.3, -0.2, -0.7))                                     # the tool tip 0.8 mm off, mostly −Z
+    p.click(dock.record)
+    assert wf.wizard.steps[0].recorded
+    assert "0.8 mm off, mostly −Z (WORLD): the tool tip was 0.7 mm −Z of the reference tip" in dock.note_md.content
+    p.choose(dock.nav, NEXT)
+    p.session.set_rules(class_rules("mystery"))                     # an exercise: the grade tells
+    p.tip_at((0.3, -0.2, -0.7))
+    p.click(dock.record)
+    assert wf.wizard.steps[1].recorded
+    assert "mm off" not in dock.note_md.content and "0.8" not in dock.note_md.content
+
+
 @pytest.mark.parametrize("frame", ["WORLD", "TOOL"])
 def test_the_delta_readout_is_the_jog_that_brings_the_tips_together(page, frame: str) -> None:
     p = page()

@@ -11,6 +11,8 @@ from typing import Any
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from tcp_pendant.pendant.guidance import tip_offset_mm
+from tcp_pendant.pendant.touch_feedback import touch_feedback
 from tcp_pendant.session import Session, SessionChange, Touch
 
 __all__ = ["TOUCHES_FILENAME", "TouchListView", "touches_csv_text"]
@@ -69,8 +71,13 @@ class TouchListView:
             self.record.visible = not (wf is not None and wf.is_open)
 
     def _on_record(self, _event: Any) -> None:
-        t = self.session.record_touch()
-        self.session.notify("Point recorded", t.label, kind="success")
+        s = self.session
+        t = s.record_touch()
+        said = t.label
+        if s.hide_distance and not s.rules.in_exercise:     # free practice by eye: how far it was
+            frame = s.jogger.settings.frame
+            said += f": {touch_feedback(tip_offset_mm(s.pose_state(), s.controller.reference_tip_world_m, frame), frame)}"
+        s.notify("Point recorded", said, kind="success")
 
     def _on_export_csv(self, event: Any) -> None:
         data = touches_csv_text(self.session.touches).encode("utf-8")
