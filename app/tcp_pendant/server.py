@@ -173,20 +173,32 @@ def _sampled_reach_m(kinematics: RobotKinematics, n: int = 400) -> float:
     return float(np.percentile(np.hypot(p[:, 0], p[:, 1]), 95))
 
 
+TIP_PLACEMENT_MM = (3.81, 1.28, -0.37)
+"""How far the default reference tip stands from the round position below the home flange
+(WORLD, mm), as a stand put down by hand does: no jog from the ready pose or a wizard's
+suggested tilt is then a whole number of millimetres, so a touch needs the 1 mm and 0.1 mm
+increments, not the 10 mm one alone. Chosen so that, for each built-in tool on both built-in
+robots, every WORLD offset from the ready pose and after the 30° B/C tilts is at least 0.19 mm
+off a whole millimetre (tests/app/test_pendant_logic.py checks 0.1)."""
+
+
 def default_reference_tip_mm(kinematics: RobotKinematics) -> tuple[float, float, float]:
     """Default reference tip (WORLD, mm), reachable from many directions.
 
     Below the home flange position at half its height, the controller's own default (tested by
-    the controller's auto-approach tests on both robots): KR 6 (525, 0, 445); GP12 (795, 0,
-    582). A robot whose HOME is stretched out near the floor (the UR5 of example-robot-data:
-    half its home height is below the floor) gets a point in front of it instead: at half its
-    horizontal reach, a quarter of that reach high (at least ``MIN_TIP_HEIGHT_M``).
+    the controller's auto-approach tests on both robots), moved by :data:`TIP_PLACEMENT_MM`:
+    KR 6 (528.81, 1.28, 444.63); GP12 (798.81, 1.28, 581.63). A robot whose HOME is
+    stretched out near the floor (the UR5 of example-robot-data: half its home height is below
+    the floor) gets a point in front of it instead: at half its horizontal reach, a quarter of
+    that reach high (at least ``MIN_TIP_HEIGHT_M``), moved alike.
     """
     p = kinematics.T_world_flange(kinematics.home_rad)[:3, 3]
     if 0.5 * p[2] >= MIN_TIP_HEIGHT_M:
-        return (float(p[0] * 1000.0), float(p[1] * 1000.0), float(0.5 * p[2] * 1000.0))
-    reach = _sampled_reach_m(kinematics)
-    tip = np.array([0.5 * reach, 0.0, max(MIN_TIP_HEIGHT_M, 0.25 * reach)]) * 1000.0
+        tip = np.array([p[0], p[1], 0.5 * p[2]]) * 1000.0
+    else:
+        reach = _sampled_reach_m(kinematics)
+        tip = np.array([0.5 * reach, 0.0, max(MIN_TIP_HEIGHT_M, 0.25 * reach)]) * 1000.0
+    tip = tip + np.asarray(TIP_PLACEMENT_MM)
     return (float(tip[0]), float(tip[1]), float(tip[2]))
 
 
