@@ -2,7 +2,9 @@
 
 Top to bottom (below the wizard dock, ``views.wizard_dock``): TCP readout (frame + tool), the
 touch indicator with the offset "ΔX ΔY ΔZ mm" of the reference tip along the jog frame's axes
-and, within 20 mm, a magnified close-up of the two tips (all hidden by "Hide distance"), the status line (why a jog stopped), the increment, the jog
+and, within 20 mm, a magnified close-up of the two tips (all hidden by "Hide distance"), the
+front and side views of the tips (``views.tip_insets``, always: geometry, no numbers), the
+status line (why a jog stopped), the increment, the jog
 keys - one row per axis with − and + side by side (X Y Z A B C, or A1..A6; in continuous mode
 the hold-to-jog keys, two per axis, since only single buttons report a hold) - then the jog
 settings (mode, frame, override, readout frame), the joints, Home and the camera buttons; the touches ("Record point" and the list) follow.
@@ -46,6 +48,7 @@ from tcp_pendant.pendant.hold import HoldDriver
 from tcp_pendant.pendant.guidance import CLOSEUP_WITHIN_MM, offset_markdown, side_view_markdown, tip_offset_mm
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.views.scene import closeup_camera, overview_camera
+from tcp_pendant.views.tip_insets import TipInsets
 
 try:                                   # viser's message type (hot path); public setter if absent
     from viser._messages import GuiUpdateMessage
@@ -134,6 +137,7 @@ class PendantPanel:
         self.tcp_md = gui.add_markdown("")
         self.touch_md = gui.add_markdown("")
         self.closeup_md = gui.add_markdown("", visible=False)
+        self.insets = TipInsets(session)           # front and side views of the tips (no numbers)
         self.hide_distance = gui.add_checkbox("Hide distance", session.hide_distance,
                                               hint="Training: judge the touch by eye, as on a real robot "
                                                    "(hides the distance, the Δ offsets and the close-up).")

@@ -1,0 +1,46 @@
+"""The pendant's two magnified tip views (front and side) as one GUI image (viser).
+
+The image comes from ``pendant.tip_insets`` (numpy, rendered on the server from the geometry:
+the reference tip and the mounted tool's true tip); this view only places it below the touch
+indicator, with a caption, and replaces it after a move that changed it (``insets_key``:
+nothing is sent while the tool tip stays far from the window or has not moved). Shown with
+and without "Hide distance": it draws what the eye would see, no number.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from tcp_pendant.pendant.tip_insets import insets_key, tip_insets_image
+from tcp_pendant.session import Session, SessionChange
+
+__all__ = ["CAPTION", "TipInsets"]
+
+CAPTION = ("**Tip close-up** · left: front (X→, Z↑) · right: side (Y→, Z↑) · "
+           "grid and bar 1 mm · magenta: the tool tip")
+
+
+class TipInsets:
+    """Builds the caption and the image in the current GUI container of ``session.target.gui``."""
+
+    def __init__(self, session: Session) -> None:
+        self.session = session
+        gui = session.target.gui
+        c = session.controller
+        self._key: tuple[object, ...] = insets_key(c.reference_tip_world_m, c.T_world_tool_true())
+        self.caption = gui.add_markdown(CAPTION)
+        self.image = gui.add_image(tip_insets_image(c.reference_tip_world_m, c.T_world_tool_true()), format="png")
+        session.subscribe(self.on_change)
+
+    def on_change(self, change: SessionChange) -> None:
+        if change.pose and change.state is not None:
+            self.render(change.state)
+
+    def render(self, state: Any) -> None:
+        """Send a new image when the tips' geometry in the window changed."""
+        tip = self.session.controller.reference_tip_world_m
+        key = insets_key(tip, state.T_world_tool_true)
+        if key == self._key:
+            return
+        self._key = key
+        self.image.image = tip_insets_image(tip, state.T_world_tool_true)
