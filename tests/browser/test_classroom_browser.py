@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 sys.path.insert(0, str(Path(__file__).parent))
-from pendant_page import TIMEOUT_MS, assert_not_blank, press, type_text, wait_enabled, wait_text  # noqa: E402
+from pendant_page import TIMEOUT_MS, assert_not_blank, choose, press, type_text, wait_enabled, wait_text  # noqa: E402
 
 pytestmark = pytest.mark.browser
 
@@ -49,6 +49,9 @@ def test_two_trainees_and_the_trainer_view(pendant_server, new_page, shot, tmp_p
     wait_text(trainer, "Download grades (CSV)")
     wait_text(trainer, "Anna <b>A</b>")        # shown literally: escaped, not HTML
     wait_text(trainer, "Ben")
+    choose(trainer, "Auto-touch for all", "allowed")    # off in an exercise unless the trainer allows it
+    press(trainer, "Push to all trainees")
+    wait_text(trainer, "Auto-touch allowed")
     # Anna calibrates her mystery tool with Auto-touch; the trainer's table follows
     anna.get_by_role("tab", name="Calibrate").click()
     wait_enabled(anna, "Start")
