@@ -28,7 +28,7 @@ import logging
 import secrets
 import threading
 from collections.abc import Callable
-from typing import Any
+from typing import Any, cast
 
 from tcp_pendant.classroom.gradebook import Gradebook, GradeRow
 from tcp_pendant.classroom.mystery import draw_mystery_tool
@@ -207,7 +207,7 @@ class ClassRoom:
         return self.gradebook.to_csv()
 
     def push_settings(self, exercise: str | None, tool_key: str | None,
-                      hide_distance: bool | DistanceAids | None = None, auto_touch: bool | None = None) -> int:
+                      hide_distance: bool | str | None = None, auto_touch: bool | None = None) -> int:
         """Set the exercise (None: free practice; "mystery": each trainee gets a mystery tool),
         mount ``tool_key`` (None: keep), set the distance aids (``hide_distance``: "locked",
         "hidden" or "shown"; True means "hidden", False "shown"; None: keep) and allow
@@ -218,9 +218,9 @@ class ClassRoom:
             raise ValueError(f"Unknown exercise {exercise!r}; use one of {', '.join(EXERCISE_IDS)}.")
         if tool_key is not None and tool_key not in self.tools:
             raise ValueError(f"Unknown tool {tool_key!r}; use one of {', '.join(self.tools)}.")
-        aids: DistanceAids | None = ({True: "hidden", False: "shown"}[hide_distance]   # type: ignore[assignment]
-                                     if isinstance(hide_distance, bool) else hide_distance)
-        class_rules(exercise, aids, auto_touch)         # ValueError: an unknown aids setting
+        named = {True: "hidden", False: "shown"}[hide_distance] if isinstance(hide_distance, bool) else hide_distance
+        class_rules(exercise, named, auto_touch)        # type: ignore[arg-type]  # ValueError: unknown aids
+        aids = cast("DistanceAids | None", named)
         new_exercise = exercise != self.exercise
         if new_exercise:
             self.distance_aids = self.auto_touch = None
