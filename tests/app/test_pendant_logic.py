@@ -238,3 +238,35 @@ def test_no_start_is_a_whole_number_of_millimetres_from_the_reference_tip(robot:
             delta = tip_offset_mm(pose_state(c, pose_state_key(c)), tip_m, "WORLD")
             frac = np.abs(delta - np.round(delta))
             assert frac.min() >= 0.1, (tool, axis, deg, delta)
+
+
+def test_the_tip_views_draw_a_half_millimetre_as_12_pixels_each_way_and_nothing_when_far() -> None:
+    from tcp_pendant.pendant.tip_insets import TOOL_COLOR, insets_key, tip_insets_image, view_pixel
+
+    ref = np.array([0.5, 0.0, 0.4])
+    T = np.eye(4)
+    T[:3, :3] = np.column_stack([[0.0, 0.0, -1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]])   # tool X down
+    T[:3, 3] = ref + np.array([0.4, -0.3, 1.6]) / 1000.0
+
+    def apex(img: np.ndarray, half: str) -> tuple[float, float]:
+        tool = np.all(img == TOOL_COLOR, axis=2)
+        w = img.shape[1] // 2
+        part = tool[:, :w] if half == "front" else tool[:, w:]
+        rows, cols = np.nonzero(part)
+        low = rows.max()
+        return float(cols[rows == low].mean()), float(low)
+
+    img0 = tip_insets_image(ref, T)
+    assert img0.dtype == np.uint8 and img0.shape == (192, 344, 3)
+    for axis, view, index in ((0, "front", 0), (1, "side", 0), (2, "front", 1), (2, "side", 1)):
+        moved = T.copy()
+        moved[axis, 3] += 0.0005
+        before, after = apex(img0, view), apex(tip_insets_image(ref, moved), view)
+        shift = after[index] - before[index]
+        assert abs(abs(shift) - 12.0) <= 1.0, (axis, view, shift)
+    col, row = view_pixel("front", np.zeros(3))
+    assert (round(col), round(row)) == (84, 120)              # the spike's point: centre, 5 mm from the top
+    far = T.copy()
+    far[2, 3] += 0.1                                           # 100 mm above: out of the window
+    assert insets_key(ref, far) == ("far",) and not np.all(tip_insets_image(ref, far) == TOOL_COLOR, axis=2).any()
+    assert insets_key(ref, T) != insets_key(ref, far)
