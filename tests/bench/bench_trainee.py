@@ -24,9 +24,12 @@ about 17 minutes on this machine driven in chromium).
 
 A second trainee steers by the distance alone (the "Distance to reference tip" figure, no Δ
 line), as a person does who only sees how far the tips are apart: it picks the increment below
-the distance (100 mm above 150 mm, 10 above 15, 1 above 1.5, else 0.1), and for each axis in
-turn presses a key, keeps pressing while the distance falls and presses back once when it
-rose; when no axis helps at an increment it takes the next finer one. Both trainees are run
+the distance (100 mm above 150 mm, 10 above 15, 1 above 1.5, else 0.1; never back to a coarser
+one); at each
+increment it levels first (X, then Y) and then goes down (Z), from above as a careful person
+does: along an axis it presses a key, keeps pressing while the distance falls and presses
+back once when it rose (or the indicator shows a crash: the tip went through the spike); when
+no axis helps at an increment it takes the next finer one. Both trainees are run
 in the same process on the same robot, so their figures compare directly.
 
 The default reference tip stands a fraction of a millimetre off the round numbers
@@ -37,6 +40,7 @@ Run: ``.venv/bin/python tests/bench/bench_trainee.py`` (about 20-60 s).
 
 from __future__ import annotations
 
+import math
 import re
 import sys
 import tempfile
@@ -84,8 +88,13 @@ class Trainee:
         return np.array([float(v) for v in m.groups()])
 
     def distance(self) -> float:
-        m = re.search(r"(\d+\.\d\d) mm", self.pendant.touch_md.content)
-        assert m
+        """The distance the touch indicator shows (mm); infinite while it shows a crash (the
+        tool went through the tip: any key that got there was wrong)."""
+        text = self.pendant.touch_md.content
+        if "CRASH" in text:
+            return math.inf
+        m = re.search(r"(?:Distance to reference tip: \*\*|TOUCHING\*\* the reference tip \()(\d+\.\d\d) mm", text)
+        assert m, f"no distance on the page: {text!r}"
         return float(m.group(1))
 
     def selected_increment(self) -> str:
@@ -144,20 +153,26 @@ class DistanceTrainee(Trainee):
 
     def bring_tips_together(self, max_clicks: int = 1500) -> None:
         start = self.clicks
+        inc = self.increment_for(self.distance())
         while self.distance() > 0.5:
             if self.clicks - start > max_clicks:
                 raise RuntimeError(f"no touch after {max_clicks} clicks; distance {self.distance()}")
-            inc = self.increment_for(self.distance())
-            while not self.descend(inc):                  # nothing helps at this size: finer
+            by_distance = self.increment_for(self.distance())   # finer when close, never coarser
+            inc = max(inc, by_distance, key=INCREMENTS.index)
+            progress = False
+            for axes in ("XY", "Z"):                      # level first, then down: from above
+                while self.distance() > 0.5 and self.descend(inc, axes):
+                    progress = True
+            if not progress:                              # nothing helps at this size: finer
                 if inc == INCREMENTS[-1]:
                     raise RuntimeError(f"stuck at {self.distance()} mm with the finest increment")
                 inc = INCREMENTS[INCREMENTS.index(inc) + 1]
 
-    def descend(self, inc: str) -> bool:
-        """Try the axes in turn at increment ``inc``: along the first key that brings the tips
+    def descend(self, inc: str, axes: str) -> bool:
+        """Try ``axes`` in turn at increment ``inc``: along the first key that brings the tips
         closer, press until the distance rises, then press back once. True if it helped."""
         self.increment(inc)
-        for axis in "XYZ":
+        for axis in axes:
             for sign in (1, -1):
                 before = self.distance()
                 self.key(axis, sign)
