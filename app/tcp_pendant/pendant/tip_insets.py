@@ -37,6 +37,8 @@ from scipy.spatial import ConvexHull, QhullError
 
 __all__ = [
     "BACKGROUND",
+    "FAR",
+    "NEAR_MM",
     "PX_PER_MM",
     "SPIKE_COLOR",
     "TOOL_COLOR",
@@ -71,7 +73,10 @@ _H = int(round(VIEW_H_MM * PX_PER_MM))
 _VIEWS = {"front": (np.array([1.0, 0.0, 0.0]), np.array([0.0, -1.0, 0.0])),
           "side": (np.array([0.0, 1.0, 0.0]), np.array([1.0, 0.0, 0.0]))}
 _UP = np.array([0.0, 0.0, 1.0])
-_NEAR_MM = 40.0        # farther than this from the reference tip the tool cannot reach the window
+NEAR_MM = 40.0
+"""Farther than this from the reference tip (mm) the tool tip cannot reach the window."""
+FAR: tuple[object, ...] = ("far",)
+"""The :func:`insets_key` of a tool tip farther than :data:`NEAR_MM`."""
 
 
 def view_pixel(view: str, point_mm: np.ndarray) -> tuple[float, float]:
@@ -187,7 +192,7 @@ def _view(tool_apex_mm: np.ndarray | None, tool_into_body: np.ndarray | None, vi
 def _tool_in_mm(reference_tip_world_m: np.ndarray, T_world_tooltrue: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
     T = np.asarray(T_world_tooltrue, dtype=float)
     apex = (T[:3, 3] - np.asarray(reference_tip_world_m, dtype=float)) * 1000.0
-    if not np.all(np.isfinite(apex)) or np.linalg.norm(apex) > _NEAR_MM:
+    if not np.all(np.isfinite(apex)) or np.linalg.norm(apex) > NEAR_MM:
         return None                                # out of every window (drawn without it)
     return apex, -T[:3, 0]                         # the body lies behind the tip, along -X
 
@@ -196,7 +201,7 @@ def insets_key(reference_tip_world_m: np.ndarray, T_world_tooltrue: np.ndarray) 
     """What the image depends on, rounded below a tenth of a pixel (equal keys: same image)."""
     tool = _tool_in_mm(reference_tip_world_m, T_world_tooltrue)
     if tool is None:
-        return ("far",)
+        return FAR
     apex, axis = tool
     return (tuple(np.round(apex * PX_PER_MM * 10).astype(int)), tuple(np.round(axis * 1e4).astype(int)))
 

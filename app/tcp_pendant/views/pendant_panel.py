@@ -3,7 +3,7 @@
 Top to bottom (below the wizard dock, ``views.wizard_dock``): TCP readout (frame + tool), the
 touch indicator with the offset "ΔX ΔY ΔZ mm" of the reference tip along the jog frame's axes
 and, within 20 mm, a magnified close-up of the two tips (all hidden by "Hide distance"), the
-front and side views of the tips (``views.tip_insets``, always: geometry, no numbers), the
+front and side views of the tips (``views.tip_insets``, within 40 mm: geometry, no numbers), the
 status line (why a jog stopped), the increment, the jog
 keys - one row per axis with − and + side by side (X Y Z A B C, or A1..A6; in continuous mode
 the hold-to-jog keys, two per axis, since only single buttons report a hold) - then the jog

@@ -4,14 +4,17 @@ The image comes from ``pendant.tip_insets`` (numpy, rendered on the server from 
 the reference tip and the mounted tool's true tip); this view only places it below the touch
 indicator, with a caption, and replaces it after a move that changed it (``insets_key``:
 nothing is sent while the tool tip stays far from the window or has not moved). Shown with
-and without "Hide distance": it draws what the eye would see, no number.
+and without "Hide distance": it draws what the eye would see, no number. It is hidden while
+the tool tip is farther than ``tip_insets.NEAR_MM`` (40 mm, plain to see in the 3D view) from
+the reference tip: there is nothing of the tool to see in it then, and a page that loads with
+the robot in its ready pose does not carry the image.
 """
 
 from __future__ import annotations
 
 from typing import Any
 
-from tcp_pendant.pendant.tip_insets import insets_key, tip_insets_image
+from tcp_pendant.pendant.tip_insets import FAR, insets_key, tip_insets_image
 from tcp_pendant.session import Session, SessionChange
 
 __all__ = ["CAPTION", "TipInsets"]
@@ -28,8 +31,10 @@ class TipInsets:
         gui = session.target.gui
         c = session.controller
         self._key: tuple[object, ...] = insets_key(c.reference_tip_world_m, c.T_world_tool_true())
-        self.caption = gui.add_markdown(CAPTION)
-        self.image = gui.add_image(tip_insets_image(c.reference_tip_world_m, c.T_world_tool_true()), format="png")
+        near = self._key != FAR
+        self.caption = gui.add_markdown(CAPTION, visible=near)
+        self.image = gui.add_image(tip_insets_image(c.reference_tip_world_m, c.T_world_tool_true()), format="png",
+                                   visible=near)
         session.subscribe(self.on_change)
 
     def on_change(self, change: SessionChange) -> None:
@@ -43,4 +48,8 @@ class TipInsets:
         if key == self._key:
             return
         self._key = key
-        self.image.image = tip_insets_image(tip, state.T_world_tool_true)
+        near = key != FAR
+        if near:
+            self.image.image = tip_insets_image(tip, state.T_world_tool_true)
+        if self.image.visible != near:
+            self.image.visible = self.caption.visible = near
