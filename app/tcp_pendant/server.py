@@ -187,15 +187,25 @@ def _pointer_T_flange_tool() -> np.ndarray:
     return np.asarray(builtin_tools()["pointer"].T_flange_tool_true, dtype=float)
 
 
+TIP_PLACEMENT_MM = (3.81, 1.28, -0.37)
+"""How far the default reference tip of our robots stands from the round position below the
+home flange (WORLD, mm), as a stand put down by hand does: no jog from the ready pose or a
+wizard's suggested tilt is then a whole number of millimetres, so a touch needs the 1 mm and
+0.1 mm increments, not the 10 mm one alone. Chosen so that, for each built-in tool on both
+built-in robots, every WORLD offset from the ready pose and after the 30° B/C tilts is at
+least 0.19 mm off a whole millimetre (tests/app/test_pendant_logic.py checks 0.1)."""
+
+
 def default_reference_tip_mm(kinematics: RobotKinematics,
                              T_flange_tool: np.ndarray | None = None) -> tuple[float, float, float]:
     """Default reference tip (WORLD, mm), reachable from many directions.
 
     Our robots (a known home, ``RobotKinematics.known_home``): below the home flange position at
     half its height, the controller's own default (tested by the controller's auto-approach
-    tests on both robots): KR 6 (525, 0, 445); GP12 (795, 0, 582); one whose home flange is
-    lower than ``2 MIN_TIP_HEIGHT_M`` gets a point in front of it instead, at half its
-    horizontal reach, a quarter of that reach high.
+    tests on both robots), moved by :data:`TIP_PLACEMENT_MM`: KR 6 (528.81, 1.28, 444.63); GP12
+    (798.81, 1.28, 581.63); one whose home flange is lower than ``2 MIN_TIP_HEIGHT_M`` gets a
+    point in front of it instead, at half its horizontal reach, a quarter of that reach high,
+    moved alike.
 
     Any other robot: computed from its model, the first point in front of it that the mounted
     tool (``T_flange_tool``, default the pointer's true TCP) reaches from every direction of the
@@ -207,9 +217,11 @@ def default_reference_tip_mm(kinematics: RobotKinematics,
         return (float(tip[0]), float(tip[1]), float(tip[2]))
     p = kinematics.T_world_flange(kinematics.home_rad)[:3, 3]
     if 0.5 * p[2] >= MIN_TIP_HEIGHT_M:
-        return (float(p[0] * 1000.0), float(p[1] * 1000.0), float(0.5 * p[2] * 1000.0))
-    reach = sampled_reach_m(kinematics)
-    tip = np.array([0.5 * reach, 0.0, max(MIN_TIP_HEIGHT_M, 0.25 * reach)]) * 1000.0
+        tip = np.array([p[0], p[1], 0.5 * p[2]]) * 1000.0
+    else:
+        reach = sampled_reach_m(kinematics)
+        tip = np.array([0.5 * reach, 0.0, max(MIN_TIP_HEIGHT_M, 0.25 * reach)]) * 1000.0
+    tip = tip + np.asarray(TIP_PLACEMENT_MM)
     return (float(tip[0]), float(tip[1]), float(tip[2]))
 
 

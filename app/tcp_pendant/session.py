@@ -70,6 +70,7 @@ from tcp_pendant.controller.pose_state import PoseState, pose_state, pose_state_
 from tcp_pendant.controller.scenarios import Scenario, ScenarioWorld, bent_tool, realize
 from tcp_pendant.events import Crash, SessionEvent
 from tcp_pendant.pendant import Jogger, touch_label
+from tcp_pendant.pendant.exercise_rules import FREE_PRACTICE, ExerciseRules
 from tcp_pendant.wizards import Wizard, WizardResult, WizardStateError
 
 if TYPE_CHECKING:
@@ -193,7 +194,9 @@ class Session:
         scene_labels: the scene's labels at the tool and the tip (``"flange"``, ``"tool"``,
             ``"tip"``: viser label handles), which the wizards' scene places apart.
         hide_distance: "Hide distance" (training: judge the touch by eye); change it with
-            :meth:`set_hide_distance`.
+            :meth:`set_hide_distance`. While it is on, a jog does not stop at the reference tip.
+        rules: what the trainer's exercise allows (``pendant.exercise_rules``); change it with
+            :meth:`set_rules`.
         rng: the session's random generator (Auto-touch's operator error and directions, the
             beam's repeatability, the scenarios the trainer plays): the server draws it from its
             one seed (``--seed``), so a seeded lesson replays the same way.
@@ -213,6 +216,7 @@ class Session:
     views: dict[str, Any] = field(default_factory=dict)
     scene_labels: dict[str, Any] = field(default_factory=dict)
     hide_distance: bool = False
+    rules: ExerciseRules = FREE_PRACTICE
     rng: np.random.Generator = field(default_factory=np.random.default_rng)
 
     def __post_init__(self) -> None:
@@ -222,6 +226,7 @@ class Session:
             raise ControllerError("A session's workflow must drive the session's own controller.")
         self.workflow.state = self              # the workflow mounts tools and sets data through us
         self.jogger = Jogger(self.controller)
+        self.jogger.stop_at_contact = not self.hide_distance
         self.closed = False
         self._subscribers: list[Callable[[SessionChange], None]] = []
         self._close_callbacks: list[Callable[[], None]] = []
@@ -341,12 +346,28 @@ class Session:
         self.changed(pose=True, jog=jog)
 
     def set_hide_distance(self, hide: bool) -> None:
-        """"Hide distance" on or off: the readouts re-render (a ``pose`` change)."""
+        """"Hide distance" on or off: the readouts re-render (a ``pose`` change); while it is
+        on, a jog goes through the reference tip instead of stopping there.
+
+        Raises:
+            RuleRefusal: the exercise's rules lock the distance aids and ``hide`` is False.
+        """
         with self.lock:
+            self.rules.check_hide_distance(bool(hide))
             if bool(hide) == self.hide_distance:
                 return
             self.hide_distance = bool(hide)
+            self.jogger.stop_at_contact = not self.hide_distance
             self.changed(pose=True)
+
+    def set_rules(self, rules: ExerciseRules) -> None:
+        """The exercise's rules (the classroom sets them): locked distance aids switch "Hide
+        distance" on; the views re-render (``pose`` and ``wizard``: the checkbox, Auto-touch)."""
+        with self.lock, self.batch():
+            self.rules = rules
+            if rules.distance_locked:
+                self.set_hide_distance(True)
+            self.changed(pose=True, wizard=True)
 
     def refresh(self) -> None:
         """Re-render everything that shows the robot (the same signal as :meth:`moved`)."""

@@ -139,6 +139,7 @@ def test_mystery_exercise_mounts_a_tool_per_trainee_and_grades_against_it(app_fa
         assert not np.allclose(true_frame(k1), true_frame(k2))
         cal = s1.views["calibrate"]
         click(cal.start, s1.client)
+        app.classroom.push_settings("mystery", None, auto_touch=True)   # off in an exercise unless allowed
         for _ in range(4):
             click(cal.steps.auto_touch, s1.client)
         row = app.gradebook.grades()[0]

@@ -158,3 +158,14 @@ def test_hold_driver_stops_when_a_jog_stops_short() -> None:
     driver.held("Z", -1)
     sched.advance(0.2)
     assert driver.key is None
+
+
+def test_a_press_after_a_stop_beside_the_tip_goes_on() -> None:
+    """Stopped where the path passes closest (1.6 mm beside the reference tip, not touching),
+    the next press in the same direction goes on instead of stopping again after 0 mm."""
+    ref = np.array([0.5, 0.0, 0.4])
+    tip = ref + np.array([-1e-9, 0.0016, 0.0])               # at the closest point (IK's last nm)
+    assert contact_stop(tip, np.array([0.001, 0.0, 0.0]), ref) is None
+    before = ref + np.array([-0.0008, 0.0016, 0.0])           # 0.8 mm before it: stops there
+    stop = contact_stop(before, np.array([0.001, 0.0, 0.0]), ref)
+    assert stop is not None and stop.fraction == pytest.approx(0.8) and stop.miss_mm == pytest.approx(1.6)

@@ -203,3 +203,70 @@ def test_invalid_entry_reports_each_bad_field_and_builds_nothing() -> None:
     assert "out of range" in res.errors["Z"]
     with pytest.raises(ValueError, match="enter a number"):
         parse_number("", "X (mm)")
+
+
+def test_touch_feedback_says_how_far_and_which_way_the_tool_tip_was() -> None:
+    from tcp_pendant.pendant.touch_feedback import touch_feedback
+
+    # the reference tip 0.72 mm +Z of the tool tip: the tool tip was below it (−Z)
+    assert touch_feedback(np.array([-0.3, 0.2, 0.72]), "WORLD") == (
+        "0.8 mm off, mostly −Z (WORLD): the tool tip was 0.7 mm −Z of the reference tip")
+    assert touch_feedback(np.array([2.0, 0.0, 0.1]), "TOOL").startswith("2.0 mm off, mostly −X (TOOL)")
+    assert touch_feedback(np.zeros(3), "WORLD") == "the touch was spot on (0.0 mm off)"
+
+
+@pytest.mark.parametrize("robot", ["kr6", "gp12"])
+def test_no_start_is_a_whole_number_of_millimetres_from_the_reference_tip(robot: str) -> None:
+    """Fine positioning must be practised: from the ready pose, and after the 30° tilts the
+    wizards suggest, every jog-axis offset to the default reference tip is at least 0.1 mm off
+    a whole millimetre, so the 1 mm and 0.1 mm increments are needed (the 10 mm one alone left
+    3 of 4 touches at 0.00 mm)."""
+    from tcp_pendant.controller import RobotKinematics, builtin_tools
+    from tcp_pendant.controller.pose_state import pose_state, pose_state_key
+    from tcp_pendant.pendant.guidance import tip_offset_mm
+    from tcp_pendant.server import default_reference_tip_mm, ready_configuration, resolve_robot
+
+    kin = RobotKinematics.from_urdf(resolve_robot(robot))
+    tip_m = np.asarray(default_reference_tip_mm(kin)) / 1000.0
+    ready = ready_configuration(kin, tip_m)
+    for tool in builtin_tools():
+        for axis, deg in (("", 0.0), ("B", 30.0), ("C", 30.0), ("B", -30.0)):
+            c = VirtualController(kin, tool=builtin_tools()[tool], reference_tip_world_m=tip_m)
+            c.set_q(ready)
+            if axis:
+                assert c.jog_cartesian("WORLD", axis, deg).ok
+            delta = tip_offset_mm(pose_state(c, pose_state_key(c)), tip_m, "WORLD")
+            frac = np.abs(delta - np.round(delta))
+            assert frac.min() >= 0.1, (tool, axis, deg, delta)
+
+
+def test_the_tip_views_draw_a_half_millimetre_as_12_pixels_each_way_and_nothing_when_far() -> None:
+    from tcp_pendant.pendant.tip_insets import TOOL_COLOR, insets_key, tip_insets_image, view_pixel
+
+    ref = np.array([0.5, 0.0, 0.4])
+    T = np.eye(4)
+    T[:3, :3] = np.column_stack([[0.0, 0.0, -1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]])   # tool X down
+    T[:3, 3] = ref + np.array([0.4, -0.3, 1.6]) / 1000.0
+
+    def apex(img: np.ndarray, half: str) -> tuple[float, float]:
+        tool = np.all(img == TOOL_COLOR, axis=2)
+        w = img.shape[1] // 2
+        part = tool[:, :w] if half == "front" else tool[:, w:]
+        rows, cols = np.nonzero(part)
+        low = rows.max()
+        return float(cols[rows == low].mean()), float(low)
+
+    img0 = tip_insets_image(ref, T)
+    assert img0.dtype == np.uint8 and img0.shape == (192, 344, 3)
+    for axis, view, index in ((0, "front", 0), (1, "side", 0), (2, "front", 1), (2, "side", 1)):
+        moved = T.copy()
+        moved[axis, 3] += 0.0005
+        before, after = apex(img0, view), apex(tip_insets_image(ref, moved), view)
+        shift = after[index] - before[index]
+        assert abs(abs(shift) - 12.0) <= 1.0, (axis, view, shift)
+    col, row = view_pixel("front", np.zeros(3))
+    assert (round(col), round(row)) == (84, 120)              # the spike's point: centre, 5 mm from the top
+    far = T.copy()
+    far[2, 3] += 0.1                                           # 100 mm above: out of the window
+    assert insets_key(ref, far) == ("far",) and not np.all(tip_insets_image(ref, far) == TOOL_COLOR, axis=2).any()
+    assert insets_key(ref, T) != insets_key(ref, far)

@@ -7,6 +7,7 @@ In-process server, headless websocket clients as browsers (``guiclick``)."""
 from __future__ import annotations
 
 import json
+import re
 import sys
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -74,6 +75,36 @@ def test_check_of_the_true_data_stays_put_and_a_1mm_error_shows(page) -> None:
     assert "(+0.000, -1.000, +0.000) mm in FLANGE axes" in p.tools.check_md.content   # no "-0.000"
     np.testing.assert_array_equal(p.session.controller.q_rad, q)    # the robot did not move
     assert p.notes == []
+
+
+def test_in_an_exercise_the_check_of_a_zero_tool_shows_a_reading_not_the_answer(page) -> None:
+    """The one-click answer: X = Y = Z = 0 saved, then Check. In an exercise the Check shows
+    what a technician would see - how far the tip swung per rotation, read to 0.5 mm - and no
+    implied TCP error vector or correction (which would be the true TCP)."""
+    from tcp_pendant.pendant.exercise_rules import class_rules
+
+    p = page({1: Tool(name="Zero", tcp_mm=(0.0, 0.0, 0.0))})
+    p.session.set_rules(class_rules("mystery"))
+    p.select_slot(1)
+    p.click(p.tools.check)                  # from the ready pose: no spike to read the swing against
+    assert p.tools.last_check is None and p.notes and "bring the tool tip to the reference tip" in p.notes[-1][1]
+    s = p.session
+    with s.lock:                             # the tip brought to the reference tip (as a touch would)
+        c = s.controller
+        T = c.T_world_tool_true().copy()
+        T[:3, 3] = c.reference_tip_world_m + np.array([0.0, 0.0, 2.0]) / 1000.0
+        assert c.move_true_tool_to(T).ok
+        s.moved()
+    p.click(p.tools.check)
+    job, res = p.tools.last_check
+    true_tcp = np.asarray(c.mounted_tool.T_flange_tool_true)[:3, 3] * 1000.0
+    assert res.implied_tcp_error_mm == pytest.approx(np.linalg.norm(true_tcp), abs=0.05)  # computed ...
+    md = p.tools.check_md.content                                     # ... but not shown
+    assert "Implied" not in md and "FLANGE axes" not in md and "by eye" in md
+    rows = re.findall(r"^\| [+-][ABC] 30° \| (\S+) \|", md, flags=re.M)
+    assert len(rows) == 6 and all(float(v) % 0.5 == 0.0 for v in rows)
+    assert [float(v) for v in rows] == [round(r.deviation_mm * 2) / 2 for r in res.rotations]
+    assert "calibrate the tool again" in md
 
 
 def test_check_active_tool_and_no_active_tool(page) -> None:

@@ -119,6 +119,27 @@ def test_record_far_from_the_tip_asks_first_and_hide_distance_records(page) -> N
     assert "mm from the tip" not in dock.note_md.content            # the distance stays hidden
 
 
+def test_free_practice_by_eye_each_record_says_how_far_the_touch_really_was(page) -> None:
+    """Judged by eye, a trainee learns only if told afterwards: in free practice the step says
+    how far the touch was and which way; in an exercise it says nothing."""
+    from tcp_pendant.pendant.exercise_rules import class_rules
+
+    p = page()
+    dock, wf = p.dock, p.calibrate.workflow
+    p.click(p.calibrate.start)
+    p.choose(p.pendant.hide_distance, True)
+    p.tip_at((0.3, -0.2, -0.7))                                     # the tool tip 0.8 mm off, mostly −Z
+    p.click(dock.record)
+    assert wf.wizard.steps[0].recorded
+    assert "0.8 mm off, mostly −Z (WORLD): the tool tip was 0.7 mm −Z of the reference tip" in dock.note_md.content
+    p.choose(dock.nav, NEXT)
+    p.session.set_rules(class_rules("mystery"))                     # an exercise: the grade tells
+    p.tip_at((0.3, -0.2, -0.7))
+    p.click(dock.record)
+    assert wf.wizard.steps[1].recorded
+    assert "mm off" not in dock.note_md.content and "0.8" not in dock.note_md.content
+
+
 @pytest.mark.parametrize("frame", ["WORLD", "TOOL"])
 def test_the_delta_readout_is_the_jog_that_brings_the_tips_together(page, frame: str) -> None:
     p = page()
@@ -158,6 +179,26 @@ def test_an_increment_stops_at_contact_and_the_next_press_goes_on(page) -> None:
     p.choose(pendant.cart_rows["Z"], "Z +")
     p.choose(pendant.cart_rows["X"], "X +")                         # beside the tip: no stop
     assert pendant.status_md.content == ""
+
+
+def test_with_the_distance_hidden_a_jog_goes_through_the_tip_silently_and_crashes(page) -> None:
+    """Judged by eye: no stop at the tip, no message, no toast - "press until it stops" would
+    tell the trainee where the tip is; driven through it, the tool crashes."""
+    p = page()
+    s, pendant = p.session, p.pendant
+    p.choose(pendant.hide_distance, True)
+    p.tip_at((0.0, 0.0, 4.0))                                       # 4 mm above the reference tip
+    p.notes.clear()
+    p.choose(pendant.increment, "10")
+    p.choose(pendant.cart_rows["Z"], "Z −")                         # 10 mm down: through the tip
+    st = s.pose_state()
+    assert st.touch.crashed and st.touch.penetration_mm == pytest.approx(6.0, abs=0.01)
+    assert pendant.status_md.content == "" and p.notes == []        # not a word before the crash ...
+    assert "CRASH" in pendant.touch_md.content                      # ... then the crash, as on a robot
+    p.choose(pendant.hide_distance, False)                          # shown again: the stop is back
+    p.tip_at((0.0, 0.0, 4.0))
+    p.choose(pendant.cart_rows["Z"], "Z −")
+    assert "Stopped at the reference tip" in pendant.status_md.content
 
 
 def test_a_stop_message_does_not_outlive_an_auto_touch(page) -> None:

@@ -22,11 +22,25 @@ selection of an increment is a click. The figures printed: clicks and wall time 
 next to the issue's figure before this work (464 clicks for the 4 touches, ~116 per touch,
 about 17 minutes on this machine driven in chromium).
 
-Run: ``.venv/bin/python tests/bench/bench_trainee.py`` (about 10-30 s).
+A second trainee steers by the distance alone (the "Distance to reference tip" figure, no Δ
+line), as a person does who only sees how far the tips are apart: it picks the increment below
+the distance (100 mm above 150 mm, 10 above 15, 1 above 1.5, else 0.1; never back to a coarser
+one); at each
+increment it levels first (X, then Y) and then goes down (Z), from above as a careful person
+does: along an axis it presses a key, keeps pressing while the distance falls and presses
+back once when it rose (or the indicator shows a crash: the tip went through the spike); when
+no axis helps at an increment it takes the next finer one. Both trainees are run
+in the same process on the same robot, so their figures compare directly.
+
+The default reference tip stands a fraction of a millimetre off the round numbers
+(``server.TIP_PLACEMENT_MM``), so no touch ends with the 10 mm increment alone.
+
+Run: ``.venv/bin/python tests/bench/bench_trainee.py`` (about 20-60 s).
 """
 
 from __future__ import annotations
 
+import math
 import re
 import sys
 import tempfile
@@ -74,8 +88,13 @@ class Trainee:
         return np.array([float(v) for v in m.groups()])
 
     def distance(self) -> float:
-        m = re.search(r"(\d+\.\d\d) mm", self.pendant.touch_md.content)
-        assert m
+        """The distance the touch indicator shows (mm); infinite while it shows a crash (the
+        tool went through the tip: any key that got there was wrong)."""
+        text = self.pendant.touch_md.content
+        if "CRASH" in text:
+            return math.inf
+        m = re.search(r"(?:Distance to reference tip: \*\*|TOUCHING\*\* the reference tip \()(\d+\.\d\d) mm", text)
+        assert m, f"no distance on the page: {text!r}"
         return float(m.group(1))
 
     def selected_increment(self) -> str:
@@ -125,12 +144,57 @@ class Trainee:
                     break
 
 
-def run() -> dict[str, list[float]]:
+class DistanceTrainee(Trainee):
+    """Steers by the distance figure alone: never reads the Δ line (module docstring)."""
+
+    @staticmethod
+    def increment_for(distance_mm: float) -> str:
+        return "100" if distance_mm > 150 else "10" if distance_mm > 15 else "1" if distance_mm > 1.5 else "0.1"
+
+    def bring_tips_together(self, max_clicks: int = 1500) -> None:
+        start = self.clicks
+        inc = self.increment_for(self.distance())
+        while self.distance() > 0.5:
+            if self.clicks - start > max_clicks:
+                raise RuntimeError(f"no touch after {max_clicks} clicks; distance {self.distance()}")
+            by_distance = self.increment_for(self.distance())   # finer when close, never coarser
+            inc = max(inc, by_distance, key=INCREMENTS.index)
+            progress = False
+            for axes in ("XY", "Z"):                      # level first, then down: from above
+                while self.distance() > 0.5 and self.descend(inc, axes):
+                    progress = True
+            if not progress:                              # nothing helps at this size: finer
+                if inc == INCREMENTS[-1]:
+                    raise RuntimeError(f"stuck at {self.distance()} mm with the finest increment")
+                inc = INCREMENTS[INCREMENTS.index(inc) + 1]
+
+    def descend(self, inc: str, axes: str) -> bool:
+        """Try ``axes`` in turn at increment ``inc``: along the first key that brings the tips
+        closer, press until the distance rises, then press back once. True if it helped."""
+        self.increment(inc)
+        for axis in axes:
+            for sign in (1, -1):
+                before = self.distance()
+                self.key(axis, sign)
+                if self.distance() >= before - 1e-9:
+                    self.key(axis, -sign)                 # worse (or no better): back
+                    continue
+                while self.distance() > 0.5:
+                    before = self.distance()
+                    self.key(axis, sign)
+                    if self.distance() >= before - 1e-9:
+                        self.key(axis, -sign)             # one too far: back
+                        break
+                return True
+        return False
+
+
+def run(trainee_cls: type[Trainee] = Trainee) -> dict[str, list[float]]:
     with tempfile.TemporaryDirectory() as tmp:
         app = PendantApp(AppConfig(port=0, tool_library=Path(tmp) / "tools.json", library_poll_s=1.0))
         app.start()
         try:
-            t = Trainee(app)
+            t = trainee_cls(app)
             calibrate = t.session.views["calibrate"]
             click(calibrate.start, t.client)             # Calibrate tab: XYZ 4-point, Start (not counted)
             clicks, seconds, dist = [], [], []
@@ -158,18 +222,27 @@ def run() -> dict[str, list[float]]:
             app.stop()
 
 
-def main() -> None:
-    out = run()
-    print("Scripted trainee, XYZ 4-point, 4 standard orientations, KR 6 + pointer")
+def report(title: str, out: dict[str, list[float]]) -> float:
+    print(title)
     print(f"{'touch':>5} {'(B, C) deg':>11} {'clicks':>7} {'wall s':>7} {'distance mm':>12}")
     for k, ((b, c), n, s, d) in enumerate(zip(ORIENTATIONS_DEG, out["clicks"], out["seconds"],
                                               out["distance_mm"])):
         print(f"{k + 1:>5} {f'({b}, {c})':>11} {n:>7.0f} {s:>7.2f} {d:>12.2f}")
     mean = float(np.mean(out["clicks"]))
-    print(f"clicks per touch: {mean:.1f} (before: ~{BEFORE_CLICKS_PER_TOUCH:.0f}; goal <= "
-          f"{GOAL_CLICKS_PER_TOUCH:.0f}), wall time per touch {np.mean(out['seconds']):.2f} s in-process")
+    print(f"clicks per touch: {mean:.1f}, wall time per touch {np.mean(out['seconds']):.2f} s in-process")
     if out["tcp_error_mm"]:
         print(f"TCP error of the result vs the hidden truth: {out['tcp_error_mm'][0]:.3f} mm")
+    return mean
+
+
+def main() -> None:
+    print("Scripted trainees, XYZ 4-point, 4 standard orientations, KR 6 + pointer (issue 10)\n")
+    delta = report("Trainee reading the Δ line:", run(Trainee))
+    print()
+    dist = report("Trainee steering by the distance alone (no Δ line):", run(DistanceTrainee))
+    print(f"\nclicks per touch: Δ line {delta:.1f}, distance alone {dist:.1f} "
+          f"({dist / delta:.1f}x; Δ line before issue 10: ~{BEFORE_CLICKS_PER_TOUCH:.0f}; "
+          f"goal with the Δ line <= {GOAL_CLICKS_PER_TOUCH:.0f})")
 
 
 if __name__ == "__main__":

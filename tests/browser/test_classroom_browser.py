@@ -51,6 +51,12 @@ def test_two_trainees_and_the_trainer_view(pendant_server, new_page, shot, tmp_p
     wait_text(trainer, "Download grades (CSV)")
     wait_text(trainer, "Anna <b>A</b>")        # shown literally: escaped, not HTML
     wait_text(trainer, "Ben")
+    # Auto-touch is off in an exercise unless the trainer allows it (by its label: viser breaks
+    # "Auto-<wbr>touch", which pendant_page.field's exact label text does not match)
+    trainer.get_by_label("Auto-touch for all").first.click()
+    trainer.get_by_role("option", name="allowed", exact=True).click()
+    press(trainer, "Push to all trainees")
+    wait_text(trainer, "Auto-touch allowed")
     # Anna calibrates her mystery tool with Auto-touch; the trainer's table follows
     anna.get_by_role("tab", name="Calibrate").click()
     wait_enabled(anna, "Start")

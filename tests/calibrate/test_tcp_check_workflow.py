@@ -191,3 +191,31 @@ def test_auto_touch_for_a_check_picks_a_pose_from_which_all_six_rotations_can_be
         res = wf.run_controller_job()
         assert all(r.reached for r in res.check.rows), (seed, [r.message for r in res.check.rows])
         assert res.check.verdict.startswith("TCP good"), seed
+
+
+def test_in_an_exercise_the_check_reads_the_tip_by_eye_and_gives_no_correction(workflow, library) -> None:
+    wf = workflow("kr6", "pointer", seed=5)
+    wf.hide_truth = True                                     # the classroom's exercise
+    slot = saved_tool(library, "pointer", OFFSET_FLANGE_MM, name="Pointer off")
+    res = check(wf, slot, angle_deg=30)
+    c = res.check
+    assert c.implied_tcp_error_mm is None and c.correction_flange_mm is None and c.fit_rms_mm is None
+    assert all(r.deviation_mm % 0.5 == 0.0 for r in c.rows) and max(r.deviation_mm for r in c.rows) >= 0.5
+    text = result_markdown(res)
+    assert "Implied TCP error" not in text and "suggested correction" not in text
+    assert "0.600" not in text and "-0.60" not in text and "by eye" in text
+    record = json.dumps(wf.export_record())
+    assert "correction_flange_mm\": null" in record and "-0.6" not in record
+
+
+def test_in_an_exercise_a_check_recorded_away_from_the_reference_tip_is_refused(workflow, library) -> None:
+    """A Record from anywhere with a made-up TCP would measure the tool without a touch."""
+    wf = workflow("kr6", "pointer", seed=5)
+    wf.hide_truth = True
+    slot = saved_tool(library, "pointer", OFFSET_FLANGE_MM)
+    wf.start("tcp-check", slot=slot)
+    assert wf.controller.touch_geometry().distance_mm > 50.0         # the ready pose hovers
+    wf.record()
+    with pytest.raises(WizardStateError, match="bring the tool tip to the reference tip"):
+        wf.next()
+    assert wf.result is None

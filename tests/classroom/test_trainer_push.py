@@ -112,9 +112,12 @@ def _finish_xyz4(session) -> None:
 def test_an_exercise_shows_the_trainee_no_truth_but_the_gradebook_keeps_it(app_factory, tmp_path: Path) -> None:
     app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token="trainer-token-of-16",
                       exercise="mystery", exercise_seed=3)
-    clients, (anna,) = _class(app, 1)
+    clients, (anna, trainer) = _class(app, 2)
     try:
         _name(anna, "Anna")
+        view = _trainer(trainer, "tok-1")
+        choose(view.auto_touch, "allowed", trainer.client)     # an exercise starts with Auto-touch off
+        click(view.push, trainer.client)
         _finish_xyz4(anna)
         cal = anna.views["calibrate"]
         result, scene = cal.result, cal.scene
@@ -141,12 +144,101 @@ def test_free_practice_shows_the_truth_and_a_pushed_exercise_hides_it(app_factor
         assert "true TOOL frame" in cal.result.truth_md.content
         view = _trainer(trainer, "trainer-token-of-16")
         choose(view.exercise, "Mystery tool", trainer.client)
+        choose(view.auto_touch, "allowed", trainer.client)      # an exercise starts with Auto-touch off
         click(view.push, trainer.client)
         _finish_xyz4(anna)                                       # a new calibration in the exercise
         assert not cal.result.truth_md.visible and not cal.scene.true_tool.visible
         choose(view.exercise, "Free practice", trainer.client)
         click(view.push, trainer.client)
         assert cal.result.truth_md.visible and cal.scene.true_tool.visible
+    finally:
+        for c in clients:
+            c.close()
+
+
+def test_an_exercise_hides_and_locks_the_distance_aids_until_the_trainer_unlocks_them(
+        app_factory, tmp_path: Path) -> None:
+    """In an exercise the distance, the Δ line and the close-up are off from the start; a
+    browser that unticks "Hide distance" anyway is refused by the server (the checkbox is
+    disabled, but a browser can send anything); the trainer unlocks and locks them again."""
+    from tcp_pendant.pendant.exercise_rules import DISTANCE_LOCKED, RuleRefusal
+
+    app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token="tok-1", exercise="mystery")
+    clients, (anna, trainer) = _class(app, 2)
+    try:
+        _name(anna, "Anna")
+        panel = anna.views["pendant"]
+        touch = anna.pose_state().touch
+        assert anna.hide_distance and anna.rules.distance_locked
+        assert panel.hide_distance.value is True and panel.hide_distance.disabled is True
+        assert "Δ" not in panel.touch_md.content and f"{touch.distance_mm:.2f}" not in panel.touch_md.content
+        notes: list[str] = []
+        anna.notify = lambda title, body, **kw: notes.append(body)          # type: ignore[method-assign]
+        choose(panel.hide_distance, False, anna.client)                     # a hostile browser unticks it
+        assert anna.hide_distance and panel.hide_distance.value is True
+        assert notes == [DISTANCE_LOCKED]
+        with pytest.raises(RuleRefusal, match="locked the distance aids"):
+            anna.set_hide_distance(False)
+        view = _trainer(trainer, "tok-1")
+        choose(view.hide_distance, "on", trainer.client)                    # hidden, but unlocked
+        click(view.push, trainer.client)
+        assert "distance aids trainee's choice" in view.push_md.content
+        assert anna.hide_distance and panel.hide_distance.disabled is False
+        choose(panel.hide_distance, False, anna.client)                     # now the trainee may
+        assert not anna.hide_distance and "Δ" in panel.touch_md.content
+        choose(view.hide_distance, "on, locked", trainer.client)
+        click(view.push, trainer.client)
+        assert anna.hide_distance and panel.hide_distance.disabled is True
+        assert "distance aids locked off" in view.push_md.content
+    finally:
+        for c in clients:
+            c.close()
+
+
+def test_auto_touch_is_refused_in_an_exercise_unless_the_trainer_allows_it(app_factory, tmp_path: Path) -> None:
+    from tcp_pendant.calibrate.workflow import AutoTouchRequest
+    from tcp_pendant.pendant.exercise_rules import AUTO_TOUCH_REFUSED, RuleRefusal
+
+    app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token="tok-1", exercise="mystery")
+    clients, (anna, trainer) = _class(app, 2)
+    try:
+        _name(anna, "Anna")
+        cal = anna.views["calibrate"]
+        click(cal.start, anna.client)
+        wf = cal.workflow
+        assert not cal.steps.auto_folder.visible                             # not offered ...
+        notes: list[str] = []
+        anna.notify = lambda title, body, **kw: notes.append(body)          # type: ignore[method-assign]
+        click(cal.steps.auto_touch, anna.client)                            # ... and refused when sent
+        assert notes == [AUTO_TOUCH_REFUSED] and not wf.wizard.recorded_poses and wf.auto_touches == 0
+        with pytest.raises(RuleRefusal, match="Auto-touch is off in this exercise"):
+            wf.auto_touch(AutoTouchRequest())
+        view = _trainer(trainer, "tok-1")
+        choose(view.auto_touch, "allowed", trainer.client)
+        click(view.push, trainer.client)
+        assert cal.steps.auto_folder.visible
+        click(cal.steps.auto_touch, anna.client)
+        assert len(wf.wizard.recorded_poses) == 1
+    finally:
+        for c in clients:
+            c.close()
+
+
+def test_free_practice_keeps_auto_touch_and_the_trainees_own_distance_choice(app_factory, tmp_path: Path) -> None:
+    app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token="tok-1")
+    clients, (anna,) = _class(app, 1)
+    try:
+        _name(anna, "Anna")
+        panel = anna.views["pendant"]
+        assert not anna.hide_distance and panel.hide_distance.disabled is False
+        choose(panel.hide_distance, True, anna.client)
+        choose(panel.hide_distance, False, anna.client)
+        assert not anna.hide_distance
+        cal = anna.views["calibrate"]
+        click(cal.start, anna.client)
+        assert cal.steps.auto_folder.visible
+        click(cal.steps.auto_touch, anna.client)
+        assert len(cal.workflow.wizard.recorded_poses) == 1
     finally:
         for c in clients:
             c.close()

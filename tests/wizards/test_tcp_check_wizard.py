@@ -129,3 +129,33 @@ def test_the_markdown_shows_six_rows_the_error_the_correction_and_escapes_the_na
     good.give_check(spin(err=0.2))
     assert "TCP good" in tcp_check_markdown(good.next()) and good.result.notes == ()
     assert wiz.result.notes and "changes no tool data" in wiz.result.notes[0]
+
+
+def test_in_an_exercise_the_check_is_a_technicians_reading_without_the_answer() -> None:
+    """What a technician sees: per rotation how far the tip moved, read to 0.5 mm; no implied
+    error, no correction, no fit RMS - in the text and in the record alike."""
+    from tcp_pendant.wizards.check_reading import CHECK_READING_MM
+
+    figures = CheckFigures.of(spin(devs=(0.12, 0.26, 0.74, 0.76, 1.3, 0.0), err=0.8, off=(0.3, -0.6, 0.4)))
+    reading = figures.as_reading()
+    assert [r.deviation_mm for r in reading.rows] == [0.0, 0.5, 0.5, 1.0, 1.5, 0.0]
+    assert reading.implied_tcp_error_mm is None and reading.correction_flange_mm is None
+    assert reading.fit_rms_mm is None and reading.read_to_mm == CHECK_READING_MM
+    assert "swung up to 1.5 mm" in reading.verdict and "calibrate" in reading.verdict
+    assert "looks good" in CheckFigures.of(spin(devs=(0.1, 0.2, 0.0, 0.24, 0.1, 0.0))).as_reading().verdict
+    wiz = wizard()
+    wiz.record(POSE)
+    wiz.give_check(reading)
+    res = wiz.next()
+    text = tcp_check_markdown(res)
+    assert "Implied TCP error" not in text and "suggested correction" not in text and "+0.300" not in text
+    assert "| \\+C 30° | 1.5 |" in text and "by eye" in text and "no TCP error, no correction" in text
+    assert res.notes == () and res.per_touch_error_mm == (0.0, 0.5, 0.5, 1.0, 1.5, 0.0)
+    stored = wiz.to_dict()["params"]["check"]
+    assert stored["correction_flange_mm"] is None and stored["read_to_mm"] == CHECK_READING_MM
+    again = Wizard.from_dict(wiz.to_dict())
+    assert again.result.check == reading
+    forged = wiz.to_dict()                                   # a reading that claims a correction
+    forged["params"]["check"]["correction_flange_mm"] = [1.0, 2.0, 3.0]
+    forged["params"]["check"]["implied_tcp_error_mm"] = 3.7
+    assert Wizard.from_dict(forged).result.check.correction_flange_mm is None

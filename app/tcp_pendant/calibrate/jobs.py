@@ -25,6 +25,8 @@ from tcp_pendant.controller.errors import ControllerError
 from tcp_pendant.controller.jog import JogSettings
 from tcp_pendant.controller.spin import SpinCheckResult, spin_check
 from tcp_pendant.wizards import BeamWizard, ManualComparison, TcpCheckWizard, Wizard, WizardResult, WizardStateError
+from tcp_pendant.wizards.check_reading import check_readable
+from tcp_pendant.wizards.tcp_check import CheckFigures
 
 if TYPE_CHECKING:
     from tcp_pendant.calibrate.workflow import CalibrationWorkflow
@@ -77,6 +79,8 @@ class TcpCheckJob:
     T_flange_tool_active: np.ndarray
     T_flange_tool_true: np.ndarray
     settings: JogSettings = field(repr=False)
+    reading_only: bool = False
+    """An exercise: the wizard gets a technician's reading only (``CheckFigures.as_reading``)."""
 
     def run(self) -> SpinCheckResult:
         """``controller.spin.spin_check`` from the recorded touch's joint angles."""
@@ -85,8 +89,10 @@ class TcpCheckJob:
                           settings=self.settings)
 
     def hand_in(self, outcome: SpinCheckResult) -> WizardResult | None:
-        """The check to its wizard (from the recorded touch it started at), then Finish."""
-        self.wizard.give_check(outcome, self.pose)
+        """The check to its wizard (from the recorded touch it started at), then Finish; in an
+        exercise the reading only (no implied TCP error, no correction)."""
+        figures = CheckFigures.of(outcome)
+        self.wizard.give_check(figures.as_reading() if self.reading_only else figures, self.pose)
         if self.wizard.status == "in_progress":
             return self.wizard.finish()
         return None
@@ -164,8 +170,15 @@ def spin_check_job(workflow: CalibrationWorkflow, wizard: Wizard) -> TcpCheckJob
         raise WizardStateError("The robot is not at the recorded touch any more: press Record again "
                                "with the tool tip on the reference tip, then Finish.")
     nominal, physical = c.kinematics_for_worker()
+    if workflow.hide_truth:                   # an exercise: read against the reference tip
+        tip = (physical.T_world_flange(q) @ np.asarray(c.mounted_tool.T_flange_tool_true))[:3, 3]
+        try:
+            check_readable(float(np.linalg.norm(tip - c.reference_tip_world_m)) * 1000.0)
+        except ValueError as exc:
+            raise WizardStateError(f"{exc} Record the touch there, then Finish.") from None
     return TcpCheckJob(check, pose, nominal, physical, np.array(q, dtype=float), T_flange_tool_m(check.tool),
-                       np.array(c.mounted_tool.T_flange_tool_true, dtype=float), c.settings)
+                       np.array(c.mounted_tool.T_flange_tool_true, dtype=float), c.settings,
+                       reading_only=workflow.hide_truth)
 
 
 def beam_scan_job(workflow: CalibrationWorkflow, wizard: Wizard) -> BeamScanJob | None:

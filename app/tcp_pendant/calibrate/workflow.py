@@ -536,6 +536,12 @@ class CalibrationWorkflow:
         self._require().back()
         self._failure = None
 
+    @property
+    def auto_touch_allowed(self) -> bool:
+        """Auto-touch may be offered: training mode, and the exercise's rules allow it."""
+        rules = getattr(self.state, "rules", None)
+        return self.training and (rules is None or bool(rules.auto_touch_allowed))
+
     def auto_touch(self, request: AutoTouchRequest) -> AutoTouchOutcome:
         """Training mode: let the controller perform the current step (mounting the tool it
         needs), record it and go on; after the last step the result is computed, so a whole
@@ -543,11 +549,15 @@ class CalibrationWorkflow:
 
         Raises:
             WizardStateError: training mode is off, or no wizard is in progress.
+            RuleRefusal: the trainer's exercise does not allow Auto-touch (the owner's ``rules``).
             CalibrationFailedError: the touches cannot determine the result (e.g. four touches
                 from the same chosen direction); the wizard stays on its last step.
         """
         if not self.training:
             raise WizardStateError("Auto-touch is a training-mode tool; switch training mode on.")
+        rules = getattr(self.state, "rules", None)     # the session's exercise rules, when it has them
+        if rules is not None:
+            rules.check_auto_touch()
         w = self._require()
         if w.status == "in_progress" and w.auto_role(w.step).by_controller:
             raise WizardStateError(f"The {w.title} wizard has nothing to touch: the controller runs this "

@@ -23,8 +23,13 @@ first time a mystery tool is drawn and kept there (``Gradebook.exercise_seed``);
 
 In an exercise the trainee sees no truth: the workflow's ``hide_truth`` is set (the result
 panel shows no error against the true TOOL frame and no grade, the scene no TRUE triad); the
-gradebook keeps them for the trainer. The settings a trainer pushes (exercise, tool, "Hide
-distance") apply to every named trainee and to those who name themselves later.
+gradebook keeps them for the trainer. The settings a trainer pushes (exercise, tool, distance
+aids, Auto-touch) apply to every named trainee and to those who name themselves later.
+
+Each trainee's pendant follows the class's :class:`~tcp_pendant.pendant.exercise_rules.ExerciseRules`
+(``Session.set_rules``): in an exercise the distance aids are hidden and locked and Auto-touch
+is off unless the trainer unlocked or allowed them (``class_rules``); a change of exercise goes
+back to those defaults unless the same push sets them.
 
 Threads: the session callbacks run on viser's event loop (``Session.on_loop``); connects and
 disconnects come from viser's thread pool and hand their trainer-view refresh to the loop
@@ -39,7 +44,7 @@ import secrets
 import threading
 import time
 from collections.abc import Callable
-from typing import Any
+from typing import Any, cast
 
 from tcp_pendant.classroom.gradebook import Gradebook, GradeRow, TraineeJoin
 from tcp_pendant.classroom.mystery import draw_mystery_tool
@@ -48,6 +53,7 @@ from tcp_pendant.classroom.recorder import TraineeRecorder, TraineeStatus
 from tcp_pendant.classroom.restore import runs_to_restore
 from tcp_pendant.classroom.trainer_token import TokenAttempts, validate_trainer_token
 from tcp_pendant.controller import ToolModel
+from tcp_pendant.pendant.exercise_rules import DistanceAids, ExerciseRules, class_rules
 from tcp_pendant.session import Session, SessionChange
 
 __all__ = ["EXERCISE_IDS", "ClassRoom"]
@@ -122,11 +128,34 @@ class ClassRoom:
         self._trainer_views: dict[int, Any] = {}    # id(session) -> TrainerView
         self._token_attempts: dict[int, TokenAttempts] = {}   # id(session) -> its wrong tokens
         self.clock = clock
-        self.hide_distance: bool | None = None
-        """"Hide distance" as the trainer last pushed it (None: each trainee's own choice)."""
+        self.distance_aids: DistanceAids | None = None
+        """The distance aids as the trainer last pushed them (None: the exercise's default -
+        locked in an exercise, each trainee's own choice in free practice)."""
+        self.auto_touch: bool | None = None
+        """Auto-touch as the trainer last allowed it (None: the default - off in an exercise)."""
         self.pushed_tool: str | None = None
         """The tool the trainer last pushed (kept across restarts)."""
         self._apply_kept(exercise_given=exercise is not None)   # what the trainer pushed before a restart
+
+    @property
+    def rules(self) -> ExerciseRules:
+        """The rules every trainee's pendant follows now."""
+        return class_rules(self.exercise, self.distance_aids, self.auto_touch)
+
+    def _apply_rules(self, session: Session, *, aids_too: bool = True) -> None:
+        """The class's rules on one trainee's pendant (under its lock), and with ``aids_too``
+        its distance aids (else a trainee's own "Hide distance" choice is kept where the rules
+        allow it)."""
+        rules = self.rules
+        aids = self.distance_aids or ("locked" if rules.in_exercise else None)
+        if not aids_too:
+            aids = "locked" if rules.distance_locked else None
+        with session.batch():
+            if not rules.distance_locked:
+                session.set_rules(rules)            # unlock first: "shown" may then switch it off
+            if aids is not None:
+                session.set_hide_distance(aids != "shown")
+            session.set_rules(rules)
 
     # ------------------------------------------------------------ sessions
     def attach(self, session: Session) -> Any:
@@ -196,8 +225,7 @@ class ClassRoom:
             session.set_hide_truth(self.exercise is not None)
             if self.exercise == "mystery":
                 self._mount_mystery(session, recorder, join.name)
-            if self.hide_distance is not None:
-                session.set_hide_distance(self.hide_distance)
+            self._apply_rules(session)
             self._restore(session, recorder, join.name)
         return recorder
 
@@ -348,36 +376,52 @@ class ClassRoom:
         this gradebook applies it again (:meth:`_apply_kept`)."""
         kept = self.gradebook.class_setting(PUSHED_SETTING)
         kept = dict(kept) if isinstance(kept, dict) else {}
-        kept.update({"exercise": self.exercise, "hide_distance": self.hide_distance})
+        kept.update({"exercise": self.exercise, "distance_aids": self.distance_aids, "auto_touch": self.auto_touch})
         if tool_key is not None:
             kept["tool_key"] = tool_key
         self.gradebook.set_class_setting(PUSHED_SETTING, kept)
 
     def _apply_kept(self, exercise_given: bool) -> None:
         """At start: the settings the trainer pushed before a restart (an ``--exercise`` given
-        at start wins over a kept one)."""
+        at start wins over a kept one; a value this version does not know is ignored)."""
         kept = self.gradebook.class_setting(PUSHED_SETTING)
         if not isinstance(kept, dict):
             return
         if not exercise_given and kept.get("exercise") in (None, *EXERCISE_IDS):
             self.exercise = kept.get("exercise")
-        if isinstance(kept.get("hide_distance"), bool):
-            self.hide_distance = kept["hide_distance"]
+        aids, auto = kept.get("distance_aids"), kept.get("auto_touch")
+        try:
+            class_rules(self.exercise, aids, auto if isinstance(auto, bool) else None)
+        except ValueError:
+            aids = None
+        self.distance_aids = cast("DistanceAids | None", aids)
+        self.auto_touch = auto if isinstance(auto, bool) else None
         tool = kept.get("tool_key")
         self.pushed_tool = tool if isinstance(tool, str) and tool in self.tools else None
 
-    def push_settings(self, exercise: str | None, tool_key: str | None, hide_distance: bool | None = None) -> int:
+    def push_settings(self, exercise: str | None, tool_key: str | None,
+                      hide_distance: bool | str | None = None, auto_touch: bool | None = None) -> int:
         """Set the exercise (None: free practice; "mystery": each trainee gets a mystery tool),
-        mount ``tool_key`` (None: keep) and set "Hide distance" (None: keep) on every named
-        trainee's pendant; later trainees get the exercise and "Hide distance" when they name
-        themselves. Returns how many trainees."""
+        mount ``tool_key`` (None: keep), set the distance aids (``hide_distance``: "locked",
+        "hidden" or "shown"; True means "hidden", False "shown"; None: keep) and allow
+        Auto-touch or not (None: keep) on every named trainee's pendant; later trainees get
+        them when they name themselves. A new exercise starts from its default rules (module
+        docstring) except what this push sets. Returns how many trainees."""
         if exercise is not None and exercise not in EXERCISE_IDS:
             raise ValueError(f"Unknown exercise {exercise!r}; use one of {', '.join(EXERCISE_IDS)}.")
         if tool_key is not None and tool_key not in self.tools:
             raise ValueError(f"Unknown tool {tool_key!r}; use one of {', '.join(self.tools)}.")
+        named = {True: "hidden", False: "shown"}[hide_distance] if isinstance(hide_distance, bool) else hide_distance
+        class_rules(exercise, named, auto_touch)        # type: ignore[arg-type]  # ValueError: unknown aids
+        aids = cast("DistanceAids | None", named)
+        new_exercise = exercise != self.exercise
+        if new_exercise:
+            self.distance_aids = self.auto_touch = None
         self.exercise = exercise
-        if hide_distance is not None:
-            self.hide_distance = bool(hide_distance)
+        if aids is not None:
+            self.distance_aids = aids
+        if auto_touch is not None:
+            self.auto_touch = bool(auto_touch)
         self._keep_pushed(tool_key)
         with self._lock:
             trainees = list(self._trainees.values())
@@ -390,8 +434,7 @@ class ClassRoom:
                         self._mount_mystery(session, recorder, name)
                     elif tool_key is not None:
                         session.mount_tool(self.tools[tool_key])
-                    if hide_distance is not None:
-                        session.set_hide_distance(bool(hide_distance))
+                    self._apply_rules(session, aids_too=new_exercise or aids is not None)
                     session.changed(wizard=True)      # the result panel shows or hides the truth
             session.guard(apply)()
         return len(trainees)

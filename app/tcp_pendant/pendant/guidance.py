@@ -44,6 +44,8 @@ CONTACT_RADIUS_MM = CRASH_RADIUS_MM
 """A translation whose tool-tip path passes closer than this to the reference tip stops where
 it is closest (the tip touches); farther, the tip passes beside the spike."""
 
+_STOPPED_HERE_M = 1e-6
+"""A closest point this near the tip's start (m) is where the last press stopped it."""
 _SCALES_MM = (0.1, 0.25, 0.5, 1.0, 2.5, 5.0, 10.0, 25.0, 50.0, 100.0)
 _HALF_W, _HALF_H = 7, 2          # characters either side of the tool tip in the drawing
 
@@ -153,6 +155,8 @@ def contact_stop(tip_world_m: np.ndarray, step_world_m: np.ndarray,
     t = float((r - p) @ step) / length2
     if not 0.0 < t < 1.0:
         return None                                   # the closest point is not inside this step
+    if t * math.sqrt(length2) < _STOPPED_HERE_M:
+        return None                                   # stopped here by the last press: this one goes on
     miss_mm = float(np.linalg.norm(p + t * step - r)) * 1000.0
     if miss_mm > CONTACT_RADIUS_MM or not math.isfinite(miss_mm):
         return None

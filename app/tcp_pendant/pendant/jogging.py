@@ -24,6 +24,9 @@ Stop at contact (a real touch-up): a Cartesian X/Y/Z press or tick whose tool-ti
 pass through the reference tip (closer than ``guidance.CONTACT_RADIUS_MM`` to it, beyond the
 closest point) stops at the closest point and says so (``JogResult.stopped_by == "contact"``);
 the next press in the same direction goes on (the tip is touching; that is the warning).
+With ``Jogger.stop_at_contact`` False (the session's "Hide distance": the trainee judges the
+touch by eye) the press goes on through the tip and says nothing: driven through it, the tool
+crashes (``controller.touch``), as a real one would.
 """
 
 from __future__ import annotations
@@ -190,6 +193,8 @@ class Jogger:
         self._last_tick: dict[str, float] = {}
         self._held_at_contact: str | None = None
         self.gate = PressGate(clock=clock)
+        self.stop_at_contact = True
+        """Stop a translation at the reference tip (False: "Hide distance", no stop, no word)."""
 
     def key(self, axis: str | int, sign: int, *, hold_tick: bool = False) -> JogResult | None:
         """One press of a -/+ key.
@@ -254,6 +259,8 @@ class Jogger:
         """A translation of ``amount_mm`` along axis ``ax`` of the jog frame, stopped at contact
         (module docstring)."""
         c = self.controller
+        if not self.stop_at_contact:
+            return c.jog_cartesian(self.settings.frame, ax, amount_mm)
         step_m = self.frame_rotation()[:, "XYZ".index(ax)] * (amount_mm / 1000.0)
         stop = contact_stop(c.T_world_tool_true()[:3, 3], step_m, c.reference_tip_world_m)
         if stop is None:

@@ -2,10 +2,12 @@
 
 Top to bottom (below the wizard dock, ``views.wizard_dock``): TCP readout (frame + tool), the
 touch indicator with the offset "ΔX ΔY ΔZ mm" of the reference tip along the jog frame's axes
-and, within 20 mm, a magnified close-up of the two tips (all hidden by "Hide distance"), the status line (why a jog stopped), the increment, the jog
+and, within 20 mm, a magnified close-up of the two tips (all hidden by "Hide distance"), the
+status line (why a jog stopped), the increment, the jog
 keys - one row per axis with − and + side by side (X Y Z A B C, or A1..A6; in continuous mode
-the hold-to-jog keys, two per axis, since only single buttons report a hold) - then the jog
-settings (mode, frame, override, readout frame), the joints, Home and the camera buttons; the touches ("Record point" and the list) follow.
+the hold-to-jog keys, two per axis, since only single buttons report a hold), the keys line,
+the front and side views of the tips (``views.tip_insets``, within 40 mm: geometry, no
+numbers) - then the jog settings (mode, frame, override, readout frame), the joints, Home and the camera buttons; the touches ("Record point" and the list) follow.
 Every button group marks its selected option with "✓ " (viser's button groups show no
 selection); a click's value is read without the mark. Keyboard shortcuts come from the page's
 own script (``static/pendant.js``, served by ``client_script``): it clicks these buttons, so a
@@ -56,6 +58,7 @@ from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.views import arrival
 from tcp_pendant.views.scene import closeup_camera, overview_camera
 from tcp_pendant.views.gui_util import ButtonEvent, ButtonGroupEvent, CheckboxEvent, set_value, target_of
+from tcp_pendant.views.tip_insets import TipInsets
 from tcp_pendant.views.viser_adapter import queue_markdown
 
 if TYPE_CHECKING:
@@ -169,6 +172,8 @@ class PendantPanel:
                     self.cart_buttons[(ax, sign)] = b
 
         self.keys_md = gui.add_markdown(KEYS_LINE)
+        self.insets = TipInsets(session)           # front and side views of the tips (no numbers),
+                                                   # below the keys: every key row stays above the fold
 
         self.joint_folder = gui.add_folder("Joint jog", visible=False)
         with self.joint_folder:
@@ -318,7 +323,11 @@ class PendantPanel:
     def _on_hide_distance(self, event: CheckboxEvent | None) -> None:
         if event is not None and getattr(event, "client", 1) is None:
             return                                   # our own assignment
-        self.session.set_hide_distance(bool(self.hide_distance.value))
+        try:
+            self.session.set_hide_distance(bool(self.hide_distance.value))
+        except ValueError:                           # refused (an exercise's lock): undo the tick
+            set_value(self.hide_distance, self.session.hide_distance)
+            raise
 
     def _slider_cb(self, index: int) -> Any:
         """The callback of joint slider ``index`` (0-based): set the joint to the browser's
@@ -421,6 +430,8 @@ class PendantPanel:
         hide = s.hide_distance
         if bool(self.hide_distance.value) != hide:
             set_value(self.hide_distance, hide)
+        if self.hide_distance.disabled != s.rules.distance_locked:     # locked by the trainer
+            self.hide_distance.disabled = s.rules.distance_locked
         touch = touch_indicator_markdown(state.touch, hide_distance=hide)
         closeup = ""
         if not hide:

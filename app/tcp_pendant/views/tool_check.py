@@ -19,6 +19,7 @@ from tcp_pendant.controller import RobotKinematics, T_flange_tool_m, VirtualCont
 from tcp_pendant.controller.jog import JogSettings
 from tcp_pendant.controller.spin import MAX_SPIN_ANGLE_DEG, SpinCheckResult, spin_check
 from tcp_pendant.text_escape import escape_markdown
+from tcp_pendant.wizards.check_reading import READING_NOTE, read_mm, reading_verdict
 from tcpcal.tool import Tool
 
 __all__ = ["CheckJob", "check_job", "check_markdown", "check_verdict"]
@@ -86,16 +87,24 @@ def check_verdict(result: SpinCheckResult) -> str:
     return f"TCP off by {err:.3f} mm: calibrate again (or the tool is bent)."
 
 
-def check_markdown(job: CheckJob, result: SpinCheckResult) -> str:
+def check_markdown(job: CheckJob, result: SpinCheckResult, *, reading: bool = False) -> str:
     """The result as markdown: per rotation the tip's deviation (mm), then the implied TCP
-    error and the correction (user text escaped)."""
+    error and the correction (user text escaped). ``reading`` (an exercise): what a technician
+    sees instead - per rotation how far the tip moved, read by eye (``wizards.check_reading``),
+    and a verdict from those readings; no implied error vector, no correction."""
     lines = [f"**TCP check of {escape_markdown(job.title)}** at ±{result.angle_deg:g}° "
              f"(mounted: {escape_markdown(job.mounted_label)})", "",
-             "| Rotation | Tip moved (mm) | |", "|---|---:|---|"]
+             f"| Rotation | Tip moved (mm{', by eye' if reading else ''}) | |", "|---|---:|---|"]
+    readings = []
     for r in result.rotations:
         status = "✔" if r.reached else f"stopped: {escape_markdown(r.message or str(r.stopped_by))}"
-        lines.append(f"| {r.label} | {r.deviation_mm:.3f} | {status} |")
+        moved = f"{read_mm(r.deviation_mm):.1f}" if reading else f"{r.deviation_mm:.3f}"
+        readings.append((r.reached, read_mm(r.deviation_mm)))
+        lines.append(f"| {r.label} | {moved} | {status} |")
     lines.append("")
+    if reading:
+        lines += [READING_NOTE, "", f"**{reading_verdict(readings, result.angle_deg)}**"]
+        return "\n".join(lines)
     err = result.implied_tcp_error_mm
     if err is not None and result.implied_offset_flange_mm is not None:
         dx, dy, dz = (0.0 if abs(v) < 5e-4 else float(v) for v in result.implied_offset_flange_mm)  # no "-0.000"

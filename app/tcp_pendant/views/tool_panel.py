@@ -49,6 +49,7 @@ from tcp_pendant.views.gui_util import (
     target_of,
 )
 from tcp_pendant.views.tool_check import CheckJob, check_job, check_markdown
+from tcp_pendant.wizards.check_reading import check_readable
 from tcpcal.controllers import CONTROLLER_FORMATS, export_tool_file
 from tcpcal.errors import TcpcalError
 from tcpcal.formats import FORMATS, export_tool, text_format
@@ -318,6 +319,8 @@ class ToolPanel:
         try:
             with s.lock:
                 title, tool = which()
+                if s.rules.in_exercise:                 # read against the spike, as on a robot
+                    check_readable(s.pose_state().touch.distance_mm)
                 job = check_job(s.controller, tool, title, self.check_angle.value)
                 self.check_md.content = f"Checking {escape_markdown(title)} ..."
         except ValueError as exc:
@@ -336,7 +339,7 @@ class ToolPanel:
             if s.closed:
                 return
             self.last_check = (job, result)
-            self.check_md.content = check_markdown(job, result)
+            self.check_md.content = check_markdown(job, result, reading=s.rules.in_exercise)
 
     def _entry(self) -> ToolEntry:
         return ToolEntry(str(self.entry_name.value), {f: str(h.value) for f, h in self.entry_fields.items()})

@@ -13,6 +13,8 @@ import viser
 from scipy.spatial.transform import Rotation
 
 from tcp_pendant.calibrate.text import empty_touches_markdown
+from tcp_pendant.pendant.guidance import tip_offset_mm
+from tcp_pendant.pendant.touch_feedback import touch_feedback
 from tcp_pendant.session import Session, SessionChange, Touch
 from tcp_pendant.views.gui_util import ButtonEvent, set_content, target_of
 
@@ -80,8 +82,13 @@ class TouchListView:
         set_content(self.empty_md, empty_touches_markdown(self.session.workflow.wizard))
 
     def _on_record(self, _event: ButtonEvent) -> None:
-        t = self.session.record_touch()
-        self.session.notify("Point recorded", t.label, kind="success")
+        s = self.session
+        t = s.record_touch()
+        said = t.label
+        if s.hide_distance and not s.rules.in_exercise:     # free practice by eye: how far it was
+            frame = s.jogger.settings.frame
+            said += f": {touch_feedback(tip_offset_mm(s.pose_state(), s.controller.reference_tip_world_m, frame), frame)}"
+        s.notify("Point recorded", said, kind="success")
 
     def _on_export_csv(self, event: ButtonEvent) -> None:
         data = touches_csv_text(self.session.touches).encode("utf-8")

@@ -23,6 +23,7 @@ from typing import Any, Protocol
 from tcp_pendant.classroom.gradebook import GradeRow, Gradebook
 from tcp_pendant.classroom.grading import RecordGrade, grade_record
 from tcp_pendant.classroom.recorder import TraineeStatus
+from tcp_pendant.pendant.exercise_rules import ExerciseRules
 from tcp_pendant.session import Session
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.upload_guard import limit_upload_size
@@ -33,12 +34,16 @@ log = logging.getLogger(__name__)
 _GRADE_WORKER = ThreadPoolExecutor(max_workers=1, thread_name_prefix="record-grading")
 """Parses, replays and grades uploaded records off viser's event loop, one at a time."""
 
-__all__ = ["EXERCISES", "HIDE_DISTANCE", "ClassControl", "TrainerView", "grades_markdown", "trainees_markdown"]
+__all__ = ["AUTO_TOUCH", "EXERCISES", "HIDE_DISTANCE", "ClassControl", "TrainerView", "grades_markdown", "trainees_markdown"]
 
 EXERCISES: dict[str, str | None] = {"Free practice": None, "Mystery tool": "mystery"}
 """Exercise choices of the trainer view: label -> exercise id."""
-HIDE_DISTANCE: dict[str, bool | None] = {"(keep)": None, "on": True, "off": False}
-"""'Hide distance' choices of the trainer view: label -> the setting pushed (None: keep)."""
+HIDE_DISTANCE: dict[str, str | None] = {"(keep)": None, "on, locked": "locked", "on": "hidden", "off": "shown"}
+"""'Hide distance' choices of the trainer view: label -> the distance aids pushed
+(``pendant.exercise_rules``; None: keep). "on, locked": the trainee cannot show them (the
+default in an exercise); "on": hidden, the trainee may show them; "off": shown."""
+AUTO_TOUCH: dict[str, bool | None] = {"(keep)": None, "off": False, "allowed": True}
+"""'Auto-touch' choices of the trainer view (None: keep; an exercise starts with it off)."""
 NO_NAME = "(choose a name) "
 """The first choice of "Release a name" (releases nothing; its trailing space keeps it apart from every
 stored name, which is stripped)."""
@@ -61,8 +66,23 @@ class ClassControl(Protocol):
 
     def grades_csv(self) -> str: ...
 
+    @property
+    def rules(self) -> ExerciseRules: ...
+
     def push_settings(self, exercise: str | None, tool_key: str | None,
-                      hide_distance: bool | None = None) -> int: ...
+                      hide_distance: bool | str | None = None, auto_touch: bool | None = None) -> int: ...
+
+    def held_names(self) -> list[str]: ...
+
+    def release(self, name: str) -> str: ...
+
+
+def rules_words(rules: ExerciseRules) -> str:
+    """The class's rules in one line for the trainer (our own words)."""
+    aids = "locked off" if rules.distance_locked else "trainee's choice"
+    auto = "allowed" if rules.auto_touch_allowed else "off"
+    where = f"Exercise {rules.exercise}" if rules.in_exercise else "Free practice"
+    return f"{where}: distance aids {aids}, Auto-touch {auto}."
 
     def held_names(self) -> list[str]: ...
 
@@ -119,7 +139,8 @@ class TrainerView:
     """The trainer's panel in one browser (see the module docstring).
 
     Attributes:
-        trainees_md, grades_md, download, exercise, tool, hide_distance, push: the widgets (for tests).
+        trainees_md, grades_md, download, exercise, tool, hide_distance, auto_touch, push: the
+            widgets (for tests).
     """
 
     def __init__(self, session: Session, control: ClassControl) -> None:
@@ -139,7 +160,11 @@ class TrainerView:
             self.tool = gui.add_dropdown("Tool for all", tools, initial_value=tools[0])
             self.hide_distance = gui.add_dropdown(
                 "Hide distance for all", tuple(HIDE_DISTANCE), initial_value="(keep)",
-                hint="on: trainees judge the touch by eye (no distance, no close-up); off: shown again.")
+                hint="on: trainees judge the touch by eye (no distance, no Δ line, no close-up, no stop "
+                     "at the tip); locked: they cannot show it (the default in an exercise); off: shown.")
+            self.auto_touch = gui.add_dropdown(
+                "Auto-touch for all", tuple(AUTO_TOUCH), initial_value="(keep)",
+                hint="allowed: trainees may let the robot touch for them (off by default in an exercise).")
             self.push = gui.add_button("Push to all trainees", color="blue")
             self.push_md = gui.add_markdown("")
             self.release_name = gui.add_dropdown(
@@ -214,6 +239,9 @@ class TrainerView:
         label = str(self.hide_distance.value)
         if label not in HIDE_DISTANCE:
             raise ValueError(f"Unknown Hide distance choice {label!r}; choose one of {', '.join(HIDE_DISTANCE)}.")
-        n = self.control.push_settings(exercise, tool, HIDE_DISTANCE[label])
-        self.push_md.content = f"Pushed to {n} trainee{'s' if n != 1 else ''}."
+        auto = str(self.auto_touch.value)
+        if auto not in AUTO_TOUCH:
+            raise ValueError(f"Unknown Auto-touch choice {auto!r}; choose one of {', '.join(AUTO_TOUCH)}.")
+        n = self.control.push_settings(exercise, tool, HIDE_DISTANCE[label], AUTO_TOUCH[auto])
+        self.push_md.content = f"Pushed to {n} trainee{'s' if n != 1 else ''}. {rules_words(self.control.rules)}"
         self.render()

@@ -28,6 +28,7 @@ from tcp_pendant.calibrate.text import meter_level, step_markdown
 from tcp_pendant.pendant.guidance import direction_words, tip_offset_mm
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.pendant.record_check import RecordCheck
+from tcp_pendant.pendant.touch_feedback import touch_feedback
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.views.gui_util import ButtonEvent, ButtonGroupEvent, set_content, set_value, target_of
 
@@ -106,6 +107,8 @@ class WizardDock:
         index = None if wiz is None else wiz.step.index
         s.record_step()
         shown = "" if s.hide_distance else f", {state.touch.distance_mm:.2f} mm from the tip"
+        if s.hide_distance and not s.rules.in_exercise:     # free practice by eye: how far it was
+            shown = f": {touch_feedback(delta, frame)}"
         self._say(f"✔ Step {index + 1 if index is not None else '?'} recorded{shown}.")
 
     def _on_nav(self, event: ButtonGroupEvent) -> None:

@@ -221,7 +221,7 @@ class WizardStepsView:
         self.cancel.label = "Cancel" if stepping else ("Close" if wf.result_saved else "Close (not saved)")
         self.add_point.visible = wiz.supports_add_point
         self.add_point.disabled = not wiz.can_add_point
-        self.auto_folder.visible = wf.training and stepping and not by_controller
+        self.auto_folder.visible = wf.auto_touch_allowed and stepping and not by_controller
         chosen = self.auto_direction.value == CHOSEN
         self.auto_tilt.visible = self.auto_azimuth.visible = chosen
         self._render_auto_line()

@@ -29,6 +29,7 @@ import numpy as np
 from tcpcal.tool import Tool
 
 from tcp_pendant.text_escape import escape_markdown
+from tcp_pendant.wizards.check_reading import CHECK_READING_MM, READING_NOTE, read_mm, reading_verdict
 from tcp_pendant.wizards.base import (
     RecordedPose,
     StartContext,
@@ -71,6 +72,9 @@ class CheckFigures:
         implied_tcp_error_mm: ``|e|``, None when the reached rotations do not determine it.
         correction_flange_mm: add it to the tool data's TCP (FLANGE axes), None as above.
         fit_rms_mm: what no TCP error explains (RMS), None as above.
+        read_to_mm: None: the figures as computed; a number: a technician's reading
+            (``wizards.check_reading``, an exercise): the deviations rounded to it, no implied
+            error, no correction, no fit RMS.
     """
 
     angle_deg: float
@@ -78,6 +82,13 @@ class CheckFigures:
     implied_tcp_error_mm: float | None
     correction_flange_mm: tuple[float, float, float] | None
     fit_rms_mm: float | None
+    read_to_mm: float | None = None
+
+    def as_reading(self) -> "CheckFigures":
+        """What a technician sees (an exercise): per rotation how far the tip moved, rounded to
+        ``check_reading.CHECK_READING_MM``; the implied error, correction and fit RMS dropped."""
+        rows = tuple(CheckRow(r.label, r.reached, r.message, read_mm(r.deviation_mm)) for r in self.rows)
+        return CheckFigures(self.angle_deg, rows, None, None, None, read_to_mm=CHECK_READING_MM)
 
     @classmethod
     def of(cls, spin: Any) -> "CheckFigures":
@@ -100,7 +111,10 @@ class CheckFigures:
     def verdict(self) -> str:
         """One line: good / off by how much / not determined (plain text). "Good" needs every
         rotation: one that could not be made proves nothing about its axis, so the verdict stays
-        open (an error already found among the others stands)."""
+        open (an error already found among the others stands); an exercise's reading says what
+        the readings say (``check_reading.reading_verdict``)."""
+        if self.read_to_mm is not None:
+            return reading_verdict(((r.reached, r.deviation_mm) for r in self.rows), self.angle_deg)
         err = self.implied_tcp_error_mm
         missing = [r.label for r in self.rows if not r.reached]
         if err is not None and err > GOOD_CHECK_MM:
@@ -115,12 +129,16 @@ class CheckFigures:
         return f"TCP good: implied error {err:.3f} mm (at most {GOOD_CHECK_MM:g} mm)."
 
     def to_dict(self) -> dict[str, Any]:
-        return {"angle_deg": self.angle_deg,
-                "rows": [{"label": r.label, "reached": r.reached, "message": r.message,
-                          "deviation_mm": r.deviation_mm} for r in self.rows],
-                "implied_tcp_error_mm": self.implied_tcp_error_mm,
-                "correction_flange_mm": None if self.correction_flange_mm is None else list(self.correction_flange_mm),
-                "fit_rms_mm": self.fit_rms_mm}
+        d: dict[str, Any] = {
+            "angle_deg": self.angle_deg,
+            "rows": [{"label": r.label, "reached": r.reached, "message": r.message,
+                      "deviation_mm": r.deviation_mm} for r in self.rows],
+            "implied_tcp_error_mm": self.implied_tcp_error_mm,
+            "correction_flange_mm": None if self.correction_flange_mm is None else list(self.correction_flange_mm),
+            "fit_rms_mm": self.fit_rms_mm}
+        if self.read_to_mm is not None:
+            d["read_to_mm"] = self.read_to_mm
+        return d
 
     @classmethod
     def from_dict(cls, d: Any) -> "CheckFigures":
@@ -147,10 +165,11 @@ class CheckFigures:
         rms = d.get("fit_rms_mm")
         if off is not None and not (isinstance(off, list) and len(off) == 3):
             raise WizardError("The TCP check's stored correction must be 3 numbers (mm).")
-        return cls(finite_number(d.get("angle_deg"), "TCP check's angle"), tuple(rows),
-                   None if err is None else finite_number(err, "TCP check's implied error"),
-                   None if off is None else mm3([finite_number(v, "TCP check's correction") for v in off]),
-                   None if rms is None else finite_number(rms, "TCP check's fit RMS"))
+        figures = cls(finite_number(d.get("angle_deg"), "TCP check's angle"), tuple(rows),
+                      None if err is None else finite_number(err, "TCP check's implied error"),
+                      None if off is None else mm3([finite_number(v, "TCP check's correction") for v in off]),
+                      None if rms is None else finite_number(rms, "TCP check's fit RMS"))
+        return figures.as_reading() if d.get("read_to_mm") is not None else figures
 
 
 @dataclass(frozen=True, eq=False, kw_only=True)
@@ -313,14 +332,17 @@ def tcp_check_markdown(result: TcpCheckResult) -> str:
     error, the correction (FLANGE, mm) and the verdict (the tool's name escaped)."""
     c = result.check
     where = "" if result.slot is None else f"slot {result.slot}: "
+    reading = c.read_to_mm is not None
     lines = [f"**TCP check of {escape_markdown(where + result.tool_name)}** at ±{c.angle_deg:g}°", "",
-             "| Rotation | Tip moved (mm) | |", "|---|---:|---|"]
+             f"| Rotation | Tip moved (mm{', by eye' if reading else ''}) | |", "|---|---:|---|"]
     for r in c.rows:
         if r.reached:
-            lines.append(f"| {escape_markdown(r.label)} | {r.deviation_mm:.3f} | ✔ |")
+            lines.append(f"| {escape_markdown(r.label)} | {r.deviation_mm:.{1 if reading else 3}f} | ✔ |")
         else:                                   # no figure: the rotation was not made
             lines.append(f"| {escape_markdown(r.label)} | not made | stopped: {escape_markdown(r.message)} |")
     lines.append("")
+    if reading:
+        lines += [READING_NOTE, ""]
     if c.implied_tcp_error_mm is not None and c.correction_flange_mm is not None:
         dx, dy, dz = (0.0 if abs(v) < 5e-4 else v for v in c.correction_flange_mm)
         lines.append(f"**Implied TCP error: {c.implied_tcp_error_mm:.3f} mm** · suggested correction "

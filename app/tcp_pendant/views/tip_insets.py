@@ -1,0 +1,56 @@
+"""The pendant's two magnified tip views (front and side) as one GUI image (viser).
+
+The image comes from ``pendant.tip_insets`` (numpy, rendered on the server from the geometry:
+the reference tip and the mounted tool's true tip); this view only places it below the touch
+indicator, with a caption, and replaces it after a move that changed it (``insets_key``:
+nothing is sent while the tool tip stays far from the window or has not moved). Shown with
+and without "Hide distance": it draws what the eye would see, no number. It is hidden while
+the tool tip is farther than ``tip_insets.NEAR_MM`` (40 mm, plain to see in the 3D view) from
+the reference tip: there is nothing of the tool to see in it then, and a page that loads with
+the robot in its ready pose does not carry the image.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from tcp_pendant.pendant.tip_insets import FAR, insets_key, tip_insets_image
+from tcp_pendant.session import Session, SessionChange
+from tcp_pendant.views.gui_util import target_of
+
+__all__ = ["CAPTION", "TipInsets"]
+
+CAPTION = ("**Tip close-up** · left: front (X→, Z↑) · right: side (Y→, Z↑) · "
+           "grid and bar 1 mm · magenta: the tool tip")
+
+
+class TipInsets:
+    """Builds the caption and the image in the current GUI container of ``session.target.gui``."""
+
+    def __init__(self, session: Session) -> None:
+        self.session = session
+        gui = target_of(session).gui
+        c = session.controller
+        self._key: tuple[object, ...] = insets_key(c.reference_tip_world_m, c.T_world_tool_true())
+        near = self._key != FAR
+        self.caption = gui.add_markdown(CAPTION, visible=near)
+        self.image = gui.add_image(tip_insets_image(c.reference_tip_world_m, c.T_world_tool_true()), format="png",
+                                   visible=near)
+        session.subscribe(self.on_change)
+
+    def on_change(self, change: SessionChange) -> None:
+        if change.pose and change.state is not None:
+            self.render(change.state)
+
+    def render(self, state: Any) -> None:
+        """Send a new image when the tips' geometry in the window changed."""
+        tip = self.session.controller.reference_tip_world_m
+        key = insets_key(tip, state.T_world_tool_true)
+        if key == self._key:
+            return
+        self._key = key
+        near = key != FAR
+        if near:
+            self.image.image = tip_insets_image(tip, state.T_world_tool_true)
+        if self.image.visible != near:
+            self.image.visible = self.caption.visible = near
