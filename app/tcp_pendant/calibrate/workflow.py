@@ -361,7 +361,7 @@ class CalibrationWorkflow:
         Args:
             touches: ``tcp_pendant.session.Touch`` (``T_world_flange``, metres; ``distance_mm``)
                 or 4x4 flange poses in WORLD, metres.
-            estimator: as for :meth:`start_xyz4`.
+            estimator: the 4-point estimator ("lstsq", "sphere", "pairwise").
 
         Raises:
             WizardError: no touches, more than the wizard's 20, a pose that is not rigid; then
