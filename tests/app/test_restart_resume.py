@@ -134,18 +134,19 @@ def test_pushed_settings_outlive_a_restart(app_factory, tmp_path: Path) -> None:
     db = tmp_path / "class.sqlite3"
     first = app_factory(class_db=db, trainer_token=TOKEN)
     assert first.classroom.exercise is None
-    first.classroom.push_settings("mystery", None, hide_distance=True)
+    first.classroom.push_settings("mystery", None, hide_distance="hidden", auto_touch=True)
     first.stop()
     again = app_factory(class_db=db, trainer_token=TOKEN)
     room = again.classroom
-    assert room.exercise == "mystery" and room.hide_distance is True
+    assert room.exercise == "mystery" and room.distance_aids == "hidden" and room.auto_touch is True
     c = DrainingClient(again.port)
     try:
         s = _join(again, c, "Cleo")
         assert s.hide_distance and s.workflow.hide_truth and s.controller.mounted_tool.key.startswith("mystery")
+        assert s.rules.auto_touch_allowed and not s.rules.distance_locked     # as pushed, not the defaults
     finally:
         c.close()
     room.push_settings(None, None, hide_distance=False)       # free practice again: also kept
     again.stop()
     third = app_factory(class_db=db, trainer_token=TOKEN)
-    assert third.classroom.exercise is None and third.classroom.hide_distance is False
+    assert third.classroom.exercise is None and third.classroom.distance_aids == "shown"

@@ -27,28 +27,7 @@ sys.path.insert(0, str(Path(__file__).parent))
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "robots"))
 from conftest import wait_until  # noqa: E402
 from ros_layouts import ACME7_MIMIC, acme7_workspace, kr16_2_urdf  # noqa: E402
-from wsclient import DrainingClient, decode_window  # noqa: E402
-
-
-class RecordingClient(DrainingClient):
-    """A :class:`DrainingClient` that keeps every decoded message the server sent."""
-
-    def __init__(self, port: int) -> None:
-        self.messages: list[dict] = []
-        super().__init__(port)
-
-    def _drain(self) -> None:
-        try:
-            for msg in self.ws:
-                self.n_messages += 1
-                self.n_bytes += len(msg)
-                if isinstance(msg, bytes):
-                    self.messages.extend(decode_window(msg))
-        except Exception:
-            pass
-
-    def of_type(self, name: str) -> list[dict]:
-        return [m for m in list(self.messages) if m.get("type") == name]
+from wsclient import RecordingClient  # noqa: E402
 
 
 def notifications(client: RecordingClient) -> list[tuple[str, str]]:
