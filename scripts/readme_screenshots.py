@@ -168,13 +168,13 @@ def shoot_xyz4(page: Any, url: str, app: Any, out: Path) -> CaptionFigures:
     fill(page, "Touches", str(N_TOUCHES))
     page.wait_for_timeout(300)                       # let the throttled slider update go out
     page.get_by_role("button", name="Start", exact=True).click()
-    page.get_by_text(f"Step 1 of {N_TOUCHES}").wait_for()
+    page.get_by_text(f"Step 1 of {N_TOUCHES}").filter(visible=True).first.wait_for()
     fill(page, "Operator error σ (mm)", f"{SIGMA_MM}")
     for k in range(1, N_TOUCHES + 1):
-        page.get_by_text(f"Step {k} of {N_TOUCHES}").first.wait_for()
+        page.get_by_text(f"Step {k} of {N_TOUCHES}").filter(visible=True).first.wait_for()
         page.get_by_role("button", name="Auto-touch").click()
         if k < N_TOUCHES:
-            page.get_by_text(f"Step {k + 1} of {N_TOUCHES}").first.wait_for()
+            page.get_by_text(f"Step {k + 1} of {N_TOUCHES}").filter(visible=True).first.wait_for()
     page.get_by_text("Against the true TOOL frame").wait_for()
     figures = _figures(view.workflow)
     shown = page.get_by_text("Position error of the TCP").first.inner_text()
