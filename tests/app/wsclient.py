@@ -59,8 +59,12 @@ class DrainingClient:
             for msg in self.ws:
                 self.n_messages += 1
                 self.n_bytes += len(msg)
+                self._received(msg)
         except Exception:
             pass
+
+    def _received(self, msg: bytes | str) -> None:
+        """One message as it arrives (the subclasses decode what they need)."""
 
     def close(self) -> None:
         """Close the websocket (the server then fires on_client_disconnect)."""
@@ -128,24 +132,22 @@ class ButtonClient(DrainingClient):
         self._send_lock = threading.Lock()
         super().__init__(port, host)
 
-    def _drain(self) -> None:
-        try:
-            for msg in self.ws:
-                self.n_messages += 1
-                self.n_bytes += len(msg)
-                if (self.record_updates or not self.found.is_set()) and isinstance(msg, bytes):
-                    for m in decode_window(msg):
-                        kind = m.get("type")
-                        if kind == "GuiButtonMessage":
-                            label = (m.get("props") or {}).get("label")
-                            if label in self.labels:
-                                self.button_uuids.setdefault(label, m["uuid"])
-                        elif kind == "GuiUpdateMessage" and self.record_updates:
-                            self.gui_props.setdefault(m["uuid"], {}).update(m["updates"])
-                    if len(self.button_uuids) == len(self.labels):
-                        self.found.set()
-        except Exception:
-            pass
+    def _received(self, msg: bytes | str) -> None:
+        if (self.record_updates or not self.found.is_set()) and isinstance(msg, bytes):
+            for m in decode_window(msg):
+                self._decoded(m)
+            if len(self.button_uuids) == len(self.labels):
+                self.found.set()
+
+    def _decoded(self, m: dict) -> None:
+        """One decoded message: a button's uuid, and with ``record_updates`` a GUI update."""
+        kind = m.get("type")
+        if kind == "GuiButtonMessage":
+            label = (m.get("props") or {}).get("label")
+            if label in self.labels:
+                self.button_uuids.setdefault(label, m["uuid"])
+        elif kind == "GuiUpdateMessage" and self.record_updates:
+            self.gui_props.setdefault(m["uuid"], {}).update(m["updates"])
 
     def hold_tick(self, label: str, frequency: float) -> None:
         """One hold message of the button ``label`` (registered hold rate ``frequency`` Hz)."""
@@ -219,15 +221,9 @@ class RecordingClient(DrainingClient):
         self.messages: list[dict] = []
         super().__init__(port, host)
 
-    def _drain(self) -> None:
-        try:
-            for msg in self.ws:
-                self.n_messages += 1
-                self.n_bytes += len(msg)
-                if isinstance(msg, bytes):
-                    self.messages.extend(decode_window_arrays(msg))
-        except Exception:
-            pass
+    def _received(self, msg: bytes | str) -> None:
+        if isinstance(msg, bytes):
+            self.messages.extend(decode_window_arrays(msg))
 
     def of_type(self, name: str) -> list[dict]:
         return [m for m in list(self.messages) if m.get("type") == name]
@@ -244,27 +240,17 @@ class ReadoutClient(ButtonClient):
         self.readouts: list[tuple[float, float]] = []
         super().__init__(port, labels, host)
 
-    def _drain(self) -> None:
-        try:
-            for msg in self.ws:
-                t = time.monotonic()
-                self.n_messages += 1
-                self.n_bytes += len(msg)
-                if not isinstance(msg, bytes):
-                    continue
-                for m in decode_window(msg):
-                    kind = m.get("type")
-                    if kind == "GuiButtonMessage" and not self.found.is_set():
-                        label = (m.get("props") or {}).get("label")
-                        if label in self.labels:
-                            self.button_uuids.setdefault(label, m["uuid"])
-                            if len(self.button_uuids) == len(self.labels):
-                                self.found.set()
-                    elif kind == "GuiUpdateMessage":
-                        text = (m.get("updates") or {}).get("_markdown")
-                        if isinstance(text, str) and text.startswith("**TCP in "):
-                            x = self.X_MM.search(text)
-                            if x:
-                                self.readouts.append((t, float(x.group(1))))
-        except Exception:
-            pass
+    def _received(self, msg: bytes | str) -> None:
+        t = time.monotonic()                      # every message is decoded: the readout goes on
+        if not isinstance(msg, bytes):
+            return
+        for m in decode_window(msg):
+            self._decoded(m)
+            if m.get("type") == "GuiUpdateMessage":
+                text = (m.get("updates") or {}).get("_markdown")
+                if isinstance(text, str) and text.startswith("**TCP in "):
+                    x = self.X_MM.search(text)
+                    if x:
+                        self.readouts.append((t, float(x.group(1))))
+        if len(self.button_uuids) == len(self.labels):
+            self.found.set()
