@@ -16,7 +16,7 @@ from __future__ import annotations
 import importlib
 import pkgutil
 import re
-from collections.abc import Callable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Collection, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from typing import overload
 
@@ -242,6 +242,18 @@ def _or_list(items: Sequence[str]) -> str:
     return items[0] if len(items) == 1 else f"{', '.join(items[:-1])} or {items[-1]}"
 
 
+def _by_extension(readers: Sequence[ControllerFormat], filename: str | None,
+                  extensions: Callable[[ControllerFormat], Collection[str]]) -> str | None:
+    """The first of ``readers`` (rank order) whose ``extensions`` hold ``filename``'s suffix
+    (lower case), or None (no file name, or no format claims the suffix)."""
+    if not filename:
+        return None
+    from pathlib import PurePath
+
+    suffix = PurePath(filename).suffix.lower()
+    return next((fmt.name for fmt in readers if suffix in extensions(fmt)), None)
+
+
 def detect_pose_format(text: str, filename: str | None = None) -> str:
     """The controller of a program file: a content only one controller writes
     (``ControllerFormat.claim``), else its extension, else its content."""
@@ -249,13 +261,9 @@ def detect_pose_format(text: str, filename: str | None = None) -> str:
     for fmt in readers:
         if fmt.claim is not None and fmt.claim.search(text):
             return fmt.name
-    if filename:
-        from pathlib import PurePath
-
-        suffix = PurePath(filename).suffix.lower()
-        for fmt in readers:
-            if suffix in fmt.pose_extensions:
-                return fmt.name
+    by_suffix = _by_extension(readers, filename, lambda f: f.pose_extensions)
+    if by_suffix is not None:
+        return by_suffix
     for fmt in readers:
         if fmt.detect is not None and fmt.detect.search(text):
             return fmt.name
@@ -269,13 +277,9 @@ def detect_tool_format(text: str, filename: str | None = None) -> str:
     """The controller of a tool file (``tools import --format auto``): from its extension,
     else from its content (``ControllerFormat.tool_file_detect``, in ``rank`` order)."""
     readers = formats(lambda f: f.parse_file is not None)
-    if filename:
-        from pathlib import PurePath
-
-        suffix = PurePath(filename).suffix.lower()
-        for fmt in readers:
-            if suffix in fmt.tool_file_extensions:
-                return fmt.name
+    by_suffix = _by_extension(readers, filename, lambda f: f.tool_file_extensions)
+    if by_suffix is not None:
+        return by_suffix
     for fmt in readers:
         if fmt.tool_file_detect is not None and fmt.tool_file_detect.search(text):
             return fmt.name
