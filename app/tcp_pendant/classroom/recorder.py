@@ -80,7 +80,7 @@ class _RunState:
     calibration_id: int
     touch_ids: dict[int, int] = field(default_factory=dict)     # step -> gradebook touch id
     status: str = "in_progress"
-    shown: tuple[Any, ...] = ()                                 # the wizard's place when last kept
+    kept: dict[str, Any] | None = None                          # the wizard's entry as last kept
 
 
 class TraineeRecorder:
@@ -152,15 +152,12 @@ class TraineeRecorder:
         st = self._runs.get(run_index)
         if st is None or self.workflow is None or not 0 <= run_index < len(self.workflow.runs):
             return
-        run = self.workflow.runs[run_index]
-        w = run.wizard
-        shown = (w.status, w.step_index, w.n_steps, tuple((k, id(p)) for k, p in sorted(w.recorded_poses.items())),
-                 repr(w.to_dict().get("params")))
-        if shown == st.shown:
-            return
         try:
-            self.gradebook.save_run_state(st.calibration_id, run_entry(run, honest=True))
-            st.shown = shown
+            entry = run_entry(self.workflow.runs[run_index], honest=True)
+            if entry == st.kept:
+                return
+            self.gradebook.save_run_state(st.calibration_id, entry)
+            st.kept = entry
         except Exception:            # a state that cannot be kept must not stop the lesson
             self.errors += 1
             log.exception("keeping the wizard of calibration %s failed", st.calibration_id)
