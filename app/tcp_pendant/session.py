@@ -728,12 +728,6 @@ class Session:
         with self._wizard_command():
             return fn(self.workflow.require_wizard())
 
-    def wizard_signal(self, *, moves: bool = False) -> None:
-        """A ``wizard`` signal for a change the views keep themselves (a re-render after a
-        choice in a menu, a controller job's busy text)."""
-        with self._wizard_command(moves=moves):
-            pass
-
     def set_hide_truth(self, hide: bool, *, always: bool = False) -> None:
         """A classroom exercise (True): no result shows the true TOOL frame or the error
         against it, and the methods that measure the tool by themselves are refused. ``always``
