@@ -77,10 +77,17 @@ class PortTakenError(RuntimeError):
     """The free port was taken by someone else before the server bound it."""
 
 
+BROWSER_SEED = 11
+"""``--seed`` of every pendant a browser test starts: a random Auto-touch direction whose 60 mm
+back-off is out of reach is retried at a shorter distance, and a test that reads the distances
+(TCP & Z, X's "displacement lengths 60.0 mm") then depended on the draw."""
+
+
 def _start_on(tmp_path: Path, port: int, *extra: str) -> ServerProcess:
     lib = tmp_path / "tools.json"
     log_path = tmp_path / f"server_{port}.log"
-    cmd = [sys.executable, "-m", "tcp_pendant", "--port", str(port), "--tool-library", str(lib), *extra]
+    seed = () if "--seed" in extra else ("--seed", str(BROWSER_SEED))   # Auto-touch's directions replay
+    cmd = [sys.executable, "-m", "tcp_pendant", "--port", str(port), "--tool-library", str(lib), *seed, *extra]
     t0 = time.perf_counter()
     with open(log_path, "wb") as logf:
         proc = subprocess.Popen(cmd, stdout=logf, stderr=subprocess.STDOUT)
