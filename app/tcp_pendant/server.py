@@ -34,6 +34,7 @@ from tcpcal.library import ToolLibrary
 from tcp_pendant import client_script, origin_check
 from tcp_pendant.calibrate import CalibrationWorkflow
 from tcp_pendant.addresses import network_urls
+from tcp_pendant.job_pool import JobPool
 from tcp_pendant.classroom.class_room import ClassRoom
 from tcp_pendant.classroom.gradebook import Gradebook
 from tcp_pendant.controller import (
@@ -337,6 +338,8 @@ class PendantApp:
         self._sessions_lock = threading.Lock()
         self._stop = threading.Event()
         self._watcher: threading.Thread | None = None
+        self.jobs = JobPool()
+        """The server's one pool of browser-triggered jobs, fair per session (``job_pool``)."""
         # warm the mesh caches so the first browser does not wait for STL parsing
         link_meshes(self.kinematics.description)
         for t in tools.values():
@@ -394,7 +397,7 @@ class PendantApp:
         rng = self.session_rng()
         workflow = CalibrationWorkflow(c, self.library, robot=self.robot_key, rng=rng)
         session = Session(c, self.library, workflow, client=client, target=target, ready_q_rad=self.ready_q_rad,
-                          shared=shared, rng=rng)
+                          shared=shared, rng=rng, jobs=self.jobs)
         session.reload_library()
         if shared:
             try:
@@ -604,6 +607,7 @@ class PendantApp:
         if self.server is not None:
             origin_check.forget(self.port)
             self.server.stop()
+        self.jobs.shutdown(wait=False)
         if self.gradebook is not None:
             self.gradebook.close()
 

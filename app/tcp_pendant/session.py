@@ -69,6 +69,7 @@ from tcp_pendant.controller import ControllerError, JogResult, ToolModel, Virtua
 from tcp_pendant.controller.pose_state import PoseState, pose_state, pose_state_key
 from tcp_pendant.controller.scenarios import Scenario, ScenarioWorld, bent_tool, realize
 from tcp_pendant.events import Crash, SessionEvent
+from tcp_pendant.job_pool import JobPool, default_pool
 from tcp_pendant.pendant import Jogger, touch_label
 from tcp_pendant.pendant.exercise_rules import FREE_PRACTICE, ExerciseRules
 from tcp_pendant.wizards import Wizard, WizardResult, WizardStateError
@@ -80,6 +81,7 @@ __all__ = ["GuiTarget", "Session", "SessionChange", "Touch"]
 
 log = logging.getLogger(__name__)
 F = TypeVar("F", bound=Callable[..., Any])
+R = TypeVar("R")
 
 _COLORS: dict[str, Literal["blue", "green", "yellow", "red"]] = {
     "info": "blue", "success": "green", "warning": "yellow", "error": "red"}
@@ -200,6 +202,8 @@ class Session:
         rng: the session's random generator (Auto-touch's operator error and directions, the
             beam's repeatability, the scenarios the trainer plays): the server draws it from its
             one seed (``--seed``), so a seeded lesson replays the same way.
+        jobs: the server's pool of browser-triggered jobs (``job_pool.JobPool``, one for the
+            whole server: :meth:`run_job`); default the process's pool.
     """
 
     controller: VirtualController
@@ -218,6 +222,7 @@ class Session:
     hide_distance: bool = False
     rules: ExerciseRules = FREE_PRACTICE
     rng: np.random.Generator = field(default_factory=np.random.default_rng)
+    jobs: JobPool = field(default_factory=default_pool, repr=False)
 
     def __post_init__(self) -> None:
         if self.target is None:
@@ -774,6 +779,23 @@ class Session:
         added to the runs; returns its replay checks."""
         with self._wizard_command():
             return self.workflow.add_loaded(loaded)
+
+    async def run_job(self, fn: Callable[[], R], *, what: str) -> R:
+        """Run ``fn()``, a job detached from the session (its own copies of what it reads, taken
+        on the loop with its limits checked), in the server's job pool, off viser's event loop,
+        and return its value (or raise its exception). One job per session at a time, the
+        rested sessions' jobs first (``job_pool``).
+
+        Args:
+            fn: the job; it must not touch the session, its GUI or its controller.
+            what: the job in words with its article ("a TCP check"), for the refusal of
+                another job of this session meanwhile.
+
+        Raises:
+            JobRefused: this session's previous job still runs (``SessionBusy``) or the
+                server's queue is full (``PoolFull``); the message says what to do.
+        """
+        return await self.jobs.run(self, fn, what=what)
 
     # ------------------------------------------------------------ touches
     def record_touch(self) -> Touch:

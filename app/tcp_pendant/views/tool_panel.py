@@ -25,10 +25,8 @@ shown right under it; the tool is saved only if all fields are valid (nothing ha
 
 from __future__ import annotations
 
-import asyncio
 import logging
 from collections.abc import Callable, Coroutine
-from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
 import viser
@@ -36,6 +34,7 @@ import viser
 from tcp_pendant.controller import builtin_tools
 from tcp_pendant.pendant import FIELDS, ToolEntry, parse_tool_entry, tool_data_markdown
 from tcp_pendant.pendant.tool_entry import entry_preview_markdown
+from tcp_pendant.job_pool import JobRefused
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.controller.spin import DEFAULT_SPIN_ANGLE_DEG, MAX_SPIN_ANGLE_DEG, SpinCheckResult
@@ -62,9 +61,6 @@ log = logging.getLogger(__name__)
 NO_TOOL = "(library empty)"
 CONTROLLER_FILE_REFUSED = "Controller file not written"
 """Title of the one notification when a controller refuses the tool (name, number)."""
-
-_CHECK_WORKER = ThreadPoolExecutor(max_workers=1, thread_name_prefix="tcp-check")
-"""Runs the TCP checks off viser's event loop (one at a time across sessions)."""
 
 
 def controller_file(tool: Tool, slot: int, label: str) -> tuple[str, str]:
@@ -308,8 +304,9 @@ class ToolPanel:
 
     async def run_check(self, which: Callable[[], tuple[str, Tool]]) -> None:
         """Run the TCP check of ``which()`` (title, tool): the job is taken under the session
-        lock on the loop, the six rotations run in ``_CHECK_WORKER``, the result is shown on
-        the loop. One check at a time per session; errors become one notification."""
+        lock on the loop, the six rotations run in the server's job pool (``Session.run_job``),
+        the result is shown on the loop. One check at a time per session (one job of any kind:
+        the pool refuses another meanwhile, in words); errors become one notification."""
         s = self.session
         if s.closed:
             return
@@ -322,13 +319,19 @@ class ToolPanel:
                 if s.rules.in_exercise:                 # read against the spike, as on a robot
                     check_readable(s.pose_state().touch.distance_mm)
                 job = check_job(s.controller, tool, title, self.check_angle.value)
+                shown = self.check_md.content
                 self.check_md.content = f"Checking {escape_markdown(title)} ..."
         except ValueError as exc:
             s.notify("Not done", str(exc), kind="warning")
             return
         self._checking = True
         try:
-            result = await asyncio.get_running_loop().run_in_executor(_CHECK_WORKER, job.run)
+            result = await s.run_job(job.run, what="a TCP check")
+        except JobRefused as exc:      # this session's other job, or a full queue: nothing ran
+            with s.lock:
+                self.check_md.content = shown
+            s.notify("Check not started", str(exc), kind="warning")
+            return
         except Exception as exc:  # a browser's click must never kill the server
             log.exception("TCP check failed")
             s.notify("TCP check failed", f"{type(exc).__name__}: {exc}", kind="error")

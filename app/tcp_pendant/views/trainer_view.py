@@ -14,16 +14,15 @@ text a trainee typed (names) goes through ``escape_markdown``; callbacks through
 
 from __future__ import annotations
 
-import asyncio
 import logging
 from collections.abc import Sequence
-from concurrent.futures import ThreadPoolExecutor
 from typing import Any, Protocol
 
 from tcp_pendant.classroom.gradebook import GradeRow, Gradebook
 from tcp_pendant.classroom.grading import RecordGrade, grade_record
 from tcp_pendant.classroom.recorder import TraineeStatus
 from tcp_pendant.pendant.exercise_rules import ExerciseRules
+from tcp_pendant.job_pool import JobRefused
 from tcp_pendant.session import Session
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.upload_guard import limit_upload_size
@@ -31,8 +30,6 @@ from tcp_pendant.wizards.session_record import MAX_RECORD_BYTES, SessionRecordEr
 from tcp_pendant.views.gui_util import ButtonEvent, UploadEvent, set_options, target_of
 
 log = logging.getLogger(__name__)
-_GRADE_WORKER = ThreadPoolExecutor(max_workers=1, thread_name_prefix="record-grading")
-"""Parses, replays and grades uploaded records off viser's event loop, one at a time."""
 
 __all__ = ["AUTO_TOUCH", "EXERCISES", "HIDE_DISTANCE", "ClassControl", "TrainerView", "grades_markdown", "trainees_markdown"]
 
@@ -210,7 +207,7 @@ class TrainerView:
                             f"{MAX_RECORD_BYTES} bytes; a session record is far smaller.", kind="warning")
 
     async def _on_grade_upload(self, event: UploadEvent) -> None:
-        """The record's bytes are parsed, replayed and graded in ``_GRADE_WORKER`` (off the loop)."""
+        """The record's bytes are parsed, replayed and graded in the server's job pool (off the loop)."""
         if self.session.closed or getattr(event, "client", None) is None or self._grading:
             return
         upload = event.target.value
@@ -218,9 +215,10 @@ class TrainerView:
         self._grading = True
         try:
             check_record_size(len(upload.content))
-            grades = await asyncio.get_running_loop().run_in_executor(
-                _GRADE_WORKER, lambda: grade_record(load_and_replay(bytes(upload.content)), self.control.gradebook))
-        except SessionRecordError as exc:
+            data, book = bytes(upload.content), self.control.gradebook
+            grades = await self.session.run_job(lambda: grade_record(load_and_replay(data), book),
+                                                what="a record's grading")
+        except (SessionRecordError, JobRefused) as exc:
             self.session.notify("Record not graded", f"{name}: {exc}", kind="warning")
             return
         except Exception as exc:  # never let an upload kill the server

@@ -17,10 +17,8 @@ uncertainty tcpcal predicts if the user recorded here.
 
 from __future__ import annotations
 
-import asyncio
 import logging
 import math
-from concurrent.futures import ThreadPoolExecutor
 from typing import TYPE_CHECKING, Any
 
 from tcp_pendant.calibrate import AUTO_SIGMA_MAX_MM, AutoTouchRequest
@@ -31,6 +29,7 @@ from tcp_pendant.calibrate.text import (
     step_markdown,
     steps_list_markdown,
 )
+from tcp_pendant.job_pool import JobRefused
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.gui_util import ButtonEvent, DropdownEvent, set_content, set_value, target_of
 from tcp_pendant.wizards import Wizard, WizardStateError
@@ -42,9 +41,6 @@ if TYPE_CHECKING:
 __all__ = ["RANDOM", "WizardStepsView"]
 
 RANDOM, CHOSEN = "random", "chosen (tilt, azimuth)"
-_CHECK_WORKER = ThreadPoolExecutor(max_workers=1, thread_name_prefix="wizard-controller-job")
-"""Runs a wizard's controller job off viser's event loop: a TCP check's six rotations (0.1-0.3
-s), a beam scan (3 to 5 orientations, well under a second)."""
 log = logging.getLogger(__name__)
 
 
@@ -108,7 +104,9 @@ class WizardStepsView:
     async def _on_next(self, event: ButtonEvent) -> None:
         """Next / Finish. A wizard waiting for its controller job (a TCP check's rotations, a
         beam scan) runs it on Finish: the job is taken on the loop (under the session lock), run
-        in ``_CHECK_WORKER``, its outcome handed to the wizard on the loop; one job at a time."""
+        in the server's job pool (``Session.run_job``: a TCP check's six rotations 0.1-0.3 s, a
+        beam scan of 3 to 5 orientations well under a second), its outcome handed to the wizard
+        on the loop; one job at a time."""
         session, act = self.parent.session, self.parent.action
         jobs: list[ControllerJob] = []
 
@@ -128,10 +126,12 @@ class WizardStepsView:
             return
         title = jobs[0].wizard.title
         try:
-            result = await asyncio.get_running_loop().run_in_executor(_CHECK_WORKER, jobs[0].run)
+            result = await session.run_job(jobs[0].run, what=f"the {title} wizard's controller job")
         except Exception as exc:  # a browser's click must never kill the server
             self._checking = False
-            if isinstance(exc, ValueError):            # the controller's words (ControllerError)
+            if isinstance(exc, JobRefused):            # another job of this session, or a full queue
+                self.parent.session.notify(f"{title}: not started", str(exc), kind="warning")
+            elif isinstance(exc, ValueError):            # the controller's words (ControllerError)
                 self.parent.session.notify(f"{title}: not possible", str(exc), kind="error")
             else:
                 log.exception("%s: controller job failed", title)
