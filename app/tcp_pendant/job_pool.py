@@ -218,14 +218,21 @@ class JobPool:
                     return
                 _, _, job = heapq.heappop(self._queue)
             job.started_s = time.monotonic()
-            if job.future.set_running_or_notify_cancel():
-                try:
-                    job.future.set_result(job.fn())
-                except BaseException as exc:  # the awaiting callback shows it; the worker lives on
-                    job.future.set_exception(exc)
-            self._finished(job)
+            if not job.future.set_running_or_notify_cancel():      # its caller gave up waiting
+                self._finished(job)
+                continue
+            try:
+                value = job.fn()
+            except BaseException as exc:  # the awaiting callback shows it; the worker lives on
+                self._finished(job)
+                job.future.set_exception(exc)
+            else:
+                self._finished(job)
+                job.future.set_result(value)
 
     def _finished(self, job: _Job) -> None:
+        """The job is no longer its owner's pending one: done before its future is resolved,
+        so the owner's next submit, made as soon as it has the result, is not refused."""
         job.finished_s = time.monotonic()
         with self._cond:
             self._pending.pop(id(job.owner), None)

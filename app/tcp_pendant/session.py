@@ -56,7 +56,7 @@ import threading
 from collections.abc import Callable, Coroutine, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
-from typing import TYPE_CHECKING, Any, ContextManager, Literal, Protocol, TypeVar
+from typing import TYPE_CHECKING, Any, ContextManager, Literal, Protocol, TypeVar, cast
 
 import numpy as np
 
@@ -676,6 +676,37 @@ class Session:
         """Training mode: the controller performs the current step (``CalibrationWorkflow.auto_touch``)."""
         with self._wizard_command(moves=True):
             return self.workflow.auto_touch(request)
+
+    async def auto_touch_in_pool(self, request: AutoTouchRequest) -> AutoTouchOutcome:
+        """:meth:`auto_touch` with the probes of the poses it reaches (a TCP check's rotations
+        from there, ``calibrate.jobs.POSE_CHECKS``) run in the job pool (:meth:`run_job`), off
+        viser's event loop: the moves and the record are wizard commands on the loop, each
+        ending in its own signal, the probes awaited in between. A robot moved meanwhile
+        records nothing (``autotouch.MOVED_DURING_PROBE``).
+
+        Raises:
+            JobRefused: this session's previous job still runs, or the queue is full.
+            WizardStateError: as :meth:`auto_touch`; the calibration on show changed meanwhile.
+        """
+        steps = self.workflow.auto_touch_steps(request)
+
+        def advance(answer: str | None, first: bool) -> tuple[Callable[[], str | None] | None, Any]:
+            with self._wizard_command(moves=True):
+                try:
+                    return (next(steps) if first else steps.send(answer)), None
+                except StopIteration as stop:
+                    return None, stop.value
+
+        probe, out = advance(None, True)
+        try:
+            while probe is not None:
+                answer = await self.run_job(probe, what="Auto-touch's check of the pose it reached")
+                if self.closed:
+                    raise WizardStateError("The session was closed.")
+                probe, out = advance(answer, False)
+        finally:
+            steps.close()
+        return cast(AutoTouchOutcome, out)
 
     def back(self) -> None:
         """One step back (from the result: to the last step); nothing is deleted."""

@@ -35,6 +35,7 @@ from tcp_pendant.views.gui_util import ButtonEvent, DropdownEvent, set_content, 
 from tcp_pendant.wizards import Wizard, WizardStateError
 
 if TYPE_CHECKING:
+    from tcp_pendant.calibrate.autotouch import AutoTouchOutcome
     from tcp_pendant.calibrate.workflow import ControllerJob
     from tcp_pendant.views.wizard_menu import CalibrateView
 
@@ -92,7 +93,8 @@ class WizardStepsView:
         self.mount.on_click(act(lambda _e: session.mount_required_tool(), sync=True))
         self.variant.on_update(act(self._on_variant, user_only=True))
         self.auto_direction.on_update(act(lambda _e: None, user_only=True))
-        self.auto_touch.on_click(act(self._on_auto_touch, sync=True))
+        self.auto_touch.on_click(self._on_auto_touch)
+        self._auto_touching = False
         self._auto_line: tuple[tuple[Any, ...], str, Any] | None = None  # (where it belongs, text, poses)
 
     # ------------------------------------------------------------ callbacks
@@ -160,9 +162,38 @@ class WizardStepsView:
             return AutoTouchRequest(float(self.auto_tilt.value), float(self.auto_azimuth.value), sigma)
         return AutoTouchRequest(sigma_mm=sigma)
 
-    def _on_auto_touch(self, _event: ButtonEvent) -> None:
-        request = self.auto_request()
-        out = self.parent.session.auto_touch(request)
+    async def _on_auto_touch(self, event: ButtonEvent) -> None:
+        """Auto-touch (``Session.auto_touch_in_pool``: the probes of a TCP check's poses run in
+        the job pool); one at a time per session, the outcome shown in one signal at the end."""
+        session = self.parent.session
+        if session.closed:
+            return
+        running = session.jobs.pending(session)
+        if self._auto_touching or running is not None:
+            what = "Auto-touch" if self._auto_touching else running
+            session.notify("Auto-touch not started", f"{str(what)[:1].upper()}{str(what)[1:]} is still running "
+                           "here; wait for its result, then try again.", kind="warning")
+            return
+        try:
+            request = self.auto_request()
+        except ValueError as exc:
+            session.notify("Not done", str(exc), kind="warning")
+            return
+        self._auto_touching = True
+        try:
+            out = await session.auto_touch_in_pool(request)
+        except ValueError as exc:               # the wizard's or the pool's words (JobRefused)
+            session.notify("Not done", str(exc), kind="warning")
+            return
+        except Exception as exc:                # a browser's click must never kill the server
+            log.exception("Auto-touch failed")
+            session.notify("Internal error", f"{type(exc).__name__}: {exc}", kind="error")
+            return
+        finally:
+            self._auto_touching = False
+        await self.parent.action(lambda _e: self._show_auto_touch(out, request), sync=True)(event)
+
+    def _show_auto_touch(self, out: AutoTouchOutcome, request: AutoTouchRequest) -> None:
         if not out.ok:
             raise ValueError(out.message)
         wiz = self.parent.workflow.wizard
