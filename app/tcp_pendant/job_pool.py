@@ -155,7 +155,8 @@ class JobPool:
         its exception), awaiting it without blocking the event loop.
 
         Args:
-            owner: whose job it is (one job per owner at a time; held weakly once finished).
+            owner: whose job it is (one job per owner at a time; held weakly once finished, so
+                an owner that cannot be referenced weakly always counts as rested).
             fn: the job, detached from the session (its own copies of what it reads).
             what: the job in words, lower case with its article ("a TCP check"), for the
                 refusal another submit of the same owner gets meanwhile.
@@ -177,7 +178,10 @@ class JobPool:
                 raise SessionBusy(f"{running.what[:1].upper()}{running.what[1:]} is still running here; "
                                   "wait for its result, then try again.")
             now = time.monotonic()
-            last = self._last_result.get(owner)
+            try:
+                last = self._last_result.get(owner)
+            except TypeError:           # an owner that cannot be referenced weakly: always rested
+                last = None
             busy = last is not None and now - last < self.rest_s
             waiting = len(self._queue)
             if waiting >= (self.max_queued if busy else 2 * self.max_queued):

@@ -677,12 +677,15 @@ class Session:
         with self._wizard_command(moves=True):
             return self.workflow.auto_touch(request)
 
-    async def auto_touch_in_pool(self, request: AutoTouchRequest) -> AutoTouchOutcome:
+    async def auto_touch_in_pool(self, request: AutoTouchRequest, *,
+                                 shown: Callable[[AutoTouchOutcome], Any] | None = None) -> AutoTouchOutcome:
         """:meth:`auto_touch` with the probes of the poses it reaches (a TCP check's rotations
         from there, ``calibrate.jobs.POSE_CHECKS``) run in the job pool (:meth:`run_job`), off
         viser's event loop: the moves and the record are wizard commands on the loop, each
-        ending in its own signal, the probes awaited in between. A robot moved meanwhile
-        records nothing (``autotouch.MOVED_DURING_PROBE``).
+        ending in its own signal, the probes awaited in between (no probe: one command, one
+        signal, as :meth:`auto_touch`). ``shown(outcome)`` runs inside the last command (the
+        view's words join its signal). A robot moved meanwhile records nothing
+        (``autotouch.MOVED_DURING_PROBE``).
 
         Raises:
             JobRefused: this session's previous job still runs, or the queue is full.
@@ -695,6 +698,8 @@ class Session:
                 try:
                     return (next(steps) if first else steps.send(answer)), None
                 except StopIteration as stop:
+                    if shown is not None:
+                        shown(stop.value)
                     return None, stop.value
 
         probe, out = advance(None, True)

@@ -162,7 +162,7 @@ class WizardStepsView:
             return AutoTouchRequest(float(self.auto_tilt.value), float(self.auto_azimuth.value), sigma)
         return AutoTouchRequest(sigma_mm=sigma)
 
-    async def _on_auto_touch(self, event: ButtonEvent) -> None:
+    async def _on_auto_touch(self, _event: ButtonEvent) -> None:
         """Auto-touch (``Session.auto_touch_in_pool``: the probes of a TCP check's poses run in
         the job pool); one at a time per session, the outcome shown in one signal at the end."""
         session = self.parent.session
@@ -181,7 +181,7 @@ class WizardStepsView:
             return
         self._auto_touching = True
         try:
-            out = await session.auto_touch_in_pool(request)
+            await session.auto_touch_in_pool(request, shown=lambda out: self._show_auto_touch(out, request))
         except ValueError as exc:               # the wizard's or the pool's words (JobRefused)
             session.notify("Not done", str(exc), kind="warning")
             return
@@ -191,7 +191,6 @@ class WizardStepsView:
             return
         finally:
             self._auto_touching = False
-        await self.parent.action(lambda _e: self._show_auto_touch(out, request), sync=True)(event)
 
     def _show_auto_touch(self, out: AutoTouchOutcome, request: AutoTouchRequest) -> None:
         if not out.ok:
