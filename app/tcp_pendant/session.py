@@ -45,7 +45,10 @@ things run elsewhere: workers copy state under it (Check, record replay), tests 
 sessions from their own thread; the session itself is built on the loop, see
 ``PendantApp.session_steps``), ignores events after the session closed, and turns any exception into a
 notification instead of a crash (a browser can send anything). Work from another thread is
-handed to the loop (the server's library watcher: ``loop.call_soon_threadsafe``).
+handed to the loop (the server's library watcher: ``loop.call_soon_threadsafe``). Work whose
+size a browser controls (a check, a scan, a record's replay, Auto-touch's pose probes) is a
+job detached from the session, run in the server's job pool by :meth:`Session.run_job`
+(``job_pool``: one job per session, a bounded queue), awaited without blocking the loop.
 """
 
 from __future__ import annotations
