@@ -802,6 +802,23 @@ class Session:
                 return None
             return self.workflow.controller_job()
 
+    async def next_step_in_pool(self) -> WizardResult | None:
+        """Next, or Finish with the controller job the wizard on show waits for (a TCP check's
+        rotations, a beam scan) taken on the loop, run in the job pool (:meth:`run_job`, off
+        viser's event loop) and handed in on the loop; no job: :meth:`next_step`.
+
+        Raises:
+            JobRefused: this session's previous job still runs, or the queue is full.
+            WizardStateError: as :meth:`next_step` (the job cannot be taken: the words say why).
+        """
+        job = self.take_controller_job()
+        if job is None:
+            return self.next_step()
+        outcome = await self.run_job(job.run, what=f"the {job.wizard.title} wizard's controller job")
+        if self.closed:
+            return None
+        return self.hand_in_controller_job(job, outcome)
+
     def hand_in_controller_job(self, job: Any, outcome: Any) -> WizardResult | None:
         """The outcome of a controller job to its wizard (its result, if it finished)."""
         with self._wizard_command(moves=True):

@@ -11,9 +11,11 @@ import threading
 from pathlib import Path
 from typing import Any
 
+from tcp_pendant.calibrate import AutoTouchRequest
 from tcp_pendant.calibrate.autotouch import MOVED_DURING_PROBE
 from tcp_pendant.job_pool import JobPool
 from tcp_pendant.session import Session
+from tcp_pendant.views.wizard_dock import FINISH
 
 HERE = Path(__file__).parent
 sys.path.insert(0, str(HERE.parent / "app"))
@@ -94,4 +96,16 @@ def test_a_check_while_the_sessions_other_job_runs_is_refused_in_words(page) -> 
     p.notes.clear()
     p.click(panel.check_active)                                              # once it is done: checked
     assert p.notes == [] and panel.last_check is not None
+    pool.shutdown()
+
+
+def test_the_docks_finish_runs_the_check_in_the_job_pool(page) -> None:
+    p = _check_wizard(page)
+    s: Session = p.session
+    s.jobs = pool = JobPool(keep_history=True)
+    assert s.auto_touch(AutoTouchRequest(tilt_deg=25.0, azimuth_deg=30.0)).ok     # probes in place
+    p.choose(s.views["dock"].nav, FINISH)
+    assert p.notes == [] and s.workflow.result is not None                       # checked, finished
+    assert pool.history is not None and [h.what for h in pool.history] == [
+        "the TCP check (spin test) wizard's controller job"]
     pool.shutdown()
