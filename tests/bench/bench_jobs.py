@@ -56,9 +56,10 @@ def main(argv: list[str] | None = None) -> int:
     for policy in ("fair", "fifo"):
         m = results[policy] = run(policy, args.checks, args.workers, args.attackers)
         ahead = [len(a) for a in m.ahead]
+        busy = [len([h for h in a if h.busy]) for a in m.ahead]
         print(f"[{policy}] {m.summary()}")
         print(f"[{policy}] other sessions' jobs started while the victim's check waited: max {max(ahead)}, "
-              f"mean {np.mean(ahead):.1f}\n")
+              f"mean {np.mean(ahead):.1f} (of busy sessions: max {max(busy)})\n")
     fair, fifo = results["fair"], results["fifo"]
     print(f"victim's check latency under attack / alone (p50): pool {fair.factor:.2f}x, "
           f"first come first served {fifo.factor:.2f}x; max under attack {max(fair.under) * 1e3:.0f} ms vs "
