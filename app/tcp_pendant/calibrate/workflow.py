@@ -222,9 +222,18 @@ class CalibrationWorkflow:
         else:
             auto_steps.discard(step)
         self._record_q[id(pose)] = (pose, c.q_rad.copy())
+        self._forget_replaced_poses()
         self._note_distance(step)
         self._events.append(TouchRecorded(i, step, pose.T_world_flange_m, joints,
                                           float(c.touch_geometry().distance_mm), auto, had_pose))
+
+    def _forget_replaced_poses(self) -> None:
+        """Keep the joints of the poses some run still holds only: a step recorded again, or a
+        run's touches dropped, leaves its old pose here, and a session that records for hours
+        would otherwise keep every pose it ever recorded."""
+        held = {id(p) for r in self.runs for p in r.wizard.recorded_poses.values()}
+        for key in [k for k in self._record_q if k not in held]:
+            del self._record_q[key]
 
     def joints_at_record(self, pose: RecordedPose) -> np.ndarray | None:
         """The joints (rad) where ``pose`` was recorded in this session (None: not known, e.g.
