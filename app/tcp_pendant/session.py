@@ -706,18 +706,11 @@ class Session:
 
     def finish_refusal(self) -> str | None:
         """Why Finish of the wizard on show is refused by the exercise (too few touches for a
-        method whose touch count the trainee chooses), None when it is not; the step panel
-        shows it, :meth:`next_step` raises it."""
+        method whose touch count the trainee chooses, ``CalibrationWorkflow.touches_short``),
+        None when it is not; the step panel shows it, :meth:`next_step` and Auto-touch's last
+        touch do not finish then."""
         with self.lock:
-            wiz = self.workflow.wizard
-            if (wiz is None or not self.workflow.is_open or wiz.is_complete or not wiz.on_last_step
-                    or self.rules.min_touches <= 0):
-                return None
-            cls = type(wiz)
-            if not (cls.supports_add_point or any(o.name == "n_points" for o in cls.options)):
-                return None                       # a fixed number of poses: the method's own count
-            return self.rules.touches_refusal(len(wiz.solver_touch_steps()),
-                                              can_add_point=cls.supports_add_point)
+            return self.workflow.touches_short()
 
     def start_wizard(self, kind: str, **options: Any) -> Wizard:
         """Open a wizard of the registered ``kind`` with its start options (the open one is
@@ -765,9 +758,6 @@ class Session:
                 (:meth:`finish_refusal`); the wizard stays on its last step.
         """
         with self._wizard_command(moves=True):
-            refusal = self.finish_refusal()
-            if refusal is not None:
-                raise RuleRefusal(refusal)
             return self.workflow.next()
 
     def cancel_wizard(self) -> bool:

@@ -295,6 +295,9 @@ class ClassRoom:
                 self._trainees[id(session)] = (session, recorder, join.name)
                 follow = id(session) not in self._subscribed
                 self._subscribed.add(id(session))
+                waiting = list(self._waiting.get(join.name, ()))
+            for message in waiting:     # what the trainee had not dismissed yet (before the mirror follows)
+                session.show_message(message)
             if follow:
                 session.subscribe(lambda change: self._on_change(session, change))
             session.set_hide_truth(self.exercise is not None)
@@ -302,10 +305,6 @@ class ClassRoom:
                 self._mount_mystery(session, recorder, join.name)
             self._apply_rules(session)
             self._restore(session, recorder, join.name)
-            with self._lock:
-                waiting = list(self._waiting.get(join.name, ()))
-            for message in waiting:                  # what the trainee had not dismissed yet
-                session.show_message(message)
         return recorder
 
     def _on_change(self, session: Session, change: SessionChange) -> None:
