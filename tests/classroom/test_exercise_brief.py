@@ -18,7 +18,7 @@ from calib_helpers import library_tool_with_true_tcp, make_session  # noqa: E402
 from tcp_pendant.calibrate import AutoTouchRequest
 from tcp_pendant.classroom.class_room import PUSHED_SETTING, ClassRoom
 from tcp_pendant.classroom.gradebook import Gradebook
-from tcp_pendant.cli import build_parser
+from tcp_pendant.cli import main
 from tcp_pendant.controller import builtin_tools
 from tcp_pendant.pendant.class_messages import ClassMessage
 from tcp_pendant.pendant.exercise_rules import RuleRefusal
@@ -160,11 +160,32 @@ def test_the_brief_outlives_a_restart_and_an_older_gradebook_still_opens(tmp_pat
         assert (old.instructions, old.allowed_methods, old.min_touches) == ("", None, 0)
 
 
-def test_the_brief_options_of_the_command_line(book: Gradebook) -> None:
-    args = build_parser().parse_args(["--exercise-instructions", "Find the TCP", "--exercise-methods",
-                                      "xyz4,reference", "--exercise-min-touches", "6"])
-    assert (args.exercise_instructions, args.exercise_methods, args.exercise_min_touches) == (
-        "Find the TCP", "xyz4,reference", 6)
+def test_the_brief_options_of_the_command_line(book: Gradebook, tmp_path: Path,
+                                              monkeypatch: pytest.MonkeyPatch) -> None:
+    """The three options reach the server's config (and imply a class); the class checks them."""
+    import tcp_pendant.classroom.gradebook as gb
+    import tcp_pendant.server as server
+
+    seen: list[object] = []
+
+    class Stop(Exception):
+        pass
+
+    class FakeApp:
+        def __init__(self, config: object) -> None:
+            seen.append(config)
+            raise Stop
+
+    monkeypatch.setattr(server, "PendantApp", FakeApp)
+    monkeypatch.setattr(gb, "default_gradebook_path", lambda: tmp_path / "data" / "class.sqlite3")
+    with pytest.raises(Stop):
+        main(["--port", "0", "--exercise-instructions", "Find the TCP", "--exercise-methods", "xyz4, reference",
+              "--exercise-min-touches", "6"])
+    config = seen[0]
+    assert (config.exercise_instructions, config.exercise_methods, config.exercise_min_touches) == (  # type: ignore[attr-defined]
+        "Find the TCP", ("xyz4", "reference"), 6)
+    assert config.class_db == tmp_path / "data" / "class.sqlite3"   # type: ignore[attr-defined]
+    assert main(["--shared", "--exercise-methods", "xyz4"]) == 2
     with pytest.raises(ValueError, match="at most 2000"):
         ClassRoom(book, {}, trainer_token=TOKEN, instructions="x" * 2001)
     with pytest.raises(ValueError, match="from 0 to 20"):

@@ -209,7 +209,7 @@ class ClassRoom:
         if given_min is not None:
             self.min_touches = given_min
         if (given_instructions, given_methods, given_min) != (None, None, None):
-            self._keep_pushed(None)
+            self._keep_pushed(None, brief_only=True)
 
     @property
     def rules(self) -> ExerciseRules:
@@ -452,13 +452,16 @@ class ClassRoom:
     def grades_csv(self) -> str:
         return self.gradebook.to_csv()
 
-    def _keep_pushed(self, tool_key: str | None) -> None:
+    def _keep_pushed(self, tool_key: str | None, *, brief_only: bool = False) -> None:
         """Keep what the trainer pushed in the gradebook (``PUSHED_SETTING``), so a restart with
-        this gradebook applies it again (:meth:`_apply_kept`)."""
+        this gradebook applies it again (:meth:`_apply_kept`); ``brief_only``: the brief's keys
+        only (the brief given at start: the exercise given with it is not kept by that)."""
         kept = self.gradebook.class_setting(PUSHED_SETTING)
         kept = dict(kept) if isinstance(kept, dict) else {}
-        kept.update({"exercise": self.exercise, "distance_aids": self.distance_aids, "auto_touch": self.auto_touch,
-                     "instructions": self.instructions, "min_touches": self.min_touches,
+        if not brief_only:
+            kept.update({"exercise": self.exercise, "distance_aids": self.distance_aids,
+                         "auto_touch": self.auto_touch})
+        kept.update({"instructions": self.instructions, "min_touches": self.min_touches,
                      "allowed_methods": None if self.allowed_methods is None else list(self.allowed_methods)})
         if tool_key is not None:
             kept["tool_key"] = tool_key
@@ -549,7 +552,7 @@ class ClassRoom:
         methods = clean_methods(allowed_methods)
         minimum = clean_min_touches(min_touches)
         self.instructions, self.allowed_methods, self.min_touches = text, methods, minimum
-        self._keep_pushed(None)
+        self._keep_pushed(None, brief_only=True)
         rules = self.rules
         with self._lock:
             trainees = list(self._trainees.values())
