@@ -688,18 +688,20 @@ class Session:
             finally:
                 self.changed(wizard=True, pose=moves)
 
-    def _check_method(self, kind: str, n_points: Any = None) -> None:
+    def _check_method(self, kind: str, options: dict[str, Any] | None = None) -> None:
         """The exercise's methods (``rules.allowed_methods``) and, for a method without Add
-        point whose touch count is chosen at start, its minimum number of touches.
+        point whose touch count is chosen at start (``options["n_points"]``), its minimum
+        number of touches.
 
         Raises:
             RuleRefusal: the method is not allowed, or too few touches are asked for.
-            WizardError: unknown kind.
+            WizardError: unknown kind, or options the method refuses (``Wizard.parse_options``).
         """
         cls = wizard_class(kind)
         self.rules.check_method(kind, {c.kind: c.title for c in wizard_classes()})
         counted = any(o.name == "n_points" for o in cls.options)
-        if counted and not cls.supports_add_point and isinstance(n_points, int) and not isinstance(n_points, bool):
+        if counted and not cls.supports_add_point and options is not None and self.rules.min_touches:
+            n_points = int(cls.parse_options(options)["n_points"])
             if self.rules.touches_refusal(n_points, can_add_point=False) is not None:
                 raise RuleRefusal(f"This exercise asks for at least {self.rules.min_touches} touches: set "
                                   f"Touches to {self.rules.min_touches} or more for the {cls.title} method.")
@@ -721,7 +723,7 @@ class Session:
                 its ``n_points`` is below the exercise's minimum; nothing is opened.
         """
         with self._wizard_command(moves=True):
-            self._check_method(kind, options.get("n_points"))
+            self._check_method(kind, options)
             return self.workflow.start(kind, **options)
 
     def start_from_touches(self, *, estimator: str = "lstsq") -> Wizard:

@@ -586,7 +586,7 @@ class ClassRoom:
             with self._lock:
                 known = to in left or to in self._waiting
             if not entries and not known:
-                raise ValueError(f"{to} is not in the class; choose a trainee in the list, or all trainees.")
+                raise ValueError(f"{to:.60} is not in the class; choose a trainee in the list, or all trainees.")
         sent = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
         message = ClassMessage(next(self._message_ids), clean, to, sent)
         names = [to] if to is not None else [name for _, _, name in entries]
