@@ -51,6 +51,7 @@ from urllib.parse import parse_qsl, urlencode, urlsplit, urlunsplit
 
 __all__ = [
     "GradebookConnection",
+    "class_db_target",
     "PostgresConnection",
     "PostgresUnavailable",
     "SqliteConnection",
@@ -81,6 +82,17 @@ class PostgresUnavailable(Exception):
 def is_postgres_url(target: object) -> bool:
     """Whether ``target`` (a ``--class-db`` value) is a ``postgresql://`` (or ``postgres://``) URL."""
     return isinstance(target, str) and target.split(":", 1)[0].lower() in POSTGRES_SCHEMES and "://" in target
+
+
+def class_db_target(text: str) -> Path | str:
+    """A ``--class-db`` value: a ``postgresql://`` URL as given (a ``str``), anything else a
+    file path."""
+    return text if is_postgres_url(text) else Path(text)
+
+
+def url_has_password(url: str) -> bool:
+    """Whether ``url`` carries a password (which then shows in the process list)."""
+    return mask_url(url) != url
 
 
 def mask_url(url: str) -> str:
