@@ -87,7 +87,7 @@ def test_an_empty_database_gets_the_schema_with_8_byte_floats(postgres_server) -
 
 def test_a_version_1_database_is_brought_to_version_2(postgres_server) -> None:
     import psycopg
-    url = postgres_server.fresh_database()
+    url = postgres_server.fresh_schema()
     v1 = _SCHEMA.replace(",\n    key_sha256 TEXT", "")
     assert v1 != _SCHEMA
     with psycopg.connect(url, autocommit=True) as conn:
@@ -105,7 +105,7 @@ def test_a_version_1_database_is_brought_to_version_2(postgres_server) -> None:
 
 def test_a_newer_or_foreign_database_is_refused_and_left_unchanged(postgres_server) -> None:
     import psycopg
-    newer = postgres_server.fresh_database()
+    newer = postgres_server.fresh_schema()
     with Gradebook(newer) as g:
         g.add_trainee("Anna")
     with psycopg.connect(newer, autocommit=True) as conn:
@@ -113,19 +113,19 @@ def test_a_newer_or_foreign_database_is_refused_and_left_unchanged(postgres_serv
     with pytest.raises(GradebookError, match="newer TCP Pendant .* give another database with --class-db"):
         Gradebook(newer)
     assert _scalar(postgres_server, newer, "SELECT count(*) FROM information_schema.tables WHERE "
-                                           "table_name = 'run_states'") == 1
-    foreign = postgres_server.fresh_database()
+                                           "table_schema = current_schema() AND table_name = 'run_states'") == 1
+    foreign = postgres_server.fresh_schema()
     with psycopg.connect(foreign, autocommit=True) as conn:
         conn.execute("CREATE TABLE invoices (id serial PRIMARY KEY)")
     with pytest.raises(GradebookError, match="is a PostgreSQL database of another program"):
         Gradebook(foreign)
     assert _scalar(postgres_server, foreign, "SELECT count(*) FROM information_schema.tables WHERE "
-                                             "table_schema = 'public'") == 1
-    empty = postgres_server.fresh_database()
+                                             "table_schema = current_schema()") == 1
+    empty = postgres_server.fresh_schema()
     with pytest.raises(GradebookError, match="No gradebook in .*no gradebook tables"):
         Gradebook(empty, create=False)
     assert _scalar(postgres_server, empty, "SELECT count(*) FROM information_schema.tables WHERE "
-                                           "table_schema = 'public'") == 0
+                                           "table_schema = current_schema()") == 0
 
 
 @pytest.mark.parametrize("case, match", [

@@ -174,7 +174,7 @@ def test_terminal_never_gets_control_characters() -> None:
 
 def test_grades_of_a_postgresql_gradebook_match_the_sqlite_ones_without_the_password(
         tmp_path: Path, postgres_server, capsys: pytest.CaptureFixture[str]) -> None:
-    url = postgres_server.fresh_database()
+    url = postgres_server.fresh_schema()
     _make(url)
     _make(tmp_path / "class.sqlite3")
     tables = []
@@ -204,6 +204,6 @@ def test_an_unreachable_postgresql_gradebook_is_one_line_and_exit_2(postgres_ser
     lines = captured.err.splitlines()
     assert captured.out == "" and len(lines) == 1 and lines[0].startswith("tcp-pendant grades: error: Cannot reach")
     assert mask_url(missing) in lines[0] and postgres_server.password not in lines[0]
-    empty = postgres_server.fresh_database()
+    empty = postgres_server.fresh_schema()
     assert grades_cli.main(["--class-db", empty]) == 2                  # never makes a gradebook
     assert "No gradebook in" in capsys.readouterr().err
