@@ -1,5 +1,6 @@
 """Fixtures shared by several test folders: a real PostgreSQL server (Debian's packages) for the
-gradebook's PostgreSQL backend, and the gradebook target parametrized over both backends.
+gradebook's PostgreSQL backend, the gradebook target parametrized over both backends, and
+Debian's nginx for the front-end test.
 
 The server is started once per test session: ``initdb`` into a temporary folder, ``pg_ctl
 start`` on a free port of 127.0.0.1 with its unix socket in that folder (password login,
@@ -8,9 +9,10 @@ user (``runuser``; ``nobody`` if the package made no such user): PostgreSQL refu
 root. ``fsync=off`` keeps the tests fast on a shared machine (durability across a power cut is
 not what they test; every commit still goes through the server as in a class).
 
-Where the server binaries (``/usr/lib/postgresql/*/bin``, or ``$PG_BIN``) or psycopg are
-missing, the tests that need PostgreSQL are skipped with the reason (reported as not run), and
-under ``CI=true`` they fail: ``scripts/run-tests.sh`` installs ``postgresql`` with apt-get.
+Where the server binaries (``/usr/lib/postgresql/*/bin``, or ``$PG_BIN``), psycopg or nginx
+are missing, the tests that need them are skipped with the reason (reported as not run), and
+under ``CI=true`` they fail: ``scripts/run-tests.sh`` installs ``postgresql`` and ``nginx`` with
+apt-get.
 """
 
 from __future__ import annotations
@@ -36,9 +38,9 @@ import pytest
 
 def _missing(reason: str) -> None:
     if os.environ.get("CI") == "true":
-        pytest.fail(f"CI=true and {reason}: scripts/run-tests.sh installs Debian's postgresql "
-                    "(apt-get install postgresql) and the test extra's psycopg", pytrace=False)
-    pytest.skip(f"PostgreSQL tests not run: {reason}")
+        pytest.fail(f"CI=true and {reason}: scripts/run-tests.sh installs Debian's postgresql and nginx "
+                    "(apt-get install postgresql nginx) and the test extra's psycopg", pytrace=False)
+    pytest.skip(f"not run: {reason}")
 
 
 def postgres_bin_dir() -> Path | None:
@@ -164,6 +166,16 @@ def postgres_server() -> Iterator[PostgresServer]:
             run(str(bin_dir / "pg_ctl"), "-D", str(data), "-m", "fast", "-w", "-t", "30", "stop",
                 check=False)
         shutil.rmtree(folder, ignore_errors=True)
+
+
+@pytest.fixture(scope="session")
+def nginx_binary() -> Path:
+    """Debian's nginx (``$PATH`` or /usr/sbin/nginx); skipped where missing, failed under CI=true."""
+    found = shutil.which("nginx") or ("/usr/sbin/nginx" if os.access("/usr/sbin/nginx", os.X_OK) else None)
+    if found is None:
+        _missing("nginx is not installed (apt-get install nginx)")
+    assert found is not None
+    return Path(found)
 
 
 @pytest.fixture(params=["sqlite", "postgresql"])
