@@ -108,3 +108,17 @@ def test_the_exercise_seed_is_the_classs_unless_given_and_never_printed(tmp_path
         assert "class gradebook" in lines and str(seed) not in lines
         assert ClassRoom(book, {}, trainer_token="trainer-tok-12345678", exercise_seed=7)._seed() == 7   # a demo's
         assert book.exercise_seed() == seed                                                   # kept
+
+
+def test_server_with_an_unreachable_postgresql_gradebook_says_so_without_the_password(
+        tmp_path: Path, postgres_server, capsys: pytest.CaptureFixture[str]) -> None:
+    url = postgres_server.url("no_such_class")
+    assert main(["--port", "0", "--tool-library", str(tmp_path / "t.json"), "--class-db", url]) == 2
+    err = capsys.readouterr().err
+    assert postgres_server.password not in err
+    note, error = err.strip().splitlines()
+    assert note.startswith("tcp-pendant: note: a password in the --class-db URL shows in the process list")
+    assert error.startswith("tcp-pendant: error: Cannot reach the PostgreSQL gradebook "
+                            f"postgresql://{postgres_server.user}:***@127.0.0.1:{postgres_server.port}/no_such_class")
+    assert 'database "no_such_class" does not exist' in error
+    assert build_parser().parse_args(["--class-db", url]).class_db == url      # a URL stays a URL

@@ -115,9 +115,11 @@ _RUN_STATES = """CREATE TABLE IF NOT EXISTS run_states (
 """What a restart gives back: each calibration's wizard as it was last acknowledged (a session
 record entry without truth, ``session_record.run_entry``). Added to every file when it is
 opened; a TCP Pendant that does not know it ignores it, so it needs no schema version."""
-_ADDITIVE_TABLES = (_RUN_STATES,)
-"""Tables made (IF NOT EXISTS) in every gradebook when it is opened, after the versioned
-schema: written in SQLite's words like every statement (``gradebook_db.sql_for``)."""
+_ADDITIVE_TABLES = {"run_states": _RUN_STATES}
+"""Tables made (CREATE TABLE IF NOT EXISTS, by name) in every gradebook that lacks them when it
+is opened, after the versioned schema; written in SQLite's words like every statement
+(``gradebook_db.sql_for``). A gradebook that has them all is not asked to create anything (a
+database user that may only read and write rows can open it)."""
 MAX_RUN_STATE_BYTES = 200_000
 """A wizard's stored state is refused above this (20 poses with joints take ~12 kB)."""
 
@@ -560,8 +562,9 @@ class Gradebook:
                     version = self._version(tables, check_storage=not looked)
                     if version < SCHEMA_VERSION:
                         self._migrate(version)
-                for statement in _ADDITIVE_TABLES:   # an older reader ignores these
-                    db.execute(statement)
+                for name, statement in _ADDITIVE_TABLES.items():   # an older reader ignores these
+                    if name not in tables:
+                        db.execute(statement)
         except db.errors as exc:
             raise self._cannot_write(exc) from exc
 
