@@ -39,8 +39,13 @@ install_chromium() { apt_install chromium; }
 # machine with systemd, Debian also starts both services after installing them; the tests use
 # neither: 'systemctl disable --now postgresql nginx' stops them.) Where they cannot be
 # installed, those tests are skipped with the reason (not run), and under CI=true they fail.
-have_postgres() { [ -n "${PG_BIN:-}" ] || ls /usr/lib/postgresql/*/bin/pg_ctl >/dev/null 2>&1; }
-have_nginx() { command -v nginx >/dev/null 2>&1 || [ -x /usr/sbin/nginx ]; }
+# PG_BIN (a folder with pg_ctl) and NGINX (the nginx binary) point the tests at other copies.
+have_postgres() {
+  if [ -n "${PG_BIN:-}" ]; then [ -x "$PG_BIN/pg_ctl" ]; else compgen -G '/usr/lib/postgresql/*/bin/pg_ctl' >/dev/null; fi
+}
+have_nginx() {
+  if [ -n "${NGINX:-}" ]; then [ -x "$NGINX" ]; else command -v nginx >/dev/null 2>&1 || [ -x /usr/sbin/nginx ]; fi
+}
 servers=()
 have_postgres || servers+=(postgresql)
 have_nginx || servers+=(nginx)

@@ -170,8 +170,12 @@ def postgres_server() -> Iterator[PostgresServer]:
 
 @pytest.fixture(scope="session")
 def nginx_binary() -> Path:
-    """Debian's nginx (``$PATH`` or /usr/sbin/nginx); skipped where missing, failed under CI=true."""
-    found = shutil.which("nginx") or ("/usr/sbin/nginx" if os.access("/usr/sbin/nginx", os.X_OK) else None)
+    """Debian's nginx (``$NGINX``, else ``$PATH`` or /usr/sbin/nginx); skipped where missing, failed
+    under CI=true."""
+    if os.environ.get("NGINX"):
+        found = os.environ["NGINX"] if os.access(os.environ["NGINX"], os.X_OK) else None
+    else:
+        found = shutil.which("nginx") or ("/usr/sbin/nginx" if os.access("/usr/sbin/nginx", os.X_OK) else None)
     if found is None:
         _missing("nginx is not installed (apt-get install nginx)")
     assert found is not None
