@@ -122,3 +122,18 @@ def test_server_with_an_unreachable_postgresql_gradebook_says_so_without_the_pas
                             f"postgresql://{postgres_server.user}:***@127.0.0.1:{postgres_server.port}/no_such_class")
     assert 'database "no_such_class" does not exist' in error
     assert build_parser().parse_args(["--class-db", url]).class_db == url      # a URL stays a URL
+
+
+def test_the_ready_message_names_a_postgresql_gradebook_without_its_password(postgres_server) -> None:
+    from types import SimpleNamespace
+
+    from tcp_pendant.classroom.class_room import ClassRoom
+    from tcp_pendant.classroom.gradebook_db import mask_url
+    from tcp_pendant.cli import _class_lines
+
+    url = postgres_server.fresh_schema()
+    with Gradebook(url) as book:
+        room = ClassRoom(book, {}, trainer_token="trainer-tok-12345678")
+        lines = _class_lines(SimpleNamespace(classroom=room, trainer_url="http://127.0.0.1:1/?trainer=tok-12345678"))
+    assert f"  class gradebook {mask_url(url)} (free practice)\n" in lines
+    assert ":***@" in lines and postgres_server.password not in lines
