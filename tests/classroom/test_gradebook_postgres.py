@@ -134,6 +134,7 @@ def test_a_newer_or_foreign_database_is_refused_and_left_unchanged(postgres_serv
     ("closed port", "Cannot reach the PostgreSQL gradebook .*(refused|failed).*server runs"),
     ("port not a number", "the port 'fivefour' is not a number"),
     ("not a URL libpq accepts", "is not a PostgreSQL URL libpq accepts"),
+    ("a bad escape in the password", "is not a PostgreSQL URL libpq accepts .*invalid percent-encoded"),
 ])
 def test_an_unreachable_server_or_bad_url_is_one_line_without_the_password(postgres_server, case: str,
                                                                            match: str) -> None:
@@ -144,6 +145,7 @@ def test_an_unreachable_server_or_bad_url_is_one_line_without_the_password(postg
         "closed port": f"postgresql://u:{secret}@127.0.0.1:{_closed_port()}/class",
         "port not a number": f"postgresql://u:{secret}@127.0.0.1:fivefour/class",
         "not a URL libpq accepts": f"postgresql://u:{secret}@127.0.0.1/class?no_such_option=1",
+        "a bad escape in the password": f"postgresql://u:{secret}%zz@127.0.0.1/class",
     }[case]
     with pytest.raises(GradebookError, match=match) as info:
         Gradebook(url, busy_timeout_s=2.0)

@@ -47,7 +47,7 @@ from abc import ABC, abstractmethod
 from collections.abc import Iterable, Iterator, Sequence
 from pathlib import Path
 from typing import Any, Protocol
-from urllib.parse import parse_qsl, urlencode, urlsplit, urlunsplit
+from urllib.parse import parse_qsl, unquote, urlencode, urlsplit, urlunsplit
 
 __all__ = [
     "GradebookConnection",
@@ -93,6 +93,24 @@ def class_db_target(text: str) -> Path | str:
 def url_has_password(url: str) -> bool:
     """Whether ``url`` carries a password (which then shows in the process list)."""
     return mask_url(url) != url
+
+
+def _secrets_of(url: str) -> list[str]:
+    """The password of ``url`` as written and decoded (user part and ``password=`` parameters),
+    longest first: what no message may show."""
+    found: set[str] = set()
+    try:
+        parts = urlsplit(url)
+        netloc = parts.netloc
+        if "@" in netloc and ":" in netloc.rsplit("@", 1)[0]:
+            found.add(netloc.rsplit("@", 1)[0].split(":", 1)[1])
+        found.update(v for k, v in parse_qsl(parts.query, keep_blank_values=True) if k.lower() == "password")
+        found.update(p for k, p in (kv.split("=", 1) for kv in parts.query.split("&") if "=" in kv)
+                     if k.lower() == "password")
+    except ValueError:
+        pass
+    found |= {unquote(x) for x in found}
+    return sorted((x for x in found if x), key=len, reverse=True)
 
 
 def mask_url(url: str) -> str:
@@ -298,6 +316,7 @@ class PostgresConnection(GradebookConnection):
 
     def __init__(self, url: str, *, busy_timeout_s: float) -> None:
         self.location = mask_url(url)
+        self._secrets = _secrets_of(url)
         try:
             import psycopg
             from psycopg import conninfo
@@ -314,7 +333,8 @@ class PostgresConnection(GradebookConnection):
             raise PostgresUnavailable(
                 f"--class-db {self.location} is not a PostgreSQL URL libpq accepts ({self._words(exc)}); "
                 "write it as postgresql://USER:PASSWORD@HOST:PORT/DATABASE.") from None
-        self._secret = str(params.get("password") or "")
+        if params.get("password"):
+            self._secrets = sorted({*self._secrets, str(params["password"])}, key=len, reverse=True)
         port = params.get("port")
         if port is not None and not str(port).isdigit():
             raise PostgresUnavailable(
@@ -328,7 +348,9 @@ class PostgresConnection(GradebookConnection):
     def _words(self, exc: BaseException) -> str:
         """The driver's message on one line, with the password (if it appears) masked."""
         text = " ".join(str(exc).split()) or type(exc).__name__
-        return text.replace(self._secret, _MASK) if getattr(self, "_secret", "") else text
+        for secret in self._secrets:
+            text = text.replace(secret, _MASK)
+        return text
 
     def _connect(self) -> Any:
         psycopg = self._psycopg
