@@ -96,7 +96,8 @@ def test_two_servers_behind_the_front_end_serve_one_class(app_factory, nginx_bin
     one server is refused on the other."""
     url = postgres_server.fresh_schema()
     front = free_port()
-    origin = f"http://127.0.0.1:{front}"
+    name = "pendant.school.test"            # the front end's name, as trainees open it
+    origin = f"http://{name}:{front}"
     apps = [app_factory(class_db=url, allow_origins=(origin,), trainer_token="one-token-for-every-server")
             for _ in range(2)]
     conf = render(nginx_folder, front, [a.port for a in apps])
@@ -106,14 +107,18 @@ def test_two_servers_behind_the_front_end_serve_one_class(app_factory, nginx_bin
     try:
         wait_until(lambda: _listening(front) or nginx.poll() is not None, timeout=20, what="nginx listening")
         assert nginx.poll() is None, nginx.stderr.read() if nginx.stderr else ""
-        # the page through the front end: answered (the host check passes) and a route cookie set
-        conn = http.client.HTTPConnection("127.0.0.1", front, timeout=20)
-        conn.request("GET", "/", headers={"Host": f"127.0.0.1:{front}"})
-        page = conn.getresponse()
-        body = page.read()
-        assert page.status == 200 and b"<html" in body.lower()
-        assert re.match(r"tcp_pendant_route=[0-9a-f]{32}; Path=/", page.getheader("Set-Cookie") or "")
-        conn.close()
+        # the page through the front end under its name: answered (--allow-origin names it) and
+        # a route cookie set; under a name the servers were not given: refused
+        for host, status in ((name, 200), ("other.school.test", 403)):
+            conn = http.client.HTTPConnection("127.0.0.1", front, timeout=20)
+            conn.request("GET", "/", headers={"Host": f"{host}:{front}"})
+            page = conn.getresponse()
+            body = page.read()
+            assert page.status == status, (host, page.status, body[:200])
+            conn.close()
+            if status == 200:
+                assert b"<html" in body.lower()
+                assert re.match(r"tcp_pendant_route=[0-9a-f]{32}; Path=/", page.getheader("Set-Cookie") or "")
 
         # a browser per route cookie until each server has one (consistent hash: a cookie
         # always leads to the same server)
@@ -123,7 +128,7 @@ def test_two_servers_behind_the_front_end_serve_one_class(app_factory, nginx_bin
                 break
             before = [len(a.sessions) for a in apps]
             cookie = f"tcp_pendant_route=browser-{i}"
-            c = DrainingClient(front, headers={"Cookie": cookie, "Origin": origin})
+            c = DrainingClient(front, headers={"Cookie": cookie, "Origin": origin}, host_name=name)
             clients.append(c)
             wait_until(lambda: sum(len(a.sessions) for a in apps) == sum(before) + 1, what="a session")
             k = next(j for j, a in enumerate(apps) if len(a.sessions) > before[j])
@@ -145,7 +150,7 @@ def test_two_servers_behind_the_front_end_serve_one_class(app_factory, nginx_bin
         # the same route cookie leads to the same server again (the websocket of a reload)
         cookie_b, _ = by_app[1]
         before = [len(a.sessions) for a in apps]
-        again = DrainingClient(front, headers={"Cookie": cookie_b, "Origin": origin})
+        again = DrainingClient(front, headers={"Cookie": cookie_b, "Origin": origin}, host_name=name)
         clients.append(again)
         wait_until(lambda: len(apps[1].sessions) == before[1] + 1, what="the same server again")
         assert len(apps[0].sessions) == before[0]
@@ -154,7 +159,7 @@ def test_two_servers_behind_the_front_end_serve_one_class(app_factory, nginx_bin
         assert thief.name is None and "already a trainee of this class" in thief.message.content
         # and a page from another web site cannot open a websocket through the front end
         with pytest.raises(Exception, match="403"):
-            DrainingClient(front, headers={"Cookie": cookie_b, "Origin": "http://evil.example"})
+            DrainingClient(front, headers={"Cookie": cookie_b, "Origin": "http://evil.example"}, host_name=name)
     finally:
         for c in clients:
             c.close()
