@@ -70,6 +70,7 @@ class PostgresServer:
     password: str
     folder: Path
     _counter: Any = None
+    _admin: Any = None
 
     def url(self, database: str = "postgres", *, password: str | None = None, schema: str | None = None) -> str:
         """``postgresql://user:password@127.0.0.1:port/database`` (``schema``: its search_path)."""
@@ -80,8 +81,11 @@ class PostgresServer:
         return url
 
     def admin(self) -> Any:
-        import psycopg
-        return psycopg.connect(self.url(), autocommit=True)
+        """The superuser's connection to the ``postgres`` database (one for the session)."""
+        if self._admin is None or self._admin.closed:
+            import psycopg
+            self._admin = psycopg.connect(self.url(), autocommit=True)
+        return self._admin
 
     def _next(self) -> int:
         if self._counter is None:
@@ -92,15 +96,13 @@ class PostgresServer:
         """A URL whose tables go into a new, empty schema of the ``postgres`` database (cheap:
         one per test)."""
         name = f"gb_{os.getpid()}_{self._next()}"
-        with self.admin() as conn:
-            conn.execute(f"CREATE SCHEMA {name}")
+        self.admin().execute(f"CREATE SCHEMA {name}")
         return self.url(schema=name)
 
     def fresh_database(self) -> str:
         """A URL of a new, empty database (its ``public`` schema, as in a class)."""
         name = f"class_{os.getpid()}_{self._next()}"
-        with self.admin() as conn:
-            conn.execute(f"CREATE DATABASE {name} TEMPLATE template0 ENCODING 'UTF8'")
+        self.admin().execute(f"CREATE DATABASE {name} TEMPLATE template0 ENCODING 'UTF8'")
         return self.url(name)
 
 
@@ -160,7 +162,12 @@ def postgres_server() -> Iterator[PostgresServer]:
             tail = log.read_text(errors="replace")[-2000:] if log.exists() else ""
             pytest.fail(f"PostgreSQL did not start: {exc.cmd[len(run_as):]} exited {exc.returncode}: "
                         f"{exc.stderr.strip()}\n{tail}", pytrace=False)
-        yield PostgresServer("127.0.0.1", port, user, password, folder)
+        server = PostgresServer("127.0.0.1", port, user, password, folder)
+        try:
+            yield server
+        finally:
+            if server._admin is not None:
+                server._admin.close()
     finally:
         if started:
             run(str(bin_dir / "pg_ctl"), "-D", str(data), "-m", "fast", "-w", "-t", "30", "stop",
