@@ -100,6 +100,9 @@ class AppConfig:
         exercise: None (free practice) or "mystery" (each trainee gets a mystery tool).
         exercise_seed: seed of the mystery tools (None: the class's secret seed, drawn once and
             kept in the gradebook; a number: that seed, for a reproducible demo).
+        exercise_instructions, exercise_methods, exercise_min_touches: the exercise's brief at
+            start (``ClassRoom``: instructions as plain text, the wizard kinds trainees may
+            start, the fewest touches a Finish takes); None: the brief kept in the gradebook.
         scenario: the systematic error every session starts with (training;
             ``controller.scenarios``: "off", "bent_tool", "robot_accuracy", "moved_reference");
             the trainer changes it per pendant in the Calibrate tab.
@@ -132,6 +135,9 @@ class AppConfig:
     trainer_token: str | None = None
     exercise: str | None = None
     exercise_seed: int | None = None
+    exercise_instructions: str | None = None
+    exercise_methods: tuple[str, ...] | None = None
+    exercise_min_touches: int | None = None
     scenario: str = "off"
     scenario_seed: int = 0
     presenter: bool = False
@@ -350,6 +356,9 @@ class PendantApp:
             self.classroom = ClassRoom(self.gradebook, tools,
                                        trainer_token=config.trainer_token,
                                        exercise=config.exercise, exercise_seed=config.exercise_seed,
+                                       instructions=config.exercise_instructions,
+                                       allowed_methods=config.exercise_methods,
+                                       min_touches=config.exercise_min_touches,
                                        hand_to_loop=self._hand_to_loop)
 
     @property
