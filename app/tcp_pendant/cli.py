@@ -27,6 +27,8 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from tcp_pendant.classroom.gradebook_db import class_db_target, url_has_password
+
 if TYPE_CHECKING:                       # the server is imported in main() only (no pinocchio for --help)
     from tcp_pendant.server import PendantApp
 
@@ -81,9 +83,11 @@ def build_parser() -> argparse.ArgumentParser:
                    help="run a class: each browser gives a name, every calibration is stored in the class "
                         "gradebook, and a trainer view (token) shows the class; implied by --class-db, "
                         "--exercise (and its --exercise-* options) and --trainer-token")
-    p.add_argument("--class-db", type=Path, default=None, metavar="PATH",
+    p.add_argument("--class-db", type=class_db_target, default=None, metavar="PATH|URL",
                    help="the class gradebook, an SQLite file every trainee's calibrations are stored in "
-                        "(default with --class: the user's data directory, class.sqlite3)")
+                        "(default with --class: the user's data directory, class.sqlite3), or a "
+                        "postgresql://USER@HOST:PORT/DATABASE URL: one PostgreSQL database that servers on "
+                        "several machines share (needs psycopg: pip install 'tcp-pendant[postgres]')")
     p.add_argument("--trainer-token", default=None, metavar="TOKEN",
                    help="the token that opens the trainer view, 16 to 200 printable characters (default: "
                         "$TCP_PENDANT_TRAINER_TOKEN, else a random one, printed at start); a token given "
@@ -216,6 +220,9 @@ def _main(argv: Sequence[str] | None) -> int:
         print("tcp-pendant: note: a --trainer-token on the command line shows in the process list; "
               "--trainer-token-file PATH or TCP_PENDANT_TRAINER_TOKEN keep it out", file=sys.stderr)
     class_db = args.class_db
+    if isinstance(class_db, str) and url_has_password(class_db):
+        print("tcp-pendant: note: a password in the --class-db URL shows in the process list; "
+              "PGPASSWORD or ~/.pgpass keep it out", file=sys.stderr)
     if classroom and class_db is None:
         class_db = default_gradebook_path()
         try:
@@ -275,10 +282,10 @@ def _class_lines(app: PendantApp) -> str:
         return ""
     exercise = "mystery tools" if room.exercise == "mystery" else "free practice"
     if room.trainer_token is None:
-        return (f"  class gradebook {room.gradebook.path} ({exercise})\n"
+        return (f"  class gradebook {room.gradebook.location} ({exercise})\n"
                 f"Trainer view: {app.url} with the trainer token this class began with (kept hashed in the "
                 "gradebook, so an open trainer page reconnects); give --trainer-token to set a new one\n")
-    return (f"  class gradebook {room.gradebook.path} ({exercise})\n"
+    return (f"  class gradebook {room.gradebook.location} ({exercise})\n"
             f"Trainer view: {app.trainer_url}  trainer token: {room.trainer_token}\n"
             "  (open that address: the page fills in the token and drops it from the address bar; or open the "
             "page and type the token in \"Trainer token\" of the welcome window; keep both secret)\n")

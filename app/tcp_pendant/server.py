@@ -23,7 +23,7 @@ import socket
 import threading
 import time
 from collections.abc import Callable, Generator, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 from urllib.parse import quote
@@ -93,8 +93,9 @@ class AppConfig:
         library_poll_s: how often the library file is checked for changes by others.
         allow_origins: web origins (``scheme://host[:port]``) whose pages may connect besides
             the pendant's own address, e.g. a reverse proxy's (``tcp_pendant.origin_check``).
-        class_db: the class gradebook (SQLite file); None: no classroom (no name prompt, nothing
-            recorded). The CLI passes its default path. Ignored with ``shared``.
+        class_db: the class gradebook: an SQLite file, or a ``postgresql://`` URL (a ``str``) of
+            the PostgreSQL database several servers share; None: no classroom (no name prompt,
+            nothing recorded). The CLI passes its default path. Ignored with ``shared``.
         trainer_token: the token that opens the trainer view, 16 to 200 printable characters
             (None: a random one).
         exercise: None (free practice) or "mystery" (each trainee gets a mystery tool).
@@ -131,7 +132,7 @@ class AppConfig:
     reference_tip_mm: tuple[float, float, float] | None = None
     library_poll_s: float = 1.0
     allow_origins: tuple[str, ...] = ()
-    class_db: Path | None = None
+    class_db: Path | str | None = field(default=None, repr=False)   # a URL may carry a password
     trainer_token: str | None = None
     exercise: str | None = None
     exercise_seed: int | None = None
