@@ -147,3 +147,22 @@ def test_twenty_attackers_do_not_stretch_the_victims_check_beyond_the_factor(cla
     assert all(not a.done() for a in c.attacks), "an attacker's job was refused or failed"
     assert m.factor <= FACTOR
     assert float(np.percentile(m.jogs, 95)) < JOG_P95_LIMIT_S
+
+
+def test_a_job_given_up_before_it_started_leaves_the_queue_and_its_sessions_place() -> None:
+    pool = JobPool(workers=1)
+    a, b = Owner(), Owner()
+    hold = Gate()
+    try:
+        pool.submit(a, hold, what="a beam check")
+        assert hold.started.wait(10)
+        waiting = pool.submit(b, lambda: "never", what="a TCP check")
+        assert pool.queued == 1 and pool.pending(b) == "a TCP check"
+        assert waiting.cancel()                                  # its browser's task was cancelled
+        assert pool.queued == 0 and pool.pending(b) is None
+        again = pool.submit(b, lambda: "b's", what="a TCP check")    # not refused as still running
+        hold.gate.set()
+        assert again.result(10) == "b's"
+    finally:
+        hold.gate.set()
+        pool.shutdown()
