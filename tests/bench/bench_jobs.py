@@ -13,8 +13,12 @@ rested session first) and with the same pool serving first come, first served
 (``rest_s=0``: every session counts as rested), the order the single-thread executor per job
 kind gave before the pool; both are measured here, so the ratio compares like with like.
 
-Run: ``PYTHONPATH=src:app .venv/bin/python tests/bench/bench_jobs.py [--checks N] [--workers W]``
-(about 30-60 s).
+With ``--attack beam`` the attackers run the TCP service's beam check instead (a job several
+times longer than the victim's check): the victim then waits for the running scan, so its
+factor is about (scan + check) / check, the bound of a pool that does not interrupt a job.
+
+Run: ``PYTHONPATH=src:app .venv/bin/python tests/bench/bench_jobs.py [--checks N] [--workers W]
+[--attack check|beam]`` (about 30-90 s).
 """
 
 from __future__ import annotations
@@ -33,11 +37,11 @@ from job_attack import Classroom, Measured  # noqa: E402
 from tcp_pendant.job_pool import JobPool, default_workers  # noqa: E402
 
 
-def run(policy: str, checks: int, workers: int | None, attackers: int) -> Measured:
+def run(policy: str, checks: int, workers: int | None, attackers: int, attack: str) -> Measured:
     """One rig with a pool of ``policy`` ("fair": the server's; "fifo": first come, first served)."""
     pool = JobPool(workers, keep_history=True) if policy == "fair" else JobPool(workers, rest_s=0.0, keep_history=True)
     with tempfile.TemporaryDirectory() as tmp:
-        rig = Classroom(Path(tmp), pool, attackers=attackers)
+        rig = Classroom(Path(tmp), pool, attackers=attackers, attack=attack)
         try:
             return rig.measure(n_alone=checks, n_under=checks)
         finally:
@@ -49,12 +53,14 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--checks", type=int, default=10, help="victim checks alone and under attack (default 10)")
     ap.add_argument("--workers", type=int, default=None, help=f"pool workers (default {default_workers()})")
     ap.add_argument("--attackers", type=int, default=20)
+    ap.add_argument("--attack", choices=("check", "beam"), default="check",
+                    help="the attackers' job: the TCP check (default) or the beam check (longer)")
     args = ap.parse_args(argv)
-    print(f"{args.attackers} attacker sessions resubmitting TCP checks; the victim checks {args.checks} times "
-          "alone, then under attack\n")
+    print(f"{args.attackers} attacker sessions resubmitting {'TCP' if args.attack == 'check' else 'beam'} checks; "
+          f"the victim runs its TCP check {args.checks} times alone, then under attack\n")
     results = {}
     for policy in ("fair", "fifo"):
-        m = results[policy] = run(policy, args.checks, args.workers, args.attackers)
+        m = results[policy] = run(policy, args.checks, args.workers, args.attackers, args.attack)
         ahead = [len(a) for a in m.ahead]
         busy = [len([h for h in a if h.busy]) for a in m.ahead]
         print(f"[{policy}] {m.summary()}")

@@ -27,10 +27,11 @@ from job_attack import Classroom  # noqa: E402
 from wsclient import wait_until  # noqa: E402  (job_attack puts tests/app on the path)
 
 ATTACKERS = 20
-FACTOR = 3.0
-"""The victim's median check latency under attack over its median alone, at most: the design
-lets at most one job per worker run ahead of it (~2x with jobs of equal size), the rest is
-margin for the GIL it shares with the running job and viser's event loop."""
+FACTOR = 4.0
+"""The victim's median check latency under attack over its median alone, at most. The design
+lets at most one job per worker run ahead of it: ~2x with jobs of its size. The rest is margin
+for the machine: one check's run time varies 2-3x from one second to the next on a shared
+2-core machine, and "alone" is measured a few seconds before the attack."""
 JOG_P95_LIMIT_S = 0.5
 
 
@@ -136,17 +137,17 @@ def classroom(tmp_path: Path) -> Iterator[Classroom]:
 
 def test_twenty_attackers_do_not_stretch_the_victims_check_beyond_the_factor(classroom: Classroom) -> None:
     c = classroom
-    m = c.measure(n_alone=4, n_under=4)
+    m = c.measure(n_alone=5, n_under=5)
     print("\n" + m.summary())
-    assert [v.busy for v in m.victim_jobs] == [False] * 4              # it rested: served first
+    assert [v.busy for v in m.victim_jobs] == [False] * 5              # it rested: served first
     # no job of a session that keeps the pool busy started while the victim's waited (a rested
     # one could, by the rule: an attacker whose resubmit the loop delayed past REST_S)
-    assert [[h for h in a if h.busy] for a in m.ahead] == [[]] * 4, "a busy session's job went ahead"
-    assert m.attackers == ATTACKERS and len(m.attacker_jobs) >= 8     # the attack really ran
+    assert [[h for h in a if h.busy] for a in m.ahead] == [[]] * 5, "a busy session's job went ahead"
+    assert m.attackers == ATTACKERS and len(m.attacker_jobs) >= 10    # the attack really ran
     assert c.notes == [], "a check of the victim was refused or failed"
     assert all(not a.done() for a in c.attacks), "an attacker's job was refused or failed"
     assert m.factor <= FACTOR
-    assert float(np.percentile(m.jogs, 95)) < JOG_P95_LIMIT_S
+    assert m.unanswered == 0 and float(np.percentile(m.jogs, 95)) < JOG_P95_LIMIT_S
 
 
 def test_a_job_given_up_before_it_started_leaves_the_queue_and_its_sessions_place() -> None:
