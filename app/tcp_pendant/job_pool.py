@@ -25,7 +25,7 @@ The rules (what bounds the harm one browser can do to another):
 The figure this guarantees: a rested session's job waits for at most the jobs already running
 (one per worker) and the rested jobs submitted before it; against any number of sessions that
 keep the pool busy, its latency is its own run time plus at most one job per worker (the
-longest a browser can start: a beam scan, ~1-3 s; a TCP check 0.05-0.3 s). A browser can
+longest a browser can start: a beam scan, up to about a second; a TCP check 0.03-0.3 s). A browser can
 defeat it only by pacing many sessions at ``rest_s`` or more apart; they then share the pool
 first come, first served with the other rested sessions, and the bounded queue refuses the
 excess. ``tests/security/test_job_pool.py`` proves it with 20 attacking sessions,
@@ -38,10 +38,14 @@ beside it. One worker per core beyond the one the loop needs, at most two
 (:func:`default_workers`; one on a 2-core machine). A process pool would take the jobs' GIL
 time off the loop, but each job carries pinocchio models (its own ``RobotKinematics`` copies)
 and a record's replay needs the robot models: they would be pickled per job or built per
-process, for a loop that measured well with threads (``bench_jobs.py`` on 2 shared cores, one
-worker, 20 attackers: the victim's jogs p95 57 ms, its check p50 as alone, max 468 ms; with
-two workers no better: p50 0.98x, max 379 ms, jogs p95 60 ms): the GIL is handed over every
-5 ms, and the one-job-per-session rule with the rested-first order is what bounds the harm.
+process (measured: a TCP check's job pickles to 213 kB in 8 ms, unpickles in 3-16 ms), and a
+record's grading holds the gradebook's connection, which does not cross processes. With
+threads the loop measured well enough (``bench_jobs.py`` on 2 shared cores, one worker, 20
+attackers: the victim's jogs p95 44-57 ms, none dropped; its check p50 1.0-2.9x its time alone;
+with two workers no better: p50 0.98x, jogs p95 60 ms): the GIL is handed over every 5 ms, and
+the one-job-per-session rule with the rested-first order is what bounds the harm. The GIL's
+price is the hops of a callback to the loop while a worker is busy (a switch interval each):
+a process pool for the picklable jobs is the next step if that matters.
 """
 
 from __future__ import annotations
