@@ -25,10 +25,10 @@ The rules (what bounds the harm one browser can do to another):
 The figure this guarantees: a rested session's job waits for at most the jobs already running
 (one per worker) and the rested jobs submitted before it; against any number of sessions that
 keep the pool busy, its latency is its own run time plus at most one job per worker (the
-longest a browser can start: a beam scan, up to about a second; a TCP check 0.03-0.3 s). A browser can
-defeat it only by pacing many sessions at ``rest_s`` or more apart; they then share the pool
-first come, first served with the other rested sessions, and the bounded queue refuses the
-excess. ``tests/security/test_job_pool.py`` proves it with 20 attacking sessions,
+longest a browser can start: a beam scan, up to about a second; a TCP check 0.03-0.3 s). A
+browser can defeat it only by pacing many sessions at ``rest_s`` or more apart; they then
+share the pool first come, first served with the other rested sessions, and the bounded queue
+refuses the excess. ``tests/security/test_job_pool.py`` proves it with 20 attacking sessions,
 ``tests/bench/bench_jobs.py`` prints the latencies.
 
 Threads, not processes: the jobs are numpy / pinocchio code driven from Python (per sub-step
