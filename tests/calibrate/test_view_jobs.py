@@ -109,3 +109,21 @@ def test_the_docks_finish_runs_the_check_in_the_job_pool(page) -> None:
     assert pool.history is not None and [h.what for h in pool.history] == [
         "the TCP check (spin test) wizard's controller job"]
     pool.shutdown()
+
+
+def test_auto_touch_of_a_check_while_the_sessions_other_job_runs_is_refused_before_it_moves(page) -> None:
+    p = _check_wizard(page)
+    s: Session = p.session
+    gate = threading.Event()
+    s.jobs = pool = JobPool()
+    running = pool.submit(s, lambda: gate.wait(10), what="a beam check")
+    q_before = s.controller.q_rad.copy()
+    try:
+        p.click(p.view.steps.auto_touch)
+        assert p.notes == [("Auto-touch not started", "A beam check is still running here; wait for its "
+                                                      "result, then try again.")]
+        assert (s.controller.q_rad == q_before).all() and s.workflow.wizard.recorded_poses == {}
+    finally:
+        gate.set()
+    assert running.result(10) is True
+    pool.shutdown()

@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING, Any
 
 from tcp_pendant.calibrate import AUTO_SIGMA_MAX_MM, AutoTouchRequest
 from tcp_pendant.calibrate.diversity import diversity_advice
+from tcp_pendant.calibrate.jobs import POSE_CHECKS
 from tcp_pendant.calibrate.text import (
     meter_level,
     meter_markdown,
@@ -168,7 +169,9 @@ class WizardStepsView:
         session = self.parent.session
         if session.closed:
             return
-        running = session.jobs.pending(session)
+        wiz = self.parent.workflow.wizard
+        probes = wiz is not None and type(wiz).controller_job in POSE_CHECKS    # its poses are probed in the pool
+        running = session.jobs.pending(session) if probes else None
         if self._auto_touching or running is not None:
             what = "Auto-touch" if self._auto_touching else running
             session.notify("Auto-touch not started", f"{str(what)[:1].upper()}{str(what)[1:]} is still running "
