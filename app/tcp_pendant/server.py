@@ -36,6 +36,7 @@ from tcp_pendant.calibrate import CalibrationWorkflow
 from tcp_pendant.addresses import network_urls
 from tcp_pendant.classroom.class_room import ClassRoom
 from tcp_pendant.classroom.gradebook import Gradebook
+from tcp_pendant.pendant.library_rights import DEFAULT_LIBRARY_QUOTA
 from tcp_pendant.controller import (
     BeamDevice,
     ControllerError,
@@ -99,6 +100,8 @@ class AppConfig:
         exercise: None (free practice) or "mystery" (each trainee gets a mystery tool).
         exercise_seed: seed of the mystery tools (None: the class's secret seed, drawn once and
             kept in the gradebook; a number: that seed, for a reproducible demo).
+        library_quota: in a class, the tool-library slots one trainee may hold (1..16; each
+            trainee renames and deletes only their own, ``pendant.library_rights``).
         scenario: the systematic error every session starts with (training;
             ``controller.scenarios``: "off", "bent_tool", "robot_accuracy", "moved_reference");
             the trainer changes it per pendant in the Calibrate tab.
@@ -131,6 +134,7 @@ class AppConfig:
     trainer_token: str | None = None
     exercise: str | None = None
     exercise_seed: int | None = None
+    library_quota: int = DEFAULT_LIBRARY_QUOTA
     scenario: str = "off"
     scenario_seed: int = 0
     presenter: bool = False
@@ -349,6 +353,7 @@ class PendantApp:
             self.classroom = ClassRoom(self.gradebook, tools,
                                        trainer_token=config.trainer_token,
                                        exercise=config.exercise, exercise_seed=config.exercise_seed,
+                                       library_quota=config.library_quota,
                                        hand_to_loop=self._hand_to_loop)
 
     @property

@@ -54,6 +54,7 @@ from tcp_pendant.classroom.restore import runs_to_restore
 from tcp_pendant.classroom.trainer_token import TokenAttempts, validate_trainer_token
 from tcp_pendant.controller import ToolModel
 from tcp_pendant.pendant.exercise_rules import DistanceAids, ExerciseRules, class_rules
+from tcp_pendant.pendant.library_rights import DEFAULT_LIBRARY_QUOTA, MAX_LIBRARY_QUOTA, UNRESTRICTED, LibraryRights
 from tcp_pendant.session import Session, SessionChange
 
 __all__ = ["EXERCISE_IDS", "ClassRoom"]
@@ -89,15 +90,23 @@ class ClassRoom:
             the gradebook.
         hand_to_loop: runs a function on viser's event loop.
         clock: seconds of a monotonic clock (the token's lockout windows; tests set it).
+        library_quota: tool-library slots one trainee may hold (1..16; ``--library-quota``).
 
     Raises:
         TrainerTokenError: a token that breaks the rules.
+        ValueError: a library quota out of range.
     """
 
     def __init__(self, gradebook: Gradebook, tools: dict[str, ToolModel], *, trainer_token: str | None,
                  exercise: str | None = None, exercise_seed: int | None = None,
                  hand_to_loop: Callable[[Callable[[], None]], None] = lambda fn: fn(),
-                 clock: Callable[[], float] = time.monotonic) -> None:
+                 clock: Callable[[], float] = time.monotonic,
+                 library_quota: int = DEFAULT_LIBRARY_QUOTA) -> None:
+        if (isinstance(library_quota, bool) or not isinstance(library_quota, int)
+                or not 1 <= library_quota <= MAX_LIBRARY_QUOTA):
+            raise ValueError(f"The library quota must be a whole number of slots 1..{MAX_LIBRARY_QUOTA}, "
+                             f"got {library_quota!r:.40}.")
+        self.library_quota = library_quota
         if exercise is not None and exercise not in EXERCISE_IDS:
             raise ValueError(f"Unknown exercise {exercise!r}; use one of {', '.join(EXERCISE_IDS)}.")
         stored = gradebook.class_setting(TOKEN_SETTING)
@@ -167,12 +176,19 @@ class ClassRoom:
         session.views["identity"] = prompt
         with self._lock:
             self._prompts[id(session)] = prompt
+        session.set_library_rights(self._library_rights(session, None))   # no change before a name
         session.on_close(lambda: self.detach(session))
         return prompt
 
     @staticmethod
     def _joined(join: TraineeJoin) -> tuple[str, str | None]:
         return join.name, join.new_key
+
+    def _library_rights(self, session: Session, name: str | None) -> LibraryRights:
+        """The trainer changes every slot; a trainee (``name``; None: not joined) only their own."""
+        with self._lock:
+            trainer = id(session) in self._trainer_views
+        return UNRESTRICTED if trainer else LibraryRights.trainee(name, self.library_quota)
 
     def _seed(self) -> int:
         if self._exercise_seed is None:
@@ -223,6 +239,7 @@ class ClassRoom:
             if follow:
                 session.subscribe(lambda change: self._on_change(session, change))
             session.set_hide_truth(self.exercise is not None)
+            session.set_library_rights(self._library_rights(session, join.name))
             if self.exercise == "mystery":
                 self._mount_mystery(session, recorder, join.name)
             self._apply_rules(session)
@@ -255,6 +272,8 @@ class ClassRoom:
             log.exception("ending the gradebook session of %r failed", name)
         with self._lock:
             self._left.append(recorder.status)
+        session.library_rights = self._library_rights(session, None)  # at once: it changes nothing more
+        self._hand_to_loop(session.guard(lambda: session.set_library_rights(session.library_rights)))
         if prompt is not None:         # on the loop, after this callback: no two sessions' locks at once
             self._hand_to_loop(session.guard(lambda: prompt.reopen(message, forget=forget)))
 
@@ -348,6 +367,7 @@ class ClassRoom:
         session.views["trainer"] = view
         with self._lock:
             self._trainer_views[id(session)] = view
+        session.set_library_rights(UNRESTRICTED)        # the trainer renames and deletes every slot
         return True
 
     def refresh_trainers(self) -> None:
