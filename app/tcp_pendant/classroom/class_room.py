@@ -31,6 +31,11 @@ Each trainee's pendant follows the class's :class:`~tcp_pendant.pendant.exercise
 is off unless the trainer unlocked or allowed them (``class_rules``); a change of exercise goes
 back to those defaults unless the same push sets them.
 
+Each pendant's library rights (``pendant.library_rights``, ``Session.set_library_rights``):
+before a name it changes no library slot; a named trainee saves into free slots and their own,
+renames and deletes only their own, within ``library_quota`` slots (the owner, the name, is
+kept in the library file); the browser that opened the trainer view changes every slot.
+
 Threads: the session callbacks run on viser's event loop (``Session.on_loop``); connects and
 disconnects come from viser's thread pool and hand their trainer-view refresh to the loop
 (``hand_to_loop``). The class's own lists are guarded by one lock.
