@@ -18,6 +18,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
+import threading
 from dataclasses import dataclass
 from typing import Any, Literal, NamedTuple
 
@@ -216,7 +217,7 @@ def _lstsq_core(info: Information, m_inv: np.ndarray, rotations: np.ndarray, f: 
     rotation rows.
     """
     n = rotations.shape[0]
-    fbar = sum_over_touches(f) / n
+    fbar = (_add(f, axis=0) if n <= 64 else sum_over_touches(f)) / n  # sum_over_touches, inlined (hot path)
     neg_d = fbar - f  # -d_i (the sign spares a negation below)
     rows = rotations.reshape(3 * n, 3)
     t = m_inv @ (neg_d.reshape(3 * n) @ rows)
@@ -483,6 +484,10 @@ def solve_xyz4(
 
 _add = np.add.reduce  # ufunc reductions without the Python wrapper of ndarray.sum (hot path)
 _max = np.maximum.reduce
+try:  # numpy.einsum without its Python dispatch (optimize=False calls this very function)
+    from numpy._core.multiarray import c_einsum as _einsum
+except ImportError:  # pragma: no cover - another numpy
+    _einsum = np.einsum
 
 _DUPLICATE_PRETEST_TRACE = 1.0 + 2.0 * math.cos(math.radians(0.5))
 """Largest ``trace(R_a^T R_b)`` of two touches below which no pair can be "the same
@@ -491,10 +496,12 @@ orientation" (``SAME_ORIENTATION_DEG`` = 0.05 deg): ``|R_a - R_b|_F^2 = |R_a|_F^
 such a pair at least 0.49 deg apart."""
 
 
-def _freeze(a: np.ndarray) -> np.ndarray:
-    """Make an array the solver created (and shares with nobody) read-only, without a copy."""
-    a.setflags(write=False)
-    return a
+@functools.lru_cache(maxsize=_GRAM_SMALL)
+def _off_diagonal(n: int) -> np.ndarray:
+    """(n, n) boolean mask, True off the diagonal (read-only)."""
+    mask = ~np.eye(n, dtype=bool)
+    mask.setflags(write=False)
+    return mask
 
 
 def _observability(rot: np.ndarray, y: np.ndarray | None, info: Information) -> AngleExtremes | None:
@@ -511,9 +518,8 @@ def _observability(rot: np.ndarray, y: np.ndarray | None, info: Information) -> 
     if info.observable:
         if n <= _GRAM_SMALL:
             x = rot.reshape(n, 9)
-            g = x @ x.T
-            g.ravel()[:: n + 1] = -math.inf
-            if float(_max(g, axis=None)) < _DUPLICATE_PRETEST_TRACE:
+            largest = float(_max(x @ x.T, axis=None, where=_off_diagonal(n), initial=-math.inf))
+            if largest < _DUPLICATE_PRETEST_TRACE:
                 return None
         elif distinct_orientations(rot, limit=MIN_TOUCHES).count >= MIN_TOUCHES:
             return None
@@ -529,7 +535,7 @@ class _Deferred(NamedTuple):
     y: np.ndarray | None
     info: Information
     ext: AngleExtremes | None  # None: not computed yet
-    cov_eig: list[float] | np.ndarray | None  # None: the eigenvalues of ``cov``
+    lstsq_noise: float | None  # lstsq: ``cov = noise^2 M^-1``, eigenvalues noise^2 / eig M; None: of ``cov``
     cov: np.ndarray
     ci_dof: int | None
     early_warnings: list[str]
@@ -541,18 +547,26 @@ class _Deferred(NamedTuple):
 
 
 class _Figures(NamedTuple):
+    mean_error: float
+    max_error: float
     ci95_radius: float
     ext: AngleExtremes
     condition_number: float
     warnings: tuple[str, ...]
 
 
-def _late_figures(d: _Deferred) -> _Figures:
-    """The 95 % radius, the angle figures, the condition number and the warnings of a solve
-    (the same numbers and words as if computed in :func:`_solve`)."""
+def _late_figures(d: _Deferred, res: np.ndarray) -> _Figures:
+    """The mean and largest residual (of ``res``, the residual lengths), the 95 % radius, the
+    angle figures, the condition number and the warnings of a solve (the same numbers and
+    words as if computed in :func:`_solve`)."""
     info, n = d.info, d.rot.shape[0]
     ext = d.ext if d.ext is not None else angle_extremes(d.rot, d.y)
-    cov_eig = d.cov_eig if d.cov_eig is not None else np.linalg.eigvalsh(d.cov)
+    cov_eig: list[float] | np.ndarray
+    if d.lstsq_noise is not None:
+        noise2 = d.lstsq_noise * d.lstsq_noise
+        cov_eig = [noise2 / v for v in info.eigvals.tolist()]  # > 0: the touches are observable
+    else:
+        cov_eig = np.linalg.eigvalsh(d.cov)
     ci95 = ci_radius(cov_eig, d.ci_dof)
     warnings = d.early_warnings
     eig = info.eigvals.tolist()
@@ -586,21 +600,39 @@ def _late_figures(d: _Deferred) -> _Figures:
             "with only 4 touches a careless touch cannot be detected; record 5 to 8 touches for a "
             "checkable result."
         )
-    return _Figures(ci95, ext, info.condition_number, tuple(warnings))
+    return _Figures(float(_add(res)) / n, float(_max(res)), ci95, ext, info.condition_number, tuple(warnings))
+
+
+_LATE_FIGURES_LOCK = threading.Lock()
 
 
 class _LazyTcpResult(TcpResult):
     """The :class:`TcpResult` of :func:`solve_xyz4`: the figures that cost more than the solve
-    needs (``ci95_radius``, the angle figures, ``condition_number``, ``warnings``) are computed
+    needs (``mean_error``, ``max_error``, ``ci95_radius``, the angle figures,
+    ``condition_number``, ``warnings``) are computed
     together on the first read of any of them (:func:`_late_figures`, from the solve's own
     arrays; the same values as computed eagerly), then kept. Frozen like its base; a copy or
     a pickle is a plain :class:`TcpResult` with every figure."""
 
-    @functools.cached_property
+    @property
     def _figures(self) -> _Figures:
-        figures = _late_figures(self.__dict__["_deferred"])
-        del self.__dict__["_deferred"]  # the solve's arrays are no longer needed
+        figures: _Figures | None = self.__dict__.get("_late")
+        if figures is None:
+            with _LATE_FIGURES_LOCK:  # once, whichever thread asks first
+                figures = self.__dict__.get("_late")
+                if figures is None:
+                    figures = _late_figures(self.__dict__["_deferred"], self.residuals)
+                    self.__dict__["_late"] = figures
+                    del self.__dict__["_deferred"]  # the solve's arrays are no longer needed
         return figures
+
+    @functools.cached_property
+    def mean_error(self) -> float:
+        return self._figures.mean_error
+
+    @functools.cached_property
+    def max_error(self) -> float:
+        return self._figures.max_error
 
     @functools.cached_property
     def ci95_radius(self) -> float:
@@ -681,19 +713,16 @@ def _solve(rot: np.ndarray, y: np.ndarray | None, f: np.ndarray, method: str, si
         r = info.rbar @ t + sum_over_touches(f) / n  # = mean_i (R_i t + f_i)
         e = rot @ t + (f - r)
 
-    res = np.einsum("ni,ni->n", e, e)
+    res = _einsum("ni,ni->n", e, e)
     sse = fit.sse if method == "lstsq" and fit is not None else float(_add(res))
-    _check_finite_result(t, r, sse)
+    if not math.isfinite(sum(t.tolist()) + sum(r.tolist()) + sse):
+        _check_finite_result(t, r, sse)
     np.sqrt(res, out=res)
     dof = 3 * n - 6
     s_est = math.sqrt(sse / dof)
     noise = s_est if sigma is None else sigma
-    cov_eig: list[float] | None = None
     if cov_unit is None:
-        noise2 = noise * noise
-        cov = noise2 * m_inv
-        # > 0: the touches are observable
-        cov_eig = [noise2 / v for v in info.eigvals.tolist()]
+        cov = (noise * noise) * m_inv
     else:
         cov = noise**2 * cov_unit
 
@@ -715,23 +744,23 @@ def _solve(rot: np.ndarray, y: np.ndarray | None, f: np.ndarray, method: str, si
             f"{'them' if plural else 'it'}."
         )
 
+    for a in (t, r, e, res, cov):  # made here and shared with nobody: read-only without a copy
+        a.setflags(write=False)
     result = object.__new__(_LazyTcpResult)  # its fields as TcpResult's __init__ sets them, the rest deferred
     result.__dict__.update(
         method=method,
-        tcp=_freeze(t),
-        reference=_freeze(r),
-        residual_vectors=_freeze(e),
-        residuals=_freeze(res),
-        mean_error=float(_add(res)) / n,
-        max_error=float(_max(res)),
+        tcp=t,
+        reference=r,
+        residual_vectors=e,
+        residuals=res,
         rms_error=math.sqrt(sse / n),
         noise_sigma=float(noise),
-        covariance=_freeze(cov),
+        covariance=cov,
         outliers=tuple(outliers),
         without_outliers=without,
         n_touches=n,
-        _deferred=_Deferred(rot, y, info, ext, cov_eig, cov, None if sigma is not None else dof, warnings,
-                            sigma, sse, s_est, dof, detect_outliers),
+        _deferred=_Deferred(rot, y, info, ext, noise if cov_unit is None else None, cov,
+                            None if sigma is not None else dof, warnings, sigma, sse, s_est, dof, detect_outliers),
     )
     return result
 
