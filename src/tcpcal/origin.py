@@ -622,7 +622,13 @@ class _LazyTcpResult(TcpResult):
                 figures = self.__dict__.get("_late")
                 if figures is None:
                     figures = _late_figures(self.__dict__["_deferred"], self.residuals)
-                    self.__dict__["_late"] = figures
+                    ext = figures.ext
+                    self.__dict__.update(  # read from now on as plain attributes
+                        mean_error=figures.mean_error, max_error=figures.max_error,
+                        ci95_radius=figures.ci95_radius, max_angle_deg=ext.max_deg, min_angle_deg=ext.min_deg,
+                        condition_number=figures.condition_number, warnings=figures.warnings,
+                        max_angle_exact=ext.max_exact, max_angle_upper_deg=ext.max_upper_deg,
+                        min_angle_exact=ext.min_exact, _late=figures)
                     del self.__dict__["_deferred"]  # the solve's arrays are no longer needed
         return figures
 
