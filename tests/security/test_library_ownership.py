@@ -121,6 +121,9 @@ def test_a_trainee_cannot_delete_rename_or_overwrite_a_classmates_or_the_trainer
         mallory.auto_touch(AutoTouchRequest())
     with pytest.raises(ToolLibraryError, match="Slot 5 belongs to another trainee"):
         mallory.save_result("pwned", 5)
+    with pytest.raises(ValueError, match="'Alice tool' is taken by slot 5, a tool that is not yours"):
+        mallory.save_result("Alice tool")                       # no slot chosen: the name's slot
+    assert lib.get(5) == kept
     for attempt in (lambda: mallory.delete_tool(1), lambda: mallory.rename_tool(1, "pwned")):
         with pytest.raises(ToolLibraryError, match="Slot 1 is the trainer's"):
             attempt()

@@ -41,6 +41,9 @@ def save_result(wizard: Wizard, library: ToolLibrary, name: str, slot: int | Non
     kwargs = rights.save_kwargs()
     if slot is None:
         found = library.find(name)
+        if found is not None and not rights.mine(library.owners(), found[0]):
+            raise WizardStateError(f"The name {name!r} is taken by slot {found[0]}, a tool that is not yours: "
+                                   "choose another name.")
         slot = found[0] if found is not None else library.first_free_slot()
         if slot is None:
             raise WizardStateError("The tool library is full: pick a slot to overwrite.")
