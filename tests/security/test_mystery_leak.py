@@ -1,14 +1,18 @@
 """What a hostile trainee's own websocket gets in a mystery exercise carries no number of the
 true TCP: a raw viser client joins a ``--class --exercise mystery`` server (the class's secret
-seed, none given), does what costs a trainee nothing (jogs, the camera buttons, a zero-tool spin
-test far from and at the reference tip, a calibration's Record by hand, the locked "Hide
-distance"), keeps every message the server sends it, and decodes all of it: every number of
-every message in order, every float array (mesh vertices, points, poses) and every raw byte
-string read as float32 and float64, and every number written in a text (markdown, labels,
-notifications). No three consecutive numbers may lie within 0.05 mm of the true TCP read from
+seed, none given), does what costs a trainee nothing (jogs, the camera buttons, a zero tool typed
+in and activated, its spin test far from and at the reference tip, a calibration's Record by
+hand, the locked "Hide distance"; switching tabs sends nothing, viser's tabs live in the browser
+and every tab's content is sent anyway), keeps every message the server sends it, and decodes
+all of it: every number of every message in order, every float array (mesh vertices, points,
+poses), every raw byte string read as float32 and float64 (at every alignment), and every
+number written in a text (markdown, labels, notifications). No three consecutive numbers may lie within 0.05 mm of the true TCP read from
 the gradebook: in FLANGE (metres and mm, the frame the tool's meshes come in), in WORLD and BASE
 at each flange pose the robot took (metres and mm), or as an offset from a zero tool (the
-numbers minus the flange position, turned into flange axes; metres and mm)."""
+numbers minus the flange position, turned into flange axes; metres and mm).
+
+The clicks reach the session as a browser's do (``guiclick``, with this client's handle); what
+is read is only what went over this client's websocket."""
 
 from __future__ import annotations
 
