@@ -547,18 +547,25 @@ class PendantApp:
     # ------------------------------------------------------------ life cycle
     def start(self) -> str:
         """Start serving; returns the URL."""
-        import viser
-
         host = self.config.host
         origin_check.enable()               # foreign web pages' websockets are refused (403)
         viser_adapter.install()             # every browser message checked before viser's handlers
         client_script.script_asset()        # the page's own script (keys, name, trainer URL): packaged?
+        with origin_check.starting():       # requests get 503 "starting" until mark_ready
+            self._start_serving(host)
+        return self.url
+
+    def _start_serving(self, host: str) -> None:
+        """The viser server, its policies, page script and session handlers; then ready."""
+        import viser
+
         self.server = viser.ViserServer(host=host, port=self.config.port, verbose=False)
         origin_check.allow(self.port, self.allow_origins,
                            origin_check.served_hosts(host, self.network_urls, self.allow_origins))
         origin_check.set_http_layer(self.port, client_script.serve)
         if self.config.port != 0 and self.port != self.config.port:
             # viser silently moves on to the next free port; the class was told this one
+            origin_check.forget(self.port)
             self.server.stop()
             self.server = None
             raise PortInUseError(host, self.config.port)
@@ -574,7 +581,7 @@ class PendantApp:
         self.server.on_client_disconnect(self._on_disconnect)
         self._watcher = threading.Thread(target=self._watch_library, name="library-watcher", daemon=True)
         self._watcher.start()
-        return self.url
+        origin_check.mark_ready(self.port)  # until now every request got 503 "starting"
 
     @property
     def trainer_url(self) -> str | None:

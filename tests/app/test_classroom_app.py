@@ -341,8 +341,9 @@ def test_the_same_browser_in_a_second_tab_takes_the_name_and_the_first_tab_holds
 def test_the_mystery_mesh_sent_to_the_browser_shows_the_tip_and_the_shaft_but_not_tool_y(
         app_factory, tmp_path: Path) -> None:
     """What the browser gets of the mystery tool (the MeshMessages under the flange, float32,
-    FLANGE coordinates): the nozzle's apex is the TCP (as a real tool's tip is there to see),
-    and no vertex of the nozzle ring lies on tool Y or Z about tool X (before: one on tool Y)."""
+    FLANGE coordinates): the nozzle's flat tip face is centred on the TCP (as a real tool's tip
+    is there to see) with no vertex at it, and no vertex of the nozzle's rings lies on tool Y or
+    Z about tool X (before: one on tool Y)."""
     app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token="trainer-token-tok-1", exercise="mystery",
                       exercise_seed=7)
     c = RecordingClient(app.port)
@@ -357,8 +358,8 @@ def test_the_mystery_mesh_sent_to_the_browser_shows_the_tip_and_the_shaft_but_no
                     for m in c.of_type("MeshMessage") if "/flange/tool/" in str(m.get("name"))]
 
         def nozzle() -> np.ndarray | None:
-            with_apex = [v for v in sent_tool_meshes() if np.min(np.linalg.norm(v - tcp, axis=1)) < 1e-6]
-            return with_apex[-1] if with_apex else None
+            with_tip = [v for v in sent_tool_meshes() if np.min(np.linalg.norm(v - tcp, axis=1)) < 3e-4]
+            return with_tip[-1] if with_tip else None
 
         wait_until(lambda: nozzle() is not None, what="the mystery tool's nozzle sent")
         v = nozzle()
@@ -366,10 +367,12 @@ def test_the_mystery_mesh_sent_to_the_browser_shows_the_tip_and_the_shaft_but_no
         r = v - tcp
         radial = r - np.outer(r @ x, x)
         ring = radial[np.linalg.norm(radial, axis=1) > 1e-4]
-        assert len(ring) == 24
+        assert len(ring) == 48 and np.min(np.linalg.norm(r, axis=1)) > 1.9e-4   # no vertex at the TCP
         angles = np.degrees(np.arctan2(ring @ z, ring @ y))
         assert np.abs((angles + 45.0) % 90.0 - 45.0).min() > 1e-3          # none on +-Y, +-Z
-        axial = r[np.linalg.norm(radial, axis=1) > 1e-4] @ x
-        assert np.allclose(axial, axial[0], atol=1e-6) and axial[0] < -0.01   # a ring behind the tip, about X
+        axial = r @ x
+        face = np.abs(axial) < 1e-6                                       # the tip face, about X
+        assert face.sum() == 24 and np.allclose(v[face].mean(axis=0), tcp, atol=1e-7)
+        assert np.all(axial[~face] < -0.01)                               # the rest behind the tip
     finally:
         c.close()
