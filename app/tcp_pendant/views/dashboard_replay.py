@@ -64,15 +64,16 @@ class ReplayScene:
         for i, t in enumerate(replay.touches):
             T = t.T_world_flange_m
             size = TOUCH_AXES_M * (0.5 if t.overwritten else 1.0)
-            add(sc.add_frame(f"{ROOT}/touch_{i}", wxyz(T), tuple(T[:3, 3]), axes_length=size,
+            add(sc.add_frame(f"{ROOT}/touch_{i}", wxyz=wxyz(T), position=tuple(T[:3, 3]), axes_length=size,
                              axes_radius=size / 25.0, origin_radius=size / 12.0))
-            add(sc.add_label(f"{ROOT}/touch_{i}/label", f"{i + 1}", position=(0.0, 0.0, size * 1.3)))
+            add(sc.add_label(f"{ROOT}/touch_{i}_label", f"{i + 1}", position=tuple(T[:3, 3] + T[:3, 2] * -size * 1.3)))
         segments = [(t.T_world_flange_m[:3, 3], t.tip_world_m) for t in replay.touches if t.tip_world_m is not None]
         if segments:
             points = np.array([[a, b] for a, b in segments], dtype=np.float32)
             colours = np.array([[AUTO_RGB if t.auto else HAND_RGB] * 2 for t in replay.touches
                                 if t.tip_world_m is not None], dtype=np.uint8)
-            add(sc.add_line_segments(f"{ROOT}/approach", points, colours, line_width=2.0))
+            add(sc.add_line_segments(f"{ROOT}/approach", points=points, colors=colours, thickness=2.0,
+                                     thickness_units="screen"))
         if replay.reference_world_m is not None:
             add(sc.add_icosphere(f"{ROOT}/reference", radius=0.004, color=(30, 30, 30),
                                  position=tuple(replay.reference_world_m)))
@@ -83,9 +84,9 @@ class ReplayScene:
                     continue
                 T = T_last @ T_ft
                 length = RESULT_AXES_M if name == "result" else RESULT_AXES_M * 0.7
-                add(sc.add_frame(f"{ROOT}/{name}", wxyz(T), tuple(T[:3, 3]), axes_length=length,
+                add(sc.add_frame(f"{ROOT}/{name}", wxyz=wxyz(T), position=tuple(T[:3, 3]), axes_length=length,
                                  axes_radius=length / 30.0))
-                add(sc.add_label(f"{ROOT}/{name}/label", name, position=(length, 0.0, 0.0)))
+                add(sc.add_label(f"{ROOT}/{name}_label", name, position=tuple(T[:3, 3] + T[:3, 0] * length)))
         self.shown = replay
         self._look(replay)
 
