@@ -170,7 +170,7 @@ class TrainerDashboard:
     def _render_chart(self) -> None:
         x, y = chart_points(self.rows)
         n = max(1, len(self.rows))
-        top = float(max(1.0, 1.15 * float(y.max()))) if y.size else 1.0
+        top = float(max(1.0, 1.15 * float(y.max()))) * 1.08 if y.size else 1.08    # the top tick inside
         data = (x, y)
         if not all(np.array_equal(a, b) for a, b in zip(self.chart.data, data)) or len(self.chart.data) != 2:
             self.chart.data = data

@@ -29,6 +29,8 @@ STUCK_BACKGROUND = "#ffe08a"
 _CELL = "padding:2px 6px;white-space:nowrap;border-bottom:1px solid #ddd"
 _CUT = "display:inline-block;overflow:hidden;text-overflow:ellipsis;vertical-align:bottom;max-width:{em}em"
 _STEP = re.compile(r"^Step (\d+) of (\d+)$")
+_ON = '<span style="color:#1f9d3a">●</span>'
+_OFF = "○"
 
 
 def short_step(step: str) -> str:
@@ -68,7 +70,7 @@ def trainees_html(rows: Sequence[DashboardRow]) -> str:
         style = f"background:{STUCK_BACKGROUND};font-weight:600" if r.stuck else ("color:#888" if not r.connected else "")
         err = "-" if r.position_error_mm is None else f"{r.position_error_mm:.2f}"
         name = ("⚠ " if r.stuck else "") + r.name
-        cells = (escape_html(str(r.number)), _cut(name, 11), "●" if r.connected else "○", _cut(r.method or "-", 10),
+        cells = (escape_html(str(r.number)), _cut(name, 11), _ON if r.connected else _OFF, _cut(r.method or "-", 10),
                  escape_html(short_step(r.step) or "-"), format_duration(r.step_s if r.in_progress else None),
                  format_duration(r.touch_s), str(r.touches), str(r.crashes), err, escape_html(r.grade or "-"))
         tds = "".join(f'<td style="{_CELL}">{c}</td>' for c in cells)
@@ -88,7 +90,7 @@ def in_progress_html(runs: Sequence[OpenRun]) -> str:
         return f'<div style="font-size:{FONT_PX}px"><i>No calibration in progress.</i></div>'
     body = []
     for r in runs:
-        cells = (str(r.calibration_id), _cut(r.trainee, 11), "●" if r.connected else "○", _cut(r.method or "-", 10),
+        cells = (str(r.calibration_id), _cut(r.trainee, 11), _ON if r.connected else _OFF, _cut(r.method or "-", 10),
                  escape_html(short_step(r.step) or "-"), format_duration(r.step_s), format_duration(r.started_s),
                  str(r.touches))
         style = "" if r.connected else "color:#888"
