@@ -148,10 +148,12 @@ def test_a_calibration_is_replayed_in_3d_from_the_gradebook(app_factory, tmp_pat
     try:
         anna = _connect(app, clients, 0)
         _join(anna, "Anna")
-        _touches(anna, 6)
-        assert anna.workflow.result is not None
         trainer = _connect(app, clients, 1)
         dash = _dashboard(trainer)
+        assert "No calibration finished yet" in dash.grades_md.content
+        _touches(anna, 6)
+        assert anna.workflow.result is not None
+        wait_until(lambda: "| Anna |" in dash.grades_md.content, what="Anna's result in the gradebook table")
         choose(dash.trainee, "Anna", trainer.client)
         click(dash.replay_button, trainer.client)
         shown = dash.replay_scene.shown

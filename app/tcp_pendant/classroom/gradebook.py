@@ -1044,7 +1044,7 @@ class Gradebook:
         calibration in progress. The shared truth of the dashboard: a server started again with
         this gradebook shows the class as it was, trainees not yet back included."""
         query = """
-            WITH b AS (
+            WITH b AS MATERIALIZED (
               SELECT t.id AS tid, t.name AS name,
                 (SELECT c.id FROM calibrations c JOIN sessions s ON s.id = c.session_id
                    WHERE s.trainee_id = t.id ORDER BY c.started_at DESC, c.id DESC LIMIT 1) AS cid,

@@ -138,6 +138,7 @@ class TrainerDashboard:
         self.rows: list[DashboardRow] = []
         self.folders: dict[str, Any] = {}
         self._grading = False
+        self._results_shown: tuple[Any, ...] | None = None
         client = session.client
         self.replay_scene = ReplayScene(target_of(session).scene, None if client is None else client.camera)
 
@@ -164,7 +165,10 @@ class TrainerDashboard:
         set_content(self.runs_html, in_progress_html(open_runs(board, connected, now)))
         self._render_chart()
         set_options(self.trainee, (NO_TRAINEE, *dict.fromkeys(r.name for r in self.rows)))   # option text, not markdown
-        set_content(self.grades_md, grades_markdown(self.control.grade_rows()))
+        results = tuple((t.result_calibration_id, t.position_error_mm, t.grade) for t in board.trainees)
+        if results != self._results_shown:       # the gradebook table (all rows: the costly read) on a new result only
+            self._results_shown = results
+            set_content(self.grades_md, grades_markdown(self.control.grade_rows()))
         set_content(self.rules_md, escape_markdown(rules_words(self.control.rules)))
 
     def _render_chart(self) -> None:
