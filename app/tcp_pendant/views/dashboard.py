@@ -375,7 +375,7 @@ def message_folder(dash: TrainerDashboard) -> None:
 def gradebook_folder(dash: TrainerDashboard) -> None:
     """The finished calibrations, the CSV, grading an uploaded record."""
     gui = dash.gui
-    with dash.folder("Gradebook", expand_by_default=False):
+    with dash.folder("Gradebook"):
         dash.grades_md = gui.add_markdown("")
         dash.download = gui.add_button("Download grades (CSV)")
         dash.grade_upload = gui.add_upload_button(
