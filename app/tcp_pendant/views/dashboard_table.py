@@ -8,7 +8,7 @@ goes through ``escape_html``: shown literally, never run. Numbers are ours.
 
 Columns of :func:`trainees_html`: ``#`` (the trainee's mark on the chart), Trainee, On (●
 connected, ○ not), Method, Step ("2/4", "result", "cancelled"), On step (time on it, m:ss),
-Touch (since the last touch), Touches, Crashes (of the latest calibration), Err mm (position
+Last touch (time since it), Touches, Crashes (of the latest calibration), Err mm (position
 error of the last finished calibration against the truth), Grade.
 """
 
@@ -55,7 +55,7 @@ def _table(headers: Sequence[tuple[str, str]], body: list[str], cls: str) -> str
 TRAINEE_HEADERS: tuple[tuple[str, str], ...] = (
     ("#", "the trainee's mark on the chart"), ("Trainee", "name"), ("On", "connected now"),
     ("Method", "the latest calibration"), ("Step", "where it is"), ("On step", "time on the step (m:ss)"),
-    ("Touch", "time since the last touch (m:ss)"), ("Touches", "touches recorded in the latest calibration"),
+    ("Last touch", "time since the last touch (m:ss)"), ("Touches", "touches recorded in the latest calibration"),
     ("Crashes", "crashes in the latest calibration"),
     ("Err mm", "position error of the last finished calibration against the true TOOL frame"),
     ("Grade", "of the last finished calibration"))
