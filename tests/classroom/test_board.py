@@ -78,6 +78,8 @@ def test_the_board_is_rebuilt_from_the_file_after_a_restart(tmp_path: Path) -> N
     html = trainees_html(rows)
     assert "Ben &lt;b&gt;" in html and "<b>" not in html                  # escaped: shown, never run
     assert html.count("<tr") == 3 and "white-space:nowrap" in html
+    tcp = ", ".join(f"{v:.1f}" for v in truth.tcp_mm)
+    assert f'title="TCP {tcp} mm">{first.position_error_mm:.2f}<' in html       # Anna's result in the tooltip
     book.close()
 
 

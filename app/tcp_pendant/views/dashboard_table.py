@@ -9,7 +9,7 @@ goes through ``escape_html``: shown literally, never run. Numbers are ours.
 Columns of :func:`trainees_html`: ``#`` (the trainee's mark on the chart), Trainee, On (●
 connected, ○ not), Method, Step ("2/4", "result", "cancelled"), On step (time on it, m:ss),
 Last touch (time since it), Touches, Crashes (of the latest calibration), Err mm (position
-error of the last finished calibration against the truth), Grade.
+error of the last finished calibration against the truth; its TCP in the tooltip), Grade.
 """
 
 from __future__ import annotations
@@ -69,6 +69,9 @@ def trainees_html(rows: Sequence[DashboardRow]) -> str:
     for r in rows:
         style = f"background:{STUCK_BACKGROUND};font-weight:600" if r.stuck else ("color:#888" if not r.connected else "")
         err = "-" if r.position_error_mm is None else f"{r.position_error_mm:.2f}"
+        if r.tcp_mm is not None:                     # the result itself in the cell's tooltip
+            tcp = ", ".join(f"{v:.1f}" for v in r.tcp_mm)
+            err = f'<span title="TCP {escape_html(tcp)} mm">{err}</span>'
         name = ("⚠ " if r.stuck else "") + r.name
         cells = (escape_html(str(r.number)), _cut(name, 11), _ON if r.connected else _OFF, _cut(r.method or "-", 10),
                  escape_html(short_step(r.step) or "-"), format_duration(r.step_s if r.in_progress else None),
