@@ -30,11 +30,12 @@ def _iso(t: datetime) -> str:
     return t.isoformat(timespec="milliseconds")
 
 
-def test_the_board_is_rebuilt_from_the_file_after_a_restart(tmp_path: Path) -> None:
+def test_the_board_is_rebuilt_from_the_file_after_a_restart(gradebook_target: Path | str, tmp_path: Path) -> None:
     """Two trainees work through their recorders; the "server" stops (the gradebook closed);
-    a new gradebook object on the same file gives back both, their steps, touches and results."""
-    path = tmp_path / "class.sqlite3"
-    book = Gradebook(path, synchronous="NORMAL")
+    a new gradebook object on the same file (or database) gives back both, their steps, touches
+    and results."""
+    path = gradebook_target
+    book = Gradebook(path)
     sessions = {}
     for name, seed in (("Anna", 3), ("Ben <b>", 4)):
         s = make_session(tmp_path / f"tools-{seed}.json", seed=seed)
@@ -83,8 +84,8 @@ def test_the_board_is_rebuilt_from_the_file_after_a_restart(tmp_path: Path) -> N
     book.close()
 
 
-def test_the_step_clock_restarts_only_with_a_new_step(tmp_path: Path) -> None:
-    with Gradebook(tmp_path / "c.sqlite3", synchronous="NORMAL") as book:
+def test_the_step_clock_restarts_only_with_a_new_step(gradebook_target: Path | str) -> None:
+    with Gradebook(gradebook_target) as book:
         cid = book.start_calibration(book.start_session(book.add_trainee("Anna"), "x"), "xyz4", "pointer", T)
         book.save_run_state(cid, {"n": 1}, method_title="XYZ 4-point", step="Step 1 of 4")
         with book._write() as db:                   # the step began long ago

@@ -15,8 +15,9 @@ is widened to the whole window (viser's ``main_panel.set_width``; 1024x768 proje
   Auto-touch: ``ClassRoom.push_to``), **Release name** (``ClassRoom.release``) and **Replay in
   3D** (their last calibration from the gradebook in this browser's own scene,
   ``views.dashboard_replay``; the panel narrows to show it until **Close replay**);
-- **Exercise**: the class's settings pushed to every trainee (``views.trainer_view``);
-- **Message**: the place for messages to all or one trainee (:func:`message_folder`);
+- **Exercise**: the class's settings pushed to every trainee (``views.trainer_view``) and the
+  exercise's brief (``views.trainer_exercise``);
+- **Message to trainees**: to all or one trainee (``views.trainer_messages``);
 - **Gradebook**: the finished calibrations, the CSV download, grading an uploaded record.
 
 The data: the gradebook (``ClassRoom.board``) plus who is connected (``ClassRoom.connected_names``);
@@ -44,6 +45,8 @@ from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.dashboard_replay import ReplayScene
 from tcp_pendant.views.dashboard_table import in_progress_html, trainees_html
 from tcp_pendant.views.gui_util import ButtonEvent, UploadEvent, set_content, set_options, target_of
+from tcp_pendant.views.trainer_exercise import build_exercise_controls
+from tcp_pendant.views.trainer_messages import build_message_controls
 from tcp_pendant.views.trainer_view import (
     AUTO_TOUCH, EXERCISES, GRADE_WORKER, HIDE_DISTANCE, ClassControl, grades_markdown, record_grades_markdown,
     rules_words,
@@ -70,8 +73,6 @@ class DashboardControl(ClassControl, Protocol):
     """What the dashboard needs of the class room, beyond the class-wide controls."""
 
     def board(self) -> ClassBoard: ...
-
-    def connected_names(self) -> set[str]: ...
 
     def replay(self, name: str) -> CalibrationReplay | None: ...
 
@@ -137,6 +138,9 @@ class TrainerDashboard:
         self.gui = target_of(session).gui
         self.rows: list[DashboardRow] = []
         self.folders: dict[str, Any] = {}
+        self.class_extras: list[Any] = []
+        """The brief's and the message box's controls (``views.trainer_exercise`` /
+        ``trainer_messages``), re-rendered with the dashboard."""
         self._grading = False
         self._results_shown: tuple[Any, ...] | None = None
         client = session.client
@@ -158,7 +162,7 @@ class TrainerDashboard:
     def render(self, board: ClassBoard | None = None, connected: Collection[str] | None = None) -> None:
         """Show the class (``board`` and ``connected``: read now when not given)."""
         board = self.control.board() if board is None else board
-        connected = self.control.connected_names() if connected is None else connected
+        connected = set(self.control.connected_names()) if connected is None else connected
         now = datetime.now(timezone.utc)
         self.rows = dashboard_rows(board, connected, now, self.stuck_after_s())
         set_content(self.table_html, trainees_html(self.rows))
@@ -170,6 +174,8 @@ class TrainerDashboard:
             self._results_shown = results
             set_content(self.grades_md, grades_markdown(self.control.grade_rows()))
         set_content(self.rules_md, escape_markdown(rules_words(self.control.rules)))
+        for extra in self.class_extras:
+            extra.render()
 
     def _render_chart(self) -> None:
         x, y = chart_points(self.rows)
@@ -364,12 +370,13 @@ def exercise_folder(dash: TrainerDashboard) -> None:
             hint="allowed: trainees may let the robot touch for them (off by default in an exercise).")
         dash.push = gui.add_button("Push to all trainees", color="blue")
         dash.push_md = gui.add_markdown("")
+        dash.class_extras.append(build_exercise_controls(gui, control, dash.session))   # "Exercise brief"
     dash.push.on_click(dash.session.on_loop(dash._push_all))
 
 
 def message_folder(dash: TrainerDashboard) -> None:
-    """The place of the messages to all or one trainee (the messaging module builds its folder
-    here, through :meth:`TrainerDashboard.folder`); none yet."""
+    """The messages to all or one trainee (``views.trainer_messages``: its own folder)."""
+    dash.class_extras.append(build_message_controls(dash.gui, dash.control, dash.session))
 
 
 def gradebook_folder(dash: TrainerDashboard) -> None:

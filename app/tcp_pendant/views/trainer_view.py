@@ -21,6 +21,8 @@ from tcp_pendant.classroom.grading import RecordGrade
 from tcp_pendant.classroom.recorder import TraineeStatus
 from tcp_pendant.pendant.exercise_rules import ExerciseRules
 from tcp_pendant.text_escape import escape_markdown
+from tcp_pendant.views.trainer_exercise import BriefControl
+from tcp_pendant.views.trainer_messages import MessageControl
 
 GRADE_WORKER = ThreadPoolExecutor(max_workers=1, thread_name_prefix="record-grading")
 """Parses, replays and grades uploaded records off viser's event loop, one at a time."""
@@ -40,8 +42,9 @@ MAX_GRADE_ROWS = 50
 """The gradebook table shows the newest rows only (the CSV has them all)."""
 
 
-class ClassControl(Protocol):
-    """What the trainer view needs of the server."""
+class ClassControl(BriefControl, MessageControl, Protocol):
+    """What the trainer's dashboard needs of the server (the brief's and the message box's
+    needs included: ``views.trainer_exercise``, ``views.trainer_messages``)."""
 
     @property
     def tool_keys(self) -> Sequence[str]: ...
