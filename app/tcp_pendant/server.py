@@ -36,6 +36,7 @@ from tcp_pendant.calibrate import CalibrationWorkflow
 from tcp_pendant.addresses import network_urls
 from tcp_pendant.classroom.class_room import ClassRoom
 from tcp_pendant.classroom.gradebook import Gradebook
+from tcp_pendant.pendant.library_rights import DEFAULT_LIBRARY_QUOTA
 from tcp_pendant.controller import (
     BeamDevice,
     ControllerError,
@@ -100,6 +101,8 @@ class AppConfig:
         exercise: None (free practice) or "mystery" (each trainee gets a mystery tool).
         exercise_seed: seed of the mystery tools (None: the class's secret seed, drawn once and
             kept in the gradebook; a number: that seed, for a reproducible demo).
+        library_quota: in a class, the tool-library slots one trainee may hold (1..16; each
+            trainee renames and deletes only their own, ``pendant.library_rights``).
         exercise_instructions, exercise_methods, exercise_min_touches: the exercise's brief at
             start (``ClassRoom``: instructions as plain text, the wizard kinds trainees may
             start, the fewest touches a Finish takes); None: the brief kept in the gradebook.
@@ -135,6 +138,7 @@ class AppConfig:
     trainer_token: str | None = None
     exercise: str | None = None
     exercise_seed: int | None = None
+    library_quota: int = DEFAULT_LIBRARY_QUOTA
     exercise_instructions: str | None = None
     exercise_methods: tuple[str, ...] | None = None
     exercise_min_touches: int | None = None
@@ -356,6 +360,7 @@ class PendantApp:
             self.classroom = ClassRoom(self.gradebook, tools,
                                        trainer_token=config.trainer_token,
                                        exercise=config.exercise, exercise_seed=config.exercise_seed,
+                                       library_quota=config.library_quota,
                                        instructions=config.exercise_instructions,
                                        allowed_methods=config.exercise_methods,
                                        min_touches=config.exercise_min_touches,

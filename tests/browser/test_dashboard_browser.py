@@ -90,7 +90,7 @@ def test_the_trainer_address_opens_a_projector_dashboard(pendant, new_page, shot
             assert page.get_by_role("button", name=label, exact=True).count() == 0, label
         assert page.get_by_role("tab", name="Jog", exact=True).count() == 0
         trainer = next(s for s in app.sessions.values() if "trainer" in s.views)
-        assert set(trainer.views) == {"trainer"}
+        assert set(trainer.views) == {"trainer", "tools"}          # the dashboard and its tool library folder
         assert page.get_by_text("Ben <b>B</b>", exact=False).count() >= 1      # shown literally, not as HTML
         assert page.locator(".tcp-dashboard-trainees b, .tcp-dashboard-runs b").count() == 0
         assert_not_blank(shot(page, "dashboard-table"), min_colors=50)

@@ -38,6 +38,11 @@ Each trainee's pendant follows the class's :class:`~tcp_pendant.pendant.exercise
 is off unless the trainer unlocked or allowed them (``class_rules``); a change of exercise goes
 back to those defaults unless the same push sets them.
 
+Each pendant's library rights (``pendant.library_rights``, ``Session.set_library_rights``):
+before a name it changes no library slot; a named trainee saves into free slots and their own,
+renames and deletes only their own, within ``library_quota`` slots (the owner, the name, is
+kept in the library file); the browser that opened the trainer view changes every slot.
+
 The exercise also carries the trainer's **brief** (:meth:`ClassRoom.push_brief`, or
 ``--exercise-instructions`` / ``--exercise-methods`` / ``--exercise-min-touches`` at start):
 instructions (plain text, a banner on every trainee's panel), the methods a trainee may start
@@ -85,6 +90,7 @@ from tcp_pendant.pendant.exercise_rules import (
     clean_instructions,
     clean_min_touches,
 )
+from tcp_pendant.pendant.library_rights import DEFAULT_LIBRARY_QUOTA, MAX_LIBRARY_QUOTA, UNRESTRICTED, LibraryRights
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.wizards import WIZARD_TYPES, wizard_classes
 
@@ -161,9 +167,11 @@ class ClassRoom:
         call_later: ``call_later(delay_s, fn)`` runs ``fn`` on viser's event loop after a
             delay (the dashboards' throttle and clock tick); None: dashboards render at once,
             every time (tests).
+        library_quota: tool-library slots one trainee may hold (1..16; ``--library-quota``).
 
     Raises:
         TrainerTokenError: a token that breaks the rules.
+        ValueError: a library quota out of range.
     """
 
     def __init__(self, gradebook: Gradebook, tools: dict[str, ToolModel], *, trainer_token: str | None,
@@ -172,7 +180,13 @@ class ClassRoom:
                  min_touches: int | None = None,
                  hand_to_loop: Callable[[Callable[[], None]], None] = lambda fn: fn(),
                  clock: Callable[[], float] = time.monotonic,
-                 call_later: Callable[[float, Callable[[], None]], None] | None = None) -> None:
+                 call_later: Callable[[float, Callable[[], None]], None] | None = None,
+                 library_quota: int = DEFAULT_LIBRARY_QUOTA) -> None:
+        if (isinstance(library_quota, bool) or not isinstance(library_quota, int)
+                or not 1 <= library_quota <= MAX_LIBRARY_QUOTA):
+            raise ValueError(f"The library quota must be a whole number of slots 1..{MAX_LIBRARY_QUOTA}, "
+                             f"got {library_quota!r:.40}.")
+        self.library_quota = library_quota
         if exercise is not None and exercise not in EXERCISE_IDS:
             raise ValueError(f"Unknown exercise {exercise!r}; use one of {', '.join(EXERCISE_IDS)}.")
         given_instructions = None if instructions is None else clean_instructions(instructions)
@@ -266,12 +280,19 @@ class ClassRoom:
         session.views["identity"] = prompt
         with self._lock:
             self._prompts[id(session)] = prompt
+        session.set_library_rights(self._library_rights(session, None))   # no change before a name
         session.on_close(lambda: self.detach(session))
         return prompt
 
     @staticmethod
     def _joined(join: TraineeJoin) -> tuple[str, str | None]:
         return join.name, join.new_key
+
+    def _library_rights(self, session: Session, name: str | None) -> LibraryRights:
+        """The trainer changes every slot; a trainee (``name``; None: not joined) only their own."""
+        with self._lock:
+            trainer = id(session) in self._trainer_views
+        return UNRESTRICTED if trainer else LibraryRights.trainee(name, self.library_quota)
 
     def _seed(self) -> int:
         if self._exercise_seed is None:
@@ -325,6 +346,7 @@ class ClassRoom:
             if follow:
                 session.subscribe(lambda change: self._on_change(session, change))
             session.set_hide_truth(self.exercise is not None)
+            session.set_library_rights(self._library_rights(session, join.name))
             if self.exercise == "mystery":
                 self._mount_mystery(session, recorder, join.name)
             self._apply_rules(session)
@@ -360,6 +382,8 @@ class ClassRoom:
             log.exception("ending the gradebook session of %r failed", name)
         with self._lock:
             self._left.append(recorder.status)
+        session.library_rights = self._library_rights(session, None)  # at once: it changes nothing more
+        self._hand_to_loop(session.guard(lambda: session.set_library_rights(session.library_rights)))
         if prompt is not None:         # on the loop, after this callback: no two sessions' locks at once
             self._hand_to_loop(session.guard(lambda: prompt.reopen(message, forget=forget)))
 
@@ -454,6 +478,7 @@ class ClassRoom:
         with self._lock:
             self._trainer_views[id(session)] = view
         self._schedule_tick()
+        session.set_library_rights(UNRESTRICTED)        # the trainer renames and deletes every slot
         return True
 
     def refresh_trainers(self) -> None:

@@ -18,7 +18,8 @@ is widened to the whole window (viser's ``main_panel.set_width``; 1024x768 proje
 - **Exercise**: the class's settings pushed to every trainee (``views.trainer_view``) and the
   exercise's brief (``views.trainer_exercise``);
 - **Message to trainees**: to all or one trainee (``views.trainer_messages``);
-- **Gradebook**: the finished calibrations, the CSV download, grading an uploaded record.
+- **Gradebook**: the finished calibrations, the CSV download, grading an uploaded record;
+- **Tool library (trainer)**: the shared library with the trainer's rights (``views.tool_panel``).
 
 The data: the gradebook (``ClassRoom.board``) plus who is connected (``ClassRoom.connected_names``);
 the class room re-renders every dashboard, throttled (``ClassRoom.refresh_trainers``). Every
@@ -45,6 +46,7 @@ from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.dashboard_replay import ReplayScene
 from tcp_pendant.views.dashboard_table import in_progress_html, trainees_html
 from tcp_pendant.views.gui_util import ButtonEvent, UploadEvent, set_content, set_options, target_of
+from tcp_pendant.views.tool_panel import ToolPanel
 from tcp_pendant.views.trainer_exercise import build_exercise_controls
 from tcp_pendant.views.trainer_messages import build_message_controls
 from tcp_pendant.views.trainer_view import (
@@ -105,6 +107,7 @@ class TrainerDashboard:
     """
 
     # the widgets, set by the folder builders (viser handles)
+    tool_panel: Any
     rules_md: Any
     stuck_min: Any
     table_html: Any
@@ -395,8 +398,16 @@ def gradebook_folder(dash: TrainerDashboard) -> None:
     limit_upload_size(dash.grade_upload, MAX_RECORD_BYTES, dash._refused)
 
 
+def tool_library_folder(dash: TrainerDashboard) -> None:
+    """The shared tool library as the pendant's Tool tab shows it (``views.tool_panel``), with the
+    trainer's rights: rename and delete any trainee's slot (``session.views["tools"]``)."""
+    with dash.folder("Tool library (trainer)", expand_by_default=False):
+        dash.tool_panel = ToolPanel(dash.session)
+    dash.session.views["tools"] = dash.tool_panel
+
+
 FOLDERS: list[Callable[[TrainerDashboard], None]] = [class_folder, chart_folder, trainee_folder, exercise_folder,
-                                                     message_folder, gradebook_folder]
+                                                     message_folder, gradebook_folder, tool_library_folder]
 """The dashboard's folders, top to bottom, each built by one function."""
 
 
