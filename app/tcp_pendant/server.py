@@ -364,7 +364,7 @@ class PendantApp:
                                        instructions=config.exercise_instructions,
                                        allowed_methods=config.exercise_methods,
                                        min_touches=config.exercise_min_touches,
-                                       hand_to_loop=self._hand_to_loop)
+                                       hand_to_loop=self._hand_to_loop, call_later=self._call_later)
 
     @property
     def warnings(self) -> list[str]:
@@ -537,6 +537,15 @@ class PendantApp:
             server.get_event_loop().call_soon_threadsafe(fn)
         except RuntimeError:                     # the loop is closed: the server is stopping
             log.debug("library reload dropped: server stopped")
+
+    def _call_later(self, delay_s: float, fn: Callable[[], object]) -> None:
+        """Run ``fn()`` on viser's event loop after ``delay_s`` seconds (the dashboards' throttle
+        and clock tick; from any thread)."""
+        server = self.server
+        if server is None:
+            raise RuntimeError("the server is not running")
+        loop = server.get_event_loop()
+        loop.call_soon_threadsafe(loop.call_later, max(0.0, delay_s), fn)
 
     def library_changed(self) -> None:
         """Every session re-reads the library (on viser's event loop: the watcher hands it

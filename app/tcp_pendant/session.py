@@ -333,6 +333,17 @@ class Session:
                 except Exception:  # one view must not keep the others from showing the change
                     log.exception("session subscriber %s failed", getattr(fn, "__qualname__", fn))
 
+    def drop_views(self) -> None:
+        """Take the views down (the browser became the trainer's dashboard): they no longer
+        follow the change signal and :attr:`views` forgets them. The session stays open: its
+        lock, :meth:`guard`, :meth:`on_loop` and :meth:`notify` serve what is built next; the
+        caller clears the browser's GUI and scene."""
+        with self.lock:
+            self._subscribers.clear()
+            self.views.clear()
+            self.scene_labels.clear()
+            self.calibrate_container = None
+
     def on_close(self, fn: Callable[[], None]) -> None:
         """Register ``fn()``, called once when the session closes."""
         self._close_callbacks.append(fn)

@@ -82,7 +82,7 @@ def test_trainer_view_needs_the_token_and_shows_the_class_escaped(app_factory, t
                    what="two sessions")
         trainee, trainer = list(app.sessions.values())
         p = trainee.views["identity"]
-        choose(p.name_field, "|Eve| **x**", trainee.client)
+        choose(p.name_field, "|Eve| <i>x</i>", trainee.client)
         click(p.start, trainee.client)
         q = trainer.views["identity"]
         choose(q.token_field, "secret-token-2", trainer.client)
@@ -91,13 +91,15 @@ def test_trainer_view_needs_the_token_and_shows_the_class_escaped(app_factory, t
         choose(q.token_field, "secret-token-1-of-16", trainer.client)
         click(q.open_trainer, trainer.client)
         view = trainer.views["trainer"]
-        md = view.trainees_md.content
-        assert "\\|Eve\\| \\*\\*x\\*\\*" in md and "| yes |" in md
-        # a touch by the trainee updates the trainer's table
+        html = view.table_html.content
+        assert "|Eve| &lt;i&gt;x&lt;/i&gt;" in html and "<i>" not in html       # escaped: shown, not run
+        assert [(r.name, r.connected, r.touches) for r in view.rows] == [("|Eve| <i>x</i>", True, 0)]
+        # a touch by the trainee updates the trainer's table (throttled: within half a second)
         cal = trainee.views["calibrate"]
         click(cal.start, trainee.client)
         click(cal.steps.auto_touch, trainee.client)
-        assert "| 1 | 0 |" in view.trainees_md.content
+        wait_until(lambda: view.rows[0].touches == 1 and view.rows[0].crashes == 0
+                   and view.rows[0].step == "Step 2 of 4", what="the touch in the trainer's table")
         # push the torch to every trainee
         choose(view.tool, "torch", trainer.client)
         click(view.push, trainer.client)
@@ -214,10 +216,10 @@ def test_a_connected_name_and_its_look_alikes_are_refused_until_the_trainer_rele
         choose(q.token_field, "trainer-token-tok-1", trainer.client)
         click(q.open_trainer, trainer.client)
         view = trainer.views["trainer"]
-        assert "Alice" in view.release_name.options
-        choose(view.release_name, "Alice", trainer.client)
+        assert "Alice" in view.trainee.options
+        choose(view.trainee, "Alice", trainer.client)
         click(view.release, trainer.client)
-        assert "Released Alice" in view.release_md.content
+        assert "Released Alice" in view.action_md.content
         wait_until(lambda: pa.name is None and "released the name Alice" in pa.message.content,
                    what="Alice's welcome window again")
         assert pa.key_html is None and pa.marker_html.content == "<div hidden data-tcp-pendant-forget></div>"

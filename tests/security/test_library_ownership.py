@@ -216,6 +216,8 @@ def test_the_trainer_renames_and_deletes_any_trainees_tool_from_the_tool_tab(app
         choose(q.token_field, TOKEN, trainer.client)
         click(q.open_trainer, trainer.client)
         assert "trainer" in trainer.views
+        panel = trainer.views["tools"]                        # the dashboard's own tool library folder
+        choose(panel.slots, "4: Alice tool", trainer.client)
         assert "Saved by trainee Alice." in panel.slot_md.content
         choose(panel.new_name, "checked by the trainer", trainer.client)
         click(panel.rename, trainer.client)
