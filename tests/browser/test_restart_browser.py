@@ -54,8 +54,13 @@ class TrainerSocket(DrainingClient):
                     self.inputs[str(props["label"])] = m["uuid"]
                 elif kind == "GuiMarkdownMessage":
                     self.texts[m["uuid"]] = str(props.get("_markdown", ""))
-                elif kind == "GuiUpdateMessage" and "_markdown" in (m.get("updates") or {}):
-                    self.texts[m["uuid"]] = str(m["updates"]["_markdown"])
+                elif kind == "GuiHtmlMessage":                  # the dashboard's tables
+                    self.texts[m["uuid"]] = str(props.get("content", ""))
+                elif kind == "GuiUpdateMessage":
+                    updates = m.get("updates") or {}
+                    for key in ("_markdown", "content"):
+                        if key in updates:
+                            self.texts[m["uuid"]] = str(updates[key])
 
     def send_value(self, label: str, value: Any) -> None:
         wait_until(lambda: label in self.inputs, what=f"the trainer's {label!r}")
@@ -149,7 +154,7 @@ def test_a_killed_server_gives_the_trainees_calibration_back(pendant_server, new
     try:
         trainer.open_trainer_view()
         try:
-            wait_until(lambda: trainer.text_with(r"(?s)Anna.*XYZ.*Step 3 of 4") is not None,
+            wait_until(lambda: trainer.text_with(r"(?s)Anna.*XYZ.*3/4") is not None,
                        what="Anna's calibration in progress in the trainer view")
         except AssertionError:
             print("the trainer's texts naming Anna:", trainer.text_with("Anna"))
