@@ -37,6 +37,7 @@ from tcp_pendant.addresses import network_urls
 from tcp_pendant.job_pool import JobPool
 from tcp_pendant.classroom.class_room import ClassRoom
 from tcp_pendant.classroom.gradebook import Gradebook
+from tcp_pendant.pendant.library_rights import DEFAULT_LIBRARY_QUOTA
 from tcp_pendant.controller import (
     BeamDevice,
     ControllerError,
@@ -101,6 +102,8 @@ class AppConfig:
         exercise: None (free practice) or "mystery" (each trainee gets a mystery tool).
         exercise_seed: seed of the mystery tools (None: the class's secret seed, drawn once and
             kept in the gradebook; a number: that seed, for a reproducible demo).
+        library_quota: in a class, the tool-library slots one trainee may hold (1..16; each
+            trainee renames and deletes only their own, ``pendant.library_rights``).
         exercise_instructions, exercise_methods, exercise_min_touches: the exercise's brief at
             start (``ClassRoom``: instructions as plain text, the wizard kinds trainees may
             start, the fewest touches a Finish takes); None: the brief kept in the gradebook.
@@ -136,6 +139,7 @@ class AppConfig:
     trainer_token: str | None = None
     exercise: str | None = None
     exercise_seed: int | None = None
+    library_quota: int = DEFAULT_LIBRARY_QUOTA
     exercise_instructions: str | None = None
     exercise_methods: tuple[str, ...] | None = None
     exercise_min_touches: int | None = None
@@ -359,10 +363,11 @@ class PendantApp:
             self.classroom = ClassRoom(self.gradebook, tools,
                                        trainer_token=config.trainer_token,
                                        exercise=config.exercise, exercise_seed=config.exercise_seed,
+                                       library_quota=config.library_quota,
                                        instructions=config.exercise_instructions,
                                        allowed_methods=config.exercise_methods,
                                        min_touches=config.exercise_min_touches,
-                                       hand_to_loop=self._hand_to_loop)
+                                       hand_to_loop=self._hand_to_loop, call_later=self._call_later)
 
     @property
     def warnings(self) -> list[str]:
@@ -536,6 +541,15 @@ class PendantApp:
         except RuntimeError:                     # the loop is closed: the server is stopping
             log.debug("library reload dropped: server stopped")
 
+    def _call_later(self, delay_s: float, fn: Callable[[], object]) -> None:
+        """Run ``fn()`` on viser's event loop after ``delay_s`` seconds (the dashboards' throttle
+        and clock tick; from any thread)."""
+        server = self.server
+        if server is None:
+            raise RuntimeError("the server is not running")
+        loop = server.get_event_loop()
+        loop.call_soon_threadsafe(loop.call_later, max(0.0, delay_s), fn)
+
     def library_changed(self) -> None:
         """Every session re-reads the library (on viser's event loop: the watcher hands it
         over); their views re-render on the change signal."""
@@ -545,18 +559,25 @@ class PendantApp:
     # ------------------------------------------------------------ life cycle
     def start(self) -> str:
         """Start serving; returns the URL."""
-        import viser
-
         host = self.config.host
         origin_check.enable()               # foreign web pages' websockets are refused (403)
         viser_adapter.install()             # every browser message checked before viser's handlers
         client_script.script_asset()        # the page's own script (keys, name, trainer URL): packaged?
+        with origin_check.starting():       # requests get 503 "starting" until mark_ready
+            self._start_serving(host)
+        return self.url
+
+    def _start_serving(self, host: str) -> None:
+        """The viser server, its policies, page script and session handlers; then ready."""
+        import viser
+
         self.server = viser.ViserServer(host=host, port=self.config.port, verbose=False)
         origin_check.allow(self.port, self.allow_origins,
                            origin_check.served_hosts(host, self.network_urls, self.allow_origins))
         origin_check.set_http_layer(self.port, client_script.serve)
         if self.config.port != 0 and self.port != self.config.port:
             # viser silently moves on to the next free port; the class was told this one
+            origin_check.forget(self.port)
             self.server.stop()
             self.server = None
             raise PortInUseError(host, self.config.port)
@@ -572,7 +593,7 @@ class PendantApp:
         self.server.on_client_disconnect(self._on_disconnect)
         self._watcher = threading.Thread(target=self._watch_library, name="library-watcher", daemon=True)
         self._watcher.start()
-        return self.url
+        origin_check.mark_ready(self.port)  # until now every request got 503 "starting"
 
     @property
     def trainer_url(self) -> str | None:

@@ -76,6 +76,7 @@ from tcp_pendant.job_pool import JobPool, default_pool
 from tcp_pendant.pendant import Jogger, touch_label
 from tcp_pendant.pendant.class_messages import MAX_WAITING_MESSAGES, ClassMessage
 from tcp_pendant.pendant.exercise_rules import FREE_PRACTICE, ExerciseRules, RuleRefusal
+from tcp_pendant.pendant.library_rights import UNRESTRICTED, LibraryRights
 from tcp_pendant.wizards import Wizard, WizardResult, WizardStateError, wizard_class, wizard_classes
 
 if TYPE_CHECKING:
@@ -249,6 +250,11 @@ class Session:
         """The library's tools as this session last read them (slot -> tool)."""
         self.library_error: str | None = None
         """Why the library could not be read at the last :meth:`reload_library` (None: it was)."""
+        self.library_owners: dict[int, str] = {}
+        """Who owns each owned slot, as this session last read it (a class's trainees)."""
+        self.library_rights: LibraryRights = UNRESTRICTED
+        """How this pendant may change the library (``pendant.library_rights``; the classroom
+        sets it with :meth:`set_library_rights`)."""
         self.scenario: Scenario = Scenario()
         """The systematic error played (training; off by default); change it with :meth:`set_scenario`."""
         self.scenario_world: ScenarioWorld | None = None
@@ -334,6 +340,17 @@ class Session:
                     fn(change)
                 except Exception:  # one view must not keep the others from showing the change
                     log.exception("session subscriber %s failed", getattr(fn, "__qualname__", fn))
+
+    def drop_views(self) -> None:
+        """Take the views down (the browser became the trainer's dashboard): they no longer
+        follow the change signal and :attr:`views` forgets them. The session stays open: its
+        lock, :meth:`guard`, :meth:`on_loop` and :meth:`notify` serve what is built next; the
+        caller clears the browser's GUI and scene."""
+        with self.lock:
+            self._subscribers.clear()
+            self.views.clear()
+            self.scene_labels.clear()
+            self.calibrate_container = None
 
     def on_close(self, fn: Callable[[], None]) -> None:
         """Register ``fn()``, called once when the session closes."""
@@ -472,38 +489,54 @@ class Session:
         with self.lock:
             try:
                 tools = self.library.tools()
+                owners = self.library.owners()
             except TcpcalError as exc:  # e.g. permissions: ToolLibraryError names the file
-                tools, self.library_error = {}, str(exc)
+                tools, owners, self.library_error = {}, {}, str(exc)
             else:
                 self.library_error = None
             self.library_tools = dict(tools)
+            self.library_owners = dict(owners)
             self.changed(library=True)
             return self.library_tools
+
+    def set_library_rights(self, rights: LibraryRights) -> None:
+        """How this pendant may change the library from now on (a class: the trainee's slots
+        only; ``pendant.library_rights``)."""
+        with self.lock:
+            self.library_rights = rights
+            self.changed(library=True)
 
     def store_tool(self, slot: int, tool: Tool) -> None:
         """Write ``tool`` into ``slot`` of the library (numeric entry) and re-read the list.
 
         Raises:
-            tcpcal.TcpcalError: the library refused (the name is in another slot, ...).
+            tcpcal.TcpcalError: the library refused (the name is in another slot, the slot is
+                another trainee's, the trainee's quota is full, ...).
         """
         with self.lock:
-            self.library.save(int(slot), tool)
+            rights = self.library_rights
+            with rights.in_words():
+                self.library.save(int(slot), tool, **rights.save_kwargs())
             self.reload_library()
 
     def rename_tool(self, slot: int, name: str) -> None:
-        """Rename the library tool in ``slot``; the active data carries the new name when it is
-        that slot's. One signal."""
+        """Rename the library tool in ``slot`` (a trainee: one of theirs); the active data
+        carries the new name when it is that slot's. One signal."""
         with self.lock, self.batch():
-            self.library.rename(int(slot), name)
+            rights = self.library_rights
+            with rights.in_words():
+                self.library.rename(int(slot), name, **rights.owner_kwargs())
             self.reload_library()
             renamed = self.library_tools.get(int(slot))
             if self.active_slot == int(slot) and renamed is not None:
                 self.set_active_data(renamed, int(slot))
 
     def delete_tool(self, slot: int) -> None:
-        """Delete the library tool in ``slot`` and re-read the list."""
+        """Delete the library tool in ``slot`` (a trainee: one of theirs) and re-read the list."""
         with self.lock:
-            self.library.remove(int(slot))
+            rights = self.library_rights
+            with rights.in_words():
+                self.library.remove(int(slot), **rights.owner_kwargs())
             self.reload_library()
 
     def notify(self, title: str, body: str, *, kind: str = "info") -> None:

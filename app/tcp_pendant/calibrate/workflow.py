@@ -39,6 +39,7 @@ from tcp_pendant.calibrate.jobs import EXERCISE_REFUSAL, JOBS, POSE_CHECKS, Cont
 from tcp_pendant.calibrate.diversity import failure_in_words
 from tcp_pendant.calibrate.library_save import save_result
 from tcp_pendant.pendant.exercise_rules import RuleRefusal
+from tcp_pendant.pendant.library_rights import UNRESTRICTED
 from tcp_pendant.events import (
     RunCancelled,
     RunFinished,
@@ -699,7 +700,8 @@ class CalibrationWorkflow:
         name = str(name).strip()
         if not name:
             raise WizardStateError("Type a name for the tool before saving.")
-        slot_tool = save_result(w, self.library, name, slot)
+        rights = getattr(self.state, "library_rights", UNRESTRICTED)   # the session's, when it has them
+        slot_tool = save_result(w, self.library, name, slot, rights)
         self.state.apply_saved(*slot_tool)
         self.last_save = slot_tool
         if self._current is not None and w.result is not None:

@@ -201,7 +201,7 @@ class BeamCheckView:
             raise ValueError("The active tool changed since the check; check the active tool again before "
                              "Update.")
         before = check.stored_tool
-        tool = update_tool_from_beam(s.library, check.slot, check)
+        tool = update_tool_from_beam(s.library, check.slot, check, s.library_rights)
         self.last_check = None
         s.apply_saved(check.slot, tool)                    # one signal: library re-read, active data
         self.result_md.content = beam_check_markdown(check) + "\n\n" + update_markdown(check.slot, before, tool)

@@ -217,8 +217,22 @@ class ToolPanel:
     def _show_slot(self) -> None:
         slot = number_of_option(self.slots.value)
         tool = None if slot is None else self._library.get(slot)
-        self.slot_md.content = "" if tool is None else tool_data_markdown(tool, slot).replace(
-            "**Active tool:**", "**Selected:**")
+        self.slot_md.content = "" if tool is None or slot is None else tool_data_markdown(tool, slot).replace(
+            "**Active tool:**", "**Selected:**") + self._owner_line(slot)
+
+    def _owner_line(self, slot: int) -> str:
+        """Whose the selected slot is (a class): a trainee reads "yours" or "not yours" (no
+        classmate's name), the trainer the owner's name (escaped)."""
+        s = self.session
+        rights, owner = s.library_rights, s.library_owners.get(slot)
+        if rights.restricted:
+            if rights.mine(s.library_owners, slot):
+                return "\n\nYours: you can rename and delete it."
+            whose = "another trainee's" if owner is not None else "the trainer's"
+            return f"\n\nThis slot is {whose}: activate and check it; you cannot change it."
+        if owner is not None:
+            return f"\n\nSaved by trainee {escape_markdown(owner)}."
+        return ""
 
     def _show_mounted(self) -> None:
         label = self.session.controller.mounted_tool.label
@@ -367,7 +381,11 @@ class ToolPanel:
         if errors or res.tool is None or slot is None:
             self.entry_md.content = "⚠ Not saved: correct the fields marked above."
             return
-        self.session.store_tool(slot, res.tool)
+        try:
+            self.session.store_tool(slot, res.tool)
+        except ValueError as exc:       # e.g. another trainee's slot, a full quota: said here too
+            self.entry_md.content = f"⚠ Not saved: {escape_markdown(str(exc))}"
+            raise
         self.entry_md.content = f"✔ Saved **{escape_markdown(res.tool.name)}** in slot {slot}."
         set_value(self.slots, slot_option(slot, res.tool.name))
         self._show_slot()

@@ -31,6 +31,8 @@ from tcp_pendant.calibrate.text import (
     steps_list_markdown,
 )
 from tcp_pendant.job_pool import JobRefused
+from tcp_pendant.pendant.guidance import tip_offset_mm
+from tcp_pendant.pendant.touch_feedback import touch_feedback
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.gui_util import ButtonEvent, DropdownEvent, set_content, set_value, target_of
 from tcp_pendant.wizards import Wizard, WizardStateError
@@ -62,6 +64,7 @@ class WizardStepsView:
             self.mount = gui.add_button("Mount the tool", color="orange", visible=False,
                                         hint="The tool change this step asks for (the app swaps the tool).")
             self.record = gui.add_button("Record", color="green", hint="Store the current flange pose for this step.")
+            self.record_md = gui.add_markdown("")
             self.next = gui.add_button("Next", color="blue")
             self.back = gui.add_button("Back", color="gray")
             self.add_point = gui.add_button("Add point", visible=False,
@@ -84,7 +87,7 @@ class WizardStepsView:
                 self.auto_md = gui.add_markdown("")
         act = parent.action
         session = parent.session
-        self.record.on_click(act(lambda _e: session.record_step()))
+        self.record.on_click(act(self._on_record))
         self.next.on_click(self._on_next)
         self._checking = False
         self._busy_text = ""
@@ -97,8 +100,26 @@ class WizardStepsView:
         self.auto_touch.on_click(self._on_auto_touch)
         self._auto_touching = False
         self._auto_line: tuple[tuple[Any, ...], str, Any] | None = None  # (where it belongs, text, poses)
+        self._record_line: tuple[tuple[Any, ...], str, Any] | None = None  # the same, for Record
 
     # ------------------------------------------------------------ callbacks
+    def _on_record(self, _event: ButtonEvent) -> None:
+        """Record the step. In free practice with the distance hidden the line below says how
+        far the touch really was (``touch_feedback``, the dock's words); never in an exercise."""
+        s = self.parent.session
+        wiz = self.parent.workflow.wizard
+        index = None if wiz is None else wiz.step.index
+        frame = s.jogger.settings.frame
+        delta = tip_offset_mm(s.pose_state(), s.controller.reference_tip_world_m, frame)
+        s.record_step()
+        self._record_line = None
+        if s.hide_distance and not s.rules.in_exercise:
+            wiz = self.parent.workflow.wizard
+            self._record_line = (self._auto_where(),
+                                 f"✔ Step {index + 1 if index is not None else '?'} recorded: "
+                                 f"{touch_feedback(delta, frame)}.",
+                                 None if wiz is None else wiz.recorded_poses)
+
     def _on_cancel(self, _event: ButtonEvent) -> None:
         if self.parent.session.cancel_wizard():
             self.parent.session.notify("Calibration cancelled",
@@ -219,6 +240,10 @@ class WizardStepsView:
         if line is not None and line[0] != self._auto_where():
             self._auto_line = line = None
         set_content(self.auto_md, "" if line is None else line[1])
+        said = self._record_line
+        if said is not None and said[0] != self._auto_where():
+            self._record_line = said = None
+        set_content(self.record_md, "" if said is None else said[1])
 
     # ------------------------------------------------------------ render
     def render(self) -> None:
