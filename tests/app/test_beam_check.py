@@ -42,7 +42,9 @@ class Page(AppPage):
 
 @pytest.fixture
 def page(tmp_path: Path) -> Iterator[Callable[..., Page]]:
-    with app_pages(tmp_path, Page) as make:
+    # seeded: the beam's repeatability noise (about 0.02 mm per axis) comes from the session's
+    # randomness, and the checks below allow 0.05 mm
+    with app_pages(tmp_path, Page, seed=7) as make:
         yield make
 
 
