@@ -24,9 +24,8 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING, Any, TypedDict
 
-import numpy as np
 
-from tcp_pendant.calibrate import error_bars
+from tcp_pendant.calibrate.chart import CHART_LEGEND, error_axis_top_mm, error_bars
 from tcp_pendant.controller.readout import PoseReadout
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.text_escape import escape_html, escape_markdown
@@ -157,7 +156,7 @@ class PresenterView:
             self.chart = gui.add_uplot(bars.columns, _chart_series(), title="Error per touch (mm)",
                                        height=CHART_HEIGHT_PX, visible=False,
                                        scales={"x": {"time": False}, "y": {"range": (0.0, 1.0)}},
-                                       axes=({"label": "touch"}, {"label": "mm"}))
+                                       axes=({"label": "touch"}, {"label": "mm"}), legend=CHART_LEGEND)
         self._shown: dict[str, str] = {}
         self.panel_width_px = NORMAL_WIDTH_PX
         self._charted: Any = None
@@ -226,5 +225,4 @@ class PresenterView:
         self._charted = res
         bars = error_bars([i + 1 for i in used], errors, [i + 1 for i in getattr(res, "outliers", ())])
         self.chart.data = bars.columns
-        top = float(np.max(errors))
-        self.chart.scales = {"x": {"time": False}, "y": {"range": (0.0, max(1.2 * top, 1e-3))}}
+        self.chart.scales = {"x": {"time": False}, "y": {"range": (0.0, error_axis_top_mm(errors))}}
