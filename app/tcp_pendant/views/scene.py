@@ -285,7 +285,7 @@ class SceneView:
         scene.add_grid("/floor", width=3.0, height=3.0, cell_size=0.1, section_size=0.5,
                        plane="xy", position=(0.0, 0.0, 0.0))
         scene.add_frame("/world", axes_length=0.25, axes_radius=0.006)
-        scene.add_label("/world/label", "WORLD", position=(0.0, 0.0, -0.04))
+        self._world_label = scene.add_label("/world/label", "WORLD", position=(0.0, 0.0, -0.04))
 
         meshes = link_meshes(k.description)
         state = session.pose_state()
@@ -326,6 +326,7 @@ class SceneView:
         self._tip_label = scene.add_label("/reference_tip_label", "reference tip",
                                           position=tuple(c.reference_tip_world_m + [0.0, 0.0, -0.06]))
         session.scene_labels.update(self.tool_labels())     # the wizards' scene moves them apart
+        session.scene_labels["world"] = self._world_label   # restyled with them (presenter mode)
         self.beam_stand = BeamStandNodes(scene, c.beam_sensor)
 
         wxyz, xyz = wxyz_xyz(state.T_world_tcp)

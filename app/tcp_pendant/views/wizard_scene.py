@@ -96,10 +96,11 @@ class WizardSceneView:
         self._label_defaults: dict[str, tuple[viser.LabelHandle, tuple[float, float, float]]] = {}
         self._labels_moved = False
         self._target_T: np.ndarray | None = None
-        self.label_scale = 1.0
-        """``font_screen_scale`` of the labels near the tip (presenter mode sets it larger)."""
         self._camera_watched: set[int] = set()
         self._relayout = session.on_loop(self._on_camera)
+        # in the session's labels too, so a view that restyles the scene's labels (presenter
+        # mode: larger) reaches these; the boxes are spread at the size they are drawn
+        session.scene_labels.update(computed=self.computed_label, true=self.true_label, target=self.abc_label)
 
     # ------------------------------------------------------------ result
     def _has_sphere(self) -> bool:
@@ -326,17 +327,6 @@ class WizardSceneView:
         if self._labels_moved and (self.workflow.is_open or self.workflow.result is not None):
             self.layout_labels()
 
-    def set_label_scale(self, scale: float) -> None:
-        """Draw the labels near the tip at ``font_screen_scale`` ``scale`` (presenter mode) and
-        move them apart for that size."""
-        self.label_scale = float(scale)
-        for handle in self.session.scene_labels.values():
-            handle.font_screen_scale = self.label_scale
-        for handle in (self.computed_label, self.true_label, self.abc_label):
-            handle.font_screen_scale = self.label_scale
-        if self._labels_moved:
-            self.layout_labels()
-
     def layout_labels(self) -> None:
         """Move the labels at the tip apart as seen by the (first) browser's camera now, or by
         the last result's framing when no camera has been reported."""
@@ -356,7 +346,8 @@ class WizardSceneView:
                 local = np.asarray(self.session.controller.reference_tip_world_m, dtype=float) + [0.0, 0.0, -0.06]
             anchors[name] = local if T is None else T[:3, :3] @ local + T[:3, 3]
         texts = {n: str(getattr(nodes[n][0], "text", None) or _LABEL_TEXTS[n]) for n in anchors}
-        placed = spread_labels(framing, anchors, texts, font_scale=self.label_scale)
+        scale = max((float(getattr(nodes[n][0], "font_screen_scale", 1.0) or 1.0) for n in anchors), default=1.0)
+        placed = spread_labels(framing, anchors, texts, font_scale=scale)
         for name, world in placed.items():
             handle, T = nodes[name]
             local = world if T is None else T[:3, :3].T @ (world - T[:3, 3])
