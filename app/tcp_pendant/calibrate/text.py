@@ -124,7 +124,7 @@ def where_to_jog_markdown(wizard: Wizard) -> str:
     controller runs itself (a beam scan: Finish is pressed here)."""
     if wizard.is_complete or wizard.auto_role(wizard.step).by_controller:
         return ""
-    return ("➜ **Jog on the Jog tab** to do this step. Then press **Record** there, in the "
+    return ("→ **Jog on the Jog tab** to do this step. Then press **Record** there, in the "
             "*Calibration step* box above the jog keys (key R), or here.")
 
 
