@@ -201,8 +201,10 @@ class Session:
         ready_q_rad: the "Ready pose" button's joint angles (None: the robot's HOME).
         views: named view objects (``"scene"``, ``"pendant"``, ``"tools"``, ...), for tests
             only: app code never looks a view up through it.
-        scene_labels: the scene's labels at the tool and the tip (``"flange"``, ``"tool"``,
-            ``"tip"``: viser label handles), which the wizards' scene places apart.
+        scene_labels: the scene's labels (viser label handles): at the tool and the tip
+            (``"flange"``, ``"tool"``, ``"tip"``), which the wizards' scene places apart, and
+            ``"world"``, ``"computed"``, ``"true"``, ``"target"``; presenter mode draws them all
+            larger.
         hide_distance: "Hide distance" (training: judge the touch by eye); change it with
             :meth:`set_hide_distance`. While it is on, a jog does not stop at the reference tip.
         rules: what the trainer's exercise allows (``pendant.exercise_rules``), with its

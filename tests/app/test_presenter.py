@@ -1,6 +1,7 @@
 """Presenter mode: the GUI checkbox and ``--presenter`` change what is
 rendered: a readout in >= 28 px monospace numbers, the running wizard's step list with the
-current step marked, the per-touch error chart tall, a narrower panel; user text escaped."""
+current step marked, the per-touch error chart, a narrower panel, larger scene labels; user
+text escaped."""
 
 from __future__ import annotations
 
@@ -18,7 +19,9 @@ from tcp_pendant.cli import build_parser
 from tcp_pendant.controller.readout import PoseReadout
 from tcp_pendant.views.presenter import (
     CHART_HEIGHT_PX,
+    LABEL_SCALE,
     NORMAL_WIDTH_PX,
+    READOUT_FONT_PX,
     PRESENTER_WIDTH_PX,
     presenter_readout_markdown,
     presenter_steps_markdown,
@@ -45,13 +48,18 @@ def test_the_checkbox_switches_presenter_mode_and_its_large_readout(app_factory)
         view = s.views["presenter"]
         assert view.toggle.value is False and not view.folder.visible
         assert view.readout_md.content == ""                 # nothing rendered while off
+        labels = s.scene_labels
+        assert {"world", "flange", "tool", "tip", "computed", "true", "target"} <= set(labels)
+        assert all(h.font_screen_scale == 1.0 for h in labels.values())
         choose(view.toggle, True, s.client)
         assert view.folder.visible and view.panel_width_px == PRESENTER_WIDTH_PX
+        assert LABEL_SCALE >= 1.5 and all(h.font_screen_scale == LABEL_SCALE for h in labels.values())
         md = view.readout_md.content
         assert _font_px(md, "presenter-readout") >= 28 and "font-family:monospace" in md
         r = s.pose_state().readout("WORLD")
-        for name, v in (("X", r.x_mm), ("Z", r.z_mm), ("A", r.a_deg)):
+        for name, v in (("X", r.x_mm), ("Z", r.z_mm)):
             assert f"{name}&nbsp;" + f"{v:8.2f}".replace(" ", "&nbsp;") in md
+        assert f"A&nbsp;{r.a_deg:.2f}&nbsp;&nbsp;B&nbsp;{r.b_deg:.2f}" in md      # A B C on one smaller line
         dist = f"{s.pose_state().touch.distance_mm:.2f}"
         assert dist in md
         # the readout follows a jog
@@ -64,6 +72,7 @@ def test_the_checkbox_switches_presenter_mode_and_its_large_readout(app_factory)
         assert dist not in view.readout_md.content and "hidden" in view.readout_md.content
         choose(view.toggle, False, s.client)
         assert not view.folder.visible and view.panel_width_px == NORMAL_WIDTH_PX
+        assert all(h.font_screen_scale == 1.0 for h in labels.values())
     finally:
         c.close()
 
@@ -82,7 +91,8 @@ def test_presenter_step_list_marks_the_current_step_and_the_chart_is_tall(app_fa
         md = view.steps_md.content
         assert _font_px(md, "presenter-steps") >= 18
         titles = [st.title for st in wiz.steps]
-        assert all(t in md for t in titles) and md.count("<br>") >= len(titles)
+        at = [md.index(f"{k + 1}. {t}") for k, t in enumerate(titles)]
+        assert at == sorted(at) and md.count('white-space:nowrap') == len(titles)   # in order, none split
         assert f'<b class="current-step">▶ 1. {titles[0]}</b>' in md
         assert not view.chart.visible
         for _ in range(8):
@@ -95,7 +105,6 @@ def test_presenter_step_list_marks_the_current_step_and_the_chart_is_tall(app_fa
         res = cal.workflow.result
         assert res is not None and '<b class="current-step">▶ Result</b>' in view.steps_md.content
         assert view.chart.visible and view.chart.height == CHART_HEIGHT_PX
-        assert CHART_HEIGHT_PX > cal.result.chart.height
         assert list(view.chart.data[1][:len(res.per_touch_error_mm)]) == pytest.approx(res.per_touch_error_mm, abs=1e-9)  # exact touches: errors ~1e-11 mm
     finally:
         c.close()
@@ -104,7 +113,7 @@ def test_presenter_step_list_marks_the_current_step_and_the_chart_is_tall(app_fa
 def test_presenter_markdown_escapes_text_and_formats_numbers_only() -> None:
     md = presenter_readout_markdown(PoseReadout("WORLD<script>", 525.0, -0.004, 400.0, 180.0, 0.0, -90.0), None)
     assert "<script>" not in md and "&lt;script&gt;" in md and "hidden" in md
-    assert _font_px(md, "presenter-readout") == 32
+    assert _font_px(md, "presenter-readout") == READOUT_FONT_PX >= 28
 
     class Step:
         def __init__(self, i: int, title: str, recorded: bool) -> None:

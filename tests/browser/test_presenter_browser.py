@@ -11,6 +11,11 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).parent))
 from pendant_page import TIMEOUT_MS, assert_not_blank, press, wait_text  # noqa: E402
+from test_wizards_browser import wait_text as wait_visible_text  # noqa: E402
+
+sys.path.insert(0, str(Path(__file__).parents[1] / "app"))
+from app_page import running_pendants  # noqa: E402
+from tcp_pendant.calibrate import AutoTouchRequest  # noqa: E402
 
 pytestmark = pytest.mark.browser
 
@@ -60,3 +65,77 @@ def test_presenter_mode_at_1024x768(pendant_server, new_page, shot) -> None:
     page.set_viewport_size({"width": 1400, "height": 900})
     page.wait_for_timeout(500)
     shot(page, "presenter_1400x900")
+
+
+# Every text uPlot writes on a canvas (its tick labels are drawn, not DOM), per canvas, since
+# the canvas was last cleared whole (a redraw starts with clearRect of the whole canvas).
+_RECORD_CANVAS_TEXT = """
+(() => {
+  const P = CanvasRenderingContext2D.prototype, fill = P.fillText, clear = P.clearRect;
+  window.__canvasTexts = new Map();
+  P.clearRect = function (x, y, w, h) {
+    if (x <= 0 && y <= 0 && w >= this.canvas.width && h >= this.canvas.height) window.__canvasTexts.set(this.canvas, []);
+    return clear.apply(this, arguments);
+  };
+  P.fillText = function (text) {
+    const list = window.__canvasTexts.get(this.canvas) || [];
+    list.push(String(text));
+    window.__canvasTexts.set(this.canvas, list);
+    return fill.apply(this, arguments);
+  };
+})();
+"""
+
+
+def _presenter_folder(page):
+    return page.locator(".presenter-readout").first.locator(
+        "xpath=ancestor::div[contains(@class,'mantine-Paper-root')][1]")
+
+
+def test_presenter_block_stays_pinned_with_its_chart_above_the_fold(tmp_path, new_page, shot) -> None:
+    """1024x768, ``--shared --presenter``, a 4-point result of exact Auto-touches (all errors
+    ~0; driven on the in-process server, as the Calibrate tab's buttons do): the panel scrolled
+    to the wizard's buttons, the presenter block is still at the top, its chart inside the
+    viewport with distinct tick labels and a legend without '--' placeholders; the Close button
+    shows below the block, nothing sticks out at the side."""
+    with running_pendants(tmp_path) as start:
+        app = start(shared=True, presenter=True)
+        page = new_page(app.url, width=1024, height=768, wait_for="")
+        page.add_init_script(_RECORD_CANVAS_TEXT)
+        page.reload()
+        _check_pinned_block(app, page, shot)
+
+
+def _check_pinned_block(app, page, shot) -> None:
+    page.locator(".presenter-readout").first.wait_for(state="visible", timeout=TIMEOUT_MS)
+    folder = _presenter_folder(page)
+    page.get_by_role("tab", name="Calibrate").click()
+    s = app.shared_session
+    s.start_wizard("xyz4")
+    for _ in range(4):
+        assert s.auto_touch(AutoTouchRequest()).ok
+    wait_visible_text(page, "Against the true TOOL frame: good")
+    chart = folder.locator(".uplot-container").first
+    chart.locator("canvas").first.wait_for(state="visible", timeout=TIMEOUT_MS)
+    top_before = folder.bounding_box()["y"]
+    close = page.get_by_role("button", name="Close (not saved)", exact=True).filter(visible=True).first
+    close.evaluate("e => e.scrollIntoView({block: 'end'})")
+    page.wait_for_timeout(500)
+    scrolled = float(page.locator(".mantine-ScrollArea-viewport").first.evaluate("e => e.scrollTop"))
+    assert scrolled > 100.0, "the panel did not scroll"
+    box, c_box, b_box = folder.bounding_box(), chart.locator("canvas").first.bounding_box(), close.bounding_box()
+    assert 40.0 <= box["y"] <= top_before + 2.0, (box, top_before)          # pinned at the top
+    assert c_box["y"] >= 0 and c_box["y"] + c_box["height"] <= 768, c_box   # the chart above the fold
+    assert b_box["y"] >= box["y"] + box["height"] - 1 and b_box["y"] + b_box["height"] <= 769   # Close shows
+    assert b_box["x"] + b_box["width"] <= 1024 and box["x"] + box["width"] <= 1024        # nothing off the side
+    legend = chart.locator(".u-legend").first.inner_text()
+    assert "error (mm)" in legend and "--" not in legend, legend
+    ticks = chart.evaluate("""e => {
+        const c = e.querySelector('canvas');
+        return (window.__canvasTexts.get(c) || []).slice();
+    }""")
+    numbers = [t for t in ticks if t.strip().replace(".", "", 1).isdigit()]
+    y_ticks = [t for t in numbers if float(t) < 1.0 or t == "0"]
+    print("presenter chart labels:", ticks)
+    assert len(y_ticks) >= 2 and len(set(numbers)) == len(numbers), ticks   # no "0.001, 0.001, 0.001, 0"
+    assert_not_blank(shot(page, "presenter_pinned_1024x768"))

@@ -8,7 +8,7 @@ import re
 import numpy as np
 import pytest
 from tcp_pendant.calibrate import error_bars
-from tcp_pendant.calibrate.chart import BAR_HALF_WIDTH
+from tcp_pendant.calibrate.chart import BAR_HALF_WIDTH, error_axis_top_mm
 from tcp_pendant.calibrate.text import (
     comparison_markdown,
     menu_markdown,
@@ -179,3 +179,15 @@ def test_replay_table_has_one_row_per_wizard() -> None:
     rows = table_rows(replay_markdown([check]))
     assert rows[-1] == ["1", escape_markdown("XYZ 4-point"), "✔ replayed result matches the record", "–"]
     assert re.fullmatch(r"[-| ]+", replay_markdown([check]).splitlines()[1])
+
+
+@pytest.mark.parametrize(("errors", "top"), [([0.0, 0.0, 0.0, 0.0], 0.01), ([0.31, 0.12], 0.5),
+                                             ([0.9], 2.0), ([0.004], 0.01), ([0.05, 0.01], 0.1), ([], 0.01)])
+def test_error_axis_top_is_round_and_leaves_the_ticks_apart(errors: list[float], top: float) -> None:
+    got = error_axis_top_mm(errors)
+    assert got == pytest.approx(top)
+    assert got >= 1.2 * max(errors, default=0.0)
+    # uPlot writes ticks with at most 3 decimals; its finest step on this axis (a tenth of it)
+    # must still read as distinct numbers
+    ticks = [f"{k * got / 10:.3f}" for k in range(11)]
+    assert len(set(ticks)) == 11, ticks

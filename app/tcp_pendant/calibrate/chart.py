@@ -12,13 +12,39 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-__all__ = ["BAR_HALF_WIDTH", "ErrorBars", "error_bars"]
+if TYPE_CHECKING:                      # the option's type only: this module does not import viser
+    from viser.uplot import Legend
+
+__all__ = ["BAR_HALF_WIDTH", "CHART_LEGEND", "MIN_TOP_MM", "ErrorBars", "error_bars", "error_axis_top_mm"]
 
 BAR_HALF_WIDTH = 0.3
 """Half the width of a bar, in touch numbers (bars are 0.6 wide, 0.4 apart)."""
+
+CHART_LEGEND: Legend = {"live": False}
+"""uPlot ``legend`` option of the error charts: the series names with their colours, no values
+at the cursor (a live legend reads "touch: -- error (mm): --" until the pointer is on the chart)."""
+
+MIN_TOP_MM = 0.01
+"""The least top of the error axis, mm. uPlot writes its tick labels with at most three
+decimals, so an axis up to 0.001 mm (all errors zero) read "0.001, 0.001, 0.001, 0"; up to
+0.01 mm its ticks are at least 0.001 mm apart and read apart."""
+
+
+def error_axis_top_mm(errors_mm: Sequence[float]) -> float:
+    """Top of the error chart's y axis (mm): 1.2 x the largest error, at least
+    :data:`MIN_TOP_MM`, rounded up to 1, 2 or 5 x 10^k so the ticks fall on round numbers."""
+    e = np.asarray(errors_mm, dtype=float)
+    top = max(1.2 * float(np.max(e)) if e.size and np.all(np.isfinite(e)) else 0.0, MIN_TOP_MM)
+    k = np.floor(np.log10(top))
+    for m in (1.0, 2.0, 5.0, 10.0):
+        nice = float(m * 10.0 ** k)
+        if nice >= top * (1 - 1e-12):
+            return nice
+    return float(10.0 ** (k + 1))
 
 
 @dataclass(frozen=True, eq=False)

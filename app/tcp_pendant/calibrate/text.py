@@ -48,7 +48,9 @@ __all__ = [
     "save_markdown",
     "save_preview_markdown",
     "step_markdown",
+    "scene_legend_markdown",
     "steps_list_markdown",
+    "where_to_jog_markdown",
     "truth_markdown",
     "empty_touches_markdown",
     "warnings_markdown",
@@ -116,6 +118,33 @@ def step_markdown(wizard: Wizard) -> str:
             f"{_esc(step.instruction)}")
 
 
+def where_to_jog_markdown(wizard: Wizard) -> str:
+    """Where a step that is jogged to is done, for the Calibrate tab (the trainee is there
+    after Start, the jog keys are on the Jog tab): "" on the result and on a step the
+    controller runs itself (a beam scan: Finish is pressed here)."""
+    if wizard.is_complete or wizard.auto_role(wizard.step).by_controller:
+        return ""
+    return ("→ **Jog on the Jog tab** to do this step. Then press **Record** there, in the "
+            "*Calibration step* box above the jog keys (key R), or here.")
+
+
+def scene_legend_markdown(*, computed: bool, true: bool, sphere: bool, radius_mm: float | None = None) -> str:
+    """What the result draws in 3D, named (the labels there are short): the COMPUTED and TRUE
+    triads and, for a 4-point result, the fitted sphere (radius mm), its flange points and
+    approach lines. "" when the result draws none of them."""
+    items = []
+    if computed:
+        items.append("**COMPUTED**: the TOOL frame of this result (thick triad)")
+    if true:
+        items.append("**TRUE**: the hidden true TOOL frame (thin, longer triad; training)")
+    if sphere:
+        r = "" if radius_mm is None else f", radius {fmt_num(radius_mm, 1)} mm = |TCP|"
+        items.append(f"**blue wire sphere**: the sphere the flange origins were fitted to (centre: the "
+                     f"reference tip{r}); dots: the flange origins of the touches (red: outlier, grey: "
+                     "dropped); blue lines: from each flange origin toward its TCP")
+    return "" if not items else "**In 3D:** " + " · ".join(items) + "."
+
+
 def steps_list_markdown(wizard: Wizard) -> str:
     """The steps in one line: ✔ recorded, ▶ current, · to do."""
     parts = []
@@ -152,12 +181,13 @@ def meter_level(gain: CandidateGain) -> tuple[float, Literal["red", "yellow", "g
 
 
 def meter_markdown(gain: CandidateGain, quality: PoseQuality | None, sigma_mm: float,
-                   advice_before_determinable: str | None = None) -> str:
+                   advice_before_determinable: str | None = None, tilt_hint: str | None = None) -> str:
     """Live advice while jogging toward the next touch (all figures predicted by tcpcal from the
     orientations alone, for an operator error of ``sigma_mm`` per axis). While recording here
     would still not make the TCP determinable (``gain.predicted_after`` infinite) the advice is
     ``advice_before_determinable`` (``tcp_pendant.calibrate.diversity``: the angle to the
-    nearest touch and the axis still missing, in words) or else ``quality.message`` (tcpcal's)."""
+    nearest touch and the axis still missing, in words) or else ``quality.message`` (tcpcal's).
+    ``tilt_hint`` (``diversity.best_tilt_words``: which way to tilt for the next touch) ends it."""
     head = f"**Pose diversity** (if you recorded here, operator error {fmt_num(sigma_mm, 1)} mm):"
     if gain.too_close:
         advice = (f"⚠ **Too close** to an earlier touch: {_deg(gain.angle_to_nearest_deg, 0)} apart. "
@@ -174,7 +204,8 @@ def meter_markdown(gain: CandidateGain, quality: PoseQuality | None, sigma_mm: f
                   f"**{_mm(gain.predicted_after)}** ({-100.0 * gain.reduction:+.0f} %).")
     near = ("" if math.isinf(gain.angle_to_nearest_deg) or advice_before_determinable else
             f"\n\nNearest recorded orientation: {_deg(gain.angle_to_nearest_deg, 0)} away.")
-    return f"{head}\n\n{advice}{near}"
+    hint = f"\n\n{tilt_hint}" if tilt_hint else ""
+    return f"{head}\n\n{advice}{near}{hint}"
 
 
 def result_markdown(result: WizardResult, truth: TruthComparison | None = None) -> str:

@@ -27,6 +27,14 @@
  * 3. /?trainer=TOKEN: the token is taken from the address, dropped from the address bar at once
  *    (history.replaceState) and typed into "Trainer token" + "Open trainer view" of each welcome
  *    window of this page (kept in memory only, for reconnects).
+ * 4. Presenter mode: the folder holding the readout (class "presenter-readout", which only
+ *    views/presenter.py writes) is pinned at the top of the panel while the panel scrolls
+ *    (position: sticky; viser 1.1 has no sticky GUI element). Its ancestors up to the panel's
+ *    scroll area that clip with overflow: hidden are set to overflow: clip, which clips the same
+ *    but is no scroll container (a sticky element sticks to its nearest scroll container), with
+ *    min-width 0 (a clipping flex item would otherwise grow with its content, and the error
+ *    chart, which takes its container's width, would grow without end); the scroll area itself
+ *    no longer scrolls sideways (what those ancestors cut off stays cut off).
  */
 (function () {
   "use strict";
@@ -320,6 +328,30 @@
     buttonsNamed(L.record).concat(buttonsNamed(L.recordPoint)).forEach(function (b) { setTitle(b, "Key R"); });
   }
 
+  var PIN_CLASS = "presenter-readout";
+  function pinPresenter() {
+    var marker = document.querySelector("." + PIN_CLASS);
+    var folder = marker && marker.closest(".mantine-Paper-root");
+    if (!folder || folder.getAttribute("data-tcp-pendant-pinned") === "1") return;
+    var viewport = folder.closest(".mantine-ScrollArea-viewport");
+    if (!viewport) return;
+    for (var e = folder.parentElement; e && e !== viewport; e = e.parentElement) {
+      var ov = getComputedStyle(e).overflowY;
+      if (ov === "hidden" || ov === "auto" || ov === "scroll") {
+        e.style.overflow = "clip";
+        e.style.minWidth = "0";             // as a scroll container's: a flex item no wider than its box
+      }
+    }
+    viewport.style.overflowX = "hidden";     // what the clipping ancestors cut off stays cut off
+    folder.style.position = "sticky";
+    folder.style.top = "10px";              // the folder's title sits on its top border
+    folder.style.zIndex = "5";
+    folder.style.background = "var(--mantine-color-body, #fff)";
+    // an opaque band over the 10 px above it, and a shadow below: the panel goes on under it
+    folder.style.boxShadow = "0 -12px 0 0 var(--mantine-color-body, #fff), 0 4px 6px -4px rgba(0, 0, 0, 0.35)";
+    folder.setAttribute("data-tcp-pendant-pinned", "1");
+  }
+
   var scheduled = false;
   function schedule() {
     if (scheduled) return;
@@ -327,6 +359,7 @@
     window.setTimeout(function () {
       scheduled = false;
       keyTitles();
+      pinPresenter();
       scan();
     }, 150);
   }

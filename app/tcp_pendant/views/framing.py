@@ -42,12 +42,16 @@ LABEL_HEIGHT_PX = 24.0
 CHAR_WIDTH_PX = 8.5
 """Width per character of a label's text (viser's default sans font at 14 px), plus padding below."""
 _LABEL_PAD_PX = 14.0
+LABEL_GAP_PX = 6.0
+"""Air between two labels moved apart (screen px): boxes that only touch read as one line."""
 _WORLD_UP = np.array([0.0, 0.0, 1.0])
 
 
-def label_box_px(text: str) -> tuple[float, float]:
-    """(width, height) of a label's box on screen, pixels."""
-    return CHAR_WIDTH_PX * len(text) + _LABEL_PAD_PX, LABEL_HEIGHT_PX
+def label_box_px(text: str, font_scale: float = 1.0) -> tuple[float, float]:
+    """(width, height) of a label's box on screen, pixels, at viser's ``font_screen_scale``
+    ``font_scale`` (the box grows with the font)."""
+    s = float(font_scale)
+    return (CHAR_WIDTH_PX * len(text) + _LABEL_PAD_PX) * s, LABEL_HEIGHT_PX * s
 
 
 @dataclass(frozen=True)
@@ -152,17 +156,19 @@ def _overlap(a: np.ndarray, wa: float, b: np.ndarray, wb: float, h: float) -> bo
 
 
 def spread_labels(framing: Framing, anchors: Mapping[str, np.ndarray],
-                  texts: Mapping[str, str]) -> dict[str, np.ndarray]:
+                  texts: Mapping[str, str], *, font_scale: float = 1.0) -> dict[str, np.ndarray]:
     """New WORLD anchors for labels so that, seen from ``framing``, no two boxes overlap.
 
     Labels are placed in the order of ``anchors``: each stays where it is unless its box
     overlaps one already placed, then it moves up the screen (along the camera's up vector, at
-    its own depth) to just above that box, until it overlaps none.
+    its own depth) to ``LABEL_GAP_PX`` above that box, until it overlaps none (boxes grown by
+    that gap, so the labels never touch).
 
     Args:
         framing: the camera the labels are seen from.
         anchors: label name -> its anchor (WORLD, m) as drawn now.
         texts: label name -> its text (its box's width).
+        font_scale: the labels' ``font_screen_scale`` (presenter mode draws them larger).
     """
     _, _, up = framing.basis()
     placed: list[tuple[np.ndarray, float]] = []
@@ -171,13 +177,14 @@ def spread_labels(framing: Framing, anchors: Mapping[str, np.ndarray],
         p = np.asarray(anchor, dtype=float).reshape(3)
         xy, depth = framing.project(p)
         xy, px_depth = xy[0].copy(), float(depth[0])
-        w, h = label_box_px(texts[name])
+        w, h = label_box_px(texts[name], font_scale)
+        h += LABEL_GAP_PX
         start = xy[1]
         for _ in range(4 * len(anchors) + 4):
             hit = next((q for q, wq in placed if _overlap(xy, w, q, wq, h)), None)
             if hit is None:
                 break
-            xy[1] = hit[1] + h + 1.0                    # just above the box it hit
+            xy[1] = hit[1] + h                          # a gap above the box it hit
         placed.append((xy, w))
         out[name] = p + up * (xy[1] - start) * framing.metres_per_px(px_depth)
     return out

@@ -2,12 +2,13 @@
 
 Top to bottom (below the wizard dock, ``views.wizard_dock``): TCP readout (frame + tool), the
 touch indicator with the offset "ΔX ΔY ΔZ mm" of the reference tip along the jog frame's axes
-and, within 20 mm, a magnified close-up of the two tips (all hidden by "Hide distance"), the
-status line (why a jog stopped), the increment, the jog
+(hidden by "Hide distance"), the increment, the jog
 keys - one row per axis with − and + side by side (X Y Z A B C, or A1..A6; in continuous mode
 the hold-to-jog keys, two per axis, since only single buttons report a hold), the keys line,
-the front and side views of the tips (``views.tip_insets``, within 40 mm: geometry, no
-numbers) - then the jog settings (mode, frame, override, readout frame), the joints, Home and the camera buttons; the touches ("Record point" and the list) follow.
+the status line (why a jog stopped), within 20 mm a magnified text close-up of the two tips
+(hidden by "Hide distance"), the front and side views of the tips (``views.tip_insets``,
+within 40 mm: geometry, no numbers) - everything that comes and goes near the tip is below
+the keys, so the keys never move - then the jog settings (mode, frame, override, readout frame), the joints, Home and the camera buttons; the touches ("Record point" and the list) follow.
 Every button group marks its selected option with "✓ " (viser's button groups show no
 selection); a click's value is read without the mark. Keyboard shortcuts come from the page's
 own script (``static/pendant.js``, served by ``client_script``): it clicks these buttons, so a
@@ -138,11 +139,9 @@ class PendantPanel:
         self._readout = "WORLD"
         self.tcp_md = gui.add_markdown("")
         self.touch_md = gui.add_markdown("")
-        self.closeup_md = gui.add_markdown("", visible=False)
         self.hide_distance = gui.add_checkbox("Hide distance", session.hide_distance,
                                               hint="Training: judge the touch by eye, as on a real robot "
                                                    "(hides the distance, the Δ offsets and the close-up).")
-        self.status_md = gui.add_markdown("")
         self.increment = gui.add_button_group("Increment", marked(INCREMENTS, st.increment),
                                               hint="mm for X/Y/Z, deg for A/B/C and joints; Cont. = hold to jog; "
                                                    + INCREMENT_KEYS)
@@ -172,8 +171,11 @@ class PendantPanel:
                     self.cart_buttons[(ax, sign)] = b
 
         self.keys_md = gui.add_markdown(KEYS_LINE)
-        self.insets = TipInsets(session)           # front and side views of the tips (no numbers),
-                                                   # below the keys: every key row stays above the fold
+        # what appears near the tip or at a stop goes below the keys, so no key moves when it
+        # shows (the keys stay where the trainee's pointer is, above the fold at 1024x768)
+        self.status_md = gui.add_markdown("")
+        self.closeup_md = gui.add_markdown("", visible=False)
+        self.insets = TipInsets(session)           # front and side views of the tips (no numbers)
 
         self.joint_folder = gui.add_folder("Joint jog", visible=False)
         with self.joint_folder:

@@ -4,13 +4,18 @@ A "Presenter mode" checkbox on top of the panel (per session; in ``--shared`` mo
 GUI's, so every browser follows it; ``tcp-pendant --presenter`` starts with it on) shows the
 "Presenter" folder above the tabs:
 
-* the TCP readout in large monospace numbers (``READOUT_FONT_PX``, 32 px): X Y Z mm, A B C deg
+* the TCP readout in large monospace numbers (``READOUT_FONT_PX``, 28 px): X Y Z mm, A B C deg
   in WORLD, and the distance to the reference tip (unless "Hide distance" is on);
-* the running wizard's step list, one step a line, the current one marked;
+* the running wizard's steps in a few wrapped lines, the current one marked;
 * the per-touch error chart of a 4-point result, ``CHART_HEIGHT_PX`` high.
 
-It narrows the panel to ``PRESENTER_WIDTH_PX`` (the scene keeps about 70 % of a 1024 px wide
-projector) and puts it back to ``NORMAL_WIDTH_PX`` when switched off.
+The folder is pinned at the top of the panel while the rest scrolls under it (the page script,
+``static/pendant.js``, makes it ``position: sticky``: viser 1.1 has no sticky GUI element), so
+it is sized to leave room below it: at 1024x768 the whole block, chart included, is above the
+fold (about 500 px of the 713 px panel). It narrows the panel to ``PRESENTER_WIDTH_PX`` (the
+scene keeps about 70 % of a 1024 px wide projector) and puts it back to ``NORMAL_WIDTH_PX``
+when switched off; the scene's labels (``Session.scene_labels``) are drawn
+``LABEL_SCALE`` times larger.
 
 The readout is raw HTML inside viser markdown (a ``<div style=...>``): only numbers this module
 formats go into it; every other text (step titles, the tool name) is escaped
@@ -24,9 +29,8 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING, Any, TypedDict
 
-import numpy as np
 
-from tcp_pendant.calibrate import error_bars
+from tcp_pendant.calibrate.chart import CHART_LEGEND, error_axis_top_mm, error_bars
 from tcp_pendant.controller.readout import PoseReadout
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.text_escape import escape_html, escape_markdown
@@ -41,6 +45,7 @@ if TYPE_CHECKING:
 __all__ = [
     "CHART_HEIGHT_PX",
     "NORMAL_WIDTH_PX",
+    "LABEL_SCALE",
     "PRESENTER_WIDTH_PX",
     "READOUT_FONT_PX",
     "STEPS_FONT_PX",
@@ -49,12 +54,16 @@ __all__ = [
     "presenter_steps_markdown",
 ]
 
-READOUT_FONT_PX = 32
-"""Font size of the presenter readout's numbers (the issue asks for at least 28 px)."""
-STEPS_FONT_PX = 20
+READOUT_FONT_PX = 28
+"""Font size of the presenter readout's numbers (at least 28 px: readable from the back row)."""
+STEPS_FONT_PX = 18
 """Font size of the presenter step list."""
-CHART_HEIGHT_PX = 260
-"""Height of the presenter's error chart (the result panel's is 170 px)."""
+CHART_HEIGHT_PX = 150
+"""Height of the presenter's error chart, pixels (its title and legend come on top): the pinned
+block stays above the fold at 1024x768 with room below it for the panel."""
+LABEL_SCALE = 1.8
+"""``font_screen_scale`` of the scene's labels in presenter mode (viser draws them about 12 px
+high at 1.0)."""
 PRESENTER_WIDTH_PX = 320
 """Panel width in presenter mode (viser's "medium"): 31 % of a 1024 px projector."""
 NORMAL_WIDTH_PX = 384
@@ -85,22 +94,30 @@ def presenter_readout_markdown(readout: PoseReadout, distance_mm: float | None, 
         font_px: font size of the numbers, pixels.
 
     Returns:
-        A ``<div>`` with one line per coordinate, monospace, ``font_px`` high.
+        A ``<div>`` with X, Y, Z one a line, monospace, ``font_px`` high; A, B, C on one line
+        below at about half that size; the distance; the frame. Compact: the block is pinned
+        at the top of the panel and must leave room below it.
     """
-    rows = [("X", readout.x_mm, "mm"), ("Y", readout.y_mm, "mm"), ("Z", readout.z_mm, "mm"),
-            ("A", readout.a_deg, "°"), ("B", readout.b_deg, "°"), ("C", readout.c_deg, "°")]
+    rows = [("X", readout.x_mm, "mm"), ("Y", readout.y_mm, "mm"), ("Z", readout.z_mm, "mm")]
     lines = [f"{name} {_num(float(v))} {unit}" for name, v, unit in rows]
+    abc = "  ".join(f"{name} {_num(float(v)).strip()}" for name, v in
+                    (("A", readout.a_deg), ("B", readout.b_deg), ("C", readout.c_deg))) + " °"
     dist = "hidden" if distance_mm is None else f"{_num(float(distance_mm)).strip()} mm"
     frame = escape_html(readout.frame)
     body = "<br>".join(lines).replace(" ", "&nbsp;")
+    small = max(int(font_px) // 2 + 1, 12)
     return (f'<div class="presenter-readout" style="font-size:{int(font_px)}px; font-family:monospace; '
-            f'line-height:1.2; white-space:nowrap">{body}</div>\n\n'
+            f'line-height:1.1; white-space:nowrap">{body}</div>'
+            f'<div class="presenter-abc" style="font-size:{small}px; font-family:monospace; white-space:nowrap">'
+            f'{abc.replace(" ", "&nbsp;")}</div>'
             f'<div class="presenter-distance" style="font-size:{int(font_px) - 8}px; font-family:monospace">'
-            f'tip&nbsp;{dist.replace(" ", "&nbsp;")}</div>\n\nTCP in {frame}')
+            f'tip&nbsp;{dist.replace(" ", "&nbsp;")} <span style="font-size:{small}px; font-family:sans-serif">'
+            f'TCP in {frame}</span></div>')
 
 
 def presenter_steps_markdown(wizard: Any | None, *, font_px: int = STEPS_FONT_PX) -> str:
-    """The running wizard's steps, one a line: ✔ recorded, ▶ current (bold), · to do.
+    """The running wizard's steps, wrapped in a few lines (a step never split): ✔ recorded,
+    ▶ current (bold), · to do.
 
     Args:
         wizard: the wizard on show (``CalibrationWorkflow.wizard``), or None.
@@ -117,8 +134,9 @@ def presenter_steps_markdown(wizard: Any | None, *, font_px: int = STEPS_FONT_PX
     if wizard.is_complete:
         lines.append('<b class="current-step">▶ Result</b>')
     title = escape_html(str(getattr(wizard, "title", "Wizard")))
-    return (f'<div class="presenter-steps" style="font-size:{int(font_px)}px; line-height:1.35">'
-            f"<u>{title}</u><br>" + "<br>".join(lines) + "</div>")
+    items = "".join(f'<span style="white-space:nowrap; margin-right:0.7em">{x}</span> ' for x in lines)
+    return (f'<div class="presenter-steps" style="font-size:{int(font_px)}px; line-height:1.3">'
+            f'<u style="margin-right:0.7em">{title}</u> ' + items.rstrip() + "</div>")
 
 
 def _chart_series() -> tuple[uplot.Series, ...]:
@@ -157,7 +175,8 @@ class PresenterView:
             self.chart = gui.add_uplot(bars.columns, _chart_series(), title="Error per touch (mm)",
                                        height=CHART_HEIGHT_PX, visible=False,
                                        scales={"x": {"time": False}, "y": {"range": (0.0, 1.0)}},
-                                       axes=({"label": "touch"}, {"label": "mm"}))
+                                       axes=({"label": "touch"}, {"label": "mm"}), legend=CHART_LEGEND,
+                                       padding=(14, 12, 0, 0))   # the top tick's label not cut off
         self._shown: dict[str, str] = {}
         self.panel_width_px = NORMAL_WIDTH_PX
         self._charted: Any = None
@@ -165,6 +184,7 @@ class PresenterView:
         session.subscribe(self.on_change)
         if on:
             self._apply_width(True)
+            self._apply_label_scale(True)
         self.render()
 
     @property
@@ -177,7 +197,16 @@ class PresenterView:
         on = self.on
         self.folder.visible = on
         self._apply_width(on)
+        self._apply_label_scale(on)
         self.render()
+
+    def _apply_label_scale(self, on: bool) -> None:
+        """The scene's labels larger in presenter mode (the wizards' scene spreads them at the
+        size they are drawn, on the next camera report or move)."""
+        scale = LABEL_SCALE if on else 1.0
+        for handle in self.session.scene_labels.values():
+            if float(getattr(handle, "font_screen_scale", 1.0)) != scale:
+                handle.font_screen_scale = scale
 
     def _apply_width(self, on: bool) -> None:
         gui = target_of(self.session).gui
@@ -209,7 +238,7 @@ class PresenterView:
         self._set(self.readout_md, "readout", presenter_readout_markdown(state.readout("WORLD"), distance))
         tool = s.controller.active_tool
         self._set(self.tool_md, "tool", f"Tool data: **{escape_markdown(tool.name)}**" if tool is not None
-                  else "Tool data: **none** (TCP = flange)")
+                  else "Tool data: **none** (TCP = flange)")   # one line under the readout
         wf = s.workflow
         wizard = None if wf is None or not wf.is_open else wf.wizard
         self._set(self.steps_md, "steps", presenter_steps_markdown(wizard))
@@ -226,5 +255,4 @@ class PresenterView:
         self._charted = res
         bars = error_bars([i + 1 for i in used], errors, [i + 1 for i in getattr(res, "outliers", ())])
         self.chart.data = bars.columns
-        top = float(np.max(errors))
-        self.chart.scales = {"x": {"time": False}, "y": {"range": (0.0, max(1.2 * top, 1e-3))}}
+        self.chart.scales = {"x": {"time": False}, "y": {"range": (0.0, error_axis_top_mm(errors))}}

@@ -51,9 +51,10 @@ from tcp_pendant.views.framing import Framing, frame_spheres
 from tcp_pendant.views.meshes import MeshPart, link_meshes, rigid_meshes
 from tcp_pendant.views.gui_util import target_of
 from tcp_pendant.views.viser_adapter import queue_pose
+from tcpcal.tool import Tool
 
 __all__ = ["POSE_EPS", "PoseSender", "SceneView", "camera_shape", "closeup_camera", "frame_cameras",
-           "link_tree_paths", "overview_camera", "overview_pose", "relative_poses", "wxyz_xyz"]
+           "link_tree_paths", "overview_camera", "overview_pose", "relative_poses", "tool_label_text", "wxyz_xyz"]
 
 log = logging.getLogger(__name__)
 
@@ -246,6 +247,18 @@ def _add_parts(scene: viser.SceneApi, parent: str, parts: tuple[MeshPart, ...], 
     return out
 
 
+def tool_label_text(active: Tool | None, mounted: ToolModel, activated_on: ToolModel | None = None) -> str:
+    """The TOOL triad's label: the active tool data's name and, when the physical tool on the
+    flange is another than the one that was on when the data was made active (a wizard bolted
+    the new tool on while the reference tool's data is still active), the tool that is on now:
+    the triad sits where that data puts the TCP, which on another tool is not its tip."""
+    if active is None:
+        return "TOOL"
+    if activated_on is None or activated_on.key == mounted.key:
+        return f"TOOL {active.name}"
+    return f"TOOL {active.name} · on {mounted.label}"
+
+
 class SceneView:
     """Builds and updates the scene of one session (see the module docstring).
 
@@ -272,7 +285,7 @@ class SceneView:
         scene.add_grid("/floor", width=3.0, height=3.0, cell_size=0.1, section_size=0.5,
                        plane="xy", position=(0.0, 0.0, 0.0))
         scene.add_frame("/world", axes_length=0.25, axes_radius=0.006)
-        scene.add_label("/world/label", "WORLD", position=(0.0, 0.0, -0.04))
+        self._world_label = scene.add_label("/world/label", "WORLD", position=(0.0, 0.0, -0.04))
 
         meshes = link_meshes(k.description)
         state = session.pose_state()
@@ -298,7 +311,8 @@ class SceneView:
         self._tool_root = f"{fl}/tool"
         self._tool_frame: Any = None
         self._shown_mounted: ToolModel | None = None
-        self._shown_active: tuple[Any, bytes] | None = None       # (active tool, T_flange_tool)
+        self._shown_active: tuple[Any, bytes, ToolModel] | None = None   # (active tool, T_flange_tool, mounted)
+        self._data_on: ToolModel | None = None
         self.set_mounted_tool(c.mounted_tool)
         self._active_axes = scene.add_frame(f"{fl}/active_tool", axes_length=0.12, axes_radius=0.005)
         self._active_label = scene.add_label(f"{fl}/active_tool/label", "TOOL", position=(0.0, 0.0, 0.04))
@@ -312,6 +326,7 @@ class SceneView:
         self._tip_label = scene.add_label("/reference_tip_label", "reference tip",
                                           position=tuple(c.reference_tip_world_m + [0.0, 0.0, -0.06]))
         session.scene_labels.update(self.tool_labels())     # the wizards' scene moves them apart
+        session.scene_labels["world"] = self._world_label   # restyled with them (presenter mode)
         self.beam_stand = BeamStandNodes(scene, c.beam_sensor)
 
         wxyz, xyz = wxyz_xyz(state.T_world_tcp)
@@ -342,7 +357,7 @@ class SceneView:
         c = self.session.controller
         if c.mounted_tool is not self._shown_mounted:
             self.set_mounted_tool(c.mounted_tool)
-        if self._shown_active != (c.active_tool, c.T_flange_tool.tobytes()):
+        if self._shown_active != (c.active_tool, c.T_flange_tool.tobytes(), c.mounted_tool):
             self.update_active_tool()
 
     # ------------------------------------------------------------ updates
@@ -391,13 +406,16 @@ class SceneView:
     def update_active_tool(self) -> None:
         """Move the TOOL triad to the active tool data (``T_flange_tool``) and relabel it."""
         c = self.session.controller
-        self._shown_active = (c.active_tool, c.T_flange_tool.tobytes())
+        shown = self._shown_active
+        if shown is None or shown[0] is not c.active_tool or shown[1] != c.T_flange_tool.tobytes():
+            self._data_on = c.mounted_tool          # the tool on the flange when the data became active
+        self._shown_active = (c.active_tool, c.T_flange_tool.tobytes(), c.mounted_tool)
         wxyz, xyz = wxyz_xyz(c.T_flange_tool)
         self._active_axes.wxyz = wxyz
         self._active_axes.position = xyz
         tool = c.active_tool
         self._active_axes.visible = tool is not None and not self._aside   # no tool data: TOOL = FLANGE
-        self._active_label.text = "TOOL" if tool is None else f"TOOL {tool.name}"
+        self._active_label.text = tool_label_text(tool, c.mounted_tool, self._data_on)
 
     def update_reference_tip(self) -> None:
         """Re-place the stand after the reference tip moved (:meth:`on_change` calls it)."""

@@ -18,9 +18,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
-
-from tcp_pendant.calibrate import error_bars
+from tcp_pendant.calibrate.chart import CHART_LEGEND, error_axis_top_mm, error_bars
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.calibrate.text import (
     comparison_markdown,
@@ -28,6 +26,7 @@ from tcp_pendant.calibrate.text import (
     hidden_touches_markdown,
     result_markdown,
     save_markdown,
+    scene_legend_markdown,
     save_preview_markdown,
     truth_markdown,
     warnings_markdown,
@@ -88,6 +87,7 @@ class WizardResultView:
         with self.folder:
             self.result_md = gui.add_markdown("")
             self.truth_md = gui.add_markdown("", visible=False)
+            self.legend_md = gui.add_markdown("", visible=False)   # what the 3D view shows of it
             self.replay_scan = gui.add_button("Replay scan", visible=False,   # a beam result's scan
                                               hint="Show the robot going through the beam scan again.")
             self.warnings_md = gui.add_markdown("")
@@ -97,7 +97,7 @@ class WizardResultView:
                 bars.columns, _chart_series(has_outliers=False),
                 title="Error per touch (mm)", height=170, visible=False,
                 scales={"x": {"time": False}, "y": {"range": (0.0, 1.0)}},
-                axes=({"label": "touch"}, {"label": "mm"}),
+                axes=({"label": "touch"}, {"label": "mm"}), legend=CHART_LEGEND,
             )
             self.drop = gui.add_button("Drop outliers", color="red", visible=False,
                                        hint="Recompute without the touches flagged as outliers.")
@@ -211,6 +211,13 @@ class WizardResultView:
         if refused is not None and refused[0] is wf.run and wf.last_save is None:
             set_content(self.save_md, f"⚠ **Not saved:** {escape_markdown(refused[1])}")
         extras = set() if wf.wizard is None else type(wf.wizard).result_extras
+        legend = scene_legend_markdown(computed=wf.T_flange_tool_computed_m() is not None,
+                                       true=truth is not None and wf.T_flange_tool_true_m() is not None,
+                                       sphere="sphere" in extras,
+                                       radius_mm=getattr(res, "sphere_radius_mm", None))
+        self.legend_md.visible = bool(legend)
+        if legend:
+            set_content(self.legend_md, legend)
         self._render_estimators(res if "estimators" in extras else None)
 
     def _render_estimators(self, res: Any) -> None:
@@ -227,8 +234,8 @@ class WizardResultView:
                               [i + 1 for i in res.outliers])
             self.chart.data = bars.columns
             self.chart.series = _chart_series(has_outliers=bool(res.outliers))
-            top = float(np.max(res.per_touch_error_mm)) if res.per_touch_error_mm else 0.0
-            self.chart.scales = {"x": {"time": False}, "y": {"range": (0.0, max(1.2 * top, 1e-3))}}
+            self.chart.scales = {"x": {"time": False},
+                                 "y": {"range": (0.0, error_axis_top_mm(res.per_touch_error_mm))}}
         self.drop.disabled = not res.outliers
         self.restore.disabled = not res.excluded
         label = ESTIMATOR_LABELS[res.estimator]

@@ -96,6 +96,11 @@ class WizardSceneView:
         self._label_defaults: dict[str, tuple[viser.LabelHandle, tuple[float, float, float]]] = {}
         self._labels_moved = False
         self._target_T: np.ndarray | None = None
+        self._camera_watched: set[int] = set()
+        self._relayout = session.on_loop(self._on_camera)
+        # in the session's labels too, so a view that restyles the scene's labels (presenter
+        # mode: larger) reaches these; the boxes are spread at the size they are drawn
+        session.scene_labels.update(computed=self.computed_label, true=self.true_label, target=self.abc_label)
 
     # ------------------------------------------------------------ result
     def _has_sphere(self) -> bool:
@@ -110,15 +115,18 @@ class WizardSceneView:
         # an exercise (classroom: ``hide_truth``) shows no TRUE triad: it would give the answer
         self._T_flange_tool_true = None if wf.hide_truth else wf.T_flange_tool_true_m()
         res = wf.result
+        framed: Framing | None = None
         if res is not self._shown_result:
             self._shown_result = res
             self._show_sphere(cast(Xyz4Result, res) if res is not None and self._has_sphere() else None)
             self._show_scan(res)
             if res is not None:
-                self.frame_result()
+                framed = self.frame_result()
         self.on_motion()
         if self.workflow.is_open or res is not None:
-            self.layout_labels()
+            # just framed: the browsers' cameras still report the old view, so the labels are
+            # moved apart for the new one (the next camera report re-lays them: _on_camera)
+            self._place_labels(framed) if framed is not None else self.layout_labels()
         else:
             self._restore_labels()
 
@@ -306,10 +314,24 @@ class WizardSceneView:
         return Framing(position=position, look_at=look_at, centre=look_at, radius_m=0.0, distance_m=distance,
                        fov_rad=fov, aspect=aspect, image_height_px=height)
 
+    def _watch_cameras(self, clients: list[viser.ClientHandle]) -> None:
+        """Re-lay the labels whenever the first browser's camera reports a new view (an orbit,
+        a zoom, a resized window, the end of a framing move): boxes spread for another view
+        can overlap in this one."""
+        for client in clients[:1]:
+            if client.client_id not in self._camera_watched:
+                self._camera_watched.add(client.client_id)
+                client.camera.on_update(self._relayout)
+
+    def _on_camera(self, _camera: Any = None) -> None:
+        if self._labels_moved and (self.workflow.is_open or self.workflow.result is not None):
+            self.layout_labels()
+
     def layout_labels(self) -> None:
         """Move the labels at the tip apart as seen by the (first) browser's camera now, or by
         the last result's framing when no camera has been reported."""
         clients = self.session.clients()
+        self._watch_cameras(clients)
         framing = self._camera_framing(clients[0]) if clients else None
         framing = framing or self.last_framing
         if framing is not None:
@@ -324,7 +346,8 @@ class WizardSceneView:
                 local = np.asarray(self.session.controller.reference_tip_world_m, dtype=float) + [0.0, 0.0, -0.06]
             anchors[name] = local if T is None else T[:3, :3] @ local + T[:3, 3]
         texts = {n: str(getattr(nodes[n][0], "text", None) or _LABEL_TEXTS[n]) for n in anchors}
-        placed = spread_labels(framing, anchors, texts)
+        scale = max((float(getattr(nodes[n][0], "font_screen_scale", 1.0) or 1.0) for n in anchors), default=1.0)
+        placed = spread_labels(framing, anchors, texts, font_scale=scale)
         for name, world in placed.items():
             handle, T = nodes[name]
             local = world if T is None else T[:3, :3].T @ (world - T[:3, 3])

@@ -22,13 +22,14 @@ import math
 from typing import TYPE_CHECKING, Any
 
 from tcp_pendant.calibrate import AUTO_SIGMA_MAX_MM, AutoTouchRequest
-from tcp_pendant.calibrate.diversity import diversity_advice
+from tcp_pendant.calibrate.diversity import best_tilt, best_tilt_words, diversity_advice
 from tcp_pendant.calibrate.jobs import POSE_CHECKS
 from tcp_pendant.calibrate.text import (
     meter_level,
     meter_markdown,
     step_markdown,
     steps_list_markdown,
+    where_to_jog_markdown,
 )
 from tcp_pendant.job_pool import JobRefused
 from tcp_pendant.pendant.guidance import tip_offset_mm
@@ -253,7 +254,9 @@ class WizardStepsView:
         self.folder.visible = wf.is_open
         if wiz is None or not wf.is_open:
             return
-        set_content(self.head_md, step_markdown(wiz) + (f"\n\n{self._busy_text}" if self._checking else ""))
+        where = where_to_jog_markdown(wiz)
+        set_content(self.head_md, step_markdown(wiz) + (f"\n\n{where}" if where else "")
+                    + (f"\n\n{self._busy_text}" if self._checking else ""))
         set_value(self.progress, round(100.0 * wiz.progress, 1))
         set_content(self.steps_md, steps_list_markdown(wiz))
         self._render_variant(wiz)
@@ -318,4 +321,8 @@ class WizardStepsView:
         self.meter_bar.color = color
         advice = (diversity_advice(wiz.other_rotations(), T_world_flange[:3, :3], gain.angle_to_nearest_deg)
                   if math.isinf(gain.predicted_after) else None)               # only then shown
-        set_content(self.meter_md, meter_markdown(gain, None, wiz.assumed_sigma_mm, advice))
+        R_flange_tool = self.parent.session.controller.T_flange_tool[:3, :3]   # the jog keys' TOOL frame
+        tilt = best_tilt(wiz.other_rotations(), T_world_flange[:3, :3], R_flange_tool=R_flange_tool,
+                         sigma_mm=wiz.assumed_sigma_mm)
+        set_content(self.meter_md, meter_markdown(gain, None, wiz.assumed_sigma_mm, advice,
+                                                  None if tilt is None else best_tilt_words(tilt)))

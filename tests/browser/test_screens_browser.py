@@ -1,0 +1,183 @@
+"""What the trainee's screen shows, in chromium at 1024x768 and 1400x900.
+
+* The jog keys stay put: their boxes far from the reference tip, within 20 mm of it (the text
+  close-up and the tip views shown) and after a jog stopped at contact (the stop message
+  shown) are the same (within 2 px), and all of them are inside the viewport.
+* The result screens: the 4-point result, an orientation result (TCP & Z, X) and the beam
+  result, each at both sizes, with the labels near the tip moved apart and the 4-point's
+  sphere named in the result panel.
+
+Every screen is saved as a PNG to be looked at: ``jog_near_tip_<size>.png``,
+``xyz4_result_<size>.png``, ``orientation_result_<size>.png``, ``beam_result_<size>.png``, into
+``$UI_SHOTS_DIR`` when set (``UI_SHOTS_DIR=/tmp/ui-shots pytest tests/browser/test_screens_browser.py``),
+else the test's tmp_path. The result screens are taken only with ``$UI_SHOTS_DIR`` set (they are
+for a person to look at, and cost about 20 s more than CI's budget for this file allows); the
+label layout they show is checked without a browser (``tests/calibrate/test_first_hour_scene.py``).
+
+The pendant runs in this process: the test teleports the tool next to the reference tip and
+drives the wizards on the server (``Session``, what the Calibrate tab's buttons call), and
+clicks the jog keys in the browser.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import sys
+import time
+from collections.abc import Callable, Iterator
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from tcp_pendant.calibrate import AutoTouchRequest
+from tcp_pendant.server import PendantApp
+
+sys.path.insert(0, str(Path(__file__).parent))
+sys.path.insert(0, str(Path(__file__).parents[1] / "app"))
+from app_page import running_pendants  # noqa: E402
+from pendant_page import TIMEOUT_MS, assert_not_blank  # noqa: E402
+
+pytestmark = pytest.mark.browser
+
+SIZES = ((1024, 768), (1400, 900))
+JOG_KEYS = tuple(f"{ax} {s}" for ax in "XYZABC" for s in ("−", "+"))
+TOLERANCE_PX = 2.0
+
+
+@pytest.fixture
+def pendant(tmp_path: Path) -> Iterator[Callable[..., PendantApp]]:
+    with running_pendants(tmp_path) as start:
+        yield start
+
+
+@pytest.fixture
+def shots(tmp_path: Path) -> Path:
+    out = Path(os.environ.get("UI_SHOTS_DIR") or tmp_path)
+    out.mkdir(parents=True, exist_ok=True)
+    return out
+
+
+def wait_until(cond: Callable[[], Any], what: str, timeout: float = 60.0) -> Any:
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        value = cond()
+        if value is not None and value is not False:
+            return value
+        time.sleep(0.05)
+    raise AssertionError(f"timed out waiting for {what}")
+
+
+def session_of(app: PendantApp) -> Any:
+    wait_until(lambda: app.sessions, "the page's session")
+    (s,) = app.sessions.values()
+    return s
+
+
+def key_boxes(page: Any) -> dict[str, tuple[float, float, float, float]]:
+    """The jog keys' boxes (x, y, width, height), page px."""
+    out = {}
+    for name in JOG_KEYS:
+        box = page.get_by_role("button", name=name, exact=True).first.bounding_box()
+        assert box is not None, f"no jog key {name!r}"
+        out[name] = (box["x"], box["y"], box["width"], box["height"])
+    return out
+
+
+def assert_same_and_inside(before: dict[str, tuple[float, ...]], after: dict[str, tuple[float, ...]],
+                           size: tuple[int, int], when: str) -> None:
+    w, h = size
+    for name, b in before.items():
+        a = after[name]
+        assert np.allclose(a, b, atol=TOLERANCE_PX), f"{when} at {w}x{h}: key {name!r} moved from {b} to {a}"
+        x, y, bw, bh = a
+        assert x >= 0 and y >= 0 and x + bw <= w and y + bh <= h, f"{when} at {w}x{h}: key {name!r} {a} off screen"
+
+
+def teleport_above_tip(s: Any, offset_mm: tuple[float, float, float]) -> None:
+    """The true tool tip at the reference tip + ``offset_mm`` (WORLD), tool orientation kept."""
+    with s.lock:
+        c = s.controller
+        T = c.T_world_tool_true().copy()
+        T[:3, 3] = c.reference_tip_world_m + np.asarray(offset_mm) / 1000.0
+        assert c.move_true_tool_to(T).ok
+        s.moved()
+
+
+def test_jog_keys_stay_put_near_the_tip_and_at_a_stop(pendant, new_page, shots) -> None:
+    app = pendant()
+    page = new_page(app.url, width=SIZES[0][0], height=SIZES[0][1])
+    s = session_of(app)
+    closeup = page.get_by_text("mm/char").first
+    for size in SIZES:
+        page.set_viewport_size({"width": size[0], "height": size[1]})
+        teleport_above_tip(s, (0.0, 0.0, 150.0))              # far: no close-up, no tip views
+        closeup.wait_for(state="hidden", timeout=TIMEOUT_MS)
+        page.wait_for_timeout(300)
+        far = key_boxes(page)
+        teleport_above_tip(s, (1.5, -1.0, 8.0))                # within 20 mm: both close-ups
+        closeup.wait_for(state="visible", timeout=TIMEOUT_MS)
+        page.locator("img:not([src^='data:image/svg'])").first.wait_for(state="visible", timeout=TIMEOUT_MS)
+        page.wait_for_timeout(300)
+        assert_same_and_inside(far, key_boxes(page), size, "within 20 mm")
+        page.get_by_role("button", name=re.compile(r"^(✓ )?10$")).first.click()   # 10 mm down: contact stops it
+        page.get_by_role("button", name="✓ 10", exact=True).first.wait_for(state="visible", timeout=TIMEOUT_MS)
+        page.get_by_role("button", name="Z −", exact=True).first.click()
+        page.get_by_text("⚠").first.wait_for(state="visible", timeout=TIMEOUT_MS)
+        page.mouse.move(300, size[1] - 60)                   # no key's hint over the keys in the shot
+        page.wait_for_timeout(300)
+        assert_same_and_inside(far, key_boxes(page), size, "at a stop")
+        png = shots / f"jog_near_tip_{size[0]}x{size[1]}.png"
+        page.screenshot(path=str(png))
+        assert_not_blank(png)
+
+
+def finish_by_auto_touch(s: Any, kind: str, **options: Any) -> Any:
+    """Start wizard ``kind``, Auto-touch (and mount) every step, Finish: the result."""
+    s.start_wizard(kind, **options)
+    wf = s.workflow
+    for _ in range(12):
+        w = wf.wizard
+        if w.is_complete:
+            break
+        if w.auto_role(w.step).by_controller:     # the beam scan: the controller runs it at Finish
+            s.next_step()
+        else:
+            out = s.auto_touch(AutoTouchRequest())
+            assert out.ok, out
+    assert wf.wizard.is_complete, wf.wizard.status
+    return wf.result
+
+
+@pytest.mark.skipif(not os.environ.get("UI_SHOTS_DIR"), reason="screens to look at: set UI_SHOTS_DIR")
+def test_result_screens(pendant, new_page, shots) -> None:
+    app = pendant()
+    page = new_page(app.url, width=SIZES[0][0], height=SIZES[0][1])
+    s = session_of(app)
+    page.get_by_role("tab", name="Calibrate").click()
+    for kind, name, extra in (("xyz4", "xyz4_result", "blue wire sphere"), ("tcp-zx", "orientation_result", None),
+                              ("beam", "beam_result", None)):
+        # off this thread: Playwright's sync API runs an asyncio loop here, on which the beam
+        # result's film would be scheduled (and play only while Playwright is called)
+        with ThreadPoolExecutor(max_workers=1) as pool:
+            res = pool.submit(finish_by_auto_touch, s, kind).result()
+        assert res is not None
+        page.get_by_text("Against the true TOOL frame").filter(visible=True).first.wait_for(
+            state="visible", timeout=TIMEOUT_MS)
+        if extra:
+            page.get_by_text(extra).filter(visible=True).first.wait_for(state="visible", timeout=TIMEOUT_MS)
+        scene = s.views["calibrate"].scene                  # the wizards' 3D: the triads are back
+        player = s.views["beam_player"]                       # when a beam scan's film has ended
+        wait_until(lambda: scene.computed.visible, f"the COMPUTED triad (film playing: {player.playing}, "
+                   f"{player.frames_played} of {len(player.frames)} frames)", timeout=90.0)
+        page.mouse.move(300, 700)
+        for size in SIZES:
+            page.set_viewport_size({"width": size[0], "height": size[1]})
+            page.wait_for_timeout(1000)                  # the camera reported, the labels re-laid
+            png = shots / f"{name}_{size[0]}x{size[1]}.png"
+            page.screenshot(path=str(png))
+            assert_not_blank(png)
+        with ThreadPoolExecutor(max_workers=1) as pool:
+            pool.submit(s.cancel_wizard).result()
