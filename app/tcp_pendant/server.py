@@ -114,6 +114,10 @@ class AppConfig:
             error and directions, the beam's repeatability noise); session k of the server draws
             from ``(seed, k)``, so a seeded lesson or test replays the same way. None: fresh
             randomness.
+        reuse_port: bind the port with ``SO_REUSEPORT`` (``views.viser_adapter.listen_reuse_port``):
+            one of the server processes of ``tcp-pendant --workers N`` on the same port.
+        presence_poll_s: the class's heartbeat period across server processes (seconds;
+            ``ClassRoom.start``).
     """
 
     robot: str = "kr6"
@@ -139,6 +143,8 @@ class AppConfig:
     beam_crossed: bool = False
     seed: int | None = None
     hide_truth: bool = False
+    reuse_port: bool = False
+    presence_poll_s: float = 1.0
 
 
 class PortInUseError(OSError):
@@ -349,7 +355,8 @@ class PendantApp:
             self.classroom = ClassRoom(self.gradebook, tools,
                                        trainer_token=config.trainer_token,
                                        exercise=config.exercise, exercise_seed=config.exercise_seed,
-                                       hand_to_loop=self._hand_to_loop)
+                                       hand_to_loop=self._hand_to_loop,
+                                       presence_poll_s=config.presence_poll_s)
 
     @property
     def warnings(self) -> list[str]:
@@ -538,6 +545,8 @@ class PendantApp:
         origin_check.enable()               # foreign web pages' websockets are refused (403)
         viser_adapter.install()             # every browser message checked before viser's handlers
         client_script.script_asset()        # the page's own script (keys, name, trainer URL): packaged?
+        if self.config.reuse_port:
+            viser_adapter.listen_reuse_port()   # one port, several server processes (--workers)
         self.server = viser.ViserServer(host=host, port=self.config.port, verbose=False)
         origin_check.allow(self.port, self.allow_origins,
                            origin_check.served_hosts(host, self.network_urls, self.allow_origins))
@@ -559,6 +568,8 @@ class PendantApp:
         self.server.on_client_disconnect(self._on_disconnect)
         self._watcher = threading.Thread(target=self._watch_library, name="library-watcher", daemon=True)
         self._watcher.start()
+        if self.classroom is not None:
+            self.classroom.start()          # presence heartbeat, the other processes' pushes
         return self.url
 
     @property
@@ -604,13 +615,16 @@ class PendantApp:
         if self.server is not None:
             origin_check.forget(self.port)
             self.server.stop()
+        if self.classroom is not None:
+            self.classroom.close()          # frees the names this process held
         if self.gradebook is not None:
             self.gradebook.close()
 
-    def serve_forever(self, poll_s: float = 0.5) -> None:
-        """Block until interrupted (Ctrl-C), then stop."""
+    def serve_forever(self, poll_s: float = 0.5, alive: Callable[[], bool] | None = None) -> None:
+        """Block until interrupted (Ctrl-C) or, with ``alive``, until it returns False (a
+        worker of ``--workers``: the first process is gone), then stop."""
         try:
-            while not self._stop.is_set():
+            while not self._stop.is_set() and (alive is None or alive()):
                 time.sleep(poll_s)
         except KeyboardInterrupt:
             pass

@@ -31,6 +31,20 @@ Each trainee's pendant follows the class's :class:`~tcp_pendant.pendant.exercise
 is off unless the trainer unlocked or allowed them (``class_rules``); a change of exercise goes
 back to those defaults unless the same push sets them.
 
+Several server processes on one gradebook (``tcp-pendant --workers N``): each process has its
+own sessions and its own ClassRoom (:attr:`ClassRoom.holder` names it); what the class shares
+goes through the gradebook. A joined name is claimed in the gradebook's presence table
+(``Gradebook.claim_presence``) and beaten every ``presence_poll_s`` by :meth:`ClassRoom.start`'s
+thread with the trainee's live row, so a name connected on one process is refused on another
+exactly as on the same one, the same browser's newer tab on another process takes the name
+(the older one's welcome window opens again at the next beat), a release by the trainer on
+any process sends the browser on its holder back to the welcome window, and
+:meth:`trainee_statuses` and :meth:`connected_names` list the whole class (the other
+processes' rows as they last beat them; who left is listed by the process they left). Every
+push of the trainer's settings is kept in order (``Gradebook.add_push``) and applied by the
+other processes at their next beat. A reconnect landing on another process gets the
+calibrations in progress back from the gradebook (``classroom.restore``), like a restart.
+
 Threads: the session callbacks run on viser's event loop (``Session.on_loop``); connects and
 disconnects come from viser's thread pool and hand their trainer-view refresh to the loop
 (``hand_to_loop``). The class's own lists are guarded by one lock.
@@ -38,15 +52,18 @@ disconnects come from viser's thread pool and hand their trainer-view refresh to
 
 from __future__ import annotations
 
-import logging
+import dataclasses
 import hashlib
+import logging
+import os
 import secrets
+import socket
 import threading
 import time
 from collections.abc import Callable
 from typing import Any, cast
 
-from tcp_pendant.classroom.gradebook import Gradebook, GradeRow, TraineeJoin
+from tcp_pendant.classroom.gradebook import Gradebook, GradebookError, GradeRow, TraineeJoin
 from tcp_pendant.classroom.mystery import draw_mystery_tool
 from tcp_pendant.classroom.names import TraineeNameError, validate_trainee_name
 from tcp_pendant.classroom.recorder import TraineeRecorder, TraineeStatus
@@ -89,6 +106,7 @@ class ClassRoom:
             the gradebook.
         hand_to_loop: runs a function on viser's event loop.
         clock: seconds of a monotonic clock (the token's lockout windows; tests set it).
+        presence_poll_s: the heartbeat period of :meth:`start` (seconds; module docstring).
 
     Raises:
         TrainerTokenError: a token that breaks the rules.
@@ -97,7 +115,7 @@ class ClassRoom:
     def __init__(self, gradebook: Gradebook, tools: dict[str, ToolModel], *, trainer_token: str | None,
                  exercise: str | None = None, exercise_seed: int | None = None,
                  hand_to_loop: Callable[[Callable[[], None]], None] = lambda fn: fn(),
-                 clock: Callable[[], float] = time.monotonic) -> None:
+                 clock: Callable[[], float] = time.monotonic, presence_poll_s: float = 1.0) -> None:
         if exercise is not None and exercise not in EXERCISE_IDS:
             raise ValueError(f"Unknown exercise {exercise!r}; use one of {', '.join(EXERCISE_IDS)}.")
         stored = gradebook.class_setting(TOKEN_SETTING)
@@ -135,6 +153,13 @@ class ClassRoom:
         """Auto-touch as the trainer last allowed it (None: the default - off in an exercise)."""
         self.pushed_tool: str | None = None
         """The tool the trainer last pushed (kept across restarts)."""
+        self.holder = f"{socket.gethostname()}:{os.getpid()}:{secrets.token_hex(4)}"
+        """This server process's id in the gradebook's presence table (host, pid, a nonce)."""
+        self.presence_poll_s = float(presence_poll_s)
+        self._remote: dict[str, TraineeStatus] = {}   # name -> row, connected on another process
+        self._push_seen = gradebook.last_push_id()    # the pushes before are in the kept settings
+        self._beater: threading.Thread | None = None
+        self._stopping = threading.Event()
         self._apply_kept(exercise_given=exercise is not None)   # what the trainer pushed before a restart
 
     @property
@@ -198,7 +223,8 @@ class ClassRoom:
                 raise TraineeNameError(f"The trainer released the name {clean} from this browser; join "
                                        "under your own name.")
             holder = self._holder(clean, session)
-            if holder is not None and not self.gradebook.holds_key(clean, key):
+            elsewhere = self.gradebook.presence_holder(clean) not in (None, self.holder)
+            if (holder is not None or elsewhere) and not self.gradebook.holds_key(clean, key):
                 raise TraineeNameError(f"{clean} is already connected in another browser; pick another "
                                        "name or ask the trainer to release it.")
             join = self.gradebook.join_trainee(clean, key)
@@ -216,6 +242,9 @@ class ClassRoom:
             session.keep_honest_records()             # the trainee's export carries no answer key
             recorder = TraineeRecorder(self.gradebook, sid, join.name, session.workflow,
                                        exercise_id=self.exercise)
+            # claimed before the name is in the table the heartbeat reads: a beat never sees a
+            # name of ours that the presence table does not give to us yet
+            self.gradebook.claim_presence(join.name, self.holder, dataclasses.asdict(recorder.status))
             with self._lock:
                 self._trainees[id(session)] = (session, recorder, join.name)
                 follow = id(session) not in self._subscribed
@@ -255,6 +284,7 @@ class ClassRoom:
             log.exception("ending the gradebook session of %r failed", name)
         with self._lock:
             self._left.append(recorder.status)
+        self._drop_presence(name)
         if prompt is not None:         # on the loop, after this callback: no two sessions' locks at once
             self._hand_to_loop(session.guard(lambda: prompt.reopen(message, forget=forget)))
 
@@ -266,6 +296,7 @@ class ClassRoom:
             raise ValueError("Choose the name to release.")
         with self._join_lock:
             held = self.gradebook.release_trainee(name)
+            elsewhere = self.gradebook.drop_presence(name) and name not in self._local_names()
             with self._lock:
                 holders = [e for e in self._trainees.values() if e[2] == name]
             for entry in holders:
@@ -273,9 +304,9 @@ class ClassRoom:
                 self._leave(entry, f"The trainer released the name {name}: this browser left the class. "
                             "Join under your own name.", forget=True)
         self.refresh_trainers()
-        if not held and not holders:
+        if not held and not holders and not elsewhere:
             return f"{name} was not held by any browser."
-        where = " and its browser left the class" if holders else ""
+        where = " and its browser left the class" if holders or elsewhere else ""
         return f"Released {name}{where}: the next browser that joins as {name} gets the trainee's records."
 
     def held_names(self) -> list[str]:
@@ -321,7 +352,109 @@ class ClassRoom:
                 if self._trainees.get(id(session)) is entry:
                     self._trainees.pop(id(session), None)
                     self._left.append(entry[1].status)
+            self._drop_presence(entry[2])
         self._hand_to_loop(self.refresh_trainers)
+
+    # ------------------------------------------------------------ presence (server processes)
+    def _local_names(self) -> set[str]:
+        with self._lock:
+            return {e[2] for e in self._trainees.values()}
+
+    def _drop_presence(self, name: str) -> None:
+        """The name's row goes, unless another session of this process holds the name now."""
+        if name in self._local_names():
+            return
+        try:
+            self.gradebook.drop_presence(name, self.holder)
+        except GradebookError:
+            log.exception("the presence of %r could not be dropped", name)
+
+    def start(self) -> None:
+        """Start the heartbeat thread (the server calls it; module docstring)."""
+        if self._beater is not None:
+            return
+        self._beater = threading.Thread(target=self._beat_loop, name="class-presence", daemon=True)
+        self._beater.start()
+
+    def close(self) -> None:
+        """Stop the heartbeat and free every name this process holds (the server stops)."""
+        self._stopping.set()
+        if self._beater is not None:
+            self._beater.join(timeout=5.0)
+            self._beater = None
+        try:
+            self.gradebook.drop_holder(self.holder)
+        except GradebookError:
+            log.debug("presence not dropped: gradebook closed", exc_info=True)
+
+    def _beat_loop(self) -> None:
+        while not self._stopping.wait(self.presence_poll_s):
+            try:
+                self.beat()
+            except GradebookError:
+                log.exception("class heartbeat failed")
+            except Exception:  # the heartbeat must go on whatever one beat met
+                log.exception("class heartbeat failed")
+
+    def beat(self) -> None:
+        """One heartbeat (the thread of :meth:`start` every ``presence_poll_s``; tests call it):
+        renew this process's names with their rows; a name this process lost (taken by the same
+        browser on another process, released by the trainer there) sends its session back to
+        the welcome window; take in the other processes' rows and the trainer's pushes made
+        there."""
+        with self._lock:
+            entries = {e[2]: e for e in self._trainees.values()}
+        statuses = {name: dataclasses.asdict(e[1].status) for name, e in entries.items()}
+        held = self.gradebook.beat_presence(self.holder, statuses)
+        lost = [(entries[n], self.gradebook.presence_holder(n) is None) for n in sorted(set(statuses) - held)]
+        if lost:
+            self._hand_to_loop(lambda: self._lost(lost))
+        fields = {f.name for f in dataclasses.fields(TraineeStatus)}
+        remote = {}
+        for name, holder, st in self.gradebook.present():
+            if holder != self.holder and isinstance(st, dict):
+                try:
+                    remote[name] = TraineeStatus(**{k: v for k, v in st.items() if k in fields})
+                except TypeError:
+                    continue
+        changed = remote != self._remote
+        self._remote = remote
+        for push_id, push in self.gradebook.pushes_after(self._push_seen):
+            self._push_seen = push_id
+            if push.get("holder") != self.holder:
+                self._hand_to_loop(lambda push=push: self._apply_remote_push(push))
+        if changed:
+            self._hand_to_loop(self.refresh_trainers)
+
+    def _lost(self, lost: list[tuple[tuple[Session, TraineeRecorder, str], bool]]) -> None:
+        for entry, released in lost:
+            name = entry[2]
+            if released:
+                self._released[id(entry[0])] = name
+                self._leave(entry, f"The trainer released the name {name}: this browser left the class. "
+                            "Join under your own name.", forget=True)
+            else:
+                self._leave(entry, f"{name} joined from another tab or window of this browser, so this "
+                            "one left the class. Close it, or join here again (the other one then leaves).",
+                            forget=False)
+        self.refresh_trainers()
+
+    def _apply_remote_push(self, push: dict[str, Any]) -> None:
+        """A push the trainer made on another server process of the class."""
+        try:
+            self.push_settings(push.get("exercise"), push.get("tool_key"), push.get("hide_distance"),
+                               push.get("auto_touch"), keep=False)
+        except (ValueError, TypeError) as exc:
+            log.warning("a pushed setting from another server process was not applied: %s", exc)
+
+    def connected_names(self) -> list[str]:
+        """The names connected now on every server process of the class, sorted."""
+        names = self._local_names()
+        try:
+            names |= {name for name, _, _ in self.gradebook.present()}
+        except GradebookError:
+            log.exception("presence unreadable")
+        return sorted(names)
 
     # ------------------------------------------------------------ trainer
     def open_trainer(self, session: Session, token: str) -> bool:
@@ -361,9 +494,14 @@ class ClassRoom:
                 log.exception("trainer view refresh failed")
 
     def trainee_statuses(self) -> list[TraineeStatus]:
-        """Rows of the live table: connected trainees in order of arrival, then those who left."""
+        """Rows of the live table: this process's connected trainees in order of arrival, those
+        connected on the other server processes of the class (by name, as they last beat),
+        then those who left this process."""
         with self._lock:
-            return [rec.status for _, rec, _ in self._trainees.values()] + list(self._left)
+            local = [rec.status for _, rec, _ in self._trainees.values()]
+            names = {row.name for row in local}
+            remote = [row for name, row in sorted(self._remote.items()) if name not in names]
+            return local + remote + list(self._left)
 
     def grade_rows(self) -> list[GradeRow]:
         return self.gradebook.grades()
@@ -400,13 +538,16 @@ class ClassRoom:
         self.pushed_tool = tool if isinstance(tool, str) and tool in self.tools else None
 
     def push_settings(self, exercise: str | None, tool_key: str | None,
-                      hide_distance: bool | str | None = None, auto_touch: bool | None = None) -> int:
+                      hide_distance: bool | str | None = None, auto_touch: bool | None = None, *,
+                      keep: bool = True) -> int:
         """Set the exercise (None: free practice; "mystery": each trainee gets a mystery tool),
         mount ``tool_key`` (None: keep), set the distance aids (``hide_distance``: "locked",
         "hidden" or "shown"; True means "hidden", False "shown"; None: keep) and allow
         Auto-touch or not (None: keep) on every named trainee's pendant; later trainees get
         them when they name themselves. A new exercise starts from its default rules (module
-        docstring) except what this push sets. Returns how many trainees."""
+        docstring) except what this push sets. Returns how many trainees of this process.
+        ``keep``: keep the push in the gradebook for a restart and for the other server
+        processes of the class (False: a push one of them made, applied here)."""
         if exercise is not None and exercise not in EXERCISE_IDS:
             raise ValueError(f"Unknown exercise {exercise!r}; use one of {', '.join(EXERCISE_IDS)}.")
         if tool_key is not None and tool_key not in self.tools:
@@ -422,7 +563,10 @@ class ClassRoom:
             self.distance_aids = aids
         if auto_touch is not None:
             self.auto_touch = bool(auto_touch)
-        self._keep_pushed(tool_key)
+        if keep:
+            self._keep_pushed(tool_key)
+            self.gradebook.add_push({"holder": self.holder, "exercise": exercise, "tool_key": tool_key,
+                                     "hide_distance": named, "auto_touch": auto_touch})
         with self._lock:
             trainees = list(self._trainees.values())
         for session, recorder, name in trainees:

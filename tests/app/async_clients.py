@@ -118,10 +118,10 @@ class LoadClient:
 
 
 async def connect_all(host: str, port: int, n: int, *, names: str | None = None, increment: str = "0.1",
-                      timeout_s: float = 120.0) -> list[LoadClient]:
+                      first: int = 0, timeout_s: float = 120.0) -> list[LoadClient]:
     """Connect ``n`` clients (a few at a time, as a class arrives), wait until each sees its
     jog key and a readout, pick the jog ``increment`` (mm) and with ``names`` (a prefix) join
-    each as ``"<names> 001"``..."""
+    each as ``"<names> 001"``... (numbered from ``first + 1``)."""
     clients = [LoadClient(i) for i in range(n)]
     sem = asyncio.Semaphore(8)
 
@@ -136,7 +136,7 @@ async def connect_all(host: str, port: int, n: int, *, names: str | None = None,
                     if time.monotonic() > deadline:
                         raise RuntimeError(f"client {c.index} never saw the name prompt")
                     await asyncio.sleep(0.05)
-                await c.join(f"{names} {c.index + 1:03d}")
+                await c.join(f"{names} {first + c.index + 1:03d}")
 
     await asyncio.gather(*(one(c) for c in clients))
     return clients
