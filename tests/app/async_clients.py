@@ -34,6 +34,8 @@ PLUS = "X +"
 NAME_LABEL = "Your name"
 JOIN_LABEL = "Join the class"
 INCREMENT_LABEL = "Increment"
+READOUT_LABEL = "Readout"
+_FRAME = re.compile(r"^\*\*TCP in (\w+)")
 _X_MM = re.compile(r"\bX\s+(-?\d+\.\d\d) mm")
 _CAMERA = dict(type="ViewerCameraMessage", wxyz=[1.0, 0.0, 0.0, 0.0], position=[2.0, -2.0, 1.0], fov=1.0,
                near=0.01, far=100.0, image_height=720, image_width=1280, look_at=[0.0, 0.0, 0.5],
@@ -58,6 +60,7 @@ class LoadClient:
     ws: Any = None
     uuids: dict[str, str] = field(default_factory=dict)
     readouts: list[tuple[float, float]] = field(default_factory=list)
+    frames: list[tuple[float, str]] = field(default_factory=list)   # (time, frame) of each TCP readout
     sends: list[float] = field(default_factory=list)
     ready: asyncio.Event = field(default_factory=asyncio.Event)
     task: asyncio.Task[None] | None = None
@@ -82,24 +85,28 @@ class LoadClient:
                     if kind == "GuiUpdateMessage":
                         text = (m.get("updates") or {}).get("_markdown")
                         if isinstance(text, str) and text.startswith("**TCP in "):
-                            x = _X_MM.search(text)
-                            if x:
-                                self.readouts.append((t, float(x.group(1))))
+                            self._readout(t, text)
                     elif kind in ("GuiButtonMessage", "GuiTextMessage", "GuiButtonGroupMessage"):
                         label = (m.get("props") or {}).get("label")
-                        if label in (PLUS, NAME_LABEL, JOIN_LABEL, INCREMENT_LABEL):
+                        if label in (PLUS, NAME_LABEL, JOIN_LABEL, INCREMENT_LABEL, READOUT_LABEL):
                             self.uuids[label] = m["uuid"]
                     elif kind == "GuiMarkdownMessage":
                         text = (m.get("props") or {}).get("_markdown")
                         if isinstance(text, str) and text.startswith("**TCP in "):
-                            x = _X_MM.search(text)
-                            if x:
-                                self.readouts.append((t, float(x.group(1))))
+                            self._readout(t, text)
                 if PLUS in self.uuids and INCREMENT_LABEL in self.uuids and self.readouts:
                     self.ready.set()
         except Exception:
             pass
         self.closed_early = True
+
+    def _readout(self, t: float, text: str) -> None:
+        x = _X_MM.search(text)
+        if x:
+            self.readouts.append((t, float(x.group(1))))
+        frame = _FRAME.match(text)
+        if frame:
+            self.frames.append((t, frame.group(1)))
 
     async def send_update(self, label: str, updates: dict[str, Any]) -> None:
         await self.ws.send(_encoder.encode({"type": "GuiUpdateMessage", "uuid": self.uuids[label],

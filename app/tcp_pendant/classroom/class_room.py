@@ -53,6 +53,7 @@ disconnects come from viser's thread pool and hand their trainer-view refresh to
 from __future__ import annotations
 
 import dataclasses
+import functools
 import hashlib
 import logging
 import os
@@ -422,7 +423,7 @@ class ClassRoom:
         for push_id, push in self.gradebook.pushes_after(self._push_seen):
             self._push_seen = push_id
             if push.get("holder") != self.holder:
-                self._hand_to_loop(lambda push=push: self._apply_remote_push(push))
+                self._hand_to_loop(functools.partial(self._apply_remote_push, push))
         if changed:
             self._hand_to_loop(self.refresh_trainers)
 
