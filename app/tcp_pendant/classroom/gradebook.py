@@ -1027,6 +1027,8 @@ class Gradebook:
         """The heartbeat of ``holder``: the names it holds get ``seen_at = now`` and their
         status. Returns the names of ``statuses`` it still holds (one another process took over,
         or the trainer released, is missing)."""
+        if not statuses:
+            return set()                          # nothing to renew: no write, no fsync
         t = time.time() if now is None else now
         rows = [(t, self._status_text(st), str(name), str(holder)) for name, st in statuses.items()]
         with self._write() as db:
