@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import asyncio
 import math
+import time
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
@@ -249,10 +250,12 @@ class PendantPanel:
         if hold_tick is False and self.session.jogger.settings.continuous:
             self._stop_hold()                        # the click that ends a hold: no move
             return
-        if not hold_tick and not self.session.jogger.gate.admit(arrival.arrived_s()):
+        arrived = arrival.arrived_s()
+        if not hold_tick and not self.session.jogger.gate.admit(arrived):
             self._report_drops_soon()                # a stale press: dropped, never carried out late
             return
-        self.session.jog(axis, sign, hold_tick=hold_tick)
+        waited = None if arrived is None else time.monotonic() - arrived
+        self.session.jog(axis, sign, hold_tick=hold_tick, waited_s=waited)
 
     # hold-to-jog on the server's 20 Hz clock (pendant/hold.py)
     def _on_hold(self, axis: str | int, sign: int) -> None:
