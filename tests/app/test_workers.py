@@ -52,6 +52,7 @@ def workers2(tmp_path: Path) -> Iterator[tuple[int, list[int], Path]]:
                for pid in pids[1:])
 
 
+@pytest.mark.timeout(300)
 def test_two_processes_share_the_port_the_class_and_each_keeps_the_deadman(workers2) -> None:
     port, pids, db = workers2
 

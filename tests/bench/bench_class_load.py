@@ -201,6 +201,9 @@ def main(argv: list[str] | None = None) -> int:
               f"{row['unanswered']:>7} {row['steps_s']:8.1f} {row['per_trainee']:6.1f}  {cpu:<31} "
               f"{row['clients_cpu']:.2f}" + (f"  ({row['no_readout']} clients saw no readout)"
                                               if row["no_readout"] else ""), flush=True)
+    print("  (latency: a press is matched to the first readout that shows as many presses; in a row with "
+          "unanswered presses the deadman dropped some, so later presses are matched to earlier sends: "
+          "those percentiles are upper bounds; rows with none are exact)")
     last = rows[-1]
     ok = verdict(last)
     print(f"RESULT: {last['k']} trainees asked {last['asked_s'] / last['k']:.1f} presses/s each on {args.workers} "
