@@ -7,6 +7,8 @@
 # when it is missing it is installed with apt-get as root (or through sudo). A user who can do
 # neither gets a one-line hint, every other test runs, and a last loud line says that the
 # browser tests did not run. Under CI=true a missing chromium fails the run (exit 1).
+# Debian's postgresql and nginx (the PostgreSQL gradebook and front-end tests) are installed
+# the same way; their tests are skipped where they are missing, and fail under CI=true.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 . scripts/venv.sh
@@ -19,8 +21,8 @@ if ! .venv/bin/python -m mypy; then
   exit 1
 fi
 
-install_chromium() {
-  local cmd='apt-get update -q && DEBIAN_FRONTEND=noninteractive apt-get install -y -q chromium'
+apt_install() {                    # apt_install PACKAGE...: as root, or through sudo; 2: neither
+  local cmd="apt-get update -q && DEBIAN_FRONTEND=noninteractive apt-get install -y -q $*"
   if [ "$(id -u)" = 0 ]; then
     sh -c "$cmd" >/dev/null
   elif command -v sudo >/dev/null 2>&1; then
@@ -29,6 +31,33 @@ install_chromium() {
     return 2
   fi
 }
+install_chromium() { apt_install chromium; }
+
+# The PostgreSQL gradebook's tests start a real server of Debian's postgresql package (initdb and
+# pg_ctl under /usr/lib/postgresql/*/bin, on a free port; tests/conftest.py) and the front-end
+# test checks docs/nginx-class.conf with Debian's nginx: both installed here like chromium. (On a
+# machine with systemd, Debian also starts both services after installing them; the tests use
+# neither: 'systemctl disable --now postgresql nginx' stops them.) Where they cannot be
+# installed, those tests are skipped with the reason (not run), and under CI=true they fail.
+# PG_BIN (a folder with pg_ctl) and NGINX (the nginx binary) point the tests at other copies.
+have_postgres() {
+  if [ -n "${PG_BIN:-}" ]; then [ -x "$PG_BIN/pg_ctl" ]; else compgen -G '/usr/lib/postgresql/*/bin/pg_ctl' >/dev/null; fi
+}
+have_nginx() {
+  if [ -n "${NGINX:-}" ]; then [ -x "$NGINX" ]; else command -v nginx >/dev/null 2>&1 || [ -x /usr/sbin/nginx ]; fi
+}
+servers=()
+have_postgres || servers+=(postgresql)
+have_nginx || servers+=(nginx)
+if [ ${#servers[@]} -gt 0 ]; then
+  rc=0
+  apt_install "${servers[@]}" || rc=$?
+  if ! have_postgres || ! have_nginx; then
+    echo "!!!!!!!! run-tests.sh: could not install ${servers[*]} (apt-get exit $rc$([ "$rc" = 2 ] && echo ': neither root nor sudo')):" \
+         "the PostgreSQL gradebook and nginx front-end tests will not run (CI=true fails them);" \
+         "install them by hand: apt-get install ${servers[*]} !!!!!!!!" >&2
+  fi
+fi
 
 chromium_missing=""
 if [ -n "${CHROMIUM:-}" ]; then                    # the browser tests' own override

@@ -28,6 +28,8 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from tcp_pendant.classroom.gradebook_db import class_db_target, url_has_password
+
 if TYPE_CHECKING:                       # the server is imported in main() only (no pinocchio for --help)
     from tcp_pendant.server import PendantApp
 
@@ -81,10 +83,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--class", dest="classroom", action="store_true",
                    help="run a class: each browser gives a name, every calibration is stored in the class "
                         "gradebook, and a trainer view (token) shows the class; implied by --class-db, "
-                        "--exercise and --trainer-token")
-    p.add_argument("--class-db", type=Path, default=None, metavar="PATH",
+                        "--exercise (and its --exercise-* options) and --trainer-token")
+    p.add_argument("--class-db", type=class_db_target, default=None, metavar="PATH|URL",
                    help="the class gradebook, an SQLite file every trainee's calibrations are stored in "
-                        "(default with --class: the user's data directory, class.sqlite3)")
+                        "(default with --class: the user's data directory, class.sqlite3), or a "
+                        "postgresql://USER@HOST:PORT/DATABASE URL: one PostgreSQL database that servers on "
+                        "several machines share (needs psycopg: pip install 'tcp-pendant[postgres]')")
     p.add_argument("--trainer-token", default=None, metavar="TOKEN",
                    help="the token that opens the trainer view, 16 to 200 printable characters (default: "
                         "$TCP_PENDANT_TRAINER_TOKEN, else a random one, printed at start); a token given "
@@ -98,6 +102,18 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--exercise-seed", type=int, default=None, metavar="N",
                    help="seed of the mystery tools, for a reproducible demo (default: the class's own "
                         "secret seed, drawn at random once and kept in the gradebook)")
+    p.add_argument("--exercise-instructions", default=None, metavar="TEXT",
+                   help="the exercise's instructions, shown in a banner at the top of every trainee's "
+                        "panel (plain text, at most 2000 characters; default: the instructions kept in "
+                        "the gradebook, else none)")
+    p.add_argument("--exercise-methods", default=None, metavar="IDS",
+                   help="the calibration methods trainees may start, comma-separated wizard ids (xyz4, "
+                        "reference, tcp-zx, three-point, abc-world, tcp-check, beam); the others are not "
+                        "offered (default: the methods kept in the gradebook, else all)")
+    p.add_argument("--exercise-min-touches", type=int, default=None, metavar="N",
+                   help="the fewest touches a Finish takes (0 to 20) in the methods whose touch count the "
+                        "trainee chooses (XYZ 4-point, TCP & Z, X); default: the minimum kept in the "
+                        "gradebook, else none")
     p.add_argument("--scenario", default="off", choices=SCENARIO_CHOICES, metavar="NAME",
                    help="training: a systematic error every pendant starts with (off, bent-tool, "
                         "robot-accuracy, moved-reference; default off); the trainer can change it in the "
@@ -214,7 +230,8 @@ def _main(argv: Sequence[str] | None) -> int:
     from tcp_pendant.classroom.trainer_token import TrainerTokenError, resolve_trainer_token
 
     classroom = bool(args.classroom or args.class_db or args.exercise or args.trainer_token
-                     or args.trainer_token_file)
+                     or args.trainer_token_file or args.exercise_instructions is not None
+                     or args.exercise_methods is not None or args.exercise_min_touches is not None)
     try:                                    # the environment's token only matters for a class
         trainer_token = resolve_trainer_token(args.trainer_token, args.trainer_token_file,
                                               os.environ if classroom else {})
@@ -223,13 +240,17 @@ def _main(argv: Sequence[str] | None) -> int:
         return 2
     if args.shared and classroom:
         print("tcp-pendant: error: --shared is a lecture demo without names or gradebook; drop "
-              "--class / --class-db / --exercise / --trainer-token / --trainer-token-file, or drop --shared",
+              "--class / --class-db / --exercise / --exercise-instructions / --exercise-methods / "
+              "--exercise-min-touches / --trainer-token / --trainer-token-file, or drop --shared",
               file=sys.stderr)
         return 2
     if args.trainer_token is not None and worker is None:
         print("tcp-pendant: note: a --trainer-token on the command line shows in the process list; "
               "--trainer-token-file PATH or TCP_PENDANT_TRAINER_TOKEN keep it out", file=sys.stderr)
     class_db = args.class_db
+    if isinstance(class_db, str) and url_has_password(class_db):
+        print("tcp-pendant: note: a password in the --class-db URL shows in the process list; "
+              "PGPASSWORD or ~/.pgpass keep it out", file=sys.stderr)
     if classroom and class_db is None:
         class_db = default_gradebook_path()
         try:
@@ -244,7 +265,11 @@ def _main(argv: Sequence[str] | None) -> int:
                            port=args.port, tool_library=args.tool_library, shared=args.shared,
                            reference_tip_mm=tip, allow_origins=tuple(args.allow_origin), class_db=class_db,
                            trainer_token=trainer_token, exercise=args.exercise,
-                           exercise_seed=args.exercise_seed, scenario=args.scenario.replace("-", "_"),
+                           exercise_seed=args.exercise_seed,
+                           exercise_instructions=args.exercise_instructions,
+                           exercise_methods=None if args.exercise_methods is None else tuple(
+                               m.strip() for m in args.exercise_methods.split(",") if m.strip()),
+                           exercise_min_touches=args.exercise_min_touches, scenario=args.scenario.replace("-", "_"),
                            scenario_seed=args.scenario_seed, presenter=args.presenter,
                            hide_truth=args.hide_truth,
                            beam_width_mm=args.beam_width, beam_repeatability_mm=args.beam_repeatability,
@@ -318,10 +343,10 @@ def _class_lines(app: PendantApp) -> str:
         return ""
     exercise = "mystery tools" if room.exercise == "mystery" else "free practice"
     if room.trainer_token is None:
-        return (f"  class gradebook {room.gradebook.path} ({exercise})\n"
+        return (f"  class gradebook {room.gradebook.location} ({exercise})\n"
                 f"Trainer view: {app.url} with the trainer token this class began with (kept hashed in the "
                 "gradebook, so an open trainer page reconnects); give --trainer-token to set a new one\n")
-    return (f"  class gradebook {room.gradebook.path} ({exercise})\n"
+    return (f"  class gradebook {room.gradebook.location} ({exercise})\n"
             f"Trainer view: {app.trainer_url}  trainer token: {room.trainer_token}\n"
             "  (open that address: the page fills in the token and drops it from the address bar; or open the "
             "page and type the token in \"Trainer token\" of the welcome window; keep both secret)\n")

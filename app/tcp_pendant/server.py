@@ -23,7 +23,7 @@ import socket
 import threading
 import time
 from collections.abc import Callable, Generator, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 from urllib.parse import quote
@@ -92,13 +92,17 @@ class AppConfig:
         library_poll_s: how often the library file is checked for changes by others.
         allow_origins: web origins (``scheme://host[:port]``) whose pages may connect besides
             the pendant's own address, e.g. a reverse proxy's (``tcp_pendant.origin_check``).
-        class_db: the class gradebook (SQLite file); None: no classroom (no name prompt, nothing
-            recorded). The CLI passes its default path. Ignored with ``shared``.
+        class_db: the class gradebook: an SQLite file, or a ``postgresql://`` URL (a ``str``) of
+            the PostgreSQL database several servers share; None: no classroom (no name prompt,
+            nothing recorded). The CLI passes its default path. Ignored with ``shared``.
         trainer_token: the token that opens the trainer view, 16 to 200 printable characters
             (None: a random one).
         exercise: None (free practice) or "mystery" (each trainee gets a mystery tool).
         exercise_seed: seed of the mystery tools (None: the class's secret seed, drawn once and
             kept in the gradebook; a number: that seed, for a reproducible demo).
+        exercise_instructions, exercise_methods, exercise_min_touches: the exercise's brief at
+            start (``ClassRoom``: instructions as plain text, the wizard kinds trainees may
+            start, the fewest touches a Finish takes); None: the brief kept in the gradebook.
         scenario: the systematic error every session starts with (training;
             ``controller.scenarios``: "off", "bent_tool", "robot_accuracy", "moved_reference");
             the trainer changes it per pendant in the Calibrate tab.
@@ -131,10 +135,13 @@ class AppConfig:
     reference_tip_mm: tuple[float, float, float] | None = None
     library_poll_s: float = 1.0
     allow_origins: tuple[str, ...] = ()
-    class_db: Path | None = None
+    class_db: Path | str | None = field(default=None, repr=False)   # a URL may carry a password
     trainer_token: str | None = None
     exercise: str | None = None
     exercise_seed: int | None = None
+    exercise_instructions: str | None = None
+    exercise_methods: tuple[str, ...] | None = None
+    exercise_min_touches: int | None = None
     scenario: str = "off"
     scenario_seed: int = 0
     presenter: bool = False
@@ -355,6 +362,9 @@ class PendantApp:
             self.classroom = ClassRoom(self.gradebook, tools,
                                        trainer_token=config.trainer_token,
                                        exercise=config.exercise, exercise_seed=config.exercise_seed,
+                                       instructions=config.exercise_instructions,
+                                       allowed_methods=config.exercise_methods,
+                                       min_touches=config.exercise_min_touches,
                                        hand_to_loop=self._hand_to_loop,
                                        presence_poll_s=config.presence_poll_s)
 

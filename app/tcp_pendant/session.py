@@ -29,7 +29,7 @@ the last step), :meth:`Session.cancel_wizard`, :meth:`Session.resume_wizard`,
 :meth:`Session.save_result`, ...). Views never change the controller or the workflow
 themselves. Each command ends in ONE change signal: every function given to
 :meth:`Session.subscribe` is called with a :class:`SessionChange` saying what to re-render
-(pose, tool, touches, wizard, library), what happened (``events``: typed facts taken when it
+(pose, tool, touches, wizard, library, notice), what happened (``events``: typed facts taken when it
 happened, ``tcp_pendant.events``) and carrying the robot's
 :class:`~tcp_pendant.controller.pose_state.PoseState`, computed once for all of them. Views
 subscribe and re-render from state; they never call each other. Inside :meth:`Session.batch`
@@ -78,8 +78,9 @@ from tcp_pendant.controller.pose_state import PoseState, pose_state, pose_state_
 from tcp_pendant.controller.scenarios import Scenario, ScenarioWorld, bent_tool, realize
 from tcp_pendant.events import Crash, SessionEvent
 from tcp_pendant.pendant import Jogger, touch_label
-from tcp_pendant.pendant.exercise_rules import FREE_PRACTICE, ExerciseRules
-from tcp_pendant.wizards import Wizard, WizardResult, WizardStateError
+from tcp_pendant.pendant.class_messages import MAX_WAITING_MESSAGES, ClassMessage
+from tcp_pendant.pendant.exercise_rules import FREE_PRACTICE, ExerciseRules, RuleRefusal
+from tcp_pendant.wizards import Wizard, WizardResult, WizardStateError, wizard_class, wizard_classes
 
 if TYPE_CHECKING:
     import viser
@@ -152,6 +153,8 @@ class SessionChange:
         touches: a touch was recorded or deleted.
         wizard: the Calibrate workflow's state changed (a click in the Calibrate tab).
         library: the session's copy of the library's list was re-read.
+        notice: the exercise's instructions or the trainer's messages waiting here changed
+            (the banner and the message box re-render).
         jog: the outcome of the move, for the status line (None: not a jog, or unchanged).
         state: the robot's pose state after the change (computed once, for every subscriber),
             None when neither ``pose`` nor ``tool`` is set.
@@ -165,6 +168,7 @@ class SessionChange:
     touches: bool = False
     wizard: bool = False
     library: bool = False
+    notice: bool = False
     jog: JogResult | None = None
     state: PoseState | None = None
     events: tuple[SessionEvent, ...] = ()
@@ -174,7 +178,7 @@ class SessionChange:
         is recomputed)."""
         return SessionChange(pose=self.pose or other.pose, tool=self.tool or other.tool,
                              touches=self.touches or other.touches, wizard=self.wizard or other.wizard,
-                             library=self.library or other.library,
+                             library=self.library or other.library, notice=self.notice or other.notice,
                              jog=other.jog if other.jog is not None else self.jog,
                              events=self.events + other.events)
 
@@ -207,8 +211,8 @@ class Session:
             ``"tip"``: viser label handles), which the wizards' scene places apart.
         hide_distance: "Hide distance" (training: judge the touch by eye); change it with
             :meth:`set_hide_distance`. While it is on, a jog does not stop at the reference tip.
-        rules: what the trainer's exercise allows (``pendant.exercise_rules``); change it with
-            :meth:`set_rules`.
+        rules: what the trainer's exercise allows (``pendant.exercise_rules``), with its
+            instructions; change it with :meth:`set_rules`.
         rng: the session's random generator (Auto-touch's operator error and directions, the
             beam's repeatability, the scenarios the trainer plays): the server draws it from its
             one seed (``--seed``), so a seeded lesson replays the same way.
@@ -263,6 +267,7 @@ class Session:
         self._scenario_touches = 0                      # touches recorded since (never decreases)
         self._crashed = False                           # the touch geometry's crash state at the last signal
         self._truth_hidden_always = False               # --hide-truth: no exercise's end shows it
+        self._messages: list[ClassMessage] = []         # the trainer's messages not dismissed yet, oldest first
 
     # ------------------------------------------------------------ the change signal
     def subscribe(self, fn: Callable[[SessionChange], None]) -> None:
@@ -400,12 +405,44 @@ class Session:
 
     def set_rules(self, rules: ExerciseRules) -> None:
         """The exercise's rules (the classroom sets them): locked distance aids switch "Hide
-        distance" on; the views re-render (``pose`` and ``wizard``: the checkbox, Auto-touch)."""
+        distance" on; the views re-render (``pose`` and ``wizard``: the checkbox, Auto-touch,
+        the methods offered; ``notice``: the instructions' banner)."""
         with self.lock, self.batch():
             self.rules = rules
             if rules.distance_locked:
                 self.set_hide_distance(True)
-            self.changed(pose=True, wizard=True)
+            self.changed(pose=True, wizard=True, notice=True)
+
+    # ------------------------------------------------------------ the trainer's messages
+    @property
+    def messages(self) -> tuple[ClassMessage, ...]:
+        """The trainer's messages given to this session and not dismissed, oldest first."""
+        with self.lock:
+            return tuple(self._messages)
+
+    def show_message(self, message: ClassMessage) -> None:
+        """Keep ``message`` until it is dismissed (the classroom delivers it; a message already
+        here is not shown twice; beyond ``MAX_WAITING_MESSAGES`` the oldest goes); one
+        ``notice`` signal."""
+        if not isinstance(message, ClassMessage):
+            raise ControllerError(f"A message must be a ClassMessage, got {type(message).__name__}.")
+        with self.lock:
+            if any(m.message_id == message.message_id for m in self._messages):
+                return
+            self._messages.append(message)
+            del self._messages[:-MAX_WAITING_MESSAGES]
+            self.changed(notice=True)
+
+    def dismiss_message(self, message_id: int) -> bool:
+        """The trainee dismissed the message ``message_id`` (one of :attr:`messages`); a stale
+        or unknown id changes nothing. True when one was dismissed; one ``notice`` signal."""
+        with self.lock:
+            kept = [m for m in self._messages if m.message_id != message_id]
+            if len(kept) == len(self._messages):
+                return False
+            self._messages = kept
+            self.changed(notice=True)
+            return True
 
     def refresh(self) -> None:
         """Re-render everything that shows the robot (the same signal as :meth:`moved`)."""
@@ -694,15 +731,52 @@ class Session:
             finally:
                 self.changed(wizard=True, pose=moves)
 
+    def _check_method(self, kind: str, options: dict[str, Any] | None = None) -> None:
+        """The exercise's methods (``rules.allowed_methods``) and, for a method without Add
+        point whose touch count is chosen at start (``options["n_points"]``), its minimum
+        number of touches.
+
+        Raises:
+            RuleRefusal: the method is not allowed, or too few touches are asked for.
+            WizardError: unknown kind, or options the method refuses (``Wizard.parse_options``).
+        """
+        cls = wizard_class(kind)
+        self.rules.check_method(kind, {c.kind: c.title for c in wizard_classes()})
+        counted = any(o.name == "n_points" for o in cls.options)
+        if counted and not cls.supports_add_point and options is not None and self.rules.min_touches:
+            n_points = int(cls.parse_options(options)["n_points"])
+            if self.rules.touches_refusal(n_points, can_add_point=False) is not None:
+                raise RuleRefusal(f"This exercise asks for at least {self.rules.min_touches} touches: set "
+                                  f"Touches to {self.rules.min_touches} or more for the {cls.title} method.")
+
+    def finish_refusal(self) -> str | None:
+        """Why Finish of the wizard on show is refused by the exercise (too few touches for a
+        method whose touch count the trainee chooses, ``CalibrationWorkflow.touches_short``),
+        None when it is not; the step panel shows it, :meth:`next_step` and Auto-touch's last
+        touch do not finish then."""
+        with self.lock:
+            return self.workflow.touches_short()
+
     def start_wizard(self, kind: str, **options: Any) -> Wizard:
         """Open a wizard of the registered ``kind`` with its start options (the open one is
-        cancelled and kept; ``CalibrationWorkflow.start``)."""
+        cancelled and kept; ``CalibrationWorkflow.start``).
+
+        Raises:
+            RuleRefusal: the exercise does not allow the method, or (a method without Add point)
+                its ``n_points`` is below the exercise's minimum; nothing is opened.
+        """
         with self._wizard_command(moves=True):
+            self._check_method(kind, options)
             return self.workflow.start(kind, **options)
 
     def start_from_touches(self, *, estimator: str = "lstsq") -> Wizard:
-        """XYZ 4-point from the free touches recorded with Record point, in order."""
+        """XYZ 4-point from the free touches recorded with Record point, in order.
+
+        Raises:
+            RuleRefusal: the exercise does not allow the XYZ 4-point method.
+        """
         with self._wizard_command(moves=True):
+            self._check_method("xyz4")
             return self.workflow.start_from_touches(list(self.touches), estimator=estimator)
 
     def record_step(self) -> None:
@@ -722,7 +796,12 @@ class Session:
 
     def next_step(self) -> WizardResult | None:
         """Next step, or on the last step Finish: the result (a wizard with a controller job runs
-        it here, synchronously; the views take the job and run it in a worker instead)."""
+        it here, synchronously; the views take the job and run it in a worker instead).
+
+        Raises:
+            RuleRefusal: Finish with fewer touches than the exercise asks for
+                (:meth:`finish_refusal`); the wizard stays on its last step.
+        """
         with self._wizard_command(moves=True):
             return self.workflow.next()
 

@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import re
 
-__all__ = ["WORD_JOINER", "escape_html", "escape_markdown"]
+__all__ = ["WORD_JOINER", "escape_html", "escape_markdown", "escape_markdown_lines"]
 
 WORD_JOINER = "\u2060"
 """Invisible, zero-width character that breaks GFM's autolink-literal patterns."""
@@ -97,3 +97,17 @@ def escape_markdown(text: str) -> str:
         else:
             out.append(c)
     return "".join(out)
+
+
+def escape_markdown_lines(text: str) -> str:
+    """User text of several lines (a trainer's instructions or message) as markdown
+    paragraphs: each non-blank line through :func:`escape_markdown`, one paragraph per line.
+
+    Args:
+        text: the user's text; its line breaks separate the paragraphs.
+
+    Returns:
+        Markdown with no raw ``<`` and no markdown syntax, a paragraph per line of ``text``.
+    """
+    lines = _LINE_BREAKS.split("" if text is None else str(text))
+    return "\n\n".join(escape_markdown(line) for line in lines if line.strip())

@@ -108,3 +108,32 @@ def test_the_exercise_seed_is_the_classs_unless_given_and_never_printed(tmp_path
         assert "class gradebook" in lines and str(seed) not in lines
         assert ClassRoom(book, {}, trainer_token="trainer-tok-12345678", exercise_seed=7)._seed() == 7   # a demo's
         assert book.exercise_seed() == seed                                                   # kept
+
+
+def test_server_with_an_unreachable_postgresql_gradebook_says_so_without_the_password(
+        tmp_path: Path, postgres_server, capsys: pytest.CaptureFixture[str]) -> None:
+    url = postgres_server.url("no_such_class")
+    assert main(["--port", "0", "--tool-library", str(tmp_path / "t.json"), "--class-db", url]) == 2
+    err = capsys.readouterr().err
+    assert postgres_server.password not in err
+    note, error = err.strip().splitlines()
+    assert note.startswith("tcp-pendant: note: a password in the --class-db URL shows in the process list")
+    assert error.startswith("tcp-pendant: error: Cannot reach the PostgreSQL gradebook "
+                            f"postgresql://{postgres_server.user}:***@127.0.0.1:{postgres_server.port}/no_such_class")
+    assert 'database "no_such_class" does not exist' in error
+    assert build_parser().parse_args(["--class-db", url]).class_db == url      # a URL stays a URL
+
+
+def test_the_ready_message_names_a_postgresql_gradebook_without_its_password(postgres_server) -> None:
+    from types import SimpleNamespace
+
+    from tcp_pendant.classroom.class_room import ClassRoom
+    from tcp_pendant.classroom.gradebook_db import mask_url
+    from tcp_pendant.cli import _class_lines
+
+    url = postgres_server.fresh_schema()
+    with Gradebook(url) as book:
+        room = ClassRoom(book, {}, trainer_token="trainer-tok-12345678")
+        lines = _class_lines(SimpleNamespace(classroom=room, trainer_url="http://127.0.0.1:1/?trainer=tok-12345678"))
+    assert f"  class gradebook {mask_url(url)} (free practice)\n" in lines
+    assert ":***@" in lines and postgres_server.password not in lines

@@ -23,25 +23,20 @@ class RecordingClient(DrainingClient):
         self._lock = threading.Lock()
         super().__init__(port)
 
-    def _drain(self) -> None:
-        try:
-            for msg in self.ws:
-                self.n_messages += 1
-                if not isinstance(msg, bytes):
-                    continue
-                for m in decode_window(msg):
-                    kind, props = m.get("type"), m.get("props") or {}
-                    with self._lock:
-                        if kind == "NotificationShowMessage":
-                            self.notifications.append(props)
-                        elif kind == "GuiTabGroupMessage":
-                            self.tab_labels[m["uuid"]] = tuple(props.get("_tab_labels", ()))
-                        elif kind == "GuiUpdateMessage" and "_tab_labels" in m["updates"]:
-                            self.tab_labels[m["uuid"]] = tuple(m["updates"]["_tab_labels"])
-                        elif kind == "GuiButtonMessage":
-                            self.button_labels.add(props.get("label"))
-        except Exception:
-            pass
+    def _received(self, msg: bytes | str) -> None:
+        if not isinstance(msg, bytes):
+            return
+        for m in decode_window(msg):
+            kind, props = m.get("type"), m.get("props") or {}
+            with self._lock:
+                if kind == "NotificationShowMessage":
+                    self.notifications.append(props)
+                elif kind == "GuiTabGroupMessage":
+                    self.tab_labels[m["uuid"]] = tuple(props.get("_tab_labels", ()))
+                elif kind == "GuiUpdateMessage" and "_tab_labels" in m["updates"]:
+                    self.tab_labels[m["uuid"]] = tuple(m["updates"]["_tab_labels"])
+                elif kind == "GuiButtonMessage":
+                    self.button_labels.add(props.get("label"))
 
     def titled(self, title: str) -> list[dict]:
         with self._lock:

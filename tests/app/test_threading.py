@@ -40,16 +40,11 @@ class Browser(DrainingClient):
         self._send_lock = threading.Lock()
         super().__init__(port)
 
-    def _drain(self) -> None:
-        try:
-            for msg in self.ws:
-                self.n_messages += 1
-                if isinstance(msg, bytes):
-                    for m in decode_window(msg):
-                        if m.get("type") == "GuiUpdateMessage":
-                            self.received.append((m["uuid"], dict(m["updates"])))
-        except Exception:
-            pass
+    def _received(self, msg: bytes | str) -> None:
+        if isinstance(msg, bytes):
+            for m in decode_window(msg):
+                if m.get("type") == "GuiUpdateMessage":
+                    self.received.append((m["uuid"], dict(m["updates"])))
 
     def values_of(self, handle: Any) -> list[Any]:
         """Every value the server sent this browser for ``handle``, in order."""

@@ -37,13 +37,19 @@ def wait_until(cond: Callable[[], bool], timeout: float = 20.0, what: str = "con
 class DrainingClient:
     """Connects to a viser server and reads (and discards) every message in a thread.
 
+    ``headers``: extra request headers of the upgrade (e.g. a browser's Cookie and Origin);
+    ``host_name``: the name the request is for (its ``Host``), reached at ``host`` (as a browser
+    that resolved the name would).
+
     Attributes:
         n_messages, n_bytes: what the server sent so far.
     """
 
-    def __init__(self, port: int, host: str = "127.0.0.1") -> None:
-        self.ws = connect(f"ws://{host}:{port}", subprotocols=[f"viser-v{viser.__version__}"],
-                          max_size=None, open_timeout=20)
+    def __init__(self, port: int, host: str = "127.0.0.1", headers: dict[str, str] | None = None,
+                 host_name: str | None = None) -> None:
+        sock = None if host_name is None else socket.create_connection((host, port), timeout=20)
+        self.ws = connect(f"ws://{host_name or host}:{port}", subprotocols=[f"viser-v{viser.__version__}"],
+                          max_size=None, open_timeout=20, additional_headers=headers, sock=sock)
         self.n_messages = 0
         self.n_bytes = 0
         self._thread = threading.Thread(target=self._drain, daemon=True)

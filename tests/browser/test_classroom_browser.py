@@ -153,3 +153,24 @@ def test_the_browser_key_is_kept_in_local_storage_across_a_reload_and_a_restart(
                 a.stop()
             except Exception:
                 pass
+
+
+def test_the_exercise_banner_is_on_screen_at_1024x768_without_scrolling(pendant_server, new_page, shot,
+                                                                         tmp_path: Path) -> None:
+    """The instructions given at start (``--exercise-instructions``) are the first thing of the
+    trainee's panel: in view on a 1024x768 screen as soon as the trainee joined, shown literally."""
+    text = "Calibrate the pointer <b>now</b>: 6 touches from all sides."
+    sp = pendant_server("--class-db", str(tmp_path / "class.sqlite3"), "--trainer-token", TOKEN,
+                        "--exercise-instructions", text, "--exercise-methods", "xyz4,reference",
+                        "--exercise-min-touches", "6")
+    anna = new_page(sp.url, width=1024, height=768)
+    join(anna, "Anna")
+    banner = anna.get_by_text(text, exact=True)
+    banner.wait_for(state="visible", timeout=TIMEOUT_MS)
+    box = banner.bounding_box()
+    assert box is not None and box["y"] >= 0 and box["y"] + box["height"] <= 768 and box["x"] + box["width"] <= 1024
+    # nothing covers it: the element at its centre is the banner's own text
+    hit = anna.evaluate("([x, y]) => document.elementFromPoint(x, y)?.textContent || ''",
+                        [box["x"] + box["width"] / 2, box["y"] + box["height"] / 2])
+    assert text in hit
+    shot(anna, "classroom_exercise_banner_1024x768")

@@ -181,3 +181,19 @@ def test_the_hide_truth_option_reaches_every_session(tmp_path: Path) -> None:
         assert "Against the true TOOL frame" not in view.result.result_md.content
     finally:
         app.stop()
+
+
+def test_joints_are_kept_only_for_the_poses_a_run_still_holds(tmp_path: Path) -> None:
+    """A step recorded again many times keeps one pose's joints, and the pose the run holds
+    still gives the joints it was recorded at."""
+    s = make_session(tmp_path / "tools.json", seed=5)
+    s.start_wizard("xyz4")
+    s.auto_touch(AutoTouchRequest())
+    for _ in range(40):                                    # step 1 again and again, by hand
+        if s.workflow.wizard.step_index > 0:
+            s.back()
+        s.record_step()
+    held = s.workflow.wizard.recorded_poses
+    assert len(held) == 1
+    assert len(s.workflow._record_q) == 1
+    np.testing.assert_allclose(s.workflow.joints_at_record(held[0]), s.controller.q_rad)

@@ -15,8 +15,9 @@ from tcp_pendant.classroom.names import TraineeNameError
 
 
 @pytest.fixture
-def book(tmp_path: Path) -> Gradebook:
-    with Gradebook(tmp_path / "class.sqlite3") as g:
+def book(gradebook_target: Path | str) -> Gradebook:
+    """A new gradebook, once as an SQLite file and once in PostgreSQL (tests/conftest.py)."""
+    with Gradebook(gradebook_target) as g:
         yield g
 
 

@@ -1,5 +1,6 @@
-"""The SQLite gradebook: what is stored, what a grade row says, and that a file it cannot read is
-refused with one clear error and left untouched."""
+"""The gradebook: what is stored, what a grade row says (on SQLite and on PostgreSQL: every test
+that takes ``book`` runs on both), and that a file it cannot read is refused with one clear
+error and left untouched."""
 
 from __future__ import annotations
 
@@ -27,8 +28,9 @@ JOINTS = [10.0, -80.0, 100.0, 20.0, 40.0, 30.0]
 
 
 @pytest.fixture
-def book(tmp_path: Path) -> Gradebook:
-    with Gradebook(tmp_path / "class.sqlite3") as g:
+def book(gradebook_target: Path | str) -> Gradebook:
+    """A new gradebook, once as an SQLite file and once in PostgreSQL (tests/conftest.py)."""
+    with Gradebook(gradebook_target) as g:
         yield g
 
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import io
+import re
 import sqlite3
 from pathlib import Path
 
@@ -11,6 +12,7 @@ import numpy as np
 import pytest
 from tcp_pendant.classroom import grades_cli
 from tcp_pendant.classroom.gradebook import CSV_COLUMNS, SCHEMA_VERSION, Gradebook
+from tcp_pendant.classroom.gradebook_db import mask_url
 from tcp_pendant.classroom.lms import MOODLE_POINTS, PER_TRAINEE_COLUMNS
 
 POSE = np.eye(4)
@@ -168,3 +170,40 @@ def test_bad_option_exits_2(capsys: pytest.CaptureFixture[str]) -> None:
 def test_terminal_never_gets_control_characters() -> None:
     assert grades_cli._terminal_text("Ben\x1b[31m", 24) == "Ben?[31m"
     assert grades_cli._terminal_text("x" * 30, 24) == "x" * 23 + "…"
+
+
+def test_grades_of_a_postgresql_gradebook_match_the_sqlite_ones_without_the_password(
+        tmp_path: Path, postgres_server, capsys: pytest.CaptureFixture[str]) -> None:
+    url = postgres_server.fresh_schema()
+    _make(url)
+    _make(tmp_path / "class.sqlite3")
+    tables = []
+    for target in (url, str(tmp_path / "class.sqlite3")):
+        assert grades_cli.main(["--class-db", target]) == 0
+        tables.append(capsys.readouterr().out.splitlines())
+    pg, lite = tables
+    assert pg[0] == f"Gradebook {mask_url(url)}: 2 finished calibrations, 1 in progress"
+    assert ":***@" in pg[0] and postgres_server.password not in "\n".join(pg)
+    no_duration = lambda lines: [re.sub(r"\b\d+:\d\d\b", "m:ss", line) for line in lines]  # noqa: E731
+    assert no_duration(pg[1:]) == no_duration(lite[1:])        # the same rows
+    texts = []
+    for target in (url, str(tmp_path / "class.sqlite3")):
+        assert grades_cli.main(["--class-db", target, "--csv"]) == 0
+        texts.append(list(csv.DictReader(io.StringIO(capsys.readouterr().out))))
+    strip = ("started_at", "finished_at", "duration_s")
+    assert [{k: v for k, v in r.items() if k not in strip} for r in texts[0]] == \
+        [{k: v for k, v in r.items() if k not in strip} for r in texts[1]]
+    assert len(texts[0]) == 3
+
+
+def test_an_unreachable_postgresql_gradebook_is_one_line_and_exit_2(postgres_server,
+                                                                     capsys: pytest.CaptureFixture[str]) -> None:
+    missing = postgres_server.url("no_such_class")
+    assert grades_cli.main(["--class-db", missing]) == 2
+    captured = capsys.readouterr()
+    lines = captured.err.splitlines()
+    assert captured.out == "" and len(lines) == 1 and lines[0].startswith("tcp-pendant grades: error: Cannot reach")
+    assert mask_url(missing) in lines[0] and postgres_server.password not in lines[0]
+    empty = postgres_server.fresh_schema()
+    assert grades_cli.main(["--class-db", empty]) == 2                  # never makes a gradebook
+    assert "No gradebook in" in capsys.readouterr().err

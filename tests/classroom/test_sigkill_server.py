@@ -36,24 +36,21 @@ class BrowserLike(ButtonClient):
         self.acks = 0
         super().__init__(port, ("Join the class", "Start", "Auto-touch"))
 
-    def _drain(self) -> None:
-        try:
-            for msg in self.ws:
-                if not isinstance(msg, bytes):
-                    continue
-                for m in decode_window(msg):
-                    kind = m.get("type")
-                    props = m.get("props") or {}
-                    if kind == "GuiButtonMessage" and props.get("label") in self.labels:
-                        self.button_uuids.setdefault(props["label"], m["uuid"])
-                    elif kind == "GuiTextMessage":
-                        self.text_uuids.setdefault(props.get("label"), m["uuid"])
-                    elif kind == "GuiUpdateMessage" and "Operator error σ" in str(m["updates"].get("_markdown", "")):
-                        self.acks += 1
-                if len(self.button_uuids) == len(self.labels):
-                    self.found.set()
-        except Exception:
-            pass
+    def _received(self, msg: bytes | str) -> None:
+        if not isinstance(msg, bytes):
+            return
+        for m in decode_window(msg):
+            self._decoded(m)
+        if len(self.button_uuids) == len(self.labels):
+            self.found.set()
+
+    def _decoded(self, m: dict) -> None:
+        super()._decoded(m)
+        kind = m.get("type")
+        if kind == "GuiTextMessage":
+            self.text_uuids.setdefault((m.get("props") or {}).get("label"), m["uuid"])
+        elif kind == "GuiUpdateMessage" and "Operator error σ" in str(m["updates"].get("_markdown", "")):
+            self.acks += 1
 
     def type_text(self, label: str, text: str) -> None:
         msg = _messages.GuiUpdateMessage(self.text_uuids[label], {"value": text})

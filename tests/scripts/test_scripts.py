@@ -7,6 +7,7 @@ The fake ``.venv/bin/python`` logs every call to ``calls.log`` and answers ``-m 
 ``.venv/bin/tcp-pendant`` logs its arguments. ``PATH`` holds only the tools the scripts need
 (bash, coreutils), a fake ``id`` printing ``$FAKE_UID``, and whatever a test adds (``sudo``,
 ``apt-get``, ``chromium``): without them the machine has no root, no sudo and no chromium.
+``PG_BIN`` and ``NGINX`` point at a fake PostgreSQL and nginx (present unless a test removes them).
 """
 
 from __future__ import annotations
@@ -56,6 +57,10 @@ exit 0
         assert real is not None, tool
         os.symlink(real, fake / tool)
     _write_exe(fake / "id", "#!/bin/sh\necho \"${FAKE_UID:-1000}\"\n")
+    # Debian's postgresql and nginx as the tests find them (PG_BIN, NGINX: run() points there)
+    (tmp_path / "pg").mkdir()
+    _write_exe(tmp_path / "pg" / "pg_ctl", "#!/bin/sh\n")
+    _write_exe(tmp_path / "nginx", "#!/bin/sh\n")
     return r
 
 
@@ -64,7 +69,8 @@ def sha(repo: Path) -> str:
 
 
 def run(repo: Path, script: str, *args: str, **env: str) -> subprocess.CompletedProcess[str]:
-    base = {"PATH": str(repo.parent / "bin"), "HOME": str(repo.parent)}
+    base = {"PATH": str(repo.parent / "bin"), "HOME": str(repo.parent), "PG_BIN": str(repo.parent / "pg"),
+            "NGINX": str(repo.parent / "nginx")}
     return subprocess.run(["bash", str(repo / "scripts" / script), *args], env={**base, **env},
                           capture_output=True, text=True, timeout=60)
 
@@ -177,6 +183,39 @@ exit 0
     assert pytest_calls(stamped) == ["python [-m] [pytest] [-q]"]
     assert f"CHROMIUM={fake / 'chromium'}" in calls(stamped)
     assert "DID NOT RUN" not in p.stderr
+
+
+def test_run_tests_as_root_installs_postgresql_and_nginx_with_apt(stamped: Path) -> None:
+    """Without Debian's postgresql and nginx (the PostgreSQL gradebook and front-end tests), apt-get
+    installs both in one call, as it does chromium."""
+    fake = stamped.parent / "bin"
+    (stamped.parent / "pg" / "pg_ctl").unlink()
+    (stamped.parent / "nginx").unlink()
+    (fake / "chromium").symlink_to(shutil.which("true") or "/bin/true")
+    _write_exe(fake / "apt-get", f"""#!/bin/sh
+echo "apt-get $*" >> {stamped / 'calls.log'}
+if [ "$1" = install ]; then
+  printf '#!/bin/sh\\n' > {stamped.parent / 'pg' / 'pg_ctl'}; printf '#!/bin/sh\\n' > {stamped.parent / 'nginx'}
+  chmod 755 {stamped.parent / 'pg' / 'pg_ctl'} {stamped.parent / 'nginx'}
+fi
+exit 0
+""")
+    p = run(stamped, "run-tests.sh", "-q", FAKE_UID="0", CI="true")
+    assert p.returncode == 0, p.stderr
+    assert "apt-get install -y -q postgresql nginx" in calls(stamped)
+    assert pytest_calls(stamped) == ["python [-m] [pytest] [-q]"]
+    assert p.stderr == ""
+
+
+def test_run_tests_that_cannot_install_postgresql_says_its_tests_will_not_run(stamped: Path) -> None:
+    (stamped.parent / "pg" / "pg_ctl").unlink()
+    (stamped.parent / "bin" / "chromium").symlink_to(shutil.which("true") or "/bin/true")
+    p = run(stamped, "run-tests.sh", "-q")                   # no root, no sudo
+    assert p.returncode == 0
+    assert pytest_calls(stamped) == ["python [-m] [pytest] [-q]"]      # the rest still runs
+    (line,) = p.stderr.strip().splitlines()
+    assert line.startswith("!!!") and "could not install postgresql" in line and "neither root nor sudo" in line
+    assert "PostgreSQL gradebook and nginx front-end tests will not run" in line
 
 
 def test_run_tests_with_chromium_runs_everything(stamped: Path) -> None:

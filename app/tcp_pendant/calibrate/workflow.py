@@ -38,6 +38,7 @@ from tcp_pendant.calibrate.autotouch import AutoTouchOutcome, auto_touch
 from tcp_pendant.calibrate.jobs import EXERCISE_REFUSAL, JOBS, POSE_CHECKS, ControllerJob
 from tcp_pendant.calibrate.diversity import failure_in_words
 from tcp_pendant.calibrate.library_save import save_result
+from tcp_pendant.pendant.exercise_rules import RuleRefusal
 from tcp_pendant.events import (
     RunCancelled,
     RunFinished,
@@ -222,9 +223,18 @@ class CalibrationWorkflow:
         else:
             auto_steps.discard(step)
         self._record_q[id(pose)] = (pose, c.q_rad.copy())
+        self._forget_replaced_poses()
         self._note_distance(step)
         self._events.append(TouchRecorded(i, step, pose.T_world_flange_m, joints,
                                           float(c.touch_geometry().distance_mm), auto, had_pose))
+
+    def _forget_replaced_poses(self) -> None:
+        """Keep the joints of the poses some run still holds only: a step recorded again, or a
+        run's touches dropped, leaves its old pose here, and a session that records for hours
+        would otherwise keep every pose it ever recorded."""
+        held = {id(p) for r in self.runs for p in r.wizard.recorded_poses.values()}
+        for key in [k for k in self._record_q if k not in held]:
+            del self._record_q[key]
 
     def joints_at_record(self, pose: RecordedPose) -> np.ndarray | None:
         """The joints (rad) where ``pose`` was recorded in this session (None: not known, e.g.
@@ -482,9 +492,33 @@ class CalibrationWorkflow:
         w.record(self.controller.T_world_flange())
         self._recorded(step, auto=False, had_pose=had_pose)
 
+    def touches_short(self) -> str | None:
+        """Why the exercise refuses Finish of the wizard on show (the owner's ``rules``, when it
+        has them): on the last step of a method whose touch count the trainee chooses (an
+        ``n_points`` start option or Add point), fewer touch steps than ``rules.min_touches``.
+        None when Finish is not refused; a method with a fixed number of poses never is."""
+        rules = getattr(self.state, "rules", None)
+        w = self.wizard
+        if (rules is None or not getattr(rules, "min_touches", 0) or w is None or not self.is_open
+                or w.is_complete or not w.on_last_step):
+            return None
+        cls = type(w)
+        if not (cls.supports_add_point or any(o.name == "n_points" for o in cls.options)):
+            return None
+        refusal: str | None = rules.touches_refusal(len(w.solver_touch_steps()), can_add_point=cls.supports_add_point)
+        return refusal
+
     def next(self) -> WizardResult | None:
-        """Next step; on the last step compute the result (returned)."""
+        """Next step; on the last step compute the result (returned).
+
+        Raises:
+            RuleRefusal: Finish with fewer touches than the exercise asks for
+                (:meth:`touches_short`); the wizard stays on its last step.
+        """
         w = self._require()
+        short = self.touches_short() if w.on_last_step else None
+        if short is not None:
+            raise RuleRefusal(short)
         job = self.controller_job() if w.on_last_step else None
         if job is not None:
             return self.run_controller_job(job)
@@ -544,8 +578,9 @@ class CalibrationWorkflow:
 
     def auto_touch(self, request: AutoTouchRequest) -> AutoTouchOutcome:
         """Training mode: let the controller perform the current step (mounting the tool it
-        needs), record it and go on; after the last step the result is computed, so a whole
-        4-point calibration takes four clicks.
+        needs), record it and go on; after the last step the result is computed (unless the
+        exercise asks for more touches: :meth:`touches_short`), so a whole 4-point calibration
+        takes four clicks.
 
         Raises:
             WizardStateError: training mode is off, or no wizard is in progress.
@@ -578,7 +613,7 @@ class CalibrationWorkflow:
             self._auto_directions[run_index] = out.direction_deg
         if type(w).controller_job is not None:    # Finish runs the controller's job (off the loop in the app)
             return out
-        if out.ok and w.on_last_step and all(s.recorded for s in w.steps):
+        if out.ok and w.on_last_step and all(s.recorded for s in w.steps) and self.touches_short() is None:
             try:
                 self._finished(w, w.finish())
             except CalibrationFailedError as exc:

@@ -31,6 +31,20 @@ Each trainee's pendant follows the class's :class:`~tcp_pendant.pendant.exercise
 is off unless the trainer unlocked or allowed them (``class_rules``); a change of exercise goes
 back to those defaults unless the same push sets them.
 
+The exercise also carries the trainer's **brief** (:meth:`ClassRoom.push_brief`, or
+``--exercise-instructions`` / ``--exercise-methods`` / ``--exercise-min-touches`` at start):
+instructions (plain text, a banner on every trainee's panel), the methods a trainee may start
+and the fewest touches a Finish takes; they are part of the rules (``ExerciseRules``) and stay
+until the trainer pushes another brief (a change of exercise keeps them).
+
+The trainer's **messages** (:meth:`ClassRoom.send_message`) go to every connected trainee or
+to one, each delivered on viser's loop to that trainee's session only
+(``Session.show_message``), which keeps it until the trainee dismisses it. The class keeps, by
+name, the messages each trainee has not dismissed yet (mirrored from the session's ``notice``
+signal), so an undismissed message comes back after a reload or when the trainee joins again;
+a message to one trainee who left waits for them. They live in memory: a server restart drops
+them (the brief, which is kept in the gradebook, is the lasting text).
+
 Several server processes on one gradebook (``tcp-pendant --workers N``): each process has its
 own sessions and its own ClassRoom (:attr:`ClassRoom.holder` names it); what the class shares
 goes through the gradebook. A joined name is claimed in the gradebook's presence table
@@ -55,13 +69,15 @@ from __future__ import annotations
 import dataclasses
 import functools
 import hashlib
+import itertools
 import logging
 import os
 import secrets
 import socket
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
+from datetime import datetime, timezone
 from typing import Any, cast
 
 from tcp_pendant.classroom.gradebook import Gradebook, GradebookError, GradeRow, TraineeJoin
@@ -71,10 +87,18 @@ from tcp_pendant.classroom.recorder import TraineeRecorder, TraineeStatus
 from tcp_pendant.classroom.restore import runs_to_restore
 from tcp_pendant.classroom.trainer_token import TokenAttempts, validate_trainer_token
 from tcp_pendant.controller import ToolModel
-from tcp_pendant.pendant.exercise_rules import DistanceAids, ExerciseRules, class_rules
+from tcp_pendant.pendant.class_messages import MAX_WAITING_MESSAGES, ClassMessage, clean_message_text
+from tcp_pendant.pendant.exercise_rules import (
+    DistanceAids,
+    ExerciseRules,
+    class_rules,
+    clean_instructions,
+    clean_min_touches,
+)
 from tcp_pendant.session import Session, SessionChange
+from tcp_pendant.wizards import WIZARD_TYPES, wizard_classes
 
-__all__ = ["EXERCISE_IDS", "ClassRoom"]
+__all__ = ["EXERCISE_IDS", "ClassRoom", "clean_methods"]
 
 log = logging.getLogger(__name__)
 
@@ -83,10 +107,37 @@ EXERCISE_IDS = ("mystery",)
 
 
 PUSHED_SETTING = "pushed"
-"""The class setting that keeps what the trainer pushed (exercise, "Hide distance", tool)."""
+"""The class setting that keeps what the trainer pushed (exercise, "Hide distance", Auto-touch,
+tool; the brief: instructions, allowed methods, minimum touches)."""
 TOKEN_SETTING = "trainer_token_sha256"
 """The class setting that keeps the trainer token's SHA-256 (hex) in the gradebook, so the
 trainer's address keeps working after a restart without the token being stored."""
+
+
+def clean_methods(methods: object) -> tuple[str, ...] | None:
+    """The methods an exercise allows, as wizard kinds in menu order (None: every method).
+
+    Args:
+        methods: None, or wizard kinds (``"xyz4"``, ``"reference"``, ...) as a sequence or one
+            comma-separated string (the CLI's ``--exercise-methods xyz4,reference``).
+
+    Raises:
+        ValueError: an unknown kind or no method at all (names the registered kinds).
+    """
+    if methods is None:
+        return None
+    if isinstance(methods, str):
+        methods = [m for m in (part.strip() for part in methods.split(",")) if m]
+    if not isinstance(methods, (list, tuple)) or not all(isinstance(m, str) for m in methods):
+        raise ValueError(f"The exercise's methods must be wizard ids, got {type(methods).__name__}.")
+    known = [c.kind for c in wizard_classes()]
+    unknown = [m for m in methods if m not in WIZARD_TYPES]
+    if unknown:
+        raise ValueError(f"Unknown calibration method {unknown[0]!r:.60} for the exercise; use some of "
+                         f"{', '.join(known)}.")
+    if not methods:
+        raise ValueError(f"An exercise needs at least one method; choose some of {', '.join(known)}.")
+    return tuple(k for k in known if k in methods)
 
 
 def _token_digest(token: str) -> str:
@@ -105,6 +156,8 @@ class ClassRoom:
         exercise: None (free practice) or "mystery".
         exercise_seed: the seed of the mystery tools; None: the class's own secret seed, kept in
             the gradebook.
+        instructions, allowed_methods, min_touches: the exercise's brief given at start (None:
+            the brief kept in the gradebook, else none); each given one wins over the kept one.
         hand_to_loop: runs a function on viser's event loop.
         clock: seconds of a monotonic clock (the token's lockout windows; tests set it).
         presence_poll_s: the heartbeat period of :meth:`start` (seconds; module docstring).
@@ -115,10 +168,15 @@ class ClassRoom:
 
     def __init__(self, gradebook: Gradebook, tools: dict[str, ToolModel], *, trainer_token: str | None,
                  exercise: str | None = None, exercise_seed: int | None = None,
+                 instructions: str | None = None, allowed_methods: Sequence[str] | str | None = None,
+                 min_touches: int | None = None,
                  hand_to_loop: Callable[[Callable[[], None]], None] = lambda fn: fn(),
                  clock: Callable[[], float] = time.monotonic, presence_poll_s: float = 1.0) -> None:
         if exercise is not None and exercise not in EXERCISE_IDS:
             raise ValueError(f"Unknown exercise {exercise!r}; use one of {', '.join(EXERCISE_IDS)}.")
+        given_instructions = None if instructions is None else clean_instructions(instructions)
+        given_methods = clean_methods(allowed_methods)
+        given_min = None if min_touches is None else clean_min_touches(min_touches)
         stored = gradebook.class_setting(TOKEN_SETTING)
         if trainer_token is None and isinstance(stored, str):
             self.trainer_token: str | None = None      # the class's token, kept (hashed) in the gradebook
@@ -154,6 +212,14 @@ class ClassRoom:
         """Auto-touch as the trainer last allowed it (None: the default - off in an exercise)."""
         self.pushed_tool: str | None = None
         """The tool the trainer last pushed (kept across restarts)."""
+        self.instructions = ""
+        """The exercise's instructions (plain text; "" none)."""
+        self.allowed_methods: tuple[str, ...] | None = None
+        """The wizard kinds trainees may start (None: every method)."""
+        self.min_touches = 0
+        """The fewest touches a Finish takes, for methods whose touch count is chosen (0: none)."""
+        self._message_ids = itertools.count(1)
+        self._waiting: dict[str, list[ClassMessage]] = {}   # name -> messages not dismissed yet
         self.holder = f"{socket.gethostname()}:{os.getpid()}:{secrets.token_hex(4)}"
         """This server process's id in the gradebook's presence table (host, pid, a nonce)."""
         self.presence_poll_s = float(presence_poll_s)
@@ -162,11 +228,20 @@ class ClassRoom:
         self._beater: threading.Thread | None = None
         self._stopping = threading.Event()
         self._apply_kept(exercise_given=exercise is not None)   # what the trainer pushed before a restart
+        if given_instructions is not None:
+            self.instructions = given_instructions
+        if given_methods is not None:
+            self.allowed_methods = given_methods
+        if given_min is not None:
+            self.min_touches = given_min
+        if (given_instructions, given_methods, given_min) != (None, None, None):
+            self._keep_pushed(None, brief_only=True)
 
     @property
     def rules(self) -> ExerciseRules:
         """The rules every trainee's pendant follows now."""
-        return class_rules(self.exercise, self.distance_aids, self.auto_touch)
+        return class_rules(self.exercise, self.distance_aids, self.auto_touch, instructions=self.instructions,
+                           allowed_methods=self.allowed_methods, min_touches=self.min_touches)
 
     def _apply_rules(self, session: Session, *, aids_too: bool = True) -> None:
         """The class's rules on one trainee's pendant (under its lock), and with ``aids_too``
@@ -250,6 +325,9 @@ class ClassRoom:
                 self._trainees[id(session)] = (session, recorder, join.name)
                 follow = id(session) not in self._subscribed
                 self._subscribed.add(id(session))
+                waiting = list(self._waiting.get(join.name, ()))
+            for message in waiting:     # what the trainee had not dismissed yet (before the mirror follows)
+                session.show_message(message)
             if follow:
                 session.subscribe(lambda change: self._on_change(session, change))
             session.set_hide_truth(self.exercise is not None)
@@ -264,6 +342,9 @@ class ClassRoom:
             entry = self._trainees.get(id(session))
         if entry is None:                  # not (or no longer) a named trainee: nothing to store
             return
+        if change.notice:                  # the messages this trainee has not dismissed, by name
+            with self._lock:
+                self._waiting[entry[2]] = list(session.messages)
         recorder = entry[1]
         before = recorder.status
         recorder.on_change(change)
@@ -441,21 +522,21 @@ class ClassRoom:
         self.refresh_trainers()
 
     def _apply_remote_push(self, push: dict[str, Any]) -> None:
-        """A push the trainer made on another server process of the class."""
+        """A push the trainer made on another server process of the class: settings, a brief
+        or a message (``kind``), applied to this process's trainees."""
+        kind = push.get("kind", "settings")
         try:
-            self.push_settings(push.get("exercise"), push.get("tool_key"), push.get("hide_distance"),
-                               push.get("auto_touch"), keep=False)
+            if kind == "settings":
+                self.push_settings(push.get("exercise"), push.get("tool_key"), push.get("hide_distance"),
+                                   push.get("auto_touch"), keep=False)
+            elif kind == "brief":
+                self.push_brief(push.get("instructions", ""), push.get("allowed_methods"),
+                                push.get("min_touches", 0), keep=False)
+            elif kind == "message":
+                self._deliver(clean_message_text(push.get("text", "")), push.get("to"), str(push.get("sent", "")),
+                              also_waiting=False)
         except (ValueError, TypeError) as exc:
-            log.warning("a pushed setting from another server process was not applied: %s", exc)
-
-    def connected_names(self) -> list[str]:
-        """The names connected now on every server process of the class, sorted."""
-        names = self._local_names()
-        try:
-            names |= {name for name, _, _ in self.gradebook.present()}
-        except GradebookError:
-            log.exception("presence unreadable")
-        return sorted(names)
+            log.warning("a %s pushed on another server process was not applied: %s", kind, exc)
 
     # ------------------------------------------------------------ trainer
     def open_trainer(self, session: Session, token: str) -> bool:
@@ -510,12 +591,17 @@ class ClassRoom:
     def grades_csv(self) -> str:
         return self.gradebook.to_csv()
 
-    def _keep_pushed(self, tool_key: str | None) -> None:
+    def _keep_pushed(self, tool_key: str | None, *, brief_only: bool = False) -> None:
         """Keep what the trainer pushed in the gradebook (``PUSHED_SETTING``), so a restart with
-        this gradebook applies it again (:meth:`_apply_kept`)."""
+        this gradebook applies it again (:meth:`_apply_kept`); ``brief_only``: the brief's keys
+        only (the brief given at start: the exercise given with it is not kept by that)."""
         kept = self.gradebook.class_setting(PUSHED_SETTING)
         kept = dict(kept) if isinstance(kept, dict) else {}
-        kept.update({"exercise": self.exercise, "distance_aids": self.distance_aids, "auto_touch": self.auto_touch})
+        if not brief_only:
+            kept.update({"exercise": self.exercise, "distance_aids": self.distance_aids,
+                         "auto_touch": self.auto_touch})
+        kept.update({"instructions": self.instructions, "min_touches": self.min_touches,
+                     "allowed_methods": None if self.allowed_methods is None else list(self.allowed_methods)})
         if tool_key is not None:
             kept["tool_key"] = tool_key
         self.gradebook.set_class_setting(PUSHED_SETTING, kept)
@@ -537,6 +623,18 @@ class ClassRoom:
         self.auto_touch = auto if isinstance(auto, bool) else None
         tool = kept.get("tool_key")
         self.pushed_tool = tool if isinstance(tool, str) and tool in self.tools else None
+        try:                              # the brief (absent in an older gradebook: none)
+            self.instructions = clean_instructions(kept.get("instructions", ""))
+        except ValueError:
+            self.instructions = ""
+        try:
+            self.allowed_methods = clean_methods(kept.get("allowed_methods"))
+        except ValueError:                # a method this version does not know: every method
+            self.allowed_methods = None
+        try:
+            self.min_touches = clean_min_touches(kept.get("min_touches", 0))
+        except ValueError:
+            self.min_touches = 0
 
     def push_settings(self, exercise: str | None, tool_key: str | None,
                       hide_distance: bool | str | None = None, auto_touch: bool | None = None, *,
@@ -566,8 +664,8 @@ class ClassRoom:
             self.auto_touch = bool(auto_touch)
         if keep:
             self._keep_pushed(tool_key)
-            self.gradebook.add_push({"holder": self.holder, "exercise": exercise, "tool_key": tool_key,
-                                     "hide_distance": named, "auto_touch": auto_touch})
+            self.gradebook.add_push({"holder": self.holder, "kind": "settings", "exercise": exercise,
+                                     "tool_key": tool_key, "hide_distance": named, "auto_touch": auto_touch})
         with self._lock:
             trainees = list(self._trainees.values())
         for session, recorder, name in trainees:
@@ -583,3 +681,96 @@ class ClassRoom:
                     session.changed(wizard=True)      # the result panel shows or hides the truth
             session.guard(apply)()
         return len(trainees)
+
+    def push_brief(self, instructions: str, allowed_methods: Sequence[str] | str | None,
+                   min_touches: int, *, keep: bool = True) -> int:
+        """Set the exercise's brief: ``instructions`` (plain text, at most
+        ``MAX_INSTRUCTIONS_CHARS``; "" none), the methods trainees may start (wizard kinds; None:
+        every method) and the fewest touches a Finish takes (0: none), on every named trainee's
+        pendant (their rules, ``Session.set_rules``) and for those who name themselves later;
+        kept in the gradebook (``keep``, as for :meth:`push_settings`). Returns how many
+        trainees of this process.
+
+        Raises:
+            ValueError: instructions too long, an unknown method, a bad minimum (nothing is set).
+        """
+        text = clean_instructions(instructions)
+        methods = clean_methods(allowed_methods)
+        minimum = clean_min_touches(min_touches)
+        self.instructions, self.allowed_methods, self.min_touches = text, methods, minimum
+        if keep:
+            self._keep_pushed(None, brief_only=True)
+            self.gradebook.add_push({"holder": self.holder, "kind": "brief", "instructions": text,
+                                     "allowed_methods": None if methods is None else list(methods),
+                                     "min_touches": minimum})
+        rules = self.rules
+        with self._lock:
+            trainees = list(self._trainees.values())
+        for session, _recorder, _name in trainees:
+            session.guard(session.set_rules)(rules)
+        return len(trainees)
+
+    # ------------------------------------------------------------ messages
+    def connected_names(self) -> list[str]:
+        """Names of the trainees connected now on every server process of the class (the
+        trainer's "To" choices): this process's in order of arrival, then the other processes'
+        by name (the presence table)."""
+        with self._lock:
+            local = [name for _, _, name in self._trainees.values()]
+        try:
+            remote = sorted({name for name, holder, _ in self.gradebook.present() if holder != self.holder})
+        except GradebookError:
+            log.exception("the class's presence table is unreadable")
+            remote = []
+        return local + [name for name in remote if name not in local]
+
+    def send_message(self, text: str, to: str | None = None) -> str:
+        """Send ``text`` (plain text) to every connected trainee (``to`` None) or to the trainee
+        named ``to`` (connected, or one who left: it waits until they join again). Each session
+        gets it on viser's loop (``Session.show_message``) and keeps it until dismissed.
+        Returns what happened, in words for the trainer (plain text).
+
+        Raises:
+            ValueError: an empty or too long text; ``to`` is no trainee of this class.
+        """
+        clean = clean_message_text(text)
+        with self._lock:
+            left = {status.name for status in self._left}
+            remote = {name for name in self._remote}
+        if to is not None:
+            if not isinstance(to, str):
+                raise ValueError("Choose whom to send the message to.")
+            with self._lock:
+                known = to in left or to in self._waiting or to in remote
+            if not known and to not in self._local_names():
+                raise ValueError(f"{to:.60} is not in the class; choose a trainee in the list, or all trainees.")
+        sent = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
+        entries = self._deliver(clean, to, sent, also_waiting=to not in remote)
+        try:                              # the trainees on the other server processes of the class
+            self.gradebook.add_push({"holder": self.holder, "kind": "message", "text": clean, "to": to, "sent": sent})
+        except GradebookError:
+            log.exception("the message could not be passed to the other server processes")
+        there = [n for n in remote if n not in {e[2] for e in entries}]
+        if to is None:
+            n = len(entries) + len(there)
+            return f"Sent to {n} trainee{'s' if n != 1 else ''}." if n else "No trainee is connected: nobody got it."
+        return (f"Sent to {to}." if entries or to in there
+                else f"{to} is not connected: the message waits until they join again.")
+
+    def _deliver(self, clean: str, to: str | None, sent: str, *,
+                 also_waiting: bool) -> list[tuple[Session, TraineeRecorder, str]]:
+        """Show the message to this process's trainees (all, or ``to``) and keep it waiting for
+        them until dismissed; ``also_waiting``: a ``to`` not connected here waits here too (the
+        process the trainer sent it from). Returns the entries it was shown to."""
+        with self._lock:
+            entries = [e for e in self._trainees.values() if to is None or e[2] == to]
+        message = ClassMessage(next(self._message_ids), clean, to, sent)
+        names = [to] if to is not None and (entries or also_waiting) else [name for _, _, name in entries]
+        with self._lock:
+            for name in names:
+                waiting = self._waiting.setdefault(name, [])
+                waiting.append(message)
+                del waiting[:-MAX_WAITING_MESSAGES]
+        for session, _recorder, _name in entries:
+            self._hand_to_loop(session.guard(lambda session=session: session.show_message(message)))
+        return entries

@@ -1,7 +1,11 @@
-"""The class gradebook: every trainee, session, calibration, touch and crash, in one SQLite file.
+"""The class gradebook: every trainee, session, calibration, touch and crash, in one SQLite file
+or, for a class served by several machines, in one PostgreSQL database.
 
 The server writes each wizard event as it happens; ``tcp-pendant grades``
-reads it back (:mod:`tcp_pendant.classroom.grades_cli`). Standard library ``sqlite3`` only.
+reads it back (:mod:`tcp_pendant.classroom.grades_cli`). Standard library ``sqlite3`` for a file;
+a ``postgresql://`` URL runs the same SQL through psycopg 3
+(:mod:`tcp_pendant.classroom.gradebook_db`: the connection seam and the one place SQL is
+translated for PostgreSQL).
 
 Durability ("a kill -9 of the server loses nothing that was acknowledged on screen"):
 
@@ -23,9 +27,15 @@ key); a TCP Pendant that reads only version 1 then refuses it as newer. Opening 
 program's database or was written by a newer TCP Pendant raises one :class:`GradebookError`
 naming the file and what to do; the file is never overwritten or "repaired".
 
+PostgreSQL: the same schema, versioned in the same ``meta`` table; every write is one
+transaction committed when the method returns (the server's ``synchronous_commit``, on by
+default, makes it durable). Writes that read before they write hold a named advisory lock or a
+row lock, so servers on several machines can share one class; opening holds the "schema" lock,
+so two servers starting on an empty database make the tables once.
+
 Threads: one connection guarded by a lock (``check_same_thread=False``), so any thread may
 call; calls run one at a time. Several processes may share the file (WAL; a writer waits up to
-``busy_timeout_s`` for another).
+``busy_timeout_s`` for another), several processes and machines the PostgreSQL database.
 
 Units: poses in metres (``T_world_flange_m``), joints and angles in degrees, distances and
 errors in mm, durations in seconds; times are UTC ISO 8601 with milliseconds
@@ -77,6 +87,13 @@ from typing import Any, Literal, overload
 import numpy as np
 import platformdirs
 
+from tcp_pendant.classroom.gradebook_db import (
+    GradebookConnection,
+    PostgresConnection,
+    PostgresUnavailable,
+    SqliteConnection,
+    is_postgres_url,
+)
 from tcp_pendant.classroom.names import TraineeNameError, looks_alike, validate_trainee_name
 
 __all__ = [
@@ -128,6 +145,11 @@ PRESENCE_STALE_S = 10.0
 """A presence row whose holder has not beaten for this long (seconds) counts as gone."""
 MAX_STATUS_BYTES = 4_000
 """A presence row's status above this is refused (a trainer's row is ~200 bytes)."""
+_ADDITIVE_TABLES = {"run_states": _RUN_STATES, "presence": _PRESENCE, "class_pushes": _CLASS_PUSHES}
+"""Tables made (CREATE TABLE IF NOT EXISTS, by name) in every gradebook that lacks them when it
+is opened, after the versioned schema; written in SQLite's words like every statement
+(``gradebook_db.sql_for``). A gradebook that has them all is not asked to create anything (a
+database user that may only read and write rows can open it)."""
 MAX_RUN_STATE_BYTES = 200_000
 """A wizard's stored state is refused above this (20 poses with joints take ~12 kB)."""
 
@@ -351,14 +373,6 @@ def _label(value: Any, what: str, *, optional: bool = False) -> str | None:
     return value
 
 
-def _new_id(cur: sqlite3.Cursor) -> int:
-    """The id of the row an INSERT just added (``lastrowid``, None only before any insert)."""
-    rowid = cur.lastrowid
-    if rowid is None:
-        raise GradebookError("the gradebook added no row")
-    return rowid
-
-
 def _finite(value: Any, what: str, *, optional: bool = False) -> float | None:
     if value is None and optional:
         return None
@@ -427,46 +441,65 @@ def _duration_s(start: str, end: str) -> float:
 # --------------------------------------------------------------------------- the gradebook
 
 class Gradebook:
-    """The class gradebook in one SQLite file (see the module docstring).
+    """The class gradebook in one SQLite file or one PostgreSQL database (see the module docstring).
 
     Args:
-        path: the database file; None = :func:`default_gradebook_path` (its folder is created).
-        create: make a new gradebook if the file does not exist (False: :class:`GradebookError`,
-            as ``tcp-pendant grades`` wants).
-        synchronous: "FULL" (default: every commit fsynced, survives a power cut) or "NORMAL"
-            (survives a kill -9 of the server but maybe not a power cut; no fsync per commit).
-        busy_timeout_s: how long a write waits for another process holding the file.
+        path: the database file, or a ``postgresql://USER[:PASSWORD]@HOST[:PORT]/DATABASE`` URL
+            (a ``str``; psycopg 3 needed); None = :func:`default_gradebook_path` (its folder is
+            created).
+        create: make a new gradebook if the file does not exist or the database has no tables
+            yet (False: :class:`GradebookError`, as ``tcp-pendant grades`` wants).
+        synchronous: SQLite: "FULL" (default: every commit fsynced, survives a power cut) or
+            "NORMAL" (survives a kill -9 of the server but maybe not a power cut; no fsync per
+            commit). PostgreSQL: the server's ``synchronous_commit`` decides.
+        busy_timeout_s: how long a write waits for another process (or machine) holding the
+            file or a row; with PostgreSQL also the connect timeout.
+
+    Attributes:
+        path: the SQLite file, or None for PostgreSQL.
+        location: what messages name: the file's path, or the URL with its password masked.
 
     Raises:
         GradebookError: the file is not an SQLite database, is damaged, is another program's
-            database, was written by a newer TCP Pendant, or cannot be opened; the message
-            names the file and what to do. Nothing is written to such a file.
+            database, was written by a newer TCP Pendant, or cannot be opened; the PostgreSQL
+            server cannot be reached or the URL is malformed; the message names the file (the
+            URL without its password) and what to do. Nothing is written to such a file.
     """
 
     def __init__(self, path: Path | str | None = None, *, create: bool = True,
                  synchronous: Literal["FULL", "NORMAL"] = "FULL", busy_timeout_s: float = 5.0) -> None:
         if synchronous not in ("FULL", "NORMAL"):
             raise GradebookError(f"synchronous must be 'FULL' or 'NORMAL', got {synchronous!r}.")
-        self.path = Path(default_gradebook_path() if path is None else path)
         self._lock = threading.Lock()
         self._closed = False
-        if self.path.is_dir():
-            raise GradebookError(f"Gradebook {self.path} is a folder; give a file name such as "
-                                 f"{self.path / 'class.sqlite3'}.")
-        exists = self.path.exists()
-        if not exists and not create:
-            raise GradebookError(f"No gradebook at {self.path}: check the path (the server writes it "
-                                 "where --class-db says, by default in the user data folder).")
-        if not exists and path is None:
-            self.path.parent.mkdir(parents=True, exist_ok=True)
+        self._db: GradebookConnection
+        self.path: Path | None
+        if is_postgres_url(path):
+            self.path = None
+            try:
+                self._db = PostgresConnection(str(path), busy_timeout_s=float(busy_timeout_s))
+            except PostgresUnavailable as exc:
+                raise GradebookError(str(exc)) from None
+            self.location = self._db.location
+        else:
+            self.path = file = Path(default_gradebook_path() if path is None else path)
+            self.location = str(file)
+            if file.is_dir():
+                raise GradebookError(f"Gradebook {file} is a folder; give a file name such as "
+                                     f"{file / 'class.sqlite3'}.")
+            exists = file.exists()
+            if not exists and not create:
+                raise GradebookError(f"No gradebook at {file}: check the path (the server writes it "
+                                     "where --class-db says, by default in the user data folder).")
+            if not exists and path is None:
+                file.parent.mkdir(parents=True, exist_ok=True)
+            try:
+                self._db = SqliteConnection(file, busy_timeout_s=float(busy_timeout_s))
+            except sqlite3.Error as exc:
+                raise GradebookError(f"Cannot open the gradebook {file}: {exc}; check that the path and "
+                                     "its folder exist and are readable and writable.") from exc
         try:
-            self._db = sqlite3.connect(str(self.path), isolation_level=None, check_same_thread=False,
-                                       timeout=float(busy_timeout_s))
-        except sqlite3.Error as exc:
-            raise GradebookError(f"Cannot open the gradebook {self.path}: {exc}; check that the path and "
-                                 "its folder exist and are readable and writable.") from exc
-        try:
-            self._open(synchronous)
+            self._open(synchronous, create)
         except BaseException:
             self._db.close()
             raise
@@ -474,122 +507,144 @@ class Gradebook:
     # -- opening ----------------------------------------------------------------------
 
     def _fail(self, what: str) -> GradebookError:
+        noun = self._db.noun
         return GradebookError(
-            f"Gradebook {self.path} {what}. Nothing was changed in it; keep it for the record, move it "
-            "aside or give another file with --class-db.")
+            f"Gradebook {self.location} {what}. Nothing was changed in it; keep it for the record, "
+            + ("move it aside or give another file with --class-db." if noun == "file"
+               else "or give another database with --class-db."))
 
-    def _open(self, synchronous: str) -> None:
+    def _cannot_write(self, exc: BaseException) -> GradebookError:
+        if self._db.noun == "file":
+            return GradebookError(f"Cannot write the gradebook {self.location}: {exc}; check that its folder "
+                                  "is writable and the disk is not full.")
+        return GradebookError(f"Cannot write the gradebook {self.location}: {' '.join(str(exc).split())}; "
+                              "check that the database user may create tables and write in the database.")
+
+    def _version(self, tables: set[str], *, check_storage: bool = True) -> int:
+        """The schema version of a database that has tables; refuses (nothing written) one that
+        is damaged (``check_storage``: SQLite's quick_check), another program's, incomplete, or
+        newer than this TCP Pendant reads."""
         db = self._db
         try:
-            tables = {r[0] for r in db.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
-        except sqlite3.OperationalError as exc:      # cannot open / locked / I/O: not the content
-            raise GradebookError(f"Cannot open the gradebook {self.path}: {exc}; check that the path and "
+            problems = db.integrity_problems() if check_storage else []
+        except db.errors as exc:
+            raise self._fail(f"is damaged ({exc})") from exc
+        if problems:
+            raise self._fail(f"is damaged (SQLite quick_check: {'; '.join(problems[:3])})")
+        if "meta" not in tables:
+            raise self._fail(f"is {db.described} of another program (no 'meta' table)")
+        try:
+            meta = {str(k): str(v) for k, v in db.execute("SELECT key, value FROM meta")}
+        except db.errors as exc:
+            raise self._fail(f"has an unreadable 'meta' table ({exc})") from exc
+        if meta.get("application") != APPLICATION:
+            raise self._fail(f"is {db.described} of another program (its meta table does not "
+                             f"say {APPLICATION!r})")
+        try:
+            version = int(meta.get("schema_version", ""))
+        except ValueError:
+            raise self._fail(f"has no valid schema_version ({meta.get('schema_version')!r})") from None
+        if version > SCHEMA_VERSION:
+            raise GradebookError(
+                f"Gradebook {self.location} was written by a newer TCP Pendant (schema version {version}; "
+                f"this one reads up to {SCHEMA_VERSION}). Nothing was changed in it: upgrade "
+                f"tcp-pendant to read it, or give another {db.noun} with --class-db.")
+        if version < 1 or not {"trainees", "sessions", "calibrations", "touches", "crashes"} <= tables:
+            raise self._fail(f"is incomplete (schema version {version}, tables {sorted(tables)})")
+        return version
+
+    def _open(self, synchronous: str, create: bool) -> None:
+        db = self._db
+        try:
+            tables = db.tables()
+        except db.operational_error as exc:      # cannot open / locked / I/O: not the content
+            raise GradebookError(f"Cannot open the gradebook {self.location}: {exc}; check that the path and "
                                  "its folder exist and are readable and writable, and that no other "
                                  "program holds it locked.") from exc
-        except sqlite3.DatabaseError as exc:
-            raise self._fail(f"is not a readable SQLite database ({exc})") from exc
-        if tables:
-            try:
-                check = [r[0] for r in db.execute("PRAGMA quick_check")]
-            except sqlite3.DatabaseError as exc:
-                raise self._fail(f"is damaged ({exc})") from exc
-            if check != ["ok"]:
-                raise self._fail(f"is damaged (SQLite quick_check: {'; '.join(check[:3])})")
-            if "meta" not in tables:
-                raise self._fail("is an SQLite database of another program (no 'meta' table)")
-            try:
-                meta = dict(db.execute("SELECT key, value FROM meta"))
-            except sqlite3.DatabaseError as exc:
-                raise self._fail(f"has an unreadable 'meta' table ({exc})") from exc
-            if meta.get("application") != APPLICATION:
-                raise self._fail("is an SQLite database of another program (its meta table does not "
-                                 f"say {APPLICATION!r})")
-            try:
-                version = int(meta.get("schema_version", ""))
-            except ValueError:
-                raise self._fail(f"has no valid schema_version ({meta.get('schema_version')!r})") from None
-            if version > SCHEMA_VERSION:
-                raise GradebookError(
-                    f"Gradebook {self.path} was written by a newer TCP Pendant (schema version {version}; "
-                    f"this one reads up to {SCHEMA_VERSION}). Nothing was changed in it: upgrade "
-                    "tcp-pendant to read it, or give another file with --class-db.")
-            if version < 1 or not {"trainees", "sessions", "calibrations", "touches", "crashes"} <= tables:
-                raise self._fail(f"is incomplete (schema version {version}, tables {sorted(tables)})")
-        else:
-            version = SCHEMA_VERSION
+        except db.errors as exc:
+            raise self._fail(f"is not a readable {db.kind} database ({exc})") from exc
+        looked = bool(tables)
+        if looked:
+            self._version(tables)                    # refuses before anything is written
+        elif not create and db.noun == "database":
+            raise GradebookError(f"No gradebook in {self.location}: the database has no gradebook tables; "
+                                 "check the URL (the server makes them where --class-db says).")
         try:
-            mode = db.execute("PRAGMA journal_mode = WAL").fetchone()[0]
-            db.execute(f"PRAGMA synchronous = {synchronous}")
-            db.execute("PRAGMA foreign_keys = ON")
-            if not tables:
-                with self._transaction():
+            if isinstance(db, SqliteConnection):
+                refused = db.configure(synchronous)
+                if refused is not None:
+                    raise GradebookError(
+                        f"Gradebook {self.location}: SQLite refused WAL mode (got {refused!r}); put the "
+                        "file on a local disk (WAL needs shared memory, network folders lack it).")
+            with self._transaction():
+                # Again inside the transaction, which holds the schema: another server process may
+                # have made or migrated the tables since the look above.
+                db.serialize("schema")
+                tables = db.tables()
+                if not tables:
                     for statement in _SCHEMA.split(";"):
                         if statement.strip():
                             db.execute(statement)
                     db.executemany("INSERT INTO meta (key, value) VALUES (?, ?)",
                                    [("application", APPLICATION), ("schema_version", str(SCHEMA_VERSION)),
                                     ("created_at", _now())])
-            elif version < SCHEMA_VERSION:
-                self._migrate(version)
-        except sqlite3.Error as exc:
-            raise GradebookError(f"Cannot write the gradebook {self.path}: {exc}; check that its folder "
-                                 "is writable and the disk is not full.") from exc
-        if str(mode).lower() != "wal":
-            raise GradebookError(f"Gradebook {self.path}: SQLite refused WAL mode (got {mode!r}); put the "
-                                 "file on a local disk (WAL needs shared memory, network folders lack it).")
-        try:                                         # additive: an older reader ignores the tables
-            with self._transaction():
-                db.execute(_RUN_STATES)
-                db.execute(_PRESENCE)
-                db.execute(_CLASS_PUSHES)
-        except sqlite3.Error as exc:
-            raise GradebookError(f"Cannot write the gradebook {self.path}: {exc}; check that its folder "
-                                 "is writable and the disk is not full.") from exc
+                else:
+                    version = self._version(tables, check_storage=not looked)
+                    if version < SCHEMA_VERSION:
+                        self._migrate(version)
+                for name, statement in _ADDITIVE_TABLES.items():   # an older reader ignores these
+                    if name not in tables:
+                        db.execute(statement)
+        except db.errors as exc:
+            raise self._cannot_write(exc) from exc
 
     def _migrate(self, version: int) -> None:
-        """Bring a file of an older schema version to :data:`SCHEMA_VERSION` (one transaction)."""
-        with self._transaction() as db:
-            if version < 2:       # browser keys: every trainee so far has none
-                columns = {r[1] for r in db.execute("PRAGMA table_info(trainees)")}
-                if "key_sha256" not in columns:
-                    db.execute("ALTER TABLE trainees ADD COLUMN key_sha256 TEXT")
-            db.execute("UPDATE meta SET value = ? WHERE key = 'schema_version'", (str(SCHEMA_VERSION),))
+        """Bring a database of an older schema version to :data:`SCHEMA_VERSION` (inside the
+        opening transaction)."""
+        db = self._db
+        if version < 2:       # browser keys: every trainee so far has none
+            if "key_sha256" not in db.columns("trainees"):
+                db.execute("ALTER TABLE trainees ADD COLUMN key_sha256 TEXT")
+        db.execute("UPDATE meta SET value = ? WHERE key = 'schema_version'", (str(SCHEMA_VERSION),))
 
     # -- plumbing ---------------------------------------------------------------------
 
     @contextmanager
-    def _transaction(self) -> Iterator[sqlite3.Connection]:
+    def _transaction(self) -> Iterator[GradebookConnection]:
         """One write transaction, committed (and, with FULL, fsynced) on leaving."""
         db = self._db
-        db.execute("BEGIN IMMEDIATE")
+        db.begin()
         try:
             yield db
         except BaseException:
-            db.execute("ROLLBACK")
+            db.rollback()
             raise
-        db.execute("COMMIT")
+        db.commit()
 
     @contextmanager
-    def _write(self) -> Iterator[sqlite3.Connection]:
+    def _write(self) -> Iterator[GradebookConnection]:
         with self._lock:
             if self._closed:
-                raise GradebookError(f"Gradebook {self.path} is closed.")
+                raise GradebookError(f"Gradebook {self.location} is closed.")
             try:
                 with self._transaction() as db:
                     yield db
-            except sqlite3.Error as exc:
-                raise GradebookError(f"Cannot write the gradebook {self.path}: {exc}. Nothing of this "
-                                     "event was stored; check the disk (full? removed?).") from exc
+            except self._db.errors as exc:
+                raise GradebookError(f"Cannot write the gradebook {self.location}: {' '.join(str(exc).split())}. "
+                                     "Nothing of this event was stored; " + (
+                                         "check the disk (full? removed?)." if self._db.noun == "file" else
+                                         "check that the PostgreSQL server runs and is reachable.")) from exc
 
     @contextmanager
-    def _read(self) -> Iterator[sqlite3.Connection]:
+    def _read(self) -> Iterator[GradebookConnection]:
         with self._lock:
             if self._closed:
-                raise GradebookError(f"Gradebook {self.path} is closed.")
+                raise GradebookError(f"Gradebook {self.location} is closed.")
             try:
                 yield self._db
-            except sqlite3.Error as exc:
-                raise GradebookError(f"Cannot read the gradebook {self.path}: {exc}.") from exc
+            except self._db.errors as exc:
+                raise GradebookError(f"Cannot read the gradebook {self.location}: "
+                                     f"{' '.join(str(exc).split())}.") from exc
 
     def close(self) -> None:
         """Close the connection (idempotent); later calls raise :class:`GradebookError`."""
@@ -605,7 +660,7 @@ class Gradebook:
         self.close()
 
     def __repr__(self) -> str:
-        return f"Gradebook({str(self.path)!r})"
+        return f"Gradebook({self.location!r})"
 
     @staticmethod
     def _id(value: Any, what: str) -> int:
@@ -613,13 +668,17 @@ class Gradebook:
             raise GradebookError(f"{what} must be a whole number (an id this gradebook returned), got {value!r:.40}.")
         return int(value)
 
-    def _calibration(self, db: sqlite3.Connection, calibration_id: Any) -> tuple[int, int, str]:
+    def _calibration(self, db: GradebookConnection, calibration_id: Any, *,
+                     for_update: bool = False) -> tuple[int, int, str]:
+        """(id, session_id, status) of a calibration; ``for_update`` (in a write): the row stays
+        locked until the transaction ends, so no other server changes its status meanwhile."""
         cid = self._id(calibration_id, "calibration_id")
-        row = db.execute("SELECT id, session_id, status FROM calibrations WHERE id = ?", (cid,)).fetchone()
+        row = db.execute("SELECT id, session_id, status FROM calibrations WHERE id = ?"
+                         + (" FOR UPDATE" if for_update else ""), (cid,)).fetchone()
         if row is None:
-            raise GradebookError(f"No calibration {cid} in the gradebook {self.path}; start it with "
+            raise GradebookError(f"No calibration {cid} in the gradebook {self.location}; start it with "
                                  "start_calibration first.")
-        return row
+        return int(row[0]), int(row[1]), str(row[2])
 
     # -- writes -----------------------------------------------------------------------
 
@@ -635,11 +694,11 @@ class Gradebook:
         except TraineeNameError as exc:
             raise GradebookError(str(exc)) from exc
         with self._write() as db:
+            db.serialize("trainee names")
             row = db.execute("SELECT id FROM trainees WHERE name = ?", (clean,)).fetchone()
             if row is not None:
                 return int(row[0])
-            return _new_id(db.execute("INSERT INTO trainees (name, created_at) VALUES (?, ?)",
-                                      (clean, _now())))
+            return db.insert("INSERT INTO trainees (name, created_at) VALUES (?, ?)", (clean, _now()))
 
     def join_trainee(self, name: str, key: Any = None) -> TraineeJoin:
         """A browser joins the class as ``name``, showing the browser key it kept (or none).
@@ -665,6 +724,7 @@ class Gradebook:
         clean = validate_trainee_name(name)
         shown = _clean_key(key)
         with self._write() as db:
+            db.serialize("trainee names")        # the look-alike check reads every name
             row = db.execute("SELECT id, key_sha256 FROM trainees WHERE name = ?", (clean,)).fetchone()
             if row is not None:
                 tid, digest = int(row[0]), row[1]
@@ -685,8 +745,8 @@ class Gradebook:
                         f"{other}, type your name exactly as before; otherwise pick a name that "
                         "looks different (add an initial or your surname).")
             new_key = secrets.token_urlsafe(BROWSER_KEY_BYTES)
-            tid = _new_id(db.execute("INSERT INTO trainees (name, created_at, key_sha256) VALUES (?, ?, ?)",
-                                     (clean, _now(), _key_digest(new_key))))
+            tid = db.insert("INSERT INTO trainees (name, created_at, key_sha256) VALUES (?, ?, ?)",
+                            (clean, _now(), _key_digest(new_key)))
             return TraineeJoin(tid, clean, new_key)
 
     def holds_key(self, name: str, key: Any) -> bool:
@@ -710,7 +770,8 @@ class Gradebook:
     def held_names(self) -> list[str]:
         """Names whose browser key a browser holds, sorted (the names a trainer can release)."""
         with self._read() as db:
-            return [r[0] for r in db.execute("SELECT name FROM trainees WHERE key_sha256 IS NOT NULL ORDER BY name")]
+            names = [str(r[0]) for r in db.execute("SELECT name FROM trainees WHERE key_sha256 IS NOT NULL")]
+        return sorted(names)              # code point order on every backend (not the server's collation)
 
     def exercise_seed(self) -> int:
         """The class's exercise seed: drawn with ``secrets`` the first time it is asked for and
@@ -718,6 +779,7 @@ class Gradebook:
         mystery tool again). A secret: whoever knows it can compute every mystery tool, so it is
         never printed, logged or sent to a browser."""
         with self._write() as db:
+            db.serialize("exercise seed")
             row = db.execute("SELECT value FROM meta WHERE key = 'exercise_seed'").fetchone()
             if row is not None:
                 try:
@@ -734,9 +796,9 @@ class Gradebook:
         mode = _label(mode, "mode")
         with self._write() as db:
             if db.execute("SELECT 1 FROM trainees WHERE id = ?", (tid,)).fetchone() is None:
-                raise GradebookError(f"No trainee {tid} in the gradebook {self.path}; add_trainee first.")
-            return _new_id(db.execute("INSERT INTO sessions (trainee_id, mode, started_at) VALUES (?, ?, ?)",
-                                      (tid, mode, _now())))
+                raise GradebookError(f"No trainee {tid} in the gradebook {self.location}; add_trainee first.")
+            return db.insert("INSERT INTO sessions (trainee_id, mode, started_at) VALUES (?, ?, ?)",
+                             (tid, mode, _now()))
 
     def end_session(self, session_id: int) -> None:
         """Mark a session ended (browser gone); its calibrations stay as they are."""
@@ -745,7 +807,7 @@ class Gradebook:
             cur = db.execute("UPDATE sessions SET ended_at = ? WHERE id = ? AND ended_at IS NULL",
                              (_now(), sid))
             if cur.rowcount == 0 and db.execute("SELECT 1 FROM sessions WHERE id = ?", (sid,)).fetchone() is None:
-                raise GradebookError(f"No session {sid} in the gradebook {self.path}.")
+                raise GradebookError(f"No session {sid} in the gradebook {self.location}.")
 
     def start_calibration(self, session_id: int, method: str, tool_key: str, truth: Any,
                           exercise_id: str | None = None) -> int:
@@ -766,11 +828,11 @@ class Gradebook:
         truth_text = _truth_json(truth)
         with self._write() as db:
             if db.execute("SELECT 1 FROM sessions WHERE id = ?", (sid,)).fetchone() is None:
-                raise GradebookError(f"No session {sid} in the gradebook {self.path}; start_session first.")
-            return _new_id(db.execute(
+                raise GradebookError(f"No session {sid} in the gradebook {self.location}; start_session first.")
+            return db.insert(
                 "INSERT INTO calibrations (session_id, method, tool_key, exercise_id, truth_json, status, "
                 "started_at) VALUES (?, ?, ?, ?, ?, 'in_progress', ?)",
-                (sid, method, tool_key, exercise, truth_text, _now())))
+                (sid, method, tool_key, exercise, truth_text, _now()))
 
     def record_touch(self, calibration_id: int, step_index: int, T_world_flange_m: Any, joints_deg: Any,
                      distance_mm: float | None, auto: bool, overwritten_touch_id: int | None = None) -> int:
@@ -799,7 +861,7 @@ class Gradebook:
         d = _finite(distance_mm, "distance_mm", optional=True)
         old = None if overwritten_touch_id is None else self._id(overwritten_touch_id, "overwritten_touch_id")
         with self._write() as db:
-            cid, _, status = self._calibration(db, calibration_id)
+            cid, _, status = self._calibration(db, calibration_id, for_update=True)
             if status == "cancelled":
                 raise GradebookError(f"Calibration {cid} was cancelled; resume_calibration({cid}) before "
                                      "recording touches in it.")
@@ -812,10 +874,10 @@ class Gradebook:
                 if row[1] is not None:
                     raise GradebookError(f"Touch {old} was already overwritten by touch {row[1]}; pass "
                                          f"{row[1]} instead.")
-            new = _new_id(db.execute(
+            new = db.insert(
                 "INSERT INTO touches (calibration_id, step_index, recorded_at, T_world_flange_m_json, "
                 "joints_deg_json, distance_mm, auto, overwrites_touch_id) VALUES (?, ?, ?, ?, ?, ?, ?, ?)",
-                (cid, step, _now(), T, q, d, int(bool(auto)), old)))
+                (cid, step, _now(), T, q, d, int(bool(auto)), old))
             if old is not None:
                 db.execute("UPDATE touches SET overwritten_by_touch_id = ? WHERE id = ?", (new, old))
             return new
@@ -841,14 +903,14 @@ class Gradebook:
         with self._write() as db:
             cid = None
             if calibration_id is not None:
-                cid, cal_session, _ = self._calibration(db, calibration_id)
+                cid, cal_session, _ = self._calibration(db, calibration_id, for_update=True)
                 if sid is not None and sid != cal_session:
                     raise GradebookError(f"Calibration {cid} belongs to session {cal_session}, not {sid}.")
                 sid = cal_session
             elif db.execute("SELECT 1 FROM sessions WHERE id = ?", (sid,)).fetchone() is None:
-                raise GradebookError(f"No session {sid} in the gradebook {self.path}.")
-            return _new_id(db.execute("INSERT INTO crashes (session_id, calibration_id, at, penetration_mm, note) "
-                                      "VALUES (?, ?, ?, ?, ?)", (sid, cid, _now(), depth, note)))
+                raise GradebookError(f"No session {sid} in the gradebook {self.location}.")
+            return db.insert("INSERT INTO crashes (session_id, calibration_id, at, penetration_mm, note) "
+                             "VALUES (?, ?, ?, ?, ?)", (sid, cid, _now(), depth, note))
 
     def finish_calibration(self, calibration_id: int, figures: Mapping[str, float], *,
                            position_error_mm: float | None, orientation_error_deg: float | None,
@@ -872,7 +934,7 @@ class Gradebook:
         tcp = None if tcp_mm is None else json.dumps(_vector(tcp_mm, "tcp_mm", 3))
         abc = None if abc_deg is None else json.dumps(_vector(abc_deg, "abc_deg", 3))
         with self._write() as db:
-            cid, _, status = self._calibration(db, calibration_id)
+            cid, _, status = self._calibration(db, calibration_id, for_update=True)
             if status == "cancelled":
                 raise GradebookError(f"Calibration {cid} was cancelled; resume_calibration({cid}) before "
                                      "finishing it.")
@@ -884,7 +946,7 @@ class Gradebook:
     def cancel_calibration(self, calibration_id: int) -> None:
         """Mark a calibration cancelled (its touches stay; a finished one stays finished)."""
         with self._write() as db:
-            cid, _, status = self._calibration(db, calibration_id)
+            cid, _, status = self._calibration(db, calibration_id, for_update=True)
             if status == "in_progress":
                 db.execute("UPDATE calibrations SET status = 'cancelled', cancelled_at = ? WHERE id = ?",
                            (_now(), cid))
@@ -892,7 +954,7 @@ class Gradebook:
     def resume_calibration(self, calibration_id: int) -> None:
         """Put a cancelled calibration back in progress (the wizard's Resume)."""
         with self._write() as db:
-            cid, _, status = self._calibration(db, calibration_id)
+            cid, _, status = self._calibration(db, calibration_id, for_update=True)
             if status == "cancelled":
                 db.execute("UPDATE calibrations SET status = 'in_progress', cancelled_at = NULL WHERE id = ?",
                            (cid,))
@@ -1056,8 +1118,7 @@ class Gradebook:
         """Keep one push of the trainer's class settings (JSON-ready); returns its id (ids grow)."""
         text = json.dumps(dict(push), sort_keys=True, allow_nan=False)
         with self._write() as db:
-            return _new_id(db.execute("INSERT INTO class_pushes (pushed_at, push_json) VALUES (?, ?)",
-                                      (_now(), text)))
+            return db.insert("INSERT INTO class_pushes (pushed_at, push_json) VALUES (?, ?)", (_now(), text))
 
     def pushes_after(self, push_id: int) -> list[tuple[int, dict[str, Any]]]:
         """``(id, push)`` of the pushes kept after ``push_id``, in order (0: all)."""

@@ -2,7 +2,7 @@
 
 Usage::
 
-    tcp-pendant grades [--class-db PATH] [--csv] [--per-trainee] [--moodle]
+    tcp-pendant grades [--class-db PATH|URL] [--csv] [--per-trainee] [--moodle]
 
 One row per calibration, finished or still in progress (oldest first): trainee, method, tool,
 touches (hand / auto), overwritten touches, crashes, duration, result figures, error against
@@ -11,12 +11,13 @@ the true TOOL frame, the grade and the status. Without ``--csv`` a table for the
 (docs/architecture.md, "Classroom (gradebook)"). ``--per-trainee``: one row per trainee
 (``classroom.lms``: attempts, best and last grade); ``--moodle``: that as the CSV Moodle's
 gradebook imports. The gradebook is read where
-the server writes it (``--class-db``, default ``user_data_dir("tcp-pendant")/class.sqlite3``);
-it may be read while the server runs.
+the server writes it (``--class-db``, default ``user_data_dir("tcp-pendant")/class.sqlite3``,
+or the ``postgresql://`` URL of the class's PostgreSQL database); it may be read while the
+servers run. A URL is printed with its password masked.
 
 Exit codes: 0 printed (also when no calibration is finished yet); 2 bad options, or the file
-is missing, not a gradebook, damaged or from a newer TCP Pendant (one line on stderr; the file
-is left as it is).
+is missing, not a gradebook, damaged or from a newer TCP Pendant, or the PostgreSQL server
+cannot be reached (one line on stderr; the file or database is left as it is).
 """
 
 from __future__ import annotations
@@ -24,9 +25,8 @@ from __future__ import annotations
 import argparse
 import sys
 from collections.abc import Sequence
-from pathlib import Path
-
 from tcp_pendant.classroom.gradebook import GradeRow, Gradebook, GradebookError, default_gradebook_path
+from tcp_pendant.classroom.gradebook_db import class_db_target
 from tcp_pendant.classroom.lms import TraineeGrade, moodle_csv, per_trainee, per_trainee_csv
 
 __all__ = ["build_parser", "format_table", "main"]
@@ -40,8 +40,9 @@ def build_parser() -> argparse.ArgumentParser:
         prog="tcp-pendant grades",
         description="Print the class gradebook: one row per calibration (finished or in progress), "
                     "or one per trainee.")
-    p.add_argument("--class-db", type=Path, default=None, metavar="PATH",
-                   help=f"the gradebook the server writes (default: {default_gradebook_path()})")
+    p.add_argument("--class-db", type=class_db_target, default=None, metavar="PATH|URL",
+                   help=f"the gradebook the server writes: a file (default: {default_gradebook_path()}) "
+                        "or the class's postgresql://USER@HOST:PORT/DATABASE URL")
     p.add_argument("--csv", action="store_true",
                    help="print CSV (columns in docs/architecture.md) instead of a table")
     p.add_argument("--per-trainee", action="store_true",
@@ -116,6 +117,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     path = default_gradebook_path() if args.class_db is None else args.class_db
     try:
         with Gradebook(path, create=False) as book:
+            where = book.location                  # a URL without its password
             rows = book.grades(include_in_progress=True)
             text = book.to_csv(rows) if args.csv else None
     except GradebookError as exc:
@@ -128,19 +130,19 @@ def main(argv: Sequence[str] | None = None) -> int:
         elif args.csv:
             sys.stdout.write(per_trainee_csv(trainees))
         elif not trainees:
-            print(f"No calibration in {path} yet.")
+            print(f"No calibration in {where} yet.")
         else:
-            print(f"Gradebook {path}: {len(trainees)} trainee{'s' if len(trainees) != 1 else ''}")
+            print(f"Gradebook {where}: {len(trainees)} trainee{'s' if len(trainees) != 1 else ''}")
             print(format_trainee_table(trainees))
         return 0
     if args.csv:
         sys.stdout.write(text or "")
         return 0
     if not rows:
-        print(f"No calibration in {path} yet.")
+        print(f"No calibration in {where} yet.")
         return 0
     done = sum(1 for r in rows if r.status == "finished")
-    print(f"Gradebook {path}: {done} finished calibration{'s' if done != 1 else ''}, {len(rows) - done} in progress")
+    print(f"Gradebook {where}: {done} finished calibration{'s' if done != 1 else ''}, {len(rows) - done} in progress")
     print(format_table(rows))
     return 0
 

@@ -9,7 +9,15 @@ words, whatever a browser sends (a disabled checkbox is only the polite half):
   close-up, the stop at the tip and its message are off (the trainee judges the touch by eye);
 * ``auto_touch_allowed``: Auto-touch (the robot touches for the trainee) may be used;
 * ``in_exercise``: the spin-test Check shows a technician's reading only
-  (:data:`CHECK_READING_MM`, ``pendant.spin_reading``).
+  (:data:`CHECK_READING_MM`, ``pendant.spin_reading``);
+* ``instructions``: the trainer's words for the exercise (plain text, at most
+  :data:`MAX_INSTRUCTIONS_CHARS` characters; a banner on the trainee's panel shows them, escaped);
+* ``allowed_methods``: the calibration methods (wizard kinds) the trainee may start (None: all);
+  the Calibrate menu offers only those and ``Session.start_wizard`` refuses the others in words;
+* ``min_touches``: the fewest touches a Finish takes (0: the method's own minimum). It applies
+  to the methods whose touch count the trainee chooses (an ``n_points`` start option or Add
+  point: XYZ 4-point, TCP & Z, X); a method with a fixed number of poses (three-point, ABC
+  world, XYZ reference, the checks) keeps its own count.
 
 Free practice (no exercise): nothing is locked, Auto-touch is allowed, the Check shows all it
 computes. In an exercise the defaults are the strict ones (:func:`class_rules`); the trainer
@@ -25,6 +33,8 @@ from tcp_pendant.controller.errors import ControllerError
 
 __all__ = [
     "AUTO_TOUCH_REFUSED",
+    "MAX_INSTRUCTIONS_CHARS",
+    "MAX_MIN_TOUCHES",
     "DISTANCE_AIDS",
     "DISTANCE_LOCKED",
     "DistanceAids",
@@ -32,6 +42,8 @@ __all__ = [
     "FREE_PRACTICE",
     "RuleRefusal",
     "class_rules",
+    "clean_instructions",
+    "clean_min_touches",
 ]
 
 DistanceAids = Literal["locked", "hidden", "shown"]
@@ -43,6 +55,43 @@ DISTANCE_LOCKED = ("The trainer has locked the distance aids for this exercise: 
                    "as on a real robot (the distance, the Δ line and the stop at the tip stay off).")
 AUTO_TOUCH_REFUSED = ("Auto-touch is off in this exercise: the robot would touch for you. Jog the tool tip "
                       "onto the reference tip and press Record (the trainer can allow Auto-touch).")
+
+
+MAX_INSTRUCTIONS_CHARS = 2000
+"""The longest instructions an exercise carries (characters, after trimming)."""
+MAX_MIN_TOUCHES = 20
+"""The largest minimum number of touches (the XYZ 4-point wizard takes at most 20)."""
+
+
+def clean_instructions(text: object) -> str:
+    """The trainer's instructions as kept: a string, trimmed, line endings as ``\\n``, control
+    characters other than line breaks and tabs dropped; plain text (escaped where shown).
+
+    Raises:
+        ValueError: not text, or longer than :data:`MAX_INSTRUCTIONS_CHARS` (says how long).
+    """
+    if not isinstance(text, str):
+        raise ValueError(f"The exercise instructions must be text, got {type(text).__name__}.")
+    text = text.replace("\r\n", "\n").replace("\r", "\n")
+    text = "".join(ch for ch in text if ch in "\n\t" or ch.isprintable()).strip()
+    if len(text) > MAX_INSTRUCTIONS_CHARS:
+        raise ValueError(f"The exercise instructions are {len(text)} characters long; shorten them to at most "
+                         f"{MAX_INSTRUCTIONS_CHARS}.")
+    return text
+
+
+def clean_min_touches(value: object) -> int:
+    """A minimum number of touches: a whole number 0..:data:`MAX_MIN_TOUCHES` (0: none).
+
+    Raises:
+        ValueError: not a whole number in that range (names it).
+    """
+    if isinstance(value, float) and value.is_integer():
+        value = int(value)
+    if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value <= MAX_MIN_TOUCHES:
+        raise ValueError(f"The minimum number of touches must be a whole number from 0 to {MAX_MIN_TOUCHES}, "
+                         f"got {value!r:.40}.")
+    return value
 
 
 class RuleRefusal(ControllerError):
@@ -57,11 +106,49 @@ class ExerciseRules:
         exercise: the exercise id (e.g. "mystery"), None in free practice.
         distance_locked: "Hide distance" is on and cannot be switched off.
         auto_touch_allowed: Auto-touch may be used.
+        instructions: the trainer's words (plain text; "" none).
+        allowed_methods: the wizard kinds the trainee may start (None: every method).
+        min_touches: the fewest touches a Finish of a method with a chosen touch count takes
+            (0: none).
     """
 
     exercise: str | None = None
     distance_locked: bool = False
     auto_touch_allowed: bool = True
+    instructions: str = ""
+    allowed_methods: tuple[str, ...] | None = None
+    min_touches: int = 0
+
+    def allows_method(self, kind: str) -> bool:
+        """The method ``kind`` may be started."""
+        return self.allowed_methods is None or kind in self.allowed_methods
+
+    def check_method(self, kind: str, titles: dict[str, str]) -> None:
+        """Refuse starting a method the exercise does not allow.
+
+        Args:
+            kind: the wizard kind asked for.
+            titles: wizard kind -> its title (the words name the allowed methods).
+
+        Raises:
+            RuleRefusal: ``kind`` is not one of :attr:`allowed_methods`.
+        """
+        if self.allows_method(kind):
+            return
+        allowed = [titles.get(k, k) for k in self.allowed_methods or ()]
+        raise RuleRefusal(f"This exercise does not use the {titles.get(kind, kind)} method: choose "
+                          f"{' or '.join(allowed)} (the trainer chose the methods).")
+
+    def touches_refusal(self, n_touches: int, *, can_add_point: bool) -> str | None:
+        """Why a Finish with ``n_touches`` touches is refused (None: it is not), for a method
+        whose touch count the trainee chooses."""
+        missing = self.min_touches - int(n_touches)
+        if missing <= 0:
+            return None
+        how = ("press Add point for another touch step" if can_add_point else
+               f"start it again with {self.min_touches} touches or more")
+        return (f"This exercise asks for at least {self.min_touches} touches: record {missing} more "
+                f"({how}).")
 
     @property
     def in_exercise(self) -> bool:
@@ -90,10 +177,12 @@ FREE_PRACTICE = ExerciseRules()
 
 
 def class_rules(exercise: str | None, aids: DistanceAids | None = None,
-                auto_touch: bool | None = None) -> ExerciseRules:
+                auto_touch: bool | None = None, *, instructions: str = "",
+                allowed_methods: tuple[str, ...] | None = None, min_touches: int = 0) -> ExerciseRules:
     """The rules of a class: ``aids`` and ``auto_touch`` as the trainer set them (None: the
     default - in an exercise the aids are locked and Auto-touch is off; in free practice
-    nothing is locked and Auto-touch is allowed).
+    nothing is locked and Auto-touch is allowed); the trainer's instructions, methods and
+    minimum number of touches as they are (checked by the classroom).
 
     Raises:
         ValueError: an unknown ``aids`` value (names the choices).
@@ -103,4 +192,5 @@ def class_rules(exercise: str | None, aids: DistanceAids | None = None,
     strict = exercise is not None
     locked = (aids == "locked") if aids is not None else strict
     allowed = bool(auto_touch) if auto_touch is not None else not strict
-    return ExerciseRules(exercise=exercise, distance_locked=locked, auto_touch_allowed=allowed)
+    return ExerciseRules(exercise=exercise, distance_locked=locked, auto_touch_allowed=allowed,
+                         instructions=instructions, allowed_methods=allowed_methods, min_touches=min_touches)

@@ -1,7 +1,8 @@
 """viser views of a pendant session: scene, jog panel, touch list, tool panel and the
 "Calibrate" tab where the wizard views plug in (see ``tcp_pendant.views.calibrate``).
 
-:func:`build_session_views` lays a session out as three tabs, like a pendant's menu:
+:func:`build_session_views` pins the exercise's instructions and the trainer's messages at the
+top (``class_notices``), then lays a session out as three tabs, like a pendant's menu:
 **Jog** (the running wizard's step dock, readouts, touch indicator, jog keys, touches), **Tool** (mounted tool, active tool
 data, library, export, controller files, TCP check, numeric entry, then the TCP service with the beam
 sensor) and **Calibrate** (wizards,
@@ -17,6 +18,7 @@ from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.beam_check import BeamCheckView
 from tcp_pendant.views.beam_replay import ScanPlayer
 from tcp_pendant.views.calibrate import build_calibrate_tab
+from tcp_pendant.views.class_notices import ClassNoticeView
 from tcp_pendant.views.pendant_panel import PendantPanel
 from tcp_pendant.views.scenario_panel import ScenarioPanel
 from tcp_pendant.views.scene import SceneView
@@ -27,6 +29,7 @@ from tcp_pendant.views.gui_util import target_of
 
 __all__ = [
     "BeamCheckView",
+    "ClassNoticeView",
     "PendantPanel",
     "ScenarioPanel",
     "SceneView",
@@ -67,6 +70,7 @@ def session_view_steps(session: Session, *, title: str = "TCP Pendant") -> Itera
         player = session.views["beam_player"] = ScanPlayer(session, stand=scene.beam_stand)
         scene.player = player
         yield "scene"
+        session.views["notices"] = ClassNoticeView(session)   # the exercise's banner, the trainer's messages
         gui.add_markdown(f"### {escape_markdown(title)}")
         tabs = gui.add_tab_group()
         with tabs.add_tab("Jog"):

@@ -27,6 +27,8 @@ from tcp_pendant.pendant.exercise_rules import ExerciseRules
 from tcp_pendant.session import Session
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.upload_guard import limit_upload_size
+from tcp_pendant.views.trainer_exercise import BriefControl, build_exercise_controls
+from tcp_pendant.views.trainer_messages import MessageControl, build_message_controls
 from tcp_pendant.wizards.session_record import MAX_RECORD_BYTES, SessionRecordError, check_record_size, load_and_replay
 from tcp_pendant.views.gui_util import ButtonEvent, UploadEvent, set_options, target_of
 
@@ -51,7 +53,7 @@ MAX_GRADE_ROWS = 50
 """The gradebook table shows the newest rows only (the CSV has them all)."""
 
 
-class ClassControl(Protocol):
+class ClassControl(BriefControl, MessageControl, Protocol):
     """What the trainer view needs of the server."""
 
     @property
@@ -178,6 +180,7 @@ class TrainerView:
                 hint="A trainee's exported session: each calibration is replayed and graded against "
                      "the truth this gradebook keeps (by its record id).")
             self.grade_md = gui.add_markdown("")
+            self.class_extras = (build_exercise_controls(gui, control, session), build_message_controls(gui, control, session))
         self._grading = False
         self.grade_upload.on_upload(self._on_grade_upload)
         limit_upload_size(self.grade_upload, MAX_RECORD_BYTES, self._refused)
@@ -191,6 +194,8 @@ class TrainerView:
         self.trainees_md.content = trainees_markdown(self.control.trainee_statuses())
         self.grades_md.content = grades_markdown(self.control.grade_rows())
         set_options(self.release_name, (NO_NAME, *self.control.held_names()))   # option text, not markdown
+        for extra in self.class_extras:
+            extra.render()
 
     def _release(self, _event: ButtonEvent | None = None) -> None:
         name = str(self.release_name.value)

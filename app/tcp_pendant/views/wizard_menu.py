@@ -7,7 +7,8 @@ Built by ``tcp_pendant.views.calibrate.build_calibrate_tab`` for the session's w
   after a result with the error against it, and offers Auto-touch;
 * **Calibrate** menu: the method (every registered wizard class, ``tcp_pendant.wizards.registry``,
   in its ``rank`` order: XYZ 4-point, XYZ reference, TCP & Z, X, three-point orientation, ABC
-  world), the options the chosen method declares (``Wizard.options``: one widget per option
+  world; in an exercise only the methods it allows, ``ExerciseRules.allowed_methods``), the
+  options the chosen method declares (``Wizard.options``: one widget per option
   name, shared by the methods that declare it: touches and estimator; the calibrated tool from
   the library; the physical reference and new tools), Start (``CalibrationWorkflow.start(kind,
   **options)``), "Start from the N recorded points" (XYZ 4-point, when the Jog tab's Record point
@@ -402,6 +403,9 @@ class CalibrateView:
 
     def _render_menu(self) -> None:
         self._menu_mounted_key = self.session.controller.mounted_tool.key
+        rules = self.session.rules                # an exercise may offer some methods only
+        offered = tuple(t for t, c in self._classes.items() if rules.allows_method(c.kind)) or tuple(self._classes)
+        set_options(self.method, offered)
         cls = self._chosen_class()
         set_content(self.method_md, cls.blurb)
         taken = {o.name for o in cls.options}

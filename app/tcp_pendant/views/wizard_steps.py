@@ -204,6 +204,9 @@ class WizardStepsView:
         failure = wf.finish_failure
         if failure is not None:                  # Finish could not compute: why, and what to do
             reason = f"Finish not possible: {failure}" if reason is None else f"{reason}\n\n{failure}"
+        short = self.parent.session.finish_refusal()   # the exercise asks for more touches
+        if short is not None:
+            reason = short if reason is None else f"{reason}\n\n{short}"
         self.blocked_md.visible = reason is not None
         if reason is not None:
             set_content(self.blocked_md, f"⚠ {escape_markdown(reason)}")

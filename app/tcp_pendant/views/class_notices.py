@@ -1,0 +1,86 @@
+"""The trainee's side of the trainer's words (viser GUI): the exercise's instructions and the
+trainer's messages, pinned at the top of the panel.
+
+* **Instructions banner**: while the class's rules carry instructions
+  (``Session.rules.instructions``, set by the classroom), the first element of the panel shows
+  them, above the tabs; hidden when there are none.
+* **Message box**: the oldest message the session keeps (``Session.messages``) with who it was
+  for and when, how many more wait, and a **Dismiss** button (``Session.dismiss_message`` of
+  the message shown: a click that arrives after another message took its place dismisses
+  nothing else). Messages queue: the next one shows when this one is dismissed.
+
+Both texts are the trainer's browser's (a stranger's): every line goes through
+``text_escape.escape_markdown_lines``. The view renders from the session's state on its
+``notice`` signal; the only command it sends is Dismiss (``Session.on_loop``).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from tcp_pendant.pendant.class_messages import ClassMessage
+from tcp_pendant.session import Session, SessionChange
+from tcp_pendant.text_escape import escape_markdown, escape_markdown_lines
+from tcp_pendant.views.gui_util import set_content, target_of
+
+__all__ = ["ClassNoticeView", "instructions_markdown", "message_markdown"]
+
+BANNER_ORDER = -1100.0
+"""The instructions' place: above every other element of the panel (the identity banner is -1000)."""
+
+
+def instructions_markdown(instructions: str) -> str:
+    """The banner's markdown for the exercise's ``instructions`` (plain text, escaped)."""
+    return f"**Exercise**\n\n{escape_markdown_lines(instructions)}"
+
+
+def message_markdown(message: ClassMessage, waiting: int) -> str:
+    """The message box's markdown: who it was for, when (UTC), the text (escaped) and how many
+    more messages wait after it."""
+    to = "the class" if message.to is None else f"you ({escape_markdown(message.to)})"
+    when = message.sent_at_utc[11:16]
+    more = f"\n\n*{waiting} more message{'s' if waiting != 1 else ''} after this one.*" if waiting else ""
+    return f"**Message from the trainer** to {to}, {when} UTC\n\n{escape_markdown_lines(message.text)}{more}"
+
+
+class ClassNoticeView:
+    """The instructions banner and the message box of one session (see the module docstring).
+
+    Attributes:
+        banner, message_md, dismiss: the widgets (for tests).
+        shown: the message on show (None: none).
+    """
+
+    def __init__(self, session: Session) -> None:
+        self.session = session
+        gui = target_of(session).gui
+        self.banner = gui.add_markdown("", order=BANNER_ORDER, visible=False)
+        self.message_md = gui.add_markdown("", order=BANNER_ORDER + 1, visible=False)
+        self.dismiss = gui.add_button("Dismiss", order=BANNER_ORDER + 2, visible=False,
+                                      hint="The message goes; the next one, if any, shows.")
+        self.shown: ClassMessage | None = None
+        self.dismiss.on_click(session.on_loop(self._on_dismiss))
+        session.subscribe(self.on_change)
+        self.render()
+
+    def on_change(self, change: SessionChange) -> None:
+        if change.notice:
+            self.render()
+
+    def _on_dismiss(self, _event: Any = None) -> None:
+        if self.shown is not None:
+            self.session.dismiss_message(self.shown.message_id)
+
+    def render(self) -> None:
+        """The banner and the message box from the session's rules and messages."""
+        if self.session.closed:
+            return
+        instructions = self.session.rules.instructions
+        if instructions:
+            set_content(self.banner, instructions_markdown(instructions))
+        self.banner.visible = bool(instructions)
+        messages = self.session.messages
+        self.shown = messages[0] if messages else None
+        if self.shown is not None:
+            set_content(self.message_md, message_markdown(self.shown, len(messages) - 1))
+        self.message_md.visible = self.dismiss.visible = self.shown is not None

@@ -1,0 +1,104 @@
+"""The trainer's controls for the exercise's brief (viser GUI): instructions, the methods
+trainees may start and the fewest touches a Finish takes.
+
+:func:`build_exercise_controls` adds them where it is called (the trainer view's panel): an
+"Instructions" text area (plain text, at most ``MAX_INSTRUCTIONS_CHARS`` characters: shown
+escaped in a banner on every trainee's panel), one checkbox per calibration method (the
+registry's, in menu order; all ticked: every method), "Minimum touches" (0: none; it applies to
+the methods whose touch count the trainee chooses, ``pendant.exercise_rules``) and **Push brief
+to all trainees** (``ClassRoom.push_brief``). What a browser sends is checked by the class; a
+refusal is a notification in words (``Session.on_loop``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any, Protocol
+
+from tcp_pendant.pendant.exercise_rules import MAX_INSTRUCTIONS_CHARS, MAX_MIN_TOUCHES
+from tcp_pendant.session import Session
+from tcp_pendant.text_escape import escape_markdown
+from tcp_pendant.wizards import wizard_classes
+
+__all__ = ["BriefControl", "ExerciseControls", "brief_words", "build_exercise_controls"]
+
+
+class BriefControl(Protocol):
+    """What the exercise controls need of the class (``ClassRoom``)."""
+
+    instructions: str
+    allowed_methods: tuple[str, ...] | None
+    min_touches: int
+
+    def push_brief(self, instructions: str, allowed_methods: Sequence[str] | str | None,
+                   min_touches: int) -> int: ...
+
+
+def brief_words(control: BriefControl) -> str:
+    """The class's brief in one line for the trainer (plain text)."""
+    titles = {c.kind: c.title for c in wizard_classes()}
+    n = len(control.instructions)
+    text = f"instructions of {n} characters" if n else "no instructions"
+    methods = ("every method" if control.allowed_methods is None
+               else ", ".join(titles.get(k, k) for k in control.allowed_methods))
+    touches = (f"at least {control.min_touches} touches where the trainee chooses how many"
+               if control.min_touches else "no minimum of touches")
+    return f"{text.capitalize()}; {methods}; {touches}."
+
+
+@dataclass(eq=False)
+class ExerciseControls:
+    """The widgets of the brief (for tests) and their push.
+
+    Attributes:
+        instructions: the text area; methods: wizard kind -> its checkbox; min_touches: the
+            number; push: the button; status: what the last push did (markdown).
+    """
+
+    session: Session
+    control: BriefControl
+    instructions: Any
+    methods: dict[str, Any]
+    min_touches: Any
+    push: Any
+    status: Any
+
+    def render(self) -> None:
+        """Nothing to re-read: the brief changes only by this push."""
+
+    def _push(self, _event: Any = None) -> None:
+        ticked = tuple(kind for kind, box in self.methods.items() if box.value is True)
+        if not ticked:
+            raise ValueError("Tick at least one method the trainees may use, then push the brief.")
+        allowed = None if len(ticked) == len(self.methods) else ticked
+        text = self.instructions.value
+        if not isinstance(text, str):
+            raise ValueError("The instructions must be text.")
+        minimum = self.min_touches.value
+        if isinstance(minimum, float) and minimum.is_integer():
+            minimum = int(minimum)
+        n = self.control.push_brief(text, allowed, minimum)
+        self.status.content = escape_markdown(f"Pushed to {n} trainee{'s' if n != 1 else ''}: "
+                                              f"{brief_words(self.control)}")
+
+
+def build_exercise_controls(gui: Any, class_control: BriefControl, session: Session) -> ExerciseControls:
+    """Add the brief's controls to ``gui`` (in the container open where it is called) for the
+    trainer's ``session``; their push goes to ``class_control``."""
+    allowed = class_control.allowed_methods
+    with gui.add_folder("Exercise brief"):
+        text = gui.add_text("Instructions", class_control.instructions, multiline=True,
+                            hint=f"What the trainees should do, plain text (at most {MAX_INSTRUCTIONS_CHARS} "
+                                 "characters): a banner at the top of every trainee's panel shows it.")
+        gui.add_markdown("Methods the trainees may use:")
+        methods = {c.kind: gui.add_checkbox(c.title, allowed is None or c.kind in allowed)
+                   for c in wizard_classes()}
+        minimum = gui.add_number("Minimum touches", int(class_control.min_touches), min=0, max=MAX_MIN_TOUCHES,
+                                 step=1, hint="0: none. A Finish with fewer touches is refused in the methods "
+                                              "whose touch count the trainee chooses (XYZ 4-point, TCP & Z, X).")
+        push = gui.add_button("Push brief to all trainees", color="blue")
+        status = gui.add_markdown("")
+    controls = ExerciseControls(session, class_control, text, methods, minimum, push, status)
+    push.on_click(session.on_loop(controls._push))
+    return controls
