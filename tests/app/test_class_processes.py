@@ -140,3 +140,24 @@ def test_a_push_on_one_process_reaches_the_trainees_of_the_other(two) -> None:
         assert b.classroom.distance_aids == "locked"
     finally:
         cb.close()
+
+
+def test_a_message_and_a_brief_sent_on_one_process_reach_the_trainees_of_the_other(two) -> None:
+    a, b = two
+    cb = DrainingClient(b.port)
+    try:
+        sb = _session(b)
+        _join(sb, "Ben")
+        a.classroom.beat()                                  # A learns who is connected on B
+        assert a.classroom.connected_names() == ["Ben"]
+        assert a.classroom.send_message("Stop jogging, look at the projector.") == "Sent to 1 trainee."
+        assert a.classroom.send_message("Ben, check your tool.", to="Ben") == "Sent to Ben."
+        a.classroom.push_brief("Calibrate the TCP first.", "xyz4", 6)
+        b.classroom.beat()
+        wait_until(lambda: [m.text for m in sb.messages] == ["Stop jogging, look at the projector.",
+                                                            "Ben, check your tool."],
+                   what="both messages shown on B")
+        wait_until(lambda: sb.rules.instructions == "Calibrate the TCP first.", what="the brief on B")
+        assert sb.rules.allowed_methods == ("xyz4",) and sb.rules.min_touches == 6
+    finally:
+        cb.close()
