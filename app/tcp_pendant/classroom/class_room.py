@@ -499,8 +499,9 @@ class ClassRoom:
                     remote[name] = TraineeStatus(**{k: v for k, v in st.items() if k in fields})
                 except TypeError:
                     continue
-        changed = remote != self._remote
-        self._remote = remote
+        with self._lock:
+            changed = remote != self._remote
+            self._remote = remote
         for push_id, push in self.gradebook.pushes_after(self._push_seen):
             self._push_seen = push_id
             if push.get("holder") != self.holder:
