@@ -191,16 +191,20 @@ def main(argv: list[str] | None = None) -> int:
           f"{PRESS_HZ:.0f}/s ({PRESS_MM} mm) for {args.duration:g} s; clients in {args.client_procs} processes "
           f"on the same {os.cpu_count()} CPUs (load average {load[0]:.1f} {load[1]:.1f} {load[2]:.1f} at start)")
     print(f"  {'K':>4} {'p50 ms':>8} {'p95 ms':>8} {'p99 ms':>8} {'max ms':>8} {'asked':>7} {'unansw.':>7} "
-          f"{'steps/s':>8} {'per K':>6}  server CPU per process (cores)   clients CPU")
+          f"{'steps/s':>8} {'per K':>6} {'ms/step':>7}  server CPU per process (cores)   clients CPU")
     rows = []
     for k in counts:
         row = run_class(k, args.workers, args.duration, min(args.client_procs, k), not args.no_names)
         rows.append(row)
         cpu = " ".join(f"{c:.2f}" for c in row["server_cpu"])
+        ms_step = sum(row["server_cpu"]) / max(row["steps_s"], 1e-9) * 1e3
         print(f"  {k:>4} {row['p50']:8.1f} {row['p95']:8.1f} {row['p99']:8.1f} {row['max']:8.1f} {row['asked']:>7} "
-              f"{row['unanswered']:>7} {row['steps_s']:8.1f} {row['per_trainee']:6.1f}  {cpu:<31} "
+              f"{row['unanswered']:>7} {row['steps_s']:8.1f} {row['per_trainee']:6.1f} {ms_step:7.2f}  {cpu:<31} "
               f"{row['clients_cpu']:.2f}" + (f"  ({row['no_readout']} clients saw no readout)"
                                               if row["no_readout"] else ""), flush=True)
+    print("  (ms/step: the server processes' CPU per step achieved, all included - the jog, the views, viser's "
+          f"sending, the deadman's drops; {os.cpu_count()} cores give at most {os.cpu_count()} / that steps per second "
+          "when nothing else runs)")
     print("  (latency: a press is matched to the first readout that shows as many presses; in a row with "
           "unanswered presses the deadman dropped some, so later presses are matched to earlier sends: "
           "those percentiles are upper bounds; rows with none are exact)")
