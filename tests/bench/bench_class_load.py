@@ -23,6 +23,10 @@ the steps asked were achieved; else NOT MET. Always printed, whatever the outcom
 
     .venv/bin/python tests/bench/bench_class_load.py                        # 1 10 30 60 100, 30 s
     .venv/bin/python tests/bench/bench_class_load.py --counts 30 --duration 10 --workers 1
+    .venv/bin/python tests/bench/bench_class_load.py --counts 10,30 --baseline   # and against --workers 1
+
+``--baseline`` runs each K against ``--workers 1`` right after (the same machine in the same
+minute: on a shared machine the ratio of steps/s achieved is the figure to trust).
 """
 
 from __future__ import annotations
@@ -184,6 +188,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--duration", type=float, default=30.0, help="seconds of pressing per class size")
     ap.add_argument("--client-procs", type=int, default=2, help="processes the headless clients run in")
     ap.add_argument("--no-names", action="store_true", help="clients do not join the class (no recorder)")
+    ap.add_argument("--baseline", action="store_true",
+                    help="also run each K against --workers 1 right after (same machine, same minute) and "
+                         "print the ratio of steps/s achieved")
     args = ap.parse_args(args_in)
     counts = [int(v) for v in args.counts.split(",") if v.strip()]
     load = os.getloadavg()
@@ -193,15 +200,24 @@ def main(argv: list[str] | None = None) -> int:
     print(f"  {'K':>4} {'p50 ms':>8} {'p95 ms':>8} {'p99 ms':>8} {'max ms':>8} {'asked':>7} {'unansw.':>7} "
           f"{'steps/s':>8} {'per K':>6} {'ms/step':>7}  server CPU per process (cores)   clients CPU")
     rows = []
-    for k in counts:
-        row = run_class(k, args.workers, args.duration, min(args.client_procs, k), not args.no_names)
-        rows.append(row)
+
+    def show(row: dict[str, Any], label: str) -> None:
         cpu = " ".join(f"{c:.2f}" for c in row["server_cpu"])
         ms_step = sum(row["server_cpu"]) / max(row["steps_s"], 1e-9) * 1e3
-        print(f"  {k:>4} {row['p50']:8.1f} {row['p95']:8.1f} {row['p99']:8.1f} {row['max']:8.1f} {row['asked']:>7} "
+        print(f"  {label:>4} {row['p50']:8.1f} {row['p95']:8.1f} {row['p99']:8.1f} {row['max']:8.1f} {row['asked']:>7} "
               f"{row['unanswered']:>7} {row['steps_s']:8.1f} {row['per_trainee']:6.1f} {ms_step:7.2f}  {cpu:<31} "
               f"{row['clients_cpu']:.2f}" + (f"  ({row['no_readout']} clients saw no readout)"
                                               if row["no_readout"] else ""), flush=True)
+
+    for k in counts:
+        row = run_class(k, args.workers, args.duration, min(args.client_procs, k), not args.no_names)
+        rows.append(row)
+        show(row, str(k))
+        if args.baseline and args.workers != 1:
+            base = run_class(k, 1, args.duration, min(args.client_procs, k), not args.no_names)
+            show(base, "w=1")
+            print(f"       steps/s with --workers {args.workers} / with --workers 1: "
+                  f"{row['steps_s'] / max(base['steps_s'], 1e-9):.2f}", flush=True)
     print("  (ms/step: the server processes' CPU per step achieved, all included - the jog, the views, viser's "
           f"sending, the deadman's drops; {os.cpu_count()} cores give at most {os.cpu_count()} / that steps per second "
           "when nothing else runs)")
