@@ -59,6 +59,18 @@ def _cpu_s(pid: int) -> float:
     return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
+def _waited_s(pid: int) -> float:
+    """Seconds the threads of process ``pid`` have spent runnable but not running (waiting for a
+    CPU; Linux ``/proc/PID/task/TID/schedstat``, second field, ns), summed over its threads."""
+    total = 0
+    for tid in os.listdir(f"/proc/{pid}/task"):
+        try:
+            total += int(Path(f"/proc/{pid}/task/{tid}/schedstat").read_text().split()[1])
+        except (OSError, IndexError, ValueError):
+            continue
+    return total / 1e9
+
+
 # ------------------------------------------------------------------ client process
 async def _client_main(port: int, first: int, n: int, names: bool) -> None:
     sys.path.insert(0, str(APP_TESTS))
@@ -129,6 +141,7 @@ def run_class(k: int, workers: int, seconds: float, client_procs: int, names: bo
                     raise RuntimeError("a client process did not connect its clients")
             start_at = time.monotonic() + 0.5
             cpu0 = [_cpu_s(pid) for pid in pids]
+            wait0 = [_waited_s(pid) for pid in pids]
             for p in procs:
                 assert p.stdin is not None
                 p.stdin.write(f"{start_at} {seconds}\n")
@@ -139,6 +152,7 @@ def run_class(k: int, workers: int, seconds: float, client_procs: int, names: bo
                 results.append(json.loads(p.stdout.readline()))
             window = time.monotonic() - start_at
             cpu = [(_cpu_s(pid) - c0) / window for pid, c0 in zip(pids, cpu0)]
+            waited = [(_waited_s(pid) - w0) / window for pid, w0 in zip(pids, wait0)]
         finally:
             for p in procs:
                 try:
@@ -167,7 +181,7 @@ def run_class(k: int, workers: int, seconds: float, client_procs: int, names: bo
     return {"k": k, "p50": pct(50), "p95": pct(95), "p99": pct(99), "max": lat[-1] if lat else float("nan"),
             "asked": asked, "answered": answered, "unanswered": asked - answered,
             "steps_s": answered / seconds, "asked_s": asked / seconds, "per_trainee": answered / seconds / k,
-            "server_cpu": cpu, "clients_cpu": sum(r["cpu_s"] for r in results) / window,
+            "server_cpu": cpu, "server_waited": waited, "clients_cpu": sum(r["cpu_s"] for r in results) / window,
             "no_readout": sum(r["no_readout"] for r in results)}
 
 
@@ -198,7 +212,8 @@ def main(argv: list[str] | None = None) -> int:
           f"{PRESS_HZ:.0f}/s ({PRESS_MM} mm) for {args.duration:g} s; clients in {args.client_procs} processes "
           f"on the same {os.cpu_count()} CPUs (load average {load[0]:.1f} {load[1]:.1f} {load[2]:.1f} at start)")
     print(f"  {'K':>4} {'p50 ms':>8} {'p95 ms':>8} {'p99 ms':>8} {'max ms':>8} {'asked':>7} {'unansw.':>7} "
-          f"{'steps/s':>8} {'per K':>6} {'ms/step':>7}  server CPU per process (cores)   clients CPU")
+          f"{'steps/s':>8} {'per K':>6} {'ms/step':>7}  server CPU per process (cores)   clients CPU   "
+          "server waiting for a CPU")
     rows = []
 
     def show(row: dict[str, Any], label: str) -> None:
@@ -206,7 +221,8 @@ def main(argv: list[str] | None = None) -> int:
         ms_step = sum(row["server_cpu"]) / max(row["steps_s"], 1e-9) * 1e3
         print(f"  {label:>4} {row['p50']:8.1f} {row['p95']:8.1f} {row['p99']:8.1f} {row['max']:8.1f} {row['asked']:>7} "
               f"{row['unanswered']:>7} {row['steps_s']:8.1f} {row['per_trainee']:6.1f} {ms_step:7.2f}  {cpu:<31} "
-              f"{row['clients_cpu']:.2f}" + (f"  ({row['no_readout']} clients saw no readout)"
+              f"{row['clients_cpu']:<13.2f} " + " ".join(f"{w:.2f}" for w in row["server_waited"])
+              + (f"  ({row['no_readout']} clients saw no readout)"
                                               if row["no_readout"] else ""), flush=True)
 
     for k in counts:
@@ -221,6 +237,9 @@ def main(argv: list[str] | None = None) -> int:
     print("  (ms/step: the server processes' CPU per step achieved, all included - the jog, the views, viser's "
           f"sending, the deadman's drops; {os.cpu_count()} cores give at most {os.cpu_count()} / that steps per second "
           "when nothing else runs)")
+    print("  (server waiting for a CPU: the share of the time each server process's threads were ready to run "
+          "but had no CPU - other programs on the machine had it; a server that waits for a CPU falls behind "
+          "and its deadman drops presses, whatever its own cost per step)")
     print("  (latency: a press is matched to the first readout that shows as many presses; in a row with "
           "unanswered presses the deadman dropped some, so later presses are matched to earlier sends: "
           "those percentiles are upper bounds; rows with none are exact)")
