@@ -102,6 +102,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--exercise-seed", type=int, default=None, metavar="N",
                    help="seed of the mystery tools, for a reproducible demo (default: the class's own "
                         "secret seed, drawn at random once and kept in the gradebook)")
+    p.add_argument("--library-quota", type=int, default=None, metavar="N",
+                   help="in a class: the tool-library slots one trainee may hold (1..16, default 3); each "
+                        "trainee renames and deletes only the slots they saved, the trainer every slot")
     p.add_argument("--exercise-instructions", default=None, metavar="TEXT",
                    help="the exercise's instructions, shown in a banner at the top of every trainee's "
                         "panel (plain text, at most 2000 characters; default: the instructions kept in "
@@ -228,6 +231,7 @@ def _main(argv: Sequence[str] | None) -> int:
 
         signal.signal(signal.SIGTERM, _terminate)
     from tcp_pendant.classroom.trainer_token import TrainerTokenError, resolve_trainer_token
+    from tcp_pendant.pendant.library_rights import DEFAULT_LIBRARY_QUOTA, MAX_LIBRARY_QUOTA
 
     classroom = bool(args.classroom or args.class_db or args.exercise or args.trainer_token
                      or args.trainer_token_file or args.exercise_instructions is not None
@@ -247,6 +251,14 @@ def _main(argv: Sequence[str] | None) -> int:
     if args.trainer_token is not None and worker is None:
         print("tcp-pendant: note: a --trainer-token on the command line shows in the process list; "
               "--trainer-token-file PATH or TCP_PENDANT_TRAINER_TOKEN keep it out", file=sys.stderr)
+    if args.library_quota is not None and not classroom:
+        print("tcp-pendant: error: --library-quota is for a class (each trainee's own library slots); "
+              "add --class, or drop --library-quota", file=sys.stderr)
+        return 2
+    if args.library_quota is not None and not 1 <= args.library_quota <= MAX_LIBRARY_QUOTA:
+        print(f"tcp-pendant: error: --library-quota must be 1..{MAX_LIBRARY_QUOTA} slots, got "
+              f"{args.library_quota}", file=sys.stderr)
+        return 2
     class_db = args.class_db
     if isinstance(class_db, str) and url_has_password(class_db):
         print("tcp-pendant: note: a password in the --class-db URL shows in the process list; "
@@ -266,6 +278,8 @@ def _main(argv: Sequence[str] | None) -> int:
                            reference_tip_mm=tip, allow_origins=tuple(args.allow_origin), class_db=class_db,
                            trainer_token=trainer_token, exercise=args.exercise,
                            exercise_seed=args.exercise_seed,
+                           library_quota=(DEFAULT_LIBRARY_QUOTA if args.library_quota is None
+                                          else args.library_quota),
                            exercise_instructions=args.exercise_instructions,
                            exercise_methods=None if args.exercise_methods is None else tuple(
                                m.strip() for m in args.exercise_methods.split(",") if m.strip()),

@@ -27,6 +27,16 @@ same-origin rule, so the checks hold from the first connection even before the s
 is known. A port may also have an HTTP layer (:func:`set_http_layer`:
 ``client_script.serve``, the page's own script) that answers plain HTTP requests, behind the
 checks and in front of viser's static server.
+
+**Not before it is ready.** viser listens as soon as its server object exists, well before the
+pendant has put its policies, its page script and its session handlers in place (seconds on a
+busy machine): a page loaded then lacked the script (no remembered name and key: a reload
+after a restart stayed at the welcome window) and a websocket connected then got no session.
+So while a pendant starts (:func:`starting`), every port without a policy yet, and the
+pendant's own port once it has one (:func:`allow`), answers every request (after the checks
+above) with HTTP 503 "starting" until the pendant marks it ready (:func:`mark_ready`); a
+browser's reload, viser's own reconnect and a readiness probe simply retry. A port without a
+policy while no pendant starts (a bare viser server in the same process) is not held back.
 """
 
 from __future__ import annotations
@@ -34,12 +44,13 @@ from __future__ import annotations
 import http
 import logging
 import threading
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Iterator, Sequence
+from contextlib import contextmanager
 from typing import Any
 from urllib.parse import urlsplit
 
-__all__ = ["LOOPBACK_HOSTS", "OriginError", "allow", "enable", "forget", "host_refusal", "normalize_origin",
-           "origin_refusal", "parse_allow_origins", "served_hosts", "set_http_layer"]
+__all__ = ["LOOPBACK_HOSTS", "STARTING", "OriginError", "allow", "enable", "forget", "host_refusal", "mark_ready",
+           "normalize_origin", "origin_refusal", "parse_allow_origins", "served_hosts", "set_http_layer", "starting"]
 
 log = logging.getLogger(__name__)
 
@@ -49,6 +60,10 @@ _allowed_by_port: dict[int, frozenset[str]] = {}
 _hosts_by_port: dict[int, frozenset[str]] = {}
 _original_handshake: Any = None
 _http_layers: dict[int, Any] = {}
+_ready_ports: set[int] = set()
+_starting = 0                     # pendants of this process inside starting()
+STARTING = "The pendant is starting; reload in a moment."
+"""The answer (HTTP 503) of a port that is not ready yet."""
 
 
 LOOPBACK_HOSTS = frozenset({"localhost", "127.0.0.1", "::1"})
@@ -197,16 +212,17 @@ def _is_upgrade(request: Any) -> bool:
     return any(v.lower() == "websocket" for v in _header_values(request.headers, "Upgrade"))
 
 
-def _allowed_for(connection: Any) -> tuple[frozenset[str], Any, frozenset[str]]:
-    """The extra origins, the HTTP layer and the served host names of the port ``connection``
-    came to."""
+def _allowed_for(connection: Any) -> tuple[frozenset[str], Any, frozenset[str], bool]:
+    """The extra origins, the HTTP layer, the served host names of the port ``connection``
+    came to, and whether that port is ready (:func:`mark_ready`)."""
     try:
         port = int(connection.local_address[1])
     except Exception:  # no socket address: same-origin rule, loopback names only
-        return frozenset(), None, LOOPBACK_HOSTS
+        return frozenset(), None, LOOPBACK_HOSTS, True
     with _lock:
+        ready = port in _ready_ports if port in _hosts_by_port else _starting == 0
         return (_allowed_by_port.get(port, frozenset()), _http_layers.get(port),
-                _hosts_by_port.get(port, LOOPBACK_HOSTS))
+                _hosts_by_port.get(port, LOOPBACK_HOSTS), ready)
 
 
 def enable() -> None:
@@ -220,7 +236,7 @@ def enable() -> None:
         original = _original_handshake = ServerConnection.handshake
 
     async def handshake(self: Any, process_request: Any = None, *args: Any, **kwargs: Any) -> None:
-        allowed, layer, hosts = _allowed_for(self)
+        allowed, layer, hosts, ready = _allowed_for(self)
 
         def checked(connection: Any, request: Any) -> Any:
             try:
@@ -237,6 +253,8 @@ def enable() -> None:
             if refusal is not None:
                 log.warning("request from %s: %s", _peer(connection), refusal)
                 return connection.respond(http.HTTPStatus.FORBIDDEN, refusal + "\n")
+            if not ready:
+                return connection.respond(http.HTTPStatus.SERVICE_UNAVAILABLE, STARTING + "\n")
             if layer is not None and not _is_upgrade(request):
                 return layer(connection, request, process_request)
             return None if process_request is None else process_request(connection, request)
@@ -273,9 +291,31 @@ def allow(port: int, origins: Sequence[str], hosts: Iterable[str] = LOOPBACK_HOS
         _hosts_by_port[int(port)] = frozenset(h.lower() for h in hosts)
 
 
-def forget(port: int) -> None:
-    """Drop the extra origins, the host names and the HTTP layer of ``port`` (the server stopped)."""
+@contextmanager
+def starting() -> Iterator[None]:
+    """While a pendant starts: a port without a policy answers 503 (module docstring)."""
+    global _starting
     with _lock:
+        _starting += 1
+    try:
+        yield
+    finally:
+        with _lock:
+            _starting -= 1
+
+
+def mark_ready(port: int) -> None:
+    """The server listening on ``port`` is ready: its requests are answered from now on (until
+    then: HTTP 503, :data:`STARTING`)."""
+    with _lock:
+        _ready_ports.add(int(port))
+
+
+def forget(port: int) -> None:
+    """Drop the extra origins, the host names, the HTTP layer and the readiness of ``port``
+    (the server stopped)."""
+    with _lock:
+        _ready_ports.discard(int(port))
         _allowed_by_port.pop(int(port), None)
         _hosts_by_port.pop(int(port), None)
         _http_layers.pop(int(port), None)

@@ -34,8 +34,10 @@ from tcpcal.library import ToolLibrary
 from tcp_pendant import client_script, origin_check
 from tcp_pendant.calibrate import CalibrationWorkflow
 from tcp_pendant.addresses import network_urls
+from tcp_pendant.job_pool import JobPool
 from tcp_pendant.classroom.class_room import ClassRoom
 from tcp_pendant.classroom.gradebook import Gradebook
+from tcp_pendant.pendant.library_rights import DEFAULT_LIBRARY_QUOTA
 from tcp_pendant.controller import (
     BeamDevice,
     ControllerError,
@@ -100,6 +102,8 @@ class AppConfig:
         exercise: None (free practice) or "mystery" (each trainee gets a mystery tool).
         exercise_seed: seed of the mystery tools (None: the class's secret seed, drawn once and
             kept in the gradebook; a number: that seed, for a reproducible demo).
+        library_quota: in a class, the tool-library slots one trainee may hold (1..16; each
+            trainee renames and deletes only their own, ``pendant.library_rights``).
         exercise_instructions, exercise_methods, exercise_min_touches: the exercise's brief at
             start (``ClassRoom``: instructions as plain text, the wizard kinds trainees may
             start, the fewest touches a Finish takes); None: the brief kept in the gradebook.
@@ -139,6 +143,7 @@ class AppConfig:
     trainer_token: str | None = None
     exercise: str | None = None
     exercise_seed: int | None = None
+    library_quota: int = DEFAULT_LIBRARY_QUOTA
     exercise_instructions: str | None = None
     exercise_methods: tuple[str, ...] | None = None
     exercise_min_touches: int | None = None
@@ -350,6 +355,8 @@ class PendantApp:
         self._sessions_lock = threading.Lock()
         self._stop = threading.Event()
         self._watcher: threading.Thread | None = None
+        self.jobs = JobPool()
+        """The server's one pool of browser-triggered jobs, fair per session (``job_pool``)."""
         # warm the mesh caches so the first browser does not wait for STL parsing
         link_meshes(self.kinematics.description)
         for t in tools.values():
@@ -362,10 +369,11 @@ class PendantApp:
             self.classroom = ClassRoom(self.gradebook, tools,
                                        trainer_token=config.trainer_token,
                                        exercise=config.exercise, exercise_seed=config.exercise_seed,
+                                       library_quota=config.library_quota,
                                        instructions=config.exercise_instructions,
                                        allowed_methods=config.exercise_methods,
                                        min_touches=config.exercise_min_touches,
-                                       hand_to_loop=self._hand_to_loop,
+                                       hand_to_loop=self._hand_to_loop, call_later=self._call_later,
                                        presence_poll_s=config.presence_poll_s)
 
     @property
@@ -411,7 +419,7 @@ class PendantApp:
         rng = self.session_rng()
         workflow = CalibrationWorkflow(c, self.library, robot=self.robot_key, rng=rng)
         session = Session(c, self.library, workflow, client=client, target=target, ready_q_rad=self.ready_q_rad,
-                          shared=shared, rng=rng)
+                          shared=shared, rng=rng, jobs=self.jobs)
         session.reload_library()
         if shared:
             try:
@@ -540,6 +548,15 @@ class PendantApp:
         except RuntimeError:                     # the loop is closed: the server is stopping
             log.debug("library reload dropped: server stopped")
 
+    def _call_later(self, delay_s: float, fn: Callable[[], object]) -> None:
+        """Run ``fn()`` on viser's event loop after ``delay_s`` seconds (the dashboards' throttle
+        and clock tick; from any thread)."""
+        server = self.server
+        if server is None:
+            raise RuntimeError("the server is not running")
+        loop = server.get_event_loop()
+        loop.call_soon_threadsafe(loop.call_later, max(0.0, delay_s), fn)
+
     def library_changed(self) -> None:
         """Every session re-reads the library (on viser's event loop: the watcher hands it
         over); their views re-render on the change signal."""
@@ -549,12 +566,18 @@ class PendantApp:
     # ------------------------------------------------------------ life cycle
     def start(self) -> str:
         """Start serving; returns the URL."""
-        import viser
-
         host = self.config.host
         origin_check.enable()               # foreign web pages' websockets are refused (403)
         viser_adapter.install()             # every browser message checked before viser's handlers
         client_script.script_asset()        # the page's own script (keys, name, trainer URL): packaged?
+        with origin_check.starting():       # requests get 503 "starting" until mark_ready
+            self._start_serving(host)
+        return self.url
+
+    def _start_serving(self, host: str) -> None:
+        """The viser server, its policies, page script and session handlers; then ready."""
+        import viser
+
         if self.config.reuse_port:
             viser_adapter.listen_reuse_port()   # one port, several server processes (--workers)
         self.server = viser.ViserServer(host=host, port=self.config.port, verbose=False)
@@ -563,6 +586,7 @@ class PendantApp:
         origin_check.set_http_layer(self.port, client_script.serve)
         if self.config.port != 0 and self.port != self.config.port:
             # viser silently moves on to the next free port; the class was told this one
+            origin_check.forget(self.port)
             self.server.stop()
             self.server = None
             raise PortInUseError(host, self.config.port)
@@ -580,7 +604,7 @@ class PendantApp:
         self._watcher.start()
         if self.classroom is not None:
             self.classroom.start()          # presence heartbeat, the other processes' pushes
-        return self.url
+        origin_check.mark_ready(self.port)  # until now every request got 503 "starting"
 
     @property
     def trainer_url(self) -> str | None:
@@ -625,6 +649,7 @@ class PendantApp:
         if self.server is not None:
             origin_check.forget(self.port)
             self.server.stop()
+        self.jobs.shutdown(wait=False)
         if self.classroom is not None:
             self.classroom.close()          # frees the names this process held
         if self.gradebook is not None:

@@ -52,7 +52,10 @@ things run elsewhere: workers copy state under it (Check, record replay), tests 
 sessions from their own thread; the session itself is built on the loop, see
 ``PendantApp.session_steps``), ignores events after the session closed, and turns any exception into a
 notification instead of a crash (a browser can send anything). Work from another thread is
-handed to the loop (the server's library watcher: ``loop.call_soon_threadsafe``).
+handed to the loop (the server's library watcher: ``loop.call_soon_threadsafe``). Work whose
+size a browser controls (a check, a scan, a record's replay, Auto-touch's pose probes) is a
+job detached from the session, run in the server's job pool by :meth:`Session.run_job`
+(``job_pool``: one job per session, a bounded queue), awaited without blocking the loop.
 """
 
 from __future__ import annotations
@@ -64,7 +67,7 @@ import threading
 from collections.abc import Callable, Coroutine, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
-from typing import TYPE_CHECKING, Any, ContextManager, Literal, Protocol, TypeVar
+from typing import TYPE_CHECKING, Any, ContextManager, Literal, Protocol, TypeVar, cast
 
 import numpy as np
 
@@ -77,9 +80,11 @@ from tcp_pendant.controller import ControllerError, JogResult, ToolModel, Virtua
 from tcp_pendant.controller.pose_state import PoseState, pose_state, pose_state_key
 from tcp_pendant.controller.scenarios import Scenario, ScenarioWorld, bent_tool, realize
 from tcp_pendant.events import Crash, SessionEvent
+from tcp_pendant.job_pool import JobPool, default_pool
 from tcp_pendant.pendant import Jogger, touch_label
 from tcp_pendant.pendant.class_messages import MAX_WAITING_MESSAGES, ClassMessage
 from tcp_pendant.pendant.exercise_rules import FREE_PRACTICE, ExerciseRules, RuleRefusal
+from tcp_pendant.pendant.library_rights import UNRESTRICTED, LibraryRights
 from tcp_pendant.wizards import Wizard, WizardResult, WizardStateError, wizard_class, wizard_classes
 
 if TYPE_CHECKING:
@@ -89,6 +94,7 @@ __all__ = ["GuiTarget", "Session", "SessionChange", "Touch"]
 
 log = logging.getLogger(__name__)
 F = TypeVar("F", bound=Callable[..., Any])
+R = TypeVar("R")
 
 COALESCE_AFTER_S = 0.010
 """A jog press that waited longer than this (s) on the event loop signals at the end of the
@@ -216,6 +222,8 @@ class Session:
         rng: the session's random generator (Auto-touch's operator error and directions, the
             beam's repeatability, the scenarios the trainer plays): the server draws it from its
             one seed (``--seed``), so a seeded lesson replays the same way.
+        jobs: the server's pool of browser-triggered jobs (``job_pool.JobPool``, one for the
+            whole server: :meth:`run_job`); default the process's pool.
     """
 
     controller: VirtualController
@@ -234,6 +242,7 @@ class Session:
     hide_distance: bool = False
     rules: ExerciseRules = FREE_PRACTICE
     rng: np.random.Generator = field(default_factory=np.random.default_rng)
+    jobs: JobPool = field(default_factory=default_pool, repr=False)
 
     def __post_init__(self) -> None:
         if self.target is None:
@@ -254,6 +263,11 @@ class Session:
         """The library's tools as this session last read them (slot -> tool)."""
         self.library_error: str | None = None
         """Why the library could not be read at the last :meth:`reload_library` (None: it was)."""
+        self.library_owners: dict[int, str] = {}
+        """Who owns each owned slot, as this session last read it (a class's trainees)."""
+        self.library_rights: LibraryRights = UNRESTRICTED
+        """How this pendant may change the library (``pendant.library_rights``; the classroom
+        sets it with :meth:`set_library_rights`)."""
         self.scenario: Scenario = Scenario()
         """The systematic error played (training; off by default); change it with :meth:`set_scenario`."""
         self.scenario_world: ScenarioWorld | None = None
@@ -341,6 +355,17 @@ class Session:
                     fn(change)
                 except Exception:  # one view must not keep the others from showing the change
                     log.exception("session subscriber %s failed", getattr(fn, "__qualname__", fn))
+
+    def drop_views(self) -> None:
+        """Take the views down (the browser became the trainer's dashboard): they no longer
+        follow the change signal and :attr:`views` forgets them. The session stays open: its
+        lock, :meth:`guard`, :meth:`on_loop` and :meth:`notify` serve what is built next; the
+        caller clears the browser's GUI and scene."""
+        with self.lock:
+            self._subscribers.clear()
+            self.views.clear()
+            self.scene_labels.clear()
+            self.calibrate_container = None
 
     def on_close(self, fn: Callable[[], None]) -> None:
         """Register ``fn()``, called once when the session closes."""
@@ -502,38 +527,54 @@ class Session:
         with self.lock:
             try:
                 tools = self.library.tools()
+                owners = self.library.owners()
             except TcpcalError as exc:  # e.g. permissions: ToolLibraryError names the file
-                tools, self.library_error = {}, str(exc)
+                tools, owners, self.library_error = {}, {}, str(exc)
             else:
                 self.library_error = None
             self.library_tools = dict(tools)
+            self.library_owners = dict(owners)
             self.changed(library=True)
             return self.library_tools
+
+    def set_library_rights(self, rights: LibraryRights) -> None:
+        """How this pendant may change the library from now on (a class: the trainee's slots
+        only; ``pendant.library_rights``)."""
+        with self.lock:
+            self.library_rights = rights
+            self.changed(library=True)
 
     def store_tool(self, slot: int, tool: Tool) -> None:
         """Write ``tool`` into ``slot`` of the library (numeric entry) and re-read the list.
 
         Raises:
-            tcpcal.TcpcalError: the library refused (the name is in another slot, ...).
+            tcpcal.TcpcalError: the library refused (the name is in another slot, the slot is
+                another trainee's, the trainee's quota is full, ...).
         """
         with self.lock:
-            self.library.save(int(slot), tool)
+            rights = self.library_rights
+            with rights.in_words():
+                self.library.save(int(slot), tool, **rights.save_kwargs())
             self.reload_library()
 
     def rename_tool(self, slot: int, name: str) -> None:
-        """Rename the library tool in ``slot``; the active data carries the new name when it is
-        that slot's. One signal."""
+        """Rename the library tool in ``slot`` (a trainee: one of theirs); the active data
+        carries the new name when it is that slot's. One signal."""
         with self.lock, self.batch():
-            self.library.rename(int(slot), name)
+            rights = self.library_rights
+            with rights.in_words():
+                self.library.rename(int(slot), name, **rights.owner_kwargs())
             self.reload_library()
             renamed = self.library_tools.get(int(slot))
             if self.active_slot == int(slot) and renamed is not None:
                 self.set_active_data(renamed, int(slot))
 
     def delete_tool(self, slot: int) -> None:
-        """Delete the library tool in ``slot`` and re-read the list."""
+        """Delete the library tool in ``slot`` (a trainee: one of theirs) and re-read the list."""
         with self.lock:
-            self.library.remove(int(slot))
+            rights = self.library_rights
+            with rights.in_words():
+                self.library.remove(int(slot), **rights.owner_kwargs())
             self.reload_library()
 
     def notify(self, title: str, body: str, *, kind: str = "info") -> None:
@@ -789,6 +830,42 @@ class Session:
         with self._wizard_command(moves=True):
             return self.workflow.auto_touch(request)
 
+    async def auto_touch_in_pool(self, request: AutoTouchRequest, *,
+                                 shown: Callable[[AutoTouchOutcome], Any] | None = None) -> AutoTouchOutcome:
+        """:meth:`auto_touch` with the probes of the poses it reaches (a TCP check's rotations
+        from there, ``calibrate.jobs.POSE_CHECKS``) run in the job pool (:meth:`run_job`), off
+        viser's event loop: the moves and the record are wizard commands on the loop, each
+        ending in its own signal, the probes awaited in between (no probe: one command, one
+        signal, as :meth:`auto_touch`). ``shown(outcome)`` runs inside the last command (the
+        view's words join its signal). A robot moved meanwhile records nothing
+        (``autotouch.MOVED_DURING_PROBE``).
+
+        Raises:
+            JobRefused: this session's previous job still runs, or the queue is full.
+            WizardStateError: as :meth:`auto_touch`; the calibration on show changed meanwhile.
+        """
+        steps = self.workflow.auto_touch_steps(request)
+
+        def advance(answer: str | None, first: bool) -> tuple[Callable[[], str | None] | None, Any]:
+            with self._wizard_command(moves=True):
+                try:
+                    return (next(steps) if first else steps.send(answer)), None
+                except StopIteration as stop:
+                    if shown is not None:
+                        shown(stop.value)
+                    return None, stop.value
+
+        probe, out = advance(None, True)
+        try:
+            while probe is not None:
+                answer = await self.run_job(probe, what="Auto-touch's check of the pose it reached")
+                if self.closed:
+                    raise WizardStateError("The session was closed.")
+                probe, out = advance(answer, False)
+        finally:
+            steps.close()
+        return cast(AutoTouchOutcome, out)
+
     def back(self) -> None:
         """One step back (from the result: to the last step); nothing is deleted."""
         with self._wizard_command():
@@ -796,7 +873,7 @@ class Session:
 
     def next_step(self) -> WizardResult | None:
         """Next step, or on the last step Finish: the result (a wizard with a controller job runs
-        it here, synchronously; the views take the job and run it in a worker instead).
+        it here, synchronously; the views run it in the job pool instead: :meth:`next_step_in_pool`).
 
         Raises:
             RuleRefusal: Finish with fewer touches than the exercise asks for
@@ -880,6 +957,23 @@ class Session:
                 return None
             return self.workflow.controller_job()
 
+    async def next_step_in_pool(self) -> WizardResult | None:
+        """Next, or Finish with the controller job the wizard on show waits for (a TCP check's
+        rotations, a beam scan) taken on the loop, run in the job pool (:meth:`run_job`, off
+        viser's event loop) and handed in on the loop; no job: :meth:`next_step`.
+
+        Raises:
+            JobRefused: this session's previous job still runs, or the queue is full.
+            WizardStateError: as :meth:`next_step` (the job cannot be taken: the words say why).
+        """
+        job = self.take_controller_job()
+        if job is None:
+            return self.next_step()
+        outcome = await self.run_job(job.run, what=f"the {job.wizard.title} wizard's controller job")
+        if self.closed:
+            return None
+        return self.hand_in_controller_job(job, outcome)
+
     def hand_in_controller_job(self, job: Any, outcome: Any) -> WizardResult | None:
         """The outcome of a controller job to its wizard (its result, if it finished)."""
         with self._wizard_command(moves=True):
@@ -896,6 +990,23 @@ class Session:
         added to the runs; returns its replay checks."""
         with self._wizard_command():
             return self.workflow.add_loaded(loaded)
+
+    async def run_job(self, fn: Callable[[], R], *, what: str) -> R:
+        """Run ``fn()``, a job detached from the session (its own copies of what it reads, taken
+        on the loop with its limits checked), in the server's job pool, off viser's event loop,
+        and return its value (or raise its exception). One job per session at a time, the
+        rested sessions' jobs first (``job_pool``).
+
+        Args:
+            fn: the job; it must not touch the session, its GUI or its controller.
+            what: the job in words with its article ("a TCP check"), for the refusal of
+                another job of this session meanwhile.
+
+        Raises:
+            JobRefused: this session's previous job still runs (``SessionBusy``) or the
+                server's queue is full (``PoolFull``); the message says what to do.
+        """
+        return await self.jobs.run(self, fn, what=what)
 
     # ------------------------------------------------------------ touches
     def record_touch(self) -> Touch:

@@ -6,7 +6,8 @@ File format (UTF-8 JSON, indented, fixed key order, one line per number triple; 
       "format": "tcp-pendant-tool-library",
       "version": 1,
       "active_slot": 1,                 # int 1..16 of an occupied slot, or null
-      "tools": {"1": {...}, "3": {...}} # slot number (as a string) -> Tool.to_dict()
+      "tools": {"1": {...}, "3": {...}},# slot number (as a string) -> Tool.to_dict()
+      "owners": {"3": "Alice"}          # optional: slot -> who saved it (see "Owners")
     }
 
 The tool dictionaries are those of :meth:`tcpcal.tool.Tool.to_dict` (keys documented in
@@ -33,11 +34,23 @@ Consistency rules:
 - A file that cannot be used at all (bad UTF-8, not JSON, nested so deeply that the JSON
   parser gives up, not an object, wrong ``format``/``version``, ``tools`` not an object) is
   moved aside whole to such a backup; the library continues empty.
+- An owner entry that is not a non-empty string of at most ``MAX_OWNER_LENGTH`` characters,
+  or that names an empty slot, is set aside the same way (the tool stays, unowned).
 - Either way :attr:`ToolLibrary.recovery` is a :class:`LibraryRecovery` (backup path, one
   line per problem, the slots kept; ``recovered_backup`` names the backup, for compatibility)
   and a :class:`ToolLibraryWarning` is issued. A file that exists but cannot be read at all
   (permissions, I/O error), or a backup that cannot be written, raises
   :class:`ToolLibraryError` instead: nothing is rewritten without its backup.
+
+Owners (optional; a classroom's trainees): a mutation given ``owner=NAME`` acts for that owner
+and is checked under the lock, in the same step that writes: it may save into an empty slot
+or one ``NAME`` owns (then the slot is ``NAME``'s), rename or remove only ``NAME``'s slots, and
+a save into a new slot is refused once ``NAME`` owns ``quota`` slots (:class:`SlotOwnedError`,
+:class:`OwnerQuotaError`). A mutation without ``owner`` is unrestricted (the CLI, a trainer,
+a single user); its save leaves the slot unowned, its rename keeps the owner, its remove drops
+it. The ``owners`` key is written only when a slot has an owner, so a library that never had
+one keeps today's file; a file without it loads with every slot unowned. (A tcpcal older than
+the key sets the key aside as unknown, with a backup, and keeps every tool.)
 """
 
 from __future__ import annotations
@@ -62,7 +75,10 @@ from tcpcal.tool import Tool
 __all__ = [
     "FORMAT_NAME",
     "FORMAT_VERSION",
+    "MAX_OWNER_LENGTH",
     "LibraryRecovery",
+    "OwnerQuotaError",
+    "SlotOwnedError",
     "ToolLibrary",
     "ToolLibraryError",
     "ToolLibraryWarning",
@@ -72,12 +88,42 @@ __all__ = [
 FORMAT_NAME = "tcp-pendant-tool-library"
 FORMAT_VERSION = 1
 LOCK_TIMEOUT_S = 30.0
+MAX_OWNER_LENGTH = 200
+"""Longest owner text kept in the file (characters)."""
 _NUMBER_ARRAY = re.compile(r"\[\n\s*([-+0-9.eE,\s]+?)\n\s*\]")
 _SLOT_KEY = re.compile(r"[0-9]{1,3}")  # ASCII digits only ("\u0663".isdigit() is True)
 
 
 class ToolLibraryError(TcpcalError):
     """A tool-library operation that cannot be done (duplicate name, empty slot, file I/O)."""
+
+
+class SlotOwnedError(ToolLibraryError):
+    """A mutation for one owner touched a slot that is not theirs.
+
+    Attributes:
+        slot: the slot.
+        owner: who owns it (None: nobody, i.e. it was saved without an owner).
+    """
+
+    def __init__(self, message: str, *, slot: int, owner: str | None) -> None:
+        super().__init__(message)
+        self.slot = slot
+        self.owner = owner
+
+
+class OwnerQuotaError(ToolLibraryError):
+    """A save for one owner into a new slot when the owner already holds ``quota`` slots.
+
+    Attributes:
+        owned: the owner's slots, in increasing order.
+        quota: slots allowed per owner.
+    """
+
+    def __init__(self, message: str, *, owned: tuple[int, ...], quota: int) -> None:
+        super().__init__(message)
+        self.owned = owned
+        self.quota = quota
 
 
 class ToolLibraryWarning(UserWarning):
@@ -106,17 +152,22 @@ def _check_slot(slot: Any, n_slots: int) -> int:
 class _State:
     """In-memory content of the library file."""
 
-    def __init__(self, tools: dict[int, Tool] | None = None, active: int | None = None) -> None:
+    def __init__(self, tools: dict[int, Tool] | None = None, active: int | None = None,
+                 owners: dict[int, str] | None = None) -> None:
         self.tools: dict[int, Tool] = dict(tools or {})
         self.active: int | None = active
+        self.owners: dict[int, str] = dict(owners or {})
 
     def to_json(self) -> str:
-        doc = {
+        doc: dict[str, Any] = {
             "format": FORMAT_NAME,
             "version": FORMAT_VERSION,
             "active_slot": self.active,
             "tools": {str(k): self.tools[k].to_dict() for k in sorted(self.tools)},
         }
+        owners = {str(k): self.owners[k] for k in sorted(self.owners) if k in self.tools}
+        if owners:
+            doc["owners"] = owners
         text = json.dumps(doc, indent=2, ensure_ascii=False, allow_nan=False)
         # Put arrays of numbers (tcp_mm, abc_deg) on one line; a literal newline never occurs
         # inside a JSON string, so this cannot touch names or notes.
@@ -154,7 +205,7 @@ class _State:
         if not isinstance(raw_tools, dict):
             raise _CorruptFile("'tools' is not an object of slot -> tool")
         problems: list[str] = []
-        unknown = sorted(set(doc) - {"format", "version", "active_slot", "tools"})
+        unknown = sorted(set(doc) - {"format", "version", "active_slot", "tools", "owners"})
         if unknown:
             problems.append(f"unknown top-level keys {_short(repr(unknown))} dropped")
         tools: dict[int, Tool] = {}
@@ -194,7 +245,26 @@ class _State:
                 "is active"
             )
             active = None
-        return cls(tools, active), problems
+        return cls(tools, active, _parse_owners(doc.get("owners", {}), tools, problems)), problems
+
+
+def _parse_owners(raw: Any, tools: dict[int, Tool], problems: list[str]) -> dict[int, str]:
+    """The valid entries of the optional ``owners`` object (slot -> owner of an occupied slot);
+    each bad one is added to ``problems``."""
+    if not isinstance(raw, dict):
+        problems.append("'owners' is not an object of slot -> owner; every slot is unowned")
+        return {}
+    owners: dict[int, str] = {}
+    for key, value in raw.items():
+        slot = int(key) if _SLOT_KEY.fullmatch(key) else None
+        if slot is None or slot not in tools:
+            problems.append(f"owner entry {_short(repr(key))}: not an occupied slot; dropped")
+        elif not (isinstance(value, str) and value.strip() and len(value) <= MAX_OWNER_LENGTH):
+            problems.append(f"owner of slot {slot}: {_short(repr(value))} is not a name of 1 to "
+                            f"{MAX_OWNER_LENGTH} characters; the slot is unowned")
+        else:
+            owners[slot] = value
+    return owners
 
 
 def _short(text: str, limit: int = 160) -> str:
@@ -470,6 +540,12 @@ class ToolLibrary:
                 return slot, tool
         return None
 
+    def owners(self) -> dict[int, str]:
+        """Owner of each owned slot (fresh read), slots in increasing order; unowned slots
+        are not listed."""
+        state = self._read()
+        return {k: state.owners[k] for k in sorted(state.owners)}
+
     def active_slot(self) -> int | None:
         """Slot of the active tool, or None (TCP = flange)."""
         return self._read().active
@@ -488,20 +564,40 @@ class ToolLibrary:
         return None
 
     # ------------------------------------------------------------------ public mutations
-    def save(self, slot: int, tool: Tool, *, activate: bool = False) -> None:
+    def save(self, slot: int, tool: Tool, *, activate: bool = False, owner: str | None = None,
+             quota: int | None = None) -> None:
         """Store ``tool`` in ``slot``, replacing what was there; optionally make it active.
+
+        Args:
+            slot: 1..16.
+            tool: the tool.
+            activate: also make it the active tool.
+            owner: save for this owner (module docstring, "Owners"): ``slot`` must be empty or
+                theirs, and it is theirs afterwards. None: unrestricted, the slot is unowned.
+            quota: with ``owner``: how many slots an owner may hold (None: no limit).
 
         Raises:
             InvalidInputError: bad slot number or not a Tool.
             ToolLibraryError: another slot already holds a tool of that name.
+            SlotOwnedError: ``slot`` holds a tool that is not ``owner``'s.
+            OwnerQuotaError: ``slot`` is not ``owner``'s and they already hold ``quota`` slots.
         """
         slot = _check_slot(slot, self.N_SLOTS)
         if not isinstance(tool, Tool):
             raise InvalidInputError(f"save() needs a tcpcal.Tool, got {type(tool).__name__}.")
+        if owner is not None:
+            owner = self._check_owner(owner)
 
         def change(state: _State) -> None:
+            if owner is not None:
+                self._check_owned_by(state, slot, owner, "save into", empty_ok=True)
+                self._check_quota(state, slot, owner, quota)
             self._check_unique(state, tool.name, slot)
             state.tools[slot] = tool
+            if owner is None:
+                state.owners.pop(slot, None)
+            else:
+                state.owners[slot] = owner
             if activate:
                 state.active = slot
 
@@ -510,7 +606,7 @@ class ToolLibrary:
     def save_many(self, tools: Mapping[int, Tool]
                   | Callable[[dict[int, Tool]], Mapping[int, Tool]]) -> dict[int, Tool]:
         """Store several tools at once, in one locked change (all or nothing): each slot's
-        tool replaced; names must be unique in the table that results.
+        tool replaced (unowned afterwards); names must be unique in the table that results.
 
         Args:
             tools: slot -> tool, or a function that computes them under the lock from the
@@ -542,33 +638,54 @@ class ToolLibrary:
                         "rename one of them first.")
                 seen[name] = slot
             state.tools = result
+            for slot in items:
+                state.owners.pop(slot, None)
             stored.update(items)
 
         self._mutate(change)
         return stored
 
-    def remove(self, slot: int) -> None:
+    def remove(self, slot: int, *, owner: str | None = None) -> None:
         """Empty ``slot``; if it was the active tool, no tool is active afterwards.
+
+        Args:
+            slot: 1..16.
+            owner: remove only if the slot is this owner's (None: unrestricted).
 
         Raises:
             ToolLibraryError: the slot is already empty.
+            SlotOwnedError: the slot is not ``owner``'s.
         """
         slot = _check_slot(slot, self.N_SLOTS)
+        if owner is not None:
+            owner = self._check_owner(owner)
 
         def change(state: _State) -> None:
             self._check_occupied(state, slot, "remove")
+            if owner is not None:
+                self._check_owned_by(state, slot, owner, "remove")
             del state.tools[slot]
+            state.owners.pop(slot, None)
             if state.active == slot:
                 state.active = None
 
         self._mutate(change)
 
-    def rename(self, slot: int, name: str) -> None:
-        """Give the tool in ``slot`` a new name (validated like ``Tool.name``, unique)."""
+    def rename(self, slot: int, name: str, *, owner: str | None = None) -> None:
+        """Give the tool in ``slot`` a new name (validated like ``Tool.name``, unique); its
+        owner stays.
+
+        Raises:
+            SlotOwnedError: ``owner`` given and the slot is not theirs.
+        """
         slot = _check_slot(slot, self.N_SLOTS)
+        if owner is not None:
+            owner = self._check_owner(owner)
 
         def change(state: _State) -> None:
             self._check_occupied(state, slot, "rename")
+            if owner is not None:
+                self._check_owned_by(state, slot, owner, "rename")
             renamed = dataclasses.replace(state.tools[slot], name=name)
             self._check_unique(state, renamed.name, slot)
             state.tools[slot] = renamed
@@ -596,6 +713,35 @@ class ToolLibrary:
                     f"the name {name!r} is already used by slot {other}; choose another name, "
                     f"rename or remove slot {other}, or save into slot {other} to replace it."
                 )
+
+    @staticmethod
+    def _check_owner(owner: Any) -> str:
+        if not (isinstance(owner, str) and owner.strip() and len(owner) <= MAX_OWNER_LENGTH):
+            raise InvalidInputError(f"owner must be a name of 1 to {MAX_OWNER_LENGTH} characters, "
+                                    f"got {_short(repr(owner), 60)}.")
+        return owner
+
+    @staticmethod
+    def _check_owned_by(state: _State, slot: int, owner: str, action: str, *, empty_ok: bool = False) -> None:
+        if empty_ok and slot not in state.tools:
+            return
+        holder = state.owners.get(slot)
+        if holder != owner:
+            whose = "nobody's (saved without an owner)" if holder is None else "another owner's"
+            raise SlotOwnedError(
+                f"cannot {action} slot {slot}: it is {whose}; only its owner or an unrestricted "
+                "user may change it.", slot=slot, owner=holder)
+
+    @staticmethod
+    def _check_quota(state: _State, slot: int, owner: str, quota: int | None) -> None:
+        if quota is None or state.owners.get(slot) == owner:
+            return
+        owned = tuple(sorted(k for k, v in state.owners.items() if v == owner and k in state.tools))
+        if len(owned) >= quota:
+            raise OwnerQuotaError(
+                f"cannot save into slot {slot}: the owner already holds {len(owned)} slots "
+                f"({', '.join(map(str, owned))}), the most allowed; remove one of them or save "
+                "into one of them.", owned=owned, quota=quota)
 
     @staticmethod
     def _check_occupied(state: _State, slot: int, action: str) -> None:

@@ -15,14 +15,18 @@ reference that moved, a tool that bends) are consistent across touches and hide 
 
 from __future__ import annotations
 
+import dataclasses
+import functools
 import math
+import threading
 from dataclasses import dataclass
-from typing import Literal, NamedTuple
+from typing import Any, Literal, NamedTuple
 
 import numpy as np
 from scipy.special import chdtrc, fdtrc
 
 from tcpcal._stats import (
+    _GRAM_SMALL,
     SAME_ORIENTATION_DEG,
     AngleExtremes,
     Information,
@@ -213,7 +217,7 @@ def _lstsq_core(info: Information, m_inv: np.ndarray, rotations: np.ndarray, f: 
     rotation rows.
     """
     n = rotations.shape[0]
-    fbar = sum_over_touches(f) / n
+    fbar = (_add(f, axis=0) if n <= 64 else sum_over_touches(f)) / n  # sum_over_touches, inlined (hot path)
     neg_d = fbar - f  # -d_i (the sign spares a negation below)
     rows = rotations.reshape(3 * n, 3)
     t = m_inv @ (neg_d.reshape(3 * n) @ rows)
@@ -480,12 +484,208 @@ def solve_xyz4(
 
 _add = np.add.reduce  # ufunc reductions without the Python wrapper of ndarray.sum (hot path)
 _max = np.maximum.reduce
+try:  # numpy.einsum without its Python dispatch (optimize=False calls this very function)
+    from numpy._core.multiarray import c_einsum as _einsum
+except ImportError:  # pragma: no cover - another numpy
+    _einsum = np.einsum
+
+_DUPLICATE_PRETEST_TRACE = 1.0 + 2.0 * math.cos(math.radians(0.5))
+"""Largest ``trace(R_a^T R_b)`` of two touches below which no pair can be "the same
+orientation" (``SAME_ORIENTATION_DEG`` = 0.05 deg): ``|R_a - R_b|_F^2 = |R_a|_F^2 + |R_b|_F^2 -
+2 trace(R_a^T R_b)`` with ``|R|_F^2 = 3 +- 3e-6`` (orthonormal within ``ORTHONORMAL_TOL``) puts
+such a pair at least 0.49 deg apart."""
 
 
-def _freeze(a: np.ndarray) -> np.ndarray:
-    """Make an array the solver created (and shares with nobody) read-only, without a copy."""
-    a.setflags(write=False)
-    return a
+@functools.lru_cache(maxsize=_GRAM_SMALL)
+def _off_diagonal(n: int) -> np.ndarray:
+    """(n, n) boolean mask, True off the diagonal (read-only)."""
+    mask = ~np.eye(n, dtype=bool)
+    mask.setflags(write=False)
+    return mask
+
+
+def _observability(rot: np.ndarray, y: np.ndarray | None, info: Information) -> AngleExtremes | None:
+    """Raise :class:`DegenerateTouchesError` exactly when :func:`_check_observable` does, and
+    compute the angle extremes only when they can decide it (returned then, else None).
+
+    Observable touches (``info.observable``) cannot all have one orientation (that would leave
+    ``min eig M / N <= 2/3 (0.05 deg)^2``, below ``DEGENERATE_TILT_RAD^2``), so only the repeated
+    orientation check remains, which needs two touches closer than ``SAME_ORIENTATION_DEG`` and
+    fewer than 4 distinct orientations: ruled out by the largest off-diagonal Gram entry of the
+    flattened rotations (N <= ``_GRAM_SMALL``, ``_DUPLICATE_PRETEST_TRACE``) or by finding 4
+    distinct orientations (:func:`distinct_orientations`, a few rows at any N)."""
+    n = rot.shape[0]
+    if info.observable:
+        if n <= _GRAM_SMALL:
+            x = rot.reshape(n, 9)
+            largest = float(_max(x @ x.T, axis=None, where=_off_diagonal(n), initial=-math.inf))
+            if largest < _DUPLICATE_PRETEST_TRACE:
+                return None
+        elif distinct_orientations(rot, limit=MIN_TOUCHES).count >= MIN_TOUCHES:
+            return None
+    ext = angle_extremes(rot, y)
+    _check_observable(rot, info, ext)
+    return ext
+
+
+class _Deferred(NamedTuple):
+    """What the deferred quality figures of one solve are computed from (:class:`_LazyTcpResult`)."""
+
+    rot: np.ndarray
+    y: np.ndarray | None
+    info: Information
+    ext: AngleExtremes | None  # None: not computed yet
+    lstsq_noise: float | None  # lstsq: ``cov = noise^2 M^-1``, eigenvalues noise^2 / eig M; None: of ``cov``
+    cov: np.ndarray
+    ci_dof: int | None
+    early_warnings: list[str]
+    sigma: float | None
+    sse: float
+    s_est: float
+    dof: int
+    detect_outliers: bool
+
+
+class _Figures(NamedTuple):
+    mean_error: float
+    max_error: float
+    ci95_radius: float
+    ext: AngleExtremes
+    condition_number: float
+    warnings: tuple[str, ...]
+
+
+def _late_figures(d: _Deferred, res: np.ndarray) -> _Figures:
+    """The mean and largest residual (of ``res``, the residual lengths), the 95 % radius, the
+    angle figures, the condition number and the warnings of a solve (the same numbers and
+    words as if computed in :func:`_solve`)."""
+    info, n = d.info, d.rot.shape[0]
+    ext = d.ext if d.ext is not None else angle_extremes(d.rot, d.y)
+    cov_eig: list[float] | np.ndarray
+    if d.lstsq_noise is not None:
+        noise2 = d.lstsq_noise * d.lstsq_noise
+        cov_eig = [noise2 / v for v in info.eigvals.tolist()]  # > 0: the touches are observable
+    else:
+        cov_eig = np.linalg.eigvalsh(d.cov)
+    ci95 = ci_radius(cov_eig, d.ci_dof)
+    warnings = d.early_warnings
+    eig = info.eigvals.tolist()
+    if ext.max_deg < SMALL_TILT_DEG and ext.max_upper_deg < SMALL_TILT_DEG:
+        warnings.append(
+            f"the touch orientations differ by at most {ext.max_deg:.1f} deg: tilt the tool 30-60 deg "
+            "between touches, about two different axes, for a precise TCP."
+        )
+    ratio = math.sqrt(eig[2] / eig[0])
+    if ratio > WEAK_AXIS_RATIO:
+        warnings.append(
+            f"the TCP along flange {fmt_vec(info.weakest_axis)} is {ratio:.0f} times less certain "
+            "than across it: the touches tilt little about a second axis; add a touch tilted "
+            "about another axis."
+        )
+    if ext.min_deg < NEAR_DUPLICATE_DEG:
+        i, j = ext.min_pair
+        warnings.append(
+            f"touches {i} and {j} (0-based) are only {ext.min_deg:.1f} deg apart in orientation, so "
+            "one of them adds little: re-record it from a clearly different orientation."
+        )
+    sigma = d.sigma
+    if sigma is not None and float(chdtrc(d.dof, d.sse / sigma**2)) < 1e-3:
+        warnings.append(
+            f"the residuals (noise estimate {d.s_est:.3g}) are larger than the given sigma {sigma:.3g} "
+            "explains: the touches are less precise than assumed, or something is not rigid or not "
+            "calibrated (tool, reference point, robot)."
+        )
+    if d.detect_outliers and n == MIN_TOUCHES:
+        warnings.append(
+            "with only 4 touches a careless touch cannot be detected; record 5 to 8 touches for a "
+            "checkable result."
+        )
+    return _Figures(float(_add(res)) / n, float(_max(res)), ci95, ext, info.condition_number, tuple(warnings))
+
+
+_LATE_FIGURES_LOCK = threading.Lock()
+
+
+class _LazyTcpResult(TcpResult):
+    """The :class:`TcpResult` of :func:`solve_xyz4`: the figures that cost more than the solve
+    needs (``mean_error``, ``max_error``, ``ci95_radius``, the angle figures,
+    ``condition_number``, ``warnings``) are computed
+    together on the first read of any of them (:func:`_late_figures`, from the solve's own
+    arrays; the same values as computed eagerly), then kept. Frozen like its base; a copy or
+    a pickle is a plain :class:`TcpResult` with every figure."""
+
+    @property
+    def _figures(self) -> _Figures:
+        figures: _Figures | None = self.__dict__.get("_late")
+        if figures is None:
+            with _LATE_FIGURES_LOCK:  # once, whichever thread asks first
+                figures = self.__dict__.get("_late")
+                if figures is None:
+                    figures = _late_figures(self.__dict__["_deferred"], self.residuals)
+                    ext = figures.ext
+                    self.__dict__.update(  # read from now on as plain attributes
+                        mean_error=figures.mean_error, max_error=figures.max_error,
+                        ci95_radius=figures.ci95_radius, max_angle_deg=ext.max_deg, min_angle_deg=ext.min_deg,
+                        condition_number=figures.condition_number, warnings=figures.warnings,
+                        max_angle_exact=ext.max_exact, max_angle_upper_deg=ext.max_upper_deg,
+                        min_angle_exact=ext.min_exact, _late=figures)
+                    del self.__dict__["_deferred"]  # the solve's arrays are no longer needed
+        return figures
+
+    @functools.cached_property
+    def mean_error(self) -> float:
+        return self._figures.mean_error
+
+    @functools.cached_property
+    def max_error(self) -> float:
+        return self._figures.max_error
+
+    @functools.cached_property
+    def ci95_radius(self) -> float:
+        return self._figures.ci95_radius
+
+    @functools.cached_property
+    def max_angle_deg(self) -> float:
+        return self._figures.ext.max_deg
+
+    @functools.cached_property
+    def min_angle_deg(self) -> float:
+        return self._figures.ext.min_deg
+
+    @functools.cached_property
+    def condition_number(self) -> float:
+        return self._figures.condition_number
+
+    @functools.cached_property
+    def warnings(self) -> tuple[str, ...]:
+        return self._figures.warnings
+
+    @functools.cached_property
+    def max_angle_exact(self) -> bool:
+        return self._figures.ext.max_exact
+
+    @functools.cached_property
+    def max_angle_upper_deg(self) -> float:
+        return self._figures.ext.max_upper_deg
+
+    @functools.cached_property
+    def min_angle_exact(self) -> bool:
+        return self._figures.ext.min_exact
+
+    def _plain(self) -> TcpResult:
+        return TcpResult(*(getattr(self, f.name) for f in dataclasses.fields(TcpResult)))
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return (TcpResult, tuple(getattr(self, f.name) for f in dataclasses.fields(TcpResult)))
+
+    def __repr__(self) -> str:
+        return repr(self._plain())
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        raise dataclasses.FrozenInstanceError(f"cannot assign to field {name!r}")
+
+    def __delattr__(self, name: str) -> None:
+        raise dataclasses.FrozenInstanceError(f"cannot delete field {name!r}")
 
 
 def _solve(rot: np.ndarray, y: np.ndarray | None, f: np.ndarray, method: str, sigma: float | None,
@@ -497,8 +697,7 @@ def _solve(rot: np.ndarray, y: np.ndarray | None, f: np.ndarray, method: str, si
     if y is None and (test_outliers or n > 64):
         y = soa(rot)
     info = information(rot, y)
-    ext = angle_extremes(rot, y)
-    _check_observable(rot, info, ext)
+    ext = _observability(rot, y, info)
     m_inv = info.m_inv()
     warnings: list[str] = []
 
@@ -520,22 +719,18 @@ def _solve(rot: np.ndarray, y: np.ndarray | None, f: np.ndarray, method: str, si
         r = info.rbar @ t + sum_over_touches(f) / n  # = mean_i (R_i t + f_i)
         e = rot @ t + (f - r)
 
-    res = np.einsum("ni,ni->n", e, e)
+    res = _einsum("ni,ni->n", e, e)
     sse = fit.sse if method == "lstsq" and fit is not None else float(_add(res))
-    _check_finite_result(t, r, sse)
+    if not math.isfinite(sum(t.tolist()) + sum(r.tolist()) + sse):
+        _check_finite_result(t, r, sse)
     np.sqrt(res, out=res)
     dof = 3 * n - 6
     s_est = math.sqrt(sse / dof)
     noise = s_est if sigma is None else sigma
     if cov_unit is None:
-        noise2 = noise * noise
-        cov = noise2 * m_inv
-        # > 0: the touches are observable
-        cov_eig: list[float] | np.ndarray = [noise2 / v for v in info.eigvals.tolist()]
+        cov = (noise * noise) * m_inv
     else:
         cov = noise**2 * cov_unit
-        cov_eig = np.linalg.eigvalsh(cov)
-    ci95 = ci_radius(cov_eig, None if sigma is not None else dof)
 
     outliers: list[int] = (_find_outliers(rot, y, f, (info, fit))
                            if test_outliers and y is not None and fit is not None else [])  # both made above
@@ -555,60 +750,25 @@ def _solve(rot: np.ndarray, y: np.ndarray | None, f: np.ndarray, method: str, si
             f"{'them' if plural else 'it'}."
         )
 
-    eig = info.eigvals.tolist()
-    if ext.max_deg < SMALL_TILT_DEG and ext.max_upper_deg < SMALL_TILT_DEG:
-        warnings.append(
-            f"the touch orientations differ by at most {ext.max_deg:.1f} deg: tilt the tool 30-60 deg "
-            "between touches, about two different axes, for a precise TCP."
-        )
-    ratio = math.sqrt(eig[2] / eig[0])
-    if ratio > WEAK_AXIS_RATIO:
-        warnings.append(
-            f"the TCP along flange {fmt_vec(info.weakest_axis)} is {ratio:.0f} times less certain "
-            "than across it: the touches tilt little about a second axis; add a touch tilted "
-            "about another axis."
-        )
-    if ext.min_deg < NEAR_DUPLICATE_DEG:
-        i, j = ext.min_pair
-        warnings.append(
-            f"touches {i} and {j} (0-based) are only {ext.min_deg:.1f} deg apart in orientation, so "
-            "one of them adds little: re-record it from a clearly different orientation."
-        )
-    if sigma is not None and float(chdtrc(dof, sse / sigma**2)) < 1e-3:
-        warnings.append(
-            f"the residuals (noise estimate {s_est:.3g}) are larger than the given sigma {sigma:.3g} "
-            "explains: the touches are less precise than assumed, or something is not rigid or not "
-            "calibrated (tool, reference point, robot)."
-        )
-    if detect_outliers and n == MIN_TOUCHES:
-        warnings.append(
-            "with only 4 touches a careless touch cannot be detected; record 5 to 8 touches for a "
-            "checkable result."
-        )
-
-    return TcpResult(
+    for a in (t, r, e, res, cov):  # made here and shared with nobody: read-only without a copy
+        a.setflags(write=False)
+    result = object.__new__(_LazyTcpResult)  # its fields as TcpResult's __init__ sets them, the rest deferred
+    result.__dict__.update(
         method=method,
-        tcp=_freeze(t),
-        reference=_freeze(r),
-        residual_vectors=_freeze(e),
-        residuals=_freeze(res),
-        mean_error=float(_add(res)) / n,
-        max_error=float(_max(res)),
+        tcp=t,
+        reference=r,
+        residual_vectors=e,
+        residuals=res,
         rms_error=math.sqrt(sse / n),
         noise_sigma=float(noise),
-        covariance=_freeze(cov),
-        ci95_radius=ci95,
-        max_angle_deg=ext.max_deg,
-        min_angle_deg=ext.min_deg,
-        condition_number=info.condition_number,
+        covariance=cov,
         outliers=tuple(outliers),
         without_outliers=without,
-        warnings=tuple(warnings),
         n_touches=n,
-        max_angle_exact=ext.max_exact,
-        max_angle_upper_deg=ext.max_upper_deg,
-        min_angle_exact=ext.min_exact,
+        _deferred=_Deferred(rot, y, info, ext, noise if cov_unit is None else None, cov,
+                            None if sigma is not None else dof, warnings, sigma, sse, s_est, dof, detect_outliers),
     )
+    return result
 
 
 def solve_reference(

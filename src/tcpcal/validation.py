@@ -100,8 +100,9 @@ def rotations_and_soa(x: Any, name: str = "rotations") -> tuple[np.ndarray, np.n
     (``tcpcal._stats.soa``) when the check computed it (N > ``SMALL_STACK``), else None.
 
     The clean path costs a handful of numpy calls at any N (the solvers run it on every call):
-    one sum for NaN/inf, the column dot products ``R^T R`` and the determinants; the reason of
-    a failure is looked up matrix by matrix only then (slow path, errors only).
+    the column dot products ``R^T R`` (a NaN or inf fails their check; above ``SMALL_STACK``
+    one sum looks for them first) and the determinants; the reason of a failure is looked up
+    matrix by matrix only then (slow path, errors only).
     """
     arr = _as_float_array(x, name, "an (N, 3, 3) array of rotation matrices")
     if arr.ndim != 3 or arr.shape[1:] != (3, 3):
@@ -112,10 +113,9 @@ def rotations_and_soa(x: Any, name: str = "rotations") -> tuple[np.ndarray, np.n
     if arr.shape[0] == 0:
         raise InvalidInputError(f"{name} is empty; pass at least one 3x3 rotation matrix.")
     n = arr.shape[0]
-    if not math.isfinite(float(_add(arr, axis=None))):  # NaN/inf (or an overflow: then go on)
-        _raise_nonfinite(arr, name)
     y = None
     if n <= SMALL_STACK:
+        # a NaN or inf makes R^T R so, which fails the check below: _raise_first_bad names it
         gram = arr.transpose(0, 2, 1) @ arr  # R^T R
         gram -= _EYE
         np.abs(gram, out=gram)
@@ -123,6 +123,8 @@ def rotations_and_soa(x: Any, name: str = "rotations") -> tuple[np.ndarray, np.n
             _raise_first_bad(arr, gram.reshape(n, 9).max(axis=1), name)
         det = _lapack.det(arr)
     else:
+        if not math.isfinite(float(_add(arr, axis=None))):  # NaN/inf (or an overflow: then go on)
+            _raise_nonfinite(arr, name)
         y = np.ascontiguousarray(arr.reshape(n, 9).T).reshape(3, 3, n)
         # R^T R entries: c_k . c_l = sum_j y[j, k] y[j, l]
         gram = np.einsum("jkn,jln->kln", y, y)

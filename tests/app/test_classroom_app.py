@@ -82,7 +82,7 @@ def test_trainer_view_needs_the_token_and_shows_the_class_escaped(app_factory, t
                    what="two sessions")
         trainee, trainer = list(app.sessions.values())
         p = trainee.views["identity"]
-        choose(p.name_field, "|Eve| **x**", trainee.client)
+        choose(p.name_field, "|Eve| <i>x</i>", trainee.client)
         click(p.start, trainee.client)
         q = trainer.views["identity"]
         choose(q.token_field, "secret-token-2", trainer.client)
@@ -91,13 +91,15 @@ def test_trainer_view_needs_the_token_and_shows_the_class_escaped(app_factory, t
         choose(q.token_field, "secret-token-1-of-16", trainer.client)
         click(q.open_trainer, trainer.client)
         view = trainer.views["trainer"]
-        md = view.trainees_md.content
-        assert "\\|Eve\\| \\*\\*x\\*\\*" in md and "| yes |" in md
-        # a touch by the trainee updates the trainer's table
+        html = view.table_html.content
+        assert "|Eve| &lt;i&gt;x&lt;/i&gt;" in html and "<i>" not in html       # escaped: shown, not run
+        assert [(r.name, r.connected, r.touches) for r in view.rows] == [("|Eve| <i>x</i>", True, 0)]
+        # a touch by the trainee updates the trainer's table (throttled: within half a second)
         cal = trainee.views["calibrate"]
         click(cal.start, trainee.client)
         click(cal.steps.auto_touch, trainee.client)
-        assert "| 1 | 0 |" in view.trainees_md.content
+        wait_until(lambda: view.rows[0].touches == 1 and view.rows[0].crashes == 0
+                   and view.rows[0].step == "Step 2 of 4", what="the touch in the trainer's table")
         # push the torch to every trainee
         choose(view.tool, "torch", trainer.client)
         click(view.push, trainer.client)
@@ -214,10 +216,10 @@ def test_a_connected_name_and_its_look_alikes_are_refused_until_the_trainer_rele
         choose(q.token_field, "trainer-token-tok-1", trainer.client)
         click(q.open_trainer, trainer.client)
         view = trainer.views["trainer"]
-        assert "Alice" in view.release_name.options
-        choose(view.release_name, "Alice", trainer.client)
+        assert "Alice" in view.trainee.options
+        choose(view.trainee, "Alice", trainer.client)
         click(view.release, trainer.client)
-        assert "Released Alice" in view.release_md.content
+        assert "Released Alice" in view.action_md.content
         wait_until(lambda: pa.name is None and "released the name Alice" in pa.message.content,
                    what="Alice's welcome window again")
         assert pa.key_html is None and pa.marker_html.content == "<div hidden data-tcp-pendant-forget></div>"
@@ -341,8 +343,9 @@ def test_the_same_browser_in_a_second_tab_takes_the_name_and_the_first_tab_holds
 def test_the_mystery_mesh_sent_to_the_browser_shows_the_tip_and_the_shaft_but_not_tool_y(
         app_factory, tmp_path: Path) -> None:
     """What the browser gets of the mystery tool (the MeshMessages under the flange, float32,
-    FLANGE coordinates): the nozzle's apex is the TCP (as a real tool's tip is there to see),
-    and no vertex of the nozzle ring lies on tool Y or Z about tool X (before: one on tool Y)."""
+    FLANGE coordinates): the nozzle's flat tip face is centred on the TCP (as a real tool's tip
+    is there to see) with no vertex at it, and no vertex of the nozzle's rings lies on tool Y or
+    Z about tool X (before: one on tool Y)."""
     app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token="trainer-token-tok-1", exercise="mystery",
                       exercise_seed=7)
     c = RecordingClient(app.port)
@@ -357,8 +360,8 @@ def test_the_mystery_mesh_sent_to_the_browser_shows_the_tip_and_the_shaft_but_no
                     for m in c.of_type("MeshMessage") if "/flange/tool/" in str(m.get("name"))]
 
         def nozzle() -> np.ndarray | None:
-            with_apex = [v for v in sent_tool_meshes() if np.min(np.linalg.norm(v - tcp, axis=1)) < 1e-6]
-            return with_apex[-1] if with_apex else None
+            with_tip = [v for v in sent_tool_meshes() if np.min(np.linalg.norm(v - tcp, axis=1)) < 3e-4]
+            return with_tip[-1] if with_tip else None
 
         wait_until(lambda: nozzle() is not None, what="the mystery tool's nozzle sent")
         v = nozzle()
@@ -366,10 +369,12 @@ def test_the_mystery_mesh_sent_to_the_browser_shows_the_tip_and_the_shaft_but_no
         r = v - tcp
         radial = r - np.outer(r @ x, x)
         ring = radial[np.linalg.norm(radial, axis=1) > 1e-4]
-        assert len(ring) == 24
+        assert len(ring) == 48 and np.min(np.linalg.norm(r, axis=1)) > 1.9e-4   # no vertex at the TCP
         angles = np.degrees(np.arctan2(ring @ z, ring @ y))
         assert np.abs((angles + 45.0) % 90.0 - 45.0).min() > 1e-3          # none on +-Y, +-Z
-        axial = r[np.linalg.norm(radial, axis=1) > 1e-4] @ x
-        assert np.allclose(axial, axial[0], atol=1e-6) and axial[0] < -0.01   # a ring behind the tip, about X
+        axial = r @ x
+        face = np.abs(axial) < 1e-6                                       # the tip face, about X
+        assert face.sum() == 24 and np.allclose(v[face].mean(axis=0), tcp, atol=1e-7)
+        assert np.all(axial[~face] < -0.01)                               # the rest behind the tip
     finally:
         c.close()

@@ -243,3 +243,44 @@ def test_hints_and_the_keys_line_name_the_keys(app: PendantApp) -> None:
         assert s.views["touches"].record.hint.endswith("; key R.")
     finally:
         ws.close()
+
+
+def test_a_starting_pendant_answers_503_until_it_is_ready(tmp_path: Path, monkeypatch) -> None:
+    """viser listens before the pendant has put its page script and session handlers in place:
+    until then the page (which would lack the script: no remembered name and key) and the
+    websocket (which would get no session) are answered 503 "starting"; then the page with its
+    script. A bare viser server started meanwhile is held back too, and served once it is over."""
+    gate, paused = threading.Event(), threading.Event()
+    real_ready = origin_check.mark_ready
+
+    def held(port: int) -> None:
+        paused.set()
+        assert gate.wait(30)
+        real_ready(port)
+
+    monkeypatch.setattr(origin_check, "mark_ready", held)
+    app = PendantApp(AppConfig(port=0, tool_library=tmp_path / "tools.json"))
+    starter = threading.Thread(target=app.start)
+    starter.start()
+    try:
+        assert paused.wait(60)
+        status, _, body = get(app.port, "/")
+        assert status == 503 and body.decode().strip() == origin_check.STARTING
+        with pytest.raises(InvalidStatus) as refused:
+            connect(f"ws://127.0.0.1:{app.port}", subprotocols=[f"viser-v{viser.__version__}"],  # type: ignore[list-item]
+                    open_timeout=20)
+        assert refused.value.response.status_code == 503
+        bare = viser.ViserServer(host="127.0.0.1", port=0, verbose=False)
+        try:
+            assert get(bare.get_port(), "/")[0] == 503             # no policy while a pendant starts
+            gate.set()
+            starter.join(60)
+            assert get(bare.get_port(), "/")[0] == 200
+        finally:
+            bare.stop()
+        status, _, body = get(app.port, "/")
+        assert status == 200 and body.count(SCRIPT_TAG) == 1
+    finally:
+        gate.set()
+        starter.join(60)
+        app.stop()

@@ -140,6 +140,33 @@ def test_free_practice_by_eye_each_record_says_how_far_the_touch_really_was(page
     assert "mm off" not in dock.note_md.content and "0.8" not in dock.note_md.content
 
 
+def test_the_calibrate_tabs_record_says_how_far_too_in_free_practice_only(page) -> None:
+    """The Calibrate tab's own Record gives the dock's words after a touch by eye in free
+    practice, and nothing in an exercise."""
+    from tcp_pendant.pendant.exercise_rules import class_rules
+
+    p = page()
+    steps, wf = p.calibrate.steps, p.calibrate.workflow
+    p.click(p.calibrate.start)
+    p.choose(p.pendant.hide_distance, True)
+    p.tip_at((0.3, -0.2, -0.7))                                     # the tool tip 0.8 mm off, mostly −Z
+    p.click(steps.record)
+    assert wf.wizard.steps[0].recorded
+    assert steps.record_md.content == ("✔ Step 1 recorded: 0.8 mm off, mostly −Z (WORLD): the tool tip was "
+                                       "0.7 mm −Z of the reference tip.")
+    p.click(steps.next)
+    assert steps.record_md.content == ""                            # not carried to the next step
+    p.tip_at((1.5, 0.1, 0.2))
+    p.click(steps.record)
+    assert steps.record_md.content.startswith("✔ Step 2 recorded: 1.5 mm off, mostly +X (WORLD)")
+    p.click(steps.next)
+    p.session.set_rules(class_rules("mystery"))                     # an exercise: the grade tells
+    p.tip_at((0.3, -0.2, -0.7))
+    p.click(steps.record)
+    assert wf.wizard.steps[2].recorded
+    assert steps.record_md.content == ""
+
+
 @pytest.mark.parametrize("frame", ["WORLD", "TOOL"])
 def test_the_delta_readout_is_the_jog_that_brings_the_tips_together(page, frame: str) -> None:
     p = page()

@@ -1,7 +1,7 @@
 """Reusable fixtures for browser end-to-end tests (pytest + Playwright + Debian's chromium).
 
-* ``pendant_server(*extra_args)`` (factory fixture): starts ``python -m tcp_pendant`` in a
-  subprocess on a free port with a fresh tool library under ``tmp_path``, waits until the
+* ``pendant_server(*extra_args, port=None)`` (factory fixture): starts ``python -m tcp_pendant``
+  in a subprocess on a free port (or ``port``) with a fresh tool library under ``tmp_path``, waits until the
   HTTP port answers (up to 60 s), yields a :class:`ServerProcess` (``url``, ``library_path``,
   ``log()``), and terminates it at the end of the test.
 * ``server``: one such server with default options.
@@ -86,6 +86,9 @@ back-off is out of reach is retried at a shorter distance, and a test that reads
 def _start_on(tmp_path: Path, port: int, *extra: str) -> ServerProcess:
     lib = tmp_path / "tools.json"
     log_path = tmp_path / f"server_{port}.log"
+    k = 1
+    while log_path.exists():                     # a server started again on the same port
+        log_path, k = tmp_path / f"server_{port}_{k}.log", k + 1
     seed = () if "--seed" in extra else ("--seed", str(BROWSER_SEED))   # Auto-touch's directions replay
     cmd = [sys.executable, "-m", "tcp_pendant", "--port", str(port), "--tool-library", str(lib), *seed, *extra]
     t0 = time.perf_counter()
@@ -121,11 +124,12 @@ def _stop(sp: ServerProcess) -> None:
 
 @pytest.fixture
 def pendant_server(tmp_path: Path) -> Iterator[Callable[..., ServerProcess]]:
-    """Factory: ``pendant_server("--shared", ...)`` starts a server with extra CLI options."""
+    """Factory: ``pendant_server("--shared", ...)`` starts a server with extra CLI options
+    (``port=N``: on that port, e.g. again on the port of a server that was killed)."""
     started: list[ServerProcess] = []
 
-    def factory(*extra: str) -> ServerProcess:
-        sp = _start(tmp_path, *extra)
+    def factory(*extra: str, port: int | None = None) -> ServerProcess:
+        sp = _start(tmp_path, *extra) if port is None else _start_on(tmp_path, port, *extra)
         started.append(sp)
         return sp
 

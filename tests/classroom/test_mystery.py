@@ -1,5 +1,5 @@
 """Mystery tools: deterministic per (seed, name), different between trainees, within bounds, a
-mesh whose tip is the true TCP, and an ordinary ToolModel the controller mounts."""
+mesh whose drawn tip is centred on the true TCP, and an ordinary ToolModel the controller mounts."""
 
 from __future__ import annotations
 
@@ -104,21 +104,43 @@ def _mesh_vertices_in_flange(urdf_path: Path) -> np.ndarray:
 
 
 @pytest.mark.parametrize("seed, name", [(1, "Anna"), (2, "Ben"), (99, "李小龙")])
-def test_the_tip_of_the_mesh_is_the_true_tcp(tmp_path: Path, pointer, seed: int, name: str) -> None:
+def test_the_mesh_is_drawn_with_a_flat_tip_centred_on_the_true_tcp(tmp_path: Path, pointer, seed: int,
+                                                                    name: str) -> None:
+    """The nozzle ends in a flat tip face 0.4 mm across, square to tool X, centred on the TCP:
+    the tip as drawn is where the TCP is (touching the face anywhere is within 0.2 mm, well inside
+    "good"), but no vertex lies at the TCP (each is 0.2 mm from it), so no number the browser
+    gets is the TCP; its centre is, for whoever fits it (README)."""
     tool = draw_mystery_tool(seed, name, pointer, cache_dir=tmp_path)
     T = tool.T_flange_tool_true
     x, tcp = T[:3, 0], T[:3, 3]
     v = _mesh_vertices_in_flange(tool.urdf_path)
-    reach = v @ x
-    tip = v[np.argmax(reach)]
-    assert np.linalg.norm(tip - tcp) < 1e-9                    # the foremost point along tool X
-    assert np.sort(reach)[-2] < reach.max() - 0.02             # a point, not a flat end
-    # the mesh the browser gets (float32) puts it there too, to float32 precision
+    reach = (v - tcp) @ x
+    front = v[np.abs(reach) < 1e-9]                             # the foremost vertices along tool X
+    assert reach.max() < 1e-9 and len(front) == 24
+    np.testing.assert_allclose(np.linalg.norm(front - tcp, axis=1), mystery._TIP_FACE_RADIUS_M, atol=1e-12)
+    np.testing.assert_allclose(front.mean(axis=0), tcp, atol=1e-12)     # the face's centre
+    assert np.sort(reach)[-25] < -0.02                          # behind the face: the cone's base
+    # what the browser gets (float32): nothing within 0.19 mm of the TCP
     parts = rigid_meshes(tool.urdf_path)
     allv = np.vstack([p.vertices for p in parts]).astype(float)
-    assert np.min(np.linalg.norm(allv - tcp, axis=1)) < 1e-7
+    assert np.min(np.linalg.norm(allv - tcp, axis=1)) > 1.9e-4
+    from tcp_pendant.wizards.truth import POSITION_THRESHOLDS_MM
+
+    assert mystery._TIP_FACE_RADIUS_M * 1e3 < POSITION_THRESHOLDS_MM[0] / 2   # well inside "good"
     # the body reaches back to the flange: the tool is bolted on
     assert np.min(np.abs(v[:, 2])) < 1e-9 and np.max(np.linalg.norm(v[:, :2], axis=1)) > 0.02
+
+
+def test_a_new_drawing_is_not_served_from_a_cache_of_the_old_one(tmp_path: Path, pointer, monkeypatch) -> None:
+    """The cache folder's name includes the drawing's version, so a cached tool drawn by an
+    older drawing is not reused; the tool itself (its key and true frame) stays the same."""
+    a = draw_mystery_tool(6, "Anna", pointer, cache_dir=tmp_path)
+    mystery._cached_tool.cache_clear()
+    monkeypatch.setattr(mystery, "_DRAWING", "another-drawing")
+    b = draw_mystery_tool(6, "Anna", pointer, cache_dir=tmp_path)
+    mystery._cached_tool.cache_clear()
+    assert a.urdf_path.parent != b.urdf_path.parent and a.key == b.key
+    np.testing.assert_array_equal(a.T_flange_tool_true, b.T_flange_tool_true)
 
 
 def test_the_controller_mounts_it_and_touches_with_its_true_tip(tmp_path: Path, pointer) -> None:
@@ -166,7 +188,7 @@ def _radial_angles_deg(v: np.ndarray, T: np.ndarray) -> np.ndarray:
 
 
 def test_the_nozzle_ring_marks_no_tool_axis_in_what_the_browser_gets(tmp_path: Path, pointer) -> None:
-    """The nozzle is a cone about tool X; its ring's 24 vertices (15 deg apart) sit at a phase
+    """The nozzle is a cone about tool X; its two rings' 24 vertices (15 deg apart) sit at a phase
     drawn with the secret seed, so across trainees the ring's offset from tool Y is spread over
     0..15 deg, and for none of them does a vertex lie on tool Y or Z (before: offset 0 for all,
     one vertex on tool Y). Checked on the meshes as sent: FLANGE coordinates, float32."""
@@ -178,7 +200,7 @@ def test_the_nozzle_ring_marks_no_tool_axis_in_what_the_browser_gets(tmp_path: P
             nozzle = [p for p in rigid_meshes(tool.urdf_path) if p.name.endswith("_nozzle")]
             assert len(nozzle) == 1
             ang = _radial_angles_deg(nozzle[0].vertices.astype(float), T)
-            assert len(ang) == 24
+            assert len(ang) == 48                                   # the base ring and the tip face
             to_axis = np.abs((ang + 45.0) % 90.0 - 45.0)            # to the nearest of +-Y, +-Z
             assert to_axis.min() > 1e-3, (seed, name)
             offsets.append(float(np.min(ang % 15.0)))

@@ -39,6 +39,9 @@ def test_bench_solver_quick_runs() -> None:
     # printed to 0.1 us and 0.01: the ratio of the printed times agrees up to their rounding
     assert bare > 0 and abs(ratio - full / bare) <= 0.005 + 0.05 * (1.0 + full / bare) / bare
     assert "x bare" in text
+    # the first read of the deferred figures, timed in the same row, in units of the solve
+    figs = re.search(r"^\s+4\s.*\|\s+([\d.]+) \(([\d.]+) x solve\)$", text, re.MULTILINE)
+    assert figs and float(figs.group(1)) > 0, text
 
 
 def test_the_bare_svd_yardstick_solves_the_same_problem() -> None:

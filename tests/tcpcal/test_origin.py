@@ -359,3 +359,47 @@ def test_weak_axis_warning() -> None:
     _w, v = np.linalg.eigh(crb_tcp(rot, 1.0))
     weak = v[:, -1]
     assert abs(weak[0]) > 0.9
+
+
+def test_the_figures_computed_on_first_read_are_frozen_and_travel_whole() -> None:
+    """The 95 % radius, angle figures, warnings ... are computed when first read: the result is
+    still frozen, a copy, a pickle or dataclasses.replace carries every figure, and threads
+    that read at once get the same values."""
+    import copy
+    import dataclasses
+    import pickle
+    import threading
+
+    rng = np.random.default_rng(8)
+    rot, pos, _, _ = make_touches(rng, 6, tilt_deg=(3.0, 8.0))    # small tilts: warnings
+    fields = [f.name for f in dataclasses.fields(TcpResult)]
+
+    def values(res: TcpResult) -> list:
+        return [getattr(res, k).tolist() if isinstance(getattr(res, k), np.ndarray) else getattr(res, k)
+                for k in fields if k != "without_outliers"]
+
+    first = solve_xyz4(rot, pos)
+    expected = values(first)
+    assert first.warnings                                          # a weak axis: one warning
+    # the angle figures against scipy: the largest relative rotation of the six touches
+    rel = [(Rotation.from_matrix(a).inv() * Rotation.from_matrix(b)).magnitude()
+           for a, b in itertools.combinations(rot, 2)]
+    assert first.max_angle_deg == pytest.approx(math.degrees(max(rel)), abs=1e-9)
+    assert first.min_angle_deg == pytest.approx(math.degrees(min(rel)), abs=1e-9)
+    for name in ("tcp", "ci95_radius", "warnings", "max_angle_deg", "new_attribute"):
+        with pytest.raises(dataclasses.FrozenInstanceError):
+            setattr(first, name, 1)
+    for fresh in (lambda: pickle.loads(pickle.dumps(solve_xyz4(rot, pos))),
+                  lambda: copy.deepcopy(solve_xyz4(rot, pos)),
+                  lambda: dataclasses.replace(solve_xyz4(rot, pos), method="lstsq")):
+        got = fresh()
+        assert isinstance(got, TcpResult) and values(got) == expected
+    shared = solve_xyz4(rot, pos)
+    seen: list[list] = []
+    threads = [threading.Thread(target=lambda: seen.append(values(shared))) for _ in range(4)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert seen == [expected] * 4
+    assert repr(shared).startswith("TcpResult(method='lstsq'")

@@ -23,13 +23,20 @@ read through ``Wizard.auto_role(step)``):
 step asks for mounted: auto-touch mounts it (from ``tools``, default ``builtin_tools()``,
 through ``mount``: the session's command in the app) and tells the wizard. This module keeps
 no state of its own.
+
+A pose reached may still not serve the step (a TCP check's rotations stopped at a joint limit
+from there: ``calibrate.jobs.POSE_CHECKS``). That check is a :data:`PoseProbe`, detached from
+the controller, so the app runs it in its job pool: :func:`auto_touch_steps` is Auto-touch as a
+generator that yields each probe and is sent its answer (the app awaits the probe between two
+sends, off viser's event loop); :func:`auto_touch` runs the probes in place (tests, scripts).
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+import functools
+from collections.abc import Callable, Generator, Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, ParamSpec, TypeVar
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -100,7 +107,37 @@ def _ensure_mounted(wizard: Wizard, controller: VirtualController, step: StepInf
     wizard.note_mounted_tool(getattr(controller.mounted_tool, "key", None))
 
 
-def auto_touch(wizard: Wizard, controller: VirtualController, *,
+PoseProbe = Callable[[], "str | None"]
+"""Why the pose reached does not serve the step (None: it serves): a check detached from the
+controller (its own copies of the robot model and the joints), safe to run in a worker thread."""
+
+R = TypeVar("R")
+P = ParamSpec("P")
+MOVED_DURING_PROBE = ("The robot was moved while Auto-touch checked the pose it reached; nothing was "
+                      "recorded. Press Auto-touch again.")
+
+
+def run_probes(steps: Generator[PoseProbe, "str | None", R]) -> R:
+    """Drive a generator of :func:`auto_touch_steps` to its end, running each probe it yields
+    here, and return what it returns."""
+    try:
+        probe = next(steps)
+        while True:
+            probe = steps.send(probe())
+    except StopIteration as stop:
+        return stop.value
+
+
+def in_place(steps: Callable[P, Generator[PoseProbe, "str | None", R]]) -> Callable[P, R]:
+    """``steps`` (a generator function yielding pose probes) as a plain function that runs each
+    probe in place (:func:`run_probes`): same arguments, its generator's return value."""
+    @functools.wraps(steps)
+    def run(*args: P.args, **kwargs: P.kwargs) -> R:
+        return run_probes(steps(*args, **kwargs))
+    return run
+
+
+def auto_touch_steps(wizard: Wizard, controller: VirtualController, *,
                direction_deg: tuple[float, float, float] | None = None,
                sigma_mm: float = 0.0, angle_sigma_deg: float | None = None,
                distance_mm: float = DEFAULT_DISTANCE_MM, hover_mm: float = 30.0,
@@ -108,8 +145,11 @@ def auto_touch(wizard: Wizard, controller: VirtualController, *,
                tools: Mapping[str, ToolModel] | None = None, max_attempts: int = 12,
                previous_direction_deg: tuple[float, float, float] | None = None,
                mount: Callable[[ToolModel], None] | None = None,
-               pose_check: Callable[[], str | None] | None = None) -> AutoTouchOutcome:
-    """Perform the wizard's current step with the controller and record the flange pose.
+               pose_check: Callable[[], PoseProbe] | None = None
+               ) -> Generator[PoseProbe, str | None, AutoTouchOutcome]:
+    """Perform the wizard's current step with the controller and record the flange pose (a
+    generator: it yields the :data:`PoseProbe` of each pose reached, when ``pose_check`` is
+    given, and must be sent the probe's answer; it returns the outcome).
 
     Args:
         wizard: any wizard, in progress.
@@ -132,9 +172,11 @@ def auto_touch(wizard: Wizard, controller: VirtualController, *,
             orientation (three-point steps 2 and 3, TCP & Z, X's z and x).
         mount: how to mount a tool (default ``controller.mount_tool``; the app passes the
             session's command, which signals the change).
-        pose_check: after a reached approach, why that pose does not serve the step (None: it
-            does), e.g. a TCP check's rotations that cannot be made from it; such a pose is not
-            recorded and the next direction is tried (``calibrate.jobs.POSE_CHECKS``).
+        pose_check: after a reached approach, called where the robot stands: the probe of why
+            that pose does not serve the step (its answer None: it does), e.g. a TCP check's
+            rotations that cannot be made from it; such a pose is not recorded and the next
+            direction is tried (``calibrate.jobs.POSE_CHECKS``). When the robot moved or the
+            wizard's step changed while the probe ran, nothing is recorded (the outcome says so).
     """
     if wizard.status != "in_progress":
         raise WizardStateError(f"Cannot auto-touch: {wizard.blocked_reason}")
@@ -204,7 +246,14 @@ def auto_touch(wizard: Wizard, controller: VirtualController, *,
                 tilt, azimuth, spin = rng.uniform(lo, hi), rng.uniform(0.0, 360.0), rng.uniform(-90.0, 90.0)
             res = controller.auto_approach(tilt_deg=tilt, azimuth_deg=azimuth, spin_deg=spin,
                                            sigma_mm=sigma_mm, tip_offset_tool_mm=offset, rng=rng)
-            refused = None if not res.ok or pose_check is None else pose_check()
+            refused = None
+            if res.ok and pose_check is not None:
+                q_reached = controller.q_rad.copy()
+                refused = yield pose_check()
+                if (not np.array_equal(controller.q_rad, q_reached) or wizard.status != "in_progress"
+                        or wizard.step_index != step.index):
+                    return AutoTouchOutcome(False, step.index, step.role, None, None, None, MOVED_DURING_PROBE,
+                                            attempts)
             if refused is not None:            # reached, but unfit for what the step is for
                 last_message = refused
                 continue
@@ -222,3 +271,7 @@ def auto_touch(wizard: Wizard, controller: VirtualController, *,
             last_message = res.message
     return AutoTouchOutcome(False, step.index, step.role, None, None, None,
                             f"Auto-touch failed after {attempts} attempt(s): {last_message}", attempts)
+
+
+auto_touch = in_place(auto_touch_steps)
+"""Auto-touch with each pose probe run in place: :func:`auto_touch_steps`' arguments, its outcome."""

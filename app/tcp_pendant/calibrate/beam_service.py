@@ -28,6 +28,7 @@ from tcp_pendant.controller.beam import BeamSensor, ToolShape
 from tcp_pendant.controller.beam_scan import BeamScan, BeamScanConfig, run_beam_scan, scan_arrays_mm, tool_shape
 from tcp_pendant.controller.errors import ControllerError
 from tcp_pendant.text_escape import escape_markdown
+from tcp_pendant.pendant.library_rights import UNRESTRICTED, LibraryRights
 from tcpcal.beam import BeamAxisResult, BeamResult, solve_beam, solve_beam_axis
 from tcpcal.errors import TcpcalError
 from tcpcal.library import ToolLibrary
@@ -292,7 +293,8 @@ def beam_check_markdown(check: BeamCheck) -> str:
     return "\n".join(lines)
 
 
-def update_tool_from_beam(library: ToolLibrary, slot: int, check: BeamCheck) -> Tool:
+def update_tool_from_beam(library: ToolLibrary, slot: int, check: BeamCheck,
+                          rights: LibraryRights = UNRESTRICTED) -> Tool:
     """Write the measured TCP into ``slot`` of ``library`` (the orientation kept).
 
     The new tool data: the stored tool with ``tcp_mm`` = the measured TCP and a calibration
@@ -304,6 +306,8 @@ def update_tool_from_beam(library: ToolLibrary, slot: int, check: BeamCheck) -> 
         library: the tool library.
         slot: the slot to write (must be the checked one).
         check: the check whose measured TCP is written.
+        rights: whose write it is (a class's trainee: only a slot of their own;
+            ``pendant.library_rights``).
 
     Returns:
         The tool as saved.
@@ -311,7 +315,8 @@ def update_tool_from_beam(library: ToolLibrary, slot: int, check: BeamCheck) -> 
     Raises:
         BeamServiceError: the check is not of that slot, or the slot changed since the check
             (another tool, other data, or emptied): check again.
-        tcpcal.TcpcalError: the library refused (bad slot, unreadable file).
+        tcpcal.TcpcalError: the library refused (bad slot, unreadable file, another trainee's
+            slot).
     """
     if not isinstance(check, BeamCheck):
         raise BeamServiceError(f"update_tool_from_beam needs a BeamCheck, got {type(check).__name__}.")
@@ -339,5 +344,6 @@ def update_tool_from_beam(library: ToolLibrary, slot: int, check: BeamCheck) -> 
     tool = Tool(name=current.name, tcp_mm=measured, abc_deg=current.abc_deg,
                 mass_kg=current.mass_kg, cog_mm=current.cog_mm, notes=current.notes,
                 calibration=Calibration.now(BEAM_METHOD, figures))
-    library.save(slot, tool, activate=False)
+    with rights.in_words():
+        library.save(slot, tool, activate=False, **rights.save_kwargs())
     return tool

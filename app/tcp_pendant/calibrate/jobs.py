@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Any, ClassVar, Protocol, cast
 
 import numpy as np
 
+from tcp_pendant.calibrate.autotouch import PoseProbe
 from tcp_pendant.controller import RobotKinematics, T_flange_tool_m, builtin_tools
 from tcp_pendant.controller.beam import BeamSensor, ToolShape
 from tcp_pendant.controller.beam_scan import BeamScan, BeamScanConfig, run_beam_scan, tool_shape
@@ -222,27 +223,37 @@ def beam_scan_job(workflow: CalibrationWorkflow, wizard: Wizard) -> BeamScanJob 
                        seed=int(workflow.rng.integers(2**31)), manual=workflow.manual_comparison())
 
 
-def spin_clearance(workflow: CalibrationWorkflow, wizard: Wizard) -> Callable[[], str | None]:
+def spin_clearance(workflow: CalibrationWorkflow, wizard: Wizard) -> Callable[[], PoseProbe]:
     """For Auto-touch of a TCP check: a pose serves only when all six rotations of the check
-    can be made from it (a rotation stopped at a joint limit proves nothing). The probe runs
-    the check's rotations on the controller's model from its joints now (0.05-0.3 s; the
-    controller is not moved) and names the rotations that cannot be made."""
+    can be made from it (a rotation stopped at a joint limit proves nothing). Called where
+    Auto-touch's approach left the robot, it takes the probe of that pose: the check's
+    rotations on its own copy of the controller's model from the joints now (0.05-0.3 s; the
+    controller is not moved), which names the rotations that cannot be made; detached, so the
+    app runs it in its job pool (``Session.auto_touch_in_pool``)."""
     check = cast(TcpCheckWizard, wizard)          # the class that names this job ("spin_check")
     c = workflow.controller
 
-    def probe() -> str | None:
-        result = spin_check(c.kinematics, c.q_rad, T_flange_tool_m(check.tool), c.mounted_tool.T_flange_tool_true,
-                            angle_deg=check.angle_deg, settings=c.settings)
-        missing = [r.label for r in result.rotations if not r.reached]
-        return None if not missing else f"{', '.join(missing)} of the check could not be made from that pose"
+    def take() -> PoseProbe:
+        kinematics, _ = c.kinematics_for_worker()
+        q, T_tool = c.q_rad.copy(), T_flange_tool_m(check.tool)
+        T_true = np.array(c.mounted_tool.T_flange_tool_true, dtype=float)
+        angle_deg, settings = check.angle_deg, c.settings
 
-    return probe
+        def probe() -> str | None:
+            result = spin_check(kinematics, q, T_tool, T_true, angle_deg=angle_deg, settings=settings)
+            missing = [r.label for r in result.rotations if not r.reached]
+            return None if not missing else f"{', '.join(missing)} of the check could not be made from that pose"
+
+        return probe
+
+    return take
 
 
-POSE_CHECKS: dict[str, Callable[[CalibrationWorkflow, Wizard], Callable[[], str | None]]] = {
+POSE_CHECKS: dict[str, Callable[[CalibrationWorkflow, Wizard], Callable[[], PoseProbe]]] = {
     "spin_check": spin_clearance,
 }
-"""``Wizard.controller_job`` name -> a check that Auto-touch's pose serves that job."""
+"""``Wizard.controller_job`` name -> what takes the probe that Auto-touch's pose serves that job
+(``autotouch.PoseProbe``, run in a worker)."""
 
 
 JOBS: dict[str, Callable[[CalibrationWorkflow, Wizard], ControllerJob | None]] = {

@@ -8,6 +8,7 @@ It never sets the library's active slot: which tool is active is the session's (
 
 from __future__ import annotations
 
+from tcp_pendant.pendant.library_rights import UNRESTRICTED, LibraryRights
 from tcp_pendant.wizards import Wizard, WizardStateError
 from tcpcal.library import ToolLibrary
 from tcpcal.tool import Tool
@@ -15,7 +16,8 @@ from tcpcal.tool import Tool
 __all__ = ["save_result"]
 
 
-def save_result(wizard: Wizard, library: ToolLibrary, name: str, slot: int | None = None) -> tuple[int, Tool]:
+def save_result(wizard: Wizard, library: ToolLibrary, name: str, slot: int | None = None,
+                rights: LibraryRights = UNRESTRICTED) -> tuple[int, Tool]:
     """Store ``wizard.to_tool(name)`` in ``slot`` of ``library``.
 
     Args:
@@ -24,19 +26,27 @@ def save_result(wizard: Wizard, library: ToolLibrary, name: str, slot: int | Non
         name: the tool's logical name.
         slot: 1..16, or None: the slot that already holds a tool of that name, else the first
             free one.
+        rights: whose save it is (a class's trainee: their own or a free slot, within their
+            quota, checked by the library under its lock; ``pendant.library_rights``).
 
     Returns:
         (slot, tool) as saved.
 
     Raises:
         WizardStateError: the wizard is not finished, or the library is full.
-        tcpcal.TcpcalError: the library refused (bad slot, name used by another slot).
+        tcpcal.TcpcalError: the library refused (bad slot, name used by another slot, the slot
+            is another trainee's, the trainee's quota is full).
     """
     tool = wizard.to_tool(name)
+    kwargs = rights.save_kwargs()
     if slot is None:
         found = library.find(name)
+        if found is not None and not rights.mine(library.owners(), found[0]):
+            raise WizardStateError(f"The name {name!r} is taken by slot {found[0]}, a tool that is not yours: "
+                                   "choose another name.")
         slot = found[0] if found is not None else library.first_free_slot()
         if slot is None:
             raise WizardStateError("The tool library is full: pick a slot to overwrite.")
-    library.save(slot, tool, activate=False)
+    with rights.in_words():
+        library.save(slot, tool, activate=False, **kwargs)
     return slot, tool

@@ -25,7 +25,7 @@ another wizard only cancels (never deletes) the one that was open.
 from __future__ import annotations
 
 import re
-from collections.abc import Mapping, Sequence
+from collections.abc import Generator, Mapping, Sequence
 from datetime import datetime
 from dataclasses import dataclass, field, replace
 from typing import Any, ClassVar, Literal, Protocol, cast
@@ -34,11 +34,12 @@ import numpy as np
 
 from tcp_pendant.controller import T_flange_tool_m, ToolModel, VirtualController, builtin_tools
 from tcp_pendant.controller.errors import ControllerError
-from tcp_pendant.calibrate.autotouch import AutoTouchOutcome, auto_touch
+from tcp_pendant.calibrate.autotouch import AutoTouchOutcome, PoseProbe, auto_touch_steps, run_probes
 from tcp_pendant.calibrate.jobs import EXERCISE_REFUSAL, JOBS, POSE_CHECKS, ControllerJob
 from tcp_pendant.calibrate.diversity import failure_in_words
 from tcp_pendant.calibrate.library_save import save_result
 from tcp_pendant.pendant.exercise_rules import RuleRefusal
+from tcp_pendant.pendant.library_rights import UNRESTRICTED
 from tcp_pendant.events import (
     RunCancelled,
     RunFinished,
@@ -577,10 +578,17 @@ class CalibrationWorkflow:
         return self.training and (rules is None or bool(rules.auto_touch_allowed))
 
     def auto_touch(self, request: AutoTouchRequest) -> AutoTouchOutcome:
+        """:meth:`auto_touch_steps` with each pose probe run in place."""
+        return run_probes(self.auto_touch_steps(request))
+
+    def auto_touch_steps(self, request: AutoTouchRequest) -> Generator[PoseProbe, str | None, AutoTouchOutcome]:
         """Training mode: let the controller perform the current step (mounting the tool it
         needs), record it and go on; after the last step the result is computed (unless the
         exercise asks for more touches: :meth:`touches_short`), so a whole 4-point calibration
-        takes four clicks.
+        takes four clicks. A generator (``autotouch.auto_touch_steps``): it yields the probe of
+        each pose reached for a wizard whose job needs the pose checked
+        (``calibrate.jobs.POSE_CHECKS``: the app runs it in its job pool) and must be sent its
+        answer; it returns the outcome.
 
         Raises:
             WizardStateError: training mode is off, or no wizard is in progress.
@@ -602,10 +610,22 @@ class CalibrationWorkflow:
         had_pose = set(w.recorded_poses) if w.status == "in_progress" else set()
         job = type(w).controller_job
         pose_check = POSE_CHECKS[job](self, w) if job in POSE_CHECKS else None
-        out = auto_touch(w, self.controller, direction_deg=request.direction_deg,
-                         sigma_mm=request.sigma_mm, rng=self.rng, tools=self.tools,
-                         previous_direction_deg=None if run_index is None else self._auto_directions.get(run_index),
-                         mount=self.state.mount_tool, pose_check=pose_check)
+        steps = auto_touch_steps(w, self.controller, direction_deg=request.direction_deg,
+                                 sigma_mm=request.sigma_mm, rng=self.rng, tools=self.tools,
+                                 previous_direction_deg=None if run_index is None
+                                 else self._auto_directions.get(run_index),
+                                 mount=self.state.mount_tool, pose_check=pose_check)
+        try:
+            probe = next(steps)
+            while True:
+                answer = yield probe
+                if self.wizard is not w or self._current != run_index:   # left while the probe ran
+                    steps.close()
+                    raise WizardStateError("The calibration on show changed while Auto-touch checked the pose "
+                                           "it reached; nothing was recorded.")
+                probe = steps.send(answer)
+        except StopIteration as stop:
+            out = stop.value
         self.note_mounted_tool()
         if out.ok:                            # the robot stands at the touch it recorded
             self._recorded(out.step_index, auto=True, had_pose=out.step_index in had_pose)
@@ -680,7 +700,8 @@ class CalibrationWorkflow:
         name = str(name).strip()
         if not name:
             raise WizardStateError("Type a name for the tool before saving.")
-        slot_tool = save_result(w, self.library, name, slot)
+        rights = getattr(self.state, "library_rights", UNRESTRICTED)   # the session's, when it has them
+        slot_tool = save_result(w, self.library, name, slot, rights)
         self.state.apply_saved(*slot_tool)
         self.last_save = slot_tool
         if self._current is not None and w.result is not None:

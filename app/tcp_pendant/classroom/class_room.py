@@ -4,8 +4,15 @@
 per-browser mode). For each new session it shows the "Your name" prompt
 (``views.identity``); a name starts a gradebook session and a :class:`TraineeRecorder`
 subscribed to the session's change signal (and, in the mystery exercise, mounts the trainee's
-mystery tool); a right trainer token builds a :class:`~tcp_pendant.views.trainer_view.TrainerView`
-in that browser. Every trainer view re-renders when a trainee's row changes.
+mystery tool); a right trainer token turns that browser into the trainer's dashboard
+(:func:`tcp_pendant.views.dashboard.open_dashboard`: its pendant is taken down). Every dashboard
+re-renders when a trainee's state changes, at most :data:`RENDER_INTERVAL_S` apart, and every
+:data:`TICK_S` for its clocks; its table comes from the gradebook (``Gradebook.board``) plus
+who is connected now (:meth:`ClassRoom.connected_names`), so it survives a restart.
+
+Per-trainee actions of the trainer (:meth:`ClassRoom.reset_wizard`, :meth:`ClassRoom.push_to`)
+run on that one trainee's session through its own commands, handed to viser's loop after the
+trainer's callback (never two sessions' locks at once); no other session is touched.
 
 Names are for the one browser that joined under them (``Gradebook.join_trainee``): a browser
 gets a browser key when it joins (its page script keeps it, ``views.identity``) and comes back
@@ -30,6 +37,11 @@ Each trainee's pendant follows the class's :class:`~tcp_pendant.pendant.exercise
 (``Session.set_rules``): in an exercise the distance aids are hidden and locked and Auto-touch
 is off unless the trainer unlocked or allowed them (``class_rules``); a change of exercise goes
 back to those defaults unless the same push sets them.
+
+Each pendant's library rights (``pendant.library_rights``, ``Session.set_library_rights``):
+before a name it changes no library slot; a named trainee saves into free slots and their own,
+renames and deletes only their own, within ``library_quota`` slots (the owner, the name, is
+kept in the library file); the browser that opened the trainer view changes every slot.
 
 The exercise also carries the trainer's **brief** (:meth:`ClassRoom.push_brief`, or
 ``--exercise-instructions`` / ``--exercise-methods`` / ``--exercise-min-touches`` at start):
@@ -80,10 +92,11 @@ from collections.abc import Callable, Sequence
 from datetime import datetime, timezone
 from typing import Any, cast
 
-from tcp_pendant.classroom.gradebook import Gradebook, GradebookError, GradeRow, TraineeJoin
+from tcp_pendant.classroom.gradebook import ClassBoard, Gradebook, GradebookError, GradeRow, TraineeJoin
 from tcp_pendant.classroom.mystery import draw_mystery_tool
 from tcp_pendant.classroom.names import TraineeNameError, validate_trainee_name
 from tcp_pendant.classroom.recorder import TraineeRecorder, TraineeStatus
+from tcp_pendant.classroom.replay import CalibrationReplay, calibration_replay
 from tcp_pendant.classroom.restore import runs_to_restore
 from tcp_pendant.classroom.trainer_token import TokenAttempts, validate_trainer_token
 from tcp_pendant.controller import ToolModel
@@ -95,15 +108,24 @@ from tcp_pendant.pendant.exercise_rules import (
     clean_instructions,
     clean_min_touches,
 )
+from tcp_pendant.pendant.library_rights import DEFAULT_LIBRARY_QUOTA, MAX_LIBRARY_QUOTA, UNRESTRICTED, LibraryRights
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.wizards import WIZARD_TYPES, wizard_classes
 
-__all__ = ["EXERCISE_IDS", "ClassRoom", "clean_methods"]
+__all__ = ["EXERCISE_IDS", "RENDER_INTERVAL_S", "TICK_S", "ClassRoom", "clean_methods"]
 
 log = logging.getLogger(__name__)
 
 EXERCISE_IDS = ("mystery",)
 """Exercises a trainer can start (``--exercise``; None: free practice)."""
+
+
+RENDER_INTERVAL_S = 0.5
+"""Dashboards re-render at most this often (seconds): a class of 100 trainees touching at once
+costs one gradebook read and one table per trainer browser per interval."""
+TICK_S = 5.0
+"""Dashboards re-render at least this often while one is open (its clocks: time on the step,
+since the last touch, stuck)."""
 
 
 PUSHED_SETTING = "pushed"
@@ -160,10 +182,15 @@ class ClassRoom:
             the brief kept in the gradebook, else none); each given one wins over the kept one.
         hand_to_loop: runs a function on viser's event loop.
         clock: seconds of a monotonic clock (the token's lockout windows; tests set it).
+        call_later: ``call_later(delay_s, fn)`` runs ``fn`` on viser's event loop after a
+            delay (the dashboards' throttle and clock tick); None: dashboards render at once,
+            every time (tests).
+        library_quota: tool-library slots one trainee may hold (1..16; ``--library-quota``).
         presence_poll_s: the heartbeat period of :meth:`start` (seconds; module docstring).
 
     Raises:
         TrainerTokenError: a token that breaks the rules.
+        ValueError: a library quota out of range.
     """
 
     def __init__(self, gradebook: Gradebook, tools: dict[str, ToolModel], *, trainer_token: str | None,
@@ -171,7 +198,14 @@ class ClassRoom:
                  instructions: str | None = None, allowed_methods: Sequence[str] | str | None = None,
                  min_touches: int | None = None,
                  hand_to_loop: Callable[[Callable[[], None]], None] = lambda fn: fn(),
-                 clock: Callable[[], float] = time.monotonic, presence_poll_s: float = 1.0) -> None:
+                 clock: Callable[[], float] = time.monotonic,
+                 call_later: Callable[[float, Callable[[], None]], None] | None = None,
+                 library_quota: int = DEFAULT_LIBRARY_QUOTA, presence_poll_s: float = 1.0) -> None:
+        if (isinstance(library_quota, bool) or not isinstance(library_quota, int)
+                or not 1 <= library_quota <= MAX_LIBRARY_QUOTA):
+            raise ValueError(f"The library quota must be a whole number of slots 1..{MAX_LIBRARY_QUOTA}, "
+                             f"got {library_quota!r:.40}.")
+        self.library_quota = library_quota
         if exercise is not None and exercise not in EXERCISE_IDS:
             raise ValueError(f"Unknown exercise {exercise!r}; use one of {', '.join(EXERCISE_IDS)}.")
         given_instructions = None if instructions is None else clean_instructions(instructions)
@@ -202,7 +236,11 @@ class ClassRoom:
         self._prompts: dict[int, Any] = {}           # id(session) -> its IdentityPrompt
         self._released: dict[int, str] = {}          # id(session) -> the name the trainer released there
         self._left: list[TraineeStatus] = []        # rows of trainees who left (connected=False)
-        self._trainer_views: dict[int, Any] = {}    # id(session) -> TrainerView
+        self._trainer_views: dict[int, Any] = {}    # id(session) -> TrainerDashboard
+        self._call_later = call_later
+        self._render_due = False                    # a throttled dashboard render is scheduled
+        self._tick_due = False                      # the dashboards' clock tick is scheduled
+        self._last_render = -float("inf")           # time.monotonic() of the last render
         self._token_attempts: dict[int, TokenAttempts] = {}   # id(session) -> its wrong tokens
         self.clock = clock
         self.distance_aids: DistanceAids | None = None
@@ -268,12 +306,19 @@ class ClassRoom:
         session.views["identity"] = prompt
         with self._lock:
             self._prompts[id(session)] = prompt
+        session.set_library_rights(self._library_rights(session, None))   # no change before a name
         session.on_close(lambda: self.detach(session))
         return prompt
 
     @staticmethod
     def _joined(join: TraineeJoin) -> tuple[str, str | None]:
         return join.name, join.new_key
+
+    def _library_rights(self, session: Session, name: str | None) -> LibraryRights:
+        """The trainer changes every slot; a trainee (``name``; None: not joined) only their own."""
+        with self._lock:
+            trainer = id(session) in self._trainer_views
+        return UNRESTRICTED if trainer else LibraryRights.trainee(name, self.library_quota)
 
     def _seed(self) -> int:
         if self._exercise_seed is None:
@@ -331,6 +376,7 @@ class ClassRoom:
             if follow:
                 session.subscribe(lambda change: self._on_change(session, change))
             session.set_hide_truth(self.exercise is not None)
+            session.set_library_rights(self._library_rights(session, join.name))
             if self.exercise == "mystery":
                 self._mount_mystery(session, recorder, join.name)
             self._apply_rules(session)
@@ -367,6 +413,8 @@ class ClassRoom:
         with self._lock:
             self._left.append(recorder.status)
         self._drop_presence(name)
+        session.library_rights = self._library_rights(session, None)  # at once: it changes nothing more
+        self._hand_to_loop(session.guard(lambda: session.set_library_rights(session.library_rights)))
         if prompt is not None:         # on the loop, after this callback: no two sessions' locks at once
             self._hand_to_loop(session.guard(lambda: prompt.reopen(message, forget=forget)))
 
@@ -555,26 +603,148 @@ class ClassRoom:
             client_id = getattr(session.client, "client_id", None)
             attempts.failed(now, "a shared page" if client_id is None else f"browser {client_id}", token)
             return False
-        from tcp_pendant.views.trainer_view import TrainerView
+        from tcp_pendant.views.dashboard import open_dashboard
 
         with self._lock:
             if id(session) in self._trainer_views:
                 return True
-        view = TrainerView(session, self)
+        view = open_dashboard(session, self)
         session.views["trainer"] = view
         with self._lock:
             self._trainer_views[id(session)] = view
+        self._schedule_tick()
+        session.set_library_rights(UNRESTRICTED)        # the trainer renames and deletes every slot
         return True
 
     def refresh_trainers(self) -> None:
-        """Re-render every open trainer view (on viser's event loop)."""
+        """Re-render every open dashboard (on viser's event loop): at once when the last render
+        is :data:`RENDER_INTERVAL_S` old, else once when it is (later changes join that one)."""
         with self._lock:
+            if self._render_due or not self._trainer_views:
+                return
+            wait = self._last_render + RENDER_INTERVAL_S - time.monotonic()
+            if wait > 0 and self._call_later is not None:
+                self._render_due = True
+                later = self._call_later
+            else:
+                later = None
+        if later is not None:
+            try:
+                later(wait, self._render_trainers)
+            except RuntimeError:                 # the loop is closed: the server is stopping
+                with self._lock:
+                    self._render_due = False
+            return
+        self._render_trainers()
+
+    def _render_trainers(self) -> None:
+        with self._lock:
+            self._render_due = False
+            self._last_render = time.monotonic()
             views = list(self._trainer_views.values())
+        if not views:
+            return
+        try:
+            board, connected = self.board(), set(self.connected_names())
+        except GradebookError:
+            log.exception("the gradebook could not be read for the dashboards")
+            return
         for view in views:
             try:
-                view.session.guard(view.render)()
+                view.session.guard(view.render)(board, connected)
             except Exception:
-                log.exception("trainer view refresh failed")
+                log.exception("trainer dashboard refresh failed")
+        self._schedule_tick()
+
+    def _schedule_tick(self) -> None:
+        with self._lock:
+            if self._tick_due or not self._trainer_views or self._call_later is None:
+                return
+            self._tick_due = True
+            later = self._call_later
+        try:
+            later(TICK_S, self._tick)
+        except RuntimeError:
+            with self._lock:
+                self._tick_due = False
+
+    def _tick(self) -> None:
+        with self._lock:
+            self._tick_due = False
+        self.refresh_trainers()
+
+    # ------------------------------------------------------------ the dashboard's data
+    def board(self) -> ClassBoard:
+        """The class as the gradebook knows it (``Gradebook.board``)."""
+        return self.gradebook.board()
+
+    def replay(self, name: str) -> CalibrationReplay | None:
+        """The latest calibration of ``name`` that has a touch, from the gradebook (None: none)."""
+        cid = self.gradebook.last_calibration(name)
+        return None if cid is None else calibration_replay(self.gradebook, cid)
+
+    def _entry_of(self, name: str) -> tuple[Session, TraineeRecorder, str] | None:
+        with self._lock:
+            return next((e for e in self._trainees.values() if e[2] == name), None)
+
+    def reset_wizard(self, name: str) -> str:
+        """Cancel the running wizard of the trainee ``name`` (``Session.cancel_wizard`` on their
+        session only; kept, resumable; the gradebook records the cancel) and tell them. Returns
+        what happened, in words for the trainer (plain text)."""
+        entry = self._entry_of(name) if isinstance(name, str) else None
+        if entry is None:
+            return f"{name} is not connected: there is no running wizard to reset."
+        session = entry[0]
+        if not session.workflow.is_open:
+            return f"{name} has no wizard running."
+
+        def cancel() -> None:
+            if session.workflow.is_open:
+                session.cancel_wizard()
+                session.notify("The trainer reset your calibration",
+                               "Your trainer closed the wizard; start it again (your touches are kept: "
+                               "Resume brings them back).", kind="warning")
+        self._hand_to_loop(session.guard(cancel))   # after the trainer's callback: one session's lock at a time
+        return f"Reset {name}'s running wizard."
+
+    def push_to(self, name: str, exercise: str | None | bool = False, tool_key: str | None = None,
+                hide_distance: str | None = None, auto_touch: bool | None = None) -> str:
+        """Push settings to the one trainee ``name``: ``exercise`` (False: keep; None: free
+        practice; "mystery": their mystery tool), ``tool_key`` (None: keep; ignored with the
+        mystery exercise), distance aids ``hide_distance`` ("locked" / "hidden" / "shown", None:
+        keep) and Auto-touch (None: keep). Only that trainee's session is changed; until their
+        next reconnect or the next push to all. Returns what happened (plain text)."""
+        if exercise is not False and exercise is not None and exercise not in EXERCISE_IDS:
+            raise ValueError(f"Unknown exercise {exercise!r}; use one of {', '.join(EXERCISE_IDS)}.")
+        if tool_key is not None and tool_key not in self.tools:
+            raise ValueError(f"Unknown tool {tool_key!r}; use one of {', '.join(self.tools)}.")
+        entry = self._entry_of(name) if isinstance(name, str) else None
+        if entry is None:
+            return f"{name} is not connected: nothing pushed."
+        session, recorder, who = entry
+        ex = self.exercise if exercise is False else exercise
+        rules = class_rules(ex, cast("DistanceAids | None", hide_distance) or self.distance_aids,
+                            self.auto_touch if auto_touch is None else bool(auto_touch))
+
+        def apply() -> None:
+            with session.batch():
+                if exercise is not False:
+                    recorder.exercise_id = ex
+                    session.set_hide_truth(ex is not None)
+                    if ex == "mystery":
+                        self._mount_mystery(session, recorder, who)
+                if tool_key is not None and ex != "mystery":
+                    session.mount_tool(self.tools[tool_key])
+                if not rules.distance_locked:
+                    session.set_rules(rules)
+                if hide_distance is not None:
+                    session.set_hide_distance(hide_distance != "shown")
+                elif exercise is not False and rules.in_exercise:
+                    session.set_hide_distance(True)
+                session.set_rules(rules)
+                session.changed(wizard=True)
+        self._hand_to_loop(session.guard(apply))
+        return f"Pushed to {who}."
 
     def trainee_statuses(self) -> list[TraineeStatus]:
         """Rows of the live table: this process's connected trainees in order of arrival, those
@@ -715,7 +885,7 @@ class ClassRoom:
     def connected_names(self) -> list[str]:
         """Names of the trainees connected now on every server process of the class (the
         trainer's "To" choices): this process's in order of arrival, then the other processes'
-        by name (the presence table)."""
+        by name (the presence table); the one place the dashboard learns who is connected."""
         with self._lock:
             local = [name for _, _, name in self._trainees.values()]
         try:

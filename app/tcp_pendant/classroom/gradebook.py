@@ -101,6 +101,9 @@ __all__ = [
     "CSV_COLUMNS",
     "GRADES",
     "SCHEMA_VERSION",
+    "BoardRun",
+    "BoardTrainee",
+    "ClassBoard",
     "GradeRow",
     "Gradebook",
     "GradebookError",
@@ -145,6 +148,10 @@ PRESENCE_STALE_S = 10.0
 """A presence row whose holder has not beaten for this long (seconds) counts as gone."""
 MAX_STATUS_BYTES = 4_000
 """A presence row's status above this is refused (a trainer's row is ~200 bytes)."""
+_RUN_STATE_COLUMNS = (("method_title", "TEXT"), ("step", "TEXT"), ("step_since", "TEXT"))
+"""Added to ``run_states`` when missing (additive, like the table): the wizard's title and the
+step as the trainee saw it ("Step 2 of 4", "result", "cancelled") and since when (UTC), for the
+trainer's dashboard after a restart (``Gradebook.board``)."""
 _ADDITIVE_TABLES = {"run_states": _RUN_STATES, "presence": _PRESENCE, "class_pushes": _CLASS_PUSHES}
 """Tables made (CREATE TABLE IF NOT EXISTS, by name) in every gradebook that lacks them when it
 is opened, after the versioned schema; written in SQLite's words like every statement
@@ -286,6 +293,75 @@ class TraineeJoin:
     trainee_id: int
     name: str
     new_key: str | None
+
+
+@dataclass(frozen=True)
+class BoardTrainee:
+    """One trainee as the gradebook knows them now (``Gradebook.board``): the trainer's live
+    table without "connected", which only the server knows (raw text: escape before showing).
+
+    Attributes:
+        trainee_id / name: the trainee.
+        calibration_id: the trainee's latest calibration (any status), or None.
+        method: its method key ("xyz4", ...), "" without one.
+        method_title: its wizard's title as last kept ("XYZ 4-point"), "" unknown.
+        status: its status ("in_progress" | "finished" | "cancelled"), "" without one.
+        step: its step as the trainee last saw it ("Step 2 of 4", "result", "cancelled"), "" unknown.
+        step_since: when that step began (UTC ISO 8601), "" unknown.
+        touches: touches recorded in it (overwritten ones included: every Record counts).
+        crashes: crashes during it (and, outside any calibration, in the trainee's sessions since
+            it started; every crash of the trainee when there is no calibration).
+        last_touch_at: the trainee's latest touch (UTC ISO 8601), "" none.
+        in_progress: how many of the trainee's calibrations are in progress.
+        result_calibration_id: the latest finished calibration, or None; position_error_mm,
+            orientation_error_deg, grade, tcp_mm: its result (None: none, or no truth).
+    """
+
+    trainee_id: int
+    name: str
+    calibration_id: int | None = None
+    method: str = ""
+    method_title: str = ""
+    status: str = ""
+    step: str = ""
+    step_since: str = ""
+    touches: int = 0
+    crashes: int = 0
+    last_touch_at: str = ""
+    in_progress: int = 0
+    result_calibration_id: int | None = None
+    position_error_mm: float | None = None
+    orientation_error_deg: float | None = None
+    grade: str | None = None
+    tcp_mm: tuple[float, float, float] | None = None
+
+
+@dataclass(frozen=True)
+class BoardRun:
+    """A calibration in progress (``Gradebook.board``), for the trainer.
+
+    Attributes:
+        calibration_id, trainee, method (key), method_title ("" unknown), step ("" unknown),
+        step_since / started_at (UTC ISO 8601, "" unknown), touches (that count).
+    """
+
+    calibration_id: int
+    trainee: str
+    method: str
+    method_title: str
+    step: str
+    step_since: str
+    started_at: str
+    touches: int
+
+
+@dataclass(frozen=True)
+class ClassBoard:
+    """``Gradebook.board``: every trainee (in the order they first joined) and every
+    calibration in progress (oldest first)."""
+
+    trainees: tuple[BoardTrainee, ...]
+    in_progress: tuple[BoardRun, ...]
 
 
 BROWSER_KEY_BYTES = 32
@@ -595,6 +671,9 @@ class Gradebook:
                 for name, statement in _ADDITIVE_TABLES.items():   # an older reader ignores these
                     if name not in tables:
                         db.execute(statement)
+                missing = [c for c in _RUN_STATE_COLUMNS if c[0] not in db.columns("run_states")]
+                for column, kind in missing:                          # additive too: only when missing
+                    db.execute(f"ALTER TABLE run_states ADD COLUMN {column} {kind}")
         except db.errors as exc:
             raise self._cannot_write(exc) from exc
 
@@ -987,9 +1066,13 @@ class Gradebook:
 
     # -- what a restart gives back ------------------------------------------------------
 
-    def save_run_state(self, calibration_id: int, entry: Mapping[str, Any]) -> None:
+    def save_run_state(self, calibration_id: int, entry: Mapping[str, Any], *, method_title: str | None = None,
+                       step: str | None = None) -> None:
         """Keep the wizard of calibration ``calibration_id`` as it is now (a session record
         entry, ``session_record.run_entry``, JSON-ready, without truth); replaces the last.
+        ``method_title`` / ``step``: the wizard's title and its step as the trainee sees it
+        ("Step 2 of 4", "result", "cancelled"); ``step_since`` is set to now when ``step``
+        differs from the one kept (the trainer's "time on the step", :meth:`board`).
 
         Raises:
             GradebookError: no such calibration, not JSON, or above :data:`MAX_RUN_STATE_BYTES`.
@@ -1000,11 +1083,19 @@ class Gradebook:
             raise GradebookError(f"A wizard's state must be plain JSON: {exc}.") from exc
         if len(text) > MAX_RUN_STATE_BYTES:
             raise GradebookError(f"A wizard's state of {len(text):,} bytes is above {MAX_RUN_STATE_BYTES:,}.")
+        title = _label(method_title, "method_title", optional=True)
+        where = _label(step, "step", optional=True)
+        now = _now()
         with self._write() as db:
             cid = self._calibration(db, calibration_id)[0]
-            db.execute("INSERT INTO run_states (calibration_id, entry_json, updated_at) VALUES (?, ?, ?) "
+            db.execute("INSERT INTO run_states (calibration_id, entry_json, updated_at, method_title, step, step_since) "
+                       "VALUES (?, ?, ?, ?, ?, ?) "
                        "ON CONFLICT(calibration_id) DO UPDATE SET entry_json = excluded.entry_json, "
-                       "updated_at = excluded.updated_at", (cid, text, _now()))
+                       "updated_at = excluded.updated_at, "
+                       "method_title = COALESCE(excluded.method_title, run_states.method_title), "
+                       "step_since = CASE WHEN excluded.step IS NOT NULL AND COALESCE(run_states.step, '') <> excluded.step "
+                       "THEN excluded.step_since ELSE COALESCE(run_states.step_since, excluded.step_since) END, "
+                       "step = COALESCE(excluded.step, run_states.step)", (cid, text, now, title, where, now))
 
     def open_runs(self, trainee: str) -> list[dict[str, Any]]:
         """The calibrations of ``trainee`` still in progress that have a stored wizard, oldest
@@ -1132,6 +1223,80 @@ class Gradebook:
         with self._read() as db:
             row = db.execute("SELECT MAX(id) FROM class_pushes").fetchone()
         return 0 if row is None or row[0] is None else int(row[0])
+
+    def board(self) -> ClassBoard:
+        """The trainer's live table as the gradebook knows it (:class:`ClassBoard`): every
+        trainee with their latest calibration, step, touches, crashes and last result, and every
+        calibration in progress. The shared truth of the dashboard: a server started again with
+        this gradebook shows the class as it was, trainees not yet back included."""
+        query = """
+            WITH b AS MATERIALIZED (
+              SELECT t.id AS tid, t.name AS name,
+                (SELECT c.id FROM calibrations c JOIN sessions s ON s.id = c.session_id
+                   WHERE s.trainee_id = t.id ORDER BY c.started_at DESC, c.id DESC LIMIT 1) AS cid,
+                (SELECT c.id FROM calibrations c JOIN sessions s ON s.id = c.session_id
+                   WHERE s.trainee_id = t.id AND c.status = 'finished'
+                   ORDER BY c.finished_at DESC, c.id DESC LIMIT 1) AS fid,
+                (SELECT MAX(x.recorded_at) FROM touches x JOIN calibrations c ON c.id = x.calibration_id
+                   JOIN sessions s ON s.id = c.session_id WHERE s.trainee_id = t.id) AS last_touch,
+                (SELECT COUNT(*) FROM calibrations c JOIN sessions s ON s.id = c.session_id
+                   WHERE s.trainee_id = t.id AND c.status = 'in_progress') AS n_open
+              FROM trainees t)
+            SELECT b.tid, b.name, b.cid, c.method, c.status, r.method_title, r.step, r.step_since,
+                   (SELECT COUNT(*) FROM touches x WHERE x.calibration_id = b.cid),
+                   (SELECT COUNT(*) FROM crashes k WHERE (b.cid IS NOT NULL AND k.calibration_id = b.cid)
+                      OR (k.calibration_id IS NULL AND k.session_id IN (SELECT id FROM sessions WHERE trainee_id = b.tid)
+                          AND (c.started_at IS NULL OR k.at >= c.started_at))),
+                   b.last_touch, b.n_open, b.fid, f.position_error_mm, f.orientation_error_deg, f.grade, f.tcp_mm_json
+            FROM b LEFT JOIN calibrations c ON c.id = b.cid LEFT JOIN run_states r ON r.calibration_id = b.cid
+                   LEFT JOIN calibrations f ON f.id = b.fid
+            ORDER BY b.tid"""
+        runs_query = """
+            SELECT c.id, t.name, c.method, r.method_title, r.step, r.step_since, c.started_at,
+                   (SELECT COUNT(*) FROM touches x WHERE x.calibration_id = c.id AND x.overwritten_by_touch_id IS NULL)
+            FROM calibrations c JOIN sessions s ON s.id = c.session_id JOIN trainees t ON t.id = s.trainee_id
+                 LEFT JOIN run_states r ON r.calibration_id = c.id
+            WHERE c.status = 'in_progress' ORDER BY c.started_at, c.id"""
+        with self._read() as db:
+            rows = db.execute(query).fetchall()
+            runs = db.execute(runs_query).fetchall()
+        trainees = tuple(BoardTrainee(
+            trainee_id=tid, name=name, calibration_id=cid, method=method or "", status=status or "",
+            method_title=title or "", step=step or "", step_since=since or "", touches=int(n), crashes=int(k),
+            last_touch_at=last or "", in_progress=int(n_open), result_calibration_id=fid, position_error_mm=pos,
+            orientation_error_deg=ori, grade=grade, tcp_mm=tuple(json.loads(tcp)) if tcp else None)
+            for (tid, name, cid, method, status, title, step, since, n, k, last, n_open, fid, pos, ori, grade, tcp)
+            in rows)
+        open_runs = tuple(BoardRun(calibration_id=cid, trainee=name, method=method, method_title=title or "",
+                                   step=step or "", step_since=since or "", started_at=started or "", touches=int(n))
+                          for cid, name, method, title, step, since, started, n in runs)
+        return ClassBoard(trainees, open_runs)
+
+    def last_calibration(self, trainee: str) -> int | None:
+        """The latest calibration of ``trainee`` that has a touch (any status), or None: what
+        the trainer replays."""
+        with self._read() as db:
+            row = db.execute(
+                "SELECT c.id FROM calibrations c JOIN sessions s ON s.id = c.session_id "
+                "JOIN trainees t ON t.id = s.trainee_id WHERE t.name = ? AND EXISTS "
+                "(SELECT 1 FROM touches x WHERE x.calibration_id = c.id) ORDER BY c.started_at DESC, c.id DESC LIMIT 1",
+                (str(trainee),)).fetchone()
+        return None if row is None else int(row[0])
+
+    def calibration_result(self, calibration_id: int) -> dict[str, Any]:
+        """A calibration's method, status and result: ``{"trainee", "method", "status",
+        "tcp_mm", "abc_deg", "position_error_mm", "orientation_error_deg", "grade"}`` (None
+        where there is none yet)."""
+        with self._read() as db:
+            cid = self._calibration(db, calibration_id)[0]
+            row = db.execute(
+                "SELECT t.name, c.method, c.status, c.tcp_mm_json, c.abc_deg_json, c.position_error_mm, "
+                "c.orientation_error_deg, c.grade FROM calibrations c JOIN sessions s ON s.id = c.session_id "
+                "JOIN trainees t ON t.id = s.trainee_id WHERE c.id = ?", (cid,)).fetchone()
+        name, method, status, tcp, abc, pos, ori, grade = row
+        return {"trainee": name, "method": method, "status": status,
+                "tcp_mm": json.loads(tcp) if tcp else None, "abc_deg": json.loads(abc) if abc else None,
+                "position_error_mm": pos, "orientation_error_deg": ori, "grade": grade}
 
     def grades(self, *, include_in_progress: bool = False) -> list[GradeRow]:
         """One row per finished calibration, oldest start first; with ``include_in_progress``

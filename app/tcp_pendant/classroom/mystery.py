@@ -23,16 +23,23 @@ hash and tells nothing about the truth; written to a temporary folder and rename
 concurrent draw never sees half a tool) and reused afterwards.
 
 The mesh is neutral: a mount disc on the flange, a shaft from the flange face to the neck and a
-cone, the nozzle, whose apex is the TCP. The nozzle is defined in the URDF's ``tcp`` link with
-its apex at that link's origin (vertex exactly (0, 0, 0)), so the tip of the mesh is at the
-true TCP up to the float64 transform (well below 1e-9 m), not at float32 STL precision.
+cone, the nozzle, about tool X, ending in a flat tip face ``_TIP_FACE_RADIUS_M`` = 0.2 mm in
+radius, square to tool X and centred on the TCP (a real pointer's or contact tip's end is never
+a mathematical point). The nozzle is defined in the URDF's ``tcp`` link, its tip face centred on
+that link's origin, so the drawn tip is at the true TCP up to the float64 transform. Touching the
+spike anywhere on that face is within 0.2 mm of the TCP, inside the exercise's "good" 0.5 mm. No
+vertex lies at the TCP: the face is a fan from one of its own ring's vertices, each 0.2 mm from
+it, so no number the browser gets is the TCP; its centre is, for a program that fits the face
+(README: what a determined trainee can still see).
 
 What the drawing gives away is what a real tool shows: the tip and the shaft. The browser gets
-the meshes in FLANGE coordinates (``rigid_meshes``), so the apex is the TCP and the nozzle's
-axis is tool X, as the wire of a real torch is. Tool Y and Z (the spin about X) are not in it:
-the nozzle is a cone, a surface of revolution about X, and the first of its ring's
+the meshes in FLANGE coordinates (``rigid_meshes``), so the tip face's centre is the TCP and the
+nozzle's axis is tool X, as the wire of a real torch is. Tool Y and Z (the spin about X) are not
+in it: the nozzle is a surface of revolution about X, and the first of each of its rings'
 ``_SECTIONS`` vertices sits at ``ring_phase_deg``, drawn with the secret seed (uniform on
 0..360 deg), not on tool Y; every other part is built from the flange and the shaft line alone.
+The cache folder is named by a hash of the tool's digest and ``_DRAWING`` (the drawing's
+version), so a tool drawn by an older drawing is not reused.
 """
 
 from __future__ import annotations
@@ -81,6 +88,8 @@ _MOUNT_HEIGHT_M = 0.012
 _SHAFT_RADIUS_M = 0.010
 _NOZZLE_LENGTH_M = 0.030
 _NOZZLE_RADIUS_M = 0.009
+_TIP_FACE_RADIUS_M = 0.0002     # the drawn tip: a flat 0.4 mm across, centred on the TCP
+_DRAWING = "tip-face-1"         # part of the cache folder's name: a new drawing is written anew
 _SECTIONS = 24
 
 
@@ -179,18 +188,27 @@ def draw_mystery_frame(seed: int, trainee_name: str, base: ToolModel) -> Mystery
 
 
 def _nozzle_mesh(phase_deg: float) -> trimesh.Trimesh:
-    """A cone in the TOOL frame: apex exactly at the origin (the TCP), base at x = -L, its ring's
-    first vertex at ``phase_deg`` about X from +Y (towards +Z)."""
+    """The nozzle in the TOOL frame: a cone about X from its base (radius ``_NOZZLE_RADIUS_M`` at
+    x = -L) to a flat tip face of radius ``_TIP_FACE_RADIUS_M`` in the plane x = 0, centred on the
+    origin (the TCP); both rings' first vertex at ``phase_deg`` about X from +Y (towards +Z).
+
+    The tip face is a fan from one of its own ring's vertices, so no vertex lies at the TCP:
+    every vertex is at least ``_TIP_FACE_RADIUS_M`` from it, and what the mesh tells of the TCP is
+    the centre of the drawn tip, as the eye sees it."""
     a = np.radians(phase_deg) + np.linspace(0.0, 2.0 * np.pi, _SECTIONS, endpoint=False)
+    tip = np.column_stack([np.zeros(_SECTIONS), _TIP_FACE_RADIUS_M * np.cos(a), _TIP_FACE_RADIUS_M * np.sin(a)])
     ring = np.column_stack([np.full(_SECTIONS, -_NOZZLE_LENGTH_M), _NOZZLE_RADIUS_M * np.cos(a),
                             _NOZZLE_RADIUS_M * np.sin(a)])
-    vertices = np.vstack([[0.0, 0.0, 0.0], ring, [-_NOZZLE_LENGTH_M, 0.0, 0.0]])
-    centre = _SECTIONS + 1
+    vertices = np.vstack([tip, ring, [[-_NOZZLE_LENGTH_M, 0.0, 0.0]]])
+    centre = 2 * _SECTIONS
     faces = []
     for i in range(_SECTIONS):
         j = (i + 1) % _SECTIONS
-        faces.append((0, 1 + j, 1 + i))          # side, outward
-        faces.append((centre, 1 + i, 1 + j))     # base disc, facing -X
+        faces.append((i, j, _SECTIONS + j))                       # side, outward
+        faces.append((i, _SECTIONS + j, _SECTIONS + i))
+        faces.append((centre, _SECTIONS + i, _SECTIONS + j))      # base disc, facing -X
+    for i in range(1, _SECTIONS - 1):
+        faces.append((0, i + 1, i))                               # tip face, facing +X
     mesh = trimesh.Trimesh(vertices=vertices, faces=np.array(faces), process=False)
     mesh.fix_normals()
     return mesh
@@ -270,8 +288,8 @@ def _write_tool(folder: Path, name: str, T_flange_tool: np.ndarray, ring_phase_d
 def _cached_tool(seed: int, name: str, base: ToolModel, cache_dir: Path) -> ToolModel:
     frame = draw_mystery_frame(seed, name, base)
     key = f"mystery-{frame.digest[:10]}"
-    urdf = _write_tool(cache_dir / frame.digest[:32], key.replace("-", "_"), frame.T_flange_tool,
-                       frame.ring_phase_deg)
+    folder = hashlib.sha256(f"{frame.digest}\0{_DRAWING}".encode()).hexdigest()[:32]
+    urdf = _write_tool(cache_dir / folder, key.replace("-", "_"), frame.T_flange_tool, frame.ring_phase_deg)
     return load_tool(urdf, key=key, label=MYSTERY_LABEL)
 
 

@@ -43,7 +43,7 @@ from tcp_pendant.classroom.gradebook import Gradebook
 from tcp_pendant.events import Crash, RunCancelled, RunFinished, RunResumed, RunStarted, SessionEvent, TouchRecorded
 from tcp_pendant.wizards.session_record import run_entry
 
-__all__ = ["TraineeRecorder", "TraineeStatus"]
+__all__ = ["TraineeRecorder", "TraineeStatus", "step_words"]
 
 log = logging.getLogger(__name__)
 
@@ -153,10 +153,12 @@ class TraineeRecorder:
         if st is None or self.workflow is None or not 0 <= run_index < len(self.workflow.runs):
             return
         try:
+            wizard = self.workflow.runs[run_index].wizard
             entry = run_entry(self.workflow.runs[run_index], honest=True)
             if entry == st.kept:
                 return
-            self.gradebook.save_run_state(st.calibration_id, entry)
+            self.gradebook.save_run_state(st.calibration_id, entry, method_title=str(wizard.title)[:200] or None,
+                                          step=step_words(wizard)[:200] or None)
             st.kept = entry
         except Exception:            # a state that cannot be kept must not stop the lesson
             self.errors += 1
@@ -221,10 +223,14 @@ class TraineeRecorder:
 
     def _update_status(self) -> None:
         w = None if self.workflow is None else self.workflow.wizard
-        if w is None:
-            method, step = "", ""
-        else:
-            method = w.title
-            step = ("result" if w.status == "complete" else "cancelled" if w.status == "cancelled"
-                    else w.step.heading)
+        method, step = ("", "") if w is None else (w.title, step_words(w))
         self._status = replace(self._status, method=method, step=step)
+
+
+def step_words(wizard: Any) -> str:
+    """Where a wizard is, as the trainer's table says it: "Step k of n", "result" or "cancelled"."""
+    if wizard.status == "complete":
+        return "result"
+    if wizard.status == "cancelled":
+        return "cancelled"
+    return str(wizard.step.heading)

@@ -9,7 +9,7 @@ check" above) verifies it.
 Check: the job (``calibrate.beam_service.beam_check_job``: a snapshot of the robot model, the
 joints, the sensor, the active tool data and its slot, the physical tool) is taken on viser's
 event loop under the session lock; the scan (a few hundred milliseconds of geometry and two
-solves) runs in :data:`_BEAM_WORKER`; its result is shown on the loop and the scan is replayed
+solves) runs in the server's job pool (``Session.run_job``); its result is shown on the loop and the scan is replayed
 in the scene (``views.beam_replay``), the robot going back to where it was, the camera turned
 to the sensor. One check at a
 time per session. Update: ``beam_service.update_tool_from_beam`` (it refuses when the slot
@@ -20,10 +20,8 @@ the markdown escaped (``beam_check_markdown`` escapes its own), notifications as
 
 from __future__ import annotations
 
-import asyncio
 import logging
 from collections.abc import Iterable
-from concurrent.futures import ThreadPoolExecutor
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -35,6 +33,7 @@ from tcp_pendant.calibrate.beam_service import (
     update_tool_from_beam,
 )
 from tcp_pendant.calibrate.jobs import EXERCISE_REFUSAL
+from tcp_pendant.job_pool import JobRefused
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.beam_replay import ScanPlayer, beam_view_direction, scan_spheres
@@ -50,9 +49,6 @@ if TYPE_CHECKING:
 __all__ = ["BeamCheckView", "update_markdown"]
 
 log = logging.getLogger(__name__)
-
-_BEAM_WORKER = ThreadPoolExecutor(max_workers=1, thread_name_prefix="tcp-beam")
-"""Runs the beam scans of the TCP service off viser's event loop (one at a time)."""
 
 INTRO = ("The robot moves the ACTIVE tool through the beam sensor by itself and measures its TCP. "
          "After a crash: **Check with beam**, then **Update** stores the measured TCP.")
@@ -151,7 +147,10 @@ class BeamCheckView:
             s.notify("Not done", str(exc), kind="warning")
             return
         try:
-            check = await asyncio.get_running_loop().run_in_executor(_BEAM_WORKER, job.run)
+            check = await s.run_job(job.run, what="a beam check")
+        except JobRefused as exc:          # another job of this session, or a full queue: nothing ran
+            self._failed("Beam check not started", str(exc), kind="warning")
+            return
         except ValueError as exc:          # nothing could be scanned: plain words from the controller
             self._failed("Beam check not done", str(exc), kind="warning")
             return
@@ -202,7 +201,7 @@ class BeamCheckView:
             raise ValueError("The active tool changed since the check; check the active tool again before "
                              "Update.")
         before = check.stored_tool
-        tool = update_tool_from_beam(s.library, check.slot, check)
+        tool = update_tool_from_beam(s.library, check.slot, check, s.library_rights)
         self.last_check = None
         s.apply_saved(check.slot, tool)                    # one signal: library re-read, active data
         self.result_md.content = beam_check_markdown(check) + "\n\n" + update_markdown(check.slot, before, tool)

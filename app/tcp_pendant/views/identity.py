@@ -158,7 +158,8 @@ class IdentityPrompt:
         if not opened:
             self.message.content = "⚠ That trainer token is not right; type the token the server printed."
             return
-        self._close_modal()
+        if self.session.views.get("identity") is self:    # else the dashboard cleared the GUI, this modal too
+            self._close_modal()
 
     def _close_modal(self) -> None:
         if self._modal_open:

@@ -25,10 +25,8 @@ shown right under it; the tool is saved only if all fields are valid (nothing ha
 
 from __future__ import annotations
 
-import asyncio
 import logging
 from collections.abc import Callable, Coroutine
-from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
 import viser
@@ -36,6 +34,7 @@ import viser
 from tcp_pendant.controller import builtin_tools
 from tcp_pendant.pendant import FIELDS, ToolEntry, parse_tool_entry, tool_data_markdown
 from tcp_pendant.pendant.tool_entry import entry_preview_markdown
+from tcp_pendant.job_pool import JobRefused
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.controller.spin import DEFAULT_SPIN_ANGLE_DEG, MAX_SPIN_ANGLE_DEG, SpinCheckResult
@@ -62,9 +61,6 @@ log = logging.getLogger(__name__)
 NO_TOOL = "(library empty)"
 CONTROLLER_FILE_REFUSED = "Controller file not written"
 """Title of the one notification when a controller refuses the tool (name, number)."""
-
-_CHECK_WORKER = ThreadPoolExecutor(max_workers=1, thread_name_prefix="tcp-check")
-"""Runs the TCP checks off viser's event loop (one at a time across sessions)."""
 
 
 def controller_file(tool: Tool, slot: int, label: str) -> tuple[str, str]:
@@ -221,8 +217,22 @@ class ToolPanel:
     def _show_slot(self) -> None:
         slot = number_of_option(self.slots.value)
         tool = None if slot is None else self._library.get(slot)
-        self.slot_md.content = "" if tool is None else tool_data_markdown(tool, slot).replace(
-            "**Active tool:**", "**Selected:**")
+        self.slot_md.content = "" if tool is None or slot is None else tool_data_markdown(tool, slot).replace(
+            "**Active tool:**", "**Selected:**") + self._owner_line(slot)
+
+    def _owner_line(self, slot: int) -> str:
+        """Whose the selected slot is (a class): a trainee reads "yours" or "not yours" (no
+        classmate's name), the trainer the owner's name (escaped)."""
+        s = self.session
+        rights, owner = s.library_rights, s.library_owners.get(slot)
+        if rights.restricted:
+            if rights.mine(s.library_owners, slot):
+                return "\n\nYours: you can rename and delete it."
+            whose = "another trainee's" if owner is not None else "the trainer's"
+            return f"\n\nThis slot is {whose}: activate and check it; you cannot change it."
+        if owner is not None:
+            return f"\n\nSaved by trainee {escape_markdown(owner)}."
+        return ""
 
     def _show_mounted(self) -> None:
         label = self.session.controller.mounted_tool.label
@@ -308,8 +318,9 @@ class ToolPanel:
 
     async def run_check(self, which: Callable[[], tuple[str, Tool]]) -> None:
         """Run the TCP check of ``which()`` (title, tool): the job is taken under the session
-        lock on the loop, the six rotations run in ``_CHECK_WORKER``, the result is shown on
-        the loop. One check at a time per session; errors become one notification."""
+        lock on the loop, the six rotations run in the server's job pool (``Session.run_job``),
+        the result is shown on the loop. One check at a time per session (one job of any kind:
+        the pool refuses another meanwhile, in words); errors become one notification."""
         s = self.session
         if s.closed:
             return
@@ -322,13 +333,19 @@ class ToolPanel:
                 if s.rules.in_exercise:                 # read against the spike, as on a robot
                     check_readable(s.pose_state().touch.distance_mm)
                 job = check_job(s.controller, tool, title, self.check_angle.value)
+                shown = self.check_md.content
                 self.check_md.content = f"Checking {escape_markdown(title)} ..."
         except ValueError as exc:
             s.notify("Not done", str(exc), kind="warning")
             return
         self._checking = True
         try:
-            result = await asyncio.get_running_loop().run_in_executor(_CHECK_WORKER, job.run)
+            result = await s.run_job(job.run, what="a TCP check")
+        except JobRefused as exc:      # this session's other job, or a full queue: nothing ran
+            with s.lock:
+                self.check_md.content = shown
+            s.notify("Check not started", str(exc), kind="warning")
+            return
         except Exception as exc:  # a browser's click must never kill the server
             log.exception("TCP check failed")
             s.notify("TCP check failed", f"{type(exc).__name__}: {exc}", kind="error")
@@ -364,7 +381,11 @@ class ToolPanel:
         if errors or res.tool is None or slot is None:
             self.entry_md.content = "⚠ Not saved: correct the fields marked above."
             return
-        self.session.store_tool(slot, res.tool)
+        try:
+            self.session.store_tool(slot, res.tool)
+        except ValueError as exc:       # e.g. another trainee's slot, a full quota: said here too
+            self.entry_md.content = f"⚠ Not saved: {escape_markdown(str(exc))}"
+            raise
         self.entry_md.content = f"✔ Saved **{escape_markdown(res.tool.name)}** in slot {slot}."
         set_value(self.slots, slot_option(slot, res.tool.name))
         self._show_slot()

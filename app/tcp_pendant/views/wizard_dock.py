@@ -7,8 +7,8 @@ meter (bar and one line), so a trainee jogs, watches and records on one screen; 
 tab stays the place to choose a method and review the result. Outside a wizard the dock is
 hidden and the touch list's "Record point" records into the free list (one Record concept).
 A step the controller runs itself (``AutoRole.by_controller``: the beam wizard's scan) shows no
-Record; its Finish runs the wizard's controller job through ``Session.next_step`` on the
-loop (bounded: a beam scan of at most 5 orientations takes well under a second to compute).
+Record; its Finish runs the wizard's controller job in the server's job pool, off the loop
+(``Session.next_step_in_pool``).
 
 The dock renders from the session's workflow (``Session.workflow``) on the change signal and
 changes it only through the session's commands (``record_step``, ``next_step``, ``back``,
@@ -20,6 +20,7 @@ and the classroom recorder see it too. Every text from a wizard goes through the
 
 from __future__ import annotations
 
+import logging
 import math
 from collections.abc import Callable, Coroutine
 from typing import TYPE_CHECKING, Any
@@ -36,6 +37,8 @@ if TYPE_CHECKING:
     from tcp_pendant.calibrate import CalibrationWorkflow
 
 __all__ = ["BACK", "CANCEL", "CLOSE", "FINISH", "NEXT", "WizardDock"]
+
+log = logging.getLogger(__name__)
 
 BACK, NEXT, FINISH, CANCEL, CLOSE = "◀ Back", "Next ▶", "Finish ▶", "Cancel", "Close"
 
@@ -62,7 +65,7 @@ class WizardDock:
             self.meter_bar = gui.add_progress_bar(0.0, color="gray", visible=False)
             self.meter_md = gui.add_markdown("", visible=False)
         self.record.on_click(self._action(self._on_record))
-        self.nav.on_click(self._action(self._on_nav))
+        self.nav.on_click(self._on_nav_click)
         self.mount.on_click(self._action(lambda _e: self.session.mount_required_tool(), sync=True))
         session.subscribe(self.on_change)
 
@@ -110,6 +113,24 @@ class WizardDock:
         if s.hide_distance and not s.rules.in_exercise:     # free practice by eye: how far it was
             shown = f": {touch_feedback(delta, frame)}"
         self._say(f"✔ Step {index + 1 if index is not None else '?'} recorded{shown}.")
+
+    async def _on_nav_click(self, event: ButtonGroupEvent) -> None:
+        """Back and Cancel as every click; Next / Finish through ``Session.next_step_in_pool``
+        (a controller job runs in the job pool), its errors one notification."""
+        s = self.session
+        if str(event.target.value) not in (NEXT, FINISH):
+            await self._action(self._on_nav)(event)
+            return
+        if s.closed:
+            return
+        self.check.clear()
+        try:
+            await s.next_step_in_pool()
+        except ValueError as exc:          # the wizard's words, or the pool's (JobRefused)
+            s.notify("Not done", str(exc), kind="warning")
+        except Exception as exc:           # a browser's click must never kill the server
+            log.exception("Next / Finish failed")
+            s.notify("Internal error", f"{type(exc).__name__}: {exc}", kind="error")
 
     def _on_nav(self, event: ButtonGroupEvent) -> None:
         s = self.session

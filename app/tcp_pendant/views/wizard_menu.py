@@ -33,10 +33,8 @@ state on that signal (:meth:`CalibrateView.on_change`), as the scene and the Too
 
 from __future__ import annotations
 
-import asyncio
 import logging
 from collections.abc import Callable
-from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
 from tcp_pendant.calibrate import CalibrationWorkflow
@@ -45,6 +43,7 @@ from tcp_pendant.calibrate.text import (
     menu_markdown,
     replay_markdown,
 )
+from tcp_pendant.job_pool import JobRefused
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.gui_util import (
@@ -80,10 +79,6 @@ RECORD_REFUSED = "Session record not loaded"
 """Title of the one notification a refused session record gets."""
 
 log = logging.getLogger(__name__)
-
-_RECORD_WORKER = ThreadPoolExecutor(max_workers=1, thread_name_prefix="session-record")
-"""Parses and replays uploaded records off viser's event loop, one at a time for the whole
-server (each is bounded by the record limits; at most ~0.3 s of CPU on the 2-core machine)."""
 
 
 class CalibrateView:
@@ -313,7 +308,8 @@ class CalibrateView:
 
     async def _on_upload(self, event: Any) -> None:
         """"Load session (JSON)": the size is checked at once, parsing and replay run in
-        ``_RECORD_WORKER`` (off viser's event loop: the other browsers keep jogging), then the
+        the server's job pool (``Session.run_job``, off viser's event loop: the other browsers
+        keep jogging; each record is bounded by the record limits), then the
         wizards are added under the session lock. A refused record gets one notification
         (:data:`RECORD_REFUSED`) saying what is wrong; nothing of the session changes."""
         session = self.session
@@ -335,9 +331,9 @@ class CalibrateView:
         try:
             with session.lock:
                 set_content(self.record_md, f"Loading {escape_markdown(name)} ...")
-            loaded = await asyncio.get_running_loop().run_in_executor(_RECORD_WORKER, load_and_replay,
-                                                                      bytes(content))
-        except SessionRecordError as exc:
+            data = bytes(content)
+            loaded = await session.run_job(lambda: load_and_replay(data), what="a session record's load")
+        except (SessionRecordError, JobRefused) as exc:
             self._refuse_record(name, exc)
             return
         except Exception as exc:  # never let an upload kill the server

@@ -17,34 +17,34 @@ uncertainty tcpcal predicts if the user recorded here.
 
 from __future__ import annotations
 
-import asyncio
 import logging
 import math
-from concurrent.futures import ThreadPoolExecutor
 from typing import TYPE_CHECKING, Any
 
 from tcp_pendant.calibrate import AUTO_SIGMA_MAX_MM, AutoTouchRequest
 from tcp_pendant.calibrate.diversity import diversity_advice
+from tcp_pendant.calibrate.jobs import POSE_CHECKS
 from tcp_pendant.calibrate.text import (
     meter_level,
     meter_markdown,
     step_markdown,
     steps_list_markdown,
 )
+from tcp_pendant.job_pool import JobRefused
+from tcp_pendant.pendant.guidance import tip_offset_mm
+from tcp_pendant.pendant.touch_feedback import touch_feedback
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.gui_util import ButtonEvent, DropdownEvent, set_content, set_value, target_of
 from tcp_pendant.wizards import Wizard, WizardStateError
 
 if TYPE_CHECKING:
+    from tcp_pendant.calibrate.autotouch import AutoTouchOutcome
     from tcp_pendant.calibrate.workflow import ControllerJob
     from tcp_pendant.views.wizard_menu import CalibrateView
 
 __all__ = ["RANDOM", "WizardStepsView"]
 
 RANDOM, CHOSEN = "random", "chosen (tilt, azimuth)"
-_CHECK_WORKER = ThreadPoolExecutor(max_workers=1, thread_name_prefix="wizard-controller-job")
-"""Runs a wizard's controller job off viser's event loop: a TCP check's six rotations (0.1-0.3
-s), a beam scan (3 to 5 orientations, well under a second)."""
 log = logging.getLogger(__name__)
 
 
@@ -64,6 +64,7 @@ class WizardStepsView:
             self.mount = gui.add_button("Mount the tool", color="orange", visible=False,
                                         hint="The tool change this step asks for (the app swaps the tool).")
             self.record = gui.add_button("Record", color="green", hint="Store the current flange pose for this step.")
+            self.record_md = gui.add_markdown("")
             self.next = gui.add_button("Next", color="blue")
             self.back = gui.add_button("Back", color="gray")
             self.add_point = gui.add_button("Add point", visible=False,
@@ -86,7 +87,7 @@ class WizardStepsView:
                 self.auto_md = gui.add_markdown("")
         act = parent.action
         session = parent.session
-        self.record.on_click(act(lambda _e: session.record_step()))
+        self.record.on_click(act(self._on_record))
         self.next.on_click(self._on_next)
         self._checking = False
         self._busy_text = ""
@@ -96,10 +97,29 @@ class WizardStepsView:
         self.mount.on_click(act(lambda _e: session.mount_required_tool(), sync=True))
         self.variant.on_update(act(self._on_variant, user_only=True))
         self.auto_direction.on_update(act(lambda _e: None, user_only=True))
-        self.auto_touch.on_click(act(self._on_auto_touch, sync=True))
+        self.auto_touch.on_click(self._on_auto_touch)
+        self._auto_touching = False
         self._auto_line: tuple[tuple[Any, ...], str, Any] | None = None  # (where it belongs, text, poses)
+        self._record_line: tuple[tuple[Any, ...], str, Any] | None = None  # the same, for Record
 
     # ------------------------------------------------------------ callbacks
+    def _on_record(self, _event: ButtonEvent) -> None:
+        """Record the step. In free practice with the distance hidden the line below says how
+        far the touch really was (``touch_feedback``, the dock's words); never in an exercise."""
+        s = self.parent.session
+        wiz = self.parent.workflow.wizard
+        index = None if wiz is None else wiz.step.index
+        frame = s.jogger.settings.frame
+        delta = tip_offset_mm(s.pose_state(), s.controller.reference_tip_world_m, frame)
+        s.record_step()
+        self._record_line = None
+        if s.hide_distance and not s.rules.in_exercise:
+            wiz = self.parent.workflow.wizard
+            self._record_line = (self._auto_where(),
+                                 f"✔ Step {index + 1 if index is not None else '?'} recorded: "
+                                 f"{touch_feedback(delta, frame)}.",
+                                 None if wiz is None else wiz.recorded_poses)
+
     def _on_cancel(self, _event: ButtonEvent) -> None:
         if self.parent.session.cancel_wizard():
             self.parent.session.notify("Calibration cancelled",
@@ -108,7 +128,9 @@ class WizardStepsView:
     async def _on_next(self, event: ButtonEvent) -> None:
         """Next / Finish. A wizard waiting for its controller job (a TCP check's rotations, a
         beam scan) runs it on Finish: the job is taken on the loop (under the session lock), run
-        in ``_CHECK_WORKER``, its outcome handed to the wizard on the loop; one job at a time."""
+        in the server's job pool (``Session.run_job``: a TCP check's six rotations 0.1-0.3 s, a
+        beam scan of 3 to 5 orientations well under a second), its outcome handed to the wizard
+        on the loop; one job at a time."""
         session, act = self.parent.session, self.parent.action
         jobs: list[ControllerJob] = []
 
@@ -128,10 +150,12 @@ class WizardStepsView:
             return
         title = jobs[0].wizard.title
         try:
-            result = await asyncio.get_running_loop().run_in_executor(_CHECK_WORKER, jobs[0].run)
+            result = await session.run_job(jobs[0].run, what=f"the {title} wizard's controller job")
         except Exception as exc:  # a browser's click must never kill the server
             self._checking = False
-            if isinstance(exc, ValueError):            # the controller's words (ControllerError)
+            if isinstance(exc, JobRefused):            # another job of this session, or a full queue
+                self.parent.session.notify(f"{title}: not started", str(exc), kind="warning")
+            elif isinstance(exc, ValueError):            # the controller's words (ControllerError)
                 self.parent.session.notify(f"{title}: not possible", str(exc), kind="error")
             else:
                 log.exception("%s: controller job failed", title)
@@ -160,9 +184,39 @@ class WizardStepsView:
             return AutoTouchRequest(float(self.auto_tilt.value), float(self.auto_azimuth.value), sigma)
         return AutoTouchRequest(sigma_mm=sigma)
 
-    def _on_auto_touch(self, _event: ButtonEvent) -> None:
-        request = self.auto_request()
-        out = self.parent.session.auto_touch(request)
+    async def _on_auto_touch(self, _event: ButtonEvent) -> None:
+        """Auto-touch (``Session.auto_touch_in_pool``: the probes of a TCP check's poses run in
+        the job pool); one at a time per session, the outcome shown in one signal at the end."""
+        session = self.parent.session
+        if session.closed:
+            return
+        wiz = self.parent.workflow.wizard
+        probes = wiz is not None and type(wiz).controller_job in POSE_CHECKS    # its poses are probed in the pool
+        running = session.jobs.pending(session) if probes else None
+        if self._auto_touching or running is not None:
+            what = "Auto-touch" if self._auto_touching else running
+            session.notify("Auto-touch not started", f"{str(what)[:1].upper()}{str(what)[1:]} is still running "
+                           "here; wait for its result, then try again.", kind="warning")
+            return
+        try:
+            request = self.auto_request()
+        except ValueError as exc:
+            session.notify("Not done", str(exc), kind="warning")
+            return
+        self._auto_touching = True
+        try:
+            await session.auto_touch_in_pool(request, shown=lambda out: self._show_auto_touch(out, request))
+        except ValueError as exc:               # the wizard's or the pool's words (JobRefused)
+            session.notify("Not done", str(exc), kind="warning")
+            return
+        except Exception as exc:                # a browser's click must never kill the server
+            log.exception("Auto-touch failed")
+            session.notify("Internal error", f"{type(exc).__name__}: {exc}", kind="error")
+            return
+        finally:
+            self._auto_touching = False
+
+    def _show_auto_touch(self, out: AutoTouchOutcome, request: AutoTouchRequest) -> None:
         if not out.ok:
             raise ValueError(out.message)
         wiz = self.parent.workflow.wizard
@@ -186,6 +240,10 @@ class WizardStepsView:
         if line is not None and line[0] != self._auto_where():
             self._auto_line = line = None
         set_content(self.auto_md, "" if line is None else line[1])
+        said = self._record_line
+        if said is not None and said[0] != self._auto_where():
+            self._record_line = said = None
+        set_content(self.record_md, "" if said is None else said[1])
 
     # ------------------------------------------------------------ render
     def render(self) -> None:

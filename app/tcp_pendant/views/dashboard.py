@@ -1,0 +1,438 @@
+"""The trainer's dashboard: a browser of its own, full width, no pendant.
+
+A browser that gives the trainer token (the trainer address ``/?trainer=TOKEN``, or the token
+typed in the welcome window) becomes the dashboard (:func:`open_dashboard`): its pendant views
+are taken down (``Session.drop_views``; the GUI and the robot scene cleared), the control panel
+is widened to the whole window (viser's ``main_panel.set_width``; 1024x768 projector), and
+:func:`build_dashboard` lays out its folders, each built by one small function (:data:`FOLDERS`):
+
+- **Class**: "Stuck after (min)" and the live table (``views.dashboard_table``: one line per
+  trainee, stuck rows highlighted), then the calibrations in progress;
+- **Position errors**: one mark per trainee (x: the trainee's ``#``, y: the last position
+  error against the truth, mm; integer ticks only);
+- **Trainee**: choose a trainee, then **Reset wizard** (their running wizard cancelled,
+  ``ClassRoom.reset_wizard``), **Push to this trainee** (exercise, tool, distance aids,
+  Auto-touch: ``ClassRoom.push_to``), **Release name** (``ClassRoom.release``) and **Replay in
+  3D** (their last calibration from the gradebook in this browser's own scene,
+  ``views.dashboard_replay``; the panel narrows to show it until **Close replay**);
+- **Exercise**: the class's settings pushed to every trainee (``views.trainer_view``) and the
+  exercise's brief (``views.trainer_exercise``);
+- **Message to trainees**: to all or one trainee (``views.trainer_messages``);
+- **Gradebook**: the finished calibrations, the CSV download, grading an uploaded record;
+- **Tool library (trainer)**: the shared library with the trainer's rights (``views.tool_panel``).
+
+The data: the gradebook (``ClassRoom.board``) plus who is connected (``ClassRoom.connected_names``);
+the class room re-renders every dashboard, throttled (``ClassRoom.refresh_trainers``). Every
+text a trainee typed is escaped (``escape_html`` in the tables, ``escape_markdown`` in
+markdown); every callback runs through ``Session.on_loop``.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Callable, Collection, Sequence
+from datetime import datetime, timezone
+from typing import Any, Protocol
+
+import numpy as np
+
+from tcp_pendant.classroom.board import DEFAULT_STUCK_MIN, DashboardRow, dashboard_rows, open_runs
+from tcp_pendant.classroom.gradebook import ClassBoard
+from tcp_pendant.classroom.grading import grade_record
+from tcp_pendant.classroom.replay import CalibrationReplay
+from tcp_pendant.job_pool import JobRefused
+from tcp_pendant.session import Session
+from tcp_pendant.text_escape import escape_markdown
+from tcp_pendant.views.dashboard_replay import ReplayScene
+from tcp_pendant.views.dashboard_table import in_progress_html, trainees_html
+from tcp_pendant.views.gui_util import ButtonEvent, UploadEvent, set_content, set_options, target_of
+from tcp_pendant.views.tool_panel import ToolPanel
+from tcp_pendant.views.trainer_exercise import build_exercise_controls
+from tcp_pendant.views.trainer_messages import build_message_controls
+from tcp_pendant.views.trainer_view import (
+    AUTO_TOUCH, EXERCISES, HIDE_DISTANCE, ClassControl, grades_markdown, record_grades_markdown,
+    rules_words,
+)
+from tcp_pendant.views.upload_guard import limit_upload_size
+from tcp_pendant.wizards.session_record import MAX_RECORD_BYTES, SessionRecordError, check_record_size, load_and_replay
+
+log = logging.getLogger(__name__)
+
+__all__ = ["FOLDERS", "DashboardControl", "FULL_WIDTH_PX", "NO_TRAINEE", "ONE_EXERCISE", "REPLAY_PANEL_PX",
+           "TrainerDashboard", "build_dashboard", "chart_points", "message_folder", "open_dashboard"]
+
+FULL_WIDTH_PX = 4000
+"""The panel's width asked for: wider than any projector, the browser keeps it to its window."""
+REPLAY_PANEL_PX = 560
+"""The panel's width while a replay is on show (the 3D scene beside it)."""
+NO_TRAINEE = "(choose a trainee) "
+"""The first choice of "Trainee" (acts on nobody; the trailing space keeps it apart from names)."""
+ONE_EXERCISE: dict[str, str | None | bool] = {"(keep)": False, "Free practice": None, "Mystery tool": "mystery"}
+"""'Exercise' choices for one trainee (False: keep)."""
+
+
+class DashboardControl(ClassControl, Protocol):
+    """What the dashboard needs of the class room, beyond the class-wide controls."""
+
+    def board(self) -> ClassBoard: ...
+
+    def replay(self, name: str) -> CalibrationReplay | None: ...
+
+    def reset_wizard(self, name: str) -> str: ...
+
+    def push_to(self, name: str, exercise: str | None | bool = False, tool_key: str | None = None,
+                hide_distance: str | None = None, auto_touch: bool | None = None) -> str: ...
+
+
+def chart_points(rows: Sequence[DashboardRow]) -> tuple[np.ndarray, np.ndarray]:
+    """(x, y) of the position-error chart: the ``#`` and the last position error (mm) of each
+    trainee who has one, in table order."""
+    marked = [(float(r.number), float(r.position_error_mm)) for r in rows if r.position_error_mm is not None]
+    if not marked:
+        return np.zeros(0), np.zeros(0)
+    x, y = zip(*marked)
+    return np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+
+
+class TrainerDashboard:
+    """The dashboard of one trainer browser (module docstring).
+
+    Attributes:
+        rows: the live table's rows as last rendered (``classroom.board.DashboardRow``).
+        stuck_min, table_html, runs_html, chart, trainee, reset, replay_button, close_replay,
+        one_exercise, one_tool, one_hide_distance, one_auto_touch, push_one, release, action_md,
+        exercise, tool, hide_distance, auto_touch, push, push_md, grades_md, download,
+        grade_upload, grade_md: the widgets (for tests); replay_scene: the 3D replay;
+        folders: the folders by title ("Class", "Exercise", ...), for the builders of other modules.
+    """
+
+    # the widgets, set by the folder builders (viser handles)
+    tool_panel: Any
+    rules_md: Any
+    stuck_min: Any
+    table_html: Any
+    runs_html: Any
+    chart: Any
+    trainee: Any
+    reset: Any
+    replay_button: Any
+    close_replay: Any
+    one_exercise: Any
+    one_tool: Any
+    one_hide_distance: Any
+    one_auto_touch: Any
+    push_one: Any
+    release: Any
+    action_md: Any
+    exercise: Any
+    tool: Any
+    hide_distance: Any
+    auto_touch: Any
+    push: Any
+    push_md: Any
+    grades_md: Any
+    download: Any
+    grade_upload: Any
+    grade_md: Any
+
+    def __init__(self, session: Session, control: DashboardControl) -> None:
+        self.session = session
+        self.control = control
+        self.gui = target_of(session).gui
+        self.rows: list[DashboardRow] = []
+        self.folders: dict[str, Any] = {}
+        self.class_extras: list[Any] = []
+        """The brief's and the message box's controls (``views.trainer_exercise`` /
+        ``trainer_messages``), re-rendered with the dashboard."""
+        self._grading = False
+        self._results_shown: tuple[Any, ...] | None = None
+        client = session.client
+        self.replay_scene = ReplayScene(target_of(session).scene, None if client is None else client.camera)
+
+    def folder(self, title: str, **kw: Any) -> Any:
+        """A folder of the dashboard, kept in :attr:`folders`."""
+        f = self.gui.add_folder(title, **kw)
+        self.folders[title] = f
+        return f
+
+    # ------------------------------------------------------------ rendering
+    def stuck_after_s(self) -> float:
+        try:
+            return float(self.stuck_min.value) * 60.0
+        except (TypeError, ValueError):
+            return DEFAULT_STUCK_MIN * 60.0
+
+    def render(self, board: ClassBoard | None = None, connected: Collection[str] | None = None) -> None:
+        """Show the class (``board`` and ``connected``: read now when not given)."""
+        board = self.control.board() if board is None else board
+        connected = set(self.control.connected_names()) if connected is None else connected
+        now = datetime.now(timezone.utc)
+        self.rows = dashboard_rows(board, connected, now, self.stuck_after_s())
+        set_content(self.table_html, trainees_html(self.rows))
+        set_content(self.runs_html, in_progress_html(open_runs(board, connected, now)))
+        self._render_chart()
+        set_options(self.trainee, (NO_TRAINEE, *dict.fromkeys(r.name for r in self.rows)))   # option text, not markdown
+        results = tuple((t.result_calibration_id, t.position_error_mm, t.grade) for t in board.trainees)
+        if results != self._results_shown:       # the gradebook table (all rows: the costly read) on a new result only
+            self._results_shown = results
+            set_content(self.grades_md, grades_markdown(self.control.grade_rows()))
+        set_content(self.rules_md, escape_markdown(rules_words(self.control.rules)))
+        for extra in self.class_extras:
+            extra.render()
+
+    def _render_chart(self) -> None:
+        x, y = chart_points(self.rows)
+        n = max(1, len(self.rows))
+        top = float(max(1.0, 1.15 * float(y.max()))) * 1.08 if y.size else 1.08    # the top tick inside
+        data = (x, y)
+        if not all(np.array_equal(a, b) for a, b in zip(self.chart.data, data)) or len(self.chart.data) != 2:
+            self.chart.data = data
+        scales = {"x": {"time": False, "range": (0.5, n + 0.5)}, "y": {"range": (0.0, round(top, 2))}}
+        if self.chart.scales != scales:
+            self.chart.scales = scales
+
+    # ------------------------------------------------------------ actions
+    def chosen(self) -> str | None:
+        name = str(self.trainee.value)
+        return None if name == NO_TRAINEE or name not in {r.name for r in self.rows} else name
+
+    def _say(self, text: str) -> None:
+        set_content(self.action_md, escape_markdown(text))
+
+    def _need_trainee(self) -> str | None:
+        name = self.chosen()
+        if name is None:
+            self._say("Choose a trainee first.")
+        return name
+
+    def _reset(self, _event: ButtonEvent | None = None) -> None:
+        name = self._need_trainee()
+        if name is not None:
+            self._say(self.control.reset_wizard(name))
+
+    def _push_one(self, _event: ButtonEvent | None = None) -> None:
+        name = self._need_trainee()
+        if name is None:
+            return
+        ex_label, aids_label, auto_label = (str(self.one_exercise.value), str(self.one_hide_distance.value),
+                                            str(self.one_auto_touch.value))
+        if ex_label not in ONE_EXERCISE or aids_label not in HIDE_DISTANCE or auto_label not in AUTO_TOUCH:
+            raise ValueError("Choose the exercise, Hide distance and Auto-touch from their lists.")
+        tool = None if self.one_tool.value == "(keep)" else str(self.one_tool.value)
+        if tool is not None and tool not in self.control.tool_keys:
+            raise ValueError(f"Unknown tool {tool!r}; choose one of {', '.join(self.control.tool_keys)}.")
+        self._say(self.control.push_to(name, ONE_EXERCISE[ex_label], tool, HIDE_DISTANCE[aids_label],
+                                       AUTO_TOUCH[auto_label]))
+
+    def _release(self, _event: ButtonEvent | None = None) -> None:
+        name = self._need_trainee()
+        if name is not None:
+            self._say(self.control.release(name))
+            self.render()
+
+    def _replay(self, _event: ButtonEvent | None = None) -> None:
+        name = self._need_trainee()
+        if name is None:
+            return
+        replay = self.control.replay(name)
+        if replay is None:
+            self._say(f"{name} has no calibration with a touch yet.")
+            return
+        self.replay_scene.show(replay)
+        self.gui.main_panel.set_width(REPLAY_PANEL_PX)
+        self.close_replay.visible = True
+        err = "" if replay.position_error_mm is None else f", error {replay.position_error_mm:.2f} mm"
+        grade = "" if replay.grade is None else f", {replay.grade}"
+        self._say(f"Replay of {name}'s calibration {replay.calibration_id} ({replay.method}, "
+                  f"{replay.status.replace('_', ' ')}): {len(replay.touches)} touches{err}{grade}. "
+                  "Triads: the flange at each touch; lines: the tool to its tip (blue by hand, orange "
+                  "Auto-touch); frames: result and true TOOL frame.")
+
+    def _close_replay(self, _event: ButtonEvent | None = None) -> None:
+        self.replay_scene.clear()
+        self.gui.main_panel.set_width(FULL_WIDTH_PX)
+        self.close_replay.visible = False
+
+    def _push_all(self, _event: ButtonEvent | None = None) -> None:
+        exercise = EXERCISES.get(str(self.exercise.value))
+        tool = None if self.tool.value == "(keep)" else str(self.tool.value)
+        if tool is not None and tool not in self.control.tool_keys:
+            raise ValueError(f"Unknown tool {tool!r}; choose one of {', '.join(self.control.tool_keys)}.")
+        label, auto = str(self.hide_distance.value), str(self.auto_touch.value)
+        if label not in HIDE_DISTANCE:
+            raise ValueError(f"Unknown Hide distance choice {label!r}; choose one of {', '.join(HIDE_DISTANCE)}.")
+        if auto not in AUTO_TOUCH:
+            raise ValueError(f"Unknown Auto-touch choice {auto!r}; choose one of {', '.join(AUTO_TOUCH)}.")
+        n = self.control.push_settings(exercise, tool, HIDE_DISTANCE[label], AUTO_TOUCH[auto])
+        self.push_md.content = f"Pushed to {n} trainee{'s' if n != 1 else ''}. {rules_words(self.control.rules)}"
+        self.render()
+
+    def _download(self, _event: ButtonEvent | None = None) -> None:
+        client = self.session.client
+        if client is not None:
+            client.send_file_download("grades.csv", self.control.grades_csv().encode("utf-8"))
+
+    def _refused(self, filename: str, size_bytes: int) -> None:
+        self.session.notify("Record not graded", f"{filename or 'The file'}: {size_bytes} bytes is more than "
+                            f"{MAX_RECORD_BYTES} bytes; a session record is far smaller.", kind="warning")
+
+    async def _on_grade_upload(self, event: UploadEvent) -> None:
+        """The record's bytes are parsed, replayed and graded in the server's job pool (off the loop)."""
+        if self.session.closed or getattr(event, "client", None) is None or self._grading:
+            return
+        upload = event.target.value
+        name = str(upload.name or "record")
+        self._grading = True
+        try:
+            check_record_size(len(upload.content))
+            data, book = bytes(upload.content), self.control.gradebook
+            grades = await self.session.run_job(lambda: grade_record(load_and_replay(data), book),
+                                                what="a record's grading")
+        except (SessionRecordError, JobRefused) as exc:
+            self.session.notify("Record not graded", f"{name}: {exc}", kind="warning")
+            return
+        except Exception as exc:  # never let an upload kill the server
+            log.exception("grading the record %r failed", name)
+            self.session.notify("Internal error", f"{type(exc).__name__}: {exc}", kind="error")
+            return
+        finally:
+            self._grading = False
+        self.session.guard(lambda: setattr(self.grade_md, "content", record_grades_markdown(name, grades)))()
+
+
+# ---------------------------------------------------------------- the folders
+def class_folder(dash: TrainerDashboard) -> None:
+    """The stuck threshold, the live table and the calibrations in progress."""
+    gui = dash.gui
+    with dash.folder("Class"):
+        dash.stuck_min = gui.add_number("Stuck after (min)", DEFAULT_STUCK_MIN, min=0.5, max=240.0, step=0.5,
+                                        hint="A trainee with no touch and no new step for this long in a "
+                                             "calibration is highlighted.")
+        dash.table_html = gui.add_html("")
+        gui.add_markdown("**Calibrations in progress**")
+        dash.runs_html = gui.add_html("")
+    dash.stuck_min.on_update(dash.session.on_loop(lambda _e=None: dash.render()))
+
+
+def chart_folder(dash: TrainerDashboard) -> None:
+    """The class's position errors, one mark per trainee."""
+    gui = dash.gui
+    with dash.folder("Position errors"):
+        dash.chart = gui.add_uplot(
+            (np.zeros(0), np.zeros(0)),
+            ({"label": "trainee #"},
+             {"label": "position error (mm)", "stroke": "#3b6fd6", "width": 0,
+              "points": {"show": True, "size": 12, "fill": "#3b6fd6", "stroke": "#1b3f96", "width": 2}}),
+            title="Last position error per trainee (mm)", height=200,
+            scales={"x": {"time": False, "range": (0.5, 1.5)}, "y": {"range": (0.0, 1.0)}},
+            axes=({"label": "trainee #", "incrs": (1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0)}, {"label": "mm"}))
+
+
+def trainee_folder(dash: TrainerDashboard) -> None:
+    """Choose a trainee; reset, push to, release, replay."""
+    gui, on_loop = dash.gui, dash.session.on_loop
+    with dash.folder("Trainee"):
+        dash.trainee = gui.add_dropdown("Trainee", (NO_TRAINEE,), initial_value=NO_TRAINEE)
+        dash.reset = gui.add_button("Reset wizard", color="red",
+                                    hint="Close this trainee's running wizard (kept: they can resume it).")
+        dash.replay_button = gui.add_button("Replay in 3D",
+                                            hint="Draw this trainee's last calibration from the gradebook.")
+        dash.close_replay = gui.add_button("Close replay", visible=False)
+        dash.one_exercise = gui.add_dropdown("Exercise for this trainee", tuple(ONE_EXERCISE), initial_value="(keep)")
+        tools = ("(keep)", *dash.control.tool_keys)
+        dash.one_tool = gui.add_dropdown("Tool for this trainee", tools, initial_value=tools[0])
+        dash.one_hide_distance = gui.add_dropdown("Hide distance for this trainee", tuple(HIDE_DISTANCE),
+                                                  initial_value="(keep)")
+        dash.one_auto_touch = gui.add_dropdown("Auto-touch for this trainee", tuple(AUTO_TOUCH), initial_value="(keep)")
+        dash.push_one = gui.add_button("Push to this trainee", color="blue")
+        dash.release = gui.add_button("Release name",
+                                      hint="A name stays with the browser it joined from. Release it so that the "
+                                           "trainee can join from another browser, or to send a browser that took "
+                                           "it back to the welcome window.")
+        dash.action_md = gui.add_markdown("")
+    dash.reset.on_click(on_loop(dash._reset))
+    dash.replay_button.on_click(on_loop(dash._replay))
+    dash.close_replay.on_click(on_loop(dash._close_replay))
+    dash.push_one.on_click(on_loop(dash._push_one))
+    dash.release.on_click(on_loop(dash._release))
+
+
+def exercise_folder(dash: TrainerDashboard) -> None:
+    """The class's settings, pushed to every trainee."""
+    gui, control = dash.gui, dash.control
+    with dash.folder("Exercise"):
+        current = next((label for label, ex in EXERCISES.items() if ex == control.exercise), "Free practice")
+        dash.exercise = gui.add_dropdown("Exercise", tuple(EXERCISES), initial_value=current)
+        tools = ("(keep)", *control.tool_keys)
+        dash.tool = gui.add_dropdown("Tool for all", tools, initial_value=tools[0])
+        dash.hide_distance = gui.add_dropdown(
+            "Hide distance for all", tuple(HIDE_DISTANCE), initial_value="(keep)",
+            hint="on: trainees judge the touch by eye (no distance, no Δ line, no close-up, no stop "
+                 "at the tip); locked: they cannot show it (the default in an exercise); off: shown.")
+        dash.auto_touch = gui.add_dropdown(
+            "Auto-touch for all", tuple(AUTO_TOUCH), initial_value="(keep)",
+            hint="allowed: trainees may let the robot touch for them (off by default in an exercise).")
+        dash.push = gui.add_button("Push to all trainees", color="blue")
+        dash.push_md = gui.add_markdown("")
+        dash.class_extras.append(build_exercise_controls(gui, control, dash.session))   # "Exercise brief"
+    dash.push.on_click(dash.session.on_loop(dash._push_all))
+
+
+def message_folder(dash: TrainerDashboard) -> None:
+    """The messages to all or one trainee (``views.trainer_messages``: its own folder)."""
+    dash.class_extras.append(build_message_controls(dash.gui, dash.control, dash.session))
+
+
+def gradebook_folder(dash: TrainerDashboard) -> None:
+    """The finished calibrations, the CSV, grading an uploaded record."""
+    gui = dash.gui
+    with dash.folder("Gradebook"):
+        dash.grades_md = gui.add_markdown("")
+        dash.download = gui.add_button("Download grades (CSV)")
+        dash.grade_upload = gui.add_upload_button(
+            "Grade a trainee's record (JSON)", mime_type="application/json",
+            hint="A trainee's exported session: each calibration is replayed and graded against "
+                 "the truth this gradebook keeps (by its record id).")
+        dash.grade_md = gui.add_markdown("")
+    dash.download.on_click(dash.session.on_loop(dash._download))
+    dash.grade_upload.on_upload(dash._on_grade_upload)
+    limit_upload_size(dash.grade_upload, MAX_RECORD_BYTES, dash._refused)
+
+
+def tool_library_folder(dash: TrainerDashboard) -> None:
+    """The shared tool library as the pendant's Tool tab shows it (``views.tool_panel``), with the
+    trainer's rights: rename and delete any trainee's slot (``session.views["tools"]``)."""
+    with dash.folder("Tool library (trainer)", expand_by_default=False):
+        dash.tool_panel = ToolPanel(dash.session)
+    dash.session.views["tools"] = dash.tool_panel
+
+
+FOLDERS: list[Callable[[TrainerDashboard], None]] = [class_folder, chart_folder, trainee_folder, exercise_folder,
+                                                     message_folder, gradebook_folder, tool_library_folder]
+"""The dashboard's folders, top to bottom, each built by one function."""
+
+
+def build_dashboard(session: Session, control: DashboardControl) -> TrainerDashboard:
+    """Lay the dashboard out in ``session``'s GUI (:data:`FOLDERS`) and show the class."""
+    dash = TrainerDashboard(session, control)
+    gui = dash.gui
+    with session.lock, target_of(session).atomic():
+        gui.add_markdown("### Trainer dashboard")
+        dash.rules_md = gui.add_markdown("")
+        for build in FOLDERS:
+            build(dash)
+        dash.render()
+    return dash
+
+
+def open_dashboard(session: Session, control: DashboardControl) -> TrainerDashboard:
+    """Turn ``session``'s browser into the trainer's dashboard: its pendant taken down (views,
+    GUI, robot scene), the panel over the whole window, then :func:`build_dashboard`."""
+    target = target_of(session)
+    with session.lock, target.atomic():
+        session.drop_views()
+        target.gui.reset()
+        target.scene.reset()
+        target.gui.set_panel_label("TCP Pendant · trainer")
+        target.gui.main_panel.set_width(FULL_WIDTH_PX)
+    return build_dashboard(session, control)

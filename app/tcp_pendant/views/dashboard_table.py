@@ -1,0 +1,101 @@
+"""The trainer dashboard's tables as HTML (``gui.add_html``), made for a 1024x768 projector.
+
+One line per trainee: short headers, no wrapping (``white-space: nowrap``), a long name or
+method cut with an ellipsis (the whole text in the cell's tooltip), 15 px text. A stuck row
+(``classroom.board``) has a yellow background and a "⚠" before the name; a trainee not
+connected is grey. Every text a trainee typed (names) and every stored text (methods, steps)
+goes through ``escape_html``: shown literally, never run. Numbers are ours.
+
+Columns of :func:`trainees_html`: ``#`` (the trainee's mark on the chart), Trainee, On (●
+connected, ○ not), Method, Step ("2/4", "result", "cancelled"), On step (time on it, m:ss),
+Last touch (time since it), Touches, Crashes (of the latest calibration), Err mm (position
+error of the last finished calibration against the truth; its TCP in the tooltip), Grade.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Sequence
+
+from tcp_pendant.classroom.board import DashboardRow, OpenRun, format_duration
+from tcp_pendant.text_escape import escape_html
+
+__all__ = ["FONT_PX", "STUCK_BACKGROUND", "in_progress_html", "short_step", "trainees_html"]
+
+FONT_PX = 15
+"""Table text size, pixels (readable from the back of a room on a 1024x768 projector)."""
+STUCK_BACKGROUND = "#ffe08a"
+"""Background of a stuck trainee's row."""
+_CELL = "padding:2px 6px;white-space:nowrap;border-bottom:1px solid #ddd"
+_CUT = "display:inline-block;overflow:hidden;text-overflow:ellipsis;vertical-align:bottom;max-width:{em}em"
+_STEP = re.compile(r"^Step (\d+) of (\d+)$")
+_ON = '<span style="color:#1f9d3a">●</span>'
+_OFF = "○"
+
+
+def short_step(step: str) -> str:
+    """"Step 2 of 4" -> "2/4"; anything else as it is."""
+    m = _STEP.match(step)
+    return f"{m.group(1)}/{m.group(2)}" if m else step
+
+
+def _cut(text: str, em: int) -> str:
+    safe = escape_html(text)
+    return f'<span title="{safe}" style="{_CUT.format(em=em)}">{safe}</span>'
+
+
+def _table(headers: Sequence[tuple[str, str]], body: list[str], cls: str) -> str:
+    head = "".join(f'<th title="{escape_html(tip)}" style="{_CELL};text-align:left;border-bottom:2px solid #888">'
+                   f"{escape_html(h)}</th>" for h, tip in headers)
+    return (f'<div class="{cls}" style="font-size:{FONT_PX}px;line-height:1.35;overflow-x:auto">'
+            f'<table style="border-collapse:collapse;width:100%"><thead><tr>{head}</tr></thead>'
+            f"<tbody>{''.join(body)}</tbody></table></div>")
+
+
+TRAINEE_HEADERS: tuple[tuple[str, str], ...] = (
+    ("#", "the trainee's mark on the chart"), ("Trainee", "name"), ("On", "connected now"),
+    ("Method", "the latest calibration"), ("Step", "where it is"), ("On step", "time on the step (m:ss)"),
+    ("Last touch", "time since the last touch (m:ss)"), ("Touches", "touches recorded in the latest calibration"),
+    ("Crashes", "crashes in the latest calibration"),
+    ("Err mm", "position error of the last finished calibration against the true TOOL frame"),
+    ("Grade", "of the last finished calibration"))
+
+
+def trainees_html(rows: Sequence[DashboardRow]) -> str:
+    """The live table (module docstring); every text escaped."""
+    if not rows:
+        return f'<div style="font-size:{FONT_PX}px"><i>No trainee has given a name yet.</i></div>'
+    body = []
+    for r in rows:
+        style = f"background:{STUCK_BACKGROUND};font-weight:600" if r.stuck else ("color:#888" if not r.connected else "")
+        err = "-" if r.position_error_mm is None else f"{r.position_error_mm:.2f}"
+        if r.tcp_mm is not None:                     # the result itself in the cell's tooltip
+            tcp = ", ".join(f"{v:.1f}" for v in r.tcp_mm)
+            err = f'<span title="TCP {escape_html(tcp)} mm">{err}</span>'
+        name = ("⚠ " if r.stuck else "") + r.name
+        cells = (escape_html(str(r.number)), _cut(name, 11), _ON if r.connected else _OFF, _cut(r.method or "-", 10),
+                 escape_html(short_step(r.step) or "-"), format_duration(r.step_s if r.in_progress else None),
+                 format_duration(r.touch_s), str(r.touches), str(r.crashes), err, escape_html(r.grade or "-"))
+        tds = "".join(f'<td style="{_CELL}">{c}</td>' for c in cells)
+        body.append(f'<tr class="{"stuck" if r.stuck else "trainee"}" style="{style}">{tds}</tr>')
+    return _table(TRAINEE_HEADERS, body, "tcp-dashboard-trainees")
+
+
+RUN_HEADERS: tuple[tuple[str, str], ...] = (
+    ("Cal.", "calibration id in the gradebook"), ("Trainee", "name"), ("On", "connected now"),
+    ("Method", "wizard"), ("Step", "where it is"), ("On step", "time on the step (m:ss)"),
+    ("Started", "time since it started (m:ss)"), ("Touches", "touches that count"))
+
+
+def in_progress_html(runs: Sequence[OpenRun]) -> str:
+    """The calibrations in progress (oldest first); every text escaped."""
+    if not runs:
+        return f'<div style="font-size:{FONT_PX}px"><i>No calibration in progress.</i></div>'
+    body = []
+    for r in runs:
+        cells = (str(r.calibration_id), _cut(r.trainee, 11), _ON if r.connected else _OFF, _cut(r.method or "-", 10),
+                 escape_html(short_step(r.step) or "-"), format_duration(r.step_s), format_duration(r.started_s),
+                 str(r.touches))
+        style = "" if r.connected else "color:#888"
+        body.append(f'<tr style="{style}">' + "".join(f'<td style="{_CELL}">{c}</td>' for c in cells) + "</tr>")
+    return _table(RUN_HEADERS, body, "tcp-dashboard-runs")

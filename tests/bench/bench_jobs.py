@@ -1,0 +1,78 @@
+"""The victim's TCP check and jogs while 20 sessions keep the server's job pool busy.
+
+The rig of ``tests/security/test_job_pool.py`` (``tests/security/job_attack.py``): a pendant
+server in this process, the victim's browser over a real websocket, 20 attacker sessions on the
+same server each running the Tool tab's TCP check job again the moment its result is back. The
+victim runs its check alone, then under the attack (each check after ~0.6 s of jogging), and
+the figures printed are its check latency alone and under attack (p50 / p95 / max), their
+ratio (p50), the jog latency between its checks, and how many other sessions' jobs started
+while its check waited (the pool's rule: none).
+
+Each run is done twice in the same process, with the server's pool (:class:`JobPool`: a
+rested session first) and with the same pool serving first come, first served
+(``rest_s=0``: every session counts as rested), the order the single-thread executor per job
+kind gave before the pool; both are measured here, so the ratio compares like with like.
+
+With ``--attack beam`` the attackers run the TCP service's beam check instead (a job several
+times longer than the victim's check): the victim then waits for the running scan, so its
+factor is about (scan + check) / check, the bound of a pool that does not interrupt a job.
+
+Run: ``PYTHONPATH=src:app .venv/bin/python tests/bench/bench_jobs.py [--checks N] [--workers W]
+[--attack check|beam]`` (about 30-90 s).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE.parent / "security"))
+from job_attack import Classroom, Measured  # noqa: E402
+
+from tcp_pendant.job_pool import JobPool, default_workers  # noqa: E402
+
+
+def run(policy: str, checks: int, workers: int | None, attackers: int, attack: str) -> Measured:
+    """One rig with a pool of ``policy`` ("fair": the server's; "fifo": first come, first served)."""
+    pool = JobPool(workers, keep_history=True) if policy == "fair" else JobPool(workers, rest_s=0.0, keep_history=True)
+    with tempfile.TemporaryDirectory() as tmp:
+        rig = Classroom(Path(tmp), pool, attackers=attackers, attack=attack)
+        try:
+            return rig.measure(n_alone=checks, n_under=checks)
+        finally:
+            rig.close()
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--checks", type=int, default=10, help="victim checks alone and under attack (default 10)")
+    ap.add_argument("--workers", type=int, default=None, help=f"pool workers (default {default_workers()})")
+    ap.add_argument("--attackers", type=int, default=20)
+    ap.add_argument("--attack", choices=("check", "beam"), default="check",
+                    help="the attackers' job: the TCP check (default) or the beam check (longer)")
+    args = ap.parse_args(argv)
+    print(f"{args.attackers} attacker sessions resubmitting {'TCP' if args.attack == 'check' else 'beam'} checks; "
+          f"the victim runs its TCP check {args.checks} times alone, then under attack\n")
+    results = {}
+    for policy in ("fair", "fifo"):
+        m = results[policy] = run(policy, args.checks, args.workers, args.attackers, args.attack)
+        ahead = [len(a) for a in m.ahead]
+        busy = [len([h for h in a if h.busy]) for a in m.ahead]
+        print(f"[{policy}] {m.summary()}")
+        print(f"[{policy}] other sessions' jobs started while the victim's check waited: max {max(ahead)}, "
+              f"mean {np.mean(ahead):.1f} (of busy sessions: max {max(busy)})\n")
+    fair, fifo = results["fair"], results["fifo"]
+    print(f"victim's check latency under attack / alone (p50): pool {fair.factor:.2f}x, "
+          f"first come first served {fifo.factor:.2f}x; max under attack {max(fair.under) * 1e3:.0f} ms vs "
+          f"{max(fifo.under) * 1e3:.0f} ms; victim jog p95 {np.percentile(fair.jogs, 95) * 1e3:.0f} ms vs "
+          f"{np.percentile(fifo.jogs, 95) * 1e3:.0f} ms")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,189 @@
+"""What a hostile trainee's own websocket gets in a mystery exercise carries no number of the
+true TCP: a raw viser client joins a ``--class --exercise mystery`` server (the class's secret
+seed, none given), does what costs a trainee nothing (jogs, the camera buttons, a zero tool typed
+in and activated, its spin test far from and at the reference tip, a calibration's Record by
+hand, the locked "Hide distance"; switching tabs sends nothing, viser's tabs live in the browser
+and every tab's content is sent anyway), keeps every message the server sends it, and decodes
+all of it: every number of every message in order, every float array (mesh vertices, points,
+poses), every raw byte string read as float32 and float64 (at every alignment), and every
+number written in a text (markdown, labels, notifications). No three consecutive numbers may lie within 0.05 mm of the true TCP read from
+the gradebook: in FLANGE (metres and mm, the frame the tool's meshes come in), in WORLD and BASE
+at each flange pose the robot took (metres and mm), or as an offset from a zero tool (the
+numbers minus the flange position, turned into flange axes; metres and mm).
+
+The clicks reach the session as a browser's do (``guiclick``, with this client's handle); what
+is read is only what went over this client's websocket."""
+
+from __future__ import annotations
+
+import re
+import sys
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+_APP_TESTS = Path(__file__).parents[1] / "app"
+sys.path.insert(0, str(_APP_TESTS))
+sys.path.insert(0, str(_APP_TESTS.parent / "calibrate"))
+from app_page import running_pendants  # noqa: E402
+from guiclick import choose, click  # noqa: E402
+from wsclient import RecordingClient, wait_until  # noqa: E402
+
+TOKEN = "trainer-token-leak-test-01"
+NEAR_M = 5e-5                     # 0.05 mm
+NUMBER = re.compile(r"[-−]?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?")
+
+
+def _sequences(obj: Any) -> tuple[list[np.ndarray], list[str]]:
+    """Every run of numbers in a decoded message (its scalars in order; each float array; each
+    byte string as float32 and float64) and every string in it."""
+    scalars: list[float] = []
+    runs: list[np.ndarray] = []
+    texts: list[str] = []
+
+    def walk(o: Any) -> None:
+        if isinstance(o, dict):
+            for v in o.values():
+                walk(v)
+        elif isinstance(o, (list, tuple)):
+            for v in o:
+                walk(v)
+        elif isinstance(o, np.ndarray):
+            if o.dtype.kind == "f":
+                with np.errstate(all="ignore"):
+                    runs.append(o.astype(float).ravel())
+            elif o.dtype == np.uint8:
+                walk(o.tobytes())
+        elif isinstance(o, (bytes, bytearray, memoryview)):
+            raw = bytes(o)
+            for dt in (np.dtype(np.float32), np.dtype(np.float64)):
+                for start in range(dt.itemsize):                    # at any alignment
+                    n = (len(raw) - start) // dt.itemsize
+                    if n >= 3:
+                        with np.errstate(all="ignore"):
+                            runs.append(np.frombuffer(raw, dtype=dt, count=n, offset=start).astype(float))
+        elif isinstance(o, bool):
+            return
+        elif isinstance(o, (int, float)):
+            scalars.append(float(o))
+        elif isinstance(o, str):
+            texts.append(o)
+
+    walk(obj)
+    runs.append(np.array(scalars))
+    for t in texts:
+        runs.append(np.array([float(x.replace("−", "-")) for x in NUMBER.findall(t)]))
+    return runs, texts
+
+
+def _triples(run: np.ndarray) -> np.ndarray:
+    """Every three consecutive numbers of a run (bytes read as floats give NaN, inf and huge
+    values: a number beyond 1e6 is no coordinate of a cell a few metres wide, in m or mm)."""
+    run = run[np.isfinite(run) & (np.abs(run) < 1e6)] if run.size else run
+    if run.size < 3:
+        return np.zeros((0, 3))
+    return np.lib.stride_tricks.sliding_window_view(run, 3)
+
+
+def _near(triples: np.ndarray, owner: np.ndarray, targets: list[tuple[str, np.ndarray, float]]
+          ) -> list[tuple[str, int]]:
+    """(what, message index) of each target some triple lies within the tolerance of (each
+    target: name, point, tolerance)."""
+    tree = cKDTree(triples)
+    hits = []
+    for name, point, tol in targets:
+        for j in tree.query_ball_point(point, tol)[:3]:
+            hits.append((f"{name}: {triples[j].tolist()} vs {point.tolist()}", int(owner[j])))
+    return hits
+
+
+def test_a_hostile_trainee_reads_no_number_of_the_true_tcp(tmp_path: Path) -> None:
+    with running_pendants(tmp_path) as start:
+        app = start(class_db=tmp_path / "class.sqlite3", trainer_token=TOKEN, exercise="mystery")
+        assert app.config.exercise_seed is None                       # the class's secret seed
+        c = RecordingClient(app.port)
+        try:
+            wait_until(lambda: len(app.sessions) == 1 and all("identity" in s.views for s in app.sessions.values()),
+                       what="the name prompt")
+            s = next(iter(app.sessions.values()))
+            prompt = s.views["identity"]
+            choose(prompt.name_field, "Mallory", s.client)
+            click(prompt.start, s.client)
+            assert prompt.name == "Mallory"
+            assert s.controller.mounted_tool.key.startswith("mystery-") and s.hide_distance
+
+            poses: list[tuple[np.ndarray, np.ndarray]] = []            # (T_world_flange, T_world_base)
+
+            def note_pose() -> None:
+                with s.lock:
+                    poses.append((s.controller.T_world_flange(), s.controller.T_world_base))
+
+            note_pose()
+            pendant, tools, cal = s.views["pendant"], s.views["tools"], s.views["calibrate"]
+            for ax, sign in (("X", "+"), ("Z", "−"), ("Y", "+"), ("A", "+")):   # jog a little
+                choose(pendant.cart_rows[ax], f"{ax} {sign}", s.client)
+                note_pose()
+            click(pendant.closeup, s.client)
+            click(pendant.overview_btn, s.client)
+            choose(tools.entry_name, "zero", s.client)                # a zero tool: X = ... = C = 0
+            click(tools.entry_save, s.client)
+            slot, _ = s.library.find("zero")
+            choose(tools.slots, next(o for o in tools.slots.options if o.startswith(f"{slot}")), s.client)
+            click(tools.activate, s.client)
+            assert s.controller.active_tool is not None and not any(s.controller.active_tool.tcp_mm)
+            click(tools.check_active, s.client)                       # far from the tip: refused
+            assert "Checking" not in tools.check_md.content
+            choose(pendant.hide_distance, False, s.client)            # locked in the exercise
+            click(cal.start, s.client)                                # XYZ 4-point
+            click(cal.steps.record, s.client)                         # a touch in the air
+            with s.lock:                                              # a patient trainee jogs the tip
+                ctrl = s.controller                                   # to 2 mm above the spike
+                T = ctrl.T_world_tool_true().copy()
+                T[:3, 3] = ctrl.reference_tip_world_m + [0.0, 0.0, 0.002]
+                assert ctrl.move_true_tool_to(T).ok
+                s.moved()
+            note_pose()
+            click(tools.check_active, s.client)                       # the spin test at the spike
+            note_pose()
+            click(cal.steps.next, s.client)
+            click(cal.steps.record, s.client)
+            note_pose()
+            assert "mm" in tools.check_md.content                     # the readings, at the spike
+            assert [st.recorded for st in s.workflow.wizard.steps] == [True, True, False, False]
+            assert pendant.hide_distance.value and "hidden" in pendant.touch_md.content
+            marker = "Mallory was here"                               # the last thing sent
+            choose(tools.entry_name, marker, s.client)
+            wait_until(lambda: any(marker in str(m) for m in list(c.messages)), what="every message sent")
+
+            (row,) = app.gradebook.grades(include_in_progress=True)   # the truth, as the gradebook keeps it
+            T_ft = np.array(app.gradebook.truth(row.calibration_id)["T_flange_tool_true_m"], dtype=float)
+            np.testing.assert_allclose(T_ft, s.controller.mounted_tool.T_flange_tool_true, atol=1e-12)
+        finally:
+            c.close()
+
+    tcp = T_ft[:3, 3]
+    targets: list[tuple[str, np.ndarray, float]] = [("FLANGE m", tcp, NEAR_M), ("FLANGE mm", tcp * 1e3, NEAR_M * 1e3)]
+    for i, (T_wf, T_wb) in enumerate(poses):
+        world = T_wf[:3, :3] @ tcp + T_wf[:3, 3]
+        base = np.linalg.solve(T_wb, np.append(world, 1.0))[:3]
+        targets += [(f"WORLD m @pose {i}", world, NEAR_M), (f"WORLD mm @pose {i}", world * 1e3, NEAR_M * 1e3),
+                    (f"BASE m @pose {i}", base, NEAR_M), (f"BASE mm @pose {i}", base * 1e3, NEAR_M * 1e3)]
+    assert len(c.messages) > 100 and any(m.get("type") == "MeshMessage" for m in c.messages)
+    chunks, owners = [], []
+    for k, m in enumerate(c.messages):
+        for run in _sequences(m)[0]:
+            tri = _triples(run)
+            chunks.append(tri)
+            owners.append(np.full(len(tri), k))
+    triples, owner = np.vstack(chunks), np.concatenate(owners)
+    assert len(triples) > 10_000                                      # the meshes were read
+    hits = [f"{h} in {c.messages[k].get('type')} {str(c.messages[k].get('name', ''))[:70]}"
+            for h, k in _near(triples, owner, targets)]
+    for i, (T_wf, _) in enumerate(poses):         # as an offset from a zero tool at each pose
+        for scale, tol in ((1.0, NEAR_M), (1e3, NEAR_M * 1e3)):
+            off = (triples - T_wf[:3, 3] * scale) @ T_wf[:3, :3]      # FLANGE axes
+            hits += [f"offset from the flange at pose {i}: {h} in {c.messages[k].get('type')}"
+                     for h, k in _near(off, owner, [(f"FLANGE x{scale:g}", tcp * scale, tol)])]
+    assert hits == [], "\n".join(hits[:20])
