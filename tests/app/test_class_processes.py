@@ -163,3 +163,22 @@ def test_a_message_and_a_brief_sent_on_one_process_reach_the_trainees_of_the_oth
         assert sb.rules.allowed_methods == ("xyz4",) and sb.rules.min_touches == 6
     finally:
         cb.close()
+
+
+def test_the_trainer_resets_and_pushes_to_one_trainee_on_the_other_process(two) -> None:
+    a, b = two
+    cb = DrainingClient(b.port)
+    try:
+        sb = _session(b)
+        _join(sb, "Ben")
+        click(sb.views["calibrate"].start, sb.client)
+        assert sb.workflow.is_open
+        a.classroom.beat()
+        assert "on another server process" in a.classroom.reset_wizard("Ben")
+        assert "on another server process" in a.classroom.push_to("Ben", hide_distance="locked")
+        b.classroom.beat()
+        wait_until(lambda: not sb.workflow.is_open, what="Ben's wizard reset on B")
+        wait_until(lambda: sb.rules.distance_locked and sb.hide_distance, what="the push to Ben on B")
+        assert a.classroom.reset_wizard("Nobody") == "Nobody is not connected: there is no running wizard to reset."
+    finally:
+        cb.close()

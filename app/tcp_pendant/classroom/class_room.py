@@ -581,6 +581,11 @@ class ClassRoom:
             elif kind == "brief":
                 self.push_brief(push.get("instructions", ""), push.get("allowed_methods"),
                                 push.get("min_touches", 0), keep=False)
+            elif kind == "reset":
+                self.reset_wizard(str(push.get("name")), forward=False)
+            elif kind == "push_to":
+                self.push_to(str(push.get("name")), push.get("exercise", False), push.get("tool_key"),
+                             push.get("hide_distance"), push.get("auto_touch"), forward=False)
             elif kind == "message":
                 self._deliver(clean_message_text(push.get("text", "")), push.get("to"), str(push.get("sent", "")),
                               also_waiting=False)
@@ -687,11 +692,20 @@ class ClassRoom:
         with self._lock:
             return next((e for e in self._trainees.values() if e[2] == name), None)
 
-    def reset_wizard(self, name: str) -> str:
+    def _on_another_process(self, name: object) -> bool:
+        with self._lock:
+            return isinstance(name, str) and name in self._remote
+
+    def reset_wizard(self, name: str, *, forward: bool = True) -> str:
         """Cancel the running wizard of the trainee ``name`` (``Session.cancel_wizard`` on their
         session only; kept, resumable; the gradebook records the cancel) and tell them. Returns
-        what happened, in words for the trainer (plain text)."""
+        what happened, in words for the trainer (plain text). A trainee connected on another
+        server process of the class gets it there at its next beat (``forward``; False: a
+        request from there, applied here only)."""
         entry = self._entry_of(name) if isinstance(name, str) else None
+        if entry is None and forward and self._on_another_process(name):
+            self.gradebook.add_push({"holder": self.holder, "kind": "reset", "name": name})
+            return f"Reset {name}'s running wizard (on another server process of the class)."
         if entry is None:
             return f"{name} is not connected: there is no running wizard to reset."
         session = entry[0]
@@ -708,17 +722,22 @@ class ClassRoom:
         return f"Reset {name}'s running wizard."
 
     def push_to(self, name: str, exercise: str | None | bool = False, tool_key: str | None = None,
-                hide_distance: str | None = None, auto_touch: bool | None = None) -> str:
+                hide_distance: str | None = None, auto_touch: bool | None = None, *, forward: bool = True) -> str:
         """Push settings to the one trainee ``name``: ``exercise`` (False: keep; None: free
         practice; "mystery": their mystery tool), ``tool_key`` (None: keep; ignored with the
         mystery exercise), distance aids ``hide_distance`` ("locked" / "hidden" / "shown", None:
         keep) and Auto-touch (None: keep). Only that trainee's session is changed; until their
-        next reconnect or the next push to all. Returns what happened (plain text)."""
+        next reconnect or the next push to all. Returns what happened (plain text). A trainee
+        connected on another server process gets it there (``forward``, as :meth:`reset_wizard`)."""
         if exercise is not False and exercise is not None and exercise not in EXERCISE_IDS:
             raise ValueError(f"Unknown exercise {exercise!r}; use one of {', '.join(EXERCISE_IDS)}.")
         if tool_key is not None and tool_key not in self.tools:
             raise ValueError(f"Unknown tool {tool_key!r}; use one of {', '.join(self.tools)}.")
         entry = self._entry_of(name) if isinstance(name, str) else None
+        if entry is None and forward and self._on_another_process(name):
+            self.gradebook.add_push({"holder": self.holder, "kind": "push_to", "name": name, "exercise": exercise,
+                                     "tool_key": tool_key, "hide_distance": hide_distance, "auto_touch": auto_touch})
+            return f"Pushed to {name} (on another server process of the class)."
         if entry is None:
             return f"{name} is not connected: nothing pushed."
         session, recorder, who = entry
