@@ -10,6 +10,7 @@ Examples::
     tcp-pendant --host 0.0.0.0 --shared          # classroom demo: one robot for everybody
     tcp-pendant --shared --presenter             # the lecture on a projector: large readout
     tcp-pendant --host 0.0.0.0 --class           # a class: names, gradebook, trainer view
+    tcp-pendant --host 0.0.0.0 --class --workers 2   # a large class on both cores (one port)
     tcp-pendant --host 0.0.0.0 --exercise mystery --exercise-seed 7   # a class with mystery tools
     tcp-pendant grades --csv > grades.csv        # the class gradebook (see classroom.grades_cli)
     tcp-pendant poses import touch.ls --robot kr6 > POSES.csv   # joint points by the robot's FK
@@ -134,6 +135,11 @@ def build_parser() -> argparse.ArgumentParser:
                    help="one seed for every pendant's randomness (Auto-touch's operator error and "
                         "directions, the beam sensor's noise): a seeded lesson replays the same way "
                         "(default: fresh randomness; >= 0)")
+    p.add_argument("--workers", type=int, default=1, metavar="N",
+                   help="N server processes on the one port (SO_REUSEPORT: the system spreads the browsers "
+                        "over them), to use N cores for a large class (default 1; up to 32; not with "
+                        "--shared); a class shares names, pushed settings and the trainer's table through "
+                        "the gradebook")
     p.add_argument("--verbose", action="store_true", help="log debugging information")
     return p
 
@@ -202,6 +208,28 @@ def _main(argv: Sequence[str] | None) -> int:
     if not 0 <= args.port <= 65535:
         print(f"tcp-pendant: error: --port must be 0..65535, got {args.port}", file=sys.stderr)
         return 2
+    from tcp_pendant.workers import MAX_WORKERS, WorkerError, Workers, worker_index
+
+    if not 1 <= args.workers <= MAX_WORKERS:
+        print(f"tcp-pendant: error: --workers must be 1..{MAX_WORKERS}, got {args.workers}", file=sys.stderr)
+        return 2
+    if args.workers > 1 and args.shared:
+        print("tcp-pendant: error: --shared is one robot in one process; drop --workers or --shared",
+              file=sys.stderr)
+        return 2
+    try:
+        worker = worker_index()
+    except WorkerError as exc:
+        print(f"tcp-pendant: error: {exc}", file=sys.stderr)
+        return 2
+    several = args.workers > 1 or worker is not None
+    if several:
+        import signal
+
+        def _terminate(_signum: int, _frame: object) -> None:
+            raise KeyboardInterrupt         # a clean stop: sessions end in the gradebook, names are freed
+
+        signal.signal(signal.SIGTERM, _terminate)
     from tcp_pendant.classroom.trainer_token import TrainerTokenError, resolve_trainer_token
     from tcp_pendant.pendant.library_rights import DEFAULT_LIBRARY_QUOTA, MAX_LIBRARY_QUOTA
 
@@ -220,7 +248,7 @@ def _main(argv: Sequence[str] | None) -> int:
               "--exercise-min-touches / --trainer-token / --trainer-token-file, or drop --shared",
               file=sys.stderr)
         return 2
-    if args.trainer_token is not None:
+    if args.trainer_token is not None and worker is None:
         print("tcp-pendant: note: a --trainer-token on the command line shows in the process list; "
               "--trainer-token-file PATH or TCP_PENDANT_TRAINER_TOKEN keep it out", file=sys.stderr)
     if args.library_quota is not None and not classroom:
@@ -259,16 +287,17 @@ def _main(argv: Sequence[str] | None) -> int:
                            scenario_seed=args.scenario_seed, presenter=args.presenter,
                            hide_truth=args.hide_truth,
                            beam_width_mm=args.beam_width, beam_repeatability_mm=args.beam_repeatability,
-                           beam_crossed=args.beam_crossed, seed=args.seed)
+                           beam_crossed=args.beam_crossed, seed=args.seed, reuse_port=several)
         app = PendantApp(config)
     except (ControllerError, ValueError, OSError, GradebookError) as exc:
         print(f"tcp-pendant: error: {exc}", file=sys.stderr)
         return 2
-    for line in app.warnings:
-        print(f"WARNING: {line}", file=sys.stderr)
-    warning = network_warning(args.host)
-    if warning is not None:
-        print(warning, file=sys.stderr)
+    if worker is None:                      # a worker's warnings are the first process's
+        for line in app.warnings:
+            print(f"WARNING: {line}", file=sys.stderr)
+        warning = network_warning(args.host)
+        if warning is not None:
+            print(warning, file=sys.stderr)
     try:
         url = app.start()
     except PortInUseError as exc:
@@ -280,12 +309,44 @@ def _main(argv: Sequence[str] | None) -> int:
     except KeyboardInterrupt:
         app.stop()
         raise
+    if worker is not None:
+        return _serve_as_worker(app, worker[2])
+    workers: Workers | None = None
+    if args.workers > 1:
+        workers = Workers(list(argv or ()), app.port, args.workers)
+        try:
+            workers.start()
+        except (WorkerError, OSError) as exc:
+            app.stop()
+            print(f"tcp-pendant: error: {exc}", file=sys.stderr)
+            return 2
+        except KeyboardInterrupt:
+            app.stop()
+            raise
     mode = "one robot shared by every browser" if args.shared else "one robot per browser"
+    if workers is not None:
+        mode += (f"; {args.workers} server processes on port {app.port} (pids "
+                 f"{', '.join(str(p) for p in [os.getpid(), *workers.pids])})")
     tip_mm = ", ".join(f"{v:.0f}" for v in app.reference_tip_m * 1000.0)
     print(f"TCP Pendant ready in {time.perf_counter() - t0:.1f} s: {ready_urls(url, app.network_urls, args.host)}"
           f"\n  robot {app.robot_label}, tool {app.tool.label}, reference tip ({tip_mm}) mm, {mode}\n"
           f"  tool library {app.library.path}\n{_class_lines(app)}  Ctrl-C to stop.", flush=True)
-    app.serve_forever()
+    try:
+        app.serve_forever()
+    finally:
+        if workers is not None:
+            workers.stop()
+    return 0
+
+
+def _serve_as_worker(app: PendantApp, parent_pid: int) -> int:
+    """A worker of ``--workers N`` (``tcp_pendant.workers``): say it listens, then serve until
+    stopped or until the first process is gone."""
+    print(f"worker ready {os.getpid()}", flush=True)
+    devnull = os.open(os.devnull, os.O_WRONLY)      # nobody reads this pipe any more
+    os.dup2(devnull, sys.stdout.fileno())
+    os.close(devnull)
+    app.serve_forever(alive=lambda: os.getppid() == parent_pid)
     return 0
 
 

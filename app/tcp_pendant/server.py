@@ -122,6 +122,10 @@ class AppConfig:
             error and directions, the beam's repeatability noise); session k of the server draws
             from ``(seed, k)``, so a seeded lesson or test replays the same way. None: fresh
             randomness.
+        reuse_port: bind the port with ``SO_REUSEPORT`` (``views.viser_adapter.listen_reuse_port``):
+            one of the server processes of ``tcp-pendant --workers N`` on the same port.
+        presence_poll_s: the class's heartbeat period across server processes (seconds;
+            ``ClassRoom.start``).
     """
 
     robot: str = "kr6"
@@ -151,6 +155,8 @@ class AppConfig:
     beam_crossed: bool = False
     seed: int | None = None
     hide_truth: bool = False
+    reuse_port: bool = False
+    presence_poll_s: float = 1.0
 
 
 class PortInUseError(OSError):
@@ -367,7 +373,8 @@ class PendantApp:
                                        instructions=config.exercise_instructions,
                                        allowed_methods=config.exercise_methods,
                                        min_touches=config.exercise_min_touches,
-                                       hand_to_loop=self._hand_to_loop, call_later=self._call_later)
+                                       hand_to_loop=self._hand_to_loop, call_later=self._call_later,
+                                       presence_poll_s=config.presence_poll_s)
 
     @property
     def warnings(self) -> list[str]:
@@ -571,6 +578,8 @@ class PendantApp:
         """The viser server, its policies, page script and session handlers; then ready."""
         import viser
 
+        if self.config.reuse_port:
+            viser_adapter.listen_reuse_port()   # one port, several server processes (--workers)
         self.server = viser.ViserServer(host=host, port=self.config.port, verbose=False)
         origin_check.allow(self.port, self.allow_origins,
                            origin_check.served_hosts(host, self.network_urls, self.allow_origins))
@@ -593,6 +602,8 @@ class PendantApp:
         self.server.on_client_disconnect(self._on_disconnect)
         self._watcher = threading.Thread(target=self._watch_library, name="library-watcher", daemon=True)
         self._watcher.start()
+        if self.classroom is not None:
+            self.classroom.start()          # presence heartbeat, the other processes' pushes
         origin_check.mark_ready(self.port)  # until now every request got 503 "starting"
 
     @property
@@ -639,13 +650,16 @@ class PendantApp:
             origin_check.forget(self.port)
             self.server.stop()
         self.jobs.shutdown(wait=False)
+        if self.classroom is not None:
+            self.classroom.close()          # frees the names this process held
         if self.gradebook is not None:
             self.gradebook.close()
 
-    def serve_forever(self, poll_s: float = 0.5) -> None:
-        """Block until interrupted (Ctrl-C), then stop."""
+    def serve_forever(self, poll_s: float = 0.5, alive: Callable[[], bool] | None = None) -> None:
+        """Block until interrupted (Ctrl-C) or, with ``alive``, until it returns False (a
+        worker of ``--workers``: the first process is gone), then stop."""
         try:
-            while not self._stop.is_set():
+            while not self._stop.is_set() and (alive is None or alive()):
                 time.sleep(poll_s)
         except KeyboardInterrupt:
             pass

@@ -36,6 +36,13 @@ subscribe and re-render from state; they never call each other. Inside :meth:`Se
 the changes of several commands are merged into one signal (a Calibrate click that mounts a
 tool, moves the robot and saves emits once, at its end).
 
+A jog press that waited on a busy event loop (more than :data:`COALESCE_AFTER_S` since it
+arrived: the server is behind) is carried out at once, but its change signal waits for the end
+of the loop's current round (``loop.call_soon``): the next presses of the same browser already
+queued in that round merge into it, so the views re-render (and viser sends) once for them
+all; any other signal of the session first takes the waiting one in. On an idle server every
+press signals at once, as before.
+
 Threading: every GUI callback is registered through :meth:`Session.on_loop`, an ``async``
 callback, so viser runs it on its event loop, one at a time and in the order the browser's
 messages arrived, and the messages it queues are pushed from the loop's own thread (viser's
@@ -53,6 +60,7 @@ job detached from the session, run in the server's job pool by :meth:`Session.ru
 
 from __future__ import annotations
 
+import asyncio
 import functools
 import logging
 import threading
@@ -87,6 +95,10 @@ __all__ = ["GuiTarget", "Session", "SessionChange", "Touch"]
 log = logging.getLogger(__name__)
 F = TypeVar("F", bound=Callable[..., Any])
 R = TypeVar("R")
+
+COALESCE_AFTER_S = 0.010
+"""A jog press that waited longer than this (s) on the event loop signals at the end of the
+loop's round, merged with the same session's next presses (module docstring)."""
 
 _COLORS: dict[str, Literal["blue", "green", "yellow", "red"]] = {
     "info": "blue", "success": "green", "warning": "yellow", "error": "red"}
@@ -248,6 +260,7 @@ class Session:
         self._pose_state: PoseState | None = None
         self._batch_depth = 0
         self._pending: SessionChange | None = None
+        self._deferred: SessionChange | None = None    # jog presses' signal waiting for the loop's round
         self.library_tools: dict[int, Tool] = {}
         """The library's tools as this session last read them (slot -> tool)."""
         self.library_error: str | None = None
@@ -316,6 +329,8 @@ class Session:
     def _emit(self, change: SessionChange) -> None:
         if self.closed:
             return
+        if self._deferred is not None:            # presses waiting to signal: shown first, in this one
+            change, self._deferred = self._deferred.merged(change), None
         if change.tool:                           # the open wizard checks its steps' tool changes
             self.workflow.note_mounted_tool()
         events = self.workflow.take_events()      # whoever drove the workflow, nothing is lost
@@ -376,6 +391,29 @@ class Session:
         """After a move of the robot (a jog, the gizmo, Home, an auto-touch): the change signal
         with ``pose`` (and the move's outcome ``jog`` for the status line)."""
         self.changed(pose=True, jog=jog)
+
+    def moved_soon(self, jog: JogResult, waited_s: float | None) -> None:
+        """:meth:`moved` after a jog press that waited ``waited_s`` on the event loop (None:
+        unknown): at once on an idle loop, else at the end of the loop's round, merged with the
+        session's next presses (module docstring). A stopped jog's outcome is kept over a later
+        one that went through, so its message is shown."""
+        with self.lock:
+            loop = _running_loop()
+            if (waited_s is None or waited_s <= COALESCE_AFTER_S or loop is None or self.target is None
+                    or self._batch_depth):
+                self.moved(jog)
+                return
+            scheduled = self._deferred is not None
+            before = None if self._deferred is None else self._deferred.jog
+            keep = jog if before is None or before.ok or not jog.ok else before
+            self._deferred = SessionChange(pose=True, jog=keep)
+            if not scheduled:
+                loop.call_soon(self.guard(self._signal_deferred))
+
+    def _signal_deferred(self) -> None:
+        if self._deferred is not None:
+            change, self._deferred = self._deferred, None
+            self._emit(change)
 
     def set_hide_distance(self, hide: bool) -> None:
         """"Hide distance" on or off: the readouts re-render (a ``pose`` change); while it is
@@ -640,14 +678,19 @@ class Session:
         return True
 
     # ------------------------------------------------------------ motion (commands)
-    def jog(self, axis: str | int, sign: int, *, hold_tick: bool = False) -> JogResult | None:
+    def jog(self, axis: str | int, sign: int, *, hold_tick: bool = False,
+            waited_s: float | None = None) -> JogResult | None:
         """One jog key: a press (one increment, or nothing in continuous mode) or a tick of a held
         key (``hold_tick``), by the session's :class:`~tcp_pendant.pendant.Jogger`; ends in one
-        ``pose`` signal carrying the move's outcome. None: nothing moved (a skipped tick)."""
+        ``pose`` signal carrying the move's outcome (a press that waited ``waited_s`` on a busy
+        loop: :meth:`moved_soon`). None: nothing moved (a skipped tick)."""
         with self.lock:
             res = self.jogger.key(axis, sign, hold_tick=hold_tick)
             if res is not None:
-                self.moved(res)
+                if hold_tick:
+                    self.moved(res)
+                else:
+                    self.moved_soon(res, waited_s)
             return res
 
     def set_jog_setting(self, name: str, value: Any) -> None:
@@ -1062,3 +1105,10 @@ class Session:
         self.workflow.state = ControllerToolState(self.controller)   # no cycle back to the closed session
         self.client = None
         self.target = None
+
+
+def _running_loop() -> asyncio.AbstractEventLoop | None:
+    try:
+        return asyncio.get_running_loop()
+    except RuntimeError:
+        return None

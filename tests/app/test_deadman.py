@@ -217,3 +217,41 @@ def test_overloaded_holds_stop_within_1s_of_the_last_hold_message(app_factory) -
     finally:
         for c in clients:
             c.close()
+
+
+def test_presses_that_waited_on_a_busy_loop_signal_once_at_the_end_of_its_round(app_factory) -> None:
+    """Each press moves the robot at once; presses that waited longer than COALESCE_AFTER_S
+    share one change signal, sent when the loop's round ends (fresh ones signal each)."""
+    import asyncio
+
+    from tcp_pendant.session import COALESCE_AFTER_S
+
+    app = app_factory(shared=True)
+    s = app.shared_session
+    with s.lock:
+        s.jogger.settings = s.jogger.settings.with_(increment="0.1", frame="WORLD", mode="Cartesian")
+    signals: list[tuple[float, bool]] = []
+    s.subscribe(lambda change: signals.append((_x_mm(s.controller), change.pose)) if change.pose else None)
+
+    async def presses(waited_s: float | None) -> tuple[list[float], int]:
+        xs = []
+        with s.lock:
+            for _ in range(3):
+                s.jog("X", 1, waited_s=waited_s)
+                xs.append(_x_mm(s.controller))
+        during = len(signals)
+        await asyncio.sleep(0)                  # the loop's round ends
+        await asyncio.sleep(0)
+        return xs, during
+
+    def run(waited_s: float | None) -> tuple[list[float], int]:
+        signals.clear()
+        return asyncio.run_coroutine_threadsafe(presses(waited_s), app.server.get_event_loop()).result(30)
+
+    xs, during = run(2 * COALESCE_AFTER_S)
+    assert [round(b - a, 3) for a, b in zip(xs, xs[1:])] == [0.1, 0.1]    # every press moved at once
+    assert during == 0 and len(signals) == 1 and signals[0] == (xs[-1], True)
+    xs, during = run(None)                       # arrival unknown (a test's call): each signals
+    assert during == 3 and [x for x, _ in signals] == xs
+    xs, during = run(COALESCE_AFTER_S / 2)       # fresh presses: each signals
+    assert during == 3 and [x for x, _ in signals] == xs

@@ -154,9 +154,10 @@ def test_two_servers_behind_the_front_end_serve_one_class(app_factory, nginx_bin
         clients.append(again)
         wait_until(lambda: len(apps[1].sessions) == before[1] + 1, what="the same server again")
         assert len(apps[0].sessions) == before[0]
-        # there, another browser typing the name Ana holds on the other server is refused
+        # there, another browser typing the name Ana holds on the other server is refused: she
+        # is connected there (the gradebook's presence table)
         thief = _join(session_of(apps[1], len(apps[1].sessions)), "Ana")
-        assert thief.name is None and "already a trainee of this class" in thief.message.content
+        assert thief.name is None and "Ana is already connected in another browser" in thief.message.content
         # and a page from another web site cannot open a websocket through the front end
         with pytest.raises(Exception, match="403"):
             DrainingClient(front, headers={"Cookie": cookie_b, "Origin": "http://evil.example"}, host_name=name)

@@ -322,3 +322,34 @@ def test_csv_has_the_documented_columns_and_one_line_per_row(book: Gradebook) ->
     assert (r["position_error_mm"], r["orientation_error_deg"], r["grade"]) == ("0.33", "", "good")
     assert r["figures_json"] == '{"ci95_mm": 0.8, "mean_error_mm": 0.21}'
     assert to_csv([]) == ",".join(CSV_COLUMNS) + "\r\n"
+
+
+def test_presence_rows_follow_claims_heartbeats_and_their_holders(tmp_path) -> None:
+    db = tmp_path / "class.sqlite3"
+    a, b = Gradebook(db), Gradebook(db)                  # two server processes' connections
+    try:
+        assert a.claim_presence("Anna", "A", {"name": "Anna", "touches": 0}, now=100.0) is None
+        assert b.presence_holder("Anna", now=105.0) == "A"
+        assert b.presence_holder("Anna", now=110.5) is None              # A stopped beating 10 s ago
+        assert b.present(now=105.0) == [("Anna", "A", {"name": "Anna", "touches": 0})]
+        assert a.beat_presence("A", {"Anna": {"name": "Anna", "touches": 2}}, now=109.0) == {"Anna"}
+        assert b.presence_holder("Anna", now=118.0) == "A"
+        assert b.present(now=118.0)[0][2]["touches"] == 2
+        assert b.claim_presence("Anna", "B", {"name": "Anna"}, now=118.0) == "A"   # taken over
+        assert a.beat_presence("A", {"Anna": {"name": "Anna"}}, now=119.0) == set()
+        assert not a.drop_presence("Anna", "A")          # not A's any more: B's row stays
+        assert a.presence_holder("Anna", now=119.0) == "B"
+        b.claim_presence("Ben", "B", {"name": "Ben"}, now=119.0)
+        assert [n for n, _, _ in a.present(now=119.0)] == ["Anna", "Ben"]
+        assert b.drop_holder("B") == 2 and a.present(now=119.0) == []
+        assert a.last_push_id() == 0
+        first = a.add_push({"exercise": "mystery"})
+        second = b.add_push({"exercise": None, "hide_distance": "shown"})
+        assert second > first
+        assert b.pushes_after(0) == [(first, {"exercise": "mystery"}),
+                                     (second, {"exercise": None, "hide_distance": "shown"})]
+        assert a.pushes_after(first) == [(second, {"exercise": None, "hide_distance": "shown"})]
+        assert a.last_push_id() == second
+    finally:
+        a.close()
+        b.close()

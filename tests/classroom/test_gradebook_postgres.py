@@ -80,7 +80,7 @@ def test_an_empty_database_gets_the_schema_with_8_byte_floats(postgres_server) -
                                          "table_name = 'calibrations' AND column_name = 'position_error_mm'") \
         == "double precision"
     assert _scalar(postgres_server, url, "SELECT count(*) FROM information_schema.tables WHERE "
-                                         "table_schema = 'public'") == 7      # 6 versioned + run_states
+                                         "table_schema = 'public'") == 9      # 6 versioned + run_states, presence, class_pushes
     with Gradebook(url) as g:                                   # opened again: everything kept
         assert [r.trainee for r in g.grades()] == ["Anna"] and g.add_trainee("Anna") == 1
 
@@ -202,3 +202,17 @@ def test_two_server_processes_share_one_class(gradebook_target: Path | str) -> N
         # n recorded each, every odd one overwriting the one before: n / 2 count
         assert [(r.touches, r.overwritten) for r in rows] == [(n // 2, n // 2)] * 2
         assert sorted(g.held_names()) == ["Ana", "Bea", "Shared Sam"]
+
+
+def test_presence_and_pushes_on_postgresql(postgres_server) -> None:
+    """The server processes' shared class state (presence rows, pushes in order) in PostgreSQL."""
+    url = postgres_server.fresh_database()
+    with Gradebook(url) as a, Gradebook(url) as b:
+        assert a.claim_presence("Anna", "A", {"name": "Anna"}, now=100.25) is None
+        assert b.presence_holder("Anna", now=105.0) == "A" and b.presence_holder("Anna", now=110.5) is None
+        assert b.claim_presence("Anna", "B", {"name": "Anna", "touches": 3}, now=111.0) == "A"
+        assert a.beat_presence("A", {"Anna": {"name": "Anna"}}, now=112.0) == set()
+        assert a.present(now=112.0) == [("Anna", "B", {"name": "Anna", "touches": 3})]
+        first, second = a.add_push({"kind": "settings"}), b.add_push({"kind": "brief"})
+        assert second > first and a.pushes_after(first) == [(second, {"kind": "brief"})]
+        assert b.drop_holder("B") == 1 and a.present(now=112.0) == []

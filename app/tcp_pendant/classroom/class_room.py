@@ -57,6 +57,20 @@ signal), so an undismissed message comes back after a reload or when the trainee
 a message to one trainee who left waits for them. They live in memory: a server restart drops
 them (the brief, which is kept in the gradebook, is the lasting text).
 
+Several server processes on one gradebook (``tcp-pendant --workers N``): each process has its
+own sessions and its own ClassRoom (:attr:`ClassRoom.holder` names it); what the class shares
+goes through the gradebook. A joined name is claimed in the gradebook's presence table
+(``Gradebook.claim_presence``) and beaten every ``presence_poll_s`` by :meth:`ClassRoom.start`'s
+thread with the trainee's live row, so a name connected on one process is refused on another
+exactly as on the same one, the same browser's newer tab on another process takes the name
+(the older one's welcome window opens again at the next beat), a release by the trainer on
+any process sends the browser on its holder back to the welcome window, and
+:meth:`trainee_statuses` and :meth:`connected_names` list the whole class (the other
+processes' rows as they last beat them; who left is listed by the process they left). Every
+push of the trainer's settings is kept in order (``Gradebook.add_push``) and applied by the
+other processes at their next beat. A reconnect landing on another process gets the
+calibrations in progress back from the gradebook (``classroom.restore``), like a restart.
+
 Threads: the session callbacks run on viser's event loop (``Session.on_loop``); connects and
 disconnects come from viser's thread pool and hand their trainer-view refresh to the loop
 (``hand_to_loop``). The class's own lists are guarded by one lock.
@@ -64,10 +78,14 @@ disconnects come from viser's thread pool and hand their trainer-view refresh to
 
 from __future__ import annotations
 
-import logging
+import dataclasses
+import functools
 import hashlib
 import itertools
+import logging
+import os
 import secrets
+import socket
 import threading
 import time
 from collections.abc import Callable, Sequence
@@ -168,6 +186,7 @@ class ClassRoom:
             delay (the dashboards' throttle and clock tick); None: dashboards render at once,
             every time (tests).
         library_quota: tool-library slots one trainee may hold (1..16; ``--library-quota``).
+        presence_poll_s: the heartbeat period of :meth:`start` (seconds; module docstring).
 
     Raises:
         TrainerTokenError: a token that breaks the rules.
@@ -181,7 +200,7 @@ class ClassRoom:
                  hand_to_loop: Callable[[Callable[[], None]], None] = lambda fn: fn(),
                  clock: Callable[[], float] = time.monotonic,
                  call_later: Callable[[float, Callable[[], None]], None] | None = None,
-                 library_quota: int = DEFAULT_LIBRARY_QUOTA) -> None:
+                 library_quota: int = DEFAULT_LIBRARY_QUOTA, presence_poll_s: float = 1.0) -> None:
         if (isinstance(library_quota, bool) or not isinstance(library_quota, int)
                 or not 1 <= library_quota <= MAX_LIBRARY_QUOTA):
             raise ValueError(f"The library quota must be a whole number of slots 1..{MAX_LIBRARY_QUOTA}, "
@@ -239,6 +258,13 @@ class ClassRoom:
         """The fewest touches a Finish takes, for methods whose touch count is chosen (0: none)."""
         self._message_ids = itertools.count(1)
         self._waiting: dict[str, list[ClassMessage]] = {}   # name -> messages not dismissed yet
+        self.holder = f"{socket.gethostname()}:{os.getpid()}:{secrets.token_hex(4)}"
+        """This server process's id in the gradebook's presence table (host, pid, a nonce)."""
+        self.presence_poll_s = float(presence_poll_s)
+        self._remote: dict[str, TraineeStatus] = {}   # name -> row, connected on another process
+        self._push_seen = gradebook.last_push_id()    # the pushes before are in the kept settings
+        self._beater: threading.Thread | None = None
+        self._stopping = threading.Event()
         self._apply_kept(exercise_given=exercise is not None)   # what the trainer pushed before a restart
         if given_instructions is not None:
             self.instructions = given_instructions
@@ -318,7 +344,8 @@ class ClassRoom:
                 raise TraineeNameError(f"The trainer released the name {clean} from this browser; join "
                                        "under your own name.")
             holder = self._holder(clean, session)
-            if holder is not None and not self.gradebook.holds_key(clean, key):
+            elsewhere = self.gradebook.presence_holder(clean) not in (None, self.holder)
+            if (holder is not None or elsewhere) and not self.gradebook.holds_key(clean, key):
                 raise TraineeNameError(f"{clean} is already connected in another browser; pick another "
                                        "name or ask the trainer to release it.")
             join = self.gradebook.join_trainee(clean, key)
@@ -336,6 +363,9 @@ class ClassRoom:
             session.keep_honest_records()             # the trainee's export carries no answer key
             recorder = TraineeRecorder(self.gradebook, sid, join.name, session.workflow,
                                        exercise_id=self.exercise)
+            # claimed before the name is in the table the heartbeat reads: a beat never sees a
+            # name of ours that the presence table does not give to us yet
+            self.gradebook.claim_presence(join.name, self.holder, dataclasses.asdict(recorder.status))
             with self._lock:
                 self._trainees[id(session)] = (session, recorder, join.name)
                 follow = id(session) not in self._subscribed
@@ -382,6 +412,7 @@ class ClassRoom:
             log.exception("ending the gradebook session of %r failed", name)
         with self._lock:
             self._left.append(recorder.status)
+        self._drop_presence(name)
         session.library_rights = self._library_rights(session, None)  # at once: it changes nothing more
         self._hand_to_loop(session.guard(lambda: session.set_library_rights(session.library_rights)))
         if prompt is not None:         # on the loop, after this callback: no two sessions' locks at once
@@ -395,6 +426,7 @@ class ClassRoom:
             raise ValueError("Choose the name to release.")
         with self._join_lock:
             held = self.gradebook.release_trainee(name)
+            elsewhere = self.gradebook.drop_presence(name) and name not in self._local_names()
             with self._lock:
                 holders = [e for e in self._trainees.values() if e[2] == name]
             for entry in holders:
@@ -402,9 +434,9 @@ class ClassRoom:
                 self._leave(entry, f"The trainer released the name {name}: this browser left the class. "
                             "Join under your own name.", forget=True)
         self.refresh_trainers()
-        if not held and not holders:
+        if not held and not holders and not elsewhere:
             return f"{name} was not held by any browser."
-        where = " and its browser left the class" if holders else ""
+        where = " and its browser left the class" if holders or elsewhere else ""
         return f"Released {name}{where}: the next browser that joins as {name} gets the trainee's records."
 
     def held_names(self) -> list[str]:
@@ -450,7 +482,115 @@ class ClassRoom:
                 if self._trainees.get(id(session)) is entry:
                     self._trainees.pop(id(session), None)
                     self._left.append(entry[1].status)
+            self._drop_presence(entry[2])
         self._hand_to_loop(self.refresh_trainers)
+
+    # ------------------------------------------------------------ presence (server processes)
+    def _local_names(self) -> set[str]:
+        with self._lock:
+            return {e[2] for e in self._trainees.values()}
+
+    def _drop_presence(self, name: str) -> None:
+        """The name's row goes, unless another session of this process holds the name now."""
+        if name in self._local_names():
+            return
+        try:
+            self.gradebook.drop_presence(name, self.holder)
+        except GradebookError:
+            log.exception("the presence of %r could not be dropped", name)
+
+    def start(self) -> None:
+        """Start the heartbeat thread (the server calls it; module docstring)."""
+        if self._beater is not None:
+            return
+        self._beater = threading.Thread(target=self._beat_loop, name="class-presence", daemon=True)
+        self._beater.start()
+
+    def close(self) -> None:
+        """Stop the heartbeat and free every name this process holds (the server stops)."""
+        self._stopping.set()
+        if self._beater is not None:
+            self._beater.join(timeout=5.0)
+            self._beater = None
+        try:
+            self.gradebook.drop_holder(self.holder)
+        except GradebookError:
+            log.debug("presence not dropped: gradebook closed", exc_info=True)
+
+    def _beat_loop(self) -> None:
+        while not self._stopping.wait(self.presence_poll_s):
+            try:
+                self.beat()
+            except GradebookError:
+                log.exception("class heartbeat failed")
+            except Exception:  # the heartbeat must go on whatever one beat met
+                log.exception("class heartbeat failed")
+
+    def beat(self) -> None:
+        """One heartbeat (the thread of :meth:`start` every ``presence_poll_s``; tests call it):
+        renew this process's names with their rows; a name this process lost (taken by the same
+        browser on another process, released by the trainer there) sends its session back to
+        the welcome window; take in the other processes' rows and the trainer's pushes made
+        there."""
+        with self._lock:
+            entries = {e[2]: e for e in self._trainees.values()}
+        statuses = {name: dataclasses.asdict(e[1].status) for name, e in entries.items()}
+        held = self.gradebook.beat_presence(self.holder, statuses)
+        lost = [(entries[n], self.gradebook.presence_holder(n) is None) for n in sorted(set(statuses) - held)]
+        if lost:
+            self._hand_to_loop(lambda: self._lost(lost))
+        fields = {f.name for f in dataclasses.fields(TraineeStatus)}
+        remote = {}
+        for name, holder, st in self.gradebook.present():
+            if holder != self.holder and isinstance(st, dict):
+                try:
+                    remote[name] = TraineeStatus(**{k: v for k, v in st.items() if k in fields})
+                except TypeError:
+                    continue
+        with self._lock:
+            changed = remote != self._remote
+            self._remote = remote
+        for push_id, push in self.gradebook.pushes_after(self._push_seen):
+            self._push_seen = push_id
+            if push.get("holder") != self.holder:
+                self._hand_to_loop(functools.partial(self._apply_remote_push, push))
+        if changed:
+            self._hand_to_loop(self.refresh_trainers)
+
+    def _lost(self, lost: list[tuple[tuple[Session, TraineeRecorder, str], bool]]) -> None:
+        for entry, released in lost:
+            name = entry[2]
+            if released:
+                self._released[id(entry[0])] = name
+                self._leave(entry, f"The trainer released the name {name}: this browser left the class. "
+                            "Join under your own name.", forget=True)
+            else:
+                self._leave(entry, f"{name} joined from another tab or window of this browser, so this "
+                            "one left the class. Close it, or join here again (the other one then leaves).",
+                            forget=False)
+        self.refresh_trainers()
+
+    def _apply_remote_push(self, push: dict[str, Any]) -> None:
+        """A push the trainer made on another server process of the class: settings, a brief
+        or a message (``kind``), applied to this process's trainees."""
+        kind = push.get("kind", "settings")
+        try:
+            if kind == "settings":
+                self.push_settings(push.get("exercise"), push.get("tool_key"), push.get("hide_distance"),
+                                   push.get("auto_touch"), keep=False)
+            elif kind == "brief":
+                self.push_brief(push.get("instructions", ""), push.get("allowed_methods"),
+                                push.get("min_touches", 0), keep=False)
+            elif kind == "reset":
+                self.reset_wizard(str(push.get("name")), forward=False)
+            elif kind == "push_to":
+                self.push_to(str(push.get("name")), push.get("exercise", False), push.get("tool_key"),
+                             push.get("hide_distance"), push.get("auto_touch"), forward=False)
+            elif kind == "message":
+                self._deliver(clean_message_text(push.get("text", "")), push.get("to"), str(push.get("sent", "")),
+                              also_waiting=False)
+        except (ValueError, TypeError) as exc:
+            log.warning("a %s pushed on another server process was not applied: %s", kind, exc)
 
     # ------------------------------------------------------------ trainer
     def open_trainer(self, session: Session, token: str) -> bool:
@@ -552,11 +692,20 @@ class ClassRoom:
         with self._lock:
             return next((e for e in self._trainees.values() if e[2] == name), None)
 
-    def reset_wizard(self, name: str) -> str:
+    def _on_another_process(self, name: object) -> bool:
+        with self._lock:
+            return isinstance(name, str) and name in self._remote
+
+    def reset_wizard(self, name: str, *, forward: bool = True) -> str:
         """Cancel the running wizard of the trainee ``name`` (``Session.cancel_wizard`` on their
         session only; kept, resumable; the gradebook records the cancel) and tell them. Returns
-        what happened, in words for the trainer (plain text)."""
+        what happened, in words for the trainer (plain text). A trainee connected on another
+        server process of the class gets it there at its next beat (``forward``; False: a
+        request from there, applied here only)."""
         entry = self._entry_of(name) if isinstance(name, str) else None
+        if entry is None and forward and self._on_another_process(name):
+            self.gradebook.add_push({"holder": self.holder, "kind": "reset", "name": name})
+            return f"Reset {name}'s running wizard (on another server process of the class)."
         if entry is None:
             return f"{name} is not connected: there is no running wizard to reset."
         session = entry[0]
@@ -573,17 +722,22 @@ class ClassRoom:
         return f"Reset {name}'s running wizard."
 
     def push_to(self, name: str, exercise: str | None | bool = False, tool_key: str | None = None,
-                hide_distance: str | None = None, auto_touch: bool | None = None) -> str:
+                hide_distance: str | None = None, auto_touch: bool | None = None, *, forward: bool = True) -> str:
         """Push settings to the one trainee ``name``: ``exercise`` (False: keep; None: free
         practice; "mystery": their mystery tool), ``tool_key`` (None: keep; ignored with the
         mystery exercise), distance aids ``hide_distance`` ("locked" / "hidden" / "shown", None:
         keep) and Auto-touch (None: keep). Only that trainee's session is changed; until their
-        next reconnect or the next push to all. Returns what happened (plain text)."""
+        next reconnect or the next push to all. Returns what happened (plain text). A trainee
+        connected on another server process gets it there (``forward``, as :meth:`reset_wizard`)."""
         if exercise is not False and exercise is not None and exercise not in EXERCISE_IDS:
             raise ValueError(f"Unknown exercise {exercise!r}; use one of {', '.join(EXERCISE_IDS)}.")
         if tool_key is not None and tool_key not in self.tools:
             raise ValueError(f"Unknown tool {tool_key!r}; use one of {', '.join(self.tools)}.")
         entry = self._entry_of(name) if isinstance(name, str) else None
+        if entry is None and forward and self._on_another_process(name):
+            self.gradebook.add_push({"holder": self.holder, "kind": "push_to", "name": name, "exercise": exercise,
+                                     "tool_key": tool_key, "hide_distance": hide_distance, "auto_touch": auto_touch})
+            return f"Pushed to {name} (on another server process of the class)."
         if entry is None:
             return f"{name} is not connected: nothing pushed."
         session, recorder, who = entry
@@ -612,9 +766,14 @@ class ClassRoom:
         return f"Pushed to {who}."
 
     def trainee_statuses(self) -> list[TraineeStatus]:
-        """Rows of the live table: connected trainees in order of arrival, then those who left."""
+        """Rows of the live table: this process's connected trainees in order of arrival, those
+        connected on the other server processes of the class (by name, as they last beat),
+        then those who left this process."""
         with self._lock:
-            return [rec.status for _, rec, _ in self._trainees.values()] + list(self._left)
+            local = [rec.status for _, rec, _ in self._trainees.values()]
+            names = {row.name for row in local}
+            remote = [row for name, row in sorted(self._remote.items()) if name not in names]
+            return local + remote + list(self._left)
 
     def grade_rows(self) -> list[GradeRow]:
         return self.gradebook.grades()
@@ -668,13 +827,16 @@ class ClassRoom:
             self.min_touches = 0
 
     def push_settings(self, exercise: str | None, tool_key: str | None,
-                      hide_distance: bool | str | None = None, auto_touch: bool | None = None) -> int:
+                      hide_distance: bool | str | None = None, auto_touch: bool | None = None, *,
+                      keep: bool = True) -> int:
         """Set the exercise (None: free practice; "mystery": each trainee gets a mystery tool),
         mount ``tool_key`` (None: keep), set the distance aids (``hide_distance``: "locked",
         "hidden" or "shown"; True means "hidden", False "shown"; None: keep) and allow
         Auto-touch or not (None: keep) on every named trainee's pendant; later trainees get
         them when they name themselves. A new exercise starts from its default rules (module
-        docstring) except what this push sets. Returns how many trainees."""
+        docstring) except what this push sets. Returns how many trainees of this process.
+        ``keep``: keep the push in the gradebook for a restart and for the other server
+        processes of the class (False: a push one of them made, applied here)."""
         if exercise is not None and exercise not in EXERCISE_IDS:
             raise ValueError(f"Unknown exercise {exercise!r}; use one of {', '.join(EXERCISE_IDS)}.")
         if tool_key is not None and tool_key not in self.tools:
@@ -690,7 +852,10 @@ class ClassRoom:
             self.distance_aids = aids
         if auto_touch is not None:
             self.auto_touch = bool(auto_touch)
-        self._keep_pushed(tool_key)
+        if keep:
+            self._keep_pushed(tool_key)
+            self.gradebook.add_push({"holder": self.holder, "kind": "settings", "exercise": exercise,
+                                     "tool_key": tool_key, "hide_distance": named, "auto_touch": auto_touch})
         with self._lock:
             trainees = list(self._trainees.values())
         for session, recorder, name in trainees:
@@ -708,12 +873,13 @@ class ClassRoom:
         return len(trainees)
 
     def push_brief(self, instructions: str, allowed_methods: Sequence[str] | str | None,
-                   min_touches: int) -> int:
+                   min_touches: int, *, keep: bool = True) -> int:
         """Set the exercise's brief: ``instructions`` (plain text, at most
         ``MAX_INSTRUCTIONS_CHARS``; "" none), the methods trainees may start (wizard kinds; None:
         every method) and the fewest touches a Finish takes (0: none), on every named trainee's
         pendant (their rules, ``Session.set_rules``) and for those who name themselves later;
-        kept in the gradebook. Returns how many trainees.
+        kept in the gradebook (``keep``, as for :meth:`push_settings`). Returns how many
+        trainees of this process.
 
         Raises:
             ValueError: instructions too long, an unknown method, a bad minimum (nothing is set).
@@ -722,7 +888,11 @@ class ClassRoom:
         methods = clean_methods(allowed_methods)
         minimum = clean_min_touches(min_touches)
         self.instructions, self.allowed_methods, self.min_touches = text, methods, minimum
-        self._keep_pushed(None, brief_only=True)
+        if keep:
+            self._keep_pushed(None, brief_only=True)
+            self.gradebook.add_push({"holder": self.holder, "kind": "brief", "instructions": text,
+                                     "allowed_methods": None if methods is None else list(methods),
+                                     "min_touches": minimum})
         rules = self.rules
         with self._lock:
             trainees = list(self._trainees.values())
@@ -732,11 +902,17 @@ class ClassRoom:
 
     # ------------------------------------------------------------ messages
     def connected_names(self) -> list[str]:
-        """Names of the trainees connected now, in order of arrival (the trainer's "To" choices;
-        the one place the dashboard learns who is connected: a server of several processes
-        answers it from the gradebook instead)."""
+        """Names of the trainees connected now on every server process of the class (the
+        trainer's "To" choices): this process's in order of arrival, then the other processes'
+        by name (the presence table); the one place the dashboard learns who is connected."""
         with self._lock:
-            return [name for _, _, name in self._trainees.values()]
+            local = [name for _, _, name in self._trainees.values()]
+        try:
+            remote = sorted({name for name, holder, _ in self.gradebook.present() if holder != self.holder})
+        except GradebookError:
+            log.exception("the class's presence table is unreadable")
+            remote = []
+        return local + [name for name in remote if name not in local]
 
     def send_message(self, text: str, to: str | None = None) -> str:
         """Send ``text`` (plain text) to every connected trainee (``to`` None) or to the trainee
@@ -749,19 +925,37 @@ class ClassRoom:
         """
         clean = clean_message_text(text)
         with self._lock:
-            entries = list(self._trainees.values())
             left = {status.name for status in self._left}
+            remote = {name for name in self._remote}
         if to is not None:
             if not isinstance(to, str):
                 raise ValueError("Choose whom to send the message to.")
-            entries = [e for e in entries if e[2] == to]
             with self._lock:
-                known = to in left or to in self._waiting
-            if not entries and not known:
+                known = to in left or to in self._waiting or to in remote
+            if not known and to not in self._local_names():
                 raise ValueError(f"{to:.60} is not in the class; choose a trainee in the list, or all trainees.")
         sent = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
+        entries = self._deliver(clean, to, sent, also_waiting=to not in remote)
+        try:                              # the trainees on the other server processes of the class
+            self.gradebook.add_push({"holder": self.holder, "kind": "message", "text": clean, "to": to, "sent": sent})
+        except GradebookError:
+            log.exception("the message could not be passed to the other server processes")
+        there = [n for n in remote if n not in {e[2] for e in entries}]
+        if to is None:
+            n = len(entries) + len(there)
+            return f"Sent to {n} trainee{'s' if n != 1 else ''}." if n else "No trainee is connected: nobody got it."
+        return (f"Sent to {to}." if entries or to in there
+                else f"{to} is not connected: the message waits until they join again.")
+
+    def _deliver(self, clean: str, to: str | None, sent: str, *,
+                 also_waiting: bool) -> list[tuple[Session, TraineeRecorder, str]]:
+        """Show the message to this process's trainees (all, or ``to``) and keep it waiting for
+        them until dismissed; ``also_waiting``: a ``to`` not connected here waits here too (the
+        process the trainer sent it from). Returns the entries it was shown to."""
+        with self._lock:
+            entries = [e for e in self._trainees.values() if to is None or e[2] == to]
         message = ClassMessage(next(self._message_ids), clean, to, sent)
-        names = [to] if to is not None else [name for _, _, name in entries]
+        names = [to] if to is not None and (entries or also_waiting) else [name for _, _, name in entries]
         with self._lock:
             for name in names:
                 waiting = self._waiting.setdefault(name, [])
@@ -769,7 +963,4 @@ class ClassRoom:
                 del waiting[:-MAX_WAITING_MESSAGES]
         for session, _recorder, _name in entries:
             self._hand_to_loop(session.guard(lambda session=session: session.show_message(message)))
-        if to is None:
-            n = len(entries)
-            return f"Sent to {n} trainee{'s' if n != 1 else ''}." if n else "No trainee is connected: nobody got it."
-        return f"Sent to {to}." if entries else f"{to} is not connected: the message waits until they join again."
+        return entries

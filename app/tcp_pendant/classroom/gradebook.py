@@ -57,6 +57,13 @@ Schema (version 2)::
     touches(id, calibration_id, step_index, recorded_at, T_world_flange_m_json, joints_deg_json,
             distance_mm, auto, overwrites_touch_id, overwritten_by_touch_id)
     crashes(id, session_id, calibration_id, at, penetration_mm, note)
+
+Added to every file when it is opened (no schema version: an older reader ignores them)::
+
+    run_states(calibration_id PRIMARY KEY, entry_json, updated_at)     a wizard as last acknowledged
+    presence(name PRIMARY KEY, holder, seen_at, status_json)           who is connected, on which
+                                                                       server process (heartbeats)
+    class_pushes(id PRIMARY KEY, pushed_at, push_json)                 the trainer's pushes, in order
 """
 
 from __future__ import annotations
@@ -69,6 +76,7 @@ import math
 import secrets
 import sqlite3
 import threading
+import time
 from collections.abc import Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -118,11 +126,33 @@ _RUN_STATES = """CREATE TABLE IF NOT EXISTS run_states (
 """What a restart gives back: each calibration's wizard as it was last acknowledged (a session
 record entry without truth, ``session_record.run_entry``). Added to every file when it is
 opened; a TCP Pendant that does not know it ignores it, so it needs no schema version."""
+_PRESENCE = """CREATE TABLE IF NOT EXISTS presence (
+    name TEXT PRIMARY KEY,
+    holder TEXT NOT NULL,
+    seen_at REAL NOT NULL,
+    status_json TEXT NOT NULL)"""
+"""Which server process holds each connected trainee's name now (``holder``: the process's
+own id, :attr:`tcp_pendant.classroom.class_room.ClassRoom.holder`), the holder's last
+heartbeat (``seen_at``: Unix time, seconds) and the trainee's row of the trainer's live table
+as that process last wrote it (``status_json``). Several server processes on one gradebook
+(``tcp-pendant --workers N``) see the whole class through it. Added when the file is opened,
+like ``run_states``; a row is deleted when its browser leaves, and a row whose holder stopped
+beating (killed) counts as gone after ``stale_s``."""
+_CLASS_PUSHES = """CREATE TABLE IF NOT EXISTS class_pushes (
+    id INTEGER PRIMARY KEY,
+    pushed_at TEXT NOT NULL,
+    push_json TEXT NOT NULL)"""
+"""Every push of the trainer's class settings, in order: the other server processes of the
+class apply the ones they have not seen (``pushes_after``)."""
+PRESENCE_STALE_S = 10.0
+"""A presence row whose holder has not beaten for this long (seconds) counts as gone."""
+MAX_STATUS_BYTES = 4_000
+"""A presence row's status above this is refused (a trainer's row is ~200 bytes)."""
 _RUN_STATE_COLUMNS = (("method_title", "TEXT"), ("step", "TEXT"), ("step_since", "TEXT"))
 """Added to ``run_states`` when missing (additive, like the table): the wizard's title and the
 step as the trainee saw it ("Step 2 of 4", "result", "cancelled") and since when (UTC), for the
 trainer's dashboard after a restart (``Gradebook.board``)."""
-_ADDITIVE_TABLES = {"run_states": _RUN_STATES}
+_ADDITIVE_TABLES = {"run_states": _RUN_STATES, "presence": _PRESENCE, "class_pushes": _CLASS_PUSHES}
 """Tables made (CREATE TABLE IF NOT EXISTS, by name) in every gradebook that lacks them when it
 is opened, after the versioned schema; written in SQLite's words like every statement
 (``gradebook_db.sql_for``). A gradebook that has them all is not asked to create anything (a
@@ -1100,6 +1130,99 @@ class Gradebook:
         with self._write() as db:
             db.execute("INSERT INTO meta (key, value) VALUES (?, ?) ON CONFLICT(key) DO UPDATE SET value = "
                        "excluded.value", (f"class:{_label(key, 'setting name')}", text))
+
+    # -- presence: which server process holds which connected name ---------------------
+
+    @staticmethod
+    def _status_text(status: Mapping[str, Any]) -> str:
+        text = json.dumps(dict(status), sort_keys=True, allow_nan=False)
+        if len(text) > MAX_STATUS_BYTES:
+            raise GradebookError(f"A trainee's status of {len(text):,} bytes is above {MAX_STATUS_BYTES:,}.")
+        return text
+
+    def presence_holder(self, name: str, *, stale_s: float = PRESENCE_STALE_S,
+                        now: float | None = None) -> str | None:
+        """The holder (a server process's id) whose browser is connected under ``name`` now,
+        None when none is (no row, or its holder stopped beating ``stale_s`` ago)."""
+        t = time.time() if now is None else now
+        with self._read() as db:
+            row = db.execute("SELECT holder, seen_at FROM presence WHERE name = ?", (str(name),)).fetchone()
+        return None if row is None or t - float(row[1]) > stale_s else str(row[0])
+
+    def claim_presence(self, name: str, holder: str, status: Mapping[str, Any], *,
+                       now: float | None = None) -> str | None:
+        """``holder`` now holds the connected name ``name`` (the caller has checked that it may:
+        a name held elsewhere is taken over only by the same browser). Returns the holder it
+        took the name from (None: nobody else held it)."""
+        text = self._status_text(status)
+        t = time.time() if now is None else now
+        with self._write() as db:
+            row = db.execute("SELECT holder FROM presence WHERE name = ?", (str(name),)).fetchone()
+            if row is None:
+                db.execute("INSERT INTO presence (name, holder, seen_at, status_json) VALUES (?, ?, ?, ?)",
+                           (str(name), str(holder), t, text))
+                return None
+            db.execute("UPDATE presence SET holder = ?, seen_at = ?, status_json = ? WHERE name = ?",
+                       (str(holder), t, text, str(name)))
+            return None if row[0] == holder else str(row[0])
+
+    def drop_presence(self, name: str, holder: str | None = None) -> bool:
+        """The browser connected under ``name`` left (``holder``: only if that process still
+        holds it; None: whoever holds it, the trainer's release). Returns whether a row went."""
+        with self._write() as db:
+            if holder is None:
+                return db.execute("DELETE FROM presence WHERE name = ?", (str(name),)).rowcount > 0
+            return db.execute("DELETE FROM presence WHERE name = ? AND holder = ?",
+                              (str(name), str(holder))).rowcount > 0
+
+    def beat_presence(self, holder: str, statuses: Mapping[str, Mapping[str, Any]], *,
+                      now: float | None = None) -> set[str]:
+        """The heartbeat of ``holder``: the names it holds get ``seen_at = now`` and their
+        status. Returns the names of ``statuses`` it still holds (one another process took over,
+        or the trainer released, is missing)."""
+        if not statuses:
+            return set()                          # nothing to renew: no write, no fsync
+        t = time.time() if now is None else now
+        rows = [(t, self._status_text(st), str(name), str(holder)) for name, st in statuses.items()]
+        with self._write() as db:
+            db.executemany("UPDATE presence SET seen_at = ?, status_json = ? WHERE name = ? AND holder = ?", rows)
+            held = {str(r[0]) for r in db.execute("SELECT name FROM presence WHERE holder = ?", (str(holder),))}
+        return held & set(statuses)
+
+    def present(self, *, stale_s: float = PRESENCE_STALE_S, now: float | None = None) -> list[tuple[str, str, dict[str, Any]]]:
+        """``(name, holder, status)`` of every connected trainee of every server process, by
+        name (rows whose holder stopped beating ``stale_s`` ago are left out)."""
+        t = time.time() if now is None else now
+        with self._read() as db:
+            rows = db.execute("SELECT name, holder, status_json FROM presence WHERE seen_at >= ? ORDER BY name",
+                              (t - stale_s,)).fetchall()
+        return [(str(n), str(h), json.loads(st)) for n, h, st in rows]
+
+    def drop_holder(self, holder: str) -> int:
+        """A server process stops: every name it holds is free (returns how many)."""
+        with self._write() as db:
+            return db.execute("DELETE FROM presence WHERE holder = ?", (str(holder),)).rowcount
+
+    # -- the trainer's pushes, for every server process of the class -------------------
+
+    def add_push(self, push: Mapping[str, Any]) -> int:
+        """Keep one push of the trainer's class settings (JSON-ready); returns its id (ids grow)."""
+        text = json.dumps(dict(push), sort_keys=True, allow_nan=False)
+        with self._write() as db:
+            return db.insert("INSERT INTO class_pushes (pushed_at, push_json) VALUES (?, ?)", (_now(), text))
+
+    def pushes_after(self, push_id: int) -> list[tuple[int, dict[str, Any]]]:
+        """``(id, push)`` of the pushes kept after ``push_id``, in order (0: all)."""
+        with self._read() as db:
+            rows = db.execute("SELECT id, push_json FROM class_pushes WHERE id > ? ORDER BY id",
+                              (int(push_id),)).fetchall()
+        return [(int(i), json.loads(p)) for i, p in rows]
+
+    def last_push_id(self) -> int:
+        """The id of the last push kept (0: none)."""
+        with self._read() as db:
+            row = db.execute("SELECT MAX(id) FROM class_pushes").fetchone()
+        return 0 if row is None or row[0] is None else int(row[0])
 
     def board(self) -> ClassBoard:
         """The trainer's live table as the gradebook knows it (:class:`ClassBoard`): every

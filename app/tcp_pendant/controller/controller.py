@@ -100,7 +100,7 @@ class VirtualController:
         self.settings = settings
         self._q = np.array(kinematics.home_rad, dtype=float)
         self._rest_q = np.array(kinematics.home_rad, dtype=float)
-        self._sigma: tuple[np.ndarray, float] | None = None  # (q, sigma_min at q) of the last path
+        self._sigma: tuple[np.ndarray, float, float] | None = None  # (q, sigma_min, sign det J) at q of the last path
         self._tool = tool
         self._active: Tool | None = None
         self._T_flange_tool = np.eye(4)
@@ -374,11 +374,12 @@ class VirtualController:
         return self._follow(path, self._T_flange_tool)
 
     def _follow(self, path: CartesianPath, T_flange_tcp: np.ndarray) -> JogResult:
-        sigma = self._sigma[1] if self._sigma is not None and np.array_equal(self._sigma[0], self._q) else None
+        known = self._sigma is not None and np.array_equal(self._sigma[0], self._q)
+        sigma, det_sign = (self._sigma[1], self._sigma[2]) if known and self._sigma is not None else (None, None)
         out = follow_path(self.kinematics, self._q, T_flange_tcp, path, self.settings, sigma_start=sigma,
-                          q_rest=self._rest_q)
+                          q_rest=self._rest_q, det_sign_start=det_sign)
         self._q = out.q_rad
-        self._sigma = (out.q_rad.copy(), out.sigma)
+        self._sigma = (out.q_rad.copy(), out.sigma, out.det_sign)
         if out.stopped_by is None:
             return JogResult(True, 1.0, None, "")
         return JogResult(False, float(out.moved), out.stopped_by, out.message)

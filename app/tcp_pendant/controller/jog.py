@@ -171,6 +171,8 @@ class PathOutcome:
     message: str
     sigma: float
     """:func:`smallest_singular_value` at ``q_rad``."""
+    det_sign: float = 0.0
+    """Sign of ``det J_flange`` at ``q_rad`` (``_det_sign``: +1, -1; 0 singular or not square)."""
 
 
 def tcp_pose(kin: RobotKinematics, q_rad: np.ndarray, T_flange_tcp: np.ndarray) -> np.ndarray:
@@ -293,9 +295,9 @@ def _solve_substep(kin: RobotKinematics, q_start: np.ndarray, sigma_start: float
         if iteration == 0 and q_rest is not None:
             dq = dq + _null_space_step(Jt, q, q_rest, settings.null_space_gain, 0.25 * allowance)
         q = q + dq
-        if not np.all(np.isfinite(q)):
+        if not np.isfinite(q).all():
             break
-    jump = float(np.abs(q - q_start).max()) if np.all(np.isfinite(q)) else math.inf
+    jump = float(np.abs(q - q_start).max()) if np.isfinite(q).all() else math.inf
     if not converged or jump > allowance:
         if sigma_start < 2.0 * eps:
             return _Attempt(q_start, sigma_start, "singularity", singularity_message(kin, q_start, settings))
@@ -328,7 +330,8 @@ def _solve_substep(kin: RobotKinematics, q_start: np.ndarray, sigma_start: float
 
 def follow_path(kin: RobotKinematics, q_rad: np.ndarray, T_flange_tcp: np.ndarray,
                 path: CartesianPath, settings: JogSettings = DEFAULT_SETTINGS, *,
-                sigma_start: float | None = None, q_rest: np.ndarray | None = None) -> PathOutcome:
+                sigma_start: float | None = None, q_rest: np.ndarray | None = None,
+                det_sign_start: float | None = None) -> PathOutcome:
     """Move the TCP along ``path`` (J-1) from configuration ``q_rad`` under the safety rules.
 
     Args:
@@ -339,6 +342,9 @@ def follow_path(kin: RobotKinematics, q_rad: np.ndarray, T_flange_tcp: np.ndarra
         sigma_start: :func:`smallest_singular_value` at ``q_rad`` if the caller knows it
             (saves one SVD per jog step: the controller keeps it from the previous step).
         q_rest: rest configuration of a redundant arm (J-3); ignored for six joints or fewer.
+        det_sign_start: the sign of ``det J_flange`` at ``q_rad`` if the caller knows it
+            (``PathOutcome.det_sign`` of the previous path); with ``sigma_start`` it saves the
+            Jacobian at the start, one pinocchio pass per jog step.
 
     Returns:
         The configuration reached, the fraction ``moved`` of the path, the stop reason and
@@ -346,19 +352,22 @@ def follow_path(kin: RobotKinematics, q_rad: np.ndarray, T_flange_tcp: np.ndarra
     """
     t_f = np.ascontiguousarray(T_flange_tcp[:3, 3], dtype=float)
     R_ft = np.ascontiguousarray(T_flange_tcp[:3, :3], dtype=float)
-    length_m = float(np.linalg.norm(path.dp))
-    angle = float(np.linalg.norm(path.w))
+    length_m = math.hypot(*path.dp.tolist())           # |dp|, |w|, |t_f|: math, no numpy call per jog step
+    angle = math.hypot(*path.w.tolist())
     n = max(1, math.ceil(max(length_m / settings.max_substep_m, angle / settings.max_substep_rad) - 1e-9))
     # joint allowance per unit of flange motion: (mm of travel -> "deg") + rad of rotation; a
     # rotation about the TCP swings the flange by |w| |t| (module doc)
-    lever_m = float(np.linalg.norm(t_f))
+    lever_m = math.hypot(*t_f.tolist())
     unit = (length_m + angle * lever_m) * 1000.0 * math.radians(1.0) + angle
 
     q = np.array(q_rad, dtype=float)
     rest = np.asarray(q_rest, dtype=float) if q_rest is not None and kin.n_joints > 6 else None
-    J0 = kin.jacobian_flange(q)
-    sigma = _sigma_min(J0, settings) if sigma_start is None else float(sigma_start)
-    det_sign = _det_sign(J0)
+    if sigma_start is None or det_sign_start is None:
+        J0 = kin.jacobian_flange(q)
+        sigma = _sigma_min(J0, settings) if sigma_start is None else float(sigma_start)
+        det_sign = _det_sign(J0) if det_sign_start is None else float(det_sign_start)
+    else:
+        sigma, det_sign = float(sigma_start), float(det_sign_start)
     s_done = 0.0
     for k in range(1, n + 1):
         s_next = k / n
@@ -379,5 +388,5 @@ def follow_path(kin: RobotKinematics, q_rad: np.ndarray, T_flange_tcp: np.ndarra
                 q, sigma, det_sign, lo = a.q, a.sigma, a.det_sign, mid
             else:
                 hi, last = mid, a
-        return PathOutcome(q, lo, last.reason, last.message, sigma)
-    return PathOutcome(q, 1.0, None, "", sigma)
+        return PathOutcome(q, lo, last.reason, last.message, sigma, det_sign)
+    return PathOutcome(q, 1.0, None, "", sigma, det_sign)

@@ -62,7 +62,7 @@ def touch_geometry(T_world_tooltrue: np.ndarray, tip_world_m: np.ndarray) -> Tou
     """Touch geometry of a true TOOL pose (4,4, metres) and a reference tip (3,, metres)."""
     T = np.asarray(T_world_tooltrue, dtype=float)
     u_mm = T[:3, :3].T @ (np.asarray(tip_world_m, dtype=float) - T[:3, 3]) * 1000.0
-    distance = float(np.linalg.norm(u_mm))
+    distance = math.hypot(*u_mm.tolist())        # |u| (math: no numpy call per step)
     rho = math.hypot(float(u_mm[1]), float(u_mm[2]))
     depth = -float(u_mm[0])
     penetration = depth if (depth > 0.0 and rho <= CRASH_RADIUS_MM and depth <= CRASH_ZONE_DEPTH_MM) else 0.0

@@ -150,14 +150,14 @@ def contact_stop(tip_world_m: np.ndarray, step_world_m: np.ndarray,
     length2 = float(step @ step)
     if length2 <= 0.0:
         return None
-    if np.linalg.norm(r - p) * 1000.0 <= TOUCH_TOLERANCE_MM:
+    if math.hypot(*(r - p).tolist()) * 1000.0 <= TOUCH_TOLERANCE_MM:
         return None                                   # at contact already: the next press goes on
     t = float((r - p) @ step) / length2
     if not 0.0 < t < 1.0:
         return None                                   # the closest point is not inside this step
     if t * math.sqrt(length2) < _STOPPED_HERE_M:
         return None                                   # stopped here by the last press: this one goes on
-    miss_mm = float(np.linalg.norm(p + t * step - r)) * 1000.0
+    miss_mm = math.hypot(*(p + t * step - r).tolist()) * 1000.0
     if miss_mm > CONTACT_RADIUS_MM or not math.isfinite(miss_mm):
         return None
     return ContactStop(t, miss_mm)

@@ -32,6 +32,8 @@ Units: metres in (WORLD), millimetres for the window; the image is (H, W, 3) uin
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from scipy.spatial import ConvexHull, QhullError
 
@@ -192,7 +194,7 @@ def _view(tool_apex_mm: np.ndarray | None, tool_into_body: np.ndarray | None, vi
 def _tool_in_mm(reference_tip_world_m: np.ndarray, T_world_tooltrue: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
     T = np.asarray(T_world_tooltrue, dtype=float)
     apex = (T[:3, 3] - np.asarray(reference_tip_world_m, dtype=float)) * 1000.0
-    if not np.all(np.isfinite(apex)) or np.linalg.norm(apex) > NEAR_MM:
+    if not np.isfinite(apex).all() or math.hypot(*apex.tolist()) > NEAR_MM:
         return None                                # out of every window (drawn without it)
     return apex, -T[:3, 0]                         # the body lies behind the tip, along -X
 

@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import asyncio
 import math
+import time
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
@@ -85,6 +86,10 @@ KEYS_LINE = ("Keys: `1`…`6` jog **+** on the rows above, `Shift`+`1`…`6` jog
 INCREMENT_KEYS = "keys [ smaller, ] larger"
 
 
+DROP_REPORT_EVERY_S = 1.0
+"""Dropped jog presses are reported (status line, notification) at most this often (s)."""
+
+
 def jog_key_hint(row: int) -> str:
     """The keys of jog-key row ``row`` (0-based) as its hint says them ("" past the 9th row)."""
     return f"keys {row + 1} (+) and Shift+{row + 1} (−)" if 0 <= row < 9 else ""
@@ -133,6 +138,7 @@ class PendantPanel:
         self._stop_key: Any = None
         self._hold: HoldDriver | None = None
         self._drop_report_due = False
+        self._drop_reported_at = -math.inf          # monotonic s of the last drop report
         arrival.install()
 
         st = session.jogger.settings
@@ -251,10 +257,12 @@ class PendantPanel:
         if hold_tick is False and self.session.jogger.settings.continuous:
             self._stop_hold()                        # the click that ends a hold: no move
             return
-        if not hold_tick and not self.session.jogger.gate.admit(arrival.arrived_s()):
+        arrived = arrival.arrived_s()
+        if not hold_tick and not self.session.jogger.gate.admit(arrived):
             self._report_drops_soon()                # a stale press: dropped, never carried out late
             return
-        self.session.jog(axis, sign, hold_tick=hold_tick)
+        waited = None if arrived is None else time.monotonic() - arrived
+        self.session.jog(axis, sign, hold_tick=hold_tick, waited_s=waited)
 
     # hold-to-jog on the server's 20 Hz clock (pendant/hold.py)
     def _on_hold(self, axis: str | int, sign: int) -> None:
@@ -285,14 +293,22 @@ class PendantPanel:
 
     def _report_drops_soon(self) -> None:
         """Report the dropped presses once the loop has worked through what is queued now (one
-        report per burst: a busy server is not sent a notification per press)."""
+        report per burst: a busy server is not sent a notification per press), and at most
+        once per :data:`DROP_REPORT_EVERY_S` (an overloaded server does not spend the time it
+        lacks on a report per loop round; the next report counts every press dropped since)."""
         if self._drop_report_due:
             return
         self._drop_report_due = True
-        asyncio.get_running_loop().call_soon(self.session.guard(self._report_drops))
+        loop = asyncio.get_running_loop()
+        wait = self._drop_reported_at + DROP_REPORT_EVERY_S - time.monotonic()
+        if wait > 0:
+            loop.call_later(wait, self.session.guard(self._report_drops))
+        else:
+            loop.call_soon(self.session.guard(self._report_drops))
 
     def _report_drops(self) -> None:
         self._drop_report_due = False
+        self._drop_reported_at = time.monotonic()
         n = self.session.jogger.gate.take_dropped()
         if self._hold is not None:
             n, self._hold.dropped = n + self._hold.dropped, 0

@@ -31,6 +31,12 @@ network. What this module reaches into, and why:
   (:class:`UploadLimits`). A refused or failing message is logged in one line, user values cut
   at :data:`LOG_VALUE_CHARS` characters, at most :data:`LOG_BUDGET` lines at a time (the rest
   counted: :func:`message_counts`); the socket stays open.
+* **One port, several processes** (:func:`listen_reuse_port`): viser 1.1 binds its port in
+  ``infra._infra`` with ``websockets.asyncio.server.serve(ws_handler, host, port, ...)`` and
+  takes no socket or option of ours; the wrapper adds ``reuse_port=True`` (``SO_REUSEPORT``,
+  which ``serve`` hands to ``loop.create_server``), so the server processes of
+  ``tcp-pendant --workers N`` listen on the same port and the kernel spreads the connections
+  over them.
 
 Moving viser up a minor version: run ``tests/security`` and ``tests/app/test_viser_adapter.py``
 (their conftest sets ``TCP_PENDANT_STRICT_VISER=1``: a fallback fails the test), then re-read in
@@ -63,7 +69,8 @@ from typing import Any
 import msgspec
 
 __all__ = ["LOG_VALUE_CHARS", "MAX_ABS_NUMBER", "MAX_TEXT_CHARS", "UploadHook", "UploadLimits",
-           "ViserInternalsChanged", "gui_value_refusal", "install", "message_refusal", "path_counts", "queue_markdown",
+           "ViserInternalsChanged", "gui_value_refusal", "install", "listen_reuse_port", "message_refusal", "path_counts",
+           "queue_markdown",
            "message_counts", "queue_pose", "reset_path_counts", "short", "upload_hook", "upload_limits",
            "uploads_in_flight"]
 
@@ -662,3 +669,30 @@ def install() -> None:
         _infra.WebsockMessageHandler._handle_incoming_message = handle_incoming_message  # type: ignore[method-assign]
         _infra._message_consumer = message_consumer
         _installed = True
+
+
+_reuse_port = False
+
+
+def listen_reuse_port() -> None:
+    """viser's server in this process binds its port with ``SO_REUSEPORT`` from now on (module
+    docstring; idempotent). Raises OSError where the platform has no ``SO_REUSEPORT``."""
+    global _reuse_port
+    import socket
+
+    import websockets.asyncio.server as ws_server
+
+    if not hasattr(socket, "SO_REUSEPORT"):
+        raise OSError("this platform has no SO_REUSEPORT: run one server process (--workers 1)")
+    with _install_lock:
+        if _reuse_port:
+            return
+        original = ws_server.serve
+
+        def serve(*args: Any, **kwargs: Any) -> Any:
+            kwargs.setdefault("reuse_port", True)
+            return original(*args, **kwargs)
+
+        serve.__wrapped__ = original  # type: ignore[attr-defined]
+        ws_server.serve = serve  # type: ignore[assignment,misc]
+        _reuse_port = True

@@ -1,0 +1,257 @@
+"""A class on one machine: press-to-readout latency of K trainees against ``tcp-pendant --workers N``.
+
+What it measures (printed too). For each class size K (default 1, 10, 30, 60, 100) the bench
+starts a real server, ``python -m tcp_pendant --class --workers N`` (default 2: one process per
+core, one port, SO_REUSEPORT; a gradebook and a tool library in a temporary folder), and K
+headless clients (tests/app/async_clients.py: real websockets speaking viser's protocol, all of
+a client process's clients on one asyncio loop, ``--client-procs`` processes, default 2). Each
+client is a trainee: it joins the class under its own name through the welcome window, picks
+the 0.1 mm increment and clicks "X +" 20 times a second (a browser's most) for ``--duration``
+seconds (default 30), spread over the period. The latency of a press runs from the client's
+click to the first TCP readout it receives that shows it (the machine's monotonic clock in the
+client processes); a press not shown ``ANSWER_WAIT_S`` after the last one is unanswered
+(dropped by the server's deadman, or never carried out). Printed per K: p50, p95, p99, max,
+presses asked / answered / unanswered, steps/s achieved (shown by the readouts; all trainees,
+and per trainee against the 20 asked), the CPU of each server process (cores, over the press
+window) and of the load generator.
+
+The load generator runs on the same two cores as the server (its CPU is printed): the figures
+are those of a 2-core machine that also runs K clients; a real class's browsers run elsewhere.
+
+RESULT: MET when, at the largest K, p99 < 100 ms, every press was answered and at least 95 % of
+the steps asked were achieved; else NOT MET. Always printed, whatever the outcome.
+
+    .venv/bin/python tests/bench/bench_class_load.py                        # 1 10 30 60 100, 30 s
+    .venv/bin/python tests/bench/bench_class_load.py --counts 30 --duration 10 --workers 1
+    .venv/bin/python tests/bench/bench_class_load.py --counts 10,30 --baseline   # and against --workers 1
+
+``--baseline`` runs each K against ``--workers 1`` right after (the same machine in the same
+minute: on a shared machine the ratio of steps/s achieved is the figure to trust).
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import json
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+from typing import Any
+
+ROOT = Path(__file__).resolve().parents[2]
+APP_TESTS = ROOT / "tests" / "app"
+PRESS_HZ = 20.0
+PRESS_MM = 0.1
+ANSWER_WAIT_S = 3.0
+P99_TARGET_MS = 100.0
+ACHIEVED_SHARE = 0.95
+TOKEN = "bench-class-load-token-0001"
+
+
+def _cpu_s(pid: int) -> float:
+    """User + system CPU seconds of process ``pid`` so far (Linux /proc)."""
+    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+def _waited_s(pid: int) -> float:
+    """Seconds the threads of process ``pid`` have spent runnable but not running (waiting for a
+    CPU; Linux ``/proc/PID/task/TID/schedstat``, second field, ns), summed over its threads."""
+    total = 0
+    for tid in os.listdir(f"/proc/{pid}/task"):
+        try:
+            total += int(Path(f"/proc/{pid}/task/{tid}/schedstat").read_text().split()[1])
+        except (OSError, IndexError, ValueError):
+            continue
+    return total / 1e9
+
+
+# ------------------------------------------------------------------ client process
+async def _client_main(port: int, first: int, n: int, names: bool) -> None:
+    sys.path.insert(0, str(APP_TESTS))
+    from async_clients import PLUS, connect_all, latencies, run_presses
+
+    clients = await connect_all("127.0.0.1", port, n, names="Trainee" if names else None, first=first)
+    await asyncio.sleep(1.0)                       # the joins and the increment are carried out
+    print("ready", flush=True)
+    loop = asyncio.get_running_loop()
+    line = await loop.run_in_executor(None, sys.stdin.readline)
+    start_at, seconds = (float(v) for v in line.split())
+    await asyncio.sleep(max(0.0, start_at - time.monotonic()))
+    t0 = os.times()
+    x0 = await run_presses(clients, PLUS, PRESS_HZ, seconds, ANSWER_WAIT_S)
+    t1 = os.times()
+    figures = latencies(clients, x0, PRESS_MM)
+    print(json.dumps({"latencies_ms": figures.latencies_ms, "asked": figures.asked, "answered": figures.answered,
+                      "no_readout": sum(x is None for x in x0),
+                      "cpu_s": t1.user + t1.system - t0.user - t0.system}), flush=True)
+    for c in clients:
+        await c.close()
+
+
+# ------------------------------------------------------------------ the bench
+def _start_server(tmp: Path, workers: int) -> tuple[subprocess.Popen[str], int, list[int]]:
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT / "src"), str(ROOT / "app"),
+                                                       os.environ.get("PYTHONPATH", "")]),
+               TCP_PENDANT_TRAINER_TOKEN=TOKEN)
+    cmd = [sys.executable, "-m", "tcp_pendant", "--port", "0", "--workers", str(workers), "--class-db",
+           str(tmp / "class.sqlite3"), "--tool-library", str(tmp / "tools.json"), "--seed", "1"]
+    server = subprocess.Popen(cmd, env=env, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, text=True)
+    assert server.stdout is not None
+    deadline = time.monotonic() + 240
+    text = ""
+    while time.monotonic() < deadline:
+        line = server.stdout.readline()
+        if not line:
+            raise RuntimeError(f"the server exited before it was ready (code {server.wait()})")
+        text += line
+        if "Ctrl-C to stop" in line:
+            break
+    port_m = re.search(r"http://127\.0\.0\.1:(\d+)", text)
+    if port_m is None:
+        raise RuntimeError(f"no URL in the server's ready message:\n{text}")
+    pids_m = re.search(r"\(pids ([\d, ]+)\)", text)
+    pids = [int(p) for p in pids_m.group(1).split(",")] if pids_m else [server.pid]
+    return server, int(port_m.group(1)), pids
+
+
+def run_class(k: int, workers: int, seconds: float, client_procs: int, names: bool) -> dict[str, Any]:
+    """One class of ``k`` trainees for ``seconds`` (module docstring)."""
+    with tempfile.TemporaryDirectory(prefix="bench_class_load_") as folder:
+        server, port, pids = _start_server(Path(folder), workers)
+        procs: list[subprocess.Popen[str]] = []
+        try:
+            sizes = [k // client_procs + (1 if i < k % client_procs else 0) for i in range(client_procs)]
+            first = 0
+            for n in sizes:
+                if n == 0:
+                    continue
+                procs.append(subprocess.Popen(
+                    [sys.executable, __file__, "--client", str(port), str(first), str(n), "1" if names else "0"],
+                    stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True))
+                first += n
+            for p in procs:
+                assert p.stdout is not None
+                if p.stdout.readline().strip() != "ready":
+                    raise RuntimeError("a client process did not connect its clients")
+            start_at = time.monotonic() + 0.5
+            cpu0 = [_cpu_s(pid) for pid in pids]
+            wait0 = [_waited_s(pid) for pid in pids]
+            for p in procs:
+                assert p.stdin is not None
+                p.stdin.write(f"{start_at} {seconds}\n")
+                p.stdin.flush()
+            results = []
+            for p in procs:
+                assert p.stdout is not None
+                results.append(json.loads(p.stdout.readline()))
+            window = time.monotonic() - start_at
+            cpu = [(_cpu_s(pid) - c0) / window for pid, c0 in zip(pids, cpu0)]
+            waited = [(_waited_s(pid) - w0) / window for pid, w0 in zip(pids, wait0)]
+        finally:
+            for p in procs:
+                try:
+                    p.wait(30)
+                except subprocess.TimeoutExpired:
+                    p.kill()
+                    p.wait()
+            server.terminate()
+            try:
+                server.wait(60)
+            except subprocess.TimeoutExpired:
+                server.kill()
+                server.wait()
+    lat = sorted(v for r in results for v in r["latencies_ms"])
+    asked = sum(r["asked"] for r in results)
+    answered = sum(r["answered"] for r in results)
+
+    def pct(q: float) -> float:
+        if not lat:
+            return float("nan")
+        i = (len(lat) - 1) * q / 100.0
+        lo = int(i)
+        hi = min(lo + 1, len(lat) - 1)
+        return lat[lo] + (lat[hi] - lat[lo]) * (i - lo)
+
+    return {"k": k, "p50": pct(50), "p95": pct(95), "p99": pct(99), "max": lat[-1] if lat else float("nan"),
+            "asked": asked, "answered": answered, "unanswered": asked - answered,
+            "steps_s": answered / seconds, "asked_s": asked / seconds, "per_trainee": answered / seconds / k,
+            "server_cpu": cpu, "server_waited": waited, "clients_cpu": sum(r["cpu_s"] for r in results) / window,
+            "no_readout": sum(r["no_readout"] for r in results)}
+
+
+def verdict(row: dict[str, Any]) -> bool:
+    return bool(row["p99"] < P99_TARGET_MS and row["unanswered"] == 0
+                and row["steps_s"] >= ACHIEVED_SHARE * row["asked_s"])
+
+
+def main(argv: list[str] | None = None) -> int:
+    args_in = sys.argv[1:] if argv is None else argv
+    if args_in[:1] == ["--client"]:
+        port, first, n, names = (int(v) for v in args_in[1:5])
+        asyncio.run(_client_main(port, first, n, bool(names)))
+        return 0
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--counts", default="1,10,30,60,100", help="class sizes K, comma-separated")
+    ap.add_argument("--workers", type=int, default=2, help="server processes (tcp-pendant --workers)")
+    ap.add_argument("--duration", type=float, default=30.0, help="seconds of pressing per class size")
+    ap.add_argument("--client-procs", type=int, default=2, help="processes the headless clients run in")
+    ap.add_argument("--no-names", action="store_true", help="clients do not join the class (no recorder)")
+    ap.add_argument("--baseline", action="store_true",
+                    help="also run each K against --workers 1 right after (same machine, same minute) and "
+                         "print the ratio of steps/s achieved")
+    args = ap.parse_args(args_in)
+    counts = [int(v) for v in args.counts.split(",") if v.strip()]
+    load = os.getloadavg()
+    print(f"bench_class_load: tcp-pendant --class --workers {args.workers}, K trainees each clicking X + "
+          f"{PRESS_HZ:.0f}/s ({PRESS_MM} mm) for {args.duration:g} s; clients in {args.client_procs} processes "
+          f"on the same {os.cpu_count()} CPUs (load average {load[0]:.1f} {load[1]:.1f} {load[2]:.1f} at start)")
+    print(f"  {'K':>4} {'p50 ms':>8} {'p95 ms':>8} {'p99 ms':>8} {'max ms':>8} {'asked':>7} {'unansw.':>7} "
+          f"{'steps/s':>8} {'per K':>6} {'ms/step':>7}  server CPU per process (cores)   clients CPU   "
+          "server waiting for a CPU")
+    rows = []
+
+    def show(row: dict[str, Any], label: str) -> None:
+        cpu = " ".join(f"{c:.2f}" for c in row["server_cpu"])
+        ms_step = sum(row["server_cpu"]) / max(row["steps_s"], 1e-9) * 1e3
+        print(f"  {label:>4} {row['p50']:8.1f} {row['p95']:8.1f} {row['p99']:8.1f} {row['max']:8.1f} {row['asked']:>7} "
+              f"{row['unanswered']:>7} {row['steps_s']:8.1f} {row['per_trainee']:6.1f} {ms_step:7.2f}  {cpu:<31} "
+              f"{row['clients_cpu']:<13.2f} " + " ".join(f"{w:.2f}" for w in row["server_waited"])
+              + (f"  ({row['no_readout']} clients saw no readout)"
+                                              if row["no_readout"] else ""), flush=True)
+
+    for k in counts:
+        row = run_class(k, args.workers, args.duration, min(args.client_procs, k), not args.no_names)
+        rows.append(row)
+        show(row, str(k))
+        if args.baseline and args.workers != 1:
+            base = run_class(k, 1, args.duration, min(args.client_procs, k), not args.no_names)
+            show(base, "w=1")
+            print(f"       steps/s with --workers {args.workers} / with --workers 1: "
+                  f"{row['steps_s'] / max(base['steps_s'], 1e-9):.2f}", flush=True)
+    print("  (ms/step: the server processes' CPU per step achieved, all included - the jog, the views, viser's "
+          f"sending, the deadman's drops; {os.cpu_count()} cores give at most {os.cpu_count()} / that steps per second "
+          "when nothing else runs)")
+    print("  (server waiting for a CPU: the share of the time each server process's threads were ready to run "
+          "but had no CPU - other programs on the machine had it; a server that waits for a CPU falls behind "
+          "and its deadman drops presses, whatever its own cost per step)")
+    print("  (latency: a press is matched to the first readout that shows as many presses; in a row with "
+          "unanswered presses the deadman dropped some, so later presses are matched to earlier sends: "
+          "those percentiles are upper bounds; rows with none are exact)")
+    last = rows[-1]
+    ok = verdict(last)
+    print(f"RESULT: {last['k']} trainees asked {last['asked_s'] / last['k']:.1f} presses/s each on {args.workers} "
+          f"server process(es): achieved {last['per_trainee']:.1f} steps/s each, press to readout p50 "
+          f"{last['p50']:.1f} ms, p95 {last['p95']:.1f} ms, p99 {last['p99']:.1f} ms, {last['unanswered']} of "
+          f"{last['asked']} presses unanswered. Target: p99 < {P99_TARGET_MS:.0f} ms, every press answered, "
+          f">= {ACHIEVED_SHARE:.0%} of the steps achieved: {'MET' if ok else 'NOT MET'}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
