@@ -78,6 +78,7 @@ def test_the_dashboard_replaces_the_pendant_and_survives_a_restart(app_factory, 
         assert dash.rows[0].grade and dash.rows[0].position_error_mm is not None
         assert "Ben" in dash.runs_html.content
         assert dash.chart.data[0].tolist() == [1.0] and dash.chart.data[1][0] == dash.rows[0].position_error_mm
+        assert dash.chart.legend == {"live": False}       # series names, no "--" values until hovered
     finally:
         for c in clients:
             c.close()

@@ -36,6 +36,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
+from tcp_pendant.calibrate.chart import CHART_LEGEND
 from tcp_pendant.classroom.board import DEFAULT_STUCK_MIN, DashboardRow, dashboard_rows, open_runs
 from tcp_pendant.classroom.gradebook import ClassBoard
 from tcp_pendant.classroom.grading import grade_record
@@ -325,7 +326,8 @@ def chart_folder(dash: TrainerDashboard) -> None:
               "points": {"show": True, "size": 12, "fill": "#3b6fd6", "stroke": "#1b3f96", "width": 2}}),
             title="Last position error per trainee (mm)", height=200,
             scales={"x": {"time": False, "range": (0.5, 1.5)}, "y": {"range": (0.0, 1.0)}},
-            axes=({"label": "trainee #", "incrs": (1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0)}, {"label": "mm"}))
+            axes=({"label": "trainee #", "incrs": (1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0)}, {"label": "mm"}),
+            legend=CHART_LEGEND)
 
 
 def trainee_folder(dash: TrainerDashboard) -> None:
