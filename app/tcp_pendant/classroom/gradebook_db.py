@@ -42,6 +42,7 @@ from __future__ import annotations
 import functools
 import re
 import sqlite3
+import time
 import zlib
 from abc import ABC, abstractmethod
 from collections.abc import Iterable, Iterator, Sequence
@@ -243,6 +244,7 @@ class SqliteConnection(GradebookConnection):
         self.location = str(path)
         self._db = sqlite3.connect(str(path), isolation_level=None, check_same_thread=False,
                                    timeout=float(busy_timeout_s))
+        self._busy_timeout_s = float(busy_timeout_s)
 
     def execute(self, sql: str, params: Sequence[Any] = ()) -> Cursor:
         return self._db.execute(sql_for("sqlite", sql), tuple(params))
@@ -275,10 +277,24 @@ class SqliteConnection(GradebookConnection):
     def configure(self, synchronous: str) -> str | None:
         """WAL, ``synchronous`` ("FULL" | "NORMAL") and foreign keys; returns the journal mode
         SQLite refused WAL for (e.g. "delete" on a network folder), or None."""
-        mode = str(self._db.execute("PRAGMA journal_mode = WAL").fetchone()[0]).lower()
+        mode = self._journal_mode_wal()
         self._db.execute(f"PRAGMA synchronous = {synchronous}")
         self._db.execute("PRAGMA foreign_keys = ON")
         return None if mode == "wal" else mode
+
+    def _journal_mode_wal(self) -> str:
+        """``PRAGMA journal_mode = WAL``, tried again for up to the busy timeout while another
+        process holds the file: the switch needs the file to itself, and SQLite answers "database
+        is locked" at once, without its busy handler, when a second server process opens a new
+        gradebook at the same moment. Returns the mode SQLite reports."""
+        deadline = time.monotonic() + self._busy_timeout_s
+        while True:
+            try:
+                return str(self._db.execute("PRAGMA journal_mode = WAL").fetchone()[0]).lower()
+            except sqlite3.OperationalError as exc:
+                if "locked" not in str(exc) or time.monotonic() >= deadline:
+                    raise
+                time.sleep(0.02)
 
     def close(self) -> None:
         self._db.close()
