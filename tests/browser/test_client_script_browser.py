@@ -22,22 +22,13 @@ from tcp_pendant.server import PendantApp
 sys.path.insert(0, str(Path(__file__).parent))
 sys.path.insert(0, str(Path(__file__).parents[1] / "app"))
 from app_page import running_pendants  # noqa: E402
-from pendant_page import TIMEOUT_MS, assert_not_blank, type_text, wait_text  # noqa: E402
+from pendant_page import TIMEOUT_MS, assert_not_blank, type_text, wait_text, wait_until  # noqa: E402
 
 pytestmark = pytest.mark.browser
 
 TOKEN = "trainer-secret-4242"
 AXES = ("X", "Y", "Z", "A", "B", "C")
 
-
-def wait_until(cond: Callable[[], Any], what: str, timeout: float = 60.0) -> Any:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        value = cond()
-        if value:
-            return value
-        time.sleep(0.05)
-    raise AssertionError(f"timed out waiting for {what}")
 
 
 @pytest.fixture

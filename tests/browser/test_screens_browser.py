@@ -24,7 +24,6 @@ from __future__ import annotations
 import os
 import re
 import sys
-import time
 from collections.abc import Callable, Iterator
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -38,7 +37,7 @@ from tcp_pendant.server import PendantApp
 sys.path.insert(0, str(Path(__file__).parent))
 sys.path.insert(0, str(Path(__file__).parents[1] / "app"))
 from app_page import running_pendants  # noqa: E402
-from pendant_page import TIMEOUT_MS, assert_not_blank  # noqa: E402
+from pendant_page import TIMEOUT_MS, assert_not_blank, wait_until  # noqa: E402
 
 pytestmark = pytest.mark.browser
 
@@ -59,15 +58,6 @@ def shots(tmp_path: Path) -> Path:
     out.mkdir(parents=True, exist_ok=True)
     return out
 
-
-def wait_until(cond: Callable[[], Any], what: str, timeout: float = 60.0) -> Any:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        value = cond()
-        if value is not None and value is not False:
-            return value
-        time.sleep(0.05)
-    raise AssertionError(f"timed out waiting for {what}")
 
 
 def session_of(app: PendantApp) -> Any:

@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import io
 import sys
-import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
@@ -29,7 +28,7 @@ from tcp_pendant.server import PendantApp
 sys.path.insert(0, str(Path(__file__).parent))
 sys.path.insert(0, str(Path(__file__).parents[1] / "app"))
 from app_page import running_pendants  # noqa: E402
-from pendant_page import TIMEOUT_MS  # noqa: E402
+from pendant_page import TIMEOUT_MS, wait_until  # noqa: E402
 
 pytestmark = pytest.mark.browser
 
@@ -44,15 +43,6 @@ def pendant(tmp_path: Path) -> Iterator[Callable[..., PendantApp]]:
     with running_pendants(tmp_path) as start:
         yield start
 
-
-def wait_until(cond: Callable[[], Any], what: str, timeout: float = 60.0) -> Any:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        value = cond()
-        if value is not None and value is not False:
-            return value
-        time.sleep(0.05)
-    raise AssertionError(f"timed out waiting for {what}")
 
 
 def inset(page: Any) -> Any:
