@@ -44,6 +44,7 @@ CONFIDENCE: float = 0.95
 _EYE3 = np.eye(3)
 _EYE3.setflags(write=False)
 _SQRT8 = 2.0 * math.sqrt(2.0)
+_dot = np.dot  # small 2-D products: ~1 us less Python dispatch than the @ operator (hot path)
 
 
 def soa(rotations: np.ndarray) -> np.ndarray:
@@ -102,7 +103,7 @@ class Information(NamedTuple):
     def m_inv(self) -> np.ndarray:
         """``M^-1 = ((A^T A)^-1)_tt`` from the eigen-decomposition (observable sets only)."""
         v = self.eigvecs
-        m_inv: np.ndarray = (v / self.eigvals) @ v.T
+        m_inv: np.ndarray = _dot(v / self.eigvals, v.T)
         return m_inv
 
     @property
@@ -128,7 +129,7 @@ _N_EYE: dict[int, np.ndarray] = {}
 def information_from_sum(s: np.ndarray, n: int) -> Information:
     """:class:`Information` from ``S = sum_i R_i`` (3x3) and N: ``M = N I - S^T S / N``."""
     rbar = s / n
-    m = s.T @ rbar
+    m = _dot(s.T, rbar)
     n_eye = _N_EYE.get(n)
     if n_eye is None:
         n_eye = _EYE3 * n
