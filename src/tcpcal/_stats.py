@@ -293,7 +293,7 @@ def angle_extremes(rotations: np.ndarray, rotations_soa: np.ndarray | None = Non
         return _angle_extremes_large(rotations)
     x = rotations.reshape(n, 9)
     if n <= _GRAM_SMALL:
-        g = x @ x.T if gram is None else gram
+        g = _dot(x, x.T) if gram is None else gram
         k_max = int(g.argmin())  # smallest trace = largest angle (diagonal is the maximum 3)
         g.ravel()[:: n + 1] = -np.inf
         k_min = int(g.argmax())
@@ -330,7 +330,7 @@ def _blocked_gram_extremes(x: np.ndarray, xt: np.ndarray) -> tuple[int, int, int
     while i < n:
         cols = n - i  # columns i.. of rows i..: the upper triangle and the diagonal block
         rows = min(max(_GRAM_BLOCK_ENTRIES // cols, 1), cols)
-        blk = x[i : i + rows] @ xt[:, i:]
+        blk = _dot(x[i : i + rows], xt[:, i:])
         diag = blk.ravel()[: rows * (cols + 1) : cols + 1]  # the pairs (i + k, i + k)
         k = int(blk.argmin())  # the diagonal (trace 3, the largest) only wins a tie
         if k % (cols + 1) == 0:  # ... of identical orientations: look again without it

@@ -226,7 +226,7 @@ def _lstsq_core(info: Information, m_inv: np.ndarray, rotations: np.ndarray, f: 
     e -= neg_d
     e -= rbar_t
     e_flat = e.reshape(3 * n)
-    return _LstsqFit(t, rbar_t + fbar, e, float(e_flat @ e_flat), neg_d)
+    return _LstsqFit(t, rbar_t + fbar, e, float(_dot(e_flat, e_flat)), neg_d)
 
 
 def _pairwise_core(rotations: np.ndarray, f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
