@@ -322,7 +322,12 @@ def _pair_angles_deg(x: np.ndarray, *pairs: tuple[int, int]) -> list[float]:
 
 def _blocked_gram_extremes(x: np.ndarray, xt: np.ndarray) -> tuple[int, int, int, int]:
     """Pairs ``(a, b)`` of the smallest and ``(c, e)`` of the largest Gram entry off the
-    diagonal, the upper triangle reduced block by block (O(N^2) time, O(N) memory)."""
+    diagonal, the upper triangle reduced block by block (O(N^2) time, O(N) memory).
+
+    A float32 screen of the blocks (with a rigorous rounding margin, float64 only for the
+    entries within it) was measured no faster on the benchmark's sets: near 180 deg the trace
+    ``-1 + (pi - angle)^2`` puts hundreds of pairs within the float32 margin of the smallest,
+    and the extra comparison pass per block cost what the cheaper products saved."""
     n = x.shape[0]
     lo, hi = math.inf, -math.inf
     a = b = c = e = 0
