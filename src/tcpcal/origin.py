@@ -220,13 +220,13 @@ def _lstsq_core(info: Information, m_inv: np.ndarray, rotations: np.ndarray, f: 
     fbar = (_add(f, axis=0) if n <= 64 else sum_over_touches(f)) / n  # sum_over_touches, inlined (hot path)
     neg_d = fbar - f  # -d_i (the sign spares a negation below)
     rows = rotations.reshape(3 * n, 3)
-    t = m_inv @ (neg_d.reshape(3 * n) @ rows)
-    rbar_t = info.rbar @ t
-    e = (rows @ t).reshape(n, 3)
+    t = _dot(m_inv, _dot(neg_d.reshape(3 * n), rows))
+    rbar_t = _dot(info.rbar, t)
+    e = _dot(rows, t).reshape(n, 3)
     e -= neg_d
     e -= rbar_t
     e_flat = e.reshape(3 * n)
-    return _LstsqFit(t, rbar_t + fbar, e, float(e_flat @ e_flat), neg_d)
+    return _LstsqFit(t, rbar_t + fbar, e, float(_dot(e_flat, e_flat)), neg_d)
 
 
 def _pairwise_core(rotations: np.ndarray, f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -484,6 +484,7 @@ def solve_xyz4(
 
 _add = np.add.reduce  # ufunc reductions without the Python wrapper of ndarray.sum (hot path)
 _max = np.maximum.reduce
+_dot = np.dot  # small 2-D products: less Python dispatch than the @ operator (hot path)
 try:  # numpy.einsum without its Python dispatch (optimize=False calls this very function)
     from numpy._core.multiarray import c_einsum as _einsum
 except ImportError:  # pragma: no cover - another numpy
@@ -518,7 +519,7 @@ def _observability(rot: np.ndarray, y: np.ndarray | None, info: Information) -> 
     if info.observable:
         if n <= _GRAM_SMALL:
             x = rot.reshape(n, 9)
-            largest = float(_max(x @ x.T, axis=None, where=_off_diagonal(n), initial=-math.inf))
+            largest = float(_max(_dot(x, x.T), axis=None, where=_off_diagonal(n), initial=-math.inf))
             if largest < _DUPLICATE_PRETEST_TRACE:
                 return None
         elif distinct_orientations(rot, limit=MIN_TOUCHES).count >= MIN_TOUCHES:
