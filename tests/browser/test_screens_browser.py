@@ -181,3 +181,79 @@ def test_result_screens(pendant, new_page, shots) -> None:
             assert_not_blank(png)
         with ThreadPoolExecutor(max_workers=1) as pool:
             pool.submit(s.cancel_wizard).result()
+
+
+def _view_png(page: Any) -> Any:
+    """The page as an RGB array (int16, for differences)."""
+    from io import BytesIO
+
+    from PIL import Image
+    return np.asarray(Image.open(BytesIO(page.screenshot())).convert("RGB"), dtype=np.int16)
+
+
+def _steady_view(page: Any) -> Any:
+    """The page once two screenshots in a row are the same (camera reported, labels re-laid)."""
+    last = _view_png(page)
+
+    def same() -> Any:
+        nonlocal last
+        now = _view_png(page)
+        done = now.shape == last.shape and not np.any(np.abs(now - last) > 8)
+        last = now
+        return now if done else None
+    return wait_until(same, "a steady 3D view", timeout=30.0)
+
+
+def label_box_drawn(page: Any, handle: Any, shown: Any, timeout: float) -> tuple[int, int, int, int] | None:
+    """The screen box (x0, y0, x1, y1 px, inclusive) of one 3D label as chromium draws it: viser
+    draws labels in WebGL (a glyph atlas), not as DOM elements, so the label is hidden and the
+    pixels that change are its box (its white backing and text). None: no pixel changed within
+    ``timeout`` s (a label whose frame is hidden or out of view is not drawn)."""
+    handle.visible = False
+    try:
+        changed = wait_until(lambda: (lambda m: m if m.any() else None)(
+            np.abs(_view_png(page) - shown).max(axis=2) > 24), f"label {handle.text!r} hidden", timeout=timeout)
+    except AssertionError:
+        return None
+    finally:
+        handle.visible = True
+    ys, xs = np.nonzero(changed)
+    return int(xs.min()), int(ys.min()), int(xs.max()), int(ys.max())
+
+
+def box_gap_px(a: tuple[int, int, int, int], b: tuple[int, int, int, int]) -> float:
+    """The gap between two boxes, px: > 0 apart, <= 0 overlapping (the overlap's smaller side)."""
+    gx = max(a[0], b[0]) - min(a[2], b[2]) - 1
+    gy = max(a[1], b[1]) - min(a[3], b[3]) - 1
+    return float(max(gx, gy)) if max(gx, gy) > 0 else float(max(gx, gy))
+
+
+def test_result_labels_drawn_apart_at_1024x768(pendant, new_page) -> None:
+    """The 4-point result at 1024x768: the labels at the tip (TRUE, COMPUTED, TOOL, reference tip,
+    FLANGE), as chromium draws them, do not overlap (measured: the smallest gap, printed)."""
+    app = pendant()
+    page = new_page(app.url, width=1024, height=768)
+    s = session_of(app)
+    page.get_by_role("tab", name="Calibrate").click()
+    with ThreadPoolExecutor(max_workers=1) as pool:
+        assert pool.submit(finish_by_auto_touch, s, "xyz4").result() is not None
+    page.get_by_text("Against the true TOOL frame").filter(visible=True).first.wait_for(
+        state="visible", timeout=TIMEOUT_MS)
+    scene = s.views["calibrate"].scene
+    wait_until(lambda: scene.computed.visible, "the COMPUTED triad")
+    page.mouse.move(1000, 760)
+    labels = {"COMPUTED": scene.computed_label, "TRUE": scene.true_label,
+              **{n: s.scene_labels[n] for n in ("tool", "tip", "flange") if n in s.scene_labels}}
+    shown = _steady_view(page)
+    boxes = {}
+    for name, handle in labels.items():
+        if handle.visible:
+            box = label_box_drawn(page, handle, shown, 20.0 if name in ("COMPUTED", "TRUE", "tip") else 3.0)
+            if box is not None:
+                boxes[name] = box
+                shown = _steady_view(page)
+    assert {"COMPUTED", "TRUE", "tip"} <= set(boxes), boxes
+    gaps = {(a, b): box_gap_px(boxes[a], boxes[b]) for i, a in enumerate(boxes) for b in list(boxes)[i + 1:]}
+    (pair, smallest), = [min(gaps.items(), key=lambda kv: kv[1])]
+    print(f"label boxes {boxes}; smallest gap {smallest:.0f} px between {pair}")
+    assert smallest > 0, f"labels {pair} overlap by {-smallest:.0f} px: {boxes}"
