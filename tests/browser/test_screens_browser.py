@@ -2,7 +2,8 @@
 
 * The jog keys stay put: their boxes far from the reference tip, within 20 mm of it (the text
   close-up and the tip views shown) and after a jog stopped at contact (the stop message
-  shown) are the same (within 2 px), and all of them are inside the viewport.
+  shown) are the same (within 2 px), and all of them are inside the viewport; in a wizard,
+  the dock's tilt line (empty, then naming the best tilt) does not move them either.
 * The beam result's 3D labels at 1024x768, as drawn (each label's box found by hiding it and
   comparing screenshots: viser draws labels in WebGL, not in the DOM), do not overlap.
 * The result screens: the 4-point result, an orientation result (TCP & Z, X) and the beam
@@ -135,6 +136,18 @@ def test_jog_keys_stay_put_near_the_tip_and_at_a_stop(pendant, new_page, shots) 
         png = shots / f"jog_near_tip_{size[0]}x{size[1]}.png"
         page.screenshot(path=str(png))
         assert_not_blank(png)
+    # in a wizard: the dock above the keys; its tilt line (empty after one touch, the words after
+    # two) keeps its height, so the keys stay where the open dock put them
+    with ThreadPoolExecutor(max_workers=1) as pool:
+        pool.submit(lambda: (s.start_wizard("xyz4"), s.auto_touch(AutoTouchRequest()))).result()
+    page.get_by_text("Step 2 of 4").first.wait_for(state="visible", timeout=TIMEOUT_MS)
+    page.wait_for_timeout(300)
+    one_touch = key_boxes(page)
+    with ThreadPoolExecutor(max_workers=1) as pool:
+        assert pool.submit(s.auto_touch, AutoTouchRequest()).result().ok
+    page.get_by_text("Tilt that helps most").first.wait_for(state="visible", timeout=TIMEOUT_MS)
+    page.wait_for_timeout(300)
+    assert_same_and_inside(one_touch, key_boxes(page), SIZES[-1], "with the dock's tilt line")
 
 
 def finish_by_auto_touch(s: Any, kind: str, **options: Any) -> Any:
