@@ -35,7 +35,10 @@ from tcp_pendant.pendant.guidance import tip_offset_mm  # noqa: E402
 from tcp_pendant.pendant.jogging import LINEAR_SPEED_MM_S  # noqa: E402
 from tcp_pendant.server import PendantApp  # noqa: E402
 from tcp_pendant.views.pendant_panel import HOLD_HZ, MARK  # noqa: E402
-from tcp_pendant.views.wizard_dock import BACK, CANCEL, NEXT  # noqa: E402
+from tcp_pendant.calibrate.diversity import best_tilt, best_tilt_words  # noqa: E402
+from tcp_pendant.text_escape import escape_html  # noqa: E402
+from tcp_pendant.calibrate import AutoTouchRequest  # noqa: E402
+from tcp_pendant.views.wizard_dock import BACK, CANCEL, NEXT, TILT_LINE_STYLE, tilt_line_html  # noqa: E402
 
 
 class Page(AppPage):
@@ -92,6 +95,28 @@ def test_the_dock_shows_the_wizards_step_on_the_jog_tab_and_records_it(page) -> 
     assert any("cancelled" in t for t, _ in p.notes)
     p.click(p.calibrate.resume)                                     # the Calibrate tab resumes it
     assert dock.folder.visible and not dock.note_md.visible         # the old line did not carry over
+
+
+def test_the_docks_tilt_line_names_the_best_tilt_on_one_fixed_line(page) -> None:
+    p = page()
+    s, dock = p.session, p.dock
+    p.click(p.calibrate.start)                                      # XYZ 4-point
+    wiz = p.calibrate.workflow.wizard
+    # one touch or none: every turn is as good, the line stays (empty, the same height)
+    assert dock.tilt_html.visible and dock.tilt_html.content == tilt_line_html(None)
+    assert "&nbsp;" in dock.tilt_html.content and "white-space:nowrap" in TILT_LINE_STYLE
+    for _ in range(2):
+        assert s.auto_touch(AutoTouchRequest()).ok
+    assert wiz.step.index == 2
+    c = s.controller
+    best = best_tilt(wiz.other_rotations(), c.T_world_flange()[:3, :3], R_flange_tool=c.T_flange_tool[:3, :3],
+                     sigma_mm=wiz.assumed_sigma_mm)
+    assert best is not None
+    words = best_tilt_words(best).replace("**", "")
+    assert words.startswith("Tilt that helps most: about TOOL "), words
+    html = dock.tilt_html.content                                   # the words, escaped, in the line
+    assert html == tilt_line_html(best_tilt_words(best)) and f">{escape_html(words)}</div>" in html
+    assert f'style="{TILT_LINE_STYLE}"' in html and "height:1.5em" in TILT_LINE_STYLE
 
 
 def test_record_far_from_the_tip_asks_first_and_hide_distance_records(page) -> None:

@@ -3,7 +3,9 @@
 While a calibration wizard is open, the top of the Jog tab shows its current step ("Step k
 of N", what to do), **Record** (the step's, checked: ``pendant.record_check``), a row
 "◀ Back · Next ▶ (Finish) · Cancel", the tool change a step asks for, and the pose-diversity
-meter (bar and one line), so a trainee jogs, watches and records on one screen; the Calibrate
+meter (bar, one line and the tilt that helps most on a line of its own, one line high whatever
+its length: cut with an ellipsis, the whole hint in its tooltip, so the keys below never move),
+so a trainee jogs, watches and records on one screen; the Calibrate
 tab stays the place to choose a method and review the result. Outside a wizard the dock is
 hidden and the touch list's "Record point" records into the free list (one Record concept).
 A step the controller runs itself (``AutoRole.by_controller``: the beam wizard's scan) shows no
@@ -25,9 +27,10 @@ import math
 from collections.abc import Callable, Coroutine
 from typing import TYPE_CHECKING, Any
 
+from tcp_pendant.calibrate.diversity import best_tilt, best_tilt_words
 from tcp_pendant.calibrate.text import meter_level, step_markdown
 from tcp_pendant.pendant.guidance import direction_words, tip_offset_mm
-from tcp_pendant.text_escape import escape_markdown
+from tcp_pendant.text_escape import escape_html, escape_markdown
 from tcp_pendant.pendant.record_check import RecordCheck
 from tcp_pendant.pendant.touch_feedback import touch_feedback
 from tcp_pendant.session import Session, SessionChange
@@ -36,11 +39,25 @@ from tcp_pendant.views.gui_util import ButtonEvent, ButtonGroupEvent, set_conten
 if TYPE_CHECKING:
     from tcp_pendant.calibrate import CalibrationWorkflow
 
-__all__ = ["BACK", "CANCEL", "CLOSE", "FINISH", "NEXT", "WizardDock"]
+__all__ = ["BACK", "CANCEL", "CLOSE", "FINISH", "NEXT", "WizardDock", "tilt_line_html"]
 
 log = logging.getLogger(__name__)
 
 BACK, NEXT, FINISH, CANCEL, CLOSE = "◀ Back", "Next ▶", "Finish ▶", "Cancel", "Close"
+
+
+TILT_LINE_STYLE = ("height:1.5em;line-height:1.5em;white-space:nowrap;overflow:hidden;"
+                   "text-overflow:ellipsis;font-size:0.875em;padding:0 0.75em")
+"""One line, always the same height (an empty hint keeps the line): the jog keys below stay put."""
+
+
+def tilt_line_html(hint: str | None) -> str:
+    """The dock's tilt line: ``hint`` (``diversity.best_tilt_words``, markdown bold dropped)
+    escaped, on one line cut with an ellipsis, the whole hint as the tooltip; no hint: the
+    same line, empty."""
+    text = escape_html((hint or "").replace("**", ""))
+    title = f' title="{text}"' if text else ""
+    return f'<div style="{TILT_LINE_STYLE}"{title}>{text or "&nbsp;"}</div>'
 
 
 class WizardDock:
@@ -64,6 +81,7 @@ class WizardDock:
             self.nav = gui.add_button_group("Step", (BACK, NEXT, CANCEL))
             self.meter_bar = gui.add_progress_bar(0.0, color="gray", visible=False)
             self.meter_md = gui.add_markdown("", visible=False)
+            self.tilt_html = gui.add_html(tilt_line_html(None), visible=False)
         self.record.on_click(self._action(self._on_record))
         self.nav.on_click(self._on_nav_click)
         self.mount.on_click(self._action(lambda _e: self.session.mount_required_tool(), sync=True))
@@ -196,10 +214,11 @@ class WizardDock:
         wf = self.session.workflow
         wiz: Any = wf.wizard  # a meter wizard (duck-typed: preview(), ...)
         show = wiz is not None and bool(wiz.meter_active)
-        self.meter_bar.visible = self.meter_md.visible = show
+        self.meter_bar.visible = self.meter_md.visible = self.tilt_html.visible = show
         if not show:
             return
-        gain = wiz.preview(self.session.controller.T_world_flange())
+        T_world_flange = self.session.controller.T_world_flange()
+        gain = wiz.preview(T_world_flange)
         value, color = meter_level(gain)
         set_value(self.meter_bar, round(value, 1))
         self.meter_bar.color = color
@@ -214,3 +233,7 @@ class WizardDock:
             text = (f"Pose diversity: {angle:.0f}° from the nearest touch; predicted TCP error "
                     f"{gain.predicted_after:.2f} mm if recorded here.")
         set_content(self.meter_md, text)              # numbers and our words only
+        R_flange_tool = self.session.controller.T_flange_tool[:3, :3]   # the jog keys' TOOL frame
+        tilt = best_tilt(wiz.other_rotations(), T_world_flange[:3, :3], R_flange_tool=R_flange_tool,
+                         sigma_mm=wiz.assumed_sigma_mm)
+        set_content(self.tilt_html, tilt_line_html(None if tilt is None else best_tilt_words(tilt)))
