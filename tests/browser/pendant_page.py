@@ -14,18 +14,19 @@ from pathlib import Path
 from collections.abc import Callable
 from typing import Any
 
+import numpy as np
+
 TIMEOUT_MS = 60_000
 
 
 def wait_until(cond: Callable[[], Any], what: str, timeout: float = 60.0) -> Any:
     """Poll ``cond`` on the test's side (a server's state, not the page) until it gives a
-    value other than None, False or an empty container (an empty dict of sessions is not yet a
-    session), and return that value; fail naming ``what``."""
+    truthy value, or a non-empty array (a screenshot), and return that value; an empty dict of
+    sessions is not yet a session, and numpy's False is False. Fail naming ``what``."""
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:
         value = cond()
-        empty = isinstance(value, (dict, list, tuple, set, str)) and not value
-        if value is not None and value is not False and not empty:   # an array counts as given
+        if value.size > 0 if isinstance(value, np.ndarray) else bool(value):   # an image counts as given
             return value
         time.sleep(0.05)
     raise AssertionError(f"timed out waiting for {what}")
