@@ -65,6 +65,8 @@ class Browsers:
         self.sb = [s for s in self.app.sessions.values() if s is not self.sa][0]
         self.view = self.sa.views["calibrate"]
         self.notes: list[tuple[str, str]] = []
+        self.dropped = 0
+        """B's presses that the deadman dropped (pressed again by :meth:`jog_latency_s`)."""
         self.sa.notify = lambda title, body, kind="info": self.notes.append((title, body))  # type: ignore[method-assign]
         with self.sb.lock:
             self.sb.jogger.settings = self.sb.jogger.settings.with_(increment="0.1", frame="WORLD")
@@ -86,15 +88,24 @@ class Browsers:
         return transfer
 
     def jog_latency_s(self, sign: int) -> float:
-        """Click X+ in browser B and wait until B's robot moved: seconds."""
+        """Click X+ in browser B and wait until B's robot moved: seconds from the first click.
+        A press the server's deadman dropped (it reached the jog more than 250 ms after it
+        arrived; B is told "press again") is pressed again, as the trainee would, so its
+        latency counts the drop, and :attr:`dropped` counts it."""
         x0 = self.sb.controller.T_world_tcp()[0, 3]
         with self.sb.lock:
             self.sb.jogger.settings = self.sb.jogger.settings.with_(increment="0.1")
+        gate = self.sb.jogger.gate
+        dropped_before = gate.dropped_total
         t0 = time.perf_counter()
         self.b.click(PLUS_X)
         while abs(self.sb.controller.T_world_tcp()[0, 3] - x0) < 5e-5:
             if time.perf_counter() - t0 > 10:
                 raise AssertionError("a jog of browser B never arrived")
+            if gate.dropped_total > dropped_before:          # dropped: press again
+                self.dropped += gate.dropped_total - dropped_before
+                dropped_before = gate.dropped_total
+                self.b.click(PLUS_X)
             time.sleep(0.001)
         return time.perf_counter() - t0
 
@@ -139,7 +150,7 @@ def test_a_second_browser_jogs_normally_while_a_record_just_under_the_limits_is_
     p99 = float(np.percentile(latencies, 99))
     print(f"\njog latency of browser B: baseline max {max(baseline) * 1e3:.0f} ms; during the load "
           f"({len(latencies)} jogs, {during} inside the replay) p50 {np.median(latencies) * 1e3:.0f} ms, "
-          f"p99 {p99 * 1e3:.0f} ms, max {max(latencies) * 1e3:.0f} ms")
+          f"p99 {p99 * 1e3:.0f} ms, max {max(latencies) * 1e3:.0f} ms, {br.dropped} presses dropped and pressed again")
     assert p99 < P99_LIMIT_S
 
 
