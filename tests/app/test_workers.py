@@ -77,6 +77,12 @@ def test_two_processes_share_the_port_the_class_and_each_keeps_the_deadman(worke
             for _ in range(1500):
                 await c.send_update(PLUS, {"value": True})
             last_press = time.monotonic()
+            # under overload a press's readout merges with the presses queued behind it: wait for
+            # the first readout of the flood (none in 5 s: every press was dropped, and the
+            # asserts below say so), so that the BASE switch cannot merge into that one render
+            deadline = last_press + 5
+            while not c.readouts and time.monotonic() < deadline:
+                await asyncio.sleep(0.02)
             await c.send_update(READOUT_LABEL, {"value": "BASE"})   # answered after every press before it
             deadline = time.monotonic() + 30
             while not any(f == "BASE" for _, f in c.frames) and time.monotonic() < deadline:
