@@ -50,12 +50,18 @@ and the fewest touches a Finish takes; they are part of the rules (``ExerciseRul
 until the trainer pushes another brief (a change of exercise keeps them).
 
 The trainer's **messages** (:meth:`ClassRoom.send_message`) go to every connected trainee or
-to one, each delivered on viser's loop to that trainee's session only
-(``Session.show_message``), which keeps it until the trainee dismisses it. The class keeps, by
-name, the messages each trainee has not dismissed yet (mirrored from the session's ``notice``
-signal), so an undismissed message comes back after a reload or when the trainee joins again;
-a message to one trainee who left waits for them. They live in memory: a server restart drops
-them (the brief, which is kept in the gradebook, is the lasting text).
+to one, and are kept in the gradebook (``Gradebook.add_message``: one row per trainee) until
+that trainee dismisses them: each is delivered on viser's loop to that trainee's session only
+(``Session.show_message``), at once on the trainer's process and by the heartbeat
+(:meth:`ClassRoom.beat`) on whichever process holds the trainee now, and again after a reload,
+a join on another process or a restart of the server. A Dismiss (the session's ``notice``
+signal: a message no longer on its screen) deletes that trainee's row
+(``Gradebook.dismiss_messages``). A message to one trainee who left waits for them.
+
+Wrong trainer tokens are counted in the gradebook per source address
+(``Gradebook.try_token``, ``classroom.trainer_token``), so the lockout holds on every process
+of the class and after a restart. Who left (connected, then not: :meth:`trainee_statuses`) is
+kept there too (``Gradebook.depart`` / ``departed``), the same on every process.
 
 Several server processes on one gradebook (``tcp-pendant --workers N``): each process has its
 own sessions and its own ClassRoom (:attr:`ClassRoom.holder` names it); what the class shares
@@ -66,7 +72,7 @@ exactly as on the same one, the same browser's newer tab on another process take
 (the older one's welcome window opens again at the next beat), a release by the trainer on
 any process sends the browser on its holder back to the welcome window, and
 :meth:`trainee_statuses` and :meth:`connected_names` list the whole class (the other
-processes' rows as they last beat them; who left is listed by the process they left). Every
+processes' rows as they last beat them, and who left, from the gradebook). Every
 push of the trainer's settings is kept in order (``Gradebook.add_push``) and applied by the
 other processes at their next beat. A reconnect landing on another process gets the
 calibrations in progress back from the gradebook (``classroom.restore``), like a restart.
@@ -81,7 +87,6 @@ from __future__ import annotations
 import dataclasses
 import functools
 import hashlib
-import itertools
 import logging
 import os
 import secrets
@@ -98,9 +103,9 @@ from tcp_pendant.classroom.names import TraineeNameError, validate_trainee_name
 from tcp_pendant.classroom.recorder import TraineeRecorder, TraineeStatus
 from tcp_pendant.classroom.replay import CalibrationReplay, calibration_replay
 from tcp_pendant.classroom.restore import runs_to_restore
-from tcp_pendant.classroom.trainer_token import TokenAttempts, validate_trainer_token
+from tcp_pendant.classroom.trainer_token import FORGET_S, lock_s, locked, log_failure, validate_trainer_token
 from tcp_pendant.controller import ToolModel
-from tcp_pendant.pendant.class_messages import MAX_WAITING_MESSAGES, ClassMessage, clean_message_text
+from tcp_pendant.pendant.class_messages import ClassMessage, clean_message_text
 from tcp_pendant.pendant.exercise_rules import (
     DistanceAids,
     ExerciseRules,
@@ -162,6 +167,23 @@ def clean_methods(methods: object) -> tuple[str, ...] | None:
     return tuple(k for k in known if k in methods)
 
 
+def source_address(session: Session) -> str:
+    """The address the browser of ``session`` connects from (its websocket's peer IP, the
+    trainer token's lockout counts per address); "unknown" when there is none to read (a
+    shared page, a closed connection): all such tries share one count.
+
+    viser keeps the connection of each client in its websocket server's table of live
+    connections (``_live_connections``, by client id); that table is private API, read here
+    with a fallback."""
+    client = session.client
+    try:
+        server = client._viser_server._websock_server  # type: ignore[union-attr]
+        connection = server._live_connections[client.client_id]  # type: ignore[union-attr]
+        return str(connection.remote_address[0])
+    except (AttributeError, KeyError, IndexError, TypeError):
+        return "unknown"
+
+
 def _token_digest(token: str) -> str:
     # A random token has 128 bits and a given one at least 16 characters: a plain SHA-256 is
     # enough for a file that holds the class's answers anyway.
@@ -181,7 +203,8 @@ class ClassRoom:
         instructions, allowed_methods, min_touches: the exercise's brief given at start (None:
             the brief kept in the gradebook, else none); each given one wins over the kept one.
         hand_to_loop: runs a function on viser's event loop.
-        clock: seconds of a monotonic clock (the token's lockout windows; tests set it).
+        clock: Unix time, seconds (the token's lockout windows, kept in the gradebook for every
+            process of the class; tests set it).
         call_later: ``call_later(delay_s, fn)`` runs ``fn`` on viser's event loop after a
             delay (the dashboards' throttle and clock tick); None: dashboards render at once,
             every time (tests).
@@ -198,7 +221,7 @@ class ClassRoom:
                  instructions: str | None = None, allowed_methods: Sequence[str] | str | None = None,
                  min_touches: int | None = None,
                  hand_to_loop: Callable[[Callable[[], None]], None] = lambda fn: fn(),
-                 clock: Callable[[], float] = time.monotonic,
+                 clock: Callable[[], float] = time.time,
                  call_later: Callable[[float, Callable[[], None]], None] | None = None,
                  library_quota: int = DEFAULT_LIBRARY_QUOTA, presence_poll_s: float = 1.0) -> None:
         if (isinstance(library_quota, bool) or not isinstance(library_quota, int)
@@ -235,13 +258,11 @@ class ClassRoom:
         self._subscribed: set[int] = set()          # id(session) of sessions whose changes we follow
         self._prompts: dict[int, Any] = {}           # id(session) -> its IdentityPrompt
         self._released: dict[int, str] = {}          # id(session) -> the name the trainer released there
-        self._left: list[TraineeStatus] = []        # rows of trainees who left (connected=False)
         self._trainer_views: dict[int, Any] = {}    # id(session) -> TrainerDashboard
         self._call_later = call_later
         self._render_due = False                    # a throttled dashboard render is scheduled
         self._tick_due = False                      # the dashboards' clock tick is scheduled
         self._last_render = -float("inf")           # time.monotonic() of the last render
-        self._token_attempts: dict[int, TokenAttempts] = {}   # id(session) -> its wrong tokens
         self.clock = clock
         self.distance_aids: DistanceAids | None = None
         """The distance aids as the trainer last pushed them (None: the exercise's default -
@@ -256,8 +277,8 @@ class ClassRoom:
         """The wizard kinds trainees may start (None: every method)."""
         self.min_touches = 0
         """The fewest touches a Finish takes, for methods whose touch count is chosen (0: none)."""
-        self._message_ids = itertools.count(1)
-        self._waiting: dict[str, list[ClassMessage]] = {}   # name -> messages not dismissed yet
+        self._on_screen: dict[int, set[int]] = {}   # id(session) -> message ids on its screen, last seen
+        self._handed: dict[int, set[int]] = {}      # id(session) -> message ids handed to it (the loop shows them)
         self.holder = f"{socket.gethostname()}:{os.getpid()}:{secrets.token_hex(4)}"
         """This server process's id in the gradebook's presence table (host, pid, a nonce)."""
         self.presence_poll_s = float(presence_poll_s)
@@ -370,9 +391,11 @@ class ClassRoom:
                 self._trainees[id(session)] = (session, recorder, join.name)
                 follow = id(session) not in self._subscribed
                 self._subscribed.add(id(session))
-                waiting = list(self._waiting.get(join.name, ()))
-            for message in waiting:     # what the trainee had not dismissed yet (before the mirror follows)
+            for message in self._kept_messages(join.name):     # what the trainee had not dismissed yet
                 session.show_message(message)
+            with self._lock:
+                self._on_screen[id(session)] = {m.message_id for m in session.messages}
+                self._handed[id(session)] = set(self._on_screen[id(session)])
             if follow:
                 session.subscribe(lambda change: self._on_change(session, change))
             session.set_hide_truth(self.exercise is not None)
@@ -388,9 +411,8 @@ class ClassRoom:
             entry = self._trainees.get(id(session))
         if entry is None:                  # not (or no longer) a named trainee: nothing to store
             return
-        if change.notice:                  # the messages this trainee has not dismissed, by name
-            with self._lock:
-                self._waiting[entry[2]] = list(session.messages)
+        if change.notice:
+            self._note_dismissed(session, entry[2])
         recorder = entry[1]
         before = recorder.status
         recorder.on_change(change)
@@ -410,8 +432,7 @@ class ClassRoom:
             recorder.disconnected()
         except Exception:
             log.exception("ending the gradebook session of %r failed", name)
-        with self._lock:
-            self._left.append(recorder.status)
+        self._depart(name, recorder.status)
         self._drop_presence(name)
         session.library_rights = self._library_rights(session, None)  # at once: it changes nothing more
         self._hand_to_loop(session.guard(lambda: session.set_library_rights(session.library_rights)))
@@ -469,7 +490,8 @@ class ClassRoom:
         with self._lock:
             entry = self._trainees.get(id(session))
             self._trainer_views.pop(id(session), None)
-            self._token_attempts.pop(id(session), None)
+            self._on_screen.pop(id(session), None)
+            self._handed.pop(id(session), None)
             self._prompts.pop(id(session), None)
             self._released.pop(id(session), None)
             self._subscribed.discard(id(session))
@@ -478,10 +500,12 @@ class ClassRoom:
                 entry[1].disconnected()
             except Exception:
                 log.exception("ending the gradebook session of %r failed", entry[2])
-            with self._lock:                 # one step: the row is never missing from the table
-                if self._trainees.get(id(session)) is entry:
+            with self._lock:
+                gone = self._trainees.get(id(session)) is entry
+                if gone:
                     self._trainees.pop(id(session), None)
-                    self._left.append(entry[1].status)
+            if gone:
+                self._depart(entry[2], entry[1].status)
             self._drop_presence(entry[2])
         self._hand_to_loop(self.refresh_trainers)
 
@@ -489,6 +513,17 @@ class ClassRoom:
     def _local_names(self) -> set[str]:
         with self._lock:
             return {e[2] for e in self._trainees.values()}
+
+    def _depart(self, name: str, status: TraineeStatus) -> None:
+        """``name`` left this process: kept in the gradebook with their last row (the trainer's
+        table on every process lists them as not connected), unless another session of this
+        process holds the name now."""
+        if name in self._local_names():
+            return
+        try:
+            self.gradebook.depart(name, dataclasses.asdict(dataclasses.replace(status, connected=False)))
+        except GradebookError:
+            log.exception("the departure of %r could not be kept", name)
 
     def _drop_presence(self, name: str) -> None:
         """The name's row goes, unless another session of this process holds the name now."""
@@ -554,6 +589,7 @@ class ClassRoom:
             self._push_seen = push_id
             if push.get("holder") != self.holder:
                 self._hand_to_loop(functools.partial(self._apply_remote_push, push))
+        self._deliver_kept({name: e for name, e in entries.items() if name in held})
         if changed:
             self._hand_to_loop(self.refresh_trainers)
 
@@ -571,8 +607,8 @@ class ClassRoom:
         self.refresh_trainers()
 
     def _apply_remote_push(self, push: dict[str, Any]) -> None:
-        """A push the trainer made on another server process of the class: settings, a brief
-        or a message (``kind``), applied to this process's trainees."""
+        """A push the trainer made on another server process of the class: settings, a brief,
+        a reset or a push to one trainee (``kind``), applied to this process's trainees."""
         kind = push.get("kind", "settings")
         try:
             if kind == "settings":
@@ -586,28 +622,39 @@ class ClassRoom:
             elif kind == "push_to":
                 self.push_to(str(push.get("name")), push.get("exercise", False), push.get("tool_key"),
                              push.get("hide_distance"), push.get("auto_touch"), forward=False)
-            elif kind == "message":
-                self._deliver(clean_message_text(push.get("text", "")), push.get("to"), str(push.get("sent", "")),
-                              also_waiting=False)
         except (ValueError, TypeError) as exc:
             log.warning("a %s pushed on another server process was not applied: %s", kind, exc)
 
     # ------------------------------------------------------------ trainer
     def open_trainer(self, session: Session, token: str) -> bool:
         """A browser typed ``token``: if it is the trainer token, build the trainer view there.
-        Wrong tokens are counted per browser (``classroom.trainer_token.TokenAttempts``).
+        Wrong tokens are counted per source address in the gradebook, for every server process
+        of the class (``Gradebook.try_token``, ``classroom.trainer_token``); the right one
+        forgives its address's.
 
         Raises:
-            TrainerTokenLocked: this browser typed too many wrong tokens; the token was not tried.
+            TrainerTokenLocked: this browser's address typed too many wrong tokens; the token was
+                not tried.
+            ValueError: the gradebook cannot count the try (the token is not tried either).
         """
         now = self.clock()
-        with self._lock:
-            attempts = self._token_attempts.setdefault(id(session), TokenAttempts())
-        attempts.check(now)
+        source = source_address(session)
+        try:
+            wait, failures, counted = self.gradebook.try_token(source, now=now, forget_s=FORGET_S, lock_s=lock_s)
+        except GradebookError as exc:
+            log.error("a trainer token was not tried: %s", exc)
+            raise ValueError("The class gradebook cannot be read now, so no trainer token is tried; "
+                             "try again in a moment.") from None
+        if not counted:
+            raise locked(wait)
         if not secrets.compare_digest(_token_digest(token), self._token_sha256):
             client_id = getattr(session.client, "client_id", None)
-            attempts.failed(now, "a shared page" if client_id is None else f"browser {client_id}", token)
+            log_failure("a shared page" if client_id is None else f"browser {client_id}", failures, token)
             return False
+        try:
+            self.gradebook.forgive_token_failures(source)
+        except GradebookError:
+            log.exception("the wrong trainer tokens of %s could not be forgiven", source)
         from tcp_pendant.views.dashboard import open_dashboard
 
         with self._lock:
@@ -768,12 +815,29 @@ class ClassRoom:
     def trainee_statuses(self) -> list[TraineeStatus]:
         """Rows of the live table: this process's connected trainees in order of arrival, those
         connected on the other server processes of the class (by name, as they last beat),
-        then those who left this process."""
+        then those who were connected and left, on any process of the class, the latest first,
+        with their last row (``Gradebook.departed``; a trainee connected again is not among
+        them)."""
+        try:
+            departed = self.gradebook.departed()
+        except GradebookError:
+            log.exception("who left the class could not be read")
+            departed = []
+        fields = {f.name for f in dataclasses.fields(TraineeStatus)}
         with self._lock:
             local = [rec.status for _, rec, _ in self._trainees.values()]
             names = {row.name for row in local}
             remote = [row for name, row in sorted(self._remote.items()) if name not in names]
-            return local + remote + list(self._left)
+        names |= {row.name for row in remote}
+        left = []
+        for name, st in departed:
+            if name in names:
+                continue
+            try:
+                left.append(TraineeStatus(**{k: v for k, v in st.items() if k in fields}))
+            except TypeError:
+                continue
+        return local + remote + left
 
     def grade_rows(self) -> list[GradeRow]:
         return self.gradebook.grades()
@@ -915,52 +979,88 @@ class ClassRoom:
         return local + [name for name in remote if name not in local]
 
     def send_message(self, text: str, to: str | None = None) -> str:
-        """Send ``text`` (plain text) to every connected trainee (``to`` None) or to the trainee
-        named ``to`` (connected, or one who left: it waits until they join again). Each session
-        gets it on viser's loop (``Session.show_message``) and keeps it until dismissed.
-        Returns what happened, in words for the trainer (plain text).
+        """Send ``text`` (plain text) to every connected trainee of the class (``to`` None) or
+        to the trainee named ``to`` (connected, or one who left: it waits until they join
+        again). It is kept in the gradebook for each of them until they dismiss it
+        (``Gradebook.add_message``), shown at once to those on this process and by the other
+        processes' heartbeat to theirs (module docstring). Returns what happened, in words for
+        the trainer (plain text).
 
         Raises:
             ValueError: an empty or too long text; ``to`` is no trainee of this class.
         """
         clean = clean_message_text(text)
-        with self._lock:
-            left = {status.name for status in self._left}
-            remote = {name for name in self._remote}
-        if to is not None:
-            if not isinstance(to, str):
-                raise ValueError("Choose whom to send the message to.")
-            with self._lock:
-                known = to in left or to in self._waiting or to in remote
-            if not known and to not in self._local_names():
-                raise ValueError(f"{to:.60} is not in the class; choose a trainee in the list, or all trainees.")
+        if to is not None and not isinstance(to, str):
+            raise ValueError("Choose whom to send the message to.")
+        connected = self.connected_names()
+        if to is not None and to not in connected and to not in self.gradebook.trainee_names():
+            raise ValueError(f"{to:.60} is not in the class; choose a trainee in the list, or all trainees.")
+        names = connected if to is None else [to]
         sent = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
-        entries = self._deliver(clean, to, sent, also_waiting=to not in remote)
-        try:                              # the trainees on the other server processes of the class
-            self.gradebook.add_push({"holder": self.holder, "kind": "message", "text": clean, "to": to, "sent": sent})
-        except GradebookError:
-            log.exception("the message could not be passed to the other server processes")
-        there = [n for n in remote if n not in {e[2] for e in entries}]
+        if names:
+            try:
+                self.gradebook.add_message(clean, names, to_all=to is None, sent_at=sent)
+            except GradebookError as exc:
+                log.error("a message was not kept: %s", exc)
+                raise ValueError("The class gradebook cannot be written now, so the message was not sent; "
+                                 "try again in a moment.") from None
+        with self._lock:
+            entries = {e[2]: e for e in self._trainees.values() if e[2] in names}
+        self._deliver_kept(entries)
         if to is None:
-            n = len(entries) + len(there)
+            n = len(names)
             return f"Sent to {n} trainee{'s' if n != 1 else ''}." if n else "No trainee is connected: nobody got it."
-        return (f"Sent to {to}." if entries or to in there
-                else f"{to} is not connected: the message waits until they join again.")
+        return f"Sent to {to}." if to in connected else f"{to} is not connected: the message waits until they join again."
 
-    def _deliver(self, clean: str, to: str | None, sent: str, *,
-                 also_waiting: bool) -> list[tuple[Session, TraineeRecorder, str]]:
-        """Show the message to this process's trainees (all, or ``to``) and keep it waiting for
-        them until dismissed; ``also_waiting``: a ``to`` not connected here waits here too (the
-        process the trainer sent it from). Returns the entries it was shown to."""
+    def _kept_messages(self, name: str) -> list[ClassMessage]:
+        """The messages the gradebook keeps for ``name`` (not dismissed), oldest first."""
+        try:
+            kept = self.gradebook.messages_for([name]).get(name, [])
+        except GradebookError:
+            log.exception("the messages of %r could not be read", name)
+            return []
+        return [ClassMessage(mid, text, None if to_all else name, sent) for mid, to_all, sent, text in kept]
+
+    def _deliver_kept(self, entries: dict[str, tuple[Session, TraineeRecorder, str]]) -> None:
+        """Hand each of this process's trainees of ``entries`` (by name) the messages the
+        gradebook keeps for them that their session was not handed yet (shown on viser's loop,
+        on that session only)."""
+        if not entries:
+            return
+        try:
+            kept = self.gradebook.messages_for(list(entries))
+        except GradebookError:
+            log.exception("the class's messages could not be read")
+            return
+        for name, rows in kept.items():
+            session = entries[name][0]
+            with self._lock:
+                if self._trainees.get(id(session)) is not entries[name]:
+                    continue
+                handed = self._handed.setdefault(id(session), set())
+                new = [ClassMessage(mid, text, None if to_all else name, sent)
+                       for mid, to_all, sent, text in rows if mid not in handed]
+                handed &= {row[0] for row in rows}
+                handed.update(m.message_id for m in new)
+            if new:
+                self._hand_to_loop(session.guard(functools.partial(self._show, session, new)))
+
+    @staticmethod
+    def _show(session: Session, messages: list[ClassMessage]) -> None:
+        for message in messages:
+            session.show_message(message)
+
+    def _note_dismissed(self, session: Session, name: str) -> None:
+        """After a ``notice`` signal of ``name``'s session: the messages that were on its screen
+        and are not any more were dismissed there (or pushed out by newer ones): the gradebook
+        forgets them for ``name``."""
+        now = {m.message_id for m in session.messages}
         with self._lock:
-            entries = [e for e in self._trainees.values() if to is None or e[2] == to]
-        message = ClassMessage(next(self._message_ids), clean, to, sent)
-        names = [to] if to is not None and (entries or also_waiting) else [name for _, _, name in entries]
-        with self._lock:
-            for name in names:
-                waiting = self._waiting.setdefault(name, [])
-                waiting.append(message)
-                del waiting[:-MAX_WAITING_MESSAGES]
-        for session, _recorder, _name in entries:
-            self._hand_to_loop(session.guard(lambda session=session: session.show_message(message)))
-        return entries
+            before = self._on_screen.get(id(session), set())
+            self._on_screen[id(session)] = now
+        gone = sorted(before - now)
+        if gone:
+            try:
+                self.gradebook.dismiss_messages(name, gone)
+            except GradebookError:
+                log.exception("the dismissal of %r's messages could not be kept", name)

@@ -64,6 +64,11 @@ Added to every file when it is opened (no schema version: an older reader ignore
     presence(name PRIMARY KEY, holder, seen_at, status_json)           who is connected, on which
                                                                        server process (heartbeats)
     class_pushes(id PRIMARY KEY, pushed_at, push_json)                 the trainer's pushes, in order
+    departures(name PRIMARY KEY, left_at, status_json)                 who left, with their last row
+    class_messages(id PRIMARY KEY, name, to_all, sent_at, text)        the trainer's messages not
+                                                                       dismissed yet, one row per trainee
+    token_failures(id PRIMARY KEY, source, failed_at)                  wrong trainer tokens per source
+                                                                       address (the last hour)
 """
 
 from __future__ import annotations
@@ -77,7 +82,7 @@ import secrets
 import sqlite3
 import threading
 import time
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from datetime import datetime, timezone
@@ -95,6 +100,7 @@ from tcp_pendant.classroom.gradebook_db import (
     is_postgres_url,
 )
 from tcp_pendant.classroom.names import TraineeNameError, looks_alike, validate_trainee_name
+from tcp_pendant.pendant.class_messages import MAX_WAITING_MESSAGES
 
 __all__ = [
     "APPLICATION",
@@ -144,6 +150,37 @@ _CLASS_PUSHES = """CREATE TABLE IF NOT EXISTS class_pushes (
     push_json TEXT NOT NULL)"""
 """Every push of the trainer's class settings, in order: the other server processes of the
 class apply the ones they have not seen (``pushes_after``)."""
+_DEPARTURES = """CREATE TABLE IF NOT EXISTS departures (
+    name TEXT PRIMARY KEY,
+    left_at REAL NOT NULL,
+    status_json TEXT NOT NULL)"""
+"""The trainees whose browser left the class (on any server process), with the row of the
+trainer's live table as it was when they left (``status_json``, ``connected`` false) and when
+(``left_at``: Unix time, seconds); a trainee connected again is listed as connected, not here
+(``Gradebook.departed``)."""
+_CLASS_MESSAGES = """CREATE TABLE IF NOT EXISTS class_messages (
+    id INTEGER PRIMARY KEY,
+    name TEXT NOT NULL,
+    to_all INTEGER NOT NULL,
+    sent_at TEXT NOT NULL,
+    text TEXT NOT NULL)"""
+"""The trainer's messages not dismissed yet: one row per trainee it was sent to (``name``; a
+message to the class has a row for every trainee connected when it was sent, ``to_all`` 1), so
+each trainee dismisses their own (the row goes). ``sent_at``: UTC ``2026-12-02T09:30:00Z``;
+``text``: plain text as the trainer typed it (cleaned; escaped where it is shown). At most
+:data:`MAX_QUEUED_MESSAGES` per trainee: a newer one pushes out the oldest."""
+_TOKEN_FAILURES = """CREATE TABLE IF NOT EXISTS token_failures (
+    id INTEGER PRIMARY KEY,
+    source TEXT NOT NULL,
+    failed_at REAL NOT NULL)"""
+"""Every wrong trainer token by the address it came from (``source``) and when (``failed_at``:
+Unix time, seconds), for every server process of the class: the lockout
+(``classroom.trainer_token``) counts them whichever process a browser reaches, and after a
+restart. Rows older than the caller's ``forget_s`` are deleted at each try."""
+MAX_QUEUED_MESSAGES = MAX_WAITING_MESSAGES
+"""Messages kept undismissed per trainee (as many as a session keeps)."""
+MAX_SOURCE_CHARS = 100
+"""A token try's source (an address) is cut to this many characters."""
 PRESENCE_STALE_S = 10.0
 """A presence row whose holder has not beaten for this long (seconds) counts as gone."""
 MAX_STATUS_BYTES = 4_000
@@ -152,7 +189,9 @@ _RUN_STATE_COLUMNS = (("method_title", "TEXT"), ("step", "TEXT"), ("step_since",
 """Added to ``run_states`` when missing (additive, like the table): the wizard's title and the
 step as the trainee saw it ("Step 2 of 4", "result", "cancelled") and since when (UTC), for the
 trainer's dashboard after a restart (``Gradebook.board``)."""
-_ADDITIVE_TABLES = {"run_states": _RUN_STATES, "presence": _PRESENCE, "class_pushes": _CLASS_PUSHES}
+_ADDITIVE_TABLES = {"run_states": _RUN_STATES, "presence": _PRESENCE, "class_pushes": _CLASS_PUSHES,
+                    "departures": _DEPARTURES, "class_messages": _CLASS_MESSAGES,
+                    "token_failures": _TOKEN_FAILURES}
 """Tables made (CREATE TABLE IF NOT EXISTS, by name) in every gradebook that lacks them when it
 is opened, after the versioned schema; written in SQLite's words like every statement
 (``gradebook_db.sql_for``). A gradebook that has them all is not asked to create anything (a
@@ -846,6 +885,11 @@ class Gradebook:
             return db.execute("UPDATE trainees SET key_sha256 = NULL WHERE name = ? AND key_sha256 IS NOT NULL",
                               (name,)).rowcount > 0
 
+    def trainee_names(self) -> list[str]:
+        """Every trainee's name, in the order they first joined."""
+        with self._read() as db:
+            return [str(r[0]) for r in db.execute("SELECT name FROM trainees ORDER BY id")]
+
     def held_names(self) -> list[str]:
         """Names whose browser key a browser holds, sorted (the names a trainer can release)."""
         with self._read() as db:
@@ -1223,6 +1267,110 @@ class Gradebook:
         with self._read() as db:
             row = db.execute("SELECT MAX(id) FROM class_pushes").fetchone()
         return 0 if row is None or row[0] is None else int(row[0])
+
+    # -- who left, for every server process of the class --------------------------------
+
+    def depart(self, name: str, status: Mapping[str, Any], *, now: float | None = None) -> None:
+        """The browser of ``name`` left the class (on whichever process): keep ``status`` (the
+        trainee's row as it was when they left) and when."""
+        text = self._status_text(status)
+        t = time.time() if now is None else now
+        with self._write() as db:
+            db.execute("INSERT INTO departures (name, left_at, status_json) VALUES (?, ?, ?) ON CONFLICT(name) "
+                       "DO UPDATE SET left_at = excluded.left_at, status_json = excluded.status_json",
+                       (str(name), t, text))
+
+    def departed(self, *, stale_s: float = PRESENCE_STALE_S,
+                 now: float | None = None) -> list[tuple[str, dict[str, Any]]]:
+        """``(name, status)`` of every trainee who was connected and is not now, on any server
+        process, the latest to leave first: those who left (:meth:`depart`) and those whose
+        server process stopped beating ``stale_s`` ago (killed: their last beaten row), with
+        ``status["connected"]`` false."""
+        t = time.time() if now is None else now
+        with self._read() as db:
+            rows = db.execute(
+                "SELECT d.name, d.left_at, d.status_json FROM departures d WHERE NOT EXISTS (SELECT 1 FROM presence "
+                "p WHERE p.name = d.name AND p.seen_at >= ?) UNION ALL SELECT p.name, p.seen_at, p.status_json "
+                "FROM presence p WHERE p.seen_at < ? AND NOT EXISTS (SELECT 1 FROM departures d WHERE d.name = p.name)",
+                (t - stale_s, t - stale_s)).fetchall()
+        out = []
+        for name, _at, st in sorted(rows, key=lambda r: (-float(r[1]), str(r[0]))):
+            status = json.loads(st)
+            if isinstance(status, dict):
+                out.append((str(name), {**status, "connected": False}))
+        return out
+
+    # -- the trainer's messages, until each trainee dismisses them ---------------------
+
+    def add_message(self, text: str, names: Sequence[str], *, to_all: bool, sent_at: str) -> dict[str, int]:
+        """Keep the trainer's message ``text`` (plain text, cleaned by the caller) for each of
+        ``names`` until that trainee dismisses it; beyond :data:`MAX_QUEUED_MESSAGES` a trainee's
+        oldest go. ``to_all``: it was sent to the class. Returns each name's message id."""
+        ids: dict[str, int] = {}
+        with self._write() as db:
+            for name in dict.fromkeys(str(n) for n in names):
+                ids[name] = db.insert("INSERT INTO class_messages (name, to_all, sent_at, text) VALUES (?, ?, ?, ?)",
+                                      (name, int(bool(to_all)), str(sent_at), str(text)))
+                db.execute("DELETE FROM class_messages WHERE name = ? AND id NOT IN (SELECT id FROM class_messages "
+                           "WHERE name = ? ORDER BY id DESC LIMIT ?)", (name, name, MAX_QUEUED_MESSAGES))
+        return ids
+
+    def messages_for(self, names: Sequence[str]) -> dict[str, list[tuple[int, bool, str, str]]]:
+        """The messages kept for each of ``names`` (not dismissed), oldest first:
+        ``{name: [(id, to_all, sent_at, text), ...]}`` (a name without any is missing)."""
+        wanted = sorted({str(n) for n in names})
+        out: dict[str, list[tuple[int, bool, str, str]]] = {}
+        if not wanted:
+            return out
+        with self._read() as db:
+            rows = db.execute("SELECT id, name, to_all, sent_at, text FROM class_messages WHERE name IN ("
+                              + ", ".join("?" * len(wanted)) + ") ORDER BY id", wanted).fetchall()
+        for mid, name, to_all, sent, text in rows:
+            out.setdefault(str(name), []).append((int(mid), bool(to_all), str(sent), str(text)))
+        return out
+
+    def dismiss_messages(self, name: str, message_ids: Sequence[int]) -> int:
+        """``name`` dismissed the messages ``message_ids`` (theirs only: another trainee's id
+        dismisses nothing). Returns how many went."""
+        ids = [self._id(i, "message id") for i in message_ids]
+        if not ids:
+            return 0
+        with self._write() as db:
+            return sum(db.execute("DELETE FROM class_messages WHERE id = ? AND name = ?", (i, str(name))).rowcount
+                       for i in ids)
+
+    # -- wrong trainer tokens, per source address, for every server process ------------
+
+    def try_token(self, source: str, *, now: float, forget_s: float,
+                  lock_s: Callable[[int], float]) -> tuple[float, int, bool]:
+        """One try of the trainer token from ``source`` (an address), counted before the token
+        is compared, in one transaction (so no try slips between the processes of the class):
+        failures older than ``forget_s`` are forgotten (every source's); when the source's
+        ``n`` failures, the last at ``t``, lock it (``t + lock_s(n) > now``) nothing is counted;
+        otherwise one failure is stored, to be forgiven (:meth:`forgive_token_failures`) if the
+        token is right. Times: Unix seconds.
+
+        Returns:
+            ``(wait_s, failures, counted)``: seconds still locked (0 when counted), the source's
+            failures with this try, whether this try was counted (False: locked, do not compare).
+        """
+        src = str(source)[:MAX_SOURCE_CHARS]
+        with self._write() as db:
+            db.serialize("token failures")
+            db.execute("DELETE FROM token_failures WHERE failed_at < ?", (float(now) - float(forget_s),))
+            n, last = db.execute("SELECT COUNT(*), MAX(failed_at) FROM token_failures WHERE source = ?",
+                                 (src,)).fetchone()
+            n = int(n)
+            if n and float(last) + lock_s(n) > now:
+                return float(last) + lock_s(n) - now, n, False
+            db.execute("INSERT INTO token_failures (source, failed_at) VALUES (?, ?)", (src, float(now)))
+        return 0.0, n + 1, True
+
+    def forgive_token_failures(self, source: str) -> int:
+        """The right token came from ``source``: its failures are forgotten (returns how many)."""
+        with self._write() as db:
+            return db.execute("DELETE FROM token_failures WHERE source = ?",
+                              (str(source)[:MAX_SOURCE_CHARS],)).rowcount
 
     def board(self) -> ClassBoard:
         """The trainer's live table as the gradebook knows it (:class:`ClassBoard`): every

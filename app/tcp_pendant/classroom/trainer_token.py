@@ -2,10 +2,18 @@
 
 The token opens the trainer view (the whole class's grades and settings), so a trainee must not
 be able to guess it: it has at least :data:`MIN_TOKEN_CHARS` characters (the random default has
-22), and each browser may try :data:`FREE_TRIES` wrong tokens; after that every wrong one locks
-that browser out for a window that doubles each time (1 s, 2 s, 4 s, ... up to
-:data:`MAX_LOCK_S`), during which no token is even compared. Each wrong try is logged with at
-most a two-character prefix of what was typed.
+22), and each source address may try :data:`FREE_TRIES` wrong tokens; after that every wrong one
+locks that address out for a window that doubles each time (1 s, 2 s, 4 s, ... up to
+:data:`MAX_LOCK_S`, :func:`lock_s`), during which no token is even compared. Each wrong try is
+logged with at most a two-character prefix of what was typed (:func:`log_failure`).
+
+The wrong tries are counted in the class gradebook (``Gradebook.try_token``: table
+``token_failures``), per source address and for every server process of the class, so a
+reconnect that lands on another process (``--workers``, several machines) or a restart of the
+server does not give new tries; a try is counted before its token is compared, and a right token
+forgives its address's failures. Failures :data:`FORGET_S` old are forgotten. Times there are
+Unix seconds (the machines' clocks). :class:`TokenAttempts` is the same rule for one counter in
+memory.
 
 It can be given on the command line (``--trainer-token``, which shows in the process list), in a
 file (``--trainer-token-file PATH``: its first line) or in the environment
@@ -20,8 +28,9 @@ import os
 from collections.abc import Mapping
 from pathlib import Path
 
-__all__ = ["FREE_TRIES", "MAX_LOCK_S", "MAX_TOKEN_CHARS", "MIN_TOKEN_CHARS", "TOKEN_ENV", "TokenAttempts",
-           "TrainerTokenError", "TrainerTokenLocked", "resolve_trainer_token", "validate_trainer_token"]
+__all__ = ["FORGET_S", "FREE_TRIES", "MAX_LOCK_S", "MAX_TOKEN_CHARS", "MIN_TOKEN_CHARS", "TOKEN_ENV", "TokenAttempts",
+           "TrainerTokenError", "TrainerTokenLocked", "lock_s", "locked", "log_failure", "resolve_trainer_token",
+           "validate_trainer_token"]
 
 log = logging.getLogger(__name__)
 
@@ -33,6 +42,8 @@ FREE_TRIES = 5
 """Wrong tokens a browser may type before it is locked out."""
 FIRST_LOCK_S = 1.0
 MAX_LOCK_S = 300.0
+FORGET_S = 3600.0
+"""A wrong token this old (seconds) no longer counts."""
 
 
 class TrainerTokenError(ValueError):
@@ -81,6 +92,30 @@ def resolve_trainer_token(option: str | None, file: Path | None,
     return None
 
 
+def lock_s(failures: int) -> float:
+    """Seconds a source is locked after its ``failures``-th wrong token: 0 before
+    :data:`FREE_TRIES`, then 1 s, 2 s, 4 s, ... at most :data:`MAX_LOCK_S`."""
+    if failures < FREE_TRIES:
+        return 0.0
+    return min(MAX_LOCK_S, FIRST_LOCK_S * 2.0 ** (failures - FREE_TRIES))
+
+
+def locked(wait_s: float) -> TrainerTokenLocked:
+    """The refusal of a try ``wait_s`` seconds before the lock ends (the trainee's words)."""
+    return TrainerTokenLocked(f"Too many wrong trainer tokens from this browser: try again in "
+                              f"{max(1, round(wait_s))} s.")
+
+
+def log_failure(who: str, failures: int, typed: str) -> None:
+    """Log a wrong token (the ``failures``-th of its source) with a two-character prefix of
+    ``typed``, and the lock it starts from the :data:`FREE_TRIES`-th on."""
+    prefix = typed[:2] + "..." if len(typed) > 2 else "..."
+    log.warning("wrong trainer token from %s (try %d, %d characters, %r)", who, failures, len(typed), prefix)
+    if failures >= FREE_TRIES:
+        log.warning("trainer token: %s typed %d wrong tokens; no token is tried from it for %.0f s",
+                    who, failures, lock_s(failures))
+
+
 @dataclasses.dataclass
 class TokenAttempts:
     """The wrong tokens of one browser (times in seconds of a monotonic clock).
@@ -99,19 +134,14 @@ class TokenAttempts:
 
     def failed(self, now: float, who: str, typed: str) -> None:
         """A wrong token: count and log it; from the :data:`FREE_TRIES`-th on, lock for
-        1 s, 2 s, 4 s, ... (at most :data:`MAX_LOCK_S`)."""
+        :func:`lock_s` seconds."""
         self.failures += 1
-        prefix = typed[:2] + "..." if len(typed) > 2 else "..."
-        log.warning("wrong trainer token from %s (try %d, %d characters, %r)", who, self.failures, len(typed), prefix)
+        log_failure(who, self.failures, typed)
         if self.failures >= FREE_TRIES:
-            lock = min(MAX_LOCK_S, FIRST_LOCK_S * 2.0 ** (self.failures - FREE_TRIES))
-            self.locked_until = now + lock
-            log.warning("trainer token: %s typed %d wrong tokens; no token is tried from it for %.0f s",
-                        who, self.failures, lock)
+            self.locked_until = now + lock_s(self.failures)
 
     def check(self, now: float) -> None:
         """Raise :class:`TrainerTokenLocked` while this browser is locked out."""
         wait = self.wait_s(now)
         if wait > 0:
-            raise TrainerTokenLocked(f"Too many wrong trainer tokens from this browser: try again in "
-                                     f"{max(1, round(wait))} s.")
+            raise locked(wait)

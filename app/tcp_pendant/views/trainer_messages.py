@@ -2,8 +2,9 @@
 
 :func:`build_message_controls` adds, where it is called (the trainer view's panel), a
 "Message" text area, a "To" dropdown (all trainees, or one connected trainee by name: option
-text, never markdown) and **Send** (``ClassRoom.send_message``: each trainee's session keeps the
-message until the trainee dismisses it, ``views.class_notices``). :meth:`MessageControls.render`
+text, never markdown) and **Send** (``ClassRoom.send_message``: the class gradebook keeps the
+message for each trainee until they dismiss it, and it reaches them on whichever server process
+of the class holds their browser, ``views.class_notices``). :meth:`MessageControls.render`
 re-lists the names (the trainer view calls it when the class changes).
 """
 
