@@ -1,7 +1,8 @@
 """Two server processes of one class on one gradebook (``tcp-pendant --workers``): each is a
 ``PendantApp`` with its own gradebook connection and its own ``ClassRoom.holder``, as two
 processes have; the heartbeat is called by the test (``ClassRoom.beat``) instead of waiting
-for its thread."""
+for its thread. Each browser is a real websocket client from 127.0.0.1 (one source address for
+the trainer token's lockout)."""
 
 from __future__ import annotations
 
@@ -16,6 +17,8 @@ from guiclick import choose, click  # noqa: E402
 from wsclient import DrainingClient, wait_until  # noqa: E402
 
 from tcp_pendant.classroom.names import TraineeNameError
+from tcp_pendant.classroom.trainer_token import TrainerTokenLocked
+from tcp_pendant.text_escape import escape_markdown, escape_markdown_lines
 
 TOKEN = "trainer-token-for-tests-0001"
 
@@ -182,3 +185,105 @@ def test_the_trainer_resets_and_pushes_to_one_trainee_on_the_other_process(two) 
         assert a.classroom.reset_wizard("Nobody") == "Nobody is not connected: there is no running wizard to reset."
     finally:
         cb.close()
+
+
+def test_the_token_lockout_holds_on_the_other_process(two) -> None:
+    """Five wrong tokens on A lock the address out on B too (a reconnect gains no tries); the
+    right token on B after the window opens the trainer view and forgives the address."""
+    a, b = two
+    now = [5000.0]
+    a.classroom.clock = b.classroom.clock = lambda: now[0]
+    ca, cb = DrainingClient(a.port), None
+    try:
+        sa = _session(a)
+        for i in range(5):
+            assert a.classroom.open_trainer(sa, f"wrong-guess-{i:02d}-abcdef") is False
+        with pytest.raises(TrainerTokenLocked, match=r"try again in 1 s\."):
+            a.classroom.open_trainer(sa, TOKEN)
+        cb = DrainingClient(b.port)                  # the same address, on the other process
+        sb = _session(b)
+        prompt = sb.views["identity"]
+        choose(prompt.token_field, TOKEN, sb.client)
+        click(prompt.open_trainer, sb.client)
+        assert prompt.message.content.startswith(escape_markdown(
+            "⚠ Too many wrong trainer tokens from this browser: try again in 1 s."))
+        assert b.classroom._trainer_views == {}
+        now[0] += 1.5
+        assert b.classroom.open_trainer(sb, "wrong-guess-05-abcdef") is False    # the 6th: 2 s
+        with pytest.raises(TrainerTokenLocked, match=r"try again in 2 s\."):
+            b.classroom.open_trainer(sb, TOKEN)
+        with pytest.raises(TrainerTokenLocked, match=r"try again in 2 s\."):
+            a.classroom.open_trainer(sa, TOKEN)
+        now[0] += 2.5
+        assert b.classroom.open_trainer(sb, TOKEN) is True
+        assert "trainer" in sb.views
+        assert a.classroom.open_trainer(sa, "wrong-guess-06-abcdef") is False    # forgiven: try 1, no lock
+        assert a.classroom.open_trainer(sa, TOKEN) is True
+    finally:
+        for c in (ca, cb):
+            if c is not None:
+                c.close()
+
+
+def test_a_message_follows_its_trainee_to_the_other_process_until_dismissed(two) -> None:
+    a, b = two
+    ca, cb = DrainingClient(a.port), None
+    try:
+        sa = _session(a)
+        _join(sa, "Anna")
+        key = _key(sa)
+        text = "Anna: *check* <b>the tool</b>"
+        assert a.classroom.send_message("Everyone: look at the projector.") == "Sent to 1 trainee."
+        assert a.classroom.send_message(text, to="Anna") == "Sent to Anna."
+        wait_until(lambda: len(sa.messages) == 2, what="both messages on A")
+        box = sa.views["notices"]
+        wait_until(lambda: box.dismiss.visible, what="A's message box")
+        click(box.dismiss, sa.client)                 # the message to the class, dismissed on A
+        wait_until(lambda: [m.text for m in sa.messages] == [text], what="the dismissal on A")
+    finally:
+        ca.close()                                    # the browser's connection drops ...
+    wait_until(lambda: a.classroom.connected_names() == [], what="A noticing the disconnect")
+    try:
+        cb = DrainingClient(b.port)                   # ... and its reconnect lands on B
+        sb = _session(b)
+        assert _join(sb, "Anna", key).name == "Anna"
+        assert [(m.text, m.to) for m in sb.messages] == [(text, "Anna")]     # undismissed: shown again
+        box = sb.views["notices"]
+        wait_until(lambda: box.message_md.visible, what="B's message box")
+        assert escape_markdown_lines(text) in box.message_md.content and "<b>" not in box.message_md.content
+        a.classroom.beat()                            # the trainer, on A, sends her another
+        assert a.classroom.send_message("Anna, come to the front.", to="Anna") == "Sent to Anna."
+        b.classroom.beat()                            # B's heartbeat delivers it
+        wait_until(lambda: [m.text for m in sb.messages] == [text, "Anna, come to the front."],
+                   what="the new message on B")
+        click(box.dismiss, sb.client)
+        wait_until(lambda: [m.text for m in sb.messages] == ["Anna, come to the front."], what="the dismissal on B")
+        assert [row[3] for row in a.gradebook.messages_for(["Anna"])["Anna"]] == ["Anna, come to the front."]
+    finally:
+        if cb is not None:
+            cb.close()
+
+
+def test_who_left_on_one_process_is_listed_the_same_on_the_other(two) -> None:
+    a, b = two
+    cb = DrainingClient(b.port)
+    try:
+        sb = _session(b)
+        _join(sb, "Ben")
+        cal = sb.views["calibrate"]
+        click(cal.start, sb.client)
+        click(cal.steps.auto_touch, sb.client)
+        b.classroom.beat()                            # B writes Ben's row, A reads it
+        a.classroom.beat()
+        assert [(r.name, r.connected, r.touches) for r in a.classroom.trainee_statuses()] == [("Ben", True, 1)]
+    finally:
+        cb.close()
+    wait_until(lambda: b.classroom.connected_names() == [], what="B noticing the disconnect")
+    a.classroom.beat()
+    left = b.classroom.trainee_statuses()
+    assert [(r.name, r.connected, r.touches, r.step) for r in left] == [("Ben", False, 1, "Step 2 of 4")]
+    assert a.classroom.trainee_statuses() == left
+    assert a.classroom.connected_names() == []
+    # the trainer on A may write to him: it waits until he joins again
+    assert a.classroom.send_message("Ben, finish your XYZ.", to="Ben") == \
+        "Ben is not connected: the message waits until they join again."

@@ -426,13 +426,16 @@ class ClassRoom:
         with self._lock:
             if self._trainees.get(id(session)) is not entry:
                 return
-            self._trainees.pop(id(session), None)
             prompt = self._prompts.get(id(session))
         try:
             recorder.disconnected()
         except Exception:
             log.exception("ending the gradebook session of %r failed", name)
-        self._depart(name, recorder.status)
+        self._depart(entry)               # before it leaves the table: the row is never missing
+        with self._lock:
+            if self._trainees.get(id(session)) is not entry:
+                return
+            self._trainees.pop(id(session), None)
         self._drop_presence(name)
         session.library_rights = self._library_rights(session, None)  # at once: it changes nothing more
         self._hand_to_loop(session.guard(lambda: session.set_library_rights(session.library_rights)))
@@ -500,12 +503,10 @@ class ClassRoom:
                 entry[1].disconnected()
             except Exception:
                 log.exception("ending the gradebook session of %r failed", entry[2])
+            self._depart(entry)           # before it leaves the table: the row is never missing
             with self._lock:
-                gone = self._trainees.get(id(session)) is entry
-                if gone:
+                if self._trainees.get(id(session)) is entry:
                     self._trainees.pop(id(session), None)
-            if gone:
-                self._depart(entry[2], entry[1].status)
             self._drop_presence(entry[2])
         self._hand_to_loop(self.refresh_trainers)
 
@@ -514,14 +515,15 @@ class ClassRoom:
         with self._lock:
             return {e[2] for e in self._trainees.values()}
 
-    def _depart(self, name: str, status: TraineeStatus) -> None:
-        """``name`` left this process: kept in the gradebook with their last row (the trainer's
-        table on every process lists them as not connected), unless another session of this
-        process holds the name now."""
-        if name in self._local_names():
+    def _depart(self, entry: tuple[Session, TraineeRecorder, str]) -> None:
+        """The trainee of ``entry`` leaves this process: kept in the gradebook with their last
+        row (the trainer's table on every process lists them as not connected), unless another
+        session of this process holds the name now."""
+        session, recorder, name = entry
+        if self._holder(name, session) is not None:
             return
         try:
-            self.gradebook.depart(name, dataclasses.asdict(dataclasses.replace(status, connected=False)))
+            self.gradebook.depart(name, dataclasses.asdict(dataclasses.replace(recorder.status, connected=False)))
         except GradebookError:
             log.exception("the departure of %r could not be kept", name)
 
