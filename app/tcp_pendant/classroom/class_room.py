@@ -568,7 +568,8 @@ class ClassRoom:
         renew this process's names with their rows; a name this process lost (taken by the same
         browser on another process, released by the trainer there) sends its session back to
         the welcome window; take in the other processes' rows and the trainer's pushes made
-        there."""
+        there; hand this process's trainees the messages the gradebook keeps for them that
+        they were not handed yet (sent on another process, or before they came here)."""
         with self._lock:
             entries = {e[2]: e for e in self._trainees.values()}
         statuses = {name: dataclasses.asdict(e[1].status) for name, e in entries.items()}
