@@ -35,6 +35,8 @@ NAME_LABEL = "Your name"
 JOIN_LABEL = "Join the class"
 INCREMENT_LABEL = "Increment"
 READOUT_LABEL = "Readout"
+TOKEN_LABEL = "Trainer token"
+OPEN_TRAINER_LABEL = "Open trainer view"
 _FRAME = re.compile(r"^\*\*TCP in (\w+)")
 _X_MM = re.compile(r"\bX\s+(-?\d+\.\d\d) mm")
 _CAMERA = dict(type="ViewerCameraMessage", wxyz=[1.0, 0.0, 0.0, 0.0], position=[2.0, -2.0, 1.0], fov=1.0,
@@ -61,6 +63,7 @@ class LoadClient:
     uuids: dict[str, str] = field(default_factory=dict)
     readouts: list[tuple[float, float]] = field(default_factory=list)
     frames: list[tuple[float, str]] = field(default_factory=list)   # (time, frame) of each TCP readout
+    notes: list[str] = field(default_factory=list)     # warnings shown ("⚠ ...") and the trainer dashboard's heading
     sends: list[float] = field(default_factory=list)
     ready: asyncio.Event = field(default_factory=asyncio.Event)
     task: asyncio.Task[None] | None = None
@@ -86,19 +89,26 @@ class LoadClient:
                         text = (m.get("updates") or {}).get("_markdown")
                         if isinstance(text, str) and text.startswith("**TCP in "):
                             self._readout(t, text)
+                        self._note(text)
                     elif kind in ("GuiButtonMessage", "GuiTextMessage", "GuiButtonGroupMessage"):
                         label = (m.get("props") or {}).get("label")
-                        if label in (PLUS, NAME_LABEL, JOIN_LABEL, INCREMENT_LABEL, READOUT_LABEL):
+                        if label in (PLUS, NAME_LABEL, JOIN_LABEL, INCREMENT_LABEL, READOUT_LABEL, TOKEN_LABEL,
+                                     OPEN_TRAINER_LABEL):
                             self.uuids[label] = m["uuid"]
                     elif kind == "GuiMarkdownMessage":
                         text = (m.get("props") or {}).get("_markdown")
                         if isinstance(text, str) and text.startswith("**TCP in "):
                             self._readout(t, text)
+                        self._note(text)
                 if PLUS in self.uuids and INCREMENT_LABEL in self.uuids and self.readouts:
                     self.ready.set()
         except Exception:
             pass
         self.closed_early = True
+
+    def _note(self, text: object) -> None:
+        if isinstance(text, str) and text.startswith(("⚠", "### Trainer dashboard")):
+            self.notes.append(text)
 
     def _readout(self, t: float, text: str) -> None:
         x = _X_MM.search(text)
@@ -111,6 +121,11 @@ class LoadClient:
     async def send_update(self, label: str, updates: dict[str, Any]) -> None:
         await self.ws.send(_encoder.encode({"type": "GuiUpdateMessage", "uuid": self.uuids[label],
                                             "updates": updates}))
+
+    async def try_token(self, token: str) -> None:
+        """Type ``token`` into "Trainer token" and press "Open trainer view"."""
+        await self.send_update(TOKEN_LABEL, {"value": token})
+        await self.send_update(OPEN_TRAINER_LABEL, {"value": True})
 
     async def join(self, name: str) -> None:
         """Type ``name`` into "Your name" and press "Join the class" (as a trainee does)."""

@@ -16,17 +16,20 @@ from pathlib import Path
 import pytest
 
 sys.path.insert(0, str(Path(__file__).parent))
-from async_clients import PLUS, READOUT_LABEL, connect_all  # noqa: E402
+from async_clients import PLUS, READOUT_LABEL, TOKEN_LABEL, connect_all  # noqa: E402
 
 from tcp_pendant.classroom.gradebook import Gradebook
+from tcp_pendant.classroom.trainer_token import lock_s
 
 ROOT = Path(__file__).resolve().parents[2]
 pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="SO_REUSEPORT spreading is Linux's")
 
 
-@pytest.fixture
-def workers2(tmp_path: Path) -> Iterator[tuple[int, list[int], Path]]:
-    """``tcp-pendant --class --workers 2 --port 0``: (port, pids, gradebook path); stopped after."""
+@pytest.fixture(scope="module")
+def workers2(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[int, list[int], Path]]:
+    """``tcp-pendant --class --workers 2 --port 0``: (port, pids, gradebook path); one pair of
+    processes for the tests of this file (each names its own trainees), stopped after."""
+    tmp_path = tmp_path_factory.mktemp("workers2")
     db = tmp_path / "class.sqlite3"
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT / "src"), str(ROOT / "app")]),
                TCP_PENDANT_TRAINER_TOKEN="trainer-token-for-tests-0001")
@@ -101,3 +104,65 @@ def test_two_processes_share_the_port_the_class_and_each_keeps_the_deadman(worke
     moved_mm = moves[-1][1] - x0
     assert 0.1 <= moved_mm < 1500 * 0.1 - 1.0          # the flood outran the server: presses were dropped
     assert max(t for t, _ in moves) - last_press < 1.0  # and the robot stood still within 1 s of the last
+
+
+@pytest.mark.timeout(300)
+def test_wrong_trainer_tokens_lock_the_address_out_on_both_processes(workers2) -> None:
+    """Wrong tokens typed on browsers spread over both processes add up to one count for their
+    address (127.0.0.1), so the right token is refused on every browser during the lock, on
+    both processes: reconnecting to the other process gives no new tries."""
+    port, pids, db = workers2
+
+    def failures() -> list[float]:
+        with Gradebook(db) as book, book._read() as conn:
+            return sorted(float(r[0]) for r in conn.execute(
+                "SELECT failed_at FROM token_failures WHERE source = '127.0.0.1'"))
+
+    async def until(what: str, fn, timeout_s: float = 30.0):
+        deadline = time.monotonic() + timeout_s
+        while not (got := fn()):
+            assert time.monotonic() < deadline, f"{what}: not within {timeout_s} s"
+            await asyncio.sleep(0.02)
+        return got
+
+    async def wrong(c, k: int) -> None:
+        """Client ``c`` types a wrong token once the lock is over; it is the ``k``-th failure."""
+        times = failures()
+        if times:
+            await asyncio.sleep(max(0.0, times[-1] + lock_s(len(times)) - time.time()) + 0.05)
+        await c.try_token(f"a-wrong-guess-{k:02d}-xyz")
+        await until(f"wrong token {k} counted", lambda: len(failures()) == k)
+
+    async def scenario() -> tuple[list[list[str]], set[int]]:
+        clients = await connect_all("127.0.0.1", port, 15)
+        try:
+            for c in clients:
+                await until("the token field", lambda c=c: TOKEN_LABEL in c.uuids)
+            for k in range(1, 6):
+                await wrong(clients[0], k)              # five: the address is locked for 1 s
+            await wrong(clients[1], 6)                  # the sixth, after it: 2 s
+            await wrong(clients[2], 7)                  # the seventh: 4 s
+            refused = clients[3:]
+            for c in refused:                           # the right token, on every browser, in the 4 s
+                await c.try_token("trainer-token-for-tests-0001")
+            await until("every browser's answer", lambda: all(c.notes for c in refused))
+            notes = [list(c.notes) for c in refused]
+            for i, c in enumerate(refused):             # which process each browser is on
+                await c.join(f"Guess {i + 1:03d}")
+            book = Gradebook(db)
+            try:
+                rows = await until("every browser named", lambda: (
+                    named := [r for r in book.present() if r[0].startswith("Guess ")]) and len(named) == len(refused) and named)
+            finally:
+                book.close()
+            return notes, {int(holder.split(":")[-2]) for _, holder, _ in rows}
+        finally:
+            for c in clients:
+                await c.close()
+
+    notes, holders = asyncio.run(scenario())
+    assert holders == set(pids)                          # the refused browsers were on both processes
+    for shown in notes:
+        assert shown[0].startswith("⚠ Too many wrong trainer tokens from this browser: try again in ")
+        assert not any(n.startswith("### Trainer dashboard") for n in shown)
+    assert len(failures()) == 7                          # the refused tries were not counted
