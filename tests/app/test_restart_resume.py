@@ -1,5 +1,6 @@
 """A restart of a class server gives back what trainees saw acknowledged: the calibration in
-progress, at its step, with its touches, and written on into the same gradebook calibration."""
+progress, at its step, with its touches, and written on into the same gradebook calibration;
+the trainer's messages not dismissed yet, who left, and the wrong trainer tokens' lockout."""
 
 from __future__ import annotations
 
@@ -12,7 +13,10 @@ sys.path.insert(0, str(Path(__file__).parents[1] / "calibrate"))
 from guiclick import choose, click  # noqa: E402
 from wsclient import DrainingClient, wait_until  # noqa: E402
 
+import pytest
+
 from tcp_pendant.classroom.gradebook import Gradebook
+from tcp_pendant.classroom.trainer_token import TrainerTokenLocked
 
 TOKEN = "trainer-token-for-tests-0001"
 
@@ -54,14 +58,26 @@ def test_a_restart_gives_the_wizard_back_at_its_step_with_its_touches(app_factor
         poses = {k: p.T_world_flange_m.copy() for k, p in before.recorded_poses.items()}
         step, n_steps = before.step_index, before.n_steps
         (cid,) = [r.calibration_id for r in app.gradebook.grades(include_in_progress=True)]
+        assert app.classroom.send_message("Anna: *slow down* near the tip.", to="Anna") == "Sent to Anna."
+        wait_until(lambda: [m.text for m in s.messages] == ["Anna: *slow down* near the tip."], what="the message")
+        now = [9000.0]
+        app.classroom.clock = lambda: now[0]
+        for i in range(5):                                   # five wrong tokens: locked for 1 s
+            assert app.classroom.open_trainer(s, f"wrong-guess-{i:02d}-abcdef") is False
     finally:
         c.close()
     app.stop()                                               # the server goes down mid-calibration
 
     again = app_factory(class_db=db, trainer_token=TOKEN, seed=4)
+    again.classroom.clock = lambda: now[0]
+    assert [(r.name, r.connected, r.touches) for r in again.classroom.trainee_statuses()] == [("Anna", False, 3)]
     c2 = DrainingClient(again.port)
     try:
+        wait_until(lambda: len(again.sessions) == 1, what="the session")
+        with pytest.raises(TrainerTokenLocked, match=r"try again in 1 s\."):     # the lockout outlasts the restart
+            again.classroom.open_trainer(next(iter(again.sessions.values())), TOKEN)
         s2 = _join(again, c2, "Anna", key)                 # the same browser: its key
+        assert [m.text for m in s2.messages] == ["Anna: *slow down* near the tip."]   # not dismissed: back
         wf = s2.workflow
         w = wf.wizard
         assert wf.is_open and w.kind == "xyz4" and (w.step_index, w.n_steps) == (step, n_steps) == (3, 5)
