@@ -170,18 +170,11 @@ def clean_methods(methods: object) -> tuple[str, ...] | None:
 def source_address(session: Session) -> str:
     """The address the browser of ``session`` connects from (its websocket's peer IP, the
     trainer token's lockout counts per address); "unknown" when there is none to read (a
-    shared page, a closed connection): all such tries share one count.
+    shared page, a closed connection): all such tries share one count
+    (``views.viser_adapter.client_address``)."""
+    from tcp_pendant.views.viser_adapter import client_address
 
-    viser keeps the connection of each client in its websocket server's table of live
-    connections (``_live_connections``, by client id); that table is private API, read here
-    with a fallback."""
-    client = session.client
-    try:
-        server = client._viser_server._websock_server  # type: ignore[union-attr]
-        connection = server._live_connections[client.client_id]  # type: ignore[union-attr]
-        return str(connection.remote_address[0])
-    except (AttributeError, KeyError, IndexError, TypeError):
-        return "unknown"
+    return client_address(session.client) or "unknown"
 
 
 def _token_digest(token: str) -> str:

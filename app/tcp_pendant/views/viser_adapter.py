@@ -620,6 +620,20 @@ def _peer(websocket: Any) -> str:
         return "?"
 
 
+def client_address(client: Any) -> str | None:
+    """The IP address a viser client's websocket connects from (its peer), None when there is
+    none to read (a closed connection, a shared page, or viser's internals differ).
+
+    viser keeps each client's connection in its websocket server's table of live connections
+    (``_live_connections``, by client id): private API, read only here."""
+    try:
+        server = client._viser_server._websock_server
+        connection = server._live_connections[client.client_id]
+        return str(connection.remote_address[0])
+    except (AttributeError, KeyError, IndexError, TypeError):
+        return None
+
+
 _install_lock = threading.Lock()
 _installed = False
 
