@@ -37,7 +37,8 @@ def fmt_num(value: float, decimals: int = 2) -> str:
     if not math.isfinite(v):
         return str(v)
     text = f"{v:.{decimals}f}"
-    return text[1:] if text.startswith("-") and float(text) == 0.0 else text
+    # fixed-point text is zero when it has no digit but 0 (no exponent in the "f" format)
+    return text[1:] if text[0] == "-" and not text.strip("-0.") else text
 
 
 def readout_rows(readout: PoseReadout, decimals: int = 2) -> tuple[tuple[str, str, str], ...]:
@@ -60,13 +61,12 @@ def readout_text(readout: PoseReadout, decimals: int = 2) -> str:
 def tcp_readout_markdown(readout: PoseReadout, tool_name: str | None) -> str:
     """The TCP readout: a title with frame and tool, then a monospace table
     ``X 525.00 mm | A 0.00 deg`` (one line per pair)."""
-    rows = readout_rows(readout, 2)
-    width = max(len(v) for _, v, _ in rows)
-    lines = [f"{rows[i][0]} {rows[i][1]:>{width}} mm   {rows[i + 3][0]} {rows[i + 3][1]:>{width}} deg"
-             for i in range(3)]
-
+    r = readout
+    x, y, z, a, b, c = (fmt_num(v) for v in (r.x_mm, r.y_mm, r.z_mm, r.a_deg, r.b_deg, r.c_deg))
+    w = max(len(x), len(y), len(z), len(a), len(b), len(c))
     tool = "FLANGE (no tool active)" if tool_name is None else f"TOOL {escape_markdown(tool_name)}"
-    return f"**TCP in {readout.frame}** · {tool}\n\n```\n" + "\n".join(lines) + "\n```"
+    return (f"**TCP in {r.frame}** · {tool}\n\n```\nX {x:>{w}} mm   A {a:>{w}} deg\n"
+            f"Y {y:>{w}} mm   B {b:>{w}} deg\nZ {z:>{w}} mm   C {c:>{w}} deg\n```")
 
 
 def joint_readout_markdown(angles_deg: Mapping[str, float]) -> str:
