@@ -170,16 +170,20 @@ class PoseSender:
         for i in skip:
             moved[i] = [False] * 4
         n = 0
+        xyz: list[list[float]] | None = None
         for i, (c0, c1, c2, p) in enumerate(moved):
             r = c0 or c1 or c2
             if not (r or p):
                 continue
             sent = self._sent[i]
+            wxyz = None
             if r:
                 R = T[i, :3, :3]
                 wxyz = quaternion_wxyz(R)
                 sent[:3, :3] = R
-            n += _set_pose(self.handles[i], wxyz if r else None, T[i, :3, 3].tolist() if p else None)
+            if p and xyz is None:
+                xyz = T[:, :3, 3].tolist()                  # every node's position in one call
+            n += _set_pose(self.handles[i], wxyz, xyz[i] if p and xyz is not None else None)
             if p:
                 sent[:3, 3] = T[i, :3, 3]
         return n
