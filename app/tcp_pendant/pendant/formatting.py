@@ -58,11 +58,21 @@ def readout_text(readout: PoseReadout, decimals: int = 2) -> str:
     return f"{readout.frame} {pos} mm  {rot} deg"
 
 
+def _two_decimals(values: tuple[float, ...]) -> list[str]:
+    """``fmt_num(v)`` of each value (two decimals, ``-0.00`` as ``0.00``, non-finite as text) in
+    one formatting pass: the readouts' numbers on every jog step."""
+    texts = (_SEP.join(("%.2f",) * len(values)) % values).split(_SEP)
+    return ["0.00" if t == "-0.00" else t for t in texts]
+
+
+_SEP = "\x1f"                      # never in a formatted number
+
+
 def tcp_readout_markdown(readout: PoseReadout, tool_name: str | None) -> str:
     """The TCP readout: a title with frame and tool, then a monospace table
     ``X 525.00 mm | A 0.00 deg`` (one line per pair)."""
     r = readout
-    x, y, z, a, b, c = (fmt_num(v) for v in (r.x_mm, r.y_mm, r.z_mm, r.a_deg, r.b_deg, r.c_deg))
+    x, y, z, a, b, c = _two_decimals((r.x_mm, r.y_mm, r.z_mm, r.a_deg, r.b_deg, r.c_deg))
     w = max(len(x), len(y), len(z), len(a), len(b), len(c))
     tool = "FLANGE (no tool active)" if tool_name is None else f"TOOL {escape_markdown(tool_name)}"
     return (f"**TCP in {r.frame}** · {tool}\n\n```\nX {x:>{w}} mm   A {a:>{w}} deg\n"
@@ -71,7 +81,8 @@ def tcp_readout_markdown(readout: PoseReadout, tool_name: str | None) -> str:
 
 def joint_readout_markdown(angles_deg: Mapping[str, float]) -> str:
     """Joint angles in degrees, three per line: ``A1 0.00  A2 -90.00  A3 90.00``."""
-    items = [f"{n} {fmt_num(v):>8}" for n, v in angles_deg.items()]
+    values = _two_decimals(tuple(angles_deg.values()))
+    items = [f"{n} {v:>8}" for n, v in zip(angles_deg, values)]
     lines = ["  ".join(items[i:i + 3]) for i in range(0, len(items), 3)]
     return "**Joints (deg)**\n\n```\n" + "\n".join(lines) + "\n```"
 
