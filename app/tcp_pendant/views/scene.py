@@ -164,7 +164,7 @@ class PoseSender:
         np.subtract(T[:, :3, :], self._sent[:, :3, :], out=d)
         np.abs(d, out=d)
         # per node and column: did any entry move? columns 0-2 are the rotation, 3 the position
-        moved = (d > POSE_EPS).any(axis=1).tolist()
+        moved = cast("list[list[bool]]", (d > POSE_EPS).any(axis=1).tolist())
         for i in force:
             moved[i] = [True] * 4
         for i in skip:
