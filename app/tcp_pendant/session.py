@@ -334,18 +334,20 @@ class Session:
         if change.tool:                           # the open wizard checks its steps' tool changes
             self.workflow.note_mounted_tool()
         events = self.workflow.take_events()      # whoever drove the workflow, nothing is lost
-        if events:
-            change = replace(change, events=change.events + events)
-        if self._play_moved_reference():
-            change = replace(change, pose=True)
-        if change.pose or change.tool:
+        moved_reference = self._play_moved_reference()
+        if change.pose or change.tool or moved_reference:
             state = self.pose_state()
-            change = replace(change, pose=True, state=state)
             crashed = bool(state.touch.crashed)
             if crashed and not self._crashed:
                 run = self.workflow.run_index if self.workflow.is_open else None
-                change = replace(change, events=change.events + (Crash(float(state.touch.penetration_mm), run),))
+                events += (Crash(float(state.touch.penetration_mm), run),)
             self._crashed = crashed
+            # the change as the subscribers get it, built once: pose, its state, every event
+            change = SessionChange(pose=True, tool=change.tool, touches=change.touches, wizard=change.wizard,
+                                   library=change.library, notice=change.notice, jog=change.jog, state=state,
+                                   events=change.events + events if events else change.events)
+        elif events:
+            change = replace(change, events=change.events + events)
         subscribers = list(self._subscribers)
         if self.target is None:
             for fn in subscribers:

@@ -107,8 +107,8 @@ def pose_state(controller: VirtualController, key: tuple[object, ...] | None = N
     T_world_tcp = T_world_flange @ c.T_flange_tool
     T_true_flange = T_world_flange if c.true_kinematics is k else c.T_world_flange_true()
     T_world_true = T_true_flange @ c.mounted_tool.T_flange_tool_true
-    angles = {name: (math.degrees(v) if k.revolute[i] else v * 1000.0)
-              for i, (name, v) in enumerate(zip(k.joint_names, q.tolist()))}
+    angles = {name: (math.degrees(v) if revolute else v * 1000.0)
+              for name, v, revolute in zip(k.joint_names, q.tolist(), k.revolute.tolist())}
     for T in (T_world_tcp, T_world_true):
         T.setflags(write=False)
     return PoseState(

@@ -37,7 +37,8 @@ def fmt_num(value: float, decimals: int = 2) -> str:
     if not math.isfinite(v):
         return str(v)
     text = f"{v:.{decimals}f}"
-    return text[1:] if text.startswith("-") and float(text) == 0.0 else text
+    # fixed-point text is zero when it has no digit but 0 (no exponent in the "f" format)
+    return text[1:] if text[0] == "-" and not text.strip("-0.") else text
 
 
 def readout_rows(readout: PoseReadout, decimals: int = 2) -> tuple[tuple[str, str, str], ...]:
@@ -57,21 +58,31 @@ def readout_text(readout: PoseReadout, decimals: int = 2) -> str:
     return f"{readout.frame} {pos} mm  {rot} deg"
 
 
+def _two_decimals(values: tuple[float, ...]) -> list[str]:
+    """``fmt_num(v)`` of each value (two decimals, ``-0.00`` as ``0.00``, non-finite as text) in
+    one formatting pass: the readouts' numbers on every jog step."""
+    texts = (_SEP.join(("%.2f",) * len(values)) % values).split(_SEP)
+    return ["0.00" if t == "-0.00" else t for t in texts]
+
+
+_SEP = "\x1f"                      # never in a formatted number
+
+
 def tcp_readout_markdown(readout: PoseReadout, tool_name: str | None) -> str:
     """The TCP readout: a title with frame and tool, then a monospace table
     ``X 525.00 mm | A 0.00 deg`` (one line per pair)."""
-    rows = readout_rows(readout, 2)
-    width = max(len(v) for _, v, _ in rows)
-    lines = [f"{rows[i][0]} {rows[i][1]:>{width}} mm   {rows[i + 3][0]} {rows[i + 3][1]:>{width}} deg"
-             for i in range(3)]
-
+    r = readout
+    x, y, z, a, b, c = _two_decimals((r.x_mm, r.y_mm, r.z_mm, r.a_deg, r.b_deg, r.c_deg))
+    w = max(len(x), len(y), len(z), len(a), len(b), len(c))
     tool = "FLANGE (no tool active)" if tool_name is None else f"TOOL {escape_markdown(tool_name)}"
-    return f"**TCP in {readout.frame}** · {tool}\n\n```\n" + "\n".join(lines) + "\n```"
+    return (f"**TCP in {r.frame}** · {tool}\n\n```\nX {x:>{w}} mm   A {a:>{w}} deg\n"
+            f"Y {y:>{w}} mm   B {b:>{w}} deg\nZ {z:>{w}} mm   C {c:>{w}} deg\n```")
 
 
 def joint_readout_markdown(angles_deg: Mapping[str, float]) -> str:
     """Joint angles in degrees, three per line: ``A1 0.00  A2 -90.00  A3 90.00``."""
-    items = [f"{n} {fmt_num(v):>8}" for n, v in angles_deg.items()]
+    values = _two_decimals(tuple(angles_deg.values()))
+    items = [f"{n} {v:>8}" for n, v in zip(angles_deg, values)]
     lines = ["  ".join(items[i:i + 3]) for i in range(0, len(items), 3)]
     return "**Joints (deg)**\n\n```\n" + "\n".join(lines) + "\n```"
 

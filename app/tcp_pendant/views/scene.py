@@ -35,7 +35,7 @@ from __future__ import annotations
 import asyncio
 import logging
 import math
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 import viser
@@ -146,6 +146,7 @@ class PoseSender:
     def __init__(self, handles: list[Any], T_parent_node: np.ndarray) -> None:
         self.handles = list(handles)
         self._sent = np.array(T_parent_node, dtype=float).reshape(len(self.handles), 4, 4)
+        self._diff = np.empty((len(self.handles), 3, 4))
 
     def send(self, T_parent_node: np.ndarray, *, skip: tuple[int, ...] = (), force: tuple[int, ...] = ()) -> int:
         """Queue the poses that changed.
@@ -159,23 +160,32 @@ class PoseSender:
             The number of messages queued.
         """
         T = np.asarray(T_parent_node, dtype=float)
-        d = np.abs(T - self._sent)
-        rot = (d[:, :3, :3].max(axis=(1, 2)) > POSE_EPS).tolist()
-        pos = (d[:, :3, 3].max(axis=1) > POSE_EPS).tolist()
+        d = self._diff
+        np.subtract(T[:, :3, :], self._sent[:, :3, :], out=d)
+        np.abs(d, out=d)
+        # per node and column: did any entry move? columns 0-2 are the rotation, 3 the position
+        moved = cast("list[list[bool]]", (d > POSE_EPS).any(axis=1).tolist())
         for i in force:
-            rot[i] = pos[i] = True
+            moved[i] = [True] * 4
         for i in skip:
-            rot[i] = pos[i] = False
+            moved[i] = [False] * 4
         n = 0
-        for i, (r, p) in enumerate(zip(rot, pos)):
+        xyz: list[list[float]] | None = None
+        for i, (c0, c1, c2, p) in enumerate(moved):
+            r = c0 or c1 or c2
             if not (r or p):
                 continue
-            n += _set_pose(self.handles[i], quaternion_wxyz(T[i, :3, :3]) if r else None,
-                           T[i, :3, 3].tolist() if p else None)
+            sent = self._sent[i]
+            wxyz = None
             if r:
-                self._sent[i, :3, :3] = T[i, :3, :3]
+                R = T[i, :3, :3]
+                wxyz = quaternion_wxyz(R)
+                sent[:3, :3] = R
+            if p and xyz is None:
+                xyz = T[:, :3, 3].tolist()                  # every node's position in one call
+            n += _set_pose(self.handles[i], wxyz, xyz[i] if p and xyz is not None else None)
             if p:
-                self._sent[i, :3, 3] = T[i, :3, 3]
+                sent[:3, 3] = T[i, :3, 3]
         return n
 
 
@@ -297,7 +307,10 @@ class SceneView:
         # the gizmo; rows of (node, parent) in [links..., T_world_tcp, identity] (render)
         self._moving = [n for n in tree if n != k.base_link]
         self._index_names: tuple[str, ...] = ()
-        self._child_idx = self._parent_idx = np.zeros(0, dtype=int)
+        self._child_idx = self._parent_idx = self._out_rows = np.zeros(0, dtype=int)
+        self._root_rows: list[tuple[int, int]] = []          # (row, link index) of links without a parent
+        self._contiguous = True
+        self._local_out = np.zeros((0, 4, 4))
         T_local = self._local_poses(state)
         local = {n: T_local[i] for i, n in enumerate(self._moving)}
         for name, (path, _) in tree.items():
@@ -322,6 +335,7 @@ class SceneView:
         wxyz, xyz = wxyz_xyz(tip.T_world_stand(c.reference_tip_world_m))
         self._tip_frame = scene.add_frame("/reference_tip", show_axes=False, wxyz=wxyz, position=xyz)
         self._shown_tip = np.array(c.reference_tip_world_m, dtype=float)
+        self._shown_tip_bytes = self._shown_tip.tobytes()
         _add_parts(scene, "/reference_tip", rigid_meshes(tip.urdf_path))
         self._tip_label = scene.add_label("/reference_tip_label", "reference tip",
                                           position=tuple(c.reference_tip_world_m + [0.0, 0.0, -0.06]))
@@ -342,9 +356,8 @@ class SceneView:
         links and the gizmo (``pose``), from the session's state."""
         if change.tool:
             self.reconcile_tools()
-        tip = self.session.controller.reference_tip_world_m
-        if not np.array_equal(tip, self._shown_tip):     # knocked (a scenario) or set anew
-            self.update_reference_tip()
+        if self.session.controller.reference_tip_world_m.tobytes() != self._shown_tip_bytes:
+            self.update_reference_tip()                   # knocked (a scenario) or set anew
         self.beam_stand.show(self.session.controller.beam_sensor)   # redraws only a changed sensor
         film = self.player
         self._step_aside(film is not None and film.playing)
@@ -363,16 +376,38 @@ class SceneView:
     # ------------------------------------------------------------ updates
     def _local_poses(self, state: Any) -> np.ndarray:
         """(N+1,4,4): ``T_parent_link`` of the moving links (``T_world_link`` for a link
-        without a parent), then ``T_world_tcp`` (the gizmo), from one pose state."""
+        without a parent), then ``T_world_tcp`` (the gizmo), from one pose state
+        (``R_p^T R_c``, ``R_p^T (p_c - p_p)`` as :func:`relative_poses`, batched into a buffer
+        reused by the next call: :class:`PoseSender` copies what it sends)."""
         if state.link_names != self._index_names:             # index rows once per link list
             row = {n: i for i, n in enumerate(state.link_names)}
-            n_links, eye = len(state.link_names), len(state.link_names) + 1
-            self._child_idx = np.array([row[n] for n in self._moving] + [n_links])
-            self._parent_idx = np.array([eye if (p := self._parent[n]) is None else row[p]
-                                         for n in self._moving] + [eye])
+            with_parent = [i for i, n in enumerate(self._moving) if self._parent[n] is not None]
+            self._out_rows = np.array(with_parent, dtype=int)
+            self._child_idx = np.array([row[self._moving[i]] for i in with_parent], dtype=int)
+            self._parent_idx = np.array([row[cast(str, self._parent[self._moving[i]])] for i in with_parent],
+                                        dtype=int)
+            self._root_rows = [(i, row[n]) for i, n in enumerate(self._moving) if self._parent[n] is None]
+            self._contiguous = with_parent == list(range(len(with_parent)))
+            self._local_out = np.zeros((len(self._moving) + 1, 4, 4))
+            self._local_out[:, 3, 3] = 1.0
             self._index_names = state.link_names
-        poses = np.concatenate([state.T_world_links, state.T_world_tcp[None], _EYE4[None]])
-        return relative_poses(poses[self._parent_idx], poses[self._child_idx])
+        out = self._local_out
+        W = state.T_world_links
+        P = W[self._parent_idx]
+        C = W[self._child_idx]
+        Rp_T = P[:, :3, :3].transpose(0, 2, 1)
+        d = (C[:, :3, 3] - P[:, :3, 3])[..., None]
+        if self._contiguous:                                  # a tree without loose links: in place
+            k = len(self._child_idx)
+            np.matmul(Rp_T, C[:, :3, :3], out=out[:k, :3, :3])
+            np.matmul(Rp_T, d, out=out[:k, :3, 3:])
+        else:
+            out[self._out_rows, :3, :3] = Rp_T @ C[:, :3, :3]
+            out[self._out_rows, :3, 3] = (Rp_T @ d)[..., 0]
+        for i, j in self._root_rows:
+            out[i] = W[j]
+        out[-1] = state.T_world_tcp
+        return out
 
     def render(self) -> None:
         """Pose the moving link frames and the gizmo on the TCP (not while dragged) from the
@@ -421,6 +456,7 @@ class SceneView:
         """Re-place the stand after the reference tip moved (:meth:`on_change` calls it)."""
         c = self.session.controller
         self._shown_tip = np.array(c.reference_tip_world_m, dtype=float)
+        self._shown_tip_bytes = self._shown_tip.tobytes()
         wxyz, xyz = wxyz_xyz(reference_tip_model().T_world_stand(c.reference_tip_world_m))
         self._tip_frame.wxyz = wxyz
         self._tip_frame.position = xyz

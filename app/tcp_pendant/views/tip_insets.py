@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from tcp_pendant.pendant.tip_insets import FAR, insets_key, tip_insets_image
+from tcp_pendant.pendant.tip_insets import FAR, NEAR_MM, insets_key, tip_insets_image
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.views.gui_util import target_of
 
@@ -22,6 +22,11 @@ __all__ = ["CAPTION", "TipInsets"]
 
 CAPTION = ("**Tip close-up** · left: front (X→, Z↑) · right: side (Y→, Z↑) · "
            "grid and bar 1 mm · magenta: the tool tip")
+
+FAR_MARGIN_MM = 1e-6
+"""The pose state's touch distance (``|R^T (tip - p)|``) and :func:`insets_key`'s (``|p - tip|``)
+are one length computed two ways (they differ by float rounding, ~1e-13 mm): beyond
+``NEAR_MM`` plus this margin the key is FAR for sure, and a view showing FAR skips the key."""
 
 
 class TipInsets:
@@ -40,6 +45,8 @@ class TipInsets:
 
     def on_change(self, change: SessionChange) -> None:
         if change.pose and change.state is not None:
+            if self._key == FAR and change.state.touch.distance_mm > NEAR_MM + FAR_MARGIN_MM:
+                return                  # far, and shown far: nothing to draw (the key is FAR too)
             self.render(change.state)
 
     def render(self, state: Any) -> None:
