@@ -40,6 +40,7 @@ from tcp_pendant.controller.errors import ControllerError
 from tcp_pendant.controller.jog import (
     DEFAULT_SETTINGS,
     CartesianPath,
+    FlangeState,
     JogFrame,
     JogResult,
     JogSettings,
@@ -100,7 +101,10 @@ class VirtualController:
         self.settings = settings
         self._q = np.array(kinematics.home_rad, dtype=float)
         self._rest_q = np.array(kinematics.home_rad, dtype=float)
-        self._sigma: tuple[np.ndarray, float, float] | None = None  # (q, sigma_min, sign det J) at q of the last path
+        self._state: FlangeState | None = None
+        """The kinematics where the last path ended (Jacobian, pose, sigma_min, det sign): the next
+        jog starts from it while the robot is still exactly there (``FlangeState.valid_for``);
+        dropped whenever q, the model or the tool data are set any other way."""
         self._tool = tool
         self._active: Tool | None = None
         self._T_flange_tool = np.eye(4)
@@ -135,6 +139,7 @@ class VirtualController:
             raise ControllerError(f"{k.joint_names[i]} = {k.format_joint(i, q[i])} is beyond its {side} "
                                   f"limit {k.format_joint(i, limit)}; give angles within the limits.")
         self._q = np.clip(q, self.kinematics.lower_rad, self.kinematics.upper_rad)
+        self._state = None
 
     def joint_angles_deg(self) -> dict[str, float]:
         """Joint readout: name -> degrees (mm for prismatic joints), in joint order."""
@@ -145,6 +150,7 @@ class VirtualController:
     def go_home(self) -> None:
         """Teleport to the home configuration."""
         self._q = np.array(self.kinematics.home_rad, dtype=float)
+        self._state = None
 
     @property
     def rest_q_rad(self) -> np.ndarray:
@@ -167,6 +173,7 @@ class VirtualController:
         Raises:
             ControllerError: a robot with other joints than the nominal model.
         """
+        self._state = None
         if true_kinematics is None:
             self._true_kin = self.kinematics
             return
@@ -202,6 +209,7 @@ class VirtualController:
 
     def set_active_tool(self, tool: Tool | None) -> None:
         """Select the active tool data; ``T_flange_tool`` = its ``tcp_mm`` (in m) and ``abc_deg``."""
+        self._state = None
         if tool is None:
             self._active, self._T_flange_tool = None, np.eye(4)
             return
@@ -322,13 +330,13 @@ class VirtualController:
         lo, hi = float(k.lower_rad[index]), float(k.upper_rad[index])
         if lo <= target <= hi:
             q[index] = target
-            self._q = q
+            self._q, self._state = q, None
             return JogResult(True, 1.0, None, "")
         side = "upper" if target > hi else "lower"
         limit = hi if side == "upper" else lo
         moved = max(0.0, min(1.0, (limit - q[index]) / delta))
         q[index] = limit
-        self._q = q
+        self._q, self._state = q, None
         return JogResult(False, moved, "joint_limit", k.limit_message(index, side))
 
     def _frame_rotation(self, frame: JogFrame) -> np.ndarray:
@@ -374,12 +382,14 @@ class VirtualController:
         return self._follow(path, self._T_flange_tool)
 
     def _follow(self, path: CartesianPath, T_flange_tcp: np.ndarray) -> JogResult:
-        known = self._sigma is not None and np.array_equal(self._sigma[0], self._q)
-        sigma, det_sign = (self._sigma[1], self._sigma[2]) if known and self._sigma is not None else (None, None)
-        out = follow_path(self.kinematics, self._q, T_flange_tcp, path, self.settings, sigma_start=sigma,
-                          q_rest=self._rest_q, det_sign_start=det_sign)
+        state = self._state
+        if state is not None and not state.valid_for(self.kinematics, self._q):
+            state = None
+        out = follow_path(self.kinematics, self._q, T_flange_tcp, path, self.settings, q_rest=self._rest_q,
+                          start=state)
         self._q = out.q_rad
-        self._sigma = (out.q_rad.copy(), out.sigma, out.det_sign)
+        self._state = out.state if out.state is not None and out.state.valid_for(self.kinematics, self._q) \
+            else None
         if out.stopped_by is None:
             return JogResult(True, 1.0, None, "")
         return JogResult(False, float(out.moved), out.stopped_by, out.message)
@@ -416,7 +426,7 @@ class VirtualController:
                              f"no configuration within the joint limits gets there (closest: "
                              f"{sol.position_error_m * 1000:.1f} mm, "
                              f"{math.degrees(sol.rotation_error_rad):.1f} deg away).")
-        self._q = sol.q_rad
+        self._q, self._state = sol.q_rad, None
         return JogResult(True, 1.0, None, "")
 
     def auto_approach(self, *, tilt_deg: float, azimuth_deg: float, spin_deg: float = 0.0,

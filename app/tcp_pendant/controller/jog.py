@@ -70,6 +70,7 @@ from typing import Literal
 
 import numpy as np
 import pinocchio as pin
+from scipy.linalg import lapack
 
 from tcp_pendant.controller.kinematics import RobotKinematics
 
@@ -78,6 +79,7 @@ __all__ = [
     "JogResult",
     "JogSettings",
     "CartesianPath",
+    "FlangeState",
     "PathOutcome",
     "follow_path",
     "singularity_message",
@@ -157,8 +159,40 @@ class CartesianPath:
     w: np.ndarray
 
     def at(self, s: float) -> tuple[np.ndarray, np.ndarray]:
-        """Target (p, R) at path parameter ``s``."""
+        """Target (p, R) at path parameter ``s`` (a translation, ``w = 0``: ``R0`` itself, not a
+        copy: ``Exp(0) R0 = R0`` exactly)."""
+        if not self.w.any():
+            return self.p0 + s * self.dp, self.R0
         return self.p0 + s * self.dp, pin.exp3(s * self.w) @ self.R0
+
+
+@dataclass(frozen=True)
+class FlangeState:
+    """What the kinematics gave at one configuration: the flange Jacobian, pose and the numbers
+    the safety rules need, so that the next path starting there needs no pinocchio pass.
+
+    Only valid for ``q_rad`` on the robot ``kin`` (compare both exactly before use,
+    :meth:`valid_for`); the arrays are never written to.
+    """
+
+    kin: RobotKinematics
+    q_rad: np.ndarray
+    q_list: list[float]
+    """``q_rad.tolist()``: the exact key (a list compare costs less than ``np.array_equal``)."""
+    J: np.ndarray
+    """(6, n) flange Jacobian, LOCAL_WORLD_ALIGNED (``RobotKinematics.jacobian_flange``)."""
+    R_wf: np.ndarray
+    p_wf: np.ndarray
+    sigma: float
+    """:func:`smallest_singular_value` at ``q_rad``."""
+    det_sign: float
+    """``_det_sign`` of ``J`` (+1, -1; 0 singular or not square)."""
+    lu: tuple[np.ndarray, np.ndarray] | None = None
+    """LAPACK ``getrf`` factors of ``J`` (square ``J`` only), for the first Newton step."""
+
+    def valid_for(self, kin: RobotKinematics, q_rad: np.ndarray) -> bool:
+        """True when this state was computed on ``kin`` at exactly ``q_rad``."""
+        return kin is self.kin and self.q_list == q_rad.tolist()
 
 
 @dataclass(frozen=True)
@@ -173,6 +207,8 @@ class PathOutcome:
     """:func:`smallest_singular_value` at ``q_rad``."""
     det_sign: float = 0.0
     """Sign of ``det J_flange`` at ``q_rad`` (``_det_sign``: +1, -1; 0 singular or not square)."""
+    state: FlangeState | None = None
+    """The kinematics at ``q_rad`` (the last Newton iteration's), to start the next path from."""
 
 
 def tcp_pose(kin: RobotKinematics, q_rad: np.ndarray, T_flange_tcp: np.ndarray) -> np.ndarray:
@@ -188,11 +224,24 @@ def smallest_singular_value(kin: RobotKinematics, q_rad: np.ndarray,
 
 
 def _sigma_min(J_flange: np.ndarray, settings: JogSettings) -> float:
-    Js = J_flange.copy()
-    Js[:3] /= settings.length_scale_m
-    s = np.linalg.svd(Js, compute_uv=False)
-    k = min(Js.shape) - 1
-    return float(s[k]) if Js.shape[1] >= 6 else 0.0
+    if J_flange.shape[1] < 6:
+        return 0.0
+    # rows 0-2 divided by L (as W J), one LAPACK gesdd call (what np.linalg.svd runs, without its
+    # wrapper's per-call cost)
+    Js = J_flange / _row_scale(settings.length_scale_m)
+    s = lapack.dgesdd(Js, compute_uv=0)[1]
+    return float(s[min(Js.shape) - 1])
+
+
+_ROW_SCALES: dict[float, np.ndarray] = {}
+
+
+def _row_scale(length_scale_m: float) -> np.ndarray:
+    """(6, 1) column ``[L, L, L, 1, 1, 1]``: ``J / it`` is ``W J`` of the module doc."""
+    col = _ROW_SCALES.get(length_scale_m)
+    if col is None:
+        col = _ROW_SCALES[length_scale_m] = np.array([[length_scale_m]] * 3 + [[1.0]] * 3)
+    return col
 
 
 def singularity_message(kin: RobotKinematics, q_rad: np.ndarray,
@@ -233,6 +282,22 @@ def _det_sign(J_flange: np.ndarray) -> float:
     return float(np.sign(np.linalg.det(J_flange)))
 
 
+def _lu_det_sign(J_flange: np.ndarray) -> tuple[float, tuple[np.ndarray, np.ndarray] | None]:
+    """:func:`_det_sign` from an LU factorisation ``P J = L U`` (what ``np.linalg.det`` does:
+    ``det J = (-1)^(row swaps) prod diag U``), and the factors for a later solve with ``J``
+    (None when J is not square or exactly singular)."""
+    if J_flange.shape[0] != J_flange.shape[1]:
+        return 0.0, None
+    lu, piv, info = lapack.dgetrf(J_flange)
+    negative = sum(1 for i, p in enumerate(piv.tolist()) if p != i)
+    for d in lu.diagonal().tolist():
+        if d == 0.0 or d != d:
+            return (0.0 if d == 0.0 else math.nan), None
+        if d < 0.0:
+            negative += 1
+    return (-1.0 if negative % 2 else 1.0), ((lu, piv) if info == 0 else None)
+
+
 @dataclass
 class _Attempt:
     q: np.ndarray
@@ -240,6 +305,8 @@ class _Attempt:
     reason: StopReason | None
     message: str
     det_sign: float = 0.0
+    state: FlangeState | None = None
+    """The kinematics at ``q`` (accepted attempts only)."""
 
 
 def _null_space_step(Jt: np.ndarray, q: np.ndarray, q_rest: np.ndarray, gain: float,
@@ -256,48 +323,79 @@ def _null_space_step(Jt: np.ndarray, q: np.ndarray, q_rest: np.ndarray, gain: fl
 
 
 def _solve_substep(kin: RobotKinematics, q_start: np.ndarray, sigma_start: float,
-                   t_f: np.ndarray, R_ft: np.ndarray, p_target: np.ndarray, R_target: np.ndarray,
-                   cart_amount: float, settings: JogSettings, det_sign_start: float = 0.0,
-                   q_rest: np.ndarray | None = None) -> _Attempt:
+                   t_f: np.ndarray | None, R_ft: np.ndarray | None, p_target: np.ndarray,
+                   R_target: np.ndarray, cart_amount: float, settings: JogSettings,
+                   det_sign_start: float = 0.0, q_rest: np.ndarray | None = None,
+                   start: FlangeState | None = None) -> _Attempt:
     """Damped Newton (J-2) from ``q_start`` to one target pose, then the safety checks.
 
+    ``t_f``, ``R_ft``: the TCP in FLANGE coordinates; None for a zero offset and an identity
+    rotation (the products with them are skipped: they would change no bit).
     ``det_sign_start`` is :func:`_det_sign` at ``q_start`` (0: unknown or on a singularity);
-    ``q_rest``: the rest configuration of a redundant arm's null-space step (J-3), None: none.
+    ``q_rest``: the rest configuration of a redundant arm's null-space step (J-3), None: none;
+    ``start``: the kinematics at ``q_start`` (its first iteration then needs no pinocchio pass).
+
+    With ``lambda = 0`` on a square Jacobian (a six-joint arm away from singularities) (J-2) is
+    the Newton step ``dq = J_tcp^-1 e``; it is solved as ``J_flange dq = [e_p + r x e_r; e_r]``
+    (``J_tcp = [I -[r]x; 0 I] J_flange``, ``r = R_wf t``), one LU solve with the flange Jacobian
+    (whose factors the previous sub-step left in ``start``).
     """
     eps = settings.singular_eps
     lam2 = 0.0
     if sigma_start < eps:
         lam2 = settings.lambda_max ** 2 * (1.0 - (sigma_start / eps) ** 2)
-    L = settings.length_scale_m
-    w2 = np.array([L * L] * 3 + [1.0] * 3)  # W^-2: damping in the scaled metric
-    q = q_start.copy()
-    J = None
+    direct = lam2 == 0.0 and q_rest is None and q_start.shape[0] == 6 and kin.n_joints == 6
+    tol_m, tol_rad = settings.tol_m, settings.tol_rad
+    q = q_start
+    J = R_wf = p_wf = None
+    lu: tuple[np.ndarray, np.ndarray] | None = None
     converged = False
     allowance = max(settings.max_joint_gain * cart_amount, settings.min_joint_allowance_rad)
     for iteration in range(settings.max_iterations + 1):
-        J, R_wf, p_wf = kin.jacobian_and_pose(q)
-        r = R_wf @ t_f
-        e_p = p_target - (p_wf + r)
-        e_r = pin.log3(R_target @ (R_wf @ R_ft).T)
-        if math.sqrt(e_p @ e_p) < settings.tol_m and math.sqrt(e_r @ e_r) < settings.tol_rad:
+        if iteration == 0 and start is not None:
+            J, R_wf, p_wf, lu = start.J, start.R_wf, start.p_wf, start.lu
+        else:
+            J, R_wf, p_wf = kin.jacobian_and_pose(q)
+            lu = None
+        r = None if t_f is None else R_wf @ t_f
+        e_p = p_target - p_wf if r is None else p_target - (p_wf + r)
+        e_r = pin.log3(R_target @ (R_wf if R_ft is None else R_wf @ R_ft).T)
+        ep, er = e_p.tolist(), e_r.tolist()
+        if math.hypot(*ep) < tol_m and math.hypot(*er) < tol_rad:
             converged = True
             break
-        Jt = J.copy()
-        Jt[:3] -= _skew(r) @ J[3:]
-        e = np.concatenate((e_p, e_r))
-        A = Jt @ Jt.T
-        if lam2 > 0.0:
-            A[np.diag_indices(6)] += lam2 * w2
-        try:
-            dq = Jt.T @ np.linalg.solve(A, e)
-        except np.linalg.LinAlgError:
-            dq = Jt.T @ np.linalg.lstsq(A, e, rcond=None)[0]
-        if iteration == 0 and q_rest is not None:
-            dq = dq + _null_space_step(Jt, q, q_rest, settings.null_space_gain, 0.25 * allowance)
+        dq = None
+        if direct:
+            if r is not None:
+                rx, ry, rz = r.tolist()
+                ex, ey, ez = er
+                ep = [ep[0] + ry * ez - rz * ey, ep[1] + rz * ex - rx * ez, ep[2] + rx * ey - ry * ex]
+            b = np.array(ep + er)
+            if lu is not None:
+                x, info = lapack.dgetrs(lu[0], lu[1], b)
+            else:
+                x, info = lapack.dgesv(J, b)[2:]
+            if info == 0:
+                dq = x
+        if dq is None:
+            Jt = J.copy()
+            if r is not None:
+                Jt[:3] -= _skew(r) @ J[3:]
+            e = np.concatenate((e_p, e_r))
+            A = Jt @ Jt.T
+            if lam2 > 0.0:
+                L = settings.length_scale_m
+                A[np.diag_indices(6)] += lam2 * np.array([L * L] * 3 + [1.0] * 3)  # W^-2: damping in the scaled metric
+            try:
+                dq = Jt.T @ np.linalg.solve(A, e)
+            except np.linalg.LinAlgError:
+                dq = Jt.T @ np.linalg.lstsq(A, e, rcond=None)[0]
+            if iteration == 0 and q_rest is not None:
+                dq = dq + _null_space_step(Jt, q, q_rest, settings.null_space_gain, 0.25 * allowance)
         q = q + dq
-        if not np.isfinite(q).all():
+        if not all(map(math.isfinite, q.tolist())):
             break
-    jump = float(np.abs(q - q_start).max()) if np.isfinite(q).all() else math.inf
+    jump = float(np.abs(q - q_start).max()) if converged else math.inf
     if not converged or jump > allowance:
         if sigma_start < 2.0 * eps:
             return _Attempt(q_start, sigma_start, "singularity", singularity_message(kin, q_start, settings))
@@ -315,23 +413,28 @@ def _solve_substep(kin: RobotKinematics, q_start: np.ndarray, sigma_start: float
         i = int(np.argmax(over))
         side = "lower" if q[i] < kin.lower_rad[i] else "upper"
         return _Attempt(q_start, sigma_start, "joint_limit", kin.limit_message(i, side))
-    assert J is not None  # the Newton loop runs at least once
+    assert J is not None and R_wf is not None and p_wf is not None  # the Newton loop runs at least once
     sigma = _sigma_min(J, settings)
     if sigma < eps and sigma < sigma_start * (1.0 - 1e-9) - 1e-12:
         return _Attempt(q_start, sigma_start, "singularity", singularity_message(kin, q, settings))
-    det_sign = _det_sign(J)
+    if lu is not None:        # converged at the start: J is the start's, its sign known
+        det_sign = start.det_sign if start is not None else _det_sign(J)
+    else:
+        det_sign, lu = _lu_det_sign(J)
     if (det_sign * det_sign_start < 0.0 and sigma > settings.singular_zero
             and sigma_start > settings.singular_zero):
         # passed through a singularity into another configuration: name the one at the start
         return _Attempt(q_start, sigma_start, "singularity", singularity_message(kin, q_start, settings),
                         det_sign_start)
-    return _Attempt(q, sigma, None, "", det_sign)
+    q_out = q.copy() if q is q_start else q
+    return _Attempt(q_out, sigma, None, "", det_sign,
+                    FlangeState(kin, q_out, q_out.tolist(), J, R_wf, p_wf, sigma, det_sign, lu))
 
 
 def follow_path(kin: RobotKinematics, q_rad: np.ndarray, T_flange_tcp: np.ndarray,
                 path: CartesianPath, settings: JogSettings = DEFAULT_SETTINGS, *,
                 sigma_start: float | None = None, q_rest: np.ndarray | None = None,
-                det_sign_start: float | None = None) -> PathOutcome:
+                det_sign_start: float | None = None, start: FlangeState | None = None) -> PathOutcome:
     """Move the TCP along ``path`` (J-1) from configuration ``q_rad`` under the safety rules.
 
     Args:
@@ -345,24 +448,36 @@ def follow_path(kin: RobotKinematics, q_rad: np.ndarray, T_flange_tcp: np.ndarra
         det_sign_start: the sign of ``det J_flange`` at ``q_rad`` if the caller knows it
             (``PathOutcome.det_sign`` of the previous path); with ``sigma_start`` it saves the
             Jacobian at the start, one pinocchio pass per jog step.
+        start: the kinematics at ``q_rad`` (``PathOutcome.state`` of the previous path): its
+            sigma and det sign, and the Jacobian and pose for the first Newton iteration (one
+            pinocchio pass less). Used only when it was computed on ``kin`` at exactly
+            ``q_rad`` (``FlangeState.valid_for``); it overrides ``sigma_start``/``det_sign_start``.
 
     Returns:
         The configuration reached, the fraction ``moved`` of the path, the stop reason and
-        message (None and "" when the whole path was carried out), and ``sigma`` at the end.
+        message (None and "" when the whole path was carried out), ``sigma`` at the end and
+        the kinematics there (``state``; None when the path did not move from ``q_rad``
+        and no ``start`` was given).
     """
-    t_f = np.ascontiguousarray(T_flange_tcp[:3, 3], dtype=float)
-    R_ft = np.ascontiguousarray(T_flange_tcp[:3, :3], dtype=float)
+    t_list = T_flange_tcp[:3, 3].tolist()
+    R_list = T_flange_tcp[:3, :3].tolist()
+    # a zero offset / identity rotation: skip the products with them (bit for bit the same)
+    t_f = None if t_list == [0.0, 0.0, 0.0] else np.array(t_list, dtype=float)
+    R_ft = None if R_list == _IDENTITY_ROWS else np.array(R_list, dtype=float)
     length_m = math.hypot(*path.dp.tolist())           # |dp|, |w|, |t_f|: math, no numpy call per jog step
     angle = math.hypot(*path.w.tolist())
     n = max(1, math.ceil(max(length_m / settings.max_substep_m, angle / settings.max_substep_rad) - 1e-9))
     # joint allowance per unit of flange motion: (mm of travel -> "deg") + rad of rotation; a
     # rotation about the TCP swings the flange by |w| |t| (module doc)
-    lever_m = math.hypot(*t_f.tolist())
+    lever_m = math.hypot(*t_list)
     unit = (length_m + angle * lever_m) * 1000.0 * math.radians(1.0) + angle
 
     q = np.array(q_rad, dtype=float)
     rest = np.asarray(q_rest, dtype=float) if q_rest is not None and kin.n_joints > 6 else None
-    if sigma_start is None or det_sign_start is None:
+    state = start if start is not None and start.valid_for(kin, q) else None
+    if state is not None:
+        sigma, det_sign = state.sigma, state.det_sign
+    elif sigma_start is None or det_sign_start is None:
         J0 = kin.jacobian_flange(q)
         sigma = _sigma_min(J0, settings) if sigma_start is None else float(sigma_start)
         det_sign = _det_sign(J0) if det_sign_start is None else float(det_sign_start)
@@ -373,9 +488,9 @@ def follow_path(kin: RobotKinematics, q_rad: np.ndarray, T_flange_tcp: np.ndarra
         s_next = k / n
         p_t, R_t = path.at(s_next)
         att = _solve_substep(kin, q, sigma, t_f, R_ft, p_t, R_t, unit * (s_next - s_done), settings,
-                             det_sign, rest)
+                             det_sign, rest, state)
         if att.reason is None:
-            q, sigma, det_sign, s_done = att.q, att.sigma, att.det_sign, s_next
+            q, sigma, det_sign, s_done, state = att.q, att.sigma, att.det_sign, s_next, att.state
             continue
         last = att
         lo, hi = s_done, s_next
@@ -383,10 +498,13 @@ def follow_path(kin: RobotKinematics, q_rad: np.ndarray, T_flange_tcp: np.ndarra
             mid = 0.5 * (lo + hi)
             p_t, R_t = path.at(mid)
             a = _solve_substep(kin, q, sigma, t_f, R_ft, p_t, R_t, unit * (mid - lo), settings, det_sign,
-                               rest)
+                               rest, state)
             if a.reason is None:
-                q, sigma, det_sign, lo = a.q, a.sigma, a.det_sign, mid
+                q, sigma, det_sign, lo, state = a.q, a.sigma, a.det_sign, mid, a.state
             else:
                 hi, last = mid, a
-        return PathOutcome(q, lo, last.reason, last.message, sigma, det_sign)
-    return PathOutcome(q, 1.0, None, "", sigma, det_sign)
+        return PathOutcome(q, lo, last.reason, last.message, sigma, det_sign, state)
+    return PathOutcome(q, 1.0, None, "", sigma, det_sign, state)
+
+
+_IDENTITY_ROWS = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
