@@ -7,21 +7,25 @@ same math: damped least squares J-2 through ``J^T (J J^T + lambda^2 W^-2)^-1 e``
 ``np.linalg.solve``, a full pinocchio pass per Newton iteration, ``np.linalg.svd`` and
 ``np.linalg.det`` per sub-step); :class:`LegacyController` is a ``VirtualController`` whose
 Cartesian jogs run it (keeping ``(q, sigma, det sign)`` of the last path as the controller then
-did). Not used by the app.
+did) and :class:`LegacyJogger` the pendant's ``Jogger`` with its translation (contact stop) as it
+was. Not used by the app.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 import pinocchio as pin
 
-from tcp_pendant.controller import VirtualController
+from tcp_pendant.controller import ControllerError, VirtualController
+from tcp_pendant.controller.controller import _AXES, _finite
 from tcp_pendant.controller.jog import (
     DEFAULT_SETTINGS,
     CartesianPath,
+    JogFrame,
     JogResult,
     JogSettings,
     PathOutcome,
@@ -30,8 +34,10 @@ from tcp_pendant.controller.jog import (
     singularity_message,
 )
 from tcp_pendant.controller.kinematics import RobotKinematics
+from tcp_pendant.pendant.guidance import contact_stop
+from tcp_pendant.pendant.jogging import CartesianAxis, Jogger
 
-__all__ = ["LegacyController", "legacy_follow_path"]
+__all__ = ["LegacyController", "LegacyJogger", "legacy_follow_path"]
 
 
 def _jacobian_and_pose(kin: RobotKinematics, q_rad: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -220,9 +226,52 @@ def legacy_follow_path(kin: RobotKinematics, q_rad: np.ndarray, T_flange_tcp: np
 
 
 class LegacyController(VirtualController):
-    """A ``VirtualController`` whose Cartesian jogs and gizmo moves follow :func:`legacy_follow_path`."""
+    """A ``VirtualController`` whose Cartesian jogs (``jog_cartesian`` as it was) and gizmo moves
+    follow :func:`legacy_follow_path`."""
 
     _legacy_sigma: tuple[np.ndarray, float, float] | None = None
+
+    def _legacy_frame_rotation(self, frame: JogFrame) -> np.ndarray:
+        if frame is JogFrame.WORLD:
+            return np.eye(3)
+        if frame is JogFrame.BASE:
+            return self._T_world_base[:3, :3].copy()
+        if frame is JogFrame.FLANGE:
+            return self.T_world_flange()[:3, :3]
+        return self.T_world_tcp()[:3, :3]
+
+    def jog_cartesian(self, frame: JogFrame | str, axis: Literal["X", "Y", "Z", "A", "B", "C"],
+                      amount: float) -> JogResult:
+        """Jog the active TCP by one increment in a jog frame.
+
+        X, Y, Z: translate the TCP by ``amount`` mm along that axis of ``frame``.
+        A, B, C: rotate the tool by ``amount`` degrees about the TCP, about the Z (A), Y (B) or
+        X (C) axis of ``frame`` (KUKA habit: A, B, C are the angles about Z, Y, X). FLANGE
+        and TOOL axes are taken at the start of the increment.
+
+        The motion follows ``jog.follow_path`` (J-1, J-2): the TCP stays on its line to
+        < 0.01 mm with the orientation held to < 0.001 deg; a rotation keeps the TCP fixed;
+        it stops at joint limits and singularities with ``stopped_by`` and the message, and
+        never jumps configuration. The app makes continuous jogging from small increments
+        (speed * override * dt).
+        """
+        try:
+            jf = JogFrame(frame.upper() if isinstance(frame, str) else frame)
+        except ValueError:
+            raise ControllerError(f"Unknown jog frame {frame!r}; use WORLD, BASE, FLANGE or TOOL.") from None
+        ax = str(axis).upper()
+        if ax not in _AXES:
+            raise ControllerError(f"Unknown jog axis {axis!r}; use X, Y, Z (mm) or A, B, C (deg).")
+        amt = _finite(amount, "jog amount")
+        if amt == 0.0:
+            return JogResult(True, 1.0, None, "")
+        direction = self._legacy_frame_rotation(jf)[:, _AXES[ax]]
+        T0 = self.T_world_tcp()
+        if ax in "XYZ":
+            path = CartesianPath(T0[:3, 3], T0[:3, :3], direction * (amt / 1000.0), np.zeros(3))
+        else:
+            path = CartesianPath(T0[:3, 3], T0[:3, :3], np.zeros(3), direction * math.radians(amt))
+        return self._follow(path, self._T_flange_tool)
 
     def _follow(self, path: CartesianPath, T_flange_tcp: np.ndarray) -> JogResult:
         known = self._legacy_sigma is not None and np.array_equal(self._legacy_sigma[0], self._q)
@@ -235,3 +284,24 @@ class LegacyController(VirtualController):
         if out.stopped_by is None:
             return JogResult(True, 1.0, None, "")
         return JogResult(False, float(out.moved), out.stopped_by, out.message)
+
+
+class LegacyJogger(Jogger):
+    """The pendant's ``Jogger`` with ``_translate`` as it was (``contact_stop`` on every press)."""
+
+    def _translate(self, ax: CartesianAxis, amount_mm: float) -> JogResult:
+        """A translation of ``amount_mm`` along axis ``ax`` of the jog frame, stopped at contact
+        (module docstring)."""
+        c = self.controller
+        if not self.stop_at_contact:
+            return c.jog_cartesian(self.settings.frame, ax, amount_mm)
+        step_m = self.frame_rotation()[:, "XYZ".index(ax)] * (amount_mm / 1000.0)
+        stop = contact_stop(c.T_world_tool_true()[:3, 3], step_m, c.reference_tip_world_m)
+        if stop is None:
+            return c.jog_cartesian(self.settings.frame, ax, amount_mm)
+        res = c.jog_cartesian(self.settings.frame, ax, amount_mm * stop.fraction)
+        if not res.ok:
+            return res
+        return JogResult(False, stop.fraction, "contact",
+                         f"Stopped at the reference tip after {abs(amount_mm) * stop.fraction:.2f} of "
+                         f"{abs(amount_mm):g} mm (touch-up: the tool tip touches it). Press again to go on.")

@@ -83,22 +83,31 @@ def _state(ctrl: VirtualController) -> FlangeState | None:
 
 def test_the_kept_state_is_the_kinematics_at_the_joint_angles_reached():
     ctrl = make_controller("kr6", "torch")
-    for frame, axis, amount in (("WORLD", "X", 0.1), ("TOOL", "A", 1.0), ("BASE", "Z", 10.0)):
-        assert ctrl.jog_cartesian(frame, axis, amount).ok
+    eps = ctrl.settings.singular_eps
+    exact_sigmas = 0
+    for frame, axis, amount in [("WORLD", "X", 0.1), ("TOOL", "A", 1.0), ("BASE", "Z", 10.0)] + _moves(7, 60):
+        res = ctrl.jog_cartesian(frame, axis, amount)
         st = _state(ctrl)
-        assert st is not None and st.valid_for(ctrl.kinematics, ctrl.q_rad)
+        assert st is not None and st.valid_for(ctrl.kinematics, ctrl.q_rad), res
         q = ctrl.q_rad
         kin = ctrl.kinematics
         np.testing.assert_array_equal(st.J, kin.jacobian_flange(q))
         T = kin.T_world_flange(q)
         np.testing.assert_allclose(st.R_wf, T[:3, :3], rtol=0.0, atol=1e-15)
         np.testing.assert_allclose(st.p_wf, T[:3, 3], rtol=0.0, atol=1e-15)
-        assert st.sigma == pytest.approx(smallest_singular_value(kin, q), rel=1e-12)
+        # sigma_min itself, or a lower bound of it that clears 2 eps (all the rules need then)
+        exact = smallest_singular_value(kin, q)
+        assert st.sigma <= exact * (1.0 + 1e-12)
+        if st.sigma != pytest.approx(exact, rel=1e-12):
+            assert st.sigma >= 2.0 * eps
+        else:
+            exact_sigmas += 1
         assert st.det_sign == _det_sign(kin.jacobian_flange(q)) != 0.0
-        assert st.lu is not None
-        lu, piv = st.lu
-        assert np.prod(np.diag(lu)) * (-1.0) ** sum(int(p) != i for i, p in enumerate(piv)) == pytest.approx(
-            np.linalg.det(st.J), rel=1e-9)
+        if st.lu is not None:
+            lu, piv = st.lu
+            det = np.prod(np.diag(lu)) * (-1.0) ** sum(int(p) != i for i, p in enumerate(piv))
+            assert det == pytest.approx(np.linalg.det(st.J), rel=1e-9)
+    assert exact_sigmas > 0              # the bound runs out and sigma is computed again
 
 
 def test_follow_path_ignores_a_state_of_other_joint_angles_or_another_robot():

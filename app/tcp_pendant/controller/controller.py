@@ -54,6 +54,11 @@ from tcp_pendant.controller.touch import TouchGeometry, touch_geometry
 __all__ = ["VirtualController"]
 
 _AXES = {"X": 0, "Y": 1, "Z": 2, "A": 2, "B": 1, "C": 0}
+_FRAMES: dict[str, JogFrame] = {f.value: f for f in JogFrame}
+_WORLD_AXES = np.eye(3)
+_WORLD_AXES.setflags(write=False)
+_NO_ROTATION = np.zeros(3)
+_NO_ROTATION.setflags(write=False)
 
 
 def _check_point(p: Sequence[float] | np.ndarray, what: str) -> np.ndarray:
@@ -340,10 +345,11 @@ class VirtualController:
         return JogResult(False, moved, "joint_limit", k.limit_message(index, side))
 
     def _frame_rotation(self, frame: JogFrame) -> np.ndarray:
+        """``R_world_frame`` of a jog frame now (read only: WORLD's and BASE's are not copies)."""
         if frame is JogFrame.WORLD:
-            return np.eye(3)
+            return _WORLD_AXES
         if frame is JogFrame.BASE:
-            return self._T_world_base[:3, :3].copy()
+            return self._T_world_base[:3, :3]
         if frame is JogFrame.FLANGE:
             return self.T_world_flange()[:3, :3]
         return self.T_world_tcp()[:3, :3]
@@ -363,10 +369,12 @@ class VirtualController:
         never jumps configuration. The app makes continuous jogging from small increments
         (speed * override * dt).
         """
-        try:
-            jf = JogFrame(frame.upper() if isinstance(frame, str) else frame)
-        except ValueError:
-            raise ControllerError(f"Unknown jog frame {frame!r}; use WORLD, BASE, FLANGE or TOOL.") from None
+        jf = _FRAMES.get(frame) if isinstance(frame, str) else None   # a JogFrame is a str too
+        if jf is None:
+            try:
+                jf = JogFrame(frame.upper() if isinstance(frame, str) else frame)
+            except ValueError:
+                raise ControllerError(f"Unknown jog frame {frame!r}; use WORLD, BASE, FLANGE or TOOL.") from None
         ax = str(axis).upper()
         if ax not in _AXES:
             raise ControllerError(f"Unknown jog axis {axis!r}; use X, Y, Z (mm) or A, B, C (deg).")
@@ -376,9 +384,9 @@ class VirtualController:
         direction = self._frame_rotation(jf)[:, _AXES[ax]]
         T0 = self.T_world_tcp()
         if ax in "XYZ":
-            path = CartesianPath(T0[:3, 3], T0[:3, :3], direction * (amt / 1000.0), np.zeros(3))
+            path = CartesianPath(T0[:3, 3], T0[:3, :3], direction * (amt / 1000.0), _NO_ROTATION)
         else:
-            path = CartesianPath(T0[:3, 3], T0[:3, :3], np.zeros(3), direction * math.radians(amt))
+            path = CartesianPath(T0[:3, 3], T0[:3, :3], _NO_ROTATION, direction * math.radians(amt))
         return self._follow(path, self._T_flange_tool)
 
     def _follow(self, path: CartesianPath, T_flange_tcp: np.ndarray) -> JogResult:

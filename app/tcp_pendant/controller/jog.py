@@ -184,7 +184,8 @@ class FlangeState:
     R_wf: np.ndarray
     p_wf: np.ndarray
     sigma: float
-    """:func:`smallest_singular_value` at ``q_rad``."""
+    """:func:`smallest_singular_value` at ``q_rad``, or a lower bound of it ``>= 2 singular_eps``
+    (``PathOutcome.sigma``)."""
     det_sign: float
     """``_det_sign`` of ``J`` (+1, -1; 0 singular or not square)."""
     lu: tuple[np.ndarray, np.ndarray] | None = None
@@ -204,7 +205,8 @@ class PathOutcome:
     stopped_by: StopReason | None
     message: str
     sigma: float
-    """:func:`smallest_singular_value` at ``q_rad``."""
+    """:func:`smallest_singular_value` at ``q_rad``, or a lower bound of it that is at least
+    ``2 singular_eps`` (``_sigma_bound``: all the singularity rules need to know then)."""
     det_sign: float = 0.0
     """Sign of ``det J_flange`` at ``q_rad`` (``_det_sign``: +1, -1; 0 singular or not square)."""
     state: FlangeState | None = None
@@ -307,6 +309,31 @@ class _Attempt:
     det_sign: float = 0.0
     state: FlangeState | None = None
     """The kinematics at ``q`` (accepted attempts only)."""
+
+
+def _sigma_bound(J: np.ndarray, start: FlangeState | None, sigma_start: float, det_sign_start: float,
+                 settings: JogSettings) -> float | None:
+    """A lower bound of ``sigma_min(W J)`` from the start's, when it is at least ``2 eps``; else None.
+
+    Weyl's inequality for singular values: ``sigma_min(W J) >= sigma_min(W J0) - ||W (J - J0)||_2``,
+    and ``||W D||_2 <= ||W D||_F`` (``J0 = start.J``; the factor ``1 + 1e-12`` covers rounding). ``sigma_start`` is sigma_min at the start (or a lower
+    bound of it). A bound ``>= 2 eps`` decides every singularity rule as the exact value would
+    (none fires; ``sigma_start < 2 eps`` is false), and as every matrix on the segment from
+    ``W J0`` to ``W J`` then has ``sigma_min > 0``, ``det J`` kept its sign (``det_sign_start``).
+    None (compute sigma and the det sign exactly): no start state, an unknown start sign on a
+    square Jacobian, or a bound below ``2 eps``.
+    """
+    if start is None or (det_sign_start == 0.0 and J.shape[0] == J.shape[1]):
+        return None
+    eps2 = 2.0 * settings.singular_eps
+    if sigma_start < eps2:
+        return None
+    if J is start.J:
+        return sigma_start
+    d = (J - start.J) / _row_scale(settings.length_scale_m)          # W (J - J0)
+    drift = math.sqrt(float(np.vdot(d, d))) * (1.0 + 1e-12)
+    bound = sigma_start - drift
+    return bound if bound >= eps2 else None
 
 
 def _null_space_step(Jt: np.ndarray, q: np.ndarray, q_rest: np.ndarray, gain: float,
@@ -414,18 +441,23 @@ def _solve_substep(kin: RobotKinematics, q_start: np.ndarray, sigma_start: float
         side = "lower" if q[i] < kin.lower_rad[i] else "upper"
         return _Attempt(q_start, sigma_start, "joint_limit", kin.limit_message(i, side))
     assert J is not None and R_wf is not None and p_wf is not None  # the Newton loop runs at least once
-    sigma = _sigma_min(J, settings)
-    if sigma < eps and sigma < sigma_start * (1.0 - 1e-9) - 1e-12:
-        return _Attempt(q_start, sigma_start, "singularity", singularity_message(kin, q, settings))
-    if lu is not None:        # converged at the start: J is the start's, its sign known
-        det_sign = start.det_sign if start is not None else _det_sign(J)
+    bound = _sigma_bound(J, start, sigma_start, det_sign_start, settings)
+    if bound is not None:
+        # sigma >= bound >= 2 eps: the sigma rule cannot fire, the det sign cannot have changed
+        sigma, det_sign, lu = bound, det_sign_start, None
     else:
-        det_sign, lu = _lu_det_sign(J)
-    if (det_sign * det_sign_start < 0.0 and sigma > settings.singular_zero
-            and sigma_start > settings.singular_zero):
-        # passed through a singularity into another configuration: name the one at the start
-        return _Attempt(q_start, sigma_start, "singularity", singularity_message(kin, q_start, settings),
-                        det_sign_start)
+        sigma = _sigma_min(J, settings)
+        if sigma < eps and sigma < sigma_start * (1.0 - 1e-9) - 1e-12:
+            return _Attempt(q_start, sigma_start, "singularity", singularity_message(kin, q, settings))
+        if lu is not None:        # converged at the start: J is the start's, its sign known
+            det_sign = start.det_sign if start is not None else _det_sign(J)
+        else:
+            det_sign, lu = _lu_det_sign(J)
+        if (det_sign * det_sign_start < 0.0 and sigma > settings.singular_zero
+                and sigma_start > settings.singular_zero):
+            # passed through a singularity into another configuration: name the one at the start
+            return _Attempt(q_start, sigma_start, "singularity", singularity_message(kin, q_start, settings),
+                            det_sign_start)
     q_out = q.copy() if q is q_start else q
     return _Attempt(q_out, sigma, None, "", det_sign,
                     FlangeState(kin, q_out, q_out.tolist(), J, R_wf, p_wf, sigma, det_sign, lu))
@@ -484,9 +516,11 @@ def follow_path(kin: RobotKinematics, q_rad: np.ndarray, T_flange_tcp: np.ndarra
     else:
         sigma, det_sign = float(sigma_start), float(det_sign_start)
     s_done = 0.0
+    p0, dp, w, R0 = path.p0, path.dp, path.w, path.R0
     for k in range(1, n + 1):
         s_next = k / n
-        p_t, R_t = path.at(s_next)
+        # path.at(s_next); a translation (|w| = 0) keeps R0: Exp(0) R0 = R0 exactly
+        p_t, R_t = p0 + s_next * dp, (R0 if angle == 0.0 else pin.exp3(s_next * w) @ R0)
         att = _solve_substep(kin, q, sigma, t_f, R_ft, p_t, R_t, unit * (s_next - s_done), settings,
                              det_sign, rest, state)
         if att.reason is None:
