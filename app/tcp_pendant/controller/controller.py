@@ -390,14 +390,11 @@ class VirtualController:
         return self._follow(path, self._T_flange_tool)
 
     def _follow(self, path: CartesianPath, T_flange_tcp: np.ndarray) -> JogResult:
-        state = self._state
-        if state is not None and not state.valid_for(self.kinematics, self._q):
-            state = None
+        # follow_path uses the state only if it is of this robot at exactly this q (valid_for)
         out = follow_path(self.kinematics, self._q, T_flange_tcp, path, self.settings, q_rest=self._rest_q,
-                          start=state)
+                          start=self._state)
         self._q = out.q_rad
-        self._state = out.state if out.state is not None and out.state.valid_for(self.kinematics, self._q) \
-            else None
+        self._state = out.state              # of out.q_rad (or None)
         if out.stopped_by is None:
             return JogResult(True, 1.0, None, "")
         return JogResult(False, float(out.moved), out.stopped_by, out.message)

@@ -12,6 +12,7 @@ Why pinocchio and not yourdfpy for the motion: one flange FK is about 1 us in pi
 from __future__ import annotations
 
 import math
+import operator
 import re
 import xml.etree.ElementTree as ET
 from collections.abc import Sequence
@@ -274,8 +275,8 @@ class RobotKinematics:
     def limit_violation(self, q_rad: np.ndarray, *, tol: float = 1e-12) -> tuple[int, str] | None:
         """First joint outside its limits as (index, "lower"|"upper"), or None."""
         if tol == 1e-12:      # the jog's check on every sub-step: Python floats, no numpy call
-            if all(lo <= v <= hi for lo, v, hi in zip(self._lower_tol, np.asarray(q_rad).tolist(),
-                                                      self._upper_tol)):
+            q = np.asarray(q_rad).tolist()
+            if all(map(operator.le, self._lower_tol, q)) and all(map(operator.le, q, self._upper_tol)):
                 return None
         elif bool(np.all(q_rad >= self.lower_rad - tol)) and bool(np.all(q_rad <= self.upper_rad + tol)):
             return None

@@ -171,6 +171,8 @@ class PressGate:
         return n
 
 
+_WORLD_AXES = np.eye(3)
+_WORLD_AXES.setflags(write=False)
 _CLEAR_M = CONTACT_RADIUS_MM / 1000.0 * (1.0 + 1e-9) + 1e-12
 
 
@@ -275,7 +277,9 @@ class Jogger:
         c = self.controller
         if not self.stop_at_contact:
             return c.jog_cartesian(self.settings.frame, ax, amount_mm)
-        step_m = self.frame_rotation()[:, "XYZ".index(ax)] * (amount_mm / 1000.0)
+        i = "XYZ".index(ax)
+        axis_m = _WORLD_AXES[:, i] if self.settings.frame == "WORLD" else self.frame_rotation()[:, i]
+        step_m = axis_m * (amount_mm / 1000.0)
         tip_m = c.T_world_tool_true()[:3, 3]
         stop = None if _clear_of(tip_m, step_m, c.reference_tip_world_m) else (
             contact_stop(tip_m, step_m, c.reference_tip_world_m))
