@@ -381,8 +381,15 @@ class VirtualController:
         amt = _finite(amount, "jog amount")
         if amt == 0.0:
             return JogResult(True, 1.0, None, "")
-        direction = self._frame_rotation(jf)[:, _AXES[ax]]
-        T0 = self.T_world_tcp()
+        # T_world_tcp() (= T_world_flange() @ T_flange_tool) once: FLANGE and TOOL axes are taken from it
+        T_wf = self.T_world_flange()
+        T0 = T_wf @ self._T_flange_tool
+        if jf is JogFrame.FLANGE:
+            direction = T_wf[:3, _AXES[ax]]
+        elif jf is JogFrame.TOOL:
+            direction = T0[:3, _AXES[ax]]
+        else:
+            direction = self._frame_rotation(jf)[:, _AXES[ax]]
         if ax in "XYZ":
             path = CartesianPath(T0[:3, 3], T0[:3, :3], direction * (amt / 1000.0), _NO_ROTATION)
         else:

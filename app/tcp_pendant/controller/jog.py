@@ -59,6 +59,26 @@ long one jogs. Six-joint arms have no null space and skip (J-3).
 
 A rejected sub-step is bisected (up to 8 times) so the robot stops close to the limit or the
 singularity; ``moved`` is the fraction of the path carried out.
+
+**Cost of a step** (a pendant increment is one sub-step; a class sends thousands a second). The
+math above is what runs; what is saved is repeated work:
+  * :func:`follow_path` returns the kinematics of the configuration it ended on
+    (:class:`FlangeState`: the flange Jacobian and pose of the last Newton iteration, sigma_min,
+    the det sign and the Jacobian's LU factors), and takes it as ``start`` of the next path: the
+    first iteration then needs no pinocchio pass. It is used only on the same robot at exactly
+    the same ``q`` (``FlangeState.valid_for``); the controller drops it whenever ``q``, the tool
+    data or the physical model are set any other way.
+  * Six joints and ``lambda = 0``: (J-2) is the Newton step ``dq = J_tcp^-1 e``, solved as
+    ``J_flange dq = [e_p + r x e_r; e_r]`` (``J_tcp = [I -[r]x; 0 I] J_flange``) by one LU solve
+    (LAPACK ``gesv``, or ``getrs`` with the start's factors). The damped form (J-2 with
+    ``lambda > 0``), a singular ``J`` and redundant arms take the formula above.
+  * sigma_min and the det sign at the end of a sub-step: by Weyl's inequality
+    ``sigma_min(W J) >= sigma_start - ||W (J - J_start)||_F``; while this bound is at least
+    ``2 eps`` no singularity rule can fire and ``det J`` cannot have changed sign, so the bound
+    stands in for sigma_min (``PathOutcome.sigma``) and the sign is kept; the SVD and the LU
+    (``det J = (-1)^swaps prod diag U``, as ``np.linalg.det``) run when it falls below.
+  * a translation keeps ``R0`` (no ``Exp(0)``); a zero TCP offset or an identity TCP rotation
+    skips its product (bit for bit the same); convergence, limit and jump tests on Python floats.
 """
 
 from __future__ import annotations
