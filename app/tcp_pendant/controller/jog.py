@@ -399,6 +399,8 @@ def _solve_substep(kin: RobotKinematics, q_start: np.ndarray, sigma_start: float
     lu: tuple[np.ndarray, np.ndarray] | None = None
     q_list: list[float] = []
     converged = False
+    # R* (R_wf R_ft)^T = (R* R_ft^T) R_wf^T: the TCP rotation folded into the target once
+    R_goal = R_target if R_ft is None else R_target @ R_ft.T
     allowance = max(settings.max_joint_gain * cart_amount, settings.min_joint_allowance_rad)
     for iteration in range(settings.max_iterations + 1):
         if iteration == 0 and start is not None:
@@ -408,7 +410,7 @@ def _solve_substep(kin: RobotKinematics, q_start: np.ndarray, sigma_start: float
             lu = None
         r = None if t_f is None else R_wf @ t_f
         e_p = p_target - p_wf if r is None else p_target - (p_wf + r)
-        e_r = pin.log3(R_target @ (R_wf if R_ft is None else R_wf @ R_ft).T)
+        e_r = pin.log3(R_goal @ R_wf.T)
         ep, er = e_p.tolist(), e_r.tolist()
         if math.hypot(*ep) < tol_m and math.hypot(*er) < tol_rad:
             converged = True
@@ -519,8 +521,8 @@ def follow_path(kin: RobotKinematics, q_rad: np.ndarray, T_flange_tcp: np.ndarra
     t_list = T_flange_tcp[:3, 3].tolist()
     R_list = T_flange_tcp[:3, :3].tolist()
     # a zero offset / identity rotation: skip the products with them (bit for bit the same)
-    t_f = None if t_list == [0.0, 0.0, 0.0] else np.array(t_list, dtype=float)
-    R_ft = None if R_list == _IDENTITY_ROWS else np.array(R_list, dtype=float)
+    t_f = None if t_list == [0.0, 0.0, 0.0] else T_flange_tcp[:3, 3]        # views: only read
+    R_ft = None if R_list == _IDENTITY_ROWS else T_flange_tcp[:3, :3]
     length_m = math.hypot(*path.dp.tolist())           # |dp|, |w|, |t_f|: math, no numpy call per jog step
     angle = math.hypot(*path.w.tolist())
     n = max(1, math.ceil(max(length_m / settings.max_substep_m, angle / settings.max_substep_rad) - 1e-9))
