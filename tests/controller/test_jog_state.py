@@ -12,7 +12,13 @@ import numpy as np
 import pytest
 
 from tcp_pendant.controller import VirtualController
-from tcp_pendant.controller.jog import FlangeState, _det_sign, follow_path, smallest_singular_value
+from tcp_pendant.controller.jog import (
+    FlangeState,
+    JogSettings,
+    _det_sign,
+    follow_path,
+    smallest_singular_value,
+)
 from tcp_pendant.controller.scenarios import Scenario, realize
 
 from .conftest import TIP_M, kinematics, make_controller, truth_tool_data
@@ -88,7 +94,7 @@ def test_the_kept_state_is_the_kinematics_at_the_joint_angles_reached():
     for frame, axis, amount in [("WORLD", "X", 0.1), ("TOOL", "A", 1.0), ("BASE", "Z", 10.0)] + _moves(7, 60):
         res = ctrl.jog_cartesian(frame, axis, amount)
         st = _state(ctrl)
-        assert st is not None and st.valid_for(ctrl.kinematics, ctrl.q_rad), res
+        assert st is not None and st.valid_for(ctrl.kinematics, ctrl.q_rad, ctrl.settings), res
         q = ctrl.q_rad
         kin = ctrl.kinematics
         np.testing.assert_array_equal(st.J, kin.jacobian_flange(q))
@@ -122,6 +128,8 @@ def test_follow_path_ignores_a_state_of_other_joint_angles_or_another_robot():
     q_moved = stale.q_rad.copy()
     q_moved[0] += 1e-15                                  # an exact compare: the last bit counts
     assert not stale.valid_for(stale.kin, q_moved)
+    assert stale.valid_for(stale.kin, stale.q_rad)
+    assert not stale.valid_for(stale.kin, stale.q_rad, JogSettings(length_scale_m=0.5))   # sigma of another W
     from tcp_pendant.controller.jog import CartesianPath
     T0 = other.T_world_tcp()
     path = CartesianPath(T0[:3, 3], T0[:3, :3], np.array([1e-4, 0.0, 0.0]), np.zeros(3))
@@ -134,7 +142,8 @@ def test_follow_path_ignores_a_state_of_other_joint_angles_or_another_robot():
 def _twin(ctrl: VirtualController) -> VirtualController:
     """A controller in the same state as ``ctrl`` but with nothing kept from earlier jogs."""
     twin = VirtualController(ctrl.kinematics, tool=ctrl.mounted_tool, active_tool=ctrl.active_tool,
-                             reference_tip_world_m=ctrl.reference_tip_world_m, T_world_base=ctrl.T_world_base)
+                             reference_tip_world_m=ctrl.reference_tip_world_m, T_world_base=ctrl.T_world_base,
+                             settings=ctrl.settings)
     twin.set_true_kinematics(None if ctrl.true_kinematics is ctrl.kinematics else ctrl.true_kinematics)
     twin.set_q(ctrl.q_rad)
     twin.set_rest_configuration(ctrl.rest_q_rad)
@@ -206,4 +215,20 @@ def test_a_tool_change_and_a_scenario_change_drop_the_state():
     world = realize(Scenario("robot_accuracy", seed=3), ctrl.kinematics, ctrl.mounted_tool)
     ctrl.set_true_kinematics(world.true_kinematics)
     assert _state(ctrl) is None
+    _next_jogs_as_fresh(ctrl)
+
+
+def test_other_jog_settings_do_not_reuse_a_sigma_of_the_old_ones():
+    ctrl = make_controller("kr6", "pointer", active=False, q_deg=Q_WRIST_PLUS_DEG)
+    assert ctrl.jog_cartesian("WORLD", "X", 0.1).ok
+    kept = _state(ctrl)
+    assert kept is not None
+    other = JogSettings(length_scale_m=3.0)          # another W: another sigma_min at the same q
+    assert smallest_singular_value(ctrl.kinematics, ctrl.q_rad, other) < 0.5 * kept.sigma
+    assert not kept.valid_for(ctrl.kinematics, ctrl.q_rad, other)
+    ctrl.settings = other
+    assert ctrl.jog_cartesian("WORLD", "X", 0.1).ok
+    st = _state(ctrl)
+    assert st is not None and st.settings is other
+    assert st.sigma <= smallest_singular_value(ctrl.kinematics, ctrl.q_rad, other) * (1.0 + 1e-12)
     _next_jogs_as_fresh(ctrl)

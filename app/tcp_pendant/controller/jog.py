@@ -212,9 +212,14 @@ class FlangeState(NamedTuple):
     lu: tuple[np.ndarray, np.ndarray] | None = None
     """LAPACK ``getrf`` factors of ``J`` (square ``J`` only), for the first Newton step."""
 
-    def valid_for(self, kin: RobotKinematics, q_rad: np.ndarray) -> bool:
-        """True when this state was computed on ``kin`` at exactly ``q_rad``."""
-        return kin is self.kin and self.q_list == q_rad.tolist()
+    settings: JogSettings = DEFAULT_SETTINGS
+    """The tuning ``sigma`` was computed with (its ``W`` and ``eps``)."""
+
+    def valid_for(self, kin: RobotKinematics, q_rad: np.ndarray,
+                  settings: JogSettings = DEFAULT_SETTINGS) -> bool:
+        """True when this state was computed on ``kin`` at exactly ``q_rad`` with ``settings``."""
+        return (kin is self.kin and self.q_list == q_rad.tolist()
+                and (settings is self.settings or settings == self.settings))
 
 
 @dataclass(frozen=True)
@@ -487,7 +492,7 @@ def _solve_substep(kin: RobotKinematics, q_start: np.ndarray, sigma_start: float
                             det_sign_start)
     q_out = q.copy() if q is q_start else q
     return _Attempt(q_out, sigma, None, "", det_sign,
-                    FlangeState(kin, q_out, q_out.tolist(), J, R_wf, p_wf, sigma, det_sign, lu))
+                    FlangeState(kin, q_out, q_out.tolist(), J, R_wf, p_wf, sigma, det_sign, lu, settings))
 
 
 def follow_path(kin: RobotKinematics, q_rad: np.ndarray, T_flange_tcp: np.ndarray,
@@ -510,7 +515,8 @@ def follow_path(kin: RobotKinematics, q_rad: np.ndarray, T_flange_tcp: np.ndarra
         start: the kinematics at ``q_rad`` (``PathOutcome.state`` of the previous path): its
             sigma and det sign, and the Jacobian and pose for the first Newton iteration (one
             pinocchio pass less). Used only when it was computed on ``kin`` at exactly
-            ``q_rad`` (``FlangeState.valid_for``); it overrides ``sigma_start``/``det_sign_start``.
+            ``q_rad`` with ``settings`` (``FlangeState.valid_for``); it overrides
+            ``sigma_start``/``det_sign_start``.
 
     Returns:
         The configuration reached, the fraction ``moved`` of the path, the stop reason and
@@ -533,7 +539,7 @@ def follow_path(kin: RobotKinematics, q_rad: np.ndarray, T_flange_tcp: np.ndarra
 
     q = np.array(q_rad, dtype=float)
     rest = np.asarray(q_rest, dtype=float) if q_rest is not None and kin.n_joints > 6 else None
-    state = start if start is not None and start.valid_for(kin, q) else None
+    state = start if start is not None and start.valid_for(kin, q, settings) else None
     if state is not None:
         sigma, det_sign = state.sigma, state.det_sign
     elif sigma_start is None or det_sign_start is None:
