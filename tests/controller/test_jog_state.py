@@ -232,3 +232,18 @@ def test_other_jog_settings_do_not_reuse_a_sigma_of_the_old_ones():
     assert st is not None and st.settings is other
     assert st.sigma <= smallest_singular_value(ctrl.kinematics, ctrl.q_rad, other) * (1.0 + 1e-12)
     _next_jogs_as_fresh(ctrl)
+
+
+def test_the_kept_arrays_are_its_own_later_pinocchio_passes_leave_them():
+    ctrl = make_controller("kr6", "torch")
+    assert ctrl.jog_cartesian("WORLD", "X", 0.1).ok
+    st = _state(ctrl)
+    assert st is not None
+    saved = [a.copy() for a in (st.J, st.R_wf, st.p_wf, st.q_rad)]
+    kin = ctrl.kinematics
+    for q in (np.zeros(6), np.ones(6), np.full(6, -0.5)):
+        kin.jacobian_and_pose(q)
+        kin.T_world_flange(q)
+        kin.link_poses(q)
+    for a, b in zip((st.J, st.R_wf, st.p_wf, st.q_rad), saved):
+        np.testing.assert_array_equal(a, b)
