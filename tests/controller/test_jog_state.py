@@ -247,3 +247,24 @@ def test_the_kept_arrays_are_its_own_later_pinocchio_passes_leave_them():
         kin.link_poses(q)
     for a, b in zip((st.J, st.R_wf, st.p_wf, st.q_rad), saved):
         np.testing.assert_array_equal(a, b)
+
+
+def test_a_repeated_small_press_costs_one_pinocchio_pass_and_lands_as_plain_newton():
+    new, old = _pair("kr6", "pointer", False)
+    kin = new.kinematics
+    calls = []
+    real = kin.jacobian_and_pose
+    kin.jacobian_and_pose = lambda q: (calls.append(1), real(q))[1]   # type: ignore[method-assign]
+    try:
+        for k in range(30):
+            assert new.jog_cartesian("WORLD", "X", 0.1).ok and old.jog_cartesian("WORLD", "X", 0.1).ok
+            if k == 1:
+                calls.clear()       # from the third press on, the midpoint step converges at once
+    finally:
+        del kin.jacobian_and_pose
+    assert len(calls) == 28
+    # each press converged to 1e-10 m (the midpoint step lands within ~2e-12 m, plain Newton's
+    # second step closer still): 30 presses apart by less than 30 tolerances
+    T, T_old = new.T_world_tcp(), old.T_world_tcp()
+    assert np.linalg.norm(T[:3, 3] - T_old[:3, 3]) < 30 * 1e-10
+    np.testing.assert_allclose(new.q_rad, old.q_rad, rtol=0.0, atol=1e-8)

@@ -72,6 +72,9 @@ math above is what runs; what is saved is repeated work:
     ``J_flange dq = [e_p + r x e_r; e_r]`` (``J_tcp = [I -[r]x; 0 I] J_flange``) by one LU solve
     (LAPACK ``gesv``, or ``getrs`` with the start's factors). The damped form (J-2 with
     ``lambda > 0``), a singular ``J`` and redundant arms take the formula above.
+  * a sub-step of the same increment as the one that ended at the start (a key pressed again)
+    takes its first step with the Jacobian extrapolated to its middle (``_solve_substep``): a
+    0.1 mm press then converges after one step, one pinocchio pass in all.
   * sigma_min and the det sign at the end of a sub-step: by Weyl's inequality
     ``sigma_min(W J) >= sigma_start - ||W (J - J_start)||_F``; while this bound is at least
     ``2 eps`` no singularity rule can fire and ``det J`` cannot have changed sign, so the bound
@@ -214,6 +217,10 @@ class FlangeState(NamedTuple):
 
     settings: JogSettings = DEFAULT_SETTINGS
     """The tuning ``sigma`` was computed with (its ``W`` and ``eps``)."""
+    J_before: np.ndarray | None = None
+    """The flange Jacobian at the start of the sub-step that ended here (None: not known)."""
+    step: list[float] | None = None
+    """That sub-step's Cartesian increment ``[dp; dw]`` (m, rad, WORLD)."""
 
     def valid_for(self, kin: RobotKinematics, q_rad: np.ndarray,
                   settings: JogSettings = DEFAULT_SETTINGS) -> bool:
@@ -362,6 +369,15 @@ def _sigma_bound(J: np.ndarray, start: FlangeState | None, sigma_start: float, d
     return bound if bound >= eps2 else None
 
 
+def _same_step(previous: list[float] | None, step: list[float]) -> bool:
+    """The two Cartesian increments agree to 1e-6 of the larger component (rounding of the frame
+    axes aside, the same key pressed again)."""
+    if previous is None:
+        return False
+    tol = 1e-6 * max(map(abs, step))
+    return tol > 0.0 and all(abs(a - b) <= tol for a, b in zip(previous, step))
+
+
 def _null_space_step(Jt: np.ndarray, q: np.ndarray, q_rest: np.ndarray, gain: float,
                      cap: float) -> np.ndarray:
     """(J-3): ``N k (q_rest - q)``, its largest joint change at most ``cap`` (rad)."""
@@ -379,19 +395,27 @@ def _solve_substep(kin: RobotKinematics, q_start: np.ndarray, sigma_start: float
                    t_f: np.ndarray | None, R_ft: np.ndarray | None, p_target: np.ndarray,
                    R_target: np.ndarray, cart_amount: float, settings: JogSettings,
                    det_sign_start: float = 0.0, q_rest: np.ndarray | None = None,
-                   start: FlangeState | None = None) -> _Attempt:
+                   start: FlangeState | None = None, step: list[float] | None = None) -> _Attempt:
     """Damped Newton (J-2) from ``q_start`` to one target pose, then the safety checks.
 
     ``t_f``, ``R_ft``: the TCP in FLANGE coordinates; None for a zero offset and an identity
     rotation (the products with them are skipped: they would change no bit).
     ``det_sign_start`` is :func:`_det_sign` at ``q_start`` (0: unknown or on a singularity);
     ``q_rest``: the rest configuration of a redundant arm's null-space step (J-3), None: none;
-    ``start``: the kinematics at ``q_start`` (its first iteration then needs no pinocchio pass).
+    ``start``: the kinematics at ``q_start`` (its first iteration then needs no pinocchio pass);
+    ``step``: this sub-step's Cartesian increment ``[dp; dw]`` (see the midpoint step below).
 
     With ``lambda = 0`` on a square Jacobian (a six-joint arm away from singularities) (J-2) is
     the Newton step ``dq = J_tcp^-1 e``; it is solved as ``J_flange dq = [e_p + r x e_r; e_r]``
     (``J_tcp = [I -[r]x; 0 I] J_flange``, ``r = R_wf t``), one LU solve with the flange Jacobian
     (whose factors the previous sub-step left in ``start``).
+
+    Midpoint first step: when ``start`` ended a sub-step of the same increment (a pendant key
+    pressed again), the first Newton step uses the Jacobian extrapolated to the middle of this
+    one, ``J(q0 + dq/2) ~ J0 + (J0 - J_before) / 2`` (the joint step repeats to second order).
+    ``f(q0 + dq) = f(q0) + J(q0 + dq/2) dq + O(|dq|^3)``, so a 0.1 mm press lands within about
+    1e-12 m after one step (plain Newton: 1e-8 m, a second step). The iteration and its
+    convergence test are otherwise unchanged.
     """
     eps = settings.singular_eps
     lam2 = 0.0
@@ -406,6 +430,10 @@ def _solve_substep(kin: RobotKinematics, q_start: np.ndarray, sigma_start: float
     converged = False
     # R* (R_wf R_ft)^T = (R* R_ft^T) R_wf^T: the TCP rotation folded into the target once
     R_goal = R_target if R_ft is None else R_target @ R_ft.T
+    J_mid = None
+    if (direct and start is not None and start.J_before is not None and step is not None
+            and _same_step(start.step, step)):
+        J_mid = 1.5 * start.J - 0.5 * start.J_before
     allowance = max(settings.max_joint_gain * cart_amount, settings.min_joint_allowance_rad)
     for iteration in range(settings.max_iterations + 1):
         if iteration == 0 and start is not None:
@@ -427,7 +455,9 @@ def _solve_substep(kin: RobotKinematics, q_start: np.ndarray, sigma_start: float
                 ex, ey, ez = er
                 ep = [ep[0] + ry * ez - rz * ey, ep[1] + rz * ex - rx * ez, ep[2] + rx * ey - ry * ex]
             b = np.array(ep + er)
-            if lu is not None:
+            if iteration == 0 and J_mid is not None:
+                x, info = lapack.dgesv(J_mid, b)[2:]
+            elif lu is not None:
                 x, info = lapack.dgetrs(lu[0], lu[1], b)
             else:
                 x, info = lapack.dgesv(J, b)[2:]
@@ -492,7 +522,8 @@ def _solve_substep(kin: RobotKinematics, q_start: np.ndarray, sigma_start: float
                             det_sign_start)
     q_out = q.copy() if q is q_start else q
     return _Attempt(q_out, sigma, None, "", det_sign,
-                    FlangeState(kin, q_out, q_out.tolist(), J, R_wf, p_wf, sigma, det_sign, lu, settings))
+                    FlangeState(kin, q_out, q_out.tolist(), J, R_wf, p_wf, sigma, det_sign, lu, settings,
+                                None if start is None else start.J, step))
 
 
 def follow_path(kin: RobotKinematics, q_rad: np.ndarray, T_flange_tcp: np.ndarray,
@@ -529,8 +560,9 @@ def follow_path(kin: RobotKinematics, q_rad: np.ndarray, T_flange_tcp: np.ndarra
     # a zero offset / identity rotation: skip the products with them (bit for bit the same)
     t_f = None if t_list == [0.0, 0.0, 0.0] else T_flange_tcp[:3, 3]        # views: only read
     R_ft = None if R_list == _IDENTITY_ROWS else T_flange_tcp[:3, :3]
-    length_m = math.hypot(*path.dp.tolist())           # |dp|, |w|, |t_f|: math, no numpy call per jog step
-    angle = math.hypot(*path.w.tolist())
+    dp_w = path.dp.tolist() + path.w.tolist()
+    length_m = math.hypot(*dp_w[:3])           # |dp|, |w|, |t_f|: math, no numpy call per jog step
+    angle = math.hypot(*dp_w[3:])
     n = max(1, math.ceil(max(length_m / settings.max_substep_m, angle / settings.max_substep_rad) - 1e-9))
     # joint allowance per unit of flange motion: (mm of travel -> "deg") + rad of rotation; a
     # rotation about the TCP swings the flange by |w| |t| (module doc)
@@ -555,7 +587,7 @@ def follow_path(kin: RobotKinematics, q_rad: np.ndarray, T_flange_tcp: np.ndarra
         # path.at(s_next); a translation (|w| = 0) keeps R0: Exp(0) R0 = R0 exactly
         p_t, R_t = p0 + s_next * dp, (R0 if angle == 0.0 else pin.exp3(s_next * w) @ R0)
         att = _solve_substep(kin, q, sigma, t_f, R_ft, p_t, R_t, unit * (s_next - s_done), settings,
-                             det_sign, rest, state)
+                             det_sign, rest, state, [(s_next - s_done) * v for v in dp_w])
         if att.reason is None:
             q, sigma, det_sign, s_done, state = att.q, att.sigma, att.det_sign, s_next, att.state
             continue
@@ -565,7 +597,7 @@ def follow_path(kin: RobotKinematics, q_rad: np.ndarray, T_flange_tcp: np.ndarra
             mid = 0.5 * (lo + hi)
             p_t, R_t = path.at(mid)
             a = _solve_substep(kin, q, sigma, t_f, R_ft, p_t, R_t, unit * (mid - lo), settings, det_sign,
-                               rest, state)
+                               rest, state, [(mid - lo) * v for v in dp_w])
             if a.reason is None:
                 q, sigma, det_sign, lo, state = a.q, a.sigma, a.det_sign, mid, a.state
             else:
