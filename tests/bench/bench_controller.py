@@ -18,7 +18,7 @@ Prints the median time (us) of, for each built-in robot (KR 6 R900, GP12):
    (the class's "X +"), BASE (rotated) and TOOL, 1 mm, 1 deg and 0.1 deg rotations, and the
    torch's tool data active; against a baseline measured in the same run, ABAB: the jog as it
    was before the per-step speed work (``jog_yardstick.py``: the same math without the kept
-   kinematics, the LU Newton step, the sigma bound and the contact pre-test). Per-increment
+   kinematics, the LU and midpoint Newton steps, the sigma bound and the contact pre-test). Per-increment
    thread CPU (``time.thread_time_ns`` over a block of presses, 25 one way then 25 back),
    median over the rounds, and the median of the per-round ratios.
 
