@@ -349,8 +349,8 @@ def _sigma_bound(J: np.ndarray, start: FlangeState | None, sigma_start: float, d
     """A lower bound of ``sigma_min(W J)`` from the start's, when it is at least ``2 eps``; else None.
 
     Weyl's inequality for singular values: ``sigma_min(W J) >= sigma_min(W J0) - ||W (J - J0)||_2``,
-    and ``||W D||_2 <= ||W D||_F`` (``J0 = start.J``; the factor ``1 + 1e-12`` covers rounding). ``sigma_start`` is sigma_min at the start (or a lower
-    bound of it). A bound ``>= 2 eps`` decides every singularity rule as the exact value would
+    and ``||W D||_2 <= ||W D||_F`` (``J0 = start.J``; the factor ``1 + 1e-12`` covers rounding).
+    ``sigma_start`` is sigma_min at the start (or a lower bound of it). A bound ``>= 2 eps`` decides every singularity rule as the exact value would
     (none fires; ``sigma_start < 2 eps`` is false), and as every matrix on the segment from
     ``W J0`` to ``W J`` then has ``sigma_min > 0``, ``det J`` kept its sign (``det_sign_start``).
     None (compute sigma and the det sign exactly): no start state, an unknown start sign on a
