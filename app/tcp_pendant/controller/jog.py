@@ -60,14 +60,14 @@ long one jogs. Six-joint arms have no null space and skip (J-3).
 A rejected sub-step is bisected (up to 8 times) so the robot stops close to the limit or the
 singularity; ``moved`` is the fraction of the path carried out.
 
-**Cost of a step** (a pendant increment is one sub-step; a class sends thousands a second). The
-math above is what runs; what is saved is repeated work:
+**Cost of a step** (a pendant increment is one sub-step; a class sends thousands a second). Every
+sub-step converges to the tolerances above under the same rules; what is saved is repeated work:
   * :func:`follow_path` returns the kinematics of the configuration it ended on
     (:class:`FlangeState`: the flange Jacobian and pose of the last Newton iteration, sigma_min,
     the det sign and the Jacobian's LU factors), and takes it as ``start`` of the next path: the
     first iteration then needs no pinocchio pass. It is used only on the same robot at exactly
-    the same ``q`` (``FlangeState.valid_for``); the controller drops it whenever ``q``, the tool
-    data or the physical model are set any other way.
+    the same ``q`` with the same settings (``FlangeState.valid_for``); the controller drops it
+    whenever ``q``, the tool data or the physical model are set any other way.
   * Six joints and ``lambda = 0``: (J-2) is the Newton step ``dq = J_tcp^-1 e``, solved as
     ``J_flange dq = [e_p + r x e_r; e_r]`` (``J_tcp = [I -[r]x; 0 I] J_flange``) by one LU solve
     (LAPACK ``gesv``, or ``getrs`` with the start's factors). The damped form (J-2 with
