@@ -24,3 +24,10 @@ def test_bench_controller_quick_runs() -> None:
     lines = [line for line in out.stdout.splitlines() if line.startswith(("kr6 ", "gp12 "))]
     timings = [float(re.search(r"\s(\d+\.\d)(\s|$)", line).group(1)) for line in lines if "speed-up" not in line]
     assert len(timings) == 16 and all(t > 0.0 for t in timings)
+    # the jog increments: new us, baseline us, speed-up for 0.1 mm (the class), 1 mm, 1 deg, ...
+    increments = [re.match(r"(.+?)\s+(\d+\.\d)\s+(\d+\.\d)\s+(\d+\.\d\d)x$", line)
+                  for line in out.stdout.splitlines() if re.match(r"\d+(\.\d)? (mm|deg) ", line)]
+    assert len(increments) == 8 and all(m is not None for m in increments), out.stdout
+    labels = [m.group(1) for m in increments]
+    assert "0.1 mm WORLD X (the class)" in labels and "1 mm WORLD X" in labels and "1 deg WORLD A" in labels
+    assert all(float(m.group(2)) > 0.0 and float(m.group(3)) > 0.0 and float(m.group(4)) > 0.0 for m in increments)

@@ -40,6 +40,7 @@ from tcp_pendant.controller.errors import ControllerError
 from tcp_pendant.controller.jog import (
     DEFAULT_SETTINGS,
     CartesianPath,
+    FlangeState,
     JogFrame,
     JogResult,
     JogSettings,
@@ -53,6 +54,11 @@ from tcp_pendant.controller.touch import TouchGeometry, touch_geometry
 __all__ = ["VirtualController"]
 
 _AXES = {"X": 0, "Y": 1, "Z": 2, "A": 2, "B": 1, "C": 0}
+_FRAMES: dict[str, JogFrame] = {f.value: f for f in JogFrame}
+_WORLD_AXES = np.eye(3)
+_WORLD_AXES.setflags(write=False)
+_NO_ROTATION = np.zeros(3)
+_NO_ROTATION.setflags(write=False)
 
 
 def _check_point(p: Sequence[float] | np.ndarray, what: str) -> np.ndarray:
@@ -100,7 +106,10 @@ class VirtualController:
         self.settings = settings
         self._q = np.array(kinematics.home_rad, dtype=float)
         self._rest_q = np.array(kinematics.home_rad, dtype=float)
-        self._sigma: tuple[np.ndarray, float, float] | None = None  # (q, sigma_min, sign det J) at q of the last path
+        self._state: FlangeState | None = None
+        """The kinematics where the last path ended (Jacobian, pose, sigma_min, det sign): the next
+        jog starts from it while the robot is still exactly there (``FlangeState.valid_for``);
+        dropped whenever q, the model or the tool data are set any other way."""
         self._tool = tool
         self._active: Tool | None = None
         self._T_flange_tool = np.eye(4)
@@ -135,6 +144,7 @@ class VirtualController:
             raise ControllerError(f"{k.joint_names[i]} = {k.format_joint(i, q[i])} is beyond its {side} "
                                   f"limit {k.format_joint(i, limit)}; give angles within the limits.")
         self._q = np.clip(q, self.kinematics.lower_rad, self.kinematics.upper_rad)
+        self._state = None
 
     def joint_angles_deg(self) -> dict[str, float]:
         """Joint readout: name -> degrees (mm for prismatic joints), in joint order."""
@@ -145,6 +155,7 @@ class VirtualController:
     def go_home(self) -> None:
         """Teleport to the home configuration."""
         self._q = np.array(self.kinematics.home_rad, dtype=float)
+        self._state = None
 
     @property
     def rest_q_rad(self) -> np.ndarray:
@@ -167,6 +178,7 @@ class VirtualController:
         Raises:
             ControllerError: a robot with other joints than the nominal model.
         """
+        self._state = None
         if true_kinematics is None:
             self._true_kin = self.kinematics
             return
@@ -202,6 +214,7 @@ class VirtualController:
 
     def set_active_tool(self, tool: Tool | None) -> None:
         """Select the active tool data; ``T_flange_tool`` = its ``tcp_mm`` (in m) and ``abc_deg``."""
+        self._state = None
         if tool is None:
             self._active, self._T_flange_tool = None, np.eye(4)
             return
@@ -322,20 +335,21 @@ class VirtualController:
         lo, hi = float(k.lower_rad[index]), float(k.upper_rad[index])
         if lo <= target <= hi:
             q[index] = target
-            self._q = q
+            self._q, self._state = q, None
             return JogResult(True, 1.0, None, "")
         side = "upper" if target > hi else "lower"
         limit = hi if side == "upper" else lo
         moved = max(0.0, min(1.0, (limit - q[index]) / delta))
         q[index] = limit
-        self._q = q
+        self._q, self._state = q, None
         return JogResult(False, moved, "joint_limit", k.limit_message(index, side))
 
     def _frame_rotation(self, frame: JogFrame) -> np.ndarray:
+        """``R_world_frame`` of a jog frame now (read only: WORLD's and BASE's are not copies)."""
         if frame is JogFrame.WORLD:
-            return np.eye(3)
+            return _WORLD_AXES
         if frame is JogFrame.BASE:
-            return self._T_world_base[:3, :3].copy()
+            return self._T_world_base[:3, :3]
         if frame is JogFrame.FLANGE:
             return self.T_world_flange()[:3, :3]
         return self.T_world_tcp()[:3, :3]
@@ -355,31 +369,39 @@ class VirtualController:
         never jumps configuration. The app makes continuous jogging from small increments
         (speed * override * dt).
         """
-        try:
-            jf = JogFrame(frame.upper() if isinstance(frame, str) else frame)
-        except ValueError:
-            raise ControllerError(f"Unknown jog frame {frame!r}; use WORLD, BASE, FLANGE or TOOL.") from None
+        jf = _FRAMES.get(frame) if isinstance(frame, str) else None   # a JogFrame is a str too
+        if jf is None:
+            try:
+                jf = JogFrame(frame.upper() if isinstance(frame, str) else frame)
+            except ValueError:
+                raise ControllerError(f"Unknown jog frame {frame!r}; use WORLD, BASE, FLANGE or TOOL.") from None
         ax = str(axis).upper()
         if ax not in _AXES:
             raise ControllerError(f"Unknown jog axis {axis!r}; use X, Y, Z (mm) or A, B, C (deg).")
         amt = _finite(amount, "jog amount")
         if amt == 0.0:
             return JogResult(True, 1.0, None, "")
-        direction = self._frame_rotation(jf)[:, _AXES[ax]]
-        T0 = self.T_world_tcp()
-        if ax in "XYZ":
-            path = CartesianPath(T0[:3, 3], T0[:3, :3], direction * (amt / 1000.0), np.zeros(3))
+        # T_world_tcp() (= T_world_flange() @ T_flange_tool) once: FLANGE and TOOL axes are taken from it
+        T_wf = self.T_world_flange()
+        T0 = T_wf @ self._T_flange_tool
+        if jf is JogFrame.FLANGE:
+            direction = T_wf[:3, _AXES[ax]]
+        elif jf is JogFrame.TOOL:
+            direction = T0[:3, _AXES[ax]]
         else:
-            path = CartesianPath(T0[:3, 3], T0[:3, :3], np.zeros(3), direction * math.radians(amt))
+            direction = self._frame_rotation(jf)[:, _AXES[ax]]
+        if ax in "XYZ":
+            path = CartesianPath(T0[:3, 3], T0[:3, :3], direction * (amt / 1000.0), _NO_ROTATION)
+        else:
+            path = CartesianPath(T0[:3, 3], T0[:3, :3], _NO_ROTATION, direction * math.radians(amt))
         return self._follow(path, self._T_flange_tool)
 
     def _follow(self, path: CartesianPath, T_flange_tcp: np.ndarray) -> JogResult:
-        known = self._sigma is not None and np.array_equal(self._sigma[0], self._q)
-        sigma, det_sign = (self._sigma[1], self._sigma[2]) if known and self._sigma is not None else (None, None)
-        out = follow_path(self.kinematics, self._q, T_flange_tcp, path, self.settings, sigma_start=sigma,
-                          q_rest=self._rest_q, det_sign_start=det_sign)
+        # follow_path uses the state only if it is of this robot at exactly this q (valid_for)
+        out = follow_path(self.kinematics, self._q, T_flange_tcp, path, self.settings, q_rest=self._rest_q,
+                          start=self._state)
         self._q = out.q_rad
-        self._sigma = (out.q_rad.copy(), out.sigma, out.det_sign)
+        self._state = out.state              # of out.q_rad (or None)
         if out.stopped_by is None:
             return JogResult(True, 1.0, None, "")
         return JogResult(False, float(out.moved), out.stopped_by, out.message)
@@ -416,7 +438,7 @@ class VirtualController:
                              f"no configuration within the joint limits gets there (closest: "
                              f"{sol.position_error_m * 1000:.1f} mm, "
                              f"{math.degrees(sol.rotation_error_rad):.1f} deg away).")
-        self._q = sol.q_rad
+        self._q, self._state = sol.q_rad, None
         return JogResult(True, 1.0, None, "")
 
     def auto_approach(self, *, tilt_deg: float, azimuth_deg: float, spin_deg: float = 0.0,

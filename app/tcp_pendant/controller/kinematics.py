@@ -12,6 +12,7 @@ Why pinocchio and not yourdfpy for the motion: one flange FK is about 1 us in pi
 from __future__ import annotations
 
 import math
+import operator
 import re
 import xml.etree.ElementTree as ET
 from collections.abc import Sequence
@@ -183,6 +184,8 @@ class RobotKinematics:
                                   "its upper limit; fix the URDF <limit>.")
         self.lower_rad.setflags(write=False)
         self.upper_rad.setflags(write=False)
+        self._lower_tol: list[float] = (self.lower_rad - 1e-12).tolist()
+        self._upper_tol: list[float] = (self.upper_rad + 1e-12).tolist()
         home_deg = KNOWN_HOMES_DEG.get(self.joint_names)
         self.known_home = home_deg is not None
         home = np.radians(home_deg) if home_deg is not None else np.zeros(self.n_joints)
@@ -271,7 +274,11 @@ class RobotKinematics:
 
     def limit_violation(self, q_rad: np.ndarray, *, tol: float = 1e-12) -> tuple[int, str] | None:
         """First joint outside its limits as (index, "lower"|"upper"), or None."""
-        if bool(np.all(q_rad >= self.lower_rad - tol)) and bool(np.all(q_rad <= self.upper_rad + tol)):
+        if tol == 1e-12:      # the jog's check on every sub-step: Python floats, no numpy call
+            q = np.asarray(q_rad).tolist()
+            if all(map(operator.le, self._lower_tol, q)) and all(map(operator.le, q, self._upper_tol)):
+                return None
+        elif bool(np.all(q_rad >= self.lower_rad - tol)) and bool(np.all(q_rad <= self.upper_rad + tol)):
             return None
         below = np.nonzero(q_rad < self.lower_rad - tol)[0]
         above = np.nonzero(q_rad > self.upper_rad + tol)[0]
@@ -318,8 +325,11 @@ class RobotKinematics:
         """
         J = pin.computeFrameJacobian(self.model, self.data, q_rad, self._flange_id,
                                      pin.LOCAL_WORLD_ALIGNED)
-        M = self.data.oMf[self._flange_id]
-        return J, M.rotation.copy(), M.translation.copy()
+        # updateFramePlacement only re-reads the placement computeFrameJacobian has just set (a
+        # cheaper way to it than data.oMf[id]); .homogeneous is a fresh (4,4) array: R and p are
+        # views of it, no one else's
+        T = pin.updateFramePlacement(self.model, self.data, self._flange_id).homogeneous
+        return J, T[:3, :3], T[:3, 3]
 
     def link_poses(self, q_rad: np.ndarray) -> dict[str, np.ndarray]:
         """``T_base_link`` (4,4, metres) for every URDF link, for the 3D scene."""

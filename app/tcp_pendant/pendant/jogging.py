@@ -41,7 +41,7 @@ from typing import Literal
 import numpy as np
 
 from tcp_pendant.controller import ControllerError, JogFrame, JogResult, VirtualController
-from tcp_pendant.pendant.guidance import contact_stop
+from tcp_pendant.pendant.guidance import CONTACT_RADIUS_MM, contact_stop
 
 __all__ = [
     "CARTESIAN_AXES",
@@ -171,6 +171,22 @@ class PressGate:
         return n
 
 
+_WORLD_AXES = np.eye(3)
+_WORLD_AXES.setflags(write=False)
+_CLEAR_M = CONTACT_RADIUS_MM / 1000.0 * (1.0 + 1e-9) + 1e-12
+
+
+def _clear_of(tip_m: np.ndarray, step_m: np.ndarray, reference_m: np.ndarray) -> bool:
+    """True when a translation ``step_m`` of the tool tip at ``tip_m`` cannot come within
+    ``CONTACT_RADIUS_MM`` of the reference tip (all WORLD, metres): it starts further from it than
+    the step's length plus that radius, so ``guidance.contact_stop`` would say None (every point
+    ``tip + t step``, ``0 <= t <= 1``, is at least ``|tip - reference| - |step|`` away). Python
+    floats: the test every press of a class makes, far from the tip."""
+    px, py, pz = tip_m.tolist()
+    rx, ry, rz = reference_m.tolist()
+    return math.hypot(rx - px, ry - py, rz - pz) > math.hypot(*step_m.tolist()) + _CLEAR_M
+
+
 class Jogger:
     """Turns pendant key presses into controller commands.
 
@@ -261,8 +277,12 @@ class Jogger:
         c = self.controller
         if not self.stop_at_contact:
             return c.jog_cartesian(self.settings.frame, ax, amount_mm)
-        step_m = self.frame_rotation()[:, "XYZ".index(ax)] * (amount_mm / 1000.0)
-        stop = contact_stop(c.T_world_tool_true()[:3, 3], step_m, c.reference_tip_world_m)
+        i = "XYZ".index(ax)
+        axis_m = _WORLD_AXES[:, i] if self.settings.frame == "WORLD" else self.frame_rotation()[:, i]
+        step_m = axis_m * (amount_mm / 1000.0)
+        tip_m = c.T_world_tool_true()[:3, 3]
+        stop = None if _clear_of(tip_m, step_m, c.reference_tip_world_m) else (
+            contact_stop(tip_m, step_m, c.reference_tip_world_m))
         if stop is None:
             return c.jog_cartesian(self.settings.frame, ax, amount_mm)
         res = c.jog_cartesian(self.settings.frame, ax, amount_mm * stop.fraction)
