@@ -235,18 +235,21 @@ _GRAM_BLOCK_ENTRIES = 16384
 on the 2-core machine the benchmark runs on, multi-threaded blocks of 128 x 1000 were up to
 40x slower whenever other processes kept the second core busy, and blocks of 16k-32k entries
 were the fastest, single- or multi-threaded)."""
-EXACT_ANGLES_MAX_N = 2048
+EXACT_ANGLES_MAX_N = 512
 """Up to this many touches :func:`angle_extremes` looks at every pair (blocked Gram matrix,
-O(N^2) time, O(N) memory; ~5 ms at N = 2048). Above, the smallest angle comes from a
-nearest-neighbour search (exact) and the largest from a bound-and-prune search (exact when the
-pruning leaves at most this many candidate touches, else a documented estimate)."""
-SAMPLED_ANGLES_ABOVE_N = 100_000
-"""Above this many touches :func:`angle_extremes` estimates both angles from a sample and one
-pass over the touches (:func:`_angle_extremes_sampled`: a few tens of ms at 10^6 touches, no
-more than the least-squares solve itself) instead of the nearest-neighbour and bound-and-prune
-searches (seconds at 10^6)."""
+O(N^2) time, O(N) memory; measured at N = 512 about half the time of the solve, at N = 1000
+already about twice it). Above, both angles come from a sample and one O(N) pass
+(:func:`_angle_extremes_sampled`, less time than the solve at any N): the smallest exact only
+when it is 0, the largest exact when its bounds meet; otherwise each is a flagged estimate."""
+SAMPLED_ANGLES_ABOVE_N = EXACT_ANGLES_MAX_N
+"""Above this many touches the angle figures may be estimates (``min_exact`` / ``max_exact``
+False); the same threshold as ``EXACT_ANGLES_MAX_N`` (kept as a name of its own: the smallest
+angle was exact up to 100,000 touches before)."""
 _SAMPLE_PAIRS = 512
-"""Consecutive pairs of touches in the sample of :func:`_angle_extremes_sampled`."""
+"""Most consecutive pairs of touches in the sample of :func:`_angle_extremes_sampled`."""
+_SAMPLE_PAIRS_PER_TOUCH = 1 / 8
+"""Sample pairs per touch below ``_SAMPLE_PAIRS`` (the sample's every-pair look costs
+O(sample^2): about a tenth of the solve at 1000 touches)."""
 _PASS_ROWS = 8192
 """Rows per block of the one pass of :func:`_angle_extremes_sampled` (a block's product with
 the two centres stays single-threaded in OpenBLAS and in cache)."""
@@ -268,15 +271,14 @@ def angle_extremes(rotations: np.ndarray, rotations_soa: np.ndarray | None = Non
     blocks of rows (``_GRAM_BLOCK_ENTRIES``), each reduced to its minimum and maximum. Ties
     resolve to the first pair in row-major order in both cases.
 
-    Above ``EXACT_ANGLES_MAX_N`` touches (recorded tracker data: 1e4-1e5 poses) the cost is
-    O(N log N) time and O(N) memory (:func:`_angle_extremes_large`): the smallest angle exactly,
-    by a nearest-neighbour search over unit quaternions with sign folding; the largest angle by
-    bound-and-prune, exact in most cases and otherwise a lower bound with an upper bound
-    (``AngleExtremes.max_exact``, ``max_upper_deg``).
-
-    Above ``SAMPLED_ANGLES_ABOVE_N`` touches (1e6 poses) both are estimates from a sample and
-    one O(N) pass (:func:`_angle_extremes_sampled`), marked as such (``min_exact`` unless the
-    sample holds two identical orientations, ``max_exact`` False unless the bound closes).
+    Above ``EXACT_ANGLES_MAX_N`` touches (many touches, recorded tracker data) both come from
+    a sample and O(N) passes in at most the time of the solve's least squares
+    (:func:`_angle_extremes_sampled`), each flagged when it is an estimate: ``min_exact`` False
+    (the angle of an actual pair, an upper bound of the smallest) unless a window check proves
+    it, ``max_exact`` False (a lower bound attained by a pair, with the upper bound
+    ``max_upper_deg``) unless the bounds meet. :func:`_angle_extremes_large` is an exact
+    O(N log N) search of the smallest angle for callers that can afford it (tens of ms at
+    10^4 touches).
 
     Args:
         rotations: (N, 3, 3).
@@ -287,10 +289,8 @@ def angle_extremes(rotations: np.ndarray, rotations_soa: np.ndarray | None = Non
     n = rotations.shape[0]
     if n < 2:
         return AngleExtremes(math.nan, math.nan, (0, 0), (0, 0))
-    if n > SAMPLED_ANGLES_ABOVE_N and gram is None:
-        return _angle_extremes_sampled(rotations)
     if n > EXACT_ANGLES_MAX_N and gram is None:
-        return _angle_extremes_large(rotations)
+        return _angle_extremes_sampled(rotations)
     x = rotations.reshape(n, 9)
     if n <= _GRAM_SMALL:
         g = _dot(x, x.T) if gram is None else gram
@@ -537,22 +537,24 @@ def _angle_extremes_large(rotations: np.ndarray) -> AngleExtremes:
 
 
 def _angle_extremes_sampled(rotations: np.ndarray) -> AngleExtremes:
-    """:func:`angle_extremes` for very many touches: estimates in O(N) time, one pass.
+    """:func:`angle_extremes` for many touches: estimates in O(N) time, flagged as such.
 
-    The sample: ``_SAMPLE_PAIRS`` consecutive pairs ``(i, i + 1)``, ``i`` spread evenly over
-    the touches (a recording's closest orientations are usually consecutive ones); every pair
-    of the sample is looked at (:func:`_blocked_gram_extremes`). Smallest angle: the sample's,
-    the angle of an actual pair, so an upper bound of the true smallest (exact when it is 0:
-    two identical orientations). Largest angle: with ``a, b`` the sample's farthest pair, one
-    pass over every touch finds the touch farthest from ``a`` and from ``b`` (smallest trace
-    ``x_j . x_a`` of the flattened rotations), so their eccentricities ``e(a), e(b)`` are
-    exact; ``L`` = the largest of the three pairs' angles is attained by a pair, and by the
-    triangle inequality every pair is at most ``U = 2 min(e(a), e(b))`` apart (capped at 180
-    deg). Exact when ``L`` reaches ``U``, else an estimate in ``[L, U]``.
+    The sample: consecutive pairs ``(i, i + 1)``, ``i`` spread evenly over the touches (a
+    recording's closest orientations are usually consecutive ones; ``N / 8`` pairs, at least
+    16, at most ``_SAMPLE_PAIRS``); every pair of the sample is looked at
+    (:func:`_blocked_gram_extremes`). Smallest angle: the sample's, the angle of an actual pair,
+    so an upper bound of the true smallest (exact when it is 0: two identical orientations).
+    Largest angle: with ``a, b`` the sample's farthest pair, one pass over every touch finds the
+    touch farthest from ``a`` and from ``b`` (smallest trace ``x_j . x_a`` of the flattened
+    rotations), so their eccentricities ``e(a), e(b)`` are exact; ``L`` = the largest of the
+    three pairs' angles is attained by a pair, and by the triangle inequality every pair is at
+    most ``U = 2 min(e(a), e(b))`` apart (capped at 180 deg). Exact when ``L`` reaches ``U``,
+    else an estimate in ``[L, U]``.
     """
     n = rotations.shape[0]
     x = rotations.reshape(n, 9)
-    starts = np.linspace(0, n - 2, _SAMPLE_PAIRS).round().astype(np.intp)
+    n_pairs = min(_SAMPLE_PAIRS, max(int(n * _SAMPLE_PAIRS_PER_TOUCH), 16))
+    starts = np.linspace(0, n - 2, n_pairs).round().astype(np.intp)
     idx = np.unique(np.concatenate([starts, starts + 1]))
     xs = x[idx]
     a, b, c, e = (int(idx[k]) for k in _blocked_gram_extremes(xs, np.ascontiguousarray(xs.T)))
@@ -560,15 +562,15 @@ def _angle_extremes_sampled(rotations: np.ndarray) -> AngleExtremes:
     lowest = [math.inf, math.inf]
     far = [a, b]
     for start in range(0, n, _PASS_ROWS):
-        tr = x[start : start + _PASS_ROWS] @ centres
+        tr = _dot(x[start : start + _PASS_ROWS], centres)
         k = tr.argmin(axis=0)
         for col in (0, 1):
             v = float(tr[k[col], col])
             if v < lowest[col]:
                 lowest[col] = v
                 far[col] = int(k[col]) + start
-    pairs = [(min(a, b), max(a, b)), (min(a, far[0]), max(a, far[0])), (min(b, far[1]), max(b, far[1]))]
     min_pair = (min(c, e), max(c, e))
+    pairs = [(min(a, b), max(a, b)), (min(a, far[0]), max(a, far[0])), (min(b, far[1]), max(b, far[1]))]
     min_deg, *max_degs = _pair_angles_deg(x, min_pair, *pairs)
     k = int(np.argmax(max_degs))
     max_deg, max_pair = float(max_degs[k]), pairs[k]
@@ -580,6 +582,8 @@ def _angle_extremes_sampled(rotations: np.ndarray) -> AngleExtremes:
     return AngleExtremes(min_deg=min_deg, max_deg=max_deg, min_pair=min_pair, max_pair=max_pair,
                          max_exact=max_exact, max_upper_deg=max_deg if max_exact else upper_deg,
                          min_exact=min_deg == 0.0)
+
+
 
 
 @dataclass(frozen=True)
