@@ -721,8 +721,15 @@ def _solve(rot: np.ndarray, y: np.ndarray | None, f: np.ndarray, method: str, si
         e = rot @ t + (f - r)
 
     res = _einsum("ni,ni->n", e, e)
-    sse = fit.sse if method == "lstsq" and fit is not None else float(_add(res))
-    if not math.isfinite(sum(t.tolist()) + sum(r.tolist()) + sse):
+    if method == "lstsq" and fit is not None:
+        sse = fit.sse
+        # a finite SSE = sum |R_i t + d_i - Rbar t|^2 (finite d_i) needs every |R_i t| = |t| and
+        # Rbar t finite, so t and r = Rbar t + fbar are finite too: one check for all three
+        finite = math.isfinite(sse)
+    else:
+        sse = float(_add(res))
+        finite = math.isfinite(sum(t.tolist()) + sum(r.tolist()) + sse)
+    if not finite:
         _check_finite_result(t, r, sse)
     np.sqrt(res, out=res)
     dof = 3 * n - 6
