@@ -257,9 +257,9 @@ _PROJECTION = np.array([0.39, -0.27, 0.21, 0.33, 0.41, -0.19, 0.29, -0.36, 0.45]
 _PROJECTION /= math.sqrt(float(_PROJECTION @ _PROJECTION))
 _PROJECTION.setflags(write=False)
 """A fixed generic unit direction in the 9-space of flattened rotations."""
-_SAMPLE_PAIRS_PER_TOUCH = 1 / 8
+_SAMPLE_PAIRS_PER_TOUCH = 1 / 16
 """Sample pairs per touch below ``_SAMPLE_PAIRS`` (the sample's every-pair look costs
-O(sample^2): about a tenth of the solve at 1000 touches)."""
+O(sample^2): a few percent of the solve at 1000 touches)."""
 _PASS_ROWS = 8192
 """Rows per block of the one pass of :func:`_angle_extremes_sampled` (a block's product with
 the two centres stays single-threaded in OpenBLAS and in cache)."""
@@ -549,7 +549,7 @@ def _angle_extremes_sampled(rotations: np.ndarray) -> AngleExtremes:
     """:func:`angle_extremes` for many touches: estimates in O(N) time, flagged as such.
 
     The sample: consecutive pairs ``(i, i + 1)``, ``i`` spread evenly over the touches (a
-    recording's closest orientations are usually consecutive ones; ``N / 8`` pairs, at least
+    recording's closest orientations are usually consecutive ones; ``N / 16`` pairs, at least
     16, at most ``_SAMPLE_PAIRS``); every pair of the sample is looked at
     (:func:`_blocked_gram_extremes`). Smallest angle: the sample's, or up to
     ``SAMPLED_PROJECTION_MAX_N`` touches the better pair of neighbours along a projection
@@ -565,7 +565,10 @@ def _angle_extremes_sampled(rotations: np.ndarray) -> AngleExtremes:
     n = rotations.shape[0]
     x = rotations.reshape(n, 9)
     n_pairs = min(_SAMPLE_PAIRS, max(int(n * _SAMPLE_PAIRS_PER_TOUCH), 16))
-    starts = np.linspace(0, n - 2, n_pairs).round().astype(np.intp)
+    # np.linspace(0, n - 2, n_pairs) without its Python overhead (the same products)
+    grid = np.arange(n_pairs) * ((n - 2) / (n_pairs - 1))
+    grid[-1] = n - 2
+    starts = grid.round().astype(np.intp)
     idx = np.unique(np.concatenate([starts, starts + 1]))
     xs = x[idx]
     a, b, c, e = (int(idx[k]) for k in _blocked_gram_extremes(xs, np.ascontiguousarray(xs.T)))
@@ -585,7 +588,7 @@ def _angle_extremes_sampled(rotations: np.ndarray) -> AngleExtremes:
         min_pair = _projected_neighbours_best(x, min_pair)
     pairs = [(min(a, b), max(a, b)), (min(a, far[0]), max(a, far[0])), (min(b, far[1]), max(b, far[1]))]
     min_deg, *max_degs = _pair_angles_deg(x, min_pair, *pairs)
-    k = int(np.argmax(max_degs))
+    k = max(range(3), key=max_degs.__getitem__)  # the first of the largest (np.argmax)
     max_deg, max_pair = float(max_degs[k]), pairs[k]
     if max_pair[0] == max_pair[1]:  # every orientation the same
         max_pair = (0, 1)
@@ -606,7 +609,10 @@ def _projected_neighbours_best(x: np.ndarray, pair: tuple[int, int]) -> tuple[in
     find close pairs a sample misses; O(N log N), no N x N matrix). Returned as ``(a, b)``,
     ``a < b``."""
     n = x.shape[0]
-    order = np.argsort(np.einsum("ij,j->i", x, _PROJECTION))  # einsum: one thread, whatever N
+    # BLAS gemv while OpenBLAS runs it on one thread (below 9216 entries), else einsum (one
+    # thread whatever N: threads are slow when the other core is busy)
+    p = _dot(x, _PROJECTION) if 9 * n < 9216 else np.einsum("ij,j->i", x, _PROJECTION)
+    order = np.argsort(p)
     xs = x[order]
     best = float(_dot(x[pair[0]], x[pair[1]]))
     for k in range(1, min(_PROJECTION_NEIGHBOURS, n - 1) + 1):

@@ -28,6 +28,14 @@ Prints, and says for each target whether it is met:
    else), and against the bare algebraic solve (``bare_svd_solve``: A and b stacked from the
    touches, ``numpy.linalg.svd``, t, r and the residual lengths). Targets: N = 4 < 100 us and
    <= 1.5 x the bare SVD solve, N = 1000 < 1000 us.
+2b. What the quality figures cost against the solve: for N = 4, 1000, 1e5 and 1e6, measured
+   round by round interleaved in this process (the load of the shared machine hits every
+   column alike), the medians of ``solve_xyz4``, the bare SVD solve and their ratio, the
+   least-squares core alone (``tcpcal.origin._lstsq_core``), the angle extremes alone
+   (``tcpcal._stats.angle_extremes``) and the first read of every deferred figure, with their
+   ratios to the solve and the core, whether the angles are exact, and a MET / NOT MET line per
+   target: N = 4 solve <= 1.5 x the bare SVD solve; N = 1000 solve < 1 ms; the angle extremes
+   at most the solve at N = 1000 and 1e5 and at most the least-squares core at 1e6.
 3. Median time of ``assess_touches`` and ``candidate_gain`` (the wizard calls them live) for
    N = 4 and N = 20. Target: well under 1 ms.
 4. Recorded tracker data: ``solve_xyz4`` on 1e4, 1e5 and 1e6 touches and on
