@@ -260,6 +260,7 @@ _PROJECTION.setflags(write=False)
 _SAMPLE_PAIRS_PER_TOUCH = 1 / 16
 """Sample pairs per touch below ``_SAMPLE_PAIRS`` (the sample's every-pair look costs
 O(sample^2): a few percent of the solve at 1000 touches)."""
+_PAIR_OFFSETS = np.array([0, 1])
 _PASS_ROWS = 8192
 """Rows per block of the one pass of :func:`_angle_extremes_sampled` (a block's product with
 the two centres stays single-threaded in OpenBLAS and in cache)."""
@@ -548,7 +549,7 @@ def _angle_extremes_large(rotations: np.ndarray) -> AngleExtremes:
 def _angle_extremes_sampled(rotations: np.ndarray) -> AngleExtremes:
     """:func:`angle_extremes` for many touches: estimates in O(N) time, flagged as such.
 
-    The sample: consecutive pairs ``(i, i + 1)``, ``i`` spread evenly over the touches (a
+    The sample: consecutive pairs ``(i, i + 1)``, ``i`` spread evenly (a fixed stride) over the touches (a
     recording's closest orientations are usually consecutive ones; ``N / 16`` pairs, at least
     16, at most ``_SAMPLE_PAIRS``); every pair of the sample is looked at
     (:func:`_blocked_gram_extremes`). Smallest angle: the sample's, or up to
@@ -565,12 +566,13 @@ def _angle_extremes_sampled(rotations: np.ndarray) -> AngleExtremes:
     n = rotations.shape[0]
     x = rotations.reshape(n, 9)
     n_pairs = min(_SAMPLE_PAIRS, max(int(n * _SAMPLE_PAIRS_PER_TOUCH), 16))
-    # np.linspace(0, n - 2, n_pairs) without its Python overhead (the same products)
-    grid = np.arange(n_pairs) * ((n - 2) / (n_pairs - 1))
-    grid[-1] = n - 2
-    starts = grid.round().astype(np.intp)
-    idx = np.unique(np.concatenate([starts, starts + 1]))
-    xs = x[idx]
+    step = (n - 2) // (n_pairs - 1)  # the starts 0, step, ..., <= n - 2
+    if step >= 2:  # disjoint pairs: the touches in ascending order, each once
+        idx = (np.arange(0, n_pairs * step, step)[:, None] + _PAIR_OFFSETS).ravel()
+    else:  # few touches: pairs overlap
+        starts = np.linspace(0, n - 2, n_pairs).round().astype(np.intp)
+        idx = np.unique(np.concatenate([starts, starts + 1]))
+    xs = x.take(idx, axis=0)
     a, b, c, e = (int(idx[k]) for k in _blocked_gram_extremes(xs, np.ascontiguousarray(xs.T)))
     centres = np.ascontiguousarray(x[[a, b]].T)  # (9, 2)
     lowest = [math.inf, math.inf]
@@ -613,16 +615,31 @@ def _projected_neighbours_best(x: np.ndarray, pair: tuple[int, int]) -> tuple[in
     # thread whatever N: threads are slow when the other core is busy)
     p = _dot(x, _PROJECTION) if 9 * n < 9216 else np.einsum("ij,j->i", x, _PROJECTION)
     order = np.argsort(p)
-    xs = x[order]
+    xs = x.take(order, axis=0)
     best = float(_dot(x[pair[0]], x[pair[1]]))
-    for k in range(1, min(_PROJECTION_NEIGHBOURS, n - 1) + 1):
-        tr: np.ndarray = np.einsum("ij,ij->i", xs[:-k], xs[k:])
-        i = int(tr.argmax())
-        if float(tr[i]) > best:
-            best = float(tr[i])
-            pa, pb = int(order[i]), int(order[i + k])
+    m = _PROJECTION_NEIGHBOURS
+    if n <= 2 * m:  # (not reached above EXACT_ANGLES_MAX_N: kept simple)
+        return pair
+    # one product for the pairs (i, i + k), k = 1..m, i + m < n: rows i + 1 .. i + m of a window
+    win = np.lib.stride_tricks.sliding_window_view(xs[1:], m, axis=0)  # (n - m, 9, m)
+    tr: np.ndarray = np.einsum("ij,ijk->ik", xs[: n - m], win)
+    tail = _dot(xs[n - m :], xs[n - m :].T)  # the pairs among the last m touches
+    tail[_LOWER_OR_DIAGONAL[m]] = -math.inf
+    i, k = divmod(int(tr.argmax()), m)
+    cands = [(float(tr[i, k]), i, i + k + 1)]
+    ti, tj = divmod(int(tail.argmax()), m)
+    cands.append((float(tail[ti, tj]), n - m + ti, n - m + tj))
+    for v, i, j in cands:
+        if v > best:
+            best = v
+            pa, pb = int(order[i]), int(order[j])
             pair = (min(pa, pb), max(pa, pb))
     return pair
+
+
+_LOWER_OR_DIAGONAL = {4: ~np.triu(np.ones((4, 4), dtype=bool), 1)}
+"""Masks of the entries of an m x m block that are not a pair (i < j), for
+``_PROJECTION_NEIGHBOURS``."""
 
 
 @dataclass(frozen=True)
