@@ -210,12 +210,11 @@ class AngleExtremes:
     """Smallest and largest rotation angle between two touch orientations (degrees) and the
     pairs (0-based touch indices) that give them.
 
-    ``min_deg`` is exact when ``min_exact`` (always up to ``SAMPLED_ANGLES_ABOVE_N`` touches);
+    ``min_deg`` is exact when ``min_exact`` (always up to ``EXACT_ANGLES_MAX_N`` touches);
     otherwise it is the angle of the actual pair ``min_pair``, an upper bound of the smallest.
-    ``max_deg`` is exact when ``max_exact``; otherwise (only above ``EXACT_ANGLES_MAX_N``
-    touches, when the bound-and-prune step of :func:`angle_extremes` could not narrow the
-    candidates, or above ``SAMPLED_ANGLES_ABOVE_N``) it is a lower bound attained by the pair
-    ``max_pair`` and the true largest angle lies in ``[max_deg, max_upper_deg]``.
+    ``max_deg`` is exact when ``max_exact`` (always up to ``EXACT_ANGLES_MAX_N`` touches);
+    otherwise it is a lower bound attained by the pair ``max_pair`` and the true largest angle
+    lies in ``[max_deg, max_upper_deg]``.
     """
 
     min_deg: float
@@ -235,23 +234,38 @@ _GRAM_BLOCK_ENTRIES = 16384
 on the 2-core machine the benchmark runs on, multi-threaded blocks of 128 x 1000 were up to
 40x slower whenever other processes kept the second core busy, and blocks of 16k-32k entries
 were the fastest, single- or multi-threaded)."""
-EXACT_ANGLES_MAX_N = 2048
+EXACT_ANGLES_MAX_N = 512
 """Up to this many touches :func:`angle_extremes` looks at every pair (blocked Gram matrix,
-O(N^2) time, O(N) memory; ~5 ms at N = 2048). Above, the smallest angle comes from a
-nearest-neighbour search (exact) and the largest from a bound-and-prune search (exact when the
-pruning leaves at most this many candidate touches, else a documented estimate)."""
-SAMPLED_ANGLES_ABOVE_N = 100_000
-"""Above this many touches :func:`angle_extremes` estimates both angles from a sample and one
-pass over the touches (:func:`_angle_extremes_sampled`: a few tens of ms at 10^6 touches, no
-more than the least-squares solve itself) instead of the nearest-neighbour and bound-and-prune
-searches (seconds at 10^6)."""
+O(N^2) time, O(N) memory; measured at N = 512 about half the time of the solve, at N = 1000
+already about twice it). Above, both angles come from a sample and one O(N) pass
+(:func:`_angle_extremes_sampled`, less time than the solve at any N): the smallest exact only
+when it is 0, the largest exact when its bounds meet; otherwise each is a flagged estimate."""
+SAMPLED_ANGLES_ABOVE_N = EXACT_ANGLES_MAX_N
+"""Above this many touches the angle figures may be estimates (``min_exact`` / ``max_exact``
+False); the same threshold as ``EXACT_ANGLES_MAX_N`` (kept as a name of its own: the smallest
+angle was exact up to 100,000 touches before)."""
 _SAMPLE_PAIRS = 512
-"""Consecutive pairs of touches in the sample of :func:`_angle_extremes_sampled`."""
+"""Most consecutive pairs of touches in the sample of :func:`_angle_extremes_sampled`."""
+SAMPLED_PROJECTION_MAX_N = 20_000
+"""Up to this many touches :func:`_angle_extremes_sampled` also looks at neighbours along a
+projection for the smallest angle (a sort and a gather of every touch: measured 0.3-0.5 x the
+solve up to here, but up to ~0.9 x at 10^5 touches on a busy machine, where the arrays leave
+the cache)."""
+_PROJECTION_NEIGHBOURS = 4
+"""Neighbours in the projected order whose pairs :func:`_projected_neighbours_best` looks at."""
+_PROJECTION = np.array([0.39, -0.27, 0.21, 0.33, 0.41, -0.19, 0.29, -0.36, 0.45])
+_PROJECTION /= math.sqrt(float(_PROJECTION @ _PROJECTION))
+_PROJECTION.setflags(write=False)
+"""A fixed generic unit direction in the 9-space of flattened rotations."""
+_SAMPLE_PAIRS_PER_TOUCH = 1 / 16
+"""Sample pairs per touch below ``_SAMPLE_PAIRS`` (the sample's every-pair look costs
+O(sample^2): a few percent of the solve at 1000 touches)."""
+_PAIR_OFFSETS = np.array([0, 1])
 _PASS_ROWS = 8192
 """Rows per block of the one pass of :func:`_angle_extremes_sampled` (a block's product with
 the two centres stays single-threaded in OpenBLAS and in cache)."""
 _CHUNK_ROWS = 65536
-"""Rows per chunk of the O(N m) passes of the large-N path (keeps memory O(N))."""
+"""Rows per chunk of the O(N m) passes of :func:`_angle_extremes_large` (keeps memory O(N))."""
 _N_RANDOM_CENTRES = 16
 _N_SWEEPS = 4
 
@@ -268,15 +282,13 @@ def angle_extremes(rotations: np.ndarray, rotations_soa: np.ndarray | None = Non
     blocks of rows (``_GRAM_BLOCK_ENTRIES``), each reduced to its minimum and maximum. Ties
     resolve to the first pair in row-major order in both cases.
 
-    Above ``EXACT_ANGLES_MAX_N`` touches (recorded tracker data: 1e4-1e5 poses) the cost is
-    O(N log N) time and O(N) memory (:func:`_angle_extremes_large`): the smallest angle exactly,
-    by a nearest-neighbour search over unit quaternions with sign folding; the largest angle by
-    bound-and-prune, exact in most cases and otherwise a lower bound with an upper bound
-    (``AngleExtremes.max_exact``, ``max_upper_deg``).
-
-    Above ``SAMPLED_ANGLES_ABOVE_N`` touches (1e6 poses) both are estimates from a sample and
-    one O(N) pass (:func:`_angle_extremes_sampled`), marked as such (``min_exact`` unless the
-    sample holds two identical orientations, ``max_exact`` False unless the bound closes).
+    Above ``EXACT_ANGLES_MAX_N`` touches (many touches, recorded tracker data) both come from
+    a sample and O(N) passes in at most the time of the solve's least squares
+    (:func:`_angle_extremes_sampled`), each flagged when it is an estimate: ``min_exact`` False
+    (the angle of an actual pair, an upper bound of the smallest) unless it is 0, ``max_exact`` False (a lower bound attained by a pair, with the upper bound
+    ``max_upper_deg``) unless the bounds meet. :func:`_angle_extremes_large` is an exact
+    O(N log N) search of the smallest angle for callers that can afford it (tens of ms at
+    10^4 touches).
 
     Args:
         rotations: (N, 3, 3).
@@ -287,10 +299,8 @@ def angle_extremes(rotations: np.ndarray, rotations_soa: np.ndarray | None = Non
     n = rotations.shape[0]
     if n < 2:
         return AngleExtremes(math.nan, math.nan, (0, 0), (0, 0))
-    if n > SAMPLED_ANGLES_ABOVE_N and gram is None:
-        return _angle_extremes_sampled(rotations)
     if n > EXACT_ANGLES_MAX_N and gram is None:
-        return _angle_extremes_large(rotations)
+        return _angle_extremes_sampled(rotations)
     x = rotations.reshape(n, 9)
     if n <= _GRAM_SMALL:
         g = _dot(x, x.T) if gram is None else gram
@@ -537,40 +547,50 @@ def _angle_extremes_large(rotations: np.ndarray) -> AngleExtremes:
 
 
 def _angle_extremes_sampled(rotations: np.ndarray) -> AngleExtremes:
-    """:func:`angle_extremes` for very many touches: estimates in O(N) time, one pass.
+    """:func:`angle_extremes` for many touches: estimates in O(N) time, flagged as such.
 
-    The sample: ``_SAMPLE_PAIRS`` consecutive pairs ``(i, i + 1)``, ``i`` spread evenly over
-    the touches (a recording's closest orientations are usually consecutive ones); every pair
-    of the sample is looked at (:func:`_blocked_gram_extremes`). Smallest angle: the sample's,
-    the angle of an actual pair, so an upper bound of the true smallest (exact when it is 0:
-    two identical orientations). Largest angle: with ``a, b`` the sample's farthest pair, one
-    pass over every touch finds the touch farthest from ``a`` and from ``b`` (smallest trace
-    ``x_j . x_a`` of the flattened rotations), so their eccentricities ``e(a), e(b)`` are
-    exact; ``L`` = the largest of the three pairs' angles is attained by a pair, and by the
-    triangle inequality every pair is at most ``U = 2 min(e(a), e(b))`` apart (capped at 180
-    deg). Exact when ``L`` reaches ``U``, else an estimate in ``[L, U]``.
+    The sample: consecutive pairs ``(i, i + 1)``, ``i`` spread evenly (a fixed stride) over the touches (a
+    recording's closest orientations are usually consecutive ones; ``N / 16`` pairs, at least
+    16, at most ``_SAMPLE_PAIRS``); every pair of the sample is looked at
+    (:func:`_blocked_gram_extremes`). Smallest angle: the sample's, or up to
+    ``SAMPLED_PROJECTION_MAX_N`` touches the better pair of neighbours along a projection
+    (:func:`_projected_neighbours_best`); the angle of an actual pair, so an upper bound of the
+    true smallest (exact when it is 0: two identical orientations).
+    Largest angle: with ``a, b`` the sample's farthest pair, one pass over every touch finds the
+    touch farthest from ``a`` and from ``b`` (smallest trace ``x_j . x_a`` of the flattened
+    rotations), so their eccentricities ``e(a), e(b)`` are exact; ``L`` = the largest of the
+    three pairs' angles is attained by a pair, and by the triangle inequality every pair is at
+    most ``U = 2 min(e(a), e(b))`` apart (capped at 180 deg). Exact when ``L`` reaches ``U``,
+    else an estimate in ``[L, U]``.
     """
     n = rotations.shape[0]
     x = rotations.reshape(n, 9)
-    starts = np.linspace(0, n - 2, _SAMPLE_PAIRS).round().astype(np.intp)
-    idx = np.unique(np.concatenate([starts, starts + 1]))
-    xs = x[idx]
+    n_pairs = min(_SAMPLE_PAIRS, max(int(n * _SAMPLE_PAIRS_PER_TOUCH), 16))
+    step = (n - 2) // (n_pairs - 1)  # the starts 0, step, ..., <= n - 2
+    if step >= 2:  # disjoint pairs: the touches in ascending order, each once
+        idx = (np.arange(0, n_pairs * step, step)[:, None] + _PAIR_OFFSETS).ravel()
+    else:  # few touches: pairs overlap
+        starts = np.linspace(0, n - 2, n_pairs).round().astype(np.intp)
+        idx = np.unique(np.concatenate([starts, starts + 1]))
+    xs = x.take(idx, axis=0)
     a, b, c, e = (int(idx[k]) for k in _blocked_gram_extremes(xs, np.ascontiguousarray(xs.T)))
     centres = np.ascontiguousarray(x[[a, b]].T)  # (9, 2)
     lowest = [math.inf, math.inf]
     far = [a, b]
     for start in range(0, n, _PASS_ROWS):
-        tr = x[start : start + _PASS_ROWS] @ centres
+        tr = _dot(x[start : start + _PASS_ROWS], centres)
         k = tr.argmin(axis=0)
         for col in (0, 1):
             v = float(tr[k[col], col])
             if v < lowest[col]:
                 lowest[col] = v
                 far[col] = int(k[col]) + start
-    pairs = [(min(a, b), max(a, b)), (min(a, far[0]), max(a, far[0])), (min(b, far[1]), max(b, far[1]))]
     min_pair = (min(c, e), max(c, e))
+    if n <= SAMPLED_PROJECTION_MAX_N:
+        min_pair = _projected_neighbours_best(x, min_pair)
+    pairs = [(min(a, b), max(a, b)), (min(a, far[0]), max(a, far[0])), (min(b, far[1]), max(b, far[1]))]
     min_deg, *max_degs = _pair_angles_deg(x, min_pair, *pairs)
-    k = int(np.argmax(max_degs))
+    k = max(range(3), key=max_degs.__getitem__)  # the first of the largest (np.argmax)
     max_deg, max_pair = float(max_degs[k]), pairs[k]
     if max_pair[0] == max_pair[1]:  # every orientation the same
         max_pair = (0, 1)
@@ -580,6 +600,46 @@ def _angle_extremes_sampled(rotations: np.ndarray) -> AngleExtremes:
     return AngleExtremes(min_deg=min_deg, max_deg=max_deg, min_pair=min_pair, max_pair=max_pair,
                          max_exact=max_exact, max_upper_deg=max_deg if max_exact else upper_deg,
                          min_exact=min_deg == 0.0)
+
+
+
+
+def _projected_neighbours_best(x: np.ndarray, pair: tuple[int, int]) -> tuple[int, int]:
+    """``pair`` or the better (larger trace ``x_a . x_b``) of the pairs of touches up to
+    ``_PROJECTION_NEIGHBOURS`` apart when the touches are sorted by their projection on the
+    fixed direction ``_PROJECTION`` (close orientations have close projections: a cheap way to
+    find close pairs a sample misses; O(N log N), no N x N matrix). Returned as ``(a, b)``,
+    ``a < b``."""
+    n = x.shape[0]
+    # BLAS gemv while OpenBLAS runs it on one thread (below 9216 entries), else einsum (one
+    # thread whatever N: threads are slow when the other core is busy)
+    p = _dot(x, _PROJECTION) if 9 * n < 9216 else np.einsum("ij,j->i", x, _PROJECTION)
+    order = np.argsort(p)
+    xs = x.take(order, axis=0)
+    best = float(_dot(x[pair[0]], x[pair[1]]))
+    m = _PROJECTION_NEIGHBOURS
+    if n <= 2 * m:  # (not reached above EXACT_ANGLES_MAX_N: kept simple)
+        return pair
+    # one product for the pairs (i, i + k), k = 1..m, i + m < n: rows i + 1 .. i + m of a window
+    win = np.lib.stride_tricks.sliding_window_view(xs[1:], m, axis=0)  # (n - m, 9, m)
+    tr: np.ndarray = np.einsum("ij,ijk->ik", xs[: n - m], win)
+    tail = _dot(xs[n - m :], xs[n - m :].T)  # the pairs among the last m touches
+    tail[_LOWER_OR_DIAGONAL[m]] = -math.inf
+    i, k = divmod(int(tr.argmax()), m)
+    cands = [(float(tr[i, k]), i, i + k + 1)]
+    ti, tj = divmod(int(tail.argmax()), m)
+    cands.append((float(tail[ti, tj]), n - m + ti, n - m + tj))
+    for v, i, j in cands:
+        if v > best:
+            best = v
+            pa, pb = int(order[i]), int(order[j])
+            pair = (min(pa, pb), max(pa, pb))
+    return pair
+
+
+_LOWER_OR_DIAGONAL = {4: ~np.triu(np.ones((4, 4), dtype=bool), 1)}
+"""Masks of the entries of an m x m block that are not a pair (i < j), for
+``_PROJECTION_NEIGHBOURS``."""
 
 
 @dataclass(frozen=True)

@@ -101,22 +101,22 @@ class TcpResult:
             probability under ``covariance`` (with the 3N - 6 degrees of freedom of ``s``
             when sigma was estimated).
         max_angle_deg: largest rotation angle between two touch orientations; exact unless
-            ``max_angle_exact`` is False (possible only above ``EXACT_ANGLES_MAX_N`` = 2048
+            ``max_angle_exact`` is False (possible only above ``EXACT_ANGLES_MAX_N`` = 512
             touches, see ``tcpcal._stats.angle_extremes``): then a lower bound attained by a
             pair of touches (the true largest angle is at most ``max_angle_upper_deg``).
         min_angle_deg: smallest rotation angle between two touch orientations; exact unless
             ``min_angle_exact`` is False (possible only above ``SAMPLED_ANGLES_ABOVE_N`` =
-            100,000 touches): then the angle of an actual pair, an upper bound of the smallest.
+            512 touches): then the angle of an actual pair, an upper bound of the smallest.
         condition_number: of the stacked (4P-3) matrix ``A`` (3N x 6).
         outliers: 0-based indices of touches flagged as outliers.
         without_outliers: the same method on the other touches (indices renumbered in
             order), or None if no touch was flagged.
         warnings: plain-words remarks on the data.
         n_touches: N.
-        max_angle_exact: whether ``max_angle_deg`` is exact (always for N <= 2048).
+        max_angle_exact: whether ``max_angle_deg`` is exact (always for N <= 512).
         max_angle_upper_deg: upper bound of the largest angle (= ``max_angle_deg`` when
             exact).
-        min_angle_exact: whether ``min_angle_deg`` is exact (always for N <= 100,000).
+        min_angle_exact: whether ``min_angle_deg`` is exact (always for N <= 512).
     """
 
     method: str
@@ -182,7 +182,7 @@ def _check_observable(rotations: np.ndarray, info: Information, ext: AngleExtrem
             f"(spread about it: {math.degrees(info.weakest_tilt_rad):.3f} deg).",
             unobservable_axis=axis,
         )
-    if ext.min_deg < SAME_ORIENTATION_DEG:
+    if ext.min_deg < SAME_ORIENTATION_DEG or not ext.min_exact:  # an estimate may miss the repeat
         found = distinct_orientations(rotations, limit=MIN_TOUCHES)
         distinct = found.count
         if distinct < MIN_TOUCHES and found.first_repeat is not None:
@@ -721,8 +721,15 @@ def _solve(rot: np.ndarray, y: np.ndarray | None, f: np.ndarray, method: str, si
         e = rot @ t + (f - r)
 
     res = _einsum("ni,ni->n", e, e)
-    sse = fit.sse if method == "lstsq" and fit is not None else float(_add(res))
-    if not math.isfinite(sum(t.tolist()) + sum(r.tolist()) + sse):
+    if method == "lstsq" and fit is not None:
+        sse = fit.sse
+        # a finite SSE = sum |R_i t + d_i - Rbar t|^2 (finite d_i) needs every |R_i t| = |t| and
+        # Rbar t finite, so t and r = Rbar t + fbar are finite too: one check for all three
+        finite = math.isfinite(sse)
+    else:
+        sse = float(_add(res))
+        finite = math.isfinite(sum(t.tolist()) + sum(r.tolist()) + sse)
+    if not finite:
         _check_finite_result(t, r, sse)
     np.sqrt(res, out=res)
     dof = 3 * n - 6

@@ -395,7 +395,7 @@ def _bullets(items: Sequence[str]) -> list[str]:
 
 
 def _largest_angle(result: TcpResult) -> str:
-    """``174.4 deg``, or for an estimate (above 2048 touches, ``max_angle_exact`` False)
+    """``174.4 deg``, or for an estimate (above 512 touches, ``max_angle_exact`` False)
     ``>= 179.9 deg (estimate, at most 180.0)``."""
     if getattr(result, "max_angle_exact", True):
         return _fig(result.max_angle_deg, " deg", ".1f")
@@ -404,7 +404,7 @@ def _largest_angle(result: TcpResult) -> str:
 
 
 def _smallest_angle(result: TcpResult) -> str:
-    """``12.3 deg``, or for an estimate (above 100,000 touches, ``min_angle_exact`` False)
+    """``12.3 deg``, or for an estimate (above 512 touches, ``min_angle_exact`` False)
     ``<= 0.4 deg (estimate)``."""
     if getattr(result, "min_angle_exact", True):
         return _fig(result.min_angle_deg, " deg", ".1f")

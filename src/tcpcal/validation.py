@@ -136,7 +136,8 @@ def rotations_and_soa(x: Any, name: str = "rotations") -> tuple[np.ndarray, np.n
         # Orthonormal => det = +-1 = sum_j c0_j (c1 x c2)_j (np.linalg.det: ~0.1 us per matrix)
         yc = y[_CYCLIC]  # rows j, j+1, j+2 (mod 3) for the cross products
         det = (yc[0:3, 0] * (yc[1:4, 1] * yc[2:5, 2] - yc[2:5, 1] * yc[1:4, 2])).sum(axis=0)
-    if float(_min(det)) < 0.0:
+    # (no NaN here: the orthonormality check refused it; a few numbers: a Python min is cheaper)
+    if (min(det.tolist()) if n <= SMALL_STACK else float(_min(det))) < 0.0:
         i = int(np.argmax(det < 0.0))
         raise InvalidInputError(
             f"{name}[{i}] is a reflection (determinant {det[i]:.6g}), not a rotation; a proper "

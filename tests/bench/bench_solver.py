@@ -28,6 +28,14 @@ Prints, and says for each target whether it is met:
    else), and against the bare algebraic solve (``bare_svd_solve``: A and b stacked from the
    touches, ``numpy.linalg.svd``, t, r and the residual lengths). Targets: N = 4 < 100 us and
    <= 1.5 x the bare SVD solve, N = 1000 < 1000 us.
+2b. What the quality figures cost against the solve: for N = 4, 1000, 1e5 and 1e6, measured
+   round by round interleaved in this process (the load of the shared machine hits every
+   column alike), the medians of ``solve_xyz4``, the bare SVD solve and their ratio, the
+   least-squares core alone (``tcpcal.origin._lstsq_core``), the angle extremes alone
+   (``tcpcal._stats.angle_extremes``) and the first read of every deferred figure, with their
+   ratios to the solve and the core, whether the angles are exact, and a MET / NOT MET line per
+   target: N = 4 solve <= 1.5 x the bare SVD solve; N = 1000 solve < 1 ms; the angle extremes
+   at most the solve at N = 1000 and 1e5 and at most the least-squares core at 1e6.
 3. Median time of ``assess_touches`` and ``candidate_gain`` (the wizard calls them live) for
    N = 4 and N = 20. Target: well under 1 ms.
 4. Recorded tracker data: ``solve_xyz4`` on 1e4, 1e5 and 1e6 touches and on
@@ -74,6 +82,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tcpcal"))
 from poses import crb_tcp, random_tcp, stacked_a, tilted_rotations, touch_positions
 
+from tcpcal._stats import EXACT_ANGLES_MAX_N
 from tcpcal.errors import DegenerateTouchesError
 from tcpcal.origin import METHODS, solve_xyz4
 from tcpcal.pose_quality import assess_touches, candidate_gain
@@ -203,6 +212,119 @@ def timing_table(repeats: int) -> list[tuple[int, float, float, float, float, fl
         bare = median_us(lambda rot=rot, pos=pos: bare_svd_solve(rot, pos), reps)
         out.append((n, full, no_outl, base, bare, figures_us(rot, pos, reps)))
     return out
+
+
+FIGURE_NS = (4, 1000, 100_000, 1_000_000)
+FIGURE_ROUNDS = {4: 2000, 1000: 200, 100_000: 7, 1_000_000: 3}
+
+
+def figure_cost_table(quick: bool, in_process: bool = False) -> list[dict]:
+    """Table 2b: for N = 4, 1000, 1e5, 1e6, interleaved round by round in this process (ABAB:
+    the machine's load hits every column alike), the medians (us) of ``solve_xyz4`` (default:
+    lstsq with the outlier test), the bare SVD solve, the least-squares core alone
+    (``tcpcal.origin._lstsq_core`` on checked arrays: the sums, t, r and the residuals), the
+    angle extremes alone (``tcpcal._stats.angle_extremes``, as the result computes them) and
+    the first read of every deferred figure of a fresh result. N >= 1e5 each in a subprocess
+    (unless ``in_process``)."""
+    from tcpcal import _stats
+    from tcpcal.origin import _lstsq_core
+    from tcpcal.validation import as_positions, rotations_and_soa
+
+    rows = []
+    ns = FIGURE_NS[:2] + (2000,) if quick else FIGURE_NS
+    for n in ns:
+        if n >= 100_000 and not in_process:  # its own process: this one's peak RSS (inherited
+            # by the later subprocesses of tables 4 and 6 on Linux) stays that of small sets
+            proc = subprocess.run([sys.executable, __file__, "--figure-case", str(n)],
+                                  capture_output=True, text=True, check=True)
+            rows.append(json.loads(proc.stdout.strip().splitlines()[-1]))
+            continue
+        rng = np.random.default_rng(n + 3)
+        rot = tilted_rotations(rng, n, (20.0, 50.0))
+        pos = touch_positions(rot, random_tcp(rng, (100.0, 300.0)), np.array([800.0, 0, 300]), rng, SIGMA)
+        r_chk, y = rotations_and_soa(rot)
+        f_chk = as_positions(pos, n)
+        info = _stats.information(r_chk, y)
+        m_inv = info.m_inv()
+        fns: dict[str, Callable[[], object]] = {
+            "solve": lambda: solve_xyz4(rot, pos),
+            "bare": lambda: bare_svd_solve(rot, pos),
+            "core": lambda: _lstsq_core(info, m_inv, r_chk, f_chk),
+            "angles": lambda: _stats.angle_extremes(r_chk, y),
+        }
+        times: dict[str, list[float]] = {k: [] for k in (*fns, "figures")}
+        rounds = 20 if quick and n <= 1000 else (2 if quick else FIGURE_ROUNDS[n])
+        # From N = 1000 numpy's SVD of the 3N x 6 matrix runs on several threads (OpenBLAS),
+        # which keep spinning on the other core for a while after it: interleaved, it would
+        # slow whatever is timed next. There it is timed in its own loop after the others.
+        apart = ("bare",) if n >= 1000 else ()
+        for f in fns.values():
+            f()
+        for _ in range(rounds):
+            for k, f in fns.items():
+                if k in apart:
+                    continue
+                t0 = time.perf_counter()
+                f()
+                times[k].append(time.perf_counter() - t0)
+            res = solve_xyz4(rot, pos)
+            t0 = time.perf_counter()
+            for name in DEFERRED_FIGURES:
+                getattr(res, name)
+            times["figures"].append(time.perf_counter() - t0)
+        for k in apart:
+            for _ in range(rounds):
+                t0 = time.perf_counter()
+                fns[k]()
+                times[k].append(time.perf_counter() - t0)
+        row = {k: float(np.median(v) * 1e6) for k, v in times.items()}
+        row["n"] = n
+        row["min_exact"], row["max_exact"] = res.min_angle_exact, res.max_angle_exact
+        rows.append(row)
+        fns.clear()  # the next N is the largest: let this one's arrays go
+    return rows
+
+
+def print_figure_cost_table(quick: bool) -> None:
+    print("2b. what the quality figures cost against the solve, medians (us) interleaved round by round")
+    print("    (from N = 1000 the bare SVD solve, multi-threaded, in a loop of its own after the others)")
+    print(f"    (targets: N=4 solve <= {BARE_RATIO_TARGET} x bare SVD; N=1000 solve < 1000 us; N=1000 and 1e5 angle")
+    print("    extremes <= the solve; N=1e6 angle extremes <= the least-squares core)")
+    hdr = (f"{'N':>9} {'solve':>10} {'bare SVD':>10} {'ratio':>6} {'LS core':>10} {'angles':>10} "
+           f"{'/solve':>7} {'/core':>6} {'figures':>10} {'/solve':>7} {'exact min/max':>14}")
+    print(hdr)
+    print("-" * len(hdr))
+    rows = figure_cost_table(quick)
+    for r in rows:
+        print(f"{r['n']:>9,} {r['solve']:10.1f} {r['bare']:10.1f} {r['solve'] / r['bare']:6.2f} {r['core']:10.1f} "
+              f"{r['angles']:10.1f} {r['angles'] / r['solve']:7.2f} {r['angles'] / r['core']:6.2f} "
+              f"{r['figures']:10.1f} {r['figures'] / r['solve']:7.2f} "
+              f"{str(r['min_exact']).lower():>6}/{str(r['max_exact']).lower():<7}")
+    by_n = {r["n"]: r for r in rows}
+    checks = []
+    if 4 in by_n:
+        r = by_n[4]
+        checks.append((f"N = 4: solve {r['solve']:.1f} us <= {BARE_RATIO_TARGET} x bare SVD {r['bare']:.1f} us "
+                       f"(ratio {r['solve'] / r['bare']:.2f})", r["solve"] <= BARE_RATIO_TARGET * r["bare"]))
+    if 1000 in by_n:
+        r = by_n[1000]
+        checks.append((f"N = 1000: solve {r['solve']:.1f} us < 1000 us", r["solve"] < 1000.0))
+        checks.append((f"N = 1000: angle extremes {r['angles']:.1f} us <= solve {r['solve']:.1f} us "
+                       f"(ratio {r['angles'] / r['solve']:.2f})", r["angles"] <= r["solve"]))
+    if 100_000 in by_n:
+        r = by_n[100_000]
+        checks.append((f"N = 1e5: angle extremes {r['angles'] / 1e3:.2f} ms <= solve {r['solve'] / 1e3:.2f} ms "
+                       f"(ratio {r['angles'] / r['solve']:.2f})", r["angles"] <= r["solve"]))
+    if 1_000_000 in by_n:
+        r = by_n[1_000_000]
+        checks.append((f"N = 1e6: angle extremes {r['angles'] / 1e3:.1f} ms <= least-squares core "
+                       f"{r['core'] / 1e3:.1f} ms (ratio {r['angles'] / r['core']:.2f})", r["angles"] <= r["core"]))
+    for text, ok in checks:
+        print(f"   {text}: {'MET' if ok else 'NOT MET'}" if not QUICK else f"   {text}: {verdict(ok)}")
+    print(f"   Angle figures up to {EXACT_ANGLES_MAX_N} touches: exact (every pair). Above: the smallest from a sample")
+    print("   of consecutive pairs (an upper bound; exact when 0), the largest from the sample's farthest pair")
+    print("   and one pass over every touch (exact when its bounds meet), each flagged when an estimate")
+    print("   (min_angle_exact / max_angle_exact false; '<=' / '>=' in the report).")
 
 
 def pose_quality_timing(repeats: int) -> list[tuple[int, float, float]]:
@@ -420,7 +542,13 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--draws", type=int, default=None, help="noise draws per set (default 5)")
     ap.add_argument("--large-case", type=int, default=None, help=argparse.SUPPRESS)
     ap.add_argument("--repeated", action="store_true", help=argparse.SUPPRESS)
+    ap.add_argument("--figure-case", type=int, default=None, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
+    if args.figure_case is not None:  # one large row of table 2b, in its own process
+        global FIGURE_NS
+        FIGURE_NS = (args.figure_case,)
+        print(json.dumps(figure_cost_table(False, in_process=True)[0]))
+        return 0
     if args.large_case is not None:  # one case of table 4, in its own process
         print(json.dumps(large_case(args.large_case, args.repeated)))
         return 0
@@ -478,6 +606,13 @@ def main(argv: list[str] | None = None) -> int:
     print("   the first read of the figures the result computes when first asked (mean and largest")
     print("   residual, 95 % radius, the largest/smallest angle between touches, condition number,")
     print("   warnings; all at once), after a solve; the solve's time does not include it.")
+    print("   Each column here is one function called back to back (a hot loop: its code and data stay")
+    print("   in the caches); the bare SVD solve (one LAPACK call) gains more from that than solve_xyz4")
+    print("   (~40 small numpy calls), so the N = 4 ratio here is higher than in table 2b, where the")
+    print("   functions take turns round by round as they do in use (the wizard solves once between")
+    print("   other work).")
+    print()
+    print_figure_cost_table(QUICK)
     print()
     print(f"3. pose quality, median us  (target well under {POSE_QUALITY_TARGET_US:.0f})")
     for n, a_us, c_us in pose_quality_timing(repeats):
@@ -500,10 +635,9 @@ def main(argv: list[str] | None = None) -> int:
             tgt = f"  {verdict(row['solve_s'] < LARGE_TARGET_S and rss < LARGE_TARGET_RSS_MB)}"
         print(f"{label:>22} {row['solve_s']:8.2f} {row['gen_s']:15.2f} {rss:12.0f} {before:>20}  "
               f"{row['outcome']}{tgt}")
-    print("   Angle figures above 2048 touches: smallest exact (nearest neighbour of quaternions),")
-    print("   largest exact when bound-and-prune leaves <= 2048 candidates, else marked as an estimate")
-    print("   ('>=' above; max_angle_exact false in the result). Above 100,000 touches both from a sample")
-    print("   and one pass ('<=' for the smallest; min_angle_exact false). Memory O(N), never N x N.")
+    print(f"   Angle figures above {EXACT_ANGLES_MAX_N} touches: both from a sample and one pass over the touches,")
+    print("   flagged when estimates ('<=' for the smallest, min_angle_exact false; '>=' for the largest,")
+    print("   max_angle_exact false; table 2b). Memory O(N), never N x N.")
     print()
     print_beam_table(n_sets, draws)
     print()

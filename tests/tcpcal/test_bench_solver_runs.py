@@ -42,6 +42,14 @@ def test_bench_solver_quick_runs() -> None:
     # the first read of the deferred figures, timed in the same row, in units of the solve
     figs = re.search(r"^\s+4\s.*\|\s+([\d.]+) \(([\d.]+) x solve\)$", text, re.MULTILINE)
     assert figs and float(figs.group(1)) > 0, text
+    # table 2b: the figures against the solve, one row per N (quick: 4, 1000, 2000), each
+    # with the solve, the bare SVD solve, their ratio, the least-squares core and the angles
+    assert "what the quality figures cost against the solve" in text
+    for label in ("4", "1,000", "2,000"):
+        row = re.search(rf"^\s+{label}\s+([\d.]+)\s+([\d.]+)\s+([\d.]+)\s+([\d.]+)\s+([\d.]+)\s+([\d.]+)\s",
+                        text, re.MULTILINE)
+        assert row and all(float(g) > 0 for g in row.groups()), (label, text)
+    assert "N = 1000: angle extremes" in text and "N = 4: solve" in text
 
 
 def test_the_bare_svd_yardstick_solves_the_same_problem() -> None:

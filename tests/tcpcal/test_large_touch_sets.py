@@ -121,23 +121,42 @@ def test_quaternions_give_the_rotation_angle() -> None:
     assert np.allclose(np.abs(np.einsum("ij,ij->i", q, ref)), 1.0, atol=1e-12)
 
 
-def test_above_the_threshold_min_is_exact_and_max_bracketed() -> None:
-    """N = 3000 uniform orientations: the smallest angle exact against every pair (blocked
-    Gram of before), the largest within [max_deg, max_upper_deg] around the true one."""
-    rot = Rotation.random(3000, random_state=5).as_matrix()
+def test_above_the_threshold_both_angles_are_bracketed_estimates() -> None:
+    """N = 1000 uniform orientations (above EXACT_ANGLES_MAX_N, where looking at every pair
+    would cost more than the solve): the smallest angle is the angle of an actual pair, at
+    least the true one (every pair, blocked Gram), and flagged; the largest within
+    [max_deg, max_upper_deg] around the true one."""
+    rot = Rotation.random(1000, random_state=5).as_matrix()
     assert len(rot) > EXACT_ANGLES_MAX_N
     fast = angle_extremes(rot)
     x = rot.reshape(len(rot), 9)
     a, b, c, e = _stats._blocked_gram_extremes(x, np.ascontiguousarray(x.T))
     min_deg, max_deg = _stats._pair_angles_deg(x, (c, e), (a, b))
-    assert fast.min_deg == pytest.approx(min_deg, abs=1e-9)
+    assert not fast.min_exact and not fast.max_exact
+    assert min_deg - 1e-9 <= fast.min_deg < 10.0
     assert fast.max_deg <= max_deg + 1e-9 <= fast.max_upper_deg + 2e-9
     assert max_deg - fast.max_deg < 0.5  # the estimate of a uniform set is close
+    (pair_deg,) = _stats._pair_angles_deg(x, fast.min_pair)
+    assert pair_deg == fast.min_deg
 
 
-def test_tracker_like_cone_gets_an_exact_largest_angle() -> None:
-    """Pivoting inside a 30 deg cone (spin about the tool axis within +-20 deg): the prune
-    leaves few candidates, so the largest angle is exact, equal to the blocked Gram result."""
+def test_a_repeated_orientation_above_the_threshold_is_exact_and_still_refused() -> None:
+    """600 touches with only 3 distinct orientations: the estimate finds the repeat (0 deg,
+    exact), and the solve refuses the set as before (the repeat check does not rely on it)."""
+    rng = np.random.default_rng(12)
+    three = Rotation.from_rotvec(rng.normal(size=(3, 3)) * 0.6).as_matrix()
+    rot = three[np.arange(600) % 3]
+    ext = angle_extremes(rot)
+    assert ext.min_exact and ext.min_deg == 0.0
+    pos = np.array([800.0, 0, 300]) - rot @ np.array([10.0, 20.0, 150.0])
+    with pytest.raises(DegenerateTouchesError, match="same orientation"):
+        solve_xyz4(rot, pos)
+
+
+def test_tracker_like_cone_exact_search_gets_an_exact_largest_angle() -> None:
+    """Pivoting inside a 30 deg cone (spin about the tool axis within +-20 deg): the exact
+    O(N log N) search (_angle_extremes_large) prunes to few candidates, so its largest angle
+    is exact, equal to the blocked Gram result; the solver's estimate brackets it."""
     rng = np.random.default_rng(11)
     n = 4000
     tilt = np.radians(30.0) * np.sqrt(rng.uniform(0, 1, n))
@@ -146,12 +165,14 @@ def test_tracker_like_cone_gets_an_exact_largest_angle() -> None:
     r = (Rotation.from_rotvec(np.c_[np.cos(az) * tilt, np.sin(az) * tilt, np.zeros(n)])
          * Rotation.from_rotvec(np.c_[np.zeros((n, 2)), spin]))
     rot = r.as_matrix()
-    fast = angle_extremes(rot)
+    exact = _angle_extremes_large(rot)
     x = rot.reshape(n, 9)
     a, b, _, _ = _stats._blocked_gram_extremes(x, np.ascontiguousarray(x.T))
     (max_deg,) = _stats._pair_angles_deg(x, (a, b))
-    assert fast.max_exact
-    assert fast.max_deg == pytest.approx(max_deg, abs=1e-7)
+    assert exact.max_exact
+    assert exact.max_deg == pytest.approx(max_deg, abs=1e-7)
+    fast = angle_extremes(rot)
+    assert fast.max_deg <= max_deg + 1e-7 <= fast.max_upper_deg + 2e-7
 
 
 def test_estimated_largest_angle_is_flagged_in_result_json_and_report() -> None:
@@ -278,3 +299,18 @@ def test_above_the_sampling_threshold_a_repeated_orientation_is_exact() -> None:
     ext = angle_extremes(rot)
     assert ext.min_exact and ext.min_deg == 0.0
     assert ext.max_deg <= ext.max_upper_deg
+
+
+def test_above_the_threshold_a_close_pair_far_apart_in_recording_order_is_found() -> None:
+    """600 uniform orientations with touch 450 re-recorded 0.2 deg from touch 17: the sample of
+    consecutive pairs cannot hold that pair, the neighbours along the projection do, so the
+    estimate names it (still flagged: nothing proves it the smallest)."""
+    rng = np.random.default_rng(21)
+    r = Rotation.random(600, random_state=rng)
+    rot = r.as_matrix()
+    rot[450] = (r[17] * Rotation.from_rotvec([0.0, math.radians(0.2), 0.0])).as_matrix()
+    lo, _ = brute_angles_deg(rot)
+    ext = angle_extremes(rot)
+    assert lo == pytest.approx(0.2, abs=1e-9)
+    assert ext.min_pair == (17, 450) and ext.min_deg == pytest.approx(0.2, abs=1e-9)
+    assert not ext.min_exact
