@@ -9,6 +9,10 @@
 # browser tests did not run. Under CI=true a missing chromium fails the run (exit 1).
 # Debian's postgresql and nginx (the PostgreSQL gradebook and front-end tests) are installed
 # the same way; their tests are skipped where they are missing, and fail under CI=true.
+# Without arguments (the README's command, CI) pytest runs twice: the tests not marked serial on
+# two pytest-xdist workers, then the serial ones (tests/app, tests/browser, tests/security:
+# servers, chromium, latency and load; tests/conftest.py marks them) alone; every test runs
+# once and the exit status is the first failing run's. With arguments: one pytest run, as given.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 . scripts/venv.sh
@@ -71,8 +75,26 @@ elif ! command -v chromium >/dev/null 2>&1; then
     chromium_missing="chromium is missing and 'apt-get install chromium' failed (exit $rc): install it by hand, or set CHROMIUM=/path/to/chromium"
   fi
 fi
+# run_suite [MARKER]: the whole suite (of MARKER, e.g. "not browser") in two runs: the tests not
+# marked serial on 2 xdist workers, then the serial ones in one process (header comment).
+run_suite() {
+  local only="${1:+$1 and }" rc_parallel=0 rc_serial=0
+  .venv/bin/python -m pytest -n 2 -m "${only}not serial" || rc_parallel=$?
+  .venv/bin/python -m pytest -m "${only}serial" || rc_serial=$?
+  if [ "$rc_parallel" != 0 ] || [ "$rc_serial" != 0 ]; then
+    echo "run-tests.sh: pytest exited $rc_parallel (the tests on 2 workers) and $rc_serial (the serial tests)." >&2
+  fi
+  [ "$rc_parallel" != 0 ] && return "$rc_parallel"
+  return "$rc_serial"
+}
+
 if [ -z "$chromium_missing" ]; then
   [ -n "${CHROMIUM:-}" ] || export CHROMIUM="$(command -v chromium)"
+  if [ $# -eq 0 ]; then
+    rc=0
+    run_suite || rc=$?
+    exit "$rc"
+  fi
   exec .venv/bin/python -m pytest "$@"
 fi
 
@@ -88,7 +110,11 @@ while [ $# -gt 0 ]; do
   esac
 done
 rc=0
-.venv/bin/python -m pytest -m "$marker" ${args[@]+"${args[@]}"} || rc=$?
+if [ ${#args[@]} -eq 0 ] && [ "$marker" = "not browser" ]; then
+  run_suite "$marker" || rc=$?
+else
+  .venv/bin/python -m pytest -m "$marker" ${args[@]+"${args[@]}"} || rc=$?
+fi
 echo "!!!!!!!! THE BROWSER TESTS DID NOT RUN: $chromium_missing. !!!!!!!!" >&2
 if [ "${CI:-}" = true ]; then
   echo "run-tests.sh: CI=true: failing the run because the browser tests could not run." >&2

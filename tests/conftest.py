@@ -13,6 +13,14 @@ Where the server binaries (``/usr/lib/postgresql/*/bin``, or ``$PG_BIN``), psyco
 are missing, the tests that need them are skipped with the reason (reported as not run), and
 under ``CI=true`` they fail: ``scripts/run-tests.sh`` installs ``postgresql`` and ``nginx`` with
 apt-get.
+
+Which tests may share the CPU: ``scripts/run-tests.sh`` runs the tests not marked ``serial`` on
+two pytest-xdist workers (each worker starts its own PostgreSQL server: a session fixture is one
+per process), then the ``serial`` ones in one process. A test is marked ``serial`` here, at
+collection, when it is in a folder of :data:`SERIAL_FOLDERS` or has the ``browser`` marker: those
+start servers, chromium and websocket clients whose latencies, loads and time bounds they assert
+or print, so they run with the machine to themselves as before. Plain ``pytest`` runs everything
+in one process, as before.
 """
 
 from __future__ import annotations
@@ -197,3 +205,22 @@ def gradebook_target(request: pytest.FixtureRequest, tmp_path: Path) -> str | Pa
         return tmp_path / "class.sqlite3"
     server: PostgresServer = request.getfixturevalue("postgres_server")
     return server.fresh_schema()
+
+
+SERIAL_FOLDERS = ("app", "browser", "security")
+"""Folders of ``tests/`` whose tests are ``serial`` (module docstring): in-process and real
+pendant servers with headless clients (deadman, latency, load, threading, workers), chromium,
+and the security tests' attack loads and latency bounds."""
+
+_TESTS = Path(__file__).resolve().parent
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """Mark ``serial`` every test of :data:`SERIAL_FOLDERS` and every ``browser`` test."""
+    for item in items:
+        try:
+            folder = item.path.resolve().relative_to(_TESTS).parts[0]
+        except ValueError:                      # a test outside tests/ (given on the command line)
+            folder = ""
+        if folder in SERIAL_FOLDERS or item.get_closest_marker("browser") is not None:
+            item.add_marker(pytest.mark.serial)

@@ -165,7 +165,9 @@ def test_run_tests_without_chromium_keeps_a_marker_the_caller_gave(stamped: Path
 def test_run_tests_under_ci_fails_when_chromium_is_missing(stamped: Path) -> None:
     p = run(stamped, "run-tests.sh", CI="true")
     assert p.returncode == 1
-    assert len(pytest_calls(stamped)) == 1               # the other tests still ran
+    assert pytest_calls(stamped) == [                    # the other tests still ran
+        "python [-m] [pytest] [-n] [2] [-m] [not browser and not serial]",
+        "python [-m] [pytest] [-m] [not browser and serial]"]
     assert "CI=true" in p.stderr and "BROWSER TESTS DID NOT RUN" in p.stderr
 
 
@@ -226,11 +228,29 @@ def test_run_tests_with_chromium_runs_everything(stamped: Path) -> None:
     assert p.stderr == ""
 
 
+def test_run_tests_without_arguments_runs_the_parallel_tests_then_the_serial_ones(stamped: Path) -> None:
+    """The README's command: the tests not marked serial on 2 xdist workers, then the serial ones
+    (tests/conftest.py marks them) in one process; a failing run fails the command, and the
+    serial tests still run after a failure of the parallel ones."""
+    (stamped.parent / "bin" / "chromium").symlink_to(shutil.which("true") or "/bin/true")
+    both = ["python [-m] [pytest] [-n] [2] [-m] [not serial]", "python [-m] [pytest] [-m] [serial]"]
+    p = run(stamped, "run-tests.sh")
+    assert p.returncode == 0, p.stderr
+    assert pytest_calls(stamped) == both
+    assert p.stderr == ""
+    (stamped / "calls.log").unlink()
+    p = run(stamped, "run-tests.sh", FAKE_PYTEST_RC="1")
+    assert p.returncode == 1
+    assert pytest_calls(stamped) == both
+    assert "pytest exited 1 (the tests on 2 workers) and 1 (the serial tests)" in p.stderr
+
+
 def test_run_tests_with_a_bad_chromium_override_says_so(stamped: Path) -> None:
     p = run(stamped, "run-tests.sh", CHROMIUM="/nowhere/chromium")
     assert p.returncode == 0
     assert "CHROMIUM=/nowhere/chromium is not an executable" in p.stderr
-    assert pytest_calls(stamped) == ["python [-m] [pytest] [-m] [not browser]"]
+    assert pytest_calls(stamped) == ["python [-m] [pytest] [-n] [2] [-m] [not browser and not serial]",
+                                     "python [-m] [pytest] [-m] [not browser and serial]"]
 
 
 # ---------------------------------------------------------------- the type check
