@@ -89,18 +89,11 @@ back-off is out of reach is retried at a shorter distance, and a test that reads
 
 
 WARM_SCRIPT = r"""
-import json, os, runpy, sys
-low = hasattr(os, "geteuid") and os.geteuid() == 0   # root may raise its priority back afterwards
-base = os.getpriority(os.PRIO_PROCESS, 0)    # pytest's, as a server started cold would have
-if low:
-    os.nice(19 - base)                              # import on the CPU the running test leaves idle
+import json, runpy, sys
 import tcp_pendant.cli, tcp_pendant.server   # what ``main()`` imports first: pinocchio, viser, trimesh
 line = sys.stdin.readline()                  # the test's arguments, or EOF: not needed
 if not line:
     raise SystemExit(0)
-if low:                                      # the server runs at pytest's priority, every thread
-    for tid in os.listdir("/proc/self/task"):
-        os.setpriority(os.PRIO_PROCESS, int(tid), base)
 sys.argv = ["-m", *json.loads(line)]         # as ``python -m tcp_pendant ARGS`` sees them
 runpy.run_module("tcp_pendant", run_name="__main__", alter_sys=True)
 """
@@ -117,9 +110,7 @@ class WarmInterpreter:
     of ``python -m tcp_pendant``, which it then runs as that command does (``runpy``, the same
     ``sys.argv``, the same environment: it is only used when the environment has not changed
     since it started). Importing the app is most of a server's start (about 3 of 4 s on a
-    shared 2-core machine); the next test's interpreter imports while this test runs, as root
-    at the lowest priority (nice 19: on the CPU the test leaves idle, so it does not slow a
-    test's timed part), and then serves at pytest's priority (every thread set back).
+    shared 2-core machine); the next test's interpreter imports while this test runs.
     Its output goes to ``log_path`` (renamed to the test's log file when it is used)."""
 
     def __init__(self) -> None:
