@@ -3,9 +3,7 @@
 * ``pendant_server(*extra_args, port=None)`` (factory fixture): starts ``python -m tcp_pendant``
   in a subprocess on a free port (or ``port``) with a fresh tool library under ``tmp_path``, waits until the
   HTTP port answers (up to 60 s), yields a :class:`ServerProcess` (``url``, ``library_path``,
-  ``log()``), and terminates it at the end of the test. The subprocess is a warm one when one is
-  ready (:class:`WarmInterpreter`: the interpreter started and the app's modules imported while
-  the previous test ran, then ``-m tcp_pendant`` run with this test's arguments).
+  ``log()``), and terminates it at the end of the test.
 * ``server``: one such server with default options.
 * ``browser``: a chromium launched once per session with ``executable_path='/usr/bin/chromium'``
   (or ``$CHROMIUM``) and ``--no-sandbox --disable-gpu --disable-background-networking
@@ -19,12 +17,9 @@ Software WebGL is slow: wait on conditions with generous timeouts, never fixed s
 
 from __future__ import annotations
 
-import json
-import os
 import socket
 import subprocess
 import sys
-import tempfile
 import time
 import urllib.request
 from collections.abc import Callable, Iterator
@@ -88,101 +83,6 @@ back-off is out of reach is retried at a shorter distance, and a test that reads
 (TCP & Z, X's "displacement lengths 60.0 mm") then depended on the draw."""
 
 
-WARM_SCRIPT = r"""
-import json, runpy, sys
-import tcp_pendant.cli, tcp_pendant.server   # what ``main()`` imports first: pinocchio, viser, trimesh
-line = sys.stdin.readline()                  # the test's arguments, or EOF: not needed
-if not line:
-    raise SystemExit(0)
-sys.argv = ["-m", *json.loads(line)]         # as ``python -m tcp_pendant ARGS`` sees them
-runpy.run_module("tcp_pendant", run_name="__main__", alter_sys=True)
-"""
-
-
-def _environment() -> dict[str, str]:
-    """The environment a server would get, but pytest's PYTEST_CURRENT_TEST (the test's name and
-    phase, which the app does not read)."""
-    return {k: v for k, v in os.environ.items() if k != "PYTEST_CURRENT_TEST"}
-
-
-class WarmInterpreter:
-    """A ``python`` started ahead of need that has imported the app and waits for the arguments
-    of ``python -m tcp_pendant``, which it then runs as that command does (``runpy``, the same
-    ``sys.argv``, the same environment: it is only used when the environment has not changed
-    since it started). Importing the app is most of a server's start (about 3 of 4 s on a
-    shared 2-core machine); the next test's interpreter imports while this test runs.
-    Its output goes to ``log_path`` (renamed to the test's log file when it is used)."""
-
-    def __init__(self) -> None:
-        fd, name = tempfile.mkstemp(prefix="tcp-pendant-warm-", suffix=".log")
-        self.log_path = Path(name)
-        self.env = _environment()
-        with os.fdopen(fd, "wb") as logf:
-            self.proc: subprocess.Popen[bytes] = subprocess.Popen(
-                [sys.executable, "-c", WARM_SCRIPT], stdin=subprocess.PIPE, stdout=logf, stderr=subprocess.STDOUT)
-
-    def run(self, args: list[str], log_path: Path) -> tuple[subprocess.Popen[bytes], Path] | None:
-        """Run ``python -m tcp_pendant *args`` in this interpreter; None if it cannot be used
-        (it exited, or the environment changed): the caller then starts a fresh one."""
-        if self.proc.poll() is not None or _environment() != self.env:
-            self.close()
-            return None
-        try:
-            os.replace(self.log_path, log_path)
-            self.log_path = log_path
-        except OSError:                          # another file system: the log stays where it is
-            pass
-        assert self.proc.stdin is not None
-        self.proc.stdin.write((json.dumps(args) + "\n").encode())
-        self.proc.stdin.close()
-        return self.proc, self.log_path
-
-    def close(self) -> None:
-        """Stop it unused (EOF on its stdin: it exits) and remove its log."""
-        if self.proc.poll() is None:
-            try:
-                assert self.proc.stdin is not None
-                self.proc.stdin.close()
-                self.proc.wait(10)
-            except (OSError, subprocess.TimeoutExpired):
-                self.proc.kill()
-                self.proc.wait(5)
-        self.log_path.unlink(missing_ok=True)
-
-
-_warm: list[WarmInterpreter] = []
-"""The one spare interpreter (at most), made by :func:`_popen_server` for the next server."""
-
-
-def _popen_server(args: list[str], log_path: Path) -> tuple[subprocess.Popen[bytes], Path]:
-    """``python -m tcp_pendant *args`` with its output in ``log_path``: in the spare warm
-    interpreter if there is a usable one, else a fresh process; then a new spare is started for
-    the next server (stopped at the end of the session by the ``_warm_interpreters`` fixture)."""
-    started = None
-    while _warm and started is None:
-        started = _warm.pop().run(args, log_path)
-    if started is None:
-        with open(log_path, "wb") as logf:
-            started = subprocess.Popen([sys.executable, "-m", "tcp_pendant", *args], stdout=logf,
-                                       stderr=subprocess.STDOUT), log_path
-    _warm.append(WarmInterpreter())
-    return started
-
-
-def close_warm_interpreters() -> None:
-    while _warm:
-        _warm.pop().close()
-
-
-@pytest.fixture(scope="session")
-def _warm_interpreters() -> Iterator[None]:
-    """Stops the spare interpreter at the end of the session (no process left behind)."""
-    try:
-        yield
-    finally:
-        close_warm_interpreters()
-
-
 def _start_on(tmp_path: Path, port: int, *extra: str) -> ServerProcess:
     lib = tmp_path / "tools.json"
     log_path = tmp_path / f"server_{port}.log"
@@ -190,9 +90,10 @@ def _start_on(tmp_path: Path, port: int, *extra: str) -> ServerProcess:
     while log_path.exists():                     # a server started again on the same port
         log_path, k = tmp_path / f"server_{port}_{k}.log", k + 1
     seed = () if "--seed" in extra else ("--seed", str(BROWSER_SEED))   # Auto-touch's directions replay
-    args = ["--port", str(port), "--tool-library", str(lib), *seed, *extra]
+    cmd = [sys.executable, "-m", "tcp_pendant", "--port", str(port), "--tool-library", str(lib), *seed, *extra]
     t0 = time.perf_counter()
-    proc, log_path = _popen_server(args, log_path)
+    with open(log_path, "wb") as logf:
+        proc = subprocess.Popen(cmd, stdout=logf, stderr=subprocess.STDOUT)
     sp = ServerProcess(proc, port, lib, log_path)
     deadline = time.monotonic() + READY_TIMEOUT_S
     while time.monotonic() < deadline:
@@ -222,7 +123,7 @@ def _stop(sp: ServerProcess) -> None:
 
 
 @pytest.fixture
-def pendant_server(tmp_path: Path, _warm_interpreters: None) -> Iterator[Callable[..., ServerProcess]]:
+def pendant_server(tmp_path: Path) -> Iterator[Callable[..., ServerProcess]]:
     """Factory: ``pendant_server("--shared", ...)`` starts a server with extra CLI options
     (``port=N``: on that port, e.g. again on the port of a server that was killed)."""
     started: list[ServerProcess] = []

@@ -1,8 +1,7 @@
 """Fixtures of the security tests.
 
 The browser tests here reuse the fixtures of ``tests/browser/conftest.py`` (``pendant_server``,
-``server``, ``browser``, ``new_page``, ``shot``, and ``_warm_interpreters``, which stops the spare
-warm interpreter of this copy of those fixtures): that file is loaded under its own module name
+``server``, ``browser``, ``new_page``, ``shot``): that file is loaded under its own module name
 and its fixtures are re-exported, so both folders start servers and chromium the same way.
 """
 
@@ -31,7 +30,6 @@ new_page = _browser_fixtures.new_page
 pendant_server = _browser_fixtures.pendant_server
 server = _browser_fixtures.server
 shot = _browser_fixtures.shot
-_warm_interpreters = _browser_fixtures._warm_interpreters
 free_port = _browser_fixtures.free_port
 CHROMIUM = _browser_fixtures.CHROMIUM
 CHROMIUM_ARGS = _browser_fixtures.CHROMIUM_ARGS
