@@ -20,6 +20,7 @@ Examples::
 from __future__ import annotations
 
 import argparse
+import gc
 import logging
 import os
 import sys
@@ -309,6 +310,7 @@ def _main(argv: Sequence[str] | None) -> int:
     except KeyboardInterrupt:
         app.stop()
         raise
+    set_apart_startup_objects()
     if worker is not None:
         return _serve_as_worker(app, worker[2])
     workers: Workers | None = None
@@ -337,6 +339,17 @@ def _main(argv: Sequence[str] | None) -> int:
         if workers is not None:
             workers.stop()
     return 0
+
+
+def set_apart_startup_objects() -> int:
+    """Collect the start-up garbage, then move every object left (the robot model, meshes,
+    viser's server: they live as long as the process) out of the cyclic collector's reach
+    (``gc.freeze``), so that a full collection while a class jogs walks only the sessions'
+    objects: its pause stalls every robot of the process at once (one full collection took
+    0.1-0.3 s with 30 sessions). Returns how many objects are set apart."""
+    gc.collect()
+    gc.freeze()
+    return gc.get_freeze_count()
 
 
 def _serve_as_worker(app: PendantApp, parent_pid: int) -> int:
