@@ -22,6 +22,18 @@ from wsclient import DrainingClient, wait_until  # noqa: E402
 P = TypeVar("P", bound="AppPage")
 
 
+def true_tip_at(session: Any, offset_mm: Any) -> None:
+    """Teleport the mounted tool's true tip to the reference tip + ``offset_mm`` (WORLD, mm),
+    the tool's orientation kept, and signal the move (as the gizmo would)."""
+    with session.lock:
+        c = session.controller
+        T = c.T_world_tool_true().copy()
+        T[:3, 3] = c.reference_tip_world_m + np.asarray(offset_mm, dtype=float) / 1000.0
+        res = c.move_true_tool_to(T)
+        assert res.ok, res.message
+        session.moved()
+
+
 def truth_tool(key: str, name: str, offset_mm: Any = (0.0, 0.0, 0.0)) -> Tool:
     """Tool data equal to a built-in tool's (unbent) hidden true frame, its TCP moved by
     ``offset_mm`` (FLANGE, mm)."""

@@ -17,6 +17,7 @@ from tcp_pendant.pendant.tip_insets import FAR, NEAR_MM
 from tcp_pendant.session import Session, SessionChange
 from tcpcal.library import ToolLibrary
 
+from app_page import true_tip_at
 from wsclient import DrainingClient, wait_until
 
 FLAGS = ("pose", "tool", "touches", "wizard", "library", "notice")
@@ -67,17 +68,6 @@ def test_a_batch_merges_every_kind_into_one_signal(session: Session) -> None:
     assert got.jog is jog and got.state is s.pose_state()
 
 
-def _true_tip_at(s: Session, offset_mm: tuple[float, float, float]) -> None:
-    """The mounted tool's true tip ``offset_mm`` from the reference tip (same orientation), then
-    one motion signal."""
-    with s.lock:
-        c = s.controller
-        T = c.T_world_tool_true().copy()
-        T[:3, 3] = c.reference_tip_world_m + np.asarray(offset_mm) / 1000.0
-        assert c.move_true_tool_to(T).ok
-        s.moved()
-
-
 def test_tip_close_up_shows_near_redraws_and_hides_far(app_factory) -> None:
     """Far (ready pose, then 60 mm and just beyond NEAR_MM): hidden, no image sent; near:
     shown with the image of the geometry; moved while near: a new image; far again: hidden."""
@@ -89,16 +79,16 @@ def test_tip_close_up_shows_near_redraws_and_hides_far(app_factory) -> None:
         insets = s.views["pendant"].insets
         assert insets._key == FAR and not insets.image.visible and not insets.caption.visible
         for offset in ((0.0, 0.0, 60.0), (0.0, 0.0, NEAR_MM + 0.05)):
-            _true_tip_at(s, offset)
+            true_tip_at(s, offset)
             assert s.pose_state().touch.distance_mm == pytest.approx(math.hypot(*offset), abs=1e-6)
             assert insets._key == FAR and not insets.image.visible
-        _true_tip_at(s, (0.0, 0.0, NEAR_MM - 0.05))       # just inside: shown at once
+        true_tip_at(s, (0.0, 0.0, NEAR_MM - 0.05))       # just inside: shown at once
         assert insets._key != FAR and insets.image.visible and insets.caption.visible
-        _true_tip_at(s, (0.4, -0.3, 1.6))
+        true_tip_at(s, (0.4, -0.3, 1.6))
         key, image = insets._key, insets.image.image
-        _true_tip_at(s, (0.4, -0.3, 1.1))                 # 0.5 mm lower: another picture
+        true_tip_at(s, (0.4, -0.3, 1.1))                 # 0.5 mm lower: another picture
         assert insets._key != key and not np.array_equal(insets.image.image, image)
-        _true_tip_at(s, (0.0, 0.0, 60.0))
+        true_tip_at(s, (0.0, 0.0, 60.0))
         assert insets._key == FAR and not insets.image.visible and not insets.caption.visible
     finally:
         client.close()

@@ -18,7 +18,7 @@ import pytest
 HERE = Path(__file__).parent
 sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(HERE.parent / "calibrate"))
-from app_page import AppPage, app_pages, truth_tool  # noqa: E402
+from app_page import AppPage, app_pages, true_tip_at, truth_tool  # noqa: E402
 from guiclick import click  # noqa: E402
 from wsclient import DrainingClient, wait_until  # noqa: E402
 
@@ -89,12 +89,8 @@ def test_in_an_exercise_the_check_of_a_zero_tool_shows_a_reading_not_the_answer(
     p.click(p.tools.check)                  # from the ready pose: no spike to read the swing against
     assert p.tools.last_check is None and p.notes and "bring the tool tip to the reference tip" in p.notes[-1][1]
     s = p.session
-    with s.lock:                             # the tip brought to the reference tip (as a touch would)
-        c = s.controller
-        T = c.T_world_tool_true().copy()
-        T[:3, 3] = c.reference_tip_world_m + np.array([0.0, 0.0, 2.0]) / 1000.0
-        assert c.move_true_tool_to(T).ok
-        s.moved()
+    true_tip_at(s, (0.0, 0.0, 2.0))          # the tip brought to the reference tip (as a touch would)
+    c = s.controller
     p.click(p.tools.check)
     job, res = p.tools.last_check
     true_tcp = np.asarray(c.mounted_tool.T_flange_tool_true)[:3, 3] * 1000.0

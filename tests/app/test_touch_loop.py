@@ -27,7 +27,7 @@ import pytest
 HERE = Path(__file__).parent
 sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(HERE.parent / "calibrate"))
-from app_page import AppPage, app_pages  # noqa: E402
+from app_page import AppPage, app_pages, true_tip_at  # noqa: E402
 from guiclick import click  # noqa: E402
 from wsclient import ButtonClient, wait_until  # noqa: E402
 
@@ -53,14 +53,7 @@ class Page(AppPage):
     def tip_at(self, offset_mm: tuple[float, float, float]) -> None:
         """Teleport the true tool tip to the reference tip + ``offset_mm`` (WORLD), same
         orientation, and signal the move (as the gizmo would)."""
-        s = self.session
-        with s.lock:
-            c = s.controller
-            T = c.T_world_tool_true().copy()
-            T[:3, 3] = c.reference_tip_world_m + np.asarray(offset_mm) / 1000.0
-            res = c.move_true_tool_to(T)
-            assert res.ok, res.message
-            s.moved()
+        true_tip_at(self.session, offset_mm)
 
 
 @pytest.fixture

@@ -40,7 +40,7 @@ from tcp_pendant.server import PendantApp
 
 sys.path.insert(0, str(Path(__file__).parent))
 sys.path.insert(0, str(Path(__file__).parents[1] / "app"))
-from app_page import running_pendants  # noqa: E402
+from app_page import running_pendants, true_tip_at  # noqa: E402
 from pendant_page import TIMEOUT_MS, assert_not_blank, wait_until  # noqa: E402
 
 pytestmark = pytest.mark.browser
@@ -90,16 +90,6 @@ def assert_same_and_inside(before: dict[str, tuple[float, ...]], after: dict[str
         assert x >= 0 and y >= 0 and x + bw <= w and y + bh <= h, f"{when} at {w}x{h}: key {name!r} {a} off screen"
 
 
-def teleport_above_tip(s: Any, offset_mm: tuple[float, float, float]) -> None:
-    """The true tool tip at the reference tip + ``offset_mm`` (WORLD), tool orientation kept."""
-    with s.lock:
-        c = s.controller
-        T = c.T_world_tool_true().copy()
-        T[:3, 3] = c.reference_tip_world_m + np.asarray(offset_mm) / 1000.0
-        assert c.move_true_tool_to(T).ok
-        s.moved()
-
-
 def test_jog_keys_stay_put_near_the_tip_and_at_a_stop(pendant, new_page, shots) -> None:
     app = pendant()
     page = new_page(app.url, width=SIZES[0][0], height=SIZES[0][1])
@@ -107,11 +97,11 @@ def test_jog_keys_stay_put_near_the_tip_and_at_a_stop(pendant, new_page, shots) 
     closeup = page.get_by_text("mm/char").first
     for size in SIZES:
         page.set_viewport_size({"width": size[0], "height": size[1]})
-        teleport_above_tip(s, (0.0, 0.0, 150.0))              # far: no close-up, no tip views
+        true_tip_at(s, (0.0, 0.0, 150.0))              # far: no close-up, no tip views
         closeup.wait_for(state="hidden", timeout=TIMEOUT_MS)
         page.wait_for_timeout(300)
         far = key_boxes(page)
-        teleport_above_tip(s, (1.5, -1.0, 8.0))                # within 20 mm: both close-ups
+        true_tip_at(s, (1.5, -1.0, 8.0))                # within 20 mm: both close-ups
         closeup.wait_for(state="visible", timeout=TIMEOUT_MS)
         page.locator("img:not([src^='data:image/svg'])").first.wait_for(state="visible", timeout=TIMEOUT_MS)
         page.wait_for_timeout(300)

@@ -27,7 +27,7 @@ from tcp_pendant.server import PendantApp
 
 sys.path.insert(0, str(Path(__file__).parent))
 sys.path.insert(0, str(Path(__file__).parents[1] / "app"))
-from app_page import running_pendants  # noqa: E402
+from app_page import running_pendants, true_tip_at  # noqa: E402
 from pendant_page import TIMEOUT_MS, wait_until  # noqa: E402
 
 pytestmark = pytest.mark.browser
@@ -99,11 +99,8 @@ def test_half_a_millimetre_is_at_least_5_px_in_both_views_in_every_direction(pen
     (s,) = app.sessions.values()
     with s.lock:
         s.set_hide_distance(True)                    # judged by eye: the views stay
+        true_tip_at(s, (0.4, -0.3, 1.6))
         c = s.controller
-        T = c.T_world_tool_true().copy()
-        T[:3, 3] = c.reference_tip_world_m + np.array([0.4, -0.3, 1.6]) / 1000.0
-        assert c.move_true_tool_to(T).ok
-        s.moved()
     shot = changed(page, None)
     width = shot.shape[1]
     moves: dict[str, dict[str, tuple[float, float]]] = {}
