@@ -211,7 +211,7 @@ class FlangeState(NamedTuple):
     """:func:`smallest_singular_value` at ``q_rad``, or a lower bound of it ``>= 2 singular_eps``
     (``PathOutcome.sigma``)."""
     det_sign: float
-    """``_det_sign`` of ``J`` (+1, -1; 0 singular or not square)."""
+    """The sign of ``det J`` (``_lu_det_sign``: +1, -1; 0 singular or not square)."""
     lu: tuple[np.ndarray, np.ndarray] | None = None
     """LAPACK ``getrf`` factors of ``J`` (square ``J`` only), for the first Newton step."""
 
@@ -241,7 +241,7 @@ class PathOutcome:
     """:func:`smallest_singular_value` at ``q_rad``, or a lower bound of it that is at least
     ``2 singular_eps`` (``_sigma_bound``: all the singularity rules need to know then)."""
     det_sign: float = 0.0
-    """Sign of ``det J_flange`` at ``q_rad`` (``_det_sign``: +1, -1; 0 singular or not square)."""
+    """Sign of ``det J_flange`` at ``q_rad`` (``_lu_det_sign``: +1, -1; 0 singular or not square)."""
     state: FlangeState | None = None
     """The kinematics at ``q_rad`` (the last Newton iteration's), to start the next path from."""
 
@@ -310,17 +310,11 @@ def _skew(v: np.ndarray) -> np.ndarray:
     return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
 
 
-def _det_sign(J_flange: np.ndarray) -> float:
-    """Sign of ``det J_flange`` (+1 or -1; 0 when J is not square or exactly singular)."""
-    if J_flange.shape[0] != J_flange.shape[1]:
-        return 0.0
-    return float(np.sign(np.linalg.det(J_flange)))
-
-
 def _lu_det_sign(J_flange: np.ndarray) -> tuple[float, tuple[np.ndarray, np.ndarray] | None]:
-    """:func:`_det_sign` from an LU factorisation ``P J = L U`` (what ``np.linalg.det`` does:
-    ``det J = (-1)^(row swaps) prod diag U``), and the factors for a later solve with ``J``
-    (None when J is not square or exactly singular)."""
+    """Sign of ``det J_flange`` (+1 or -1; 0 when J is not square or exactly singular) from an LU
+    factorisation ``P J = L U`` (what ``np.linalg.det`` does: ``det J = (-1)^(row swaps) prod
+    diag U``), and the factors for a later solve with ``J`` (None when J is not square or
+    exactly singular)."""
     if J_flange.shape[0] != J_flange.shape[1]:
         return 0.0, None
     lu, piv, info = lapack.dgetrf(J_flange)
@@ -511,8 +505,8 @@ def _solve_substep(kin: RobotKinematics, q_start: np.ndarray, sigma_start: float
         sigma = _sigma_min(J, settings)
         if sigma < eps and sigma < sigma_start * (1.0 - 1e-9) - 1e-12:
             return _Attempt(q_start, sigma_start, "singularity", singularity_message(kin, q, settings))
-        if lu is not None:        # converged at the start: J is the start's, its sign known
-            det_sign = start.det_sign if start is not None else _det_sign(J)
+        if lu is not None and start is not None:   # converged at the start: J is the start's, its sign known
+            det_sign = start.det_sign
         else:
             det_sign, lu = _lu_det_sign(J)
         if (det_sign * det_sign_start < 0.0 and sigma > settings.singular_zero
@@ -577,7 +571,7 @@ def follow_path(kin: RobotKinematics, q_rad: np.ndarray, T_flange_tcp: np.ndarra
     elif sigma_start is None or det_sign_start is None:
         J0 = kin.jacobian_flange(q)
         sigma = _sigma_min(J0, settings) if sigma_start is None else float(sigma_start)
-        det_sign = _det_sign(J0) if det_sign_start is None else float(det_sign_start)
+        det_sign = _lu_det_sign(J0)[0] if det_sign_start is None else float(det_sign_start)
     else:
         sigma, det_sign = float(sigma_start), float(det_sign_start)
     s_done = 0.0
