@@ -81,13 +81,16 @@ def wxyz_xyz(T: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return (q[0] if T.ndim == 2 else q), T[..., :3, 3]
 
 
-def relative_poses(T_world_parent: np.ndarray, T_world_child: np.ndarray) -> np.ndarray:
+def relative_poses(T_world_parent: np.ndarray, T_world_child: np.ndarray,
+                   out: np.ndarray | None = None) -> np.ndarray:
     """``T_parent_child = inv(T_world_parent) @ T_world_child`` for stacks (N,4,4) of rigid
-    poses (``R_p^T R_c``, ``R_p^T (p_c - p_p)``)."""
+    poses (``R_p^T R_c``, ``R_p^T (p_c - p_p)``), written into ``out`` ((N,4,4), e.g. a view of a
+    buffer reused every jog step) when given, else into a new array."""
+    if out is None:
+        out = np.empty_like(T_world_child)
     Rp_T = T_world_parent[:, :3, :3].transpose(0, 2, 1)
-    out = np.empty_like(T_world_child)
-    out[:, :3, :3] = Rp_T @ T_world_child[:, :3, :3]
-    out[:, :3, 3] = (Rp_T @ (T_world_child[:, :3, 3] - T_world_parent[:, :3, 3])[..., None])[..., 0]
+    np.matmul(Rp_T, T_world_child[:, :3, :3], out=out[:, :3, :3])
+    np.matmul(Rp_T, (T_world_child[:, :3, 3] - T_world_parent[:, :3, 3])[..., None], out=out[:, :3, 3:])
     out[:, 3, :] = (0.0, 0.0, 0.0, 1.0)
     return out
 
@@ -377,8 +380,8 @@ class SceneView:
     def _local_poses(self, state: Any) -> np.ndarray:
         """(N+1,4,4): ``T_parent_link`` of the moving links (``T_world_link`` for a link
         without a parent), then ``T_world_tcp`` (the gizmo), from one pose state
-        (``R_p^T R_c``, ``R_p^T (p_c - p_p)`` as :func:`relative_poses`, batched into a buffer
-        reused by the next call: :class:`PoseSender` copies what it sends)."""
+        (:func:`relative_poses`, batched into a buffer reused by the next call:
+        :class:`PoseSender` copies what it sends)."""
         if state.link_names != self._index_names:             # index rows once per link list
             row = {n: i for i, n in enumerate(state.link_names)}
             with_parent = [i for i, n in enumerate(self._moving) if self._parent[n] is not None]
@@ -389,21 +392,15 @@ class SceneView:
             self._root_rows = [(i, row[n]) for i, n in enumerate(self._moving) if self._parent[n] is None]
             self._contiguous = with_parent == list(range(len(with_parent)))
             self._local_out = np.zeros((len(self._moving) + 1, 4, 4))
-            self._local_out[:, 3, 3] = 1.0
             self._index_names = state.link_names
         out = self._local_out
         W = state.T_world_links
         P = W[self._parent_idx]
         C = W[self._child_idx]
-        Rp_T = P[:, :3, :3].transpose(0, 2, 1)
-        d = (C[:, :3, 3] - P[:, :3, 3])[..., None]
         if self._contiguous:                                  # a tree without loose links: in place
-            k = len(self._child_idx)
-            np.matmul(Rp_T, C[:, :3, :3], out=out[:k, :3, :3])
-            np.matmul(Rp_T, d, out=out[:k, :3, 3:])
+            relative_poses(P, C, out=out[:len(self._child_idx)])
         else:
-            out[self._out_rows, :3, :3] = Rp_T @ C[:, :3, :3]
-            out[self._out_rows, :3, 3] = (Rp_T @ d)[..., 0]
+            out[self._out_rows] = relative_poses(P, C)
         for i, j in self._root_rows:
             out[i] = W[j]
         out[-1] = state.T_world_tcp

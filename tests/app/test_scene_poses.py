@@ -1,0 +1,53 @@
+"""The scene's link poses: ``relative_poses`` against ``inv(T_parent) @ T_child``, and the
+poses the scene sends for a jog step chained back to the pose state's ``T_world_link``."""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+from tcp_pendant.views.scene import relative_poses
+from wsclient import DrainingClient, wait_until
+
+
+def _rigid(rng: np.random.Generator, n: int) -> np.ndarray:
+    T = np.tile(np.eye(4), (n, 1, 1))
+    T[:, :3, :3] = Rotation.random(n, random_state=rng).as_matrix()
+    T[:, :3, 3] = rng.normal(size=(n, 3))
+    return T
+
+
+def test_relative_poses_are_the_parent_inverse_times_the_child_into_a_buffer_or_not() -> None:
+    rng = np.random.default_rng(4)
+    P, C = _rigid(rng, 7), _rigid(rng, 7)
+    expected = np.linalg.inv(P) @ C
+    np.testing.assert_allclose(relative_poses(P, C), expected, atol=1e-12)
+    buffer = np.full((9, 4, 4), np.nan)                   # a view of a larger buffer, stale values
+    got = relative_poses(P, C, out=buffer[:7])
+    assert np.shares_memory(got, buffer)                  # written in place
+    np.testing.assert_allclose(buffer[:7], expected, atol=1e-12)
+    assert np.isnan(buffer[7:]).all()                    # nothing written beyond the view
+
+
+def test_the_scene_poses_chain_back_to_the_links_world_poses_after_jogs(app_factory) -> None:
+    app = app_factory()
+    client = DrainingClient(app.port)
+    try:
+        wait_until(lambda: len(app.sessions) == 1, what="session built")
+        (s,) = app.sessions.values()
+        scene = s.views["scene"]
+        for axis, amount in (("X", 5.0), ("Z", -3.0), ("A", 10.0)):
+            with s.lock:
+                assert s.controller.jog_cartesian("WORLD", axis, amount).ok
+                s.moved()
+            state = s.pose_state()
+            local = scene._local_poses(state).copy()
+            row = {n: i for i, n in enumerate(state.link_names)}
+            world: dict[str, np.ndarray] = {}
+            for i, name in enumerate(scene._moving):         # parents come before children
+                parent = scene._parent[name]
+                world[name] = local[i] if parent is None else world.get(
+                    parent, state.T_world_links[row[parent]]) @ local[i]
+                np.testing.assert_allclose(world[name], state.T_world_links[row[name]], atol=1e-12)
+            np.testing.assert_allclose(local[-1], state.T_world_tcp, atol=0)
+    finally:
+        client.close()
