@@ -6,6 +6,7 @@ a two-character prefix of each guess."""
 from __future__ import annotations
 
 import logging
+import math
 import os
 import re
 import subprocess
@@ -14,11 +15,13 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
+from tcp_pendant.classroom.gradebook import Gradebook
 from tcp_pendant.classroom.trainer_token import (
     TOKEN_ENV,
-    TokenAttempts,
     TrainerTokenError,
     TrainerTokenLocked,
+    lock_s,
+    locked,
     resolve_trainer_token,
 )
 from tcp_pendant.cli import main
@@ -76,17 +79,20 @@ def test_a_token_from_a_file_or_the_environment_is_not_in_the_process_list(tmp_p
         proc.wait(timeout=30)
 
 
-def test_the_lockout_doubles_from_the_fifth_wrong_token_up_to_five_minutes() -> None:
-    a = TokenAttempts()
-    windows = []
-    for i in range(15):
-        a.check(1000.0 * i)                                  # each try after the previous window
-        a.failed(1000.0 * i, "browser 1", "guess")
-        windows.append(a.wait_s(1000.0 * i))
-    assert windows == [0, 0, 0, 0, 1, 2, 4, 8, 16, 32, 64, 128, 256, 300, 300]
-    with pytest.raises(TrainerTokenLocked, match=r"try again in 300 s\."):
-        a.check(14_000.0)
-    a.check(14_300.0)
+def test_the_lockout_doubles_from_the_fifth_wrong_token_up_to_five_minutes(tmp_path: Path) -> None:
+    assert [lock_s(n) for n in range(1, 16)] == [0, 0, 0, 0, 1, 2, 4, 8, 16, 32, 64, 128, 256, 300, 300]
+    with Gradebook(tmp_path / "class.sqlite3") as book:      # the count the app keeps (never forgotten here)
+        def attempt(now: float) -> tuple[float, int, bool]:
+            return book.try_token("10.0.0.5", now=now, forget_s=math.inf, lock_s=lock_s)
+
+        for i in range(15):                                  # each try after the previous window
+            assert attempt(1000.0 * i) == (0.0, i + 1, True)
+        wait, failures, counted = attempt(14_000.0)          # the 15th's window: 300 s
+        assert (wait, failures, counted) == (300.0, 15, False)
+        with pytest.raises(TrainerTokenLocked, match=r"try again in 300 s\."):
+            raise locked(wait)
+        assert attempt(14_299.0) == (1.0, 15, False)
+        assert attempt(14_300.0) == (0.0, 16, True)
 
 
 @pytest.fixture

@@ -168,7 +168,8 @@ _CLASS_MESSAGES = """CREATE TABLE IF NOT EXISTS class_messages (
 message to the class has a row for every trainee connected when it was sent, ``to_all`` 1), so
 each trainee dismisses their own (the row goes). ``sent_at``: UTC ``2026-12-02T09:30:00Z``;
 ``text``: plain text as the trainer typed it (cleaned; escaped where it is shown). At most
-:data:`MAX_QUEUED_MESSAGES` per trainee: a newer one pushes out the oldest."""
+``MAX_WAITING_MESSAGES`` per trainee (as many as a session keeps): a newer one pushes out the
+oldest."""
 _TOKEN_FAILURES = """CREATE TABLE IF NOT EXISTS token_failures (
     id INTEGER PRIMARY KEY,
     source TEXT NOT NULL,
@@ -177,8 +178,6 @@ _TOKEN_FAILURES = """CREATE TABLE IF NOT EXISTS token_failures (
 Unix time, seconds), for every server process of the class: the lockout
 (``classroom.trainer_token``) counts them whichever process a browser reaches, and after a
 restart. Rows older than the caller's ``forget_s`` are deleted at each try."""
-MAX_QUEUED_MESSAGES = MAX_WAITING_MESSAGES
-"""Messages kept undismissed per trainee (as many as a session keeps)."""
 MAX_SOURCE_CHARS = 100
 """A token try's source (an address) is cut to this many characters."""
 PRESENCE_STALE_S = 10.0
@@ -1304,7 +1303,7 @@ class Gradebook:
 
     def add_message(self, text: str, names: Sequence[str], *, to_all: bool, sent_at: str) -> dict[str, int]:
         """Keep the trainer's message ``text`` (plain text, cleaned by the caller) for each of
-        ``names`` until that trainee dismisses it; beyond :data:`MAX_QUEUED_MESSAGES` a trainee's
+        ``names`` until that trainee dismisses it; beyond ``MAX_WAITING_MESSAGES`` a trainee's
         oldest go. ``to_all``: it was sent to the class. Returns each name's message id."""
         ids: dict[str, int] = {}
         with self._write() as db:
@@ -1312,7 +1311,7 @@ class Gradebook:
                 ids[name] = db.insert("INSERT INTO class_messages (name, to_all, sent_at, text) VALUES (?, ?, ?, ?)",
                                       (name, int(bool(to_all)), str(sent_at), str(text)))
                 db.execute("DELETE FROM class_messages WHERE name = ? AND id NOT IN (SELECT id FROM class_messages "
-                           "WHERE name = ? ORDER BY id DESC LIMIT ?)", (name, name, MAX_QUEUED_MESSAGES))
+                           "WHERE name = ? ORDER BY id DESC LIMIT ?)", (name, name, MAX_WAITING_MESSAGES))
         return ids
 
     def messages_for(self, names: Sequence[str]) -> dict[str, list[tuple[int, bool, str, str]]]:

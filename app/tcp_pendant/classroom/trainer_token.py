@@ -12,8 +12,7 @@ The wrong tries are counted in the class gradebook (``Gradebook.try_token``: tab
 reconnect that lands on another process (``--workers``, several machines) or a restart of the
 server does not give new tries; a try is counted before its token is compared, and a right token
 forgives its address's failures. Failures :data:`FORGET_S` old are forgotten. Times there are
-Unix seconds (the machines' clocks). :class:`TokenAttempts` is the same rule for one counter in
-memory.
+Unix seconds (the machines' clocks).
 
 It can be given on the command line (``--trainer-token``, which shows in the process list), in a
 file (``--trainer-token-file PATH``: its first line) or in the environment
@@ -22,13 +21,12 @@ file (``--trainer-token-file PATH``: its first line) or in the environment
 
 from __future__ import annotations
 
-import dataclasses
 import logging
 import os
 from collections.abc import Mapping
 from pathlib import Path
 
-__all__ = ["FORGET_S", "FREE_TRIES", "MAX_LOCK_S", "MAX_TOKEN_CHARS", "MIN_TOKEN_CHARS", "TOKEN_ENV", "TokenAttempts",
+__all__ = ["FORGET_S", "FREE_TRIES", "MAX_LOCK_S", "MAX_TOKEN_CHARS", "MIN_TOKEN_CHARS", "TOKEN_ENV",
            "TrainerTokenError", "TrainerTokenLocked", "lock_s", "locked", "log_failure", "resolve_trainer_token",
            "validate_trainer_token"]
 
@@ -114,34 +112,3 @@ def log_failure(who: str, failures: int, typed: str) -> None:
     if failures >= FREE_TRIES:
         log.warning("trainer token: %s typed %d wrong tokens; no token is tried from it for %.0f s",
                     who, failures, lock_s(failures))
-
-
-@dataclasses.dataclass
-class TokenAttempts:
-    """The wrong tokens of one browser (times in seconds of a monotonic clock).
-
-    Attributes:
-        failures: wrong tokens so far.
-        locked_until: no token is compared before this time.
-    """
-
-    failures: int = 0
-    locked_until: float = 0.0
-
-    def wait_s(self, now: float) -> float:
-        """Seconds until a token may be tried again (0: now)."""
-        return max(0.0, self.locked_until - now)
-
-    def failed(self, now: float, who: str, typed: str) -> None:
-        """A wrong token: count and log it; from the :data:`FREE_TRIES`-th on, lock for
-        :func:`lock_s` seconds."""
-        self.failures += 1
-        log_failure(who, self.failures, typed)
-        if self.failures >= FREE_TRIES:
-            self.locked_until = now + lock_s(self.failures)
-
-    def check(self, now: float) -> None:
-        """Raise :class:`TrainerTokenLocked` while this browser is locked out."""
-        wait = self.wait_s(now)
-        if wait > 0:
-            raise locked(wait)
