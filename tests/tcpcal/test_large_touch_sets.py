@@ -81,7 +81,7 @@ def touch_sets(draw: st.DrawFn) -> np.ndarray:
 @given(touch_sets())
 def test_large_path_equals_every_pair(rot: np.ndarray) -> None:
     exact = angle_extremes(rot)  # N <= 60: every pair (the Gram path of before)
-    fast = _angle_extremes_large(rot)  # the path used above EXACT_ANGLES_MAX_N touches
+    fast = _angle_extremes_large(rot)  # the exact O(N log N) search (the estimates' reference)
     lo, hi = brute_angles_deg(rot)
     # The every-pair path picks the closest pair by the Gram entry trace(R_a^T R_b) = 3 - angle^2
     # + ..., whose rounding (~6e-15) cannot tell apart pairs closer than ~8e-8 rad (4.4e-6 deg);
