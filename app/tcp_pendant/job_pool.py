@@ -42,10 +42,17 @@ process (measured: a TCP check's job pickles to 213 kB in 8 ms, unpickles in 3-1
 record's grading holds the gradebook's connection, which does not cross processes. With
 threads the loop measured well enough (``bench_jobs.py`` on 2 shared cores, one worker, 20
 attackers: the victim's jogs p95 44-57 ms, none dropped; its check p50 1.0-2.9x its time alone;
-with two workers no better: p50 0.98x, jogs p95 60 ms): the GIL is handed over every 5 ms, and
-the one-job-per-session rule with the rested-first order is what bounds the harm. The GIL's
-price is the hops of a callback to the loop while a worker is busy (a switch interval each):
-a process pool for the picklable jobs is the next step if that matters.
+with two workers no better: p50 0.98x, jogs p95 60 ms), and the one-job-per-session rule with
+the rested-first order is what bounds the harm. The GIL's price is the loop's hops while a
+worker is busy: each time the loop gives the GIL up (a select, a socket write) it waits for
+the worker's next forced switch, Python's switch interval (5 ms by default), so a callback of a
+few hops waits tens of ms. :func:`favour_the_event_loop` (the server calls it at start) sets
+the interval to :data:`LOOP_SWITCH_INTERVAL_S`. Measured with the rig of ``test_job_pool.py``
+(20 attackers, one worker, this 2-core machine), 5 ms against 1 ms: the victim's jogs p50 60
+against 8 ms, p95 183 against 17 ms; its check p50 86 against 36 ms (5.3x against 2.5x its
+time alone); the attackers' jobs then get about half as many runs (206 against 99 in the same
+time), the loop the rest. At 0.5 ms the switches themselves cost: an attacker's check ran 36
+against 25 ms. ``bench_jobs.py`` prints both intervals in one run.
 """
 
 from __future__ import annotations
@@ -54,7 +61,9 @@ import asyncio
 import concurrent.futures
 import heapq
 import itertools
+import math
 import os
+import sys
 import threading
 import time
 import weakref
@@ -63,7 +72,8 @@ from dataclasses import dataclass, field
 from typing import Any, TypeVar
 
 __all__ = ["BUSY_DELAY_S", "MAX_QUEUED", "REST_S", "JobPool", "JobRefused", "JobTiming", "PoolFull",
-           "SessionBusy", "default_pool", "default_workers"]
+           "LOOP_SWITCH_INTERVAL_S", "SessionBusy", "default_pool", "default_workers",
+           "favour_the_event_loop"]
 
 T = TypeVar("T")
 
@@ -73,6 +83,8 @@ BUSY_DELAY_S = 30.0
 """How much later than its submit time a busy session's job is queued (seconds)."""
 MAX_QUEUED = 32
 """Jobs of busy sessions that may wait; twice as many jobs in all."""
+LOOP_SWITCH_INTERVAL_S = 0.001
+"""Python's thread switch interval while the server runs (seconds; module docstring)."""
 
 
 class JobRefused(ValueError):
@@ -278,6 +290,17 @@ class JobPool:
             for t in threads:
                 if t is not threading.current_thread():
                     t.join()
+
+
+def favour_the_event_loop(interval_s: float = LOOP_SWITCH_INTERVAL_S) -> float:
+    """Let viser's event loop take the GIL back from a busy worker within ``interval_s``
+    (Python's switch interval, ``sys.setswitchinterval``; never raised above what it is).
+    Process-wide, as the GIL is. Returns the interval now in force (seconds)."""
+    if not (math.isfinite(interval_s) and interval_s > 0):
+        raise ValueError(f"The switch interval must be a positive number of seconds, got {interval_s!r}.")
+    if sys.getswitchinterval() > interval_s:
+        sys.setswitchinterval(interval_s)
+    return sys.getswitchinterval()
 
 
 _DEFAULT: JobPool | None = None

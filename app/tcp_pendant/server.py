@@ -34,6 +34,7 @@ from tcpcal.library import ToolLibrary
 from tcp_pendant import client_script, origin_check
 from tcp_pendant.calibrate import CalibrationWorkflow
 from tcp_pendant.addresses import network_urls
+from tcp_pendant import job_pool
 from tcp_pendant.job_pool import JobPool
 from tcp_pendant.classroom.class_room import ClassRoom
 from tcp_pendant.classroom.gradebook import Gradebook
@@ -570,6 +571,7 @@ class PendantApp:
         origin_check.enable()               # foreign web pages' websockets are refused (403)
         viser_adapter.install()             # every browser message checked before viser's handlers
         client_script.script_asset()        # the page's own script (keys, name, trainer URL): packaged?
+        job_pool.favour_the_event_loop()    # a busy job thread hands the GIL back to the loop within 1 ms
         with origin_check.starting():       # requests get 503 "starting" until mark_ready
             self._start_serving(host)
         return self.url
