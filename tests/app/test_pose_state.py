@@ -70,6 +70,26 @@ def test_quaternion_is_scipys_rotation() -> None:
         assert abs(w * w + x * x + y * y + z * z - 1.0) < 1e-12, i
 
 
+def test_quaternion_is_pinocchios_bit_for_bit_from_an_array_or_rows() -> None:
+    """The scene's quaternion repeats Eigen's float operations: the very numbers pinocchio gives,
+    in both of its branches (trace > 0, and each largest diagonal entry), from the matrix or its rows."""
+    import pinocchio as pin
+
+    mats = list(_rotations()) + list(Rotation.random(20000, random_state=5).as_matrix())
+    for axis in np.eye(3):                           # near the half turns: the trace <= 0 branches
+        mats += [Rotation.from_rotvec(a * axis).as_matrix() for a in (np.pi - 1e-9, 2.5, 2.0 * np.pi / 3.0)]
+    branches: set[object] = set()
+    for i, R in enumerate(mats):
+        x, y, z, w = pin.Quaternion(np.ascontiguousarray(R)).coeffs().tolist()
+        assert quaternion_wxyz(R) == [w, x, y, z], i
+        T = np.eye(4)
+        T[:3, :3] = R
+        assert quaternion_wxyz(T.tolist()) == [w, x, y, z], i
+        d = np.diag(R)
+        branches.add("trace" if R[0, 0] + (R[1, 1] + R[2, 2]) > 0.0 else int(np.argmax(d)))
+    assert branches == {"trace", 0, 1, 2}
+
+
 def test_quaternions_of_a_stack() -> None:
     R = _rotations()[:20]
     Q = quaternions_wxyz(R)
