@@ -3,6 +3,9 @@ poses the scene sends for a jog step chained back to the pose state's ``T_world_
 
 from __future__ import annotations
 
+import sys
+from pathlib import Path
+
 import numpy as np
 from scipy.spatial.transform import Rotation
 from tcp_pendant.views.scene import relative_poses
@@ -49,5 +52,60 @@ def test_the_scene_poses_chain_back_to_the_links_world_poses_after_jogs(app_fact
                     parent, state.T_world_links[row[parent]]) @ local[i]
                 np.testing.assert_allclose(world[name], state.T_world_links[row[name]], atol=1e-12)
             np.testing.assert_allclose(local[-1], state.T_world_tcp, atol=0)
+    finally:
+        client.close()
+
+
+def test_the_scene_queues_the_same_messages_as_the_code_it_replaced(app_factory, monkeypatch) -> None:
+    """``SceneView.on_change`` against its yardstick (``tests/bench/scene_yardstick.py``, the
+    code before the speed work) on the same change, from the same last sent poses: the same
+    messages (class, node, values bit for bit), none for an unchanged node, over the class's
+    0.1 mm steps, larger jogs, rotations and the gizmo forced after a drag."""
+    sys.path.insert(0, str(Path(__file__).parents[1] / "bench"))
+    from scene_yardstick import LegacyScenePoses
+
+    from tcp_pendant.session import SessionChange
+
+    app = app_factory()
+    client = DrainingClient(app.port)
+    try:
+        wait_until(lambda: len(app.sessions) == 1, what="session built")
+        (s,) = app.sessions.values()
+        scene = s.views["scene"]
+        legacy = LegacyScenePoses(scene)
+        ws = scene.gizmo._impl.api._websock_interface
+        queued: list[object] = []
+        real = ws.queue_message
+        monkeypatch.setattr(ws, "queue_message", lambda m: (queued.append(m), real(m))[1])
+
+        def messages(fn: object, change: SessionChange) -> list[tuple[object, ...]]:
+            queued.clear()
+            fn(change)                                    # type: ignore[operator]
+            return [(type(m).__name__, m.name, getattr(m, "wxyz", None), getattr(m, "position", None))
+                    for m in queued if type(m).__name__ in ("SetOrientationMessage", "SetPositionMessage")]
+
+        moves = [("X", 0.1)] * 6 + [("X", -0.1)] * 3 + [("Z", 2.0), ("Y", -5.0), ("A", 3.0), ("C", -0.1),
+                                                           ("X", 0.0)]
+        counts = []
+        for axis, amount in moves:
+            with s.lock:
+                assert s.controller.jog_cartesian("WORLD", axis, amount).ok
+                change = SessionChange(pose=True, state=s.pose_state())
+                legacy.take_sent()
+                old = messages(legacy.on_change, change)
+                new = messages(scene.on_change, change)
+                assert new == old, (axis, amount)
+                assert messages(scene.on_change, change) == []     # nothing moved since
+                counts.append(len(new))
+        assert min(counts[:-1]) >= 2 and counts[-1] == 0           # every step moved links and the gizmo
+        with s.lock:                                               # the gizmo after a drag: always resent
+            legacy.take_sent()
+            queued.clear()
+            legacy.send(legacy._local_poses(s.pose_state()), force=(scene._gizmo_row,))
+            old = [(type(m).__name__, m.name) for m in queued]
+            queued.clear()
+            scene._snap_gizmo()
+            assert [(type(m).__name__, m.name) for m in queued] == old == [
+                ("SetOrientationMessage", "/tcp_gizmo"), ("SetPositionMessage", "/tcp_gizmo")]
     finally:
         client.close()

@@ -55,6 +55,38 @@ def test_pose_fast_path_is_taken(server) -> None:
     np.testing.assert_allclose(frame.position, [0.4, 0.5, 0.6])
 
 
+def test_the_pose_fast_path_queues_what_the_public_setters_queue(server, monkeypatch) -> None:
+    """Message class, node, values, owner, wire form and redundancy key (cached by the fast path
+    from a node's first message on) are the public setters' own, for two nodes interleaved."""
+    from tcp_pendant.views.viser_adapter import queue_pose
+
+    frames = [server.scene.add_frame(name, show_axes=False) for name in ("/g", "/g/h")]
+    ws = frames[0]._impl.api._websock_interface
+    queued: list[object] = []
+    real = ws.queue_message
+    monkeypatch.setattr(ws, "queue_message", lambda m: (queued.append(m), real(m))[1])
+    rng = np.random.default_rng(3)
+    for _ in range(3):
+        for f in frames:
+            for fast in (False, True):
+                wxyz = rng.normal(size=4)
+                wxyz = (wxyz / np.linalg.norm(wxyz)).tolist()
+                xyz = rng.normal(size=3).tolist()
+                if fast:
+                    assert queue_pose(f, wxyz, xyz)
+                else:
+                    f.wxyz, f.position = wxyz, xyz
+                np.testing.assert_array_equal(f.wxyz, wxyz)
+                np.testing.assert_array_equal(f.position, xyz)
+                *_, orientation, position = queued
+                assert (orientation.wxyz, position.position) == (tuple(wxyz), tuple(xyz))
+    assert len(queued) == 3 * 2 * 2 * 2
+    for public, fast in zip(queued[0::4] + queued[1::4], queued[2::4] + queued[3::4]):
+        assert type(fast) is type(public) and fast.name == public.name and fast.owner == public.owner
+        assert fast.redundancy_key() == public.redundancy_key()
+        assert set(fast.as_serializable_dict()) == set(public.as_serializable_dict())
+
+
 def test_upload_hook_is_taken(server) -> None:
     button = server.gui.add_upload_button("Load")
     assert limit_upload_size(button, 1000, lambda name, size: None) is True

@@ -95,6 +95,14 @@ def relative_poses(T_world_parent: np.ndarray, T_world_child: np.ndarray,
     return out
 
 
+def _as_slice(rows: np.ndarray) -> slice | np.ndarray:
+    """``rows`` as the slice ``a:b`` when they are ``a, a+1, ..., b-1`` (indexing with it gives a
+    view, not a copy), else ``rows`` itself."""
+    if len(rows) and np.array_equal(rows, np.arange(rows[0], rows[0] + len(rows))):
+        return slice(int(rows[0]), int(rows[0]) + len(rows))
+    return rows
+
+
 def link_tree_paths(urdf_path: Any, links: tuple[str, ...] | list[str]) -> dict[str, tuple[str, str | None]]:
     """Scene path and parent link of every link, nested like the URDF's link tree.
 
@@ -173,22 +181,20 @@ class PoseSender:
         for i in skip:
             moved[i] = [False] * 4
         n = 0
-        xyz: list[list[float]] | None = None
         for i, (c0, c1, c2, p) in enumerate(moved):
             r = c0 or c1 or c2
             if not (r or p):
                 continue
+            rows = T[i].tolist()                  # the node's pose as floats, one call
             sent = self._sent[i]
-            wxyz = None
-            if r:
-                R = T[i, :3, :3]
-                wxyz = quaternion_wxyz(R)
-                sent[:3, :3] = R
-            if p and xyz is None:
-                xyz = T[:, :3, 3].tolist()                  # every node's position in one call
-            n += _set_pose(self.handles[i], wxyz, xyz[i] if p and xyz is not None else None)
-            if p:
+            if r and p:
+                sent[:3] = T[i, :3]
+            elif r:
+                sent[:3, :3] = T[i, :3, :3]
+            else:
                 sent[:3, 3] = T[i, :3, 3]
+            n += _set_pose(self.handles[i], quaternion_wxyz(rows) if r else None,
+                           [rows[0][3], rows[1][3], rows[2][3]] if p else None)
         return n
 
 
@@ -311,6 +317,8 @@ class SceneView:
         self._moving = [n for n in tree if n != k.base_link]
         self._index_names: tuple[str, ...] = ()
         self._child_idx = self._parent_idx = self._out_rows = np.zeros(0, dtype=int)
+        self._parent_rows: slice | np.ndarray = self._parent_idx
+        self._child_rows: slice | np.ndarray = self._child_idx
         self._root_rows: list[tuple[int, int]] = []          # (row, link index) of links without a parent
         self._contiguous = True
         self._local_out = np.zeros((0, 4, 4))
@@ -381,7 +389,9 @@ class SceneView:
         """(N+1,4,4): ``T_parent_link`` of the moving links (``T_world_link`` for a link
         without a parent), then ``T_world_tcp`` (the gizmo), from one pose state
         (:func:`relative_poses`, batched into a buffer reused by the next call:
-        :class:`PoseSender` copies what it sends)."""
+        :class:`PoseSender` copies what it sends). Parent and child rows that are runs of
+        consecutive links (a serial arm in pinocchio's order: parent = child - 1) are read as
+        slices, views of the state's stacked poses, instead of fancy-indexed copies."""
         if state.link_names != self._index_names:             # index rows once per link list
             row = {n: i for i, n in enumerate(state.link_names)}
             with_parent = [i for i, n in enumerate(self._moving) if self._parent[n] is not None]
@@ -389,14 +399,16 @@ class SceneView:
             self._child_idx = np.array([row[self._moving[i]] for i in with_parent], dtype=int)
             self._parent_idx = np.array([row[cast(str, self._parent[self._moving[i]])] for i in with_parent],
                                         dtype=int)
+            self._parent_rows = _as_slice(self._parent_idx)
+            self._child_rows = _as_slice(self._child_idx)
             self._root_rows = [(i, row[n]) for i, n in enumerate(self._moving) if self._parent[n] is None]
             self._contiguous = with_parent == list(range(len(with_parent)))
             self._local_out = np.zeros((len(self._moving) + 1, 4, 4))
             self._index_names = state.link_names
         out = self._local_out
         W = state.T_world_links
-        P = W[self._parent_idx]
-        C = W[self._child_idx]
+        P = W[self._parent_rows]
+        C = W[self._child_rows]
         if self._contiguous:                                  # a tree without loose links: in place
             relative_poses(P, C, out=out[:len(self._child_idx)])
         else:

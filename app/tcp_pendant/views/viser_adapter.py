@@ -8,7 +8,9 @@ network. What this module reaches into, and why:
   ``GuiUpdateMessage`` itself (``handle._impl``, ``gui_api._websock_interface``), skipping the
   public setter's per-call typing machinery; :func:`queue_pose` writes a scene node's
   ``wxyz`` / ``position`` and queues ``SetOrientationMessage`` / ``SetPositionMessage``
-  (``api._queue_scene_message``). Each returns False when viser's internals differ, and the
+  stamped with the scene's ``_owner_id`` as ``api._queue_scene_message`` does, on
+  ``api._websock_interface``, their ``_cached_redundancy_key`` set from viser's own
+  ``redundancy_key`` of the node's first message. Each returns False when viser's internals differ, and the
   caller then uses the public setter. Which path ran is counted (:func:`path_counts`); the first
   fallback of each path logs a warning, and with ``TCP_PENDANT_STRICT_VISER=1`` in the
   environment (the tests' flag) a fallback raises :class:`ViserInternalsChanged` instead.
@@ -42,7 +44,9 @@ Moving viser up a minor version: run ``tests/security`` and ``tests/app/test_vis
 (their conftest sets ``TCP_PENDANT_STRICT_VISER=1``: a fallback fails the test), then re-read in
 viser's source each name used here: ``_GuiHandleState`` (``uuid``, ``value``, ``props``,
 ``removed``, ``gui_api``), ``GuiApi._gui_input_handle_from_uuid`` /
-``_current_file_upload_states`` / ``_websock_interface``, ``SceneApi._queue_scene_message``,
+``_current_file_upload_states`` / ``_websock_interface``, ``SceneApi._queue_scene_message`` (what
+it stamps: ``_owner_id``) / ``_websock_interface``, ``Message.redundancy_key`` (its
+``_cached_redundancy_key``),
 the scene handle's ``_impl`` (``name``, ``wxyz``, ``position``, ``api``),
 ``WebsockMessageHandler._handle_incoming_message`` / ``_incoming_handlers``,
 ``infra._infra._message_consumer`` (its signature and its ``deserialize`` call), the message
@@ -64,7 +68,7 @@ import typing
 import weakref
 from collections import Counter
 from collections.abc import Callable
-from typing import Any
+from typing import Any, cast
 
 import msgspec
 
@@ -161,23 +165,54 @@ def queue_markdown(handle: Any, text: str) -> bool:
     return _fast("markdown")
 
 
+try:
+    from viser import _messages as _viser_messages
+except ImportError:                     # queue_pose falls back to the public setters
+    _viser_messages = None
+
+_POSE_KEYS_MAX = 4096
+_pose_keys: dict[tuple[type, str, str], str] = {}
+"""viser's redundancy key of a pose message, by (message class, node name, owner): computed by
+viser's own ``Message.redundancy_key`` for the first message of each, then handed to the next
+ones (it depends on the node and the message class only, never on the pose)."""
+
+
+def _pose_message(cls: Any, name: str, value: tuple[float, ...], owner: str) -> Any:
+    """A ``SetOrientationMessage`` / ``SetPositionMessage`` stamped with its scene's ``owner``
+    (as ``SceneApi._queue_scene_message`` stamps it), its redundancy key already cached (viser
+    caches it in ``_cached_redundancy_key`` the first time it asks: here it is not rebuilt per
+    message)."""
+    msg = cls(name, value)
+    msg.owner = owner
+    k = (cls, name, owner)
+    key = _pose_keys.get(k)
+    if key is None:
+        if len(_pose_keys) >= _POSE_KEYS_MAX:
+            _pose_keys.clear()
+        _pose_keys[k] = msg.redundancy_key()
+    else:
+        object.__setattr__(msg, "_cached_redundancy_key", key)
+    return msg
+
+
 def queue_pose(handle: Any, wxyz: list[float] | None, xyz: list[float] | None) -> bool:
     """Set a scene node's orientation (``wxyz``) and/or position (``xyz``, metres) and queue
-    viser's ``SetOrientationMessage`` / ``SetPositionMessage`` without its public setters.
+    viser's ``SetOrientationMessage`` / ``SetPositionMessage`` without its public setters: the
+    messages ``SceneApi._queue_scene_message`` would queue (owner stamped), put on the scene's
+    ``_websock_interface`` directly, with their redundancy key cached (:func:`_pose_message`).
     Returns False when the caller must use ``handle.wxyz`` / ``handle.position``."""
     try:
-        from viser import _messages
-
+        messages = cast(Any, _viser_messages)             # None (AttributeError below): viser differs
         impl = handle._impl
         api = impl.api
+        owner = api._owner_id
+        queue = api._websock_interface.queue_message
         if wxyz is not None:
             impl.wxyz[:] = wxyz
-            api._queue_scene_message(_messages.SetOrientationMessage(
-                impl.name, typing.cast("tuple[float, float, float, float]", tuple(wxyz))))
+            queue(_pose_message(messages.SetOrientationMessage, impl.name, tuple(wxyz), owner))
         if xyz is not None:
             impl.position[:] = xyz
-            api._queue_scene_message(_messages.SetPositionMessage(
-                impl.name, typing.cast("tuple[float, float, float]", tuple(xyz))))
+            queue(_pose_message(messages.SetPositionMessage, impl.name, tuple(xyz), owner))
     except (AttributeError, ImportError) as exc:
         return _fallback("pose", exc)
     return _fast("pose")
