@@ -138,6 +138,74 @@ def test_pose_state_equals_the_controllers_own_answers(controller: VirtualContro
         pose_state(c).readout("TOOL")
 
 
+def _yardstick():
+    sys.path.insert(0, str(Path(__file__).parents[1] / "bench"))
+    import scene_yardstick
+
+    return scene_yardstick
+
+
+def test_pose_state_is_the_code_it_replaced_bit_for_bit(controller: VirtualController, kr6) -> None:
+    """Every field equal to the yardstick's (``tests/bench/scene_yardstick.py``, the code before
+    the speed work): the same numbers, not close ones; with tool data, BASE, another tool, and a
+    physical robot that differs from the model."""
+    legacy_pose_state = _yardstick().legacy_pose_state
+    c = controller
+    perturbed = kr6.own_copy()
+    perturbed.model = kr6.model.copy()
+    perturbed.model.jointPlacements[2].translation += np.array([0.0005, -0.0003, 0.0002])
+    perturbed.data = perturbed.model.createData()
+    for setup in range(3):
+        if setup == 1:
+            c.set_active_tool(Tool(name="bent", tcp_mm=(20.0, -5.0, 150.0), abc_deg=(10.0, -60.0, 5.0)))
+            T_base = np.eye(4)
+            T_base[:3, 3] = [0.4, -0.2, 0.1]
+            c.set_T_world_base(T_base)
+            c.mount_tool(builtin_tools()["torch"])
+        if setup == 2:
+            c.set_true_kinematics(perturbed)
+        for q in _configurations(c, 6):
+            c.set_q(q)
+            new, old = pose_state(c), legacy_pose_state(c)
+            assert new.key == old.key and new.link_names == old.link_names
+            for f in ("q_rad", "T_world_links", "T_world_flange", "T_world_tcp", "T_world_tool_true", "T_world_base"):
+                np.testing.assert_array_equal(getattr(new, f), getattr(old, f), err_msg=f)
+            assert list(new.T_world_link) == list(old.T_world_link)
+            for name in old.T_world_link:
+                np.testing.assert_array_equal(new.T_world_link[name], old.T_world_link[name])
+            assert not new.T_world_links.flags.writeable
+            assert not new.T_world_link[new.link_names[0]].flags.writeable
+            assert list(new.joint_angles_deg.items()) == list(old.joint_angles_deg.items())
+            assert new.touch == old.touch
+            assert new.readout("BASE") == old.readout("BASE")
+
+
+def test_touch_geometry_is_the_code_it_replaced_bit_for_bit_at_the_crash_zone_edges() -> None:
+    """Random true TOOL poses with the reference tip all around the TCP, many of them at the
+    crash zone's edges (2 mm radius, 20 mm depth) and the touch tolerance: the yardstick's
+    numbers and verdicts."""
+    from tcp_pendant.controller.touch import touch_geometry
+
+    legacy = _yardstick().legacy_touch_geometry
+    rng = np.random.default_rng(12)
+    Rs = Rotation.random(3000, random_state=13).as_matrix()
+    crashed = inside = 0
+    for i, R in enumerate(Rs):
+        T = np.eye(4)
+        T[:3, :3] = R
+        T[:3, 3] = rng.uniform(-0.8, 0.8, 3)
+        depth = rng.choice([rng.uniform(-1.0, 25.0), 20.0, 0.5, rng.uniform(19.9, 20.1)])
+        rho = rng.choice([rng.uniform(0.0, 3.0), 2.0, rng.uniform(1.99, 2.01), 0.0])
+        phi = rng.uniform(0.0, 2.0 * np.pi)
+        u_mm = np.array([-depth, rho * np.cos(phi), rho * np.sin(phi)]) * rng.choice([1.0, 1.0, 30.0])
+        tip = T[:3, 3] + R @ (u_mm / 1000.0)
+        new, old = touch_geometry(T, tip), legacy(T, tip)
+        assert new == old, (i, new, old)
+        crashed += new.crashed
+        inside += new.penetration_mm > 0.0
+    assert crashed > 100 and inside > crashed                   # the zone and its edges were exercised
+
+
 def test_pose_state_key_follows_every_input(controller: VirtualController) -> None:
     c = controller
     keys = [pose_state_key(c)]

@@ -9,8 +9,9 @@ server (``PendantApp``), each with a headless websocket client (``tests/app/wscl
 threads of this process draining what the server sends; their CPU is not counted: thread CPU of
 the stepping thread only). Timed per step with ``time.thread_time_ns``:
 
-* pose state: ``Session.pose_state``'s one computation of the change's
-  ``controller.pose_state.pose_state`` (link poses, TCP, true TCP, joint angles, touch geometry);
+* pose state: ``Session.pose_state`` (its key, its cache, and the one computation per change of
+  ``controller.pose_state.pose_state``: link poses, TCP, true TCP, joint angles, touch geometry;
+  the old or the new function, switched untimed);
 * scene: the scene's subscriber to the change signal, ``SceneView.on_change`` (reference tip
   and beam stand checks, ``_local_poses``, ``PoseSender.send`` with the viser messages it queues).
 
@@ -69,15 +70,18 @@ def main(argv: list[str] | None = None) -> int:
         mode = ["new"]
         acc = {p: 0 for p in PARTS}
 
-        def timed_pose_state(controller: Any, key: Any = None) -> Any:
-            fn = legacy_pose_state if mode[0] == "old" else new_pose_state
-            t0 = time.thread_time_ns()
-            try:
-                return fn(controller, key)
-            finally:
-                acc["pose state"] += time.thread_time_ns() - t0
+        def switched_pose_state(controller: Any, key: Any = None) -> Any:
+            return (legacy_pose_state if mode[0] == "old" else new_pose_state)(controller, key)
 
-        session_module.pose_state = timed_pose_state  # type: ignore[assignment]
+        session_module.pose_state = switched_pose_state  # type: ignore[assignment]
+        for s in sessions:
+            def timed_pose_state(real: Callable[[], Any] = s.pose_state) -> Any:
+                t0 = time.thread_time_ns()
+                try:
+                    return real()
+                finally:
+                    acc["pose state"] += time.thread_time_ns() - t0
+            s.pose_state = timed_pose_state  # type: ignore[method-assign]
         legacies: list[LegacyScenePoses] = []
         for s in sessions:
             with s.lock:
@@ -156,6 +160,8 @@ def main(argv: list[str] | None = None) -> int:
             f"{results['new'][r]['scene'] + results['new'][r]['pose state']:.1f}" for r in range(rounds)))
     finally:
         session_module.pose_state = real_pose_state  # type: ignore[assignment]
+        for s in list(app.sessions.values()):
+            s.__dict__.pop("pose_state", None)
         for c in clients:
             c.close()
         app.stop()

@@ -6,7 +6,8 @@ messages, and build the same pose state).
 dict of ``.homogeneous`` per link, stacked, a dict of views, numpy touch geometry);
 :class:`LegacyScenePoses` is ``SceneView.on_change`` with its ``_local_poses`` (fancy-indexed
 parent and child rows, ``relative_poses``) and ``PoseSender.send`` (a pinocchio quaternion per
-moved node, viser's messages through ``_queue_scene_message``) as they were. Not used by the app.
+moved node, viser's messages through ``_queue_scene_message``) as they were, its default beam
+sensor lookup's ``np.array_equal`` of the reference tip included. Not used by the app.
 """
 
 from __future__ import annotations
@@ -121,6 +122,7 @@ class LegacyScenePoses:
         self._index_names: tuple[str, ...] = ()
         self._moving = list(scene._moving)
         self._parent = dict(scene._parent)
+        self._beam_tip = scene.session.controller.reference_tip_world_m
 
     def take_sent(self) -> None:
         """Start from what the app's sender sent last."""
@@ -136,7 +138,10 @@ class LegacyScenePoses:
             sv.reconcile_tools()
         if sv.session.controller.reference_tip_world_m.tobytes() != sv._shown_tip_bytes:
             sv.update_reference_tip()
-        sv.beam_stand.show(sv.session.controller.beam_sensor)
+        c = sv.session.controller
+        if not np.array_equal(self._beam_tip, c._tip):     # the old lookup's compare (then the new one's)
+            self._beam_tip = c._tip.copy()
+        sv.beam_stand.show(c.beam_sensor)
         film = sv.player
         sv._step_aside(film is not None and film.playing)
         if change.pose and change.state is not None:

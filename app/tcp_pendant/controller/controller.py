@@ -120,7 +120,7 @@ class VirtualController:
             reference_tip_world_m = (p[0], p[1], 0.5 * p[2])
         self._tip = _check_point(reference_tip_world_m, "reference_tip_world_m")
         self._beam: BeamSensor | None = None  # None: default_beam_sensor(reference tip)
-        self._default_beam: tuple[np.ndarray, BeamSensor] | None = None  # (tip, its default sensor)
+        self._default_beam: tuple[bytes, BeamSensor] | None = None  # (tip's bytes, its default sensor)
         self._beam_device = BeamDevice()  # the default sensor's width, repeatability, crossing
 
     # ----------------------------------------------------------------- state
@@ -243,8 +243,9 @@ class VirtualController:
         that is moved). The same object until it changes (views may compare by identity)."""
         if self._beam is not None:
             return self._beam
-        if self._default_beam is None or not np.array_equal(self._default_beam[0], self._tip):
-            self._default_beam = (self._tip.copy(), default_beam_sensor(self._tip, self._beam_device))
+        tip = self._tip.tobytes()     # the scene asks every jog step: a bytes compare, not array_equal
+        if self._default_beam is None or self._default_beam[0] != tip:
+            self._default_beam = (tip, default_beam_sensor(self._tip, self._beam_device))
         return self._default_beam[1]
 
     @property
