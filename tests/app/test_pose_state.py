@@ -167,7 +167,8 @@ def test_pose_state_is_the_code_it_replaced_bit_for_bit(controller: VirtualContr
         for q in _configurations(c, 6):
             c.set_q(q)
             new, old = pose_state(c), legacy_pose_state(c)
-            assert new.key == old.key and new.link_names == old.link_names
+            assert new.key == old.key == _yardstick().legacy_pose_state_key(c) == pose_state_key(c)
+            assert new.link_names == old.link_names
             for f in ("q_rad", "T_world_links", "T_world_flange", "T_world_tcp", "T_world_tool_true", "T_world_base"):
                 np.testing.assert_array_equal(getattr(new, f), getattr(old, f), err_msg=f)
             assert list(new.T_world_link) == list(old.T_world_link)

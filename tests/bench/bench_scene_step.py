@@ -39,11 +39,12 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(HERE.parent / "app"))
 
-from scene_yardstick import LegacyScenePoses, legacy_pose_state  # noqa: E402
+from scene_yardstick import LegacyScenePoses, legacy_pose_state, legacy_pose_state_key  # noqa: E402
 from wsclient import DrainingClient, wait_until  # noqa: E402
 
 import tcp_pendant.session as session_module  # noqa: E402
 from tcp_pendant.controller.pose_state import pose_state as new_pose_state  # noqa: E402
+from tcp_pendant.controller.pose_state import pose_state_key as new_pose_state_key  # noqa: E402
 from tcp_pendant.server import AppConfig, PendantApp  # noqa: E402
 
 PARTS = ("pose state", "scene")
@@ -62,7 +63,7 @@ def main(argv: list[str] | None = None) -> int:
     app = PendantApp(AppConfig(port=0, tool_library=tmp / "tools.json"))
     app.start()
     clients: list[DrainingClient] = []
-    real_pose_state = session_module.pose_state
+    real_pose_state, real_key = session_module.pose_state, session_module.pose_state_key
     try:
         clients = [DrainingClient(app.port) for _ in range(n)]
         wait_until(lambda: len(app.sessions) == n, timeout=120, what=f"{n} sessions")
@@ -73,7 +74,11 @@ def main(argv: list[str] | None = None) -> int:
         def switched_pose_state(controller: Any, key: Any = None) -> Any:
             return (legacy_pose_state if mode[0] == "old" else new_pose_state)(controller, key)
 
+        def switched_key(controller: Any) -> Any:
+            return (legacy_pose_state_key if mode[0] == "old" else new_pose_state_key)(controller)
+
         session_module.pose_state = switched_pose_state  # type: ignore[assignment]
+        session_module.pose_state_key = switched_key  # type: ignore[assignment]
         for s in sessions:
             def timed_pose_state(real: Callable[[], Any] = s.pose_state) -> Any:
                 t0 = time.thread_time_ns()
@@ -160,6 +165,7 @@ def main(argv: list[str] | None = None) -> int:
             f"{results['new'][r]['scene'] + results['new'][r]['pose state']:.1f}" for r in range(rounds)))
     finally:
         session_module.pose_state = real_pose_state  # type: ignore[assignment]
+        session_module.pose_state_key = real_key  # type: ignore[assignment]
         for s in list(app.sessions.values()):
             s.__dict__.pop("pose_state", None)
         for c in clients:

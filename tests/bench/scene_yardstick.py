@@ -3,7 +3,8 @@ the yardstick of ``bench_scene_step.py`` (the new code must send the same poses,
 messages, and build the same pose state).
 
 ``legacy_pose_state`` is ``tcp_pendant.controller.pose_state.pose_state`` of that version (a
-dict of ``.homogeneous`` per link, stacked, a dict of views, numpy touch geometry);
+dict of ``.homogeneous`` per link, stacked, a dict of views, numpy touch geometry) and
+``legacy_pose_state_key`` its key (through the controller's copying properties);
 :class:`LegacyScenePoses` is ``SceneView.on_change`` with its ``_local_poses`` (fancy-indexed
 parent and child rows, ``relative_poses``) and ``PoseSender.send`` (a pinocchio quaternion per
 moved node, viser's messages through ``_queue_scene_message``) as they were, its default beam
@@ -20,7 +21,7 @@ import numpy as np
 import pinocchio as pin
 
 from tcp_pendant.controller.controller import VirtualController
-from tcp_pendant.controller.pose_state import PoseState, pose_state_key
+from tcp_pendant.controller.pose_state import PoseState
 from tcp_pendant.controller.touch import (
     CRASH_DEPTH_MM,
     CRASH_RADIUS_MM,
@@ -29,7 +30,8 @@ from tcp_pendant.controller.touch import (
     TouchGeometry,
 )
 
-__all__ = ["LegacyScenePoses", "legacy_pose_state", "legacy_quaternion_wxyz", "legacy_touch_geometry"]
+__all__ = ["LegacyScenePoses", "legacy_pose_state", "legacy_pose_state_key", "legacy_quaternion_wxyz",
+           "legacy_touch_geometry"]
 
 POSE_EPS = 1e-6
 
@@ -43,6 +45,12 @@ def legacy_touch_geometry(T_world_tooltrue: np.ndarray, tip_world_m: np.ndarray)
     penetration = depth if (depth > 0.0 and rho <= CRASH_RADIUS_MM and depth <= CRASH_ZONE_DEPTH_MM) else 0.0
     return TouchGeometry(distance_mm=distance, touching=distance <= TOUCH_TOLERANCE_MM,
                          crashed=penetration > CRASH_DEPTH_MM, penetration_mm=penetration)
+
+
+def legacy_pose_state_key(controller: VirtualController) -> tuple[object, ...]:
+    c = controller
+    return (id(c.kinematics), c.q_rad.tobytes(), c.T_flange_tool.tobytes(), id(c.mounted_tool),
+            c.reference_tip_world_m.tobytes(), c.T_world_base.tobytes(), id(c.true_kinematics))
 
 
 def legacy_pose_state(controller: VirtualController, key: tuple[object, ...] | None = None) -> PoseState:
@@ -65,7 +73,7 @@ def legacy_pose_state(controller: VirtualController, key: tuple[object, ...] | N
     for T in (T_world_tcp, T_world_true):
         T.setflags(write=False)
     return PoseState(
-        key=pose_state_key(c) if key is None else key,
+        key=legacy_pose_state_key(c) if key is None else key,
         q_rad=q,
         link_names=names,
         T_world_links=stacked,

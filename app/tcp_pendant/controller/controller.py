@@ -311,6 +311,13 @@ class VirtualController:
         """``T_world_link`` for every robot link (scene updates)."""
         return self.kinematics.link_poses(self._q)
 
+    def pose_state_key(self) -> tuple[object, ...]:
+        """What the robot's pose state depends on (``pose_state.pose_state_key``): the robot
+        model, joint angles, active tool data, mounted tool, reference tip, BASE frame and the
+        physical robot, read without the copies the properties make (a jog step asks once)."""
+        return (id(self.kinematics), self._q.tobytes(), self._T_flange_tool.tobytes(), id(self._tool),
+                self._tip.tobytes(), self._T_world_base.tobytes(), id(self._true_kin))
+
     # ----------------------------------------------------------------- jogging
     def jog_joint(self, index: int, delta_deg: float) -> JogResult:
         """Turn one axis by ``delta_deg`` degrees (mm for a prismatic joint), clamped at its limit.

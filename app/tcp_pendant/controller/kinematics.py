@@ -203,6 +203,10 @@ class RobotKinematics:
         self.revolute = np.array([re.search(r"Prismatic|JointModelP[XYZ]$", j.shortname()) is None
                                   for j, _ in actuated], dtype=bool)
         """True for revolute joints (radians), False for prismatic ones (metres)."""
+        self.readout_scales: tuple[float, ...] = tuple(180.0 / math.pi if r else 1000.0
+                                                       for r in self.revolute.tolist())
+        """Per joint, readout units per joint unit: degrees per radian (revolute; ``math.degrees(v)``
+        is ``v * (180 / pi)``, the same numbers), mm per metre (prismatic)."""
 
     @property
     def description(self) -> RobotDescription:

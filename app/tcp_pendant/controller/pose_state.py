@@ -20,7 +20,6 @@ No viser.
 
 from __future__ import annotations
 
-import math
 import operator
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
@@ -29,7 +28,6 @@ from typing import cast
 import numpy as np
 
 from tcp_pendant.controller.controller import VirtualController
-from tcp_pendant.controller.kinematics import RobotKinematics
 from tcp_pendant.controller.readout import PoseReadout, readout_in_frame
 from tcp_pendant.controller.touch import TouchGeometry, touch_geometry
 
@@ -86,13 +84,7 @@ def pose_state_key(controller: VirtualController) -> tuple[object, ...]:
     """What a :class:`PoseState` depends on: joint angles, active tool data, mounted tool,
     reference tip, BASE frame and the robot model (nominal first, the physical robot last).
     Equal keys, equal states."""
-    c = controller
-    return (id(c.kinematics), c.q_rad.tobytes(), c.T_flange_tool.tobytes(), id(c.mounted_tool),
-            c.reference_tip_world_m.tobytes(), c.T_world_base.tobytes(), id(c.true_kinematics))
-
-
-_RAD_TO_DEG = 180.0 / math.pi
-"""``math.degrees(v)`` is ``v * (180 / pi)`` (CPython's ``radToDeg``): the same numbers."""
+    return controller.pose_state_key()
 
 
 class LinkPoses(Mapping[str, np.ndarray]):
@@ -115,11 +107,6 @@ class LinkPoses(Mapping[str, np.ndarray]):
         return len(self._rows)
 
 
-def _joint_scales(k: RobotKinematics) -> list[float]:
-    """Per joint, the factor of its readout: degrees per radian (revolute), mm per m (prismatic)."""
-    return [_RAD_TO_DEG if revolute else 1000.0 for revolute in k.revolute.tolist()]
-
-
 def pose_state(controller: VirtualController, key: tuple[object, ...] | None = None) -> PoseState:
     """Compute the :class:`PoseState` of ``controller`` (one pinocchio FK pass).
 
@@ -137,7 +124,7 @@ def pose_state(controller: VirtualController, key: tuple[object, ...] | None = N
     T_world_tcp = T_world_flange @ c.T_flange_tool
     T_true_flange = T_world_flange if c.true_kinematics is k else c.T_world_flange_true()
     T_world_true = T_true_flange @ c.mounted_tool.T_flange_tool_true
-    angles = dict(zip(k.joint_names, map(operator.mul, q.tolist(), _joint_scales(k))))
+    angles = dict(zip(k.joint_names, map(operator.mul, q.tolist(), k.readout_scales)))
     for T in (T_world_tcp, T_world_true):
         T.setflags(write=False)
     return PoseState(
