@@ -82,15 +82,19 @@ def wxyz_xyz(T: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def relative_poses(T_world_parent: np.ndarray, T_world_child: np.ndarray,
-                   out: np.ndarray | None = None) -> np.ndarray:
+                   out: np.ndarray | None = None, work: np.ndarray | None = None) -> np.ndarray:
     """``T_parent_child = inv(T_world_parent) @ T_world_child`` for stacks (N,4,4) of rigid
-    poses (``R_p^T R_c``, ``R_p^T (p_c - p_p)``), written into ``out`` ((N,4,4), e.g. a view of a
-    buffer reused every jog step) when given, else into a new array."""
+    poses: ``R_p^T [R_c | p_c - p_p]`` in one product, written into ``out`` ((N,4,4), e.g. a
+    view of a buffer reused every jog step) when given, else into a new array; ``work`` is an
+    (N,3,4) scratch buffer for ``[R_c | p_c - p_p]`` (the caller's, reused; else a new one)."""
     if out is None:
         out = np.empty_like(T_world_child)
-    Rp_T = T_world_parent[:, :3, :3].transpose(0, 2, 1)
-    np.matmul(Rp_T, T_world_child[:, :3, :3], out=out[:, :3, :3])
-    np.matmul(Rp_T, (T_world_child[:, :3, 3] - T_world_parent[:, :3, 3])[..., None], out=out[:, :3, 3:])
+    if work is None:
+        work = np.empty((len(T_world_child), 3, 4))
+    np.copyto(work, T_world_child[:, :3, :])
+    offset = work[:, :, 3]
+    np.subtract(offset, T_world_parent[:, :3, 3], out=offset)
+    np.matmul(T_world_parent[:, :3, :3].transpose(0, 2, 1), work, out=out[:, :3, :])
     out[:, 3, :] = (0.0, 0.0, 0.0, 1.0)
     return out
 
@@ -157,6 +161,7 @@ class PoseSender:
     def __init__(self, handles: list[Any], T_parent_node: np.ndarray) -> None:
         self.handles = list(handles)
         self._sent = np.array(T_parent_node, dtype=float).reshape(len(self.handles), 4, 4)
+        self._sent_rows = self._sent[:, :3, :]            # the compared part (a view, made once)
         self._diff = np.empty((len(self.handles), 3, 4))
 
     def send(self, T_parent_node: np.ndarray, *, skip: tuple[int, ...] = (), force: tuple[int, ...] = ()) -> int:
@@ -172,7 +177,7 @@ class PoseSender:
         """
         T = np.asarray(T_parent_node, dtype=float)
         d = self._diff
-        np.subtract(T[:, :3, :], self._sent[:, :3, :], out=d)
+        np.subtract(T[:, :3, :], self._sent_rows, out=d)
         np.abs(d, out=d)
         # per node and column: did any entry move? columns 0-2 are the rotation, 3 the position
         moved = cast("list[list[bool]]", (d > POSE_EPS).any(axis=1).tolist())
@@ -322,6 +327,7 @@ class SceneView:
         self._root_rows: list[tuple[int, int]] = []          # (row, link index) of links without a parent
         self._contiguous = True
         self._local_out = np.zeros((0, 4, 4))
+        self._local_work = np.zeros((0, 3, 4))
         T_local = self._local_poses(state)
         local = {n: T_local[i] for i, n in enumerate(self._moving)}
         for name, (path, _) in tree.items():
@@ -367,9 +373,10 @@ class SceneView:
         links and the gizmo (``pose``), from the session's state."""
         if change.tool:
             self.reconcile_tools()
-        if self.session.controller.reference_tip_world_m.tobytes() != self._shown_tip_bytes:
+        c = self.session.controller
+        if c.reference_tip_world_m.tobytes() != self._shown_tip_bytes:
             self.update_reference_tip()                   # knocked (a scenario) or set anew
-        self.beam_stand.show(self.session.controller.beam_sensor)   # redraws only a changed sensor
+        self.beam_stand.show(c.beam_sensor)               # redraws only a changed sensor
         film = self.player
         self._step_aside(film is not None and film.playing)
         if change.pose and change.state is not None:
@@ -404,15 +411,16 @@ class SceneView:
             self._root_rows = [(i, row[n]) for i, n in enumerate(self._moving) if self._parent[n] is None]
             self._contiguous = with_parent == list(range(len(with_parent)))
             self._local_out = np.zeros((len(self._moving) + 1, 4, 4))
+            self._local_work = np.empty((len(self._child_idx), 3, 4))
             self._index_names = state.link_names
         out = self._local_out
         W = state.T_world_links
         P = W[self._parent_rows]
         C = W[self._child_rows]
         if self._contiguous:                                  # a tree without loose links: in place
-            relative_poses(P, C, out=out[:len(self._child_idx)])
+            relative_poses(P, C, out=out[:len(self._child_idx)], work=self._local_work)
         else:
-            out[self._out_rows] = relative_poses(P, C)
+            out[self._out_rows] = relative_poses(P, C, work=self._local_work)
         for i, j in self._root_rows:
             out[i] = W[j]
         out[-1] = state.T_world_tcp
