@@ -349,7 +349,7 @@ class RobotKinematics:
         """:meth:`link_poses` stacked, (N,4,4) metres, row :attr:`link_rows` ``[link]``: the same
         pinocchio pass and numbers, in one new array (the pose state of a jog step)."""
         pin.framesForwardKinematics(self.model, self.data, q_rad)
-        oMf = self.data.oMf
+        oMf = self.data.oMf.tolist()       # every frame's SE3 in one call (indexing oMf costs as much per frame)
         return np.array([oMf[i].homogeneous for i in self._link_frame_ids])
 
     def __repr__(self) -> str:
