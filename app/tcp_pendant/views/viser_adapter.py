@@ -68,7 +68,7 @@ import typing
 import weakref
 from collections import Counter
 from collections.abc import Callable
-from typing import Any, cast
+from typing import Any
 
 import msgspec
 
@@ -167,8 +167,8 @@ def queue_markdown(handle: Any, text: str) -> bool:
 
 try:
     from viser import _messages as _viser_messages
-except ImportError:                     # queue_pose falls back to the public setters
-    _viser_messages = None
+except ImportError:                     # queue_pose falls back to the public setters (AttributeError)
+    _viser_messages = None  # type: ignore[assignment]
 
 _POSE_KEYS_MAX = 4096
 _pose_keys: dict[tuple[type, str, str], str] = {}
@@ -202,7 +202,7 @@ def queue_pose(handle: Any, wxyz: list[float] | None, xyz: list[float] | None) -
     ``_websock_interface`` directly, with their redundancy key cached (:func:`_pose_message`).
     Returns False when the caller must use ``handle.wxyz`` / ``handle.position``."""
     try:
-        messages = cast(Any, _viser_messages)             # None (AttributeError below): viser differs
+        messages = _viser_messages
         impl = handle._impl
         api = impl.api
         owner = api._owner_id
