@@ -222,6 +222,8 @@ def test_pose_state_key_follows_every_input(controller: VirtualController) -> No
     T[0, 3] = 0.1
     c.set_T_world_base(T)
     keys.append(pose_state_key(c))
+    c.set_true_kinematics(c.kinematics.own_copy())            # another physical robot
+    keys.append(pose_state_key(c))
     assert len(set(keys)) == len(keys)
     assert pose_state_key(c) == keys[-1]                      # nothing changed: same key
 
