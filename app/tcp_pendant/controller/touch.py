@@ -63,11 +63,12 @@ class TouchGeometry:
 def touch_geometry(T_world_tooltrue: np.ndarray, tip_world_m: np.ndarray) -> TouchGeometry:
     """Touch geometry of a true TOOL pose (4,4, metres) and a reference tip (3,, metres).
 
-    ``u`` is one numpy product (the same operations, so the same numbers, on every path); the
-    rest is Python floats, and the crash zone's test is skipped where it cannot hold (farther
+    ``R^T (r - p)`` is one numpy product (the same operations, so the same numbers, on every
+    path); the rest is Python floats, and the crash zone's test is skipped where it cannot hold (farther
     than the zone's far corner, ``hypot(CRASH_ZONE_DEPTH_MM, CRASH_RADIUS_MM)``: penetration 0)."""
     T = np.asarray(T_world_tooltrue, dtype=float)
-    ux, uy, uz = (T[:3, :3].T @ (np.asarray(tip_world_m, dtype=float) - T[:3, 3]) * 1000.0).tolist()
+    ux, uy, uz = (T[:3, :3].T @ (np.asarray(tip_world_m, dtype=float) - T[:3, 3])).tolist()
+    ux, uy, uz = ux * 1000.0, uy * 1000.0, uz * 1000.0      # m -> mm (the products numpy's * 1000 makes)
     distance = math.hypot(ux, uy, uz)            # |u| (math: no numpy call per step)
     penetration = 0.0
     if distance <= _CRASH_ZONE_REACH_MM:
