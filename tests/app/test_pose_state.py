@@ -297,16 +297,16 @@ def test_only_changed_poses_are_sent(app_factory) -> None:
     client, s = _session(app)
     try:
         view = s.views["scene"]
-        sent: list[tuple[str, bool, bool]] = []
-        import tcp_pendant.views.scene as scene_module
+        sent: list[tuple[str, str]] = []                           # (node, message) queued
+        ws = view.gizmo._impl.api._websock_interface
+        real = ws.queue_message
 
-        real = scene_module._set_pose
+        def spy(message):
+            if type(message).__name__ in ("SetOrientationMessage", "SetPositionMessage"):
+                sent.append((message.name, type(message).__name__))
+            return real(message)
 
-        def spy(handle, wxyz, xyz):
-            sent.append((handle._impl.name, wxyz is not None, xyz is not None))
-            return real(handle, wxyz, xyz)
-
-        scene_module._set_pose = spy
+        ws.queue_message = spy
         try:
             with s.lock:
                 s.moved()                                          # nothing moved
@@ -315,10 +315,10 @@ def test_only_changed_poses_are_sent(app_factory) -> None:
                 s.controller.jog_joint(0, 3.0)
                 s.moved()
         finally:
-            scene_module._set_pose = real
-        names = {n for n, _, _ in sent}
+            del ws.queue_message
+        names = {n for n, _ in sent}
         assert names == {view.link_paths["link_1"], "/tcp_gizmo"}, sent
-        assert (view.link_paths["link_1"], True, False) in sent   # orientation only
+        assert [m for n, m in sent if n == view.link_paths["link_1"]] == ["SetOrientationMessage"]   # orientation only
     finally:
         client.close()
 

@@ -29,6 +29,10 @@ def test_relative_poses_are_the_parent_inverse_times_the_child_into_a_buffer_or_
     assert np.shares_memory(got, buffer)                  # written in place
     np.testing.assert_allclose(buffer[:7], expected, atol=1e-12)
     assert np.isnan(buffer[7:]).all()                    # nothing written beyond the view
+    again = np.full((7, 4, 4), np.nan)                    # the scene's buffer: bottom rows left as they are
+    relative_poses(P, C, out=again, work=np.full((7, 3, 4), np.nan), bottom_rows_set=True)
+    np.testing.assert_allclose(again[:, :3], expected[:, :3], atol=1e-12)
+    assert np.isnan(again[:, 3]).all()
 
 
 def test_the_scene_poses_chain_back_to_the_links_world_poses_after_jogs(app_factory) -> None:

@@ -56,24 +56,25 @@ def test_pose_fast_path_is_taken(server) -> None:
 
 
 def test_the_pose_fast_path_queues_what_the_public_setters_queue(server, monkeypatch) -> None:
-    """Message class, node, values, owner, wire form and redundancy key (cached by the fast path
-    from a node's first message on) are the public setters' own, for two nodes interleaved."""
-    from tcp_pendant.views.viser_adapter import queue_pose
+    """Message class, node, values, owner, wire form and redundancy key (cached by a node's
+    PoseQueue from its first message on) are the public setters' own, for two nodes interleaved."""
+    from tcp_pendant.views.viser_adapter import pose_queue
 
     frames = [server.scene.add_frame(name, show_axes=False) for name in ("/g", "/g/h")]
+    queues = [pose_queue(f) for f in frames]
     ws = frames[0]._impl.api._websock_interface
     queued: list[object] = []
     real = ws.queue_message
     monkeypatch.setattr(ws, "queue_message", lambda m: (queued.append(m), real(m))[1])
     rng = np.random.default_rng(3)
     for _ in range(3):
-        for f in frames:
+        for f, q in zip(frames, queues):
             for fast in (False, True):
                 wxyz = rng.normal(size=4)
                 wxyz = (wxyz / np.linalg.norm(wxyz)).tolist()
                 xyz = rng.normal(size=3).tolist()
                 if fast:
-                    assert queue_pose(f, wxyz, xyz)
+                    assert q is not None and q(wxyz, xyz)
                 else:
                     f.wxyz, f.position = wxyz, xyz
                 np.testing.assert_array_equal(f.wxyz, wxyz)

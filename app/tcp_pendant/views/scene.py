@@ -50,7 +50,7 @@ from tcp_pendant.views.beam_stand import BeamStandNodes
 from tcp_pendant.views.framing import Framing, frame_spheres
 from tcp_pendant.views.meshes import MeshPart, link_meshes, rigid_meshes
 from tcp_pendant.views.gui_util import target_of
-from tcp_pendant.views.viser_adapter import queue_pose
+from tcp_pendant.views.viser_adapter import pose_queue, queue_pose
 from tcpcal.tool import Tool
 
 __all__ = ["POSE_EPS", "PoseSender", "SceneView", "camera_shape", "closeup_camera", "frame_cameras",
@@ -82,20 +82,24 @@ def wxyz_xyz(T: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def relative_poses(T_world_parent: np.ndarray, T_world_child: np.ndarray,
-                   out: np.ndarray | None = None, work: np.ndarray | None = None) -> np.ndarray:
+                   out: np.ndarray | None = None, work: np.ndarray | None = None, *,
+                   bottom_rows_set: bool = False) -> np.ndarray:
     """``T_parent_child = inv(T_world_parent) @ T_world_child`` for stacks (N,4,4) of rigid
     poses: ``R_p^T [R_c | p_c - p_p]`` in one product, written into ``out`` ((N,4,4), e.g. a
     view of a buffer reused every jog step) when given, else into a new array; ``work`` is an
-    (N,3,4) scratch buffer for ``[R_c | p_c - p_p]`` (the caller's, reused; else a new one)."""
+    (N,3,4) scratch buffer for ``[R_c | p_c - p_p]`` (the caller's, reused; else a new one).
+    ``bottom_rows_set``: ``out``'s rows ``[:, 3]`` already hold ``(0, 0, 0, 1)`` and only this
+    function writes them (the scene's buffer): not rewritten."""
     if out is None:
-        out = np.empty_like(T_world_child)
+        out, bottom_rows_set = np.empty_like(T_world_child), False
     if work is None:
         work = np.empty((len(T_world_child), 3, 4))
     np.copyto(work, T_world_child[:, :3, :])
     offset = work[:, :, 3]
     np.subtract(offset, T_world_parent[:, :3, 3], out=offset)
     np.matmul(T_world_parent[:, :3, :3].transpose(0, 2, 1), work, out=out[:, :3, :])
-    out[:, 3, :] = (0.0, 0.0, 0.0, 1.0)
+    if not bottom_rows_set:
+        out[:, 3, :] = (0.0, 0.0, 0.0, 1.0)
     return out
 
 
@@ -150,8 +154,9 @@ class PoseSender:
     rotation (position) moved by more than :data:`POSE_EPS`. The comparison is one numpy pass
     over all nodes; quaternions are computed for the changed ones only. The messages are
     viser's own, queued as its public ``handle.wxyz = ...`` setters would, minus their
-    per-call validation and ``allclose`` (4x the cost of the message here); the node's stored
-    pose is updated too. Falls back to the public setters if viser's internals differ.
+    per-call validation and ``allclose`` (4x the cost of the message here), by one
+    ``views.viser_adapter.PoseQueue`` per node; the node's stored pose is updated too. Falls
+    back to the public setters if viser's internals differ.
 
     Args:
         handles: scene node handles.
@@ -162,6 +167,7 @@ class PoseSender:
         self.handles = list(handles)
         self._sent = np.array(T_parent_node, dtype=float).reshape(len(self.handles), 4, 4)
         self._sent_rows = self._sent[:, :3, :]            # the compared part (a view, made once)
+        self._queues = [pose_queue(h) for h in self.handles]   # None: viser differs, public setters
         self._diff = np.empty((len(self.handles), 3, 4))
 
     def send(self, T_parent_node: np.ndarray, *, skip: tuple[int, ...] = (), force: tuple[int, ...] = ()) -> int:
@@ -198,8 +204,12 @@ class PoseSender:
                 sent[:3, :3] = T[i, :3, :3]
             else:
                 sent[:3, 3] = T[i, :3, 3]
-            n += _set_pose(self.handles[i], quaternion_wxyz(rows) if r else None,
-                           [rows[0][3], rows[1][3], rows[2][3]] if p else None)
+            wxyz = quaternion_wxyz(rows) if r else None
+            xyz = [rows[0][3], rows[1][3], rows[2][3]] if p else None
+            q = self._queues[i]
+            if q is None or not q(wxyz, xyz):
+                _public_setters(self.handles[i], wxyz, xyz)
+            n += int(r) + int(p)
         return n
 
 
@@ -207,11 +217,15 @@ def _set_pose(handle: Any, wxyz: list[float] | None, xyz: list[float] | None) ->
     """Send a node's orientation and/or position (``views.viser_adapter.queue_pose``; the public
     setters if viser's internals differ); returns how many messages."""
     if not queue_pose(handle, wxyz, xyz):
-        if wxyz is not None:
-            handle.wxyz = wxyz
-        if xyz is not None:
-            handle.position = xyz
+        _public_setters(handle, wxyz, xyz)
     return int(wxyz is not None) + int(xyz is not None)
+
+
+def _public_setters(handle: Any, wxyz: list[float] | None, xyz: list[float] | None) -> None:
+    if wxyz is not None:
+        handle.wxyz = wxyz
+    if xyz is not None:
+        handle.position = xyz
 
 
 def overview_pose(tip_world_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -411,6 +425,7 @@ class SceneView:
             self._root_rows = [(i, row[n]) for i, n in enumerate(self._moving) if self._parent[n] is None]
             self._contiguous = with_parent == list(range(len(with_parent)))
             self._local_out = np.zeros((len(self._moving) + 1, 4, 4))
+            self._local_out[:, 3, 3] = 1.0            # rigid poses' bottom rows, never written again
             self._local_work = np.empty((len(self._child_idx), 3, 4))
             self._index_names = state.link_names
         out = self._local_out
@@ -418,7 +433,7 @@ class SceneView:
         P = W[self._parent_rows]
         C = W[self._child_rows]
         if self._contiguous:                                  # a tree without loose links: in place
-            relative_poses(P, C, out=out[:len(self._child_idx)], work=self._local_work)
+            relative_poses(P, C, out=out[:len(self._child_idx)], work=self._local_work, bottom_rows_set=True)
         else:
             out[self._out_rows] = relative_poses(P, C, work=self._local_work)
         for i, j in self._root_rows:

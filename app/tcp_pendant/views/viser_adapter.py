@@ -74,7 +74,7 @@ import msgspec
 
 __all__ = ["LOG_VALUE_CHARS", "MAX_ABS_NUMBER", "MAX_TEXT_CHARS", "UploadHook", "UploadLimits",
            "ViserInternalsChanged", "gui_value_refusal", "install", "listen_reuse_port", "message_refusal", "path_counts",
-           "queue_markdown",
+           "queue_markdown", "PoseQueue", "pose_queue",
            "message_counts", "queue_pose", "reset_path_counts", "short", "upload_hook", "upload_limits",
            "uploads_in_flight"]
 
@@ -170,52 +170,72 @@ try:
 except ImportError:                     # queue_pose falls back to the public setters (AttributeError)
     _viser_messages = None  # type: ignore[assignment]
 
-_POSE_KEYS_MAX = 4096
-_pose_keys: dict[tuple[type, str, str], str] = {}
-"""viser's redundancy key of a pose message, by (message class, node name, owner): computed by
-viser's own ``Message.redundancy_key`` for the first message of each, then handed to the next
-ones (it depends on the node and the message class only, never on the pose)."""
+
+class PoseQueue:
+    """Queues one scene node's ``SetOrientationMessage`` / ``SetPositionMessage`` without viser's
+    public setters, its internals looked up once (:func:`pose_queue` builds it): writes the
+    node's ``wxyz`` / ``position`` in place, stamps each message with the scene's owner as
+    ``SceneApi._queue_scene_message`` does and queues it on the scene's ``_websock_interface``.
+    The node's redundancy key (per message class) is viser's own ``Message.redundancy_key`` of
+    its first message, then set on the next ones (viser caches it in ``_cached_redundancy_key``
+    the first time it asks; it depends on the node and the message class, never on the pose):
+    not rebuilt per message."""
+
+    __slots__ = ("_impl", "_keys", "_name", "_orientation", "_owner", "_position", "_ws")
+
+    def __init__(self, handle: Any) -> None:
+        messages = _viser_messages             # None (AttributeError below): viser differs
+        impl = handle._impl
+        api = impl.api
+        self._impl, self._name, self._owner, self._ws = impl, impl.name, api._owner_id, api._websock_interface
+        self._orientation: Any = messages.SetOrientationMessage
+        self._position: Any = messages.SetPositionMessage
+        if not (callable(self._ws.queue_message) and hasattr(impl, "wxyz") and hasattr(impl, "position")):
+            raise AttributeError("a scene node without wxyz / position or a websocket interface")
+        self._keys: list[str | None] = [None, None]
+
+    def _queue(self, kind: int, value: tuple[float, ...]) -> None:
+        msg = (self._orientation if kind == 0 else self._position)(self._name, value)
+        msg.owner = self._owner
+        key = self._keys[kind]
+        if key is None:
+            self._keys[kind] = msg.redundancy_key()
+        else:
+            object.__setattr__(msg, "_cached_redundancy_key", key)
+        self._ws.queue_message(msg)
+
+    def __call__(self, wxyz: list[float] | None, xyz: list[float] | None) -> bool:
+        """Set and queue the orientation (``wxyz``) and/or position (``xyz``, metres); False when
+        viser's internals differ (the caller then uses the public setters)."""
+        try:
+            if wxyz is not None:
+                self._impl.wxyz[:] = wxyz
+                self._queue(0, tuple(wxyz))
+            if xyz is not None:
+                self._impl.position[:] = xyz
+                self._queue(1, tuple(xyz))
+        except AttributeError as exc:
+            return _fallback("pose", exc)
+        return _fast("pose")
 
 
-def _pose_message(cls: Any, name: str, value: tuple[float, ...], owner: str) -> Any:
-    """A ``SetOrientationMessage`` / ``SetPositionMessage`` stamped with its scene's ``owner``
-    (as ``SceneApi._queue_scene_message`` stamps it), its redundancy key already cached (viser
-    caches it in ``_cached_redundancy_key`` the first time it asks: here it is not rebuilt per
-    message)."""
-    msg = cls(name, value)
-    msg.owner = owner
-    k = (cls, name, owner)
-    key = _pose_keys.get(k)
-    if key is None:
-        if len(_pose_keys) >= _POSE_KEYS_MAX:
-            _pose_keys.clear()
-        _pose_keys[k] = msg.redundancy_key()
-    else:
-        object.__setattr__(msg, "_cached_redundancy_key", key)
-    return msg
+def pose_queue(handle: Any) -> PoseQueue | None:
+    """The :class:`PoseQueue` of a scene node handle; None when viser's internals differ (counted
+    and warned as the ``pose`` path's fallback: the caller uses the public setters)."""
+    try:
+        return PoseQueue(handle)
+    except (AttributeError, ImportError) as exc:
+        _fallback("pose", exc)
+        return None
 
 
 def queue_pose(handle: Any, wxyz: list[float] | None, xyz: list[float] | None) -> bool:
     """Set a scene node's orientation (``wxyz``) and/or position (``xyz``, metres) and queue
-    viser's ``SetOrientationMessage`` / ``SetPositionMessage`` without its public setters: the
-    messages ``SceneApi._queue_scene_message`` would queue (owner stamped), put on the scene's
-    ``_websock_interface`` directly, with their redundancy key cached (:func:`_pose_message`).
+    viser's ``SetOrientationMessage`` / ``SetPositionMessage`` without its public setters
+    (a :class:`PoseQueue` of the node, made for this call; the scene keeps one per node).
     Returns False when the caller must use ``handle.wxyz`` / ``handle.position``."""
-    try:
-        messages = _viser_messages
-        impl = handle._impl
-        api = impl.api
-        owner = api._owner_id
-        queue = api._websock_interface.queue_message
-        if wxyz is not None:
-            impl.wxyz[:] = wxyz
-            queue(_pose_message(messages.SetOrientationMessage, impl.name, tuple(wxyz), owner))
-        if xyz is not None:
-            impl.position[:] = xyz
-            queue(_pose_message(messages.SetPositionMessage, impl.name, tuple(xyz), owner))
-    except (AttributeError, ImportError) as exc:
-        return _fallback("pose", exc)
-    return _fast("pose")
+    q = pose_queue(handle)
+    return q is not None and q(wxyz, xyz)
 
 
 # ------------------------------------------------------------------ uploads
