@@ -136,6 +136,26 @@ def test_a_fallback_warns_once_and_uses_the_public_setters(monkeypatch, caplog) 
     assert len(warnings) == 2 and "markdown uses viser's public setters" in warnings[0]
 
 
+def test_the_scene_pose_sender_falls_back_to_the_public_setters(monkeypatch) -> None:
+    """A node whose handle has no viser internals gets no PoseQueue (one fallback counted at
+    build) and is posed through ``handle.wxyz`` / ``handle.position``, with the same values."""
+    from tcp_pendant.views.scene import PoseSender
+
+    monkeypatch.delenv(viser_adapter.STRICT_ENV)
+    monkeypatch.setattr(viser_adapter, "_warned", set())
+    reset_path_counts()
+    h = _Other()
+    sender = PoseSender([h], np.eye(4)[None])
+    assert path_counts() == {("pose", "fallback"): 1}
+    T = np.eye(4)
+    T[:3, :3] = [[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]     # 90 deg about Z
+    T[:3, 3] = [0.1, 0.2, 0.3]
+    assert sender.send(T[None]) == 2
+    np.testing.assert_allclose(h.wxyz, [np.sqrt(0.5), 0.0, 0.0, np.sqrt(0.5)], atol=1e-15)
+    assert h.position == [0.1, 0.2, 0.3]
+    assert sender.send(T[None]) == 0                                     # unchanged: nothing
+
+
 def test_a_fallback_raises_under_the_strict_flag() -> None:
     with pytest.raises(ViserInternalsChanged, match="viser fast path 'markdown' fell back"):
         set_markdown(_Other(), "a")
