@@ -113,3 +113,19 @@ def test_the_scene_queues_the_same_messages_as_the_code_it_replaced(app_factory,
                 ("SetOrientationMessage", "/tcp_gizmo"), ("SetPositionMessage", "/tcp_gizmo")]
     finally:
         client.close()
+
+
+def test_runs_of_rows_are_read_as_slices_other_rows_as_indices() -> None:
+    """The scene reads a serial arm's parent and child rows as slices (views); a tree's (a UR's
+    ee_link and tool0 on one parent) or a reordered list stay index arrays: the same rows."""
+    from tcp_pendant.views.scene import _as_slice
+
+    W = np.arange(10 * 16, dtype=float).reshape(10, 4, 4)
+    for rows in ([1, 2, 3], [0], [4, 5, 6, 7, 8, 9]):
+        got = _as_slice(np.array(rows))
+        assert isinstance(got, slice) and np.shares_memory(W[got], W)
+        np.testing.assert_array_equal(W[got], W[rows])
+    for rows in ([0, 2, 3], [3, 2], [5, 5], []):
+        got = _as_slice(np.array(rows, dtype=int))
+        assert isinstance(got, np.ndarray)
+        np.testing.assert_array_equal(W[got], W[np.array(rows, dtype=int)])
