@@ -6,11 +6,12 @@ network. What this module reaches into, and why:
 * **Fast paths** (the readouts and the robot pose change on every jog step):
   :func:`queue_markdown` stores a markdown's ``_markdown`` prop and queues viser's
   ``GuiUpdateMessage`` itself (``handle._impl``, ``gui_api._websock_interface``), skipping the
-  public setter's per-call typing machinery; :func:`queue_pose` writes a scene node's
-  ``wxyz`` / ``position`` and queues ``SetOrientationMessage`` / ``SetPositionMessage``
-  stamped with the scene's ``_owner_id`` as ``api._queue_scene_message`` does, on
-  ``api._websock_interface``, their ``_cached_redundancy_key`` set from viser's own
-  ``redundancy_key`` of the node's first message. Each returns False when viser's internals differ, and the
+  public setter's per-call typing machinery; :func:`queue_pose` (and :class:`PoseQueue`, one
+  per scene node, which the scene keeps) writes a scene node's ``wxyz`` / ``position`` and
+  queues ``SetOrientationMessage`` / ``SetPositionMessage`` stamped with the scene's
+  ``_owner_id`` as ``api._queue_scene_message`` does, on ``api._websock_interface``, their
+  ``_cached_redundancy_key`` set from viser's own ``redundancy_key`` of the node's first
+  message. Each returns False when viser's internals differ (:func:`pose_queue`: None), and the
   caller then uses the public setter. Which path ran is counted (:func:`path_counts`); the first
   fallback of each path logs a warning, and with ``TCP_PENDANT_STRICT_VISER=1`` in the
   environment (the tests' flag) a fallback raises :class:`ViserInternalsChanged` instead.
