@@ -59,6 +59,7 @@ _WORLD_AXES = np.eye(3)
 _WORLD_AXES.setflags(write=False)
 _NO_ROTATION = np.zeros(3)
 _NO_ROTATION.setflags(write=False)
+_BOTTOM_ROW = (0.0, 0.0, 0.0, 1.0)
 
 
 def _check_point(p: Sequence[float] | np.ndarray, what: str) -> np.ndarray:
@@ -303,8 +304,29 @@ class VirtualController:
 
     def T_world_tool_true(self) -> np.ndarray:
         """Hidden true TOOL pose in WORLD on the physical robot:
-        ``true_kinematics.T_world_flange(q) @ T_flange_tool_true``."""
-        return self.T_world_flange_true() @ self._tool.T_flange_tool_true
+        ``true_kinematics.T_world_flange(q) @ T_flange_tool_true`` (a fresh array).
+
+        The flange pose is the one the last jog ended on (its :class:`FlangeState`, the same
+        pinocchio frame placement, bit for bit) when that state is of the physical robot at
+        exactly the current ``q`` (compared on every call, so a ``q`` set any other way is
+        never answered from it); else one FK pass. The stop at contact asks for it on every
+        Cartesian press."""
+        T_wf = self._flange_of_state()
+        if T_wf is None:
+            T_wf = self.T_world_flange_true()
+        return T_wf @ self._tool.T_flange_tool_true
+
+    def _flange_of_state(self) -> np.ndarray | None:
+        """``T_world_flange`` (4,4, a new array) of the kept jog state when it is of the physical
+        robot at exactly the current ``q``; else None."""
+        st = self._state
+        if st is None or st.kin is not self._true_kin or st.q_list != self._q.tolist():
+            return None
+        T = np.empty((4, 4))
+        T[:3, :3] = st.R_wf
+        T[:3, 3] = st.p_wf
+        T[3] = _BOTTOM_ROW
+        return T
 
     def link_poses(self) -> dict[str, np.ndarray]:
         """``T_world_link`` for every robot link (scene updates)."""
