@@ -59,7 +59,6 @@ _WORLD_AXES = np.eye(3)
 _WORLD_AXES.setflags(write=False)
 _NO_ROTATION = np.zeros(3)
 _NO_ROTATION.setflags(write=False)
-_BOTTOM_ROW = (0.0, 0.0, 0.0, 1.0)
 
 
 def _check_point(p: Sequence[float] | np.ndarray, what: str) -> np.ndarray:
@@ -304,29 +303,30 @@ class VirtualController:
 
     def T_world_tool_true(self) -> np.ndarray:
         """Hidden true TOOL pose in WORLD on the physical robot:
-        ``true_kinematics.T_world_flange(q) @ T_flange_tool_true`` (a fresh array).
+        ``true_kinematics.T_world_flange(q) @ T_flange_tool_true``."""
+        return self.T_world_flange_true() @ self._tool.T_flange_tool_true
 
-        The flange pose is the one the last jog ended on (its :class:`FlangeState`, the same
-        pinocchio frame placement, bit for bit) when that state is of the physical robot at
-        exactly the current ``q`` (compared on every call, so a ``q`` set any other way is
-        never answered from it); else one FK pass. The stop at contact asks for it on every
-        Cartesian press."""
-        T_wf = self._flange_of_state()
-        if T_wf is None:
-            T_wf = self.T_world_flange_true()
-        return T_wf @ self._tool.T_flange_tool_true
+    def tool_tip_true_m(self) -> list[float]:
+        """The true tool tip in WORLD (m, three Python floats): ``T_world_tool_true()[:3, 3]``
+        to rounding (``R t + p`` summed in another order than the matrix product: within a few
+        1e-16 m, not bit for bit), for tests with a margin far above that (the stop at
+        contact's pre-test on every Cartesian press).
 
-    def _flange_of_state(self) -> np.ndarray | None:
-        """``T_world_flange`` (4,4, a new array) of the kept jog state when it is of the physical
-        robot at exactly the current ``q``; else None."""
+        From the flange pose the last jog ended on (its :class:`FlangeState`) when that state is
+        of the physical robot at exactly the current ``q`` (compared on every call: a ``q`` set
+        any other way is never answered from it); else from one FK pass.
+        """
+        t = self._tool.T_flange_tool_true[:3, 3].tolist()
         st = self._state
-        if st is None or st.kin is not self._true_kin or st.q_list != self._q.tolist():
-            return None
-        T = np.empty((4, 4))
-        T[:3, :3] = st.R_wf
-        T[:3, 3] = st.p_wf
-        T[3] = _BOTTOM_ROW
-        return T
+        if st is not None and st.kin is self._true_kin and st.q_list == self._q.tolist():
+            (r0, r1, r2), p = st.R_wf.tolist(), st.p_wf.tolist()
+        else:
+            T = self.T_world_flange_true()
+            r0, r1, r2 = T[:3, :3].tolist()
+            p = T[:3, 3].tolist()
+        tx, ty, tz = t
+        return [r0[0] * tx + r0[1] * ty + r0[2] * tz + p[0], r1[0] * tx + r1[1] * ty + r1[2] * tz + p[1],
+                r2[0] * tx + r2[1] * ty + r2[2] * tz + p[2]]
 
     def link_poses(self) -> dict[str, np.ndarray]:
         """``T_world_link`` for every robot link (scene updates)."""

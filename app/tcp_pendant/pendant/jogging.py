@@ -286,16 +286,21 @@ class Jogger:
             return c.jog_cartesian(self.settings.frame, ax, amount_mm)
         i = "XYZ".index(ax)
         frame = self.settings.frame
-        tip_m = c.T_world_tool_true()[:3, 3]
         reference_m = c.reference_tip_world_m
         if frame == "WORLD":
-            # the WORLD axis times the step is the step on axis i and (signed) zeros elsewhere:
-            # |step| is the same, so the pre-test runs on Python floats without the array
+            # the pre-test on Python floats: the WORLD axis times the step is the step on axis i
+            # and (signed) zeros elsewhere (the same length), and the tip to rounding
+            # (``tool_tip_true_m``: its few 1e-16 m are far inside _CLEAR_M's margin, so "clear"
+            # still means contact_stop of the exact tip says None)
             step = [0.0, 0.0, 0.0]
             step[i] = amount_mm / 1000.0
-            stop = None if _clear_of_floats(tip_m.tolist(), step, reference_m.tolist()) else (
-                contact_stop(tip_m, _WORLD_AXES[:, i] * (amount_mm / 1000.0), reference_m))
+            if _clear_of_floats(c.tool_tip_true_m(), step, reference_m.tolist()):
+                stop = None
+            else:
+                stop = contact_stop(c.T_world_tool_true()[:3, 3], _WORLD_AXES[:, i] * (amount_mm / 1000.0),
+                                    reference_m)
         else:
+            tip_m = c.T_world_tool_true()[:3, 3]
             step_m = self.frame_rotation()[:, i] * (amount_mm / 1000.0)
             stop = None if _clear_of(tip_m, step_m, reference_m) else contact_stop(tip_m, step_m, reference_m)
         if stop is None:
