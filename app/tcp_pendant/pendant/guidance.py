@@ -127,7 +127,7 @@ def _scale(delta_mm: np.ndarray) -> float:
     return next((s for s in _SCALES_MM if s >= need), _SCALES_MM[-1])
 
 
-def side_view_markdown(delta_mm: np.ndarray, frame: str) -> str:
+def side_view_markdown(delta_mm: np.ndarray | tuple[float, float, float], frame: str) -> str:
     """Two magnified views of the tips around the tool tip ``+`` (a code block): the reference
     tip ``o`` (``@`` when they share a character; at the border when it is out of range). Left:
     X across, Z up; right: Y across, Z up (the jog frame's axes). The scale (mm per character,
