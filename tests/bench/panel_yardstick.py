@@ -2,8 +2,9 @@
 per-step speed work on them: the yardstick of ``bench_panel.py`` (old and new code measured in
 one process, alternating) and of ``tests/app/test_panel_fast_paths.py`` (the new texts must be
 the old ones to the last character). Copies of ``PendantPanel.on_change`` / ``show_jog_result`` /
-``_set_md`` / ``render``, the readout formatting (``pendant.formatting``, ``pendant.guidance``),
-``Jogger._translate`` and ``VirtualController.T_world_tool_true`` (a fresh FK per press) of that
+``_set_md`` / ``render`` / ``set_markdown`` (and ``viser_adapter.queue_markdown``), the readout
+formatting (``pendant.formatting``, ``pendant.guidance``), ``Jogger._translate`` (with
+``_clear_of``) and ``VirtualController.T_world_tool_true`` (a fresh FK per press) of that
 version. Not used by the app.
 """
 
@@ -19,10 +20,11 @@ import numpy as np
 from tcp_pendant.controller import JogResult, PoseReadout, TouchGeometry
 from tcp_pendant.controller.touch import TOUCH_TOLERANCE_MM
 from tcp_pendant.pendant.guidance import CLOSEUP_WITHIN_MM, contact_stop, jog_frame_rotation, side_view_markdown
-from tcp_pendant.pendant.jogging import _WORLD_AXES, _clear_of
+from tcp_pendant.pendant.jogging import _CLEAR_M, _WORLD_AXES
 from tcp_pendant.text_escape import escape_markdown
+from tcp_pendant.views import viser_adapter
 from tcp_pendant.views.gui_util import set_value
-from tcp_pendant.views.pendant_panel import PendantPanel, set_markdown
+from tcp_pendant.views.pendant_panel import PendantPanel
 
 __all__ = ["install_legacy", "install_new", "legacy_joint_readout_markdown", "legacy_offset_markdown",
            "legacy_tcp_readout_markdown", "legacy_tip_offset_mm", "legacy_touch_indicator_markdown"]
@@ -90,6 +92,28 @@ def legacy_offset_markdown(delta_mm: np.ndarray, frame: str) -> str:
 
 
 # ------------------------------------------------------------------ the panel (views/pendant_panel.py)
+def legacy_queue_markdown(handle: Any, text: str) -> bool:
+    """``views.viser_adapter.queue_markdown`` of that version (viser's message class imported per call)."""
+    try:
+        from viser._messages import GuiUpdateMessage
+
+        impl = handle._impl
+        if impl.removed:
+            return False
+        object.__setattr__(handle, "_content", text)
+        if impl.props._markdown != text:
+            impl.props._markdown = text
+            impl.gui_api._websock_interface.queue_message(GuiUpdateMessage(impl.uuid, {"_markdown": text}))
+    except (AttributeError, ImportError) as exc:
+        return viser_adapter._fallback("markdown", exc)
+    return viser_adapter._fast("markdown")
+
+
+def set_markdown(handle: Any, text: str) -> None:
+    if "![" in text or not legacy_queue_markdown(handle, text):
+        handle.content = text
+
+
 def legacy_on_change(self: PendantPanel, change: Any) -> None:
     if change.jog is not None:
         legacy_show_jog_result(self, change.jog)
@@ -154,6 +178,12 @@ def legacy_render(self: PendantPanel, state: Any = None) -> None:
 
 
 # ------------------------------------------------------------------ the jogger (pendant/jogging.py)
+def _clear_of(tip_m: np.ndarray, step_m: np.ndarray, reference_m: np.ndarray) -> bool:
+    px, py, pz = tip_m.tolist()
+    rx, ry, rz = reference_m.tolist()
+    return math.hypot(rx - px, ry - py, rz - pz) > math.hypot(*step_m.tolist()) + _CLEAR_M
+
+
 def legacy_T_world_tool_true(controller: Any) -> np.ndarray:
     """``true_kinematics.T_world_flange(q) @ T_flange_tool_true``: a fresh FK."""
     return controller.T_world_flange_true() @ controller.mounted_tool.T_flange_tool_true
