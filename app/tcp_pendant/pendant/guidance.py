@@ -90,12 +90,9 @@ def tip_offset_xyz_mm(state: PoseState, reference_tip_world_m: np.ndarray,
     return x, y, z
 
 
-def _n(v: float) -> str:
-    text = f"{v:+.2f}" if abs(v) < 100 else f"{v:+.1f}"
-    return "0.00" if float(text) == 0.0 else text
-
-
-_OFFSETS = "%+.2f  ΔY %+.2f  ΔZ %+.2f"
+_OFFSETS = {(fx, fy, fz): f"{fx}  ΔY {fy}  ΔZ {fz}"
+            for fx in ("%+.2f", "%+.1f") for fy in ("%+.2f", "%+.1f") for fz in ("%+.2f", "%+.1f")}
+"""The three numbers of the Δ line in one template per choice of decimals (two under 100 mm)."""
 
 
 def offset_markdown(delta_mm: np.ndarray | tuple[float, float, float], frame: str) -> str:
@@ -103,12 +100,13 @@ def offset_markdown(delta_mm: np.ndarray | tuple[float, float, float], frame: st
     frame that brings the tool tip onto the reference tip (two decimals with the sign, one from
     100 mm on; a zero as ``0.00``)."""
     x, y, z = delta_mm                       # floats or numpy floats: the same text
-    if abs(x) < 100 and abs(y) < 100 and abs(z) < 100:
-        # all three "%+.2f" in one pass; a zero is then exactly "+0.00" or "-0.00", which can
-        # only be a whole number of this text (a sign starts each number)
-        text = (_OFFSETS % (x, y, z)).replace("+0.00", "0.00").replace("-0.00", "0.00")
-    else:
-        text = f"{_n(x)}  ΔY {_n(y)}  ΔZ {_n(z)}"
+    # the numbers in one pass (each "%+.2f" under 100 mm, else "%+.1f"); a zero is then
+    # "+0.00" or "-0.00", which can only be a whole number of this text (a sign starts each
+    # number, and a "%+.1f" one is at least 100 or not finite)
+    text = (_OFFSETS[("%+.2f" if abs(x) < 100 else "%+.1f", "%+.2f" if abs(y) < 100 else "%+.1f",
+                      "%+.2f" if abs(z) < 100 else "%+.1f")] % (x, y, z))
+    if "0.00" in text:
+        text = text.replace("+0.00", "0.00").replace("-0.00", "0.00")
     return f"`ΔX {text} mm` to the tip ({frame})"
 
 
