@@ -147,18 +147,29 @@ def queue_markdown(handle: Any, text: str) -> bool:
     (a removed handle, or viser's internals differ).
     """
     try:
-        from viser._messages import GuiUpdateMessage
-
+        update = _GUI_UPDATE[0] if _GUI_UPDATE else _gui_update_message()
         impl = handle._impl
         if impl.removed:
             return False
         object.__setattr__(handle, "_content", text)
-        if impl.props._markdown != text:
-            impl.props._markdown = text
-            impl.gui_api._websock_interface.queue_message(GuiUpdateMessage(impl.uuid, {"_markdown": text}))
+        props = impl.props
+        if props._markdown != text:
+            props._markdown = text
+            impl.gui_api._websock_interface.queue_message(update(impl.uuid, {"_markdown": text}))
     except (AttributeError, ImportError) as exc:
         return _fallback("markdown", exc)
     return _fast("markdown")
+
+
+_GUI_UPDATE: list[Any] = []
+"""viser's ``GuiUpdateMessage`` once imported (an import statement per readout costs a lookup)."""
+
+
+def _gui_update_message() -> Any:
+    from viser._messages import GuiUpdateMessage
+
+    _GUI_UPDATE.append(GuiUpdateMessage)
+    return GuiUpdateMessage
 
 
 def queue_pose(handle: Any, wxyz: list[float] | None, xyz: list[float] | None) -> bool:
