@@ -44,7 +44,7 @@ CONFIDENCE: float = 0.95
 _EYE3 = np.eye(3)
 _EYE3.setflags(write=False)
 _SQRT8 = 2.0 * math.sqrt(2.0)
-_dot = np.dot  # small 2-D products: ~1 us less Python dispatch than the @ operator (hot path)
+_dot = _lapack.dot  # small 2-D products: less Python dispatch than the @ operator (hot path)
 
 
 def soa(rotations: np.ndarray) -> np.ndarray:
@@ -83,7 +83,7 @@ class Information(NamedTuple):
     def weakest_tilt_rad(self) -> float:
         """RMS spread of the orientations about the weakest flange direction,
         ``sqrt(min eig M / N)`` (radians, approximately)."""
-        return math.sqrt(self.eigvals[0] / self.n)
+        return math.sqrt(self.eigvals.item(0) / self.n)
 
     @property
     def weakest_axis(self) -> np.ndarray:
@@ -122,25 +122,34 @@ class Information(NamedTuple):
         return (n + s_max) / math.sqrt(n * mu)
 
 
-_N_EYE: dict[int, np.ndarray] = {}
-"""``N I`` (3x3) for small N, made once (hot path)."""
+_N_CONSTANTS: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+"""``(N I, N)`` for small N: the 3x3 matrix ``N I`` and N as a 0-d float array (dividing by a
+0-d array is the same IEEE division as by the number, with less of numpy's scalar handling),
+made once (hot path)."""
+
+
+def _n_constants(n: int) -> tuple[np.ndarray, np.ndarray]:
+    found = _N_CONSTANTS.get(n)
+    if found is not None:
+        return found
+    n_eye, n_0d = _EYE3 * n, np.array(float(n))
+    if n <= 64:
+        n_eye.setflags(write=False)
+        n_0d.setflags(write=False)
+        _N_CONSTANTS[n] = (n_eye, n_0d)
+    return n_eye, n_0d
 
 
 def information_from_sum(s: np.ndarray, n: int) -> Information:
     """:class:`Information` from ``S = sum_i R_i`` (3x3) and N: ``M = N I - S^T S / N``."""
-    rbar = s / n
+    n_eye, n_0d = _n_constants(n)
+    rbar = s / n_0d
     m = _dot(s.T, rbar)
-    n_eye = _N_EYE.get(n)
-    if n_eye is None:
-        n_eye = _EYE3 * n
-        if n <= 64:
-            n_eye.setflags(write=False)
-            _N_EYE[n] = n_eye
     np.subtract(n_eye, m, out=m)
     w, v = _lapack.eigh(m)
-    if w[0] < 0.0:  # rounding of a (numerically) singular M
+    if w.item(0) < 0.0:  # rounding of a (numerically) singular M
         w = np.maximum(w, 0.0)
-    return Information(n=n, rbar=rbar, m=m, eigvals=w, eigvecs=v)
+    return Information(n, rbar, m, w, v)  # positional: a third of the time of keywords
 
 
 def information(rotations: np.ndarray, rotations_soa: np.ndarray | None = None) -> Information:
