@@ -567,7 +567,7 @@ class _Deferred(NamedTuple):
     info: Information
     ext: AngleExtremes | None  # None: not computed yet
     lstsq_noise: float | None  # lstsq: ``cov = noise^2 M^-1``, eigenvalues noise^2 / eig M; None: of ``cov``
-    cov: np.ndarray
+    cov: np.ndarray | None  # the covariance (None for lstsq, whose eigenvalues need it not)
     ci_dof: int | None
     early_warnings: list[str]
     sigma: float | None
@@ -597,6 +597,7 @@ def _late_figures(d: _Deferred, res: np.ndarray) -> _Figures:
         noise2 = d.lstsq_noise * d.lstsq_noise
         cov_eig = [noise2 / v for v in info.eigvals.tolist()]  # > 0: the touches are observable
     else:
+        assert d.cov is not None  # given for every estimator but lstsq
         cov_eig = np.linalg.eigvalsh(d.cov)
     ci95 = ci_radius(cov_eig, d.ci_dof)
     warnings = d.early_warnings
@@ -642,8 +643,16 @@ class _LazyTcpResult(TcpResult):
     needs (``mean_error``, ``max_error``, ``ci95_radius``, the angle figures,
     ``condition_number``, ``warnings``) are computed
     together on the first read of any of them (:func:`_late_figures`, from the solve's own
-    arrays; the same values as computed eagerly), then kept. Frozen like its base; a copy or
-    a pickle is a plain :class:`TcpResult` with every figure."""
+    arrays; the same values as computed eagerly), then kept; so is the lstsq ``covariance``
+    of up to ``_SMALL_N`` touches, ``noise^2 M^-1``, on its own first read (one product). Frozen
+    like its base; a copy or a pickle is a plain :class:`TcpResult` with every figure."""
+
+    @functools.cached_property
+    def covariance(self) -> np.ndarray:
+        scale, m_inv = self.__dict__["_covariance_of"]  # (noise^2, M^-1): kept, never written
+        cov: np.ndarray = scale * m_inv
+        cov.setflags(write=False)
+        return cov
 
     @property
     def _figures(self) -> _Figures:
@@ -803,18 +812,25 @@ def _without_outliers(rot: np.ndarray, f: np.ndarray, outliers: list[int], metho
 
 
 def _lazy_result(method: str, t: np.ndarray, r: np.ndarray, e: np.ndarray, res: np.ndarray, sse: float,
-                 noise: float, cov: np.ndarray, outliers: list[int], without: TcpResult | None,
-                 deferred: _Deferred) -> TcpResult:
+                 noise: float, cov: np.ndarray | tuple[float, np.ndarray], outliers: list[int],
+                 without: TcpResult | None, deferred: _Deferred) -> TcpResult:
     """The :class:`_LazyTcpResult` of a solve; its arrays become read-only (made by the solve
-    and shared with nobody: no copy)."""
-    for a in (t, r, e, res, cov):
+    and shared with nobody: no copy). ``cov``: the covariance, or ``(noise^2, M^-1)`` to make
+    it from on its first read."""
+    for a in (t, r, e, res):
         a.setflags(write=False)
     n = e.shape[0]
     result = object.__new__(_LazyTcpResult)  # its fields as TcpResult's __init__ sets them, the rest deferred
-    object.__setattr__(result, "__dict__", {
+    fields = {
         "method": method, "tcp": t, "reference": r, "residual_vectors": e, "residuals": res,
-        "rms_error": math.sqrt(sse / n), "noise_sigma": float(noise), "covariance": cov,
-        "outliers": tuple(outliers), "without_outliers": without, "n_touches": n, "_deferred": deferred})
+        "rms_error": math.sqrt(sse / n), "noise_sigma": float(noise),
+        "outliers": tuple(outliers), "without_outliers": without, "n_touches": n, "_deferred": deferred}
+    if isinstance(cov, tuple):
+        fields["_covariance_of"] = cov
+    else:
+        cov.setflags(write=False)
+        fields["covariance"] = cov
+    object.__setattr__(result, "__dict__", fields)
     return result
 
 
@@ -867,12 +883,11 @@ def _solve_lstsq_small(rot: np.ndarray, f: np.ndarray, sigma: float | None, dete
     dof = 3 * n - 6
     s_est = math.sqrt(sse / dof)
     noise = s_est if sigma is None else sigma
-    cov = (noise * noise) * m_inv
     warnings: list[str] = []
     outliers = _find_outliers(rot, y, f, (info, _LstsqFit(t, r, e, sse, neg_d))) if y is not None else []
     without = _without_outliers(rot, f, outliers, "lstsq", sigma, res, warnings) if outliers else None
-    return _lazy_result("lstsq", t, r, e, res, sse, noise, cov, outliers, without,
-                        _Deferred(rot, y, info, ext, noise, cov, None if sigma is not None else dof, warnings,
+    return _lazy_result("lstsq", t, r, e, res, sse, noise, (noise * noise, m_inv), outliers, without,
+                        _Deferred(rot, y, info, ext, noise, None, None if sigma is not None else dof, warnings,
                                   sigma, sse, s_est, dof, detect_outliers))
 
 

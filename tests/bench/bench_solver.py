@@ -181,8 +181,10 @@ def bare_svd_solve(rot: np.ndarray, pos: np.ndarray) -> tuple[np.ndarray, np.nda
 
 
 DEFERRED_FIGURES = ("mean_error", "max_error", "ci95_radius", "max_angle_deg", "min_angle_deg",
-                    "condition_number", "warnings", "max_angle_exact", "max_angle_upper_deg", "min_angle_exact")
-"""The figures of solve_xyz4's result computed on their first read (tcpcal.origin._LazyTcpResult)."""
+                    "condition_number", "warnings", "max_angle_exact", "max_angle_upper_deg", "min_angle_exact",
+                    "covariance")
+"""The figures of solve_xyz4's result computed on their first read (tcpcal.origin._LazyTcpResult;
+the covariance for lstsq up to 64 touches)."""
 
 
 def figures_us(rot: np.ndarray, pos: np.ndarray, repeats: int) -> float:
@@ -599,16 +601,17 @@ def main(argv: list[str] | None = None) -> int:
             tgt += f"; <= {BARE_RATIO_TARGET} x bare: {verdict(full <= BARE_RATIO_TARGET * bare)}"
         print(f"{n:>5} {full:11.1f} {no_outl:16.1f} {base:21.1f} {full / base:6.1f} {bare:15.1f} "
               f"{full / bare:6.2f}  {tgt}  | {figs:8.1f} ({figs / full:.2f} x solve)")
-    print("   solve_xyz4 includes input checks, the residuals, noise and covariance, the check for")
-    print("   repeated orientations and the outlier test; np.linalg.lstsq (A prebuilt) gives t and r only;")
-    print("   the bare SVD solve builds A and b from the touches, solves by numpy.linalg.svd and gives t,")
-    print("   r and the residual lengths (bare_svd_solve: no check, no quality figure). 'figures read':")
-    print("   the first read of the figures the result computes when first asked (mean and largest")
-    print("   residual, 95 % radius, the largest/smallest angle between touches, condition number,")
-    print("   warnings; all at once), after a solve; the solve's time does not include it.")
+    print("   solve_xyz4 includes input checks, the residuals, noise (and the covariance above 64 touches),")
+    print("   the check for repeated orientations and the outlier test; np.linalg.lstsq (A prebuilt) gives")
+    print("   t and r only; the bare SVD solve builds A and b from the touches, solves by numpy.linalg.svd")
+    print("   and gives t, r and the residual lengths (bare_svd_solve: no check, no quality figure).")
+    print("   'figures read': the first read of the figures the result computes when first asked (mean")
+    print("   and largest residual, 95 % radius, the largest/smallest angle between touches, condition")
+    print("   number, warnings; all at once; and the covariance, one product, up to 64 touches), after a")
+    print("   solve; the solve's time does not include it.")
     print("   Each column here is one function called back to back (a hot loop: its code and data stay")
     print("   in the caches); the bare SVD solve (one LAPACK call) gains more from that than solve_xyz4")
-    print("   (~40 small numpy calls), so the N = 4 ratio here is higher than in table 2b, where the")
+    print("   (~35 small numpy calls), so the N = 4 ratio here is higher than in table 2b, where the")
     print("   functions take turns round by round as they do in use (the wizard solves once between")
     print("   other work).")
     print()
