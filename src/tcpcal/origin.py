@@ -843,7 +843,8 @@ def _solve_lstsq_small(rot: np.ndarray, f: np.ndarray, sigma: float | None, dete
     case), written as one function: the same arithmetic, in the same order, as
     :func:`tcpcal._stats.information`, :func:`_observability`, ``Information.m_inv`` and
     :func:`_lstsq_core` (a test checks them equal to the last bit), without their calls and
-    intermediate tuples. At a few touches every numpy call costs more in overhead than in
+    intermediate tuples; the covariance ``noise^2 M^-1`` is left to its first read
+    (:class:`_LazyTcpResult`). At a few touches every numpy call costs more in overhead than in
     arithmetic (~1 us against a few ns), so the count of calls is the cost
     (``tests/bench/bench_solver.py``, tables 2 and 2b)."""
     n = rot.shape[0]
