@@ -644,7 +644,7 @@ def main(argv: list[str] | None = None) -> int:
     print(f"   Each column here is one function called back to back in blocks of {HOT_BLOCK} calls (a hot loop:")
     print("   its code and data stay in the caches), the columns' blocks taking turns so that the machine's")
     print("   load hits them alike (N = 1000: the multi-threaded lstsq and SVD after the others); the bare")
-    print("   SVD solve (one LAPACK call) gains more from hot caches than solve_xyz4 (~35 small numpy")
+    print("   SVD solve (one LAPACK call) gains more from hot caches than solve_xyz4 (~30 small numpy")
     print("   calls), so the N = 4 ratio here is higher than in table 2b, where the functions take turns")
     print("   call by call as they do in use (the wizard solves once between other work).")
     print()
