@@ -23,7 +23,9 @@ import argparse
 import gc
 import logging
 import os
+import shutil
 import sys
+import tempfile
 import time
 from collections.abc import Sequence
 from pathlib import Path
@@ -272,6 +274,7 @@ def _main(argv: Sequence[str] | None) -> int:
             print(f"tcp-pendant: error: cannot make the folder of the class gradebook {class_db.parent}: "
                   f"{exc}; give another file with --class-db PATH", file=sys.stderr)
             return 2
+    balance_file = _balance_file(args.workers, worker)
     try:
         tip = None if args.reference_tip is None else parse_xyz_mm(args.reference_tip)
         config = AppConfig(robot=args.robot, package_paths=tuple(args.package_path), flange_link=args.flange_link, tool=args.tool, host=args.host,
@@ -288,9 +291,11 @@ def _main(argv: Sequence[str] | None) -> int:
                            scenario_seed=args.scenario_seed, presenter=args.presenter,
                            hide_truth=args.hide_truth,
                            beam_width_mm=args.beam_width, beam_repeatability_mm=args.beam_repeatability,
-                           beam_crossed=args.beam_crossed, seed=args.seed, reuse_port=several)
+                           beam_crossed=args.beam_crossed, seed=args.seed, reuse_port=several,
+                           balance_file=balance_file)
         app = PendantApp(config)
     except (ControllerError, ValueError, OSError, GradebookError) as exc:
+        _drop_balance_file(balance_file, worker)
         print(f"tcp-pendant: error: {exc}", file=sys.stderr)
         return 2
     if worker is None:                      # a worker's warnings are the first process's
@@ -302,28 +307,38 @@ def _main(argv: Sequence[str] | None) -> int:
     try:
         url = app.start()
     except PortInUseError as exc:
+        _drop_balance_file(balance_file, worker)
         print(f"tcp-pendant: error: {exc}", file=sys.stderr)
         return 2
     except OSError as exc:
+        _drop_balance_file(balance_file, worker)
         print(f"tcp-pendant: error: cannot listen on {args.host}:{args.port}: {exc}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         app.stop()
+        _drop_balance_file(balance_file, worker)
         raise
     set_apart_startup_objects()
     if worker is not None:
         return _serve_as_worker(app, worker[2])
     workers: Workers | None = None
     if args.workers > 1:
-        workers = Workers(list(argv or ()), app.port, args.workers)
+        balance = app.balance
+        from tcp_pendant.balance import BALANCE_ENV
+
+        workers = Workers(list(argv or ()), app.port, args.workers,
+                          env={} if balance_file is None else {BALANCE_ENV: str(balance_file)},
+                          on_stopped=None if balance is None else balance.turn_off)
         try:
             workers.start()
         except (WorkerError, OSError) as exc:
             app.stop()
+            _drop_balance_file(balance_file, worker)
             print(f"tcp-pendant: error: {exc}", file=sys.stderr)
             return 2
         except KeyboardInterrupt:
             app.stop()
+            _drop_balance_file(balance_file, worker)
             raise
     mode = "one robot shared by every browser" if args.shared else "one robot per browser"
     if workers is not None:
@@ -338,7 +353,30 @@ def _main(argv: Sequence[str] | None) -> int:
     finally:
         if workers is not None:
             workers.stop()
+        _drop_balance_file(balance_file, worker)
     return 0
+
+
+def _drop_balance_file(balance_file: Path | None, worker: tuple[int, int, int] | None) -> None:
+    """The first process removes the balance record's folder when it stops."""
+    if balance_file is not None and worker is None:
+        shutil.rmtree(balance_file.parent, ignore_errors=True)
+
+
+def _balance_file(workers: int, worker: tuple[int, int, int] | None) -> Path | None:
+    """The record the ``--workers`` processes share to balance their connections
+    (``tcp_pendant.balance``): made by the first process in a folder of its own, named to the
+    others in their environment; None for a single process."""
+    from tcp_pendant.balance import BALANCE_ENV, BalanceFile
+
+    if worker is not None:
+        value = os.environ.get(BALANCE_ENV)
+        return Path(value) if value else None
+    if workers <= 1:
+        return None
+    path = Path(tempfile.mkdtemp(prefix="tcp-pendant-workers-")) / "balance.json"
+    BalanceFile.create(path, workers)
+    return path
 
 
 def set_apart_startup_objects() -> int:

@@ -35,6 +35,7 @@ from tcp_pendant import client_script, origin_check
 from tcp_pendant.calibrate import CalibrationWorkflow
 from tcp_pendant.addresses import network_urls
 from tcp_pendant import job_pool
+from tcp_pendant.balance import Balance, BalanceFile
 from tcp_pendant.job_pool import JobPool
 from tcp_pendant.classroom.class_room import ClassRoom
 from tcp_pendant.classroom.gradebook import Gradebook
@@ -125,6 +126,9 @@ class AppConfig:
             randomness.
         reuse_port: bind the port with ``SO_REUSEPORT`` (``views.viser_adapter.listen_reuse_port``):
             one of the server processes of ``tcp-pendant --workers N`` on the same port.
+        balance_file: with ``reuse_port``, the record the ``--workers`` processes share so that
+            each new connection goes to the process with the fewest browsers
+            (``tcp_pendant.balance``); None: the kernel's hash spreads them.
         presence_poll_s: the class's heartbeat period across server processes (seconds;
             ``ClassRoom.start``).
     """
@@ -157,6 +161,7 @@ class AppConfig:
     seed: int | None = None
     hide_truth: bool = False
     reuse_port: bool = False
+    balance_file: Path | None = None
     presence_poll_s: float = 1.0
 
 
@@ -357,6 +362,8 @@ class PendantApp:
         self._stop = threading.Event()
         self._watcher: threading.Thread | None = None
         self.jobs = JobPool()
+        self.balance: Balance | None = None
+        self._browsers = 0                  # websockets connected to this process (the balance's count)
         """The server's one pool of browser-triggered jobs, fair per session (``job_pool``)."""
         # warm the mesh caches so the first browser does not wait for STL parsing
         link_meshes(self.kinematics.description)
@@ -458,6 +465,7 @@ class PendantApp:
         """``on_client_connect``, on viser's event loop (every push from the loop's thread): the
         browser's session is built a view at a time, other browsers' callbacks run in between;
         a browser that left meanwhile gets nothing registered."""
+        self._count_browser(+1)
         if self.config.shared:
             if self.shared_session is not None:
                 try:
@@ -510,8 +518,18 @@ class PendantApp:
             client.add_notification(title, body, color="yellow", with_close_button=True,
                                     auto_close_seconds=None)
 
+    def _count_browser(self, delta: int) -> None:
+        """One browser more or fewer on this process: the ``--workers`` balance hears of it."""
+        self._browsers = max(0, self._browsers + delta)
+        if self.balance is not None:
+            try:
+                self.balance.sessions(self._browsers)
+            except OSError:
+                log.exception("the connection balance of the server processes could not be updated")
+
     async def _on_disconnect(self, client: viser.ClientHandle) -> None:
         """``on_client_disconnect``, on viser's event loop like every other callback."""
+        self._count_browser(-1)
         if not self.config.shared:
             self.close_session(client)
 
@@ -580,8 +598,12 @@ class PendantApp:
         """The viser server, its policies, page script and session handlers; then ready."""
         import viser
 
-        if self.config.reuse_port:
-            viser_adapter.listen_reuse_port()   # one port, several server processes (--workers)
+        if self.config.reuse_port:              # one port, several server processes (--workers)
+            if self.config.balance_file is not None:
+                self.balance = Balance(BalanceFile(self.config.balance_file))
+                viser_adapter.listen_reuse_port(self.balance.listening, self.balance.started)
+            else:
+                viser_adapter.listen_reuse_port()
         self.server = viser.ViserServer(host=host, port=self.config.port, verbose=False)
         origin_check.allow(self.port, self.allow_origins,
                            origin_check.served_hosts(host, self.network_urls, self.allow_origins))

@@ -261,6 +261,7 @@ class Session:
         self._batch_depth = 0
         self._pending: SessionChange | None = None
         self._deferred: SessionChange | None = None    # jog presses' signal waiting for the loop's round
+        self._deferred_signal: Callable[[], None] | None = None   # guard(_signal_deferred), made once
         self.library_tools: dict[int, Tool] = {}
         """The library's tools as this session last read them (slot -> tool)."""
         self.library_error: str | None = None
@@ -410,7 +411,10 @@ class Session:
             keep = jog if before is None or before.ok or not jog.ok else before
             self._deferred = SessionChange(pose=True, jog=keep)
             if not scheduled:
-                loop.call_soon(self.guard(self._signal_deferred))
+                signal = self._deferred_signal          # the guard checks closed when called: one serves all
+                if signal is None:
+                    signal = self._deferred_signal = self.guard(self._signal_deferred)
+                loop.call_soon(signal)
 
     def _signal_deferred(self) -> None:
         if self._deferred is not None:

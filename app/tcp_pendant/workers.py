@@ -5,9 +5,10 @@ with ``SO_REUSEPORT``: ``views.viser_adapter.listen_reuse_port``, so ``--port 0`
 port the others take too) it starts the N - 1 others, each ``python -m tcp_pendant`` with the
 same options plus ``--port PORT`` and :data:`WORKER_ENV` in its environment. Every process
 binds the same address with ``SO_REUSEPORT`` and the kernel hands each new connection to one
-of them (Linux spreads them by a hash of the client's address and port), so a browser's
-websocket (its whole session) lives in one process, and its page's static files may come from
-another: every process serves the same files.
+of them: to the one with the fewest browsers (``tcp_pendant.balance``; the record's path is in
+the workers' environment, ``BALANCE_ENV``), so a browser's websocket (its whole session) lives
+in one process, and its page's static files may come from another: every process serves the
+same files.
 
 Each process has its own sessions (a jog step never leaves the process that runs it) and its
 own copy of the robot; what the class shares goes through the gradebook (SQLite in WAL mode:
@@ -30,7 +31,7 @@ import subprocess
 import sys
 import threading
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 __all__ = ["MAX_WORKERS", "WORKER_ENV", "WorkerError", "Workers", "worker_index"]
@@ -68,11 +69,15 @@ class Workers:
         argv: the first process's command-line options (passed on as they are).
         port: the port the first process listens on.
         n: server processes in all (>= 2).
+        env: more environment of the workers (the balance record's path: ``tcp_pendant.balance``).
+        on_stopped: called once when a worker stops while the class runs (the balance turns off).
     """
 
     argv: Sequence[str]
     port: int
     n: int
+    env: dict[str, str] = field(default_factory=dict)
+    on_stopped: Callable[[], None] | None = None
     processes: list[subprocess.Popen[bytes]] = field(default_factory=list)
     _stopping: threading.Event = field(default_factory=threading.Event)
 
@@ -88,7 +93,7 @@ class Workers:
         """
         cmd = [sys.executable, "-m", "tcp_pendant", *self.argv, "--port", str(self.port), "--workers", "1"]
         for k in range(2, self.n + 1):
-            env = dict(os.environ, **{WORKER_ENV: f"{k}/{self.n}:{os.getpid()}"})
+            env = dict(os.environ, **self.env, **{WORKER_ENV: f"{k}/{self.n}:{os.getpid()}"})
             self.processes.append(subprocess.Popen(cmd, env=env, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE))
         deadline = time.monotonic() + timeout_s
         try:
@@ -124,6 +129,11 @@ class Workers:
     def _watch(self, k: int, p: subprocess.Popen[bytes]) -> None:
         code = p.wait()
         if not self._stopping.is_set():
+            if self.on_stopped is not None:
+                try:
+                    self.on_stopped()
+                except Exception as exc:  # the warning below must still be printed
+                    print(f"WARNING: after server process {k} stopped: {exc}", file=sys.stderr, flush=True)
             print(f"WARNING: server process {k} of {self.n} (pid {p.pid}) stopped (exit code {code}); its "
                   "browsers reconnect to the others and get their calibrations back from the gradebook",
                   file=sys.stderr, flush=True)

@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import NamedTuple, cast
+from typing import NamedTuple
 
 import numpy as np
 from scipy.special import chdtri, fdtri
@@ -44,7 +44,7 @@ CONFIDENCE: float = 0.95
 _EYE3 = np.eye(3)
 _EYE3.setflags(write=False)
 _SQRT8 = 2.0 * math.sqrt(2.0)
-_dot = np.dot  # small 2-D products: ~1 us less Python dispatch than the @ operator (hot path)
+_dot = _lapack.dot  # small 2-D products: less Python dispatch than the @ operator (hot path)
 
 
 def soa(rotations: np.ndarray) -> np.ndarray:
@@ -83,7 +83,7 @@ class Information(NamedTuple):
     def weakest_tilt_rad(self) -> float:
         """RMS spread of the orientations about the weakest flange direction,
         ``sqrt(min eig M / N)`` (radians, approximately)."""
-        return math.sqrt(self.eigvals[0] / self.n)
+        return math.sqrt(self.eigvals.item(0) / self.n)
 
     @property
     def weakest_axis(self) -> np.ndarray:
@@ -122,25 +122,34 @@ class Information(NamedTuple):
         return (n + s_max) / math.sqrt(n * mu)
 
 
-_N_EYE: dict[int, np.ndarray] = {}
-"""``N I`` (3x3) for small N, made once (hot path)."""
+_N_CONSTANTS: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+"""``(N I, N)`` for small N: the 3x3 matrix ``N I`` and N as a 0-d float array (dividing by a
+0-d array is the same IEEE division as by the number, with less of numpy's scalar handling),
+made once (hot path)."""
+
+
+def _n_constants(n: int) -> tuple[np.ndarray, np.ndarray]:
+    found = _N_CONSTANTS.get(n)
+    if found is not None:
+        return found
+    n_eye, n_0d = _EYE3 * n, np.array(float(n))
+    if n <= 64:
+        n_eye.setflags(write=False)
+        n_0d.setflags(write=False)
+        _N_CONSTANTS[n] = (n_eye, n_0d)
+    return n_eye, n_0d
 
 
 def information_from_sum(s: np.ndarray, n: int) -> Information:
     """:class:`Information` from ``S = sum_i R_i`` (3x3) and N: ``M = N I - S^T S / N``."""
-    rbar = s / n
+    n_eye, n_0d = _n_constants(n)
+    rbar = s / n_0d
     m = _dot(s.T, rbar)
-    n_eye = _N_EYE.get(n)
-    if n_eye is None:
-        n_eye = _EYE3 * n
-        if n <= 64:
-            n_eye.setflags(write=False)
-            _N_EYE[n] = n_eye
     np.subtract(n_eye, m, out=m)
     w, v = _lapack.eigh(m)
-    if w[0] < 0.0:  # rounding of a (numerically) singular M
+    if w.item(0) < 0.0:  # rounding of a (numerically) singular M
         w = np.maximum(w, 0.0)
-    return Information(n=n, rbar=rbar, m=m, eigvals=w, eigvecs=v)
+    return Information(n, rbar, m, w, v)  # positional: a third of the time of keywords
 
 
 def information(rotations: np.ndarray, rotations_soa: np.ndarray | None = None) -> Information:
@@ -242,8 +251,9 @@ already about twice it). Above, both angles come from a sample and one O(N) pass
 when it is 0, the largest exact when its bounds meet; otherwise each is a flagged estimate."""
 SAMPLED_ANGLES_ABOVE_N = EXACT_ANGLES_MAX_N
 """Above this many touches the angle figures may be estimates (``min_exact`` / ``max_exact``
-False); the same threshold as ``EXACT_ANGLES_MAX_N`` (kept as a name of its own: the smallest
-angle was exact up to 100,000 touches before)."""
+False); the same threshold as ``EXACT_ANGLES_MAX_N``, named for what callers of the smallest
+angle ask (``TcpResult.min_angle_exact``). The exact reference of both angles for many
+touches, an O(N log N) search, lives with the tests (``tests/tcpcal/angle_reference.py``)."""
 _SAMPLE_PAIRS = 512
 """Most consecutive pairs of touches in the sample of :func:`_angle_extremes_sampled`."""
 SAMPLED_PROJECTION_MAX_N = 20_000
@@ -264,10 +274,6 @@ _PAIR_OFFSETS = np.array([0, 1])
 _PASS_ROWS = 8192
 """Rows per block of the one pass of :func:`_angle_extremes_sampled` (a block's product with
 the two centres stays single-threaded in OpenBLAS and in cache)."""
-_CHUNK_ROWS = 65536
-"""Rows per chunk of the O(N m) passes of :func:`_angle_extremes_large` (keeps memory O(N))."""
-_N_RANDOM_CENTRES = 16
-_N_SWEEPS = 4
 
 
 def angle_extremes(rotations: np.ndarray, rotations_soa: np.ndarray | None = None, *,
@@ -286,9 +292,7 @@ def angle_extremes(rotations: np.ndarray, rotations_soa: np.ndarray | None = Non
     a sample and O(N) passes in at most the time of the solve's least squares
     (:func:`_angle_extremes_sampled`), each flagged when it is an estimate: ``min_exact`` False
     (the angle of an actual pair, an upper bound of the smallest) unless it is 0, ``max_exact`` False (a lower bound attained by a pair, with the upper bound
-    ``max_upper_deg``) unless the bounds meet. :func:`_angle_extremes_large` is an exact
-    O(N log N) search of the smallest angle for callers that can afford it (tens of ms at
-    10^4 touches).
+    ``max_upper_deg``) unless the bounds meet.
 
     Args:
         rotations: (N, 3, 3).
@@ -367,185 +371,6 @@ def _blocked_gram_extremes(x: np.ndarray, xt: np.ndarray) -> tuple[int, int, int
     return a, b, c, e
 
 
-def quaternions(rotations: np.ndarray) -> np.ndarray:
-    """Unit quaternions ``(w, x, y, z)`` of proper rotations (N, 3, 3), folded to ``w >= 0``.
-
-    Shepperd's method, element-wise (no Python loop): the largest of ``4w^2 = 1 + tr R``,
-    ``4x^2 = 1 + 2 R_00 - tr R``, ... picks the stable formula per row. ``q`` and ``-q`` are the
-    same rotation; the rotation angle between two rotations is ``2 acos |q_a . q_b|`` =
-    ``4 asin(|q_a - s q_b| / 2)`` with the sign ``s`` that makes the distance smallest.
-    """
-    n = rotations.shape[0]
-    r = rotations.reshape(n, 9)
-    r00, r01, r02, r10, r11, r12, r20, r21, r22 = (r[:, k] for k in range(9))
-    tr = r00 + r11 + r22
-    cand = np.stack([1.0 + tr, 1.0 + 2.0 * r00 - tr, 1.0 + 2.0 * r11 - tr, 1.0 + 2.0 * r22 - tr], axis=1)
-    k = cand.argmax(axis=1)
-    q = np.empty((n, 4))
-    for case in range(4):
-        m = k == case
-        if not m.any():
-            continue
-        s = 2.0 * np.sqrt(np.maximum(cand[m, case], 1e-300))  # = 4 |component|
-        if case == 0:
-            q[m] = np.stack([s / 4, (r21[m] - r12[m]) / s, (r02[m] - r20[m]) / s, (r10[m] - r01[m]) / s], 1)
-        elif case == 1:
-            q[m] = np.stack([(r21[m] - r12[m]) / s, s / 4, (r01[m] + r10[m]) / s, (r02[m] + r20[m]) / s], 1)
-        elif case == 2:
-            q[m] = np.stack([(r02[m] - r20[m]) / s, (r01[m] + r10[m]) / s, s / 4, (r12[m] + r21[m]) / s], 1)
-        else:
-            q[m] = np.stack([(r10[m] - r01[m]) / s, (r02[m] + r20[m]) / s, (r12[m] + r21[m]) / s, s / 4], 1)
-    q /= np.sqrt(np.einsum("ij,ij->i", q, q))[:, None]
-    q[q[:, 0] < 0.0] *= -1.0
-    return q
-
-
-def _exact_duplicate_pair(q: np.ndarray) -> tuple[int, int] | None:
-    """A pair of touches with bit-identical quaternions (same rotation matrix), or None.
-    O(N log N): sort by a random projection, compare neighbours with equal keys."""
-    key = q @ np.array([0.5773502691896258, 0.4472135954999579, 0.3779644730092272, 0.5773502691896257])
-    order = np.argsort(key, kind="stable")
-    ks = key[order]
-    same = np.flatnonzero(ks[1:] == ks[:-1])
-    if same.size:
-        qs0, qs1 = q[order[same]], q[order[same + 1]]
-        eq = np.flatnonzero((qs0 == qs1).all(axis=1))
-        if eq.size:
-            k = same[eq[0]]
-            i, j = int(order[k]), int(order[k + 1])
-            return (min(i, j), max(i, j))
-    return None
-
-
-def _nearest_pair(q: np.ndarray) -> tuple[int, int]:
-    """The two touches whose orientations are closest (exact), for quaternions folded to
-    ``w >= 0`` without bit-identical duplicates.
-
-    A KD-tree over the folded quaternions; an upper bound ``delta`` on the smallest chord
-    comes from the nearest neighbours of a sample of touches, then every touch's nearest
-    neighbour is searched within ``delta`` only (cheap: the search stops at ``delta``). Two
-    rotations near ``w = 0`` may be closest through the sign flip: a touch with ``w_i > delta``
-    cannot be within ``delta`` of a flipped one (``|-q_i - q_j| >= w_i + w_j``), so only touches
-    with ``w_i <= delta`` are searched again as ``-q_i``.
-    """
-    from scipy.spatial import cKDTree  # noqa: PLC0415 - only large sets need it
-
-    n = q.shape[0]
-    tree = cKDTree(q, leafsize=16, balanced_tree=False, compact_nodes=False)
-    rng = np.random.default_rng(0)
-    sample = rng.choice(n, size=min(n, 2048), replace=False)
-    # A 2-D query gives (m, k) arrays (the stubs also allow the scalars of a 1-D query).
-    d, idx = cast("tuple[np.ndarray, np.ndarray]", tree.query(q[sample], k=2))
-    own = idx[:, 0] == sample
-    nd = np.where(own, d[:, 1], d[:, 0])
-    ni = np.where(own, idx[:, 1], idx[:, 0])
-    k = int(nd.argmin())
-    best_d, best = float(nd[k]), (int(sample[k]), int(ni[k]))
-    bound = best_d * (1.0 + 1e-9) + 1e-300
-    for start in range(0, n, _CHUNK_ROWS):
-        rows = np.arange(start, min(start + _CHUNK_ROWS, n))
-        d, idx = cast("tuple[np.ndarray, np.ndarray]", tree.query(q[rows], k=2, distance_upper_bound=bound))
-        own = idx[:, 0] == rows
-        nd = np.where(own, d[:, 1], d[:, 0])
-        ni = np.where(own, idx[:, 1], idx[:, 0])
-        k = int(nd.argmin())
-        if float(nd[k]) < best_d:
-            best_d, best = float(nd[k]), (int(rows[k]), int(ni[k]))
-    edge = np.flatnonzero(q[:, 0] <= bound)
-    if edge.size:
-        d, idx = cast("tuple[np.ndarray, np.ndarray]", tree.query(-q[edge], k=1, distance_upper_bound=bound))
-        k = int(d.argmin())
-        if float(d[k]) < best_d:
-            best_d, best = float(d[k]), (int(edge[k]), int(idx[k]))
-    i, j = best
-    return (min(i, j), max(i, j))
-
-
-def _angles_to(q: np.ndarray, c: np.ndarray) -> np.ndarray:
-    """Rotation angles (rad) between every row of ``q`` (N, 4) and every row of ``c`` (m, 4)."""
-    dots = np.abs(q @ c.T)
-    np.minimum(dots, 1.0, out=dots)
-    angles: np.ndarray = 2.0 * np.arccos(dots)
-    return angles
-
-
-def _angle_extremes_large(rotations: np.ndarray) -> AngleExtremes:
-    """:func:`angle_extremes` for many touches: O(N log N) time, O(N) memory.
-
-    Smallest angle (exact): bit-identical rotations give 0 (found by sorting); otherwise the
-    nearest pair of the quaternions with sign folding (:func:`_nearest_pair`).
-
-    Largest angle (bound and prune): the rotation angle is a metric on SO(3). For a few
-    centres ``c`` (touch 0, touches found by farthest-point sweeps, random touches, and the
-    principal direction of the quaternions, which need not be a touch) one pass computes
-    every touch's angle to every centre, ``d(j, c)``, and each touch centre's eccentricity
-    ``e(c) = max_j d(c, j)``. ``L = max e(c)`` over the touch centres is attained by a pair.
-    By the triangle inequality ``d(i, j) <= d(i, c) + e(c)`` for every ``c``, so a touch can
-    belong to a pair farther apart than ``L`` only if ``u_j = min_c (d(j, c) + e(c)) > L``,
-    and ``U = max_j u_j`` bounds the largest angle from above. When at most
-    ``EXACT_ANGLES_MAX_N`` touches have ``u_j > L`` every pair among them is looked at and the
-    result is exact; otherwise ``L`` is returned as an estimate with ``max_upper_deg = U``.
-    """
-    n = rotations.shape[0]
-    x = rotations.reshape(n, 9)
-    q = quaternions(rotations)
-    dup = _exact_duplicate_pair(q)
-    min_pair = dup if dup is not None else _nearest_pair(q)
-
-    # --- largest angle: centres
-    rng = np.random.default_rng(1)
-    touch_centres = [0]
-    c = 0
-    for _ in range(_N_SWEEPS):  # farthest-point sweeps (the double-sweep heuristic)
-        c = int(np.abs(q @ q[c]).argmin())
-        if c in touch_centres:
-            break
-        touch_centres.append(c)
-    touch_centres += [int(i) for i in rng.choice(n, size=min(n, _N_RANDOM_CENTRES), replace=False)]
-    touch_centres = list(dict.fromkeys(touch_centres))
-    _, vecs = np.linalg.eigh(q.T @ q)  # sign-invariant "mean" orientation
-    centres = np.vstack([q[touch_centres], vecs[:, -1]])
-    m_touch = len(touch_centres)
-    ecc = np.zeros(len(centres))
-    far = np.zeros(len(centres), dtype=np.int64)
-    for start in range(0, n, _CHUNK_ROWS):
-        ang = _angles_to(q[start : start + _CHUNK_ROWS], centres)
-        k = ang.argmax(axis=0)
-        v = ang[k, np.arange(len(centres))]
-        better = v > ecc
-        ecc[better] = v[better]
-        far[better] = k[better] + start
-    slack = 1e-7  # rad: rounding of arccos near 1 (~1e-8) with a margin
-    k = int(ecc[:m_touch].argmax())
-    lower = float(ecc[k])
-    max_pair = (touch_centres[k], int(far[k]))
-    upper = 0.0
-    cand_parts = []
-    for start in range(0, n, _CHUNK_ROWS):
-        ang = _angles_to(q[start : start + _CHUNK_ROWS], centres)
-        ang += ecc
-        u = ang.min(axis=1)
-        upper = max(upper, float(u.max()))
-        cand_parts.append(np.flatnonzero(u > lower - slack) + start)
-    cand = np.concatenate(cand_parts)
-    upper = min(upper + slack, math.pi)
-    exact = cand.size <= EXACT_ANGLES_MAX_N
-    if exact and cand.size >= 2:
-        qc = q[cand]
-        g = np.abs(qc @ qc.T)
-        kk = int(g.argmin())
-        a, b = divmod(kk, cand.size)
-        if a != b and 2.0 * math.acos(min(float(g.item(kk)), 1.0)) > lower:
-            max_pair = (int(cand[a]), int(cand[b]))
-    a, b = min(max_pair), max(max_pair)
-    if a == b:  # every orientation the same
-        a, b = (0, 1)
-    min_deg, max_deg = _pair_angles_deg(x, min_pair, (a, b))
-    upper_deg = max_deg if exact else max(max_deg, math.degrees(upper))
-    return AngleExtremes(min_deg=min_deg, max_deg=max_deg, min_pair=min_pair, max_pair=(a, b),
-                         max_exact=exact, max_upper_deg=upper_deg)
-
-
 def _angle_extremes_sampled(rotations: np.ndarray) -> AngleExtremes:
     """:func:`angle_extremes` for many touches: estimates in O(N) time, flagged as such.
 
@@ -600,8 +425,6 @@ def _angle_extremes_sampled(rotations: np.ndarray) -> AngleExtremes:
     return AngleExtremes(min_deg=min_deg, max_deg=max_deg, min_pair=min_pair, max_pair=max_pair,
                          max_exact=max_exact, max_upper_deg=max_deg if max_exact else upper_deg,
                          min_exact=min_deg == 0.0)
-
-
 
 
 def _projected_neighbours_best(x: np.ndarray, pair: tuple[int, int]) -> tuple[int, int]:

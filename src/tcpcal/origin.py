@@ -25,8 +25,10 @@ from typing import Any, Literal, NamedTuple
 import numpy as np
 from scipy.special import chdtrc, fdtrc
 
+from tcpcal import _lapack
 from tcpcal._stats import (
     _GRAM_SMALL,
+    DEGENERATE_TILT_RAD,
     SAME_ORIENTATION_DEG,
     AngleExtremes,
     Information,
@@ -36,6 +38,7 @@ from tcpcal._stats import (
     distinct_orientations,
     fmt_vec,
     information,
+    information_from_sum,
     soa,
     sum_over_touches,
 )
@@ -217,16 +220,41 @@ def _lstsq_core(info: Information, m_inv: np.ndarray, rotations: np.ndarray, f: 
     rotation rows.
     """
     n = rotations.shape[0]
-    fbar = (_add(f, axis=0) if n <= 64 else sum_over_touches(f)) / n  # sum_over_touches, inlined (hot path)
-    neg_d = fbar - f  # -d_i (the sign spares a negation below)
+    fbar, neg_d = _centred(f)  # neg_d = -d_i (the sign spares a negation below)
     rows = rotations.reshape(3 * n, 3)
     t = _dot(m_inv, _dot(neg_d.reshape(3 * n), rows))
     rbar_t = _dot(info.rbar, t)
     e = _dot(rows, t).reshape(n, 3)
     e -= neg_d
     e -= rbar_t
-    e_flat = e.reshape(3 * n)
-    return _LstsqFit(t, rbar_t + fbar, e, float(_dot(e_flat, e_flat)), neg_d)
+    return _LstsqFit(t, rbar_t + fbar, e, float(_vdot(e, e)), neg_d)
+
+
+def _centred(f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(fbar, fbar - f_i)`` of the (N, 3) positions: their mean and negated deviations.
+
+    Up to ``_MEAN_ROWS_MAX_N`` touches one product gives the mean in every row (two numpy
+    calls rather than three, no broadcast: hot path). BLAS sums such short columns in order,
+    so every row is the same and, for N = 4 and 8 (1/N exact), equal to ``sum f_i / N`` bit
+    for bit; for N = 5 to 7 within an ulp of it."""
+    n = f.shape[0]
+    if n <= _MEAN_ROWS_MAX_N:
+        fbar_rows = _dot(_mean_rows(n), f)
+        return fbar_rows[0], fbar_rows - f
+    fbar = (_add(f, axis=0) if n <= 64 else sum_over_touches(f)) / n  # sum_over_touches, inlined
+    return fbar, fbar - f
+
+
+_MEAN_ROWS_MAX_N = 8
+
+
+@functools.lru_cache(maxsize=_MEAN_ROWS_MAX_N)
+def _mean_rows(n: int) -> np.ndarray:
+    """The (n, n) matrix with every entry ``1/n`` (read-only): its product with the (n, 3)
+    positions has their mean in every row."""
+    mean_rows = np.full((n, n), 1.0 / n)
+    mean_rows.setflags(write=False)
+    return mean_rows
 
 
 def _pairwise_core(rotations: np.ndarray, f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -484,7 +512,8 @@ def solve_xyz4(
 
 _add = np.add.reduce  # ufunc reductions without the Python wrapper of ndarray.sum (hot path)
 _max = np.maximum.reduce
-_dot = np.dot  # small 2-D products: less Python dispatch than the @ operator (hot path)
+_dot = _lapack.dot  # small 2-D products: less Python dispatch than the @ operator (hot path)
+_vdot = _lapack.vdot  # a whole array's sum of squares
 try:  # numpy.einsum without its Python dispatch (optimize=False calls this very function)
     from numpy._core.multiarray import c_einsum as _einsum
 except ImportError:  # pragma: no cover - another numpy
@@ -497,12 +526,12 @@ orientation" (``SAME_ORIENTATION_DEG`` = 0.05 deg): ``|R_a - R_b|_F^2 = |R_a|_F^
 such a pair at least 0.49 deg apart."""
 
 
-@functools.lru_cache(maxsize=_GRAM_SMALL)
-def _off_diagonal(n: int) -> np.ndarray:
-    """(n, n) boolean mask, True off the diagonal (read-only)."""
-    mask = ~np.eye(n, dtype=bool)
-    mask.setflags(write=False)
-    return mask
+@functools.lru_cache(maxsize=16)
+def _three_eye(n: int) -> np.ndarray:
+    """``3 I`` (n x n, read-only): ``|R|_F^2`` of a rotation on the diagonal."""
+    three_eye = 3.0 * np.eye(n)
+    three_eye.setflags(write=False)
+    return three_eye
 
 
 def _observability(rot: np.ndarray, y: np.ndarray | None, info: Information) -> AngleExtremes | None:
@@ -519,8 +548,9 @@ def _observability(rot: np.ndarray, y: np.ndarray | None, info: Information) -> 
     if info.observable:
         if n <= _GRAM_SMALL:
             x = rot.reshape(n, 9)
-            largest = float(_max(_dot(x, x.T), axis=None, where=_off_diagonal(n), initial=-math.inf))
-            if largest < _DUPLICATE_PRETEST_TRACE:
+            g = _dot(x, x.T)
+            g -= _three_eye(n)  # the diagonal |R_i|_F^2 - 3 = +-3e-6: far below the pretest's bound
+            if float(_max(g, axis=None)) < _DUPLICATE_PRETEST_TRACE:
                 return None
         elif distinct_orientations(rot, limit=MIN_TOUCHES).count >= MIN_TOUCHES:
             return None
@@ -537,7 +567,7 @@ class _Deferred(NamedTuple):
     info: Information
     ext: AngleExtremes | None  # None: not computed yet
     lstsq_noise: float | None  # lstsq: ``cov = noise^2 M^-1``, eigenvalues noise^2 / eig M; None: of ``cov``
-    cov: np.ndarray
+    cov: np.ndarray | None  # the covariance (None for lstsq, whose eigenvalues need it not)
     ci_dof: int | None
     early_warnings: list[str]
     sigma: float | None
@@ -567,6 +597,7 @@ def _late_figures(d: _Deferred, res: np.ndarray) -> _Figures:
         noise2 = d.lstsq_noise * d.lstsq_noise
         cov_eig = [noise2 / v for v in info.eigvals.tolist()]  # > 0: the touches are observable
     else:
+        assert d.cov is not None  # given for every estimator but lstsq
         cov_eig = np.linalg.eigvalsh(d.cov)
     ci95 = ci_radius(cov_eig, d.ci_dof)
     warnings = d.early_warnings
@@ -612,8 +643,16 @@ class _LazyTcpResult(TcpResult):
     needs (``mean_error``, ``max_error``, ``ci95_radius``, the angle figures,
     ``condition_number``, ``warnings``) are computed
     together on the first read of any of them (:func:`_late_figures`, from the solve's own
-    arrays; the same values as computed eagerly), then kept. Frozen like its base; a copy or
-    a pickle is a plain :class:`TcpResult` with every figure."""
+    arrays; the same values as computed eagerly), then kept; so is the lstsq ``covariance``
+    of up to ``_SMALL_N`` touches, ``noise^2 M^-1``, on its own first read (one product). Frozen
+    like its base; a copy or a pickle is a plain :class:`TcpResult` with every figure."""
+
+    @functools.cached_property
+    def covariance(self) -> np.ndarray:
+        scale, m_inv = self.__dict__["_covariance_of"]  # (noise^2, M^-1): kept, never written
+        cov: np.ndarray = scale * m_inv
+        cov.setflags(write=False)
+        return cov
 
     @property
     def _figures(self) -> _Figures:
@@ -694,6 +733,8 @@ def _solve(rot: np.ndarray, y: np.ndarray | None, f: np.ndarray, method: str, si
     """Solve validated touches: ``rot`` (N, 3, 3), ``f`` (N, 3); ``y`` = ``soa(rot)`` or None
     (then made here if needed)."""
     n = rot.shape[0]
+    if method == "lstsq" and n <= _SMALL_N:
+        return _solve_lstsq_small(rot, f, sigma, detect_outliers)
     test_outliers = detect_outliers and n > MIN_TOUCHES
     if y is None and (test_outliers or n > 64):
         y = soa(rot)
@@ -742,41 +783,113 @@ def _solve(rot: np.ndarray, y: np.ndarray | None, f: np.ndarray, method: str, si
 
     outliers: list[int] = (_find_outliers(rot, y, f, (info, fit))
                            if test_outliers and y is not None and fit is not None else [])  # both made above
-    without: TcpResult | None = None
-    if outliers:
-        keep = np.setdiff1d(np.arange(n), outliers)
-        try:
-            without = _solve(rot[keep], None, f[keep], method, sigma, False)
-        except DegenerateTouchesError as exc:
-            warnings.append(f"without the outliers the touches are degenerate: {exc}")
-        scale = f"noise estimate {without.noise_sigma:.3g}" if without is not None else "the others"
-        plural = len(outliers) > 1
-        warnings.append(
-            f"touch{'es' if plural else ''} {_fmt_idx(outliers)} (0-based) stand{'' if plural else 's'} out "
-            f"(residual {', '.join(f'{res[i]:.3g}' for i in outliers)} vs {scale}): probably a careless "
-            f"touch; see the result without {'them' if plural else 'it'} (without_outliers), or re-record "
-            f"{'them' if plural else 'it'}."
-        )
+    without = _without_outliers(rot, f, outliers, method, sigma, res, warnings) if outliers else None
+    return _lazy_result(method, t, r, e, res, sse, noise, cov, outliers, without,
+                        _Deferred(rot, y, info, ext, noise if cov_unit is None else None, cov,
+                                  None if sigma is not None else dof, warnings, sigma, sse, s_est, dof,
+                                  detect_outliers))
 
-    for a in (t, r, e, res, cov):  # made here and shared with nobody: read-only without a copy
-        a.setflags(write=False)
-    result = object.__new__(_LazyTcpResult)  # its fields as TcpResult's __init__ sets them, the rest deferred
-    result.__dict__.update(
-        method=method,
-        tcp=t,
-        reference=r,
-        residual_vectors=e,
-        residuals=res,
-        rms_error=math.sqrt(sse / n),
-        noise_sigma=float(noise),
-        covariance=cov,
-        outliers=tuple(outliers),
-        without_outliers=without,
-        n_touches=n,
-        _deferred=_Deferred(rot, y, info, ext, noise if cov_unit is None else None, cov,
-                            None if sigma is not None else dof, warnings, sigma, sse, s_est, dof, detect_outliers),
+
+def _without_outliers(rot: np.ndarray, f: np.ndarray, outliers: list[int], method: str, sigma: float | None,
+                      res: np.ndarray, warnings: list[str]) -> TcpResult | None:
+    """The same method on the touches not in ``outliers`` (None if they are degenerate), and
+    the remarks on the outliers appended to ``warnings`` (``res``: the residual lengths)."""
+    keep = np.setdiff1d(np.arange(rot.shape[0]), outliers)
+    without: TcpResult | None = None
+    try:
+        without = _solve(rot[keep], None, f[keep], method, sigma, False)
+    except DegenerateTouchesError as exc:
+        warnings.append(f"without the outliers the touches are degenerate: {exc}")
+    scale = f"noise estimate {without.noise_sigma:.3g}" if without is not None else "the others"
+    plural = len(outliers) > 1
+    warnings.append(
+        f"touch{'es' if plural else ''} {_fmt_idx(outliers)} (0-based) stand{'' if plural else 's'} out "
+        f"(residual {', '.join(f'{res[i]:.3g}' for i in outliers)} vs {scale}): probably a careless "
+        f"touch; see the result without {'them' if plural else 'it'} (without_outliers), or re-record "
+        f"{'them' if plural else 'it'}."
     )
+    return without
+
+
+def _lazy_result(method: str, t: np.ndarray, r: np.ndarray, e: np.ndarray, res: np.ndarray, sse: float,
+                 noise: float, cov: np.ndarray | tuple[float, np.ndarray], outliers: list[int],
+                 without: TcpResult | None, deferred: _Deferred) -> TcpResult:
+    """The :class:`_LazyTcpResult` of a solve; its arrays become read-only (made by the solve
+    and shared with nobody: no copy). ``cov``: the covariance, or ``(noise^2, M^-1)`` to make
+    it from on its first read."""
+    for a in (t, r, e, res):
+        a.setflags(write=False)
+    n = e.shape[0]
+    result = object.__new__(_LazyTcpResult)  # its fields as TcpResult's __init__ sets them, the rest deferred
+    fields = {
+        "method": method, "tcp": t, "reference": r, "residual_vectors": e, "residuals": res,
+        "rms_error": math.sqrt(sse / n), "noise_sigma": float(noise),
+        "outliers": tuple(outliers), "without_outliers": without, "n_touches": n, "_deferred": deferred}
+    if isinstance(cov, tuple):
+        fields["_covariance_of"] = cov
+    else:
+        cov.setflags(write=False)
+        fields["covariance"] = cov
+    object.__setattr__(result, "__dict__", fields)
     return result
+
+
+_SMALL_N = 64
+"""Up to this many touches the default estimator's solve is :func:`_solve_lstsq_small`."""
+
+
+def _solve_lstsq_small(rot: np.ndarray, f: np.ndarray, sigma: float | None, detect_outliers: bool) -> TcpResult:
+    """:func:`_solve` with ``method="lstsq"`` for up to ``_SMALL_N`` touches (the wizard's
+    case), written as one function: the same arithmetic, in the same order, as
+    :func:`tcpcal._stats.information`, :func:`_observability`, ``Information.m_inv`` and
+    :func:`_lstsq_core` (a test checks them equal to the last bit), without their calls and
+    intermediate tuples; the covariance ``noise^2 M^-1`` is left to its first read
+    (:class:`_LazyTcpResult`). At a few touches every numpy call costs more in overhead than in
+    arithmetic (~1 us against a few ns), so the count of calls is the cost
+    (``tests/bench/bench_solver.py``, tables 2 and 2b)."""
+    n = rot.shape[0]
+    y = soa(rot) if detect_outliers and n > MIN_TOUCHES else None
+    # information(rot, y)
+    s = _add(rot, 0) if y is None else y.reshape(9, n).sum(axis=1).reshape(3, 3)
+    info = information_from_sum(s, n)
+    w, v = info.eigvals, info.eigvecs
+    # _observability(rot, y, info): the pretest of the largest off-diagonal Gram entry
+    ext: AngleExtremes | None = None
+    if math.sqrt(w.item(0) / n) >= DEGENERATE_TILT_RAD:  # info.observable
+        x = rot.reshape(n, 9)
+        g = _dot(x, x.T)
+        g -= _three_eye(n)
+        if not float(_max(g, None)) < _DUPLICATE_PRETEST_TRACE:
+            ext = angle_extremes(rot, y)
+            _check_observable(rot, info, ext)
+    else:
+        ext = angle_extremes(rot, y)
+        _check_observable(rot, info, ext)  # raises
+    m_inv = _dot(v / w, v.T)  # info.m_inv()
+    # _lstsq_core(info, m_inv, rot, f)
+    fbar, neg_d = _centred(f)
+    rows = rot.reshape(3 * n, 3)
+    t = _dot(m_inv, _dot(neg_d.reshape(3 * n), rows))
+    rbar_t = _dot(info.rbar, t)
+    e = _dot(rows, t).reshape(n, 3)
+    e -= neg_d
+    e -= rbar_t
+    sse = float(_vdot(e, e))
+    r = rbar_t + fbar
+    # the rest of _solve for lstsq
+    res = _einsum("ni,ni->n", e, e)
+    if not math.isfinite(sse):  # see _solve: one check for t, r and the SSE
+        _check_finite_result(t, r, sse)
+    np.sqrt(res, out=res)
+    dof = 3 * n - 6
+    s_est = math.sqrt(sse / dof)
+    noise = s_est if sigma is None else sigma
+    warnings: list[str] = []
+    outliers = _find_outliers(rot, y, f, (info, _LstsqFit(t, r, e, sse, neg_d))) if y is not None else []
+    without = _without_outliers(rot, f, outliers, "lstsq", sigma, res, warnings) if outliers else None
+    return _lazy_result("lstsq", t, r, e, res, sse, noise, (noise * noise, m_inv), outliers, without,
+                        _Deferred(rot, y, info, ext, noise, None, None if sigma is not None else dof, warnings,
+                                  sigma, sse, s_est, dof, detect_outliers))
 
 
 def solve_reference(

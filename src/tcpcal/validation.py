@@ -11,6 +11,7 @@ absolute entry of ``R^T R - I``) and proper (``det R > 0``, i.e. +1 within the t
 
 from __future__ import annotations
 
+import functools
 import math
 from typing import Any
 
@@ -43,7 +44,10 @@ _EYE = np.eye(3)
 _EYE_COLUMN = _EYE[:, :, None]
 # ufunc reductions without the Python wrappers of ndarray.sum/max/min (the solvers' hot path)
 _add, _max, _min = np.add.reduce, np.maximum.reduce, np.minimum.reduce
+_vdot = _lapack.vdot  # the sum of squares of a whole array (hot path)
 _CYCLIC = np.array([0, 1, 2, 0, 1])
+_ORTHONORMAL_TOL_SQ = ORTHONORMAL_TOL * ORTHONORMAL_TOL
+_MAX_ABS_COORDINATE_SQ = MAX_ABS_COORDINATE * MAX_ABS_COORDINATE  # 1e18: exact in float64
 
 
 def read_only_array(a: Any) -> np.ndarray:
@@ -95,6 +99,15 @@ SMALL_STACK = 64
 above, element-wise products of contiguous length-N rows (``(3, 3, N)`` layout, faster)."""
 
 
+@functools.lru_cache(maxsize=16)
+def _eye_stack(n: int) -> np.ndarray:
+    """``n`` 3x3 identities, (n, 3, 3), read-only: subtracting an array of the same shape is
+    several times faster in numpy than broadcasting one 3x3 identity over the stack."""
+    eye = np.tile(_EYE, (n, 1, 1))
+    eye.setflags(write=False)
+    return eye
+
+
 def rotations_and_soa(x: Any, name: str = "rotations") -> tuple[np.ndarray, np.ndarray | None]:
     """:func:`as_rotations`, also returning the ``(3, 3, N)`` layout ``y[j, k] = R[:, j, k]``
     (``tcpcal._stats.soa``) when the check computed it (N > ``SMALL_STACK``), else None.
@@ -117,10 +130,15 @@ def rotations_and_soa(x: Any, name: str = "rotations") -> tuple[np.ndarray, np.n
     if n <= SMALL_STACK:
         # a NaN or inf makes R^T R so, which fails the check below: _raise_first_bad names it
         gram = arr.transpose(0, 2, 1) @ arr  # R^T R
-        gram -= _EYE
-        np.abs(gram, out=gram)
-        if not float(_max(gram, axis=None)) <= ORTHONORMAL_TOL:
-            _raise_first_bad(arr, gram.reshape(n, 9).max(axis=1), name)
+        gram -= _eye_stack(n)
+        # Clean path, one call: a sum of squares below tol^2 bounds every |entry| (float
+        # rounding is monotone: no rounded partial sum of squares falls below a rounded
+        # square, so an entry beyond tol makes the sum at least fl(tol^2)); else, or for a
+        # NaN, the entry-by-entry check decides.
+        if not float(_vdot(gram, gram)) < _ORTHONORMAL_TOL_SQ:
+            np.abs(gram, out=gram)
+            if not float(_max(gram, axis=None)) <= ORTHONORMAL_TOL:
+                _raise_first_bad(arr, gram.reshape(n, 9).max(axis=1), name)
         det = _lapack.det(arr)
     else:
         if not math.isfinite(float(_add(arr, axis=None))):  # NaN/inf (or an overflow: then go on)
@@ -225,9 +243,13 @@ def as_positions(x: Any, n: int | None = None, name: str = "positions") -> np.nd
             f"{name} has {arr.shape[0]} rows but there are {n} rotations; pass exactly one "
             "position per rotation (same touches, same order)."
         )
-    # one reduction: the largest |entry| is NaN for a NaN (maximum propagates it), inf for an inf
-    if not float(_max(np.abs(arr), axis=None)) <= MAX_ABS_COORDINATE:
-        _raise_bad_coordinate(arr, name)
+    # Up to SMALL_STACK rows the clean path is one call: a sum of squares below
+    # MAX_ABS_COORDINATE^2 bounds every |entry| (monotone rounding, as in rotations_and_soa).
+    # Otherwise one reduction decides: the largest |entry| is NaN for a NaN (maximum
+    # propagates it), inf for an inf.
+    if not (arr.shape[0] <= SMALL_STACK and float(_vdot(arr, arr)) < _MAX_ABS_COORDINATE_SQ):
+        if not float(_max(np.abs(arr), axis=None)) <= MAX_ABS_COORDINATE:
+            _raise_bad_coordinate(arr, name)
     return arr
 
 

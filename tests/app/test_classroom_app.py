@@ -51,6 +51,35 @@ def test_name_prompt_records_the_trainee_and_escapes_the_name(app_factory, tmp_p
         assert db.execute("SELECT ended_at FROM sessions").fetchone()[0] is not None
 
 
+def test_a_trainee_leaving_while_the_table_is_read_is_in_it_connected_or_left(app_factory, tmp_path: Path) -> None:
+    """The dashboard's table reads the connected trainees and who left at two moments: a
+    trainee who leaves in between (here: right after the departures were read) is in one of
+    the two lists, never missing from both."""
+    app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token="secret-token-1-of-16")
+    c = DrainingClient(app.port)
+    try:
+        s = _session(app, c)
+        prompt = s.views["identity"]
+        choose(prompt.name_field, "Anna", _browser(s))
+        click(prompt.start, _browser(s))
+        assert [row.name for row in app.classroom.trainee_statuses()] == ["Anna"]
+        room = app.classroom
+        real = room.gradebook.departed
+
+        def departed_then_anna_leaves(*args, **kwargs):
+            rows = real(*args, **kwargs)
+            room.gradebook.departed = real
+            room.detach(s)                         # Anna's browser closes just after the read
+            return rows
+
+        room.gradebook.departed = departed_then_anna_leaves
+        rows = room.trainee_statuses()
+        assert [row.name for row in rows] == ["Anna"], rows
+        assert [(row.name, row.connected) for row in room.trainee_statuses()] == [("Anna", False)]
+    finally:
+        c.close()
+
+
 def test_wizard_events_reach_the_gradebook_through_the_gui(app_factory, tmp_path: Path) -> None:
     app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token="secret-token-1-of-16")
     c = DrainingClient(app.port)

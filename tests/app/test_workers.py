@@ -1,6 +1,6 @@
-"""``tcp-pendant --workers 2``: two real server processes on one port. The kernel spreads the
-browsers over both (each process's pid is in the gradebook's presence table, ``holder``), and
-the jog deadman holds in each."""
+"""``tcp-pendant --workers 2``: two real server processes on one port. The browsers are spread
+over both, each new one to the process with fewer (``tcp_pendant.balance``; each process's pid
+is in the gradebook's presence table, ``holder``), and the jog deadman holds in each."""
 
 from __future__ import annotations
 
@@ -18,6 +18,7 @@ import pytest
 sys.path.insert(0, str(Path(__file__).parent))
 from async_clients import PLUS, READOUT_LABEL, TOKEN_LABEL, connect_all  # noqa: E402
 
+from tcp_pendant.balance import BalanceFile
 from tcp_pendant.classroom.gradebook import Gradebook
 from tcp_pendant.classroom.trainer_token import lock_s
 
@@ -35,7 +36,7 @@ def workers2(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[int, li
     tmp_path = tmp_path_factory.mktemp("workers2")
     db = tmp_path / "class.sqlite3"
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT / "src"), str(ROOT / "app")]),
-               TCP_PENDANT_TRAINER_TOKEN="trainer-token-for-tests-0001")
+               TCP_PENDANT_TRAINER_TOKEN="trainer-token-for-tests-0001", TMPDIR=str(tmp_path))
     server = subprocess.Popen([sys.executable, "-m", "tcp_pendant", "--port", "0", "--workers", "2", "--class-db",
                                str(db), "--tool-library", str(tmp_path / "tools.json"), "--seed", "5"],
                               env=env, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, text=True)
@@ -169,3 +170,51 @@ def test_wrong_trainer_tokens_lock_the_address_out_on_both_processes(workers2) -
         assert shown[0].startswith("⚠ Too many wrong trainer tokens from this browser: try again in ")
         assert not any(n.startswith("### Trainer dashboard") for n in shown)
     assert len(failures()) == 7                          # the refused tries were not counted
+
+
+@pytest.mark.timeout(300)
+def test_browsers_arriving_one_by_one_are_split_evenly_over_the_processes(workers2) -> None:
+    """Trainees who arrive one after another (each one's session built before the next comes)
+    are split 8 / 8, each process's share read from the gradebook's presence (the pid that
+    holds the name), and never more than one apart on the way: the kernel's hash alone splits
+    16 browsers 8 / 8 in 20 % of the classes and keeps them one apart throughout in < 1 %."""
+    port, pids, db = workers2
+    (record_path,) = (db.parent).glob("tcp-pendant-workers-*/balance.json")
+    record = BalanceFile(record_path)
+
+    def browsers() -> list[int]:
+        return [row["sessions"] for row in record.read()["listeners"]]
+
+    async def until(what: str, fn, timeout_s: float = 30.0) -> None:
+        deadline = time.monotonic() + timeout_s
+        while not fn():
+            assert time.monotonic() < deadline, f"{what}: not within {timeout_s} s ({browsers()})"
+            await asyncio.sleep(0.02)
+
+    async def scenario() -> tuple[list[list[int]], dict[int, int]]:
+        await until("the other tests' browsers gone", lambda: sum(browsers()) == 0)
+        clients, seen = [], []
+        try:
+            for i in range(16):
+                clients += await connect_all("127.0.0.1", port, 1, names="Even", first=i)
+                await until(f"browser {i + 1} counted", lambda: sum(browsers()) == i + 1)
+                seen.append(browsers())
+            book = Gradebook(db)
+            try:
+                await until("every trainee present", lambda: len(
+                    [r for r in book.present() if r[0].startswith("Even ")]) == 16)
+                rows = [r for r in book.present() if r[0].startswith("Even ")]
+            finally:
+                book.close()
+            per_pid: dict[int, int] = {}
+            for _, holder, _ in rows:
+                pid = int(holder.split(":")[-2])
+                per_pid[pid] = per_pid.get(pid, 0) + 1
+            return seen, per_pid
+        finally:
+            for c in clients:
+                await c.close()
+
+    seen, per_pid = asyncio.run(scenario())
+    assert all(max(counts) - min(counts) <= 1 for counts in seen), seen
+    assert per_pid == {pids[0]: 8, pids[1]: 8}

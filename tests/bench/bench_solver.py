@@ -20,7 +20,8 @@ Prints, and says for each target whether it is met:
    (smallest / largest singular value of the centred positions), which is what ruins the
    sphere fit at N = 4.
 2. Median wall-clock time (us) of ``solve_xyz4`` with the default lstsq estimator and the
-   outlier test, and the same without the outlier test, for N = 4, 8, 20 and 1000, and of the
+   outlier test, and the same without the outlier test, for N = 4, 8, 20 and 1000 (each in hot
+   loops of ``HOT_BLOCK`` calls, the columns' blocks taking turns: ``hot_loop_medians_us``), and of the
    first read of the figures the result computes when first asked (``DEFERRED_FIGURES``:
    the angle figures, the 95 % radius, ...; each row also says it in units of the solve),
    against a baseline measured in the same run: ``numpy.linalg.lstsq`` on the
@@ -160,6 +161,35 @@ def median_us(fn: Callable[[], object], repeats: int) -> float:
     return float(np.median(times) * 1e6)
 
 
+HOT_BLOCK = 25
+"""Table 2: calls of one function back to back per block (its hot loop)."""
+
+
+def hot_loop_medians_us(fns: dict[str, Callable[[], object]], repeats: int, apart: tuple[str, ...] = (),
+                        block: int = HOT_BLOCK) -> dict[str, float]:
+    """Median time (us) of each of ``fns`` over ``repeats`` calls, made in blocks of ``block``
+    calls of one function back to back (a hot loop: its code and data stay in the caches),
+    the functions' blocks taking turns, in reversed order every other round: the shared
+    machine's load then hits every column alike instead of whichever ran during a busy
+    second (one untimed call before each block). ``apart``: functions whose blocks run after
+    all the others instead (numpy's multi-threaded LAPACK at large N: its threads keep the
+    other core busy for a while after it)."""
+    times: dict[str, list[float]] = {k: [] for k in fns}
+    rounds = max(1, -(-repeats // block))
+    turns = [(k, f) for k, f in fns.items() if k not in apart]
+    for rnd in range(rounds):
+        for k, f in turns if rnd % 2 == 0 else turns[::-1]:
+            f()
+            for _ in range(block):
+                t0 = time.perf_counter()
+                f()
+                times[k].append(time.perf_counter() - t0)
+    medians = {k: float(np.median(v) * 1e6) for k, v in times.items() if k not in apart}
+    for k in apart:
+        medians[k] = median_us(fns[k], repeats)
+    return medians
+
+
 _MINUS_EYE = -np.eye(3)
 
 
@@ -181,8 +211,10 @@ def bare_svd_solve(rot: np.ndarray, pos: np.ndarray) -> tuple[np.ndarray, np.nda
 
 
 DEFERRED_FIGURES = ("mean_error", "max_error", "ci95_radius", "max_angle_deg", "min_angle_deg",
-                    "condition_number", "warnings", "max_angle_exact", "max_angle_upper_deg", "min_angle_exact")
-"""The figures of solve_xyz4's result computed on their first read (tcpcal.origin._LazyTcpResult)."""
+                    "condition_number", "warnings", "max_angle_exact", "max_angle_upper_deg", "min_angle_exact",
+                    "covariance")
+"""The figures of solve_xyz4's result computed on their first read (tcpcal.origin._LazyTcpResult;
+the covariance for lstsq up to 64 touches)."""
 
 
 def figures_us(rot: np.ndarray, pos: np.ndarray, repeats: int) -> float:
@@ -206,11 +238,13 @@ def timing_table(repeats: int) -> list[tuple[int, float, float, float, float, fl
         a = stacked_a(rot)
         b = -pos.reshape(-1)
         reps = repeats if n < 1000 else max(repeats // 4, 10)
-        full = median_us(lambda rot=rot, pos=pos: solve_xyz4(rot, pos), reps)
-        no_outl = median_us(lambda rot=rot, pos=pos: solve_xyz4(rot, pos, detect_outliers=False), reps)
-        base = median_us(lambda a=a, b=b: np.linalg.lstsq(a, b, rcond=None), reps)
-        bare = median_us(lambda rot=rot, pos=pos: bare_svd_solve(rot, pos), reps)
-        out.append((n, full, no_outl, base, bare, figures_us(rot, pos, reps)))
+        med = hot_loop_medians_us({
+            "full": lambda rot=rot, pos=pos: solve_xyz4(rot, pos),
+            "no_outl": lambda rot=rot, pos=pos: solve_xyz4(rot, pos, detect_outliers=False),
+            "base": lambda a=a, b=b: np.linalg.lstsq(a, b, rcond=None),
+            "bare": lambda rot=rot, pos=pos: bare_svd_solve(rot, pos),
+        }, reps, apart=("base", "bare") if n >= 1000 else (), block=min(HOT_BLOCK, reps))
+        out.append((n, med["full"], med["no_outl"], med["base"], med["bare"], figures_us(rot, pos, reps)))
     return out
 
 
@@ -599,18 +633,20 @@ def main(argv: list[str] | None = None) -> int:
             tgt += f"; <= {BARE_RATIO_TARGET} x bare: {verdict(full <= BARE_RATIO_TARGET * bare)}"
         print(f"{n:>5} {full:11.1f} {no_outl:16.1f} {base:21.1f} {full / base:6.1f} {bare:15.1f} "
               f"{full / bare:6.2f}  {tgt}  | {figs:8.1f} ({figs / full:.2f} x solve)")
-    print("   solve_xyz4 includes input checks, the residuals, noise and covariance, the check for")
-    print("   repeated orientations and the outlier test; np.linalg.lstsq (A prebuilt) gives t and r only;")
-    print("   the bare SVD solve builds A and b from the touches, solves by numpy.linalg.svd and gives t,")
-    print("   r and the residual lengths (bare_svd_solve: no check, no quality figure). 'figures read':")
-    print("   the first read of the figures the result computes when first asked (mean and largest")
-    print("   residual, 95 % radius, the largest/smallest angle between touches, condition number,")
-    print("   warnings; all at once), after a solve; the solve's time does not include it.")
-    print("   Each column here is one function called back to back (a hot loop: its code and data stay")
-    print("   in the caches); the bare SVD solve (one LAPACK call) gains more from that than solve_xyz4")
-    print("   (~40 small numpy calls), so the N = 4 ratio here is higher than in table 2b, where the")
-    print("   functions take turns round by round as they do in use (the wizard solves once between")
-    print("   other work).")
+    print("   solve_xyz4 includes input checks, the residuals, noise (and the covariance above 64 touches),")
+    print("   the check for repeated orientations and the outlier test; np.linalg.lstsq (A prebuilt) gives")
+    print("   t and r only; the bare SVD solve builds A and b from the touches, solves by numpy.linalg.svd")
+    print("   and gives t, r and the residual lengths (bare_svd_solve: no check, no quality figure).")
+    print("   'figures read': the first read of the figures the result computes when first asked (mean")
+    print("   and largest residual, 95 % radius, the largest/smallest angle between touches, condition")
+    print("   number, warnings; all at once; and the covariance, one product, up to 64 touches), after a")
+    print("   solve; the solve's time does not include it.")
+    print(f"   Each column here is one function called back to back in blocks of {HOT_BLOCK} calls (a hot loop:")
+    print("   its code and data stay in the caches), the columns' blocks taking turns so that the machine's")
+    print("   load hits them alike (N = 1000: the multi-threaded lstsq and SVD after the others); the bare")
+    print("   SVD solve (one LAPACK call) gains more from hot caches than solve_xyz4 (~30 small numpy")
+    print("   calls), so the N = 4 ratio here is higher than in table 2b, where the functions take turns")
+    print("   call by call as they do in use (the wizard solves once between other work).")
     print()
     print_figure_cost_table(QUICK)
     print()

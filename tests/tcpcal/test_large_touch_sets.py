@@ -11,6 +11,7 @@ import tracemalloc
 
 import numpy as np
 import pytest
+from angle_reference import angle_extremes_large, quaternions
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
@@ -19,11 +20,9 @@ from tcpcal import _stats
 from tcpcal._stats import (
     EXACT_ANGLES_MAX_N,
     SAMPLED_ANGLES_ABOVE_N,
-    _angle_extremes_large,
     _angle_extremes_sampled,
     angle_extremes,
     distinct_orientations,
-    quaternions,
 )
 from tcpcal.errors import DegenerateTouchesError
 from tcpcal.origin import solve_xyz4
@@ -81,7 +80,7 @@ def touch_sets(draw: st.DrawFn) -> np.ndarray:
 @given(touch_sets())
 def test_large_path_equals_every_pair(rot: np.ndarray) -> None:
     exact = angle_extremes(rot)  # N <= 60: every pair (the Gram path of before)
-    fast = _angle_extremes_large(rot)  # the exact O(N log N) search (the estimates' reference)
+    fast = angle_extremes_large(rot)  # the exact O(N log N) search (the estimates' reference)
     lo, hi = brute_angles_deg(rot)
     # The every-pair path picks the closest pair by the Gram entry trace(R_a^T R_b) = 3 - angle^2
     # + ..., whose rounding (~6e-15) cannot tell apart pairs closer than ~8e-8 rad (4.4e-6 deg);
@@ -155,7 +154,7 @@ def test_a_repeated_orientation_above_the_threshold_is_exact_and_still_refused()
 
 def test_tracker_like_cone_exact_search_gets_an_exact_largest_angle() -> None:
     """Pivoting inside a 30 deg cone (spin about the tool axis within +-20 deg): the exact
-    O(N log N) search (_angle_extremes_large) prunes to few candidates, so its largest angle
+    O(N log N) search (angle_extremes_large) prunes to few candidates, so its largest angle
     is exact, equal to the blocked Gram result; the solver's estimate brackets it."""
     rng = np.random.default_rng(11)
     n = 4000
@@ -165,7 +164,7 @@ def test_tracker_like_cone_exact_search_gets_an_exact_largest_angle() -> None:
     r = (Rotation.from_rotvec(np.c_[np.cos(az) * tilt, np.sin(az) * tilt, np.zeros(n)])
          * Rotation.from_rotvec(np.c_[np.zeros((n, 2)), spin]))
     rot = r.as_matrix()
-    exact = _angle_extremes_large(rot)
+    exact = angle_extremes_large(rot)
     x = rot.reshape(n, 9)
     a, b, _, _ = _stats._blocked_gram_extremes(x, np.ascontiguousarray(x.T))
     (max_deg,) = _stats._pair_angles_deg(x, (a, b))
@@ -278,7 +277,7 @@ def test_above_the_sampling_threshold_both_angles_are_flagged_estimates() -> Non
     pos = np.array([800.0, 0, 300]) - rot @ tcp + 0.1 * rng.normal(size=(n, 3))
     res = solve_xyz4(rot, pos)
     assert not res.min_angle_exact and not res.max_angle_exact
-    exact = _angle_extremes_large(rot)                   # the exact search of up to 1e5 touches
+    exact = angle_extremes_large(rot)                   # the exact search of up to 1e5 touches
     assert exact.min_deg <= res.min_angle_deg < 5.0      # uniform: the sample's closest pair is close
     assert res.max_angle_deg <= exact.max_upper_deg and res.max_angle_deg > 170.0
     assert res.max_angle_deg <= res.max_angle_upper_deg <= 180.0

@@ -813,18 +813,19 @@ class ClassRoom:
         connected on the other server processes of the class (by name, as they last beat),
         then those who were connected and left, on any process of the class, the latest first,
         with their last row (``Gradebook.departed``; a trainee connected again is not among
-        them)."""
-        try:
-            departed = self.gradebook.departed()
-        except GradebookError:
-            log.exception("who left the class could not be read")
-            departed = []
+        them). The departures are read after the connected trainees: a departure is kept before
+        its trainee leaves the table, so one leaving meanwhile is in one list or the other."""
         fields = {f.name for f in dataclasses.fields(TraineeStatus)}
         with self._lock:
             local = [rec.status for _, rec, _ in self._trainees.values()]
             names = {row.name for row in local}
             remote = [row for name, row in sorted(self._remote.items()) if name not in names]
         names |= {row.name for row in remote}
+        try:
+            departed = self.gradebook.departed()
+        except GradebookError:
+            log.exception("who left the class could not be read")
+            departed = []
         left = []
         for name, st in departed:
             if name in names:

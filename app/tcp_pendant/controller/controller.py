@@ -307,6 +307,28 @@ class VirtualController:
         ``true_kinematics.T_world_flange(q) @ T_flange_tool_true``."""
         return self.T_world_flange_true() @ self._tool.T_flange_tool_true
 
+    def tool_tip_true_m(self) -> list[float]:
+        """The true tool tip in WORLD (m, three Python floats): ``T_world_tool_true()[:3, 3]``
+        to rounding (``R t + p`` summed in another order than the matrix product: within a few
+        1e-16 m, not bit for bit), for tests with a margin far above that (the stop at
+        contact's pre-test on every Cartesian press).
+
+        From the flange pose the last jog ended on (its :class:`FlangeState`) when that state is
+        of the physical robot at exactly the current ``q`` (compared on every call: a ``q`` set
+        any other way is never answered from it); else from one FK pass.
+        """
+        t = self._tool.T_flange_tool_true[:3, 3].tolist()
+        st = self._state
+        if st is not None and st.kin is self._true_kin and st.q_list == self._q.tolist():
+            (r0, r1, r2), p = st.R_wf.tolist(), st.p_wf.tolist()
+        else:
+            T = self.T_world_flange_true()
+            r0, r1, r2 = T[:3, :3].tolist()
+            p = T[:3, 3].tolist()
+        tx, ty, tz = t
+        return [r0[0] * tx + r0[1] * ty + r0[2] * tz + p[0], r1[0] * tx + r1[1] * ty + r1[2] * tz + p[1],
+                r2[0] * tx + r2[1] * ty + r2[2] * tz + p[2]]
+
     def link_poses(self) -> dict[str, np.ndarray]:
         """``T_world_link`` for every robot link (scene updates)."""
         return self.kinematics.link_poses(self._q)

@@ -7,6 +7,7 @@ shows the active TCP (the tool data the controller believes) as X, Y, Z and KUKA
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Mapping
 
@@ -36,7 +37,7 @@ def fmt_num(value: float, decimals: int = 2) -> str:
     v = float(value)
     if not math.isfinite(v):
         return str(v)
-    text = f"{v:.{decimals}f}"
+    text = "%.*f" % (decimals, v)                # f"{v:.{decimals}f}" without the nested spec
     # fixed-point text is zero when it has no digit but 0 (no exponent in the "f" format)
     return text[1:] if text[0] == "-" and not text.strip("-0.") else text
 
@@ -60,27 +61,57 @@ def readout_text(readout: PoseReadout, decimals: int = 2) -> str:
 
 def _two_decimals(values: tuple[float, ...]) -> list[str]:
     """``fmt_num(v)`` of each value (two decimals, ``-0.00`` as ``0.00``, non-finite as text) in
-    one formatting pass: the readouts' numbers on every jog step."""
-    texts = (_SEP.join(("%.2f",) * len(values)) % values).split(_SEP)
-    return ["0.00" if t == "-0.00" else t for t in texts]
+    one formatting pass: the readouts' numbers on every jog step.
+
+    ``"%.2f"`` text is ``-?digits.dd``, ``nan``, ``inf`` or ``-inf``: ``-0.00`` can only be a
+    whole number, so one ``replace`` over the joined texts is the per-number rule."""
+    return (_SEP.join(("%.2f",) * len(values)) % values).replace("-0.00", "0.00").split(_SEP)
 
 
 _SEP = "\x1f"                      # never in a formatted number
+_SIX = _SEP.join(("%.2f",) * 6)
+_TCP_TABLE = ("**TCP in %s** · %s\n\n```\nX %*s mm   A %*s deg\n"
+              "Y %*s mm   B %*s deg\nZ %*s mm   C %*s deg\n```")
+
+
+@functools.lru_cache(maxsize=64)
+def _tool_title(tool_name: str | None) -> str:
+    """The TCP readout's tool: ``TOOL <name>`` (escaped) or the flange (a pure function of the name)."""
+    return "FLANGE (no tool active)" if tool_name is None else f"TOOL {escape_markdown(tool_name)}"
 
 
 def tcp_readout_markdown(readout: PoseReadout, tool_name: str | None) -> str:
     """The TCP readout: a title with frame and tool, then a monospace table
-    ``X 525.00 mm | A 0.00 deg`` (one line per pair)."""
+    ``X 525.00 mm | A 0.00 deg`` (one line per pair), the numbers right-aligned to the widest."""
     r = readout
-    x, y, z, a, b, c = _two_decimals((r.x_mm, r.y_mm, r.z_mm, r.a_deg, r.b_deg, r.c_deg))
+    x, y, z, a, b, c = (_SIX % (r.x_mm, r.y_mm, r.z_mm, r.a_deg, r.b_deg, r.c_deg)).replace(
+        "-0.00", "0.00").split(_SEP)
     w = max(len(x), len(y), len(z), len(a), len(b), len(c))
-    tool = "FLANGE (no tool active)" if tool_name is None else f"TOOL {escape_markdown(tool_name)}"
-    return (f"**TCP in {r.frame}** · {tool}\n\n```\nX {x:>{w}} mm   A {a:>{w}} deg\n"
-            f"Y {y:>{w}} mm   B {b:>{w}} deg\nZ {z:>{w}} mm   C {c:>{w}} deg\n```")
+    return _TCP_TABLE % (r.frame, _tool_title(tool_name), w, x, w, a, w, y, w, b, w, z, w, c)
+
+
+@functools.lru_cache(maxsize=32)
+def _joint_table(names: tuple[str, ...]) -> str | None:
+    """The joint readout of :func:`joint_readout_markdown` for one robot's joints with a
+    ``%8.2f`` slot per angle (the names' own ``%`` doubled); None when a name holds ``-0.00``.
+
+    A negative zero fills its slot as ``   -0.00`` (always padded: 5 of 8 characters), so
+    ``" -0.00"`` in the filled text is exactly such a slot unless a name holds it (the text
+    around the slots is fixed, and a slot is preceded by a space and followed by a space or a
+    line end): one ``replace`` of ``" -0.00"`` by ``"  0.00"`` is the per-number rule."""
+    if any("-0.00" in str(n) for n in names):
+        return None
+    items = [f"{str(n).replace('%', '%%')} %8.2f" for n in names]
+    lines = ["  ".join(items[i:i + 3]) for i in range(0, len(items), 3)]
+    return "**Joints (deg)**\n\n```\n" + "\n".join(lines) + "\n```"
 
 
 def joint_readout_markdown(angles_deg: Mapping[str, float]) -> str:
-    """Joint angles in degrees, three per line: ``A1 0.00  A2 -90.00  A3 90.00``."""
+    """Joint angles in degrees, three per line: ``A1 0.00  A2 -90.00  A3 90.00`` (each angle
+    right-aligned in 8 characters; ``-0.00`` as ``0.00``)."""
+    table = _joint_table(tuple(angles_deg))
+    if table is not None:
+        return (table % tuple(angles_deg.values())).replace(" -0.00", "  0.00")
     values = _two_decimals(tuple(angles_deg.values()))
     items = [f"{n} {v:>8}" for n, v in zip(angles_deg, values)]
     lines = ["  ".join(items[i:i + 3]) for i in range(0, len(items), 3)]

@@ -36,6 +36,7 @@ __all__ = [
     "offset_markdown",
     "side_view_markdown",
     "tip_offset_mm",
+    "tip_offset_xyz_mm",
 ]
 
 CLOSEUP_WITHIN_MM = 20.0
@@ -70,20 +71,43 @@ def jog_frame_rotation(state: PoseState, frame: str) -> np.ndarray:
 
 def tip_offset_mm(state: PoseState, reference_tip_world_m: np.ndarray, frame: str) -> np.ndarray:
     """Reference tip minus the true tool tip, along the axes of jog frame ``frame`` (mm, (3,))."""
+    return np.array(tip_offset_xyz_mm(state, reference_tip_world_m, frame))
+
+
+def tip_offset_xyz_mm(state: PoseState, reference_tip_world_m: np.ndarray,
+                      frame: str) -> tuple[float, float, float]:
+    """:func:`tip_offset_mm` as three Python floats (the readout's every step).
+
+    WORLD: ``(r - p) * 1000`` per axis on floats, the same IEEE operations as the array
+    formula (``I^T d`` is ``d``, up to the sign of a zero); other frames ``R^T (r - p) * 1000``.
+    """
+    if str(frame).upper() == "WORLD":
+        px, py, pz = np.asarray(state.T_world_tool_true)[:3, 3].tolist()
+        rx, ry, rz = np.asarray(reference_tip_world_m, dtype=float).tolist()
+        return (rx - px) * 1000.0, (ry - py) * 1000.0, (rz - pz) * 1000.0
     d_world_m = np.asarray(reference_tip_world_m, dtype=float) - np.asarray(state.T_world_tool_true)[:3, 3]
-    return jog_frame_rotation(state, frame).T @ d_world_m * 1000.0
+    x, y, z = (jog_frame_rotation(state, frame).T @ d_world_m * 1000.0).tolist()
+    return x, y, z
 
 
-def _n(v: float) -> str:
-    text = f"{v:+.2f}" if abs(v) < 100 else f"{v:+.1f}"
-    return "0.00" if float(text) == 0.0 else text
+_OFFSETS = {(fx, fy, fz): f"{fx}  ΔY {fy}  ΔZ {fz}"
+            for fx in ("%+.2f", "%+.1f") for fy in ("%+.2f", "%+.1f") for fz in ("%+.2f", "%+.1f")}
+"""The three numbers of the Δ line in one template per choice of decimals (two under 100 mm)."""
 
 
-def offset_markdown(delta_mm: np.ndarray, frame: str) -> str:
+def offset_markdown(delta_mm: np.ndarray | tuple[float, float, float], frame: str) -> str:
     """``ΔX +1.20  ΔY -0.40  ΔZ -3.00 mm`` to the tip (TOOL): the jog along each axis of the jog
-    frame that brings the tool tip onto the reference tip."""
-    d = np.asarray(delta_mm, dtype=float)
-    return f"`ΔX {_n(d[0])}  ΔY {_n(d[1])}  ΔZ {_n(d[2])} mm` to the tip ({frame})"
+    frame that brings the tool tip onto the reference tip (two decimals with the sign, one from
+    100 mm on; a zero as ``0.00``)."""
+    x, y, z = delta_mm                       # floats or numpy floats: the same text
+    # the numbers in one pass (each "%+.2f" under 100 mm, else "%+.1f"); a zero is then
+    # "+0.00" or "-0.00", which can only be a whole number of this text (a sign starts each
+    # number, and a "%+.1f" one is at least 100 or not finite)
+    text = (_OFFSETS[("%+.2f" if abs(x) < 100 else "%+.1f", "%+.2f" if abs(y) < 100 else "%+.1f",
+                      "%+.2f" if abs(z) < 100 else "%+.1f")] % (x, y, z))
+    if "0.00" in text:
+        text = text.replace("+0.00", "0.00").replace("-0.00", "0.00")
+    return f"`ΔX {text} mm` to the tip ({frame})"
 
 
 def direction_words(delta_mm: np.ndarray, frame: str) -> str:
@@ -101,7 +125,7 @@ def _scale(delta_mm: np.ndarray) -> float:
     return next((s for s in _SCALES_MM if s >= need), _SCALES_MM[-1])
 
 
-def side_view_markdown(delta_mm: np.ndarray, frame: str) -> str:
+def side_view_markdown(delta_mm: np.ndarray | tuple[float, float, float], frame: str) -> str:
     """Two magnified views of the tips around the tool tip ``+`` (a code block): the reference
     tip ``o`` (``@`` when they share a character; at the border when it is out of range). Left:
     X across, Z up; right: Y across, Z up (the jog frame's axes). The scale (mm per character,

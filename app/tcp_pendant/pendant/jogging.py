@@ -182,9 +182,14 @@ def _clear_of(tip_m: np.ndarray, step_m: np.ndarray, reference_m: np.ndarray) ->
     the step's length plus that radius, so ``guidance.contact_stop`` would say None (every point
     ``tip + t step``, ``0 <= t <= 1``, is at least ``|tip - reference| - |step|`` away). Python
     floats: the test every press of a class makes, far from the tip."""
-    px, py, pz = tip_m.tolist()
-    rx, ry, rz = reference_m.tolist()
-    return math.hypot(rx - px, ry - py, rz - pz) > math.hypot(*step_m.tolist()) + _CLEAR_M
+    return _clear_of_floats(tip_m.tolist(), step_m.tolist(), reference_m.tolist())
+
+
+def _clear_of_floats(tip_m: list[float], step_m: list[float], reference_m: list[float]) -> bool:
+    """:func:`_clear_of` of the three vectors as lists of Python floats."""
+    px, py, pz = tip_m
+    rx, ry, rz = reference_m
+    return math.hypot(rx - px, ry - py, rz - pz) > math.hypot(*step_m) + _CLEAR_M
 
 
 class Jogger:
@@ -233,11 +238,13 @@ class Jogger:
         if sign not in (1, -1):
             raise ControllerError(f"Jog sign must be +1 or -1, got {sign!r}.")
         s = self.settings
-        if hold_tick != s.continuous:
+        continuous = s.continuous
+        if hold_tick != continuous:
             return None
-        name = f"{axis}{sign}"
+        name = ""
         dt = None
-        if s.continuous:
+        if continuous:
+            name = f"{axis}{sign}"
             if self._held_at_contact == name:
                 return None
             now = self._clock()
@@ -254,7 +261,7 @@ class Jogger:
         amount = sign * s.step_amount(rotational=ax in "ABC", dt_s=dt)
         if ax in "XYZ":
             res = self._translate(ax, amount)
-            if s.continuous and res.stopped_by == "contact":
+            if continuous and res.stopped_by == "contact":
                 self._held_at_contact = name         # this hold stays stopped until released
             return res
         return self.controller.jog_cartesian(s.frame, ax, amount)
@@ -278,11 +285,24 @@ class Jogger:
         if not self.stop_at_contact:
             return c.jog_cartesian(self.settings.frame, ax, amount_mm)
         i = "XYZ".index(ax)
-        axis_m = _WORLD_AXES[:, i] if self.settings.frame == "WORLD" else self.frame_rotation()[:, i]
-        step_m = axis_m * (amount_mm / 1000.0)
-        tip_m = c.T_world_tool_true()[:3, 3]
-        stop = None if _clear_of(tip_m, step_m, c.reference_tip_world_m) else (
-            contact_stop(tip_m, step_m, c.reference_tip_world_m))
+        frame = self.settings.frame
+        reference_m = c.reference_tip_world_m
+        if frame == "WORLD":
+            # the pre-test on Python floats: the WORLD axis times the step is the step on axis i
+            # and (signed) zeros elsewhere (the same length), and the tip to rounding
+            # (``tool_tip_true_m``: its few 1e-16 m are far inside _CLEAR_M's margin, so "clear"
+            # still means contact_stop of the exact tip says None)
+            step = [0.0, 0.0, 0.0]
+            step[i] = amount_mm / 1000.0
+            if _clear_of_floats(c.tool_tip_true_m(), step, reference_m.tolist()):
+                stop = None
+            else:
+                stop = contact_stop(c.T_world_tool_true()[:3, 3], _WORLD_AXES[:, i] * (amount_mm / 1000.0),
+                                    reference_m)
+        else:
+            tip_m = c.T_world_tool_true()[:3, 3]
+            step_m = self.frame_rotation()[:, i] * (amount_mm / 1000.0)
+            stop = None if _clear_of(tip_m, step_m, reference_m) else contact_stop(tip_m, step_m, reference_m)
         if stop is None:
             return c.jog_cartesian(self.settings.frame, ax, amount_mm)
         res = c.jog_cartesian(self.settings.frame, ax, amount_mm * stop.fraction)

@@ -55,7 +55,7 @@ from tcp_pendant.pendant import (
     touch_indicator_markdown,
 )
 from tcp_pendant.pendant.hold import HoldDriver
-from tcp_pendant.pendant.guidance import CLOSEUP_WITHIN_MM, offset_markdown, side_view_markdown, tip_offset_mm
+from tcp_pendant.pendant.guidance import CLOSEUP_WITHIN_MM, offset_markdown, side_view_markdown, tip_offset_xyz_mm
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.views import arrival
 from tcp_pendant.views.scene import closeup_camera, overview_camera
@@ -134,6 +134,8 @@ class PendantPanel:
         k = c.kinematics
         self._from_client: dict[int, float] = {}   # slider -> angle (deg, 0.01) its browser value set
         self._last_text: dict[str, str] = {}
+        self._joint_folder_shown = False           # joint_folder.visible as _show_settings set it
+        self._hide_locked = False                  # hide_distance.disabled as render set it
         self._last_stop = ""
         self._stop_key: Any = None
         self._hold: HoldDriver | None = None
@@ -393,6 +395,7 @@ class PendantPanel:
             row.visible = joint and not hold
         self.cart_folder.visible = not joint and hold
         self.joint_folder.visible = joint
+        self._joint_folder_shown = joint            # what render reads (only written here)
         for b in self.joint_buttons.values():
             b.visible = hold
         self.frame.disabled = joint
@@ -423,6 +426,8 @@ class PendantPanel:
     # ------------------------------------------------------------ display
     def show_jog_result(self, res: JogResult) -> None:
         """Status line: the stop message of a jog (limit, singularity, unreachable), else clear."""
+        if res.ok and not self._last_stop and self._last_text.get("status") == "":
+            return                                   # a clear line stays clear: nothing to send or note
         text = "" if res.ok else f"⚠ {res.message}"
         self._set_md(self.status_md, "status", text)
         if text and text != self._last_stop:
@@ -442,29 +447,31 @@ class PendantPanel:
         value of it put it is not written (module docstring)."""
         s = self.session
         state = s.pose_state() if state is None else state
-        frame = self._readout
         tool = s.controller.active_tool
-        self._set_md(self.tcp_md, "tcp", tcp_readout_markdown(state.readout(frame), None if tool is None else tool.name))
+        self._set_md(self.tcp_md, "tcp", tcp_readout_markdown(state.readout(self._readout),
+                                                              None if tool is None else tool.name))
         hide = s.hide_distance
         if bool(self.hide_distance.value) != hide:
             set_value(self.hide_distance, hide)
-        if self.hide_distance.disabled != s.rules.distance_locked:     # locked by the trainer
-            self.hide_distance.disabled = s.rules.distance_locked
+        locked = s.rules.distance_locked
+        if self._hide_locked != locked:            # locked by the trainer
+            self.hide_distance.disabled = self._hide_locked = locked
         touch = touch_indicator_markdown(state.touch, hide_distance=hide)
         closeup = ""
         if not hide:
             jf = s.jogger.settings.frame
-            delta = tip_offset_mm(state, s.controller.reference_tip_world_m, jf)
+            delta = tip_offset_xyz_mm(state, s.controller.reference_tip_world_m, jf)
             touch += "\n\n" + offset_markdown(delta, jf)
             if state.touch.distance_mm <= CLOSEUP_WITHIN_MM:
                 closeup = side_view_markdown(delta, jf)
         self._set_md(self.touch_md, "touch", touch)
-        self._set_md(self.closeup_md, "closeup", closeup)
-        if self.closeup_md.visible != bool(closeup):
-            self.closeup_md.visible = bool(closeup)
+        if closeup or self._last_text.get("closeup"):   # else it is hidden and empty already
+            self._set_md(self.closeup_md, "closeup", closeup)
+            if self.closeup_md.visible != bool(closeup):
+                self.closeup_md.visible = bool(closeup)
         angles = state.joint_angles_deg
         self._set_md(self.joints_md, "joints", joint_readout_markdown(angles))
-        if not self.joint_folder.visible:
+        if not self._joint_folder_shown:
             return                      # hidden sliders are synced when joint mode is shown
         for i, (slider, v) in enumerate(zip(self.joint_sliders, angles.values())):
             value = round(float(v), 2)

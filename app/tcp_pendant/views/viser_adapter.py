@@ -152,18 +152,29 @@ def queue_markdown(handle: Any, text: str) -> bool:
     (a removed handle, or viser's internals differ).
     """
     try:
-        from viser._messages import GuiUpdateMessage
-
+        update = _GUI_UPDATE[0] if _GUI_UPDATE else _gui_update_message()
         impl = handle._impl
         if impl.removed:
             return False
         object.__setattr__(handle, "_content", text)
-        if impl.props._markdown != text:
-            impl.props._markdown = text
-            impl.gui_api._websock_interface.queue_message(GuiUpdateMessage(impl.uuid, {"_markdown": text}))
+        props = impl.props
+        if props._markdown != text:
+            props._markdown = text
+            impl.gui_api._websock_interface.queue_message(update(impl.uuid, {"_markdown": text}))
     except (AttributeError, ImportError) as exc:
         return _fallback("markdown", exc)
     return _fast("markdown")
+
+
+_GUI_UPDATE: list[Any] = []
+"""viser's ``GuiUpdateMessage`` once imported (an import statement per readout costs a lookup)."""
+
+
+def _gui_update_message() -> Any:
+    from viser._messages import GuiUpdateMessage
+
+    _GUI_UPDATE.append(GuiUpdateMessage)
+    return GuiUpdateMessage
 
 
 try:
@@ -742,12 +753,42 @@ def install() -> None:
 
 
 _reuse_port = False
+_listen_hooks: tuple[Callable[[], Any] | None, Callable[[list[Any]], None] | None] = (None, None)
 
 
-def listen_reuse_port() -> None:
+class _ListeningServe:
+    """websockets' ``serve(...)`` as viser enters it (``async with``), with the hooks of
+    :func:`listen_reuse_port` around the moment its listener starts listening."""
+
+    def __init__(self, serve: Any) -> None:
+        self._serve = serve
+
+    async def __aenter__(self) -> Any:
+        around, started = _listen_hooks
+        if around is None:
+            server = await self._serve.__aenter__()
+        else:
+            with around():
+                server = await self._serve.__aenter__()
+        if started is not None:
+            started(list(server.sockets))
+        return server
+
+    async def __aexit__(self, *exc: Any) -> Any:
+        return await self._serve.__aexit__(*exc)
+
+    def __await__(self) -> Any:
+        return self._serve.__await__()
+
+
+def listen_reuse_port(around_listen: Callable[[], Any] | None = None,
+                      on_listening: Callable[[list[Any]], None] | None = None) -> None:
     """viser's server in this process binds its port with ``SO_REUSEPORT`` from now on (module
-    docstring; idempotent). Raises OSError where the platform has no ``SO_REUSEPORT``."""
-    global _reuse_port
+    docstring; idempotent). ``around_listen()``: a context manager entered while the listener
+    binds and starts listening; ``on_listening(sockets)``: called with its listening sockets
+    (``tcp_pendant.balance``; the last call's hooks serve). Raises OSError where the platform
+    has no ``SO_REUSEPORT``."""
+    global _reuse_port, _listen_hooks
     import socket
 
     import websockets.asyncio.server as ws_server
@@ -755,13 +796,14 @@ def listen_reuse_port() -> None:
     if not hasattr(socket, "SO_REUSEPORT"):
         raise OSError("this platform has no SO_REUSEPORT: run one server process (--workers 1)")
     with _install_lock:
+        _listen_hooks = (around_listen, on_listening)
         if _reuse_port:
             return
         original = ws_server.serve
 
         def serve(*args: Any, **kwargs: Any) -> Any:
             kwargs.setdefault("reuse_port", True)
-            return original(*args, **kwargs)
+            return _ListeningServe(original(*args, **kwargs))
 
         serve.__wrapped__ = original  # type: ignore[attr-defined]
         ws_server.serve = serve  # type: ignore[assignment,misc]
