@@ -70,6 +70,26 @@ def test_quaternion_is_scipys_rotation() -> None:
         assert abs(w * w + x * x + y * y + z * z - 1.0) < 1e-12, i
 
 
+def test_quaternion_is_pinocchios_bit_for_bit_from_an_array_or_rows() -> None:
+    """The scene's quaternion repeats Eigen's float operations: the very numbers pinocchio gives,
+    in both of its branches (trace > 0, and each largest diagonal entry), from the matrix or its rows."""
+    import pinocchio as pin
+
+    mats = list(_rotations()) + list(Rotation.random(20000, random_state=5).as_matrix())
+    for axis in np.eye(3):                           # near the half turns: the trace <= 0 branches
+        mats += [Rotation.from_rotvec(a * axis).as_matrix() for a in (np.pi - 1e-9, 2.5, 2.0 * np.pi / 3.0)]
+    branches: set[object] = set()
+    for i, R in enumerate(mats):
+        x, y, z, w = pin.Quaternion(np.ascontiguousarray(R)).coeffs().tolist()
+        assert quaternion_wxyz(R) == [w, x, y, z], i
+        T = np.eye(4)
+        T[:3, :3] = R
+        assert quaternion_wxyz(T.tolist()) == [w, x, y, z], i
+        d = np.diag(R)
+        branches.add("trace" if R[0, 0] + (R[1, 1] + R[2, 2]) > 0.0 else int(np.argmax(d)))
+    assert branches == {"trace", 0, 1, 2}
+
+
 def test_quaternions_of_a_stack() -> None:
     R = _rotations()[:20]
     Q = quaternions_wxyz(R)
@@ -118,6 +138,75 @@ def test_pose_state_equals_the_controllers_own_answers(controller: VirtualContro
         pose_state(c).readout("TOOL")
 
 
+def _yardstick():
+    sys.path.insert(0, str(Path(__file__).parents[1] / "bench"))
+    import scene_yardstick
+
+    return scene_yardstick
+
+
+def test_pose_state_is_the_code_it_replaced_bit_for_bit(controller: VirtualController, kr6) -> None:
+    """Every field equal to the yardstick's (``tests/bench/scene_yardstick.py``, the code before
+    the speed work): the same numbers, not close ones; with tool data, BASE, another tool, and a
+    physical robot that differs from the model."""
+    legacy_pose_state = _yardstick().legacy_pose_state
+    c = controller
+    perturbed = kr6.own_copy()
+    perturbed.model = kr6.model.copy()
+    perturbed.model.jointPlacements[2].translation += np.array([0.0005, -0.0003, 0.0002])
+    perturbed.data = perturbed.model.createData()
+    for setup in range(3):
+        if setup == 1:
+            c.set_active_tool(Tool(name="bent", tcp_mm=(20.0, -5.0, 150.0), abc_deg=(10.0, -60.0, 5.0)))
+            T_base = np.eye(4)
+            T_base[:3, 3] = [0.4, -0.2, 0.1]
+            c.set_T_world_base(T_base)
+            c.mount_tool(builtin_tools()["torch"])
+        if setup == 2:
+            c.set_true_kinematics(perturbed)
+        for q in _configurations(c, 6):
+            c.set_q(q)
+            new, old = pose_state(c), legacy_pose_state(c)
+            assert new.key == old.key == _yardstick().legacy_pose_state_key(c) == pose_state_key(c)
+            assert new.link_names == old.link_names
+            for f in ("q_rad", "T_world_links", "T_world_flange", "T_world_tcp", "T_world_tool_true", "T_world_base"):
+                np.testing.assert_array_equal(getattr(new, f), getattr(old, f), err_msg=f)
+            assert list(new.T_world_link) == list(old.T_world_link)
+            for name in old.T_world_link:
+                np.testing.assert_array_equal(new.T_world_link[name], old.T_world_link[name])
+            assert not new.T_world_links.flags.writeable
+            assert not new.T_world_link[new.link_names[0]].flags.writeable
+            assert list(new.joint_angles_deg.items()) == list(old.joint_angles_deg.items())
+            assert new.touch == old.touch
+            assert new.readout("BASE") == old.readout("BASE")
+
+
+def test_touch_geometry_is_the_code_it_replaced_bit_for_bit_at_the_crash_zone_edges() -> None:
+    """Random true TOOL poses with the reference tip all around the TCP, many of them at the
+    crash zone's edges (2 mm radius, 20 mm depth) and the touch tolerance: the yardstick's
+    numbers and verdicts."""
+    from tcp_pendant.controller.touch import touch_geometry
+
+    legacy = _yardstick().legacy_touch_geometry
+    rng = np.random.default_rng(12)
+    Rs = Rotation.random(3000, random_state=13).as_matrix()
+    crashed = inside = 0
+    for i, R in enumerate(Rs):
+        T = np.eye(4)
+        T[:3, :3] = R
+        T[:3, 3] = rng.uniform(-0.8, 0.8, 3)
+        depth = rng.choice([rng.uniform(-1.0, 25.0), 20.0, 0.5, rng.uniform(19.9, 20.1)])
+        rho = rng.choice([rng.uniform(0.0, 3.0), 2.0, rng.uniform(1.99, 2.01), 0.0])
+        phi = rng.uniform(0.0, 2.0 * np.pi)
+        u_mm = np.array([-depth, rho * np.cos(phi), rho * np.sin(phi)]) * rng.choice([1.0, 1.0, 30.0])
+        tip = T[:3, 3] + R @ (u_mm / 1000.0)
+        new, old = touch_geometry(T, tip), legacy(T, tip)
+        assert new == old, (i, new, old)
+        crashed += new.crashed
+        inside += new.penetration_mm > 0.0
+    assert crashed > 100 and inside > crashed                   # the zone and its edges were exercised
+
+
 def test_pose_state_key_follows_every_input(controller: VirtualController) -> None:
     c = controller
     keys = [pose_state_key(c)]
@@ -132,6 +221,8 @@ def test_pose_state_key_follows_every_input(controller: VirtualController) -> No
     T = np.eye(4)
     T[0, 3] = 0.1
     c.set_T_world_base(T)
+    keys.append(pose_state_key(c))
+    c.set_true_kinematics(c.kinematics.own_copy())            # another physical robot
     keys.append(pose_state_key(c))
     assert len(set(keys)) == len(keys)
     assert pose_state_key(c) == keys[-1]                      # nothing changed: same key
@@ -206,16 +297,16 @@ def test_only_changed_poses_are_sent(app_factory) -> None:
     client, s = _session(app)
     try:
         view = s.views["scene"]
-        sent: list[tuple[str, bool, bool]] = []
-        import tcp_pendant.views.scene as scene_module
+        sent: list[tuple[str, str]] = []                           # (node, message) queued
+        ws = view.gizmo._impl.api._websock_interface
+        real = ws.queue_message
 
-        real = scene_module._set_pose
+        def spy(message):
+            if type(message).__name__ in ("SetOrientationMessage", "SetPositionMessage"):
+                sent.append((message.name, type(message).__name__))
+            return real(message)
 
-        def spy(handle, wxyz, xyz):
-            sent.append((handle._impl.name, wxyz is not None, xyz is not None))
-            return real(handle, wxyz, xyz)
-
-        scene_module._set_pose = spy
+        ws.queue_message = spy
         try:
             with s.lock:
                 s.moved()                                          # nothing moved
@@ -224,10 +315,10 @@ def test_only_changed_poses_are_sent(app_factory) -> None:
                 s.controller.jog_joint(0, 3.0)
                 s.moved()
         finally:
-            scene_module._set_pose = real
-        names = {n for n, _, _ in sent}
+            del ws.queue_message
+        names = {n for n, _ in sent}
         assert names == {view.link_paths["link_1"], "/tcp_gizmo"}, sent
-        assert (view.link_paths["link_1"], True, False) in sent   # orientation only
+        assert [m for n, m in sent if n == view.link_paths["link_1"]] == ["SetOrientationMessage"]   # orientation only
     finally:
         client.close()
 

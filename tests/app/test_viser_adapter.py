@@ -55,6 +55,39 @@ def test_pose_fast_path_is_taken(server) -> None:
     np.testing.assert_allclose(frame.position, [0.4, 0.5, 0.6])
 
 
+def test_the_pose_fast_path_queues_what_the_public_setters_queue(server, monkeypatch) -> None:
+    """Message class, node, values, owner, wire form and redundancy key (cached by a node's
+    PoseQueue from its first message on) are the public setters' own, for two nodes interleaved."""
+    from tcp_pendant.views.viser_adapter import pose_queue
+
+    frames = [server.scene.add_frame(name, show_axes=False) for name in ("/g", "/g/h")]
+    queues = [pose_queue(f) for f in frames]
+    ws = frames[0]._impl.api._websock_interface
+    queued: list[object] = []
+    real = ws.queue_message
+    monkeypatch.setattr(ws, "queue_message", lambda m: (queued.append(m), real(m))[1])
+    rng = np.random.default_rng(3)
+    for _ in range(3):
+        for f, q in zip(frames, queues):
+            for fast in (False, True):
+                wxyz = rng.normal(size=4)
+                wxyz = (wxyz / np.linalg.norm(wxyz)).tolist()
+                xyz = rng.normal(size=3).tolist()
+                if fast:
+                    assert q is not None and q(wxyz, xyz)
+                else:
+                    f.wxyz, f.position = wxyz, xyz
+                np.testing.assert_array_equal(f.wxyz, wxyz)
+                np.testing.assert_array_equal(f.position, xyz)
+                *_, orientation, position = queued
+                assert (orientation.wxyz, position.position) == (tuple(wxyz), tuple(xyz))
+    assert len(queued) == 3 * 2 * 2 * 2
+    for public, fast in zip(queued[0::4] + queued[1::4], queued[2::4] + queued[3::4]):
+        assert type(fast) is type(public) and fast.name == public.name and fast.owner == public.owner
+        assert fast.redundancy_key() == public.redundancy_key()
+        assert set(fast.as_serializable_dict()) == set(public.as_serializable_dict())
+
+
 def test_upload_hook_is_taken(server) -> None:
     button = server.gui.add_upload_button("Load")
     assert limit_upload_size(button, 1000, lambda name, size: None) is True
@@ -101,6 +134,26 @@ def test_a_fallback_warns_once_and_uses_the_public_setters(monkeypatch, caplog) 
     assert path_counts() == {("markdown", "fallback"): 2, ("pose", "fallback"): 1}
     warnings = [r.getMessage() for r in caplog.records]
     assert len(warnings) == 2 and "markdown uses viser's public setters" in warnings[0]
+
+
+def test_the_scene_pose_sender_falls_back_to_the_public_setters(monkeypatch) -> None:
+    """A node whose handle has no viser internals gets no PoseQueue (one fallback counted at
+    build) and is posed through ``handle.wxyz`` / ``handle.position``, with the same values."""
+    from tcp_pendant.views.scene import PoseSender
+
+    monkeypatch.delenv(viser_adapter.STRICT_ENV)
+    monkeypatch.setattr(viser_adapter, "_warned", set())
+    reset_path_counts()
+    h = _Other()
+    sender = PoseSender([h], np.eye(4)[None])
+    assert path_counts() == {("pose", "fallback"): 1}
+    T = np.eye(4)
+    T[:3, :3] = [[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]     # 90 deg about Z
+    T[:3, 3] = [0.1, 0.2, 0.3]
+    assert sender.send(T[None]) == 2
+    np.testing.assert_allclose(h.wxyz, [np.sqrt(0.5), 0.0, 0.0, np.sqrt(0.5)], atol=1e-15)
+    assert h.position == [0.1, 0.2, 0.3]
+    assert sender.send(T[None]) == 0                                     # unchanged: nothing
 
 
 def test_a_fallback_raises_under_the_strict_flag() -> None:

@@ -120,7 +120,7 @@ class VirtualController:
             reference_tip_world_m = (p[0], p[1], 0.5 * p[2])
         self._tip = _check_point(reference_tip_world_m, "reference_tip_world_m")
         self._beam: BeamSensor | None = None  # None: default_beam_sensor(reference tip)
-        self._default_beam: tuple[np.ndarray, BeamSensor] | None = None  # (tip, its default sensor)
+        self._default_beam: tuple[bytes, BeamSensor] | None = None  # (tip's bytes, its default sensor)
         self._beam_device = BeamDevice()  # the default sensor's width, repeatability, crossing
 
     # ----------------------------------------------------------------- state
@@ -243,8 +243,9 @@ class VirtualController:
         that is moved). The same object until it changes (views may compare by identity)."""
         if self._beam is not None:
             return self._beam
-        if self._default_beam is None or not np.array_equal(self._default_beam[0], self._tip):
-            self._default_beam = (self._tip.copy(), default_beam_sensor(self._tip, self._beam_device))
+        tip = self._tip.tobytes()     # the scene asks every jog step: a bytes compare, not array_equal
+        if self._default_beam is None or self._default_beam[0] != tip:
+            self._default_beam = (tip, default_beam_sensor(self._tip, self._beam_device))
         return self._default_beam[1]
 
     @property
@@ -331,6 +332,13 @@ class VirtualController:
     def link_poses(self) -> dict[str, np.ndarray]:
         """``T_world_link`` for every robot link (scene updates)."""
         return self.kinematics.link_poses(self._q)
+
+    def pose_state_key(self) -> tuple[object, ...]:
+        """What the robot's pose state depends on (``pose_state.pose_state_key``): the robot
+        model, joint angles, active tool data, mounted tool, reference tip, BASE frame and the
+        physical robot, read without the copies the properties make (a jog step asks once)."""
+        return (id(self.kinematics), self._q.tobytes(), self._T_flange_tool.tobytes(), id(self._tool),
+                self._tip.tobytes(), self._T_world_base.tobytes(), id(self._true_kin))
 
     # ----------------------------------------------------------------- jogging
     def jog_joint(self, index: int, delta_deg: float) -> JogResult:

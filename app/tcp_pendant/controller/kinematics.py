@@ -196,9 +196,17 @@ class RobotKinematics:
             (f.name, i) for i, f in enumerate(model.frames) if f.type == pin.FrameType.BODY
         )
         self.link_names: tuple[str, ...] = tuple(name for name, _ in self._body_frames)
+        frame_of = {name: i for name, i in self._body_frames}     # as link_poses' dict: one entry a name
+        self._link_frame_ids: tuple[int, ...] = tuple(frame_of.values())
+        self.link_rows: dict[str, int] = {name: row for row, name in enumerate(frame_of)}
+        """Row of each link in :meth:`link_poses_array` (the order of :meth:`link_poses`)."""
         self.revolute = np.array([re.search(r"Prismatic|JointModelP[XYZ]$", j.shortname()) is None
                                   for j, _ in actuated], dtype=bool)
         """True for revolute joints (radians), False for prismatic ones (metres)."""
+        self.readout_scales: tuple[float, ...] = tuple(180.0 / math.pi if r else 1000.0
+                                                       for r in self.revolute.tolist())
+        """Per joint, readout units per joint unit: degrees per radian (revolute; ``math.degrees(v)``
+        is ``v * (180 / pi)``, the same numbers), mm per metre (prismatic)."""
 
     @property
     def description(self) -> RobotDescription:
@@ -336,6 +344,13 @@ class RobotKinematics:
         pin.framesForwardKinematics(self.model, self.data, q_rad)
         oMf = self.data.oMf
         return {name: oMf[i].homogeneous for name, i in self._body_frames}
+
+    def link_poses_array(self, q_rad: np.ndarray) -> np.ndarray:
+        """:meth:`link_poses` stacked, (N,4,4) metres, row :attr:`link_rows` ``[link]``: the same
+        pinocchio pass and numbers, in one new array (the pose state of a jog step)."""
+        pin.framesForwardKinematics(self.model, self.data, q_rad)
+        oMf = self.data.oMf.tolist()       # every frame's SE3 in one call (indexing oMf costs as much per frame)
+        return np.array([oMf[i].homogeneous for i in self._link_frame_ids])
 
     def __repr__(self) -> str:
         return (f"RobotKinematics({self.urdf_path.name!r}, joints={list(self.joint_names)}, "

@@ -20,9 +20,10 @@ No viser.
 
 from __future__ import annotations
 
-import math
-from collections.abc import Mapping
+import operator
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
+from typing import cast
 
 import numpy as np
 
@@ -30,7 +31,7 @@ from tcp_pendant.controller.controller import VirtualController
 from tcp_pendant.controller.readout import PoseReadout, readout_in_frame
 from tcp_pendant.controller.touch import TouchGeometry, touch_geometry
 
-__all__ = ["PoseState", "pose_state", "pose_state_key"]
+__all__ = ["LinkPoses", "PoseState", "pose_state", "pose_state_key"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -83,9 +84,27 @@ def pose_state_key(controller: VirtualController) -> tuple[object, ...]:
     """What a :class:`PoseState` depends on: joint angles, active tool data, mounted tool,
     reference tip, BASE frame and the robot model (nominal first, the physical robot last).
     Equal keys, equal states."""
-    c = controller
-    return (id(c.kinematics), c.q_rad.tobytes(), c.T_flange_tool.tobytes(), id(c.mounted_tool),
-            c.reference_tip_world_m.tobytes(), c.T_world_base.tobytes(), id(c.true_kinematics))
+    return controller.pose_state_key()
+
+
+class LinkPoses(Mapping[str, np.ndarray]):
+    """``T_world_link`` by link name: read-only views into the stacked poses, made when asked
+    (a jog step's scene reads the stack; only a view being built asks by name)."""
+
+    __slots__ = ("_rows", "_stacked")
+
+    def __init__(self, rows: Mapping[str, int], stacked: np.ndarray) -> None:
+        self._rows = rows
+        self._stacked = stacked
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        return cast(np.ndarray, self._stacked[self._rows[name]])
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._rows)
+
+    def __len__(self) -> int:
+        return len(self._rows)
 
 
 def pose_state(controller: VirtualController, key: tuple[object, ...] | None = None) -> PoseState:
@@ -98,25 +117,22 @@ def pose_state(controller: VirtualController, key: tuple[object, ...] | None = N
     c = controller
     k = c.kinematics
     q = c.q_rad
-    poses = c.link_poses()
-    names = tuple(poses)
-    stacked = np.array(list(poses.values()))
+    stacked = k.link_poses_array(q)
     stacked.setflags(write=False)
-    links = dict(zip(names, stacked))
-    T_world_flange = links[k.flange_link]
+    rows = k.link_rows
+    T_world_flange = stacked[rows[k.flange_link]]
     T_world_tcp = T_world_flange @ c.T_flange_tool
     T_true_flange = T_world_flange if c.true_kinematics is k else c.T_world_flange_true()
     T_world_true = T_true_flange @ c.mounted_tool.T_flange_tool_true
-    angles = {name: (math.degrees(v) if revolute else v * 1000.0)
-              for name, v, revolute in zip(k.joint_names, q.tolist(), k.revolute.tolist())}
+    angles = dict(zip(k.joint_names, map(operator.mul, q.tolist(), k.readout_scales)))
     for T in (T_world_tcp, T_world_true):
         T.setflags(write=False)
     return PoseState(
         key=pose_state_key(c) if key is None else key,
         q_rad=q,
-        link_names=names,
+        link_names=tuple(rows),
         T_world_links=stacked,
-        T_world_link=links,
+        T_world_link=LinkPoses(rows, stacked),
         T_world_flange=T_world_flange,
         T_world_tcp=T_world_tcp,
         T_world_tool_true=T_world_true,

@@ -39,6 +39,8 @@ TOUCH_TOLERANCE_MM = 0.5
 CRASH_DEPTH_MM = 0.5
 CRASH_RADIUS_MM = 2.0
 CRASH_ZONE_DEPTH_MM = 20.0
+_CRASH_ZONE_REACH_MM = math.hypot(CRASH_ZONE_DEPTH_MM, CRASH_RADIUS_MM) * (1.0 + 1e-9)
+"""Farthest a point of the crash zone is from the TCP (with a margin for rounding), mm."""
 
 
 @dataclass(frozen=True)
@@ -59,12 +61,19 @@ class TouchGeometry:
 
 
 def touch_geometry(T_world_tooltrue: np.ndarray, tip_world_m: np.ndarray) -> TouchGeometry:
-    """Touch geometry of a true TOOL pose (4,4, metres) and a reference tip (3,, metres)."""
+    """Touch geometry of a true TOOL pose (4,4, metres) and a reference tip (3,, metres).
+
+    ``R^T (r - p)`` is one numpy product (the same operations, so the same numbers, on every
+    path); the rest is Python floats, and the crash zone's test is skipped where it cannot hold (farther
+    than the zone's far corner, ``hypot(CRASH_ZONE_DEPTH_MM, CRASH_RADIUS_MM)``: penetration 0)."""
     T = np.asarray(T_world_tooltrue, dtype=float)
-    u_mm = T[:3, :3].T @ (np.asarray(tip_world_m, dtype=float) - T[:3, 3]) * 1000.0
-    distance = math.hypot(*u_mm.tolist())        # |u| (math: no numpy call per step)
-    rho = math.hypot(float(u_mm[1]), float(u_mm[2]))
-    depth = -float(u_mm[0])
-    penetration = depth if (depth > 0.0 and rho <= CRASH_RADIUS_MM and depth <= CRASH_ZONE_DEPTH_MM) else 0.0
+    ux, uy, uz = (T[:3, :3].T @ (np.asarray(tip_world_m, dtype=float) - T[:3, 3])).tolist()
+    ux, uy, uz = ux * 1000.0, uy * 1000.0, uz * 1000.0      # m -> mm (the products numpy's * 1000 makes)
+    distance = math.hypot(ux, uy, uz)            # |u| (math: no numpy call per step)
+    penetration = 0.0
+    if distance <= _CRASH_ZONE_REACH_MM:
+        depth = -ux
+        if depth > 0.0 and depth <= CRASH_ZONE_DEPTH_MM and math.hypot(uy, uz) <= CRASH_RADIUS_MM:
+            penetration = depth
     return TouchGeometry(distance_mm=distance, touching=distance <= TOUCH_TOLERANCE_MM,
                          crashed=penetration > CRASH_DEPTH_MM, penetration_mm=penetration)

@@ -50,7 +50,7 @@ from tcp_pendant.views.beam_stand import BeamStandNodes
 from tcp_pendant.views.framing import Framing, frame_spheres
 from tcp_pendant.views.meshes import MeshPart, link_meshes, rigid_meshes
 from tcp_pendant.views.gui_util import target_of
-from tcp_pendant.views.viser_adapter import queue_pose
+from tcp_pendant.views.viser_adapter import pose_queue, queue_pose
 from tcpcal.tool import Tool
 
 __all__ = ["POSE_EPS", "PoseSender", "SceneView", "camera_shape", "closeup_camera", "frame_cameras",
@@ -82,17 +82,33 @@ def wxyz_xyz(T: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def relative_poses(T_world_parent: np.ndarray, T_world_child: np.ndarray,
-                   out: np.ndarray | None = None) -> np.ndarray:
+                   out: np.ndarray | None = None, work: np.ndarray | None = None, *,
+                   bottom_rows_set: bool = False) -> np.ndarray:
     """``T_parent_child = inv(T_world_parent) @ T_world_child`` for stacks (N,4,4) of rigid
-    poses (``R_p^T R_c``, ``R_p^T (p_c - p_p)``), written into ``out`` ((N,4,4), e.g. a view of a
-    buffer reused every jog step) when given, else into a new array."""
+    poses: ``R_p^T [R_c | p_c - p_p]`` in one product, written into ``out`` ((N,4,4), e.g. a
+    view of a buffer reused every jog step) when given, else into a new array; ``work`` is an
+    (N,3,4) scratch buffer for ``[R_c | p_c - p_p]`` (the caller's, reused; else a new one).
+    ``bottom_rows_set``: ``out``'s rows ``[:, 3]`` already hold ``(0, 0, 0, 1)`` and only this
+    function writes them (the scene's buffer): not rewritten."""
     if out is None:
-        out = np.empty_like(T_world_child)
-    Rp_T = T_world_parent[:, :3, :3].transpose(0, 2, 1)
-    np.matmul(Rp_T, T_world_child[:, :3, :3], out=out[:, :3, :3])
-    np.matmul(Rp_T, (T_world_child[:, :3, 3] - T_world_parent[:, :3, 3])[..., None], out=out[:, :3, 3:])
-    out[:, 3, :] = (0.0, 0.0, 0.0, 1.0)
+        out, bottom_rows_set = np.empty_like(T_world_child), False
+    if work is None:
+        work = np.empty((len(T_world_child), 3, 4))
+    np.copyto(work, T_world_child[:, :3, :])
+    offset = work[:, :, 3]
+    np.subtract(offset, T_world_parent[:, :3, 3], out=offset)
+    np.matmul(T_world_parent[:, :3, :3].transpose(0, 2, 1), work, out=out[:, :3, :])
+    if not bottom_rows_set:
+        out[:, 3, :] = (0.0, 0.0, 0.0, 1.0)
     return out
+
+
+def _as_slice(rows: np.ndarray) -> slice | np.ndarray:
+    """``rows`` as the slice ``a:b`` when they are ``a, a+1, ..., b-1`` (indexing with it gives a
+    view, not a copy), else ``rows`` itself."""
+    if len(rows) and np.array_equal(rows, np.arange(rows[0], rows[0] + len(rows))):
+        return slice(int(rows[0]), int(rows[0]) + len(rows))
+    return rows
 
 
 def link_tree_paths(urdf_path: Any, links: tuple[str, ...] | list[str]) -> dict[str, tuple[str, str | None]]:
@@ -138,8 +154,9 @@ class PoseSender:
     rotation (position) moved by more than :data:`POSE_EPS`. The comparison is one numpy pass
     over all nodes; quaternions are computed for the changed ones only. The messages are
     viser's own, queued as its public ``handle.wxyz = ...`` setters would, minus their
-    per-call validation and ``allclose`` (4x the cost of the message here); the node's stored
-    pose is updated too. Falls back to the public setters if viser's internals differ.
+    per-call validation and ``allclose`` (4x the cost of the message here), by one
+    ``views.viser_adapter.PoseQueue`` per node; the node's stored pose is updated too. Falls
+    back to the public setters if viser's internals differ.
 
     Args:
         handles: scene node handles.
@@ -149,6 +166,8 @@ class PoseSender:
     def __init__(self, handles: list[Any], T_parent_node: np.ndarray) -> None:
         self.handles = list(handles)
         self._sent = np.array(T_parent_node, dtype=float).reshape(len(self.handles), 4, 4)
+        self._sent_rows = self._sent[:, :3, :]            # the compared part (a view, made once)
+        self._queues = [pose_queue(h) for h in self.handles]   # None: viser differs, public setters
         self._diff = np.empty((len(self.handles), 3, 4))
 
     def send(self, T_parent_node: np.ndarray, *, skip: tuple[int, ...] = (), force: tuple[int, ...] = ()) -> int:
@@ -164,7 +183,7 @@ class PoseSender:
         """
         T = np.asarray(T_parent_node, dtype=float)
         d = self._diff
-        np.subtract(T[:, :3, :], self._sent[:, :3, :], out=d)
+        np.subtract(T[:, :3, :], self._sent_rows, out=d)
         np.abs(d, out=d)
         # per node and column: did any entry move? columns 0-2 are the rotation, 3 the position
         moved = cast("list[list[bool]]", (d > POSE_EPS).any(axis=1).tolist())
@@ -173,22 +192,24 @@ class PoseSender:
         for i in skip:
             moved[i] = [False] * 4
         n = 0
-        xyz: list[list[float]] | None = None
         for i, (c0, c1, c2, p) in enumerate(moved):
             r = c0 or c1 or c2
             if not (r or p):
                 continue
+            rows = T[i].tolist()                  # the node's pose as floats, one call
             sent = self._sent[i]
-            wxyz = None
-            if r:
-                R = T[i, :3, :3]
-                wxyz = quaternion_wxyz(R)
-                sent[:3, :3] = R
-            if p and xyz is None:
-                xyz = T[:, :3, 3].tolist()                  # every node's position in one call
-            n += _set_pose(self.handles[i], wxyz, xyz[i] if p and xyz is not None else None)
-            if p:
+            if r and p:
+                sent[:3] = T[i, :3]
+            elif r:
+                sent[:3, :3] = T[i, :3, :3]
+            else:
                 sent[:3, 3] = T[i, :3, 3]
+            wxyz = quaternion_wxyz(rows) if r else None
+            xyz = [rows[0][3], rows[1][3], rows[2][3]] if p else None
+            q = self._queues[i]
+            if q is None or not q(wxyz, xyz):
+                _public_setters(self.handles[i], wxyz, xyz)
+            n += int(r) + int(p)
         return n
 
 
@@ -196,11 +217,15 @@ def _set_pose(handle: Any, wxyz: list[float] | None, xyz: list[float] | None) ->
     """Send a node's orientation and/or position (``views.viser_adapter.queue_pose``; the public
     setters if viser's internals differ); returns how many messages."""
     if not queue_pose(handle, wxyz, xyz):
-        if wxyz is not None:
-            handle.wxyz = wxyz
-        if xyz is not None:
-            handle.position = xyz
+        _public_setters(handle, wxyz, xyz)
     return int(wxyz is not None) + int(xyz is not None)
+
+
+def _public_setters(handle: Any, wxyz: list[float] | None, xyz: list[float] | None) -> None:
+    if wxyz is not None:
+        handle.wxyz = wxyz
+    if xyz is not None:
+        handle.position = xyz
 
 
 def overview_pose(tip_world_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -311,9 +336,12 @@ class SceneView:
         self._moving = [n for n in tree if n != k.base_link]
         self._index_names: tuple[str, ...] = ()
         self._child_idx = self._parent_idx = self._out_rows = np.zeros(0, dtype=int)
+        self._parent_rows: slice | np.ndarray = self._parent_idx
+        self._child_rows: slice | np.ndarray = self._child_idx
         self._root_rows: list[tuple[int, int]] = []          # (row, link index) of links without a parent
         self._contiguous = True
         self._local_out = np.zeros((0, 4, 4))
+        self._local_work = np.zeros((0, 3, 4))
         T_local = self._local_poses(state)
         local = {n: T_local[i] for i, n in enumerate(self._moving)}
         for name, (path, _) in tree.items():
@@ -359,9 +387,10 @@ class SceneView:
         links and the gizmo (``pose``), from the session's state."""
         if change.tool:
             self.reconcile_tools()
-        if self.session.controller.reference_tip_world_m.tobytes() != self._shown_tip_bytes:
+        c = self.session.controller
+        if c.reference_tip_world_m.tobytes() != self._shown_tip_bytes:
             self.update_reference_tip()                   # knocked (a scenario) or set anew
-        self.beam_stand.show(self.session.controller.beam_sensor)   # redraws only a changed sensor
+        self.beam_stand.show(c.beam_sensor)               # redraws only a changed sensor
         film = self.player
         self._step_aside(film is not None and film.playing)
         if change.pose and change.state is not None:
@@ -381,7 +410,9 @@ class SceneView:
         """(N+1,4,4): ``T_parent_link`` of the moving links (``T_world_link`` for a link
         without a parent), then ``T_world_tcp`` (the gizmo), from one pose state
         (:func:`relative_poses`, batched into a buffer reused by the next call:
-        :class:`PoseSender` copies what it sends)."""
+        :class:`PoseSender` copies what it sends). Parent and child rows that are runs of
+        consecutive links (a serial arm in pinocchio's order: parent = child - 1) are read as
+        slices, views of the state's stacked poses, instead of fancy-indexed copies."""
         if state.link_names != self._index_names:             # index rows once per link list
             row = {n: i for i, n in enumerate(state.link_names)}
             with_parent = [i for i, n in enumerate(self._moving) if self._parent[n] is not None]
@@ -389,18 +420,22 @@ class SceneView:
             self._child_idx = np.array([row[self._moving[i]] for i in with_parent], dtype=int)
             self._parent_idx = np.array([row[cast(str, self._parent[self._moving[i]])] for i in with_parent],
                                         dtype=int)
+            self._parent_rows = _as_slice(self._parent_idx)
+            self._child_rows = _as_slice(self._child_idx)
             self._root_rows = [(i, row[n]) for i, n in enumerate(self._moving) if self._parent[n] is None]
             self._contiguous = with_parent == list(range(len(with_parent)))
             self._local_out = np.zeros((len(self._moving) + 1, 4, 4))
+            self._local_out[:, 3, 3] = 1.0            # rigid poses' bottom rows, never written again
+            self._local_work = np.empty((len(self._child_idx), 3, 4))
             self._index_names = state.link_names
         out = self._local_out
         W = state.T_world_links
-        P = W[self._parent_idx]
-        C = W[self._child_idx]
+        P = W[self._parent_rows]
+        C = W[self._child_rows]
         if self._contiguous:                                  # a tree without loose links: in place
-            relative_poses(P, C, out=out[:len(self._child_idx)])
+            relative_poses(P, C, out=out[:len(self._child_idx)], work=self._local_work, bottom_rows_set=True)
         else:
-            out[self._out_rows] = relative_poses(P, C)
+            out[self._out_rows] = relative_poses(P, C, work=self._local_work)
         for i, j in self._root_rows:
             out[i] = W[j]
         out[-1] = state.T_world_tcp

@@ -6,9 +6,12 @@ network. What this module reaches into, and why:
 * **Fast paths** (the readouts and the robot pose change on every jog step):
   :func:`queue_markdown` stores a markdown's ``_markdown`` prop and queues viser's
   ``GuiUpdateMessage`` itself (``handle._impl``, ``gui_api._websock_interface``), skipping the
-  public setter's per-call typing machinery; :func:`queue_pose` writes a scene node's
-  ``wxyz`` / ``position`` and queues ``SetOrientationMessage`` / ``SetPositionMessage``
-  (``api._queue_scene_message``). Each returns False when viser's internals differ, and the
+  public setter's per-call typing machinery; :func:`queue_pose` (and :class:`PoseQueue`, one
+  per scene node, which the scene keeps) writes a scene node's ``wxyz`` / ``position`` and
+  queues ``SetOrientationMessage`` / ``SetPositionMessage`` stamped with the scene's
+  ``_owner_id`` as ``api._queue_scene_message`` does, on ``api._websock_interface``, their
+  ``_cached_redundancy_key`` set from viser's own ``redundancy_key`` of the node's first
+  message. Each returns False when viser's internals differ (:func:`pose_queue`: None), and the
   caller then uses the public setter. Which path ran is counted (:func:`path_counts`); the first
   fallback of each path logs a warning, and with ``TCP_PENDANT_STRICT_VISER=1`` in the
   environment (the tests' flag) a fallback raises :class:`ViserInternalsChanged` instead.
@@ -42,7 +45,9 @@ Moving viser up a minor version: run ``tests/security`` and ``tests/app/test_vis
 (their conftest sets ``TCP_PENDANT_STRICT_VISER=1``: a fallback fails the test), then re-read in
 viser's source each name used here: ``_GuiHandleState`` (``uuid``, ``value``, ``props``,
 ``removed``, ``gui_api``), ``GuiApi._gui_input_handle_from_uuid`` /
-``_current_file_upload_states`` / ``_websock_interface``, ``SceneApi._queue_scene_message``,
+``_current_file_upload_states`` / ``_websock_interface``, ``SceneApi._queue_scene_message`` (what
+it stamps: ``_owner_id``) / ``_websock_interface``, ``Message.redundancy_key`` (its
+``_cached_redundancy_key``),
 the scene handle's ``_impl`` (``name``, ``wxyz``, ``position``, ``api``),
 ``WebsockMessageHandler._handle_incoming_message`` / ``_incoming_handlers``,
 ``infra._infra._message_consumer`` (its signature and its ``deserialize`` call), the message
@@ -70,7 +75,7 @@ import msgspec
 
 __all__ = ["LOG_VALUE_CHARS", "MAX_ABS_NUMBER", "MAX_TEXT_CHARS", "UploadHook", "UploadLimits",
            "ViserInternalsChanged", "gui_value_refusal", "install", "listen_reuse_port", "message_refusal", "path_counts",
-           "queue_markdown",
+           "queue_markdown", "PoseQueue", "pose_queue",
            "message_counts", "queue_pose", "reset_path_counts", "short", "upload_hook", "upload_limits",
            "uploads_in_flight"]
 
@@ -172,26 +177,77 @@ def _gui_update_message() -> Any:
     return GuiUpdateMessage
 
 
-def queue_pose(handle: Any, wxyz: list[float] | None, xyz: list[float] | None) -> bool:
-    """Set a scene node's orientation (``wxyz``) and/or position (``xyz``, metres) and queue
-    viser's ``SetOrientationMessage`` / ``SetPositionMessage`` without its public setters.
-    Returns False when the caller must use ``handle.wxyz`` / ``handle.position``."""
-    try:
-        from viser import _messages
+try:
+    from viser import _messages as _viser_messages
+except ImportError:                     # queue_pose falls back to the public setters (AttributeError)
+    _viser_messages = None  # type: ignore[assignment]
 
+
+class PoseQueue:
+    """Queues one scene node's ``SetOrientationMessage`` / ``SetPositionMessage`` without viser's
+    public setters, its internals looked up once (:func:`pose_queue` builds it): writes the
+    node's ``wxyz`` / ``position`` in place, stamps each message with the scene's owner as
+    ``SceneApi._queue_scene_message`` does and queues it on the scene's ``_websock_interface``.
+    The node's redundancy key (per message class) is viser's own ``Message.redundancy_key`` of
+    its first message, then set on the next ones (viser caches it in ``_cached_redundancy_key``
+    the first time it asks; it depends on the node and the message class, never on the pose):
+    not rebuilt per message."""
+
+    __slots__ = ("_impl", "_keys", "_name", "_orientation", "_owner", "_position", "_ws")
+
+    def __init__(self, handle: Any) -> None:
+        messages = _viser_messages             # None (AttributeError below): viser differs
         impl = handle._impl
         api = impl.api
-        if wxyz is not None:
-            impl.wxyz[:] = wxyz
-            api._queue_scene_message(_messages.SetOrientationMessage(
-                impl.name, typing.cast("tuple[float, float, float, float]", tuple(wxyz))))
-        if xyz is not None:
-            impl.position[:] = xyz
-            api._queue_scene_message(_messages.SetPositionMessage(
-                impl.name, typing.cast("tuple[float, float, float]", tuple(xyz))))
+        self._impl, self._name, self._owner, self._ws = impl, impl.name, api._owner_id, api._websock_interface
+        self._orientation: Any = messages.SetOrientationMessage
+        self._position: Any = messages.SetPositionMessage
+        if not (callable(self._ws.queue_message) and hasattr(impl, "wxyz") and hasattr(impl, "position")):
+            raise AttributeError("a scene node without wxyz / position or a websocket interface")
+        self._keys: list[str | None] = [None, None]
+
+    def _queue(self, kind: int, value: tuple[float, ...]) -> None:
+        msg = (self._orientation if kind == 0 else self._position)(self._name, value)
+        msg.owner = self._owner
+        key = self._keys[kind]
+        if key is None:
+            self._keys[kind] = msg.redundancy_key()
+        else:
+            object.__setattr__(msg, "_cached_redundancy_key", key)
+        self._ws.queue_message(msg)
+
+    def __call__(self, wxyz: list[float] | None, xyz: list[float] | None) -> bool:
+        """Set and queue the orientation (``wxyz``) and/or position (``xyz``, metres); False when
+        viser's internals differ (the caller then uses the public setters)."""
+        try:
+            if wxyz is not None:
+                self._impl.wxyz[:] = wxyz
+                self._queue(0, tuple(wxyz))
+            if xyz is not None:
+                self._impl.position[:] = xyz
+                self._queue(1, tuple(xyz))
+        except AttributeError as exc:
+            return _fallback("pose", exc)
+        return _fast("pose")
+
+
+def pose_queue(handle: Any) -> PoseQueue | None:
+    """The :class:`PoseQueue` of a scene node handle; None when viser's internals differ (counted
+    and warned as the ``pose`` path's fallback: the caller uses the public setters)."""
+    try:
+        return PoseQueue(handle)
     except (AttributeError, ImportError) as exc:
-        return _fallback("pose", exc)
-    return _fast("pose")
+        _fallback("pose", exc)
+        return None
+
+
+def queue_pose(handle: Any, wxyz: list[float] | None, xyz: list[float] | None) -> bool:
+    """Set a scene node's orientation (``wxyz``) and/or position (``xyz``, metres) and queue
+    viser's ``SetOrientationMessage`` / ``SetPositionMessage`` without its public setters
+    (a :class:`PoseQueue` of the node, made for this call; the scene keeps one per node).
+    Returns False when the caller must use ``handle.wxyz`` / ``handle.position``."""
+    q = pose_queue(handle)
+    return q is not None and q(wxyz, xyz)
 
 
 # ------------------------------------------------------------------ uploads
