@@ -139,17 +139,26 @@ class LoadClient:
             await asyncio.wait([self.task], timeout=5)
 
 
+ARRIVAL_GAP_S = 0.02
+"""The clients of :func:`connect_all` arrive at least this far apart (seconds): as a class
+does, one browser after another, not all in the same millisecond (100 in 2 s or more)."""
+
+
 async def connect_all(host: str, port: int, n: int, *, names: str | None = None, increment: str = "0.1",
                       first: int = 0, timeout_s: float = 120.0) -> list[LoadClient]:
-    """Connect ``n`` clients (a few at a time, as a class arrives), wait until each sees its
-    jog key and a readout, pick the jog ``increment`` (mm) and with ``names`` (a prefix) join
-    each as ``"<names> 001"``... (numbered from ``first + 1``)."""
+    """Connect ``n`` clients (a few at a time, :data:`ARRIVAL_GAP_S` apart, as a class
+    arrives), wait until each sees its jog key and a readout, pick the jog ``increment`` (mm)
+    and with ``names`` (a prefix) join each as ``"<names> 001"``... (numbered from
+    ``first + 1``)."""
     clients = [LoadClient(i) for i in range(n)]
     sem = asyncio.Semaphore(8)
+    arrival = asyncio.Lock()
 
     async def one(c: LoadClient) -> None:
         async with sem:
-            await c.connect(host, port)
+            async with arrival:                   # the next one arrives a gap later
+                await c.connect(host, port)
+                await asyncio.sleep(ARRIVAL_GAP_S)
             await asyncio.wait_for(c.ready.wait(), timeout_s)
             await c.send_update(INCREMENT_LABEL, {"value": increment})
             if names is not None:
