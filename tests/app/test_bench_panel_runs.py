@@ -3,11 +3,15 @@ new code, ratio) with finite figures and its RESULT line."""
 
 from __future__ import annotations
 
+import pytest
+
 import math
 import re
 import subprocess
 import sys
 from pathlib import Path
+
+pytestmark = pytest.mark.shares_cpu   # asserts no time or load (tests/conftest.py)
 
 BENCH = Path(__file__).resolve().parents[1] / "bench" / "bench_panel.py"
 ROW = re.compile(r"^  (\S.+?)\s+(\S+) us\s+(\S+) us\s+(\S+)$", re.MULTILINE)

@@ -4,11 +4,15 @@ they move without it)."""
 
 from __future__ import annotations
 
+import pytest
+
 import math
 import re
 import subprocess
 import sys
 from pathlib import Path
+
+pytestmark = pytest.mark.shares_cpu   # asserts no time or load (tests/conftest.py)
 
 BENCH = Path(__file__).resolve().parents[1] / "bench" / "bench_scene_step.py"
 ROW = re.compile(r"^  (pose state|scene|scene \+ pose state)\s+(\S+)\s+(\S+)\s+(\S+)$", re.MULTILINE)

@@ -4,11 +4,15 @@ from the steps achieved and the press-to-readout latency."""
 
 from __future__ import annotations
 
+import pytest
+
 import math
 import re
 import subprocess
 import sys
 from pathlib import Path
+
+pytestmark = pytest.mark.shares_cpu   # asserts no time or load (tests/conftest.py)
 
 BENCH = Path(__file__).resolve().parents[1] / "bench" / "bench_server.py"
 ROW = re.compile(r"^  (\S.+?)\s+(\S+) ms\s+(\S+) ms\s+(\S+)$", re.MULTILINE)
