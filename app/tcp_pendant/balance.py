@@ -68,8 +68,8 @@ def detach_listener_choice(listener: Any) -> None:
 
 class BalanceFile:
     """The shared record of the ``--workers`` processes: ``{"n": N, "off": bool, "chosen":
-    index or None (the group's program now), "listeners": [{"pid", "index", "sessions"}, ...]}``, read and written under an exclusive ``flock`` of
-    the file (module docstring)."""
+    index or None (the group's program now), "listeners": [{"pid", "index", "sessions"},
+    ...]}``, read and written under an exclusive ``flock`` of the file (module docstring)."""
 
     def __init__(self, path: Path) -> None:
         self.path = Path(path)
