@@ -13,7 +13,8 @@ client processes); a press not shown ``ANSWER_WAIT_S`` after the last one is una
 (dropped by the server's deadman, or never carried out). Printed per K: p50, p95, p99, max,
 presses asked / answered / unanswered, steps/s achieved (shown by the readouts; all trainees,
 and per trainee against the 20 asked), the CPU of each server process (cores, over the press
-window) and of the load generator.
+window) and of the load generator, and how many trainees each server process held (the
+gradebook's presence, 1.5 s into the presses: the connection balance at work).
 
 The load generator runs on the same two cores as the server (its CPU is printed): the figures
 are those of a 2-core machine that also runs K clients; a real class's browsers run elsewhere.
@@ -95,6 +96,24 @@ async def _client_main(port: int, first: int, n: int, names: bool) -> None:
 
 
 # ------------------------------------------------------------------ the bench
+def _trainees_per_process(db: Path, pids: list[int]) -> list[int] | None:
+    """How many of the class's connected trainees each server process holds, in the order of
+    ``pids``, from the gradebook's presence (its holder names the process's pid); None when
+    the gradebook cannot be read."""
+    sys.path.insert(0, str(ROOT / "app"))
+    from tcp_pendant.classroom.gradebook import Gradebook
+
+    try:
+        book = Gradebook(db)
+    except Exception:
+        return None
+    try:
+        holders = [int(holder.split(":")[-2]) for _, holder, _ in book.present()]
+    finally:
+        book.close()
+    return [holders.count(pid) for pid in pids]
+
+
 def _start_server(tmp: Path, workers: int) -> tuple[subprocess.Popen[str], int, list[int]]:
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT / "src"), str(ROOT / "app"),
                                                        os.environ.get("PYTHONPATH", "")]),
@@ -146,6 +165,10 @@ def run_class(k: int, workers: int, seconds: float, client_procs: int, names: bo
                 assert p.stdin is not None
                 p.stdin.write(f"{start_at} {seconds}\n")
                 p.stdin.flush()
+            split = None
+            if names:                                 # each process's presence beats once a second
+                time.sleep(max(0.0, start_at + 1.5 - time.monotonic()))
+                split = _trainees_per_process(Path(folder) / "class.sqlite3", pids)
             results = []
             for p in procs:
                 assert p.stdout is not None
@@ -182,7 +205,7 @@ def run_class(k: int, workers: int, seconds: float, client_procs: int, names: bo
             "asked": asked, "answered": answered, "unanswered": asked - answered,
             "steps_s": answered / seconds, "asked_s": asked / seconds, "per_trainee": answered / seconds / k,
             "server_cpu": cpu, "server_waited": waited, "clients_cpu": sum(r["cpu_s"] for r in results) / window,
-            "no_readout": sum(r["no_readout"] for r in results)}
+            "no_readout": sum(r["no_readout"] for r in results), "split": split}
 
 
 def verdict(row: dict[str, Any]) -> bool:
@@ -213,7 +236,7 @@ def main(argv: list[str] | None = None) -> int:
           f"on the same {os.cpu_count()} CPUs (load average {load[0]:.1f} {load[1]:.1f} {load[2]:.1f} at start)")
     print(f"  {'K':>4} {'p50 ms':>8} {'p95 ms':>8} {'p99 ms':>8} {'max ms':>8} {'asked':>7} {'unansw.':>7} "
           f"{'steps/s':>8} {'per K':>6} {'ms/step':>7}  server CPU per process (cores)   clients CPU   "
-          "server waiting for a CPU")
+          "server waiting for a CPU   trainees per process")
     rows = []
 
     def show(row: dict[str, Any], label: str) -> None:
@@ -221,7 +244,8 @@ def main(argv: list[str] | None = None) -> int:
         ms_step = sum(row["server_cpu"]) / max(row["steps_s"], 1e-9) * 1e3
         print(f"  {label:>4} {row['p50']:8.1f} {row['p95']:8.1f} {row['p99']:8.1f} {row['max']:8.1f} {row['asked']:>7} "
               f"{row['unanswered']:>7} {row['steps_s']:8.1f} {row['per_trainee']:6.1f} {ms_step:7.2f}  {cpu:<31} "
-              f"{row['clients_cpu']:<13.2f} " + " ".join(f"{w:.2f}" for w in row["server_waited"])
+              f"{row['clients_cpu']:<13.2f} " + f"{' '.join(f'{w:.2f}' for w in row['server_waited']):<26}"
+              + (" " + "/".join(str(n) for n in row["split"]) if row["split"] is not None else " -")
               + (f"  ({row['no_readout']} clients saw no readout)"
                                               if row["no_readout"] else ""), flush=True)
 
@@ -240,6 +264,8 @@ def main(argv: list[str] | None = None) -> int:
     print("  (server waiting for a CPU: the share of the time each server process's threads were ready to run "
           "but had no CPU - other programs on the machine had it; a server that waits for a CPU falls behind "
           "and its deadman drops presses, whatever its own cost per step)")
+    print("  (trainees per process: the connected trainees each server process held 1.5 s into the presses, "
+          "from the gradebook's presence; - without names)")
     print("  (latency: a press is matched to the first readout that shows as many presses; in a row with "
           "unanswered presses the deadman dropped some, so later presses are matched to earlier sends: "
           "those percentiles are upper bounds; rows with none are exact)")

@@ -1,0 +1,34 @@
+"""Smoke test: the class-load benchmark still runs on a real ``tcp-pendant --class --workers 2``
+(two trainees, two seconds) and prints a row whose figures add up: every press asked is
+answered or counted unanswered, the percentiles are ordered, and the two trainees are split
+one per server process (the connection balance, read from the gradebook's presence)."""
+
+from __future__ import annotations
+
+import math
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+pytestmark = pytest.mark.shares_cpu   # asserts no time or load (tests/conftest.py)
+
+BENCH = Path(__file__).resolve().parents[1] / "bench" / "bench_class_load.py"
+ROW = re.compile(r"^ +2 +(?P<p50>\S+) +(?P<p95>\S+) +(?P<p99>\S+) +(?P<max>\S+) +(?P<asked>\d+) +(?P<unanswered>\d+) "
+                 r"+(?P<steps>\S+) .* (?P<split>\d+/\d+)$", re.MULTILINE)
+
+
+def test_bench_class_load_prints_a_row_that_adds_up_and_the_split() -> None:
+    out = subprocess.run([sys.executable, str(BENCH), "--counts", "2", "--duration", "2"], capture_output=True,
+                         text=True, timeout=300)
+    assert out.returncode == 0, out.stderr[-3000:]
+    m = ROW.search(out.stdout)
+    assert m, out.stdout
+    p50, p95, p99, worst = (float(m.group(k)) for k in ("p50", "p95", "p99", "max"))
+    assert all(math.isfinite(v) and v > 0 for v in (p50, p95, p99, worst)) and p50 <= p95 <= p99 <= worst
+    asked, unanswered = int(m.group("asked")), int(m.group("unanswered"))
+    assert asked >= 2 * 2 * 20 * 0.9 and 0 <= unanswered <= asked
+    assert m.group("split") == "1/1"
+    assert re.search(r"^RESULT: 2 trainees asked .*: (MET|NOT MET)$", out.stdout, re.MULTILINE), out.stdout
