@@ -59,9 +59,7 @@ def test_a_trainee_leaving_while_the_table_is_read_is_in_it_connected_or_left(ap
     c = DrainingClient(app.port)
     try:
         s = _session(app, c)
-        prompt = s.views["identity"]
-        choose(prompt.name_field, "Anna", _browser(s))
-        click(prompt.start, _browser(s))
+        _join(s, "Anna")
         assert [row.name for row in app.classroom.trainee_statuses()] == ["Anna"]
         room = app.classroom
         real = room.gradebook.departed
@@ -85,9 +83,7 @@ def test_wizard_events_reach_the_gradebook_through_the_gui(app_factory, tmp_path
     c = DrainingClient(app.port)
     try:
         s = _session(app, c)
-        prompt = s.views["identity"]
-        choose(prompt.name_field, "Bo", _browser(s))
-        click(prompt.start, _browser(s))
+        _join(s, "Bo")
         cal = s.views["calibrate"]
         click(cal.start, _browser(s))                         # XYZ 4-point, the default
         for _ in range(4):
