@@ -866,16 +866,8 @@ def _solve_lstsq_small(rot: np.ndarray, f: np.ndarray, sigma: float | None, dete
         ext = angle_extremes(rot, y)
         _check_observable(rot, info, ext)  # raises
     m_inv = _dot(v / w, v.T)  # info.m_inv()
-    # _lstsq_core(info, m_inv, rot, f)
-    fbar, neg_d = _centred(f)
-    rows = rot.reshape(3 * n, 3)
-    t = _dot(m_inv, _dot(neg_d.reshape(3 * n), rows))
-    rbar_t = _dot(info.rbar, t)
-    e = _dot(rows, t).reshape(n, 3)
-    e -= neg_d
-    e -= rbar_t
-    sse = float(_vdot(e, e))
-    r = rbar_t + fbar
+    fit = _lstsq_core(info, m_inv, rot, f)
+    t, r, e, sse, neg_d = fit
     # the rest of _solve for lstsq
     res = _einsum("ni,ni->n", e, e)
     if not math.isfinite(sse):  # see _solve: one check for t, r and the SSE
@@ -885,7 +877,7 @@ def _solve_lstsq_small(rot: np.ndarray, f: np.ndarray, sigma: float | None, dete
     s_est = math.sqrt(sse / dof)
     noise = s_est if sigma is None else sigma
     warnings: list[str] = []
-    outliers = _find_outliers(rot, y, f, (info, _LstsqFit(t, r, e, sse, neg_d))) if y is not None else []
+    outliers = _find_outliers(rot, y, f, (info, fit)) if y is not None else []
     without = _without_outliers(rot, f, outliers, "lstsq", sigma, res, warnings) if outliers else None
     return _lazy_result("lstsq", t, r, e, res, sse, noise, (noise * noise, m_inv), outliers, without,
                         _Deferred(rot, y, info, ext, noise, None, None if sigma is not None else dof, warnings,
