@@ -867,7 +867,7 @@ def _solve_lstsq_small(rot: np.ndarray, f: np.ndarray, sigma: float | None, dete
         _check_observable(rot, info, ext)  # raises
     m_inv = _dot(v / w, v.T)  # info.m_inv()
     fit = _lstsq_core(info, m_inv, rot, f)
-    t, r, e, sse, neg_d = fit
+    t, r, e, sse, _ = fit
     # the rest of _solve for lstsq
     res = _einsum("ni,ni->n", e, e)
     if not math.isfinite(sse):  # see _solve: one check for t, r and the SSE
