@@ -14,7 +14,8 @@ import pytest
 
 from tcp_pendant.balance import Balance, BalanceFile
 
-pytestmark = [pytest.mark.skipif(not sys.platform.startswith("linux"), reason="SO_ATTACH_REUSEPORT_CBPF is Linux's"), pytest.mark.shares_cpu]
+pytestmark = [pytest.mark.skipif(not sys.platform.startswith("linux"), reason="SO_ATTACH_REUSEPORT_CBPF is Linux's"),
+              pytest.mark.shares_cpu]
 
 
 def _listener(port: int) -> socket.socket:

@@ -4,13 +4,13 @@ from the steps achieved and the press-to-readout latency."""
 
 from __future__ import annotations
 
-import pytest
-
 import math
 import re
 import subprocess
 import sys
 from pathlib import Path
+
+import pytest
 
 pytestmark = pytest.mark.shares_cpu   # asserts no time or load (tests/conftest.py)
 
