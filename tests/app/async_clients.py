@@ -65,6 +65,7 @@ class LoadClient:
     frames: list[tuple[float, str]] = field(default_factory=list)   # (time, frame) of each TCP readout
     notes: list[str] = field(default_factory=list)     # warnings shown ("⚠ ...") and the trainer dashboard's heading
     sends: list[float] = field(default_factory=list)
+    late_s: list[float] = field(default_factory=list)   # per press of run_presses: sent this long after its plan
     ready: asyncio.Event = field(default_factory=asyncio.Event)
     task: asyncio.Task[None] | None = None
     closed_early: bool = False
@@ -181,6 +182,7 @@ async def run_presses(clients: list[LoadClient], label: str, hz: float, seconds:
     x0 = [c.readouts[-1][1] if c.readouts else None for c in clients]
     for c in clients:
         c.sends = []
+        c.late_s = []
     period = 1.0 / hz
     n = len(clients)
     start = time.monotonic() + 0.2
@@ -192,7 +194,9 @@ async def run_presses(clients: list[LoadClient], label: str, hz: float, seconds:
             delay = t0 + k * period - time.monotonic()
             if delay > 0:
                 await asyncio.sleep(delay)
-            c.sends.append(time.monotonic())
+            now = time.monotonic()
+            c.sends.append(now)
+            c.late_s.append(now - (t0 + k * period))
             try:
                 await c.send_update(label, {"value": True})
             except Exception:

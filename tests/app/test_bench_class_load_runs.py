@@ -1,9 +1,10 @@
 """Smoke test: the class-load benchmark still runs on a real ``tcp-pendant --class --workers 2``
 (two trainees, two seconds) and prints a row whose figures add up: every press asked is
-answered or counted unanswered, the percentiles are ordered, and the two trainees are split
-one per server process (the connection balance, read from the gradebook's presence). The two
-clients run in one client process, so the second arrives after the first's handshake and the
-benchmark's arrival gap, as in a class, not at the same instant from two processes."""
+answered or counted unanswered, the percentiles are ordered, the two trainees are split one
+per server process (the connection balance, read from the gradebook's presence), and the load
+generator's own delay ("sent late") is printed. The two clients run in one client process, so
+the second arrives after the first's handshake and the benchmark's arrival gap, as in a class,
+not at the same instant from two processes."""
 
 from __future__ import annotations
 
@@ -19,7 +20,7 @@ pytestmark = pytest.mark.shares_cpu   # asserts no time or load (tests/conftest.
 
 BENCH = Path(__file__).resolve().parents[1] / "bench" / "bench_class_load.py"
 ROW = re.compile(r"^ +2 +(?P<p50>\S+) +(?P<p95>\S+) +(?P<p99>\S+) +(?P<max>\S+) +(?P<asked>\d+) +(?P<unanswered>\d+) "
-                 r"+(?P<steps>\S+) .* (?P<split>\d+/\d+)$", re.MULTILINE)
+                 r"+(?P<steps>\S+) .* (?P<split>\d+/\d+) +(?P<late50>\S+)/(?P<late99>\S+)$", re.MULTILINE)
 
 
 def test_bench_class_load_prints_a_row_that_adds_up_and_the_split() -> None:
@@ -33,4 +34,6 @@ def test_bench_class_load_prints_a_row_that_adds_up_and_the_split() -> None:
     asked, unanswered = int(m.group("asked")), int(m.group("unanswered"))
     assert asked >= 2 * 2 * 20 * 0.9 and 0 <= unanswered <= asked
     assert m.group("split") == "1/1"
+    late50, late99 = float(m.group("late50")), float(m.group("late99"))   # the load generator's own delay, ms
+    assert -1.0 <= late50 <= late99 < 2000.0
     assert re.search(r"^RESULT: 2 trainees asked .*: (MET|NOT MET)$", out.stdout, re.MULTILINE), out.stdout
