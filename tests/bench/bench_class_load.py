@@ -18,8 +18,8 @@ gradebook's presence, 1.5 s into the presses: the connection balance at work).
 
 The load generator runs on the same two cores as the server (its CPU is printed); a real
 class's browsers run elsewhere. It runs at ``--client-nice`` (default 19, the lowest priority):
-it takes the CPU the servers leave, as browsers on other machines would not take the server's,
-instead of a fair share of the server's two cores. That cannot flatter the latency: both ends
+it takes the CPU the servers leave, as browsers on other machines take none of the server's,
+instead of a fair share of its two cores. That cannot flatter the latency: both ends
 of it are read in the client processes, so a client that waits for a CPU reads its readouts late
 (the latency only grows), and it sends a press late rather than not at all (the presses asked
 are counted as sent). How late the clients sent their presses against their plan is printed
@@ -167,7 +167,8 @@ def run_class(k: int, workers: int, seconds: float, client_procs: int, names: bo
                 if n == 0:
                     continue
                 procs.append(subprocess.Popen(
-                    [sys.executable, __file__, "--client", str(port), str(first), str(n), "1" if names else "0", str(nice)],
+                    [sys.executable, __file__, "--client", str(port), str(first), str(n), "1" if names else "0",
+                     str(nice)],
                     stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True))
                 first += n
             for p in procs:
@@ -234,7 +235,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--workers", type=int, default=2, help="server processes (tcp-pendant --workers)")
     ap.add_argument("--duration", type=float, default=30.0, help="seconds of pressing per class size")
     ap.add_argument("--client-procs", type=int, default=2, help="processes the headless clients run in")
-    ap.add_argument("--client-nice", type=int, default=19,
+    ap.add_argument("--client-nice", type=int, default=19, choices=range(20), metavar="0..19",
                     help="the client processes' niceness (19: the lowest priority, 0: the servers' own)")
     ap.add_argument("--no-names", action="store_true", help="clients do not join the class (no recorder)")
     ap.add_argument("--baseline", action="store_true",
@@ -245,7 +246,8 @@ def main(argv: list[str] | None = None) -> int:
     load = os.getloadavg()
     print(f"bench_class_load: tcp-pendant --class --workers {args.workers}, K trainees each clicking X + "
           f"{PRESS_HZ:.0f}/s ({PRESS_MM} mm) for {args.duration:g} s; clients in {args.client_procs} processes "
-          f"at nice {args.client_nice} on the same {os.cpu_count()} CPUs (load average {load[0]:.1f} {load[1]:.1f} {load[2]:.1f} at start)")
+          f"at nice {args.client_nice} on the same {os.cpu_count()} CPUs "
+          f"(load average {load[0]:.1f} {load[1]:.1f} {load[2]:.1f} at start)")
     print(f"  {'K':>4} {'p50 ms':>8} {'p95 ms':>8} {'p99 ms':>8} {'max ms':>8} {'asked':>7} {'unansw.':>7} "
           f"{'steps/s':>8} {'per K':>6} {'ms/step':>7}  server CPU per process (cores)   clients CPU   "
           "server waiting for a CPU   trainees per process   sent late p50/p99 ms")
