@@ -140,6 +140,9 @@ class LoadClient:
             await asyncio.wait([self.task], timeout=5)
 
 
+PRESS_LEAD_S = 0.2
+""":func:`run_presses` starts its first press this long (seconds) after it was called."""
+
 ARRIVAL_GAP_S = 0.02
 """The clients of :func:`connect_all` arrive at least this far apart (seconds): as a class
 does, one browser after another, not all in the same millisecond (100 in 2 s or more)."""
@@ -185,7 +188,7 @@ async def run_presses(clients: list[LoadClient], label: str, hz: float, seconds:
         c.late_s = []
     period = 1.0 / hz
     n = len(clients)
-    start = time.monotonic() + 0.2
+    start = time.monotonic() + PRESS_LEAD_S
 
     async def press(c: LoadClient) -> None:
         t0 = start + period * c.index / n

@@ -53,6 +53,10 @@ from typing import Any
 
 ROOT = Path(__file__).resolve().parents[2]
 APP_TESTS = ROOT / "tests" / "app"
+if str(APP_TESTS) not in sys.path:
+    sys.path.insert(0, str(APP_TESTS))
+from async_clients import PLUS, PRESS_LEAD_S, connect_all, latencies, run_presses  # noqa: E402
+
 PRESS_HZ = 20.0
 PRESS_MM = 0.1
 ANSWER_WAIT_S = 3.0
@@ -82,9 +86,6 @@ def _waited_s(pid: int) -> float:
 # ------------------------------------------------------------------ client process
 async def _client_main(port: int, first: int, n: int, names: bool, nice: int) -> None:
     os.nice(nice)
-    sys.path.insert(0, str(APP_TESTS))
-    from async_clients import PLUS, connect_all, latencies, run_presses
-
     clients = await connect_all("127.0.0.1", port, n, names="Trainee" if names else None, first=first)
     await asyncio.sleep(1.0)                       # the joins and the increment are carried out
     print("ready", flush=True)
@@ -92,14 +93,23 @@ async def _client_main(port: int, first: int, n: int, names: bool, nice: int) ->
     line = await loop.run_in_executor(None, sys.stdin.readline)
     start_at, seconds = (float(v) for v in line.split())
     await asyncio.sleep(max(0.0, start_at - time.monotonic()))
-    t0 = os.times()
+    pressing: dict[str, tuple[float, float]] = {}   # CPU seconds and time at the presses' start and end
+
+    async def mark(name: str, at: float) -> None:
+        await asyncio.sleep(max(0.0, at - time.monotonic()))
+        t = os.times()
+        pressing[name] = (t.user + t.system, time.monotonic())
+
+    marks = [asyncio.create_task(mark("from", start_at + PRESS_LEAD_S)),
+             asyncio.create_task(mark("to", start_at + PRESS_LEAD_S + seconds))]
     x0 = await run_presses(clients, PLUS, PRESS_HZ, seconds, ANSWER_WAIT_S)
-    t1 = os.times()
+    await asyncio.gather(*marks)
     figures = latencies(clients, x0, PRESS_MM)
     print(json.dumps({"latencies_ms": figures.latencies_ms, "asked": figures.asked, "answered": figures.answered,
                       "no_readout": sum(x is None for x in x0),
                       "late_ms": [v * 1e3 for c in clients for v in c.late_s],
-                      "cpu_s": t1.user + t1.system - t0.user - t0.system}), flush=True)
+                      "cores": (pressing["to"][0] - pressing["from"][0]) / (pressing["to"][1] - pressing["from"][1])}),
+          flush=True)
     for c in clients:
         await c.close()
 
@@ -176,23 +186,26 @@ def run_class(k: int, workers: int, seconds: float, client_procs: int, names: bo
                 if p.stdout.readline().strip() != "ready":
                     raise RuntimeError("a client process did not connect its clients")
             start_at = time.monotonic() + 0.5
-            cpu0 = [_cpu_s(pid) for pid in pids]
-            wait0 = [_waited_s(pid) for pid in pids]
             for p in procs:
                 assert p.stdin is not None
                 p.stdin.write(f"{start_at} {seconds}\n")
                 p.stdin.flush()
+            # the servers' CPU over the presses only (not the wait for the last answers after them)
+            press_from = start_at + PRESS_LEAD_S
+            time.sleep(max(0.0, press_from - time.monotonic()))
+            t0, cpu0, wait0 = time.monotonic(), [_cpu_s(pid) for pid in pids], [_waited_s(pid) for pid in pids]
             split: list[int] | None = None
             if names:                                 # each process's presence beats once a second
                 time.sleep(max(0.0, start_at + 1.5 - time.monotonic()))
                 split = _trainees_per_process(Path(folder) / "class.sqlite3", pids)
+            time.sleep(max(0.0, press_from + seconds - time.monotonic()))
+            t1, cpu1, wait1 = time.monotonic(), [_cpu_s(pid) for pid in pids], [_waited_s(pid) for pid in pids]
+            cpu = [(c1 - c0) / (t1 - t0) for c0, c1 in zip(cpu0, cpu1)]
+            waited = [(w1 - w0) / (t1 - t0) for w0, w1 in zip(wait0, wait1)]
             results = []
             for p in procs:
                 assert p.stdout is not None
                 results.append(json.loads(p.stdout.readline()))
-            window = time.monotonic() - start_at
-            cpu = [(_cpu_s(pid) - c0) / window for pid, c0 in zip(pids, cpu0)]
-            waited = [(_waited_s(pid) - w0) / window for pid, w0 in zip(pids, wait0)]
         finally:
             for p in procs:
                 try:
@@ -215,7 +228,7 @@ def run_class(k: int, workers: int, seconds: float, client_procs: int, names: bo
             "late_p99": _percentile(late, 99),
             "asked": asked, "answered": answered, "unanswered": asked - answered,
             "steps_s": answered / seconds, "asked_s": asked / seconds, "per_trainee": answered / seconds / k,
-            "server_cpu": cpu, "server_waited": waited, "clients_cpu": sum(r["cpu_s"] for r in results) / window,
+            "server_cpu": cpu, "server_waited": waited, "clients_cpu": sum(r["cores"] for r in results),
             "no_readout": sum(r["no_readout"] for r in results), "split": split}
 
 
