@@ -218,3 +218,65 @@ def test_browsers_arriving_one_by_one_are_split_evenly_over_the_processes(worker
     seen, per_pid = asyncio.run(scenario())
     assert all(max(counts) - min(counts) <= 1 for counts in seen), seen
     assert per_pid == {pids[0]: 8, pids[1]: 8}
+
+
+@pytest.mark.timeout(300)
+def test_two_processes_share_one_postgresql_gradebook(tmp_path: Path, postgres_server) -> None:
+    """``--workers 2 --class-db postgresql://...`` (README's "1,000 trainees on ten machines",
+    one machine of them with its cores in use): both processes keep their trainees in the one
+    PostgreSQL gradebook, six arriving trainees are split three per process (each one's
+    process read from the database's presence rows), and a name already joined is refused to a
+    second browser, whichever process that reaches."""
+    url = postgres_server.fresh_schema()
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT / "src"), str(ROOT / "app")]),
+               TCP_PENDANT_TRAINER_TOKEN="trainer-token-for-tests-0002", TMPDIR=str(tmp_path))
+    server = subprocess.Popen([sys.executable, "-m", "tcp_pendant", "--port", "0", "--workers", "2", "--class-db", url,
+                               "--tool-library", str(tmp_path / "tools.json"), "--seed", "6"],
+                              env=env, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, text=True)
+    try:
+        assert server.stdout is not None
+        text = ""
+        while "Ctrl-C to stop" not in text:
+            line = server.stdout.readline()
+            assert line, f"the server exited (code {server.wait()}):\n{text}"
+            text += line
+        assert postgres_server.password not in text
+        port = int(re.search(r"http://127\.0\.0\.1:(\d+)", text).group(1))   # type: ignore[union-attr]
+        listed = re.search(r"2 server processes on port \d+ \(pids ([\d, ]+)\)", text)
+        assert listed, text
+        pids = [int(p) for p in listed.group(1).split(",")]
+
+        async def scenario() -> tuple[dict[int, int], list[str]]:
+            clients = []
+            book = Gradebook(url)
+            try:
+                for i in range(6):                  # one after another, as a class arrives
+                    clients += await connect_all("127.0.0.1", port, 1, names="Pg", first=i)
+                    deadline = time.monotonic() + 30
+                    while len(book.present()) < i + 1:
+                        assert time.monotonic() < deadline, f"trainee {i + 1} never present: {book.present()}"
+                        await asyncio.sleep(0.05)
+                per_pid: dict[int, int] = {}
+                for _, holder, _ in book.present():
+                    pid = int(holder.split(":")[-2])
+                    per_pid[pid] = per_pid.get(pid, 0) + 1
+                # the same name again, from a new browser: whichever process it reaches refuses it
+                intruder = (await connect_all("127.0.0.1", port, 1, names="Pg", first=0))[0]
+                clients.append(intruder)
+                deadline = time.monotonic() + 30
+                refusal = "⚠ Pg 001 is already connected in another browser"
+                while not any(n.startswith(refusal) for n in intruder.notes):
+                    assert time.monotonic() < deadline, f"the second 'Pg 001' was not refused: {intruder.notes}"
+                    await asyncio.sleep(0.05)
+                return per_pid, sorted(name for name, _, _ in book.present())
+            finally:
+                book.close()
+                for c in clients:
+                    await c.close()
+
+        per_pid, names = asyncio.run(scenario())
+        assert per_pid == {pids[0]: 3, pids[1]: 3}
+        assert names == [f"Pg {i:03d}" for i in range(1, 7)]
+    finally:
+        server.terminate()
+        server.wait(60)
