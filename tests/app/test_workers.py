@@ -29,27 +29,40 @@ deadman's bound (of 1,500, all were carried out in time in one full run)."""
 pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="SO_REUSEPORT spreading is Linux's")
 
 
+def _start_workers2(tmp_path: Path, class_db: str, seed: str,
+                    token: str) -> tuple[subprocess.Popen[str], int, list[int], str]:
+    """Start ``tcp-pendant --class-db CLASS_DB --workers 2 --port 0`` and wait until it is ready:
+    (the first process, the port, both pids, its ready message). The caller terminates it."""
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT / "src"), str(ROOT / "app")]),
+               TCP_PENDANT_TRAINER_TOKEN=token, TMPDIR=str(tmp_path))
+    server = subprocess.Popen([sys.executable, "-m", "tcp_pendant", "--port", "0", "--workers", "2", "--class-db",
+                               class_db, "--tool-library", str(tmp_path / "tools.json"), "--seed", seed],
+                              env=env, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, text=True)
+    assert server.stdout is not None
+    text = ""
+    while "Ctrl-C to stop" not in text:
+        line = server.stdout.readline()
+        if not line:
+            server.terminate()
+            raise AssertionError(f"the server exited (code {server.wait()}):\n{text}")
+        text += line
+    port = re.search(r"http://127\.0\.0\.1:(\d+)", text)
+    listed = re.search(r"2 server processes on port \d+ \(pids ([\d, ]+)\)", text)
+    if port is None or listed is None:
+        server.terminate()
+        server.wait(60)
+        raise AssertionError(f"no URL or pids in the ready message:\n{text}")
+    return server, int(port.group(1)), [int(p) for p in listed.group(1).split(",")], text
+
+
 @pytest.fixture(scope="module")
 def workers2(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[int, list[int], Path]]:
     """``tcp-pendant --class --workers 2 --port 0``: (port, pids, gradebook path); one pair of
     processes for the tests of this file (each names its own trainees), stopped after."""
     tmp_path = tmp_path_factory.mktemp("workers2")
     db = tmp_path / "class.sqlite3"
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT / "src"), str(ROOT / "app")]),
-               TCP_PENDANT_TRAINER_TOKEN="trainer-token-for-tests-0001", TMPDIR=str(tmp_path))
-    server = subprocess.Popen([sys.executable, "-m", "tcp_pendant", "--port", "0", "--workers", "2", "--class-db",
-                               str(db), "--tool-library", str(tmp_path / "tools.json"), "--seed", "5"],
-                              env=env, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, text=True)
+    server, port, pids, _ = _start_workers2(tmp_path, str(db), "5", "trainer-token-for-tests-0001")
     try:
-        assert server.stdout is not None
-        text = ""
-        while "Ctrl-C to stop" not in text:
-            line = server.stdout.readline()
-            assert line, f"the server exited (code {server.wait()}):\n{text}"
-            text += line
-        port = int(re.search(r"http://127\.0\.0\.1:(\d+)", text).group(1))   # type: ignore[union-attr]
-        pids = [int(p) for p in re.search(r"2 server processes on port \d+ \(pids ([\d, ]+)\)",   # type: ignore[union-attr]
-                                          text).group(1).split(",")]
         assert pids[0] == server.pid and len(set(pids)) == 2
         yield port, pids, db
     finally:
@@ -228,23 +241,9 @@ def test_two_processes_share_one_postgresql_gradebook(tmp_path: Path, postgres_s
     process read from the database's presence rows), and a name already joined is refused to a
     second browser, whichever process that reaches."""
     url = postgres_server.fresh_schema()
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT / "src"), str(ROOT / "app")]),
-               TCP_PENDANT_TRAINER_TOKEN="trainer-token-for-tests-0002", TMPDIR=str(tmp_path))
-    server = subprocess.Popen([sys.executable, "-m", "tcp_pendant", "--port", "0", "--workers", "2", "--class-db", url,
-                               "--tool-library", str(tmp_path / "tools.json"), "--seed", "6"],
-                              env=env, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, text=True)
+    server, port, pids, text = _start_workers2(tmp_path, url, "6", "trainer-token-for-tests-0002")
     try:
-        assert server.stdout is not None
-        text = ""
-        while "Ctrl-C to stop" not in text:
-            line = server.stdout.readline()
-            assert line, f"the server exited (code {server.wait()}):\n{text}"
-            text += line
         assert postgres_server.password not in text
-        port = int(re.search(r"http://127\.0\.0\.1:(\d+)", text).group(1))   # type: ignore[union-attr]
-        listed = re.search(r"2 server processes on port \d+ \(pids ([\d, ]+)\)", text)
-        assert listed, text
-        pids = [int(p) for p in listed.group(1).split(",")]
 
         async def scenario() -> tuple[dict[int, int], list[str]]:
             clients = []
