@@ -20,6 +20,7 @@ import asyncio
 import math
 import re
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -28,7 +29,7 @@ import viser
 import websockets.asyncio.client
 import zstandard
 
-__all__ = ["LoadClient", "connect_all", "latencies", "run_presses"]
+__all__ = ["LoadClient", "connect_all", "latencies", "percentile", "run_presses"]
 
 PLUS = "X +"
 NAME_LABEL = "Your name"
@@ -227,12 +228,17 @@ class PressFigures:
         return self.asked - self.answered
 
     def percentile(self, q: float) -> float:
-        if not self.latencies_ms:
-            return math.nan
-        v = sorted(self.latencies_ms)
-        k = (len(v) - 1) * q / 100.0
-        lo, hi = math.floor(k), math.ceil(k)
-        return v[lo] + (v[hi] - v[lo]) * (k - lo)
+        return percentile(self.latencies_ms, q)
+
+
+def percentile(values: Sequence[float], q: float) -> float:
+    """The ``q``-th percentile of ``values`` (linear between ranks; nan when empty)."""
+    if not values:
+        return math.nan
+    v = sorted(values)
+    k = (len(v) - 1) * q / 100.0
+    lo, hi = math.floor(k), math.ceil(k)
+    return v[lo] + (v[hi] - v[lo]) * (k - lo)
 
 
 def latencies(clients: list[LoadClient], x0: list[float | None], step_mm: float) -> PressFigures:

@@ -55,7 +55,7 @@ ROOT = Path(__file__).resolve().parents[2]
 APP_TESTS = ROOT / "tests" / "app"
 if str(APP_TESTS) not in sys.path:
     sys.path.insert(0, str(APP_TESTS))
-from async_clients import PLUS, PRESS_LEAD_S, connect_all, latencies, run_presses  # noqa: E402
+from async_clients import PLUS, PRESS_LEAD_S, connect_all, latencies, percentile, run_presses  # noqa: E402
 
 PRESS_HZ = 20.0
 PRESS_MM = 0.1
@@ -155,16 +155,6 @@ def _start_server(tmp: Path, workers: int) -> tuple[subprocess.Popen[str], int, 
     return server, int(port_m.group(1)), pids
 
 
-def _percentile(values: list[float], q: float) -> float:
-    """The ``q``-th percentile of sorted ``values`` (linear between ranks; nan when empty)."""
-    if not values:
-        return float("nan")
-    i = (len(values) - 1) * q / 100.0
-    lo = int(i)
-    hi = min(lo + 1, len(values) - 1)
-    return values[lo] + (values[hi] - values[lo]) * (i - lo)
-
-
 def run_class(k: int, workers: int, seconds: float, client_procs: int, names: bool, nice: int) -> dict[str, Any]:
     """One class of ``k`` trainees for ``seconds`` (module docstring)."""
     with tempfile.TemporaryDirectory(prefix="bench_class_load_") as folder:
@@ -223,9 +213,9 @@ def run_class(k: int, workers: int, seconds: float, client_procs: int, names: bo
     asked = sum(r["asked"] for r in results)
     answered = sum(r["answered"] for r in results)
     late = sorted(v for r in results for v in r["late_ms"])
-    return {"k": k, "p50": _percentile(lat, 50), "p95": _percentile(lat, 95), "p99": _percentile(lat, 99),
-            "max": lat[-1] if lat else float("nan"), "late_p50": _percentile(late, 50),
-            "late_p99": _percentile(late, 99),
+    return {"k": k, "p50": percentile(lat, 50), "p95": percentile(lat, 95), "p99": percentile(lat, 99),
+            "max": lat[-1] if lat else float("nan"), "late_p50": percentile(late, 50),
+            "late_p99": percentile(late, 99),
             "asked": asked, "answered": answered, "unanswered": asked - answered,
             "steps_s": answered / seconds, "asked_s": asked / seconds, "per_trainee": answered / seconds / k,
             "server_cpu": cpu, "server_waited": waited, "clients_cpu": sum(r["cores"] for r in results),
