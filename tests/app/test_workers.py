@@ -10,8 +10,10 @@ import re
 import subprocess
 import sys
 import time
-from collections.abc import Iterator
+from collections import Counter
+from collections.abc import Callable, Iterator
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -27,6 +29,23 @@ FLOOD_PRESSES = 6000
 """The deadman test's flood: far more 0.1 mm presses than the server carries out within the
 deadman's bound (of 1,500, all were carried out in time in one full run)."""
 pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="SO_REUSEPORT spreading is Linux's")
+
+
+async def until(what: str, fn: Callable[[], Any], timeout_s: float = 30.0,
+                detail: Callable[[], object] = lambda: "") -> Any:
+    """Poll ``fn`` every 20 ms until it returns something true, and return that; fail naming
+    ``what`` (and ``detail()``, what was seen) after ``timeout_s``."""
+    deadline = time.monotonic() + timeout_s
+    while not (got := fn()):
+        assert time.monotonic() < deadline, f"{what}: not within {timeout_s} s ({detail()})"
+        await asyncio.sleep(0.02)
+    return got
+
+
+def trainees_per_process(present: list[tuple[str, str, Any]]) -> Counter[int]:
+    """How many of the gradebook's presence rows each server process (the pid in the holder,
+    ``...:<pid>:<n>``) holds."""
+    return Counter(int(holder.split(":")[-2]) for _, holder, _ in present)
 
 
 def _start_workers2(tmp_path: Path, class_db: str, seed: str,
@@ -135,13 +154,6 @@ def test_wrong_trainer_tokens_lock_the_address_out_on_both_processes(workers2) -
             return sorted(float(r[0]) for r in conn.execute(
                 "SELECT failed_at FROM token_failures WHERE source = '127.0.0.1'"))
 
-    async def until(what: str, fn, timeout_s: float = 30.0):
-        deadline = time.monotonic() + timeout_s
-        while not (got := fn()):
-            assert time.monotonic() < deadline, f"{what}: not within {timeout_s} s"
-            await asyncio.sleep(0.02)
-        return got
-
     async def wrong(c, k: int) -> None:
         """Client ``c`` types a wrong token once the lock is over; it is the ``k``-th failure."""
         times = failures()
@@ -198,32 +210,22 @@ def test_browsers_arriving_one_by_one_are_split_evenly_over_the_processes(worker
     def browsers() -> list[int]:
         return [row["sessions"] for row in record.read()["listeners"]]
 
-    async def until(what: str, fn, timeout_s: float = 30.0) -> None:
-        deadline = time.monotonic() + timeout_s
-        while not fn():
-            assert time.monotonic() < deadline, f"{what}: not within {timeout_s} s ({browsers()})"
-            await asyncio.sleep(0.02)
-
-    async def scenario() -> tuple[list[list[int]], dict[int, int]]:
-        await until("the other tests' browsers gone", lambda: sum(browsers()) == 0)
+    async def scenario() -> tuple[list[list[int]], Counter[int]]:
+        await until("the other tests' browsers gone", lambda: sum(browsers()) == 0, detail=browsers)
         clients, seen = [], []
         try:
             for i in range(16):
                 clients += await connect_all("127.0.0.1", port, 1, names="Even", first=i)
-                await until(f"browser {i + 1} counted", lambda: sum(browsers()) == i + 1)
+                await until(f"browser {i + 1} counted", lambda: sum(browsers()) == i + 1, detail=browsers)
                 seen.append(browsers())
             book = Gradebook(db)
             try:
                 await until("every trainee present", lambda: len(
-                    [r for r in book.present() if r[0].startswith("Even ")]) == 16)
+                    [r for r in book.present() if r[0].startswith("Even ")]) == 16, detail=browsers)
                 rows = [r for r in book.present() if r[0].startswith("Even ")]
             finally:
                 book.close()
-            per_pid: dict[int, int] = {}
-            for _, holder, _ in rows:
-                pid = int(holder.split(":")[-2])
-                per_pid[pid] = per_pid.get(pid, 0) + 1
-            return seen, per_pid
+            return seen, trainees_per_process(rows)
         finally:
             for c in clients:
                 await c.close()
@@ -245,28 +247,22 @@ def test_two_processes_share_one_postgresql_gradebook(tmp_path: Path, postgres_s
     try:
         assert postgres_server.password not in text
 
-        async def scenario() -> tuple[dict[int, int], list[str]]:
+        async def scenario() -> tuple[Counter[int], list[str]]:
             clients = []
             book = Gradebook(url)
             try:
                 for i in range(6):                  # one after another, as a class arrives
                     clients += await connect_all("127.0.0.1", port, 1, names="Pg", first=i)
-                    deadline = time.monotonic() + 30
-                    while len(book.present()) < i + 1:
-                        assert time.monotonic() < deadline, f"trainee {i + 1} never present: {book.present()}"
-                        await asyncio.sleep(0.05)
-                per_pid: dict[int, int] = {}
-                for _, holder, _ in book.present():
-                    pid = int(holder.split(":")[-2])
-                    per_pid[pid] = per_pid.get(pid, 0) + 1
+                    await until(f"trainee {i + 1} present", lambda: len(book.present()) >= i + 1,
+                                detail=book.present)
+                per_pid = trainees_per_process(book.present())
                 # the same name again, from a new browser: whichever process it reaches refuses it
                 intruder = (await connect_all("127.0.0.1", port, 1, names="Pg", first=0))[0]
                 clients.append(intruder)
-                deadline = time.monotonic() + 30
                 refusal = "⚠ Pg 001 is already connected in another browser"
-                while not any(n.startswith(refusal) for n in intruder.notes):
-                    assert time.monotonic() < deadline, f"the second 'Pg 001' was not refused: {intruder.notes}"
-                    await asyncio.sleep(0.05)
+                await until("the second 'Pg 001' refused",
+                            lambda: any(n.startswith(refusal) for n in intruder.notes),
+                            detail=lambda: intruder.notes)
                 return per_pid, sorted(name for name, _, _ in book.present())
             finally:
                 book.close()
