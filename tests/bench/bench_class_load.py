@@ -8,8 +8,8 @@ a client process's clients on one asyncio loop, ``--client-procs`` processes, de
 client is a trainee: it joins the class under its own name through the welcome window, picks
 the 0.1 mm increment and clicks "X +" 20 times a second (a browser's most) for ``--duration``
 seconds (default 30), spread over the period. The latency of a press runs from the client's
-click to the first TCP readout it receives that shows it (the machine's monotonic clock in the
-client processes); a press not shown ``ANSWER_WAIT_S`` after the last one is unanswered
+click (written to its socket) to the arrival at its socket of the first TCP readout that shows it
+(the kernel's receive stamp, SO_TIMESTAMPNS, on the machine's monotonic clock); a press not shown ``ANSWER_WAIT_S`` after the last one is unanswered
 (dropped by the server's deadman, or never carried out). Printed per K: p50, p95, p99, max,
 presses asked / answered / unanswered, steps/s achieved (shown by the readouts; all trainees,
 and per trainee against the 20 asked), the CPU of each server process (cores, over the press
@@ -19,10 +19,11 @@ gradebook's presence, 1.5 s into the presses: the connection balance at work).
 The load generator runs on the same two cores as the server (its CPU is printed); a real
 class's browsers run elsewhere. It runs at ``--client-nice`` (default 19, the lowest priority):
 it takes the CPU the servers leave, as browsers on other machines take none of the server's,
-instead of a fair share of its two cores. That cannot flatter the latency: both ends
-of it are read in the client processes, so a client that waits for a CPU reads its readouts late
-(the latency only grows), and it sends a press late rather than not at all (the presses asked
-are counted as sent). How late the clients sent their presses against their plan is printed
+instead of a fair share of its two cores. That cannot flatter the latency: a readout is
+stamped when the kernel received it (the stamp of a read's last segment, so never early), a
+press when the client wrote it, and a client that waits for a CPU sends a press late rather than
+not at all (the presses asked are counted as sent; a burst of late presses is load the server
+must serve). How late the clients sent their presses against their plan is printed
 ("sent late"): the load actually offered. ``--client-nice 0`` gives the clients a fair share.
 
 RESULT: MET when, at the largest K, p99 < 100 ms, every press was answered and at least 95 % of
