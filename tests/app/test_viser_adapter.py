@@ -102,8 +102,22 @@ def test_a_jog_over_the_websocket_takes_the_fast_paths_only(app_factory) -> None
         wait_until(lambda: len(app.sessions) == 1, what="session built")
         (s,) = app.sessions.values()
         reset_path_counts()
-        client.click("X +")
-        wait_until(lambda: path_counts().get(("pose", "fast"), 0) > 0, what="the jog's pose messages")
+        gate = s.jogger.gate
+        presses = 0
+
+        def moved_or_pressed_again() -> bool:
+            # a press the deadman dropped (the loop reached it more than 250 ms late, e.g. while
+            # it still sent the new client's scene) is pressed again, as a trainee would
+            nonlocal presses
+            if path_counts().get(("pose", "fast"), 0) > 0:
+                return True
+            if presses == 0 or (gate.dropped_total >= presses and presses < 5):
+                presses += 1
+                client.click("X +")
+            return False
+
+        wait_until(moved_or_pressed_again, what="the jog's pose messages")
+        assert gate.dropped_total < presses      # the press that moved was not one the deadman dropped
         wait_until(lambda: path_counts().get(("markdown", "fast"), 0) > 0, what="the jog's readout")
         assert not [k for k in path_counts() if k[1] == "fallback"]
         assert s.controller.T_world_tcp()[0, 3] != 0.0
