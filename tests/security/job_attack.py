@@ -10,6 +10,7 @@ same beam scan) from the same pose."""
 from __future__ import annotations
 
 import asyncio
+import gc
 import sys
 import threading
 import time
@@ -20,6 +21,7 @@ from typing import Any
 import numpy as np
 from tcp_pendant.calibrate import CalibrationWorkflow
 from tcp_pendant.calibrate.beam_service import beam_check_job
+from tcp_pendant.cli import set_apart_startup_objects
 from tcp_pendant.controller import builtin_tools
 from tcp_pendant.job_pool import REST_S, JobPool, JobTiming
 from tcp_pendant.server import AppConfig, PendantApp
@@ -100,6 +102,10 @@ class Classroom:
         self.app = app = PendantApp(AppConfig(port=0, tool_library=tmp_path / "tools.json"))
         self.pool = app.jobs = pool
         app.start()
+        # as `tcp-pendant` does once it listens: without it, a full collection of the test
+        # process's objects (~200k after hundreds of tests) stalls every thread 150-330 ms, past
+        # the deadman's bound, and the victim's press is dropped for a reason no server has
+        set_apart_startup_objects()
         self.victim_client = ButtonClient(app.port, (PLUS_X,))
         assert self.victim_client.found.wait(30), "the victim never saw the jog keys"
         wait_until(lambda: len(app.sessions) == 1, what="the victim's session")
@@ -191,3 +197,4 @@ class Classroom:
             a.cancel()
         self.victim_client.close()
         self.app.stop()
+        gc.unfreeze()                            # the later tests' objects are collected as usual
