@@ -81,6 +81,26 @@ def test_overlapping_labels_are_moved_apart_on_screen() -> None:
         assert np.linalg.norm(d - up * (d @ up)) < 1e-9 and d @ up >= 0
 
 
+def test_labels_clustered_anywhere_at_the_tip_end_up_apart() -> None:
+    # a label moved to exactly a box's height above another must count as apart whatever the
+    # rounding of (y + h) - h: before, the search hit the same box again until it gave up and
+    # left two labels on top of one another (it did with numpy 2.4's projection)
+    f = frame_spheres(np.array([[0.6, 0.0, 0.2]]), [0.2], fov_rad=1.0, image_height_px=720)
+    texts = {"computed": "COMPUTED", "true": "TRUE", "tool": "TOOL Pen 4P", "tip": "reference tip",
+             "flange": "FLANGE"}
+    rng = np.random.default_rng(7)
+    for _ in range(300):
+        tip = np.array([0.6, 0.0, 0.2]) + rng.uniform(-0.05, 0.05, 3)
+        anchors = {n: tip + rng.uniform(-0.004, 0.004, 3) for n in texts}
+        placed = spread_labels(f, anchors, texts)
+        xy, _ = f.project(np.array(list(placed.values())))
+        for (i, a), (j, b) in combinations(enumerate(placed), 2):
+            wa, h = label_box_px(texts[a])
+            wb, _ = label_box_px(texts[b])
+            apart_x = xy[i, 0] >= xy[j, 0] + wb - 1e-6 or xy[j, 0] >= xy[i, 0] + wa - 1e-6
+            assert apart_x or abs(xy[i, 1] - xy[j, 1]) >= h, (a, b, anchors)
+
+
 def test_labels_already_apart_stay_where_they_are() -> None:
     f = frame_spheres(np.array([[0.6, 0.0, 0.2]]), [0.2], fov_rad=1.0, image_height_px=720)
     anchors = {"a": np.array([0.6, 0.0, 0.35]), "b": np.array([0.6, 0.0, 0.05])}

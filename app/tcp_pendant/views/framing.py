@@ -150,9 +150,15 @@ def frame_spheres(centres: np.ndarray, radii: np.ndarray | Sequence[float] | Non
                    distance_m=distance, fov_rad=fov, aspect=asp, image_height_px=height)
 
 
+_TOUCH_PX = 1e-6
+"""Boxes closer than this to touching (screen px) count as touching, not overlapping: a label
+moved to exactly ``h`` above another is apart, whatever the rounding of ``(y + h) - h``."""
+
+
 def _overlap(a: np.ndarray, wa: float, b: np.ndarray, wb: float, h: float) -> bool:
-    """Boxes anchored top-left at a and b (pixels, y up) overlap."""
-    return bool(a[0] < b[0] + wb and b[0] < a[0] + wa and a[1] - h < b[1] and b[1] - h < a[1])
+    """Boxes anchored top-left at a and b (pixels, y up) overlap by more than ``_TOUCH_PX``."""
+    e = _TOUCH_PX
+    return bool(a[0] < b[0] + wb - e and b[0] < a[0] + wa - e and a[1] - h < b[1] - e and b[1] - h < a[1] - e)
 
 
 def spread_labels(framing: Framing, anchors: Mapping[str, np.ndarray],
