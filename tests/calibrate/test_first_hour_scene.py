@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 import sys
+from collections.abc import Iterator
 from itertools import combinations
 from pathlib import Path
 
@@ -53,23 +54,35 @@ def test_framing_shows_the_whole_sphere_and_fills_the_view(fov_deg, aspect) -> N
     np.testing.assert_allclose(f.look_at, f.centre)
 
 
+TIP_LABELS = {"computed": "COMPUTED", "true": "TRUE", "tool": "TOOL Pen 4P", "tip": "reference tip",
+              "flange": "FLANGE"}
+"""The labels drawn at the tool tip after Finish: name -> text."""
+
+
+def label_pairs(xy: np.ndarray, names: list[str], texts: dict[str, str],
+                x_slack_px: float = 0.0) -> Iterator[tuple[int, str, int, str, bool, bool]]:
+    """Each pair of labels at screen anchors ``xy`` (row per name, px): (i, a, j, b, apart
+    across the screen, apart up it). Across counts boxes within ``x_slack_px`` of touching as
+    apart (``spread_labels`` leaves those where they are)."""
+    for (i, a), (j, b) in combinations(enumerate(names), 2):
+        wa, h = label_box_px(texts[a])
+        wb, _ = label_box_px(texts[b])
+        apart_x = xy[i, 0] >= xy[j, 0] + wb - x_slack_px or xy[j, 0] >= xy[i, 0] + wa - x_slack_px
+        yield i, a, j, b, apart_x, abs(xy[i, 1] - xy[j, 1]) >= h
+
+
 def test_overlapping_labels_are_moved_apart_on_screen() -> None:
     f = frame_spheres(np.array([[0.6, 0.0, 0.2]]), [0.2], fov_rad=1.0, image_height_px=720)
     tip = np.array([0.6, 0.0, 0.2])
     anchors = {"computed": tip + [0, 0, -0.001], "true": tip + [0.002, 0, 0], "tool": tip + [0, 0, 0.003],
                "tip": tip + [0, 0, -0.004], "flange": tip + [0, 0, 0.12]}
-    texts = {"computed": "COMPUTED", "true": "TRUE", "tool": "TOOL Pen 4P", "tip": "reference tip",
-             "flange": "FLANGE"}
+    texts = TIP_LABELS
     placed = spread_labels(f, anchors, texts)
     assert list(placed) == list(anchors)
     np.testing.assert_allclose(placed["computed"], anchors["computed"])       # the first stays
     xy, depth = f.project(np.array(list(placed.values())))
     names = list(placed)
-    for (i, a), (j, b) in combinations(enumerate(names), 2):
-        wa, h = label_box_px(texts[a])
-        wb, _ = label_box_px(texts[b])
-        apart_x = xy[i, 0] >= xy[j, 0] + wb or xy[j, 0] >= xy[i, 0] + wa
-        apart_y = abs(xy[i, 1] - xy[j, 1]) >= h
+    for i, a, j, b, apart_x, apart_y in label_pairs(xy, names, texts):
         assert apart_x or apart_y, (a, b)
         if not apart_x:                         # stacked: at least a label's height apart in WORLD
             mm = 1000 * np.linalg.norm(placed[a] - placed[b])
@@ -86,19 +99,15 @@ def test_labels_clustered_anywhere_at_the_tip_end_up_apart() -> None:
     # rounding of (y + h) - h: before, the search hit the same box again until it gave up and
     # left two labels on top of one another (it did with numpy 2.4's projection)
     f = frame_spheres(np.array([[0.6, 0.0, 0.2]]), [0.2], fov_rad=1.0, image_height_px=720)
-    texts = {"computed": "COMPUTED", "true": "TRUE", "tool": "TOOL Pen 4P", "tip": "reference tip",
-             "flange": "FLANGE"}
+    texts = TIP_LABELS
     rng = np.random.default_rng(7)
     for _ in range(300):
         tip = np.array([0.6, 0.0, 0.2]) + rng.uniform(-0.05, 0.05, 3)
         anchors = {n: tip + rng.uniform(-0.004, 0.004, 3) for n in texts}
         placed = spread_labels(f, anchors, texts)
         xy, _ = f.project(np.array(list(placed.values())))
-        for (i, a), (j, b) in combinations(enumerate(placed), 2):
-            wa, h = label_box_px(texts[a])
-            wb, _ = label_box_px(texts[b])
-            apart_x = xy[i, 0] >= xy[j, 0] + wb - 1e-6 or xy[j, 0] >= xy[i, 0] + wa - 1e-6
-            assert apart_x or abs(xy[i, 1] - xy[j, 1]) >= h, (a, b, anchors)
+        for _, a, _, b, apart_x, apart_y in label_pairs(xy, list(placed), texts, x_slack_px=1e-6):
+            assert apart_x or apart_y, (a, b, anchors)
 
 
 def test_labels_already_apart_stay_where_they_are() -> None:
