@@ -13,9 +13,20 @@ import os
 import shutil
 from pathlib import Path
 from typing import Any
+from urllib.parse import parse_qsl, urlsplit, urlunsplit
 
 CHROMIUM = os.environ.get("CHROMIUM", "/usr/bin/chromium")
 CHROMIUM_ARGS = ["--no-sandbox", "--disable-gpu", "--disable-background-networking", "--disable-component-update"]
+
+RENDER_SCALE = os.environ.get("UI_RENDER_SCALE", "0.5")
+"""The 3D view's resolution in the tests' pages, device pixels per CSS pixel (viser's ``fixedDpr``
+address parameter, read by its client at load; the page's layout and the screenshots' size are
+unchanged). WebGL is software-rendered here (SwiftShader), at a cost per pixel: an idle pendant
+page at 1400 x 900 took 1.4-1.5 of the machine's two cores at the browser's own scale (viser
+adapts it down to 0.75 on a slow machine) and 0.9 at 0.5, and ten jog clicks, each waited on until
+its readout changed, took 5.8-7.1 s against 4.7 s, the server and the test sharing the same cores.
+At 0.5 the 3D labels still read in a screenshot (at 0.3 they do not). ``UI_RENDER_SCALE=`` (empty)
+leaves the browser's own."""
 
 _state: dict[str, Any] = {"users": 0, "pw": None, "browser": None}
 
@@ -41,6 +52,17 @@ def acquire() -> Any:
         _state["pw"] = pw
     _state["users"] += 1
     return _state["browser"]
+
+
+def with_render_scale(url: str) -> str:
+    """``url`` with :data:`RENDER_SCALE` as viser's ``fixedDpr`` parameter, appended to the query
+    as it is written (a page that drops a parameter of its own, e.g. ``trainer``, keeps this one);
+    unchanged when the scale is empty or the address gives one."""
+    parts = urlsplit(url)
+    if not RENDER_SCALE or any(name == "fixedDpr" for name, _ in parse_qsl(parts.query)):
+        return url
+    query = f"{parts.query}&" if parts.query else ""
+    return urlunsplit(parts._replace(path=parts.path or "/", query=f"{query}fixedDpr={RENDER_SCALE}"))
 
 
 def release() -> None:

@@ -8,8 +8,9 @@
 * ``browser``: a chromium launched once per session with ``executable_path='/usr/bin/chromium'``
   (or ``$CHROMIUM``) and ``--no-sandbox --disable-gpu --disable-background-networking
   --disable-component-update``.
-* ``new_page(url)`` (factory fixture): a fresh browser context + page at ``url``, waits for the
-  pendant's GUI ("Record point" button), closed at the end.
+* ``new_page(url)`` (factory fixture): a fresh browser context + page at ``url`` (its 3D view at
+  ``chromium_session.RENDER_SCALE`` device pixels per CSS pixel), waits for the pendant's GUI
+  ("Record point" button), closed at the end.
 * ``shot(page, name)``: screenshot into the test's ``tmp_path`` (returns the path).
 
 Software WebGL is slow: wait on conditions with generous timeouts, never fixed sleeps.
@@ -160,15 +161,18 @@ def browser() -> Iterator[object]:
 @pytest.fixture
 def new_page(browser: object) -> Iterator[Callable[..., object]]:
     """Factory: ``new_page(url)`` opens a fresh context (its own viser client) at ``url`` and
-    waits until the pendant GUI is there."""
+    waits until the pendant GUI is there (``init_script``: JavaScript run first in its pages)."""
     contexts: list[object] = []
 
-    def factory(url: str, *, width: int = 1400, height: int = 900, wait_for: str = "Record point") -> object:
+    def factory(url: str, *, width: int = 1400, height: int = 900, wait_for: str = "Record point",
+                init_script: str | None = None) -> object:
         ctx = browser.new_context(viewport={"width": width, "height": height})  # type: ignore[attr-defined]
         contexts.append(ctx)
+        if init_script is not None:                # runs in every page of the context before its own scripts
+            ctx.add_init_script(init_script)  # type: ignore[attr-defined]
         page = ctx.new_page()
         page.set_default_timeout(UI_TIMEOUT_MS)
-        page.goto(url)
+        page.goto(chromium_session.with_render_scale(url))
         if wait_for:
             page.get_by_role("button", name=wait_for).first.wait_for(state="visible", timeout=UI_TIMEOUT_MS)
         return page

@@ -24,6 +24,7 @@ from typing import Any
 import numpy as np
 import pytest
 import viser
+from chromium_session import with_render_scale
 from pendant_page import TIMEOUT_MS, choose, type_text, wait_text
 from tcp_pendant.calibrate import AutoTouchRequest, CalibrationWorkflow
 from tcp_pendant.text_escape import WORD_JOINER, escape_markdown
@@ -138,7 +139,7 @@ def bare_viser(browser: Any) -> Iterator[Callable[[], tuple[viser.ViserServer, A
         page = ctx.new_page()
         page.set_default_timeout(TIMEOUT_MS)
         made.append((srv, ctx))
-        page.goto(f"http://127.0.0.1:{srv.get_port()}")
+        page.goto(with_render_scale(f"http://127.0.0.1:{srv.get_port()}"))
         srv.gui.add_button("Ready")
         page.get_by_role("button", name="Ready").wait_for(state="visible", timeout=TIMEOUT_MS)
         return srv, page
