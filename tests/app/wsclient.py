@@ -181,7 +181,7 @@ CAMERA = dict(type="ViewerCameraMessage", wxyz=[1.0, 0.0, 0.0, 0.0], position=[2
 
 class InputsClient:
     """A raw viser websocket that records the GUI inputs the server creates (uuid -> kind,
-    label, props) and sends whatever it is given (a msgpack mapping, raw bytes or a text
+    label, props), the GUI updates and every message it gets, and sends whatever it is given (a msgpack mapping, raw bytes or a text
     frame), as a hostile browser could. ``closed`` is set when the server closed it."""
 
     def __init__(self, port: int) -> None:
@@ -189,6 +189,7 @@ class InputsClient:
                           max_size=None, open_timeout=20)
         self.inputs: dict[str, tuple[str, str, dict[str, Any]]] = {}
         self.updates: list[tuple[str, dict[str, Any]]] = []     # (uuid, updates) the server sent
+        self.messages: list[dict[str, Any]] = []                # every message the server sent, decoded
         self.closed = threading.Event()
         self._thread = threading.Thread(target=self._drain, daemon=True)
         self._thread.start()
@@ -199,6 +200,7 @@ class InputsClient:
             for msg in self.ws:
                 if isinstance(msg, bytes):
                     for m in decode_window(msg):
+                        self.messages.append(m)
                         if m.get("type") in INPUTS:
                             props = m.get("props") or {}
                             self.inputs[m["uuid"]] = (m["type"], str(props.get("label")), props)

@@ -1,6 +1,7 @@
 """The page's own script in chromium (``static/pendant.js``, ``tcp_pendant.client_script``):
 keyboard shortcuts that click the pendant's buttons, the trainee's name remembered across a
-reload, and the trainer view opened from ``/?trainer=TOKEN``.
+reload, the trainer view opened from ``/?trainer=TOKEN``, and "Shadows" off in a browser that
+draws WebGL in software.
 
 The pendant runs in this process (``PendantApp`` on a free port) so each key's effect is read
 off the session's controller, workflow and classroom, not only off the page.
@@ -254,3 +255,43 @@ def test_the_typed_token_still_works(pendant, new_page, tmp_path: Path) -> None:
     page.get_by_role("button", name="Open trainer view", exact=True).click()
     wait_text(page, "Download grades (CSV)")
     assert "trainer" in s.views
+
+
+_HARDWARE_RENDERER = """
+(() => {   // this page's WebGL says it runs on a graphics card (chromium here draws with SwiftShader)
+  const UNMASKED_RENDERER_WEBGL = 0x9246;
+  for (const C of [WebGLRenderingContext, WebGL2RenderingContext]) {
+    const get = C.prototype.getParameter;
+    C.prototype.getParameter = function (p) {
+      return p === UNMASKED_RENDERER_WEBGL ? "ANGLE (NVIDIA, NVIDIA GeForce RTX 3060 Direct3D11 vs_5_0 ps_5_0)" : get.call(this, p);
+    };
+  }
+})();
+"""
+
+
+def _shadows_decision(page: Any) -> str:
+    """What the page's script decided for the Shadows checkbox ("off" or "kept"), once it did."""
+    box = "[data-tcp-pendant-shadows]"
+    page.wait_for_selector(box, state="attached", timeout=TIMEOUT_MS)
+    return str(page.get_attribute(box, "data-tcp-pendant-shadows"))
+
+
+def test_a_software_webgl_browser_turns_the_shadows_off_and_a_graphics_card_keeps_them(pendant, new_page) -> None:
+    from tcp_pendant.views.pendant_panel import SHADOWS_LABEL
+
+    app = pendant()
+    page, s = open_page(app, new_page)
+    renderer = page.evaluate("""() => { const gl = document.createElement('canvas').getContext('webgl');
+        const i = gl.getExtension('WEBGL_debug_renderer_info'); return gl.getParameter(i.UNMASKED_RENDERER_WEBGL); }""")
+    assert "swiftshader" in renderer.lower()                 # this machine's chromium: no GPU
+    assert _shadows_decision(page) == "off"
+    wait_until(lambda: s.views["pendant"].shadows.value is False, "the server told: shadows off")
+    assert page.get_by_role("checkbox", name=SHADOWS_LABEL).is_checked() is False
+    page.get_by_role("checkbox", name=SHADOWS_LABEL).click()          # the trainee may tick it again
+    wait_until(lambda: s.views["pendant"].shadows.value is True, "shadows on again")
+    # a page whose WebGL names a graphics card keeps them
+    page2, s2 = open_page(app, new_page, init_script=_HARDWARE_RENDERER)
+    assert _shadows_decision(page2) == "kept"
+    assert page2.get_by_role("checkbox", name=SHADOWS_LABEL).is_checked() is True
+    assert s2.views["pendant"].shadows.value is True

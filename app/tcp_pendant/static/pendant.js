@@ -35,6 +35,12 @@
  *    min-width 0 (a clipping flex item would otherwise grow with its content, and the error
  *    chart, which takes its container's width, would grow without end); the scroll area itself
  *    no longer scrolls sideways (what those ancestors cut off stays cut off).
+ * 5. Software WebGL: in a browser whose WebGL renderer is a software one (its name, as
+ *    WEBGL_debug_renderer_info gives it, says SwiftShader, llvmpipe, softpipe, software or Basic
+ *    Render: no graphics card), the "Shadows" checkbox is clicked off once each time the server
+ *    shows one: the shadow maps would cost such a browser most of each frame. A trainee may tick
+ *    it again. The --shared pendant's "Shadows (every screen)" is left alone. The checkbox gets
+ *    data-tcp-pendant-shadows="off" or "kept" (a hardware renderer), what the script decided.
  */
 (function () {
   "use strict";
@@ -46,8 +52,10 @@
   var L = {
     name: "Your name", key: "Browser key", join: "Join the class", token: "Trainer token",
     openTrainer: "Open trainer view",
-    increment: "Increment", record: "Record", recordPoint: "Record point", banner: "Trainee:"
+    increment: "Increment", record: "Record", recordPoint: "Record point", banner: "Trainee:",
+    shadows: "Shadows"
   };
+  var SOFTWARE_RE = /swiftshader|llvmpipe|softpipe|software|basic render/i;
   var CARTESIAN = ["X", "Y", "Z", "A", "B", "C"];
   var NAME_KEY = "tcpPendant.traineeName";
   var BROWSER_KEY = "tcpPendant.browserKey";
@@ -352,6 +360,31 @@
     folder.setAttribute("data-tcp-pendant-pinned", "1");
   }
 
+  // ------------------------------------------------------------------ 5. software WebGL
+  var software = null;                      // the renderer's verdict, asked once
+  function softwareWebgl() {
+    if (software === null) {
+      software = false;
+      try {
+        var canvas = document.createElement("canvas");
+        var gl = canvas.getContext("webgl2") || canvas.getContext("webgl");
+        var info = gl && gl.getExtension("WEBGL_debug_renderer_info");
+        if (info) software = SOFTWARE_RE.test(String(gl.getParameter(info.UNMASKED_RENDERER_WEBGL) || ""));
+        var lose = gl && gl.getExtension("WEBGL_lose_context");
+        if (lose) lose.loseContext();       // the probe's context is not kept
+      } catch (e) { software = false; }
+    }
+    return software;
+  }
+  function shadowsOff() {
+    var row = labelled(L.shadows);
+    var box = row ? row.querySelector("input[type=checkbox]") : null;
+    if (!box || !first(box)) return;
+    var off = softwareWebgl();
+    box.setAttribute("data-tcp-pendant-shadows", off ? "off" : "kept");   // what the script decided
+    if (off && box.checked) box.click();
+  }
+
   var scheduled = false;
   function schedule() {
     if (scheduled) return;
@@ -360,6 +393,7 @@
       scheduled = false;
       keyTitles();
       pinPresenter();
+      shadowsOff();
       scan();
     }, 150);
   }

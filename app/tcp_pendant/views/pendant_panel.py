@@ -8,7 +8,7 @@ the hold-to-jog keys, two per axis, since only single buttons report a hold), th
 the status line (why a jog stopped), within 20 mm a magnified text close-up of the two tips
 (hidden by "Hide distance"), the front and side views of the tips (``views.tip_insets``,
 within 40 mm: geometry, no numbers) - everything that comes and goes near the tip is below
-the keys, so the keys never move - then the jog settings (mode, frame, override, readout frame), the joints, Home and the camera buttons; the touches ("Record point" and the list) follow.
+the keys, so the keys never move - then the jog settings (mode, frame, override, readout frame), the joints, Home and the view (the camera buttons, "Shadows"); the touches ("Record point" and the list) follow.
 Every button group marks its selected option with "✓ " (viser's button groups show no
 selection); a click's value is read without the mark. Keyboard shortcuts come from the page's
 own script (``static/pendant.js``, served by ``client_script``): it clicks these buttons, so a
@@ -23,6 +23,11 @@ status line and as a notification ("N jog presses dropped: the server was busy")
 Widgets only call :class:`tcp_pendant.pendant.Jogger` and the session; all text comes from
 ``tcp_pendant.pendant.formatting``. Every callback runs on viser's event loop
 (:meth:`Session.on_loop`), in the order the browser's messages arrived.
+
+"Shadows" switches the shadows of viser's default lights for this browser (every browser in
+``--shared`` mode, where its label says so). The page's script unchecks it when the browser
+draws WebGL in software (no GPU: a thin client, a virtual machine), where the shadow maps cost
+most of each frame (:data:`SHADOWS_LABEL`).
 
 Joint sliders: setting a slider's value from Python fires its ``on_update`` (later, on the
 loop) with ``event.client is None``; those events are ignored. A slider the browser is
@@ -83,6 +88,15 @@ MARK = "✓ "
 KEYS_LINE = ("Keys: `1`…`6` jog **+** on the rows above, `Shift`+`1`…`6` jog **−**, "
              "`[` `]` smaller / larger increment, `R` Record")
 """The keyboard shortcuts (``static/pendant.js``), shown below the jog keys."""
+
+SHADOWS_LABEL = "Shadows"
+"""The shadows checkbox of one browser's pendant; ``static/pendant.js`` unchecks the checkbox
+of this exact label in a browser that renders WebGL in software (its renderer's name says
+SwiftShader, llvmpipe, softpipe, software or Basic Render), once per checkbox shown."""
+SHARED_SHADOWS_LABEL = "Shadows (every screen)"
+"""The same in ``--shared`` mode: it switches every browser's shadows, and the script leaves it alone."""
+SHADOWS_HINT = ("Shadows of the robot and the tools. Off by itself in a browser that draws 3D without a "
+                "graphics card, where they cost most of each frame.")
 INCREMENT_KEYS = "keys [ smaller, ] larger"
 
 
@@ -217,6 +231,8 @@ class PendantPanel:
         with gui.add_folder("View"):
             self.closeup = gui.add_button("Close-up on reference tip")
             self.overview_btn = gui.add_button("Overview")
+            self.shadows = gui.add_checkbox(SHARED_SHADOWS_LABEL if session.shared else SHADOWS_LABEL, True,
+                                            hint=SHADOWS_HINT)
 
         g = session.on_loop
         self.mode.on_click(g(self._setting("mode", JogMode)))
@@ -229,6 +245,7 @@ class PendantPanel:
         self.kuka_home.on_click(g(self._on_kuka_home))
         self.closeup.on_click(g(self._on_camera(True)))
         self.overview_btn.on_click(g(self._on_camera(False)))
+        self.shadows.on_update(g(self._on_shadows))
         self._show_settings()
         session.subscribe(self.on_change)
 
@@ -422,6 +439,10 @@ class PendantPanel:
                 return
             (closeup_camera if close else overview_camera)(client, self.session.controller.reference_tip_world_m)
         return cb
+
+    def _on_shadows(self, _event: CheckboxEvent | None = None) -> None:
+        """The default lights cast shadows or not, where this panel draws (module docstring)."""
+        target_of(self.session).scene.configure_default_lights(True, cast_shadow=bool(self.shadows.value))
 
     # ------------------------------------------------------------ display
     def show_jog_result(self, res: JogResult) -> None:

@@ -1,0 +1,60 @@
+"""The "Shadows" checkbox of the jog panel's View folder, over real websockets: it switches the
+shadows of viser's default lights for the browser that clicked it only (every browser in
+``--shared`` mode, where its label says so)."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).parent))
+from wsclient import InputsClient, wait_until  # noqa: E402
+
+from tcp_pendant.views.pendant_panel import SHADOWS_LABEL, SHARED_SHADOWS_LABEL  # noqa: E402
+
+
+def _lights(c: InputsClient) -> list[tuple[bool, bool]]:
+    """(enabled, cast_shadow) of every EnableLightsMessage ``c`` received, in order."""
+    return [(m["enabled"], m["cast_shadow"]) for m in list(c.messages) if m.get("type") == "EnableLightsMessage"]
+
+
+def _set(c: InputsClient, label: str, value: bool) -> None:
+    c.send({"type": "GuiUpdateMessage", "uuid": c.uuid_of(label), "updates": {"value": value}})
+
+
+def test_shadows_switch_for_the_browser_that_clicked_only(app_factory) -> None:
+    app = app_factory()
+    anna, ben = InputsClient(app.port), InputsClient(app.port)
+    try:
+        for c in (anna, ben):
+            wait_until(lambda c=c: SHADOWS_LABEL in c.labels(), timeout=30, what="the Shadows checkbox")
+            assert _lights(c) == []                              # viser's default: lights with shadows
+        _set(anna, SHADOWS_LABEL, False)
+        wait_until(lambda: _lights(anna) == [(True, False)], what="Anna's lights without shadows")
+        # Ben's own click, handled after Anna's: had hers gone to him too, it would come first
+        _set(ben, SHADOWS_LABEL, False)
+        wait_until(lambda: len(_lights(ben)) >= 1, what="Ben's lights")
+        assert _lights(ben) == [(True, False)]
+        _set(anna, SHADOWS_LABEL, True)
+        wait_until(lambda: len(_lights(anna)) == 2, what="Anna's shadows back")
+        assert _lights(anna) == [(True, False), (True, True)]
+        assert sorted(s.views["pendant"].shadows.value for s in app.sessions.values()) == [False, True]   # Ben's, Anna's
+    finally:
+        anna.ws.close()
+        ben.ws.close()
+
+
+def test_the_shared_pendant_switches_every_screen_and_says_so(app_factory) -> None:
+    app = app_factory(shared=True)
+    anna, ben = InputsClient(app.port), InputsClient(app.port)
+    try:
+        for c in (anna, ben):
+            wait_until(lambda c=c: SHARED_SHADOWS_LABEL in c.labels(), timeout=30, what="the shared Shadows checkbox")
+            assert SHADOWS_LABEL not in c.labels()               # the page's script leaves this one alone
+        _set(anna, SHARED_SHADOWS_LABEL, False)
+        for c in (anna, ben):
+            wait_until(lambda c=c: _lights(c) == [(True, False)], what="every screen's lights without shadows")
+        assert app.shared_session.views["pendant"].shadows.value is False
+    finally:
+        anna.ws.close()
+        ben.ws.close()
