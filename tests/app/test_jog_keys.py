@@ -13,7 +13,7 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).parent))
 from conftest import wait_until  # noqa: E402
-from wsclient import ButtonClient  # noqa: E402
+from wsclient import ButtonClient, click_until_carried_out  # noqa: E402
 
 PLUS_X, MINUS_Z = "X +", "Z −"
 
@@ -34,10 +34,11 @@ def test_clicking_a_key_over_the_websocket_jogs_one_increment(app_factory) -> No
             s.jogger.settings = s.jogger.settings.with_(increment="10", frame="WORLD")
             T0 = s.controller.T_world_tcp()
             text0 = s.views["pendant"].tcp_md.content
-        client.click(PLUS_X)
-        wait_until(lambda: abs(s.controller.T_world_tcp()[0, 3] - T0[0, 3] - 0.010) < 1e-8, what="X + 10 mm")
-        client.click(MINUS_Z)
-        wait_until(lambda: abs(s.controller.T_world_tcp()[2, 3] - T0[2, 3] + 0.010) < 1e-8, what="Z - 10 mm")
+        gate = s.jogger.gate
+        click_until_carried_out(client, PLUS_X, gate, what="X + 10 mm",
+                                done=lambda: abs(s.controller.T_world_tcp()[0, 3] - T0[0, 3] - 0.010) < 1e-8)
+        click_until_carried_out(client, MINUS_Z, gate, what="Z - 10 mm",
+                                done=lambda: abs(s.controller.T_world_tcp()[2, 3] - T0[2, 3] + 0.010) < 1e-8)
         T1 = s.controller.T_world_tcp()
         np.testing.assert_allclose(T1[:3, 3] - T0[:3, 3], [0.010, 0.0, -0.010], atol=1e-8)
         # the readout followed: X and Z 10 mm off, Y unchanged, as text

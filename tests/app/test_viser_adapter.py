@@ -18,7 +18,7 @@ from tcp_pendant.views.viser_adapter import ViserInternalsChanged, path_counts, 
 
 sys.path.insert(0, str(Path(__file__).parent))
 from conftest import wait_until  # noqa: E402
-from wsclient import ButtonClient  # noqa: E402
+from wsclient import ButtonClient, click_until_carried_out  # noqa: E402
 
 
 @pytest.fixture
@@ -102,22 +102,10 @@ def test_a_jog_over_the_websocket_takes_the_fast_paths_only(app_factory) -> None
         wait_until(lambda: len(app.sessions) == 1, what="session built")
         (s,) = app.sessions.values()
         reset_path_counts()
-        gate = s.jogger.gate
-        presses = 0
-
-        def moved_or_pressed_again() -> bool:
-            # a press the deadman dropped (the loop reached it more than 250 ms late, e.g. while
-            # it still sent the new client's scene) is pressed again, as a trainee would
-            nonlocal presses
-            if path_counts().get(("pose", "fast"), 0) > 0:
-                return True
-            if presses == 0 or (gate.dropped_total >= presses and presses < 5):
-                presses += 1
-                client.click("X +")
-            return False
-
-        wait_until(moved_or_pressed_again, what="the jog's pose messages")
-        assert gate.dropped_total < presses      # the press that moved was not one the deadman dropped
+        # a press the deadman dropped (the loop reached it more than 250 ms late, e.g. while it
+        # still sent the new client's scene) is pressed again, as a trainee would
+        click_until_carried_out(client, "X +", s.jogger.gate, what="the jog's pose messages",
+                                done=lambda: path_counts().get(("pose", "fast"), 0) > 0)
         wait_until(lambda: path_counts().get(("markdown", "fast"), 0) > 0, what="the jog's readout")
         assert not [k for k in path_counts() if k[1] == "fallback"]
         assert s.controller.T_world_tcp()[0, 3] != 0.0
