@@ -22,6 +22,10 @@ def _set(c: InputsClient, label: str, value: bool) -> None:
     c.send({"type": "GuiUpdateMessage", "uuid": c.uuid_of(label), "updates": {"value": value}})
 
 
+def _count(c: InputsClient, kind: str) -> int:
+    return sum(m.get("type") == kind for m in list(c.messages))
+
+
 def test_shadows_switch_for_the_browser_that_clicked_only(app_factory) -> None:
     app = app_factory()
     anna, ben = InputsClient(app.port), InputsClient(app.port)
@@ -31,14 +35,15 @@ def test_shadows_switch_for_the_browser_that_clicked_only(app_factory) -> None:
             assert _lights(c) == []                              # viser's default: lights with shadows
         _set(anna, SHADOWS_LABEL, False)
         wait_until(lambda: _lights(anna) == [(True, False)], what="Anna's lights without shadows")
-        # Ben's own click, handled after Anna's: had hers gone to him too, it would come first
-        _set(ben, SHADOWS_LABEL, False)
-        wait_until(lambda: len(_lights(ben)) >= 1, what="Ben's lights")
-        assert _lights(ben) == [(True, False)]
+        # Ben's own click, handled after Anna's: his camera's answer comes after anything her
+        # click had sent him (one stream per browser, in order)
+        cameras = _count(ben, "SetCameraLookAtMessage")
+        _set(ben, "Close-up on reference tip", True)   # a camera pose he does not have yet
+        wait_until(lambda: _count(ben, "SetCameraLookAtMessage") > cameras, what="Ben's camera")
+        assert _lights(ben) == []
+        assert [s.views["pendant"].shadows.value for s in app.sessions.values()] == [False, True]   # Anna's, Ben's
         _set(anna, SHADOWS_LABEL, True)
-        wait_until(lambda: len(_lights(anna)) == 2, what="Anna's shadows back")
-        assert _lights(anna) == [(True, False), (True, True)]
-        assert sorted(s.views["pendant"].shadows.value for s in app.sessions.values()) == [False, True]   # Ben's, Anna's
+        wait_until(lambda: _lights(anna)[-1:] == [(True, True)], what="Anna's shadows back")
     finally:
         anna.ws.close()
         ben.ws.close()
