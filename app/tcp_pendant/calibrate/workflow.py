@@ -782,9 +782,23 @@ class CalibrationWorkflow:
     # ------------------------------------------------------------ session record
     def export_record(self, touches: Any = ()) -> dict[str, Any]:
         """The session record (JSON-ready dict, ``tcp_pendant.wizards.session_record`` format):
-        every wizard of the session with its poses, result and errors against truth."""
+        every wizard of the session with its poses, result and errors against truth. With the
+        truth hidden (an exercise) it carries no touch's true distance either
+        (:meth:`distances_shown`)."""
         return session_from_controller(self.controller, self.runs, robot=self.robot, touches=touches,
-                                       honest=self.honest_records, record_ids=self.record_ids)
+                                       honest=self.honest_records, record_ids=self.record_ids,
+                                       with_distances=not self.hide_truth)
+
+    def distances_shown(self) -> tuple[dict[int, float], set[int]]:
+        """The run on show's distance-at-record of its touch steps (mm, by 0-based step) and
+        the steps recorded with "Hide distance" on: the result's lesson of judging by eye.
+        Empty with the truth hidden (an exercise): the true distances d_i of touches whose
+        flange poses (R_i, p_i) the trainee knows give the true TCP t by trilateration,
+        ``|R_i t + p_i - r| = d_i``, so neither the table nor the export may carry them."""
+        run = self.run
+        if run is None or self.hide_truth:
+            return {}, set()
+        return dict(run.distance_mm), set(run.distance_hidden)
 
     def load_record(self, source: Any) -> tuple[ReplayCheck, ...]:
         """Load a session record (its bytes, JSON text or a dict; text is never taken for a path),

@@ -193,8 +193,7 @@ class WizardResultView:
         set_content(self.result_md, result_markdown(res, truth))   # a beam result: errors of both vs truth
         self.replay_scan.visible = bool(getattr(getattr(res, "scan", None), "moves", ()))   # a stored scan: none
         set_content(self.warnings_md, warnings_markdown(res))
-        run = wf.run
-        hidden = "" if run is None else hidden_touches_markdown(res, run.distance_mm, run.distance_hidden)
+        hidden = hidden_touches_markdown(res, *wf.distances_shown())
         self.hidden_md.visible = bool(hidden)
         if hidden:
             set_content(self.hidden_md, hidden)

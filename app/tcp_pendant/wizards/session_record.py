@@ -64,7 +64,8 @@ angles in degrees; poses are 4x4 row-major nested lists; times ISO 8601 UTC. The
                                                   # recorded steps (deg; mm linear), by step
           "distance_mm": {"0": 0.42, ...},        # optional: true tool tip to
                                                   # reference tip when each touch step was
-                                                  # recorded, mm (>= 0), by step
+                                                  # recorded, mm (>= 0), by step; never in
+                                                  # a record exported in an exercise
           "truth": TruthComparison.to_dict() | null   # position_error_mm, orientation_error_deg,
                                                       # x_axis_error_deg, inside_ci95, graded,
                                                       # grade, verdict, position_error_vector_mm
@@ -203,7 +204,8 @@ def _touch_dict(touch: Any) -> dict[str, Any]:
     return out
 
 
-def _run_dict(run: WizardRun | Wizard, honest: bool = False, record_id: int | None = None) -> dict[str, Any]:
+def _run_dict(run: WizardRun | Wizard, honest: bool = False, record_id: int | None = None,
+              with_distances: bool = True) -> dict[str, Any]:
     if isinstance(run, Wizard):
         run = WizardRun(run)
     out = _run_entry(run, honest, record_id)
@@ -212,7 +214,7 @@ def _run_dict(run: WizardRun | Wizard, honest: bool = False, record_id: int | No
     if joints:                         # optional: the joint values of the recorded steps
         out["joints_deg"] = joints
     distances = {str(k): float(d) for k, d in sorted(run.distance_mm.items()) if k in steps}
-    if distances:                      # optional: distance-at-record of the touch steps
+    if distances and with_distances:   # optional: distance-at-record of the touch steps
         out["distance_mm"] = distances
     return out
 
@@ -221,7 +223,8 @@ def run_entry(run: WizardRun, *, honest: bool = True, record_id: int | None = No
     """One wizard run as a session record's entry (``"state"``, ``"result"``, ``"true_tool"``,
     ``"truth"``, ``"record_id"``, and ``"joints_deg"`` / ``"distance_mm"`` of its recorded
     steps); ``honest``: no truth in it (the classroom keeps the truth apart, in the gradebook).
-    The gradebook stores it for each calibration in progress, so a restart gives it back."""
+    The gradebook stores it for each calibration in progress, so a restart gives it back; it
+    keeps the distances (the server's copy, never sent to a browser)."""
     return _run_dict(run, honest, record_id)
 
 
@@ -277,7 +280,7 @@ def _run_entry(run: WizardRun, honest: bool, record_id: int | None) -> dict[str,
 def session_to_dict(runs: Sequence[WizardRun | Wizard], *, robot: str, urdf: str | Path | None = None,
                     T_world_base_m: Any = None, mounted_tool: Any = None,
                     reference_tip_world_m: Any = None, touches: Sequence[Any] = (), honest: bool = False,
-                    record_ids: Mapping[int, int] | None = None) -> dict[str, Any]:
+                    record_ids: Mapping[int, int] | None = None, with_distances: bool = True) -> dict[str, Any]:
     """The session as a JSON-ready dict (see the module docstring for the keys).
 
     Args:
@@ -293,6 +296,11 @@ def session_to_dict(runs: Sequence[WizardRun | Wizard], *, robot: str, urdf: str
             errors against it, no server path (``robot.urdf`` null); the trainer grades it
             against the gradebook by each wizard's ``record_id``.
         record_ids: run index -> gradebook calibration id (``record_id`` of each wizard).
+        with_distances: each wizard's ``"distance_mm"`` (the true tip-to-reference distance of
+            every touch) is written. False in an exercise: with the touches' flange poses and
+            the reference tip, the distances d_i give the true TCP t by trilateration,
+            ``|R_i t + p_i - r| = d_i`` (four touches in general position suffice), without a
+            single real touch.
     """
     ids = {} if record_ids is None else dict(record_ids)
     tool = None
@@ -310,21 +318,22 @@ def session_to_dict(runs: Sequence[WizardRun | Wizard], *, robot: str, urdf: str
                   "T_world_base_m": _pose_list(np.eye(4) if T_world_base_m is None else T_world_base_m)},
         "mounted_tool": tool, "reference_tip_world_m": tip,
         "touches": [_touch_dict(t) for t in touches],
-        "wizards": [_run_dict(r, honest, ids.get(i)) for i, r in enumerate(runs)],
+        "wizards": [_run_dict(r, honest, ids.get(i), with_distances) for i, r in enumerate(runs)],
     }
 
 
 def session_from_controller(controller: Any, runs: Sequence[WizardRun | Wizard], *, robot: str,
                             touches: Sequence[Any] = (), honest: bool = False,
-                            record_ids: Mapping[int, int] | None = None) -> dict[str, Any]:
+                            record_ids: Mapping[int, int] | None = None,
+                            with_distances: bool = True) -> dict[str, Any]:
     """``session_to_dict`` filled from a ``VirtualController`` (base, tool, reference tip, URDF;
-    ``honest`` and ``record_ids`` as there)."""
+    ``honest``, ``record_ids`` and ``with_distances`` as there)."""
     kin = getattr(controller, "kinematics", None)
     urdf = getattr(kin, "urdf_path", None)
     return session_to_dict(runs, robot=robot, urdf=urdf, T_world_base_m=controller.T_world_base,
                            mounted_tool=controller.mounted_tool,
                            reference_tip_world_m=controller.reference_tip_world_m, touches=touches,
-                           honest=honest, record_ids=record_ids)
+                           honest=honest, record_ids=record_ids, with_distances=with_distances)
 
 
 def dumps(record: Mapping[str, Any]) -> str:
