@@ -6,16 +6,21 @@ hand, the locked "Hide distance"; switching tabs sends nothing, viser's tabs liv
 and every tab's content is sent anyway), keeps every message the server sends it, and decodes
 all of it: every number of every message in order, every float array (mesh vertices, points,
 poses), every raw byte string read as float32 and float64 (at every alignment), and every
-number written in a text (markdown, labels, notifications). No three consecutive numbers may lie within 0.05 mm of the true TCP read from
+number written in a text (markdown, labels, notifications), and every file sent for download (the
+session record, the touches' CSV, a controller file: viser's file transfer parts put together and
+read as text). No three consecutive numbers may lie within 0.05 mm of the true TCP read from
 the gradebook: in FLANGE (metres and mm, the frame the tool's meshes come in), in WORLD and BASE
 at each flange pose the robot took (metres and mm), or as an offset from a zero tool (the
-numbers minus the flange position, turned into flange axes; metres and mm).
+numbers minus the flange position, turned into flange axes; metres and mm). No touch's true
+distance is in the exported record or the result (with the poses they give the TCP by
+trilateration: ``tests/calibrate/test_exercise_distances.py``).
 
 The clicks reach the session as a browser's do (``guiclick``, with this client's handle); what
 is read is only what went over this client's websocket."""
 
 from __future__ import annotations
 
+import json
 import re
 import sys
 from pathlib import Path
@@ -23,6 +28,8 @@ from typing import Any
 
 import numpy as np
 from scipy.spatial import cKDTree
+from tcp_pendant.views.touch_list import TOUCHES_FILENAME
+from tcp_pendant.views.wizard_menu import SESSION_FILENAME
 
 _APP_TESTS = Path(__file__).parents[1] / "app"
 sys.path.insert(0, str(_APP_TESTS))
@@ -99,6 +106,23 @@ def _near(triples: np.ndarray, owner: np.ndarray, targets: list[tuple[str, np.nd
     return hits
 
 
+def _downloads(messages: list[dict]) -> dict[str, str]:
+    """The files sent to this browser (viser's ``FileTransferStartDownload`` and its
+    ``FileTransferPart`` messages, put together in part order), by file name, as UTF-8 text."""
+    names = {m["transfer_uuid"]: (m["filename"], m["part_count"])
+             for m in messages if m.get("type") == "FileTransferStartDownload"}
+    parts: dict[str, dict[int, bytes]] = {}
+    for m in messages:
+        if m.get("type") == "FileTransferPart" and m.get("transfer_uuid") in names:
+            parts.setdefault(m["transfer_uuid"], {})[int(m["part_index"])] = bytes(m["content"])
+    out = {}
+    for uuid, (name, count) in names.items():
+        got = parts.get(uuid, {})
+        assert sorted(got) == list(range(count)), f"{name}: parts {sorted(got)} of {count}"
+        out[name] = b"".join(got[i] for i in range(count)).decode("utf-8")
+    return out
+
+
 def test_a_hostile_trainee_reads_no_number_of_the_true_tcp(tmp_path: Path) -> None:
     with running_pendants(tmp_path) as start:
         app = start(class_db=tmp_path / "class.sqlite3", trainer_token=TOKEN, exercise="mystery")
@@ -139,7 +163,8 @@ def test_a_hostile_trainee_reads_no_number_of_the_true_tcp(tmp_path: Path) -> No
             click(cal.start, s.client)                                # XYZ 4-point
             click(cal.steps.record, s.client)                         # a touch in the air
             with s.lock:                                              # a patient trainee jogs the tip
-                ctrl = s.controller                                   # to 2 mm above the spike
+                ctrl = s.controller                                   # to 2 mm above the spike,
+                assert ctrl.jog_cartesian("flange", "A", 10.0).ok      # turned from touch 1
                 T = ctrl.T_world_tool_true().copy()
                 T[:3, 3] = ctrl.reference_tip_world_m + [0.0, 0.0, 0.002]
                 assert ctrl.move_true_tool_to(T).ok
@@ -153,6 +178,22 @@ def test_a_hostile_trainee_reads_no_number_of_the_true_tcp(tmp_path: Path) -> No
             assert "mm" in tools.check_md.content                     # the readings, at the spike
             assert [st.recorded for st in s.workflow.wizard.steps] == [True, True, False, False]
             assert pendant.hide_distance.value and "hidden" in pendant.touch_md.content
+            click(s.views["touches"].record, s.client)                # a free touch ("Record point")
+            for axis, up_mm in (("A", 200.0), ("B", 0.0)):             # steps 3 and 4 far in the air,
+                with s.lock:                                          # the tool turned between them
+                    assert s.controller.jog_cartesian("world", "Z", up_mm).ok if up_mm else True
+                    assert s.controller.jog_cartesian("flange", axis, 10.0).ok
+                    s.moved()
+                note_pose()
+                click(cal.steps.next, s.client)
+                click(cal.steps.record, s.client)
+            click(cal.steps.next, s.client)                           # Finish
+            assert s.workflow.result is not None, s.workflow.finish_failure
+            distances = dict(s.workflow.run.distance_mm)              # the server's own copy
+            assert len(distances) == 4 and min(distances.values()) < 3.0 < 150.0 < max(distances.values())
+            click(cal.export, s.client)                               # Export session (JSON)
+            click(s.views["touches"].export_csv, s.client)            # the free touches as CSV
+            click(tools.download, s.client)                           # the active tool's controller file
             marker = "Mallory was here"                               # the last thing sent
             choose(tools.entry_name, marker, s.client)
             wait_until(lambda: any(marker in str(m) for m in list(c.messages)), what="every message sent")
@@ -163,6 +204,15 @@ def test_a_hostile_trainee_reads_no_number_of_the_true_tcp(tmp_path: Path) -> No
         finally:
             c.close()
 
+    downloads = _downloads(c.messages)
+    assert len(downloads) == 3 and {SESSION_FILENAME, TOUCHES_FILENAME} <= set(downloads)   # + the controller file
+    record = json.loads(downloads[SESSION_FILENAME])
+    assert record["honest"] is True and len(record["wizards"]) == 1
+    assert "distance_mm" not in record["wizards"][0], "the export gives the touches' true distances"
+    assert "T_flange_tcp_true" not in downloads[SESSION_FILENAME]
+    texts = [t for m in c.messages for t in _sequences(m)[1]] + list(downloads.values())
+    assert not [t for t in texts if "distance at record" in t or "how far each tip really was" in t]
+
     tcp = T_ft[:3, 3]
     targets: list[tuple[str, np.ndarray, float]] = [("FLANGE m", tcp, NEAR_M), ("FLANGE mm", tcp * 1e3, NEAR_M * 1e3)]
     for i, (T_wf, T_wb) in enumerate(poses):
@@ -171,19 +221,20 @@ def test_a_hostile_trainee_reads_no_number_of_the_true_tcp(tmp_path: Path) -> No
         targets += [(f"WORLD m @pose {i}", world, NEAR_M), (f"WORLD mm @pose {i}", world * 1e3, NEAR_M * 1e3),
                     (f"BASE m @pose {i}", base, NEAR_M), (f"BASE mm @pose {i}", base * 1e3, NEAR_M * 1e3)]
     assert len(c.messages) > 100 and any(m.get("type") == "MeshMessage" for m in c.messages)
+    read = c.messages + [{"type": "download", "name": name, "text": text} for name, text in downloads.items()]
     chunks, owners = [], []
-    for k, m in enumerate(c.messages):
+    for k, m in enumerate(read):
         for run in _sequences(m)[0]:
             tri = _triples(run)
             chunks.append(tri)
             owners.append(np.full(len(tri), k))
     triples, owner = np.vstack(chunks), np.concatenate(owners)
     assert len(triples) > 10_000                                      # the meshes were read
-    hits = [f"{h} in {c.messages[k].get('type')} {str(c.messages[k].get('name', ''))[:70]}"
+    hits = [f"{h} in {read[k].get('type')} {str(read[k].get('name', ''))[:70]}"
             for h, k in _near(triples, owner, targets)]
     for i, (T_wf, _) in enumerate(poses):         # as an offset from a zero tool at each pose
         for scale, tol in ((1.0, NEAR_M), (1e3, NEAR_M * 1e3)):
             off = (triples - T_wf[:3, 3] * scale) @ T_wf[:3, :3]      # FLANGE axes
-            hits += [f"offset from the flange at pose {i}: {h} in {c.messages[k].get('type')}"
+            hits += [f"offset from the flange at pose {i}: {h} in {read[k].get('type')}"
                      for h, k in _near(off, owner, [(f"FLANGE x{scale:g}", tcp * scale, tol)])]
     assert hits == [], "\n".join(hits[:20])
