@@ -95,6 +95,37 @@ def test_a_name_connected_on_one_process_is_refused_on_the_other_and_its_browser
                 c.close()
 
 
+def test_a_name_with_invisible_marks_is_refused_on_the_other_process(two) -> None:
+    """Issue 42: "Alice" with a default-ignorable mark is refused while Alice is connected on
+    the other process, and a Persian name with and without its zero-width non-joiner (kept in
+    the name, dropped when names are compared) is one trainee on both processes."""
+    a, b = two
+    ca, cb = DrainingClient(a.port), None
+    try:
+        sa = _session(a)
+        assert _join(sa, "Alice").name == "Alice"
+        cb = DrainingClient(b.port)
+        sb = _session(b)
+        for invisible in ("Alice\ufe0f", "Al\ufe00ice", "Al\U000e0100ice", "Alice\u180b", "Alice\u17b4",
+                          "Al\u17b5ice"):
+            prompt = _join(sb, invisible)
+            mark = next(c for c in invisible if c not in "Alice")
+            assert prompt.name is None and escape_markdown(f"U+{ord(mark):04X}") in prompt.message.content
+            with pytest.raises(TraineeNameError, match=f"U\\+{ord(mark):04X}"):
+                b.classroom.named(sb, invisible, None)
+        joined, bare = "\u0639\u0644\u06cc\u200c\u0627\u06a9\u0628\u0631", "\u0639\u0644\u06cc\u0627\u06a9\u0628\u0631"
+        assert _join(sb, joined).name == joined
+        with pytest.raises(TraineeNameError, match=f"^{bare} looks like {joined}, a name already in this class"):
+            a.classroom.named(sa, bare, None)
+        assert a.gradebook.trainee_names() == ["Alice", joined]
+        b.classroom.beat()
+        assert sorted(a.classroom.connected_names()) == sorted(b.classroom.connected_names()) == ["Alice", joined]
+    finally:
+        for c in (ca, cb):
+            if c is not None:
+                c.close()
+
+
 def test_a_reconnect_landing_on_the_other_process_resumes_the_calibration(two) -> None:
     a, b = two
     ca = DrainingClient(a.port)

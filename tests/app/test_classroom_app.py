@@ -15,6 +15,7 @@ from wsclient import DrainingClient, RecordingClient, wait_until  # noqa: E402
 
 from tcp_pendant.classroom.gradebook import Gradebook
 from tcp_pendant.classroom.mystery import true_frame
+from tcp_pendant.text_escape import escape_markdown
 
 
 def _session(app, client: DrainingClient):
@@ -235,6 +236,10 @@ def test_a_connected_name_and_its_look_alikes_are_refused_until_the_trainer_rele
         for look_alike in ("\u0410lice", "ＡＬＩＣＥ", "A\u013aice"):
             _join(other, look_alike)
             assert po.name is None and "looks like Alice, a name already in this class" in po.message.content
+        for invisible in ("Alice\ufe0f", "Al\ufe00ice", "Al\U000e0100ice", "Alice\u180b", "Alice\u17b4", "Al\u17b5ice"):
+            _join(other, invisible)                       # "Alice" on the screen: refused, naming the mark
+            mark = next(c for c in invisible if c not in "Alice")
+            assert po.name is None and escape_markdown(f"U+{ord(mark):04X}") in po.message.content
         assert [t.name for t in app.classroom.trainee_statuses()] == ["Alice"]
         # the trainer releases Alice: her browser goes back to the welcome window (its script told to forget)
         q = trainer.views["identity"]

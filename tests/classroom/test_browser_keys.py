@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from tcp_pendant.classroom.gradebook import SCHEMA_VERSION, Gradebook
+from tcp_pendant.classroom.gradebook import SCHEMA_VERSION, Gradebook, GradebookError
 from tcp_pendant.classroom.names import TraineeNameError
 
 
@@ -69,6 +69,44 @@ def test_a_look_alike_of_a_name_in_the_class_is_refused_naming_it(book: Gradeboo
     with book._read() as db:
         assert [r[0] for r in db.execute("SELECT name FROM trainees")] == ["Alice"]
     assert book.join_trainee("Alice B.").new_key is not None          # a different name is fine
+
+
+INVISIBLE_ALICES = ["Alice\ufe0f", "Al\ufe00ice", "Al\U000e0100ice", "Alice\u180b", "Alice\u17b4", "Al\u17b5ice"]
+"""Issue 42: "Alice" with a default-ignorable code point that draws nothing (names.py)."""
+
+
+@pytest.mark.parametrize("invisible", INVISIBLE_ALICES)
+def test_alice_with_an_invisible_mark_is_refused_while_alice_is_in_the_class(book: Gradebook,
+                                                                             invisible: str) -> None:
+    book.join_trainee("Alice")
+    with pytest.raises(TraineeNameError, match=f"U\\+{ord(next(c for c in invisible if c not in 'Alice')):04X}"):
+        book.join_trainee(invisible)
+    with pytest.raises(GradebookError, match="invisible"):
+        book.add_trainee(invisible)
+    assert book.trainee_names() == ["Alice"]
+
+
+@pytest.mark.parametrize("stored", INVISIBLE_ALICES)
+def test_a_name_with_an_invisible_mark_kept_in_the_book_blocks_its_look_alikes(book: Gradebook,
+                                                                              stored: str) -> None:
+    """A gradebook written before the default-ignorables were refused may hold such a name:
+    the comparison reads the stored names and drops the marks, so "Alice" looks like it."""
+    with book._write() as db:
+        db.insert("INSERT INTO trainees (name, created_at, key_sha256) VALUES (?, ?, ?)",
+                  (stored, "2025-01-01T00:00:00Z", "0" * 64))
+    with pytest.raises(TraineeNameError, match=f"^Alice looks like {stored}, a name already in this class"):
+        book.join_trainee("Alice")
+    assert book.trainee_names() == [stored]
+
+
+def test_a_joiner_kept_in_a_name_does_not_make_a_second_trainee(book: Gradebook) -> None:
+    """Persian "Ali-Akbar" with and without the zero-width non-joiner (kept in a name where
+    it breaks a cursive join, dropped when names are compared)."""
+    joined, bare = "\u0639\u0644\u06cc\u200c\u0627\u06a9\u0628\u0631", "\u0639\u0644\u06cc\u0627\u06a9\u0628\u0631"
+    assert book.join_trainee(joined).name == joined
+    with pytest.raises(TraineeNameError, match=f"^{bare} looks like {joined}, a name already in this class"):
+        book.join_trainee(bare)
+    assert book.trainee_names() == [joined]
 
 
 def test_the_exercise_seed_is_random_per_class_and_kept(tmp_path: Path) -> None:

@@ -1,4 +1,4 @@
-"""The trainee's name ("Your name"): what the pendant accepts and how it is normalised.
+r"""The trainee's name ("Your name"): what the pendant accepts and how it is normalised.
 
 A name is what the trainer reads in the gradebook, so it must be visible text: after
 :func:`validate_trainee_name` it is NFC-normalised (the same letters typed on two keyboards give
@@ -9,15 +9,47 @@ Why not ``tcpcal.tool``'s tool-name check: that check is private (``_check_name`
 a controller's rules that do not apply to people (at most 24 characters, no double quote, no
 surrounding spaces instead of stripping them). The rule both share is Python's
 ``str.isprintable`` (no Unicode category C*, no separator but the space), used here as there;
-on top of it this module refuses the few *letters* that draw nothing (Hangul fillers, the
-braille blank), which ``isprintable`` lets through.
+on top of it this module refuses the braille blank, a symbol that draws nothing, and every
+default-ignorable code point (below), which ``isprintable`` partly lets through.
+
+Default-ignorable code points (Unicode's ``Default_Ignorable_Code_Point`` property,
+DerivedCoreProperties.txt; The Unicode Standard, section 5.21): variation selectors, the
+Mongolian free variation selectors, the Khmer inherent vowels U+17B4/U+17B5, the Hangul fillers,
+the combining grapheme joiner, the tag characters and the format characters. A renderer draws
+them as nothing, so "Alice" followed by VARIATION SELECTOR-16 shows as "Alice" in the trainer's
+table, yet is another name. They are **refused, not stripped**: what the trainee typed is what the
+gradebook keeps and what they type again after a reload, and the refusal names the code point
+(U+FE0F ...) so they know what to retype; stripping would store a name they did not type. The
+two exceptions are the joiners that change how a word is drawn: ZERO WIDTH NON-JOINER (U+200C)
+and ZERO WIDTH JOINER (U+200D) are part of the correct spelling of many Persian, Arabic-script and
+Indic names, so a name keeps one where UAX #31 (Unicode Identifiers and Syntax), section 2.3,
+"Layout and Format Control Characters", allows it in an identifier: ZWNJ between a character
+that joins to its left and one that joins to its right (A1: it breaks a cursive join, as in
+Persian "علی‌اکبر"), ZWNJ after a virama (A2) and ZWJ after a virama not followed by a
+dual-joining character (B: Indic half forms). Anywhere else a joiner draws nothing ("Al‌ice",
+or ZWNJ after Persian dal, which joins no letter after it) and is refused; emoji sequences
+(woman + ZWJ + laptop) are refused too, a name is letters. UTS #39 (Unicode Security
+Mechanisms), section 3.1, "General Security Profile for Identifiers", restricts the same set
+(Identifier_Type Default_Ignorable) and allows the two joiners.
+
+The table: the ``regex`` package (PyPI; wheels on every platform a classroom PC runs), whose
+``\p{Default_Ignorable_Code_Point}``, ``\p{Joining_Type=...}`` and
+``\p{Canonical_Combining_Class=Virama}`` are generated from the Unicode Character Database of
+its release (Unicode 17.0 in regex 2026.12.2); Python's ``unicodedata`` (Unicode 14.0 in 3.11)
+has none of these properties. Python's older Unicode only matters for NFC and NFKC here: the
+default-ignorable set is the same in Unicode 14.0 to 17.0 (4174 code points), so the two versions
+agree on it.
 
 Look-alikes (:func:`name_keys`, :func:`looks_alike`): two different names that a reader cannot
 tell apart ("Alice" and "Аlice" with a Cyrillic А, "ＡＬＩＣＥ", "Aĺice") would let a second
 browser pass for a trainee in the trainer's table. Names are compared by a confusable skeleton
 after Unicode TR39 (UTS #39, section 4, "Confusable Detection"): NFKC, then TR39's skeleton
-(NFD, every character replaced by its prototype from Unicode's ``confusables.txt``, NFD again),
-once with the letters' case kept and once case-folded. Two names look alike when either skeleton
+(NFD, every default-ignorable code point removed, every character replaced by its prototype
+from Unicode's ``confusables.txt``, NFD again), once with the letters' case kept and once
+case-folded. The removal covers the whole default-ignorable set, the joiners a name may keep
+included ("علی‌اکبر" and "علیاکبر" look alike), and holds for every name a gradebook holds,
+whichever check let it in: the comparison reads the stored names and computes their keys each
+time (``Gradebook.join_trainee``), no key is stored. Two names look alike when either skeleton
 is the same. On top of TR39 the diacritics of the Combining Diacritical Marks blocks are
 dropped (after NFD): TR39 keeps "Aĺice" (l with acute) apart from "Alice", but at the size of a
 table row the acute is a dot over the l, so here they look alike, and so do "José" and "Jose"
@@ -48,6 +80,7 @@ import unicodedata
 from functools import lru_cache
 from typing import Any
 
+import regex
 from confusable_homoglyphs import confusables
 
 __all__ = ["MAX_TRAINEE_NAME_LENGTH", "TraineeNameError", "looks_alike", "name_keys", "skeleton",
@@ -56,8 +89,18 @@ __all__ = ["MAX_TRAINEE_NAME_LENGTH", "TraineeNameError", "looks_alike", "name_k
 MAX_TRAINEE_NAME_LENGTH: int = 40
 """Longest trainee name, in characters (after normalisation)."""
 
-#: Printable by ``str.isprintable`` but drawn as nothing: a name made of them looks empty.
-_BLANK_LETTERS = frozenset("\u115f\u1160\u3164\uffa0\u2800")
+#: Printable by ``str.isprintable``, not default-ignorable, but drawn as nothing: BRAILLE PATTERN BLANK.
+_BLANK_SYMBOLS = frozenset("\u2800")
+#: Unicode's Default_Ignorable_Code_Point (module docstring): one such code point.
+_DEFAULT_IGNORABLE = regex.compile(r"\p{Default_Ignorable_Code_Point}")
+#: The joiners where UAX #31, section 2.3, lets an identifier keep them (A1, A2, B); matched at
+#: the joiner's index of the whole name, so the look-behinds see the letters before it.
+_KEPT_JOINER = regex.compile(
+    r"(?<=[\p{Joining_Type=Dual_Joining}\p{Joining_Type=Left_Joining}]\p{Joining_Type=Transparent}*)"
+    r"\u200c(?=\p{Joining_Type=Transparent}*[\p{Joining_Type=Dual_Joining}\p{Joining_Type=Right_Joining}])"
+    r"|(?<=\p{L}\p{Mn}*\p{Canonical_Combining_Class=Virama}[\p{Mn}&&\P{Canonical_Combining_Class=0}]*)"
+    r"(?:\u200c|\u200d(?!\p{Joining_Type=Dual_Joining}))",
+    regex.V1)
 _SPACES = re.compile(" {2,}")
 
 
@@ -76,13 +119,16 @@ def validate_trainee_name(text: Any) -> str:
 
     Raises:
         TraineeNameError: not a string, empty, longer than 40 characters, or holding a control
-            or invisible character (the message names it by its code point and Unicode name).
+            or invisible character (the message names it by its code point and Unicode name):
+            a default-ignorable code point but for a joiner in a UAX #31 context (module docstring).
     """
     if not isinstance(text, str):
         raise TraineeNameError(f"a name must be text, got {type(text).__name__}; type your name.")
     name = _SPACES.sub(" ", unicodedata.normalize("NFC", text).strip())
-    for ch in name:
-        if not ch.isprintable() or ch in _BLANK_LETTERS:
+    for i, ch in enumerate(name):
+        if ch in "\u200c\u200d" and _KEPT_JOINER.match(name, i):
+            continue
+        if not ch.isprintable() or ch in _BLANK_SYMBOLS or _DEFAULT_IGNORABLE.match(ch):
             what = unicodedata.name(ch, unicodedata.category(ch))
             raise TraineeNameError(
                 f"your name contains an invisible or control character, U+{ord(ch):04X} ({what}); "
@@ -131,11 +177,12 @@ def _is_diacritic(ch: str) -> bool:
 
 
 def skeleton(text: str) -> str:
-    """TR39's skeleton of ``text``: NFD, each character replaced by its confusable prototype,
-    NFD again (the prototypes as :func:`_prototypes` names them)."""
+    """TR39's skeleton of ``text`` (UTS #39, section 4): NFD, default-ignorable code points
+    removed, each character replaced by its confusable prototype, NFD again (the prototypes as
+    :func:`_prototypes` names them)."""
     table = _prototypes()
-    mapped = "".join(table.get(ch, ch) for ch in unicodedata.normalize("NFD", text))
-    return unicodedata.normalize("NFD", mapped)
+    visible = _DEFAULT_IGNORABLE.sub("", unicodedata.normalize("NFD", text))
+    return unicodedata.normalize("NFD", "".join(table.get(ch, ch) for ch in visible))
 
 
 @lru_cache(maxsize=4096)
