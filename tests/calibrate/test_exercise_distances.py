@@ -83,7 +83,9 @@ def test_the_export_gives_no_distance_to_trilaterate_the_tcp_from_in_an_exercise
     assert solved is None and "distance_mm" not in text
     assert not any(k.startswith("T_flange_tcp_true") for k in text.split('"'))
     assert record["honest"] is True
-    assert wf.run.distance_mm                     # the server keeps them (the gradebook's copy)
+    assert wf.run.distance_mm == {} and wf.run.distance_hidden == set()   # kept by the gradebook only
+    wf.hide_truth = False                         # the trainer ends the exercise: still none
+    assert "distance_mm" not in dumps(wf.export_record()) and wf.distances_shown() == ({}, set())
 
 
 def test_the_result_shows_no_distance_table_in_an_exercise(page) -> None:
@@ -101,11 +103,12 @@ def test_the_result_shows_no_distance_table_in_an_exercise(page) -> None:
         p.click(v.steps.record)
         p.click(v.steps.next)
     res, run = v.workflow.result, v.workflow.run
-    assert res is not None and run.distance_hidden == {0, 1, 2, 3} and min(run.distance_mm.values()) > 200.0
+    assert res is not None and run.distance_mm == {}
+    distances = [float(s.controller.touch_geometry().distance_mm)]
     assert not v.result.hidden_md.visible
     shown = "\n".join(str(h.content) for h in (v.result.result_md, v.result.hidden_md, v.result.warnings_md))
     assert "distance hidden" not in shown and "distance at record" not in shown
-    for d in run.distance_mm.values():            # no true distance, to the 0.01 mm shown
+    for d in distances:                           # not the last touch's true distance either
         assert f"{d:.2f}" not in shown and f"{d:.1f} mm" not in shown
 
 

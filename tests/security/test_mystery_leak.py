@@ -189,8 +189,10 @@ def test_a_hostile_trainee_reads_no_number_of_the_true_tcp(tmp_path: Path) -> No
                 click(cal.steps.record, s.client)
             click(cal.steps.next, s.client)                           # Finish
             assert s.workflow.result is not None, s.workflow.finish_failure
-            distances = dict(s.workflow.run.distance_mm)              # the server's own copy
-            assert len(distances) == 4 and min(distances.values()) < 3.0 < 150.0 < max(distances.values())
+            (row,) = app.gradebook.grades(include_in_progress=True)   # the truth, as the gradebook keeps it
+            distances = [t["distance_mm"] for t in app.gradebook.touches(row.calibration_id)]
+            assert len(distances) == 4 and min(distances) < 3.0 < 150.0 < max(distances)
+            assert s.workflow.run.distance_mm == {}                   # nothing of it in the trainee's run
             click(cal.export, s.client)                               # Export session (JSON)
             click(s.views["touches"].export_csv, s.client)            # the free touches as CSV
             click(tools.download, s.client)                           # the active tool's controller file
@@ -198,7 +200,6 @@ def test_a_hostile_trainee_reads_no_number_of_the_true_tcp(tmp_path: Path) -> No
             choose(tools.entry_name, marker, s.client)
             wait_until(lambda: any(marker in str(m) for m in list(c.messages)), what="every message sent")
 
-            (row,) = app.gradebook.grades(include_in_progress=True)   # the truth, as the gradebook keeps it
             T_ft = np.array(app.gradebook.truth(row.calibration_id)["T_flange_tool_true_m"], dtype=float)
             np.testing.assert_allclose(T_ft, s.controller.mounted_tool.T_flange_tool_true, atol=1e-12)
         finally:

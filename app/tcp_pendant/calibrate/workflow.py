@@ -395,7 +395,7 @@ class CalibrationWorkflow:
         for i, t in enumerate(touches):
             d = float(getattr(t, "distance_mm", float("nan")))
             joints = tuple(float(v) for v in getattr(t, "joints_deg", ()))
-            if run is not None and np.isfinite(d) and d >= 0.0:
+            if run is not None and np.isfinite(d) and d >= 0.0 and not self.hide_truth:
                 run.distance_mm[i] = d
                 if hidden:
                     run.distance_hidden.add(i)
@@ -410,9 +410,16 @@ class CalibrationWorkflow:
     def _note_distance(self, step: int) -> None:
         """Keep the true tool tip to reference tip distance (mm) of the touch step just recorded
         at the robot's pose (``WizardRun.distance_mm``; the session record exports it), and
-        whether the distance was hidden then (``ToolState.hide_distance``, when the owner has it)."""
+        whether the distance was hidden then (``ToolState.hide_distance``, when the owner has it).
+        With the truth hidden (an exercise) the run keeps none (:meth:`distances_shown`): the
+        gradebook's touch rows keep the truth (``TouchRecorded``), and a run recorded in an
+        exercise shows none after it either."""
         run = self.run
         if run is None or not 0 <= step < run.wizard.n_steps or run.wizard.steps[step].role != "touch":
+            return
+        if self.hide_truth:
+            run.distance_mm.pop(step, None)
+            run.distance_hidden.discard(step)
             return
         run.distance_mm[step] = float(self.controller.touch_geometry().distance_mm)
         if getattr(self.state, "hide_distance", False):
