@@ -7,6 +7,7 @@ press-to-readout matching is right.
 
 from __future__ import annotations
 
+import select
 import socket
 import time
 
@@ -24,6 +25,8 @@ def test_a_read_late_is_stamped_with_its_arrival() -> None:
         offset = time.time() - time.monotonic()
         sent = time.monotonic()
         sender.sendall(b"readout")
+        assert select.select([receiver], [], [], 30.0)[0], "the bytes never arrived"
+        arrived_by = time.monotonic()              # they are in the receive queue, stamped
         time.sleep(0.2)                            # the client is busy; the bytes wait in the kernel
         read = time.monotonic()
         data, ancillary, _, _ = receiver.recvmsg(4096, _ANCILLARY)
@@ -32,8 +35,8 @@ def test_a_read_late_is_stamped_with_its_arrival() -> None:
         for s in (receiver, sender, listener):
             s.close()
     assert data == b"readout"
-    assert sent - 0.005 <= stamp <= sent + 0.05    # when the bytes arrived (loopback: microseconds)
-    assert read - stamp >= 0.15                    # not when they were read
+    assert sent - 0.005 <= stamp <= arrived_by + 0.005   # when the bytes arrived (the clocks' rounding)
+    assert read - stamp >= 0.2 - 0.005                   # not when they were read
 
 
 def test_no_stamp_from_the_kernel_falls_back_to_now() -> None:

@@ -14,7 +14,8 @@ click (written to its socket) to the arrival at its socket of the first TCP read
 presses asked / answered / unanswered, steps/s achieved (shown by the readouts; all trainees,
 and per trainee against the 20 asked), the CPU of each server process (cores, over the press
 window) and of the load generator, and how many trainees each server process held (the
-gradebook's presence, 1.5 s into the presses: the connection balance at work).
+gradebook's presence, from 1.5 s into the presses until every trainee is present: the
+connection balance at work).
 
 The load generator runs on the same two cores as the server (its CPU is printed); a real
 class's browsers run elsewhere. It runs at ``--client-nice`` (default 19, the lowest priority):
@@ -186,9 +187,13 @@ def run_class(k: int, workers: int, seconds: float, client_procs: int, names: bo
             time.sleep(max(0.0, press_from - time.monotonic()))
             t0, cpu0, wait0 = time.monotonic(), [_cpu_s(pid) for pid in pids], [_waited_s(pid) for pid in pids]
             split: list[int] | None = None
-            if names:                                 # each process's presence beats once a second
-                time.sleep(max(0.0, start_at + 1.5 - time.monotonic()))
-                split = _trainees_per_process(Path(folder) / "class.sqlite3", pids)
+            if names:                                 # each process's presence beats once a second:
+                time.sleep(max(0.0, start_at + 1.5 - time.monotonic()))   # read from 1.5 s on, until
+                while True:                                              # every trainee is present or
+                    split = _trainees_per_process(Path(folder) / "class.sqlite3", pids)   # the presses end
+                    if sum(split) >= k or time.monotonic() >= press_from + seconds:
+                        break
+                    time.sleep(0.2)
             time.sleep(max(0.0, press_from + seconds - time.monotonic()))
             t1, cpu1, wait1 = time.monotonic(), [_cpu_s(pid) for pid in pids], [_waited_s(pid) for pid in pids]
             cpu = [(c1 - c0) / (t1 - t0) for c0, c1 in zip(cpu0, cpu1)]
@@ -284,7 +289,7 @@ def main(argv: list[str] | None = None) -> int:
     print("  (server waiting for a CPU: the share of the time each server process's threads were ready to run "
           "but had no CPU - other programs on the machine had it; a server that waits for a CPU falls behind "
           "and its deadman drops presses, whatever its own cost per step)")
-    print("  (trainees per process: the connected trainees each server process held 1.5 s into the presses, "
+    print("  (trainees per process: the connected trainees each server process held once all were present, "
           "from the gradebook's presence; - without names)")
     print("  (sent late: how long after its planned time each press was sent, the load generator's own "
           "delay; the latency runs from the actual send)")
