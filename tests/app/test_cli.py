@@ -50,15 +50,36 @@ def _serve(tmp_path, *args: str):
     import subprocess
     import sys
 
+    import signal
+
+    # Ctrl-C reaches the server even where this test runs with SIGINT ignored (nohup, some CI
+    # shells): a child inherits the ignore, and Python then installs no KeyboardInterrupt handler.
     proc = subprocess.Popen([sys.executable, "-m", "tcp_pendant", "--port", "0", "--tool-library",
                              str(tmp_path / "tools.json"), *args],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     assert proc.stdout is not None
     for line in proc.stdout:
         if "ready" in line:
             return proc, line
+    proc.kill()
     proc.wait(30)
     raise AssertionError(f"no ready line; exit {proc.returncode}: {proc.stderr.read() if proc.stderr else ''}")
+
+
+def stop_with_ctrl_c(proc, timeout_s: float = 60.0) -> tuple[str, str]:
+    """Ctrl-C to a server this test started and its output; killed if it is still running
+    after ``timeout_s`` (the test then fails, and leaves no server behind)."""
+    import signal
+    import subprocess
+
+    proc.send_signal(signal.SIGINT)
+    try:
+        return proc.communicate(timeout=timeout_s)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        proc.communicate(timeout=30)
+        raise
 
 
 @pytest.mark.parametrize("host,warned", [("127.0.0.1", False), ("0.0.0.0", True)])
@@ -90,8 +111,7 @@ def test_command_serves_prints_the_url_and_stops_on_ctrl_c(tmp_path, host: str, 
             with urllib.request.urlopen(u, timeout=10) as r:
                 assert r.status == 200
     finally:
-        proc.send_signal(signal.SIGINT)
-        out, err = proc.communicate(timeout=30)
+        out, err = stop_with_ctrl_c(proc)
     assert proc.returncode == 0, err
     assert ("anyone on the network" in err) is warned
 

@@ -147,7 +147,8 @@ def test_command_prints_a_warning_line_for_each_missing_mesh(tmp_path) -> None:
     proc = subprocess.Popen([sys.executable, "-m", "tcp_pendant", "--port", "0", "--tool-library",
                              str(tmp_path / "tools.json"), "--robot", str(urdf),
                              "--package-path", str(tmp_path / "src"), "--reference-tip", "1768,0,320"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))   # Ctrl-C under nohup too
     assert proc.stdout is not None
     seen = []
     try:
@@ -161,7 +162,12 @@ def test_command_prints_a_warning_line_for_each_missing_mesh(tmp_path) -> None:
             assert r.status == 200
     finally:
         proc.send_signal(signal.SIGINT)
-        out, err = proc.communicate(timeout=60)
+        try:
+            out, err = proc.communicate(timeout=60)
+        except subprocess.TimeoutExpired:          # a server left running would outlive the test
+            proc.kill()
+            proc.communicate(timeout=30)
+            raise
     lines = [line for line in err.splitlines() if line.startswith("WARNING: ")]
     assert len([x for x in lines if x.startswith("WARNING: robot mesh not found: package://kuka_kr16_support/")]) == 7
     assert any(x.startswith("WARNING: the reference tip (1768, 0, 320) mm is out of reach") for x in lines)
