@@ -26,7 +26,9 @@ ensure_venv() {
     return 0
   fi
   [ "$extra" = app ] || spec=".[$extra]"
-  echo "Installing the project into .venv (first run, or pyproject.toml changed) ..." >&2
+  echo "Installing the project and its dependencies into .venv (first run, or pyproject.toml changed):" \
+       "about 1-2 minutes on a fresh machine (pinocchio, scipy, viser, chromium's driver for the tests);" \
+       "later starts skip this." >&2
   if .venv/bin/python -m pip install -q --disable-pip-version-check -e "$spec"; then
     rm -f .venv/.installed-"$extra"-*
     touch ".venv/.installed-$extra-$sum"
