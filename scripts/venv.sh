@@ -27,7 +27,7 @@ ensure_venv() {
   fi
   [ "$extra" = app ] || spec=".[$extra]"
   echo "Installing the project and its dependencies into .venv (first run, or pyproject.toml changed):" \
-       "about 1-2 minutes on a fresh machine (pinocchio, scipy, viser, chromium's driver for the tests);" \
+       "about 1-2 minutes on a fresh machine (pinocchio, scipy, viser; run-tests.sh adds the test tools);" \
        "later starts skip this." >&2
   if .venv/bin/python -m pip install -q --disable-pip-version-check -e "$spec"; then
     rm -f .venv/.installed-"$extra"-*
