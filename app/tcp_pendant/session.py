@@ -18,7 +18,8 @@ State and its one owner each (docs/architecture.md, "State owners and the change
 The session is the only command surface of its state. Its commands: the robot's motion
 (:meth:`Session.jog`, :meth:`Session.set_joints`, :meth:`Session.set_joint`,
 :meth:`Session.ready`, :meth:`Session.home`, :meth:`Session.move_tcp_to`), the tools
-(:meth:`Session.mount_tool`, :meth:`Session.activate`, :meth:`Session.deactivate`,
+(:meth:`Session.mount_tool`, :meth:`Session.set_exercise_tool`, :meth:`Session.mount_step_tool`,
+:meth:`Session.activate`, :meth:`Session.deactivate`,
 :meth:`Session.set_active_data`, :meth:`Session.apply_saved`, :meth:`Session.reload_library`),
 the free touches (:meth:`Session.record_touch`, :meth:`Session.delete_touch`) and the
 calibration wizards of its :class:`~tcp_pendant.calibrate.CalibrationWorkflow`
@@ -83,7 +84,13 @@ from tcp_pendant.events import Crash, SessionEvent
 from tcp_pendant.job_pool import JobPool, default_pool
 from tcp_pendant.pendant import Jogger, touch_label
 from tcp_pendant.pendant.class_messages import MAX_WAITING_MESSAGES, ClassMessage
-from tcp_pendant.pendant.exercise_rules import FREE_PRACTICE, ExerciseRules, RuleRefusal
+from tcp_pendant.pendant.exercise_rules import (
+    FREE_PRACTICE,
+    ExerciseRules,
+    RuleRefusal,
+    check_calibrated_tool,
+    check_tool_change,
+)
 from tcp_pendant.pendant.library_rights import UNRESTRICTED, LibraryRights
 from tcp_pendant.wizards import Wizard, WizardResult, WizardStateError, wizard_class, wizard_classes
 
@@ -129,12 +136,15 @@ class Touch:
             when the distance is hidden).
         joints_deg: the joint values when recorded, degrees (mm for a prismatic joint), in
             joint order (as RoboDK and ABB store touches); () when not known.
+        tool_key: the physical tool mounted when recorded (None: not known); an XYZ 4-point
+            started from the touches measures that tool.
     """
 
     T_world_flange: np.ndarray
     label: str
     distance_mm: float = float("nan")
     joints_deg: tuple[float, ...] = ()
+    tool_key: str | None = None
 
     def __post_init__(self) -> None:
         T = np.array(self.T_world_flange, dtype=float)
@@ -285,6 +295,9 @@ class Session:
         self._crashed = False                           # the touch geometry's crash state at the last signal
         self._truth_hidden_always = False               # --hide-truth: no exercise's end shows it
         self._messages: list[ClassMessage] = []         # the trainer's messages not dismissed yet, oldest first
+        self.exercise_tool: ToolModel | None = None
+        """The physical tool the exercise keeps mounted (a classroom's mystery tool; None: the
+        trainee mounts any tool); change it with :meth:`set_exercise_tool`."""
 
     # ------------------------------------------------------------ the change signal
     def subscribe(self, fn: Callable[[SessionChange], None]) -> None:
@@ -438,12 +451,16 @@ class Session:
 
     def set_rules(self, rules: ExerciseRules) -> None:
         """The exercise's rules (the classroom sets them): locked distance aids switch "Hide
-        distance" on; the views re-render (``pose`` and ``wizard``: the checkbox, Auto-touch,
-        the methods offered; ``notice``: the instructions' banner)."""
+        distance" on; free practice releases the exercise's tool (:meth:`set_exercise_tool`:
+        the lock follows the exercise); the views re-render (``pose`` and ``wizard``: the
+        checkbox, Auto-touch, the methods offered; ``notice``: the instructions' banner;
+        ``tool``: the Mounted tool lock)."""
         with self.lock, self.batch():
             self.rules = rules
             if rules.distance_locked:
                 self.set_hide_distance(True)
+            if not rules.in_exercise:
+                self.set_exercise_tool(None)
             self.changed(pose=True, wizard=True, notice=True)
 
     # ------------------------------------------------------------ the trainer's messages
@@ -484,13 +501,76 @@ class Session:
     # ------------------------------------------------------------ tools (state owner)
     def mount_tool(self, tool: ToolModel) -> None:
         """Bolt another physical tool on (the active tool data does not change). While the
-        "bent tool" scenario plays, the tool bolted on is the bent version of ``tool``."""
+        "bent tool" scenario plays, the tool bolted on is the bent version of ``tool``.
+
+        Raises:
+            RuleRefusal: the exercise keeps its tool mounted (:attr:`exercise_tool`) and
+                ``tool`` is another one; nothing changes.
+        """
         with self.lock:
-            tool = self._physical(tool)
-            if tool is self.controller.mounted_tool:
+            held = self.exercise_tool
+            if held is not None:
+                check_tool_change(held.key, held.label, tool.key, tool.label)
+            self._mount(tool)
+
+    def _mount(self, tool: ToolModel) -> None:
+        tool = self._physical(tool)
+        if tool is self.controller.mounted_tool:
+            return
+        self.controller.mount_tool(tool)
+        self.changed(tool=True)
+
+    def set_exercise_tool(self, tool: ToolModel | None) -> None:
+        """The exercise's tool (the classroom's mystery tool of this trainee): mounted now, and
+        from now on "Mounted tool" is locked to it. :meth:`mount_tool` refuses another tool in
+        words; a calibration may only measure it (:meth:`start_wizard`); a wizard step's own
+        tool change (the XYZ reference method's reference tool, :meth:`mount_step_tool`) may
+        mount another for that run's steps, and the exercise's tool is mounted again when the
+        run ends or is cancelled. None: released, any tool may be mounted (free practice;
+        :meth:`set_rules` of free practice releases it too). One ``tool`` signal."""
+        with self.lock, self.batch():
+            if tool is None and self.exercise_tool is None:
                 return
-            self.controller.mount_tool(tool)
+            self.exercise_tool = tool
+            if tool is not None:
+                self._mount(tool)
             self.changed(tool=True)
+
+    def mount_step_tool(self, tool: ToolModel) -> None:
+        """The tool change a wizard step asks for (its "Mount the tool" button, Auto-touch):
+        :meth:`mount_tool`, except that while the exercise holds its tool, the run on show may
+        mount the tool of its current step when that run calibrates the exercise's tool (the
+        XYZ reference method's reference tool for its first touch).
+
+        Raises:
+            RuleRefusal: the exercise holds its tool and this is no such step.
+        """
+        with self.lock:
+            if not self._step_may_mount(tool.key):
+                self.mount_tool(tool)
+                return
+            self._mount(tool)
+
+    def _step_may_mount(self, key: str) -> bool:
+        """The run on show is in progress, calibrates the exercise's tool and its current step
+        needs the tool ``key`` (the exception to the exercise's lock)."""
+        held, run, w = self.exercise_tool, self.workflow.run, self.workflow.wizard
+        return (held is not None and run is not None and w is not None and w.status == "in_progress"
+                and run.true_tool_key == held.key and w.step.mount_tool_key == key)
+
+    def _remount_exercise_tool(self) -> None:
+        """The exercise's tool back on the flange, unless the run on show is in progress,
+        calibrates it and one of its steps asks for the tool on the flange now (the XYZ
+        reference method between its two touches)."""
+        held = self.exercise_tool
+        mounted = self.controller.mounted_tool
+        if held is None or mounted.key == held.key:
+            return
+        run, w = self.workflow.run, self.workflow.wizard
+        if (run is not None and w is not None and w.status == "in_progress" and run.true_tool_key == held.key
+                and any(step.mount_tool_key == mounted.key for step in w.steps)):
+            return
+        self._mount(held)
 
     def set_active_data(self, tool: Tool | None, slot: int | None = None) -> None:
         """Make ``tool`` the active tool data (typed in, a wizard's, or the library's ``slot``);
@@ -773,11 +853,13 @@ class Session:
     @contextmanager
     def _wizard_command(self, *, moves: bool = False) -> Iterator[None]:
         """Run a wizard command in one batch that ends in one ``wizard`` signal (``pose`` too
-        when the command may have moved the robot), also when it raised."""
+        when the command may have moved the robot), also when it raised; a run that ended or
+        was left gives the exercise's tool back to the flange (:meth:`set_exercise_tool`)."""
         with self.lock, self.batch():
             try:
                 yield
             finally:
+                self._remount_exercise_tool()
                 self.changed(wizard=True, pose=moves)
 
     def _check_method(self, kind: str, options: dict[str, Any] | None = None) -> None:
@@ -1023,7 +1105,7 @@ class Session:
         with self.lock:
             T = self.controller.T_world_flange()
             touch = Touch(T, touch_label(len(self.touches), T), self.controller.touch_geometry().distance_mm,
-                          tuple(self.controller.joint_angles_deg().values()))
+                          tuple(self.controller.joint_angles_deg().values()), self.controller.mounted_tool.key)
             self.touches.append(touch)
             self._free_records += 1
             self.changed(touches=True)
@@ -1041,7 +1123,7 @@ class Session:
                                       f"{len(self.touches)} recorded.")
             del self.touches[index]
             self.touches[:] = [Touch(t.T_world_flange, touch_label(i, t.T_world_flange), t.distance_mm,
-                                     t.joints_deg) for i, t in enumerate(self.touches)]
+                                     t.joints_deg, t.tool_key) for i, t in enumerate(self.touches)]
             self.changed(touches=True)
 
     # ------------------------------------------------------------ callbacks

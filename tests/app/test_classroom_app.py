@@ -131,7 +131,9 @@ def test_trainer_view_needs_the_token_and_shows_the_class_escaped(app_factory, t
         click(view.push, trainer.client)
         assert trainee.controller.mounted_tool.key == "torch"
         assert "1 trainee" in view.push_md.content
-        # the trainee finishes; the trainer grades the trainee's exported record by its record id
+        # the pointer's touch measured another tool: the trainee calibrates the torch anew and
+        # finishes; the trainer grades the trainee's exported record by its record id
+        click(cal.start, trainee.client)
         for _ in range(6):
             if cal.workflow.result is not None:
                 break
@@ -144,6 +146,7 @@ def test_trainer_view_needs_the_token_and_shows_the_class_escaped(app_factory, t
         wait_until(lambda: "Record id" in view.grade_md.content, what="the record's grades")
         grade = cal.workflow.truth().grade
         assert f"| {grade} |" in view.grade_md.content and "matches the gradebook" in view.grade_md.content
+        assert [r.tool_key for r in app.gradebook.grades()] == ["torch"]
     finally:
         a.close()
         t.close()

@@ -38,7 +38,7 @@ from tcp_pendant.calibrate.autotouch import AutoTouchOutcome, PoseProbe, auto_to
 from tcp_pendant.calibrate.jobs import EXERCISE_REFUSAL, JOBS, POSE_CHECKS, ControllerJob
 from tcp_pendant.calibrate.diversity import failure_in_words
 from tcp_pendant.calibrate.library_save import save_result
-from tcp_pendant.pendant.exercise_rules import RuleRefusal
+from tcp_pendant.pendant.exercise_rules import RuleRefusal, check_calibrated_tool
 from tcp_pendant.pendant.library_rights import UNRESTRICTED
 from tcp_pendant.events import (
     RunCancelled,
@@ -126,6 +126,11 @@ class ToolState(Protocol):
     def mount_tool(self, tool: ToolModel) -> None:
         """Bolt the physical ``tool`` on."""
 
+    def mount_step_tool(self, tool: ToolModel) -> None:
+        """Bolt on the physical ``tool`` that the current step of the run on show asks for
+        (the owner may allow it where :meth:`mount_tool` is refused: an exercise's reference
+        tool)."""
+
     def set_active_data(self, tool: Tool | None, slot: int | None = None) -> None:
         """Make ``tool`` (from library ``slot``) the active tool data."""
 
@@ -140,6 +145,9 @@ class ControllerToolState:
         self.controller = controller
 
     def mount_tool(self, tool: ToolModel) -> None:
+        self.controller.mount_tool(tool)
+
+    def mount_step_tool(self, tool: ToolModel) -> None:
         self.controller.mount_tool(tool)
 
     def set_active_data(self, tool: Tool | None, slot: int | None = None) -> None:
@@ -218,6 +226,7 @@ class CalibrationWorkflow:
         c = self.controller
         joints = tuple(c.joint_angles_deg().values())
         run.joints_deg[step] = joints
+        run.touch_tools[step] = c.mounted_tool.key
         auto_steps = self._auto_steps.setdefault(i, set())
         if auto:
             auto_steps.add(step)
@@ -342,7 +351,7 @@ class CalibrationWorkflow:
         self.runs.append(WizardRun(wizard, key, T_true))
         self._current = len(self.runs) - 1
         self._events.append(RunStarted(self._current, wizard.kind, wizard.title,
-                                       key if key is not None else self.controller.mounted_tool.key, T_true))
+                                       key if key is not None else _StartContext(self).mounted_tool.key, T_true))
         self.note_mounted_tool()
         return wizard
 
@@ -353,11 +362,16 @@ class CalibrationWorkflow:
 
         Raises:
             WizardError: unknown kind or option, a value out of its choices, an empty slot.
+            RuleRefusal: the owner's exercise holds its tool (``exercise_tool``) and the method
+                would calibrate another one (the XYZ reference method's New tool).
         """
         cls = wizard_class(kind)
         if self.hide_truth and not cls.in_exercises:
             raise WizardError(EXERCISE_REFUSAL.format(what=f"The {cls.title} wizard"))
         started = cls.start(_StartContext(self), cls.parse_options(options))
+        held = getattr(self.state, "exercise_tool", None)     # the session's exercise tool, when it has one
+        if held is not None:
+            check_calibrated_tool(held.key, held.label, getattr(started.true_tool, "key", None), cls.title)
         self._open(started.wizard, started.true_tool)
         if started.active_data is not None:
             self.state.set_active_data(started.active_data[0], int(started.active_data[1]))
@@ -401,6 +415,9 @@ class CalibrationWorkflow:
                     run.distance_hidden.add(i)
             if run is not None and joints:
                 run.joints_deg[i] = joints
+            tool_key = getattr(t, "tool_key", None)
+            if run is not None and isinstance(tool_key, str):
+                run.touch_tools[i] = tool_key
             if index is not None and i in recorded:
                 self._events.append(TouchRecorded(index, i, recorded[i].T_world_flange_m, joints, d,
                                                   auto=False, overwrite=False))
@@ -482,7 +499,7 @@ class CalibrationWorkflow:
         tool = self.required_tool()
         if tool is None:
             raise WizardStateError("This step needs no tool change.")
-        self.state.mount_tool(tool)
+        self.state.mount_step_tool(tool)
         mounted = self.controller.mounted_tool          # a scenario may mount a bent version
         run = self.run
         if run is not None and self._current is not None and run.true_tool_key == mounted.key:
@@ -516,17 +533,48 @@ class CalibrationWorkflow:
         refusal: str | None = rules.touches_refusal(len(w.solver_touch_steps()), can_add_point=cls.supports_add_point)
         return refusal
 
+    def wrong_tool_touch(self) -> str | None:
+        """Why the run on show cannot be filed as it is: a touch recorded with another physical
+        tool than the one its step measures (the step's tool change, else the tool the run
+        calibrates), in words with what to do; None when every touch whose tool is known was
+        made with the right one. A calibration is graded and filed under the tool it measured,
+        so touches of two tools cannot make one."""
+        run = self.run
+        if run is None or run.true_tool_key is None:
+            return None
+        w = run.wizard
+        for step in sorted(w.recorded_poses):
+            used = run.touch_tools.get(step)
+            spec = w.steps[step] if 0 <= step < w.n_steps else None
+            need = run.true_tool_key if spec is None or spec.mount_tool_key is None else spec.mount_tool_key
+            if used is None or used == need:
+                continue
+            label = self._tool_label
+            return (f"Step {step + 1} was recorded with the {label(used)}, but it measures the {label(need)}: "
+                    f"a calibration is filed under the tool it measured. Mount the {label(need)} and record "
+                    f"step {step + 1} again (or start a new calibration for the {label(used)}).")
+        return None
+
+    def _tool_label(self, key: str) -> str:
+        tool = self.tools.get(key)
+        return (key if tool is None else tool.label).lower()
+
     def next(self) -> WizardResult | None:
         """Next step; on the last step compute the result (returned).
 
         Raises:
             RuleRefusal: Finish with fewer touches than the exercise asks for
                 (:meth:`touches_short`); the wizard stays on its last step.
+            WizardStateError: Finish of touches made with another tool than their step
+                measures (:meth:`wrong_tool_touch`); the wizard stays on its last step.
         """
         w = self._require()
         short = self.touches_short() if w.on_last_step else None
         if short is not None:
             raise RuleRefusal(short)
+        wrong = self.wrong_tool_touch() if w.on_last_step else None
+        if wrong is not None:
+            raise WizardStateError(wrong)
         job = self.controller_job() if w.on_last_step else None
         if job is not None:
             return self.run_controller_job(job)
@@ -621,7 +669,7 @@ class CalibrationWorkflow:
                                  sigma_mm=request.sigma_mm, rng=self.rng, tools=self.tools,
                                  previous_direction_deg=None if run_index is None
                                  else self._auto_directions.get(run_index),
-                                 mount=self.state.mount_tool, pose_check=pose_check)
+                                 mount=self.state.mount_step_tool, pose_check=pose_check)
         try:
             probe = next(steps)
             while True:
@@ -641,6 +689,9 @@ class CalibrationWorkflow:
         if type(w).controller_job is not None:    # Finish runs the controller's job (off the loop in the app)
             return out
         if out.ok and w.on_last_step and all(s.recorded for s in w.steps) and self.touches_short() is None:
+            wrong = self.wrong_tool_touch()
+            if wrong is not None:
+                raise WizardStateError(wrong)
             try:
                 self._finished(w, w.finish())
             except CalibrationFailedError as exc:
@@ -882,7 +933,10 @@ class _StartContext:
 
     @property
     def mounted_tool(self) -> ToolModel:
-        return self._workflow.controller.mounted_tool
+        """The tool a new run starts with: the one on the flange, or the owner's exercise tool
+        (``exercise_tool``), which goes back on the flange as the open run is left."""
+        held = getattr(self._workflow.state, "exercise_tool", None)
+        return self._workflow.controller.mounted_tool if held is None else cast(ToolModel, held)
 
     def library_tool(self, slot: int) -> Tool:
         return self._workflow._library_tool(slot)

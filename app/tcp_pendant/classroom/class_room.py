@@ -479,7 +479,7 @@ class ClassRoom:
         tool = draw_mystery_tool(self._seed(), name, base)
         recorder.exercise_id = "mystery"
         session.add_physical_tool(tool)              # its label in the wizard's tool-change words
-        session.mount_tool(tool)
+        session.set_exercise_tool(tool)              # mounted, and "Mounted tool" locked to it
 
     def detach(self, session: Session) -> None:
         """The session closed (its browser left)."""
@@ -795,6 +795,8 @@ class ClassRoom:
                     session.set_hide_truth(ex is not None)
                     if ex == "mystery":
                         self._mount_mystery(session, recorder, who)
+                    else:
+                        session.set_exercise_tool(None)     # free practice: the trainee swaps tools again
                 if tool_key is not None and ex != "mystery":
                     session.mount_tool(self.tools[tool_key])
                 if not rules.distance_locked:
@@ -926,8 +928,10 @@ class ClassRoom:
                     session.set_hide_truth(exercise is not None)
                     if exercise == "mystery":
                         self._mount_mystery(session, recorder, name)
-                    elif tool_key is not None:
-                        session.mount_tool(self.tools[tool_key])
+                    else:
+                        session.set_exercise_tool(None)     # free practice: the trainee swaps tools again
+                        if tool_key is not None:
+                            session.mount_tool(self.tools[tool_key])
                     self._apply_rules(session, aids_too=new_exercise or aids is not None)
                     session.changed(wizard=True)      # the result panel shows or hides the truth
             session.guard(apply)()

@@ -19,6 +19,13 @@ words, whatever a browser sends (a disabled checkbox is only the polite half):
   point: XYZ 4-point, TCP & Z, X); a method with a fixed number of poses (three-point, ABC
   world, XYZ reference, the checks) keeps its own count.
 
+The exercise's tool (``Session.set_exercise_tool``, the classroom's mystery tool of each trainee)
+is not a class-wide rule: each trainee has their own. While one is held, "Mounted tool" is locked
+to it (:func:`check_tool_change` refuses another in words), a calibration may only measure it
+(:func:`check_calibrated_tool`), and the one exception is a wizard step's own tool change: the XYZ
+reference method touches first with its known reference tool (``Session.mount_required_tool``),
+and the exercise's tool is mounted again when that run ends or is cancelled.
+
 Free practice (no exercise): nothing is locked, Auto-touch is allowed, the Check shows all it
 computes. In an exercise the defaults are the strict ones (:func:`class_rules`); the trainer
 view can unlock the distance aids and allow Auto-touch for the class.
@@ -41,6 +48,9 @@ __all__ = [
     "ExerciseRules",
     "FREE_PRACTICE",
     "RuleRefusal",
+    "TOOL_LOCKED_WORDS",
+    "check_calibrated_tool",
+    "check_tool_change",
     "class_rules",
     "clean_instructions",
     "clean_min_touches",
@@ -55,6 +65,8 @@ DISTANCE_LOCKED = ("The trainer has locked the distance aids for this exercise: 
                    "as on a real robot (the distance, the Δ line and the stop at the tip stay off).")
 AUTO_TOUCH_REFUSED = ("Auto-touch is off in this exercise: the robot would touch for you. Jog the tool tip "
                       "onto the reference tip and press Record (the trainer can allow Auto-touch).")
+TOOL_LOCKED_WORDS = "This exercise keeps your own tool mounted"
+"""The start of the refusal of a tool change in an exercise (:func:`check_tool_change`)."""
 
 
 MAX_INSTRUCTIONS_CHARS = 2000
@@ -96,6 +108,34 @@ def clean_min_touches(value: object) -> int:
 
 class RuleRefusal(ControllerError):
     """A command the exercise forbids (a ``ValueError``: the session shows it as a warning)."""
+
+
+def check_tool_change(held_key: str, held_label: str, wanted_key: str, wanted_label: str) -> None:
+    """Refuse mounting the tool ``wanted_key`` while the exercise holds the tool ``held_key``
+    mounted (the same tool is no change and passes).
+
+    Raises:
+        RuleRefusal: ``wanted_key`` is another tool; the words say what stays mounted and why.
+    """
+    if wanted_key == held_key:
+        return
+    raise RuleRefusal(f"{TOOL_LOCKED_WORDS} (the {held_label.lower()}): the trainer gave it to you to "
+                      f"calibrate, so the {wanted_label.lower()} cannot be mounted. (The XYZ reference method "
+                      "mounts its reference tool for its first touch by itself, with its Mount the tool button.)")
+
+
+def check_calibrated_tool(held_key: str, held_label: str, calibrated_key: str | None, method_title: str) -> None:
+    """Refuse a calibration that would measure another tool than the exercise's ``held_key``
+    (``calibrated_key``: the physical tool whose truth grades it; None: none, e.g. a check).
+
+    Raises:
+        RuleRefusal: it measures another tool; the words name the one to choose.
+    """
+    if calibrated_key is None or calibrated_key == held_key:
+        return
+    raise RuleRefusal(f"This exercise calibrates your own tool (the {held_label.lower()}): the {method_title} "
+                      f"method can only measure it. Choose the {held_label.lower()} as the tool to calibrate "
+                      "(the XYZ reference method: as its New tool).")
 
 
 @dataclass(frozen=True)

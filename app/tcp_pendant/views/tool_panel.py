@@ -54,13 +54,15 @@ from tcpcal.errors import TcpcalError
 from tcpcal.formats import FORMATS, export_tool, text_format
 from tcpcal.tool import Tool
 
-__all__ = ["CONTROLLER_FILE_REFUSED", "NO_TOOL", "ToolPanel", "controller_file"]
+__all__ = ["CONTROLLER_FILE_REFUSED", "NO_TOOL", "TOOL_LOCKED_LINE", "ToolPanel", "controller_file"]
 
 log = logging.getLogger(__name__)
 
 NO_TOOL = "(library empty)"
 CONTROLLER_FILE_REFUSED = "Controller file not written"
 """Title of the one notification when a controller refuses the tool (name, number)."""
+TOOL_LOCKED_LINE = "Locked by the exercise"
+"""The start of the line under "Mounted tool" while the exercise holds its tool."""
 
 
 def controller_file(tool: Tool, slot: int, label: str) -> tuple[str, str]:
@@ -91,6 +93,7 @@ class ToolPanel:
         mounted = c.mounted_tool.label if c.mounted_tool.label in labels else labels[0]
         self.mounted = gui.add_dropdown("Mounted tool", labels, initial_value=mounted,
                                         hint="The physical tool bolted on the flange.")
+        self.mounted_lock_md = gui.add_markdown("", visible=False)
         self.active_md = gui.add_markdown("")
         with gui.add_folder("Tool library"):
             self.slots = gui.add_dropdown("Slot", (NO_TOOL,), initial_value=NO_TOOL)
@@ -154,6 +157,7 @@ class ToolPanel:
         self._recoveries_told = max(0, len(session.library.recoveries) - 1)
         self._library_error: str | None = None
         self.show_library()
+        self._show_mounted()
         self._show_active()
         session.subscribe(self.on_change)
 
@@ -234,21 +238,43 @@ class ToolPanel:
             return f"\n\nSaved by trainee {escape_markdown(owner)}."
         return ""
 
+    def _choices(self) -> dict[str, str]:
+        """Mounted tool's choices, label -> key: the built-in tools and the exercise's tool."""
+        held = self.session.exercise_tool
+        return self._tool_key_by_label if held is None else {**self._tool_key_by_label, held.label: held.key}
+
     def _show_mounted(self) -> None:
+        """The mounted tool; in an exercise that holds its tool, the dropdown locked with why."""
+        held = self.session.exercise_tool
         label = self.session.controller.mounted_tool.label
-        if label in self._tool_key_by_label and self.mounted.value != label:
-            set_value(self.mounted, label)              # its own handler then sees no change
+        options = tuple(self._choices())
+        if label in options:
+            set_options(self.mounted, options, keep=label)   # its own handler then sees no change
+        self.mounted.disabled = held is not None
+        self.mounted_lock_md.content = "" if held is None else (
+            f"{TOOL_LOCKED_LINE}: you calibrate your own tool, the {escape_markdown(held.label.lower())}. "
+            "The XYZ reference method mounts its reference tool for its first touch by itself.")
+        self.mounted_lock_md.visible = held is not None
 
     def _show_active(self) -> None:
         self.active_md.content = tool_data_markdown(self.session.controller.active_tool, self.session.active_slot)
 
     # ------------------------------------------------------------ callbacks
     def _on_mount(self, event: DropdownEvent) -> None:
-        key = self._tool_key_by_label.get(str(event.target.value))
+        """Mount the tool chosen (``Session.mount_tool``); a refused change (the exercise holds
+        its tool) puts the dropdown back on the tool mounted."""
+        key = self._choices().get(str(event.target.value))
         if key is None:
-            raise ValueError(f"Unknown tool {event.target.value!r}.")
-        if key != self.session.controller.mounted_tool.key:
-            self.session.mount_tool(self._tools[key])
+            self._show_mounted()
+            raise ValueError(f"Unknown tool {event.target.value!r}; choose one of the list.")
+        if key == self.session.controller.mounted_tool.key:
+            return
+        held = self.session.exercise_tool
+        try:
+            self.session.mount_tool(held if held is not None and key == held.key else self._tools[key])
+        except ValueError:
+            self._show_mounted()
+            raise
 
     def _on_activate(self, _event: ButtonEvent) -> None:
         slot, _ = self._selected()

@@ -150,6 +150,10 @@ class WizardRun:
             exported as the wizard's ``"distance_mm"`` for the steps still recorded.
         distance_hidden: steps recorded while "Hide distance" was on (the result shows their
             distance-at-record next to their error; not exported).
+        touch_tools: the physical tool (key) mounted when each step was recorded, by 0-based
+            step index (not exported; unknown for poses loaded or restored): a Finish of touches
+            made with another tool than their step measures is refused
+            (``CalibrationWorkflow.wrong_tool_touch``).
     """
 
     wizard: Wizard
@@ -158,6 +162,7 @@ class WizardRun:
     joints_deg: dict[int, tuple[float, ...]] = field(default_factory=dict)
     distance_mm: dict[int, float] = field(default_factory=dict)
     distance_hidden: set[int] = field(default_factory=set)
+    touch_tools: dict[int, str] = field(default_factory=dict)
 
 
 @dataclass(frozen=True, eq=False)
