@@ -79,8 +79,8 @@ fi
 # marked serial on 2 xdist workers, then the serial ones in one process (header comment).
 run_suite() {
   local only="${1:+$1 and }" rc_parallel=0 rc_serial=0
-  .venv/bin/python -m pytest -n 2 -m "${only}not serial" || rc_parallel=$?
-  .venv/bin/python -m pytest -m "${only}serial" || rc_serial=$?
+  .venv/bin/python -m pytest -n 2 --durations=25 -m "${only}not serial" || rc_parallel=$?
+  .venv/bin/python -m pytest --durations=25 -m "${only}serial" || rc_serial=$?
   if [ "$rc_parallel" != 0 ] || [ "$rc_serial" != 0 ]; then
     echo "run-tests.sh: pytest exited $rc_parallel (the tests on 2 workers) and $rc_serial (the serial tests)." >&2
   fi
