@@ -75,22 +75,59 @@ class DrainingClient:
                           max_size=None, open_timeout=20, additional_headers=headers, sock=sock)
         self.n_messages = 0
         self.n_bytes = 0
+        self._sync_uuid: str | None = None         # the marker :meth:`sync` waits for
+        self._synced = threading.Event()
         self._thread = threading.Thread(target=self._drain, daemon=True)
         self._thread.start()
         # viser counts a client as connected at its first camera message
         cam = _messages.ViewerCameraMessage(wxyz=(1.0, 0.0, 0.0, 0.0), position=(2.0, -2.0, 1.0), fov=1.0,
                                             near=0.01, far=100.0, image_height=720, image_width=1280,
                                             look_at=(0.0, 0.0, 0.5), up_direction=(0.0, 0.0, 1.0))
-        self.ws.send(msgspec.msgpack.encode(cam.as_serializable_dict()))
+        self._camera = msgspec.msgpack.encode(cam.as_serializable_dict())
+        self.ws.send(self._camera)
 
     def _drain(self) -> None:
         try:
             for msg in self.ws:
                 self.n_messages += 1
                 self.n_bytes += len(msg)
+                if self._sync_uuid is not None and isinstance(msg, bytes):
+                    if any(m.get("uuid") == self._sync_uuid for m in decode_window(msg)):
+                        self._synced.set()
                 self._received(msg)
         except Exception:
             pass
+
+    def sync(self, handle: viser.ClientHandle, timeout: float = 20.0) -> None:
+        """A round trip behind everything this client sent: returns once the server has handled
+        every message sent on this socket before the call, and this client has received every
+        message the server queued for it while handling them.
+
+        ``handle``: the server's :class:`viser.ClientHandle` of this connection (in-process
+        server). The marker is the camera message again, unchanged (it changes nothing the app
+        shows; a camera callback, e.g. a wizard scene's relayout, does run): viser handles one
+        socket's messages in order, so once ``handle.camera`` is the marker's, the messages
+        before it have been handled (their callbacks ran up to their first real ``await``: the
+        pendant's GUI callbacks are synchronous on the loop). Then the server's loop queues a
+        ``GuiUpdateMessage`` for the made-up uuid ``sync-...`` (updates ``{}``) on this client's
+        own buffer, behind whatever those callbacks queued for it; when it arrives, so have they.
+        A subclass that records GUI updates sees that message too.
+        """
+        before = handle.camera._state
+        self.ws.send(self._camera)
+        wait_until(lambda: handle.camera._state is not before, timeout=timeout,
+                   what="the server handling the marker behind this client's messages")
+        uuid = f"sync-{time.monotonic_ns()}"
+        self._synced.clear()
+        self._sync_uuid = uuid
+        conn = handle._websock_connection
+        conn._state.event_loop.call_soon_threadsafe(                  # type: ignore[attr-defined]
+            lambda: conn.queue_message(_messages.GuiUpdateMessage(uuid, {})))
+        try:
+            if not self._synced.wait(timeout):
+                raise AssertionError("timed out waiting for the server's sync message")
+        finally:
+            self._sync_uuid = None
 
     def _received(self, msg: bytes | str) -> None:
         """One message as it arrives (the subclasses decode what they need)."""
