@@ -117,7 +117,7 @@ def test_newest_slider_value_wins_when_the_first_apply_is_slow(app_factory) -> N
         b.set(a1, 20.0)
         wait_until(lambda: len(calls) >= 2, what="both slider values applied")
         wait_until(lambda: "20.00" in p.joints_md.content, what="readout")
-        time.sleep(0.2)                                  # let the loop send what it queued
+        b.sync(s.client)                                 # both handled, and all they sent received
         assert math.degrees(s.controller.q_rad[0]) == pytest.approx(20.0, abs=1e-9)
         assert p.joints_md.content == joint_readout_markdown(s.controller.joint_angles_deg())
         assert a1.value == pytest.approx(20.0)
@@ -139,9 +139,9 @@ def test_a_dragged_slider_is_not_echoed_but_a_jog_is_sent(app_factory) -> None:
         a1 = p.joint_sliders[0]
         b.set(a1, 10.004)
         wait_until(lambda: abs(math.degrees(s.controller.q_rad[0]) - 10.004) < 1e-9, what="A1 at 10.004")
-        b.set(p.increment, "1")                          # a message after the slider's: settled
+        b.set(p.increment, "1")                          # for the jog below
         wait_until(lambda: s.jogger.settings.increment == "1", what="increment 1")
-        time.sleep(0.2)
+        b.sync(s.client)                                  # all the slider's handling sent, received
         assert b.values_of(a1) == []                      # nothing echoed
         b.click(p.joint_buttons[(0, 1)])                  # A1 +: a jog key moves the joint
         wait_until(lambda: abs(math.degrees(s.controller.q_rad[0]) - 11.004) < 1e-9, what="A1 + 1 deg")
@@ -242,9 +242,14 @@ def test_shared_rename_keeps_the_name_another_browser_typed(app_factory, tmp_pat
     library.save(1, Tool(name="T1", tcp_mm=(0.0, 0.0, 100.0)))
     library.save(2, Tool(name="T2", tcp_mm=(0.0, 0.0, 200.0)))
     app = app_factory(shared=True)
-    a, b = Browser(app.port), Browser(app.port)
+    a = Browser(app.port)
+    b = None
     try:
+        wait_until(lambda: len(app.server.get_clients()) == 1, what="browser A")
+        (handle_a,) = app.server.get_clients().values()
+        b = Browser(app.port)
         wait_until(lambda: len(app.server.get_clients()) == 2, what="two browsers")
+        (handle_b,) = (h for h in app.server.get_clients().values() if h is not handle_a)
         s = app.shared_session
         tools = s.views["tools"]
         wait_until(lambda: tools.slots.options == ("1: T1", "2: T2"), what="library listed")
@@ -259,17 +264,19 @@ def test_shared_rename_keeps_the_name_another_browser_typed(app_factory, tmp_pat
         b.set(tools.slots, "2: T2")
         b.set(tools.new_name, "Beta")
         wait_until(lambda: len(calls) == 1 and tools.new_name.value == "Beta", what="A renaming, B typed")
-        time.sleep(0.4)                                   # A's rename done meanwhile
+        a.sync(handle_a)                                  # A's rename handled to its end
         assert tools.new_name.value == "Beta"
         b.click(tools.rename)
         wait_until(lambda: len(calls) == 2 or any(t == "Not done" for t, _ in notes), what="B's rename")
         wait_until(lambda: {t.name for t in library.tools().values()} == {"Alpha", "Beta"}, timeout=5,
                    what=f"both renamed (notifications: {notes})")
         assert not [n for n in notes if n[0] == "Not done"]
+        b.sync(handle_b)                                  # B received all its rename sent
         assert "" not in b.values_of(tools.new_name)      # B's box was never cleared under B
     finally:
         a.close()
-        b.close()
+        if b is not None:
+            b.close()
 
 
 def test_per_browser_rename_clears_the_box_of_the_browser_that_clicked(app_factory, tmp_path: Path) -> None:
