@@ -65,14 +65,16 @@ def test_holding_a_key_jogs_continuously_and_the_click_that_ends_it_does_not(app
             client.hold_tick(PLUS_X, HOLD_HZ)
             time.sleep(1.0 / HOLD_HZ)
         wait_until(lambda: len(moves) >= 3, what="three jog ticks")
+        z0 = s.controller.T_world_tcp()[2, 3]
         client.click(PLUS_X)                               # the release click: no extra move
         client.hold_tick(MINUS_Z, HOLD_HZ)                 # a marker behind it on the same socket
-        n = len(moves)
-        wait_until(lambda: len(moves) > n, what="the marker tick")
+        # only Z - moves Z (1.25 mm a tick at 10 %): the release before it has been handled
+        wait_until(lambda: s.controller.T_world_tcp()[2, 3] < z0 - 5e-4, what="the marker's first Z - tick")
         x3 = s.controller.T_world_tcp()[0, 3]
         assert x3 > x0                                     # moved along +X while held
-        time.sleep(0.2)                                    # Z - still held: X stays
-        assert s.controller.T_world_tcp()[0, 3] == pytest.approx(x3, abs=2e-5)
+        n = len(moves)                                     # Z - still held: the server's clock
+        wait_until(lambda: len(moves) >= n + 3, what="three more ticks of the held Z -")
+        assert s.controller.T_world_tcp()[0, 3] == pytest.approx(x3, abs=2e-5)   # and X stays
         client.click(MINUS_Z)
     finally:
         client.close()
