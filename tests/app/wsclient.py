@@ -3,6 +3,7 @@ subprotocol and drains whatever the server sends (no rendering)."""
 
 from __future__ import annotations
 
+import asyncio
 import re
 import socket
 import threading
@@ -32,6 +33,17 @@ def wait_until(cond: Callable[[], bool], timeout: float = 20.0, what: str = "con
             return
         time.sleep(0.01)
     raise AssertionError(f"timed out waiting for {what}")
+
+
+def loop_ran_for(loop: asyncio.AbstractEventLoop, seconds: float, timeout: float = 20.0) -> None:
+    """Return once the server's event ``loop`` has run a callback scheduled ``seconds`` from now:
+    asyncio runs timers in the order they fall due, so every timer due before it (e.g. a held
+    key's next ticks) has run. The positive condition that lets a negative check ("nothing moved
+    meanwhile") stand after real time passed."""
+    done = threading.Event()
+    loop.call_soon_threadsafe(lambda: loop.call_later(seconds, done.set))
+    if not done.wait(seconds + timeout):
+        raise AssertionError(f"timed out waiting for the server's loop to run {seconds} s on")
 
 
 def click_until_carried_out(client: ButtonClient, label: str, gate: Any, done: Callable[[], bool], *,
