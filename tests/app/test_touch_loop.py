@@ -29,7 +29,7 @@ sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(HERE.parent / "calibrate"))
 from app_page import AppPage, app_pages, true_tip_at  # noqa: E402
 from guiclick import click  # noqa: E402
-from wsclient import ButtonClient, wait_until  # noqa: E402
+from wsclient import ButtonClient, loop_ran_for, wait_until  # noqa: E402
 
 from tcp_pendant.pendant.guidance import tip_offset_mm  # noqa: E402
 from tcp_pendant.pendant.jogging import LINEAR_SPEED_MM_S  # noqa: E402
@@ -342,13 +342,14 @@ def test_continuous_jog_keeps_its_speed_when_the_browser_sends_few_hold_messages
             time.sleep(0.5)
         client.click("X +")
         held_s = time.monotonic() - t0
-        time.sleep(0.3)
+        client.sync(s.client)                                       # the release handled
+        assert not s.views["pendant"]._hold.active                  # it stopped the server's ticks
         x_end = float(s.controller.T_world_tcp()[0, 3])
         speed = (x_end - x0) * 1000.0 / held_s
         print(f"sparse hold messages: {speed:.1f} mm/s over {held_s:.2f} s, {len(xs)} ticks")
         assert speed == pytest.approx(125.0, rel=0.2)
         assert np.diff([x0] + xs).max() * 1000.0 <= 125.0 / HOLD_HZ * 1.001
-        time.sleep(0.2)
+        loop_ran_for(app.server.get_event_loop(), 3 / HOLD_HZ)      # three ticks' time on the server
         assert float(s.controller.T_world_tcp()[0, 3]) == x_end      # stopped at the release
     finally:
         client.close()
