@@ -164,7 +164,7 @@ def test_a_record_over_the_size_limit_is_dropped_as_its_transfer_starts(
     latencies = [br.jog_latency_s(1) for _ in range(20)]
     sender.join()
     wait_until(lambda: len(br.notes) >= 1, what="the refusal")
-    time.sleep(0.3)                                       # every part has arrived and was ignored
+    br.a.sync(br.sa.client)                               # every part was handled (and ignored)
     assert br.notes == [(RECORD_REFUSED, f"huge.json: The session record is {len(data):,} bytes "
                          f"({len(data) / 1e6:.1f} MB); the pendant loads records with at most "
                          f"{MAX_RECORD_BYTES:,} bytes (2 MB) (a full training session is far below that). "
@@ -179,7 +179,7 @@ def test_a_client_that_understates_its_size_is_dropped_once_it_sends_more(browse
     data = b" " * (MAX_RECORD_BYTES + 300_000)
     br.send_upload("liar.json", data, announced=100)
     wait_until(lambda: len(br.notes) >= 1, what="the refusal")
-    time.sleep(0.3)
+    br.a.sync(br.sa.client)                               # every part was handled (the rest ignored)
     assert len(br.notes) == 1 and br.notes[0][0] == RECORD_REFUSED and "liar.json" in br.notes[0][1]
     assert br.upload_states() == {} and br.view.workflow.runs == []
 
