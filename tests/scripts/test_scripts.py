@@ -166,8 +166,8 @@ def test_run_tests_under_ci_fails_when_chromium_is_missing(stamped: Path) -> Non
     p = run(stamped, "run-tests.sh", CI="true")
     assert p.returncode == 1
     assert pytest_calls(stamped) == [                    # the other tests still ran
-        "python [-m] [pytest] [-n] [2] [-m] [not browser and not serial]",
-        "python [-m] [pytest] [-m] [not browser and serial]"]
+        "python [-m] [pytest] [-n] [2] [--durations=25] [-m] [not browser and not serial]",
+        "python [-m] [pytest] [--durations=25] [-m] [not browser and serial]"]
     assert "CI=true" in p.stderr and "BROWSER TESTS DID NOT RUN" in p.stderr
 
 
@@ -233,7 +233,7 @@ def test_run_tests_without_arguments_runs_the_parallel_tests_then_the_serial_one
     (tests/conftest.py marks them) in one process; a failing run fails the command, and the
     serial tests still run after a failure of the parallel ones."""
     (stamped.parent / "bin" / "chromium").symlink_to(shutil.which("true") or "/bin/true")
-    both = ["python [-m] [pytest] [-n] [2] [-m] [not serial]", "python [-m] [pytest] [-m] [serial]"]
+    both = ["python [-m] [pytest] [-n] [2] [--durations=25] [-m] [not serial]", "python [-m] [pytest] [--durations=25] [-m] [serial]"]
     p = run(stamped, "run-tests.sh")
     assert p.returncode == 0, p.stderr
     assert pytest_calls(stamped) == both
@@ -249,8 +249,8 @@ def test_run_tests_with_a_bad_chromium_override_says_so(stamped: Path) -> None:
     p = run(stamped, "run-tests.sh", CHROMIUM="/nowhere/chromium")
     assert p.returncode == 0
     assert "CHROMIUM=/nowhere/chromium is not an executable" in p.stderr
-    assert pytest_calls(stamped) == ["python [-m] [pytest] [-n] [2] [-m] [not browser and not serial]",
-                                     "python [-m] [pytest] [-m] [not browser and serial]"]
+    assert pytest_calls(stamped) == ["python [-m] [pytest] [-n] [2] [--durations=25] [-m] [not browser and not serial]",
+                                     "python [-m] [pytest] [--durations=25] [-m] [not browser and serial]"]
 
 
 # ---------------------------------------------------------------- the type check
