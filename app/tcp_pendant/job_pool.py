@@ -67,13 +67,14 @@ import sys
 import threading
 import time
 import weakref
+from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any, TypeVar
 
-__all__ = ["BUSY_DELAY_S", "MAX_QUEUED", "REST_S", "JobPool", "JobRefused", "JobTiming", "PoolFull",
-           "LOOP_SWITCH_INTERVAL_S", "SessionBusy", "default_pool", "default_workers",
-           "favour_the_event_loop"]
+__all__ = ["BUSY_DELAY_S", "MAX_QUEUED", "REST_S", "SHARE", "SHARE_WINDOW_S", "JobPool", "JobRefused",
+           "JobTiming", "OverShare", "PoolFull", "LOOP_SWITCH_INTERVAL_S", "SessionBusy", "default_pool",
+           "default_workers", "favour_the_event_loop"]
 
 T = TypeVar("T")
 
@@ -85,6 +86,11 @@ MAX_QUEUED = 32
 """Jobs of busy sessions that may wait; twice as many jobs in all."""
 LOOP_SWITCH_INTERVAL_S = 0.001
 """Python's thread switch interval while the server runs (seconds; module docstring)."""
+SHARE = 0.25
+"""The part of one worker's time (and of the event loop's, :meth:`JobPool.charge`) one session's
+jobs may use over :data:`SHARE_WINDOW_S`."""
+SHARE_WINDOW_S = 4.0
+"""The window over which a session's share is counted (seconds)."""
 
 
 class JobRefused(ValueError):
@@ -97,6 +103,14 @@ class SessionBusy(JobRefused):
 
 class PoolFull(JobRefused):
     """The queue is full."""
+
+
+class OverShare(JobRefused):
+    """The session's jobs used their share of the server's time within the window."""
+
+    def __init__(self, message: str, retry_in_s: float) -> None:
+        super().__init__(message)
+        self.retry_in_s = retry_in_s
 
 
 def default_workers() -> int:
@@ -139,14 +153,17 @@ class JobPool:
         max_queued: jobs of busy sessions that may wait (twice as many in all).
         rest_s: a session that submits within this many seconds of its previous result is busy.
         busy_delay_s: how much later than its submit time a busy session's job is queued.
+        share: the part of one worker's time one session's jobs (and the loop work charged to
+            it) may use over ``share_window_s``; beyond it a submit is refused (:class:`OverShare`).
+        share_window_s: the window of ``share`` (seconds).
         name: the threads' name prefix.
         keep_history: keep a :class:`JobTiming` of each finished job in :attr:`history`
             (tests and benchmarks; off in the server).
     """
 
     def __init__(self, workers: int | None = None, *, max_queued: int = MAX_QUEUED, rest_s: float = REST_S,
-                 busy_delay_s: float = BUSY_DELAY_S, name: str = "tcp-pendant-job",
-                 keep_history: bool = False) -> None:
+                 busy_delay_s: float = BUSY_DELAY_S, share: float = SHARE, share_window_s: float = SHARE_WINDOW_S,
+                 name: str = "tcp-pendant-job", keep_history: bool = False) -> None:
         self.workers = default_workers() if workers is None else int(workers)
         if self.workers < 1 or max_queued < 1:
             raise ValueError(f"A job pool needs at least one worker and one queue place, got {workers} "
@@ -154,6 +171,11 @@ class JobPool:
         self.max_queued = int(max_queued)
         self.rest_s = float(rest_s)
         self.busy_delay_s = float(busy_delay_s)
+        if not (0.0 < share and share_window_s > 0.0):
+            raise ValueError(f"A session's share must be positive over a positive window, got {share} "
+                             f"over {share_window_s} s.")
+        self.share = float(share)
+        self.share_window_s = float(share_window_s)
         self.name = name
         self.history: list[JobTiming] | None = [] if keep_history else None
         self._cond = threading.Condition()
@@ -161,6 +183,8 @@ class JobPool:
         self._order = itertools.count()
         self._pending: dict[int, _Job] = {}                     # id(owner) -> its job, queued or running
         self._last_result: weakref.WeakKeyDictionary[Any, float] = weakref.WeakKeyDictionary()
+        # owner -> (when each of its jobs / charges ended, its seconds), oldest first
+        self._used: weakref.WeakKeyDictionary[Any, deque[tuple[float, float]]] = weakref.WeakKeyDictionary()
         self._threads: list[threading.Thread] = []
         self._closed = False
 
@@ -188,11 +212,8 @@ class JobPool:
         with self._cond:
             if self._closed:
                 raise JobRefused("The server is shutting down; the job was not started.")
-            running = self._pending.get(id(owner))
-            if running is not None:
-                raise SessionBusy(f"{running.what[:1].upper()}{running.what[1:]} is still running here; "
-                                  "wait for its result, then try again.")
             now = time.monotonic()
+            self._admit(owner, now)
             try:
                 last = self._last_result.get(owner)
             except TypeError:           # an owner that cannot be referenced weakly: always rested
@@ -208,6 +229,72 @@ class JobPool:
             self._cond.notify()
         future.add_done_callback(lambda f: self._drop_cancelled(job) if f.cancelled() else None)
         return future
+
+    def admit(self, owner: object) -> None:
+        """Refuse at once what :meth:`submit` would refuse for ``owner`` itself (its pending job,
+        its share used up), before a caller spends the event loop's time on taking a job.
+
+        Raises:
+            SessionBusy: ``owner`` has a job queued or running.
+            OverShare: ``owner``'s jobs used their share within the window; its message says
+                in how many seconds to try again.
+        """
+        with self._cond:
+            self._admit(owner, time.monotonic())
+
+    def _admit(self, owner: object, now: float) -> None:
+        running = self._pending.get(id(owner))
+        if running is not None:
+            raise SessionBusy(f"{running.what[:1].upper()}{running.what[1:]} is still running here; "
+                              "wait for its result, then try again.")
+        retry_in_s = self._retry_in_s(owner, now)
+        if retry_in_s > 0.0:
+            wait = max(1, math.ceil(retry_in_s))
+            raise OverShare(f"The server is busy with this browser's jobs: try again in {wait} s.", retry_in_s)
+
+    def _retry_in_s(self, owner: object, now: float) -> float:
+        """Seconds until ``owner``'s use within the window is back within its share (0: now)."""
+        try:
+            used = self._used.get(owner)
+        except TypeError:               # an owner that cannot be referenced weakly: not counted
+            return 0.0
+        if not used:
+            return 0.0
+        start = now - self.share_window_s
+        while used and used[0][0] <= start:
+            used.popleft()
+        allowed = self.share * self.share_window_s
+        total = sum(seconds for _, seconds in used)
+        if total <= allowed:
+            return 0.0
+        for ended, seconds in used:                  # the oldest leave the window first
+            total -= seconds
+            if total <= allowed:
+                return ended + self.share_window_s - now
+        return self.share_window_s
+
+    def charge(self, owner: object, seconds: float) -> None:
+        """Count ``seconds`` of the event loop's time spent on ``owner``'s job-like work (e.g.
+        Auto-touch's motion and the re-render it ends in) against its share, as a job's run."""
+        if seconds > 0.0:
+            self._count(owner, time.monotonic(), float(seconds))
+
+    def used_s(self, owner: object) -> float:
+        """Seconds ``owner``'s jobs and charges used within the window ending now."""
+        with self._cond:
+            try:
+                used = self._used.get(owner)
+            except TypeError:
+                return 0.0
+            start = time.monotonic() - self.share_window_s
+            return sum(seconds for ended, seconds in used or () if ended > start)
+
+    def _count(self, owner: object, ended: float, seconds: float) -> None:
+        with self._cond:
+            try:
+                self._used.setdefault(owner, deque()).append((ended, seconds))
+            except TypeError:           # an owner that cannot be referenced weakly: not counted
+                pass
 
     def _drop_cancelled(self, job: _Job) -> None:
         """A job whose caller gave up before it started (its awaiting task was cancelled) leaves
@@ -269,6 +356,9 @@ class JobPool:
             self._pending.pop(id(job.owner), None)
             try:
                 self._last_result[job.owner] = job.finished_s
+                if job.started_s is not None:
+                    self._used.setdefault(job.owner, deque()).append(
+                        (job.finished_s, job.finished_s - job.started_s))
             except TypeError:           # an owner that cannot be referenced weakly: no history
                 pass
             if self.history is not None and job.started_s is not None:
