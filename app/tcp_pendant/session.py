@@ -868,6 +868,10 @@ class Session:
             WizardStateError: as :meth:`auto_touch`; the calibration on show changed meanwhile.
         """
         self.admit_job()
+        with self.lock:                 # refused by the state alone: nothing moved, nothing to show
+            why = self.workflow.auto_touch_refusal()
+        if why is not None:
+            raise WizardStateError(why)
         steps = self.workflow.auto_touch_steps(request)
 
         def advance(answer: str | None, first: bool) -> tuple[Callable[[], str | None] | None, Any]:
