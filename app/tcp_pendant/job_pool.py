@@ -67,12 +67,11 @@ import sys
 import threading
 import time
 import weakref
-from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any, TypeVar
 
-__all__ = ["BUSY_DELAY_S", "MAX_QUEUED", "REST_S", "SHARE", "SHARE_WINDOW_S", "JobPool", "JobRefused",
+__all__ = ["BUSY_DELAY_S", "MAX_QUEUED", "REST_S", "SHARE", "BURST_S", "JobPool", "JobRefused",
            "JobTiming", "OverShare", "PoolFull", "LOOP_SWITCH_INTERVAL_S", "SessionBusy", "default_pool",
            "default_workers", "favour_the_event_loop"]
 
@@ -86,11 +85,11 @@ MAX_QUEUED = 32
 """Jobs of busy sessions that may wait; twice as many jobs in all."""
 LOOP_SWITCH_INTERVAL_S = 0.001
 """Python's thread switch interval while the server runs (seconds; module docstring)."""
-SHARE = 0.25
-"""The part of one worker's time (and of the event loop's, :meth:`JobPool.charge`) one session's
-jobs may use over :data:`SHARE_WINDOW_S`."""
-SHARE_WINDOW_S = 4.0
-"""The window over which a session's share is counted (seconds)."""
+SHARE = 0.1
+"""The part of one worker's time one session's jobs (and the loop work charged to it,
+:meth:`JobPool.charge`) may use on average: its credit refills at this many seconds per second."""
+BURST_S = 1.0
+"""A session's credit when full (seconds of jobs it may run back to back)."""
 
 
 class JobRefused(ValueError):
@@ -154,15 +153,16 @@ class JobPool:
         rest_s: a session that submits within this many seconds of its previous result is busy.
         busy_delay_s: how much later than its submit time a busy session's job is queued.
         share: the part of one worker's time one session's jobs (and the loop work charged to
-            it) may use over ``share_window_s``; beyond it a submit is refused (:class:`OverShare`).
-        share_window_s: the window of ``share`` (seconds).
+            it) may use on average: its credit refills at ``share`` seconds per second.
+        burst_s: a session's credit when full; at no credit left a submit is refused
+            (:class:`OverShare`).
         name: the threads' name prefix.
         keep_history: keep a :class:`JobTiming` of each finished job in :attr:`history`
             (tests and benchmarks; off in the server).
     """
 
     def __init__(self, workers: int | None = None, *, max_queued: int = MAX_QUEUED, rest_s: float = REST_S,
-                 busy_delay_s: float = BUSY_DELAY_S, share: float = SHARE, share_window_s: float = SHARE_WINDOW_S,
+                 busy_delay_s: float = BUSY_DELAY_S, share: float = SHARE, burst_s: float = BURST_S,
                  name: str = "tcp-pendant-job", keep_history: bool = False) -> None:
         self.workers = default_workers() if workers is None else int(workers)
         if self.workers < 1 or max_queued < 1:
@@ -171,11 +171,10 @@ class JobPool:
         self.max_queued = int(max_queued)
         self.rest_s = float(rest_s)
         self.busy_delay_s = float(busy_delay_s)
-        if not (0.0 < share and share_window_s > 0.0):
-            raise ValueError(f"A session's share must be positive over a positive window, got {share} "
-                             f"over {share_window_s} s.")
+        if not (share > 0.0 and burst_s > 0.0):
+            raise ValueError(f"A session's share and burst must be positive, got {share} and {burst_s} s.")
         self.share = float(share)
-        self.share_window_s = float(share_window_s)
+        self.burst_s = float(burst_s)
         self.name = name
         self.history: list[JobTiming] | None = [] if keep_history else None
         self._cond = threading.Condition()
@@ -183,8 +182,8 @@ class JobPool:
         self._order = itertools.count()
         self._pending: dict[int, _Job] = {}                     # id(owner) -> its job, queued or running
         self._last_result: weakref.WeakKeyDictionary[Any, float] = weakref.WeakKeyDictionary()
-        # owner -> (when each of its jobs / charges ended, its seconds), oldest first
-        self._used: weakref.WeakKeyDictionary[Any, deque[tuple[float, float]]] = weakref.WeakKeyDictionary()
+        # owner -> its credit (seconds; below 0 after a job longer than the credit) and when it was counted
+        self._credit: weakref.WeakKeyDictionary[Any, tuple[float, float]] = weakref.WeakKeyDictionary()
         self._threads: list[threading.Thread] = []
         self._closed = False
 
@@ -253,48 +252,39 @@ class JobPool:
             raise OverShare(f"The server is busy with this browser's jobs: try again in {wait} s.", retry_in_s)
 
     def _retry_in_s(self, owner: object, now: float) -> float:
-        """Seconds until ``owner``'s use within the window is back within its share (0: now)."""
+        """Seconds until ``owner`` has credit again (0: it has)."""
+        credit = self._credit_at(owner, now)
+        return 0.0 if credit > 0.0 else -credit / self.share + 1e-3
+
+    def _credit_at(self, owner: object, now: float) -> float:
+        """``owner``'s credit at ``now`` (full for an owner never counted or not weakly
+        referable)."""
         try:
-            used = self._used.get(owner)
-        except TypeError:               # an owner that cannot be referenced weakly: not counted
-            return 0.0
-        if not used:
-            return 0.0
-        start = now - self.share_window_s
-        while used and used[0][0] <= start:
-            used.popleft()
-        allowed = self.share * self.share_window_s
-        total = sum(seconds for _, seconds in used)
-        if total <= allowed:
-            return 0.0
-        for ended, seconds in used:                  # the oldest leave the window first
-            total -= seconds
-            if total <= allowed:
-                return ended + self.share_window_s - now
-        return self.share_window_s
+            held = self._credit.get(owner)
+        except TypeError:
+            return self.burst_s
+        if held is None:
+            return self.burst_s
+        credit, when = held
+        return min(self.burst_s, credit + (now - when) * self.share)
 
     def charge(self, owner: object, seconds: float) -> None:
         """Count ``seconds`` of the event loop's time spent on ``owner``'s job-like work (e.g.
-        Auto-touch's motion and the re-render it ends in) against its share, as a job's run."""
+        Auto-touch's motion and the re-render it ends in) against its credit, as a job's run."""
         if seconds > 0.0:
-            self._count(owner, time.monotonic(), float(seconds))
+            with self._cond:
+                self._spend(owner, time.monotonic(), float(seconds))
 
-    def used_s(self, owner: object) -> float:
-        """Seconds ``owner``'s jobs and charges used within the window ending now."""
+    def credit_s(self, owner: object) -> float:
+        """``owner``'s credit now (seconds; negative: refused for ``-credit / share`` s)."""
         with self._cond:
-            try:
-                used = self._used.get(owner)
-            except TypeError:
-                return 0.0
-            start = time.monotonic() - self.share_window_s
-            return sum(seconds for ended, seconds in used or () if ended > start)
+            return self._credit_at(owner, time.monotonic())
 
-    def _count(self, owner: object, ended: float, seconds: float) -> None:
-        with self._cond:
-            try:
-                self._used.setdefault(owner, deque()).append((ended, seconds))
-            except TypeError:           # an owner that cannot be referenced weakly: not counted
-                pass
+    def _spend(self, owner: object, now: float, seconds: float) -> None:
+        try:
+            self._credit[owner] = (self._credit_at(owner, now) - seconds, now)
+        except TypeError:           # an owner that cannot be referenced weakly: not counted
+            pass
 
     def _drop_cancelled(self, job: _Job) -> None:
         """A job whose caller gave up before it started (its awaiting task was cancelled) leaves
@@ -357,8 +347,7 @@ class JobPool:
             try:
                 self._last_result[job.owner] = job.finished_s
                 if job.started_s is not None:
-                    self._used.setdefault(job.owner, deque()).append(
-                        (job.finished_s, job.finished_s - job.started_s))
+                    self._spend(job.owner, job.finished_s, job.finished_s - job.started_s)
             except TypeError:           # an owner that cannot be referenced weakly: no history
                 pass
             if self.history is not None and job.started_s is not None:
