@@ -19,8 +19,11 @@ attack interleave in one run (the machine's other load hits both alike).
 
 from __future__ import annotations
 
+import asyncio
 import gc
 import os
+import socket
+import struct
 import subprocess
 import sys
 import threading
@@ -29,6 +32,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from tcp_pendant.cli import set_apart_startup_objects
@@ -98,33 +102,73 @@ class FloodRig:
         assert self.victim_client.found.wait(30), "the victim never saw the jog keys"
         wait_until(lambda: len(app.sessions) == 1, what="the victim's session")
         (self.victim,) = app.sessions.values()
+        self.loop = self.victim.views["calibrate"].load._impl.gui_api._event_loop
         self.victim_notes: list[tuple[str, str]] = []
         self.victim.notify = lambda title, body, kind="info": self.victim_notes.append((title, body))  # type: ignore[method-assign]
         with self.victim.lock:
             self.victim.set_active_data(self.tool)
             self.victim.jogger.settings = self.victim.jogger.settings.with_(increment="0.1", frame="WORLD")
+        self.rate_hz = rate_hz
         self.attacker_notes: list[tuple[str, str]] = []
-        self._proc = subprocess.Popen([sys.executable, __file__, str(app.port), str(rate_hz)], stdin=subprocess.PIPE,
-                                      stdout=subprocess.PIPE, text=True, bufsize=1,
-                                      env={**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)})
-        assert self._proc.stdout is not None
-        assert self._proc.stdout.readline().strip() == "ready", "the attacker never saw its buttons"
-        wait_until(lambda: len(app.sessions) == 2, what="the attacker's session")
-        self.attacker: Session = next(s for s in app.sessions.values() if s is not self.victim)
-        self._prepare_attacker()
+        """The notifications the attackers' browsers were shown."""
+        self.attacker_refusals: list[str] = []
+        """Every refusal of an attacker's click, shown or left out (``Session.notify_refusal``)."""
+        self.attackers: list[Session] = []
         self.clicks = 0
 
-    def _prepare_attacker(self) -> None:
-        """Library slot 1 selected, its data active, training on, an XYZ 4-point open."""
-        a = self.attacker
-        original = a.notify
+    # ------------------------------------------------------------ the attack
+    @contextmanager
+    def flood(self) -> Iterator[Session]:
+        """A fresh attacker browser (its own process, its own session, prepared) clicks while
+        the block runs; at its end the browser closes (its clicks still in the socket are
+        dropped with the connection, as a closed tab's)."""
+        n = len(self.app.sessions)
+        proc = subprocess.Popen([sys.executable, __file__, str(self.app.port), str(self.rate_hz)],
+                                stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True, bufsize=1,
+                                env={**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)})
+        assert proc.stdin is not None and proc.stdout is not None
+        try:
+            assert proc.stdout.readline().strip() == "ready", "the attacker never saw its buttons"
+            wait_until(lambda: len(self.app.sessions) > n, what="the attacker's session")
+            attacker = next(s for s in self.app.sessions.values() if s is not self.victim and s not in self.attackers)
+            self.attackers.append(attacker)
+            self._prepare(attacker)
+            proc.stdin.write("go\n")
+            proc.stdin.flush()
+            assert proc.stdout.readline().strip() == "going"
+            yield attacker
+            proc.stdin.write("stop\n")
+            proc.stdin.flush()
+            self.clicks += int(proc.stdout.readline().split()[0])
+        finally:
+            proc.stdin.close()
+            try:
+                proc.wait(20)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                proc.wait(10)
+        wait_until(lambda: attacker.closed, timeout=30, what="the attacker's session closed")
+        wait_until(lambda: self.pool.pending(attacker) is None, timeout=30, what="the attack's last job")
+
+    def _prepare(self, a: Session) -> None:
+        """Library slot 1 selected, its data active, training on, an XYZ 4-point open; its
+        notifications and refusals noted."""
+        original_notify = a.notify
+        refusals = getattr(a, "refusals", None)       # None: a server without coalesced refusals
 
         def note(title: str, body: str, kind: str = "info") -> None:
             self.attacker_notes.append((title, body))
-            original(title, body, kind=kind)
+            original_notify(title, body, kind=kind)
+
         a.notify = note  # type: ignore[method-assign]
+        if refusals is not None:
+            original_body = refusals.body
+
+            def refusal(body: str) -> str | None:
+                self.attacker_refusals.append(body)
+                return original_body(body)
+            refusals.body = refusal
         tools = a.views["tools"]
-        self._attack_handles = (tools.check, tools.check_active, a.views["calibrate"].steps.auto_touch)
 
         async def select() -> None:
             with a.lock:
@@ -134,41 +178,15 @@ class FloodRig:
                 tools.slots.value = next(o for o in tools.slots.options if str(o).startswith("1"))
         self.on_loop(select())
 
-    def on_loop(self, coro: object) -> None:
-        import asyncio
-        loop = self.attacker.views["calibrate"].load._impl.gui_api._event_loop
-        asyncio.run_coroutine_threadsafe(coro, loop).result(30)  # type: ignore[arg-type]
+    def on_loop(self, coro: Any) -> Any:
+        """Run ``coro`` on the server's event loop; its value."""
+        return asyncio.run_coroutine_threadsafe(coro, self.loop).result(60)
 
-    # ------------------------------------------------------------ the attack
-    @contextmanager
-    def flood(self) -> Iterator[None]:
-        """The attacker clicks while the block runs (and a moment after: its clicks in flight)."""
-        assert self._proc.stdin is not None and self._proc.stdout is not None
-        self._proc.stdin.write("go\n")
-        self._proc.stdin.flush()
-        assert self._proc.stdout.readline().strip() == "going"
-        try:
-            yield
-        finally:
-            self._proc.stdin.write("stop\n")
-            self._proc.stdin.flush()
-            self.clicks += int(self._proc.stdout.readline().split()[0])
-            self.wait_for_the_clicks_in_flight()
-
-    def wait_for_the_clicks_in_flight(self, quiet_s: float = 0.3, timeout_s: float = 60.0) -> None:
-        """Until the server handled no click of the attacker's for ``quiet_s`` (at most
-        ``timeout_s``)."""
-        handles = self._attack_handles
-        def latest() -> float:
-            return max(h._impl.update_timestamp for h in handles)
-        last, seen = latest(), time.monotonic()
-        deadline = seen + timeout_s
-        while time.monotonic() - seen < quiet_s and time.monotonic() < deadline:
-            time.sleep(0.02)
-            now = latest()
-            if now != last:
-                last, seen = now, time.monotonic()
-        wait_until(lambda: self.pool.pending(self.attacker) is None, timeout=30, what="the attack's last job")
+    def victim_check(self) -> None:
+        """The victim's "Check active tool", as its button's callback runs it."""
+        panel = self.victim.views["tools"]
+        self.on_loop(panel.run_check(panel._active_for_check))
+        assert panel.check_md.content.startswith("**TCP check"), (panel.check_md.content, self.victim_notes)
 
     # ------------------------------------------------------------ the victim
     def press(self, timeout_s: float = 2.0) -> float | None:
@@ -212,15 +230,9 @@ class FloodRig:
         return base, under
 
     def attacker_jobs(self) -> list[JobTiming]:
-        return [h for h in self.pool.history or () if h.owner is self.attacker]
+        return [h for h in self.pool.history or () if h.owner is not self.victim]
 
     def close(self) -> None:
-        try:
-            if self._proc.stdin is not None:
-                self._proc.stdin.close()
-            self._proc.wait(10)
-        except Exception:
-            self._proc.kill()
         self.victim_client.close()
         self.app.stop()
         gc.unfreeze()
@@ -263,7 +275,10 @@ def _attacker(port: int, rate_hz: float) -> None:
             go.clear()
             time.sleep(0.05)
             print(f"{sent} clicks{' (connection closed)' if closed.is_set() else ''}", flush=True)
-    client.close()
+    # the tab closes: the connection is reset (its clicks still in the sockets are dropped)
+    client.ws.socket.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, struct.pack("ii", 1, 0))
+    client.ws.socket.close()
+    os._exit(0)
 
 
 if __name__ == "__main__":
