@@ -14,7 +14,9 @@ beyond, its reading waits (nothing is dropped: the websocket's and the kernel's 
 the sender's socket blocks, so the sender is slowed, not the server). A browser sends far fewer:
 its camera while orbiting, a held key's 20 Hz ticks, a slider's drag. Measured with the rig of
 ``tests/security/browser_flood.py``: at 500 and 1000 clicks a second the victim's jog p95 stayed
-within 1.3x of its baseline, none dropped.
+within 1.3x of its baseline, none dropped. A connection past its pace stays *flooding* until its
+bucket is full again, and the deadman takes every jog press of a flooding connection as stale
+(a press read seconds after it was sent would move the robot long after the last one).
 """
 
 from __future__ import annotations
@@ -40,6 +42,10 @@ class MessagePacer:
 
     Attributes:
         paced: messages that had to wait so far.
+        flooding: the connection went beyond its pace and its bucket has not filled up since
+            (it stayed quiet for less than ``burst / rate_hz`` seconds in all): its messages
+            may have waited in the socket for seconds, so a jog press of it is stale
+            (``views.viser_adapter`` stamps it so for the deadman).
     """
 
     def __init__(self, rate_hz: float = RATE_HZ, burst: int = BURST,
@@ -53,13 +59,18 @@ class MessagePacer:
         self._tokens = self.burst
         self._last = clock()
         self.paced = 0
+        self.flooding = False
 
     def delay_s(self) -> float:
         """Take one message: the seconds its handling must wait (0: none)."""
         now = self._clock()
-        self._tokens = min(self.burst, self._tokens + (now - self._last) * self.rate_hz) - 1.0
+        refilled = self._tokens + (now - self._last) * self.rate_hz
+        if refilled >= self.burst:
+            self.flooding = False
+        self._tokens = min(self.burst, refilled) - 1.0
         self._last = now
         if self._tokens >= 0.0:
             return 0.0
         self.paced += 1
+        self.flooding = True
         return -self._tokens / self.rate_hz

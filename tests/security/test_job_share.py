@@ -93,3 +93,14 @@ def test_a_connections_messages_wait_beyond_its_burst_at_its_pace() -> None:
     assert pacer.delay_s() == 0.0 and pacer.paced == 2
     with pytest.raises(ValueError, match="positive rate"):
         MessagePacer(rate_hz=0.0)
+
+
+def test_a_connection_past_its_pace_floods_until_its_bucket_is_full_again() -> None:
+    clock = Clock()
+    pacer = MessagePacer(rate_hz=500.0, burst=10, clock=clock)
+    assert [pacer.delay_s() for _ in range(10)] == [0.0] * 10 and not pacer.flooding
+    assert pacer.delay_s() > 0.0 and pacer.flooding                     # past its pace
+    clock.t += 0.01                                                     # 5 tokens back: still flooding,
+    assert pacer.delay_s() == 0.0 and pacer.flooding                    # though not held back
+    clock.t += 10.0                                                     # quiet until full: a browser again
+    assert pacer.delay_s() == 0.0 and not pacer.flooding

@@ -76,6 +76,7 @@ from typing import Any
 import msgspec
 
 from tcp_pendant.message_rate import MessagePacer
+from tcp_pendant.views import arrival
 
 __all__ = ["LOG_VALUE_CHARS", "MAX_ABS_NUMBER", "MAX_TEXT_CHARS", "UploadHook", "UploadLimits",
            "ViserInternalsChanged", "gui_value_refusal", "install", "listen_reuse_port", "message_refusal", "path_counts",
@@ -715,6 +716,12 @@ holds thousands of small messages, all parsed in one callback of the loop: measu
 stalls of every other browser)."""
 
 
+PACED_AGE_S = 60.0
+"""How old a message of a flooding connection counts for the deadman (``arrival``,
+``message_rate.MessagePacer.flooding``): read slowly, its messages sat in the socket for an
+unknown time, so its jog presses are dropped, not carried out seconds after its last one."""
+
+
 def _read_in_small_chunks(websocket: Any) -> None:
     """Read a paced connection at most :data:`PACED_READ_BYTES` at a time (asyncio's selector
     transport's ``max_size``; nothing when the transport differs)."""
@@ -757,6 +764,7 @@ def install() -> None:
                     if pacer.paced == 1:
                         _read_in_small_chunks(websocket)
                     await asyncio.sleep(wait_s)
+                arrival.stamp_not_after(time.monotonic() - PACED_AGE_S if pacer.flooding else None)
                 try:
                     if not isinstance(raw, bytes):
                         raise TypeError("a text frame; viser speaks binary msgpack")
