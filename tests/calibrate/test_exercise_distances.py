@@ -88,44 +88,43 @@ def test_the_export_gives_no_distance_to_trilaterate_the_tcp_from_in_an_exercise
     assert "distance_mm" not in dumps(wf.export_record()) and wf.distances_shown() == ({}, set())
 
 
-def test_the_result_shows_no_distance_table_in_an_exercise(page) -> None:
-    p = page()
+def record_in_the_air_on_the_page(p: Any, *, exercise: bool) -> list[float]:
+    """The same attack through the Calibrate tab (an XYZ 4-point, "Hide distance" on, the truth
+    hidden in an exercise); returns each touch's true distance at record (mm)."""
     v, s = p.view, p.session
     s.set_hide_distance(True)
-    s.set_hide_truth(True)                        # what the classroom sets in an exercise
+    if exercise:
+        s.set_hide_truth(True)                    # what the classroom sets in an exercise
     with s.lock:
         s.controller.jog_cartesian("world", "Z", 300.0)
     p.click(v.start)
+    distances = []
     for i in range(4):
-        if i:
-            with s.lock:
+        with s.lock:
+            if i:
                 s.controller.jog_cartesian("tool", TURNS[i][0], TURNS[i][1])
+            distances.append(float(s.controller.touch_geometry().distance_mm))
         p.click(v.steps.record)
         p.click(v.steps.next)
-    res, run = v.workflow.result, v.workflow.run
-    assert res is not None and run.distance_mm == {}
-    distances = [float(s.controller.touch_geometry().distance_mm)]
-    assert not v.result.hidden_md.visible
+    assert v.workflow.result is not None and min(distances) > 200.0
+    return distances
+
+
+def test_the_result_shows_no_distance_table_in_an_exercise(page) -> None:
+    p = page()
+    v = p.view
+    distances = record_in_the_air_on_the_page(p, exercise=True)
+    assert v.workflow.run.distance_mm == {} and not v.result.hidden_md.visible
     shown = "\n".join(str(h.content) for h in (v.result.result_md, v.result.hidden_md, v.result.warnings_md))
     assert "distance hidden" not in shown and "distance at record" not in shown
-    for d in distances:                           # not the last touch's true distance either
+    for d in distances:                           # no true distance, to the 0.1 or 0.01 mm shown
         assert f"{d:.2f}" not in shown and f"{d:.1f} mm" not in shown
 
 
 def test_free_practice_keeps_the_distance_table(page) -> None:
     p = page()
-    v, s = p.view, p.session
-    s.set_hide_distance(True)
-    with s.lock:
-        s.controller.jog_cartesian("world", "Z", 300.0)
-    p.click(v.start)
-    for i in range(4):
-        if i:
-            with s.lock:
-                s.controller.jog_cartesian("tool", TURNS[i][0], TURNS[i][1])
-        p.click(v.steps.record)
-        p.click(v.steps.next)
-    run = v.workflow.run
-    assert v.workflow.result is not None and v.result.hidden_md.visible
-    for i, d in run.distance_mm.items():
+    v = p.view
+    distances = record_in_the_air_on_the_page(p, exercise=False)
+    assert v.result.hidden_md.visible
+    for i, d in enumerate(distances):
         assert f"| P{i + 1} | {d:.2f} mm |" in v.result.hidden_md.content
