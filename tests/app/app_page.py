@@ -62,6 +62,19 @@ class AppPage:
         choose(handle, value, self.client)
 
 
+def join_as_the_only_trainee(app: PendantApp, name: str) -> Any:
+    """The one browser of a class server, once its name prompt is up, joined as ``name``
+    (typed and Start clicked as that browser's messages); returns its session."""
+    wait_until(lambda: len(app.sessions) == 1 and all("identity" in s.views for s in app.sessions.values()),
+               what="the name prompt")
+    session = next(iter(app.sessions.values()))
+    prompt = session.views["identity"]
+    choose(prompt.name_field, name, session.client)
+    click(prompt.start, session.client)
+    assert prompt.name == name
+    return session
+
+
 @contextmanager
 def running_pendants(tmp_path: Path) -> Iterator[Callable[..., PendantApp]]:
     """``start(tools=None, **config)``: a pendant in this process on a free port (``AppConfig``

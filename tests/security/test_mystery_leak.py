@@ -34,7 +34,7 @@ from tcp_pendant.views.wizard_menu import SESSION_FILENAME
 _APP_TESTS = Path(__file__).parents[1] / "app"
 sys.path.insert(0, str(_APP_TESTS))
 sys.path.insert(0, str(_APP_TESTS.parent / "calibrate"))
-from app_page import running_pendants  # noqa: E402
+from app_page import join_as_the_only_trainee, running_pendants  # noqa: E402
 from guiclick import choose, click  # noqa: E402
 from wsclient import RecordingClient, wait_until  # noqa: E402
 
@@ -129,13 +129,7 @@ def test_a_hostile_trainee_reads_no_number_of_the_true_tcp(tmp_path: Path) -> No
         assert app.config.exercise_seed is None                       # the class's secret seed
         c = RecordingClient(app.port)
         try:
-            wait_until(lambda: len(app.sessions) == 1 and all("identity" in s.views for s in app.sessions.values()),
-                       what="the name prompt")
-            s = next(iter(app.sessions.values()))
-            prompt = s.views["identity"]
-            choose(prompt.name_field, "Mallory", s.client)
-            click(prompt.start, s.client)
-            assert prompt.name == "Mallory"
+            s = join_as_the_only_trainee(app, "Mallory")
             assert s.controller.mounted_tool.key.startswith("mystery-") and s.hide_distance
 
             poses: list[tuple[np.ndarray, np.ndarray]] = []            # (T_world_flange, T_world_base)

@@ -15,7 +15,7 @@ from typing import Any
 _APP_TESTS = Path(__file__).parents[1] / "app"
 sys.path.insert(0, str(_APP_TESTS))
 sys.path.insert(0, str(_APP_TESTS.parent / "calibrate"))
-from app_page import running_pendants  # noqa: E402
+from app_page import join_as_the_only_trainee, running_pendants  # noqa: E402
 from guiclick import choose, click  # noqa: E402
 from wsclient import InputsClient, wait_until  # noqa: E402
 
@@ -54,12 +54,7 @@ def test_the_mystery_tool_cannot_be_swapped_for_the_pointer_over_the_websocket(t
         app = start(class_db=tmp_path / "class.sqlite3", trainer_token=TOKEN, exercise="mystery")
         c = InputsClient(app.port)
         try:
-            wait_until(lambda: len(app.sessions) == 1 and all("identity" in s.views for s in app.sessions.values()),
-                       what="the name prompt")
-            s = next(iter(app.sessions.values()))
-            prompt = s.views["identity"]
-            choose(prompt.name_field, "Mallory", s.client)
-            click(prompt.start, s.client)
+            s = join_as_the_only_trainee(app, "Mallory")
             mystery = s.controller.mounted_tool
             assert mystery.key.startswith("mystery-")
             wait_until(lambda: "Mounted tool" in c.labels(), what="the Mounted tool dropdown")
