@@ -42,6 +42,7 @@ from tcp_pendant.views.gui_util import (
     ButtonEvent,
     DropdownEvent,
     number_of_option,
+    set_content,
     set_options,
     set_value,
     slot_option,
@@ -251,9 +252,9 @@ class ToolPanel:
         if label in options:
             set_options(self.mounted, options, keep=label)   # its own handler then sees no change
         self.mounted.disabled = held is not None
-        self.mounted_lock_md.content = "" if held is None else (
+        set_content(self.mounted_lock_md, "" if held is None else (
             f"{TOOL_LOCKED_LINE}: you calibrate your own tool, the {escape_markdown(held.label.lower())}. "
-            "The XYZ reference method mounts its reference tool for its first touch by itself.")
+            "The XYZ reference method mounts its reference tool for its first touch by itself."))
         self.mounted_lock_md.visible = held is not None
 
     def _show_active(self) -> None:
