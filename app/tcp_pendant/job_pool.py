@@ -71,9 +71,9 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any, TypeVar
 
-__all__ = ["BUSY_DELAY_S", "MAX_QUEUED", "REST_S", "JobPool", "JobRefused", "JobTiming", "PoolFull",
-           "LOOP_SWITCH_INTERVAL_S", "SessionBusy", "default_pool", "default_workers",
-           "favour_the_event_loop"]
+__all__ = ["BUSY_DELAY_S", "MAX_QUEUED", "REST_S", "SHARE", "BURST_S", "JobPool", "JobRefused",
+           "JobTiming", "OverShare", "PoolFull", "LOOP_SWITCH_INTERVAL_S", "SessionBusy", "default_pool",
+           "default_workers", "favour_the_event_loop"]
 
 T = TypeVar("T")
 
@@ -85,6 +85,11 @@ MAX_QUEUED = 32
 """Jobs of busy sessions that may wait; twice as many jobs in all."""
 LOOP_SWITCH_INTERVAL_S = 0.001
 """Python's thread switch interval while the server runs (seconds; module docstring)."""
+SHARE = 0.1
+"""The part of one worker's time one session's jobs (and the loop work charged to it,
+:meth:`JobPool.charge`) may use on average: its credit refills at this many seconds per second."""
+BURST_S = 1.0
+"""A session's credit when full (seconds of jobs it may run back to back)."""
 
 
 class JobRefused(ValueError):
@@ -97,6 +102,14 @@ class SessionBusy(JobRefused):
 
 class PoolFull(JobRefused):
     """The queue is full."""
+
+
+class OverShare(JobRefused):
+    """The session's jobs used their share of the server's time within the window."""
+
+    def __init__(self, message: str, retry_in_s: float) -> None:
+        super().__init__(message)
+        self.retry_in_s = retry_in_s
 
 
 def default_workers() -> int:
@@ -139,14 +152,18 @@ class JobPool:
         max_queued: jobs of busy sessions that may wait (twice as many in all).
         rest_s: a session that submits within this many seconds of its previous result is busy.
         busy_delay_s: how much later than its submit time a busy session's job is queued.
+        share: the part of one worker's time one session's jobs (and the loop work charged to
+            it) may use on average: its credit refills at ``share`` seconds per second.
+        burst_s: a session's credit when full; at no credit left a submit is refused
+            (:class:`OverShare`).
         name: the threads' name prefix.
         keep_history: keep a :class:`JobTiming` of each finished job in :attr:`history`
             (tests and benchmarks; off in the server).
     """
 
     def __init__(self, workers: int | None = None, *, max_queued: int = MAX_QUEUED, rest_s: float = REST_S,
-                 busy_delay_s: float = BUSY_DELAY_S, name: str = "tcp-pendant-job",
-                 keep_history: bool = False) -> None:
+                 busy_delay_s: float = BUSY_DELAY_S, share: float = SHARE, burst_s: float = BURST_S,
+                 name: str = "tcp-pendant-job", keep_history: bool = False) -> None:
         self.workers = default_workers() if workers is None else int(workers)
         if self.workers < 1 or max_queued < 1:
             raise ValueError(f"A job pool needs at least one worker and one queue place, got {workers} "
@@ -154,6 +171,10 @@ class JobPool:
         self.max_queued = int(max_queued)
         self.rest_s = float(rest_s)
         self.busy_delay_s = float(busy_delay_s)
+        if not (share > 0.0 and burst_s > 0.0):
+            raise ValueError(f"A session's share and burst must be positive, got {share} and {burst_s} s.")
+        self.share = float(share)
+        self.burst_s = float(burst_s)
         self.name = name
         self.history: list[JobTiming] | None = [] if keep_history else None
         self._cond = threading.Condition()
@@ -161,6 +182,8 @@ class JobPool:
         self._order = itertools.count()
         self._pending: dict[int, _Job] = {}                     # id(owner) -> its job, queued or running
         self._last_result: weakref.WeakKeyDictionary[Any, float] = weakref.WeakKeyDictionary()
+        # owner -> its credit (seconds; below 0 after a job longer than the credit) and when it was counted
+        self._credit: weakref.WeakKeyDictionary[Any, tuple[float, float]] = weakref.WeakKeyDictionary()
         self._threads: list[threading.Thread] = []
         self._closed = False
 
@@ -188,11 +211,8 @@ class JobPool:
         with self._cond:
             if self._closed:
                 raise JobRefused("The server is shutting down; the job was not started.")
-            running = self._pending.get(id(owner))
-            if running is not None:
-                raise SessionBusy(f"{running.what[:1].upper()}{running.what[1:]} is still running here; "
-                                  "wait for its result, then try again.")
             now = time.monotonic()
+            self._admit(owner, now)
             try:
                 last = self._last_result.get(owner)
             except TypeError:           # an owner that cannot be referenced weakly: always rested
@@ -208,6 +228,63 @@ class JobPool:
             self._cond.notify()
         future.add_done_callback(lambda f: self._drop_cancelled(job) if f.cancelled() else None)
         return future
+
+    def admit(self, owner: object) -> None:
+        """Refuse at once what :meth:`submit` would refuse for ``owner`` itself (its pending job,
+        its share used up), before a caller spends the event loop's time on taking a job.
+
+        Raises:
+            SessionBusy: ``owner`` has a job queued or running.
+            OverShare: ``owner``'s jobs used their share within the window; its message says
+                in how many seconds to try again.
+        """
+        with self._cond:
+            self._admit(owner, time.monotonic())
+
+    def _admit(self, owner: object, now: float) -> None:
+        running = self._pending.get(id(owner))
+        if running is not None:
+            raise SessionBusy(f"{running.what[:1].upper()}{running.what[1:]} is still running here; "
+                              "wait for its result, then try again.")
+        retry_in_s = self._retry_in_s(owner, now)
+        if retry_in_s > 0.0:
+            wait = max(1, math.ceil(retry_in_s))
+            raise OverShare(f"The server is busy with this browser's jobs: try again in {wait} s.", retry_in_s)
+
+    def _retry_in_s(self, owner: object, now: float) -> float:
+        """Seconds until ``owner`` has credit again (0: it has)."""
+        credit = self._credit_at(owner, now)
+        return 0.0 if credit > 0.0 else -credit / self.share + 1e-3
+
+    def _credit_at(self, owner: object, now: float) -> float:
+        """``owner``'s credit at ``now`` (full for an owner never counted or not weakly
+        referable)."""
+        try:
+            held = self._credit.get(owner)
+        except TypeError:
+            return self.burst_s
+        if held is None:
+            return self.burst_s
+        credit, when = held
+        return min(self.burst_s, credit + (now - when) * self.share)
+
+    def charge(self, owner: object, seconds: float) -> None:
+        """Count ``seconds`` of the event loop's time spent on ``owner``'s job-like work (e.g.
+        Auto-touch's motion and the re-render it ends in) against its credit, as a job's run."""
+        if seconds > 0.0:
+            with self._cond:
+                self._spend(owner, time.monotonic(), float(seconds))
+
+    def credit_s(self, owner: object) -> float:
+        """``owner``'s credit now (seconds; negative: refused for ``-credit / share`` s)."""
+        with self._cond:
+            return self._credit_at(owner, time.monotonic())
+
+    def _spend(self, owner: object, now: float, seconds: float) -> None:
+        try:
+            self._credit[owner] = (self._credit_at(owner, now) - seconds, now)
+        except TypeError:           # an owner that cannot be referenced weakly: not counted
+            pass
 
     def _drop_cancelled(self, job: _Job) -> None:
         """A job whose caller gave up before it started (its awaiting task was cancelled) leaves
@@ -269,6 +346,8 @@ class JobPool:
             self._pending.pop(id(job.owner), None)
             try:
                 self._last_result[job.owner] = job.finished_s
+                if job.started_s is not None:
+                    self._spend(job.owner, job.finished_s, job.finished_s - job.started_s)
             except TypeError:           # an owner that cannot be referenced weakly: no history
                 pass
             if self.history is not None and job.started_s is not None:

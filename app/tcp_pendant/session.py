@@ -65,6 +65,7 @@ import asyncio
 import functools
 import logging
 import threading
+import time
 from collections.abc import Callable, Coroutine, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
@@ -92,6 +93,7 @@ from tcp_pendant.pendant.exercise_rules import (
     check_tool_change,
 )
 from tcp_pendant.pendant.library_rights import UNRESTRICTED, LibraryRights
+from tcp_pendant.refusal_notices import RefusalNotices
 from tcp_pendant.wizards import Wizard, WizardResult, WizardStateError, wizard_class, wizard_classes
 
 if TYPE_CHECKING:
@@ -272,6 +274,8 @@ class Session:
         self._pending: SessionChange | None = None
         self._deferred: SessionChange | None = None    # jog presses' signal waiting for the loop's round
         self._deferred_signal: Callable[[], None] | None = None   # guard(_signal_deferred), made once
+        self.refusals = RefusalNotices()
+        """Which refusals of a click are shown (:meth:`notify_refusal`)."""
         self.library_tools: dict[int, Tool] = {}
         """The library's tools as this session last read them (slot -> tool)."""
         self.library_error: str | None = None
@@ -679,6 +683,13 @@ class Session:
             except Exception:  # the browser may have gone
                 log.debug("notification to a closed client dropped", exc_info=True)
 
+    def notify_refusal(self, title: str, body: str) -> None:
+        """A click refused at once, as a warning; coalesced per session (``refusal_notices``:
+        at most one every 2 s, the ones left out counted in the next)."""
+        shown = self.refusals.body(body)
+        if shown is not None:
+            self.notify(title, shown, kind="warning")
+
     def clients(self) -> list[viser.ClientHandle]:
         """The browser(s) that show this session: its own, or every browser of the shared GUI."""
         if self.client is not None:
@@ -930,14 +941,23 @@ class Session:
         view's words join its signal). A robot moved meanwhile records nothing
         (``autotouch.MOVED_DURING_PROBE``).
 
+        Its moves and the signals they end in count against the session's share of the job pool
+        (:meth:`charged`); a session whose share is used up is refused before anything moves.
+
         Raises:
-            JobRefused: this session's previous job still runs, or the queue is full.
+            JobRefused: this session's previous job still runs, its share is used up
+                (:meth:`admit_job`), or the queue is full.
             WizardStateError: as :meth:`auto_touch`; the calibration on show changed meanwhile.
         """
+        self.admit_job()
+        with self.lock:                 # refused by the state alone: nothing moved, nothing to show
+            why = self.workflow.auto_touch_refusal()
+        if why is not None:
+            raise WizardStateError(why)
         steps = self.workflow.auto_touch_steps(request)
 
         def advance(answer: str | None, first: bool) -> tuple[Callable[[], str | None] | None, Any]:
-            with self._wizard_command(moves=True):
+            with self.charged(), self._wizard_command(moves=True):
                 try:
                     return (next(steps) if first else steps.send(answer)), None
                 except StopIteration as stop:
@@ -1080,6 +1100,27 @@ class Session:
         added to the runs; returns its replay checks."""
         with self._wizard_command():
             return self.workflow.add_loaded(loaded)
+
+    def admit_job(self) -> None:
+        """Refuse at once a job this session may not start now (its previous job still runs, or
+        its jobs used their share of the server's time: ``JobPool.admit``), before the event
+        loop spends time on taking it.
+
+        Raises:
+            JobRefused: ``SessionBusy`` or ``OverShare``; the message says what to do.
+        """
+        self.jobs.admit(self)
+
+    @contextmanager
+    def charged(self) -> Iterator[None]:
+        """Count the event loop's time spent inside against this session's share of the job
+        pool (``JobPool.charge``): job-like work done on the loop (Auto-touch's motion, the
+        re-render its signal causes)."""
+        t0 = time.perf_counter()
+        try:
+            yield
+        finally:
+            self.jobs.charge(self, time.perf_counter() - t0)
 
     async def run_job(self, fn: Callable[[], R], *, what: str) -> R:
         """Run ``fn()``, a job detached from the session (its own copies of what it reads, taken

@@ -20,8 +20,18 @@ With ``--attack beam`` the attackers run the TCP service's beam check instead (a
 times longer than the victim's check): the victim then waits for the running scan, so its
 factor is about (scan + check) / check, the bound of a pool that does not interrupt a job.
 
+With ``--flood`` (issue 42, item 5; the rig of ``tests/security/browser_flood.py``) the attack
+is one attacker *browser* instead, in a process of its own, clicking Check, "Check active tool"
+and Auto-touch in turn as fast as its socket takes the clicks (``--rate`` clicks a second to
+pace it: the issue's browser made ~128), while the victim's browser presses X+ (``--presses``
+presses, 0.6 s apart, as the issue's 40 in 25 s) alone and under the attack, in alternating
+blocks in one run. Printed side by side: the victim's press-to-readout latency p50 / p95 / max
+and the presses the deadman dropped, baseline and attack, and the attack's p95 over the
+baseline's against the 1.5x target ("met" / "NOT MET").
+
 Run: ``PYTHONPATH=src:app .venv/bin/python tests/bench/bench_jobs.py [--checks N] [--workers W]
-[--attack check|beam]`` (about 30-90 s).
+[--attack check|beam]`` (about 30-90 s), or ``... bench_jobs.py --flood [--presses N] [--rate HZ]
+[--quick]`` (about 60 s for 40 presses; ``--quick``: 6 presses).
 """
 
 from __future__ import annotations
@@ -35,12 +45,15 @@ import numpy as np
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent / "security"))
+from browser_flood import FloodRig  # noqa: E402
 from job_attack import Classroom, Measured  # noqa: E402
 
 from tcp_pendant.job_pool import LOOP_SWITCH_INTERVAL_S, JobPool, default_workers  # noqa: E402
 
 
 PYTHON_DEFAULT_SWITCH_S = 0.005
+P95_TARGET = 1.5
+"""The victim's jog p95 under the browser flood over its baseline p95, at most (issue 42)."""
 
 
 def run(policy: str, checks: int, workers: int | None, attackers: int, attack: str,
@@ -58,6 +71,32 @@ def run(policy: str, checks: int, workers: int | None, attackers: int, attack: s
             rig.close()
 
 
+def flood(presses: int, rate_hz: float, block: int) -> bool:
+    """The browser flood (module docstring): prints the figures side by side; True when the
+    p95 target is met and no press was dropped."""
+    with tempfile.TemporaryDirectory() as tmp:
+        rig = FloodRig(Path(tmp), JobPool(keep_history=True), rate_hz=rate_hz)
+        try:
+            base, under = rig.measure(presses=presses, block=block)
+            shown = len(rig.attacker_notes)                 # every notification its browser was sent
+            refusals = len(rig.attacker_refusals) or shown   # a server without coalescing: one per refusal
+            jobs = len(rig.attacker_jobs())
+        finally:
+            rig.close()
+    pace = "as fast as its socket takes them" if rate_hz <= 0 else f"{rate_hz:.0f} a second"
+    print(f"one attacker browser clicking Check / Check active tool / Auto-touch, {pace}: {rig.clicks} clicks "
+          f"sent, {jobs} of its jobs ran, {refusals} clicks refused in words ({shown} notices shown)")
+    print(f"{'victim jog (press to readout)':32s} {'p50':>7s} {'p95':>7s} {'max':>7s} {'answered':>9s} {'dropped':>8s}")
+    for label, p in (("baseline", base), ("attack", under)):
+        print(f"{label:32s} {p.p(50) * 1e3:5.0f}ms {p.p(95) * 1e3:5.0f}ms {max(p.latencies, default=float('nan')) * 1e3:5.0f}ms "
+              f"{len(p.latencies):>4d}/{p.n:<4d} {p.dropped:>8d}")
+    ratio = under.p(95) / base.p(95)
+    met = ratio <= P95_TARGET and under.dropped == 0
+    print(f"RESULT flood: attack p95 / baseline p95 = {ratio:.2f}x (target <= {P95_TARGET}x, none dropped): "
+          f"{'met' if met else 'NOT MET'}")
+    return met
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--checks", type=int, default=10, help="victim checks alone and under attack (default 10)")
@@ -65,7 +104,17 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--attackers", type=int, default=20)
     ap.add_argument("--attack", choices=("check", "beam"), default="check",
                     help="the attackers' job: the TCP check (default) or the beam check (longer)")
+    ap.add_argument("--flood", action="store_true",
+                    help="the browser flood of issue 42 (one attacker browser clicking job buttons)")
+    ap.add_argument("--presses", type=int, default=40, help="--flood: the victim's presses alone and under attack")
+    ap.add_argument("--rate", type=float, default=0.0,
+                    help="--flood: the attacker's clicks a second (default 0: as fast as its socket takes them)")
+    ap.add_argument("--quick", action="store_true", help="--flood: 6 presses (a smoke run)")
     args = ap.parse_args(argv)
+    if args.flood:
+        presses = 6 if args.quick else args.presses
+        flood(presses, args.rate, block=3 if args.quick else 5)
+        return 0
     print(f"{args.attackers} attacker sessions resubmitting {'TCP' if args.attack == 'check' else 'beam'} checks; "
           f"the victim runs its TCP check {args.checks} times alone, then under attack\n")
     runs = {"fair": ("fair", LOOP_SWITCH_INTERVAL_S), "fair, 5 ms switch": ("fair", PYTHON_DEFAULT_SWITCH_S),

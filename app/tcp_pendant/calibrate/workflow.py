@@ -636,6 +636,23 @@ class CalibrationWorkflow:
         """:meth:`auto_touch_steps` with each pose probe run in place."""
         return run_probes(self.auto_touch_steps(request))
 
+    def auto_touch_refusal(self) -> str | None:
+        """Why Auto-touch is refused in the state as it is (training mode off, the wizard on show
+        finished or cancelled), in the words :meth:`auto_touch_steps` raises; None when only
+        trying tells. Reads, changes nothing: a caller refuses the click without a signal."""
+        if not self.training:
+            return "Auto-touch is a training-mode tool; switch training mode on."
+        rules = getattr(self.state, "rules", None)
+        if rules is not None:
+            try:
+                rules.check_auto_touch()
+            except ValueError:          # the exercise's refusal comes first: trying says it
+                return None
+        w = self.wizard
+        if w is not None and w.status != "in_progress":
+            return f"Cannot auto-touch: {w.blocked_reason}"
+        return None
+
     def auto_touch_steps(self, request: AutoTouchRequest) -> Generator[PoseProbe, str | None, AutoTouchOutcome]:
         """Training mode: let the controller perform the current step (mounting the tool it
         needs), record it and go on; after the last step the result is computed (unless the

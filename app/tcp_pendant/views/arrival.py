@@ -43,10 +43,20 @@ _WAITED_S = 0.0005
 """A poll that took longer than this waited for data (one that finds data ready takes microseconds)."""
 
 _ARRIVED: contextvars.ContextVar[float | None] = contextvars.ContextVar("tcp_pendant_arrived_s", default=None)
+_NOT_AFTER: contextvars.ContextVar[float | None] = contextvars.ContextVar("tcp_pendant_not_after_s", default=None)
 _polls: weakref.WeakKeyDictionary[asyncio.AbstractEventLoop, collections.deque[tuple[float, float]]] = (
     weakref.WeakKeyDictionary())
 _lock = threading.Lock()
 _installed = False
+
+
+def stamp_not_after(t: float | None) -> None:
+    """The next messages this task decodes are stamped no later than ``t`` (monotonic s; None:
+    from the polls alone). The reader of a connection past its pace (``views.viser_adapter``,
+    ``message_rate``) reads it slowly, so its messages wait unseen in the socket: it stamps
+    them long ago, and a flood's presses are stale to the deadman instead of fresh when their
+    turn comes."""
+    _NOT_AFTER.set(t)
 
 
 def arrived_s() -> float | None:
@@ -111,7 +121,8 @@ def install() -> bool:
 
         def deserialize(cls: type, message: bytes) -> Any:
             decoded = original(cls, message)
-            _ARRIVED.set(_stamp())
+            ceiling = _NOT_AFTER.get()
+            _ARRIVED.set(_stamp() if ceiling is None else min(_stamp(), ceiling))
             return decoded
 
         Message.deserialize = classmethod(deserialize)  # type: ignore[method-assign,assignment]

@@ -347,15 +347,22 @@ class ToolPanel:
         """Run the TCP check of ``which()`` (title, tool): the job is taken under the session
         lock on the loop, the six rotations run in the server's job pool (``Session.run_job``),
         the result is shown on the loop. One check at a time per session (one job of any kind:
-        the pool refuses another meanwhile, in words); errors become one notification."""
+        the pool refuses another meanwhile, in words, and a session whose jobs used their share of
+        the server's time: ``Session.admit_job``, before the job is taken); the loop's work on
+        it counts against that share (``Session.charged``); errors become one notification."""
         s = self.session
         if s.closed:
             return
         if self._checking:
-            s.notify("Check running", "A TCP check is still running here; wait for its result.", kind="info")
+            s.notify_refusal("Check running", "A TCP check is still running here; wait for its result.")
+            return
+        try:                           # refused at once, before the loop takes the job
+            s.admit_job()
+        except JobRefused as exc:
+            s.notify_refusal("Check not started", str(exc))
             return
         try:
-            with s.lock:
+            with s.charged(), s.lock:
                 title, tool = which()
                 if s.rules.in_exercise:                 # read against the spike, as on a robot
                     check_readable(s.pose_state().touch.distance_mm)
@@ -371,7 +378,7 @@ class ToolPanel:
         except JobRefused as exc:      # this session's other job, or a full queue: nothing ran
             with s.lock:
                 self.check_md.content = shown
-            s.notify("Check not started", str(exc), kind="warning")
+            s.notify_refusal("Check not started", str(exc))
             return
         except Exception as exc:  # a browser's click must never kill the server
             log.exception("TCP check failed")
@@ -379,7 +386,7 @@ class ToolPanel:
             return
         finally:
             self._checking = False
-        with s.lock:
+        with s.charged(), s.lock:
             if s.closed:
                 return
             self.last_check = (job, result)

@@ -21,7 +21,9 @@ network. What this module reaches into, and why:
   its handlers in a task of its own, with no check of the values' types; a bad message raised in
   that task ("Task exception was never retrieved", quoting the value) or, when it could not
   even be decoded, closed the sender's socket. :func:`install` wraps viser's message consumer
-  (``infra._infra._message_consumer``: a frame that does not decode is dropped) and
+  (``infra._infra._message_consumer``: a frame that does not decode is dropped, and each
+  connection is read at most at the pace of ``message_rate.MessagePacer``, a paced one in
+  small reads, asyncio's transport's ``max_size``) and
   ``WebsockMessageHandler._handle_incoming_message`` (each message is checked, then its
   handlers run under one ``try``): :func:`message_refusal` checks every field against the
   message class's annotations (types, finite numbers), refuses the share-URL requests (a
@@ -72,6 +74,9 @@ from collections.abc import Callable
 from typing import Any
 
 import msgspec
+
+from tcp_pendant.message_rate import MessagePacer
+from tcp_pendant.views import arrival
 
 __all__ = ["LOG_VALUE_CHARS", "MAX_ABS_NUMBER", "MAX_TEXT_CHARS", "UploadHook", "UploadLimits",
            "ViserInternalsChanged", "gui_value_refusal", "install", "listen_reuse_port", "message_refusal", "path_counts",
@@ -705,6 +710,26 @@ _install_lock = threading.Lock()
 _installed = False
 
 
+PACED_READ_BYTES = 4096
+"""What a paced connection's transport reads from its socket at once (asyncio's default 256 kB
+holds thousands of small messages, all parsed in one callback of the loop: measured 40-120 ms
+stalls of every other browser)."""
+
+
+PACED_AGE_S = 60.0
+"""How old a message of a flooding connection counts for the deadman (``arrival``,
+``message_rate.MessagePacer.flooding``): read slowly, its messages sat in the socket for an
+unknown time, so its jog presses are dropped, not carried out seconds after its last one."""
+
+
+def _read_in_small_chunks(websocket: Any) -> None:
+    """Read a paced connection at most :data:`PACED_READ_BYTES` at a time (asyncio's selector
+    transport's ``max_size``; nothing when the transport differs)."""
+    transport = getattr(websocket, "transport", None)
+    if transport is not None and isinstance(getattr(transport, "max_size", None), int):
+        transport.max_size = PACED_READ_BYTES
+
+
 def install() -> None:
     """Check and guard every message viser receives, in this process (idempotent; see the
     module docstring)."""
@@ -731,8 +756,15 @@ def install() -> None:
 
         async def message_consumer(websocket: Any, handle_message: Callable[[Any], None],
                                    message_class: Any) -> None:
+            pacer = MessagePacer()                 # this connection's pace (``message_rate``)
             while True:
                 raw = await websocket.recv()
+                wait_s = pacer.delay_s()
+                if wait_s > 0.0:                   # its reading waits: the sender's socket fills
+                    if pacer.paced == 1:
+                        _read_in_small_chunks(websocket)
+                    await asyncio.sleep(wait_s)
+                arrival.stamp_not_after(time.monotonic() - PACED_AGE_S if pacer.flooding else None)
                 try:
                     if not isinstance(raw, bytes):
                         raise TypeError("a text frame; viser speaks binary msgpack")

@@ -187,7 +187,9 @@ class WizardStepsView:
 
     async def _on_auto_touch(self, _event: ButtonEvent) -> None:
         """Auto-touch (``Session.auto_touch_in_pool``: the probes of a TCP check's poses run in
-        the job pool); one at a time per session, the outcome shown in one signal at the end."""
+        the job pool, the moves count against the session's share of it); one at a time per
+        session, refused at once while the session's job runs or its share is used up
+        (``Session.admit_job``), the outcome shown in one signal at the end."""
         session = self.parent.session
         if session.closed:
             return
@@ -196,8 +198,13 @@ class WizardStepsView:
         running = session.jobs.pending(session) if probes else None
         if self._auto_touching or running is not None:
             what = "Auto-touch" if self._auto_touching else running
-            session.notify("Auto-touch not started", f"{str(what)[:1].upper()}{str(what)[1:]} is still running "
-                           "here; wait for its result, then try again.", kind="warning")
+            session.notify_refusal("Auto-touch not started", f"{str(what)[:1].upper()}{str(what)[1:]} is still "
+                                   "running here; wait for its result, then try again.")
+            return
+        try:                                    # refused at once, before anything moves
+            session.admit_job()
+        except JobRefused as exc:
+            session.notify_refusal("Auto-touch not started", str(exc))
             return
         try:
             request = self.auto_request()
@@ -207,8 +214,11 @@ class WizardStepsView:
         self._auto_touching = True
         try:
             await session.auto_touch_in_pool(request, shown=lambda out: self._show_auto_touch(out, request))
-        except ValueError as exc:               # the wizard's or the pool's words (JobRefused)
-            session.notify("Not done", str(exc), kind="warning")
+        except JobRefused as exc:
+            session.notify_refusal("Auto-touch not started", str(exc))
+            return
+        except ValueError as exc:               # the wizard's words
+            session.notify_refusal("Not done", str(exc))
             return
         except Exception as exc:                # a browser's click must never kill the server
             log.exception("Auto-touch failed")
