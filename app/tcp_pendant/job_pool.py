@@ -11,6 +11,17 @@ The rules (what bounds the harm one browser can do to another):
 * **one job per session**: a session (the pool's ``owner``) has at most one job queued or
   running; a second submit while one is pending is refused with :class:`SessionBusy`
   ("A TCP check is still running here ..."), whatever kind of job it is;
+* **a share per session**: a session's jobs draw on a credit of ``burst_s`` (:data:`BURST_S`,
+  0.25 s) of run time that refills at ``share`` (:data:`SHARE`, 0.1) seconds per second: on
+  average a tenth of one worker, in bursts of a quarter second (a trainee's two or three TCP
+  checks in a row). A job is admitted while the credit is positive and costs its whole run, so a
+  job longer than the credit (a beam scan, a record's grading) leaves a debt that refills at the
+  same pace: after a 1 s scan the session waits about 7.5 s. A job's work on viser's event
+  loop (a TCP check's setup and the result it shows) is charged to the same credit
+  (:meth:`JobPool.charge`). With no credit left a submit is refused at once with :class:`OverShare` ("The server is busy with
+  this browser's jobs: try again in 3 s"), and the views ask first (:meth:`JobPool.admit`), so
+  a refused click costs the loop no job setup; the session's refusal notices are coalesced
+  (``refusal_notices``);
 * **a bounded queue**: at most ``max_queued`` jobs of busy sessions wait (twice as many in
   all, so a resting trainee is not refused because others keep the pool busy); beyond it a
   submit is refused with :class:`PoolFull` ("The server is busy ...");
@@ -88,7 +99,7 @@ LOOP_SWITCH_INTERVAL_S = 0.001
 SHARE = 0.1
 """The part of one worker's time one session's jobs (and the loop work charged to it,
 :meth:`JobPool.charge`) may use on average: its credit refills at this many seconds per second."""
-BURST_S = 1.0
+BURST_S = 0.25
 """A session's credit when full (seconds of jobs it may run back to back)."""
 
 
@@ -270,7 +281,7 @@ class JobPool:
 
     def charge(self, owner: object, seconds: float) -> None:
         """Count ``seconds`` of the event loop's time spent on ``owner``'s job-like work (e.g.
-        Auto-touch's motion and the re-render it ends in) against its credit, as a job's run."""
+        a TCP check's setup and the result it shows) against its credit, as a job's run."""
         if seconds > 0.0:
             with self._cond:
                 self._spend(owner, time.monotonic(), float(seconds))

@@ -941,8 +941,11 @@ class Session:
         view's words join its signal). A robot moved meanwhile records nothing
         (``autotouch.MOVED_DURING_PROBE``).
 
-        Its moves and the signals they end in count against the session's share of the job pool
-        (:meth:`charged`); a session whose share is used up is refused before anything moves.
+        Refused before anything moves while this session's job runs or its share of the job pool
+        is used up (:meth:`admit_job`), and without a signal when the state alone refuses it
+        (training off, the wizard finished: ``CalibrationWorkflow.auto_touch_refusal``). Its
+        moves are not charged to the share: a wizard has a few steps, and a trainee clicks
+        Auto-touch once per step, a whole calibration in a few seconds.
 
         Raises:
             JobRefused: this session's previous job still runs, its share is used up
@@ -957,7 +960,7 @@ class Session:
         steps = self.workflow.auto_touch_steps(request)
 
         def advance(answer: str | None, first: bool) -> tuple[Callable[[], str | None] | None, Any]:
-            with self.charged(), self._wizard_command(moves=True):
+            with self._wizard_command(moves=True):
                 try:
                     return (next(steps) if first else steps.send(answer)), None
                 except StopIteration as stop:
@@ -1114,8 +1117,8 @@ class Session:
     @contextmanager
     def charged(self) -> Iterator[None]:
         """Count the event loop's time spent inside against this session's share of the job
-        pool (``JobPool.charge``): job-like work done on the loop (Auto-touch's motion, the
-        re-render its signal causes)."""
+        pool (``JobPool.charge``): a job's work done on the loop (a TCP check's setup and the
+        result it shows)."""
         t0 = time.perf_counter()
         try:
             yield

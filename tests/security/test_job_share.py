@@ -1,5 +1,5 @@
 """The rules that keep one browser's clicks from slowing another's, one by one (no server):
-a session's share of the job pool (``JobPool``: a credit of 1 s refilling at a tenth of a
+a session's share of the job pool (``JobPool``: a credit of 0.25 s refilling at a tenth of a
 second per second, refused at once beyond it), its refusal notices coalesced
 (``refusal_notices``) and each connection's messages paced (``message_rate``)."""
 
@@ -26,7 +26,7 @@ class Clock:
 
 
 def test_the_servers_share_is_a_tenth_of_a_worker_in_bursts_of_a_second() -> None:
-    assert (SHARE, BURST_S) == (0.1, 1.0)
+    assert (SHARE, BURST_S) == (0.1, 0.25)
     pool = JobPool(workers=1)
     assert (pool.share, pool.burst_s) == (SHARE, BURST_S)
 

@@ -120,12 +120,19 @@ class BeamCheckView:
             self._failed("Beam check failed", f"{type(exc).__name__}: {exc}", kind="error")
 
     async def run_check(self) -> None:
-        """The check of the active tool: job on the loop, scan in the worker, result on the loop."""
+        """The check of the active tool: job on the loop, scan in the worker, result on the loop;
+        refused at once while this session's job runs or its share is used up
+        (``Session.admit_job``)."""
         s = self.session
         if s.closed:
             return
         if self._checking:
-            s.notify("Check running", "A beam check is still running here; wait for its result.", kind="info")
+            s.notify_refusal("Check running", "A beam check is still running here; wait for its result.")
+            return
+        try:                               # refused at once, before the loop takes the job
+            s.admit_job()
+        except JobRefused as exc:
+            s.notify_refusal("Beam check not started", str(exc))
             return
         try:
             with s.lock:

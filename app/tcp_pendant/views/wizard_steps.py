@@ -187,7 +187,7 @@ class WizardStepsView:
 
     async def _on_auto_touch(self, _event: ButtonEvent) -> None:
         """Auto-touch (``Session.auto_touch_in_pool``: the probes of a TCP check's poses run in
-        the job pool, the moves count against the session's share of it); one at a time per
+        the job pool); one at a time per
         session, refused at once while the session's job runs or its share is used up
         (``Session.admit_job``), the outcome shown in one signal at the end."""
         session = self.parent.session
