@@ -42,6 +42,21 @@ share the pool first come, first served with the other rested sessions, and the 
 refuses the excess. ``tests/security/test_job_pool.py`` proves it with 20 attacking sessions,
 ``tests/bench/bench_jobs.py`` prints the latencies.
 
+One browser flooding the pool (issue 42: Check, "Check active tool" and Auto-touch clicked in
+turn as fast as it can; the rig of ``tests/security/browser_flood.py``, ``bench_jobs.py
+--flood``: another browser's X+ press to the readout showing the move, 40 presses alone and 40
+under the flood, interleaved in blocks, 2 shared cores, one worker). Without the share the one
+worker ran the attacker's checks back to back, holding the GIL against the loop, and every
+refused click cost the loop a notification (and a refused Auto-touch a re-render of the
+Calibrate tab): at 128 clicks a second the victim's p95 went from 22 to 60 ms (2.75x), as fast
+as the socket allows every press was dropped. With the share, the refusals coalesced and the
+connection's messages paced (``message_rate``): at 128 clicks a second p95 25 against 26 ms and
+25 against 25 ms (1.05x, 1.01x), as fast as the socket allows 23 against 31 ms and 23 against
+29 ms (1.33x, 1.26x), none dropped; with a credit of 1 s instead of 0.25 s, 1.7-1.9x at 128 a
+second. ``tests/security/test_browser_flood.py`` proves the behaviour (every press carried out,
+the attacker refused in words, the victim's check behind no job of the attacker's but the one
+running).
+
 Threads, not processes: the jobs are numpy / pinocchio code driven from Python (per sub-step
 IK, small arrays) that holds the GIL most of the time, so a second worker thread adds little
 throughput and takes GIL time from viser's event loop (the jogs) and from the job running

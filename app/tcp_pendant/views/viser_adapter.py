@@ -22,8 +22,8 @@ network. What this module reaches into, and why:
   that task ("Task exception was never retrieved", quoting the value) or, when it could not
   even be decoded, closed the sender's socket. :func:`install` wraps viser's message consumer
   (``infra._infra._message_consumer``: a frame that does not decode is dropped, and each
-  connection is read at most at the pace of ``message_rate.MessagePacer``, a paced one in
-  small reads, asyncio's transport's ``max_size``) and
+  connection is read at most at the pace of ``message_rate.MessagePacer``, in reads of at most
+  :data:`READ_BYTES`, asyncio's transport's ``max_size``) and
   ``WebsockMessageHandler._handle_incoming_message`` (each message is checked, then its
   handlers run under one ``try``): :func:`message_refusal` checks every field against the
   message class's annotations (types, finite numbers), refuses the share-URL requests (a
@@ -710,10 +710,10 @@ _install_lock = threading.Lock()
 _installed = False
 
 
-PACED_READ_BYTES = 4096
-"""What a paced connection's transport reads from its socket at once (asyncio's default 256 kB
-holds thousands of small messages, all parsed in one callback of the loop: measured 40-120 ms
-stalls of every other browser)."""
+READ_BYTES = 16384
+"""What a connection's transport reads from its socket at once (asyncio's default 256 kB holds
+thousands of small messages, all parsed in one callback of the loop: measured 40-120 ms stalls
+of every other browser while one client flooded)."""
 
 
 PACED_AGE_S = 60.0
@@ -723,11 +723,11 @@ unknown time, so its jog presses are dropped, not carried out seconds after its 
 
 
 def _read_in_small_chunks(websocket: Any) -> None:
-    """Read a paced connection at most :data:`PACED_READ_BYTES` at a time (asyncio's selector
-    transport's ``max_size``; nothing when the transport differs)."""
+    """Read a connection at most :data:`READ_BYTES` at a time (asyncio's selector transport's
+    ``max_size``; nothing when the transport differs)."""
     transport = getattr(websocket, "transport", None)
     if transport is not None and isinstance(getattr(transport, "max_size", None), int):
-        transport.max_size = PACED_READ_BYTES
+        transport.max_size = READ_BYTES
 
 
 def install() -> None:
@@ -757,12 +757,11 @@ def install() -> None:
         async def message_consumer(websocket: Any, handle_message: Callable[[Any], None],
                                    message_class: Any) -> None:
             pacer = MessagePacer()                 # this connection's pace (``message_rate``)
+            _read_in_small_chunks(websocket)
             while True:
                 raw = await websocket.recv()
                 wait_s = pacer.delay_s()
                 if wait_s > 0.0:                   # its reading waits: the sender's socket fills
-                    if pacer.paced == 1:
-                        _read_in_small_chunks(websocket)
                     await asyncio.sleep(wait_s)
                 arrival.stamp_not_after(time.monotonic() - PACED_AGE_S if pacer.flooding else None)
                 try:
