@@ -52,6 +52,8 @@ from tcp_pendant.job_pool import LOOP_SWITCH_INTERVAL_S, JobPool, default_worker
 
 
 PYTHON_DEFAULT_SWITCH_S = 0.005
+RIG_BURST_S = 60.0
+"""The pool's credit per session in the 20-session rig (``JobPool``'s ``burst_s``)."""
 P95_TARGET = 1.5
 """The victim's jog p95 under the browser flood over its baseline p95, at most (issue 42)."""
 
@@ -61,7 +63,10 @@ def run(policy: str, checks: int, workers: int | None, attackers: int, attack: s
     """One rig with a pool of ``policy`` ("fair": the server's; "fifo": first come, first
     served), at Python thread switch interval ``switch_interval_s`` (set after the server's
     start, which sets its own)."""
-    pool = JobPool(workers, keep_history=True) if policy == "fair" else JobPool(workers, rest_s=0.0, keep_history=True)
+    # the victim's checks come back to back (a script's pace): a credit that holds them all, so
+    # this measures the order rule (the share per session is --flood's)
+    pool = (JobPool(workers, keep_history=True, burst_s=RIG_BURST_S) if policy == "fair"
+            else JobPool(workers, rest_s=0.0, keep_history=True, burst_s=RIG_BURST_S))
     with tempfile.TemporaryDirectory() as tmp:
         rig = Classroom(Path(tmp), pool, attackers=attackers, attack=attack)
         sys.setswitchinterval(switch_interval_s)

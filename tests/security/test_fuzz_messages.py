@@ -9,6 +9,7 @@ import logging
 import math
 import random
 import sys
+import time
 from pathlib import Path
 from typing import Any
 
@@ -109,6 +110,7 @@ def test_fuzzed_messages_leave_no_traceback_and_the_socket_open(app: PendantApp,
         moves: list[int] = []
         session.add_motion_listener(lambda: moves.append(1))
         refused_before = message_counts().get("refused", 0)
+        t0 = time.monotonic()
         with caplog.at_level(logging.WARNING):
             for m in messages:
                 client.send(m)
@@ -116,6 +118,9 @@ def test_fuzzed_messages_leave_no_traceback_and_the_socket_open(app: PendantApp,
             # handled in order, so every fuzzed one was handled before it)
             client.send({"type": "GuiUpdateMessage", "uuid": client.uuid_of("X +"), "updates": {"value": True}})
             wait_until(lambda: len(moves) > 0, what="the jog behind the fuzzed messages")
+        # the connection is read at its pace (``message_rate``: 200 a second), so the flood spans
+        # several of the log's windows; each window logs at most its budget per sender (two here)
+        windows = math.ceil((time.monotonic() - t0) / LOG_BUDGET[1]) + 1
         assert not client.closed.is_set()
         after = _values(app)
         after.pop(client.uuid_of("X +"))                     # the click's own value (True)
@@ -130,7 +135,8 @@ def test_fuzzed_messages_leave_no_traceback_and_the_socket_open(app: PendantApp,
         assert message_counts().get("refused", 0) - refused_before == len(messages) - 1
         assert message_counts().get("failed", 0) == 0
         logged = [r.getMessage() for r in caplog.records if r.name.endswith("viser_adapter")]
-        assert LOG_BUDGET[0] <= len(logged) <= 2 * LOG_BUDGET[0]     # a flood is not logged line by line
+        assert LOG_BUDGET[0] <= len(logged) <= 2 * LOG_BUDGET[0] * windows   # not logged line by line
+        assert len(logged) < len(messages) / 5
         longest = max(len(r.getMessage()) for r in caplog.records)
         assert longest < 2 * LOG_VALUE_CHARS + 200, max((r.getMessage() for r in caplog.records), key=len)[:400]
     finally:
