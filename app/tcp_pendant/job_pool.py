@@ -40,16 +40,18 @@ longest a browser can start: a beam scan, up to about a second; a TCP check 0.03
 browser can defeat it only by pacing many sessions at ``rest_s`` or more apart; they then
 share the pool first come, first served with the other rested sessions, and the bounded queue
 refuses the excess. ``tests/security/test_job_pool.py`` proves it with 20 attacking sessions,
-``tests/bench/bench_jobs.py`` prints the latencies.
+``tests/bench/bench_jobs.py`` prints the latencies (that rig's victim checks back to back, at a
+script's pace: its pool gives every session a credit of 60 s, so it measures the order alone).
 
 One browser flooding the pool (issue 42: Check, "Check active tool" and Auto-touch clicked in
 turn as fast as it can; the rig of ``tests/security/browser_flood.py``, ``bench_jobs.py
 --flood``: another browser's X+ press to the readout showing the move, 40 presses alone and 40
-under the flood, interleaved in blocks, 2 shared cores, one worker). Without the share the one
-worker ran the attacker's checks back to back, holding the GIL against the loop, and every
-refused click cost the loop a notification (and a refused Auto-touch a re-render of the
-Calibrate tab): at 128 clicks a second the victim's p95 went from 22 to 60 ms (2.75x), as fast
-as the socket allows every press was dropped. With the share, the refusals coalesced and the
+under the flood, interleaved in blocks, 2 shared cores, one worker). Without the share, the
+refusal rules and the pace, the one worker runs the attacker's checks back to back, holding the
+GIL against the loop, and every refused click costs the loop a notification (a refused
+Auto-touch a re-render of the Calibrate tab): measured at 128 clicks a second, the victim's p95
+22 ms alone and 60 ms under the flood (2.75x); as fast as the socket allows, every press
+dropped. With the share, the refusals coalesced and the
 connection's messages paced (``message_rate``): at 128 clicks a second p95 25 against 26 ms and
 25 against 25 ms (1.05x, 1.01x), as fast as the socket allows 23 against 31 ms and 23 against
 29 ms (1.33x, 1.26x), none dropped; with a credit of 1 s instead of 0.25 s, 1.7-1.9x at 128 a

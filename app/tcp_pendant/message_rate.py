@@ -3,9 +3,10 @@
 viser reads each websocket connection in a task of its own and starts a task per message; a
 client that sends as fast as its socket takes the messages (a script clicking a button, tens of
 thousands of messages a second) fills the event loop with its tasks, and every other browser's
-message waits behind them: measured (``tests/bench/bench_jobs.py``, one such client clicking
-Check / Check active tool / Auto-touch, cheap refusals), another trainee's jog press to its
-readout went from p50 21 ms to 490 ms, 13 of 20 presses dropped by the deadman.
+message waits behind them: measured without a pace (``tests/bench/bench_jobs.py --flood``, one
+such client clicking Check / Check active tool / Auto-touch, cheap refusals), another trainee's
+jog press to its readout p50 21 ms alone and 490 ms under the flood, 13 of 20 presses dropped
+by the deadman.
 
 The rule (:class:`MessagePacer`, one per connection, applied where viser reads the connection:
 ``views.viser_adapter.install``): a connection's messages are handled at most ``rate_hz``
