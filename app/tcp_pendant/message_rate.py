@@ -42,10 +42,6 @@ class MessagePacer:
 
     Attributes:
         paced: messages that had to wait so far.
-        flooding: the connection went beyond its pace and its bucket has not filled up since
-            (it stayed quiet for less than ``burst / rate_hz`` seconds in all): its messages
-            may have waited in the socket for seconds, so a jog press of it is stale
-            (``views.viser_adapter`` stamps it so for the deadman).
     """
 
     def __init__(self, rate_hz: float = RATE_HZ, burst: int = BURST,
@@ -59,18 +55,13 @@ class MessagePacer:
         self._tokens = self.burst
         self._last = clock()
         self.paced = 0
-        self.flooding = False
 
     def delay_s(self) -> float:
         """Take one message: the seconds its handling must wait (0: none)."""
         now = self._clock()
-        refilled = self._tokens + (now - self._last) * self.rate_hz
-        if refilled >= self.burst:
-            self.flooding = False
-        self._tokens = min(self.burst, refilled) - 1.0
+        self._tokens = min(self.burst, self._tokens + (now - self._last) * self.rate_hz) - 1.0
         self._last = now
         if self._tokens >= 0.0:
             return 0.0
         self.paced += 1
-        self.flooding = True
         return -self._tokens / self.rate_hz

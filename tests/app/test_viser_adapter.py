@@ -108,6 +108,7 @@ def test_a_jog_over_the_websocket_takes_the_fast_paths_only(app_factory) -> None
                                 done=lambda: path_counts().get(("pose", "fast"), 0) > 0)
         wait_until(lambda: path_counts().get(("markdown", "fast"), 0) > 0, what="the jog's readout")
         assert not [k for k in path_counts() if k[1] == "fallback"]
+        assert path_counts().get(("unread", "fast"), 0) > 0          # each press stamped from its backlog
         assert s.controller.T_world_tcp()[0, 3] != 0.0
     finally:
         client.close()
@@ -135,7 +136,7 @@ def test_a_fallback_warns_once_and_uses_the_public_setters(monkeypatch, caplog) 
     assert h.content == "b" and h.wxyz == [0.0, 0.0, 1.0, 0.0]
     assert path_counts() == {("markdown", "fallback"): 2, ("pose", "fallback"): 1}
     warnings = [r.getMessage() for r in caplog.records]
-    assert len(warnings) == 2 and "markdown uses viser's public setters" in warnings[0]
+    assert len(warnings) == 2 and "markdown takes its fallback" in warnings[0]
 
 
 def test_the_scene_pose_sender_falls_back_to_the_public_setters(monkeypatch) -> None:

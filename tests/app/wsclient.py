@@ -8,6 +8,7 @@ import re
 import socket
 import threading
 import time
+import typing
 from collections.abc import Callable
 from typing import Any
 
@@ -46,7 +47,11 @@ def loop_ran_for(loop: asyncio.AbstractEventLoop, seconds: float, timeout: float
         raise AssertionError(f"timed out waiting for the server's loop to run {seconds} s on")
 
 
-def click_until_carried_out(client: ButtonClient, label: str, gate: Any, done: Callable[[], bool], *,
+class _Clicks(typing.Protocol):
+    def click(self, label: str) -> None: ...
+
+
+def click_until_carried_out(client: _Clicks, label: str, gate: Any, done: Callable[[], bool], *,
                             what: str, clicks: int = 5, timeout: float = 20.0) -> int:
     """Click ``label`` and wait until ``done()``. A click the server's deadman dropped (``gate``:
     the session's ``PressGate``; its loop reached the click more than ``PRESS_BOUND_S`` late, e.g.
@@ -288,6 +293,10 @@ class InputsClient:
     def uuid_of(self, label: str) -> str:
         """The uuid of the input labelled ``label``."""
         return next(u for u, (_, lab, _) in self.inputs.items() if lab == label)
+
+    def click(self, label: str) -> None:
+        """Click the button labelled ``label`` as a browser does."""
+        self.send({"type": "GuiUpdateMessage", "uuid": self.uuid_of(label), "updates": {"value": True}})
 
     def labels(self) -> set[str]:
         return {lab for _, lab, _ in self.inputs.values()}

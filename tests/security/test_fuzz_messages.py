@@ -19,7 +19,7 @@ from tcp_pendant.server import AppConfig, PendantApp
 from tcp_pendant.views.viser_adapter import LOG_BUDGET, LOG_VALUE_CHARS, message_counts
 
 sys.path.insert(0, str(Path(__file__).parents[1] / "app"))
-from wsclient import CAMERA, InputsClient, wait_until  # noqa: E402
+from wsclient import CAMERA, InputsClient, click_until_carried_out, wait_until  # noqa: E402
 
 HUGE = "x" * 100_000
 
@@ -114,10 +114,13 @@ def test_fuzzed_messages_leave_no_traceback_and_the_socket_open(app: PendantApp,
         with caplog.at_level(logging.WARNING):
             for m in messages:
                 client.send(m)
-            # the same socket, after every fuzzed message: a click still jogs (messages are
-            # handled in order, so every fuzzed one was handled before it)
-            client.send({"type": "GuiUpdateMessage", "uuid": client.uuid_of("X +"), "updates": {"value": True}})
-            wait_until(lambda: len(moves) > 0, what="the jog behind the fuzzed messages")
+            # the same socket, once every fuzzed message was handled, still jogs. (A click sent
+            # right behind them would wait in the socket while the paced flood is read, and the
+            # deadman drops a press that old: ``views.arrival``.)
+            wait_until(lambda: message_counts().get("refused", 0) - refused_before >= len(messages) - 1,
+                       timeout=60.0, what="every fuzzed message handled")
+            click_until_carried_out(client, "X +", session.jogger.gate, lambda: len(moves) > 0,
+                                    what="the jog behind the fuzzed messages")
         # the connection is read at its pace (``message_rate``: 200 a second), so the flood spans
         # several of the log's windows; each window logs at most its budget per sender (two here)
         windows = math.ceil((time.monotonic() - t0) / LOG_BUDGET[1]) + 1

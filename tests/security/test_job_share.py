@@ -5,12 +5,14 @@ second per second, refused at once beyond it), its refusal notices coalesced
 
 from __future__ import annotations
 
+import collections
 import time
 
 import pytest
 from tcp_pendant.job_pool import BURST_S, SHARE, JobPool, OverShare, SessionBusy
 from tcp_pendant.message_rate import MessagePacer
 from tcp_pendant.refusal_notices import RefusalNotices
+from tcp_pendant.views.arrival import ArrivalFloor, earliest_from_polls
 
 
 class Owner:
@@ -95,12 +97,20 @@ def test_a_connections_messages_wait_beyond_its_burst_at_its_pace() -> None:
         MessagePacer(rate_hz=0.0)
 
 
-def test_a_connection_past_its_pace_floods_until_its_bucket_is_full_again() -> None:
-    clock = Clock()
-    pacer = MessagePacer(rate_hz=500.0, burst=10, clock=clock)
-    assert [pacer.delay_s() for _ in range(10)] == [0.0] * 10 and not pacer.flooding
-    assert pacer.delay_s() > 0.0 and pacer.flooding                     # past its pace
-    clock.t += 0.01                                                     # 5 tokens back: still flooding,
-    assert pacer.delay_s() == 0.0 and pacer.flooding                    # though not held back
-    clock.t += 10.0                                                     # quiet until full: a browser again
-    assert pacer.delay_s() == 0.0 and not pacer.flooding
+def test_a_backlogged_connections_messages_keep_the_stamp_of_the_first_one_read_caught_up() -> None:
+    floor = ArrivalFloor()
+    assert floor.stamp(False, 10.0) == 10.0                             # asked while caught up: its own
+    assert floor.stamp(True, 12.0) == 10.0                              # already waiting: no later than
+    assert floor.stamp(True, 30.0) == 10.0                              # the one before it, however late
+    assert floor.stamp(True, 9.5) == 9.5                                # a lower bound from the polls wins
+    assert floor.stamp(False, 31.0) == 31.0                             # caught up again: fresh
+    assert ArrivalFloor().stamp(True, 5.0) == 5.0                       # a first message in a backlog
+
+
+def test_the_polls_bound_a_messages_arrival_by_the_poll_that_read_it() -> None:
+    assert earliest_from_polls([(0.0, 0.1)], 5.0) == 5.0                # too few polls known: now
+    waited = collections.deque([(0.0, 1.0), (1.0, 2.0), (2.0, 2.0001)], maxlen=3)   # as the adapter keeps
+    assert earliest_from_polls(waited, 5.0) == 2.0                      # them; poll j-1 waited: its end
+    at_once = [(0.0, 1.0), (3.0, 3.0001), (4.0, 4.0001)]                # j-1 returned at once: j-2's end
+    assert earliest_from_polls(at_once, 5.0) == 1.0
+    assert earliest_from_polls(at_once, 0.5) == 0.5                     # never later than now

@@ -1,130 +1,81 @@
 """When a browser's message reached the server (monotonic s), for callbacks that must not act
-on stale input (the pendant's deadman, ``pendant.jogging.PressGate``).
+on stale input (the pendant's deadman, ``pendant.jogging.PressGate``). No private API here: the
+hooks that feed this module are in ``views.viser_adapter``.
 
-viser reads each websocket message in a per-connection task, decodes it
-(``Message.deserialize``) and starts a task per handler (``create_task``), which copies the
-reading task's context; the GUI callbacks then run in those tasks, one after the other, when
-the event loop reaches them. Under load that is long after the message came in. :func:`install`
-wraps viser's decoder so that every decoded message sets the context variable behind
-:func:`arrived_s` in the reading task; the handler tasks made for that message inherit it, so a
-callback reads the arrival of the very message it handles (not the time it runs).
+viser reads each websocket connection in a task of its own and starts a task per handler
+(``create_task``), which copies the reading task's context; the GUI callbacks run in those
+tasks, one after the other, when the event loop reaches them. Under load that is long after the
+message came in. The reading task (``viser_adapter.install``) sets the context variable behind
+:func:`arrived_s` to the message's stamp before it hands the message on, so a callback reads the
+arrival of the very message it handles, not the time it runs.
 
-The decoder runs only when the event loop gets round to the socket, so a message may already
-have waited there while the loop was busy. The stamp is therefore not the decoding time but the
-earliest time the message can have arrived, from the loop's own polls of its sockets (its
-selector, wrapped on the first message; each poll's start and end are kept): a message decoded
-in the loop's iteration ``j`` was read by poll ``j - 1``. If that poll waited (it returned when
-data came), everything it returned arrived as it returned; if it returned at once, the data came
-in after the end of poll ``j - 2``. The stamp is that time: not later than the real arrival (but
-for the microseconds of a wake-up),
-the safe side for a deadman (a press that may be stale counts as stale), and on an idle loop the
-arrival itself.
+The stamp is the *earliest* time the message can have arrived: a press that may be stale counts
+as stale, the safe side for a deadman. Two lower bounds, the smaller of which is taken:
 
-Falls back to "now" (no hook) if viser's internals differ; the deadman then measures the wait
-on the loop only.
+* **The loop's polls** (:func:`earliest_from_polls`): the loop reads a socket only when it gets
+  round to it, so a message may have waited there while the loop was busy. Of the loop's polls
+  of its sockets (their starts and ends), a message read in the loop's iteration ``j`` came in
+  poll ``j - 1``: if that poll waited (it returned when data came), the message arrived as it
+  returned; if it returned at once, the data came in after the end of poll ``j - 2``.
+* **The connection's backlog** (:class:`ArrivalFloor`): a connection read at a pace
+  (``message_rate``) leaves its later messages in the socket, where no poll sees them. A message
+  that was already received when its connection's reader asked for it arrived after the
+  message before it, so it is stamped no later than that one; a message asked for while nothing
+  of the connection was unread arrived after the asking. A flood's presses thus keep the stamp of
+  the flood's start and are dropped by the deadman, and the first press after the backlog is
+  read is fresh again.
 """
 
 from __future__ import annotations
 
-import asyncio
-import collections
 import contextvars
-import logging
-import threading
-import time
-import weakref
-from typing import Any
+from collections.abc import Sequence
 
-__all__ = ["arrived_s", "install"]
+__all__ = ["WAITED_S", "ArrivalFloor", "arrived_s", "earliest_from_polls", "set_arrived"]
 
-log = logging.getLogger(__name__)
-
-_WAITED_S = 0.0005
-"""A poll that took longer than this waited for data (one that finds data ready takes microseconds)."""
+WAITED_S = 0.0005
+"""A poll that took longer than this (s) waited for data (one that finds data ready takes microseconds)."""
 
 _ARRIVED: contextvars.ContextVar[float | None] = contextvars.ContextVar("tcp_pendant_arrived_s", default=None)
-_NOT_AFTER: contextvars.ContextVar[float | None] = contextvars.ContextVar("tcp_pendant_not_after_s", default=None)
-_polls: weakref.WeakKeyDictionary[asyncio.AbstractEventLoop, collections.deque[tuple[float, float]]] = (
-    weakref.WeakKeyDictionary())
-_lock = threading.Lock()
-_installed = False
-
-
-def stamp_not_after(t: float | None) -> None:
-    """The next messages this task decodes are stamped no later than ``t`` (monotonic s; None:
-    from the polls alone). The reader of a connection past its pace (``views.viser_adapter``,
-    ``message_rate``) reads it slowly, so its messages wait unseen in the socket: it stamps
-    them long ago, and a flood's presses are stale to the deadman instead of fresh when their
-    turn comes."""
-    _NOT_AFTER.set(t)
 
 
 def arrived_s() -> float | None:
     """Arrival (``time.monotonic()`` s, the earliest possible) of the browser message whose
-    callback is running, or None outside such a callback (or without the hook)."""
+    callback is running, or None outside such a callback (or when viser's internals differ)."""
     return _ARRIVED.get()
 
 
-class _TimedSelector:
-    """The loop's selector, keeping the start and end (monotonic s) of its last three polls."""
-
-    def __init__(self, inner: Any, polls: collections.deque[tuple[float, float]]) -> None:
-        self._inner = inner
-        self._polls = polls
-
-    def select(self, timeout: float | None = None) -> Any:
-        t0 = time.monotonic()
-        try:
-            return self._inner.select(timeout)
-        finally:
-            self._polls.append((t0, time.monotonic()))
-
-    def __getattr__(self, name: str) -> Any:
-        return getattr(self._inner, name)
+def set_arrived(t: float | None) -> None:
+    """Stamp the messages the current task hands on from now (``viser_adapter``'s reader)."""
+    _ARRIVED.set(t)
 
 
-def _stamp() -> float:
-    now = time.monotonic()
-    try:
-        loop = asyncio.get_running_loop()
-    except RuntimeError:
-        return now
-    polls = _polls.get(loop)
-    if polls is None:                          # first message on this loop: time its polls
-        polls = collections.deque(maxlen=3)
-        _polls[loop] = polls
-        selector = getattr(loop, "_selector", None)
-        if selector is not None and callable(getattr(selector, "select", None)):
-            loop._selector = _TimedSelector(selector, polls)  # type: ignore[attr-defined]
-        else:
-            log.warning("event loop without a selector: jog presses are timed from their decoding")
-        return now
+def earliest_from_polls(polls: Sequence[tuple[float, float]], now: float) -> float:
+    """The earliest arrival (monotonic s) of data read from a socket now, from the loop's last
+    three polls (start, end; the oldest first): ``end[j-1]`` if poll ``j - 1`` waited longer
+    than :data:`WAITED_S`, else ``end[j-2]``; ``now`` with fewer than three polls known."""
     if len(polls) < 3:
         return now
-    (_, end_before), (start_read, end_read), _ = polls   # polls j - 2, j - 1 (read it) and j
-    return min(now, end_read if end_read - start_read > _WAITED_S else end_before)
+    (_, end_before), (start_read, end_read) = polls[-3], polls[-2]
+    return min(now, end_read if end_read - start_read > WAITED_S else end_before)
 
 
-def install() -> bool:
-    """Wrap viser's message decoder to stamp arrivals (idempotent; any thread). Returns False
-    when viser's internals are not as expected (then :func:`arrived_s` stays None)."""
-    global _installed
-    with _lock:
-        if _installed:
-            return True
-        try:
-            from viser.infra._messages import Message
-            original: Any = Message.__dict__["deserialize"].__func__
-        except (ImportError, KeyError, AttributeError):
-            log.warning("viser's message decoder not found: jog presses are timed from their callback")
-            return False
+class ArrivalFloor:
+    """The backlog bound of one connection's stamps (module docstring).
 
-        def deserialize(cls: type, message: bytes) -> Any:
-            decoded = original(cls, message)
-            ceiling = _NOT_AFTER.get()
-            _ARRIVED.set(_stamp() if ceiling is None else min(_stamp(), ceiling))
-            return decoded
+    Call :meth:`stamp` once per message, in the order they are read, with whether anything of
+    the connection was unread when the reader asked for this message and the message's stamp
+    from the polls.
+    """
 
-        Message.deserialize = classmethod(deserialize)  # type: ignore[method-assign,assignment]
-        _installed = True
-        return True
+    def __init__(self) -> None:
+        self._floor: float | None = None
+
+    def stamp(self, backlog: bool, from_polls: float) -> float:
+        """The message's stamp (monotonic s): ``from_polls`` when the reader was caught up,
+        else no later than the stamp of the message before it."""
+        if not backlog or self._floor is None:
+            self._floor = from_polls
+        else:
+            self._floor = min(from_polls, self._floor)
+        return self._floor

@@ -155,7 +155,6 @@ class PendantPanel:
         self._hold: HoldDriver | None = None
         self._drop_report_due = False
         self._drop_reported_at = -math.inf          # monotonic s of the last drop report
-        arrival.install()
 
         st = session.jogger.settings
         self._readout = "WORLD"

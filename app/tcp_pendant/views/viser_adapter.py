@@ -23,7 +23,11 @@ network. What this module reaches into, and why:
   even be decoded, closed the sender's socket. :func:`install` wraps viser's message consumer
   (``infra._infra._message_consumer``: a frame that does not decode is dropped, and each
   connection is read at most at the pace of ``message_rate.MessagePacer``, in reads of at most
-  :data:`READ_BYTES`, asyncio's transport's ``max_size``) and
+  :data:`READ_BYTES`, asyncio's transport's ``max_size``; each message is stamped with its
+  earliest arrival for the deadman, ``views.arrival``, from the event loop's polls, timed by
+  wrapping asyncio's ``loop._selector``, and from what of the connection was still unread when
+  it was asked for: websockets' ``recv_messages.frames`` and ``protocol.reader.buffer`` and the
+  kernel's ``FIONREAD``) and
   ``WebsockMessageHandler._handle_incoming_message`` (each message is checked, then its
   handlers run under one ``try``): :func:`message_refusal` checks every field against the
   message class's annotations (types, finite numbers), refuses the share-URL requests (a
@@ -52,18 +56,23 @@ it stamps: ``_owner_id``) / ``_websock_interface``, ``Message.redundancy_key`` (
 ``_cached_redundancy_key``),
 the scene handle's ``_impl`` (``name``, ``wxyz``, ``position``, ``api``),
 ``WebsockMessageHandler._handle_incoming_message`` / ``_incoming_handlers``,
-``infra._infra._message_consumer`` (its signature and its ``deserialize`` call), the message
+``infra._infra._message_consumer`` (its signature and its ``deserialize`` call), websockets'
+``ServerConnection.recv_messages.frames`` / ``protocol.reader.buffer`` / ``transport``, the message
 classes named below, and the props classes' ``min`` / ``max`` / ``options`` / ``disabled``.
 """
 
 from __future__ import annotations
 
+import array
 import asyncio
+import collections
 import dataclasses
+import fcntl
 import logging
 import math
 import os
 import re
+import termios
 import threading
 import time
 import types
@@ -143,8 +152,9 @@ def _fallback(path: str, exc: BaseException) -> bool:
         raise ViserInternalsChanged(f"viser fast path {path!r} fell back: {type(exc).__name__}: {exc}") from exc
     if path not in _warned:
         _warned.add(path)
-        log.warning("viser's internals differ (%s: %s): %s uses viser's public setters from now on "
-                    "(slower); see tcp_pendant.views.viser_adapter", type(exc).__name__, exc, path)
+        log.warning("viser's internals differ (%s: %s): %s takes its fallback from now on (viser's public "
+                    "setters, slower; for \"unread\", jog presses timed by the loop's polls only); see "
+                    "tcp_pendant.views.viser_adapter", type(exc).__name__, exc, path)
     return False
 
 
@@ -716,10 +726,60 @@ thousands of small messages, all parsed in one callback of the loop: measured 40
 of every other browser while one client flooded)."""
 
 
-PACED_AGE_S = 60.0
-"""How old a message of a flooding connection counts for the deadman (``arrival``,
-``message_rate.MessagePacer.flooding``): read slowly, its messages sat in the socket for an
-unknown time, so its jog presses are dropped, not carried out seconds after its last one."""
+class _TimedSelector:
+    """An event loop's selector, keeping the start and end (monotonic s) of its last three polls
+    (``arrival.earliest_from_polls``)."""
+
+    def __init__(self, inner: Any, polls: collections.deque[tuple[float, float]]) -> None:
+        self._inner = inner
+        self._polls = polls
+
+    def select(self, timeout: float | None = None) -> Any:
+        t0 = time.monotonic()
+        try:
+            return self._inner.select(timeout)
+        finally:
+            self._polls.append((t0, time.monotonic()))
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._inner, name)
+
+
+_loop_polls: weakref.WeakKeyDictionary[asyncio.AbstractEventLoop, collections.deque[tuple[float, float]]] = (
+    weakref.WeakKeyDictionary())
+
+
+def _polls_of(loop: asyncio.AbstractEventLoop) -> collections.deque[tuple[float, float]]:
+    """The running loop's last polls, timed from the first call on (asyncio's ``loop._selector``,
+    private: a loop without one is never timed, and its messages are stamped when read)."""
+    polls = _loop_polls.get(loop)
+    if polls is None:
+        polls = collections.deque(maxlen=3)
+        _loop_polls[loop] = polls
+        selector = getattr(loop, "_selector", None)
+        if selector is not None and callable(getattr(selector, "select", None)):
+            loop._selector = _TimedSelector(selector, polls)  # type: ignore[attr-defined]
+        else:
+            log.warning("event loop without a selector: jog presses are timed from their reading")
+    return polls
+
+
+def _unread(websocket: Any) -> int | None:
+    """What a connection has received and not yet given out as messages: frames in websockets'
+    queue (``recv_messages.frames``), bytes in its parser (``protocol.reader.buffer``) and bytes
+    in the kernel's socket buffer (``FIONREAD``). 0: the next message is still to come. None
+    when websockets' internals differ."""
+    try:
+        frames = len(websocket.recv_messages.frames)
+        parsing = len(websocket.protocol.reader.buffer)
+        sock = websocket.transport.get_extra_info("socket")
+        kernel = array.array("i", [0])
+        fcntl.ioctl(sock.fileno(), termios.FIONREAD, kernel)
+    except (AttributeError, TypeError, ValueError, OSError) as exc:
+        _fallback("unread", exc)
+        return None
+    _fast("unread")
+    return frames + parsing + int(kernel[0])
 
 
 def _read_in_small_chunks(websocket: Any) -> None:
@@ -757,13 +817,18 @@ def install() -> None:
         async def message_consumer(websocket: Any, handle_message: Callable[[Any], None],
                                    message_class: Any) -> None:
             pacer = MessagePacer()                 # this connection's pace (``message_rate``)
+            floor = arrival.ArrivalFloor()         # its backlog's bound on arrivals (``arrival``)
+            polls = _polls_of(asyncio.get_running_loop())
             _read_in_small_chunks(websocket)
+            wait_s = 0.0
             while True:
+                unread = _unread(websocket)
+                backlog = unread > 0 if unread is not None else wait_s > 0.0
                 raw = await websocket.recv()
+                arrival.set_arrived(floor.stamp(backlog, arrival.earliest_from_polls(polls, time.monotonic())))
                 wait_s = pacer.delay_s()
                 if wait_s > 0.0:                   # its reading waits: the sender's socket fills
                     await asyncio.sleep(wait_s)
-                arrival.stamp_not_after(time.monotonic() - PACED_AGE_S if pacer.flooding else None)
                 try:
                     if not isinstance(raw, bytes):
                         raise TypeError("a text frame; viser speaks binary msgpack")
