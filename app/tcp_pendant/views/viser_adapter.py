@@ -772,9 +772,10 @@ def _unread(websocket: Any) -> int | None:
     try:
         frames = len(websocket.recv_messages.frames)
         parsing = len(websocket.protocol.reader.buffer)
-        sock = websocket.transport.get_extra_info("socket")
+        fd = websocket.transport.get_extra_info("socket").fileno()
         kernel = array.array("i", [0])
-        fcntl.ioctl(sock.fileno(), termios.FIONREAD, kernel)
+        if fd >= 0:                                # -1: closed, nothing more will come
+            fcntl.ioctl(fd, termios.FIONREAD, kernel)
     except (AttributeError, TypeError, ValueError, OSError) as exc:
         _fallback("unread", exc)
         return None
