@@ -82,7 +82,7 @@ def seeded_figures() -> CaptionFigures:
     clicks from random directions with ``SIGMA_MM`` operator error.
     """
     from tcp_pendant.calibrate.workflow import AutoTouchRequest
-    from tcp_pendant.server import AppConfig, PendantApp
+    from tcp_pendant.serve.server import AppConfig, PendantApp
 
     with tempfile.TemporaryDirectory() as tmp:
         app = PendantApp(AppConfig(tool_library=Path(tmp) / "tools.json", seed=SEED))
@@ -195,7 +195,7 @@ def main() -> None:
     args = parser.parse_args()
     from playwright.sync_api import sync_playwright
 
-    from tcp_pendant.server import AppConfig, PendantApp
+    from tcp_pendant.serve.server import AppConfig, PendantApp
 
     expected = seeded_figures()
     args.out_dir.mkdir(parents=True, exist_ok=True)

@@ -2,6 +2,6 @@
 
 import sys
 
-from tcp_pendant.cli import main
+from tcp_pendant.serve.cli import main
 
 sys.exit(main())

@@ -15,7 +15,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).parents[1] / "calibrate"))
 from guiclick import choose, click  # noqa: E402
-from tcp_pendant.server import AppConfig, PendantApp  # noqa: E402
+from tcp_pendant.serve.server import AppConfig, PendantApp  # noqa: E402
 from tcpcal.tool import Tool  # noqa: E402
 from wsclient import DrainingClient, wait_until  # noqa: E402
 

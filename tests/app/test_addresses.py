@@ -5,9 +5,9 @@ from __future__ import annotations
 
 import pytest
 
-from tcp_pendant import addresses
-from tcp_pendant.addresses import interface_addresses, network_urls, usable_address
-from tcp_pendant.cli import ready_urls
+from tcp_pendant.serve import addresses
+from tcp_pendant.serve.addresses import interface_addresses, network_urls, usable_address
+from tcp_pendant.serve.cli import ready_urls
 
 MACHINE = ["127.0.0.1", "192.168.1.20", "fe80::1%eth0", "::1", "2001:db8::5", "10.0.0.7", "169.254.3.3",
            "0.0.0.0"]

@@ -1,4 +1,4 @@
-"""The ``--workers`` connection balance (``tcp_pendant.balance``) on real listening sockets of one
+"""The ``--workers`` connection balance (``tcp_pendant.serve.balance``) on real listening sockets of one
 ``SO_REUSEPORT`` group in this process: the order of listening gives the indices, the program
 the record chooses sends every new connection to the listener with the fewest sessions, and
 turning it off gives the connections back to the kernel's hash."""
@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from tcp_pendant.balance import Balance, BalanceFile
+from tcp_pendant.serve.balance import Balance, BalanceFile
 
 pytestmark = [pytest.mark.skipif(not sys.platform.startswith("linux"), reason="SO_ATTACH_REUSEPORT_CBPF is Linux's"),
               pytest.mark.shares_cpu]
@@ -113,7 +113,7 @@ def test_a_worker_that_stops_while_the_class_runs_turns_the_balance_off(tmp_path
     worker exits by itself, and not when the class is being stopped."""
     import subprocess
 
-    from tcp_pendant.workers import Workers
+    from tcp_pendant.serve.workers import Workers
 
     record = BalanceFile.create(tmp_path / "balance.json", 2)
     balance = Balance(record, pid=1)

@@ -200,7 +200,7 @@ def test_an_unexpected_failure_is_one_notification_and_the_view_stays_usable(pag
 
 def test_shared_mode_checks_and_updates_the_one_robot(tmp_path: Path) -> None:
     from guiclick import click
-    from tcp_pendant.server import AppConfig, PendantApp
+    from tcp_pendant.serve.server import AppConfig, PendantApp
     from wsclient import DrainingClient
 
     app = PendantApp(AppConfig(port=0, tool_library=tmp_path / "tools.json", shared=True, library_poll_s=0.1))

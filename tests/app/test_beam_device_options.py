@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 
 from tcp_pendant.calibrate.beam_service import beam_check_job
-from tcp_pendant.cli import build_parser, main
+from tcp_pendant.serve.cli import build_parser, main
 from tcp_pendant.controller import BeamDevice, ControllerError
-from tcp_pendant.server import AppConfig, PendantApp
+from tcp_pendant.serve.server import AppConfig, PendantApp
 from tcpcal.tool import Tool
 
 

@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from tcp_pendant.classroom.gradebook import CSV_COLUMNS, Gradebook
-from tcp_pendant.cli import build_parser, main
+from tcp_pendant.serve.cli import build_parser, main
 
 
 def _book_with_one_row(path: Path) -> None:
@@ -67,7 +67,7 @@ def test_parser_knows_the_classroom_options() -> None:
 def test_the_class_is_opt_in(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """Without --class (or a class option) no gradebook is opened and no name is asked; with
     --class the default gradebook path is used."""
-    import tcp_pendant.server as server
+    import tcp_pendant.serve.server as server
 
     seen: list[object] = []
 
@@ -97,7 +97,7 @@ def test_the_exercise_seed_is_the_classs_unless_given_and_never_printed(tmp_path
     from types import SimpleNamespace
 
     from tcp_pendant.classroom.class_room import ClassRoom
-    from tcp_pendant.cli import _class_lines
+    from tcp_pendant.serve.cli import _class_lines
 
     assert build_parser().parse_args(["--exercise", "mystery"]).exercise_seed is None
     with Gradebook(tmp_path / "class.sqlite3") as book:
@@ -129,7 +129,7 @@ def test_the_ready_message_names_a_postgresql_gradebook_without_its_password(pos
 
     from tcp_pendant.classroom.class_room import ClassRoom
     from tcp_pendant.classroom.gradebook_db import mask_url
-    from tcp_pendant.cli import _class_lines
+    from tcp_pendant.serve.cli import _class_lines
 
     url = postgres_server.fresh_schema()
     with Gradebook(url) as book:

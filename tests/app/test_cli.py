@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from tcp_pendant.cli import build_parser, main
-from tcp_pendant.server import is_loopback, parse_xyz_mm, ready_configuration
+from tcp_pendant.serve.cli import build_parser, main
+from tcp_pendant.serve.server import is_loopback, parse_xyz_mm, ready_configuration
 
 
 def test_defaults() -> None:
@@ -38,7 +38,7 @@ def test_ready_pose_points_flange_down(kr6) -> None:
 
 
 def test_network_warning_only_off_loopback() -> None:
-    from tcp_pendant.cli import network_warning
+    from tcp_pendant.serve.cli import network_warning
 
     assert network_warning("127.0.0.1") is None and network_warning("localhost") is None
     text = network_warning("0.0.0.0")
@@ -94,7 +94,7 @@ def test_command_serves_prints_the_url_and_stops_on_ctrl_c(tmp_path, host: str, 
         url = re.search(r"http://\S+", line).group(0)
         urls = [url]
         if host == "0.0.0.0":                 # the URLs trainees can open, not 127.0.0.1
-            from tcp_pendant.addresses import interface_addresses
+            from tcp_pendant.serve.addresses import interface_addresses
 
             assert proc.stdout is not None
             more = proc.stdout.readline()

@@ -1,4 +1,4 @@
-"""The page's own script as the server serves it (``tcp_pendant.client_script``): viser's
+"""The page's own script as the server serves it (``tcp_pendant.serve.client_script``): viser's
 index.html with one script tag, the one static file at its one path, 404 (and no file read) for
 anything else under /tcp-pendant/, the origin check in front of it all unchanged; the printed
 trainer URL; the hints and the Keys line that name the keys."""
@@ -19,10 +19,10 @@ from typing import Any
 import msgspec.msgpack
 import pytest
 import viser
-from tcp_pendant import client_script, origin_check
-from tcp_pendant.cli import _class_lines
-from tcp_pendant.client_script import SCRIPT_PATH, SCRIPT_TAG, inject_script_tag, is_index_path
-from tcp_pendant.server import AppConfig, PendantApp
+from tcp_pendant.serve import client_script, origin_check
+from tcp_pendant.serve.cli import _class_lines
+from tcp_pendant.serve.client_script import SCRIPT_PATH, SCRIPT_TAG, inject_script_tag, is_index_path
+from tcp_pendant.serve.server import AppConfig, PendantApp
 from tcp_pendant.views.pendant_panel import INCREMENT_KEYS, KEYS_LINE, jog_key_hint
 from viser import _messages
 from websockets.datastructures import Headers
@@ -34,7 +34,7 @@ sys.path.insert(0, str(Path(__file__).parent))
 from wsclient import wait_until  # noqa: E402
 
 VISER_INDEX = (Path(viser.__file__).parent / "client" / "build" / "index.html").read_bytes()
-PACKAGED_JS = (resources.files("tcp_pendant") / "static" / "pendant.js").read_bytes()
+PACKAGED_JS = (resources.files("tcp_pendant.serve") / "static" / "pendant.js").read_bytes()
 
 
 @pytest.fixture

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 from tcp_pendant.calibrate import AutoTouchRequest
 from tcp_pendant.controller import JogFrame, builtin_tools, example_robot_urdf
-from tcp_pendant.server import MIN_TIP_HEIGHT_M
+from tcp_pendant.serve.server import MIN_TIP_HEIGHT_M
 
 sys.path.insert(0, str(Path(__file__).parent))
 from conftest import wait_until

@@ -224,7 +224,7 @@ def test_no_start_is_a_whole_number_of_millimetres_from_the_reference_tip(robot:
     from tcp_pendant.controller import RobotKinematics, builtin_tools
     from tcp_pendant.controller.pose_state import pose_state, pose_state_key
     from tcp_pendant.pendant.guidance import tip_offset_mm
-    from tcp_pendant.server import default_reference_tip_mm, ready_configuration, resolve_robot
+    from tcp_pendant.serve.server import default_reference_tip_mm, ready_configuration, resolve_robot
 
     kin = RobotKinematics.from_urdf(resolve_robot(robot))
     tip_m = np.asarray(default_reference_tip_mm(kin)) / 1000.0

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from tcp_pendant.cli import main
+from tcp_pendant.serve.cli import main
 from tcpcal.cli import main as tcpcal_main
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "controller_files"

@@ -15,7 +15,7 @@ sys.path.insert(0, str(Path(__file__).parents[1] / "calibrate"))
 from guiclick import choose, click  # noqa: E402
 from wsclient import DrainingClient, wait_until  # noqa: E402
 
-from tcp_pendant.cli import build_parser
+from tcp_pendant.serve.cli import build_parser
 from tcp_pendant.controller.readout import PoseReadout
 from tcp_pendant.views.presenter import (
     CHART_HEIGHT_PX,

@@ -21,10 +21,10 @@ from app_page import AppPage, app_pages  # noqa: E402
 
 from tcpcal.tool import Tool  # noqa: E402
 from tcp_pendant.calibrate.workflow import AutoTouchRequest  # noqa: E402
-from tcp_pendant.cli import SCENARIO_CHOICES, build_parser  # noqa: E402
+from tcp_pendant.serve.cli import SCENARIO_CHOICES, build_parser  # noqa: E402
 from tcp_pendant.controller import ControllerError, builtin_tools, reference_tip_model  # noqa: E402
 from tcp_pendant.controller.scenarios import SCENARIO_KINDS, explain  # noqa: E402
-from tcp_pendant.server import AppConfig, PendantApp  # noqa: E402
+from tcp_pendant.serve.server import AppConfig, PendantApp  # noqa: E402
 from tcp_pendant.session import SessionChange  # noqa: E402
 from tcp_pendant.text_escape import escape_markdown  # noqa: E402
 from tcp_pendant.views.scenario_panel import SCENARIO_CHOICES as PANEL_CHOICES  # noqa: E402

@@ -1,12 +1,12 @@
 """The server process sets its start-up objects apart from the cyclic collector
-(``tcp_pendant.cli.set_apart_startup_objects``)."""
+(``tcp_pendant.serve.cli.set_apart_startup_objects``)."""
 
 from __future__ import annotations
 
 import gc
 import weakref
 
-from tcp_pendant.cli import set_apart_startup_objects
+from tcp_pendant.serve.cli import set_apart_startup_objects
 
 
 def test_start_up_objects_are_frozen_and_garbage_is_collected_first() -> None:

@@ -23,7 +23,7 @@ from guiclick import click  # noqa: E402
 from wsclient import DrainingClient, wait_until  # noqa: E402
 
 from tcp_pendant.controller import builtin_tools  # noqa: E402
-from tcp_pendant.server import AppConfig, PendantApp  # noqa: E402
+from tcp_pendant.serve.server import AppConfig, PendantApp  # noqa: E402
 from tcp_pendant.text_escape import escape_markdown  # noqa: E402
 from tcp_pendant.views.tool_panel import CONTROLLER_FILE_REFUSED  # noqa: E402
 from tcp_pendant.views.touch_list import TOUCHES_FILENAME, touches_csv_text  # noqa: E402

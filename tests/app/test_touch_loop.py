@@ -33,7 +33,7 @@ from wsclient import ButtonClient, loop_ran_for, wait_until  # noqa: E402
 
 from tcp_pendant.pendant.guidance import tip_offset_mm  # noqa: E402
 from tcp_pendant.pendant.jogging import LINEAR_SPEED_MM_S  # noqa: E402
-from tcp_pendant.server import PendantApp  # noqa: E402
+from tcp_pendant.serve.server import PendantApp  # noqa: E402
 from tcp_pendant.views.pendant_panel import HOLD_HZ, MARK  # noqa: E402
 from tcp_pendant.calibrate.diversity import best_tilt, best_tilt_words  # noqa: E402
 from tcp_pendant.text_escape import escape_html  # noqa: E402

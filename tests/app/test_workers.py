@@ -1,5 +1,5 @@
 """``tcp-pendant --workers 2``: two real server processes on one port. The browsers are spread
-over both, each new one to the process with fewer (``tcp_pendant.balance``; each process's pid
+over both, each new one to the process with fewer (``tcp_pendant.serve.balance``; each process's pid
 is in the gradebook's presence table, ``holder``), and the jog deadman holds in each."""
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ import pytest
 sys.path.insert(0, str(Path(__file__).parent))
 from async_clients import PLUS, READOUT_LABEL, TOKEN_LABEL, connect_all  # noqa: E402
 
-from tcp_pendant.balance import BalanceFile
+from tcp_pendant.serve.balance import BalanceFile
 from tcp_pendant.classroom.gradebook import Gradebook
 from tcp_pendant.classroom.trainer_token import lock_s
 

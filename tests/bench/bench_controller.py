@@ -14,7 +14,7 @@ Prints the median time (us) of, for each built-in robot (KR 6 R900, GP12):
 4. one ``auto_approach`` (IK from the current configuration, typical demo call);
 5. the server CPU of one pendant jog increment as the app runs it (``Jogger.key`` -> the
    controller's ``jog_cartesian`` -> ``jog.follow_path``), on the app's KR 6 with the pointer
-   (TCP = flange, the reference tip and ready pose of ``tcp_pendant.server``): 0.1 mm in WORLD
+   (TCP = flange, the reference tip and ready pose of ``tcp_pendant.serve.server``): 0.1 mm in WORLD
    (the class's "X +"), BASE (rotated) and TOOL, 1 mm, 1 deg and 0.1 deg rotations, and the
    torch's tool data active; against a baseline measured in the same run, ABAB: the jog as it
    was before the per-step speed work (``jog_yardstick.py``: the same math without the kept
@@ -122,7 +122,7 @@ INCREMENT_CASES = (  # (label, frame, axis, increment, torch tool data active)
 
 def _app_jogger(kin: RobotKinematics, legacy: bool, frame: str, increment: str, torch_data: bool) -> Jogger:
     """A pendant's jogger on a controller built as ``PendantApp.new_controller`` builds it."""
-    from tcp_pendant.server import default_reference_tip_mm, ready_configuration  # viser: only here
+    from tcp_pendant.serve.server import default_reference_tip_mm, ready_configuration  # viser: only here
 
     pointer = builtin_tools()["pointer"]
     tip_m = np.asarray(default_reference_tip_mm(kin, np.asarray(pointer.T_flange_tool_true)), dtype=float) / 1000.0

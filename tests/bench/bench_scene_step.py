@@ -45,7 +45,7 @@ from wsclient import DrainingClient, wait_until  # noqa: E402
 import tcp_pendant.session as session_module  # noqa: E402
 from tcp_pendant.controller.pose_state import pose_state as new_pose_state  # noqa: E402
 from tcp_pendant.controller.pose_state import pose_state_key as new_pose_state_key  # noqa: E402
-from tcp_pendant.server import AppConfig, PendantApp  # noqa: E402
+from tcp_pendant.serve.server import AppConfig, PendantApp  # noqa: E402
 
 PARTS = ("pose state", "scene")
 

@@ -502,7 +502,7 @@ class Rig:
     """
 
     def __init__(self, n: int, tmp: Path, class_db: Path | None = None) -> None:
-        from tcp_pendant.server import AppConfig, PendantApp
+        from tcp_pendant.serve.server import AppConfig, PendantApp
 
         tmp.mkdir(parents=True, exist_ok=True)
         self.app = PendantApp(AppConfig(port=free_port(), tool_library=tmp / "tools.json", class_db=class_db))

@@ -55,7 +55,7 @@ sys.path.insert(0, str(HERE.parent / "calibrate"))
 from guiclick import choose, click  # noqa: E402
 from wsclient import DrainingClient, wait_until  # noqa: E402
 
-from tcp_pendant.server import AppConfig, PendantApp  # noqa: E402
+from tcp_pendant.serve.server import AppConfig, PendantApp  # noqa: E402
 from tcp_pendant.views.pendant_panel import MARK  # noqa: E402
 from tcp_pendant.views.wizard_dock import FINISH, NEXT  # noqa: E402
 

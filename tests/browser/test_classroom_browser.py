@@ -99,7 +99,7 @@ def test_the_browser_key_is_kept_in_local_storage_across_a_reload_and_a_restart(
     and after a server restart on the same gradebook her page joins by itself as Anna: the
     script sends the key back. The server runs in this process (the same port after the
     restart: localStorage belongs to the page's origin)."""
-    from tcp_pendant.server import AppConfig, PendantApp
+    from tcp_pendant.serve.server import AppConfig, PendantApp
 
     db = tmp_path / "class.sqlite3"
 

@@ -1,4 +1,4 @@
-"""The page's own script in chromium (``static/pendant.js``, ``tcp_pendant.client_script``):
+"""The page's own script in chromium (``serve/static/pendant.js``, ``tcp_pendant.serve.client_script``):
 keyboard shortcuts that click the pendant's buttons, the trainee's name remembered across a
 reload, the trainer view opened from ``/?trainer=TOKEN``, and "Shadows" off in a browser that
 draws WebGL in software.
@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
-from tcp_pendant.server import PendantApp
+from tcp_pendant.serve.server import PendantApp
 
 sys.path.insert(0, str(Path(__file__).parent))
 sys.path.insert(0, str(Path(__file__).parents[1] / "app"))

@@ -36,7 +36,7 @@ from typing import Any
 import numpy as np
 import pytest
 from tcp_pendant.calibrate import AutoTouchRequest
-from tcp_pendant.server import PendantApp
+from tcp_pendant.serve.server import PendantApp
 
 sys.path.insert(0, str(Path(__file__).parent))
 sys.path.insert(0, str(Path(__file__).parents[1] / "app"))

@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 import pytest
 from tcp_pendant.pendant.tip_insets import GAP_PX, PX_PER_MM, TOOL_COLOR, VIEW_W_MM
-from tcp_pendant.server import PendantApp
+from tcp_pendant.serve.server import PendantApp
 
 sys.path.insert(0, str(Path(__file__).parent))
 sys.path.insert(0, str(Path(__file__).parents[1] / "app"))

@@ -13,7 +13,7 @@ from tcp_pendant.controller import (
     builtin_robots,
     builtin_tools,
 )
-from tcp_pendant.server import default_reference_tip_mm, ready_configuration
+from tcp_pendant.serve.server import default_reference_tip_mm, ready_configuration
 
 from tcpcal.tool import Tool
 

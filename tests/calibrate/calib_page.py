@@ -8,7 +8,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).parents[1] / "app"))
 from app_page import AppPage  # noqa: E402
-from tcp_pendant.server import PendantApp  # noqa: E402
+from tcp_pendant.serve.server import PendantApp  # noqa: E402
 from tcp_pendant.views.wizard_menu import CalibrateView  # noqa: E402
 
 

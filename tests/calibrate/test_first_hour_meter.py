@@ -111,7 +111,7 @@ def test_meter_markdown_uses_the_advice_and_does_not_repeat_the_angle() -> None:
 
 def test_the_meter_in_the_app_speaks_of_touch_1_after_one_touch(tmp_path) -> None:
     from calib_page import Page
-    from tcp_pendant.server import AppConfig, PendantApp
+    from tcp_pendant.serve.server import AppConfig, PendantApp
 
     app = PendantApp(AppConfig(port=0, tool="pointer", tool_library=tmp_path / "tools.json",
                                library_poll_s=0.1, seed=5))

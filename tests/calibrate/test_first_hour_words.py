@@ -121,7 +121,7 @@ def test_tool_data_defaults_to_the_active_slot_not_slot_1(tmp_path) -> None:
     """In a running app: with the torch's data active in slot 3, the orientation wizards
     offer slot 3; a pick by the user holds until the active tool data changes."""
     from calib_page import Page  # noqa: F401  (the in-process browser)
-    from tcp_pendant.server import AppConfig, PendantApp
+    from tcp_pendant.serve.server import AppConfig, PendantApp
 
     from tcpcal.library import ToolLibrary
 

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from tcp_pendant.calibrate import AutoTouchRequest
 from tcp_pendant.events import Crash, RunCancelled, RunFinished, RunResumed, RunStarted, ToolSaved, TouchRecorded
-from tcp_pendant.server import AppConfig, PendantApp
+from tcp_pendant.serve.server import AppConfig, PendantApp
 from tcp_pendant.session import SessionChange
 
 sys.path.insert(0, str(Path(__file__).parent))
@@ -164,7 +164,7 @@ def test_hide_truth_always_outlasts_an_exercise(tmp_path: Path) -> None:
 
 
 def test_the_hide_truth_option_reaches_every_session(tmp_path: Path) -> None:
-    from tcp_pendant.cli import build_parser
+    from tcp_pendant.serve.cli import build_parser
 
     assert build_parser().parse_args(["--hide-truth"]).hide_truth is True
     assert build_parser().parse_args([]).hide_truth is False

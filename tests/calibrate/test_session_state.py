@@ -25,7 +25,7 @@ from tcpcal.library import ToolLibrary
 from tcpcal.tool import Tool
 from tcp_pendant.calibrate import AutoTouchRequest
 from tcp_pendant.controller import builtin_tools
-from tcp_pendant.server import AppConfig, PendantApp
+from tcp_pendant.serve.server import AppConfig, PendantApp
 from tcp_pendant.session import SessionChange
 
 from calib_page import Page

@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 import pytest
 from tcp_pendant.calibrate import JOBS, AutoTouchRequest, CalibrationWorkflow
-from tcp_pendant.server import AppConfig, PendantApp
+from tcp_pendant.serve.server import AppConfig, PendantApp
 from tcp_pendant.wizards import (
     StepSpec,
     Wizard,

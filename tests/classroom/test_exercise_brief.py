@@ -18,7 +18,7 @@ from calib_helpers import library_tool_with_true_tcp, make_session  # noqa: E402
 from tcp_pendant.calibrate import AutoTouchRequest
 from tcp_pendant.classroom.class_room import PUSHED_SETTING, ClassRoom
 from tcp_pendant.classroom.gradebook import Gradebook
-from tcp_pendant.cli import main
+from tcp_pendant.serve.cli import main
 from tcp_pendant.controller import builtin_tools
 from tcp_pendant.pendant.class_messages import ClassMessage
 from tcp_pendant.pendant.exercise_rules import RuleRefusal
@@ -164,7 +164,7 @@ def test_the_brief_options_of_the_command_line(book: Gradebook, tmp_path: Path,
                                               monkeypatch: pytest.MonkeyPatch) -> None:
     """The three options reach the server's config (and imply a class); the class checks them."""
     import tcp_pendant.classroom.gradebook as gb
-    import tcp_pendant.server as server
+    import tcp_pendant.serve.server as server
 
     seen: list[object] = []
 

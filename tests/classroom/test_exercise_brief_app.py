@@ -26,7 +26,7 @@ INJECTION = "<style>*{opacity:0}</style> [x](//evil.example) ![](//127.0.0.1:9/x
 
 @pytest.fixture
 def app_factory(tmp_path: Path) -> Iterator[Callable[..., object]]:
-    from tcp_pendant.server import AppConfig, PendantApp
+    from tcp_pendant.serve.server import AppConfig, PendantApp
 
     apps: list[PendantApp] = []
 

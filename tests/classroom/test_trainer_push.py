@@ -21,7 +21,7 @@ from tcp_pendant.pendant.formatting import touch_indicator_markdown
 
 @pytest.fixture
 def app_factory(tmp_path: Path) -> Iterator[Callable[..., object]]:
-    from tcp_pendant.server import AppConfig, PendantApp
+    from tcp_pendant.serve.server import AppConfig, PendantApp
 
     apps: list[PendantApp] = []
 

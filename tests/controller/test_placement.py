@@ -20,7 +20,7 @@ from tcp_pendant.controller.placement import (
     XYZ4_DIRECTIONS,
     unreachable_directions,
 )
-from tcp_pendant.server import default_reference_tip_mm, ready_configuration, tip_reach_warning
+from tcp_pendant.serve.server import default_reference_tip_mm, ready_configuration, tip_reach_warning
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "robots"))
 from ros_layouts import acme7_workspace, kr16_2_urdf  # noqa: E402

@@ -35,10 +35,10 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from tcp_pendant.cli import set_apart_startup_objects
+from tcp_pendant.serve.cli import set_apart_startup_objects
 from tcp_pendant.controller import builtin_tools
 from tcp_pendant.job_pool import JobPool, JobTiming
-from tcp_pendant.server import AppConfig, PendantApp
+from tcp_pendant.serve.server import AppConfig, PendantApp
 from tcp_pendant.session import Session
 from tcpcal.tool import Tool
 

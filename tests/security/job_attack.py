@@ -21,10 +21,10 @@ from typing import Any
 import numpy as np
 from tcp_pendant.calibrate import CalibrationWorkflow
 from tcp_pendant.calibrate.beam_service import beam_check_job
-from tcp_pendant.cli import set_apart_startup_objects
+from tcp_pendant.serve.cli import set_apart_startup_objects
 from tcp_pendant.controller import builtin_tools
 from tcp_pendant.job_pool import REST_S, JobPool, JobTiming
-from tcp_pendant.server import AppConfig, PendantApp
+from tcp_pendant.serve.server import AppConfig, PendantApp
 from tcp_pendant.session import Session
 from tcp_pendant.views.tool_check import check_job
 from tcpcal.tool import Tool

@@ -15,7 +15,7 @@ from typing import Any
 
 import msgspec.msgpack
 import pytest
-from tcp_pendant.server import AppConfig, PendantApp
+from tcp_pendant.serve.server import AppConfig, PendantApp
 from tcp_pendant.views.viser_adapter import LOG_BUDGET, LOG_VALUE_CHARS, message_counts
 
 sys.path.insert(0, str(Path(__file__).parents[1] / "app"))

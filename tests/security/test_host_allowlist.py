@@ -13,9 +13,9 @@ from pathlib import Path
 
 import pytest
 import viser
-from tcp_pendant import origin_check
-from tcp_pendant.origin_check import LOOPBACK_HOSTS, host_refusal, served_hosts
-from tcp_pendant.server import AppConfig, PendantApp
+from tcp_pendant.serve import origin_check
+from tcp_pendant.serve.origin_check import LOOPBACK_HOSTS, host_refusal, served_hosts
+from tcp_pendant.serve.server import AppConfig, PendantApp
 from websockets.datastructures import Headers
 
 PROXY = "https://pendant.school.example"
@@ -147,7 +147,7 @@ def test_a_request_that_breaks_a_page_handler_is_a_400_without_traceback(app: Pe
 def test_on_every_interface_the_printed_names_are_served(tmp_path: Path, monkeypatch) -> None:
     """--host 0.0.0.0: the host name and addresses the server prints (addresses.network_urls,
     here fixed) are answered; other names are not."""
-    import tcp_pendant.server as server_module
+    import tcp_pendant.serve.server as server_module
 
     monkeypatch.setattr(server_module, "network_urls",
                         lambda host, port: [f"http://classroom-pc:{port}", f"http://10.9.8.7:{port}"])

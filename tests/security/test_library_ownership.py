@@ -178,7 +178,7 @@ def test_a_library_file_without_owners_loads_and_bad_owner_entries_are_set_aside
 
 
 def test_without_a_class_and_in_shared_mode_every_slot_is_anyones_as_before(tmp_path: Path) -> None:
-    from tcp_pendant.cli import main
+    from tcp_pendant.serve.cli import main
 
     room = _class(tmp_path)
     _trainee(room, tmp_path, "Alice").store_tool(5, _tool("Alice tool"))

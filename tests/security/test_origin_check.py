@@ -10,10 +10,10 @@ from pathlib import Path
 import msgspec.msgpack
 import pytest
 import viser
-from tcp_pendant import origin_check
-from tcp_pendant.cli import build_parser, main
-from tcp_pendant.origin_check import OriginError, normalize_origin, origin_refusal, parse_allow_origins
-from tcp_pendant.server import AppConfig, PendantApp
+from tcp_pendant.serve import origin_check
+from tcp_pendant.serve.cli import build_parser, main
+from tcp_pendant.serve.origin_check import OriginError, normalize_origin, origin_refusal, parse_allow_origins
+from tcp_pendant.serve.server import AppConfig, PendantApp
 from viser import _messages
 from websockets.datastructures import Headers
 from websockets.exceptions import InvalidStatus

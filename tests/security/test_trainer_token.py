@@ -24,8 +24,8 @@ from tcp_pendant.classroom.trainer_token import (
     locked,
     resolve_trainer_token,
 )
-from tcp_pendant.cli import main
-from tcp_pendant.server import AppConfig, PendantApp
+from tcp_pendant.serve.cli import main
+from tcp_pendant.serve.server import AppConfig, PendantApp
 
 sys.path.insert(0, str(Path(__file__).parents[1] / "app"))
 from wsclient import InputsClient, wait_until  # noqa: E402

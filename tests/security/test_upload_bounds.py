@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from tcp_pendant.server import AppConfig, PendantApp
+from tcp_pendant.serve.server import AppConfig, PendantApp
 from tcp_pendant.views import viser_adapter
 from tcp_pendant.views.viser_adapter import UploadLimits
 

@@ -20,7 +20,7 @@ import msgspec.msgpack
 import numpy as np
 import pytest
 from tcp_pendant.calibrate import AutoTouchRequest, CalibrationWorkflow
-from tcp_pendant.server import AppConfig, PendantApp
+from tcp_pendant.serve.server import AppConfig, PendantApp
 from tcp_pendant.views.wizard_menu import RECORD_REFUSED
 from tcp_pendant.wizards.session_record import MAX_RECORD_BYTES, MAX_WIZARDS
 from viser import _messages

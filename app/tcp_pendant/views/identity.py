@@ -10,7 +10,7 @@ another browser, held by another browser) gets the reason, escaped, in the modal
 server).
 
 Browser keys and reconnects: viser 1.1 gives the server no per-browser storage, so the page's
-own script (``static/pendant.js``, ``client_script``) keeps the accepted name and the browser
+own script (``serve/static/pendant.js``, ``serve.client_script``) keeps the accepted name and the browser
 key in the browser's ``localStorage``. The server hands a newly issued key to that script in a
 hidden element, ``<div hidden data-tcp-pendant-key="KEY">`` (:data:`KEY_ATTRIBUTE`; the key is
 ours, 43 characters of ``A-Z a-z 0-9 - _``, never user text), outside the modal. When a new

@@ -11,7 +11,7 @@ within 40 mm: geometry, no numbers) - everything that comes and goes near the ti
 the keys, so the keys never move - then the jog settings (mode, frame, override, readout frame), the joints, Home and the view (the camera buttons, "Shadows"); the touches ("Record point" and the list) follow.
 Every button group marks its selected option with "✓ " (viser's button groups show no
 selection); a click's value is read without the mark. Keyboard shortcuts come from the page's
-own script (``static/pendant.js``, served by ``client_script``): it clicks these buttons, so a
+own script (``serve/static/pendant.js``, served by ``serve.client_script``): it clicks these buttons, so a
 key is a click; every jog, increment and Record hint names its key and :data:`KEYS_LINE` sums
 them up below the jog keys.
 
@@ -87,10 +87,10 @@ MARK = "✓ "
 
 KEYS_LINE = ("Keys: `1`…`6` jog **+** on the rows above, `Shift`+`1`…`6` jog **−**, "
              "`[` `]` smaller / larger increment, `R` Record")
-"""The keyboard shortcuts (``static/pendant.js``), shown below the jog keys."""
+"""The keyboard shortcuts (``serve/static/pendant.js``), shown below the jog keys."""
 
 SHADOWS_LABEL = "Shadows"
-"""The shadows checkbox of one browser's pendant; ``static/pendant.js`` unchecks the checkbox
+"""The shadows checkbox of one browser's pendant; ``serve/static/pendant.js`` unchecks the checkbox
 of this exact label in a browser that renders WebGL in software (its renderer's name says
 SwiftShader, llvmpipe, softpipe, software or Basic Render), once per checkbox shown."""
 SHARED_SHADOWS_LABEL = "Shadows (every screen)"

@@ -10,7 +10,7 @@ GUI's, so every browser follows it; ``tcp-pendant --presenter`` starts with it o
 * the per-touch error chart of a 4-point result, ``CHART_HEIGHT_PX`` high.
 
 The folder is pinned at the top of the panel while the rest scrolls under it (the page script,
-``static/pendant.js``, makes it ``position: sticky``: viser 1.1 has no sticky GUI element), so
+``serve/static/pendant.js``, makes it ``position: sticky``: viser 1.1 has no sticky GUI element), so
 it is sized to leave room below it: at 1024x768 the whole block, chart included, is above the
 fold (about 500 px of the 713 px panel). It narrows the panel to ``PRESENTER_WIDTH_PX`` (the
 scene keeps about 70 % of a 1024 px wide projector) and puts it back to ``NORMAL_WIDTH_PX``

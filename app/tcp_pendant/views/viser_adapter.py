@@ -883,7 +883,7 @@ def listen_reuse_port(around_listen: Callable[[], Any] | None = None,
     """viser's server in this process binds its port with ``SO_REUSEPORT`` from now on (module
     docstring; idempotent). ``around_listen()``: a context manager entered while the listener
     binds and starts listening; ``on_listening(sockets)``: called with its listening sockets
-    (``tcp_pendant.balance``; the last call's hooks serve). Raises OSError where the platform
+    (``tcp_pendant.serve.balance``; the last call's hooks serve). Raises OSError where the platform
     has no ``SO_REUSEPORT``."""
     global _reuse_port, _listen_hooks
     import socket

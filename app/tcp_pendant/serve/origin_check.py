@@ -275,7 +275,7 @@ def _peer(connection: Any) -> str:
 def set_http_layer(port: int, layer: Any) -> None:
     """On the server listening on ``port``, answer plain HTTP requests (not upgrades) with
     ``layer(connection, request, process_request)`` in front of viser's static server
-    (``tcp_pendant.client_script.serve``; None: viser alone). The origin check is unchanged."""
+    (``tcp_pendant.serve.client_script.serve``; None: viser alone). The origin check is unchanged."""
     with _lock:
         if layer is None:
             _http_layers.pop(int(port), None)

@@ -5,7 +5,7 @@ with ``SO_REUSEPORT``: ``views.viser_adapter.listen_reuse_port``, so ``--port 0`
 port the others take too) it starts the N - 1 others, each ``python -m tcp_pendant`` with the
 same options plus ``--port PORT`` and :data:`WORKER_ENV` in its environment. Every process
 binds the same address with ``SO_REUSEPORT`` and the kernel hands each new connection to one
-of them: to the one with the fewest browsers (``tcp_pendant.balance``; the record's path is in
+of them: to the one with the fewest browsers (``tcp_pendant.serve.balance``; the record's path is in
 the workers' environment, ``BALANCE_ENV``), so a browser's websocket (its whole session) lives
 in one process, and its page's static files may come from another: every process serves the
 same files.
@@ -69,7 +69,7 @@ class Workers:
         argv: the first process's command-line options (passed on as they are).
         port: the port the first process listens on.
         n: server processes in all (>= 2).
-        env: more environment of the workers (the balance record's path: ``tcp_pendant.balance``).
+        env: more environment of the workers (the balance record's path: ``tcp_pendant.serve.balance``).
         on_stopped: called once when a worker stops while the class runs (the balance turns off).
     """
 

@@ -31,11 +31,11 @@ from urllib.parse import quote
 import numpy as np
 
 from tcpcal.library import ToolLibrary
-from tcp_pendant import client_script, origin_check
+from tcp_pendant.serve import client_script, origin_check
 from tcp_pendant.calibrate import CalibrationWorkflow
-from tcp_pendant.addresses import network_urls
+from tcp_pendant.serve.addresses import network_urls
 from tcp_pendant import job_pool
-from tcp_pendant.balance import Balance, BalanceFile
+from tcp_pendant.serve.balance import Balance, BalanceFile
 from tcp_pendant.job_pool import JobPool
 from tcp_pendant.classroom.class_room import ClassRoom
 from tcp_pendant.classroom.gradebook import Gradebook
@@ -95,7 +95,7 @@ class AppConfig:
         reference_tip_mm: reference tip in WORLD, mm (None: :func:`default_reference_tip_mm`).
         library_poll_s: how often the library file is checked for changes by others.
         allow_origins: web origins (``scheme://host[:port]``) whose pages may connect besides
-            the pendant's own address, e.g. a reverse proxy's (``tcp_pendant.origin_check``).
+            the pendant's own address, e.g. a reverse proxy's (``tcp_pendant.serve.origin_check``).
         class_db: the class gradebook: an SQLite file, or a ``postgresql://`` URL (a ``str``) of
             the PostgreSQL database several servers share; None: no classroom (no name prompt,
             nothing recorded). The CLI passes its default path. Ignored with ``shared``.
@@ -128,7 +128,7 @@ class AppConfig:
             one of the server processes of ``tcp-pendant --workers N`` on the same port.
         balance_file: with ``reuse_port``, the record the ``--workers`` processes share so that
             each new connection goes to the process with the fewest browsers
-            (``tcp_pendant.balance``); None: the kernel's hash spreads them.
+            (``tcp_pendant.serve.balance``); None: the kernel's hash spreads them.
         presence_poll_s: the class's heartbeat period across server processes (seconds;
             ``ClassRoom.start``).
     """

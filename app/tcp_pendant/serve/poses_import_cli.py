@@ -119,7 +119,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(list(sys.argv[1:] if argv is None else argv))
     from tcpcal.cli import read_controller_text
     from tcp_pendant.controller import ControllerError, RobotKinematics
-    from tcp_pendant.server import resolve_robot
+    from tcp_pendant.serve.server import resolve_robot
 
     try:
         urdf = resolve_robot(args.robot)

@@ -9,7 +9,7 @@ server issued at the join (``views.identity``) are remembered in the browser's
 trainer token.
 
 What this module serves, in front of viser's static-file server (``process_request`` of its
-``websockets`` server, reached through :func:`tcp_pendant.origin_check.set_http_layer`):
+``websockets`` server, reached through :func:`tcp_pendant.serve.origin_check.set_http_layer`):
 
 * ``GET /`` and ``GET /index.html`` (and the paths viser maps to them): viser's own response
   with one ``<script src="tcp-pendant/pendant.js" defer></script>`` inserted right after
@@ -80,7 +80,7 @@ def script_asset() -> ScriptAsset:
     global _asset
     with _asset_lock:
         if _asset is None:
-            body = (resources.files("tcp_pendant") / "static" / "pendant.js").read_bytes()
+            body = (resources.files("tcp_pendant.serve") / "static" / "pendant.js").read_bytes()
             _asset = ScriptAsset(body, gzip.compress(body, mtime=0))
         return _asset
 

@@ -34,7 +34,7 @@ from typing import TYPE_CHECKING
 from tcp_pendant.classroom.gradebook_db import class_db_target, url_has_password
 
 if TYPE_CHECKING:                       # the server is imported in main() only (no pinocchio for --help)
-    from tcp_pendant.server import PendantApp
+    from tcp_pendant.serve.server import PendantApp
 
 __all__ = ["SCENARIO_CHOICES", "build_parser", "main", "network_warning", "ready_urls"]
 
@@ -149,7 +149,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 def network_warning(host: str) -> str | None:
     """The warning printed when ``host`` lets other machines connect (None for loopback)."""
-    from tcp_pendant.server import is_loopback
+    from tcp_pendant.serve.server import is_loopback
 
     if is_loopback(host):
         return None
@@ -166,7 +166,7 @@ def ready_urls(local_url: str, network: Sequence[str], host: str) -> str:
         network: ``PendantApp.network_urls`` (empty on loopback, or when no address was found).
         host: the ``--host`` given.
     """
-    from tcp_pendant.server import is_loopback
+    from tcp_pendant.serve.server import is_loopback
 
     if is_loopback(host) or list(network) == [local_url]:
         return local_url
@@ -189,7 +189,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
         return grades_main(args_list[1:])
     if args_list[:2] == ["poses", "import"]:
-        from tcp_pendant.poses_import_cli import main as poses_import_main
+        from tcp_pendant.serve.poses_import_cli import main as poses_import_main
 
         return poses_import_main(args_list[2:])
     try:
@@ -206,12 +206,12 @@ def _main(argv: Sequence[str] | None) -> int:
                         format="%(levelname)s %(name)s: %(message)s")
     from tcp_pendant.classroom.gradebook import GradebookError, default_gradebook_path
     from tcp_pendant.controller import ControllerError
-    from tcp_pendant.server import AppConfig, PendantApp, PortInUseError, parse_xyz_mm
+    from tcp_pendant.serve.server import AppConfig, PendantApp, PortInUseError, parse_xyz_mm
 
     if not 0 <= args.port <= 65535:
         print(f"tcp-pendant: error: --port must be 0..65535, got {args.port}", file=sys.stderr)
         return 2
-    from tcp_pendant.workers import MAX_WORKERS, WorkerError, Workers, worker_index
+    from tcp_pendant.serve.workers import MAX_WORKERS, WorkerError, Workers, worker_index
 
     if not 1 <= args.workers <= MAX_WORKERS:
         print(f"tcp-pendant: error: --workers must be 1..{MAX_WORKERS}, got {args.workers}", file=sys.stderr)
@@ -324,7 +324,7 @@ def _main(argv: Sequence[str] | None) -> int:
     workers: Workers | None = None
     if args.workers > 1:
         balance = app.balance
-        from tcp_pendant.balance import BALANCE_ENV
+        from tcp_pendant.serve.balance import BALANCE_ENV
 
         workers = Workers(list(argv or ()), app.port, args.workers,
                           env={} if balance_file is None else {BALANCE_ENV: str(balance_file)},
@@ -365,9 +365,9 @@ def _drop_balance_file(balance_file: Path | None, worker: tuple[int, int, int] |
 
 def _balance_file(workers: int, worker: tuple[int, int, int] | None) -> Path | None:
     """The record the ``--workers`` processes share to balance their connections
-    (``tcp_pendant.balance``): made by the first process in a folder of its own, named to the
+    (``tcp_pendant.serve.balance``): made by the first process in a folder of its own, named to the
     others in their environment; None for a single process."""
-    from tcp_pendant.balance import BALANCE_ENV, BalanceFile
+    from tcp_pendant.serve.balance import BALANCE_ENV, BalanceFile
 
     if worker is not None:
         value = os.environ.get(BALANCE_ENV)
@@ -391,7 +391,7 @@ def set_apart_startup_objects() -> int:
 
 
 def _serve_as_worker(app: PendantApp, parent_pid: int) -> int:
-    """A worker of ``--workers N`` (``tcp_pendant.workers``): say it listens, then serve until
+    """A worker of ``--workers N`` (``tcp_pendant.serve.workers``): say it listens, then serve until
     stopped or until the first process is gone."""
     print(f"worker ready {os.getpid()}", flush=True)
     devnull = os.open(os.devnull, os.O_WRONLY)      # nobody reads this pipe any more

@@ -1,4 +1,4 @@
-/* TCP Pendant's own page script (served at /tcp-pendant/pendant.js by tcp_pendant/client_script.py).
+/* TCP Pendant's own page script (served at /tcp-pendant/pendant.js by tcp_pendant/serve/client_script.py).
  *
  * A static file: no server state, request or user text is ever written into it. It only reads the
  * page's DOM and clicks viser's own GUI buttons, so the server sees exactly what a mouse click
