@@ -77,6 +77,14 @@ from tcpcal.library import ToolLibrary
 from tcpcal.errors import TcpcalError
 from tcpcal.tool import Tool
 from tcp_pendant.calibrate.autotouch import AutoTouchOutcome
+from tcp_pendant.calibrate.pendant_rules import (
+    FREE_PRACTICE,
+    UNRESTRICTED,
+    ExerciseRules,
+    LibraryRights,
+    RuleRefusal,
+    check_tool_change,
+)
 from tcp_pendant.calibrate.workflow import AutoTouchRequest, CalibrationWorkflow, ControllerToolState
 from tcp_pendant.controller import ControllerError, JogResult, ToolModel, VirtualController
 from tcp_pendant.controller.pose_state import PoseState, pose_state, pose_state_key
@@ -84,22 +92,13 @@ from tcp_pendant.controller.scenarios import Scenario, ScenarioWorld, bent_tool,
 from tcp_pendant.events import Crash, SessionEvent
 from tcp_pendant.job_pool import JobPool, default_pool
 from tcp_pendant.pendant import Jogger, touch_label
-from tcp_pendant.pendant.class_messages import MAX_WAITING_MESSAGES, ClassMessage
-from tcp_pendant.pendant.exercise_rules import (
-    FREE_PRACTICE,
-    ExerciseRules,
-    RuleRefusal,
-    check_calibrated_tool,
-    check_tool_change,
-)
-from tcp_pendant.pendant.library_rights import UNRESTRICTED, LibraryRights
 from tcp_pendant.refusal_notices import RefusalNotices
 from tcp_pendant.wizards import Wizard, WizardResult, WizardStateError, wizard_class, wizard_classes
 
 if TYPE_CHECKING:
     import viser
 
-__all__ = ["GuiTarget", "Session", "SessionChange", "Touch"]
+__all__ = ["MAX_WAITING_MESSAGES", "ClassMessage", "GuiTarget", "Session", "SessionChange", "Touch"]
 
 log = logging.getLogger(__name__)
 F = TypeVar("F", bound=Callable[..., Any])
@@ -125,6 +124,30 @@ class GuiTarget(Protocol):
 
     def send_file_download(self, filename: str, content: bytes, chunk_size: int = ...,
                            save_immediately: bool = False) -> None: ...
+
+
+MAX_WAITING_MESSAGES = 10
+"""Messages a session (and the gradebook, per trainee) keeps undismissed; a newer one pushes out
+the oldest."""
+
+
+@dataclass(frozen=True)
+class ClassMessage:
+    """One message of the trainer as a trainee's session keeps it (``classroom.class_messages``:
+    how the class sends and keeps them).
+
+    Attributes:
+        message_id: the gradebook's id of this trainee's copy, unique in the class (the
+            Dismiss button names it).
+        text: plain text (``classroom.class_messages.clean_message_text``).
+        to: the trainee's name it was sent to, None for the whole class.
+        sent_at_utc: when it was sent, ISO 8601 UTC (``2026-12-02T09:30:00Z``).
+    """
+
+    message_id: int
+    text: str
+    to: str | None
+    sent_at_utc: str
 
 
 @dataclass(frozen=True)
@@ -231,7 +254,7 @@ class Session:
             larger.
         hide_distance: "Hide distance" (training: judge the touch by eye); change it with
             :meth:`set_hide_distance`. While it is on, a jog does not stop at the reference tip.
-        rules: what the trainer's exercise allows (``pendant.exercise_rules``), with its
+        rules: what the trainer's exercise allows (``calibrate.pendant_rules``, made by ``classroom.exercise_rules``), with its
             instructions; change it with :meth:`set_rules`.
         rng: the session's random generator (Auto-touch's operator error and directions, the
             beam's repeatability, the scenarios the trainer plays): the server draws it from its
@@ -283,7 +306,7 @@ class Session:
         self.library_owners: dict[int, str] = {}
         """Who owns each owned slot, as this session last read it (a class's trainees)."""
         self.library_rights: LibraryRights = UNRESTRICTED
-        """How this pendant may change the library (``pendant.library_rights``; the classroom
+        """How this pendant may change the library (``calibrate.pendant_rules``; the classroom
         sets it with :meth:`set_library_rights`)."""
         self.scenario: Scenario = Scenario()
         """The systematic error played (training; off by default); change it with :meth:`set_scenario`."""
@@ -631,7 +654,7 @@ class Session:
 
     def set_library_rights(self, rights: LibraryRights) -> None:
         """How this pendant may change the library from now on (a class: the trainee's slots
-        only; ``pendant.library_rights``)."""
+        only; ``classroom.library_rights``)."""
         with self.lock:
             self.library_rights = rights
             self.changed(library=True)

@@ -81,7 +81,7 @@ def test_in_an_exercise_the_check_of_a_zero_tool_shows_a_reading_not_the_answer(
     """The one-click answer: X = Y = Z = 0 saved, then Check. In an exercise the Check shows
     what a technician would see - how far the tip swung per rotation, read to 0.5 mm - and no
     implied TCP error vector or correction (which would be the true TCP)."""
-    from tcp_pendant.pendant.exercise_rules import class_rules
+    from tcp_pendant.classroom.exercise_rules import class_rules
 
     p = page({1: Tool(name="Zero", tcp_mm=(0.0, 0.0, 0.0))})
     p.session.set_rules(class_rules("mystery"))

@@ -140,7 +140,7 @@ def test_record_far_from_the_tip_asks_first_and_hide_distance_records(page) -> N
 def test_free_practice_by_eye_each_record_says_how_far_the_touch_really_was(page) -> None:
     """Judged by eye, a trainee learns only if told afterwards: in free practice the step says
     how far the touch was and which way; in an exercise it says nothing."""
-    from tcp_pendant.pendant.exercise_rules import class_rules
+    from tcp_pendant.classroom.exercise_rules import class_rules
 
     p = page()
     dock, wf = p.dock, p.calibrate.workflow
@@ -161,7 +161,7 @@ def test_free_practice_by_eye_each_record_says_how_far_the_touch_really_was(page
 def test_the_calibrate_tabs_record_says_how_far_too_in_free_practice_only(page) -> None:
     """The Calibrate tab's own Record gives the dock's words after a touch by eye in free
     practice, and nothing in an exercise."""
-    from tcp_pendant.pendant.exercise_rules import class_rules
+    from tcp_pendant.classroom.exercise_rules import class_rules
 
     p = page()
     steps, wf = p.calibrate.steps, p.calibrate.workflow

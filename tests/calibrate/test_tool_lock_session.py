@@ -12,7 +12,8 @@ import pytest
 from tcp_pendant.classroom.mystery import draw_mystery_tool
 from tcp_pendant.controller import ToolModel, builtin_tools
 from tcp_pendant.events import RunStarted
-from tcp_pendant.pendant.exercise_rules import FREE_PRACTICE, TOOL_LOCKED_WORDS, RuleRefusal, class_rules
+from tcp_pendant.calibrate.pendant_rules import FREE_PRACTICE, TOOL_LOCKED_WORDS, RuleRefusal
+from tcp_pendant.classroom.exercise_rules import class_rules
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.wizards import WizardStateError
 

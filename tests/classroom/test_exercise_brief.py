@@ -20,8 +20,8 @@ from tcp_pendant.classroom.class_room import PUSHED_SETTING, ClassRoom
 from tcp_pendant.classroom.gradebook import Gradebook
 from tcp_pendant.serve.cli import main
 from tcp_pendant.controller import builtin_tools
-from tcp_pendant.pendant.class_messages import ClassMessage
-from tcp_pendant.pendant.exercise_rules import RuleRefusal
+from tcp_pendant.session import ClassMessage
+from tcp_pendant.calibrate.pendant_rules import RuleRefusal
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.class_notices import instructions_markdown, message_markdown
 

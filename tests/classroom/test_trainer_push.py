@@ -161,7 +161,7 @@ def test_an_exercise_hides_and_locks_the_distance_aids_until_the_trainer_unlocks
     """In an exercise the distance, the Δ line and the close-up are off from the start; a
     browser that unticks "Hide distance" anyway is refused by the server (the checkbox is
     disabled, but a browser can send anything); the trainer unlocks and locks them again."""
-    from tcp_pendant.pendant.exercise_rules import DISTANCE_LOCKED, RuleRefusal
+    from tcp_pendant.calibrate.pendant_rules import DISTANCE_LOCKED, RuleRefusal
 
     app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token="trainer-token-tok-1", exercise="mystery")
     clients, (anna, trainer) = _class(app, 2)
@@ -197,7 +197,7 @@ def test_an_exercise_hides_and_locks_the_distance_aids_until_the_trainer_unlocks
 
 def test_auto_touch_is_refused_in_an_exercise_unless_the_trainer_allows_it(app_factory, tmp_path: Path) -> None:
     from tcp_pendant.calibrate.workflow import AutoTouchRequest
-    from tcp_pendant.pendant.exercise_rules import AUTO_TOUCH_REFUSED, RuleRefusal
+    from tcp_pendant.calibrate.pendant_rules import AUTO_TOUCH_REFUSED, RuleRefusal
 
     app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token="trainer-token-tok-1", exercise="mystery")
     clients, (anna, trainer) = _class(app, 2)

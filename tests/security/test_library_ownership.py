@@ -18,7 +18,7 @@ from tcp_pendant.calibrate import AutoTouchRequest
 from tcp_pendant.classroom.class_room import ClassRoom
 from tcp_pendant.classroom.gradebook import Gradebook
 from tcp_pendant.controller import builtin_tools
-from tcp_pendant.pendant.library_rights import UNRESTRICTED
+from tcp_pendant.calibrate.pendant_rules import UNRESTRICTED
 
 from tcpcal.library import ToolLibrary, ToolLibraryError
 from tcpcal.tool import Tool

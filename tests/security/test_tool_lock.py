@@ -19,7 +19,7 @@ from app_page import join_as_the_only_trainee, running_pendants  # noqa: E402
 from guiclick import choose, click  # noqa: E402
 from wsclient import InputsClient, wait_until  # noqa: E402
 
-from tcp_pendant.pendant.exercise_rules import TOOL_LOCKED_WORDS  # noqa: E402
+from tcp_pendant.calibrate.pendant_rules import TOOL_LOCKED_WORDS  # noqa: E402
 from tcp_pendant.views.tool_panel import TOOL_LOCKED_LINE  # noqa: E402
 
 TOKEN = "trainer-token-toollock-01"

@@ -28,7 +28,7 @@ from tcp_pendant.controller.beam import BeamSensor, ToolShape
 from tcp_pendant.controller.beam_scan import BeamScan, BeamScanConfig, run_beam_scan, scan_arrays_mm, tool_shape
 from tcp_pendant.controller.errors import ControllerError
 from tcp_pendant.text_escape import escape_markdown
-from tcp_pendant.pendant.library_rights import UNRESTRICTED, LibraryRights
+from tcp_pendant.calibrate.pendant_rules import UNRESTRICTED, LibraryRights
 from tcpcal.beam import BeamAxisResult, BeamResult, solve_beam, solve_beam_axis
 from tcpcal.errors import TcpcalError
 from tcpcal.library import ToolLibrary
@@ -307,7 +307,7 @@ def update_tool_from_beam(library: ToolLibrary, slot: int, check: BeamCheck,
         slot: the slot to write (must be the checked one).
         check: the check whose measured TCP is written.
         rights: whose write it is (a class's trainee: only a slot of their own;
-            ``pendant.library_rights``).
+            ``calibrate.pendant_rules``).
 
     Returns:
         The tool as saved.

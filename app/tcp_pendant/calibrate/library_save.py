@@ -8,7 +8,7 @@ It never sets the library's active slot: which tool is active is the session's (
 
 from __future__ import annotations
 
-from tcp_pendant.pendant.library_rights import UNRESTRICTED, LibraryRights
+from tcp_pendant.calibrate.pendant_rules import UNRESTRICTED, LibraryRights
 from tcp_pendant.wizards import Wizard, WizardStateError
 from tcpcal.library import ToolLibrary
 from tcpcal.tool import Tool
@@ -27,7 +27,7 @@ def save_result(wizard: Wizard, library: ToolLibrary, name: str, slot: int | Non
         slot: 1..16, or None: the slot that already holds a tool of that name, else the first
             free one.
         rights: whose save it is (a class's trainee: their own or a free slot, within their
-            quota, checked by the library under its lock; ``pendant.library_rights``).
+            quota, checked by the library under its lock; ``calibrate.pendant_rules``).
 
     Returns:
         (slot, tool) as saved.

@@ -38,8 +38,7 @@ from tcp_pendant.calibrate.autotouch import AutoTouchOutcome, PoseProbe, auto_to
 from tcp_pendant.calibrate.jobs import EXERCISE_REFUSAL, JOBS, POSE_CHECKS, ControllerJob
 from tcp_pendant.calibrate.diversity import failure_in_words
 from tcp_pendant.calibrate.library_save import save_result
-from tcp_pendant.pendant.exercise_rules import RuleRefusal, check_calibrated_tool
-from tcp_pendant.pendant.library_rights import UNRESTRICTED
+from tcp_pendant.calibrate.pendant_rules import UNRESTRICTED, RuleRefusal, check_calibrated_tool
 from tcp_pendant.events import (
     RunCancelled,
     RunFinished,

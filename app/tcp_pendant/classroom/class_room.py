@@ -1,11 +1,12 @@
 """The class as the server runs it: names, gradebook recorders, trainer views, the exercise.
 
 :class:`ClassRoom` is the server's classroom state (one per ``PendantApp`` with a gradebook,
-per-browser mode). For each new session it shows the "Your name" prompt
-(``views.identity``); a name starts a gradebook session and a :class:`TraineeRecorder`
-subscribed to the session's change signal (and, in the mystery exercise, mounts the trainee's
-mystery tool); a right trainer token turns that browser into the trainer's dashboard
-(:func:`tcp_pendant.views.dashboard.open_dashboard`: its pendant is taken down). Every dashboard
+per-browser mode). For each new session it shows the "Your name" prompt; a name starts a
+gradebook session and a :class:`TraineeRecorder` subscribed to the session's change signal
+(and, in the mystery exercise, mounts the trainee's mystery tool); a right trainer token turns
+that browser into the trainer's dashboard (its pendant is taken down). Both windows are views,
+a layer above the classroom: the server hands the class room their builders
+(:class:`~tcp_pendant.classroom.class_views.ClassViews`). Every dashboard
 re-renders when a trainee's state changes, at most :data:`RENDER_INTERVAL_S` apart, and every
 :data:`TICK_S` for its clocks; its table comes from the gradebook (``Gradebook.board``) plus
 who is connected now (:meth:`ClassRoom.connected_names`), so it survives a restart.
@@ -33,12 +34,12 @@ panel shows no error against the true TOOL frame and no grade, the scene no TRUE
 gradebook keeps them for the trainer. The settings a trainer pushes (exercise, tool, distance
 aids, Auto-touch) apply to every named trainee and to those who name themselves later.
 
-Each trainee's pendant follows the class's :class:`~tcp_pendant.pendant.exercise_rules.ExerciseRules`
+Each trainee's pendant follows the class's :class:`~tcp_pendant.calibrate.pendant_rules.ExerciseRules`
 (``Session.set_rules``): in an exercise the distance aids are hidden and locked and Auto-touch
 is off unless the trainer unlocked or allowed them (``class_rules``); a change of exercise goes
 back to those defaults unless the same push sets them.
 
-Each pendant's library rights (``pendant.library_rights``, ``Session.set_library_rights``):
+Each pendant's library rights (``classroom.library_rights``, ``Session.set_library_rights``):
 before a name it changes no library slot; a named trainee saves into free slots and their own,
 renames and deletes only their own, within ``library_quota`` slots (the owner, the name, is
 kept in the library file); the browser that opened the trainer view changes every slot.
@@ -104,17 +105,13 @@ from tcp_pendant.classroom.recorder import TraineeRecorder, TraineeStatus
 from tcp_pendant.classroom.replay import CalibrationReplay, calibration_replay
 from tcp_pendant.classroom.restore import runs_to_restore
 from tcp_pendant.classroom.trainer_token import FORGET_S, lock_s, locked, log_failure, validate_trainer_token
+from tcp_pendant.classroom.class_messages import clean_message_text
+from tcp_pendant.classroom.class_views import ClassViews, TrainerView, WelcomeWindow
+from tcp_pendant.classroom.exercise_rules import DistanceAids, class_rules, clean_instructions, clean_min_touches
+from tcp_pendant.classroom.library_rights import DEFAULT_LIBRARY_QUOTA, MAX_LIBRARY_QUOTA, trainee_rights
+from tcp_pendant.calibrate.pendant_rules import UNRESTRICTED, ExerciseRules, LibraryRights
 from tcp_pendant.controller import ToolModel
-from tcp_pendant.pendant.class_messages import ClassMessage, clean_message_text
-from tcp_pendant.pendant.exercise_rules import (
-    DistanceAids,
-    ExerciseRules,
-    class_rules,
-    clean_instructions,
-    clean_min_touches,
-)
-from tcp_pendant.pendant.library_rights import DEFAULT_LIBRARY_QUOTA, MAX_LIBRARY_QUOTA, UNRESTRICTED, LibraryRights
-from tcp_pendant.session import Session, SessionChange
+from tcp_pendant.session import ClassMessage, Session, SessionChange
 from tcp_pendant.wizards import WIZARD_TYPES, wizard_classes
 
 __all__ = ["EXERCISE_IDS", "RENDER_INTERVAL_S", "TICK_S", "ClassRoom", "clean_methods"]
@@ -167,16 +164,6 @@ def clean_methods(methods: object) -> tuple[str, ...] | None:
     return tuple(k for k in known if k in methods)
 
 
-def source_address(session: Session) -> str:
-    """The address the browser of ``session`` connects from (its websocket's peer IP, the
-    trainer token's lockout counts per address); "unknown" when there is none to read (a
-    shared page, a closed connection): all such tries share one count
-    (``views.viser_adapter.client_address``)."""
-    from tcp_pendant.views.viser_adapter import client_address
-
-    return client_address(session.client) or "unknown"
-
-
 def _token_digest(token: str) -> str:
     # A random token has 128 bits and a given one at least 16 characters: a plain SHA-256 is
     # enough for a file that holds the class's answers anyway.
@@ -203,6 +190,9 @@ class ClassRoom:
             every time (tests).
         library_quota: tool-library slots one trainee may hold (1..16; ``--library-quota``).
         presence_poll_s: the heartbeat period of :meth:`start` (seconds; module docstring).
+        views: the welcome window, the dashboard and the browser's address, as the server
+            builds them (``classroom.class_views``); None: a class room without browsers (its
+            data and rules only: :meth:`attach` and :meth:`open_trainer` refuse).
 
     Raises:
         TrainerTokenError: a token that breaks the rules.
@@ -216,7 +206,8 @@ class ClassRoom:
                  hand_to_loop: Callable[[Callable[[], None]], None] = lambda fn: fn(),
                  clock: Callable[[], float] = time.time,
                  call_later: Callable[[float, Callable[[], None]], None] | None = None,
-                 library_quota: int = DEFAULT_LIBRARY_QUOTA, presence_poll_s: float = 1.0) -> None:
+                 library_quota: int = DEFAULT_LIBRARY_QUOTA, presence_poll_s: float = 1.0,
+                 views: ClassViews | None = None) -> None:
         if (isinstance(library_quota, bool) or not isinstance(library_quota, int)
                 or not 1 <= library_quota <= MAX_LIBRARY_QUOTA):
             raise ValueError(f"The library quota must be a whole number of slots 1..{MAX_LIBRARY_QUOTA}, "
@@ -245,13 +236,14 @@ class ClassRoom:
             raise ValueError(f"The exercise seed must be a whole number, got {exercise_seed!r:.40}.")
         self._exercise_seed = exercise_seed      # None: the gradebook's, read when first needed
         self._hand_to_loop = hand_to_loop
+        self._views = views
         self._lock = threading.Lock()
         self._join_lock = threading.Lock()       # one join or release at a time
         self._trainees: dict[int, tuple[Session, TraineeRecorder, str]] = {}   # id(session) -> ...
         self._subscribed: set[int] = set()          # id(session) of sessions whose changes we follow
-        self._prompts: dict[int, Any] = {}           # id(session) -> its IdentityPrompt
+        self._prompts: dict[int, WelcomeWindow] = {}   # id(session) -> its welcome window
         self._released: dict[int, str] = {}          # id(session) -> the name the trainer released there
-        self._trainer_views: dict[int, Any] = {}    # id(session) -> TrainerDashboard
+        self._trainer_views: dict[int, TrainerView] = {}   # id(session) -> its dashboard
         self._call_later = call_later
         self._render_due = False                    # a throttled dashboard render is scheduled
         self._tick_due = False                      # the dashboards' clock tick is scheduled
@@ -311,18 +303,28 @@ class ClassRoom:
             session.set_rules(rules)
 
     # ------------------------------------------------------------ sessions
-    def attach(self, session: Session) -> Any:
+    def attach(self, session: Session) -> WelcomeWindow:
         """Show the "Your name" prompt in a new per-browser session (returns the prompt)."""
-        from tcp_pendant.views.identity import IdentityPrompt
-
-        prompt = IdentityPrompt(session, lambda name, key: self._joined(self.named(session, name, key)),
-                                lambda token: self.open_trainer(session, token))
+        prompt = self._class_views().welcome(session, lambda name, key: self._joined(self.named(session, name, key)),
+                                             lambda token: self.open_trainer(session, token))
         session.views["identity"] = prompt
         with self._lock:
             self._prompts[id(session)] = prompt
         session.set_library_rights(self._library_rights(session, None))   # no change before a name
         session.on_close(lambda: self.detach(session))
         return prompt
+
+    def _class_views(self) -> ClassViews:
+        if self._views is None:
+            raise RuntimeError("this class room was made without views (ClassRoom(views=...)): it shows no browser")
+        return self._views
+
+    def source_address(self, session: Session) -> str:
+        """The address the browser of ``session`` connects from (its websocket's peer IP, the
+        trainer token's lockout counts per address); "unknown" when there is none to read (a
+        shared page, a closed connection): all such tries share one count
+        (``ClassViews.client_address``)."""
+        return self._class_views().client_address(session.client) or "unknown"
 
     @staticmethod
     def _joined(join: TraineeJoin) -> tuple[str, str | None]:
@@ -332,7 +334,7 @@ class ClassRoom:
         """The trainer changes every slot; a trainee (``name``; None: not joined) only their own."""
         with self._lock:
             trainer = id(session) in self._trainer_views
-        return UNRESTRICTED if trainer else LibraryRights.trainee(name, self.library_quota)
+        return UNRESTRICTED if trainer else trainee_rights(name, self.library_quota)
 
     def _seed(self) -> int:
         if self._exercise_seed is None:
@@ -634,7 +636,7 @@ class ClassRoom:
             ValueError: the gradebook cannot count the try (the token is not tried either).
         """
         now = self.clock()
-        source = source_address(session)
+        source = self.source_address(session)
         try:
             wait, failures, counted = self.gradebook.try_token(source, now=now, forget_s=FORGET_S, lock_s=lock_s)
         except GradebookError as exc:
@@ -651,12 +653,10 @@ class ClassRoom:
             self.gradebook.forgive_token_failures(source)
         except GradebookError:
             log.exception("the wrong trainer tokens of %s could not be forgiven", source)
-        from tcp_pendant.views.dashboard import open_dashboard
-
         with self._lock:
             if id(session) in self._trainer_views:
                 return True
-        view = open_dashboard(session, self)
+        view = self._class_views().dashboard(session, self)
         session.views["trainer"] = view
         with self._lock:
             self._trainer_views[id(session)] = view

@@ -100,7 +100,7 @@ from tcp_pendant.classroom.gradebook_db import (
     is_postgres_url,
 )
 from tcp_pendant.classroom.names import TraineeNameError, looks_alike, validate_trainee_name
-from tcp_pendant.pendant.class_messages import MAX_WAITING_MESSAGES
+from tcp_pendant.session import MAX_WAITING_MESSAGES
 
 __all__ = [
     "APPLICATION",

@@ -234,7 +234,7 @@ def _main(argv: Sequence[str] | None) -> int:
 
         signal.signal(signal.SIGTERM, _terminate)
     from tcp_pendant.classroom.trainer_token import TrainerTokenError, resolve_trainer_token
-    from tcp_pendant.pendant.library_rights import DEFAULT_LIBRARY_QUOTA, MAX_LIBRARY_QUOTA
+    from tcp_pendant.classroom.library_rights import DEFAULT_LIBRARY_QUOTA, MAX_LIBRARY_QUOTA
 
     classroom = bool(args.classroom or args.class_db or args.exercise or args.trainer_token
                      or args.trainer_token_file or args.exercise_instructions is not None

@@ -38,8 +38,9 @@ from tcp_pendant import job_pool
 from tcp_pendant.serve.balance import Balance, BalanceFile
 from tcp_pendant.job_pool import JobPool
 from tcp_pendant.classroom.class_room import ClassRoom
+from tcp_pendant.classroom.class_views import ClassViews
 from tcp_pendant.classroom.gradebook import Gradebook
-from tcp_pendant.pendant.library_rights import DEFAULT_LIBRARY_QUOTA
+from tcp_pendant.classroom.library_rights import DEFAULT_LIBRARY_QUOTA
 from tcp_pendant.controller import (
     BeamDevice,
     ControllerError,
@@ -62,7 +63,9 @@ from tcp_pendant.controller.placement import (
 from tcp_pendant.controller.scenarios import Scenario
 from tcp_pendant.session import GuiTarget, Session
 from tcp_pendant.views import session_view_steps, viser_adapter
+from tcp_pendant.views.dashboard import open_dashboard
 from tcp_pendant.views.gui_util import target_of
+from tcp_pendant.views.identity import IdentityPrompt
 from tcp_pendant.views.presenter import PresenterView
 from tcp_pendant.views.scene import overview_camera, overview_pose
 from tcp_pendant.views.meshes import link_meshes, rigid_meshes
@@ -105,7 +108,7 @@ class AppConfig:
         exercise_seed: seed of the mystery tools (None: the class's secret seed, drawn once and
             kept in the gradebook; a number: that seed, for a reproducible demo).
         library_quota: in a class, the tool-library slots one trainee may hold (1..16; each
-            trainee renames and deletes only their own, ``pendant.library_rights``).
+            trainee renames and deletes only their own, ``classroom.library_rights``).
         exercise_instructions, exercise_methods, exercise_min_touches: the exercise's brief at
             start (``ClassRoom``: instructions as plain text, the wizard kinds trainees may
             start, the fewest touches a Finish takes); None: the brief kept in the gradebook.
@@ -382,7 +385,9 @@ class PendantApp:
                                        allowed_methods=config.exercise_methods,
                                        min_touches=config.exercise_min_touches,
                                        hand_to_loop=self._hand_to_loop, call_later=self._call_later,
-                                       presence_poll_s=config.presence_poll_s)
+                                       presence_poll_s=config.presence_poll_s,
+                                       views=ClassViews(welcome=IdentityPrompt, dashboard=open_dashboard,
+                                                        client_address=viser_adapter.client_address))
 
     @property
     def warnings(self) -> list[str]:

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from tcp_pendant.pendant.class_messages import ClassMessage
+from tcp_pendant.session import ClassMessage
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.text_escape import escape_markdown, escape_markdown_lines
 from tcp_pendant.views.gui_util import set_content, target_of

@@ -5,7 +5,7 @@ trainees may start and the fewest touches a Finish takes.
 "Instructions" text area (plain text, at most ``MAX_INSTRUCTIONS_CHARS`` characters: shown
 escaped in a banner on every trainee's panel), one checkbox per calibration method (the
 registry's, in menu order; all ticked: every method), "Minimum touches" (0: none; it applies to
-the methods whose touch count the trainee chooses, ``pendant.exercise_rules``) and **Push brief
+the methods whose touch count the trainee chooses, ``calibrate.pendant_rules``) and **Push brief
 to all trainees** (``ClassRoom.push_brief``). What a browser sends is checked by the class; a
 refusal is a notification in words (``Session.on_loop``).
 """
@@ -16,7 +16,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, Protocol
 
-from tcp_pendant.pendant.exercise_rules import MAX_INSTRUCTIONS_CHARS, MAX_MIN_TOUCHES
+from tcp_pendant.classroom.exercise_rules import MAX_INSTRUCTIONS_CHARS, MAX_MIN_TOUCHES
 from tcp_pendant.session import Session
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.wizards import wizard_classes

@@ -13,7 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any, Protocol
 
-from tcp_pendant.pendant.class_messages import MAX_MESSAGE_CHARS
+from tcp_pendant.classroom.class_messages import MAX_MESSAGE_CHARS
 from tcp_pendant.session import Session
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.gui_util import set_options, set_value

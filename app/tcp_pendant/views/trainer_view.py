@@ -18,7 +18,7 @@ from typing import Protocol
 from tcp_pendant.classroom.gradebook import GradeRow, Gradebook
 from tcp_pendant.classroom.grading import RecordGrade
 from tcp_pendant.classroom.recorder import TraineeStatus
-from tcp_pendant.pendant.exercise_rules import ExerciseRules
+from tcp_pendant.calibrate.pendant_rules import ExerciseRules
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.trainer_exercise import BriefControl
 from tcp_pendant.views.trainer_messages import MessageControl
@@ -30,7 +30,7 @@ EXERCISES: dict[str, str | None] = {"Free practice": None, "Mystery tool": "myst
 """Exercise choices of the trainer view: label -> exercise id."""
 HIDE_DISTANCE: dict[str, str | None] = {"(keep)": None, "on, locked": "locked", "on": "hidden", "off": "shown"}
 """'Hide distance' choices of the trainer view: label -> the distance aids pushed
-(``pendant.exercise_rules``; None: keep). "on, locked": the trainee cannot show them (the
+(``classroom.exercise_rules``; None: keep). "on, locked": the trainee cannot show them (the
 default in an exercise); "on": hidden, the trainee may show them; "off": shown."""
 AUTO_TOUCH: dict[str, bool | None] = {"(keep)": None, "off": False, "allowed": True}
 """'Auto-touch' choices of the trainer view (None: keep; an exercise starts with it off)."""

@@ -1,17 +1,25 @@
-"""What a classroom exercise allows the trainee's pendant (no viser).
+"""What one pendant may do: its exercise's rules and its library rights, as data with their
+checks (no viser).
 
-A trainer's exercise asks the trainee to find a tool's frame by touching; the pendant must not
-hand them the answer. :class:`ExerciseRules` is the session's copy of the class's rules (the
-classroom sets it, ``Session.set_rules``); the session's commands refuse what it forbids, in
-words, whatever a browser sends (a disabled checkbox is only the polite half):
+These are the types the session holds (``Session.rules``, ``Session.library_rights``) and
+the calibration workflow obeys (Finish, Auto-touch, the tool a run measures, Save to the
+library); they sit here, in the lowest layer that enforces them, so that neither the workflow
+nor the session imports the classroom. Their values are the class's: the classroom decides
+them and hands them to each session (``classroom.exercise_rules.class_rules``,
+``classroom.library_rights.trainee_rights``; ``Session.set_rules``,
+``Session.set_library_rights``). Without a class a pendant has :data:`FREE_PRACTICE` and
+:data:`UNRESTRICTED`.
+
+:class:`ExerciseRules`: the session's commands refuse what the exercise forbids, in words,
+whatever a browser sends (a disabled checkbox is only the polite half):
 
 * ``distance_locked``: "Hide distance" is on and stays on - the distance, the Δ line, the text
   close-up, the stop at the tip and its message are off (the trainee judges the touch by eye);
 * ``auto_touch_allowed``: Auto-touch (the robot touches for the trainee) may be used;
 * ``in_exercise``: the spin-test Check shows a technician's reading only
-  (:data:`CHECK_READING_MM`, ``pendant.spin_reading``);
-* ``instructions``: the trainer's words for the exercise (plain text, at most
-  :data:`MAX_INSTRUCTIONS_CHARS` characters; a banner on the trainee's panel shows them, escaped);
+  (``wizards.check_reading``);
+* ``instructions``: the trainer's words for the exercise (plain text; a banner on the trainee's
+  panel shows them, escaped);
 * ``allowed_methods``: the calibration methods (wizard kinds) the trainee may start (None: all);
   the Calibrate menu offers only those and ``Session.start_wizard`` refuses the others in words;
 * ``min_touches``: the fewest touches a Finish takes (0: the method's own minimum). It applies
@@ -26,40 +34,36 @@ to it (:func:`check_tool_change` refuses another in words), a calibration may on
 reference method touches first with its known reference tool (``Session.mount_required_tool``),
 and the exercise's tool is mounted again when that run ends or is cancelled.
 
-Free practice (no exercise): nothing is locked, Auto-touch is allowed, the Check shows all it
-computes. In an exercise the defaults are the strict ones (:func:`class_rules`); the trainer
-view can unlock the distance aids and allow Auto-touch for the class.
+:class:`LibraryRights`: who a pendant may change the shared tool library as. A class pendant
+(``restricted``) writes with its trainee's name as the slot's ``owner`` (kept in the library
+file, ``tcpcal.library``, so the check and the write are one step under the file's lock): it
+saves into an empty slot or one of its own, renames and deletes only its own, within its
+``quota``. A refusal names no other trainee (the class list is the trainer's to see) and says
+what to do instead.
 """
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
-from typing import Literal
+from typing import Any
 
+from tcpcal.library import OwnerQuotaError, SlotOwnedError, ToolLibraryError
 from tcp_pendant.controller.errors import ControllerError
 
 __all__ = [
     "AUTO_TOUCH_REFUSED",
-    "MAX_INSTRUCTIONS_CHARS",
-    "MAX_MIN_TOUCHES",
-    "DISTANCE_AIDS",
     "DISTANCE_LOCKED",
-    "DistanceAids",
     "ExerciseRules",
     "FREE_PRACTICE",
+    "LibraryRights",
     "RuleRefusal",
     "TOOL_LOCKED_WORDS",
+    "UNRESTRICTED",
     "check_calibrated_tool",
     "check_tool_change",
-    "class_rules",
-    "clean_instructions",
-    "clean_min_touches",
 ]
-
-DistanceAids = Literal["locked", "hidden", "shown"]
-"""The class's distance aids as the trainer sets them: ``locked`` (hidden, the trainee cannot
-show them), ``hidden`` (hidden, the trainee may show them), ``shown``."""
-DISTANCE_AIDS: tuple[str, ...] = ("locked", "hidden", "shown")
 
 DISTANCE_LOCKED = ("The trainer has locked the distance aids for this exercise: judge the touch by eye, "
                    "as on a real robot (the distance, the Δ line and the stop at the tip stay off).")
@@ -67,43 +71,6 @@ AUTO_TOUCH_REFUSED = ("Auto-touch is off in this exercise: the robot would touch
                       "onto the reference tip and press Record (the trainer can allow Auto-touch).")
 TOOL_LOCKED_WORDS = "This exercise keeps your own tool mounted"
 """The start of the refusal of a tool change in an exercise (:func:`check_tool_change`)."""
-
-
-MAX_INSTRUCTIONS_CHARS = 2000
-"""The longest instructions an exercise carries (characters, after trimming)."""
-MAX_MIN_TOUCHES = 20
-"""The largest minimum number of touches (the XYZ 4-point wizard takes at most 20)."""
-
-
-def clean_instructions(text: object) -> str:
-    """The trainer's instructions as kept: a string, trimmed, line endings as ``\\n``, control
-    characters other than line breaks and tabs dropped; plain text (escaped where shown).
-
-    Raises:
-        ValueError: not text, or longer than :data:`MAX_INSTRUCTIONS_CHARS` (says how long).
-    """
-    if not isinstance(text, str):
-        raise ValueError(f"The exercise instructions must be text, got {type(text).__name__}.")
-    text = text.replace("\r\n", "\n").replace("\r", "\n")
-    text = "".join(ch for ch in text if ch in "\n\t" or ch.isprintable()).strip()
-    if len(text) > MAX_INSTRUCTIONS_CHARS:
-        raise ValueError(f"The exercise instructions are {len(text)} characters long; shorten them to at most "
-                         f"{MAX_INSTRUCTIONS_CHARS}.")
-    return text
-
-
-def clean_min_touches(value: object) -> int:
-    """A minimum number of touches: a whole number 0..:data:`MAX_MIN_TOUCHES` (0: none).
-
-    Raises:
-        ValueError: not a whole number in that range (names it).
-    """
-    if isinstance(value, float) and value.is_integer():
-        value = int(value)
-    if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value <= MAX_MIN_TOUCHES:
-        raise ValueError(f"The minimum number of touches must be a whole number from 0 to {MAX_MIN_TOUCHES}, "
-                         f"got {value!r:.40}.")
-    return value
 
 
 class RuleRefusal(ControllerError):
@@ -214,23 +181,66 @@ class ExerciseRules:
 
 
 FREE_PRACTICE = ExerciseRules()
+"""No exercise: nothing is locked, Auto-touch is allowed, the Check shows all it computes."""
 
 
-def class_rules(exercise: str | None, aids: DistanceAids | None = None,
-                auto_touch: bool | None = None, *, instructions: str = "",
-                allowed_methods: tuple[str, ...] | None = None, min_touches: int = 0) -> ExerciseRules:
-    """The rules of a class: ``aids`` and ``auto_touch`` as the trainer set them (None: the
-    default - in an exercise the aids are locked and Auto-touch is off; in free practice
-    nothing is locked and Auto-touch is allowed); the trainer's instructions, methods and
-    minimum number of touches as they are (checked by the classroom).
+@dataclass(frozen=True)
+class LibraryRights:
+    """How a pendant may change the library (see the module docstring).
 
-    Raises:
-        ValueError: an unknown ``aids`` value (names the choices).
+    Attributes:
+        restricted: a class pendant (changes need an ``owner``).
+        owner: the trainee's name (None: not joined yet, or unrestricted).
+        quota: slots one owner may hold (None: no limit).
     """
-    if aids is not None and aids not in DISTANCE_AIDS:
-        raise ValueError(f"Unknown distance aids setting {aids!r}; use one of {', '.join(DISTANCE_AIDS)}.")
-    strict = exercise is not None
-    locked = (aids == "locked") if aids is not None else strict
-    allowed = bool(auto_touch) if auto_touch is not None else not strict
-    return ExerciseRules(exercise=exercise, distance_locked=locked, auto_touch_allowed=allowed,
-                         instructions=instructions, allowed_methods=allowed_methods, min_touches=min_touches)
+
+    restricted: bool = False
+    owner: str | None = None
+    quota: int | None = None
+
+    def owner_kwargs(self) -> dict[str, Any]:
+        """The keywords of ``ToolLibrary.rename``/``remove`` for these rights.
+
+        Raises:
+            ToolLibraryError: a class pendant that has not joined (the words say what to do).
+        """
+        if not self.restricted:
+            return {}
+        if self.owner is None:
+            raise ToolLibraryError("Join the class with your name first: in a class each library slot "
+                                   "belongs to the trainee who saved it.")
+        return {"owner": self.owner}
+
+    def save_kwargs(self) -> dict[str, Any]:
+        """The keywords of ``ToolLibrary.save`` (owner and quota) for these rights."""
+        kw = self.owner_kwargs()
+        if kw and self.quota is not None:
+            kw["quota"] = self.quota
+        return kw
+
+    def mine(self, owners: dict[int, str], slot: int) -> bool:
+        """Whether ``slot`` may be renamed or deleted with these rights."""
+        return not self.restricted or (self.owner is not None and owners.get(slot) == self.owner)
+
+    @contextmanager
+    def in_words(self) -> Iterator[None]:
+        """Turn tcpcal's ownership refusals into a trainee's words (a ``ToolLibraryError``)."""
+        try:
+            yield
+        except SlotOwnedError as exc:
+            whose = ("belongs to another trainee" if exc.owner is not None
+                     else "is the trainer's (saved without an owner)")
+            raise ToolLibraryError(
+                f"Slot {exc.slot} {whose}: you can activate and check it, not change it. Save into a "
+                "free slot or one of your own, or ask the trainer.") from None
+        except OwnerQuotaError as exc:
+            slots = ", ".join(map(str, exc.owned))
+            n = len(exc.owned)
+            raise ToolLibraryError(
+                f"You have {n} tool{'s' if n != 1 else ''} in the library (slot{'s' if n != 1 else ''} "
+                f"{slots}), the most a trainee may keep ({exc.quota}): delete one of yours first, "
+                "or save into one of your slots to replace it.") from None
+
+
+UNRESTRICTED = LibraryRights()
+"""The trainer, ``--shared`` and a pendant without a class."""
