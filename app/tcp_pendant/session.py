@@ -95,10 +95,8 @@ from tcp_pendant.pendant import Jogger, touch_label
 from tcp_pendant.refusal_notices import RefusalNotices
 from tcp_pendant.wizards import Wizard, WizardResult, WizardStateError, wizard_class, wizard_classes
 
-if TYPE_CHECKING:
-    import viser
-
-__all__ = ["MAX_WAITING_MESSAGES", "ClassMessage", "GuiTarget", "Session", "SessionChange", "Touch"]
+__all__ = ["MAX_WAITING_MESSAGES", "Browser", "ClassMessage", "GuiTarget", "NotificationColor", "Session",
+           "SessionChange", "Touch"]
 
 log = logging.getLogger(__name__)
 F = TypeVar("F", bound=Callable[..., Any])
@@ -108,22 +106,29 @@ COALESCE_AFTER_S = 0.010
 """A jog press that waited longer than this (s) on the event loop signals at the end of the
 loop's round, merged with the same session's next presses (module docstring)."""
 
-_COLORS: dict[str, Literal["blue", "green", "yellow", "red"]] = {
+NotificationColor = Literal["blue", "green", "yellow", "red"]
+"""The colours of the session's notifications (info, success, warning, error)."""
+
+_COLORS: dict[str, NotificationColor] = {
     "info": "blue", "success": "green", "warning": "yellow", "error": "red"}
 
 
 class GuiTarget(Protocol):
     """What views draw into: a ``viser.ClientHandle`` (one browser) or a ``viser.ViserServer``
-    (every browser, ``--shared``). Both have ``.scene``, ``.gui``, ``.atomic()`` and
-    ``.send_file_download()``."""
-
-    scene: viser.SceneApi
-    gui: viser.GuiApi
+    (every browser, ``--shared``). The session itself only sends its change signal's messages
+    as one batch (``atomic()``); the views reach the scene and the GUI through
+    ``views.gui_util.target_of``, which types it as viser's (the server gives the session no
+    other), so the session's layer imports no viser."""
 
     def atomic(self) -> ContextManager[None]: ...
 
-    def send_file_download(self, filename: str, content: bytes, chunk_size: int = ...,
-                           save_immediately: bool = False) -> None: ...
+
+class Browser(GuiTarget, Protocol):
+    """One browser that shows the session (a ``viser.ClientHandle``; the views type it as one:
+    ``views.gui_util.client_of``): what the session itself calls on it."""
+
+    def add_notification(self, title: str, body: str, *, color: NotificationColor,
+                         auto_close_seconds: float) -> object: ...
 
 
 MAX_WAITING_MESSAGES = 10
@@ -266,7 +271,7 @@ class Session:
     controller: VirtualController
     library: ToolLibrary
     workflow: CalibrationWorkflow
-    client: viser.ClientHandle | None = None
+    client: Browser | None = None
     target: GuiTarget | None = None
     touches: list[Touch] = field(default_factory=list)
     lock: threading.RLock = field(default_factory=threading.RLock)
@@ -713,7 +718,7 @@ class Session:
         if shown is not None:
             self.notify(title, shown, kind="warning")
 
-    def clients(self) -> list[viser.ClientHandle]:
+    def clients(self) -> list[Browser]:
         """The browser(s) that show this session: its own, or every browser of the shared GUI."""
         if self.client is not None:
             return [self.client]

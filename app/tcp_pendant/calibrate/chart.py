@@ -12,21 +12,12 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
-
 import numpy as np
 
-if TYPE_CHECKING:                      # the option's type only: this module does not import viser
-    from viser.uplot import Legend
-
-__all__ = ["BAR_HALF_WIDTH", "CHART_LEGEND", "MIN_TOP_MM", "ErrorBars", "error_bars", "error_axis_top_mm"]
+__all__ = ["BAR_HALF_WIDTH", "MIN_TOP_MM", "ErrorBars", "error_bars", "error_axis_top_mm"]
 
 BAR_HALF_WIDTH = 0.3
 """Half the width of a bar, in touch numbers (bars are 0.6 wide, 0.4 apart)."""
-
-CHART_LEGEND: Legend = {"live": False}
-"""uPlot ``legend`` option of the error charts: the series names with their colours, no values
-at the cursor (a live legend reads "touch: -- error (mm): --" until the pointer is on the chart)."""
 
 MIN_TOP_MM = 0.01
 """The least top of the error axis, mm. uPlot writes its tick labels with at most three

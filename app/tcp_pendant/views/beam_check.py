@@ -39,7 +39,7 @@ from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.beam_replay import ScanPlayer, beam_view_direction, scan_spheres
 from tcp_pendant.views.framing import Framing
 from tcp_pendant.views.scene import frame_cameras
-from tcp_pendant.views.gui_util import ButtonEvent, target_of
+from tcp_pendant.views.gui_util import ButtonEvent, clients_of, target_of
 from tcpcal.tool import Tool
 
 if TYPE_CHECKING:
@@ -183,7 +183,7 @@ class BeamCheckView:
             return
         centres, radii = scan_spheres(scan)
         direction = beam_view_direction(scan.events[0].beam_point, scan.events[0].beam_dir)
-        self.framing = frame_cameras(self.session.clients(), centres, radii, direction=direction, margin=1.4)
+        self.framing = frame_cameras(clients_of(self.session), centres, radii, direction=direction, margin=1.4)
 
     def _failed(self, title: str, body: str, *, kind: str) -> None:
         s = self.session

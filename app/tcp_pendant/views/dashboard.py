@@ -36,7 +36,6 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from tcp_pendant.calibrate.chart import CHART_LEGEND
 from tcp_pendant.classroom.board import DEFAULT_STUCK_MIN, DashboardRow, dashboard_rows, open_runs
 from tcp_pendant.classroom.gradebook import ClassBoard
 from tcp_pendant.classroom.grading import grade_record
@@ -46,7 +45,15 @@ from tcp_pendant.session import Session
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.dashboard_replay import ReplayScene
 from tcp_pendant.views.dashboard_table import in_progress_html, trainees_html
-from tcp_pendant.views.gui_util import ButtonEvent, UploadEvent, set_content, set_options, target_of
+from tcp_pendant.views.gui_util import (
+    CHART_LEGEND,
+    ButtonEvent,
+    UploadEvent,
+    client_of,
+    set_content,
+    set_options,
+    target_of,
+)
 from tcp_pendant.views.tool_panel import ToolPanel
 from tcp_pendant.views.trainer_exercise import build_exercise_controls
 from tcp_pendant.views.trainer_messages import build_message_controls
@@ -147,7 +154,7 @@ class TrainerDashboard:
         ``trainer_messages``), re-rendered with the dashboard."""
         self._grading = False
         self._results_shown: tuple[Any, ...] | None = None
-        client = session.client
+        client = client_of(session)
         self.replay_scene = ReplayScene(target_of(session).scene, None if client is None else client.camera)
 
     def folder(self, title: str, **kw: Any) -> Any:
@@ -269,7 +276,7 @@ class TrainerDashboard:
         self.render()
 
     def _download(self, _event: ButtonEvent | None = None) -> None:
-        client = self.session.client
+        client = client_of(self.session)
         if client is not None:
             client.send_file_download("grades.csv", self.control.grades_csv().encode("utf-8"))
 

@@ -1,17 +1,28 @@
-"""Small helpers shared by the views: where a session draws (:func:`target_of`), setting a
-widget only when its value changed, and the types of viser's GUI events."""
+"""Small helpers shared by the views: where a session draws (:func:`target_of`) and the
+browsers that show it (:func:`client_of`, :func:`clients_of`) as viser's types, setting a
+widget only when its value changed, the types of viser's GUI events and the error charts'
+legend option."""
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any, Protocol, TypeVar
+from typing import TYPE_CHECKING, Any, Protocol, TypeVar, cast
 
 import viser
+from viser.uplot import Legend
 
 if TYPE_CHECKING:
-    from tcp_pendant.session import GuiTarget, Session
+    from tcp_pendant.session import Session
 
-__all__ = ["ButtonEvent", "ButtonGroupEvent", "CheckboxEvent", "DropdownEvent", "UploadEvent",
-           "number_of_option", "set_content", "set_options", "set_value", "slot_option", "target_of"]
+__all__ = ["CHART_LEGEND", "ButtonEvent", "ButtonGroupEvent", "CheckboxEvent", "DropdownEvent", "UploadEvent",
+           "ViserTarget", "client_of", "clients_of", "number_of_option", "set_content", "set_options", "set_value",
+           "slot_option", "target_of"]
+
+ViserTarget = viser.ClientHandle | viser.ViserServer
+"""Where a session's views draw: its browser, or (``--shared``) the server, every browser."""
+
+CHART_LEGEND: Legend = {"live": False}
+"""uPlot ``legend`` option of the error charts: the series names with their colours, no values
+at the cursor (a live legend reads "touch: -- error (mm): --" until the pointer is on the chart)."""
 
 # The events viser hands to a widget's callback (``event.target`` is the widget, ``event.client``
 # the browser that sent it, None for a change made by the server).
@@ -39,13 +50,25 @@ def set_value(handle: _Input[_T], value: _T) -> None:
     handle.value = value  # type: ignore[misc]  # viser's setter is not next to its getter
 
 
-def target_of(session: Session) -> GuiTarget:
+def target_of(session: Session) -> ViserTarget:
     """Where ``session``'s views draw (``session.target``): None only for a session made
-    without a browser (it has no views) or after it closed."""
+    without a browser (it has no views) or after it closed. The session keeps it as a
+    ``session.GuiTarget`` (its layer imports no viser); the server gives it viser's only."""
     target = session.target
     if target is None:
         raise RuntimeError("this session has no browser to draw in (none given, or it was closed)")
-    return target
+    return cast(ViserTarget, target)
+
+
+def client_of(session: Session) -> viser.ClientHandle | None:
+    """The browser of a per-browser ``session`` (``session.client``; None: ``--shared``, no
+    browser, or closed), as the viser client the server gave it."""
+    return cast("viser.ClientHandle | None", session.client)
+
+
+def clients_of(session: Session) -> list[viser.ClientHandle]:
+    """The browsers that show ``session`` (``Session.clients``), as viser clients."""
+    return cast("list[viser.ClientHandle]", session.clients())
 
 
 class _Content(Protocol):

@@ -30,11 +30,11 @@ import math
 from typing import TYPE_CHECKING, Any, TypedDict
 
 
-from tcp_pendant.calibrate.chart import CHART_LEGEND, error_axis_top_mm, error_bars
+from tcp_pendant.calibrate.chart import error_axis_top_mm, error_bars
 from tcp_pendant.controller.readout import PoseReadout
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.text_escape import escape_html, escape_markdown
-from tcp_pendant.views.gui_util import CheckboxEvent, target_of
+from tcp_pendant.views.gui_util import CHART_LEGEND, CheckboxEvent, target_of
 
 if TYPE_CHECKING:
     import viser

@@ -41,6 +41,7 @@ from tcp_pendant.controller.spin import DEFAULT_SPIN_ANGLE_DEG, MAX_SPIN_ANGLE_D
 from tcp_pendant.views.gui_util import (
     ButtonEvent,
     DropdownEvent,
+    client_of,
     number_of_option,
     set_content,
     set_options,
@@ -321,7 +322,7 @@ class ToolPanel:
             self.session.notify(CONTROLLER_FILE_REFUSED, str(exc), kind="warning")
             return
         # to the browser that clicked (in --shared mode the session is every browser's)
-        target = event.client or self.session.client or target_of(self.session)
+        target = event.client or client_of(self.session) or target_of(self.session)
         target.send_file_download(filename, text.encode("utf-8"), save_immediately=True)
 
     # ------------------------------------------------------------ TCP check

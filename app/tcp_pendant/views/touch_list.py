@@ -16,7 +16,7 @@ from tcp_pendant.calibrate.text import empty_touches_markdown
 from tcp_pendant.pendant.guidance import tip_offset_mm
 from tcp_pendant.pendant.touch_feedback import touch_feedback
 from tcp_pendant.session import Session, SessionChange, Touch
-from tcp_pendant.views.gui_util import ButtonEvent, set_content, target_of
+from tcp_pendant.views.gui_util import ButtonEvent, client_of, set_content, target_of
 
 __all__ = ["TOUCHES_FILENAME", "TouchListView", "touches_csv_text"]
 
@@ -93,7 +93,7 @@ class TouchListView:
     def _on_export_csv(self, event: ButtonEvent) -> None:
         data = touches_csv_text(self.session.touches).encode("utf-8")
         # to the browser that clicked (in --shared mode the session is every browser's)
-        target = event.client or self.session.client or target_of(self.session)
+        target = event.client or client_of(self.session) or target_of(self.session)
         target.send_file_download(TOUCHES_FILENAME, data, save_immediately=True)
 
     def _delete_cb(self, index: int, label: str) -> Callable[..., Coroutine[Any, Any, None]]:

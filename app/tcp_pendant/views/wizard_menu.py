@@ -47,6 +47,7 @@ from tcp_pendant.job_pool import JobRefused
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.gui_util import (
+    client_of,
     number_of_option,
     set_content,
     set_options,
@@ -302,7 +303,7 @@ class CalibrateView:
     def _on_export(self, event: Any) -> None:
         data = dumps(self.workflow.export_record(self.session.touches)).encode("utf-8")
         # to the browser that clicked (in --shared mode the session is every browser's)
-        target = getattr(event, "client", None) or self.session.client or target_of(self.session)
+        target = getattr(event, "client", None) or client_of(self.session) or target_of(self.session)
         target.send_file_download(SESSION_FILENAME, data, save_immediately=True)
         set_content(self.record_md, f"Exported {len(self.workflow.runs)} calibration(s) as {SESSION_FILENAME}.")
 

@@ -18,7 +18,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
-from tcp_pendant.calibrate.chart import CHART_LEGEND, error_axis_top_mm, error_bars
+from tcp_pendant.calibrate.chart import error_axis_top_mm, error_bars
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.calibrate.text import (
     comparison_markdown,
@@ -32,6 +32,7 @@ from tcp_pendant.calibrate.text import (
     warnings_markdown,
 )
 from tcp_pendant.views.gui_util import (
+    CHART_LEGEND,
     ButtonEvent,
     DropdownEvent,
     number_of_option,

@@ -48,7 +48,7 @@ from tcp_pendant.views.beam_replay import ScanPlayer, beam_view_direction, scan_
 from tcp_pendant.views.framing import Framing, spread_labels
 from tcp_pendant.views.scene import frame_cameras, wxyz_xyz
 from tcp_pendant.wizards import WizardResult, Xyz4Result
-from tcp_pendant.views.gui_util import target_of
+from tcp_pendant.views.gui_util import clients_of, target_of
 
 __all__ = ["WizardSceneView"]
 
@@ -284,7 +284,7 @@ class WizardSceneView:
         if not np.all(np.isfinite(centres)) or not np.all(np.isfinite(radii)):
             return None
         kw = {} if (d := self._view_direction()) is None else {"direction": d}
-        framing = frame_cameras(self.session.clients(), centres, radii, **kw)
+        framing = frame_cameras(clients_of(self.session), centres, radii, **kw)
         self.last_framing = framing
         return framing
 
@@ -330,7 +330,7 @@ class WizardSceneView:
     def layout_labels(self) -> None:
         """Move the labels at the tip apart as seen by the (first) browser's camera now, or by
         the last result's framing when no camera has been reported."""
-        clients = self.session.clients()
+        clients = clients_of(self.session)
         self._watch_cameras(clients)
         framing = self._camera_framing(clients[0]) if clients else None
         framing = framing or self.last_framing
