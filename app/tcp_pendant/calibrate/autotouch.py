@@ -36,16 +36,14 @@ from __future__ import annotations
 import functools
 from collections.abc import Callable, Generator, Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, ParamSpec, TypeVar
+from typing import ParamSpec, TypeVar
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from tcp_pendant.controller import ToolModel, VirtualController, builtin_tools
 from tcp_pendant.wizards.abc_world import R_WORLD_TOOL_TARGET
 from tcp_pendant.wizards.base import StepInfo, Wizard, WizardError, WizardStateError
-
-if TYPE_CHECKING:
-    from tcp_pendant.controller import ToolModel, VirtualController
 
 DEFAULT_DISTANCE_MM = 60.0
 MIN_RETRY_DISTANCE_MM = 20.0
@@ -99,7 +97,6 @@ def _ensure_mounted(wizard: Wizard, controller: VirtualController, step: StepInf
     key = step.mount_tool_key
     if key is not None and getattr(controller.mounted_tool, "key", None) != key:
         if tools is None:
-            from tcp_pendant.controller import builtin_tools
             tools = builtin_tools()
         if key not in tools:
             raise WizardError(f"The step needs the tool '{key}', which is not among {sorted(tools)}.")

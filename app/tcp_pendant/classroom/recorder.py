@@ -42,6 +42,7 @@ import numpy as np
 from tcp_pendant.classroom.gradebook import Gradebook
 from tcp_pendant.events import Crash, RunCancelled, RunFinished, RunResumed, RunStarted, SessionEvent, TouchRecorded
 from tcp_pendant.wizards.session_record import run_entry
+from tcp_pendant.wizards.truth import compare_with_truth
 
 __all__ = ["TraineeRecorder", "TraineeStatus", "step_words"]
 
@@ -207,8 +208,6 @@ class TraineeRecorder:
                 st.status = "in_progress"
 
     def _finish(self, st: _RunState, event: RunFinished) -> None:
-        from tcp_pendant.wizards.truth import compare_with_truth
-
         result: Any = event.result
         pos = ori = grade = None
         if event.T_flange_tool_true_m is not None:
