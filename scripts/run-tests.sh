@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Set up everything the test suite needs on a fresh machine, type-check the code (mypy), then run
-# the tests.
-#   bash scripts/run-tests.sh            # mypy, then the whole suite (unit, property, CLI, browser)
+# Set up everything the test suite needs on a fresh machine, type-check the code (mypy), check
+# the import layers (lint-imports), then run the tests.
+#   bash scripts/run-tests.sh            # mypy, lint-imports, then the whole suite (unit, property, CLI, browser)
 #   bash scripts/run-tests.sh -m browser # only the browser end-to-end tests
 # The browser tests drive Debian's chromium (Playwright cannot download its own browser here):
 # when it is missing it is installed with apt-get as root (or through sudo). A user who can do
@@ -22,6 +22,14 @@ ensure_venv test
 # a type error fails the run before any test.
 if ! .venv/bin/python -m mypy; then
   echo "run-tests.sh: mypy found the type errors listed above; no test ran." >&2
+  exit 1
+fi
+
+# The layers next (pyproject.toml [tool.importlinter]: tcpcal imports nothing of the app, each
+# package of the app only the layers below it, viser only views and serve): an import that
+# breaks one fails the run before any test.
+if ! .venv/bin/lint-imports --no-logo; then
+  echo "run-tests.sh: lint-imports found the imports listed above that break a layer contract; no test ran." >&2
   exit 1
 fi
 
