@@ -4,7 +4,8 @@
 The fake ``.venv/bin/python`` logs every call to ``calls.log`` and answers ``-m pip`` with
 ``$FAKE_PIP_RC`` (default 1: no package index), ``-m pytest`` with ``$FAKE_PYTEST_RC`` and
 ``-m mypy`` with ``$FAKE_MYPY_OUT`` on stdout and ``$FAKE_MYPY_RC`` (default 0: no type error);
-``.venv/bin/tcp-pendant`` logs its arguments. ``PATH`` holds only the tools the scripts need
+``.venv/bin/lint-imports`` logs its arguments and answers with ``$FAKE_LINT_OUT`` on stdout and
+``$FAKE_LINT_RC`` (default 0: every layer kept); ``.venv/bin/tcp-pendant`` logs its arguments. ``PATH`` holds only the tools the scripts need
 (bash, coreutils), a fake ``id`` printing ``$FAKE_UID``, and whatever a test adds (``sudo``,
 ``apt-get``, ``chromium``): without them the machine has no root, no sudo and no chromium.
 ``PG_BIN`` and ``NGINX`` point at a fake PostgreSQL and nginx (present unless a test removes them).
@@ -47,6 +48,10 @@ if [ "$2" = pip ]; then exit "${{FAKE_PIP_RC:-1}}"; fi
 if [ "$2" = pytest ]; then echo "CHROMIUM=${{CHROMIUM:-}}" >> {log}; exit "${{FAKE_PYTEST_RC:-0}}"; fi
 if [ "$2" = mypy ]; then echo "${{FAKE_MYPY_OUT:-Success: no issues found}}"; exit "${{FAKE_MYPY_RC:-0}}"; fi
 exit 0
+""")
+    _write_exe(venv_bin / "lint-imports", f"""#!/bin/sh
+printf 'lint-imports' >> {log}; for a in "$@"; do printf ' [%s]' "$a" >> {log}; done; echo >> {log}
+echo "${{FAKE_LINT_OUT:-Contracts: 3 kept, 0 broken.}}"; exit "${{FAKE_LINT_RC:-0}}"
 """)
     _write_exe(venv_bin / "tcp-pendant", f"#!/bin/sh\necho tcp-pendant \"$@\" >> {log}\n")
     _write_exe(venv_bin / "tcpcal", "#!/bin/sh\n")
@@ -258,8 +263,8 @@ def test_run_tests_type_checks_before_the_tests(stamped: Path) -> None:
     (stamped.parent / "bin" / "chromium").symlink_to(shutil.which("true") or "/bin/true")
     p = run(stamped, "run-tests.sh", "-q")
     assert p.returncode == 0, p.stderr
-    assert [c for c in calls(stamped) if c.startswith("python")] == [
-        "python [-m] [mypy]", "python [-m] [pytest] [-q]"]
+    assert [c for c in calls(stamped) if c.startswith(("python", "lint-imports"))] == [
+        "python [-m] [mypy]", "lint-imports [--no-logo]", "python [-m] [pytest] [-q]"]
 
 
 def test_run_tests_fails_on_a_type_error_with_mypy_s_output_and_runs_no_test(stamped: Path) -> None:
@@ -270,6 +275,74 @@ def test_run_tests_fails_on_a_type_error_with_mypy_s_output_and_runs_no_test(sta
     assert error in p.stdout
     assert "mypy found the type errors listed above; no test ran" in p.stderr
     assert pytest_calls(stamped) == []
+
+
+def test_run_tests_fails_on_a_broken_layer_with_lint_imports_output_and_runs_no_test(stamped: Path) -> None:
+    (stamped.parent / "bin" / "chromium").symlink_to(shutil.which("true") or "/bin/true")
+    broken = "tcp_pendant.controller is not allowed to import tcp_pendant.views:"
+    p = run(stamped, "run-tests.sh", "-q", FAKE_LINT_RC="1", FAKE_LINT_OUT=broken, CI="true")
+    assert p.returncode == 1
+    assert broken in p.stdout
+    assert "lint-imports found the imports listed above that break a layer contract; no test ran" in p.stderr
+    assert pytest_calls(stamped) == []
+
+
+# The layers of pyproject.toml's [tool.importlinter], bottom first ("|": siblings that import
+# none of each other); lint-imports also wants every module of tcp_pendant in one of them.
+APP_LAYERS = (("events", "job_pool", "message_rate", "refusal_notices", "text_escape"), ("controller",),
+              ("pendant",), ("wizards",), ("calibrate",), ("session",), ("classroom",), ("views",),
+              ("serve",), ("__main__",))
+
+
+def _lint_imports(tree: Path) -> subprocess.CompletedProcess[str]:
+    env = {**os.environ, "PYTHONPATH": f"{tree / 'src'}{os.pathsep}{tree / 'app'}"}
+    return subprocess.run([str(Path(sys.executable).parent / "lint-imports"), "--no-logo", "--no-cache"],
+                          cwd=tree, env=env, capture_output=True, text=True, timeout=300)
+
+
+def test_the_layer_contracts_refuse_an_upward_import_viser_below_the_views_and_a_loose_module(tmp_path: Path) -> None:
+    """The real lint-imports with the repository's ``[tool.importlinter]`` on a tree of empty
+    layers: kept; an import of a higher layer (even inside a function), viser imported by the
+    session (even for types only), tcpcal importing the app, or a module in no layer each break
+    a contract, and lint-imports exits 1."""
+    shutil.copy(ROOT / "pyproject.toml", tmp_path)
+    (tmp_path / "src" / "tcpcal").mkdir(parents=True)
+    (tmp_path / "src" / "tcpcal" / "__init__.py").write_text("")
+    app = tmp_path / "app" / "tcp_pendant"
+    app.mkdir(parents=True)
+    (app / "__init__.py").write_text("")
+    for layer in APP_LAYERS:
+        for name in layer:
+            (app / f"{name}.py").write_text("")
+    (app / "__main__.py").write_text("import tcp_pendant.serve\n")
+    (app / "serve.py").write_text("import viser\nimport tcp_pendant.views\nimport tcp_pendant.controller\n")
+    (app / "views.py").write_text("import viser\nimport tcp_pendant.classroom\n")
+    (app / "calibrate.py").write_text("import tcp_pendant.wizards\nimport tcp_pendant.text_escape\n")
+    kept = _lint_imports(tmp_path)
+    assert kept.returncode == 0, kept.stdout + kept.stderr
+    assert "3 kept, 0 broken" in kept.stdout
+
+    breaks = {
+        app / "controller.py": ("def f():\n    import tcp_pendant.views\n",
+                                "tcp_pendant.controller is not allowed to import tcp_pendant.views"),
+        app / "session.py": ("from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    import viser\n",
+                             "tcp_pendant.session is not allowed to import viser"),
+        app / "events.py": ("import tcp_pendant.job_pool\n",
+                            "tcp_pendant.events is not allowed to import tcp_pendant.job_pool"),
+        tmp_path / "src" / "tcpcal" / "__init__.py": ("import tcp_pendant.controller\n",
+                                                      "tcpcal is not allowed to import tcp_pendant"),
+        app / "loose.py": ("", "tcp_pendant.loose"),
+    }
+    for path, (text, said) in breaks.items():
+        before = path.read_text() if path.exists() else None
+        path.write_text(text)
+        broken = _lint_imports(tmp_path)
+        assert broken.returncode == 1, (path, broken.stdout + broken.stderr)
+        assert said in broken.stdout, (path, broken.stdout)
+        if before is None:
+            path.unlink()
+        else:
+            path.write_text(before)
 
 
 def test_the_mypy_configuration_is_strict_on_tcpcal_and_standard_on_the_app(tmp_path: Path) -> None:
