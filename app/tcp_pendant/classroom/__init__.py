@@ -5,7 +5,11 @@ Modules (one job each): :mod:`~tcp_pendant.classroom.gradebook` (the database),
 :mod:`~tcp_pendant.classroom.gradebook_db` (its SQLite / PostgreSQL connections),
 :mod:`~tcp_pendant.classroom.grades_cli` (the ``grades`` command),
 :mod:`~tcp_pendant.classroom.mystery` (mystery tools), :mod:`~tcp_pendant.classroom.names`
-(the "Your name" check). Nothing here imports viser.
+(the "Your name" check), :mod:`~tcp_pendant.classroom.class_room` (the class as the server runs
+it; its windows come from the views through
+:class:`~tcp_pendant.classroom.class_views.ClassViews`), and the class's rules:
+:mod:`~tcp_pendant.classroom.exercise_rules`, :mod:`~tcp_pendant.classroom.library_rights`,
+:mod:`~tcp_pendant.classroom.class_messages`. Nothing here imports viser or the views.
 """
 
 from __future__ import annotations
