@@ -431,7 +431,7 @@ CSV_COLUMNS: tuple[str, ...] = (
     "tcp_x_mm", "tcp_y_mm", "tcp_z_mm", "a_deg", "b_deg", "c_deg",
     *CSV_FIGURES, "position_error_mm", "orientation_error_deg", "grade", "figures_json", "status",
 )
-"""Columns of :func:`to_csv` (a contract: docs/architecture.md "Classroom (gradebook)")."""
+"""Columns of :func:`to_csv` (a contract: docs/pendant-cli.md "tcp-pendant grades")."""
 
 
 def _cell(value: Any) -> str:
