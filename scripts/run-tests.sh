@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Set up everything the test suite needs on a fresh machine, type-check the code (mypy), then run
-# the tests.
-#   bash scripts/run-tests.sh            # mypy, then the whole suite (unit, property, CLI, browser)
+# Set up everything the test suite needs on a fresh machine, type-check the code (mypy), build the
+# documentation site (mkdocs build --strict), then run the tests.
+#   bash scripts/run-tests.sh            # mypy, the site, then the whole suite (unit, property, CLI, browser)
 #   bash scripts/run-tests.sh -m browser # only the browser end-to-end tests
 # The browser tests drive Debian's chromium (Playwright cannot download its own browser here):
 # when it is missing it is installed with apt-get as root (or through sudo). A user who can do
@@ -22,6 +22,21 @@ ensure_venv test
 # a type error fails the run before any test.
 if ! .venv/bin/python -m mypy; then
   echo "run-tests.sh: mypy found the type errors listed above; no test ran." >&2
+  exit 1
+fi
+
+# The documentation site next (mkdocs.yml, into a scratch folder, removed after): a broken link
+# or anchor, a page left out of the nav, or a docstring the API reference cannot parse or resolve
+# fails the run before any test. Quiet when it builds; on failure its warnings, then one line.
+site_dir="${TMPDIR:-/tmp}/tcp-pendant-site-$$"
+site_rc=0
+site_log="$(NO_MKDOCS_2_WARNING=1 .venv/bin/python -m mkdocs build --strict --site-dir "$site_dir" 2>&1)" || site_rc=$?
+rm -rf "$site_dir"
+if [ "$site_rc" != 0 ]; then
+  while IFS= read -r line; do
+    case "$line" in INFO*) ;; *) printf '%s\n' "$line" >&2 ;; esac
+  done <<< "$site_log"
+  echo "run-tests.sh: the documentation site does not build (mkdocs build --strict: the warnings above); no test ran." >&2
   exit 1
 fi
 

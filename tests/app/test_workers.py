@@ -237,7 +237,7 @@ def test_browsers_arriving_one_by_one_are_split_evenly_over_the_processes(worker
 
 @pytest.mark.timeout(300)
 def test_two_processes_share_one_postgresql_gradebook(tmp_path: Path, postgres_server) -> None:
-    """``--workers 2 --class-db postgresql://...`` (README's "1,000 trainees on ten machines",
+    """``--workers 2 --class-db postgresql://...`` (docs/large-class.md, "1,000 trainees on ten machines",
     one machine of them with its cores in use): both processes keep their trainees in the one
     PostgreSQL gradebook, six arriving trainees are split three per process (each one's
     process read from the database's presence rows), and a name already joined is refused to a

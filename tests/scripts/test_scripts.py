@@ -3,7 +3,8 @@
 
 The fake ``.venv/bin/python`` logs every call to ``calls.log`` and answers ``-m pip`` with
 ``$FAKE_PIP_RC`` (default 1: no package index), ``-m pytest`` with ``$FAKE_PYTEST_RC`` and
-``-m mypy`` with ``$FAKE_MYPY_OUT`` on stdout and ``$FAKE_MYPY_RC`` (default 0: no type error);
+``-m mypy`` with ``$FAKE_MYPY_OUT`` on stdout and ``$FAKE_MYPY_RC`` (default 0: no type error),
+``-m mkdocs`` with ``$FAKE_MKDOCS_OUT`` on stderr and ``$FAKE_MKDOCS_RC`` (default 0: the site builds);
 ``.venv/bin/tcp-pendant`` logs its arguments. ``PATH`` holds only the tools the scripts need
 (bash, coreutils), a fake ``id`` printing ``$FAKE_UID``, and whatever a test adds (``sudo``,
 ``apt-get``, ``chromium``): without them the machine has no root, no sudo and no chromium.
@@ -46,6 +47,7 @@ printf 'python' >> {log}; for a in "$@"; do printf ' [%s]' "$a" >> {log}; done; 
 if [ "$2" = pip ]; then exit "${{FAKE_PIP_RC:-1}}"; fi
 if [ "$2" = pytest ]; then echo "CHROMIUM=${{CHROMIUM:-}}" >> {log}; exit "${{FAKE_PYTEST_RC:-0}}"; fi
 if [ "$2" = mypy ]; then echo "${{FAKE_MYPY_OUT:-Success: no issues found}}"; exit "${{FAKE_MYPY_RC:-0}}"; fi
+if [ "$2" = mkdocs ]; then printf '%b\n' "${{FAKE_MKDOCS_OUT:-INFO    -  Documentation built}}" >&2; exit "${{FAKE_MKDOCS_RC:-0}}"; fi
 exit 0
 """)
     _write_exe(venv_bin / "tcp-pendant", f"#!/bin/sh\necho tcp-pendant \"$@\" >> {log}\n")
@@ -254,12 +256,34 @@ def test_run_tests_with_a_bad_chromium_override_says_so(stamped: Path) -> None:
 
 
 # ---------------------------------------------------------------- the type check
-def test_run_tests_type_checks_before_the_tests(stamped: Path) -> None:
+def test_run_tests_type_checks_and_builds_the_site_before_the_tests(stamped: Path) -> None:
+    """mypy, then ``mkdocs build --strict`` into a scratch folder (quiet when it builds), then pytest."""
     (stamped.parent / "bin" / "chromium").symlink_to(shutil.which("true") or "/bin/true")
-    p = run(stamped, "run-tests.sh", "-q")
+    p = run(stamped, "run-tests.sh", "-q", TMPDIR=str(stamped.parent))
     assert p.returncode == 0, p.stderr
-    assert [c for c in calls(stamped) if c.startswith("python")] == [
-        "python [-m] [mypy]", "python [-m] [pytest] [-q]"]
+    python_calls = [c for c in calls(stamped) if c.startswith("python")]
+    assert len(python_calls) == 3, python_calls
+    assert python_calls[0] == "python [-m] [mypy]"
+    assert python_calls[1].startswith("python [-m] [mkdocs] [build] [--strict] [--site-dir] "
+                                      f"[{stamped.parent}/tcp-pendant-site-")
+    assert python_calls[2] == "python [-m] [pytest] [-q]"
+    assert "Documentation built" not in p.stdout + p.stderr
+    assert not list(stamped.parent.glob("tcp-pendant-site-*"))      # the scratch site is removed
+
+
+def test_run_tests_fails_when_the_site_does_not_build_and_runs_no_test(stamped: Path) -> None:
+    """A broken link (or a docstring reference that does not resolve) fails ``mkdocs build
+    --strict``: its warnings are shown without the INFO lines, then one line, exit 1, no pytest."""
+    (stamped.parent / "bin" / "chromium").symlink_to(shutil.which("true") or "/bin/true")
+    warning = "WARNING -  Doc file 'cli.md' contains a link 'nowhere.md', but the target is not found among documentation files."
+    p = run(stamped, "run-tests.sh", "-q", FAKE_MKDOCS_RC="1", TMPDIR=str(stamped.parent),
+            FAKE_MKDOCS_OUT=f"INFO    -  Building documentation\\n{warning}\\nAborted with 1 warnings in strict mode!")
+    assert p.returncode == 1
+    assert warning in p.stderr
+    assert "INFO" not in p.stderr
+    assert p.stderr.strip().splitlines()[-1] == (
+        "run-tests.sh: the documentation site does not build (mkdocs build --strict: the warnings above); no test ran.")
+    assert pytest_calls(stamped) == []
 
 
 def test_run_tests_fails_on_a_type_error_with_mypy_s_output_and_runs_no_test(stamped: Path) -> None:

@@ -193,8 +193,10 @@ class ClassRoom:
         exercise: None (free practice) or "mystery".
         exercise_seed: the seed of the mystery tools; None: the class's own secret seed, kept in
             the gradebook.
-        instructions, allowed_methods, min_touches: the exercise's brief given at start (None:
-            the brief kept in the gradebook, else none); each given one wins over the kept one.
+        instructions: the exercise's instructions given at start (None: those kept in the
+            gradebook, else none); each part of the brief given wins over the kept one.
+        allowed_methods: the methods the exercise allows, given at start (None: as kept).
+        min_touches: the fewest touches a Finish takes, given at start (None: as kept).
         hand_to_loop: runs a function on viser's event loop.
         clock: Unix time, seconds (the token's lockout windows, kept in the gradebook for every
             process of the class; tests set it).

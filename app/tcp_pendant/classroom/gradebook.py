@@ -378,9 +378,8 @@ class BoardTrainee:
 class BoardRun:
     """A calibration in progress (``Gradebook.board``), for the trainer.
 
-    Attributes:
-        calibration_id, trainee, method (key), method_title ("" unknown), step ("" unknown),
-        step_since / started_at (UTC ISO 8601, "" unknown), touches (that count).
+    Fields: calibration_id, trainee, method (key), method_title ("" unknown), step ("" unknown),
+    step_since / started_at (UTC ISO 8601, "" unknown), touches (that count).
     """
 
     calibration_id: int
@@ -432,7 +431,7 @@ CSV_COLUMNS: tuple[str, ...] = (
     "tcp_x_mm", "tcp_y_mm", "tcp_z_mm", "a_deg", "b_deg", "c_deg",
     *CSV_FIGURES, "position_error_mm", "orientation_error_deg", "grade", "figures_json", "status",
 )
-"""Columns of :func:`to_csv` (a contract: docs/architecture.md "Classroom (gradebook)")."""
+"""Columns of :func:`to_csv` (a contract: docs/pendant-cli.md "tcp-pendant grades")."""
 
 
 def _cell(value: Any) -> str:
@@ -1042,7 +1041,8 @@ class Gradebook:
 
         Args:
             figures: quality figures by name (``WizardResult.figures``: mm, deg, counts).
-            position_error_mm / orientation_error_deg: error against the truth (None: not known).
+            position_error_mm: position error against the truth (None: not known).
+            orientation_error_deg: orientation error against the truth (None: not known).
             grade: "good" | "fair" | "poor" | None.
             tcp_mm: computed TCP (3, mm) or None; abc_deg: computed KUKA A, B, C (3, deg) or None.
         """

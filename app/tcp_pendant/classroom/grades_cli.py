@@ -8,7 +8,7 @@ One row per calibration, finished or still in progress (oldest first): trainee, 
 touches (hand / auto), overwritten touches, crashes, duration, result figures, error against
 the true TOOL frame, the grade and the status. Without ``--csv`` a table for the terminal; with
 ``--csv`` the columns of :data:`tcp_pendant.classroom.gradebook.CSV_COLUMNS`
-(docs/architecture.md, "Classroom (gradebook)"). ``--per-trainee``: one row per trainee
+(docs/pendant-cli.md, "tcp-pendant grades"). ``--per-trainee``: one row per trainee
 (``classroom.lms``: attempts, best and last grade); ``--moodle``: that as the CSV Moodle's
 gradebook imports. The gradebook is read where
 the server writes it (``--class-db``, default ``user_data_dir("tcp-pendant")/class.sqlite3``,
@@ -44,7 +44,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help=f"the gradebook the server writes: a file (default: {default_gradebook_path()}) "
                         "or the class's postgresql://USER@HOST:PORT/DATABASE URL")
     p.add_argument("--csv", action="store_true",
-                   help="print CSV (columns in docs/architecture.md) instead of a table")
+                   help="print CSV (columns in docs/pendant-cli.md) instead of a table")
     p.add_argument("--per-trainee", action="store_true",
                    help="one row per trainee: attempts, best and last grade and position error")
     p.add_argument("--moodle", action="store_true",

@@ -5,8 +5,8 @@
 :class:`TraineeGrade` per trainee: attempts, the best and the last grade, their position
 errors. Two CSV layouts are written from it:
 
-* :func:`per_trainee_csv`: the columns of :data:`PER_TRAINEE_COLUMNS` (a contract, docs in
-  README "Running a class");
+* :func:`per_trainee_csv`: the columns of :data:`PER_TRAINEE_COLUMNS` (a contract, documented in
+  docs/pendant-cli.md "tcp-pendant grades");
 * :func:`moodle_csv`: the layout Moodle's gradebook imports (Grades > Import > CSV file,
   https://docs.moodle.org/en/Grade_import): a header row, one row per learner, a column that
   identifies the learner (the teacher maps it to "username" or "useremail" in the import form;
