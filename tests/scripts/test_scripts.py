@@ -123,6 +123,36 @@ def test_run_app_without_a_venv_and_no_index_fails_with_a_hint(repo: Path) -> No
     assert not any(c.startswith("tcp-pendant") for c in calls(repo))
 
 
+def _fake_interpreter(repo: Path, name: str, minor: int) -> None:
+    """A ``name`` on PATH that is Python 3.``minor``: it answers the scripts' version check and
+    logs ``-m venv``."""
+    log = repo / "calls.log"
+    _write_exe(repo.parent / "bin" / name, f"""#!/bin/sh
+if [ "$1" = -c ]; then [ {minor} -ge 11 ]; exit $?; fi
+echo "{name} $*" >> {log}
+""")
+
+
+def test_a_new_venv_is_made_with_the_first_python_of_at_least_3_11(repo: Path) -> None:
+    shutil.rmtree(repo / ".venv")
+    _fake_interpreter(repo, "python3", 10)                   # Ubuntu 22.04's python3
+    _fake_interpreter(repo, "python3.11", 11)                # and its python3.11 package
+    run(repo, "run-app.sh", "--help")
+    assert "python3.11 -m venv .venv" in calls(repo)
+    assert not any(c.startswith("python3 ") for c in calls(repo))
+
+
+def test_without_python_3_11_the_scripts_say_what_to_install(repo: Path) -> None:
+    shutil.rmtree(repo / ".venv")
+    _fake_interpreter(repo, "python3", 10)
+    p = run(repo, "run-tests.sh")
+    assert p.returncode != 0
+    assert "needs Python 3.11 or newer" in p.stderr and "apt install python3.11 python3.11-venv" in p.stderr
+    assert "PYTHON=" in p.stderr and calls(repo) == []                  # nothing was made or run
+    p = run(repo, "run-app.sh", PYTHON="python3")                       # a PYTHON that is too old
+    assert p.returncode != 0 and "python3 is older or missing" in p.stderr
+
+
 def test_the_test_stamp_covers_the_app_but_not_the_reverse(repo: Path) -> None:
     (repo / ".venv" / f".installed-test-{sha(repo)}").touch()
     assert run(repo, "run-app.sh").returncode == 0 and pip_calls(repo) == []
