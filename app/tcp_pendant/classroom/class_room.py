@@ -281,7 +281,7 @@ class ClassRoom:
         """This server process's id in the gradebook's presence table (host, pid, a nonce)."""
         self.presence_poll_s = float(presence_poll_s)
         self._remote: dict[str, TraineeStatus] = {}   # name -> row, connected on another process
-        self._push_seen = gradebook.pushes.last_id()    # the pushes before are in the kept settings
+        self._push_seen = gradebook.pushes.last_id()  # the pushes before are in the kept settings
         self._beater: threading.Thread | None = None
         self._stopping = threading.Event()
         self._apply_kept(exercise_given=exercise is not None)   # what the trainer pushed before a restart
@@ -784,7 +784,7 @@ class ClassRoom:
         entry = self._entry_of(name) if isinstance(name, str) else None
         if entry is None and forward and self._on_another_process(name):
             self.gradebook.pushes.add({"holder": self.holder, "kind": "push_to", "name": name, "exercise": exercise,
-                                     "tool_key": tool_key, "hide_distance": hide_distance, "auto_touch": auto_touch})
+                                       "tool_key": tool_key, "hide_distance": hide_distance, "auto_touch": auto_touch})
             return f"Pushed to {name} (on another server process of the class)."
         if entry is None:
             return f"{name} is not connected: nothing pushed."
@@ -923,7 +923,7 @@ class ClassRoom:
         if keep:
             self._keep_pushed(tool_key)
             self.gradebook.pushes.add({"holder": self.holder, "kind": "settings", "exercise": exercise,
-                                     "tool_key": tool_key, "hide_distance": named, "auto_touch": auto_touch})
+                                       "tool_key": tool_key, "hide_distance": named, "auto_touch": auto_touch})
         with self._lock:
             trainees = list(self._trainees.values())
         for session, recorder, name in trainees:
@@ -961,8 +961,8 @@ class ClassRoom:
         if keep:
             self._keep_pushed(None, brief_only=True)
             self.gradebook.pushes.add({"holder": self.holder, "kind": "brief", "instructions": text,
-                                     "allowed_methods": None if methods is None else list(methods),
-                                     "min_touches": minimum})
+                                       "allowed_methods": None if methods is None else list(methods),
+                                       "min_touches": minimum})
         rules = self.rules
         with self._lock:
             trainees = list(self._trainees.values())
