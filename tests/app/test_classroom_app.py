@@ -63,15 +63,15 @@ def test_a_trainee_leaving_while_the_table_is_read_is_in_it_connected_or_left(ap
         _join(s, "Anna")
         assert [row.name for row in app.classroom.trainee_statuses()] == ["Anna"]
         room = app.classroom
-        real = room.gradebook.departed
+        real = room.gradebook.presence.departed
 
         def departed_then_anna_leaves(*args, **kwargs):
             rows = real(*args, **kwargs)
-            room.gradebook.departed = real
+            room.gradebook.presence.departed = real
             room.detach(s)                         # Anna's browser closes just after the read
             return rows
 
-        room.gradebook.departed = departed_then_anna_leaves
+        room.gradebook.presence.departed = departed_then_anna_leaves
         rows = room.trainee_statuses()
         assert [row.name for row in rows] == ["Anna"], rows
         assert [(row.name, row.connected) for row in room.trainee_statuses()] == [("Anna", False)]

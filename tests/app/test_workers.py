@@ -254,7 +254,7 @@ def test_two_processes_share_one_postgresql_gradebook(tmp_path: Path, postgres_s
                 for i in range(6):                  # one after another, as a class arrives
                     clients += await connect_all("127.0.0.1", port, 1, names="Pg", first=i)
                     await until(f"trainee {i + 1} present", lambda: len(book.presence.present()) >= i + 1,
-                                detail=book.present)
+                                detail=book.presence.present)
                 per_pid = trainees_per_process(book.presence.present())
                 # the same name again, from a new browser: whichever process it reaches refuses it
                 intruder = (await connect_all("127.0.0.1", port, 1, names="Pg", first=0))[0]
