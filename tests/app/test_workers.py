@@ -181,7 +181,8 @@ def test_wrong_trainer_tokens_lock_the_address_out_on_both_processes(workers2) -
             book = Gradebook(db)
             try:
                 rows = await until("every browser named", lambda: (
-                    named := [r for r in book.presence.present() if r[0].startswith("Guess ")]) and len(named) == len(refused) and named)
+                    named := [r for r in book.presence.present() if r[0].startswith("Guess ")])
+                    and len(named) == len(refused) and named)
             finally:
                 book.close()
             return notes, {int(holder.split(":")[-2]) for _, holder, _ in rows}

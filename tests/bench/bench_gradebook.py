@@ -88,10 +88,12 @@ def postgres_rows(url: str, repeats: int, reps: int) -> list[tuple[str, float, f
         sid = book.records.start_session(book.trainees.add("Bench"), "own")
         cid = book.records.start_calibration(sid, "xyz4", "pointer", np.eye(4))
         rows.append(("record_touch, PostgreSQL",
-                     *timings_us(lambda i: book.records.record_touch(cid, i % 4, POSE, JOINTS, 0.1, i % 2 == 0), repeats)))
+                     *timings_us(lambda i: book.records.record_touch(cid, i % 4, POSE, JOINTS, 0.1, i % 2 == 0),
+                                 repeats)))
         for _ in range(repeats):
-            book.records.finish_calibration(book.records.start_calibration(sid, "xyz4", "pointer", np.eye(4)), {"mean_error_mm": 0.2},
-                                            position_error_mm=0.3, orientation_error_deg=None, grade="good")
+            book.records.finish_calibration(book.records.start_calibration(sid, "xyz4", "pointer", np.eye(4)),
+                                            {"mean_error_mm": 0.2}, position_error_mm=0.3, orientation_error_deg=None,
+                                            grade="good")
         rows.append((f"grades() of {repeats} rows, PostgreSQL", *timings_us(lambda i: book.grades.rows(), reps)))
     return rows
 

@@ -40,7 +40,8 @@ def test_the_board_is_rebuilt_from_the_file_after_a_restart(gradebook_target: Pa
     sessions = {}
     for name, seed in (("Anna", 3), ("Ben <b>", 4)):
         s = make_session(tmp_path / f"tools-{seed}.json", seed=seed)
-        rec = TraineeRecorder(book, book.records.start_session(book.trainees.add(name), "per-browser"), name, s.workflow)
+        sid = book.records.start_session(book.trainees.add(name), "per-browser")
+        rec = TraineeRecorder(book, sid, name, s.workflow)
         s.subscribe(rec.on_change)
         sessions[name] = s
     anna, ben = sessions["Anna"], sessions["Ben <b>"]
@@ -87,7 +88,8 @@ def test_the_board_is_rebuilt_from_the_file_after_a_restart(gradebook_target: Pa
 
 def test_the_step_clock_restarts_only_with_a_new_step(gradebook_target: Path | str) -> None:
     with Gradebook(gradebook_target) as book:
-        cid = book.records.start_calibration(book.records.start_session(book.trainees.add("Anna"), "x"), "xyz4", "pointer", T)
+        sid = book.records.start_session(book.trainees.add("Anna"), "x")
+        cid = book.records.start_calibration(sid, "xyz4", "pointer", T)
         book.run_states.save(cid, {"n": 1}, method_title="XYZ 4-point", step="Step 1 of 4")
         with book.store.write() as db:              # the step began long ago
             db.execute("UPDATE run_states SET step_since = '2020-01-01T00:00:00.000+00:00'")

@@ -521,7 +521,8 @@ class ClassRoom:
         if self._holder(name, session) is not None:
             return
         try:
-            self.gradebook.presence.depart(name, dataclasses.asdict(dataclasses.replace(recorder.status, connected=False)))
+            left = dataclasses.replace(recorder.status, connected=False)
+            self.gradebook.presence.depart(name, dataclasses.asdict(left))
         except GradebookError:
             log.exception("the departure of %r could not be kept", name)
 
@@ -641,7 +642,8 @@ class ClassRoom:
         now = self.clock()
         source = source_address(session)
         try:
-            wait, failures, counted = self.gradebook.token_failures.try_token(source, now=now, forget_s=FORGET_S, lock_s=lock_s)
+            wait, failures, counted = self.gradebook.token_failures.try_token(source, now=now, forget_s=FORGET_S,
+                                                                              lock_s=lock_s)
         except GradebookError as exc:
             log.error("a trainer token was not tried: %s", exc)
             raise ValueError("The class gradebook cannot be read now, so no trainer token is tried; "

@@ -86,7 +86,8 @@ class Presence:
             held = {str(r[0]) for r in db.execute("SELECT name FROM presence WHERE holder = ?", (str(holder),))}
         return held & set(statuses)
 
-    def present(self, *, stale_s: float = PRESENCE_STALE_S, now: float | None = None) -> list[tuple[str, str, dict[str, Any]]]:
+    def present(self, *, stale_s: float = PRESENCE_STALE_S,
+                now: float | None = None) -> list[tuple[str, str, dict[str, Any]]]:
         """``(name, holder, status)`` of every connected trainee of every server process, by
         name (rows whose holder stopped beating ``stale_s`` ago are left out)."""
         t = time.time() if now is None else now
