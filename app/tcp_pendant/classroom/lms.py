@@ -1,7 +1,7 @@
 """Grades for a learning management system: one row per trainee (no viser, no SQL).
 
 ``tcp-pendant grades`` lists one row per calibration; an LMS wants one grade per learner.
-:func:`per_trainee` folds the gradebook's rows (``Gradebook.grades``) into one
+:func:`per_trainee` folds the gradebook's rows (``Gradebook.grades.rows``) into one
 :class:`TraineeGrade` per trainee: attempts, the best and the last grade, their position
 errors. Two CSV layouts are written from it:
 
@@ -25,7 +25,8 @@ import io
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
-from tcp_pendant.classroom.gradebook import GRADES, GradeRow
+from tcp_pendant.classroom.grade_rows import GradeRow
+from tcp_pendant.classroom.gradebook_schema import GRADES
 
 __all__ = ["MOODLE_POINTS", "PER_TRAINEE_COLUMNS", "TraineeGrade", "moodle_csv", "per_trainee", "per_trainee_csv"]
 

@@ -1,6 +1,6 @@
 """Mystery tools: a tool per trainee whose true TCP and orientation are drawn
 from the exercise seed and the trainee's name, so answers differ between trainees. The seed of
-a class is a secret (``Gradebook.exercise_seed``: random, kept in the gradebook): this code is
+a class is a secret (``Gradebook.settings.exercise_seed``: random, kept in the gradebook): this code is
 public, so whoever knows the seed and a name computes that trainee's tool.
 
 :func:`draw_mystery_tool` draws (deterministically: same seed, name and base tool, same tool on

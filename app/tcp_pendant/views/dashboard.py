@@ -38,7 +38,7 @@ import numpy as np
 
 from tcp_pendant.calibrate.chart import CHART_LEGEND
 from tcp_pendant.classroom.board import DEFAULT_STUCK_MIN, DashboardRow, dashboard_rows, open_runs
-from tcp_pendant.classroom.gradebook import ClassBoard
+from tcp_pendant.classroom.class_board import ClassBoard
 from tcp_pendant.classroom.grading import grade_record
 from tcp_pendant.classroom.replay import CalibrationReplay
 from tcp_pendant.job_pool import JobRefused
