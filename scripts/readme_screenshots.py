@@ -1,4 +1,4 @@
-"""Regenerate the README's two screenshots and keep the caption's numbers true.
+"""Regenerate the documentation's two screenshots and keep the caption's numbers true.
 
 Starts the pendant in this process (default KR 6 and pointer, a throw-away tool library) on a
 free port and drives it in Debian's chromium with Playwright like a trainer would:
@@ -13,10 +13,11 @@ Every random source is seeded: Auto-touch draws its directions and operator erro
 session's generator, which a server started with ``--seed SEED`` draws for each session
 (``PendantApp.session_rng``). :func:`seeded_figures` computes the same calibration without a browser
 (the same controller, workflow and auto-touch calls); the script checks that the browser shows
-those figures, then writes them into the README caption (:func:`update_caption`).
+those figures, then writes them into the caption under the 4-point screenshot in the trainer's
+guide, ``docs/trainer.md`` (:func:`update_caption`).
 ``tests/scripts/test_readme_screenshots.py`` compares the caption with :func:`seeded_figures`.
 
-    .venv/bin/python scripts/readme_screenshots.py [--out-dir docs/images] [--readme README.md]
+    .venv/bin/python scripts/readme_screenshots.py [--out-dir docs/images] [--page docs/trainer.md]
 """
 
 from __future__ import annotations
@@ -43,12 +44,12 @@ SIGMA_MM = 0.3
 """Simulated operator error of Auto-touch, mm per axis."""
 CAPTION = re.compile(r"the TCP is (?P<error>\d+\.\d+) mm from the true one,\s+(?P<inside>inside|outside) its "
                      r"95 % radius of (?P<ci95>\d+\.\d+) mm")
-"""The numbers of the README caption under the 4-point screenshot."""
+"""The numbers of the caption under the 4-point screenshot (docs/trainer.md)."""
 
 
 @dataclass(frozen=True)
 class CaptionFigures:
-    """The figures the README caption quotes (mm).
+    """The figures the caption quotes (mm).
 
     Attributes:
         position_error_mm: distance of the computed TCP from the true one.
@@ -102,18 +103,18 @@ def _figures(workflow: Any) -> CaptionFigures:
     return CaptionFigures(position_error_mm=float(truth.position_error_mm), ci95_mm=float(result.ci95_mm))
 
 
-def caption_figures(readme_text: str) -> tuple[float, bool, float]:
-    """(position error, inside?, 95 % radius) as the README caption states them."""
-    m = CAPTION.search(readme_text)
+def caption_figures(page_text: str) -> tuple[float, bool, float]:
+    """(position error, inside?, 95 % radius) as the caption states them."""
+    m = CAPTION.search(page_text)
     if m is None:
-        raise ValueError("README.md has no caption 'the TCP is X mm from the true one, inside its 95 % radius "
+        raise ValueError("the page has no caption 'the TCP is X mm from the true one, inside its 95 % radius "
                          "of Y mm'")
     return float(m["error"]), m["inside"] == "inside", float(m["ci95"])
 
 
-def update_caption(readme_text: str, figures: CaptionFigures) -> str:
-    """The README text with the caption's numbers set to ``figures`` (2 decimals)."""
-    caption_figures(readme_text)                     # raises when the caption is missing
+def update_caption(page_text: str, figures: CaptionFigures) -> str:
+    """The page's text with the caption's numbers set to ``figures`` (2 decimals)."""
+    caption_figures(page_text)                     # raises when the caption is missing
 
     def fill(m: re.Match[str]) -> str:
         where = "inside" if figures.inside else "outside"
@@ -121,7 +122,7 @@ def update_caption(readme_text: str, figures: CaptionFigures) -> str:
         return (f"the TCP is {figures.position_error_mm:.2f}{gap}{where} its 95 % radius of "
                 f"{figures.ci95_mm:.2f} mm")
 
-    return CAPTION.sub(fill, readme_text, count=1)
+    return CAPTION.sub(fill, page_text, count=1)
 
 
 # ------------------------------------------------------------------ the browser run
@@ -191,7 +192,8 @@ def shoot_xyz4(page: Any, url: str, app: Any, out: Path) -> CaptionFigures:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out-dir", type=Path, default=ROOT / "docs" / "images")
-    parser.add_argument("--readme", type=Path, default=ROOT / "README.md")
+    parser.add_argument("--page", type=Path, default=ROOT / "docs" / "trainer.md",
+                        help="the page whose caption gets the numbers (default: docs/trainer.md)")
     args = parser.parse_args()
     from playwright.sync_api import sync_playwright
 
@@ -222,9 +224,9 @@ def main() -> None:
             app.stop()
     if figures != expected:
         raise SystemExit(f"the browser run gave {figures}, the seeded run without a browser {expected}")
-    text = args.readme.read_text(encoding="utf-8")
-    args.readme.write_text(update_caption(text, figures), encoding="utf-8")
-    print(f"caption in {args.readme}: TCP {figures.position_error_mm:.2f} mm from the true one, "
+    text = args.page.read_text(encoding="utf-8")
+    args.page.write_text(update_caption(text, figures), encoding="utf-8")
+    print(f"caption in {args.page}: TCP {figures.position_error_mm:.2f} mm from the true one, "
           f"95 % radius {figures.ci95_mm:.2f} mm")
 
 

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Set up everything the test suite needs on a fresh machine, type-check the code (mypy), check
-# the import layers (lint-imports), then run the tests.
-#   bash scripts/run-tests.sh            # mypy, lint-imports, then the whole suite (unit, property, CLI, browser)
+# the import layers (lint-imports), build the documentation site (mkdocs build --strict), then
+# run the tests.
+#   bash scripts/run-tests.sh            # mypy, lint-imports, the site, then the whole suite (unit, property, CLI, browser)
 #   bash scripts/run-tests.sh -m browser # only the browser end-to-end tests
 # The browser tests drive Debian's chromium (Playwright cannot download its own browser here):
 # when it is missing it is installed with apt-get as root (or through sudo). A user who can do
@@ -30,6 +31,21 @@ fi
 # breaks one fails the run before any test.
 if ! .venv/bin/lint-imports --no-logo; then
   echo "run-tests.sh: lint-imports found the imports listed above that break a layer contract; no test ran." >&2
+  exit 1
+fi
+
+# Then the documentation site (mkdocs.yml, into a scratch folder, removed after): a broken link
+# or anchor, a page left out of the nav, or a docstring the API reference cannot parse or resolve
+# fails the run before any test. Quiet when it builds; on failure its warnings, then one line.
+site_dir="${TMPDIR:-/tmp}/tcp-pendant-site-$$"
+site_rc=0
+site_log="$(NO_MKDOCS_2_WARNING=1 .venv/bin/python -m mkdocs build --strict --site-dir "$site_dir" 2>&1)" || site_rc=$?
+rm -rf "$site_dir"
+if [ "$site_rc" != 0 ]; then
+  while IFS= read -r line; do
+    case "$line" in INFO*) ;; *) printf '%s\n' "$line" >&2 ;; esac
+  done <<< "$site_log"
+  echo "run-tests.sh: the documentation site does not build (mkdocs build --strict: the warnings above); no test ran." >&2
   exit 1
 fi
 

@@ -18,9 +18,29 @@ pyproject_sha256() {
   fi
 }
 
+# The interpreter a new .venv is made with: $PYTHON when set, else the first of python3,
+# python3.13, python3.12 and python3.11 on PATH that is Python 3.11 or newer (the oldest the
+# whole test suite runs on; Ubuntu 22.04's python3 is 3.10, its python3.11 package is found).
+pick_python() {
+  local py
+  for py in ${PYTHON:-python3 python3.13 python3.12 python3.11}; do
+    if command -v "$py" >/dev/null 2>&1 && "$py" -c 'import sys; sys.exit(sys.version_info < (3, 11))' 2>/dev/null; then
+      echo "$py"
+      return 0
+    fi
+  done
+  echo "error: TCP Pendant needs Python 3.11 or newer with venv, and ${PYTHON:-python3} is older or missing." \
+       "On Ubuntu 22.04: sudo apt install python3.11 python3.11-venv (then run this again; it is found" \
+       "by itself), or point PYTHON at another interpreter: PYTHON=/path/to/python3.12 bash $0" >&2
+  return 1
+}
+
 ensure_venv() {
-  local extra="$1" sum spec="."
-  [ -x .venv/bin/python ] || python3 -m venv .venv
+  local extra="$1" sum spec="." py
+  if [ ! -x .venv/bin/python ]; then
+    py="$(pick_python)" || return 1
+    "$py" -m venv .venv
+  fi
   sum="$(pyproject_sha256)"
   if [ -e ".venv/.installed-$extra-$sum" ] || [ -e ".venv/.installed-test-$sum" ]; then
     return 0

@@ -2,7 +2,7 @@
 
 Unit-agnostic (lengths come out in the unit they went in; the CLI speaks mm and degrees),
 numpy/scipy only, no UI and no robot model. The methods and their equations are described in
-``docs/methods.md``; the public interfaces in ``docs/architecture.md``.
+``docs/methods.md``; the public interfaces in the API reference (``docs/reference/tcpcal.md``).
 
 Typical use::
 

@@ -1,4 +1,4 @@
-"""The errors tcpcal raises (docs/architecture.md, ``tcpcal/errors.py``).
+"""The errors tcpcal raises.
 
 Every error the package raises on bad input is a :class:`TcpcalError`, itself a
 ``ValueError`` so that callers that already catch ``ValueError`` keep working. Messages name

@@ -1,4 +1,4 @@
-"""Tool data: a calibrated tool as a controller stores it (docs/architecture.md, ``tool.py``).
+"""Tool data: a calibrated tool as a controller stores it.
 
 A :class:`Tool` is the TOOL frame of one physical tool: its TCP ``t`` in FLANGE coordinates
 (millimetres) and the orientation ``R_flange_tool`` as KUKA A, B, C angles in degrees
@@ -10,7 +10,7 @@ Names follow a controller's tool table: 1 to :data:`MAX_NAME_LENGTH` (24) printa
 spaces other than U+0020), no double quote (it ends a string literal in KRL and RAPID), no
 leading or trailing spaces. Every Tool is checked when it is made, so this holds for names
 typed in the pendant, given to ``tcpcal tools add``, set by ``ToolLibrary.rename`` or read from
-a library file. What each controller format accepts beyond that: README.md, "Tool names".
+a library file. What each controller format accepts beyond that: docs/cli.md, "Tool names".
 
 Dictionary form (``Tool.to_dict`` / ``Tool.from_dict``; the tool library file stores exactly
 this, so scripts may rely on these keys; they are a stable contract)::

@@ -70,12 +70,12 @@ def test_a_name_connected_on_one_process_is_refused_on_the_other_and_its_browser
         b.classroom.beat()
         assert a.classroom.connected_names() == b.classroom.connected_names() == ["Anna"]
         assert [(r.name, r.connected) for r in b.classroom.trainee_statuses()] == [("Anna", True)]
-        assert b.gradebook.presence_holder("Anna") == a.classroom.holder
+        assert b.gradebook.presence.holder("Anna") == a.classroom.holder
         # the same browser (its key) on B takes the name; A's tab returns to the welcome window
         cb2 = DrainingClient(b.port)
         sb2 = _session(b, 2)
         assert _join(sb2, "Anna", key).name == "Anna"
-        assert b.gradebook.presence_holder("Anna") == b.classroom.holder
+        assert b.gradebook.presence.holder("Anna") == b.classroom.holder
         a.classroom.beat()
         wait_until(lambda: "joined from another tab" in sa.views["identity"].message.content,
                    what="A's tab back at the welcome window")          # reopen sets the message last
@@ -117,7 +117,7 @@ def test_a_name_with_invisible_marks_is_refused_on_the_other_process(two) -> Non
         assert _join(sb, joined).name == joined
         with pytest.raises(TraineeNameError, match=f"^{bare} looks like {joined}, a name already in this class"):
             a.classroom.named(sa, bare, None)
-        assert a.gradebook.trainee_names() == ["Alice", joined]
+        assert a.gradebook.trainees.names() == ["Alice", joined]
         b.classroom.beat()
         assert sorted(a.classroom.connected_names()) == sorted(b.classroom.connected_names()) == ["Alice", joined]
     finally:
@@ -140,7 +140,7 @@ def test_a_reconnect_landing_on_the_other_process_resumes_the_calibration(two) -
             click(cal.steps.auto_touch, sa.client)
         before = sa.workflow.wizard
         poses = {k: p.T_world_flange_m.copy() for k, p in before.recorded_poses.items()}
-        (cid,) = [r.calibration_id for r in a.gradebook.grades(include_in_progress=True)]
+        (cid,) = [r.calibration_id for r in a.gradebook.grades.rows(include_in_progress=True)]
     finally:
         ca.close()                                   # the browser's connection drops ...
     wait_until(lambda: a.classroom.connected_names() == [], what="A noticing the disconnect")
@@ -157,7 +157,7 @@ def test_a_reconnect_landing_on_the_other_process_resumes_the_calibration(two) -
         for _ in range(2):                           # the touches land in the same calibration
             click(sb.views["calibrate"].steps.auto_touch, sb.client)
         assert wf.result is not None
-        rows = a.gradebook.grades()                   # A's connection sees B's writes
+        rows = a.gradebook.grades.rows()              # A's connection sees B's writes
         assert [(r.calibration_id, r.trainee, r.touches, r.status) for r in rows] == [(cid, "Anna", 5, "finished")]
     finally:
         cb.close()
@@ -289,7 +289,7 @@ def test_a_message_follows_its_trainee_to_the_other_process_until_dismissed(two)
                    what="the new message on B")
         click(box.dismiss, sb.client)
         wait_until(lambda: [m.text for m in sb.messages] == ["Anna, come to the front."], what="the dismissal on B")
-        assert [row[3] for row in a.gradebook.messages_for(["Anna"])["Anna"]] == ["Anna, come to the front."]
+        assert [row[3] for row in a.gradebook.messages.waiting(["Anna"])["Anna"]] == ["Anna, come to the front."]
     finally:
         if cb is not None:
             cb.close()

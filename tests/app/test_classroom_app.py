@@ -42,13 +42,13 @@ def test_name_prompt_records_the_trainee_and_escapes_the_name(app_factory, tmp_p
         click(prompt.start, _browser(s))
         assert prompt.name == "*Anna* <b>x</b>"
         assert "\\*Anna\\*" in prompt.banner.content and "<b>" not in prompt.banner.content
-        with Gradebook(tmp_path / "class.sqlite3") as book, book._read() as db:
+        with Gradebook(tmp_path / "class.sqlite3") as book, book.store.read() as db:
             assert db.execute("SELECT name FROM trainees").fetchall() == [("*Anna* <b>x</b>",)]
             assert db.execute("SELECT mode, ended_at FROM sessions").fetchall() == [("per-browser", None)]
     finally:
         c.close()
     wait_until(lambda: app.classroom.trainee_statuses()[0].connected is False, what="the session closed")
-    with Gradebook(tmp_path / "class.sqlite3") as book, book._read() as db:
+    with Gradebook(tmp_path / "class.sqlite3") as book, book.store.read() as db:
         assert db.execute("SELECT ended_at FROM sessions").fetchone()[0] is not None
 
 
@@ -63,15 +63,15 @@ def test_a_trainee_leaving_while_the_table_is_read_is_in_it_connected_or_left(ap
         _join(s, "Anna")
         assert [row.name for row in app.classroom.trainee_statuses()] == ["Anna"]
         room = app.classroom
-        real = room.gradebook.departed
+        real = room.gradebook.presence.departed
 
         def departed_then_anna_leaves(*args, **kwargs):
             rows = real(*args, **kwargs)
-            room.gradebook.departed = real
+            room.gradebook.presence.departed = real
             room.detach(s)                         # Anna's browser closes just after the read
             return rows
 
-        room.gradebook.departed = departed_then_anna_leaves
+        room.gradebook.presence.departed = departed_then_anna_leaves
         rows = room.trainee_statuses()
         assert [row.name for row in rows] == ["Anna"], rows
         assert [(row.name, row.connected) for row in room.trainee_statuses()] == [("Anna", False)]
@@ -90,7 +90,7 @@ def test_wizard_events_reach_the_gradebook_through_the_gui(app_factory, tmp_path
         for _ in range(4):
             click(cal.steps.auto_touch, _browser(s))
         assert cal.workflow.result is not None
-        rows = app.gradebook.grades()
+        rows = app.gradebook.grades.rows()
         assert len(rows) == 1 and rows[0].trainee == "Bo" and rows[0].auto == 4 and rows[0].hand == 0
         assert rows[0].grade == cal.workflow.truth().grade
         assert app.classroom.trainee_statuses()[0].step == "result"
@@ -146,7 +146,7 @@ def test_trainer_view_needs_the_token_and_shows_the_class_escaped(app_factory, t
         wait_until(lambda: "Record id" in view.grade_md.content, what="the record's grades")
         grade = cal.workflow.truth().grade
         assert f"| {grade} |" in view.grade_md.content and "matches the gradebook" in view.grade_md.content
-        assert [r.tool_key for r in app.gradebook.grades()] == ["torch"]
+        assert [r.tool_key for r in app.gradebook.grades.rows()] == ["torch"]
     finally:
         a.close()
         t.close()
@@ -173,9 +173,9 @@ def test_mystery_exercise_mounts_a_tool_per_trainee_and_grades_against_it(app_fa
         app.classroom.push_settings("mystery", None, auto_touch=True)   # off in an exercise unless allowed
         for _ in range(4):
             click(cal.steps.auto_touch, s1.client)
-        row = app.gradebook.grades()[0]
+        row = app.gradebook.grades.rows()[0]
         assert row.exercise_id == "mystery" and row.tool_key == k1.key
-        truth = app.gradebook.truth(row.calibration_id)
+        truth = app.gradebook.records.truth(row.calibration_id)
         np.testing.assert_allclose(truth["T_flange_tool_true_m"], true_frame(k1), atol=1e-12)
         assert row.position_error_mm == pytest.approx(cal.workflow.truth().position_error_mm)
     finally:
@@ -256,13 +256,13 @@ def test_a_connected_name_and_its_look_alikes_are_refused_until_the_trainer_rele
         wait_until(lambda: pa.name is None and "released the name Alice" in pa.message.content,
                    what="Alice's welcome window again")
         assert pa.key_html is None and pa.marker_html.content == "<div hidden data-tcp-pendant-forget></div>"
-        assert not app.gradebook.holds_key("Alice", key)
+        assert not app.gradebook.trainees.holds_key("Alice", key)
         # the released browser cannot take it straight back; another browser now can, with her records
         _join(alice, "Alice", key)
         assert pa.name is None and "released the name Alice from this browser" in pa.message.content
         _join(other, "Alice")
         assert po.name == "Alice" and _issued_key(po) != key
-        with app.gradebook._read() as db:
+        with app.gradebook.store.read() as db:
             assert db.execute("SELECT COUNT(*) FROM trainees").fetchone()[0] == 1
             assert db.execute("SELECT COUNT(*), COUNT(ended_at) FROM sessions").fetchone() == (2, 1)
         # a name connected again is listed once, as connected (who left is who is not connected now)
@@ -302,7 +302,7 @@ def test_a_browser_that_comes_back_proves_itself_with_its_key(app_factory, tmp_p
         p = _join(s, "Anna", key)
         assert p.name == "Anna"
         np.testing.assert_array_equal(true_frame(s.controller.mounted_tool), true_frame(tool))
-        with app2.gradebook._read() as book:
+        with app2.gradebook.store.read() as book:
             assert book.execute("SELECT COUNT(*) FROM trainees").fetchone()[0] == 1
     finally:
         c.close()
@@ -360,14 +360,14 @@ def test_the_same_browser_in_a_second_tab_takes_the_name_and_the_first_tab_holds
         wait_until(lambda: p1.name is None and "joined from another tab or window of this browser"
                    in p1.message.content, what="the first tab's welcome window")
         assert p1.marker_html.content == "<div hidden data-tcp-pendant-hold></div>"
-        assert app.gradebook.holds_key("Anna", key)                   # the key stays the browser's
+        assert app.gradebook.trainees.holds_key("Anna", key)          # the key stays the browser's
         assert [(t.name, t.connected) for t in app.classroom.trainee_statuses()] == [("Anna", True)]
         # the first tab's changes are no longer Anna's: a touch there is not recorded
         cal = first.views["calibrate"]
         click(cal.start, first.client)
         click(cal.steps.auto_touch, first.client)
-        assert app.gradebook.grades() == [] and app.classroom.trainee_statuses()[0].touches == 0
-        with app.gradebook._read() as db:
+        assert app.gradebook.grades.rows() == [] and app.classroom.trainee_statuses()[0].touches == 0
+        with app.gradebook.store.read() as db:
             assert db.execute("SELECT COUNT(*) FROM touches").fetchone()[0] == 0
     finally:
         for c in clients:

@@ -6,17 +6,18 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from tcp_pendant.classroom.gradebook import CSV_COLUMNS, Gradebook
+from tcp_pendant.classroom.gradebook import Gradebook
+from tcp_pendant.classroom.grades_csv import CSV_COLUMNS
 from tcp_pendant.serve.cli import build_parser, main
 
 
 def _book_with_one_row(path: Path) -> None:
     with Gradebook(path, synchronous="NORMAL") as g:
-        sid = g.start_session(g.add_trainee("=Anna"), "per-browser")
-        cal = g.start_calibration(sid, "xyz4", "pointer", np.eye(4))
-        g.record_touch(cal, 0, np.eye(4), [0.0] * 6, 0.1, False)
-        g.finish_calibration(cal, {"mean_error_mm": 0.2}, position_error_mm=0.3, orientation_error_deg=None,
-                             grade="good", tcp_mm=(1.0, 2.0, 3.0))
+        sid = g.records.start_session(g.trainees.add("=Anna"), "per-browser")
+        cal = g.records.start_calibration(sid, "xyz4", "pointer", np.eye(4))
+        g.records.record_touch(cal, 0, np.eye(4), [0.0] * 6, 0.1, False)
+        g.records.finish_calibration(cal, {"mean_error_mm": 0.2}, position_error_mm=0.3, orientation_error_deg=None,
+                                     grade="good", tcp_mm=(1.0, 2.0, 3.0))
 
 
 def test_grades_subcommand_prints_the_csv(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -80,7 +81,7 @@ def test_the_class_is_opt_in(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) ->
             raise Stop
 
     monkeypatch.setattr(server, "PendantApp", FakeApp)
-    import tcp_pendant.classroom.gradebook as gb
+    import tcp_pendant.classroom.gradebook_open as gb
 
     monkeypatch.setattr(gb, "default_gradebook_path", lambda: tmp_path / "data" / "class.sqlite3")
     for argv in (["--port", "0"], ["--port", "0", "--class"], ["--port", "0", "--exercise", "mystery"]):
@@ -103,11 +104,11 @@ def test_the_exercise_seed_is_the_classs_unless_given_and_never_printed(tmp_path
     with Gradebook(tmp_path / "class.sqlite3") as book:
         room = ClassRoom(book, {}, trainer_token="trainer-tok-12345678", exercise="mystery")
         seed = room._seed()
-        assert seed == book.exercise_seed() and seed.bit_length() > 20
+        assert seed == book.settings.exercise_seed() and seed.bit_length() > 20
         lines = _class_lines(SimpleNamespace(classroom=room, trainer_url="http://127.0.0.1:1/?trainer=tok-12345678"))
         assert "class gradebook" in lines and str(seed) not in lines
         assert ClassRoom(book, {}, trainer_token="trainer-tok-12345678", exercise_seed=7)._seed() == 7   # a demo's
-        assert book.exercise_seed() == seed                                                   # kept
+        assert book.settings.exercise_seed() == seed                                          # kept
 
 
 def test_server_with_an_unreachable_postgresql_gradebook_says_so_without_the_password(

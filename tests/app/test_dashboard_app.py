@@ -67,7 +67,7 @@ def test_the_dashboard_replaces_the_pendant_and_survives_a_restart(app_factory, 
         ben = _connect(app, clients, 1)
         key_ben = _key(_join(ben, "Ben"))
         _touches(anna, 6)                                 # Anna finishes
-        assert anna.workflow.result is not None and len(app.gradebook.grades()) == 1
+        assert anna.workflow.result is not None and len(app.gradebook.grades.rows()) == 1
         _touches(ben, 2)                                  # Ben stays at step 3
         trainer = _connect(app, clients, 2)
         dash = _dashboard(trainer)
@@ -124,9 +124,9 @@ def test_reset_and_push_act_on_the_chosen_trainee_only(app_factory, tmp_path: Pa
         click(dash.reset, trainer.client)
         wait_until(lambda: not anna.workflow.is_open, what="Anna's wizard reset")
         assert ben.workflow.is_open and ben.workflow.wizard.step_index == 1        # Ben untouched
-        statuses = {r.trainee: r.status for r in app.gradebook.grades(include_in_progress=True)}
+        statuses = {r.trainee: r.status for r in app.gradebook.grades.rows(include_in_progress=True)}
         assert statuses == {"Ben": "in_progress"}          # Anna's is cancelled in the gradebook
-        with app.gradebook._read() as db:
+        with app.gradebook.store.read() as db:
             assert db.execute("SELECT status FROM calibrations ORDER BY id").fetchall() == [("cancelled",), ("in_progress",)]
         wait_until(lambda: dash.rows[0].step == "cancelled", what="the reset on the dashboard")
         # push the torch and hidden distances to Ben only

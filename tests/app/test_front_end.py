@@ -145,7 +145,7 @@ def test_two_servers_behind_the_front_end_serve_one_class(app_factory, nginx_bin
             prompt = _join(session_of(app, len(app.sessions)), names[k])
             assert prompt.name == names[k]
         with Gradebook(url, create=False) as book:
-            assert book.held_names() == ["Ana", "Bea"]          # one class, two servers
+            assert book.trainees.held_names() == ["Ana", "Bea"]  # one class, two servers
 
         # the same route cookie leads to the same server again (the websocket of a reload)
         cookie_b, _ = by_app[1]

@@ -57,7 +57,7 @@ def test_a_restart_gives_the_wizard_back_at_its_step_with_its_touches(app_factor
         before = s.workflow.wizard
         poses = {k: p.T_world_flange_m.copy() for k, p in before.recorded_poses.items()}
         step, n_steps = before.step_index, before.n_steps
-        (cid,) = [r.calibration_id for r in app.gradebook.grades(include_in_progress=True)]
+        (cid,) = [r.calibration_id for r in app.gradebook.grades.rows(include_in_progress=True)]
         assert app.classroom.send_message("Anna: *slow down* near the tip.", to="Anna") == "Sent to Anna."
         wait_until(lambda: [m.text for m in s.messages] == ["Anna: *slow down* near the tip."], what="the message")
         now = [9000.0]
@@ -91,13 +91,13 @@ def test_a_restart_gives_the_wizard_back_at_its_step_with_its_touches(app_factor
         for _ in range(2):
             click(cal2.steps.auto_touch, s2.client)
         assert wf.result is not None
-        rows = again.gradebook.grades()
+        rows = again.gradebook.grades.rows()
         assert [(r.calibration_id, r.trainee, r.touches, r.status) for r in rows] == [(cid, "Anna", 5, "finished")]
         assert rows[0].grade == wf.truth().grade
     finally:
         c2.close()
     with Gradebook(db) as book:
-        assert book.open_runs("Anna") == []                  # finished: nothing left to give back
+        assert book.run_states.open_runs("Anna") == []       # finished: nothing left to give back
 
 
 def test_a_trainee_without_work_in_progress_starts_clean(app_factory, tmp_path: Path) -> None:
@@ -123,8 +123,8 @@ def test_the_trainer_token_outlives_a_restart_as_a_hash(app_factory, tmp_path: P
     assert token is not None and first.trainer_url.endswith(token)
     first.stop()
     with Gradebook(db) as book:
-        assert book.class_setting("trainer_token_sha256") == hashlib.sha256(token.encode()).hexdigest()
-        with book._read() as sql:
+        assert book.settings.get("trainer_token_sha256") == hashlib.sha256(token.encode()).hexdigest()
+        with book.store.read() as sql:
             assert token not in repr(sql.execute("SELECT * FROM meta").fetchall())
     again = app_factory(class_db=db)
     room = again.classroom
@@ -141,7 +141,7 @@ def test_the_trainer_token_outlives_a_restart_as_a_hash(app_factory, tmp_path: P
     renewed = app_factory(class_db=db, trainer_token=TOKEN)       # a new token replaces it
     assert renewed.classroom.trainer_token == TOKEN
     with Gradebook(db) as book:
-        assert book.class_setting("trainer_token_sha256") == hashlib.sha256(TOKEN.encode()).hexdigest()
+        assert book.settings.get("trainer_token_sha256") == hashlib.sha256(TOKEN.encode()).hexdigest()
 
 
 def test_pushed_settings_outlive_a_restart(app_factory, tmp_path: Path) -> None:

@@ -102,9 +102,9 @@ def test_two_processes_share_the_port_the_class_and_each_keeps_the_deadman(worke
             book = Gradebook(db)
             try:
                 deadline = time.monotonic() + 20
-                while len(book.present()) < 20 and time.monotonic() < deadline:
+                while len(book.presence.present()) < 20 and time.monotonic() < deadline:
                     await asyncio.sleep(0.1)
-                rows = book.present()
+                rows = book.presence.present()
             finally:
                 book.close()
             holders = {int(holder.split(":")[-2]) for _, holder, _ in rows}
@@ -150,7 +150,7 @@ def test_wrong_trainer_tokens_lock_the_address_out_on_both_processes(workers2) -
     port, pids, db = workers2
 
     def failures() -> list[float]:
-        with Gradebook(db) as book, book._read() as conn:
+        with Gradebook(db) as book, book.store.read() as conn:
             return sorted(float(r[0]) for r in conn.execute(
                 "SELECT failed_at FROM token_failures WHERE source = '127.0.0.1'"))
 
@@ -181,7 +181,8 @@ def test_wrong_trainer_tokens_lock_the_address_out_on_both_processes(workers2) -
             book = Gradebook(db)
             try:
                 rows = await until("every browser named", lambda: (
-                    named := [r for r in book.present() if r[0].startswith("Guess ")]) and len(named) == len(refused) and named)
+                    named := [r for r in book.presence.present() if r[0].startswith("Guess ")])
+                    and len(named) == len(refused) and named)
             finally:
                 book.close()
             return notes, {int(holder.split(":")[-2]) for _, holder, _ in rows}
@@ -221,8 +222,8 @@ def test_browsers_arriving_one_by_one_are_split_evenly_over_the_processes(worker
             book = Gradebook(db)
             try:
                 await until("every trainee present", lambda: len(
-                    [r for r in book.present() if r[0].startswith("Even ")]) == 16, detail=browsers)
-                rows = [r for r in book.present() if r[0].startswith("Even ")]
+                    [r for r in book.presence.present() if r[0].startswith("Even ")]) == 16, detail=browsers)
+                rows = [r for r in book.presence.present() if r[0].startswith("Even ")]
             finally:
                 book.close()
             return seen, trainees_per_process(rows)
@@ -237,7 +238,7 @@ def test_browsers_arriving_one_by_one_are_split_evenly_over_the_processes(worker
 
 @pytest.mark.timeout(300)
 def test_two_processes_share_one_postgresql_gradebook(tmp_path: Path, postgres_server) -> None:
-    """``--workers 2 --class-db postgresql://...`` (README's "1,000 trainees on ten machines",
+    """``--workers 2 --class-db postgresql://...`` (docs/large-class.md, "1,000 trainees on ten machines",
     one machine of them with its cores in use): both processes keep their trainees in the one
     PostgreSQL gradebook, six arriving trainees are split three per process (each one's
     process read from the database's presence rows), and a name already joined is refused to a
@@ -253,9 +254,9 @@ def test_two_processes_share_one_postgresql_gradebook(tmp_path: Path, postgres_s
             try:
                 for i in range(6):                  # one after another, as a class arrives
                     clients += await connect_all("127.0.0.1", port, 1, names="Pg", first=i)
-                    await until(f"trainee {i + 1} present", lambda: len(book.present()) >= i + 1,
-                                detail=book.present)
-                per_pid = trainees_per_process(book.present())
+                    await until(f"trainee {i + 1} present", lambda: len(book.presence.present()) >= i + 1,
+                                detail=book.presence.present)
+                per_pid = trainees_per_process(book.presence.present())
                 # the same name again, from a new browser: whichever process it reaches refuses it
                 intruder = (await connect_all("127.0.0.1", port, 1, names="Pg", first=0))[0]
                 clients.append(intruder)
@@ -263,7 +264,7 @@ def test_two_processes_share_one_postgresql_gradebook(tmp_path: Path, postgres_s
                 await until("the second 'Pg 001' refused",
                             lambda: any(n.startswith(refusal) for n in intruder.notes),
                             detail=lambda: intruder.notes)
-                return per_pid, sorted(name for name, _, _ in book.present())
+                return per_pid, sorted(name for name, _, _ in book.presence.present())
             finally:
                 book.close()
                 for c in clients:

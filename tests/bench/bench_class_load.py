@@ -126,7 +126,7 @@ def _trainees_per_process(db: Path, pids: list[int]) -> list[int]:
 
     book = Gradebook(db)
     try:
-        holders = [int(holder.split(":")[-2]) for _, holder, _ in book.present()]
+        holders = [int(holder.split(":")[-2]) for _, holder, _ in book.presence.present()]
     finally:
         book.close()
     return [holders.count(pid) for pid in pids]

@@ -85,14 +85,16 @@ def postgres_rows(url: str, repeats: int, reps: int) -> list[tuple[str, float, f
         finally:
             conn.execute("DROP TABLE bench_plain")
     with Gradebook(url) as book:
-        sid = book.start_session(book.add_trainee("Bench"), "own")
-        cid = book.start_calibration(sid, "xyz4", "pointer", np.eye(4))
+        sid = book.records.start_session(book.trainees.add("Bench"), "own")
+        cid = book.records.start_calibration(sid, "xyz4", "pointer", np.eye(4))
         rows.append(("record_touch, PostgreSQL",
-                     *timings_us(lambda i: book.record_touch(cid, i % 4, POSE, JOINTS, 0.1, i % 2 == 0), repeats)))
+                     *timings_us(lambda i: book.records.record_touch(cid, i % 4, POSE, JOINTS, 0.1, i % 2 == 0),
+                                 repeats)))
         for _ in range(repeats):
-            book.finish_calibration(book.start_calibration(sid, "xyz4", "pointer", np.eye(4)), {"mean_error_mm": 0.2},
-                                    position_error_mm=0.3, orientation_error_deg=None, grade="good")
-        rows.append((f"grades() of {repeats} rows, PostgreSQL", *timings_us(lambda i: book.grades(), reps)))
+            book.records.finish_calibration(book.records.start_calibration(sid, "xyz4", "pointer", np.eye(4)),
+                                            {"mean_error_mm": 0.2}, position_error_mm=0.3, orientation_error_deg=None,
+                                            grade="good")
+        rows.append((f"grades() of {repeats} rows, PostgreSQL", *timings_us(lambda i: book.grades.rows(), reps)))
     return rows
 
 
@@ -115,20 +117,20 @@ def main(argv: list[str] | None = None) -> None:
         rows.append(("baseline: plain INSERT+COMMIT, WAL file FULL", *timings_us(plain_insert(raw), repeats)))
         for sync in ("FULL", "NORMAL"):
             with Gradebook(folder / f"class-{sync}.sqlite3", synchronous=sync) as book:
-                sid = book.start_session(book.add_trainee("Bench"), "own")
-                cid = book.start_calibration(sid, "xyz4", "pointer", np.eye(4))
+                sid = book.records.start_session(book.trainees.add("Bench"), "own")
+                cid = book.records.start_calibration(sid, "xyz4", "pointer", np.eye(4))
                 rows.append((f"record_touch, synchronous={sync}",
-                             *timings_us(lambda i: book.record_touch(cid, i % 4, POSE, JOINTS, 0.1, i % 2 == 0),
+                             *timings_us(lambda i: book.records.record_touch(cid, i % 4, POSE, JOINTS, 0.1, i % 2 == 0),
                                          repeats)))
                 if sync == "FULL":
-                    cids = [book.start_calibration(sid, "xyz4", "pointer", np.eye(4)) for _ in range(repeats)]
+                    cids = [book.records.start_calibration(sid, "xyz4", "pointer", np.eye(4)) for _ in range(repeats)]
                     rows.append(("finish_calibration, synchronous=FULL", *timings_us(
-                        lambda i: book.finish_calibration(cids[i], {"mean_error_mm": 0.2, "ci95_mm": 0.8},
-                                                          position_error_mm=0.3, orientation_error_deg=None,
-                                                          grade="good", tcp_mm=(0, 0, 180)), repeats)))
+                        lambda i: book.records.finish_calibration(cids[i], {"mean_error_mm": 0.2, "ci95_mm": 0.8},
+                                                                  position_error_mm=0.3, orientation_error_deg=None,
+                                                                  grade="good", tcp_mm=(0, 0, 180)), repeats)))
                     reps = 5 if args.quick else 20
                     rows.append((f"grades() of {repeats} rows, {repeats} touches",
-                                 *timings_us(lambda i: book.grades(), reps)))
+                                 *timings_us(lambda i: book.grades.rows(), reps)))
     if args.postgres:
         rows.extend(postgres_rows(args.postgres, repeats, 5 if args.quick else 20))
     base = rows[0][1]

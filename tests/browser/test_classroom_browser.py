@@ -75,7 +75,7 @@ def test_two_trainees_and_the_trainer_view(pendant_server, new_page, shot, tmp_p
     from tcp_pendant.classroom.gradebook import Gradebook
 
     with Gradebook(db, create=False) as book:
-        rows = book.grades()
+        rows = book.grades.rows()
     assert [r.trainee for r in rows] == ["Anna <b>A</b>"]
     assert rows[0].exercise_id == "mystery" and rows[0].tool_key.startswith("mystery-") and rows[0].auto == 4
 
@@ -116,7 +116,7 @@ def test_the_browser_key_is_kept_in_local_storage_across_a_reload_and_a_restart(
         join(anna, "Anna")
         anna.wait_for_function(f"/^[A-Za-z0-9_-]{{43}}$/.test({KEY_JS} || '')", timeout=TIMEOUT_MS)
         key = anna.evaluate(KEY_JS)
-        assert app.gradebook.holds_key("Anna", key)
+        assert app.gradebook.trainees.holds_key("Anna", key)
         tool_key = next(s for s in app.sessions.values() if "identity" in s.views
                         and s.views["identity"].name == "Anna").controller.mounted_tool.key
         # another browser: refused in words while Anna is connected; it has no key in its storage
@@ -145,7 +145,7 @@ def test_the_browser_key_is_kept_in_local_storage_across_a_reload_and_a_restart(
         named = _wait(lambda: [s for s in app.sessions.values() if "identity" in s.views
                                and s.views["identity"].name == "Anna"], "Anna named after the restart")
         assert named[0].controller.mounted_tool.key == tool_key          # the class's seed survived
-        with app.gradebook._read() as book:
+        with app.gradebook.store.read() as book:
             assert book.execute("SELECT COUNT(*) FROM trainees").fetchone()[0] == 1
             assert book.execute("SELECT COUNT(*) FROM sessions").fetchone()[0] == 3
     finally:

@@ -70,7 +70,7 @@ def test_the_trainer_address_opens_a_projector_dashboard(pendant, new_page, shot
     app = pendant(class_db=tmp_path / "class.sqlite3", trainer_token=TOKEN, seed=11)
     clients = _class_of_three(app)
     try:
-        with app.gradebook._write() as db:          # Ben has been on his step for 12 minutes, no touch since
+        with app.gradebook.store.write() as db:     # Ben has been on his step for 12 minutes, no touch since
             db.execute("UPDATE run_states SET step_since = strftime('%Y-%m-%dT%H:%M:%f+00:00', 'now', '-12 minutes') "
                        "WHERE calibration_id = 2")
             db.execute("UPDATE touches SET recorded_at = strftime('%Y-%m-%dT%H:%M:%f+00:00', 'now', '-12 minutes') "

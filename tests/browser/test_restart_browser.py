@@ -88,7 +88,7 @@ def _in_progress(db: Path) -> list[tuple[str, int, str]]:
     from tcp_pendant.classroom.gradebook import Gradebook
 
     with Gradebook(db, create=False) as book:
-        return [(r.trainee, r.touches, r.status) for r in book.grades(include_in_progress=True)]
+        return [(r.trainee, r.touches, r.status) for r in book.grades.rows(include_in_progress=True)]
 
 
 LOCKED_JS = """() => { const b = [...document.querySelectorAll('input[type=checkbox]')]

@@ -21,22 +21,22 @@ def main(target: str, name: str, n_touches: int) -> None:
         return
     with Gradebook(target) as g:
         try:
-            g.join_trainee("Shared Sam")
+            g.trainees.join("Shared Sam")
             print("shared won", flush=True)
         except TraineeNameError:
             print("shared refused", flush=True)
-        me = g.join_trainee(name)
-        sid = g.start_session(me.trainee_id, "own")
-        cid = g.start_calibration(sid, "xyz4", "pointer", np.eye(4))
+        me = g.trainees.join(name)
+        sid = g.records.start_session(me.trainee_id, "own")
+        cid = g.records.start_calibration(sid, "xyz4", "pointer", np.eye(4))
         pose = np.eye(4)
         previous = None
         for i in range(n_touches):       # every odd touch overwrites the one before, at its step
             pose[0, 3] = i * 1e-3
-            previous = g.record_touch(cid, i // 2, pose, [float(i)] * 6, 0.1, i % 3 == 0,
-                                      overwritten_touch_id=previous if i % 2 == 1 else None)
-        print(f"seed {g.exercise_seed()}", flush=True)
-        g.finish_calibration(cid, {"mean_error_mm": 0.1}, position_error_mm=0.2, orientation_error_deg=None,
-                             grade="good")
+            previous = g.records.record_touch(cid, i // 2, pose, [float(i)] * 6, 0.1, i % 3 == 0,
+                                              overwritten_touch_id=previous if i % 2 == 1 else None)
+        print(f"seed {g.settings.exercise_seed()}", flush=True)
+        g.records.finish_calibration(cid, {"mean_error_mm": 0.1}, position_error_mm=0.2, orientation_error_deg=None,
+                                     grade="good")
         print(f"done {cid}", flush=True)
 
 

@@ -12,14 +12,14 @@ from tcp_pendant.classroom.gradebook import Gradebook
 
 def main(path: str) -> None:
     g = Gradebook(path)
-    sid = g.start_session(g.add_trainee("Killed Kim"), "own")
-    cid = g.start_calibration(sid, "xyz4", "pointer", np.eye(4))
+    sid = g.records.start_session(g.trainees.add("Killed Kim"), "own")
+    cid = g.records.start_calibration(sid, "xyz4", "pointer", np.eye(4))
     print(f"calibration {cid}", flush=True)
     pose = np.eye(4)
     i = 0
     while True:
         pose[0, 3] = i * 1e-3
-        touch = g.record_touch(cid, i % 4, pose, [float(i)] * 6, 0.1, i % 3 == 0)
+        touch = g.records.record_touch(cid, i % 4, pose, [float(i)] * 6, 0.1, i % 3 == 0)
         print(f"ack {touch}", flush=True)
         i += 1
 

@@ -14,8 +14,9 @@ import numpy as np
 import pytest
 from tcp_pendant.calibrate import AutoTouchRequest
 from tcp_pendant.classroom.board import dashboard_rows, format_duration, is_stuck, open_runs
+from tcp_pendant.classroom.class_board import BoardTrainee, ClassBoard
 from tcp_pendant.classroom.class_room import ClassRoom
-from tcp_pendant.classroom.gradebook import BoardTrainee, ClassBoard, Gradebook
+from tcp_pendant.classroom.gradebook import Gradebook
 from tcp_pendant.classroom.recorder import TraineeRecorder
 from tcp_pendant.controller import builtin_tools
 from tcp_pendant.views.dashboard_table import STUCK_BACKGROUND, trainees_html
@@ -39,7 +40,8 @@ def test_the_board_is_rebuilt_from_the_file_after_a_restart(gradebook_target: Pa
     sessions = {}
     for name, seed in (("Anna", 3), ("Ben <b>", 4)):
         s = make_session(tmp_path / f"tools-{seed}.json", seed=seed)
-        rec = TraineeRecorder(book, book.start_session(book.add_trainee(name), "per-browser"), name, s.workflow)
+        sid = book.records.start_session(book.trainees.add(name), "per-browser")
+        rec = TraineeRecorder(book, sid, name, s.workflow)
         s.subscribe(rec.on_change)
         sessions[name] = s
     anna, ben = sessions["Anna"], sessions["Ben <b>"]
@@ -55,11 +57,11 @@ def test_the_board_is_rebuilt_from_the_file_after_a_restart(gradebook_target: Pa
     ben.auto_touch(AutoTouchRequest())
     ben.auto_touch(AutoTouchRequest())              # Ben at step 3, two touches
     truth = anna.workflow.runs[0].wizard.finished_result
-    first = book.grades()[0]
+    first = book.grades.rows()[0]
     book.close()
 
     book = Gradebook(path)                           # the restart: nothing in memory but the file
-    board = book.board()
+    board = book.board.read()
     a, b = board.trainees
     assert (a.name, a.method, a.method_title, a.status, a.step, a.touches) == \
         ("Anna", "xyz4", "XYZ 4-point", "in_progress", "Step 2 of 4", 1)
@@ -86,18 +88,19 @@ def test_the_board_is_rebuilt_from_the_file_after_a_restart(gradebook_target: Pa
 
 def test_the_step_clock_restarts_only_with_a_new_step(gradebook_target: Path | str) -> None:
     with Gradebook(gradebook_target) as book:
-        cid = book.start_calibration(book.start_session(book.add_trainee("Anna"), "x"), "xyz4", "pointer", T)
-        book.save_run_state(cid, {"n": 1}, method_title="XYZ 4-point", step="Step 1 of 4")
-        with book._write() as db:                   # the step began long ago
+        sid = book.records.start_session(book.trainees.add("Anna"), "x")
+        cid = book.records.start_calibration(sid, "xyz4", "pointer", T)
+        book.run_states.save(cid, {"n": 1}, method_title="XYZ 4-point", step="Step 1 of 4")
+        with book.store.write() as db:              # the step began long ago
             db.execute("UPDATE run_states SET step_since = '2020-01-01T00:00:00.000+00:00'")
-        book.save_run_state(cid, {"n": 2}, method_title="XYZ 4-point", step="Step 1 of 4")   # same step, new pose
-        (t,) = book.board().trainees
+        book.run_states.save(cid, {"n": 2}, method_title="XYZ 4-point", step="Step 1 of 4")  # same step, new pose
+        (t,) = book.board.read().trainees
         assert t.step == "Step 1 of 4" and t.step_since == "2020-01-01T00:00:00.000+00:00"
-        book.save_run_state(cid, {"n": 3}, method_title="XYZ 4-point", step="Step 2 of 4")
-        (t,) = book.board().trainees
+        book.run_states.save(cid, {"n": 3}, method_title="XYZ 4-point", step="Step 2 of 4")
+        (t,) = book.board.read().trainees
         assert t.step == "Step 2 of 4" and t.step_since > "2026"
-        book.save_run_state(cid, {"n": 4})          # an older writer: no step given, the kept one stays
-        (t,) = book.board().trainees
+        book.run_states.save(cid, {"n": 4})         # an older writer: no step given, the kept one stays
+        (t,) = book.board.read().trainees
         assert t.step == "Step 2 of 4" and t.method_title == "XYZ 4-point"
 
 

@@ -155,7 +155,7 @@ def test_the_brief_outlives_a_restart_and_an_older_gradebook_still_opens(tmp_pat
         assert ClassRoom(book, {}, trainer_token=None, min_touches=3, allowed_methods="reference").rules.min_touches == 3
         assert ClassRoom(book, {}, trainer_token=None).rules.allowed_methods == ("reference",)
         # a gradebook kept by an older version: no brief keys at all
-        book.set_class_setting(PUSHED_SETTING, {"exercise": None, "distance_aids": None, "auto_touch": None})
+        book.settings.set(PUSHED_SETTING, {"exercise": None, "distance_aids": None, "auto_touch": None})
         old = ClassRoom(book, {}, trainer_token=None).rules
         assert (old.instructions, old.allowed_methods, old.min_touches) == ("", None, 0)
 
@@ -163,7 +163,7 @@ def test_the_brief_outlives_a_restart_and_an_older_gradebook_still_opens(tmp_pat
 def test_the_brief_options_of_the_command_line(book: Gradebook, tmp_path: Path,
                                               monkeypatch: pytest.MonkeyPatch) -> None:
     """The three options reach the server's config (and imply a class); the class checks them."""
-    import tcp_pendant.classroom.gradebook as gb
+    import tcp_pendant.classroom.gradebook_open as gb
     import tcp_pendant.serve.server as server
 
     seen: list[object] = []

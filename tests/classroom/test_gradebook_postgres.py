@@ -12,8 +12,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from tcp_pendant.classroom.gradebook import _SCHEMA, SCHEMA_VERSION, Gradebook, GradebookError
+from tcp_pendant.classroom.gradebook import Gradebook
 from tcp_pendant.classroom.gradebook_db import class_db_target, is_postgres_url, mask_url, sql_for
+from tcp_pendant.classroom.gradebook_schema import SCHEMA, SCHEMA_VERSION
+from tcp_pendant.classroom.gradebook_store import GradebookError
 
 WRITER = Path(__file__).with_name("concurrent_writer.py")
 POSE = np.eye(4)
@@ -68,13 +70,13 @@ def test_an_empty_database_gets_the_schema_with_8_byte_floats(postgres_server) -
     url = postgres_server.fresh_database()
     with Gradebook(url) as g:
         assert g.path is None and "***" in g.location and postgres_server.password not in g.location
-        sid = g.start_session(g.add_trainee("Anna"), "own")
-        cid = g.start_calibration(sid, "xyz4", "pointer", np.eye(4))
-        g.record_touch(cid, 0, POSE, JOINTS, 0.1 + 0.2, False)
-        g.finish_calibration(cid, {"mean_error_mm": 0.1 + 0.2}, position_error_mm=1 / 3,
-                             orientation_error_deg=None, grade="good")
-        (row,) = g.grades()
-        assert row.position_error_mm == 1 / 3 and g.touches(cid)[0]["distance_mm"] == 0.1 + 0.2
+        sid = g.records.start_session(g.trainees.add("Anna"), "own")
+        cid = g.records.start_calibration(sid, "xyz4", "pointer", np.eye(4))
+        g.records.record_touch(cid, 0, POSE, JOINTS, 0.1 + 0.2, False)
+        g.records.finish_calibration(cid, {"mean_error_mm": 0.1 + 0.2}, position_error_mm=1 / 3,
+                                     orientation_error_deg=None, grade="good")
+        (row,) = g.grades.rows()
+        assert row.position_error_mm == 1 / 3 and g.records.touches(cid)[0]["distance_mm"] == 0.1 + 0.2
     assert _scalar(postgres_server, url, "SELECT value FROM meta WHERE key = 'schema_version'") == str(SCHEMA_VERSION)
     assert _scalar(postgres_server, url, "SELECT data_type FROM information_schema.columns WHERE "
                                          "table_name = 'calibrations' AND column_name = 'position_error_mm'") \
@@ -83,14 +85,14 @@ def test_an_empty_database_gets_the_schema_with_8_byte_floats(postgres_server) -
                                          "table_schema = 'public'") == 12     # 6 versioned + run_states, presence, class_pushes,
                                                                         # departures, class_messages, token_failures
     with Gradebook(url) as g:                                   # opened again: everything kept
-        assert [r.trainee for r in g.grades()] == ["Anna"] and g.add_trainee("Anna") == 1
+        assert [r.trainee for r in g.grades.rows()] == ["Anna"] and g.trainees.add("Anna") == 1
 
 
 def test_a_version_1_database_is_brought_to_version_2(postgres_server) -> None:
     import psycopg
     url = postgres_server.fresh_schema()
-    v1 = _SCHEMA.replace(",\n    key_sha256 TEXT", "")
-    assert v1 != _SCHEMA
+    v1 = SCHEMA.replace(",\n    key_sha256 TEXT", "")
+    assert v1 != SCHEMA
     with psycopg.connect(url, autocommit=True) as conn:
         for statement in v1.split(";"):
             if statement.strip():
@@ -98,9 +100,9 @@ def test_a_version_1_database_is_brought_to_version_2(postgres_server) -> None:
         conn.execute("INSERT INTO meta VALUES ('application', 'tcp-pendant gradebook'), ('schema_version', '1')")
         conn.execute("INSERT INTO trainees (name, created_at) VALUES ('Anna', '2025-01-31T09:15:02.125+00:00')")
     with Gradebook(url) as g:
-        claim = g.join_trainee("Anna")              # a version 1 trainee: no browser holds the name
+        claim = g.trainees.join("Anna")             # a version 1 trainee: no browser holds the name
         assert claim.trainee_id == 1 and claim.new_key is not None
-        assert g.holds_key("Anna", claim.new_key)
+        assert g.trainees.holds_key("Anna", claim.new_key)
     assert _scalar(postgres_server, url, "SELECT value FROM meta WHERE key = 'schema_version'") == "2"
 
 
@@ -108,7 +110,7 @@ def test_a_newer_or_foreign_database_is_refused_and_left_unchanged(postgres_serv
     import psycopg
     newer = postgres_server.fresh_schema()
     with Gradebook(newer) as g:
-        g.add_trainee("Anna")
+        g.trainees.add("Anna")
     with psycopg.connect(newer, autocommit=True) as conn:
         conn.execute("UPDATE meta SET value = %s WHERE key = 'schema_version'", (str(SCHEMA_VERSION + 1),))
     with pytest.raises(GradebookError, match="newer TCP Pendant .* give another database with --class-db"):
@@ -159,16 +161,16 @@ def test_a_connection_the_server_dropped_is_made_again(postgres_server) -> None:
     import psycopg
     url = postgres_server.fresh_schema()
     with Gradebook(url) as g:
-        sid = g.start_session(g.add_trainee("Anna"), "own")
-        pid = g._db._conn.info.backend_pid
+        sid = g.records.start_session(g.trainees.add("Anna"), "own")
+        pid = g.store._db._conn.info.backend_pid
         with psycopg.connect(postgres_server.url(), autocommit=True) as admin:
             admin.execute("SELECT pg_terminate_backend(%s)", (pid,))
         with pytest.raises(GradebookError, match="Nothing of this event was stored; check that the PostgreSQL"):
-            g.start_calibration(sid, "xyz4", "pointer", np.eye(4))    # the call the drop broke
-        cid = g.start_calibration(sid, "xyz4", "pointer", np.eye(4))  # the next one reconnects
-        assert g._db._conn.info.backend_pid != pid
-        assert g.calibration_status(cid) == "in_progress"
-        assert g._db.execute("SELECT count(*) FROM calibrations").fetchone()[0] == 1   # the broken one: none
+            g.records.start_calibration(sid, "xyz4", "pointer", np.eye(4))  # the call the drop broke
+        cid = g.records.start_calibration(sid, "xyz4", "pointer", np.eye(4))  # the next one reconnects
+        assert g.store._db._conn.info.backend_pid != pid
+        assert g.records.calibration_status(cid) == "in_progress"
+        assert g.store._db.execute("SELECT count(*) FROM calibrations").fetchone()[0] == 1  # the broken one: none
 
 
 # ------------------------------------------------------------------ several server processes
@@ -198,22 +200,22 @@ def test_two_server_processes_share_one_class(gradebook_target: Path | str) -> N
     seeds = {x[1] for x in lines}
     assert len(seeds) == 1 and next(iter(seeds)).startswith("seed ")
     with Gradebook(gradebook_target, create=False) as g:
-        rows = g.grades()
+        rows = g.grades.rows()
         assert sorted(r.trainee for r in rows) == ["Ana", "Bea"]
         # n recorded each, every odd one overwriting the one before: n / 2 count
         assert [(r.touches, r.overwritten) for r in rows] == [(n // 2, n // 2)] * 2
-        assert sorted(g.held_names()) == ["Ana", "Bea", "Shared Sam"]
+        assert sorted(g.trainees.held_names()) == ["Ana", "Bea", "Shared Sam"]
 
 
 def test_presence_and_pushes_on_postgresql(postgres_server) -> None:
     """The server processes' shared class state (presence rows, pushes in order) in PostgreSQL."""
     url = postgres_server.fresh_database()
     with Gradebook(url) as a, Gradebook(url) as b:
-        assert a.claim_presence("Anna", "A", {"name": "Anna"}, now=100.25) is None
-        assert b.presence_holder("Anna", now=105.0) == "A" and b.presence_holder("Anna", now=110.5) is None
-        assert b.claim_presence("Anna", "B", {"name": "Anna", "touches": 3}, now=111.0) == "A"
-        assert a.beat_presence("A", {"Anna": {"name": "Anna"}}, now=112.0) == set()
-        assert a.present(now=112.0) == [("Anna", "B", {"name": "Anna", "touches": 3})]
-        first, second = a.add_push({"kind": "settings"}), b.add_push({"kind": "brief"})
-        assert second > first and a.pushes_after(first) == [(second, {"kind": "brief"})]
-        assert b.drop_holder("B") == 1 and a.present(now=112.0) == []
+        assert a.presence.claim("Anna", "A", {"name": "Anna"}, now=100.25) is None
+        assert b.presence.holder("Anna", now=105.0) == "A" and b.presence.holder("Anna", now=110.5) is None
+        assert b.presence.claim("Anna", "B", {"name": "Anna", "touches": 3}, now=111.0) == "A"
+        assert a.presence.beat("A", {"Anna": {"name": "Anna"}}, now=112.0) == set()
+        assert a.presence.present(now=112.0) == [("Anna", "B", {"name": "Anna", "touches": 3})]
+        first, second = a.pushes.add({"kind": "settings"}), b.pushes.add({"kind": "brief"})
+        assert second > first and a.pushes.after(first) == [(second, {"kind": "brief"})]
+        assert b.presence.drop_holder("B") == 1 and a.presence.present(now=112.0) == []

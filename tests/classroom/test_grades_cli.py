@@ -11,8 +11,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 from tcp_pendant.classroom import grades_cli
-from tcp_pendant.classroom.gradebook import CSV_COLUMNS, SCHEMA_VERSION, Gradebook
+from tcp_pendant.classroom.gradebook import Gradebook
 from tcp_pendant.classroom.gradebook_db import mask_url
+from tcp_pendant.classroom.gradebook_schema import SCHEMA_VERSION
+from tcp_pendant.classroom.grades_csv import CSV_COLUMNS
 from tcp_pendant.classroom.lms import MOODLE_POINTS, PER_TRAINEE_COLUMNS
 
 POSE = np.eye(4)
@@ -21,22 +23,22 @@ JOINTS = [0.0] * 6
 
 def _make(path: Path) -> None:
     with Gradebook(path) as g:
-        anna = g.start_session(g.add_trainee("Anna Meier"), "own")
-        cid = g.start_calibration(anna, "xyz4", "pointer", np.eye(4))
+        anna = g.records.start_session(g.trainees.add("Anna Meier"), "own")
+        cid = g.records.start_calibration(anna, "xyz4", "pointer", np.eye(4))
         for i in range(4):
-            g.record_touch(cid, i, POSE, JOINTS, 0.1, i == 3)
-        g.record_crash(cid, penetration_mm=2.0)
-        g.finish_calibration(cid, {"mean_error_mm": 0.2104, "ci95_mm": 0.84}, position_error_mm=0.2311,
-                             orientation_error_deg=None, grade="good", tcp_mm=(0, 0, 180))
-        ben = g.start_session(g.add_trainee("Ben <b>"), "own")
-        cid = g.start_calibration(ben, "abc-world", "torch", np.eye(4))
-        g.record_touch(cid, 0, POSE, JOINTS, None, True)
-        g.finish_calibration(cid, {"orthogonality_defect_deg": 0.0}, position_error_mm=None,
-                             orientation_error_deg=1.234, grade="fair")
-        left = g.start_calibration(ben, "xyz4", "pointer", np.eye(4))      # still in progress
-        g.record_touch(left, 0, POSE, JOINTS, 0.1, False)
-        gone = g.start_calibration(ben, "xyz4", "pointer", np.eye(4))      # cancelled: no row
-        g.cancel_calibration(gone)
+            g.records.record_touch(cid, i, POSE, JOINTS, 0.1, i == 3)
+        g.records.record_crash(cid, penetration_mm=2.0)
+        g.records.finish_calibration(cid, {"mean_error_mm": 0.2104, "ci95_mm": 0.84}, position_error_mm=0.2311,
+                                     orientation_error_deg=None, grade="good", tcp_mm=(0, 0, 180))
+        ben = g.records.start_session(g.trainees.add("Ben <b>"), "own")
+        cid = g.records.start_calibration(ben, "abc-world", "torch", np.eye(4))
+        g.records.record_touch(cid, 0, POSE, JOINTS, None, True)
+        g.records.finish_calibration(cid, {"orthogonality_defect_deg": 0.0}, position_error_mm=None,
+                                     orientation_error_deg=1.234, grade="fair")
+        left = g.records.start_calibration(ben, "xyz4", "pointer", np.eye(4))  # still in progress
+        g.records.record_touch(left, 0, POSE, JOINTS, 0.1, False)
+        gone = g.records.start_calibration(ben, "xyz4", "pointer", np.eye(4))  # cancelled: no row
+        g.records.cancel_calibration(gone)
 
 
 def test_table_has_one_row_per_calibration_with_its_status(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -75,13 +77,13 @@ def test_csv_output(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
 def _two_attempts(path: Path) -> None:
     """Anna: fair (1.9 mm) then good (0.3 mm) then poor (4.0 mm), and one in progress; Ben: none."""
     with Gradebook(path) as g:
-        anna = g.start_session(g.add_trainee("Anna"), "own")
+        anna = g.records.start_session(g.trainees.add("Anna"), "own")
         for grade, err in (("fair", 1.9), ("good", 0.3), ("poor", 4.0)):
-            cid = g.start_calibration(anna, "xyz4", "pointer", np.eye(4))
-            g.finish_calibration(cid, {}, position_error_mm=err, orientation_error_deg=None, grade=grade)
-        g.start_calibration(anna, "xyz4", "pointer", np.eye(4))
-        ben = g.start_session(g.add_trainee("=Ben"), "own")
-        g.start_calibration(ben, "xyz4", "pointer", np.eye(4))
+            cid = g.records.start_calibration(anna, "xyz4", "pointer", np.eye(4))
+            g.records.finish_calibration(cid, {}, position_error_mm=err, orientation_error_deg=None, grade=grade)
+        g.records.start_calibration(anna, "xyz4", "pointer", np.eye(4))
+        ben = g.records.start_session(g.trainees.add("=Ben"), "own")
+        g.records.start_calibration(ben, "xyz4", "pointer", np.eye(4))
 
 
 def test_one_row_per_trainee_with_the_best_and_the_last_grade(tmp_path: Path,

@@ -26,7 +26,7 @@ def _finished_class_session(tmp_path: Path, name: str = "Anna", sigma: float = 0
     book = Gradebook(tmp_path / "class.sqlite3", synchronous="NORMAL")
     s = make_session(tmp_path / "tools.json", seed=5)
     s.keep_honest_records()
-    rec = TraineeRecorder(book, book.start_session(book.add_trainee(name), "per-browser"), name, s.workflow)
+    rec = TraineeRecorder(book, book.records.start_session(book.trainees.add(name), "per-browser"), name, s.workflow)
     s.subscribe(rec.on_change)
     s.start_wizard("xyz4")
     while s.workflow.result is None:
@@ -43,7 +43,7 @@ def test_a_classroom_export_holds_no_truth_and_no_server_path(tmp_path: Path) ->
     assert record["robot"]["urdf"] is None and "/" not in json.dumps(record["robot"])
     w = record["wizards"][0]
     assert w["truth"] is None and w["true_tool"] == {"key": "pointer"}
-    assert w["record_id"] == book.grades()[0].calibration_id
+    assert w["record_id"] == book.grades.rows()[0].calibration_id
     # outside a class the record still carries the truth (self-study), now with record_id null
     c2 = make_controller()
     free = CalibrationWorkflow(c2, ToolLibrary(tmp_path / "t2.json"), robot="kr6")
@@ -63,7 +63,7 @@ def test_the_trainer_grades_the_record_against_the_gradebook(tmp_path: Path) -> 
     truth = wf.truth()
     assert g.trainee == "Anna" and g.matches_gradebook is True
     assert g.position_error_mm == pytest.approx(truth.position_error_mm, abs=1e-9)
-    assert g.grade == truth.grade == book.grades()[0].grade
+    assert g.grade == truth.grade == book.grades.rows()[0].grade
     # edited afterwards (one touch moved 2 mm, result recomputed into the file): caught
     tampered = copy.deepcopy(record)
     pose = tampered["wizards"][0]["state"]["poses"]["0"]["T_world_flange_m"]

@@ -109,7 +109,7 @@ def test_the_mesh_is_drawn_with_a_flat_tip_centred_on_the_true_tcp(tmp_path: Pat
     """The nozzle ends in a flat tip face 0.4 mm across, square to tool X, centred on the TCP:
     the tip as drawn is where the TCP is (touching the face anywhere is within 0.2 mm, well inside
     "good"), but no vertex lies at the TCP (each is 0.2 mm from it), so no number the browser
-    gets is the TCP; its centre is, for whoever fits it (README)."""
+    gets is the TCP; its centre is, for whoever fits it (docs/security.md)."""
     tool = draw_mystery_tool(seed, name, pointer, cache_dir=tmp_path)
     T = tool.T_flange_tool_true
     x, tcp = T[:3, 0], T[:3, 3]

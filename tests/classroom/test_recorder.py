@@ -20,7 +20,7 @@ from calib_helpers import make_session  # noqa: E402
 def setup(tmp_path: Path):
     book = Gradebook(tmp_path / "class.sqlite3", synchronous="NORMAL")
     s = make_session(tmp_path / "tools.json", seed=3)
-    sid = book.start_session(book.add_trainee("Anna"), "per-browser")
+    sid = book.records.start_session(book.trainees.add("Anna"), "per-browser")
     rec = TraineeRecorder(book, sid, "Anna", s.workflow)
     s.subscribe(rec.on_change)
     yield book, s, rec
@@ -32,12 +32,12 @@ def test_auto_and_hand_touches_overwrite_and_finish_are_stored(setup) -> None:
     c, wf = s.controller, s.workflow
     s.start_wizard("xyz4")
     cal = rec._runs[0].calibration_id
-    assert book.calibration_status(cal) == "in_progress"
+    assert book.records.calibration_status(cal) == "in_progress"
     s.auto_touch(AutoTouchRequest())               # step 1 by Auto-touch
     s.back()                                       # Auto-touch went on to step 2: back to step 1
     s.record_step()                                # step 1 again, by hand: overwrites the auto touch
     s.next_step()
-    touches = book.touches(cal)
+    touches = book.records.touches(cal)
     assert [t["auto"] for t in touches] == [True, False]
     assert touches[1]["overwrites_touch_id"] == touches[0]["id"]
     assert touches[0]["overwritten_by_touch_id"] == touches[1]["id"]
@@ -49,7 +49,7 @@ def test_auto_and_hand_touches_overwrite_and_finish_are_stored(setup) -> None:
         if wf.result is not None:
             break
     assert wf.result is not None
-    rows = book.grades()
+    rows = book.grades.rows()
     assert len(rows) == 1
     row = rows[0]
     assert row.trainee == "Anna" and row.method == "xyz4" and row.tool_key == "pointer"
@@ -76,7 +76,7 @@ def test_a_touch_is_stored_with_the_joints_and_distance_of_its_record_not_of_the
         s.jog("Z", 1)
         s.jog("Z", 1)
     assert s.controller.touch_geometry().distance_mm > d_at_record + 15.0     # the robot moved away
-    touches = book.touches(rec._runs[0].calibration_id)
+    touches = book.records.touches(rec._runs[0].calibration_id)
     last = touches[-1]
     assert last["auto"] is False and last["overwrites_touch_id"] == touches[0]["id"]
     np.testing.assert_allclose(last["joints_deg"], q_at_record, atol=1e-9)
@@ -89,16 +89,16 @@ def test_cancel_resume_and_loaded_runs(setup, tmp_path: Path) -> None:
     s.record_step()
     cal = rec._runs[0].calibration_id
     s.cancel_wizard()
-    assert book.calibration_status(cal) == "cancelled"
+    assert book.records.calibration_status(cal) == "cancelled"
     s.resume_wizard(0)
-    assert book.calibration_status(cal) == "in_progress"
+    assert book.records.calibration_status(cal) == "in_progress"
     # a record loaded from a file arrives cancelled: not this session's work, not stored
     other = make_session(tmp_path / "t2.json", seed=1)
     other.start_wizard("xyz4")
     other.record_step()
     s.load_record(load_and_replay(other.workflow.export_record()))
     assert len(s.workflow.runs) == 2 and 1 not in rec._runs
-    with book._read() as db:
+    with book.store.read() as db:
         assert db.execute("SELECT COUNT(*) FROM calibrations").fetchone()[0] == 1
 
 
@@ -114,7 +114,7 @@ def test_crash_transitions_are_counted_once(setup) -> None:
     assert c.touch_geometry().crashed, c.touch_geometry()
     s.moved()
     s.moved()                          # still crashed: the same crash
-    with book._read() as db:
+    with book.store.read() as db:
         assert db.execute("SELECT COUNT(*) FROM crashes").fetchone()[0] == 1
         assert db.execute("SELECT calibration_id FROM crashes").fetchone()[0] == rec._runs[0].calibration_id
     assert rec.status.crashes == 1

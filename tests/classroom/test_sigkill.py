@@ -38,7 +38,7 @@ def test_sigkill_after_n_acknowledgements_keeps_all_n(tmp_path: Path, n_acks: in
         proc.wait(timeout=30)
     assert proc.returncode == -signal.SIGKILL
     with Gradebook(path, create=False) as g:
-        stored = {t["id"]: t for t in g.touches(calibration_id)}
+        stored = {t["id"]: t for t in g.records.touches(calibration_id)}
     assert set(printed) <= set(stored), f"lost acknowledged touches {sorted(set(printed) - set(stored))}"
     # the acknowledged ones are whole: pose and joints as written
     for k, touch_id in enumerate(printed):

@@ -95,7 +95,7 @@ def test_sigkill_of_the_server_keeps_every_acknowledged_touch(tmp_path: Path) ->
         proc.kill()
         proc.wait(timeout=30)
     assert proc.returncode == -signal.SIGKILL
-    with Gradebook(db, create=False) as book, book._read() as db_:
+    with Gradebook(db, create=False) as book, book.store.read() as db_:
         touches = db_.execute("SELECT step_index, auto FROM touches ORDER BY id").fetchall()
     assert len(touches) >= 3, touches
     assert touches[:3] == [(0, 1), (1, 1), (2, 1)]
@@ -104,5 +104,5 @@ def test_sigkill_of_the_server_keeps_every_acknowledged_touch(tmp_path: Path) ->
 def _trainees(db: Path) -> list[str]:
     if not db.exists():
         return []
-    with Gradebook(db, create=False) as book, book._read() as c:
+    with Gradebook(db, create=False) as book, book.store.read() as c:
         return [r[0] for r in c.execute("SELECT name FROM trainees")]

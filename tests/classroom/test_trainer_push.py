@@ -125,7 +125,7 @@ def test_an_exercise_shows_the_trainee_no_truth_but_the_gradebook_keeps_it(app_f
         assert result.folder.visible and not result.truth_md.visible       # ... the trainee does not see it
         assert not scene.true_tool.visible and not scene.true_label.visible
         assert scene.computed.visible                           # the computed triad is still shown
-        row = app.gradebook.grades()[0]                         # the trainer's gradebook has the error
+        row = app.gradebook.grades.rows()[0]                    # the trainer's gradebook has the error
         assert row.position_error_mm == pytest.approx(cal.workflow.truth().position_error_mm)
         assert row.grade
     finally:

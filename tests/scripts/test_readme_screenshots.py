@@ -1,4 +1,4 @@
-"""The README caption under the 4-point screenshot quotes the seeded run of
+"""The caption under the 4-point screenshot (docs/trainer.md) quotes the seeded run of
 ``scripts/readme_screenshots.py`` (regenerating gave 0.72 mm while the caption said
 0.51 mm). The calibration is computed here without a browser, by the function the script
 itself uses for the caption and checks the browser's page against."""
@@ -24,10 +24,10 @@ def script() -> ModuleType:
     return module
 
 
-def test_readme_caption_quotes_the_seeded_run() -> None:
+def test_trainer_guide_caption_quotes_the_seeded_run() -> None:
     s = script()
     figures = s.seeded_figures()
-    error, inside, ci95 = s.caption_figures((ROOT / "README.md").read_text(encoding="utf-8"))
+    error, inside, ci95 = s.caption_figures((ROOT / "docs" / "trainer.md").read_text(encoding="utf-8"))
     assert error == pytest.approx(figures.position_error_mm, abs=0.005)
     assert ci95 == pytest.approx(figures.ci95_mm, abs=0.005)
     assert inside is figures.inside

@@ -3,9 +3,11 @@
 
 The fake ``.venv/bin/python`` logs every call to ``calls.log`` and answers ``-m pip`` with
 ``$FAKE_PIP_RC`` (default 1: no package index), ``-m pytest`` with ``$FAKE_PYTEST_RC`` and
-``-m mypy`` with ``$FAKE_MYPY_OUT`` on stdout and ``$FAKE_MYPY_RC`` (default 0: no type error);
+``-m mypy`` with ``$FAKE_MYPY_OUT`` on stdout and ``$FAKE_MYPY_RC`` (default 0: no type error),
+``-m mkdocs`` with ``$FAKE_MKDOCS_OUT`` on stderr and ``$FAKE_MKDOCS_RC`` (default 0: the site builds);
 ``.venv/bin/lint-imports`` logs its arguments and answers with ``$FAKE_LINT_OUT`` on stdout and
-``$FAKE_LINT_RC`` (default 0: every layer kept); ``.venv/bin/tcp-pendant`` logs its arguments. ``PATH`` holds only the tools the scripts need
+``$FAKE_LINT_RC`` (default 0: every layer kept); ``.venv/bin/tcp-pendant`` logs its arguments.
+``PATH`` holds only the tools the scripts need
 (bash, coreutils), a fake ``id`` printing ``$FAKE_UID``, and whatever a test adds (``sudo``,
 ``apt-get``, ``chromium``): without them the machine has no root, no sudo and no chromium.
 ``PG_BIN`` and ``NGINX`` point at a fake PostgreSQL and nginx (present unless a test removes them).
@@ -47,6 +49,7 @@ printf 'python' >> {log}; for a in "$@"; do printf ' [%s]' "$a" >> {log}; done; 
 if [ "$2" = pip ]; then exit "${{FAKE_PIP_RC:-1}}"; fi
 if [ "$2" = pytest ]; then echo "CHROMIUM=${{CHROMIUM:-}}" >> {log}; exit "${{FAKE_PYTEST_RC:-0}}"; fi
 if [ "$2" = mypy ]; then echo "${{FAKE_MYPY_OUT:-Success: no issues found}}"; exit "${{FAKE_MYPY_RC:-0}}"; fi
+if [ "$2" = mkdocs ]; then printf '%b\n' "${{FAKE_MKDOCS_OUT:-INFO    -  Documentation built}}" >&2; exit "${{FAKE_MKDOCS_RC:-0}}"; fi
 exit 0
 """)
     _write_exe(venv_bin / "lint-imports", f"""#!/bin/sh
@@ -124,6 +127,36 @@ def test_run_app_without_a_venv_and_no_index_fails_with_a_hint(repo: Path) -> No
     assert p.returncode != 0
     assert "'pip install -e .' failed" in p.stderr and "package index" in p.stderr
     assert not any(c.startswith("tcp-pendant") for c in calls(repo))
+
+
+def _fake_interpreter(repo: Path, name: str, minor: int) -> None:
+    """A ``name`` on PATH that is Python 3.``minor``: it answers the scripts' version check and
+    logs ``-m venv``."""
+    log = repo / "calls.log"
+    _write_exe(repo.parent / "bin" / name, f"""#!/bin/sh
+if [ "$1" = -c ]; then [ {minor} -ge 11 ]; exit $?; fi
+echo "{name} $*" >> {log}
+""")
+
+
+def test_a_new_venv_is_made_with_the_first_python_of_at_least_3_11(repo: Path) -> None:
+    shutil.rmtree(repo / ".venv")
+    _fake_interpreter(repo, "python3", 10)                   # Ubuntu 22.04's python3
+    _fake_interpreter(repo, "python3.11", 11)                # and its python3.11 package
+    run(repo, "run-app.sh", "--help")
+    assert "python3.11 -m venv .venv" in calls(repo)
+    assert not any(c.startswith("python3 ") for c in calls(repo))
+
+
+def test_without_python_3_11_the_scripts_say_what_to_install(repo: Path) -> None:
+    shutil.rmtree(repo / ".venv")
+    _fake_interpreter(repo, "python3", 10)
+    p = run(repo, "run-tests.sh")
+    assert p.returncode != 0
+    assert "needs Python 3.11 or newer" in p.stderr and "apt install python3.11 python3.11-venv" in p.stderr
+    assert "PYTHON=" in p.stderr and calls(repo) == []                  # nothing was made or run
+    p = run(repo, "run-app.sh", PYTHON="python3")                       # a PYTHON that is too old
+    assert p.returncode != 0 and "python3 is older or missing" in p.stderr
 
 
 def test_the_test_stamp_covers_the_app_but_not_the_reverse(repo: Path) -> None:
@@ -259,12 +292,36 @@ def test_run_tests_with_a_bad_chromium_override_says_so(stamped: Path) -> None:
 
 
 # ---------------------------------------------------------------- the type check
-def test_run_tests_type_checks_before_the_tests(stamped: Path) -> None:
+def test_run_tests_type_checks_lints_the_layers_and_builds_the_site_before_the_tests(stamped: Path) -> None:
+    """mypy, then lint-imports, then ``mkdocs build --strict`` into a scratch folder (quiet when it
+    builds), then pytest."""
     (stamped.parent / "bin" / "chromium").symlink_to(shutil.which("true") or "/bin/true")
-    p = run(stamped, "run-tests.sh", "-q")
+    p = run(stamped, "run-tests.sh", "-q", TMPDIR=str(stamped.parent))
     assert p.returncode == 0, p.stderr
-    assert [c for c in calls(stamped) if c.startswith(("python", "lint-imports"))] == [
-        "python [-m] [mypy]", "lint-imports [--no-logo]", "python [-m] [pytest] [-q]"]
+    checks = [c for c in calls(stamped) if c.startswith(("python", "lint-imports"))]
+    assert len(checks) == 4, checks
+    assert checks[0] == "python [-m] [mypy]"
+    assert checks[1] == "lint-imports [--no-logo]"
+    assert checks[2].startswith("python [-m] [mkdocs] [build] [--strict] [--site-dir] "
+                                f"[{stamped.parent}/tcp-pendant-site-")
+    assert checks[3] == "python [-m] [pytest] [-q]"
+    assert "Documentation built" not in p.stdout + p.stderr
+    assert not list(stamped.parent.glob("tcp-pendant-site-*"))      # the scratch site is removed
+
+
+def test_run_tests_fails_when_the_site_does_not_build_and_runs_no_test(stamped: Path) -> None:
+    """A broken link (or a docstring reference that does not resolve) fails ``mkdocs build
+    --strict``: its warnings are shown without the INFO lines, then one line, exit 1, no pytest."""
+    (stamped.parent / "bin" / "chromium").symlink_to(shutil.which("true") or "/bin/true")
+    warning = "WARNING -  Doc file 'cli.md' contains a link 'nowhere.md', but the target is not found among documentation files."
+    p = run(stamped, "run-tests.sh", "-q", FAKE_MKDOCS_RC="1", TMPDIR=str(stamped.parent),
+            FAKE_MKDOCS_OUT=f"INFO    -  Building documentation\\n{warning}\\nAborted with 1 warnings in strict mode!")
+    assert p.returncode == 1
+    assert warning in p.stderr
+    assert "INFO" not in p.stderr
+    assert p.stderr.strip().splitlines()[-1] == (
+        "run-tests.sh: the documentation site does not build (mkdocs build --strict: the warnings above); no test ran.")
+    assert pytest_calls(stamped) == []
 
 
 def test_run_tests_fails_on_a_type_error_with_mypy_s_output_and_runs_no_test(stamped: Path) -> None:

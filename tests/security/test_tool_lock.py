@@ -88,7 +88,7 @@ def test_the_mystery_tool_cannot_be_swapped_for_the_pointer_over_the_websocket(t
             assert cal.workflow.result is not None
             assert s.controller.mounted_tool is mystery
 
-            (row,) = app.gradebook.grades()
+            (row,) = app.gradebook.grades.rows()
             assert (row.method, row.tool_key, row.exercise_id) == ("xyz4", mystery.key, "mystery")
         finally:
             c.ws.close()

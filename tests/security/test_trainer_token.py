@@ -83,7 +83,7 @@ def test_the_lockout_doubles_from_the_fifth_wrong_token_up_to_five_minutes(tmp_p
     assert [lock_s(n) for n in range(1, 16)] == [0, 0, 0, 0, 1, 2, 4, 8, 16, 32, 64, 128, 256, 300, 300]
     with Gradebook(tmp_path / "class.sqlite3") as book:      # the count the app keeps (never forgotten here)
         def attempt(now: float) -> tuple[float, int, bool]:
-            return book.try_token("10.0.0.5", now=now, forget_s=math.inf, lock_s=lock_s)
+            return book.token_failures.try_token("10.0.0.5", now=now, forget_s=math.inf, lock_s=lock_s)
 
         for i in range(15):                                  # each try after the previous window
             assert attempt(1000.0 * i) == (0.0, i + 1, True)

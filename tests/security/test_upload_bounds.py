@@ -19,7 +19,7 @@ from tcp_pendant.views import viser_adapter
 from tcp_pendant.views.viser_adapter import UploadLimits
 
 sys.path.insert(0, str(Path(__file__).parents[1] / "app"))
-from wsclient import InputsClient, wait_until  # noqa: E402
+from wsclient import CAMERA, InputsClient, wait_until  # noqa: E402
 
 LOAD = "Load session (JSON)"
 MB = 1_000_000
@@ -60,13 +60,14 @@ def _part(c: InputsClient, tid: str, index: int, content: bytes) -> None:
 
 
 def _handled(app: PendantApp, c: InputsClient) -> None:
-    """Wait until the server handled everything ``c`` sent so far (a jog click behind it)."""
-    moves: list[int] = []
+    """Wait until the server handled everything ``c`` sent so far: a camera message behind it
+    (viser handles one socket's messages in order; a jog click would not do: the deadman drops a
+    press that waited behind megabytes of parts, ``views.arrival``)."""
     button = c.uuid_of("X +")
-    session = next(s for s in app.sessions.values() if button in s.client.gui._gui_input_handle_from_uuid)
-    session.add_motion_listener(lambda: moves.append(1))
-    c.send({"type": "GuiUpdateMessage", "uuid": c.uuid_of("X +"), "updates": {"value": True}})
-    wait_until(lambda: len(moves) > 0, what="the click behind the uploads")
+    handle = next(s.client for s in app.sessions.values() if button in s.client.gui._gui_input_handle_from_uuid)
+    before = handle.camera._state
+    c.send(CAMERA)
+    wait_until(lambda: handle.camera._state is not before, what="the camera message behind the uploads")
 
 
 def _held(app: PendantApp) -> dict[str, int]:

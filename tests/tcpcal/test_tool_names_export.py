@@ -1,4 +1,4 @@
-"""What each controller format does with a tool name (README.md, "Tool names"): every valid
+"""What each controller format does with a tool name (docs/cli.md, "Tool names"): every valid
 tcpcal name gives valid controller text -- ABB a RAPID identifier, FANUC a 16-character
 comment, KUKA the name itself in TOOL_NAME, UR no name at all."""
 

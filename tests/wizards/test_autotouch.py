@@ -1,4 +1,5 @@
-"""auto_touch against a test double of the controller (contract of docs/architecture.md).
+"""auto_touch against a test double of the controller (its contract: the docstrings of
+calibrate.autotouch, docs/reference/calibrate.md).
 
 The double places the true tool exactly as ``VirtualController.auto_approach`` promises (the
 reference tip at ``tip_offset_tool_mm`` in TOOL coordinates, tool X tilted from WORLD -Z), using

@@ -24,7 +24,8 @@ def default_library_slot(tools: Mapping[int, Any], *, active_slot: int | None,
         tools: the library, slot -> tool (anything with a ``name``).
         active_slot: the session's active slot (None: no library tool is active).
         active_tool_name: name of the controller's active tool data (None: none).
-        mounted_label, mounted_key: the mounted physical tool's label and key.
+        mounted_label: the mounted physical tool's label.
+        mounted_key: the mounted physical tool's key.
     """
     if not tools:
         return None

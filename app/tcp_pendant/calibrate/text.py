@@ -66,7 +66,8 @@ def menu_markdown(kind: str, *, library_tool: str | None, reference_tool: str, n
     Args:
         kind: wizard kind.
         library_tool: the chosen library entry ("1: Pointer"), None when the library is empty.
-        reference_tool, new_tool: physical tools chosen for the reference method (labels).
+        reference_tool: the reference tool chosen for the reference method (label).
+        new_tool: the new physical tool chosen for the reference method (label).
         mounted_tool: label of the physical tool on the flange now.
     """
     cls = wizard_class(kind)

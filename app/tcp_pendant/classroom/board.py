@@ -1,6 +1,6 @@
 """The rows of the trainer's dashboard, from the gradebook and who is connected (no viser).
 
-The gradebook is the shared truth (``Gradebook.board``): every trainee with their latest
+The gradebook is the shared truth (``Gradebook.board.read``): every trainee with their latest
 calibration, its step as they last saw it and since when, its touches and crashes, and their
 last result. The server adds only who is connected now (``ClassRoom.connected_names``), so a
 server started again with the same gradebook shows the class as it was, the trainees not yet
@@ -21,7 +21,7 @@ from collections.abc import Collection
 from dataclasses import dataclass
 from datetime import datetime, timezone
 
-from tcp_pendant.classroom.gradebook import BoardRun, BoardTrainee, ClassBoard
+from tcp_pendant.classroom.class_board import BoardRun, BoardTrainee, ClassBoard
 
 __all__ = ["DEFAULT_STUCK_MIN", "DashboardRow", "OpenRun", "dashboard_rows", "format_duration", "is_stuck",
            "open_runs", "seconds_since"]

@@ -8,14 +8,14 @@ that browser into the trainer's dashboard (its pendant is taken down). Both wind
 a layer above the classroom: the server hands the class room their builders
 (:class:`~tcp_pendant.classroom.class_views.ClassViews`). Every dashboard
 re-renders when a trainee's state changes, at most :data:`RENDER_INTERVAL_S` apart, and every
-:data:`TICK_S` for its clocks; its table comes from the gradebook (``Gradebook.board``) plus
+:data:`TICK_S` for its clocks; its table comes from the gradebook (``Gradebook.board.read``) plus
 who is connected now (:meth:`ClassRoom.connected_names`), so it survives a restart.
 
 Per-trainee actions of the trainer (:meth:`ClassRoom.reset_wizard`, :meth:`ClassRoom.push_to`)
 run on that one trainee's session through its own commands, handed to viser's loop after the
 trainer's callback (never two sessions' locks at once); no other session is touched.
 
-Names are for the one browser that joined under them (``Gradebook.join_trainee``): a browser
+Names are for the one browser that joined under them (``Gradebook.trainees.join``): a browser
 gets a browser key when it joins (its page script keeps it, ``views.identity``) and comes back
 with it after a reload or a server restart. A name connected in another browser is refused in
 words, unless the browser shows that name's key (the same browser: then the newer tab takes
@@ -26,7 +26,7 @@ under it is shown the welcome window again, so the next browser that joins under
 trainee's records.
 
 The exercise seed (the mystery tools) is the gradebook's, drawn at random for the class the
-first time a mystery tool is drawn and kept there (``Gradebook.exercise_seed``); an explicit
+first time a mystery tool is drawn and kept there (``Gradebook.settings.exercise_seed``); an explicit
 ``exercise_seed`` (``--exercise-seed``, reproducible demos) is used instead. It is never shown.
 
 In an exercise the trainee sees no truth: the workflow's ``hide_truth`` is set (the result
@@ -51,30 +51,30 @@ and the fewest touches a Finish takes; they are part of the rules (``ExerciseRul
 until the trainer pushes another brief (a change of exercise keeps them).
 
 The trainer's **messages** (:meth:`ClassRoom.send_message`) go to every connected trainee or
-to one, and are kept in the gradebook (``Gradebook.add_message``: one row per trainee) until
+to one, and are kept in the gradebook (``Gradebook.messages.add``: one row per trainee) until
 that trainee dismisses them: each is delivered on viser's loop to that trainee's session only
 (``Session.show_message``), at once on the trainer's process and by the heartbeat
 (:meth:`ClassRoom.beat`) on whichever process holds the trainee now, and again after a reload,
 a join on another process or a restart of the server. A Dismiss (the session's ``notice``
 signal: a message no longer on its screen) deletes that trainee's row
-(``Gradebook.dismiss_messages``). A message to one trainee who left waits for them.
+(``Gradebook.messages.dismiss``). A message to one trainee who left waits for them.
 
 Wrong trainer tokens are counted in the gradebook per source address
-(``Gradebook.try_token``, ``classroom.trainer_token``), so the lockout holds on every process
+(``Gradebook.token_failures.try_token``, ``classroom.trainer_token``), so the lockout holds on every process
 of the class and after a restart. Who left (connected, then not: :meth:`trainee_statuses`) is
-kept there too (``Gradebook.depart`` / ``departed``), the same on every process.
+kept there too (``Gradebook.presence.depart`` / ``departed``), the same on every process.
 
 Several server processes on one gradebook (``tcp-pendant --workers N``): each process has its
 own sessions and its own ClassRoom (:attr:`ClassRoom.holder` names it); what the class shares
 goes through the gradebook. A joined name is claimed in the gradebook's presence table
-(``Gradebook.claim_presence``) and beaten every ``presence_poll_s`` by :meth:`ClassRoom.start`'s
+(``Gradebook.presence.claim``) and beaten every ``presence_poll_s`` by :meth:`ClassRoom.start`'s
 thread with the trainee's live row, so a name connected on one process is refused on another
 exactly as on the same one, the same browser's newer tab on another process takes the name
 (the older one's welcome window opens again at the next beat), a release by the trainer on
 any process sends the browser on its holder back to the welcome window, and
 :meth:`trainee_statuses` and :meth:`connected_names` list the whole class (the other
 processes' rows as they last beat them, and who left, from the gradebook). Every
-push of the trainer's settings is kept in order (``Gradebook.add_push``) and applied by the
+push of the trainer's settings is kept in order (``Gradebook.pushes.add``) and applied by the
 other processes at their next beat. A reconnect landing on another process gets the
 calibrations in progress back from the gradebook (``classroom.restore``), like a restart.
 
@@ -98,12 +98,17 @@ from collections.abc import Callable, Sequence
 from datetime import datetime, timezone
 from typing import Any, cast
 
-from tcp_pendant.classroom.gradebook import ClassBoard, Gradebook, GradebookError, GradeRow, TraineeJoin
+from tcp_pendant.classroom.class_board import ClassBoard
+from tcp_pendant.classroom.grade_rows import GradeRow
+from tcp_pendant.classroom.gradebook import Gradebook
+from tcp_pendant.classroom.gradebook_store import GradebookError
+from tcp_pendant.classroom.grades_csv import to_csv
 from tcp_pendant.classroom.mystery import draw_mystery_tool
 from tcp_pendant.classroom.names import TraineeNameError, validate_trainee_name
 from tcp_pendant.classroom.recorder import TraineeRecorder, TraineeStatus
 from tcp_pendant.classroom.replay import CalibrationReplay, calibration_replay
 from tcp_pendant.classroom.restore import runs_to_restore
+from tcp_pendant.classroom.trainees import TraineeJoin
 from tcp_pendant.classroom.trainer_token import FORGET_S, lock_s, locked, log_failure, validate_trainer_token
 from tcp_pendant.classroom.class_messages import clean_message_text
 from tcp_pendant.classroom.class_views import ClassViews, TrainerView, WelcomeWindow
@@ -180,8 +185,10 @@ class ClassRoom:
         exercise: None (free practice) or "mystery".
         exercise_seed: the seed of the mystery tools; None: the class's own secret seed, kept in
             the gradebook.
-        instructions, allowed_methods, min_touches: the exercise's brief given at start (None:
-            the brief kept in the gradebook, else none); each given one wins over the kept one.
+        instructions: the exercise's instructions given at start (None: those kept in the
+            gradebook, else none); each part of the brief given wins over the kept one.
+        allowed_methods: the methods the exercise allows, given at start (None: as kept).
+        min_touches: the fewest touches a Finish takes, given at start (None: as kept).
         hand_to_loop: runs a function on viser's event loop.
         clock: Unix time, seconds (the token's lockout windows, kept in the gradebook for every
             process of the class; tests set it).
@@ -218,7 +225,7 @@ class ClassRoom:
         given_instructions = None if instructions is None else clean_instructions(instructions)
         given_methods = clean_methods(allowed_methods)
         given_min = None if min_touches is None else clean_min_touches(min_touches)
-        stored = gradebook.class_setting(TOKEN_SETTING)
+        stored = gradebook.settings.get(TOKEN_SETTING)
         if trainer_token is None and isinstance(stored, str):
             self.trainer_token: str | None = None      # the class's token, kept (hashed) in the gradebook
             self._token_sha256 = stored
@@ -227,7 +234,7 @@ class ClassRoom:
             validate_trainer_token(token, "The trainer token")
             self.trainer_token = token
             self._token_sha256 = _token_digest(token)
-            gradebook.set_class_setting(TOKEN_SETTING, self._token_sha256)
+            gradebook.settings.set(TOKEN_SETTING, self._token_sha256)
         self.gradebook = gradebook
         self.tools = dict(tools)
         self.tool_keys = tuple(self.tools)
@@ -268,7 +275,7 @@ class ClassRoom:
         """This server process's id in the gradebook's presence table (host, pid, a nonce)."""
         self.presence_poll_s = float(presence_poll_s)
         self._remote: dict[str, TraineeStatus] = {}   # name -> row, connected on another process
-        self._push_seen = gradebook.last_push_id()    # the pushes before are in the kept settings
+        self._push_seen = gradebook.pushes.last_id()  # the pushes before are in the kept settings
         self._beater: threading.Thread | None = None
         self._stopping = threading.Event()
         self._apply_kept(exercise_given=exercise is not None)   # what the trainer pushed before a restart
@@ -338,7 +345,7 @@ class ClassRoom:
 
     def _seed(self) -> int:
         if self._exercise_seed is None:
-            self._exercise_seed = self.gradebook.exercise_seed()
+            self._exercise_seed = self.gradebook.settings.exercise_seed()
         return self._exercise_seed
 
     def _holder(self, name: str, other_than: Session) -> tuple[Session, TraineeRecorder, str] | None:
@@ -347,7 +354,7 @@ class ClassRoom:
 
     def named(self, session: Session, name: Any, key: Any = None) -> TraineeJoin:
         """The browser of ``session`` joins as ``name`` showing the browser key ``key`` (or
-        none): the gradebook's check (``Gradebook.join_trainee``), then a gradebook session, its
+        none): the gradebook's check (``Gradebook.trainees.join``), then a gradebook session, its
         recorder, and the exercise's tool.
 
         Raises:
@@ -360,11 +367,11 @@ class ClassRoom:
                 raise TraineeNameError(f"The trainer released the name {clean} from this browser; join "
                                        "under your own name.")
             holder = self._holder(clean, session)
-            elsewhere = self.gradebook.presence_holder(clean) not in (None, self.holder)
-            if (holder is not None or elsewhere) and not self.gradebook.holds_key(clean, key):
+            elsewhere = self.gradebook.presence.holder(clean) not in (None, self.holder)
+            if (holder is not None or elsewhere) and not self.gradebook.trainees.holds_key(clean, key):
                 raise TraineeNameError(f"{clean} is already connected in another browser; pick another "
                                        "name or ask the trainer to release it.")
-            join = self.gradebook.join_trainee(clean, key)
+            join = self.gradebook.trainees.join(clean, key)
             if holder is not None:         # the same browser (its key): the newer tab takes the name
                 self._leave(holder, f"{clean} joined from another tab or window of this browser, so this "
                             "one left the class. Close it, or join here again (the other one then leaves).",
@@ -375,13 +382,13 @@ class ClassRoom:
 
     def _start(self, session: Session, join: TraineeJoin) -> TraineeRecorder:
         with session.lock:
-            sid = self.gradebook.start_session(join.trainee_id, "per-browser")
+            sid = self.gradebook.records.start_session(join.trainee_id, "per-browser")
             session.keep_honest_records()             # the trainee's export carries no answer key
             recorder = TraineeRecorder(self.gradebook, sid, join.name, session.workflow,
                                        exercise_id=self.exercise)
             # claimed before the name is in the table the heartbeat reads: a beat never sees a
             # name of ours that the presence table does not give to us yet
-            self.gradebook.claim_presence(join.name, self.holder, dataclasses.asdict(recorder.status))
+            self.gradebook.presence.claim(join.name, self.holder, dataclasses.asdict(recorder.status))
             with self._lock:
                 self._trainees[id(session)] = (session, recorder, join.name)
                 follow = id(session) not in self._subscribed
@@ -444,8 +451,8 @@ class ClassRoom:
         if not isinstance(name, str):
             raise ValueError("Choose the name to release.")
         with self._join_lock:
-            held = self.gradebook.release_trainee(name)
-            elsewhere = self.gradebook.drop_presence(name) and name not in self._local_names()
+            held = self.gradebook.trainees.release(name)
+            elsewhere = self.gradebook.presence.drop(name) and name not in self._local_names()
             with self._lock:
                 holders = [e for e in self._trainees.values() if e[2] == name]
             for entry in holders:
@@ -460,7 +467,7 @@ class ClassRoom:
 
     def held_names(self) -> list[str]:
         """Names a browser holds (the trainer view's "Release a name" choices)."""
-        return self.gradebook.held_names()
+        return self.gradebook.trainees.held_names()
 
     def _restore(self, session: Session, recorder: TraineeRecorder, name: str) -> None:
         """The calibrations ``name`` had in progress (a reload, a restart of the server with this
@@ -518,7 +525,8 @@ class ClassRoom:
         if self._holder(name, session) is not None:
             return
         try:
-            self.gradebook.depart(name, dataclasses.asdict(dataclasses.replace(recorder.status, connected=False)))
+            left = dataclasses.replace(recorder.status, connected=False)
+            self.gradebook.presence.depart(name, dataclasses.asdict(left))
         except GradebookError:
             log.exception("the departure of %r could not be kept", name)
 
@@ -527,7 +535,7 @@ class ClassRoom:
         if name in self._local_names():
             return
         try:
-            self.gradebook.drop_presence(name, self.holder)
+            self.gradebook.presence.drop(name, self.holder)
         except GradebookError:
             log.exception("the presence of %r could not be dropped", name)
 
@@ -545,7 +553,7 @@ class ClassRoom:
             self._beater.join(timeout=5.0)
             self._beater = None
         try:
-            self.gradebook.drop_holder(self.holder)
+            self.gradebook.presence.drop_holder(self.holder)
         except GradebookError:
             log.debug("presence not dropped: gradebook closed", exc_info=True)
 
@@ -568,13 +576,13 @@ class ClassRoom:
         with self._lock:
             entries = {e[2]: e for e in self._trainees.values()}
         statuses = {name: dataclasses.asdict(e[1].status) for name, e in entries.items()}
-        held = self.gradebook.beat_presence(self.holder, statuses)
-        lost = [(entries[n], self.gradebook.presence_holder(n) is None) for n in sorted(set(statuses) - held)]
+        held = self.gradebook.presence.beat(self.holder, statuses)
+        lost = [(entries[n], self.gradebook.presence.holder(n) is None) for n in sorted(set(statuses) - held)]
         if lost:
             self._hand_to_loop(lambda: self._lost(lost))
         fields = {f.name for f in dataclasses.fields(TraineeStatus)}
         remote = {}
-        for name, holder, st in self.gradebook.present():
+        for name, holder, st in self.gradebook.presence.present():
             if holder != self.holder and isinstance(st, dict):
                 try:
                     remote[name] = TraineeStatus(**{k: v for k, v in st.items() if k in fields})
@@ -583,7 +591,7 @@ class ClassRoom:
         with self._lock:
             changed = remote != self._remote
             self._remote = remote
-        for push_id, push in self.gradebook.pushes_after(self._push_seen):
+        for push_id, push in self.gradebook.pushes.after(self._push_seen):
             self._push_seen = push_id
             if push.get("holder") != self.holder:
                 self._hand_to_loop(functools.partial(self._apply_remote_push, push))
@@ -627,7 +635,7 @@ class ClassRoom:
     def open_trainer(self, session: Session, token: str) -> bool:
         """A browser typed ``token``: if it is the trainer token, build the trainer view there.
         Wrong tokens are counted per source address in the gradebook, for every server process
-        of the class (``Gradebook.try_token``, ``classroom.trainer_token``); the right one
+        of the class (``Gradebook.token_failures.try_token``, ``classroom.trainer_token``); the right one
         forgives its address's.
 
         Raises:
@@ -638,7 +646,8 @@ class ClassRoom:
         now = self.clock()
         source = self.source_address(session)
         try:
-            wait, failures, counted = self.gradebook.try_token(source, now=now, forget_s=FORGET_S, lock_s=lock_s)
+            wait, failures, counted = self.gradebook.token_failures.try_token(source, now=now, forget_s=FORGET_S,
+                                                                              lock_s=lock_s)
         except GradebookError as exc:
             log.error("a trainer token was not tried: %s", exc)
             raise ValueError("The class gradebook cannot be read now, so no trainer token is tried; "
@@ -650,7 +659,7 @@ class ClassRoom:
             log_failure("a shared page" if client_id is None else f"browser {client_id}", failures, token)
             return False
         try:
-            self.gradebook.forgive_token_failures(source)
+            self.gradebook.token_failures.forgive(source)
         except GradebookError:
             log.exception("the wrong trainer tokens of %s could not be forgiven", source)
         with self._lock:
@@ -723,12 +732,12 @@ class ClassRoom:
 
     # ------------------------------------------------------------ the dashboard's data
     def board(self) -> ClassBoard:
-        """The class as the gradebook knows it (``Gradebook.board``)."""
-        return self.gradebook.board()
+        """The class as the gradebook knows it (``Gradebook.board.read``)."""
+        return self.gradebook.board.read()
 
     def replay(self, name: str) -> CalibrationReplay | None:
         """The latest calibration of ``name`` that has a touch, from the gradebook (None: none)."""
-        cid = self.gradebook.last_calibration(name)
+        cid = self.gradebook.records.last_calibration(name)
         return None if cid is None else calibration_replay(self.gradebook, cid)
 
     def _entry_of(self, name: str) -> tuple[Session, TraineeRecorder, str] | None:
@@ -747,7 +756,7 @@ class ClassRoom:
         request from there, applied here only)."""
         entry = self._entry_of(name) if isinstance(name, str) else None
         if entry is None and forward and self._on_another_process(name):
-            self.gradebook.add_push({"holder": self.holder, "kind": "reset", "name": name})
+            self.gradebook.pushes.add({"holder": self.holder, "kind": "reset", "name": name})
             return f"Reset {name}'s running wizard (on another server process of the class)."
         if entry is None:
             return f"{name} is not connected: there is no running wizard to reset."
@@ -778,8 +787,8 @@ class ClassRoom:
             raise ValueError(f"Unknown tool {tool_key!r}; use one of {', '.join(self.tools)}.")
         entry = self._entry_of(name) if isinstance(name, str) else None
         if entry is None and forward and self._on_another_process(name):
-            self.gradebook.add_push({"holder": self.holder, "kind": "push_to", "name": name, "exercise": exercise,
-                                     "tool_key": tool_key, "hide_distance": hide_distance, "auto_touch": auto_touch})
+            self.gradebook.pushes.add({"holder": self.holder, "kind": "push_to", "name": name, "exercise": exercise,
+                                       "tool_key": tool_key, "hide_distance": hide_distance, "auto_touch": auto_touch})
             return f"Pushed to {name} (on another server process of the class)."
         if entry is None:
             return f"{name} is not connected: nothing pushed."
@@ -814,7 +823,7 @@ class ClassRoom:
         """Rows of the live table: this process's connected trainees in order of arrival, those
         connected on the other server processes of the class (by name, as they last beat),
         then those who were connected and left, on any process of the class, the latest first,
-        with their last row (``Gradebook.departed``; a trainee connected again is not among
+        with their last row (``Gradebook.presence.departed``; a trainee connected again is not among
         them). The departures are read after the connected trainees: a departure is kept before
         its trainee leaves the table, so one leaving meanwhile is in one list or the other."""
         fields = {f.name for f in dataclasses.fields(TraineeStatus)}
@@ -824,7 +833,7 @@ class ClassRoom:
             remote = [row for name, row in sorted(self._remote.items()) if name not in names]
         names |= {row.name for row in remote}
         try:
-            departed = self.gradebook.departed()
+            departed = self.gradebook.presence.departed()
         except GradebookError:
             log.exception("who left the class could not be read")
             departed = []
@@ -839,16 +848,16 @@ class ClassRoom:
         return local + remote + left
 
     def grade_rows(self) -> list[GradeRow]:
-        return self.gradebook.grades()
+        return self.gradebook.grades.rows()
 
     def grades_csv(self) -> str:
-        return self.gradebook.to_csv()
+        return to_csv(self.gradebook.grades.rows())
 
     def _keep_pushed(self, tool_key: str | None, *, brief_only: bool = False) -> None:
         """Keep what the trainer pushed in the gradebook (``PUSHED_SETTING``), so a restart with
         this gradebook applies it again (:meth:`_apply_kept`); ``brief_only``: the brief's keys
         only (the brief given at start: the exercise given with it is not kept by that)."""
-        kept = self.gradebook.class_setting(PUSHED_SETTING)
+        kept = self.gradebook.settings.get(PUSHED_SETTING)
         kept = dict(kept) if isinstance(kept, dict) else {}
         if not brief_only:
             kept.update({"exercise": self.exercise, "distance_aids": self.distance_aids,
@@ -857,12 +866,12 @@ class ClassRoom:
                      "allowed_methods": None if self.allowed_methods is None else list(self.allowed_methods)})
         if tool_key is not None:
             kept["tool_key"] = tool_key
-        self.gradebook.set_class_setting(PUSHED_SETTING, kept)
+        self.gradebook.settings.set(PUSHED_SETTING, kept)
 
     def _apply_kept(self, exercise_given: bool) -> None:
         """At start: the settings the trainer pushed before a restart (an ``--exercise`` given
         at start wins over a kept one; a value this version does not know is ignored)."""
-        kept = self.gradebook.class_setting(PUSHED_SETTING)
+        kept = self.gradebook.settings.get(PUSHED_SETTING)
         if not isinstance(kept, dict):
             return
         if not exercise_given and kept.get("exercise") in (None, *EXERCISE_IDS):
@@ -917,8 +926,8 @@ class ClassRoom:
             self.auto_touch = bool(auto_touch)
         if keep:
             self._keep_pushed(tool_key)
-            self.gradebook.add_push({"holder": self.holder, "kind": "settings", "exercise": exercise,
-                                     "tool_key": tool_key, "hide_distance": named, "auto_touch": auto_touch})
+            self.gradebook.pushes.add({"holder": self.holder, "kind": "settings", "exercise": exercise,
+                                       "tool_key": tool_key, "hide_distance": named, "auto_touch": auto_touch})
         with self._lock:
             trainees = list(self._trainees.values())
         for session, recorder, name in trainees:
@@ -955,9 +964,9 @@ class ClassRoom:
         self.instructions, self.allowed_methods, self.min_touches = text, methods, minimum
         if keep:
             self._keep_pushed(None, brief_only=True)
-            self.gradebook.add_push({"holder": self.holder, "kind": "brief", "instructions": text,
-                                     "allowed_methods": None if methods is None else list(methods),
-                                     "min_touches": minimum})
+            self.gradebook.pushes.add({"holder": self.holder, "kind": "brief", "instructions": text,
+                                       "allowed_methods": None if methods is None else list(methods),
+                                       "min_touches": minimum})
         rules = self.rules
         with self._lock:
             trainees = list(self._trainees.values())
@@ -973,7 +982,7 @@ class ClassRoom:
         with self._lock:
             local = [name for _, _, name in self._trainees.values()]
         try:
-            remote = sorted({name for name, holder, _ in self.gradebook.present() if holder != self.holder})
+            remote = sorted({name for name, holder, _ in self.gradebook.presence.present() if holder != self.holder})
         except GradebookError:
             log.exception("the class's presence table is unreadable")
             remote = []
@@ -983,7 +992,7 @@ class ClassRoom:
         """Send ``text`` (plain text) to every connected trainee of the class (``to`` None) or
         to the trainee named ``to`` (connected, or one who left: it waits until they join
         again). It is kept in the gradebook for each of them until they dismiss it
-        (``Gradebook.add_message``), shown at once to those on this process and by the other
+        (``Gradebook.messages.add``), shown at once to those on this process and by the other
         processes' heartbeat to theirs (module docstring). Returns what happened, in words for
         the trainer (plain text).
 
@@ -994,13 +1003,13 @@ class ClassRoom:
         if to is not None and not isinstance(to, str):
             raise ValueError("Choose whom to send the message to.")
         connected = self.connected_names()
-        if to is not None and to not in connected and to not in self.gradebook.trainee_names():
+        if to is not None and to not in connected and to not in self.gradebook.trainees.names():
             raise ValueError(f"{to:.60} is not in the class; choose a trainee in the list, or all trainees.")
         names = connected if to is None else [to]
         sent = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
         if names:
             try:
-                self.gradebook.add_message(clean, names, to_all=to is None, sent_at=sent)
+                self.gradebook.messages.add(clean, names, to_all=to is None, sent_at=sent)
             except GradebookError as exc:
                 log.error("a message was not kept: %s", exc)
                 raise ValueError("The class gradebook cannot be written now, so the message was not sent; "
@@ -1016,7 +1025,7 @@ class ClassRoom:
     def _kept_messages(self, name: str) -> list[ClassMessage]:
         """The messages the gradebook keeps for ``name`` (not dismissed), oldest first."""
         try:
-            kept = self.gradebook.messages_for([name]).get(name, [])
+            kept = self.gradebook.messages.waiting([name]).get(name, [])
         except GradebookError:
             log.exception("the messages of %r could not be read", name)
             return []
@@ -1029,7 +1038,7 @@ class ClassRoom:
         if not entries:
             return
         try:
-            kept = self.gradebook.messages_for(list(entries))
+            kept = self.gradebook.messages.waiting(list(entries))
         except GradebookError:
             log.exception("the class's messages could not be read")
             return
@@ -1062,6 +1071,6 @@ class ClassRoom:
         gone = sorted(before - now)
         if gone:
             try:
-                self.gradebook.dismiss_messages(name, gone)
+                self.gradebook.messages.dismiss(name, gone)
             except GradebookError:
                 log.exception("the dismissal of %r's messages could not be kept", name)

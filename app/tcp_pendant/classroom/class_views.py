@@ -15,7 +15,7 @@ from collections.abc import Callable, Collection
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Protocol
 
-from tcp_pendant.classroom.gradebook import ClassBoard
+from tcp_pendant.classroom.class_board import ClassBoard
 from tcp_pendant.session import Session
 
 if TYPE_CHECKING:

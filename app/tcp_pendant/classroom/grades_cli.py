@@ -7,8 +7,8 @@ Usage::
 One row per calibration, finished or still in progress (oldest first): trainee, method, tool,
 touches (hand / auto), overwritten touches, crashes, duration, result figures, error against
 the true TOOL frame, the grade and the status. Without ``--csv`` a table for the terminal; with
-``--csv`` the columns of :data:`tcp_pendant.classroom.gradebook.CSV_COLUMNS`
-(docs/architecture.md, "Classroom (gradebook)"). ``--per-trainee``: one row per trainee
+``--csv`` the columns of :data:`tcp_pendant.classroom.grades_csv.CSV_COLUMNS`
+(docs/pendant-cli.md, "tcp-pendant grades"). ``--per-trainee``: one row per trainee
 (``classroom.lms``: attempts, best and last grade); ``--moodle``: that as the CSV Moodle's
 gradebook imports. The gradebook is read where
 the server writes it (``--class-db``, default ``user_data_dir("tcp-pendant")/class.sqlite3``,
@@ -25,8 +25,13 @@ from __future__ import annotations
 import argparse
 import sys
 from collections.abc import Sequence
-from tcp_pendant.classroom.gradebook import GradeRow, Gradebook, GradebookError, default_gradebook_path
+
+from tcp_pendant.classroom.grade_rows import GradeRow
+from tcp_pendant.classroom.gradebook import Gradebook
 from tcp_pendant.classroom.gradebook_db import class_db_target
+from tcp_pendant.classroom.gradebook_open import default_gradebook_path
+from tcp_pendant.classroom.gradebook_store import GradebookError
+from tcp_pendant.classroom.grades_csv import to_csv
 from tcp_pendant.classroom.lms import TraineeGrade, moodle_csv, per_trainee, per_trainee_csv
 
 __all__ = ["build_parser", "format_table", "main"]
@@ -44,7 +49,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help=f"the gradebook the server writes: a file (default: {default_gradebook_path()}) "
                         "or the class's postgresql://USER@HOST:PORT/DATABASE URL")
     p.add_argument("--csv", action="store_true",
-                   help="print CSV (columns in docs/architecture.md) instead of a table")
+                   help="print CSV (columns in docs/pendant-cli.md) instead of a table")
     p.add_argument("--per-trainee", action="store_true",
                    help="one row per trainee: attempts, best and last grade and position error")
     p.add_argument("--moodle", action="store_true",
@@ -118,8 +123,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         with Gradebook(path, create=False) as book:
             where = book.location                  # a URL without its password
-            rows = book.grades(include_in_progress=True)
-            text = book.to_csv(rows) if args.csv else None
+            rows = book.grades.rows(include_in_progress=True)
+            text = to_csv(rows) if args.csv else None
     except GradebookError as exc:
         print(f"tcp-pendant grades: error: {' '.join(str(exc).split())}", file=sys.stderr)
         return 2

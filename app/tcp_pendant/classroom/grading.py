@@ -13,7 +13,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tcp_pendant.classroom.gradebook import Gradebook, GradebookError
+from tcp_pendant.classroom.gradebook import Gradebook
+from tcp_pendant.classroom.gradebook_store import GradebookError
 from tcp_pendant.wizards.session_record import LoadedRecord
 from tcp_pendant.wizards.truth import compare_with_truth
 
@@ -55,7 +56,7 @@ def grade_record(loaded: LoadedRecord, gradebook: Gradebook) -> tuple[RecordGrad
 
     Safe to call off viser's event loop (the gradebook takes its own lock).
     """
-    rows = {r.calibration_id: r for r in gradebook.grades()}
+    rows = {r.calibration_id: r for r in gradebook.grades.rows()}
     out: list[RecordGrade] = []
     for check, entry in zip(loaded.checks, loaded.record.get("wizards", [])):
         rid = entry.get("record_id")
@@ -65,7 +66,7 @@ def grade_record(loaded: LoadedRecord, gradebook: Gradebook) -> tuple[RecordGrad
                                    "no record id: not recorded in this class's gradebook"))
             continue
         try:
-            truth = gradebook.truth(rid)
+            truth = gradebook.records.truth(rid)
         except GradebookError:
             out.append(RecordGrade(check.index, rid, "", check.kind, None, None, None, None,
                                    f"calibration {rid} is not in this gradebook"))

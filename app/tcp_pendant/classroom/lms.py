@@ -1,12 +1,12 @@
 """Grades for a learning management system: one row per trainee (no viser, no SQL).
 
 ``tcp-pendant grades`` lists one row per calibration; an LMS wants one grade per learner.
-:func:`per_trainee` folds the gradebook's rows (``Gradebook.grades``) into one
+:func:`per_trainee` folds the gradebook's rows (``Gradebook.grades.rows``) into one
 :class:`TraineeGrade` per trainee: attempts, the best and the last grade, their position
 errors. Two CSV layouts are written from it:
 
-* :func:`per_trainee_csv`: the columns of :data:`PER_TRAINEE_COLUMNS` (a contract, docs in
-  README "Running a class");
+* :func:`per_trainee_csv`: the columns of :data:`PER_TRAINEE_COLUMNS` (a contract, documented in
+  docs/pendant-cli.md "tcp-pendant grades");
 * :func:`moodle_csv`: the layout Moodle's gradebook imports (Grades > Import > CSV file,
   https://docs.moodle.org/en/Grade_import): a header row, one row per learner, a column that
   identifies the learner (the teacher maps it to "username" or "useremail" in the import form;
@@ -25,7 +25,8 @@ import io
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
-from tcp_pendant.classroom.gradebook import GRADES, GradeRow
+from tcp_pendant.classroom.grade_rows import GradeRow
+from tcp_pendant.classroom.gradebook_schema import GRADES
 
 __all__ = ["MOODLE_POINTS", "PER_TRAINEE_COLUMNS", "TraineeGrade", "moodle_csv", "per_trainee", "per_trainee_csv"]
 

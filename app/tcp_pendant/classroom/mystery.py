@@ -1,6 +1,6 @@
 """Mystery tools: a tool per trainee whose true TCP and orientation are drawn
 from the exercise seed and the trainee's name, so answers differ between trainees. The seed of
-a class is a secret (``Gradebook.exercise_seed``: random, kept in the gradebook): this code is
+a class is a secret (``Gradebook.settings.exercise_seed``: random, kept in the gradebook): this code is
 public, so whoever knows the seed and a name computes that trainee's tool.
 
 :func:`draw_mystery_tool` draws (deterministically: same seed, name and base tool, same tool on
@@ -30,7 +30,7 @@ that link's origin, so the drawn tip is at the true TCP up to the float64 transf
 spike anywhere on that face is within 0.2 mm of the TCP, inside the exercise's "good" 0.5 mm. No
 vertex lies at the TCP: the face is a fan from one of its own ring's vertices, each 0.2 mm from
 it, so no number the browser gets is the TCP; its centre is, for a program that fits the face
-(README: what a determined trainee can still see).
+(docs/security.md: what a determined trainee can still see).
 
 What the drawing gives away is what a real tool shows: the tip and the shaft. The browser gets
 the meshes in FLANGE coordinates (``rigid_meshes``), so the tip face's centre is the TCP and the

@@ -49,7 +49,7 @@ from Unicode's ``confusables.txt``, NFD again), once with the letters' case kept
 case-folded. The removal covers the whole default-ignorable set, the joiners a name may keep
 included ("علی‌اکبر" and "علیاکبر" look alike), and holds for every name a gradebook holds,
 whichever check let it in: the comparison reads the stored names and computes their keys each
-time (``Gradebook.join_trainee``), no key is stored. Two names look alike when either skeleton
+time (``Gradebook.trainees.join``), no key is stored. Two names look alike when either skeleton
 is the same. On top of TR39 the diacritics of the Combining Diacritical Marks blocks are
 dropped (after NFD): TR39 keeps "Aĺice" (l with acute) apart from "Alice", but at the size of a
 table row the acute is a dot over the l, so here they look alike, and so do "José" and "Jose"

@@ -21,7 +21,7 @@ workflow makes no events for them, so they are not stored.
 
 What a restart gives back: after the events of a signal, each calibration they touched (and the
 one on show, when its step or status changed) is kept as its wizard is now
-(``Gradebook.save_run_state``, a session record entry without truth), so a server started again
+(``Gradebook.run_states.save``, a session record entry without truth), so a server started again
 with the same gradebook rebuilds it for the trainee (``classroom.restore``, :meth:`adopt`).
 
 Acknowledgement: the change signal is emitted inside ``target.atomic()``, so the GUI messages of
@@ -89,7 +89,7 @@ class TraineeRecorder:
 
     Args:
         gradebook: the class gradebook.
-        session_id: the gradebook session (``Gradebook.start_session``).
+        session_id: the gradebook session (``Gradebook.records.start_session``).
         name: the trainee's name (validated).
         workflow: the session's ``CalibrationWorkflow``: the run on show, for the trainer's
             table, and where the gradebook ids of the runs are noted (the exported record names
@@ -117,7 +117,7 @@ class TraineeRecorder:
     def disconnected(self) -> None:
         """The browser left: the gradebook session ends, the row says "not connected"."""
         with self._lock:
-            self.gradebook.end_session(self.session_id)
+            self.gradebook.records.end_session(self.session_id)
             self._status = replace(self._status, connected=False)
 
     # ------------------------------------------------------------ the change signal
@@ -158,8 +158,8 @@ class TraineeRecorder:
             entry = run_entry(self.workflow.runs[run_index], honest=True)
             if entry == st.kept:
                 return
-            self.gradebook.save_run_state(st.calibration_id, entry, method_title=str(wizard.title)[:200] or None,
-                                          step=step_words(wizard)[:200] or None)
+            self.gradebook.run_states.save(st.calibration_id, entry, method_title=str(wizard.title)[:200] or None,
+                                           step=step_words(wizard)[:200] or None)
             st.kept = entry
         except Exception:            # a state that cannot be kept must not stop the lesson
             self.errors += 1
@@ -169,8 +169,8 @@ class TraineeRecorder:
         if isinstance(event, RunStarted):
             truth: Any = ({"T_flange_tool_true_m": None} if event.T_flange_tool_true_m is None
                           else np.asarray(event.T_flange_tool_true_m, dtype=float))
-            cal = self.gradebook.start_calibration(self.session_id, event.kind, event.tool_key or "", truth,
-                                                   exercise_id=self.exercise_id)
+            cal = self.gradebook.records.start_calibration(self.session_id, event.kind, event.tool_key or "",
+                                                           truth, exercise_id=self.exercise_id)
             self._runs[event.run_index] = _RunState(cal)
             if self.workflow is not None:
                 self.workflow.record_ids[event.run_index] = cal    # the export names it: the trainer grades by it
@@ -179,10 +179,10 @@ class TraineeRecorder:
             pen = event.penetration_mm if math.isfinite(event.penetration_mm) else None
             st = None if event.run_index is None else self._runs.get(event.run_index)
             if st is None:
-                self.gradebook.record_crash(session_id=self.session_id, penetration_mm=pen,
-                                            note="reference tip hit")
+                self.gradebook.records.record_crash(session_id=self.session_id, penetration_mm=pen,
+                                                    note="reference tip hit")
             else:
-                self.gradebook.record_crash(st.calibration_id, penetration_mm=pen, note="reference tip hit")
+                self.gradebook.records.record_crash(st.calibration_id, penetration_mm=pen, note="reference tip hit")
             self._status = replace(self._status, crashes=self._status.crashes + 1)
             return
         run_index = getattr(event, "run_index", None)
@@ -191,7 +191,7 @@ class TraineeRecorder:
             return
         if isinstance(event, TouchRecorded):
             dist = event.distance_mm if math.isfinite(event.distance_mm) else None
-            touch_id = self.gradebook.record_touch(
+            touch_id = self.gradebook.records.record_touch(
                 st.calibration_id, event.step, event.T_world_flange_m, np.asarray(event.joints_deg, dtype=float),
                 dist, event.auto, overwritten_touch_id=st.touch_ids.get(event.step))
             st.touch_ids[event.step] = touch_id
@@ -200,11 +200,11 @@ class TraineeRecorder:
             self._finish(st, event)
         elif isinstance(event, RunCancelled):
             if st.status == "in_progress" and not event.finished:
-                self.gradebook.cancel_calibration(st.calibration_id)
+                self.gradebook.records.cancel_calibration(st.calibration_id)
                 st.status = "cancelled"
         elif isinstance(event, RunResumed):
             if st.status == "cancelled":
-                self.gradebook.resume_calibration(st.calibration_id)
+                self.gradebook.records.resume_calibration(st.calibration_id)
                 st.status = "in_progress"
 
     def _finish(self, st: _RunState, event: RunFinished) -> None:
@@ -213,7 +213,7 @@ class TraineeRecorder:
         if event.T_flange_tool_true_m is not None:
             cmp = compare_with_truth(result, event.T_flange_tool_true_m)
             pos, ori, grade = cmp.position_error_mm, cmp.orientation_error_deg, cmp.grade
-        self.gradebook.finish_calibration(
+        self.gradebook.records.finish_calibration(
             st.calibration_id, result.figures, position_error_mm=pos, orientation_error_deg=ori, grade=grade,
             tcp_mm=tuple(result.tcp_mm), abc_deg=None if result.abc_deg is None else tuple(result.abc_deg))
         st.status = "finished"

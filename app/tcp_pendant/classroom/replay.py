@@ -88,12 +88,12 @@ def calibration_replay(gradebook: Gradebook, calibration_id: int) -> Calibration
     Raises:
         GradebookError: no such calibration.
     """
-    info = gradebook.calibration_result(calibration_id)
-    true_T = _truth(gradebook.truth(calibration_id))
+    info = gradebook.records.calibration_result(calibration_id)
+    true_T = _truth(gradebook.records.truth(calibration_id))
     result_T = None if info["tcp_mm"] is None else T_flange_tool_m(info["tcp_mm"], info["abc_deg"])
     tip_T = true_T if true_T is not None else result_T
     touches = []
-    for t in gradebook.touches(calibration_id):
+    for t in gradebook.records.touches(calibration_id):
         T = np.asarray(t["T_world_flange_m"], dtype=float)
         tip = None if tip_T is None else (T @ tip_T)[:3, 3]
         touches.append(ReplayTouch(int(t["step_index"]), T, bool(t["auto"]),

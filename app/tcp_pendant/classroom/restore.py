@@ -1,7 +1,7 @@
 """What a restart gives back to a trainee: the calibrations in progress, from the gradebook.
 
 The recorder keeps each calibration's wizard in the gradebook as it is acknowledged
-(``Gradebook.save_run_state``: a session record entry without truth). When a trainee joins
+(``Gradebook.run_states.save``: a session record entry without truth). When a trainee joins
 again under their name (after a reload, a reconnect to another server process, or a restart
 of the server with the same gradebook), :func:`runs_to_restore` rebuilds those wizards with the
 truth the gradebook keeps apart (``calibrations.truth_json``), so the trainee finds each one at
@@ -54,7 +54,7 @@ def runs_to_restore(gradebook: Gradebook, trainee: str) -> list[RestoredRun]:
     A stored wizard that cannot be rebuilt (a file from another version, damaged) is skipped
     with a log line; the calibration stays in the gradebook as it is."""
     out = []
-    for row in gradebook.open_runs(trainee):
+    for row in gradebook.run_states.open_runs(trainee):
         entry = row["entry"]
         try:
             wizard = Wizard.from_dict(entry["state"])

@@ -7,7 +7,7 @@ locks that address out for a window that doubles each time (1 s, 2 s, 4 s, ... u
 :data:`MAX_LOCK_S`, :func:`lock_s`), during which no token is even compared. Each wrong try is
 logged with at most a two-character prefix of what was typed (:func:`log_failure`).
 
-The wrong tries are counted in the class gradebook (``Gradebook.try_token``: table
+The wrong tries are counted in the class gradebook (``Gradebook.token_failures.try_token``: table
 ``token_failures``), per source address and for every server process of the class, so a
 reconnect that lands on another process (``--workers``, several machines) or a restart of the
 server does not give new tries; a try is counted before its token is compared, and a right token

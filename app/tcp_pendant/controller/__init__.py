@@ -1,4 +1,4 @@
-"""The virtual robot controller (docs/architecture.md, ``tcp_pendant.controller``). No viser.
+"""The virtual robot controller. No viser.
 
 Modules, one job each:
 

@@ -58,7 +58,8 @@ class HoldDriver:
         schedule: ``schedule(delay_s, fn)`` calls ``fn()`` later; returns a handle with
             ``cancel()``.
         clock: seconds, monotonic.
-        period_s, deadman_s: see the module constants.
+        period_s: the period of a tick (s; ``HOLD_PERIOD_S``).
+        deadman_s: how long a hold lasts after its last hold message (s; ``DEADMAN_S``).
         start_bound_s: the largest age of a hold message that starts a hold (s).
     """
 

@@ -204,7 +204,8 @@ def _main(argv: Sequence[str] | None) -> int:
     args = build_parser().parse_args(argv)
     logging.basicConfig(level=logging.DEBUG if args.verbose else logging.WARNING,
                         format="%(levelname)s %(name)s: %(message)s")
-    from tcp_pendant.classroom.gradebook import GradebookError, default_gradebook_path
+    from tcp_pendant.classroom.gradebook_open import default_gradebook_path
+    from tcp_pendant.classroom.gradebook_store import GradebookError
     from tcp_pendant.controller import ControllerError
     from tcp_pendant.serve.server import AppConfig, PendantApp, PortInUseError, parse_xyz_mm
 

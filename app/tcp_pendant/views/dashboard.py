@@ -37,7 +37,7 @@ from typing import Any, Protocol
 import numpy as np
 
 from tcp_pendant.classroom.board import DEFAULT_STUCK_MIN, DashboardRow, dashboard_rows, open_runs
-from tcp_pendant.classroom.gradebook import ClassBoard
+from tcp_pendant.classroom.class_board import ClassBoard
 from tcp_pendant.classroom.grading import grade_record
 from tcp_pendant.classroom.replay import CalibrationReplay
 from tcp_pendant.job_pool import JobRefused
@@ -107,11 +107,13 @@ class TrainerDashboard:
 
     Attributes:
         rows: the live table's rows as last rendered (``classroom.board.DashboardRow``).
-        stuck_min, table_html, runs_html, chart, trainee, reset, replay_button, close_replay,
-        one_exercise, one_tool, one_hide_distance, one_auto_touch, push_one, release, action_md,
-        exercise, tool, hide_distance, auto_touch, push, push_md, grades_md, download,
-        grade_upload, grade_md: the widgets (for tests); replay_scene: the 3D replay;
+        replay_scene: the 3D replay.
         folders: the folders by title ("Class", "Exercise", ...), for the builders of other modules.
+
+    The widgets (for tests): stuck_min, table_html, runs_html, chart, trainee, reset,
+    replay_button, close_replay, one_exercise, one_tool, one_hide_distance, one_auto_touch,
+    push_one, release, action_md, exercise, tool, hide_distance, auto_touch, push, push_md,
+    grades_md, download, grade_upload, grade_md.
     """
 
     # the widgets, set by the folder builders (viser handles)

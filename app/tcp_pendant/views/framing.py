@@ -130,7 +130,8 @@ def frame_spheres(centres: np.ndarray, radii: np.ndarray | Sequence[float] | Non
     view with ``margin`` (1.15: 15 % space around it).
 
     Args:
-        centres, radii: the geometry to show (WORLD, m); see :func:`bounding_sphere`.
+        centres: the centres of the spheres to show (WORLD, m); see :func:`bounding_sphere`.
+        radii: their radii (m).
         fov_rad: vertical field of view; aspect: width / height (the narrower one counts).
         image_height_px: the view's height in pixels (for :func:`spread_labels`).
         direction: from the framed point toward the camera (normalised here).

@@ -12,9 +12,12 @@ no geometry at all is drawn as link shapes.
 
 from __future__ import annotations
 
+import contextlib
 import io
 import threading
+import warnings
 import xml.etree.ElementTree as ET
+from collections.abc import Iterator
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
@@ -39,10 +42,22 @@ class MeshPart:
     rgb: tuple[int, int, int]
 
 
+@contextlib.contextmanager
+def _yourdfpys_deprecated_trimesh_call() -> Iterator[None]:
+    """Silence the one DeprecationWarning yourdfpy's mesh loading causes in trimesh (it joins a
+    link's several geometries with ``Scene.dump(concatenate=True)``, which trimesh deprecates
+    for ``Scene.to_geometry()``; the meshes are the same). Only that message, only here."""
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message=r"`Scene\.dump\(concatenate=True\)` DEPRECATED",
+                                category=DeprecationWarning)
+        yield
+
+
 def _load(path: Path) -> yourdfpy.URDF:
     try:
-        return yourdfpy.URDF.load(str(path), load_meshes=True, build_collision_scene_graph=False,
-                                  load_collision_meshes=False)
+        with _yourdfpys_deprecated_trimesh_call():
+            return yourdfpy.URDF.load(str(path), load_meshes=True, build_collision_scene_graph=False,
+                                      load_collision_meshes=False)
     except Exception as exc:
         raise ControllerError(f"Cannot load the visual meshes of {path}: {exc}") from exc
 
@@ -146,10 +161,11 @@ def _link_meshes(description: RobotDescription) -> dict[str, tuple[MeshPart, ...
     plan = {link: description.drawing(link) for link in description.links}
     need_collision = any(how != "visual" for how in plan.values())
     try:
-        urdf = yourdfpy.URDF.load(io.StringIO(_found_only_xml(description)), load_meshes=True,
-                                  build_collision_scene_graph=need_collision,
-                                  load_collision_meshes=need_collision,
-                                  mesh_dir=str(description.source.parent))
+        with _yourdfpys_deprecated_trimesh_call():
+            urdf = yourdfpy.URDF.load(io.StringIO(_found_only_xml(description)), load_meshes=True,
+                                      build_collision_scene_graph=need_collision,
+                                      load_collision_meshes=need_collision,
+                                      mesh_dir=str(description.source.parent))
     except Exception as exc:
         raise ControllerError(f"Cannot load the meshes of {description.source}: {exc}") from exc
     visual = _scene_parts(urdf, urdf.scene)

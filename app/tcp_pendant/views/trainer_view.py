@@ -15,7 +15,8 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Protocol
 
-from tcp_pendant.classroom.gradebook import GradeRow, Gradebook
+from tcp_pendant.classroom.grade_rows import GradeRow
+from tcp_pendant.classroom.gradebook import Gradebook
 from tcp_pendant.classroom.grading import RecordGrade
 from tcp_pendant.classroom.recorder import TraineeStatus
 from tcp_pendant.calibrate.pendant_rules import ExerciseRules

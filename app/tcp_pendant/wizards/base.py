@@ -81,7 +81,8 @@ def finite_number(value: Any, what: str, *, low: float | None = None, high: floa
     Args:
         value: what was given.
         what: its name in the message ("TCP check's angle": "The TCP check's angle must ...").
-        low, high: inclusive bounds (None: none).
+        low: inclusive lower bound (None: none).
+        high: inclusive upper bound (None: none).
 
     Raises:
         WizardError: a bool, not a number, not finite, or out of the bounds (naming ``what``).
