@@ -209,12 +209,11 @@ class ClassRoom:
     def __init__(self, gradebook: Gradebook, tools: dict[str, ToolModel], *, trainer_token: str | None,
                  exercise: str | None = None, exercise_seed: int | None = None,
                  instructions: str | None = None, allowed_methods: Sequence[str] | str | None = None,
-                 min_touches: int | None = None,
+                 min_touches: int | None = None, views: ClassViews | None = None,
                  hand_to_loop: Callable[[Callable[[], None]], None] = lambda fn: fn(),
                  clock: Callable[[], float] = time.time,
                  call_later: Callable[[float, Callable[[], None]], None] | None = None,
-                 library_quota: int = DEFAULT_LIBRARY_QUOTA, presence_poll_s: float = 1.0,
-                 views: ClassViews | None = None) -> None:
+                 library_quota: int = DEFAULT_LIBRARY_QUOTA, presence_poll_s: float = 1.0) -> None:
         if (isinstance(library_quota, bool) or not isinstance(library_quota, int)
                 or not 1 <= library_quota <= MAX_LIBRARY_QUOTA):
             raise ValueError(f"The library quota must be a whole number of slots 1..{MAX_LIBRARY_QUOTA}, "
