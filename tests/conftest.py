@@ -1,4 +1,6 @@
-"""Fixtures shared by several test folders: a real PostgreSQL server (Debian's packages) for the
+"""Fixtures shared by several test folders: the pendants and browsers of ``support.fixtures``
+(registered below; ``tests/`` is on ``sys.path`` through pyproject.toml's ``pythonpath``, so the
+shared helpers import as ``support.*``), a real PostgreSQL server (Debian's packages) for the
 gradebook's PostgreSQL backend, the gradebook target parametrized over both backends, and
 Debian's nginx for the front-end test.
 
@@ -42,6 +44,8 @@ from typing import Any
 from urllib.parse import quote
 
 import pytest
+
+pytest_plugins = ["support.fixtures"]
 
 
 def _missing(reason: str) -> None:

@@ -1,10 +1,9 @@
 """Server and sessions in-process: a real viser server on a free port, headless websocket
-clients (tests/app/wsclient.py) standing in for browsers."""
+clients (tests/support/wsclient.py) standing in for browsers."""
 
 from __future__ import annotations
 
 import gc
-import sys
 import weakref
 from pathlib import Path
 
@@ -15,9 +14,8 @@ from tcpcal.formats import export_tool
 from tcpcal.library import ToolLibrary
 from tcpcal.tool import Tool
 
-sys.path.insert(0, str(Path(__file__).parent))
-from conftest import wait_until  # noqa: E402
-from wsclient import DrainingClient  # noqa: E402
+from support.wsclient import wait_until
+from support.wsclient import DrainingClient
 
 
 def _connect(app, n_before: int) -> DrainingClient:

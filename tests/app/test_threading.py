@@ -1,7 +1,7 @@
 """Every GUI callback runs on viser's event loop, in the order the browser's messages
 arrived, and no render writes a widget value older than the newest one the browser sent.
 
-Real viser server in-process, headless websocket clients (tests/app/wsclient.py) that send what
+Real viser server in-process, headless websocket clients (tests/support/wsclient.py) that send what
 a browser sends (GUI updates, clicks, gizmo drags) and record every GUI update they receive.
 """
 
@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import asyncio
 import math
-import sys
 import threading
 import time
 from pathlib import Path
@@ -26,9 +25,8 @@ from tcpcal.library import ToolLibrary
 from tcpcal.tool import Tool
 from tcp_pendant.pendant import joint_readout_markdown
 
-sys.path.insert(0, str(Path(__file__).parent))
-from conftest import wait_until  # noqa: E402
-from wsclient import DrainingClient, decode_window  # noqa: E402
+from support.wsclient import wait_until
+from support.wsclient import DrainingClient, decode_window
 
 
 class Browser(DrainingClient):

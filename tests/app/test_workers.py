@@ -17,8 +17,7 @@ from typing import Any
 
 import pytest
 
-sys.path.insert(0, str(Path(__file__).parent))
-from async_clients import PLUS, READOUT_LABEL, TOKEN_LABEL, connect_all  # noqa: E402
+from support.async_clients import PLUS, READOUT_LABEL, TOKEN_LABEL, connect_all
 
 from tcp_pendant.balance import BalanceFile
 from tcp_pendant.classroom.gradebook import Gradebook

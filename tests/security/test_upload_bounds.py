@@ -7,30 +7,24 @@ pass its announced size is dropped, and one that gets no part for a while times 
 from __future__ import annotations
 
 import logging
-import sys
 import uuid
-from collections.abc import Iterator
-from pathlib import Path
+from collections.abc import Callable, Iterator
 from typing import Any
 
 import pytest
-from tcp_pendant.server import AppConfig, PendantApp
+from tcp_pendant.server import PendantApp
 from tcp_pendant.views import viser_adapter
 from tcp_pendant.views.viser_adapter import UploadLimits
 
-sys.path.insert(0, str(Path(__file__).parents[1] / "app"))
-from wsclient import InputsClient, wait_until  # noqa: E402
+from support.wsclient import InputsClient, wait_until
 
 LOAD = "Load session (JSON)"
 MB = 1_000_000
 
 
 @pytest.fixture
-def app(tmp_path: Path) -> Iterator[PendantApp]:
-    a = PendantApp(AppConfig(port=0, tool_library=tmp_path / "tools.json"))
-    a.start()
-    yield a
-    a.stop()
+def app(app_factory: Callable[..., PendantApp]) -> PendantApp:
+    return app_factory()
 
 
 @pytest.fixture

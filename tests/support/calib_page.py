@@ -3,13 +3,10 @@
 
 from __future__ import annotations
 
-import sys
-from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).parents[1] / "app"))
-from app_page import AppPage  # noqa: E402
-from tcp_pendant.server import PendantApp  # noqa: E402
-from tcp_pendant.views.wizard_menu import CalibrateView  # noqa: E402
+from support.app_page import AppPage
+from tcp_pendant.server import PendantApp
+from tcp_pendant.views.wizard_menu import CalibrateView
 
 
 class Page(AppPage):

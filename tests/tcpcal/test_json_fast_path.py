@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 import pytest
-from poses import random_tcp, tilted_rotations, touch_positions
+from support.poses import random_tcp, tilted_rotations, touch_positions
 from scipy.spatial.transform import Rotation
 
 from tcpcal import report

@@ -11,7 +11,7 @@ import tracemalloc
 
 import numpy as np
 import pytest
-from angle_reference import angle_extremes_large, quaternions
+from support.angle_reference import angle_extremes_large, quaternions
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
