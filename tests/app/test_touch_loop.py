@@ -286,7 +286,8 @@ def test_continuous_jog_moves_at_the_override_speed_and_stops_at_release(app_fac
             time.sleep(max(0.0, t_start + (i + 1) * period - time.monotonic()))
         client.click("X +")                                         # the release
         wait_until(lambda: len(xs) >= n - 3, what="the hold ticks")
-        time.sleep(0.3)
+        client.sync(s.client)                                       # the release handled
+        loop_ran_for(app.server.get_event_loop(), 3 / HOLD_HZ)      # three ticks' time on the server
         x_end = float(s.controller.T_world_tcp()[0, 3])
         held_s = n * period
         speed = (x_end - x0) * 1000.0 / held_s

@@ -17,10 +17,12 @@ from typing import Any
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
+from tcp_pendant.pendant.hold import DEADMAN_S
 from tcp_pendant.server import PendantApp
 
 from support.chromium_session import with_render_scale
-from support.pendant_page import TIMEOUT_MS, assert_not_blank, type_text, wait_text, wait_until
+from support.pendant_page import TIMEOUT_MS, assert_not_blank, field, type_text, wait_text, wait_until
+from support.wsclient import loop_ran_for
 
 pytestmark = pytest.mark.browser
 
@@ -130,7 +132,7 @@ def test_cont_mode_holds_the_key_like_the_mouse_button(app_factory, new_page) ->
     wait_until(lambda: (pose(s)[0, 3] - T0[0, 3]) * 1000.0 > 20.0, "X to move 20 mm while the key is held")
     page.keyboard.up("Digit1")
     T1 = settled(s, T0)
-    page.wait_for_timeout(1500)                            # longer than the server's deadman time
+    loop_ran_for(app.server.get_event_loop(), 1.5 * DEADMAN_S)   # every tick due meanwhile has run
     np.testing.assert_allclose(pose(s), T1, atol=1e-9)    # stopped at the release
     dx = (T1[:3, 3] - T0[:3, 3]) * 1000.0
     assert dx[0] > 20.0 and abs(dx[1]) < 0.05 and abs(dx[2]) < 0.05, dx
@@ -173,7 +175,8 @@ def test_typing_in_a_field_does_not_jog(app_factory, new_page) -> None:
     type_text(page, "New name", "r1[2]3")
     page.keyboard.press("Enter")
     page.keyboard.press("Shift+Digit2")
-    page.wait_for_timeout(1500)
+    typed = field(page, "New name").input_value()          # the field's last value: sent behind the keys
+    wait_until(lambda: s.views["tools"].new_name.value == typed, "the field's value on the server")
     np.testing.assert_allclose(pose(s), T0, atol=1e-12)
     assert len(s.touches) == 0 and increment(s) == "10"
     # the same keys with the focus out of the field do act
@@ -193,7 +196,8 @@ def test_the_name_is_remembered_across_a_reload(app_factory, new_page, tmp_path:
     page.keyboard.press("Digit1")                         # the welcome window is open: keys do nothing
     page.keyboard.press("r")
     type_text(page, "Your name", "Anna 12")               # digits typed in the name do not jog either
-    page.wait_for_timeout(1000)
+    wait_until(lambda: s.views["identity"].name_field.value == "Anna 12",
+               "the typed name on the server (sent behind the keys)")
     np.testing.assert_allclose(pose(s), T0, atol=1e-12)
     assert len(s.touches) == 0
     page.get_by_role("button", name="Join the class", exact=True).click()
