@@ -47,6 +47,7 @@ def test_each_browser_gets_its_own_robot(app_factory) -> None:
         c2.close()
 
 
+@pytest.mark.slow  # 100 connections
 def test_no_leak_after_100_connect_disconnect_cycles(app_factory) -> None:
     """100 real websocket connects/disconnects: every session is closed, forgotten and freed."""
     app = app_factory()

@@ -88,6 +88,7 @@ def _values(app: PendantApp) -> dict[str, Any]:
     return out
 
 
+@pytest.mark.slow  # thousands of fuzzed messages
 def test_fuzzed_messages_leave_no_traceback_and_the_socket_open(app: PendantApp, caplog: pytest.LogCaptureFixture,
                                                                capfd: pytest.CaptureFixture[str]) -> None:
     client = InputsClient(app.port)
