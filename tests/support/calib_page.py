@@ -1,5 +1,6 @@
 """One connected browser on an in-process pendant, for the Calibrate-tab tests: the app tests'
-``AppPage`` with its Calibrate view. The ``page`` fixture in ``conftest.py`` makes them."""
+``AppPage`` with its Calibrate view. The ``page`` fixture (``support.fixtures``) makes them in a
+module marked ``pytest.mark.app_page(cls=Page)``."""
 
 from __future__ import annotations
 
