@@ -15,8 +15,9 @@
 # servers, chromium, latency and load; tests/conftest.py marks them) alone; every test runs
 # once and the exit status is the first failing run's. --quick (the lane to run while working,
 # under 5 minutes on two cores): the same two runs without the tests marked slow (benchmarks'
-# smoke runs, the 1e5-row CLI runs, Monte Carlo and the other long ones); arguments after it go
-# to both runs. With other arguments: one pytest run, as given.
+# smoke runs, the 1e5-row CLI runs, Monte Carlo, the other long ones and every browser test:
+# tests/conftest.py); arguments after it go to both runs. With other arguments: one pytest run,
+# as given.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 quick=""
