@@ -1,5 +1,6 @@
 """What the tests share, imported as ``support.*`` (pyproject.toml's pytest ``pythonpath`` puts
-``tests/`` on ``sys.path``; a benchmark run as a script gets it from ``tests/bench/_tests_on_path.py``).
+``tests/`` on ``sys.path``; a benchmark run as a script gets it from
+``tests/bench/_tests_on_path.py``).
 
 * ``fixtures``: the pytest fixtures of every folder (registered by ``tests/conftest.py``): a
   pendant in this process (``app_factory``), a browser on it (``page``), a pendant in a
