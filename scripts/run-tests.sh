@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
-# Set up everything the test suite needs on a fresh machine, type-check the code (mypy), check
-# the import layers (lint-imports), build the documentation site (mkdocs build --strict), then
-# run the tests.
-#   bash scripts/run-tests.sh            # mypy, lint-imports, the site, then the whole suite (unit, property, CLI, browser)
+# Set up everything the test suite needs on a fresh machine, type-check the code (mypy), then run
+# the tests.
+#   bash scripts/run-tests.sh            # mypy, then the whole suite (unit, property, CLI, browser)
+#   bash scripts/run-tests.sh --quick    # mypy, then all but the tests marked slow: while working
 #   bash scripts/run-tests.sh -m browser # only the browser end-to-end tests
 # The browser tests drive Debian's chromium (Playwright cannot download its own browser here):
 # when it is missing it is installed with apt-get as root (or through sudo). A user who can do
@@ -13,9 +13,15 @@
 # Without arguments (the README's command, CI) pytest runs twice: the tests not marked serial on
 # two pytest-xdist workers, then the serial ones (tests/app, tests/browser, tests/security:
 # servers, chromium, latency and load; tests/conftest.py marks them) alone; every test runs
-# once and the exit status is the first failing run's. With arguments: one pytest run, as given.
+# once and the exit status is the first failing run's. --quick (the lane to run while working,
+# under 5 minutes on two cores): the same two runs without the tests marked slow (benchmarks'
+# smoke runs, the 1e5-row CLI runs, Monte Carlo, the other long ones and every browser test:
+# tests/conftest.py); arguments after it go to both runs. With other arguments: one pytest run,
+# as given.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+quick=""
+if [ "${1:-}" = --quick ]; then quick="not slow"; shift; fi
 . scripts/venv.sh
 ensure_venv test
 
@@ -99,12 +105,14 @@ elif ! command -v chromium >/dev/null 2>&1; then
     chromium_missing="chromium is missing and 'apt-get install chromium' failed (exit $rc): install it by hand, or set CHROMIUM=/path/to/chromium"
   fi
 fi
-# run_suite [MARKER]: the whole suite (of MARKER, e.g. "not browser") in two runs: the tests not
-# marked serial on 2 xdist workers, then the serial ones in one process (header comment).
+# run_suite MARKER [ARGS...]: the whole suite (of MARKER, e.g. "not browser"; empty: all) in two
+# runs, each with ARGS: the tests not marked serial on 2 xdist workers, then the serial ones in one
+# process (header comment).
 run_suite() {
   local only="${1:+$1 and }" rc_parallel=0 rc_serial=0
-  .venv/bin/python -m pytest -n 2 --durations=25 -m "${only}not serial" || rc_parallel=$?
-  .venv/bin/python -m pytest --durations=25 -m "${only}serial" || rc_serial=$?
+  shift
+  .venv/bin/python -m pytest -n 2 --durations=25 -m "${only}not serial" "$@" || rc_parallel=$?
+  .venv/bin/python -m pytest --durations=25 -m "${only}serial" "$@" || rc_serial=$?
   if [ "$rc_parallel" != 0 ] || [ "$rc_serial" != 0 ]; then
     echo "run-tests.sh: pytest exited $rc_parallel (the tests on 2 workers) and $rc_serial (the serial tests)." >&2
   fi
@@ -114,9 +122,9 @@ run_suite() {
 
 if [ -z "$chromium_missing" ]; then
   [ -n "${CHROMIUM:-}" ] || export CHROMIUM="$(command -v chromium)"
-  if [ $# -eq 0 ]; then
+  if [ $# -eq 0 ] || [ -n "$quick" ]; then
     rc=0
-    run_suite || rc=$?
+    run_suite "$quick" "$@" || rc=$?
     exit "$rc"
   fi
   exec .venv/bin/python -m pytest "$@"
@@ -134,7 +142,9 @@ while [ $# -gt 0 ]; do
   esac
 done
 rc=0
-if [ ${#args[@]} -eq 0 ] && [ "$marker" = "not browser" ]; then
+if [ -n "$quick" ]; then
+  run_suite "$marker and $quick" ${args[@]+"${args[@]}"} || rc=$?
+elif [ ${#args[@]} -eq 0 ] && [ "$marker" = "not browser" ]; then
   run_suite "$marker" || rc=$?
 else
   .venv/bin/python -m pytest -m "$marker" ${args[@]+"${args[@]}"} || rc=$?

@@ -1,4 +1,6 @@
-"""Fixtures shared by several test folders: a real PostgreSQL server (Debian's packages) for the
+"""Fixtures shared by several test folders: the pendants and browsers of ``support.fixtures``
+(registered below; ``tests/`` is on ``sys.path`` through pyproject.toml's ``pythonpath``, so the
+shared helpers import as ``support.*``), a real PostgreSQL server (Debian's packages) for the
 gradebook's PostgreSQL backend, the gradebook target parametrized over both backends, and
 Debian's nginx for the front-end test.
 
@@ -13,6 +15,9 @@ Where the server binaries (``/usr/lib/postgresql/*/bin``, or ``$PG_BIN``), psyco
 are missing, the tests that need them are skipped with the reason (reported as not run), and
 under ``CI=true`` they fail: ``scripts/run-tests.sh`` installs ``postgresql`` and ``nginx`` with
 apt-get.
+
+Which tests are slow: the ``browser`` tests are marked ``slow`` here as well (the quick lane,
+``scripts/run-tests.sh --quick``, runs ``-m "not slow"``).
 
 Which tests may share the CPU: ``scripts/run-tests.sh`` runs the tests not marked ``serial`` on
 two pytest-xdist workers (each worker starts its own PostgreSQL server: a session fixture is one
@@ -42,6 +47,8 @@ from typing import Any
 from urllib.parse import quote
 
 import pytest
+
+pytest_plugins = ["support.fixtures"]
 
 
 def _missing(reason: str) -> None:
@@ -218,8 +225,13 @@ _TESTS = Path(__file__).resolve().parent
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     """Mark ``serial`` every test of :data:`SERIAL_FOLDERS` and every ``browser`` test, but
     not a module of those folders marked ``shares_cpu`` (it asserts no time, latency or load:
-    a unit test of an app module, a benchmark's smoke run that checks what it prints)."""
+    a unit test of an app module, a benchmark's smoke run that checks what it prints). Mark
+    ``slow`` every ``browser`` test too: chromium draws WebGL in software here, 7-35 s a test,
+    about 9 of the full run's minutes on two cores, so the quick lane (``run-tests.sh
+    --quick``: ``-m "not slow"``) leaves them to the full run and ``-m browser``."""
     for item in items:
+        if item.get_closest_marker("browser") is not None:
+            item.add_marker(pytest.mark.slow)
         try:
             folder = item.path.resolve().relative_to(_TESTS).parts[0]
         except ValueError:                      # a test outside tests/ (given on the command line)

@@ -44,7 +44,7 @@ refuses the excess. ``tests/security/test_job_pool.py`` proves it with 20 attack
 script's pace: its pool gives every session a credit of 60 s, so it measures the order alone).
 
 One browser flooding the pool (Check, "Check active tool" and Auto-touch clicked in
-turn as fast as it can; the rig of ``tests/security/browser_flood.py``, ``bench_jobs.py
+turn as fast as it can; the rig of ``tests/support/browser_flood.py``, ``bench_jobs.py
 --flood``: another browser's X+ press to the readout showing the move, 40 presses alone and 40
 under the flood, interleaved in blocks, 2 shared cores, one worker). Without the share, the
 refusal rules and the pace, the one worker runs the attacker's checks back to back, holding the

@@ -253,7 +253,7 @@ SAMPLED_ANGLES_ABOVE_N = EXACT_ANGLES_MAX_N
 """Above this many touches the angle figures may be estimates (``min_exact`` / ``max_exact``
 False); the same threshold as ``EXACT_ANGLES_MAX_N``, named for what callers of the smallest
 angle ask (``TcpResult.min_angle_exact``). The exact reference of both angles for many
-touches, an O(N log N) search, lives with the tests (``tests/tcpcal/angle_reference.py``)."""
+touches, an O(N log N) search, lives with the tests (``tests/support/angle_reference.py``)."""
 _SAMPLE_PAIRS = 512
 """Most consecutive pairs of touches in the sample of :func:`_angle_extremes_sampled`."""
 SAMPLED_PROJECTION_MAX_N = 20_000

@@ -1,11 +1,9 @@
-"""Fixtures of the app tests: controllers on the KR 6, a tool library in tmp_path, a pendant
-server in-process on a free port (real viser server, headless websocket clients)."""
+"""Fixtures of the app tests: controllers on the KR 6, a tool library in tmp_path (the pendants
+in this process are ``support.fixtures``' ``app_factory`` and ``page``)."""
 
 from __future__ import annotations
 
 import os
-import sys
-from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import pytest
@@ -17,10 +15,6 @@ from tcp_pendant.controller import (
 )
 
 from tcpcal.library import ToolLibrary
-
-sys.path.insert(0, str(Path(__file__).parent))
-from wsclient import free_port, wait_until  # noqa: F401  (re-exported: the tests import them from here)
-from app_page import running_pendants  # noqa: E402
 
 # a fast path into viser's private API that falls back raises (views.viser_adapter)
 os.environ.setdefault("TCP_PENDANT_STRICT_VISER", "1")
@@ -39,10 +33,3 @@ def controller(kr6: RobotKinematics) -> VirtualController:
 @pytest.fixture
 def library(tmp_path: Path) -> ToolLibrary:
     return ToolLibrary(tmp_path / "tools.json")
-
-
-@pytest.fixture
-def app_factory(tmp_path: Path) -> Iterator[Callable[..., object]]:
-    """``app_factory(**AppConfig options)``: a started pendant in this process (``app_page.running_pendants``)."""
-    with running_pendants(tmp_path) as start:
-        yield start

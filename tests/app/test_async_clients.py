@@ -13,7 +13,7 @@ import time
 
 import pytest
 
-from async_clients import _ANCILLARY, SO_TIMESTAMPNS, LoadClient, _arrival_monotonic, latencies
+from support.async_clients import _ANCILLARY, SO_TIMESTAMPNS, LoadClient, _arrival_monotonic, latencies
 
 
 def test_a_read_late_is_stamped_with_its_arrival() -> None:

@@ -6,22 +6,16 @@ headless websocket client as the browser (``guiclick``)."""
 
 from __future__ import annotations
 
-import sys
-from collections.abc import Callable, Iterator
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-HERE = Path(__file__).parent
-sys.path.insert(0, str(HERE))
-sys.path.insert(0, str(HERE.parent / "calibrate"))
-from app_page import AppPage, app_pages, truth_tool  # noqa: E402
-from wsclient import wait_until  # noqa: E402
+from support.app_page import AppPage, truth_tool
+from support.wsclient import wait_until
 
-from tcp_pendant.controller import builtin_tools  # noqa: E402
-from tcp_pendant.text_escape import escape_markdown  # noqa: E402
-from tcp_pendant.views.beam_replay import ScanPlayer  # noqa: E402
+from tcp_pendant.controller import builtin_tools
+from tcp_pendant.text_escape import escape_markdown
+from tcp_pendant.views.beam_replay import ScanPlayer
 
 
 class Page(AppPage):
@@ -40,12 +34,9 @@ class Page(AppPage):
         wait_until(lambda: not self.session.views["beam_player"].playing, timeout=60, what="the scan's film")
 
 
-@pytest.fixture
-def page(tmp_path: Path) -> Iterator[Callable[..., Page]]:
-    # seeded: the beam's repeatability noise (about 0.02 mm per axis) comes from the session's
-    # randomness, and the checks below allow 0.05 mm
-    with app_pages(tmp_path, Page, seed=7) as make:
-        yield make
+# seeded: the beam's repeatability noise (about 0.02 mm per axis) comes from the session's
+# randomness, and the checks below allow 0.05 mm
+pytestmark = pytest.mark.app_page(cls=Page, seed=7)
 
 
 def test_check_with_beam_needs_an_active_tool(page) -> None:
@@ -198,14 +189,11 @@ def test_an_unexpected_failure_is_one_notification_and_the_view_stays_usable(pag
     assert p.beam.last_check is not None
 
 
-def test_shared_mode_checks_and_updates_the_one_robot(tmp_path: Path) -> None:
-    from guiclick import click
-    from tcp_pendant.serve.server import AppConfig, PendantApp
-    from wsclient import DrainingClient
+def test_shared_mode_checks_and_updates_the_one_robot(app_factory) -> None:
+    from support.guiclick import click
+    from support.wsclient import DrainingClient
 
-    app = PendantApp(AppConfig(port=0, tool_library=tmp_path / "tools.json", shared=True, library_poll_s=0.1))
-    app.library.save(1, truth_tool("pointer", "Pointer", (0.0, 1.0, 0.0)), activate=True)   # 1 mm off
-    app.start()
+    app = app_factory({1: truth_tool("pointer", "Pointer", (0.0, 1.0, 0.0))}, active_slot=1, shared=True)   # 1 mm off
     ws = [DrainingClient(app.port), DrainingClient(app.port)]
     try:
         wait_until(lambda: len(app.server.get_clients()) == 2, what="two browsers")
@@ -224,4 +212,3 @@ def test_shared_mode_checks_and_updates_the_one_robot(tmp_path: Path) -> None:
     finally:
         for w in ws:
             w.close()
-        app.stop()

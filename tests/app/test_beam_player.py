@@ -6,21 +6,16 @@ only its owner's film. In-process server, headless websocket client as the brows
 from __future__ import annotations
 
 import asyncio
-import sys
-from collections.abc import Callable, Iterator
-from pathlib import Path
+from collections.abc import Callable
 from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
-HERE = Path(__file__).parent
-sys.path.insert(0, str(HERE))
-sys.path.insert(0, str(HERE.parent / "calibrate"))
-from app_page import AppPage, app_pages  # noqa: E402
-from wsclient import wait_until  # noqa: E402
+from support.app_page import AppPage
+from support.wsclient import wait_until
 
-from tcp_pendant.views.beam_replay import ScanPlayer  # noqa: E402
+from tcp_pendant.views.beam_replay import ScanPlayer
 
 
 class Page(AppPage):
@@ -34,10 +29,7 @@ class Page(AppPage):
         return asyncio.run_coroutine_threadsafe(call(), loop).result(timeout=30)
 
 
-@pytest.fixture
-def page(tmp_path: Path) -> Iterator[Callable[..., Page]]:
-    with app_pages(tmp_path, Page) as make:
-        yield make
+pytestmark = pytest.mark.app_page(cls=Page)
 
 
 def fake_scan(p: Page) -> SimpleNamespace:

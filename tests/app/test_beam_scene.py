@@ -4,26 +4,14 @@ is set, and the overview camera sees it. In-process server, headless websocket c
 
 from __future__ import annotations
 
-import sys
-from collections.abc import Callable, Iterator
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-HERE = Path(__file__).parent
-sys.path.insert(0, str(HERE))
-sys.path.insert(0, str(HERE.parent / "calibrate"))
-from app_page import AppPage, app_pages  # noqa: E402
+from support.app_page import AppPage
 
-from tcp_pendant.controller.beam import BeamSensor  # noqa: E402
-from tcp_pendant.views.scene import overview_pose  # noqa: E402
-
-
-@pytest.fixture
-def page(tmp_path: Path) -> Iterator[Callable[..., AppPage]]:
-    with app_pages(tmp_path, AppPage) as make:
-        yield make
+from tcp_pendant.controller.beam import BeamSensor
+from tcp_pendant.views.scene import overview_pose
 
 
 def beam_on_screen(p: AppPage) -> np.ndarray:

@@ -6,20 +6,14 @@ truth (training) or without them (an exercise). In-process server, headless webs
 
 from __future__ import annotations
 
-import sys
-from collections.abc import Callable, Iterator
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-HERE = Path(__file__).parent
-sys.path.insert(0, str(HERE))
-sys.path.insert(0, str(HERE.parent / "calibrate"))
-from app_page import AppPage, app_pages  # noqa: E402
-from wsclient import wait_until  # noqa: E402
+from support.app_page import AppPage
+from support.wsclient import wait_until
 
-from tcp_pendant.views.beam_replay import ScanPlayer  # noqa: E402
+from tcp_pendant.views.beam_replay import ScanPlayer
 
 
 class Page(AppPage):
@@ -49,10 +43,7 @@ class Page(AppPage):
         wait_until(lambda: not self.player.playing, timeout=60, what="the scan's film")
 
 
-@pytest.fixture
-def page(tmp_path: Path) -> Iterator[Callable[..., Page]]:
-    with app_pages(tmp_path, Page, seed=3) as make:
-        yield make
+pytestmark = pytest.mark.app_page(cls=Page, seed=3)
 
 
 def _in_view(framing, point: np.ndarray) -> bool:

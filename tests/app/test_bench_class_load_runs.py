@@ -19,7 +19,8 @@ from pathlib import Path
 
 import pytest
 
-pytestmark = pytest.mark.shares_cpu   # asserts no time or load (tests/conftest.py)
+pytestmark = [pytest.mark.shares_cpu,  # asserts no time or load (tests/conftest.py)
+              pytest.mark.slow]       # a benchmark's smoke run
 
 BENCH = Path(__file__).resolve().parents[1] / "bench" / "bench_class_load.py"
 ROW = re.compile(r"^ +2 +(?P<p50>\S+) +(?P<p95>\S+) +(?P<p99>\S+) +(?P<max>\S+) +(?P<asked>\d+) +(?P<unanswered>\d+) "

@@ -12,7 +12,8 @@ from pathlib import Path
 
 import pytest
 
-pytestmark = pytest.mark.shares_cpu   # asserts no time or load (tests/conftest.py)
+pytestmark = [pytest.mark.shares_cpu,  # asserts no time or load (tests/conftest.py)
+              pytest.mark.slow]       # a benchmark's smoke run
 
 BENCH = Path(__file__).resolve().parents[1] / "bench" / "bench_server.py"
 ROW = re.compile(r"^  (\S.+?)\s+(\S+) ms\s+(\S+) ms\s+(\S+)$", re.MULTILINE)

@@ -17,8 +17,8 @@ from tcp_pendant.pendant.tip_insets import FAR, NEAR_MM
 from tcp_pendant.session import Session, SessionChange
 from tcpcal.library import ToolLibrary
 
-from app_page import true_tip_at
-from wsclient import DrainingClient, wait_until
+from support.app_page import true_tip_at
+from support.wsclient import DrainingClient, wait_until
 
 FLAGS = ("pose", "tool", "touches", "wizard", "library", "notice")
 

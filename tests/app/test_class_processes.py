@@ -6,15 +6,13 @@ the trainer token's lockout)."""
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-sys.path.insert(0, str(Path(__file__).parents[1] / "calibrate"))
-from guiclick import choose, click  # noqa: E402
-from wsclient import DrainingClient, wait_until  # noqa: E402
+from support.guiclick import choose, click
+from support.wsclient import DrainingClient, wait_until
 
 from tcp_pendant.classroom.names import TraineeNameError
 from tcp_pendant.classroom.trainer_token import TrainerTokenLocked

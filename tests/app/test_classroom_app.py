@@ -3,15 +3,13 @@ the trainer view behind its token, the mystery exercise and the settings the tra
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-sys.path.insert(0, str(Path(__file__).parents[1] / "calibrate"))
-from guiclick import choose, click, upload  # noqa: E402
-from wsclient import DrainingClient, RecordingClient, wait_until  # noqa: E402
+from support.guiclick import choose, click, upload
+from support.wsclient import DrainingClient, RecordingClient, wait_until
 
 from tcp_pendant.classroom.gradebook import Gradebook
 from tcp_pendant.classroom.mystery import true_frame

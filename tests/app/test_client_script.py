@@ -10,7 +10,7 @@ import http.client
 import re
 import sys
 import threading
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from importlib import resources
 from pathlib import Path
@@ -30,20 +30,15 @@ from websockets.exceptions import InvalidStatus
 from websockets.http11 import Request
 from websockets.sync.client import connect
 
-sys.path.insert(0, str(Path(__file__).parent))
-from wsclient import wait_until  # noqa: E402
+from support.wsclient import wait_until
 
 VISER_INDEX = (Path(viser.__file__).parent / "client" / "build" / "index.html").read_bytes()
 PACKAGED_JS = (resources.files("tcp_pendant.serve") / "static" / "pendant.js").read_bytes()
 
 
 @pytest.fixture
-def app(tmp_path: Path) -> Iterator[PendantApp]:
-    a = PendantApp(AppConfig(port=0, tool_library=tmp_path / "tools.json", class_db=tmp_path / "class.sqlite3",
-                             trainer_token="token with & and + and #"))
-    a.start()
-    yield a
-    a.stop()
+def app(app_factory: Callable[..., PendantApp], tmp_path: Path) -> PendantApp:
+    return app_factory(class_db=tmp_path / "class.sqlite3", trainer_token="token with & and + and #")
 
 
 def get(port: int, path: str, *, gzip_ok: bool = False, origin: str | None = None) -> tuple[int, dict[str, str], bytes]:

@@ -5,20 +5,17 @@ also with the reference tip placed right at the pre-test's margin."""
 
 from __future__ import annotations
 
-import sys
-from pathlib import Path
 from types import MethodType
 
 import numpy as np
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "bench"))
-from panel_yardstick import legacy_translate  # noqa: E402
+from bench.panel_yardstick import legacy_translate
 
-from tcp_pendant.controller import VirtualController, builtin_robots, builtin_tools  # noqa: E402
-from tcp_pendant.controller.kinematics import RobotKinematics  # noqa: E402
-from tcp_pendant.pendant.guidance import CONTACT_RADIUS_MM  # noqa: E402
-from tcp_pendant.pendant.jogging import Jogger  # noqa: E402
+from tcp_pendant.controller import VirtualController, builtin_robots, builtin_tools
+from tcp_pendant.controller.kinematics import RobotKinematics
+from tcp_pendant.pendant.guidance import CONTACT_RADIUS_MM
+from tcp_pendant.pendant.jogging import Jogger
 
 _KIN: list[RobotKinematics] = []
 

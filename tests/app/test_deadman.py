@@ -13,10 +13,8 @@ moved.
 from __future__ import annotations
 
 import re
-import sys
 import threading
 import time
-from pathlib import Path
 
 import pytest
 from tcp_pendant.controller import JogResult, VirtualController
@@ -24,10 +22,8 @@ from tcp_pendant.pendant import Jogger, JogSettings, dropped_presses_text
 from tcp_pendant.pendant.hold import DEADMAN_S, HoldDriver
 from tcp_pendant.pendant.jogging import PRESS_BOUND_S
 
-sys.path.insert(0, str(Path(__file__).parent))
-from test_jog_continuous import _Scheduler  # noqa: E402
-from test_pendant_logic import FakeClock, away_from_singularity  # noqa: E402
-from wsclient import ButtonClient, wait_until  # noqa: E402
+from support.jogging import FakeClock, FakeScheduler, away_from_singularity
+from support.wsclient import ButtonClient, wait_until
 
 PLUS_X = "X +"
 
@@ -68,7 +64,7 @@ def test_the_trainee_is_told_how_many_presses_were_dropped() -> None:
 
 def test_hold_deadman_counts_from_the_arrival_not_from_when_the_server_got_to_it() -> None:
     clock = FakeClock()
-    sched = _Scheduler(clock)
+    sched = FakeScheduler(clock)
     steps: list[float] = []
     driver = HoldDriver(lambda a, s: steps.append(clock.t) or JogResult(True, 1.0, None, ""), sched, clock=clock)
     t0 = clock.t

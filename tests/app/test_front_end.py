@@ -11,16 +11,14 @@ import re
 import shutil
 import socket
 import subprocess
-import sys
 import tempfile
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 
 import pytest
 
-sys.path.insert(0, str(Path(__file__).parents[1] / "calibrate"))
-from guiclick import choose, click  # noqa: E402
-from wsclient import DrainingClient, free_port, wait_until  # noqa: E402
+from support.guiclick import choose, click
+from support.wsclient import DrainingClient, free_port, wait_until
 
 from tcp_pendant.classroom.gradebook import Gradebook
 

@@ -18,7 +18,7 @@ from tcp_pendant.pendant import Jogger, JogSettings
 from tcp_pendant.pendant.guidance import contact_stop
 from tcp_pendant.pendant.jogging import LINEAR_SPEED_MM_S, MAX_TICK_S
 
-from test_pendant_logic import FakeClock, away_from_singularity
+from support.jogging import FakeClock, FakeScheduler, away_from_singularity
 
 
 def _x_mm(c: VirtualController) -> float:
@@ -94,42 +94,12 @@ def test_a_held_key_stops_at_contact_until_released(controller: VirtualControlle
     assert jog.key("X", 1, hold_tick=True).ok        # a new hold goes on
 
 
-class _Scheduler:
-    """A fake ``call_later``: runs the due callbacks when the test advances the clock."""
-
-    def __init__(self, clock: FakeClock) -> None:
-        self.clock = clock
-        self.pending: list[tuple[float, object]] = []
-
-    def __call__(self, delay_s: float, fn):
-        entry = [self.clock.t + delay_s, fn, False]
-
-        class Handle:
-            def cancel(self_inner) -> None:
-                entry[2] = True
-
-        self.pending.append(entry)  # type: ignore[arg-type]
-        return Handle()
-
-    def advance(self, seconds: float) -> None:
-        end = self.clock.t + seconds
-        while True:
-            due = [e for e in self.pending if e[0] <= end and not e[2]]
-            if not due:
-                break
-            e = min(due, key=lambda e: e[0])
-            self.pending.remove(e)
-            self.clock.t = max(self.clock.t, e[0])
-            e[1]()
-        self.clock.t = end
-
-
 def test_hold_driver_ticks_at_20hz_until_release_or_deadman() -> None:
     from tcp_pendant.controller import JogResult
     from tcp_pendant.pendant.hold import DEADMAN_S, HoldDriver
 
     clock = FakeClock()
-    sched = _Scheduler(clock)
+    sched = FakeScheduler(clock)
     steps: list[float] = []
     driver = HoldDriver(lambda axis, sign: steps.append(clock.t) or JogResult(True, 1.0, None, ""),
                         sched, clock=clock)
@@ -152,7 +122,7 @@ def test_hold_driver_stops_when_a_jog_stops_short() -> None:
     from tcp_pendant.pendant.hold import HoldDriver
 
     clock = FakeClock()
-    sched = _Scheduler(clock)
+    sched = FakeScheduler(clock)
     results = iter([JogResult(True, 1.0, None, ""), JogResult(False, 0.3, "contact", "Stopped")])
     driver = HoldDriver(lambda a, s: next(results), sched, clock=clock)
     driver.held("Z", -1)

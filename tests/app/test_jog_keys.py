@@ -4,16 +4,13 @@ texts and the joint sliders on the hot path."""
 from __future__ import annotations
 
 import re
-import sys
 import time
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-sys.path.insert(0, str(Path(__file__).parent))
-from conftest import wait_until  # noqa: E402
-from wsclient import ButtonClient, click_until_carried_out  # noqa: E402
+from support.wsclient import wait_until
+from support.wsclient import ButtonClient, click_until_carried_out
 
 PLUS_X, MINUS_Z = "X +", "Z −"
 

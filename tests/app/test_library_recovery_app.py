@@ -5,12 +5,9 @@ was set aside and where the backup is -- once per recovery, not on every reload.
 from __future__ import annotations
 
 import json
-import sys
 import threading
-from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).parent))
-from wsclient import DrainingClient, decode_window, wait_until  # noqa: E402
+from support.wsclient import DrainingClient, decode_window, wait_until
 
 
 class RecordingClient(DrainingClient):

@@ -3,17 +3,14 @@ URDF given on the command line loads, flange = the last link of the longest chai
 
 from __future__ import annotations
 
-import sys
-from pathlib import Path
 
 import numpy as np
 from tcp_pendant.calibrate import AutoTouchRequest
 from tcp_pendant.controller import JogFrame, builtin_tools, example_robot_urdf
 from tcp_pendant.serve.server import MIN_TIP_HEIGHT_M
 
-sys.path.insert(0, str(Path(__file__).parent))
-from conftest import wait_until
-from wsclient import DrainingClient
+from support.wsclient import wait_until
+from support.wsclient import DrainingClient
 
 
 def test_ur5_session_starts_over_a_visible_tip_and_calibrates(app_factory) -> None:

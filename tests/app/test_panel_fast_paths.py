@@ -7,18 +7,12 @@ re-sends (the close-up, the status line) still follows every change."""
 from __future__ import annotations
 
 import math
-import sys
-from collections.abc import Callable, Iterator
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-HERE = Path(__file__).parent
-sys.path.insert(0, str(HERE))
-sys.path.insert(0, str(HERE.parent / "bench"))
-from app_page import AppPage, app_pages, true_tip_at  # noqa: E402
-from panel_yardstick import (  # noqa: E402
+from support.app_page import AppPage, true_tip_at
+from bench.panel_yardstick import (
     legacy_fmt_num,
     legacy_joint_readout_markdown,
     legacy_offset_markdown,
@@ -27,16 +21,16 @@ from panel_yardstick import (  # noqa: E402
     legacy_touch_indicator_markdown,
 )
 
-from tcp_pendant.controller import PoseReadout, TouchGeometry, VirtualController, builtin_robots, builtin_tools  # noqa: E402
-from tcp_pendant.controller.kinematics import RobotKinematics  # noqa: E402
-from tcp_pendant.controller.pose_state import pose_state  # noqa: E402
-from tcp_pendant.pendant.formatting import (  # noqa: E402
+from tcp_pendant.controller import PoseReadout, TouchGeometry, VirtualController, builtin_robots, builtin_tools
+from tcp_pendant.controller.kinematics import RobotKinematics
+from tcp_pendant.controller.pose_state import pose_state
+from tcp_pendant.pendant.formatting import (
     fmt_num,
     joint_readout_markdown,
     tcp_readout_markdown,
     touch_indicator_markdown,
 )
-from tcp_pendant.pendant.guidance import offset_markdown, tip_offset_mm, tip_offset_xyz_mm  # noqa: E402
+from tcp_pendant.pendant.guidance import offset_markdown, tip_offset_mm, tip_offset_xyz_mm
 
 EDGES = [0.0, -0.0, -0.004, 0.004, -0.005, 0.005, -0.0049999, 0.0050001, 99.995, -99.995, 99.994999,
          99.9999, 100.0, -100.0, -100.04, 1e6, -1e6, 1e20, math.nan, math.inf, -math.inf, 12.345,
@@ -105,10 +99,7 @@ class Page(AppPage):
         self.pendant = self.session.views["pendant"]
 
 
-@pytest.fixture
-def page(tmp_path: Path) -> Iterator[Callable[..., Page]]:
-    with app_pages(tmp_path, Page, seed=3) as make:
-        yield make
+pytestmark = pytest.mark.app_page(cls=Page, seed=3)
 
 
 def test_the_close_up_and_the_status_line_follow_every_change(page) -> None:

@@ -17,7 +17,7 @@ from tcp_pendant.pendant.guidance import (
 from tcp_pendant.pendant.record_check import CONFIRM_WINDOW_S, RecordCheck
 from tcp_pendant.controller.pose_state import pose_state
 
-from test_pendant_logic import FakeClock
+from support.jogging import FakeClock
 
 
 def _grid(md: str) -> list[str]:

@@ -25,18 +25,7 @@ from tcp_pendant.pendant import (
 )
 from tcp_pendant.pendant.jogging import LINEAR_SPEED_MM_S, MAX_TICK_S
 
-
-def away_from_singularity(c: VirtualController) -> None:
-    """KUKA HOME has A5 = 0 (wrist singular); tilt A5 so Cartesian jogs are well-conditioned."""
-    c.jog_joint(4, 30.0)
-
-
-class FakeClock:
-    def __init__(self) -> None:
-        self.t = 100.0
-
-    def __call__(self) -> float:
-        return self.t
+from support.jogging import FakeClock, away_from_singularity
 
 
 # ------------------------------------------------------------------ settings

@@ -6,8 +6,6 @@ against the controller's link poses."""
 from __future__ import annotations
 
 import math
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -19,9 +17,8 @@ from tcp_pendant.pendant.formatting import tcp_readout_markdown, touch_indicator
 from tcp_pendant.controller.pose_state import pose_state, pose_state_key
 from tcp_pendant.controller.rotations import GIMBAL_LOCK_COS_B, kuka_abc_deg, quaternion_wxyz, quaternions_wxyz
 
-sys.path.insert(0, str(Path(__file__).parent))
-from conftest import wait_until  # noqa: E402
-from wsclient import DrainingClient  # noqa: E402
+from support.wsclient import wait_until
+from support.wsclient import DrainingClient
 
 
 def _angle_diff_deg(a: float, b: float) -> float:
@@ -139,8 +136,7 @@ def test_pose_state_equals_the_controllers_own_answers(controller: VirtualContro
 
 
 def _yardstick():
-    sys.path.insert(0, str(Path(__file__).parents[1] / "bench"))
-    import scene_yardstick
+    from bench import scene_yardstick
 
     return scene_yardstick
 

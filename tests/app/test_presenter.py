@@ -6,14 +6,11 @@ text escaped."""
 from __future__ import annotations
 
 import re
-import sys
-from pathlib import Path
 
 import pytest
 
-sys.path.insert(0, str(Path(__file__).parents[1] / "calibrate"))
-from guiclick import choose, click  # noqa: E402
-from wsclient import DrainingClient, wait_until  # noqa: E402
+from support.guiclick import choose, click
+from support.wsclient import DrainingClient, wait_until
 
 from tcp_pendant.serve.cli import build_parser
 from tcp_pendant.controller.readout import PoseReadout

@@ -4,14 +4,12 @@ the trainer's messages not dismissed yet, who left, and the wrong trainer tokens
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).parents[1] / "calibrate"))
-from guiclick import choose, click  # noqa: E402
-from wsclient import DrainingClient, wait_until  # noqa: E402
+from support.guiclick import choose, click
+from support.wsclient import DrainingClient, wait_until
 
 import pytest
 

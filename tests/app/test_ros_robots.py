@@ -1,5 +1,5 @@
 """The pendant on robot descriptions as ROS and ROS-Industrial publish them (layouts and
-sources: tests/robots/ros_layouts.py, robots/README.md): a 7-axis xacro description with
+sources: tests/support/ros_layouts.py, robots/README.md): a 7-axis xacro description with
 package:// meshes and a mimic joint starts, draws, jogs and calibrates; a KR 16 whose meshes are
 missing is still drawn and says so; a reference tip out of reach is said at start."""
 
@@ -10,7 +10,6 @@ import signal
 import subprocess
 import sys
 import urllib.request
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -23,11 +22,9 @@ from tcp_pendant.controller.jog import DEFAULT_SETTINGS, smallest_singular_value
 from tcp_pendant.controller.placement import READY_HOVER_M
 from tcp_pendant.views.meshes import SHAPE_RGB, link_meshes
 
-sys.path.insert(0, str(Path(__file__).parent))
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "robots"))
-from conftest import wait_until  # noqa: E402
-from ros_layouts import ACME7_MIMIC, acme7_workspace, kr16_2_urdf  # noqa: E402
-from wsclient import RecordingClient  # noqa: E402
+from support.wsclient import wait_until
+from support.ros_layouts import ACME7_MIMIC, acme7_workspace, kr16_2_urdf
+from support.wsclient import RecordingClient
 
 
 def notifications(client: RecordingClient) -> list[tuple[str, str]]:

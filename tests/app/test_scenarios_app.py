@@ -7,29 +7,24 @@ clients as browsers (``guiclick``)."""
 
 from __future__ import annotations
 
-import sys
-from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-HERE = Path(__file__).parent
-sys.path.insert(0, str(HERE))
-sys.path.insert(0, str(HERE.parent / "calibrate"))
-from app_page import AppPage, app_pages  # noqa: E402
+from support.app_page import AppPage
 
-from tcpcal.tool import Tool  # noqa: E402
-from tcp_pendant.calibrate.workflow import AutoTouchRequest  # noqa: E402
-from tcp_pendant.serve.cli import SCENARIO_CHOICES, build_parser  # noqa: E402
-from tcp_pendant.controller import ControllerError, builtin_tools, reference_tip_model  # noqa: E402
-from tcp_pendant.controller.scenarios import SCENARIO_KINDS, explain  # noqa: E402
-from tcp_pendant.serve.server import AppConfig, PendantApp  # noqa: E402
-from tcp_pendant.session import SessionChange  # noqa: E402
-from tcp_pendant.text_escape import escape_markdown  # noqa: E402
-from tcp_pendant.views.scenario_panel import SCENARIO_CHOICES as PANEL_CHOICES  # noqa: E402
-from tcp_pendant.views.scenario_panel import scenario_markdown  # noqa: E402
-from tcp_pendant.wizards.session_record import (  # noqa: E402
+from tcpcal.tool import Tool
+from tcp_pendant.calibrate.workflow import AutoTouchRequest
+from tcp_pendant.cli import SCENARIO_CHOICES, build_parser
+from tcp_pendant.controller import ControllerError, builtin_tools, reference_tip_model
+from tcp_pendant.controller.scenarios import SCENARIO_KINDS, explain
+from tcp_pendant.server import AppConfig, PendantApp
+from tcp_pendant.session import SessionChange
+from tcp_pendant.text_escape import escape_markdown
+from tcp_pendant.views.scenario_panel import SCENARIO_CHOICES as PANEL_CHOICES
+from tcp_pendant.views.scenario_panel import scenario_markdown
+from tcp_pendant.wizards.session_record import (
     SessionRecordError,
     check_session_record,
     session_from_controller,
@@ -49,10 +44,7 @@ class Page(AppPage):
         self.session.subscribe(self.changes.append)
 
 
-@pytest.fixture
-def page(tmp_path: Path) -> Iterator[Callable[..., Page]]:
-    with app_pages(tmp_path, Page, seed=5) as make:
-        yield make
+pytestmark = pytest.mark.app_page(cls=Page, seed=5)
 
 
 def auto_xyz4(p: Page) -> None:

@@ -3,13 +3,11 @@ poses the scene sends for a jog step chained back to the pose state's ``T_world_
 
 from __future__ import annotations
 
-import sys
-from pathlib import Path
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 from tcp_pendant.views.scene import relative_poses
-from wsclient import DrainingClient, wait_until
+from support.wsclient import DrainingClient, wait_until
 
 
 def _rigid(rng: np.random.Generator, n: int) -> np.ndarray:
@@ -65,8 +63,7 @@ def test_the_scene_queues_the_same_messages_as_the_code_it_replaced(app_factory,
     code before the speed work) on the same change, from the same last sent poses: the same
     messages (class, node, values bit for bit), none for an unchanged node, over the class's
     0.1 mm steps, larger jogs, rotations and the gizmo forced after a drag."""
-    sys.path.insert(0, str(Path(__file__).parents[1] / "bench"))
-    from scene_yardstick import LegacyScenePoses
+    from bench.scene_yardstick import LegacyScenePoses
 
     from tcp_pendant.session import SessionChange
 

@@ -1,10 +1,9 @@
 """Server and sessions in-process: a real viser server on a free port, headless websocket
-clients (tests/app/wsclient.py) standing in for browsers."""
+clients (tests/support/wsclient.py) standing in for browsers."""
 
 from __future__ import annotations
 
 import gc
-import sys
 import weakref
 from pathlib import Path
 
@@ -15,9 +14,8 @@ from tcpcal.formats import export_tool
 from tcpcal.library import ToolLibrary
 from tcpcal.tool import Tool
 
-sys.path.insert(0, str(Path(__file__).parent))
-from conftest import wait_until  # noqa: E402
-from wsclient import DrainingClient  # noqa: E402
+from support.wsclient import wait_until
+from support.wsclient import DrainingClient
 
 
 def _connect(app, n_before: int) -> DrainingClient:
@@ -49,6 +47,7 @@ def test_each_browser_gets_its_own_robot(app_factory) -> None:
         c2.close()
 
 
+@pytest.mark.slow  # 100 connections
 def test_no_leak_after_100_connect_disconnect_cycles(app_factory) -> None:
     """100 real websocket connects/disconnects: every session is closed, forgotten and freed."""
     app = app_factory()

@@ -4,13 +4,10 @@ shadows of viser's default lights for the browser that clicked it only (every br
 
 from __future__ import annotations
 
-import sys
-from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).parent))
-from wsclient import InputsClient, wait_until  # noqa: E402
+from support.wsclient import InputsClient, wait_until
 
-from tcp_pendant.views.pendant_panel import SHADOWS_LABEL, SHARED_SHADOWS_LABEL  # noqa: E402
+from tcp_pendant.views.pendant_panel import SHADOWS_LABEL, SHARED_SHADOWS_LABEL
 
 
 def _lights(c: InputsClient) -> list[tuple[bool, bool]]:

@@ -1,7 +1,7 @@
 """Every GUI callback runs on viser's event loop, in the order the browser's messages
 arrived, and no render writes a widget value older than the newest one the browser sent.
 
-Real viser server in-process, headless websocket clients (tests/app/wsclient.py) that send what
+Real viser server in-process, headless websocket clients (tests/support/wsclient.py) that send what
 a browser sends (GUI updates, clicks, gizmo drags) and record every GUI update they receive.
 """
 
@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import asyncio
 import math
-import sys
 import threading
 import time
 from pathlib import Path
@@ -26,9 +25,7 @@ from tcpcal.library import ToolLibrary
 from tcpcal.tool import Tool
 from tcp_pendant.pendant import joint_readout_markdown
 
-sys.path.insert(0, str(Path(__file__).parent))
-from conftest import wait_until  # noqa: E402
-from wsclient import DrainingClient, decode_window  # noqa: E402
+from support.wsclient import DrainingClient, decode_window, loop_ran_for, wait_until
 
 
 class Browser(DrainingClient):
@@ -84,6 +81,27 @@ def _joint_mode(b: Browser, s: Any) -> None:
     p = s.views["pendant"]
     b.set(p.mode, "Joint")
     wait_until(lambda: p.joint_folder.visible, what="joint mode")
+
+
+class _WatcherPolls:
+    """The library stamps the app's library watcher reads from now on, one a poll, in order."""
+
+    def __init__(self, app: Any) -> None:
+        self.app, self.read, self.polls = app, app._library_stamp, []
+        app._library_stamp = self._poll
+
+    def _poll(self) -> Any:
+        self.polls.append(self.read())
+        return self.polls[-1]
+
+    def caught_up(self) -> None:
+        """Barrier behind the library file's last change: two polls read the file as it is
+        now (a change the watcher had not seen yet is handed to the loop right after the first),
+        then the loop runs everything queued so far, that hand-over included."""
+        final, n = self.read(), len(self.polls)
+        wait_until(lambda: len(self.polls) >= n + 2 and self.polls[-2] == self.polls[-1] == final,
+                   what="two polls of the library watcher behind the file's last change")
+        loop_ran_for(self.app.server.get_event_loop(), 0.0)
 
 
 def _slow_first_call(obj: Any, name: str, seconds: float) -> list[Any]:
@@ -172,7 +190,9 @@ def test_no_message_is_pushed_off_the_event_loop_under_mixed_load(app_factory, t
         loop_thread: list[int] = []
         loop.call_soon_threadsafe(lambda: loop_thread.append(threading.get_ident()))
         wait_until(lambda: bool(loop_thread), what="loop thread")
-        time.sleep(0.3)                                   # connect-time work done
+        watcher = _WatcherPolls(app)
+        for b, s in browsers:                             # connect-time work done and sent
+            b.sync(s.client)
 
         pushes: list[tuple[int, str]] = []
         real_push = AsyncMessageBuffer.push
@@ -217,7 +237,9 @@ def test_no_message_is_pushed_off_the_event_loop_under_mixed_load(app_factory, t
                 wait_until(lambda s=s: "9: Saved elsewhere" in s.views["tools"].slots.options, what="reload")
             wait_until(lambda: sum(t.name.startswith("Gun ") for t in library.tools().values()) == 3,
                        what="three numeric entries saved")
-            time.sleep(0.3)
+            for b, s in browsers:                         # every message handled, all it queued sent
+                b.sync(s.client)
+            watcher.caught_up()                           # and the library's last change reloaded
         finally:
             AsyncMessageBuffer.push = real_push           # type: ignore[method-assign]
         # the load did what it says
@@ -350,6 +372,18 @@ def test_sessions_are_built_and_closed_on_the_event_loop_while_others_jog(app_fa
         if not stop_ticks.is_set():
             loop.call_soon(tick)
 
+    builds: list[Any] = []                                # the session builds under way
+    real_steps = app.session_steps
+
+    def counted_steps(*args: Any, **kwargs: Any) -> Any:
+        steps = real_steps(*args, **kwargs)
+        builds.append(steps)
+        try:
+            yield from steps
+        finally:
+            builds.remove(steps)
+
+    app.session_steps = counted_steps
     AsyncMessageBuffer.push = recording_push              # type: ignore[method-assign]
     visitors: list[Browser] = []
     try:
@@ -378,7 +412,14 @@ def test_sessions_are_built_and_closed_on_the_event_loop_while_others_jog(app_fa
         finally:
             stop.set()
             t.join()
-        time.sleep(0.3)
+        # barrier: the server is done with every connection but the jogger's and no session build
+        # is under way; a round trip on the jogger's socket lets the loop start any task those
+        # connections left, and such a build, once started, finishes
+        live = app.server._websock_server._live_connections
+        wait_until(lambda: list(live) == [session.client.client_id] and not builds,
+                   what="the visitors' connections gone and no session build under way")
+        jogger.sync(session.client)
+        wait_until(lambda: not builds, what="no session build under way")
     finally:
         stop_ticks.set()
         AsyncMessageBuffer.push = real_push               # type: ignore[method-assign]

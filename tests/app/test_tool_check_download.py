@@ -8,29 +8,24 @@ from __future__ import annotations
 
 import json
 import re
-import sys
-from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-HERE = Path(__file__).parent
-sys.path.insert(0, str(HERE))
-sys.path.insert(0, str(HERE.parent / "calibrate"))
-from app_page import AppPage, app_pages, true_tip_at, truth_tool  # noqa: E402
-from guiclick import click  # noqa: E402
-from wsclient import DrainingClient, wait_until  # noqa: E402
+from support.app_page import AppPage, true_tip_at, truth_tool
+from support.guiclick import click
+from support.wsclient import DrainingClient, wait_until
 
-from tcp_pendant.controller import builtin_tools  # noqa: E402
-from tcp_pendant.serve.server import AppConfig, PendantApp  # noqa: E402
-from tcp_pendant.text_escape import escape_markdown  # noqa: E402
-from tcp_pendant.views.tool_panel import CONTROLLER_FILE_REFUSED  # noqa: E402
-from tcp_pendant.views.touch_list import TOUCHES_FILENAME, touches_csv_text  # noqa: E402
-from tcpcal.cli import main as tcpcal_main  # noqa: E402
-from tcpcal.controllers import CONTROLLER_FORMATS, parse_tool_file  # noqa: E402
-from tcpcal.origin import solve_xyz4  # noqa: E402
-from tcpcal.tool import Tool  # noqa: E402
+from tcp_pendant.controller import builtin_tools
+from tcp_pendant.server import PendantApp
+from tcp_pendant.text_escape import escape_markdown
+from tcp_pendant.views.tool_panel import CONTROLLER_FILE_REFUSED
+from tcp_pendant.views.touch_list import TOUCHES_FILENAME, touches_csv_text
+from tcpcal.cli import main as tcpcal_main
+from tcpcal.controllers import CONTROLLER_FORMATS, parse_tool_file
+from tcpcal.origin import solve_xyz4
+from tcpcal.tool import Tool
 
 
 class Page(AppPage):
@@ -48,10 +43,7 @@ class Page(AppPage):
         self.choose(self.tools.slots, opt)
 
 
-@pytest.fixture
-def page(tmp_path: Path) -> Iterator[Callable[..., Page]]:
-    with app_pages(tmp_path, Page) as make:
-        yield make
+pytestmark = pytest.mark.app_page(cls=Page)
 
 
 # ----------------------------------------------------------------------------- Check
@@ -163,10 +155,8 @@ def test_a_refused_tool_is_one_notification_and_nothing_is_sent(page) -> None:
     assert len(p.notes) == 1 and p.notes[0][0] == CONTROLLER_FILE_REFUSED and "tool0" in p.notes[0][1]
 
 
-def test_shared_mode_sends_the_file_to_the_browser_that_clicked(tmp_path: Path) -> None:
-    app = PendantApp(AppConfig(port=0, tool_library=tmp_path / "tools.json", shared=True, library_poll_s=0.1))
-    app.library.save(1, Tool("T1", (0.0, 0.0, 100.0)))
-    app.start()
+def test_shared_mode_sends_the_file_to_the_browser_that_clicked(app_factory) -> None:
+    app = app_factory({1: Tool("T1", (0.0, 0.0, 100.0))}, shared=True)
     ws = [DrainingClient(app.port), DrainingClient(app.port)]
     try:
         wait_until(lambda: len(app.server.get_clients()) == 2, what="two browsers")
@@ -181,7 +171,6 @@ def test_shared_mode_sends_the_file_to_the_browser_that_clicked(tmp_path: Path) 
     finally:
         for w in ws:
             w.close()
-        app.stop()
 
 
 # ----------------------------------------------------------------------------- touches CSV

@@ -16,29 +16,22 @@ clients as browsers; clicks arrive as a browser's do, ``guiclick``).
 from __future__ import annotations
 
 import re
-import sys
 import time
-from collections.abc import Callable, Iterator
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-HERE = Path(__file__).parent
-sys.path.insert(0, str(HERE))
-sys.path.insert(0, str(HERE.parent / "calibrate"))
-from app_page import AppPage, app_pages, true_tip_at  # noqa: E402
-from guiclick import click  # noqa: E402
-from wsclient import ButtonClient, loop_ran_for, wait_until  # noqa: E402
+from support.app_page import AppPage, true_tip_at
+from support.wsclient import ButtonClient, loop_ran_for, wait_until
 
-from tcp_pendant.pendant.guidance import tip_offset_mm  # noqa: E402
-from tcp_pendant.pendant.jogging import LINEAR_SPEED_MM_S  # noqa: E402
-from tcp_pendant.serve.server import PendantApp  # noqa: E402
-from tcp_pendant.views.pendant_panel import HOLD_HZ, MARK  # noqa: E402
-from tcp_pendant.calibrate.diversity import best_tilt, best_tilt_words  # noqa: E402
-from tcp_pendant.text_escape import escape_html  # noqa: E402
-from tcp_pendant.calibrate import AutoTouchRequest  # noqa: E402
-from tcp_pendant.views.wizard_dock import BACK, CANCEL, NEXT, TILT_LINE_STYLE, tilt_line_html  # noqa: E402
+from tcp_pendant.pendant.guidance import tip_offset_mm
+from tcp_pendant.pendant.jogging import LINEAR_SPEED_MM_S
+from tcp_pendant.server import PendantApp
+from tcp_pendant.views.pendant_panel import HOLD_HZ, MARK
+from tcp_pendant.calibrate.diversity import best_tilt, best_tilt_words
+from tcp_pendant.text_escape import escape_html
+from tcp_pendant.calibrate import AutoTouchRequest
+from tcp_pendant.views.wizard_dock import BACK, CANCEL, NEXT, TILT_LINE_STYLE, tilt_line_html
 
 
 class Page(AppPage):
@@ -56,10 +49,7 @@ class Page(AppPage):
         true_tip_at(self.session, offset_mm)
 
 
-@pytest.fixture
-def page(tmp_path: Path) -> Iterator[Callable[..., Page]]:
-    with app_pages(tmp_path, Page, seed=3) as make:
-        yield make
+pytestmark = pytest.mark.app_page(cls=Page, seed=3)
 
 
 def test_the_dock_shows_the_wizards_step_on_the_jog_tab_and_records_it(page) -> None:
@@ -296,7 +286,8 @@ def test_continuous_jog_moves_at_the_override_speed_and_stops_at_release(app_fac
             time.sleep(max(0.0, t_start + (i + 1) * period - time.monotonic()))
         client.click("X +")                                         # the release
         wait_until(lambda: len(xs) >= n - 3, what="the hold ticks")
-        time.sleep(0.3)
+        client.sync(s.client)                                       # the release handled
+        loop_ran_for(app.server.get_event_loop(), 3 / HOLD_HZ)      # three ticks' time on the server
         x_end = float(s.controller.T_world_tcp()[0, 3])
         held_s = n * period
         speed = (x_end - x0) * 1000.0 / held_s
@@ -313,8 +304,7 @@ def test_continuous_jog_moves_at_the_override_speed_and_stops_at_release(app_fac
 def test_the_scripted_trainee_touches_in_at_most_30_clicks() -> None:
     """tests/bench/bench_trainee.py's trainee (only what the page shows) finishes the 4-point
     calibration within 0.5 mm per touch, in at most 30 clicks per touch (the goal)."""
-    sys.path.insert(0, str(HERE.parent / "bench"))
-    from bench_trainee import run
+    from bench.bench_trainee import run
 
     out = run()
     assert len(out["clicks"]) == 4 and max(out["distance_mm"]) <= 0.5

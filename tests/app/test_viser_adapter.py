@@ -5,8 +5,6 @@ strict flag) instead of passing silently."""
 from __future__ import annotations
 
 import logging
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -16,9 +14,8 @@ from tcp_pendant.views.pendant_panel import set_markdown
 from tcp_pendant.views.upload_guard import limit_upload_size
 from tcp_pendant.views.viser_adapter import ViserInternalsChanged, path_counts, reset_path_counts
 
-sys.path.insert(0, str(Path(__file__).parent))
-from conftest import wait_until  # noqa: E402
-from wsclient import ButtonClient, click_until_carried_out  # noqa: E402
+from support.wsclient import wait_until
+from support.wsclient import ButtonClient, click_until_carried_out
 
 
 @pytest.fixture

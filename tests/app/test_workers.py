@@ -17,8 +17,7 @@ from typing import Any
 
 import pytest
 
-sys.path.insert(0, str(Path(__file__).parent))
-from async_clients import PLUS, READOUT_LABEL, TOKEN_LABEL, connect_all  # noqa: E402
+from support.async_clients import PLUS, READOUT_LABEL, TOKEN_LABEL, connect_all
 
 from tcp_pendant.serve.balance import BalanceFile
 from tcp_pendant.classroom.gradebook import Gradebook
@@ -91,6 +90,7 @@ def workers2(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[int, li
                for pid in pids[1:])
 
 
+@pytest.mark.slow  # two server processes under load
 @pytest.mark.timeout(300)
 def test_two_processes_share_the_port_the_class_and_each_keeps_the_deadman(workers2) -> None:
     port, pids, db = workers2
@@ -236,6 +236,7 @@ def test_browsers_arriving_one_by_one_are_split_evenly_over_the_processes(worker
     assert per_pid == {pids[0]: 8, pids[1]: 8}
 
 
+@pytest.mark.slow  # two server processes
 @pytest.mark.timeout(300)
 def test_two_processes_share_one_postgresql_gradebook(tmp_path: Path, postgres_server) -> None:
     """``--workers 2 --class-db postgresql://...`` (docs/large-class.md, "1,000 trainees on ten machines",

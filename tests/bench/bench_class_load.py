@@ -3,7 +3,7 @@
 What it measures (printed too). For each class size K (default 1, 10, 30, 60, 100) the bench
 starts a real server, ``python -m tcp_pendant --class --workers N`` (default 2: one process per
 core, one port, SO_REUSEPORT; a gradebook and a tool library in a temporary folder), and K
-headless clients (tests/app/async_clients.py: real websockets speaking viser's protocol, all of
+headless clients (tests/support/async_clients.py: real websockets speaking viser's protocol, all of
 a client process's clients on one asyncio loop, ``--client-procs`` processes, default 2). Each
 client is a trainee: it joins the class under its own name through the welcome window, picks
 the 0.1 mm increment and clicks "X +" 20 times a second (a browser's most) for ``--duration``
@@ -53,11 +53,11 @@ import time
 from pathlib import Path
 from typing import Any
 
+if __name__ == "__main__":                  # run as a script: tests/ on sys.path (support.*, bench.*)
+    import _tests_on_path  # noqa: F401
+from support.async_clients import PLUS, PRESS_LEAD_S, connect_all, latencies, percentile, run_presses
+
 ROOT = Path(__file__).resolve().parents[2]
-APP_TESTS = ROOT / "tests" / "app"
-if str(APP_TESTS) not in sys.path:
-    sys.path.insert(0, str(APP_TESTS))
-from async_clients import PLUS, PRESS_LEAD_S, connect_all, latencies, percentile, run_presses  # noqa: E402
 
 PRESS_HZ = 20.0
 PRESS_MM = 0.1
@@ -120,8 +120,6 @@ async def _client_main(port: int, first: int, n: int, names: bool, nice: int) ->
 def _trainees_per_process(db: Path, pids: list[int]) -> list[int]:
     """How many of the class's connected trainees each server process holds, in the order of
     ``pids``, from the gradebook's presence (its holder names the process's pid)."""
-    if str(ROOT / "app") not in sys.path:
-        sys.path.insert(0, str(ROOT / "app"))
     from tcp_pendant.classroom.gradebook import Gradebook
 
     book = Gradebook(db)

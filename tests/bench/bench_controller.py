@@ -30,10 +30,8 @@ from __future__ import annotations
 
 import argparse
 import statistics
-import sys
 import time
 from collections.abc import Callable
-from pathlib import Path
 
 import numpy as np
 import yourdfpy
@@ -42,8 +40,9 @@ from tcpcal.tool import Tool
 from tcp_pendant.controller import RobotKinematics, VirtualController, builtin_robots, builtin_tools
 from tcp_pendant.pendant.jogging import Jogger
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from jog_yardstick import LegacyController, LegacyJogger  # noqa: E402
+if __name__ == "__main__":                  # run as a script: tests/ on sys.path (support.*, bench.*)
+    import _tests_on_path  # noqa: F401
+from bench.jog_yardstick import LegacyController, LegacyJogger
 
 WORK_Q_DEG = {"kr6": (10.0, -80.0, 100.0, 20.0, 40.0, 30.0), "gp12": (10.0, 10.0, 10.0, 20.0, -50.0, 30.0)}
 TIP_M = {"kr6": (0.55, 0.05, 0.25), "gp12": (0.95, 0.05, 0.35)}

@@ -1,6 +1,6 @@
 """The victim's TCP check and jogs while 20 sessions keep the server's job pool busy.
 
-The rig of ``tests/security/test_job_pool.py`` (``tests/security/job_attack.py``): a pendant
+The rig of ``tests/security/test_job_pool.py`` (``tests/support/job_attack.py``): a pendant
 server in this process, the victim's browser over a real websocket, 20 attacker sessions on the
 same server each running the Tool tab's TCP check job again the moment its result is back. The
 victim runs its check alone, then under the attack (each check after ~0.6 s of jogging), and
@@ -20,7 +20,7 @@ With ``--attack beam`` the attackers run the TCP service's beam check instead (a
 times longer than the victim's check): the victim then waits for the running scan, so its
 factor is about (scan + check) / check, the bound of a pool that does not interrupt a job.
 
-With ``--flood`` (issue 42, item 5; the rig of ``tests/security/browser_flood.py``) the attack
+With ``--flood`` (issue 42, item 5; the rig of ``tests/support/browser_flood.py``) the attack
 is one attacker *browser* instead, in a process of its own, clicking Check, "Check active tool"
 and Auto-touch in turn as fast as its socket takes the clicks (``--rate`` clicks a second to
 pace it: the issue's browser made ~128), while the victim's browser presses X+ (``--presses``
@@ -43,12 +43,12 @@ from pathlib import Path
 
 import numpy as np
 
-HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE.parent / "security"))
-from browser_flood import FloodRig  # noqa: E402
-from job_attack import Classroom, Measured  # noqa: E402
+from tcp_pendant.job_pool import LOOP_SWITCH_INTERVAL_S, JobPool, default_workers
 
-from tcp_pendant.job_pool import LOOP_SWITCH_INTERVAL_S, JobPool, default_workers  # noqa: E402
+if __name__ == "__main__":                  # run as a script: tests/ on sys.path (support.*, bench.*)
+    import _tests_on_path  # noqa: F401
+from support.browser_flood import FloodRig
+from support.job_attack import Classroom, Measured
 
 
 PYTHON_DEFAULT_SWITCH_S = 0.005

@@ -35,15 +35,15 @@ import argparse
 import os
 import shutil
 import statistics
-import sys
 import tempfile
 import time
 from pathlib import Path
 from typing import Any
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_server import Rig  # noqa: E402
-from panel_yardstick import install_legacy, install_new  # noqa: E402
+if __name__ == "__main__":                  # run as a script: tests/ on sys.path (support.*, bench.*)
+    import _tests_on_path  # noqa: F401
+from bench.bench_server import Rig
+from bench.panel_yardstick import install_legacy, install_new
 
 PRESS_MM = "0.1"
 PARTS = ("panel", "jogger", "press")

@@ -5,7 +5,7 @@
 The step is the class's: one 0.1 mm WORLD X increment press ("X +", back and forth, 5 presses
 each way) of the KR 6 with the pointer (the default robot and tool), ``Jogger.key`` then
 ``Session.moved`` under the session's lock, round robin over N sessions of one in-process
-server (``PendantApp``), each with a headless websocket client (``tests/app/wsclient.py``,
+server (``PendantApp``), each with a headless websocket client (``tests/support/wsclient.py``,
 threads of this process draining what the server sends; their CPU is not counted: thread CPU of
 the stepping thread only). Timed per step with ``time.thread_time_ns``:
 
@@ -28,24 +28,21 @@ from __future__ import annotations
 
 import argparse
 import statistics
-import sys
 import tempfile
 import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE))
-sys.path.insert(0, str(HERE.parent / "app"))
+import tcp_pendant.session as session_module
+from tcp_pendant.controller.pose_state import pose_state as new_pose_state
+from tcp_pendant.controller.pose_state import pose_state_key as new_pose_state_key
+from tcp_pendant.server import AppConfig, PendantApp
 
-from scene_yardstick import LegacyScenePoses, legacy_pose_state, legacy_pose_state_key  # noqa: E402
-from wsclient import DrainingClient, wait_until  # noqa: E402
-
-import tcp_pendant.session as session_module  # noqa: E402
-from tcp_pendant.controller.pose_state import pose_state as new_pose_state  # noqa: E402
-from tcp_pendant.controller.pose_state import pose_state_key as new_pose_state_key  # noqa: E402
-from tcp_pendant.serve.server import AppConfig, PendantApp  # noqa: E402
+if __name__ == "__main__":                  # run as a script: tests/ on sys.path (support.*, bench.*)
+    import _tests_on_path  # noqa: F401
+from bench.scene_yardstick import LegacyScenePoses, legacy_pose_state, legacy_pose_state_key
+from support.wsclient import DrainingClient, wait_until
 
 PARTS = ("pose state", "scene")
 

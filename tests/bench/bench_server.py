@@ -1,7 +1,7 @@
 """Jog latency from press to readout, steps achieved, and the server's CPU per jog step.
 
 What it measures (printed too). The pendant server runs in this process: a real viser server
-on a free port. N headless clients run in a *separate process* (tests/app/wsclient.py: real
+on a free port. N headless clients run in a *separate process* (tests/support/wsclient.py: real
 websockets speaking viser's protocol; they receive every message, and press buttons the way a
 browser does), so each one has a real session built by ``on_client_connect``, every scene/GUI
 update is really serialised, compressed and sent, and the clients' own CPU is not counted. No
@@ -88,7 +88,7 @@ from typing import Any
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[2]
-APP_TESTS = ROOT / "tests" / "app"
+TESTS = ROOT / "tests"
 STEP_HZ = 30.0
 TARGET_SESSIONS = 30
 PRESS_HZ = 20.0
@@ -103,8 +103,7 @@ PLUS, MINUS = "X +", "X −"
 
 CLIENTS_SCRIPT = r"""
 import json, sys, threading, time
-sys.path.insert(0, {app_tests!r})
-from wsclient import ReadoutClient
+from support.wsclient import ReadoutClient
 clients = [ReadoutClient({port}, ({plus!r}, {minus!r})) for _ in range({n})]   # connected in this order
 for c in clients:
     if not c.found.wait(60):
@@ -507,9 +506,10 @@ class Rig:
         tmp.mkdir(parents=True, exist_ok=True)
         self.app = PendantApp(AppConfig(port=free_port(), tool_library=tmp / "tools.json", class_db=class_db))
         self.app.start()
-        script = CLIENTS_SCRIPT.format(app_tests=str(APP_TESTS), port=self.app.port, n=n, plus=PLUS, minus=MINUS)
+        script = CLIENTS_SCRIPT.format(port=self.app.port, n=n, plus=PLUS, minus=MINUS)
+        env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(TESTS), os.environ.get("PYTHONPATH", "")]))
         self.clients = subprocess.Popen([sys.executable, "-c", script], stdin=subprocess.PIPE,
-                                        stdout=subprocess.PIPE, text=True)
+                                        stdout=subprocess.PIPE, text=True, env=env)   # support.wsclient
         self.counts: dict[int, int] = {}
         self.sessions: list[Any] = []
         assert self.clients.stdout is not None
@@ -612,7 +612,6 @@ def median_of(rounds: list[dict[str, dict[str, float]]]) -> dict[str, dict[str, 
     """Median of each figure over the rounds (one round disturbed by another process on the
     shared machine does not move it)."""
     return {k: {f: float(np.median([r[k][f] for r in rounds])) for f in rounds[0][k]} for k in rounds[0]}
-
 
 
 def row(name: str, a: float, b: float, unit: str = "ms") -> None:

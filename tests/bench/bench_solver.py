@@ -80,13 +80,15 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tcpcal"))
-from poses import crb_tcp, random_tcp, stacked_a, tilted_rotations, touch_positions
 
 from tcpcal._stats import EXACT_ANGLES_MAX_N
 from tcpcal.errors import DegenerateTouchesError
 from tcpcal.origin import METHODS, solve_xyz4
 from tcpcal.pose_quality import assess_touches, candidate_gain
+
+if __name__ == "__main__":                  # run as a script: tests/ on sys.path (support.*, bench.*)
+    import _tests_on_path  # noqa: F401
+from support.poses import crb_tcp, random_tcp, stacked_a, tilted_rotations, touch_positions
 
 SIGMA = 0.5
 NS = (4, 8, 20)

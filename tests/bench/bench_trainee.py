@@ -3,8 +3,8 @@
 A trainee who follows only what the Jog tab shows: the wizard dock's step, the Δ readout
 ("ΔX n ΔY n ΔZ n mm" to the tip, WORLD jog frame), the increment buttons and the compact jog
 key rows. No Auto-touch, no scripting of the robot. The pendant server runs in this process
-(a real viser server); one headless websocket client is the browser (tests/app/wsclient.py),
-and every click reaches the views as a browser's event does (tests/calibrate/guiclick.py), so
+(a real viser server); one headless websocket client is the browser (tests/support/wsclient.py),
+and every click reaches the views as a browser's event does (tests/support/guiclick.py), so
 each click is served exactly as in a browser (rendering, change signal, messages sent); what
 is not measured is a human's reading time and the browser's own rendering.
 
@@ -42,22 +42,20 @@ from __future__ import annotations
 
 import math
 import re
-import sys
 import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
 
-HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE.parent / "app"))
-sys.path.insert(0, str(HERE.parent / "calibrate"))
-from guiclick import choose, click  # noqa: E402
-from wsclient import DrainingClient, wait_until  # noqa: E402
+from tcp_pendant.server import AppConfig, PendantApp
+from tcp_pendant.views.pendant_panel import MARK
+from tcp_pendant.views.wizard_dock import FINISH, NEXT
 
-from tcp_pendant.serve.server import AppConfig, PendantApp  # noqa: E402
-from tcp_pendant.views.pendant_panel import MARK  # noqa: E402
-from tcp_pendant.views.wizard_dock import FINISH, NEXT  # noqa: E402
+if __name__ == "__main__":                  # run as a script: tests/ on sys.path (support.*, bench.*)
+    import _tests_on_path  # noqa: F401
+from support.guiclick import choose, click
+from support.wsclient import DrainingClient, wait_until
 
 BEFORE_CLICKS_PER_TOUCH = 116.0
 """The pendant's figure before the one-screen touch loop (464 clicks for one 4-point calibration)."""

@@ -15,22 +15,18 @@ from __future__ import annotations
 
 import json
 import re
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-sys.path.insert(0, str(Path(__file__).parents[1] / "calibrate"))
-sys.path.insert(0, str(Path(__file__).parent))
-from calib_helpers import true_frame  # noqa: E402
-from pendant_page import assert_not_blank, choose, type_text  # noqa: E402
-from test_wizards_browser import auto_touch_to_result, open_calibrate, press, text_of, wait_enabled, wait_text  # noqa: E402
+from support.calib_helpers import true_frame
+from support.pendant_page import assert_not_blank, choose, type_text
+from support.wizard_page import auto_touch_to_result, open_calibrate, press, text_of, wait_enabled, wait_text
 
-from tcp_pendant.controller import builtin_tools  # noqa: E402
-from tcp_pendant.controller.scenarios import Scenario, bent_tool_frame, draw_tool_bend  # noqa: E402
-from tcpcal.library import ToolLibrary  # noqa: E402
-from tcpcal.tool import Tool  # noqa: E402
+from tcp_pendant.controller import builtin_tools
+from tcp_pendant.controller.scenarios import Scenario, bent_tool_frame, draw_tool_bend
+from tcpcal.library import ToolLibrary
+from tcpcal.tool import Tool
 
 pytestmark = pytest.mark.browser
 

@@ -5,28 +5,25 @@ keeps in localStorage, across a reload and a server restart."""
 from __future__ import annotations
 
 import re
-import sys
 import time
 from pathlib import Path
 
 import pytest
 
-sys.path.insert(0, str(Path(__file__).parent))
-from pendant_page import TIMEOUT_MS, assert_not_blank, press, type_text, wait_enabled, wait_text  # noqa: E402
+from support.pendant_page import (
+    BROWSER_KEY_JS,
+    TIMEOUT_MS,
+    assert_not_blank,
+    join_class,
+    press,
+    type_text,
+    wait_enabled,
+    wait_text,
+)
 
 pytestmark = pytest.mark.browser
 
 TOKEN = "trainer-secret-4242"
-
-
-def join(page, name: str) -> None:
-    welcome = page.get_by_text("Welcome to the TCP Pendant")
-    welcome.wait_for(state="visible", timeout=TIMEOUT_MS)
-    type_text(page, "Your name", name)
-    page.wait_for_timeout(300)             # viser's 50 ms message slot: the name reaches the server first
-    press(page, "Join the class")
-    welcome.wait_for(state="hidden", timeout=TIMEOUT_MS)
-    wait_text(page, f"Trainee: {name}")
 
 
 def test_two_trainees_and_the_trainer_view(pendant_server, new_page, shot, tmp_path: Path) -> None:
@@ -37,8 +34,8 @@ def test_two_trainees_and_the_trainer_view(pendant_server, new_page, shot, tmp_p
     ben = new_page(sp.url)
     trainer = new_page(sp.url)
     assert_not_blank(shot(anna, "classroom_name_prompt"), min_colors=50)
-    join(anna, "Anna <b>A</b>")
-    join(ben, "Ben")
+    join_class(anna, "Anna <b>A</b>")
+    join_class(ben, "Ben")
     # the trainer: a wrong token opens nothing, the right one opens the trainer view
     type_text(trainer, "Trainer token", "wrong-token")
     trainer.wait_for_timeout(300)
@@ -80,9 +77,6 @@ def test_two_trainees_and_the_trainer_view(pendant_server, new_page, shot, tmp_p
     assert rows[0].exercise_id == "mystery" and rows[0].tool_key.startswith("mystery-") and rows[0].auto == 4
 
 
-KEY_JS = "localStorage.getItem('tcpPendant.browserKey')"
-
-
 def _wait(cond, what: str, timeout: float = 30.0):
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:
@@ -93,67 +87,55 @@ def _wait(cond, what: str, timeout: float = 30.0):
     raise AssertionError(f"timed out waiting for {what}")
 
 
-def test_the_browser_key_is_kept_in_local_storage_across_a_reload_and_a_restart(new_page, tmp_path: Path) -> None:
+def test_the_browser_key_is_kept_in_local_storage_across_a_reload_and_a_restart(app_factory, new_page, tmp_path: Path) -> None:
     """Anna's browser gets a key when she joins (the page script keeps it; the server keeps its
     SHA-256 only), another browser cannot be Anna while she is connected, and after a reload
     and after a server restart on the same gradebook her page joins by itself as Anna: the
     script sends the key back. The server runs in this process (the same port after the
     restart: localStorage belongs to the page's origin)."""
-    from tcp_pendant.serve.server import AppConfig, PendantApp
+    from tcp_pendant.server import PendantApp
 
     db = tmp_path / "class.sqlite3"
 
     def start(port: int = 0) -> PendantApp:
-        app = PendantApp(AppConfig(port=port, tool_library=tmp_path / "tools.json", class_db=db,
-                                   trainer_token=TOKEN, exercise="mystery"))
-        app.start()
-        return app
+        return app_factory(port=port, class_db=db, trainer_token=TOKEN, exercise="mystery")
 
     app = start()
-    apps = [app]
-    try:
-        anna = new_page(app.url)
-        join(anna, "Anna")
-        anna.wait_for_function(f"/^[A-Za-z0-9_-]{{43}}$/.test({KEY_JS} || '')", timeout=TIMEOUT_MS)
-        key = anna.evaluate(KEY_JS)
-        assert app.gradebook.trainees.holds_key("Anna", key)
-        tool_key = next(s for s in app.sessions.values() if "identity" in s.views
-                        and s.views["identity"].name == "Anna").controller.mounted_tool.key
-        # another browser: refused in words while Anna is connected; it has no key in its storage
-        other = new_page(app.url)
-        other.get_by_text("Welcome to the TCP Pendant").wait_for(state="visible", timeout=TIMEOUT_MS)
-        assert other.get_by_label("Browser key").count() == 0 or not other.get_by_label("Browser key").first.is_visible()
-        type_text(other, "Your name", "Anna")
-        other.wait_for_timeout(300)
-        press(other, "Join the class")
-        wait_text(other, "Anna is already connected in another browser; pick another name or ask the trainer "
-                         "to release it")
-        assert other.evaluate(KEY_JS) is None
-        # a reload: the page joins by itself with the name and the key
-        anna.reload()
-        wait_text(anna, "Trainee: Anna")
-        anna.get_by_text("Welcome to the TCP Pendant").wait_for(state="hidden", timeout=TIMEOUT_MS)
-        assert anna.evaluate(KEY_JS) == key
-        # a server restart on the same gradebook and port: the same browser is Anna again
-        port = app.port
-        app.stop()
-        app = start(port)
-        apps.append(app)
-        anna.reload()
-        wait_text(anna, "Trainee: Anna")
-        anna.get_by_text("Welcome to the TCP Pendant").wait_for(state="hidden", timeout=TIMEOUT_MS)
-        named = _wait(lambda: [s for s in app.sessions.values() if "identity" in s.views
-                               and s.views["identity"].name == "Anna"], "Anna named after the restart")
-        assert named[0].controller.mounted_tool.key == tool_key          # the class's seed survived
-        with app.gradebook.store.read() as book:
-            assert book.execute("SELECT COUNT(*) FROM trainees").fetchone()[0] == 1
-            assert book.execute("SELECT COUNT(*) FROM sessions").fetchone()[0] == 3
-    finally:
-        for a in apps:
-            try:
-                a.stop()
-            except Exception:
-                pass
+    anna = new_page(app.url)
+    join_class(anna, "Anna")
+    anna.wait_for_function(f"/^[A-Za-z0-9_-]{{43}}$/.test({BROWSER_KEY_JS} || '')", timeout=TIMEOUT_MS)
+    key = anna.evaluate(BROWSER_KEY_JS)
+    assert app.gradebook.holds_key("Anna", key)
+    tool_key = next(s for s in app.sessions.values() if "identity" in s.views
+                    and s.views["identity"].name == "Anna").controller.mounted_tool.key
+    # another browser: refused in words while Anna is connected; it has no key in its storage
+    other = new_page(app.url)
+    other.get_by_text("Welcome to the TCP Pendant").wait_for(state="visible", timeout=TIMEOUT_MS)
+    assert other.get_by_label("Browser key").count() == 0 or not other.get_by_label("Browser key").first.is_visible()
+    type_text(other, "Your name", "Anna")
+    other.wait_for_timeout(300)
+    press(other, "Join the class")
+    wait_text(other, "Anna is already connected in another browser; pick another name or ask the trainer "
+                     "to release it")
+    assert other.evaluate(BROWSER_KEY_JS) is None
+    # a reload: the page joins by itself with the name and the key
+    anna.reload()
+    wait_text(anna, "Trainee: Anna")
+    anna.get_by_text("Welcome to the TCP Pendant").wait_for(state="hidden", timeout=TIMEOUT_MS)
+    assert anna.evaluate(BROWSER_KEY_JS) == key
+    # a server restart on the same gradebook and port: the same browser is Anna again
+    port = app.port
+    app.stop()
+    app = start(port)
+    anna.reload()
+    wait_text(anna, "Trainee: Anna")
+    anna.get_by_text("Welcome to the TCP Pendant").wait_for(state="hidden", timeout=TIMEOUT_MS)
+    named = _wait(lambda: [s for s in app.sessions.values() if "identity" in s.views
+                           and s.views["identity"].name == "Anna"], "Anna named after the restart")
+    assert named[0].controller.mounted_tool.key == tool_key          # the class's seed survived
+    with app.gradebook._read() as book:
+        assert book.execute("SELECT COUNT(*) FROM trainees").fetchone()[0] == 1
+        assert book.execute("SELECT COUNT(*) FROM sessions").fetchone()[0] == 3
 
 
 def test_the_exercise_banner_is_on_screen_at_1024x768_without_scrolling(pendant_server, new_page, shot,
@@ -165,7 +147,7 @@ def test_the_exercise_banner_is_on_screen_at_1024x768_without_scrolling(pendant_
                         "--exercise-instructions", text, "--exercise-methods", "xyz4,reference",
                         "--exercise-min-touches", "6")
     anna = new_page(sp.url, width=1024, height=768)
-    join(anna, "Anna")
+    join_class(anna, "Anna")
     banner = anna.get_by_text(text, exact=True)
     banner.wait_for(state="visible", timeout=TIMEOUT_MS)
     box = banner.bounding_box()

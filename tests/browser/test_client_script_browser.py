@@ -9,35 +9,25 @@ off the session's controller, workflow and classroom, not only off the page.
 
 from __future__ import annotations
 
-import sys
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
-from tcp_pendant.serve.server import PendantApp
+from tcp_pendant.pendant.hold import DEADMAN_S
+from tcp_pendant.server import PendantApp
 
-sys.path.insert(0, str(Path(__file__).parent))
-sys.path.insert(0, str(Path(__file__).parents[1] / "app"))
-from app_page import running_pendants  # noqa: E402
-from chromium_session import with_render_scale  # noqa: E402
-from pendant_page import TIMEOUT_MS, assert_not_blank, type_text, wait_text, wait_until  # noqa: E402
+from support.chromium_session import with_render_scale
+from support.pendant_page import TIMEOUT_MS, assert_not_blank, field, type_text, wait_text, wait_until
+from support.wsclient import loop_ran_for
 
 pytestmark = pytest.mark.browser
 
 TOKEN = "trainer-secret-4242"
 AXES = ("X", "Y", "Z", "A", "B", "C")
-
-
-
-@pytest.fixture
-def pendant(tmp_path: Path) -> Iterator[Callable[..., PendantApp]]:
-    """``pendant(**AppConfig options)``: a pendant in this process on a free port."""
-    with running_pendants(tmp_path) as start:
-        yield start
 
 
 def open_page(app: PendantApp, new_page: Callable[..., Any], url: str | None = None, **kw: Any) -> tuple[Any, Any]:
@@ -88,8 +78,8 @@ def increment(session: Any) -> str:
 
 
 # ---------------------------------------------------------------------------------------------
-def test_each_key_jogs_its_axis_by_the_increment_and_brackets_change_it(pendant, new_page, shot) -> None:
-    app = pendant()
+def test_each_key_jogs_its_axis_by_the_increment_and_brackets_change_it(app_factory, new_page, shot) -> None:
+    app = app_factory()
     page, s = open_page(app, new_page)
     assert s.jogger.settings.frame == "WORLD" and increment(s) == "10"
     wait_text(page, "Keys:")
@@ -122,8 +112,8 @@ def test_each_key_jogs_its_axis_by_the_increment_and_brackets_change_it(pendant,
         assert_not_blank(shot(page, f"pendant_keys_{size[0]}x{size[1]}"), min_colors=200)
 
 
-def test_cont_mode_holds_the_key_like_the_mouse_button(pendant, new_page) -> None:
-    app = pendant()
+def test_cont_mode_holds_the_key_like_the_mouse_button(app_factory, new_page) -> None:
+    app = app_factory()
     page, s = open_page(app, new_page)
     page.keyboard.press("BracketRight")                   # 10 -> 100
     wait_until(lambda: increment(s) == "100", "increment 100")
@@ -142,14 +132,14 @@ def test_cont_mode_holds_the_key_like_the_mouse_button(pendant, new_page) -> Non
     wait_until(lambda: (pose(s)[0, 3] - T0[0, 3]) * 1000.0 > 20.0, "X to move 20 mm while the key is held")
     page.keyboard.up("Digit1")
     T1 = settled(s, T0)
-    page.wait_for_timeout(1500)                            # longer than the server's deadman time
+    loop_ran_for(app.server.get_event_loop(), 1.5 * DEADMAN_S)   # every tick due meanwhile has run
     np.testing.assert_allclose(pose(s), T1, atol=1e-9)    # stopped at the release
     dx = (T1[:3, 3] - T0[:3, 3]) * 1000.0
     assert dx[0] > 20.0 and abs(dx[1]) < 0.05 and abs(dx[2]) < 0.05, dx
 
 
-def test_the_record_key_records_a_free_touch_and_a_wizard_step(pendant, new_page) -> None:
-    app = pendant()
+def test_the_record_key_records_a_free_touch_and_a_wizard_step(app_factory, new_page) -> None:
+    app = app_factory()
     page, s = open_page(app, new_page)
     assert len(s.touches) == 0
     page.keyboard.press("r")
@@ -177,15 +167,16 @@ def test_the_record_key_records_a_free_touch_and_a_wizard_step(pendant, new_page
     assert len(s.touches) == 2                             # the free list is untouched: one Record concept
 
 
-def test_typing_in_a_field_does_not_jog(pendant, new_page) -> None:
-    app = pendant()
+def test_typing_in_a_field_does_not_jog(app_factory, new_page) -> None:
+    app = app_factory()
     page, s = open_page(app, new_page)
     page.get_by_role("tab", name="Tool").click()
     T0 = pose(s)
     type_text(page, "New name", "r1[2]3")
     page.keyboard.press("Enter")
     page.keyboard.press("Shift+Digit2")
-    page.wait_for_timeout(1500)
+    typed = field(page, "New name").input_value()          # the field's last value: sent behind the keys
+    wait_until(lambda: s.views["tools"].new_name.value == typed, "the field's value on the server")
     np.testing.assert_allclose(pose(s), T0, atol=1e-12)
     assert len(s.touches) == 0 and increment(s) == "10"
     # the same keys with the focus out of the field do act
@@ -194,8 +185,8 @@ def test_typing_in_a_field_does_not_jog(pendant, new_page) -> None:
     assert_moved(T0, settled(s, T0), "Y", 1, 10.0)
 
 
-def test_the_name_is_remembered_across_a_reload(pendant, new_page, tmp_path: Path) -> None:
-    app = pendant(class_db=tmp_path / "class.sqlite3", trainer_token=TOKEN)
+def test_the_name_is_remembered_across_a_reload(app_factory, new_page, tmp_path: Path) -> None:
+    app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token=TOKEN)
     page, s = open_page(app, new_page)
     welcome = page.get_by_text("Welcome to the TCP Pendant")
     welcome.wait_for(state="visible", timeout=TIMEOUT_MS)
@@ -205,7 +196,8 @@ def test_the_name_is_remembered_across_a_reload(pendant, new_page, tmp_path: Pat
     page.keyboard.press("Digit1")                         # the welcome window is open: keys do nothing
     page.keyboard.press("r")
     type_text(page, "Your name", "Anna 12")               # digits typed in the name do not jog either
-    page.wait_for_timeout(1000)
+    wait_until(lambda: s.views["identity"].name_field.value == "Anna 12",
+               "the typed name on the server (sent behind the keys)")
     np.testing.assert_allclose(pose(s), T0, atol=1e-12)
     assert len(s.touches) == 0
     page.get_by_role("button", name="Join the class", exact=True).click()
@@ -224,8 +216,8 @@ def test_the_name_is_remembered_across_a_reload(pendant, new_page, tmp_path: Pat
     assert len({id(x) for x in app.sessions.values()}) == 1
 
 
-def test_the_trainer_url_opens_the_trainer_view_and_leaves_the_address_bar(pendant, new_page, tmp_path: Path) -> None:
-    app = pendant(class_db=tmp_path / "class.sqlite3", trainer_token=TOKEN)
+def test_the_trainer_url_opens_the_trainer_view_and_leaves_the_address_bar(app_factory, new_page, tmp_path: Path) -> None:
+    app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token=TOKEN)
     assert app.trainer_url == f"{app.url}/?trainer={TOKEN}"
     # a wrong token: no trainer view, the token gone from the address bar all the same
     page, s = open_page(app, new_page, f"{app.url}/?trainer=wrong-token-1")
@@ -243,8 +235,8 @@ def test_the_trainer_url_opens_the_trainer_view_and_leaves_the_address_bar(penda
     assert TOKEN not in page.evaluate("JSON.stringify(localStorage) + JSON.stringify(sessionStorage)")
 
 
-def test_the_typed_token_still_works(pendant, new_page, tmp_path: Path) -> None:
-    app = pendant(class_db=tmp_path / "class.sqlite3", trainer_token="token with & and + and #")
+def test_the_typed_token_still_works(app_factory, new_page, tmp_path: Path) -> None:
+    app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token="token with & and + and #")
     assert app.trainer_url.endswith("/?trainer=token%20with%20%26%20and%20%2B%20and%20%23")
     page, s = open_page(app, new_page, app.trainer_url)      # percent-encoded: the page reads it whole
     wait_text(page, "Download grades (CSV)")
@@ -277,10 +269,10 @@ def _shadows_decision(page: Any) -> str:
     return str(page.get_attribute(box, "data-tcp-pendant-shadows"))
 
 
-def test_a_software_webgl_browser_turns_the_shadows_off_and_a_graphics_card_keeps_them(pendant, new_page) -> None:
+def test_a_software_webgl_browser_turns_the_shadows_off_and_a_graphics_card_keeps_them(app_factory, new_page) -> None:
     from tcp_pendant.views.pendant_panel import SHADOWS_LABEL
 
-    app = pendant()
+    app = app_factory()
     page, s = open_page(app, new_page)
     renderer = page.evaluate("""() => { const gl = document.createElement('canvas').getContext('webgl');
         const i = gl.getExtension('WEBGL_debug_renderer_info'); return gl.getParameter(i.UNMASKED_RENDERER_WEBGL); }""")

@@ -6,31 +6,19 @@ Screenshots: ``dashboard-table.png``, ``dashboard-replay.png`` in the test's fol
 
 from __future__ import annotations
 
-import sys
-from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
 import pytest
 
-sys.path.insert(0, str(Path(__file__).parent))
-sys.path.insert(0, str(Path(__file__).parents[1] / "app"))
-sys.path.insert(0, str(Path(__file__).parents[1] / "calibrate"))
-from app_page import running_pendants  # noqa: E402
-from guiclick import choose, click  # noqa: E402
-from pendant_page import TIMEOUT_MS, assert_not_blank, wait_text  # noqa: E402
-from wsclient import DrainingClient, wait_until  # noqa: E402
+from support.guiclick import choose, click
+from support.pendant_page import TIMEOUT_MS, assert_not_blank, wait_text
+from support.wsclient import DrainingClient, wait_until
 
 pytestmark = pytest.mark.browser
 
 TOKEN = "trainer-secret-4242"
 NAMES = ("Anna", "Ben <b>B</b>", "Chiara Maria Long-Surname")
-
-
-@pytest.fixture
-def pendant(tmp_path: Path) -> Iterator[Callable[..., Any]]:
-    with running_pendants(tmp_path) as start:
-        yield start
 
 
 def _class_of_three(app: Any) -> list[DrainingClient]:
@@ -66,8 +54,8 @@ FITS_JS = """() => {
 }"""
 
 
-def test_the_trainer_address_opens_a_projector_dashboard(pendant, new_page, shot, tmp_path: Path) -> None:
-    app = pendant(class_db=tmp_path / "class.sqlite3", trainer_token=TOKEN, seed=11)
+def test_the_trainer_address_opens_a_projector_dashboard(app_factory, new_page, shot, tmp_path: Path) -> None:
+    app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token=TOKEN, seed=11)
     clients = _class_of_three(app)
     try:
         with app.gradebook.store.write() as db:     # Ben has been on his step for 12 minutes, no touch since

@@ -6,14 +6,11 @@ pseudo-inverse beside the joint least squares after four. Screenshots go to tmp_
 from __future__ import annotations
 
 import re
-import sys
-from pathlib import Path
 
 import pytest
 
-sys.path.insert(0, str(Path(__file__).parent))
-from pendant_page import TIMEOUT_MS, assert_not_blank  # noqa: E402
-from test_wizards_browser import open_calibrate, press, wait_text  # noqa: E402
+from support.pendant_page import TIMEOUT_MS, assert_not_blank
+from support.wizard_page import open_calibrate, press, wait_text
 
 pytestmark = [pytest.mark.browser, pytest.mark.timeout(1200)]     # software WebGL on a loaded machine
 KEYS = ("touch-1", "touch-4", "pair", "stack", "lstsq", "sphere")

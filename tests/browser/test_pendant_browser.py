@@ -5,16 +5,13 @@ exporting it to KUKA text. Screenshots go to the test's tmp_path."""
 from __future__ import annotations
 
 import re
-import sys
 import time
-from pathlib import Path
 
 import pytest
 
 from tcpcal.library import ToolLibrary
 
-sys.path.insert(0, str(Path(__file__).parent))
-from pendant_page import TIMEOUT_MS, field  # noqa: E402
+from support.pendant_page import TIMEOUT_MS, field
 
 pytestmark = pytest.mark.browser
 

@@ -4,18 +4,13 @@ step list marks the running wizard's step; switched off in the GUI, the panel is
 
 from __future__ import annotations
 
-import sys
-from pathlib import Path
 
 import pytest
 
-sys.path.insert(0, str(Path(__file__).parent))
-from pendant_page import TIMEOUT_MS, assert_not_blank, press, wait_text  # noqa: E402
-from test_wizards_browser import wait_text as wait_visible_text  # noqa: E402
+from support.pendant_page import TIMEOUT_MS, assert_not_blank, press
+from support.wizard_page import wait_text as wait_visible_text
 
-sys.path.insert(0, str(Path(__file__).parents[1] / "app"))
-from app_page import running_pendants  # noqa: E402
-from tcp_pendant.calibrate import AutoTouchRequest  # noqa: E402
+from tcp_pendant.calibrate import AutoTouchRequest
 
 pytestmark = pytest.mark.browser
 
@@ -92,18 +87,17 @@ def _presenter_folder(page):
         "xpath=ancestor::div[contains(@class,'mantine-Paper-root')][1]")
 
 
-def test_presenter_block_stays_pinned_with_its_chart_above_the_fold(tmp_path, new_page, shot) -> None:
+def test_presenter_block_stays_pinned_with_its_chart_above_the_fold(app_factory, new_page, shot) -> None:
     """1024x768, ``--shared --presenter``, a 4-point result of exact Auto-touches (all errors
     ~0; driven on the in-process server, as the Calibrate tab's buttons do): the panel scrolled
     to the wizard's buttons, the presenter block is still at the top, its chart inside the
     viewport with distinct tick labels and a legend without '--' placeholders; the Close button
     shows below the block, nothing sticks out at the side."""
-    with running_pendants(tmp_path) as start:
-        app = start(shared=True, presenter=True)
-        page = new_page(app.url, width=1024, height=768, wait_for="")
-        page.add_init_script(_RECORD_CANVAS_TEXT)
-        page.reload()
-        _check_pinned_block(app, page, shot)
+    app = app_factory(shared=True, presenter=True)
+    page = new_page(app.url, width=1024, height=768, wait_for="")
+    page.add_init_script(_RECORD_CANVAS_TEXT)
+    page.reload()
+    _check_pinned_block(app, page, shot)
 
 
 def _check_pinned_block(app, page, shot) -> None:

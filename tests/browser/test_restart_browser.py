@@ -23,11 +23,8 @@ import msgspec.msgpack
 import pytest
 from viser import _messages
 
-sys.path.insert(0, str(Path(__file__).parent))
-sys.path.insert(0, str(Path(__file__).parents[1] / "app"))
-from pendant_page import TIMEOUT_MS, press, wait_enabled, wait_text  # noqa: E402
-from test_classroom_browser import KEY_JS, join  # noqa: E402
-from wsclient import INPUTS, DrainingClient, decode_window, wait_until  # noqa: E402
+from support.pendant_page import BROWSER_KEY_JS, TIMEOUT_MS, join_class, press, wait_enabled, wait_text
+from support.wsclient import INPUTS, DrainingClient, decode_window, wait_until
 
 pytestmark = pytest.mark.browser
 
@@ -103,8 +100,8 @@ def test_a_killed_server_gives_the_trainees_calibration_back(pendant_server, new
     args = ("--class", "--class-db", str(db), "--trainer-token-file", str(token_file))
     sp = pendant_server(*args)
     anna = new_page(sp.url, width=1100, height=760)      # fewer pixels for software WebGL
-    join(anna, "Anna")
-    anna.wait_for_function(f"/^[A-Za-z0-9_-]{{43}}$/.test({KEY_JS} || '')", timeout=TIMEOUT_MS)
+    join_class(anna, "Anna")
+    anna.wait_for_function(f"/^[A-Za-z0-9_-]{{43}}$/.test({BROWSER_KEY_JS} || '')", timeout=TIMEOUT_MS)
     # the trainer pushes "Hide distance: on, locked"
     trainer = TrainerSocket(sp.port)
     try:
@@ -137,7 +134,7 @@ def test_a_killed_server_gives_the_trainees_calibration_back(pendant_server, new
     except AssertionError:
         shot(anna, "restart_not_joined")
         print("page script:", anna.evaluate("document.documentElement.getAttribute('data-tcp-pendant-script')"),
-              "kept:", anna.evaluate(KEY_JS), "\nserver log:", again.log())
+              "kept:", anna.evaluate(BROWSER_KEY_JS), "\nserver log:", again.log())
         raise
     anna.get_by_text("Welcome to the TCP Pendant").wait_for(state="hidden", timeout=TIMEOUT_MS)
     anna.get_by_role("tab", name="Calibrate").click()

@@ -27,8 +27,6 @@ from __future__ import annotations
 
 import os
 import re
-import sys
-from collections.abc import Callable, Iterator
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
@@ -38,10 +36,8 @@ import pytest
 from tcp_pendant.calibrate import AutoTouchRequest
 from tcp_pendant.serve.server import PendantApp
 
-sys.path.insert(0, str(Path(__file__).parent))
-sys.path.insert(0, str(Path(__file__).parents[1] / "app"))
-from app_page import running_pendants, true_tip_at  # noqa: E402
-from pendant_page import TIMEOUT_MS, assert_not_blank, wait_until  # noqa: E402
+from support.app_page import true_tip_at
+from support.pendant_page import TIMEOUT_MS, assert_not_blank, wait_until
 
 pytestmark = pytest.mark.browser
 
@@ -51,17 +47,10 @@ TOLERANCE_PX = 2.0
 
 
 @pytest.fixture
-def pendant(tmp_path: Path) -> Iterator[Callable[..., PendantApp]]:
-    with running_pendants(tmp_path) as start:
-        yield start
-
-
-@pytest.fixture
 def shots(tmp_path: Path) -> Path:
     out = Path(os.environ.get("UI_SHOTS_DIR") or tmp_path)
     out.mkdir(parents=True, exist_ok=True)
     return out
-
 
 
 def session_of(app: PendantApp) -> Any:
@@ -90,8 +79,8 @@ def assert_same_and_inside(before: dict[str, tuple[float, ...]], after: dict[str
         assert x >= 0 and y >= 0 and x + bw <= w and y + bh <= h, f"{when} at {w}x{h}: key {name!r} {a} off screen"
 
 
-def test_jog_keys_stay_put_near_the_tip_and_at_a_stop(pendant, new_page, shots) -> None:
-    app = pendant()
+def test_jog_keys_stay_put_near_the_tip_and_at_a_stop(app_factory, new_page, shots) -> None:
+    app = app_factory()
     page = new_page(app.url, width=SIZES[0][0], height=SIZES[0][1])
     s = session_of(app)
     closeup = page.get_by_text("mm/char").first
@@ -148,8 +137,8 @@ def finish_by_auto_touch(s: Any, kind: str, **options: Any) -> Any:
 
 
 @pytest.mark.skipif(not os.environ.get("UI_SHOTS_DIR"), reason="screens to look at: set UI_SHOTS_DIR")
-def test_result_screens(pendant, new_page, shots) -> None:
-    app = pendant()
+def test_result_screens(app_factory, new_page, shots) -> None:
+    app = app_factory()
     page = new_page(app.url, width=SIZES[0][0], height=SIZES[0][1])
     s = session_of(app)
     page.get_by_role("tab", name="Calibrate").click()
@@ -235,12 +224,12 @@ def box_gap_px(a: tuple[int, int, int, int], b: tuple[int, int, int, int]) -> fl
     return float(max(gx, gy))
 
 
-def test_result_labels_drawn_apart_at_1024x768(pendant, new_page) -> None:
+def test_result_labels_drawn_apart_at_1024x768(app_factory, new_page) -> None:
     """The beam result at 1024x768 (where COMPUTED and TRUE were seen overlapping): the labels
     near the tip (COMPUTED, TRUE, TOOL, reference tip, FLANGE), as chromium draws them, do not
     overlap, 0 px allowed. Measured at --seed 11: the smallest gap 9 to 10 px (COMPUTED and reference
     tip); a label not drawn (hiding it changes no pixel: TOOL there) is left out."""
-    app = pendant()
+    app = app_factory()
     page = new_page(app.url, width=1024, height=768)
     s = session_of(app)
     page.get_by_role("tab", name="Calibrate").click()

@@ -5,18 +5,15 @@ a saved tool 1 mm off (auto-touch, Finish, six rows and the implied error; no Sa
 from __future__ import annotations
 
 import re
-import sys
-from pathlib import Path
 
 import pytest
 
-sys.path.insert(0, str(Path(__file__).parent))
-from pendant_page import assert_not_blank, choose  # noqa: E402
-from test_wizards_browser import open_calibrate, press, save_tool, wait_enabled, wait_text  # noqa: E402
+from support.pendant_page import assert_not_blank, choose
+from support.wizard_page import open_calibrate, press, save_tool, wait_enabled, wait_text
 
-from tcp_pendant.controller import builtin_tools  # noqa: E402
-from tcpcal.library import ToolLibrary  # noqa: E402
-from tcpcal.tool import Tool  # noqa: E402
+from tcp_pendant.controller import builtin_tools
+from tcpcal.library import ToolLibrary
+from tcpcal.tool import Tool
 
 pytestmark = pytest.mark.browser
 LABELS = ("+A 30°", "-A 30°", "+B 30°", "-B 30°", "+C 30°", "-C 30°")

@@ -15,20 +15,14 @@ the side view), Y: 12 px across in the side view (0 in the front view), Z: 12 px
 from __future__ import annotations
 
 import io
-import sys
-from collections.abc import Callable, Iterator
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
 from tcp_pendant.pendant.tip_insets import GAP_PX, PX_PER_MM, TOOL_COLOR, VIEW_W_MM
-from tcp_pendant.serve.server import PendantApp
 
-sys.path.insert(0, str(Path(__file__).parent))
-sys.path.insert(0, str(Path(__file__).parents[1] / "app"))
-from app_page import running_pendants, true_tip_at  # noqa: E402
-from pendant_page import TIMEOUT_MS, wait_until  # noqa: E402
+from support.app_page import true_tip_at
+from support.pendant_page import TIMEOUT_MS, wait_until
 
 pytestmark = pytest.mark.browser
 
@@ -36,13 +30,6 @@ MIN_PX = 5.0
 """What must hold: 0.5 mm is at least this many screen pixels, in every direction."""
 MEASURED_PX = 12.0
 """What this test measured for 0.5 mm (module docstring); the assertions hold MIN_PX."""
-
-
-@pytest.fixture
-def pendant(tmp_path: Path) -> Iterator[Callable[..., PendantApp]]:
-    with running_pendants(tmp_path) as start:
-        yield start
-
 
 
 def inset(page: Any) -> Any:
@@ -92,8 +79,8 @@ def changed(page: Any, before: np.ndarray | None) -> np.ndarray:
     return wait_until(new, "the tip views to show the moved tool tip")
 
 
-def test_half_a_millimetre_is_at_least_5_px_in_both_views_in_every_direction(pendant, new_page, tmp_path) -> None:
-    app = pendant()
+def test_half_a_millimetre_is_at_least_5_px_in_both_views_in_every_direction(app_factory, new_page, tmp_path) -> None:
+    app = app_factory()
     page = new_page(app.url, width=1400, height=900)
     wait_until(lambda: app.sessions, "the page's session")
     (s,) = app.sessions.values()

@@ -5,19 +5,17 @@ tcpcal, and the trainer's "Systematic error" panel in the Calibrate tab."""
 from __future__ import annotations
 
 import re
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-sys.path.insert(0, str(Path(__file__).parent))
-from pendant_page import TIMEOUT_MS, assert_not_blank, choose, press, wait_enabled, wait_text  # noqa: E402
+from support.pendant_page import TIMEOUT_MS, assert_not_blank, choose, press, wait_enabled, wait_text
 
-from tcp_pendant.controller import builtin_tools  # noqa: E402
-from tcpcal.controllers import parse_tool_file  # noqa: E402
-from tcpcal.library import ToolLibrary  # noqa: E402
-from tcpcal.tool import Tool  # noqa: E402
+from tcp_pendant.controller import builtin_tools
+from tcpcal.controllers import parse_tool_file
+from tcpcal.library import ToolLibrary
+from tcpcal.tool import Tool
 
 pytestmark = pytest.mark.browser
 

@@ -11,8 +11,6 @@ from __future__ import annotations
 
 import json
 import re
-import sys
-import time
 from pathlib import Path
 
 import numpy as np
@@ -21,47 +19,21 @@ import pytest
 from tcpcal.library import ToolLibrary
 from tcpcal.tool import Tool
 
-sys.path.insert(0, str(Path(__file__).parents[1] / "calibrate"))
-sys.path.insert(0, str(Path(__file__).parent))
-from calib_helpers import true_frame
-from pendant_page import TIMEOUT_MS, assert_not_blank, choose, type_text
+from support.calib_helpers import true_frame
+from support.pendant_page import TIMEOUT_MS, assert_not_blank, choose
+from support.wizard_page import (
+    auto_touch_to_result,
+    open_calibrate,
+    press,
+    save_tool,
+    text_of,
+    wait_enabled,
+    wait_text,
+)
 
 pytestmark = pytest.mark.browser
 
 DISPLAY_TOL = 0.006     # the pendant shows two decimals
-
-
-# The Jog tab's wizard dock repeats the step's words and buttons (hidden while the Calibrate tab
-# is shown): these helpers look at what is visible only.
-def wait_text(page, pattern: str | re.Pattern[str], what: str | None = None) -> None:
-    """Wait until some visible element shows ``pattern`` (substring, or a regex)."""
-    loc = page.get_by_text(pattern) if isinstance(pattern, re.Pattern) else page.get_by_text(pattern, exact=False)
-    try:
-        loc.filter(visible=True).first.wait_for(state="visible", timeout=TIMEOUT_MS)
-    except Exception as exc:  # a clearer failure than Playwright's
-        raise AssertionError(f"never saw {what or pattern!r} on the page") from exc
-
-
-def press(page, name: str) -> None:
-    """Click the visible button named exactly ``name``."""
-    page.get_by_role("button", name=name, exact=True).filter(visible=True).first.click()
-
-
-def wait_enabled(page, name: str) -> None:
-    """Wait until a visible button ``name`` is enabled."""
-    btn = page.get_by_role("button", name=name, exact=True).filter(visible=True).first
-    btn.wait_for(state="visible", timeout=TIMEOUT_MS)
-    deadline = time.monotonic() + TIMEOUT_MS / 1000.0
-    while btn.is_disabled():
-        if time.monotonic() > deadline:
-            raise AssertionError(f"button {name!r} stayed disabled")
-        page.wait_for_timeout(50)
-
-
-def text_of(page, pattern: str | re.Pattern[str]) -> str:
-    """Inner text of the innermost visible element showing ``pattern``."""
-    loc = page.locator("div, p, td, span").filter(has_text=pattern).filter(visible=True).last
-    return str(loc.inner_text(timeout=TIMEOUT_MS))
 
 
 def truth(key: str) -> tuple[np.ndarray, np.ndarray]:
@@ -83,40 +55,6 @@ def shown_abc(page) -> np.ndarray:
     m = re.search(r"Orientation A (-?\d+\.\d\d) · B (-?\d+\.\d\d) · C (-?\d+\.\d\d)°", text)
     assert m, text
     return np.array([float(g) for g in m.groups()])
-
-
-def join_class_if_asked(page) -> None:
-    """A per-browser server with a class gradebook first asks for the trainee's name (a modal
-    over the page): give one, so the tabs can be reached."""
-    welcome = page.get_by_text("Welcome to the TCP Pendant")
-    try:
-        welcome.wait_for(state="visible", timeout=3000)
-    except Exception:
-        return                                                 # no classroom: no name asked
-    type_text(page, "Your name", "Ada Trainee")
-    press(page, "Join the class")
-    welcome.wait_for(state="hidden", timeout=TIMEOUT_MS)
-
-
-def open_calibrate(page) -> None:
-    join_class_if_asked(page)
-    page.get_by_role("tab", name="Calibrate").click()
-    wait_enabled(page, "Start")
-
-
-def auto_touch_to_result(page, n_steps: int) -> None:
-    """Auto-touch every step (the last one computes the result)."""
-    for k in range(1, n_steps + 1):
-        wait_text(page, f"Step {k} of {n_steps}")
-        press(page, "Auto-touch")
-    wait_text(page, "Against the true TOOL frame: good")
-
-
-def save_tool(page, name: str, slot_text: str) -> None:
-    """Type the name (waiting for the save preview to echo it), save, wait for the confirmation."""
-    type_text(page, "Tool name", name, re.compile(rf"Will save {re.escape(name)} · X"))
-    press(page, "Save to tool library")
-    wait_text(page, re.compile(rf"Saved {re.escape(name)} in slot {slot_text}; it is now the active tool"))
 
 
 def check_library_panel(page, name: str, slot: int, tcp: np.ndarray, abc: np.ndarray | None) -> None:

@@ -5,8 +5,6 @@ Update, spin test says good) and Update's refusals. No browser."""
 from __future__ import annotations
 
 import math
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -25,8 +23,7 @@ from tcp_pendant.text_escape import escape_markdown
 from tcpcal.library import ToolLibrary
 from tcpcal.tool import Calibration, Tool
 
-sys.path.insert(0, str(Path(__file__).parent))
-from calib_helpers import make_controller
+from support.calib_helpers import make_controller
 
 
 def truth_tool(tool_key: str, name: str) -> Tool:

@@ -14,8 +14,6 @@ from __future__ import annotations
 import json
 import math
 import re
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -31,8 +29,10 @@ from tcp_pendant.wizards import BeamWizard, BeamWizardResult, WizardError, Wizar
 from tcpcal.library import ToolLibrary
 from tcpcal.tool import Tool
 
-sys.path.insert(0, str(Path(__file__).parent))
-from calib_helpers import true_frame
+from support.calib_helpers import true_frame
+from support.calib_page import Page
+
+pytestmark = pytest.mark.app_page(cls=Page, seed=5)
 
 
 def exact_sensor(wf: CalibrationWorkflow) -> None:
@@ -276,7 +276,7 @@ def test_steps_view_runs_the_scan_in_its_worker(page) -> None:
     """In-process pendant, websocket client: the beam step shows no Record and no Auto-touch,
     Finish runs the scan off the loop and the result panel shows the events and the lesson."""
     from tcp_pendant.views.wizard_dock import BACK, CANCEL, FINISH
-    from wsclient import wait_until
+    from support.wsclient import wait_until
 
     p = page()
     v = p.view

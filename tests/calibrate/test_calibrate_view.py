@@ -4,27 +4,23 @@ browser: clicks and choices reach the views as browser events do (``guiclick``).
 from __future__ import annotations
 
 import json
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 from tcp_pendant.calibrate import error_bars
-from tcp_pendant.serve.server import AppConfig, PendantApp
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.wizard_menu import CalibrateView
 from tcp_pendant.wizards import ESTIMATOR_LABELS
 
+from support.calib_helpers import library_tool_with_true_tcp, true_frame
+from support.calib_page import Page
+from support.guiclick import click, upload
+from support.wsclient import DrainingClient, wait_until
 from tcpcal.library import ToolLibrary
 from tcpcal.origin import solve_xyz4
 
-HERE = Path(__file__).parent
-sys.path.insert(0, str(HERE.parent / "app"))
-sys.path.insert(0, str(HERE))
-from calib_helpers import library_tool_with_true_tcp, true_frame
-from guiclick import choose, click, upload
-from wsclient import DrainingClient, wait_until
+pytestmark = pytest.mark.app_page(cls=Page, seed=5)
 
 
 def test_four_auto_touches_run_a_4point_calibration_and_every_view_follows(page) -> None:
@@ -265,9 +261,8 @@ def test_closing_the_page_loses_nothing_saved(page) -> None:
     assert ToolLibrary(s.library.path).get(1).name == "Kept"
 
 
-def test_shared_mode_export_goes_to_the_browser_that_clicked(tmp_path: Path) -> None:
-    app = PendantApp(AppConfig(port=0, shared=True, tool_library=tmp_path / "tools.json"))
-    app.start()
+def test_shared_mode_export_goes_to_the_browser_that_clicked(app_factory) -> None:
+    app = app_factory(shared=True)
     ws = [DrainingClient(app.port), DrainingClient(app.port)]
     try:
         wait_until(lambda: len(app.server.get_clients()) == 2, what="two browsers")
@@ -283,7 +278,6 @@ def test_shared_mode_export_goes_to_the_browser_that_clicked(tmp_path: Path) -> 
     finally:
         for w in ws:
             w.close()
-        app.stop()
 
 
 def test_resume_names_what_it_brings_back_and_offers_the_choice(page) -> None:

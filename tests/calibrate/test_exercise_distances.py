@@ -21,6 +21,9 @@ from scipy.optimize import least_squares
 from tcp_pendant.wizards.session_record import dumps
 
 from tcpcal.origin import solve_xyz4
+from support.calib_page import Page
+
+pytestmark = pytest.mark.app_page(cls=Page, seed=5)
 
 TURNS = (("A", 10.0), ("B", 10.0), ("C", 10.0), ("A", -20.0), ("B", -20.0))
 

@@ -4,7 +4,6 @@ the panel)."""
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
 import pytest
@@ -12,8 +11,10 @@ from tcp_pendant.calibrate import AutoTouchRequest
 from tcp_pendant.views.wizard_dock import FINISH
 from tcp_pendant.wizards import CalibrationFailedError
 
-sys.path.insert(0, str(Path(__file__).parent))
-from calib_helpers import make_session  # noqa: E402
+from support.calib_helpers import make_session
+from support.calib_page import Page
+
+pytestmark = pytest.mark.app_page(cls=Page, seed=5)
 
 
 def three_touches_then_a_repeat(s) -> None:

@@ -4,16 +4,13 @@ operator error is applied to the alignment step as an angle, atan(σ / 100 mm) p
 from __future__ import annotations
 
 import math
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 from tcp_pendant.calibrate import AutoTouchRequest
 from tcp_pendant.calibrate.autotouch import ANGLE_LEVER_MM, operator_angle_sigma_deg
 
-sys.path.insert(0, str(Path(__file__).parent))
-from calib_helpers import library_tool_with_true_tcp
+from support.calib_helpers import library_tool_with_true_tcp
 
 
 def abc_errors(workflow, library, sigma_mm: float, n: int, tool: str = "torch") -> tuple[np.ndarray, list[str]]:

@@ -5,8 +5,6 @@ orientation is from the recorded ones and what the next touch must add, in words
 from __future__ import annotations
 
 import math
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -14,9 +12,9 @@ from scipy.spatial.transform import Rotation
 from tcp_pendant.calibrate.diversity import MIN_TILT_DEG, axis_in_words, diversity_advice, missing_axis_in_words
 from tcp_pendant.calibrate.text import meter_markdown
 
+from support.calib_page import Page
 from tcpcal.pose_quality import candidate_gain
 
-sys.path.insert(0, str(Path(__file__).parent))
 
 R_DOWN = Rotation.from_euler("x", 180, degrees=True).as_matrix()   # flange Z pointing down
 
@@ -109,38 +107,27 @@ def test_meter_markdown_uses_the_advice_and_does_not_repeat_the_angle() -> None:
     assert "Nearest recorded orientation" not in text
 
 
-def test_the_meter_in_the_app_speaks_of_touch_1_after_one_touch(tmp_path) -> None:
-    from calib_page import Page
-    from tcp_pendant.serve.server import AppConfig, PendantApp
+@pytest.mark.app_page(cls=Page, seed=5)
+def test_the_meter_in_the_app_speaks_of_touch_1_after_one_touch(page) -> None:
+    p = page(tool="pointer")
+    p.click(p.view.start)
+    assert "Touch 1 can have any orientation" in p.view.steps.meter_md.content
+    s = p.session
 
-    app = PendantApp(AppConfig(port=0, tool="pointer", tool_library=tmp_path / "tools.json",
-                               library_poll_s=0.1, seed=5))
-    app.start()
-    p = None
-    try:
-        p = Page(app)
-        p.click(p.view.start)
-        assert "Touch 1 can have any orientation" in p.view.steps.meter_md.content
-        s = p.session
+    def move_to(tilt_deg: float, azimuth_deg: float) -> None:    # as if the trainee jogged there
+        with s.lock:
+            assert s.controller.auto_approach(tilt_deg=tilt_deg, azimuth_deg=azimuth_deg, spin_deg=0.0,
+                                              sigma_mm=0.0, tip_offset_tool_mm=(0.0, 0.0, 0.0)).ok
+            s.moved()
 
-        def move_to(tilt_deg: float, azimuth_deg: float) -> None:    # as if the trainee jogged there
-            with s.lock:
-                assert s.controller.auto_approach(tilt_deg=tilt_deg, azimuth_deg=azimuth_deg, spin_deg=0.0,
-                                                  sigma_mm=0.0, tip_offset_tool_mm=(0.0, 0.0, 0.0)).ok
-                s.moved()
-
-        p.click(p.view.steps.auto_touch)
-        move_to(25.0, 0.0)
-        text = p.view.steps.meter_md.content
-        assert "Not determinable yet. This orientation is **" in text and "°** from touch 1" in text
-        p.click(p.view.steps.auto_touch)
-        move_to(30.0, 90.0)
-        text = p.view.steps.meter_md.content
-        assert "from the nearest touch" in text and "differ only by" in text and "flange [" not in text
-    finally:
-        if p is not None:
-            p.ws.close()
-        app.stop()
+    p.click(p.view.steps.auto_touch)
+    move_to(25.0, 0.0)
+    text = p.view.steps.meter_md.content
+    assert "Not determinable yet. This orientation is **" in text and "°** from touch 1" in text
+    p.click(p.view.steps.auto_touch)
+    move_to(30.0, 90.0)
+    text = p.view.steps.meter_md.content
+    assert "from the nearest touch" in text and "differ only by" in text and "flange [" not in text
 
 
 def test_finish_failure_says_the_shared_axis_in_words(workflow) -> None:

@@ -5,10 +5,8 @@ the flange positions, the frames) and the labels at the tip (COMPUTED, TRUE, TOO
 from __future__ import annotations
 
 import math
-import sys
 from collections.abc import Iterator
 from itertools import combinations
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -19,8 +17,9 @@ from tcp_pendant.views.framing import (
     label_box_px,
     spread_labels,
 )
+from support.calib_page import Page
 
-sys.path.insert(0, str(Path(__file__).parent))
+pytestmark = pytest.mark.app_page(cls=Page, seed=5)
 
 
 def sphere_surface(c: np.ndarray, r: float, n: int = 200) -> np.ndarray:
@@ -161,7 +160,6 @@ def test_finish_frames_the_camera_and_spreads_the_labels(page) -> None:
     assert tuple(others["tool"].position) == pytest.approx((0.0, 0.0, 0.04))
 
 
-
 def _boxes_apart(f, world: dict[str, np.ndarray]) -> list[tuple[str, str]]:
     xy, _ = f.project(np.array(list(world.values())))
     texts = list(world)
@@ -175,7 +173,7 @@ def _boxes_apart(f, world: dict[str, np.ndarray]) -> list[tuple[str, str]]:
 
 
 def test_abc_world_target_tool_and_tip_labels_do_not_collide(page, tmp_path) -> None:
-    from calib_helpers import library_tool_with_true_tcp
+    from support.calib_helpers import library_tool_with_true_tcp
     from tcp_pendant.views.wizard_scene import WizardSceneView
 
     p = page()

@@ -4,9 +4,7 @@ orientation wizards offer first."""
 from __future__ import annotations
 
 import re
-import sys
 from datetime import datetime
-from pathlib import Path
 
 import pytest
 from tcp_pendant.calibrate import AutoTouchRequest
@@ -16,8 +14,8 @@ from tcp_pendant.wizards import WizardStateError
 
 from tcpcal.tool import Tool
 
-sys.path.insert(0, str(Path(__file__).parent))
-from calib_helpers import library_tool_with_true_tcp
+from support.calib_helpers import library_tool_with_true_tcp
+from support.calib_page import Page
 
 
 def run_auto(wf) -> None:
@@ -117,38 +115,24 @@ def test_default_library_slot_matches_the_mounted_tools_label() -> None:
                                 mounted_label="Bent-neck welding torch", mounted_key="torch") == 2
 
 
-def test_tool_data_defaults_to_the_active_slot_not_slot_1(tmp_path) -> None:
+@pytest.mark.app_page(cls=Page)
+def test_tool_data_defaults_to_the_active_slot_not_slot_1(page) -> None:
     """In a running app: with the torch's data active in slot 3, the orientation wizards
     offer slot 3; a pick by the user holds until the active tool data changes."""
-    from calib_page import Page  # noqa: F401  (the in-process browser)
-    from tcp_pendant.serve.server import AppConfig, PendantApp
-
-    from tcpcal.library import ToolLibrary
-
-    lib = ToolLibrary(tmp_path / "tools.json")
-    lib.save(1, Tool(name="Pen", tcp_mm=(0.0, 0.0, 150.0)))
-    lib.save(3, Tool(name="Torch", tcp_mm=(0.0, 0.0, 200.0)))
-    lib.save(4, Tool(name="Gripper", tcp_mm=(0.0, 0.0, 120.0)))
-    app = PendantApp(AppConfig(port=0, tool="torch", tool_library=tmp_path / "tools.json",
-                               library_poll_s=0.1))
-    app.start()
-    try:
-        p = Page(app)
-        v, s = p.view, p.session
-        tools = s.views["tools"]                     # the trainee activates slot 3 on the Tool tab
-        p.choose(tools.slots, "3: Torch")
-        p.click(tools.activate)
-        p.choose(v.method, "ABC world (parallel axes)")
-        assert s.active_slot == 3, "the session's active tool should be offered"
-        assert v.library_tool.value == "3: Torch"
-        p.choose(v.library_tool, "4: Gripper")       # the user's pick holds ...
-        p.choose(v.method, "Three-point orientation")
-        assert v.library_tool.value == "4: Gripper"
-        p.click(v.start)                             # ... and Start makes it active
-        assert s.active_slot == 4 and v.workflow.wizard.tool.name == "Gripper"
-    finally:
-        p.ws.close()
-        app.stop()
+    p = page({1: Tool(name="Pen", tcp_mm=(0.0, 0.0, 150.0)), 3: Tool(name="Torch", tcp_mm=(0.0, 0.0, 200.0)),
+              4: Tool(name="Gripper", tcp_mm=(0.0, 0.0, 120.0))}, tool="torch")
+    v, s = p.view, p.session
+    tools = s.views["tools"]                     # the trainee activates slot 3 on the Tool tab
+    p.choose(tools.slots, "3: Torch")
+    p.click(tools.activate)
+    p.choose(v.method, "ABC world (parallel axes)")
+    assert s.active_slot == 3, "the session's active tool should be offered"
+    assert v.library_tool.value == "3: Torch"
+    p.choose(v.library_tool, "4: Gripper")       # the user's pick holds ...
+    p.choose(v.method, "Three-point orientation")
+    assert v.library_tool.value == "4: Gripper"
+    p.click(v.start)                             # ... and Start makes it active
+    assert s.active_slot == 4 and v.workflow.wizard.tool.name == "Gripper"
 
 
 def test_the_4_point_steps_ask_for_what_the_meter_can_reward() -> None:
@@ -168,7 +152,7 @@ def test_the_4_point_steps_ask_for_what_the_meter_can_reward() -> None:
 def test_the_touch_list_points_at_the_wizards_touches(tmp_path) -> None:
     """With no free touch but four wizard touches the Jog tab's Touches list does not say
     'No touch recorded' (it did): it says where they are."""
-    from calib_helpers import make_session
+    from support.calib_helpers import make_session
     from tcp_pendant.calibrate.text import empty_touches_markdown
 
     s = make_session(tmp_path / "tools.json", seed=4)
@@ -185,7 +169,7 @@ def test_the_touch_list_points_at_the_wizards_touches(tmp_path) -> None:
 def test_exact_touches_are_not_called_outside_the_95_percent_radius(tmp_path) -> None:
     """sigma 0: an error of ~1e-12 mm next to a radius of ~1e-13 mm was 'outside the 95 %
     radius' beside '0.000 mm, good'."""
-    from calib_helpers import make_session
+    from support.calib_helpers import make_session
     from tcp_pendant.calibrate.text import truth_markdown
 
     s = make_session(tmp_path / "tools.json", seed=6)

@@ -14,8 +14,6 @@ from __future__ import annotations
 import html
 import math
 import re
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -24,9 +22,11 @@ from tcp_pendant.calibrate import AutoTouchRequest
 from tcp_pendant.calibrate.math_view import MAX_LINE, MathSheet, math_sheet
 from tcp_pendant.text_escape import escape_markdown
 
-sys.path.insert(0, str(Path(__file__).parent))
-from calib_helpers import library_tool_with_true_tcp, true_frame  # noqa: E402
-from tcpcal.tool import Tool  # noqa: E402
+from support.calib_helpers import library_tool_with_true_tcp, true_frame
+from tcpcal.tool import Tool
+from support.calib_page import Page
+
+pytestmark = pytest.mark.app_page(cls=Page, seed=5)
 
 P_PARALLEL = np.array([[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]])   # (PA-1)
 _BLOCK = re.compile(r'<div class="math-block" data-key="([^"]+)"[^>]*>(.*?)</div>', re.S)

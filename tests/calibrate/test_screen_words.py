@@ -17,6 +17,9 @@ from tcp_pendant.controller import builtin_tools
 from tcp_pendant.views.scene import tool_label_text
 from tcpcal.pose_quality import candidate_gain
 from tcpcal.tool import Tool
+from support.calib_page import Page
+
+pytestmark = pytest.mark.app_page(cls=Page, seed=5)
 
 
 def _rot(axis: tuple[float, float, float], deg: float) -> np.ndarray:

@@ -3,7 +3,6 @@ the signal carries typed events with the facts of the moment they happened."""
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -13,8 +12,7 @@ from tcp_pendant.events import Crash, RunCancelled, RunFinished, RunResumed, Run
 from tcp_pendant.serve.server import AppConfig, PendantApp
 from tcp_pendant.session import SessionChange
 
-sys.path.insert(0, str(Path(__file__).parent))
-from calib_helpers import make_session  # noqa: E402
+from support.calib_helpers import make_session
 
 
 def recording(session) -> list[SessionChange]:
@@ -163,24 +161,20 @@ def test_hide_truth_always_outlasts_an_exercise(tmp_path: Path) -> None:
     assert free.workflow.hide_truth is False
 
 
-def test_the_hide_truth_option_reaches_every_session(tmp_path: Path) -> None:
-    from tcp_pendant.serve.cli import build_parser
+def test_the_hide_truth_option_reaches_every_session(app_factory) -> None:
+    from tcp_pendant.cli import build_parser
 
     assert build_parser().parse_args(["--hide-truth"]).hide_truth is True
     assert build_parser().parse_args([]).hide_truth is False
-    app = PendantApp(AppConfig(port=0, tool_library=tmp_path / "tools.json", hide_truth=True, shared=True))
-    try:
-        app.start()
-        s = app.shared_session
-        assert s is not None and s.workflow.hide_truth
-        s.start_wizard("xyz4")
-        while s.workflow.result is None:
-            s.auto_touch(AutoTouchRequest())
-        view = s.views["calibrate"]
-        assert not view.result.truth_md.visible and not view.scene.true_tool.visible
-        assert "Against the true TOOL frame" not in view.result.result_md.content
-    finally:
-        app.stop()
+    app = app_factory(hide_truth=True, shared=True)
+    s = app.shared_session
+    assert s is not None and s.workflow.hide_truth
+    s.start_wizard("xyz4")
+    while s.workflow.result is None:
+        s.auto_touch(AutoTouchRequest())
+    view = s.views["calibrate"]
+    assert not view.result.truth_md.visible and not view.scene.true_tool.visible
+    assert "Against the true TOOL frame" not in view.result.result_md.content
 
 
 def test_joints_are_kept_only_for_the_poses_a_run_still_holds(tmp_path: Path) -> None:

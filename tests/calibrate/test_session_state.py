@@ -14,7 +14,6 @@ would (``guiclick``). What is checked:
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -25,36 +24,12 @@ from tcpcal.library import ToolLibrary
 from tcpcal.tool import Tool
 from tcp_pendant.calibrate import AutoTouchRequest
 from tcp_pendant.controller import builtin_tools
-from tcp_pendant.serve.server import AppConfig, PendantApp
 from tcp_pendant.session import SessionChange
 
-from calib_page import Page
+from support.calib_page import Page
 
 
-@pytest.fixture
-def server(tmp_path: Path) -> Iterator[Callable[..., PendantApp]]:
-    apps: list[PendantApp] = []
-    pages: list[Page] = []
-
-    def make(**kw: Any) -> PendantApp:
-        kw.setdefault("seed", 5)
-        app = PendantApp(AppConfig(port=0, tool_library=tmp_path / "tools.json", library_poll_s=0.1, **kw))
-        app.start()
-        apps.append(app)
-        return app
-
-    make.pages = pages  # type: ignore[attr-defined]
-    yield make
-    for p in pages:
-        p.ws.close()
-    for a in apps:
-        a.stop()
-
-
-def _page(server: Any, app: PendantApp) -> Page:
-    p = Page(app)
-    server.pages.append(p)
-    return p
+pytestmark = pytest.mark.app_page(cls=Page, seed=5)
 
 
 def _save_torch_as(p: Page, name: str) -> int:
@@ -72,15 +47,15 @@ def _save_torch_as(p: Page, name: str) -> int:
     return slot
 
 
-def test_a_trainees_tool_does_not_become_the_next_trainees(server) -> None:
-    app = server()
-    a = _page(server, app)
+def test_a_trainees_tool_does_not_become_the_next_trainees(page) -> None:
+    a = page()
+    app = a.app
     slot = _save_torch_as(a, "Torch A")
     a.choose(a.session.views["tools"].slots, f"{slot}: Torch A")
     a.click(a.session.views["tools"].activate)
     assert ToolLibrary(app.library.path).active_slot() is None      # the file's is not a trainee's
 
-    b = _page(server, app)                           # B connects later
+    b = page(on=app)                                 # B connects later
     sb = b.session
     assert sb.active_slot is None and sb.controller.active_tool is None
     assert sb.controller.mounted_tool.key == "pointer"
@@ -100,11 +75,11 @@ def test_a_trainees_tool_does_not_become_the_next_trainees(server) -> None:
     assert ToolLibrary(app.library.path).active_slot() is None
 
 
-def test_shared_mode_starts_with_the_librarys_active_tool_and_sets_it(server, tmp_path: Path) -> None:
+def test_shared_mode_starts_with_the_librarys_active_tool_and_sets_it(app_factory, tmp_path: Path) -> None:
     lib = ToolLibrary(tmp_path / "tools.json")
     lib.save(1, Tool(name="Pen", tcp_mm=(0.0, 0.0, 150.0)))
     lib.save(2, Tool(name="Torch", tcp_mm=(0.0, 0.0, 200.0)), activate=True)
-    app = server(shared=True)
+    app = app_factory(shared=True, seed=5)
     s = app.shared_session
     assert s is not None and s.active_slot == 2 and s.controller.active_tool.name == "Torch"
     with s.lock:
@@ -113,9 +88,8 @@ def test_shared_mode_starts_with_the_librarys_active_tool_and_sets_it(server, tm
     assert "TOOL Pen" in s.views["pendant"].tcp_md.content
 
 
-def test_a_command_ends_in_one_change_signal_and_every_view_follows(server) -> None:
-    app = server()
-    p = _page(server, app)
+def test_a_command_ends_in_one_change_signal_and_every_view_follows(page) -> None:
+    p = page()
     s = p.session
     changes: list[SessionChange] = []
     s.subscribe(changes.append)
@@ -146,9 +120,8 @@ def test_a_command_ends_in_one_change_signal_and_every_view_follows(server) -> N
     assert "TOOL Typed" in s.views["pendant"].tcp_md.content
 
 
-def test_the_gizmos_stop_reaches_the_status_line_through_the_signal(server) -> None:
-    app = server()
-    p = _page(server, app)
+def test_the_gizmos_stop_reaches_the_status_line_through_the_signal(page) -> None:
+    p = page()
     s = p.session
     changes: list[SessionChange] = []
     s.subscribe(changes.append)
@@ -161,9 +134,8 @@ def test_the_gizmos_stop_reaches_the_status_line_through_the_signal(server) -> N
     assert change.jog.message in s.views["pendant"].status_md.content
 
 
-def test_workflow_wizard_is_a_plain_getter(server) -> None:
-    app = server()
-    p = _page(server, app)
+def test_workflow_wizard_is_a_plain_getter(page) -> None:
+    p = page()
     wf = p.view.workflow
     p.click(p.view.start)
     w = wf.wizard

@@ -9,8 +9,6 @@ from __future__ import annotations
 from tcp_pendant.text_escape import escape_markdown
 
 import json
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -22,8 +20,7 @@ from tcp_pendant.wizards.session_record import dumps
 
 from tcpcal.tool import Tool
 
-sys.path.insert(0, str(Path(__file__).parent))
-from calib_helpers import true_frame
+from support.calib_helpers import true_frame
 
 OFFSET_FLANGE_MM = np.array([0.6, -0.48, 0.64])     # |.| = 1.000 mm
 

@@ -5,8 +5,6 @@ tool's hidden true frame (``ToolModel.T_flange_tool_true``, converted with scipy
 from __future__ import annotations
 
 import json
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -15,8 +13,7 @@ from tcp_pendant.calibrate import AutoTouchRequest, CalibrationWorkflow
 from tcp_pendant.wizards import CalibrationFailedError, TcpZxWizard, WizardError
 from tcp_pendant.wizards.session_record import dumps
 
-sys.path.insert(0, str(Path(__file__).parent))
-from calib_helpers import true_frame
+from support.calib_helpers import true_frame
 
 EXACT_MM = 1e-6
 EXACT_DEG = 1e-6

@@ -5,7 +5,6 @@ tool it measured: touches of another tool than their step measures do not finish
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
 import pytest
@@ -17,8 +16,7 @@ from tcp_pendant.classroom.exercise_rules import class_rules
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.wizards import WizardStateError
 
-sys.path.insert(0, str(Path(__file__).parent))
-from calib_helpers import library_tool_with_true_tcp, make_session  # noqa: E402
+from support.calib_helpers import library_tool_with_true_tcp, make_session
 
 TOOLS = builtin_tools()
 

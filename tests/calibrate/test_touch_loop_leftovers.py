@@ -6,8 +6,6 @@ wizard touches keep their distance-at-record for the session record and the resu
 from __future__ import annotations
 
 import json
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -17,11 +15,9 @@ from tcp_pendant.wizards import WizardError
 from tcp_pendant.wizards.session_record import SessionRecordError, dumps, load_and_replay
 
 from tcpcal.origin import solve_xyz4
+from support.calib_page import Page
 
-HERE = Path(__file__).parent
-sys.path.insert(0, str(HERE.parent / "app"))
-sys.path.insert(0, str(HERE))
-from guiclick import choose, click
+pytestmark = pytest.mark.app_page(cls=Page, seed=5)
 
 
 # ---------------------------------------------------------------- stale texts

@@ -6,21 +6,20 @@ in the pool's words, the Check's line left as it was."""
 
 from __future__ import annotations
 
-import sys
 import threading
-from pathlib import Path
 from typing import Any
 
+import pytest
 from tcp_pendant.calibrate import AutoTouchRequest
 from tcp_pendant.calibrate.autotouch import MOVED_DURING_PROBE
 from tcp_pendant.job_pool import JobPool
 from tcp_pendant.session import Session
 from tcp_pendant.views.wizard_dock import FINISH
 
-HERE = Path(__file__).parent
-sys.path.insert(0, str(HERE.parent / "app"))
-sys.path.insert(0, str(HERE))
-from app_page import truth_tool  # noqa: E402
+from support.app_page import truth_tool
+from support.calib_page import Page
+
+pytestmark = pytest.mark.app_page(cls=Page, seed=5)
 
 PROBE = "Auto-touch's check of the pose it reached"
 

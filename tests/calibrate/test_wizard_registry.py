@@ -6,15 +6,12 @@ other change to the app. Plus the registry's own checks of what a wizard declare
 from __future__ import annotations
 
 import json
-import sys
 from collections.abc import Iterator, Mapping
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
 from tcp_pendant.calibrate import JOBS, AutoTouchRequest, CalibrationWorkflow
-from tcp_pendant.serve.server import AppConfig, PendantApp
 from tcp_pendant.wizards import (
     StepSpec,
     Wizard,
@@ -31,12 +28,9 @@ from tcp_pendant.wizards.session_record import dumps
 from tcpcal.library import ToolLibrary
 from tcpcal.tool import Tool
 
-HERE = Path(__file__).parent
-sys.path.insert(0, str(HERE.parent / "app"))
-sys.path.insert(0, str(HERE))
-from calib_helpers import make_controller  # noqa: E402
-from guiclick import choose, click  # noqa: E402
-from wsclient import DrainingClient, wait_until  # noqa: E402
+from support.calib_helpers import make_controller
+from support.guiclick import choose, click
+from support.wsclient import DrainingClient, wait_until
 
 
 class ToyTapWizard(Wizard):
@@ -89,9 +83,8 @@ def toy() -> Iterator[type[ToyTapWizard]]:
         unregister(ToyTapWizard.kind)
 
 
-def test_a_registered_kind_is_offered_started_performed_recorded_and_replayed(toy, tmp_path) -> None:
-    app = PendantApp(AppConfig(port=0, tool="pointer", tool_library=tmp_path / "tools.json"))
-    app.start()
+def test_a_registered_kind_is_offered_started_performed_recorded_and_replayed(toy, app_factory, tmp_path) -> None:
+    app = app_factory(tool="pointer")
     ws = DrainingClient(app.port)
     try:
         wait_until(lambda: len(app.sessions) == 1, what="session built")
@@ -123,7 +116,6 @@ def test_a_registered_kind_is_offered_started_performed_recorded_and_replayed(to
         assert record["wizards"][0]["state"]["kind"] == "toy-tap"
     finally:
         ws.close()
-        app.stop()
     other = CalibrationWorkflow(make_controller(), ToolLibrary(tmp_path / "other.json"), robot="kr6")
     checks = other.load_record(json.dumps(record))                  # ... and replayable
     assert [c.matches for c in checks] == [True] and isinstance(other.wizard, ToyTapWizard)

@@ -5,8 +5,6 @@ auto-touch on the real virtual controller, checked against the tools' hidden tru
 from __future__ import annotations
 
 import json
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -23,8 +21,7 @@ from tcp_pendant.wizards.session_record import dumps
 from tcpcal.errors import TcpcalError
 from tcpcal.tool import Tool
 
-sys.path.insert(0, str(Path(__file__).parent))
-from calib_helpers import library_tool_with_true_tcp, true_frame
+from support.calib_helpers import library_tool_with_true_tcp, true_frame
 
 EXACT_MM = 1e-6
 EXACT_DEG = 1e-6

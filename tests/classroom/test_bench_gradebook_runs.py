@@ -24,6 +24,7 @@ def _rows(text: str) -> dict[str, tuple[float, float]]:
             for m in re.finditer(r"^  (.+?)\s+(\d+\.\d)\s+(\d+\.\d)\s+x\s*\d", text, re.MULTILINE)}
 
 
+@pytest.mark.slow
 def test_bench_gradebook_quick_runs(tmp_path: Path) -> None:
     out = subprocess.run([sys.executable, str(BENCH), "--quick", "--dir", str(tmp_path)], capture_output=True,
                          text=True, timeout=120)
@@ -34,6 +35,7 @@ def test_bench_gradebook_quick_runs(tmp_path: Path) -> None:
     assert list(tmp_path.iterdir()) == []          # its temporary folder is gone
 
 
+@pytest.mark.slow
 def test_bench_gradebook_quick_runs_on_postgresql(tmp_path: Path, postgres_server,
                                                   capsys: pytest.CaptureFixture[str]) -> None:
     spec = importlib.util.spec_from_file_location("bench_gradebook", BENCH)   # in this process: no start-up

@@ -6,7 +6,6 @@ re-render of the class room."""
 from __future__ import annotations
 
 import re
-import sys
 from datetime import datetime, timedelta, timezone
 from pathlib import Path
 
@@ -21,8 +20,7 @@ from tcp_pendant.classroom.recorder import TraineeRecorder
 from tcp_pendant.controller import builtin_tools
 from tcp_pendant.views.dashboard_table import STUCK_BACKGROUND, trainees_html
 
-sys.path.insert(0, str(Path(__file__).parents[1] / "calibrate"))
-from calib_helpers import make_session  # noqa: E402
+from support.calib_helpers import make_session
 
 T = np.eye(4)
 

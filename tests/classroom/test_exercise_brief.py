@@ -6,14 +6,12 @@ session's."""
 from __future__ import annotations
 
 import re
-import sys
 from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 
-sys.path.insert(0, str(Path(__file__).parents[1] / "calibrate"))
-from calib_helpers import library_tool_with_true_tcp, make_session  # noqa: E402
+from support.calib_helpers import library_tool_with_true_tcp, make_session
 
 from tcp_pendant.calibrate import AutoTouchRequest
 from tcp_pendant.classroom.class_room import PUSHED_SETTING, ClassRoom

@@ -6,17 +6,11 @@ and Dismiss dismisses on the trainee's own screen only."""
 from __future__ import annotations
 
 import re
-import sys
-from collections.abc import Callable, Iterator
 from pathlib import Path
 
-import pytest
 
-TESTS = Path(__file__).parents[1]
-sys.path.insert(0, str(TESTS / "app"))
-sys.path.insert(0, str(TESTS / "calibrate"))
-from guiclick import choose, click  # noqa: E402
-from wsclient import DrainingClient, wait_until  # noqa: E402
+from support.guiclick import choose, click
+from support.wsclient import DrainingClient, wait_until
 
 from tcp_pendant.text_escape import escape_markdown
 
@@ -24,30 +18,12 @@ TOKEN = "trainer-token-of-16"
 INJECTION = "<style>*{opacity:0}</style> [x](//evil.example) ![](//127.0.0.1:9/x) www.evil.example"
 
 
-@pytest.fixture
-def app_factory(tmp_path: Path) -> Iterator[Callable[..., object]]:
-    from tcp_pendant.serve.server import AppConfig, PendantApp
-
-    apps: list[PendantApp] = []
-
-    def make(**kw: object) -> PendantApp:
-        app = PendantApp(AppConfig(port=0, tool_library=tmp_path / "tools.json", library_poll_s=0.1, seed=11,
-                                   **kw))  # type: ignore[arg-type]
-        app.start()
-        apps.append(app)
-        return app
-
-    yield make
-    for a in apps:
-        a.stop()
-
-
 def live(md: str) -> list[str]:
     return re.findall(r"<|\]\(|!\[|www\.|https?:", md)
 
 
 def test_the_trainers_brief_and_message_reach_the_right_screens_escaped(app_factory, tmp_path: Path) -> None:
-    app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token=TOKEN)
+    app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token=TOKEN, seed=11)
     clients = []
     for i in range(3):
         clients.append(DrainingClient(app.port))

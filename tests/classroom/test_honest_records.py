@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import copy
 import json
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -18,8 +17,7 @@ from tcp_pendant.wizards.session_record import VERSION, load_and_replay
 
 from tcpcal.library import ToolLibrary
 
-sys.path.insert(0, str(Path(__file__).parents[1] / "calibrate"))
-from calib_helpers import make_controller, make_session  # noqa: E402
+from support.calib_helpers import make_controller, make_session
 
 
 def _finished_class_session(tmp_path: Path, name: str = "Anna", sigma: float = 0.3):

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -12,8 +11,7 @@ from tcp_pendant.classroom.gradebook import Gradebook
 from tcp_pendant.classroom.recorder import TraineeRecorder
 from tcp_pendant.wizards.session_record import load_and_replay
 
-sys.path.insert(0, str(Path(__file__).parents[1] / "calibrate"))
-from calib_helpers import make_session  # noqa: E402
+from support.calib_helpers import make_session
 
 
 @pytest.fixture

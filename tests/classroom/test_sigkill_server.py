@@ -22,8 +22,7 @@ import msgspec.msgpack
 import pytest
 from viser import _messages
 
-sys.path.insert(0, str(Path(__file__).parents[1] / "app"))
-from wsclient import ButtonClient, decode_window, wait_until  # noqa: E402
+from support.wsclient import ButtonClient, decode_window, wait_until
 
 from tcp_pendant.classroom.gradebook import Gradebook
 

@@ -4,36 +4,14 @@ the trainer's gradebook keeps it."""
 
 from __future__ import annotations
 
-import sys
-from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import pytest
 
-TESTS = Path(__file__).parents[1]
-sys.path.insert(0, str(TESTS / "app"))
-sys.path.insert(0, str(TESTS / "calibrate"))
-from guiclick import choose, click  # noqa: E402
-from wsclient import DrainingClient, wait_until  # noqa: E402
+from support.guiclick import choose, click
+from support.wsclient import DrainingClient, wait_until
 
 from tcp_pendant.pendant.formatting import touch_indicator_markdown
-
-
-@pytest.fixture
-def app_factory(tmp_path: Path) -> Iterator[Callable[..., object]]:
-    from tcp_pendant.serve.server import AppConfig, PendantApp
-
-    apps: list[PendantApp] = []
-
-    def make(**kw: object) -> PendantApp:
-        app = PendantApp(AppConfig(port=0, tool_library=tmp_path / "tools.json", library_poll_s=0.1, **kw))  # type: ignore[arg-type]
-        app.start()
-        apps.append(app)
-        return app
-
-    yield make
-    for a in apps:
-        a.stop()
 
 
 def _class(app, n: int) -> tuple[list[DrainingClient], list]:

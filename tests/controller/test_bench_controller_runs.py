@@ -7,9 +7,12 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 BENCH = Path(__file__).resolve().parents[1] / "bench" / "bench_controller.py"
 
 
+@pytest.mark.slow
 def test_bench_controller_quick_runs() -> None:
     out = subprocess.run([sys.executable, str(BENCH), "--quick"], capture_output=True, text=True, timeout=120)
     assert out.returncode == 0, out.stderr

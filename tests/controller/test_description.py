@@ -1,11 +1,10 @@
 """Robot descriptions as ROS packages ship them (controller/description.py, kinematics.py):
 xacro, package:// and $(find pkg) through --package-path and ROS_PACKAGE_PATH, missing meshes,
-mimic joints. The layouts and their sources: tests/robots/ros_layouts.py, robots/README.md."""
+mimic joints. The layouts and their sources: tests/support/ros_layouts.py, robots/README.md."""
 
 from __future__ import annotations
 
 import math
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -16,8 +15,7 @@ from scipy.spatial.transform import Rotation
 from tcp_pendant.controller import ControllerError, RobotKinematics
 from tcp_pendant.controller.description import PackageFinder, load_description, package_search_path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "robots"))
-from ros_layouts import (  # noqa: E402
+from support.ros_layouts import (
     ACME7_MIMIC,
     IRB6640,
     acme7_T_base_flange,

@@ -5,8 +5,6 @@ fast Newton step: the same joint angles and stops as the algorithm before them
 from __future__ import annotations
 
 import math
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -22,8 +20,7 @@ from tcp_pendant.controller.scenarios import Scenario, realize
 
 from .conftest import TIP_M, kinematics, make_controller, truth_tool_data
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "bench"))
-from jog_yardstick import LegacyController  # noqa: E402
+from bench.jog_yardstick import LegacyController
 
 # A5 = +-10 deg: the same arm on both sides of the wrist singularity, det J_flange of opposite sign
 Q_WRIST_PLUS_DEG = (0.0, -80.0, 100.0, 0.0, 10.0, 0.0)

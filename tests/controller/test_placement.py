@@ -1,11 +1,10 @@
 """Where a foreign robot starts (controller/placement.py, server.default_reference_tip_mm and
-ready_configuration) and how a 7-axis arm jogs (jog.py, J-3). Layouts: tests/robots/ros_layouts.py."""
+ready_configuration) and how a 7-axis arm jogs (jog.py, J-3). Layouts: tests/support/ros_layouts.py."""
 
 from __future__ import annotations
 
 import math
 import re
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -22,8 +21,7 @@ from tcp_pendant.controller.placement import (
 )
 from tcp_pendant.serve.server import default_reference_tip_mm, ready_configuration, tip_reach_warning
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "robots"))
-from ros_layouts import acme7_workspace, kr16_2_urdf  # noqa: E402
+from support.ros_layouts import acme7_workspace, kr16_2_urdf
 
 ROBOTS = Path(__file__).resolve().parents[2] / "robots"
 POINTER = np.asarray(builtin_tools()["pointer"].T_flange_tool_true)

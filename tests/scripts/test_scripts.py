@@ -1,4 +1,4 @@
-"""The two commands of the README, ``scripts/run-app.sh`` and ``scripts/run-tests.sh``, run for real
+"""The commands of the README, ``scripts/run-app.sh`` and ``scripts/run-tests.sh`` (``--quick``), run for real
 (bash) in a copy of the repository's scripts with a fake ``.venv`` and a fake ``PATH``.
 
 The fake ``.venv/bin/python`` logs every call to ``calls.log`` and answers ``-m pip`` with
@@ -281,6 +281,35 @@ def test_run_tests_without_arguments_runs_the_parallel_tests_then_the_serial_one
     assert p.returncode == 1
     assert pytest_calls(stamped) == both
     assert "pytest exited 1 (the tests on 2 workers) and 1 (the serial tests)" in p.stderr
+
+
+def test_run_tests_quick_runs_both_parts_without_the_slow_tests(stamped: Path) -> None:
+    """``--quick``, the lane to run while working: mypy, then the same two runs as the README's
+    command without the tests marked slow; arguments after it go to both runs."""
+    (stamped.parent / "bin" / "chromium").symlink_to(shutil.which("true") or "/bin/true")
+    p = run(stamped, "run-tests.sh", "--quick")
+    assert p.returncode == 0, p.stderr
+    assert [c for c in calls(stamped) if c.startswith("python")] == [
+        "python [-m] [mypy]",
+        "python [-m] [pytest] [-n] [2] [--durations=25] [-m] [not slow and not serial]",
+        "python [-m] [pytest] [--durations=25] [-m] [not slow and serial]"]
+    assert p.stderr == ""
+    (stamped / "calls.log").unlink()
+    p = run(stamped, "run-tests.sh", "--quick", "-x", FAKE_PYTEST_RC="1")
+    assert p.returncode == 1
+    assert pytest_calls(stamped) == [
+        "python [-m] [pytest] [-n] [2] [--durations=25] [-m] [not slow and not serial] [-x]",
+        "python [-m] [pytest] [--durations=25] [-m] [not slow and serial] [-x]"]
+    assert "pytest exited 1 (the tests on 2 workers) and 1 (the serial tests)" in p.stderr
+
+
+def test_run_tests_quick_without_chromium_leaves_out_the_browser_tests_too(stamped: Path) -> None:
+    p = run(stamped, "run-tests.sh", "--quick")
+    assert p.returncode == 0
+    assert pytest_calls(stamped) == [
+        "python [-m] [pytest] [-n] [2] [--durations=25] [-m] [not browser and not slow and not serial]",
+        "python [-m] [pytest] [--durations=25] [-m] [not browser and not slow and serial]"]
+    assert "BROWSER TESTS DID NOT RUN" in p.stderr.strip().splitlines()[-1]
 
 
 def test_run_tests_with_a_bad_chromium_override_says_so(stamped: Path) -> None:

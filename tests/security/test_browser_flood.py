@@ -17,16 +17,14 @@ own TCP check meanwhile. What must hold, counted, not timed:
 
 from __future__ import annotations
 
-import sys
 from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 from tcp_pendant.job_pool import JobPool
 
-sys.path.insert(0, str(Path(__file__).parent))
-from browser_flood import FloodRig, Presses  # noqa: E402
-from wsclient import wait_until  # noqa: E402  (browser_flood puts tests/app on the path)
+from support.browser_flood import FloodRig, Presses
+from support.wsclient import wait_until
 
 OVER_SHARE = "The server is busy with this browser's jobs: try again in"
 PRESSES = 20

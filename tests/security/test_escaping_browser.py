@@ -15,7 +15,6 @@ import http.server
 import json
 import re
 import socket
-import sys
 import threading
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -24,8 +23,8 @@ from typing import Any
 import numpy as np
 import pytest
 import viser
-from chromium_session import with_render_scale
-from pendant_page import TIMEOUT_MS, choose, type_text, wait_text
+from support.chromium_session import with_render_scale
+from support.pendant_page import TIMEOUT_MS, choose, type_text, wait_text
 from tcp_pendant.calibrate import AutoTouchRequest, CalibrationWorkflow
 from tcp_pendant.text_escape import WORD_JOINER, escape_markdown
 from tcp_pendant.wizards.session_record import dumps
@@ -33,8 +32,7 @@ from tcp_pendant.wizards.session_record import dumps
 from tcpcal.library import ToolLibrary
 from tcpcal.tool import Tool
 
-sys.path.insert(0, str(Path(__file__).parents[1] / "calibrate"))
-from calib_helpers import library_tool_with_true_tcp, make_controller  # noqa: E402
+from support.calib_helpers import library_tool_with_true_tcp, make_controller
 
 pytestmark = pytest.mark.browser
 

@@ -8,7 +8,6 @@ tests/calibrate do; the browser tests (test_escaping_browser.py) check the rende
 from __future__ import annotations
 
 import re
-import sys
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
@@ -27,6 +26,7 @@ from tcp_pendant.calibrate.text import (
 )
 from tcp_pendant.pendant.formatting import tcp_readout_markdown, tool_data_markdown
 from tcp_pendant.pendant.tool_entry import ToolEntry, entry_preview_markdown
+from tcp_pendant.server import PendantApp
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.wizards import ThreePointWizard
 from tcp_pendant.wizards.session_record import dumps, load_and_replay
@@ -34,13 +34,10 @@ from tcp_pendant.wizards.session_record import dumps, load_and_replay
 from tcpcal.library import ToolLibrary
 from tcpcal.tool import Calibration, Tool
 
-TESTS = Path(__file__).parents[1]
-sys.path.insert(0, str(TESTS / "app"))
-sys.path.insert(0, str(TESTS / "calibrate"))
-from calib_helpers import library_tool_with_true_tcp, make_controller  # noqa: E402
-from guiclick import choose, click, upload  # noqa: E402
-from app_page import AppPage, running_pendants  # noqa: E402
-from wsclient import wait_until  # noqa: E402
+from support.calib_helpers import library_tool_with_true_tcp, make_controller
+from support.guiclick import choose, click, upload
+from support.app_page import AppPage
+from support.wsclient import wait_until
 
 # valid tool names (<= 24 characters, no double quote) that would do harm as markdown
 NAMES = ["<style>*{opacity:0}", "[click](//evil)", "![](//127.0.0.1:9/x)", "![](/etc/passwd)",
@@ -136,25 +133,24 @@ def test_escaped_markdown_makes_viser_read_no_file(monkeypatch) -> None:
 
 # --------------------------------------------------------------------------- the app's views
 @pytest.fixture
-def app_with_hostile_library(tmp_path: Path) -> Iterator[Callable[[], AppPage]]:
+def app_with_hostile_library(tmp_path: Path, app_factory: Callable[..., PendantApp]) -> Iterator[Callable[[], AppPage]]:
     lib = ToolLibrary(tmp_path / "tools.json")
     for slot, name in enumerate(NAMES, start=1):
         lib.save(slot, Tool(name=name, tcp_mm=(0.0, 0.0, 100.0 + slot),
                             calibration=Calibration(method=name, calibrated_at=_AT)), activate=slot == 1)
     browsers: list[AppPage] = []
-    with running_pendants(tmp_path) as start:
-        app = start()
+    app = app_factory()
 
-        def connect() -> AppPage:
-            b = AppPage(app)
-            browsers.append(b)
-            return b
+    def connect() -> AppPage:
+        b = AppPage(app)
+        browsers.append(b)
+        return b
 
-        try:
-            yield connect
-        finally:
-            for b in browsers:
-                b.ws.close()
+    try:
+        yield connect
+    finally:
+        for b in browsers:
+            b.ws.close()
 
 
 def _all_markdown(b: AppPage) -> str:

@@ -8,18 +8,16 @@ from __future__ import annotations
 import logging
 import math
 import random
-import sys
 import time
-from pathlib import Path
+from collections.abc import Callable
 from typing import Any
 
 import msgspec.msgpack
 import pytest
-from tcp_pendant.serve.server import AppConfig, PendantApp
+from tcp_pendant.server import PendantApp
 from tcp_pendant.views.viser_adapter import LOG_BUDGET, LOG_VALUE_CHARS, message_counts
 
-sys.path.insert(0, str(Path(__file__).parents[1] / "app"))
-from wsclient import CAMERA, InputsClient, click_until_carried_out, wait_until  # noqa: E402
+from support.wsclient import CAMERA, InputsClient, click_until_carried_out, wait_until
 
 HUGE = "x" * 100_000
 
@@ -77,11 +75,8 @@ def fuzz_messages(inputs: dict[str, tuple[str, str, dict[str, Any]]], seed: int)
 
 
 @pytest.fixture
-def app(tmp_path: Path):
-    a = PendantApp(AppConfig(port=0, tool_library=tmp_path / "tools.json"))
-    a.start()
-    yield a
-    a.stop()
+def app(app_factory: Callable[..., PendantApp]) -> PendantApp:
+    return app_factory()
 
 
 def _values(app: PendantApp) -> dict[str, Any]:
@@ -93,6 +88,7 @@ def _values(app: PendantApp) -> dict[str, Any]:
     return out
 
 
+@pytest.mark.slow  # thousands of fuzzed messages
 def test_fuzzed_messages_leave_no_traceback_and_the_socket_open(app: PendantApp, caplog: pytest.LogCaptureFixture,
                                                                capfd: pytest.CaptureFixture[str]) -> None:
     client = InputsClient(app.port)

@@ -144,20 +144,16 @@ def test_a_request_that_breaks_a_page_handler_is_a_400_without_traceback(app: Pe
     assert len(line) < 300
 
 
-def test_on_every_interface_the_printed_names_are_served(tmp_path: Path, monkeypatch) -> None:
+def test_on_every_interface_the_printed_names_are_served(app_factory, monkeypatch) -> None:
     """--host 0.0.0.0: the host name and addresses the server prints (addresses.network_urls,
     here fixed) are answered; other names are not."""
     import tcp_pendant.serve.server as server_module
 
     monkeypatch.setattr(server_module, "network_urls",
                         lambda host, port: [f"http://classroom-pc:{port}", f"http://10.9.8.7:{port}"])
-    a = PendantApp(AppConfig(host="0.0.0.0", port=0, tool_library=tmp_path / "t.json"))
-    a.start()
-    try:
-        port = a.port
-        for host in (f"classroom-pc:{port}", f"10.9.8.7:{port}", f"127.0.0.1:{port}", f"localhost:{port}"):
-            assert raw_request(port, [("Host", host)], upgrade=False)[0] == 200, host
-        for host in (f"evil.example:{port}", f"classroom-pc.evil.example:{port}", f"10.9.8.8:{port}"):
-            assert raw_request(port, [("Host", host)], upgrade=False)[0] == 403, host
-    finally:
-        a.stop()
+    a = app_factory(host="0.0.0.0")
+    port = a.port
+    for host in (f"classroom-pc:{port}", f"10.9.8.7:{port}", f"127.0.0.1:{port}", f"localhost:{port}"):
+        assert raw_request(port, [("Host", host)], upgrade=False)[0] == 200, host
+    for host in (f"evil.example:{port}", f"classroom-pc.evil.example:{port}", f"10.9.8.8:{port}"):
+        assert raw_request(port, [("Host", host)], upgrade=False)[0] == 403, host

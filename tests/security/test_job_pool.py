@@ -22,9 +22,8 @@ import numpy as np
 import pytest
 from tcp_pendant.job_pool import LOOP_SWITCH_INTERVAL_S, JobPool, PoolFull, SessionBusy, favour_the_event_loop
 
-sys.path.insert(0, str(Path(__file__).parent))
-from job_attack import Classroom  # noqa: E402
-from wsclient import wait_until  # noqa: E402  (job_attack puts tests/app on the path)
+from support.job_attack import Classroom
+from support.wsclient import wait_until
 
 ATTACKERS = 20
 FACTOR = 4.0

@@ -10,7 +10,6 @@ outlives a restart. ``--shared`` and a pendant without a class change any slot, 
 from __future__ import annotations
 
 import json
-import sys
 from pathlib import Path
 
 import pytest
@@ -23,21 +22,11 @@ from tcp_pendant.calibrate.pendant_rules import UNRESTRICTED
 from tcpcal.library import ToolLibrary, ToolLibraryError
 from tcpcal.tool import Tool
 
-sys.path.insert(0, str(Path(__file__).parents[1] / "calibrate"))
-sys.path.insert(0, str(Path(__file__).parents[1] / "app"))
-from app_page import running_pendants  # noqa: E402
-from calib_helpers import make_session  # noqa: E402
-from guiclick import choose, click  # noqa: E402
-from wsclient import DrainingClient, wait_until  # noqa: E402
+from support.calib_helpers import make_session
+from support.guiclick import choose, click
+from support.wsclient import DrainingClient, wait_until
 
 TOKEN = "trainer-token-of-the-class"
-
-
-@pytest.fixture
-def app_factory(tmp_path: Path):
-    """``app_factory(**AppConfig options)``: a started pendant in this process, stopped after."""
-    with running_pendants(tmp_path) as start:
-        yield start
 
 
 def _tool(name: str, z: float = 100.0) -> Tool:

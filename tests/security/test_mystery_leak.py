@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import json
 import re
-import sys
 from pathlib import Path
 from typing import Any
 
@@ -31,12 +30,9 @@ from scipy.spatial import cKDTree
 from tcp_pendant.views.touch_list import TOUCHES_FILENAME
 from tcp_pendant.views.wizard_menu import SESSION_FILENAME
 
-_APP_TESTS = Path(__file__).parents[1] / "app"
-sys.path.insert(0, str(_APP_TESTS))
-sys.path.insert(0, str(_APP_TESTS.parent / "calibrate"))
-from app_page import join_as_the_only_trainee, running_pendants  # noqa: E402
-from guiclick import choose, click  # noqa: E402
-from wsclient import RecordingClient, wait_until  # noqa: E402
+from support.app_page import join_as_the_only_trainee
+from support.guiclick import choose, click
+from support.wsclient import RecordingClient, wait_until
 
 TOKEN = "trainer-token-leak-test-01"
 NEAR_M = 5e-5                     # 0.05 mm
@@ -123,81 +119,80 @@ def _downloads(messages: list[dict]) -> dict[str, str]:
     return out
 
 
-def test_a_hostile_trainee_reads_no_number_of_the_true_tcp(tmp_path: Path) -> None:
-    with running_pendants(tmp_path) as start:
-        app = start(class_db=tmp_path / "class.sqlite3", trainer_token=TOKEN, exercise="mystery")
-        assert app.config.exercise_seed is None                       # the class's secret seed
-        c = RecordingClient(app.port)
-        try:
-            s = join_as_the_only_trainee(app, "Mallory")
-            assert s.controller.mounted_tool.key.startswith("mystery-") and s.hide_distance
+def test_a_hostile_trainee_reads_no_number_of_the_true_tcp(tmp_path: Path, app_factory) -> None:
+    app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token=TOKEN, exercise="mystery")
+    assert app.config.exercise_seed is None                       # the class's secret seed
+    c = RecordingClient(app.port)
+    try:
+        s = join_as_the_only_trainee(app, "Mallory")
+        assert s.controller.mounted_tool.key.startswith("mystery-") and s.hide_distance
 
-            poses: list[tuple[np.ndarray, np.ndarray]] = []            # (T_world_flange, T_world_base)
+        poses: list[tuple[np.ndarray, np.ndarray]] = []            # (T_world_flange, T_world_base)
 
-            def note_pose() -> None:
-                with s.lock:
-                    poses.append((s.controller.T_world_flange(), s.controller.T_world_base))
+        def note_pose() -> None:
+            with s.lock:
+                poses.append((s.controller.T_world_flange(), s.controller.T_world_base))
 
+        note_pose()
+        pendant, tools, cal = s.views["pendant"], s.views["tools"], s.views["calibrate"]
+        for ax, sign in (("X", "+"), ("Z", "−"), ("Y", "+"), ("A", "+")):   # jog a little
+            choose(pendant.cart_rows[ax], f"{ax} {sign}", s.client)
             note_pose()
-            pendant, tools, cal = s.views["pendant"], s.views["tools"], s.views["calibrate"]
-            for ax, sign in (("X", "+"), ("Z", "−"), ("Y", "+"), ("A", "+")):   # jog a little
-                choose(pendant.cart_rows[ax], f"{ax} {sign}", s.client)
-                note_pose()
-            click(pendant.closeup, s.client)
-            click(pendant.overview_btn, s.client)
-            choose(tools.entry_name, "zero", s.client)                # a zero tool: X = ... = C = 0
-            click(tools.entry_save, s.client)
-            slot, _ = s.library.find("zero")
-            choose(tools.slots, next(o for o in tools.slots.options if o.startswith(f"{slot}")), s.client)
-            click(tools.activate, s.client)
-            assert s.controller.active_tool is not None and not any(s.controller.active_tool.tcp_mm)
-            click(tools.check_active, s.client)                       # far from the tip: refused
-            assert "Checking" not in tools.check_md.content
-            choose(pendant.hide_distance, False, s.client)            # locked in the exercise
-            click(cal.start, s.client)                                # XYZ 4-point
-            click(cal.steps.record, s.client)                         # a touch in the air
-            with s.lock:                                              # a patient trainee jogs the tip
-                ctrl = s.controller                                   # to 2 mm above the spike,
-                assert ctrl.jog_cartesian("flange", "A", 10.0).ok      # turned from touch 1
-                T = ctrl.T_world_tool_true().copy()
-                T[:3, 3] = ctrl.reference_tip_world_m + [0.0, 0.0, 0.002]
-                assert ctrl.move_true_tool_to(T).ok
+        click(pendant.closeup, s.client)
+        click(pendant.overview_btn, s.client)
+        choose(tools.entry_name, "zero", s.client)                # a zero tool: X = ... = C = 0
+        click(tools.entry_save, s.client)
+        slot, _ = s.library.find("zero")
+        choose(tools.slots, next(o for o in tools.slots.options if o.startswith(f"{slot}")), s.client)
+        click(tools.activate, s.client)
+        assert s.controller.active_tool is not None and not any(s.controller.active_tool.tcp_mm)
+        click(tools.check_active, s.client)                       # far from the tip: refused
+        assert "Checking" not in tools.check_md.content
+        choose(pendant.hide_distance, False, s.client)            # locked in the exercise
+        click(cal.start, s.client)                                # XYZ 4-point
+        click(cal.steps.record, s.client)                         # a touch in the air
+        with s.lock:                                              # a patient trainee jogs the tip
+            ctrl = s.controller                                   # to 2 mm above the spike,
+            assert ctrl.jog_cartesian("flange", "A", 10.0).ok      # turned from touch 1
+            T = ctrl.T_world_tool_true().copy()
+            T[:3, 3] = ctrl.reference_tip_world_m + [0.0, 0.0, 0.002]
+            assert ctrl.move_true_tool_to(T).ok
+            s.moved()
+        note_pose()
+        click(tools.check_active, s.client)                       # the spin test at the spike
+        note_pose()
+        click(cal.steps.next, s.client)
+        click(cal.steps.record, s.client)
+        note_pose()
+        assert "mm" in tools.check_md.content                     # the readings, at the spike
+        assert [st.recorded for st in s.workflow.wizard.steps] == [True, True, False, False]
+        assert pendant.hide_distance.value and "hidden" in pendant.touch_md.content
+        click(s.views["touches"].record, s.client)                # a free touch ("Record point")
+        for axis, up_mm in (("A", 200.0), ("B", 0.0)):             # steps 3 and 4 far in the air,
+            with s.lock:                                          # the tool turned between them
+                assert s.controller.jog_cartesian("world", "Z", up_mm).ok if up_mm else True
+                assert s.controller.jog_cartesian("flange", axis, 10.0).ok
                 s.moved()
-            note_pose()
-            click(tools.check_active, s.client)                       # the spin test at the spike
             note_pose()
             click(cal.steps.next, s.client)
             click(cal.steps.record, s.client)
-            note_pose()
-            assert "mm" in tools.check_md.content                     # the readings, at the spike
-            assert [st.recorded for st in s.workflow.wizard.steps] == [True, True, False, False]
-            assert pendant.hide_distance.value and "hidden" in pendant.touch_md.content
-            click(s.views["touches"].record, s.client)                # a free touch ("Record point")
-            for axis, up_mm in (("A", 200.0), ("B", 0.0)):             # steps 3 and 4 far in the air,
-                with s.lock:                                          # the tool turned between them
-                    assert s.controller.jog_cartesian("world", "Z", up_mm).ok if up_mm else True
-                    assert s.controller.jog_cartesian("flange", axis, 10.0).ok
-                    s.moved()
-                note_pose()
-                click(cal.steps.next, s.client)
-                click(cal.steps.record, s.client)
-            click(cal.steps.next, s.client)                           # Finish
-            assert s.workflow.result is not None, s.workflow.finish_failure
-            (row,) = app.gradebook.grades.rows(include_in_progress=True)  # the truth, as the gradebook keeps it
-            distances = [t["distance_mm"] for t in app.gradebook.records.touches(row.calibration_id)]
-            assert len(distances) == 4 and min(distances) < 3.0 < 150.0 < max(distances)
-            assert s.workflow.run.distance_mm == {}                   # nothing of it in the trainee's run
-            click(cal.export, s.client)                               # Export session (JSON)
-            click(s.views["touches"].export_csv, s.client)            # the free touches as CSV
-            click(tools.download, s.client)                           # the active tool's controller file
-            marker = "Mallory was here"                               # the last thing sent
-            choose(tools.entry_name, marker, s.client)
-            wait_until(lambda: any(marker in str(m) for m in list(c.messages)), what="every message sent")
+        click(cal.steps.next, s.client)                           # Finish
+        assert s.workflow.result is not None, s.workflow.finish_failure
+        (row,) = app.gradebook.grades(include_in_progress=True)   # the truth, as the gradebook keeps it
+        distances = [t["distance_mm"] for t in app.gradebook.touches(row.calibration_id)]
+        assert len(distances) == 4 and min(distances) < 3.0 < 150.0 < max(distances)
+        assert s.workflow.run.distance_mm == {}                   # nothing of it in the trainee's run
+        click(cal.export, s.client)                               # Export session (JSON)
+        click(s.views["touches"].export_csv, s.client)            # the free touches as CSV
+        click(tools.download, s.client)                           # the active tool's controller file
+        marker = "Mallory was here"                               # the last thing sent
+        choose(tools.entry_name, marker, s.client)
+        wait_until(lambda: any(marker in str(m) for m in list(c.messages)), what="every message sent")
 
-            T_ft = np.array(app.gradebook.records.truth(row.calibration_id)["T_flange_tool_true_m"], dtype=float)
-            np.testing.assert_allclose(T_ft, s.controller.mounted_tool.T_flange_tool_true, atol=1e-12)
-        finally:
-            c.close()
+        T_ft = np.array(app.gradebook.truth(row.calibration_id)["T_flange_tool_true_m"], dtype=float)
+        np.testing.assert_allclose(T_ft, s.controller.mounted_tool.T_flange_tool_true, atol=1e-12)
+    finally:
+        c.close()
 
     downloads = _downloads(c.messages)
     assert len(downloads) == 3 and {SESSION_FILENAME, TOUCHES_FILENAME} <= set(downloads)   # + the controller file

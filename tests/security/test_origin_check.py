@@ -3,8 +3,7 @@ and is not the page's own address (nor an --allow-origin one) is refused with HT
 
 from __future__ import annotations
 
-import sys
-from collections.abc import Iterator
+from collections.abc import Callable
 from pathlib import Path
 
 import msgspec.msgpack
@@ -19,8 +18,7 @@ from websockets.datastructures import Headers
 from websockets.exceptions import InvalidStatus
 from websockets.sync.client import ClientConnection, connect
 
-sys.path.insert(0, str(Path(__file__).parents[1] / "app"))
-from wsclient import wait_until  # noqa: E402
+from support.wsclient import wait_until
 
 PROXY = "https://pendant.school.example"
 CAMERA = _messages.ViewerCameraMessage(wxyz=(1.0, 0.0, 0.0, 0.0), position=(2.0, -2.0, 1.0), fov=1.0, near=0.01,
@@ -91,11 +89,8 @@ def test_two_origin_headers_are_refused_and_allowed_origins_pass() -> None:
 
 
 @pytest.fixture
-def app(tmp_path: Path) -> Iterator[PendantApp]:
-    a = PendantApp(AppConfig(port=0, tool_library=tmp_path / "tools.json", allow_origins=(PROXY,)))
-    a.start()
-    yield a
-    a.stop()
+def app(app_factory: Callable[..., PendantApp]) -> PendantApp:
+    return app_factory(allow_origins=(PROXY,))
 
 
 def _handshake(port: int, origin: str | None) -> ClientConnection:

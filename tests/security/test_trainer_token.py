@@ -11,7 +11,7 @@ import os
 import re
 import subprocess
 import sys
-from collections.abc import Iterator
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
@@ -24,11 +24,10 @@ from tcp_pendant.classroom.trainer_token import (
     locked,
     resolve_trainer_token,
 )
-from tcp_pendant.serve.cli import main
-from tcp_pendant.serve.server import AppConfig, PendantApp
+from tcp_pendant.cli import main
+from tcp_pendant.server import PendantApp
 
-sys.path.insert(0, str(Path(__file__).parents[1] / "app"))
-from wsclient import InputsClient, wait_until  # noqa: E402
+from support.wsclient import InputsClient, wait_until
 
 TOKEN = "the-trainers-own-token"
 
@@ -96,12 +95,8 @@ def test_the_lockout_doubles_from_the_fifth_wrong_token_up_to_five_minutes(tmp_p
 
 
 @pytest.fixture
-def app(tmp_path: Path) -> Iterator[PendantApp]:
-    a = PendantApp(AppConfig(port=0, tool_library=tmp_path / "tools.json", class_db=tmp_path / "class.sqlite3",
-                             trainer_token=TOKEN))
-    a.start()
-    yield a
-    a.stop()
+def app(app_factory: Callable[..., PendantApp], tmp_path: Path) -> PendantApp:
+    return app_factory(class_db=tmp_path / "class.sqlite3", trainer_token=TOKEN)
 
 
 def test_guessing_over_a_websocket_is_locked_out_after_five_and_logged_short(app: PendantApp, caplog) -> None:

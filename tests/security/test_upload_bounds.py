@@ -7,30 +7,24 @@ pass its announced size is dropped, and one that gets no part for a while times 
 from __future__ import annotations
 
 import logging
-import sys
 import uuid
-from collections.abc import Iterator
-from pathlib import Path
+from collections.abc import Callable, Iterator
 from typing import Any
 
 import pytest
-from tcp_pendant.serve.server import AppConfig, PendantApp
+from tcp_pendant.server import PendantApp
 from tcp_pendant.views import viser_adapter
 from tcp_pendant.views.viser_adapter import UploadLimits
 
-sys.path.insert(0, str(Path(__file__).parents[1] / "app"))
-from wsclient import CAMERA, InputsClient, wait_until  # noqa: E402
+from support.wsclient import InputsClient, wait_until
 
 LOAD = "Load session (JSON)"
 MB = 1_000_000
 
 
 @pytest.fixture
-def app(tmp_path: Path) -> Iterator[PendantApp]:
-    a = PendantApp(AppConfig(port=0, tool_library=tmp_path / "tools.json"))
-    a.start()
-    yield a
-    a.stop()
+def app(app_factory: Callable[..., PendantApp]) -> PendantApp:
+    return app_factory()
 
 
 @pytest.fixture
@@ -60,14 +54,17 @@ def _part(c: InputsClient, tid: str, index: int, content: bytes) -> None:
 
 
 def _handled(app: PendantApp, c: InputsClient) -> None:
-    """Wait until the server handled everything ``c`` sent so far: a camera message behind it
-    (viser handles one socket's messages in order; a jog click would not do: the deadman drops a
-    press that waited behind megabytes of parts, ``views.arrival``)."""
+    """Wait until the server handled everything ``c`` sent so far: a jog click behind it moved
+    the robot, or the deadman dropped it as read too late (behind megabytes of uploads on a busy
+    machine); either way it was read after the rest."""
+    moves: list[int] = []
     button = c.uuid_of("X +")
-    handle = next(s.client for s in app.sessions.values() if button in s.client.gui._gui_input_handle_from_uuid)
-    before = handle.camera._state
-    c.send(CAMERA)
-    wait_until(lambda: handle.camera._state is not before, what="the camera message behind the uploads")
+    session = next(s for s in app.sessions.values() if button in s.client.gui._gui_input_handle_from_uuid)
+    session.add_motion_listener(lambda: moves.append(1))
+    dropped = session.jogger.gate.dropped_total
+    c.send({"type": "GuiUpdateMessage", "uuid": c.uuid_of("X +"), "updates": {"value": True}})
+    wait_until(lambda: len(moves) > 0 or session.jogger.gate.dropped_total > dropped,
+               what="the click behind the uploads")
 
 
 def _held(app: PendantApp) -> dict[str, int]:

@@ -7,12 +7,10 @@ from __future__ import annotations
 
 import asyncio
 import json
-import sys
 import threading
 import time
 import uuid
-from collections.abc import Iterator
-from pathlib import Path
+from collections.abc import Callable, Iterator
 from types import SimpleNamespace
 from typing import Any
 
@@ -26,8 +24,7 @@ from tcp_pendant.wizards.session_record import MAX_RECORD_BYTES, MAX_WIZARDS
 from viser import _messages
 from viser._gui_handles import UploadedFile
 
-sys.path.insert(0, str(Path(__file__).parents[1] / "app"))
-from wsclient import ButtonClient, DrainingClient, wait_until  # noqa: E402
+from support.wsclient import ButtonClient, DrainingClient, wait_until
 
 PLUS_X = "X +"
 P99_LIMIT_S = 0.5
@@ -51,11 +48,10 @@ def _record(wizard_entry: dict[str, Any], n_wizards: int) -> bytes:
 
 
 class Browsers:
-    """A pendant server with an uploading browser (A) and a jogging one (B)."""
+    """An uploading browser (A) and a jogging one (B) on a pendant server."""
 
-    def __init__(self, tmp_path: Path) -> None:
-        self.app = PendantApp(AppConfig(port=0, tool_library=tmp_path / "tools.json"))
-        self.app.start()
+    def __init__(self, app: PendantApp) -> None:
+        self.app = app
         self.a = DrainingClient(self.app.port)
         wait_until(lambda: len(self.app.sessions) == 1, what="session A")
         (self.sa,) = self.app.sessions.values()
@@ -115,12 +111,11 @@ class Browsers:
     def close(self) -> None:
         self.a.close()
         self.b.close()
-        self.app.stop()
 
 
 @pytest.fixture
-def browsers(tmp_path: Path) -> Iterator[Browsers]:
-    b = Browsers(tmp_path)
+def browsers(app_factory: Callable[..., PendantApp]) -> Iterator[Browsers]:
+    b = Browsers(app_factory())
     yield b
     b.close()
 

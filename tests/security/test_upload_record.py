@@ -7,7 +7,6 @@ from __future__ import annotations
 import builtins
 import json
 import os
-import sys
 import threading
 from pathlib import Path
 from typing import Any
@@ -34,8 +33,7 @@ from tcp_pendant.wizards.session_record import (
 
 from tcpcal.library import ToolLibrary
 
-sys.path.insert(0, str(Path(__file__).parents[1] / "calibrate"))
-from calib_helpers import make_controller  # noqa: E402
+from support.calib_helpers import make_controller
 
 
 def _workflow(tmp_path: Path, seed: int = 0) -> CalibrationWorkflow:

@@ -7,9 +7,12 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 BENCH = Path(__file__).resolve().parents[1] / "bench" / "bench_solver.py"
 
 
+@pytest.mark.slow
 def test_bench_solver_quick_runs() -> None:
     out = subprocess.run([sys.executable, str(BENCH), "--quick"], capture_output=True, text=True, timeout=120, check=False)
     assert out.returncode == 0, out.stderr
@@ -56,9 +59,8 @@ def test_the_bare_svd_yardstick_solves_the_same_problem() -> None:
     """The yardstick of table 2 gives the TCP, reference and residuals of solve_xyz4."""
     import numpy as np
 
-    sys.path.insert(0, str(BENCH.parent))
-    from bench_solver import bare_svd_solve
-    from poses import random_tcp, tilted_rotations, touch_positions
+    from bench.bench_solver import bare_svd_solve
+    from support.poses import random_tcp, tilted_rotations, touch_positions
 
     from tcpcal.origin import solve_xyz4
 

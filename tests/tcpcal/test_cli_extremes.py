@@ -17,8 +17,7 @@ import pytest
 from tcpcal.errors import InvalidInputError
 from tcpcal.origin import solve_xyz4
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from test_cli import R_REF, T_TRUE, assert_one_error_line, run, write_csv, xyz4_poses  # noqa: E402
+from support.cli_runs import R_REF, T_TRUE, assert_one_error_line, run, write_csv, xyz4_poses
 
 
 def _csv(tmp_path: Path, scale: float = 1.0, row: int | None = None, value: float | None = None) -> Path:

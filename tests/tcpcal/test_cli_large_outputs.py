@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 import pytest
-from poses import random_tcp, tilted_rotations, touch_positions
+from support.poses import random_tcp, tilted_rotations, touch_positions
 from scipy.spatial.transform import Rotation
 
 from tcpcal import poses_csv, report
@@ -155,7 +155,7 @@ def _json_out(res: Any, poses: Any) -> dict[str, Any]:
 # ------------------------------------------------------------------ byte-identical outputs
 @pytest.mark.parametrize(("n", "labels", "joints", "outliers"), [
     (10, True, True, 1), (1000, True, False, 3), (1000, False, True, 0),
-    (100_000, False, False, 0)])
+    pytest.param(100_000, False, False, 0, marks=pytest.mark.slow)])
 def test_text_and_json_are_byte_identical_to_the_row_by_row_code(
         tmp_path: Path, n: int, labels: bool, joints: bool, outliers: int) -> None:
     path = tmp_path / "touches.csv"
@@ -309,6 +309,7 @@ def _profiled_calls(fn: Any) -> int:
     return sum(s[1] for s in pstats.Stats(prof).stats.values())  # type: ignore[attr-defined]
 
 
+@pytest.mark.slow
 def test_reading_and_formatting_make_no_python_call_per_row(tmp_path: Path) -> None:
     """10^5 rows cost O(1) Python-level calls (blocks of rows, columns), not O(N): the row
     loops of the csv reader, the report table and the JSON conversion were 10^5 - 10^6 calls
@@ -322,6 +323,7 @@ def test_reading_and_formatting_make_no_python_call_per_row(tmp_path: Path) -> N
     assert _profiled_calls(lambda: json_dumps(_json_out(res, poses))) < 5_000
 
 
+@pytest.mark.slow
 def test_cli_solves_1e5_rows_in_process(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     path = tmp_path / "tracker.csv"
     tcp = _write_touches(path, 100_000, seed=7)

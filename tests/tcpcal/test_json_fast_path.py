@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 import pytest
-from poses import random_tcp, tilted_rotations, touch_positions
+from support.poses import random_tcp, tilted_rotations, touch_positions
 from scipy.spatial.transform import Rotation
 
 from tcpcal import report
@@ -193,6 +193,7 @@ def test_a_dying_formatting_process_changes_nothing(monkeypatch: pytest.MonkeyPa
     assert json_dumps(obj, workers=2) == json_dumps(as_lists(obj))
 
 
+@pytest.mark.slow  # a large file through the CLI twice
 def test_cli_json_of_a_large_file_equals_the_list_path(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """``tcpcal solve xyz4 --json`` on 120,000 rows (360,000 residual values: the CLI's
     parallel path) prints the list path's text of the same result, with outliers (a second,

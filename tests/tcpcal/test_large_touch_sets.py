@@ -11,7 +11,7 @@ import tracemalloc
 
 import numpy as np
 import pytest
-from angle_reference import angle_extremes_large, quaternions
+from support.angle_reference import angle_extremes_large, quaternions
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
@@ -209,6 +209,7 @@ def test_continuous_motion_counts_as_many_orientations() -> None:
     assert distinct_orientations(rot, limit=4).count == 4
 
 
+@pytest.mark.slow
 def test_1e5_touches_one_orientation_fail_cleanly_in_modest_memory() -> None:
     """All touches one orientation (the case that asked for a 74.5 GiB matrix before)."""
     n = 100_000
@@ -226,6 +227,7 @@ def test_1e5_touches_one_orientation_fail_cleanly_in_modest_memory() -> None:
     assert peak < 300e6, peak  # O(N): the input is 7 MB, an N x N matrix 80 GB
 
 
+@pytest.mark.slow
 def test_1e5_touches_with_a_repeated_orientation_solve() -> None:
     """Half of 1e5 touches repeat one orientation, the rest are diverse: solved, smallest
     angle 0 (the repeated pair), no N x N matrix."""

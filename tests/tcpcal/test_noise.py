@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 import pytest
-from poses import crb_tcp, make_touches, touch_positions
+from support.poses import crb_tcp, make_touches, touch_positions
 from scipy.spatial.transform import Rotation
 
 from tcpcal._stats import ci_radius

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
-from poses import crb_tcp, make_touches, random_rotations, stacked_a, touch_positions
+from support.poses import crb_tcp, make_touches, random_rotations, stacked_a, touch_positions
 from scipy.spatial.transform import Rotation
 
 from tcpcal.errors import DegenerateTouchesError, InvalidInputError, TcpcalError

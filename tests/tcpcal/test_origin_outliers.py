@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from poses import make_touches
+from support.poses import make_touches
 
 from tcpcal.origin import solve_xyz4
 

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 import pytest
-from poses import crb_tcp, random_rotations, tilted_rotations
+from support.poses import crb_tcp, random_rotations, tilted_rotations
 from scipy.spatial.transform import Rotation
 from scipy.stats import chi2
 

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from poses import tilted_rotations, touch_positions
+from support.poses import tilted_rotations, touch_positions
 from scipy.spatial.transform import Rotation
 
 from tcpcal.cli import main

@@ -15,7 +15,7 @@ import math
 
 import numpy as np
 import pytest
-from poses import random_tcp, stacked_a, tilted_rotations, touch_positions
+from support.poses import random_tcp, stacked_a, tilted_rotations, touch_positions
 from scipy import stats
 from scipy.spatial.transform import Rotation
 

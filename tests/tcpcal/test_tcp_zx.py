@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from poses import tilted_rotations
+from support.poses import tilted_rotations
 from scipy.optimize import minimize
 from scipy.spatial.transform import Rotation
 

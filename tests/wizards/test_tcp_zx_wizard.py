@@ -3,8 +3,6 @@ auto-touch roles, against the known tool frames of conftest.py (independent geom
 
 from __future__ import annotations
 
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -14,8 +12,7 @@ from tcp_pendant.calibrate.autotouch import auto_touch
 from tcp_pendant.wizards import CalibrationFailedError, TcpZxWizard, Wizard, WizardError
 from tcp_pendant.wizards.truth import compare_with_truth
 
-sys.path.insert(0, str(Path(__file__).parent))
-from test_autotouch import fake  # noqa: E402  (its test double of the controller)
+from support.fake_controller import exact_tool, fake
 
 
 def record_exact(wiz: TcpZxWizard, tool, synth, d_mm: float = 60.0) -> None:
@@ -163,8 +160,6 @@ def test_auto_touch_z_step_out_of_reach_retries_shorter_then_a_new_orientation(s
 
 
 def test_three_point_keeps_its_orientation_and_never_draws_a_new_one(synth) -> None:
-    from test_autotouch import exact_tool
-
     from tcp_pendant.calibrate.autotouch import MIN_RETRY_DISTANCE_MM
     from tcp_pendant.wizards import MIN_DISPLACEMENT_MM, ThreePointWizard
     assert MIN_RETRY_DISTANCE_MM >= MIN_DISPLACEMENT_MM          # a retry is still a valid step

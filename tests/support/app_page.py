@@ -1,25 +1,18 @@
 """One connected browser on an in-process pendant, shared by the app and Calibrate tests: its
-session, client and notifications (``AppPage``), and ``app_pages``, the factory behind each
-test file's ``page`` fixture (a server on port 0 with its library in ``tmp_path``). A test file
+session, client and notifications (``AppPage``, what the ``page`` fixture of
+``support.fixtures`` makes), and helpers that act on a session as a browser would. A test file
 subclasses ``AppPage`` for the views and helpers it needs."""
 
 from __future__ import annotations
 
-import sys
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager
-from pathlib import Path
-from typing import Any, TypeVar
+from typing import Any
 
 import numpy as np
+from tcp_pendant.server import PendantApp
 
-sys.path.insert(0, str(Path(__file__).parents[1] / "calibrate"))
-from guiclick import choose, click  # noqa: E402
-from tcp_pendant.serve.server import AppConfig, PendantApp  # noqa: E402
-from tcpcal.tool import Tool  # noqa: E402
-from wsclient import DrainingClient, wait_until  # noqa: E402
-
-P = TypeVar("P", bound="AppPage")
+from support.guiclick import choose, click
+from support.wsclient import DrainingClient, wait_until
+from tcpcal.tool import Tool
 
 
 def true_tip_at(session: Any, offset_mm: Any) -> None:
@@ -47,6 +40,7 @@ class AppPage:
     """One connected browser: its session, client and the notifications it was shown."""
 
     def __init__(self, app: PendantApp) -> None:
+        self.app = app
         n = len(app.sessions)
         self.ws = DrainingClient(app.port)
         wait_until(lambda: len(app.sessions) > n, what="session built")
@@ -73,47 +67,3 @@ def join_as_the_only_trainee(app: PendantApp, name: str) -> Any:
     click(prompt.start, session.client)
     assert prompt.name == name
     return session
-
-
-@contextmanager
-def running_pendants(tmp_path: Path) -> Iterator[Callable[..., PendantApp]]:
-    """``start(tools=None, **config)``: a pendant in this process on a free port (``AppConfig``
-    options, the library ``tmp_path/tools.json`` holding ``tools`` {slot: Tool}, polled every
-    0.1 s); every one stopped at exit."""
-    apps: list[PendantApp] = []
-
-    def start(tools: dict[int, Tool] | None = None, **config: Any) -> PendantApp:
-        app = PendantApp(AppConfig(port=0, tool_library=tmp_path / "tools.json", library_poll_s=0.1, **config))
-        for slot, tool in (tools or {}).items():
-            app.library.save(slot, tool)
-        app.start()
-        apps.append(app)
-        return app
-
-    try:
-        yield start
-    finally:
-        for a in apps:
-            a.stop()
-
-
-@contextmanager
-def app_pages(tmp_path: Path, page_cls: type[P], *, seed: int | None = None) -> Iterator[Callable[..., P]]:
-    """``make(tools=None, **config)``: start a pendant (:func:`running_pendants`) and connect a
-    ``page_cls`` browser to it; the server started with ``seed`` (``AppConfig.seed``, the
-    ``--seed`` option: every session's randomness), if given. Everything stops at exit."""
-    pages: list[P] = []
-    with running_pendants(tmp_path) as start:
-
-        def make(tools: dict[int, Tool] | None = None, **config: Any) -> P:
-            if seed is not None:
-                config.setdefault("seed", seed)
-            p = page_cls(start(tools, **config))
-            pages.append(p)
-            return p
-
-        try:
-            yield make
-        finally:
-            for p in pages:
-                p.ws.close()

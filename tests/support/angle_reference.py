@@ -1,6 +1,4 @@
-"""Exact angle figures of many touches, the reference of the tests of ``tcpcal._stats.angle_extremes``
-(import as ``from angle_reference import ...``; ``tests/tcpcal/conftest.py`` puts this folder on
-``sys.path``).
+"""Exact angle figures of many touches, the reference of the tests of ``tcpcal._stats.angle_extremes``.
 
 Above ``EXACT_ANGLES_MAX_N`` touches the library estimates both angles from a sample and one
 pass (``tcpcal._stats._angle_extremes_sampled``); :func:`angle_extremes_large` finds them in

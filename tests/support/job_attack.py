@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import asyncio
 import gc
-import sys
 import threading
 import time
 from dataclasses import dataclass
@@ -29,8 +28,7 @@ from tcp_pendant.session import Session
 from tcp_pendant.views.tool_check import check_job
 from tcpcal.tool import Tool
 
-sys.path.insert(0, str(Path(__file__).parents[1] / "app"))
-from wsclient import ButtonClient, wait_until  # noqa: E402
+from support.wsclient import ButtonClient, wait_until
 
 PLUS_X = "X +"
 

@@ -1,15 +1,13 @@
 """One connected browser on an in-process pendant, for the Calibrate-tab tests: the app tests'
-``AppPage`` with its Calibrate view. The ``page`` fixture in ``conftest.py`` makes them."""
+``AppPage`` with its Calibrate view. The ``page`` fixture (``support.fixtures``) makes them in a
+module marked ``pytest.mark.app_page(cls=Page)``."""
 
 from __future__ import annotations
 
-import sys
-from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).parents[1] / "app"))
-from app_page import AppPage  # noqa: E402
-from tcp_pendant.serve.server import PendantApp  # noqa: E402
-from tcp_pendant.views.wizard_menu import CalibrateView  # noqa: E402
+from support.app_page import AppPage
+from tcp_pendant.server import PendantApp
+from tcp_pendant.views.wizard_menu import CalibrateView
 
 
 class Page(AppPage):

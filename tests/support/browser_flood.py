@@ -42,9 +42,7 @@ from tcp_pendant.serve.server import AppConfig, PendantApp
 from tcp_pendant.session import Session
 from tcpcal.tool import Tool
 
-HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE.parent / "app"))
-from wsclient import ButtonClient, ReadoutClient, wait_until  # noqa: E402
+from support.wsclient import ButtonClient, ReadoutClient, wait_until
 
 PLUS_X = "X +"
 ATTACK_BUTTONS = ("Check", "Check active tool", "Auto-touch")

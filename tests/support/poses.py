@@ -1,5 +1,4 @@
-"""Random touch-pose generators for the tcpcal tests (import as ``from poses import ...``;
-``tests/tcpcal/conftest.py`` puts this folder on ``sys.path``).
+"""Random touch-pose generators for the tcpcal tests and ``tests/bench/bench_solver.py``.
 
 Touch poses are built from the forward model (4P-1) ``R_i t + f_i = r (+ noise)``: pick the
 flange rotation ``R_i``, then ``f_i = r - R_i t + eps_i``. Units: whatever the caller uses

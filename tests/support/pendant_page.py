@@ -99,3 +99,18 @@ def assert_not_blank(png: Path, *, min_colors: int = 400) -> None:
     view = img.crop((0, 0, int(w * 0.6), h))
     spread = max(ImageStat.Stat(view).stddev)
     assert spread > 10.0, f"{png.name}: the 3D view is nearly flat (stddev {spread:.1f})"
+
+
+BROWSER_KEY_JS = "localStorage.getItem('tcpPendant.browserKey')"
+"""JavaScript: the browser key the page script keeps for a trainee who joined a class."""
+
+
+def join_class(page: Any, name: str) -> None:
+    """Answer a class's name prompt with ``name`` and wait until the page names the trainee."""
+    welcome = page.get_by_text("Welcome to the TCP Pendant")
+    welcome.wait_for(state="visible", timeout=TIMEOUT_MS)
+    type_text(page, "Your name", name)
+    page.wait_for_timeout(300)             # viser's 50 ms message slot: the name reaches the server first
+    press(page, "Join the class")
+    welcome.wait_for(state="hidden", timeout=TIMEOUT_MS)
+    wait_text(page, f"Trainee: {name}")

@@ -1,5 +1,5 @@
-"""Helpers of the Calibrate-menu tests (a module of its own: ``conftest`` names clash between
-test folders when imported): a controller as the app builds it, the tools' hidden truth."""
+"""Helpers of the Calibrate-menu tests and the others that calibrate: a controller and a session
+as the app builds them, the tools' hidden truth."""
 
 from __future__ import annotations
 

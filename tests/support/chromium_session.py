@@ -1,10 +1,8 @@
 """One chromium (Debian's, driven by Playwright's sync API) per test process.
 
 Playwright's sync API cannot be started twice in one thread while the first is running ("Sync API
-inside the asyncio loop"), so every folder whose conftest has a ``browser`` fixture
-(``tests/browser``, ``tests/security``) takes the browser from here: imported by its plain name
-from ``sys.path``, this module is one object however many conftest copies import it. The last
-fixture to let go closes it.
+inside the asyncio loop"), so the ``browser`` fixture (``support.fixtures``) and any other user
+take the browser from here; the last to let go closes it.
 """
 
 from __future__ import annotations
