@@ -16,10 +16,10 @@ from support.app_page import AppPage
 
 from tcpcal.tool import Tool
 from tcp_pendant.calibrate.workflow import AutoTouchRequest
-from tcp_pendant.cli import SCENARIO_CHOICES, build_parser
+from tcp_pendant.serve.cli import SCENARIO_CHOICES, build_parser
 from tcp_pendant.controller import ControllerError, builtin_tools, reference_tip_model
 from tcp_pendant.controller.scenarios import SCENARIO_KINDS, explain
-from tcp_pendant.server import AppConfig, PendantApp
+from tcp_pendant.serve.server import AppConfig, PendantApp
 from tcp_pendant.session import SessionChange
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.scenario_panel import SCENARIO_CHOICES as PANEL_CHOICES

@@ -18,7 +18,7 @@ from support.guiclick import click
 from support.wsclient import DrainingClient, wait_until
 
 from tcp_pendant.controller import builtin_tools
-from tcp_pendant.server import PendantApp
+from tcp_pendant.serve.server import PendantApp
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.tool_panel import CONTROLLER_FILE_REFUSED
 from tcp_pendant.views.touch_list import TOUCHES_FILENAME, touches_csv_text

@@ -26,7 +26,7 @@ from support.wsclient import ButtonClient, loop_ran_for, wait_until
 
 from tcp_pendant.pendant.guidance import tip_offset_mm
 from tcp_pendant.pendant.jogging import LINEAR_SPEED_MM_S
-from tcp_pendant.server import PendantApp
+from tcp_pendant.serve.server import PendantApp
 from tcp_pendant.views.pendant_panel import HOLD_HZ, MARK
 from tcp_pendant.calibrate.diversity import best_tilt, best_tilt_words
 from tcp_pendant.text_escape import escape_html

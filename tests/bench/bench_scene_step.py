@@ -37,7 +37,7 @@ from typing import Any
 import tcp_pendant.session as session_module
 from tcp_pendant.controller.pose_state import pose_state as new_pose_state
 from tcp_pendant.controller.pose_state import pose_state_key as new_pose_state_key
-from tcp_pendant.server import AppConfig, PendantApp
+from tcp_pendant.serve.server import AppConfig, PendantApp
 
 if __name__ == "__main__":                  # run as a script: tests/ on sys.path (support.*, bench.*)
     import _tests_on_path  # noqa: F401

@@ -48,7 +48,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tcp_pendant.server import AppConfig, PendantApp
+from tcp_pendant.serve.server import AppConfig, PendantApp
 from tcp_pendant.views.pendant_panel import MARK
 from tcp_pendant.views.wizard_dock import FINISH, NEXT
 

@@ -93,7 +93,7 @@ def test_the_browser_key_is_kept_in_local_storage_across_a_reload_and_a_restart(
     and after a server restart on the same gradebook her page joins by itself as Anna: the
     script sends the key back. The server runs in this process (the same port after the
     restart: localStorage belongs to the page's origin)."""
-    from tcp_pendant.server import PendantApp
+    from tcp_pendant.serve.server import PendantApp
 
     db = tmp_path / "class.sqlite3"
 
@@ -133,7 +133,7 @@ def test_the_browser_key_is_kept_in_local_storage_across_a_reload_and_a_restart(
     named = _wait(lambda: [s for s in app.sessions.values() if "identity" in s.views
                            and s.views["identity"].name == "Anna"], "Anna named after the restart")
     assert named[0].controller.mounted_tool.key == tool_key          # the class's seed survived
-    with app.gradebook._read() as book:
+    with app.gradebook.store.read() as book:
         assert book.execute("SELECT COUNT(*) FROM trainees").fetchone()[0] == 1
         assert book.execute("SELECT COUNT(*) FROM sessions").fetchone()[0] == 3
 

@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 from tcp_pendant.pendant.hold import DEADMAN_S
-from tcp_pendant.server import PendantApp
+from tcp_pendant.serve.server import PendantApp
 
 from support.chromium_session import with_render_scale
 from support.pendant_page import TIMEOUT_MS, assert_not_blank, field, type_text, wait_text, wait_until

@@ -162,7 +162,7 @@ def test_hide_truth_always_outlasts_an_exercise(tmp_path: Path) -> None:
 
 
 def test_the_hide_truth_option_reaches_every_session(app_factory) -> None:
-    from tcp_pendant.cli import build_parser
+    from tcp_pendant.serve.cli import build_parser
 
     assert build_parser().parse_args(["--hide-truth"]).hide_truth is True
     assert build_parser().parse_args([]).hide_truth is False

@@ -4,15 +4,12 @@ geometries) raises no DeprecationWarning through us (``tcp_pendant.views.meshes`
 
 from __future__ import annotations
 
-import sys
 import warnings
 from pathlib import Path
 
+from support.ros_layouts import acme7_workspace
 from tcp_pendant.controller.description import load_description
 from tcp_pendant.views.meshes import link_meshes
-
-sys.path.insert(0, str(Path(__file__).parent))
-from ros_layouts import acme7_workspace  # noqa: E402
 
 
 def test_drawing_a_xacro_robot_raises_no_deprecation_warning(tmp_path: Path, monkeypatch) -> None:

@@ -26,7 +26,7 @@ from tcp_pendant.calibrate.text import (
 )
 from tcp_pendant.pendant.formatting import tcp_readout_markdown, tool_data_markdown
 from tcp_pendant.pendant.tool_entry import ToolEntry, entry_preview_markdown
-from tcp_pendant.server import PendantApp
+from tcp_pendant.serve.server import PendantApp
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.wizards import ThreePointWizard
 from tcp_pendant.wizards.session_record import dumps, load_and_replay

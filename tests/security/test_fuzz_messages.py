@@ -14,7 +14,7 @@ from typing import Any
 
 import msgspec.msgpack
 import pytest
-from tcp_pendant.server import PendantApp
+from tcp_pendant.serve.server import PendantApp
 from tcp_pendant.views.viser_adapter import LOG_BUDGET, LOG_VALUE_CHARS, message_counts
 
 from support.wsclient import CAMERA, InputsClient, click_until_carried_out, wait_until

@@ -178,8 +178,8 @@ def test_a_hostile_trainee_reads_no_number_of_the_true_tcp(tmp_path: Path, app_f
             click(cal.steps.record, s.client)
         click(cal.steps.next, s.client)                           # Finish
         assert s.workflow.result is not None, s.workflow.finish_failure
-        (row,) = app.gradebook.grades(include_in_progress=True)   # the truth, as the gradebook keeps it
-        distances = [t["distance_mm"] for t in app.gradebook.touches(row.calibration_id)]
+        (row,) = app.gradebook.grades.rows(include_in_progress=True)   # the truth, as the gradebook keeps it
+        distances = [t["distance_mm"] for t in app.gradebook.records.touches(row.calibration_id)]
         assert len(distances) == 4 and min(distances) < 3.0 < 150.0 < max(distances)
         assert s.workflow.run.distance_mm == {}                   # nothing of it in the trainee's run
         click(cal.export, s.client)                               # Export session (JSON)
@@ -189,7 +189,7 @@ def test_a_hostile_trainee_reads_no_number_of_the_true_tcp(tmp_path: Path, app_f
         choose(tools.entry_name, marker, s.client)
         wait_until(lambda: any(marker in str(m) for m in list(c.messages)), what="every message sent")
 
-        T_ft = np.array(app.gradebook.truth(row.calibration_id)["T_flange_tool_true_m"], dtype=float)
+        T_ft = np.array(app.gradebook.records.truth(row.calibration_id)["T_flange_tool_true_m"], dtype=float)
         np.testing.assert_allclose(T_ft, s.controller.mounted_tool.T_flange_tool_true, atol=1e-12)
     finally:
         c.close()

@@ -15,7 +15,7 @@ from support.app_page import join_as_the_only_trainee
 from support.guiclick import choose, click
 from support.wsclient import InputsClient, wait_until
 
-from tcp_pendant.pendant.exercise_rules import TOOL_LOCKED_WORDS
+from tcp_pendant.calibrate.pendant_rules import TOOL_LOCKED_WORDS
 from tcp_pendant.views.tool_panel import TOOL_LOCKED_LINE
 
 TOKEN = "trainer-token-toollock-01"
@@ -83,7 +83,7 @@ def test_the_mystery_tool_cannot_be_swapped_for_the_pointer_over_the_websocket(t
         assert cal.workflow.result is not None
         assert s.controller.mounted_tool is mystery
 
-        (row,) = app.gradebook.grades()
+        (row,) = app.gradebook.grades.rows()
         assert (row.method, row.tool_key, row.exercise_id) == ("xyz4", mystery.key, "mystery")
     finally:
         c.ws.close()

@@ -24,8 +24,8 @@ from tcp_pendant.classroom.trainer_token import (
     locked,
     resolve_trainer_token,
 )
-from tcp_pendant.cli import main
-from tcp_pendant.server import PendantApp
+from tcp_pendant.serve.cli import main
+from tcp_pendant.serve.server import PendantApp
 
 from support.wsclient import InputsClient, wait_until
 

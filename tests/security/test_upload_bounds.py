@@ -12,11 +12,11 @@ from collections.abc import Callable, Iterator
 from typing import Any
 
 import pytest
-from tcp_pendant.server import PendantApp
+from tcp_pendant.serve.server import PendantApp
 from tcp_pendant.views import viser_adapter
 from tcp_pendant.views.viser_adapter import UploadLimits
 
-from support.wsclient import InputsClient, wait_until
+from support.wsclient import CAMERA, InputsClient, wait_until
 
 LOAD = "Load session (JSON)"
 MB = 1_000_000
@@ -54,17 +54,14 @@ def _part(c: InputsClient, tid: str, index: int, content: bytes) -> None:
 
 
 def _handled(app: PendantApp, c: InputsClient) -> None:
-    """Wait until the server handled everything ``c`` sent so far: a jog click behind it moved
-    the robot, or the deadman dropped it as read too late (behind megabytes of uploads on a busy
-    machine); either way it was read after the rest."""
-    moves: list[int] = []
+    """Wait until the server handled everything ``c`` sent so far: a camera message behind it
+    (viser handles one socket's messages in order; a jog click would not do: the deadman drops a
+    press that waited behind megabytes of parts, ``views.arrival``)."""
     button = c.uuid_of("X +")
-    session = next(s for s in app.sessions.values() if button in s.client.gui._gui_input_handle_from_uuid)
-    session.add_motion_listener(lambda: moves.append(1))
-    dropped = session.jogger.gate.dropped_total
-    c.send({"type": "GuiUpdateMessage", "uuid": c.uuid_of("X +"), "updates": {"value": True}})
-    wait_until(lambda: len(moves) > 0 or session.jogger.gate.dropped_total > dropped,
-               what="the click behind the uploads")
+    handle = next(s.client for s in app.sessions.values() if button in s.client.gui._gui_input_handle_from_uuid)
+    before = handle.camera._state
+    c.send(CAMERA)
+    wait_until(lambda: handle.camera._state is not before, what="the camera message behind the uploads")
 
 
 def _held(app: PendantApp) -> dict[str, int]:

@@ -8,7 +8,7 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from tcp_pendant.server import PendantApp
+from tcp_pendant.serve.server import PendantApp
 
 from support.guiclick import choose, click
 from support.wsclient import DrainingClient, wait_until

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 
 from support.app_page import AppPage
-from tcp_pendant.server import PendantApp
+from tcp_pendant.serve.server import PendantApp
 from tcp_pendant.views.wizard_menu import CalibrateView
 
 

@@ -36,7 +36,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from tcp_pendant.server import AppConfig, PendantApp
+from tcp_pendant.serve.server import AppConfig, PendantApp
 
 from support import chromium_session, server_process
 from support.app_page import AppPage
