@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# Set up everything the test suite needs on a fresh machine, type-check the code (mypy), then run
-# the tests.
-#   bash scripts/run-tests.sh            # mypy, then the whole suite (unit, property, CLI, browser)
-#   bash scripts/run-tests.sh --quick    # mypy, then all but the tests marked slow: while working
+# Set up everything the test suite needs on a fresh machine, type-check the code (mypy), check
+# the import layers (lint-imports), build the documentation site (mkdocs build --strict), then
+# run the tests.
+#   bash scripts/run-tests.sh            # the checks, then the whole suite (unit, property, CLI, browser)
+#   bash scripts/run-tests.sh --quick    # the checks, then all but the tests marked slow: while working
 #   bash scripts/run-tests.sh -m browser # only the browser end-to-end tests
 # The browser tests drive Debian's chromium (Playwright cannot download its own browser here):
 # when it is missing it is installed with apt-get as root (or through sudo). A user who can do
