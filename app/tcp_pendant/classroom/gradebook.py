@@ -73,8 +73,10 @@ class Gradebook:
     Attributes:
         path: the SQLite file, or None for PostgreSQL.
         location: what messages name: the file's path, or the URL with its password masked.
-        store, trainees, records, run_states, grades, board, settings, presence, pushes,
-            messages, token_failures: the parts (module docstring).
+
+    Its parts (module docstring) are the attributes ``store``, ``trainees``, ``records``,
+    ``run_states``, ``grades``, ``board``, ``settings``, ``presence``, ``pushes``, ``messages`` and
+    ``token_failures``.
 
     Raises:
         GradebookError: the file is not an SQLite database, is damaged, is another program's
