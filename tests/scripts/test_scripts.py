@@ -284,13 +284,16 @@ def test_run_tests_without_arguments_runs_the_parallel_tests_then_the_serial_one
 
 
 def test_run_tests_quick_runs_both_parts_without_the_slow_tests(stamped: Path) -> None:
-    """``--quick``, the lane to run while working: mypy, then the same two runs as the README's
-    command without the tests marked slow; arguments after it go to both runs."""
+    """``--quick``, the lane to run while working: the same checks (mypy, the layers, the site),
+    then the same two runs as the README's command without the tests marked slow; arguments
+    after it go to both runs."""
     (stamped.parent / "bin" / "chromium").symlink_to(shutil.which("true") or "/bin/true")
     p = run(stamped, "run-tests.sh", "--quick")
     assert p.returncode == 0, p.stderr
-    assert [c for c in calls(stamped) if c.startswith("python")] == [
-        "python [-m] [mypy]",
+    checks = [c for c in calls(stamped) if c.startswith(("python", "lint-imports"))]
+    assert checks[:2] == ["python [-m] [mypy]", "lint-imports [--no-logo]"]
+    assert checks[2].startswith("python [-m] [mkdocs] [build] [--strict]")
+    assert checks[3:] == [
         "python [-m] [pytest] [-n] [2] [--durations=25] [-m] [not slow and not serial]",
         "python [-m] [pytest] [--durations=25] [-m] [not slow and serial]"]
     assert p.stderr == ""
