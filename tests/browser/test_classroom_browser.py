@@ -105,7 +105,7 @@ def test_the_browser_key_is_kept_in_local_storage_across_a_reload_and_a_restart(
     join_class(anna, "Anna")
     anna.wait_for_function(f"/^[A-Za-z0-9_-]{{43}}$/.test({BROWSER_KEY_JS} || '')", timeout=TIMEOUT_MS)
     key = anna.evaluate(BROWSER_KEY_JS)
-    assert app.gradebook.holds_key("Anna", key)
+    assert app.gradebook.trainees.holds_key("Anna", key)
     tool_key = next(s for s in app.sessions.values() if "identity" in s.views
                     and s.views["identity"].name == "Anna").controller.mounted_tool.key
     # another browser: refused in words while Anna is connected; it has no key in its storage
