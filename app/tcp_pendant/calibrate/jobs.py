@@ -229,7 +229,7 @@ def spin_clearance(workflow: CalibrationWorkflow, wizard: Wizard) -> Callable[[]
     Auto-touch's approach left the robot, it takes the probe of that pose: the check's
     rotations on its own copy of the controller's model from the joints now (0.05-0.3 s; the
     controller is not moved), which names the rotations that cannot be made; detached, so the
-    app runs it in its job pool (``Session.auto_touch_in_pool``)."""
+    app runs it in its job pool (``WizardCommands.auto_touch_in_pool``)."""
     check = cast(TcpCheckWizard, wizard)          # the class that names this job ("spin_check")
     c = workflow.controller
 

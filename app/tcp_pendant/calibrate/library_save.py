@@ -3,7 +3,7 @@
 The file I/O of saving lives here, in ``calibrate/``, not in the wizards (state machines that
 only compute): :func:`save_result` picks the slot and writes one atomic ``ToolLibrary.save``.
 It never sets the library's active slot: which tool is active is the session's (the app's
-``Session.apply_saved``; in ``--shared`` mode that also sets the library's active slot).
+``SessionTools.apply_saved``; in ``--shared`` mode that also sets the library's active slot).
 """
 
 from __future__ import annotations

@@ -1,13 +1,13 @@
 """What one pendant may do: its exercise's rules and its library rights, as data with their
 checks (no viser).
 
-These are the types the session holds (``Session.rules``, ``Session.library_rights``) and
+These are the types the session holds (``Session.rules``, ``SessionTools.library_rights``) and
 the calibration workflow obeys (Finish, Auto-touch, the tool a run measures, Save to the
 library); they sit here, in the lowest layer that enforces them, so that neither the workflow
 nor the session imports the classroom. Their values are the class's: the classroom decides
 them and hands them to each session (``classroom.exercise_rules.class_rules``,
 ``classroom.library_rights.trainee_rights``; ``Session.set_rules``,
-``Session.set_library_rights``). Without a class a pendant has :data:`FREE_PRACTICE` and
+``SessionTools.set_library_rights``). Without a class a pendant has :data:`FREE_PRACTICE` and
 :data:`UNRESTRICTED`.
 
 :class:`ExerciseRules`: the session's commands refuse what the exercise forbids, in words,
@@ -21,17 +21,17 @@ whatever a browser sends (a disabled checkbox is only the polite half):
 * ``instructions``: the trainer's words for the exercise (plain text; a banner on the trainee's
   panel shows them, escaped);
 * ``allowed_methods``: the calibration methods (wizard kinds) the trainee may start (None: all);
-  the Calibrate menu offers only those and ``Session.start_wizard`` refuses the others in words;
+  the Calibrate menu offers only those and ``WizardCommands.start`` refuses the others in words;
 * ``min_touches``: the fewest touches a Finish takes (0: the method's own minimum). It applies
   to the methods whose touch count the trainee chooses (an ``n_points`` start option or Add
   point: XYZ 4-point, TCP & Z, X); a method with a fixed number of poses (three-point, ABC
   world, XYZ reference, the checks) keeps its own count.
 
-The exercise's tool (``Session.set_exercise_tool``, the classroom's mystery tool of each trainee)
+The exercise's tool (``SessionTools.set_exercise_tool``, the classroom's mystery tool of each trainee)
 is not a class-wide rule: each trainee has their own. While one is held, "Mounted tool" is locked
 to it (:func:`check_tool_change` refuses another in words), a calibration may only measure it
 (:func:`check_calibrated_tool`), and the one exception is a wizard step's own tool change: the XYZ
-reference method touches first with its known reference tool (``Session.mount_required_tool``),
+reference method touches first with its known reference tool (``WizardCommands.mount_required_tool``),
 and the exercise's tool is mounted again when that run ends or is cancelled.
 
 :class:`LibraryRights`: who a pendant may change the shared tool library as. A class pendant

@@ -39,7 +39,7 @@ Each trainee's pendant follows the class's :class:`~tcp_pendant.calibrate.pendan
 is off unless the trainer unlocked or allowed them (``class_rules``); a change of exercise goes
 back to those defaults unless the same push sets them.
 
-Each pendant's library rights (``classroom.library_rights``, ``Session.set_library_rights``):
+Each pendant's library rights (``classroom.library_rights``, ``SessionTools.set_library_rights``):
 before a name it changes no library slot; a named trainee saves into free slots and their own,
 renames and deletes only their own, within ``library_quota`` slots (the owner, the name, is
 kept in the library file); the browser that opened the trainer view changes every slot.
@@ -78,7 +78,7 @@ push of the trainer's settings is kept in order (``Gradebook.pushes.add``) and a
 other processes at their next beat. A reconnect landing on another process gets the
 calibrations in progress back from the gradebook (``classroom.restore``), like a restart.
 
-Threads: the session callbacks run on viser's event loop (``Session.on_loop``); connects and
+Threads: the session callbacks run on viser's event loop (``SessionLoop.on_loop``); connects and
 disconnects come from viser's thread pool and hand their trainer-view refresh to the loop
 (``hand_to_loop``). The class's own lists are guarded by one lock.
 """
@@ -316,7 +316,7 @@ class ClassRoom:
         session.views["identity"] = prompt
         with self._lock:
             self._prompts[id(session)] = prompt
-        session.set_library_rights(self._library_rights(session, None))   # no change before a name
+        session.tools.set_library_rights(self._library_rights(session, None))   # no change before a name
         session.on_close(lambda: self.detach(session))
         return prompt
 
@@ -382,7 +382,7 @@ class ClassRoom:
     def _start(self, session: Session, join: TraineeJoin) -> TraineeRecorder:
         with session.lock:
             sid = self.gradebook.records.start_session(join.trainee_id, "per-browser")
-            session.keep_honest_records()             # the trainee's export carries no answer key
+            session.wizard_commands.keep_honest_records()             # the trainee's export carries no answer key
             recorder = TraineeRecorder(self.gradebook, sid, join.name, session.workflow,
                                        exercise_id=self.exercise)
             # claimed before the name is in the table the heartbeat reads: a beat never sees a
@@ -399,8 +399,8 @@ class ClassRoom:
                 self._handed[id(session)] = set(self._on_screen[id(session)])
             if follow:
                 session.subscribe(lambda change: self._on_change(session, change))
-            session.set_hide_truth(self.exercise is not None)
-            session.set_library_rights(self._library_rights(session, join.name))
+            session.wizard_commands.set_hide_truth(self.exercise is not None)
+            session.tools.set_library_rights(self._library_rights(session, join.name))
             if self.exercise == "mystery":
                 self._mount_mystery(session, recorder, join.name)
             self._apply_rules(session)
@@ -438,10 +438,10 @@ class ClassRoom:
                 return
             self._trainees.pop(id(session), None)
         self._drop_presence(name)
-        session.library_rights = self._library_rights(session, None)  # at once: it changes nothing more
-        self._hand_to_loop(session.guard(lambda: session.set_library_rights(session.library_rights)))
+        session.tools.library_rights = self._library_rights(session, None)  # at once: it changes nothing more
+        self._hand_to_loop(session.loop.guard(lambda: session.tools.set_library_rights(session.tools.library_rights)))
         if prompt is not None:         # on the loop, after this callback: no two sessions' locks at once
-            self._hand_to_loop(session.guard(lambda: prompt.reopen(message, forget=forget)))
+            self._hand_to_loop(session.loop.guard(lambda: prompt.reopen(message, forget=forget)))
 
     def release(self, name: str) -> str:
         """The trainer releases ``name``: the gradebook forgets its browser key and a browser
@@ -475,7 +475,7 @@ class ClassRoom:
         restored = runs_to_restore(self.gradebook, name)
         if not restored:
             return
-        indices = session.restore_runs([r.run for r in restored])
+        indices = session.wizard_commands.restore_runs([r.run for r in restored])
         for index, r in zip(indices, restored):
             recorder.adopt(index, r.calibration_id, r.touch_ids)
         n = len(restored)
@@ -486,8 +486,8 @@ class ClassRoom:
         base = self.tools.get("pointer") or next(iter(self.tools.values()))
         tool = draw_mystery_tool(self._seed(), name, base)
         recorder.exercise_id = "mystery"
-        session.add_physical_tool(tool)              # its label in the wizard's tool-change words
-        session.set_exercise_tool(tool)              # mounted, and "Mounted tool" locked to it
+        session.wizard_commands.add_physical_tool(tool)              # its label in the wizard's tool-change words
+        session.tools.set_exercise_tool(tool)              # mounted, and "Mounted tool" locked to it
 
     def detach(self, session: Session) -> None:
         """The session closed (its browser left)."""
@@ -669,7 +669,7 @@ class ClassRoom:
         with self._lock:
             self._trainer_views[id(session)] = view
         self._schedule_tick()
-        session.set_library_rights(UNRESTRICTED)        # the trainer renames and deletes every slot
+        session.tools.set_library_rights(UNRESTRICTED)        # the trainer renames and deletes every slot
         return True
 
     def refresh_trainers(self) -> None:
@@ -707,7 +707,7 @@ class ClassRoom:
             return
         for view in views:
             try:
-                view.session.guard(view.render)(board, connected)
+                view.session.loop.guard(view.render)(board, connected)
             except Exception:
                 log.exception("trainer dashboard refresh failed")
         self._schedule_tick()
@@ -748,7 +748,7 @@ class ClassRoom:
             return isinstance(name, str) and name in self._remote
 
     def reset_wizard(self, name: str, *, forward: bool = True) -> str:
-        """Cancel the running wizard of the trainee ``name`` (``Session.cancel_wizard`` on their
+        """Cancel the running wizard of the trainee ``name`` (``WizardCommands.cancel`` on their
         session only; kept, resumable; the gradebook records the cancel) and tell them. Returns
         what happened, in words for the trainer (plain text). A trainee connected on another
         server process of the class gets it there at its next beat (``forward``; False: a
@@ -765,11 +765,11 @@ class ClassRoom:
 
         def cancel() -> None:
             if session.workflow.is_open:
-                session.cancel_wizard()
+                session.wizard_commands.cancel()
                 session.notify("The trainer reset your calibration",
                                "Your trainer closed the wizard; start it again (your touches are kept: "
                                "Resume brings them back).", kind="warning")
-        self._hand_to_loop(session.guard(cancel))   # after the trainer's callback: one session's lock at a time
+        self._hand_to_loop(session.loop.guard(cancel))   # after the trainer's callback: one session's lock at a time
         return f"Reset {name}'s running wizard."
 
     def push_to(self, name: str, exercise: str | None | bool = False, tool_key: str | None = None,
@@ -800,13 +800,13 @@ class ClassRoom:
             with session.batch():
                 if exercise is not False:
                     recorder.exercise_id = ex
-                    session.set_hide_truth(ex is not None)
+                    session.wizard_commands.set_hide_truth(ex is not None)
                     if ex == "mystery":
                         self._mount_mystery(session, recorder, who)
                     else:
-                        session.set_exercise_tool(None)     # free practice: the trainee swaps tools again
+                        session.tools.set_exercise_tool(None)     # free practice: the trainee swaps tools again
                 if tool_key is not None and ex != "mystery":
-                    session.mount_tool(self.tools[tool_key])
+                    session.tools.mount_tool(self.tools[tool_key])
                 if not rules.distance_locked:
                     session.set_rules(rules)
                 if hide_distance is not None:
@@ -815,7 +815,7 @@ class ClassRoom:
                     session.set_hide_distance(True)
                 session.set_rules(rules)
                 session.changed(wizard=True)
-        self._hand_to_loop(session.guard(apply))
+        self._hand_to_loop(session.loop.guard(apply))
         return f"Pushed to {who}."
 
     def trainee_statuses(self) -> list[TraineeStatus]:
@@ -933,16 +933,16 @@ class ClassRoom:
             def apply(session: Session = session, recorder: TraineeRecorder = recorder, name: str = name) -> None:
                 with session.batch():
                     recorder.exercise_id = exercise
-                    session.set_hide_truth(exercise is not None)
+                    session.wizard_commands.set_hide_truth(exercise is not None)
                     if exercise == "mystery":
                         self._mount_mystery(session, recorder, name)
                     else:
-                        session.set_exercise_tool(None)     # free practice: the trainee swaps tools again
+                        session.tools.set_exercise_tool(None)     # free practice: the trainee swaps tools again
                         if tool_key is not None:
-                            session.mount_tool(self.tools[tool_key])
+                            session.tools.mount_tool(self.tools[tool_key])
                     self._apply_rules(session, aids_too=new_exercise or aids is not None)
                     session.changed(wizard=True)      # the result panel shows or hides the truth
-            session.guard(apply)()
+            session.loop.guard(apply)()
         return len(trainees)
 
     def push_brief(self, instructions: str, allowed_methods: Sequence[str] | str | None,
@@ -970,7 +970,7 @@ class ClassRoom:
         with self._lock:
             trainees = list(self._trainees.values())
         for session, _recorder, _name in trainees:
-            session.guard(session.set_rules)(rules)
+            session.loop.guard(session.set_rules)(rules)
         return len(trainees)
 
     # ------------------------------------------------------------ messages
@@ -1052,7 +1052,7 @@ class ClassRoom:
                 handed &= {row[0] for row in rows}
                 handed.update(m.message_id for m in new)
             if new:
-                self._hand_to_loop(session.guard(functools.partial(self._show, session, new)))
+                self._hand_to_loop(session.loop.guard(functools.partial(self._show, session, new)))
 
     @staticmethod
     def _show(session: Session, messages: list[ClassMessage]) -> None:

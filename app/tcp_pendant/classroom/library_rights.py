@@ -13,7 +13,7 @@ unrestricted.
 
 The classroom makes each pendant's rights here (:func:`trainee_rights`, or
 ``calibrate.pendant_rules.UNRESTRICTED``) and gives them to the session
-(``Session.set_library_rights``); ``calibrate.pendant_rules.LibraryRights`` checks them and
+(``SessionTools.set_library_rights``); ``calibrate.pendant_rules.LibraryRights`` checks them and
 words the refusals.
 """
 

@@ -7,7 +7,7 @@ Per-browser: ``on_client_connect`` builds a session in the client's own scene an
 cycles). All sessions share the robot's pinocchio *model* (read-only) but each has its own
 pinocchio *data*, so sessions never race in FK. The tool library is shared (one
 ``tcpcal.ToolLibrary``); a watcher thread notices when its file changes and every session
-re-reads it (``Session.reload_library``, on viser's event loop) so it sees tools saved by others.
+re-reads it (``SessionTools.reload_library``, on viser's event loop) so it sees tools saved by others.
 
 Start tool: a per-browser session starts with no active tool (TCP = flange), whatever other
 trainees activated or saved; the ``--shared`` session starts with the library's active slot
@@ -433,20 +433,20 @@ class PendantApp:
         workflow = CalibrationWorkflow(c, self.library, robot=self.robot_key, rng=rng)
         session = Session(c, self.library, workflow, client=client, target=target, ready_q_rad=self.ready_q_rad,
                           shared=shared, rng=rng, jobs=self.jobs)
-        session.reload_library()
+        session.tools.reload_library()
         if shared:
             try:
                 slot = self.library.active_slot()
             except Exception:  # an unreadable library must not keep the pendant from starting
                 log.exception("tool library unreadable")
                 slot = None
-            tool = None if slot is None else session.library_tools.get(slot)
+            tool = None if slot is None else session.tools.library_tools.get(slot)
             if tool is not None:
-                session.set_active_data(tool, slot)
+                session.tools.set_active_data(tool, slot)
         if self.config.scenario != "off":
             session.set_scenario(self.config.scenario, self.config.scenario_seed)
         if self.config.hide_truth:
-            session.set_hide_truth(True, always=True)
+            session.wizard_commands.set_hide_truth(True, always=True)
         try:
             for _ in session_view_steps(session, title=f"TCP Pendant · {self.robot_label}"):
                 yield None
@@ -585,7 +585,7 @@ class PendantApp:
         """Every session re-reads the library (on viser's event loop: the watcher hands it
         over); their views re-render on the change signal."""
         for s in self.all_sessions():
-            s.guard(s.reload_library)()
+            s.loop.guard(s.tools.reload_library)()
 
     # ------------------------------------------------------------ life cycle
     def start(self) -> str:

@@ -9,11 +9,11 @@ check" above) verifies it.
 Check: the job (``calibrate.beam_service.beam_check_job``: a snapshot of the robot model, the
 joints, the sensor, the active tool data and its slot, the physical tool) is taken on viser's
 event loop under the session lock; the scan (a few hundred milliseconds of geometry and two
-solves) runs in the server's job pool (``Session.run_job``); its result is shown on the loop and the scan is replayed
+solves) runs in the server's job pool (``SessionLoop.run_job``); its result is shown on the loop and the scan is replayed
 in the scene (``views.beam_replay``), the robot going back to where it was, the camera turned
 to the sensor. One check at a
 time per session. Update: ``beam_service.update_tool_from_beam`` (it refuses when the slot
-changed since the check), then ``Session.apply_saved`` (the library re-read, the updated tool
+changed since the check), then ``SessionTools.apply_saved`` (the library re-read, the updated tool
 the active data); refused when the active tool is no longer the one checked. Tool names reach
 the markdown escaped (``beam_check_markdown`` escapes its own), notifications as plain text.
 """
@@ -89,7 +89,7 @@ class BeamCheckView:
         self.framing: Framing | None = None
         """The camera framing of the last check's scan (None before one), for tests."""
         self.check.on_click(self._on_check)
-        g = session.on_loop
+        g = session.loop.on_loop
         self.update.on_click(g(self._on_update))
         self.replay.on_click(g(self._on_replay))
         session.subscribe(self.on_change)
@@ -103,7 +103,7 @@ class BeamCheckView:
         chk = self.last_check
         s = self.session
         tool = s.controller.active_tool
-        return chk is not None and tool is not None and s.active_slot == chk.slot and tool == chk.stored_tool
+        return chk is not None and tool is not None and s.tools.active_slot == chk.slot and tool == chk.stored_tool
 
     def _render_buttons(self) -> None:
         self.check.disabled = self._checking
@@ -122,7 +122,7 @@ class BeamCheckView:
     async def run_check(self) -> None:
         """The check of the active tool: job on the loop, scan in the worker, result on the loop;
         refused at once while this session's job runs or its share is used up
-        (``Session.admit_job``)."""
+        (``SessionLoop.admit_job``)."""
         s = self.session
         if s.closed:
             return
@@ -130,7 +130,7 @@ class BeamCheckView:
             s.notify_refusal("Check running", "A beam check is still running here; wait for its result.")
             return
         try:                               # refused at once, before the loop takes the job
-            s.admit_job()
+            s.loop.admit_job()
         except JobRefused as exc:
             s.notify_refusal("Beam check not started", str(exc))
             return
@@ -146,7 +146,7 @@ class BeamCheckView:
                 if not (player.playing and player.owner is self):   # a check during our film: back to
                     self._q_before = s.controller.q_rad             # where the first one started
                 player.stop()                                       # the robot stays where the job sees it
-                job = beam_check_job(s.controller, s.active_slot, tool, rng_seed=int(s.rng.integers(2**31)))
+                job = beam_check_job(s.controller, s.tools.active_slot, tool, rng_seed=int(s.rng.integers(2**31)))
                 self._checking = True
                 self.result_md.content = f"Scanning **{escape_markdown(tool.name)}** with the beam sensor ..."
                 self._render_buttons()
@@ -154,7 +154,7 @@ class BeamCheckView:
             s.notify("Not done", str(exc), kind="warning")
             return
         try:
-            check = await s.run_job(job.run, what="a beam check")
+            check = await s.loop.run_job(job.run, what="a beam check")
         except JobRefused as exc:          # another job of this session, or a full queue: nothing ran
             self._failed("Beam check not started", str(exc), kind="warning")
             return
@@ -208,9 +208,9 @@ class BeamCheckView:
             raise ValueError("The active tool changed since the check; check the active tool again before "
                              "Update.")
         before = check.stored_tool
-        tool = update_tool_from_beam(s.library, check.slot, check, s.library_rights)
+        tool = update_tool_from_beam(s.library, check.slot, check, s.tools.library_rights)
         self.last_check = None
-        s.apply_saved(check.slot, tool)                    # one signal: library re-read, active data
+        s.tools.apply_saved(check.slot, tool)                    # one signal: library re-read, active data
         self.result_md.content = beam_check_markdown(check) + "\n\n" + update_markdown(check.slot, before, tool)
         self._render_buttons()
         s.notify("TCP updated", f"Slot {check.slot}: {tool.name} now has the TCP the beam measured.",

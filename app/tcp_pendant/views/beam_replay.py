@@ -357,7 +357,7 @@ class ScanPlayer:
     def _apply(self, i: int) -> None:
         frame = self.frames[i]
         s = self.session
-        s.set_joints(frame.q_rad, status=False)
+        s.motion.set_joints(frame.q_rad, status=False)
         self._last_q = s.controller.q_rad
         self.frames_played = i + 1
         self._show(frame.broken_event, frame.shown)

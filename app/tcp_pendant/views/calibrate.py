@@ -17,6 +17,5 @@ __all__ = ["build_calibrate_tab"]
 def build_calibrate_tab(session: Session, tab: Any, player: ScanPlayer) -> CalibrateView:
     """Fill the Calibrate tab (``tab``: a viser tab handle) with the wizards' views of
     ``session.workflow``; ``player``: the session's scan film (the beam result replays its scan)."""
-    session.calibrate_container = tab
     with tab:
         return CalibrateView(session, player)

@@ -11,7 +11,7 @@ trainer's messages, pinned at the top of the panel.
 
 Both texts are the trainer's browser's (a stranger's): every line goes through
 ``text_escape.escape_markdown_lines``. The view renders from the session's state on its
-``notice`` signal; the only command it sends is Dismiss (``Session.on_loop``).
+``notice`` signal; the only command it sends is Dismiss (``SessionLoop.on_loop``).
 """
 
 from __future__ import annotations
@@ -59,7 +59,7 @@ class ClassNoticeView:
         self.dismiss = gui.add_button("Dismiss", order=BANNER_ORDER + 2, visible=False,
                                       hint="The message goes; the next one, if any, shows.")
         self.shown: ClassMessage | None = None
-        self.dismiss.on_click(session.on_loop(self._on_dismiss))
+        self.dismiss.on_click(session.loop.on_loop(self._on_dismiss))
         session.subscribe(self.on_change)
         self.render()
 

@@ -24,7 +24,7 @@ is widened to the whole window (viser's ``main_panel.set_width``; 1024x768 proje
 The data: the gradebook (``ClassRoom.board``) plus who is connected (``ClassRoom.connected_names``);
 the class room re-renders every dashboard, throttled (``ClassRoom.refresh_trainers``). Every
 text a trainee typed is escaped (``escape_html`` in the tables, ``escape_markdown`` in
-markdown); every callback runs through ``Session.on_loop``.
+markdown); every callback runs through ``SessionLoop.on_loop``.
 """
 
 from __future__ import annotations
@@ -296,7 +296,7 @@ class TrainerDashboard:
         try:
             check_record_size(len(upload.content))
             data, book = bytes(upload.content), self.control.gradebook
-            grades = await self.session.run_job(lambda: grade_record(load_and_replay(data), book),
+            grades = await self.session.loop.run_job(lambda: grade_record(load_and_replay(data), book),
                                                 what="a record's grading")
         except (SessionRecordError, JobRefused) as exc:
             self.session.notify("Record not graded", f"{name}: {exc}", kind="warning")
@@ -307,7 +307,7 @@ class TrainerDashboard:
             return
         finally:
             self._grading = False
-        self.session.guard(lambda: setattr(self.grade_md, "content", record_grades_markdown(name, grades)))()
+        self.session.loop.guard(lambda: setattr(self.grade_md, "content", record_grades_markdown(name, grades)))()
 
 
 # ---------------------------------------------------------------- the folders
@@ -321,7 +321,7 @@ def class_folder(dash: TrainerDashboard) -> None:
         dash.table_html = gui.add_html("")
         gui.add_markdown("**Calibrations in progress**")
         dash.runs_html = gui.add_html("")
-    dash.stuck_min.on_update(dash.session.on_loop(lambda _e=None: dash.render()))
+    dash.stuck_min.on_update(dash.session.loop.on_loop(lambda _e=None: dash.render()))
 
 
 def chart_folder(dash: TrainerDashboard) -> None:
@@ -341,7 +341,7 @@ def chart_folder(dash: TrainerDashboard) -> None:
 
 def trainee_folder(dash: TrainerDashboard) -> None:
     """Choose a trainee; reset, push to, release, replay."""
-    gui, on_loop = dash.gui, dash.session.on_loop
+    gui, on_loop = dash.gui, dash.session.loop.on_loop
     with dash.folder("Trainee"):
         dash.trainee = gui.add_dropdown("Trainee", (NO_TRAINEE,), initial_value=NO_TRAINEE)
         dash.reset = gui.add_button("Reset wizard", color="red",
@@ -386,7 +386,7 @@ def exercise_folder(dash: TrainerDashboard) -> None:
         dash.push = gui.add_button("Push to all trainees", color="blue")
         dash.push_md = gui.add_markdown("")
         dash.class_extras.append(build_exercise_controls(gui, control, dash.session))   # "Exercise brief"
-    dash.push.on_click(dash.session.on_loop(dash._push_all))
+    dash.push.on_click(dash.session.loop.on_loop(dash._push_all))
 
 
 def message_folder(dash: TrainerDashboard) -> None:
@@ -405,7 +405,7 @@ def gradebook_folder(dash: TrainerDashboard) -> None:
             hint="A trainee's exported session: each calibration is replayed and graded against "
                  "the truth this gradebook keeps (by its record id).")
         dash.grade_md = gui.add_markdown("")
-    dash.download.on_click(dash.session.on_loop(dash._download))
+    dash.download.on_click(dash.session.loop.on_loop(dash._download))
     dash.grade_upload.on_upload(dash._on_grade_upload)
     limit_upload_size(dash.grade_upload, MAX_RECORD_BYTES, dash._refused)
 

@@ -26,7 +26,7 @@ script does not join by itself in that window, so two tabs cannot take the name 
 other in a loop) or ``data-tcp-pendant-forget`` (released: the script also forgets the name
 and key it kept).
 
-Every callback runs through ``Session.on_loop``; the name is shown through ``escape_markdown``.
+Every callback runs through ``SessionLoop.on_loop``; the name is shown through ``escape_markdown``.
 """
 
 from __future__ import annotations
@@ -105,8 +105,8 @@ class IdentityPrompt:
             self.token_field = gui.add_text(TOKEN_LABEL, "")
             self.open_trainer = gui.add_button("Open trainer view")
         self._modal_open = True
-        self.start.on_click(self.session.on_loop(self._start))
-        self.open_trainer.on_click(self.session.on_loop(self._trainer))
+        self.start.on_click(self.session.loop.on_loop(self._start))
+        self.open_trainer.on_click(self.session.loop.on_loop(self._trainer))
 
     def _start(self, _event: ButtonEvent | None = None) -> None:
         if self.name is not None:

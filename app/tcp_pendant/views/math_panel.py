@@ -48,7 +48,7 @@ class MathView:
         self.sheet: MathSheet | None = None
         self.renders = 0
         self._pairs: dict[str, tuple[int, int]] = {}
-        self.pair.on_update(session.on_loop(self._on_pair))
+        self.pair.on_update(session.loop.on_loop(self._on_pair))
         session.subscribe(self.on_change)
         self.render()
 

@@ -22,7 +22,7 @@ status line and as a notification ("N jog presses dropped: the server was busy")
 
 Widgets only call :class:`tcp_pendant.pendant.Jogger` and the session; all text comes from
 ``tcp_pendant.pendant.formatting``. Every callback runs on viser's event loop
-(:meth:`Session.on_loop`), in the order the browser's messages arrived.
+(:meth:`SessionLoop.on_loop`), in the order the browser's messages arrived.
 
 "Shadows" switches the shadows of viser's default lights for this browser (every browser in
 ``--shared`` mode, where its label says so). The page's script unchecks it when the browser
@@ -171,13 +171,13 @@ class PendantPanel:
         self.cart_rows: dict[str, viser.GuiButtonGroupHandle] = {}
         for r, ax in enumerate(CARTESIAN_AXES):
             row = gui.add_button_group(ax, (f"{ax} −", f"{ax} +"), hint=_with_keys(_AXIS_HINT[ax], r))
-            row.on_click(session.on_loop(self._row_cb(ax)))
+            row.on_click(session.loop.on_loop(self._row_cb(ax)))
             self.cart_rows[ax] = row
         self.joint_rows: list[viser.GuiButtonGroupHandle] = []
         for i, name in enumerate(k.joint_names):
             row = gui.add_button_group(name, (f"{name} −", f"{name} +"), visible=False,
                                        hint=_with_keys(f"jog {name} (deg)", i))
-            row.on_click(session.on_loop(self._row_cb(i)))
+            row.on_click(session.loop.on_loop(self._row_cb(i)))
             self.joint_rows.append(row)
 
         # hold-to-jog keys (continuous mode): viser reports holds of single buttons only
@@ -233,7 +233,7 @@ class PendantPanel:
             self.shadows = gui.add_checkbox(SHARED_SHADOWS_LABEL if session.shared else SHADOWS_LABEL, True,
                                             hint=SHADOWS_HINT)
 
-        g = session.on_loop
+        g = session.loop.on_loop
         self.mode.on_click(g(self._setting("mode", JogMode)))
         self.frame.on_update(g(self._setting("frame", str)))
         self.increment.on_click(g(self._setting("increment", str)))
@@ -263,11 +263,11 @@ class PendantPanel:
     # ------------------------------------------------------------ wiring
     def _wire_key(self, button: viser.GuiButtonHandle, axis: str | int, sign: int) -> None:
         """Click and hold of a jog key, on viser's event loop like every callback
-        (:meth:`Session.on_loop`): besides thread safety, that spares every jog tick a hand-over
+        (:meth:`SessionLoop.on_loop`): besides thread safety, that spares every jog tick a hand-over
         to viser's thread pool (a thread wake-up and GIL hand-over per tick: 10-30 % of a jog
         step's server CPU, measured by bench_server.py). The step is synchronous, under the
         session lock, and never waits on the event loop."""
-        on_loop = self.session.on_loop
+        on_loop = self.session.loop.on_loop
         button.on_click(on_loop(lambda _event: self._jog(axis, sign, hold_tick=False)))
         button.on_hold(on_loop(lambda _event: self._on_hold(axis, sign)), callback_hz=HOLD_HZ)
 
@@ -280,7 +280,7 @@ class PendantPanel:
             self._report_drops_soon()                # a stale press: dropped, never carried out late
             return
         waited = None if arrived is None else time.monotonic() - arrived
-        self.session.jog(axis, sign, hold_tick=hold_tick, waited_s=waited)
+        self.session.motion.jog(axis, sign, hold_tick=hold_tick, waited_s=waited)
 
     # hold-to-jog on the server's 20 Hz clock (pendant/hold.py)
     def _on_hold(self, axis: str | int, sign: int) -> None:
@@ -290,7 +290,7 @@ class PendantPanel:
             return
         if self._hold is None:
             loop = asyncio.get_running_loop()
-            guard = self.session.guard
+            guard = self.session.loop.guard
 
             def schedule(delay_s: float, fn: Any) -> Any:
                 return loop.call_later(delay_s, guard(fn))
@@ -307,7 +307,7 @@ class PendantPanel:
         if s.closed or not s.jogger.settings.continuous:
             self._stop_hold()
             return None
-        return s.jog(axis, sign, hold_tick=True)
+        return s.motion.jog(axis, sign, hold_tick=True)
 
     def _report_drops_soon(self) -> None:
         """Report the dropped presses once the loop has worked through what is queued now (one
@@ -320,9 +320,9 @@ class PendantPanel:
         loop = asyncio.get_running_loop()
         wait = self._drop_reported_at + DROP_REPORT_EVERY_S - time.monotonic()
         if wait > 0:
-            loop.call_later(wait, self.session.guard(self._report_drops))
+            loop.call_later(wait, self.session.loop.guard(self._report_drops))
         else:
-            loop.call_soon(self.session.guard(self._report_drops))
+            loop.call_soon(self.session.loop.guard(self._report_drops))
 
     def _report_drops(self) -> None:
         self._drop_report_due = False
@@ -339,7 +339,7 @@ class PendantPanel:
     def _stop_hold(self) -> None:
         if self._hold is not None:
             self._hold.stop()
-        self.session.release_jog()
+        self.session.motion.release_jog()
 
     def _row_cb(self, axis: str | int) -> Callable[[ButtonGroupEvent], None]:
         """Click on a compact key row: the value is the key's label ("X +", "A3 −")."""
@@ -382,13 +382,13 @@ class PendantPanel:
             if not math.isfinite(value):
                 return
             with s.batch():                           # the echo rule is set before the one signal
-                applied = round(s.set_joint(index, value), 2)
+                applied = round(s.motion.set_joint(index, value), 2)
                 if abs(applied - value) <= 0.005:     # the browser shows the angle: no echo
                     self._from_client[index] = applied
                 else:                                 # clipped: render sends the limit
                     self._from_client.pop(index, None)
 
-        return s.on_loop(cb)
+        return s.loop.on_loop(cb)
 
     def _setting(self, name: str, kind: Any) -> Any:
         """Callback of one selector: only the selector that fired changes its setting (a button
@@ -396,7 +396,7 @@ class PendantPanel:
         def cb(event: Any) -> None:
             value = event.target.value
             self._stop_hold()
-            self.session.set_jog_setting(name, kind(unmarked(value) if isinstance(value, str) else value))
+            self.session.motion.set_jog_setting(name, kind(unmarked(value) if isinstance(value, str) else value))
             self._show_settings()
             self.render()
         return cb
@@ -426,10 +426,10 @@ class PendantPanel:
         self._set_md(self.settings_md, "settings", f"{st.mode.value} jog in {where}, {step}, override {st.override_pct:.0f} %")
 
     def _on_home(self, _event: ButtonEvent) -> None:
-        self.session.ready()
+        self.session.motion.ready()
 
     def _on_kuka_home(self, _event: ButtonEvent) -> None:
-        self.session.home()
+        self.session.motion.home()
 
     def _on_camera(self, close: bool) -> Any:
         def cb(event: Any) -> None:

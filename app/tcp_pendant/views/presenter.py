@@ -14,7 +14,7 @@ The folder is pinned at the top of the panel while the rest scrolls under it (th
 it is sized to leave room below it: at 1024x768 the whole block, chart included, is above the
 fold (about 500 px of the 713 px panel). It narrows the panel to ``PRESENTER_WIDTH_PX`` (the
 scene keeps about 70 % of a 1024 px wide projector) and puts it back to ``NORMAL_WIDTH_PX``
-when switched off; the scene's labels (``Session.scene_labels``) are drawn
+when switched off; the scene's labels (``session.views.labels``) are drawn
 ``LABEL_SCALE`` times larger.
 
 The readout is raw HTML inside viser markdown (a ``<div style=...>``): only numbers this module
@@ -180,7 +180,7 @@ class PresenterView:
         self._shown: dict[str, str] = {}
         self.panel_width_px = NORMAL_WIDTH_PX
         self._charted: Any = None
-        self.toggle.on_update(session.on_loop(self._on_toggle))
+        self.toggle.on_update(session.loop.on_loop(self._on_toggle))
         session.subscribe(self.on_change)
         if on:
             self._apply_width(True)
@@ -204,7 +204,7 @@ class PresenterView:
         """The scene's labels larger in presenter mode (the wizards' scene spreads them at the
         size they are drawn, on the next camera report or move)."""
         scale = LABEL_SCALE if on else 1.0
-        for handle in self.session.scene_labels.values():
+        for handle in self.session.views.labels.drawn().values():
             if float(getattr(handle, "font_screen_scale", 1.0)) != scale:
                 handle.font_screen_scale = scale
 

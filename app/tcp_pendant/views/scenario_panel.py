@@ -33,7 +33,7 @@ assert tuple(SCENARIO_CHOICES) == SCENARIO_KINDS
 def scenario_markdown(session: Session) -> str:
     """What the panel says: the scenario played and, after a calibration result, how it shows
     (``explain``, escaped)."""
-    world = session.scenario_world
+    world = session.scenario_player.world
     if world is None:
         return "*No systematic error: the residual reflects the touching accuracy only.*"
     s = world.scenario
@@ -55,13 +55,13 @@ class ScenarioPanel:
         with self.folder:
             labels = list(SCENARIO_CHOICES.values())
             self.kind = gui.add_dropdown("Systematic error", labels,
-                                         initial_value=SCENARIO_CHOICES[session.scenario.kind],
+                                         initial_value=SCENARIO_CHOICES[session.scenario_player.scenario.kind],
                                          hint="What the physical world gets wrong (training).")
-            self.seed = gui.add_number("Seed", int(session.scenario.seed), min=0, step=1,
+            self.seed = gui.add_number("Seed", int(session.scenario_player.scenario.seed), min=0, step=1,
                                        hint=f"Draws the errors; the tests check seeds "
                                             f"{DEFAULT_SEED_RANGE.start}-{DEFAULT_SEED_RANGE.stop - 1}.")
             self.md = gui.add_markdown("")
-        g = session.on_loop
+        g = session.loop.on_loop
         self.kind.on_update(g(self._on_choose))
         self.seed.on_update(g(self._on_choose))
         session.subscribe(self.on_change)
@@ -79,11 +79,11 @@ class ScenarioPanel:
         s = self.session
         wf = s.workflow
         self.folder.visible = wf is None or bool(getattr(wf, "training", True))
-        label = SCENARIO_CHOICES[s.scenario.kind]
+        label = SCENARIO_CHOICES[s.scenario_player.scenario.kind]
         if self.kind.value != label:
             set_value(self.kind, label)
-        if int(self.seed.value or 0) != int(s.scenario.seed):
-            set_value(self.seed, int(s.scenario.seed))
+        if int(self.seed.value or 0) != int(s.scenario_player.scenario.seed):
+            set_value(self.seed, int(s.scenario_player.scenario.seed))
         self.md.content = scenario_markdown(s)
 
     def _on_choose(self, event: Any) -> None:
@@ -97,7 +97,7 @@ class ScenarioPanel:
             seed = int(self.seed.value)
         except (TypeError, ValueError):
             raise ValueError(f"The seed must be a whole number >= 0, got {self.seed.value!r}.") from None
-        if kind == self.session.scenario.kind and seed == self.session.scenario.seed:
+        if kind == self.session.scenario_player.scenario.kind and seed == self.session.scenario_player.scenario.seed:
             return
         try:
             self.session.set_scenario(kind, seed)

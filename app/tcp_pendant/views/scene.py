@@ -24,7 +24,7 @@ links and the gizmo from the change's pose state. No other view tells it anythin
 
 * ``/tcp_gizmo``: transform controls on the active TCP; dragging it moves the TCP by
   ``VirtualController.move_tcp_to`` (straight line, same safety rules as jogging), on viser's
-  event loop (``Session.on_loop``), a backlog of drag messages coalesced into one move.
+  event loop (``SessionLoop.on_loop``), a backlog of drag messages coalesced into one move.
 
 Axis colours are viser's: X red, Y green, Z blue. Quaternions (w, x, y, z) come from
 ``tcp_pendant.controller.rotations.quaternions_wxyz`` (pinocchio; checked against scipy).
@@ -317,7 +317,7 @@ class SceneView:
         self._aside = False                     # gizmo and TOOL triad hidden for a beam scan's film
         self._gizmo_pending: tuple[np.ndarray, np.ndarray] | None = None  # (wxyz, xyz) not yet applied
         self._gizmo_scheduled = False
-        self._apply_scheduled_gizmo = session.guard(self._apply_scheduled)
+        self._apply_scheduled_gizmo = session.loop.guard(self._apply_scheduled)
 
         scene.set_up_direction("+z")
         scene.add_grid("/floor", width=3.0, height=3.0, cell_size=0.1, section_size=0.5,
@@ -370,8 +370,9 @@ class SceneView:
         _add_parts(scene, "/reference_tip", rigid_meshes(tip.urdf_path))
         self._tip_label = scene.add_label("/reference_tip_label", "reference tip",
                                           position=tuple(c.reference_tip_world_m + [0.0, 0.0, -0.06]))
-        session.scene_labels.update(self.tool_labels())     # the wizards' scene moves them apart
-        session.scene_labels["world"] = self._world_label   # restyled with them (presenter mode)
+        labels = session.views.labels                       # the wizards' scene moves them apart
+        labels.flange, labels.tool, labels.tip = self._flange_label, self._active_label, self._tip_label
+        labels.world = self._world_label                    # restyled with them (presenter mode)
         self.beam_stand = BeamStandNodes(scene, c.beam_sensor)
 
         wxyz, xyz = wxyz_xyz(state.T_world_tcp)
@@ -379,7 +380,7 @@ class SceneView:
                                                   position=xyz, depth_test=False, opacity=0.85)
         self._gizmo_row = len(self._moving)
         self._poses = PoseSender([self.link_frames[n] for n in self._moving] + [self.gizmo], T_local)
-        self.gizmo.on_update(session.on_loop(self._on_gizmo))
+        self.gizmo.on_update(session.loop.on_loop(self._on_gizmo))
         session.subscribe(self.on_change)
 
     def on_change(self, change: SessionChange) -> None:
@@ -557,4 +558,4 @@ class SceneView:
         T = np.eye(4)
         T[:3, :3] = Rotation.from_quat(np.roll(wxyz, -1)).as_matrix()
         T[:3, 3] = xyz
-        s.move_tcp_to(T)
+        s.motion.move_tcp_to(T)

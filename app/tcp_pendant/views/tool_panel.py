@@ -2,10 +2,10 @@
 library (activate, rename, delete, export to controller text) and numeric tool entry.
 
 The library is the server's ``tcpcal.ToolLibrary`` (one file, shared by every session and
-process); the session keeps the list it last read (``Session.reload_library``, also called by
+process); the session keeps the list it last read (``SessionTools.reload_library``, also called by
 the server's watcher when the file changes, so a trainee sees the tools others save) and this
 panel re-renders it on the session's ``library`` change. Mount, Activate and "No tool" are the
-session's commands (``Session.mount_tool`` / ``activate`` / ``deactivate``): this session only
+session's commands (``SessionTools.mount_tool`` / ``activate`` / ``deactivate``): this session only
 (in ``--shared`` mode Activate also sets the library's active slot, the shared start tool);
 the panel re-renders the mounted tool and the active data on the session's ``tool`` change.
 
@@ -137,7 +137,7 @@ class ToolPanel:
             self.entry_save = gui.add_button("Save to library", color="green")
             self.entry_md = gui.add_markdown("")
 
-        g = session.on_loop                       # every callback on viser's event loop
+        g = session.loop.on_loop                       # every callback on viser's event loop
         self.mounted.on_update(g(self._on_mount))
         self.slots.on_update(g(lambda _e: self._show_slot()))
         self.activate.on_click(g(self._on_activate))
@@ -174,9 +174,9 @@ class ToolPanel:
 
     # ------------------------------------------------------------ library
     def reload(self) -> None:
-        """Re-read the shared library (``Session.reload_library``; the panel re-renders on its
+        """Re-read the shared library (``SessionTools.reload_library``; the panel re-renders on its
         change signal)."""
-        self.session.reload_library()
+        self.session.tools.reload_library()
 
     def show_library(self) -> None:
         """Render the session's list of the library's tools (keeps the selection).
@@ -186,12 +186,12 @@ class ToolPanel:
         tools and says why (once per reason), so the rest of the pendant still works.
         """
         s = self.session
-        error = s.library_error
+        error = s.tools.library_error
         if error is not None and error != self._library_error:
             s.notify("Tool library unavailable", error, kind="error")
         self._library_error = error
         self._tell_recoveries()
-        lib = s.library_tools
+        lib = s.tools.library_tools
         self._library = lib
         options = tuple(slot_option(slot, t.name) for slot, t in sorted(lib.items())) or (NO_TOOL,)
         current = number_of_option(self.slots.value)
@@ -230,9 +230,9 @@ class ToolPanel:
         """Whose the selected slot is (a class): a trainee reads "yours" or "not yours" (no
         classmate's name), the trainer the owner's name (escaped)."""
         s = self.session
-        rights, owner = s.library_rights, s.library_owners.get(slot)
+        rights, owner = s.tools.library_rights, s.tools.library_owners.get(slot)
         if rights.restricted:
-            if rights.mine(s.library_owners, slot):
+            if rights.mine(s.tools.library_owners, slot):
                 return "\n\nYours: you can rename and delete it."
             whose = "another trainee's" if owner is not None else "the trainer's"
             return f"\n\nThis slot is {whose}: activate and check it; you cannot change it."
@@ -242,12 +242,12 @@ class ToolPanel:
 
     def _choices(self) -> dict[str, str]:
         """Mounted tool's choices, label -> key: the built-in tools and the exercise's tool."""
-        held = self.session.exercise_tool
+        held = self.session.tools.exercise_tool
         return self._tool_key_by_label if held is None else {**self._tool_key_by_label, held.label: held.key}
 
     def _show_mounted(self) -> None:
         """The mounted tool; in an exercise that holds its tool, the dropdown locked with why."""
-        held = self.session.exercise_tool
+        held = self.session.tools.exercise_tool
         label = self.session.controller.mounted_tool.label
         options = tuple(self._choices())
         if label in options:
@@ -259,11 +259,11 @@ class ToolPanel:
         self.mounted_lock_md.visible = held is not None
 
     def _show_active(self) -> None:
-        self.active_md.content = tool_data_markdown(self.session.controller.active_tool, self.session.active_slot)
+        self.active_md.content = tool_data_markdown(self.session.controller.active_tool, self.session.tools.active_slot)
 
     # ------------------------------------------------------------ callbacks
     def _on_mount(self, event: DropdownEvent) -> None:
-        """Mount the tool chosen (``Session.mount_tool``); a refused change (the exercise holds
+        """Mount the tool chosen (``SessionTools.mount_tool``); a refused change (the exercise holds
         its tool) puts the dropdown back on the tool mounted."""
         key = self._choices().get(str(event.target.value))
         if key is None:
@@ -271,20 +271,20 @@ class ToolPanel:
             raise ValueError(f"Unknown tool {event.target.value!r}; choose one of the list.")
         if key == self.session.controller.mounted_tool.key:
             return
-        held = self.session.exercise_tool
+        held = self.session.tools.exercise_tool
         try:
-            self.session.mount_tool(held if held is not None and key == held.key else self._tools[key])
+            self.session.tools.mount_tool(held if held is not None and key == held.key else self._tools[key])
         except ValueError:
             self._show_mounted()
             raise
 
     def _on_activate(self, _event: ButtonEvent) -> None:
         slot, _ = self._selected()
-        tool = self.session.activate(slot)
+        tool = self.session.tools.activate(slot)
         self.session.notify("Tool activated", f"{slot}: {tool.name}", kind="success")
 
     def _on_deactivate(self, _event: ButtonEvent) -> None:
-        self.session.deactivate()
+        self.session.tools.deactivate()
 
     def _on_rename(self, _event: ButtonEvent) -> None:
         slot, tool = self._selected()
@@ -293,7 +293,7 @@ class ToolPanel:
             raise ValueError("Type the new name in 'New name' first.")
         s = self.session
         with s.batch():
-            s.rename_tool(slot, name)
+            s.tools.rename_tool(slot, name)
             if s.client is not None:
                 # a courtesy, per browser only: in --shared mode the box is every browser's, and
                 # another trainee may be typing in it
@@ -301,7 +301,7 @@ class ToolPanel:
 
     def _on_delete(self, _event: ButtonEvent) -> None:
         slot, tool = self._selected()
-        self.session.delete_tool(slot)
+        self.session.tools.delete_tool(slot)
         self.session.notify("Tool deleted", f"{slot}: {tool.name}")
 
     def _on_export(self, _event: ButtonEvent) -> None:
@@ -335,7 +335,7 @@ class ToolPanel:
         if tool is None:
             raise ValueError("No tool data is active (TCP = flange): activate a tool or pick one in the "
                              "library and press Check.")
-        slot = self.session.active_slot
+        slot = self.session.tools.active_slot
         return (tool.name if slot is None else f"slot {slot}: {tool.name}"), tool
 
     def _check_callback(self, which: Callable[[], tuple[str, Tool]]
@@ -346,11 +346,11 @@ class ToolPanel:
 
     async def run_check(self, which: Callable[[], tuple[str, Tool]]) -> None:
         """Run the TCP check of ``which()`` (title, tool): the job is taken under the session
-        lock on the loop, the six rotations run in the server's job pool (``Session.run_job``),
+        lock on the loop, the six rotations run in the server's job pool (``SessionLoop.run_job``),
         the result is shown on the loop. One check at a time per session (one job of any kind:
         the pool refuses another meanwhile, in words, and a session whose jobs used their share of
-        the server's time: ``Session.admit_job``, before the job is taken); the loop's work on
-        it counts against that share (``Session.charged``); errors become one notification."""
+        the server's time: ``SessionLoop.admit_job``, before the job is taken); the loop's work on
+        it counts against that share (``SessionLoop.charged``); errors become one notification."""
         s = self.session
         if s.closed:
             return
@@ -358,12 +358,12 @@ class ToolPanel:
             s.notify_refusal("Check running", "A TCP check is still running here; wait for its result.")
             return
         try:                           # refused at once, before the loop takes the job
-            s.admit_job()
+            s.loop.admit_job()
         except JobRefused as exc:
             s.notify_refusal("Check not started", str(exc))
             return
         try:
-            with s.charged(), s.lock:
+            with s.loop.charged(), s.lock:
                 title, tool = which()
                 if s.rules.in_exercise:                 # read against the spike, as on a robot
                     check_readable(s.pose_state().touch.distance_mm)
@@ -375,7 +375,7 @@ class ToolPanel:
             return
         self._checking = True
         try:
-            result = await s.run_job(job.run, what="a TCP check")
+            result = await s.loop.run_job(job.run, what="a TCP check")
         except JobRefused as exc:      # this session's other job, or a full queue: nothing ran
             with s.lock:
                 self.check_md.content = shown
@@ -387,7 +387,7 @@ class ToolPanel:
             return
         finally:
             self._checking = False
-        with s.charged(), s.lock:
+        with s.loop.charged(), s.lock:
             if s.closed:
                 return
             self.last_check = (job, result)
@@ -417,7 +417,7 @@ class ToolPanel:
             self.entry_md.content = "⚠ Not saved: correct the fields marked above."
             return
         try:
-            self.session.store_tool(slot, res.tool)
+            self.session.tools.store_tool(slot, res.tool)
         except ValueError as exc:       # e.g. another trainee's slot, a full quota: said here too
             self.entry_md.content = f"⚠ Not saved: {escape_markdown(str(exc))}"
             raise

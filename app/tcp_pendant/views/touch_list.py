@@ -60,8 +60,8 @@ class TouchListView:
             self.export_csv = gui.add_button("Export CSV", hint="The touches as POSES.csv with joint values "
                                              "(tcpcal solve xyz4), sent to this browser.")
         self._rows: list[viser.GuiMarkdownHandle | viser.GuiButtonHandle] = []
-        self.record.on_click(session.on_loop(self._on_record))
-        self.export_csv.on_click(session.on_loop(self._on_export_csv))
+        self.record.on_click(session.loop.on_loop(self._on_record))
+        self.export_csv.on_click(session.loop.on_loop(self._on_export_csv))
         session.subscribe(self.on_change)
 
     def on_change(self, change: SessionChange) -> None:
@@ -102,7 +102,7 @@ class TouchListView:
             labels = [t.label for t in self.session.touches]
             if label in labels:
                 self.session.delete_touch(labels.index(label))
-        return self.session.on_loop(cb)
+        return self.session.loop.on_loop(cb)
 
     def rebuild(self) -> None:
         """Redraw the rows: one markdown line and one "Delete Pn" button per touch."""

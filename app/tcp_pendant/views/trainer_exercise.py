@@ -7,7 +7,7 @@ escaped in a banner on every trainee's panel), one checkbox per calibration meth
 registry's, in menu order; all ticked: every method), "Minimum touches" (0: none; it applies to
 the methods whose touch count the trainee chooses, ``calibrate.pendant_rules``) and **Push brief
 to all trainees** (``ClassRoom.push_brief``). What a browser sends is checked by the class; a
-refusal is a notification in words (``Session.on_loop``).
+refusal is a notification in words (``SessionLoop.on_loop``).
 """
 
 from __future__ import annotations
@@ -100,5 +100,5 @@ def build_exercise_controls(gui: Any, class_control: BriefControl, session: Sess
         push = gui.add_button("Push brief to all trainees", color="blue")
         status = gui.add_markdown("")
     controls = ExerciseControls(session, class_control, text, methods, minimum, push, status)
-    push.on_click(session.on_loop(controls._push))
+    push.on_click(session.loop.on_loop(controls._push))
     return controls

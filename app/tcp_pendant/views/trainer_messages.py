@@ -73,6 +73,6 @@ def build_message_controls(gui: Any, class_control: MessageControl, session: Ses
         send = gui.add_button("Send", color="blue")
         status = gui.add_markdown("")
     controls = MessageControls(session, class_control, text, to, send, status)
-    send.on_click(session.on_loop(controls._send))
+    send.on_click(session.loop.on_loop(controls._send))
     controls.render()
     return controls

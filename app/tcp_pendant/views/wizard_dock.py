@@ -10,11 +10,11 @@ tab stays the place to choose a method and review the result. Outside a wizard t
 hidden and the touch list's "Record point" records into the free list (one Record concept).
 A step the controller runs itself (``AutoRole.by_controller``: the beam wizard's scan) shows no
 Record; its Finish runs the wizard's controller job in the server's job pool, off the loop
-(``Session.next_step_in_pool``).
+(``WizardCommands.next_step_in_pool``).
 
 The dock renders from the session's workflow (``Session.workflow``) on the change signal and
-changes it only through the session's commands (``record_step``, ``next_step``, ``back``,
-``cancel_wizard``, ``mount_required_tool``); it never calls another view. Each click runs through ``Session.on_loop`` inside ``Session.batch`` and ends in one
+changes it only through the session's commands (``session.wizard_commands``: ``record_step``,
+``next_step``, ``back``, ``cancel``, ``mount_required_tool``); it never calls another view. Each click runs through ``SessionLoop.on_loop`` inside ``Session.batch`` and ends in one
 change signal with ``wizard`` (as the Calibrate tab's clicks), so the Calibrate tab, the scene
 and the classroom recorder see it too. Every text from a wizard goes through the escaping
 ``calibrate.text`` helpers.
@@ -84,7 +84,7 @@ class WizardDock:
             self.tilt_html = gui.add_html(tilt_line_html(None), visible=False)
         self.record.on_click(self._action(self._on_record))
         self.nav.on_click(self._on_nav_click)
-        self.mount.on_click(self._action(lambda _e: self.session.mount_required_tool(), sync=True))
+        self.mount.on_click(self._action(lambda _e: self.session.wizard_commands.mount_required_tool(), sync=True))
         session.subscribe(self.on_change)
 
     # ------------------------------------------------------------ plumbing
@@ -100,7 +100,7 @@ class WizardDock:
                     s.changed(wizard=True, pose=sync)
 
         run.__qualname__ = getattr(fn, "__qualname__", "dock action")
-        return s.on_loop(run)
+        return s.loop.on_loop(run)
 
     def _where(self) -> tuple[int, int, int]:
         wf = self.session.workflow
@@ -126,14 +126,14 @@ class WizardDock:
             return
         wiz = wf.wizard
         index = None if wiz is None else wiz.step.index
-        s.record_step()
+        s.wizard_commands.record_step()
         shown = "" if s.hide_distance else f", {state.touch.distance_mm:.2f} mm from the tip"
         if s.hide_distance and not s.rules.in_exercise:     # free practice by eye: how far it was
             shown = f": {touch_feedback(delta, frame)}"
         self._say(f"✔ Step {index + 1 if index is not None else '?'} recorded{shown}.")
 
     async def _on_nav_click(self, event: ButtonGroupEvent) -> None:
-        """Back and Cancel as every click; Next / Finish through ``Session.next_step_in_pool``
+        """Back and Cancel as every click; Next / Finish through ``WizardCommands.next_step_in_pool``
         (a controller job runs in the job pool), its errors one notification."""
         s = self.session
         if str(event.target.value) not in (NEXT, FINISH):
@@ -143,7 +143,7 @@ class WizardDock:
             return
         self.check.clear()
         try:
-            await s.next_step_in_pool()
+            await s.wizard_commands.next_step_in_pool()
         except ValueError as exc:          # the wizard's words, or the pool's (JobRefused)
             s.notify("Not done", str(exc), kind="warning")
         except Exception as exc:           # a browser's click must never kill the server
@@ -155,11 +155,11 @@ class WizardDock:
         choice = str(event.target.value)
         self.check.clear()
         if choice == BACK:
-            s.back()
+            s.wizard_commands.back()
         elif choice in (NEXT, FINISH):
-            s.next_step()
+            s.wizard_commands.next_step()
         elif choice in (CANCEL, CLOSE):
-            if s.cancel_wizard():
+            if s.wizard_commands.cancel():
                 self.session.notify("Calibration cancelled",
                                     "Nothing recorded is lost: Resume it from the Calibrate menu.")
         else:

@@ -24,9 +24,9 @@ Built by ``tcp_pendant.views.calibrate.build_calibrate_tab`` for the session's w
   browser), one load per session at a time; the result is added under the session lock.
 
 All logic is in :class:`tcp_pendant.calibrate.CalibrationWorkflow` (no viser), owned by the
-session, whose commands (``Session.start_wizard``, ``record_step``, ``save_result``, ...) are
+session, whose commands (``WizardCommands.start``, ``record_step``, ``save_result``, ...) are
 the only way a click changes it; every click goes through :meth:`CalibrateView.action`
-(``Session.on_loop``: the event loop, the session's lock and error notifications) inside
+(``SessionLoop.on_loop``: the event loop, the session's lock and error notifications) inside
 ``Session.batch``, so a click ends in one change signal; the tab re-renders from the workflow's
 state on that signal (:meth:`CalibrateView.on_change`), as the scene and the Tool tab do.
 """
@@ -219,7 +219,7 @@ class CalibrateView:
     # ------------------------------------------------------------ plumbing
     def action(self, fn: Callable[[Any], Any], *, user_only: bool = False,
                sync: bool = False) -> Callable[[Any], Any]:
-        """Wrap a GUI callback: ``Session.on_loop`` (viser's event loop, session lock, error
+        """Wrap a GUI callback: ``SessionLoop.on_loop`` (viser's event loop, session lock, error
         notifications), inside ``Session.batch``, ending in one change signal with ``wizard``
         (with ``sync`` also ``pose``: the click may have moved the robot, as auto-touch does).
         Tool and library changes the click made through the session's commands join that
@@ -244,7 +244,7 @@ class CalibrateView:
                     s.changed(wizard=True, pose=sync)
 
         run.__qualname__ = getattr(fn, "__qualname__", "action")
-        return s.on_loop(run)
+        return s.loop.on_loop(run)
 
     def saved(self, slot: int, tool: Tool) -> None:
         """After "Save to tool library" (the session made it the active tool)."""
@@ -252,19 +252,19 @@ class CalibrateView:
 
     # ------------------------------------------------------------ callbacks
     def _on_training(self, event: Any) -> None:
-        self.session.set_training(bool(event.target.value))
+        self.session.wizard_commands.set_training(bool(event.target.value))
 
     def _on_library_pick(self, event: Any) -> None:
         # the user's pick holds until the active tool data changes (then the default is offered)
-        self._library_pick = (str(event.target.value), self.session.active_slot)
+        self._library_pick = (str(event.target.value), self.session.tools.active_slot)
 
     def _library_option(self, options: tuple[str, ...]) -> str | None:
         """The library option to show: the user's pick, else :func:`default_library_slot`."""
         pick = self._library_pick
-        if pick is not None and pick[0] in options and pick[1] == self.session.active_slot:
+        if pick is not None and pick[0] in options and pick[1] == self.session.tools.active_slot:
             return pick[0]
         c = self.session.controller
-        slot = default_library_slot(self._library, active_slot=self.session.active_slot,
+        slot = default_library_slot(self._library, active_slot=self.session.tools.active_slot,
                                     active_tool_name=None if c.active_tool is None else c.active_tool.name,
                                     mounted_label=c.mounted_tool.label, mounted_key=c.mounted_tool.key)
         return None if slot is None else slot_option(slot, self._library[slot].name)
@@ -280,7 +280,7 @@ class CalibrateView:
         if str(self.method.value) not in self._classes:
             raise ValueError(f"Unknown calibration method {self.method.value!r}.")
         cls = self._chosen_class()
-        self.session.start_wizard(cls.kind, **{opt.name: self._option_value(opt) for opt in cls.options})
+        self.session.wizard_commands.start(cls.kind, **{opt.name: self._option_value(opt) for opt in cls.options})
 
     def _on_start_from_points(self, _event: Any) -> None:
         """XYZ 4-point from the free touches (``CalibrationWorkflow.start_from_touches``)."""
@@ -289,7 +289,7 @@ class CalibrateView:
             raise ValueError("Only the XYZ 4-point method starts from the recorded points; choose it first.")
         spec = self._option_specs.get("estimator")
         estimator = "lstsq" if spec is None else self._option_value(spec)
-        self.session.start_from_touches(estimator=estimator)
+        self.session.wizard_commands.start_from_touches(estimator=estimator)
 
     def _on_resume(self, _event: Any) -> None:
         number = number_of_option(self.resume_list.value)
@@ -298,7 +298,7 @@ class CalibrateView:
         if number - 1 not in {i for i, _ in self.workflow.resumable()}:
             raise ValueError(f"Calibration {number} is not waiting to be resumed any more; choose one in "
                              "'To resume'.")
-        self.session.resume_wizard(number - 1)
+        self.session.wizard_commands.resume(number - 1)
 
     def _on_export(self, event: Any) -> None:
         data = dumps(self.workflow.export_record(self.session.touches)).encode("utf-8")
@@ -309,7 +309,7 @@ class CalibrateView:
 
     async def _on_upload(self, event: Any) -> None:
         """"Load session (JSON)": the size is checked at once, parsing and replay run in
-        the server's job pool (``Session.run_job``, off viser's event loop: the other browsers
+        the server's job pool (``SessionLoop.run_job``, off viser's event loop: the other browsers
         keep jogging; each record is bounded by the record limits), then the
         wizards are added under the session lock. A refused record gets one notification
         (:data:`RECORD_REFUSED`) saying what is wrong; nothing of the session changes."""
@@ -333,7 +333,7 @@ class CalibrateView:
             with session.lock:
                 set_content(self.record_md, f"Loading {escape_markdown(name)} ...")
             data = bytes(content)
-            loaded = await session.run_job(lambda: load_and_replay(data), what="a session record's load")
+            loaded = await session.loop.run_job(lambda: load_and_replay(data), what="a session record's load")
         except (SessionRecordError, JobRefused) as exc:
             self._refuse_record(name, exc)
             return
@@ -346,7 +346,7 @@ class CalibrateView:
         await self.action(lambda _e: self._show_loaded(str(upload.name or "session"), loaded))(event)
 
     def _show_loaded(self, name: str, loaded: LoadedRecord) -> None:
-        checks = self.session.load_record(loaded)
+        checks = self.session.wizard_commands.load_record(loaded)
         set_content(self.record_md, f"**Loaded {escape_markdown(name)}**\n\n" + replay_markdown(checks))
 
     def _refuse_record(self, name: str, exc: Exception) -> None:
@@ -364,9 +364,9 @@ class CalibrateView:
 
     # ------------------------------------------------------------ library and motion
     def refresh_library(self, *, render: bool = True) -> None:
-        """Re-list the library's tools as the session last read them (``Session.library_tools``;
+        """Re-list the library's tools as the session last read them (``SessionTools.library_tools``;
         the file is not read here). Called on the session's ``library`` change."""
-        tools = self.session.library_tools
+        tools = self.session.tools.library_tools
         self._library = dict(tools)
         options = tuple(slot_option(s, t.name) for s, t in sorted(tools.items())) or (NO_LIBRARY_TOOL,)
         for widget in self._slot_widgets:

@@ -137,7 +137,7 @@ class WizardResultView:
             if "estimators" not in type(wiz).result_extras:
                 raise WizardStateError(f"The {wiz.title} result has no estimators to choose.")
             return fn(wiz)
-        self.parent.session.edit_result(edit)
+        self.parent.session.wizard_commands.edit_result(edit)
 
     def _on_drop(self, _event: ButtonEvent) -> None:
         self._with_estimators(lambda wiz: wiz.drop_outliers())
@@ -156,7 +156,7 @@ class WizardResultView:
         result), not only in the toast the session's guard shows."""
         run = self.parent.workflow.run
         try:
-            slot, tool = self.parent.session.save_result(str(self.save_name.value),
+            slot, tool = self.parent.session.wizard_commands.save_result(str(self.save_name.value),
                                                          number_of_option(self.save_slot.value))
         except ValueError as exc:
             self._refused = (run, str(exc))
@@ -168,7 +168,7 @@ class WizardResultView:
         wf = self.parent.workflow
         if wf.last_save is None:
             raise WizardStateError("Save the tool first: the TCP check works on a tool of the library.")
-        self.parent.session.start_wizard("tcp-check", slot=wf.last_save[0])
+        self.parent.session.wizard_commands.start("tcp-check", slot=wf.last_save[0])
 
     # ------------------------------------------------------------ render
     def refresh_slots(self, tools: dict[int, Tool]) -> None:

@@ -44,6 +44,7 @@ import viser
 
 from tcp_pendant.calibrate import CalibrationWorkflow
 from tcp_pendant.session import Session
+from tcp_pendant.session_views import SceneLabel
 from tcp_pendant.views.beam_replay import ScanPlayer, beam_view_direction, scan_spheres
 from tcp_pendant.views.framing import Framing, spread_labels
 from tcp_pendant.views.scene import frame_cameras, wxyz_xyz
@@ -93,14 +94,15 @@ class WizardSceneView:
         self._T_flange_tool_true: np.ndarray | None = None
         self.last_framing: Framing | None = None
         """The camera framing of the last result (None before one), for tests."""
-        self._label_defaults: dict[str, tuple[viser.LabelHandle, tuple[float, float, float]]] = {}
+        self._label_defaults: dict[str, tuple[SceneLabel, tuple[float, float, float]]] = {}
         self._labels_moved = False
         self._target_T: np.ndarray | None = None
         self._camera_watched: set[int] = set()
-        self._relayout = session.on_loop(self._on_camera)
+        self._relayout = session.loop.on_loop(self._on_camera)
         # in the session's labels too, so a view that restyles the scene's labels (presenter
         # mode: larger) reaches these; the boxes are spread at the size they are drawn
-        session.scene_labels.update(computed=self.computed_label, true=self.true_label, target=self.abc_label)
+        labels = session.views.labels
+        labels.computed, labels.true, labels.target = self.computed_label, self.true_label, self.abc_label
 
     # ------------------------------------------------------------ result
     def _has_sphere(self) -> bool:
@@ -219,22 +221,22 @@ class WizardSceneView:
                                                    thickness=0.003)
 
     # ------------------------------------------------------------ camera and labels
-    def _label_nodes(self) -> dict[str, tuple[viser.LabelHandle, np.ndarray | None]]:
+    def _label_nodes(self) -> dict[str, tuple[SceneLabel, np.ndarray | None]]:
         """Label name -> (handle, T_world_parent now; None: the label is in WORLD), visible ones."""
         T_wf = self.session.pose_state().T_world_flange
-        out: dict[str, tuple[viser.LabelHandle, np.ndarray | None]] = {}
+        out: dict[str, tuple[SceneLabel, np.ndarray | None]] = {}
         film = self._film_playing()                 # the triads and their labels step aside
         if self._T_flange_computed is not None and not film:
             out["computed"] = (self.computed_label, T_wf @ self._T_flange_computed)
         if self._T_flange_tool_true is not None and not film:
             out["true"] = (self.true_label, T_wf @ self._T_flange_tool_true)
-        others = self.session.scene_labels          # the robot scene's labels at the tool and tip
-        if "tool" in others and self.session.controller.active_tool is not None:
-            out["tool"] = (others["tool"], T_wf @ np.asarray(self.session.controller.T_flange_tool, dtype=float))
-        if "tip" in others:
-            out["tip"] = (others["tip"], None)
-        if "flange" in others:
-            out["flange"] = (others["flange"], T_wf)
+        others = self.session.views.labels          # the robot scene's labels at the tool and tip
+        if others.tool is not None and self.session.controller.active_tool is not None:
+            out["tool"] = (others.tool, T_wf @ np.asarray(self.session.controller.T_flange_tool, dtype=float))
+        if others.tip is not None:
+            out["tip"] = (others.tip, None)
+        if others.flange is not None:
+            out["flange"] = (others.flange, T_wf)
         if self._target_T is not None:
             out["target"] = (self.abc_label, self._target_T)
         for name, (handle, _) in out.items():

@@ -5,9 +5,9 @@ point" (``supports_add_point``: 4-point) and the live pose-diversity meter (``me
 the touch steps of 4-point and TCP & Z, X), and in training mode the Auto-touch controls. No
 wizard class is named here: what is shown is what the wizard declares. A step the controller
 runs itself (its role's ``AutoRole.by_controller``: the beam wizard's scan) shows neither Record
-nor Auto-touch; its Finish runs the wizard's controller job (``Session.take_controller_job``: the
+nor Auto-touch; its Finish runs the wizard's controller job (``WizardCommands.take_controller_job``: the
 job its class names) in a worker thread, as a TCP check's Finish runs its six rotations. Every
-click is a command of the session (``Session.record_step``, ``back``, ``next_step``, ...).
+click is a command of the session (``WizardCommands.record_step``, ``back``, ``next_step``, ...).
 
 Record is enabled only when the wizard can record (``Wizard.can_record``); Next only when the
 step is recorded. The pose-diversity meter is updated on every move of the robot (a motion
@@ -92,10 +92,10 @@ class WizardStepsView:
         self.next.on_click(self._on_next)
         self._checking = False
         self._busy_text = ""
-        self.back.on_click(act(lambda _e: session.back()))
+        self.back.on_click(act(lambda _e: session.wizard_commands.back()))
         self.cancel.on_click(act(self._on_cancel))
         self.add_point.on_click(act(self._on_add_point))
-        self.mount.on_click(act(lambda _e: session.mount_required_tool(), sync=True))
+        self.mount.on_click(act(lambda _e: session.wizard_commands.mount_required_tool(), sync=True))
         self.variant.on_update(act(self._on_variant, user_only=True))
         self.auto_direction.on_update(act(lambda _e: None, user_only=True))
         self.auto_touch.on_click(self._on_auto_touch)
@@ -112,7 +112,7 @@ class WizardStepsView:
         index = None if wiz is None else wiz.step.index
         frame = s.jogger.settings.frame
         delta = tip_offset_mm(s.pose_state(), s.controller.reference_tip_world_m, frame)
-        s.record_step()
+        s.wizard_commands.record_step()
         self._record_line = None
         if s.hide_distance and not s.rules.in_exercise:
             wiz = self.parent.workflow.wizard
@@ -122,14 +122,14 @@ class WizardStepsView:
                                  None if wiz is None else wiz.recorded_poses)
 
     def _on_cancel(self, _event: ButtonEvent) -> None:
-        if self.parent.session.cancel_wizard():
+        if self.parent.session.wizard_commands.cancel():
             self.parent.session.notify("Calibration cancelled",
                                        "Nothing recorded is lost: Resume it from the Calibrate menu.")
 
     async def _on_next(self, event: ButtonEvent) -> None:
         """Next / Finish. A wizard waiting for its controller job (a TCP check's rotations, a
         beam scan) runs it on Finish: the job is taken on the loop (under the session lock), run
-        in the server's job pool (``Session.run_job``: a TCP check's six rotations 0.1-0.3 s, a
+        in the server's job pool (``SessionLoop.run_job``: a TCP check's six rotations 0.1-0.3 s, a
         beam scan of 3 to 5 orientations well under a second), its outcome handed to the wizard
         on the loop; one job at a time."""
         session, act = self.parent.session, self.parent.action
@@ -138,9 +138,9 @@ class WizardStepsView:
         def take(_e: ButtonEvent) -> None:
             if self._checking:
                 raise WizardStateError("The controller is still at work; wait for its result.")
-            job = session.take_controller_job()
+            job = session.wizard_commands.take_controller_job()
             if job is None:
-                session.next_step()
+                session.wizard_commands.next_step()
             else:
                 jobs.append(job)
                 self._busy_text = job.busy_text
@@ -151,7 +151,7 @@ class WizardStepsView:
             return
         title = jobs[0].wizard.title
         try:
-            result = await session.run_job(jobs[0].run, what=f"the {title} wizard's controller job")
+            result = await session.loop.run_job(jobs[0].run, what=f"the {title} wizard's controller job")
         except Exception as exc:  # a browser's click must never kill the server
             self._checking = False
             if isinstance(exc, JobRefused):            # another job of this session, or a full queue
@@ -165,10 +165,10 @@ class WizardStepsView:
             return
         finally:
             self._checking = False
-        await act(lambda _e: session.hand_in_controller_job(jobs[0], result), sync=True)(event)
+        await act(lambda _e: session.wizard_commands.hand_in_controller_job(jobs[0], result), sync=True)(event)
 
     def _on_add_point(self, _event: ButtonEvent) -> None:
-        self.parent.session.add_point()
+        self.parent.session.wizard_commands.add_point()
 
     def _on_variant(self, event: DropdownEvent) -> None:
         wiz = self.parent.workflow.wizard
@@ -176,7 +176,7 @@ class WizardStepsView:
         values = {} if wiz is None else {lab: v for v, lab in type(wiz).variants}
         if wiz is None or label not in values:
             raise ValueError(f"Unknown variant {label!r}.")
-        self.parent.session.set_variant(values[label])
+        self.parent.session.wizard_commands.set_variant(values[label])
 
     def auto_request(self) -> AutoTouchRequest:
         """The Auto-touch settings as a request (random or chosen direction, operator error)."""
@@ -186,10 +186,10 @@ class WizardStepsView:
         return AutoTouchRequest(sigma_mm=sigma)
 
     async def _on_auto_touch(self, _event: ButtonEvent) -> None:
-        """Auto-touch (``Session.auto_touch_in_pool``: the probes of a TCP check's poses run in
+        """Auto-touch (``WizardCommands.auto_touch_in_pool``: the probes of a TCP check's poses run in
         the job pool); one at a time per
         session, refused at once while the session's job runs or its share is used up
-        (``Session.admit_job``), the outcome shown in one signal at the end."""
+        (``SessionLoop.admit_job``), the outcome shown in one signal at the end."""
         session = self.parent.session
         if session.closed:
             return
@@ -202,7 +202,7 @@ class WizardStepsView:
                                    "running here; wait for its result, then try again.")
             return
         try:                                    # refused at once, before anything moves
-            session.admit_job()
+            session.loop.admit_job()
         except JobRefused as exc:
             session.notify_refusal("Auto-touch not started", str(exc))
             return
@@ -213,7 +213,7 @@ class WizardStepsView:
             return
         self._auto_touching = True
         try:
-            await session.auto_touch_in_pool(request, shown=lambda out: self._show_auto_touch(out, request))
+            await session.wizard_commands.auto_touch_in_pool(request, shown=lambda out: self._show_auto_touch(out, request))
         except JobRefused as exc:
             session.notify_refusal("Auto-touch not started", str(exc))
             return
@@ -275,7 +275,7 @@ class WizardStepsView:
         failure = wf.finish_failure
         if failure is not None:                  # Finish could not compute: why, and what to do
             reason = f"Finish not possible: {failure}" if reason is None else f"{reason}\n\n{failure}"
-        short = self.parent.session.finish_refusal()   # the exercise asks for more touches
+        short = self.parent.session.wizard_commands.finish_refusal()   # the exercise asks for more touches
         if short is not None:
             reason = short if reason is None else f"{reason}\n\n{short}"
         self.blocked_md.visible = reason is not None
