@@ -52,14 +52,14 @@ def test_check_with_beam_is_off_in_an_exercise(page) -> None:
     from tcp_pendant.wizards import WizardError
     p = page({1: truth_tool("pointer", "Pointer")})
     p.activate(1)
-    p.session.set_hide_truth(True)
+    p.session.wizard_commands.set_hide_truth(True)
     p.click(p.beam.check)
     assert p.notes[-1][0] == "Not done" and "off during the trainer's exercise" in p.notes[-1][1]
     assert p.beam.last_check is None and not p.session.views["beam_player"].playing
     with pytest.raises(WizardError, match="Automatic \\(beam\\) wizard is off during the trainer's exercise"):
-        p.session.start_wizard("beam")
-    assert p.session.start_wizard("xyz4").kind == "xyz4"            # touching is the exercise
-    p.session.set_hide_truth(False)
+        p.session.wizard_commands.start("beam")
+    assert p.session.wizard_commands.start("xyz4").kind == "xyz4"            # touching is the exercise
+    p.session.wizard_commands.set_hide_truth(False)
     p.click(p.beam.check)
     assert p.beam.last_check is not None
 
@@ -96,7 +96,7 @@ def test_the_industrial_loop_crash_check_update_verify(page) -> None:
     stored = s.library.get(1)
     np.testing.assert_allclose(stored.tcp_mm, check.measured_tcp_mm, atol=1e-6)
     assert stored.calibration is not None and stored.calibration.method == "beam"
-    assert c.active_tool == stored and s.active_slot == 1           # the updated data is active
+    assert c.active_tool == stored and s.tools.active_slot == 1           # the updated data is active
     assert p.notes[-1][0] == "TCP updated"
     assert "Updated slot 1: Pointer" in p.beam.result_md.content
     assert p.beam.update.disabled                                   # one check, one update
@@ -202,7 +202,7 @@ def test_shared_mode_checks_and_updates_the_one_robot(app_factory) -> None:
         view = s.views["beam_check"]
         a, _b = app.server.get_clients().values()
         s.notify = lambda *args, **kw: None                          # type: ignore[method-assign]
-        assert s.active_slot == 1
+        assert s.tools.active_slot == 1
         click(view.check, a)
         assert view.last_check.deviation_norm_mm == pytest.approx(1.0, abs=0.05)
         wait_until(lambda: not s.views["beam_player"].playing, timeout=60, what="the film")

@@ -108,7 +108,7 @@ def test_in_an_exercise_the_beam_is_off_and_says_why(page) -> None:
     """The classroom's exercise hides the truth and asks for a calibration by touching: the
     Automatic (beam) wizard would measure the mystery tool, so Start refuses it in words."""
     p = page()
-    p.session.set_hide_truth(True)                                    # the classroom's exercise
+    p.session.wizard_commands.set_hide_truth(True)                                    # the classroom's exercise
     p.xyz4_by_hand()
     n_runs = len(p.view.workflow.runs)
     p.choose(p.view.method, "Automatic (beam)")

@@ -233,7 +233,7 @@ def test_presses_that_waited_on_a_busy_loop_signal_once_at_the_end_of_its_round(
         xs = []
         with s.lock:
             for _ in range(3):
-                s.jog("X", 1, waited_s=waited_s)
+                s.motion.jog("X", 1, waited_s=waited_s)
                 xs.append(_x_mm(s.controller))
         during = len(signals)
         await asyncio.sleep(0)                  # the loop's round ends

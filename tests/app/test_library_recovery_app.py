@@ -69,7 +69,7 @@ def test_one_bad_entry_keeps_the_others_and_the_browser_is_told(app_factory, tmp
         assert "calibrate" in session.views
         panel = session.views["tools"]
         assert panel.slots.options == ("1: tool1", "2: tool2", "4: tool4", "5: tool5")
-        assert session.active_slot is None  # per-browser: the library's active slot is not the session's
+        assert session.tools.active_slot is None  # per-browser: the library's active slot is not the session's
         title = "Tool library: bad entries set aside"
         wait_until(lambda: c.titled(title), what="the recovery notification")
         (note,) = c.titled(title)
@@ -105,7 +105,7 @@ def test_deeply_nested_library_still_gives_the_calibrate_tab(app_factory, tmp_pa
     app = app_factory()
     c, session = _open(app)
     try:
-        assert "calibrate" in session.views and session.active_slot is None
+        assert "calibrate" in session.views and session.tools.active_slot is None
         wait_until(lambda: c.titled("Tool library moved aside"), what="the notification")
         (note,) = c.titled("Tool library moved aside")
         assert "nested too deeply" in note["body"] and str(app.library.recovered_backup) in note["body"]

@@ -32,9 +32,9 @@ def test_ur5_session_starts_over_a_visible_tip_and_calibrates(app_factory) -> No
         # a 4-point calibration by the session's commands gives the pointer's true TCP
         wf = s.workflow
         with s.lock:
-            s.start_wizard("xyz4")
+            s.wizard_commands.start("xyz4")
             for _ in range(4):
-                assert s.auto_touch(AutoTouchRequest()).ok
+                assert s.wizard_commands.auto_touch(AutoTouchRequest()).ok
         true_tcp = builtin_tools()["pointer"].T_flange_tool_true[:3, 3] * 1000.0
         np.testing.assert_allclose(wf.result.tcp_mm, true_tcp, atol=1e-6)
         assert wf.export_record()["robot"]["name"] == "ur5_robot"

@@ -114,17 +114,17 @@ def test_the_close_up_and_the_status_line_follow_every_change(page) -> None:
     with s.lock:
         s.jogger.settings = s.jogger.settings.with_(increment="1", frame="WORLD")
     true_tip_at(s, (-0.6, 0.0, 0.0))                                 # 0.6 mm -X of the tip: +X 1 mm meets it
-    res = s.jog("X", 1)
+    res = s.motion.jog("X", 1)
     assert res is not None and res.stopped_by == "contact"
     assert panel.status_md.content.startswith("⚠ Stopped at the reference tip")
     assert any(title == "Jog stopped" for title, _ in p.notes)
-    s.jog("X", -1)                                                   # a press that goes through
+    s.motion.jog("X", -1)                                                   # a press that goes through
     assert panel.status_md.content == ""
-    s.jog("X", -1)
+    s.motion.jog("X", -1)
     assert panel.status_md.content == ""                             # and stays clear
     with s.lock:                                                     # a dropped press's report ...
         s.jogger.gate.dropped = 2
         panel._report_drops()
     assert panel.status_md.content == "⚠ 2 jog presses dropped: the server was busy."
-    s.jog("X", -1)                                                   # ... is cleared by the next press
+    s.motion.jog("X", -1)                                                   # ... is cleared by the next press
     assert panel.status_md.content == ""

@@ -45,7 +45,7 @@ def test_the_checkbox_switches_presenter_mode_and_its_large_readout(app_factory)
         view = s.views["presenter"]
         assert view.toggle.value is False and not view.folder.visible
         assert view.readout_md.content == ""                 # nothing rendered while off
-        labels = s.scene_labels
+        labels = s.views.labels.drawn()
         assert {"world", "flange", "tool", "tip", "computed", "true", "target"} <= set(labels)
         assert all(h.font_screen_scale == 1.0 for h in labels.values())
         choose(view.toggle, True, s.client)

@@ -76,9 +76,9 @@ def test_seven_axis_xacro_starts_draws_jogs_and_auto_touch_finds_the_tcp(app_fac
             np.testing.assert_allclose(R, Rotation.from_euler("y", -0.5 * c.q_rad[1] + 0.1).as_matrix(), atol=1e-9)
         # Auto-touch XYZ 4-point by the session's commands: the pointer's true TCP
         with s.lock:
-            s.start_wizard("xyz4")
+            s.wizard_commands.start("xyz4")
             for _ in range(4):
-                out = s.auto_touch(AutoTouchRequest())
+                out = s.wizard_commands.auto_touch(AutoTouchRequest())
                 assert out.ok, out.message
         true_tcp = builtin_tools()["pointer"].T_flange_tool_true[:3, 3] * 1000.0
         np.testing.assert_allclose(s.workflow.result.tcp_mm, true_tcp, atol=1e-6)

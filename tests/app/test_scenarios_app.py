@@ -151,7 +151,7 @@ def test_bad_scenarios_are_refused_by_name_and_change_nothing(page) -> None:
         s.set_scenario("wobbly")
     with pytest.raises(ControllerError, match="seed"):
         s.set_scenario("bent_tool", -1)
-    assert s.scenario.kind == "off" and s.scenario_world is None
+    assert s.scenario_player.scenario.kind == "off" and s.scenario_player.world is None
 
 
 # ----------------------------------------------------------------------------- the panel
@@ -162,16 +162,16 @@ def test_panel_chooses_the_scenario_and_explains_it_after_a_result(page) -> None
     assert panel.kind.value == "Off" and "No systematic error" in panel.md.content
     p.choose(panel.seed, 7)
     p.choose(panel.kind, "Robot accuracy")
-    assert s.scenario.kind == "robot_accuracy" and s.scenario.seed == 7
+    assert s.scenario_player.scenario.kind == "robot_accuracy" and s.scenario_player.scenario.seed == 7
     assert "Playing **Robot accuracy** (seed 7)" in panel.md.content
     assert "How this result shows it" not in panel.md.content
     auto_xyz4(p)
-    expected = escape_markdown(explain(s.scenario_world))
+    expected = escape_markdown(explain(s.scenario_player.world))
     assert expected in panel.md.content and panel.md.content == scenario_markdown(s)
     res = p.calibrate.workflow.result
     assert 0.02 < res.max_error_mm < 1.0                               # the arm's inaccuracy shows
     p.choose(panel.kind, "Off")
-    assert s.scenario.kind == "off" and s.controller.true_kinematics is s.controller.kinematics
+    assert s.scenario_player.scenario.kind == "off" and s.controller.true_kinematics is s.controller.kinematics
 
 
 def test_panel_shows_in_training_mode_only(page) -> None:
@@ -188,7 +188,7 @@ def test_a_bad_seed_from_the_browser_is_one_notification(page) -> None:
     p = page()
     p.choose(p.panel.kind, "Bent tool")
     p.choose(p.panel.seed, -3)
-    assert p.session.scenario.kind == "bent_tool" and p.session.scenario.seed == 0
+    assert p.session.scenario_player.scenario.kind == "bent_tool" and p.session.scenario_player.scenario.seed == 0
     assert len(p.notes) == 1 and "seed" in p.notes[0][1]
     assert p.panel.seed.value == 0 and p.panel.kind.value == "Bent tool"   # shows what is played
 
@@ -196,7 +196,7 @@ def test_a_bad_seed_from_the_browser_is_one_notification(page) -> None:
 # ----------------------------------------------------------------------------- start options
 def test_start_option_scenario_every_session_starts_with_it(page) -> None:
     p = page(scenario="bent_tool", scenario_seed=5)
-    assert p.session.scenario.kind == "bent_tool" and p.session.scenario.seed == 5
+    assert p.session.scenario_player.scenario.kind == "bent_tool" and p.session.scenario_player.scenario.seed == 5
     assert p.panel.kind.value == "Bent tool"
     pointer = builtin_tools()["pointer"]
     assert not np.allclose(p.session.controller.mounted_tool.T_flange_tool_true, pointer.T_flange_tool_true)
@@ -269,15 +269,15 @@ def test_reference_wizard_under_a_bent_tool_is_graded_against_the_bent_new_tool(
     pointer = c.mounted_tool                                         # the bent pointer, as bolted on
     T = pointer.T_flange_tool_true
     s.library.save(1, Tool.from_rotation("Pointer", tuple(T[:3, 3] * 1000.0), T[:3, :3]))
-    s.reload_library()
+    s.tools.reload_library()
     wf = p.calibrate.workflow
-    s.start_wizard("reference", slot=1, reference_tool_key="pointer", new_tool_key="torch")
-    s.auto_touch(AutoTouchRequest())
-    s.mount_required_tool()
+    s.wizard_commands.start("reference", slot=1, reference_tool_key="pointer", new_tool_key="torch")
+    s.wizard_commands.auto_touch(AutoTouchRequest())
+    s.wizard_commands.mount_required_tool()
     torch = c.mounted_tool
     bent_mm = np.linalg.norm(torch.T_flange_tool_true[:3, 3] - builtin_tools()["torch"].T_flange_tool_true[:3, 3])
     assert torch.key == "torch" and bent_mm * 1000.0 > 2.0           # the bent torch is on the flange
-    s.auto_touch(AutoTouchRequest())
+    s.wizard_commands.auto_touch(AutoTouchRequest())
     res, truth = wf.result, wf.truth()
     assert res is not None and truth is not None
     np.testing.assert_allclose(res.tcp_mm, torch.T_flange_tool_true[:3, 3] * 1000.0, atol=1e-6)

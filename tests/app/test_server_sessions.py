@@ -120,24 +120,24 @@ def test_numeric_entry_saves_all_or_nothing_and_exports(app_factory, tmp_path: P
         p.entry_name.value = "Gun"
         for f, v in zip("XYZABC", ("12.5", "-3", "abc", "0", "90", "0")):
             p.entry_fields[f].value = v
-        s.guard(p._on_entry_save)(None)
+        s.loop.guard(p._on_entry_save)(None)
         assert s.library.tools() == {}                        # nothing saved half-way
         assert p.entry_errors["Z"].visible and "not a number" in p.entry_errors["Z"].content
         assert not p.entry_errors["X"].visible
         p.entry_fields["Z"].value = "180"
-        s.guard(p._on_entry_save)(None)
+        s.loop.guard(p._on_entry_save)(None)
         tools = s.library.tools()
         assert list(tools) == [1] and tools[1].tcp_mm == (12.5, -3.0, 180.0)
         assert not p.entry_errors["Z"].visible
         # same name again: refused, with the error next to the name
-        s.guard(p._on_entry_save)(None)
+        s.loop.guard(p._on_entry_save)(None)
         assert len(s.library.tools()) == 1 and p.entry_name_err.visible
         p.slots.value = "1: Gun"
         p.export_fmt.value = "KUKA"
-        s.guard(p._on_export)(None)
+        s.loop.guard(p._on_export)(None)
         assert p.export_text.value == export_tool(tools[1], "kuka", slot=1)
         # activate: the controller's TCP becomes the tool's
-        s.guard(p._on_activate)(None)
+        s.loop.guard(p._on_activate)(None)
         T = s.controller.T_world_flange()
         expected = T[:3, :3] @ (np.array([12.5, -3.0, 180.0]) / 1000.0) + T[:3, 3]
         np.testing.assert_allclose(s.controller.T_world_tcp()[:3, 3], expected, atol=1e-12)
@@ -164,9 +164,9 @@ def test_touches_record_delete_and_guard(app_factory) -> None:
         rows = s.views["touches"]._rows
         assert len(rows) == 4                                   # label + delete button per touch
         # a bad event is reported, not raised
-        assert s.guard(lambda: s.delete_touch(7))() is None
+        assert s.loop.guard(lambda: s.delete_touch(7))() is None
         assert len(s.touches) == 2
     finally:
         c.close()
     wait_until(lambda: not app.sessions, what="session closed")
-    assert s.closed and s.guard(lambda: 1 / 0)() is None         # after close: ignored
+    assert s.closed and s.loop.guard(lambda: 1 / 0)() is None         # after close: ignored

@@ -331,7 +331,7 @@ def test_on_loop_runs_callbacks_on_the_loop_under_the_guard(app_factory) -> None
 
         notes: list[tuple[str, str]] = []
         s.notify = lambda title, body, **kw: notes.append((title, body))
-        cb = s.on_loop(fn)
+        cb = s.loop.on_loop(fn)
         assert asyncio.iscoroutinefunction(cb)
         asyncio.run_coroutine_threadsafe(cb(None), app.server.get_event_loop()).result(10)
         assert seen == [(True, True)] and notes == [("Not done", "no such slot")]

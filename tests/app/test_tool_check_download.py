@@ -165,7 +165,7 @@ def test_shared_mode_sends_the_file_to_the_browser_that_clicked(app_factory) -> 
         for c in (a, b):
             c.send_file_download = lambda name, data, *_, _id=c.client_id, **__: got[_id].append(name)
         panel = app.shared_session.views["tools"]
-        app.shared_session.reload_library()
+        app.shared_session.tools.reload_library()
         click(panel.download, b)
         assert got == {a.client_id: [], b.client_id: ["tool1_config.dat"]}
     finally:

@@ -89,7 +89,7 @@ def test_the_docks_tilt_line_names_the_best_tilt_on_one_fixed_line(page) -> None
     assert dock.tilt_html.visible and dock.tilt_html.content == tilt_line_html(None)
     assert "&nbsp;" in dock.tilt_html.content and "white-space:nowrap" in TILT_LINE_STYLE
     for _ in range(2):
-        assert s.auto_touch(AutoTouchRequest()).ok
+        assert s.wizard_commands.auto_touch(AutoTouchRequest()).ok
     assert wiz.step.index == 2
     c = s.controller
     best = best_tilt(wiz.other_rotations(), c.T_world_flange()[:3, :3], R_flange_tool=c.T_flange_tool[:3, :3],

@@ -195,7 +195,7 @@ def install_baseline(session: Any) -> None:
         for sign in (1, -1):
             def hold(_event: Any, sign: int = sign) -> None:
                 pendant._jog("X", sign, hold_tick=True)
-            pendant.cart_buttons[("X", sign)]._button_impl.hold_cbs_from_freq[HOLD_HZ] = [session.guard(hold)]
+            pendant.cart_buttons[("X", sign)]._button_impl.hold_cbs_from_freq[HOLD_HZ] = [session.loop.guard(hold)]
 
 
 class NaiveRenderer:
@@ -587,7 +587,7 @@ def wizard_touches(sessions: list[Any], per_session: int) -> dict[str, float]:
     with the classroom the recorder's gradebook write), its wall time (median, p95: the event
     loop is blocked that long; includes the write's fsync) and process CPU per touch."""
     for s in sessions:
-        _in_action(s, lambda s=s: s.start_wizard("xyz4"))
+        _in_action(s, lambda s=s: s.wizard_commands.start("xyz4"))
     time.sleep(0.3)
     cpu: list[float] = []
     wall: list[float] = []
@@ -595,13 +595,13 @@ def wizard_touches(sessions: list[Any], per_session: int) -> dict[str, float]:
     for _ in range(per_session):
         for s in sessions:
             t0, w0 = time.thread_time(), time.perf_counter()
-            _in_action(s, s.record_step)
+            _in_action(s, s.wizard_commands.record_step)
             cpu.append(time.thread_time() - t0)
             wall.append(time.perf_counter() - w0)
     time.sleep(0.3)
     process = time.process_time() - p0
     for s in sessions:
-        _in_action(s, s.cancel_wizard)
+        _in_action(s, s.wizard_commands.cancel)
     time.sleep(0.3)
     n = len(cpu)
     return {"thread_ms": float(np.median(cpu)) * 1e3, "wall_ms": float(np.median(wall)) * 1e3,

@@ -105,9 +105,9 @@ def _check_pinned_block(app, page, shot) -> None:
     folder = _presenter_folder(page)
     page.get_by_role("tab", name="Calibrate").click()
     s = app.shared_session
-    s.start_wizard("xyz4")
+    s.wizard_commands.start("xyz4")
     for _ in range(4):
-        assert s.auto_touch(AutoTouchRequest()).ok
+        assert s.wizard_commands.auto_touch(AutoTouchRequest()).ok
     wait_visible_text(page, "Against the true TOOL frame: good")
     chart = folder.locator(".uplot-container").first
     chart.locator("canvas").first.wait_for(state="visible", timeout=TIMEOUT_MS)

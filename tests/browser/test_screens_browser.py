@@ -108,12 +108,12 @@ def test_jog_keys_stay_put_near_the_tip_and_at_a_stop(app_factory, new_page, sho
     # in a wizard: the dock above the keys; its tilt line (empty after one touch, the words after
     # two) keeps its height, so the keys stay where the open dock put them
     with ThreadPoolExecutor(max_workers=1) as pool:
-        pool.submit(lambda: (s.start_wizard("xyz4"), s.auto_touch(AutoTouchRequest()))).result()
+        pool.submit(lambda: (s.wizard_commands.start("xyz4"), s.wizard_commands.auto_touch(AutoTouchRequest()))).result()
     page.get_by_text("Step 2 of 4").first.wait_for(state="visible", timeout=TIMEOUT_MS)
     page.wait_for_timeout(300)
     one_touch = key_boxes(page)
     with ThreadPoolExecutor(max_workers=1) as pool:
-        assert pool.submit(s.auto_touch, AutoTouchRequest()).result().ok
+        assert pool.submit(s.wizard_commands.auto_touch, AutoTouchRequest()).result().ok
     page.get_by_text("Tilt that helps most").first.wait_for(state="visible", timeout=TIMEOUT_MS)
     page.wait_for_timeout(300)
     assert_same_and_inside(one_touch, key_boxes(page), SIZES[-1], "with the dock's tilt line")
@@ -121,16 +121,16 @@ def test_jog_keys_stay_put_near_the_tip_and_at_a_stop(app_factory, new_page, sho
 
 def finish_by_auto_touch(s: Any, kind: str, **options: Any) -> Any:
     """Start wizard ``kind``, Auto-touch (and mount) every step, Finish: the result."""
-    s.start_wizard(kind, **options)
+    s.wizard_commands.start(kind, **options)
     wf = s.workflow
     for _ in range(12):
         w = wf.wizard
         if w.is_complete:
             break
         if w.auto_role(w.step).by_controller:     # the beam scan: the controller runs it at Finish
-            s.next_step()
+            s.wizard_commands.next_step()
         else:
-            out = s.auto_touch(AutoTouchRequest())
+            out = s.wizard_commands.auto_touch(AutoTouchRequest())
             assert out.ok, out
     assert wf.wizard.is_complete, wf.wizard.status
     return wf.result
@@ -165,7 +165,7 @@ def test_result_screens(app_factory, new_page, shots) -> None:
             page.screenshot(path=str(png))
             assert_not_blank(png)
         with ThreadPoolExecutor(max_workers=1) as pool:
-            pool.submit(s.cancel_wizard).result()
+            pool.submit(s.wizard_commands.cancel).result()
 
 
 def _view_png(page: Any) -> Any:
@@ -241,7 +241,7 @@ def test_result_labels_drawn_apart_at_1024x768(app_factory, new_page) -> None:
     wait_until(lambda: scene.computed.visible, "the COMPUTED triad", timeout=90)
     page.mouse.move(1000, 760)
     labels = {"COMPUTED": scene.computed_label, "TRUE": scene.true_label,
-              **{n: s.scene_labels[n] for n in ("tool", "tip", "flange") if n in s.scene_labels}}
+              **{n: h for n, h in s.views.labels.drawn().items() if n in ("tool", "tip", "flange")}}
     boxes = {}
     for name, handle in labels.items():
         if handle.visible:

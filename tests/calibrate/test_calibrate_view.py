@@ -74,7 +74,7 @@ def test_four_auto_touches_run_a_4point_calibration_and_every_view_follows(page)
     assert v.result.save_preview.content.startswith("Will save **Pen 4P** · X 0.00 Y 0.00 Z 180.00 mm")
     p.click(v.result.save)
     assert "Saved **Pen 4P** in slot 1" in v.result.save_md.content
-    assert s.active_slot == 1 and s.controller.active_tool.name == "Pen 4P"
+    assert s.tools.active_slot == 1 and s.controller.active_tool.name == "Pen 4P"
     assert "Active tool:** Pen 4P (slot 1)" in s.views["tools"].active_md.content
     assert ToolLibrary(s.library.path).active_slot() is None     # per-browser: the file's is not touched
 
@@ -96,7 +96,7 @@ def test_reference_wizard_disables_record_until_the_tool_change(page) -> None:
     p.choose(v.new_physical, "Bent-neck welding torch")
     assert f"touch 2 with the *{escape_markdown('bent-neck welding torch')}*" in v.menu_md.content
     p.click(v.start)
-    assert s.active_slot == 1 and "Active tool:** Pointer (slot 1)" in s.views["tools"].active_md.content
+    assert s.tools.active_slot == 1 and "Active tool:** Pointer (slot 1)" in s.views["tools"].active_md.content
     p.click(v.steps.auto_touch)
     assert v.steps.record.disabled and v.steps.mount.visible
     assert v.steps.mount.label == "Mount the bent-neck welding torch"

@@ -97,7 +97,7 @@ def record_in_the_air_on_the_page(p: Any, *, exercise: bool) -> list[float]:
     v, s = p.view, p.session
     s.set_hide_distance(True)
     if exercise:
-        s.set_hide_truth(True)                    # what the classroom sets in an exercise
+        s.wizard_commands.set_hide_truth(True)                    # what the classroom sets in an exercise
     with s.lock:
         s.controller.jog_cartesian("world", "Z", 300.0)
     p.click(v.start)

@@ -179,7 +179,7 @@ def test_abc_world_target_tool_and_tip_labels_do_not_collide(page, tmp_path) -> 
     p = page()
     v, s = p.view, p.session
     s.library.save(2, library_tool_with_true_tcp("pointer", "Pen"))
-    s.reload_library()                               # as the server's library watcher does
+    s.tools.reload_library()                               # as the server's library watcher does
     p.choose(v.method, "ABC world (parallel axes)")
     p.click(v.start)
     with s.lock:                                     # the trainee jogs the tip onto the reference tip

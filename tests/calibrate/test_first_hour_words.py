@@ -126,13 +126,13 @@ def test_tool_data_defaults_to_the_active_slot_not_slot_1(page) -> None:
     p.choose(tools.slots, "3: Torch")
     p.click(tools.activate)
     p.choose(v.method, "ABC world (parallel axes)")
-    assert s.active_slot == 3, "the session's active tool should be offered"
+    assert s.tools.active_slot == 3, "the session's active tool should be offered"
     assert v.library_tool.value == "3: Torch"
     p.choose(v.library_tool, "4: Gripper")       # the user's pick holds ...
     p.choose(v.method, "Three-point orientation")
     assert v.library_tool.value == "4: Gripper"
     p.click(v.start)                             # ... and Start makes it active
-    assert s.active_slot == 4 and v.workflow.wizard.tool.name == "Gripper"
+    assert s.tools.active_slot == 4 and v.workflow.wizard.tool.name == "Gripper"
 
 
 def test_the_4_point_steps_ask_for_what_the_meter_can_reward() -> None:
@@ -157,12 +157,12 @@ def test_the_touch_list_points_at_the_wizards_touches(tmp_path) -> None:
 
     s = make_session(tmp_path / "tools.json", seed=4)
     assert empty_touches_markdown(s.workflow.wizard) == "*No touch recorded.*"
-    s.start_wizard("xyz4")
+    s.wizard_commands.start("xyz4")
     for _ in range(4):
-        s.auto_touch(AutoTouchRequest())
+        s.wizard_commands.auto_touch(AutoTouchRequest())
     text = empty_touches_markdown(s.workflow.wizard)
     assert "No touch recorded with Record point" in text and "has 4 touches of its own" in text
-    s.cancel_wizard()
+    s.wizard_commands.cancel()
     assert empty_touches_markdown(s.workflow.wizard) == "*No touch recorded.*"
 
 
@@ -173,15 +173,15 @@ def test_exact_touches_are_not_called_outside_the_95_percent_radius(tmp_path) ->
     from tcp_pendant.calibrate.text import truth_markdown
 
     s = make_session(tmp_path / "tools.json", seed=6)
-    s.start_wizard("xyz4")
+    s.wizard_commands.start("xyz4")
     while s.workflow.result is None:
-        s.auto_touch(AutoTouchRequest(sigma_mm=0.0))
+        s.wizard_commands.auto_touch(AutoTouchRequest(sigma_mm=0.0))
     truth = s.workflow.truth()
     assert truth.position_error_mm < 1e-6 and truth.inside_ci95 is True and truth.grade == "good"
     md = truth_markdown(truth)
     assert "outside" not in md and "the computed TCP is the true one" in md
-    s.back()                                     # a touch 2 mm off: a real error, judged as before
-    s.auto_touch(AutoTouchRequest(sigma_mm=2.0))
+    s.wizard_commands.back()                                     # a touch 2 mm off: a real error, judged as before
+    s.wizard_commands.auto_touch(AutoTouchRequest(sigma_mm=2.0))
     noisy = s.workflow.truth()
     assert noisy.position_error_mm > 1e-3
     assert ("inside" if noisy.inside_ci95 else "**outside**") in truth_markdown(noisy)

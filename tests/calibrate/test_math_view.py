@@ -83,7 +83,7 @@ def math_md(v) -> str:
 def touch(s, n: int = 1, sigma_mm: float = 0.3) -> None:
     for _ in range(n):
         with s.lock:
-            assert s.auto_touch(AutoTouchRequest(sigma_mm=sigma_mm)).ok
+            assert s.wizard_commands.auto_touch(AutoTouchRequest(sigma_mm=sigma_mm)).ok
 
 
 def check_pair(sheet: MathSheet, R: np.ndarray, f: np.ndarray, a: int, b: int) -> None:
@@ -107,7 +107,7 @@ def test_xyz4_math_is_live_from_the_first_touch_and_matches_numpy(page) -> None:
     v, s = p.view, p.session
     assert not v.math.folder.visible
     with s.lock:
-        s.start_wizard("xyz4")
+        s.wizard_commands.start("xyz4")
     wiz = s.workflow.wizard
     assert v.math.folder.visible and v.math.sheet is not None and v.math.sheet.blocks == ()
     touch(s)
@@ -181,13 +181,13 @@ def test_xyz4_math_is_live_from_the_first_touch_and_matches_numpy(page) -> None:
         s.moved()
     assert v.math.renders == n
     with s.lock:
-        s.back()
+        s.wizard_commands.back()
     assert v.math.renders == n + 1
 
     # an exercise: the same sheet, the trainee's data only (no number other than the blocks')
     before = math_md(v)
     with s.lock:
-        s.set_hide_truth(True)
+        s.wizard_commands.set_hide_truth(True)
     assert math_md(v) == before
     assert_text_is_the_numbers(math_md(v), v.math.sheet)
 
@@ -196,10 +196,10 @@ def test_dropped_touches_leave_the_math_as_they_leave_the_solver(page) -> None:
     p = page()
     v, s = p.view, p.session
     with s.lock:
-        s.start_wizard("xyz4", n_points=5)
+        s.wizard_commands.start("xyz4", n_points=5)
     touch(s, 5)
     with s.lock:
-        s.edit_result(lambda w: w.set_excluded([1]))
+        s.wizard_commands.edit_result(lambda w: w.set_excluded([1]))
     res = s.workflow.result
     sheet = v.math.sheet
     assert [b.key for b in sheet.blocks][:4] == ["touch-1", "touch-3", "touch-4", "touch-5"]
@@ -216,12 +216,12 @@ def test_reference_math_r_then_t2_in_world_and_in_flange(page) -> None:
     ref = library_tool_with_true_tcp("pointer", "Pointer")
     s.library.save(1, ref)
     with s.lock:
-        s.start_wizard("reference", slot=1, reference_tool_key="pointer", new_tool_key="torch")
+        s.wizard_commands.start("reference", slot=1, reference_tool_key="pointer", new_tool_key="torch")
     touch(s)
     sheet = v.math.sheet
     assert [b.key for b in sheet.blocks] == ["reference-point"]
     with s.lock:
-        s.mount_required_tool()
+        s.wizard_commands.mount_required_tool()
     touch(s)
     res = s.workflow.result
     assert res is not None
@@ -259,7 +259,7 @@ def test_three_point_variants_1_and_2_follow_the_papers_steps(page) -> None:
     s.library.save(1, tool)
     t = np.asarray(tool.tcp_mm)
     with s.lock:
-        s.start_wizard("three-point", slot=1)
+        s.wizard_commands.start("three-point", slot=1)
     touch(s, 2)
     sheet = v.math.sheet
     assert [b.key for b in sheet.blocks] == ["eq7", "eq8-17"]            # live, as the poses arrive
@@ -289,7 +289,7 @@ def test_three_point_variants_1_and_2_follow_the_papers_steps(page) -> None:
     assert_text_is_the_numbers(md, sheet)
 
     with s.lock:                                                   # variant 2: V(3), Δ3, Δ4
-        s.set_variant(2)
+        s.wizard_commands.set_variant(2)
     touch(s)
     res = s.workflow.result
     assert res is not None and res.method == "three-point-2"
@@ -318,7 +318,7 @@ def test_abc_world_math_is_the_flange_rotation_transposed_times_the_target(page)
     v, s = p.view, p.session
     s.library.save(1, library_tool_with_true_tcp("torch", "Torch"))
     with s.lock:
-        s.start_wizard("abc-world", slot=1)
+        s.wizard_commands.start("abc-world", slot=1)
     assert v.math.folder.visible and v.math.sheet.blocks == ()
     touch(s, sigma_mm=0.0)
     res = s.workflow.result
@@ -338,7 +338,7 @@ def test_tcp_zx_math_touches_then_the_z_and_x_directions(page) -> None:
     p = page()
     v, s = p.view, p.session
     with s.lock:
-        s.start_wizard("tcp-zx", n_points=4)
+        s.wizard_commands.start("tcp-zx", n_points=4)
     touch(s, 2)
     sheet, md = v.math.sheet, math_md(v)
     R, f = touches_mm(s.workflow.wizard)
@@ -376,10 +376,10 @@ def test_beam_math_stacks_the_tip_events(page) -> None:
     p = page()
     v, s = p.view, p.session
     with s.lock:
-        s.start_wizard("beam")
+        s.wizard_commands.start("beam")
     assert v.math.folder.visible and v.math.sheet.blocks == ()
     with s.lock:
-        s.next_step()                               # the controller runs the scan
+        s.wizard_commands.next_step()                               # the controller runs the scan
     res = s.workflow.result
     assert res is not None
     sheet, md = v.math.sheet, math_md(v)
@@ -425,9 +425,9 @@ def test_spin_check_math_bounds_the_drifts_by_the_tcp_error(page) -> None:
     s.library.save(1, Tool(name="Off", tcp_mm=tuple(float(x) for x in tcp + off),
                            abc_deg=tuple(float(x) for x in abc)))
     with s.lock:
-        s.start_wizard("tcp-check", slot=1)
-        assert s.auto_touch(AutoTouchRequest(tilt_deg=25.0, azimuth_deg=30.0)).ok
-        s.next_step()                                               # the six spins, here synchronously
+        s.wizard_commands.start("tcp-check", slot=1)
+        assert s.wizard_commands.auto_touch(AutoTouchRequest(tilt_deg=25.0, azimuth_deg=30.0)).ok
+        s.wizard_commands.next_step()                                               # the six spins, here synchronously
     check = s.workflow.result.check
     sheet, md = v.math.sheet, math_md(v)
     drifts = [r.deviation_mm for r in check.rows if r.reached]

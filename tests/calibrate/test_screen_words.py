@@ -39,10 +39,10 @@ def test_after_start_the_calibrate_tab_says_to_jog_on_the_jog_tab_and_record_in_
     # the words name what is there: the dock's folder and its Record button, on the Jog tab
     assert f"*{dock.folder.label}* box" in head and dock.record.label == "Record" and "**Record**" in head
     assert "(key R)" in head
-    s.auto_touch(AutoTouchRequest())
+    s.wizard_commands.auto_touch(AutoTouchRequest())
     assert "Step 2 of 4" in v.steps.head_md.content and "Jog on the Jog tab" in v.steps.head_md.content
     for _ in range(3):
-        s.auto_touch(AutoTouchRequest())
+        s.wizard_commands.auto_touch(AutoTouchRequest())
     assert v.workflow.result is not None
     assert "Jog on the Jog tab" not in v.steps.head_md.content          # the result: nothing to jog
 
@@ -108,8 +108,8 @@ def test_the_calibrate_tab_meter_names_the_tilt_after_two_touches(page) -> None:
     v, s = p.view, p.session
     p.click(v.start)
     assert "Tilt that helps most" not in v.steps.meter_md.content       # no touch yet
-    s.auto_touch(AutoTouchRequest())
-    s.auto_touch(AutoTouchRequest())
+    s.wizard_commands.auto_touch(AutoTouchRequest())
+    s.wizard_commands.auto_touch(AutoTouchRequest())
     wiz = v.workflow.wizard
     tilt = best_tilt(wiz.other_rotations(), s.controller.T_world_flange()[:3, :3],
                      R_flange_tool=s.controller.T_flange_tool[:3, :3], sigma_mm=wiz.assumed_sigma_mm)
@@ -122,19 +122,19 @@ def test_the_3d_tool_label_follows_a_wizards_tool_change(page) -> None:
     s, c = p.session, p.session.controller
     T = builtin_tools()["pointer"].T_flange_tool_true
     s.library.save(1, Tool.from_rotation("Straight pointer", tuple(T[:3, 3] * 1000.0), T[:3, :3]))
-    s.reload_library()
+    s.tools.reload_library()
     scene = s.views["scene"]
-    s.start_wizard("reference", slot=1, reference_tool_key="pointer", new_tool_key="torch")
+    s.wizard_commands.start("reference", slot=1, reference_tool_key="pointer", new_tool_key="torch")
     label, axes = scene._active_label, scene._active_axes
     assert label.text == "TOOL Straight pointer"             # the pointer's data on the pointer
-    s.auto_touch(AutoTouchRequest())
-    s.mount_required_tool()                                  # the wizard bolts the torch on
+    s.wizard_commands.auto_touch(AutoTouchRequest())
+    s.wizard_commands.mount_required_tool()                                  # the wizard bolts the torch on
     assert c.mounted_tool.key == "torch" and c.active_tool is not None
     assert label.text == "TOOL Straight pointer · on Bent-neck welding torch"
     np.testing.assert_allclose(axes.position, c.T_flange_tool[:3, 3], atol=1e-12)   # where the data puts the TCP
     # new tool data: the label and the triad follow it
     torch_T = builtin_tools()["torch"].T_flange_tool_true
-    s.set_active_data(Tool.from_rotation("Bent-neck welding torch", tuple(torch_T[:3, 3] * 1000.0), torch_T[:3, :3]))
+    s.tools.set_active_data(Tool.from_rotation("Bent-neck welding torch", tuple(torch_T[:3, 3] * 1000.0), torch_T[:3, :3]))
     assert label.text == "TOOL Bent-neck welding torch"
     np.testing.assert_allclose(axes.position, torch_T[:3, 3], atol=1e-9)
     assert tool_label_text(None, c.mounted_tool) == "TOOL"
@@ -145,7 +145,7 @@ def test_the_result_panel_names_what_3d_draws(page) -> None:
     v, s = p.view, p.session
     p.click(v.start)
     for _ in range(4):
-        s.auto_touch(AutoTouchRequest())
+        s.wizard_commands.auto_touch(AutoTouchRequest())
     res = v.workflow.result
     legend = v.result.legend_md.content
     assert v.result.legend_md.visible and "**COMPUTED**" in legend and "**TRUE**" in legend

@@ -42,7 +42,7 @@ def _save_torch_as(p: Page, name: str) -> int:
     assert v.workflow.result is not None
     p.choose(v.result.save_name, name)
     p.click(v.result.save)
-    slot = p.session.active_slot
+    slot = p.session.tools.active_slot
     assert slot is not None and p.session.controller.active_tool.name == name
     return slot
 
@@ -57,7 +57,7 @@ def test_a_trainees_tool_does_not_become_the_next_trainees(page) -> None:
 
     b = page(on=app)                                 # B connects later
     sb = b.session
-    assert sb.active_slot is None and sb.controller.active_tool is None
+    assert sb.tools.active_slot is None and sb.controller.active_tool is None
     assert sb.controller.mounted_tool.key == "pointer"
     np.testing.assert_allclose(sb.controller.T_flange_tool, np.eye(4))
     assert "FLANGE (no tool active)" in sb.views["pendant"].tcp_md.content
@@ -65,11 +65,11 @@ def test_a_trainees_tool_does_not_become_the_next_trainees(page) -> None:
     assert f"{slot}: Torch A" in sb.views["tools"].slots.options   # ... but sees the stored tool
 
     b.click(sb.views["tools"].deactivate)            # B's "No tool" is B's
-    assert a.session.active_slot == slot and a.session.controller.active_tool.name == "Torch A"
+    assert a.session.tools.active_slot == slot and a.session.controller.active_tool.name == "Torch A"
     assert "TOOL Torch A" in a.session.views["pendant"].tcp_md.content
     b.choose(sb.views["tools"].slots, f"{slot}: Torch A")
     b.click(sb.views["tools"].activate)              # B activates it: B's only
-    assert sb.active_slot == slot
+    assert sb.tools.active_slot == slot
     a.click(a.session.views["tools"].deactivate)     # A's "No tool" is A's
     assert a.session.controller.active_tool is None and sb.controller.active_tool.name == "Torch A"
     assert ToolLibrary(app.library.path).active_slot() is None
@@ -81,9 +81,9 @@ def test_shared_mode_starts_with_the_librarys_active_tool_and_sets_it(app_factor
     lib.save(2, Tool(name="Torch", tcp_mm=(0.0, 0.0, 200.0)), activate=True)
     app = app_factory(shared=True, seed=5)
     s = app.shared_session
-    assert s is not None and s.active_slot == 2 and s.controller.active_tool.name == "Torch"
+    assert s is not None and s.tools.active_slot == 2 and s.controller.active_tool.name == "Torch"
     with s.lock:
-        s.activate(1)
+        s.tools.activate(1)
     assert ToolLibrary(lib.path).active_slot() == 1                # the shared start tool
     assert "TOOL Pen" in s.views["pendant"].tcp_md.content
 
@@ -95,7 +95,7 @@ def test_a_command_ends_in_one_change_signal_and_every_view_follows(page) -> Non
     s.subscribe(changes.append)
     torch = builtin_tools()["torch"]
     with s.lock:
-        s.mount_tool(torch)                          # a command that knows no view
+        s.tools.mount_tool(torch)                          # a command that knows no view
     (change,) = changes
     assert change.tool and change.pose and change.state is not None
     assert change.state.key[3] == id(torch)          # the pose state is the new tool's
@@ -112,9 +112,9 @@ def test_a_command_ends_in_one_change_signal_and_every_view_follows(page) -> Non
 
     changes.clear()
     with s.lock:
-        s.set_active_data(Tool(name="Typed", tcp_mm=(0.0, 0.0, 123.0)))
+        s.tools.set_active_data(Tool(name="Typed", tcp_mm=(0.0, 0.0, 123.0)))
     (change,) = changes
-    assert change.tool and s.active_slot is None
+    assert change.tool and s.tools.active_slot is None
     np.testing.assert_allclose(s.views["scene"]._active_axes.position, (0.0, 0.0, 0.123), atol=1e-12)
     assert s.views["scene"]._active_label.text == "TOOL Typed"
     assert "TOOL Typed" in s.views["pendant"].tcp_md.content
@@ -147,7 +147,7 @@ def test_workflow_wizard_is_a_plain_getter(page) -> None:
     p.view.render()                                  # a whole re-render reads it many times
     assert calls == []
     with p.session.lock:
-        p.session.mount_tool(builtin_tools()["gripper"])    # the wizard learns it from the signal
+        p.session.tools.mount_tool(builtin_tools()["gripper"])    # the wizard learns it from the signal
     assert calls and calls[-1][0] == "gripper"
     calls.clear()
     with p.session.lock:

@@ -27,7 +27,7 @@ PROBE = "Auto-touch's check of the pose it reached"
 def _check_wizard(page: Any) -> Any:
     p = page(tools={1: truth_tool("pointer", "Pointer")})
     s = p.session
-    s.start_wizard("tcp-check", slot=1)
+    s.wizard_commands.start("tcp-check", slot=1)
     return p
 
 
@@ -62,7 +62,7 @@ def test_a_robot_moved_while_the_probe_ran_records_nothing(page) -> None:
         """The browser jogs while the probe runs (on the loop, between the move and the answer)."""
 
         async def run(self, owner: Any, fn: Any, *, what: str) -> Any:
-            s.jog("x", 1)
+            s.motion.jog("x", 1)
             return await super().run(owner, fn, what=what)
 
     s.jobs = pool = MovingPool()
@@ -79,7 +79,7 @@ def test_a_check_while_the_sessions_other_job_runs_is_refused_in_words(page) -> 
     p = page(tools={1: truth_tool("pointer", "Pointer")})
     s: Session = p.session
     panel = s.views["tools"]
-    s.activate(1)
+    s.tools.activate(1)
     gate = threading.Event()
     s.jobs = pool = JobPool()
     running = pool.submit(s, lambda: gate.wait(10), what="a beam check")     # e.g. the TCP service's scan
@@ -102,7 +102,7 @@ def test_the_docks_finish_runs_the_check_in_the_job_pool(page) -> None:
     p = _check_wizard(page)
     s: Session = p.session
     s.jobs = pool = JobPool(keep_history=True)
-    assert s.auto_touch(AutoTouchRequest(tilt_deg=25.0, azimuth_deg=30.0)).ok     # probes in place
+    assert s.wizard_commands.auto_touch(AutoTouchRequest(tilt_deg=25.0, azimuth_deg=30.0)).ok     # probes in place
     p.choose(s.views["dock"].nav, FINISH)
     assert p.notes == [] and s.workflow.result is not None                       # checked, finished
     assert pool.history is not None and [h.what for h in pool.history] == [

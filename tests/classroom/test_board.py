@@ -43,17 +43,17 @@ def test_the_board_is_rebuilt_from_the_file_after_a_restart(gradebook_target: Pa
         s.subscribe(rec.on_change)
         sessions[name] = s
     anna, ben = sessions["Anna"], sessions["Ben <b>"]
-    anna.start_wizard("xyz4")
+    anna.wizard_commands.start("xyz4")
     for _ in range(6):
         if anna.workflow.result is not None:
             break
-        anna.auto_touch(AutoTouchRequest())
+        anna.wizard_commands.auto_touch(AutoTouchRequest())
     assert anna.workflow.result is not None
-    anna.start_wizard("xyz4")                       # a second one, left at step 2 after one touch
-    anna.auto_touch(AutoTouchRequest())
-    ben.start_wizard("xyz4")
-    ben.auto_touch(AutoTouchRequest())
-    ben.auto_touch(AutoTouchRequest())              # Ben at step 3, two touches
+    anna.wizard_commands.start("xyz4")                       # a second one, left at step 2 after one touch
+    anna.wizard_commands.auto_touch(AutoTouchRequest())
+    ben.wizard_commands.start("xyz4")
+    ben.wizard_commands.auto_touch(AutoTouchRequest())
+    ben.wizard_commands.auto_touch(AutoTouchRequest())              # Ben at step 3, two touches
     truth = anna.workflow.runs[0].wizard.finished_result
     first = book.grades.rows()[0]
     book.close()

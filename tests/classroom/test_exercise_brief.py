@@ -61,14 +61,14 @@ def test_a_method_the_exercise_does_not_allow_is_refused_by_start_wizard(book: G
     assert room.push_brief("Find the TCP.", ["xyz4"], 0) == 1
     assert anna.rules.allowed_methods == ("xyz4",) and anna.rules.instructions == "Find the TCP."
     with pytest.raises(RuleRefusal, match=r"does not use the Three-point orientation method: choose XYZ 4-point"):
-        anna.start_wizard("three-point")
+        anna.wizard_commands.start("three-point")
     assert anna.workflow.wizard is None                    # nothing was opened
     anna.record_touch()
     room.push_brief("", ["tcp-zx"], 0)
     with pytest.raises(RuleRefusal, match="does not use the XYZ 4-point method"):
-        anna.start_from_touches()                          # an XYZ 4-point too
+        anna.wizard_commands.start_from_touches()                          # an XYZ 4-point too
     assert anna.workflow.wizard is None
-    assert anna.start_wizard("tcp-zx").kind == "tcp-zx"
+    assert anna.wizard_commands.start("tcp-zx").kind == "tcp-zx"
     with pytest.raises(ValueError, match="Unknown calibration method 'nope'.*xyz4"):
         room.push_brief("", ["xyz4", "nope"], 0)
     assert anna.rules.allowed_methods == ("tcp-zx",)       # a refused push set nothing
@@ -78,31 +78,31 @@ def test_finish_with_fewer_touches_than_the_minimum_is_refused_in_words(book: Gr
     room = ClassRoom(book, {}, trainer_token=TOKEN)
     bo, _ = _trainee(room, tmp_path, "Bo")
     room.push_brief("", None, 6)
-    wiz = bo.start_wizard("xyz4", n_points=4)
+    wiz = bo.wizard_commands.start("xyz4", n_points=4)
     for _ in range(4):
-        assert bo.auto_touch(AutoTouchRequest()).ok
+        assert bo.wizard_commands.auto_touch(AutoTouchRequest()).ok
     words = "This exercise asks for at least 6 touches: record 2 more (press Add point for another touch step)."
     assert bo.workflow.result is None and wiz.on_last_step        # Auto-touch's last touch did not finish
-    assert bo.finish_refusal() == words
+    assert bo.wizard_commands.finish_refusal() == words
     with pytest.raises(RuleRefusal) as refused:
-        bo.next_step()
+        bo.wizard_commands.next_step()
     assert str(refused.value) == words and not wiz.is_complete
-    bo.add_point()
-    assert "record 1 more" in (bo.finish_refusal() or "")
-    bo.add_point()
-    bo.auto_touch(AutoTouchRequest())
-    bo.auto_touch(AutoTouchRequest())
-    assert bo.finish_refusal() is None and bo.workflow.result is not None and len(wiz.solver_touch_steps()) == 6
+    bo.wizard_commands.add_point()
+    assert "record 1 more" in (bo.wizard_commands.finish_refusal() or "")
+    bo.wizard_commands.add_point()
+    bo.wizard_commands.auto_touch(AutoTouchRequest())
+    bo.wizard_commands.auto_touch(AutoTouchRequest())
+    assert bo.wizard_commands.finish_refusal() is None and bo.workflow.result is not None and len(wiz.solver_touch_steps()) == 6
     # TCP & Z, X chooses its touches at start and has no Add point: refused there
     with pytest.raises(RuleRefusal, match="set Touches to 6 or more for the TCP & Z, X"):
-        bo.start_wizard("tcp-zx", n_points=4)
-    assert bo.start_wizard("tcp-zx", n_points=6).kind == "tcp-zx"
+        bo.wizard_commands.start("tcp-zx", n_points=4)
+    assert bo.wizard_commands.start("tcp-zx", n_points=6).kind == "tcp-zx"
     # a method with a fixed number of poses keeps its own count
-    bo.store_tool(1, library_tool_with_true_tcp("pointer", "Pointer"))
-    three = bo.start_wizard("three-point", slot=1)
+    bo.tools.store_tool(1, library_tool_with_true_tcp("pointer", "Pointer"))
+    three = bo.wizard_commands.start("three-point", slot=1)
     for _ in range(three.n_steps):
-        bo.auto_touch(AutoTouchRequest())
-    assert bo.workflow.result is not None and bo.finish_refusal() is None
+        bo.wizard_commands.auto_touch(AutoTouchRequest())
+    assert bo.workflow.result is not None and bo.wizard_commands.finish_refusal() is None
 
 
 def test_a_message_to_one_trainee_reaches_only_that_trainee_and_dismissed_stays_dismissed(
@@ -148,7 +148,7 @@ def test_the_brief_outlives_a_restart_and_an_older_gradebook_still_opens(tmp_pat
         cleo, _ = _trainee(room, tmp_path, "Cleo")
         assert cleo.rules == room.rules
         with pytest.raises(RuleRefusal):
-            cleo.start_wizard("abc-world")
+            cleo.wizard_commands.start("abc-world")
         # options given at start win over the kept brief, and are kept
         assert ClassRoom(book, {}, trainer_token=None, min_touches=3, allowed_methods="reference").rules.min_touches == 3
         assert ClassRoom(book, {}, trainer_token=None).rules.allowed_methods == ("reference",)

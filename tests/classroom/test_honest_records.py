@@ -23,12 +23,12 @@ from support.calib_helpers import make_controller, make_session
 def _finished_class_session(tmp_path: Path, name: str = "Anna", sigma: float = 0.3):
     book = Gradebook(tmp_path / "class.sqlite3", synchronous="NORMAL")
     s = make_session(tmp_path / "tools.json", seed=5)
-    s.keep_honest_records()
+    s.wizard_commands.keep_honest_records()
     rec = TraineeRecorder(book, book.records.start_session(book.trainees.add(name), "per-browser"), name, s.workflow)
     s.subscribe(rec.on_change)
-    s.start_wizard("xyz4")
+    s.wizard_commands.start("xyz4")
     while s.workflow.result is None:
-        s.auto_touch(AutoTouchRequest(sigma_mm=sigma))
+        s.wizard_commands.auto_touch(AutoTouchRequest(sigma_mm=sigma))
     return book, s.workflow
 
 

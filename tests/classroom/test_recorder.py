@@ -28,13 +28,13 @@ def setup(tmp_path: Path):
 def test_auto_and_hand_touches_overwrite_and_finish_are_stored(setup) -> None:
     book, s, rec = setup
     c, wf = s.controller, s.workflow
-    s.start_wizard("xyz4")
+    s.wizard_commands.start("xyz4")
     cal = rec._runs[0].calibration_id
     assert book.records.calibration_status(cal) == "in_progress"
-    s.auto_touch(AutoTouchRequest())               # step 1 by Auto-touch
-    s.back()                                       # Auto-touch went on to step 2: back to step 1
-    s.record_step()                                # step 1 again, by hand: overwrites the auto touch
-    s.next_step()
+    s.wizard_commands.auto_touch(AutoTouchRequest())               # step 1 by Auto-touch
+    s.wizard_commands.back()                                       # Auto-touch went on to step 2: back to step 1
+    s.wizard_commands.record_step()                                # step 1 again, by hand: overwrites the auto touch
+    s.wizard_commands.next_step()
     touches = book.records.touches(cal)
     assert [t["auto"] for t in touches] == [True, False]
     assert touches[1]["overwrites_touch_id"] == touches[0]["id"]
@@ -43,7 +43,7 @@ def test_auto_and_hand_touches_overwrite_and_finish_are_stored(setup) -> None:
     np.testing.assert_allclose(touches[1]["joints_deg"], np.degrees(c.q_rad))
     assert touches[0]["distance_mm"] is not None and touches[0]["distance_mm"] < 3.0
     for _ in range(4):
-        s.auto_touch(AutoTouchRequest())
+        s.wizard_commands.auto_touch(AutoTouchRequest())
         if wf.result is not None:
             break
     assert wf.result is not None
@@ -63,16 +63,16 @@ def test_a_touch_is_stored_with_the_joints_and_distance_of_its_record_not_of_the
     """A Record and a jog in one signal (one batch): the gradebook keeps the joints and the
     distance the robot had at Record, not those after the jog."""
     book, s, rec = setup
-    s.start_wizard("xyz4")
-    s.auto_touch(AutoTouchRequest())                # the tool tip on the reference tip
-    s.back()
+    s.wizard_commands.start("xyz4")
+    s.wizard_commands.auto_touch(AutoTouchRequest())                # the tool tip on the reference tip
+    s.wizard_commands.back()
     q_at_record = np.degrees(s.controller.q_rad)
     d_at_record = s.controller.touch_geometry().distance_mm
     with s.batch():
-        s.record_step()
+        s.wizard_commands.record_step()
         s.jogger.settings = s.jogger.settings.with_(increment="10")
-        s.jog("Z", 1)
-        s.jog("Z", 1)
+        s.motion.jog("Z", 1)
+        s.motion.jog("Z", 1)
     assert s.controller.touch_geometry().distance_mm > d_at_record + 15.0     # the robot moved away
     touches = book.records.touches(rec._runs[0].calibration_id)
     last = touches[-1]
@@ -83,18 +83,18 @@ def test_a_touch_is_stored_with_the_joints_and_distance_of_its_record_not_of_the
 
 def test_cancel_resume_and_loaded_runs(setup, tmp_path: Path) -> None:
     book, s, rec = setup
-    s.start_wizard("xyz4")
-    s.record_step()
+    s.wizard_commands.start("xyz4")
+    s.wizard_commands.record_step()
     cal = rec._runs[0].calibration_id
-    s.cancel_wizard()
+    s.wizard_commands.cancel()
     assert book.records.calibration_status(cal) == "cancelled"
-    s.resume_wizard(0)
+    s.wizard_commands.resume(0)
     assert book.records.calibration_status(cal) == "in_progress"
     # a record loaded from a file arrives cancelled: not this session's work, not stored
     other = make_session(tmp_path / "t2.json", seed=1)
-    other.start_wizard("xyz4")
-    other.record_step()
-    s.load_record(load_and_replay(other.workflow.export_record()))
+    other.wizard_commands.start("xyz4")
+    other.wizard_commands.record_step()
+    s.wizard_commands.load_record(load_and_replay(other.workflow.export_record()))
     assert len(s.workflow.runs) == 2 and 1 not in rec._runs
     with book.store.read() as db:
         assert db.execute("SELECT COUNT(*) FROM calibrations").fetchone()[0] == 1
@@ -103,7 +103,7 @@ def test_cancel_resume_and_loaded_runs(setup, tmp_path: Path) -> None:
 def test_crash_transitions_are_counted_once(setup) -> None:
     book, s, rec = setup
     c = s.controller
-    s.start_wizard("xyz4")
+    s.wizard_commands.start("xyz4")
     assert not c.touch_geometry().crashed
     # drive the true tool 5 mm through the tip along its own X (the approach direction)
     T_true = c.T_world_tool_true()

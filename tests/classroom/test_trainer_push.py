@@ -229,14 +229,14 @@ def test_the_mounted_tool_lock_follows_the_trainers_exercise(app_factory, tmp_pa
     try:
         _name(anna, "Anna")
         mystery, tools = anna.controller.mounted_tool, anna.views["tools"]
-        assert anna.exercise_tool is mystery and tools.mounted.disabled and tools.mounted_lock_md.visible
+        assert anna.tools.exercise_tool is mystery and tools.mounted.disabled and tools.mounted_lock_md.visible
         app.classroom.push_settings("mystery", "torch")           # a tool pushed in the exercise: ignored
         assert anna.controller.mounted_tool is mystery
         app.classroom.push_to("Anna", tool_key="torch", hide_distance="shown")
         wait_until(lambda: not anna.hide_distance, what="the push to Anna, applied on her loop")
         assert anna.controller.mounted_tool is mystery
         app.classroom.push_settings(None, None)                   # free practice: the lock goes
-        assert anna.exercise_tool is None and not tools.mounted.disabled and not tools.mounted_lock_md.visible
+        assert anna.tools.exercise_tool is None and not tools.mounted.disabled and not tools.mounted_lock_md.visible
         choose(tools.mounted, "Bent-neck welding torch", anna.client)
         assert anna.controller.mounted_tool.key == "torch"
         app.classroom.push_settings("mystery", None)              # the exercise again: its tool, locked

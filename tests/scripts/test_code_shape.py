@@ -29,7 +29,6 @@ JUSTIFIED = "Long because"
 """A docstring line starting with this states why a function is over :data:`MAX_FUNCTION_LINES`."""
 
 BIG_CLASSES = {
-    "session:Session": "the browser session owns too much: being split into small owners",
     "class_room:ClassRoom": "the class room owns too much: being split into small owners",
     "workflow:CalibrationWorkflow": "the calibration workflow owns too much: being split into small owners",
 }

@@ -54,10 +54,10 @@ def _trainee(room: ClassRoom, tmp_path: Path, name: str, seed: int = 0):
 
 def _calibrate_and_save(session, name: str) -> tuple[int, Tool]:
     """The XYZ 4-point by Auto-touch, then "Save to tool library" (slot: the first free one)."""
-    session.start_wizard("xyz4")
+    session.wizard_commands.start("xyz4")
     while session.workflow.result is None:
-        session.auto_touch(AutoTouchRequest())
-    return session.save_result(name)
+        session.wizard_commands.auto_touch(AutoTouchRequest())
+    return session.wizard_commands.save_result(name)
 
 
 def test_one_trainee_cannot_fill_the_library_so_another_trainees_save_still_works(tmp_path: Path) -> None:
@@ -66,7 +66,7 @@ def test_one_trainee_cannot_fill_the_library_so_another_trainees_save_still_work
     alice = _trainee(room, tmp_path, "Alice", seed=1)
     for slot in range(1, 17):                                 # the attack: every slot, one by one
         try:
-            mallory.store_tool(slot, _tool(f"spam {slot}", slot))
+            mallory.tools.store_tool(slot, _tool(f"spam {slot}", slot))
         except ToolLibraryError as exc:
             refusal = str(exc)
             break
@@ -79,12 +79,12 @@ def test_one_trainee_cannot_fill_the_library_so_another_trainees_save_still_work
     # a calibration (the wizard's Save) and the numeric entry of another trainee still save
     slot, tool = _calibrate_and_save(alice, "Alice pointer")
     assert slot == 4 and lib.get(4) == tool
-    alice.store_tool(5, _tool("Alice typed"))
+    alice.tools.store_tool(5, _tool("Alice typed"))
     assert lib.owners() == {1: "Mallory", 2: "Mallory", 3: "Mallory", 4: "Alice", 5: "Alice"}
     # Mallory may still replace a tool of her own (no new slot), and after a delete save again
-    mallory.store_tool(2, _tool("spam 2 again"))
-    mallory.delete_tool(1)
-    mallory.store_tool(6, _tool("spam 6"))
+    mallory.tools.store_tool(2, _tool("spam 2 again"))
+    mallory.tools.delete_tool(1)
+    mallory.tools.store_tool(6, _tool("spam 6"))
     assert sorted(k for k, v in lib.owners().items() if v == "Mallory") == [2, 3, 6]
 
 
@@ -94,10 +94,10 @@ def test_a_trainee_cannot_delete_rename_or_overwrite_a_classmates_or_the_trainer
     room = _class(tmp_path)
     alice = _trainee(room, tmp_path, "Alice")
     mallory = _trainee(room, tmp_path, "Mallory", seed=1)
-    alice.store_tool(5, _tool("Alice tool"))
+    alice.tools.store_tool(5, _tool("Alice tool"))
     kept = lib.get(5)
-    for attempt in (lambda: mallory.delete_tool(5), lambda: mallory.rename_tool(5, "pwned"),
-                    lambda: mallory.store_tool(5, _tool("pwned"))):
+    for attempt in (lambda: mallory.tools.delete_tool(5), lambda: mallory.tools.rename_tool(5, "pwned"),
+                    lambda: mallory.tools.store_tool(5, _tool("pwned"))):
         with pytest.raises(ToolLibraryError) as exc:
             attempt()
         assert str(exc.value).startswith("Slot 5 belongs to another trainee:")
@@ -105,28 +105,28 @@ def test_a_trainee_cannot_delete_rename_or_overwrite_a_classmates_or_the_trainer
         assert "Save into a free slot or one of your own" in str(exc.value)
     assert lib.get(5) == kept and lib.owners()[5] == "Alice"
     # the calibration Save into a chosen slot of another trainee is refused the same way
-    mallory.start_wizard("xyz4")
+    mallory.wizard_commands.start("xyz4")
     while mallory.workflow.result is None:
-        mallory.auto_touch(AutoTouchRequest())
+        mallory.wizard_commands.auto_touch(AutoTouchRequest())
     with pytest.raises(ToolLibraryError, match="Slot 5 belongs to another trainee"):
-        mallory.save_result("pwned", 5)
+        mallory.wizard_commands.save_result("pwned", 5)
     with pytest.raises(ValueError, match="'Alice tool' is taken by slot 5, a tool that is not yours"):
-        mallory.save_result("Alice tool")                       # no slot chosen: the name's slot
+        mallory.wizard_commands.save_result("Alice tool")                       # no slot chosen: the name's slot
     assert lib.get(5) == kept
-    for attempt in (lambda: mallory.delete_tool(1), lambda: mallory.rename_tool(1, "pwned")):
+    for attempt in (lambda: mallory.tools.delete_tool(1), lambda: mallory.tools.rename_tool(1, "pwned")):
         with pytest.raises(ToolLibraryError, match="Slot 1 is the trainer's"):
             attempt()
     assert lib.get(1) == _tool("reference pointer") and lib.get(5) == kept
     # the owner herself may
-    alice.rename_tool(5, "Alice renamed")
+    alice.tools.rename_tool(5, "Alice renamed")
     assert lib.get(5).name == "Alice renamed" and lib.owners()[5] == "Alice"
-    alice.delete_tool(5)
+    alice.tools.delete_tool(5)
     assert lib.get(5) is None and lib.owners() == {}
     # a pendant of the class that has not given a name changes nothing
     stranger = make_session(tmp_path / "tools.json", seed=2)
-    stranger.set_library_rights(room._library_rights(stranger, None))
+    stranger.tools.set_library_rights(room._library_rights(stranger, None))
     with pytest.raises(ToolLibraryError, match="Join the class with your name first"):
-        stranger.store_tool(7, _tool("anonymous"))
+        stranger.tools.store_tool(7, _tool("anonymous"))
     assert lib.get(7) is None
 
 
@@ -141,10 +141,10 @@ def test_ownership_survives_a_restart_of_the_server(tmp_path: Path) -> None:
     room2 = _class(tmp_path)
     bob = _trainee(room2, tmp_path, "Bob", seed=2)
     with pytest.raises(ToolLibraryError, match="Slot 3 belongs to another trainee"):
-        bob.delete_tool(3)
-    bob.rename_tool(4, "Bob tool 2")
+        bob.tools.delete_tool(3)
+    bob.tools.rename_tool(4, "Bob tool 2")
     alice = _trainee(room2, tmp_path, "Alice", seed=3)
-    alice.delete_tool(3)
+    alice.tools.delete_tool(3)
     assert ToolLibrary(tmp_path / "tools.json").owners() == {4: "Bob"}
     room2.gradebook.close()
 
@@ -172,12 +172,12 @@ def test_without_a_class_and_in_shared_mode_every_slot_is_anyones_as_before(tmp_
     room = _class(tmp_path)
     _trainee(room, tmp_path, "Alice").store_tool(5, _tool("Alice tool"))
     free = make_session(tmp_path / "tools.json", seed=4)     # a pendant without a class (and --shared)
-    assert free.library_rights == UNRESTRICTED
+    assert free.tools.library_rights == UNRESTRICTED
     for slot in range(1, 17):
         if slot != 5:
-            free.store_tool(slot, _tool(f"tool {slot}"))      # no quota
-    free.rename_tool(5, "renamed")
-    free.delete_tool(5)
+            free.tools.store_tool(slot, _tool(f"tool {slot}"))      # no quota
+    free.tools.rename_tool(5, "renamed")
+    free.tools.delete_tool(5)
     lib = ToolLibrary(tmp_path / "tools.json")
     assert len(lib.tools()) == 15 and lib.owners() == {}
     assert "owners" not in json.loads((tmp_path / "tools.json").read_text(encoding="utf-8"))
@@ -195,9 +195,9 @@ def test_the_trainer_renames_and_deletes_any_trainees_tool_from_the_tool_tab(app
         p = trainee.views["identity"]
         choose(p.name_field, "Alice", trainee.client)
         click(p.start, trainee.client)
-        trainee.store_tool(4, _tool("Alice tool"))
+        trainee.tools.store_tool(4, _tool("Alice tool"))
         panel = trainer.views["tools"]
-        wait_until(lambda: 4 in trainer.library_tools, what="the trainer's pendant lists the tool")
+        wait_until(lambda: 4 in trainer.tools.library_tools, what="the trainer's pendant lists the tool")
         choose(panel.slots, "4: Alice tool", trainer.client)
         click(panel.delete, trainer.client)                   # not the trainer yet: a pendant without a name
         assert app.library.get(4) == _tool("Alice tool")

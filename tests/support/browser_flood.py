@@ -104,7 +104,7 @@ class FloodRig:
         self.victim_notes: list[tuple[str, str]] = []
         self.victim.notify = lambda title, body, kind="info": self.victim_notes.append((title, body))  # type: ignore[method-assign]
         with self.victim.lock:
-            self.victim.set_active_data(self.tool)
+            self.victim.tools.set_active_data(self.tool)
             self.victim.jogger.settings = self.victim.jogger.settings.with_(increment="0.1", frame="WORLD")
         self.rate_hz = rate_hz
         self.attacker_notes: list[tuple[str, str]] = []
@@ -170,9 +170,9 @@ class FloodRig:
 
         async def select() -> None:
             with a.lock:
-                a.set_active_data(self.tool, 1)
-                a.set_training(True)
-                a.start_wizard("xyz4")
+                a.tools.set_active_data(self.tool, 1)
+                a.wizard_commands.set_training(True)
+                a.wizard_commands.start("xyz4")
                 tools.slots.value = next(o for o in tools.slots.options if str(o).startswith("1"))
         self.on_loop(select())
 

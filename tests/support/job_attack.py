@@ -121,7 +121,7 @@ class Classroom:
         self.victim.notify = lambda title, body, kind="info": self.notes.append((title, body))  # type: ignore[method-assign]
         for s in [self.victim, *self.attackers]:
             with s.lock:
-                s.set_active_data(self.tool)
+                s.tools.set_active_data(self.tool)
         with self.victim.lock:
             self.victim.jogger.settings = self.victim.jogger.settings.with_(increment="0.1", frame="WORLD")
         self.loop = self.victim.views["calibrate"].load._impl.gui_api._event_loop
@@ -143,7 +143,7 @@ class Classroom:
             with s.lock:
                 job = (check_job(s.controller, self.tool, "Pointer", 30.0) if self.attack_kind == "check"
                        else beam_check_job(s.controller, None, self.tool, rng_seed=1))
-            await s.run_job(job.run, what=f"a {'TCP' if self.attack_kind == 'check' else 'beam'} check")
+            await s.loop.run_job(job.run, what=f"a {'TCP' if self.attack_kind == 'check' else 'beam'} check")
 
     def jog_latency_s(self, timeout_s: float = 2.0) -> float | None:
         """Click X+ in the victim's browser and wait until its robot moved: seconds, or None when
