@@ -6,7 +6,8 @@ stored tools; its ``active_slot`` is the CLI's ``tools activate`` and the ``--sh
 start tool: a per-browser session starts with no active tool (TCP = flange), never reads it and
 never writes it; the ``--shared`` session starts with it and writes it when a tool is activated
 or saved there. :class:`SessionTools` is also the workflow's ``ToolState``: a wizard mounts
-tools and sets tool data through it. Every command ends in the session's one change signal.
+tools and sets tool data through it, and reads there what limits it (the exercise's tool, its
+rules, "Hide distance"). Every command ends in the session's one change signal.
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ from typing import ContextManager, Protocol
 from tcpcal.errors import TcpcalError
 from tcpcal.library import ToolLibrary
 from tcpcal.tool import Tool
-from tcp_pendant.calibrate.pendant_rules import UNRESTRICTED, LibraryRights, check_tool_change
+from tcp_pendant.calibrate.pendant_rules import UNRESTRICTED, ExerciseRules, LibraryRights, check_tool_change
 from tcp_pendant.calibrate.workflow import CalibrationWorkflow
 from tcp_pendant.controller import ControllerError, ToolModel, VirtualController
 from tcp_pendant.session_scenario import ScenarioPlayer
@@ -34,6 +35,8 @@ class ToolsHost(Protocol):
     workflow: CalibrationWorkflow
     shared: bool
     scenario_player: ScenarioPlayer
+    rules: ExerciseRules
+    hide_distance: bool
 
     def changed(self, *, tool: bool = False, library: bool = False) -> None: ...
 
@@ -64,6 +67,16 @@ class SessionTools:
         self.library_error: str | None = None
         self.library_owners: dict[int, str] = {}
         self.library_rights: LibraryRights = UNRESTRICTED
+
+    @property
+    def rules(self) -> ExerciseRules:
+        """The session's exercise rules (the workflow reads them: the methods, Auto-touch)."""
+        return self._host.rules
+
+    @property
+    def hide_distance(self) -> bool:
+        """The session's "Hide distance" (the workflow notes it with each touch)."""
+        return self._host.hide_distance
 
     # ------------------------------------------------------------ the physical tool
     def mount_tool(self, tool: ToolModel) -> None:
