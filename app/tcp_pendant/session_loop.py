@@ -81,7 +81,7 @@ class SessionLoop:
 
         return wrapper
 
-    def on_loop(self, fn: Callable[..., Any]) -> Callable[..., Coroutine[Any, Any, None]]:
+    def on_loop(self, fn: Callable[P, object]) -> Callable[P, Coroutine[Any, Any, None]]:
         """``fn`` as a GUI callback that viser runs on its event loop, under :meth:`guard`.
 
         viser awaits an ``async`` callback on its event loop (a plain one goes to its thread
@@ -101,7 +101,7 @@ class SessionLoop:
         guarded = self.guard(fn)
 
         @functools.wraps(fn)
-        async def callback(*args: Any, **kwargs: Any) -> None:
+        async def callback(*args: P.args, **kwargs: P.kwargs) -> None:
             guarded(*args, **kwargs)
 
         return callback

@@ -13,7 +13,7 @@ from __future__ import annotations
 import threading
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
-from typing import Any, ContextManager, Protocol, TypeVar
+from typing import ContextManager, Protocol, TypeVar
 
 from tcpcal.tool import Tool
 from tcp_pendant.calibrate import ControllerJob
@@ -96,7 +96,7 @@ class WizardCommands:
         with self._host.lock:
             return self._host.workflow.touches_short()
 
-    def start(self, kind: str, **options: Any) -> Wizard:
+    def start(self, kind: str, **options: object) -> Wizard:
         """Open a wizard of the registered ``kind`` with its start options (the open one is
         cancelled and kept; ``CalibrationWorkflow.start``).
 

@@ -318,7 +318,7 @@ def test_per_browser_rename_clears_the_box_of_the_browser_that_clicked(app_facto
 
 
 def test_on_loop_runs_callbacks_on_the_loop_under_the_guard(app_factory) -> None:
-    """``Session.on_loop``: an ``async`` callback (viser awaits it on its loop) that holds the
+    """``SessionLoop.on_loop``: an ``async`` callback (viser awaits it on its loop) that holds the
     session lock, ignores a closed session and turns an error into a notification."""
     app = app_factory()
     b, s = _browser_session(app)

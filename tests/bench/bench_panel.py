@@ -4,7 +4,7 @@ one process, alternating.
 
 The step is the class's: the pendant's "X +" / "X −" key pressed (0.1 mm increments, WORLD
 frame) on the KR 6 with the pointer (the default robot and tool), through the press path a
-browser's click takes (``PendantPanel._jog`` -> ``Session.jog`` -> ``Jogger.key`` -> the change
+browser's click takes (``PendantPanel._jog`` -> ``MotionCommands.jog`` -> ``Jogger.key`` -> the change
 signal), over N sessions built by ``on_client_connect`` for N headless websocket clients in a
 separate process (``bench_server.Rig``: real viser messages are queued and sent). Five presses
 one way, five back, round robin over the sessions.

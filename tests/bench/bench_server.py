@@ -24,7 +24,7 @@ the same code in both:
 * B  paced: every session 30 steps/s for a few seconds, steps called in this process;
 * C  paced end to end: every client holds "X +" / "X −" (viser's button-hold messages, 30 per
      second per client, alternating every 5); the server receives them, runs the hold
-     callbacks (the app's on viser's event loop, through ``Session.on_loop`` like every GUI
+     callbacks (the app's on viser's event loop, through ``SessionLoop.on_loop`` like every GUI
      callback; the baseline's in viser's thread pool), jogs (continuous mode,
      override set for ~1 mm per tick) and sends the updates. Steps are counted by a motion
      listener. This is the path a browser's jog takes.

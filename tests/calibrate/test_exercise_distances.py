@@ -73,7 +73,7 @@ def record_in_the_air(wf: Any, *, hide_distance: bool) -> list[float]:
 def test_the_export_gives_no_distance_to_trilaterate_the_tcp_from_in_an_exercise(workflow, exercise: bool) -> None:
     wf = workflow()
     wf.honest_records = exercise                  # a classroom's trainee
-    wf.hide_truth = exercise                      # the exercise (Session.set_hide_truth)
+    wf.hide_truth = exercise                      # the exercise (WizardCommands.set_hide_truth)
     true_tcp = wf.controller.mounted_tool.T_flange_tool_true[:3, 3] * 1e3
     record_in_the_air(wf, hide_distance=True)
     text = dumps(wf.export_record())

@@ -1,4 +1,4 @@
-"""The exercise's tool stays mounted (``Session.set_exercise_tool``): "Mounted tool" is refused in
+"""The exercise's tool stays mounted (``SessionTools.set_exercise_tool``): "Mounted tool" is refused in
 words, a calibration may only measure that tool, and the XYZ reference method's tool change is
 the one exception, for its own run; free practice swaps freely. A calibration is filed under the
 tool it measured: touches of another tool than their step measures do not finish."""

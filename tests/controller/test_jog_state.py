@@ -163,7 +163,7 @@ def _jogged_at_wrist_plus() -> VirtualController:
 
 def test_a_wizard_move_to_the_other_side_of_the_wrist_singularity_drops_the_state():
     ctrl = _jogged_at_wrist_plus()
-    ctrl.set_q(np.radians(Q_WRIST_MINUS_DEG))          # Session.set_joints: a wizard's or a scan's move
+    ctrl.set_q(np.radians(Q_WRIST_MINUS_DEG))          # MotionCommands.set_joints: a wizard's or a scan's move
     assert _state(ctrl) is None
     res = ctrl.jog_cartesian("WORLD", "X", 0.1)        # a stale det sign (+) would stop it here
     assert res.ok, res.message

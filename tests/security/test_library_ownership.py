@@ -132,8 +132,8 @@ def test_a_trainee_cannot_delete_rename_or_overwrite_a_classmates_or_the_trainer
 
 def test_ownership_survives_a_restart_of_the_server(tmp_path: Path) -> None:
     room = _class(tmp_path)
-    _trainee(room, tmp_path, "Alice").store_tool(3, _tool("Alice tool"))
-    _trainee(room, tmp_path, "Bob", seed=1).store_tool(4, _tool("Bob tool"))
+    _trainee(room, tmp_path, "Alice").tools.store_tool(3, _tool("Alice tool"))
+    _trainee(room, tmp_path, "Bob", seed=1).tools.store_tool(4, _tool("Bob tool"))
     room.gradebook.close()
     doc = json.loads((tmp_path / "tools.json").read_text(encoding="utf-8"))
     assert doc["owners"] == {"3": "Alice", "4": "Bob"}        # documented in docs/formats.md
@@ -170,7 +170,7 @@ def test_without_a_class_and_in_shared_mode_every_slot_is_anyones_as_before(tmp_
     from tcp_pendant.serve.cli import main
 
     room = _class(tmp_path)
-    _trainee(room, tmp_path, "Alice").store_tool(5, _tool("Alice tool"))
+    _trainee(room, tmp_path, "Alice").tools.store_tool(5, _tool("Alice tool"))
     free = make_session(tmp_path / "tools.json", seed=4)     # a pendant without a class (and --shared)
     assert free.tools.library_rights == UNRESTRICTED
     for slot in range(1, 17):

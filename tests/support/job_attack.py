@@ -3,7 +3,7 @@ pendant server in this process, the victim's browser over a real websocket (a Bu
 jogs, and runs the Tool tab's Check through the panel's own callback) and attacker sessions on
 the same server and job pool (sessions as the server builds them, without a browser: they run
 the Check's job, taken under the session lock as the Tool tab takes it, through the session's
-own command ``Session.run_job``, again the moment its result is back). Every session has the
+own command ``SessionLoop.run_job``, again the moment its result is back). Every session has the
 pointer's true tool data (TCP and axes) active, so every job is the same six rotations (or the
 same beam scan) from the same pose."""
 
