@@ -379,8 +379,9 @@ def test_run_tests_fails_on_a_broken_layer_with_lint_imports_output_and_runs_no_
 # The layers of pyproject.toml's [tool.importlinter], bottom first ("|": siblings that import
 # none of each other); lint-imports also wants every module of tcp_pendant in one of them.
 APP_LAYERS = (("events", "job_pool", "message_rate", "refusal_notices", "text_escape"), ("controller",),
-              ("pendant",), ("wizards",), ("calibrate",), ("session",), ("classroom",), ("views",),
-              ("serve",), ("__main__",))
+              ("pendant",), ("wizards",), ("calibrate",), ("session_scenario", "session_views"),
+              ("session_tools", "session_loop"), ("session_wizard", "session_motion"), ("session",),
+              ("classroom",), ("views",), ("serve",), ("__main__",))
 
 
 def _lint_imports(tree: Path) -> subprocess.CompletedProcess[str]:
