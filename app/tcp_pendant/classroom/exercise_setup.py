@@ -66,8 +66,10 @@ class ExerciseSetup:
         settings: the gradebook's class settings (what was pushed is kept there).
         tool_keys: the physical tools a push may mount.
         exercise: None (free practice) or "mystery", given at start: it wins over a kept one.
-        instructions, allowed_methods, min_touches: the brief given at start (None: as kept);
-            each part given wins over the kept one and is kept.
+        instructions: the exercise's instructions given at start (None: as kept); each part
+            of the brief given wins over the kept one and is kept.
+        allowed_methods: the methods the exercise allows, given at start (None: as kept).
+        min_touches: the fewest touches a Finish takes, given at start (None: as kept).
 
     Raises:
         ValueError: an unknown exercise or method, instructions too long, a bad minimum.
