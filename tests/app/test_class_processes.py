@@ -236,7 +236,7 @@ def test_the_token_lockout_holds_on_the_other_process(two) -> None:
         click(prompt.open_trainer, sb.client)
         assert prompt.message.content.startswith(escape_markdown(
             "⚠ Too many wrong trainer tokens from this browser: try again in 1 s."))
-        assert b.classroom._trainer_views == {}
+        assert b.classroom.dashboards.views == {}
         now[0] += 1.5
         assert b.classroom.open_trainer(sb, "wrong-guess-05-abcdef") is False    # the 6th: 2 s
         with pytest.raises(TrainerTokenLocked, match=r"try again in 2 s\."):

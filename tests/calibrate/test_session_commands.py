@@ -189,5 +189,5 @@ def test_joints_are_kept_only_for_the_poses_a_run_still_holds(tmp_path: Path) ->
         s.wizard_commands.record_step()
     held = s.workflow.wizard.recorded_poses
     assert len(held) == 1
-    assert len(s.workflow._record_q) == 1
+    assert len(s.workflow.touches._record_q) == 1
     np.testing.assert_allclose(s.workflow.joints_at_record(held[0]), s.controller.q_rad)

@@ -149,7 +149,7 @@ def test_dashboards_render_at_most_twice_a_second_and_once_per_burst(tmp_path: P
                      call_later=lambda delay, fn: later.append((delay, fn)))
     s = make_session(tmp_path / "tools.json", seed=1)
     view = _FakeView(s)
-    room._trainer_views[id(s)] = view
+    room.dashboards.views[id(s)] = view
     for _ in range(50):                      # a burst of changes (100 trainees touching at once)
         room.refresh_trainers()
     assert len(view.renders) == 1            # the first at once ...

@@ -14,7 +14,8 @@ import pytest
 from support.calib_helpers import library_tool_with_true_tcp, make_session
 
 from tcp_pendant.calibrate import AutoTouchRequest
-from tcp_pendant.classroom.class_room import PUSHED_SETTING, ClassRoom
+from tcp_pendant.classroom.class_room import ClassRoom
+from tcp_pendant.classroom.exercise_setup import PUSHED_SETTING
 from tcp_pendant.classroom.gradebook import Gradebook
 from tcp_pendant.serve.cli import main
 from tcp_pendant.controller import builtin_tools

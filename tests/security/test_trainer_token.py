@@ -127,12 +127,12 @@ def test_guessing_over_a_websocket_is_locked_out_after_five_and_logged_short(app
         assert wrong[0] == "wrong trainer token from browser 0 (try 1, 22 characters, 'gu...')"
         assert any("typed 5 wrong tokens; no token is tried from it for 1 s" in r.getMessage() for r in caplog.records)
         assert not any(g in caplog.text for g in guesses) and TOKEN not in caplog.text
-        assert app.classroom._trainer_views == {}
+        assert app.classroom.dashboards.views == {}
         assert session.views["identity"].message.content.startswith(     # (markdown-escaped)
             "⚠ Too many wrong trainer tokens from this browser: try again in 1 s")
         now[0] += 1.5                                        # the window has passed
         try_token(TOKEN)
-        wait_until(lambda: len(app.classroom._trainer_views) == 1, what="the trainer view")
+        wait_until(lambda: len(app.classroom.dashboards.views) == 1, what="the trainer view")
     finally:
         c.ws.close()
 

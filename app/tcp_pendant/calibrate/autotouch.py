@@ -44,6 +44,7 @@ from scipy.spatial.transform import Rotation
 from tcp_pendant.controller import ToolModel, VirtualController, builtin_tools
 from tcp_pendant.wizards.abc_world import R_WORLD_TOOL_TARGET
 from tcp_pendant.wizards.base import StepInfo, Wizard, WizardError, WizardStateError
+from tcp_pendant.wizards.describe import AutoRole
 
 DEFAULT_DISTANCE_MM = 60.0
 MIN_RETRY_DISTANCE_MM = 20.0
@@ -107,6 +108,9 @@ def _ensure_mounted(wizard: Wizard, controller: VirtualController, step: StepInf
 PoseProbe = Callable[[], "str | None"]
 """Why the pose reached does not serve the step (None: it serves): a check detached from the
 controller (its own copies of the robot model and the joints), safe to run in a worker thread."""
+AutoTouchSteps = Generator[PoseProbe, "str | None", AutoTouchOutcome]
+"""Auto-touch as a generator (:func:`auto_touch_steps`): it yields pose probes, is sent their
+answers and returns the outcome."""
 
 R = TypeVar("R")
 P = ParamSpec("P")
@@ -135,15 +139,13 @@ def in_place(steps: Callable[P, Generator[PoseProbe, "str | None", R]]) -> Calla
 
 
 def auto_touch_steps(wizard: Wizard, controller: VirtualController, *,
-               direction_deg: tuple[float, float, float] | None = None,
-               sigma_mm: float = 0.0, angle_sigma_deg: float | None = None,
-               distance_mm: float = DEFAULT_DISTANCE_MM, hover_mm: float = 30.0,
-               rng: np.random.Generator | None = None, advance: bool = True,
-               tools: Mapping[str, ToolModel] | None = None, max_attempts: int = 12,
-               previous_direction_deg: tuple[float, float, float] | None = None,
-               mount: Callable[[ToolModel], None] | None = None,
-               pose_check: Callable[[], PoseProbe] | None = None
-               ) -> Generator[PoseProbe, str | None, AutoTouchOutcome]:
+                     direction_deg: tuple[float, float, float] | None = None, sigma_mm: float = 0.0,
+                     angle_sigma_deg: float | None = None, distance_mm: float = DEFAULT_DISTANCE_MM,
+                     hover_mm: float = 30.0, rng: np.random.Generator | None = None, advance: bool = True,
+                     tools: Mapping[str, ToolModel] | None = None, max_attempts: int = 12,
+                     previous_direction_deg: tuple[float, float, float] | None = None,
+                     mount: Callable[[ToolModel], None] | None = None,
+                     pose_check: Callable[[], PoseProbe] | None = None) -> AutoTouchSteps:
     """Perform the wizard's current step with the controller and record the flange pose (a
     generator: it yields the :data:`PoseProbe` of each pose reached, when ``pose_check`` is
     given, and must be sent the probe's answer; it returns the outcome).
@@ -177,97 +179,146 @@ def auto_touch_steps(wizard: Wizard, controller: VirtualController, *,
     """
     if wizard.status != "in_progress":
         raise WizardStateError(f"Cannot auto-touch: {wizard.blocked_reason}")
-    if angle_sigma_deg is None and np.isfinite(sigma_mm):
-        angle_sigma_deg = operator_angle_sigma_deg(sigma_mm)
-    if not 0.0 <= sigma_mm <= 10.0 or angle_sigma_deg is None or not 0.0 <= angle_sigma_deg <= 30.0:
-        raise WizardError(f"sigma_mm must be in 0..10 mm and angle_sigma_deg in 0..30 deg, "
-                          f"got {sigma_mm} and {angle_sigma_deg}.")
+    angle_sigma_deg = _angle_sigma_deg(sigma_mm, angle_sigma_deg)
     rng = np.random.default_rng() if rng is None else rng
     step = wizard.step
     _ensure_mounted(wizard, controller, step, tools, mount)
     if not wizard.can_record:
         raise WizardStateError(f"Cannot auto-touch: {wizard.blocked_reason}")
-
     role = wizard.auto_role(step)
     if role.align_world:
-        R = R_WORLD_TOOL_TARGET.copy()
-        if role.free_turn_about_x:
-            R = R @ Rotation.from_euler("x", rng.uniform(-60.0, 60.0), degrees=True).as_matrix()
-        misalignment_deg = 0.0
-        if angle_sigma_deg > 0.0:
-            rotvec_deg = rng.normal(0.0, angle_sigma_deg, 3)
-            misalignment_deg = float(np.linalg.norm(rotvec_deg))
-            R = R @ Rotation.from_rotvec(rotvec_deg, degrees=True).as_matrix()
-        T = np.eye(4)
-        T[:3, :3] = R
-        T[:3, 3] = np.asarray(controller.reference_tip_world_m, dtype=float) + [0.0, 0.0, hover_mm / 1000.0]
-        res = controller.move_true_tool_to(T)
-        if not res.ok:
-            return AutoTouchOutcome(False, step.index, step.role, None, None, None,
-                                    f"Could not align the tool with WORLD: {res.message}", 1)
-        wizard.record(controller.T_world_flange())
-        if advance and not wizard.on_last_step:
-            wizard.next()
-        how = ("exactly" if angle_sigma_deg == 0.0 else
-               f"by eye, {misalignment_deg:.2f}° off (σ {angle_sigma_deg:.2f}° per axis = operator error "
-               f"{sigma_mm:g} mm over {ANGLE_LEVER_MM:.0f} mm)")
-        return AutoTouchOutcome(True, step.index, step.role, None, None, None,
-                                f"Tool aligned with WORLD {how} and recorded.", 1)
-
-    fixed = direction_deg
-    if fixed is None and role.keeps_orientation and step.index > 0:
-        fixed = previous_direction_deg
-    # A fixed direction gets one try per distance. A step that keeps the orientation and puts the
-    # reference off the tip (TCP & Z, X's z and x, three-point's axes) may be out of reach at the
-    # full distance while a shorter back-off along the same axis is not (a ~2 % case at 60 mm on
-    # the KR 6 with the torch): as an operator would, it retries at half the distance and at
-    # MIN_RETRY_DISTANCE_MM.
-    # Where the solve takes each pose's own rotation (``any_orientation_solves``), new random
-    # directions at the full distance come last.
-    plan: list[tuple[float, bool]] = [(distance_mm, fixed is not None)]
-    if fixed is not None and any(role.reference_in_tool_mm(1.0)):
-        shorter_mm = sorted({max(distance_mm / 2.0, MIN_RETRY_DISTANCE_MM), MIN_RETRY_DISTANCE_MM}, reverse=True)
-        plan += [(d, True) for d in shorter_mm if d < distance_mm]
-    if fixed is not None and direction_deg is None and role.any_orientation_solves:
-        plan.append((distance_mm, False))
+        return _align_with_world(wizard, controller, step, role, sigma_mm=sigma_mm, angle_sigma_deg=angle_sigma_deg,
+                                 hover_mm=hover_mm, rng=rng, advance=advance)
+    keeps = role.keeps_orientation and step.index > 0     # the previous auto-touch's direction
+    fixed = direction_deg or (previous_direction_deg if keeps else None)
     attempts = 0
     last_message = ""
-    for d_mm, use_fixed in plan:
+    for d_mm, use_fixed in _approach_plan(role, distance_mm, fixed, chosen=direction_deg is not None):
         offset = role.reference_in_tool_mm(d_mm)
         for _ in range(1 if use_fixed else max_attempts):
             attempts += 1
-            if use_fixed and fixed is not None:
-                tilt, azimuth, spin = (float(v) for v in fixed)
-            else:
-                lo, hi = role.tilt_range_deg
-                tilt, azimuth, spin = rng.uniform(lo, hi), rng.uniform(0.0, 360.0), rng.uniform(-90.0, 90.0)
+            tilt, azimuth, spin = _direction_deg(fixed if use_fixed else None, role, rng)
             res = controller.auto_approach(tilt_deg=tilt, azimuth_deg=azimuth, spin_deg=spin,
                                            sigma_mm=sigma_mm, tip_offset_tool_mm=offset, rng=rng)
             refused = None
             if res.ok and pose_check is not None:
                 q_reached = controller.q_rad.copy()
                 refused = yield pose_check()
-                if (not np.array_equal(controller.q_rad, q_reached) or wizard.status != "in_progress"
-                        or wizard.step_index != step.index):
+                if _moved(controller, q_reached, wizard, step):
                     return AutoTouchOutcome(False, step.index, step.role, None, None, None, MOVED_DURING_PROBE,
                                             attempts)
             if refused is not None:            # reached, but unfit for what the step is for
                 last_message = refused
                 continue
             if res.ok:
-                wizard.record(controller.T_world_flange())
-                if advance and not wizard.on_last_step:
-                    wizard.next()
-                shorter = (f" The reference is {d_mm:g} mm off the tip: {distance_mm:g} mm was out of "
-                           f"reach." if d_mm != distance_mm else
-                           " The previous orientation was out of reach: a new one was drawn."
-                           if fixed is not None and not use_fixed else "")
-                return AutoTouchOutcome(True, step.index, step.role, tilt, azimuth, spin,
-                                        f"Step {step.index + 1} recorded: {step.title} (tilt {tilt:.0f}°, "
-                                        f"azimuth {azimuth:.0f}°).{shorter}", attempts)
+                _record(wizard, controller, advance)
+                return _touched(step, (tilt, azimuth, spin), d_mm, distance_mm, attempts,
+                                redrawn=fixed is not None and not use_fixed)
             last_message = res.message
     return AutoTouchOutcome(False, step.index, step.role, None, None, None,
                             f"Auto-touch failed after {attempts} attempt(s): {last_message}", attempts)
+
+
+def _angle_sigma_deg(sigma_mm: float, angle_sigma_deg: float | None) -> float:
+    """The angular error per tool axis (deg) of ``parallel`` steps: ``angle_sigma_deg``, or
+    None: :func:`operator_angle_sigma_deg` of ``sigma_mm``.
+
+    Raises:
+        WizardError: ``sigma_mm`` out of 0..10 mm or the angle out of 0..30 deg.
+    """
+    if angle_sigma_deg is None and np.isfinite(sigma_mm):
+        angle_sigma_deg = operator_angle_sigma_deg(sigma_mm)
+    if not 0.0 <= sigma_mm <= 10.0 or angle_sigma_deg is None or not 0.0 <= angle_sigma_deg <= 30.0:
+        raise WizardError(f"sigma_mm must be in 0..10 mm and angle_sigma_deg in 0..30 deg, "
+                          f"got {sigma_mm} and {angle_sigma_deg}.")
+    return angle_sigma_deg
+
+
+def _direction_deg(fixed: tuple[float, float, float] | None, role: AutoRole,
+                   rng: np.random.Generator) -> tuple[float, float, float]:
+    """The approach (tilt, azimuth, spin; deg): ``fixed``, or None: a random one (tilt in the
+    role's ``tilt_range_deg``, azimuth 0-360, spin -90..90)."""
+    if fixed is not None:
+        return float(fixed[0]), float(fixed[1]), float(fixed[2])
+    lo, hi = role.tilt_range_deg
+    return rng.uniform(lo, hi), rng.uniform(0.0, 360.0), rng.uniform(-90.0, 90.0)
+
+
+def _touched(step: StepInfo, direction_deg: tuple[float, float, float], d_mm: float, distance_mm: float,
+             attempts: int, *, redrawn: bool) -> AutoTouchOutcome:
+    """The outcome of a step recorded from ``direction_deg`` with the reference ``d_mm`` off the
+    tip (shorter than the ``distance_mm`` asked: it was out of reach; ``redrawn``: the previous
+    orientation was, and a new one was drawn)."""
+    tilt, azimuth, spin = direction_deg
+    shorter = (f" The reference is {d_mm:g} mm off the tip: {distance_mm:g} mm was out of "
+               f"reach." if d_mm != distance_mm else
+               " The previous orientation was out of reach: a new one was drawn." if redrawn else "")
+    return AutoTouchOutcome(True, step.index, step.role, tilt, azimuth, spin,
+                            f"Step {step.index + 1} recorded: {step.title} (tilt {tilt:.0f}°, "
+                            f"azimuth {azimuth:.0f}°).{shorter}", attempts)
+
+
+def _moved(controller: VirtualController, q_reached: np.ndarray, wizard: Wizard, step: StepInfo) -> bool:
+    """While a pose probe ran, the robot left the joints ``q_reached`` (rad) or the wizard left
+    ``step``: the pose is not recorded."""
+    return (not np.array_equal(controller.q_rad, q_reached) or wizard.status != "in_progress"
+            or wizard.step_index != step.index)
+
+
+def _record(wizard: Wizard, controller: VirtualController, advance: bool) -> None:
+    """Record the flange pose where the controller stands; with ``advance`` go to the next step
+    (never past the last: Finish is the user's click)."""
+    wizard.record(controller.T_world_flange())
+    if advance and not wizard.on_last_step:
+        wizard.next()
+
+
+def _approach_plan(role: AutoRole, distance_mm: float, fixed: tuple[float, float, float] | None, *,
+                   chosen: bool) -> list[tuple[float, bool]]:
+    """The approaches to try, in order: (distance of the reference off the tip in mm, whether
+    to use the ``fixed`` direction; else random ones). A fixed direction gets one try per
+    distance. A step that keeps the orientation and puts the reference off the tip (TCP & Z,
+    X's z and x, three-point's axes) may be out of reach at the full distance while a shorter
+    back-off along the same axis is not (a ~2 % case at 60 mm on the KR 6 with the torch): as an
+    operator would, it retries at half the distance and at :data:`MIN_RETRY_DISTANCE_MM`. Where
+    the solve takes each pose's own rotation (``any_orientation_solves``) and the direction was
+    not ``chosen`` by the user, new random directions at the full distance come last."""
+    plan: list[tuple[float, bool]] = [(distance_mm, fixed is not None)]
+    if fixed is not None and any(role.reference_in_tool_mm(1.0)):
+        shorter_mm = sorted({max(distance_mm / 2.0, MIN_RETRY_DISTANCE_MM), MIN_RETRY_DISTANCE_MM}, reverse=True)
+        plan += [(d, True) for d in shorter_mm if d < distance_mm]
+    if fixed is not None and not chosen and role.any_orientation_solves:
+        plan.append((distance_mm, False))
+    return plan
+
+
+def _align_with_world(wizard: Wizard, controller: VirtualController, step: StepInfo, role: AutoRole, *,
+                      sigma_mm: float, angle_sigma_deg: float, hover_mm: float, rng: np.random.Generator,
+                      advance: bool) -> AutoTouchOutcome:
+    """An ``align_world`` step: the true tool at the (PA-1) orientation (a random turn about tool
+    X for a 5D tool), off by a random rotation of ``angle_sigma_deg`` per axis, its tip
+    ``hover_mm`` above the reference tip; recorded."""
+    R = R_WORLD_TOOL_TARGET.copy()
+    if role.free_turn_about_x:
+        R = R @ Rotation.from_euler("x", rng.uniform(-60.0, 60.0), degrees=True).as_matrix()
+    misalignment_deg = 0.0
+    if angle_sigma_deg > 0.0:
+        rotvec_deg = rng.normal(0.0, angle_sigma_deg, 3)
+        misalignment_deg = float(np.linalg.norm(rotvec_deg))
+        R = R @ Rotation.from_rotvec(rotvec_deg, degrees=True).as_matrix()
+    T = np.eye(4)
+    T[:3, :3] = R
+    T[:3, 3] = np.asarray(controller.reference_tip_world_m, dtype=float) + [0.0, 0.0, hover_mm / 1000.0]
+    res = controller.move_true_tool_to(T)
+    if not res.ok:
+        return AutoTouchOutcome(False, step.index, step.role, None, None, None,
+                                f"Could not align the tool with WORLD: {res.message}", 1)
+    _record(wizard, controller, advance)
+    how = ("exactly" if angle_sigma_deg == 0.0 else
+           f"by eye, {misalignment_deg:.2f}° off (σ {angle_sigma_deg:.2f}° per axis = operator error "
+           f"{sigma_mm:g} mm over {ANGLE_LEVER_MM:.0f} mm)")
+    return AutoTouchOutcome(True, step.index, step.role, None, None, None,
+                            f"Tool aligned with WORLD {how} and recorded.", 1)
 
 
 auto_touch = in_place(auto_touch_steps)

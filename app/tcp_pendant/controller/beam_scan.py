@@ -593,26 +593,91 @@ def _same_beam(beam: int, detect: Callable[..., object], sensor: BeamSensor, sha
     return find
 
 
-def _scan_orientation(P: _Planner, k: int, spin: float, tilt: float,
-                      R_base: np.ndarray, T_ft_inv: np.ndarray, a: np.ndarray, W: float,
-                      h1: float, h2: float, clear: float) -> None:
-    """One orientation of the scan (module docstring); raises _Skip with the reason."""
-    sensor, shape, c = P.sensor, P.shape, P.config
+@dataclass(frozen=True, eq=False)
+class _ScanFrame:
+    """What every orientation of one scan shares (metres): the pass direction ``a`` (across the
+    beams), half a pass ``W``, the heights ``h1`` and ``h2`` behind the believed tip at which the
+    passes cross the beam, the ``clear``-ance of the approach start, the tool orientation before
+    its tilt and turn ``R_base`` (tool X down, Y along the beam) and the inverse of the believed
+    tool data ``T_ft_inv``."""
+
+    a: np.ndarray
+    W: float
+    h1: float
+    h2: float
+    clear: float
+    R_base: np.ndarray
+    T_ft_inv: np.ndarray
+
+
+def _scan_frame(sensor: BeamSensor, shape: ToolShape, c: BeamScanConfig, T_ft: np.ndarray) -> _ScanFrame:
+    """The scan's shared geometry (:class:`_ScanFrame`).
+
+    Raises:
+        ControllerError: a beam within 30 deg of vertical.
+    """
+    u = np.array(sensor.direction)
+    up = np.array([0.0, 0.0, 1.0])
+    for k_beam, (_, u_k) in enumerate(sensor.beams):
+        if float(np.linalg.norm(np.cross(up, u_k))) < 0.5:
+            raise ControllerError(f"Beam {k_beam} must be roughly horizontal for the scan (it is within "
+                                  "30 deg of vertical); set the beam sensor's direction across WORLD Z.")
+    a, sin_min = _pass_direction(sensor)
+    # half a pass: the shaft's radius, half the beam and the margin, measured across every beam
+    W = (shape.radius + sensor.width / 2.0 + c.pass_margin_mm / 1000.0) / sin_min
+    h1, h2 = (v / 1000.0 for v in c.pass_heights_mm)
+    # tool X down, tool Y along the beam's horizontal direction, tool Z = X x Y
+    u_flat = (u - (u @ up) * up) / np.linalg.norm(u - (u @ up) * up)
+    R_base = np.column_stack((-up, u_flat, np.cross(-up, u_flat)))
+    return _ScanFrame(a, W, h1, h2, c.clearance_mm / 1000.0, R_base, np.linalg.inv(T_ft))
+
+
+def _scan_orientation(P: _Planner, k: int, spin: float, tilt: float, F: _ScanFrame) -> None:
+    """One orientation of the scan (module docstring): the two passes, then the approach along
+    the line of flange positions that keeps the tool axis on the beam; raises _Skip with the
+    reason."""
+    sensor = P.sensor
     b, u = np.array(sensor.point), np.array(sensor.direction)
-    R_tool = _rot(u, math.radians(tilt)) @ R_base @ _rot(np.array([1.0, 0.0, 0.0]), math.radians(spin))
+    R_tool = _rot(u, math.radians(tilt)) @ F.R_base @ _rot(np.array([1.0, 0.0, 0.0]), math.radians(spin))
     x_w = R_tool[:, 0]  # believed working direction in WORLD (down-ish)
 
     def flange(tip: np.ndarray) -> np.ndarray:
-        return _pose(R_tool, tip) @ T_ft_inv
+        return _pose(R_tool, tip) @ F.T_ft_inv
 
-    lift = clear + h2  # above everything of the beam device the tool may meet
-    T_above = flange(b - W * a - lift * x_w)
-    P.move_to(T_above, k, "The pose above the beam")
-    T_p1 = flange(b + h1 * x_w - W * a)
-    P.move_to(T_p1, k, "The start of the first pass")
+    lift = F.clear + F.h2  # above everything of the beam device the tool may meet
+    P.move_to(flange(b - F.W * F.a - lift * x_w), k, "The pose above the beam")
+    P.move_to(flange(b + F.h1 * x_w - F.W * F.a), k, "The start of the first pass")
+    f_axis, f_second = _passes(P, k, flange, x_w, F)
+    # the line of flange positions that keeps the tool axis on the beam:
+    # f(h) = f1 + (h - h1) / (h2 - h1) (f2 - f1)
+    f1, f2 = f_axis
+    g = (f2 - f1) / (F.h2 - F.h1)  # flange motion per unit of forward travel
+    glen = float(np.linalg.norm(g))
+    if glen < 0.5:
+        raise _Skip("the passes put the tool axis along the beam")
+    m = g / glen
+    f_start = f1 + (-F.clear - F.h1) * g
+    if len(f_second) == 2:
+        f_start, m = _aim_at_crossing(f1, f2, f_second[0], f_second[1], sensor, f_start, m)
+    # retract beside the beam, then over to the approach start
+    P.move_to(flange(b - F.W * F.a - F.clear * x_w), k, "The retract after the passes")
+    T_start = P.T.copy()
+    T_start[:3, 3] = f_start
+    T_start[:3, :3] = R_tool @ F.T_ft_inv[:3, :3]
+    P.move_to(T_start, k, "The approach start")
+    _approach(P, k, T_start, m, max_travel=2.0 * F.clear * glen)
+
+
+def _passes(P: _Planner, k: int, flange: Callable[[np.ndarray], np.ndarray], x_w: np.ndarray,
+            F: _ScanFrame) -> tuple[list[np.ndarray], list[np.ndarray]]:
+    """The two sideways passes across the beam (the robot at the first one's start): their axis
+    events recorded; returns the flange positions of the scanned beam's two axis events and of
+    the second beam's (crossed beams; else none). Raises _Skip with the reason."""
+    sensor, shape, c = P.sensor, P.shape, P.config
+    b, a, W = np.array(sensor.point), F.a, F.W
     f_axis: list[np.ndarray] = []
     f_second: list[np.ndarray] = []  # the second beam's axis events (crossed beams)
-    for j, (h, sgn) in enumerate(((h1, 1.0), (h2, -1.0))):
+    for j, (h, sgn) in enumerate(((F.h1, 1.0), (F.h2, -1.0))):
         if j == 1:
             P.move_to(flange(b + h * x_w + W * a), k, "The start of the second pass")
         m = sgn * a
@@ -638,24 +703,13 @@ def _scan_orientation(P: _Planner, k: int, spin: float, tilt: float,
         for i in idx:
             (f_axis if P.events[i].beam == 0 else f_second).append(P.events[i].T_world_flange[:3, 3].copy())
         P.add_move("pass", T_end, q_end, k, length=2.0 * W, events=idx)
-    # the line of flange positions that keeps the tool axis on the beam:
-    # f(h) = f1 + (h - h1) / (h2 - h1) (f2 - f1)
-    f1, f2 = f_axis
-    g = (f2 - f1) / (h2 - h1)  # flange motion per unit of forward travel
-    glen = float(np.linalg.norm(g))
-    if glen < 0.5:
-        raise _Skip("the passes put the tool axis along the beam")
-    m = g / glen
-    f_start = f1 + (-clear - h1) * g
-    if len(f_second) == 2:
-        f_start, m = _aim_at_crossing(f1, f2, f_second[0], f_second[1], sensor, f_start, m)
-    # retract beside the beam, then over to the approach start
-    P.move_to(flange(b - W * a - clear * x_w), k, "The retract after the passes")
-    T_start = P.T.copy()
-    T_start[:3, 3] = f_start
-    T_start[:3, :3] = R_tool @ T_ft_inv[:3, :3]
-    P.move_to(T_start, k, "The approach start")
-    max_travel = 2.0 * clear * glen
+    return f_axis, f_second
+
+
+def _approach(P: _Planner, k: int, T_start: np.ndarray, m: np.ndarray, *, max_travel: float) -> None:
+    """The approach from ``T_start`` along ``m`` until the tip breaks the beam (crossed beams:
+    both), its tip events recorded, and the retract to ``T_start``. Raises _Skip with the reason."""
+    sensor, shape, c = P.sensor, P.shape, P.config
     try:
         ev = tip_on_beam(*P.physical_line(P.q, T_start, m, 0.0), sensor, shape, max_travel=max_travel)
         if ev is not None:
@@ -689,6 +743,69 @@ def _scan_orientation(P: _Planner, k: int, spin: float, tilt: float,
     P.move_to(T_start, k, "The retract after the approach")
 
 
+def _scan_or_skip(P: _Planner, k: int, F: _ScanFrame) -> str | None:
+    """Scan orientation ``k``: None when done, else why it was skipped (a sentence); the moves
+    and events of a try that failed are dropped. The tilt about the beam observes nothing
+    (module docstring) and the turns only need to differ: when a pose of this orientation is
+    out of reach, the other tilts and then turns a third of the way to the neighbours are
+    tried before it is skipped."""
+    c, n = P.config, P.config.n_orientations
+    spin = 360.0 * k / n
+    sign = 1.0 if k % 2 == 0 else -1.0
+    label = f"orientation {k + 1} (turned {spin:.0f} deg about the tool axis)"
+    tilts = (sign * c.tilt_deg, -sign * c.tilt_deg, 0.0) if c.tilt_deg > 0.0 else (0.0,)
+    step = 120.0 / n
+    tries = [(tilt, spin) for tilt in tilts] + [(0.0, spin + step), (0.0, spin - step)]
+    saved = (P.q.copy(), P.T.copy(), len(P.moves), len(P.events))
+    first_reason = ""
+    for tilt, turn in tries:
+        try:
+            _scan_orientation(P, k, turn, tilt, F)
+            return None
+        except _Skip as exc:
+            P.q, P.T = saved[0].copy(), saved[1].copy()
+            del P.moves[saved[2]:]
+            del P.events[saved[3]:], P.points[saved[3]:], P.orient[saved[3]:]
+            if not exc.reach:  # the tool data or the beam: another pose does not help
+                first_reason = str(exc)
+                break
+            first_reason = first_reason or str(exc)
+    tried = ", ".join(f"{t:+.0f}" for t in tilts)
+    more = (f" (tried tilts of {tried} deg about the beam and turns of {spin - step:.0f} and "
+            f"{spin + step:.0f} deg)") if "out of reach" in first_reason else ""
+    return (f"{label[0].upper()}{label[1:]} was skipped: {first_reason[0].lower()}"
+            f"{first_reason[1:]}{more}.")
+
+
+def _checked_scan(kinematics: RobotKinematics, q_start_rad: np.ndarray, sensor: BeamSensor,
+                  T_flange_tool_plan: np.ndarray, shape: ToolShape, true_kinematics: RobotKinematics | None,
+                  config: BeamScanConfig) -> tuple[RobotKinematics, np.ndarray, np.ndarray]:
+    """:func:`run_beam_scan`'s arguments checked: the physical robot, the start joints (rad) and
+    the believed tool data (4x4, m).
+
+    Raises:
+        ControllerError: what is wrong with them.
+    """
+    if not isinstance(kinematics, RobotKinematics):
+        raise ControllerError("run_beam_scan: kinematics must be a RobotKinematics.")
+    true_kin = kinematics if true_kinematics is None else true_kinematics
+    if not isinstance(true_kin, RobotKinematics) or tuple(true_kin.joint_names) != tuple(kinematics.joint_names):
+        raise ControllerError("run_beam_scan: true_kinematics must be the same robot as the model (a "
+                              "RobotKinematics with the same joints).")
+    if not isinstance(sensor, BeamSensor) or not isinstance(shape, ToolShape):
+        raise ControllerError("run_beam_scan: give a BeamSensor and a ToolShape.")
+    if not isinstance(config, BeamScanConfig):
+        raise ControllerError("run_beam_scan: config must be a BeamScanConfig.")
+    q0 = kinematics.check_q(q_start_rad)
+    T_ft = np.asarray(T_flange_tool_plan, dtype=float)
+    if T_ft.shape != (4, 4) or not np.isfinite(T_ft).all():
+        raise ControllerError("run_beam_scan: T_flange_tool_plan must be a finite 4x4 pose (m).")
+    R_ft = T_ft[:3, :3]
+    if np.abs(R_ft.T @ R_ft - np.eye(3)).max() > 1e-6 or np.linalg.det(R_ft) <= 0.0:
+        raise ControllerError("run_beam_scan: T_flange_tool_plan has no proper rotation.")
+    return true_kin, q0, T_ft
+
+
 def run_beam_scan(kinematics: RobotKinematics, q_start_rad: np.ndarray, sensor: BeamSensor,
                   T_flange_tool_plan: np.ndarray, shape: ToolShape, *,
                   true_kinematics: RobotKinematics | None = None,
@@ -713,76 +830,13 @@ def run_beam_scan(kinematics: RobotKinematics, q_start_rad: np.ndarray, sensor: 
     Raises:
         ControllerError: bad arguments, or no orientation could be scanned (the reasons).
     """
-    if not isinstance(kinematics, RobotKinematics):
-        raise ControllerError("run_beam_scan: kinematics must be a RobotKinematics.")
-    true_kin = kinematics if true_kinematics is None else true_kinematics
-    if not isinstance(true_kin, RobotKinematics) or tuple(true_kin.joint_names) != tuple(kinematics.joint_names):
-        raise ControllerError("run_beam_scan: true_kinematics must be the same robot as the model (a "
-                              "RobotKinematics with the same joints).")
-    if not isinstance(sensor, BeamSensor) or not isinstance(shape, ToolShape):
-        raise ControllerError("run_beam_scan: give a BeamSensor and a ToolShape.")
-    if not isinstance(config, BeamScanConfig):
-        raise ControllerError("run_beam_scan: config must be a BeamScanConfig.")
-    q0 = kinematics.check_q(q_start_rad)
-    T_ft = np.asarray(T_flange_tool_plan, dtype=float)
-    if T_ft.shape != (4, 4) or not np.isfinite(T_ft).all():
-        raise ControllerError("run_beam_scan: T_flange_tool_plan must be a finite 4x4 pose (m).")
-    R_ft = T_ft[:3, :3]
-    if np.abs(R_ft.T @ R_ft - np.eye(3)).max() > 1e-6 or np.linalg.det(R_ft) <= 0.0:
-        raise ControllerError("run_beam_scan: T_flange_tool_plan has no proper rotation.")
-
-    b, u = np.array(sensor.point), np.array(sensor.direction)
-    up = np.array([0.0, 0.0, 1.0])
-    for k_beam, (_, u_k) in enumerate(sensor.beams):
-        if float(np.linalg.norm(np.cross(up, u_k))) < 0.5:
-            raise ControllerError(f"Beam {k_beam} must be roughly horizontal for the scan (it is within "
-                                  "30 deg of vertical); set the beam sensor's direction across WORLD Z.")
-    a, sin_min = _pass_direction(sensor)
-    c = config
-    # half a pass: the shaft's radius, half the beam and the margin, measured across every beam
-    W = (shape.radius + sensor.width / 2.0 + c.pass_margin_mm / 1000.0) / sin_min
-    h1, h2 = (v / 1000.0 for v in c.pass_heights_mm)
-    clear = c.clearance_mm / 1000.0
-    # tool X down, tool Y along the beam's horizontal direction, tool Z = X x Y
-    u_flat = (u - (u @ up) * up) / np.linalg.norm(u - (u @ up) * up)
-    R_base = np.column_stack((-up, u_flat, np.cross(-up, u_flat)))
-    T_ft_inv = np.linalg.inv(T_ft)
-
+    true_kin, q0, T_ft = _checked_scan(kinematics, q_start_rad, sensor, T_flange_tool_plan, shape,
+                                       true_kinematics, config)
+    F = _scan_frame(sensor, shape, config, T_ft)
     P = _Planner(kin=kinematics, true_kin=true_kin, T_ft_plan=T_ft, sensor=sensor, shape=shape,
-                 config=c, rng=rng, q=q0.copy(), T=kinematics.T_world_flange(q0))
-    skipped: list[str] = []
-    n = c.n_orientations
-    for k in range(n):
-        spin = 360.0 * k / n
-        sign = 1.0 if k % 2 == 0 else -1.0
-        label = f"orientation {k + 1} (turned {spin:.0f} deg about the tool axis)"
-        # the tilt about the beam observes nothing (module docstring) and the turns only need to
-        # differ: when a pose of this orientation is out of reach, the other tilts and then turns
-        # a third of the way to the neighbours are tried before it is skipped
-        tilts = (sign * c.tilt_deg, -sign * c.tilt_deg, 0.0) if c.tilt_deg > 0.0 else (0.0,)
-        step = 120.0 / n
-        tries = [(tilt, spin) for tilt in tilts] + [(0.0, spin + step), (0.0, spin - step)]
-        saved = (P.q.copy(), P.T.copy(), len(P.moves), len(P.events))
-        first_reason, done = "", False
-        for tilt, turn in tries:
-            try:
-                _scan_orientation(P, k, turn, tilt, R_base, T_ft_inv, a, W, h1, h2, clear)
-                done = True
-                break
-            except _Skip as exc:
-                P.q, P.T = saved[0].copy(), saved[1].copy()
-                del P.moves[saved[2]:]
-                del P.events[saved[3]:], P.points[saved[3]:], P.orient[saved[3]:]
-                if not exc.reach:  # the tool data or the beam: another pose does not help
-                    first_reason = str(exc)
-                    break
-                first_reason = first_reason or str(exc)
-        if not done:
-            tried = ", ".join(f"{t:+.0f}" for t in tilts)
-            more = (f" (tried tilts of {tried} deg about the beam and turns of {spin - step:.0f} and "
-                    f"{spin + step:.0f} deg)") if "out of reach" in first_reason else ""
-            skipped.append(f"{label[0].upper()}{label[1:]} was skipped: {first_reason[0].lower()}"
-                           f"{first_reason[1:]}{more}.")
+                 config=config, rng=rng, q=q0.copy(), T=kinematics.T_world_flange(q0))
+    n = config.n_orientations
+    skipped = [why for why in (_scan_or_skip(P, k, F) for k in range(n)) if why is not None]
     if not P.events:
         raise ControllerError("The beam scan could not run at any tool orientation: "
                               + " ".join(skipped) + " Move the beam sensor closer to the robot or "
@@ -793,4 +847,4 @@ def run_beam_scan(kinematics: RobotKinematics, q_start_rad: np.ndarray, sensor: 
         events=tuple(P.events), orientation_index=tuple(P.orient), moves=tuple(P.moves),
         path_length_m=length, duration_s=duration, skipped=tuple(skipped),
         q_end_rad=read_only_array(P.q), beam_points_world_m=read_only_array(np.array(P.points)),
-        sensor=sensor, n_orientations_planned=n, config=c)
+        sensor=sensor, n_orientations_planned=n, config=config)

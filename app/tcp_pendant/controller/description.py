@@ -357,6 +357,29 @@ def load_description(path: Path | str, package_paths: Iterable[Path | str] = ())
                               ".xacro file.")
     roots = package_search_path(package_paths)
     finder = PackageFinder(roots, near=source)
+    root = _robot_element(source, finder)
+    links, meshes, geometry_links = _resolve_meshes(root, source.resolve().parent, finder)
+    children, origins, continuous, mimic = _read_joints(root, links)
+    return RobotDescription(
+        source=source.resolve(),
+        urdf_xml=ET.tostring(root, encoding="unicode"),
+        links=tuple(links),
+        children={k: tuple(v) for k, v in children.items()},
+        joint_origins=origins,
+        meshes=tuple(meshes),
+        geometry_links={k: frozenset(v) for k, v in geometry_links.items()},
+        package_roots=roots,
+        continuous_joints=tuple(continuous),
+        mimic_joints=mimic,
+    )
+
+
+def _robot_element(source: Path, finder: PackageFinder) -> ET.Element:
+    """The ``<robot>`` element of ``source`` (a URDF, or a xacro expanded).
+
+    Raises:
+        ControllerError: unreadable file, not a URDF, xacro error.
+    """
     if is_xacro(source):
         text = expand_xacro(source, finder)
     else:
@@ -370,8 +393,13 @@ def load_description(path: Path | str, package_paths: Iterable[Path | str] = ())
         raise ControllerError(f"Cannot read the URDF {source}: {exc}.") from exc
     if root.tag != "robot":
         raise ControllerError(f"{source} is not a URDF: its root element is <{root.tag}>, expected <robot>.")
+    return root
 
-    base_dir = source.resolve().parent
+
+def _resolve_meshes(root: ET.Element, base_dir: Path,
+                    finder: PackageFinder) -> tuple[list[str], list[MeshRef], dict[str, set[str]]]:
+    """The links in order, every mesh reference (each ``filename`` found is rewritten in
+    ``root`` to its path), and the links with visual / collision geometry."""
     meshes: list[MeshRef] = []
     geometry_links: dict[str, set[str]] = {"visual": set(), "collision": set()}
     links: list[str] = []
@@ -387,11 +415,23 @@ def load_description(path: Path | str, package_paths: Iterable[Path | str] = ())
                     meshes.append(MeshRef(name, kind, uri, found, reason))
                     if found is not None:
                         mesh.set("filename", str(found))
+    return links, meshes, geometry_links
 
+
+_Origins = dict[str, tuple[str, tuple[float, float, float]]]
+"""Child link -> (parent link, the joint's origin xyz in the parent, m)."""
+_Mimics = dict[str, tuple[str, float, float]]
+"""Mimic joint -> (the joint it follows, multiplier, offset)."""
+
+
+def _read_joints(root: ET.Element, links: list[str]) -> tuple[dict[str, list[str]], _Origins, list[str], _Mimics]:
+    """The joints of ``root``: each link's children, each child's parent and origin, the
+    continuous joints (rewritten in ``root`` as revolute within +-``CONTINUOUS_LIMIT_RAD``) and
+    the mimic joints."""
     children: dict[str, list[str]] = {name: [] for name in links}
-    origins: dict[str, tuple[str, tuple[float, float, float]]] = {}
+    origins: _Origins = {}
     continuous: list[str] = []
-    mimic: dict[str, tuple[str, float, float]] = {}
+    mimic: _Mimics = {}
     for joint in root.findall("joint"):
         parent, child = joint.find("parent"), joint.find("child")
         if parent is None or child is None:
@@ -413,16 +453,4 @@ def load_description(path: Path | str, package_paths: Iterable[Path | str] = ())
                 limit = ET.SubElement(joint, "limit", {"effort": "0", "velocity": "1"})
             limit.set("lower", repr(-CONTINUOUS_LIMIT_RAD))
             limit.set("upper", repr(CONTINUOUS_LIMIT_RAD))
-
-    return RobotDescription(
-        source=source.resolve(),
-        urdf_xml=ET.tostring(root, encoding="unicode"),
-        links=tuple(links),
-        children={k: tuple(v) for k, v in children.items()},
-        joint_origins=origins,
-        meshes=tuple(meshes),
-        geometry_links={k: frozenset(v) for k, v in geometry_links.items()},
-        package_roots=roots,
-        continuous_joints=tuple(continuous),
-        mimic_joints=mimic,
-    )
+    return children, origins, continuous, mimic

@@ -165,6 +165,41 @@ def _true_tip(kin: RobotKinematics, q: np.ndarray, T_flange_tool_true: np.ndarra
     return (kin.T_world_flange(q) @ T_flange_tool_true)[:3, 3]
 
 
+def _start_joints(kin: RobotKinematics, q_rad: Sequence[float] | np.ndarray) -> np.ndarray:
+    """The start configuration checked (rad; m for prismatic joints) and clipped onto the limits
+    it is within to 1e-9.
+
+    Raises:
+        ControllerError: wrong length, not finite, or beyond a limit (names the joint).
+    """
+    q0 = kin.check_q(q_rad).copy()
+    viol = kin.limit_violation(q0, tol=1e-9)
+    if viol is not None:
+        i, side = viol
+        limit = (kin.lower_rad if side == "lower" else kin.upper_rad)[i]
+        raise ControllerError(f"{kin.joint_names[i]} = {kin.format_joint(i, q0[i])} is beyond its {side} "
+                              f"limit {kin.format_joint(i, limit)}; start the TCP check within the limits.")
+    return np.clip(q0, kin.lower_rad, kin.upper_rad)
+
+
+def _implied_offset(rows: list[np.ndarray], rhs: list[np.ndarray], R_flange_tool: np.ndarray
+                    ) -> tuple[np.ndarray | None, np.ndarray | None, float | None, float | None]:
+    """The TCP offset ``e`` (TOOL frame, mm) that explains the deviations of the rotations
+    reached: the least-squares solution of ``(exp(theta_k) - I) e = d_k`` stacked over them
+    (``rows`` and ``rhs``); returns ``e`` in TOOL and in FLANGE (``R_flange_tool e``), its
+    norm and the fit's RMS residual (mm), all None without a rotation reached or when the
+    rotations do not determine ``e`` (rank below 3)."""
+    if not rows:
+        return None, None, None, None
+    A = np.vstack(rows)
+    b = np.concatenate(rhs)
+    e, _, rank, _ = np.linalg.lstsq(A, b, rcond=None)
+    if rank != 3:
+        return None, None, None, None
+    return (read_only_array(e), read_only_array(R_flange_tool @ e), float(np.linalg.norm(e)),
+            float(np.sqrt(np.mean((A @ e - b) ** 2))))
+
+
 def spin_check(kinematics: RobotKinematics, q_rad: Sequence[float] | np.ndarray,
                T_flange_tool_active: np.ndarray, T_flange_tool_true: np.ndarray, *,
                angle_deg: float = DEFAULT_SPIN_ANGLE_DEG,
@@ -199,14 +234,7 @@ def spin_check(kinematics: RobotKinematics, q_rad: Sequence[float] | np.ndarray,
                               f"model has {', '.join(kin.joint_names)}; give the same robot.")
     T_active = check_pose(T_flange_tool_active, "T_flange_tool_active")
     T_true = check_pose(T_flange_tool_true, "T_flange_tool_true")
-    q0 = kin.check_q(q_rad).copy()
-    viol = kin.limit_violation(q0, tol=1e-9)
-    if viol is not None:
-        i, side = viol
-        limit = (kin.lower_rad if side == "lower" else kin.upper_rad)[i]
-        raise ControllerError(f"{kin.joint_names[i]} = {kin.format_joint(i, q0[i])} is beyond its {side} "
-                              f"limit {kin.format_joint(i, limit)}; start the TCP check within the limits.")
-    q0 = np.clip(q0, kin.lower_rad, kin.upper_rad)
+    q0 = _start_joints(kin, q_rad)
 
     T0 = kin.T_world_flange(q0) @ T_active
     R0, p0 = T0[:3, :3].copy(), T0[:3, 3].copy()
@@ -236,16 +264,7 @@ def spin_check(kinematics: RobotKinematics, q_rad: Sequence[float] | np.ndarray,
 
     reached_dev = [r.deviation_mm for r in rotations if r.reached]
     max_dev = max(reached_dev) if reached_dev else math.nan
-    e_tool = e_flange = err = rms = None
-    if rows:
-        A = np.vstack(rows)
-        b = np.concatenate(rhs)
-        e, _, rank, _ = np.linalg.lstsq(A, b, rcond=None)
-        if rank == 3:
-            e_tool = read_only_array(e)
-            e_flange = read_only_array(T_active[:3, :3] @ e)
-            err = float(np.linalg.norm(e))
-            rms = float(np.sqrt(np.mean((A @ e - b) ** 2)))
+    e_tool, e_flange, err, rms = _implied_offset(rows, rhs, T_active[:3, :3])
     return SpinCheckResult(angle_deg=angle, rotations=tuple(rotations), max_deviation_mm=float(max_dev),
                            implied_offset_tool_mm=e_tool, implied_offset_flange_mm=e_flange,
                            implied_tcp_error_mm=err, fit_rms_mm=rms, q_start_rad=read_only_array(q0))

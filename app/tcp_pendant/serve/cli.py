@@ -35,6 +35,7 @@ from tcp_pendant.classroom.gradebook_db import class_db_target, url_has_password
 
 if TYPE_CHECKING:                       # the server is imported in main() only (no pinocchio for --help)
     from tcp_pendant.serve.server import PendantApp
+    from tcp_pendant.serve.workers import Workers
 
 __all__ = ["SCENARIO_CHOICES", "build_parser", "main", "network_warning", "ready_urls"]
 
@@ -44,11 +45,28 @@ for ``--help``)."""
 
 
 def build_parser() -> argparse.ArgumentParser:
-    """The argument parser (options in mm where they are lengths)."""
+    """The argument parser (options in mm where they are lengths): the robot, the server and
+    what every pendant shows, the class, the training (scenarios, beam sensor, seed), then the
+    processes; ``--help`` lists them in that order."""
     p = argparse.ArgumentParser(
         prog="tcp-pendant",
         description="Teach-pendant web app for TCP / TOOL frame calibration training. "
                     "Each browser gets its own virtual robot unless --shared is given.")
+    _add_robot_options(p)
+    _add_server_options(p)
+    _add_class_options(p)
+    _add_training_options(p)
+    p.add_argument("--workers", type=int, default=1, metavar="N",
+                   help="N server processes on the one port (SO_REUSEPORT: the system spreads the browsers "
+                        "over them), to use N cores for a large class (default 1; up to 32; not with "
+                        "--shared); a class shares names, pushed settings and the trainer's table through "
+                        "the gradebook")
+    p.add_argument("--verbose", action="store_true", help="log debugging information")
+    return p
+
+
+def _add_robot_options(p: argparse.ArgumentParser) -> None:
+    """The robot and the tool mounted at start."""
     p.add_argument("--robot", default="kr6",
                    help="kr6 (KUKA KR 6 R900 sixx, default), gp12 (Yaskawa GP12 class), PATH.urdf or "
                         "PATH.xacro (a ROS description: package:// meshes are found through --package-path "
@@ -60,6 +78,10 @@ def build_parser() -> argparse.ArgumentParser:
                    help="link used as FLANGE (default: 'flange', else the last link of the longest chain)")
     p.add_argument("--tool", default="pointer", choices=("pointer", "torch", "gripper"),
                    help="physical tool mounted at start (default: pointer)")
+
+
+def _add_server_options(p: argparse.ArgumentParser) -> None:
+    """Where the server listens, the tool library, and what every pendant shows."""
     p.add_argument("--host", default="127.0.0.1",
                    help="address to bind (default 127.0.0.1; anything else lets the network connect)")
     p.add_argument("--port", type=int, default=8080,
@@ -83,6 +105,10 @@ def build_parser() -> argparse.ArgumentParser:
                         "its height on kr6 and gp12, e.g. 525,0,445 on the KR 6; for another robot a point "
                         "in front of it that the tool reaches from the XYZ 4-point's directions); a tip out "
                         "of reach is warned about at start")
+
+
+def _add_class_options(p: argparse.ArgumentParser) -> None:
+    """A class: the gradebook, the trainer token, the exercise and its brief, library quotas."""
     p.add_argument("--class", dest="classroom", action="store_true",
                    help="run a class: each browser gives a name, every calibration is stored in the class "
                         "gradebook, and a trainer view (token) shows the class; implied by --class-db, "
@@ -120,6 +146,10 @@ def build_parser() -> argparse.ArgumentParser:
                    help="the fewest touches a Finish takes (0 to 20) in the methods whose touch count the "
                         "trainee chooses (XYZ 4-point, TCP & Z, X); default: the minimum kept in the "
                         "gradebook, else none")
+
+
+def _add_training_options(p: argparse.ArgumentParser) -> None:
+    """Training: the scenario's systematic error, the beam sensor, one seed for the randomness."""
     p.add_argument("--scenario", default="off", choices=SCENARIO_CHOICES, metavar="NAME",
                    help="training: a systematic error every pendant starts with (off, bent-tool, "
                         "robot-accuracy, moved-reference; default off); the trainer can change it in the "
@@ -138,13 +168,6 @@ def build_parser() -> argparse.ArgumentParser:
                    help="one seed for every pendant's randomness (Auto-touch's operator error and "
                         "directions, the beam sensor's noise): a seeded lesson replays the same way "
                         "(default: fresh randomness; >= 0)")
-    p.add_argument("--workers", type=int, default=1, metavar="N",
-                   help="N server processes on the one port (SO_REUSEPORT: the system spreads the browsers "
-                        "over them), to use N cores for a large class (default 1; up to 32; not with "
-                        "--shared); a class shares names, pushed settings and the trainer's table through "
-                        "the gradebook")
-    p.add_argument("--verbose", action="store_true", help="log debugging information")
-    return p
 
 
 def network_warning(host: str) -> str | None:
@@ -199,43 +222,92 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 130
 
 
+class _Refused(Exception):
+    """Options or a start that cannot go on: the message, printed after "tcp-pendant: error: "
+    (exit 2)."""
+
+
 def _main(argv: Sequence[str] | None) -> int:
     t0 = time.perf_counter()
     args = build_parser().parse_args(argv)
     logging.basicConfig(level=logging.DEBUG if args.verbose else logging.WARNING,
                         format="%(levelname)s %(name)s: %(message)s")
-    from tcp_pendant.classroom.gradebook_open import default_gradebook_path
-    from tcp_pendant.classroom.gradebook_store import GradebookError
-    from tcp_pendant.controller import ControllerError
-    from tcp_pendant.serve.server import AppConfig, PendantApp, PortInUseError, parse_xyz_mm
+    try:
+        worker = _check_processes(args)
+        trainer_token, class_db = _check_class(args, worker)
+        balance_file = _balance_file(args.workers, worker)
+        app = _make_app(args, trainer_token, class_db, balance_file, worker)
+        url = _start(app, args, balance_file, worker)
+    except _Refused as exc:
+        print(f"tcp-pendant: error: {exc}", file=sys.stderr)
+        return 2
+    set_apart_startup_objects()
+    if worker is not None:
+        return _serve_as_worker(app, worker[2])
+    try:
+        workers = _start_workers(app, args, argv, balance_file)
+    except _Refused as exc:
+        print(f"tcp-pendant: error: {exc}", file=sys.stderr)
+        return 2
+    mode = "one robot shared by every browser" if args.shared else "one robot per browser"
+    if workers is not None:
+        mode += (f"; {args.workers} server processes on port {app.port} (pids "
+                 f"{', '.join(str(p) for p in [os.getpid(), *workers.pids])})")
+    tip_mm = ", ".join(f"{v:.0f}" for v in app.reference_tip_m * 1000.0)
+    print(f"TCP Pendant ready in {time.perf_counter() - t0:.1f} s: {ready_urls(url, app.network_urls, args.host)}"
+          f"\n  robot {app.robot_label}, tool {app.tool.label}, reference tip ({tip_mm}) mm, {mode}\n"
+          f"  tool library {app.library.path}\n{_class_lines(app)}  Ctrl-C to stop.", flush=True)
+    try:
+        app.serve_forever()
+    finally:
+        if workers is not None:
+            workers.stop()
+        _drop_balance_file(balance_file, worker)
+    return 0
+
+
+def _check_processes(args: argparse.Namespace) -> tuple[int, int, int] | None:
+    """Check ``--port`` and ``--workers``; returns this process's place among the ``--workers``
+    processes (None: the first, or the only one). Several processes stop cleanly on SIGTERM.
+
+    Raises:
+        _Refused: a port or a number of workers out of range, ``--workers`` with ``--shared``.
+    """
+    from tcp_pendant.serve.workers import MAX_WORKERS, WorkerError, worker_index
 
     if not 0 <= args.port <= 65535:
-        print(f"tcp-pendant: error: --port must be 0..65535, got {args.port}", file=sys.stderr)
-        return 2
-    from tcp_pendant.serve.workers import MAX_WORKERS, WorkerError, Workers, worker_index
-
+        raise _Refused(f"--port must be 0..65535, got {args.port}")
     if not 1 <= args.workers <= MAX_WORKERS:
-        print(f"tcp-pendant: error: --workers must be 1..{MAX_WORKERS}, got {args.workers}", file=sys.stderr)
-        return 2
+        raise _Refused(f"--workers must be 1..{MAX_WORKERS}, got {args.workers}")
     if args.workers > 1 and args.shared:
-        print("tcp-pendant: error: --shared is one robot in one process; drop --workers or --shared",
-              file=sys.stderr)
-        return 2
+        raise _Refused("--shared is one robot in one process; drop --workers or --shared")
     try:
         worker = worker_index()
     except WorkerError as exc:
-        print(f"tcp-pendant: error: {exc}", file=sys.stderr)
-        return 2
-    several = args.workers > 1 or worker is not None
-    if several:
+        raise _Refused(str(exc)) from None
+    if args.workers > 1 or worker is not None:
         import signal
 
         def _terminate(_signum: int, _frame: object) -> None:
             raise KeyboardInterrupt         # a clean stop: sessions end in the gradebook, names are freed
 
         signal.signal(signal.SIGTERM, _terminate)
+    return worker
+
+
+def _check_class(args: argparse.Namespace,
+                 worker: tuple[int, int, int] | None) -> tuple[str | None, Path | str | None]:
+    """Check the class's options (notes on stderr for a token or a password in the process list);
+    returns the trainer token (None: the gradebook's, or a new one) and the class gradebook
+    (None: no class; its folder made when it is the default file).
+
+    Raises:
+        _Refused: two tokens or a bad one, ``--shared`` with a class, a library quota out of
+            place or range, a gradebook folder that cannot be made.
+    """
+    from tcp_pendant.classroom.gradebook_open import default_gradebook_path
+    from tcp_pendant.classroom.library_rights import MAX_LIBRARY_QUOTA
     from tcp_pendant.classroom.trainer_token import TrainerTokenError, resolve_trainer_token
-    from tcp_pendant.classroom.library_rights import DEFAULT_LIBRARY_QUOTA, MAX_LIBRARY_QUOTA
 
     classroom = bool(args.classroom or args.class_db or args.exercise or args.trainer_token
                      or args.trainer_token_file or args.exercise_instructions is not None
@@ -244,25 +316,19 @@ def _main(argv: Sequence[str] | None) -> int:
         trainer_token = resolve_trainer_token(args.trainer_token, args.trainer_token_file,
                                               os.environ if classroom else {})
     except TrainerTokenError as exc:
-        print(f"tcp-pendant: error: {exc}", file=sys.stderr)
-        return 2
+        raise _Refused(str(exc)) from None
     if args.shared and classroom:
-        print("tcp-pendant: error: --shared is a lecture demo without names or gradebook; drop "
-              "--class / --class-db / --exercise / --exercise-instructions / --exercise-methods / "
-              "--exercise-min-touches / --trainer-token / --trainer-token-file, or drop --shared",
-              file=sys.stderr)
-        return 2
+        raise _Refused("--shared is a lecture demo without names or gradebook; drop "
+                       "--class / --class-db / --exercise / --exercise-instructions / --exercise-methods / "
+                       "--exercise-min-touches / --trainer-token / --trainer-token-file, or drop --shared")
     if args.trainer_token is not None and worker is None:
         print("tcp-pendant: note: a --trainer-token on the command line shows in the process list; "
               "--trainer-token-file PATH or TCP_PENDANT_TRAINER_TOKEN keep it out", file=sys.stderr)
     if args.library_quota is not None and not classroom:
-        print("tcp-pendant: error: --library-quota is for a class (each trainee's own library slots); "
-              "add --class, or drop --library-quota", file=sys.stderr)
-        return 2
+        raise _Refused("--library-quota is for a class (each trainee's own library slots); "
+                       "add --class, or drop --library-quota")
     if args.library_quota is not None and not 1 <= args.library_quota <= MAX_LIBRARY_QUOTA:
-        print(f"tcp-pendant: error: --library-quota must be 1..{MAX_LIBRARY_QUOTA} slots, got "
-              f"{args.library_quota}", file=sys.stderr)
-        return 2
+        raise _Refused(f"--library-quota must be 1..{MAX_LIBRARY_QUOTA} slots, got {args.library_quota}")
     class_db = args.class_db
     if isinstance(class_db, str) and url_has_password(class_db):
         print("tcp-pendant: note: a password in the --class-db URL shows in the process list; "
@@ -272,10 +338,25 @@ def _main(argv: Sequence[str] | None) -> int:
         try:
             class_db.parent.mkdir(parents=True, exist_ok=True)
         except OSError as exc:
-            print(f"tcp-pendant: error: cannot make the folder of the class gradebook {class_db.parent}: "
-                  f"{exc}; give another file with --class-db PATH", file=sys.stderr)
-            return 2
-    balance_file = _balance_file(args.workers, worker)
+            raise _Refused(f"cannot make the folder of the class gradebook {class_db.parent}: "
+                           f"{exc}; give another file with --class-db PATH") from None
+    return trainer_token, class_db
+
+
+def _make_app(args: argparse.Namespace, trainer_token: str | None, class_db: Path | str | None,
+              balance_file: Path | None, worker: tuple[int, int, int] | None) -> PendantApp:
+    """The app the options describe (the robot loaded, not serving yet); its warnings printed
+    by the first process.
+
+    Raises:
+        _Refused: the robot, a file, the gradebook or an option refused (the balance file is
+            dropped).
+    """
+    from tcp_pendant.classroom.gradebook_store import GradebookError
+    from tcp_pendant.classroom.library_rights import DEFAULT_LIBRARY_QUOTA
+    from tcp_pendant.controller import ControllerError
+    from tcp_pendant.serve.server import AppConfig, PendantApp, parse_xyz_mm
+
     try:
         tip = None if args.reference_tip is None else parse_xyz_mm(args.reference_tip)
         config = AppConfig(robot=args.robot, package_paths=tuple(args.package_path), flange_link=args.flange_link, tool=args.tool, host=args.host,
@@ -292,70 +373,74 @@ def _main(argv: Sequence[str] | None) -> int:
                            scenario_seed=args.scenario_seed, presenter=args.presenter,
                            hide_truth=args.hide_truth,
                            beam_width_mm=args.beam_width, beam_repeatability_mm=args.beam_repeatability,
-                           beam_crossed=args.beam_crossed, seed=args.seed, reuse_port=several,
+                           beam_crossed=args.beam_crossed, seed=args.seed,
+                           reuse_port=args.workers > 1 or worker is not None,
                            balance_file=balance_file)
         app = PendantApp(config)
     except (ControllerError, ValueError, OSError, GradebookError) as exc:
         _drop_balance_file(balance_file, worker)
-        print(f"tcp-pendant: error: {exc}", file=sys.stderr)
-        return 2
+        raise _Refused(str(exc)) from None
     if worker is None:                      # a worker's warnings are the first process's
         for line in app.warnings:
             print(f"WARNING: {line}", file=sys.stderr)
         warning = network_warning(args.host)
         if warning is not None:
             print(warning, file=sys.stderr)
+    return app
+
+
+def _start(app: PendantApp, args: argparse.Namespace, balance_file: Path | None,
+           worker: tuple[int, int, int] | None) -> str:
+    """Start serving ``app``; returns its URL.
+
+    Raises:
+        _Refused: the port is in use or cannot be listened on (the balance file is dropped).
+        KeyboardInterrupt: Ctrl-C while starting (the app is stopped first).
+    """
+    from tcp_pendant.serve.server import PortInUseError
+
     try:
-        url = app.start()
+        return app.start()
     except PortInUseError as exc:
         _drop_balance_file(balance_file, worker)
-        print(f"tcp-pendant: error: {exc}", file=sys.stderr)
-        return 2
+        raise _Refused(str(exc)) from None
     except OSError as exc:
         _drop_balance_file(balance_file, worker)
-        print(f"tcp-pendant: error: cannot listen on {args.host}:{args.port}: {exc}", file=sys.stderr)
-        return 2
+        raise _Refused(f"cannot listen on {args.host}:{args.port}: {exc}") from None
     except KeyboardInterrupt:
         app.stop()
         _drop_balance_file(balance_file, worker)
         raise
-    set_apart_startup_objects()
-    if worker is not None:
-        return _serve_as_worker(app, worker[2])
-    workers: Workers | None = None
-    if args.workers > 1:
-        balance = app.balance
-        from tcp_pendant.serve.balance import BALANCE_ENV
 
-        workers = Workers(list(argv or ()), app.port, args.workers,
-                          env={} if balance_file is None else {BALANCE_ENV: str(balance_file)},
-                          on_stopped=None if balance is None else balance.turn_off)
-        try:
-            workers.start()
-        except (WorkerError, OSError) as exc:
-            app.stop()
-            _drop_balance_file(balance_file, worker)
-            print(f"tcp-pendant: error: {exc}", file=sys.stderr)
-            return 2
-        except KeyboardInterrupt:
-            app.stop()
-            _drop_balance_file(balance_file, worker)
-            raise
-    mode = "one robot shared by every browser" if args.shared else "one robot per browser"
-    if workers is not None:
-        mode += (f"; {args.workers} server processes on port {app.port} (pids "
-                 f"{', '.join(str(p) for p in [os.getpid(), *workers.pids])})")
-    tip_mm = ", ".join(f"{v:.0f}" for v in app.reference_tip_m * 1000.0)
-    print(f"TCP Pendant ready in {time.perf_counter() - t0:.1f} s: {ready_urls(url, app.network_urls, args.host)}"
-          f"\n  robot {app.robot_label}, tool {app.tool.label}, reference tip ({tip_mm}) mm, {mode}\n"
-          f"  tool library {app.library.path}\n{_class_lines(app)}  Ctrl-C to stop.", flush=True)
+
+def _start_workers(app: PendantApp, args: argparse.Namespace, argv: Sequence[str] | None,
+                   balance_file: Path | None) -> Workers | None:
+    """Start the other ``--workers`` processes on the app's port (None: one process).
+
+    Raises:
+        _Refused: a worker did not start (the app is stopped, the balance file dropped).
+        KeyboardInterrupt: Ctrl-C while they start (likewise).
+    """
+    from tcp_pendant.serve.balance import BALANCE_ENV
+    from tcp_pendant.serve.workers import WorkerError, Workers
+
+    if args.workers <= 1:
+        return None
+    balance = app.balance
+    workers = Workers(list(argv or ()), app.port, args.workers,
+                      env={} if balance_file is None else {BALANCE_ENV: str(balance_file)},
+                      on_stopped=None if balance is None else balance.turn_off)
     try:
-        app.serve_forever()
-    finally:
-        if workers is not None:
-            workers.stop()
-        _drop_balance_file(balance_file, worker)
-    return 0
+        workers.start()
+    except (WorkerError, OSError) as exc:
+        app.stop()
+        _drop_balance_file(balance_file, None)
+        raise _Refused(str(exc)) from None
+    except KeyboardInterrupt:
+        app.stop()
+        _drop_balance_file(balance_file, None)
+        raise
+    return workers
 
 
 def _drop_balance_file(balance_file: Path | None, worker: tuple[int, int, int] | None) -> None:

@@ -27,9 +27,14 @@ __all__ = ["BriefControl", "ExerciseControls", "brief_words", "build_exercise_co
 class BriefControl(Protocol):
     """What the exercise controls need of the class (``ClassRoom``)."""
 
-    instructions: str
-    allowed_methods: tuple[str, ...] | None
-    min_touches: int
+    @property
+    def instructions(self) -> str: ...
+
+    @property
+    def allowed_methods(self) -> tuple[str, ...] | None: ...
+
+    @property
+    def min_touches(self) -> int: ...
 
     def push_brief(self, instructions: str, allowed_methods: Sequence[str] | str | None,
                    min_touches: int) -> int: ...

@@ -47,7 +47,9 @@ class ClassControl(BriefControl, MessageControl, Protocol):
     def tool_keys(self) -> Sequence[str]: ...
 
     gradebook: Gradebook
-    exercise: str | None
+
+    @property
+    def exercise(self) -> str | None: ...
 
     def trainee_statuses(self) -> list[TraineeStatus]: ...
 
