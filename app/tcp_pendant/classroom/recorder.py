@@ -81,7 +81,7 @@ class _RunState:
     calibration_id: int
     touch_ids: dict[int, int] = field(default_factory=dict)     # step -> gradebook touch id
     status: str = "in_progress"
-    kept: dict[str, Any] | None = None                          # the wizard's entry as last kept
+    kept: dict[str, object] | None = None                          # the wizard's entry as last kept
 
 
 class TraineeRecorder:

@@ -33,6 +33,7 @@ from tcp_pendant.classroom.gradebook_values import (
     vector,
     whole_id,
 )
+from tcp_pendant.json_shapes import JsonRecord
 
 __all__ = ["TrainingRecords", "calibration_row"]
 
@@ -234,7 +235,7 @@ class TrainingRecords:
         with self._store.read() as db:
             return calibration_row(self._store, db, calibration_id)[2]
 
-    def touches(self, calibration_id: int) -> list[dict[str, Any]]:
+    def touches(self, calibration_id: int) -> list[JsonRecord]:
         """Every touch of a calibration in recording order, overwritten ones included: dicts with
         id, step_index, recorded_at, T_world_flange_m (4x4 list), joints_deg, distance_mm, auto,
         overwrites_touch_id, overwritten_by_touch_id."""
@@ -247,13 +248,13 @@ class TrainingRecords:
                  "joints_deg": json.loads(r[4]), "distance_mm": r[5], "auto": bool(r[6]),
                  "overwrites_touch_id": r[7], "overwritten_by_touch_id": r[8]} for r in rows]
 
-    def truth(self, calibration_id: int) -> dict[str, Any]:
+    def truth(self, calibration_id: int) -> JsonRecord:
         """The truth stored by :meth:`start_calibration` (server side only)."""
         with self._store.read() as db:
             cid = calibration_row(self._store, db, calibration_id)[0]
             return json.loads(db.execute("SELECT truth_json FROM calibrations WHERE id = ?", (cid,)).fetchone()[0])
 
-    def calibration_result(self, calibration_id: int) -> dict[str, Any]:
+    def calibration_result(self, calibration_id: int) -> JsonRecord:
         """A calibration's method, status and result: ``{"trainee", "method", "status",
         "tcp_mm", "abc_deg", "position_error_mm", "orientation_error_deg", "grade"}`` (None
         where there is none yet)."""

@@ -34,6 +34,7 @@ from tcp_pendant.wizards.describe import (
     WizardOption,
     WizardStart,
 )
+from tcp_pendant.json_shapes import JsonRecord
 
 R_WORLD_TOOL_TARGET: np.ndarray = R_WORLD_TOOL_PARALLEL
 """(PA-1): the prescribed tool orientation in WORLD (columns: tool X, Y, Z in WORLD), tcpcal's."""
@@ -62,7 +63,7 @@ class AbcWorldWizard(Wizard):
     needs_tool = "library"
 
     @classmethod
-    def start(cls, ctx: StartContext, options: Mapping[str, Any]) -> WizardStart:
+    def start(cls, ctx: StartContext, options: JsonRecord) -> WizardStart:
         """For the library tool in ``slot``; its data is made active so rotations A, B, C turn
         about its TCP."""
         tool = ctx.library_tool(options["slot"])
@@ -157,9 +158,9 @@ class AbcWorldWizard(Wizard):
         return Tool(name=name, tcp_mm=res.tcp_mm, abc_deg=res.abc_deg, mass_kg=self.tool.mass_kg,
                     cog_mm=self.tool.cog_mm, notes=self.tool.notes, calibration=self._calibration(res, figures))
 
-    def _params(self) -> dict[str, Any]:
+    def _params(self) -> dict[str, object]:
         return {"tool": self.tool.to_dict(), "variant": self._variant}
 
     @classmethod
-    def _from_params(cls, params: Mapping[str, Any]) -> "AbcWorldWizard":
+    def _from_params(cls, params: JsonRecord) -> "AbcWorldWizard":
         return cls(Tool.from_dict(params["tool"]), variant=params.get("variant", "6d"))

@@ -43,6 +43,7 @@ from tcp_pendant.wizards.describe import (
     WizardOption,
     WizardStart,
 )
+from tcp_pendant.json_shapes import JsonRecord
 
 M_TO_MM = 1000.0
 """Metres (controller) to millimetres (tcpcal input and every ``*_mm`` figure)."""
@@ -145,11 +146,11 @@ class RecordedPose:
     T_world_flange_m: np.ndarray
     recorded_at: str
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, object]:
         return {"T_world_flange_m": self.T_world_flange_m.tolist(), "recorded_at": self.recorded_at}
 
     @classmethod
-    def from_dict(cls, d: Mapping[str, Any]) -> "RecordedPose":
+    def from_dict(cls, d: JsonRecord) -> "RecordedPose":
         return cls(check_pose_m(d["T_world_flange_m"]), str(d["recorded_at"]))
 
 
@@ -257,7 +258,7 @@ class WizardResult:
             out["n_touches"] = float(self.tcp_result.n_touches)
         return out
 
-    def summary(self) -> dict[str, Any]:
+    def summary(self) -> dict[str, object]:
         """JSON-ready summary (used by the session record): method, frame, figures, warnings."""
         return {
             "wizard": self.wizard,
@@ -344,7 +345,7 @@ class Wizard(abc.ABC):
         return type(self).step_role(step.role).auto
 
     @classmethod
-    def parse_options(cls, options: Mapping[str, Any]) -> dict[str, Any]:
+    def parse_options(cls, options: JsonRecord) -> JsonRecord:
         """The start options checked against :attr:`options` (and ``variant`` against
         :attr:`variants`); defaults filled in.
 
@@ -357,7 +358,7 @@ class Wizard(abc.ABC):
         if unknown:
             raise WizardError(f"The {cls.title} wizard takes no option {', '.join(unknown)}; "
                               f"it takes {', '.join(sorted(allowed)) or 'none'}.")
-        out: dict[str, Any] = {}
+        out: dict[str, object] = {}
         try:
             for name, opt in declared.items():
                 if name in options and options[name] is not None:
@@ -377,7 +378,7 @@ class Wizard(abc.ABC):
         return out
 
     @classmethod
-    def start(cls, ctx: StartContext, options: Mapping[str, Any]) -> WizardStart:
+    def start(cls, ctx: StartContext, options: JsonRecord) -> WizardStart:
         """Build the wizard from checked ``options`` (:meth:`parse_options`)."""
         raise NotImplementedError(f"{cls.__name__} does not say how to start it.")
 
@@ -440,12 +441,12 @@ class Wizard(abc.ABC):
         """Call tcpcal on the recorded poses (metres, in step order) and build the result."""
 
     @abc.abstractmethod
-    def _params(self) -> dict[str, Any]:
+    def _params(self) -> dict[str, object]:
         """JSON-ready constructor options, for ``to_dict``."""
 
     @classmethod
     @abc.abstractmethod
-    def _from_params(cls, params: Mapping[str, Any]) -> "Wizard":
+    def _from_params(cls, params: JsonRecord) -> "Wizard":
         """Inverse of ``_params``."""
 
     # ----- steps --------------------------------------------------------------------------
@@ -697,7 +698,7 @@ class Wizard(abc.ABC):
         return self.result
 
     # ----- serialisation (resume, session record) -----------------------------------------
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, object]:
         """JSON-ready state: kind, options, recorded poses (metres), step, status."""
         status = self._status
         if status == "cancelled":
@@ -713,7 +714,7 @@ class Wizard(abc.ABC):
         }
 
     @classmethod
-    def from_dict(cls, d: Mapping[str, Any]) -> "Wizard":
+    def from_dict(cls, d: JsonRecord) -> "Wizard":
         """Rebuild a wizard from ``to_dict`` output; a complete wizard is recomputed with tcpcal.
 
         Called on the base class, dispatches on ``d["kind"]``.
@@ -730,7 +731,7 @@ class Wizard(abc.ABC):
         wiz._load_state(d)
         return wiz
 
-    def _load_state(self, d: Mapping[str, Any]) -> None:
+    def _load_state(self, d: JsonRecord) -> None:
         self._poses = {int(i): RecordedPose.from_dict(p) for i, p in d.get("poses", {}).items()}
         n = self.n_steps
         bad = [i for i in self._poses if not 0 <= i < n]

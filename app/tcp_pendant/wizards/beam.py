@@ -58,6 +58,7 @@ from tcp_pendant.wizards.base import (
     mm3,
 )
 from tcp_pendant.wizards.describe import BY_CONTROLLER, StepRole, WizardOption, WizardStart
+from tcp_pendant.json_shapes import JsonRecord
 
 __all__ = [
     "BeamWizard",
@@ -131,7 +132,7 @@ class ScanEvent:
                               "beam_dir": list(np.asarray(event.beam_dir, float)),
                               "on_shaft": bool(event.on_shaft), "orientation": int(orientation)})
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, object]:
         return {"kind": self.kind, "T_world_flange_m": self.T_world_flange.tolist(), "beam": self.beam,
                 "beam_point_m": self.beam_point.tolist(), "beam_dir": self.beam_dir.tolist(),
                 "on_shaft": self.on_shaft, "orientation": self.orientation}
@@ -206,7 +207,7 @@ class RecordedScan:
                              "skipped": [str(s) for s in getattr(scan, "skipped", ())]})
         return out
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, object]:
         return {"events": [e.to_dict() for e in self.events], "duration_s": self.duration_s,
                 "path_length_m": self.path_length_m, "skipped": list(self.skipped)}
 
@@ -276,7 +277,7 @@ class ManualComparison:
     touches: int = 0
     auto_touches: int = 0
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, object]:
         """JSON-ready; the truth-derived figures under ``"truth"`` (an honest record drops it)."""
         truth = None
         if self.position_error_mm is not None:
@@ -455,7 +456,7 @@ class BeamWizard(Wizard):
         self._manual: ManualComparison | None = None
 
     @classmethod
-    def start(cls, ctx: StartContext, options: Mapping[str, Any]) -> WizardStart:
+    def start(cls, ctx: StartContext, options: JsonRecord) -> WizardStart:
         """For the mounted tool (its truth grades the TCP and the tool direction)."""
         return WizardStart(cls(n_orientations=options.get("n_orientations", 4),
                                scan_speed_mm_s=options.get("scan_speed_mm_s", 50)),
@@ -643,20 +644,20 @@ class BeamWizard(Wizard):
                     calibration=self._calibration(res, res.figures))
 
     # ----- serialisation ------------------------------------------------------------------
-    def _params(self) -> dict[str, Any]:
+    def _params(self) -> dict[str, object]:
         return {"n_orientations": self.n_orientations, "scan_speed_mm_s": self.scan_speed_mm_s,
                 "scan": None if self._scan is None else self._scan.to_dict(),
                 "R_flange_tool_base": None if self._R_base is None else self._R_base.tolist(),
                 "manual": None if self._manual is None else self._manual.to_dict()}
 
     @classmethod
-    def _from_params(cls, params: Mapping[str, Any]) -> "BeamWizard":
+    def _from_params(cls, params: JsonRecord) -> "BeamWizard":
         if not isinstance(params, Mapping):
             raise WizardError("The beam wizard's stored params must be an object.")
         return cls(n_orientations=params.get("n_orientations", 4),
                    scan_speed_mm_s=params.get("scan_speed_mm_s", 50.0))
 
-    def _load_state(self, d: Mapping[str, Any]) -> None:
+    def _load_state(self, d: JsonRecord) -> None:
         """The stored scan is handed in before the base class finishes a complete wizard (a
         replay runs no robot); scan, planning orientation and manual comparison are checked."""
         params = d.get("params")

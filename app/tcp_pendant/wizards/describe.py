@@ -13,6 +13,7 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Literal, Protocol
+from tcp_pendant.json_shapes import JsonRecord
 
 if TYPE_CHECKING:
     from tcp_pendant.wizards.base import Wizard
@@ -160,7 +161,7 @@ class StartContext(Protocol):
     """What a wizard class may read when it is started (the workflow provides it)."""
 
     @property
-    def tools(self) -> Mapping[str, Any]:
+    def tools(self) -> JsonRecord:
         """Physical tools (``ToolModel``) by key."""
 
     @property

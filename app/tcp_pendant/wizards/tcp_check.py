@@ -42,6 +42,7 @@ from tcp_pendant.wizards.base import (
     mm3,
 )
 from tcp_pendant.wizards.describe import TOUCH, StepRole, WizardOption, WizardStart
+from tcp_pendant.json_shapes import JsonRecord
 
 __all__ = ["CheckFigures", "CheckRow", "GOOD_CHECK_MM", "TcpCheckResult", "TcpCheckWizard",
            "tcp_check_markdown"]
@@ -128,8 +129,8 @@ class CheckFigures:
                     "limits, record again and check again.")
         return f"TCP good: implied error {err:.3f} mm (at most {GOOD_CHECK_MM:g} mm)."
 
-    def to_dict(self) -> dict[str, Any]:
-        d: dict[str, Any] = {
+    def to_dict(self) -> dict[str, object]:
+        d: dict[str, object] = {
             "angle_deg": self.angle_deg,
             "rows": [{"label": r.label, "reached": r.reached, "message": r.message,
                       "deviation_mm": r.deviation_mm} for r in self.rows],
@@ -226,7 +227,7 @@ class TcpCheckWizard(Wizard):
         self._checked_pose: RecordedPose | None = None
 
     @classmethod
-    def start(cls, ctx: StartContext, options: Mapping[str, Any]) -> WizardStart:
+    def start(cls, ctx: StartContext, options: JsonRecord) -> WizardStart:
         """For the library tool in ``slot``, made active (the rotations turn about its TCP); no
         true tool: a check is not graded."""
         slot = int(options["slot"])
@@ -301,17 +302,17 @@ class TcpCheckWizard(Wizard):
         raise WizardStateError("A TCP check saves nothing to the library: it only checks the tool data.")
 
     # ----- serialisation ------------------------------------------------------------------
-    def _params(self) -> dict[str, Any]:
+    def _params(self) -> dict[str, object]:
         check = self.check
         return {"tool": self.tool.to_dict(), "slot": self.slot, "angle_deg": self.angle_deg,
                 "check": None if check is None else check.to_dict()}
 
     @classmethod
-    def _from_params(cls, params: Mapping[str, Any]) -> "TcpCheckWizard":
+    def _from_params(cls, params: JsonRecord) -> "TcpCheckWizard":
         return cls(Tool.from_dict(params["tool"]), slot=params.get("slot"),
                    angle_deg=params.get("angle_deg", 30.0))
 
-    def _load_state(self, d: Mapping[str, Any]) -> None:
+    def _load_state(self, d: JsonRecord) -> None:
         """The stored check belongs to the stored touch: hand it in before the base class
         finishes a complete wizard (a replay runs no robot)."""
         params = d.get("params")

@@ -37,6 +37,7 @@ from tcp_pendant.wizards.describe import (
     WizardStart,
 )
 from tcp_pendant.wizards.xyz4 import RESIDUAL_CAVEAT
+from tcp_pendant.json_shapes import JsonRecord
 
 __all__ = ["MIN_AXIS_DISTANCE_MM", "TcpZxWizard"]
 
@@ -83,7 +84,7 @@ class TcpZxWizard(Wizard):
         self.assumed_sigma_mm = float(assumed_sigma_mm)
 
     @classmethod
-    def start(cls, ctx: StartContext, options: Mapping[str, Any]) -> WizardStart:
+    def start(cls, ctx: StartContext, options: JsonRecord) -> WizardStart:
         """For the mounted tool (its truth grades the TCP and the frame)."""
         return WizardStart(cls(n_points=options["n_points"]), true_tool=ctx.mounted_tool)
 
@@ -163,10 +164,10 @@ class TcpZxWizard(Wizard):
                     calibration=self._calibration(res, res.figures))
 
     # ----- serialisation ------------------------------------------------------------------
-    def _params(self) -> dict[str, Any]:
+    def _params(self) -> dict[str, object]:
         return {"n_points": self._n_points, "assumed_sigma_mm": self.assumed_sigma_mm}
 
     @classmethod
-    def _from_params(cls, params: Mapping[str, Any]) -> "TcpZxWizard":
+    def _from_params(cls, params: JsonRecord) -> "TcpZxWizard":
         return cls(n_points=int(params.get("n_points", 4)),
                    assumed_sigma_mm=float(params.get("assumed_sigma_mm", 0.5)))

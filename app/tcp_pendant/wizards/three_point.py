@@ -33,6 +33,7 @@ from tcp_pendant.wizards.describe import (
     WizardOption,
     WizardStart,
 )
+from tcp_pendant.json_shapes import JsonRecord
 
 MIN_DISPLACEMENT_MM = 20.0
 """Displacements shorter than this give a poor orientation; the wizard warns."""
@@ -67,7 +68,7 @@ class ThreePointWizard(Wizard):
     needs_tool = "library"
 
     @classmethod
-    def start(cls, ctx: StartContext, options: Mapping[str, Any]) -> WizardStart:
+    def start(cls, ctx: StartContext, options: JsonRecord) -> WizardStart:
         """For the library tool in ``slot`` (its TCP must be calibrated); its data is made
         active so jogs along tool X/Y use it."""
         tool = ctx.library_tool(options["slot"])
@@ -166,9 +167,9 @@ class ThreePointWizard(Wizard):
         return Tool(name=name, tcp_mm=res.tcp_mm, abc_deg=res.abc_deg, mass_kg=self.tool.mass_kg,
                     cog_mm=self.tool.cog_mm, notes=self.tool.notes, calibration=self._calibration(res, figures))
 
-    def _params(self) -> dict[str, Any]:
+    def _params(self) -> dict[str, object]:
         return {"tool": self.tool.to_dict(), "variant": self._variant}
 
     @classmethod
-    def _from_params(cls, params: Mapping[str, Any]) -> "ThreePointWizard":
+    def _from_params(cls, params: JsonRecord) -> "ThreePointWizard":
         return cls(Tool.from_dict(params["tool"]), variant=int(params.get("variant", 1)))  # type: ignore[arg-type]

@@ -59,7 +59,7 @@ class TruthComparison:
     grade: Grade
     verdict: str
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, object]:
         return {"position_error_mm": self.position_error_mm,
                 "position_error_vector_mm": list(self.position_error_vector_mm),
                 "orientation_error_deg": self.orientation_error_deg,
