@@ -26,15 +26,17 @@ import datetime as _dt
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any, ClassVar, Literal
+from typing import ClassVar, Literal
 
 import numpy as np
+import numpy.typing as npt
 
 from tcpcal.errors import TcpcalError
 from tcpcal.origin import TcpResult
 from tcpcal.orientation import OrientationResult
 from tcpcal.tool import Calibration, Tool
 
+from tcp_pendant.json_shapes import JsonRecord
 from tcp_pendant.wizards.describe import (
     AutoRole,
     OptionError,
@@ -43,7 +45,6 @@ from tcp_pendant.wizards.describe import (
     WizardOption,
     WizardStart,
 )
-from tcp_pendant.json_shapes import JsonRecord
 
 M_TO_MM = 1000.0
 """Metres (controller) to millimetres (tcpcal input and every ``*_mm`` figure)."""
@@ -76,7 +77,7 @@ def utc_now_iso() -> str:
     return _dt.datetime.now(_dt.timezone.utc).replace(microsecond=0).isoformat().replace("+00:00", "Z")
 
 
-def finite_number(value: Any, what: str, *, low: float | None = None, high: float | None = None) -> float:
+def finite_number(value: object, what: str, *, low: float | None = None, high: float | None = None) -> float:
     """A number from untrusted input (a session record's stored figures, a start option), checked.
 
     Args:
@@ -91,7 +92,7 @@ def finite_number(value: Any, what: str, *, low: float | None = None, high: floa
     if isinstance(value, bool):
         raise WizardError(f"The {what} must be a number, got {value!r:.40}.")
     try:
-        x = float(value)
+        x = float(value)  # type: ignore[arg-type]  # any value: what float() refuses is refused
     except (TypeError, ValueError):
         raise WizardError(f"The {what} must be a number, got {value!r:.40}.") from None
     if low is None and high is None:
@@ -104,7 +105,7 @@ def finite_number(value: Any, what: str, *, low: float | None = None, high: floa
     return x
 
 
-def check_pose_m(T_world_flange_m: Any, *, what: str = "flange pose") -> np.ndarray:
+def check_pose_m(T_world_flange_m: object, *, what: str = "flange pose") -> np.ndarray:
     """Validate a rigid transform in metres and return it as a float (4,4) copy.
 
     Raises:
@@ -320,7 +321,7 @@ class Wizard(abc.ABC):
     rank: ClassVar[int] = 100
     step_roles: ClassVar[tuple[StepRole, ...]] = ()
     options: ClassVar[tuple[WizardOption, ...]] = ()
-    variants: ClassVar[tuple[tuple[Any, str], ...]] = ()
+    variants: ClassVar[tuple[tuple[int | str, str], ...]] = ()
     needs_tool: ClassVar[Literal["mounted", "library"]] = "mounted"
     supports_add_point: ClassVar[bool] = False
     diversity_meter: ClassVar[bool] = False
@@ -384,11 +385,11 @@ class Wizard(abc.ABC):
 
     # ----- capabilities the views ask for (defaults: none) ------------------------------
     @property
-    def variant(self) -> Any:
+    def variant(self) -> int | str | None:
         """The variant in use (None when the wizard has none)."""
         return None
 
-    def set_variant(self, variant: Any) -> None:
+    def set_variant(self, variant: int | str) -> None:
         """Switch the variant (wizards with :attr:`variants` override this)."""
         raise WizardStateError(f"The {self.title} wizard has no variants.")
 
@@ -561,7 +562,7 @@ class Wizard(abc.ABC):
         return self._index == self.n_steps - 1
 
     # ----- actions ------------------------------------------------------------------------
-    def record(self, T_world_flange_m: Any) -> StepInfo:
+    def record(self, T_world_flange_m: npt.ArrayLike) -> StepInfo:
         """Store the flange pose (4x4, metres, WORLD) for the current step; overwrite any earlier.
 
         Returns:
@@ -578,7 +579,7 @@ class Wizard(abc.ABC):
         self._poses[self._index] = RecordedPose(T, utc_now_iso())
         return self.step
 
-    def prefill(self, poses_m: Sequence[Any]) -> StepInfo:
+    def prefill(self, poses_m: Sequence[npt.ArrayLike]) -> StepInfo:
         """Record ``poses_m`` (4x4 flange poses in WORLD, metres) as the first steps of a wizard
         just started, then stand on the first step left to record (the last step when all are).
         Every pose is checked before any is stored.

@@ -14,9 +14,9 @@ import numpy as np
 from tcpcal.origin import solve_reference
 from tcpcal.tool import Tool
 
+from tcp_pendant.json_shapes import JsonRecord
 from tcp_pendant.wizards.base import StartContext, StepSpec, Wizard, WizardError, WizardResult, mm3
 from tcp_pendant.wizards.describe import TOUCH, StepRole, WizardOption, WizardStart
-from tcp_pendant.json_shapes import JsonRecord
 
 ERRORS_ADD_UP = (
     "The reference method uses one touch per tool: the new TCP carries the error of both "

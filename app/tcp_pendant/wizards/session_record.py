@@ -99,14 +99,20 @@ import stat
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from tcp_pendant.json_shapes import JsonRecord
 from tcp_pendant.wizards.base import Wizard, WizardError, check_pose_m, utc_now_iso
 from tcp_pendant.wizards.truth import TruthComparison, compare_with_truth
-from tcp_pendant.json_shapes import JsonRecord
+
+if TYPE_CHECKING:
+    import numpy.typing as npt
+
+    from tcp_pendant.controller.controller import VirtualController
+    from tcp_pendant.controller.tools import ToolModel
 
 FORMAT = "tcp-pendant-session"
 VERSION = 2
@@ -192,11 +198,30 @@ class ReplayCheck:
     message: str
 
 
-def _pose_list(T: Any) -> list[list[float]]:
+class PendantTouch(Protocol):
+    """A touch captured on the pendant (``session.Touch``)."""
+
+    @property
+    def T_world_flange(self) -> np.ndarray:
+        """(4,4) flange pose in WORLD, metres."""
+
+    @property
+    def label(self) -> str: ...
+
+    @property
+    def joints_deg(self) -> tuple[float, ...]: ...
+
+
+TouchLike = PendantTouch | JsonRecord | tuple[np.ndarray, str]
+"""A touch as :func:`session_to_dict` takes it: the pendant's, a dict with ``T_world_flange_m``,
+``label`` (and ``joints_deg``), or ``(T_world_flange_m, label)``."""
+
+
+def _pose_list(T: object) -> list[list[float]]:
     return check_pose_m(T).tolist()
 
 
-def _touch_dict(touch: Any) -> dict[str, object]:
+def _touch_dict(touch: TouchLike) -> dict[str, object]:
     if isinstance(touch, Mapping):
         T, label = touch["T_world_flange_m"], touch.get("label", "")
     elif isinstance(touch, tuple):
@@ -246,7 +271,7 @@ def step_distances(entry: JsonRecord) -> dict[int, float]:
     return {int(k): float(v) for k, v in raw.items()}
 
 
-def _distance_map(value: Any) -> bool:
+def _distance_map(value: object) -> bool:
     """Step index ("0"..) -> finite distance >= 0 mm, at most :data:`MAX_POSES_PER_WIZARD` steps."""
     return isinstance(value, Mapping) and len(value) <= MAX_POSES_PER_WIZARD and all(
         isinstance(k, str) and k.isdigit() and len(k) <= 3
@@ -258,7 +283,7 @@ def _without_truth(state: dict[str, object]) -> dict[str, object]:
     """A wizard state for an honest record: every ``"truth"`` key inside its params (where a
     wizard keeps figures derived from the hidden truth, e.g. the beam wizard's manual
     comparison) set to null."""
-    def strip(value: Any, depth: int = 0) -> Any:
+    def strip(value: object, depth: int = 0) -> object:
         if isinstance(value, Mapping) and depth < 8:
             return {k: (None if k == "truth" else strip(v, depth + 1)) for k, v in value.items()}
         return value
@@ -284,8 +309,9 @@ def _run_entry(run: WizardRun, honest: bool, record_id: int | None) -> dict[str,
 
 
 def session_to_dict(runs: Sequence[WizardRun | Wizard], *, robot: str, urdf: str | Path | None = None,
-                    T_world_base_m: Any = None, mounted_tool: Any = None,
-                    reference_tip_world_m: Any = None, touches: Sequence[Any] = (), honest: bool = False,
+                    T_world_base_m: npt.ArrayLike | None = None, mounted_tool: ToolModel | None = None,
+                    reference_tip_world_m: npt.ArrayLike | None = None, touches: Sequence[TouchLike] = (),
+                    honest: bool = False,
                     record_ids: Mapping[int, int] | None = None, with_distances: bool = True) -> dict[str, object]:
     """The session as a JSON-ready dict (see the module docstring for the keys).
 
@@ -328,8 +354,8 @@ def session_to_dict(runs: Sequence[WizardRun | Wizard], *, robot: str, urdf: str
     }
 
 
-def session_from_controller(controller: Any, runs: Sequence[WizardRun | Wizard], *, robot: str,
-                            touches: Sequence[Any] = (), honest: bool = False,
+def session_from_controller(controller: VirtualController, runs: Sequence[WizardRun | Wizard], *, robot: str,
+                            touches: Sequence[TouchLike] = (), honest: bool = False,
                             record_ids: Mapping[int, int] | None = None,
                             with_distances: bool = True) -> dict[str, object]:
     """``session_to_dict`` filled from a ``VirtualController`` (base, tool, reference tip, URDF;
@@ -392,7 +418,7 @@ def json_nesting_depth(data: bytes) -> int:
     return int(max(0, np.cumsum(step).max()))
 
 
-def _joint_list(value: Any) -> bool:
+def _joint_list(value: object) -> bool:
     """A list of at most :data:`MAX_JOINTS` finite numbers (a touch's joint values)."""
     return isinstance(value, list) and len(value) <= MAX_JOINTS and all(
         isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in value)

@@ -22,12 +22,13 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any, ClassVar, Literal
+from typing import TYPE_CHECKING, ClassVar, Literal
 
 import numpy as np
 
 from tcpcal.tool import Tool
 
+from tcp_pendant.json_shapes import JsonRecord
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.wizards.check_reading import CHECK_READING_MM, READING_NOTE, read_mm, reading_verdict
 from tcp_pendant.wizards.base import (
@@ -42,7 +43,9 @@ from tcp_pendant.wizards.base import (
     mm3,
 )
 from tcp_pendant.wizards.describe import TOUCH, StepRole, WizardOption, WizardStart
-from tcp_pendant.json_shapes import JsonRecord
+
+if TYPE_CHECKING:
+    from tcp_pendant.controller.spin import SpinCheckResult
 
 __all__ = ["CheckFigures", "CheckRow", "GOOD_CHECK_MM", "TcpCheckResult", "TcpCheckWizard",
            "tcp_check_markdown"]
@@ -92,8 +95,8 @@ class CheckFigures:
         return CheckFigures(self.angle_deg, rows, None, None, None, read_to_mm=CHECK_READING_MM)
 
     @classmethod
-    def of(cls, spin: Any) -> "CheckFigures":
-        """From a ``controller.spin.SpinCheckResult`` (duck-typed: no controller import here)."""
+    def of(cls, spin: SpinCheckResult) -> "CheckFigures":
+        """From a ``controller.spin.SpinCheckResult``."""
         rows = tuple(CheckRow(str(r.label), bool(r.reached), str(r.message or (r.stopped_by or ""))[:_MAX_TEXT],
                               float(r.deviation_mm)) for r in spin.rotations)
         off = spin.implied_offset_flange_mm
@@ -142,7 +145,7 @@ class CheckFigures:
         return d
 
     @classmethod
-    def from_dict(cls, d: Any) -> "CheckFigures":
+    def from_dict(cls, d: object) -> "CheckFigures":
         """Inverse of :meth:`to_dict`, checked (a record is untrusted: at most 6 rows, finite
         numbers, messages cut to 200 characters).
 
@@ -265,7 +268,7 @@ class TcpCheckWizard(Wizard):
         pose = self.recorded_pose
         return self._check if pose is not None and self._checked_pose is pose else None
 
-    def give_check(self, spin: Any, pose: RecordedPose | None = None) -> None:
+    def give_check(self, spin: SpinCheckResult | CheckFigures, pose: RecordedPose | None = None) -> None:
         """Hand in the check (a ``SpinCheckResult`` or :class:`CheckFigures`) run from the
         recorded touch ``pose`` (default: the current one).
 

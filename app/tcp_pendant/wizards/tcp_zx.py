@@ -11,14 +11,16 @@ and go to tcpcal in millimetres, so every figure is in mm (angles in degrees).
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Any, ClassVar
+from typing import ClassVar
 
 import numpy as np
+import numpy.typing as npt
 
 from tcpcal.pose_quality import CandidateGain, candidate_gain
 from tcpcal.tcp_zx import solve_tcp_zx
 from tcpcal.tool import Tool
 
+from tcp_pendant.json_shapes import JsonRecord
 from tcp_pendant.wizards.base import (
     StartContext,
     StepSpec,
@@ -37,7 +39,6 @@ from tcp_pendant.wizards.describe import (
     WizardStart,
 )
 from tcp_pendant.wizards.xyz4 import RESIDUAL_CAVEAT
-from tcp_pendant.json_shapes import JsonRecord
 
 __all__ = ["MIN_AXIS_DISTANCE_MM", "TcpZxWizard"]
 
@@ -127,7 +128,7 @@ class TcpZxWizard(Wizard):
                 if roles[i] == "touch" and (i != self._index or self.is_complete)]
         return np.array(rots, dtype=float).reshape(-1, 3, 3)
 
-    def preview(self, T_world_flange_m: Any, *, min_angle_deg: float = 15.0) -> CandidateGain:
+    def preview(self, T_world_flange_m: npt.ArrayLike, *, min_angle_deg: float = 15.0) -> CandidateGain:
         """Predicted TCP uncertainty (mm) if the current pose were recorded as a touch
         (``tcpcal.candidate_gain`` against the other touches, operator error ``assumed_sigma_mm``)."""
         T = check_pose_m(T_world_flange_m, what="candidate flange pose")

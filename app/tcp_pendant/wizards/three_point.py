@@ -8,13 +8,14 @@ in metres and go to tcpcal in mm, so displacement lengths are in mm.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Any, ClassVar, Literal
+from typing import ClassVar, Literal
 
 import numpy as np
 
 from tcpcal.orientation import solve_three_point
 from tcpcal.tool import Tool
 
+from tcp_pendant.json_shapes import JsonRecord
 from tcp_pendant.wizards.base import (
     StepSpec,
     Wizard,
@@ -33,7 +34,6 @@ from tcp_pendant.wizards.describe import (
     WizardOption,
     WizardStart,
 )
-from tcp_pendant.json_shapes import JsonRecord
 
 MIN_DISPLACEMENT_MM = 20.0
 """Displacements shorter than this give a poor orientation; the wizard warns."""
@@ -89,18 +89,21 @@ class ThreePointWizard(Wizard):
         self._variant: Literal[1, 2] = variant
 
     @staticmethod
-    def _check_variant(variant: Any) -> None:
-        if variant not in (1, 2):
-            raise WizardError(f"The three-point variant is 1 or 2, got {variant!r}.")
+    def _check_variant(variant: object) -> Literal[1, 2]:
+        if variant == 1:
+            return 1
+        if variant == 2:
+            return 2
+        raise WizardError(f"The three-point variant is 1 or 2, got {variant!r}.")
 
     @property
     def variant(self) -> Literal[1, 2]:
         return self._variant
 
-    def set_variant(self, variant: Literal[1, 2]) -> None:
+    def set_variant(self, variant: int | str) -> None:
         """Choose variant 1 or 2. A step-3 pose recorded for variant 2 is dropped when switching
         to variant 1 (a point in the half-plane is not on the +Y axis); a finished wizard reopens."""
-        self._check_variant(variant)
+        variant = self._check_variant(variant)
         if self.status == "cancelled":
             raise WizardStateError("The wizard was cancelled; resume it first.")
         if variant == self._variant:

@@ -9,15 +9,17 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field, replace
-from typing import Any, ClassVar, Literal, TypedDict
+from typing import ClassVar, Literal, TypedDict
 
 import numpy as np
+import numpy.typing as npt
 
 from tcpcal.errors import TcpcalError
 from tcpcal.origin import TcpResult, solve_xyz4
 from tcpcal.pose_quality import CandidateGain, PoseQuality, assess_touches, candidate_gain
 from tcpcal.tool import Tool
 
+from tcp_pendant.json_shapes import JsonRecord
 from tcp_pendant.wizards.base import (
     StartContext,
     StepSpec,
@@ -30,7 +32,6 @@ from tcp_pendant.wizards.base import (
     rotation_and_position_mm,
 )
 from tcp_pendant.wizards.describe import TOUCH, StepRole, WizardOption, WizardStart
-from tcp_pendant.json_shapes import JsonRecord
 
 Estimator = Literal["lstsq", "sphere", "pairwise"]
 ESTIMATORS: tuple[Estimator, ...] = ("lstsq", "sphere", "pairwise")
@@ -290,7 +291,7 @@ class Xyz4Wizard(Wizard):
         current step's own): what :meth:`preview` compares the candidate with."""
         return self._other_rotations()
 
-    def preview(self, T_world_flange_m: Any, *, min_angle_deg: float = 15.0) -> CandidateGain:
+    def preview(self, T_world_flange_m: npt.ArrayLike, *, min_angle_deg: float = 15.0) -> CandidateGain:
         """Predicted TCP uncertainty if the current pose were recorded (tcpcal.candidate_gain).
 
         Compares the candidate flange orientation with the touches recorded so far (except the
