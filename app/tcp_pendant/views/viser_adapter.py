@@ -106,6 +106,8 @@ if TYPE_CHECKING:                        # viser's and websockets' private types
     )
     from viser.infra import ClientId, WebsockMessageHandler
     from viser.infra._messages import Message
+
+    from tcp_pendant.session import Browser
     from websockets.asyncio.server import Server, ServerConnection, serve
 
     UploadStart = FileTransferStartUpload
@@ -733,15 +735,16 @@ def _peer(websocket: ServerConnection) -> str:
         return "?"
 
 
-def client_address(client: viser.ClientHandle) -> str | None:
+def client_address(client: Browser | None) -> str | None:
     """The IP address a viser client's websocket connects from (its peer), None when there is
     none to read (a closed connection, a shared page, or viser's internals differ).
 
     viser keeps each client's connection in its websocket server's table of live connections
     (``_live_connections``, by client id): private API, read only here."""
     try:
-        server = client._viser_server._websock_server
-        connection = server._live_connections[client.client_id]
+        viser_client = cast("viser.ClientHandle", client)      # a served session's browser is viser's
+        server = viser_client._viser_server._websock_server
+        connection = server._live_connections[viser_client.client_id]
         return str(connection.remote_address[0])
     except (AttributeError, KeyError, IndexError, TypeError):
         return None
