@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable, Coroutine
-from typing import Any
 
 import viser
 
@@ -339,7 +338,7 @@ class ToolPanel:
         return (tool.name if slot is None else f"slot {slot}: {tool.name}"), tool
 
     def _check_callback(self, which: Callable[[], tuple[str, Tool]]
-                        ) -> Callable[[ButtonEvent], Coroutine[Any, Any, None]]:
+                        ) -> Callable[[ButtonEvent], Coroutine[object, object, None]]:
         async def callback(_event: ButtonEvent) -> None:
             await self.run_check(which)
         return callback

@@ -25,7 +25,7 @@ from __future__ import annotations
 import logging
 import math
 from collections.abc import Callable, Coroutine
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, TypeVar, cast
 
 from tcp_pendant.calibrate.diversity import best_tilt, best_tilt_words
 from tcp_pendant.calibrate.text import meter_level, step_markdown
@@ -37,7 +37,10 @@ from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.views.gui_util import ButtonEvent, ButtonGroupEvent, set_content, set_value, target_of
 
 if TYPE_CHECKING:
+    from tcp_pendant.wizards.base import MeterWizard
     from tcp_pendant.calibrate import CalibrationWorkflow
+
+_E = TypeVar("_E")
 
 __all__ = ["BACK", "CANCEL", "CLOSE", "FINISH", "NEXT", "WizardDock", "tilt_line_html"]
 
@@ -88,11 +91,11 @@ class WizardDock:
         session.subscribe(self.on_change)
 
     # ------------------------------------------------------------ plumbing
-    def _action(self, fn: Callable[[Any], object], *,
-                sync: bool = False) -> Callable[..., Coroutine[Any, Any, None]]:
+    def _action(self, fn: Callable[[_E], object], *,
+                sync: bool = False) -> Callable[[_E], Coroutine[object, object, None]]:
         s = self.session
 
-        def run(event: Any) -> None:
+        def run(event: _E) -> None:
             with s.batch():
                 try:
                     fn(event)
@@ -212,11 +215,12 @@ class WizardDock:
     def update_meter(self) -> None:
         """The pose-diversity meter (the wizards that declare it: ``Wizard.meter_active``)."""
         wf = self.session.workflow
-        wiz: Any = wf.wizard  # a meter wizard (duck-typed: preview(), ...)
-        show = wiz is not None and bool(wiz.meter_active)
+        shown = wf.wizard
+        show = shown is not None and bool(shown.meter_active)
         self.meter_bar.visible = self.meter_md.visible = self.tilt_html.visible = show
         if not show:
             return
+        wiz = cast("MeterWizard", shown)              # meter_active: a wizard that declares the meter
         T_world_flange = self.session.controller.T_world_flange()
         gain = wiz.preview(T_world_flange)
         value, color = meter_level(gain)

@@ -26,7 +26,7 @@ import datetime as _dt
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import ClassVar, Literal
+from typing import ClassVar, Literal, Protocol
 
 import numpy as np
 import numpy.typing as npt
@@ -34,6 +34,7 @@ import numpy.typing as npt
 from tcpcal.errors import TcpcalError
 from tcpcal.origin import TcpResult
 from tcpcal.orientation import OrientationResult
+from tcpcal.pose_quality import CandidateGain
 from tcpcal.tool import Calibration, Tool
 
 from tcp_pendant.json_shapes import JsonRecord
@@ -133,6 +134,22 @@ def check_pose_m(T_world_flange_m: object, *, what: str = "flange pose") -> np.n
 def rotation_and_position_mm(T_world_flange_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Split a flange pose in metres into ``R_world_flange`` (3,3) and ``p_world_flange`` in mm."""
     return T_world_flange_m[:3, :3].copy(), T_world_flange_m[:3, 3] * M_TO_MM
+
+
+class MeterWizard(Protocol):
+    """A wizard that declares ``diversity_meter`` (XYZ 4-point, TCP & Z, X), as the meter reads it."""
+
+    assumed_sigma_mm: float
+    """The operator's jogging error the meter assumes, mm per axis."""
+
+    @property
+    def meter_active(self) -> bool: ...
+
+    def other_rotations(self) -> np.ndarray:
+        """(N,3,3) ``R_world_flange`` of the touches recorded so far."""
+
+    def preview(self, T_world_flange_m: npt.ArrayLike, *, min_angle_deg: float = 15.0) -> CandidateGain:
+        """What a touch at ``T_world_flange_m`` (metres) would add (tcpcal's ``candidate_gain``)."""
 
 
 @dataclass(frozen=True)
