@@ -42,6 +42,7 @@ from tcp_pendant.views.gui_util import (
     DropdownEvent,
     client_of,
     number_of_option,
+    refused_before_job,
     set_content,
     set_options,
     set_value,
@@ -351,15 +352,7 @@ class ToolPanel:
         the server's time: ``Session.admit_job``, before the job is taken); the loop's work on
         it counts against that share (``Session.charged``); errors become one notification."""
         s = self.session
-        if s.closed:
-            return
-        if self._checking:
-            s.notify_refusal("Check running", "A TCP check is still running here; wait for its result.")
-            return
-        try:                           # refused at once, before the loop takes the job
-            s.admit_job()
-        except JobRefused as exc:
-            s.notify_refusal("Check not started", str(exc))
+        if refused_before_job(s, running=self._checking, what="TCP check", not_started="Check not started"):
             return
         try:
             with s.charged(), s.lock:
