@@ -243,16 +243,16 @@ class PoseQueue:
         impl = handle._impl
         api = impl.api
         self._impl, self._name, self._owner, self._ws = impl, impl.name, api._owner_id, api._websock_interface
-        self._orientation: type[SetOrientationMessage] = messages.SetOrientationMessage
-        self._position: type[SetPositionMessage] = messages.SetPositionMessage
+        # the message classes, called with a tuple of 4 (wxyz) or 3 (xyz) floats (cast once, here)
+        self._orientation = cast("Callable[[str, tuple[float, ...]], SetOrientationMessage]",
+                                 messages.SetOrientationMessage)
+        self._position = cast("Callable[[str, tuple[float, ...]], SetPositionMessage]", messages.SetPositionMessage)
         if not (callable(self._ws.queue_message) and hasattr(impl, "wxyz") and hasattr(impl, "position")):
             raise AttributeError("a scene node without wxyz / position or a websocket interface")
         self._keys: list[str | None] = [None, None]
 
     def _queue(self, kind: int, value: tuple[float, ...]) -> None:
-        msg: SetOrientationMessage | SetPositionMessage = (
-            self._orientation(self._name, cast("tuple[float, float, float, float]", value)) if kind == 0
-            else self._position(self._name, cast("tuple[float, float, float]", value)))
+        msg = (self._orientation if kind == 0 else self._position)(self._name, value)
         msg.owner = self._owner
         key = self._keys[kind]
         if key is None:
