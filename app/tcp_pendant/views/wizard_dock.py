@@ -37,12 +37,13 @@ from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.views.gui_util import ButtonEvent, ButtonGroupEvent, set_content, set_value, target_of
 
 if TYPE_CHECKING:
-    from tcp_pendant.wizards.base import MeterWizard
     from tcp_pendant.calibrate import CalibrationWorkflow
-
-_E = TypeVar("_E")
+    from tcp_pendant.wizards.base import MeterWizard
 
 __all__ = ["BACK", "CANCEL", "CLOSE", "FINISH", "NEXT", "WizardDock", "tilt_line_html"]
+
+_E = TypeVar("_E")
+"""The event a dock action's callback takes (viser's, of the widget it is attached to)."""
 
 log = logging.getLogger(__name__)
 

@@ -92,6 +92,7 @@ OptionWidget = viser.GuiSliderHandle[int] | viser.GuiDropdownHandle[str]
 """The menu widget of a start option: a slider for a number, a dropdown for the others."""
 
 _E = TypeVar("_E")
+"""The event an action's callback takes (viser's, of the widget it is attached to)."""
 
 
 class CalibrateView:

@@ -39,10 +39,10 @@ from tcp_pendant.views.gui_util import ButtonEvent, DropdownEvent, set_content, 
 from tcp_pendant.wizards import Wizard, WizardStateError
 
 if TYPE_CHECKING:
-    from tcp_pendant.wizards.base import MeterWizard
     from tcp_pendant.calibrate.autotouch import AutoTouchOutcome
     from tcp_pendant.calibrate.workflow import ControllerJob
     from tcp_pendant.views.wizard_menu import CalibrateView
+    from tcp_pendant.wizards.base import MeterWizard
 
 __all__ = ["RANDOM", "WizardStepsView"]
 
