@@ -227,10 +227,10 @@ def _set_pose(handle: viser.SceneNodeHandle, wxyz: list[float] | None, xyz: list
 
 
 def _public_setters(handle: viser.SceneNodeHandle, wxyz: list[float] | None, xyz: list[float] | None) -> None:
-    if wxyz is not None:
-        handle.wxyz = np.asarray(wxyz, dtype=float)
+    if wxyz is not None:                     # viser's setters take any sequence of floats
+        handle.wxyz = cast("tuple[float, float, float, float]", wxyz)
     if xyz is not None:
-        handle.position = np.asarray(xyz, dtype=float)
+        handle.position = cast("tuple[float, float, float]", xyz)
 
 
 def overview_pose(tip_world_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
