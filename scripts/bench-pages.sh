@@ -2,7 +2,7 @@
 # Re-measure the figures of the benchmark pages: each bench below runs through
 # tests/bench/record.py, which writes what it printed to docs/benchmarks/<bench>.md with the date,
 # the machine and the command (docs/benchmarks.md includes those pages).
-#   bash scripts/bench-pages.sh                    # every page (about 10 minutes; the class load alone ~3)
+#   bash scripts/bench-pages.sh                    # every page (the benches that start servers load both cores for minutes)
 #   bash scripts/bench-pages.sh bench_solver ...   # only these
 # A bench measures the machine it runs on: run it on a quiet one and commit the pages with the change
 # they measure. The options are the benches' own (their module docstrings).
