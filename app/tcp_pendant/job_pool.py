@@ -150,7 +150,7 @@ def default_workers() -> int:
 @dataclass(eq=False)
 class _Job:
     owner: object
-    fn: Callable[[], Any]
+    fn: Callable[[], Any]                  # its result goes to the future the caller holds (a Future[T])
     what: str
     future: concurrent.futures.Future[Any]
     submitted_s: float
@@ -209,9 +209,9 @@ class JobPool:
         self._queue: list[tuple[float, int, _Job]] = []          # heap of (key, order, job)
         self._order = itertools.count()
         self._pending: dict[int, _Job] = {}                     # id(owner) -> its job, queued or running
-        self._last_result: weakref.WeakKeyDictionary[Any, float] = weakref.WeakKeyDictionary()
+        self._last_result: weakref.WeakKeyDictionary[object, float] = weakref.WeakKeyDictionary()
         # owner -> its credit (seconds; below 0 after a job longer than the credit) and when it was counted
-        self._credit: weakref.WeakKeyDictionary[Any, tuple[float, float]] = weakref.WeakKeyDictionary()
+        self._credit: weakref.WeakKeyDictionary[object, tuple[float, float]] = weakref.WeakKeyDictionary()
         self._threads: list[threading.Thread] = []
         self._closed = False
 

@@ -249,7 +249,7 @@ class WizardCommands:
         with self._command():
             self._host.workflow.require_wizard().add_point()
 
-    def set_variant(self, variant: object) -> None:
+    def set_variant(self, variant: int | str) -> None:
         """Switch the open wizard's variant (one of its class's ``variants`` values)."""
         with self._command():
             self._host.workflow.require_wizard().set_variant(variant)

@@ -378,8 +378,8 @@ def test_run_tests_fails_on_a_broken_layer_with_lint_imports_output_and_runs_no_
 
 # The layers of pyproject.toml's [tool.importlinter], bottom first ("|": siblings that import
 # none of each other); lint-imports also wants every module of tcp_pendant in one of them.
-APP_LAYERS = (("events", "job_pool", "message_rate", "refusal_notices", "text_escape"), ("controller",),
-              ("pendant",), ("wizards",), ("calibrate",), ("session_scenario", "session_views"),
+APP_LAYERS = (("events", "job_pool", "json_shapes", "message_rate", "refusal_notices", "text_escape"),
+              ("controller",), ("pendant",), ("wizards",), ("calibrate",), ("session_scenario", "session_views"),
               ("session_tools", "session_loop"), ("session_wizard", "session_motion"), ("session",),
               ("classroom",), ("views",), ("serve",), ("__main__",))
 
@@ -435,21 +435,26 @@ def test_the_layer_contracts_refuse_an_upward_import_viser_below_the_views_and_a
             path.write_text(before)
 
 
-def test_the_mypy_configuration_is_strict_on_tcpcal_and_standard_on_the_app(tmp_path: Path) -> None:
-    """The real mypy with the repository's ``[tool.mypy]`` on a two-module tree: an unannotated
-    function is an error in tcpcal only (strict there, not leaking to the app), and a wrong
-    return type is an error in the app; mypy exits 1, which fails run-tests.sh."""
+def test_the_mypy_configuration_is_strict_on_tcpcal_and_typed_on_the_app(tmp_path: Path) -> None:
+    """The real mypy with the repository's ``[tool.mypy]`` on a two-module tree: returning
+    ``Any`` is an error in tcpcal only (strict there, not leaking to the app); an unannotated
+    function, a generic without its type arguments and a wrong return type are errors in the app
+    (``disallow_untyped_defs``, ``disallow_any_generics``); mypy exits 1, which fails run-tests.sh."""
     shutil.copy(ROOT / "pyproject.toml", tmp_path)
-    untyped = "def scaled(x):\n    return 2 * x\n"
+    returns_any = "import json\n\n\ndef parsed(text: str) -> dict[str, int]:\n    return json.loads(text)\n"
     (tmp_path / "src" / "tcpcal").mkdir(parents=True)
-    (tmp_path / "src" / "tcpcal" / "__init__.py").write_text(untyped)
+    (tmp_path / "src" / "tcpcal" / "__init__.py").write_text(returns_any)
     (tmp_path / "app" / "tcp_pendant").mkdir(parents=True)
     (tmp_path / "app" / "tcp_pendant" / "__init__.py").write_text(
-        untyped + "\n\ndef length_mm() -> float:\n    return \"12.5 mm\"\n")
+        returns_any + "\n\ndef scaled(x):\n    return 2 * x\n"
+        "\n\ndef first(d: dict) -> int:\n    return 1\n"
+        "\n\ndef length_mm() -> float:\n    return \"12.5 mm\"\n")
     p = subprocess.run([sys.executable, "-m", "mypy", "--cache-dir", str(tmp_path / "cache")],
                        cwd=tmp_path, capture_output=True, text=True, timeout=300)
     errors = sorted(line for line in p.stdout.splitlines() if ": error: " in line)
     assert p.returncode == 1, p.stdout + p.stderr
-    assert len(errors) == 2, p.stdout
-    assert errors[0].startswith("app/tcp_pendant/__init__.py:6: error: Incompatible return value type")
-    assert errors[1].startswith("src/tcpcal/__init__.py:1: error: Function is missing a type annotation")
+    assert len(errors) == 4, p.stdout
+    assert errors[0].startswith("app/tcp_pendant/__init__.py:12: error: Missing type arguments for generic type")
+    assert errors[1].startswith("app/tcp_pendant/__init__.py:17: error: Incompatible return value type")
+    assert errors[2].startswith("app/tcp_pendant/__init__.py:8: error: Function is missing a type annotation")
+    assert errors[3].startswith("src/tcpcal/__init__.py:5: error: Returning Any from function declared to return")

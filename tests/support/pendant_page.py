@@ -70,9 +70,11 @@ def press(page: Any, name: str) -> None:
     page.get_by_role("button", name=name, exact=True).first.click()
 
 
-def wait_enabled(page: Any, name: str) -> None:
-    """Wait until the button ``name`` is visible and enabled."""
-    btn = page.get_by_role("button", name=name, exact=True).first
+def wait_enabled(page: Any, name: str, *, visible_only: bool = False) -> None:
+    """Wait until the button ``name`` is visible and enabled (``visible_only``: the first
+    visible button of that name, where a hidden copy of it comes first on the page)."""
+    buttons = page.get_by_role("button", name=name, exact=True)
+    btn = (buttons.filter(visible=True) if visible_only else buttons).first
     btn.wait_for(state="visible", timeout=TIMEOUT_MS)
     deadline = time.monotonic() + TIMEOUT_MS / 1000
     while btn.is_disabled():

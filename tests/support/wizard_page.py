@@ -6,8 +6,8 @@ Auto-touched, the result saved to the library."""
 from __future__ import annotations
 
 import re
-import time
 
+from support import pendant_page
 from support.pendant_page import TIMEOUT_MS, type_text
 
 
@@ -26,14 +26,9 @@ def press(page, name: str) -> None:
 
 
 def wait_enabled(page, name: str) -> None:
-    """Wait until a visible button ``name`` is enabled."""
-    btn = page.get_by_role("button", name=name, exact=True).filter(visible=True).first
-    btn.wait_for(state="visible", timeout=TIMEOUT_MS)
-    deadline = time.monotonic() + TIMEOUT_MS / 1000.0
-    while btn.is_disabled():
-        if time.monotonic() > deadline:
-            raise AssertionError(f"button {name!r} stayed disabled")
-        page.wait_for_timeout(50)
+    """Wait until a visible button ``name`` is enabled (the Jog tab's dock repeats the wizard's
+    buttons, hidden while the Calibrate tab is shown)."""
+    pendant_page.wait_enabled(page, name, visible_only=True)
 
 
 def text_of(page, pattern: str | re.Pattern[str]) -> str:

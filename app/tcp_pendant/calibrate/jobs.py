@@ -25,7 +25,15 @@ from tcp_pendant.controller.beam_scan import BeamScan, BeamScanConfig, run_beam_
 from tcp_pendant.controller.errors import ControllerError
 from tcp_pendant.controller.jog import JogSettings
 from tcp_pendant.controller.spin import SpinCheckResult, spin_check
-from tcp_pendant.wizards import BeamWizard, ManualComparison, TcpCheckWizard, Wizard, WizardResult, WizardStateError
+from tcp_pendant.wizards import (
+    BeamWizard,
+    ManualComparison,
+    RecordedPose,
+    TcpCheckWizard,
+    Wizard,
+    WizardResult,
+    WizardStateError,
+)
 from tcp_pendant.wizards.check_reading import check_readable
 from tcp_pendant.wizards.tcp_check import CheckFigures
 
@@ -73,7 +81,7 @@ class TcpCheckJob:
     busy_text: ClassVar[str] = "**Checking:** the controller turns the tool ±A, ±B, ±C about the TCP ..."
 
     wizard: TcpCheckWizard
-    pose: Any                     # the RecordedPose the check starts from
+    pose: RecordedPose            # the touch the check starts from
     kinematics: RobotKinematics
     true_kinematics: RobotKinematics
     q_rad: np.ndarray

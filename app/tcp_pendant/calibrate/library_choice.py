@@ -10,18 +10,19 @@ controller's active tool data (same name); else a slot named like the mounted ph
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Any
+
+from tcpcal.tool import Tool
 
 __all__ = ["default_library_slot"]
 
 
-def default_library_slot(tools: Mapping[int, Any], *, active_slot: int | None,
+def default_library_slot(tools: Mapping[int, Tool], *, active_slot: int | None,
                          active_tool_name: str | None, mounted_label: str,
                          mounted_key: str) -> int | None:
     """The slot to propose (see the module docstring); None when the library is empty.
 
     Args:
-        tools: the library, slot -> tool (anything with a ``name``).
+        tools: the library, slot -> tool.
         active_slot: the session's active slot (None: no library tool is active).
         active_tool_name: name of the controller's active tool data (None: none).
         mounted_label: the mounted physical tool's label.

@@ -37,16 +37,29 @@ import math
 import re
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
+import numpy.typing as npt
 
 from tcpcal.errors import TcpcalError
 from tcpcal.orientation import R_WORLD_TOOL_PARALLEL
-from tcpcal.origin import solve_xyz4
+from tcpcal.origin import TcpResult, solve_xyz4
 from tcpcal.tool import abc_deg_from_rotation
 
 from tcp_pendant.text_escape import escape_html, escape_markdown
+
+if TYPE_CHECKING:
+    from tcp_pendant.wizards import (
+        AbcWorldWizard,
+        BeamWizard,
+        ReferenceWizard,
+        TcpCheckWizard,
+        TcpZxWizard,
+        ThreePointWizard,
+        Wizard,
+        Xyz4Wizard,
+    )
 
 __all__ = [
     "MATH_FONT_PX",
@@ -159,7 +172,7 @@ class _Block:
         self.values: dict[str, Shown] = {}
         self.notes: list[str] = []
 
-    def _keep(self, name: str, value: Any, decimals: int, unit: str) -> Shown:
+    def _keep(self, name: str, value: npt.ArrayLike, decimals: int, unit: str) -> Shown:
         if name in self.values:
             raise ValueError(f"block {self.key}: {name!r} shown twice")
         shown = Shown(np.array(value, dtype=float), decimals, unit)
@@ -233,7 +246,7 @@ class _Block:
 
 
 # ------------------------------------------------------------------ shared pieces
-def _poses_mm(wizard: Any, indices: Sequence[int] | None = None) -> tuple[list[int], np.ndarray, np.ndarray]:
+def _poses_mm(wizard: Wizard, indices: Sequence[int] | None = None) -> tuple[list[int], np.ndarray, np.ndarray]:
     """(step indices, R (N,3,3), f (N,3) mm) of the recorded poses, in step order, exactly as
     the wizards hand them to tcpcal (rotation block; translation times 1000)."""
     poses = wizard.recorded_poses
@@ -327,7 +340,7 @@ def _stack_block(steps: Sequence[int], R: np.ndarray, f: np.ndarray) -> tuple[Ma
     return blk.build(), t_pinv
 
 
-def _lstsq_block(R: np.ndarray, f: np.ndarray, t_pinv: np.ndarray | None) -> tuple[MathBlock, Any]:
+def _lstsq_block(R: np.ndarray, f: np.ndarray, t_pinv: np.ndarray | None) -> tuple[MathBlock, TcpResult | None]:
     """(4P-3) by tcpcal's solve_xyz4 (the solver), set beside the pseudo-inverse."""
     blk = _Block("lstsq", "(4P-3)", "joint least squares, x = (t, r): [R_i  −I] x = −f_i")
     try:
@@ -385,7 +398,7 @@ def _intro(n: int, what: str) -> str:
 
 
 # ------------------------------------------------------------------ the sheets
-def xyz4_sheet(wizard: Any, pair: tuple[int, int] | None = None) -> MathSheet:
+def xyz4_sheet(wizard: Xyz4Wizard, pair: tuple[int, int] | None = None) -> MathSheet:
     """XYZ 4-point: (4P-1) per touch, a pair's Eq. (7), the stack's rank and Eq. (8), (4P-3)
     beside it, the sphere (4P-1a). Touches the trainee dropped are left out, as the solver does.
 
@@ -419,7 +432,7 @@ def _origin_sheet(view: str, title: str, steps: list[int], R: np.ndarray, f: np.
     return MathSheet(view, title, (*blocks, *extra), intro)
 
 
-def reference_sheet(wizard: Any) -> MathSheet:
+def reference_sheet(wizard: ReferenceWizard) -> MathSheet:
     """XYZ reference: ``r = f_1 + R_1 t_1`` (lecture ``r ≡ f_1 + t_1``), then (REF-1):
     ``t_2 = r - f_2`` in WORLD and ``R_2^T (r - f_2)`` in FLANGE."""
     steps, R, f = _poses_mm(wizard)
@@ -454,7 +467,7 @@ def reference_sheet(wizard: Any) -> MathSheet:
     return MathSheet("reference", wizard.title, tuple(blocks), _intro(len(steps), "touches"))
 
 
-def three_point_sheet(wizard: Any) -> MathSheet:
+def three_point_sheet(wizard: ThreePointWizard) -> MathSheet:
     """Three-point, variants 1 and 2 (paper eqs. 7-30): V(1), c11 c21 c31, Δ1; V(2) (variant
     1) or V(3) (variant 2), the second column and its orthogonality; c3 (30) and the defect."""
     steps, R, f = _poses_mm(wizard)
@@ -555,7 +568,7 @@ def three_point_sheet(wizard: Any) -> MathSheet:
     return MathSheet("three_point", wizard.title, tuple(blocks), _intro(len(steps), "poses"))
 
 
-def abc_world_sheet(wizard: Any) -> MathSheet:
+def abc_world_sheet(wizard: AbcWorldWizard) -> MathSheet:
     """ABC world: (PA-1) the prescribed R_0,n*, (PA-2) ``R_n,n* = R_0,n^T R_0,n*``."""
     steps, R, _ = _poses_mm(wizard)
     blocks = []
@@ -580,7 +593,7 @@ def abc_world_sheet(wizard: Any) -> MathSheet:
     return MathSheet("abc_world", wizard.title, tuple(blocks), _intro(len(steps), "poses"))
 
 
-def tcp_zx_sheet(wizard: Any, pair: tuple[int, int] | None = None) -> MathSheet:
+def tcp_zx_sheet(wizard: TcpZxWizard, pair: tuple[int, int] | None = None) -> MathSheet:
     """TCP & Z, X (methods.md section 8): the touches as the 4-point's, then
     ``u_k = unit(R_k^T (r - f_k) - t)`` for the z and x poses, Gram-Schmidt keeping z."""
     roles = [s.role for s in wizard.steps]
@@ -629,7 +642,7 @@ def tcp_zx_sheet(wizard: Any, pair: tuple[int, int] | None = None) -> MathSheet:
     return sheet
 
 
-def beam_sheet(wizard: Any) -> MathSheet:
+def beam_sheet(wizard: BeamWizard) -> MathSheet:
     """Beam (BEAM-1): per tip event ``(I - u u^T)(R_i t + f_i - b) = 0``, stacked
     ``(P R_i) t = -P (f_i - b)``: its rank and singular values, and tcpcal's t."""
     scan = wizard.scan
@@ -666,7 +679,7 @@ def beam_sheet(wizard: Any) -> MathSheet:
     return MathSheet("beam", wizard.title, tuple(blocks), f"{len(tips)} tip events.")
 
 
-def spin_check_sheet(wizard: Any) -> MathSheet:
+def spin_check_sheet(wizard: TcpCheckWizard) -> MathSheet:
     """TCP check (methods.md section 10): a spin by θ moves the tip by at most
     ``2 sin(θ/2) |t - t_s|``."""
     check = getattr(wizard, "check", None)
@@ -698,7 +711,7 @@ PAIR_VIEWS = frozenset({"xyz4", "tcp_zx"})
 """The sheets that take a chosen pair of touches (``pair=``)."""
 
 
-def math_sheet(wizard: Any, *, pair: tuple[int, int] | None = None) -> MathSheet | None:
+def math_sheet(wizard: Wizard, *, pair: tuple[int, int] | None = None) -> MathSheet | None:
     """The sheet of ``wizard`` by its class's ``math_view`` (None: it declares none)."""
     name = getattr(type(wizard), "math_view", None)
     if name is None:

@@ -47,7 +47,7 @@ from __future__ import annotations
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
-from typing import Any
+from typing import TypedDict
 
 from tcpcal.library import OwnerQuotaError, SlotOwnedError, ToolLibraryError
 from tcp_pendant.controller.errors import ControllerError
@@ -184,6 +184,18 @@ FREE_PRACTICE = ExerciseRules()
 """No exercise: nothing is locked, Auto-touch is allowed, the Check shows all it computes."""
 
 
+class OwnerKwargs(TypedDict, total=False):
+    """The keywords of ``ToolLibrary.rename``/``remove`` for a pendant's rights (none: no rule)."""
+
+    owner: str
+
+
+class SaveKwargs(OwnerKwargs, total=False):
+    """The keywords of ``ToolLibrary.save``: the owner's and the quota of slots."""
+
+    quota: int
+
+
 @dataclass(frozen=True)
 class LibraryRights:
     """How a pendant may change the library (see the module docstring).
@@ -198,22 +210,22 @@ class LibraryRights:
     owner: str | None = None
     quota: int | None = None
 
-    def owner_kwargs(self) -> dict[str, Any]:
+    def owner_kwargs(self) -> OwnerKwargs:
         """The keywords of ``ToolLibrary.rename``/``remove`` for these rights.
 
         Raises:
             ToolLibraryError: a class pendant that has not joined (the words say what to do).
         """
         if not self.restricted:
-            return {}
+            return OwnerKwargs()
         if self.owner is None:
             raise ToolLibraryError("Join the class with your name first: in a class each library slot "
                                    "belongs to the trainee who saved it.")
-        return {"owner": self.owner}
+        return OwnerKwargs(owner=self.owner)
 
-    def save_kwargs(self) -> dict[str, Any]:
+    def save_kwargs(self) -> SaveKwargs:
         """The keywords of ``ToolLibrary.save`` (owner and quota) for these rights."""
-        kw = self.owner_kwargs()
+        kw = SaveKwargs(**self.owner_kwargs())
         if kw and self.quota is not None:
             kw["quota"] = self.quota
         return kw

@@ -20,7 +20,7 @@ class ClassPushes:
     def __init__(self, store: GradebookStore) -> None:
         self._store = store
 
-    def add(self, push: Mapping[str, Any]) -> int:
+    def add(self, push: Mapping[str, object]) -> int:
         """Keep one push of the trainer's class settings (JSON-ready); returns its id (ids grow)."""
         text = json.dumps(dict(push), sort_keys=True, allow_nan=False)
         with self._store.write() as db:

@@ -44,7 +44,7 @@ class ClassSettings:
             row = db.execute("SELECT value FROM meta WHERE key = ?", (f"class:{key}",)).fetchone()
         return None if row is None else json.loads(row[0])
 
-    def set(self, key: str, value: Any) -> None:
+    def set(self, key: str, value: object) -> None:
         """Keep a class setting (JSON-ready; the pushed exercise, the distance-aid lock, the
         trainer token's hash) across restarts of the server."""
         text = json.dumps(value, sort_keys=True, allow_nan=False)

@@ -13,10 +13,10 @@ from __future__ import annotations
 
 from collections.abc import Callable, Collection
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Protocol
+from typing import TYPE_CHECKING, Protocol
 
 from tcp_pendant.classroom.class_board import ClassBoard
-from tcp_pendant.session import Session
+from tcp_pendant.session import Browser, Session
 
 if TYPE_CHECKING:
     from tcp_pendant.classroom.class_room import ClassRoom
@@ -55,6 +55,6 @@ class ClassViews:
             there is none to read.
     """
 
-    welcome: Callable[[Session, Callable[[Any, str], tuple[str, str | None]], Callable[[str], bool]], WelcomeWindow]
+    welcome: Callable[[Session, Callable[[object, str], tuple[str, str | None]], Callable[[str], bool]], WelcomeWindow]
     dashboard: Callable[[Session, ClassRoom], TrainerView]
-    client_address: Callable[[Any], str | None]
+    client_address: Callable[[Browser | None], str | None]

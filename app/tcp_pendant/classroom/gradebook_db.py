@@ -43,12 +43,16 @@ import functools
 import re
 import sqlite3
 import time
+import types
 import zlib
 from abc import ABC, abstractmethod
 from collections.abc import Iterable, Iterator, Sequence
 from pathlib import Path
-from typing import Any, Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 from urllib.parse import parse_qsl, unquote, urlencode, urlsplit, urlunsplit
+
+if TYPE_CHECKING:
+    import psycopg
 
 __all__ = [
     "GradebookConnection",
@@ -58,6 +62,7 @@ __all__ = [
     "SqliteConnection",
     "is_postgres_url",
     "mask_url",
+    "only_row",
     "sql_for",
 ]
 
@@ -65,14 +70,31 @@ POSTGRES_SCHEMES = ("postgresql", "postgres")
 _MASK = "***"
 
 
+SqlRow = tuple[Any, ...]
+"""A row as the driver gives it: each column's type is what the query selects (an id an int, a
+time a float, a JSON column a str...), read by the code that wrote the query."""
+
+
 class Cursor(Protocol):
     """What the gradebook reads from an executed statement (sqlite3 and psycopg cursors both)."""
 
     @property
     def rowcount(self) -> int: ...
-    def fetchone(self) -> Any: ...
-    def fetchall(self) -> list[Any]: ...
-    def __iter__(self) -> Iterator[Any]: ...
+    def fetchone(self) -> SqlRow | None: ...
+    def fetchall(self) -> list[SqlRow]: ...
+    def __iter__(self) -> Iterator[SqlRow]: ...
+
+
+def only_row(cursor: Cursor) -> SqlRow:
+    """The row of a query that always gives one (an aggregate, or a row just checked to exist).
+
+    Raises:
+        LookupError: it gave none (the gradebook changed under the caller).
+    """
+    row = cursor.fetchone()
+    if row is None:
+        raise LookupError("the gradebook query gave no row")
+    return row
 
 
 class PostgresUnavailable(Exception):
@@ -178,16 +200,16 @@ class GradebookConnection(ABC):
     operational_error: type[Exception]
 
     @abstractmethod
-    def execute(self, sql: str, params: Sequence[Any] = ()) -> Cursor:
+    def execute(self, sql: str, params: Sequence[object] = ()) -> Cursor:
         """Run one statement (``?`` parameters)."""
 
-    def executemany(self, sql: str, rows: Iterable[Sequence[Any]]) -> None:
+    def executemany(self, sql: str, rows: Iterable[Sequence[object]]) -> None:
         """Run one statement once per row of parameters."""
         for row in rows:
             self.execute(sql, row)
 
     @abstractmethod
-    def insert(self, sql: str, params: Sequence[Any] = ()) -> int:
+    def insert(self, sql: str, params: Sequence[object] = ()) -> int:
         """Run an ``INSERT`` into a table with an ``id`` column and return the new row's id."""
 
     @abstractmethod
@@ -246,13 +268,13 @@ class SqliteConnection(GradebookConnection):
                                    timeout=float(busy_timeout_s))
         self._busy_timeout_s = float(busy_timeout_s)
 
-    def execute(self, sql: str, params: Sequence[Any] = ()) -> Cursor:
+    def execute(self, sql: str, params: Sequence[object] = ()) -> Cursor:
         return self._db.execute(sql_for("sqlite", sql), tuple(params))
 
-    def executemany(self, sql: str, rows: Iterable[Sequence[Any]]) -> None:
+    def executemany(self, sql: str, rows: Iterable[Sequence[object]]) -> None:
         self._db.executemany(sql_for("sqlite", sql), rows)
 
-    def insert(self, sql: str, params: Sequence[Any] = ()) -> int:
+    def insert(self, sql: str, params: Sequence[object] = ()) -> int:
         rowid = self._db.execute(sql_for("sqlite", sql), tuple(params)).lastrowid
         if rowid is None:
             raise sqlite3.DatabaseError("the INSERT added no row")
@@ -340,7 +362,7 @@ class PostgresConnection(GradebookConnection):
             raise PostgresUnavailable(
                 f"--class-db {self.location} needs psycopg 3, which is not installed: "
                 "pip install 'tcp-pendant[postgres]' (or pip install 'psycopg[binary]').") from None
-        self._psycopg: Any = psycopg
+        self._psycopg: types.ModuleType = psycopg            # imported here: an optional dependency
         self.errors = psycopg.Error
         self.operational_error = psycopg.OperationalError
         try:
@@ -368,7 +390,7 @@ class PostgresConnection(GradebookConnection):
             text = text.replace(secret, _MASK)
         return text
 
-    def _connect(self) -> Any:
+    def _connect(self) -> psycopg.Connection[SqlRow]:
         psycopg = self._psycopg
         try:
             conn = psycopg.connect(self._url, autocommit=True, connect_timeout=int(self._connect_timeout))
@@ -380,7 +402,7 @@ class PostgresConnection(GradebookConnection):
                 "server runs and accepts connections from this machine, and that the URL's host, port, user, "
                 "password and database are right (the database must exist: createdb NAME).") from None
 
-    def _live(self) -> Any:
+    def _live(self) -> psycopg.Connection[SqlRow]:
         conn = self._conn
         if conn.closed or conn.broken:
             try:
@@ -390,7 +412,7 @@ class PostgresConnection(GradebookConnection):
             self._conn = conn = self._connect()
         return conn
 
-    def execute(self, sql: str, params: Sequence[Any] = ()) -> Cursor:
+    def execute(self, sql: str, params: Sequence[object] = ()) -> Cursor:
         in_transaction = self._conn.info.transaction_status in (self._psycopg.pq.TransactionStatus.INTRANS,
                                                                 self._psycopg.pq.TransactionStatus.INERROR)
         conn = self._conn if in_transaction else self._live()
@@ -398,7 +420,7 @@ class PostgresConnection(GradebookConnection):
             return conn.execute(sql_for("postgresql", sql, True), tuple(params))
         return conn.execute(sql_for("postgresql", sql, False))
 
-    def insert(self, sql: str, params: Sequence[Any] = ()) -> int:
+    def insert(self, sql: str, params: Sequence[object] = ()) -> int:
         row = self.execute(sql.rstrip().rstrip(";") + " RETURNING id", params).fetchone()
         if row is None:
             raise self._psycopg.DatabaseError("the INSERT added no row")

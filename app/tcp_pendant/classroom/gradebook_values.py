@@ -15,7 +15,7 @@ import json
 import math
 from collections.abc import Mapping
 from datetime import datetime, timezone
-from typing import Any, Literal, overload
+from typing import Literal, overload
 
 import numpy as np
 
@@ -48,10 +48,10 @@ def duration_s(start: str, end: str) -> float:
 
 
 @overload
-def label(value: Any, what: str, *, optional: Literal[False] = False) -> str: ...
+def label(value: object, what: str, *, optional: Literal[False] = False) -> str: ...
 @overload
-def label(value: Any, what: str, *, optional: bool) -> str | None: ...
-def label(value: Any, what: str, *, optional: bool = False) -> str | None:
+def label(value: object, what: str, *, optional: bool) -> str | None: ...
+def label(value: object, what: str, *, optional: bool = False) -> str | None:
     """``value`` if it is a non-empty printable text of at most :data:`MAX_TEXT` characters
     (``optional``: None passes too)."""
     if value is None and optional:
@@ -63,7 +63,7 @@ def label(value: Any, what: str, *, optional: bool = False) -> str | None:
     return value
 
 
-def finite(value: Any, what: str, *, optional: bool = False) -> float | None:
+def finite(value: object, what: str, *, optional: bool = False) -> float | None:
     """``value`` as a finite float (``optional``: None passes too); a bool is not a number."""
     if value is None and optional:
         return None
@@ -75,7 +75,7 @@ def finite(value: Any, what: str, *, optional: bool = False) -> float | None:
     return out
 
 
-def matrix4(value: Any, what: str) -> list[list[float]]:
+def matrix4(value: object, what: str) -> list[list[float]]:
     """``value`` as a finite 4x4 matrix (nested lists)."""
     try:
         T = np.asarray(value, dtype=float)
@@ -86,7 +86,7 @@ def matrix4(value: Any, what: str) -> list[list[float]]:
     return T.tolist()
 
 
-def vector(value: Any, what: str, n: int | None = None) -> list[float]:
+def vector(value: object, what: str, n: int | None = None) -> list[float]:
     """``value`` as a list of finite numbers (``n`` of them when given)."""
     try:
         v = np.asarray(value, dtype=float)
@@ -98,12 +98,12 @@ def vector(value: Any, what: str, n: int | None = None) -> list[float]:
     return v.tolist()
 
 
-def json_value(value: Any, what: str, depth: int = 0) -> Any:
+def json_value(value: object, what: str, depth: int = 0) -> object:
     """A copy of ``value`` made of JSON types only (finite numbers, str keys), at most 8 deep."""
     if depth > 8:
         raise GradebookError(f"{what} nests more than 8 levels.")
     if isinstance(value, Mapping):
-        out = {}
+        out: dict[str, object] = {}
         for k, v in value.items():
             if not isinstance(k, str):
                 raise GradebookError(f"{what} keys must be text, got {k!r:.40}.")
@@ -118,7 +118,7 @@ def json_value(value: Any, what: str, depth: int = 0) -> Any:
     return finite(value, what)
 
 
-def truth_json(truth: Any) -> str:
+def truth_json(truth: object) -> str:
     """The true TOOL frame as stored (``calibrations.truth_json``): a non-empty JSON-able dict
     as given, or ``{"T_flange_tool_true_m": 4x4}`` for a matrix (metres)."""
     if isinstance(truth, Mapping):
@@ -129,7 +129,7 @@ def truth_json(truth: Any) -> str:
     return json.dumps({"T_flange_tool_true_m": matrix4(truth, "T_flange_tool_true_m")})
 
 
-def whole_id(value: Any, what: str) -> int:
+def whole_id(value: object, what: str) -> int:
     """``value`` as an id (a whole number; a bool is not one)."""
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
         raise GradebookError(f"{what} must be a whole number (an id this gradebook returned), got {value!r:.40}.")

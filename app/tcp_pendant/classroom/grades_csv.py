@@ -7,7 +7,6 @@ import csv
 import io
 import json
 from collections.abc import Sequence
-from typing import Any
 
 from tcp_pendant.classroom.grade_rows import GradeRow
 
@@ -23,7 +22,7 @@ CSV_COLUMNS: tuple[str, ...] = (
 """Columns of :func:`to_csv` (a contract: docs/pendant-cli.md "tcp-pendant grades")."""
 
 
-def _cell(value: Any) -> str:
+def _cell(value: object) -> str:
     if value is None:
         return ""
     if isinstance(value, float):

@@ -23,6 +23,8 @@ import threading
 from collections.abc import Callable
 from typing import Any
 
+from tcp_pendant.json_shapes import JsonRecord
+
 from tcp_pendant.classroom.gradebook import Gradebook
 from tcp_pendant.classroom.gradebook_store import GradebookError
 from tcp_pendant.classroom.recorder import TraineeStatus
@@ -37,7 +39,7 @@ LostSeat = tuple[Seat, bool]
 browser took it on another process)."""
 
 
-def _status(row: dict[str, Any]) -> TraineeStatus | None:
+def _status(row: JsonRecord) -> TraineeStatus | None:
     """A presence row as a :class:`TraineeStatus` (None: not one this version reads)."""
     fields = {f.name for f in dataclasses.fields(TraineeStatus)}
     try:

@@ -78,7 +78,6 @@ from __future__ import annotations
 import re
 import unicodedata
 from functools import lru_cache
-from typing import Any
 
 import regex
 from confusable_homoglyphs import confusables
@@ -108,7 +107,7 @@ class TraineeNameError(ValueError):
     """A name the pendant does not accept; the message says why and what to type instead."""
 
 
-def validate_trainee_name(text: Any) -> str:
+def validate_trainee_name(text: object) -> str:
     """Check and normalise a trainee's name.
 
     Args:

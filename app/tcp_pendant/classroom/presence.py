@@ -13,10 +13,10 @@ from __future__ import annotations
 
 import json
 import time
-from collections.abc import Mapping
-from typing import Any
+from collections.abc import Mapping, Sequence
 
 from tcp_pendant.classroom.gradebook_store import GradebookError, GradebookStore
+from tcp_pendant.json_shapes import JsonRecord
 
 __all__ = ["MAX_STATUS_BYTES", "PRESENCE_STALE_S", "Presence"]
 
@@ -26,7 +26,7 @@ MAX_STATUS_BYTES = 4_000
 """A presence row's status above this is refused (a trainer's row is ~200 bytes)."""
 
 
-def _status_text(status: Mapping[str, Any]) -> str:
+def _status_text(status: Mapping[str, object]) -> str:
     text = json.dumps(dict(status), sort_keys=True, allow_nan=False)
     if len(text) > MAX_STATUS_BYTES:
         raise GradebookError(f"A trainee's status of {len(text):,} bytes is above {MAX_STATUS_BYTES:,}.")
@@ -48,7 +48,7 @@ class Presence:
             row = db.execute("SELECT holder, seen_at FROM presence WHERE name = ?", (str(name),)).fetchone()
         return None if row is None or t - float(row[1]) > stale_s else str(row[0])
 
-    def claim(self, name: str, holder: str, status: Mapping[str, Any], *, now: float | None = None) -> str | None:
+    def claim(self, name: str, holder: str, status: Mapping[str, object], *, now: float | None = None) -> str | None:
         """``holder`` now holds the connected name ``name`` (the caller has checked that it may:
         a name held elsewhere is taken over only by the same browser). Returns the holder it
         took the name from (None: nobody else held it)."""
@@ -73,7 +73,7 @@ class Presence:
             return db.execute("DELETE FROM presence WHERE name = ? AND holder = ?",
                               (str(name), str(holder))).rowcount > 0
 
-    def beat(self, holder: str, statuses: Mapping[str, Mapping[str, Any]], *, now: float | None = None) -> set[str]:
+    def beat(self, holder: str, statuses: Mapping[str, Mapping[str, object]], *, now: float | None = None) -> set[str]:
         """The heartbeat of ``holder``: the names it holds get ``seen_at = now`` and their
         status. Returns the names of ``statuses`` it still holds (one another process took over,
         or the trainer released, is missing)."""
@@ -87,7 +87,7 @@ class Presence:
         return held & set(statuses)
 
     def present(self, *, stale_s: float = PRESENCE_STALE_S,
-                now: float | None = None) -> list[tuple[str, str, dict[str, Any]]]:
+                now: float | None = None) -> list[tuple[str, str, JsonRecord]]:
         """``(name, holder, status)`` of every connected trainee of every server process, by
         name (rows whose holder stopped beating ``stale_s`` ago are left out)."""
         t = time.time() if now is None else now
@@ -103,7 +103,7 @@ class Presence:
 
     # -- who left, for every server process of the class --------------------------------
 
-    def depart(self, name: str, status: Mapping[str, Any], *, now: float | None = None) -> None:
+    def depart(self, name: str, status: Mapping[str, object], *, now: float | None = None) -> None:
         """The browser of ``name`` left the class (on whichever process): keep ``status`` (the
         trainee's row as it was when they left) and when."""
         text = _status_text(status)
@@ -114,7 +114,7 @@ class Presence:
                        (str(name), t, text))
 
     def departed(self, *, stale_s: float = PRESENCE_STALE_S,
-                 now: float | None = None) -> list[tuple[str, dict[str, Any]]]:
+                 now: float | None = None) -> Sequence[tuple[str, JsonRecord]]:
         """``(name, status)`` of every trainee who was connected and is not now, on any server
         process, the latest to leave first: those who left (:meth:`depart`) and those whose
         server process stopped beating ``stale_s`` ago (killed: their last beaten row), with

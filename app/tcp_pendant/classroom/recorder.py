@@ -35,7 +35,7 @@ import logging
 import math
 import threading
 from dataclasses import dataclass, field, replace
-from typing import Any
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
@@ -43,6 +43,11 @@ from tcp_pendant.classroom.gradebook import Gradebook
 from tcp_pendant.events import Crash, RunCancelled, RunFinished, RunResumed, RunStarted, SessionEvent, TouchRecorded
 from tcp_pendant.wizards.session_record import run_entry
 from tcp_pendant.wizards.truth import compare_with_truth
+
+if TYPE_CHECKING:
+    from tcp_pendant.calibrate import CalibrationWorkflow
+    from tcp_pendant.session import SessionChange
+    from tcp_pendant.wizards import Wizard, WizardResult
 
 __all__ = ["TraineeRecorder", "TraineeStatus", "step_words"]
 
@@ -81,7 +86,7 @@ class _RunState:
     calibration_id: int
     touch_ids: dict[int, int] = field(default_factory=dict)     # step -> gradebook touch id
     status: str = "in_progress"
-    kept: dict[str, Any] | None = None                          # the wizard's entry as last kept
+    kept: dict[str, object] | None = None                          # the wizard's entry as last kept
 
 
 class TraineeRecorder:
@@ -97,7 +102,7 @@ class TraineeRecorder:
         exercise_id: the exercise the calibrations belong to (None: free practice).
     """
 
-    def __init__(self, gradebook: Gradebook, session_id: int, name: str, workflow: Any | None, *,
+    def __init__(self, gradebook: Gradebook, session_id: int, name: str, workflow: CalibrationWorkflow | None, *,
                  exercise_id: str | None = None) -> None:
         self.gradebook = gradebook
         self.session_id = session_id
@@ -121,7 +126,7 @@ class TraineeRecorder:
             self._status = replace(self._status, connected=False)
 
     # ------------------------------------------------------------ the change signal
-    def on_change(self, change: Any) -> None:
+    def on_change(self, change: SessionChange) -> None:
         """Subscriber of the session's change signal: its events to the gradebook, in order
         (see the module docstring); the trainer's row after a wizard change."""
         with self._lock:
@@ -167,7 +172,7 @@ class TraineeRecorder:
 
     def _store(self, event: SessionEvent) -> None:
         if isinstance(event, RunStarted):
-            truth: Any = ({"T_flange_tool_true_m": None} if event.T_flange_tool_true_m is None
+            truth: object = ({"T_flange_tool_true_m": None} if event.T_flange_tool_true_m is None
                           else np.asarray(event.T_flange_tool_true_m, dtype=float))
             cal = self.gradebook.records.start_calibration(self.session_id, event.kind, event.tool_key or "",
                                                            truth, exercise_id=self.exercise_id)
@@ -208,7 +213,7 @@ class TraineeRecorder:
                 st.status = "in_progress"
 
     def _finish(self, st: _RunState, event: RunFinished) -> None:
-        result: Any = event.result
+        result = cast("WizardResult", event.result)       # events, a utility, names no wizard type
         pos = ori = grade = None
         if event.T_flange_tool_true_m is not None:
             cmp = compare_with_truth(result, event.T_flange_tool_true_m)
@@ -226,7 +231,7 @@ class TraineeRecorder:
         self._status = replace(self._status, method=method, step=step)
 
 
-def step_words(wizard: Any) -> str:
+def step_words(wizard: Wizard) -> str:
     """Where a wizard is, as the trainer's table says it: "Step k of n", "result" or "cancelled"."""
     if wizard.status == "complete":
         return "result"

@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import logging
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
@@ -41,7 +40,7 @@ class RestoredRun:
     touch_ids: dict[int, int]
 
 
-def _truth_matrix(truth: Any) -> np.ndarray | None:
+def _truth_matrix(truth: object) -> np.ndarray | None:
     T = truth.get("T_flange_tool_true_m") if isinstance(truth, dict) else None
     if T is None:
         return None

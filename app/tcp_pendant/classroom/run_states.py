@@ -10,12 +10,12 @@ started again with the same gradebook rebuilds the trainee's calibrations in pro
 from __future__ import annotations
 
 import json
-from collections.abc import Mapping
-from typing import Any
+from collections.abc import Mapping, Sequence
 
 from tcp_pendant.classroom.gradebook_store import GradebookError, GradebookStore
 from tcp_pendant.classroom.gradebook_values import label, utc_now
 from tcp_pendant.classroom.training_records import calibration_row
+from tcp_pendant.json_shapes import JsonRecord
 
 __all__ = ["MAX_RUN_STATE_BYTES", "RunStates"]
 
@@ -29,7 +29,7 @@ class RunStates:
     def __init__(self, store: GradebookStore) -> None:
         self._store = store
 
-    def save(self, calibration_id: int, entry: Mapping[str, Any], *, method_title: str | None = None,
+    def save(self, calibration_id: int, entry: Mapping[str, object], *, method_title: str | None = None,
              step: str | None = None) -> None:
         """Keep the wizard of calibration ``calibration_id`` as it is now (a session record
         entry, ``session_record.run_entry``, JSON-ready, without truth); replaces the last.
@@ -60,7 +60,7 @@ class RunStates:
                        "THEN excluded.step_since ELSE COALESCE(run_states.step_since, excluded.step_since) END, "
                        "step = COALESCE(excluded.step, run_states.step)", (cid, text, now, title, where, now))
 
-    def open_runs(self, trainee: str) -> list[dict[str, Any]]:
+    def open_runs(self, trainee: str) -> Sequence[JsonRecord]:
         """The calibrations of ``trainee`` still in progress that have a stored wizard, oldest
         first: ``{"calibration_id", "method", "tool_key", "exercise_id", "truth", "entry",
         "touch_ids"}`` (``touch_ids``: step -> the id of its touch that counts, to link the next

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
+from tcp_pendant.classroom.gradebook_db import only_row
 from tcp_pendant.classroom.gradebook_store import GradebookStore
 
 __all__ = ["MAX_SOURCE_CHARS", "TokenFailures"]
@@ -37,8 +38,8 @@ class TokenFailures:
         with self._store.write() as db:
             db.serialize("token failures")
             db.execute("DELETE FROM token_failures WHERE failed_at < ?", (float(now) - float(forget_s),))
-            n, last = db.execute("SELECT COUNT(*), MAX(failed_at) FROM token_failures WHERE source = ?",
-                                 (src,)).fetchone()
+            n, last = only_row(db.execute("SELECT COUNT(*), MAX(failed_at) FROM token_failures WHERE source = ?",
+                                          (src,)))
             n = int(n)
             if n and float(last) + lock_s(n) > now:
                 return float(last) + lock_s(n) - now, n, False

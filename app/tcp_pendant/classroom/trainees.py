@@ -14,7 +14,6 @@ from __future__ import annotations
 import hashlib
 import secrets
 from dataclasses import dataclass
-from typing import Any
 
 from tcp_pendant.classroom.gradebook_store import GradebookError, GradebookStore
 from tcp_pendant.classroom.gradebook_values import utc_now
@@ -51,7 +50,7 @@ def _key_digest(key: str) -> str:
     return hashlib.sha256(key.encode("utf-8")).hexdigest()
 
 
-def _clean_key(key: Any) -> str | None:
+def _clean_key(key: object) -> str | None:
     """The browser key a browser sent, or None (none, or not the shape of a key we issue)."""
     if not isinstance(key, str):
         return None
@@ -85,7 +84,7 @@ class Trainees:
                 return int(row[0])
             return db.insert("INSERT INTO trainees (name, created_at) VALUES (?, ?)", (clean, utc_now()))
 
-    def join(self, name: str, key: Any = None) -> TraineeJoin:
+    def join(self, name: str, key: object = None) -> TraineeJoin:
         """A browser joins the class as ``name``, showing the browser key it kept (or none).
 
         - A name no trainee has: refused if it looks like one (``names.looks_alike``: the words
@@ -134,7 +133,7 @@ class Trainees:
                             (clean, utc_now(), _key_digest(new_key)))
             return TraineeJoin(tid, clean, new_key)
 
-    def holds_key(self, name: str, key: Any) -> bool:
+    def holds_key(self, name: str, key: object) -> bool:
         """Whether ``key`` is the browser key of the trainee called ``name`` (False: no such
         trainee, no key held, or another key)."""
         shown = _clean_key(key)

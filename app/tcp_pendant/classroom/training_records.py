@@ -16,11 +16,10 @@ from __future__ import annotations
 
 import json
 from collections.abc import Mapping
-from typing import Any
 
 import numpy as np
 
-from tcp_pendant.classroom.gradebook_db import GradebookConnection
+from tcp_pendant.classroom.gradebook_db import GradebookConnection, only_row
 from tcp_pendant.classroom.gradebook_schema import GRADES
 from tcp_pendant.classroom.gradebook_store import GradebookError, GradebookStore
 from tcp_pendant.classroom.gradebook_values import (
@@ -33,11 +32,12 @@ from tcp_pendant.classroom.gradebook_values import (
     vector,
     whole_id,
 )
+from tcp_pendant.json_shapes import JsonRecord
 
 __all__ = ["TrainingRecords", "calibration_row"]
 
 
-def calibration_row(store: GradebookStore, db: GradebookConnection, calibration_id: Any, *,
+def calibration_row(store: GradebookStore, db: GradebookConnection, calibration_id: object, *,
                     for_update: bool = False) -> tuple[int, int, str]:
     """(id, session_id, status) of a calibration; ``for_update`` (in a write): the row stays
     locked until the transaction ends, so no other server changes its status meanwhile."""
@@ -76,7 +76,7 @@ class TrainingRecords:
             if cur.rowcount == 0 and db.execute("SELECT 1 FROM sessions WHERE id = ?", (sid,)).fetchone() is None:
                 raise GradebookError(f"No session {sid} in the gradebook {self._store.location}.")
 
-    def start_calibration(self, session_id: int, method: str, tool_key: str, truth: Any,
+    def start_calibration(self, session_id: int, method: str, tool_key: str, truth: object,
                           exercise_id: str | None = None) -> int:
         """A calibration started in a session.
 
@@ -101,7 +101,7 @@ class TrainingRecords:
                 "started_at) VALUES (?, ?, ?, ?, ?, 'in_progress', ?)",
                 (sid, method, tool_key, exercise, truth_text, utc_now()))
 
-    def record_touch(self, calibration_id: int, step_index: int, T_world_flange_m: Any, joints_deg: Any,
+    def record_touch(self, calibration_id: int, step_index: int, T_world_flange_m: object, joints_deg: object,
                      distance_mm: float | None, auto: bool, overwritten_touch_id: int | None = None) -> int:
         """Store one recorded touch (as it is recorded, hidden distance or not).
 
@@ -181,7 +181,7 @@ class TrainingRecords:
 
     def finish_calibration(self, calibration_id: int, figures: Mapping[str, float], *,
                            position_error_mm: float | None, orientation_error_deg: float | None,
-                           grade: str | None, tcp_mm: Any = None, abc_deg: Any = None) -> None:
+                           grade: str | None, tcp_mm: object = None, abc_deg: object = None) -> None:
         """Store a calibration's result. Called again (the trainee went back and finished once
         more), the newest result replaces the stored one.
 
@@ -234,7 +234,7 @@ class TrainingRecords:
         with self._store.read() as db:
             return calibration_row(self._store, db, calibration_id)[2]
 
-    def touches(self, calibration_id: int) -> list[dict[str, Any]]:
+    def touches(self, calibration_id: int) -> list[JsonRecord]:
         """Every touch of a calibration in recording order, overwritten ones included: dicts with
         id, step_index, recorded_at, T_world_flange_m (4x4 list), joints_deg, distance_mm, auto,
         overwrites_touch_id, overwritten_by_touch_id."""
@@ -247,22 +247,22 @@ class TrainingRecords:
                  "joints_deg": json.loads(r[4]), "distance_mm": r[5], "auto": bool(r[6]),
                  "overwrites_touch_id": r[7], "overwritten_by_touch_id": r[8]} for r in rows]
 
-    def truth(self, calibration_id: int) -> dict[str, Any]:
+    def truth(self, calibration_id: int) -> JsonRecord:
         """The truth stored by :meth:`start_calibration` (server side only)."""
         with self._store.read() as db:
             cid = calibration_row(self._store, db, calibration_id)[0]
-            return json.loads(db.execute("SELECT truth_json FROM calibrations WHERE id = ?", (cid,)).fetchone()[0])
+            return json.loads(only_row(db.execute("SELECT truth_json FROM calibrations WHERE id = ?", (cid,)))[0])
 
-    def calibration_result(self, calibration_id: int) -> dict[str, Any]:
+    def calibration_result(self, calibration_id: int) -> JsonRecord:
         """A calibration's method, status and result: ``{"trainee", "method", "status",
         "tcp_mm", "abc_deg", "position_error_mm", "orientation_error_deg", "grade"}`` (None
         where there is none yet)."""
         with self._store.read() as db:
             cid = calibration_row(self._store, db, calibration_id)[0]
-            row = db.execute(
+            row = only_row(db.execute(
                 "SELECT t.name, c.method, c.status, c.tcp_mm_json, c.abc_deg_json, c.position_error_mm, "
                 "c.orientation_error_deg, c.grade FROM calibrations c JOIN sessions s ON s.id = c.session_id "
-                "JOIN trainees t ON t.id = s.trainee_id WHERE c.id = ?", (cid,)).fetchone()
+                "JOIN trainees t ON t.id = s.trainee_id WHERE c.id = ?", (cid,)))
         name, method, status, tcp, abc, pos, ori, grade = row
         return {"trainee": name, "method": method, "status": status,
                 "tcp_mm": json.loads(tcp) if tcp else None, "abc_deg": json.loads(abc) if abc else None,

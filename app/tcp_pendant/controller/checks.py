@@ -3,8 +3,6 @@
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 
 from tcp_pendant.controller.errors import ControllerError
@@ -12,7 +10,7 @@ from tcp_pendant.controller.errors import ControllerError
 __all__ = ["check_pose"]
 
 
-def check_pose(T: Any, what: str) -> np.ndarray:
+def check_pose(T: object, what: str) -> np.ndarray:
     """A rigid transform (4, 4, metres) checked and copied: finite, a proper rotation in the
     upper-left 3x3 block (orthonormal to 1e-6, right-handed) and ``[0, 0, 0, 1]`` as last row.
 

@@ -35,7 +35,7 @@ import struct
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any
+from typing import TypedDict
 
 __all__ = ["BALANCE_ENV", "Balance", "BalanceFile", "attach_listener_choice", "detach_listener_choice"]
 
@@ -47,7 +47,7 @@ SO_DETACH_REUSEPORT_BPF = getattr(socket, "SO_DETACH_REUSEPORT_BPF", 68)
 _BPF_RET_K = 0x06 | 0x00                                                     # linux/filter.h: BPF_RET | BPF_K
 
 
-def attach_listener_choice(listener: Any, index: int) -> None:
+def attach_listener_choice(listener: socket.socket, index: int) -> None:
     """Attach ``ret #index`` to ``listener``'s ``SO_REUSEPORT`` group: every new connection
     goes to the group's listener ``index``. Raises OSError where the kernel refuses.
 
@@ -58,12 +58,29 @@ def attach_listener_choice(listener: Any, index: int) -> None:
     listener.setsockopt(socket.SOL_SOCKET, SO_ATTACH_REUSEPORT_CBPF, prog)
 
 
-def detach_listener_choice(listener: Any) -> None:
+def detach_listener_choice(listener: socket.socket) -> None:
     """The group's program goes: the kernel's hash spreads the connections again."""
     try:
         listener.setsockopt(socket.SOL_SOCKET, SO_DETACH_REUSEPORT_BPF, 0)
     except OSError:
         pass                                      # none attached (ENOENT): nothing to detach
+
+
+class ListenerRow(TypedDict):
+    """One process's line in the shared record."""
+
+    pid: int
+    index: int
+    sessions: int
+
+
+class BalanceRecord(TypedDict, total=False):
+    """The shared record (:class:`BalanceFile`)."""
+
+    n: int
+    off: bool
+    chosen: int | None
+    listeners: list[ListenerRow]
 
 
 class BalanceFile:
@@ -81,12 +98,12 @@ class BalanceFile:
         return cls(path)
 
     @contextmanager
-    def locked(self) -> Iterator[dict[str, Any]]:
+    def locked(self) -> Iterator[BalanceRecord]:
         """The record, under the lock; what the caller changes in it is written back."""
         with open(self.path, "r+") as f:
             fcntl.flock(f, fcntl.LOCK_EX)
             try:
-                record = json.loads(f.read() or "{}")
+                record: BalanceRecord = json.loads(f.read() or "{}")
                 before = json.dumps(record)
                 yield record
                 after = json.dumps(record)
@@ -98,12 +115,12 @@ class BalanceFile:
             finally:
                 fcntl.flock(f, fcntl.LOCK_UN)
 
-    def read(self) -> dict[str, Any]:
+    def read(self) -> BalanceRecord:
         with self.locked() as record:
             return record
 
 
-def _choice(record: dict[str, Any]) -> int | None:
+def _choice(record: BalanceRecord) -> int | None:
     """The index of the listener with the fewest sessions (the lowest index among equals);
     None while not every process listens, or when the balancing is off."""
     listeners = record.get("listeners", [])
@@ -124,7 +141,7 @@ class Balance:
         self.record = record
         self.pid = os.getpid() if pid is None else int(pid)
         self.index: int | None = None
-        self.listener: Any = None
+        self.listener: socket.socket | None = None
 
     @contextmanager
     def listening(self) -> Iterator[None]:
@@ -136,7 +153,7 @@ class Balance:
             yield
             listeners.append({"pid": self.pid, "index": self.index, "sessions": 0})
 
-    def started(self, listeners: list[Any]) -> None:
+    def started(self, listeners: list[socket.socket]) -> None:
         """The listening sockets of this process's server (one per address; the first serves)."""
         self.listener = listeners[0] if listeners else None
         self.sessions(0)

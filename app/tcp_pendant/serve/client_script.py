@@ -35,11 +35,16 @@ import re
 import threading
 from dataclasses import dataclass
 from importlib import resources
-from typing import Any
+from typing import TYPE_CHECKING
 from urllib.parse import unquote
 
 from websockets.datastructures import Headers
-from websockets.http11 import Response
+from websockets.http11 import Request, Response
+
+if TYPE_CHECKING:
+    from websockets.asyncio.server import ServerConnection
+
+    from tcp_pendant.serve.origin_check import ProcessRequest
 
 __all__ = ["SCRIPT_PATH", "SCRIPT_TAG", "ScriptAsset", "inject_script_tag", "is_index_path", "serve",
            "script_asset"]
@@ -117,7 +122,7 @@ def _plain(status: http.HTTPStatus, text: str) -> Response:
                                                           "Content-Length": str(len(body))}), body)
 
 
-def _script_response(request: Any) -> Response:
+def _script_response(request: Request) -> Response:
     asset = script_asset()
     use_gzip = "gzip" in str(request.headers.get("Accept-Encoding", ""))
     body = asset.gzipped if use_gzip else asset.body
@@ -127,7 +132,7 @@ def _script_response(request: Any) -> Response:
     return Response(http.HTTPStatus.OK.value, "OK", headers, body)
 
 
-def _index_response(response: Any) -> Any:
+def _index_response(response: Response | None) -> Response | None:
     """viser's index.html response with the script tag (viser's response itself if it is not a
     200 HTML page or holds no ``<head>``)."""
     if response is None or getattr(response, "status_code", None) != 200:
@@ -160,7 +165,7 @@ def _index_response(response: Any) -> Any:
     return Response(response.status_code, response.reason_phrase, new_headers, new_body)
 
 
-def serve(connection: Any, request: Any, process_request: Any) -> Any:
+def serve(connection: ServerConnection, request: Request, process_request: ProcessRequest | None) -> Response | None:
     """The HTTP layer (``origin_check.set_http_layer``): answer a plain GET (module docstring).
 
     Args:
@@ -172,7 +177,7 @@ def serve(connection: Any, request: Any, process_request: Any) -> Any:
     Returns:
         A ``Response``, or None to go on with the websocket handshake (viser's answer).
     """
-    def viser() -> Any:
+    def viser() -> Response | None:
         return None if process_request is None else process_request(connection, request)
 
     try:

@@ -44,10 +44,21 @@ from __future__ import annotations
 import http
 import logging
 import threading
-from collections.abc import Iterable, Iterator, Sequence
+from collections.abc import Callable, Coroutine, Iterable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
-from typing import Any
+from typing import TYPE_CHECKING, Any
 from urllib.parse import urlsplit
+
+if TYPE_CHECKING:
+    from websockets.asyncio.server import ServerConnection
+    from websockets.datastructures import Headers
+    from websockets.http11 import Request, Response
+
+    ProcessRequest = Callable[[ServerConnection, Request], Response | None]
+    """viser's static-file server as websockets calls it: a response, or None to go on with the
+    websocket handshake."""
+    HttpLayer = Callable[[ServerConnection, Request, ProcessRequest | None], Response | None]
+    """An HTTP layer in front of viser's static server (:func:`set_http_layer`)."""
 
 __all__ = ["LOOPBACK_HOSTS", "STARTING", "OriginError", "allow", "enable", "forget", "host_refusal", "mark_ready",
            "normalize_origin", "origin_refusal", "parse_allow_origins", "served_hosts", "set_http_layer", "starting"]
@@ -58,8 +69,8 @@ _DEFAULT_PORTS = {"http": 80, "https": 443}
 _lock = threading.Lock()
 _allowed_by_port: dict[int, frozenset[str]] = {}
 _hosts_by_port: dict[int, frozenset[str]] = {}
-_original_handshake: Any = None
-_http_layers: dict[int, Any] = {}
+_original_handshake: Callable[..., Coroutine[object, object, None]] | None = None
+_http_layers: dict[int, HttpLayer] = {}
 _ready_ports: set[int] = set()
 _starting = 0                     # pendants of this process inside starting()
 STARTING = "The pendant is starting; reload in a moment."
@@ -118,7 +129,7 @@ def parse_allow_origins(values: Iterable[str]) -> tuple[str, ...]:
     return tuple(out)
 
 
-def _header_values(headers: Any, name: str) -> list[str]:
+def _header_values(headers: Headers | Mapping[str, str], name: str) -> list[str]:
     get_all = getattr(headers, "get_all", None)
     return [str(v) for v in get_all(name)] if callable(get_all) else ([str(headers[name])] if name in headers else [])
 
@@ -156,7 +167,7 @@ def served_hosts(bind_host: str, urls: Iterable[str] = (), allow_origins: Iterab
     return frozenset(hosts)
 
 
-def host_refusal(headers: Any, hosts: Iterable[str] = LOOPBACK_HOSTS) -> str | None:
+def host_refusal(headers: Headers | Mapping[str, str], hosts: Iterable[str] = LOOPBACK_HOSTS) -> str | None:
     """Why a request with these headers is refused for its ``Host``, or None to answer it.
 
     Args:
@@ -173,7 +184,7 @@ def host_refusal(headers: Any, hosts: Iterable[str] = LOOPBACK_HOSTS) -> str | N
     return None
 
 
-def origin_refusal(headers: Any, allowed: Iterable[str] = ()) -> str | None:
+def origin_refusal(headers: Headers | Mapping[str, str], allowed: Iterable[str] = ()) -> str | None:
     """Why a websocket upgrade with these request headers is refused, or None to accept it.
 
     Args:
@@ -208,11 +219,11 @@ def origin_refusal(headers: Any, allowed: Iterable[str] = ()) -> str | None:
             "for a reverse proxy.")
 
 
-def _is_upgrade(request: Any) -> bool:
+def _is_upgrade(request: Request) -> bool:
     return any(v.lower() == "websocket" for v in _header_values(request.headers, "Upgrade"))
 
 
-def _allowed_for(connection: Any) -> tuple[frozenset[str], Any, frozenset[str], bool]:
+def _allowed_for(connection: ServerConnection) -> tuple[frozenset[str], HttpLayer | None, frozenset[str], bool]:
     """The extra origins, the HTTP layer, the served host names of the port ``connection``
     came to, and whether that port is ready (:func:`mark_ready`)."""
     try:
@@ -235,10 +246,11 @@ def enable() -> None:
             return
         original = _original_handshake = ServerConnection.handshake
 
-    async def handshake(self: Any, process_request: Any = None, *args: Any, **kwargs: Any) -> None:
+    async def handshake(self: ServerConnection, process_request: ProcessRequest | None = None,
+                        *args: Any, **kwargs: Any) -> None:         # websockets' other arguments, passed on
         allowed, layer, hosts, ready = _allowed_for(self)
 
-        def checked(connection: Any, request: Any) -> Any:
+        def checked(connection: ServerConnection, request: Request) -> Response | None:
             try:
                 return answer(connection, request)
             except Exception as exc:                # a request nobody foresaw: one line, no traceback
@@ -246,7 +258,7 @@ def enable() -> None:
                             _shown(str(getattr(request, "path", "?"))), type(exc).__name__, _shown(str(exc)))
                 return connection.respond(http.HTTPStatus.BAD_REQUEST, "Bad request.\n")
 
-        def answer(connection: Any, request: Any) -> Any:
+        def answer(connection: ServerConnection, request: Request) -> Response | None:
             refusal = host_refusal(request.headers, hosts)
             if refusal is None and _is_upgrade(request):
                 refusal = origin_refusal(request.headers, allowed)
@@ -262,17 +274,17 @@ def enable() -> None:
         return await original(self, checked, *args, **kwargs)
 
     handshake.__doc__ = original.__doc__
-    ServerConnection.handshake = handshake  # type: ignore[method-assign]
+    ServerConnection.handshake = handshake  # type: ignore[method-assign,assignment]  # viser's process_request is sync
 
 
-def _peer(connection: Any) -> str:
+def _peer(connection: ServerConnection) -> str:
     try:
         return f"{connection.remote_address[0]}:{connection.remote_address[1]}"
     except Exception:
         return "?"
 
 
-def set_http_layer(port: int, layer: Any) -> None:
+def set_http_layer(port: int, layer: HttpLayer | None) -> None:
     """On the server listening on ``port``, answer plain HTTP requests (not upgrades) with
     ``layer(connection, request, process_request)`` in front of viser's static server
     (``tcp_pendant.serve.client_script.serve``; None: viser alone). The origin check is unchanged."""

@@ -39,7 +39,7 @@ from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.beam_replay import ScanPlayer, beam_view_direction, scan_spheres
 from tcp_pendant.views.framing import Framing
 from tcp_pendant.views.scene import frame_cameras
-from tcp_pendant.views.gui_util import ButtonEvent, clients_of, target_of
+from tcp_pendant.views.gui_util import ButtonEvent, clients_of, refused_before_job, target_of
 from tcpcal.tool import Tool
 
 if TYPE_CHECKING:
@@ -124,15 +124,7 @@ class BeamCheckView:
         refused at once while this session's job runs or its share is used up
         (``SessionLoop.admit_job``)."""
         s = self.session
-        if s.closed:
-            return
-        if self._checking:
-            s.notify_refusal("Check running", "A beam check is still running here; wait for its result.")
-            return
-        try:                               # refused at once, before the loop takes the job
-            s.loop.admit_job()
-        except JobRefused as exc:
-            s.notify_refusal("Beam check not started", str(exc))
+        if refused_before_job(s, running=self._checking, what="beam check", not_started="Beam check not started"):
             return
         try:
             with s.lock:

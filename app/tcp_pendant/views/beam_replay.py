@@ -28,7 +28,7 @@ import asyncio
 import logging
 import threading
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 import viser
@@ -178,7 +178,7 @@ def _on_beam(point: np.ndarray, b: np.ndarray, u: np.ndarray) -> np.ndarray:
     return b + float((point - b) @ u) * u
 
 
-def event_points_world(scan: BeamScan | RecordedScan, points: Any = None) -> np.ndarray:
+def event_points_world(scan: BeamScan | RecordedScan, points: np.ndarray | None = None) -> np.ndarray:
     """(N, 3) where each event met its beam (WORLD, m), projected onto the event's beam line:
     ``points`` (N, 3) if given, else the scan's point for the event (``BeamScan.tip_world_m(i)``:
     where the physical tool met the beam), else (a stored scan) the flange's position."""
@@ -210,7 +210,7 @@ def beam_view_direction(beam_point: np.ndarray, beam_dir: np.ndarray) -> np.ndar
     return side + 0.35 * u * (1.0 if float(u @ b) >= 0.0 else -1.0) + np.array([0.0, 0.0, 0.5])
 
 
-def scan_spheres(scan: BeamScan | RecordedScan, points: Any = None) -> tuple[np.ndarray, np.ndarray]:
+def scan_spheres(scan: BeamScan | RecordedScan, points: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """(centres, radii) in WORLD m of what a camera should show of a scan: the flange at each
     event (with room for the wrist), the event points, the beam and the fork below it."""
     events: tuple[BeamEvent | ScanEvent, ...] = tuple(scan.events)
@@ -267,7 +267,7 @@ class ScanPlayer:
     # ------------------------------------------------------------ commands
     def play(self, scan: BeamScan | RecordedScan, *, owner: object | None = None,
              return_to: np.ndarray | None = None,
-             points: Any = None) -> None:
+             points: np.ndarray | None = None) -> None:
         """Replay ``scan`` from its first move (on the loop: a task at :attr:`rate_hz`; off the
         loop: its last frame at once). A film already playing stops first. A stored scan (no
         moves) only shows its markers; ``points``: the markers' points (see

@@ -5,7 +5,7 @@ then the trainer's "Systematic error" panel below them (built by ``views.build_s
 
 from __future__ import annotations
 
-from typing import Any
+import viser
 
 from tcp_pendant.session import Session
 from tcp_pendant.views.beam_replay import ScanPlayer
@@ -14,7 +14,7 @@ from tcp_pendant.views.wizard_menu import CalibrateView
 __all__ = ["build_calibrate_tab"]
 
 
-def build_calibrate_tab(session: Session, tab: Any, player: ScanPlayer) -> CalibrateView:
+def build_calibrate_tab(session: Session, tab: viser.GuiTabHandle, player: ScanPlayer) -> CalibrateView:
     """Fill the Calibrate tab (``tab``: a viser tab handle) with the wizards' views of
     ``session.workflow``; ``player``: the session's scan film (the beam result replays its scan)."""
     with tab:

@@ -16,12 +16,10 @@ Both texts are the trainer's browser's (a stranger's): every line goes through
 
 from __future__ import annotations
 
-from typing import Any
-
 from tcp_pendant.session import ClassMessage
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.text_escape import escape_markdown, escape_markdown_lines
-from tcp_pendant.views.gui_util import set_content, target_of
+from tcp_pendant.views.gui_util import ButtonEvent, set_content, target_of
 
 __all__ = ["ClassNoticeView", "instructions_markdown", "message_markdown"]
 
@@ -67,7 +65,7 @@ class ClassNoticeView:
         if change.notice:
             self.render()
 
-    def _on_dismiss(self, _event: Any = None) -> None:
+    def _on_dismiss(self, _event: ButtonEvent | None = None) -> None:
         if self.shown is not None:
             self.session.dismiss_message(self.shown.message_id)
 

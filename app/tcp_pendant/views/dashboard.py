@@ -32,9 +32,11 @@ from __future__ import annotations
 import logging
 from collections.abc import Callable, Collection, Sequence
 from datetime import datetime, timezone
-from typing import Any, Protocol
+from typing import Protocol
 
 import numpy as np
+import viser
+from viser.uplot import Scale
 
 from tcp_pendant.classroom.board import DEFAULT_STUCK_MIN, DashboardRow, dashboard_rows, open_runs
 from tcp_pendant.classroom.class_board import ClassBoard
@@ -102,6 +104,12 @@ def chart_points(rows: Sequence[DashboardRow]) -> tuple[np.ndarray, np.ndarray]:
     return np.asarray(x, dtype=float), np.asarray(y, dtype=float)
 
 
+class _Rendered(Protocol):
+    """A part of the dashboard built by another module, re-rendered with it."""
+
+    def render(self) -> None: ...
+
+
 class TrainerDashboard:
     """The dashboard of one trainer browser (module docstring).
 
@@ -117,51 +125,51 @@ class TrainerDashboard:
     """
 
     # the widgets, set by the folder builders (viser handles)
-    tool_panel: Any
-    rules_md: Any
-    stuck_min: Any
-    table_html: Any
-    runs_html: Any
-    chart: Any
-    trainee: Any
-    reset: Any
-    replay_button: Any
-    close_replay: Any
-    one_exercise: Any
-    one_tool: Any
-    one_hide_distance: Any
-    one_auto_touch: Any
-    push_one: Any
-    release: Any
-    action_md: Any
-    exercise: Any
-    tool: Any
-    hide_distance: Any
-    auto_touch: Any
-    push: Any
-    push_md: Any
-    grades_md: Any
-    download: Any
-    grade_upload: Any
-    grade_md: Any
+    tool_panel: ToolPanel
+    rules_md: viser.GuiMarkdownHandle
+    stuck_min: viser.GuiNumberHandle[float]
+    table_html: viser.GuiHtmlHandle
+    runs_html: viser.GuiHtmlHandle
+    chart: viser.GuiUplotHandle
+    trainee: viser.GuiDropdownHandle[str]
+    reset: viser.GuiButtonHandle
+    replay_button: viser.GuiButtonHandle
+    close_replay: viser.GuiButtonHandle
+    one_exercise: viser.GuiDropdownHandle[str]
+    one_tool: viser.GuiDropdownHandle[str]
+    one_hide_distance: viser.GuiDropdownHandle[str]
+    one_auto_touch: viser.GuiDropdownHandle[str]
+    push_one: viser.GuiButtonHandle
+    release: viser.GuiButtonHandle
+    action_md: viser.GuiMarkdownHandle
+    exercise: viser.GuiDropdownHandle[str]
+    tool: viser.GuiDropdownHandle[str]
+    hide_distance: viser.GuiDropdownHandle[str]
+    auto_touch: viser.GuiDropdownHandle[str]
+    push: viser.GuiButtonHandle
+    push_md: viser.GuiMarkdownHandle
+    grades_md: viser.GuiMarkdownHandle
+    download: viser.GuiButtonHandle
+    grade_upload: viser.GuiUploadButtonHandle
+    grade_md: viser.GuiMarkdownHandle
 
     def __init__(self, session: Session, control: DashboardControl) -> None:
         self.session = session
         self.control = control
         self.gui = target_of(session).gui
         self.rows: list[DashboardRow] = []
-        self.folders: dict[str, Any] = {}
-        self.class_extras: list[Any] = []
+        self.folders: dict[str, viser.GuiFolderHandle] = {}
+        self.class_extras: list[_Rendered] = []
         """The brief's and the message box's controls (``views.trainer_exercise`` /
         ``trainer_messages``), re-rendered with the dashboard."""
         self._grading = False
-        self._results_shown: tuple[Any, ...] | None = None
+        self._results_shown: tuple[tuple[int | None, float | None, str | None], ...] | None = None
         client = client_of(session)
         self.replay_scene = ReplayScene(target_of(session).scene, None if client is None else client.camera)
 
-    def folder(self, title: str, **kw: Any) -> Any:
+    def folder(self, title: str, *, expand_by_default: bool = True) -> viser.GuiFolderHandle:
         """A folder of the dashboard, kept in :attr:`folders`."""
-        f = self.gui.add_folder(title, **kw)
+        f = self.gui.add_folder(title, expand_by_default=expand_by_default)
         self.folders[title] = f
         return f
 
@@ -197,7 +205,8 @@ class TrainerDashboard:
         data = (x, y)
         if not all(np.array_equal(a, b) for a, b in zip(self.chart.data, data)) or len(self.chart.data) != 2:
             self.chart.data = data
-        scales = {"x": {"time": False, "range": (0.5, n + 0.5)}, "y": {"range": (0.0, round(top, 2))}}
+        scales: dict[str, Scale] = {"x": {"time": False, "range": (0.5, n + 0.5)},
+                                     "y": {"range": (0.0, round(top, 2))}}
         if self.chart.scales != scales:
             self.chart.scales = scales
 
@@ -321,8 +330,14 @@ def class_folder(dash: TrainerDashboard) -> None:
         dash.table_html = gui.add_html("")
         gui.add_markdown("**Calibrations in progress**")
         dash.runs_html = gui.add_html("")
-    dash.stuck_min.on_update(dash.session.loop.on_loop(lambda _e=None: dash.render()))
+    dash.stuck_min.on_update(dash.session.loop.on_loop(_rerender(dash)))
 
+
+def _rerender(dash: TrainerDashboard) -> Callable[[viser.GuiEvent[viser.GuiNumberHandle[float]]], None]:
+    """A setting's callback that draws the dashboard again with the new value."""
+    def rerender(_event: viser.GuiEvent[viser.GuiNumberHandle[float]]) -> None:
+        dash.render()
+    return rerender
 
 def chart_folder(dash: TrainerDashboard) -> None:
     """The class's position errors, one mark per trainee."""

@@ -10,9 +10,8 @@ the reference tip. Metres, WORLD. Labels are our own text (numbers and fixed wor
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
+import viser
 from scipy.spatial.transform import Rotation
 
 from tcp_pendant.classroom.replay import CalibrationReplay
@@ -40,11 +39,11 @@ class ReplayScene:
         handles: the scene handles drawn (for tests).
     """
 
-    def __init__(self, scene: Any, camera: Any | None = None) -> None:
+    def __init__(self, scene: viser.SceneApi, camera: viser.CameraHandle | None = None) -> None:
         self.scene = scene
         self.camera = camera
         self.shown: CalibrationReplay | None = None
-        self.handles: list[Any] = []
+        self.handles: list[viser.SceneNodeHandle] = []
 
     def clear(self) -> None:
         for h in self.handles:

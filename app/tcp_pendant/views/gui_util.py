@@ -5,17 +5,19 @@ legend option."""
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any, Protocol, TypeVar, cast
+from typing import TYPE_CHECKING, Protocol, TypeVar, cast
 
 import viser
 from viser.uplot import Legend
+
+from tcp_pendant.job_pool import JobRefused
 
 if TYPE_CHECKING:
     from tcp_pendant.session import Session
 
 __all__ = ["CHART_LEGEND", "ButtonEvent", "ButtonGroupEvent", "CheckboxEvent", "DropdownEvent", "UploadEvent",
-           "ViserTarget", "client_of", "clients_of", "number_of_option", "set_content", "set_options", "set_value",
-           "slot_option", "target_of"]
+           "ViserTarget", "client_of", "clients_of", "number_of_option", "refused_before_job", "set_content",
+           "set_options", "set_value", "slot_option", "target_of"]
 
 ViserTarget = viser.ClientHandle | viser.ViserServer
 """Where a session's views draw: its browser, or (``--shared``) the server, every browser."""
@@ -48,6 +50,25 @@ def set_value(handle: _Input[_T], value: _T) -> None:
     its getter, which mypy reads as a read-only property; the assignment is viser's documented
     way to set an input (and sends it to the browser)."""
     handle.value = value  # type: ignore[misc]  # viser's setter is not next to its getter
+
+
+def refused_before_job(session: Session, *, running: bool, what: str, not_started: str) -> bool:
+    """Whether a click that would start a job of ``session`` (a check in the job pool) is refused
+    at once, before the loop takes the job, each refusal told in one notification: the session
+    closed (nothing to tell), the view's own ``what`` still running, or the session may not start
+    a job now (``Session.admit_job``: its job runs, or its share of the server's time is used up;
+    titled ``not_started``)."""
+    if session.closed:
+        return True
+    if running:
+        session.notify_refusal("Check running", f"A {what} is still running here; wait for its result.")
+        return True
+    try:
+        session.loop.admit_job()
+    except JobRefused as exc:
+        session.notify_refusal(not_started, str(exc))
+        return True
+    return False
 
 
 def target_of(session: Session) -> ViserTarget:

@@ -33,7 +33,8 @@ from __future__ import annotations
 
 import re
 from collections.abc import Callable
-from typing import Any
+
+import viser
 
 from tcp_pendant.classroom.names import TraineeNameError
 from tcp_pendant.session import Session
@@ -76,7 +77,7 @@ class IdentityPrompt:
             none issued to this session).
     """
 
-    def __init__(self, session: Session, on_name: Callable[[Any, str], tuple[str, str | None]],
+    def __init__(self, session: Session, on_name: Callable[[object, str], tuple[str, str | None]],
                  on_token: Callable[[str], bool]) -> None:
         self.session = session
         self.name: str | None = None
@@ -84,8 +85,8 @@ class IdentityPrompt:
         self._on_token = on_token
         gui = target_of(session).gui
         self.banner = gui.add_markdown("", order=-1000.0, visible=False)
-        self.key_html: Any = None
-        self.marker_html: Any = None
+        self.key_html: viser.GuiHtmlHandle | None = None
+        self.marker_html: viser.GuiHtmlHandle | None = None
         self._build("")
 
     def _build(self, marker: str) -> None:

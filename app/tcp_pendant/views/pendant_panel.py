@@ -41,8 +41,8 @@ from __future__ import annotations
 import asyncio
 import math
 import time
-from collections.abc import Callable
-from typing import TYPE_CHECKING, Any
+from collections.abc import Callable, Coroutine
+from typing import TYPE_CHECKING, TypeVar
 
 import numpy as np
 import viser
@@ -59,7 +59,7 @@ from tcp_pendant.pendant import (
     tcp_readout_markdown,
     touch_indicator_markdown,
 )
-from tcp_pendant.pendant.hold import HoldDriver
+from tcp_pendant.pendant.hold import HoldDriver, Timer
 from tcp_pendant.pendant.guidance import CLOSEUP_WITHIN_MM, offset_markdown, side_view_markdown, tip_offset_xyz_mm
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.views import arrival
@@ -70,6 +70,13 @@ from tcp_pendant.views.viser_adapter import queue_markdown
 
 if TYPE_CHECKING:
     from tcp_pendant.controller.pose_state import PoseState
+
+SliderEvent = viser.GuiEvent[viser.GuiSliderHandle[float]]
+"""A joint slider's change."""
+SettingHandle = TypeVar("SettingHandle", viser.GuiButtonGroupHandle, viser.GuiDropdownHandle[str],
+                        viser.GuiSliderHandle[float])
+"""The selectors of a jog setting: a button group, a dropdown, a slider."""
+"""A jog setting's change: mode and increment (button groups), frame (dropdown), override (slider)."""
 
 __all__ = ["HOLD_HZ", "KEYS_LINE", "MARK", "PendantPanel", "jog_key_hint", "marked", "set_markdown", "unmarked"]
 
@@ -151,7 +158,7 @@ class PendantPanel:
         self._joint_folder_shown = False           # joint_folder.visible as _show_settings set it
         self._hide_locked = False                  # hide_distance.disabled as render set it
         self._last_stop = ""
-        self._stop_key: Any = None
+        self._stop_key: tuple[object, ...] | None = None
         self._hold: HoldDriver | None = None
         self._drop_report_due = False
         self._drop_reported_at = -math.inf          # monotonic s of the last drop report
@@ -292,7 +299,7 @@ class PendantPanel:
             loop = asyncio.get_running_loop()
             guard = self.session.loop.guard
 
-            def schedule(delay_s: float, fn: Any) -> Any:
+            def schedule(delay_s: float, fn: Callable[[], object]) -> Timer:
                 return loop.call_later(delay_s, guard(fn))
 
             self._hold = HoldDriver(self._hold_step, schedule)
@@ -365,13 +372,13 @@ class PendantPanel:
             set_value(self.hide_distance, self.session.hide_distance)
             raise
 
-    def _slider_cb(self, index: int) -> Any:
+    def _slider_cb(self, index: int) -> Callable[[SliderEvent], Coroutine[object, object, None]]:
         """The callback of joint slider ``index`` (0-based): set the joint to the browser's
         value (deg, clipped to the limits) and remember it, so that :meth:`render` does not
         echo it back."""
         s = self.session
 
-        def cb(event: Any) -> None:
+        def cb(event: SliderEvent) -> None:
             if event.client is None:
                 return                                # our own update of the slider: no loop
             if not s.jogger.gate.admit(arrival.arrived_s()):
@@ -390,10 +397,11 @@ class PendantPanel:
 
         return s.loop.on_loop(cb)
 
-    def _setting(self, name: str, kind: Any) -> Any:
+    def _setting(self, name: str, kind: Callable[[str | float], object]
+                 ) -> Callable[[viser.GuiEvent[SettingHandle]], None]:
         """Callback of one selector: only the selector that fired changes its setting (a button
         group's value is the option just clicked)."""
-        def cb(event: Any) -> None:
+        def cb(event: viser.GuiEvent[SettingHandle]) -> None:
             value = event.target.value
             self._stop_hold()
             self.session.motion.set_jog_setting(name, kind(unmarked(value) if isinstance(value, str) else value))
@@ -431,8 +439,8 @@ class PendantPanel:
     def _on_kuka_home(self, _event: ButtonEvent) -> None:
         self.session.motion.home()
 
-    def _on_camera(self, close: bool) -> Any:
-        def cb(event: Any) -> None:
+    def _on_camera(self, close: bool) -> Callable[[ButtonEvent], None]:
+        def cb(event: ButtonEvent) -> None:
             client = event.client
             if client is None:
                 return

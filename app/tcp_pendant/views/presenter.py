@@ -27,8 +27,7 @@ degrees on screen.
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, Any, TypedDict
-
+from typing import TYPE_CHECKING, TypedDict
 
 from tcp_pendant.calibrate.chart import error_axis_top_mm, error_bars
 from tcp_pendant.controller.readout import PoseReadout
@@ -41,6 +40,7 @@ if TYPE_CHECKING:
     from viser import uplot
 
     from tcp_pendant.controller.pose_state import PoseState
+    from tcp_pendant.wizards import Wizard, WizardResult
 
 __all__ = [
     "CHART_HEIGHT_PX",
@@ -115,7 +115,7 @@ def presenter_readout_markdown(readout: PoseReadout, distance_mm: float | None, 
             f'TCP in {frame}</span></div>')
 
 
-def presenter_steps_markdown(wizard: Any | None, *, font_px: int = STEPS_FONT_PX) -> str:
+def presenter_steps_markdown(wizard: Wizard | None, *, font_px: int = STEPS_FONT_PX) -> str:
     """The running wizard's steps, wrapped in a few lines (a step never split): ✔ recorded,
     ▶ current (bold), · to do.
 
@@ -179,7 +179,7 @@ class PresenterView:
                                        padding=(14, 12, 0, 0))   # the top tick's label not cut off
         self._shown: dict[str, str] = {}
         self.panel_width_px = NORMAL_WIDTH_PX
-        self._charted: Any = None
+        self._charted: WizardResult | None = None
         self.toggle.on_update(session.loop.on_loop(self._on_toggle))
         session.subscribe(self.on_change)
         if on:
@@ -244,7 +244,7 @@ class PresenterView:
         self._set(self.steps_md, "steps", presenter_steps_markdown(wizard))
         self._render_chart(None if wizard is None else wizard.result)
 
-    def _render_chart(self, res: Any) -> None:
+    def _render_chart(self, res: WizardResult | None) -> None:
         errors = getattr(res, "per_touch_error_mm", None)
         used = getattr(res, "used_indices", None)
         show = errors is not None and used is not None and len(errors) > 0

@@ -11,7 +11,7 @@ mode" switch, ``CalibrationWorkflow.training``).
 
 from __future__ import annotations
 
-from typing import Any
+import viser
 
 from tcp_pendant.controller.scenarios import DEFAULT_SEED_RANGE, SCENARIO_KINDS, explain
 from tcp_pendant.session import Session, SessionChange
@@ -86,7 +86,7 @@ class ScenarioPanel:
             set_value(self.seed, int(s.scenario_player.scenario.seed))
         self.md.content = scenario_markdown(s)
 
-    def _on_choose(self, event: Any) -> None:
+    def _on_choose(self, event: viser.GuiEvent[viser.GuiDropdownHandle[str]] | viser.GuiEvent[viser.GuiNumberHandle[int]]) -> None:
         if getattr(event, "client", None) is None:      # our own write-backs fire it too
             return
         kind = next((k for k, v in SCENARIO_CHOICES.items() if v == str(self.kind.value)), None)

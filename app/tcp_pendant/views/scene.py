@@ -35,23 +35,28 @@ from __future__ import annotations
 import asyncio
 import logging
 import math
-from typing import Any, cast
+from pathlib import Path
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 import viser
 from scipy.spatial.transform import Rotation
 
 from tcp_pendant.controller import ToolModel, reference_tip_model
+from tcp_pendant.controller.description import RobotDescription
 from tcp_pendant.controller.kinematics import urdf_links_and_tree
 from tcp_pendant.controller.rotations import quaternion_wxyz, quaternions_wxyz
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.views.beam_replay import ScanPlayer
 from tcp_pendant.views.beam_stand import BeamStandNodes
-from tcp_pendant.views.framing import Framing, frame_spheres
+from tcp_pendant.views.framing import VIEW_DIRECTION, Framing, frame_spheres
 from tcp_pendant.views.meshes import MeshPart, link_meshes, rigid_meshes
 from tcp_pendant.views.gui_util import target_of
 from tcp_pendant.views.viser_adapter import pose_queue, queue_pose
 from tcpcal.tool import Tool
+
+if TYPE_CHECKING:
+    from tcp_pendant.controller.pose_state import PoseState
 
 __all__ = ["POSE_EPS", "PoseSender", "SceneView", "camera_shape", "closeup_camera", "frame_cameras",
            "link_tree_paths", "overview_camera", "overview_pose", "relative_poses", "tool_label_text", "wxyz_xyz"]
@@ -111,7 +116,7 @@ def _as_slice(rows: np.ndarray) -> slice | np.ndarray:
     return rows
 
 
-def link_tree_paths(urdf_path: Any, links: tuple[str, ...] | list[str]) -> dict[str, tuple[str, str | None]]:
+def link_tree_paths(urdf_path: Path | RobotDescription, links: tuple[str, ...] | list[str]) -> dict[str, tuple[str, str | None]]:
     """Scene path and parent link of every link, nested like the URDF's link tree.
 
     Args:
@@ -163,7 +168,7 @@ class PoseSender:
         T_parent_node: their current poses (as created), (N,4,4).
     """
 
-    def __init__(self, handles: list[Any], T_parent_node: np.ndarray) -> None:
+    def __init__(self, handles: list[viser.SceneNodeHandle], T_parent_node: np.ndarray) -> None:
         self.handles = list(handles)
         self._sent = np.array(T_parent_node, dtype=float).reshape(len(self.handles), 4, 4)
         self._sent_rows = self._sent[:, :3, :]            # the compared part (a view, made once)
@@ -213,7 +218,7 @@ class PoseSender:
         return n
 
 
-def _set_pose(handle: Any, wxyz: list[float] | None, xyz: list[float] | None) -> int:
+def _set_pose(handle: viser.SceneNodeHandle, wxyz: list[float] | None, xyz: list[float] | None) -> int:
     """Send a node's orientation and/or position (``views.viser_adapter.queue_pose``; the public
     setters if viser's internals differ); returns how many messages."""
     if not queue_pose(handle, wxyz, xyz):
@@ -221,11 +226,11 @@ def _set_pose(handle: Any, wxyz: list[float] | None, xyz: list[float] | None) ->
     return int(wxyz is not None) + int(xyz is not None)
 
 
-def _public_setters(handle: Any, wxyz: list[float] | None, xyz: list[float] | None) -> None:
-    if wxyz is not None:
-        handle.wxyz = wxyz
+def _public_setters(handle: viser.SceneNodeHandle, wxyz: list[float] | None, xyz: list[float] | None) -> None:
+    if wxyz is not None:                     # viser's setters take any sequence of floats
+        handle.wxyz = cast("tuple[float, float, float, float]", wxyz)
     if xyz is not None:
-        handle.position = xyz
+        handle.position = cast("tuple[float, float, float]", xyz)
 
 
 def overview_pose(tip_world_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -252,11 +257,12 @@ def camera_shape(client: viser.ClientHandle) -> tuple[float, float, float]:
 
 
 def frame_cameras(clients: list[viser.ClientHandle], centres: np.ndarray, radii: np.ndarray,
-                  **framing: Any) -> Framing:
+                  direction: np.ndarray = VIEW_DIRECTION, margin: float = 1.15) -> Framing:
     """Frame each browser's camera on the spheres (``framing.frame_spheres`` with that camera's
-    shape and the ``framing`` options: ``direction``, ``margin``). Returns the first browser's
+    shape, ``direction`` and ``margin``). Returns the first browser's
     framing (a default camera's when there is none)."""
-    framings = [frame_spheres(centres, radii, fov_rad=fov, aspect=aspect, image_height_px=height, **framing)
+    framings = [frame_spheres(centres, radii, fov_rad=fov, aspect=aspect, image_height_px=height,
+                              direction=direction, margin=margin)
                 for fov, aspect, height in (camera_shape(c) for c in clients)]
     for client, f in zip(clients, framings):
         try:
@@ -265,7 +271,7 @@ def frame_cameras(clients: list[viser.ClientHandle], centres: np.ndarray, radii:
                 client.camera.look_at = f.look_at
         except Exception:                # a browser that left, or has not sent its camera yet
             log.debug("camera of a client not framed", exc_info=True)
-    return framings[0] if framings else frame_spheres(centres, radii, **framing)
+    return framings[0] if framings else frame_spheres(centres, radii, direction=direction, margin=margin)
 
 
 def closeup_camera(client: viser.ClientHandle, tip_world_m: np.ndarray) -> None:
@@ -353,9 +359,9 @@ class SceneView:
         scene.add_frame(f"{fl}/flange_axes", axes_length=0.09, axes_radius=0.004)
         self._flange_label = scene.add_label(f"{fl}/flange_axes/label", "FLANGE", position=(0.0, 0.05, 0.0))
         self._tool_root = f"{fl}/tool"
-        self._tool_frame: Any = None
+        self._tool_frame: viser.FrameHandle | None = None
         self._shown_mounted: ToolModel | None = None
-        self._shown_active: tuple[Any, bytes, ToolModel] | None = None   # (active tool, T_flange_tool, mounted)
+        self._shown_active: tuple[Tool | None, bytes, ToolModel] | None = None   # (active tool, T_flange_tool, mounted)
         self._data_on: ToolModel | None = None
         self.set_mounted_tool(c.mounted_tool)
         self._active_axes = scene.add_frame(f"{fl}/active_tool", axes_length=0.12, axes_radius=0.005)
@@ -407,7 +413,7 @@ class SceneView:
             self.update_active_tool()
 
     # ------------------------------------------------------------ updates
-    def _local_poses(self, state: Any) -> np.ndarray:
+    def _local_poses(self, state: PoseState) -> np.ndarray:
         """(N+1,4,4): ``T_parent_link`` of the moving links (``T_world_link`` for a link
         without a parent), then ``T_world_tcp`` (the gizmo), from one pose state
         (:func:`relative_poses`, batched into a buffer reused by the next call:

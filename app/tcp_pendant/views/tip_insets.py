@@ -12,11 +12,14 @@ the robot in its ready pose does not carry the image.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING
 
 from tcp_pendant.pendant.tip_insets import FAR, NEAR_MM, insets_key, tip_insets_image
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.views.gui_util import target_of
+
+if TYPE_CHECKING:
+    from tcp_pendant.controller.pose_state import PoseState
 
 __all__ = ["CAPTION", "TipInsets"]
 
@@ -49,7 +52,7 @@ class TipInsets:
                 return                  # far, and shown far: nothing to draw (the key is FAR too)
             self.render(change.state)
 
-    def render(self, state: Any) -> None:
+    def render(self, state: PoseState) -> None:
         """Send a new image when the tips' geometry in the window changed."""
         tip = self.session.controller.reference_tip_world_m
         key = insets_key(tip, state.T_world_tool_true)

@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable, Coroutine
-from typing import Any
 
 import viser
 
@@ -43,6 +42,7 @@ from tcp_pendant.views.gui_util import (
     DropdownEvent,
     client_of,
     number_of_option,
+    refused_before_job,
     set_content,
     set_options,
     set_value,
@@ -339,7 +339,7 @@ class ToolPanel:
         return (tool.name if slot is None else f"slot {slot}: {tool.name}"), tool
 
     def _check_callback(self, which: Callable[[], tuple[str, Tool]]
-                        ) -> Callable[[ButtonEvent], Coroutine[Any, Any, None]]:
+                        ) -> Callable[[ButtonEvent], Coroutine[object, object, None]]:
         async def callback(_event: ButtonEvent) -> None:
             await self.run_check(which)
         return callback
@@ -352,15 +352,7 @@ class ToolPanel:
         the server's time: ``SessionLoop.admit_job``, before the job is taken); the loop's work on
         it counts against that share (``SessionLoop.charged``); errors become one notification."""
         s = self.session
-        if s.closed:
-            return
-        if self._checking:
-            s.notify_refusal("Check running", "A TCP check is still running here; wait for its result.")
-            return
-        try:                           # refused at once, before the loop takes the job
-            s.loop.admit_job()
-        except JobRefused as exc:
-            s.notify_refusal("Check not started", str(exc))
+        if refused_before_job(s, running=self._checking, what="TCP check", not_started="Check not started"):
             return
         try:
             with s.loop.charged(), s.lock:

@@ -6,7 +6,6 @@ that clicked, ready for ``tcpcal solve xyz4``."""
 from __future__ import annotations
 
 from collections.abc import Callable, Coroutine, Sequence
-from typing import Any
 
 import numpy as np
 import viser
@@ -96,7 +95,7 @@ class TouchListView:
         target = event.client or client_of(self.session) or target_of(self.session)
         target.send_file_download(TOUCHES_FILENAME, data, save_immediately=True)
 
-    def _delete_cb(self, index: int, label: str) -> Callable[..., Coroutine[Any, Any, None]]:
+    def _delete_cb(self, index: int, label: str) -> Callable[..., Coroutine[object, object, None]]:
         def cb(_event: ButtonEvent) -> None:
             # the list may have changed since the button was drawn: delete by label
             labels = [t.label for t in self.session.touches]

@@ -14,11 +14,14 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any, Protocol
+from typing import Protocol
 
-from tcp_pendant.classroom.exercise_rules import MAX_INSTRUCTIONS_CHARS, MAX_MIN_TOUCHES
+import viser
+
+from tcp_pendant.classroom.exercise_rules import MAX_INSTRUCTIONS_CHARS, MAX_MIN_TOUCHES, clean_min_touches
 from tcp_pendant.session import Session
 from tcp_pendant.text_escape import escape_markdown
+from tcp_pendant.views.gui_util import ButtonEvent
 from tcp_pendant.wizards import wizard_classes
 
 __all__ = ["BriefControl", "ExerciseControls", "brief_words", "build_exercise_controls"]
@@ -63,16 +66,16 @@ class ExerciseControls:
 
     session: Session
     control: BriefControl
-    instructions: Any
-    methods: dict[str, Any]
-    min_touches: Any
-    push: Any
-    status: Any
+    instructions: viser.GuiTextHandle
+    methods: dict[str, viser.GuiCheckboxHandle]
+    min_touches: viser.GuiNumberHandle[int]
+    push: viser.GuiButtonHandle
+    status: viser.GuiMarkdownHandle
 
     def render(self) -> None:
         """Nothing to re-read: the brief changes only by this push."""
 
-    def _push(self, _event: Any = None) -> None:
+    def _push(self, _event: ButtonEvent | None = None) -> None:
         ticked = tuple(kind for kind, box in self.methods.items() if box.value is True)
         if not ticked:
             raise ValueError("Tick at least one method the trainees may use, then push the brief.")
@@ -80,15 +83,13 @@ class ExerciseControls:
         text = self.instructions.value
         if not isinstance(text, str):
             raise ValueError("The instructions must be text.")
-        minimum = self.min_touches.value
-        if isinstance(minimum, float) and minimum.is_integer():
-            minimum = int(minimum)
+        minimum = clean_min_touches(self.min_touches.value)     # a browser may send 3.0
         n = self.control.push_brief(text, allowed, minimum)
         self.status.content = escape_markdown(f"Pushed to {n} trainee{'s' if n != 1 else ''}: "
                                               f"{brief_words(self.control)}")
 
 
-def build_exercise_controls(gui: Any, class_control: BriefControl, session: Session) -> ExerciseControls:
+def build_exercise_controls(gui: viser.GuiApi, class_control: BriefControl, session: Session) -> ExerciseControls:
     """Add the brief's controls to ``gui`` (in the container open where it is called) for the
     trainer's ``session``; their push goes to ``class_control``."""
     allowed = class_control.allowed_methods

@@ -11,12 +11,14 @@ re-lists the names (the trainer view calls it when the class changes).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Protocol
+from typing import Protocol
+
+import viser
 
 from tcp_pendant.classroom.class_messages import MAX_MESSAGE_CHARS
 from tcp_pendant.session import Session
 from tcp_pendant.text_escape import escape_markdown
-from tcp_pendant.views.gui_util import set_options, set_value
+from tcp_pendant.views.gui_util import ButtonEvent, set_options, set_value
 
 __all__ = ["TO_ALL", "MessageControl", "MessageControls", "build_message_controls"]
 
@@ -43,16 +45,16 @@ class MessageControls:
 
     session: Session
     control: MessageControl
-    text: Any
-    to: Any
-    send: Any
-    status: Any
+    text: viser.GuiTextHandle
+    to: viser.GuiDropdownHandle[str]
+    send: viser.GuiButtonHandle
+    status: viser.GuiMarkdownHandle
 
     def render(self) -> None:
         """Re-list the connected trainees in "To" (the choice kept while its trainee is there)."""
         set_options(self.to, (TO_ALL, *self.control.connected_names()))
 
-    def _send(self, _event: Any = None) -> None:
+    def _send(self, _event: ButtonEvent | None = None) -> None:
         text = self.text.value
         if not isinstance(text, str):
             raise ValueError("The message must be text.")
@@ -62,7 +64,7 @@ class MessageControls:
         set_value(self.text, "")
 
 
-def build_message_controls(gui: Any, class_control: MessageControl, session: Session) -> MessageControls:
+def build_message_controls(gui: viser.GuiApi, class_control: MessageControl, session: Session) -> MessageControls:
     """Add the message box to ``gui`` (in the container open where it is called) for the
     trainer's ``session``; Send goes to ``class_control``."""
     with gui.add_folder("Message to trainees"):

@@ -21,16 +21,24 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING
+
+import viser
 
 from tcp_pendant.views.viser_adapter import upload_hook
+
+if TYPE_CHECKING:
+    from viser.infra import ClientId
+
+    from tcp_pendant.views.viser_adapter import UploadPart, UploadStart
 
 __all__ = ["limit_upload_size"]
 
 log = logging.getLogger(__name__)
 
 
-def limit_upload_size(handle: Any, max_bytes: int, on_refused: Callable[[str, int], None]) -> bool:
+def limit_upload_size(handle: viser.GuiUploadButtonHandle, max_bytes: int,
+                      on_refused: Callable[[str, int], None]) -> bool:
     """Drop uploads to the upload button ``handle`` bigger than ``max_bytes`` as they start.
 
     Args:
@@ -49,14 +57,14 @@ def limit_upload_size(handle: Any, max_bytes: int, on_refused: Callable[[str, in
         return False
     uuid, states = hook.uuid, hook.states
 
-    def on_start(_client_id: Any, message: Any) -> None:
+    def on_start(_client_id: ClientId, message: UploadStart) -> None:
         if message.source_component_uuid != uuid:
             return
         size = int(getattr(message, "size_bytes", 0) or 0)
         if size > max_bytes and states.pop(message.transfer_uuid, None) is not None:
             on_refused(str(message.filename), size)
 
-    def on_part(_client_id: Any, message: Any) -> None:
+    def on_part(_client_id: ClientId, message: UploadPart) -> None:
         if message.source_component_uuid != uuid:
             return
         state = states.get(message.transfer_uuid)

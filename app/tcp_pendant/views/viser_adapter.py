@@ -79,13 +79,41 @@ import types
 import typing
 import weakref
 from collections import Counter
-from collections.abc import Callable
-from typing import Any
+from collections.abc import Callable, Generator
+from typing import TYPE_CHECKING, Any, TypeGuard, cast
 
 import msgspec
+import viser
 
 from tcp_pendant.message_rate import MessagePacer
 from tcp_pendant.views import arrival
+
+if TYPE_CHECKING:                        # viser's and websockets' private types, named here only
+    import selectors
+    import socket
+    from contextlib import AbstractContextManager
+
+    from viser._gui_api import _FileUploadState
+    from viser._gui_handles import _GuiInputHandle
+    from viser._messages import (
+        FileTransferPart,
+        FileTransferStartUpload,
+        GuiButtonHoldMessage,
+        GuiMarkdownProps,
+        GuiUpdateMessage,
+        SetOrientationMessage,
+        SetPositionMessage,
+    )
+    from viser.infra import ClientId, WebsockMessageHandler
+    from viser.infra._messages import Message
+
+    from tcp_pendant.session import Browser
+    from websockets.asyncio.server import Server, ServerConnection, serve
+
+    UploadStart = FileTransferStartUpload
+    """A browser's announcement of an upload (:class:`UploadHook`'s ``on_start`` gets it)."""
+    UploadPart = FileTransferPart
+    """One part of an upload (:class:`UploadHook`'s ``on_part`` gets it)."""
 
 __all__ = ["LOG_VALUE_CHARS", "MAX_ABS_NUMBER", "MAX_TEXT_CHARS", "UploadHook", "UploadLimits",
            "ViserInternalsChanged", "gui_value_refusal", "install", "listen_reuse_port", "message_refusal", "path_counts",
@@ -117,7 +145,7 @@ class ViserInternalsChanged(RuntimeError):
     """A fast path had to fall back while ``TCP_PENDANT_STRICT_VISER=1``."""
 
 
-def short(value: Any, limit: int = LOG_VALUE_CHARS) -> str:
+def short(value: object, limit: int = LOG_VALUE_CHARS) -> str:
     """``repr(value)`` cut to ``limit`` characters (with the full length) for log lines."""
     try:
         text = repr(value)
@@ -158,7 +186,7 @@ def _fallback(path: str, exc: BaseException) -> bool:
     return False
 
 
-def queue_markdown(handle: Any, text: str) -> bool:
+def queue_markdown(handle: viser.GuiMarkdownHandle, text: str) -> bool:
     """Set a markdown handle's content to ``text`` without viser's public setter.
 
     Stores ``_content`` and the ``_markdown`` prop and queues the one ``GuiUpdateMessage`` the
@@ -172,7 +200,7 @@ def queue_markdown(handle: Any, text: str) -> bool:
         if impl.removed:
             return False
         object.__setattr__(handle, "_content", text)
-        props = impl.props
+        props = cast("GuiMarkdownProps", impl.props)
         if props._markdown != text:
             props._markdown = text
             impl.gui_api._websock_interface.queue_message(update(impl.uuid, {"_markdown": text}))
@@ -181,11 +209,11 @@ def queue_markdown(handle: Any, text: str) -> bool:
     return _fast("markdown")
 
 
-_GUI_UPDATE: list[Any] = []
+_GUI_UPDATE: list[type[GuiUpdateMessage]] = []
 """viser's ``GuiUpdateMessage`` once imported (an import statement per readout costs a lookup)."""
 
 
-def _gui_update_message() -> Any:
+def _gui_update_message() -> type[GuiUpdateMessage]:
     from viser._messages import GuiUpdateMessage
 
     _GUI_UPDATE.append(GuiUpdateMessage)
@@ -210,13 +238,15 @@ class PoseQueue:
 
     __slots__ = ("_impl", "_keys", "_name", "_orientation", "_owner", "_position", "_ws")
 
-    def __init__(self, handle: Any) -> None:
+    def __init__(self, handle: viser.SceneNodeHandle) -> None:
         messages = _viser_messages             # None (AttributeError below): viser differs
         impl = handle._impl
         api = impl.api
         self._impl, self._name, self._owner, self._ws = impl, impl.name, api._owner_id, api._websock_interface
-        self._orientation: Any = messages.SetOrientationMessage
-        self._position: Any = messages.SetPositionMessage
+        # the message classes, called with a tuple of 4 (wxyz) or 3 (xyz) floats (cast once, here)
+        self._orientation = cast("Callable[[str, tuple[float, ...]], SetOrientationMessage]",
+                                 messages.SetOrientationMessage)
+        self._position = cast("Callable[[str, tuple[float, ...]], SetPositionMessage]", messages.SetPositionMessage)
         if not (callable(self._ws.queue_message) and hasattr(impl, "wxyz") and hasattr(impl, "position")):
             raise AttributeError("a scene node without wxyz / position or a websocket interface")
         self._keys: list[str | None] = [None, None]
@@ -246,7 +276,7 @@ class PoseQueue:
         return _fast("pose")
 
 
-def pose_queue(handle: Any) -> PoseQueue | None:
+def pose_queue(handle: viser.SceneNodeHandle) -> PoseQueue | None:
     """The :class:`PoseQueue` of a scene node handle; None when viser's internals differ (counted
     and warned as the ``pose`` path's fallback: the caller uses the public setters)."""
     try:
@@ -256,7 +286,7 @@ def pose_queue(handle: Any) -> PoseQueue | None:
         return None
 
 
-def queue_pose(handle: Any, wxyz: list[float] | None, xyz: list[float] | None) -> bool:
+def queue_pose(handle: viser.SceneNodeHandle, wxyz: list[float] | None, xyz: list[float] | None) -> bool:
     """Set a scene node's orientation (``wxyz``) and/or position (``xyz``, metres) and queue
     viser's ``SetOrientationMessage`` / ``SetPositionMessage`` without its public setters
     (a :class:`PoseQueue` of the node, made for this call; the scene keeps one per node).
@@ -279,11 +309,11 @@ class UploadHook:
     """
 
     uuid: str
-    states: dict[str, Any]
-    register: Callable[[Callable[[Any, Any], None], Callable[[Any, Any], None]], None]
+    states: dict[str, _FileUploadState]
+    register: Callable[[Callable[[ClientId, FileTransferStartUpload], None], Callable[[ClientId, FileTransferPart], None]], None]
 
 
-def upload_hook(handle: Any) -> UploadHook | None:
+def upload_hook(handle: viser.GuiUploadButtonHandle) -> UploadHook | None:
     """The :class:`UploadHook` of a ``viser.GuiUploadButtonHandle`` (None: viser lacks it)."""
     try:
         from viser import _messages
@@ -300,7 +330,8 @@ def upload_hook(handle: Any) -> UploadHook | None:
         _fallback("upload", exc)
         return None
 
-    def register(on_start: Callable[[Any, Any], None], on_part: Callable[[Any, Any], None]) -> None:
+    def register(on_start: Callable[[ClientId, FileTransferStartUpload], None],
+                 on_part: Callable[[ClientId, FileTransferPart], None]) -> None:
         ws.register_handler(start_cls, on_start)
         ws.register_handler(part_cls, on_part)
 
@@ -343,7 +374,7 @@ def upload_limits(limits: UploadLimits | None = None) -> UploadLimits:
 class _Transfer:
     client: tuple[int, int]          # (id of the server's event loop, viser client id)
     size: int                        # announced, bytes
-    states: dict[str, Any]           # viser's buffers (the GuiApi's)
+    states: dict[str, _FileUploadState]  # viser's buffers (the GuiApi's)
     last_part: float                 # time.monotonic() of the start or the last part
     seen: list[bool]                 # part received, by index
     received: int = 0                # bytes of the parts received
@@ -391,7 +422,7 @@ def _expire(loop: asyncio.AbstractEventLoop, tid: str) -> None:
         loop.call_later(_limits.idle_s - idle, _expire, loop, tid)
 
 
-def _upload_start_refusal(gui_api: Any, client_id: Any, message: Any) -> str | None:
+def _upload_start_refusal(gui_api: viser.GuiApi, client_id: ClientId, message: FileTransferStartUpload) -> str | None:
     """Admit an upload start (registering its transfer) or say why it is refused."""
     if message.source_component_uuid not in getattr(gui_api, "_gui_input_handle_from_uuid", {}):
         return None                                   # not this GUI's button: viser ignores it
@@ -415,7 +446,7 @@ def _upload_start_refusal(gui_api: Any, client_id: Any, message: Any) -> str | N
     return None
 
 
-def _upload_part_refusal(gui_api: Any, message: Any) -> str | None:
+def _upload_part_refusal(gui_api: viser.GuiApi, message: FileTransferPart) -> str | None:
     """A part of an admitted upload: count it; refuse it (dropping the upload) when the bytes
     received pass the per-browser limit or, counted with every other upload in flight, the
     server's. (A client may understate its size: an upload button's own limit,
@@ -442,11 +473,11 @@ def _upload_part_refusal(gui_api: Any, message: Any) -> str | None:
 
 
 # ------------------------------------------------------------------ value checks
-def _finite_number(v: Any) -> bool:
+def _finite_number(v: object) -> TypeGuard[int | float]:
     return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
 
 
-def _checker(hint: Any) -> Callable[[Any], bool]:
+def _checker(hint: object) -> Callable[[object], bool]:
     """A function telling whether a decoded msgpack value fits the annotation ``hint``
     (numbers finite; a browser's numbers are doubles, so ``720.0`` is an int); unknown
     annotations pass. Built once per message field (:func:`_fields_of`)."""
@@ -486,10 +517,10 @@ def _checker(hint: Any) -> Callable[[Any], bool]:
     return lambda v: True
 
 
-_fields: dict[type, dict[str, tuple[Any, Callable[[Any], bool]]]] = {}
+_fields: dict[type, dict[str, tuple[object, Callable[[object], bool]]]] = {}
 
 
-def _fields_of(cls: type) -> dict[str, tuple[Any, Callable[[Any], bool]]]:
+def _fields_of(cls: type) -> dict[str, tuple[object, Callable[[object], bool]]]:
     """A message class's fields: name -> (annotation, its checker)."""
     fields = _fields.get(cls)
     if fields is None:
@@ -503,7 +534,7 @@ def _fields_of(cls: type) -> dict[str, tuple[Any, Callable[[Any], bool]]]:
     return fields
 
 
-def message_refusal(mapping: Any) -> str | None:
+def message_refusal(mapping: object) -> str | None:
     """Why a decoded client message (the msgpack mapping, before viser builds its message
     object) is refused, or None: not a known message, a missing, extra or wrongly typed field
     (by the message class's annotations; numbers finite), or a share-URL request. The value of a
@@ -531,11 +562,11 @@ def message_refusal(mapping: Any) -> str | None:
     return None
 
 
-def _hint_name(hint: Any) -> str:
+def _hint_name(hint: object) -> str:
     return "a finite number" if hint is float else getattr(hint, "__name__", None) or str(hint)
 
 
-def gui_value_refusal(handle: Any, updates: Any) -> str | None:
+def gui_value_refusal(handle: _GuiInputHandle[object], updates: object) -> str | None:
     """Why a browser's ``GuiUpdateMessage.updates`` for the GUI input ``handle`` is refused, or
     None: only ``value`` may be sent; it must have the type of the handle's value, be finite,
     lie within the handle's ``min`` / ``max`` (and :data:`MAX_ABS_NUMBER`), be one of its
@@ -594,7 +625,7 @@ def _bare(option: str) -> str:
     return _DECORATION.sub("", option, count=1)
 
 
-def _number_refusal(label: str, value: Any, lo: Any, hi: Any, integer: bool) -> str | None:
+def _number_refusal(label: str, value: object, lo: float | None, hi: float | None, integer: bool) -> str | None:
     if not _finite_number(value) or abs(value) > MAX_ABS_NUMBER:
         return f"{label}: {short(value)} is not a finite number of at most {MAX_ABS_NUMBER:g}"
     if integer and value != int(value):
@@ -605,7 +636,7 @@ def _number_refusal(label: str, value: Any, lo: Any, hi: Any, integer: bool) -> 
 
 
 # ------------------------------------------------------------------ message dispatch
-def _gui_apis(interface: Any) -> list[Any]:
+def _gui_apis(interface: WebsockMessageHandler) -> list[viser.GuiApi]:
     """The ``GuiApi`` objects whose handlers are registered on a websocket interface."""
     from viser._messages import GuiUpdateMessage
 
@@ -613,7 +644,7 @@ def _gui_apis(interface: Any) -> list[Any]:
     return [h.__self__ for h in handlers if hasattr(getattr(h, "__self__", None), "_gui_input_handle_from_uuid")]
 
 
-def _resend_value(gui_api: Any, handle: Any) -> None:
+def _resend_value(gui_api: viser.GuiApi, handle: _GuiInputHandle[object]) -> None:
     """Send an input's value back after a refused update, so the browser's widget shows what
     the server holds again (not for buttons: their value is a click, not a state)."""
     from viser._messages import GuiUpdateMessage
@@ -624,30 +655,32 @@ def _resend_value(gui_api: Any, handle: Any) -> None:
     gui_api._websock_interface.queue_message(GuiUpdateMessage(impl.uuid, {"value": impl.value}))
 
 
-def _refusal(interface: Any, client_id: Any, message: Any) -> str | None:
+def _refusal(interface: WebsockMessageHandler, client_id: ClientId, message: Message) -> str | None:
     """Why ``message`` is not handed to the handlers of ``interface``, or None."""
-    name = type(message).__name__
+    name = type(message).__name__               # the class by its name: each cast below is that class
     if name == "GuiUpdateMessage":
+        update = cast("GuiUpdateMessage", message)
         for api in _gui_apis(interface):
-            handle = api._gui_input_handle_from_uuid.get(message.uuid)
+            handle = api._gui_input_handle_from_uuid.get(update.uuid)
             if handle is not None:
-                why = gui_value_refusal(handle, message.updates)
+                why = gui_value_refusal(handle, update.updates)
                 if why is not None:
                     _resend_value(api, handle)
                 return why
     elif name == "GuiButtonHoldMessage":
+        hold = cast("GuiButtonHoldMessage", message)
         for api in _gui_apis(interface):
-            handle = api._gui_input_handle_from_uuid.get(message.uuid)
+            handle = api._gui_input_handle_from_uuid.get(hold.uuid)
             if handle is not None and (handle._impl.removed or getattr(handle._impl.props, "disabled", False)):
                 return f"{short(getattr(handle._impl.props, 'label', '?'), 60)} is disabled: no hold"
     elif name == "FileTransferStartUpload":
         for api in _gui_apis(interface):
-            why = _upload_start_refusal(api, client_id, message)
+            why = _upload_start_refusal(api, client_id, cast("FileTransferStartUpload", message))
             if why is not None:
                 return why
-    elif name == "FileTransferPart" and message.source_component_uuid is not None:
+    elif name == "FileTransferPart" and cast("FileTransferPart", message).source_component_uuid is not None:
         for api in _gui_apis(interface):
-            why = _upload_part_refusal(api, message)
+            why = _upload_part_refusal(api, cast("FileTransferPart", message))
             if why is not None:
                 return why
     return None
@@ -671,7 +704,7 @@ def message_counts() -> dict[str, int]:
         return dict(_message_counts)
 
 
-def _log_message(kind: str, sender: str, fmt: str, *args: Any) -> None:
+def _log_message(kind: str, sender: str, fmt: str, *args: object) -> None:
     """Count a refused / failed message of ``sender`` and log it within :data:`LOG_BUDGET`."""
     lines, window_s = LOG_BUDGET
     now = time.monotonic()
@@ -694,7 +727,7 @@ def _log_message(kind: str, sender: str, fmt: str, *args: Any) -> None:
         log.warning(fmt, *args)
 
 
-def _peer(websocket: Any) -> str:
+def _peer(websocket: ServerConnection) -> str:
     try:
         host, port = websocket.remote_address[:2]
         return f"{host}:{port}"
@@ -702,15 +735,16 @@ def _peer(websocket: Any) -> str:
         return "?"
 
 
-def client_address(client: Any) -> str | None:
+def client_address(client: Browser | None) -> str | None:
     """The IP address a viser client's websocket connects from (its peer), None when there is
     none to read (a closed connection, a shared page, or viser's internals differ).
 
     viser keeps each client's connection in its websocket server's table of live connections
     (``_live_connections``, by client id): private API, read only here."""
     try:
-        server = client._viser_server._websock_server
-        connection = server._live_connections[client.client_id]
+        viser_client = cast("viser.ClientHandle", client)      # a served session's browser is viser's
+        server = viser_client._viser_server._websock_server
+        connection = server._live_connections[viser_client.client_id]
         return str(connection.remote_address[0])
     except (AttributeError, KeyError, IndexError, TypeError):
         return None
@@ -730,18 +764,18 @@ class _TimedSelector:
     """An event loop's selector, keeping the start and end (monotonic s) of its last three polls
     (``arrival.earliest_from_polls``)."""
 
-    def __init__(self, inner: Any, polls: collections.deque[tuple[float, float]]) -> None:
+    def __init__(self, inner: selectors.BaseSelector, polls: collections.deque[tuple[float, float]]) -> None:
         self._inner = inner
         self._polls = polls
 
-    def select(self, timeout: float | None = None) -> Any:
+    def select(self, timeout: float | None = None) -> list[tuple[selectors.SelectorKey, int]]:
         t0 = time.monotonic()
         try:
             return self._inner.select(timeout)
         finally:
             self._polls.append((t0, time.monotonic()))
 
-    def __getattr__(self, name: str) -> Any:
+    def __getattr__(self, name: str) -> object:
         return getattr(self._inner, name)
 
 
@@ -764,7 +798,7 @@ def _polls_of(loop: asyncio.AbstractEventLoop) -> collections.deque[tuple[float,
     return polls
 
 
-def _unread(websocket: Any) -> int | None:
+def _unread(websocket: ServerConnection) -> int | None:
     """What a connection has received and not yet given out as messages: frames in websockets'
     queue (``recv_messages.frames``), bytes in its parser (``protocol.reader.buffer``) and bytes
     in the kernel's socket buffer (``FIONREAD``). 0: the next message is still to come. None
@@ -783,7 +817,7 @@ def _unread(websocket: Any) -> int | None:
     return frames + parsing + int(kernel[0])
 
 
-def _read_in_small_chunks(websocket: Any) -> None:
+def _read_in_small_chunks(websocket: ServerConnection) -> None:
     """Read a connection at most :data:`READ_BYTES` at a time (asyncio's selector transport's
     ``max_size``; nothing when the transport differs)."""
     transport = getattr(websocket, "transport", None)
@@ -803,7 +837,7 @@ def install() -> None:
         original_handle = _infra.WebsockMessageHandler._handle_incoming_message
         original_consumer = _infra._message_consumer
 
-        async def handle_incoming_message(self: Any, client_id: Any, message: Any) -> None:
+        async def handle_incoming_message(self: WebsockMessageHandler, client_id: ClientId, message: Message) -> None:
             try:
                 why = _refusal(self, client_id, message)
                 if why is not None:
@@ -815,8 +849,8 @@ def install() -> None:
                 _log_message("failed", f"client {client_id}", "message %s from client %s failed: %s: %s",
                              type(message).__name__, client_id, type(exc).__name__, short(str(exc)))
 
-        async def message_consumer(websocket: Any, handle_message: Callable[[Any], None],
-                                   message_class: Any) -> None:
+        async def message_consumer(websocket: ServerConnection, handle_message: Callable[[Message], None],
+                                   message_class: type[Message]) -> None:
             pacer = MessagePacer()                 # this connection's pace (``message_rate``)
             floor = arrival.ArrivalFloor()         # its backlog's bound on arrivals (``arrival``)
             polls = _polls_of(asyncio.get_running_loop())
@@ -841,7 +875,7 @@ def install() -> None:
                     peer = _peer(websocket)
                     _log_message("refused", peer, "message from %s refused: %s", peer, why)
                     continue
-                handle_message(message)
+                handle_message(cast("Message", message))
 
         message_consumer.__wrapped__ = original_consumer  # type: ignore[attr-defined]
         _infra.WebsockMessageHandler._handle_incoming_message = handle_incoming_message  # type: ignore[method-assign]
@@ -850,17 +884,18 @@ def install() -> None:
 
 
 _reuse_port = False
-_listen_hooks: tuple[Callable[[], Any] | None, Callable[[list[Any]], None] | None] = (None, None)
+_ListenHooks = tuple["Callable[[], AbstractContextManager[object]] | None", "Callable[[list[socket.socket]], None] | None"]
+_listen_hooks: _ListenHooks = (None, None)
 
 
 class _ListeningServe:
     """websockets' ``serve(...)`` as viser enters it (``async with``), with the hooks of
     :func:`listen_reuse_port` around the moment its listener starts listening."""
 
-    def __init__(self, serve: Any) -> None:
+    def __init__(self, serve: serve) -> None:
         self._serve = serve
 
-    async def __aenter__(self) -> Any:
+    async def __aenter__(self) -> Server:
         around, started = _listen_hooks
         if around is None:
             server = await self._serve.__aenter__()
@@ -871,15 +906,16 @@ class _ListeningServe:
             started(list(server.sockets))
         return server
 
-    async def __aexit__(self, *exc: Any) -> Any:
-        return await self._serve.__aexit__(*exc)
+    async def __aexit__(self, exc_type: type[BaseException] | None, exc: BaseException | None,
+                        tb: types.TracebackType | None) -> None:
+        await self._serve.__aexit__(exc_type, exc, tb)
 
-    def __await__(self) -> Any:
+    def __await__(self) -> Generator[object, None, Server]:
         return self._serve.__await__()
 
 
-def listen_reuse_port(around_listen: Callable[[], Any] | None = None,
-                      on_listening: Callable[[list[Any]], None] | None = None) -> None:
+def listen_reuse_port(around_listen: Callable[[], AbstractContextManager[object]] | None = None,
+                      on_listening: Callable[[list[socket.socket]], None] | None = None) -> None:
     """viser's server in this process binds its port with ``SO_REUSEPORT`` from now on (module
     docstring; idempotent). ``around_listen()``: a context manager entered while the listener
     binds and starts listening; ``on_listening(sockets)``: called with its listening sockets
@@ -898,7 +934,7 @@ def listen_reuse_port(around_listen: Callable[[], Any] | None = None,
             return
         original = ws_server.serve
 
-        def serve(*args: Any, **kwargs: Any) -> Any:
+        def serve(*args: Any, **kwargs: Any) -> _ListeningServe:     # websockets' serve(), any arguments
             kwargs.setdefault("reuse_port", True)
             return _ListeningServe(original(*args, **kwargs))
 

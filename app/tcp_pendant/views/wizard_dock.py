@@ -25,7 +25,7 @@ from __future__ import annotations
 import logging
 import math
 from collections.abc import Callable, Coroutine
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, TypeVar, cast
 
 from tcp_pendant.calibrate.diversity import best_tilt, best_tilt_words
 from tcp_pendant.calibrate.text import meter_level, step_markdown
@@ -38,8 +38,12 @@ from tcp_pendant.views.gui_util import ButtonEvent, ButtonGroupEvent, set_conten
 
 if TYPE_CHECKING:
     from tcp_pendant.calibrate import CalibrationWorkflow
+    from tcp_pendant.wizards.base import MeterWizard
 
 __all__ = ["BACK", "CANCEL", "CLOSE", "FINISH", "NEXT", "WizardDock", "tilt_line_html"]
+
+_E = TypeVar("_E")
+"""The event a dock action's callback takes (viser's, of the widget it is attached to)."""
 
 log = logging.getLogger(__name__)
 
@@ -88,11 +92,11 @@ class WizardDock:
         session.subscribe(self.on_change)
 
     # ------------------------------------------------------------ plumbing
-    def _action(self, fn: Callable[[Any], object], *,
-                sync: bool = False) -> Callable[..., Coroutine[Any, Any, None]]:
+    def _action(self, fn: Callable[[_E], object], *,
+                sync: bool = False) -> Callable[[_E], Coroutine[object, object, None]]:
         s = self.session
 
-        def run(event: Any) -> None:
+        def run(event: _E) -> None:
             with s.batch():
                 try:
                     fn(event)
@@ -212,11 +216,12 @@ class WizardDock:
     def update_meter(self) -> None:
         """The pose-diversity meter (the wizards that declare it: ``Wizard.meter_active``)."""
         wf = self.session.workflow
-        wiz: Any = wf.wizard  # a meter wizard (duck-typed: preview(), ...)
-        show = wiz is not None and bool(wiz.meter_active)
+        shown = wf.wizard
+        show = shown is not None and bool(shown.meter_active)
         self.meter_bar.visible = self.meter_md.visible = self.tilt_html.visible = show
         if not show:
             return
+        wiz = cast("MeterWizard", shown)              # meter_active: a wizard that declares the meter
         T_world_flange = self.session.controller.T_world_flange()
         gain = wiz.preview(T_world_flange)
         value, color = meter_level(gain)

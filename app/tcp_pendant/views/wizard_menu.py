@@ -34,8 +34,10 @@ state on that signal (:meth:`CalibrateView.on_change`), as the scene and the Too
 from __future__ import annotations
 
 import logging
-from collections.abc import Callable
-from typing import Any
+from collections.abc import Callable, Coroutine
+from typing import TypeVar, cast
+
+import viser
 
 from tcp_pendant.calibrate import CalibrationWorkflow
 from tcp_pendant.calibrate.library_choice import default_library_slot
@@ -47,10 +49,15 @@ from tcp_pendant.job_pool import JobRefused
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.gui_util import (
+    ButtonEvent,
+    CheckboxEvent,
+    DropdownEvent,
+    UploadEvent,
     client_of,
     number_of_option,
     set_content,
     set_options,
+    set_value,
     slot_option,
     target_of,
 )
@@ -81,6 +88,12 @@ RECORD_REFUSED = "Session record not loaded"
 
 log = logging.getLogger(__name__)
 
+OptionWidget = viser.GuiSliderHandle[int] | viser.GuiDropdownHandle[str]
+"""The menu widget of a start option: a slider for a number, a dropdown for the others."""
+
+_E = TypeVar("_E")
+"""The event an action's callback takes (viser's, of the widget it is attached to)."""
+
 
 class CalibrateView:
     """The Calibrate tab of ``session`` (see the module docstring).
@@ -110,7 +123,7 @@ class CalibrateView:
             labels = tuple(self._classes)
             self.method = gui.add_dropdown("Method", labels, initial_value=labels[0])
             self.method_md = gui.add_markdown("")
-            self.option_widgets: dict[str, Any] = {}
+            self.option_widgets: dict[str, OptionWidget] = {}
             self._option_specs: dict[str, WizardOption] = {}
             for cls in self._classes.values():
                 for opt in cls.options:
@@ -126,7 +139,8 @@ class CalibrateView:
                                                 hint="Calibrations you left: where, and when they started.")
             self.resume = gui.add_button("Resume", color="blue", visible=False)
         widgets = self.option_widgets
-        self._slot_widgets = [widgets[n] for n, o in self._option_specs.items() if o.kind == "library_slot"]
+        self._slot_widgets = [cast("viser.GuiDropdownHandle[str]", widgets[n])    # a library slot: a dropdown
+                              for n, o in self._option_specs.items() if o.kind == "library_slot"]
         # the built-in methods' widgets by their old names (tests and views read them)
         self.n_points = widgets.get("n_points")
         self.estimator = widgets.get("estimator")
@@ -163,7 +177,7 @@ class CalibrateView:
         self.refresh_library()      # the session's list: no file read here (an unreadable file is told once)
         self.render()
 
-    def _add_option_widget(self, gui: Any, opt: WizardOption) -> Any:
+    def _add_option_widget(self, gui: viser.GuiApi, opt: WizardOption) -> OptionWidget:
         """The menu widget of a declared start option (hidden until a method that takes it is
         chosen)."""
         hint = opt.hint or None
@@ -184,7 +198,7 @@ class CalibrateView:
             initial = next((p for p in physical if p != initial), physical[0])
         return gui.add_dropdown(opt.label, physical, initial_value=initial, hint=hint)
 
-    def _option_value(self, opt: WizardOption) -> Any:
+    def _option_value(self, opt: WizardOption) -> object:
         """The value of ``opt`` as chosen in its widget (checked by the wizard class at Start)."""
         widget = self.option_widgets[opt.name]
         if opt.kind == "int":
@@ -217,9 +231,9 @@ class CalibrateView:
             self.render()
 
     # ------------------------------------------------------------ plumbing
-    def action(self, fn: Callable[[Any], Any], *, user_only: bool = False,
-               sync: bool = False) -> Callable[[Any], Any]:
-        """Wrap a GUI callback: ``SessionLoop.on_loop`` (viser's event loop, session lock, error
+    def action(self, fn: Callable[[_E], object], *, user_only: bool = False,
+               sync: bool = False) -> Callable[[_E], Coroutine[object, object, None]]:
+        """Wrap a GUI callback: ``Session.on_loop`` (viser's event loop, session lock, error
         notifications), inside ``Session.batch``, ending in one change signal with ``wizard``
         (with ``sync`` also ``pose``: the click may have moved the robot, as auto-touch does).
         Tool and library changes the click made through the session's commands join that
@@ -234,7 +248,7 @@ class CalibrateView:
         """
         s = self.session
 
-        def run(event: Any) -> None:
+        def run(event: _E) -> None:
             if user_only and getattr(event, "client", None) is None:
                 return
             with s.batch():
@@ -251,10 +265,10 @@ class CalibrateView:
         self.session.notify("Tool saved", f"Slot {slot}: {tool.name} is now the active tool.", kind="success")
 
     # ------------------------------------------------------------ callbacks
-    def _on_training(self, event: Any) -> None:
+    def _on_training(self, event: CheckboxEvent) -> None:
         self.session.wizard_commands.set_training(bool(event.target.value))
 
-    def _on_library_pick(self, event: Any) -> None:
+    def _on_library_pick(self, event: DropdownEvent) -> None:
         # the user's pick holds until the active tool data changes (then the default is offered)
         self._library_pick = (str(event.target.value), self.session.tools.active_slot)
 
@@ -269,29 +283,29 @@ class CalibrateView:
                                     mounted_label=c.mounted_tool.label, mounted_key=c.mounted_tool.key)
         return None if slot is None else slot_option(slot, self._library[slot].name)
 
-    def _selected_slot(self, widget: Any = None) -> int:
+    def _selected_slot(self, widget: OptionWidget | None = None) -> int:
         picked = widget or self.library_tool                     # None: the library is empty
-        slot = None if picked is None else number_of_option(picked.value)
+        slot = None if picked is None else number_of_option(str(picked.value))
         if slot is None:
             raise ValueError("The tool library is empty: calibrate the TCP first (XYZ 4-point) and save it.")
         return slot
 
-    def _on_start(self, _event: Any) -> None:
+    def _on_start(self, _event: ButtonEvent) -> None:
         if str(self.method.value) not in self._classes:
             raise ValueError(f"Unknown calibration method {self.method.value!r}.")
         cls = self._chosen_class()
         self.session.wizard_commands.start(cls.kind, **{opt.name: self._option_value(opt) for opt in cls.options})
 
-    def _on_start_from_points(self, _event: Any) -> None:
+    def _on_start_from_points(self, _event: ButtonEvent) -> None:
         """XYZ 4-point from the free touches (``CalibrationWorkflow.start_from_touches``)."""
         cls = self._chosen_class()
         if cls.kind != "xyz4":
             raise ValueError("Only the XYZ 4-point method starts from the recorded points; choose it first.")
         spec = self._option_specs.get("estimator")
-        estimator = "lstsq" if spec is None else self._option_value(spec)
+        estimator = "lstsq" if spec is None else str(self._option_value(spec))
         self.session.wizard_commands.start_from_touches(estimator=estimator)
 
-    def _on_resume(self, _event: Any) -> None:
+    def _on_resume(self, _event: ButtonEvent) -> None:
         number = number_of_option(self.resume_list.value)
         if number is None:
             raise ValueError("There is no calibration to resume.")
@@ -300,14 +314,14 @@ class CalibrateView:
                              "'To resume'.")
         self.session.wizard_commands.resume(number - 1)
 
-    def _on_export(self, event: Any) -> None:
+    def _on_export(self, event: ButtonEvent) -> None:
         data = dumps(self.workflow.export_record(self.session.touches)).encode("utf-8")
         # to the browser that clicked (in --shared mode the session is every browser's)
         target = getattr(event, "client", None) or client_of(self.session) or target_of(self.session)
         target.send_file_download(SESSION_FILENAME, data, save_immediately=True)
         set_content(self.record_md, f"Exported {len(self.workflow.runs)} calibration(s) as {SESSION_FILENAME}.")
 
-    async def _on_upload(self, event: Any) -> None:
+    async def _on_upload(self, event: UploadEvent) -> None:
         """"Load session (JSON)": the size is checked at once, parsing and replay run in
         the server's job pool (``SessionLoop.run_job``, off viser's event loop: the other browsers
         keep jogging; each record is bounded by the record limits), then the
@@ -413,7 +427,7 @@ class CalibrateView:
         for widget in self._slot_widgets:
             wanted = self._library_option(tuple(widget.options))
             if wanted is not None and widget.value != wanted and wanted in widget.options:
-                widget.value = wanted
+                set_value(widget, wanted)
         empty = library_widget is None or library_widget.value == NO_LIBRARY_TOOL
         physical = [self.option_widgets[o.name].value for o in cls.options if o.kind == "physical_tool"]
         mounted = self.session.controller.mounted_tool.label

@@ -16,7 +16,7 @@ offers "Check this TCP", which starts the TCP check wizard on the slot just save
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, cast
 
 from tcp_pendant.calibrate.chart import error_axis_top_mm, error_bars
 from tcp_pendant.text_escape import escape_markdown
@@ -46,12 +46,16 @@ from tcp_pendant.wizards import (
     ESTIMATOR_LABELS,
     Wizard,
     WizardStateError,
+    Xyz4Result,
+    Xyz4Wizard,
 )
 from tcpcal.library import ToolLibrary
 from tcpcal.tool import Tool
 
 if TYPE_CHECKING:
     from viser import uplot
+
+    from tcp_pendant.wizards.session_record import WizardRun
 
     from tcp_pendant.views.wizard_menu import CalibrateView
 
@@ -125,18 +129,18 @@ class WizardResultView:
         self.replay_scan.on_click(act(lambda _e: self.parent.scene.replay_scan()))
         self.save_name.on_update(act(lambda _e: None, user_only=True))
         self.save_slot.on_update(act(lambda _e: None, user_only=True))
-        self._named_run: Any = None
-        self._refused: tuple[Any, str] | None = None   # (run, why its last Save was refused)
-        self._charted: Any = None
+        self._named_run: WizardRun | None = None
+        self._refused: tuple[WizardRun | None, str] | None = None   # (run, why its last Save was refused)
+        self._charted: Xyz4Result | None = None
 
     # ------------------------------------------------------------ callbacks
-    def _with_estimators(self, fn: Callable[[Any], Any]) -> None:
+    def _with_estimators(self, fn: Callable[[Xyz4Wizard], object]) -> None:
         """``fn(wizard)`` on the result on show, for the wizards whose result panel offers the
         estimators (``Wizard.result_extras``), as one command of the session."""
-        def edit(wiz: Wizard) -> Any:
+        def edit(wiz: Wizard) -> object:
             if "estimators" not in type(wiz).result_extras:
                 raise WizardStateError(f"The {wiz.title} result has no estimators to choose.")
-            return fn(wiz)
+            return fn(cast("Xyz4Wizard", wiz))       # the 4-point's, the one that offers them
         self.parent.session.wizard_commands.edit_result(edit)
 
     def _on_drop(self, _event: ButtonEvent) -> None:
@@ -218,9 +222,9 @@ class WizardResultView:
         self.legend_md.visible = bool(legend)
         if legend:
             set_content(self.legend_md, legend)
-        self._render_estimators(res if "estimators" in extras else None)
+        self._render_estimators(cast("Xyz4Result", res) if "estimators" in extras else None)
 
-    def _render_estimators(self, res: Any) -> None:
+    def _render_estimators(self, res: Xyz4Result | None) -> None:
         """The 4-point's estimator parts (``result_extras`` "estimators"): the per-touch chart,
         outlier drop and restore, the estimator choice and their comparison."""
         for h in (self.chart, self.drop, self.restore, self.estimator, self.compare):

@@ -37,7 +37,7 @@ from __future__ import annotations
 
 import logging
 import math
-from typing import Any, cast
+from typing import cast
 
 import numpy as np
 import viser
@@ -46,7 +46,7 @@ from tcp_pendant.calibrate import CalibrationWorkflow
 from tcp_pendant.session import Session
 from tcp_pendant.session_views import SceneLabel
 from tcp_pendant.views.beam_replay import ScanPlayer, beam_view_direction, scan_spheres
-from tcp_pendant.views.framing import Framing, spread_labels
+from tcp_pendant.views.framing import VIEW_DIRECTION, Framing, spread_labels
 from tcp_pendant.views.scene import frame_cameras, wxyz_xyz
 from tcp_pendant.wizards import WizardResult, Xyz4Result
 from tcp_pendant.views.gui_util import clients_of, target_of
@@ -142,12 +142,13 @@ class WizardSceneView:
             player.play(scan, owner=self, points=self._scan_points(res))
 
     @staticmethod
-    def _scan_points(res: Any) -> Any:
+    def _scan_points(res: WizardResult | None) -> np.ndarray | None:
         """The markers' points: the scan's own (where the physical tool met the beam) when it
         has them, else (a stored scan) where the result's tool met it."""
-        if callable(getattr(res.scan, "tip_world_m", None)) or not callable(getattr(res, "event_points_world_m", None)):
+        points_of = getattr(res, "event_points_world_m", None)          # a beam result's
+        if callable(getattr(getattr(res, "scan", None), "tip_world_m", None)) or not callable(points_of):
             return None
-        return np.asarray(res.event_points_world_m(), dtype=float).reshape(-1, 3)
+        return np.asarray(points_of(), dtype=float).reshape(-1, 3)
 
     def replay_scan(self) -> None:
         """"Replay scan": the result's scan again, from its first move."""
@@ -285,8 +286,9 @@ class WizardSceneView:
         centres, radii = self._framed_geometry()
         if not np.all(np.isfinite(centres)) or not np.all(np.isfinite(radii)):
             return None
-        kw = {} if (d := self._view_direction()) is None else {"direction": d}
-        framing = frame_cameras(clients_of(self.session), centres, radii, **kw)
+        d = self._view_direction()
+        framing = frame_cameras(clients_of(self.session), centres, radii,
+                                direction=VIEW_DIRECTION if d is None else d)
         self.last_framing = framing
         return framing
 
@@ -325,7 +327,7 @@ class WizardSceneView:
                 self._camera_watched.add(client.client_id)
                 client.camera.on_update(self._relayout)
 
-    def _on_camera(self, _camera: Any = None) -> None:
+    def _on_camera(self, _camera: viser.CameraHandle | None = None) -> None:
         if self._labels_moved and (self.workflow.is_open or self.workflow.result is not None):
             self.layout_labels()
 

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import logging
 import math
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, cast
 
 from tcp_pendant.calibrate import AUTO_SIGMA_MAX_MM, AutoTouchRequest
 from tcp_pendant.calibrate.diversity import best_tilt, best_tilt_words, diversity_advice
@@ -42,6 +42,7 @@ if TYPE_CHECKING:
     from tcp_pendant.calibrate.autotouch import AutoTouchOutcome
     from tcp_pendant.calibrate.workflow import ControllerJob
     from tcp_pendant.views.wizard_menu import CalibrateView
+    from tcp_pendant.wizards.base import MeterWizard
 
 __all__ = ["RANDOM", "WizardStepsView"]
 
@@ -100,8 +101,8 @@ class WizardStepsView:
         self.auto_direction.on_update(act(lambda _e: None, user_only=True))
         self.auto_touch.on_click(self._on_auto_touch)
         self._auto_touching = False
-        self._auto_line: tuple[tuple[Any, ...], str, Any] | None = None  # (where it belongs, text, poses)
-        self._record_line: tuple[tuple[Any, ...], str, Any] | None = None  # the same, for Record
+        self._auto_line: tuple[tuple[object, ...], str, object] | None = None  # (where it belongs, text, poses)
+        self._record_line: tuple[tuple[object, ...], str, object] | None = None  # the same, for Record
 
     # ------------------------------------------------------------ callbacks
     def _on_record(self, _event: ButtonEvent) -> None:
@@ -235,7 +236,7 @@ class WizardStepsView:
                            f"{escape_markdown(out.message)} Operator error σ {request.sigma_mm:.2f} mm.",
                            None if wiz is None else wiz.recorded_poses)
 
-    def _auto_where(self) -> tuple[Any, ...]:
+    def _auto_where(self) -> tuple[object, ...]:
         """Where the Auto-touch line belongs: the wizard on show, its step and status and its
         recorded poses (a new record, a step change or another wizard makes the line stale)."""
         wiz = self.parent.workflow.wizard
@@ -319,11 +320,12 @@ class WizardStepsView:
         """The live pose-diversity meter (while a touch is to be recorded, for the wizards that
         declare it: ``Wizard.meter_active``)."""
         wf = self.parent.workflow
-        wiz: Any = wf.wizard                          # a meter wizard (duck-typed: preview(), ...)
-        show = wiz is not None and wiz.meter_active
+        shown = wf.wizard
+        show = shown is not None and shown.meter_active
         self.meter_bar.visible = self.meter_md.visible = show
         if not show:
             return
+        wiz = cast("MeterWizard", shown)              # meter_active: a wizard that declares the meter
         T_world_flange = self.parent.session.controller.T_world_flange()
         gain = wiz.preview(T_world_flange)
         value, color = meter_level(gain)

@@ -10,13 +10,15 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import replace
-from typing import Any, ClassVar, Literal
+from typing import ClassVar, Literal
 
 import numpy as np
+import numpy.typing as npt
 
 from tcpcal.orientation import R_WORLD_TOOL_PARALLEL, solve_abc_world
 from tcpcal.tool import Tool
 
+from tcp_pendant.json_shapes import JsonRecord
 from tcp_pendant.wizards.base import (
     StepSpec,
     Wizard,
@@ -62,7 +64,7 @@ class AbcWorldWizard(Wizard):
     needs_tool = "library"
 
     @classmethod
-    def start(cls, ctx: StartContext, options: Mapping[str, Any]) -> WizardStart:
+    def start(cls, ctx: StartContext, options: JsonRecord) -> WizardStart:
         """For the library tool in ``slot``; its data is made active so rotations A, B, C turn
         about its TCP."""
         tool = ctx.library_tool(options["slot"])
@@ -92,17 +94,20 @@ class AbcWorldWizard(Wizard):
         self._variant: Literal["6d", "5d"] = variant
 
     @staticmethod
-    def _check_variant(variant: Any) -> None:
-        if variant not in ("6d", "5d"):
-            raise WizardError(f"The ABC world variant is '6d' or '5d', got {variant!r}.")
+    def _check_variant(variant: object) -> Literal["6d", "5d"]:
+        if variant == "6d":
+            return "6d"
+        if variant == "5d":
+            return "5d"
+        raise WizardError(f"The ABC world variant is '6d' or '5d', got {variant!r}.")
 
     @property
     def variant(self) -> Literal["6d", "5d"]:
         return self._variant
 
-    def set_variant(self, variant: Literal["6d", "5d"]) -> None:
+    def set_variant(self, variant: int | str) -> None:
         """Choose 6D or 5D; the recorded pose is valid for both; a finished wizard is recomputed."""
-        self._check_variant(variant)
+        variant = self._check_variant(variant)
         self._variant = variant
         if self.is_complete:
             self.finish()
@@ -118,7 +123,7 @@ class AbcWorldWizard(Wizard):
                     "it does not matter. Then press Record.")
         return [StepSpec(role="parallel", title="Align the tool with WORLD", instruction=text)]
 
-    def target_T_world_tool_m(self, T_world_flange_m: Any) -> np.ndarray:
+    def target_T_world_tool_m(self, T_world_flange_m: npt.ArrayLike) -> np.ndarray:
         """Pose of the target triad for the scene (4x4, metres): the prescribed orientation
         (PA-1) placed at the tool's TCP as currently believed (``tool.tcp_mm``)."""
         T = check_pose_m(T_world_flange_m)
@@ -157,9 +162,9 @@ class AbcWorldWizard(Wizard):
         return Tool(name=name, tcp_mm=res.tcp_mm, abc_deg=res.abc_deg, mass_kg=self.tool.mass_kg,
                     cog_mm=self.tool.cog_mm, notes=self.tool.notes, calibration=self._calibration(res, figures))
 
-    def _params(self) -> dict[str, Any]:
+    def _params(self) -> dict[str, object]:
         return {"tool": self.tool.to_dict(), "variant": self._variant}
 
     @classmethod
-    def _from_params(cls, params: Mapping[str, Any]) -> "AbcWorldWizard":
+    def _from_params(cls, params: JsonRecord) -> "AbcWorldWizard":
         return cls(Tool.from_dict(params["tool"]), variant=params.get("variant", "6d"))

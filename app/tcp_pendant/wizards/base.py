@@ -26,15 +26,18 @@ import datetime as _dt
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any, ClassVar, Literal
+from typing import ClassVar, Literal, Protocol
 
 import numpy as np
+import numpy.typing as npt
 
 from tcpcal.errors import TcpcalError
 from tcpcal.origin import TcpResult
 from tcpcal.orientation import OrientationResult
+from tcpcal.pose_quality import CandidateGain
 from tcpcal.tool import Calibration, Tool
 
+from tcp_pendant.json_shapes import JsonRecord
 from tcp_pendant.wizards.describe import (
     AutoRole,
     OptionError,
@@ -75,7 +78,7 @@ def utc_now_iso() -> str:
     return _dt.datetime.now(_dt.timezone.utc).replace(microsecond=0).isoformat().replace("+00:00", "Z")
 
 
-def finite_number(value: Any, what: str, *, low: float | None = None, high: float | None = None) -> float:
+def finite_number(value: object, what: str, *, low: float | None = None, high: float | None = None) -> float:
     """A number from untrusted input (a session record's stored figures, a start option), checked.
 
     Args:
@@ -90,7 +93,7 @@ def finite_number(value: Any, what: str, *, low: float | None = None, high: floa
     if isinstance(value, bool):
         raise WizardError(f"The {what} must be a number, got {value!r:.40}.")
     try:
-        x = float(value)
+        x = float(value)  # type: ignore[arg-type]  # any value: what float() refuses is refused
     except (TypeError, ValueError):
         raise WizardError(f"The {what} must be a number, got {value!r:.40}.") from None
     if low is None and high is None:
@@ -103,7 +106,7 @@ def finite_number(value: Any, what: str, *, low: float | None = None, high: floa
     return x
 
 
-def check_pose_m(T_world_flange_m: Any, *, what: str = "flange pose") -> np.ndarray:
+def check_pose_m(T_world_flange_m: object, *, what: str = "flange pose") -> np.ndarray:
     """Validate a rigid transform in metres and return it as a float (4,4) copy.
 
     Raises:
@@ -133,6 +136,22 @@ def rotation_and_position_mm(T_world_flange_m: np.ndarray) -> tuple[np.ndarray, 
     return T_world_flange_m[:3, :3].copy(), T_world_flange_m[:3, 3] * M_TO_MM
 
 
+class MeterWizard(Protocol):
+    """A wizard that declares ``diversity_meter`` (XYZ 4-point, TCP & Z, X), as the meter reads it."""
+
+    assumed_sigma_mm: float
+    """The operator's jogging error the meter assumes, mm per axis."""
+
+    @property
+    def meter_active(self) -> bool: ...
+
+    def other_rotations(self) -> np.ndarray:
+        """(N,3,3) ``R_world_flange`` of the touches recorded so far."""
+
+    def preview(self, T_world_flange_m: npt.ArrayLike, *, min_angle_deg: float = 15.0) -> CandidateGain:
+        """What a touch at ``T_world_flange_m`` (metres) would add (tcpcal's ``candidate_gain``)."""
+
+
 @dataclass(frozen=True)
 class RecordedPose:
     """One pose recorded at a wizard step.
@@ -145,11 +164,11 @@ class RecordedPose:
     T_world_flange_m: np.ndarray
     recorded_at: str
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, object]:
         return {"T_world_flange_m": self.T_world_flange_m.tolist(), "recorded_at": self.recorded_at}
 
     @classmethod
-    def from_dict(cls, d: Mapping[str, Any]) -> "RecordedPose":
+    def from_dict(cls, d: JsonRecord) -> "RecordedPose":
         return cls(check_pose_m(d["T_world_flange_m"]), str(d["recorded_at"]))
 
 
@@ -257,7 +276,7 @@ class WizardResult:
             out["n_touches"] = float(self.tcp_result.n_touches)
         return out
 
-    def summary(self) -> dict[str, Any]:
+    def summary(self) -> dict[str, object]:
         """JSON-ready summary (used by the session record): method, frame, figures, warnings."""
         return {
             "wizard": self.wizard,
@@ -319,7 +338,7 @@ class Wizard(abc.ABC):
     rank: ClassVar[int] = 100
     step_roles: ClassVar[tuple[StepRole, ...]] = ()
     options: ClassVar[tuple[WizardOption, ...]] = ()
-    variants: ClassVar[tuple[tuple[Any, str], ...]] = ()
+    variants: ClassVar[tuple[tuple[int | str, str], ...]] = ()
     needs_tool: ClassVar[Literal["mounted", "library"]] = "mounted"
     supports_add_point: ClassVar[bool] = False
     diversity_meter: ClassVar[bool] = False
@@ -344,7 +363,7 @@ class Wizard(abc.ABC):
         return type(self).step_role(step.role).auto
 
     @classmethod
-    def parse_options(cls, options: Mapping[str, Any]) -> dict[str, Any]:
+    def parse_options(cls, options: JsonRecord) -> JsonRecord:
         """The start options checked against :attr:`options` (and ``variant`` against
         :attr:`variants`); defaults filled in.
 
@@ -357,7 +376,7 @@ class Wizard(abc.ABC):
         if unknown:
             raise WizardError(f"The {cls.title} wizard takes no option {', '.join(unknown)}; "
                               f"it takes {', '.join(sorted(allowed)) or 'none'}.")
-        out: dict[str, Any] = {}
+        out: dict[str, object] = {}
         try:
             for name, opt in declared.items():
                 if name in options and options[name] is not None:
@@ -377,17 +396,17 @@ class Wizard(abc.ABC):
         return out
 
     @classmethod
-    def start(cls, ctx: StartContext, options: Mapping[str, Any]) -> WizardStart:
+    def start(cls, ctx: StartContext, options: JsonRecord) -> WizardStart:
         """Build the wizard from checked ``options`` (:meth:`parse_options`)."""
         raise NotImplementedError(f"{cls.__name__} does not say how to start it.")
 
     # ----- capabilities the views ask for (defaults: none) ------------------------------
     @property
-    def variant(self) -> Any:
+    def variant(self) -> int | str | None:
         """The variant in use (None when the wizard has none)."""
         return None
 
-    def set_variant(self, variant: Any) -> None:
+    def set_variant(self, variant: int | str) -> None:
         """Switch the variant (wizards with :attr:`variants` override this)."""
         raise WizardStateError(f"The {self.title} wizard has no variants.")
 
@@ -440,12 +459,12 @@ class Wizard(abc.ABC):
         """Call tcpcal on the recorded poses (metres, in step order) and build the result."""
 
     @abc.abstractmethod
-    def _params(self) -> dict[str, Any]:
+    def _params(self) -> dict[str, object]:
         """JSON-ready constructor options, for ``to_dict``."""
 
     @classmethod
     @abc.abstractmethod
-    def _from_params(cls, params: Mapping[str, Any]) -> "Wizard":
+    def _from_params(cls, params: JsonRecord) -> "Wizard":
         """Inverse of ``_params``."""
 
     # ----- steps --------------------------------------------------------------------------
@@ -560,7 +579,7 @@ class Wizard(abc.ABC):
         return self._index == self.n_steps - 1
 
     # ----- actions ------------------------------------------------------------------------
-    def record(self, T_world_flange_m: Any) -> StepInfo:
+    def record(self, T_world_flange_m: npt.ArrayLike) -> StepInfo:
         """Store the flange pose (4x4, metres, WORLD) for the current step; overwrite any earlier.
 
         Returns:
@@ -577,7 +596,7 @@ class Wizard(abc.ABC):
         self._poses[self._index] = RecordedPose(T, utc_now_iso())
         return self.step
 
-    def prefill(self, poses_m: Sequence[Any]) -> StepInfo:
+    def prefill(self, poses_m: Sequence[npt.ArrayLike]) -> StepInfo:
         """Record ``poses_m`` (4x4 flange poses in WORLD, metres) as the first steps of a wizard
         just started, then stand on the first step left to record (the last step when all are).
         Every pose is checked before any is stored.
@@ -697,7 +716,7 @@ class Wizard(abc.ABC):
         return self.result
 
     # ----- serialisation (resume, session record) -----------------------------------------
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, object]:
         """JSON-ready state: kind, options, recorded poses (metres), step, status."""
         status = self._status
         if status == "cancelled":
@@ -713,7 +732,7 @@ class Wizard(abc.ABC):
         }
 
     @classmethod
-    def from_dict(cls, d: Mapping[str, Any]) -> "Wizard":
+    def from_dict(cls, d: JsonRecord) -> "Wizard":
         """Rebuild a wizard from ``to_dict`` output; a complete wizard is recomputed with tcpcal.
 
         Called on the base class, dispatches on ``d["kind"]``.
@@ -730,7 +749,7 @@ class Wizard(abc.ABC):
         wiz._load_state(d)
         return wiz
 
-    def _load_state(self, d: Mapping[str, Any]) -> None:
+    def _load_state(self, d: JsonRecord) -> None:
         self._poses = {int(i): RecordedPose.from_dict(p) for i, p in d.get("poses", {}).items()}
         n = self.n_steps
         bad = [i for i in self._poses if not 0 <= i < n]

@@ -33,7 +33,7 @@ import datetime as _dt
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
-from typing import Any, ClassVar, Literal
+from typing import TYPE_CHECKING, ClassVar, Literal
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -43,6 +43,7 @@ from tcpcal.errors import TcpcalError
 from tcpcal.tool import Tool, abc_deg_from_rotation
 from tcpcal.validation import read_only_array
 
+from tcp_pendant.json_shapes import JsonRecord
 from tcp_pendant.wizards.base import (
     M_TO_MM,
     CalibrationFailedError,
@@ -58,6 +59,10 @@ from tcp_pendant.wizards.base import (
     mm3,
 )
 from tcp_pendant.wizards.describe import BY_CONTROLLER, StepRole, WizardOption, WizardStart
+
+if TYPE_CHECKING:
+    from tcp_pendant.controller.beam import BeamEvent
+    from tcp_pendant.controller.beam_scan import BeamScan
 
 __all__ = [
     "BeamWizard",
@@ -82,13 +87,13 @@ _MAX_TEXT = 200          # characters kept of a stored text (the record is untru
 _GRADES = ("good", "fair", "poor")
 
 
-def _vector(value: Any, what: str, *, limit: float) -> np.ndarray:
+def _vector(value: object, what: str, *, limit: float) -> np.ndarray:
     if not (isinstance(value, (list, tuple, np.ndarray)) and len(value) == 3):
         raise WizardError(f"The beam scan's {what} must be 3 numbers, got {value!r:.60}.")
     return np.array([finite_number(v, f"beam scan's {what}", low=-limit, high=limit) for v in value], dtype=float)
 
 
-def _rotation(value: Any, what: str) -> np.ndarray:
+def _rotation(value: object, what: str) -> np.ndarray:
     try:
         R = np.array(value, dtype=float)
     except (TypeError, ValueError):
@@ -124,20 +129,20 @@ class ScanEvent:
     orientation: int
 
     @classmethod
-    def of(cls, event: Any, orientation: int) -> "ScanEvent":
-        """From a ``controller.beam.BeamEvent`` (duck-typed: no controller import here)."""
+    def of(cls, event: BeamEvent, orientation: int) -> "ScanEvent":
+        """From a ``controller.beam.BeamEvent``, checked as a stored one."""
         return cls.from_dict({"kind": event.kind, "T_world_flange_m": np.asarray(event.T_world_flange).tolist(),
                               "beam": int(event.beam), "beam_point_m": list(np.asarray(event.beam_point, float)),
                               "beam_dir": list(np.asarray(event.beam_dir, float)),
                               "on_shaft": bool(event.on_shaft), "orientation": int(orientation)})
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, object]:
         return {"kind": self.kind, "T_world_flange_m": self.T_world_flange.tolist(), "beam": self.beam,
                 "beam_point_m": self.beam_point.tolist(), "beam_dir": self.beam_dir.tolist(),
                 "on_shaft": self.on_shaft, "orientation": self.orientation}
 
     @classmethod
-    def from_dict(cls, d: Any) -> "ScanEvent":
+    def from_dict(cls, d: object) -> "ScanEvent":
         """Inverse of :meth:`to_dict`, checked (kind, a rigid pose, a finite beam point within
         100 m, a nonzero direction, beam 0 or 1, orientation 0..99).
 
@@ -184,8 +189,8 @@ class RecordedScan:
     duration_s: float
     path_length_m: float
     skipped: tuple[str, ...] = ()
-    moves: tuple[Any, ...] = field(default=())
-    q_end_rad: Any = None
+    moves: tuple[object, ...] = field(default=())
+    q_end_rad: np.ndarray | None = None
 
     @property
     def orientation_index(self) -> tuple[int, ...]:
@@ -193,8 +198,8 @@ class RecordedScan:
         return tuple(e.orientation for e in self.events)
 
     @classmethod
-    def of(cls, scan: Any) -> "RecordedScan":
-        """From a ``controller.beam_scan.BeamScan`` (duck-typed), checked as a stored one."""
+    def of(cls, scan: BeamScan | RecordedScan) -> "RecordedScan":
+        """From a ``controller.beam_scan.BeamScan``, checked as a stored one."""
         if isinstance(scan, RecordedScan):
             return scan
         events = tuple(scan.events)
@@ -206,12 +211,12 @@ class RecordedScan:
                              "skipped": [str(s) for s in getattr(scan, "skipped", ())]})
         return out
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, object]:
         return {"events": [e.to_dict() for e in self.events], "duration_s": self.duration_s,
                 "path_length_m": self.path_length_m, "skipped": list(self.skipped)}
 
     @classmethod
-    def from_dict(cls, d: Any) -> "RecordedScan":
+    def from_dict(cls, d: object) -> "RecordedScan":
         """Inverse of :meth:`to_dict`, checked and bounded (at most :data:`MAX_SCAN_EVENTS`
         events, :data:`MAX_SKIPPED` reasons of at most 200 characters, finite times).
 
@@ -276,7 +281,7 @@ class ManualComparison:
     touches: int = 0
     auto_touches: int = 0
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, object]:
         """JSON-ready; the truth-derived figures under ``"truth"`` (an honest record drops it)."""
         truth = None
         if self.position_error_mm is not None:
@@ -287,7 +292,7 @@ class ManualComparison:
                 "truth": truth}
 
     @classmethod
-    def from_dict(cls, d: Any) -> "ManualComparison":
+    def from_dict(cls, d: object) -> "ManualComparison":
         """Inverse of :meth:`to_dict`, checked (texts cut to 200 characters, finite figures).
 
         Raises:
@@ -346,7 +351,7 @@ class BeamWizardResult(WizardResult):
         manual: the trainee's last manual calibration of the same tool, or None.
     """
 
-    scan: Any
+    scan: BeamScan | RecordedScan
     events: tuple[ScanEvent, ...]
     beam_result: BeamResult
     axis_result: BeamAxisResult | None
@@ -450,12 +455,12 @@ class BeamWizard(Wizard):
         self.n_orientations = int(n)
         self.scan_speed_mm_s = speed
         self._scan: RecordedScan | None = None
-        self._live_scan: Any = None
+        self._live_scan: BeamScan | RecordedScan | None = None
         self._R_base: np.ndarray | None = None
         self._manual: ManualComparison | None = None
 
     @classmethod
-    def start(cls, ctx: StartContext, options: Mapping[str, Any]) -> WizardStart:
+    def start(cls, ctx: StartContext, options: JsonRecord) -> WizardStart:
         """For the mounted tool (its truth grades the TCP and the tool direction)."""
         return WizardStart(cls(n_orientations=options.get("n_orientations", 4),
                                scan_speed_mm_s=options.get("scan_speed_mm_s", 50)),
@@ -502,7 +507,7 @@ class BeamWizard(Wizard):
     def manual(self) -> ManualComparison | None:
         return self._manual
 
-    def give_scan(self, scan: Any, *, R_flange_tool_base: Any,
+    def give_scan(self, scan: BeamScan | RecordedScan, *, R_flange_tool_base: np.ndarray,
                   manual: ManualComparison | None = None) -> None:
         """Hand in the scan the controller ran (a ``BeamScan`` or :class:`RecordedScan`).
 
@@ -535,7 +540,7 @@ class BeamWizard(Wizard):
         """0 before the scan, 0.5 with the scan handed in, 1 with the result."""
         return ((self._scan is not None) + (self._status == "complete")) / 2.0
 
-    def next(self) -> Any:
+    def next(self) -> StepInfo | WizardResult:
         """Finish (the only step); refused with words before a scan was handed in."""
         if self._status != "in_progress":
             raise WizardStateError(f"Next is not possible: the wizard is {self._status.replace('_', ' ')}.")
@@ -565,7 +570,7 @@ class BeamWizard(Wizard):
         super().clear_step()
         self._scan = self._live_scan = None
 
-    def back(self) -> Any:
+    def back(self) -> StepInfo:
         """From the result back to the scan step, forgetting the scan: Finish scans again (the
         scan is the controller's, nothing the trainee recorded is lost)."""
         was_complete = self._status == "complete"
@@ -643,20 +648,20 @@ class BeamWizard(Wizard):
                     calibration=self._calibration(res, res.figures))
 
     # ----- serialisation ------------------------------------------------------------------
-    def _params(self) -> dict[str, Any]:
+    def _params(self) -> dict[str, object]:
         return {"n_orientations": self.n_orientations, "scan_speed_mm_s": self.scan_speed_mm_s,
                 "scan": None if self._scan is None else self._scan.to_dict(),
                 "R_flange_tool_base": None if self._R_base is None else self._R_base.tolist(),
                 "manual": None if self._manual is None else self._manual.to_dict()}
 
     @classmethod
-    def _from_params(cls, params: Mapping[str, Any]) -> "BeamWizard":
+    def _from_params(cls, params: JsonRecord) -> "BeamWizard":
         if not isinstance(params, Mapping):
             raise WizardError("The beam wizard's stored params must be an object.")
         return cls(n_orientations=params.get("n_orientations", 4),
                    scan_speed_mm_s=params.get("scan_speed_mm_s", 50.0))
 
-    def _load_state(self, d: Mapping[str, Any]) -> None:
+    def _load_state(self, d: JsonRecord) -> None:
         """The stored scan is handed in before the base class finishes a complete wizard (a
         replay runs no robot); scan, planning orientation and manual comparison are checked."""
         params = d.get("params")

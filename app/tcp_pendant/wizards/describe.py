@@ -12,9 +12,10 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Literal, Protocol
+from typing import TYPE_CHECKING, Literal, Protocol
 
 if TYPE_CHECKING:
+    from tcp_pendant.controller.tools import ToolModel
     from tcp_pendant.wizards.base import Wizard
     from tcpcal.tool import Tool
 
@@ -116,8 +117,8 @@ class WizardOption:
     name: str
     label: str
     kind: Literal["int", "choice", "library_slot", "physical_tool"]
-    default: Any = None
-    choices: tuple[tuple[Any, str], ...] = ()
+    default: int | str | None = None
+    choices: tuple[tuple[object, str], ...] = ()
     minimum: int | None = None
     maximum: int | None = None
     hint: str = ""
@@ -127,7 +128,7 @@ class WizardOption:
         """The start needs a value (no default to fall back on)."""
         return self.kind in ("library_slot", "physical_tool")
 
-    def parse(self, value: Any) -> Any:
+    def parse(self, value: object) -> object:
         """``value`` checked against the option's kind and choices.
 
         Raises:
@@ -135,7 +136,7 @@ class WizardOption:
         """
         if self.kind in ("int", "library_slot"):
             try:
-                number = float(value)
+                number = float(value)  # type: ignore[arg-type]  # any value: what float() refuses is refused
             except (TypeError, ValueError):
                 raise OptionError(f"{self.label}: {value!r} is not a whole number.") from None
             if not math.isfinite(number) or number != int(number):
@@ -160,11 +161,11 @@ class StartContext(Protocol):
     """What a wizard class may read when it is started (the workflow provides it)."""
 
     @property
-    def tools(self) -> Mapping[str, Any]:
+    def tools(self) -> Mapping[str, ToolModel]:
         """Physical tools (``ToolModel``) by key."""
 
     @property
-    def mounted_tool(self) -> Any:
+    def mounted_tool(self) -> ToolModel:
         """The physical tool on the flange now (``ToolModel``)."""
 
     def library_tool(self, slot: int) -> "Tool":
@@ -184,5 +185,5 @@ class WizardStart:
     """
 
     wizard: "Wizard"
-    true_tool: Any = None
+    true_tool: "ToolModel | None" = None
     active_data: "tuple[Tool, int] | None" = None

@@ -7,13 +7,14 @@ Math: ``tcpcal.origin.solve_reference`` (REF-1), ``t_2 = R_2^T (r - f_2)`` with
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Any, ClassVar
+from typing import ClassVar
 
 import numpy as np
 
 from tcpcal.origin import solve_reference
 from tcpcal.tool import Tool
 
+from tcp_pendant.json_shapes import JsonRecord
 from tcp_pendant.wizards.base import StartContext, StepSpec, Wizard, WizardError, WizardResult, mm3
 from tcp_pendant.wizards.describe import TOUCH, StepRole, WizardOption, WizardStart
 
@@ -57,7 +58,7 @@ class ReferenceWizard(Wizard):
     needs_tool = "library"
 
     @classmethod
-    def start(cls, ctx: StartContext, options: Mapping[str, Any]) -> WizardStart:
+    def start(cls, ctx: StartContext, options: JsonRecord) -> WizardStart:
         """The reference tool's data from the library slot (made active: "mounted and active"
         for step 1); the new physical tool's truth grades the result."""
         ref = ctx.library_tool(options["slot"])
@@ -139,14 +140,14 @@ class ReferenceWizard(Wizard):
         res = self._require_result()
         return Tool(name=name, tcp_mm=res.tcp_mm, calibration=self._calibration(res, res.figures))
 
-    def _params(self) -> dict[str, Any]:
+    def _params(self) -> dict[str, object]:
         return {"reference_tool": self.reference_tool.to_dict(),
                 "reference_tool_key": self.reference_tool_key,
                 "new_tool_key": self.new_tool_key, "new_tool_label": self.new_tool_label,
                 "assumed_sigma_mm": self.assumed_sigma_mm}
 
     @classmethod
-    def _from_params(cls, params: Mapping[str, Any]) -> "ReferenceWizard":
+    def _from_params(cls, params: JsonRecord) -> "ReferenceWizard":
         return cls(Tool.from_dict(params["reference_tool"]),
                    reference_tool_key=params.get("reference_tool_key"),
                    new_tool_key=params.get("new_tool_key"),

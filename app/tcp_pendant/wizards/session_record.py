@@ -99,13 +99,20 @@ import stat
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from tcp_pendant.json_shapes import JsonRecord
 from tcp_pendant.wizards.base import Wizard, WizardError, check_pose_m, utc_now_iso
 from tcp_pendant.wizards.truth import TruthComparison, compare_with_truth
+
+if TYPE_CHECKING:
+    import numpy.typing as npt
+
+    from tcp_pendant.controller.controller import VirtualController
+    from tcp_pendant.controller.tools import ToolModel
 
 FORMAT = "tcp-pendant-session"
 VERSION = 2
@@ -191,18 +198,37 @@ class ReplayCheck:
     message: str
 
 
-def _pose_list(T: Any) -> list[list[float]]:
+class PendantTouch(Protocol):
+    """A touch captured on the pendant (``session.Touch``)."""
+
+    @property
+    def T_world_flange(self) -> np.ndarray:
+        """(4,4) flange pose in WORLD, metres."""
+
+    @property
+    def label(self) -> str: ...
+
+    @property
+    def joints_deg(self) -> tuple[float, ...]: ...
+
+
+TouchLike = PendantTouch | JsonRecord | tuple[np.ndarray, str]
+"""A touch as :func:`session_to_dict` takes it: the pendant's, a dict with ``T_world_flange_m``,
+``label`` (and ``joints_deg``), or ``(T_world_flange_m, label)``."""
+
+
+def _pose_list(T: object) -> list[list[float]]:
     return check_pose_m(T).tolist()
 
 
-def _touch_dict(touch: Any) -> dict[str, Any]:
+def _touch_dict(touch: TouchLike) -> dict[str, object]:
     if isinstance(touch, Mapping):
         T, label = touch["T_world_flange_m"], touch.get("label", "")
     elif isinstance(touch, tuple):
         T, label = touch
     else:  # tcp_pendant.session.Touch: T_world_flange (metres), label, joints_deg
         T, label = touch.T_world_flange, touch.label
-    out: dict[str, Any] = {"label": str(label), "T_world_flange_m": _pose_list(T)}
+    out: dict[str, object] = {"label": str(label), "T_world_flange_m": _pose_list(T)}
     joints = touch.get("joints_deg") if isinstance(touch, Mapping) else getattr(touch, "joints_deg", ())
     if joints:
         out["joints_deg"] = [float(v) for v in joints]
@@ -210,7 +236,7 @@ def _touch_dict(touch: Any) -> dict[str, Any]:
 
 
 def _run_dict(run: WizardRun | Wizard, honest: bool = False, record_id: int | None = None,
-              with_distances: bool = True) -> dict[str, Any]:
+              with_distances: bool = True) -> dict[str, object]:
     if isinstance(run, Wizard):
         run = WizardRun(run)
     out = _run_entry(run, honest, record_id)
@@ -224,7 +250,7 @@ def _run_dict(run: WizardRun | Wizard, honest: bool = False, record_id: int | No
     return out
 
 
-def run_entry(run: WizardRun, *, honest: bool = True, record_id: int | None = None) -> dict[str, Any]:
+def run_entry(run: WizardRun, *, honest: bool = True, record_id: int | None = None) -> dict[str, object]:
     """One wizard run as a session record's entry (``"state"``, ``"result"``, ``"true_tool"``,
     ``"truth"``, ``"record_id"``, and ``"joints_deg"`` / ``"distance_mm"`` of its recorded
     steps); ``honest``: no truth in it (the classroom keeps the truth apart, in the gradebook).
@@ -233,19 +259,19 @@ def run_entry(run: WizardRun, *, honest: bool = True, record_id: int | None = No
     return _run_dict(run, honest, record_id)
 
 
-def step_joints(entry: Mapping[str, Any]) -> dict[int, tuple[float, ...]]:
+def step_joints(entry: JsonRecord) -> dict[int, tuple[float, ...]]:
     """A checked record entry's ``"joints_deg"`` by 0-based step index ({} when absent)."""
     raw = entry.get("joints_deg") or {}
     return {int(k): tuple(float(v) for v in q) for k, q in raw.items()}
 
 
-def step_distances(entry: Mapping[str, Any]) -> dict[int, float]:
+def step_distances(entry: JsonRecord) -> dict[int, float]:
     """A checked record entry's ``"distance_mm"`` by 0-based step index ({} when absent)."""
     raw = entry.get("distance_mm") or {}
     return {int(k): float(v) for k, v in raw.items()}
 
 
-def _distance_map(value: Any) -> bool:
+def _distance_map(value: object) -> bool:
     """Step index ("0"..) -> finite distance >= 0 mm, at most :data:`MAX_POSES_PER_WIZARD` steps."""
     return isinstance(value, Mapping) and len(value) <= MAX_POSES_PER_WIZARD and all(
         isinstance(k, str) and k.isdigit() and len(k) <= 3
@@ -253,11 +279,11 @@ def _distance_map(value: Any) -> bool:
         for k, v in value.items())
 
 
-def _without_truth(state: dict[str, Any]) -> dict[str, Any]:
+def _without_truth(state: dict[str, object]) -> dict[str, object]:
     """A wizard state for an honest record: every ``"truth"`` key inside its params (where a
     wizard keeps figures derived from the hidden truth, e.g. the beam wizard's manual
     comparison) set to null."""
-    def strip(value: Any, depth: int = 0) -> Any:
+    def strip(value: object, depth: int = 0) -> object:
         if isinstance(value, Mapping) and depth < 8:
             return {k: (None if k == "truth" else strip(v, depth + 1)) for k, v in value.items()}
         return value
@@ -265,7 +291,7 @@ def _without_truth(state: dict[str, Any]) -> dict[str, Any]:
     return {**state, "params": strip(state.get("params", {}))}
 
 
-def _run_entry(run: WizardRun, honest: bool, record_id: int | None) -> dict[str, Any]:
+def _run_entry(run: WizardRun, honest: bool, record_id: int | None) -> dict[str, object]:
     wiz = run.wizard
     res = wiz.finished_result          # a finished wizard closed to resume later keeps its result
     truth = None
@@ -283,9 +309,10 @@ def _run_entry(run: WizardRun, honest: bool, record_id: int | None) -> dict[str,
 
 
 def session_to_dict(runs: Sequence[WizardRun | Wizard], *, robot: str, urdf: str | Path | None = None,
-                    T_world_base_m: Any = None, mounted_tool: Any = None,
-                    reference_tip_world_m: Any = None, touches: Sequence[Any] = (), honest: bool = False,
-                    record_ids: Mapping[int, int] | None = None, with_distances: bool = True) -> dict[str, Any]:
+                    T_world_base_m: npt.ArrayLike | None = None, mounted_tool: ToolModel | None = None,
+                    reference_tip_world_m: npt.ArrayLike | None = None, touches: Sequence[TouchLike] = (),
+                    honest: bool = False,
+                    record_ids: Mapping[int, int] | None = None, with_distances: bool = True) -> dict[str, object]:
     """The session as a JSON-ready dict (see the module docstring for the keys).
 
     Args:
@@ -327,10 +354,10 @@ def session_to_dict(runs: Sequence[WizardRun | Wizard], *, robot: str, urdf: str
     }
 
 
-def session_from_controller(controller: Any, runs: Sequence[WizardRun | Wizard], *, robot: str,
-                            touches: Sequence[Any] = (), honest: bool = False,
+def session_from_controller(controller: VirtualController, runs: Sequence[WizardRun | Wizard], *, robot: str,
+                            touches: Sequence[TouchLike] = (), honest: bool = False,
                             record_ids: Mapping[int, int] | None = None,
-                            with_distances: bool = True) -> dict[str, Any]:
+                            with_distances: bool = True) -> dict[str, object]:
     """``session_to_dict`` filled from a ``VirtualController`` (base, tool, reference tip, URDF;
     ``honest``, ``record_ids`` and ``with_distances`` as there)."""
     kin = getattr(controller, "kinematics", None)
@@ -341,12 +368,12 @@ def session_from_controller(controller: Any, runs: Sequence[WizardRun | Wizard],
                            honest=honest, record_ids=record_ids, with_distances=with_distances)
 
 
-def dumps(record: Mapping[str, Any]) -> str:
+def dumps(record: JsonRecord) -> str:
     """The record as JSON text (floats written exactly, so a replay reproduces the numbers)."""
     return json.dumps(record, indent=1, allow_nan=False)
 
 
-def save_session(path: str | Path, record: Mapping[str, Any]) -> Path:
+def save_session(path: str | Path, record: JsonRecord) -> Path:
     """Write the record as JSON to ``path`` and return the path."""
     p = Path(path)
     p.write_text(dumps(record), encoding="utf-8")
@@ -391,13 +418,13 @@ def json_nesting_depth(data: bytes) -> int:
     return int(max(0, np.cumsum(step).max()))
 
 
-def _joint_list(value: Any) -> bool:
+def _joint_list(value: object) -> bool:
     """A list of at most :data:`MAX_JOINTS` finite numbers (a touch's joint values)."""
     return isinstance(value, list) and len(value) <= MAX_JOINTS and all(
         isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in value)
 
 
-def check_session_record(data: Any) -> dict[str, Any]:
+def check_session_record(data: object) -> JsonRecord:
     """Check a parsed record: header (``format``, ``version``), the types of ``wizards`` and
     ``touches`` and the count limits (:data:`MAX_WIZARDS`, :data:`MAX_POSES_PER_WIZARD`,
     :data:`MAX_TOUCHES`), which bound the cost of :func:`replay`. Returns a shallow copy.
@@ -463,7 +490,7 @@ def check_session_record(data: Any) -> dict[str, Any]:
     return data
 
 
-def parse_session_record(data: bytes) -> dict[str, Any]:
+def parse_session_record(data: bytes) -> JsonRecord:
     """Parse an uploaded (or read) record: bytes of UTF-8 JSON, nothing else (never a path).
 
     The limits are checked before the work they bound: the size on ``len(data)`` before
@@ -498,7 +525,7 @@ def parse_session_record(data: bytes) -> dict[str, Any]:
     return check_session_record(parsed)
 
 
-def read_session_file(path: Path) -> dict[str, Any]:
+def read_session_file(path: Path) -> JsonRecord:
     """Read a record from the server's disk (command line and server-side use only: nothing a
     browser sends reaches this). Only regular files are read (a FIFO or device is refused
     without blocking), at most :data:`MAX_RECORD_BYTES` + 1 bytes, then
@@ -538,11 +565,11 @@ class LoadedRecord:
         checks: one :class:`ReplayCheck` per wizard, in order.
     """
 
-    record: dict[str, Any]
+    record: JsonRecord
     checks: tuple[ReplayCheck, ...]
 
 
-def load_and_replay(source: bytes | str | Mapping[str, Any]) -> LoadedRecord:
+def load_and_replay(source: bytes | str | JsonRecord) -> LoadedRecord:
     """Parse (bytes, or ``str`` as JSON text: never a path) or check (a dict) a record, then
     :func:`replay` it. Pure: touches no session, so it can run in a worker thread.
 
@@ -562,7 +589,7 @@ def load_and_replay(source: bytes | str | Mapping[str, Any]) -> LoadedRecord:
     return LoadedRecord(data, replay(data))
 
 
-def replay(record: Mapping[str, Any]) -> tuple[ReplayCheck, ...]:
+def replay(record: JsonRecord) -> tuple[ReplayCheck, ...]:
     """Rebuild every wizard of a record, recompute with tcpcal, compare with the stored result.
 
     Raises:
@@ -583,7 +610,7 @@ def replay(record: Mapping[str, Any]) -> tuple[ReplayCheck, ...]:
     return tuple(checks)
 
 
-def _check_entry(i: int, entry: Mapping[str, Any], wiz: Wizard) -> ReplayCheck:
+def _check_entry(i: int, entry: JsonRecord, wiz: Wizard) -> ReplayCheck:
     """Compare one rebuilt wizard with its stored result and truth (see :func:`replay`)."""
     stored = entry.get("result")
     res = wiz.finished_result

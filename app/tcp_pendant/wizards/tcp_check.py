@@ -22,12 +22,13 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any, ClassVar, Literal
+from typing import TYPE_CHECKING, ClassVar, Literal
 
 import numpy as np
 
 from tcpcal.tool import Tool
 
+from tcp_pendant.json_shapes import JsonRecord
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.wizards.check_reading import CHECK_READING_MM, READING_NOTE, read_mm, reading_verdict
 from tcp_pendant.wizards.base import (
@@ -42,6 +43,9 @@ from tcp_pendant.wizards.base import (
     mm3,
 )
 from tcp_pendant.wizards.describe import TOUCH, StepRole, WizardOption, WizardStart
+
+if TYPE_CHECKING:
+    from tcp_pendant.controller.spin import SpinCheckResult
 
 __all__ = ["CheckFigures", "CheckRow", "GOOD_CHECK_MM", "TcpCheckResult", "TcpCheckWizard",
            "tcp_check_markdown"]
@@ -91,8 +95,8 @@ class CheckFigures:
         return CheckFigures(self.angle_deg, rows, None, None, None, read_to_mm=CHECK_READING_MM)
 
     @classmethod
-    def of(cls, spin: Any) -> "CheckFigures":
-        """From a ``controller.spin.SpinCheckResult`` (duck-typed: no controller import here)."""
+    def of(cls, spin: SpinCheckResult) -> "CheckFigures":
+        """From a ``controller.spin.SpinCheckResult``."""
         rows = tuple(CheckRow(str(r.label), bool(r.reached), str(r.message or (r.stopped_by or ""))[:_MAX_TEXT],
                               float(r.deviation_mm)) for r in spin.rotations)
         off = spin.implied_offset_flange_mm
@@ -128,8 +132,8 @@ class CheckFigures:
                     "limits, record again and check again.")
         return f"TCP good: implied error {err:.3f} mm (at most {GOOD_CHECK_MM:g} mm)."
 
-    def to_dict(self) -> dict[str, Any]:
-        d: dict[str, Any] = {
+    def to_dict(self) -> dict[str, object]:
+        d: dict[str, object] = {
             "angle_deg": self.angle_deg,
             "rows": [{"label": r.label, "reached": r.reached, "message": r.message,
                       "deviation_mm": r.deviation_mm} for r in self.rows],
@@ -141,7 +145,7 @@ class CheckFigures:
         return d
 
     @classmethod
-    def from_dict(cls, d: Any) -> "CheckFigures":
+    def from_dict(cls, d: object) -> "CheckFigures":
         """Inverse of :meth:`to_dict`, checked (a record is untrusted: at most 6 rows, finite
         numbers, messages cut to 200 characters).
 
@@ -226,7 +230,7 @@ class TcpCheckWizard(Wizard):
         self._checked_pose: RecordedPose | None = None
 
     @classmethod
-    def start(cls, ctx: StartContext, options: Mapping[str, Any]) -> WizardStart:
+    def start(cls, ctx: StartContext, options: JsonRecord) -> WizardStart:
         """For the library tool in ``slot``, made active (the rotations turn about its TCP); no
         true tool: a check is not graded."""
         slot = int(options["slot"])
@@ -264,7 +268,7 @@ class TcpCheckWizard(Wizard):
         pose = self.recorded_pose
         return self._check if pose is not None and self._checked_pose is pose else None
 
-    def give_check(self, spin: Any, pose: RecordedPose | None = None) -> None:
+    def give_check(self, spin: SpinCheckResult | CheckFigures, pose: RecordedPose | None = None) -> None:
         """Hand in the check (a ``SpinCheckResult`` or :class:`CheckFigures`) run from the
         recorded touch ``pose`` (default: the current one).
 
@@ -301,17 +305,17 @@ class TcpCheckWizard(Wizard):
         raise WizardStateError("A TCP check saves nothing to the library: it only checks the tool data.")
 
     # ----- serialisation ------------------------------------------------------------------
-    def _params(self) -> dict[str, Any]:
+    def _params(self) -> dict[str, object]:
         check = self.check
         return {"tool": self.tool.to_dict(), "slot": self.slot, "angle_deg": self.angle_deg,
                 "check": None if check is None else check.to_dict()}
 
     @classmethod
-    def _from_params(cls, params: Mapping[str, Any]) -> "TcpCheckWizard":
+    def _from_params(cls, params: JsonRecord) -> "TcpCheckWizard":
         return cls(Tool.from_dict(params["tool"]), slot=params.get("slot"),
                    angle_deg=params.get("angle_deg", 30.0))
 
-    def _load_state(self, d: Mapping[str, Any]) -> None:
+    def _load_state(self, d: JsonRecord) -> None:
         """The stored check belongs to the stored touch: hand it in before the base class
         finishes a complete wizard (a replay runs no robot)."""
         params = d.get("params")

@@ -11,14 +11,16 @@ and go to tcpcal in millimetres, so every figure is in mm (angles in degrees).
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Any, ClassVar
+from typing import ClassVar
 
 import numpy as np
+import numpy.typing as npt
 
 from tcpcal.pose_quality import CandidateGain, candidate_gain
 from tcpcal.tcp_zx import solve_tcp_zx
 from tcpcal.tool import Tool
 
+from tcp_pendant.json_shapes import JsonRecord
 from tcp_pendant.wizards.base import (
     StartContext,
     StepSpec,
@@ -83,7 +85,7 @@ class TcpZxWizard(Wizard):
         self.assumed_sigma_mm = float(assumed_sigma_mm)
 
     @classmethod
-    def start(cls, ctx: StartContext, options: Mapping[str, Any]) -> WizardStart:
+    def start(cls, ctx: StartContext, options: JsonRecord) -> WizardStart:
         """For the mounted tool (its truth grades the TCP and the frame)."""
         return WizardStart(cls(n_points=options["n_points"]), true_tool=ctx.mounted_tool)
 
@@ -126,7 +128,7 @@ class TcpZxWizard(Wizard):
                 if roles[i] == "touch" and (i != self._index or self.is_complete)]
         return np.array(rots, dtype=float).reshape(-1, 3, 3)
 
-    def preview(self, T_world_flange_m: Any, *, min_angle_deg: float = 15.0) -> CandidateGain:
+    def preview(self, T_world_flange_m: npt.ArrayLike, *, min_angle_deg: float = 15.0) -> CandidateGain:
         """Predicted TCP uncertainty (mm) if the current pose were recorded as a touch
         (``tcpcal.candidate_gain`` against the other touches, operator error ``assumed_sigma_mm``)."""
         T = check_pose_m(T_world_flange_m, what="candidate flange pose")
@@ -163,10 +165,10 @@ class TcpZxWizard(Wizard):
                     calibration=self._calibration(res, res.figures))
 
     # ----- serialisation ------------------------------------------------------------------
-    def _params(self) -> dict[str, Any]:
+    def _params(self) -> dict[str, object]:
         return {"n_points": self._n_points, "assumed_sigma_mm": self.assumed_sigma_mm}
 
     @classmethod
-    def _from_params(cls, params: Mapping[str, Any]) -> "TcpZxWizard":
+    def _from_params(cls, params: JsonRecord) -> "TcpZxWizard":
         return cls(n_points=int(params.get("n_points", 4)),
                    assumed_sigma_mm=float(params.get("assumed_sigma_mm", 0.5)))

@@ -8,13 +8,14 @@ in metres and go to tcpcal in mm, so displacement lengths are in mm.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Any, ClassVar, Literal
+from typing import ClassVar, Literal
 
 import numpy as np
 
 from tcpcal.orientation import solve_three_point
 from tcpcal.tool import Tool
 
+from tcp_pendant.json_shapes import JsonRecord
 from tcp_pendant.wizards.base import (
     StepSpec,
     Wizard,
@@ -67,7 +68,7 @@ class ThreePointWizard(Wizard):
     needs_tool = "library"
 
     @classmethod
-    def start(cls, ctx: StartContext, options: Mapping[str, Any]) -> WizardStart:
+    def start(cls, ctx: StartContext, options: JsonRecord) -> WizardStart:
         """For the library tool in ``slot`` (its TCP must be calibrated); its data is made
         active so jogs along tool X/Y use it."""
         tool = ctx.library_tool(options["slot"])
@@ -88,18 +89,21 @@ class ThreePointWizard(Wizard):
         self._variant: Literal[1, 2] = variant
 
     @staticmethod
-    def _check_variant(variant: Any) -> None:
-        if variant not in (1, 2):
-            raise WizardError(f"The three-point variant is 1 or 2, got {variant!r}.")
+    def _check_variant(variant: object) -> Literal[1, 2]:
+        if variant == 1:
+            return 1
+        if variant == 2:
+            return 2
+        raise WizardError(f"The three-point variant is 1 or 2, got {variant!r}.")
 
     @property
     def variant(self) -> Literal[1, 2]:
         return self._variant
 
-    def set_variant(self, variant: Literal[1, 2]) -> None:
+    def set_variant(self, variant: int | str) -> None:
         """Choose variant 1 or 2. A step-3 pose recorded for variant 2 is dropped when switching
         to variant 1 (a point in the half-plane is not on the +Y axis); a finished wizard reopens."""
-        self._check_variant(variant)
+        variant = self._check_variant(variant)
         if self.status == "cancelled":
             raise WizardStateError("The wizard was cancelled; resume it first.")
         if variant == self._variant:
@@ -166,9 +170,9 @@ class ThreePointWizard(Wizard):
         return Tool(name=name, tcp_mm=res.tcp_mm, abc_deg=res.abc_deg, mass_kg=self.tool.mass_kg,
                     cog_mm=self.tool.cog_mm, notes=self.tool.notes, calibration=self._calibration(res, figures))
 
-    def _params(self) -> dict[str, Any]:
+    def _params(self) -> dict[str, object]:
         return {"tool": self.tool.to_dict(), "variant": self._variant}
 
     @classmethod
-    def _from_params(cls, params: Mapping[str, Any]) -> "ThreePointWizard":
+    def _from_params(cls, params: JsonRecord) -> "ThreePointWizard":
         return cls(Tool.from_dict(params["tool"]), variant=int(params.get("variant", 1)))  # type: ignore[arg-type]

@@ -20,9 +20,10 @@ the other figure is still reported.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Literal
+from typing import Literal
 
 import numpy as np
+import numpy.typing as npt
 from scipy.spatial.transform import Rotation
 
 from tcp_pendant.wizards.base import WizardError, WizardResult, check_pose_m
@@ -59,7 +60,7 @@ class TruthComparison:
     grade: Grade
     verdict: str
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, object]:
         return {"position_error_mm": self.position_error_mm,
                 "position_error_vector_mm": list(self.position_error_vector_mm),
                 "orientation_error_deg": self.orientation_error_deg,
@@ -87,7 +88,7 @@ NUMERICAL_NOISE_MM = 1e-6
 """Lengths below this are the solver's rounding, not a measurement (exact touches, sigma 0)."""
 
 
-def compare_with_truth(result: WizardResult, T_flange_tool_true_m: Any) -> TruthComparison:
+def compare_with_truth(result: WizardResult, T_flange_tool_true_m: npt.ArrayLike) -> TruthComparison:
     """Errors of ``result`` against the true TOOL frame (see the module docstring).
 
     Args:

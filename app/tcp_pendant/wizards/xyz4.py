@@ -8,16 +8,18 @@ in metres and are handed to tcpcal in millimetres, so every figure of the result
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass, field
-from typing import Any, ClassVar, Literal
+from dataclasses import dataclass, field, replace
+from typing import ClassVar, Literal, TypedDict
 
 import numpy as np
+import numpy.typing as npt
 
 from tcpcal.errors import TcpcalError
 from tcpcal.origin import TcpResult, solve_xyz4
 from tcpcal.pose_quality import CandidateGain, PoseQuality, assess_touches, candidate_gain
 from tcpcal.tool import Tool
 
+from tcp_pendant.json_shapes import JsonRecord
 from tcp_pendant.wizards.base import (
     StartContext,
     StepSpec,
@@ -43,6 +45,22 @@ RESIDUAL_CAVEAT = (
     "A small residual does not prove an accurate TCP: systematic errors (a bent tip, a "
     "reference that moved, a wrong robot model) hide in it. Check the TCP by rotating about it."
 )
+
+
+class EstimatorRow(TypedDict, total=False):
+    """One estimator's line of :meth:`Xyz4Result.comparison_rows` (figures in mm): ``error``
+    when it could not solve (``ok`` false), the figures when it could."""
+
+    estimator: str
+    label: str
+    ok: bool
+    error: str
+    tcp_mm: tuple[float, float, float]
+    mean_error_mm: float
+    max_error_mm: float
+    rms_error_mm: float
+    ci95_mm: float
+    chosen: bool
 
 
 @dataclass(frozen=True, eq=False, kw_only=True)
@@ -75,9 +93,9 @@ class Xyz4Result(WizardResult):
     estimators: Mapping[str, TcpResult] = field(default_factory=dict)
     estimator_errors: Mapping[str, str] = field(default_factory=dict)
 
-    def comparison_rows(self) -> list[dict[str, Any]]:
+    def comparison_rows(self) -> list[EstimatorRow]:
         """One row per estimator for the side-by-side table (mm), in ``ESTIMATORS`` order."""
-        rows: list[dict[str, Any]] = []
+        rows: list[EstimatorRow] = []
         for name in ESTIMATORS:
             res = self.estimators.get(name)
             if res is None:
@@ -126,7 +144,7 @@ class Xyz4Wizard(Wizard):
     diversity_meter = True
 
     @classmethod
-    def start(cls, ctx: StartContext, options: Mapping[str, Any]) -> WizardStart:
+    def start(cls, ctx: StartContext, options: JsonRecord) -> WizardStart:
         """A 4-point wizard for the mounted tool (its truth grades the result)."""
         return WizardStart(cls(n_points=options["n_points"], estimator=options["estimator"]),
                            true_tool=ctx.mounted_tool)
@@ -273,7 +291,7 @@ class Xyz4Wizard(Wizard):
         current step's own): what :meth:`preview` compares the candidate with."""
         return self._other_rotations()
 
-    def preview(self, T_world_flange_m: Any, *, min_angle_deg: float = 15.0) -> CandidateGain:
+    def preview(self, T_world_flange_m: npt.ArrayLike, *, min_angle_deg: float = 15.0) -> CandidateGain:
         """Predicted TCP uncertainty if the current pose were recorded (tcpcal.candidate_gain).
 
         Compares the candidate flange orientation with the touches recorded so far (except the
@@ -337,25 +355,22 @@ class Xyz4Wizard(Wizard):
     def to_tool(self, name: str) -> Tool:
         """The tool with the calibrated TCP; orientation from ``base_tool`` (or A = B = C = 0)."""
         res = self._require_result()
-        kw: dict[str, Any] = {}
-        abc = (0.0, 0.0, 0.0)
-        if self.base_tool is not None:
-            a, b, c = (float(v) for v in self.base_tool.abc_deg)
-            abc = (a, b, c)
-            kw = {"mass_kg": self.base_tool.mass_kg, "cog_mm": self.base_tool.cog_mm,
-                  "notes": self.base_tool.notes}
-        return Tool(name=name, tcp_mm=res.tcp_mm, abc_deg=abc,
-                    calibration=self._calibration(res, res.figures), **kw)
+        tool = Tool(name=name, tcp_mm=res.tcp_mm, calibration=self._calibration(res, res.figures))
+        if self.base_tool is None:
+            return tool
+        a, b, c = (float(v) for v in self.base_tool.abc_deg)
+        return replace(tool, abc_deg=(a, b, c), mass_kg=self.base_tool.mass_kg,
+                       cog_mm=self.base_tool.cog_mm, notes=self.base_tool.notes)
 
     # ----- serialisation ------------------------------------------------------------------
-    def _params(self) -> dict[str, Any]:
+    def _params(self) -> dict[str, object]:
         return {"n_points": self._n_points, "estimator": self._estimator,
                 "assumed_sigma_mm": self.assumed_sigma_mm,
                 "base_tool": None if self.base_tool is None else self.base_tool.to_dict(),
                 "excluded": list(self._excluded)}
 
     @classmethod
-    def _from_params(cls, params: Mapping[str, Any]) -> "Xyz4Wizard":
+    def _from_params(cls, params: JsonRecord) -> "Xyz4Wizard":
         base = params.get("base_tool")
         wiz = cls(n_points=int(params.get("n_points", 4)),
                   estimator=params.get("estimator", "lstsq"),
