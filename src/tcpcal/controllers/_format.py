@@ -104,6 +104,9 @@ class ControllerFormat:
         tool_file_extensions: extensions (lower case) of the files ``tools import`` reads.
         tool_file_detect: content found in this controller's tool files (``tools import
             --format auto`` tries the formats in ``rank`` order).
+        pose_layout: the name of another format whose POSES.csv layout this format's poses
+            are written in, when it has none of its own (Yaskawa: ``fanuc``, the same
+            convention).
     """
 
     name: str
@@ -136,6 +139,7 @@ class ControllerFormat:
     claim: re.Pattern[str] | None = None
     tool_file_extensions: tuple[str, ...] = ()
     tool_file_detect: re.Pattern[str] | None = None
+    pose_layout: str = ""
 
     # The names the file functions had before the registries were one (tests, callers).
     @property
