@@ -124,7 +124,8 @@ def test_a_toy_format_declared_in_one_place_is_offered_everywhere(
     assert _choices(["convert"], "from_fmt") == ("kuka", "abb", "fanuc", "ur", "toy", "matrix")
     assert _choices(["convert"], "to_fmt") == ("kuka", "abb", "fanuc", "ur", "toy", "matrix")
     assert "toy" in _choices(["tools", "export"], "fmt")
-    assert _choices(["poses", "import"], "fmt") == ("auto", "kuka", "abb", "fanuc", "ur", "toy")
+    assert _choices(["poses", "import"], "fmt") == ("auto", "kuka", "abb", "fanuc", "ur", "toy",
+                                                   "yaskawa")
     assert tuple(FORMATS) == ("kuka", "abb", "fanuc", "ur", "toy", "matrix")
     assert text_format("toy").label == "Toy (U, V, W)"  # the app's export list reads this
 

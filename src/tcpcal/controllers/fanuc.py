@@ -197,21 +197,26 @@ def _name(p: _Point) -> str:
 
 
 def parse_tool(text: str) -> list[ToolEntry]:
-    """The tool frames a TP program sets by ``PR[m]=P[k]`` and ``UTOOL[n]=PR[m]``."""
+    """The tool frames a TP program sets by ``PR[m]=P[k]`` and ``UTOOL[n]=PR[m]``; the
+    comments pendants add (``UTOOL[1:Vac]=PR[109:temp]``, ``PR[109:temp]=P[1:tip]``) are read
+    as the bare forms, a ``UTOOL`` comment as the tool's name."""
     points = {k: v for k, _, v, _, _, _ in _positions(text)}
     pr_from_p = {int(m.group(1)): int(m.group(2)) for m in
-                 re.finditer(r"PR\[\s*(\d+)\s*(?::[^\]]*)?\]\s*=\s*P\[\s*(\d+)\s*\]", text)}
+                 re.finditer(r"PR\[\s*(\d+)\s*(?::[^\]]*)?\]\s*=\s*P\[\s*(\d+)\s*(?::[^\]]*)?\]",
+                             text)}
     out: list[ToolEntry] = []
-    for m in re.finditer(r"UTOOL\[\s*(\d+)\s*\]\s*=\s*PR\[\s*(\d+)\s*(?::[^\]]*)?\]", text):
-        n, reg = int(m.group(1)), int(m.group(2))
+    for m in re.finditer(r"UTOOL\[\s*(\d+)\s*(?::([^\]]*))?\]\s*=\s*PR\[\s*(\d+)\s*(?::[^\]]*)?\]",
+                         text):
+        n, reg = int(m.group(1)), int(m.group(3))
         k = pr_from_p.get(reg)
         if k is None or k not in points:
             raise ControllerFileError(f"fanuc: UTOOL[{n}]=PR[{reg}] but the program does not "
                                       f"set PR[{reg}] from a P[] of its /POS section")
         v = points[k]
         name = re.search(rf"!tcpcal UTOOL\[{n}\] ([^;]*);", text)
+        label = name.group(1).strip() if name else (m.group(2) or "").strip()
         rot = Rotation.from_euler("xyz", [v["W"], v["P"], v["R"]], degrees=True).as_matrix()
-        out.append(ToolEntry(n, name.group(1).strip() if name else "",
+        out.append(ToolEntry(n, label,
                              (v["X"], v["Y"], v["Z"]), rot))
     if not out:
         raise ControllerFileError("fanuc: no 'UTOOL[n]=PR[m]' line found")
@@ -367,7 +372,8 @@ FORMAT = ControllerFormat(
     parse_poses=parse_poses, render_poses=render_poses, pose_extensions=(".ls",),
     detect=re.compile(r"^/POS\b", re.M), detect_text="FANUC /POS",
     pose_warnings=pose_warnings, parse_joint_points=parse_joint_points, claim=_ORDERFIL,
-    tool_file_extensions=(".ls",), tool_file_detect=re.compile(r"\bUTOOL\[\s*\d+\s*\]\s*=\s*PR\["),
+    tool_file_extensions=(".ls",),
+    tool_file_detect=re.compile(r"\bUTOOL\[\s*\d+\s*(?::[^\]]*)?\]\s*=\s*PR\["),
     csv=CsvLayout("fanuc", ("w", "p", "r"), "FANUC W,P,R in deg", _csv_rotations, decimals=6,
                   rank=20),
 )
