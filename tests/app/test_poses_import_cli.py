@@ -142,3 +142,32 @@ def test_an_unknown_robot_is_one_error_line(capsys: pytest.CaptureFixture[str]) 
     assert main(["poses", "import", str(DATA / "touches.mod"), "--robot", "nope"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "Unknown robot 'nope'" in err
+
+
+REAL = DATA / "real"
+
+
+def test_yaskawa_pulse_positions_become_flange_poses_with_pulses_per_degree(
+        capsys: pytest.CaptureFixture[str]) -> None:
+    """R1_PRESS.JBI (a GP25's job, README of the real files): PULSE counts / pulses per degree
+    are the axis values; the flange poses are the built-in gp12's at those values."""
+    from tcp_pendant.controller import RobotKinematics
+    from tcp_pendant.serve.server import resolve_robot
+
+    ppd = [1000.0, -1200.0, 900.0, 600.0, 700.0, 400.0]
+    job = REAL / "yaskawa_R1_PRESS_excerpt.JBI"
+    assert main(["poses", "import", str(job), "--robot", "gp12"]) == 2
+    assert "--pulses-per-degree" in capsys.readouterr().err
+    assert main(["poses", "import", str(job), "--robot", "gp12", "--package-path", "/nonexistent",
+                 "--pulses-per-degree", ",".join(map(str, ppd))]) == 0
+    out, err = capsys.readouterr()
+    got = rows(out)
+    assert [r["name"] for r in got] == ["C00000", "C00001", "P00007", "P00008", "P00030"]
+    assert "5 points in joint representation converted" in err
+    kin = RobotKinematics.from_urdf(resolve_robot("gp12"))
+    counts = [-111044, -86410, -81415, -4390, 7023, 2426]  # P00007
+    T = kin.T_world_flange(np.radians([c / f for c, f in zip(counts, ppd)]))
+    np.testing.assert_allclose([float(got[2][k]) for k in "xyz"], T[:3, 3] * 1000, atol=1e-4)
+    assert main(["poses", "import", str(job), "--robot", "gp12",
+                 "--pulses-per-degree", "1000,1000"]) == 2
+    assert "has 6 axes but --pulses-per-degree gives 2 numbers" in capsys.readouterr().err

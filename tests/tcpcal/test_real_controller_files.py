@@ -153,3 +153,35 @@ def test_yaskawa_pulse_only_job_is_refused_with_the_way_out() -> None:
     assert "5 positions in PULSE (encoder counts)" in message
     assert "tcp-pendant poses import FILE --robot" in message and "--pulses-per-degree" in message
     assert "RECTAN" in message
+
+
+# ------------------------------------------------------------------ rules without a real file yet
+# No public FANUC program with commented UTOOL/PR lines nor a PolyScope-exported UR script with
+# pose_trans offsets was found to store here (README): these check the reading rules on the
+# lines the issue quotes, not a controller's layout.
+def test_fanuc_utool_and_pr_comments_read_as_the_bare_forms() -> None:
+    pos = ("/POS\nP[1:\"tip\"]{\n   GP1:\n\tUF : 0, UT : 0,\t\tCONFIG : 'N U T, 0, 0, 0',\n"
+           "\tX =  1.5  mm,\tY =  -2.0  mm,\tZ =  180.25  mm,\n"
+           "\tW =  0.0 deg,\tP =  90.0 deg,\tR =  0.0 deg\n};\n/END\n")
+    text = ("/PROG  UT\n/MN\n   1:  PR[109:temp]=P[1:tip] ;\n   2:  UTOOL[1:Vac]=PR[109:temp] ;\n"
+            + pos)
+    (entry,) = parse_tool_file(text, "fanuc")
+    assert (entry.number, entry.name, entry.tcp_mm) == (1, "Vac", (1.5, -2.0, 180.25))
+    bare = text.replace("[109:temp]", "[109]").replace("[1:Vac]", "[1]")
+    assert parse_tool_file(bare, "fanuc")[0].tcp_mm == entry.tcp_mm
+
+
+def test_ur_relative_offsets_strings_and_line_labels_are_not_positions() -> None:
+    text = ('def prog():\n  $ 1 "Robot Program"\n  global Waypoint_1_p=p[.1, .2, .3, 0, 3.14, 0]\n'
+            '  $ 43 "movel(pose_trans(get_target_tcp_pose(), p[0.01,0,0,0,0,0]))"\n'
+            '  movel(pose_trans(get_target_tcp_pose(), p[0.01,0,0,0,0,0]), a=1.2)\n'
+            '  textmsg("p[1,2,3,4,5,6] # a string")\n  movel(pose_add(Waypoint_1_p, p[0,0,.02,0,0,0]))\n'
+            '  movel(pose_trans(p[.4, 0, .3, 0, 3.14, 0], p[0, 0, .05, 0, 0, 0]))\nend\n')
+    imported = import_poses(text, "ur")
+    assert [(p.name, p.position_mm) for p in imported.poses] == [
+        ("Waypoint_1_p", (100.0, 200.0, 300.0)), ("p2", (400.0, 0.0, 300.0)),
+        ("p3", (0.0, 0.0, 50.0))]
+    (offsets,) = [w for w in imported.warnings if "relative" in w]
+    assert offsets.startswith("2 poses used as relative offsets of the current pose: "
+                              "p[0.01,0,0,0,0,0] (line 5, pose_trans), p[0,0,.02,0,0,0] (line 7, "
+                              "pose_add)")
