@@ -221,7 +221,7 @@ def test_the_registry_holds_each_format_once_in_menu_order() -> None:
         ["kuka", "abb", "fanuc", "ur", "matrix", "yaskawa"]
     assert tuple(FORMATS) == ("kuka", "abb", "fanuc", "ur", "matrix")
     assert list(controllers.CONTROLLER_FORMATS) == ["kuka", "abb", "fanuc", "ur", "yaskawa"]
-    assert tuple(controllers.POSE_FORMATS) == ("kuka", "abb", "fanuc", "ur")
+    assert tuple(controllers.POSE_FORMATS) == ("kuka", "abb", "fanuc", "ur", "yaskawa")
     assert [text_format(f).label for f in FORMATS] == ["KUKA", "ABB", "FANUC", "UR", "Matrix"]
     assert {n: lay.columns for n, lay in controllers.csv_layouts().items()} == {
         "kuka": ("a", "b", "c"), "fanuc": ("w", "p", "r"), "abb": ("qw", "qx", "qy", "qz"),

@@ -342,8 +342,7 @@ class Xyz4Wizard(Wizard):
         if self.base_tool is not None:
             a, b, c = (float(v) for v in self.base_tool.abc_deg)
             abc = (a, b, c)
-            kw = {"mass_kg": self.base_tool.mass_kg, "cog_mm": self.base_tool.cog_mm,
-                  "notes": self.base_tool.notes}
+            kw = {**self.base_tool.load_fields(), "notes": self.base_tool.notes}
         return Tool(name=name, tcp_mm=res.tcp_mm, abc_deg=abc,
                     calibration=self._calibration(res, res.figures), **kw)
 

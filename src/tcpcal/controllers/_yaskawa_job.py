@@ -32,14 +32,16 @@ docs/formats.md cites the public jobs this layout is taken from.
 from __future__ import annotations
 
 import re
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 from scipy.spatial.transform import Rotation
 
-from tcpcal.controllers._common import ControllerFileError, RecordedPose, to_float
+from tcpcal.controllers._common import ControllerFileError, RecordedPose, fixed, to_float
+from tcpcal.tool import abc_deg_from_rotation
 
 __all__ = ["PULSE_SKIPPED", "PulsePoint", "job_warnings", "parse_job_poses",
-           "parse_pulse_points", "pulse_refusal"]
+           "parse_pulse_points", "pulse_refusal", "render_job"]
 
 _POSITION = re.compile(r"^(C|P)(\d+)\s*=\s*(.*)$")
 _OFFSET_USE = re.compile(r"^\s*(?:ADD|SUB)\s+P(\d+)\s+P(\d+)\b|^\s*SFTON\s+P(\d+)\b", re.M)
@@ -187,3 +189,16 @@ def job_warnings(text: str) -> list[str]:
         out.append(f"skipped {', '.join(job.other)}: tcpcal reads RECTAN positions in the "
                    "ROBOT, BASE or USER frame")
     return out
+
+
+def render_job(poses: Sequence[RecordedPose], name: str = "TOUCHES") -> str:
+    """A job declaring each pose as ``P0000k`` RECTAN in the ROBOT frame with tool 0 (the
+    flange), mm 3 decimals and deg 4, as the public jobs write them (tests, examples)."""
+    lines = ["/JOB", f"//NAME {name}", "//POS", f"///NPOS 0,0,0,{len(poses)},0,0", "///TOOL 0",
+             "///POSTYPE ROBOT", "///RECTAN", "///RCONF 0,0,0,0,0,0,0,0"]
+    for k, p in enumerate(poses, 1):
+        rz, ry, rx = abc_deg_from_rotation(p.rotation)
+        values = [fixed(v, 3) for v in p.position_mm] + [fixed(v, 4) for v in (rx, ry, rz)]
+        lines.append(f"P{k:05d}={','.join(values)}")
+    lines += ["//INST", "///ATTR SC,RW", "///GROUP1 RB1", "NOP", "END"]
+    return "\n".join(lines) + "\n"

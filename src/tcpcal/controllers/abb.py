@@ -434,15 +434,17 @@ def text_identifier(name: str) -> str:
 
 
 def render_text(tool: Tool, slot: int = 1) -> str:
-    """``PERS tooldata <identifier>:=[TRUE,[[x,y,z],[q1,q2,q3,q4]],[mass,[0,0,0.001],
-    [1,0,0,0],0,0,0]];`` on one line (mm; ``q1 >= 0``; unknown mass as tool0's 0.001 kg;
+    """``PERS tooldata <identifier>:=[TRUE,[[x,y,z],[q1,q2,q3,q4]],[mass,[cx,cy,cz],
+    [aom q1..q4],ix,iy,iz]];`` on one line (mm; ``q1 >= 0``; an unknown load as tool0's
+    ``[0.001,[0,0,0.001],[1,0,0,0],0,0,0]``, an unknown part of a known one as those defaults;
     ``slot`` is not written)."""
     q1234 = _quaternion(tool.rotation)
     known = tool.mass_kg is not None
     mass = DEFAULT_MASS_KG if tool.mass_kg is None else tool.mass_kg
     cog = _DEFAULT_COG if tool.cog_mm is None or not known else tool.cog_mm
-    aom = ([1, 0, 0, 0] if not known or tool.load_abc_deg is None or not any(tool.load_abc_deg)
-           else list(_quaternion(rotation_from_abc_deg(tool.load_abc_deg))))
+    aom = ("1,0,0,0" if not known or tool.load_abc_deg is None or not any(tool.load_abc_deg)
+           else ",".join(text_number(x, True)
+                         for x in _quaternion(rotation_from_abc_deg(tool.load_abc_deg))))
     inertia = (0, 0, 0) if not known or tool.inertia_kgm2 is None else tool.inertia_kgm2
 
     def lst(v: Iterable[float]) -> str:
@@ -453,7 +455,7 @@ def render_text(tool: Tool, slot: int = 1) -> str:
 
     return (
         f"PERS tooldata {text_identifier(tool.name)}:=[TRUE,[{lst(tool.tcp_mm)},{lst(q1234)}],"
-        f"[{text_number(mass, True)},{lst(cog)},[{bare(aom)}],{bare(inertia)}]];\n"
+        f"[{text_number(mass, True)},{lst(cog)},[{aom}],{bare(inertia)}]];\n"
     )
 
 
@@ -506,7 +508,8 @@ def _aggregate_numbers(v: Any, n: int, what: str) -> list[float]:
 
 def parse_text(text: str, name: str | None) -> Tool:
     """One ``tooldata`` declaration (``PERS``/``CONST``/``VAR``/``TASK PERS``) or the bare
-    aggregate; ``robhold`` FALSE is refused; tool0's load maps back to ``mass_kg=None``."""
+    aggregate; ``robhold`` FALSE is refused; tool0's load maps back to ``mass_kg=None``; a known
+    load keeps its centre of gravity, inertia axes (``aom``) and moments (all zero: unset)."""
     decls = _TEXT_DECL.findall(text)
     if len(decls) > 1:
         raise InvalidInputError(
