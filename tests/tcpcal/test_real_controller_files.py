@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
 
 from tcpcal.controllers import (
     ControllerFileError,
@@ -155,10 +156,26 @@ def test_yaskawa_pulse_only_job_is_refused_with_the_way_out() -> None:
     assert "RECTAN" in message
 
 
+# ------------------------------------------------------------------ FANUC tool frame program
+def test_fanuc_commented_utool_from_a_register_set_element_by_element(tmp_path: Path) -> None:
+    """``PR[16]=LPOS``, ``PR[16,1]=(-.4)`` .. ``PR[16,6]=(-90)``, ``UTOOL[1:SSW]=PR[16]``."""
+    text = read("fanuc_tooldataub10200rbt01_excerpt.ls")
+    (entry,) = parse_tool_file(text, "fanuc")
+    assert (entry.number, entry.name, entry.tcp_mm) == (1, "SSW", (-0.4, -1100.3, 770.299))
+    wpr = Rotation.from_matrix(entry.rotation).as_euler("xyz", degrees=True)
+    np.testing.assert_allclose(wpr, (180.0, 0.0, -90.0), atol=1e-9)
+    library = ToolLibrary(tmp_path / "tools.json")
+    result = import_tool_file(library, text, filename="tooldataub10200rbt01.ls")
+    assert result.format == "fanuc" and [s for s, _ in result.stored] == [1]
+    cut = text.replace("   7:  PR[16,6]=(-90)    ;\n", "")
+    with pytest.raises(ControllerFileError, match=r"does not set PR\[16\] before it"):
+        parse_tool_file(cut, "fanuc")
+
+
 # ------------------------------------------------------------------ rules without a real file yet
-# No public FANUC program with commented UTOOL/PR lines nor a PolyScope-exported UR script with
-# pose_trans offsets was found to store here (README): these check the reading rules on the
-# lines the issue quotes, not a controller's layout.
+# No public FANUC program with a commented PR register in UTOOL[n:c]=PR[m:c], nor a
+# PolyScope-exported UR script with pose_trans offsets, was found to store here (README): these
+# check the reading rules on the lines the issue quotes, not a controller's layout.
 def test_fanuc_utool_and_pr_comments_read_as_the_bare_forms() -> None:
     pos = ("/POS\nP[1:\"tip\"]{\n   GP1:\n\tUF : 0, UT : 0,\t\tCONFIG : 'N U T, 0, 0, 0',\n"
            "\tX =  1.5  mm,\tY =  -2.0  mm,\tZ =  180.25  mm,\n"
