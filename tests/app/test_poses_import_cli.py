@@ -148,7 +148,7 @@ REAL = DATA / "real"
 
 
 def test_yaskawa_pulse_positions_become_flange_poses_with_pulses_per_degree(
-        capsys: pytest.CaptureFixture[str]) -> None:
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """R1_PRESS.JBI (a GP25's job, README of the real files): PULSE counts / pulses per degree
     are the axis values; the flange poses are the built-in gp12's at those values."""
     from tcp_pendant.controller import RobotKinematics
@@ -168,6 +168,11 @@ def test_yaskawa_pulse_positions_become_flange_poses_with_pulses_per_degree(
     counts = [-111044, -86410, -81415, -4390, 7023, 2426]  # P00007
     T = kin.T_world_flange(np.radians([c / f for c, f in zip(counts, ppd)]))
     np.testing.assert_allclose([float(got[2][k]) for k in "xyz"], T[:3, 3] * 1000, atol=1e-4)
+    factors = tmp_path / "robot.ppd"
+    factors.write_text("# S L U\n1000 -1200 900\n# R B T\n600\n700\n400\n")
+    assert main(["poses", "import", str(job), "--robot", "gp12",
+                 "--pulses-per-degree", str(factors)]) == 0
+    assert capsys.readouterr().out == out  # the same factors from a file
     assert main(["poses", "import", str(job), "--robot", "gp12",
                  "--pulses-per-degree", "1000,1000"]) == 2
     assert "has 6 axes but --pulses-per-degree gives 2 numbers" in capsys.readouterr().err

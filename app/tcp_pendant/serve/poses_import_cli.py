@@ -19,8 +19,9 @@ A Yaskawa job's PULSE positions (encoder counts, :class:`tcpcal.controllers.yask
 become joint points with ``--pulses-per-degree``: axis value (deg) = pulses / pulses per degree
 of that axis, one number per robot axis in the job's order (S, L, U, R, B, T[, E]), from the
 controller's parameters (the pulses of one axis revolution divided by 360; a negative number
-turns an axis whose positive direction is the URDF's opposite). Without it they are refused
-with this way out.
+turns an axis whose positive direction is the URDF's opposite), or the path of a text file
+holding those numbers (commas, spaces or one per line; ``#`` starts a comment). Without it they
+are refused with this way out.
 
 Units: the file's axis values are degrees for revolute joints and millimetres for prismatic
 ones (as the controllers write them), in the URDF's joint order; the CSV is mm and the format's
@@ -35,6 +36,7 @@ differs from the robot's (one line on stderr).
 from __future__ import annotations
 
 import argparse
+import re
 import sys
 from collections.abc import Sequence
 from dataclasses import replace
@@ -82,16 +84,25 @@ def build_parser() -> argparse.ArgumentParser:
                    help="a folder holding ROS packages (or a package itself), searched for "
                         "xacro's $(find pkg) before ROS_PACKAGE_PATH (repeatable)")
     p.add_argument("--pulses-per-degree", type=_pulses_per_degree, default=None,
-                   metavar="S,L,U,R,B,T",
+                   metavar="S,L,U,R,B,T|FILE",
                    help="Yaskawa PULSE positions: the encoder pulses per degree of each axis "
-                        "(controller parameters); the counts become axis values in degrees")
+                        "(controller parameters), or a text file holding them; the counts "
+                        "become axis values in degrees")
     p.add_argument("--output", type=Path, default=None, metavar="POSES.csv",
                    help="write the CSV to this file instead of stdout (an existing file is refused)")
     return p
 
 
 def _pulses_per_degree(text: str) -> tuple[float, ...]:
-    """``--pulses-per-degree``: comma-separated non-zero finite numbers."""
+    """``--pulses-per-degree``: comma-separated non-zero finite numbers, or the path of a text
+    file holding them (separated by commas, spaces or lines; ``#`` starts a comment)."""
+    path = Path(text).expanduser()
+    if not re.fullmatch(r"[-+0-9.,eE\s]*", text) and path.is_file():
+        try:
+            body = path.read_text(encoding="utf-8")
+        except (OSError, UnicodeDecodeError) as exc:
+            raise argparse.ArgumentTypeError(f"{text}: cannot read the file: {exc}") from None
+        text = ",".join(re.sub(r"#[^\n]*", "", body).replace(",", " ").split())
     try:
         values = tuple(float(v) for v in text.split(","))
     except ValueError:
