@@ -202,3 +202,12 @@ def test_ur_relative_offsets_strings_and_line_labels_are_not_positions() -> None
     assert offsets.startswith("2 poses used as relative offsets of the current pose: "
                               "p[0.01,0,0,0,0,0] (line 5, pose_trans), p[0,0,.02,0,0,0] (line 7, "
                               "pose_add)")
+
+
+def test_abb_an_unreadable_array_element_names_the_array_and_its_line() -> None:
+    text = read("abb_Rob1_MainModule_excerpt.mod")
+    broken = text.replace("[[-3,-4.5,1],", "[[-3,-4.5,x],", 1)
+    with pytest.raises(ControllerFileError,
+                       match=r"^abb: line 2: robtarget pWeldPosR1\{40\} cannot be read: could "
+                             r"not parse the values near 'x\]"):
+        import_poses(broken, filename="x.mod")

@@ -219,10 +219,11 @@ def _array_elements(text: str) -> list[tuple[str, int, int, list[Any]]]:
     for m in _ROBTARGET_ARRAY.finditer(code):
         line = line_of(text, m.start())
         try:
-            agg = _parse_aggregate(code, m.end() - 1)
+            agg = _parse_aggregate(code, m.end() - 1, "the values")
         except InvalidInputError as exc:
             raise ControllerFileError(f"abb: line {line}: robtarget {m.group(1)}{{{m.group(2)}}}"
-                                      f" cannot be read: {exc}") from None
+                                      f" cannot be read: {str(exc).removeprefix('abb: ')}"
+                                      ) from None
         if not isinstance(agg, list):
             continue
         out.extend((m.group(1), k, line, el) for k, el in enumerate(agg, 1))
@@ -459,8 +460,9 @@ def render_text(tool: Tool, slot: int = 1) -> str:
     )
 
 
-def _parse_aggregate(text: str, start: int) -> Any:
-    """Parse a RAPID aggregate ``[a,[b,c],...]`` beginning at ``text[start] == '['``."""
+def _parse_aggregate(text: str, start: int, what: str = "the tooldata") -> Any:
+    """Parse a RAPID aggregate ``[a,[b,c],...]`` beginning at ``text[start] == '['`` (``what``
+    names it in the error messages)."""
     pos = start
 
     def token() -> str:
@@ -468,7 +470,7 @@ def _parse_aggregate(text: str, start: int) -> Any:
         m = _TEXT_TOKEN.match(text, pos)
         if not m:
             snippet = text[pos:pos + 20].strip() or "end of text"
-            raise InvalidInputError(f"abb: could not parse the tooldata near {snippet!r}.")
+            raise InvalidInputError(f"abb: could not parse {what} near {snippet!r}.")
         pos = m.end()
         return m.group(1)
 
@@ -485,11 +487,11 @@ def _parse_aggregate(text: str, start: int) -> Any:
                     return items
                 if tok != ",":
                     raise InvalidInputError(
-                        f"abb: expected ',' or ']' in the tooldata, got {tok!r}."
+                        f"abb: expected ',' or ']' in {what}, got {tok!r}."
                     )
                 tok = token()
         if tok in ("]", ","):
-            raise InvalidInputError(f"abb: unexpected {tok!r} in the tooldata.")
+            raise InvalidInputError(f"abb: unexpected {tok!r} in {what}.")
         if tok.upper() in ("TRUE", "FALSE"):
             return tok.upper() == "TRUE"
         return text_float(tok, "abb", "value")
