@@ -13,8 +13,9 @@ rotation conversion goes through ``scipy.spatial.transform.Rotation``):
     ``R = Rz(A) Ry(B) Rx(C)`` = ``from_euler("ZYX", [A, B, C])``. A, B, C are written exactly as
     stored in the tool. Import accepts a surrounding declaration (``DECL FRAME TOOL_DATA[1]=...``),
     any whitespace, lower case, and reads ``TOOL_NAME[n,]`` of the same index if present and
-    ``LOAD_DATA[n]={M ...}`` for the mass (``M`` <= 0, e.g. KUKA's default -1, means unknown).
-    Export does not write ``LOAD_DATA`` (tcpcal knows no centre of mass).
+    ``LOAD_DATA[n]={M ..,CM {..},J {..}}`` for the load (``M`` <= 0, e.g. KUKA's default -1,
+    means none; docs/formats.md "Tool loads"). The text does not write ``LOAD_DATA`` (the
+    ``$config.dat`` file of ``tools export --file`` does).
 ``abb``
     A RAPID ``tooldata`` declaration::
 
@@ -70,7 +71,7 @@ Numbers are written with Python's shortest round-trip representation (``repr``),
 trip returns the same frame to better than 1e-9 (a real KUKA controller writes fewer digits;
 import accepts any). Values smaller than 1e-13 in magnitude (floating-point noise of the
 rotation conversions) are written as 0. Only the frame, the name and (ABB) the load travel
-through a format (KUKA: the mass, on import); notes and calibration records do not.
+through a format (KUKA: the load, on import); notes and calibration records do not.
 
 Where the code lives: each format is one module of :mod:`tcpcal.controllers` (``kuka.py``,
 ``abb.py``, ``fanuc.py``, ``ur.py``, ``matrix.py``) whose ``FORMAT`` declares its

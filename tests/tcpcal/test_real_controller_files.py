@@ -20,6 +20,7 @@ from tcpcal.controllers import (
     poses_csv_text,
 )
 from tcpcal.errors import InvalidInputError
+from tcpcal.formats import import_tool
 from tcpcal.library import ToolLibrary
 from tcpcal.tools_import import import_tool_file, plan_tool_import
 
@@ -111,6 +112,12 @@ def test_kuka_load_data_centre_of_mass_orientation_and_inertia_round_trip(tmp_pa
     (back,) = parse_tool_file(out, "kuka")
     assert back.load_abc_deg == spindle.load_abc_deg and back.inertia_kgm2 == (5.25,) * 3
     assert "LOAD_DATA" not in export_tool_file(screw, "kuka", number=2)
+    # the tool data text of the same tool (tcpcal convert / import_tool) reads the same load
+    lines = [ln for ln in text.splitlines()
+             if ln.startswith(("TOOL_DATA[1]=", "TOOL_NAME[1,]=", "LOAD_DATA[1]="))]
+    pasted = import_tool("\n".join(lines), "kuka")
+    assert (pasted.name, pasted.mass_kg, pasted.load_abc_deg, pasted.inertia_kgm2) == (
+        "Spindle", 40.317646, (-90.0085373, -0.080452, 88.8709488), (5.25, 5.25, 5.25))
 
 
 # ------------------------------------------------------------------ Yaskawa TOOL.CND and jobs

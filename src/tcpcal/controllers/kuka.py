@@ -136,8 +136,8 @@ def render_tool(tool: Tool, number: int, name: str | None = None) -> str:
 
 _Load = tuple[float | None, tuple[float, float, float] | None,
               tuple[float, float, float] | None, tuple[float, float, float] | None]
-_LOAD_CM = re.compile(rf"CM\s*\{{([^}}]*)\}}", re.IGNORECASE)
-_LOAD_J = re.compile(rf"\bJ\s*\{{([^}}]*)\}}", re.IGNORECASE)
+_LOAD_CM = re.compile(r"CM\s*\{([^}]*)\}", re.IGNORECASE)
+_LOAD_J = re.compile(r"\bJ\s*\{([^}]*)\}", re.IGNORECASE)
 
 
 def _load(text: str, n: int) -> _Load:
@@ -319,7 +319,8 @@ def render_text(tool: Tool, slot: int = 1) -> str:
 
 def parse_text(text: str, name: str | None) -> Tool:
     """One ``TOOL_DATA[n]`` (any surrounding declaration), its ``TOOL_NAME[n,]`` and
-    ``LOAD_DATA[n]={M ..}`` mass (``M <= 0``: unknown)."""
+    ``LOAD_DATA[n]={M ..,CM {..},J {..}}`` load (``M <= 0``: unknown; docs/formats.md "Tool
+    loads")."""
     matches = _DATA.findall(text)
     if not matches:
         raise InvalidInputError(
@@ -361,13 +362,17 @@ def parse_text(text: str, name: str | None) -> Tool:
     m = re.search(
         rf"LOAD_DATA\s*\[\s*{int(index)}\s*\]\s*=\s*\{{\s*M\s*({TEXT_NUM})", text, re.IGNORECASE
     )
+    load: dict[str, object] = {}
     if m:
         value = text_float(m.group(1), "kuka", "LOAD_DATA mass M")
         mass = value if value > 0 else None
+        if mass is not None:
+            _, cog, axes, inertia = _load(text, int(index))
+            load = {"cog_mm": cog, "load_abc_deg": axes, "inertia_kgm2": inertia}
     return make_tool(
         "kuka", name or found_name or f"tool{int(index)}", name is not None,
         tcp_mm=(values["X"], values["Y"], values["Z"]),
-        abc_deg=(values["A"], values["B"], values["C"]), mass_kg=mass,
+        abc_deg=(values["A"], values["B"], values["C"]), mass_kg=mass, **load,
     )
 
 
