@@ -206,6 +206,9 @@ def test_ur_relative_offsets_strings_and_line_labels_are_not_positions() -> None
         ("Waypoint_1_p", (100.0, 200.0, 300.0)), ("p2", (400.0, 0.0, 300.0)),
         ("p3", (0.0, 0.0, 50.0))]
     (offsets,) = [w for w in imported.warnings if "relative" in w]
+    assert not [w for w in imported.warnings if "TCP" in w]  # no set_tcp outside strings
+    labelled = text.replace('$ 1 "Robot Program"', '$ 1 "set_tcp(tcp)"')
+    assert not [w for w in import_poses(labelled, "ur").warnings if "TCP" in w]
     assert offsets.startswith("2 poses used as relative offsets of the current pose: "
                               "p[0.01,0,0,0,0,0] (line 5, pose_trans), p[0,0,.02,0,0,0] (line 7, "
                               "pose_add)")

@@ -254,7 +254,7 @@ def _pose_warnings(text: str) -> list[str]:
     try:
         tcps = parse_tool(text)
     except ControllerFileError:
-        sets = bool(re.search(r"set_tcp\s*\(", text))  # a TCP we cannot read: say so
+        sets = bool(re.search(r"set_tcp\s*\(", _code(text)))  # a TCP we cannot read: say so
     else:
         sets = any(max(map(abs, t.tcp_mm)) > 0 or abs(t.rotation.trace() - 3.0) > 1e-12
                    for t in tcps)
