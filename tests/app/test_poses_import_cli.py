@@ -176,3 +176,12 @@ def test_yaskawa_pulse_positions_become_flange_poses_with_pulses_per_degree(
     assert main(["poses", "import", str(job), "--robot", "gp12",
                  "--pulses-per-degree", "1000,1000"]) == 2
     assert "has 6 axes but --pulses-per-degree gives 2 numbers" in capsys.readouterr().err
+
+
+def test_pulses_per_degree_for_a_format_without_encoder_counts_is_one_error_line(
+        capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["poses", "import", str(REAL / "abb_Rob1_MainModule_excerpt.mod"), "--robot",
+                 "kr6", "--pulses-per-degree", "1,1,1,1,1,1"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].endswith(
+        "--pulses-per-degree: ABB files hold no positions in encoder counts; leave it out")

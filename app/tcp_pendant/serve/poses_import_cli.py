@@ -15,8 +15,9 @@ skipped: each becomes the flange pose ``T_world_flange(q)`` of the robot's forwa
 and FLANGE the ``--flange-link`` (default as ``tcp-pendant --robot``; ``--package-path`` finds
 a ROS description's packages, as the server's option does). Rows keep the file order.
 
-A Yaskawa job's PULSE positions (encoder counts, :class:`tcpcal.controllers.yaskawa.PulsePoint`)
-become joint points with ``--pulses-per-degree``: axis value (deg) = pulses / pulses per degree
+Positions in encoder counts (a Yaskawa job's PULSE positions,
+:class:`tcpcal.controllers.PulsePoint`, of a format with ``parse_pulse_points``) become joint
+points with ``--pulses-per-degree``: axis value (deg) = pulses / pulses per degree
 of that axis, one number per robot axis in the job's order (S, L, U, R, B, T[, E]), from the
 controller's parameters (the pulses of one axis revolution divided by 360; a negative number
 turns an axis whose positive direction is the URDF's opposite), or the path of a text file
@@ -47,16 +48,17 @@ import numpy as np
 
 from tcpcal.controllers import (
     POSE_FORMATS,
+    PULSE_SKIPPED,
     REGISTRY,
     ControllerFileError,
     JointPoint,
     PoseImport,
+    PulsePoint,
     RecordedPose,
     import_poses,
     detect_pose_format,
     poses_csv_text,
 )
-from tcpcal.controllers.yaskawa import PULSE_SKIPPED, PulsePoint, parse_pulse_points
 from tcpcal.errors import TcpcalError
 
 if TYPE_CHECKING:
@@ -132,14 +134,23 @@ def joint_points_of_pulses(points: Sequence[PulsePoint], pulses_per_degree: Sequ
 
 def _with_pulses(text: str, fmt: str, filename: str,
                  pulses_per_degree: Sequence[float]) -> PoseImport:
-    """``import_poses`` of a Yaskawa job with its PULSE positions as joint points."""
-    pulses = parse_pulse_points(text)
+    """``import_poses`` of a program with its positions in encoder counts as joint points.
+
+    Raises:
+        ControllerFileError: the format has no such positions, or the file is unreadable.
+        ValueError: a position whose axis count is not the number of factors.
+    """
+    parse = REGISTRY[fmt].parse_pulse_points
+    if parse is None:
+        raise ControllerFileError(f"--pulses-per-degree: {REGISTRY[fmt].label} files hold no "
+                                  "positions in encoder counts; leave it out")
+    pulses = parse(text)
     try:
         imported = import_poses(text, fmt, filename=filename)
     except ControllerFileError:
         if not pulses:
             raise
-        imported = PoseImport("yaskawa", (), ())
+        imported = PoseImport(fmt, (), ())
     warnings = tuple(w for w in imported.warnings if PULSE_SKIPPED not in w)
     joints = joint_points_of_pulses(pulses, pulses_per_degree)
     return replace(imported, warnings=warnings, joint_points=(*imported.joint_points, *joints))
@@ -204,7 +215,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         text = read_controller_text(args.file)
         fmt = detect_pose_format(text, args.file.name) if args.fmt == "auto" else args.fmt
-        if fmt == "yaskawa" and args.pulses_per_degree is not None:
+        if args.pulses_per_degree is not None:
             imported = _with_pulses(text, fmt, args.file.name, args.pulses_per_degree)
         else:
             imported = import_poses(text, fmt, filename=args.file.name)

@@ -21,8 +21,10 @@ from dataclasses import dataclass
 from typing import overload
 
 from tcpcal.controllers._common import (
+    PULSE_SKIPPED,
     ControllerFileError,
     JointPoint,
+    PulsePoint,
     RecordedPose,
     ToolEntry,
     fixed,
@@ -34,6 +36,7 @@ from tcpcal.tool import Tool
 __all__ = [
     "CONTROLLER_FORMATS",
     "POSE_FORMATS",
+    "PULSE_SKIPPED",
     "REGISTRY",
     "ROBOT_HINT",
     "ControllerFileError",
@@ -41,6 +44,7 @@ __all__ = [
     "CsvLayout",
     "JointPoint",
     "PoseImport",
+    "PulsePoint",
     "RecordedPose",
     "ToolEntry",
     "csv_layouts",

@@ -16,8 +16,8 @@ import numpy as np
 
 from tcpcal.errors import InvalidInputError
 
-__all__ = ["NUM", "ControllerFileError", "JointPoint", "RecordedPose", "ToolEntry", "fixed",
-           "inertia_or_none",
+__all__ = ["NUM", "PULSE_SKIPPED", "ControllerFileError", "JointPoint", "PulsePoint",
+           "RecordedPose", "ToolEntry", "fixed", "inertia_or_none",
            "line_of", "to_float"]
 
 NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
@@ -153,6 +153,30 @@ class JointPoint:
     tool: int | None = None
     base: int | None = None
     kind: str = ""
+
+
+PULSE_SKIPPED = "in PULSE (encoder counts)"
+"""Words of the warning and the refusal about positions in encoder counts (the app drops the
+warning once it converts them)."""
+
+
+@dataclass(frozen=True)
+class PulsePoint:
+    """A robot position a program holds in encoder counts (Yaskawa ``///PULSE``): an axis
+    angle is ``pulses / pulses_per_degree`` of that axis, a controller parameter tcpcal does not
+    know; the app's ``tcp-pendant poses import --pulses-per-degree`` converts them.
+
+    Attributes:
+        name: the position's name in the file (``C00000``, ``P00007``).
+        pulses: the counts of each robot axis, file order.
+        line: 1-based line in the file.
+        tool: the tool number it was taught with, if the file says.
+    """
+
+    name: str
+    pulses: tuple[int, ...]
+    line: int
+    tool: int | None = None
 
 
 def line_of(text: str, pos: int) -> int:

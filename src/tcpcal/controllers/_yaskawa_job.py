@@ -37,36 +37,22 @@ from dataclasses import dataclass
 
 from scipy.spatial.transform import Rotation
 
-from tcpcal.controllers._common import ControllerFileError, RecordedPose, fixed, to_float
+from tcpcal.controllers._common import (
+    PULSE_SKIPPED,
+    ControllerFileError,
+    PulsePoint,
+    RecordedPose,
+    fixed,
+    to_float,
+)
 from tcpcal.tool import abc_deg_from_rotation
 
-__all__ = ["PULSE_SKIPPED", "PulsePoint", "job_warnings", "parse_job_poses",
-           "parse_pulse_points", "pulse_refusal", "render_job"]
+__all__ = ["job_warnings", "parse_job_poses", "parse_pulse_points", "pulse_refusal",
+           "render_job"]
 
 _POSITION = re.compile(r"^(C|P)(\d+)\s*=\s*(.*)$")
 _OFFSET_USE = re.compile(r"^\s*(?:ADD|SUB)\s+P(\d+)\s+P(\d+)\b|^\s*SFTON\s+P(\d+)\b", re.M)
 _CARTESIAN = ("ROBOT", "BASE", "USER")
-PULSE_SKIPPED = "in PULSE (encoder counts)"
-"""Words of the warning about skipped PULSE positions (the app drops it once it converts them)."""
-
-
-@dataclass(frozen=True)
-class PulsePoint:
-    """A robot position a job holds in encoder counts (``///PULSE``).
-
-    Attributes:
-        name: the position's name in the job (``C00000``, ``P00007``).
-        pulses: the counts of each robot axis (S, L, U, R, B, T[, E]), file order.
-        line: 1-based line in the file.
-        tool: the ``///TOOL`` number it was taught with, if the job says.
-    """
-
-    name: str
-    pulses: tuple[int, ...]
-    line: int
-    tool: int | None = None
-
-
 @dataclass
 class _Job:
     rectan: list[RecordedPose]

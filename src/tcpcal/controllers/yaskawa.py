@@ -44,8 +44,6 @@ from tcpcal.controllers._common import (
 )
 from tcpcal.controllers._format import ControllerFormat
 from tcpcal.controllers._yaskawa_job import (
-    PULSE_SKIPPED,
-    PulsePoint,
     job_warnings,
     parse_job_poses,
     parse_pulse_points,
@@ -54,8 +52,8 @@ from tcpcal.controllers._yaskawa_job import (
 )
 from tcpcal.tool import Tool, abc_deg_from_rotation, rotation_from_abc_deg
 
-__all__ = ["FORMAT", "PULSE_SKIPPED", "PulsePoint", "job_warnings", "parse_job_poses",
-           "parse_pulse_points", "parse_tool", "pulse_refusal", "render_job", "render_tool"]
+__all__ = ["FORMAT", "job_warnings", "parse_job_poses", "parse_pulse_points", "parse_tool",
+           "pulse_refusal", "render_job", "render_tool"]
 
 N_TOOLS = 64
 TOOL_NUMBERS = range(0, N_TOOLS)
@@ -174,7 +172,7 @@ FORMAT = ControllerFormat(
     render_file=render_tool, parse_file=parse_tool,
     tool_file_extensions=(".cnd",), tool_file_detect=re.compile(r"^//TOOL\s+\d+", re.M),
     parse_poses=parse_job_poses, pose_warnings=job_warnings, pose_extensions=(".jbi",),
-    render_poses=render_job,
+    render_poses=render_job, parse_pulse_points=parse_pulse_points,
     claim=re.compile(r"^/JOB[ \t]*\r?\n//NAME[ \t]", re.M),
     detect=re.compile(r"^//POS[ \t]*\r?$", re.M), detect_text="Yaskawa //POS",
     pose_layout="fanuc",
