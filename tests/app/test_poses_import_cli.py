@@ -185,3 +185,31 @@ def test_pulses_per_degree_for_a_format_without_encoder_counts_is_one_error_line
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].endswith(
         "--pulses-per-degree: ABB files hold no positions in encoder counts; leave it out")
+
+
+def test_package_path_finds_the_packages_of_a_xacro_description(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    """A cell xacro outside any package that includes the acme7 macro (tests/support/
+    ros_layouts.py) by $(find acme_description): without ROS_PACKAGE_PATH only --package-path
+    finds it, as the server's option does."""
+    from support.ros_layouts import acme7_workspace
+    from tcp_pendant.controller import RobotKinematics
+
+    ws = acme7_workspace(tmp_path / "robot")
+    monkeypatch.delenv("ROS_PACKAGE_PATH", raising=False)
+    cell = tmp_path / "cell" / "cell.urdf.xacro"
+    cell.parent.mkdir()
+    cell.write_text(ws.xacro.read_text())
+    q = [10.0, -20.0, 15.0, 30.0, -25.0, 40.0, 5.0]
+    joints = ",\t".join(f"J{k}=  {v:.3f} deg" for k, v in enumerate(q, 1))
+    program = tmp_path / "seven.ls"
+    program.write_text(f"/PROG  SEVEN\n/MN\n   1:J P[1] 10% FINE ;\n/POS\nP[1]{{\n   GP1:\n"
+                       f"\tUF : 0, UT : 0,\n\t{joints}\n}};\n/END\n")
+    assert main(["poses", "import", str(program), "--robot", str(cell)]) == 2
+    assert "acme_description" in capsys.readouterr().err
+    assert main(["poses", "import", str(program), "--robot", str(cell),
+                 "--package-path", str(ws.ros_package_path)]) == 0
+    (row,) = rows(capsys.readouterr().out)
+    kin = RobotKinematics.from_urdf(ws.xacro)
+    T = kin.T_world_flange(np.radians(q))
+    np.testing.assert_allclose([float(row[k]) for k in "xyz"], T[:3, 3] * 1000.0, atol=1e-4)
