@@ -13,8 +13,9 @@ rotation conversion goes through ``scipy.spatial.transform.Rotation``):
     ``R = Rz(A) Ry(B) Rx(C)`` = ``from_euler("ZYX", [A, B, C])``. A, B, C are written exactly as
     stored in the tool. Import accepts a surrounding declaration (``DECL FRAME TOOL_DATA[1]=...``),
     any whitespace, lower case, and reads ``TOOL_NAME[n,]`` of the same index if present and
-    ``LOAD_DATA[n]={M ...}`` for the mass (``M`` <= 0, e.g. KUKA's default -1, means unknown).
-    Export does not write ``LOAD_DATA`` (tcpcal knows no centre of mass).
+    ``LOAD_DATA[n]={M ..,CM {..},J {..}}`` for the load (``M`` <= 0, e.g. KUKA's default -1,
+    means none; docs/formats.md "Tool loads"). The text does not write ``LOAD_DATA`` (the
+    ``$config.dat`` file of ``tools export --file`` does).
 ``abb``
     A RAPID ``tooldata`` declaration::
 
@@ -26,8 +27,10 @@ rotation conversion goes through ``scipy.spatial.transform.Rotation``):
     ``q1`` is the scalar part, written with ``q1 >= 0``. ABB requires a positive mass: the tool's
     ``mass_kg`` or, when unknown, :data:`ABB_DEFAULT_MASS_KG` = 0.001 kg with the centre of
     gravity ``[0, 0, 0.001]`` (the load of ABB's ``tool0``); import maps exactly that load back
-    to ``mass_kg=None``. The centre of gravity of a known mass is written as ``[0, 0, 0.001]``
-    too: identify the real load data on the controller before moving fast. The identifier is the
+    to ``mass_kg=None``. A known load is written as the tool holds it (``cog_mm``, the inertia
+    axes ``load_abc_deg`` as the ``aom`` quaternion, the moments ``inertia_kgm2``; an unknown
+    part as ``[0,0,0.001]``, ``[1,0,0,0]``, ``0,0,0``) and read back so (docs/formats.md "Tool
+    loads"): identify the real load data on the controller before moving fast. The identifier is the
     tool name with every character that is not an ASCII letter, digit or ``_`` replaced by ``_``
     (and a leading ``t`` if it does not start with a letter or is a RAPID reserved word such as
     ``IF`` or ``TRUE``): a tcpcal name (at most 24 characters) always gives a valid identifier of
@@ -67,8 +70,8 @@ rotation conversion goes through ``scipy.spatial.transform.Rotation``):
 Numbers are written with Python's shortest round-trip representation (``repr``), so a round
 trip returns the same frame to better than 1e-9 (a real KUKA controller writes fewer digits;
 import accepts any). Values smaller than 1e-13 in magnitude (floating-point noise of the
-rotation conversions) are written as 0. Only the frame, the name and (ABB) the mass travel
-through a format; notes and calibration records do not.
+rotation conversions) are written as 0. Only the frame, the name and (ABB) the load travel
+through a format (KUKA: the load, on import); notes and calibration records do not.
 
 Where the code lives: each format is one module of :mod:`tcpcal.controllers` (``kuka.py``,
 ``abb.py``, ``fanuc.py``, ``ur.py``, ``matrix.py``) whose ``FORMAT`` declares its

@@ -529,6 +529,11 @@ def format_tool(tool: Tool, *, slot: int | None = None, active: bool = False) ->
         lines.append(f"  Mass: {tool.mass_kg:g} kg")
     if tool.cog_mm is not None:
         lines.append(f"  Centre of gravity in FLANGE (mm): {_xyz(tool.cog_mm)}")
+    if tool.load_abc_deg is not None:
+        lines.append(f"  Load inertia axes KUKA (deg): {_abc(tool.load_abc_deg)}")
+    if tool.inertia_kgm2 is not None:
+        lines.append("  Moments of inertia (kg m^2): "
+                     + ", ".join(f"{v:g}" for v in tool.inertia_kgm2))
     if tool.notes:
         lines.append(f"  Notes: {tool.notes}")
     cal = tool.calibration

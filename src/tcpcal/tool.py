@@ -22,6 +22,12 @@ this, so scripts may rely on these keys; they are a stable contract)::
       "mass_kg": 2.5,                       # float > 0, or null when unknown
       "cog_mm": [0.0, 0.0, 80.0],           # optional: centre of gravity in FLANGE, mm
                                             #   (written only when known)
+      "load_abc_deg": [0.0, 0.0, 0.0],      # optional: KUKA A, B, C of R_flange_load, the
+                                            #   load's inertia axes at the centre of gravity,
+                                            #   degrees (written only when known)
+      "inertia_kgm2": [0.05, 0.05, 0.01],   # optional: moments of inertia about those axes
+                                            #   through the centre of gravity, kg m^2
+                                            #   (written only when known)
       "notes": "",                          # str
       "calibration": null | {
         "method": "xyz4-lstsq",             # e.g. "xyz4-lstsq", "reference", "three-point-1",
@@ -31,11 +37,12 @@ this, so scripts may rely on these keys; they are a stable contract)::
       }
     }
 
-``from_dict`` accepts missing optional keys (``abc_deg``, ``mass_kg``, ``cog_mm``, ``notes``,
-``calibration``) and rejects unknown keys, so a typo in a hand-edited file is reported instead
-of silently dropped. Every number must be finite (JSON has no NaN). ``cog_mm`` is written only
-for a tool that has one, so the file of a tool without it is the same as before the key
-existed.
+``from_dict`` accepts missing optional keys (``abc_deg``, ``mass_kg``, ``cog_mm``,
+``load_abc_deg``, ``inertia_kgm2``, ``notes``, ``calibration``) and rejects unknown keys, so a typo in a hand-edited file is reported instead
+of silently dropped. Every number must be finite (JSON has no NaN). ``cog_mm``,
+``load_abc_deg`` and ``inertia_kgm2`` are written only for a tool that has them, so the file of
+a tool without them is the same as before those keys existed. A load a controller file does not
+give stays unset (``null``/absent), never zero (docs/formats.md "Tool loads").
 """
 
 from __future__ import annotations
@@ -66,7 +73,8 @@ __all__ = [
 MAX_NAME_LENGTH: int = 24
 """Longest tool name, as on a KUKA controller (``TOOL_NAME[n, 24]``)."""
 
-_TOOL_KEYS = ("name", "tcp_mm", "abc_deg", "mass_kg", "cog_mm", "notes", "calibration")
+_TOOL_KEYS = ("name", "tcp_mm", "abc_deg", "mass_kg", "cog_mm", "load_abc_deg", "inertia_kgm2",
+              "notes", "calibration")
 _CALIBRATION_KEYS = ("method", "calibrated_at", "figures")
 
 
@@ -257,6 +265,12 @@ class Tool:
         mass_kg: tool mass in kg (> 0) or None when unknown.
         cog_mm: the tool's centre of gravity in FLANGE coordinates, mm (3 finite floats), or
             None when unknown (a controller's load data: Yaskawa ``TOOL.CND``, ABB ``tload``).
+        load_abc_deg: KUKA A, B, C (deg) of ``R_flange_load``, the axes of the load's moments of
+            inertia at the centre of gravity (ABB ``tload.aom``, KUKA ``LOAD_DATA`` CM A, B, C),
+            or None when unknown.
+        inertia_kgm2: the load's moments of inertia about those axes through the centre of
+            gravity, kg m^2 (each >= 0: ABB ``ix, iy, iz``, KUKA ``J``, Yaskawa ``Ix, Iy, Iz``),
+            or None when unknown.
         notes: free text.
         calibration: how and when it was calibrated, or None (e.g. typed in).
 
@@ -271,6 +285,8 @@ class Tool:
     notes: str = ""
     calibration: Calibration | None = None
     cog_mm: tuple[float, float, float] | None = None
+    load_abc_deg: tuple[float, float, float] | None = None
+    inertia_kgm2: tuple[float, float, float] | None = None
 
     def __post_init__(self) -> None:
         _check_name(self.name)
@@ -285,6 +301,14 @@ class Tool:
             object.__setattr__(self, "mass_kg", mass)
         if self.cog_mm is not None:
             object.__setattr__(self, "cog_mm", _triple(self.cog_mm, "cog_mm"))
+        if self.load_abc_deg is not None:
+            object.__setattr__(self, "load_abc_deg", _triple(self.load_abc_deg, "load_abc_deg"))
+        if self.inertia_kgm2 is not None:
+            inertia = _triple(self.inertia_kgm2, "inertia_kgm2")
+            if min(inertia) < 0.0:
+                raise InvalidInputError(
+                    f"inertia_kgm2 must be 3 moments of inertia >= 0 (kg m^2), got {inertia!r}.")
+            object.__setattr__(self, "inertia_kgm2", inertia)
         if not isinstance(self.notes, str):
             raise InvalidInputError(f"notes must be a string, got {self.notes!r}.")
         if self.calibration is not None and not isinstance(self.calibration, Calibration):
@@ -305,6 +329,12 @@ class Tool:
         T[:3, 3] = self.tcp_mm
         return T
 
+    def load_fields(self) -> dict[str, Any]:
+        """The tool's load as keyword arguments of :class:`Tool` (``mass_kg``, ``cog_mm``,
+        ``load_abc_deg``, ``inertia_kgm2``): what a new calibration of the tool keeps."""
+        return {"mass_kg": self.mass_kg, "cog_mm": self.cog_mm,
+                "load_abc_deg": self.load_abc_deg, "inertia_kgm2": self.inertia_kgm2}
+
     @classmethod
     def from_rotation(
         cls, name: str, tcp_mm: Any, rotation: Any, **kw: Any
@@ -316,7 +346,8 @@ class Tool:
             tcp_mm: TCP in FLANGE, mm.
             rotation: ``R_flange_tool``; checked with :func:`tcpcal.validation.as_rotation`
                 (orthonormal within 1e-6, det +1).
-            **kw: ``mass_kg``, ``cog_mm``, ``notes``, ``calibration``.
+            **kw: ``mass_kg``, ``cog_mm``, ``load_abc_deg``, ``inertia_kgm2``, ``notes``,
+                ``calibration``.
         """
         R = as_rotation(rotation, name="rotation")
         abc = abc_deg_from_rotation(R)
@@ -333,6 +364,10 @@ class Tool:
         }
         if self.cog_mm is not None:
             out["cog_mm"] = list(self.cog_mm)
+        if self.load_abc_deg is not None:
+            out["load_abc_deg"] = list(self.load_abc_deg)
+        if self.inertia_kgm2 is not None:
+            out["inertia_kgm2"] = list(self.inertia_kgm2)
         out["notes"] = self.notes
         out["calibration"] = None if self.calibration is None else self.calibration.to_dict()
         return out
@@ -362,6 +397,8 @@ class Tool:
             abc_deg=d.get("abc_deg", (0.0, 0.0, 0.0)),
             mass_kg=d.get("mass_kg"),
             cog_mm=d.get("cog_mm"),
+            load_abc_deg=d.get("load_abc_deg"),
+            inertia_kgm2=d.get("inertia_kgm2"),
             notes=d.get("notes", ""),
             calibration=None if cal is None else Calibration.from_dict(cal),
         )

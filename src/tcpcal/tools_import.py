@@ -12,8 +12,9 @@ The entries come from :func:`tcpcal.controllers.parse_tool_file` (docs/formats.m
   a name is stored as ``tool<n>`` (``<n>`` its tool number, or its place in the file).
 * Unused entries (no name, TCP and rotation zero, no load: the empty rows of a Yaskawa
   ``TOOL.CND``) are skipped and counted.
-* Mass and centre of gravity come along where the file has them (Yaskawa, ABB ``tload``, KUKA
-  ``LOAD_DATA``).
+* The load comes along where the file has it (Yaskawa ``TOOL.CND``, ABB ``tload``, KUKA
+  ``LOAD_DATA``): mass, centre of gravity, the orientation of its inertia axes and the moments
+  of inertia; a part the file does not give stays unset (docs/formats.md "Tool loads").
 * Nothing is written unless every entry can be stored: an occupied slot is refused (listing
   the slots) unless ``replace``; the names must stay unique in the library. The change is one
   locked library write (:meth:`tcpcal.library.ToolLibrary.save_many`).
@@ -130,8 +131,11 @@ def plan_tool_import(entries: list[ToolEntry], fmt: str, existing: dict[int, Too
 def _tool(e: ToolEntry, name: str, label: str, where: str, what: str) -> Tool:
     note = f"imported from {Path(where).name or 'a controller file'} ({label} {what})"
     try:
+        known = e.mass_kg is not None
         return Tool.from_rotation(name, e.tcp_mm, e.rotation, mass_kg=e.mass_kg,
-                                  cog_mm=e.cog_mm if e.mass_kg is not None else None, notes=note)
+                                  cog_mm=e.cog_mm if known else None,
+                                  load_abc_deg=e.load_abc_deg if known else None,
+                                  inertia_kgm2=e.inertia_kgm2 if known else None, notes=note)
     except TcpcalError as exc:
         raise InvalidInputError(f"{label} {what} {e.name!r} cannot be stored: "
                                 f"{' '.join(str(exc).split())} (rename it on the controller, "

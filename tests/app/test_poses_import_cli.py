@@ -142,3 +142,74 @@ def test_an_unknown_robot_is_one_error_line(capsys: pytest.CaptureFixture[str]) 
     assert main(["poses", "import", str(DATA / "touches.mod"), "--robot", "nope"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "Unknown robot 'nope'" in err
+
+
+REAL = DATA / "real"
+
+
+def test_yaskawa_pulse_positions_become_flange_poses_with_pulses_per_degree(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """R1_PRESS.JBI (a GP25's job, README of the real files): PULSE counts / pulses per degree
+    are the axis values; the flange poses are the built-in gp12's at those values."""
+    from tcp_pendant.controller import RobotKinematics
+    from tcp_pendant.serve.server import resolve_robot
+
+    ppd = [1000.0, -1200.0, 900.0, 600.0, 700.0, 400.0]
+    job = REAL / "yaskawa_R1_PRESS_excerpt.JBI"
+    assert main(["poses", "import", str(job), "--robot", "gp12"]) == 2
+    assert "--pulses-per-degree" in capsys.readouterr().err
+    assert main(["poses", "import", str(job), "--robot", "gp12", "--package-path", "/nonexistent",
+                 "--pulses-per-degree", ",".join(map(str, ppd))]) == 0
+    out, err = capsys.readouterr()
+    got = rows(out)
+    assert [r["name"] for r in got] == ["C00000", "C00001", "P00007", "P00008", "P00030"]
+    assert "5 points in joint representation converted" in err
+    kin = RobotKinematics.from_urdf(resolve_robot("gp12"))
+    counts = [-111044, -86410, -81415, -4390, 7023, 2426]  # P00007
+    T = kin.T_world_flange(np.radians([c / f for c, f in zip(counts, ppd)]))
+    np.testing.assert_allclose([float(got[2][k]) for k in "xyz"], T[:3, 3] * 1000, atol=1e-4)
+    factors = tmp_path / "robot.ppd"
+    factors.write_text("# S L U\n1000 -1200 900\n# R B T\n600\n700\n400\n")
+    assert main(["poses", "import", str(job), "--robot", "gp12",
+                 "--pulses-per-degree", str(factors)]) == 0
+    assert capsys.readouterr().out == out  # the same factors from a file
+    assert main(["poses", "import", str(job), "--robot", "gp12",
+                 "--pulses-per-degree", "1000,1000"]) == 2
+    assert "has 6 axes but --pulses-per-degree gives 2 numbers" in capsys.readouterr().err
+
+
+def test_pulses_per_degree_for_a_format_without_encoder_counts_is_one_error_line(
+        capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["poses", "import", str(REAL / "abb_Rob1_MainModule_excerpt.mod"), "--robot",
+                 "kr6", "--pulses-per-degree", "1,1,1,1,1,1"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].endswith(
+        "--pulses-per-degree: ABB files hold no positions in encoder counts; leave it out")
+
+
+def test_package_path_finds_the_packages_of_a_xacro_description(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    """A cell xacro outside any package that includes the acme7 macro (tests/support/
+    ros_layouts.py) by $(find acme_description): without ROS_PACKAGE_PATH only --package-path
+    finds it, as the server's option does."""
+    from support.ros_layouts import acme7_workspace
+    from tcp_pendant.controller import RobotKinematics
+
+    ws = acme7_workspace(tmp_path / "robot")
+    monkeypatch.delenv("ROS_PACKAGE_PATH", raising=False)
+    cell = tmp_path / "cell" / "cell.urdf.xacro"
+    cell.parent.mkdir()
+    cell.write_text(ws.xacro.read_text())
+    q = [10.0, -20.0, 15.0, 30.0, -25.0, 40.0, 5.0]
+    joints = ",\t".join(f"J{k}=  {v:.3f} deg" for k, v in enumerate(q, 1))
+    program = tmp_path / "seven.ls"
+    program.write_text(f"/PROG  SEVEN\n/MN\n   1:J P[1] 10% FINE ;\n/POS\nP[1]{{\n   GP1:\n"
+                       f"\tUF : 0, UT : 0,\n\t{joints}\n}};\n/END\n")
+    assert main(["poses", "import", str(program), "--robot", str(cell)]) == 2
+    assert "acme_description" in capsys.readouterr().err
+    assert main(["poses", "import", str(program), "--robot", str(cell),
+                 "--package-path", str(ws.ros_package_path)]) == 0
+    (row,) = rows(capsys.readouterr().out)
+    kin = RobotKinematics.from_urdf(ws.xacro)
+    T = kin.T_world_flange(np.radians(q))
+    np.testing.assert_allclose([float(row[k]) for k in "xyz"], T[:3, 3] * 1000.0, atol=1e-4)

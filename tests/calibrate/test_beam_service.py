@@ -29,7 +29,7 @@ from support.calib_helpers import make_controller
 def truth_tool(tool_key: str, name: str) -> Tool:
     """Tool data equal to a built-in tool's (unbent) hidden truth."""
     T = builtin_tools()[tool_key].T_flange_tool_true
-    return Tool.from_rotation(name, tuple(T[:3, 3] * 1000.0), T[:3, :3], mass_kg=1.5, cog_mm=(0, 0, 40), notes="shop 2",
+    return Tool.from_rotation(name, tuple(T[:3, 3] * 1000.0), T[:3, :3], mass_kg=1.5, cog_mm=(0, 0, 40), inertia_kgm2=(0.02, 0.02, 0.005), notes="shop 2",
                               calibration=Calibration("xyz4-lstsq", "2024-05-01T12:00:00+00:00", {"ci95_mm": 0.3}))
 
 
@@ -102,6 +102,7 @@ def test_the_whole_loop_crash_check_update_spin_test(library: ToolLibrary):
     assert np.allclose(reread.tcp_mm, check.measured_tcp_mm, atol=1e-9)
     assert reread.abc_deg == stored.abc_deg  # orientation kept
     assert (reread.name, reread.mass_kg, reread.cog_mm, reread.notes) == ("Torch 1", 1.5, (0, 0, 40), "shop 2")
+    assert reread.inertia_kgm2 == (0.02, 0.02, 0.005)
     cal = reread.calibration
     assert cal.method == "beam"
     assert cal.figures["deviation_mm"] == pytest.approx(check.deviation_norm_mm)

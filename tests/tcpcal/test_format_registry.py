@@ -124,7 +124,8 @@ def test_a_toy_format_declared_in_one_place_is_offered_everywhere(
     assert _choices(["convert"], "from_fmt") == ("kuka", "abb", "fanuc", "ur", "toy", "matrix")
     assert _choices(["convert"], "to_fmt") == ("kuka", "abb", "fanuc", "ur", "toy", "matrix")
     assert "toy" in _choices(["tools", "export"], "fmt")
-    assert _choices(["poses", "import"], "fmt") == ("auto", "kuka", "abb", "fanuc", "ur", "toy")
+    assert _choices(["poses", "import"], "fmt") == ("auto", "kuka", "abb", "fanuc", "ur", "toy",
+                                                   "yaskawa")
     assert tuple(FORMATS) == ("kuka", "abb", "fanuc", "ur", "toy", "matrix")
     assert text_format("toy").label == "Toy (U, V, W)"  # the app's export list reads this
 
@@ -220,7 +221,7 @@ def test_the_registry_holds_each_format_once_in_menu_order() -> None:
         ["kuka", "abb", "fanuc", "ur", "matrix", "yaskawa"]
     assert tuple(FORMATS) == ("kuka", "abb", "fanuc", "ur", "matrix")
     assert list(controllers.CONTROLLER_FORMATS) == ["kuka", "abb", "fanuc", "ur", "yaskawa"]
-    assert tuple(controllers.POSE_FORMATS) == ("kuka", "abb", "fanuc", "ur")
+    assert tuple(controllers.POSE_FORMATS) == ("kuka", "abb", "fanuc", "ur", "yaskawa")
     assert [text_format(f).label for f in FORMATS] == ["KUKA", "ABB", "FANUC", "UR", "Matrix"]
     assert {n: lay.columns for n, lay in controllers.csv_layouts().items()} == {
         "kuka": ("a", "b", "c"), "fanuc": ("w", "p", "r"), "abb": ("qw", "qx", "qy", "qz"),

@@ -22,7 +22,7 @@ from tcp_pendant.wizards import (
 def library_tool(synth_tool, name="tool", *, calibrated=True) -> Tool:
     cal = Calibration("xyz4-lstsq", "2026-01-01T00:00:00Z", {"ci95_mm": 0.3}) if calibrated else None
     return Tool(name=name, tcp_mm=tuple(synth_tool.tcp_mm), calibration=cal, mass_kg=2.0,
-                cog_mm=(1.0, 2.0, 50.0))
+                cog_mm=(1.0, 2.0, 50.0), inertia_kgm2=(0.04, 0.04, 0.01))
 
 
 def angle_deg(R1, R2) -> float:
@@ -92,6 +92,7 @@ def test_three_point_exact(synth, synth_tool, variant, third):
     np.testing.assert_allclose(t.tcp_mm, synth_tool.tcp_mm)
     assert angle_deg(t.rotation, synth_tool.R_flange_tool) < 1e-6
     assert (t.mass_kg, t.cog_mm) == (2.0, (1.0, 2.0, 50.0))  # the tool's load is kept
+    assert t.inertia_kgm2 == (0.04, 0.04, 0.01)
 
 
 def test_three_point_warns_on_short_displacement(synth):
@@ -135,6 +136,7 @@ def test_abc_world_6d_exact(synth, synth_tool):
     assert res.method == "abc-world-6d"
     assert wiz.to_tool("x").calibration.method == "abc-world-6d"
     assert (wiz.to_tool("x").mass_kg, wiz.to_tool("x").cog_mm) == (2.0, (1.0, 2.0, 50.0))
+    assert wiz.to_tool("x").inertia_kgm2 == (0.04, 0.04, 0.01)
 
 
 def test_abc_world_5d_fixes_tool_x_only(synth):

@@ -216,12 +216,13 @@ def test_invalid_poses_rejected():
 def test_to_tool_and_serialisation(synth):
     tool = synth.tools["gripper"]
     base = Tool(name="old gripper", tcp_mm=(0.0, 0.0, 100.0), abc_deg=(10.0, 20.0, 30.0), mass_kg=1.2,
-                cog_mm=(0.0, 5.0, 60.0))
+                cog_mm=(0.0, 5.0, 60.0), load_abc_deg=(0.0, 90.0, 0.0), inertia_kgm2=(0.01, 0.02, 0.03))
     wiz = Xyz4Wizard(base_tool=base)
     res = run_xyz4(wiz, synth, tool, synth.directions[:5])
     t = wiz.to_tool("gripper 1")
     assert isinstance(t, Tool) and t.name == "gripper 1" and t.mass_kg == 1.2
     assert t.cog_mm == (0.0, 5.0, 60.0)  # the load is the tool's, not the calibration's
+    assert (t.load_abc_deg, t.inertia_kgm2) == ((0.0, 90.0, 0.0), (0.01, 0.02, 0.03))
     np.testing.assert_allclose(t.tcp_mm, tool.tcp_mm, atol=1e-6)
     assert t.abc_deg == pytest.approx((10.0, 20.0, 30.0))
     assert t.calibration.method == "xyz4-lstsq"

@@ -342,7 +342,7 @@ def update_tool_from_beam(library: ToolLibrary, slot: int, check: BeamCheck,
     x, y, z = (float(v) for v in check.measured_tcp_mm)
     measured = (x, y, z)
     tool = Tool(name=current.name, tcp_mm=measured, abc_deg=current.abc_deg,
-                mass_kg=current.mass_kg, cog_mm=current.cog_mm, notes=current.notes,
+                notes=current.notes, **current.load_fields(),
                 calibration=Calibration.now(BEAM_METHOD, figures))
     with rights.in_words():
         library.save(slot, tool, activate=False, **rights.save_kwargs())

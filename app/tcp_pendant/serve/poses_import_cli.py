@@ -2,15 +2,27 @@
 
 Usage::
 
-    tcp-pendant poses import FILE --robot kr6|gp12|PATH.urdf [--format auto|kuka|abb|fanuc|ur]
-                             [--flange-link LINK] [--output POSES.csv]
+    tcp-pendant poses import FILE --robot kr6|gp12|PATH.urdf|PATH.xacro
+                             [--format auto|kuka|abb|fanuc|ur|yaskawa] [--flange-link LINK]
+                             [--package-path DIR]... [--pulses-per-degree S,L,U,R,B,T]
+                             [--output POSES.csv]
 
 The same POSES.csv as ``tcpcal poses import`` (docs/cli.md), and the same warnings, but the
 positions a program records in joint representation (FANUC ``J1 = ..`` points, ABB
 ``jointtarget``, KUKA ``E6AXIS``/``AXIS``; :class:`tcpcal.controllers.JointPoint`) are not
 skipped: each becomes the flange pose ``T_world_flange(q)`` of the robot's forward kinematics
 (:class:`tcp_pendant.controller.RobotKinematics`, pinocchio), WORLD being the URDF's root link
-and FLANGE the ``--flange-link`` (default as ``tcp-pendant --robot``). Rows keep the file order.
+and FLANGE the ``--flange-link`` (default as ``tcp-pendant --robot``; ``--package-path`` finds
+a ROS description's packages, as the server's option does). Rows keep the file order.
+
+Positions in encoder counts (a Yaskawa job's PULSE positions,
+:class:`tcpcal.controllers.PulsePoint`, of a format with ``parse_pulse_points``) become joint
+points with ``--pulses-per-degree``: axis value (deg) = pulses / pulses per degree
+of that axis, one number per robot axis in the job's order (S, L, U, R, B, T[, E]), from the
+controller's parameters (the pulses of one axis revolution divided by 360; a negative number
+turns an axis whose positive direction is the URDF's opposite), or the path of a text file
+holding those numbers (commas, spaces or one per line; ``#`` starts a comment). Without it they
+are refused with this way out.
 
 Units: the file's axis values are degrees for revolute joints and millimetres for prismatic
 ones (as the controllers write them), in the URDF's joint order; the CSV is mm and the format's
@@ -25,8 +37,10 @@ differs from the robot's (one line on stderr).
 from __future__ import annotations
 
 import argparse
+import re
 import sys
 from collections.abc import Sequence
+from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -34,11 +48,15 @@ import numpy as np
 
 from tcpcal.controllers import (
     POSE_FORMATS,
+    PULSE_SKIPPED,
     REGISTRY,
+    ControllerFileError,
     JointPoint,
     PoseImport,
+    PulsePoint,
     RecordedPose,
     import_poses,
+    detect_pose_format,
     poses_csv_text,
 )
 from tcpcal.errors import TcpcalError
@@ -46,7 +64,7 @@ from tcpcal.errors import TcpcalError
 if TYPE_CHECKING:
     from tcp_pendant.controller import RobotKinematics
 
-__all__ = ["build_parser", "flange_poses_of_joint_points", "main"]
+__all__ = ["build_parser", "flange_poses_of_joint_points", "joint_points_of_pulses", "main"]
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -64,9 +82,78 @@ def build_parser() -> argparse.ArgumentParser:
                         "chain)")
     p.add_argument("--format", dest="fmt", default="auto", choices=("auto", *POSE_FORMATS),
                    help="the controller (default auto: from the extension, else the content)")
+    p.add_argument("--package-path", action="append", default=[], type=Path, metavar="DIR",
+                   help="a folder holding ROS packages (or a package itself), searched for "
+                        "xacro's $(find pkg) before ROS_PACKAGE_PATH (repeatable)")
+    p.add_argument("--pulses-per-degree", type=_pulses_per_degree, default=None,
+                   metavar="S,L,U,R,B,T|FILE",
+                   help="Yaskawa PULSE positions: the encoder pulses per degree of each axis "
+                        "(controller parameters), or a text file holding them; the counts "
+                        "become axis values in degrees")
     p.add_argument("--output", type=Path, default=None, metavar="POSES.csv",
                    help="write the CSV to this file instead of stdout (an existing file is refused)")
     return p
+
+
+def _pulses_per_degree(text: str) -> tuple[float, ...]:
+    """``--pulses-per-degree``: comma-separated non-zero finite numbers, or the path of a text
+    file holding them (separated by commas, spaces or lines; ``#`` starts a comment)."""
+    path = Path(text).expanduser()
+    if not re.fullmatch(r"[-+0-9.,eE\s]*", text) and path.is_file():
+        try:
+            body = path.read_text(encoding="utf-8")
+        except (OSError, UnicodeDecodeError) as exc:
+            raise argparse.ArgumentTypeError(f"{text}: cannot read the file: {exc}") from None
+        text = ",".join(re.sub(r"#[^\n]*", "", body).replace(",", " ").split())
+    try:
+        values = tuple(float(v) for v in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: give one number per axis, e.g. "
+                                         "1300.5,1300.5,1100,800,800,500") from None
+    if not values or any(not np.isfinite(v) or v == 0 for v in values):
+        raise argparse.ArgumentTypeError(f"{text!r}: every axis needs a non-zero finite number")
+    return values
+
+
+def joint_points_of_pulses(points: Sequence[PulsePoint], pulses_per_degree: Sequence[float]
+                           ) -> list[JointPoint]:
+    """Each PULSE position as a joint point: ``deg = pulses / pulses_per_degree`` per axis.
+
+    Raises:
+        ValueError: a position whose axis count is not the number of factors given.
+    """
+    out = []
+    for p in points:
+        if len(p.pulses) != len(pulses_per_degree):
+            raise ValueError(f"line {p.line}: {p.name} has {len(p.pulses)} axes but "
+                             f"--pulses-per-degree gives {len(pulses_per_degree)} numbers")
+        out.append(JointPoint(p.name, tuple(c / f for c, f in zip(p.pulses, pulses_per_degree)),
+                              p.line, tool=p.tool, kind="PULSE"))
+    return out
+
+
+def _with_pulses(text: str, fmt: str, filename: str,
+                 pulses_per_degree: Sequence[float]) -> PoseImport:
+    """``import_poses`` of a program with its positions in encoder counts as joint points.
+
+    Raises:
+        ControllerFileError: the format has no such positions, or the file is unreadable.
+        ValueError: a position whose axis count is not the number of factors.
+    """
+    parse = REGISTRY[fmt].parse_pulse_points
+    if parse is None:
+        raise ControllerFileError(f"--pulses-per-degree: {REGISTRY[fmt].label} files hold no "
+                                  "positions in encoder counts; leave it out")
+    pulses = parse(text)
+    try:
+        imported = import_poses(text, fmt, filename=filename)
+    except ControllerFileError:
+        if not pulses:
+            raise
+        imported = PoseImport(fmt, (), ())
+    warnings = tuple(w for w in imported.warnings if PULSE_SKIPPED not in w)
+    joints = joint_points_of_pulses(pulses, pulses_per_degree)
+    return replace(imported, warnings=warnings, joint_points=(*imported.joint_points, *joints))
 
 
 def flange_poses_of_joint_points(points: Sequence[JointPoint], kinematics: RobotKinematics,
@@ -127,16 +214,21 @@ def main(argv: Sequence[str] | None = None) -> int:
         return _error(str(exc))
     try:
         text = read_controller_text(args.file)
-        imported = import_poses(text, args.fmt, filename=args.file.name)
+        fmt = detect_pose_format(text, args.file.name) if args.fmt == "auto" else args.fmt
+        if args.pulses_per_degree is not None:
+            imported = _with_pulses(text, fmt, args.file.name, args.pulses_per_degree)
+        else:
+            imported = import_poses(text, fmt, filename=args.file.name)
     except OSError as exc:
         return _error(f"{args.file}: cannot read the file: {exc.strerror or exc}")
-    except TcpcalError as exc:
+    except (TcpcalError, ValueError) as exc:
         return _error(f"{args.file}: {exc}")
     warnings = list(imported.warnings)
     poses = list(imported.poses)
     if imported.joint_points:
         try:
-            kin = RobotKinematics.from_urdf(urdf, flange_link=args.flange_link)
+            kin = RobotKinematics.from_urdf(urdf, flange_link=args.flange_link,
+                                            package_paths=tuple(args.package_path))
             converted, more = flange_poses_of_joint_points(imported.joint_points, kin,
                                                            imported.format)
         except (ControllerError, ValueError) as exc:

@@ -159,8 +159,8 @@ class AbcWorldWizard(Wizard):
             for k, v in self.tool.calibration.figures.items():
                 figures.setdefault(f"tcp_{k}" if not k.startswith("tcp_") else k, float(v))
         assert res.abc_deg is not None
-        return Tool(name=name, tcp_mm=res.tcp_mm, abc_deg=res.abc_deg, mass_kg=self.tool.mass_kg,
-                    cog_mm=self.tool.cog_mm, notes=self.tool.notes, calibration=self._calibration(res, figures))
+        return Tool(name=name, tcp_mm=res.tcp_mm, abc_deg=res.abc_deg, notes=self.tool.notes,
+                    **self.tool.load_fields(), calibration=self._calibration(res, figures))
 
     def _params(self) -> dict[str, object]:
         return {"tool": self.tool.to_dict(), "variant": self._variant}

@@ -359,8 +359,7 @@ class Xyz4Wizard(Wizard):
         if self.base_tool is None:
             return tool
         a, b, c = (float(v) for v in self.base_tool.abc_deg)
-        return replace(tool, abc_deg=(a, b, c), mass_kg=self.base_tool.mass_kg,
-                       cog_mm=self.base_tool.cog_mm, notes=self.base_tool.notes)
+        return replace(tool, abc_deg=(a, b, c), notes=self.base_tool.notes, **self.base_tool.load_fields())
 
     # ----- serialisation ------------------------------------------------------------------
     def _params(self) -> dict[str, object]:

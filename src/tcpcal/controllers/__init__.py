@@ -21,8 +21,10 @@ from dataclasses import dataclass
 from typing import overload
 
 from tcpcal.controllers._common import (
+    PULSE_SKIPPED,
     ControllerFileError,
     JointPoint,
+    PulsePoint,
     RecordedPose,
     ToolEntry,
     fixed,
@@ -34,6 +36,7 @@ from tcpcal.tool import Tool
 __all__ = [
     "CONTROLLER_FORMATS",
     "POSE_FORMATS",
+    "PULSE_SKIPPED",
     "REGISTRY",
     "ROBOT_HINT",
     "ControllerFileError",
@@ -41,6 +44,7 @@ __all__ = [
     "CsvLayout",
     "JointPoint",
     "PoseImport",
+    "PulsePoint",
     "RecordedPose",
     "ToolEntry",
     "csv_layouts",
@@ -329,7 +333,8 @@ def import_poses(text: str, fmt: str = "auto", *, filename: str | None = None) -
 def poses_csv_text(imported: PoseImport) -> str:
     """POSES.csv (docs/cli.md) of imported poses: ``name,x,y,z`` and the controller's own
     orientation layout (``ControllerFormat.csv``), numbers with fixed decimals (mm 4)."""
-    layout = REGISTRY[imported.format].csv
+    fmt = REGISTRY[imported.format]
+    layout = fmt.csv if fmt.csv is not None or not fmt.pose_layout else REGISTRY[fmt.pose_layout].csv
     if layout is None:
         raise ControllerFileError(f"{imported.format}: the format has no POSES.csv layout")
     rows = [f"name,x,y,z,{','.join(layout.columns)}"]

@@ -9,13 +9,15 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from tcpcal.errors import InvalidInputError
 
-__all__ = ["NUM", "ControllerFileError", "JointPoint", "RecordedPose", "ToolEntry", "fixed",
+__all__ = ["NUM", "PULSE_SKIPPED", "ControllerFileError", "JointPoint", "PulsePoint",
+           "RecordedPose", "ToolEntry", "fixed", "inertia_or_none",
            "line_of", "to_float"]
 
 NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
@@ -66,6 +68,10 @@ class ToolEntry:
         rotation: (3, 3) ``R_flange_tool``.
         mass_kg: the load's mass the file gives, kg, or ``None`` (not in the file, or 0: unset).
         cog_mm: the load's centre of gravity in FLANGE, mm, or ``None`` (not in the file).
+        load_abc_deg: KUKA A, B, C (deg) of ``R_flange_load``, the axes of the load's moments of
+            inertia, or ``None`` (not in the file, or no mass).
+        inertia_kgm2: the load's moments of inertia about those axes through the centre of
+            gravity, kg m^2, or ``None`` (not in the file, all zero, or no mass).
     """
 
     number: int | None
@@ -74,11 +80,20 @@ class ToolEntry:
     rotation: np.ndarray
     mass_kg: float | None = None
     cog_mm: tuple[float, float, float] | None = None
+    load_abc_deg: tuple[float, float, float] | None = None
+    inertia_kgm2: tuple[float, float, float] | None = None
 
     def __post_init__(self) -> None:
         rot = np.array(self.rotation, dtype=float)
         rot.setflags(write=False)
         object.__setattr__(self, "rotation", rot)
+
+
+def inertia_or_none(values: Sequence[float]) -> tuple[float, float, float] | None:
+    """Three moments of inertia (kg m^2), or ``None`` when all are zero: the controllers'
+    "not given" (ABB treats the load as a point mass, KUKA and Yaskawa as unset)."""
+    ix, iy, iz = (float(v) for v in values)
+    return None if ix == iy == iz == 0.0 else (ix, iy, iz)
 
 
 @dataclass(frozen=True)
@@ -138,6 +153,30 @@ class JointPoint:
     tool: int | None = None
     base: int | None = None
     kind: str = ""
+
+
+PULSE_SKIPPED = "in PULSE (encoder counts)"
+"""Words of the warning and the refusal about positions in encoder counts (the app drops the
+warning once it converts them)."""
+
+
+@dataclass(frozen=True)
+class PulsePoint:
+    """A robot position a program holds in encoder counts (Yaskawa ``///PULSE``): an axis
+    angle is ``pulses / pulses_per_degree`` of that axis, a controller parameter tcpcal does not
+    know; the app's ``tcp-pendant poses import --pulses-per-degree`` converts them.
+
+    Attributes:
+        name: the position's name in the file (``C00000``, ``P00007``).
+        pulses: the counts of each robot axis, file order.
+        line: 1-based line in the file.
+        tool: the tool number it was taught with, if the file says.
+    """
+
+    name: str
+    pulses: tuple[int, ...]
+    line: int
+    tool: int | None = None
 
 
 def line_of(text: str, pos: int) -> int:

@@ -104,6 +104,12 @@ class ControllerFormat:
         tool_file_extensions: extensions (lower case) of the files ``tools import`` reads.
         tool_file_detect: content found in this controller's tool files (``tools import
             --format auto`` tries the formats in ``rank`` order).
+        parse_pulse_points: ``text -> [PulsePoint]``: the positions a program holds in encoder
+            counts (Yaskawa PULSE; ``None``: the format has none); ``poses import`` refuses or
+            skips them, the app converts them with ``--pulses-per-degree``.
+        pose_layout: the name of another format whose POSES.csv layout this format's poses
+            are written in, when it has none of its own (Yaskawa: ``fanuc``, the same
+            convention).
     """
 
     name: str
@@ -136,6 +142,8 @@ class ControllerFormat:
     claim: re.Pattern[str] | None = None
     tool_file_extensions: tuple[str, ...] = ()
     tool_file_detect: re.Pattern[str] | None = None
+    parse_pulse_points: Callable[[str], list[Any]] | None = None
+    pose_layout: str = ""
 
     # The names the file functions had before the registries were one (tests, callers).
     @property

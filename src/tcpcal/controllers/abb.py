@@ -31,6 +31,7 @@ from tcpcal.controllers._common import (
     RecordedPose,
     ToolEntry,
     fixed,
+    inertia_or_none,
     line_of,
     to_float,
 )
@@ -43,7 +44,7 @@ from tcpcal.controllers._format import (
     tool_from_rotation,
 )
 from tcpcal.errors import InvalidInputError
-from tcpcal.tool import Tool
+from tcpcal.tool import Tool, abc_deg_from_rotation, rotation_from_abc_deg
 from tcpcal.validation import ORTHONORMAL_TOL
 
 __all__ = ["DEFAULT_MASS_KG", "FORMAT", "RESERVED", "check_identifier", "parse_joint_points",
@@ -101,23 +102,45 @@ def _rotation(q: ArrayLike, what: str) -> np.ndarray:
     return Rotation.from_quat(np.array([q[1], q[2], q[3], q[0]]) / norm).as_matrix()
 
 
+def _short(v: float) -> str:
+    """``v`` with 6 decimals, trailing zeros dropped (``0.055``, ``0``)."""
+    text = fixed(v, 6).rstrip("0").rstrip(".")
+    return text if text not in ("", "-") else "0"
+
+
+def _tload(tool: Tool) -> str:
+    """The ``tload`` aggregate ``[mass,[cx,cy,cz],[q1..q4],ix,iy,iz]`` of ``tool`` (kg, mm,
+    kg m^2): its load where the library has one, else tool0's ``[0.001,[0,0,0.001],...]``;
+    an unknown centre of gravity as ``[0,0,0.001]``, an unknown orientation as ``[1,0,0,0]``,
+    unknown inertia as 0 (ABB: a point mass)."""
+    if tool.mass_kg is None:
+        return "[0.001,[0,0,0.001],[1,0,0,0],0,0,0]"
+    cog = ("0,0,0.001" if tool.cog_mm is None else ",".join(fixed(v, 3) for v in tool.cog_mm))
+    aom = ("1,0,0,0" if tool.load_abc_deg is None or not any(tool.load_abc_deg) else
+           ",".join(fixed(v, 6) for v in _quaternion(rotation_from_abc_deg(tool.load_abc_deg))))
+    inertia = ("0,0,0" if tool.inertia_kgm2 is None
+               else ",".join(_short(v) for v in tool.inertia_kgm2))
+    return f"[{fixed(tool.mass_kg, 3)},[{cog}],[{aom}],{inertia}]"
+
+
 def render_tool(tool: Tool, number: int = 1, name: str | None = None) -> str:
-    """A RAPID module with one ``PERS tooldata`` (``number`` only appears in the comment)."""
+    """A RAPID module with one ``PERS tooldata`` (``number`` only appears in the comment); the
+    load is the tool's (mass, centre of gravity, inertia axes and moments) where it has one."""
     ident = check_identifier(tool.name if name is None else name)
     q = _quaternion(tool.rotation)
-    mass = DEFAULT_MASS_KG if tool.mass_kg is None else float(tool.mass_kg)
     pos = ",".join(fixed(v, 3) for v in tool.tcp_mm)
     quat = ",".join(fixed(v, 6) for v in q)
     module = f"tcpcal_{ident}"[:32]
-    cog = ("0,0,0.001" if tool.cog_mm is None or tool.mass_kg is None
-           else ",".join(fixed(v, 3) for v in tool.cog_mm))
+    load_note = ("    ! tload: placeholder load; identify the real one (LoadIdentify) before use\n"
+                 if tool.mass_kg is None else
+                 "    ! tload: the tool's load in the library: mass kg, centre of gravity mm in the\n"
+                 "    ! wrist frame, inertia axes [q1..q4], moments of inertia ix,iy,iz kg m^2\n")
     return (f"MODULE {module}\n"
             f"    ! tcpcal: tool {ident} (library slot {number}) for ABB RAPID\n"
             "    ! tframe: TCP [x,y,z] in mm in the wrist (flange) frame; orientation R_flange_tool\n"
             "    ! as a unit quaternion [q1,q2,q3,q4], q1 the scalar part\n"
-            "    ! tload: placeholder load; identify the real one (LoadIdentify) before use\n"
-            f"    PERS tooldata {ident}:=[TRUE,[[{pos}],[{quat}]],"
-            f"[{fixed(mass, 3)},[{cog}],[1,0,0,0],0,0,0]];\n"
+            f"{load_note}"
+            f"    PERS tooldata {ident}:=[TRUE,[[{pos}],[{quat}]],{_tload(tool)}];\n"
             "ENDMODULE\n")
 
 
@@ -128,18 +151,31 @@ def _numbers(text: str, n: int, what: str) -> list[float]:
     return [to_float(t, "abb", what) for t in toks]
 
 
-def _load(body: str, name: str) -> tuple[float | None, tuple[float, float, float] | None]:
-    """Mass (kg) and centre of gravity (mm) of a tooldata's ``tload``; ``(None, None)`` for
-    tool0's placeholder load ``[0.001,[0,0,0.001],...]`` or a load that cannot be read."""
+_Load = tuple[float | None, tuple[float, float, float] | None,
+              tuple[float, float, float] | None, tuple[float, float, float] | None]
+
+
+def _load(body: str, name: str) -> _Load:
+    """Mass (kg), centre of gravity (mm), inertia axes (KUKA A, B, C deg) and moments of inertia
+    (kg m^2; all zero: ``None``) of a tooldata's ``tload``; all ``None`` for tool0's placeholder
+    load ``[0.001,[0,0,0.001],...]`` or a load that cannot be read."""
     try:
         agg = _parse_aggregate(body, 0)
         mass = float(agg[2][0])
         cog = tuple(float(v) for v in agg[2][1])
+        aom = [float(v) for v in agg[2][2]]
+        inertia = [float(v) for v in agg[2][3:6]]
     except (InvalidInputError, IndexError, TypeError, ValueError):
-        return None, None
-    if mass <= 0 or (mass == DEFAULT_MASS_KG and cog == _DEFAULT_COG) or len(cog) != 3:
-        return None, None
-    return mass, (cog[0], cog[1], cog[2])
+        return None, None, None, None
+    if (mass <= 0 or (mass == DEFAULT_MASS_KG and cog == _DEFAULT_COG) or len(cog) != 3
+            or len(aom) != 4 or len(inertia) != 3):
+        return None, None, None, None
+    try:
+        axes = abc_deg_from_rotation(_rotation(aom, f"tooldata {name} tload.aom"))
+    except ControllerFileError:
+        axes = None
+    abc = None if axes is None else (float(axes[0]), float(axes[1]), float(axes[2]))
+    return mass, (cog[0], cog[1], cog[2]), abc, inertia_or_none(inertia)
 
 
 def parse_tool(text: str) -> list[ToolEntry]:
@@ -159,16 +195,73 @@ def parse_tool(text: str) -> list[ToolEntry]:
         pos = _numbers(inner.group(2), 3, f"tooldata {name} position")
         rot = _rotation(_numbers(inner.group(3), 4, f"tooldata {name} orientation"),
                         f"tooldata {name}")
-        mass, cog = _load(body, name)
+        mass, cog, axes, inertia = _load(body, name)
         out.append(ToolEntry(None, name, tuple(pos), rot,  # type: ignore[arg-type]
-                             mass_kg=mass, cog_mm=cog))
+                             mass_kg=mass, cog_mm=cog, load_abc_deg=axes, inertia_kgm2=inertia))
     if not out:
         raise ControllerFileError("abb: no 'PERS tooldata name:=[...];' declaration found")
     return out
 
 
+_ROBTARGET_ARRAY = re.compile(r"robtarget\s+(\w+)\s*\{\s*(\d+)\s*\}\s*:=\s*\[", re.IGNORECASE)
+"""A one-dimensional robtarget array with its values: ``PERS robtarget p{40}:=[[...],...];``."""
+
+
+def _array_elements(text: str) -> list[tuple[str, int, int, list[Any]]]:
+    """Every element of every robtarget array of ``text``: ``(array name, 1-based index, line,
+    element aggregate)``, in file order (comments blanked first).
+
+    Raises:
+        ControllerFileError: an array whose values cannot be read (names it and its line).
+    """
+    code = _comment_free(text)
+    out: list[tuple[str, int, int, list[Any]]] = []
+    for m in _ROBTARGET_ARRAY.finditer(code):
+        line = line_of(text, m.start())
+        try:
+            agg = _parse_aggregate(code, m.end() - 1, "the values")
+        except InvalidInputError as exc:
+            raise ControllerFileError(f"abb: line {line}: robtarget {m.group(1)}{{{m.group(2)}}}"
+                                      f" cannot be read: {str(exc).removeprefix('abb: ')}"
+                                      ) from None
+        if not isinstance(agg, list):
+            continue
+        out.extend((m.group(1), k, line, el) for k, el in enumerate(agg, 1))
+    return out
+
+
+def _all_zero(element: Any) -> bool:
+    """A robtarget element whose position and orientation are all 0: never taught (RAPID
+    fills the unset elements of a declared array so)."""
+    try:
+        return not any(float(v) for v in [*element[0], *element[1]])
+    except (IndexError, TypeError, ValueError):
+        return False
+
+
+def _array_poses(text: str) -> list[RecordedPose]:
+    """The elements of robtarget arrays as ``name{i}`` poses (all-zero elements skipped)."""
+    out: list[RecordedPose] = []
+    for name, k, line, el in _array_elements(text):
+        if _all_zero(el):
+            continue
+        what = f"line {line}: robtarget {name}{{{k}}}"
+        try:
+            pos = [float(v) for v in el[0]]
+            q = [float(v) for v in el[1]]
+        except (IndexError, TypeError, ValueError):
+            raise ControllerFileError(f"abb: {what} is not [[x,y,z],[q1,q2,q3,q4],...]") from None
+        if len(pos) != 3 or len(q) != 4:
+            raise ControllerFileError(f"abb: {what} needs [x,y,z] and [q1,q2,q3,q4]")
+        out.append(RecordedPose(f"{name}{{{k}}}", (pos[0], pos[1], pos[2]), _rotation(q, what),
+                                tuple(q), line=line))
+    return out
+
+
 def parse_poses(text: str) -> list[RecordedPose]:
-    """``robtarget`` declarations (``CONST``/``PERS``/``VAR``/``LOCAL``), in file order."""
+    """``robtarget`` declarations (``CONST``/``PERS``/``VAR``/``LOCAL``) and the elements of
+    robtarget arrays (``name{i}``; all-zero elements, never taught, skipped and counted by
+    :func:`pose_warnings`), in file order."""
     out: list[RecordedPose] = []
     for m in _ROBTARGET.finditer(text):
         name = m.group(1)
@@ -177,7 +270,8 @@ def parse_poses(text: str) -> list[RecordedPose]:
         q = _numbers(m.group(3), 4, f"{what} orientation")
         out.append(RecordedPose(name, tuple(pos), _rotation(q, what), tuple(q),  # type: ignore[arg-type]
                                 line=line_of(text, m.start())))
-    return out
+    out.extend(_array_poses(text))
+    return sorted(out, key=lambda p: p.line)
 
 
 _JOINTTARGET = re.compile(r"jointtarget\s+(\w+)\s*:=\s*\[\s*\[([^\]]*)\]\s*,\s*\[([^\]]*)\]",
@@ -187,6 +281,8 @@ _MOVE = re.compile(r"^[ \t]*(Move(?:L|J|C|AbsJ|LDO|JDO|CDO|LSync|JSync|CSync|LAO
 """Move instructions whose positional arguments are ToPoint (MoveC: CirPoint, ToPoint),
 Speed, Zone, Tool (ABB RAPID reference manual)."""
 _WOBJ = re.compile(r"\\WObj\s*:=\s*(\w+)", re.IGNORECASE)
+_OPTIONAL_TOOL = re.compile(r"\\Tool\s*:=\s*(\w+)", re.IGNORECASE)
+"""An optional ``\\Tool:=name`` argument (the tool of the move where the instruction takes one)."""
 _UNSET_EXTAX = 9e8
 """An external axis value at or above this (RAPID writes 9E+09) is 'no axis'."""
 
@@ -211,6 +307,7 @@ def _arguments(args: str) -> list[str]:
     out = []
     for part in parts:
         bare = re.sub(r"\\\w+(?:\s*:=\s*[^\\]*)?", "", part).strip()
+        bare = re.sub(r"^[A-Za-z]\w*\s*:=\s*", "", bare)  # a named argument: Tool:=tool0
         if bare:
             out.append(bare)
     return out
@@ -229,9 +326,19 @@ def _moves(text: str) -> list[tuple[str, list[str], str, str | None, int]]:
             continue
         targets = [a for a in args[:n_points] if re.fullmatch(r"[A-Za-z]\w*", a)]
         wobj = _WOBJ.search(m.group(2))
-        out.append((instr, targets, args[tool_at], wobj.group(1) if wobj else None,
+        optional_tool = _OPTIONAL_TOOL.search(m.group(2))
+        tool = optional_tool.group(1) if optional_tool else args[tool_at]
+        out.append((instr, targets, tool, wobj.group(1) if wobj else None,
                     line_of(text, m.start(1))))
     return out
+
+
+def _has_extax(values: Any) -> bool:
+    """An element's external axes hold a value (not 9E+09)."""
+    try:
+        return any(abs(float(v)) < _UNSET_EXTAX for v in values)
+    except (TypeError, ValueError):
+        return False
 
 
 def pose_warnings(text: str) -> list[str]:
@@ -264,6 +371,19 @@ def pose_warnings(text: str) -> list[str]:
                     extax.append(m.group(1))
             except ValueError:
                 continue
+    zeros: dict[str, list[int]] = {}
+    sizes: dict[str, int] = {}
+    for name, k, _, el in _array_elements(text):
+        zeros.setdefault(name, [])
+        sizes[name] = k
+        if _all_zero(el):
+            zeros[name].append(k)
+        elif len(el) >= 4 and _has_extax(el[3]):
+            extax.append(f"{name}{{{k}}}")
+    for name, skipped in zeros.items():
+        if skipped:
+            out.append(f"{name}: {len(skipped)} of {sizes[name]} elements all zero (never "
+                       "taught), skipped")
     if extax:
         out.append(f"{', '.join(extax)} hold external axis values (eax not 9E+09): tcpcal "
                    "ignores them; the poses are right only if no external axis moves the robot "
@@ -315,24 +435,34 @@ def text_identifier(name: str) -> str:
 
 
 def render_text(tool: Tool, slot: int = 1) -> str:
-    """``PERS tooldata <identifier>:=[TRUE,[[x,y,z],[q1,q2,q3,q4]],[mass,[0,0,0.001],
-    [1,0,0,0],0,0,0]];`` on one line (mm; ``q1 >= 0``; unknown mass as tool0's 0.001 kg;
+    """``PERS tooldata <identifier>:=[TRUE,[[x,y,z],[q1,q2,q3,q4]],[mass,[cx,cy,cz],
+    [aom q1..q4],ix,iy,iz]];`` on one line (mm; ``q1 >= 0``; an unknown load as tool0's
+    ``[0.001,[0,0,0.001],[1,0,0,0],0,0,0]``, an unknown part of a known one as those defaults;
     ``slot`` is not written)."""
     q1234 = _quaternion(tool.rotation)
+    known = tool.mass_kg is not None
     mass = DEFAULT_MASS_KG if tool.mass_kg is None else tool.mass_kg
-    cog = _DEFAULT_COG if tool.cog_mm is None or tool.mass_kg is None else tool.cog_mm
+    cog = _DEFAULT_COG if tool.cog_mm is None or not known else tool.cog_mm
+    aom = ("1,0,0,0" if not known or tool.load_abc_deg is None or not any(tool.load_abc_deg)
+           else ",".join(text_number(x, True)
+                         for x in _quaternion(rotation_from_abc_deg(tool.load_abc_deg))))
+    inertia = (0, 0, 0) if not known or tool.inertia_kgm2 is None else tool.inertia_kgm2
 
     def lst(v: Iterable[float]) -> str:
         return "[" + ",".join(text_number(x, True) for x in v) + "]"
 
+    def bare(v: Iterable[float]) -> str:
+        return ",".join("0" if x == 0 else text_number(x, True) for x in v)
+
     return (
         f"PERS tooldata {text_identifier(tool.name)}:=[TRUE,[{lst(tool.tcp_mm)},{lst(q1234)}],"
-        f"[{text_number(mass, True)},{lst(cog)},[1,0,0,0],0,0,0]];\n"
+        f"[{text_number(mass, True)},{lst(cog)},[{aom}],{bare(inertia)}]];\n"
     )
 
 
-def _parse_aggregate(text: str, start: int) -> Any:
-    """Parse a RAPID aggregate ``[a,[b,c],...]`` beginning at ``text[start] == '['``."""
+def _parse_aggregate(text: str, start: int, what: str = "the tooldata") -> Any:
+    """Parse a RAPID aggregate ``[a,[b,c],...]`` beginning at ``text[start] == '['`` (``what``
+    names it in the error messages)."""
     pos = start
 
     def token() -> str:
@@ -340,7 +470,7 @@ def _parse_aggregate(text: str, start: int) -> Any:
         m = _TEXT_TOKEN.match(text, pos)
         if not m:
             snippet = text[pos:pos + 20].strip() or "end of text"
-            raise InvalidInputError(f"abb: could not parse the tooldata near {snippet!r}.")
+            raise InvalidInputError(f"abb: could not parse {what} near {snippet!r}.")
         pos = m.end()
         return m.group(1)
 
@@ -357,11 +487,11 @@ def _parse_aggregate(text: str, start: int) -> Any:
                     return items
                 if tok != ",":
                     raise InvalidInputError(
-                        f"abb: expected ',' or ']' in the tooldata, got {tok!r}."
+                        f"abb: expected ',' or ']' in {what}, got {tok!r}."
                     )
                 tok = token()
         if tok in ("]", ","):
-            raise InvalidInputError(f"abb: unexpected {tok!r} in the tooldata.")
+            raise InvalidInputError(f"abb: unexpected {tok!r} in {what}.")
         if tok.upper() in ("TRUE", "FALSE"):
             return tok.upper() == "TRUE"
         return text_float(tok, "abb", "value")
@@ -380,7 +510,8 @@ def _aggregate_numbers(v: Any, n: int, what: str) -> list[float]:
 
 def parse_text(text: str, name: str | None) -> Tool:
     """One ``tooldata`` declaration (``PERS``/``CONST``/``VAR``/``TASK PERS``) or the bare
-    aggregate; ``robhold`` FALSE is refused; tool0's load maps back to ``mass_kg=None``."""
+    aggregate; ``robhold`` FALSE is refused; tool0's load maps back to ``mass_kg=None``; a known
+    load keeps its centre of gravity, inertia axes (``aom``) and moments (all zero: unset)."""
     decls = _TEXT_DECL.findall(text)
     if len(decls) > 1:
         raise InvalidInputError(
@@ -433,9 +564,18 @@ def parse_text(text: str, name: str | None) -> Tool:
     mass_kg = None if (mass == DEFAULT_MASS_KG and tuple(cog) == _DEFAULT_COG) else mass
     R = Rotation.from_quat([q[1], q[2], q[3], q[0]]).as_matrix()  # scipy order x, y, z, w
     cog_mm = None if mass_kg is None else (cog[0], cog[1], cog[2])
+    axes, inertia = None, None
+    if mass_kg is not None:
+        aom = np.array(_aggregate_numbers(tload[2], 4, "tload.aom (quaternion q1..q4)"))
+        moments = [_aggregate_numbers([v], 1, "tload inertia")[0] for v in tload[3:6]]
+        if abs(float(np.linalg.norm(aom)) - 1.0) > 1e-3:
+            raise InvalidInputError(f"abb: tload.aom {aom.tolist()} is not a unit quaternion.")
+        abc = abc_deg_from_rotation(Rotation.from_quat(aom[[1, 2, 3, 0]]).as_matrix())
+        axes = (float(abc[0]), float(abc[1]), float(abc[2]))
+        inertia = inertia_or_none(moments)
     return tool_from_rotation(
         "abb", name or found_name or "imported", name is not None, trans, R, mass_kg=mass_kg,
-        cog_mm=cog_mm,
+        cog_mm=cog_mm, load_abc_deg=axes, inertia_kgm2=inertia,
     )
 
 

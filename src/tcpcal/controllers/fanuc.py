@@ -196,23 +196,50 @@ def _name(p: _Point) -> str:
     return p.comment or f"P[{p.k}]"
 
 
+_C = r"\s*(?::[^\]]*)?"
+"""An optional ``:comment`` in a register's brackets (``PR[109:temp]``, ``UTOOL[1:Vac]``)."""
+_PR_FROM_P = re.compile(rf"\bPR\[\s*(\d+){_C}\]\s*=\s*P\[\s*(\d+){_C}\]")
+_PR_ELEMENT = re.compile(rf"\bPR\[\s*(\d+)\s*,\s*([1-6]){_C}\]\s*=\s*\(?\s*({NUM})\s*\)?\s*;")
+_PR_OTHER = re.compile(rf"\bPR\[\s*(\d+){_C}\]\s*=")
+_UTOOL_FROM_PR = re.compile(rf"\bUTOOL\[\s*(\d+)\s*(?::([^\]]*))?\]\s*=\s*PR\[\s*(\d+){_C}\]")
+
+
+def _main_lines(text: str) -> list[str]:
+    """The lines of a TP program's ``/MN`` section (the whole text when it has none)."""
+    start = text.find("/MN")
+    end = text.find("/POS", start if start >= 0 else 0)
+    body = text[start if start >= 0 else 0:end if end >= 0 else len(text)]
+    return body.splitlines()
+
+
 def parse_tool(text: str) -> list[ToolEntry]:
-    """The tool frames a TP program sets by ``PR[m]=P[k]`` and ``UTOOL[n]=PR[m]``."""
+    """The tool frames a TP program sets by ``UTOOL[n]=PR[m]``, with the register's value at
+    that line: set from a position (``PR[m]=P[k]``) or element by element (``PR[m,1]=x`` ..
+    ``PR[m,6]=r``, X, Y, Z mm, W, P, R deg, after e.g. ``PR[m]=LPOS``), the program's lines in
+    order. The comments pendants add (``UTOOL[1:Vac]=PR[109:temp]``, ``PR[109:temp]=P[1:tip]``)
+    are read as the bare forms, a ``UTOOL`` comment as the tool's name."""
     points = {k: v for k, _, v, _, _, _ in _positions(text)}
-    pr_from_p = {int(m.group(1)): int(m.group(2)) for m in
-                 re.finditer(r"PR\[\s*(\d+)\s*(?::[^\]]*)?\]\s*=\s*P\[\s*(\d+)\s*\]", text)}
+    registers: dict[int, dict[str, float]] = {}
     out: list[ToolEntry] = []
-    for m in re.finditer(r"UTOOL\[\s*(\d+)\s*\]\s*=\s*PR\[\s*(\d+)\s*(?::[^\]]*)?\]", text):
-        n, reg = int(m.group(1)), int(m.group(2))
-        k = pr_from_p.get(reg)
-        if k is None or k not in points:
-            raise ControllerFileError(f"fanuc: UTOOL[{n}]=PR[{reg}] but the program does not "
-                                      f"set PR[{reg}] from a P[] of its /POS section")
-        v = points[k]
-        name = re.search(rf"!tcpcal UTOOL\[{n}\] ([^;]*);", text)
-        rot = Rotation.from_euler("xyz", [v["W"], v["P"], v["R"]], degrees=True).as_matrix()
-        out.append(ToolEntry(n, name.group(1).strip() if name else "",
-                             (v["X"], v["Y"], v["Z"]), rot))
+    for line in _main_lines(text):
+        if m := _PR_FROM_P.search(line):
+            registers[int(m.group(1))] = dict(points.get(int(m.group(2)), {}))
+        elif m := _PR_ELEMENT.search(line):
+            key = "XYZWPR"[int(m.group(2)) - 1]
+            registers.setdefault(int(m.group(1)), {})[key] = to_float(m.group(3), "fanuc", key)
+        elif (m := _PR_OTHER.search(line)) and not _UTOOL_FROM_PR.search(line):
+            registers[int(m.group(1))] = {}  # PR[m]=LPOS, =JPOS, ...: not known here
+        if m := _UTOOL_FROM_PR.search(line):
+            n, reg = int(m.group(1)), int(m.group(3))
+            v = registers.get(reg, {})
+            if any(k not in v for k in "XYZWPR"):
+                raise ControllerFileError(
+                    f"fanuc: UTOOL[{n}]=PR[{reg}] but the program does not set PR[{reg}] before "
+                    f"it, from a P[] of its /POS section or by PR[{reg},1..6]=")
+            name = re.search(rf"!tcpcal UTOOL\[{n}\] ([^;]*);", text)
+            label = name.group(1).strip() if name else (m.group(2) or "").strip()
+            rot = Rotation.from_euler("xyz", [v["W"], v["P"], v["R"]], degrees=True).as_matrix()
+            out.append(ToolEntry(n, label, (v["X"], v["Y"], v["Z"]), rot))
     if not out:
         raise ControllerFileError("fanuc: no 'UTOOL[n]=PR[m]' line found")
     return out
@@ -367,7 +394,8 @@ FORMAT = ControllerFormat(
     parse_poses=parse_poses, render_poses=render_poses, pose_extensions=(".ls",),
     detect=re.compile(r"^/POS\b", re.M), detect_text="FANUC /POS",
     pose_warnings=pose_warnings, parse_joint_points=parse_joint_points, claim=_ORDERFIL,
-    tool_file_extensions=(".ls",), tool_file_detect=re.compile(r"\bUTOOL\[\s*\d+\s*\]\s*=\s*PR\["),
+    tool_file_extensions=(".ls",),
+    tool_file_detect=re.compile(r"\bUTOOL\[\s*\d+\s*(?::[^\]]*)?\]\s*=\s*PR\["),
     csv=CsvLayout("fanuc", ("w", "p", "r"), "FANUC W,P,R in deg", _csv_rotations, decimals=6,
                   rank=20),
 )

@@ -28,6 +28,7 @@ from tcpcal.controllers._common import (
     RecordedPose,
     ToolEntry,
     fixed,
+    inertia_or_none,
     line_of,
     to_float,
 )
@@ -89,8 +90,29 @@ def _xyzabc(comp: dict[str, str], what: str) -> tuple[float, ...]:
     return tuple(to_float(comp[k], "kuka", f"{what} {k}") for k in "XYZABC")
 
 
+def _short(v: float) -> str:
+    """``v`` with 7 decimals (KRC writes about 9 digits), trailing zeros dropped, ``0.0``
+    for zero (as KRC writes it)."""
+    text = fixed(v, 7).rstrip("0")
+    return text + "0" if text.endswith(".") else text
+
+
+def _load_line(tool: Tool, number: int) -> str:
+    """``LOAD_DATA[n]={M ..,CM {X ..,Y ..,Z ..,A ..,B ..,C ..},J {X ..,Y ..,Z ..}}`` of a tool
+    with a known mass (kg; mm; deg; kg m^2; an unknown part as 0), else ``""``."""
+    if tool.mass_kg is None:
+        return ""
+    cm = (*(tool.cog_mm or (0.0, 0.0, 0.0)), *(tool.load_abc_deg or (0.0, 0.0, 0.0)))
+    j = tool.inertia_kgm2 or (0.0, 0.0, 0.0)
+    cm_text = ",".join(f"{k} {_short(v)}" for k, v in zip("XYZABC", cm))
+    j_text = ",".join(f"{k} {_short(v)}" for k, v in zip("XYZ", j))
+    return (f"LOAD_DATA[{number}]={{M {_short(tool.mass_kg)},CM {{{cm_text}}},"
+            f"J {{{j_text}}}}}\n")
+
+
 def render_tool(tool: Tool, number: int, name: str | None = None) -> str:
-    """The ``$config.dat`` lines of one tool (``;`` comments name the convention)."""
+    """The ``$config.dat`` lines of one tool (``;`` comments name the convention), with its
+    ``LOAD_DATA[n]`` when the tool's mass is known."""
     if not 1 <= number <= N_TOOLS:
         raise ControllerFileError(f"kuka: tool number must be 1..{N_TOOLS}, got {number}")
     label = tool.name if name is None else name
@@ -100,25 +122,48 @@ def render_tool(tool: Tool, number: int, name: str | None = None) -> str:
             "not fit: pass a shorter name")
     x, y, z = (fixed(v, 3) for v in tool.tcp_mm)
     a, b, c = (fixed(v, 4) for v in abc_deg_from_rotation(tool.rotation))
+    load = _load_line(tool, number)
+    load_note = ("set the load data on the controller)" if not load else
+                 f"and LOAD_DATA[{number}]: M kg, CM mm and deg, J kg m^2)")
     return (f"; tcpcal: tool {number} {label!r} for KUKA KR C $config.dat (replace the lines of\n"
-            f"; TOOL_DATA[{number}] and TOOL_NAME[{number},]; set the load data on the controller)\n"
+            f"; TOOL_DATA[{number}] and TOOL_NAME[{number},]; {load_note}\n"
             "; X, Y, Z: TCP in FLANGE, mm; A, B, C deg: R = Rz(A) Ry(B) Rx(C) "
             "(A about Z, then B about the new Y, then C about the newest X)\n"
             f"TOOL_DATA[{number}]={{X {x},Y {y},Z {z},A {a},B {b},C {c}}}\n"
-            f'TOOL_NAME[{number},]="{label}"\n')
+            f'TOOL_NAME[{number},]="{label}"\n'
+            f"{load}")
 
 
-def _load(text: str, n: int) -> tuple[float | None, tuple[float, float, float] | None]:
-    """Mass (kg) and centre of gravity (mm) of ``LOAD_DATA[n]={M ..,CM {X ..,Y ..,Z ..,..},..}``
-    (``M`` <= 0, e.g. KUKA's -1 "default": unknown)."""
+_Load = tuple[float | None, tuple[float, float, float] | None,
+              tuple[float, float, float] | None, tuple[float, float, float] | None]
+_LOAD_CM = re.compile(r"CM\s*\{([^}]*)\}", re.IGNORECASE)
+_LOAD_J = re.compile(r"\bJ\s*\{([^}]*)\}", re.IGNORECASE)
+
+
+def _load(text: str, n: int) -> _Load:
+    """Mass (kg), centre of gravity (mm), inertia axes (A, B, C deg) and moments of inertia
+    (kg m^2) of ``LOAD_DATA[n]={M ..,CM {X ..,Y ..,Z ..,A ..,B ..,C ..},J {X ..,Y ..,Z ..}}``.
+    ``M`` <= 0 (KUKA's -1 "default"): no load at all; a part the line lacks is ``None``; J all
+    zero is ``None`` (not given)."""
     m = re.search(rf"LOAD_DATA\s*\[\s*{n}\s*\]\s*=\s*\{{\s*M\s+({NUM})(.*)$", text,
                   re.IGNORECASE | re.MULTILINE)
     if not m or float(m.group(1)) <= 0:
-        return None, None
-    cm = re.search(rf"CM\s*\{{\s*X\s+({NUM})\s*,\s*Y\s+({NUM})\s*,\s*Z\s+({NUM})", m.group(2),
-                   re.IGNORECASE)
-    cog = None if not cm else (float(cm.group(1)), float(cm.group(2)), float(cm.group(3)))
-    return float(m.group(1)), cog
+        return None, None, None, None
+    what = f"LOAD_DATA[{n}]"
+    cm = _LOAD_CM.search(m.group(2))
+    comp = _components(cm.group(1), f"{what} CM") if cm else {}
+    cog = axes = inertia = None
+    if all(k in comp for k in "XYZ"):
+        x, y, z = (to_float(comp[k], "kuka", f"{what} CM {k}") for k in "XYZ")
+        cog = (x, y, z)
+    if all(k in comp for k in "ABC"):
+        a, b, c = (to_float(comp[k], "kuka", f"{what} CM {k}") for k in "ABC")
+        axes = (a, b, c)
+    j = _LOAD_J.search(m.group(2))
+    jcomp = _components(j.group(1), f"{what} J") if j else {}
+    if all(k in jcomp for k in "XYZ"):
+        inertia = inertia_or_none([to_float(jcomp[k], "kuka", f"{what} J {k}") for k in "XYZ"])
+    return float(m.group(1)), cog, axes, inertia
 
 
 def parse_tool(text: str) -> list[ToolEntry]:
@@ -131,9 +176,9 @@ def parse_tool(text: str) -> list[ToolEntry]:
         vals = _xyzabc(_components(m.group(2), what), what)
         nm = re.search(rf'TOOL_NAME\s*\[\s*{n}\s*,\s*\]\s*=\s*"([^"]*)"', text, re.IGNORECASE)
         rot = Rotation.from_euler("ZYX", vals[3:], degrees=True).as_matrix()
-        mass, cog = _load(text, n)
+        mass, cog, axes, inertia = _load(text, n)
         out.append(ToolEntry(n, nm.group(1).strip() if nm else "", vals[:3], rot,  # type: ignore[arg-type]
-                             mass_kg=mass, cog_mm=cog))
+                             mass_kg=mass, cog_mm=cog, load_abc_deg=axes, inertia_kgm2=inertia))
     if not out:
         raise ControllerFileError("kuka: no TOOL_DATA[n]={X ..,Y ..,Z ..,A ..,B ..,C ..} found")
     return out
@@ -274,7 +319,8 @@ def render_text(tool: Tool, slot: int = 1) -> str:
 
 def parse_text(text: str, name: str | None) -> Tool:
     """One ``TOOL_DATA[n]`` (any surrounding declaration), its ``TOOL_NAME[n,]`` and
-    ``LOAD_DATA[n]={M ..}`` mass (``M <= 0``: unknown)."""
+    ``LOAD_DATA[n]={M ..,CM {..},J {..}}`` load (``M <= 0``: unknown; docs/formats.md "Tool
+    loads")."""
     matches = _DATA.findall(text)
     if not matches:
         raise InvalidInputError(
@@ -316,13 +362,17 @@ def parse_text(text: str, name: str | None) -> Tool:
     m = re.search(
         rf"LOAD_DATA\s*\[\s*{int(index)}\s*\]\s*=\s*\{{\s*M\s*({TEXT_NUM})", text, re.IGNORECASE
     )
+    load: dict[str, object] = {}
     if m:
         value = text_float(m.group(1), "kuka", "LOAD_DATA mass M")
         mass = value if value > 0 else None
+        if mass is not None:
+            _, cog, axes, inertia = _load(text, int(index))
+            load = {"cog_mm": cog, "load_abc_deg": axes, "inertia_kgm2": inertia}
     return make_tool(
         "kuka", name or found_name or f"tool{int(index)}", name is not None,
         tcp_mm=(values["X"], values["Y"], values["Z"]),
-        abc_deg=(values["A"], values["B"], values["C"]), mass_kg=mass,
+        abc_deg=(values["A"], values["B"], values["C"]), mass_kg=mass, **load,
     )
 
 

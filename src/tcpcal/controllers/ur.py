@@ -80,9 +80,51 @@ def render_tool(tool: Tool, number: int = 1, name: str | None = None) -> str:
             f"set_tcp({ident})\n")
 
 
+_NOT_CODE = re.compile(r"\"[^\"\n]*\"|'[^'\n]*'|#[^\n]*|^[ \t]*\$[^\n]*", re.M)
+"""What is not code: string literals, ``#`` comments and PolyScope's ``$ 43 "..."`` line
+labels (scanned left to right, so a ``#`` inside a string is the string's)."""
+
+
 def _code(text: str) -> str:
-    """``text`` with every ``#`` comment blanked (same length, so offsets and lines hold)."""
-    return re.sub(r"#[^\n]*", lambda m: " " * len(m.group(0)), text)
+    """``text`` with string literals, ``#`` comments and ``$`` line labels blanked (same
+    length, so offsets and lines hold): nothing inside them is ever parsed."""
+    return _NOT_CODE.sub(lambda m: re.sub(r"[^\n]", " ", m.group(0)), text)
+
+
+_RELATIVE_CALL = re.compile(r"(?<![\w.])(pose_trans|pose_add)\s*\(")
+
+
+def _call_arguments(text: str, start: int) -> list[tuple[int, int]]:
+    """The top-level argument spans of the call whose ``(`` ends at ``start``."""
+    spans, depth, begin, i = [], 0, start, start
+    while i < len(text):
+        ch = text[i]
+        if ch in "([":
+            depth += 1
+        elif ch in ")]":
+            if depth == 0:
+                spans.append((begin, i))
+                return spans
+            depth -= 1
+        elif ch == "," and depth == 0:
+            spans.append((begin, i))
+            begin = i + 1
+        i += 1
+    return spans
+
+
+def _relative_offsets(code: str) -> list[tuple[int, str]]:
+    """Pose literals used as relative offsets: the arguments of ``pose_trans``/``pose_add``
+    whose first argument is not a pose literal (``get_actual_tcp_pose()``, a variable): their
+    start offsets and the call's name."""
+    out: list[tuple[int, str]] = []
+    for m in _RELATIVE_CALL.finditer(code):
+        args = _call_arguments(code, m.end())
+        if not args or re.fullmatch(r"\s*p\[[^\[\]]*\]\s*", code[args[0][0]:args[0][1]]):
+            continue
+        for a, b in args[1:]:
+            out.extend((p.start(), m.group(1)) for p in _POSE.finditer(code, a, b))
+    return out
 
 
 def _numbers(body: str, what: str) -> list[float]:
@@ -146,11 +188,14 @@ def parse_poses(text: str) -> list[RecordedPose]:
     """Every pose literal ``p[x, y, z, rx, ry, rz]`` of six numbers in a script, read by
     tokens (``p[`` starts a token), except TCPs and functions' default arguments; positions
     converted m -> mm. A pose of expressions (``p[x, y, 0.3, 0, 0, 0]``) is not a recorded
-    position: skipped, and :func:`_pose_warnings` names it."""
+    position, nor is a relative offset (an argument of ``pose_trans``/``pose_add`` whose first
+    argument is not a pose literal): skipped, and :func:`_pose_warnings` names them. String
+    literals and PolyScope's ``$`` line labels are never parsed."""
     text = _code(text)
+    relative = {start for start, _ in _relative_offsets(text)}
     out: list[RecordedPose] = []
     for m in _literal_poses(text):
-        if _is_tcp(text, m.start()) or not _is_numeric(m.group(1)):
+        if _is_tcp(text, m.start()) or not _is_numeric(m.group(1)) or m.start() in relative:
             continue
         line = line_of(text, m.start())
         v = _numbers(m.group(1), f"line {line}: pose")
@@ -209,7 +254,7 @@ def _pose_warnings(text: str) -> list[str]:
     try:
         tcps = parse_tool(text)
     except ControllerFileError:
-        sets = bool(re.search(r"set_tcp\s*\(", text))  # a TCP we cannot read: say so
+        sets = bool(re.search(r"set_tcp\s*\(", _code(text)))  # a TCP we cannot read: say so
     else:
         sets = any(max(map(abs, t.tcp_mm)) > 0 or abs(t.rotation.trace() - 3.0) > 1e-12
                    for t in tcps)
@@ -222,6 +267,13 @@ def _pose_warnings(text: str) -> list[str]:
         out.append(f"{len(computed)} pose{'s' if len(computed) != 1 else ''} on line"
                    f"{'s' if len(computed) != 1 else ''} {', '.join(map(str, computed))} "
                    "computed from variables (not numbers): not recorded positions, skipped")
+    relative = _relative_offsets(code)
+    if relative:
+        named = ", ".join(f"p[{code[s + 2:code.index(']', s)].replace(' ', '')}] (line "
+                          f"{line_of(code, s)}, {call})" for s, call in relative[:8])
+        out.append(f"{len(relative)} pose{'s' if len(relative) != 1 else ''} used as relative "
+                   f"offset{'s' if len(relative) != 1 else ''} of the current pose: {named}"
+                   f"{', ...' if len(relative) > 8 else ''}: not recorded positions, skipped")
     defaults = sum(1 for a, b in _default_spans(code) for m in _POSE.finditer(code, a, b))
     if defaults:
         out.append(f"{defaults} pose{'s' if defaults != 1 else ''} in function default "
