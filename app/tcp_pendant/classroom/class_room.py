@@ -107,7 +107,7 @@ from tcp_pendant.classroom.mystery import draw_mystery_tool
 from tcp_pendant.classroom.names import TraineeNameError, validate_trainee_name
 from tcp_pendant.classroom.recorder import TraineeRecorder, TraineeStatus
 from tcp_pendant.classroom.replay import CalibrationReplay, calibration_replay
-from tcp_pendant.classroom.restore import runs_to_restore
+from tcp_pendant.classroom.restore import restored_words, runs_to_restore
 from tcp_pendant.classroom.trainees import TraineeJoin
 from tcp_pendant.classroom.trainer_token import FORGET_S, lock_s, locked, log_failure, validate_trainer_token
 from tcp_pendant.classroom.class_messages import clean_message_text
@@ -478,9 +478,7 @@ class ClassRoom:
         indices = session.restore_runs([r.run for r in restored])
         for index, r in zip(indices, restored):
             recorder.adopt(index, r.calibration_id, r.touch_ids)
-        n = len(restored)
-        session.notify("Calibration restored", f"{n} calibration{'s' if n != 1 else ''} you had in progress "
-                       "came back, each at its step with its touches.", kind="info")
+        session.notify("Calibration restored", restored_words(restored), kind="info")
 
     def _mount_mystery(self, session: Session, recorder: TraineeRecorder, name: str) -> None:
         base = self.tools.get("pointer") or next(iter(self.tools.values()))
@@ -552,6 +550,7 @@ class ClassRoom:
             self._beater.join(timeout=5.0)
             self._beater = None
         try:
+            self.gradebook.uptime.beat(self.holder, force=True)      # up until now: the clocks' downtime starts here
             self.gradebook.presence.drop_holder(self.holder)
         except GradebookError:
             log.debug("presence not dropped: gradebook closed", exc_info=True)
@@ -572,6 +571,7 @@ class ClassRoom:
         the welcome window; take in the other processes' rows and the trainer's pushes made
         there; hand this process's trainees the messages the gradebook keeps for them that
         they were not handed yet (sent on another process, or before they came here)."""
+        self.gradebook.uptime.beat(self.holder)          # this process is up (``classroom.uptime``)
         with self._lock:
             entries = {e[2]: e for e in self._trainees.values()}
         statuses = {name: dataclasses.asdict(e[1].status) for name, e in entries.items()}
@@ -850,7 +850,7 @@ class ClassRoom:
         return self.gradebook.grades.rows()
 
     def grades_csv(self) -> str:
-        return to_csv(self.gradebook.grades.rows())
+        return to_csv(self.gradebook.grades.rows(), self.gradebook.grades.attendance())
 
     def _keep_pushed(self, tool_key: str | None, *, brief_only: bool = False) -> None:
         """Keep what the trainer pushed in the gradebook (``PUSHED_SETTING``), so a restart with
