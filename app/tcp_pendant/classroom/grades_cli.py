@@ -86,7 +86,7 @@ def format_table(rows: Sequence[GradeRow], attendees: Sequence[Attendee] = ()) -
     line for each of ``attendees`` without a row (status "joined, no calibration finished")."""
     header = ("id", "trainee", "method", "tool", "touches", "hand", "auto", "overwr.", "crashes",
               "duration", "mean mm", "ci95 mm", "pos err mm", "ori err deg", "grade", "status")
-    body = [(str(r.calibration_id), _terminal_text(r.trainee, _NAME_WIDTH), _terminal_text(r.method, 16),
+    body: list[tuple[str, ...]] = [(str(r.calibration_id), _terminal_text(r.trainee, _NAME_WIDTH), _terminal_text(r.method, 16),
              _terminal_text(r.tool_key, 16), str(r.touches), str(r.hand), str(r.auto), str(r.overwritten),
              str(r.crashes), _duration(r.duration_s), _num(r.figures.get("mean_error_mm"), ".3f"),
              _num(r.figures.get("ci95_mm"), ".3f"), _num(r.position_error_mm, ".3f"),
