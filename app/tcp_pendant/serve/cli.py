@@ -95,7 +95,7 @@ def build_parser() -> argparse.ArgumentParser:
                         "several machines share (needs psycopg: pip install 'tcp-pendant[postgres]')")
     p.add_argument("--trainer-token", default=None, metavar="TOKEN",
                    help="the token that opens the trainer view, 16 to 200 printable characters (default: "
-                        "$TCP_PENDANT_TRAINER_TOKEN, else a random one, printed at start); a token given "
+                        "$TCP_PENDANT_TRAINER_TOKEN, else a random one, kept in a file named at start); a token given "
                         "here shows in the process list: prefer --trainer-token-file")
     p.add_argument("--trainer-token-file", type=Path, default=None, metavar="PATH",
                    help="read the trainer token from the first line of PATH (like --trainer-token, "
