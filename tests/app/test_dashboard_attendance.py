@@ -58,7 +58,7 @@ def test_stuck_and_idle_and_the_thresholds_outlast_a_restart(app_factory, tmp_pa
         dash = _dashboard(trainer)
         assert [(r.name, r.stuck, r.idle) for r in dash.rows] == [("ana", False, False),
                                                                   ("ben", True, False), ("chen", False, True)]
-        assert 'class="idle"' in dash.table_html.content and "☕ chen" in dash.table_html.content
+        assert 'class="idle"' in dash.table_html.content and "◔ chen" in dash.table_html.content
         choose(dash.stuck_min, 15.0, trainer.client)     # the trainer allows 15 min: ben is no longer stuck
         choose(dash.idle_min, 20.0, trainer.client)      # ... and 20 min of idling
         assert [(r.stuck, r.idle) for r in dash.rows] == [(False, False)] * 3

@@ -63,7 +63,7 @@ def test_the_dashboard_flags_the_stuck_and_the_idle_trainee(app_factory, new_pag
             box = page.get_by_label(label, exact=True).first.bounding_box()
             assert box is not None and box["y"] + box["height"] <= height, (label, box)   # in view, no scroll
         idle = page.locator(".tcp-dashboard-trainees tr.idle").first
-        assert "☕ chen" in idle.inner_text() and "idle" in idle.inner_text()
+        assert "◔ chen" in idle.inner_text() and "idle" in idle.inner_text()
         assert_not_blank(shot(page, f"attendance-{width}x{height}"), min_colors=50)
     finally:
         for c in clients:

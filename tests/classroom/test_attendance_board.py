@@ -51,7 +51,7 @@ def test_an_idle_trainee_is_flagged_against_the_trainers_threshold(joined_min, i
                             stuck_after_s=300.0, idle_after_s=idle_min * 60.0)
     assert row.idle is idle
     html = trainees_html([row])
-    assert (IDLE_BACKGROUND in html and "☕ chen" in html and 'class="idle"' in html) is idle
+    assert (IDLE_BACKGROUND in html and "◔ chen" in html and 'class="idle"' in html) is idle
     if idle and not extra:
         assert ">idle<" in html and ">6:00<" in html               # Step says idle, On step how long
 

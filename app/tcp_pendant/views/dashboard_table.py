@@ -3,7 +3,7 @@
 One line per trainee: short headers, no wrapping (``white-space: nowrap``), a long name or
 method cut with an ellipsis (the whole text in the cell's tooltip), 15 px text. A stuck row
 (``classroom.board``) has a yellow background and a "⚠" before the name; an idle row (joined,
-nothing started, quiet) a blue one, "☕" before the name and "idle" in its Step cell; a trainee
+nothing started, quiet) a blue one, "◔" before the name and "idle" in its Step cell; a trainee
 not connected is grey. Every text a trainee typed (names) and every stored text (methods, steps)
 goes through ``escape_html``: shown literally, never run. Numbers are ours.
 
@@ -76,7 +76,7 @@ def trainees_html(rows: Sequence[DashboardRow]) -> str:
         if r.tcp_mm is not None:                     # the result itself in the cell's tooltip
             tcp = ", ".join(f"{v:.1f}" for v in r.tcp_mm)
             err = f'<span title="TCP {escape_html(tcp)} mm">{err}</span>'
-        name = ("⚠ " if r.stuck else "☕ " if r.idle else "") + r.name
+        name = ("⚠ " if r.stuck else "◔ " if r.idle else "") + r.name
         step = "idle" if r.idle and not r.step else short_step(r.step)
         cells = (escape_html(str(r.number)), _cut(name, 11), _ON if r.connected else _OFF, _cut(r.method or "-", 10),
                  escape_html(step or "-"), format_duration(r.step_s if r.in_progress else r.quiet_s if r.idle else None),
