@@ -105,7 +105,8 @@ def test_the_exercise_seed_is_the_classs_unless_given_and_never_printed(tmp_path
         room = ClassRoom(book, {}, trainer_token="trainer-tok-12345678", exercise="mystery")
         seed = room._seed()
         assert seed == book.settings.exercise_seed() and seed.bit_length() > 20
-        lines = _class_lines(SimpleNamespace(classroom=room, trainer_url="http://127.0.0.1:1/?trainer=tok-12345678"))
+        lines = _class_lines(SimpleNamespace(classroom=room, url="http://127.0.0.1:1",
+                                             trainer_url="http://127.0.0.1:1/?trainer=tok-12345678"))
         assert "class gradebook" in lines and str(seed) not in lines
         assert ClassRoom(book, {}, trainer_token="trainer-tok-12345678", exercise_seed=7)._seed() == 7   # a demo's
         assert book.settings.exercise_seed() == seed                                          # kept
@@ -135,6 +136,7 @@ def test_the_ready_message_names_a_postgresql_gradebook_without_its_password(pos
     url = postgres_server.fresh_schema()
     with Gradebook(url) as book:
         room = ClassRoom(book, {}, trainer_token="trainer-tok-12345678")
-        lines = _class_lines(SimpleNamespace(classroom=room, trainer_url="http://127.0.0.1:1/?trainer=tok-12345678"))
+        lines = _class_lines(SimpleNamespace(classroom=room, url="http://127.0.0.1:1",
+                                             trainer_url="http://127.0.0.1:1/?trainer=tok-12345678"))
     assert f"  class gradebook {mask_url(url)} (free practice)\n" in lines
     assert ":***@" in lines and postgres_server.password not in lines

@@ -201,7 +201,7 @@ def test_index_paths_and_injection() -> None:
 def test_the_printed_trainer_url_carries_the_token_percent_encoded(app: PendantApp) -> None:
     url = f"http://127.0.0.1:{app.port}/?trainer=token%20with%20%26%20and%20%2B%20and%20%23"
     assert app.trainer_url == url
-    lines = _class_lines(app)
+    lines = _class_lines(app, print_token=True)                          # tcp-pendant --print-token
     assert f"Trainer view: {url}  trainer token: token with & and + and #\n" in lines
     from urllib.parse import parse_qs, urlsplit
 

@@ -82,8 +82,8 @@ def test_an_empty_database_gets_the_schema_with_8_byte_floats(postgres_server) -
                                          "table_name = 'calibrations' AND column_name = 'position_error_mm'") \
         == "double precision"
     assert _scalar(postgres_server, url, "SELECT count(*) FROM information_schema.tables WHERE "
-                                         "table_schema = 'public'") == 12     # 6 versioned + run_states, presence, class_pushes,
-                                                                        # departures, class_messages, token_failures
+                                         "table_schema = 'public'") == 13     # 6 versioned + run_states, presence, class_pushes,
+                                                            # departures, class_messages, token_failures, server_uptime
     with Gradebook(url) as g:                                   # opened again: everything kept
         assert [r.trainee for r in g.grades.rows()] == ["Anna"] and g.trainees.add("Anna") == 1
 

@@ -117,7 +117,7 @@ def test_the_moodle_csv_is_the_layout_moodles_grade_import_reads(tmp_path: Path,
     rows = sorted(list(csv.reader(io.StringIO(text)))[1:], key=lambda r: r[0] != "Anna")
     assert rows[0][:2] == ["Anna", str(MOODLE_POINTS["good"])] and 0 <= int(rows[0][1]) <= 100
     assert "best: good, TCP 0.30 mm off; 3 attempts; last: poor" == rows[0][2]
-    assert rows[1] == ["'=Ben", "", "no finished calibration yet"]
+    assert rows[1] == ["'=Ben", "", "joined, no calibration finished; 1 in progress"]
 
 
 def test_empty_gradebook(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

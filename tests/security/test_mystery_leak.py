@@ -7,7 +7,7 @@ and every tab's content is sent anyway), keeps every message the server sends it
 all of it: every number of every message in order, every float array (mesh vertices, points,
 poses), every raw byte string read as float32 and float64 (at every alignment), and every
 number written in a text (markdown, labels, notifications), and every file sent for download (the
-session record, the touches' CSV, a controller file: viser's file transfer parts put together and
+session record, the touches' CSV, the wizard's touches' CSV, a controller file: viser's file transfer parts put together and
 read as text). No three consecutive numbers may lie within 0.05 mm of the true TCP read from
 the gradebook: in FLANGE (metres and mm, the frame the tool's meshes come in), in WORLD and BASE
 at each flange pose the robot took (metres and mm), or as an offset from a zero tool (the
@@ -184,6 +184,8 @@ def test_a_hostile_trainee_reads_no_number_of_the_true_tcp(tmp_path: Path, app_f
         assert s.workflow.run.distance_mm == {}                   # nothing of it in the trainee's run
         click(cal.export, s.client)                               # Export session (JSON)
         click(s.views["touches"].export_csv, s.client)            # the free touches as CSV
+        assert cal.steps.export.button.visible
+        click(cal.steps.export.button, s.client)                  # the wizard's touches as CSV (tcpcal solve)
         click(tools.download, s.client)                           # the active tool's controller file
         marker = "Mallory was here"                               # the last thing sent
         choose(tools.entry_name, marker, s.client)
@@ -195,7 +197,8 @@ def test_a_hostile_trainee_reads_no_number_of_the_true_tcp(tmp_path: Path, app_f
         c.close()
 
     downloads = _downloads(c.messages)
-    assert len(downloads) == 3 and {SESSION_FILENAME, TOUCHES_FILENAME} <= set(downloads)   # + the controller file
+    assert len(downloads) == 4 and {SESSION_FILENAME, TOUCHES_FILENAME, "xyz4-touches.csv"} <= set(downloads)
+    assert downloads["xyz4-touches.csv"].startswith("# tcpcal solve xyz4")       # + the controller file
     record = json.loads(downloads[SESSION_FILENAME])
     assert record["honest"] is True and len(record["wizards"]) == 1
     assert "distance_mm" not in record["wizards"][0], "the export gives the touches' true distances"

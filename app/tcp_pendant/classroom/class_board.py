@@ -13,6 +13,7 @@ import json
 from dataclasses import dataclass
 
 from tcp_pendant.classroom.gradebook_store import GradebookStore
+from tcp_pendant.classroom.uptime import UPTIME_QUERY, downtimes
 
 __all__ = ["BoardReader", "BoardRun", "BoardTrainee", "ClassBoard"]
 
@@ -37,6 +38,7 @@ class BoardTrainee:
         in_progress: how many of the trainee's calibrations are in progress.
         result_calibration_id: the latest finished calibration, or None; position_error_mm,
             orientation_error_deg, grade, tcp_mm: its result (None: none, or no truth).
+        joined_at: when the trainee first joined (their first session, UTC ISO 8601), "" never.
     """
 
     trainee_id: int
@@ -56,6 +58,7 @@ class BoardTrainee:
     orientation_error_deg: float | None = None
     grade: str | None = None
     tcp_mm: tuple[float, float, float] | None = None
+    joined_at: str = ""
 
 
 @dataclass(frozen=True)
@@ -78,11 +81,13 @@ class BoardRun:
 
 @dataclass(frozen=True)
 class ClassBoard:
-    """:meth:`BoardReader.read`: every trainee (in the order they first joined) and every
-    calibration in progress (oldest first)."""
+    """:meth:`BoardReader.read`: every trainee (in the order they first joined), every
+    calibration in progress (oldest first) and the gaps no server process of the class was up
+    (``(from, to)`` Unix seconds, ``classroom.uptime``), which the dashboard's clocks leave out."""
 
     trainees: tuple[BoardTrainee, ...]
     in_progress: tuple[BoardRun, ...]
+    downtimes: tuple[tuple[float, float], ...] = ()
 
 
 _TRAINEES_QUERY = """
@@ -96,14 +101,16 @@ _TRAINEES_QUERY = """
                 (SELECT MAX(x.recorded_at) FROM touches x JOIN calibrations c ON c.id = x.calibration_id
                    JOIN sessions s ON s.id = c.session_id WHERE s.trainee_id = t.id) AS last_touch,
                 (SELECT COUNT(*) FROM calibrations c JOIN sessions s ON s.id = c.session_id
-                   WHERE s.trainee_id = t.id AND c.status = 'in_progress') AS n_open
+                   WHERE s.trainee_id = t.id AND c.status = 'in_progress') AS n_open,
+                (SELECT MIN(s.started_at) FROM sessions s WHERE s.trainee_id = t.id) AS joined
               FROM trainees t)
             SELECT b.tid, b.name, b.cid, c.method, c.status, r.method_title, r.step, r.step_since,
                    (SELECT COUNT(*) FROM touches x WHERE x.calibration_id = b.cid),
                    (SELECT COUNT(*) FROM crashes k WHERE (b.cid IS NOT NULL AND k.calibration_id = b.cid)
                       OR (k.calibration_id IS NULL AND k.session_id IN (SELECT id FROM sessions WHERE trainee_id = b.tid)
                           AND (c.started_at IS NULL OR k.at >= c.started_at))),
-                   b.last_touch, b.n_open, b.fid, f.position_error_mm, f.orientation_error_deg, f.grade, f.tcp_mm_json
+                   b.last_touch, b.n_open, b.fid, f.position_error_mm, f.orientation_error_deg, f.grade, f.tcp_mm_json,
+                   b.joined
             FROM b LEFT JOIN calibrations c ON c.id = b.cid LEFT JOIN run_states r ON r.calibration_id = b.cid
                    LEFT JOIN calibrations f ON f.id = b.fid
             ORDER BY b.tid"""
@@ -131,14 +138,16 @@ class BoardReader:
         with self._store.read() as db:
             rows = db.execute(_TRAINEES_QUERY).fetchall()
             runs = db.execute(_RUNS_QUERY).fetchall()
+            stretches = db.execute(UPTIME_QUERY).fetchall()
         trainees = tuple(BoardTrainee(
             trainee_id=tid, name=name, calibration_id=cid, method=method or "", status=status or "",
             method_title=title or "", step=step or "", step_since=since or "", touches=int(n), crashes=int(k),
             last_touch_at=last or "", in_progress=int(n_open), result_calibration_id=fid, position_error_mm=pos,
-            orientation_error_deg=ori, grade=grade, tcp_mm=tuple(json.loads(tcp)) if tcp else None)
-            for (tid, name, cid, method, status, title, step, since, n, k, last, n_open, fid, pos, ori, grade, tcp)
-            in rows)
+            orientation_error_deg=ori, grade=grade, tcp_mm=tuple(json.loads(tcp)) if tcp else None,
+            joined_at=joined or "")
+            for (tid, name, cid, method, status, title, step, since, n, k, last, n_open, fid, pos, ori, grade, tcp,
+                 joined) in rows)
         open_runs = tuple(BoardRun(calibration_id=cid, trainee=name, method=method, method_title=title or "",
                                    step=step or "", step_since=since or "", started_at=started or "", touches=int(n))
                           for cid, name, method, title, step, since, started, n in runs)
-        return ClassBoard(trainees, open_runs)
+        return ClassBoard(trainees, open_runs, downtimes(stretches))

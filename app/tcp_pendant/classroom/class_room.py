@@ -113,7 +113,7 @@ from tcp_pendant.classroom.message_delivery import MessageDelivery
 from tcp_pendant.classroom.names import TraineeNameError, validate_trainee_name
 from tcp_pendant.classroom.recorder import TraineeRecorder, TraineeStatus
 from tcp_pendant.classroom.replay import CalibrationReplay, calibration_replay
-from tcp_pendant.classroom.restore import runs_to_restore
+from tcp_pendant.classroom.restore import restored_words, runs_to_restore
 from tcp_pendant.classroom.roster import Roster, Seat
 from tcp_pendant.classroom.trainee_settings import apply_rules, mount_mystery
 from tcp_pendant.classroom.trainees import TraineeJoin
@@ -393,9 +393,7 @@ class ClassRoom:
         indices = session.wizard_commands.restore_runs([r.run for r in restored])
         for index, r in zip(indices, restored):
             recorder.adopt(index, r.calibration_id, r.touch_ids)
-        n = len(restored)
-        session.notify("Calibration restored", f"{n} calibration{'s' if n != 1 else ''} you had in progress "
-                       "came back, each at its step with its touches.", kind="info")
+        session.notify("Calibration restored", restored_words(restored), kind="info")
 
     def detach(self, session: Session) -> None:
         """The session closed (its browser left)."""
@@ -502,7 +500,7 @@ class ClassRoom:
         return self.gradebook.grades.rows()
 
     def grades_csv(self) -> str:
-        return to_csv(self.gradebook.grades.rows())
+        return to_csv(self.gradebook.grades.rows(), self.gradebook.grades.attendance())
 
     def push_settings(self, exercise: str | None, tool_key: str | None,
                       hide_distance: bool | str | None = None, auto_touch: bool | None = None, *,

@@ -15,7 +15,24 @@ from dataclasses import dataclass, field
 from tcp_pendant.classroom.gradebook_store import GradebookStore
 from tcp_pendant.classroom.gradebook_values import duration_s, utc_now
 
-__all__ = ["GradeRow", "Grades"]
+__all__ = ["Attendee", "GradeRow", "Grades", "NO_RESULT_REASON"]
+
+NO_RESULT_REASON = "joined, no calibration finished"
+"""Why a trainee who joined has an empty grade in every export (``grades_csv``, ``lms``)."""
+
+
+@dataclass(frozen=True)
+class Attendee:
+    """A trainee who joined the class (has a gradebook session), for the exports that list
+    every trainee (:meth:`Grades.attendance`).
+
+    Attributes:
+        trainee: the name (raw text: escape before showing it as markdown).
+        joined_at: their first session's start (UTC ISO 8601).
+    """
+
+    trainee: str
+    joined_at: str
 
 
 @dataclass(frozen=True)
@@ -73,6 +90,14 @@ class Grades:
 
     def __init__(self, store: GradebookStore) -> None:
         self._store = store
+
+    def attendance(self) -> list[Attendee]:
+        """Every trainee who joined (at least one session), in the order they first joined; a
+        name added but never joined under is not listed."""
+        with self._store.read() as db:
+            rows = db.execute("SELECT t.name, MIN(s.started_at) FROM trainees t JOIN sessions s ON s.trainee_id = t.id "
+                              "GROUP BY t.id, t.name ORDER BY MIN(s.started_at), t.id").fetchall()
+        return [Attendee(trainee=str(name), joined_at=str(joined)) for name, joined in rows]
 
     def rows(self, *, include_in_progress: bool = False) -> list[GradeRow]:
         """One row per finished calibration, oldest start first; with ``include_in_progress``

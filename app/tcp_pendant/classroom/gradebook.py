@@ -31,6 +31,8 @@ callers use the parts directly (``book.records.record_touch(...)``):
                               (:mod:`~tcp_pendant.classroom.waiting_messages`)
 ``book.token_failures``       wrong trainer tokens per source address
                               (:mod:`~tcp_pendant.classroom.token_failures`)
+``book.uptime``               when each server process was up, for clocks without the downtime
+                              (:mod:`~tcp_pendant.classroom.uptime`)
 ============================  =====================================================================
 """
 
@@ -48,6 +50,7 @@ from tcp_pendant.classroom.presence import Presence
 from tcp_pendant.classroom.run_states import RunStates
 from tcp_pendant.classroom.token_failures import TokenFailures
 from tcp_pendant.classroom.trainees import Trainees
+from tcp_pendant.classroom.uptime import ServerUptime
 from tcp_pendant.classroom.training_records import TrainingRecords
 from tcp_pendant.classroom.waiting_messages import WaitingMessages
 
@@ -75,8 +78,8 @@ class Gradebook:
         location: what messages name: the file's path, or the URL with its password masked.
 
     Its parts (module docstring) are the attributes ``store``, ``trainees``, ``records``,
-    ``run_states``, ``grades``, ``board``, ``settings``, ``presence``, ``pushes``, ``messages`` and
-    ``token_failures``.
+    ``run_states``, ``grades``, ``board``, ``settings``, ``presence``, ``pushes``, ``messages``,
+    ``token_failures`` and ``uptime``.
 
     Raises:
         GradebookError: the file is not an SQLite database, is damaged, is another program's
@@ -101,6 +104,7 @@ class Gradebook:
         self.pushes = ClassPushes(store)
         self.messages = WaitingMessages(store)
         self.token_failures = TokenFailures(store)
+        self.uptime = ServerUptime(store)
 
     def close(self) -> None:
         """Close the connection (idempotent); later calls raise ``GradebookError``."""

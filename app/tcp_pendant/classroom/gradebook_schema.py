@@ -34,6 +34,11 @@ Added to every file when it is opened (no schema version: an older reader ignore
                                                                        dismissed yet, one row per trainee
     token_failures(id PRIMARY KEY, source, failed_at)                  wrong trainer tokens per source
                                                                        address (the last hour)
+    server_uptime(holder PRIMARY KEY, started_at, seen_at)             when each server process was up
+                                                                       (the clocks leave downtime out)
+
+and the column ``run_states.result_saved_at`` (with ``method_title``, ``step``, ``step_since``:
+:data:`RUN_STATE_COLUMNS`).
 
 A new table: add it to :data:`SCHEMA` (a new schema version and a :func:`migrate` step) or, if
 an older reader may ignore it, to :data:`ADDITIVE_TABLES`.
@@ -167,13 +172,22 @@ _TOKEN_FAILURES = """CREATE TABLE IF NOT EXISTS token_failures (
 Unix time, seconds), for every server process of the class: the lockout
 (``classroom.trainer_token``) counts them whichever process a browser reaches, and after a
 restart. Rows older than the caller's ``forget_s`` are deleted at each try."""
-RUN_STATE_COLUMNS = (("method_title", "TEXT"), ("step", "TEXT"), ("step_since", "TEXT"))
+_SERVER_UPTIME = """CREATE TABLE IF NOT EXISTS server_uptime (
+    holder TEXT PRIMARY KEY,
+    started_at REAL NOT NULL,
+    seen_at REAL NOT NULL)"""
+"""When each server process of the class started and last beat (Unix time, seconds;
+``classroom.uptime``): the gaps between are the server's downtime, which the trainer's clocks
+(time on the step, stuck, idle) leave out."""
+RUN_STATE_COLUMNS = (("method_title", "TEXT"), ("step", "TEXT"), ("step_since", "TEXT"), ("result_saved_at", "TEXT"))
 """Added to ``run_states`` when missing (additive, like the table): the wizard's title and the
 step as the trainee saw it ("Step 2 of 4", "result", "cancelled") and since when (UTC), for the
-trainer's dashboard after a restart (``BoardReader.read``)."""
+trainer's dashboard after a restart (``BoardReader.read``); when its result as it is now was
+saved to the tool library (UTC; NULL: not saved, and a new result clears it), so that a restart
+gives back a finished result until it is saved or dismissed (``classroom.restore``)."""
 ADDITIVE_TABLES = {"run_states": _RUN_STATES, "presence": _PRESENCE, "class_pushes": _CLASS_PUSHES,
                    "departures": _DEPARTURES, "class_messages": _CLASS_MESSAGES,
-                   "token_failures": _TOKEN_FAILURES}
+                   "token_failures": _TOKEN_FAILURES, "server_uptime": _SERVER_UPTIME}
 """Tables made (CREATE TABLE IF NOT EXISTS, by name) in every gradebook that lacks them when it
 is opened, after the versioned schema; written in SQLite's words like every statement
 (``gradebook_db.sql_for``). A gradebook that has them all is not asked to create anything (a

@@ -126,6 +126,7 @@ class Heartbeat:
             self._beater.join(timeout=5.0)
             self._beater = None
         try:
+            self._gradebook.uptime.beat(self.holder, force=True)   # up until now: downtime starts here
             self._gradebook.presence.drop_holder(self.holder)
         except GradebookError:
             log.debug("presence not dropped: gradebook closed", exc_info=True)
@@ -141,6 +142,7 @@ class Heartbeat:
 
     def beat(self) -> None:
         """One heartbeat (``ClassRoom.beat``; module docstring)."""
+        self._gradebook.uptime.beat(self.holder)       # this process is up (``classroom.uptime``)
         seats = {seat.name: seat for seat in self._roster.seats()}
         statuses = {name: dataclasses.asdict(seat.recorder.status) for name, seat in seats.items()}
         held = self._gradebook.presence.beat(self.holder, statuses)

@@ -14,7 +14,9 @@ onto one gradebook write, in order:
 - :class:`~tcp_pendant.events.RunFinished` -> ``finish_calibration`` (figures, TCP, A B C, error
   against the truth, grade; a new result of the same run replaces it);
 - :class:`~tcp_pendant.events.RunCancelled` -> ``cancel_calibration`` (a finished run stays
-  finished), :class:`~tcp_pendant.events.RunResumed` -> ``resume_calibration``.
+  finished), :class:`~tcp_pendant.events.RunResumed` -> ``resume_calibration``;
+- :class:`~tcp_pendant.events.ToolSaved` -> ``run_states.mark_saved`` (a restart no longer
+  gives that result back; a new result of the run clears the mark).
 
 Runs loaded from a session record file are somebody's earlier work, not this session's: the
 workflow makes no events for them, so they are not stored.
@@ -40,7 +42,9 @@ from typing import TYPE_CHECKING, cast
 import numpy as np
 
 from tcp_pendant.classroom.gradebook import Gradebook
-from tcp_pendant.events import Crash, RunCancelled, RunFinished, RunResumed, RunStarted, SessionEvent, TouchRecorded
+from tcp_pendant.events import (
+    Crash, RunCancelled, RunFinished, RunResumed, RunStarted, SessionEvent, ToolSaved, TouchRecorded,
+)
 from tcp_pendant.wizards.session_record import run_entry
 from tcp_pendant.wizards.truth import compare_with_truth
 
@@ -146,7 +150,10 @@ class TraineeRecorder:
         """Go on writing run ``run_index`` (restored after a restart) into its calibration;
         ``touch_ids``: step -> the touch that counts there (the next overwrite links it)."""
         with self._lock:
-            self._runs[int(run_index)] = _RunState(int(calibration_id), dict(touch_ids))
+            runs = [] if self.workflow is None else self.workflow.runs
+            done = 0 <= run_index < len(runs) and runs[run_index].wizard.finished_result is not None
+            self._runs[int(run_index)] = _RunState(int(calibration_id), dict(touch_ids),
+                                                   status="finished" if done else "in_progress")
             if self.workflow is not None:
                 self.workflow.record_ids[int(run_index)] = int(calibration_id)
             self._status = replace(self._status, touches=self._status.touches + len(touch_ids))
@@ -194,7 +201,9 @@ class TraineeRecorder:
         st = None if run_index is None else self._runs.get(run_index)
         if st is None:                      # a run of a loaded record, or started before the name
             return
-        if isinstance(event, TouchRecorded):
+        if isinstance(event, ToolSaved):
+            self.gradebook.run_states.mark_saved(st.calibration_id)
+        elif isinstance(event, TouchRecorded):
             dist = event.distance_mm if math.isfinite(event.distance_mm) else None
             touch_id = self.gradebook.records.record_touch(
                 st.calibration_id, event.step, event.T_world_flange_m, np.asarray(event.joints_deg, dtype=float),
@@ -221,6 +230,7 @@ class TraineeRecorder:
         self.gradebook.records.finish_calibration(
             st.calibration_id, result.figures, position_error_mm=pos, orientation_error_deg=ori, grade=grade,
             tcp_mm=tuple(result.tcp_mm), abc_deg=None if result.abc_deg is None else tuple(result.abc_deg))
+        self.gradebook.run_states.mark_saved(st.calibration_id, False)     # a new result: not saved yet
         st.status = "finished"
         tcp = ", ".join(f"{v:.1f}" for v in result.tcp_mm)
         self._status = replace(self._status, last_result=tcp, grade=grade or "")

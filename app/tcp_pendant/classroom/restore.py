@@ -1,4 +1,5 @@
-"""What a restart gives back to a trainee: the calibrations in progress, from the gradebook.
+"""What a restart gives back to a trainee: the calibrations in progress, and a finished result
+not saved yet, from the gradebook.
 
 The recorder keeps each calibration's wizard in the gradebook as it is acknowledged
 (``Gradebook.run_states.save``: a session record entry without truth). When a trainee joins
@@ -6,7 +7,11 @@ again under their name (after a reload, a reconnect to another server process, o
 of the server with the same gradebook), :func:`runs_to_restore` rebuilds those wizards with the
 truth the gradebook keeps apart (``calibrations.truth_json``), so the trainee finds each one at
 its step with its touches, and :class:`~tcp_pendant.classroom.recorder.TraineeRecorder` goes on
-writing into the same calibrations (``TraineeRecorder.adopt``). No viser here.
+writing into the same calibrations (``TraineeRecorder.adopt``). A finished calibration whose
+result was on show and not saved to the tool library comes back on show too (recomputed with
+tcpcal from its touches), so the trainee can still save it; it outlasts every restart until it
+is saved (``RunStates.mark_saved``) or dismissed (closed, or left for another calibration). A
+finished check (a method that saves nothing) is done and does not come back. No viser here.
 """
 
 from __future__ import annotations
@@ -20,7 +25,7 @@ from tcp_pendant.classroom.gradebook import Gradebook
 from tcp_pendant.wizards import Wizard, WizardError
 from tcp_pendant.wizards.session_record import WizardRun, step_distances, step_joints
 
-__all__ = ["RestoredRun", "runs_to_restore"]
+__all__ = ["RestoredRun", "restored_words", "runs_to_restore"]
 
 log = logging.getLogger(__name__)
 
@@ -33,11 +38,13 @@ class RestoredRun:
         run: the wizard with its true tool, joints and distances.
         calibration_id: its gradebook calibration.
         touch_ids: step -> the gradebook id of the touch that counts (the next overwrite links it).
+        finished: a finished result not saved yet (else a calibration in progress).
     """
 
     run: WizardRun
     calibration_id: int
     touch_ids: dict[int, int]
+    finished: bool = False
 
 
 def _truth_matrix(truth: object) -> np.ndarray | None:
@@ -60,8 +67,28 @@ def runs_to_restore(gradebook: Gradebook, trainee: str) -> list[RestoredRun]:
         except (WizardError, KeyError, TypeError, ValueError) as exc:
             log.warning("calibration %s of %r not restored: %s", row["calibration_id"], trainee, exc)
             continue
+        finished = row.get("status") == "finished"
+        if finished and (wizard.finished_result is None or not wizard.saves_to_library):
+            continue                      # a check is done when finished; a result that no longer computes: skipped
         key = (entry.get("true_tool") or {}).get("key") or row["tool_key"]
         run = WizardRun(wizard, key, _truth_matrix(row["truth"]),
                         joints_deg=step_joints(entry), distance_mm=step_distances(entry))
-        out.append(RestoredRun(run, int(row["calibration_id"]), dict(row["touch_ids"])))
+        out.append(RestoredRun(run, int(row["calibration_id"]), dict(row["touch_ids"]), finished))
     return out
+
+
+def restored_words(restored: list[RestoredRun]) -> str:
+    """What the trainee is told about ``restored`` (plain text), e.g. "1 calibration you had in
+    progress came back, at its step with its touches. Your XYZ 4-point result not saved yet came
+    back: save it to the tool library or close it." """
+    open_ = [r for r in restored if not r.finished]
+    results = [r for r in restored if r.finished]
+    parts = []
+    if open_:
+        n = len(open_)
+        parts.append(f"{n} calibration{'s' if n != 1 else ''} you had in progress came back, "
+                     f"{'each ' if n != 1 else ''}at its step with its touches.")
+    for r in results:
+        parts.append(f"Your {r.run.wizard.title} result not saved yet came back: save it to the tool library "
+                     "or close it.")
+    return " ".join(parts)

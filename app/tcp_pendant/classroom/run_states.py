@@ -3,8 +3,11 @@
 wizard's title and step as the trainee saw it, for the trainer's dashboard.
 
 The recorder keeps a wizard here whenever its place changes (``classroom.recorder``); a server
-started again with the same gradebook rebuilds the trainee's calibrations in progress from
-:meth:`RunStates.open_runs` and the truth kept apart (``classroom.restore``).
+started again with the same gradebook rebuilds the trainee's calibrations in progress, and the
+finished ones whose result is on show and not saved yet, from :meth:`RunStates.open_runs` and
+the truth kept apart (``classroom.restore``). A result saved to the tool library is marked
+(:meth:`RunStates.mark_saved`, column ``result_saved_at``; a new result of the run clears it);
+one the trainee closed (its step "cancelled") is dismissed: neither comes back.
 """
 
 from __future__ import annotations
@@ -60,22 +63,33 @@ class RunStates:
                        "THEN excluded.step_since ELSE COALESCE(run_states.step_since, excluded.step_since) END, "
                        "step = COALESCE(excluded.step, run_states.step)", (cid, text, now, title, where, now))
 
+    def mark_saved(self, calibration_id: int, saved: bool = True) -> None:
+        """The result of calibration ``calibration_id`` as it is now was saved to the tool
+        library (``saved``), or it has a new result not saved yet (False). Nothing happens to a
+        calibration without a kept wizard."""
+        when = utc_now() if saved else None
+        with self._store.write() as db:
+            cid = calibration_row(self._store, db, calibration_id)[0]
+            db.execute("UPDATE run_states SET result_saved_at = ? WHERE calibration_id = ?", (when, cid))
+
     def open_runs(self, trainee: str) -> Sequence[JsonRecord]:
-        """The calibrations of ``trainee`` still in progress that have a stored wizard, oldest
-        first: ``{"calibration_id", "method", "tool_key", "exercise_id", "truth", "entry",
-        "touch_ids"}`` (``touch_ids``: step -> the id of its touch that counts, to link the next
-        overwrite); for a restart to give them back."""
+        """The calibrations of ``trainee`` that have a stored wizard and are still in progress,
+        or finished with their result on show ("result") and not saved to the library, oldest
+        first: ``{"calibration_id", "status", "method", "tool_key", "exercise_id", "truth",
+        "entry", "touch_ids"}`` (``touch_ids``: step -> the id of its touch that counts, to link
+        the next overwrite); for a restart to give them back."""
         with self._store.read() as db:
             rows = db.execute(
-                "SELECT c.id, c.method, c.tool_key, c.exercise_id, c.truth_json, r.entry_json FROM calibrations c "
-                "JOIN sessions s ON s.id = c.session_id JOIN trainees t ON t.id = s.trainee_id "
+                "SELECT c.id, c.status, c.method, c.tool_key, c.exercise_id, c.truth_json, r.entry_json "
+                "FROM calibrations c JOIN sessions s ON s.id = c.session_id JOIN trainees t ON t.id = s.trainee_id "
                 "JOIN run_states r ON r.calibration_id = c.id "
-                "WHERE t.name = ? AND c.status = 'in_progress' ORDER BY c.started_at, c.id", (str(trainee),)).fetchall()
+                "WHERE t.name = ? AND (c.status = 'in_progress' OR (c.status = 'finished' AND r.step = 'result' "
+                "AND r.result_saved_at IS NULL)) ORDER BY c.started_at, c.id", (str(trainee),)).fetchall()
             out = []
-            for cid, method, tool, exercise, truth, entry in rows:
+            for cid, status, method, tool, exercise, truth, entry in rows:
                 touch_ids = {int(step): int(tid) for tid, step in db.execute(
                     "SELECT id, step_index FROM touches WHERE calibration_id = ? AND overwritten_by_touch_id IS NULL",
                     (cid,))}
-                out.append({"calibration_id": cid, "method": method, "tool_key": tool, "exercise_id": exercise,
+                out.append({"calibration_id": cid, "status": status, "method": method, "tool_key": tool, "exercise_id": exercise,
                             "truth": json.loads(truth), "entry": json.loads(entry), "touch_ids": touch_ids})
         return out

@@ -32,6 +32,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from tcp_pendant.classroom.gradebook_db import class_db_target, url_has_password
+from tcp_pendant.serve.token_notice import class_lines, token_source
 
 if TYPE_CHECKING:                       # the server is imported in main() only (no pinocchio for --help)
     from tcp_pendant.serve.server import PendantApp
@@ -120,11 +121,13 @@ def _add_class_options(p: argparse.ArgumentParser) -> None:
                         "several machines share (needs psycopg: pip install 'tcp-pendant[postgres]')")
     p.add_argument("--trainer-token", default=None, metavar="TOKEN",
                    help="the token that opens the trainer view, 16 to 200 printable characters (default: "
-                        "$TCP_PENDANT_TRAINER_TOKEN, else a random one, printed at start); a token given "
+                        "$TCP_PENDANT_TRAINER_TOKEN, else a random one, kept in a file named at start); a token given "
                         "here shows in the process list: prefer --trainer-token-file")
     p.add_argument("--trainer-token-file", type=Path, default=None, metavar="PATH",
                    help="read the trainer token from the first line of PATH (like --trainer-token, "
                         "but not shown in the process list)")
+    p.add_argument("--print-token", action="store_true", help="print the whole trainer token and the trainer "
+                   "address at start (default: its first 4 characters and where to read it)")
     p.add_argument("--exercise", default=None, choices=("mystery",),
                    help="start an exercise: mystery = each trainee calibrates a tool of their own whose "
                         "true TCP and orientation only the gradebook knows")
@@ -254,9 +257,11 @@ def _main(argv: Sequence[str] | None) -> int:
         mode += (f"; {args.workers} server processes on port {app.port} (pids "
                  f"{', '.join(str(p) for p in [os.getpid(), *workers.pids])})")
     tip_mm = ", ".join(f"{v:.0f}" for v in app.reference_tip_m * 1000.0)
+    in_class = getattr(app, "classroom", None) is not None
+    token_from = token_source(args.trainer_token, args.trainer_token_file, os.environ if in_class else {})
     print(f"TCP Pendant ready in {time.perf_counter() - t0:.1f} s: {ready_urls(url, app.network_urls, args.host)}"
           f"\n  robot {app.robot_label}, tool {app.tool.label}, reference tip ({tip_mm}) mm, {mode}\n"
-          f"  tool library {app.library.path}\n{_class_lines(app)}  Ctrl-C to stop.", flush=True)
+          f"  tool library {app.library.path}\n{_class_lines(app, token_from, args.print_token)}  Ctrl-C to stop.", flush=True)
     try:
         app.serve_forever()
     finally:
@@ -487,20 +492,9 @@ def _serve_as_worker(app: PendantApp, parent_pid: int) -> int:
     return 0
 
 
-def _class_lines(app: PendantApp) -> str:
-    """The classroom lines of the ready message (empty without a gradebook)."""
-    room = getattr(app, "classroom", None)
-    if room is None:
-        return ""
-    exercise = "mystery tools" if room.exercise == "mystery" else "free practice"
-    if room.trainer_token is None:
-        return (f"  class gradebook {room.gradebook.location} ({exercise})\n"
-                f"Trainer view: {app.url} with the trainer token this class began with (kept hashed in the "
-                "gradebook, so an open trainer page reconnects); give --trainer-token to set a new one\n")
-    return (f"  class gradebook {room.gradebook.location} ({exercise})\n"
-            f"Trainer view: {app.trainer_url}  trainer token: {room.trainer_token}\n"
-            "  (open that address: the page fills in the token and drops it from the address bar; or open the "
-            "page and type the token in \"Trainer token\" of the welcome window; keep both secret)\n")
+def _class_lines(app: PendantApp, source: str = "", print_token: bool = False) -> str:
+    """The classroom lines of the ready message (``serve.token_notice``: the token masked)."""
+    return class_lines(app, source, print_token)
 
 
 if __name__ == "__main__":  # pragma: no cover

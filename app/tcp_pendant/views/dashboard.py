@@ -6,8 +6,9 @@ are taken down (``Session.drop_views``; the GUI and the robot scene cleared), th
 is widened to the whole window (viser's ``main_panel.set_width``; 1024x768 projector), and
 :func:`build_dashboard` lays out its folders, each built by one small function (:data:`FOLDERS`):
 
-- **Class**: "Stuck after (min)" and the live table (``views.dashboard_table``: one line per
-  trainee, stuck rows highlighted), then the calibrations in progress;
+- **Class**: "Stuck after (min)" and "Idle after (min)" (kept in the gradebook, so they outlast
+  a restart: ``classroom.dashboard_settings``) and the live table (``views.dashboard_table``: one
+  line per trainee, stuck and idle rows highlighted), then the calibrations in progress;
 - **Position errors**: one mark per trainee (x: the trainee's ``#``, y: the last position
   error against the truth, mm; integer ticks only);
 - **Trainee**: choose a trainee, then **Reset wizard** (their running wizard cancelled,
@@ -38,7 +39,10 @@ import numpy as np
 import viser
 from viser.uplot import Scale
 
-from tcp_pendant.classroom.board import DEFAULT_STUCK_MIN, DashboardRow, dashboard_rows, open_runs
+from tcp_pendant.classroom.board import DEFAULT_IDLE_MIN, DEFAULT_STUCK_MIN, DashboardRow, dashboard_rows, open_runs
+from tcp_pendant.classroom.dashboard_settings import (
+    IDLE_SETTING, MAX_MINUTES, MIN_MINUTES, STUCK_SETTING, keep_minutes, kept_minutes,
+)
 from tcp_pendant.classroom.class_board import ClassBoard
 from tcp_pendant.classroom.grading import grade_record
 from tcp_pendant.classroom.replay import CalibrationReplay
@@ -118,7 +122,7 @@ class TrainerDashboard:
         replay_scene: the 3D replay.
         folders: the folders by title ("Class", "Exercise", ...), for the builders of other modules.
 
-    The widgets (for tests): stuck_min, table_html, runs_html, chart, trainee, reset,
+    The widgets (for tests): stuck_min, idle_min, table_html, runs_html, chart, trainee, reset,
     replay_button, close_replay, one_exercise, one_tool, one_hide_distance, one_auto_touch,
     push_one, release, action_md, exercise, tool, hide_distance, auto_touch, push, push_md,
     grades_md, download, grade_upload, grade_md.
@@ -128,6 +132,7 @@ class TrainerDashboard:
     tool_panel: ToolPanel
     rules_md: viser.GuiMarkdownHandle
     stuck_min: viser.GuiNumberHandle[float]
+    idle_min: viser.GuiNumberHandle[float]
     table_html: viser.GuiHtmlHandle
     runs_html: viser.GuiHtmlHandle
     chart: viser.GuiUplotHandle
@@ -180,12 +185,23 @@ class TrainerDashboard:
         except (TypeError, ValueError):
             return DEFAULT_STUCK_MIN * 60.0
 
+    def idle_after_s(self) -> float:
+        try:
+            return float(self.idle_min.value) * 60.0
+        except (TypeError, ValueError):
+            return DEFAULT_IDLE_MIN * 60.0
+
+    def _threshold_changed(self, key: str, widget: viser.GuiNumberHandle[float]) -> None:
+        """A threshold typed: kept in the gradebook (it outlasts a restart), then the table."""
+        keep_minutes(self.control.gradebook.settings, key, float(widget.value))
+        self.render()
+
     def render(self, board: ClassBoard | None = None, connected: Collection[str] | None = None) -> None:
         """Show the class (``board`` and ``connected``: read now when not given)."""
         board = self.control.board() if board is None else board
         connected = set(self.control.connected_names()) if connected is None else connected
         now = datetime.now(timezone.utc)
-        self.rows = dashboard_rows(board, connected, now, self.stuck_after_s())
+        self.rows = dashboard_rows(board, connected, now, self.stuck_after_s(), self.idle_after_s())
         set_content(self.table_html, trainees_html(self.rows))
         set_content(self.runs_html, in_progress_html(open_runs(board, connected, now)))
         self._render_chart()
@@ -321,23 +337,32 @@ class TrainerDashboard:
 
 # ---------------------------------------------------------------- the folders
 def class_folder(dash: TrainerDashboard) -> None:
-    """The stuck threshold, the live table and the calibrations in progress."""
-    gui = dash.gui
+    """The stuck and idle thresholds (as kept in the gradebook), the live table and the
+    calibrations in progress."""
+    gui, settings = dash.gui, dash.control.gradebook.settings
     with dash.folder("Class"):
-        dash.stuck_min = gui.add_number("Stuck after (min)", DEFAULT_STUCK_MIN, min=0.5, max=240.0, step=0.5,
+        dash.stuck_min = gui.add_number("Stuck after (min)", kept_minutes(settings, STUCK_SETTING), min=MIN_MINUTES,
+                                        max=MAX_MINUTES, step=0.5,
                                         hint="A trainee with no touch and no new step for this long in a "
-                                             "calibration is highlighted.")
+                                             "calibration is highlighted (the server's downtime not counted).")
+        dash.idle_min = gui.add_number("Idle after (min)", kept_minutes(settings, IDLE_SETTING), min=MIN_MINUTES,
+                                       max=MAX_MINUTES, step=0.5,
+                                       hint="A trainee who joined and has no calibration in progress or finished, "
+                                            "with no step and no touch for this long, is marked idle.")
         dash.table_html = gui.add_html("")
         gui.add_markdown("**Calibrations in progress**")
         dash.runs_html = gui.add_html("")
-    dash.stuck_min.on_update(dash.session.loop.on_loop(_rerender(dash)))
+    dash.stuck_min.on_update(dash.session.loop.on_loop(_on_threshold(dash, STUCK_SETTING)))
+    dash.idle_min.on_update(dash.session.loop.on_loop(_on_threshold(dash, IDLE_SETTING)))
 
 
-def _rerender(dash: TrainerDashboard) -> Callable[[viser.GuiEvent[viser.GuiNumberHandle[float]]], None]:
-    """A setting's callback that draws the dashboard again with the new value."""
-    def rerender(_event: viser.GuiEvent[viser.GuiNumberHandle[float]]) -> None:
-        dash.render()
-    return rerender
+def _on_threshold(dash: TrainerDashboard, key: str) -> Callable[[viser.GuiEvent[viser.GuiNumberHandle[float]]], None]:
+    """A threshold's callback: the minutes typed are kept in the gradebook under ``key`` (they
+    outlast a restart), then the table is drawn again with them."""
+    def changed(event: viser.GuiEvent[viser.GuiNumberHandle[float]]) -> None:
+        dash._threshold_changed(key, event.target)
+    return changed
+
 
 def chart_folder(dash: TrainerDashboard) -> None:
     """The class's position errors, one mark per trainee."""

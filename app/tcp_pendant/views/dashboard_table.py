@@ -2,8 +2,9 @@
 
 One line per trainee: short headers, no wrapping (``white-space: nowrap``), a long name or
 method cut with an ellipsis (the whole text in the cell's tooltip), 15 px text. A stuck row
-(``classroom.board``) has a yellow background and a "⚠" before the name; a trainee not
-connected is grey. Every text a trainee typed (names) and every stored text (methods, steps)
+(``classroom.board``) has a yellow background and a "⚠" before the name; an idle row (joined,
+nothing started, quiet) a blue one, "◔" before the name and "idle" in its Step cell; a trainee
+not connected is grey. Every text a trainee typed (names) and every stored text (methods, steps)
 goes through ``escape_html``: shown literally, never run. Numbers are ours.
 
 Columns of :func:`trainees_html`: ``#`` (the trainee's mark on the chart), Trainee, On (●
@@ -20,12 +21,14 @@ from collections.abc import Sequence
 from tcp_pendant.classroom.board import DashboardRow, OpenRun, format_duration
 from tcp_pendant.text_escape import escape_html
 
-__all__ = ["FONT_PX", "STUCK_BACKGROUND", "in_progress_html", "short_step", "trainees_html"]
+__all__ = ["FONT_PX", "IDLE_BACKGROUND", "STUCK_BACKGROUND", "in_progress_html", "short_step", "trainees_html"]
 
 FONT_PX = 15
 """Table text size, pixels (readable from the back of a room on a 1024x768 projector)."""
 STUCK_BACKGROUND = "#ffe08a"
 """Background of a stuck trainee's row."""
+IDLE_BACKGROUND = "#d6e4ff"
+"""Background of an idle trainee's row."""
 _CELL = "padding:2px 6px;white-space:nowrap;border-bottom:1px solid #ddd"
 _CUT = "display:inline-block;overflow:hidden;text-overflow:ellipsis;vertical-align:bottom;max-width:{em}em"
 _STEP = re.compile(r"^Step (\d+) of (\d+)$")
@@ -54,7 +57,7 @@ def _table(headers: Sequence[tuple[str, str]], body: list[str], cls: str) -> str
 
 TRAINEE_HEADERS: tuple[tuple[str, str], ...] = (
     ("#", "the trainee's mark on the chart"), ("Trainee", "name"), ("On", "connected now"),
-    ("Method", "the latest calibration"), ("Step", "where it is"), ("On step", "time on the step (m:ss)"),
+    ("Method", "the latest calibration"), ("Step", "where it is"), ("On step", "time on the step, or idle for (m:ss)"),
     ("Last touch", "time since the last touch (m:ss)"), ("Touches", "touches recorded in the latest calibration"),
     ("Crashes", "crashes in the latest calibration"),
     ("Err mm", "position error of the last finished calibration against the true TOOL frame"),
@@ -67,17 +70,20 @@ def trainees_html(rows: Sequence[DashboardRow]) -> str:
         return f'<div style="font-size:{FONT_PX}px"><i>No trainee has given a name yet.</i></div>'
     body = []
     for r in rows:
-        style = f"background:{STUCK_BACKGROUND};font-weight:600" if r.stuck else ("color:#888" if not r.connected else "")
+        style = (f"background:{STUCK_BACKGROUND};font-weight:600" if r.stuck else
+                 f"background:{IDLE_BACKGROUND};font-weight:600" if r.idle else "color:#888" if not r.connected else "")
         err = "-" if r.position_error_mm is None else f"{r.position_error_mm:.2f}"
         if r.tcp_mm is not None:                     # the result itself in the cell's tooltip
             tcp = ", ".join(f"{v:.1f}" for v in r.tcp_mm)
             err = f'<span title="TCP {escape_html(tcp)} mm">{err}</span>'
-        name = ("⚠ " if r.stuck else "") + r.name
+        name = ("⚠ " if r.stuck else "◔ " if r.idle else "") + r.name
+        step = "idle" if r.idle and not r.step else short_step(r.step)
         cells = (escape_html(str(r.number)), _cut(name, 11), _ON if r.connected else _OFF, _cut(r.method or "-", 10),
-                 escape_html(short_step(r.step) or "-"), format_duration(r.step_s if r.in_progress else None),
+                 escape_html(step or "-"), format_duration(r.step_s if r.in_progress else r.quiet_s if r.idle else None),
                  format_duration(r.touch_s), str(r.touches), str(r.crashes), err, escape_html(r.grade or "-"))
         tds = "".join(f'<td style="{_CELL}">{c}</td>' for c in cells)
-        body.append(f'<tr class="{"stuck" if r.stuck else "trainee"}" style="{style}">{tds}</tr>')
+        kind = "stuck" if r.stuck else "idle" if r.idle else "trainee"
+        body.append(f'<tr class="{kind}" style="{style}">{tds}</tr>')
     return _table(TRAINEE_HEADERS, body, "tcp-dashboard-trainees")
 
 

@@ -36,6 +36,7 @@ from tcp_pendant.pendant.guidance import tip_offset_mm
 from tcp_pendant.pendant.touch_feedback import touch_feedback
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.views.gui_util import ButtonEvent, DropdownEvent, set_content, set_value, target_of
+from tcp_pendant.views.touches_export import TouchesExport
 from tcp_pendant.wizards import Wizard, WizardStateError
 
 if TYPE_CHECKING:
@@ -73,6 +74,7 @@ class WizardStepsView:
                                             hint="One more touch (up to 20): more touches, smaller error.")
             self.cancel = gui.add_button("Cancel", color="red",
                                          hint="Leave the wizard; nothing recorded is lost, Resume brings it back.")
+            self.export = TouchesExport(parent)          # "Export touches (CSV)" for tcpcal solve
             self.meter_bar = gui.add_progress_bar(0.0, color="gray", visible=False)
             self.meter_md = gui.add_markdown("", visible=False)
             self.auto_folder = gui.add_folder("Auto-touch (training)", expand_by_default=True)
@@ -295,6 +297,7 @@ class WizardStepsView:
         self.back.disabled = not wiz.can_back
         self.cancel.label = "Cancel" if stepping else ("Close" if wf.result_saved else "Close (not saved)")
         self.add_point.visible = wiz.supports_add_point
+        self.export.render(wiz)
         self.add_point.disabled = not wiz.can_add_point
         self.auto_folder.visible = wf.auto_touch_allowed and stepping and not by_controller
         chosen = self.auto_direction.value == CHOSEN
