@@ -1,9 +1,9 @@
 """The pendant's two magnified tip views (front and side) as one GUI image (viser).
 
 The image comes from ``pendant.tip_insets`` (numpy, rendered on the server from the geometry:
-the reference tip and the mounted tool's true tip); this view only places it below the touch
-indicator, with a caption, and replaces it after a move that changed it (``insets_key``:
-nothing is sent while the tool tip stays far from the window or has not moved). Shown with
+the reference tip and the mounted tool's true tip); this view only places it below the jog
+keys, labelled (:data:`CAPTION`; the page's script floats it over the 3D view's corner), and
+replaces it after a move that changed it (``insets_key``: nothing is sent while the tool tip stays far from the window or has not moved). Shown with
 and without "Hide distance": it draws what the eye would see, no number. It is hidden while
 the tool tip is farther than ``tip_insets.NEAR_MM`` (40 mm, plain to see in the 3D view) from
 the reference tip: there is nothing of the tool to see in it then, and a page that loads with
@@ -20,8 +20,10 @@ from tcp_pendant.views.gui_util import target_of
 
 __all__ = ["CAPTION", "TipInsets"]
 
-CAPTION = ("**Tip close-up** · left: front (X→, Z↑) · right: side (Y→, Z↑) · "
+CAPTION = ("Tip close-up · left: front (X→, Z↑) · right: side (Y→, Z↑) · "
            "grid and bar 1 mm · magenta: the tool tip")
+"""The image's label; the page's script (``serve/static/pendant.js``) finds the views by its
+first words and floats them over the 3D view's corner, out of the panel's way."""
 
 FAR_MARGIN_MM = 1e-6
 """The pose state's touch distance (``|R^T (tip - p)|``) and :func:`insets_key`'s (``|p - tip|``)
@@ -38,9 +40,8 @@ class TipInsets:
         c = session.controller
         self._key: tuple[object, ...] = insets_key(c.reference_tip_world_m, c.T_world_tool_true())
         near = self._key != FAR
-        self.caption = gui.add_markdown(CAPTION, visible=near)
         self.image = gui.add_image(tip_insets_image(c.reference_tip_world_m, c.T_world_tool_true()), format="png",
-                                   visible=near)
+                                   label=CAPTION, visible=near)
         session.subscribe(self.on_change)
 
     def on_change(self, change: SessionChange) -> None:
@@ -60,4 +61,4 @@ class TipInsets:
         if near:
             self.image.image = tip_insets_image(tip, state.T_world_tool_true)
         if self.image.visible != near:
-            self.image.visible = self.caption.visible = near
+            self.image.visible = near
