@@ -104,6 +104,9 @@
     if (!el || el.nodeType !== 1) return false;
     if (el.isContentEditable) return true;
     var tag = el.tagName;
+    if (el.getAttribute("aria-haspopup") === "listbox" && el.getAttribute("aria-expanded") !== "true") {
+      return false;                         // a dropdown, closed: its field is no text to type
+    }
     return tag === "TEXTAREA" || (tag === "INPUT" && !el.readOnly && !el.disabled && !NOT_TEXT.test(el.type || ""));
   }
   function interactive(el) {
@@ -451,11 +454,11 @@
   var TIP_W = 344;                          // the tip views' image, px wide (2 x 168 + 8)
   var STYLE = [
     "[data-tcp-pendant-tipviews] { position: fixed !important; left: 12px; bottom: 12px; z-index: 30;",
-    "  width: " + (TIP_W + 16) + "px; max-width: calc(100vw - 24px); box-sizing: border-box; padding: 6px 8px;",
+    "  width: calc(" + TIP_W + "px + 2 * var(--mantine-spacing-xs, 10px)); max-width: calc(100vw - 24px); box-sizing: border-box; padding-top: 6px; padding-bottom: 4px;",
     "  background: rgba(255, 255, 255, 0.94); border-radius: 6px; box-shadow: 0 1px 6px rgba(0, 0, 0, 0.3); }",
     "[data-tcp-pendant-tipviews] p { font-size: 12px !important; line-height: 1.3; margin-bottom: 2px; }",
     "@media (max-width: 600px) {",
-    "  [data-tcp-pendant-tipviews] { top: 8px; bottom: auto; left: 8px; width: min(" + (TIP_W + 16) + "px, 62vw); padding: 3px 4px; }",
+    "  [data-tcp-pendant-tipviews] { top: 8px; bottom: auto; left: 8px; width: min(" + (TIP_W + 20) + "px, 62vw); padding-top: 3px; }",
     "  [data-tcp-pendant-tipviews] p { font-size: 10px !important; }",
     "  .mantine-Paper-root[style*='position: fixed'][style*='bottom: 0px'] { max-height: 38% !important; }",
     "}",
