@@ -276,8 +276,8 @@ def test_the_tip_views_zoom_out_and_point_the_way_from_25_mm(app_factory, browse
         tool = np.all(np.abs(a - np.array(TOOL_COLOR)) <= 40, axis=2)
         half = a.shape[1] // 2
         cols = np.nonzero(tool[:, :half])[1]
-        assert cols.size and cols.mean() < half / 2 - 20 or cols.mean() > half / 2 + 20
-        assert cols.mean() > half / 2, "the front view's arrow does not point to +X"
+        assert cols.size > 20, "no arrow in the front view"
+        assert cols.mean() > half / 2 + 20, "the front view's arrow does not point to +X (right of the reference tip)"
     finally:
         ctx.close()
 
@@ -293,7 +293,8 @@ def test_screenshots_with_a_wizard_open(app_factory, browser, tmp_path, size) ->
         open_wizard(s, page)
         page.locator("[data-tcp-pendant-tipviews] img").first.wait_for(state="visible", timeout=TIMEOUT_MS)
         close_toasts(page)
-        page.mouse.move(5, 5) if size not in TOUCH else None
+        if size not in TOUCH:
+            page.mouse.move(5, 5)                            # no hint over the panel in the shot
         page.wait_for_timeout(1500)                          # the 3D view drawn (software WebGL)
         png = out / f"wizard_{size[0]}x{size[1]}.png"
         page.screenshot(path=str(png))
