@@ -15,6 +15,7 @@ from tcp_pendant.controller import JogResult, VirtualController
 from tcp_pendant.events import Crash
 from tcp_pendant.pendant.tip_insets import FAR, NEAR_MM
 from tcp_pendant.session import Session, SessionChange
+from tcp_pendant.views.tip_insets import CAPTION, CAPTION_ZOOMED
 from tcpcal.library import ToolLibrary
 
 from support.app_page import true_tip_at
@@ -77,18 +78,19 @@ def test_tip_close_up_shows_near_redraws_and_hides_far(app_factory) -> None:
         wait_until(lambda: len(app.sessions) == 1, what="session built")
         (s,) = app.sessions.values()
         insets = s.views["pendant"].insets
-        assert insets._key == FAR and not insets.image.visible and not insets.caption.visible
+        assert insets._key == FAR and not insets.image.visible
         for offset in ((0.0, 0.0, 60.0), (0.0, 0.0, NEAR_MM + 0.05)):
             true_tip_at(s, offset)
             assert s.pose_state().touch.distance_mm == pytest.approx(math.hypot(*offset), abs=1e-6)
             assert insets._key == FAR and not insets.image.visible
         true_tip_at(s, (0.0, 0.0, NEAR_MM - 0.05))       # just inside: shown at once
-        assert insets._key != FAR and insets.image.visible and insets.caption.visible
+        assert insets._key != FAR and insets.image.visible and insets.image.label == CAPTION_ZOOMED
         true_tip_at(s, (0.4, -0.3, 1.6))
+        assert insets.image.label == CAPTION                 # in the window: not zoomed
         key, image = insets._key, insets.image.image
         true_tip_at(s, (0.4, -0.3, 1.1))                 # 0.5 mm lower: another picture
         assert insets._key != key and not np.array_equal(insets.image.image, image)
         true_tip_at(s, (0.0, 0.0, 60.0))
-        assert insets._key == FAR and not insets.image.visible and not insets.caption.visible
+        assert insets._key == FAR and not insets.image.visible
     finally:
         client.close()

@@ -94,27 +94,27 @@ def test_a_held_key_stops_at_contact_until_released(controller: VirtualControlle
     assert jog.key("X", 1, hold_tick=True).ok        # a new hold goes on
 
 
-def test_hold_driver_ticks_at_20hz_until_release_or_deadman() -> None:
+def test_hold_driver_ticks_at_20hz_until_release_or_lease() -> None:
     from tcp_pendant.controller import JogResult
-    from tcp_pendant.pendant.hold import DEADMAN_S, HoldDriver
+    from tcp_pendant.pendant.hold import LEASE_S, HoldDriver
 
     clock = FakeClock()
     sched = FakeScheduler(clock)
     steps: list[float] = []
     driver = HoldDriver(lambda axis, sign: steps.append(clock.t) or JogResult(True, 1.0, None, ""),
                         sched, clock=clock)
-    driver.held("X", 1)                              # one message, then silence
-    sched.advance(0.5)
+    driver.held("X", 1)                              # renewed every 50 ms for 0.5 s
+    for _ in range(10):
+        sched.advance(0.05)
+        driver.held("X", 1)
     assert len(steps) == 11                          # now + every 50 ms
-    driver.held("X", 1)                              # a late message keeps it going
-    sched.advance(0.5)
-    assert len(steps) == 21
     driver.release()
     sched.advance(1.0)
-    assert len(steps) == 21                          # nothing after the release
-    driver.held("Y", -1)
-    sched.advance(DEADMAN_S + 0.5)                   # the browser went quiet: the deadman stops it
-    assert driver.key is None and len(steps) <= 21 + int(DEADMAN_S / 0.05) + 2
+    assert len(steps) == 11                          # nothing after the release
+    driver.held("Y", -1)                             # one message, then the browser went quiet
+    sched.advance(LEASE_S + 0.5)
+    assert driver.key is None and driver.lapsed == ("Y", -1)
+    assert len(steps) == 11 + int(round(LEASE_S / 0.05)) + 1
 
 
 def test_hold_driver_stops_when_a_jog_stops_short() -> None:

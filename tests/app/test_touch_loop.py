@@ -312,9 +312,13 @@ def test_the_scripted_trainee_touches_in_at_most_30_clicks() -> None:
     assert out["tcp_error_mm"] and out["tcp_error_mm"][0] < 1.0       # a usable result
 
 
-def test_continuous_jog_keeps_its_speed_when_the_browser_sends_few_hold_messages(app_factory) -> None:
-    """A busy browser (software WebGL here) sends its 20 Hz hold messages 0.4-0.6 s apart; the
-    server's own 20 Hz ticks keep the set speed, in steps no larger than one tick's."""
+def test_continuous_jog_keeps_its_speed_at_10_renewals_a_second_and_stops_when_they_lapse(app_factory) -> None:
+    """A held key is a lease (``pendant.hold``): renewed 10 times a second (the least the page
+    must send) the server's own 20 Hz ticks keep the set speed, in steps no larger than one
+    tick's; renewed only every 0.5 s (a browser too busy to renew) it stops 250 ms after a
+    renewal, says so, and a renewal after the lapse moves nothing until the key is released."""
+    from tcp_pendant.views.pendant_panel import LAPSE_TEXT
+
     app = app_factory()
     client = ButtonClient(app.port, ("X +",))
     assert client.found.wait(30)
@@ -327,19 +331,35 @@ def test_continuous_jog_keeps_its_speed_when_the_browser_sends_few_hold_messages
         s.add_motion_listener(lambda: xs.append(float(s.controller.T_world_tcp()[0, 3])))
         x0 = float(s.controller.T_world_tcp()[0, 3])
         t0 = time.monotonic()
-        for _ in range(3):
+        for k in range(15):                                          # 10 renewals a second, 1.5 s
             client.hold_tick("X +", HOLD_HZ)
-            time.sleep(0.5)
+            time.sleep(max(0.0, t0 + (k + 1) * 0.1 - time.monotonic()))
         client.click("X +")
         held_s = time.monotonic() - t0
         client.sync(s.client)                                       # the release handled
-        assert not s.views["pendant"]._hold.active                  # it stopped the server's ticks
+        panel = s.views["pendant"]
+        assert not panel._hold.active                               # it stopped the server's ticks
         x_end = float(s.controller.T_world_tcp()[0, 3])
         speed = (x_end - x0) * 1000.0 / held_s
-        print(f"sparse hold messages: {speed:.1f} mm/s over {held_s:.2f} s, {len(xs)} ticks")
+        print(f"10 Hz renewals: {speed:.1f} mm/s over {held_s:.2f} s, {len(xs)} ticks")
         assert speed == pytest.approx(125.0, rel=0.2)
         assert np.diff([x0] + xs).max() * 1000.0 <= 125.0 / HOLD_HZ * 1.001
         loop_ran_for(app.server.get_event_loop(), 3 / HOLD_HZ)      # three ticks' time on the server
         assert float(s.controller.T_world_tcp()[0, 3]) == x_end      # stopped at the release
+        # renewals 0.5 s apart: the lease runs out after the first, the later ones move nothing
+        client.hold_tick("X +", HOLD_HZ)
+        client.sync(s.client)
+        wait_until(lambda: panel._hold.lapsed is not None, what="the lease run out")
+        x_lapsed = float(s.controller.T_world_tcp()[0, 3])
+        assert (x_lapsed - x_end) * 1000.0 <= 125.0 * (0.25 + 1 / HOLD_HZ) + 1e-6
+        assert panel._last_text.get("status") == f"⚠ {LAPSE_TEXT}"
+        time.sleep(0.5)                                              # the busy browser's pace
+        client.hold_tick("X +", HOLD_HZ)
+        client.sync(s.client)                                       # the late renewal handled
+        loop_ran_for(app.server.get_event_loop(), 3 / HOLD_HZ)
+        assert float(s.controller.T_world_tcp()[0, 3]) == x_lapsed
+        client.click("X +")                                          # let go ...
+        client.sync(s.client)
+        assert panel._hold.lapsed is None
     finally:
         client.close()

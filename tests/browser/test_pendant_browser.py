@@ -235,11 +235,11 @@ def test_close_up_and_contact_stop_in_the_browser(server, new_page, shot) -> Non
 
 def test_continuous_jog_speed_in_the_browser(server, new_page) -> None:
     """In chromium: holding X + for about 1 s at 50 % moves at about 125 mm/s
-    (the server's 20 Hz ticks, whatever the rate of the browser's hold messages), and stops."""
+    (the server's 20 Hz ticks while the browser renews the hold's lease), and stops."""
     page = new_page(server.url)
     r0 = wait_numbers(page, lambda n: True, "a readout")
     option(page, "Cont.").click()
-    key = page.get_by_role("button", name="X +", exact=True).first
+    key = page.locator("button[id]").filter(has_text="X +").filter(visible=True).first   # the hold-to-jog key
     key.wait_for(state="visible", timeout=TIMEOUT_MS)
     box = key.bounding_box()
     page.mouse.move(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)

@@ -14,9 +14,16 @@ left corner: the scale. A 0.5 mm move is 12 image pixels in at least one view fo
 direction (X: front; Y: side; Z: both), about 10 screen pixels at 1400x900 where the panel
 shows the image ~300 px wide (tests/browser/test_tip_insets_browser.py measures it).
 
-What is drawn is geometry only, as the eye sees it - no number, no zoom that follows the
-distance (a fixed window; the tool tip leaves it when far), so the views keep "Hide distance"
-honest in an exercise: the spike (a steel cone, :data:`SPIKE_LENGTH_MM` long, radius
+Finding the tool tip from farther away (a trainee steers in from 40 mm by the views alone):
+when the tool tip is outside the window, both views zoom out :data:`ZOOM_OUT` times
+(:func:`inset_zoom`: a window of +-17.5 mm, the grid and the scale bar 5 mm, the same pixels
+apart, each view framed in orange so the zoom is plain to see); when it is outside that window
+too, a magenta arrow from the reference tip points the way to it in every view where it is
+outside (:func:`arrow_direction`, the tip's offset as that view sees it). Within 40 mm
+(:data:`NEAR_MM`) the trainee thus always sees the tool tip or the way to it.
+
+What is drawn is geometry only, as the eye sees it - no number, two fixed scales (not a zoom
+that follows the distance), so the views keep "Hide distance" honest in an exercise: the spike (a steel cone, :data:`SPIKE_LENGTH_MM` long, radius
 :data:`SPIKE_RADIUS_MM` at its base, axis WORLD +Z, as ``robots/generate.py`` builds it) and the
 tool's tip as a pointed cone along its working direction (tool X; the body behind, along -X;
 :data:`TOOL_CONE_LENGTH_MM` long, radius :data:`TOOL_CONE_RADIUS_MM`, the pointer's tip),
@@ -46,6 +53,9 @@ __all__ = [
     "TOOL_COLOR",
     "VIEW_H_MM",
     "VIEW_W_MM",
+    "ZOOM_OUT",
+    "arrow_direction",
+    "inset_zoom",
     "insets_key",
     "tip_insets_image",
     "view_pixel",
@@ -68,6 +78,13 @@ SPIKE_COLOR = (112, 118, 128)
 TOOL_COLOR = (222, 38, 170)
 """A colour found nowhere else on the page (the browser test finds the tool tip by it)."""
 SCALE_COLOR = (30, 30, 30)
+ZOOM_FRAME_COLOR = (240, 140, 0)
+"""The frame of a zoomed-out view."""
+ZOOM_OUT = 5
+"""The zoomed-out views show this many times the field (+-17.5 mm wide), grid and bar 5 mm."""
+EDGE_MARGIN_MM = 0.4
+"""The tool tip counts as in a window when it is at least this far (mm, at the view's scale)
+inside its edges."""
 
 _W = int(round(VIEW_W_MM * PX_PER_MM))
 _H = int(round(VIEW_H_MM * PX_PER_MM))
@@ -81,16 +98,44 @@ FAR: tuple[object, ...] = ("far",)
 """The :func:`insets_key` of a tool tip farther than :data:`NEAR_MM`."""
 
 
-def view_pixel(view: str, point_mm: np.ndarray) -> tuple[float, float]:
+def view_pixel(view: str, point_mm: np.ndarray, zoom: int = 1) -> tuple[float, float]:
     """Image (column, row) of a point given relative to the reference tip (WORLD, mm) in view
-    ``view`` ("front" or "side"), in the whole image's pixels (the side view starts after the
-    front one and the gap)."""
+    ``view`` ("front" or "side") at ``zoom`` (1, or :data:`ZOOM_OUT`), in the whole image's
+    pixels (the side view starts after the front one and the gap)."""
     right, _ = _VIEWS[view]
     p = np.asarray(point_mm, dtype=float)
     x0 = 0 if view == "front" else _W + GAP_PX
-    col = x0 + (VIEW_W_MM / 2 + float(p @ right)) * PX_PER_MM
-    row = (VIEW_H_MM - BELOW_MM - float(p @ _UP)) * PX_PER_MM
+    col = x0 + (VIEW_W_MM / 2 + float(p @ right) / zoom) * PX_PER_MM
+    row = (VIEW_H_MM - BELOW_MM - float(p @ _UP) / zoom) * PX_PER_MM
     return col, row
+
+
+def _in_window(view: str, apex_mm: np.ndarray, zoom: int) -> bool:
+    right, _ = _VIEWS[view]
+    h, v = float(apex_mm @ right) / zoom, float(apex_mm @ _UP) / zoom
+    m = EDGE_MARGIN_MM
+    return abs(h) <= VIEW_W_MM / 2 - m and -BELOW_MM + m <= v <= VIEW_H_MM - BELOW_MM - m
+
+
+def inset_zoom(apex_mm: np.ndarray) -> int:
+    """The views' zoom for a tool tip at ``apex_mm`` (WORLD, mm from the reference tip): 1 while
+    it is in both views' windows, else :data:`ZOOM_OUT`."""
+    apex = np.asarray(apex_mm, dtype=float)
+    return 1 if all(_in_window(v, apex, 1) for v in _VIEWS) else ZOOM_OUT
+
+
+def arrow_direction(view: str, apex_mm: np.ndarray) -> tuple[float, float] | None:
+    """The unit direction (image column, row: right and down) from the reference tip to the
+    tool tip at ``apex_mm`` (WORLD, mm) as view ``view`` sees it, when the tip is outside that
+    view's zoomed-out window; None when the view shows the tip itself (or sees it straight
+    along its line of sight)."""
+    apex = np.asarray(apex_mm, dtype=float)
+    if _in_window(view, apex, inset_zoom(apex)):
+        return None
+    right, _ = _VIEWS[view]
+    d = np.array([float(apex @ right), -float(apex @ _UP)])
+    n = float(np.linalg.norm(d))
+    return None if n < 1e-9 else (float(d[0] / n), float(d[1] / n))
 
 
 def _cone_points(apex_mm: np.ndarray, into_body: np.ndarray, length: float, radius: float,
@@ -137,10 +182,10 @@ def _mask(poly: np.ndarray) -> tuple[np.ndarray, int, int] | None:
     return inside, r0, c0
 
 
-def _project(points: np.ndarray, view: str) -> np.ndarray:
+def _project(points: np.ndarray, view: str, zoom: int = 1) -> np.ndarray:
     right, _ = _VIEWS[view]
-    return np.column_stack([(VIEW_W_MM / 2 + points @ right) * PX_PER_MM,
-                            (VIEW_H_MM - BELOW_MM - points @ _UP) * PX_PER_MM])
+    return np.column_stack([(VIEW_W_MM / 2 + points @ right / zoom) * PX_PER_MM,
+                            (VIEW_H_MM - BELOW_MM - points @ _UP / zoom) * PX_PER_MM])
 
 
 def _paint(img: np.ndarray, mask: tuple[np.ndarray, int, int] | None, color: tuple[int, int, int]) -> None:
@@ -149,12 +194,13 @@ def _paint(img: np.ndarray, mask: tuple[np.ndarray, int, int] | None, color: tup
         img[r0:r0 + inside.shape[0], c0:c0 + inside.shape[1]][inside] = color
 
 
-_BASES: dict[str, tuple[np.ndarray, tuple[np.ndarray, int, int] | None]] = {}
+_BASES: dict[tuple[str, int], tuple[np.ndarray, tuple[np.ndarray, int, int] | None]] = {}
 
 
-def _base(view: str) -> tuple[np.ndarray, tuple[np.ndarray, int, int] | None]:
-    """The view without the tool (grid, scale bar, spike) and the spike's mask (cached)."""
-    cached = _BASES.get(view)
+def _base(view: str, zoom: int = 1) -> tuple[np.ndarray, tuple[np.ndarray, int, int] | None]:
+    """The view without the tool (grid every ``zoom`` mm, scale bar, spike, the orange frame of
+    a zoomed-out view) and the spike's mask (cached)."""
+    cached = _BASES.get((view, zoom))
     if cached is not None:
         return cached
     img = np.empty((_H, _W, 3), dtype=np.uint8)
@@ -172,22 +218,49 @@ def _base(view: str) -> tuple[np.ndarray, tuple[np.ndarray, int, int] | None]:
     img[bar_r - 2:bar_r + 2, 8:8 + PX_PER_MM] = SCALE_COLOR
     img[bar_r - 6:bar_r + 6, 8:10] = SCALE_COLOR
     img[bar_r - 6:bar_r + 6, 6 + PX_PER_MM:8 + PX_PER_MM] = SCALE_COLOR
-    spike = _mask(_project(_cone_points(np.zeros(3), -_UP, SPIKE_LENGTH_MM, SPIKE_RADIUS_MM), view))
+    spike = _mask(_project(_cone_points(np.zeros(3), -_UP, SPIKE_LENGTH_MM, SPIKE_RADIUS_MM), view, zoom))
     _paint(img, spike, SPIKE_COLOR)
+    if zoom != 1:
+        f = 3
+        img[:f, :], img[-f:, :], img[:, :f], img[:, -f:] = (ZOOM_FRAME_COLOR,) * 4
     img.setflags(write=False)
-    _BASES[view] = (img, spike)
+    _BASES[(view, zoom)] = (img, spike)
     return img, spike
 
 
+def _arrow(img: np.ndarray, view: str, direction: tuple[float, float], zoom: int) -> None:
+    """A magenta arrow from near the reference tip toward the image's edge along ``direction``
+    (image column, row)."""
+    c0, r0 = view_pixel(view, np.zeros(3), zoom)
+    c0 -= 0 if view == "front" else _W + GAP_PX
+    d = np.asarray(direction, dtype=float)
+    n = np.array([-d[1], d[0]])
+    # how far the ray from the reference tip runs inside the view (px), less a margin
+    limits = []
+    for comp, lo, hi, at in ((d[0], 0.0, float(_W), c0), (d[1], 0.0, float(_H), r0)):
+        if abs(comp) > 1e-9:
+            limits.append(((hi if comp > 0 else lo) - at) / comp)
+    reach = max(20.0, min(limits) - 10.0)
+    start, tip = np.array([c0, r0]) + d * 18.0, np.array([c0, r0]) + d * reach
+    head = tip - d * 16.0
+    shaft = np.array([start + n * 3, start - n * 3, head + n * 3, head - n * 3])
+    _paint(img, _mask(shaft), TOOL_COLOR)
+    _paint(img, _mask(np.array([tip, head + n * 10, head - n * 10])), TOOL_COLOR)
+
+
 def _view(tool_apex_mm: np.ndarray | None, tool_into_body: np.ndarray | None, view: str) -> np.ndarray:
-    base, spike = _base(view)
+    zoom = 1 if tool_apex_mm is None else inset_zoom(tool_apex_mm)
+    base, spike = _base(view, zoom)
     img = base.copy()
     if tool_apex_mm is None or tool_into_body is None:
         return img
     tool = _cone_points(tool_apex_mm, tool_into_body, TOOL_CONE_LENGTH_MM, TOOL_CONE_RADIUS_MM, TOOL_SHAFT_MM)
-    _paint(img, _mask(_project(tool, view)), TOOL_COLOR)
+    _paint(img, _mask(_project(tool, view, zoom)), TOOL_COLOR)
     if float(tool_apex_mm @ _VIEWS[view][1]) < 0.0:    # the tool behind the spike: the spike in front
         _paint(img, spike, SPIKE_COLOR)
+    direction = arrow_direction(view, tool_apex_mm)
+    if direction is not None:
+        _arrow(img, view, direction, zoom)
     return img
 
 

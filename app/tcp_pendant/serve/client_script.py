@@ -1,5 +1,6 @@
 """Our own static script in the page: keyboard shortcuts, the remembered name and browser key,
-the trainer URL.
+the trainer URL, a constant style sheet for the screen sizes (tip views over the 3D view, touch
+targets on coarse pointers, the phone's bottom sheet) and the release click of every held jog key.
 
 viser 1.1 gives the Python side no keyboard events, no browser storage and no page URL. A few
 lines of JavaScript in the page can (``static/pendant.js``): keys click the pendant's own GUI

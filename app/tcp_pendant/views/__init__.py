@@ -71,7 +71,7 @@ def session_view_steps(session: Session, *, title: str = "TCP Pendant") -> Itera
         scene.player = player
         yield "scene"
         session.views["notices"] = ClassNoticeView(session)   # the exercise's banner, the trainer's messages
-        gui.add_markdown(f"### {escape_markdown(title)}")
+        gui.add_markdown(f"#### {escape_markdown(title)}")   # one line in the panel: room for the keys
         tabs = gui.add_tab_group()
         with tabs.add_tab("Jog"):
             session.views["dock"] = WizardDock(session)      # the running wizard's step, on top

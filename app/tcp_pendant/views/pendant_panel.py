@@ -1,14 +1,17 @@
 """The jog panel of one session, laid out like a teach pendant (viser GUI).
 
-Top to bottom (below the wizard dock, ``views.wizard_dock``): TCP readout (frame + tool), the
-touch indicator with the offset "ΔX ΔY ΔZ mm" of the reference tip along the jog frame's axes
-(hidden by "Hide distance"), the increment, the jog
-keys - one row per axis with − and + side by side (X Y Z A B C, or A1..A6; in continuous mode
-the hold-to-jog keys, two per axis, since only single buttons report a hold), the keys line,
-the status line (why a jog stopped), within 20 mm a magnified text close-up of the two tips
-(hidden by "Hide distance"), the front and side views of the tips (``views.tip_insets``,
-within 40 mm: geometry, no numbers) - everything that comes and goes near the tip is below
-the keys, so the keys never move - then the jog settings (mode, frame, override, readout frame), the joints, Home and the view (the camera buttons, "Shadows"); the touches ("Record point" and the list) follow.
+Top to bottom (below the wizard dock, ``views.wizard_dock``): the touch indicator with the
+offset "ΔX ΔY ΔZ mm" of the reference tip along the jog frame's axes (hidden by "Hide
+distance"), the increment, the jog keys - one row per axis with − and + side by side (X Y Z A B
+C, or A1..A6; in continuous mode the hold-to-jog keys, two per axis, since only single buttons
+report a hold), the keys line, the TCP readout (frame + tool; below the keys, so that a
+wizard's step, its Record and the keys fit above the fold at 1024x768), the status line (why a
+jog stopped), within 20 mm a magnified text close-up of the two tips (hidden by "Hide
+distance"), the front and side views of the tips (``views.tip_insets``, within 40 mm: geometry,
+no numbers; the page's script floats them over the 3D view's corner) - everything that comes
+and goes near the tip is below the keys, so the keys never move - then the jog settings (mode,
+frame, override, readout frame), the joints, Home and the view (the camera buttons,
+"Shadows"); the touches ("Record point" and the list) follow.
 Every button group marks its selected option with "✓ " (viser's button groups show no
 selection); a click's value is read without the mark. Keyboard shortcuts come from the page's
 own script (``serve/static/pendant.js``, served by ``serve.client_script``): it clicks these buttons, so a
@@ -93,8 +96,13 @@ MARK = "✓ "
 """Prefix of the selected option of a button group."""
 
 KEYS_LINE = ("Keys: `1`…`6` jog **+** on the rows above, `Shift`+`1`…`6` jog **−**, "
-             "`[` `]` smaller / larger increment, `R` Record")
-"""The keyboard shortcuts (``serve/static/pendant.js``), shown below the jog keys."""
+             "`[` `]` smaller / larger increment, `R` Record, `N` Next / Finish, `B` Back")
+"""The keyboard shortcuts (``serve/static/pendant.js``), shown below the jog keys (hidden by the
+page's script on a touch screen, whose pointer is coarse: no keyboard there)."""
+
+LAPSE_TEXT = ("Jog stopped: the browser did not renew the held key for 0.25 s (a busy browser or "
+              "a slow network); let go and press again.")
+"""The status line when a hold's lease ran out (``pendant.hold``)."""
 
 SHADOWS_LABEL = "Shadows"
 """The shadows checkbox of one browser's pendant; ``serve/static/pendant.js`` unchecks the checkbox
@@ -151,8 +159,6 @@ class PendantPanel:
     def __init__(self, session: Session) -> None:
         self.session = session
         gui = target_of(session).gui
-        c = session.controller
-        k = c.kinematics
         self._from_client: dict[int, float] = {}   # slider -> angle (deg, 0.01) its browser value set
         self._last_text: dict[str, str] = {}
         self._joint_folder_shown = False           # joint_folder.visible as _show_settings set it
@@ -163,17 +169,35 @@ class PendantPanel:
         self._drop_report_due = False
         self._drop_reported_at = -math.inf          # monotonic s of the last drop report
 
-        st = session.jogger.settings
         self._readout = "WORLD"
-        self.tcp_md = gui.add_markdown("")
         self.touch_md = gui.add_markdown("")
+        self._build_keys(gui)
+        self.keys_md = gui.add_markdown(KEYS_LINE)
+        # the TCP readout below the keys: the step, its Record and the keys fit above the fold
+        # at 1024x768 with a wizard open (a fixed three lines: the keys above it never move)
+        self.tcp_md = gui.add_markdown("")
+        # what appears near the tip or at a stop goes below the keys, so no key moves when it
+        # shows (the keys stay where the trainee's pointer is, above the fold at 1024x768)
+        self.status_md = gui.add_markdown("")
+        self.closeup_md = gui.add_markdown("", visible=False)
+        self.insets = TipInsets(session)           # front and side views of the tips (no numbers)
+        self._build_joint_folder(gui)
+        self._build_settings(gui)
+        self._wire_settings()
+        self._show_settings()
+        session.subscribe(self.on_change)
+
+    def _build_keys(self, gui: viser.GuiApi) -> None:
+        """"Hide distance", the increment, the compact key rows (Cartesian, joints) and the
+        hold-to-jog keys of continuous mode."""
+        session = self.session
+        st = session.jogger.settings
         self.hide_distance = gui.add_checkbox("Hide distance", session.hide_distance,
                                               hint="Training: judge the touch by eye, as on a real robot "
                                                    "(hides the distance, the Δ offsets and the close-up).")
         self.increment = gui.add_button_group("Increment", marked(INCREMENTS, st.increment),
                                               hint="mm for X/Y/Z, deg for A/B/C and joints; Cont. = hold to jog; "
                                                    + INCREMENT_KEYS)
-
         # compact keys: one row per axis (− and + side by side); clicks only
         self.cart_rows: dict[str, viser.GuiButtonGroupHandle] = {}
         for r, ax in enumerate(CARTESIAN_AXES):
@@ -181,12 +205,11 @@ class PendantPanel:
             row.on_click(session.loop.on_loop(self._row_cb(ax)))
             self.cart_rows[ax] = row
         self.joint_rows: list[viser.GuiButtonGroupHandle] = []
-        for i, name in enumerate(k.joint_names):
+        for i, name in enumerate(session.controller.kinematics.joint_names):
             row = gui.add_button_group(name, (f"{name} −", f"{name} +"), visible=False,
                                        hint=_with_keys(f"jog {name} (deg)", i))
             row.on_click(session.loop.on_loop(self._row_cb(i)))
             self.joint_rows.append(row)
-
         # hold-to-jog keys (continuous mode): viser reports holds of single buttons only
         self.cart_folder = gui.add_folder("Cartesian jog (hold)", visible=False)
         with self.cart_folder:
@@ -198,13 +221,10 @@ class PendantPanel:
                     self._wire_key(b, ax, sign)
                     self.cart_buttons[(ax, sign)] = b
 
-        self.keys_md = gui.add_markdown(KEYS_LINE)
-        # what appears near the tip or at a stop goes below the keys, so no key moves when it
-        # shows (the keys stay where the trainee's pointer is, above the fold at 1024x768)
-        self.status_md = gui.add_markdown("")
-        self.closeup_md = gui.add_markdown("", visible=False)
-        self.insets = TipInsets(session)           # front and side views of the tips (no numbers)
-
+    def _build_joint_folder(self, gui: viser.GuiApi) -> None:
+        """Joint mode's sliders and hold-to-jog keys (deg)."""
+        c = self.session.controller
+        k = c.kinematics
         self.joint_folder = gui.add_folder("Joint jog", visible=False)
         with self.joint_folder:
             self.joint_sliders: list[viser.GuiSliderHandle[float]] = []
@@ -222,6 +242,9 @@ class PendantPanel:
                     self._wire_key(b, i, sign)
                     self.joint_buttons[(i, sign)] = b
 
+    def _build_settings(self, gui: viser.GuiApi) -> None:
+        """The jog settings, the joints readout, the two poses and the view."""
+        st = self.session.jogger.settings
         with gui.add_folder("Jog settings"):
             self.mode = gui.add_button_group("Mode", marked((JogMode.CARTESIAN.value, JogMode.JOINT.value),
                                                             st.mode.value))
@@ -237,10 +260,11 @@ class PendantPanel:
         with gui.add_folder("View"):
             self.closeup = gui.add_button("Close-up on reference tip")
             self.overview_btn = gui.add_button("Overview")
-            self.shadows = gui.add_checkbox(SHARED_SHADOWS_LABEL if session.shared else SHADOWS_LABEL, True,
+            self.shadows = gui.add_checkbox(SHARED_SHADOWS_LABEL if self.session.shared else SHADOWS_LABEL, True,
                                             hint=SHADOWS_HINT)
 
-        g = session.loop.on_loop
+    def _wire_settings(self) -> None:
+        g = self.session.loop.on_loop
         self.mode.on_click(g(self._setting("mode", JogMode)))
         self.frame.on_update(g(self._setting("frame", str)))
         self.increment.on_click(g(self._setting("increment", str)))
@@ -252,8 +276,6 @@ class PendantPanel:
         self.closeup.on_click(g(self._on_camera(True)))
         self.overview_btn.on_click(g(self._on_camera(False)))
         self.shadows.on_update(g(self._on_shadows))
-        self._show_settings()
-        session.subscribe(self.on_change)
 
     def on_change(self, change: SessionChange) -> None:
         """The change signal: the status line from the move's outcome (a move that is not a
@@ -302,11 +324,18 @@ class PendantPanel:
             def schedule(delay_s: float, fn: Callable[[], object]) -> Timer:
                 return loop.call_later(delay_s, guard(fn))
 
-            self._hold = HoldDriver(self._hold_step, schedule)
+            self._hold = HoldDriver(self._hold_step, schedule, on_lapse=self._on_lapse)
             self.session.on_close(self._hold.stop)
         self._hold.held(axis, sign, arrival.arrived_s())
         if self._hold.dropped:
             self._report_drops_soon()
+
+    def _on_lapse(self, _key: object) -> None:
+        """The held key's lease ran out (no renewal for ``LEASE_S``): stopped, and said so."""
+        text = f"⚠ {LAPSE_TEXT}"
+        self._set_md(self.status_md, "status", text)
+        self._last_stop = text
+        self.session.motion.release_jog()
 
     def _hold_step(self, axis: str | int, sign: int) -> JogResult | None:
         """One server tick of the held key (under the session lock, on the loop)."""

@@ -1,9 +1,9 @@
 """The pendant's two magnified tip views (front and side) as one GUI image (viser).
 
 The image comes from ``pendant.tip_insets`` (numpy, rendered on the server from the geometry:
-the reference tip and the mounted tool's true tip); this view only places it below the touch
-indicator, with a caption, and replaces it after a move that changed it (``insets_key``:
-nothing is sent while the tool tip stays far from the window or has not moved). Shown with
+the reference tip and the mounted tool's true tip); this view only places it below the jog
+keys, labelled (:data:`CAPTION`; the page's script floats it over the 3D view's corner), and
+replaces it after a move that changed it (``insets_key``: nothing is sent while the tool tip stays far from the window or has not moved). Shown with
 and without "Hide distance": it draws what the eye would see, no number. It is hidden while
 the tool tip is farther than ``tip_insets.NEAR_MM`` (40 mm, plain to see in the 3D view) from
 the reference tip: there is nothing of the tool to see in it then, and a page that loads with
@@ -14,22 +14,35 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from tcp_pendant.pendant.tip_insets import FAR, NEAR_MM, insets_key, tip_insets_image
+import numpy as np
+
+from tcp_pendant.pendant.tip_insets import FAR, NEAR_MM, ZOOM_OUT, inset_zoom, insets_key, tip_insets_image
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.views.gui_util import target_of
 
 if TYPE_CHECKING:
     from tcp_pendant.controller.pose_state import PoseState
 
-__all__ = ["CAPTION", "TipInsets"]
+__all__ = ["CAPTION", "CAPTION_ZOOMED", "TipInsets", "caption_for"]
 
-CAPTION = ("**Tip close-up** · left: front (X→, Z↑) · right: side (Y→, Z↑) · "
+CAPTION = ("Tip close-up · left: front (X→, Z↑) · right: side (Y→, Z↑) · "
            "grid and bar 1 mm · magenta: the tool tip")
+CAPTION_ZOOMED = (f"Tip close-up, zoomed out {ZOOM_OUT}× (orange frame) · left: front (X→, Z↑) · right: side "
+                  f"(Y→, Z↑) · grid and bar {ZOOM_OUT} mm · magenta: the tool tip, or an arrow the way to it")
+"""The image's label (:data:`CAPTION_ZOOMED` while zoomed out); the page's script (``serve/static/pendant.js``) finds the views by its
+first words and floats them over the 3D view's corner, out of the panel's way."""
 
 FAR_MARGIN_MM = 1e-6
 """The pose state's touch distance (``|R^T (tip - p)|``) and :func:`insets_key`'s (``|p - tip|``)
 are one length computed two ways (they differ by float rounding, ~1e-13 mm): beyond
 ``NEAR_MM`` plus this margin the key is FAR for sure, and a view showing FAR skips the key."""
+
+
+def caption_for(reference_tip_world_m: np.ndarray, T_world_tooltrue: np.ndarray) -> str:
+    """The image's label: :data:`CAPTION_ZOOMED` while the views are zoomed out
+    (``tip_insets.inset_zoom``), else :data:`CAPTION`."""
+    apex_mm = (T_world_tooltrue[:3, 3] - reference_tip_world_m) * 1000.0
+    return CAPTION if inset_zoom(apex_mm) == 1 else CAPTION_ZOOMED
 
 
 class TipInsets:
@@ -41,8 +54,8 @@ class TipInsets:
         c = session.controller
         self._key: tuple[object, ...] = insets_key(c.reference_tip_world_m, c.T_world_tool_true())
         near = self._key != FAR
-        self.caption = gui.add_markdown(CAPTION, visible=near)
         self.image = gui.add_image(tip_insets_image(c.reference_tip_world_m, c.T_world_tool_true()), format="png",
+                                   label=caption_for(c.reference_tip_world_m, c.T_world_tool_true()),
                                    visible=near)
         session.subscribe(self.on_change)
 
@@ -62,5 +75,8 @@ class TipInsets:
         near = key != FAR
         if near:
             self.image.image = tip_insets_image(tip, state.T_world_tool_true)
+            label = caption_for(tip, state.T_world_tool_true)
+            if self.image.label != label:
+                self.image.label = label
         if self.image.visible != near:
-            self.image.visible = self.caption.visible = near
+            self.image.visible = near

@@ -82,7 +82,8 @@ class WizardDock:
             self.record = gui.add_button("Record", color="green",
                                          hint="Record this step at the current pose (a touch farther than "
                                               "0.5 mm asks first, unless the distance is hidden); key R.")
-            self.nav = gui.add_button_group("Step", (BACK, NEXT, CANCEL))
+            self.nav = gui.add_button_group("Step", (BACK, NEXT, CANCEL),
+                                            hint="Keys: N Next (Finish on the last step), B Back.")
             self.meter_bar = gui.add_progress_bar(0.0, color="gray", visible=False)
             self.meter_md = gui.add_markdown("", visible=False)
             self.tilt_html = gui.add_html(tilt_line_html(None), visible=False)

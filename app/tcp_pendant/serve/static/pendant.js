@@ -5,13 +5,16 @@
  * sends (no new server API). User text (a trainee's name, a trainer token) is only ever put into
  * an input's .value, never into HTML.
  *
- * 1. Keyboard shortcuts (ignored while typing in a field, with Ctrl/Alt/Meta held, or while a
- *    dialog such as the welcome window is open):
+ * 1. Keyboard shortcuts (ignored while typing in a text field, with Ctrl/Alt/Meta held, or while
+ *    a dialog such as the welcome window is open; a checkbox, button, dropdown or slider that
+ *    kept the focus after a click does not swallow them):
  *      1..6          jog + on jog-key row 1..6 (X Y Z A B C; in Joint mode the joints A1..A6)
  *      Shift+1..6    jog - on that row
  *      [  ]          next smaller / larger increment (the Increment row, toward 0.1 / Cont.)
  *      R, Enter      Record: the running wizard's step, else "Record point" (Enter only when no
  *                    button or field has the focus)
+ *      N             the running wizard's Next (Finish on its last step)
+ *      B             the running wizard's Back
  *    Incremental mode: one step per key press (a held key does not repeat, as on a pendant).
  *    Cont. mode: the key is held like the mouse button on a hold-to-jog key (press, release).
  *    viser's own keys (W A S D Q E, the arrows: camera; Space) are not used.
@@ -41,6 +44,17 @@
  *    shows one: the shadow maps would cost such a browser most of each frame. A trainee may tick
  *    it again. The --shared pendant's "Shadows (every screen)" is left alone. The checkbox gets
  *    data-tcp-pendant-shadows="off" or "kept" (a hardware renderer), what the script decided.
+ * 6. Screens (one constant style sheet, STYLE): the tip views (the image labelled "Tip close-up",
+ *    views/tip_insets.py) float over the 3D view's lower left corner (a phone's: its upper
+ *    left), so the step, its Record and the jog keys fit the panel beside them at 1024x768; on a
+ *    device whose pointer is coarse (a touch screen) every button is at least 44 CSS px tall
+ *    and the "Keys: ..." line is hidden (no keyboard); on a phone the panel's bottom sheet is at
+ *    most 38 % of the screen high, so the reference tip (the 3D view's centre) stays in view.
+ * 7. Touch and hold-to-jog: a held jog key is a lease the server lets run out 250 ms after the
+ *    browser's last renewal (pendant/hold.py). The script makes sure every hold ends in the
+ *    release click the server waits for (a touch the browser cancels, a long press it turns
+ *    into a context menu, or a lost pointer capture sends none of its own) and keeps the
+ *    browser from panning or selecting while a jog key is held.
  */
 (function () {
   "use strict";
@@ -53,7 +67,8 @@
     name: "Your name", key: "Browser key", join: "Join the class", token: "Trainer token",
     openTrainer: "Open trainer view",
     increment: "Increment", record: "Record", recordPoint: "Record point", banner: "Trainee:",
-    shadows: "Shadows"
+    shadows: "Shadows", next: "Next \u25b6", finish: "Finish \u25b6", back: "\u25c0 Back",
+    keysLine: "Keys:", tipViews: "Tip close-up"
   };
   var SOFTWARE_RE = /swiftshader|llvmpipe|softpipe|software|basic render/i;
   var CARTESIAN = ["X", "Y", "Z", "A", "B", "C"];
@@ -84,11 +99,15 @@
     return null;
   }
   function field(name) { var row = labelled(name); return row ? row.querySelector("input, textarea") : null; }
-  function editable(el) {
+  var NOT_TEXT = /^(checkbox|radio|range|button|submit|reset|color|file|image)$/i;
+  function editable(el) {                   // a text field: the keys type into it
     if (!el || el.nodeType !== 1) return false;
     if (el.isContentEditable) return true;
     var tag = el.tagName;
-    return tag === "TEXTAREA" || tag === "SELECT" || (tag === "INPUT" && !el.readOnly);
+    if (el.getAttribute("aria-haspopup") === "listbox" && el.getAttribute("aria-expanded") !== "true") {
+      return false;                         // a dropdown, closed: its field is no text to type
+    }
+    return tag === "TEXTAREA" || (tag === "INPUT" && !el.readOnly && !el.disabled && !NOT_TEXT.test(el.type || ""));
   }
   function interactive(el) {
     return !!(el && el.nodeType === 1 && el !== document.body &&
@@ -148,6 +167,13 @@
     return !!selected && text(selected).indexOf("Cont.") >= 0;
   }
 
+  function step(names) {                    // the wizard's Next / Finish or Back (the one on show)
+    var list = [];
+    names.forEach(function (n) { list = list.concat(buttonsNamed(n)); });
+    var b = pick(list.filter(laidOut));
+    if (b) b.click();
+  }
+
   function record() {
     var free = buttonsNamed(L.recordPoint);          // shown outside a wizard only
     var b = free.length ? pick(free) : pick(buttonsNamed(L.record));
@@ -201,12 +227,49 @@
     } else if (key === "r" || key === "R" || (key === "Enter" && !interactive(e.target))) {
       e.preventDefault();
       if (!e.repeat) record();
+    } else if (key === "n" || key === "N") {
+      e.preventDefault();
+      if (!e.repeat) step([L.next, L.finish]);
+    } else if (key === "b" || key === "B") {
+      e.preventDefault();
+      if (!e.repeat) step([L.back]);
     }
   }
   document.addEventListener("keydown", onKeyDown);
   document.addEventListener("keyup", function (e) { release(e.code); });
   window.addEventListener("blur", releaseAll);
   document.addEventListener("visibilitychange", function () { if (document.hidden) releaseAll(); });
+
+  // ------------------------------------------------------------------ 7. a hold ends in a release
+  function holdKey(el) {                    // the hold-to-jog key (a single button) under el
+    var b = el && el.closest ? el.closest("button") : null;
+    return b && b.id && JOG_RE.test(text(b)) ? b : null;
+  }
+  var pressed = null;                       // {button, clicked}: a hold-to-jog key held by a pointer
+  function endHold(cancelled) {
+    var p = pressed;
+    if (!p) return;
+    pressed = null;
+    if (cancelled) { if (p.button.isConnected) p.button.click(); return; }
+    window.setTimeout(function () {         // the browser's own click comes right after pointerup
+      if (!p.clicked && p.button.isConnected) p.button.click();
+    }, 60);
+  }
+  document.addEventListener("pointerdown", function (e) {
+    var b = holdKey(e.target);
+    if (b && e.isTrusted) pressed = { button: b, clicked: false };
+  }, true);
+  document.addEventListener("click", function (e) {
+    if (pressed && holdKey(e.target) === pressed.button) pressed.clicked = true;
+  }, true);
+  document.addEventListener("pointerup", function (e) { if (e.isTrusted) endHold(false); }, true);
+  document.addEventListener("pointercancel", function () { endHold(true); }, true);
+  document.addEventListener("contextmenu", function (e) {        // a long press: no menu, no lost release
+    if (holdKey(e.target) || (e.target && e.target.closest && e.target.closest("[data-tcp-pendant-touch]"))) {
+      e.preventDefault();
+    }
+  }, true);
+  window.addEventListener("blur", function () { endHold(true); });
 
   // ------------------------------------------------------------------ 3. the trainer URL
   var trainerToken = null;
@@ -334,6 +397,8 @@
       setTitle(r.minus, "Key Shift+" + (i + 1));
     });
     buttonsNamed(L.record).concat(buttonsNamed(L.recordPoint)).forEach(function (b) { setTitle(b, "Key R"); });
+    buttonsNamed(L.next).concat(buttonsNamed(L.finish)).forEach(function (b) { setTitle(b, "Key N"); });
+    buttonsNamed(L.back).forEach(function (b) { setTitle(b, "Key B"); });
   }
 
   var PIN_CLASS = "presenter-readout";
@@ -385,6 +450,58 @@
     if (off && box.checked) box.click();
   }
 
+  // ------------------------------------------------------------------ 6. screens
+  var TIP_W = 344;                          // the tip views' image, px wide (2 x 168 + 8)
+  var STYLE = [
+    "[data-tcp-pendant-tipviews] { position: fixed !important; left: 12px; bottom: 12px; z-index: 30;",
+    "  width: calc(" + TIP_W + "px + 2 * var(--mantine-spacing-xs, 10px)); max-width: calc(100vw - 24px); box-sizing: border-box; padding-top: 6px; padding-bottom: 4px;",
+    "  background: rgba(255, 255, 255, 0.94); border-radius: 6px; box-shadow: 0 1px 6px rgba(0, 0, 0, 0.3); }",
+    "[data-tcp-pendant-tipviews] p { font-size: 12px !important; line-height: 1.3; margin-bottom: 2px; }",
+    "@media (max-width: 600px) {",
+    "  [data-tcp-pendant-tipviews] { top: 8px; bottom: auto; left: 8px; width: min(" + (TIP_W + 20) + "px, 62vw); padding-top: 3px; }",
+    "  [data-tcp-pendant-tipviews] p { font-size: 10px !important; }",
+    "  .mantine-Paper-root[style*='position: fixed'][style*='bottom: 0px'] { max-height: 38% !important; }",
+    "}",
+    "[data-tcp-pendant-touch] { touch-action: none; user-select: none; -webkit-user-select: none; -webkit-touch-callout: none; }",
+    "@media (pointer: coarse) {",
+    "  .mantine-Button-root { height: auto !important; min-height: 44px !important; }",
+    "  [data-tcp-pendant-keys-line] { display: none !important; }",
+    "}"
+  ].join("\n");
+  function styleSheet() {
+    if (document.getElementById("tcp-pendant-style")) return;
+    var el = document.createElement("style");
+    el.id = "tcp-pendant-style";
+    el.textContent = STYLE;                 // a constant: nothing from the server or the user
+    (document.head || document.documentElement).appendChild(el);
+  }
+  function guiRow(el) {                     // the wrapper viser puts around one GUI element
+    var row = el;
+    while (row && row.parentElement && row.parentElement.children.length === 1 &&
+           !row.parentElement.classList.contains("mantine-Tabs-panel")) row = row.parentElement;
+    return row;
+  }
+  function markScreens() {
+    allButtons().forEach(function (b) {     // the keys a finger holds: no pan, no selection, no menu
+      var t = text(b);
+      if ((JOG_RE.test(t) || t === L.record || t === L.recordPoint) && !b.hasAttribute("data-tcp-pendant-touch")) {
+        b.setAttribute("data-tcp-pendant-touch", "1");
+      }
+    });
+    var ps = document.querySelectorAll("p");
+    for (var i = 0; i < ps.length; i++) {
+      if (text(ps[i]).indexOf(L.keysLine) !== 0) continue;
+      var line = guiRow(ps[i]);
+      if (line && !line.hasAttribute("data-tcp-pendant-keys-line")) line.setAttribute("data-tcp-pendant-keys-line", "1");
+    }
+    var imgs = document.querySelectorAll("img");
+    for (var j = 0; j < imgs.length; j++) {
+      var box = imgs[j].parentElement && imgs[j].parentElement.parentElement;   // label + image (viser's image)
+      if (!box || box.hasAttribute("data-tcp-pendant-tipviews")) continue;
+      if (text(box).indexOf(L.tipViews) === 0) box.setAttribute("data-tcp-pendant-tipviews", "1");
+    }
+  }
+
   var scheduled = false;
   function schedule() {
     if (scheduled) return;
@@ -392,6 +509,7 @@
     window.setTimeout(function () {
       scheduled = false;
       keyTitles();
+      markScreens();
       pinPresenter();
       shadowsOff();
       scan();
@@ -399,6 +517,7 @@
   }
   function start() {
     new MutationObserver(schedule).observe(document.documentElement, { childList: true, subtree: true });
+    styleSheet();
     document.documentElement.setAttribute("data-tcp-pendant-script", "1");
     schedule();
   }
