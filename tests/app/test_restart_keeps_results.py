@@ -72,7 +72,7 @@ def test_an_unsaved_result_comes_back_after_a_restart_until_it_is_saved(app_fact
         assert wf.record_ids == {len(wf.runs) - 1: row.calibration_id}
         assert s2.views["calibrate"].result.folder.visible
         assert wf.hide_truth                                       # the exercise: the result shows no truth
-        slot, tool = s2.save_result("ana tool")                    # she can still save it to the library
+        slot, tool = s2.wizard_commands.save_result("ana tool")                    # she can still save it to the library
         kept = again.library.get(slot)
         assert kept is not None and kept.name == "ana tool"
         np.testing.assert_allclose(kept.tcp_mm, tcp, atol=1e-6)

@@ -75,7 +75,7 @@ def tcp_mm(s: Any) -> np.ndarray:
 def open_wizard(s: Any, page: Any) -> None:
     """XYZ 4-point at step 2 (one auto touch), the tool tip 3.5 mm off the reference tip."""
     with ThreadPoolExecutor(max_workers=1) as pool:
-        pool.submit(lambda: (s.start_wizard("xyz4"), s.auto_touch(AutoTouchRequest()))).result()
+        pool.submit(lambda: (s.wizard_commands.start("xyz4"), s.wizard_commands.auto_touch(AutoTouchRequest()))).result()
     true_tip_at(s, (1.5, -1.0, 3.0))
     page.get_by_text("Step 2 of 4").first.wait_for(state="visible", timeout=TIMEOUT_MS)
 
