@@ -44,7 +44,6 @@ LONG_FUNCTIONS = {
     "beam_scan:_scan_orientation": _LONG,
     "beam_scan:run_beam_scan": _LONG,
     "description:load_description": _LONG,
-    "jog:_solve_substep": _LONG,
     "spin:spin_check": _LONG,
     "pendant_panel:PendantPanel.__init__": _LONG,
 }
