@@ -384,9 +384,11 @@ class Session:
         if change.pose or change.tool or moved_reference:
             state = self.pose_state()
             crashed = bool(state.touch.crashed)
+            run = self.workflow.run_index if self.workflow.is_open else None
             if crashed and not self._crashed:
-                run = self.workflow.run_index if self.workflow.is_open else None
                 events += (Crash(float(state.touch.penetration_mm), run),)
+            elif change.jog is not None and change.jog.stopped_by == "collision":   # stopped at the tip
+                events += (Crash(0.0, run),)
             self._crashed = crashed
             # the change as the subscribers get it, built once: pose, its state, every event
             change = SessionChange(pose=True, tool=change.tool, touches=change.touches, wizard=change.wizard,

@@ -216,24 +216,52 @@ def test_an_increment_stops_at_contact_and_the_next_press_goes_on(page) -> None:
     assert pendant.status_md.content == ""
 
 
-def test_with_the_distance_hidden_a_jog_goes_through_the_tip_silently_and_crashes(page) -> None:
-    """Judged by eye: no stop at the tip, no message, no toast - "press until it stops" would
-    tell the trainee where the tip is; driven through it, the tool crashes."""
+def test_with_the_distance_hidden_a_jog_into_the_tip_stops_as_a_collision_and_is_a_crash(page) -> None:
+    """Judged by eye: a press that would drive the tool tip through the reference tip stops where
+    the tips meet, as a real collision stops a robot, says so with the key that backs off, and is
+    recorded as a crash; the next press the same way goes on through (a second crash)."""
+    from tcp_pendant.events import Crash
+
     p = page()
     s, pendant = p.session, p.pendant
+    crashes: list[Crash] = []
+    s.subscribe(lambda change: crashes.extend(e for e in change.events if isinstance(e, Crash)))
     p.choose(pendant.hide_distance, True)
     p.tip_at((0.0, 0.0, 4.0))                                       # 4 mm above the reference tip
     p.notes.clear()
     p.choose(pendant.increment, "10")
-    p.choose(pendant.cart_rows["Z"], "Z −")                         # 10 mm down: through the tip
+    p.choose(pendant.cart_rows["Z"], "Z −")                         # 10 mm down: would go 6 mm through
     st = s.pose_state()
-    assert st.touch.crashed and st.touch.penetration_mm == pytest.approx(6.0, abs=0.01)
-    assert pendant.status_md.content == "" and p.notes == []        # not a word before the crash ...
-    assert "CRASH" in pendant.touch_md.content                      # ... then the crash, as on a robot
-    p.choose(pendant.hide_distance, False)                          # shown again: the stop is back
-    p.tip_at((0.0, 0.0, 4.0))
-    p.choose(pendant.cart_rows["Z"], "Z −")
-    assert "Stopped at the reference tip" in pendant.status_md.content
+    assert st.touch.distance_mm < 0.01 and not st.touch.crashed     # stopped where the tips meet
+    assert "COLLISION" in pendant.status_md.content
+    assert "Back off with Z + (3, WORLD frame)" in pendant.status_md.content
+    assert [c.penetration_mm for c in crashes] == [0.0]             # recorded as a crash
+    p.choose(pendant.cart_rows["Z"], "Z −")                         # the trainee insists: goes through
+    assert s.pose_state().touch.crashed and "CRASH" in pendant.touch_md.content
+    assert len(crashes) == 2
+
+
+def test_with_the_distance_hidden_a_firm_touch_goes_on_and_a_backing_off_key_in_tool_warns(page) -> None:
+    """0.1 mm past the tip is a firm touch (no stop, no word: the stop would give the tip away);
+    in TOOL, where the tool's own +Z leads into the tip, "backing off" with Z + is stopped."""
+    p = page()
+    s, pendant = p.session, p.pendant
+    p.choose(pendant.hide_distance, True)
+    p.tip_at((0.0, 0.0, 0.35))
+    p.choose(pendant.increment, "1")
+    p.choose(pendant.cart_rows["Z"], "Z −")                         # 0.65 mm past: beyond the 0.5 mm
+    assert "COLLISION" in pendant.status_md.content
+    p.tip_at((0.0, 0.0, 0.3))
+    p.choose(pendant.increment, "0.1")
+    for _ in range(4):
+        p.choose(pendant.cart_rows["Z"], "Z −")                     # ends 0.1 mm past: a firm touch
+    assert "COLLISION" not in pendant.status_md.content and not s.pose_state().touch.crashed
+    p.choose(pendant.frame, "TOOL")
+    p.tip_at((0.0, 0.0, 5.0))                                       # 5 mm above the tip, flange down
+    p.choose(pendant.increment, "10")
+    p.choose(pendant.cart_rows["Z"], "Z +")                         # TOOL +Z points down, into the tip
+    assert "COLLISION" in pendant.status_md.content and not s.pose_state().touch.crashed
+    assert "Back off with Z − (Shift+3, TOOL frame)" in pendant.status_md.content
 
 
 def test_a_stop_message_does_not_outlive_an_auto_touch(page) -> None:

@@ -111,9 +111,9 @@ __all__ = [
     "tcp_pose",
 ]
 
-StopReason = Literal["joint_limit", "singularity", "unreachable", "contact"]
-"""Why a motion stopped early; "contact": the pendant's stop at the reference tip
-(``tcp_pendant.pendant.jogging``)."""
+StopReason = Literal["joint_limit", "singularity", "unreachable", "contact", "collision"]
+"""Why a motion stopped early; "contact": the pendant's stop at the reference tip, "collision":
+its stop there with the distance hidden (``tcp_pendant.pendant.jogging``)."""
 
 
 class JogFrame(str, Enum):
