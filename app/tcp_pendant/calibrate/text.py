@@ -182,14 +182,18 @@ def meter_level(gain: CandidateGain) -> tuple[float, Literal["red", "yellow", "g
 
 
 def meter_markdown(gain: CandidateGain, quality: PoseQuality | None, sigma_mm: float,
-                   advice_before_determinable: str | None = None, tilt_hint: str | None = None) -> str:
+                   advice_before_determinable: str | None = None, tilt_hint: str | None = None, *,
+                   measured: bool = False) -> str:
     """Live advice while jogging toward the next touch (all figures predicted by tcpcal from the
     orientations alone, for an operator error of ``sigma_mm`` per axis). While recording here
     would still not make the TCP determinable (``gain.predicted_after`` infinite) the advice is
     ``advice_before_determinable`` (``tcp_pendant.calibrate.diversity``: the angle to the
     nearest touch and the axis still missing, in words) or else ``quality.message`` (tcpcal's).
-    ``tilt_hint`` (``diversity.best_tilt_words``: which way to tilt for the next touch) ends it."""
-    head = f"**Pose diversity** (if you recorded here, operator error {fmt_num(sigma_mm, 1)} mm):"
+    ``tilt_hint`` (``tilt_advice.TiltAdvice.text``: which way to tilt for the next touch) ends it.
+    ``measured``: ``sigma_mm`` is the scatter of the trainee's own touches (else assumed)."""
+    basis = (f"your touches' scatter {fmt_num(sigma_mm, 2)} mm" if measured
+             else f"operator error {fmt_num(sigma_mm, 1)} mm")
+    head = f"**Pose diversity** (if you recorded here, {basis}):"
     if gain.too_close:
         advice = (f"⚠ **Too close** to an earlier touch: {_deg(gain.angle_to_nearest_deg, 0)} apart. "
                   "Tilt the tool further, about another axis, before recording.")

@@ -107,23 +107,38 @@ class TiltOptions:
 
 def reachable_line(options: tuple[TiltOption, ...], *, frame: str, joint_mode: bool) -> str:
     """The dock's line of the tilts reachable from here (markdown, our words only), e.g.
-    "Tilts of 45° reachable from here with the tip held (WORLD frame): **B +** (5), **C +** (6),
-    **C −** (Shift+6). Not: A (turns the tool about its own length); B − (A5 near 8.0 deg: ...)."."""
+    "Reachable 45° tilts, tip held (WORLD): **B +** (5), **C +** (6), **C −** (Shift+6). Not: A
+    (own axis); B − (wrist singularity)." (the reasons shortened: :func:`_short`)."""
     if not options:
         return ""
     angle = options[0].reach.angle_deg
     ok = [f"**{key_label(o.reach.key, o.reach.sign)}** ({keyboard_key(o.reach.key, o.reach.sign)})"
           for o in options if o.usable]
     own = sorted({o.reach.key for o in options if o.own_axis})
-    blocked = [f"{key_label(o.reach.key, o.reach.sign)} ({o.reach.why})" for o in options
+    blocked = [f"{key_label(o.reach.key, o.reach.sign)} ({_short(o.reach.why)})" for o in options
                if not o.own_axis and not o.reach.reachable]
-    head = f"Tilts of {angle:.0f}° reachable from here with the tip held ({frame} frame): "
-    head += ", ".join(ok) + "." if ok else "none in this frame: change the Frame or jog back toward the ready pose."
-    nots = ([f"{' and '.join(own)} (turns the tool about its own length)"] if own else []) + blocked
+    head = f"Reachable {angle:.0f}° tilts, tip held ({frame}): "
+    head += ", ".join(ok) + "." if ok else "none in this frame: change the Jog frame or press Ready pose."
+    nots = ([f"{' '.join(own)} (own axis)"] if own else []) + blocked
     text = head + (" Not: " + "; ".join(nots) + "." if nots else "")
     if joint_mode:
         text += " (Set Mode to Cartesian: the keys are joints now.)"
     return text
+
+
+def _short(why: str) -> str:
+    """A blocked tilt's reason in two or three words: "wrist singularity", "A5 limit", "tip out
+    of reach" (the whole reason is in a stopped jog's message)."""
+    if "out of reach" in why:
+        return "tip out of reach"
+    if "singularity" in why:
+        for kind in ("wrist", "elbow", "shoulder"):
+            if kind in why:
+                return f"{kind} singularity"
+        return "singularity"
+    if "limit" in why:
+        return f"{why.split()[0]} limit"
+    return why
 
 
 def stopped_advice(options: tuple[TiltOption, ...], stopped_key: str, stopped_sign: int) -> str:
@@ -135,4 +150,4 @@ def stopped_advice(options: tuple[TiltOption, ...], stopped_key: str, stopped_si
     back = f"{key_label(stopped_key, -stopped_sign)} ({keyboard_key(stopped_key, -stopped_sign)}) turns back"
     if others:
         return f"Instead tilt with {', '.join(others)} (reachable from here with the tip held); {back}."
-    return f"No tilt of 45° is reachable from here in this frame; {back}."
+    return f"No tilt of 45° is reachable from here in this frame (try another Jog frame); {back}."
