@@ -28,8 +28,6 @@ from tcp_pendant.pendant.guidance import tip_offset_mm
 from tcp_pendant.pendant.jogging import LINEAR_SPEED_MM_S
 from tcp_pendant.serve.server import PendantApp
 from tcp_pendant.views.pendant_panel import HOLD_HZ, MARK
-from tcp_pendant.calibrate.diversity import best_tilt, best_tilt_words
-from tcp_pendant.text_escape import escape_html
 from tcp_pendant.calibrate import AutoTouchRequest
 from tcp_pendant.views.wizard_dock import BACK, CANCEL, NEXT, TILT_LINE_STYLE, tilt_line_html
 
@@ -80,26 +78,34 @@ def test_the_dock_shows_the_wizards_step_on_the_jog_tab_and_records_it(page) -> 
     assert dock.folder.visible and not dock.note_md.visible         # the old line did not carry over
 
 
-def test_the_docks_tilt_line_names_the_best_tilt_on_one_fixed_line(page) -> None:
+def test_the_docks_tilt_line_names_a_reachable_tilt_by_its_keyboard_key_in_full(page) -> None:
+    """The hint: a tilt of the active jog frame the robot model can make with the tip held (not
+    a turn about the tool's own length), its keyboard key, in full (no ellipsis); the reachable
+    tilts under it; followed, it does not come back unchanged."""
+    from tcp_pendant.controller.reach import tilt_reach
+
     p = page()
     s, dock = p.session, p.dock
     p.click(p.calibrate.start)                                      # XYZ 4-point
     wiz = p.calibrate.workflow.wizard
-    # one touch or none: every turn is as good, the line stays (empty, the same height)
-    assert dock.tilt_html.visible and dock.tilt_html.content == tilt_line_html(None)
-    assert "&nbsp;" in dock.tilt_html.content and "white-space:nowrap" in TILT_LINE_STYLE
+    assert dock.tilt_html.visible and dock.tilt_html.content == tilt_line_html(None)   # no touch yet
+    assert "nowrap" not in TILT_LINE_STYLE and "ellipsis" not in TILT_LINE_STYLE
     for _ in range(2):
         assert s.auto_touch(AutoTouchRequest()).ok
     assert wiz.step.index == 2
-    c = s.controller
-    best = best_tilt(wiz.other_rotations(), c.T_world_flange()[:3, :3], R_flange_tool=c.T_flange_tool[:3, :3],
-                     sigma_mm=wiz.assumed_sigma_mm)
-    assert best is not None
-    words = best_tilt_words(best).replace("**", "")
-    assert words.startswith("Tilt that helps most: about TOOL "), words
-    html = dock.tilt_html.content                                   # the words, escaped, in the line
-    assert html == tilt_line_html(best_tilt_words(best)) and f">{escape_html(words)}</div>" in html
-    assert f'style="{TILT_LINE_STYLE}"' in html and "height:1.5em" in TILT_LINE_STYLE
+    html = dock.tilt_html.content
+    m = re.search(r"Tilt next: ([ABC]) ([+−]) 45° in WORLD \(key (Shift\+)?([456])\)", html)
+    assert m, html
+    key, sign = m.group(1), 1 if m.group(2) == "+" else -1
+    assert m.group(4) == {"A": "4", "B": "5", "C": "6"}[key] and bool(m.group(3)) == (sign < 0)
+    assert tilt_reach(s.controller, "WORLD", key, sign, 45.0).reachable          # on the model
+    axis = np.eye(3)[:, {"A": 2, "B": 1, "C": 0}[key]]
+    assert abs(axis @ s.controller.T_world_flange()[:3, 2]) < np.cos(np.radians(25.0))   # a tilt
+    assert "Reachable 45° tilts, tip held (WORLD):" in html and "…" not in html
+    before = m.group(0)
+    assert s.controller.jog_cartesian("WORLD", key, sign * 45.0).ok               # followed
+    s.moved()
+    assert before not in dock.tilt_html.content
 
 
 def test_record_far_from_the_tip_asks_first_and_hide_distance_records(page) -> None:

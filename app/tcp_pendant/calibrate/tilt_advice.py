@@ -53,7 +53,7 @@ def measured_sigma_mm(wizard: Any) -> float | None:
     wizard, fewer than three touches, or tcpcal cannot solve them (module docstring)."""
     if getattr(wizard, "kind", "") != "xyz4":
         return None
-    poses = wizard.recorded_poses()
+    poses = wizard.recorded_poses
     rows = [poses[i].T_world_flange_m for i in wizard.solver_touch_steps() if i in poses]
     if len(rows) < 3:
         return None
