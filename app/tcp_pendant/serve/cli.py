@@ -410,12 +410,13 @@ def _class_lines(app: PendantApp) -> str:
     exercise = "mystery tools" if room.exercise == "mystery" else "free practice"
     if room.trainer_token is None:
         return (f"  class gradebook {room.gradebook.location} ({exercise})\n"
-                f"Trainer view: {app.url} with the trainer token this class began with (kept hashed in the "
+                f"Trainer view: {app.url.rstrip('/')}/?trainer with the trainer token this class began with (kept hashed in the "
                 "gradebook, so an open trainer page reconnects); give --trainer-token to set a new one\n")
     return (f"  class gradebook {room.gradebook.location} ({exercise})\n"
             f"Trainer view: {app.trainer_url}  trainer token: {room.trainer_token}\n"
-            "  (open that address: the page fills in the token and drops it from the address bar; or open the "
-            "page and type the token in \"Trainer token\" of the welcome window; keep both secret)\n")
+            "  (open that address: the page fills in the token and drops it from the address bar; or open "
+            f"{app.url.rstrip('/')}/?trainer and type the token in \"Trainer token\" of the welcome window, "
+            "which only a /?trainer page shows; keep both secret)\n")
 
 
 if __name__ == "__main__":  # pragma: no cover
