@@ -18,16 +18,18 @@ the orientation is good. :class:`TiltAdvisor` also remembers the hint it gave an
 orientation then: once the trainee has turned by 0.8 x the tilt since, that same key is not
 suggested again (followed, it does not come back unchanged).
 
-**Scatter.** :func:`measured_sigma_mm`: once the solver's touches over-determine the TCP (XYZ
-4-point: three touches, ``3N - 6 >= 3``), the per-axis scatter of the trainee's own touches,
-tcpcal's ``noise_sigma = sqrt(sum |e_i|^2 / (3N - 6))`` (methods.md, 4P-3); the predictions are
-linear in sigma, so they are scaled from the wizard's assumed one.
+**Scatter.** :func:`measured_sigma_mm`: once tcpcal solves the run's touches (XYZ 4-point: four
+or more, its minimum), the per-axis scatter of the trainee's own touches, tcpcal's
+``noise_sigma = sqrt(sum |e_i|^2 / (3N - 6))`` (methods.md, 4P-3); before that, the scatter of
+the trainee's last finished XYZ calibration in this session (its result's ``noise_sigma``); only
+without either the wizard's assumed error. :func:`meter_gain` predicts with it.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -49,13 +51,13 @@ must not promise a perfect result."""
 
 
 def measured_sigma_mm(wizard: Any) -> float | None:
-    """The per-axis scatter of the recorded touches (mm), or None: not an XYZ 4-point kind of
-    wizard, fewer than three touches, or tcpcal cannot solve them (module docstring)."""
+    """The per-axis scatter of the run's recorded touches (mm), or None: not an XYZ 4-point
+    wizard, fewer than four touches, or tcpcal cannot solve them (module docstring)."""
     if getattr(wizard, "kind", "") != "xyz4":
         return None
     poses = wizard.recorded_poses
     rows = [poses[i].T_world_flange_m for i in wizard.solver_touch_steps() if i in poses]
-    if len(rows) < 3:
+    if len(rows) < 4:
         return None
     R = np.array([T[:3, :3] for T in rows])
     f_mm = np.array([T[:3, 3] for T in rows]) * 1000.0           # metres -> mm for tcpcal
@@ -80,21 +82,41 @@ class MeterGain:
     gain: CandidateGain
     sigma_mm: float
     measured: bool
+    source: str = ""
+    """Whose scatter: "your touches" (this run's) or "your last calibration" ("" assumed)."""
 
     @property
     def basis(self) -> str:
-        """"your touches scatter 0.21 mm" or "assuming 0.5 mm per touch"."""
-        return (f"your touches scatter {self.sigma_mm:.2f} mm" if self.measured
-                else f"assuming {self.sigma_mm:g} mm per touch")
+        """"your touches scatter 0.21 mm", "your last calibration scattered 0.21 mm" or
+        "assuming 0.5 mm per touch"."""
+        if not self.measured:
+            return f"assuming {self.sigma_mm:g} mm per touch"
+        verb = "scatter" if self.source == "your touches" else "scattered"
+        return f"{self.source} {verb} {self.sigma_mm:.2f} mm"
 
 
-def meter_gain(wizard: Any, R_world_flange: np.ndarray) -> MeterGain:
-    """``candidate_gain`` of the wizard's other touches and ``R_world_flange`` for the measured
-    scatter once there is one, else the wizard's assumed error (as ``wizard.preview``)."""
-    measured = measured_sigma_mm(wizard)
-    sigma = float(wizard.assumed_sigma_mm) if measured is None else measured
-    gain = candidate_gain(wizard.other_rotations(), np.asarray(R_world_flange, dtype=float), sigma=sigma)
-    return MeterGain(gain, sigma, measured is not None)
+def _last_scatter(earlier: Sequence[Any]) -> float | None:
+    """``noise_sigma`` of the latest finished XYZ result among ``earlier`` wizards (mm)."""
+    for w in reversed(list(earlier)):
+        result = getattr(w, "finished_result", None)
+        tcp = getattr(result, "tcp_result", None)
+        sigma = getattr(tcp, "noise_sigma", None)
+        if sigma is not None and math.isfinite(float(sigma)):
+            return max(float(sigma), MIN_MEASURED_SIGMA_MM)
+    return None
+
+
+def meter_gain(wizard: Any, R_world_flange: np.ndarray, earlier: Sequence[Any] = ()) -> MeterGain:
+    """``candidate_gain`` of the wizard's other touches and ``R_world_flange`` for the trainee's
+    measured scatter (this run's touches, else the last finished calibration among ``earlier``
+    wizards of the session), else the wizard's assumed error (as ``wizard.preview``)."""
+    sigma, source = measured_sigma_mm(wizard), "your touches"
+    if sigma is None:
+        sigma, source = _last_scatter([w for w in earlier if w is not wizard]), "your last calibration"
+    measured = sigma is not None
+    sigma_mm = float(wizard.assumed_sigma_mm) if sigma is None else sigma
+    gain = candidate_gain(wizard.other_rotations(), np.asarray(R_world_flange, dtype=float), sigma=sigma_mm)
+    return MeterGain(gain, sigma_mm, measured, source if measured else "")
 
 
 @dataclass(frozen=True)

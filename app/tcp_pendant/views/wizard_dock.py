@@ -218,7 +218,7 @@ class WizardDock:
         if not show:
             return
         T_world_flange = self.session.controller.T_world_flange()
-        meter = meter_gain(wiz, T_world_flange[:3, :3])
+        meter = meter_gain(wiz, T_world_flange[:3, :3], [r.wizard for r in wf.runs])
         gain = meter.gain
         value, color = meter_level(gain)
         set_value(self.meter_bar, round(value, 1))

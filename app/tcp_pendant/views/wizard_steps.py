@@ -327,7 +327,7 @@ class WizardStepsView:
         if not show:
             return
         T_world_flange = self.parent.session.controller.T_world_flange()
-        meter = meter_gain(wiz, T_world_flange[:3, :3])
+        meter = meter_gain(wiz, T_world_flange[:3, :3], [r.wizard for r in wf.runs])
         gain = meter.gain
         value, color = meter_level(gain)
         set_value(self.meter_bar, round(value, 1))
@@ -337,4 +337,4 @@ class WizardStepsView:
         s = self.parent.session
         tilt = self.advisor.advise(wiz.other_rotations(), T_world_flange[:3, :3], s.jogger, meter.sigma_mm)
         set_content(self.meter_md, meter_markdown(gain, None, meter.sigma_mm, advice,
-                                                  None if tilt is None else tilt.text, measured=meter.measured))
+                                                  None if tilt is None else tilt.text, measured=meter.source))
