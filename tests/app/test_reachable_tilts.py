@@ -115,3 +115,28 @@ def test_a_translation_stopped_at_the_reach_says_the_key_that_goes_back() -> Non
             break
     assert res is not None and not res.ok
     assert res.message.endswith("X − (Shift+1) goes back.")
+
+
+def test_a_joint_key_at_its_limit_says_the_other_key_turns_it_back() -> None:
+    from tcp_pendant.pendant.jogging import JogMode
+
+    c = make_controller("kr6")
+    j = Jogger(c)
+    j.settings = j.settings.with_(mode=JogMode.JOINT, increment="100")
+    res = j.key(4, 1)                                     # A5 from +90 by 100 deg: its limit +120
+    assert res is not None and res.stopped_by == "joint_limit"
+    assert res.message == "A5 at its limit +120.0 deg. The other key of that row (Shift+5) turns it back."
+
+
+def test_fine_presses_near_the_tip_reuse_the_check_and_a_tilt_checks_again() -> None:
+    c = make_controller("kr6")
+    _onto_tip(c)
+    tilts = TiltOptions(c)
+    first = tilts.options("WORLD")
+    assert tilts.checks == 1
+    for axis in "XYZ":                                    # 0.1 and 1 mm presses: the same answer
+        assert c.jog_cartesian("WORLD", axis, 1.0).ok and c.jog_cartesian("WORLD", axis, -0.9).ok
+    assert tilts.options("WORLD") is first and tilts.checks == 1
+    assert c.jog_cartesian("WORLD", "C", 10.0).ok          # a 10 deg tilt: checked again
+    tilts.options("WORLD")
+    assert tilts.checks == 2

@@ -34,7 +34,7 @@ the session records the collision as a crash. The next press the same way goes o
 A Cartesian key that stops at a joint limit, a singularity or the edge of the reach says which
 way to go instead: after a rotation key, the tilts the model says are reachable from the stop
 with the tip held (``pendant.tilts``) and the key that turns back; after a translation key, the
-key that goes back.
+key that goes back; after a joint key, the other key of its row.
 """
 
 from __future__ import annotations
@@ -265,7 +265,11 @@ class Jogger:
             dt = self._tick_s if last is None or now - last > 4 * self._tick_s else now - last
             self._last_tick = {name: now}
         if isinstance(axis, int) and not isinstance(axis, bool):
-            return self.controller.jog_joint(axis, sign * s.step_amount(rotational=True, joint=True, dt_s=dt))
+            res = self.controller.jog_joint(axis, sign * s.step_amount(rotational=True, joint=True, dt_s=dt))
+            if res.stopped_by == "joint_limit" and axis < 9:          # the way back: the other key of the row
+                back = f"key {axis + 1}" if sign < 0 else f"Shift+{axis + 1}"
+                res = replace(res, message=f"{res.message}. The other key of that row ({back}) turns it back.")
+            return res
         ax = str(axis).upper()
         if ax not in CARTESIAN_AXES:
             raise ControllerError(f"Jog keys are joint indices or X, Y, Z, A, B, C; got {axis!r}.")

@@ -2,9 +2,12 @@
 
 :class:`TiltOptions` checks the six rotation keys of a jog frame (A, B, C, each way) by an
 angle on the robot model (``controller.reach.tilt_reach``: joint limits, the wrist singularity
-margin, the reference tip still reachable after the turn) and keeps the answer for the pose it
-was asked at (the controller's ``pose_state_key``), so the dock's line, the tilt hint and a
-stopped jog's advice cost the check once per pose. A rotation whose axis lies within 25 deg of
+margin, the reference tip still reachable after the turn) and keeps the answer while the robot
+stays within :data:`REUSE_DEG` of the orientation and :data:`REUSE_MM` of the TCP position it
+was asked at (the tool data, the mounted tool, the reference tip and BASE unchanged): the dock's
+line, the tilt hint and a stopped jog's advice cost the check (a few ms per key) once, not on
+every fine jog press near the tip. The margins of the check (3 deg from every joint limit, the
+wrist singularity margin) are wider than what the robot can change within that. A rotation whose axis lies within 25 deg of
 the flange axis turns the tool about its own length: it is no tilt (it adds nothing a tilt
 adds, and ``calibrate.diversity`` calls the same axis "the flange axis").
 
@@ -22,13 +25,17 @@ import numpy as np
 from tcp_pendant.controller import VirtualController
 from tcp_pendant.controller.reach import ROTATION_KEYS, TiltReach, frame_axes, tilt_reach
 
-__all__ = ["OWN_AXIS_DEG", "ROW_OF_KEY", "TILT_DEG", "TiltOption", "TiltOptions", "keyboard_key", "key_label",
+__all__ = ["OWN_AXIS_DEG", "REUSE_DEG", "REUSE_MM", "ROW_OF_KEY", "TILT_DEG", "TiltOption", "TiltOptions", "keyboard_key", "key_label",
            "reachable_line", "stopped_advice"]
 
 TILT_DEG = 45.0
 """The tilt the steps ask for (45 to 60 deg: the least of it is checked)."""
 OWN_AXIS_DEG = 25.0
 """A rotation axis this close to the flange axis turns the tool about its own length (deg)."""
+REUSE_DEG = 2.0
+REUSE_MM = 5.0
+"""An answer is kept while the flange turned less than ``REUSE_DEG`` and the TCP moved less
+than ``REUSE_MM`` since it was checked (module docstring)."""
 ROW_OF_KEY = {"X": 1, "Y": 2, "Z": 3, "A": 4, "B": 5, "C": 6}
 """The jog row (and keyboard digit) of each Cartesian key."""
 _OWN_AXIS_COS = math.cos(math.radians(OWN_AXIS_DEG))
@@ -81,14 +88,28 @@ class TiltOptions:
     def __init__(self, controller: VirtualController) -> None:
         self.controller = controller
         self._key: tuple[object, ...] | None = None
+        self._T: np.ndarray | None = None                  # T_world_tcp the answers were checked at
         self._cache: dict[tuple[str, float], tuple[TiltOption, ...]] = {}
+        self.checks = 0
+        """How many sets of six keys were checked on the model (for tests and benchmarks)."""
+
+    def _still_valid(self) -> bool:
+        c = self.controller
+        key = (id(c.kinematics), c.T_flange_tool.tobytes(), id(c.mounted_tool),
+               np.asarray(c.reference_tip_world_m).tobytes(), np.asarray(c.T_world_base).tobytes())
+        T = c.T_world_tcp()
+        if key == self._key and self._T is not None:
+            turned = math.degrees(math.acos(max(-1.0, min(1.0, (float(np.trace(self._T[:3, :3].T @ T[:3, :3])) - 1.0) / 2.0))))
+            if turned < REUSE_DEG and float(np.linalg.norm(T[:3, 3] - self._T[:3, 3])) * 1000.0 < REUSE_MM:
+                return True
+        self._key, self._T, self._cache = key, T, {}
+        return False
 
     def options(self, frame: str, angle_deg: float = TILT_DEG) -> tuple[TiltOption, ...]:
-        """A, B, C (+ then −) of ``frame``, each checked by ``angle_deg`` from the current pose."""
+        """A, B, C (+ then −) of ``frame``, each checked by ``angle_deg`` from the current pose
+        (or one within the reuse distance, module docstring)."""
         c = self.controller
-        key = c.pose_state_key()
-        if key != self._key:
-            self._key, self._cache = key, {}
+        self._still_valid()
         found = self._cache.get((frame, angle_deg))
         if found is None:
             axes = frame_axes(c, frame)
@@ -102,6 +123,7 @@ class TiltOptions:
                              if own else tilt_reach(c, frame, k, sign, angle_deg))
                     out.append(TiltOption(reach, axis, own))
             found = self._cache[(frame, angle_deg)] = tuple(out)
+            self.checks += 1
         return found
 
 
