@@ -415,7 +415,7 @@ def _class_lines(app: PendantApp) -> str:
     return (f"  class gradebook {room.gradebook.location} ({exercise})\n"
             f"Trainer view: {app.trainer_url}  trainer token: {room.trainer_token}\n"
             "  (open that address: the page fills in the token and drops it from the address bar; or open "
-            f"{app.url.rstrip('/')}/?trainer and type the token in \"Trainer token\" of the welcome window, "
+            f"{str(app.trainer_url).split('?')[0]}?trainer and type the token in \"Trainer token\" of the welcome window, "
             "which only a /?trainer page shows; keep both secret)\n")
 
 
