@@ -85,7 +85,7 @@ def test_the_issues_kr6_case_b_plus_at_the_ready_pose_is_named_unreachable_with_
     opts = TiltOptions(c).options("WORLD")
     line = reachable_line(opts, frame="WORLD", joint_mode=False)
     assert "B + (A5 limit)" in line and "A (own axis)" in line       # flange down: A turns it about itself
-    assert "B − (wrist singularity)" in line and "**C +** (6), **C −** (Shift+6)" in line
+    assert "B − (wrist singularity)" in line and "**C ±** (6, Shift+6)" in line
 
 
 def test_a_rotation_key_stopped_at_a_limit_names_the_reachable_tilts_instead() -> None:

@@ -128,20 +128,29 @@ class TiltOptions:
 
 
 def reachable_line(options: tuple[TiltOption, ...], *, frame: str, joint_mode: bool) -> str:
-    """The dock's line of the tilts reachable from here (markdown, our words only), e.g.
-    "Reachable 45° tilts, tip held (WORLD): **B +** (5), **C +** (6), **C −** (Shift+6). Not: A
-    (own axis); B − (wrist singularity)." (the reasons shortened: :func:`_short`)."""
+    """The dock's line of the tilts reachable from here (markdown, our words only), both ways of
+    a key in one, the blocked ones grouped by their reason (:func:`_short`), e.g. "Reachable 45°
+    tilts, tip held (WORLD): **B −** (Shift+5), **C ±** (6, Shift+6). Not: A (own axis); B +
+    (A5 limit)."."""
     if not options:
         return ""
     angle = options[0].reach.angle_deg
-    ok = [f"**{key_label(o.reach.key, o.reach.sign)}** ({keyboard_key(o.reach.key, o.reach.sign)})"
-          for o in options if o.usable]
+    ok = []
+    for key in ("A", "B", "C"):
+        signs = [o.reach.sign for o in options if o.usable and o.reach.key == key]
+        if len(signs) == 2:
+            ok.append(f"**{key} ±** ({keyboard_key(key, 1)}, {keyboard_key(key, -1)})")
+        elif signs:
+            ok.append(f"**{key_label(key, signs[0])}** ({keyboard_key(key, signs[0])})")
     own = sorted({o.reach.key for o in options if o.own_axis})
-    blocked = [f"{key_label(o.reach.key, o.reach.sign)} ({_short(o.reach.why)})" for o in options
-               if not o.own_axis and not o.reach.reachable]
+    blocked: dict[str, list[str]] = {}
+    for o in options:
+        if not o.own_axis and not o.reach.reachable:
+            blocked.setdefault(_short(o.reach.why), []).append(key_label(o.reach.key, o.reach.sign))
     head = f"Reachable {angle:.0f}° tilts, tip held ({frame}): "
     head += ", ".join(ok) + "." if ok else "none in this frame: change the Jog frame or press Ready pose."
-    nots = ([f"{' '.join(own)} (own axis)"] if own else []) + blocked
+    nots = ([f"{' '.join(own)} (own axis)"] if own else []) + [f"{', '.join(keys)} ({why})"
+                                                               for why, keys in blocked.items()]
     text = head + (" Not: " + "; ".join(nots) + "." if nots else "")
     if joint_mode:
         text += " (Set Mode to Cartesian: the keys are joints now.)"
