@@ -258,7 +258,7 @@ class Session:
             ``"world"``, ``"computed"``, ``"true"``, ``"target"``; presenter mode draws them all
             larger.
         hide_distance: "Hide distance" (training: judge the touch by eye); change it with
-            :meth:`set_hide_distance`. While it is on, a jog does not stop at the reference tip.
+            :meth:`set_hide_distance`. While it is on, only a collision stops a jog at the tip.
         rules: what the trainer's exercise allows (``calibrate.pendant_rules``, made by ``classroom.exercise_rules``), with its
             instructions; change it with :meth:`set_rules`.
         rng: the session's random generator (Auto-touch's operator error and directions, the
@@ -384,11 +384,11 @@ class Session:
         if change.pose or change.tool or moved_reference:
             state = self.pose_state()
             crashed = bool(state.touch.crashed)
-            run = self.workflow.run_index if self.workflow.is_open else None
             if crashed and not self._crashed:
+                run = self.workflow.run_index if self.workflow.is_open else None
                 events += (Crash(float(state.touch.penetration_mm), run),)
             elif change.jog is not None and change.jog.stopped_by == "collision":   # stopped at the tip
-                events += (Crash(0.0, run),)
+                events += (Crash(0.0, self.workflow.run_index if self.workflow.is_open else None),)
             self._crashed = crashed
             # the change as the subscribers get it, built once: pose, its state, every event
             change = SessionChange(pose=True, tool=change.tool, touches=change.touches, wizard=change.wizard,
