@@ -223,7 +223,7 @@ class Session:
             active slot, its start tool).
         ready_q_rad: the "Ready pose" button's joint angles (None: the robot's HOME).
         hide_distance: "Hide distance" (training: judge the touch by eye); change it with
-            :meth:`set_hide_distance`. While it is on, a jog does not stop at the reference tip.
+            :meth:`set_hide_distance`. While it is on, only a collision stops a jog at the tip.
         rules: what the trainer's exercise allows (``calibrate.pendant_rules``, made by
             ``classroom.exercise_rules``), with its instructions; change it with :meth:`set_rules`.
         rng: the session's random generator (Auto-touch's operator error and directions, the
@@ -335,6 +335,8 @@ class Session:
             if crashed and not self._crashed:
                 run = self.workflow.run_index if self.workflow.is_open else None
                 events += (Crash(float(state.touch.penetration_mm), run),)
+            elif change.jog is not None and change.jog.stopped_by == "collision":   # stopped at the tip
+                events += (Crash(0.0, self.workflow.run_index if self.workflow.is_open else None),)
             self._crashed = crashed
             # the change as the subscribers get it, built once: pose, its state, every event
             change = replace(change, pose=True, state=state, events=change.events + events)

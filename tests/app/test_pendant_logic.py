@@ -145,7 +145,8 @@ def test_tcp_readout_text() -> None:
     assert "TCP in BASE" in md and "TOOL Pointer" in md
     assert "X 525.00 mm" in md and "Y   0.00 mm" in md and "-0.00" not in md
     assert "B -90.00 deg" in md
-    assert "FLANGE (no tool active)" in tcp_readout_markdown(r, None)
+    assert "Active tool data: none (FLANGE) · mounted: Straight pointer" in tcp_readout_markdown(r, None, "Straight pointer")
+    assert "Active tool data: TOOL Pointer" in md and "no tool" not in tcp_readout_markdown(r, None, "Straight pointer")
 
 
 def test_joint_texts() -> None:

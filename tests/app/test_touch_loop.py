@@ -28,8 +28,6 @@ from tcp_pendant.pendant.guidance import tip_offset_mm
 from tcp_pendant.pendant.jogging import LINEAR_SPEED_MM_S
 from tcp_pendant.serve.server import PendantApp
 from tcp_pendant.views.pendant_panel import HOLD_HZ, MARK
-from tcp_pendant.calibrate.diversity import best_tilt, best_tilt_words
-from tcp_pendant.text_escape import escape_html
 from tcp_pendant.calibrate import AutoTouchRequest
 from tcp_pendant.views.wizard_dock import BACK, CANCEL, NEXT, TILT_LINE_STYLE, tilt_line_html
 
@@ -80,26 +78,34 @@ def test_the_dock_shows_the_wizards_step_on_the_jog_tab_and_records_it(page) -> 
     assert dock.folder.visible and not dock.note_md.visible         # the old line did not carry over
 
 
-def test_the_docks_tilt_line_names_the_best_tilt_on_one_fixed_line(page) -> None:
+def test_the_docks_tilt_line_names_a_reachable_tilt_by_its_keyboard_key_in_full(page) -> None:
+    """The hint: a tilt of the active jog frame the robot model can make with the tip held (not
+    a turn about the tool's own length), its keyboard key, in full (no ellipsis); the reachable
+    tilts under it; followed, it does not come back unchanged."""
+    from tcp_pendant.controller.reach import tilt_reach
+
     p = page()
     s, dock = p.session, p.dock
     p.click(p.calibrate.start)                                      # XYZ 4-point
     wiz = p.calibrate.workflow.wizard
-    # one touch or none: every turn is as good, the line stays (empty, the same height)
-    assert dock.tilt_html.visible and dock.tilt_html.content == tilt_line_html(None)
-    assert "&nbsp;" in dock.tilt_html.content and "white-space:nowrap" in TILT_LINE_STYLE
+    assert dock.tilt_html.visible and dock.tilt_html.content == tilt_line_html(None)   # no touch yet
+    assert "nowrap" not in TILT_LINE_STYLE and "ellipsis" not in TILT_LINE_STYLE
     for _ in range(2):
         assert s.wizard_commands.auto_touch(AutoTouchRequest()).ok
     assert wiz.step.index == 2
-    c = s.controller
-    best = best_tilt(wiz.other_rotations(), c.T_world_flange()[:3, :3], R_flange_tool=c.T_flange_tool[:3, :3],
-                     sigma_mm=wiz.assumed_sigma_mm)
-    assert best is not None
-    words = best_tilt_words(best).replace("**", "")
-    assert words.startswith("Tilt that helps most: about TOOL "), words
-    html = dock.tilt_html.content                                   # the words, escaped, in the line
-    assert html == tilt_line_html(best_tilt_words(best)) and f">{escape_html(words)}</div>" in html
-    assert f'style="{TILT_LINE_STYLE}"' in html and "height:1.5em" in TILT_LINE_STYLE
+    html = dock.tilt_html.content
+    m = re.search(r"Tilt next: ([ABC]) ([+−]) 45° in WORLD \(key (Shift\+)?([456])\)", html)
+    assert m, html
+    key, sign = m.group(1), 1 if m.group(2) == "+" else -1
+    assert m.group(4) == {"A": "4", "B": "5", "C": "6"}[key] and bool(m.group(3)) == (sign < 0)
+    assert tilt_reach(s.controller, "WORLD", key, sign, 45.0).reachable          # on the model
+    axis = np.eye(3)[:, {"A": 2, "B": 1, "C": 0}[key]]
+    assert abs(axis @ s.controller.T_world_flange()[:3, 2]) < np.cos(np.radians(25.0))   # a tilt
+    assert "Reachable 45° tilts, tip held (WORLD):" in html and "…" not in html
+    before = m.group(0)
+    assert s.controller.jog_cartesian("WORLD", key, sign * 45.0).ok               # followed
+    s.moved()
+    assert before not in dock.tilt_html.content
 
 
 def test_record_far_from_the_tip_asks_first_and_hide_distance_records(page) -> None:
@@ -216,24 +222,52 @@ def test_an_increment_stops_at_contact_and_the_next_press_goes_on(page) -> None:
     assert pendant.status_md.content == ""
 
 
-def test_with_the_distance_hidden_a_jog_goes_through_the_tip_silently_and_crashes(page) -> None:
-    """Judged by eye: no stop at the tip, no message, no toast - "press until it stops" would
-    tell the trainee where the tip is; driven through it, the tool crashes."""
+def test_with_the_distance_hidden_a_jog_into_the_tip_stops_as_a_collision_and_is_a_crash(page) -> None:
+    """Judged by eye: a press that would drive the tool tip through the reference tip stops where
+    the tips meet, as a real collision stops a robot, says so with the key that backs off, and is
+    recorded as a crash; the next press the same way goes on through (a second crash)."""
+    from tcp_pendant.events import Crash
+
     p = page()
     s, pendant = p.session, p.pendant
+    crashes: list[Crash] = []
+    s.subscribe(lambda change: crashes.extend(e for e in change.events if isinstance(e, Crash)))
     p.choose(pendant.hide_distance, True)
     p.tip_at((0.0, 0.0, 4.0))                                       # 4 mm above the reference tip
     p.notes.clear()
     p.choose(pendant.increment, "10")
-    p.choose(pendant.cart_rows["Z"], "Z −")                         # 10 mm down: through the tip
+    p.choose(pendant.cart_rows["Z"], "Z −")                         # 10 mm down: would go 6 mm through
     st = s.pose_state()
-    assert st.touch.crashed and st.touch.penetration_mm == pytest.approx(6.0, abs=0.01)
-    assert pendant.status_md.content == "" and p.notes == []        # not a word before the crash ...
-    assert "CRASH" in pendant.touch_md.content                      # ... then the crash, as on a robot
-    p.choose(pendant.hide_distance, False)                          # shown again: the stop is back
-    p.tip_at((0.0, 0.0, 4.0))
-    p.choose(pendant.cart_rows["Z"], "Z −")
-    assert "Stopped at the reference tip" in pendant.status_md.content
+    assert st.touch.distance_mm < 0.01 and not st.touch.crashed     # stopped where the tips meet
+    assert "COLLISION" in pendant.status_md.content
+    assert "Back off with Z + (3, WORLD frame)" in pendant.status_md.content
+    assert [c.penetration_mm for c in crashes] == [0.0]             # recorded as a crash
+    p.choose(pendant.cart_rows["Z"], "Z −")                         # the trainee insists: goes through
+    assert s.pose_state().touch.crashed and "CRASH" in pendant.touch_md.content
+    assert len(crashes) == 2
+
+
+def test_with_the_distance_hidden_a_firm_touch_goes_on_and_a_backing_off_key_in_tool_warns(page) -> None:
+    """0.1 mm past the tip is a firm touch (no stop, no word: the stop would give the tip away);
+    in TOOL, where the tool's own +Z leads into the tip, "backing off" with Z + is stopped."""
+    p = page()
+    s, pendant = p.session, p.pendant
+    p.choose(pendant.hide_distance, True)
+    p.tip_at((0.0, 0.0, 0.35))
+    p.choose(pendant.increment, "1")
+    p.choose(pendant.cart_rows["Z"], "Z −")                         # 0.65 mm past: beyond the 0.5 mm
+    assert "COLLISION" in pendant.status_md.content
+    p.tip_at((0.0, 0.0, 0.3))
+    p.choose(pendant.increment, "0.1")
+    for _ in range(4):
+        p.choose(pendant.cart_rows["Z"], "Z −")                     # ends 0.1 mm past: a firm touch
+    assert "COLLISION" not in pendant.status_md.content and not s.pose_state().touch.crashed
+    p.choose(pendant.frame, "TOOL")
+    p.tip_at((0.0, 0.0, 5.0))                                       # 5 mm above the tip, flange down
+    p.choose(pendant.increment, "10")
+    p.choose(pendant.cart_rows["Z"], "Z +")                         # TOOL +Z points down, into the tip
+    assert "COLLISION" in pendant.status_md.content and not s.pose_state().touch.crashed
+    assert "Back off with Z − (Shift+3, TOOL frame)" in pendant.status_md.content
 
 
 def test_a_stop_message_does_not_outlive_an_auto_touch(page) -> None:

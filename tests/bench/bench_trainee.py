@@ -1,4 +1,17 @@
-"""The scripted trainee: clicks and wall time per touch of one XYZ 4-point calibration.
+"""The scripted trainees: presses per touch of one XYZ 4-point calibration.
+
+**By the tip views** (the default run; issue 44): ``view_trainee.ViewTrainee`` steers with the
+distance hidden by the two tip views alone (their pixels, or the same views zoomed out when the
+tip is outside their window; never the distance), follows the pendant's own tilt hint for
+touches 2-4, on the KR 6, the GP12 and a ROS-Industrial KR 16 (the chain of
+``ros-industrial/kuka_experimental`` ``kuka_kr16_support/urdf/kr16_2_macro.xacro``,
+tests/support/ros_layouts.py). It prints, per robot and touch, the presses, the true distance
+(measured, not steered by) and the tilt suggested and whether the robot made it, then the
+targets as MET / NOT MET: at most 30 presses per touch, every touch within 0.5 mm, every
+suggestion reachable.
+
+**By the Δ line** (``--delta-line``; issue 10's figures): the trainees below, in a real server
+through a websocket client.
 
 A trainee who follows only what the Jog tab shows: the wizard dock's step, the Δ readout
 ("ΔX n ΔY n ΔZ n mm" to the tip, WORLD jog frame), the increment buttons and the compact jog
@@ -35,13 +48,15 @@ in the same process on the same robot, so their figures compare directly.
 The default reference tip stands a fraction of a millimetre off the round numbers
 (``server.TIP_PLACEMENT_MM``), so no touch ends with the 10 mm increment alone.
 
-Run: ``.venv/bin/python tests/bench/bench_trainee.py`` (about 20-60 s).
+Run: ``.venv/bin/python tests/bench/bench_trainee.py`` (the views, a few seconds) or with
+``--delta-line`` (about 20-60 s).
 """
 
 from __future__ import annotations
 
 import math
 import re
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -233,7 +248,42 @@ def report(title: str, out: dict[str, list[float]]) -> float:
     return mean
 
 
-def main() -> None:
+ROBOTS = ("kr6", "gp12", "kr16")
+GOAL_PRESSES_PER_TOUCH = 30
+GOAL_DISTANCE_MM = 0.5
+
+
+def views_table() -> bool:
+    """Run the view trainee on every robot, print its table and the targets; True: all met."""
+    from bench.view_trainee import run_robot
+
+    print("Scripted trainee by the two tip views, distance hidden, XYZ 4-point, pointer, "
+          "following the pendant's tilt hints\n")
+    print(f"{'robot':<6} {'touch':>5} {'presses':>7} {'true mm':>8} {'reachable':>9}  suggestion")
+    presses, distances, suggested, reachable = [], [], 0, 0
+    for robot in ROBOTS:
+        for k, t in enumerate(run_robot(robot)):
+            presses.append(t.presses)
+            distances.append(t.distance_mm)
+            mark = "-" if t.reachable is None else ("yes" if t.reachable else "NO")
+            if t.reachable is not None:
+                suggested += 1
+                reachable += int(t.reachable)
+            words = t.suggestion.split(" → ")[0] if t.suggestion else "(first touch: any orientation)"
+            print(f"{robot:<6} {k + 1:>5} {t.presses:>7} {t.distance_mm:>8.3f} {mark:>9}  {words}")
+    ok_presses = max(presses) <= GOAL_PRESSES_PER_TOUCH
+    ok_distance = max(distances) <= GOAL_DISTANCE_MM
+    ok_reach = suggested > 0 and reachable == suggested
+    print(f"\npresses per touch: mean {np.mean(presses):.1f}, max {max(presses)}")
+    print(f"TARGET at most {GOAL_PRESSES_PER_TOUCH} presses per touch: {'MET' if ok_presses else 'NOT MET'}")
+    print(f"TARGET every touch within {GOAL_DISTANCE_MM} mm (max {max(distances):.3f} mm): "
+          f"{'MET' if ok_distance else 'NOT MET'}")
+    print(f"TARGET every suggested tilt reachable on {', '.join(ROBOTS)} ({reachable} of {suggested}): "
+          f"{'MET' if ok_reach else 'NOT MET'}")
+    return ok_presses and ok_distance and ok_reach
+
+
+def delta_line_tables() -> None:
     print("Scripted trainees, XYZ 4-point, 4 standard orientations, KR 6 + pointer (issue 10)\n")
     delta = report("Trainee reading the Δ line:", run(Trainee))
     print()
@@ -241,6 +291,14 @@ def main() -> None:
     print(f"\nclicks per touch: Δ line {delta:.1f}, distance alone {dist:.1f} "
           f"({dist / delta:.1f}x; Δ line before issue 10: ~{BEFORE_CLICKS_PER_TOUCH:.0f}; "
           f"goal with the Δ line <= {GOAL_CLICKS_PER_TOUCH:.0f})")
+
+
+def main(argv: list[str] | None = None) -> None:
+    args = sys.argv[1:] if argv is None else argv
+    if "--delta-line" in args:
+        delta_line_tables()
+    else:
+        views_table()
 
 
 if __name__ == "__main__":

@@ -51,7 +51,7 @@ def legacy_tcp_readout_markdown(readout: PoseReadout, tool_name: str | None) -> 
     r = readout
     x, y, z, a, b, c = _two_decimals((r.x_mm, r.y_mm, r.z_mm, r.a_deg, r.b_deg, r.c_deg))
     w = max(len(x), len(y), len(z), len(a), len(b), len(c))
-    tool = "FLANGE (no tool active)" if tool_name is None else f"TOOL {escape_markdown(tool_name)}"
+    tool = "Active tool data: none (FLANGE)" if tool_name is None else f"Active tool data: TOOL {escape_markdown(tool_name)}"
     return (f"**TCP in {r.frame}** · {tool}\n\n```\nX {x:>{w}} mm   A {a:>{w}} deg\n"
             f"Y {y:>{w}} mm   B {b:>{w}} deg\nZ {z:>{w}} mm   C {c:>{w}} deg\n```")
 

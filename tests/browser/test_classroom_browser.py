@@ -32,7 +32,7 @@ def test_two_trainees_and_the_trainer_view(pendant_server, new_page, shot, tmp_p
                         "--exercise-seed", "3")
     anna = new_page(sp.url)
     ben = new_page(sp.url)
-    trainer = new_page(sp.url)
+    trainer = new_page(sp.url.rstrip("/") + "/?trainer")   # the trainer's page: its welcome window has the token row
     assert_not_blank(shot(anna, "classroom_name_prompt"), min_colors=50)
     join_class(anna, "Anna <b>A</b>")
     join_class(ben, "Ben")

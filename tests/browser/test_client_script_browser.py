@@ -241,7 +241,14 @@ def test_the_typed_token_still_works(app_factory, new_page, tmp_path: Path) -> N
     page, s = open_page(app, new_page, app.trainer_url)      # percent-encoded: the page reads it whole
     wait_text(page, "Download grades (CSV)")
     assert "trainer" in s.views
-    page, s = open_page(app, new_page)
+    page, s = open_page(app, new_page)                         # a trainee's welcome window: no trainer rows
+    page.get_by_text("Join the class").first.wait_for(timeout=TIMEOUT_MS)
+    page.wait_for_function("""() => [...document.querySelectorAll('button')].some(
+        b => b.textContent.trim() === 'Open trainer view' && b.style.display === 'none')""", timeout=TIMEOUT_MS)
+    assert page.get_by_text("Trainer token").is_hidden()
+    assert page.get_by_role("button", name="Open trainer view", exact=True).is_hidden()
+    assert page.get_by_text("Trainer: open").is_hidden()
+    page, s = open_page(app, new_page, app.url + "/?trainer")   # the trainer's: the rows, the token typed
     type_text(page, "Trainer token", "token with & and + and #")
     page.wait_for_timeout(400)
     page.get_by_role("button", name="Open trainer view", exact=True).click()

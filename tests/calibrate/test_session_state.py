@@ -60,7 +60,7 @@ def test_a_trainees_tool_does_not_become_the_next_trainees(page) -> None:
     assert sb.tools.active_slot is None and sb.controller.active_tool is None
     assert sb.controller.mounted_tool.key == "pointer"
     np.testing.assert_allclose(sb.controller.T_flange_tool, np.eye(4))
-    assert "FLANGE (no tool active)" in sb.views["pendant"].tcp_md.content
+    assert "Active tool data: none (FLANGE) · mounted: " in sb.views["pendant"].tcp_md.content
     assert not sb.views["scene"]._active_axes.visible
     assert f"{slot}: Torch A" in sb.views["tools"].slots.options   # ... but sees the stored tool
 

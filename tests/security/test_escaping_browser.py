@@ -223,7 +223,7 @@ def test_hostile_tool_names_are_shown_as_text_in_the_pendant(pendant_server, new
     page = new_page(server.url)
     title = page.title()
     # a browser's robot starts with no active tool: activate the style one on the Tool tab
-    wait_js(page, "() => document.body.innerText.includes('FLANGE (no tool active)')", "no active tool")
+    wait_js(page, "() => document.body.innerText.includes('Active tool data: none (FLANGE)')", "no active tool")
     page.get_by_role("tab", name="Tool").click()
     choose(page, "Slot", f"1: {STYLE}")
     page.get_by_role("button", name="Activate", exact=True).click()
@@ -249,7 +249,7 @@ def test_hostile_tool_names_are_shown_as_text_in_the_pendant(pendant_server, new
     # a new browser starts with no active tool, whatever the first one activated; it activates
     # the style one itself
     fresh = new_page(server.url)
-    wait_js(fresh, "() => document.body.innerText.includes('FLANGE (no tool active)')", "no active tool")
+    wait_js(fresh, "() => document.body.innerText.includes('Active tool data: none (FLANGE)')", "no active tool")
     fresh.get_by_role("tab", name="Tool").click()
     choose(fresh, "Slot", f"2: {names[2]}")
     choose(fresh, "Slot", f"1: {STYLE}")

@@ -182,14 +182,19 @@ def meter_level(gain: CandidateGain) -> tuple[float, Literal["red", "yellow", "g
 
 
 def meter_markdown(gain: CandidateGain, quality: PoseQuality | None, sigma_mm: float,
-                   advice_before_determinable: str | None = None, tilt_hint: str | None = None) -> str:
+                   advice_before_determinable: str | None = None, tilt_hint: str | None = None, *,
+                   measured: str = "") -> str:
     """Live advice while jogging toward the next touch (all figures predicted by tcpcal from the
     orientations alone, for an operator error of ``sigma_mm`` per axis). While recording here
     would still not make the TCP determinable (``gain.predicted_after`` infinite) the advice is
     ``advice_before_determinable`` (``tcp_pendant.calibrate.diversity``: the angle to the
     nearest touch and the axis still missing, in words) or else ``quality.message`` (tcpcal's).
-    ``tilt_hint`` (``diversity.best_tilt_words``: which way to tilt for the next touch) ends it."""
-    head = f"**Pose diversity** (if you recorded here, operator error {fmt_num(sigma_mm, 1)} mm):"
+    ``tilt_hint`` (``tilt_advice.TiltAdvice.text``: which way to tilt for the next touch) ends it.
+    ``measured``: whose scatter ``sigma_mm`` is ("your touches", "your last calibration"; ""
+    assumed)."""
+    basis = (f"{measured}: scatter {fmt_num(sigma_mm, 2)} mm" if measured
+             else f"operator error {fmt_num(sigma_mm, 1)} mm")
+    head = f"**Pose diversity** (if you recorded here, {basis}):"
     if gain.too_close:
         advice = (f"⚠ **Too close** to an earlier touch: {_deg(gain.angle_to_nearest_deg, 0)} apart. "
                   "Tilt the tool further, about another axis, before recording.")
@@ -392,7 +397,7 @@ def comparison_markdown(result: Xyz4Result) -> str:
         rows.append(f"| {label} | {x} | {y} | {z} | {fmt_num(r['mean_error_mm'])} | "
                     f"{fmt_num(r['max_error_mm'])} | {fmt_num(r['rms_error_mm'])} | {fmt_num(r['ci95_mm'])} |")
     return (head + "\n" + "\n".join(rows) + "\n\nAll figures in mm. Same touches, three estimators: "
-            "the joint least squares (4P-3) is the maximum-likelihood one.")
+            "the joint least squares is the maximum-likelihood one (their equations: The math).")
 
 
 def truth_markdown(cmp: TruthComparison) -> str:

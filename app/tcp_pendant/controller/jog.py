@@ -111,9 +111,9 @@ __all__ = [
     "tcp_pose",
 ]
 
-StopReason = Literal["joint_limit", "singularity", "unreachable", "contact"]
-"""Why a motion stopped early; "contact": the pendant's stop at the reference tip
-(``tcp_pendant.pendant.jogging``)."""
+StopReason = Literal["joint_limit", "singularity", "unreachable", "contact", "collision"]
+"""Why a motion stopped early; "contact": the pendant's stop at the reference tip, "collision":
+its stop there with the distance hidden (``tcp_pendant.pendant.jogging``)."""
 
 
 class JogFrame(str, Enum):
@@ -385,19 +385,51 @@ def _null_space_step(Jt: np.ndarray, q: np.ndarray, q_rest: np.ndarray, gain: fl
     return dq * (cap / biggest) if biggest > cap else dq
 
 
+class _Newton(NamedTuple):
+    """Where the Newton iterations of one sub-step ended: ``q`` and the kinematics of the last
+    iteration there (the Jacobian, flange pose, LU factors of the start's Jacobian if the
+    start converged at once), and whether it converged."""
+
+    q: np.ndarray
+    q_list: list[float]
+    J: np.ndarray
+    R_wf: np.ndarray
+    p_wf: np.ndarray
+    lu: tuple[np.ndarray, np.ndarray] | None
+    converged: bool
+
+
 def _solve_substep(kin: RobotKinematics, q_start: np.ndarray, sigma_start: float,
                    t_f: np.ndarray | None, R_ft: np.ndarray | None, p_target: np.ndarray,
                    R_target: np.ndarray, cart_amount: float, settings: JogSettings,
                    det_sign_start: float = 0.0, q_rest: np.ndarray | None = None,
                    start: FlangeState | None = None, step: list[float] | None = None) -> _Attempt:
-    """Damped Newton (J-2) from ``q_start`` to one target pose, then the safety checks.
+    """Damped Newton (J-2) from ``q_start`` to one target pose (:func:`_newton`), then the
+    safety checks (:func:`_checked`).
 
     ``t_f``, ``R_ft``: the TCP in FLANGE coordinates; None for a zero offset and an identity
     rotation (the products with them are skipped: they would change no bit).
     ``det_sign_start`` is :func:`_det_sign` at ``q_start`` (0: unknown or on a singularity);
     ``q_rest``: the rest configuration of a redundant arm's null-space step (J-3), None: none;
     ``start``: the kinematics at ``q_start`` (its first iteration then needs no pinocchio pass);
-    ``step``: this sub-step's Cartesian increment ``[dp; dw]`` (see the midpoint step below).
+    ``step``: this sub-step's Cartesian increment ``[dp; dw]`` (the midpoint step of
+    :func:`_newton`).
+    """
+    eps = settings.singular_eps
+    lam2 = 0.0
+    if sigma_start < eps:
+        lam2 = settings.lambda_max ** 2 * (1.0 - (sigma_start / eps) ** 2)
+    allowance = max(settings.max_joint_gain * cart_amount, settings.min_joint_allowance_rad)
+    nt = _newton(kin, q_start, t_f, R_ft, p_target, R_target, settings, lam2, allowance, q_rest, start, step)
+    return _checked(kin, q_start, sigma_start, nt, allowance, settings, det_sign_start, start, step)
+
+
+def _newton(kin: RobotKinematics, q_start: np.ndarray, t_f: np.ndarray | None, R_ft: np.ndarray | None,
+            p_target: np.ndarray, R_target: np.ndarray, settings: JogSettings, lam2: float,
+            allowance: float, q_rest: np.ndarray | None, start: FlangeState | None,
+            step: list[float] | None) -> _Newton:
+    """The damped Newton iterations (J-2) of one sub-step, from ``q_start`` (arguments as
+    :func:`_solve_substep`; ``lam2`` the damping, ``allowance`` the joint allowance in rad).
 
     With ``lambda = 0`` on a square Jacobian (a six-joint arm away from singularities) (J-2) is
     the Newton step ``dq = J_tcp^-1 e``; it is solved as ``J_flange dq = [e_p + r x e_r; e_r]``
@@ -411,10 +443,6 @@ def _solve_substep(kin: RobotKinematics, q_start: np.ndarray, sigma_start: float
     1e-12 m after one step (plain Newton: 1e-8 m, a second step). The iteration and its
     convergence test are otherwise unchanged.
     """
-    eps = settings.singular_eps
-    lam2 = 0.0
-    if sigma_start < eps:
-        lam2 = settings.lambda_max ** 2 * (1.0 - (sigma_start / eps) ** 2)
     direct = lam2 == 0.0 and q_rest is None and q_start.shape[0] == 6 and kin.n_joints == 6
     tol_m, tol_rad = settings.tol_m, settings.tol_rad
     q = q_start
@@ -428,7 +456,6 @@ def _solve_substep(kin: RobotKinematics, q_start: np.ndarray, sigma_start: float
     if (direct and start is not None and start.J_before is not None and step is not None
             and _same_step(start.step, step)):
         J_mid = 1.5 * start.J - 0.5 * start.J_before
-    allowance = max(settings.max_joint_gain * cart_amount, settings.min_joint_allowance_rad)
     for iteration in range(settings.max_iterations + 1):
         if iteration == 0 and start is not None:
             J, R_wf, p_wf, lu = start.J, start.R_wf, start.p_wf, start.lu
@@ -458,24 +485,48 @@ def _solve_substep(kin: RobotKinematics, q_start: np.ndarray, sigma_start: float
             if info == 0:
                 dq = x
         if dq is None:
-            Jt = J.copy()
-            if r is not None:
-                Jt[:3] -= _skew(r) @ J[3:]
-            e = np.concatenate((e_p, e_r))
-            A = Jt @ Jt.T
-            if lam2 > 0.0:
-                L = settings.length_scale_m
-                A[np.diag_indices(6)] += lam2 * np.array([L * L] * 3 + [1.0] * 3)  # W^-2: damping in the scaled metric
-            try:
-                dq = Jt.T @ np.linalg.solve(A, e)
-            except np.linalg.LinAlgError:
-                dq = Jt.T @ np.linalg.lstsq(A, e, rcond=None)[0]
+            dq = _damped_step(J, r, e_p, e_r, lam2, settings)
             if iteration == 0 and q_rest is not None:
+                Jt = J if r is None else _tcp_jacobian(J, r)
                 dq = dq + _null_space_step(Jt, q, q_rest, settings.null_space_gain, 0.25 * allowance)
         q = q + dq
         q_list = q.tolist()
         if not all(map(math.isfinite, q_list)):
             break
+    assert J is not None and R_wf is not None and p_wf is not None  # the loop runs at least once
+    return _Newton(q, q_list, J, R_wf, p_wf, lu, converged)
+
+
+def _tcp_jacobian(J_flange: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """``J_tcp = [Jv - [r]x Jw ; Jw]`` of the flange Jacobian and the TCP offset ``r`` (WORLD)."""
+    Jt = J_flange.copy()
+    Jt[:3] -= _skew(r) @ J_flange[3:]
+    return Jt
+
+
+def _damped_step(J: np.ndarray, r: np.ndarray | None, e_p: np.ndarray, e_r: np.ndarray, lam2: float,
+                 settings: JogSettings) -> np.ndarray:
+    """(J-2) in its damped least-squares form: ``dq = J^T (J J^T + lambda^2 W^-2)^-1 e``."""
+    Jt = J.copy() if r is None else _tcp_jacobian(J, r)
+    e = np.concatenate((e_p, e_r))
+    A = Jt @ Jt.T
+    if lam2 > 0.0:
+        L = settings.length_scale_m
+        A[np.diag_indices(6)] += lam2 * np.array([L * L] * 3 + [1.0] * 3)  # W^-2: damping in the scaled metric
+    try:
+        return Jt.T @ np.linalg.solve(A, e)
+    except np.linalg.LinAlgError:
+        return Jt.T @ np.linalg.lstsq(A, e, rcond=None)[0]
+
+
+def _checked(kin: RobotKinematics, q_start: np.ndarray, sigma_start: float, nt: _Newton, allowance: float,
+             settings: JogSettings, det_sign_start: float, start: FlangeState | None,
+             step: list[float] | None) -> _Attempt:
+    """The safety rules of the module docstring on the Newton result ``nt``: the sub-step is
+    accepted (an attempt without a reason, with the kinematics at its end) or rejected (the
+    robot stays at ``q_start``, the reason and its words)."""
+    eps = settings.singular_eps
+    q, q_list, J, converged = nt.q, nt.q_list, nt.J, nt.converged
     # max |q - q_start| (the q of the last update is the one that converged), Python floats
     jump = (0.0 if q is q_start else max(map(abs, map(operator.sub, q_list, q_start.tolist())))) \
         if converged else math.inf
@@ -496,7 +547,7 @@ def _solve_substep(kin: RobotKinematics, q_start: np.ndarray, sigma_start: float
         i = int(np.argmax(over))
         side = "lower" if q[i] < kin.lower_rad[i] else "upper"
         return _Attempt(q_start, sigma_start, "joint_limit", kin.limit_message(i, side))
-    assert J is not None and R_wf is not None and p_wf is not None  # the Newton loop runs at least once
+    lu = nt.lu
     bound = _sigma_bound(J, start, sigma_start, det_sign_start, settings)
     if bound is not None:
         # sigma >= bound >= 2 eps: the sigma rule cannot fire, the det sign cannot have changed
@@ -516,7 +567,7 @@ def _solve_substep(kin: RobotKinematics, q_start: np.ndarray, sigma_start: float
                             det_sign_start)
     q_out = q.copy() if q is q_start else q
     return _Attempt(q_out, sigma, None, "", det_sign,
-                    FlangeState(kin, q_out, q_out.tolist(), J, R_wf, p_wf, sigma, det_sign, lu, settings,
+                    FlangeState(kin, q_out, q_out.tolist(), J, nt.R_wf, nt.p_wf, sigma, det_sign, lu, settings,
                                 None if start is None else start.J, step))
 
 

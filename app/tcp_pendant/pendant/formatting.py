@@ -75,19 +75,25 @@ _TCP_TABLE = ("**TCP in %s** · %s\n\n```\nX %*s mm   A %*s deg\n"
 
 
 @functools.lru_cache(maxsize=64)
-def _tool_title(tool_name: str | None) -> str:
-    """The TCP readout's tool: ``TOOL <name>`` (escaped) or the flange (a pure function of the name)."""
-    return "FLANGE (no tool active)" if tool_name is None else f"TOOL {escape_markdown(tool_name)}"
+def _tool_title(tool_name: str | None, mounted: str | None = None) -> str:
+    """The TCP readout's tool: the tool data really active, ``Active tool data: TOOL <name>`` or
+    ``Active tool data: none (FLANGE)`` (the TCP is the flange), and the tool mounted on the
+    flange, ``· mounted: <label>``, so a pointer on the flange with no data active is not read
+    as "no tool" (names escaped; a pure function of the names)."""
+    data = "none (FLANGE)" if tool_name is None else f"TOOL {escape_markdown(tool_name)}"
+    on = "" if not mounted else f" · mounted: {escape_markdown(mounted)}"
+    return f"Active tool data: {data}{on}"
 
 
-def tcp_readout_markdown(readout: PoseReadout, tool_name: str | None) -> str:
-    """The TCP readout: a title with frame and tool, then a monospace table
-    ``X 525.00 mm | A 0.00 deg`` (one line per pair), the numbers right-aligned to the widest."""
+def tcp_readout_markdown(readout: PoseReadout, tool_name: str | None, mounted: str | None = None) -> str:
+    """The TCP readout: a title with frame, the active tool data and the mounted tool
+    (:func:`_tool_title`), then a monospace table ``X 525.00 mm | A 0.00 deg`` (one line per
+    pair), the numbers right-aligned to the widest."""
     r = readout
     x, y, z, a, b, c = (_SIX % (r.x_mm, r.y_mm, r.z_mm, r.a_deg, r.b_deg, r.c_deg)).replace(
         "-0.00", "0.00").split(_SEP)
     w = max(len(x), len(y), len(z), len(a), len(b), len(c))
-    return _TCP_TABLE % (r.frame, _tool_title(tool_name), w, x, w, a, w, y, w, b, w, z, w, c)
+    return _TCP_TABLE % (r.frame, _tool_title(tool_name, mounted), w, x, w, a, w, y, w, b, w, z, w, c)
 
 
 @functools.lru_cache(maxsize=32)

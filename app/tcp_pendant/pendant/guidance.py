@@ -9,6 +9,8 @@
 * :func:`offset_markdown` and :func:`side_view_markdown`: the "ΔX n ΔY n ΔZ n mm" line and a
   magnified two-view drawing of the tips (text in a code block, auto-scaled so that 0.5 mm is
   several characters when close).
+* :func:`collision_stop`: the same with the distance hidden, only for a step that would carry
+  the tip more than ``touch.CRASH_DEPTH_MM`` past the reference tip (a collision).
 * :func:`contact_stop`: the fraction of a translation after which the tool tip meets the
   reference tip (stop at contact, like a real touch-up), or None when the step does not pass
   through it.
@@ -24,12 +26,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from tcp_pendant.controller.pose_state import PoseState
-from tcp_pendant.controller.touch import CRASH_RADIUS_MM, TOUCH_TOLERANCE_MM
+from tcp_pendant.controller.touch import CRASH_DEPTH_MM, CRASH_RADIUS_MM, TOUCH_TOLERANCE_MM
 
 __all__ = [
     "CLOSEUP_WITHIN_MM",
     "CONTACT_RADIUS_MM",
     "ContactStop",
+    "collision_stop",
     "contact_stop",
     "direction_words",
     "jog_frame_rotation",
@@ -181,6 +184,35 @@ def contact_stop(tip_world_m: np.ndarray, step_world_m: np.ndarray,
         return None                                   # the closest point is not inside this step
     if t * math.sqrt(length2) < _STOPPED_HERE_M:
         return None                                   # stopped here by the last press: this one goes on
+    miss_mm = math.hypot(*(p + t * step - r).tolist()) * 1000.0
+    if miss_mm > CONTACT_RADIUS_MM or not math.isfinite(miss_mm):
+        return None
+    return ContactStop(t, miss_mm)
+
+
+def collision_stop(tip_world_m: np.ndarray, step_world_m: np.ndarray,
+                   reference_tip_world_m: np.ndarray) -> ContactStop | None:
+    """With the distance hidden: the stop of a straight translation ``step_world_m`` of the tool
+    tip at ``tip_world_m`` (metres) where it meets the reference tip, when it would otherwise
+    carry the tip more than ``CRASH_DEPTH_MM`` past its closest point to it and that point is
+    within :data:`CONTACT_RADIUS_MM` (a real robot would collide there). None: the step ends
+    before the tip, passes beside it, overshoots it by no more than a firm touch does, or starts
+    where the last press stopped it (that press warned: this one goes on through).
+
+    Unlike :func:`contact_stop` a start within the touch tolerance is no exemption: from 0.3 mm
+    above the tip a 1 mm press would go 0.7 mm through."""
+    p = np.asarray(tip_world_m, dtype=float)
+    step = np.asarray(step_world_m, dtype=float)
+    r = np.asarray(reference_tip_world_m, dtype=float)
+    length2 = float(step @ step)
+    if length2 <= 0.0:
+        return None
+    t = float((r - p) @ step) / length2
+    length = math.sqrt(length2)
+    if not 0.0 < t < 1.0 or t * length < _STOPPED_HERE_M:
+        return None
+    if (1.0 - t) * length * 1000.0 <= CRASH_DEPTH_MM:
+        return None
     miss_mm = math.hypot(*(p + t * step - r).tolist()) * 1000.0
     if miss_mm > CONTACT_RADIUS_MM or not math.isfinite(miss_mm):
         return None

@@ -25,8 +25,16 @@ pass through the reference tip (closer than ``guidance.CONTACT_RADIUS_MM`` to it
 closest point) stops at the closest point and says so (``JogResult.stopped_by == "contact"``);
 the next press in the same direction goes on (the tip is touching; that is the warning).
 With ``Jogger.stop_at_contact`` False (the session's "Hide distance": the trainee judges the
-touch by eye) the press goes on through the tip and says nothing: driven through it, the tool
-crashes (``controller.touch``), as a real one would.
+touch by eye) a small overshoot goes on (the tip pressed into the spike by at most
+``touch.CRASH_DEPTH_MM``, as a careful touch does), but a translation that would drive the tool
+tip more than that past the reference tip stops where the tips meet, as a real collision stops a
+robot (``stopped_by == "collision"``): the message says so and names the key that backs off, and
+the session records the collision as a crash. The next press the same way goes on through.
+
+A Cartesian key that stops at a joint limit, a singularity or the edge of the reach says which
+way to go instead: after a rotation key, the tilts the model says are reachable from the stop
+with the tip held (``pendant.tilts``) and the key that turns back; after a translation key, the
+key that goes back; after a joint key, the other key of its row.
 """
 
 from __future__ import annotations
@@ -41,7 +49,8 @@ from typing import Literal
 import numpy as np
 
 from tcp_pendant.controller import ControllerError, JogFrame, JogResult, VirtualController
-from tcp_pendant.pendant.guidance import CONTACT_RADIUS_MM, contact_stop
+from tcp_pendant.pendant.guidance import CONTACT_RADIUS_MM, collision_stop, contact_stop
+from tcp_pendant.pendant.tilts import TiltOptions, keyboard_key, key_label, stopped_advice
 
 __all__ = [
     "CARTESIAN_AXES",
@@ -215,7 +224,9 @@ class Jogger:
         self._held_at_contact: str | None = None
         self.gate = PressGate(clock=clock)
         self.stop_at_contact = True
-        """Stop a translation at the reference tip (False: "Hide distance", no stop, no word)."""
+        """Stop a translation at the reference tip (False: "Hide distance": only a collision stops)."""
+        self.tilts = TiltOptions(controller)
+        """The rotation keys checked on the model from the current pose (``pendant.tilts``)."""
 
     def key(self, axis: str | int, sign: int, *, hold_tick: bool = False) -> JogResult | None:
         """One press of a -/+ key.
@@ -254,17 +265,32 @@ class Jogger:
             dt = self._tick_s if last is None or now - last > 4 * self._tick_s else now - last
             self._last_tick = {name: now}
         if isinstance(axis, int) and not isinstance(axis, bool):
-            return self.controller.jog_joint(axis, sign * s.step_amount(rotational=True, joint=True, dt_s=dt))
+            res = self.controller.jog_joint(axis, sign * s.step_amount(rotational=True, joint=True, dt_s=dt))
+            if res.stopped_by == "joint_limit" and axis < 9:          # the way back: the other key of the row
+                back = f"key {axis + 1}" if sign < 0 else f"Shift+{axis + 1}"
+                res = replace(res, message=f"{res.message}. The other key of that row ({back}) turns it back.")
+            return res
         ax = str(axis).upper()
         if ax not in CARTESIAN_AXES:
             raise ControllerError(f"Jog keys are joint indices or X, Y, Z, A, B, C; got {axis!r}.")
         amount = sign * s.step_amount(rotational=ax in "ABC", dt_s=dt)
         if ax in "XYZ":
             res = self._translate(ax, amount)
-            if continuous and res.stopped_by == "contact":
+            if continuous and res.stopped_by in ("contact", "collision"):
                 self._held_at_contact = name         # this hold stays stopped until released
+            return self._with_advice(res, ax, sign)
+        return self._with_advice(self.controller.jog_cartesian(s.frame, ax, amount), ax, sign)
+
+    def _with_advice(self, res: JogResult, ax: str, sign: int) -> JogResult:
+        """A Cartesian key stopped by the robot (a limit, a singularity, the reach) with the way
+        to go instead appended to its message (module docstring)."""
+        if res.ok or res.stopped_by not in ("joint_limit", "singularity", "unreachable"):
             return res
-        return self.controller.jog_cartesian(s.frame, ax, amount)
+        if ax in "ABC":
+            advice = stopped_advice(self.tilts.options(self.settings.frame), ax, sign)
+        else:
+            advice = f"{key_label(ax, -sign)} ({keyboard_key(ax, -sign)}) goes back."
+        return replace(res, message=f"{res.message}. {advice}")
 
     def frame_rotation(self) -> np.ndarray:
         """``R_world_frame`` of the selected jog frame now (the axes the X/Y/Z keys move along)."""
@@ -279,11 +305,9 @@ class Jogger:
         return c.T_world_tcp()[:3, :3]
 
     def _translate(self, ax: CartesianAxis, amount_mm: float) -> JogResult:
-        """A translation of ``amount_mm`` along axis ``ax`` of the jog frame, stopped at contact
-        (module docstring)."""
+        """A translation of ``amount_mm`` along axis ``ax`` of the jog frame, stopped at contact,
+        or with the distance hidden at a collision (module docstring)."""
         c = self.controller
-        if not self.stop_at_contact:
-            return c.jog_cartesian(self.settings.frame, ax, amount_mm)
         i = "XYZ".index(ax)
         frame = self.settings.frame
         reference_m = c.reference_tip_world_m
@@ -294,23 +318,42 @@ class Jogger:
             # still means contact_stop of the exact tip says None)
             step = [0.0, 0.0, 0.0]
             step[i] = amount_mm / 1000.0
-            if _clear_of_floats(c.tool_tip_true_m(), step, reference_m.tolist()):
-                stop = None
-            else:
-                stop = contact_stop(c.T_world_tool_true()[:3, 3], _WORLD_AXES[:, i] * (amount_mm / 1000.0),
-                                    reference_m)
+            clear = _clear_of_floats(c.tool_tip_true_m(), step, reference_m.tolist())
+            step_m = _WORLD_AXES[:, i] * (amount_mm / 1000.0)
         else:
-            tip_m = c.T_world_tool_true()[:3, 3]
             step_m = self.frame_rotation()[:, i] * (amount_mm / 1000.0)
-            stop = None if _clear_of(tip_m, step_m, reference_m) else contact_stop(tip_m, step_m, reference_m)
+            clear = _clear_of(c.T_world_tool_true()[:3, 3], step_m, reference_m)
+        if clear:
+            return c.jog_cartesian(frame, ax, amount_mm)
+        tip_m = c.T_world_tool_true()[:3, 3]
+        if not self.stop_at_contact:
+            hit = collision_stop(tip_m, step_m, reference_m)
+            if hit is None:
+                return c.jog_cartesian(frame, ax, amount_mm)
+            return self._collide(ax, amount_mm, hit.fraction)
+        stop = contact_stop(tip_m, step_m, reference_m)
         if stop is None:
-            return c.jog_cartesian(self.settings.frame, ax, amount_mm)
-        res = c.jog_cartesian(self.settings.frame, ax, amount_mm * stop.fraction)
+            return c.jog_cartesian(frame, ax, amount_mm)
+        res = c.jog_cartesian(frame, ax, amount_mm * stop.fraction)
         if not res.ok:
             return res
         return JogResult(False, stop.fraction, "contact",
                          f"Stopped at the reference tip after {abs(amount_mm) * stop.fraction:.2f} of "
                          f"{abs(amount_mm):g} mm (touch-up: the tool tip touches it). Press again to go on.")
+
+    def _collide(self, ax: CartesianAxis, amount_mm: float, fraction: float) -> JogResult:
+        """"Hide distance": the press would run into the reference tip at ``fraction`` of its
+        path (``guidance.collision_stop``): it stops there, a collision (module docstring)."""
+        c = self.controller
+        res = c.jog_cartesian(self.settings.frame, ax, amount_mm * fraction)
+        if not res.ok:
+            return res
+        sign = 1 if amount_mm > 0 else -1
+        return JogResult(False, fraction, "collision",
+                         f"COLLISION: the tool ran into the reference tip and the robot stopped "
+                         f"(recorded as a crash). Back off with {key_label(ax, -sign)} "
+                         f"({keyboard_key(ax, -sign)}, {self.settings.frame} frame); pressing "
+                         f"{key_label(ax, sign)} again drives the tool through the tip.")
 
     def release(self) -> None:
         """Forget the hold timing and a stop at contact (key released)."""

@@ -73,22 +73,24 @@ def keep_random_token(token: str, trainer_url: str | None, path: Path) -> None:
 def class_lines(app: Any, source: str = "", print_token: bool = False) -> str:
     """The classroom lines of the ready message (empty without a gradebook): the gradebook and
     the trainer view, with the token masked and where to read it (module docstring), or whole
-    with ``print_token``."""
+    with ``print_token``. The page to type the token in is ``/?trainer`` (a trainee's welcome
+    window has no trainer-token field)."""
     room = getattr(app, "classroom", None)
     if room is None:
         return ""
+    trainer_page = f"{str(app.url).rstrip('/')}/?trainer"
     exercise = "mystery tools" if room.exercise == "mystery" else "free practice"
     head = f"  class gradebook {room.gradebook.location} ({exercise})\n"
     if room.trainer_token is None:
         kept = token_file_for(room.gradebook.path)
         where = f" ({source})" if source else f" (a random one is in {kept})" if kept.exists() else ""
-        return (head + f"Trainer view: {app.url} with the trainer token this class began with{where}; kept hashed in "
+        return (head + f"Trainer view: {trainer_page} with the trainer token this class began with{where}; kept hashed in "
                 "the gradebook, so an open trainer page reconnects; give --trainer-token-file to set a new one\n")
     token = room.trainer_token
     if print_token:
         return (head + f"Trainer view: {app.trainer_url}  trainer token: {token}\n"
-                "  (open that address: the page fills in the token and drops it from the address bar; or open the "
-                "page and type the token in \"Trainer token\" of the welcome window; keep both secret)\n")
+                "  (open that address: the page fills in the token and drops it from the address bar; or open "
+                f"{trainer_page} and type the token in \"Trainer token\" of the welcome window; keep both secret)\n")
     if not source:
         path = token_file_for(room.gradebook.path)
         try:
@@ -96,6 +98,6 @@ def class_lines(app: Any, source: str = "", print_token: bool = False) -> str:
             source = f"a random one: read it, and the trainer address, in {path}"
         except OSError as exc:
             source = f"a random one that could not be written to {path} ({exc}); restart with --print-token"
-    return (head + f"Trainer view: {app.url}  trainer token {masked(token)} ({source})\n"
-            "  (open the page and type the token in \"Trainer token\" of the welcome window, or open the trainer "
+    return (head + f"Trainer view: {trainer_page}  trainer token {masked(token)} ({source})\n"
+            "  (open that page and type the token in \"Trainer token\" of the welcome window, or open the trainer "
             "address /?trainer=TOKEN; the token is not shown here: --print-token shows it; keep it secret)\n")

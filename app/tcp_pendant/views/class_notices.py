@@ -3,7 +3,9 @@ trainer's messages, pinned at the top of the panel.
 
 * **Instructions banner**: while the class's rules carry instructions
   (``Session.rules.instructions``, set by the classroom), the first element of the panel shows
-  them, above the tabs; hidden when there are none.
+  them, above the tabs; in an exercise whose trainer typed none, the default brief
+  (``calibrate.exercise_brief``: what to calibrate, how it is graded, what is hidden); hidden
+  in free practice without instructions.
 * **Message box**: the oldest message the session keeps (``Session.messages``) with who it was
   for and when, how many more wait, and a **Dismiss** button (``Session.dismiss_message`` of
   the message shown: a click that arrives after another message took its place dismisses
@@ -16,6 +18,7 @@ Both texts are the trainer's browser's (a stranger's): every line goes through
 
 from __future__ import annotations
 
+from tcp_pendant.calibrate.exercise_brief import default_instructions_markdown
 from tcp_pendant.session import ClassMessage
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.text_escape import escape_markdown, escape_markdown_lines
@@ -73,10 +76,12 @@ class ClassNoticeView:
         """The banner and the message box from the session's rules and messages."""
         if self.session.closed:
             return
-        instructions = self.session.rules.instructions
-        if instructions:
-            set_content(self.banner, instructions_markdown(instructions))
-        self.banner.visible = bool(instructions)
+        rules = self.session.rules
+        text = (instructions_markdown(rules.instructions) if rules.instructions
+                else f"**Exercise**\n\n{default_instructions_markdown(rules)}" if rules.exercise is not None else "")
+        if text:
+            set_content(self.banner, text)
+        self.banner.visible = bool(text)
         messages = self.session.messages
         self.shown = messages[0] if messages else None
         if self.shown is not None:

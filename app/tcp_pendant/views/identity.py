@@ -5,9 +5,10 @@ modal holds a text field labelled **"Your name"** and a **Join the class** butto
 handed to ``on_name`` with what the **Browser key** field holds, and a refused name
 (``TraineeNameError`` / ``ValueError``: invalid, a look-alike of a classmate's, connected in
 another browser, held by another browser) gets the reason, escaped, in the modal. Below it, a
-**Trainer token** field and an **Open trainer view** button: the token is handed to
-``on_token``, which says whether it was right (compared with ``secrets.compare_digest`` by the
-server).
+**Trainer token** field and an **Open trainer view** button, which the page script shows only
+on a page opened as ``/?trainer`` (a trainee's welcome window has no trainer rows): the token
+is handed to ``on_token``, which says whether it was right (compared with
+``secrets.compare_digest`` by the server).
 
 Browser keys and reconnects: viser 1.1 gives the server no per-browser storage, so the page's
 own script (``serve/static/pendant.js``, ``serve.client_script``) keeps the accepted name and the browser
@@ -101,8 +102,8 @@ class IdentityPrompt:
             self.start = gui.add_button("Join the class", color="green")
             self.message = gui.add_markdown("")
             self.marker_html = gui.add_html(f"<div hidden {marker}></div>") if marker else None
-            gui.add_markdown("---\n*Trainer:* open the trainer address the server printed, or type "
-                             "its token here.")
+            gui.add_markdown("*Trainer:* open the trainer address the server printed (/?trainer=...), "
+                             "or open /?trainer and type the token here.")
             self.token_field = gui.add_text(TOKEN_LABEL, "")
             self.open_trainer = gui.add_button("Open trainer view")
         self._modal_open = True

@@ -505,8 +505,8 @@ class PendantPanel:
         s = self.session
         state = s.pose_state() if state is None else state
         tool = s.controller.active_tool
-        self._set_md(self.tcp_md, "tcp", tcp_readout_markdown(state.readout(self._readout),
-                                                              None if tool is None else tool.name))
+        self._set_md(self.tcp_md, "tcp", tcp_readout_markdown(state.readout(self._readout), None if tool is None
+                                                              else tool.name, s.controller.mounted_tool.label))
         hide = s.hide_distance
         if bool(self.hide_distance.value) != hide:
             set_value(self.hide_distance, hide)

@@ -3,8 +3,8 @@
 While a calibration wizard is open, the top of the Jog tab shows its current step ("Step k
 of N", what to do), **Record** (the step's, checked: ``pendant.record_check``), a row
 "◀ Back · Next ▶ (Finish) · Cancel", the tool change a step asks for, and the pose-diversity
-meter (bar, one line and the tilt that helps most on a line of its own, one line high whatever
-its length: cut with an ellipsis, the whole hint in its tooltip, so the keys below never move),
+meter (bar, one line, and below it the tilt that helps most and the tilts reachable from here,
+``calibrate.tilt_advice`` and ``pendant.tilts``, wrapped in full and at least three lines high),
 so a trainee jogs, watches and records on one screen; the Calibrate
 tab stays the place to choose a method and review the result. Outside a wizard the dock is
 hidden and the touch list's "Record point" records into the free list (one Record concept).
@@ -27,11 +27,13 @@ import math
 from collections.abc import Callable, Coroutine
 from typing import TYPE_CHECKING, TypeVar, cast
 
-from tcp_pendant.calibrate.diversity import best_tilt, best_tilt_words
+from tcp_pendant.calibrate.record_words import recorded_words
+from tcp_pendant.calibrate.tilt_advice import TiltAdvisor, meter_gain
 from tcp_pendant.calibrate.text import meter_level, step_markdown
 from tcp_pendant.pendant.guidance import direction_words, tip_offset_mm
 from tcp_pendant.text_escape import escape_html, escape_markdown
 from tcp_pendant.pendant.record_check import RecordCheck
+from tcp_pendant.pendant.tilts import reachable_line
 from tcp_pendant.pendant.touch_feedback import touch_feedback
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.views.gui_util import ButtonEvent, ButtonGroupEvent, set_content, set_value, target_of
@@ -50,18 +52,17 @@ log = logging.getLogger(__name__)
 BACK, NEXT, FINISH, CANCEL, CLOSE = "◀ Back", "Next ▶", "Finish ▶", "Cancel", "Close"
 
 
-TILT_LINE_STYLE = ("height:1.5em;line-height:1.5em;white-space:nowrap;overflow:hidden;"
-                   "text-overflow:ellipsis;font-size:0.875em;padding:0 0.75em")
-"""One line, always the same height (an empty hint keeps the line): the jog keys below stay put."""
+TILT_LINE_STYLE = "min-height:4.2em;line-height:1.4em;white-space:normal;font-size:0.875em;padding:0 0.75em"
+"""Wrapped in full (never cut), at least three lines high (an empty hint keeps them): the jog
+keys below stay put while the hint is three lines or less."""
 
 
-def tilt_line_html(hint: str | None) -> str:
-    """The dock's tilt line: ``hint`` (``diversity.best_tilt_words``, markdown bold dropped)
-    escaped, on one line cut with an ellipsis, the whole hint as the tooltip; no hint: the
-    same line, empty."""
-    text = escape_html((hint or "").replace("**", ""))
-    title = f' title="{text}"' if text else ""
-    return f'<div style="{TILT_LINE_STYLE}"{title}>{text or "&nbsp;"}</div>'
+def tilt_line_html(hint: str | None, reachable: str = "") -> str:
+    """The dock's tilt lines: ``hint`` (``tilt_advice.TiltAdvice.text``) and the reachable tilts
+    (``tilts.reachable_line``), markdown bold dropped, escaped, wrapped; none: the same lines,
+    empty."""
+    parts = [escape_html(t.replace("**", "")) for t in (hint or "", reachable) if t]
+    return f'<div style="{TILT_LINE_STYLE}">{"<br>".join(parts) or "&nbsp;"}</div>'
 
 
 class WizardDock:
@@ -70,6 +71,7 @@ class WizardDock:
     def __init__(self, session: Session, *, check: RecordCheck | None = None) -> None:
         self.session = session
         self.check = RecordCheck() if check is None else check
+        self.advisor = TiltAdvisor()          # the tilt hint given to this browser
         self._note = ""                       # the last click's line, for this run and step only
         self._note_at: tuple[int, int, int] | None = None
         gui = target_of(session).gui
@@ -132,10 +134,8 @@ class WizardDock:
         wiz = wf.wizard
         index = None if wiz is None else wiz.step.index
         s.wizard_commands.record_step()
-        shown = "" if s.hide_distance else f", {state.touch.distance_mm:.2f} mm from the tip"
-        if s.hide_distance and not s.rules.in_exercise:     # free practice by eye: how far it was
-            shown = f": {touch_feedback(delta, frame)}"
-        self._say(f"✔ Step {index + 1 if index is not None else '?'} recorded{shown}.")
+        self._say(recorded_words(index, state.touch.distance_mm, hidden=s.hide_distance,
+                                 in_exercise=s.rules.in_exercise, feedback=touch_feedback(delta, frame)))
 
     async def _on_nav_click(self, event: ButtonGroupEvent) -> None:
         """Back and Cancel as every click; Next / Finish through ``WizardCommands.next_step_in_pool``
@@ -224,7 +224,8 @@ class WizardDock:
             return
         wiz = cast("MeterWizard", shown)              # meter_active: a wizard that declares the meter
         T_world_flange = self.session.controller.T_world_flange()
-        gain = wiz.preview(T_world_flange)
+        meter = meter_gain(wiz, T_world_flange[:3, :3], [r.wizard for r in wf.runs])
+        gain = meter.gain
         value, color = meter_level(gain)
         set_value(self.meter_bar, round(value, 1))
         self.meter_bar.color = color
@@ -237,9 +238,14 @@ class WizardDock:
             text = f"Pose diversity: {angle:.0f}° from the nearest touch; not yet determinable."
         else:
             text = (f"Pose diversity: {angle:.0f}° from the nearest touch; predicted TCP error "
-                    f"{gain.predicted_after:.2f} mm if recorded here.")
+                    f"{gain.predicted_after:.2f} mm if recorded here ({meter.basis}).")
         set_content(self.meter_md, text)              # numbers and our words only
-        R_flange_tool = self.session.controller.T_flange_tool[:3, :3]   # the jog keys' TOOL frame
-        tilt = best_tilt(wiz.other_rotations(), T_world_flange[:3, :3], R_flange_tool=R_flange_tool,
-                         sigma_mm=wiz.assumed_sigma_mm)
-        set_content(self.tilt_html, tilt_line_html(None if tilt is None else best_tilt_words(tilt)))
+        s = self.session
+        others = wiz.other_rotations()
+        advice = self.advisor.advise(others, T_world_flange[:3, :3], s.jogger, meter.sigma_mm)
+        reach = ""
+        if len(others):
+            from_mode = s.jogger.settings.mode.value == "Joint"
+            reach = reachable_line(s.jogger.tilts.options(s.jogger.settings.frame),
+                                   frame=s.jogger.settings.frame, joint_mode=from_mode)
+        set_content(self.tilt_html, tilt_line_html(None if advice is None else advice.text, reach))

@@ -22,7 +22,8 @@ import math
 from typing import TYPE_CHECKING, cast
 
 from tcp_pendant.calibrate import AUTO_SIGMA_MAX_MM, AutoTouchRequest
-from tcp_pendant.calibrate.diversity import best_tilt, best_tilt_words, diversity_advice
+from tcp_pendant.calibrate.diversity import diversity_advice
+from tcp_pendant.calibrate.tilt_advice import TiltAdvisor, meter_gain
 from tcp_pendant.calibrate.jobs import POSE_CHECKS
 from tcp_pendant.calibrate.text import (
     meter_level,
@@ -55,6 +56,7 @@ class WizardStepsView:
     """Builds the step panel in the current GUI container (see the module docstring)."""
 
     def __init__(self, parent: CalibrateView) -> None:
+        self.advisor = TiltAdvisor()          # the tilt hint given on this tab
         self.parent = parent
         gui = target_of(parent.session).gui
         self.folder = gui.add_folder("Wizard", visible=False)
@@ -330,14 +332,14 @@ class WizardStepsView:
             return
         wiz = cast("MeterWizard", shown)              # meter_active: a wizard that declares the meter
         T_world_flange = self.parent.session.controller.T_world_flange()
-        gain = wiz.preview(T_world_flange)
+        meter = meter_gain(wiz, T_world_flange[:3, :3], [r.wizard for r in wf.runs])
+        gain = meter.gain
         value, color = meter_level(gain)
         set_value(self.meter_bar, round(value, 1))
         self.meter_bar.color = color
         advice = (diversity_advice(wiz.other_rotations(), T_world_flange[:3, :3], gain.angle_to_nearest_deg)
                   if math.isinf(gain.predicted_after) else None)               # only then shown
-        R_flange_tool = self.parent.session.controller.T_flange_tool[:3, :3]   # the jog keys' TOOL frame
-        tilt = best_tilt(wiz.other_rotations(), T_world_flange[:3, :3], R_flange_tool=R_flange_tool,
-                         sigma_mm=wiz.assumed_sigma_mm)
-        set_content(self.meter_md, meter_markdown(gain, None, wiz.assumed_sigma_mm, advice,
-                                                  None if tilt is None else best_tilt_words(tilt)))
+        s = self.parent.session
+        tilt = self.advisor.advise(wiz.other_rotations(), T_world_flange[:3, :3], s.jogger, meter.sigma_mm)
+        set_content(self.meter_md, meter_markdown(gain, None, meter.sigma_mm, advice,
+                                                  None if tilt is None else tilt.text, measured=meter.source))

@@ -99,7 +99,8 @@ class TcpZxWizard(Wizard):
         for i in range(self._n_points):
             text = ("Jog the tool tip onto the reference tip, approaching from any direction; then "
                     "press Record." if i == 0 else
-                    "Back off, tilt the tool 45 to 60 degrees about one axis (A, B or C) and touch the "
+                    "Back off, tilt the tool 45 to 60 degrees about one axis (A, B or C: the line under "
+                    "the Pose diversity meter names the ones reachable from here) and touch the "
                     "reference tip again (touch 2); then press Record." if i == 1 else
                     f"Back off, tilt the tool 45 to 60 degrees about another axis than for the earlier "
                     f"touches and touch the reference tip again (touch {i + 1}); then press Record.")

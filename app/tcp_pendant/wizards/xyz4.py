@@ -36,10 +36,12 @@ from tcp_pendant.wizards.describe import TOUCH, StepRole, WizardOption, WizardSt
 Estimator = Literal["lstsq", "sphere", "pairwise"]
 ESTIMATORS: tuple[Estimator, ...] = ("lstsq", "sphere", "pairwise")
 ESTIMATOR_LABELS: dict[Estimator, str] = {
-    "lstsq": "joint least squares (4P-3), default",
-    "sphere": "best-fit sphere (4P-1a)",
-    "pairwise": "pairwise differences (4P-2)",
+    "lstsq": "joint least squares (default)",
+    "sphere": "best-fit sphere",
+    "pairwise": "pairwise differences",
 }
+"""The estimators in words for the trainee's Calibrate tab; their equations, (4P-3), (4P-1a) and
+(4P-2) of methods.md, are shown in "The math" (``calibrate.math_view``)."""
 
 RESIDUAL_CAVEAT = (
     "A small residual does not prove an accurate TCP: systematic errors (a bent tip, a "
@@ -176,7 +178,8 @@ class Xyz4Wizard(Wizard):
                 text = ("Jog the tool tip onto the reference tip, approaching from any direction; "
                         "then press Record.")
             elif i == 1:
-                text = ("Back off, tilt the tool 45 to 60 degrees about one axis (A, B or C), and touch "
+                text = ("Back off, tilt the tool 45 to 60 degrees about one axis (A, B or C: the line "
+                        "under the Pose diversity meter names the ones reachable from here), and touch "
                         "the reference tip again from this new orientation (touch 2); then press Record.")
             elif i == 2:
                 text = ("Back off, tilt the tool 45 to 60 degrees about another axis than for touch 2, "
@@ -184,8 +187,8 @@ class Xyz4Wizard(Wizard):
             elif i == 3:
                 text = ("Back off and touch the reference tip from an orientation 45 to 60 degrees away "
                         "from all three earlier ones, e.g. tilted the other way than touch 2 (touch 4); "
-                        "then press Record. Smaller tilts leave the TCP uncertain: the meter below "
-                        "predicts the error.")
+                        "then press Record. Smaller tilts leave the TCP uncertain: the Pose diversity "
+                        "meter under the Step buttons predicts the error.")
             else:
                 text = (f"Extra touch {i + 1}: touch the reference tip from an orientation unlike "
                         f"the earlier ones (watch the pose-diversity meter); then press Record.")

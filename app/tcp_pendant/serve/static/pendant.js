@@ -29,7 +29,9 @@
  *    released the name) also makes it forget the name and key.
  * 3. /?trainer=TOKEN: the token is taken from the address, dropped from the address bar at once
  *    (history.replaceState) and typed into "Trainer token" + "Open trainer view" of each welcome
- *    window of this page (kept in memory only, for reconnects).
+ *    window of this page (kept in memory only, for reconnects). Only a page opened as /?trainer
+ *    (with or without a token: then the trainer types it) shows the "Trainer token" row, "Open
+ *    trainer view" and the welcome window's "Trainer: open ..." line; a trainee's page hides them.
  * 4. Presenter mode: the folder holding the readout (class "presenter-readout", which only
  *    views/presenter.py writes) is pinned at the top of the panel while the panel scrolls
  *    (position: sticky; viser 1.1 has no sticky GUI element). Its ancestors up to the panel's
@@ -65,7 +67,7 @@
   var MARK = "\u2713";
   var L = {
     name: "Your name", key: "Browser key", join: "Join the class", token: "Trainer token",
-    openTrainer: "Open trainer view",
+    openTrainer: "Open trainer view", trainerLine: "Trainer: open",
     increment: "Increment", record: "Record", recordPoint: "Record point", banner: "Trainee:",
     shadows: "Shadows", next: "Next \u25b6", finish: "Finish \u25b6", back: "\u25c0 Back",
     keysLine: "Keys:", tipViews: "Tip close-up"
@@ -273,9 +275,11 @@
 
   // ------------------------------------------------------------------ 3. the trainer URL
   var trainerToken = null;
+  var trainerPage = false;                  // opened as /?trainer: the welcome window's trainer rows show
   try {
     var url = new URL(window.location.href);
     if (url.searchParams.has("trainer")) {
+      trainerPage = true;
       var t = url.searchParams.get("trainer") || "";
       url.searchParams.delete("trainer");
       window.history.replaceState(window.history.state, "", url.pathname + url.search + url.hash);
@@ -358,12 +362,21 @@
     if (KEY_RE.test(k)) rememberKey(k);
   }
 
+  function hide(el) { if (el && el.style.display !== "none") el.style.display = "none"; }
+  function hideTrainerRows() {              // the token row, its button and the trainer's line
+    hide(labelled(L.token));
+    buttonsNamed(L.openTrainer).forEach(hide);
+    var ps = document.querySelectorAll("p");
+    for (var i = 0; i < ps.length; i++) if (text(ps[i]).indexOf(L.trainerLine) === 0) hide(ps[i]);
+  }
+
   function scan() {
     browserKey();
     var forget = document.querySelector("[data-tcp-pendant-forget]");
     if (first(forget)) { forgetAll(); joining = null; }
     var keyRow = labelled(L.key);
     if (keyRow && keyRow.style.display !== "none") keyRow.style.display = "none";   // the script's own field
+    if (!trainerPage) hideTrainerRows();    // a trainee's welcome window: no trainer token
     if (!joining && !trainerToken && storedName() === null && storedKey() === null) return;
     if (joining && !joining.input.isConnected) {
       if (bannerShown()) { rememberName(joining.value); joining = null; }

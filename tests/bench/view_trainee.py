@@ -1,0 +1,232 @@
+"""A scripted trainee who steers by the two tip views alone, with the distance hidden
+(``bench_trainee.py`` runs it and prints its figures).
+
+**What it sees.** The front and side views the pendant draws (``pendant.tip_insets``: the very
+image the Jog tab shows, rendered by the same function): in each view it finds the tool's
+pixels (``TOOL_COLOR``) and takes the tip as the tool pixel farthest along the tool's pointing
+direction on the screen (the cone's narrow end, as an eye sees it), then reads its place off the
+fixed scale (``PX_PER_MM`` pixels per mm, the reference tip at the grid's origin): front gives X
+and Z, side gives Y and Z (WORLD), to a pixel (1/24 mm). When the tool tip is outside a view's
+7 x 8 mm window it reads the same view's geometry zoomed out to the 1-2-5 scale that holds the tip
+(``view_pixel`` of the tip quantised to that zoom's pixel: what a view that finds the tip, by
+zooming out, shows; the issue asks the views for it). It never reads the distance, the Δ line or
+the touch indicator; the true distance is measured only to print it.
+
+**What it presses** (each a press of the pendant: a jog key, a ``[``/``]`` increment step, a
+frame change, Record (R), Next): per touch after the first, the pendant's own tilt hint
+(``calibrate.tilt_advice``, as the dock shows it: the key, its frame, 45°) by 10° presses (five,
+50°, inside the step's 45-60°); then, from the largest increment down (100, 10, 1, 0.1 mm), X
+and Y by ``round(offset / increment)`` presses and Z down to a margin above the tip (30 % of
+the increment; none at 0.1 mm), re-reading the views after each axis; the last level repeats
+until both views show the tips within 0.2 mm on every axis. A suggestion counts as reachable
+when every press of the tilt ran to its end (no stop at a limit or singularity) and the tip was
+then touched with no stop of the robot.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from support.calib_helpers import make_session
+from support.ros_layouts import kr16_2_urdf
+
+from tcp_pendant.calibrate import CalibrationWorkflow
+from tcp_pendant.calibrate.tilt_advice import TiltAdvisor, meter_gain
+from tcp_pendant.controller import RobotKinematics, VirtualController, builtin_tools
+from tcp_pendant.pendant.jogging import INCREMENTS
+from tcp_pendant.pendant.tip_insets import (
+    BELOW_MM,
+    GAP_PX,
+    PX_PER_MM,
+    TOOL_COLOR,
+    VIEW_H_MM,
+    VIEW_W_MM,
+    tip_insets_image,
+)
+from tcp_pendant.serve.server import default_reference_tip_mm, ready_configuration
+from tcp_pendant.session import Session
+
+from tcpcal.library import ToolLibrary
+
+LEVELS = ("100", "10", "1", "0.1")
+TILT_PRESSES, TILT_STEP = 5, "10"
+"""The tilt by 10° presses: 50° (the steps ask 45 to 60)."""
+_W = int(round(VIEW_W_MM * PX_PER_MM))
+_VIEWS = {"front": (0, np.array([1.0, 0.0, 0.0])), "side": (_W + GAP_PX, np.array([0.0, 1.0, 0.0]))}
+_ZOOMS = (1, 2, 5, 10, 20, 50, 100, 200, 500, 1000)
+
+
+@dataclass
+class Touch:
+    """One touch's figures."""
+
+    presses: int = 0
+    distance_mm: float = math.nan
+    suggestion: str = ""
+    reachable: bool | None = None
+    stops: list[str] = field(default_factory=list)
+
+
+def session_for(robot: str, library: Path) -> Session:
+    """A pendant session without a browser on ``robot`` ("kr6", "gp12", or "kr16": the
+    ROS-Industrial KR 16 chain of tests/support/ros_layouts.py), pointer mounted, ready pose."""
+    if robot != "kr16":
+        return make_session(library, robot=robot)
+    kin = RobotKinematics.from_urdf(kr16_2_urdf(library.parent / "kr16", meshes=False))
+    c = VirtualController(kin, tool=builtin_tools()["pointer"],
+                          reference_tip_world_m=np.asarray(default_reference_tip_mm(kin)) / 1000.0)
+    c.set_q(ready_configuration(kin))
+    lib = ToolLibrary(library)
+    rng = np.random.default_rng(0)
+    return Session(c, lib, CalibrationWorkflow(c, lib, robot="kr16", rng=rng), rng=rng)
+
+
+class ViewTrainee:
+    """Steers one session by the tip views (module docstring)."""
+
+    def __init__(self, session: Session) -> None:
+        self.s = session
+        self.advisor = TiltAdvisor()
+        self.presses = 0
+        self.stops: list[str] = []
+
+    # ------------------------------------------------------------ the eye
+    def _tip_in_view(self, img: np.ndarray, view: str, T: np.ndarray) -> tuple[float, float] | None:
+        """(across, up) mm of the tool tip read off one view's pixels, or None: not in it."""
+        x0, right = _VIEWS[view]
+        part = img[:, x0:x0 + _W]
+        rows, cols = np.nonzero(np.all(part == TOOL_COLOR, axis=2))
+        if rows.size == 0:
+            return None
+        d = np.array([float(T[:3, 0] @ right), -float(T[:3, 0][2])])    # tool X on the screen (col, row)
+        score = cols * d[0] + rows * d[1]
+        i = int(np.argmax(score)) if np.hypot(*d) > 0.2 else int(np.argmin(np.hypot(
+            cols - cols.mean(), rows - rows.mean())))
+        c, r = int(cols[i]), int(rows[i])
+        if c in (0, _W - 1) or r in (0, part.shape[0] - 1):
+            return None                                                 # cut by the window's edge
+        return (c + 0.5) / PX_PER_MM - VIEW_W_MM / 2, (VIEW_H_MM - BELOW_MM) - (r + 0.5) / PX_PER_MM
+
+    @staticmethod
+    def _zoomed(value_mm: float, half_mm: float) -> float:
+        """A coordinate as a view zoomed out to hold it shows it: quantised to that zoom's pixel."""
+        zoom = next((z for z in _ZOOMS if abs(value_mm) <= half_mm * z), _ZOOMS[-1])
+        q = zoom / PX_PER_MM
+        return round(value_mm / q) * q
+
+    def look(self) -> np.ndarray:
+        """The tool tip relative to the reference tip as the two views show it (WORLD, mm)."""
+        c = self.s.controller
+        T = c.T_world_tool_true()
+        ref = c.reference_tip_world_m
+        img = tip_insets_image(ref, T)
+        apex = (T[:3, 3] - ref) * 1000.0                    # the geometry the views draw
+        front, side = self._tip_in_view(img, "front", T), self._tip_in_view(img, "side", T)
+        x = front[0] if front else self._zoomed(apex[0], VIEW_W_MM / 2)
+        y = side[0] if side else self._zoomed(apex[1], VIEW_W_MM / 2)
+        zs = [v[1] for v in (front, side) if v]
+        z = float(np.mean(zs)) if zs else self._zoomed(apex[2], VIEW_H_MM / 2)
+        return np.array([x, y, z])
+
+    # ------------------------------------------------------------ the hands
+    def press(self, axis: str, sign: int) -> None:
+        res = self.s.jog(axis, sign)
+        self.presses += 1
+        if res is not None and not res.ok:
+            self.stops.append(f"{res.stopped_by}: {res.message}")
+
+    def increment(self, value: str) -> None:
+        now = self.s.jogger.settings.increment
+        if now != value:
+            self.presses += abs(INCREMENTS.index(value) - INCREMENTS.index(now))   # [ / ] steps
+            self.s.set_jog_setting("increment", value)
+
+    def frame(self, value: str) -> None:
+        if self.s.jogger.settings.frame != value:
+            self.presses += 1
+            self.s.set_jog_setting("frame", value)
+
+    # ------------------------------------------------------------ the skill
+    def tilt(self) -> str:
+        """Follow the pendant's tilt hint; its words ("" none)."""
+        wf = self.s.workflow
+        wiz = wf.wizard
+        R_wf = self.s.controller.T_world_flange()[:3, :3]
+        meter = meter_gain(wiz, R_wf, [r.wizard for r in wf.runs])
+        advice = self.advisor.advise(wiz.other_rotations(), R_wf, self.s.jogger, meter.sigma_mm)
+        if advice is None or advice.option is None:
+            return "" if advice is None else advice.text
+        r = advice.option.reach
+        self.frame(r.frame)
+        self.increment(TILT_STEP)
+        for _ in range(TILT_PRESSES):
+            self.press(r.key, r.sign)
+        self.frame("WORLD")
+        return re.sub(r"\*\*", "", advice.text)
+
+    def bring_tips_together(self, max_presses: int = 200) -> None:
+        start = self.presses
+        apex = self.look()
+        first = next((k for k, level in enumerate(LEVELS) if np.max(np.abs(apex)) >= 0.5 * float(level)),
+                     len(LEVELS) - 1)
+        for level in LEVELS[first:]:
+            step = float(level)
+            for _ in range(2 if level == "0.1" else 1):
+                moved = self._level(level, step)
+                if self.presses - start > max_presses:
+                    return
+                if level == "0.1" and (not moved or np.all(np.abs(self.look()) <= 0.2)):
+                    break
+
+    def _level(self, level: str, step: float) -> bool:
+        """One pass at one increment: up first when the tip is below its margin above the
+        reference tip, then X and Y to the nearest press, then Z down to the margin (half the
+        increment above the tip, the tip's height at 0.1 mm): never down past it."""
+        moved = False
+        margin = 0.0 if level == "0.1" else 0.5 * step
+        for k, axis in enumerate(("Z", "X", "Y", "Z")):
+            apex = self.look()
+            i = "XYZ".index(axis)
+            n = round(-apex[i] / step) if axis != "Z" else round((margin - apex[2]) / step)
+            if k == 0 and n <= 0:
+                continue                                    # the first Z: only up
+            if n:
+                self.increment(level)
+            for _ in range(abs(n)):
+                self.press(axis, 1 if n > 0 else -1)
+                moved = True
+        return moved
+
+
+def run_robot(robot: str) -> list[Touch]:
+    """One XYZ 4-point by the views on ``robot``; the figures per touch."""
+    with tempfile.TemporaryDirectory() as tmp:
+        s = session_for(robot, Path(tmp) / "tools.json")
+        s.set_hide_distance(True)
+        s.wizard_commands.start("xyz4")
+        t = ViewTrainee(s)
+        touches = []
+        for k in range(4):
+            t.presses, t.stops = 0, []
+            touch = Touch()
+            if k:
+                touch.suggestion = t.tilt()
+                tilt_stops = list(t.stops)
+            t.bring_tips_together()
+            touch.distance_mm = float(s.pose_state().touch.distance_mm)     # measured, never steered by
+            if k and touch.suggestion.startswith("Tilt next"):                # the robot never stopped it
+                robot_stops = [m for m in tilt_stops + t.stops if not m.startswith("collision")]
+                touch.reachable = not robot_stops
+            s.wizard_commands.record_step()
+            t.presses += 1                                                  # R
+            s.wizard_commands.next_step()
+            t.presses += 1                                                  # Next / Finish
+            touch.presses, touch.stops = t.presses, list(t.stops)
+            touches.append(touch)
+        return touches
