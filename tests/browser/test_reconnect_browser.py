@@ -1,7 +1,8 @@
 """Every page comes back by itself: a class server (the real ``tcp-pendant --class`` program) is
 killed with SIGKILL and started again on the same port and gradebook, five times, while three
-trainees' pages and the trainer's page stay open in chromium. No page is reloaded: each one
-reconnects, joins again (the trainees under their names, the trainer with the token of its
+trainees' pages and the trainer's page stay open in chromium: chen's in a window without the
+focus, ben's behind a slow link (a handshake takes 1.5 s; viser's own client gave each attempt
+1 s, then closed it for the next). No page is reloaded: each one reconnects, joins again (the trainees under their names, the trainer with the token of its
 address) and finds its calibration at its step with its touches.
 
 The figures printed are the seconds from the new server answering HTTP to each page having
@@ -19,7 +20,8 @@ import pytest
 
 from support.pendant_page import TIMEOUT_MS, join_class, press, wait_enabled, wait_text
 from support.trainer_socket import TrainerSocket
-from support.wsclient import wait_until
+from support.slow_link import SlowLink
+from support.wsclient import free_port, wait_until
 
 pytestmark = pytest.mark.browser
 
@@ -28,6 +30,12 @@ RESTARTS = 5
 REJOIN_TIMEOUT_S = 90.0
 """How long the test waits for a page to rejoin before it fails (far above the 10 s goal: a
 page that never rejoins, the fault this test is about, still fails)."""
+
+SLOW_LINK_S = 1.5
+"""ben's link: each connection's answer comes this late (a websocket handshake takes 1.5 s)."""
+
+NO_FOCUS_JS = "Document.prototype.hasFocus = function () { return false; };"
+"""A page whose window never has the focus (run before the page's own scripts)."""
 
 MARK_JS = """() => { document.querySelectorAll('body *').forEach(e => e.setAttribute('data-old', '1'));
                      window.__notReloaded = true; }"""
@@ -71,8 +79,10 @@ def _at_step(page: Any, touches: int) -> None:
 def test_every_page_rejoins_after_five_kills(pendant_server, new_page, shot, tmp_path: Path) -> None:
     db, token_file = tmp_path / "class.sqlite3", tmp_path / "trainer-token.txt"
     token_file.write_text(TOKEN + "\n", encoding="utf-8")
-    args = ("--class", "--class-db", str(db), "--trainer-token-file", str(token_file))
-    sp = pendant_server(*args)
+    port = free_port()
+    link = SlowLink(port, SLOW_LINK_S)          # ben's page is behind a slow link
+    args = ("--class", "--class-db", str(db), "--trainer-token-file", str(token_file), "--allow-origin", link.url)
+    sp = pendant_server(*args, port=port)
     trainer = TrainerSocket(sp.port, TOKEN)     # "Hide distance: on, locked": Record at once
     try:
         trainer.open_trainer_view()
@@ -81,8 +91,12 @@ def test_every_page_rejoins_after_five_kills(pendant_server, new_page, shot, tmp
         wait_until(lambda: trainer.text_with(r"[Pp]ushed") is not None, what="the push acknowledged")
     finally:
         trainer.close()
-    # small windows: four software-WebGL pages share the machine
-    trainees = {name: new_page(sp.url, width=820, height=640) for name in ("ana", "ben", "chen")}
+    # small windows: four software-WebGL pages share the machine. Playwright tells every page it
+    # has the focus; chen's is told it has not (a window behind another, a projector's page):
+    # viser's client asks for no new connection while its window has no focus
+    trainees = {name: new_page(link.url if name == "ben" else sp.url, width=820, height=640,
+                               init_script=NO_FOCUS_JS if name == "chen" else None)
+                for name in ("ana", "ben", "chen")}
     for name, page in trainees.items():
         join_class(page, name)
     touches = {"ana": 2, "ben": 1, "chen": 0}
@@ -92,7 +106,7 @@ def test_every_page_rejoins_after_five_kills(pendant_server, new_page, shot, tmp
     lecturer = new_page(f"{sp.url}/?trainer={TOKEN}", width=1024, height=768, wait_for="Push to all trainees")
     pages = {**{n: (p, f"Trainee: {n}") for n, p in trainees.items()}, "trainer": (lecturer, "Push to all trainees")}
 
-    port, seconds, rejoined = sp.port, [], 0
+    seconds, rejoined = [], 0
     for restart in range(1, RESTARTS + 1):
         for page, _ in pages.values():
             page.evaluate(MARK_JS)
@@ -118,6 +132,7 @@ def test_every_page_rejoins_after_five_kills(pendant_server, new_page, shot, tmp
             if n:                                   # chen never started: nothing to find again
                 _at_step(trainees[name], n)
             rejoined += 1
+    link.close()
     shot(lecturer, "trainer_after_restarts")
     print("\nrejoin seconds (restart, page, s):", *(f"{r} {n} {s:.1f}" for r, n, s in seconds), sep="\n  ")
     print(f"trainee pages rejoined without a reload: {rejoined} of {RESTARTS * len(trainees)}")

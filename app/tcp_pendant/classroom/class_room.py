@@ -108,6 +108,7 @@ from tcp_pendant.classroom.names import TraineeNameError, validate_trainee_name
 from tcp_pendant.classroom.recorder import TraineeRecorder, TraineeStatus
 from tcp_pendant.classroom.replay import CalibrationReplay, calibration_replay
 from tcp_pendant.classroom.restore import runs_to_restore
+from tcp_pendant.classroom.push_words import PUSH_TITLE, push_words
 from tcp_pendant.classroom.trainees import TraineeJoin
 from tcp_pendant.classroom.trainer_token import FORGET_S, lock_s, locked, log_failure, validate_trainer_token
 from tcp_pendant.classroom.class_messages import clean_message_text
@@ -815,6 +816,8 @@ class ClassRoom:
                     session.set_hide_distance(True)
                 session.set_rules(rules)
                 session.changed(wizard=True)
+            session.notify(PUSH_TITLE, push_words(exercise, None if tool_key is None else self.tools[tool_key].label,
+                                                  hide_distance, auto_touch), kind="warning")
         self._hand_to_loop(session.guard(apply))
         return f"Pushed to {who}."
 
