@@ -20,14 +20,14 @@ pytestmark = pytest.mark.browser
 TOKEN = "trainer-message-token-2026"
 
 IN_VIEW_JS = """(text) => {
-    const el = [...document.querySelectorAll('.mantine-Paper-root')].find(e =>
-        e.querySelector('.trainer-message') && (e.innerText || '').includes(text));
-    if (!el) return null;
+    const marker = document.querySelector('.trainer-message'), el = marker && marker.closest('.mantine-Paper-root');
+    if (!el || !(el.innerText || '').includes(text)) return null;
     const box = el.getBoundingClientRect(), x = box.left + box.width / 2, y = box.top + Math.min(box.height / 2, 30);
     const hit = document.elementFromPoint(x, y);
     return {top: box.top, bottom: box.bottom, height: innerHeight, onTop: !!hit && el.contains(hit)};
 }"""
-"""The message's folder: where it is on screen, and whether it is what shows at its middle."""
+"""The message's folder (the nearest box around its marker): where it is on screen, and whether
+it is what shows near its top."""
 
 SCROLLED_JS = """() => { const v = [...document.querySelectorAll('.mantine-ScrollArea-viewport')]
     .find(e => e.scrollHeight > e.clientHeight + 50); if (!v) return -1;
