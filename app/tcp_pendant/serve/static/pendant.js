@@ -522,12 +522,11 @@
       document.body.appendChild(overlay);
     }
     var holder = overlay.lastChild;
-    if (holder.getAttribute("data-copied") !== source.innerHTML) {    // our own markup, copied as nodes
-      var copy = source.cloneNode(true);
-      copy.style.display = "";
+    var copy = source.cloneNode(true);       // our own markup, copied as nodes (no HTML parsed)
+    copy.style.display = "";
+    if (!holder.firstChild || !holder.firstChild.isEqualNode(copy)) {
       while (holder.firstChild) holder.removeChild(holder.firstChild);
       holder.appendChild(copy);
-      holder.setAttribute("data-copied", source.innerHTML);
     }
   }
 
