@@ -146,3 +146,28 @@ def test_every_page_rejoins_after_five_kills(pendant_server, new_page, shot, tmp
           *(f"{r} {n} {c:.1f} {s:.1f}" for r, n, c, s in seconds), sep="\n  ")
     print(f"trainee pages rejoined without a reload: {rejoined} of {RESTARTS * len(trainees)}")
     assert rejoined == RESTARTS * len(trainees)
+
+
+def test_a_page_that_cannot_reach_the_server_says_so_and_offers_a_reload(pendant_server, new_page, shot,
+                                                                        tmp_path: Path) -> None:
+    args = ("--class", "--class-db", str(tmp_path / "class.sqlite3"))
+    sp = pendant_server(*args)
+    page = new_page(sp.url, width=1024, height=768)
+    join_class(page, "dana")
+    notice = page.get_by_role("alert").filter(has_text="cannot reach the pendant server")
+    for cycle in (1, 2):
+        sp.proc.kill()
+        assert sp.proc.wait(10) == -9
+        notice.wait_for(state="visible", timeout=TIMEOUT_MS)          # after 15 s without a connection
+        assert "recorded touches are kept on the server" in notice.inner_text()
+        reload = notice.get_by_role("button", name="Reload the page")
+        if cycle == 2:                                                 # the button reloads the page
+            with page.expect_navigation(timeout=TIMEOUT_MS):
+                reload.click()
+            break
+        shot(page, "connection_lost_1024x768")
+        page.evaluate("window.__notReloaded = true")
+        sp = pendant_server(*args, port=sp.port)
+        notice.wait_for(state="detached", timeout=TIMEOUT_MS)         # it kept trying: back by itself
+        wait_text(page, "Trainee: dana")
+        assert page.evaluate("window.__notReloaded === true")
