@@ -794,10 +794,13 @@ def math_sheet(wizard: Any, *, pair: tuple[int, int] | None = None) -> MathSheet
 
 # ------------------------------------------------------------------ markdown
 def block_html(block: MathBlock, *, font_px: int = MATH_FONT_PX) -> str:
-    """The block's lines as one monospace ``<div>`` (raw HTML of our own lines, escaped)."""
+    """The block's lines as one monospace ``<div>`` (raw HTML of our own lines, escaped). A block
+    with a line over :data:`MAX_LINE` (the stacked A's rows, :data:`MAX_WIDE_LINE`) is set
+    half a pixel tighter per character, so it fits the 320 px presenter panel as well."""
     body = "<br>".join(escape_html(line).replace(" ", "&nbsp;") for line in block.lines)
+    tight = " letter-spacing:-0.5px;" if any(len(line) > MAX_LINE for line in block.lines) else ""
     return (f'<div class="math-block" data-key="{escape_html(block.key)}" style="font-family:monospace; '
-            f'font-size:{int(font_px)}px; line-height:1.25; white-space:nowrap; overflow-x:auto">'
+            f'font-size:{int(font_px)}px; line-height:1.25; white-space:nowrap; overflow-x:auto;{tight}">'
             f"{body}</div>")
 
 
