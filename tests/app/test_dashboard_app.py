@@ -10,6 +10,8 @@ from pathlib import Path
 
 import numpy as np
 
+from tcp_pendant.controller.kinematics import RobotKinematics
+
 from support.guiclick import choose, click
 from support.wsclient import DrainingClient, wait_until
 
@@ -168,8 +170,23 @@ def test_a_calibration_is_replayed_in_3d_from_the_gradebook(app_factory, tmp_pat
         np.testing.assert_allclose(handles["/replay/touch_0"].position, T0[:3, 3], atol=1e-9)
         np.testing.assert_allclose(handles["/replay/reference"].position, shown.reference_world_m, atol=1e-9)
         assert "4 touches" in dash.action_md.content and dash.close_replay.visible
+        # the robot at each touch: posed at the joints the gradebook kept, its flange where the
+        # touch's flange was (pinocchio on a model read afresh from the URDF); the reference tip's stand
+        robot = dash.replay_scene.robot
+        k = RobotKinematics.from_urdf(anna.controller.kinematics.urdf_path)
+        assert dash.replay_touch.visible and dash.replay_touch.value.startswith("4: step 4")   # the last touch first
+        assert robot is not None and robot.stand is not None
+        for i, touch in enumerate(shown.touches):
+            choose(dash.replay_touch, dash.replay_touch.options[i], trainer.client)
+            wait_until(lambda: dash.replay_scene.touch_shown == i, what=f"the robot at touch {i + 1}")
+            np.testing.assert_allclose(robot.posed_joints_deg, touch.joints_deg, atol=1e-12)
+            flange = robot.link_frames[k.flange_link]
+            T = k.T_world_flange(np.radians(touch.joints_deg))
+            np.testing.assert_allclose(flange.position, T[:3, 3], atol=1e-9)
+            np.testing.assert_allclose(flange.position, touch.T_world_flange_m[:3, 3], atol=1e-6)
         click(dash.close_replay, trainer.client)
         assert dash.replay_scene.handles == [] and not dash.close_replay.visible
+        assert robot.link_frames == {} and robot.stand is None and not dash.replay_touch.visible
     finally:
         for c in clients:
             c.close()

@@ -13,7 +13,7 @@ from support.pendant_page import TIMEOUT_MS, assert_not_blank
 from support.wizard_page import open_calibrate, press, wait_text
 
 pytestmark = [pytest.mark.browser, pytest.mark.timeout(1200)]     # software WebGL on a loaded machine
-KEYS = ("touch-1", "touch-4", "pair", "stack", "lstsq", "sphere")
+KEYS = ("touch-1", "touch-4", "A", "pair", "stack", "lstsq", "sphere")
 
 
 def block(page, key: str):

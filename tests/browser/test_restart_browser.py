@@ -15,63 +15,17 @@ import io
 import re
 import subprocess
 import sys
-import threading
 from pathlib import Path
-from typing import Any
 
-import msgspec.msgpack
 import pytest
-from viser import _messages
 
 from support.pendant_page import BROWSER_KEY_JS, TIMEOUT_MS, join_class, press, wait_enabled, wait_text
-from support.wsclient import INPUTS, DrainingClient, decode_window, wait_until
+from support.trainer_socket import TrainerSocket
+from support.wsclient import wait_until
 
 pytestmark = pytest.mark.browser
 
 TOKEN = "trainer-restart-token-2026"
-
-
-class TrainerSocket(DrainingClient):
-    """A trainer's raw websocket: learns the GUI inputs by label, keeps every markdown text the
-    server sends (by uuid, the latest), and sets values / clicks as its browser would."""
-
-    def __init__(self, port: int) -> None:
-        self.inputs: dict[str, str] = {}                 # label -> uuid (the latest of that label)
-        self.texts: dict[str, str] = {}
-        self._lock = threading.Lock()
-        super().__init__(port)
-
-    def _received(self, msg: bytes | str) -> None:
-        if not isinstance(msg, bytes):
-            return
-        for m in decode_window(msg):
-            kind, props = m.get("type"), m.get("props") or {}
-            with self._lock:
-                if kind in INPUTS and props.get("label"):
-                    self.inputs[str(props["label"])] = m["uuid"]
-                elif kind == "GuiMarkdownMessage":
-                    self.texts[m["uuid"]] = str(props.get("_markdown", ""))
-                elif kind == "GuiHtmlMessage":                  # the dashboard's tables
-                    self.texts[m["uuid"]] = str(props.get("content", ""))
-                elif kind == "GuiUpdateMessage":
-                    updates = m.get("updates") or {}
-                    for key in ("_markdown", "content"):
-                        if key in updates:
-                            self.texts[m["uuid"]] = str(updates[key])
-
-    def send_value(self, label: str, value: Any) -> None:
-        wait_until(lambda: label in self.inputs, what=f"the trainer's {label!r}")
-        msg = _messages.GuiUpdateMessage(self.inputs[label], {"value": value})
-        self.ws.send(msgspec.msgpack.encode(msg.as_serializable_dict()))
-
-    def text_with(self, pattern: str) -> str | None:
-        with self._lock:
-            return next((t for t in self.texts.values() if re.search(pattern, t)), None)
-
-    def open_trainer_view(self) -> None:
-        self.send_value("Trainer token", TOKEN)
-        self.send_value("Open trainer view", True)
-        wait_until(lambda: "Push to all trainees" in self.inputs, what="the trainer view")
 
 
 def _grades(db: Path) -> list[dict[str, str]]:
@@ -103,7 +57,7 @@ def test_a_killed_server_gives_the_trainees_calibration_back(pendant_server, new
     join_class(anna, "Anna")
     anna.wait_for_function(f"/^[A-Za-z0-9_-]{{43}}$/.test({BROWSER_KEY_JS} || '')", timeout=TIMEOUT_MS)
     # the trainer pushes "Hide distance: on, locked"
-    trainer = TrainerSocket(sp.port)
+    trainer = TrainerSocket(sp.port, TOKEN)
     try:
         trainer.open_trainer_view()
         trainer.send_value("Hide distance for all", "on, locked")
@@ -147,7 +101,7 @@ def test_a_killed_server_gives_the_trainees_calibration_back(pendant_server, new
     assert anna.evaluate(LOCKED_JS), "Hide distance is not on and locked after the restart"
     shot(anna, "restart_restored_jog")
     # the trainer's view lists the calibration in progress; so does `tcp-pendant grades`
-    trainer = TrainerSocket(again.port)
+    trainer = TrainerSocket(again.port, TOKEN)
     try:
         trainer.open_trainer_view()
         try:

@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 from tcp_pendant.calibrate import AutoTouchRequest
-from tcp_pendant.calibrate.math_view import MAX_LINE, MathSheet, math_sheet
+from tcp_pendant.calibrate.math_view import MAX_LINE, MAX_WIDE_LINE, MathSheet, math_sheet
 from tcp_pendant.text_escape import escape_markdown
 
 from support.calib_helpers import library_tool_with_true_tcp, true_frame
@@ -44,7 +44,8 @@ def assert_text_is_the_numbers(md: str, sheet: MathSheet) -> None:
     and the markdown holds no other decimal number (intro, labels and notes have none)."""
     blocks = shown_blocks(md)
     assert list(blocks) == [b.key for b in sheet.blocks]
-    too_long = [line for lines in blocks.values() for line in lines if len(line) > MAX_LINE]
+    too_long = [line for key, lines in blocks.items() for line in lines
+                if len(line) > (MAX_WIDE_LINE if key == "A" else MAX_LINE)]
     assert not too_long, too_long                                   # fits the presenter panel
     for b in sheet.blocks:
         got = [float(x) for line in blocks[b.key] for x in _NUMBER.findall(line)]
@@ -66,6 +67,22 @@ def touches_mm(wiz, steps=None) -> tuple[np.ndarray, np.ndarray]:
     steps = sorted(poses) if steps is None else steps
     T = np.array([poses[i].T_world_flange_m for i in steps])
     return T[:, :3, :3], T[:, :3, 3] * 1000.0
+
+
+def check_design(sheet: MathSheet, md: str, R: np.ndarray) -> None:
+    """(4P-3)'s A = [R_i -I] stacked (3N x 6), built here with numpy: its R part as shown, its
+    singular values and rank, and each shown row's -I part."""
+    A = np.vstack([np.hstack([Ri, -np.eye(3)]) for Ri in R])
+    assert A.shape == (3 * len(R), 6)
+    np.testing.assert_allclose(value(sheet, "A", "A_R"), A[:, :3], atol=1e-12)
+    s = np.linalg.svd(A, compute_uv=False)
+    np.testing.assert_allclose(value(sheet, "A", "sigma"), s, atol=1e-9)
+    rank = int(np.sum(s > 1e-6 * s[0]))
+    lines = shown_blocks(md)["A"]
+    assert f"rank {rank} of 6" in lines
+    rows = lines[1:1 + 3 * len(R)]
+    assert [row.split()[3:] for row in rows] == [[str(int(x)) for x in A[k, 3:]] for k in range(len(rows))]
+    assert len(rows) == 3 * len(R)
 
 
 def lstsq_4p3(R: np.ndarray, f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -113,15 +130,21 @@ def test_xyz4_math_is_live_from_the_first_touch_and_matches_numpy(page) -> None:
     touch(s)
     sheet = v.math.sheet
     R, f = touches_mm(wiz)
-    assert [b.key for b in sheet.blocks] == ["touch-1"]
+    assert [b.key for b in sheet.blocks] == ["touch-1", "A"]
     np.testing.assert_allclose(value(sheet, "touch-1", "R_1"), R[0], atol=1e-12)
     np.testing.assert_allclose(value(sheet, "touch-1", "f_1"), f[0], atol=1e-9)
+    assert sheet.intro.startswith("1 touch recorded.")
+    check_design(sheet, math_md(v), R)
+    assert "rank 3 of 6" in shown_blocks(math_md(v))["A"]
     assert_text_is_the_numbers(math_md(v), sheet)
 
     touch(s)                                            # two touches: rank 2, no solution
     sheet, md = v.math.sheet, math_md(v)
     R, f = touches_mm(wiz)
-    assert [b.key for b in sheet.blocks] == ["touch-1", "touch-2", "pair", "stack"]
+    assert [b.key for b in sheet.blocks] == ["touch-1", "touch-2", "A", "pair", "stack"]
+    assert sheet.intro.startswith("2 touches recorded.")
+    check_design(sheet, md, R)
+    assert "rank 5 of 6" in shown_blocks(md)["A"]                # t along the turning axis is free
     check_pair(sheet, R, f, 0, 1)
     assert "rank 2 of 3" in shown_blocks(md)["pair"] and "rank 2 of 3" in shown_blocks(md)["stack"]
     assert "normally a singular matrix and results in no solution" in md
@@ -133,8 +156,10 @@ def test_xyz4_math_is_live_from_the_first_touch_and_matches_numpy(page) -> None:
     assert res is not None and v.result.folder.visible and v.math.folder.visible
     sheet, md = v.math.sheet, math_md(v)
     R, f = touches_mm(wiz)
-    assert [b.key for b in sheet.blocks] == ["touch-1", "touch-2", "touch-3", "touch-4", "pair", "stack",
+    assert [b.key for b in sheet.blocks] == ["touch-1", "touch-2", "touch-3", "touch-4", "A", "pair", "stack",
                                              "lstsq", "sphere"]
+    check_design(sheet, md, R)
+    assert "rank 6 of 6" in shown_blocks(md)["A"]
     check_pair(sheet, R, f, 2, 3)                       # the last two touches by default
     # the stack of consecutive pairs: rank 3, its singular values, Eq. (8) by numpy's lstsq
     D = np.vstack([R[k] - R[k + 1] for k in range(3)])
@@ -282,6 +307,8 @@ def test_three_point_variants_1_and_2_follow_the_papers_steps(page) -> None:
     assert defect == pytest.approx(res.orthogonality_defect_deg, abs=1e-9) and defect > 0.0   # noisy touches
     c2o = c2 - (c1 @ c2) * c1
     c2o /= np.linalg.norm(c2o)
+    np.testing.assert_allclose(value(sheet, "eq18-24", "c2_straight"), c2o, atol=1e-12)    # printed
+    np.testing.assert_allclose(value(sheet, "eq30", "R_n,n*")[:, 1], c2o, atol=1e-12)     # = the middle column
     c3 = np.cross(c1, c2o)                                         # (30)
     np.testing.assert_allclose(value(sheet, "eq30", "c3"), c3, atol=1e-12)
     np.testing.assert_allclose(value(sheet, "eq30", "R_n,n*"), res.rotation, atol=1e-12)   # the solver's

@@ -130,6 +130,12 @@ def test_the_3d_tool_label_follows_a_wizards_tool_change(page) -> None:
     assert c.mounted_tool.key == "torch" and c.active_tool is not None
     assert label.text == "TOOL Straight pointer · on Bent-neck welding torch"
     np.testing.assert_allclose(axes.position, c.T_flange_tool[:3, 3], atol=1e-12)   # where the data puts the TCP
+    # the controller keeps which tool the data was selected on: a view drawn later (a reload, a
+    # reconnect after a restart) names the data and the tool bolted on alike
+    assert c.active_data_mounted_on is not None and c.active_data_mounted_on.key == "pointer"
+    scene._shown_active = None
+    scene.update_active_tool()
+    assert label.text == "TOOL Straight pointer · on Bent-neck welding torch"
     # new tool data: the label and the triad follow it
     torch_T = builtin_tools()["torch"].T_flange_tool_true
     s.tools.set_active_data(Tool.from_rotation("Bent-neck welding torch", tuple(torch_T[:3, 3] * 1000.0), torch_T[:3, :3]))

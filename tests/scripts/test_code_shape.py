@@ -6,10 +6,8 @@ Every module is parsed with :mod:`ast`; a definition's lines run from its first 
 ``def`` / ``class`` line) to its last line, blank lines and comments included. A definition is
 named ``<module file stem>:<qualified name>`` (``session:Session``, ``pendant_panel:PendantPanel.__init__``).
 
-A class over the limit fails :func:`test_no_class_is_over_the_limit` by name. The functions
-still too long are listed in :data:`LONG_FUNCTIONS`, each a strict xfail: when one is split below
-the limit (or gone), its test passes and fails the run as XPASS, and its line here goes. Any other
-function over the limit fails :func:`test_no_function_is_over_the_limit` by name.
+A class or function over its limit fails :func:`test_no_class_is_over_the_limit` /
+:func:`test_no_function_is_over_the_limit`, which name it, where, and its lines.
 """
 
 from __future__ import annotations
@@ -19,19 +17,12 @@ from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
 
-import pytest
-
 APP = Path(__file__).resolve().parents[2] / "app" / "tcp_pendant"
 MAX_CLASS_LINES = 500
 MAX_FUNCTION_LINES = 80
 JUSTIFIED = "Long because"
 """A docstring line starting with this states why a function is over :data:`MAX_FUNCTION_LINES`."""
 
-_LONG = "over 80 lines, no 'Long because' in its docstring: to be split or justified"
-LONG_FUNCTIONS = {
-    "math_view:three_point_sheet": _LONG,
-}
-"""Functions over :data:`MAX_FUNCTION_LINES` without a reason, still to be split or justified."""
 
 
 @dataclass(frozen=True)
@@ -100,14 +91,6 @@ def test_no_class_is_over_the_limit() -> None:
 
 
 def test_no_function_is_over_the_limit() -> None:
-    new = {n: d for n, d in _long_functions().items() if n not in LONG_FUNCTIONS}
+    new = _long_functions()
     assert not new, (f"functions over {MAX_FUNCTION_LINES} lines without a docstring line starting "
                      f"{JUSTIFIED!r}: {_listed(new)}")
-
-
-@pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.xfail(strict=True, reason=why))
-                                  for n, why in LONG_FUNCTIONS.items()])
-def test_a_listed_function_is_within_the_limit(name: str) -> None:
-    """A strict xfail while the function is too long; it passes, failing the run, once it is
-    split or its docstring says why it is long."""
-    assert name not in _long_functions(), _listed({name: _long_functions()[name]})

@@ -64,6 +64,7 @@ if TYPE_CHECKING:
 __all__ = [
     "MATH_FONT_PX",
     "MAX_LINE",
+    "MAX_WIDE_LINE",
     "MATH_VIEWS",
     "MathBlock",
     "MathSheet",
@@ -77,6 +78,9 @@ MATH_FONT_PX = 17
 """Font size of the monospace equations, pixels (28 characters fit the 320 px presenter panel)."""
 MAX_LINE = 25
 """Longest monospace line, characters: 25 at ``MATH_FONT_PX`` fit the 320 px presenter panel."""
+MAX_WIDE_LINE = 26
+"""Longest row of the stacked matrix A (:meth:`_Block.stacked`): six entries; the block scrolls
+sideways in the 320 px panel if the font makes it wider, and fits the board (``math_board``)."""
 RANK_TOL = 1e-6
 """A singular value below this times the largest counts as zero (numerical rank)."""
 
@@ -237,6 +241,22 @@ class _Block:
             line += "  " + item
         self.lines.append(line)
 
+    def stacked(self, name: str, symbol: str, R: np.ndarray, decimals: int = 2) -> None:
+        """(4P-3)'s ``A = [R_i  -I]`` stacked, one of its 3N rows a line, under ``symbol =``:
+        the R_i entries at ``decimals`` (kept as ``name``, 3N x 3) and -I's entries as the whole
+        numbers -1 and 0 (no decimal: constants, not kept). 2 decimals keep a row at
+        :data:`MAX_WIDE_LINE` characters."""
+        shown = self._keep(name, np.asarray(R, dtype=float).reshape(-1, 3), decimals, "")
+        cells = [[fmt(float(v), decimals) for v in row] for row in shown.value]
+        w = max(len(c) for row in cells for c in row)
+        self.lines.append(f"{symbol} =")
+        for k, row in enumerate(cells):
+            eye = " ".join("-1" if j == k % 3 else " 0" for j in range(3))
+            line = " ".join(c.rjust(w) for c in row) + " " + eye
+            if len(line) > MAX_WIDE_LINE:
+                raise ValueError(f"block {self.key}: a row of A too long: {line!r}")
+            self.lines.append(line)
+
     def note(self, words: str) -> None:
         self.notes.append(words)
 
@@ -393,8 +413,32 @@ def _sphere_block(R: np.ndarray, f: np.ndarray) -> MathBlock:
     return blk.build()
 
 
+_SINGULAR = {"touches": "touch", "poses": "pose", "tip events": "tip event"}
+
+
+def _design_block(steps: Sequence[int], R: np.ndarray) -> MathBlock:
+    """(4P-3)'s design matrix ``A = [R_i  -I]`` stacked (3N x 6, unknowns ``x = (t, r)``, right
+    side ``b = -f_i``), its singular values and numerical rank (of 6), as the touches arrive."""
+    n = len(steps)
+    A = np.vstack([np.hstack([Ri, -np.eye(3)]) for Ri in R])
+    rank, s, _ = rank_and_singular_values(A)
+    blk = _Block("A", "(4P-3) · A x = b", f"A = [R_i  −I] stacked: {3 * n}×6, x = (t, r), b = −f_i")
+    blk.stacked("A_R", "A", R)
+    blk.numbers("sigma", "σ(A)", s)
+    blk.text(f"rank {rank} of 6")
+    if rank < 6:
+        blk.note("Rank below 6: t and r cannot both be determined yet. Each touch adds three rows; "
+                 "two touches leave the TCP along the axis the tool turned about free (a zero "
+                 "singular value). Touches about two different axes give rank 6.")
+    else:
+        blk.note("Rank 6: t and r are determined; the smallest singular value says how well "
+                 "(a small one: the touches are nearly about one axis).")
+    return blk.build()
+
+
 def _intro(n: int, what: str) -> str:
-    return f"{n} {what} recorded." if n != 1 else f"1 {what[:-1] if what.endswith('s') else what} recorded."
+    """``"2 touches recorded."``, ``"1 touch recorded."`` (``what``: a plural of :data:`_SINGULAR`)."""
+    return f"{n} {what if n != 1 else _SINGULAR.get(what, what)} recorded."
 
 
 # ------------------------------------------------------------------ the sheets
@@ -415,6 +459,8 @@ def _origin_sheet(view: str, title: str, steps: list[int], R: np.ndarray, f: np.
                   pair: tuple[int, int] | None, extra: Sequence[MathBlock] = ()) -> MathSheet:
     blocks = _touch_blocks(steps, R, f, "(4P-1) · lecture Eqs. (1)-(3)")
     n = len(steps)
+    if n >= 1:
+        blocks.append(_design_block(steps, R))
     if n >= 2:
         if pair is None or pair[0] not in steps or pair[1] not in steps or pair[0] == pair[1]:
             pair = (steps[-2], steps[-1])
@@ -469,103 +515,140 @@ def reference_sheet(wizard: ReferenceWizard) -> MathSheet:
 
 def three_point_sheet(wizard: ThreePointWizard) -> MathSheet:
     """Three-point, variants 1 and 2 (paper eqs. 7-30): V(1), c11 c21 c31, Δ1; V(2) (variant
-    1) or V(3) (variant 2), the second column and its orthogonality; c3 (30) and the defect."""
+    1, with c2 straightened orthogonal to c1) or V(3) (variant 2), the second column and its
+    orthogonality; c3 (30) and the defect."""
     steps, R, f = _poses_mm(wizard)
     got = dict(zip(steps, range(len(steps))))
     t = np.asarray(wizard.tool.tcp_mm, dtype=float)
-    variant = int(wizard.variant)
-    blocks = []
-    if 0 not in got:
-        return MathSheet("three_point", wizard.title, (), _intro(len(steps), "poses"))
-    k = got[0]
-    r = R[k] @ t + f[k]
+    blocks: list[MathBlock] = []
+    if 0 in got:
+        block, r = _tp_reference(t, R[got[0]], f[got[0]])
+        blocks.append(block)
+        c1 = None
+        if 1 in got:
+            block, c1 = _tp_first_axis(t, r, R[got[1]], f[got[1]])
+            blocks.append(block)
+        if c1 is not None and 2 in got:
+            k = got[2]
+            second = _tp_variant1 if int(wizard.variant) == 1 else _tp_variant2
+            block, c2 = second(t, r, c1, R[k], f[k])
+            blocks.append(block)
+            if c2 is not None:
+                res = wizard.result
+                blocks.append(_tp_frame(c1, c2, None if res is None else res.orthogonality_defect_deg))
+    return MathSheet("three_point", wizard.title, tuple(blocks), _intro(len(steps), "poses"))
+
+
+def _tp_reference(t: np.ndarray, R1: np.ndarray, f1: np.ndarray) -> tuple[MathBlock, np.ndarray]:
+    """Paper Eq. (7): the TCP ``t`` (mm, FLANGE) touches the reference, ``r = R⁽¹⁾ t + f⁽¹⁾``."""
+    r = R1 @ t + f1
     b = _Block("eq7", "paper Eq. (7)", "the TCP touches the reference: r = T⁽¹⁾ [t; 1]")
     b.vector("t", "t", t)
-    b.matrix("R_1", "R⁽¹⁾", R[k])
-    b.vector("f_1", "f⁽¹⁾", f[k])
+    b.matrix("R_1", "R⁽¹⁾", R1)
+    b.vector("f_1", "f⁽¹⁾", f1)
     b.vector("r", "r", r)
-    blocks.append(b.build())
+    return b.build(), r
+
+
+def _tp_first_axis(t: np.ndarray, r: np.ndarray, R2: np.ndarray, f2: np.ndarray
+                   ) -> tuple[MathBlock, np.ndarray | None]:
+    """Paper Eqs. (8)-(17): ``V(1) = R⁽²⁾ᵀ (r − f⁽²⁾) = t + Δ1 c1``, ``Δ1 = −|V(1) − t|``; c1
+    (None when the tip was not moved off the TCP)."""
+    v1 = R2.T @ (r - f2)
+    d1 = v1 - t
+    delta1 = -float(np.linalg.norm(d1))
+    b = _Block("eq8-17", "paper Eqs. (8)-(17)", "the tip on the tool's −X axis: V(1) = (T⁽²⁾)⁻¹ r = t + Δ1 c1")
+    b.matrix("R_2", "R⁽²⁾", R2)
+    b.vector("f_2", "f⁽²⁾", f2)
+    b.vector("V1", "V(1)", v1)
+    b.scalar("delta1", "Δ1", delta1)
     c1 = None
-    if 1 in got:
-        k = got[1]
-        v1 = R[k].T @ (r - f[k])
-        d1 = v1 - t
-        delta1 = -float(np.linalg.norm(d1))
-        b = _Block("eq8-17", "paper Eqs. (8)-(17)", "the tip on the tool's −X axis: V(1) = (T⁽²⁾)⁻¹ r = t + Δ1 c1")
-        b.matrix("R_2", "R⁽²⁾", R[k])
-        b.vector("f_2", "f⁽²⁾", f[k])
-        b.vector("V1", "V(1)", v1)
-        b.scalar("delta1", "Δ1", delta1)
-        if delta1 < 0:
-            c1 = d1 / delta1
-            b.text("c1 = (c11, c21, c31)")
-            b.text("   = (V(1) − t) / Δ1")
-            b.vector("c1", "c1", c1, decimals=3, unit="")
-        else:
-            b.note("The tip was not moved off the TCP: Δ1 = 0, tool X is undefined.")
-        blocks.append(b.build())
-    if c1 is not None and 2 in got:
-        k = got[2]
-        v = R[k].T @ (r - f[k])
-        w = v - t
-        if variant == 1:
-            b = _Block("eq18-24", "paper Eqs. (18)-(24)",
-                       "variant 1, the tip on the tool's +Y axis: V(2) = t + Δ2 c2")
-            b.matrix("R_3", "R⁽³⁾", R[k])
-            b.vector("f_3", "f⁽³⁾", f[k])
-            b.vector("V2", "V(2)", v)
-            delta2 = float(np.linalg.norm(w))
-            b.scalar("delta2", "Δ2", delta2)
-            if delta2 > 0:
-                c2_raw = w / delta2
-                b.text("c2 = (c12, c22, c32)")
-                b.text("   = (V(2) − t) / Δ2")
-                b.vector("c2", "c2", c2_raw, decimals=3, unit="")
-                cos = float(c1 @ c2_raw)
-                b.scalar("c1.c2", "c1 · c2", cos, decimals=3, unit="")
-                defect = abs(90.0 - math.degrees(math.atan2(float(np.linalg.norm(np.cross(c1, c2_raw))), cos)))
-                b.scalar("defect", "|90° − ∠(c1, c2)|", defect, unit="deg")
-                b.note("c1 and c2 should be orthogonal (c1 · c2 = 0); the touch error leaves them "
-                       "not quite so. tcpcal keeps c1 and makes c2 orthogonal to it (Gram-Schmidt) "
-                       "and reports the angle as the orthogonality defect.")
-                c2 = c2_raw - cos * c1
-                c2 = c2 / np.linalg.norm(c2)
-            else:
-                c2 = None
-        else:
-            b = _Block("eq25-29", "paper Eqs. (25)-(29)",
-                       "variant 2, the tip in the +Y half-plane: V(3) = t + Δ3 c1 + Δ4 c2")
-            b.matrix("R_3", "R⁽³⁾", R[k])
-            b.vector("f_3", "f⁽³⁾", f[k])
-            b.vector("V3", "V(3)", v)
-            delta3 = float(c1 @ w)
-            p = w - delta3 * c1
-            delta4 = float(np.linalg.norm(p))
-            b.scalar("delta3", "Δ3 = c1 · (V(3) − t)", delta3)
-            b.scalar("delta4", "Δ4", delta4)
-            c2 = p / delta4 if delta4 > 0 else None
-            if c2 is not None:
-                b.text("c2 = (c12, c22, c32)")
-                b.text("   = (V(3)−t−Δ3 c1)/Δ4")
-                b.vector("c2", "c2", c2, decimals=3, unit="")
-                b.scalar("c1.c2", "c1 · c2", float(c1 @ c2), decimals=3, unit="")
-                b.scalar("defect", "defect", 0.0, unit="deg")
-                b.note("Eq. (29) with the orthogonality condition: c2 is orthogonal to c1 by "
-                       "construction, so variant 2 has no orthogonality defect.")
-        blocks.append(b.build())
-        if c2 is not None:
-            c3 = np.cross(c1, c2)
-            c3 = c3 / np.linalg.norm(c3)
-            Rt = np.column_stack([c1, c2, c3])
-            b = _Block("eq30", "paper Eq. (30)", "c3 = c1 × c2, R_n,n* = [c1 c2 c3]")
-            b.vector("c3", "c3", c3, decimals=3, unit="")
-            b.matrix("R_n,n*", "R_n,n*", Rt)
-            b.vector("abc", "A,B,C", np.asarray(abc_deg_from_rotation(Rt), dtype=float), unit="°")
-            res = wizard.result
-            if res is not None and res.orthogonality_defect_deg is not None:
-                b.scalar("defect_tcpcal", "tcpcal's defect", float(res.orthogonality_defect_deg), unit="deg")
-            blocks.append(b.build())
-    return MathSheet("three_point", wizard.title, tuple(blocks), _intro(len(steps), "poses"))
+    if delta1 < 0:
+        c1 = d1 / delta1
+        b.text("c1 = (c11, c21, c31)")
+        b.text("   = (V(1) − t) / Δ1")
+        b.vector("c1", "c1", c1, decimals=3, unit="")
+    else:
+        b.note("The tip was not moved off the TCP: Δ1 = 0, tool X is undefined.")
+    return b.build(), c1
+
+
+def _tp_variant1(t: np.ndarray, r: np.ndarray, c1: np.ndarray, R3: np.ndarray, f3: np.ndarray
+                 ) -> tuple[MathBlock, np.ndarray | None]:
+    """Paper Eqs. (18)-(24), variant 1: ``V(2) = t + Δ2 c2``; c2 as measured, ``c1 · c2``, the
+    orthogonality defect, and c2 straightened (Gram-Schmidt keeping c1, as tcpcal does): the
+    middle column of ``R_n,n*``. Returns the straightened c2 (None: Δ2 = 0)."""
+    v = R3.T @ (r - f3)
+    w = v - t
+    b = _Block("eq18-24", "paper Eqs. (18)-(24)", "variant 1, the tip on the tool's +Y axis: V(2) = t + Δ2 c2")
+    b.matrix("R_3", "R⁽³⁾", R3)
+    b.vector("f_3", "f⁽³⁾", f3)
+    b.vector("V2", "V(2)", v)
+    delta2 = float(np.linalg.norm(w))
+    b.scalar("delta2", "Δ2", delta2)
+    if delta2 <= 0:
+        return b.build(), None
+    c2_raw = w / delta2
+    b.text("c2 = (c12, c22, c32)")
+    b.text("   = (V(2) − t) / Δ2")
+    b.vector("c2", "c2", c2_raw, decimals=3, unit="")
+    cos = float(c1 @ c2_raw)
+    b.scalar("c1.c2", "c1 · c2", cos, decimals=3, unit="")
+    defect = abs(90.0 - math.degrees(math.atan2(float(np.linalg.norm(np.cross(c1, c2_raw))), cos)))
+    b.scalar("defect", "|90° − ∠(c1, c2)|", defect, unit="deg")
+    c2 = c2_raw - cos * c1
+    c2 = c2 / np.linalg.norm(c2)
+    b.text("c2' ∝ c2 − (c1·c2) c1")
+    b.text("|c2'| = 1, c1 · c2' = 0")
+    b.vector("c2_straight", "c2'", c2, decimals=3, unit="")
+    b.note("c1 and c2 should be orthogonal (c1 · c2 = 0); the touch error leaves them not quite "
+           "so. tcpcal keeps c1 and makes c2 orthogonal to it (Gram-Schmidt): the straightened c2' "
+           "is the middle column of R_n,n* below, and the angle is the orthogonality defect.")
+    return b.build(), c2
+
+
+def _tp_variant2(t: np.ndarray, r: np.ndarray, c1: np.ndarray, R3: np.ndarray, f3: np.ndarray
+                 ) -> tuple[MathBlock, np.ndarray | None]:
+    """Paper Eqs. (25)-(29), variant 2: ``V(3) = t + Δ3 c1 + Δ4 c2`` with ``Δ3 = c1 · (V(3) − t)``;
+    c2 orthogonal to c1 by construction (None: Δ4 = 0)."""
+    v = R3.T @ (r - f3)
+    w = v - t
+    b = _Block("eq25-29", "paper Eqs. (25)-(29)",
+               "variant 2, the tip in the +Y half-plane: V(3) = t + Δ3 c1 + Δ4 c2")
+    b.matrix("R_3", "R⁽³⁾", R3)
+    b.vector("f_3", "f⁽³⁾", f3)
+    b.vector("V3", "V(3)", v)
+    delta3 = float(c1 @ w)
+    p = w - delta3 * c1
+    delta4 = float(np.linalg.norm(p))
+    b.scalar("delta3", "Δ3 = c1 · (V(3) − t)", delta3)
+    b.scalar("delta4", "Δ4", delta4)
+    if delta4 <= 0:
+        return b.build(), None
+    c2 = p / delta4
+    b.text("c2 = (c12, c22, c32)")
+    b.text("   = (V(3)−t−Δ3 c1)/Δ4")
+    b.vector("c2", "c2", c2, decimals=3, unit="")
+    b.scalar("c1.c2", "c1 · c2", float(c1 @ c2), decimals=3, unit="")
+    b.scalar("defect", "defect", 0.0, unit="deg")
+    b.note("Eq. (29) with the orthogonality condition: c2 is orthogonal to c1 by "
+           "construction, so variant 2 has no orthogonality defect.")
+    return b.build(), c2
+
+
+def _tp_frame(c1: np.ndarray, c2: np.ndarray, defect_tcpcal_deg: float | None) -> MathBlock:
+    """Paper Eq. (30): ``c3 = c1 × c2`` and ``R_n,n* = [c1 c2 c3]`` with its A, B, C (degrees);
+    tcpcal's orthogonality defect when the result is there."""
+    c3 = np.cross(c1, c2)
+    c3 = c3 / np.linalg.norm(c3)
+    Rt = np.column_stack([c1, c2, c3])
+    b = _Block("eq30", "paper Eq. (30)", "c3 = c1 × c2, R_n,n* = [c1 c2 c3]")
+    b.vector("c3", "c3", c3, decimals=3, unit="")
+    b.matrix("R_n,n*", "R_n,n*", Rt)
+    b.vector("abc", "A,B,C", np.asarray(abc_deg_from_rotation(Rt), dtype=float), unit="°")
+    if defect_tcpcal_deg is not None:
+        b.scalar("defect_tcpcal", "tcpcal's defect", float(defect_tcpcal_deg), unit="deg")
+    return b.build()
 
 
 def abc_world_sheet(wizard: AbcWorldWizard) -> MathSheet:
@@ -724,10 +807,13 @@ def math_sheet(wizard: Wizard, *, pair: tuple[int, int] | None = None) -> MathSh
 
 # ------------------------------------------------------------------ markdown
 def block_html(block: MathBlock, *, font_px: int = MATH_FONT_PX) -> str:
-    """The block's lines as one monospace ``<div>`` (raw HTML of our own lines, escaped)."""
+    """The block's lines as one monospace ``<div>`` (raw HTML of our own lines, escaped). A block
+    with a line over :data:`MAX_LINE` (the stacked A's rows, :data:`MAX_WIDE_LINE`) is set
+    half a pixel tighter per character, so it fits the 320 px presenter panel as well."""
     body = "<br>".join(escape_html(line).replace(" ", "&nbsp;") for line in block.lines)
+    tight = " letter-spacing:-0.5px;" if any(len(line) > MAX_LINE for line in block.lines) else ""
     return (f'<div class="math-block" data-key="{escape_html(block.key)}" style="font-family:monospace; '
-            f'font-size:{int(font_px)}px; line-height:1.25; white-space:nowrap; overflow-x:auto">'
+            f'font-size:{int(font_px)}px; line-height:1.25; white-space:nowrap; overflow-x:auto;{tight}">'
             f"{body}</div>")
 
 

@@ -1,7 +1,7 @@
 """A trainee's calibration as the gradebook keeps it, ready to draw again (no viser).
 
-The trainer's dashboard replays a calibration in 3D (``views.dashboard_replay``): each touch's
-flange pose, the approach of the tool at it (flange origin to where the tool tip was: the
+The trainer's dashboard replays a calibration in 3D (``views.dashboard_replay``): the robot at
+each touch (its joint angles), each touch's flange pose, the approach of the tool at it (flange origin to where the tool tip was: the
 true TOOL frame's tip, else the computed one), the computed TOOL frame and the true one, and the
 reference tip (the mean of the true tip positions: where the tip really was at the touches).
 Everything comes from the gradebook (touches, truth, result), so it works for a trainee who is
@@ -30,6 +30,7 @@ class ReplayTouch:
         auto: done by Auto-touch.
         overwritten: a later touch of the same step replaced it.
         tip_world_m: (3,) where the tool tip was (true TOOL frame, else the computed one), or None.
+        joints_deg: the robot's joint angles at the touch, degrees (None: not kept).
     """
 
     step_index: int
@@ -37,6 +38,7 @@ class ReplayTouch:
     auto: bool
     overwritten: bool
     tip_world_m: np.ndarray | None
+    joints_deg: np.ndarray | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -82,6 +84,14 @@ def _truth(truth: object) -> np.ndarray | None:
     return out if out.shape == (4, 4) and np.all(np.isfinite(out)) else None
 
 
+def _joints(value: object) -> np.ndarray | None:
+    try:
+        q = np.asarray(value, dtype=float).reshape(-1)
+    except (TypeError, ValueError):
+        return None
+    return q if q.size > 0 and np.all(np.isfinite(q)) else None
+
+
 def calibration_replay(gradebook: Gradebook, calibration_id: int) -> CalibrationReplay:
     """Calibration ``calibration_id`` from ``gradebook`` (see the module docstring).
 
@@ -97,7 +107,7 @@ def calibration_replay(gradebook: Gradebook, calibration_id: int) -> Calibration
         T = np.asarray(t["T_world_flange_m"], dtype=float)
         tip = None if tip_T is None else (T @ tip_T)[:3, 3]
         touches.append(ReplayTouch(int(t["step_index"]), T, bool(t["auto"]),
-                                   t["overwritten_by_touch_id"] is not None, tip))
+                                   t["overwritten_by_touch_id"] is not None, tip, _joints(t.get("joints_deg"))))
     counted = [t.tip_world_m for t in touches if not t.overwritten and t.tip_world_m is not None]
     reference = np.mean(counted, axis=0) if counted else None
     return CalibrationReplay(int(calibration_id), str(info["trainee"]), str(info["method"]), str(info["status"]),

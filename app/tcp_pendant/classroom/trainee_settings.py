@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from tcp_pendant.classroom.exercise_rules import DistanceAids
 from tcp_pendant.classroom.mystery import draw_mystery_tool
+from tcp_pendant.classroom.push_words import PUSH_TITLE, push_words
 from tcp_pendant.classroom.recorder import TraineeRecorder
 from tcp_pendant.calibrate.pendant_rules import ExerciseRules
 from tcp_pendant.controller import ToolModel
@@ -67,11 +68,14 @@ def apply_class_push(session: Session, recorder: TraineeRecorder, name: str, exe
 
 def apply_push_to(session: Session, recorder: TraineeRecorder, name: str, exercise: str | None,
                   tool_key: str | None, rules: ExerciseRules, hide_distance: str | None, *,
-                  sets_exercise: bool, seed: int | None, tools: dict[str, ToolModel]) -> None:
+                  sets_exercise: bool, seed: int | None, tools: dict[str, ToolModel],
+                  auto_touch: bool | None = None) -> None:
     """A push to the one trainee ``name`` (``ClassRoom.push_to``): the ``exercise`` in force
     (set on the pendant when the push ``sets_exercise``; the mystery one: their mystery tool
     from the class's ``seed``), ``tool_key`` (None: keep; not with the mystery exercise), the
-    ``rules`` and the distance aids ``hide_distance`` (None: keep; a new exercise hides them)."""
+    ``rules`` and the distance aids ``hide_distance`` (None: keep; a new exercise hides them).
+    The trainee is told in words what changed (``push_words``; ``auto_touch`` as pushed, None:
+    not changed)."""
     with session.batch():
         if sets_exercise:
             recorder.exercise_id = exercise
@@ -90,6 +94,9 @@ def apply_push_to(session: Session, recorder: TraineeRecorder, name: str, exerci
             session.set_hide_distance(True)
         session.set_rules(rules)
         session.changed(wizard=True)
+    session.notify(PUSH_TITLE, push_words(exercise if sets_exercise else False,
+                                          None if tool_key is None else tools[tool_key].label,
+                                          hide_distance, auto_touch), kind="warning")
 
 
 def reset_wizard(session: Session) -> None:

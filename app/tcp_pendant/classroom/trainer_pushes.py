@@ -129,7 +129,7 @@ class TrainerPushes:
         seed = self._seed() if ex == "mystery" and exercise is not False else None
         self._hand_to_loop(seat.session.loop.guard(lambda: apply_push_to(
             seat.session, seat.recorder, seat.name, ex, tool_key, rules, hide_distance,
-            sets_exercise=exercise is not False, seed=seed, tools=self._tools)))
+            sets_exercise=exercise is not False, seed=seed, tools=self._tools, auto_touch=auto_touch)))
         return f"Pushed to {seat.name}."
 
     def apply_remote(self, push: dict[str, Any]) -> None:

@@ -112,6 +112,7 @@ class VirtualController:
         dropped whenever q, the model or the tool data are set any other way."""
         self._tool = tool
         self._active: Tool | None = None
+        self._active_on: ToolModel | None = None        # the tool on the flange when the data became active
         self._T_flange_tool = np.eye(4)
         self.set_active_tool(active_tool)
         self._T_world_base = np.eye(4) if T_world_base is None else check_pose(T_world_base, "T_world_base")
@@ -216,11 +217,17 @@ class VirtualController:
         """Select the active tool data; ``T_flange_tool`` = its ``tcp_mm`` (in m) and ``abc_deg``."""
         self._state = None
         if tool is None:
-            self._active, self._T_flange_tool = None, np.eye(4)
+            self._active, self._T_flange_tool, self._active_on = None, np.eye(4), None
             return
         if not isinstance(tool, Tool):
             raise ControllerError(f"set_active_tool expects a tcpcal.Tool or None, got {type(tool).__name__}.")
-        self._active, self._T_flange_tool = tool, T_flange_tool_m(tool)
+        self._active, self._T_flange_tool, self._active_on = tool, T_flange_tool_m(tool), self._tool
+
+    @property
+    def active_data_mounted_on(self) -> ToolModel | None:
+        """The physical tool that was on the flange when the active tool data was selected
+        (None: no data active): the data is that tool's, whatever is bolted on since."""
+        return self._active_on
 
     @property
     def T_flange_tool(self) -> np.ndarray:

@@ -13,8 +13,11 @@ What this module serves, in front of viser's static-file server (``process_reque
 ``websockets`` server, reached through :func:`tcp_pendant.serve.origin_check.set_http_layer`):
 
 * ``GET /`` and ``GET /index.html`` (and the paths viser maps to them): viser's own response
-  with one ``<script src="tcp-pendant/pendant.js" defer></script>`` inserted right after
-  ``<head>``; headers as viser's (the length recomputed; gzip kept when viser used it). The
+  with one ``<script src="tcp-pendant/pendant.js"></script>`` inserted right after
+  ``<head>``: a classic script, not deferred, so it runs before viser's loader (the next script
+  in the head) starts the page's code: the script wraps the page's ``Worker`` constructor before
+  viser makes its websocket worker (a deferred script arriving late, over a slow link, ran after
+  it and saw nothing of the connection); headers as viser's (the length recomputed; gzip kept when viser used it). The
   ``src`` is relative, so a reverse proxy that serves the pendant under a path prefix
   (``https://school.example/pendant/``) still finds the script.
 * ``GET /tcp-pendant/pendant.js``: the script's bytes, read once from the package at import of
@@ -56,7 +59,7 @@ PREFIX = "tcp-pendant"
 """The first path segment of everything this module answers."""
 SCRIPT_PATH = f"/{PREFIX}/pendant.js"
 """Where the page loads the script from."""
-SCRIPT_TAG = f'<script src="{SCRIPT_PATH[1:]}" defer></script>'.encode("ascii")
+SCRIPT_TAG = f'<script src="{SCRIPT_PATH[1:]}"></script>'.encode("ascii")
 """The one tag inserted into viser's index.html."""
 JS_CONTENT_TYPE = "text/javascript; charset=utf-8"
 

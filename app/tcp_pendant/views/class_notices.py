@@ -9,7 +9,12 @@ trainer's messages, pinned at the top of the panel.
 * **Message box**: the oldest message the session keeps (``Session.messages``) with who it was
   for and when, how many more wait, and a **Dismiss** button (``Session.dismiss_message`` of
   the message shown: a click that arrives after another message took its place dismisses
-  nothing else). Messages queue: the next one shows when this one is dismissed.
+  nothing else). Messages queue: the next one shows when this one is dismissed. The box is a
+  folder holding an empty marker of class ``trainer-message`` (a constant): the page script
+  (``serve/static/pendant.js``) pins it at the top of the panel while the panel scrolls, so it is
+  in view on whatever tab and wherever the trainee scrolled to.
+* **Toast**: each message this view shows for the first time also comes as a notification
+  (``Session.notify``), in the corner of the screen, whatever the trainee is looking at.
 
 Both texts are the trainer's browser's (a stranger's): every line goes through
 ``text_escape.escape_markdown_lines``. The view renders from the session's state on its
@@ -24,8 +29,11 @@ from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.text_escape import escape_markdown, escape_markdown_lines
 from tcp_pendant.views.gui_util import ButtonEvent, set_content, target_of
 
-__all__ = ["ClassNoticeView", "instructions_markdown", "message_markdown"]
+__all__ = ["PIN_CLASS", "TOAST_TITLE", "ClassNoticeView", "instructions_markdown", "message_markdown"]
 
+PIN_CLASS = "trainer-message"
+"""The class of the empty marker in the message's folder: the page script pins the folder."""
+TOAST_TITLE = "Message from the trainer"
 BANNER_ORDER = -1100.0
 """The instructions' place: above every other element of the panel (the identity banner is -1000)."""
 
@@ -48,7 +56,7 @@ class ClassNoticeView:
     """The instructions banner and the message box of one session (see the module docstring).
 
     Attributes:
-        banner, message_md, dismiss: the widgets (for tests).
+        banner, box, message_md, dismiss: the widgets (for tests).
         shown: the message on show (None: none).
     """
 
@@ -56,10 +64,13 @@ class ClassNoticeView:
         self.session = session
         gui = target_of(session).gui
         self.banner = gui.add_markdown("", order=BANNER_ORDER, visible=False)
-        self.message_md = gui.add_markdown("", order=BANNER_ORDER + 1, visible=False)
-        self.dismiss = gui.add_button("Dismiss", order=BANNER_ORDER + 2, visible=False,
-                                      hint="The message goes; the next one, if any, shows.")
+        self.box = gui.add_folder("Message", order=BANNER_ORDER + 1, visible=False)
+        with self.box:
+            gui.add_html(f'<span class="{PIN_CLASS}"></span>')    # a constant: the page script pins the folder
+            self.message_md = gui.add_markdown("")
+            self.dismiss = gui.add_button("Dismiss", hint="The message goes; the next one, if any, shows.")
         self.shown: ClassMessage | None = None
+        self._toasted: set[int] = set()
         self.dismiss.on_click(session.loop.on_loop(self._on_dismiss))
         session.subscribe(self.on_change)
         self.render()
@@ -86,4 +97,8 @@ class ClassNoticeView:
         self.shown = messages[0] if messages else None
         if self.shown is not None:
             set_content(self.message_md, message_markdown(self.shown, len(messages) - 1))
-        self.message_md.visible = self.dismiss.visible = self.shown is not None
+        self.box.visible = self.message_md.visible = self.dismiss.visible = self.shown is not None
+        for m in messages:                  # a toast for each message new to this browser's view
+            if m.message_id not in self._toasted:
+                self._toasted.add(m.message_id)
+                self.session.notify(TOAST_TITLE, m.text)

@@ -67,6 +67,8 @@ from tcp_pendant.views.trainer_view import (
     AUTO_TOUCH, EXERCISES, HIDE_DISTANCE, ClassControl, grades_markdown, record_grades_markdown,
     rules_words,
 )
+from tcp_pendant.views.replay_robot import ReplayRobot
+from tcp_pendant.views.replay_touches import NO_TOUCH, pose_replay_touch, set_replay_touches
 from tcp_pendant.views.upload_guard import limit_upload_size
 from tcp_pendant.wizards.session_record import MAX_RECORD_BYTES, SessionRecordError, check_record_size, load_and_replay
 
@@ -123,7 +125,7 @@ class TrainerDashboard:
         folders: the folders by title ("Class", "Exercise", ...), for the builders of other modules.
 
     The widgets (for tests): stuck_min, idle_min, table_html, runs_html, chart, trainee, reset,
-    replay_button, close_replay, one_exercise, one_tool, one_hide_distance, one_auto_touch,
+    replay_button, close_replay, replay_touch, one_exercise, one_tool, one_hide_distance, one_auto_touch,
     push_one, release, action_md, exercise, tool, hide_distance, auto_touch, push, push_md,
     grades_md, download, grade_upload, grade_md.
     """
@@ -140,6 +142,7 @@ class TrainerDashboard:
     reset: viser.GuiButtonHandle
     replay_button: viser.GuiButtonHandle
     close_replay: viser.GuiButtonHandle
+    replay_touch: viser.GuiDropdownHandle[str]
     one_exercise: viser.GuiDropdownHandle[str]
     one_tool: viser.GuiDropdownHandle[str]
     one_hide_distance: viser.GuiDropdownHandle[str]
@@ -170,7 +173,8 @@ class TrainerDashboard:
         self._grading = False
         self._results_shown: tuple[tuple[int | None, float | None, str | None], ...] | None = None
         client = client_of(session)
-        self.replay_scene = ReplayScene(target_of(session).scene, None if client is None else client.camera)
+        self.replay_scene = ReplayScene(target_of(session).scene, None if client is None else client.camera,
+                                        ReplayRobot(target_of(session).scene, session.controller.kinematics))
 
     def folder(self, title: str, *, expand_by_default: bool = True) -> viser.GuiFolderHandle:
         """A folder of the dashboard, kept in :attr:`folders`."""
@@ -276,17 +280,18 @@ class TrainerDashboard:
         self.replay_scene.show(replay)
         self.gui.main_panel.set_width(REPLAY_PANEL_PX)
         self.close_replay.visible = True
+        set_replay_touches(self.replay_touch, replay, self.replay_scene.touch_shown)
         err = "" if replay.position_error_mm is None else f", error {replay.position_error_mm:.2f} mm"
         grade = "" if replay.grade is None else f", {replay.grade}"
         self._say(f"Replay of {name}'s calibration {replay.calibration_id} ({replay.method}, "
                   f"{replay.status.replace('_', ' ')}): {len(replay.touches)} touches{err}{grade}. "
-                  "Triads: the flange at each touch; lines: the tool to its tip (blue by hand, orange "
+                  "The robot as it was at the touch chosen in 'Robot at touch'; triads: the flange at each touch; lines: the tool to its tip (blue by hand, orange "
                   "Auto-touch); frames: result and true TOOL frame.")
 
     def _close_replay(self, _event: ButtonEvent | None = None) -> None:
         self.replay_scene.clear()
         self.gui.main_panel.set_width(FULL_WIDTH_PX)
-        self.close_replay.visible = False
+        self.close_replay.visible = self.replay_touch.visible = False
 
     def _push_all(self, _event: ButtonEvent | None = None) -> None:
         exercise = EXERCISES.get(str(self.exercise.value))
@@ -389,6 +394,8 @@ def trainee_folder(dash: TrainerDashboard) -> None:
         dash.replay_button = gui.add_button("Replay in 3D",
                                             hint="Draw this trainee's last calibration from the gradebook.")
         dash.close_replay = gui.add_button("Close replay", visible=False)
+        dash.replay_touch = gui.add_dropdown("Robot at touch", (NO_TOUCH,), initial_value=NO_TOUCH, visible=False,
+                                             hint="The robot of the replay, posed as it was at that touch.")
         dash.one_exercise = gui.add_dropdown("Exercise for this trainee", tuple(ONE_EXERCISE), initial_value="(keep)")
         tools = ("(keep)", *dash.control.tool_keys)
         dash.one_tool = gui.add_dropdown("Tool for this trainee", tools, initial_value=tools[0])
@@ -404,6 +411,7 @@ def trainee_folder(dash: TrainerDashboard) -> None:
     dash.reset.on_click(on_loop(dash._reset))
     dash.replay_button.on_click(on_loop(dash._replay))
     dash.close_replay.on_click(on_loop(dash._close_replay))
+    dash.replay_touch.on_update(on_loop(lambda _e: pose_replay_touch(dash.replay_scene, dash.replay_touch)))
     dash.push_one.on_click(on_loop(dash._push_one))
     dash.release.on_click(on_loop(dash._release))
 

@@ -1,7 +1,9 @@
-"""The dashboard's 3D replay of a trainee's calibration (the trainer's own scene, no robot).
+"""The dashboard's 3D replay of a trainee's calibration (the trainer's own scene).
 
 Draws a :class:`~tcp_pendant.classroom.replay.CalibrationReplay` under ``/replay`` in the
-trainer browser's scene: each touch as a small flange triad (numbered; an overwritten one
+trainer browser's scene: the robot posed at one touch (the last counted one first; the trainer
+steps through them, :meth:`ReplayScene.show_touch`) with the reference tip's stand
+(``views.replay_robot``), each touch as a small flange triad (numbered; an overwritten one
 half-size), the approach of the tool at it as a line from the flange to where the tip was
 (blue: by hand, orange: Auto-touch), the reference tip as a dark sphere, and at the last
 counted touch the computed TOOL frame ("result") and the true one ("true"). The camera looks at
@@ -15,6 +17,7 @@ import viser
 from scipy.spatial.transform import Rotation
 
 from tcp_pendant.classroom.replay import CalibrationReplay
+from tcp_pendant.views.replay_robot import ReplayRobot
 
 __all__ = ["ReplayScene", "wxyz"]
 
@@ -39,11 +42,14 @@ class ReplayScene:
         handles: the scene handles drawn (for tests).
     """
 
-    def __init__(self, scene: viser.SceneApi, camera: viser.CameraHandle | None = None) -> None:
+    def __init__(self, scene: viser.SceneApi, camera: viser.CameraHandle | None = None,
+                 robot: ReplayRobot | None = None) -> None:
         self.scene = scene
         self.camera = camera
+        self.robot = robot
         self.shown: CalibrationReplay | None = None
         self.handles: list[viser.SceneNodeHandle] = []
+        self.touch_shown: int | None = None
 
     def clear(self) -> None:
         for h in self.handles:
@@ -53,6 +59,9 @@ class ReplayScene:
                 pass
         self.handles = []
         self.shown = None
+        self.touch_shown = None
+        if self.robot is not None:
+            self.robot.clear()
 
     def show(self, replay: CalibrationReplay) -> None:
         """Draw ``replay`` (the previous one removed) and look at its reference tip."""
@@ -87,7 +96,18 @@ class ReplayScene:
                                  axes_radius=length / 30.0))
                 add(sc.add_label(f"{ROOT}/{name}_label", name, position=tuple(T[:3, 3] + T[:3, 0] * length)))
         self.shown = replay
+        if counted:
+            self.show_touch(replay.touches.index(counted[-1]))
         self._look(replay)
+
+    def show_touch(self, index: int) -> bool:
+        """The robot at touch ``index`` (0-based in ``shown.touches``), the stand at the reference
+        tip. False: no replay, no such touch, or its joint angles were not kept (robot hidden)."""
+        replay = self.shown
+        if replay is None or self.robot is None or not 0 <= index < len(replay.touches):
+            return False
+        self.touch_shown = index
+        return self.robot.show(replay.touches[index].joints_deg, replay.reference_world_m)
 
     def _look(self, replay: CalibrationReplay) -> None:
         if self.camera is None:

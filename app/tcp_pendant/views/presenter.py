@@ -7,7 +7,8 @@ GUI's, so every browser follows it; ``tcp-pendant --presenter`` starts with it o
 * the TCP readout in large monospace numbers (``READOUT_FONT_PX``, 28 px): X Y Z mm, A B C deg
   in WORLD, and the distance to the reference tip (unless "Hide distance" is on);
 * the running wizard's steps in a few wrapped lines, the current one marked;
-* the per-touch error chart of a 4-point result, ``CHART_HEIGHT_PX`` high.
+* the per-touch error chart of a 4-point result, ``CHART_HEIGHT_PX`` high;
+* the "Math board" checkbox: "The math" over the whole screen (``views.math_board_view``).
 
 The folder is pinned at the top of the panel while the rest scrolls under it (the page script,
 ``serve/static/pendant.js``, makes it ``position: sticky``: viser 1.1 has no sticky GUI element), so
@@ -34,6 +35,7 @@ from tcp_pendant.controller.readout import PoseReadout
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.text_escape import escape_html, escape_markdown
 from tcp_pendant.views.gui_util import CHART_LEGEND, CheckboxEvent, target_of
+from tcp_pendant.views.math_board_view import MathBoardView
 
 if TYPE_CHECKING:
     import viser
@@ -158,6 +160,7 @@ class PresenterView:
 
     Attributes:
         toggle, folder, readout_md, tool_md, steps_md, chart: the widgets (for tests).
+        board: the "Math board" (``views.math_board_view``).
         panel_width_px: the panel width last set, pixels.
     """
 
@@ -177,6 +180,7 @@ class PresenterView:
                                        scales={"x": {"time": False}, "y": {"range": (0.0, 1.0)}},
                                        axes=({"label": "touch"}, {"label": "mm"}), legend=CHART_LEGEND,
                                        padding=(14, 12, 0, 0))   # the top tick's label not cut off
+            self.board = MathBoardView(session)         # "The math" over the whole screen
         self._shown: dict[str, str] = {}
         self.panel_width_px = NORMAL_WIDTH_PX
         self._charted: WizardResult | None = None

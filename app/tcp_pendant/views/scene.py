@@ -480,9 +480,7 @@ class SceneView:
     def update_active_tool(self) -> None:
         """Move the TOOL triad to the active tool data (``T_flange_tool``) and relabel it."""
         c = self.session.controller
-        shown = self._shown_active
-        if shown is None or shown[0] is not c.active_tool or shown[1] != c.T_flange_tool.tobytes():
-            self._data_on = c.mounted_tool          # the tool on the flange when the data became active
+        self._data_on = c.active_data_mounted_on    # the controller's: a view built later knows it too
         self._shown_active = (c.active_tool, c.T_flange_tool.tobytes(), c.mounted_tool)
         wxyz, xyz = wxyz_xyz(c.T_flange_tool)
         self._active_axes.wxyz = wxyz

@@ -32,8 +32,11 @@
  *    window of this page (kept in memory only, for reconnects). Only a page opened as /?trainer
  *    (with or without a token: then the trainer types it) shows the "Trainer token" row, "Open
  *    trainer view" and the welcome window's "Trainer: open ..." line; a trainee's page hides them.
- * 4. Presenter mode: the folder holding the readout (class "presenter-readout", which only
- *    views/presenter.py writes) is pinned at the top of the panel while the panel scrolls
+ * 4. Pinned folders: the trainer's message to a trainee (the folder holding class
+ *    "trainer-message", views/class_notices.py: in view on whatever tab, however far the trainee
+ *    scrolled) and, in presenter mode, the folder holding the readout (class "presenter-readout",
+ *    which only views/presenter.py writes), the message's first, are pinned at the top of the
+ *    panel while the panel scrolls
  *    (position: sticky; viser 1.1 has no sticky GUI element). Its ancestors up to the panel's
  *    scroll area that clip with overflow: hidden are set to overflow: clip, which clips the same
  *    but is no scroll container (a sticky element sticks to its nearest scroll container), with
@@ -57,6 +60,24 @@
  *    release click the server waits for (a touch the browser cancels, a long press it turns
  *    into a context menu, or a lost pointer capture sends none of its own) and keeps the
  *    browser from panning or selecting while a jog key is held.
+ * 8. The connection after a server restart. viser's client asks its websocket worker for a new
+ *    attempt every second while it is disconnected, and the worker closes the attempt still
+ *    opening when the next one comes: a server that needs more than a second to answer the
+ *    handshake (just restarted, restoring every trainee's calibration, answering the other pages
+ *    rejoining) never gets one finished, each socket closes before it opened (code 1006), for
+ *    minutes; and viser asks for no attempt at all while the window has no focus (a projector's
+ *    page, a trainee in another window). The script wraps the page's Worker constructor and, for
+ *    viser's websocket worker only (the one told "set_server"), drops viser's own retries and
+ *    sends one of its own after each failed attempt: never while one is opening (the worker
+ *    gives an attempt 5 s), 0.5 s after the first failure, then every second, focus or not.
+ *    Once down for LOST_MS it shows, in words, that the server cannot be reached, with a
+ *    "Reload the page" button (it keeps trying meanwhile; the notice goes at the next
+ *    connection). <html> gets data-tcp-pendant-connection="connected" / "reconnecting" / "lost"
+ *    and data-tcp-pendant-connections (how many times the page connected).
+ * 9. The math board (presenter mode's "Math board", views/math_board_view.py): while the page
+ *    holds the server's <div class="math-board"> (our own escaped markup), a copy of its nodes
+ *    (cloneNode: no HTML parsed here) covers the whole page, with a "Back to the pendant" button
+ *    that unticks "Math board" (as a click on it would); the original is hidden in the panel.
  */
 (function () {
   "use strict";
@@ -126,6 +147,101 @@
     Object.getOwnPropertyDescriptor(proto, "value").set.call(input, value);
     input.dispatchEvent(new Event("input", { bubbles: true }));
   }
+
+  // ------------------------------------------------------------------ 6. the connection
+  var RETRY_MS = [500, 1000];               // the wait after the 1st, then every failed attempt
+  var LOST_MS = 15000;                      // down this long: say so, offer a reload
+  var conn = { worker: null, post: null, opening: false, up: false, failures: 0, downSince: 0,
+               timer: null, lostTimer: null, connections: 0 };
+  function connState(state) {
+    var root = document.documentElement;
+    root.setAttribute("data-tcp-pendant-connection", state);
+    root.setAttribute("data-tcp-pendant-connections", String(conn.connections));
+  }
+  function attempt() {                      // one attempt, only when none is opening
+    conn.timer = null;
+    if (!conn.worker || conn.up || conn.opening) return;
+    conn.opening = true;
+    conn.post.call(conn.worker, { type: "retry" });
+  }
+  function lostNotice(show) {
+    var box = document.getElementById("tcp-pendant-lost");
+    if (!show) { if (box) box.remove(); return; }
+    if (box || !document.body) return;
+    box = document.createElement("div");
+    box.id = "tcp-pendant-lost";
+    box.setAttribute("role", "alert");
+    box.style.cssText = "position:fixed;top:12px;left:50%;transform:translateX(-50%);z-index:10000;" +
+      "max-width:min(560px,92vw);padding:14px 18px;border-radius:8px;background:#fff4e5;color:#5f3700;" +
+      "border:2px solid #e8590c;box-shadow:0 4px 16px rgba(0,0,0,.3);font:16px/1.4 sans-serif";
+    var p = document.createElement("p");
+    p.style.margin = "0 0 10px 0";
+    p.textContent = "This page cannot reach the pendant server (it is still trying). " +
+      "Your name and your recorded touches are kept on the server: reload the page to join again.";
+    var b = document.createElement("button");
+    b.type = "button";
+    b.textContent = "Reload the page";
+    b.style.cssText = "font:600 16px sans-serif;padding:6px 14px;border-radius:6px;border:0;" +
+      "background:#e8590c;color:#fff;cursor:pointer";
+    b.addEventListener("click", function () { window.location.reload(); });
+    box.appendChild(p);
+    box.appendChild(b);
+    document.body.appendChild(box);
+  }
+  function onConnected() {
+    conn.up = true; conn.opening = false; conn.failures = 0; conn.downSince = 0;
+    conn.connections += 1;
+    if (conn.timer !== null) { window.clearTimeout(conn.timer); conn.timer = null; }
+    if (conn.lostTimer !== null) { window.clearTimeout(conn.lostTimer); conn.lostTimer = null; }
+    lostNotice(false);
+    connState("connected");
+  }
+  function onClosed() {
+    conn.up = false; conn.opening = false;
+    if (!conn.downSince) {
+      conn.downSince = Date.now();
+      conn.lostTimer = window.setTimeout(function () {
+        conn.lostTimer = null;
+        if (!conn.up && conn.worker) { lostNotice(true); connState("lost"); }
+      }, LOST_MS);
+    }
+    if (document.getElementById("tcp-pendant-lost") === null) connState("reconnecting");
+    var wait = RETRY_MS[Math.min(conn.failures, RETRY_MS.length - 1)];
+    conn.failures += 1;
+    if (conn.timer === null) conn.timer = window.setTimeout(attempt, wait);
+  }
+  function watchWorker(w) {
+    var post = w.postMessage;
+    w.postMessage = function (data) {
+      var type = data && typeof data === "object" ? data.type : null;
+      if (type === "set_server") {          // viser's websocket worker: its first attempt
+        conn.worker = w; conn.post = post; conn.opening = true; conn.up = false;
+      } else if (conn.worker === w && type === "retry") {
+        return undefined;                   // ours instead (attempt)
+      } else if (conn.worker === w && type === "close") {
+        conn.worker = null;
+        if (conn.timer !== null) { window.clearTimeout(conn.timer); conn.timer = null; }
+      }
+      return post.apply(w, arguments);
+    };
+    w.addEventListener("message", function (e) {
+      var d = e.data;
+      if (conn.worker !== w || !d || typeof d !== "object") return;
+      if (d.type === "connected") onConnected();
+      else if (d.type === "closed") onClosed();
+    });
+  }
+  (function wrapWorker() {
+    var Native = window.Worker;
+    if (typeof Native !== "function") return;
+    function PendantWorker(url, options) {
+      var w = arguments.length > 1 ? new Native(url, options) : new Native(url);
+      try { watchWorker(w); } catch (err) { /* the page works as viser's alone */ }
+      return w;
+    }
+    PendantWorker.prototype = Native.prototype;
+    window.Worker = PendantWorker;
+  })();
 
   // ------------------------------------------------------------------ 1. keys
   function jogRows() {
@@ -414,28 +530,82 @@
     buttonsNamed(L.back).forEach(function (b) { setTitle(b, "Key B"); });
   }
 
-  var PIN_CLASS = "presenter-readout";
-  function pinPresenter() {
-    var marker = document.querySelector("." + PIN_CLASS);
-    var folder = marker && marker.closest(".mantine-Paper-root");
-    if (!folder || folder.getAttribute("data-tcp-pendant-pinned") === "1") return;
+  // the trainer's message (class "trainer-message", views/class_notices.py) above the presenter's
+  // readout (class "presenter-readout", views/presenter.py): each one's folder pinned, one under the other
+  var PIN_CLASSES = ["trainer-message", "presenter-readout"];
+  function pinFolder(folder, top) {
     var viewport = folder.closest(".mantine-ScrollArea-viewport");
-    if (!viewport) return;
-    for (var e = folder.parentElement; e && e !== viewport; e = e.parentElement) {
-      var ov = getComputedStyle(e).overflowY;
-      if (ov === "hidden" || ov === "auto" || ov === "scroll") {
-        e.style.overflow = "clip";
-        e.style.minWidth = "0";             // as a scroll container's: a flex item no wider than its box
+    if (!viewport) return false;
+    if (folder.getAttribute("data-tcp-pendant-pinned") !== "1") {
+      for (var e = folder.parentElement; e && e !== viewport; e = e.parentElement) {
+        var ov = getComputedStyle(e).overflowY;
+        if (ov === "hidden" || ov === "auto" || ov === "scroll") {
+          e.style.overflow = "clip";
+          e.style.minWidth = "0";           // as a scroll container's: a flex item no wider than its box
+        }
       }
+      viewport.style.overflowX = "hidden";   // what the clipping ancestors cut off stays cut off
+      folder.style.position = "sticky";
+      folder.style.zIndex = "5";
+      folder.style.background = "var(--mantine-color-body, #fff)";
+      // an opaque band over the 10 px above it, and a shadow below: the panel goes on under it
+      folder.style.boxShadow = "0 -12px 0 0 var(--mantine-color-body, #fff), 0 4px 6px -4px rgba(0, 0, 0, 0.35)";
+      folder.setAttribute("data-tcp-pendant-pinned", "1");
     }
-    viewport.style.overflowX = "hidden";     // what the clipping ancestors cut off stays cut off
-    folder.style.position = "sticky";
-    folder.style.top = "10px";              // the folder's title sits on its top border
-    folder.style.zIndex = "5";
-    folder.style.background = "var(--mantine-color-body, #fff)";
-    // an opaque band over the 10 px above it, and a shadow below: the panel goes on under it
-    folder.style.boxShadow = "0 -12px 0 0 var(--mantine-color-body, #fff), 0 4px 6px -4px rgba(0, 0, 0, 0.35)";
-    folder.setAttribute("data-tcp-pendant-pinned", "1");
+    var px = top + "px";
+    if (folder.style.top !== px) folder.style.top = px;   // the folder's title sits on its top border
+    return true;
+  }
+  function pinPresenter() {
+    var top = 10;
+    PIN_CLASSES.forEach(function (cls) {
+      var marker = document.querySelector("." + cls);
+      var folder = marker && marker.closest(".mantine-Paper-root");
+      if (folder && laidOut(folder) && pinFolder(folder, top)) top += folder.getBoundingClientRect().height + 12;
+    });
+  }
+
+  // ------------------------------------------------------------------ 7. the math board
+  var BOARD_CLASS = "math-board";
+  var BOARD_ID = "tcp-pendant-board";
+  var BOARD_TOGGLE = "Math board";
+  function boardSource() {
+    var all = document.querySelectorAll("." + BOARD_CLASS);
+    for (var i = 0; i < all.length; i++) if (!all[i].closest("#" + BOARD_ID)) return all[i];
+    return null;
+  }
+  function leaveBoard() {
+    var row = labelled(BOARD_TOGGLE);
+    var box = row ? row.querySelector("input[type=checkbox]") : null;
+    if (box && box.checked) box.click();     // the server unticks it: the board goes for every screen
+  }
+  function board() {
+    var source = boardSource();
+    var overlay = document.getElementById(BOARD_ID);
+    if (!source) { if (overlay) overlay.remove(); return; }
+    if (source.style.display !== "none") source.style.display = "none";   // shown once, full screen
+    if (!overlay) {
+      overlay = document.createElement("div");
+      overlay.id = BOARD_ID;
+      overlay.style.cssText = "position:fixed;inset:0;z-index:9000;background:#fff;color:#111;" +
+        "padding:10px 16px;box-sizing:border-box;overflow:hidden";
+      var back = document.createElement("button");
+      back.type = "button";
+      back.textContent = "Back to the pendant";
+      back.style.cssText = "position:absolute;top:8px;right:12px;z-index:1;font:600 15px sans-serif;" +
+        "padding:4px 12px;border-radius:6px;border:1px solid #888;background:#f4f4f4;cursor:pointer";
+      back.addEventListener("click", leaveBoard);
+      overlay.appendChild(back);
+      overlay.appendChild(document.createElement("div"));
+      document.body.appendChild(overlay);
+    }
+    var holder = overlay.lastChild;
+    var copy = source.cloneNode(true);       // our own markup, copied as nodes (no HTML parsed)
+    copy.style.display = "";
+    if (!holder.firstChild || !holder.firstChild.isEqualNode(copy)) {
+      while (holder.firstChild) holder.removeChild(holder.firstChild);
+      holder.appendChild(copy);
+    }
   }
 
   // ------------------------------------------------------------------ 5. software WebGL
@@ -524,6 +694,7 @@
       keyTitles();
       markScreens();
       pinPresenter();
+      board();
       shadowsOff();
       scan();
     }, 150);
