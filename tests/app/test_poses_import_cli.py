@@ -178,6 +178,33 @@ def test_yaskawa_pulse_positions_become_flange_poses_with_pulses_per_degree(
     assert "has 6 axes but --pulses-per-degree gives 2 numbers" in capsys.readouterr().err
 
 
+def test_a_controller_parameter_file_as_pulses_per_degree_is_refused_with_what_to_write(
+        capsys: pytest.CaptureFixture[str]) -> None:
+    """The GP25's ALL.PRM (README of the real files): integer blocks under ``///`` headers that
+    name no axis nor unit; the pulses per degree are not guessed from it."""
+    job, prm = REAL / "yaskawa_R1_PRESS_excerpt.JBI", REAL / "yaskawa_ALL_excerpt.PRM"
+    with pytest.raises(SystemExit) as exit_:
+        main(["poses", "import", str(job), "--robot", "gp12", "--pulses-per-degree", str(prm)])
+    assert exit_.value.code == 2
+    err = capsys.readouterr().err
+    assert (f"{prm}: a Yaskawa parameter file (/ALL YAS); tcp-pendant does not read pulses per "
+            "degree from it. Write the robot's pulses per degree, one number per axis S L U R B "
+            "T, in a plain text file (docs/pendant-cli.md) or give them as S,L,U,R,B,T") in err
+    assert "20,100,1" not in err  # the file's numbers are not echoed
+
+
+def test_an_unreadable_pulses_per_degree_file_is_named_not_echoed(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    factors = tmp_path / "robot.ppd"
+    factors.write_text("S 1000\nL 1200\n")
+    with pytest.raises(SystemExit):
+        main(["poses", "import", str(REAL / "yaskawa_R1_PRESS_excerpt.JBI"), "--robot", "gp12",
+              "--pulses-per-degree", str(factors)])
+    err = capsys.readouterr().err
+    assert f"{factors}: give one number per axis, e.g. 1300.5,1300.5,1100,800,800,500" in err
+    assert "S,1000" not in err
+
+
 def test_pulses_per_degree_for_a_format_without_encoder_counts_is_one_error_line(
         capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["poses", "import", str(REAL / "abb_Rob1_MainModule_excerpt.mod"), "--robot",

@@ -180,9 +180,10 @@ def test_fanuc_commented_utool_from_a_register_set_element_by_element(tmp_path: 
 
 
 # ------------------------------------------------------------------ rules without a real file yet
-# No public FANUC program with a commented PR register in UTOOL[n:c]=PR[m:c], nor a
-# PolyScope-exported UR script with pose_trans offsets, was found to store here (README): these
-# check the reading rules on the lines the issue quotes, not a controller's layout.
+# No public FANUC program with a commented PR register in UTOOL[n:c]=PR[m:c], nor a UR program
+# with a pose_add offset or a pose inside a string, was found to store here (README): these
+# check those reading rules on the lines the issue quotes, not a controller's layout. The
+# PolyScope programs (pose_trans offsets, $ labels, strings) are in test_real_ur_scripts.py.
 def test_fanuc_utool_and_pr_comments_read_as_the_bare_forms() -> None:
     pos = ("/POS\nP[1:\"tip\"]{\n   GP1:\n\tUF : 0, UT : 0,\t\tCONFIG : 'N U T, 0, 0, 0',\n"
            "\tX =  1.5  mm,\tY =  -2.0  mm,\tZ =  180.25  mm,\n"

@@ -21,8 +21,9 @@ points with ``--pulses-per-degree``: axis value (deg) = pulses / pulses per degr
 of that axis, one number per robot axis in the job's order (S, L, U, R, B, T[, E]), from the
 controller's parameters (the pulses of one axis revolution divided by 360; a negative number
 turns an axis whose positive direction is the URDF's opposite), or the path of a text file
-holding those numbers (commas, spaces or one per line; ``#`` starts a comment). Without it they
-are refused with this way out.
+holding those numbers (commas, spaces or one per line; ``#`` starts a comment: tcp-pendant's
+own format; a controller's parameter file such as ``ALL.PRM`` is refused with what to write).
+Without it they are refused with this way out.
 
 Units: the file's axis values are degrees for revolute joints and millimetres for prismatic
 ones (as the controllers write them), in the URDF's joint order; the CSV is mm and the format's
@@ -95,23 +96,38 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
+_CONTROLLER_PARAMETERS = re.compile(r"\A\s*/+[A-Z0-9]+ YAS\b")
+"""The first line of a Yaskawa parameter file (``ALL.PRM``: ``/ALL YAS``, ``RC.PRM``: ``//RC
+YAS``): blocks of comma-separated integers under ``///`` headers, which name no axis nor
+unit."""
+
+
 def _pulses_per_degree(text: str) -> tuple[float, ...]:
     """``--pulses-per-degree``: comma-separated non-zero finite numbers, or the path of a text
-    file holding them (separated by commas, spaces or lines; ``#`` starts a comment)."""
+    file holding them (separated by commas, spaces or lines; ``#`` starts a comment). A
+    controller's parameter file (``ALL.PRM``, ``RC.PRM``...) is refused with what to write."""
     path = Path(text).expanduser()
+    source = repr(text)
     if not re.fullmatch(r"[-+0-9.,eE\s]*", text) and path.is_file():
         try:
             body = path.read_text(encoding="utf-8")
         except (OSError, UnicodeDecodeError) as exc:
             raise argparse.ArgumentTypeError(f"{text}: cannot read the file: {exc}") from None
+        if _CONTROLLER_PARAMETERS.match(body):
+            raise argparse.ArgumentTypeError(
+                f"{text}: a Yaskawa parameter file ({body.split(chr(10), 1)[0].strip()}); "
+                "tcp-pendant does not read pulses per degree from it. Write the robot's pulses "
+                "per degree, one number per axis S L U R B T, in a plain text file "
+                "(docs/pendant-cli.md) or give them as S,L,U,R,B,T")
+        source = text
         text = ",".join(re.sub(r"#[^\n]*", "", body).replace(",", " ").split())
     try:
         values = tuple(float(v) for v in text.split(","))
     except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r}: give one number per axis, e.g. "
+        raise argparse.ArgumentTypeError(f"{source}: give one number per axis, e.g. "
                                          "1300.5,1300.5,1100,800,800,500") from None
     if not values or any(not np.isfinite(v) or v == 0 for v in values):
-        raise argparse.ArgumentTypeError(f"{text!r}: every axis needs a non-zero finite number")
+        raise argparse.ArgumentTypeError(f"{source}: every axis needs a non-zero finite number")
     return values
 
 
