@@ -136,7 +136,7 @@ class ViewTrainee:
 
     # ------------------------------------------------------------ the hands
     def press(self, axis: str, sign: int) -> None:
-        res = self.s.jog(axis, sign)
+        res = self.s.motion.jog(axis, sign)
         self.presses += 1
         if res is not None and not res.ok:
             self.stops.append(f"{res.stopped_by}: {res.message}")
@@ -145,12 +145,12 @@ class ViewTrainee:
         now = self.s.jogger.settings.increment
         if now != value:
             self.presses += abs(INCREMENTS.index(value) - INCREMENTS.index(now))   # [ / ] steps
-            self.s.set_jog_setting("increment", value)
+            self.s.motion.set_jog_setting("increment", value)
 
     def frame(self, value: str) -> None:
         if self.s.jogger.settings.frame != value:
             self.presses += 1
-            self.s.set_jog_setting("frame", value)
+            self.s.motion.set_jog_setting("frame", value)
 
     # ------------------------------------------------------------ the skill
     def tilt(self) -> str:
