@@ -44,9 +44,14 @@ from tcp_pendant.pendant.tip_insets import (
     BELOW_MM,
     GAP_PX,
     PX_PER_MM,
+    NEAR_MM,
     TOOL_COLOR,
     VIEW_H_MM,
     VIEW_W_MM,
+    ZOOM_FRAME_COLOR,
+    ZOOM_OUT,
+    arrow_direction,
+    inset_zoom,
     tip_insets_image,
 )
 from tcp_pendant.serve.server import default_reference_tip_mm, ready_configuration
@@ -59,7 +64,11 @@ TILT_PRESSES, TILT_STEP = 5, "10"
 """The tilt by 10° presses: 50° (the steps ask 45 to 60)."""
 _W = int(round(VIEW_W_MM * PX_PER_MM))
 _VIEWS = {"front": (0, np.array([1.0, 0.0, 0.0])), "side": (_W + GAP_PX, np.array([0.0, 1.0, 0.0]))}
-_ZOOMS = (1, 2, 5, 10, 20, 50, 100, 200, 500, 1000)
+EYE_3D_MM = 10.0
+"""Beyond the tip views (hidden farther than ``NEAR_MM``, or a view showing only its arrow) the
+trainee judges the tip's offset in the 3D view, each WORLD axis to the nearest 10 mm (the
+spike is 45 mm long, the pointer's cone 12 mm): a model of an eye, the one thing here not read
+off what the pendant draws."""
 
 
 @dataclass
@@ -97,8 +106,9 @@ class ViewTrainee:
         self.stops: list[str] = []
 
     # ------------------------------------------------------------ the eye
-    def _tip_in_view(self, img: np.ndarray, view: str, T: np.ndarray) -> tuple[float, float] | None:
-        """(across, up) mm of the tool tip read off one view's pixels, or None: not in it."""
+    def _tip_in_view(self, img: np.ndarray, view: str, T: np.ndarray, zoom: int) -> tuple[float, float] | None:
+        """(across, up) mm of the tool tip read off one view's pixels at the view's ``zoom``,
+        or None: the view does not show it (cut by the window's edge)."""
         x0, right = _VIEWS[view]
         part = img[:, x0:x0 + _W]
         rows, cols = np.nonzero(np.all(part == TOOL_COLOR, axis=2))
@@ -111,32 +121,43 @@ class ViewTrainee:
         c, r = int(cols[i]), int(rows[i])
         if c in (0, _W - 1) or r in (0, part.shape[0] - 1):
             return None                                                 # cut by the window's edge
-        return (c + 0.5) / PX_PER_MM - VIEW_W_MM / 2, (VIEW_H_MM - BELOW_MM) - (r + 0.5) / PX_PER_MM
+        return (((c + 0.5) / PX_PER_MM - VIEW_W_MM / 2) * zoom,
+                ((VIEW_H_MM - BELOW_MM) - (r + 0.5) / PX_PER_MM) * zoom)
 
-    @staticmethod
-    def _zoomed(value_mm: float, half_mm: float) -> float:
-        """A coordinate as a view zoomed out to hold it shows it: quantised to that zoom's pixel."""
-        zoom = next((z for z in _ZOOMS if abs(value_mm) <= half_mm * z), _ZOOMS[-1])
-        q = zoom / PX_PER_MM
-        return round(value_mm / q) * q
-
-    def look(self) -> np.ndarray:
-        """The tool tip relative to the reference tip as the two views show it (WORLD, mm)."""
+    def look(self) -> tuple[np.ndarray, float]:
+        """The tool tip relative to the reference tip as the trainee sees it (WORLD, mm) and the
+        coarsest resolution of that reading (mm): the tip views' pixels where a view shows the
+        tip (their real zoom, ``inset_zoom``: 1/24 mm a pixel, 5/24 zoomed out), else the 3D
+        view (:data:`EYE_3D_MM`)."""
         c = self.s.controller
         T = c.T_world_tool_true()
         ref = c.reference_tip_world_m
+        apex = (T[:3, 3] - ref) * 1000.0                     # the geometry the views draw
+        eye3d = np.round(apex / EYE_3D_MM) * EYE_3D_MM       # the 3D view, by eye
+        shown = bool(np.linalg.norm(apex) <= NEAR_MM)        # the views are hidden beyond 40 mm
+        if not shown:
+            return eye3d, EYE_3D_MM
         img = tip_insets_image(ref, T)
-        apex = (T[:3, 3] - ref) * 1000.0                    # the geometry the views draw
-        front, side = self._tip_in_view(img, "front", T), self._tip_in_view(img, "side", T)
-        x = front[0] if front else self._zoomed(apex[0], VIEW_W_MM / 2)
-        y = side[0] if side else self._zoomed(apex[1], VIEW_W_MM / 2)
+        zoom = ZOOM_OUT if self._framed(img) else 1
+        assert zoom == inset_zoom(apex), "the orange frame is the views' zoom"
+        seen = {v: None if arrow_direction(v, apex) is not None else self._tip_in_view(img, v, T, zoom)
+                for v in _VIEWS}
+        front, side = seen["front"], seen["side"]
+        x = front[0] if front else eye3d[0]
+        y = side[0] if side else eye3d[1]
         zs = [v[1] for v in (front, side) if v]
-        z = float(np.mean(zs)) if zs else self._zoomed(apex[2], VIEW_H_MM / 2)
-        return np.array([x, y, z])
+        z = float(np.mean(zs)) if zs else eye3d[2]
+        res = zoom / PX_PER_MM if front and side else EYE_3D_MM
+        return np.array([x, y, z]), res
+
+    @staticmethod
+    def _framed(img: np.ndarray) -> bool:
+        """The views' orange frame (a zoomed-out view): most of the front view's top row."""
+        return bool(np.mean(np.all(img[1, :_W] == ZOOM_FRAME_COLOR, axis=1)) > 0.5)
 
     # ------------------------------------------------------------ the hands
     def press(self, axis: str, sign: int) -> None:
-        res = self.s.jog(axis, sign)
+        res = self.s.motion.jog(axis, sign)
         self.presses += 1
         if res is not None and not res.ok:
             self.stops.append(f"{res.stopped_by}: {res.message}")
@@ -145,12 +166,12 @@ class ViewTrainee:
         now = self.s.jogger.settings.increment
         if now != value:
             self.presses += abs(INCREMENTS.index(value) - INCREMENTS.index(now))   # [ / ] steps
-            self.s.set_jog_setting("increment", value)
+            self.s.motion.set_jog_setting("increment", value)
 
     def frame(self, value: str) -> None:
         if self.s.jogger.settings.frame != value:
             self.presses += 1
-            self.s.set_jog_setting("frame", value)
+            self.s.motion.set_jog_setting("frame", value)
 
     # ------------------------------------------------------------ the skill
     def tilt(self) -> str:
@@ -171,18 +192,26 @@ class ViewTrainee:
         return re.sub(r"\*\*", "", advice.text)
 
     def bring_tips_together(self, max_presses: int = 200) -> None:
-        start = self.presses
-        apex = self.look()
-        first = next((k for k, level in enumerate(LEVELS) if np.max(np.abs(apex)) >= 0.5 * float(level)),
-                     len(LEVELS) - 1)
-        for level in LEVELS[first:]:
-            step = float(level)
-            for _ in range(2 if level == "0.1" else 1):
-                moved = self._level(level, step)
-                if self.presses - start > max_presses:
-                    return
-                if level == "0.1" and (not moved or np.all(np.abs(self.look()) <= 0.2)):
-                    break
+        """Steer the tip onto the reference tip by what the eye sees (module docstring): the
+        increment follows the reading's resolution (the 3D view: 100 mm beyond 75 mm, else 10;
+        the zoomed-out views: 1 mm; the close views: 0.1 mm), one pass per look, until the
+        close views show the tips within 0.2 mm on every axis."""
+        start, finer = self.presses, 0
+        while self.presses - start <= max_presses:
+            apex, res = self.look()
+            if res >= EYE_3D_MM:
+                by_eye = 0 if np.max(np.abs(apex)) >= 75.0 else 1
+            else:
+                by_eye = 2 if res > 1.0 / PX_PER_MM else 3
+            level = LEVELS[min(3, max(by_eye, finer))]
+            if level == "0.1" and np.all(np.abs(apex) <= 0.2):
+                return
+            if self._level(level, float(level)):
+                finer = by_eye
+            elif level == "0.1":
+                return
+            else:
+                finer = LEVELS.index(level) + 1      # nothing to press at this size: finer
 
     def _level(self, level: str, step: float) -> bool:
         """One pass at one increment: up first when the tip is below its margin above the
@@ -191,7 +220,7 @@ class ViewTrainee:
         moved = False
         margin = 0.0 if level == "0.1" else 0.5 * step
         for k, axis in enumerate(("Z", "X", "Y", "Z")):
-            apex = self.look()
+            apex, _ = self.look()
             i = "XYZ".index(axis)
             n = round(-apex[i] / step) if axis != "Z" else round((margin - apex[2]) / step)
             if k == 0 and n <= 0:
