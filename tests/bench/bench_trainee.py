@@ -255,14 +255,15 @@ GOAL_DISTANCE_MM = 0.5
 
 def views_table() -> bool:
     """Run the view trainee on every robot, print its table and the targets; True: all met."""
-    from bench.view_trainee import run_robot
+    from bench.view_trainee import KINDS, run_robot
 
     print("Scripted trainee by the two tip views, distance hidden, XYZ 4-point, pointer, "
           "following the pendant's tilt hints\n")
     print(f"{'robot':<6} {'touch':>5} {'presses':>7} {'true mm':>8} {'reachable':>9}  suggestion")
     presses, distances, suggested, reachable = [], [], 0, 0
-    for robot in ROBOTS:
-        for k, t in enumerate(run_robot(robot)):
+    runs = {robot: run_robot(robot) for robot in ROBOTS}
+    for robot, touches in runs.items():
+        for k, t in enumerate(touches):
             presses.append(t.presses)
             distances.append(t.distance_mm)
             mark = "-" if t.reachable is None else ("yes" if t.reachable else "NO")
@@ -271,6 +272,11 @@ def views_table() -> bool:
                 reachable += int(t.reachable)
             words = t.suggestion.split(" → ")[0] if t.suggestion else "(first touch: any orientation)"
             print(f"{robot:<6} {k + 1:>5} {t.presses:>7} {t.distance_mm:>8.3f} {mark:>9}  {words}")
+    print("\nWhere the presses go (X/Y/Z presses by increment, mm):")
+    print(f"{'robot':<6} {'touch':>5} " + " ".join(f"{kind:>5}" for kind in KINDS))
+    for robot, touches in runs.items():
+        for k, t in enumerate(touches):
+            print(f"{robot:<6} {k + 1:>5} " + " ".join(f"{t.kinds.get(kind, 0):>5}" for kind in KINDS))
     ok_presses = max(presses) <= GOAL_PRESSES_PER_TOUCH
     ok_distance = max(distances) <= GOAL_DISTANCE_MM
     ok_reach = suggested > 0 and reachable == suggested

@@ -60,6 +60,9 @@ from tcp_pendant.session import Session
 from tcpcal.library import ToolLibrary
 
 LEVELS = ("100", "10", "1", "0.1")
+KINDS = ("tilt", "frame", "[ ]", "100", "10", "1", "0.1", "R/N")
+"""The kinds of press counted: the tilt's 10° presses, a jog-frame change, an increment step,
+the X/Y/Z presses at each increment (mm), Record and Next."""
 TILT_PRESSES, TILT_STEP = 5, "10"
 """The tilt by 10° presses: 50° (the steps ask 45 to 60)."""
 _W = int(round(VIEW_W_MM * PX_PER_MM))
@@ -80,6 +83,8 @@ class Touch:
     suggestion: str = ""
     reachable: bool | None = None
     stops: list[str] = field(default_factory=list)
+    kinds: dict[str, int] = field(default_factory=dict)
+    """Where the presses went (:data:`KINDS`)."""
 
 
 def session_for(robot: str, library: Path) -> Session:
@@ -104,6 +109,12 @@ class ViewTrainee:
         self.advisor = TiltAdvisor()
         self.presses = 0
         self.stops: list[str] = []
+        self.kinds: dict[str, int] = {}
+
+    def count(self, kind: str, n: int = 1) -> None:
+        """``n`` presses of one kind (:data:`KINDS`)."""
+        self.presses += n
+        self.kinds[kind] = self.kinds.get(kind, 0) + n
 
     # ------------------------------------------------------------ the eye
     def _tip_in_view(self, img: np.ndarray, view: str, T: np.ndarray, zoom: int) -> tuple[float, float] | None:
@@ -158,19 +169,19 @@ class ViewTrainee:
     # ------------------------------------------------------------ the hands
     def press(self, axis: str, sign: int) -> None:
         res = self.s.motion.jog(axis, sign)
-        self.presses += 1
+        self.count("tilt" if axis in "ABC" else self.s.jogger.settings.increment)
         if res is not None and not res.ok:
             self.stops.append(f"{res.stopped_by}: {res.message}")
 
     def increment(self, value: str) -> None:
         now = self.s.jogger.settings.increment
         if now != value:
-            self.presses += abs(INCREMENTS.index(value) - INCREMENTS.index(now))   # [ / ] steps
+            self.count("[ ]", abs(INCREMENTS.index(value) - INCREMENTS.index(now)))   # [ / ] steps
             self.s.motion.set_jog_setting("increment", value)
 
     def frame(self, value: str) -> None:
         if self.s.jogger.settings.frame != value:
-            self.presses += 1
+            self.count("frame")
             self.s.motion.set_jog_setting("frame", value)
 
     # ------------------------------------------------------------ the skill
@@ -199,10 +210,9 @@ class ViewTrainee:
         start, finer = self.presses, 0
         while self.presses - start <= max_presses:
             apex, res = self.look()
-            if res >= EYE_3D_MM:
-                by_eye = 0 if np.max(np.abs(apex)) >= 75.0 else 1
-            else:
-                by_eye = 2 if res > 1.0 / PX_PER_MM else 3
+            finest = 1 if res >= EYE_3D_MM else 2 if res > 1.0 / PX_PER_MM else 3   # what the eye can judge
+            far = float(np.max(np.abs(apex)))
+            by_eye = min(finest, next((k for k, v in enumerate(LEVELS) if far >= 0.75 * float(v)), 3))
             level = LEVELS[min(3, max(by_eye, finer))]
             if level == "0.1" and np.all(np.abs(apex) <= 0.2):
                 return
@@ -242,7 +252,7 @@ def run_robot(robot: str) -> list[Touch]:
         t = ViewTrainee(s)
         touches = []
         for k in range(4):
-            t.presses, t.stops = 0, []
+            t.presses, t.stops, t.kinds = 0, [], {}
             touch = Touch()
             if k:
                 touch.suggestion = t.tilt()
@@ -253,9 +263,9 @@ def run_robot(robot: str) -> list[Touch]:
                 robot_stops = [m for m in tilt_stops + t.stops if not m.startswith("collision")]
                 touch.reachable = not robot_stops
             s.wizard_commands.record_step()
-            t.presses += 1                                                  # R
+            t.count("R/N")                                                  # R
             s.wizard_commands.next_step()
-            t.presses += 1                                                  # Next / Finish
-            touch.presses, touch.stops = t.presses, list(t.stops)
+            t.count("R/N")                                                  # Next / Finish
+            touch.presses, touch.stops, touch.kinds = t.presses, list(t.stops), dict(t.kinds)
             touches.append(touch)
         return touches
