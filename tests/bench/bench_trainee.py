@@ -1,14 +1,15 @@
 """The scripted trainees: presses per touch of one XYZ 4-point calibration.
 
 **By the tip views** (the default run; issue 44): ``view_trainee.ViewTrainee`` steers with the
-distance hidden by the two tip views alone (their pixels, or the same views zoomed out when the
-tip is outside their window; never the distance), follows the pendant's own tilt hint for
-touches 2-4, on the KR 6, the GP12 and a ROS-Industrial KR 16 (the chain of
-``ros-industrial/kuka_experimental`` ``kuka_kr16_support/urdf/kr16_2_macro.xacro``,
-tests/support/ros_layouts.py). It prints, per robot and touch, the presses, the true distance
-(measured, not steered by) and the tilt suggested and whether the robot made it, then the
-targets as MET / NOT MET: at most 30 presses per touch, every touch within 0.5 mm, every
-suggestion reachable.
+distance hidden by the two tip views alone (the pixels of the views the Jog tab shows, at their
+own zoom, with their arrow; beyond them, the 3D view judged to 10 mm; never the distance),
+follows the pendant's own tilt hint for touches 2-4, on the KR 6, the GP12 and a
+ROS-Industrial KR 16 (the chain of ``ros-industrial/kuka_experimental``
+``kuka_kr16_support/urdf/kr16_2_macro.xacro``, tests/support/ros_layouts.py). It prints, per
+robot and touch, the presses, the true distance (measured, not steered by) and the tilt
+suggested and whether the robot made it, then where the presses went (the tilt, frame changes,
+increment steps, X/Y/Z presses per increment, Record and Next), then the targets as MET /
+NOT MET: at most 30 presses per touch, every touch within 0.5 mm, every suggestion reachable.
 
 **By the Δ line** (``--delta-line``; issue 10's figures): the trainees below, in a real server
 through a websocket client.

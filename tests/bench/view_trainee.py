@@ -2,25 +2,32 @@
 (``bench_trainee.py`` runs it and prints its figures).
 
 **What it sees.** The front and side views the pendant draws (``pendant.tip_insets``: the very
-image the Jog tab shows, rendered by the same function): in each view it finds the tool's
-pixels (``TOOL_COLOR``) and takes the tip as the tool pixel farthest along the tool's pointing
-direction on the screen (the cone's narrow end, as an eye sees it), then reads its place off the
-fixed scale (``PX_PER_MM`` pixels per mm, the reference tip at the grid's origin): front gives X
-and Z, side gives Y and Z (WORLD), to a pixel (1/24 mm). When the tool tip is outside a view's
-7 x 8 mm window it reads the same view's geometry zoomed out to the 1-2-5 scale that holds the tip
-(``view_pixel`` of the tip quantised to that zoom's pixel: what a view that finds the tip, by
-zooming out, shows; the issue asks the views for it). It never reads the distance, the Δ line or
-the touch indicator; the true distance is measured only to print it.
+image the Jog tab shows, rendered by the same function, and only while the Jog tab shows it:
+the tool tip within ``NEAR_MM``, 40 mm). Their zoom it reads off the image (the orange frame of
+the views zoomed out ``ZOOM_OUT`` times); in a view without the arrow (``arrow_direction``: the
+view shows the tip) it finds the tool's pixels (``TOOL_COLOR``) and takes the tip as the tool
+pixel farthest along the tool's pointing direction on the screen (the cone's narrow end, as an
+eye sees it), then reads its place off the scale (``PX_PER_MM`` pixels per mm times the zoom,
+the reference tip at the grid's origin): front gives X and Z, side gives Y and Z (WORLD), to a
+pixel (1/24 mm, 5/24 mm zoomed out). Where no view shows the tip (the views hidden beyond
+40 mm, or a view showing only its arrow) it judges the offset in the 3D view, each WORLD axis to
+the nearest :data:`EYE_3D_MM` (10 mm): the one model of an eye here, not read off the pendant.
+It never reads the distance, the Δ line or the touch indicator; the true distance is measured
+only to print it.
 
 **What it presses** (each a press of the pendant: a jog key, a ``[``/``]`` increment step, a
-frame change, Record (R), Next): per touch after the first, the pendant's own tilt hint
-(``calibrate.tilt_advice``, as the dock shows it: the key, its frame, 45°) by 10° presses (five,
-50°, inside the step's 45-60°); then, from the largest increment down (100, 10, 1, 0.1 mm), X
-and Y by ``round(offset / increment)`` presses and Z down to a margin above the tip (30 % of
-the increment; none at 0.1 mm), re-reading the views after each axis; the last level repeats
-until both views show the tips within 0.2 mm on every axis. A suggestion counts as reachable
-when every press of the tilt ran to its end (no stop at a limit or singularity) and the tip was
-then touched with no stop of the robot.
+frame change, Record (R), Next; :data:`KINDS`): per touch after the first, the pendant's own
+tilt hint (``calibrate.tilt_advice``, as the dock shows it: the key, its frame, 45°) by 10°
+presses (five, 50°, inside the step's 45-60°); then, look by look, the increment that what it
+sees allows and the offset asks for (docs/tutorial.md, "Steering in by eye"): no view shows the
+tip: 100 mm while an axis is 75 mm or more off, else 10; the zoomed-out views: 1 mm; the close
+views: 0.1 mm (never coarser than the offset: 1 mm while an axis is 0.75 mm or more off). At
+that increment, up first when the tip is below its margin above the reference tip, X and Y by
+``round(offset / increment)`` presses and Z down to the margin (half the increment above the
+tip; none at 0.1 mm); an increment that finds nothing to press gives way to the next finer one,
+until the close views show the tips within 0.2 mm on every axis. A suggestion counts as
+reachable when every press of the tilt ran to its end (no stop at a limit or singularity) and
+the tip was then touched with no stop of the robot.
 """
 
 from __future__ import annotations
