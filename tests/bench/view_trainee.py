@@ -96,13 +96,16 @@ class Touch:
 
 def session_for(robot: str, library: Path) -> Session:
     """A pendant session without a browser on ``robot`` ("kr6", "gp12", or "kr16": the
-    ROS-Industrial KR 16 chain of tests/support/ros_layouts.py), pointer mounted, ready pose."""
+    ROS-Industrial KR 16 chain of tests/support/ros_layouts.py), pointer mounted, in the ready
+    pose the server starts it in (for the KR 16, a robot without a known home: hovering over the
+    reference tip, ``ready_configuration`` given the tip)."""
     if robot != "kr16":
         return make_session(library, robot=robot)
     kin = RobotKinematics.from_urdf(kr16_2_urdf(library.parent / "kr16", meshes=False))
-    c = VirtualController(kin, tool=builtin_tools()["pointer"],
-                          reference_tip_world_m=np.asarray(default_reference_tip_mm(kin)) / 1000.0)
-    c.set_q(ready_configuration(kin))
+    pointer = builtin_tools()["pointer"]
+    tip_m = np.asarray(default_reference_tip_mm(kin, pointer.T_flange_tool_true)) / 1000.0
+    c = VirtualController(kin, tool=pointer, reference_tip_world_m=tip_m)
+    c.set_q(ready_configuration(kin, tip_m))        # as the server starts it (PendantApp.ready_q_rad)
     lib = ToolLibrary(library)
     rng = np.random.default_rng(0)
     return Session(c, lib, CalibrationWorkflow(c, lib, robot="kr16", rng=rng), rng=rng)
