@@ -67,8 +67,8 @@ from tcp_pendant.session import Session
 from tcpcal.library import ToolLibrary
 
 LEVELS = ("100", "10", "1", "0.1")
-KINDS = ("tilt", "frame", "[ ]", "100", "10", "1", "0.1", "R/N")
-"""The kinds of press counted: the tilt's 10° presses, a jog-frame change, an increment step,
+KINDS = ("pivot", "tilt", "frame", "[ ]", "100", "10", "1", "0.1", "R/N")
+"""The kinds of press counted: "Tilt about the wizard's estimate", the tilt's 10° presses, a jog-frame change, an increment step,
 the X/Y/Z presses at each increment (mm), Record and Next."""
 TILT_PRESSES, TILT_STEP = 5, "10"
 """The tilt by 10° presses: 50° (the steps ask 45 to 60)."""
@@ -114,8 +114,10 @@ def session_for(robot: str, library: Path) -> Session:
 class ViewTrainee:
     """Steers one session by the tip views (module docstring)."""
 
-    def __init__(self, session: Session) -> None:
+    def __init__(self, session: Session, *, pivot: bool = True) -> None:
         self.s = session
+        self.pivot = pivot
+        """Tilt about the wizard's estimate once it offers one (False: always about the flange)."""
         self.advisor = TiltAdvisor()
         self.presses = 0
         self.stops: list[str] = []
@@ -195,8 +197,16 @@ class ViewTrainee:
             self.s.motion.set_jog_setting("frame", value)
 
     # ------------------------------------------------------------ the skill
+    def pivot_on_estimate(self) -> None:
+        """Press the dock's "Tilt about the wizard's estimate" (docs/tutorial.md) when it is
+        offered: the rotation keys then turn about the TCP the touches so far give."""
+        if self.pivot and self.s.wizard_commands.estimate_offer() is not None:     # the button shows
+            self.count("pivot")
+            self.s.wizard_commands.pivot_on_estimate()
+
     def tilt(self) -> str:
         """Follow the pendant's tilt hint; its words ("" none)."""
+        self.pivot_on_estimate()
         wf = self.s.workflow
         wiz = wf.wizard
         R_wf = self.s.controller.T_world_flange()[:3, :3]
@@ -253,13 +263,14 @@ class ViewTrainee:
         return moved
 
 
-def run_robot(robot: str) -> list[Touch]:
-    """One XYZ 4-point by the views on ``robot``; the figures per touch."""
+def run_robot(robot: str, *, pivot: bool = True) -> list[Touch]:
+    """One XYZ 4-point by the views on ``robot``; the figures per touch (``pivot``: tilts
+    about the wizard's estimate once offered, else about the flange)."""
     with tempfile.TemporaryDirectory() as tmp:
         s = session_for(robot, Path(tmp) / "tools.json")
         s.set_hide_distance(True)
         s.wizard_commands.start("xyz4")
-        t = ViewTrainee(s)
+        t = ViewTrainee(s, pivot=pivot)
         touches = []
         for k in range(4):
             t.presses, t.stops, t.kinds = 0, [], {}
