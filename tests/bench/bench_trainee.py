@@ -278,6 +278,11 @@ def views_table() -> bool:
     for robot, touches in runs.items():
         for k, t in enumerate(touches):
             print(f"{robot:<6} {k + 1:>5} " + " ".join(f"{t.kinds.get(kind, 0):>5}" for kind in KINDS))
+    flange = [[t.presses for t in run_robot(robot, pivot=False)] for robot in ROBOTS]
+    print("\nThe same trainee never pressing \"Tilt about the wizard's estimate\" (every tilt about the "
+          "flange), presses per touch:")
+    for robot, row in zip(ROBOTS, flange):
+        print(f"{robot:<6} " + " ".join(f"{n:>5}" for n in row))
     ok_presses = max(presses) <= GOAL_PRESSES_PER_TOUCH
     ok_distance = max(distances) <= GOAL_DISTANCE_MM
     ok_reach = suggested > 0 and reachable == suggested
