@@ -70,7 +70,9 @@ PIVOT_HINT = ("Make the TCP your touches so far give (the wizard's estimate, nev
               "tool data: the A, B, C keys then turn about it, so a tilt keeps the tip near the "
               "reference tip. Offered from two touches in different orientations; press again after "
               "a touch for a better estimate.")
-"""The dock's button of ``WizardCommands.pivot_on_estimate`` (shown while it has an estimate to offer)."""
+"""The dock's button of ``WizardCommands.pivot_on_estimate``, shown while it has an estimate to
+offer; the meter's bar gives it its row then (the meter's line says the same in words), so the
+jog keys stay above the fold at 1024x768."""
 
 
 class WizardDock:
@@ -230,7 +232,8 @@ class WizardDock:
         wf = self.session.workflow
         shown = wf.wizard
         show = shown is not None and bool(shown.meter_active)
-        self.meter_bar.visible = self.meter_md.visible = self.tilt_html.visible = show
+        self.meter_md.visible = self.tilt_html.visible = show
+        self.meter_bar.visible = show and not self.pivot.visible   # its row goes to the button (PIVOT_LABEL)
         if not show:
             return
         wiz = cast("MeterWizard", shown)              # meter_active: a wizard that declares the meter
