@@ -3,7 +3,9 @@
 **By the tip views** (the default run; issue 44): ``view_trainee.ViewTrainee`` steers with the
 distance hidden by the two tip views alone (the pixels of the views the Jog tab shows, at their
 own zoom, with their arrow; beyond them, the 3D view judged to 10 mm; never the distance),
-follows the pendant's own tilt hint for touches 2-4, on the KR 6, the GP12 and a
+follows the pendant's own tilt hint for touches 2-4 (from touch 3 on tilting about the
+wizard's estimate, the dock's button; the same trainee never pressing it is printed too), on
+the KR 6, the GP12 and a
 ROS-Industrial KR 16 (the chain of ``ros-industrial/kuka_experimental``
 ``kuka_kr16_support/urdf/kr16_2_macro.xacro``, tests/support/ros_layouts.py). It prints, per
 robot and touch, the presses, the true distance (measured, not steered by) and the tilt

@@ -16,8 +16,10 @@ It never reads the distance, the Δ line or the touch indicator; the true distan
 only to print it.
 
 **What it presses** (each a press of the pendant: a jog key, a ``[``/``]`` increment step, a
-frame change, Record (R), Next; :data:`KINDS`): per touch after the first, the pendant's own
-tilt hint (``calibrate.tilt_advice``, as the dock shows it: the key, its frame, 45°) by 10°
+frame change, Record (R), Next, the dock's "Tilt about the wizard's estimate"; :data:`KINDS`):
+per touch after the first, that button whenever the dock shows it (from two touches on:
+``WizardCommands.estimate_offer``; ``pivot=False``: never, every tilt about the flange), the
+pendant's own tilt hint (``calibrate.tilt_advice``, as the dock shows it: the key, its frame, 45°) by 10°
 presses (five, 50°, inside the step's 45-60°); then, look by look, the increment that what it
 sees allows and the offset asks for (docs/tutorial.md, "Steering in by eye"): no view shows the
 tip: 100 mm while an axis is 75 mm or more off, else 10; the zoomed-out views: 1 mm; the close
