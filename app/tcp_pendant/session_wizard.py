@@ -15,10 +15,13 @@ from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from typing import ContextManager, Protocol, TypeVar
 
+import numpy as np
+
 from tcpcal.tool import Tool
 from tcp_pendant.calibrate import ControllerJob
 from tcp_pendant.calibrate.autotouch import AutoTouchOutcome, PoseProbe
 from tcp_pendant.calibrate.pendant_rules import ExerciseRules, RuleRefusal
+from tcp_pendant.calibrate.tcp_estimate import TcpEstimate, tcp_estimate
 from tcp_pendant.calibrate.workflow import AutoTouchRequest, CalibrationWorkflow
 from tcp_pendant.controller import ToolModel
 from tcp_pendant.session_loop import SessionLoop
@@ -248,6 +251,38 @@ class WizardCommands:
         """One more touch step (the wizards that declare ``supports_add_point``)."""
         with self._command():
             self._host.workflow.require_wizard().add_point()
+
+    def estimate_offer(self) -> TcpEstimate | None:
+        """The wizard's TCP estimate from the touches so far (``calibrate.tcp_estimate``) when
+        there is one and it is not the active tool data already: what "Tilt about the wizard's
+        estimate" would activate (None: nothing to offer)."""
+        with self._host.lock:
+            wf = self._host.workflow
+            est = tcp_estimate(wf.wizard) if wf.is_open else None
+            active = wf.controller.active_tool
+            if est is None or (active is not None and active.name == est.tool().name
+                               and np.allclose(active.tcp_mm, est.tcp_mm, atol=1e-6)
+                               and not np.any(active.abc_deg)):
+                return None
+            return est
+
+    def pivot_on_estimate(self) -> TcpEstimate:
+        """Make the wizard's TCP estimate from the touches so far the active tool data, so the
+        rotation keys turn about it (a tilt then swings the tip only by the estimate's error);
+        the readout names it as the estimate.
+
+        Raises:
+            WizardStateError: no XYZ 4-point open, or fewer than two touches in different
+                orientations (says what to do).
+        """
+        with self._command(moves=True):
+            wf = self._host.workflow
+            est = tcp_estimate(wf.wizard) if wf.is_open else None
+            if est is None:
+                raise WizardStateError("The wizard estimates the TCP from two touches in different "
+                                       "orientations of an XYZ 4-point: record them first.")
+            self._host.tools.set_active_data(est.tool())
+            return est
 
     def set_variant(self, variant: int | str) -> None:
         """Switch the open wizard's variant (one of its class's ``variants`` values)."""

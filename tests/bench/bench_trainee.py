@@ -1,14 +1,17 @@
 """The scripted trainees: presses per touch of one XYZ 4-point calibration.
 
 **By the tip views** (the default run; issue 44): ``view_trainee.ViewTrainee`` steers with the
-distance hidden by the two tip views alone (their pixels, or the same views zoomed out when the
-tip is outside their window; never the distance), follows the pendant's own tilt hint for
-touches 2-4, on the KR 6, the GP12 and a ROS-Industrial KR 16 (the chain of
-``ros-industrial/kuka_experimental`` ``kuka_kr16_support/urdf/kr16_2_macro.xacro``,
-tests/support/ros_layouts.py). It prints, per robot and touch, the presses, the true distance
-(measured, not steered by) and the tilt suggested and whether the robot made it, then the
-targets as MET / NOT MET: at most 30 presses per touch, every touch within 0.5 mm, every
-suggestion reachable.
+distance hidden by the two tip views alone (the pixels of the views the Jog tab shows, at their
+own zoom, with their arrow; beyond them, the 3D view judged to 10 mm; never the distance),
+follows the pendant's own tilt hint for touches 2-4 (from touch 3 on tilting about the
+wizard's estimate, the dock's button; the same trainee never pressing it is printed too), on
+the KR 6, the GP12 and a
+ROS-Industrial KR 16 (the chain of ``ros-industrial/kuka_experimental``
+``kuka_kr16_support/urdf/kr16_2_macro.xacro``, tests/support/ros_layouts.py). It prints, per
+robot and touch, the presses, the true distance (measured, not steered by) and the tilt
+suggested and whether the robot made it, then where the presses went (the tilt, frame changes,
+increment steps, X/Y/Z presses per increment, Record and Next), then the targets as MET /
+NOT MET: at most 30 presses per touch, every touch within 0.5 mm, every suggestion reachable.
 
 **By the Δ line** (``--delta-line``; issue 10's figures): the trainees below, in a real server
 through a websocket client.
@@ -255,14 +258,15 @@ GOAL_DISTANCE_MM = 0.5
 
 def views_table() -> bool:
     """Run the view trainee on every robot, print its table and the targets; True: all met."""
-    from bench.view_trainee import run_robot
+    from bench.view_trainee import KINDS, run_robot
 
     print("Scripted trainee by the two tip views, distance hidden, XYZ 4-point, pointer, "
           "following the pendant's tilt hints\n")
     print(f"{'robot':<6} {'touch':>5} {'presses':>7} {'true mm':>8} {'reachable':>9}  suggestion")
     presses, distances, suggested, reachable = [], [], 0, 0
-    for robot in ROBOTS:
-        for k, t in enumerate(run_robot(robot)):
+    runs = {robot: run_robot(robot) for robot in ROBOTS}
+    for robot, touches in runs.items():
+        for k, t in enumerate(touches):
             presses.append(t.presses)
             distances.append(t.distance_mm)
             mark = "-" if t.reachable is None else ("yes" if t.reachable else "NO")
@@ -271,6 +275,16 @@ def views_table() -> bool:
                 reachable += int(t.reachable)
             words = t.suggestion.split(" → ")[0] if t.suggestion else "(first touch: any orientation)"
             print(f"{robot:<6} {k + 1:>5} {t.presses:>7} {t.distance_mm:>8.3f} {mark:>9}  {words}")
+    print("\nWhere the presses go (X/Y/Z presses by increment, mm):")
+    print(f"{'robot':<6} {'touch':>5} " + " ".join(f"{kind:>5}" for kind in KINDS))
+    for robot, touches in runs.items():
+        for k, t in enumerate(touches):
+            print(f"{robot:<6} {k + 1:>5} " + " ".join(f"{t.kinds.get(kind, 0):>5}" for kind in KINDS))
+    flange = [[t.presses for t in run_robot(robot, pivot=False)] for robot in ROBOTS]
+    print("\nThe same trainee never pressing \"Tilt about the wizard's estimate\" (every tilt about the "
+          "flange), presses per touch:")
+    for robot, row in zip(ROBOTS, flange):
+        print(f"{robot:<6} " + " ".join(f"{n:>5}" for n in row))
     ok_presses = max(presses) <= GOAL_PRESSES_PER_TOUCH
     ok_distance = max(distances) <= GOAL_DISTANCE_MM
     ok_reach = suggested > 0 and reachable == suggested

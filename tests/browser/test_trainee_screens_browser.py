@@ -167,6 +167,37 @@ def test_step_record_feedback_keys_and_tip_views_in_sight_with_a_wizard_open(app
         ctx.close()
 
 
+@pytest.mark.parametrize("hidden", [True, False], ids=["distance hidden", "distance shown"])
+@pytest.mark.parametrize("size", DESKTOP, ids=lambda s: f"{s[0]}x{s[1]}")
+def test_the_estimate_button_leaves_record_keys_and_tip_views_in_sight(app_factory, browser, size, hidden) -> None:
+    """At step 3 (two touches) the dock adds "Tilt about the wizard's estimate": it, Record,
+    Next, the jog keys and the tip views are all in sight without scrolling, with the distance
+    hidden or shown."""
+    app = app_factory()
+    ctx, page, s = open_page(browser, app, size)
+    try:
+        with s.lock:
+            s.set_hide_distance(hidden)
+        with ThreadPoolExecutor(max_workers=1) as pool:
+            pool.submit(lambda: (s.wizard_commands.start("xyz4"), s.wizard_commands.auto_touch(AutoTouchRequest()),
+                                 s.wizard_commands.auto_touch(AutoTouchRequest(tilt_deg=45.0, azimuth_deg=0.0)))).result()
+        true_tip_at(s, (1.5, -1.0, 3.0))
+        page.get_by_text("Step 3 of 4").first.wait_for(state="visible", timeout=TIMEOUT_MS)
+        button = page.get_by_role("button", name="Tilt about the wizard's estimate", exact=True).first
+        button.wait_for(state="visible", timeout=TIMEOUT_MS)
+        box_inside(page, button, size, "the estimate button")
+        box_inside(page, page.get_by_role("button", name="Record", exact=True).first, size, "Record")
+        box_inside(page, page.get_by_role("button", name="Next ▶", exact=True).first, size, "Next")
+        for name in JOG_KEYS:
+            box_inside(page, page.get_by_role("button", name=name, exact=True).first, size, f"key {name}")
+        box_inside(page, page.locator("[data-tcp-pendant-tipviews] img").first, size, "the tip views")
+        button.click()
+        wait_until(lambda: s.controller.active_tool is not None, "the estimate active")
+        assert s.controller.active_tool.name == "Estimate, 2 touches"
+    finally:
+        ctx.close()
+
+
 # ------------------------------------------------------------------ touch
 def reference_tip_on_screen(s: Any, page: Any) -> tuple[float, float]:
     """The reference tip in CSS px, projected with the browser's camera (viser's report)."""

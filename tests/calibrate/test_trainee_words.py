@@ -83,3 +83,29 @@ def test_equation_labels_are_in_the_math_only_and_the_meter_is_named(page) -> No
     tab = " ".join([v.result.compare_md.content, *map(str, v.result.estimator.options)])
     assert "(4P-" not in tab and "joint least squares (default)" in tab
     assert "(4P-3)" in v.math.md.content                                     # in The math
+
+
+def test_the_dock_offers_the_wizards_estimate_to_tilt_about(page) -> None:
+    """After two touches in different orientations the dock shows "Tilt about the wizard's
+    estimate"; a click makes the estimate the active tool data, named as the estimate in the TCP
+    readout, and the button goes (the estimate is active); the next touch offers a new one."""
+    p = page()
+    v, s = p.view, p.session
+    dock = s.views["dock"]
+    p.click(v.start)
+    _touches(s, 1)
+    assert not dock.pivot.visible
+    _touches_from(s, 1, 2)
+    assert dock.pivot.visible and dock.pivot.label == "Tilt about the wizard's estimate"
+    p.click(dock.pivot)
+    active = s.controller.active_tool
+    assert active is not None and active.name == "Estimate, 2 touches"
+    assert "Active tool data: TOOL Estimate, 2 touches" in s.views["pendant"].tcp_md.content
+    assert not dock.pivot.visible
+    _touches_from(s, 2, 3)
+    assert dock.pivot.visible                                   # three touches: a better estimate
+
+
+def _touches_from(s, first: int, last: int) -> None:
+    for tilt, az in _ORIENTATIONS[first:last]:
+        assert s.wizard_commands.auto_touch(AutoTouchRequest(tilt_deg=tilt, azimuth_deg=az)).ok

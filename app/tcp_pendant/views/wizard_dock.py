@@ -65,6 +65,16 @@ def tilt_line_html(hint: str | None, reachable: str = "") -> str:
     return f'<div style="{TILT_LINE_STYLE}">{"<br>".join(parts) or "&nbsp;"}</div>'
 
 
+PIVOT_LABEL = "Tilt about the wizard's estimate"
+PIVOT_HINT = ("Make the TCP your touches so far give (the wizard's estimate, never the truth) the active "
+              "tool data: the A, B, C keys then turn about it, so a tilt keeps the tip near the "
+              "reference tip. Offered from two touches in different orientations; press again after "
+              "a touch for a better estimate.")
+"""The dock's button of ``WizardCommands.pivot_on_estimate``, shown while it has an estimate to
+offer; the meter's bar gives it its row then (the meter's line says the same in words), so the
+jog keys stay above the fold at 1024x768."""
+
+
 class WizardDock:
     """Builds the dock in the current GUI container (the top of the Jog tab)."""
 
@@ -89,9 +99,11 @@ class WizardDock:
             self.meter_bar = gui.add_progress_bar(0.0, color="gray", visible=False)
             self.meter_md = gui.add_markdown("", visible=False)
             self.tilt_html = gui.add_html(tilt_line_html(None), visible=False)
+            self.pivot = gui.add_button(PIVOT_LABEL, visible=False, hint=PIVOT_HINT)
         self.record.on_click(self._action(self._on_record))
         self.nav.on_click(self._on_nav_click)
         self.mount.on_click(self._action(lambda _e: self.session.wizard_commands.mount_required_tool(), sync=True))
+        self.pivot.on_click(self._action(lambda _e: self.session.wizard_commands.pivot_on_estimate(), sync=True))
         session.subscribe(self.on_change)
 
     # ------------------------------------------------------------ plumbing
@@ -205,6 +217,7 @@ class WizardDock:
             self.mount.label = f"Mount the {needed.label.lower()}"
         self.record.visible = stepping and not wiz.auto_role(wiz.step).by_controller   # a scan: no Record
         self.record.disabled = not wiz.can_record
+        self.pivot.visible = stepping and self.session.wizard_commands.estimate_offer() is not None
         options: tuple[str, ...]
         if stepping:
             options = (BACK, FINISH if wiz.on_last_step else NEXT, CANCEL)
@@ -219,7 +232,8 @@ class WizardDock:
         wf = self.session.workflow
         shown = wf.wizard
         show = shown is not None and bool(shown.meter_active)
-        self.meter_bar.visible = self.meter_md.visible = self.tilt_html.visible = show
+        self.meter_md.visible = self.tilt_html.visible = show
+        self.meter_bar.visible = show and not self.pivot.visible   # its row goes to the button (PIVOT_LABEL)
         if not show:
             return
         wiz = cast("MeterWizard", shown)              # meter_active: a wizard that declares the meter
