@@ -77,11 +77,16 @@ def test_the_selector_switches_one_browser_live_keeping_pose_and_wizard(app_fact
             anna.send({"type": "GuiUpdateMessage", "uuid": uuid, "updates": {"value": "Deutsch"}})
             wait_until(lambda: s_anna.language == "de", what="Anna's German")
             panel = s_anna.views["pendant"]
-            wait_until(lambda: panel.hide_distance.label == "Abstand ausblenden", what="the relabel")
+            with s_anna.lock:                            # the change signal ran to its end
+                assert panel.hide_distance.label == "Abstand ausblenden"
             assert panel.language.dropdown.label == "🌐 Sprache"
             assert tuple(panel.mode.options) == ("✓ Kartesisch", "Achsen")
             assert "Koordinatensystem WORLD" in panel.settings_md.content
             assert "Achswinkel (Grad)" in panel.joints_md.content
+            # the labels the page's script looks for, in German (serve/static/pendant.js, 8.)
+            assert panel.keys_md.content.startswith("Tasten: `1`…`6` verfahren")
+            assert ('<div hidden data-tcp-pendant-labels data-increment="Inkrement" data-cont="Kont." '
+                    'data-shadows="Schatten" data-keys-line="Tasten:"></div>') in panel.keys_md.content
             np.testing.assert_array_equal(s_anna.controller.q_rad, q_before)
             assert s_anna.workflow.wizard is wizard_before is not None
             # Ben's browser: untouched
@@ -91,7 +96,7 @@ def test_the_selector_switches_one_browser_live_keeping_pose_and_wizard(app_fact
             mode_uuid = next(u for u, (_, label, _) in anna.inputs.items() if label == "Mode")
             anna.send({"type": "GuiUpdateMessage", "uuid": mode_uuid, "updates": {"value": "Achsen"}})
             wait_until(lambda: s_anna.jogger.settings.mode.value == "Joint", what="joint mode")
-            assert tuple(panel.mode.options) == ("Kartesisch", "✓ Achsen")
+            wait_until(lambda: tuple(panel.mode.options) == ("Kartesisch", "✓ Achsen"), what="the marked mode")
             inc_uuid = next(u for u, (_, label, _) in anna.inputs.items() if label == "Increment")
             anna.send({"type": "GuiUpdateMessage", "uuid": inc_uuid, "updates": {"value": "Kont."}})
             wait_until(lambda: s_anna.jogger.settings.continuous, what="continuous jog")
@@ -99,8 +104,9 @@ def test_the_selector_switches_one_browser_live_keeping_pose_and_wizard(app_fact
             anna.send({"type": "GuiUpdateMessage", "uuid": uuid, "updates": {"value": "Klingon"}})
             anna.send({"type": "GuiUpdateMessage", "uuid": uuid, "updates": {"value": "English"}})
             wait_until(lambda: s_anna.language == "en", what="back to English")
-            wait_until(lambda: panel.hide_distance.label == "Hide distance", what="the English labels")
-            assert tuple(panel.mode.options) == ("Cartesian", "✓ Joint")
+            with s_anna.lock:
+                assert panel.hide_distance.label == "Hide distance"
+                assert tuple(panel.mode.options) == ("Cartesian", "✓ Joint")
         finally:
             ben.ws.close()
     finally:
@@ -110,13 +116,15 @@ def test_the_selector_switches_one_browser_live_keeping_pose_and_wizard(app_fact
 # ---------------------------------------------------------------- the pseudo-locale's check
 PSEUDO_SPAN = re.compile(r"⟦[^⟦⟧]*⟧")
 CODE_SPAN = re.compile(r"`[^`]*`|```.*?```", re.S)
+TAG = re.compile(r"<[^<>]*>")
 WORD = re.compile(r"[A-Za-z][A-Za-z0-9]*")
 
 
 def untranslated_words(text: str, names: set[str]) -> list[str]:
     """The ASCII words of ``text`` outside the pseudo-locale's ``⟦ ⟧`` spans and code blocks
-    (the readouts' fixed tables and key names) that are not ``names``."""
-    rest = CODE_SPAN.sub(" ", PSEUDO_SPAN.sub(" ", text))
+    (the readouts' fixed tables and key names) and HTML tags (hidden markup, not shown) that
+    are not ``names``."""
+    rest = CODE_SPAN.sub(" ", PSEUDO_SPAN.sub(" ", TAG.sub(" ", text)))
     return [w for w in WORD.findall(rest) if w not in names]
 
 

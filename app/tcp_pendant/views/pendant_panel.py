@@ -48,6 +48,7 @@ newer-or-equal value; writing the rounded angle back would pull its slider to an
 from __future__ import annotations
 
 import asyncio
+import html
 import math
 import time
 from collections.abc import Callable, Coroutine
@@ -206,7 +207,7 @@ class PendantPanel:
         self._readout = "WORLD"
         self.touch_md = gui.add_markdown("")
         self._build_keys(gui)
-        self.keys_md = gui.add_markdown(KEYS_LINE)
+        self.keys_md = gui.add_markdown(self._keys_markdown())
         # the TCP readout below the keys: the step, its Record and the keys fit above the fold
         # at 1024x768 with a wizard open (a fixed three lines: the keys above it never move)
         self.tcp_md = gui.add_markdown("")
@@ -349,7 +350,7 @@ class PendantPanel:
         self.joint_folder.label = _("Joint jog")
         for (i, _sign), b in self.joint_buttons.items():
             b.hint = _with_keys(_("hold to jog {joint} (deg)").format(joint=names[i]), i, tr)
-        self._set_md(self.keys_md, "keys", _(KEYS_LINE))
+        self._set_md(self.keys_md, "keys", self._keys_markdown())
         self.settings_folder.label = _("Jog settings")
         self.mode.label, self.frame.label = _("Mode"), _("Jog frame")
         self.override.label, self.readout_frame.label = _("Override %"), _("Readout")
@@ -363,6 +364,18 @@ class PendantPanel:
         if self._last_text.get("status"):
             self._set_md(self.status_md, "status", "")     # a stop message in the other language: cleared
             self._last_stop = ""
+
+    def _keys_markdown(self) -> str:
+        """The keys line and, hidden below it, the labels the page's script looks for in this
+        language (``<div hidden data-tcp-pendant-labels data-increment=... data-cont=...
+        data-shadows=... data-keys-line=...>``, attributes escaped): it finds the Increment row,
+        continuous mode, the Shadows checkbox and the keys line by them."""
+        tr = self.session.translator
+        _ = tr.gettext
+        labels = {"increment": _("Increment"), "cont": increment_word(CONTINUOUS, tr),
+                  "shadows": _(SHADOWS_LABEL), "keys-line": _(KEYS_LINE).split(" ", 1)[0]}
+        attrs = " ".join(f'data-{k}="{html.escape(v, quote=True)}"' for k, v in labels.items())
+        return f"{_(KEYS_LINE)}\n\n<div hidden data-tcp-pendant-labels {attrs}></div>"
 
     def _mode_of(self, label: str | float) -> JogMode:
         """The Mode button ``label`` (this or English's words) as a ``JogMode``."""

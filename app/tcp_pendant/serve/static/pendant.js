@@ -57,6 +57,11 @@
  *    release click the server waits for (a touch the browser cancels, a long press it turns
  *    into a context menu, or a lost pointer capture sends none of its own) and keeps the
  *    browser from panning or selecting while a jog key is held.
+ * 8. Languages: the labels this script looks for (Increment, its "Cont." button, Shadows, the keys
+ *    line's first word) are read in the pendant's language from the hidden
+ *    <div data-tcp-pendant-labels data-increment=... data-cont=... data-shadows=... data-keys-line=...>
+ *    below the keys line (views/pendant_panel.py), English when it is absent. The jog keys' labels
+ *    ("X +", "A1 −") are the same in every language.
  */
 (function () {
   "use strict";
@@ -70,7 +75,7 @@
     openTrainer: "Open trainer view", trainerLine: "Trainer: open",
     increment: "Increment", record: "Record", recordPoint: "Record point", banner: "Trainee:",
     shadows: "Shadows", next: "Next \u25b6", finish: "Finish \u25b6", back: "\u25c0 Back",
-    keysLine: "Keys:", tipViews: "Tip close-up"
+    keysLine: "Keys:", tipViews: "Tip close-up", cont: "Cont."
   };
   var SOFTWARE_RE = /swiftshader|llvmpipe|softpipe|software|basic render/i;
   var CARTESIAN = ["X", "Y", "Z", "A", "B", "C"];
@@ -99,6 +104,11 @@
       if (row) return row;
     }
     return null;
+  }
+  function label(key) {                     // a label in the pendant's language (views/pendant_panel.py
+    var el = document.querySelector("[data-tcp-pendant-labels]");   // hands them over), else English
+    var v = el && el.getAttribute("data-" + key);
+    return v || L[{ "increment": "increment", "cont": "cont", "shadows": "shadows", "keys-line": "keysLine" }[key]];
   }
   function field(name) { var row = labelled(name); return row ? row.querySelector("input, textarea") : null; }
   var NOT_TEXT = /^(checkbox|radio|range|button|submit|reset|color|file|image)$/i;
@@ -144,7 +154,7 @@
   }
 
   function incrementButtons() {
-    var row = labelled(L.increment);
+    var row = labelled(label("increment"));
     return row ? Array.prototype.slice.call(row.querySelectorAll("button")) : [];
   }
   var pendingIncrement = null;              // {index, at}: clicked, the server's mark not yet back
@@ -166,7 +176,7 @@
 
   function continuous() {
     var selected = incrementButtons().filter(function (b) { return text(b).indexOf(MARK) === 0; })[0];
-    return !!selected && text(selected).indexOf("Cont.") >= 0;
+    return !!selected && text(selected).indexOf(label("cont")) >= 0;
   }
 
   function step(names) {                    // the wizard's Next / Finish or Back (the one on show)
@@ -455,7 +465,7 @@
     return software;
   }
   function shadowsOff() {
-    var row = labelled(L.shadows);
+    var row = labelled(label("shadows"));
     var box = row ? row.querySelector("input[type=checkbox]") : null;
     if (!box || !first(box)) return;
     var off = softwareWebgl();
@@ -503,7 +513,7 @@
     });
     var ps = document.querySelectorAll("p");
     for (var i = 0; i < ps.length; i++) {
-      if (text(ps[i]).indexOf(L.keysLine) !== 0) continue;
+      if (text(ps[i]).indexOf(label("keys-line")) !== 0) continue;
       var line = guiRow(ps[i]);
       if (line && !line.hasAttribute("data-tcp-pendant-keys-line")) line.setAttribute("data-tcp-pendant-keys-line", "1");
     }
