@@ -1,5 +1,5 @@
 """Each browser its own language, over real websockets: ``Accept-Language`` picks the start
-language, ``--language`` every browser's, the 🌐 selector switches one browser live (the pose
+language, ``--language`` every browser's, the Language selector switches one browser live (the pose
 and the wizard stay; another browser keeps its language), and with the pseudo-locale every
 text of the Jog panel is in the catalogs except names and numbers."""
 
@@ -72,14 +72,14 @@ def test_the_selector_switches_one_browser_live_keeping_pose_and_wizard(app_fact
                 s_anna.wizard_commands.start("xyz4")
             q_before = s_anna.controller.q_rad.copy()
             wizard_before = s_anna.workflow.wizard
-            wait_until(lambda: "🌐 Language" in anna.labels(), what="the selector")
-            uuid = next(u for u, (_, label, _) in anna.inputs.items() if label == "🌐 Language")
+            wait_until(lambda: "Language" in anna.labels(), what="the selector")
+            uuid = next(u for u, (_, label, _) in anna.inputs.items() if label == "Language")
             anna.send({"type": "GuiUpdateMessage", "uuid": uuid, "updates": {"value": "Deutsch"}})
             wait_until(lambda: s_anna.language == "de", what="Anna's German")
             panel = s_anna.views["pendant"]
             with s_anna.lock:                            # the change signal ran to its end
                 assert panel.hide_distance.label == "Abstand ausblenden"
-            assert panel.language.dropdown.label == "🌐 Sprache"
+            assert panel.language.dropdown.label == "Sprache (Language)"
             assert tuple(panel.mode.options) == ("✓ Kartesisch", "Achsen")
             assert "Koordinatensystem WORLD" in panel.settings_md.content
             assert "Achswinkel (Grad)" in panel.joints_md.content
@@ -152,7 +152,8 @@ def _texts(handle: object) -> Iterator[str]:
 def test_with_the_pseudo_locale_every_text_of_the_jog_panel_is_from_the_catalogs(app_factory: Any) -> None:
     """Labels, hints, options and markdown of every handle of the panel, in Cartesian and Joint
     mode, incremental and continuous: outside ``⟦ ⟧`` only names (axes, joints, frames, tool
-    names, units, the 🌐 selector's language names) and numbers. The offset line of
+    names, units, the selector's language names and the English word "Language" it keeps beside
+    the translation) and numbers. The offset line of
     ``pendant.guidance`` under the distance is not this view's text (its owner wraps it)."""
     app = app_factory(language=PSEUDO_LANGUAGE)
     c = DrainingClient(app.port)
@@ -161,7 +162,7 @@ def test_with_the_pseudo_locale_every_text_of_the_jog_panel_is_from_the_catalogs
         panel = s.views["pendant"]
         joints = set(s.controller.kinematics.joint_names)
         names = (set("XYZABC") | joints | set(JOG_FRAMES) | {"WORLD", "BASE", "HOME", "mm", "deg", "TOOL",
-                 "FLANGE", "TCP", "KR", "Shift", "A5"} | {w for n in (s.controller.mounted_tool.label,)
+                 "FLANGE", "TCP", "KR", "Shift", "A5", "Language"} | {w for n in (s.controller.mounted_tool.label,)
                                                           for w in WORD.findall(n or "")})
         for mode, increment in (("Cartesian", "10"), ("Joint", "10"), ("Joint", "Cont."), ("Cartesian", "Cont.")):
             with s.lock:

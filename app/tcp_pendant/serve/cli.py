@@ -172,7 +172,7 @@ def _add_training_options(p: argparse.ArgumentParser) -> None:
                    metavar="LANG",
                    help="the language every browser starts in: " + ", ".join(languages()) + "; default auto: "
                         "each browser's own (its Accept-Language), else English. Each trainee can switch "
-                        "with the 🌐 selector (docs/languages.md)")
+                        "with the Language selector in the Jog tab's View folder (docs/languages.md)")
     p.add_argument("--seed", type=int, default=None, metavar="N",
                    help="one seed for every pendant's randomness (Auto-touch's operator error and "
                         "directions, the beam sensor's noise): a seeded lesson replays the same way "

@@ -4,8 +4,9 @@ Choosing one runs the session's command (:meth:`Session.set_language`), whose ``
 change makes every view re-render its texts: the pose, the touches and a running wizard stay.
 The selector changes only its own session: another browser keeps its language. Its options
 are :data:`tcp_pendant.translation.LANGUAGE_NAMES` (the pseudo-locale is listed only in a
-session that uses it: the tests set it by the command). Its label is ``🌐`` and the word
-"Language" in the session's language, so a trainee who reads neither finds it by the globe.
+session that uses it: the tests set it by the command). Its label is the word "Language" in
+the session's language followed by the English word (``Sprache (Language)``), so a trainee
+shown a language they cannot read finds the way back.
 """
 
 from __future__ import annotations
@@ -13,13 +14,13 @@ from __future__ import annotations
 import viser
 
 from tcp_pendant.session import Session, SessionChange
-from tcp_pendant.translation import LANGUAGE_NAMES, PSEUDO_LANGUAGE, N_
+from tcp_pendant.translation import LANGUAGE_NAMES, PSEUDO_LANGUAGE, N_, Translator
 from tcp_pendant.views.gui_util import set_value, target_of
 
-__all__ = ["LANGUAGE_LABEL", "LanguageSelector", "language_options"]
+__all__ = ["LANGUAGE_LABEL", "LanguageSelector", "language_options", "selector_label"]
 
 LANGUAGE_LABEL = N_("Language")
-"""The selector's word (after ``🌐 ``)."""
+"""The selector's word, in English after the session's language's (:func:`selector_label`)."""
 PSEUDO_NAME = "⟦Ƥšéûðö⟧"
 """The pseudo-locale's entry (tests only)."""
 
@@ -31,6 +32,12 @@ def language_options(current: str) -> dict[str, str]:
     if current == PSEUDO_LANGUAGE:
         names[PSEUDO_NAME] = PSEUDO_LANGUAGE
     return names
+
+
+def selector_label(tr: Translator) -> str:
+    """``Language``, or ``Sprache (Language)`` in another language than English."""
+    word = tr.gettext(LANGUAGE_LABEL)
+    return word if word == LANGUAGE_LABEL else f"{word} ({LANGUAGE_LABEL})"
 
 
 class LanguageSelector:
@@ -46,7 +53,7 @@ class LanguageSelector:
         session.subscribe(self.on_change)
 
     def _label(self) -> str:
-        return "🌐 " + self.session.translator.gettext(LANGUAGE_LABEL)
+        return selector_label(self.session.translator)
 
     def _name(self, code: str) -> str:
         return next(name for name, c in self._codes.items() if c == code)
