@@ -47,3 +47,8 @@ def test_a_german_browser_gets_the_jog_tab_in_german_and_its_keys_work(app_facto
         page.set_viewport_size({"width": width, "height": height})
         page.wait_for_timeout(500)
         assert_not_blank(shot(page, f"jog_tab_de_{width}x{height}"), min_colors=200)
+    # the View folder with the language selector, in German and English
+    selector = page.get_by_text("Sprache (Language)").first
+    selector.scroll_into_view_if_needed(timeout=TIMEOUT_MS)
+    page.wait_for_timeout(300)
+    assert_not_blank(shot(page, "jog_tab_de_view_folder"), min_colors=200)
