@@ -26,7 +26,8 @@ small owners it builds and holds own the rest, each in its module:
 
 The session is the only command surface of its state: its own commands
 (:meth:`Session.record_touch`, :meth:`Session.delete_touch`, :meth:`Session.set_hide_distance`,
-:meth:`Session.set_rules`, :meth:`Session.show_message`, :meth:`Session.set_scenario`, ...) and
+:meth:`Session.set_rules`, :meth:`Session.show_message`, :meth:`Session.set_scenario`,
+:meth:`Session.set_language`, ...) and
 those of the owners above, reached through it. Views never change the controller or the
 workflow themselves. Each command ends in ONE change signal of the session: every function
 given to :meth:`Session.subscribe` is called with a :class:`SessionChange` saying what to
@@ -72,6 +73,7 @@ from tcp_pendant.session_scenario import ScenarioPlayer
 from tcp_pendant.session_tools import SessionTools
 from tcp_pendant.session_views import ViewRegistry
 from tcp_pendant.session_wizard import WizardCommands
+from tcp_pendant.translation import SOURCE_LANGUAGE, translator
 
 __all__ = ["MAX_WAITING_MESSAGES", "Browser", "ClassMessage", "GuiTarget", "NotificationColor", "Session",
            "SessionChange", "Touch"]
@@ -177,6 +179,8 @@ class SessionChange:
         library: the session's copy of the library's list was re-read.
         notice: the exercise's instructions or the trainer's messages waiting here changed
             (the banner and the message box re-render).
+        language: the session's language changed (:meth:`Session.set_language`): every view
+            re-renders its texts with ``session.translator``.
         jog: the outcome of the move, for the status line (None: not a jog, or unchanged).
         state: the robot's pose state after the change (computed once, for every subscriber),
             None when neither ``pose`` nor ``tool`` is set.
@@ -191,6 +195,7 @@ class SessionChange:
     wizard: bool = False
     library: bool = False
     notice: bool = False
+    language: bool = False
     jog: JogResult | None = None
     state: PoseState | None = None
     events: tuple[SessionEvent, ...] = ()
@@ -201,6 +206,7 @@ class SessionChange:
         return SessionChange(pose=self.pose or other.pose, tool=self.tool or other.tool,
                              touches=self.touches or other.touches, wizard=self.wizard or other.wizard,
                              library=self.library or other.library, notice=self.notice or other.notice,
+                             language=self.language or other.language,
                              jog=other.jog if other.jog is not None else self.jog,
                              events=self.events + other.events)
 
@@ -231,6 +237,9 @@ class Session:
             one seed (``--seed``), so a seeded lesson replays the same way.
         jobs: the server's pool of browser-triggered jobs (``job_pool.JobPool``, one for the
             whole server: ``SessionLoop.run_job``); default the process's pool.
+        language: the language of this browser's texts (a code of ``translation.languages``,
+            or the pseudo-locale); change it with :meth:`set_language`; its messages are
+            :attr:`translator`'s.
 
     Its owners, built with it: :attr:`jogger` (the jog keys' settings), :attr:`motion`
     (``MotionCommands``), :attr:`tools` (``SessionTools``), :attr:`wizard_commands`
@@ -252,8 +261,10 @@ class Session:
     rules: ExerciseRules = FREE_PRACTICE
     rng: np.random.Generator = field(default_factory=np.random.default_rng)
     jobs: JobPool = field(default_factory=default_pool, repr=False)
+    language: str = SOURCE_LANGUAGE
 
     def __post_init__(self) -> None:
+        self.translator = translator(self.language)     # raises on an unknown code
         if self.target is None:
             self.target = self.client
         if self.workflow.controller is not self.controller:
@@ -421,6 +432,21 @@ class Session:
             self.hide_distance = bool(hide)
             self.jogger.stop_at_contact = not self.hide_distance
             self.changed(pose=True)
+
+    def set_language(self, language: str) -> None:
+        """This session's language (a code of ``translation.languages`` or the pseudo-locale):
+        the views re-render their texts (a ``language`` change); the pose, the touches and the
+        wizard stay as they are. Another session's language never changes.
+
+        Raises:
+            ValueError: an unknown code (naming the known ones).
+        """
+        with self.lock:
+            new = translator(language)
+            if new.language == self.language:
+                return
+            self.language, self.translator = new.language, new
+            self.changed(language=True)
 
     def set_rules(self, rules: ExerciseRules) -> None:
         """The exercise's rules (the classroom sets them): locked distance aids switch "Hide

@@ -378,7 +378,7 @@ def test_run_tests_fails_on_a_broken_layer_with_lint_imports_output_and_runs_no_
 
 # The layers of pyproject.toml's [tool.importlinter], bottom first ("|": siblings that import
 # none of each other); lint-imports also wants every module of tcp_pendant in one of them.
-APP_LAYERS = (("events", "job_pool", "json_shapes", "message_rate", "refusal_notices", "text_escape"),
+APP_LAYERS = (("events", "job_pool", "json_shapes", "message_rate", "refusal_notices", "text_escape", "translation"),
               ("controller",), ("pendant",), ("wizards",), ("calibrate",), ("session_scenario", "session_views"),
               ("session_tools", "session_loop"), ("session_wizard", "session_motion"), ("session",),
               ("classroom",), ("views",), ("serve",), ("__main__",))

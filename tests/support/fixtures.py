@@ -149,12 +149,15 @@ def browser() -> Iterator[Any]:
 @pytest.fixture
 def new_page(browser: Any) -> Iterator[Callable[..., Any]]:
     """``new_page(url)``: a fresh context (its own viser client) at ``url``, once the pendant GUI
-    is there (``init_script``: JavaScript run first in its pages; module docstring)."""
+    is there (``init_script``: JavaScript run first in its pages; ``locale``: the browser's
+    language; module docstring)."""
     contexts: list[Any] = []
 
     def factory(url: str, *, width: int = 1400, height: int = 900, wait_for: str = "Record point",
-                init_script: str | None = None) -> Any:
-        ctx = browser.new_context(viewport={"width": width, "height": height})
+                init_script: str | None = None, locale: str | None = None) -> Any:
+        # locale: the browser's language ("de-DE": its Accept-Language and navigator.language)
+        ctx = browser.new_context(viewport={"width": width, "height": height},
+                                  **({} if locale is None else {"locale": locale}))
         contexts.append(ctx)
         if init_script is not None:                # runs in every page of the context before its own scripts
             ctx.add_init_script(init_script)

@@ -3,6 +3,11 @@
 Units as on a pendant: positions in mm, angles in degrees, two decimals. The TCP readout
 shows the active TCP (the tool data the controller believes) as X, Y, Z and KUKA A, B, C
 (``R = Rz(A) Ry(B) Rx(C)``) in the named frame; ``-0.00`` is printed as ``0.00``.
+
+The words of the Jog tab's readouts are in the session's language (a
+:class:`~tcp_pendant.translation.Translator`, English by default); axis names, frame names
+(WORLD, BASE, TOOL, FLANGE), units and the numbers' fixed layout stay as they are in every
+language.
 """
 
 from __future__ import annotations
@@ -17,6 +22,10 @@ from tcpcal.tool import Tool
 from tcp_pendant.controller import PoseReadout, TouchGeometry
 from tcp_pendant.controller.touch import TOUCH_TOLERANCE_MM
 from tcp_pendant.text_escape import escape_markdown
+from tcp_pendant.translation import SOURCE_LANGUAGE, Translator, translator
+
+ENGLISH = translator(SOURCE_LANGUAGE)
+"""The source language's translator: the default of the readouts' ``tr``."""
 
 __all__ = [
     "dropped_presses_text",
@@ -70,22 +79,31 @@ def _two_decimals(values: tuple[float, ...]) -> list[str]:
 
 _SEP = "\x1f"                      # never in a formatted number
 _SIX = _SEP.join(("%.2f",) * 6)
-_TCP_TABLE = ("**TCP in %s** · %s\n\n```\nX %*s mm   A %*s deg\n"
-              "Y %*s mm   B %*s deg\nZ %*s mm   C %*s deg\n```")
+_TABLE = ("\n\n```\nX %*s mm   A %*s deg\nY %*s mm   B %*s deg\nZ %*s mm   C %*s deg\n```")
 
 
 @functools.lru_cache(maxsize=64)
-def _tool_title(tool_name: str | None, mounted: str | None = None) -> str:
+def _tcp_table(language: str) -> str:
+    """The TCP readout's ``%`` template in ``language``: its title (``**TCP in %s** · %s``,
+    frame and tool title) in words, the table in the fixed layout of every language."""
+    title = translator(language).gettext("**TCP in {frame}** · {tool}").replace("%", "%%")
+    return title.format(frame="%s", tool="%s") + _TABLE
+
+
+@functools.lru_cache(maxsize=64)
+def _tool_title(tool_name: str | None, mounted: str | None = None, tr: Translator = ENGLISH) -> str:
     """The TCP readout's tool: the tool data really active, ``Active tool data: TOOL <name>`` or
     ``Active tool data: none (FLANGE)`` (the TCP is the flange), and the tool mounted on the
     flange, ``· mounted: <label>``, so a pointer on the flange with no data active is not read
     as "no tool" (names escaped; a pure function of the names)."""
-    data = "none (FLANGE)" if tool_name is None else f"TOOL {escape_markdown(tool_name)}"
-    on = "" if not mounted else f" · mounted: {escape_markdown(mounted)}"
-    return f"Active tool data: {data}{on}"
+    _ = tr.gettext
+    data = _("none (FLANGE)") if tool_name is None else f"TOOL {escape_markdown(tool_name)}"
+    on = "" if not mounted else _(" · mounted: {tool}").format(tool=escape_markdown(mounted))
+    return _("Active tool data: {data}").format(data=data) + on
 
 
-def tcp_readout_markdown(readout: PoseReadout, tool_name: str | None, mounted: str | None = None) -> str:
+def tcp_readout_markdown(readout: PoseReadout, tool_name: str | None, mounted: str | None = None,
+                         tr: Translator = ENGLISH) -> str:
     """The TCP readout: a title with frame, the active tool data and the mounted tool
     (:func:`_tool_title`), then a monospace table ``X 525.00 mm | A 0.00 deg`` (one line per
     pair), the numbers right-aligned to the widest."""
@@ -93,11 +111,11 @@ def tcp_readout_markdown(readout: PoseReadout, tool_name: str | None, mounted: s
     x, y, z, a, b, c = (_SIX % (r.x_mm, r.y_mm, r.z_mm, r.a_deg, r.b_deg, r.c_deg)).replace(
         "-0.00", "0.00").split(_SEP)
     w = max(len(x), len(y), len(z), len(a), len(b), len(c))
-    return _TCP_TABLE % (r.frame, _tool_title(tool_name, mounted), w, x, w, a, w, y, w, b, w, z, w, c)
+    return _tcp_table(tr.language) % (r.frame, _tool_title(tool_name, mounted, tr), w, x, w, a, w, y, w, b, w, z, w, c)
 
 
 @functools.lru_cache(maxsize=32)
-def _joint_table(names: tuple[str, ...]) -> str | None:
+def _joint_table(names: tuple[str, ...], tr: Translator = ENGLISH) -> str | None:
     """The joint readout of :func:`joint_readout_markdown` for one robot's joints with a
     ``%8.2f`` slot per angle (the names' own ``%`` doubled); None when a name holds ``-0.00``.
 
@@ -109,19 +127,23 @@ def _joint_table(names: tuple[str, ...]) -> str | None:
         return None
     items = [f"{str(n).replace('%', '%%')} %8.2f" for n in names]
     lines = ["  ".join(items[i:i + 3]) for i in range(0, len(items), 3)]
-    return "**Joints (deg)**\n\n```\n" + "\n".join(lines) + "\n```"
+    return _joints_title(tr) + "\n\n```\n" + "\n".join(lines) + "\n```"
 
 
-def joint_readout_markdown(angles_deg: Mapping[str, float]) -> str:
+def _joints_title(tr: Translator) -> str:
+    return tr.gettext("**Joints (deg)**")
+
+
+def joint_readout_markdown(angles_deg: Mapping[str, float], tr: Translator = ENGLISH) -> str:
     """Joint angles in degrees, three per line: ``A1 0.00  A2 -90.00  A3 90.00`` (each angle
     right-aligned in 8 characters; ``-0.00`` as ``0.00``)."""
-    table = _joint_table(tuple(angles_deg))
+    table = _joint_table(tuple(angles_deg), tr)
     if table is not None:
         return (table % tuple(angles_deg.values())).replace(" -0.00", "  0.00")
     values = _two_decimals(tuple(angles_deg.values()))
     items = [f"{n} {v:>8}" for n, v in zip(angles_deg, values)]
     lines = ["  ".join(items[i:i + 3]) for i in range(0, len(items), 3)]
-    return "**Joints (deg)**\n\n```\n" + "\n".join(lines) + "\n```"
+    return _joints_title(tr) + "\n\n```\n" + "\n".join(lines) + "\n```"
 
 
 def joint_label(name: str, lower_deg: float, upper_deg: float) -> str:
@@ -129,26 +151,29 @@ def joint_label(name: str, lower_deg: float, upper_deg: float) -> str:
     return f"{name} [{lower_deg:+.0f}, {upper_deg:+.0f}]°"
 
 
-def touch_indicator_markdown(touch: TouchGeometry, *, hide_distance: bool) -> str:
+def touch_indicator_markdown(touch: TouchGeometry, *, hide_distance: bool, tr: Translator = ENGLISH) -> str:
     """The touch indicator.
 
     * crash (tool tip driven through the reference tip): always shown, with the depth;
     * otherwise, unless ``hide_distance``: "TOUCHING" within 0.5 mm, else the distance (mm).
     """
+    _ = tr.gettext
     if touch.crashed:
-        return (f"✖ **CRASH**: the tool tip went {fmt_num(touch.penetration_mm, 1)} mm through the "
-                "reference tip. Jog back out.")
+        return _("✖ **CRASH**: the tool tip went {depth} mm through the reference tip. Jog back out."
+                 ).format(depth=fmt_num(touch.penetration_mm, 1))
     if hide_distance:
-        return "Distance to reference tip: *hidden (judge by eye)*"
+        return _("Distance to reference tip: *hidden (judge by eye)*")
     if touch.touching:
-        return f"✔ **TOUCHING** the reference tip ({fmt_num(touch.distance_mm)} mm ≤ {TOUCH_TOLERANCE_MM} mm)"
-    return f"Distance to reference tip: **{fmt_num(touch.distance_mm)} mm**"
+        return _("✔ **TOUCHING** the reference tip ({distance} mm ≤ {tolerance} mm)").format(
+            distance=fmt_num(touch.distance_mm), tolerance=TOUCH_TOLERANCE_MM)
+    return _("Distance to reference tip: **{distance} mm**").format(distance=fmt_num(touch.distance_mm))
 
 
-def dropped_presses_text(n: int) -> str:
+def dropped_presses_text(n: int, tr: Translator = ENGLISH) -> str:
     """What the trainee is told when ``n`` jog presses (or hold starts, or joint-slider moves)
     came too late to be carried out (``pendant.jogging.PressGate``)."""
-    return f"{n} jog press{'' if n == 1 else 'es'} dropped: the server was busy"
+    return tr.ngettext("{n} jog press dropped: the server was busy",
+                       "{n} jog presses dropped: the server was busy", n).format(n=n)
 
 
 def touch_label(index: int, T_world_flange: np.ndarray) -> str:

@@ -33,6 +33,7 @@ from typing import TYPE_CHECKING
 
 from tcp_pendant.classroom.gradebook_db import class_db_target, url_has_password
 from tcp_pendant.serve.token_notice import class_lines, token_source
+from tcp_pendant.translation import languages
 
 if TYPE_CHECKING:                       # the server is imported in main() only (no pinocchio for --help)
     from tcp_pendant.serve.server import PendantApp
@@ -167,6 +168,11 @@ def _add_training_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--beam-crossed", action="store_true",
                    help="a second beam along WORLD Y crosses the first (crossed beams, as on TRACC-type "
                         "devices)")
+    p.add_argument("--language", default="auto", choices=("auto",) + languages(include_pseudo=True),
+                   metavar="LANG",
+                   help="the language every browser starts in: " + ", ".join(languages()) + "; default auto: "
+                        "each browser's own (its Accept-Language), else English. Each trainee can switch "
+                        "with the Language selector in the Jog tab's View folder (docs/languages.md)")
     p.add_argument("--seed", type=int, default=None, metavar="N",
                    help="one seed for every pendant's randomness (Auto-touch's operator error and "
                         "directions, the beam sensor's noise): a seeded lesson replays the same way "
@@ -378,7 +384,7 @@ def _make_app(args: argparse.Namespace, trainer_token: str | None, class_db: Pat
                            scenario_seed=args.scenario_seed, presenter=args.presenter,
                            hide_truth=args.hide_truth,
                            beam_width_mm=args.beam_width, beam_repeatability_mm=args.beam_repeatability,
-                           beam_crossed=args.beam_crossed, seed=args.seed,
+                           beam_crossed=args.beam_crossed, seed=args.seed, language=args.language,
                            reuse_port=args.workers > 1 or worker is not None,
                            balance_file=balance_file)
         app = PendantApp(config)

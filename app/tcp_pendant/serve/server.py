@@ -62,6 +62,7 @@ from tcp_pendant.controller.placement import (
 )
 from tcp_pendant.controller.scenarios import Scenario
 from tcp_pendant.session import GuiTarget, Session
+from tcp_pendant.translation import PSEUDO_LANGUAGE, languages, negotiate
 from tcp_pendant.views import session_view_steps, viser_adapter
 from tcp_pendant.views.dashboard import open_dashboard
 from tcp_pendant.views.gui_util import target_of
@@ -123,6 +124,9 @@ class AppConfig:
             WORLD Y crossing it.
         hide_truth: no pendant shows the truth (the TRUE triad, the error and the grade against
             the true TOOL frame), as in an exercise: a ``--shared`` projector in front of a class.
+        language: the language every browser starts in (a code of ``translation.languages``;
+            each browser may switch); "auto": the best of the browser's ``Accept-Language``,
+            else English (:meth:`PendantApp.start_language`).
         seed: the one seed of every session's randomness (``Session.rng``: Auto-touch's operator
             error and directions, the beam's repeatability noise); session k of the server draws
             from ``(seed, k)``, so a seeded lesson or test replays the same way. None: fresh
@@ -166,6 +170,7 @@ class AppConfig:
     reuse_port: bool = False
     balance_file: Path | None = None
     presence_poll_s: float = 1.0
+    language: str = "auto"
 
 
 class PortInUseError(OSError):
@@ -334,6 +339,9 @@ class PendantApp:
             raise ControllerError(f"Unknown tool {config.tool!r}; use one of {', '.join(tools)}.")
         self.tool = tools[config.tool]
         Scenario(config.scenario, seed=config.scenario_seed)  # type: ignore[arg-type]  # ControllerError: names the choices
+        if config.language != "auto" and config.language not in languages(include_pseudo=True):
+            raise ValueError(f"Unknown language {config.language!r}; use auto or one of "
+                             f"{', '.join(languages())} ({PSEUDO_LANGUAGE}: the tests' pseudo-locale).")
         self.tip_warning: str | None = None
         """:func:`tip_reach_warning` of a ``--reference-tip`` given (None: reachable, or the default)."""
         T_flange_tool = np.asarray(self.tool.T_flange_tool_true, dtype=float)
@@ -422,6 +430,14 @@ class PendantApp:
         assert session is not None
         return session
 
+    def start_language(self, client: viser.ClientHandle | None) -> str:
+        """The language a session starts in: ``--language`` when it names one; with ``auto`` (the
+        default) the best of the browser's ``Accept-Language`` the pendant offers
+        (``translation.negotiate``), else English (the ``--shared`` session: English)."""
+        if self.config.language != "auto":
+            return self.config.language
+        return negotiate(None if client is None else viser_adapter.accept_language(client))
+
     def session_steps(self, client: viser.ClientHandle | None, target: GuiTarget | None = None, *,
                       shared: bool = False) -> Generator[Session | None, None, None]:
         """:meth:`make_session` step by step: yields None after each step (a view, a few to a few
@@ -432,7 +448,7 @@ class PendantApp:
         rng = self.session_rng()
         workflow = CalibrationWorkflow(c, self.library, robot=self.robot_key, rng=rng)
         session = Session(c, self.library, workflow, client=client, target=target, ready_q_rad=self.ready_q_rad,
-                          shared=shared, rng=rng, jobs=self.jobs)
+                          shared=shared, rng=rng, jobs=self.jobs, language=self.start_language(client))
         session.tools.reload_library()
         if shared:
             try:

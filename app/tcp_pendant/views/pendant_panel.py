@@ -32,6 +32,12 @@ Widgets only call :class:`tcp_pendant.pendant.Jogger` and the session; all text 
 draws WebGL in software (no GPU: a thin client, a virtual machine), where the shadow maps cost
 most of each frame (:data:`SHADOWS_LABEL`).
 
+Language: every word of the panel is the session's (``session.translator``; the selector,
+``views.language_selector``, is in the View folder). A ``language`` change relabels every
+handle (:meth:`PendantPanel.relabel`) and re-renders the readouts; the key labels (``X −``,
+``A1 +``), frame names (WORLD, BASE, TOOL) and numbers stay as they are. A button group's
+click is read in the language it was shown in or in English (a click that crossed a switch).
+
 Joint sliders: setting a slider's value from Python fires its ``on_update`` (later, on the
 loop) with ``event.client is None``; those events are ignored. A slider the browser is
 dragging is not echoed back: while the joint is where the browser's last value of that slider
@@ -42,6 +48,7 @@ newer-or-equal value; writing the rounded angle back would pull its slider to an
 from __future__ import annotations
 
 import asyncio
+import html
 import math
 import time
 from collections.abc import Callable, Coroutine
@@ -63,11 +70,14 @@ from tcp_pendant.pendant import (
     touch_indicator_markdown,
 )
 from tcp_pendant.pendant.hold import HoldDriver, Timer
+from tcp_pendant.pendant.jogging import CONTINUOUS
 from tcp_pendant.pendant.guidance import CLOSEUP_WITHIN_MM, offset_markdown, side_view_markdown, tip_offset_xyz_mm
 from tcp_pendant.session import Session, SessionChange
+from tcp_pendant.translation import N_, SOURCE_LANGUAGE, Translator, translator
 from tcp_pendant.views import arrival
 from tcp_pendant.views.scene import closeup_camera, overview_camera
 from tcp_pendant.views.gui_util import ButtonEvent, ButtonGroupEvent, CheckboxEvent, set_value, target_of
+from tcp_pendant.views.language_selector import LanguageSelector
 from tcp_pendant.views.tip_insets import TipInsets
 from tcp_pendant.views.viser_adapter import queue_markdown
 
@@ -87,46 +97,71 @@ HOLD_HZ = 20.0
 """Rate the browser is asked to send hold messages at; the jog itself ticks on the server's
 20 Hz clock (``pendant.hold.HoldDriver``) while they keep coming."""
 
-_AXIS_HINT = {"X": "translate along X (mm)", "Y": "translate along Y (mm)", "Z": "translate along Z (mm)",
-              "A": "rotate about Z through the TCP (deg)", "B": "rotate about Y through the TCP (deg)",
-              "C": "rotate about X through the TCP (deg)"}
+_AXIS_HINT = {"X": N_("translate along X (mm)"), "Y": N_("translate along Y (mm)"),
+              "Z": N_("translate along Z (mm)"), "A": N_("rotate about Z through the TCP (deg)"),
+              "B": N_("rotate about Y through the TCP (deg)"), "C": N_("rotate about X through the TCP (deg)")}
+_ENGLISH = translator(SOURCE_LANGUAGE)
+_MODE_WORDS = {JogMode.CARTESIAN: N_("Cartesian"), JogMode.JOINT: N_("Joint")}
+"""The Mode buttons' words (the values are ``JogMode``'s English names)."""
 
 
 MARK = "✓ "
 """Prefix of the selected option of a button group."""
 
-KEYS_LINE = ("Keys: `1`…`6` jog **+** on the rows above, `Shift`+`1`…`6` jog **−**, "
+KEYS_LINE = N_("Keys: `1`…`6` jog **+** on the rows above, `Shift`+`1`…`6` jog **−**, "
              "`[` `]` smaller / larger increment, `R` Record, `N` Next / Finish, `B` Back")
 """The keyboard shortcuts (``serve/static/pendant.js``), shown below the jog keys (hidden by the
 page's script on a touch screen, whose pointer is coarse: no keyboard there)."""
 
-LAPSE_TEXT = ("Jog stopped: the browser did not renew the held key for 0.25 s (a busy browser or "
+LAPSE_TEXT = N_("Jog stopped: the browser did not renew the held key for 0.25 s (a busy browser or "
               "a slow network); let go and press again.")
 """The status line when a hold's lease ran out (``pendant.hold``)."""
 
-SHADOWS_LABEL = "Shadows"
+SHADOWS_LABEL = N_("Shadows")
 """The shadows checkbox of one browser's pendant; ``serve/static/pendant.js`` unchecks the checkbox
 of this exact label in a browser that renders WebGL in software (its renderer's name says
 SwiftShader, llvmpipe, softpipe, software or Basic Render), once per checkbox shown."""
-SHARED_SHADOWS_LABEL = "Shadows (every screen)"
+SHARED_SHADOWS_LABEL = N_("Shadows (every screen)")
 """The same in ``--shared`` mode: it switches every browser's shadows, and the script leaves it alone."""
-SHADOWS_HINT = ("Shadows of the robot and the tools. Off by itself in a browser that draws 3D without a "
+SHADOWS_HINT = N_("Shadows of the robot and the tools. Off by itself in a browser that draws 3D without a "
                 "graphics card, where they cost most of each frame.")
-INCREMENT_KEYS = "keys [ smaller, ] larger"
+INCREMENT_KEYS = N_("keys [ smaller, ] larger")
+HIDE_DISTANCE_HINT = N_("Training: judge the touch by eye, as on a real robot (hides the distance, the Δ offsets "
+                        "and the close-up).")
+INCREMENT_HINT = N_("mm for X/Y/Z, deg for A/B/C and joints; Cont. = hold to jog; {keys}")
 
 
 DROP_REPORT_EVERY_S = 1.0
 """Dropped jog presses are reported (status line, notification) at most this often (s)."""
 
 
-def jog_key_hint(row: int) -> str:
+def jog_key_hint(row: int, tr: Translator = _ENGLISH) -> str:
     """The keys of jog-key row ``row`` (0-based) as its hint says them ("" past the 9th row)."""
-    return f"keys {row + 1} (+) and Shift+{row + 1} (−)" if 0 <= row < 9 else ""
+    return tr.gettext("keys {n} (+) and Shift+{n} (−)").format(n=row + 1) if 0 <= row < 9 else ""
 
 
-def _with_keys(hint: str, row: int) -> str:
-    keys = jog_key_hint(row)
+def _with_keys(hint: str, row: int, tr: Translator = _ENGLISH) -> str:
+    keys = jog_key_hint(row, tr)
     return f"{hint}; {keys}" if hint and keys else hint or keys
+
+
+def mode_word(mode: JogMode, tr: Translator = _ENGLISH) -> str:
+    """The Mode button of ``mode`` in ``tr``'s language."""
+    return tr.gettext(_MODE_WORDS[mode])
+
+
+def increment_word(increment: str, tr: Translator = _ENGLISH) -> str:
+    """An Increment button: the numbers as they are, ``Cont.`` in ``tr``'s language."""
+    return tr.pgettext("increment", "Cont.") if increment == CONTINUOUS else increment
+
+
+def _read_choice(label: str, words: dict[str, str], tr: Translator) -> str:
+    """The value of the button ``label`` of a group whose values have ``words`` (value → English
+    word): ``label`` in ``tr``'s language or in English, else ``label`` itself."""
+    for value, word in words.items():
+        if label in (word, tr.gettext(word)):
+            return value
+    return label
 
 
 def marked(options: tuple[str, ...], selected: str) -> tuple[str, ...]:
@@ -172,7 +207,7 @@ class PendantPanel:
         self._readout = "WORLD"
         self.touch_md = gui.add_markdown("")
         self._build_keys(gui)
-        self.keys_md = gui.add_markdown(KEYS_LINE)
+        self.keys_md = gui.add_markdown(self._keys_markdown())
         # the TCP readout below the keys: the step, its Record and the keys fit above the fold
         # at 1024x768 with a wizard open (a fixed three lines: the keys above it never move)
         self.tcp_md = gui.add_markdown("")
@@ -184,6 +219,8 @@ class PendantPanel:
         self._build_joint_folder(gui)
         self._build_settings(gui)
         self._wire_settings()
+        if session.language != SOURCE_LANGUAGE:
+            self.relabel()
         self._show_settings()
         session.subscribe(self.on_change)
 
@@ -192,12 +229,9 @@ class PendantPanel:
         hold-to-jog keys of continuous mode."""
         session = self.session
         st = session.jogger.settings
-        self.hide_distance = gui.add_checkbox("Hide distance", session.hide_distance,
-                                              hint="Training: judge the touch by eye, as on a real robot "
-                                                   "(hides the distance, the Δ offsets and the close-up).")
+        self.hide_distance = gui.add_checkbox("Hide distance", session.hide_distance, hint=HIDE_DISTANCE_HINT)
         self.increment = gui.add_button_group("Increment", marked(INCREMENTS, st.increment),
-                                              hint="mm for X/Y/Z, deg for A/B/C and joints; Cont. = hold to jog; "
-                                                   + INCREMENT_KEYS)
+                                              hint=INCREMENT_HINT.format(keys=INCREMENT_KEYS))
         # compact keys: one row per axis (− and + side by side); clicks only
         self.cart_rows: dict[str, viser.GuiButtonGroupHandle] = {}
         for r, ax in enumerate(CARTESIAN_AXES):
@@ -245,7 +279,8 @@ class PendantPanel:
     def _build_settings(self, gui: viser.GuiApi) -> None:
         """The jog settings, the joints readout, the two poses and the view."""
         st = self.session.jogger.settings
-        with gui.add_folder("Jog settings"):
+        self.settings_folder = gui.add_folder("Jog settings")
+        with self.settings_folder:
             self.mode = gui.add_button_group("Mode", marked((JogMode.CARTESIAN.value, JogMode.JOINT.value),
                                                             st.mode.value))
             self.frame = gui.add_dropdown("Jog frame", JOG_FRAMES, initial_value=st.frame)
@@ -257,17 +292,19 @@ class PendantPanel:
                                    "flange pointing down.")
         self.kuka_home = gui.add_button("HOME", hint="The robot's HOME position (teleport); on a KR 6 the "
                                         "wrist is singular there (A5 = 0).")
-        with gui.add_folder("View"):
+        self.view_folder = gui.add_folder("View")
+        with self.view_folder:
             self.closeup = gui.add_button("Close-up on reference tip")
             self.overview_btn = gui.add_button("Overview")
             self.shadows = gui.add_checkbox(SHARED_SHADOWS_LABEL if self.session.shared else SHADOWS_LABEL, True,
                                             hint=SHADOWS_HINT)
+            self.language = LanguageSelector(self.session)
 
     def _wire_settings(self) -> None:
         g = self.session.loop.on_loop
-        self.mode.on_click(g(self._setting("mode", JogMode)))
+        self.mode.on_click(g(self._setting("mode", self._mode_of)))
         self.frame.on_update(g(self._setting("frame", str)))
-        self.increment.on_click(g(self._setting("increment", str)))
+        self.increment.on_click(g(self._setting("increment", self._increment_of)))
         self.override.on_update(g(self._setting("override_pct", float)))
         self.readout_frame.on_click(g(self._on_readout_frame))
         self.hide_distance.on_update(g(self._on_hide_distance))
@@ -280,7 +317,11 @@ class PendantPanel:
     def on_change(self, change: SessionChange) -> None:
         """The change signal: the status line from the move's outcome (a move that is not a
         jog - auto-touch, Home, a wizard's tool change - clears a stop message it made stale),
-        the readouts from the change's pose state."""
+        the readouts from the change's pose state; a ``language`` change relabels the panel."""
+        if change.language:
+            self.relabel()
+            self._show_settings()
+            self.render(change.state)
         if change.jog is not None:
             self.show_jog_result(change.jog)
             self._stop_key = None if change.state is None else change.state.key
@@ -288,6 +329,63 @@ class PendantPanel:
             self.show_jog_result(JogResult(True, 1.0, None, ""))
         if change.pose:
             self.render(change.state)
+
+    def relabel(self) -> None:
+        """Every word of the panel in the session's language (labels, hints, the keys line):
+        at a ``language`` change, and once at the start in a language other than English. The
+        key labels (``X −``), frame names and numbers are the same in every language."""
+        tr = self.session.translator
+        _ = tr.gettext
+        self.hide_distance.label, self.hide_distance.hint = _("Hide distance"), _(HIDE_DISTANCE_HINT)
+        self.increment.label = _("Increment")
+        self.increment.hint = _(INCREMENT_HINT).format(keys=_(INCREMENT_KEYS))
+        for r, (ax, row) in enumerate(self.cart_rows.items()):
+            row.hint = _with_keys(_(_AXIS_HINT[ax]), r, tr)
+        names = self.session.controller.kinematics.joint_names
+        for i, (name, row) in enumerate(zip(names, self.joint_rows)):
+            row.hint = _with_keys(_("jog {joint} (deg)").format(joint=name), i, tr)
+        self.cart_folder.label = _("Cartesian jog (hold)")
+        for (ax, _sign), b in self.cart_buttons.items():
+            b.hint = _with_keys(_(_AXIS_HINT[ax]), CARTESIAN_AXES.index(ax), tr)
+        self.joint_folder.label = _("Joint jog")
+        for (i, _sign), b in self.joint_buttons.items():
+            b.hint = _with_keys(_("hold to jog {joint} (deg)").format(joint=names[i]), i, tr)
+        self._set_md(self.keys_md, "keys", self._keys_markdown())
+        self.settings_folder.label = _("Jog settings")
+        self.mode.label, self.frame.label = _("Mode"), _("Jog frame")
+        self.override.label, self.readout_frame.label = _("Override %"), _("Readout")
+        self.home.label = _("Ready pose")
+        self.home.hint = _("Back to the start pose (teleport): HOME with the flange pointing down.")
+        self.kuka_home.hint = _("The robot's HOME position (teleport); on a KR 6 the wrist is singular there (A5 = 0).")
+        self.view_folder.label = _("View")
+        self.closeup.label, self.overview_btn.label = _("Close-up on reference tip"), _("Overview")
+        self.shadows.label = _(SHARED_SHADOWS_LABEL if self.session.shared else SHADOWS_LABEL)
+        self.shadows.hint = _(SHADOWS_HINT)
+        if self._last_text.get("status"):
+            self._set_md(self.status_md, "status", "")     # a stop message in the other language: cleared
+            self._last_stop = ""
+
+    def _keys_markdown(self) -> str:
+        """The keys line and, hidden below it, the labels the page's script looks for in this
+        language (``<div hidden data-tcp-pendant-labels data-increment=... data-cont=...
+        data-shadows=... data-keys-line=...>``, attributes escaped): it finds the Increment row,
+        continuous mode, the Shadows checkbox and the keys line by them."""
+        tr = self.session.translator
+        _ = tr.gettext
+        labels = {"increment": _("Increment"), "cont": increment_word(CONTINUOUS, tr),
+                  "shadows": _(SHADOWS_LABEL), "keys-line": _(KEYS_LINE).split(" ", 1)[0]}
+        attrs = " ".join(f'data-{k}="{html.escape(v, quote=True)}"' for k, v in labels.items())
+        return f"{_(KEYS_LINE)}\n\n<div hidden data-tcp-pendant-labels {attrs}></div>"
+
+    def _mode_of(self, label: str | float) -> JogMode:
+        """The Mode button ``label`` (this or English's words) as a ``JogMode``."""
+        words = {m.value: w for m, w in _MODE_WORDS.items()}
+        return JogMode(_read_choice(str(label), words, self.session.translator))
+
+    def _increment_of(self, label: str | float) -> str:
+        """The Increment button ``label`` as the jog setting (``Cont.`` in any language → ``CONTINUOUS``)."""
+        text = str(label)
+        return CONTINUOUS if text in (CONTINUOUS, increment_word(CONTINUOUS, self.session.translator)) else text
 
     # ------------------------------------------------------------ wiring
     def _wire_key(self, button: viser.GuiButtonHandle, axis: str | int, sign: int) -> None:
@@ -332,7 +430,7 @@ class PendantPanel:
 
     def _on_lapse(self, _key: object) -> None:
         """The held key's lease ran out (no renewal for ``LEASE_S``): stopped, and said so."""
-        text = f"⚠ {LAPSE_TEXT}"
+        text = f"⚠ {self.session.translator.gettext(LAPSE_TEXT)}"
         self._set_md(self.status_md, "status", text)
         self._last_stop = text
         self.session.motion.release_jog()
@@ -367,9 +465,10 @@ class PendantPanel:
         if self._hold is not None:
             n, self._hold.dropped = n + self._hold.dropped, 0
         if n:
-            text = dropped_presses_text(n)
+            _ = self.session.translator.gettext
+            text = dropped_presses_text(n, self.session.translator)
             self._set_md(self.status_md, "status", f"⚠ {text}.")
-            self.session.notify("Jog presses dropped", f"{text}; press again.", kind="warning")
+            self.session.notify(_("Jog presses dropped"), _("{what}; press again.").format(what=text), kind="warning")
             self.render()                            # a dropped slider move: the slider shows the joint
 
     def _stop_hold(self) -> None:
@@ -452,15 +551,21 @@ class PendantPanel:
         for b in self.joint_buttons.values():
             b.visible = hold
         self.frame.disabled = joint
-        for group, options, value in ((self.increment, INCREMENTS, st.increment),
-                                      (self.mode, (JogMode.CARTESIAN.value, JogMode.JOINT.value), st.mode.value)):
+        tr = self.session.translator
+        _ = tr.gettext
+        modes = (JogMode.CARTESIAN, JogMode.JOINT)
+        for group, options, value in ((self.increment, tuple(increment_word(i, tr) for i in INCREMENTS),
+                                       increment_word(st.increment, tr)),
+                                      (self.mode, tuple(mode_word(m, tr) for m in modes), mode_word(st.mode, tr))):
             want = marked(options, value)
             if tuple(group.options) != want:
                 group.options = want
         unit = "deg" if joint else "mm / deg"
-        step = "continuous while held" if st.continuous else f"{st.increment} {unit} per press"
-        where = "joints" if joint else f"{st.frame} frame"
-        self._set_md(self.settings_md, "settings", f"{st.mode.value} jog in {where}, {step}, override {st.override_pct:.0f} %")
+        step = (_("continuous while held") if st.continuous
+                else _("{increment} {unit} per press").format(increment=st.increment, unit=unit))
+        where = _("joints") if joint else _("{frame} frame").format(frame=st.frame)
+        self._set_md(self.settings_md, "settings", _("{mode} jog in {where}, {step}, override {override} %").format(
+            mode=mode_word(st.mode, tr), where=where, step=step, override=f"{st.override_pct:.0f}"))
 
     def _on_home(self, _event: ButtonEvent) -> None:
         self.session.motion.ready()
@@ -488,7 +593,7 @@ class PendantPanel:
         text = "" if res.ok else f"⚠ {res.message}"
         self._set_md(self.status_md, "status", text)
         if text and text != self._last_stop:
-            self.session.notify("Jog stopped", res.message, kind="warning")
+            self.session.notify(self.session.translator.gettext("Jog stopped"), res.message, kind="warning")
         self._last_stop = text
 
     def _set_md(self, handle: viser.GuiMarkdownHandle, key: str, text: str) -> None:
@@ -505,15 +610,16 @@ class PendantPanel:
         s = self.session
         state = s.pose_state() if state is None else state
         tool = s.controller.active_tool
+        tr = s.translator
         self._set_md(self.tcp_md, "tcp", tcp_readout_markdown(state.readout(self._readout), None if tool is None
-                                                              else tool.name, s.controller.mounted_tool.label))
+                                                              else tool.name, s.controller.mounted_tool.label, tr))
         hide = s.hide_distance
         if bool(self.hide_distance.value) != hide:
             set_value(self.hide_distance, hide)
         locked = s.rules.distance_locked
         if self._hide_locked != locked:            # locked by the trainer
             self.hide_distance.disabled = self._hide_locked = locked
-        touch = touch_indicator_markdown(state.touch, hide_distance=hide)
+        touch = touch_indicator_markdown(state.touch, hide_distance=hide, tr=tr)
         closeup = ""
         if not hide:
             jf = s.jogger.settings.frame
@@ -527,7 +633,7 @@ class PendantPanel:
             if self.closeup_md.visible != bool(closeup):
                 self.closeup_md.visible = bool(closeup)
         angles = state.joint_angles_deg
-        self._set_md(self.joints_md, "joints", joint_readout_markdown(angles))
+        self._set_md(self.joints_md, "joints", joint_readout_markdown(angles, tr))
         if not self._joint_folder_shown:
             return                      # hidden sliders are synced when joint mode is shown
         for i, (slider, v) in enumerate(zip(self.joint_sliders, angles.values())):

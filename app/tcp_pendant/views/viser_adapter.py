@@ -15,6 +15,9 @@ network. What this module reaches into, and why:
   caller then uses the public setter. Which path ran is counted (:func:`path_counts`); the first
   fallback of each path logs a warning, and with ``TCP_PENDANT_STRICT_VISER=1`` in the
   environment (the tests' flag) a fallback raises :class:`ViserInternalsChanged` instead.
+* **The browser's languages** (:func:`accept_language`): the ``Accept-Language`` header of
+  a client's websocket handshake, from the connection viser's websocket server keeps per
+  client (``_live_connections``): the session's start language.
 * **Uploads** (:func:`upload_hook`): the file-transfer messages and ``GuiApi``'s
   ``_current_file_upload_states``, for the per-button size limit of ``views.upload_guard``.
 * **Incoming messages** (:func:`install`): viser decodes each websocket message and hands it to
@@ -941,3 +944,21 @@ def listen_reuse_port(around_listen: Callable[[], AbstractContextManager[object]
         serve.__wrapped__ = original  # type: ignore[attr-defined]
         ws_server.serve = serve  # type: ignore[assignment,misc]
         _reuse_port = True
+
+
+def accept_language(client: viser.ClientHandle) -> str | None:
+    """The ``Accept-Language`` header of ``client``'s websocket handshake (browsers send their
+    language list on it as on every request), or None: no header, a client that left, or
+    viser's internals differ (the websocket server's ``_live_connections``, the
+    ``websockets`` connection viser keeps per client id; the caller then starts in the
+    server's default language). Read once, when the browser's session is built."""
+    server = getattr(getattr(client, "_viser_server", None), "_websock_server", None)
+    connections = getattr(server, "_live_connections", None)
+    if not isinstance(connections, dict):
+        _fallback("accept_language", AttributeError("viser's websocket server keeps no _live_connections"))
+        return None
+    headers = getattr(getattr(connections.get(client.client_id), "request", None), "headers", None)
+    if headers is None:
+        return None                                   # the client left
+    value = headers.get("Accept-Language")
+    return None if value is None else str(value)

@@ -78,6 +78,11 @@
  *    holds the server's <div class="math-board"> (our own escaped markup), a copy of its nodes
  *    (cloneNode: no HTML parsed here) covers the whole page, with a "Back to the pendant" button
  *    that unticks "Math board" (as a click on it would); the original is hidden in the panel.
+ * 10. Languages: the labels this script looks for (Increment, its "Cont." button, Shadows, the keys
+ *     line's first word) are read in the pendant's language from the hidden
+ *     <div data-tcp-pendant-labels data-increment=... data-cont=... data-shadows=... data-keys-line=...>
+ *     below the keys line (views/pendant_panel.py), English when it is absent. The jog keys' labels
+ *     ("X +", "A1 −") are the same in every language.
  */
 (function () {
   "use strict";
@@ -91,7 +96,7 @@
     openTrainer: "Open trainer view", trainerLine: "Trainer: open",
     increment: "Increment", record: "Record", recordPoint: "Record point", banner: "Trainee:",
     shadows: "Shadows", next: "Next \u25b6", finish: "Finish \u25b6", back: "\u25c0 Back",
-    keysLine: "Keys:", tipViews: "Tip close-up"
+    keysLine: "Keys:", tipViews: "Tip close-up", cont: "Cont."
   };
   var SOFTWARE_RE = /swiftshader|llvmpipe|softpipe|software|basic render/i;
   var CARTESIAN = ["X", "Y", "Z", "A", "B", "C"];
@@ -120,6 +125,11 @@
       if (row) return row;
     }
     return null;
+  }
+  function label(key) {                     // a label in the pendant's language (views/pendant_panel.py
+    var el = document.querySelector("[data-tcp-pendant-labels]");   // hands them over), else English
+    var v = el && el.getAttribute("data-" + key);
+    return v || L[{ "increment": "increment", "cont": "cont", "shadows": "shadows", "keys-line": "keysLine" }[key]];
   }
   function field(name) { var row = labelled(name); return row ? row.querySelector("input, textarea") : null; }
   var NOT_TEXT = /^(checkbox|radio|range|button|submit|reset|color|file|image)$/i;
@@ -260,7 +270,7 @@
   }
 
   function incrementButtons() {
-    var row = labelled(L.increment);
+    var row = labelled(label("increment"));
     return row ? Array.prototype.slice.call(row.querySelectorAll("button")) : [];
   }
   var pendingIncrement = null;              // {index, at}: clicked, the server's mark not yet back
@@ -282,7 +292,7 @@
 
   function continuous() {
     var selected = incrementButtons().filter(function (b) { return text(b).indexOf(MARK) === 0; })[0];
-    return !!selected && text(selected).indexOf("Cont.") >= 0;
+    return !!selected && text(selected).indexOf(label("cont")) >= 0;
   }
 
   function step(names) {                    // the wizard's Next / Finish or Back (the one on show)
@@ -625,7 +635,7 @@
     return software;
   }
   function shadowsOff() {
-    var row = labelled(L.shadows);
+    var row = labelled(label("shadows"));
     var box = row ? row.querySelector("input[type=checkbox]") : null;
     if (!box || !first(box)) return;
     var off = softwareWebgl();
@@ -673,7 +683,7 @@
     });
     var ps = document.querySelectorAll("p");
     for (var i = 0; i < ps.length; i++) {
-      if (text(ps[i]).indexOf(L.keysLine) !== 0) continue;
+      if (text(ps[i]).indexOf(label("keys-line")) !== 0) continue;
       var line = guiRow(ps[i]);
       if (line && !line.hasAttribute("data-tcp-pendant-keys-line")) line.setAttribute("data-tcp-pendant-keys-line", "1");
     }

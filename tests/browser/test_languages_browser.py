@@ -1,0 +1,54 @@
+"""The pendant in German in chromium: a browser whose language is German starts in German (its
+``Accept-Language`` on the websocket handshake), the page's script still finds the Increment
+row, continuous mode and the Shadows checkbox by their German labels, and screenshots at
+1400x900 and 1024x768 show the Jog tab in German."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import pytest
+
+from support.pendant_page import TIMEOUT_MS, assert_not_blank, wait_text, wait_until
+
+pytestmark = pytest.mark.browser
+
+
+def test_a_german_browser_gets_the_jog_tab_in_german_and_its_keys_work(app_factory, new_page: Callable[..., Any],
+                                                                       shot) -> None:
+    app = app_factory()
+    page = new_page(app.url, locale="de-DE", wait_for="Record point")
+    page.wait_for_function("document.documentElement.dataset.tcpPendantScript === '1'", timeout=TIMEOUT_MS)
+    wait_until(lambda: len(app.sessions) == 1, "the page's session")
+    (s,) = app.sessions.values()
+    assert s.language == "de"
+    wait_text(page, "Tasten:")
+    page.get_by_text("Handverfahr-Optionen").first.wait_for(state="attached", timeout=TIMEOUT_MS)
+    # the script's keys read the German labels: ] to 100, then to Kont.
+    assert s.jogger.settings.increment == "10"
+    page.keyboard.press("BracketRight")
+    wait_until(lambda: s.jogger.settings.increment == "100", "increment 100")
+    page.keyboard.press("BracketRight")
+    wait_until(lambda: s.jogger.settings.continuous, "continuous mode (Kont.)")
+    wait_text(page, "✓ Kont.")
+    with s.lock:
+        x0 = float(s.controller.T_world_tcp()[0, 3])
+    page.keyboard.down("Digit1")                               # held: a continuous jog (the script knows Kont.)
+    wait_until(lambda: (float(s.controller.T_world_tcp()[0, 3]) - x0) * 1000.0 > 5.0, "X to move while held")
+    page.keyboard.up("Digit1")
+    # Shadows: the German checkbox, off in this software-WebGL chromium
+    page.wait_for_selector("[data-tcp-pendant-shadows]", state="attached", timeout=TIMEOUT_MS)
+    assert page.get_attribute("[data-tcp-pendant-shadows]", "data-tcp-pendant-shadows") == "off"
+    wait_until(lambda: s.views["pendant"].shadows.value is False, "the server told: shadows off")
+    page.keyboard.press("BracketLeft")                         # back to 100 mm steps for the pictures
+    wait_until(lambda: s.jogger.settings.increment == "100", "increment 100")
+    for width, height in ((1400, 900), (1024, 768)):
+        page.set_viewport_size({"width": width, "height": height})
+        page.wait_for_timeout(500)
+        assert_not_blank(shot(page, f"jog_tab_de_{width}x{height}"), min_colors=200)
+    # the View folder with the language selector, in German and English
+    selector = page.get_by_text("Sprache (Language)").first
+    selector.scroll_into_view_if_needed(timeout=TIMEOUT_MS)
+    page.wait_for_timeout(300)
+    assert_not_blank(shot(page, "jog_tab_de_view_folder"), min_colors=200)
