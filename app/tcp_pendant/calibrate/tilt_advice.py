@@ -224,7 +224,6 @@ def _words(option: TiltOption, score: tuple[float, float], frame: str, active: s
         steps.append(f"set Jog frame to {frame}")
     how = f"{', '.join(steps)}, then " if steps else ""
     where = "" if steps else f" in {frame}"
-    tail = (f" → predicted TCP error **{score[0]:.2f} mm**" if math.isfinite(score[0])
-            else " → shows the TCP from the side the touches see least")
+    tail = f" → predicted TCP error **{score[0]:.2f} mm**" if math.isfinite(score[0]) else ""
     return (f"Tilt next: {how}**{key_label(r.key, r.sign)}** {r.angle_deg:.0f}°{where} "
             f"(key {keyboard_key(r.key, r.sign)}){tail}.")

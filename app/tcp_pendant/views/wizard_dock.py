@@ -70,9 +70,10 @@ PIVOT_HINT = ("Make the TCP your touches so far give (the wizard's estimate, nev
               "tool data: the A, B, C keys then turn about it, so a tilt keeps the tip near the "
               "reference tip. Offered from two touches in different orientations; press again after "
               "a touch for a better estimate.")
-"""The dock's button of ``WizardCommands.pivot_on_estimate``, shown while it has an estimate to
-offer; the meter's bar gives it its row then (the meter's line says the same in words), so the
-jog keys stay above the fold at 1024x768."""
+"""The dock's button of ``WizardCommands.pivot_on_estimate``: shown through an XYZ 4-point's
+steps, enabled while it has an estimate to offer. It takes the row of the meter's bar (the
+meter's line says the same in words), so the jog keys stay above the fold at 1024x768 and do not
+move when the estimate comes."""
 
 
 class WizardDock:
@@ -217,7 +218,10 @@ class WizardDock:
             self.mount.label = f"Mount the {needed.label.lower()}"
         self.record.visible = stepping and not wiz.auto_role(wiz.step).by_controller   # a scan: no Record
         self.record.disabled = not wiz.can_record
-        self.pivot.visible = stepping and self.session.wizard_commands.estimate_offer() is not None
+        # the button keeps its row through the whole XYZ 4-point (disabled until two touches give
+        # an estimate, and once it is active), so the jog keys below never move when it comes
+        self.pivot.visible = stepping and wiz.kind == "xyz4" and bool(getattr(wiz, "meter_active", False))
+        self.pivot.disabled = self.session.wizard_commands.estimate_offer() is None
         options: tuple[str, ...]
         if stepping:
             options = (BACK, FINISH if wiz.on_last_step else NEXT, CANCEL)
@@ -247,7 +251,7 @@ class WizardDock:
         if math.isinf(angle):
             text = "Pose diversity: first touch, any orientation."
         elif gain.too_close:
-            text = f"Pose diversity: ⚠ **too close**, {angle:.0f}° from an earlier touch: tilt further."
+            text = f"Pose diversity: ⚠ **too close**, {angle:.0f}°: tilt further."
         elif math.isinf(gain.predicted_after):
             text = f"Pose diversity: {angle:.0f}° from the nearest touch; not yet determinable."
         else:

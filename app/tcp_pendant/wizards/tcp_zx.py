@@ -99,11 +99,11 @@ class TcpZxWizard(Wizard):
         for i in range(self._n_points):
             text = ("Jog the tool tip onto the reference tip, approaching from any direction; then "
                     "press Record." if i == 0 else
-                    "Back off, tilt the tool 45 to 60 degrees about one axis (A, B or C: the line under "
-                    "the Pose diversity meter names the ones reachable from here) and touch the "
-                    "reference tip again (touch 2); then press Record." if i == 1 else
-                    f"Back off, tilt the tool 45 to 60 degrees about another axis than for the earlier "
-                    f"touches and touch the reference tip again (touch {i + 1}); then press Record.")
+                    "Back off, tilt 45 to 60° about A, B or C (\"Reachable 45° tilts\" below names "
+                    "those that work from here) and touch the reference tip again (touch 2); then "
+                    "Record." if i == 1 else
+                    f"Back off, tilt 45 to 60° about another axis than for the earlier touches and touch "
+                    f"the reference tip again (touch {i + 1}); then Record.")
             specs.append(StepSpec(role="touch", title=f"Touch {i + 1}", instruction=text))
         specs.append(StepSpec(
             role="z", title="Reference on the tool's +Z axis",

@@ -178,17 +178,15 @@ class Xyz4Wizard(Wizard):
                 text = ("Jog the tool tip onto the reference tip, approaching from any direction; "
                         "then press Record.")
             elif i == 1:
-                text = ("Back off, tilt the tool 45 to 60 degrees about one axis (A, B or C: the line "
-                        "under the Pose diversity meter names the ones reachable from here), and touch "
-                        "the reference tip again from this new orientation (touch 2); then press Record.")
+                text = ("Back off, tilt 45 to 60° about A, B or C (\"Reachable 45° tilts\" below names "
+                        "those that work from here) and touch the reference tip again (touch 2); then "
+                        "Record.")
             elif i == 2:
-                text = ("Back off, tilt the tool 45 to 60 degrees about another axis than for touch 2, "
-                        "and touch the reference tip again (touch 3); then press Record.")
+                text = ("Back off, tilt 45 to 60° about another axis than for touch 2 and touch the "
+                        "reference tip again (touch 3); then Record.")
             elif i == 3:
-                text = ("Back off and touch the reference tip from an orientation 45 to 60 degrees away "
-                        "from all three earlier ones, e.g. tilted the other way than touch 2 (touch 4); "
-                        "then press Record. Smaller tilts leave the TCP uncertain: the Pose diversity "
-                        "meter under the Step buttons predicts the error.")
+                text = ("Back off and touch the reference tip from an orientation 45 to 60° away from all "
+                        "three earlier ones, e.g. tilted the other way than touch 2 (touch 4); then Record.")
             else:
                 text = (f"Extra touch {i + 1}: touch the reference tip from an orientation unlike "
                         f"the earlier ones (watch the pose-diversity meter); then press Record.")
