@@ -143,10 +143,10 @@ def test_the_4_point_steps_ask_for_what_the_meter_can_reward() -> None:
     from tcp_pendant.wizards import Xyz4Wizard
 
     steps = Xyz4Wizard(n_points=4).steps
-    assert "about one axis" in steps[1].instruction and "before" not in steps[1].instruction
+    assert "about A, B or C" in steps[1].instruction and "before" not in steps[1].instruction
     assert "another axis than for touch 2" in steps[2].instruction
     for step in steps[1:]:
-        assert f"{MIN_TILT_DEG:.0f} to 60 degrees" in step.instruction, step.index
+        assert f"{MIN_TILT_DEG:.0f} to 60°" in step.instruction, step.index
 
 
 def test_the_touch_list_points_at_the_wizards_touches(tmp_path) -> None:
