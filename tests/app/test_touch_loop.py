@@ -60,7 +60,8 @@ def test_the_dock_shows_the_wizards_step_on_the_jog_tab_and_records_it(page) -> 
     assert dock.folder.visible and not touches.record.visible       # one Record: the dock's
     assert "Step 1 of 4" in dock.step_md.content
     assert tuple(dock.nav.options) == (BACK, NEXT, CANCEL)
-    assert dock.meter_bar.visible and "Pose diversity" in dock.meter_md.content
+    assert "Pose diversity" in dock.meter_md.content                # the meter's line; its bar's row
+    assert dock.pivot.visible and dock.pivot.disabled and not dock.meter_bar.visible   # holds the estimate
     p.tip_at((0.0, 0.0, 0.2))                                       # 0.2 mm above the tip
     p.click(dock.record)
     wiz = p.calibrate.workflow.wizard
