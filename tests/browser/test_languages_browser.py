@@ -29,6 +29,7 @@ def test_a_german_browser_gets_the_jog_tab_in_german_and_its_keys_work(app_facto
     assert s.jogger.settings.increment == "10"
     page.keyboard.press("BracketRight")
     wait_until(lambda: s.jogger.settings.increment == "100", "increment 100")
+    wait_text(page, "✓ 100")                  # the page shows it: the next ] steps on from 100
     page.keyboard.press("BracketRight")
     wait_until(lambda: s.jogger.settings.continuous, "continuous mode (Kont.)")
     wait_text(page, "✓ Kont.")
