@@ -54,16 +54,24 @@ def apply_class_push(session: Session, recorder: TraineeRecorder, name: str, exe
     (``tool_key`` of ``tools``; None: keep; free practice only), the rules and, with
     ``aids_too``, the aids."""
     with session.batch():
-        recorder.exercise_id = exercise
-        session.wizard_commands.set_hide_truth(exercise is not None)
-        if exercise == "mystery" and seed is not None:
-            mount_mystery(session, recorder, name, seed, tools)
-        else:
-            session.tools.set_exercise_tool(None)     # free practice: the trainee swaps tools again
-            if tool_key is not None:
-                session.tools.mount_tool(tools[tool_key])
+        if not _set_exercise(session, recorder, name, exercise, seed, tools) and tool_key is not None:
+            session.tools.mount_tool(tools[tool_key])
         apply_rules(session, rules, distance_aids, aids_too=aids_too)
         session.changed(wizard=True)      # the result panel shows or hides the truth
+
+
+def _set_exercise(session: Session, recorder: TraineeRecorder, name: str, exercise: str | None,
+                  seed: int | None, tools: dict[str, ToolModel]) -> bool:
+    """Put ``name``'s pendant in ``exercise`` (None: free practice): recorded as the exercise, the
+    truth hidden in one, the mystery tool from ``seed`` mounted and locked, or the lock lifted.
+    True: the mystery tool was mounted (no other tool may be)."""
+    recorder.exercise_id = exercise
+    session.wizard_commands.set_hide_truth(exercise is not None)
+    if exercise == "mystery" and seed is not None:
+        mount_mystery(session, recorder, name, seed, tools)
+        return True
+    session.tools.set_exercise_tool(None)         # free practice: the trainee swaps tools again
+    return False
 
 
 def apply_push_to(session: Session, recorder: TraineeRecorder, name: str, exercise: str | None,
@@ -78,12 +86,7 @@ def apply_push_to(session: Session, recorder: TraineeRecorder, name: str, exerci
     not changed)."""
     with session.batch():
         if sets_exercise:
-            recorder.exercise_id = exercise
-            session.wizard_commands.set_hide_truth(exercise is not None)
-            if exercise == "mystery" and seed is not None:
-                mount_mystery(session, recorder, name, seed, tools)
-            else:
-                session.tools.set_exercise_tool(None)     # free practice: the trainee swaps tools again
+            _set_exercise(session, recorder, name, exercise, seed, tools)
         if tool_key is not None and exercise != "mystery":
             session.tools.mount_tool(tools[tool_key])
         if not rules.distance_locked:

@@ -171,23 +171,11 @@ def contact_stop(tip_world_m: np.ndarray, step_world_m: np.ndarray,
     to the reference tip, and that point is within :data:`CONTACT_RADIUS_MM` of it, and the tip
     is not touching already (then it may go on: the trainee was warned at contact). None: the
     step goes on (it ends before the reference tip, passes beside it, or starts at it)."""
-    p = np.asarray(tip_world_m, dtype=float)
-    step = np.asarray(step_world_m, dtype=float)
-    r = np.asarray(reference_tip_world_m, dtype=float)
-    length2 = float(step @ step)
-    if length2 <= 0.0:
-        return None
-    if math.hypot(*(r - p).tolist()) * 1000.0 <= TOUCH_TOLERANCE_MM:
+    gap_m = np.asarray(reference_tip_world_m, dtype=float) - np.asarray(tip_world_m, dtype=float)
+    if math.hypot(*gap_m.tolist()) * 1000.0 <= TOUCH_TOLERANCE_MM:
         return None                                   # at contact already: the next press goes on
-    t = float((r - p) @ step) / length2
-    if not 0.0 < t < 1.0:
-        return None                                   # the closest point is not inside this step
-    if t * math.sqrt(length2) < _STOPPED_HERE_M:
-        return None                                   # stopped here by the last press: this one goes on
-    miss_mm = math.hypot(*(p + t * step - r).tolist()) * 1000.0
-    if miss_mm > CONTACT_RADIUS_MM or not math.isfinite(miss_mm):
-        return None
-    return ContactStop(t, miss_mm)
+    near = _closest_in_step(tip_world_m, step_world_m, reference_tip_world_m)
+    return None if near is None else ContactStop(near[0], near[2])
 
 
 def collision_stop(tip_world_m: np.ndarray, step_world_m: np.ndarray,
@@ -201,6 +189,22 @@ def collision_stop(tip_world_m: np.ndarray, step_world_m: np.ndarray,
 
     Unlike :func:`contact_stop` a start within the touch tolerance is no exemption: from 0.3 mm
     above the tip a 1 mm press would go 0.7 mm through."""
+    near = _closest_in_step(tip_world_m, step_world_m, reference_tip_world_m)
+    if near is None:
+        return None
+    t, length_m, miss_mm = near
+    if (1.0 - t) * length_m * 1000.0 <= CRASH_DEPTH_MM:
+        return None
+    return ContactStop(t, miss_mm)
+
+
+def _closest_in_step(tip_world_m: np.ndarray, step_world_m: np.ndarray,
+                     reference_tip_world_m: np.ndarray) -> tuple[float, float, float] | None:
+    """The point of a straight translation ``step_world_m`` of the tip at ``tip_world_m`` closest
+    to the reference tip (all metres), for :func:`contact_stop` and :func:`collision_stop`:
+    ``(t, |step| in m, miss in mm)`` with the point at ``tip + t step``, ``t = (r - p)·s / |s|²``.
+    None: an empty step, the closest point not inside the step (``0 < t < 1``), the tip stopped
+    there by the last press, or a miss over :data:`CONTACT_RADIUS_MM`."""
     p = np.asarray(tip_world_m, dtype=float)
     step = np.asarray(step_world_m, dtype=float)
     r = np.asarray(reference_tip_world_m, dtype=float)
@@ -210,10 +214,8 @@ def collision_stop(tip_world_m: np.ndarray, step_world_m: np.ndarray,
     t = float((r - p) @ step) / length2
     length = math.sqrt(length2)
     if not 0.0 < t < 1.0 or t * length < _STOPPED_HERE_M:
-        return None
-    if (1.0 - t) * length * 1000.0 <= CRASH_DEPTH_MM:
-        return None
+        return None                                   # outside this step, or stopped here by the last press
     miss_mm = math.hypot(*(p + t * step - r).tolist()) * 1000.0
     if miss_mm > CONTACT_RADIUS_MM or not math.isfinite(miss_mm):
         return None
-    return ContactStop(t, miss_mm)
+    return t, length, miss_mm
