@@ -1,33 +1,21 @@
 """What the trainee reads and sees named: where a step is jogged (Calibrate tab), which way to tilt
 for the next touch (the meter), which tool the 3D TOOL label names after a wizard's tool change,
-and the 3D legend of a result. In-process pendant and a websocket browser (``page``); the tilt
-numbers from tcpcal's own prediction."""
+and the 3D legend of a result. In-process pendant and a websocket browser (``page``)."""
 
 from __future__ import annotations
 
-import math
 import re
 
 import numpy as np
 import pytest
-from scipy.spatial.transform import Rotation
 from tcp_pendant.calibrate import AutoTouchRequest
-from tcp_pendant.calibrate.diversity import best_tilt, best_tilt_words
 from tcp_pendant.calibrate.text import scene_legend_markdown
 from tcp_pendant.controller import builtin_tools
 from tcp_pendant.views.scene import tool_label_text
-from tcpcal.pose_quality import candidate_gain
 from tcpcal.tool import Tool
 from support.calib_page import Page
 
 pytestmark = pytest.mark.app_page(cls=Page, seed=5)
-
-
-def _rot(axis: tuple[float, float, float], deg: float) -> np.ndarray:
-    return Rotation.from_rotvec(math.radians(deg) * np.asarray(axis, dtype=float)).as_matrix()
-
-
-R0 = np.diag([1.0, -1.0, -1.0])          # the flange pointing down (WORLD), as at the ready pose
 
 
 def test_after_start_the_calibrate_tab_says_to_jog_on_the_jog_tab_and_record_in_the_dock(page) -> None:
@@ -54,54 +42,6 @@ def test_a_beam_scan_step_is_not_sent_to_the_jog_tab(page) -> None:
     p.choose(v.method, "Automatic (beam)")
     p.click(v.start)
     assert "Beam scan" in v.steps.head_md.content and "Jog on the Jog tab" not in v.steps.head_md.content
-
-
-def test_best_tilt_after_tilts_about_one_axis_is_about_the_other_with_tcpcals_numbers() -> None:
-    # three touches turned about flange X only: the TCP component along X is not observed
-    touches = np.array([R0, R0 @ _rot((1, 0, 0), 45.0), R0 @ _rot((1, 0, 0), -45.0)])
-    tilt = best_tilt(touches, R0, sigma_mm=0.5)
-    assert tilt is not None
-    assert tilt.axis in ("Y", "Z") and tilt.key == {"Y": "B", "Z": "A"}[tilt.axis]
-    # every other turn of 45 deg about a TOOL (= FLANGE) axis predicts no smaller error
-    predicted = {}
-    for i, ax in enumerate("XYZ"):
-        for sign in (1, -1):
-            e = np.zeros(3)
-            e[i] = sign
-            predicted[(ax, sign)] = candidate_gain(touches, R0 @ _rot(tuple(e), 45.0), sigma=0.5).predicted_after
-    assert math.isinf(predicted[("X", 1)]) and math.isinf(predicted[("X", -1)])   # along the unobserved axis
-    assert tilt.predicted_mm == pytest.approx(min(predicted.values()))
-    assert tilt.predicted_mm == pytest.approx(predicted[(tilt.axis, tilt.sign)])
-    assert math.isinf(tilt.predicted_now_mm)                 # recording here adds nothing
-    np.testing.assert_allclose(tilt.axis_world, R0[:, "XYZ".index(tilt.axis)], atol=1e-12)
-    words = best_tilt_words(tilt)
-    assert f"about **TOOL {tilt.axis}**" in words and "by 45°" in words
-    assert f"key **{tilt.key} {'+' if tilt.sign > 0 else '−'}**" in words
-    assert f"**{tilt.predicted_mm:.2f} mm**" in words
-    if tilt.axis == "Y":
-        assert "(WORLD -Y now)" in words                     # flange Y points along WORLD -Y here
-
-
-def test_best_tilt_uses_the_tool_frame_of_the_jog_keys() -> None:
-    """With tool data turned 90 deg about flange Z, TOOL X is flange Y: the same missing turn
-    is named by the other TOOL axis (and the other key)."""
-    touches = np.array([R0, R0 @ _rot((1, 0, 0), 45.0), R0 @ _rot((1, 0, 0), -45.0)])
-    plain = best_tilt(touches, R0, sigma_mm=0.5)
-    R_ft = _rot((0, 0, 1), 90.0)
-    turned = best_tilt(touches, R0, R_flange_tool=R_ft, sigma_mm=0.5)
-    assert plain is not None and turned is not None
-    np.testing.assert_allclose(np.abs(turned.axis_world), np.abs(plain.axis_world), atol=1e-9)
-    assert turned.predicted_mm == pytest.approx(plain.predicted_mm)
-    assert (plain.axis, turned.axis) == ("Y", "X") or plain.axis == turned.axis == "Z"
-
-
-def test_best_tilt_says_nothing_before_two_touches_or_when_here_is_as_good() -> None:
-    assert best_tilt(np.array([R0]), R0 @ _rot((0, 1, 0), 45.0)) is None
-    spread = np.array([R0, R0 @ _rot((1, 0, 0), 45.0), R0 @ _rot((0, 1, 0), 45.0)])
-    here = R0 @ _rot((1, 1, 0) / np.sqrt(2.0), -50.0)         # already a good fourth orientation
-    tilt = best_tilt(spread, here)
-    now = candidate_gain(spread, here, sigma=0.5).predicted_after
-    assert tilt is None or tilt.predicted_mm < 0.95 * now
 
 
 def test_the_calibrate_tab_meter_names_the_tilt_after_two_touches(page) -> None:

@@ -23,16 +23,15 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike
 from scipy.spatial.transform import Rotation
 
-from tcpcal.pose_quality import assess_touches, candidate_gain
+from tcpcal.pose_quality import assess_touches
 
-__all__ = ["MIN_TILT_DEG", "BestTilt", "axis_in_words", "best_tilt", "best_tilt_words", "diversity_advice",
-           "failure_in_words", "missing_axis_in_words"]
+__all__ = ["MIN_TILT_DEG", "axis_in_words", "diversity_advice", "failure_in_words", "least_observed",
+           "missing_axis_in_words"]
 
 MIN_TILT_DEG = 45.0
 """The least tilt asked for between touches (the step texts ask 45-60 deg about two axes): four
@@ -156,104 +155,10 @@ def diversity_advice(recorded: ArrayLike, candidate: ArrayLike, angle_to_nearest
             f"{missing_axis_in_words(axis, cand)}.")
 
 
-_TOOL_KEYS = {"X": "C", "Y": "B", "Z": "A"}
-"""The jog key that turns about each TOOL axis (KUKA: A about Z, B about Y, C about X)."""
-
-
-@dataclass(frozen=True)
-class BestTilt:
-    """The turn from the current orientation that helps the TCP most (:func:`best_tilt`).
-
-    Attributes:
-        axis: "X", "Y" or "Z": the TOOL axis to turn about.
-        sign: +1 or -1, the direction of the turn (right hand about ``axis``).
-        angle_deg: the turn, degrees.
-        key: the jog key of that turn in the TOOL frame ("A", "B", "C").
-        axis_world: the axis in WORLD now (unit vector).
-        predicted_now_mm: tcpcal's predicted TCP RMS error if the current pose were recorded, mm
-            (inf: not determinable).
-        predicted_mm: the same after the turn, mm (inf: one more touch gives no prediction yet).
-    """
-
-    axis: str
-    sign: int
-    angle_deg: float
-    key: str
-    axis_world: np.ndarray
-    predicted_now_mm: float
-    predicted_mm: float
-
-
-def _world_axis_name(w: np.ndarray) -> str:
-    """The WORLD axis a direction is closest to, with its sign ("WORLD -Y"); "" when it is
-    more than 30 deg from all of them."""
-    i = int(np.argmax(np.abs(w)))
-    if abs(float(w[i])) < _VERTICAL_COS:
-        return ""
-    return f"WORLD {'+' if w[i] > 0 else '-'}{'XYZ'[i]}"
-
-
-def _least_observed(rots: np.ndarray) -> float:
+def least_observed(rots: np.ndarray) -> float:
     """Smallest eigenvalue of the touches' information matrix for the TCP, ``sum (R_i -
     R_mean)^T (R_i - R_mean)`` (the reference point eliminated): how well the worst-determined
     TCP direction is seen (0: not at all)."""
     d = rots - rots.mean(axis=0)
     M = np.einsum("nji,njk->ik", d, d)
     return float(np.linalg.eigvalsh(M)[0])
-
-
-def best_tilt(recorded: ArrayLike, R_world_flange: ArrayLike, *, R_flange_tool: ArrayLike | None = None,
-              sigma_mm: float = 0.5, angle_deg: float = MIN_TILT_DEG) -> BestTilt | None:
-    """Of the six turns by ``angle_deg`` about the TOOL axes (both ways) from ``R_world_flange``,
-    the one that helps the TCP most if recorded next: the smallest TCP RMS error tcpcal predicts
-    after it; while one more touch cannot give a prediction yet (tcpcal wants four), the
-    largest smallest eigenvalue of the information matrix (the least-observed TCP direction
-    seen best).
-
-    Args:
-        recorded: (N, 3, 3) ``R_world_flange`` of the touches so far.
-        R_world_flange: (3, 3) the flange's orientation now.
-        R_flange_tool: (3, 3) the active TOOL frame's orientation on the flange (None: TOOL =
-            FLANGE, no tool data).
-        sigma_mm: the operator error per axis assumed, mm.
-        angle_deg: the turn tried, degrees.
-
-    Returns:
-        The best turn, or None with fewer than two touches (every turn is as good), or when
-        recording here is as good as the best turn (within 5 %).
-    """
-    rots = np.asarray(recorded, dtype=float).reshape(-1, 3, 3)
-    R_wf = np.asarray(R_world_flange, dtype=float).reshape(3, 3)
-    R_ft = np.eye(3) if R_flange_tool is None else np.asarray(R_flange_tool, dtype=float).reshape(3, 3)
-    if rots.shape[0] < 2:
-        return None
-    now = float(candidate_gain(rots, R_wf, sigma=sigma_mm).predicted_after)
-    tries = []
-    for i, axis in enumerate("XYZ"):
-        a_flange = R_ft[:, i]
-        for sign in (1, -1):
-            turn = Rotation.from_rotvec(sign * math.radians(angle_deg) * a_flange).as_matrix()
-            R_try = R_wf @ turn                         # turned about a flange-fixed (TOOL) axis
-            after = float(candidate_gain(rots, R_try, sigma=sigma_mm).predicted_after)
-            seen = _least_observed(np.concatenate([rots, R_try[None]]))
-            tries.append((BestTilt(axis, sign, float(angle_deg), _TOOL_KEYS[axis], R_wf @ a_flange, now, after), seen))
-    finite = [(b, s) for b, s in tries if math.isfinite(b.predicted_mm)]
-    if finite:
-        best = min(finite, key=lambda bs: bs[0].predicted_mm)[0]
-        return None if math.isfinite(now) and best.predicted_mm >= 0.95 * now else best
-    best, seen = max(tries, key=lambda bs: bs[1])
-    seen_now = _least_observed(np.concatenate([rots, R_wf[None]]))
-    return None if seen <= 1e-6 or seen <= 1.05 * seen_now else best
-
-
-def best_tilt_words(tilt: BestTilt) -> str:
-    """"Tilt that helps most: about TOOL Y (WORLD -X now) by 45° (key B +) → predicted error 0.95 mm"."""
-    world = _world_axis_name(tilt.axis_world)
-    where = f" ({world} now)" if world else ""
-    sym = "+" if tilt.sign > 0 else "−"
-    head = (f"Tilt that helps most: about **TOOL {tilt.axis}**{where} by {tilt.angle_deg:.0f}° "
-            f"(key **{tilt.key} {sym}**, TOOL frame)")
-    if not math.isfinite(tilt.predicted_mm):
-        return head + ": it shows the TCP from the side the touches see least."
-    now = ("" if not math.isfinite(tilt.predicted_now_mm) else f"{tilt.predicted_now_mm:.2f} mm here → ")
-    return f"{head}: predicted TCP error {now}**{tilt.predicted_mm:.2f} mm**."

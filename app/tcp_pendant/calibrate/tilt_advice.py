@@ -4,9 +4,9 @@
 frame by ``tilts.TILT_DEG``, as the trainee will press them (about the frame's axes through the
 TCP): ``R_world_flange' = Exp(s angle a) R_world_flange`` with ``a`` the frame's axis in WORLD.
 Only usable ones count (``pendant.tilts``: reachable on the robot model with the tip held, and
-not a turn about the tool's own length). Each is scored as ``diversity.best_tilt`` scores its
-turns: tcpcal's predicted TCP error after it (``candidate_gain``), or, while one more touch
-cannot give a prediction yet, the least-observed eigenvalue of the touches' information matrix.
+not a turn about the tool's own length). Each is scored by tcpcal's predicted TCP error after it
+(``candidate_gain``), or, while one more touch cannot give a prediction yet, the least-observed
+eigenvalue of the touches' information matrix (``diversity.least_observed``).
 When no key of the active frame is usable the other frames are tried, and the hint says how
 to switch (the Frame dropdown); in Joint mode it says to set Mode to Cartesian first.
 
@@ -39,7 +39,7 @@ from tcpcal.errors import TcpcalError
 from tcpcal.origin import solve_xyz4
 from tcpcal.pose_quality import CandidateGain, candidate_gain
 
-from tcp_pendant.calibrate.diversity import MIN_TILT_DEG
+from tcp_pendant.calibrate.diversity import MIN_TILT_DEG, least_observed
 from tcp_pendant.pendant.jogging import JOG_FRAMES, Jogger, JogMode
 from tcp_pendant.pendant.tilts import TILT_DEG, TiltOption, key_label, keyboard_key
 
@@ -134,15 +134,10 @@ class TiltAdvice:
     text: str
 
 
-def _least_observed(rots: np.ndarray) -> float:
-    d = rots - rots.mean(axis=0)
-    return float(np.linalg.eigvalsh(np.einsum("nji,njk->ik", d, d))[0])
-
-
 def _score(rots: np.ndarray, R: np.ndarray, sigma_mm: float) -> tuple[float, float]:
     """(predicted TCP error after recording at ``R`` (inf: none yet), least-observed eigenvalue)."""
     after = float(candidate_gain(rots, R, sigma=sigma_mm).predicted_after)
-    return after, _least_observed(np.concatenate([rots, R[None]]))
+    return after, least_observed(np.concatenate([rots, R[None]]))
 
 
 def _better(a: tuple[float, float], b: tuple[float, float]) -> bool:
