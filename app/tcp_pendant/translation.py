@@ -23,6 +23,7 @@ from pathlib import Path
 
 __all__ = [
     "DOMAIN",
+    "ENGLISH",
     "LANGUAGE_NAMES",
     "LOCALE_DIR",
     "N_",
@@ -161,3 +162,8 @@ def negotiate(accept_language: str | None, default: str = SOURCE_LANGUAGE) -> st
         if language is not None and (best is None or (-quality, order) < (-best[0], best[1])):
             best = (quality, order, language)
     return default if best is None else best[2]
+
+
+ENGLISH = translator(SOURCE_LANGUAGE)
+"""The source language's translator: the default ``tr`` of every function that composes text
+(``def words(..., tr: Translator = ENGLISH)``), so tests and the CLI get English."""

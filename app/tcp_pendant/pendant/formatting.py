@@ -22,9 +22,8 @@ from tcpcal.tool import Tool
 from tcp_pendant.controller import PoseReadout, TouchGeometry
 from tcp_pendant.controller.touch import TOUCH_TOLERANCE_MM
 from tcp_pendant.text_escape import escape_markdown
-from tcp_pendant.translation import SOURCE_LANGUAGE, Translator, translator
+from tcp_pendant.translation import ENGLISH, Translator, translator
 
-ENGLISH = translator(SOURCE_LANGUAGE)
 """The source language's translator: the default of the readouts' ``tr``."""
 
 __all__ = [

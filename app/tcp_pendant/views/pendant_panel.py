@@ -73,7 +73,7 @@ from tcp_pendant.pendant.hold import HoldDriver, Timer
 from tcp_pendant.pendant.jogging import CONTINUOUS
 from tcp_pendant.pendant.guidance import CLOSEUP_WITHIN_MM, offset_markdown, side_view_markdown, tip_offset_xyz_mm
 from tcp_pendant.session import Session, SessionChange
-from tcp_pendant.translation import N_, SOURCE_LANGUAGE, Translator, translator
+from tcp_pendant.translation import ENGLISH, N_, SOURCE_LANGUAGE, Translator, translator
 from tcp_pendant.views import arrival
 from tcp_pendant.views.scene import closeup_camera, overview_camera
 from tcp_pendant.views.gui_util import ButtonEvent, ButtonGroupEvent, CheckboxEvent, set_value, target_of
@@ -100,7 +100,6 @@ HOLD_HZ = 20.0
 _AXIS_HINT = {"X": N_("translate along X (mm)"), "Y": N_("translate along Y (mm)"),
               "Z": N_("translate along Z (mm)"), "A": N_("rotate about Z through the TCP (deg)"),
               "B": N_("rotate about Y through the TCP (deg)"), "C": N_("rotate about X through the TCP (deg)")}
-_ENGLISH = translator(SOURCE_LANGUAGE)
 _MODE_WORDS = {JogMode.CARTESIAN: N_("Cartesian"), JogMode.JOINT: N_("Joint")}
 """The Mode buttons' words (the values are ``JogMode``'s English names)."""
 
@@ -135,22 +134,22 @@ DROP_REPORT_EVERY_S = 1.0
 """Dropped jog presses are reported (status line, notification) at most this often (s)."""
 
 
-def jog_key_hint(row: int, tr: Translator = _ENGLISH) -> str:
+def jog_key_hint(row: int, tr: Translator = ENGLISH) -> str:
     """The keys of jog-key row ``row`` (0-based) as its hint says them ("" past the 9th row)."""
     return tr.gettext("keys {n} (+) and Shift+{n} (−)").format(n=row + 1) if 0 <= row < 9 else ""
 
 
-def _with_keys(hint: str, row: int, tr: Translator = _ENGLISH) -> str:
+def _with_keys(hint: str, row: int, tr: Translator = ENGLISH) -> str:
     keys = jog_key_hint(row, tr)
     return f"{hint}; {keys}" if hint and keys else hint or keys
 
 
-def mode_word(mode: JogMode, tr: Translator = _ENGLISH) -> str:
+def mode_word(mode: JogMode, tr: Translator = ENGLISH) -> str:
     """The Mode button of ``mode`` in ``tr``'s language."""
     return tr.gettext(_MODE_WORDS[mode])
 
 
-def increment_word(increment: str, tr: Translator = _ENGLISH) -> str:
+def increment_word(increment: str, tr: Translator = ENGLISH) -> str:
     """An Increment button: the numbers as they are, ``Cont.`` in ``tr``'s language."""
     return tr.pgettext("increment", "Cont.") if increment == CONTINUOUS else increment
 
