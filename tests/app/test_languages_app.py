@@ -5,7 +5,6 @@ text of the Jog panel is in the catalogs except names and numbers."""
 
 from __future__ import annotations
 
-import re
 from collections.abc import Iterator
 from typing import Any
 
@@ -13,6 +12,7 @@ import numpy as np
 import pytest
 import viser
 
+from support.pseudo_text import WORD, gui_texts, untranslated_words
 from support.wsclient import DrainingClient, InputsClient, wait_until
 
 from tcp_pendant.controller import TouchGeometry
@@ -20,7 +20,7 @@ from tcp_pendant.pendant.formatting import dropped_presses_text, touch_indicator
 from tcp_pendant.pendant.jogging import JOG_FRAMES, JogMode
 from tcp_pendant.serve.server import AppConfig, PendantApp
 from tcp_pendant.session import Session
-from tcp_pendant.translation import PSEUDO_LANGUAGE, translator
+from tcp_pendant.translation import LANGUAGE_NAMES, PSEUDO_LANGUAGE, translator
 from tcp_pendant.views.pendant_panel import PendantPanel
 
 
@@ -113,21 +113,6 @@ def test_the_selector_switches_one_browser_live_keeping_pose_and_wizard(app_fact
         anna.ws.close()
 
 
-# ---------------------------------------------------------------- the pseudo-locale's check
-PSEUDO_SPAN = re.compile(r"⟦[^⟦⟧]*⟧")
-CODE_SPAN = re.compile(r"`[^`]*`|```.*?```", re.S)
-TAG = re.compile(r"<[^<>]*>")
-WORD = re.compile(r"[A-Za-z][A-Za-z0-9]*")
-
-
-def untranslated_words(text: str, names: set[str]) -> list[str]:
-    """The ASCII words of ``text`` outside the pseudo-locale's ``⟦ ⟧`` spans and code blocks
-    (the readouts' fixed tables and key names) and HTML tags (hidden markup, not shown) that
-    are not ``names``."""
-    rest = CODE_SPAN.sub(" ", PSEUDO_SPAN.sub(" ", TAG.sub(" ", text)))
-    return [w for w in WORD.findall(rest) if w not in names]
-
-
 def _handles(panel: PendantPanel) -> Iterator[tuple[str, object]]:
     """Every GUI handle of the Jog panel (its own: not the tip views', a view of its own)."""
     for name, value in vars(panel).items():
@@ -138,15 +123,6 @@ def _handles(panel: PendantPanel) -> Iterator[tuple[str, object]]:
                           | viser.GuiFolderHandle):
                 yield name, item
     yield "language", panel.language.dropdown
-
-
-def _texts(handle: object) -> Iterator[str]:
-    for prop in ("label", "hint", "content"):
-        value = getattr(handle, prop, None)
-        if isinstance(value, str) and value:
-            yield value
-    if isinstance(handle, viser.GuiButtonGroupHandle):
-        yield from handle.options
 
 
 def test_with_the_pseudo_locale_every_text_of_the_jog_panel_is_from_the_catalogs(app_factory: Any) -> None:
@@ -162,7 +138,8 @@ def test_with_the_pseudo_locale_every_text_of_the_jog_panel_is_from_the_catalogs
         panel = s.views["pendant"]
         joints = set(s.controller.kinematics.joint_names)
         names = (set("XYZABC") | joints | set(JOG_FRAMES) | {"WORLD", "BASE", "HOME", "mm", "deg", "TOOL",
-                 "FLANGE", "TCP", "KR", "Shift", "A5", "Language"} | {w for n in (s.controller.mounted_tool.label,)
+                 "FLANGE", "TCP", "KR", "Shift", "A5", "Language"}
+                 | {w for n in LANGUAGE_NAMES.values() for w in WORD.findall(n)} | {w for n in (s.controller.mounted_tool.label,)
                                                           for w in WORD.findall(n or "")})
         for mode, increment in (("Cartesian", "10"), ("Joint", "10"), ("Joint", "Cont."), ("Cartesian", "Cont.")):
             with s.lock:
@@ -171,7 +148,7 @@ def test_with_the_pseudo_locale_every_text_of_the_jog_panel_is_from_the_catalogs
                 panel._show_settings()
                 panel.render()
             for name, handle in _handles(panel):
-                for text in _texts(handle):
+                for text in gui_texts(handle):
                     if name == "touch_md":
                         text = text.split("\n\n`ΔX")[0]          # the guidance's offset line (docstring)
                     assert untranslated_words(text, names) == [], (name, text)
