@@ -150,7 +150,8 @@ def presenter_steps_markdown(wizard: Wizard | None, *, font_px: int = STEPS_FONT
         text = f"{sym} {s.index + 1}. {escape_html(str(s.title))}"
         lines.append(f'<b class="current-step">{text}</b>' if here else text)
     if wizard.is_complete:
-        lines.append(f'<b class="current-step">▶ {escape_html(_("Result"))}</b>')
+        result = escape_html(_("Result"))
+        lines.append(f'<b class="current-step">▶ {result}</b>')
     method = getattr(wizard, "title", None)
     title = escape_html(_(str(method)) if method else _("Wizard"))
     items = "".join(f'<span style="white-space:nowrap; margin-right:0.7em">{x}</span> ' for x in lines)
