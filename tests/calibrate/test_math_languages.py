@@ -66,6 +66,10 @@ def _texts(s) -> Iterator[tuple[str, str]]:
     yield "board.html", board.html.content
 
 
+def math_board_content(s) -> str:
+    return str(s.views["presenter"].board.html.content)
+
+
 def check_all_from_catalogs(s) -> int:
     """Asserts every text is from the catalogs; returns how many texts it checked."""
     names = NAMES | _wizard_words(s)
@@ -153,3 +157,75 @@ def test_every_math_view_shows_only_catalog_words_in_the_pseudo_locale(page) -> 
     assert seen == set(MATH_VIEWS)
     assert {"touch-1", "A", "pair", "stack", "lstsq", "sphere", "eq7", "eq8-17", "eq18-24", "eq25-29", "eq30",
             "pa", "axis-z", "axis-x", "frame", "reference-point", "new-tcp", "event-1", "spin"} <= keys
+
+
+def _turning_about_one_axis(n: int) -> SimpleNamespace:
+    """A 4-point wizard's record (what ``math_sheet`` reads) of ``n`` exact touches whose tool
+    turns about WORLD Z only: the TCP along that axis is unobservable, the flange origins lie on
+    one circle (a plane), so the stack stays rank 2, the solver refuses and the sphere cannot
+    be fitted."""
+    t_mm, r_mm = np.array([10.0, 20.0, 150.0]), np.array([600.0, 50.0, 300.0])
+    poses = {}
+    for i in range(n):
+        R = Rotation.from_euler("zx", [40.0 * i, 180.0], degrees=True).as_matrix()
+        T = np.eye(4)
+        T[:3, :3], T[:3, 3] = R, (r_mm - R @ t_mm) / 1000.0          # metres, as recorded
+        poses[i] = SimpleNamespace(T_world_flange_m=T)
+
+    class Wizard(SimpleNamespace):
+        math_view = "xyz4"
+        title = "XYZ 4-point"
+
+    return Wizard(recorded_poses=poses, steps=[SimpleNamespace(role="touch") for _ in range(n)], excluded=())
+
+
+def test_the_degenerate_touches_words_are_from_the_catalogs_too() -> None:
+    """The words a good run never shows: a stack of rank 2 from more than two touches, the
+    solver's refusal (in our words, not tcpcal's English), no sphere."""
+    qps, names = translator(PSEUDO_LANGUAGE), NAMES | {"XYZ", "point"}
+    sheet = math_sheet(_turning_about_one_axis(4), tr=qps)
+    assert sheet is not None and sheet.has("lstsq") and sheet.has("sphere")
+    assert sheet.block("lstsq").lines == (qps.gettext("no solution yet"),)
+    assert sheet.block("sphere").lines == (qps.gettext("no sphere yet"),)
+    assert "⟦Åļļ ţöûçĥéš ŕöţåţé" in sheet.block("stack").note and "⟦Åļļ ţöûçĥéš ŕöţåţé" in sheet.block("lstsq").note
+    md = math_markdown(sheet, tr=qps)
+    assert untranslated_outside_math(md, names) == []
+    assert untranslated_outside_math(board_html(sheet, tr=qps), names) == []
+    assert untranslated_outside_math(math_markdown(None, tr=qps), set()) == []
+    assert untranslated_outside_math(board_html(None, tr=qps), set()) == []
+    english = math_sheet(_turning_about_one_axis(4))
+    assert english is not None and english.block("lstsq").note.startswith("All touches rotate about nearly")
+
+
+def test_a_language_switch_re_renders_the_math_keeping_the_pair_and_english_comes_back_byte_for_byte(page) -> None:
+    p = page()
+    s = p.session
+    presenter = s.views["presenter"]
+    choose(presenter.toggle, True, s.client)
+    choose(presenter.board.toggle, True, s.client)
+    with s.lock:
+        s.wizard_commands.start("xyz4")
+    touch(s, 3, sigma_mm=0.3)
+    math = s.views["calibrate"].math
+    choose(math.pair, "1 and 3", s.client)
+    pair = math.sheet.block("pair").values["R_a-R_b"].value
+    english = list(_texts(s))
+    assert ("math.folder", "The math") in english and "1 and 3" in math.pair.options
+    assert 'data-toggle="Math board" data-back="Back to the pendant"' in math_board_content(s)
+
+    s.set_language(PSEUDO_LANGUAGE)
+    with s.lock:
+        pseudo = list(_texts(s))
+        assert math.pair.value == "⟦{a} åñð {b}⟧".replace("{a}", "1").replace("{b}", "3")   # the same pair
+        np.testing.assert_array_equal(math.sheet.block("pair").values["R_a-R_b"].value, pair)
+    assert check_all_from_catalogs(s) > 10
+    assert [w for w, _ in pseudo] == [w for w, _ in english]
+    changed = {w for (w, before), (_, after) in zip(english, pseudo) if before != after}
+    assert {"math.folder", "math.pair", "math.md", "presenter.toggle", "presenter.folder", "presenter.readout_md",
+            "presenter.tool_md", "chart.title", "chart.series", "chart.axis", "board.toggle", "board.html"} <= changed
+    assert 'data-toggle="⟦Ṁåţĥ ƀöåŕð⟧"' in math_board_content(s)     # the page script finds the checkbox by it
+
+    s.set_language("en")
+    with s.lock:
+        assert list(_texts(s)) == english
+        assert math.pair.value == "1 and 3"

@@ -42,7 +42,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import numpy.typing as npt
 
-from tcpcal.errors import TcpcalError
+from tcpcal.errors import DegenerateTouchesError, TcpcalError
 from tcpcal.orientation import R_WORLD_TOOL_PARALLEL
 from tcpcal.origin import TcpResult, solve_xyz4
 from tcpcal.tool import abc_deg_from_rotation
@@ -389,10 +389,28 @@ def _stack_block(steps: Sequence[int], R: np.ndarray, f: np.ndarray,
     return blk.build(), t_pinv
 
 
+def _refusal_note(exc: TcpcalError, steps: Sequence[int], tr: Translator) -> str:
+    """Why the solver refused the touches, in ``tr``'s language (tcpcal's own message is English:
+    it has no user interface), from what its error names: the axis all touches turn about, the
+    two touches (step numbers of ``steps``) of the same orientation, or the orientations alike."""
+    _ = tr.gettext
+    if isinstance(exc, DegenerateTouchesError):
+        if exc.unobservable_axis is not None:
+            return _("All touches rotate about nearly the same axis, so the TCP along it cannot be "
+                     "determined; tilt the tool about a second axis.")
+        if len(exc.indices) == 2 and all(0 <= i < len(steps) for i in exc.indices):
+            a, b = (steps[i] + 1 for i in exc.indices)
+            return _("Touches {a} and {b} have the same orientation: record touch {b} again from a "
+                     "different orientation.").format(a=a, b=b)
+        return _("The touches have nearly the same orientation, so the TCP cannot be determined; tilt "
+                 "the tool 30 to 60 degrees between touches, about two different axes.")
+    return _("The solver refuses these touches: {error}").format(error=exc)
+
+
 def _lstsq_block(R: np.ndarray, f: np.ndarray, t_pinv: np.ndarray | None,
-                 tr: Translator = ENGLISH) -> tuple[MathBlock, TcpResult | None]:
-    """(4P-3) by tcpcal's solve_xyz4 (the solver), set beside the pseudo-inverse. The solver's
-    refusal shows as it comes (tcpcal speaks English: it has no user interface)."""
+                 tr: Translator = ENGLISH, steps: Sequence[int] = ()) -> tuple[MathBlock, TcpResult | None]:
+    """(4P-3) by tcpcal's solve_xyz4 (the solver), set beside the pseudo-inverse; its refusal
+    in words (:func:`_refusal_note`)."""
     _ = tr.gettext
     blk = _Block("lstsq", "(4P-3)", _("joint least squares, {equation}").format(
         equation="x = (t, r): [R_i  −I] x = −f_i"), tr)
@@ -400,7 +418,7 @@ def _lstsq_block(R: np.ndarray, f: np.ndarray, t_pinv: np.ndarray | None,
         res = solve_xyz4(R, f, method="lstsq", detect_outliers=False)   # t, r: the same; cheaper
     except TcpcalError as exc:
         blk.words(N_("no solution yet"))
-        blk.note(_("tcpcal: {error}").format(error=exc))
+        blk.note(_refusal_note(exc, steps, tr))
         return blk.build(), None
     t = np.asarray(res.tcp, dtype=float)
     if t_pinv is not None:                       # side by side: Eq. (8), then (4P-3)
@@ -517,7 +535,7 @@ def _origin_sheet(view: str, title: str, steps: list[int], R: np.ndarray, f: np.
         stack, t_pinv = _stack_block(steps, R, f, tr)
         blocks.append(stack)
         if n >= 4:
-            lst, _res = _lstsq_block(R, f, t_pinv, tr)
+            lst, _res = _lstsq_block(R, f, t_pinv, tr, steps)
             blocks.append(lst)
             blocks.append(_sphere_block(R, f, tr))
     more = _("Each touch gives R_i t + f_i = r (4P-1): three equations, but t and r are six unknowns.") if n < 2 else ""
