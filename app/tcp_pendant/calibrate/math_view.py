@@ -20,6 +20,12 @@ Units: lengths in mm (2 decimals), rotation entries and cosines 3 decimals, angl
 (2 decimals), as a slide would show them. Nothing here reads the hidden true tool: in a
 classroom exercise the sheet is the trainee's own data only.
 
+Languages: the sheet's words (labels, titles, lines of words, notes, the intro) are catalog
+messages in the language of ``math_sheet``'s ``tr`` (English by default); the equations stand
+in them as ``{placeholders}`` and are the same in every language, as are the numbers (decimal
+point) and the frame names. A line of words is held to ``MAX_LINE`` in English
+(:meth:`_Block.words`); a translation may run longer and the block scrolls sideways.
+
 Rendering (:func:`math_markdown`): monospace matrices in viser markdown, not matplotlib's
 mathtext as PNG images. Why: (1) the panel is 320 px wide in presenter mode and an image is
 scaled to the panel's width, so a rendered equation with two 3x3 matrices would shrink below
