@@ -34,11 +34,10 @@ NAMES = {"WORLD", "FLANGE", "TOOL", "mm", "deg", "X", "Y", "Z", "A", "B", "C", "
 
 def _wizard_words(s) -> set[str]:
     """The words the wizard gives: its method's title (its class's msgid, wrapped by the wizards'
-    part of issue 47) and its steps' titles (they come in the wizard's language), and the tools'
-    names (user text)."""
+    part of issue 47) and its steps' titles (they come in the wizard's language), and the active
+    tool's name (user text: the presenter's "Tool data")."""
     wiz = s.workflow.wizard
     texts = [str(getattr(type(wiz), "title", ""))] + [str(st.title) for st in getattr(wiz, "steps", ())]
-    texts += [t.name for _, t in s.library.items()] if hasattr(s.library, "items") else []
     tool = s.controller.active_tool
     texts += [tool.name] if tool is not None else []
     return {w for t in texts for w in WORD.findall(t)}
