@@ -14,6 +14,7 @@ from typing import Any
 import pytest
 from tcpcal.library import ToolLibrary
 from tcpcal.tool import Tool
+from tcp_pendant.translation import PSEUDO_LANGUAGE, translator
 
 from support.calib_helpers import true_frame
 from support.pendant_page import TIMEOUT_MS, choose
@@ -95,3 +96,23 @@ def test_three_point_board_at_1024x768(pendant_server, new_page, shot, tmp_path:
     text = board_in_view(page, ("eq7", "eq8-17", "eq18-24", "eq30"))
     assert "c2' =" in text and "3 poses recorded." in text
     shot(page, "board_three_point_1024x768")
+
+
+def test_in_another_language_the_board_and_its_button_speak_it_and_the_button_still_unticks(
+        pendant_server, new_page, shot) -> None:
+    """The page script finds the "Math board" checkbox by its label in the pendant's language
+    and words its button in it (the board's data-toggle and data-back; serve/static/pendant.js,
+    9.): the pseudo-locale, whose words are nothing like English."""
+    qps = translator(PSEUDO_LANGUAGE)
+    server = pendant_server("--shared", "--presenter", "--language", PSEUDO_LANGUAGE)
+    page = new_page(server.url, width=1024, height=768)
+    page.get_by_label(qps.gettext("Math board")).first.check()
+    board = page.locator("#tcp-pendant-board")
+    board.wait_for(state="visible", timeout=TIMEOUT_MS)
+    back = board.get_by_role("button", name=qps.gettext("Back to the pendant"))
+    assert back.count() == 1
+    assert qps.gettext("No method with worked equations is open: start one in the Calibrate tab.") in board.inner_text()
+    shot(page, "board_pseudo_locale_1024x768")
+    back.click()
+    board.wait_for(state="detached", timeout=TIMEOUT_MS)
+    assert not page.get_by_label(qps.gettext("Math board")).first.is_checked()

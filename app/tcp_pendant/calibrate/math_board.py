@@ -11,14 +11,26 @@ sheet is in view without scrolling. To fit it, the board leaves out what the pan
 says in addition: the notes (the lecturer says them) and, once the stacked matrix A is on the
 sheet, the per-touch blocks (A holds every R_i). The numbers are the sheet's lines as they are
 (``MathBlock.lines``); every text is escaped (``text_escape.escape_html``).
+
+The board's words come in the session's language: the sheet's own (``math_view.math_sheet``'s
+``tr``), the "no method" line and, as ``data-toggle`` and ``data-back`` attributes of the outer
+``<div>``, the "Math board" checkbox's label and the "Back to the pendant" button's text: the
+page script finds the checkbox and words its button by them.
 """
 
 from __future__ import annotations
 
 from tcp_pendant.calibrate.math_view import MathBlock, MathSheet
 from tcp_pendant.text_escape import escape_html
+from tcp_pendant.translation import ENGLISH, N_, Translator
 
-__all__ = ["BOARD_CLASS", "BOARD_COLUMN_CH", "BOARD_FONT_PX", "board_blocks", "board_html"]
+__all__ = ["BACK_LABEL", "BOARD_CLASS", "BOARD_COLUMN_CH", "BOARD_FONT_PX", "BOARD_LABEL", "board_blocks",
+           "board_html"]
+
+BOARD_LABEL = N_("Math board")
+"""The presenter's checkbox that shows the board (English msgid; shown translated)."""
+BACK_LABEL = N_("Back to the pendant")
+"""The board's button that unticks :data:`BOARD_LABEL` (English msgid; shown translated)."""
 
 BOARD_CLASS = "math-board"
 """The class of the board's outer ``<div>`` (the page script shows it full screen)."""
@@ -49,14 +61,25 @@ def _block(b: MathBlock) -> str:
             f'line-height:{BOARD_LINE_HEIGHT}; white-space:nowrap">{body}</div></div>')
 
 
-def board_html(sheet: MathSheet | None) -> str:
+def _outer(tr: Translator, view: str = "") -> str:
+    """The board's opening ``<div>``: its class, the view, the page script's two labels."""
+    data_view = f' data-view="{escape_html(view)}"' if view else ""
+    return (f'<div class="{BOARD_CLASS}"{data_view} data-toggle="{escape_html(tr.gettext(BOARD_LABEL))}" '
+            f'data-back="{escape_html(tr.gettext(BACK_LABEL))}">')
+
+
+def board_html(sheet: MathSheet | None, *, tr: Translator = ENGLISH) -> str:
     """The board's HTML (one ``<div class="math-board">``) for ``sheet`` (None: no method with
-    equations is open, said in words)."""
+    equations is open, said in words), its own words in ``tr``'s language (the sheet's come in
+    the sheet's)."""
     if sheet is None:
-        inner = (f'<div class="board-title" style="font:{BOARD_FONT_PX}px sans-serif">No method with worked '
-                 "equations is open: start one in the Calibrate tab.</div>")
-        return f'<div class="{BOARD_CLASS}">{inner}</div>'
-    intro = sheet.intro.split(". ")[0].rstrip(".") + "." if sheet.intro else ""
+        words = escape_html(tr.gettext("No method with worked equations is open: start one in the Calibrate tab."))
+        inner = f'<div class="board-title" style="font:{BOARD_FONT_PX}px sans-serif">{words}</div>'
+        return f"{_outer(tr)}{inner}</div>"
+    if sheet.headline:
+        intro = sheet.headline
+    else:
+        intro = sheet.intro.split(". ")[0].rstrip(".") + "." if sheet.intro else ""
     title = (f'<div class="board-title" style="font:700 {BOARD_FONT_PX + 2}px/1.3 sans-serif; margin:0 0 8px 0; '
              f'white-space:nowrap; overflow:hidden; text-overflow:ellipsis">{escape_html(sheet.title)}'
              f'<span style="font-weight:400"> · {escape_html(intro)}</span></div>')
@@ -64,4 +87,4 @@ def board_html(sheet: MathSheet | None) -> str:
     columns = (f'<div class="board-columns" style="column-width:{BOARD_COLUMN_CH}ch; column-gap:18px; '
                f'column-fill:auto; height:calc(100vh - 60px); font-family:monospace; '
                f'font-size:{BOARD_FONT_PX}px">{blocks}</div>')
-    return f'<div class="{BOARD_CLASS}" data-view="{escape_html(sheet.view)}">{title}{columns}</div>'
+    return f"{_outer(tr, sheet.view)}{title}{columns}</div>"

@@ -20,6 +20,12 @@ Units: lengths in mm (2 decimals), rotation entries and cosines 3 decimals, angl
 (2 decimals), as a slide would show them. Nothing here reads the hidden true tool: in a
 classroom exercise the sheet is the trainee's own data only.
 
+Languages: the sheet's words (labels, titles, lines of words, notes, the intro) are catalog
+messages in the language of ``math_sheet``'s ``tr`` (English by default); the equations stand
+in them as ``{placeholders}`` and are the same in every language, as are the numbers (decimal
+point) and the frame names. A line of words is held to ``MAX_LINE`` in English
+(:meth:`_Block.words`); a translation may run longer and the block scrolls sideways.
+
 Rendering (:func:`math_markdown`): monospace matrices in viser markdown, not matplotlib's
 mathtext as PNG images. Why: (1) the panel is 320 px wide in presenter mode and an image is
 scaled to the panel's width, so a rendered equation with two 3x3 matrices would shrink below
@@ -42,12 +48,13 @@ from typing import TYPE_CHECKING
 import numpy as np
 import numpy.typing as npt
 
-from tcpcal.errors import TcpcalError
+from tcpcal.errors import DegenerateTouchesError, TcpcalError
 from tcpcal.orientation import R_WORLD_TOOL_PARALLEL
 from tcpcal.origin import TcpResult, solve_xyz4
 from tcpcal.tool import abc_deg_from_rotation
 
 from tcp_pendant.text_escape import escape_html, escape_markdown
+from tcp_pendant.translation import ENGLISH, N_, Translator
 
 if TYPE_CHECKING:
     from tcp_pendant.wizards import (
@@ -149,13 +156,16 @@ class MathSheet:
         view: the wizard's ``math_view`` name.
         title: the method's title.
         blocks: in the order the lecture derives them.
-        intro: plain words on top (what is recorded so far).
+        intro: plain words on top (what is recorded so far), in the sheet's language.
+        headline: the intro's first sentence (what is recorded), the board's line under the
+            title; "" for the intro's text up to its first ". ".
     """
 
     view: str
     title: str
     blocks: tuple[MathBlock, ...]
     intro: str = ""
+    headline: str = ""
 
     def block(self, key: str) -> MathBlock:
         for b in self.blocks:
@@ -168,10 +178,11 @@ class MathSheet:
 
 
 class _Block:
-    """Builds a :class:`MathBlock` line by line, recording every number it writes."""
+    """Builds a :class:`MathBlock` line by line, recording every number it writes; its lines of
+    words (:meth:`words`) in ``tr``'s language."""
 
-    def __init__(self, key: str, label: str, title: str) -> None:
-        self.key, self.label, self.title = key, label, title
+    def __init__(self, key: str, label: str, title: str, tr: Translator = ENGLISH) -> None:
+        self.key, self.label, self.title, self.tr = key, label, title, tr
         self.lines: list[str] = []
         self.values: dict[str, Shown] = {}
         self.notes: list[str] = []
@@ -188,6 +199,16 @@ class _Block:
         if _DECIMAL.search(line) or len(line) > MAX_LINE:
             raise ValueError(f"block {self.key}: a number in a text line, or a line too long: {line!r}")
         self.lines.append(line)
+
+    def words(self, message: str, **values: object) -> None:
+        """A line of words (``message``: an English msgid marked ``N_``, its ``{placeholders}``
+        filled from ``values``) in the block's language. The English line is held to
+        :meth:`text`'s rules (no decimal number, at most :data:`MAX_LINE`); a translation may
+        run longer (the block scrolls sideways)."""
+        english = message.format(**values)
+        if _DECIMAL.search(english) or len(english) > MAX_LINE:
+            raise ValueError(f"block {self.key}: a number in a text line, or a line too long: {english!r}")
+        self.lines.append(self.tr.gettext(message).format(**values))
 
     def _column(self, symbol: str, rows: list[str], unit: str) -> None:
         """Three bracketed rows with ``symbol =`` on the middle one (or on a line of its own
@@ -288,37 +309,47 @@ def _unit_sign(u: np.ndarray) -> np.ndarray:
     return u if u[int(np.argmax(np.abs(u)))] >= 0 else -u
 
 
-def _touch_blocks(steps: Sequence[int], R: np.ndarray, f: np.ndarray, label: str) -> list[MathBlock]:
+def _label(tag: str, words: str = "") -> str:
+    """A block's label: the equation's tag (``(4P-2)``), then where it comes from in words."""
+    return f"{tag} · {words}" if words else tag
+
+
+def _touch_blocks(steps: Sequence[int], R: np.ndarray, f: np.ndarray, label: str,
+                  tr: Translator = ENGLISH) -> list[MathBlock]:
     out = []
     for i, Ri, fi in zip(steps, R, f):
         n = i + 1
-        b = _Block(f"touch-{n}", label, f"touch {n}: T_f{n} = [R{sub(n)} f{sub(n)}; 0 1]")
+        b = _Block(f"touch-{n}", label, tr.gettext("touch {n}: {equation}").format(
+            n=n, equation=f"T_f{n} = [R{sub(n)} f{sub(n)}; 0 1]"), tr)
         b.matrix(f"R_{n}", f"R{sub(n)}", Ri)
         b.vector(f"f_{n}", f"f{sub(n)}", fi)
         out.append(b.build())
     return out
 
 
-def _pair_block(a: int, b_: int, Ra: np.ndarray, Rb: np.ndarray, fa: np.ndarray, fb: np.ndarray) -> MathBlock:
+def _pair_block(a: int, b_: int, Ra: np.ndarray, Rb: np.ndarray, fa: np.ndarray, fb: np.ndarray,
+                tr: Translator = ENGLISH) -> MathBlock:
     """Lecture Eq. (7) / (4P-2) for one pair, with its rank and unobservable direction."""
+    _ = tr.gettext
     A, B = a + 1, b_ + 1
     D = Ra - Rb
     y = -(fa - fb)
     rank, s, u = rank_and_singular_values(D)
-    blk = _Block("pair", "(4P-2) · lecture Eq. (7)",
-                 f"one pair, touches {A} and {B}")
+    blk = _Block("pair", _label("(4P-2)", _("lecture Eq. {eq}").format(eq="(7)")),
+                 _("one pair, touches {a} and {b}").format(a=A, b=B), tr)
     blk.text(f"(R{sub(A)}−R{sub(B)}) t = −(f{sub(A)}−f{sub(B)})")
     blk.matrix("R_a-R_b", f"R{sub(A)}−R{sub(B)}", D)
     blk.vector("-(f_a-f_b)", f"−(f{sub(A)}−f{sub(B)})", y)
     blk.numbers("sigma", "σ", s)
-    blk.text(f"rank {rank} of 3")
+    blk.words(N_("rank {rank} of {full}"), rank=rank, full=3)
     # (R_a - R_b) u = 0 for u the axis of R_b^T R_a: the tool turned about u between a and b.
     blk.vector("u", "u", _unit_sign(u), decimals=3, unit="")
-    blk.note(f"[R{sub(A)} − R{sub(B)}] is normally a singular matrix and results in no solution "
-             f"(lecture, Eq. 7): its rank is {rank}, never 3. Between touch {A} and {B} the tool turned about "
-             f"the flange direction u, and (R{sub(A)} − R{sub(B)}) u = 0, so the TCP along u "
-             "cannot be determined from this pair. Brush the reference from four quite distinct "
-             "directions: they give six linear equations.")
+    blk.note(_("[{ra} − {rb}] is normally a singular matrix and results in no solution "
+               "(lecture, Eq. 7): its rank is {rank}, never 3. Between touch {a} and {b} the tool turned about "
+               "the flange direction u, and ({ra} − {rb}) u = 0, so the TCP along u "
+               "cannot be determined from this pair. Brush the reference from four quite distinct "
+               "directions: they give six linear equations.").format(
+                   ra=f"R{sub(A)}", rb=f"R{sub(B)}", rank=rank, a=A, b=B))
     return blk.build()
 
 
@@ -330,157 +361,197 @@ def _stack(R: np.ndarray, f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return D, y
 
 
-def _stack_block(steps: Sequence[int], R: np.ndarray, f: np.ndarray) -> tuple[MathBlock, np.ndarray | None]:
+def _stack_block(steps: Sequence[int], R: np.ndarray, f: np.ndarray,
+                 tr: Translator = ENGLISH) -> tuple[MathBlock, np.ndarray | None]:
     """The stacked pair system's rank and singular values; the pseudo-inverse solution
     (lecture Eq. (8)) when it has rank 3, else None."""
+    _ = tr.gettext
     n = len(steps)
     D, y = _stack(R, f)
     rank, s, u = rank_and_singular_values(D)
     pairs = ", ".join(f"({steps[k] + 1},{steps[k + 1] + 1})" for k in range(n - 1))
-    blk = _Block("stack", "(4P-2) stacked · lecture Eqs. (7)-(8)",
-                 f"{n - 1} consecutive pair(s) {pairs}: {3 * (n - 1)} equations, 3 unknowns")
+    blk = _Block("stack", _label(_("{tag} stacked").format(tag="(4P-2)"), _("lecture Eqs. {eqs}").format(eqs="(7)-(8)")),
+                 tr.ngettext("{n} consecutive pair {pairs}: {rows} equations, 3 unknowns",
+                             "{n} consecutive pairs {pairs}: {rows} equations, 3 unknowns",
+                             n - 1).format(n=n - 1, pairs=pairs, rows=3 * (n - 1)), tr)
     blk.numbers("sigma", "σ", s)
-    blk.text(f"rank {rank} of 3")
+    blk.words(N_("rank {rank} of {full}"), rank=rank, full=3)
     t_pinv = None
     if rank < 3:
         blk.vector("u", "u", _unit_sign(u), decimals=3, unit="")
         if n == 2:
-            blk.note("One pair is rank ≤ 2: the matrix is normally singular and results in no "
-                     "solution (lecture, Eq. 7); the TCP along u cannot be determined. Touch again "
-                     "from a quite distinct direction.")
+            blk.note(_("One pair is rank ≤ 2: the matrix is normally singular and results in no "
+                       "solution (lecture, Eq. 7); the TCP along u cannot be determined. Touch again "
+                       "from a quite distinct direction."))
         else:
-            blk.note("All touches rotate about nearly the same axis u, so the TCP along u cannot "
-                     "be determined; tilt the tool about a second axis.")
+            blk.note(_("All touches rotate about nearly the same axis u, so the TCP along u cannot "
+                       "be determined; tilt the tool about a second axis."))
     else:
         t_pinv = np.linalg.pinv(D) @ y          # t = -[R_a - R_b]^+ [f_a - f_b]   (Eq. 8)
         blk.text("t = −[R_a−R_b]†[f_a−f_b]")
         blk.vector("t_pinv", "t", t_pinv)
-        blk.note("Eq. (8): the pseudo-inverse of the stacked differences (tcpcal's pairwise "
-                 "estimator uses these same consecutive pairs).")
+        blk.note(_("Eq. (8): the pseudo-inverse of the stacked differences (tcpcal's pairwise "
+                   "estimator uses these same consecutive pairs)."))
     return blk.build(), t_pinv
 
 
-def _lstsq_block(R: np.ndarray, f: np.ndarray, t_pinv: np.ndarray | None) -> tuple[MathBlock, TcpResult | None]:
-    """(4P-3) by tcpcal's solve_xyz4 (the solver), set beside the pseudo-inverse."""
-    blk = _Block("lstsq", "(4P-3)", "joint least squares, x = (t, r): [R_i  −I] x = −f_i")
+def _refusal_note(exc: TcpcalError, steps: Sequence[int], tr: Translator) -> str:
+    """Why the solver refused the touches, in ``tr``'s language (tcpcal's own message is English:
+    it has no user interface), from what its error names: the axis all touches turn about, the
+    two touches (step numbers of ``steps``) of the same orientation, or the orientations alike."""
+    _ = tr.gettext
+    if isinstance(exc, DegenerateTouchesError):
+        if exc.unobservable_axis is not None:
+            return _("All touches rotate about nearly the same axis, so the TCP along it cannot be "
+                     "determined; tilt the tool about a second axis.")
+        if len(exc.indices) == 2 and all(0 <= i < len(steps) for i in exc.indices):
+            a, b = (steps[i] + 1 for i in exc.indices)
+            return _("Touches {a} and {b} have the same orientation: record touch {b} again from a "
+                     "different orientation.").format(a=a, b=b)
+        return _("The touches have nearly the same orientation, so the TCP cannot be determined; tilt "
+                 "the tool 30 to 60 degrees between touches, about two different axes.")
+    return _("The solver refuses these touches: {error}").format(error=exc)
+
+
+def _lstsq_block(R: np.ndarray, f: np.ndarray, t_pinv: np.ndarray | None,
+                 tr: Translator = ENGLISH, steps: Sequence[int] = ()) -> tuple[MathBlock, TcpResult | None]:
+    """(4P-3) by tcpcal's solve_xyz4 (the solver), set beside the pseudo-inverse; its refusal
+    in words (:func:`_refusal_note`)."""
+    _ = tr.gettext
+    blk = _Block("lstsq", "(4P-3)", _("joint least squares, {equation}").format(
+        equation="x = (t, r): [R_i  −I] x = −f_i"), tr)
     try:
         res = solve_xyz4(R, f, method="lstsq", detect_outliers=False)   # t, r: the same; cheaper
     except TcpcalError as exc:
-        blk.text("no solution yet")
-        blk.note(f"tcpcal: {exc}")
+        blk.words(N_("no solution yet"))
+        blk.note(_refusal_note(exc, steps, tr))
         return blk.build(), None
     t = np.asarray(res.tcp, dtype=float)
     if t_pinv is not None:                       # side by side: Eq. (8), then (4P-3)
-        blk.vector("t_pinv", "t (Eq. 8)", t_pinv)
+        blk.vector("t_pinv", _("t (Eq. 8)"), t_pinv)
     blk.vector("t_lstsq", "t (4P-3)", t)
     blk.vector("r_lstsq", "r", np.asarray(res.reference, dtype=float))
-    blk.scalar("ci95", "95 % radius", float(res.ci95_radius))
+    blk.scalar("ci95", _("{percent} radius").format(percent="95 %"), float(res.ci95_radius))
     if t_pinv is not None:
         diff = float(np.linalg.norm(t - t_pinv))
         blk.scalar("diff", "|t − t_pinv|", diff)
-        blk.note("The pseudo-inverse of Eq. (8) solves only the differences of consecutive "
-                 "touches: it drops the reference point r and weights every difference equally, "
-                 "although neighbouring differences share a touch and its error, so it discards "
-                 "information. The joint least squares (4P-3) fits t and r to every touch at once: "
-                 "for an isotropic touch error it is the maximum-likelihood estimate, the one "
-                 "tcpcal reports. With exact touches both give the same t; the difference is the "
-                 "touch noise, seen through two different weightings (compare it with the 95 % radius).")
+        blk.note(_("The pseudo-inverse of Eq. (8) solves only the differences of consecutive "
+                   "touches: it drops the reference point r and weights every difference equally, "
+                   "although neighbouring differences share a touch and its error, so it discards "
+                   "information. The joint least squares (4P-3) fits t and r to every touch at once: "
+                   "for an isotropic touch error it is the maximum-likelihood estimate, the one "
+                   "tcpcal reports. With exact touches both give the same t; the difference is the "
+                   "touch noise, seen through two different weightings (compare it with the {percent} radius)."
+                   ).format(percent="95 %"))
     return blk.build(), res
 
 
-def _sphere_block(R: np.ndarray, f: np.ndarray) -> MathBlock:
+def _sphere_block(R: np.ndarray, f: np.ndarray, tr: Translator = ENGLISH) -> MathBlock:
     """(4P-1a): ``|f_i|^2 = 2 f_i . r + k`` by least squares (centred as tcpcal does),
     radius ``sqrt(k + |r|^2)``, then ``t = mean R_i^T (r - f_i)``."""
-    blk = _Block("sphere", "(4P-1a) · lecture: best-fit sphere",
-                 "the flange origins f_i lie on a sphere about r of radius |t|")
+    _ = tr.gettext
+    blk = _Block("sphere", _label("(4P-1a)", _("lecture: best-fit sphere")),
+                 _("the flange origins f_i lie on a sphere about r of radius |t|"), tr)
     fbar = f.mean(axis=0)
     d = f - fbar
     H = np.column_stack([2.0 * d, np.ones(len(f))])
     sv = np.linalg.svd(d, compute_uv=False)
     if len(f) < 4 or sv[0] <= 0 or sv[-1] / sv[0] < 1e-6:
-        blk.text("no sphere yet")
-        blk.note("The sphere needs four flange origins that are not in one plane.")
+        blk.words(N_("no sphere yet"))
+        blk.note(_("The sphere needs four flange origins that are not in one plane."))
         return blk.build()
-    z, *_ = np.linalg.lstsq(H, np.einsum("ni,ni->n", d, d), rcond=None)
+    z, *_rest = np.linalg.lstsq(H, np.einsum("ni,ni->n", d, d), rcond=None)
     r = fbar + z[:3]
     radius = math.sqrt(max(float(z[3] + z[:3] @ z[:3]), 0.0))
     t = np.einsum("nki,nk->i", R, r - f) / len(f)
     blk.text("|f_i − r|² = |t|²")
     blk.vector("centre", "r", r)
-    blk.scalar("radius", "radius", radius)
-    blk.text("t = mean R_iᵀ (r − f_i)")
+    blk.scalar("radius", _("radius"), radius)
+    blk.words(N_("t = mean R_iᵀ (r − f_i)"))
     blk.vector("t_sphere", "t", t)
     return blk.build()
 
 
-_SINGULAR = {"touches": "touch", "poses": "pose", "tip events": "tip event"}
-
-
-def _design_block(steps: Sequence[int], R: np.ndarray) -> MathBlock:
+def _design_block(steps: Sequence[int], R: np.ndarray, tr: Translator = ENGLISH) -> MathBlock:
     """(4P-3)'s design matrix ``A = [R_i  -I]`` stacked (3N x 6, unknowns ``x = (t, r)``, right
     side ``b = -f_i``), its singular values and numerical rank (of 6), as the touches arrive."""
     n = len(steps)
     A = np.vstack([np.hstack([Ri, -np.eye(3)]) for Ri in R])
-    rank, s, _ = rank_and_singular_values(A)
-    blk = _Block("A", "(4P-3) · A x = b", f"A = [R_i  −I] stacked: {3 * n}×6, x = (t, r), b = −f_i")
+    rank, s, _v = rank_and_singular_values(A)
+    _ = tr.gettext
+    blk = _Block("A", "(4P-3) · A x = b", _("{matrix} stacked: {size}, {unknowns}").format(
+        matrix="A = [R_i  −I]", size=f"{3 * n}×6", unknowns="x = (t, r), b = −f_i"), tr)
     blk.stacked("A_R", "A", R)
     blk.numbers("sigma", "σ(A)", s)
-    blk.text(f"rank {rank} of 6")
+    blk.words(N_("rank {rank} of {full}"), rank=rank, full=6)
     if rank < 6:
-        blk.note("Rank below 6: t and r cannot both be determined yet. Each touch adds three rows; "
-                 "two touches leave the TCP along the axis the tool turned about free (a zero "
-                 "singular value). Touches about two different axes give rank 6.")
+        blk.note(_("Rank below 6: t and r cannot both be determined yet. Each touch adds three rows; "
+                   "two touches leave the TCP along the axis the tool turned about free (a zero "
+                   "singular value). Touches about two different axes give rank 6."))
     else:
-        blk.note("Rank 6: t and r are determined; the smallest singular value says how well "
-                 "(a small one: the touches are nearly about one axis).")
+        blk.note(_("Rank 6: t and r are determined; the smallest singular value says how well "
+                   "(a small one: the touches are nearly about one axis)."))
     return blk.build()
 
 
-def _intro(n: int, what: str) -> str:
-    """``"2 touches recorded."``, ``"1 touch recorded."`` (``what``: a plural of :data:`_SINGULAR`)."""
-    return f"{n} {what if n != 1 else _SINGULAR.get(what, what)} recorded."
+def _touches_recorded(n: int, tr: Translator) -> str:
+    """``"2 touches recorded."``, ``"1 touch recorded."`` in ``tr``'s language."""
+    return tr.ngettext("{n} touch recorded.", "{n} touches recorded.", n).format(n=n)
+
+
+def _poses_recorded(n: int, tr: Translator) -> str:
+    """``"3 poses recorded."``, ``"1 pose recorded."`` in ``tr``'s language."""
+    return tr.ngettext("{n} pose recorded.", "{n} poses recorded.", n).format(n=n)
+
+
+def _sheet(view: str, title: str, blocks: Sequence[MathBlock], headline: str = "", more: str = "") -> MathSheet:
+    """A sheet whose intro is ``headline`` (what is recorded) then ``more`` (sentences apart:
+    each its own message)."""
+    return MathSheet(view, title, tuple(blocks), " ".join(x for x in (headline, more) if x), headline)
 
 
 # ------------------------------------------------------------------ the sheets
-def xyz4_sheet(wizard: Xyz4Wizard, pair: tuple[int, int] | None = None) -> MathSheet:
+def xyz4_sheet(wizard: Xyz4Wizard, pair: tuple[int, int] | None = None, *, tr: Translator = ENGLISH) -> MathSheet:
     """XYZ 4-point: (4P-1) per touch, a pair's Eq. (7), the stack's rank and Eq. (8), (4P-3)
     beside it, the sphere (4P-1a). Touches the trainee dropped are left out, as the solver does.
 
     Args:
         wizard: the 4-point wizard (``recorded_poses``, ``excluded``).
         pair: 0-based step indices (a, b) of the pair to show; default the last two recorded.
+        tr: the language of the words.
     """
     excluded = set(getattr(wizard, "excluded", ()))
     steps, R, f = _poses_mm(wizard, [i for i in sorted(wizard.recorded_poses) if i not in excluded])
-    return _origin_sheet("xyz4", wizard.title, steps, R, f, pair)
+    return _origin_sheet("xyz4", tr.gettext(wizard.title), steps, R, f, pair, tr=tr)
 
 
 def _origin_sheet(view: str, title: str, steps: list[int], R: np.ndarray, f: np.ndarray,
-                  pair: tuple[int, int] | None, extra: Sequence[MathBlock] = ()) -> MathSheet:
-    blocks = _touch_blocks(steps, R, f, "(4P-1) · lecture Eqs. (1)-(3)")
+                  pair: tuple[int, int] | None, extra: Sequence[MathBlock] = (), *,
+                  tr: Translator = ENGLISH) -> MathSheet:
+    _ = tr.gettext
+    blocks = _touch_blocks(steps, R, f, _label("(4P-1)", _("lecture Eqs. {eqs}").format(eqs="(1)-(3)")), tr)
     n = len(steps)
     if n >= 1:
-        blocks.append(_design_block(steps, R))
+        blocks.append(_design_block(steps, R, tr))
     if n >= 2:
         if pair is None or pair[0] not in steps or pair[1] not in steps or pair[0] == pair[1]:
             pair = (steps[-2], steps[-1])
         ia, ib = steps.index(pair[0]), steps.index(pair[1])
-        blocks.append(_pair_block(pair[0], pair[1], R[ia], R[ib], f[ia], f[ib]))
-        stack, t_pinv = _stack_block(steps, R, f)
+        blocks.append(_pair_block(pair[0], pair[1], R[ia], R[ib], f[ia], f[ib], tr))
+        stack, t_pinv = _stack_block(steps, R, f, tr)
         blocks.append(stack)
         if n >= 4:
-            lst, _ = _lstsq_block(R, f, t_pinv)
+            lst, _res = _lstsq_block(R, f, t_pinv, tr, steps)
             blocks.append(lst)
-            blocks.append(_sphere_block(R, f))
-    intro = _intro(n, "touches")
-    if n < 2:
-        intro += " Each touch gives R_i t + f_i = r (4P-1): three equations, but t and r are six unknowns."
-    return MathSheet(view, title, (*blocks, *extra), intro)
+            blocks.append(_sphere_block(R, f, tr))
+    more = _("Each touch gives R_i t + f_i = r (4P-1): three equations, but t and r are six unknowns.") if n < 2 else ""
+    return _sheet(view, title, (*blocks, *extra), _touches_recorded(n, tr), more)
 
 
-def reference_sheet(wizard: ReferenceWizard) -> MathSheet:
+def reference_sheet(wizard: ReferenceWizard, *, tr: Translator = ENGLISH) -> MathSheet:
     """XYZ reference: ``r = f_1 + R_1 t_1`` (lecture ``r ≡ f_1 + t_1``), then (REF-1):
     ``t_2 = r - f_2`` in WORLD and ``R_2^T (r - f_2)`` in FLANGE."""
+    _ = tr.gettext
     steps, R, f = _poses_mm(wizard)
     got = dict(zip(steps, range(len(steps))))
     t1 = np.asarray(wizard.reference_tool.tcp_mm, dtype=float)
@@ -488,32 +559,32 @@ def reference_sheet(wizard: ReferenceWizard) -> MathSheet:
     if 0 in got:
         k = got[0]
         r = R[k] @ t1 + f[k]
-        b = _Block("reference-point", "(REF-1) · lecture: r ≡ f₁ + t₁",
-                   "the calibrated tool touches the reference point")
+        b = _Block("reference-point", _label("(REF-1)", _("lecture: {equation}").format(equation="r ≡ f₁ + t₁")),
+                   _("the calibrated tool touches the reference point"), tr)
         b.vector("t_1", "t₁", t1)
         b.matrix("R_1", "R₁", R[k])
         b.vector("f_1", "f₁", f[k])
         b.text("r = f₁ + R₁ t₁")
         b.vector("r", "r", r)
-        b.note(f"t₁ is the TCP of the reference tool data '{wizard.reference_tool.name}' (FLANGE); "
-               "R₁ t₁ is the same vector in WORLD.")
+        b.note(_("t₁ is the TCP of the reference tool data '{name}' (FLANGE); "
+                 "R₁ t₁ is the same vector in WORLD.").format(name=wizard.reference_tool.name))
         blocks.append(b.build())
         if 1 in got:
             j = got[1]
-            b = _Block("new-tcp", "(REF-1) · lecture: t₂ = r − f₂, ᶠt₂ = [⁰Q₂]⁻¹ t₂",
-                       "the new tool touches the same point")
+            b = _Block("new-tcp", _label("(REF-1)", _("lecture: {equation}").format(
+                equation="t₂ = r − f₂, ᶠt₂ = [⁰Q₂]⁻¹ t₂")), _("the new tool touches the same point"), tr)
             b.matrix("R_2", "R₂", R[j])
             b.vector("f_2", "f₂", f[j])
             b.text("t₂ = r − f₂  WORLD")
             b.vector("t_2_world", "t₂", r - f[j])
             b.text("ᶠt₂ = R₂ᵀ(r − f₂) FLANGE")
             b.vector("t_2", "ᶠt₂", R[j].T @ (r - f[j]))
-            b.note("One touch per tool: the new TCP carries the errors of both touches and of t₁.")
+            b.note(_("One touch per tool: the new TCP carries the errors of both touches and of t₁."))
             blocks.append(b.build())
-    return MathSheet("reference", wizard.title, tuple(blocks), _intro(len(steps), "touches"))
+    return _sheet("reference", _(wizard.title), blocks, _touches_recorded(len(steps), tr))
 
 
-def three_point_sheet(wizard: ThreePointWizard) -> MathSheet:
+def three_point_sheet(wizard: ThreePointWizard, *, tr: Translator = ENGLISH) -> MathSheet:
     """Three-point, variants 1 and 2 (paper eqs. 7-30): V(1), c11 c21 c31, Δ1; V(2) (variant
     1, with c2 straightened orthogonal to c1) or V(3) (variant 2), the second column and its
     orthogonality; c3 (30) and the defect."""
@@ -522,27 +593,36 @@ def three_point_sheet(wizard: ThreePointWizard) -> MathSheet:
     t = np.asarray(wizard.tool.tcp_mm, dtype=float)
     blocks: list[MathBlock] = []
     if 0 in got:
-        block, r = _tp_reference(t, R[got[0]], f[got[0]])
+        block, r = _tp_reference(t, R[got[0]], f[got[0]], tr)
         blocks.append(block)
         c1 = None
         if 1 in got:
-            block, c1 = _tp_first_axis(t, r, R[got[1]], f[got[1]])
+            block, c1 = _tp_first_axis(t, r, R[got[1]], f[got[1]], tr)
             blocks.append(block)
         if c1 is not None and 2 in got:
             k = got[2]
             second = _tp_variant1 if int(wizard.variant) == 1 else _tp_variant2
-            block, c2 = second(t, r, c1, R[k], f[k])
+            block, c2 = second(t, r, c1, R[k], f[k], tr)
             blocks.append(block)
             if c2 is not None:
                 res = wizard.result
-                blocks.append(_tp_frame(c1, c2, None if res is None else res.orthogonality_defect_deg))
-    return MathSheet("three_point", wizard.title, tuple(blocks), _intro(len(steps), "poses"))
+                blocks.append(_tp_frame(c1, c2, None if res is None else res.orthogonality_defect_deg, tr))
+    return _sheet("three_point", tr.gettext(wizard.title), blocks, _poses_recorded(len(steps), tr))
 
 
-def _tp_reference(t: np.ndarray, R1: np.ndarray, f1: np.ndarray) -> tuple[MathBlock, np.ndarray]:
+def _paper(tr: Translator, eqs: str) -> str:
+    """``paper Eq. (7)`` / ``paper Eqs. (8)-(17)`` in ``tr``'s language."""
+    if "-" in eqs:
+        return tr.gettext("paper Eqs. {eqs}").format(eqs=eqs)
+    return tr.gettext("paper Eq. {eq}").format(eq=eqs)
+
+
+def _tp_reference(t: np.ndarray, R1: np.ndarray, f1: np.ndarray,
+                  tr: Translator = ENGLISH) -> tuple[MathBlock, np.ndarray]:
     """Paper Eq. (7): the TCP ``t`` (mm, FLANGE) touches the reference, ``r = R⁽¹⁾ t + f⁽¹⁾``."""
     r = R1 @ t + f1
-    b = _Block("eq7", "paper Eq. (7)", "the TCP touches the reference: r = T⁽¹⁾ [t; 1]")
+    b = _Block("eq7", _paper(tr, "(7)"), tr.gettext("the TCP touches the reference: {equation}").format(
+        equation="r = T⁽¹⁾ [t; 1]"), tr)
     b.vector("t", "t", t)
     b.matrix("R_1", "R⁽¹⁾", R1)
     b.vector("f_1", "f⁽¹⁾", f1)
@@ -550,14 +630,15 @@ def _tp_reference(t: np.ndarray, R1: np.ndarray, f1: np.ndarray) -> tuple[MathBl
     return b.build(), r
 
 
-def _tp_first_axis(t: np.ndarray, r: np.ndarray, R2: np.ndarray, f2: np.ndarray
-                   ) -> tuple[MathBlock, np.ndarray | None]:
+def _tp_first_axis(t: np.ndarray, r: np.ndarray, R2: np.ndarray, f2: np.ndarray,
+                   tr: Translator = ENGLISH) -> tuple[MathBlock, np.ndarray | None]:
     """Paper Eqs. (8)-(17): ``V(1) = R⁽²⁾ᵀ (r − f⁽²⁾) = t + Δ1 c1``, ``Δ1 = −|V(1) − t|``; c1
     (None when the tip was not moved off the TCP)."""
     v1 = R2.T @ (r - f2)
     d1 = v1 - t
     delta1 = -float(np.linalg.norm(d1))
-    b = _Block("eq8-17", "paper Eqs. (8)-(17)", "the tip on the tool's −X axis: V(1) = (T⁽²⁾)⁻¹ r = t + Δ1 c1")
+    b = _Block("eq8-17", _paper(tr, "(8)-(17)"), tr.gettext("the tip on the tool's −X axis: {equation}").format(
+        equation="V(1) = (T⁽²⁾)⁻¹ r = t + Δ1 c1"), tr)
     b.matrix("R_2", "R⁽²⁾", R2)
     b.vector("f_2", "f⁽²⁾", f2)
     b.vector("V1", "V(1)", v1)
@@ -569,18 +650,19 @@ def _tp_first_axis(t: np.ndarray, r: np.ndarray, R2: np.ndarray, f2: np.ndarray
         b.text("   = (V(1) − t) / Δ1")
         b.vector("c1", "c1", c1, decimals=3, unit="")
     else:
-        b.note("The tip was not moved off the TCP: Δ1 = 0, tool X is undefined.")
+        b.note(tr.gettext("The tip was not moved off the TCP: Δ1 = 0, tool X is undefined."))
     return b.build(), c1
 
 
-def _tp_variant1(t: np.ndarray, r: np.ndarray, c1: np.ndarray, R3: np.ndarray, f3: np.ndarray
-                 ) -> tuple[MathBlock, np.ndarray | None]:
+def _tp_variant1(t: np.ndarray, r: np.ndarray, c1: np.ndarray, R3: np.ndarray, f3: np.ndarray,
+                 tr: Translator = ENGLISH) -> tuple[MathBlock, np.ndarray | None]:
     """Paper Eqs. (18)-(24), variant 1: ``V(2) = t + Δ2 c2``; c2 as measured, ``c1 · c2``, the
     orthogonality defect, and c2 straightened (Gram-Schmidt keeping c1, as tcpcal does): the
     middle column of ``R_n,n*``. Returns the straightened c2 (None: Δ2 = 0)."""
     v = R3.T @ (r - f3)
     w = v - t
-    b = _Block("eq18-24", "paper Eqs. (18)-(24)", "variant 1, the tip on the tool's +Y axis: V(2) = t + Δ2 c2")
+    b = _Block("eq18-24", _paper(tr, "(18)-(24)"), tr.gettext("variant 1, the tip on the tool's +Y axis: {equation}").format(
+        equation="V(2) = t + Δ2 c2"), tr)
     b.matrix("R_3", "R⁽³⁾", R3)
     b.vector("f_3", "f⁽³⁾", f3)
     b.vector("V2", "V(2)", v)
@@ -601,20 +683,20 @@ def _tp_variant1(t: np.ndarray, r: np.ndarray, c1: np.ndarray, R3: np.ndarray, f
     b.text("c2' ∝ c2 − (c1·c2) c1")
     b.text("|c2'| = 1, c1 · c2' = 0")
     b.vector("c2_straight", "c2'", c2, decimals=3, unit="")
-    b.note("c1 and c2 should be orthogonal (c1 · c2 = 0); the touch error leaves them not quite "
-           "so. tcpcal keeps c1 and makes c2 orthogonal to it (Gram-Schmidt): the straightened c2' "
-           "is the middle column of R_n,n* below, and the angle is the orthogonality defect.")
+    b.note(tr.gettext("c1 and c2 should be orthogonal (c1 · c2 = 0); the touch error leaves them not quite "
+                      "so. tcpcal keeps c1 and makes c2 orthogonal to it (Gram-Schmidt): the straightened c2' "
+                      "is the middle column of R_n,n* below, and the angle is the orthogonality defect."))
     return b.build(), c2
 
 
-def _tp_variant2(t: np.ndarray, r: np.ndarray, c1: np.ndarray, R3: np.ndarray, f3: np.ndarray
-                 ) -> tuple[MathBlock, np.ndarray | None]:
+def _tp_variant2(t: np.ndarray, r: np.ndarray, c1: np.ndarray, R3: np.ndarray, f3: np.ndarray,
+                 tr: Translator = ENGLISH) -> tuple[MathBlock, np.ndarray | None]:
     """Paper Eqs. (25)-(29), variant 2: ``V(3) = t + Δ3 c1 + Δ4 c2`` with ``Δ3 = c1 · (V(3) − t)``;
     c2 orthogonal to c1 by construction (None: Δ4 = 0)."""
     v = R3.T @ (r - f3)
     w = v - t
-    b = _Block("eq25-29", "paper Eqs. (25)-(29)",
-               "variant 2, the tip in the +Y half-plane: V(3) = t + Δ3 c1 + Δ4 c2")
+    b = _Block("eq25-29", _paper(tr, "(25)-(29)"), tr.gettext("variant 2, the tip in the +Y half-plane: {equation}").format(
+        equation="V(3) = t + Δ3 c1 + Δ4 c2"), tr)
     b.matrix("R_3", "R⁽³⁾", R3)
     b.vector("f_3", "f⁽³⁾", f3)
     b.vector("V3", "V(3)", v)
@@ -630,53 +712,55 @@ def _tp_variant2(t: np.ndarray, r: np.ndarray, c1: np.ndarray, R3: np.ndarray, f
     b.text("   = (V(3)−t−Δ3 c1)/Δ4")
     b.vector("c2", "c2", c2, decimals=3, unit="")
     b.scalar("c1.c2", "c1 · c2", float(c1 @ c2), decimals=3, unit="")
-    b.scalar("defect", "defect", 0.0, unit="deg")
-    b.note("Eq. (29) with the orthogonality condition: c2 is orthogonal to c1 by "
-           "construction, so variant 2 has no orthogonality defect.")
+    b.scalar("defect", tr.gettext("defect"), 0.0, unit="deg")
+    b.note(tr.gettext("Eq. (29) with the orthogonality condition: c2 is orthogonal to c1 by "
+                      "construction, so variant 2 has no orthogonality defect."))
     return b.build(), c2
 
 
-def _tp_frame(c1: np.ndarray, c2: np.ndarray, defect_tcpcal_deg: float | None) -> MathBlock:
+def _tp_frame(c1: np.ndarray, c2: np.ndarray, defect_tcpcal_deg: float | None,
+              tr: Translator = ENGLISH) -> MathBlock:
     """Paper Eq. (30): ``c3 = c1 × c2`` and ``R_n,n* = [c1 c2 c3]`` with its A, B, C (degrees);
     tcpcal's orthogonality defect when the result is there."""
     c3 = np.cross(c1, c2)
     c3 = c3 / np.linalg.norm(c3)
     Rt = np.column_stack([c1, c2, c3])
-    b = _Block("eq30", "paper Eq. (30)", "c3 = c1 × c2, R_n,n* = [c1 c2 c3]")
+    b = _Block("eq30", _paper(tr, "(30)"), "c3 = c1 × c2, R_n,n* = [c1 c2 c3]", tr)
     b.vector("c3", "c3", c3, decimals=3, unit="")
     b.matrix("R_n,n*", "R_n,n*", Rt)
     b.vector("abc", "A,B,C", np.asarray(abc_deg_from_rotation(Rt), dtype=float), unit="°")
     if defect_tcpcal_deg is not None:
-        b.scalar("defect_tcpcal", "tcpcal's defect", float(defect_tcpcal_deg), unit="deg")
+        b.scalar("defect_tcpcal", tr.gettext("tcpcal's defect"), float(defect_tcpcal_deg), unit="deg")
     return b.build()
 
 
-def abc_world_sheet(wizard: AbcWorldWizard) -> MathSheet:
+def abc_world_sheet(wizard: AbcWorldWizard, *, tr: Translator = ENGLISH) -> MathSheet:
     """ABC world: (PA-1) the prescribed R_0,n*, (PA-2) ``R_n,n* = R_0,n^T R_0,n*``."""
     steps, R, _ = _poses_mm(wizard)
     blocks = []
     if steps:
         R0n = R[0]
-        b = _Block("pa", "(PA-1), (PA-2) · paper Eqs. (4)-(6)",
-                   "R_0,n* = R_0,n R_n,n*  ⇒  R_n,n* = R_0,nᵀ R_0,n*")
+        b = _Block("pa", _label("(PA-1), (PA-2)", _paper(tr, "(4)-(6)")),
+                   "R_0,n* = R_0,n R_n,n*  ⇒  R_n,n* = R_0,nᵀ R_0,n*", tr)
         b.matrix("R_0,n", "R_0,n", R0n)
         b.matrix("R_0,n*", "R_0,n*", R_WORLD_TOOL_PARALLEL)
         Rnn = R0n.T @ R_WORLD_TOOL_PARALLEL
         b.matrix("R_n,n*", "R_n,n*", Rnn)
         b.vector("abc", "A,B,C", np.asarray(abc_deg_from_rotation(Rnn), dtype=float), unit="°")
-        b.note("R_0,n is the flange rotation read at the aligned pose; R_0,n* is the orientation "
-               "(PA-1) prescribes (tool X down, Y along WORLD Y, Z along WORLD X).")
+        b.note(tr.gettext("R_0,n is the flange rotation read at the aligned pose; R_0,n* is the orientation "
+                          "(PA-1) prescribes (tool X down, Y along WORLD Y, Z along WORLD X)."))
         if getattr(wizard, "variant", "6d") == "5d":
-            b.note("5D: only the first column (tool X) is kept; the turn about X comes from the "
-                   "tool's current data.")
+            b.note(tr.gettext("5D: only the first column (tool X) is kept; the turn about X comes from the "
+                              "tool's current data."))
             res = wizard.result
             if res is not None and res.rotation is not None:
                 b.matrix("R_5d", "R (5D)", np.asarray(res.rotation, dtype=float))
         blocks.append(b.build())
-    return MathSheet("abc_world", wizard.title, tuple(blocks), _intro(len(steps), "poses"))
+    return _sheet("abc_world", tr.gettext(wizard.title), blocks, _poses_recorded(len(steps), tr))
 
 
-def tcp_zx_sheet(wizard: TcpZxWizard, pair: tuple[int, int] | None = None) -> MathSheet:
+def tcp_zx_sheet(wizard: TcpZxWizard, pair: tuple[int, int] | None = None, *,
+                 tr: Translator = ENGLISH) -> MathSheet:
     """TCP & Z, X (methods.md section 8): the touches as the 4-point's, then
     ``u_k = unit(R_k^T (r - f_k) - t)`` for the z and x poses, Gram-Schmidt keeping z."""
     roles = [s.role for s in wizard.steps]
@@ -699,7 +783,8 @@ def tcp_zx_sheet(wizard: TcpZxWizard, pair: tuple[int, int] | None = None) -> Ma
                 v = Rk[0].T @ (r - fk[0]) - t
                 d = float(np.linalg.norm(v))
                 b = _Block(f"axis-{role}", "(ZX-1) · (ZX-3)" if role == "z" else "(ZX-2) · (ZX-3)",
-                           f"the reference on the tool's +{role.upper()} axis: R_kᵀ (r − f_k) − t = d_k {role}")
+                           tr.gettext("the reference on the tool's +{axis} axis: {equation}").format(
+                               axis=role.upper(), equation=f"R_kᵀ (r − f_k) − t = d_k {role}"), tr)
                 b.matrix("R_k", "R_k", Rk[0])
                 b.vector("f_k", "f_k", fk[0])
                 b.vector("v", "v", v)
@@ -714,23 +799,25 @@ def tcp_zx_sheet(wizard: TcpZxWizard, pair: tuple[int, int] | None = None) -> Ma
                 x = xm - (xm @ z) * z
                 x = x / np.linalg.norm(x)
                 y = np.cross(z, x)
-                b = _Block("frame", "methods.md §8 step 5", "z defines, x only completes: x orthogonalised "
-                           "(Gram-Schmidt keeping z), y = z × x")
+                b = _Block("frame", tr.gettext("methods.md §{section} step {step}").format(section=8, step=5),
+                           tr.gettext("z defines, x only completes: x orthogonalised "
+                                      "(Gram-Schmidt keeping z), y = z × x"), tr)
                 b.scalar("defect", "|90° − ∠(x, z)|", abs(90.0 - angle), unit="deg")
                 Rt = np.column_stack([x, y, z])
                 b.matrix("R_flange_tool", "[x y z]", Rt)
                 b.vector("abc", "A,B,C", np.asarray(abc_deg_from_rotation(Rt), dtype=float), unit="°")
                 axis_blocks.append(b.build())
-    sheet = _origin_sheet("tcp_zx", wizard.title, steps, R, f, pair, axis_blocks)
+    sheet = _origin_sheet("tcp_zx", tr.gettext(wizard.title), steps, R, f, pair, axis_blocks, tr=tr)
     return sheet
 
 
-def beam_sheet(wizard: BeamWizard) -> MathSheet:
+def beam_sheet(wizard: BeamWizard, *, tr: Translator = ENGLISH) -> MathSheet:
     """Beam (BEAM-1): per tip event ``(I - u u^T)(R_i t + f_i - b) = 0``, stacked
     ``(P R_i) t = -P (f_i - b)``: its rank and singular values, and tcpcal's t."""
+    _ = tr.gettext
     scan = wizard.scan
     if scan is None:
-        return MathSheet("beam", wizard.title, (), "No scan yet: press Finish and the controller runs it.")
+        return _sheet("beam", _(wizard.title), (), _("No scan yet: press Finish and the controller runs it."))
     tips = [e for e in scan.events if e.kind == "tip"]
     blocks = []
     rows, rhs = [], []
@@ -741,7 +828,8 @@ def beam_sheet(wizard: BeamWizard) -> MathSheet:
         rows.append(P @ Ri)
         rhs.append(-P @ (fi - bp))
         if k <= 2:                               # the first two in full; the rest are alike
-            b = _Block(f"event-{k}", "(BEAM-1)", f"tip event {k}: (I − u uᵀ)(R_i t + f_i − b) = 0")
+            b = _Block(f"event-{k}", "(BEAM-1)", _("tip event {k}: {equation}").format(
+                k=k, equation="(I − u uᵀ)(R_i t + f_i − b) = 0"), tr)
             b.vector("b", "b", bp)
             b.vector("u", "u", u, decimals=3, unit="")
             b.matrix("R_i", "R_i", Ri)
@@ -749,34 +837,39 @@ def beam_sheet(wizard: BeamWizard) -> MathSheet:
             blocks.append(b.build())
     if tips:
         A = np.vstack(rows)
-        rank, s, _ = rank_and_singular_values(A)
-        b = _Block("stack", "(BEAM-1) stacked · (BEAM-2)", f"{len(tips)} tip events: (P R_i) t = −P (f_i − b)")
+        rank, s, _v = rank_and_singular_values(A)
+        b = _Block("stack", _label(_("{tag} stacked").format(tag="(BEAM-1)"), "(BEAM-2)"),
+                   tr.ngettext("{n} tip event: {equation}", "{n} tip events: {equation}", len(tips)).format(
+                       n=len(tips), equation="(P R_i) t = −P (f_i − b)"), tr)
         b.numbers("sigma", "σ", s)
-        b.text(f"rank {rank} of 3")
+        b.words(N_("rank {rank} of {full}"), rank=rank, full=3)
         res = wizard.result
         if res is not None:
             b.vector("t", "t", np.asarray(res.tcp_mm, dtype=float))
-        b.note("Each event gives two equations (across the beam); t is observable once the stack "
-               "has rank 3, i.e. events at several tool orientations.")
+        b.note(_("Each event gives two equations (across the beam); t is observable once the stack "
+                 "has rank 3, i.e. events at several tool orientations."))
         blocks.append(b.build())
-    return MathSheet("beam", wizard.title, tuple(blocks), f"{len(tips)} tip events.")
+    return _sheet("beam", _(wizard.title), blocks,
+                  tr.ngettext("{n} tip event.", "{n} tip events.", len(tips)).format(n=len(tips)))
 
 
-def spin_check_sheet(wizard: TcpCheckWizard) -> MathSheet:
+def spin_check_sheet(wizard: TcpCheckWizard, *, tr: Translator = ENGLISH) -> MathSheet:
     """TCP check (methods.md section 10): a spin by θ moves the tip by at most
     ``2 sin(θ/2) |t - t_s|``."""
+    _ = tr.gettext
     check = getattr(wizard, "check", None)
     if check is None:
-        return MathSheet("spin_check", wizard.title, (), "No check run yet.")
-    b = _Block("spin", "(SC-1), (SC-2)", "drift |d_i| = 2 |sin(θ/2)| |e_⊥| ≤ 2 sin(θ/2) |e|, e = t − t_s")
+        return _sheet("spin_check", _(wizard.title), (), _("No check run yet."))
+    b = _Block("spin", "(SC-1), (SC-2)", _("drift {equation}").format(
+        equation="|d_i| = 2 |sin(θ/2)| |e_⊥| ≤ 2 sin(θ/2) |e|, e = t − t_s"), tr)
     b.scalar("theta", "θ", float(check.angle_deg), unit="deg")
     devs = [float(r.deviation_mm) for r in check.rows if r.reached]
-    b.numbers("drifts", "drifts (mm)", devs, decimals=2)
+    b.numbers("drifts", _("drifts (mm)"), devs, decimals=2)
     if check.implied_tcp_error_mm is not None:
         e = float(check.implied_tcp_error_mm)
         b.scalar("error", "|e| (SC-2)", e)
         b.scalar("bound", "2 sin(θ/2) |e|", 2.0 * math.sin(math.radians(float(check.angle_deg)) / 2.0) * e)
-    return MathSheet("spin_check", wizard.title, (b.build(),))
+    return _sheet("spin_check", _(wizard.title), (b.build(),))
 
 
 MATH_VIEWS: dict[str, Callable[..., MathSheet]] = {
@@ -794,15 +887,17 @@ PAIR_VIEWS = frozenset({"xyz4", "tcp_zx"})
 """The sheets that take a chosen pair of touches (``pair=``)."""
 
 
-def math_sheet(wizard: Wizard, *, pair: tuple[int, int] | None = None) -> MathSheet | None:
-    """The sheet of ``wizard`` by its class's ``math_view`` (None: it declares none)."""
+def math_sheet(wizard: Wizard, *, pair: tuple[int, int] | None = None,
+               tr: Translator = ENGLISH) -> MathSheet | None:
+    """The sheet of ``wizard`` by its class's ``math_view`` (None: it declares none), its
+    words in ``tr``'s language (the equations' symbols and numbers are the same in every one)."""
     name = getattr(type(wizard), "math_view", None)
     if name is None:
         return None
     build = MATH_VIEWS.get(name)
     if build is None:
         raise ValueError(f"The {wizard.title} wizard declares math view {name!r}; known: {sorted(MATH_VIEWS)}.")
-    return build(wizard, pair=pair) if name in PAIR_VIEWS else build(wizard)
+    return build(wizard, pair=pair, tr=tr) if name in PAIR_VIEWS else build(wizard, tr=tr)
 
 
 # ------------------------------------------------------------------ markdown
@@ -817,10 +912,11 @@ def block_html(block: MathBlock, *, font_px: int = MATH_FONT_PX) -> str:
             f"{body}</div>")
 
 
-def math_markdown(sheet: MathSheet | None, *, font_px: int = MATH_FONT_PX) -> str:
-    """The whole sheet as viser markdown: per block its label (bold), words, lines and note."""
+def math_markdown(sheet: MathSheet | None, *, font_px: int = MATH_FONT_PX, tr: Translator = ENGLISH) -> str:
+    """The whole sheet as viser markdown: per block its label (bold), words, lines and note
+    (the sheet's words are in its language already; ``tr``: the words without a sheet)."""
     if sheet is None:
-        return "*This method has no worked equations.*"
+        return tr.gettext("*This method has no worked equations.*")
     parts = [escape_markdown(sheet.intro)] if sheet.intro else []
     for b in sheet.blocks:
         parts.append(f"**{escape_markdown(b.label)}** {escape_markdown(b.title)}")

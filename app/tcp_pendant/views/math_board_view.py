@@ -6,20 +6,22 @@ wizard's sheet laid out for the board (``calibrate.math_board.board_html``) and 
 button that unticks the checkbox. In ``--shared`` mode every browser follows (the shared GUI).
 It renders on the session's change signal when the ``wizard`` flag is set (a record, Back,
 Finish, a variant change), never on a jog step, and only while ticked. Like "The math" panel it
-reads the wizard's own poses only (never the hidden true tool).
+reads the wizard's own poses only (never the hidden true tool). A language change re-labels the
+checkbox and, while ticked, re-renders the board in the new language.
 """
 
 from __future__ import annotations
 
-from tcp_pendant.calibrate.math_board import board_html
+from tcp_pendant.calibrate.math_board import BOARD_LABEL, board_html
 from tcp_pendant.calibrate.math_view import math_sheet
 from tcp_pendant.session import Session, SessionChange
+from tcp_pendant.translation import N_
 from tcp_pendant.views.gui_util import CheckboxEvent, set_content, target_of
 
 __all__ = ["BOARD_LABEL", "MathBoardView"]
 
-BOARD_LABEL = "Math board"
-"""The checkbox's label (the page script's "Back to the pendant" button finds it by this)."""
+_HINT = N_("The math of the open wizard over the whole screen, large, for the projector ('Back to the "
+           "pendant' on the board ends it).")
 
 
 class MathBoardView:
@@ -33,9 +35,8 @@ class MathBoardView:
     def __init__(self, session: Session) -> None:
         self.session = session
         gui = target_of(session).gui
-        self.toggle = gui.add_checkbox(BOARD_LABEL, False,
-                                       hint="The math of the open wizard over the whole screen, large, for "
-                                            "the projector ('Back to the pendant' on the board ends it).")
+        _ = session.translator.gettext
+        self.toggle = gui.add_checkbox(_(BOARD_LABEL), False, hint=_(_HINT))
         self.html = gui.add_html("", visible=False)
         self.renders = 0
         self.toggle.on_update(session.loop.on_loop(self._on_toggle))
@@ -49,7 +50,10 @@ class MathBoardView:
         self.render()
 
     def on_change(self, change: SessionChange) -> None:
-        if self.on and change.wizard:
+        if change.language:
+            _ = self.session.translator.gettext
+            self.toggle.label, self.toggle.hint = _(BOARD_LABEL), _(_HINT)
+        if self.on and (change.wizard or change.language):
             self.render()
 
     def render(self) -> None:
@@ -61,7 +65,8 @@ class MathBoardView:
             return
         wf = self.session.workflow
         wiz = None if wf is None or not wf.is_open else wf.wizard
-        sheet = None if wiz is None else math_sheet(wiz)
+        tr = self.session.translator
+        sheet = None if wiz is None else math_sheet(wiz, tr=tr)
         self.renders += 1
-        set_content(self.html, board_html(sheet))
+        set_content(self.html, board_html(sheet, tr=tr))
         self.html.visible = True

@@ -22,7 +22,9 @@ The readout is raw HTML inside viser markdown (a ``<div style=...>``): only numb
 formats go into it; every other text (step titles, the tool name) is escaped
 (``text_escape.escape_html`` / ``escape_markdown``). The view subscribes to the session's change
 signal and renders from state (pose state, workflow); it calls no other view. Units: mm and
-degrees on screen.
+degrees on screen. Its words are the session's language (``Session.translator``); a language
+change re-labels the checkbox, the folder and the chart and re-renders the folder. The readout's
+layout is the same in every language (axis names, units and the numbers' columns stay).
 """
 
 from __future__ import annotations
@@ -34,6 +36,7 @@ from tcp_pendant.calibrate.chart import error_axis_top_mm, error_bars
 from tcp_pendant.controller.readout import PoseReadout
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.text_escape import escape_html, escape_markdown
+from tcp_pendant.translation import ENGLISH, N_, Translator
 from tcp_pendant.views.gui_util import CHART_LEGEND, CheckboxEvent, target_of
 from tcp_pendant.views.math_board_view import MathBoardView
 
@@ -78,6 +81,11 @@ class _Theme(TypedDict):
 
 _THEME: _Theme = {"dark_mode": False, "show_logo": False, "show_share_button": False}   # as PendantApp.start
 
+_TOGGLE = N_("Presenter mode")
+_TOGGLE_HINT = N_("Large readout, step list and error chart for a projector.")
+_FOLDER = N_("Presenter")
+_CHART_TITLE = N_("Error per touch (mm)")
+
 
 def _num(value: float, decimals: int = 2) -> str:
     """A number we format ourselves (never user text): right-aligned, 8 characters."""
@@ -87,13 +95,15 @@ def _num(value: float, decimals: int = 2) -> str:
 
 
 def presenter_readout_markdown(readout: PoseReadout, distance_mm: float | None, *,
-                               font_px: int = READOUT_FONT_PX) -> str:
-    """The big TCP readout (raw HTML in markdown; numbers only).
+                               font_px: int = READOUT_FONT_PX, tr: Translator = ENGLISH) -> str:
+    """The big TCP readout (raw HTML in markdown; numbers, and the distance's and frame's words
+    in ``tr``'s language, escaped).
 
     Args:
         readout: the TCP pose (mm, degrees) in its frame.
         distance_mm: true tool tip to reference tip, mm; None when "Hide distance" is on.
         font_px: font size of the numbers, pixels.
+        tr: the language of the words.
 
     Returns:
         A ``<div>`` with X, Y, Z one a line, monospace, ``font_px`` high; A, B, C on one line
@@ -104,8 +114,10 @@ def presenter_readout_markdown(readout: PoseReadout, distance_mm: float | None, 
     lines = [f"{name} {_num(float(v))} {unit}" for name, v, unit in rows]
     abc = "  ".join(f"{name} {_num(float(v)).strip()}" for name, v in
                     (("A", readout.a_deg), ("B", readout.b_deg), ("C", readout.c_deg))) + " °"
-    dist = "hidden" if distance_mm is None else f"{_num(float(distance_mm)).strip()} mm"
-    frame = escape_html(readout.frame)
+    _ = tr.gettext
+    dist = _("hidden") if distance_mm is None else f"{_num(float(distance_mm)).strip()} mm"
+    tip = escape_html(_("tip {distance}").format(distance=dist)).replace(" ", "&nbsp;")
+    frame = escape_html(_("TCP in {frame}").format(frame=readout.frame))
     body = "<br>".join(lines).replace(" ", "&nbsp;")
     small = max(int(font_px) // 2 + 1, 12)
     return (f'<div class="presenter-readout" style="font-size:{int(font_px)}px; font-family:monospace; '
@@ -113,20 +125,24 @@ def presenter_readout_markdown(readout: PoseReadout, distance_mm: float | None, 
             f'<div class="presenter-abc" style="font-size:{small}px; font-family:monospace; white-space:nowrap">'
             f'{abc.replace(" ", "&nbsp;")}</div>'
             f'<div class="presenter-distance" style="font-size:{int(font_px) - 8}px; font-family:monospace">'
-            f'tip&nbsp;{dist.replace(" ", "&nbsp;")} <span style="font-size:{small}px; font-family:sans-serif">'
-            f'TCP in {frame}</span></div>')
+            f'{tip} <span style="font-size:{small}px; font-family:sans-serif">'
+            f'{frame}</span></div>')
 
 
-def presenter_steps_markdown(wizard: Wizard | None, *, font_px: int = STEPS_FONT_PX) -> str:
+def presenter_steps_markdown(wizard: Wizard | None, *, font_px: int = STEPS_FONT_PX,
+                             tr: Translator = ENGLISH) -> str:
     """The running wizard's steps, wrapped in a few lines (a step never split): ✔ recorded,
     ▶ current (bold), · to do.
 
     Args:
         wizard: the wizard on show (``CalibrationWorkflow.wizard``), or None.
         font_px: font size, pixels.
+        tr: the language of the words: the method's title (an ``N_`` msgid of its class) and
+            this function's own; the steps' titles come in the wizard's language as they are.
     """
+    _ = tr.gettext
     if wizard is None:
-        return "*No wizard running: start one in the Calibrate tab.*"
+        return _("*No wizard running: start one in the Calibrate tab.*")
     lines = []
     for s in wizard.steps:
         here = s.index == wizard.step_index and not wizard.is_complete
@@ -134,21 +150,30 @@ def presenter_steps_markdown(wizard: Wizard | None, *, font_px: int = STEPS_FONT
         text = f"{sym} {s.index + 1}. {escape_html(str(s.title))}"
         lines.append(f'<b class="current-step">{text}</b>' if here else text)
     if wizard.is_complete:
-        lines.append('<b class="current-step">▶ Result</b>')
-    title = escape_html(str(getattr(wizard, "title", "Wizard")))
+        result = escape_html(_("Result"))
+        lines.append(f'<b class="current-step">▶ {result}</b>')
+    method = getattr(wizard, "title", None)
+    title = escape_html(_(str(method)) if method else _("Wizard"))
     items = "".join(f'<span style="white-space:nowrap; margin-right:0.7em">{x}</span> ' for x in lines)
     return (f'<div class="presenter-steps" style="font-size:{int(font_px)}px; line-height:1.3">'
             f'<u style="margin-right:0.7em">{title}</u> ' + items.rstrip() + "</div>")
 
 
-def _chart_series() -> tuple[uplot.Series, ...]:
+def _chart_series(tr: Translator = ENGLISH) -> tuple[uplot.Series, ...]:
+    """The error chart's series, named in ``tr``'s language."""
+    _ = tr.gettext
     no_points: uplot.Series_Points = {"show": False}
-    return ({"label": "touch"},
-            {"label": "error (mm)", "stroke": "#3b6fd6", "fill": "rgba(59,111,214,0.55)", "width": 2,
+    return ({"label": _("touch")},
+            {"label": _("error (mm)"), "stroke": "#3b6fd6", "fill": "rgba(59,111,214,0.55)", "width": 2,
              "points": no_points},
-            {"label": "outlier (mm)", "stroke": "#d62020", "fill": "rgba(214,32,32,0.6)", "width": 2,
+            {"label": _("outlier (mm)"), "stroke": "#d62020", "fill": "rgba(214,32,32,0.6)", "width": 2,
              "points": no_points},
-            {"label": "mean (mm)", "stroke": "#444444", "dash": (6.0, 6.0), "width": 2, "points": no_points})
+            {"label": _("mean (mm)"), "stroke": "#444444", "dash": (6.0, 6.0), "width": 2, "points": no_points})
+
+
+def _chart_axes(tr: Translator = ENGLISH) -> tuple[uplot.Axis, ...]:
+    """The error chart's axes: touch numbers across, mm up (a unit: not translated)."""
+    return ({"label": tr.gettext("touch")}, {"label": "mm"})
 
 
 class PresenterView:
@@ -167,18 +192,19 @@ class PresenterView:
     def __init__(self, session: Session, *, on: bool = False) -> None:
         self.session = session
         gui = target_of(session).gui
-        self.toggle = gui.add_checkbox("Presenter mode", bool(on), order=-950.0,
-                                       hint="Large readout, step list and error chart for a projector.")
-        self.folder = gui.add_folder("Presenter", order=-949.0, visible=bool(on))
+        tr = session.translator
+        _ = tr.gettext
+        self.toggle = gui.add_checkbox(_(_TOGGLE), bool(on), order=-950.0, hint=_(_TOGGLE_HINT))
+        self.folder = gui.add_folder(_(_FOLDER), order=-949.0, visible=bool(on))
         with self.folder:
             self.readout_md = gui.add_markdown("")
             self.tool_md = gui.add_markdown("")
             self.steps_md = gui.add_markdown("")
             bars = error_bars([1], [0.0])
-            self.chart = gui.add_uplot(bars.columns, _chart_series(), title="Error per touch (mm)",
+            self.chart = gui.add_uplot(bars.columns, _chart_series(tr), title=_(_CHART_TITLE),
                                        height=CHART_HEIGHT_PX, visible=False,
                                        scales={"x": {"time": False}, "y": {"range": (0.0, 1.0)}},
-                                       axes=({"label": "touch"}, {"label": "mm"}), legend=CHART_LEGEND,
+                                       axes=_chart_axes(tr), legend=CHART_LEGEND,
                                        padding=(14, 12, 0, 0))   # the top tick's label not cut off
             self.board = MathBoardView(session)         # "The math" over the whole screen
         self._shown: dict[str, str] = {}
@@ -222,9 +248,22 @@ class PresenterView:
 
     def on_change(self, change: SessionChange) -> None:
         """The change signal: the readout after a move, the steps and the chart after a
-        wizard or tool change (only while presenter mode is on)."""
-        if self.on and (change.pose or change.tool or change.wizard or change.touches):
+        wizard or tool change (only while presenter mode is on); every word after a language
+        change."""
+        if change.language:
+            self._relabel()
+        if self.on and (change.pose or change.tool or change.wizard or change.touches or change.language):
             self.render(change.state)
+
+    def _relabel(self) -> None:
+        """The checkbox's, the folder's and the chart's words in the session's language."""
+        tr = self.session.translator
+        _ = tr.gettext
+        self.toggle.label, self.toggle.hint = _(_TOGGLE), _(_TOGGLE_HINT)
+        self.folder.label = _(_FOLDER)
+        self.chart.title = _(_CHART_TITLE)
+        self.chart.series = _chart_series(tr)
+        self.chart.axes = _chart_axes(tr)
 
     # ------------------------------------------------------------ render
     def _set(self, handle: viser.GuiMarkdownHandle, key: str, text: str) -> None:
@@ -237,15 +276,17 @@ class PresenterView:
         if not self.on:
             return
         s = self.session
+        tr = s.translator
+        _ = tr.gettext
         state = s.pose_state() if state is None else state
         distance = None if s.hide_distance else float(state.touch.distance_mm)
-        self._set(self.readout_md, "readout", presenter_readout_markdown(state.readout("WORLD"), distance))
+        self._set(self.readout_md, "readout", presenter_readout_markdown(state.readout("WORLD"), distance, tr=tr))
         tool = s.controller.active_tool
-        self._set(self.tool_md, "tool", f"Tool data: **{escape_markdown(tool.name)}**" if tool is not None
-                  else "Tool data: **none** (TCP = flange)")   # one line under the readout
+        self._set(self.tool_md, "tool", _("Tool data: **{name}**").format(name=escape_markdown(tool.name))
+                  if tool is not None else _("Tool data: **none** (TCP = flange)"))   # one line under the readout
         wf = s.workflow
         wizard = None if wf is None or not wf.is_open else wf.wizard
-        self._set(self.steps_md, "steps", presenter_steps_markdown(wizard))
+        self._set(self.steps_md, "steps", presenter_steps_markdown(wizard, tr=tr))
         self._render_chart(None if wizard is None else wizard.result)
 
     def _render_chart(self, res: WizardResult | None) -> None:

@@ -78,6 +78,8 @@
  *    holds the server's <div class="math-board"> (our own escaped markup), a copy of its nodes
  *    (cloneNode: no HTML parsed here) covers the whole page, with a "Back to the pendant" button
  *    that unticks "Math board" (as a click on it would); the original is hidden in the panel.
+ *    Both words come in the pendant's language from the board's data-toggle and data-back
+ *    attributes (calibrate/math_board.py), English when they are absent.
  * 10. Languages: the labels this script looks for (Increment, its "Cont." button, Shadows, the keys
  *     line's first word) are read in the pendant's language from the hidden
  *     <div data-tcp-pendant-labels data-increment=... data-cont=... data-shadows=... data-keys-line=...>
@@ -584,8 +586,12 @@
     for (var i = 0; i < all.length; i++) if (!all[i].closest("#" + BOARD_ID)) return all[i];
     return null;
   }
+  function boardWord(attr, english) {        // the board's words in the pendant's language
+    var source = boardSource();             // (calibrate/math_board.py hands them over), else English
+    return (source && source.getAttribute(attr)) || english;
+  }
   function leaveBoard() {
-    var row = labelled(BOARD_TOGGLE);
+    var row = labelled(boardWord("data-toggle", BOARD_TOGGLE));
     var box = row ? row.querySelector("input[type=checkbox]") : null;
     if (box && box.checked) box.click();     // the server unticks it: the board goes for every screen
   }
@@ -609,6 +615,8 @@
       overlay.appendChild(document.createElement("div"));
       document.body.appendChild(overlay);
     }
+    var backButton = overlay.firstChild, backWord = boardWord("data-back", "Back to the pendant");
+    if (backButton.textContent !== backWord) backButton.textContent = backWord;
     var holder = overlay.lastChild;
     var copy = source.cloneNode(true);       // our own markup, copied as nodes (no HTML parsed)
     copy.style.display = "";
