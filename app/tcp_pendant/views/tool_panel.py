@@ -168,24 +168,11 @@ class ToolPanel:
             self.entry_save = gui.add_button("Save to library", color="green")
             self.entry_md = gui.add_markdown("")
 
-        g = session.loop.on_loop                       # every callback on viser's event loop
-        self.mounted.on_update(g(self._on_mount))
-        self.slots.on_update(g(lambda _e: self._show_slot()))
-        self.activate.on_click(g(self._on_activate))
-        self.deactivate.on_click(g(self._on_deactivate))
-        self.rename.on_click(g(self._on_rename))
-        self.delete.on_click(g(self._on_delete))
-        self.export.on_click(g(self._on_export))
-        self.download.on_click(g(self._on_download))
-        self.check.on_click(self._check_callback(self._selected_for_check))
-        self.check_active.on_click(self._check_callback(self._active_for_check))
         self._checking = False
         self.last_check: tuple[CheckJob, SpinCheckResult] | None = None
         self._check_subject: tuple[int | None, str] | None = None     # the last check's (slot, tool name)
         self._entry_said: Callable[[Translator], EntryOutcome] | None = None
-        self.entry_save.on_click(g(self._on_entry_save))
-        for handle in (self.entry_name, *self.entry_fields.values()):
-            handle.on_update(g(lambda _e: self._show_entry_preview()))
+        self._wire()
         self._show_entry_preview()
         self._library: dict[int, Tool] = {}
         # a new browser hears of the library's latest recovery; later ones as they happen
@@ -197,6 +184,23 @@ class ToolPanel:
         if session.language != SOURCE_LANGUAGE:
             self.relabel()
         session.subscribe(self.on_change)
+
+    def _wire(self) -> None:
+        """Every handle's callback, on viser's event loop."""
+        g = self.session.loop.on_loop
+        self.mounted.on_update(g(self._on_mount))
+        self.slots.on_update(g(lambda _e: self._show_slot()))
+        self.activate.on_click(g(self._on_activate))
+        self.deactivate.on_click(g(self._on_deactivate))
+        self.rename.on_click(g(self._on_rename))
+        self.delete.on_click(g(self._on_delete))
+        self.export.on_click(g(self._on_export))
+        self.download.on_click(g(self._on_download))
+        self.check.on_click(self._check_callback(self._selected_for_check))
+        self.check_active.on_click(self._check_callback(self._active_for_check))
+        self.entry_save.on_click(g(self._on_entry_save))
+        for handle in (self.entry_name, *self.entry_fields.values()):
+            handle.on_update(g(lambda _e: self._show_entry_preview()))
 
     @property
     def tr(self) -> Translator:
