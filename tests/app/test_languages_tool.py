@@ -15,11 +15,12 @@ from typing import Any
 import pytest
 import viser
 
-from support.app_page import AppPage, truth_tool
+from support.app_page import AppPage, true_tip_at, truth_tool
 from support.pseudo_text import WORD, gui_texts, untranslated_words
 from support.wsclient import wait_until
 
 from tcp_pendant.calibrate.beam_service import beam_check_markdown, beam_verdict
+from tcp_pendant.classroom.exercise_rules import class_rules
 from tcp_pendant.controller import builtin_tools
 from tcp_pendant.controller.scenarios import SCENARIO_KINDS, Scenario, explain
 from tcp_pendant.pendant.tool_entry import ToolEntry, entry_preview_markdown, parse_tool_entry
@@ -157,6 +158,21 @@ def test_with_the_pseudo_locale_the_check_the_beam_service_the_lock_and_the_scen
     _assert_pseudo(p, "the exercise's lock")
     label = s.views["scene"].beam_stand.label
     assert label is not None and untranslated_words(label.text, NAMES) == []
+    notes = _note_texts(p)
+    assert notes and all(untranslated_words(t, NAMES) == [] for t in notes), p.notes
+
+
+def test_with_the_pseudo_locale_an_exercises_check_reading_and_its_refusal_are_from_the_catalogs(page) -> None:
+    p = page(TOOLS, language=PSEUDO_LANGUAGE)
+    s = p.session
+    s.set_rules(class_rules("mystery"))
+    p.select(2)
+    p.click(p.tools.check)                   # no reference tip to read the swing against: refused
+    assert p.tools.last_check is None and p.notes
+    true_tip_at(s, (0.0, 0.0, 2.0))
+    p.click(p.tools.check)
+    assert p.tools.last_check is not None and "Implied" not in p.tools.check_md.content
+    _assert_pseudo(p, "an exercise's reading")
     notes = _note_texts(p)
     assert notes and all(untranslated_words(t, NAMES) == [] for t in notes), p.notes
 

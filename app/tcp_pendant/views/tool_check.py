@@ -20,7 +20,7 @@ from tcp_pendant.controller.jog import JogSettings
 from tcp_pendant.controller.spin import MAX_SPIN_ANGLE_DEG, SpinCheckResult, spin_check
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.translation import ENGLISH, Translator
-from tcp_pendant.wizards.check_reading import READING_NOTE, read_mm, reading_verdict
+from tcp_pendant.wizards.check_reading import read_mm, reading_note, reading_verdict
 from tcpcal.tool import Tool
 
 __all__ = ["CheckJob", "check_job", "check_markdown", "check_verdict"]
@@ -114,7 +114,7 @@ def check_markdown(job: CheckJob, result: SpinCheckResult, *, reading: bool = Fa
         lines.append(f"| {r.label} | {moved} | {status} |")
     lines.append("")
     if reading:
-        lines += [READING_NOTE, "", f"**{reading_verdict(readings, result.angle_deg)}**"]
+        lines += [reading_note(tr=tr), "", f"**{reading_verdict(readings, result.angle_deg, tr=tr)}**"]
         return "\n".join(lines)
     err = result.implied_tcp_error_mm
     if err is not None and result.implied_offset_flange_mm is not None:

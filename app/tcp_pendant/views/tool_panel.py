@@ -457,7 +457,7 @@ class ToolPanel:
                 slot, tool = which()
                 title = self._check_title(slot, tool.name)
                 if s.rules.in_exercise:                 # read against the spike, as on a robot
-                    check_readable(s.pose_state().touch.distance_mm)
+                    check_readable(s.pose_state().touch.distance_mm, tr=self.tr)
                 job = check_job(s.controller, tool, title, self.check_angle.value, tr=self.tr)
                 shown = self.check_md.content
                 self.check_md.content = _("Checking {title} ...").format(title=escape_markdown(title))
