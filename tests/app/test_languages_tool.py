@@ -177,6 +177,29 @@ def test_with_the_pseudo_locale_an_exercises_check_reading_and_its_refusal_are_f
     assert notes and all(untranslated_words(t, NAMES) == [] for t in notes), p.notes
 
 
+def test_with_the_pseudo_locale_the_scenario_panel_is_chosen_in_its_words_and_explains_a_result(page) -> None:
+    """The trainer picks "Robot accuracy" by its pseudo-locale word; after an XYZ 4-point
+    result the panel explains it, every word from the catalogs."""
+    p = page(language=PSEUDO_LANGUAGE)
+    s, panel = p.session, p.scenario
+    word = next(o for o in panel.kind.options if o == QPS.gettext("Robot accuracy"))
+    assert word.startswith("⟦") and len(set(panel.kind.options)) == len(SCENARIO_KINDS)
+    p.choose(panel.seed, 7)
+    p.choose(panel.kind, word)
+    assert s.scenario_player.scenario.kind == "robot_accuracy" and s.scenario_player.scenario.seed == 7
+    v = s.views["calibrate"]
+    p.click(v.start)
+    for _ in range(4):
+        p.click(v.steps.auto_touch)
+    assert v.workflow.result is not None
+    md = panel.md.content
+    assert md.count("\n\n") >= 1 and untranslated_words(md, NAMES) == [], md
+    _assert_pseudo(p, "a result explained")
+    with s.lock:
+        s.set_language("en")
+    assert panel.kind.value == "Robot accuracy" and "**How this result shows it:** The robot differs" in panel.md.content
+
+
 def test_a_live_switch_relabels_every_text_and_english_comes_back_the_same(page) -> None:
     p = page(TOOLS)
     s = p.session
