@@ -20,6 +20,7 @@ from support.pseudo_text import WORD, gui_texts, untranslated_words
 from support.wsclient import wait_until
 
 from tcp_pendant.calibrate.beam_service import beam_check_markdown, beam_verdict
+from tcp_pendant.calibrate.touches_export import wizard_touches_csv
 from tcp_pendant.classroom.exercise_rules import class_rules
 from tcp_pendant.controller import builtin_tools
 from tcp_pendant.controller.scenarios import SCENARIO_KINDS, Scenario, explain
@@ -267,3 +268,32 @@ def test_the_text_functions_speak_the_pseudo_locale_and_english_by_default(page)
     assert untranslated_words(beam_check_markdown(check, tr=QPS), NAMES) == []
     assert beam_verdict(check) == check.verdict and check.verdict.startswith("TCP off by")
     assert beam_check_markdown(check).startswith("**Beam check of Pointer** (slot 1)")
+
+
+def test_the_touches_export_speaks_the_pseudo_locale_and_its_csv_is_the_same_in_every_language(page) -> None:
+    """"Export touches (CSV)" (the wizard panel): its label, hint and refusal from the catalogs,
+    relabelled on a switch; the POSES.csv it sends the same bytes in every language."""
+    p = page(language=PSEUDO_LANGUAGE)
+    s = p.session
+    export = s.views["calibrate"].steps.export
+    p.click(export.button)                                       # no calibration open: refused
+    assert p.notes and untranslated_words(p.notes[-1][1], NAMES) == [], p.notes
+    with pytest.raises(ValueError) as refused:
+        wizard_touches_csv(s.wizard_commands.start("xyz4"), tr=QPS)
+    assert untranslated_words(str(refused.value), NAMES) == []
+    for _ in range(4):
+        p.click(s.views["calibrate"].steps.auto_touch)
+    assert export.button.visible
+    texts = [t for t in gui_texts(export.button)]
+    assert len(texts) == 2 and all(untranslated_words(t, NAMES) == [] for t in texts)
+    sent = {}
+    for language in languages(include_pseudo=True):
+        with s.lock:
+            s.set_language(language)
+        p.sent.clear()
+        p.click(export.button)
+        (sent[language],) = p.sent
+    with s.lock:
+        s.set_language("en")
+    assert export.button.label == "Export touches (CSV)"
+    assert all(data == sent["en"] for data in sent.values()) and sent["en"][1].startswith(b"# tcpcal solve")
