@@ -104,7 +104,8 @@ def check_markdown(job: CheckJob, result: SpinCheckResult, *, reading: bool = Fa
     lines = [_("**TCP check of {title}** at ±{angle}° (mounted: {mounted})").format(
                  title=escape_markdown(job.title), angle=f"{result.angle_deg:g}",
                  mounted=escape_markdown(job.mounted_label)), "",
-             _("| Rotation | Tip moved (mm, by eye) | |") if reading else _("| Rotation | Tip moved (mm) | |"),
+             "| {rotation} | {moved} | |".format(rotation=_("Rotation"),
+                                                 moved=_("Tip moved (mm, by eye)") if reading else _("Tip moved (mm)")),
              "|---|---:|---|"]
     readings = []
     for r in result.rotations:
