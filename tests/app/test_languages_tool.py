@@ -185,6 +185,8 @@ def test_with_the_pseudo_locale_the_scenario_panel_is_chosen_in_its_words_and_ex
     s, panel = p.session, p.scenario
     word = next(o for o in panel.kind.options if o == QPS.gettext("Robot accuracy"))
     assert word.startswith("⟦") and len(set(panel.kind.options)) == len(SCENARIO_KINDS)
+    p.choose(panel.seed, -3)                                     # refused in words, the seed put back
+    assert p.notes and untranslated_words(p.notes[-1][1], NAMES) == [] and panel.seed.value == 0
     p.choose(panel.seed, 7)
     p.choose(panel.kind, word)
     assert s.scenario_player.scenario.kind == "robot_accuracy" and s.scenario_player.scenario.seed == 7

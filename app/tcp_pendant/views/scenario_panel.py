@@ -127,11 +127,12 @@ class ScenarioPanel:
         if kind is None:
             raise ValueError(tr.gettext("Unknown systematic error {name}; choose one of {choices}.").format(
                 name=repr(self.kind.value), choices=", ".join(scenario_word(k, tr) for k in SCENARIO_CHOICES)))
-        try:
-            seed = int(self.seed.value)
-        except (TypeError, ValueError):
+        value = self.seed.value
+        seed = int(value) if isinstance(value, int | float) and float(value).is_integer() else -1
+        if seed < 0:                                  # refused here, in the session's language
+            self.render()                             # the widgets show the scenario still played
             raise ValueError(tr.gettext("The seed must be a whole number >= 0, got {value}.").format(
-                value=repr(self.seed.value))) from None
+                value=repr(value)))
         if kind == self.session.scenario_player.scenario.kind and seed == self.session.scenario_player.scenario.seed:
             return
         try:
