@@ -20,6 +20,7 @@ from support.pseudo_text import WORD, gui_texts, untranslated_words
 from support.wsclient import wait_until
 
 from tcp_pendant.calibrate.beam_service import beam_check_markdown, beam_verdict
+from tcp_pendant.calibrate.pendant_rules import LibraryRights
 from tcp_pendant.calibrate.touches_export import wizard_touches_csv
 from tcp_pendant.classroom.exercise_rules import class_rules
 from tcp_pendant.controller import builtin_tools
@@ -94,8 +95,13 @@ def _note_texts(page: Page) -> list[str]:
 
 
 def _assert_pseudo(page: Page, state: str) -> None:
+    _assert_pseudo_names(page, set(), state)
+
+
+def _assert_pseudo_names(page: Page, names: set[str], state: str) -> None:
+    """Every text of the page's views from the catalogs but :data:`NAMES` and ``names``."""
     bad = {key: (text, words) for key, text in _texts(page).items()
-           if (words := untranslated_words(text, NAMES))}
+           if (words := untranslated_words(text, NAMES | names))}
     assert bad == {}, state
 
 
@@ -201,6 +207,26 @@ def test_with_the_pseudo_locale_the_scenario_panel_is_chosen_in_its_words_and_ex
     with s.lock:
         s.set_language("en")
     assert panel.kind.value == "Robot accuracy" and "**How this result shows it:** The robot differs" in panel.md.content
+
+
+def test_with_the_pseudo_locale_whose_slot_it_is_is_said_in_the_catalogs_words(page) -> None:
+    """A class's library: the selected slot is the trainee's own, another trainee's or the
+    trainer's (no classmate's name); unrestricted, who saved it (a trainee's name)."""
+    p = page(TOOLS, language=PSEUDO_LANGUAGE)
+    s = p.session
+    s.library.save(3, truth_tool("pointer", "AnnaPointer"), owner="Anna")
+    s.library.save(4, truth_tool("pointer", "BenPointer"), owner="Ben")
+    s.tools.reload_library()
+    lines = {}
+    for rights in (LibraryRights(), LibraryRights(restricted=True, owner="Anna")):
+        with s.lock:
+            s.tools.set_library_rights(rights)
+        for slot in (1, 3, 4):
+            p.select(slot)
+            lines[(rights.restricted, slot)] = p.tools.slot_md.content.split("\n\n")[-1]
+            _assert_pseudo_names(p, {"Anna", "Ben", "AnnaPointer", "BenPointer"}, f"slot {slot}, restricted {rights.restricted}")
+    assert len(set(lines.values())) == 6, lines   # no owner, saved by Anna, by Ben; the trainer's, Anna's own, another's
+    assert "Anna" in lines[(False, 3)] and "Ben" not in lines[(True, 4)]
 
 
 def test_a_live_switch_relabels_every_text_and_english_comes_back_the_same(page) -> None:
