@@ -182,6 +182,10 @@ def test_with_the_pseudo_locale_an_exercises_check_reading_and_its_refusal_are_f
     _assert_pseudo(p, "an exercise's reading")
     notes = _note_texts(p)
     assert notes and all(untranslated_words(t, NAMES) == [] for t in notes), p.notes
+    with s.lock:
+        s.set_language("en")                 # said again in English: still the reading, no answer
+    md = p.tools.check_md.content
+    assert "by eye" in md and "Implied" not in md and "FLANGE axes" not in md
 
 
 def test_with_the_pseudo_locale_the_scenario_panel_is_chosen_in_its_words_and_explains_a_result(page) -> None:

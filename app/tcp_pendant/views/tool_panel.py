@@ -170,7 +170,7 @@ class ToolPanel:
 
         self._checking = False
         self.last_check: tuple[CheckJob, SpinCheckResult] | None = None
-        self._check_subject: tuple[int | None, str] | None = None     # the last check's (slot, tool name)
+        self._check_subject: tuple[int | None, str, bool] | None = None  # the last check's (slot, tool name, reading)
         self._entry_said: Callable[[Translator], EntryOutcome] | None = None
         self._wire()
         self._show_entry_preview()
@@ -260,8 +260,9 @@ class ToolPanel:
         self._show_entry_outcome()
         if self.last_check is not None and self._check_subject is not None:
             job, result = self.last_check
-            job = dataclasses.replace(job, title=self._check_title(*self._check_subject))
-            self.check_md.content = check_markdown(job, result, reading=self.session.rules.in_exercise, tr=self.tr)
+            slot, name, reading = self._check_subject
+            job = dataclasses.replace(job, title=self._check_title(slot, name))
+            self.check_md.content = check_markdown(job, result, reading=reading, tr=self.tr)
 
     # ------------------------------------------------------------ library
     def reload(self) -> None:
@@ -482,8 +483,9 @@ class ToolPanel:
             if s.closed:
                 return
             self.last_check = (job, result)
-            self._check_subject = (slot, tool.name)
-            self.check_md.content = check_markdown(job, result, reading=s.rules.in_exercise, tr=self.tr)
+            reading = s.rules.in_exercise
+            self._check_subject = (slot, tool.name, reading)
+            self.check_md.content = check_markdown(job, result, reading=reading, tr=self.tr)
 
     def _entry(self) -> ToolEntry:
         return ToolEntry(str(self.entry_name.value), {f: str(h.value) for f, h in self.entry_fields.items()})
