@@ -188,8 +188,11 @@ def evaluate_check(tool: Tool, slot: int | None, scan: BeamScan, seed: int = 0, 
     axis_sigma = axis_sigma_mm if lo <= axis_sigma_mm <= hi else None
     if len(ti) < 2:
         raise ControllerError(" ".join((
-            tr.gettext("The beam check found too few tip events for a TCP: {n} of {count} orientations could "
-                       "be scanned, at least 2 are needed.").format(n=len(ti), count=scan.n_orientations_planned),
+            tr.ngettext("The beam check found too few tip events for a TCP: {n} of {count} orientation could "
+                        "be scanned, at least 2 are needed.",
+                        "The beam check found too few tip events for a TCP: {n} of {count} orientations could "
+                        "be scanned, at least 2 are needed.",
+                        scan.n_orientations_planned).format(n=len(ti), count=scan.n_orientations_planned),
             *scan.skipped,
             tr.gettext("Place the beam sensor where the robot reaches it with the tool turned about its own axis "
                        "(nearer the robot, or lower), or start from another pose."))))
