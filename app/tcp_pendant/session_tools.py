@@ -22,6 +22,7 @@ from tcp_pendant.calibrate.pendant_rules import UNRESTRICTED, ExerciseRules, Lib
 from tcp_pendant.calibrate.workflow import CalibrationWorkflow
 from tcp_pendant.controller import ControllerError, ToolModel, VirtualController
 from tcp_pendant.session_scenario import ScenarioPlayer
+from tcp_pendant.translation import Translator
 
 __all__ = ["SessionTools", "ToolsHost"]
 
@@ -37,6 +38,7 @@ class ToolsHost(Protocol):
     scenario_player: ScenarioPlayer
     rules: ExerciseRules
     hide_distance: bool
+    translator: Translator
 
     def changed(self, *, tool: bool = False, library: bool = False) -> None: ...
 
@@ -171,7 +173,8 @@ class SessionTools:
         with self._host.lock:
             tool = self.library_tools.get(int(slot))
             if tool is None:
-                raise ControllerError(f"Slot {slot} of the tool library is empty; pick a stored tool.")
+                raise ControllerError(self._host.translator.gettext(
+                    "Slot {slot} of the tool library is empty; pick a stored tool.").format(slot=slot))
             if self._host.shared:
                 self._host.library.activate(int(slot))
             self.set_active_data(tool, int(slot))

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import math
 import secrets
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -28,6 +28,7 @@ from tcp_pendant.controller.beam import BeamSensor, ToolShape
 from tcp_pendant.controller.beam_scan import BeamScan, BeamScanConfig, run_beam_scan, scan_arrays_mm, tool_shape
 from tcp_pendant.controller.errors import ControllerError
 from tcp_pendant.text_escape import escape_markdown
+from tcp_pendant.translation import ENGLISH, Translator
 from tcp_pendant.calibrate.pendant_rules import UNRESTRICTED, LibraryRights
 from tcpcal.beam import BeamAxisResult, BeamResult, solve_beam, solve_beam_axis
 from tcpcal.errors import TcpcalError
@@ -44,6 +45,7 @@ __all__ = [
     "BeamServiceError",
     "beam_check_job",
     "beam_check_markdown",
+    "beam_verdict",
     "update_tool_from_beam",
 ]
 
@@ -92,9 +94,11 @@ class BeamCheck:
         scan: the scan (events, moves, time on a real robot).
         beam_result: tcpcal's result of the tip events.
         axis_result: tcpcal's result of the axis events, or None.
-        verdict: plain text: good, or off by how much and what to do.
+        verdict: plain text: good, or off by how much and what to do (English; in another
+            language :func:`beam_verdict`).
         good: the deviation is at most :data:`GOOD_BEAM_MM`.
         seed: the random seed of the repeatability noise (a check is reproducible from it).
+        tip_sigma_mm: the tip events' repeatability the residual is judged against, mm.
     """
 
     tool_name: str
@@ -115,6 +119,7 @@ class BeamCheck:
     verdict: str
     good: bool
     seed: int
+    tip_sigma_mm: float = math.nan
 
 
 @dataclass(frozen=True, eq=False)
@@ -132,6 +137,7 @@ class BeamCheckJob:
         mounted_label: the physical tool's name (plain text).
         config: the scan's configuration.
         seed: random seed of the repeatability noise.
+        tr: the language of a refusal (too few tip events).
     """
 
     tool: Tool
@@ -144,6 +150,7 @@ class BeamCheckJob:
     mounted_label: str
     config: BeamScanConfig
     seed: int
+    tr: Translator = ENGLISH
 
     @property
     def T_flange_tool_plan(self) -> np.ndarray:
@@ -161,11 +168,13 @@ class BeamCheckJob:
         true_kin = None if self.true_kinematics is self.kinematics else self.true_kinematics
         scan = run_beam_scan(self.kinematics, self.q_rad, self.sensor, self.T_flange_tool_plan,
                              self.shape, true_kinematics=true_kin, config=self.config, rng=rng)
-        return evaluate_check(self.tool, self.slot, scan, self.seed)
+        return evaluate_check(self.tool, self.slot, scan, self.seed, tr=self.tr)
 
 
-def evaluate_check(tool: Tool, slot: int | None, scan: BeamScan, seed: int = 0) -> BeamCheck:
-    """Solve a scan's events and compare with the stored tool data (mm, FLANGE).
+def evaluate_check(tool: Tool, slot: int | None, scan: BeamScan, seed: int = 0, *,
+                   tr: Translator = ENGLISH) -> BeamCheck:
+    """Solve a scan's events and compare with the stored tool data (mm, FLANGE); a refusal in
+    ``tr``'s language (the verdict is English: :func:`beam_verdict` says it in another).
 
     Raises:
         ControllerError: fewer than two orientations gave a tip event (the skip reasons).
@@ -178,15 +187,20 @@ def evaluate_check(tool: Tool, slot: int | None, scan: BeamScan, seed: int = 0) 
     tip_sigma = tip_sigma_mm if lo <= tip_sigma_mm <= hi else None
     axis_sigma = axis_sigma_mm if lo <= axis_sigma_mm <= hi else None
     if len(ti) < 2:
-        raise ControllerError(
-            f"The beam check found too few tip events for a TCP: {len(ti)} of "
-            f"{scan.n_orientations_planned} orientations could be scanned, at least 2 are needed. "
-            + " ".join(scan.skipped) + " Place the beam sensor where the robot reaches it with the "
-            "tool turned about its own axis (nearer the robot, or lower), or start from another pose.")
+        raise ControllerError(" ".join((
+            tr.ngettext("The beam check found too few tip events for a TCP: {n} of {count} orientation could "
+                        "be scanned, at least 2 are needed.",
+                        "The beam check found too few tip events for a TCP: {n} of {count} orientations could "
+                        "be scanned, at least 2 are needed.",
+                        scan.n_orientations_planned).format(n=len(ti), count=scan.n_orientations_planned),
+            *scan.skipped,
+            tr.gettext("Place the beam sensor where the robot reaches it with the tool turned about its own axis "
+                       "(nearer the robot, or lower), or start from another pose."))))
     try:
         beam = solve_beam(rot[ti], pos[ti], b[ti], u[ti], sigma=tip_sigma)
     except TcpcalError as exc:
-        raise ControllerError(f"The beam check's tip events do not determine a TCP: {exc}") from None
+        raise ControllerError(tr.gettext("The beam check's tip events do not determine a TCP: {problem}").format(
+            problem=exc)) from None
     axis: BeamAxisResult | None
     try:
         axis = solve_beam_axis(rot[ai], pos[ai], b[ai], u[ai], beam.tcp, sigma=axis_sigma)
@@ -199,35 +213,50 @@ def evaluate_check(tool: Tool, slot: int | None, scan: BeamScan, seed: int = 0) 
     direction = None if axis is None else np.asarray(axis.direction, dtype=float)
     dir_dev = None if direction is None else _angle_deg(direction, tool.rotation[:, 0])
     good = norm <= GOOD_BEAM_MM
-    if good:
-        verdict = (f"TCP good: the beam measured it {norm:.3f} mm from the stored data "
-                   f"(at most {GOOD_BEAM_MM:g} mm).")
-    else:
-        verdict = (f"TCP off by {norm:.3f} mm: the tool is bent or its data is stale. Update "
-                   "writes the measured TCP into the library; verify it with the TCP check.")
-    if dir_dev is not None and dir_dev > DIRECTION_NOTE_DEG:
-        verdict += (f" The tool direction differs by {dir_dev:.2f} deg from the stored X axis; "
-                    "Update keeps the stored orientation (calibrate it with TCP & Z, X if the work "
-                    "depends on it).")
     consistent = beam.rms_error <= CONSISTENT_FACTOR * max(tip_sigma_mm, 1e-4)
-    if not consistent:
-        verdict += (f" The tip events disagree by {beam.rms_error:.3f} mm RMS, far more than the "
-                    f"sensor's repeatability ({tip_sigma_mm:.3f} mm): the robot's absolute accuracy "
-                    "(its model is not the real arm) or a moved sensor limits this measurement, and "
-                    "an Update would store part of that error in the tool data.")
-    if scan.skipped:
-        verdict += f" {len(scan.skipped)} of {scan.n_orientations_planned} orientations were skipped."
-    return BeamCheck(
+    check = BeamCheck(
         tool_name=tool.name, slot=slot, stored_tool=tool, stored_tcp_mm=read_only_array(stored),
         measured_tcp_mm=read_only_array(measured), deviation_mm=read_only_array(dev),
         deviation_norm_mm=norm, ci95_mm=float(beam.ci95_radius),
         residual_rms_mm=float(beam.rms_error), consistent=consistent, direction_deviation_deg=dir_dev,
         measured_direction=None if direction is None else read_only_array(direction), scan=scan,
-        beam_result=beam, axis_result=axis, verdict=verdict, good=good, seed=int(seed))
+        beam_result=beam, axis_result=axis, verdict="", good=good, seed=int(seed), tip_sigma_mm=tip_sigma_mm)
+    return replace(check, verdict=beam_verdict(check))
+
+
+def beam_verdict(check: BeamCheck, *, tr: Translator = ENGLISH) -> str:
+    """The check's verdict in ``tr``'s language (plain text): good, or off by how much and what to
+    do; then whether the direction differs, the tip events disagree, orientations were skipped."""
+    _ = tr.gettext
+    norm = check.deviation_norm_mm
+    if check.good:
+        verdict = _("TCP good: the beam measured it {deviation} mm from the stored data (at most {limit} mm).").format(
+            deviation=f"{norm:.3f}", limit=f"{GOOD_BEAM_MM:g}")
+    else:
+        verdict = _("TCP off by {deviation} mm: the tool is bent or its data is stale. Update writes the measured "
+                    "TCP into the library; verify it with the TCP check.").format(deviation=f"{norm:.3f}")
+    dir_dev = check.direction_deviation_deg
+    if dir_dev is not None and dir_dev > DIRECTION_NOTE_DEG:
+        verdict += " " + _("The tool direction differs by {angle} deg from the stored X axis; Update keeps the "
+                           "stored orientation (calibrate it with TCP & Z, X if the work depends on it).").format(
+            angle=f"{dir_dev:.2f}")
+    if not check.consistent:
+        verdict += " " + _("The tip events disagree by {rms} mm RMS, far more than the sensor's repeatability "
+                           "({sigma} mm): the robot's absolute accuracy (its model is not the real arm) or a moved "
+                           "sensor limits this measurement, and an Update would store part of that error in the "
+                           "tool data.").format(rms=f"{check.residual_rms_mm:.3f}", sigma=f"{check.tip_sigma_mm:.3f}")
+    scan = check.scan
+    if scan.skipped:
+        verdict += " " + tr.ngettext("{n} of {count} orientation was skipped.",
+                                     "{n} of {count} orientations were skipped.",
+                                     scan.n_orientations_planned).format(
+            n=len(scan.skipped), count=scan.n_orientations_planned)
+    return verdict
 
 
 def beam_check_job(controller: VirtualController, slot: int | None, tool: Tool, *,
-                   rng_seed: int | None = None, config: BeamScanConfig | None = None) -> BeamCheckJob:
+                   rng_seed: int | None = None, config: BeamScanConfig | None = None,
+                   tr: Translator = ENGLISH) -> BeamCheckJob:
     """A :class:`BeamCheckJob` of ``tool`` from the controller's current state (on the loop).
 
     Args:
@@ -257,39 +286,46 @@ def beam_check_job(controller: VirtualController, slot: int | None, tool: Tool, 
     return BeamCheckJob(tool=tool, slot=None if slot is None else int(slot), kinematics=nominal,
                         true_kinematics=physical, q_rad=c.q_rad, sensor=c.beam_sensor, shape=shape,
                         mounted_label=c.mounted_tool.label,
-                        config=BeamScanConfig() if config is None else config, seed=seed)
+                        config=BeamScanConfig() if config is None else config, seed=seed, tr=tr)
 
 
 def _fmt3(v: np.ndarray) -> str:
     return ", ".join(f"{0.0 if abs(float(x)) < 5e-4 else float(x):.3f}" for x in v)
 
 
-def beam_check_markdown(check: BeamCheck) -> str:
-    """The check's text for the Tool tab (markdown; the tool name and words escaped)."""
-    where = "not in the library" if check.slot is None else f"slot {check.slot}"
+def beam_check_markdown(check: BeamCheck, *, tr: Translator = ENGLISH) -> str:
+    """The check's text for the Tool tab (markdown; the tool name and words escaped), in ``tr``'s
+    language."""
+    _ = tr.gettext
+    name = escape_markdown(check.tool_name)
+    head = (_("**Beam check of {name}** (not in the library)").format(name=name) if check.slot is None
+            else _("**Beam check of {name}** (slot {slot})").format(name=name, slot=check.slot))
     lines = [
-        f"**Beam check of {escape_markdown(check.tool_name)}** ({where})",
+        head,
         "",
         "| | X | Y | Z |",
         "|---|---:|---:|---:|",
-        "| stored TCP (mm) | " + " | ".join(f"{v:.3f}" for v in check.stored_tcp_mm) + " |",
-        "| measured TCP (mm) | " + " | ".join(f"{v:.3f}" for v in check.measured_tcp_mm) + " |",
-        "| deviation (mm) | " + " | ".join(f"{v:+.3f}" for v in check.deviation_mm) + " |",
+        "| " + _("stored TCP (mm)") + " | " + " | ".join(f"{v:.3f}" for v in check.stored_tcp_mm) + " |",
+        "| " + _("measured TCP (mm)") + " | " + " | ".join(f"{v:.3f}" for v in check.measured_tcp_mm) + " |",
+        "| " + _("deviation (mm)") + " | " + " | ".join(f"{v:+.3f}" for v in check.deviation_mm) + " |",
         "",
-        f"Deviation **{check.deviation_norm_mm:.3f} mm** (95 % radius of the measurement "
-        f"{check.ci95_mm:.3f} mm), FLANGE coordinates, measured - stored.",
+        _("Deviation **{deviation} mm** (95 % radius of the measurement {ci95} mm), FLANGE coordinates, "
+          "measured - stored.").format(deviation=f"{check.deviation_norm_mm:.3f}", ci95=f"{check.ci95_mm:.3f}"),
         "",
-        f"- the tip events fit the beam to {check.residual_rms_mm:.3f} mm RMS",
+        "- " + _("the tip events fit the beam to {rms} mm RMS").format(rms=f"{check.residual_rms_mm:.3f}"),
     ]
     if check.direction_deviation_deg is not None:
-        lines.append(f"- tool direction: {check.direction_deviation_deg:.2f} deg from the stored X axis")
+        lines.append("- " + _("tool direction: {angle} deg from the stored X axis").format(
+            angle=f"{check.direction_deviation_deg:.2f}"))
     s = check.scan
-    lines.append(f"- {len(s.tip_indices)} tip and {len(s.axis_indices)} axis events at "
-                 f"{s.n_orientations_done} orientations; the scan takes {s.duration_s:.1f} s on the "
-                 f"robot ({s.path_length_m * 1000.0:.0f} mm of path)")
+    lines.append("- " + _("{tips} tip and {axes} axis events at {n} orientations; the scan takes {seconds} s on "
+                          "the robot ({path} mm of path)").format(
+        tips=len(s.tip_indices), axes=len(s.axis_indices), n=s.n_orientations_done, seconds=f"{s.duration_s:.1f}",
+        path=f"{s.path_length_m * 1000.0:.0f}"))
     for reason in s.skipped:
         lines.append(f"- {escape_markdown(reason)}")
-    lines += ["", ("✔ " if check.good else "⚠ ") + escape_markdown(check.verdict)]
+    verdict = check.verdict if tr.language == ENGLISH.language else beam_verdict(check, tr=tr)
+    lines += ["", ("✔ " if check.good else "⚠ ") + escape_markdown(verdict)]
     return "\n".join(lines)
 
 

@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from tcp_pendant.translation import ENGLISH, Translator
 from tcp_pendant.wizards import Wizard
 
 __all__ = ["EXPORTABLE", "TOUCHES_CSV_FILENAME", "touches_csv_filename", "wizard_touches_csv"]
@@ -65,18 +66,22 @@ def _rows(wizard: Wizard) -> list[int]:
     return sorted(poses)
 
 
-def wizard_touches_csv(wizard: Wizard, joints_deg: Mapping[int, Sequence[float]] | None = None) -> str:
-    """The recorded steps of ``wizard`` as POSES.csv text (module docstring); ``joints_deg``:
-    the joint values by 0-based step (the workflow's ``WizardRun.joints_deg``).
+def wizard_touches_csv(wizard: Wizard, joints_deg: Mapping[int, Sequence[float]] | None = None, *,
+                       tr: Translator = ENGLISH) -> str:
+    """The recorded steps of ``wizard`` as POSES.csv text (module docstring; the same in every
+    language); ``joints_deg``: the joint values by 0-based step (the workflow's
+    ``WizardRun.joints_deg``).
 
     Raises:
-        ValueError: a wizard ``tcpcal solve`` has no command for, or no step recorded yet.
+        ValueError: a wizard ``tcpcal solve`` has no command for, or no step recorded yet (in
+            ``tr``'s language).
     """
     if wizard.kind not in EXPORTABLE:
-        raise ValueError(f"The {wizard.title} has no touches tcpcal solve reads; export the session record instead.")
+        raise ValueError(tr.gettext("The {method} has no touches tcpcal solve reads; export the session record "
+                                    "instead.").format(method=tr.gettext(wizard.title)))
     steps = _rows(wizard)
     if not steps:
-        raise ValueError("No step recorded yet: record the wizard's steps first, then export them.")
+        raise ValueError(tr.gettext("No step recorded yet: record the wizard's steps first, then export them."))
     joints = {i: tuple(float(v) for v in (joints_deg or {}).get(i, ())) for i in steps}
     n = {len(j) for j in joints.values()}
     n_joints = n.pop() if len(n) == 1 else 0

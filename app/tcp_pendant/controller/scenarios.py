@@ -36,6 +36,7 @@ import pinocchio as pin
 from tcp_pendant.controller.errors import ControllerError
 from tcp_pendant.controller.kinematics import RobotKinematics
 from tcp_pendant.controller.tools import ToolModel
+from tcp_pendant.translation import ENGLISH, Translator
 
 __all__ = [
     "DEFAULT_SEED_RANGE",
@@ -321,43 +322,46 @@ def realize(scenario: Scenario, kinematics: RobotKinematics, tool: ToolModel) ->
     return ScenarioWorld(scenario, kinematics, tool)
 
 
-def explain(world: ScenarioWorld | Scenario) -> str:
+def explain(world: ScenarioWorld | Scenario, *, tr: Translator = ENGLISH) -> str:
     """Plain words for after a result: the error, how it shows in the result, how the TCP check
-    reveals it. Numbers when given a :class:`ScenarioWorld`. Escape before markdown."""
+    reveals it, in ``tr``'s language. Numbers when given a :class:`ScenarioWorld`. Escape before
+    markdown."""
+    _ = tr.gettext
     w = world if isinstance(world, ScenarioWorld) else None
     kind = world.scenario.kind if isinstance(world, ScenarioWorld) else world.kind
     if kind == "bent_tool":
-        what = "The tool was bent in a crash"
         if w is not None and w.tool_bend is not None:
-            what += (f": its tip moved {w.tool_bend.shift_mm:.1f} mm sideways and its axis turned "
-                     f"{w.tool_bend.angle_deg:.1f}°")
-        return (f"{what}, while the tool data in the library stayed as it was. "
-                "In a new calibration the touches agree (small residual) and the TCP comes out away from "
-                "the saved one: the new TCP is right and the saved data is stale; working with the saved "
-                "data puts every point off by the bend. "
-                "The TCP check with the saved data shows it: the tip swings off the reference by "
-                "2·sin(angle/2) times the sideways error on each rotation, and the implied TCP error is "
-                "the size of the bend; with the new calibration it drops to your touching accuracy.")
-    if kind == "robot_accuracy":
-        return ("The robot differs from its model as a real, uncalibrated arm does: each link length by "
-                "0.1-0.5 mm and each joint zero by 0.01-0.05°. "
-                "Even perfect touches leave a residual of a few tenths of a millimetre and the TCP is off by "
-                "a few tenths; calibrating again gives the same picture, because it is the robot's absolute "
-                "accuracy, not your touching. "
-                "The TCP check shows tenths of a millimetre that no TCP correction removes (the implied TCP "
-                "error stays and the fit of the six rotations leaves a remainder): only a robot calibration "
-                "(mastering, absolute-accuracy option) improves it.")
-    if kind == "moved_reference":
-        what = "The reference tip was knocked"
-        if w is not None and w.reference_move is not None:
-            s = float(np.linalg.norm(w.reference_move.shift_mm))
-            what += f" {s:.1f} mm after touch {w.reference_move.after_touch}"
+            what = _("The tool was bent in a crash: its tip moved {shift} mm sideways and its axis turned "
+                     "{angle}°, while the tool data in the library stayed as it was.").format(
+                shift=f"{w.tool_bend.shift_mm:.1f}", angle=f"{w.tool_bend.angle_deg:.1f}")
         else:
-            what += " after one of the touches"
-        return (f"{what}. "
-                "The touches after the move disagree with the earlier ones: the residual is large (the solver "
-                "may flag outliers) and the TCP can be wrong by millimetres. Remove the touches after the move "
-                "or calibrate again with the tip fixed. "
-                "The TCP check needs no reference tip (the tool turns about its own TCP), so it shows the "
-                "wrong TCP directly: the implied TCP error is how far the computed TCP is off.")
-    return "No systematic error: the residual reflects only your touching accuracy."
+            what = _("The tool was bent in a crash, while the tool data in the library stayed as it was.")
+        return what + " " + _(
+            "In a new calibration the touches agree (small residual) and the TCP comes out away from "
+            "the saved one: the new TCP is right and the saved data is stale; working with the saved "
+            "data puts every point off by the bend. "
+            "The TCP check with the saved data shows it: the tip swings off the reference by "
+            "2·sin(angle/2) times the sideways error on each rotation, and the implied TCP error is "
+            "the size of the bend; with the new calibration it drops to your touching accuracy.")
+    if kind == "robot_accuracy":
+        return _("The robot differs from its model as a real, uncalibrated arm does: each link length by "
+                 "0.1-0.5 mm and each joint zero by 0.01-0.05°. "
+                 "Even perfect touches leave a residual of a few tenths of a millimetre and the TCP is off by "
+                 "a few tenths; calibrating again gives the same picture, because it is the robot's absolute "
+                 "accuracy, not your touching. "
+                 "The TCP check shows tenths of a millimetre that no TCP correction removes (the implied TCP "
+                 "error stays and the fit of the six rotations leaves a remainder): only a robot calibration "
+                 "(mastering, absolute-accuracy option) improves it.")
+    if kind == "moved_reference":
+        if w is not None and w.reference_move is not None:
+            what = _("The reference tip was knocked {shift} mm after touch {touch}.").format(
+                shift=f"{float(np.linalg.norm(w.reference_move.shift_mm)):.1f}", touch=w.reference_move.after_touch)
+        else:
+            what = _("The reference tip was knocked after one of the touches.")
+        return what + " " + _(
+            "The touches after the move disagree with the earlier ones: the residual is large (the solver "
+            "may flag outliers) and the TCP can be wrong by millimetres. Remove the touches after the move "
+            "or calibrate again with the tip fixed. "
+            "The TCP check needs no reference tip (the tool turns about its own TCP), so it shows the "
+            "wrong TCP directly: the implied TCP error is how far the computed TCP is off.")
+    return _("No systematic error: the residual reflects only your touching accuracy.")

@@ -186,13 +186,23 @@ def touch_label(index: int, T_world_flange: np.ndarray) -> str:
     return f"P{index + 1}  X {fmt_num(p[0], 1)} Y {fmt_num(p[1], 1)} Z {fmt_num(p[2], 1)} mm"
 
 
-def tool_data_markdown(tool: Tool | None, slot: int | None = None) -> str:
-    """Active tool data: name (slot), TCP X, Y, Z mm and A, B, C deg, calibration method."""
+def tool_data_markdown(tool: Tool | None, slot: int | None = None, *, selected: bool = False,
+                       tr: Translator = ENGLISH) -> str:
+    """Active tool data: name (slot), TCP X, Y, Z mm and A, B, C deg, calibration method, in
+    ``tr``'s language; ``selected``: headed "Selected:" (the library's selection) instead of
+    "Active tool:"."""
 
+    _ = tr.gettext
     if tool is None:
-        return "**Active tool:** none (TCP = flange)"
-    head = f"**Active tool:** {escape_markdown(tool.name)}" + ("" if slot is None else f" (slot {slot})")
+        return _("**Selected:** none (TCP = flange)") if selected else _("**Active tool:** none (TCP = flange)")
+    name = escape_markdown(tool.name)
+    if slot is None:
+        head = (_("**Selected:** {name}") if selected else _("**Active tool:** {name}")).format(name=name)
+    else:
+        head = (_("**Selected:** {name} (slot {slot})") if selected
+                else _("**Active tool:** {name} (slot {slot})")).format(name=name, slot=slot)
     x, y, z = (fmt_num(v) for v in tool.tcp_mm)
     a, b, c = (fmt_num(v) for v in tool.abc_deg)
-    cal = "" if tool.calibration is None else f"\n\ncalibrated by {escape_markdown(tool.calibration.method)}"
+    cal = "" if tool.calibration is None else "\n\n" + _("calibrated by {method}").format(
+        method=escape_markdown(tool.calibration.method))
     return f"{head}\n\n```\nX {x}  Y {y}  Z {z} mm\nA {a}  B {b}  C {c} deg\n```{cal}"

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from tcpcal.tool import Calibration, Tool
 from tcp_pendant.pendant.formatting import fmt_num
 from tcp_pendant.text_escape import escape_markdown
+from tcp_pendant.translation import ENGLISH, Translator
 
 __all__ = [
     "FIELDS",
@@ -30,21 +31,22 @@ MAX_ABS_MM = 5000.0
 """A TCP farther than 5 m from the flange is a typing error, not a tool."""
 
 
-def parse_number(text: str, what: str) -> float:
-    """A finite number from a text field; accepts a decimal comma (``"12,5"``).
+def parse_number(text: str, what: str, *, tr: Translator = ENGLISH) -> float:
+    """A finite number from a text field; accepts a decimal comma (``"12,5"``). The error is
+    in ``tr``'s language (``what``: the field's label, e.g. ``X (mm)``).
 
     Raises:
         ValueError: with a message naming the field and what to type.
     """
     t = str(text).strip().replace(",", ".") if text is not None else ""
     if not t:
-        raise ValueError(f"{what}: enter a number")
+        raise ValueError(tr.gettext("{what}: enter a number").format(what=what))
     try:
         v = float(t)
     except ValueError:
-        raise ValueError(f"{what}: '{text}' is not a number") from None
+        raise ValueError(tr.gettext("{what}: '{text}' is not a number").format(what=what, text=text)) from None
     if not math.isfinite(v):
-        raise ValueError(f"{what}: '{text}' is not a finite number")
+        raise ValueError(tr.gettext("{what}: '{text}' is not a finite number").format(what=what, text=text))
     return v
 
 
@@ -69,24 +71,25 @@ class ToolEntryResult:
         return self.tool is not None and not self.errors
 
 
-def parse_tool_entry(entry: ToolEntry) -> ToolEntryResult:
+def parse_tool_entry(entry: ToolEntry, *, tr: Translator = ENGLISH) -> ToolEntryResult:
     """Validate the form: a non-empty name, X/Y/Z in mm within +-5000, A/B/C in deg within
-    +-360 (A, B, C are KUKA angles, ``R = Rz(A) Ry(B) Rx(C)``)."""
+    +-360 (A, B, C are KUKA angles, ``R = Rz(A) Ry(B) Rx(C)``); the errors in ``tr``'s language."""
     errors: dict[str, str] = {}
     name = (entry.name or "").strip()
     if not name:
-        errors["name"] = "Name: enter a tool name"
+        errors["name"] = tr.gettext("Name: enter a tool name")
     nums: dict[str, float] = {}
     for f in FIELDS:
         unit = "mm" if f in "XYZ" else "deg"
         try:
-            v = parse_number(entry.values.get(f, ""), f"{f} ({unit})")
+            v = parse_number(entry.values.get(f, ""), f"{f} ({unit})", tr=tr)
         except ValueError as exc:
             errors[f] = str(exc)
             continue
         limit = MAX_ABS_MM if f in "XYZ" else 360.0
         if abs(v) > limit:
-            errors[f] = f"{f} ({unit}): {v:g} is out of range (within ±{limit:g} {unit})"
+            errors[f] = tr.gettext("{field} ({unit}): {value} is out of range (within ±{limit} {unit})").format(
+                field=f, unit=unit, value=f"{v:g}", limit=f"{limit:g}")
             continue
         nums[f] = v
     if errors:
@@ -96,11 +99,11 @@ def parse_tool_entry(entry: ToolEntry) -> ToolEntryResult:
                     abc_deg=(nums["A"], nums["B"], nums["C"]),
                     calibration=Calibration.now("numeric", {}))
     except ValueError as exc:                       # tcpcal's own validation (e.g. the name)
-        return ToolEntryResult(None, {"name": f"Name: {exc}"})
+        return ToolEntryResult(None, {"name": tr.gettext("Name: {problem}").format(problem=exc)})
     return ToolEntryResult(tool, {})
 
 
-def entry_preview_markdown(entry: ToolEntry) -> str:
+def entry_preview_markdown(entry: ToolEntry, *, tr: Translator = ENGLISH) -> str:
     """The form's live preview: what "Save" would store, as the server has received it.
 
     One line with the name and every field as it will be stored (two decimals, mm and deg;
@@ -118,8 +121,8 @@ def entry_preview_markdown(entry: ToolEntry) -> str:
         except ValueError:
             text = "?"
         shown.append(f"{f} {text}")
-    head = (f"**{name}**" if name else "*(no name)*") + \
+    head = (f"**{name}**" if name else tr.gettext("*(no name)*")) + \
         f" · {' '.join(shown[:3])} mm · {' '.join(shown[3:])} deg"
-    res = parse_tool_entry(entry)
-    status = "✔ ready to save" if res.ok else "⚠ " + "; ".join(escape_markdown(e) for e in res.errors.values())
+    res = parse_tool_entry(entry, tr=tr)
+    status = tr.gettext("✔ ready to save") if res.ok else "⚠ " + "; ".join(escape_markdown(e) for e in res.errors.values())
     return f"{head}\n\n{status}"

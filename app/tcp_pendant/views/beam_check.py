@@ -16,12 +16,15 @@ time per session. Update: ``beam_service.update_tool_from_beam`` (it refuses whe
 changed since the check), then ``SessionTools.apply_saved`` (the library re-read, the updated tool
 the active data); refused when the active tool is no longer the one checked. Tool names reach
 the markdown escaped (``beam_check_markdown`` escapes its own), notifications as plain text.
+
+Language: every word is the session's (``session.translator``); a ``language`` change relabels
+the folder and the buttons and says the result again (:meth:`BeamCheckView.relabel`).
 """
 
 from __future__ import annotations
 
 import logging
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -36,6 +39,7 @@ from tcp_pendant.calibrate.jobs import EXERCISE_REFUSAL
 from tcp_pendant.job_pool import JobRefused
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.text_escape import escape_markdown
+from tcp_pendant.translation import ENGLISH, N_, SOURCE_LANGUAGE, Translator
 from tcp_pendant.views.beam_replay import ScanPlayer, beam_view_direction, scan_spheres
 from tcp_pendant.views.framing import Framing
 from tcp_pendant.views.scene import frame_cameras
@@ -50,20 +54,23 @@ __all__ = ["BeamCheckView", "update_markdown"]
 
 log = logging.getLogger(__name__)
 
-INTRO = ("The robot moves the ACTIVE tool through the beam sensor by itself and measures its TCP. "
-         "After a crash: **Check with beam**, then **Update** stores the measured TCP.")
+INTRO = N_("The robot moves the ACTIVE tool through the beam sensor by itself and measures its TCP. "
+           "After a crash: **Check with beam**, then **Update** stores the measured TCP.")
+_FOLDER = N_("TCP service (beam sensor)")
+_CHECK = N_("Check with beam")
 
 
 def _fmt3(v: Iterable[float]) -> str:
     return ", ".join(f"{0.0 if abs(float(x)) < 5e-4 else float(x):.3f}" for x in v)
 
 
-def update_markdown(slot: int, before: Tool, after: Tool) -> str:
-    """What Update did (tool name escaped)."""
-    return (f"✔ **Updated slot {slot}: {escape_markdown(after.name)}**: TCP ({_fmt3(after.tcp_mm)}) mm "
-            f"(was ({_fmt3(before.tcp_mm)}) mm), calibration method "
-            f"{escape_markdown(after.calibration.method if after.calibration else 'beam')}. It is the active "
-            "tool data now; verify it with the TCP check (spin test) above.")
+def update_markdown(slot: int, before: Tool, after: Tool, *, tr: Translator = ENGLISH) -> str:
+    """What Update did (tool name escaped), in ``tr``'s language."""
+    return tr.gettext("✔ **Updated slot {slot}: {name}**: TCP ({tcp}) mm (was ({before}) mm), calibration method "
+                      "{method}. It is the active tool data now; verify it with the TCP check (spin test) "
+                      "above.").format(
+        slot=slot, name=escape_markdown(after.name), tcp=_fmt3(after.tcp_mm), before=_fmt3(before.tcp_mm),
+        method=escape_markdown(after.calibration.method if after.calibration else 'beam'))
 
 
 class BeamCheckView:
@@ -73,9 +80,10 @@ class BeamCheckView:
         self.session = session
         self.player = player
         gui = target_of(session).gui
-        with gui.add_folder("TCP service (beam sensor)"):
+        self.folder = gui.add_folder(_FOLDER)
+        with self.folder:
             self.intro_md = gui.add_markdown(INTRO)
-            self.check = gui.add_button("Check with beam", color="blue",
+            self.check = gui.add_button(_CHECK, color="blue",
                                         hint="Measure the active tool's TCP with the beam sensor now.")
             self.update = gui.add_button("Update", color="green", disabled=True,
                                          hint="Write the measured TCP into the library slot of the active tool.")
@@ -83,6 +91,7 @@ class BeamCheckView:
                                          hint="Show the last check's scan again in the 3D view.")
             self.result_md = gui.add_markdown("")
         self._checking = False
+        self._said: Callable[[Translator], str] | None = None   # result_md's text in a language
         self.last_check: BeamCheck | None = None
         """The last check's result (None before one, and after its Update)."""
         self._q_before: np.ndarray | None = None
@@ -92,12 +101,44 @@ class BeamCheckView:
         g = session.loop.on_loop
         self.update.on_click(g(self._on_update))
         self.replay.on_click(g(self._on_replay))
+        if session.language != SOURCE_LANGUAGE:
+            self.relabel()
         session.subscribe(self.on_change)
 
+    @property
+    def tr(self) -> Translator:
+        """The session's language."""
+        return self.session.translator
+
     def on_change(self, change: SessionChange) -> None:
-        """The change signal: Update is offered only while the active tool is the one checked."""
+        """The change signal: Update is offered only while the active tool is the one checked;
+        every text again on ``language``."""
+        if change.language:
+            self.relabel()
         if change.tool or change.library:
             self._render_buttons()
+
+    def relabel(self) -> None:
+        """The folder, the intro, the buttons and the result in the session's language."""
+        _ = self.tr.gettext
+        self.folder.label = _(_FOLDER)
+        self.intro_md.content = _(INTRO)
+        self.check.label = _(_CHECK)
+        self.check.hint = _("Measure the active tool's TCP with the beam sensor now.")
+        self.update.label = _("Update")
+        self.update.hint = _("Write the measured TCP into the library slot of the active tool.")
+        self.replay.label = _("Replay scan")
+        self.replay.hint = _("Show the last check's scan again in the 3D view.")
+        self._show_said()
+
+    def _say(self, said: Callable[[Translator], str]) -> None:
+        """Show ``said`` (the result's text as a function of the language) and keep it for a switch."""
+        self._said = said
+        self._show_said()
+
+    def _show_said(self) -> None:
+        if self._said is not None:
+            self.result_md.content = self._said(self.tr)
 
     def _still_checked(self) -> bool:
         chk = self.last_check
@@ -117,56 +158,60 @@ class BeamCheckView:
             await self.run_check()
         except Exception as exc:           # a browser's click must never kill the server
             log.exception("beam check failed")
-            self._failed("Beam check failed", f"{type(exc).__name__}: {exc}", kind="error")
+            self._failed(N_("Beam check failed"), f"{type(exc).__name__}: {exc}", kind="error")
 
     async def run_check(self) -> None:
         """The check of the active tool: job on the loop, scan in the worker, result on the loop;
         refused at once while this session's job runs or its share is used up
         (``SessionLoop.admit_job``)."""
-        s = self.session
-        if refused_before_job(s, running=self._checking, what="beam check", not_started="Beam check not started"):
+        s, _ = self.session, self.tr.gettext
+        if refused_before_job(s, running=self._checking, what=_("beam check"),
+                              not_started=_("Beam check not started")):
             return
         try:
             with s.lock:
                 tool = s.controller.active_tool
                 if s.workflow.hide_truth:
-                    raise ValueError(EXERCISE_REFUSAL.format(what="Check with beam"))
+                    raise ValueError(_(EXERCISE_REFUSAL).format(what=_(_CHECK)))
                 if tool is None:
-                    raise ValueError("No tool data is active (TCP = flange): activate the tool to check in the "
-                                     "Tool library first.")
+                    raise ValueError(_("No tool data is active (TCP = flange): activate the tool to check in the "
+                                       "Tool library first."))
                 player = self.player
                 if not (player.playing and player.owner is self):   # a check during our film: back to
                     self._q_before = s.controller.q_rad             # where the first one started
                 player.stop()                                       # the robot stays where the job sees it
-                job = beam_check_job(s.controller, s.tools.active_slot, tool, rng_seed=int(s.rng.integers(2**31)))
+                job = beam_check_job(s.controller, s.tools.active_slot, tool, rng_seed=int(s.rng.integers(2**31)),
+                                     tr=self.tr)
                 self._checking = True
-                self.result_md.content = f"Scanning **{escape_markdown(tool.name)}** with the beam sensor ..."
+                name = escape_markdown(tool.name)
+                self._say(lambda tr: tr.gettext("Scanning **{name}** with the beam sensor ...").format(name=name))
                 self._render_buttons()
         except ValueError as exc:          # ControllerError and tcpcal's errors are ValueErrors
-            s.notify("Not done", str(exc), kind="warning")
+            s.notify(_("Not done"), str(exc), kind="warning")
             return
         try:
             check = await s.loop.run_job(job.run, what="a beam check")
         except JobRefused as exc:          # another job of this session, or a full queue: nothing ran
-            self._failed("Beam check not started", str(exc), kind="warning")
+            self._failed(N_("Beam check not started"), str(exc), kind="warning")
             return
         except ValueError as exc:          # nothing could be scanned: plain words from the controller
-            self._failed("Beam check not done", str(exc), kind="warning")
+            self._failed(N_("Beam check not done"), str(exc), kind="warning")
             return
         except Exception as exc:           # a browser's click must never kill the server
             log.exception("beam check failed")
-            self._failed("Beam check failed", f"{type(exc).__name__}: {exc}", kind="error")
+            self._failed(N_("Beam check failed"), f"{type(exc).__name__}: {exc}", kind="error")
             return
         with s.lock:
             self._checking = False
             if s.closed:
                 return
             self.last_check = check
-            self.result_md.content = beam_check_markdown(check)
+            self._say(lambda tr: beam_check_markdown(check, tr=tr))
             self._render_buttons()
             self.player.play(check.scan, owner=self, return_to=self._q_before)
             self.frame_scan(check.scan)
-        s.notify("Beam check done", f"{check.tool_name}: deviation {check.deviation_norm_mm:.3f} mm", kind="info")
+        s.notify(_("Beam check done"), _("{name}: deviation {deviation} mm").format(
+            name=check.tool_name, deviation=f"{check.deviation_norm_mm:.3f}"), kind="info")
 
     def frame_scan(self, scan: BeamScan | RecordedScan) -> None:
         """Turn the session's camera(s) to the beam sensor, the scan's events and the flange
@@ -178,39 +223,42 @@ class BeamCheckView:
         self.framing = frame_cameras(clients_of(self.session), centres, radii, direction=direction, margin=1.4)
 
     def _failed(self, title: str, body: str, *, kind: str) -> None:
+        """``title``: an English message (translated here); ``body``: already in its words."""
         s = self.session
         with s.lock:
             self._checking = False
             if s.closed:
                 return
-            self.result_md.content = f"⚠ {escape_markdown(body)}"
+            shown = f"⚠ {escape_markdown(body)}"
+            self._say(lambda _tr: shown)
             self._render_buttons()
-        s.notify(title, body, kind=kind)
+        s.notify(self.tr.gettext(title), body, kind=kind)
 
     # ------------------------------------------------------------ Update
     def _on_update(self, _event: ButtonEvent) -> None:
-        s = self.session
+        s, _ = self.session, self.tr.gettext
         check = self.last_check
         if check is None:
-            raise ValueError("Check with beam first: Update writes the TCP the check measured.")
+            raise ValueError(_("Check with beam first: Update writes the TCP the check measured."))
         if check.slot is None:
-            raise ValueError("The checked tool data is not in the library (typed in or an unsaved result): "
-                             "save it to a slot first, then check again.")
+            raise ValueError(_("The checked tool data is not in the library (typed in or an unsaved result): "
+                               "save it to a slot first, then check again."))
         if not self._still_checked():
-            raise ValueError("The active tool changed since the check; check the active tool again before "
-                             "Update.")
+            raise ValueError(_("The active tool changed since the check; check the active tool again before "
+                               "Update."))
         before = check.stored_tool
         tool = update_tool_from_beam(s.library, check.slot, check, s.tools.library_rights)
         self.last_check = None
         s.tools.apply_saved(check.slot, tool)                    # one signal: library re-read, active data
-        self.result_md.content = beam_check_markdown(check) + "\n\n" + update_markdown(check.slot, before, tool)
+        slot = check.slot
+        self._say(lambda tr: beam_check_markdown(check, tr=tr) + "\n\n" + update_markdown(slot, before, tool, tr=tr))
         self._render_buttons()
-        s.notify("TCP updated", f"Slot {check.slot}: {tool.name} now has the TCP the beam measured.",
-                 kind="success")
+        s.notify(_("TCP updated"), _("Slot {slot}: {name} now has the TCP the beam measured.").format(
+            slot=slot, name=tool.name), kind="success")
 
     def _on_replay(self, _event: ButtonEvent) -> None:
         check = self.last_check
         player = self.player
         if check is None:
-            raise ValueError("No beam check to replay: press Check with beam first.")
+            raise ValueError(self.tr.gettext("No beam check to replay: press Check with beam first."))
         player.play(check.scan, owner=self, return_to=self._q_before)

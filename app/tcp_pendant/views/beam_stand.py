@@ -23,8 +23,9 @@ import viser
 
 from tcp_pendant.controller.beam import BeamSensor
 from tcp_pendant.controller.rotations import quaternion_wxyz
+from tcp_pendant.translation import ENGLISH, N_, Translator
 
-__all__ = ["BEAM_RGB", "BROKEN_RGB", "FORK_DEPTH_M", "HALF_GAP_M", "BeamStandNodes", "StandBox", "StandGeometry",
+__all__ = ["BEAM_RGB", "BEAM_SENSOR_LABEL", "BROKEN_RGB", "FORK_DEPTH_M", "HALF_GAP_M", "BeamStandNodes", "StandBox", "StandGeometry",
            "sensor_key", "stand_frame", "stand_geometry"]
 
 HALF_GAP_M = 0.05
@@ -133,17 +134,22 @@ def sensor_key(sensor: BeamSensor | None) -> bytes | None:
     return np.concatenate(parts).tobytes()
 
 
+BEAM_SENSOR_LABEL = N_("beam sensor")
+"""The stand's 3D label (shown in the session's language)."""
+
+
 class BeamStandNodes:
     """The stand and the beam(s) under ``/beam_sensor`` of one scene.
 
     Args:
         scene: viser's scene API of the session.
         sensor: the sensor to draw first (None: nothing drawn until :meth:`show`).
+        tr: the language of the label (:meth:`show` takes the current one).
     """
 
     ROOT = "/beam_sensor"
 
-    def __init__(self, scene: viser.SceneApi, sensor: BeamSensor | None) -> None:
+    def __init__(self, scene: viser.SceneApi, sensor: BeamSensor | None, *, tr: Translator = ENGLISH) -> None:
         self.scene = scene
         self._nodes: list[viser.SceneNodeHandle] = []
         self.shown_key: bytes | None = None
@@ -153,7 +159,8 @@ class BeamStandNodes:
         self.broken: int | None = None
         """The beam drawn red (broken; ``views.beam_replay``), or None."""
         self._shown_sensor: BeamSensor | None = None
-        self.show(sensor)
+        self._label_text = tr.gettext(BEAM_SENSOR_LABEL)
+        self.show(sensor, tr=tr)
 
     def _colors(self) -> np.ndarray:
         n = 0 if self.geometry is None else len(self.geometry.beams)
@@ -170,9 +177,19 @@ class BeamStandNodes:
         if self.beam_handle is not None:
             self.beam_handle.colors = self._colors()
 
-    def show(self, sensor: BeamSensor | None) -> bool:
-        """Draw ``sensor`` if it differs from what is drawn (returns whether it redrew). Called on
-        every change signal (each jog step): the same sensor object returns at once."""
+    def _relabel(self, tr: Translator) -> None:
+        """The label in ``tr``'s language (sent only when its words change)."""
+        text = tr.gettext(BEAM_SENSOR_LABEL)
+        if text != self._label_text:
+            self._label_text = text
+            if self.label is not None:
+                self.label.text = text
+
+    def show(self, sensor: BeamSensor | None, *, tr: Translator = ENGLISH) -> bool:
+        """Draw ``sensor`` if it differs from what is drawn (returns whether it redrew), its label
+        in ``tr``'s language. Called on every change signal (each jog step): the same sensor
+        object returns at once."""
+        self._relabel(tr)
         if sensor is self._shown_sensor and sensor is not None:
             return False
         self._shown_sensor = sensor
@@ -202,6 +219,6 @@ class BeamStandNodes:
                                               receive_shadow=False))
         self.beam_handle = s.add_line_segments(f"{root}/beam", points=g.beams, colors=self._colors(),
                                                thickness=BEAM_PX, thickness_units="screen")
-        self.label = s.add_label(f"{root}/label", "beam sensor", position=g.label_position)
+        self.label = s.add_label(f"{root}/label", self._label_text, position=g.label_position)
         self._nodes.extend([self.beam_handle, self.label])
         return True

@@ -57,11 +57,13 @@ def refused_before_job(session: Session, *, running: bool, what: str, not_starte
     at once, before the loop takes the job, each refusal told in one notification: the session
     closed (nothing to tell), the view's own ``what`` still running, or the session may not start
     a job now (``Session.admit_job``: its job runs, or its share of the server's time is used up;
-    titled ``not_started``)."""
+    titled ``not_started``). ``what`` and ``not_started`` come in the session's language."""
     if session.closed:
         return True
     if running:
-        session.notify_refusal("Check running", f"A {what} is still running here; wait for its result.")
+        _ = session.translator.gettext
+        session.notify_refusal(_("Check running"), _("A {what} is still running here; wait for its result.").format(
+            what=what))
         return True
     try:
         session.loop.admit_job()

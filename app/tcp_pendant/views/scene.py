@@ -379,7 +379,7 @@ class SceneView:
         labels = session.views.labels                       # the wizards' scene moves them apart
         labels.flange, labels.tool, labels.tip = self._flange_label, self._active_label, self._tip_label
         labels.world = self._world_label                    # restyled with them (presenter mode)
-        self.beam_stand = BeamStandNodes(scene, c.beam_sensor)
+        self.beam_stand = BeamStandNodes(scene, c.beam_sensor, tr=session.translator)
 
         wxyz, xyz = wxyz_xyz(state.T_world_tcp)
         self.gizmo = scene.add_transform_controls("/tcp_gizmo", scale=0.14, line_width=2.0, wxyz=wxyz,
@@ -397,7 +397,7 @@ class SceneView:
         c = self.session.controller
         if c.reference_tip_world_m.tobytes() != self._shown_tip_bytes:
             self.update_reference_tip()                   # knocked (a scenario) or set anew
-        self.beam_stand.show(c.beam_sensor)               # redraws only a changed sensor
+        self.beam_stand.show(c.beam_sensor, tr=self.session.translator)   # redraws only a changed sensor
         film = self.player
         self._step_aside(film is not None and film.playing)
         if change.pose and change.state is not None:

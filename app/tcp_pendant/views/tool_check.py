@@ -19,7 +19,8 @@ from tcp_pendant.controller import RobotKinematics, T_flange_tool_m, VirtualCont
 from tcp_pendant.controller.jog import JogSettings
 from tcp_pendant.controller.spin import MAX_SPIN_ANGLE_DEG, SpinCheckResult, spin_check
 from tcp_pendant.text_escape import escape_markdown
-from tcp_pendant.wizards.check_reading import READING_NOTE, read_mm, reading_verdict
+from tcp_pendant.translation import ENGLISH, Translator
+from tcp_pendant.wizards.check_reading import read_mm, reading_note, reading_verdict
 from tcpcal.tool import Tool
 
 __all__ = ["CheckJob", "check_job", "check_markdown", "check_verdict"]
@@ -56,8 +57,10 @@ class CheckJob:
                           true_kinematics=self.true_kinematics, settings=self.settings)
 
 
-def check_job(controller: VirtualController, tool: Tool, title: str, angle_deg: float) -> CheckJob:
-    """A :class:`CheckJob` of ``tool`` from the controller's current state.
+def check_job(controller: VirtualController, tool: Tool, title: str, angle_deg: float, *,
+              tr: Translator = ENGLISH) -> CheckJob:
+    """A :class:`CheckJob` of ``tool`` from the controller's current state (a refusal in ``tr``'s
+    language).
 
     Raises:
         ValueError: an angle outside (0, 90] degrees (names the range).
@@ -65,10 +68,12 @@ def check_job(controller: VirtualController, tool: Tool, title: str, angle_deg: 
     try:
         angle = float(angle_deg)
     except (TypeError, ValueError):
-        raise ValueError(f"The check angle must be a number of degrees, got {angle_deg!r}.") from None
+        raise ValueError(tr.gettext("The check angle must be a number of degrees, got {value}.").format(
+            value=repr(angle_deg))) from None
     if not math.isfinite(angle) or not 0.0 < angle <= MAX_SPIN_ANGLE_DEG:
-        raise ValueError(f"The check angle must be above 0 and at most {MAX_SPIN_ANGLE_DEG:g} degrees "
-                         f"(technicians use 10-45), got {angle_deg!r}.")
+        raise ValueError(tr.gettext("The check angle must be above 0 and at most {max} degrees "
+                                    "(technicians use 10-45), got {value}.").format(
+            max=f"{MAX_SPIN_ANGLE_DEG:g}", value=repr(angle_deg)))
     c = controller
     nominal, physical = c.kinematics_for_worker()
     return CheckJob(title=title, tool=tool, mounted_label=c.mounted_tool.label, angle_deg=angle,
@@ -77,40 +82,47 @@ def check_job(controller: VirtualController, tool: Tool, title: str, angle_deg: 
                     settings=c.settings)
 
 
-def check_verdict(result: SpinCheckResult) -> str:
-    """One line: good / off by how much / undetermined (plain text)."""
+def check_verdict(result: SpinCheckResult, *, tr: Translator = ENGLISH) -> str:
+    """One line: good / off by how much / undetermined (plain text, ``tr``'s language)."""
+    _ = tr.gettext
     err = result.implied_tcp_error_mm
     if err is None:
-        return "Not determined: fewer than two of A, B, C were reached; move away from limits and check again."
+        return _("Not determined: fewer than two of A, B, C were reached; move away from limits and check again.")
     if err <= GOOD_CHECK_MM:
-        return f"TCP good: implied error {err:.3f} mm (at most {GOOD_CHECK_MM:g} mm)."
-    return f"TCP off by {err:.3f} mm: calibrate again (or the tool is bent)."
+        return _("TCP good: implied error {error} mm (at most {limit} mm).").format(
+            error=f"{err:.3f}", limit=f"{GOOD_CHECK_MM:g}")
+    return _("TCP off by {error} mm: calibrate again (or the tool is bent).").format(error=f"{err:.3f}")
 
 
-def check_markdown(job: CheckJob, result: SpinCheckResult, *, reading: bool = False) -> str:
+def check_markdown(job: CheckJob, result: SpinCheckResult, *, reading: bool = False,
+                   tr: Translator = ENGLISH) -> str:
     """The result as markdown: per rotation the tip's deviation (mm), then the implied TCP
     error and the correction (user text escaped). ``reading`` (an exercise): what a technician
     sees instead - per rotation how far the tip moved, read by eye (``wizards.check_reading``),
     and a verdict from those readings; no implied error vector, no correction."""
-    lines = [f"**TCP check of {escape_markdown(job.title)}** at ±{result.angle_deg:g}° "
-             f"(mounted: {escape_markdown(job.mounted_label)})", "",
-             f"| Rotation | Tip moved (mm{', by eye' if reading else ''}) | |", "|---|---:|---|"]
+    _ = tr.gettext
+    lines = [_("**TCP check of {title}** at ±{angle}° (mounted: {mounted})").format(
+                 title=escape_markdown(job.title), angle=f"{result.angle_deg:g}",
+                 mounted=escape_markdown(job.mounted_label)), "",
+             "| {rotation} | {moved} | |".format(rotation=_("Rotation"),
+                                                 moved=_("Tip moved (mm, by eye)") if reading else _("Tip moved (mm)")),
+             "|---|---:|---|"]
     readings = []
     for r in result.rotations:
-        status = "✔" if r.reached else f"stopped: {escape_markdown(r.message or str(r.stopped_by))}"
+        status = "✔" if r.reached else _("stopped: {why}").format(why=escape_markdown(r.message or str(r.stopped_by)))
         moved = f"{read_mm(r.deviation_mm):.1f}" if reading else f"{r.deviation_mm:.3f}"
         readings.append((r.reached, read_mm(r.deviation_mm)))
         lines.append(f"| {r.label} | {moved} | {status} |")
     lines.append("")
     if reading:
-        lines += [READING_NOTE, "", f"**{reading_verdict(readings, result.angle_deg)}**"]
+        lines += [reading_note(tr=tr), "", f"**{reading_verdict(readings, result.angle_deg, tr=tr)}**"]
         return "\n".join(lines)
     err = result.implied_tcp_error_mm
     if err is not None and result.implied_offset_flange_mm is not None:
         dx, dy, dz = (0.0 if abs(v) < 5e-4 else float(v) for v in result.implied_offset_flange_mm)  # no "-0.000"
-        lines.append(f"**Implied TCP error: {err:.3f} mm** (the true tip is at TCP + "
-                     f"({dx:+.3f}, {dy:+.3f}, {dz:+.3f}) mm in FLANGE axes); "
-                     f"what no TCP explains: {result.fit_rms_mm:.3f} mm RMS.")
+        lines.append(_("**Implied TCP error: {error} mm** (the true tip is at TCP + "
+                       "({dx}, {dy}, {dz}) mm in FLANGE axes); what no TCP explains: {rms} mm RMS.").format(
+            error=f"{err:.3f}", dx=f"{dx:+.3f}", dy=f"{dy:+.3f}", dz=f"{dz:+.3f}", rms=f"{result.fit_rms_mm:.3f}"))
     lines.append("")
-    lines.append(f"**{check_verdict(result)}**")             # our own words, no user text
+    lines.append(f"**{check_verdict(result, tr=tr)}**")             # our own words, no user text
     return "\n".join(lines)
