@@ -10,19 +10,14 @@ composes itself (a count, a tool name) is not kept: the view's render sets it.
 
 from __future__ import annotations
 
-from typing import Protocol, TypeVar
+from typing import TypeVar
 
 from tcp_pendant.translation import Translator
 
 __all__ = ["GuiWords"]
 
-
-class _Labelled(Protocol):
-    label: str
-
-
-H = TypeVar("H", bound=_Labelled)
-"""A viser GUI handle with a label (and maybe a hint)."""
+H = TypeVar("H")
+"""A viser GUI handle with a label (and maybe a hint: viser's handles share no type for them)."""
 
 
 class GuiWords:
@@ -30,14 +25,17 @@ class GuiWords:
 
     def __init__(self, tr: Translator) -> None:
         self._tr = tr
-        self._kept: list[tuple[_Labelled, str, str | None]] = []
+        self._kept: list[tuple[object, str, str | None]] = []
 
     def keep(self, handle: H) -> H:
         """Remember ``handle``'s label and hint (English msgids) and show them in the current
         language; returns ``handle``."""
-        hint = getattr(handle, "hint", None)
-        self._kept.append((handle, handle.label, hint if isinstance(hint, str) and hint else None))
-        self._show(handle, handle.label, hint if isinstance(hint, str) and hint else None)
+        label, hint = getattr(handle, "label", None), getattr(handle, "hint", None)
+        if not isinstance(label, str):
+            raise TypeError(f"{type(handle).__name__} has no label to translate")
+        kept = (handle, label, hint if isinstance(hint, str) and hint else None)
+        self._kept.append(kept)
+        self._show(*kept)
         return handle
 
     def relabel(self, tr: Translator) -> None:
@@ -46,10 +44,10 @@ class GuiWords:
         for handle, label, hint in self._kept:
             self._show(handle, label, hint)
 
-    def _show(self, handle: _Labelled, label: str, hint: str | None) -> None:
+    def _show(self, handle: object, label: str, hint: str | None) -> None:
         text = self._tr.gettext(label)
-        if handle.label != text:                 # an unchanged text sends nothing
-            handle.label = text
+        if getattr(handle, "label", None) != text:      # an unchanged text sends nothing
+            setattr(handle, "label", text)
         if hint is not None:
             words = self._tr.gettext(hint)
             if getattr(handle, "hint", None) != words:

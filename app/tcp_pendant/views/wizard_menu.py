@@ -284,15 +284,13 @@ class CalibrateView:
         told which tool is mounted first); every text after a ``language`` change."""
         if change.language:
             self.relabel()
-            self.render()
-            return
         if change.library:
             self.refresh_library(render=False)
         if change.pose:
             self.on_motion()
         if change.touches and not (change.wizard or change.tool or change.library):
             self._render_menu()                # "Start from the N recorded points"
-        if change.wizard or change.tool or change.library:
+        if change.wizard or change.tool or change.library or change.language:
             self.render()
 
     # ------------------------------------------------------------ plumbing
