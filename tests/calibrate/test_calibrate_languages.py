@@ -39,7 +39,10 @@ from tcp_pendant.translation import ENGLISH, PSEUDO_LANGUAGE, translator
 from tcp_pendant.views.wizard_dock import WizardDock
 from tcp_pendant.views.wizard_menu import CalibrateView
 from tcp_pendant.wizards import ESTIMATOR_LABELS, Wizard, wizard_classes
+from tcp_pendant.wizards.tcp_check import tcp_check_markdown
 from tcpcal.pose_quality import CandidateGain
+
+from support.wsclient import wait_until
 
 pytestmark = pytest.mark.app_page(cls=Page, seed=5)
 
@@ -76,11 +79,14 @@ def _foreign(session: object, wiz: Wizard | None) -> set[str]:
         res = wiz.finished_result
         if res is not None:
             pieces |= set(res.warnings) | set(res.notes)
+            pieces.add(f" {escape_markdown(res.method)} |")      # the method's key in the figures table
+            if type(wiz).result_view == "spin_check":          # the TCP check's own words (its module's)
+                pieces.add(tcp_check_markdown(res))  # type: ignore[arg-type]
     wf = session.workflow                                    # type: ignore[attr-defined]
     truth = wf.truth() if wf.result is not None else None
     if truth is not None:
         pieces.add(truth.verdict)
-    pieces |= {label for _i, label in wf.resumable()}
+    pieces |= {part for _i, label in wf.resumable() for part in (label, label.rsplit(", ", 1)[0])}
     pieces |= {session.controller.mounted_tool.label, session.controller.mounted_tool.label.lower()}  # type: ignore[attr-defined]
     return {p for p in pieces if p} | {escape_markdown(p) for p in pieces if p}
 
@@ -114,7 +120,8 @@ def _untranslated(session: object, view: CalibrateView, dock: WizardDock) -> lis
     names = NAMES | {w for t in view._physical for w in WORD.findall(t)}
     names |= {w for t in view._library.values() for w in WORD.findall(str(t.name))}
     bad = []
-    for name, handle in _handles(view, view.steps, view.result, dock):
+    shown = [o for o in (view.steps, view.result, dock) if o.folder.visible]   # a hidden panel: not on screen
+    for name, handle in _handles(view, *shown):
         if name in _OTHERS or not getattr(handle, "visible", True):
             continue
         for text in gui_texts(handle):
@@ -162,6 +169,55 @@ def test_with_the_pseudo_locale_a_4point_its_steps_dock_and_result_are_from_the_
     assert v.workflow.last_save is not None
     assert v.result.save_md.content.startswith("⟦✔")
     assert _untranslated(s, v, dock) == []
+
+
+def _walk(p: Page, dock: WizardDock) -> list[str]:
+    """The open wizard through its steps to its result (Auto-touch, Mount, Next / Finish),
+    checking every text at each step and on the result; returns what was checked."""
+    v, s = p.view, p.session
+    seen = []
+    for _i in range(40):
+        wiz = v.workflow.wizard
+        assert wiz is not None
+        where = "result" if wiz.is_complete else f"step {wiz.step_index + 1}"
+        assert _untranslated(s, v, dock) == [], f"{wiz.kind} {where}"
+        seen.append(where)
+        if wiz.is_complete:
+            return seen
+        if v.steps.mount.visible:
+            p.click(v.steps.mount)
+        elif v.steps.record.visible and not wiz.step.recorded and v.steps.auto_folder.visible:
+            p.click(v.steps.auto_touch)
+            wait_until(lambda: not v.steps._auto_touching, what="Auto-touch")
+        elif not v.steps.next.disabled:
+            p.click(v.steps.next)
+            wait_until(lambda: not v.steps._checking, what="the controller job")
+        else:
+            raise AssertionError(f"{wiz.kind} {where}: nothing to click")
+    raise AssertionError("no result after 40 clicks")
+
+
+def test_with_the_pseudo_locale_every_wizard_walks_to_its_result_in_the_catalogs_words(page) -> None:
+    """Each method of the menu, started with its defaults (the tool library holds the 4-point
+    just saved), through its steps to its result; then Close brings the menu back."""
+    p = page(language=PSEUDO_LANGUAGE)
+    v, s = p.view, p.session
+    dock: WizardDock = s.views["dock"]
+    walked = {}
+    for cls in [c for c in v._classes.values() if c.kind == "xyz4"] + [c for c in v._classes.values()
+                                                                          if c.kind != "xyz4"]:
+        p.choose(v.method, QPS.gettext(cls.title))
+        assert _untranslated(s, v, dock) == [], f"menu of {cls.kind}"
+        p.click(v.start)
+        assert v.workflow.wizard is not None and v.workflow.wizard.kind == cls.kind, cls.kind
+        walked[cls.kind] = _walk(p, dock)
+        if cls.kind == "xyz4":
+            p.click(v.result.save)
+            assert v.workflow.last_save is not None
+        p.click(v.steps.cancel)                       # Close
+        assert v.menu_folder.visible and _untranslated(s, v, dock) == []
+    assert set(walked) == {c.kind for c in wizard_classes()}
+    assert all(w[-1] == "result" and len(w) >= 2 for w in walked.values()), walked
 
 
 def test_the_language_switched_mid_wizard_re_renders_dock_steps_and_result(page) -> None:

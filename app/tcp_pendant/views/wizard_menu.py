@@ -194,10 +194,10 @@ class CalibrateView:
                                    initial_value=int(opt.default if opt.default is not None else lo), hint=hint))
         if opt.kind == "choice":
             labels = self._choice_labels(opt)
-            initial = next((self.tr(label) for v, label in opt.choices if v == opt.default), labels[0])
+            initial = next((self.gettext(label) for v, label in opt.choices if v == opt.default), labels[0])
             return self.words.keep(gui.add_dropdown(opt.label, labels, initial_value=initial, hint=hint))
         if opt.kind == "library_slot":
-            empty = self.tr(NO_LIBRARY_TOOL)
+            empty = self.gettext(NO_LIBRARY_TOOL)
             return self.words.keep(gui.add_dropdown(opt.label, (empty,), initial_value=empty, hint=hint))
         physical = tuple(self._physical)
         mounted = self.session.controller.mounted_tool.label
@@ -206,22 +206,22 @@ class CalibrateView:
             initial = next((p for p in physical if p != initial), physical[0])
         return self.words.keep(gui.add_dropdown(opt.label, physical, initial_value=initial, hint=hint))
 
-    def tr(self, message: str) -> str:
+    def gettext(self, message: str) -> str:
         """``message`` (an English msgid) in the session's language."""
         return self.session.translator.gettext(message)
 
     def _method_labels(self, titles: tuple[str, ...]) -> tuple[str, ...]:
         """The Method dropdown's options: the wizard classes' titles in the session's language."""
-        return tuple(self.tr(t) for t in titles)
+        return tuple(self.gettext(t) for t in titles)
 
     def _choice_labels(self, opt: WizardOption) -> tuple[str, ...]:
-        return tuple(self.tr(label) for _, label in opt.choices)
+        return tuple(self.gettext(label) for _, label in opt.choices)
 
     def said_as(self, message: str) -> set[str]:
         """The ways an option ``message`` may come back from the browser: in the session's
         language, in the language the options were shown in (a click that crossed a switch) or
         in English."""
-        return {message, self.tr(message), self._shown_in.gettext(message)}
+        return {message, self.gettext(message), self._shown_in.gettext(message)}
 
     def _option_value(self, opt: WizardOption) -> object:
         """The value of ``opt`` as chosen in its widget (checked by the wizard class at Start);
@@ -233,14 +233,14 @@ class CalibrateView:
             choices = self._option_specs[opt.name].choices
             values = {said: v for v, label in choices for said in self.said_as(label)}
             if widget.value not in values:
-                raise ValueError(self.tr("{option}: unknown choice {value!r}.").format(
-                    option=self.tr(opt.label), value=widget.value))
+                raise ValueError(self.gettext("{option}: unknown choice {value!r}.").format(
+                    option=self.gettext(opt.label), value=widget.value))
             return values[widget.value]
         if opt.kind == "library_slot":
             return self._selected_slot(widget)
         if widget.value not in self._physical:
-            raise ValueError(self.tr("{option}: unknown physical tool {value!r}.").format(
-                option=self.tr(opt.label), value=widget.value))
+            raise ValueError(self.gettext("{option}: unknown physical tool {value!r}.").format(
+                option=self.gettext(opt.label), value=widget.value))
         return self._physical[widget.value]
 
     def _class_of(self, label: str) -> type[Wizard] | None:
@@ -260,18 +260,18 @@ class CalibrateView:
         self.words.relabel(self.session.translator)
         chosen = self._chosen_class()
         self.method.options = self._method_labels(tuple(self._classes))     # _render_menu narrows them
-        set_value(self.method, self.tr(chosen.title))
+        set_value(self.method, self.gettext(chosen.title))
         for name, opt in self._option_specs.items():
             widget = self.option_widgets[name]
             if opt.kind == "choice":
                 value = self._option_value(opt)
                 labels = self._choice_labels(opt)
                 set_options(cast("viser.GuiDropdownHandle[str]", widget), labels,
-                            keep=next(self.tr(lab) for v, lab in opt.choices if v == value))
+                            keep=next(self.gettext(lab) for v, lab in opt.choices if v == value))
         if not self._library:
             for widget in self._slot_widgets:
-                set_options(widget, (self.tr(NO_LIBRARY_TOOL),))
-        hint = self.tr("XYZ 4-point from the touches of the Jog tab's Record point: they become its first steps.")
+                set_options(widget, (self.gettext(NO_LIBRARY_TOOL),))
+        hint = self.gettext("XYZ 4-point from the touches of the Jog tab's Record point: they become its first steps.")
         if self.start_from_points.hint != hint:
             self.start_from_points.hint = hint
         self._shown_in = self.session.translator
@@ -325,7 +325,7 @@ class CalibrateView:
 
     def saved(self, slot: int, tool: Tool) -> None:
         """After "Save to tool library" (the session made it the active tool)."""
-        self.session.notify(self.tr("Tool saved"), self.tr("Slot {slot}: {name} is now the active tool.").format(
+        self.session.notify(self.gettext("Tool saved"), self.gettext("Slot {slot}: {name} is now the active tool.").format(
             slot=slot, name=tool.name), kind="success")
 
     # ------------------------------------------------------------ callbacks
@@ -351,12 +351,12 @@ class CalibrateView:
         picked = widget or self.library_tool                     # None: the library is empty
         slot = None if picked is None else number_of_option(str(picked.value))
         if slot is None:
-            raise ValueError(self.tr("The tool library is empty: calibrate the TCP first (XYZ 4-point) and save it."))
+            raise ValueError(self.gettext("The tool library is empty: calibrate the TCP first (XYZ 4-point) and save it."))
         return slot
 
     def _on_start(self, _event: ButtonEvent) -> None:
         if self._class_of(str(self.method.value)) is None:
-            raise ValueError(self.tr("Unknown calibration method {value!r}.").format(value=self.method.value))
+            raise ValueError(self.gettext("Unknown calibration method {value!r}.").format(value=self.method.value))
         cls = self._chosen_class()
         self.session.wizard_commands.start(cls.kind, **{opt.name: self._option_value(opt) for opt in cls.options})
 
@@ -364,7 +364,7 @@ class CalibrateView:
         """XYZ 4-point from the free touches (``CalibrationWorkflow.start_from_touches``)."""
         cls = self._chosen_class()
         if cls.kind != "xyz4":
-            raise ValueError(self.tr("Only the XYZ 4-point method starts from the recorded points; choose it first."))
+            raise ValueError(self.gettext("Only the XYZ 4-point method starts from the recorded points; choose it first."))
         spec = self._option_specs.get("estimator")
         estimator = "lstsq" if spec is None else str(self._option_value(spec))
         self.session.wizard_commands.start_from_touches(estimator=estimator)
@@ -372,9 +372,9 @@ class CalibrateView:
     def _on_resume(self, _event: ButtonEvent) -> None:
         number = number_of_option(self.resume_list.value)
         if number is None:
-            raise ValueError(self.tr("There is no calibration to resume."))
+            raise ValueError(self.gettext("There is no calibration to resume."))
         if number - 1 not in {i for i, _ in self.workflow.resumable()}:
-            raise ValueError(self.tr("Calibration {number} is not waiting to be resumed any more; choose one in "
+            raise ValueError(self.gettext("Calibration {number} is not waiting to be resumed any more; choose one in "
                                      "'To resume'.").format(number=number))
         self.session.wizard_commands.resume(number - 1)
 
@@ -401,7 +401,7 @@ class CalibrateView:
         name = str(upload.name or "The file")
         content = upload.content
         if self._loading_record:
-            session.notify(self.tr(RECORD_REFUSED), self.tr(
+            session.notify(self.gettext(RECORD_REFUSED), self.gettext(
                 "{file}: another session record is still being loaded here; wait until it is shown, then "
                 "load this one.").format(file=name), kind="warning")
             return
@@ -413,7 +413,7 @@ class CalibrateView:
         self._loading_record = True
         try:
             with session.lock:
-                set_content(self.record_md, self.tr("Loading {file} ...").format(file=escape_markdown(name)))
+                set_content(self.record_md, self.gettext("Loading {file} ...").format(file=escape_markdown(name)))
             data = bytes(content)
             loaded = await session.loop.run_job(lambda: load_and_replay(data), what="a session record's load")
         except (SessionRecordError, JobRefused) as exc:
@@ -421,7 +421,7 @@ class CalibrateView:
             return
         except Exception as exc:  # never let an upload kill the server
             log.exception("loading the session record %r failed", name)
-            session.notify(self.tr("Internal error"), f"{type(exc).__name__}: {exc}", kind="error")
+            session.notify(self.gettext("Internal error"), f"{type(exc).__name__}: {exc}", kind="error")
             return
         finally:
             self._loading_record = False
@@ -429,14 +429,14 @@ class CalibrateView:
 
     def _show_loaded(self, name: str, loaded: LoadedRecord) -> None:
         checks = self.session.wizard_commands.load_record(loaded)
-        set_content(self.record_md, self.tr("**Loaded {file}**").format(file=escape_markdown(name)) + "\n\n"
+        set_content(self.record_md, self.gettext("**Loaded {file}**").format(file=escape_markdown(name)) + "\n\n"
                     + replay_markdown(checks, tr=self.session.translator))
 
     def _refuse_record(self, name: str, exc: Exception) -> None:
         if not self.session.closed:
             with self.session.lock:
                 set_content(self.record_md, "")
-            self.session.notify(self.tr(RECORD_REFUSED), f"{name}: {exc}", kind="warning")
+            self.session.notify(self.gettext(RECORD_REFUSED), f"{name}: {exc}", kind="warning")
 
     def _upload_refused(self, filename: str, size_bytes: int) -> None:
         """``upload_guard``: a transfer above the size limit was dropped as it started."""
@@ -451,7 +451,7 @@ class CalibrateView:
         the file is not read here). Called on the session's ``library`` change."""
         tools = self.session.tools.library_tools
         self._library = dict(tools)
-        options = tuple(slot_option(s, t.name) for s, t in sorted(tools.items())) or (self.tr(NO_LIBRARY_TOOL),)
+        options = tuple(slot_option(s, t.name) for s, t in sorted(tools.items())) or (self.gettext(NO_LIBRARY_TOOL),)
         for widget in self._slot_widgets:
             set_options(widget, options, keep=self._library_option(options))
         self.result.refresh_slots(tools)
@@ -487,7 +487,7 @@ class CalibrateView:
         offered = tuple(t for t, c in self._classes.items() if rules.allows_method(c.kind)) or tuple(self._classes)
         set_options(self.method, self._method_labels(offered))
         cls = self._chosen_class()
-        set_content(self.method_md, self.tr(cls.blurb))
+        set_content(self.method_md, self.gettext(cls.blurb))
         taken = {o.name for o in cls.options}
         for name, widget in self.option_widgets.items():
             widget.visible = name in taken
@@ -526,6 +526,6 @@ class CalibrateView:
             number = number_of_option(self.resume_list.value)
             chosen = next((label for i, label in waiting if number == i + 1), waiting[0][1])
             # names what the click brings back (the list's label without its last part, the start time)
-            label = self.tr("Resume {calibration}").format(calibration=chosen.rsplit(", ", 1)[0])
+            label = self.gettext("Resume {calibration}").format(calibration=chosen.rsplit(", ", 1)[0])
             if self.resume.label != label:
                 self.resume.label = label

@@ -197,7 +197,7 @@ class WizardResultView:
     def _on_check_tcp(self, _event: ButtonEvent) -> None:
         wf = self.parent.workflow
         if wf.last_save is None:
-            raise WizardStateError(self.parent.tr("Save the tool first: the TCP check works on a tool of the library."))
+            raise WizardStateError(self.parent.gettext("Save the tool first: the TCP check works on a tool of the library."))
         self.parent.session.wizard_commands.start("tcp-check", slot=wf.last_save[0])
 
     # ------------------------------------------------------------ render

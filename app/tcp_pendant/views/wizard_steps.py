@@ -62,7 +62,7 @@ class WizardStepsView:
         self.parent = parent
         gui = target_of(parent.session).gui
         keep = parent.words.keep                  # the tab's fixed words, relabelled per language
-        _ = parent.tr
+        _ = parent.gettext
         self.folder = keep(gui.add_folder(N_("Wizard"), visible=False))
         with self.folder:
             self.head_md = gui.add_markdown("")
@@ -122,7 +122,7 @@ class WizardStepsView:
         in the new language, the chosen one kept; the lines of the last clicks are dropped (they
         were said in the old language); ``render`` shows the rest."""
         chosen = self._direction()
-        _ = self.parent.tr
+        _ = self.parent.gettext
         options = (_(RANDOM), _(CHOSEN))
         if tuple(self.auto_direction.options) != options:
             self.auto_direction.options = options
@@ -148,13 +148,13 @@ class WizardStepsView:
         if s.hide_distance and not s.rules.in_exercise:
             wiz = self.parent.workflow.wizard
             self._record_line = (self._auto_where(),
-                                 self.parent.tr("✔ Step {n} recorded: {feedback}.").format(
+                                 self.parent.gettext("✔ Step {n} recorded: {feedback}.").format(
                                      n=index + 1 if index is not None else "?", feedback=touch_feedback(delta, frame)),
                                  None if wiz is None else wiz.recorded_poses)
 
     def _on_cancel(self, _event: ButtonEvent) -> None:
         if self.parent.session.wizard_commands.cancel():
-            _ = self.parent.tr
+            _ = self.parent.gettext
             self.parent.session.notify(_("Calibration cancelled"),
                                        _("Nothing recorded is lost: Resume it from the Calibrate menu."))
 
@@ -165,7 +165,7 @@ class WizardStepsView:
         beam scan of 3 to 5 orientations well under a second), its outcome handed to the wizard
         on the loop; one job at a time."""
         session, act = self.parent.session, self.parent.action
-        _ = self.parent.tr
+        _ = self.parent.gettext
         jobs: list[ControllerJob] = []
 
         def take(_e: ButtonEvent) -> None:
@@ -210,7 +210,7 @@ class WizardStepsView:
         label = str(event.target.value)
         values = {} if wiz is None else {said: v for v, lab in type(wiz).variants for said in self.parent.said_as(lab)}
         if wiz is None or label not in values:
-            raise ValueError(self.parent.tr("Unknown variant {label!r}.").format(label=label))
+            raise ValueError(self.parent.gettext("Unknown variant {label!r}.").format(label=label))
         self.parent.session.wizard_commands.set_variant(values[label])
 
     def auto_request(self) -> AutoTouchRequest:
@@ -228,7 +228,7 @@ class WizardStepsView:
         session = self.parent.session
         if session.closed:
             return
-        _ = self.parent.tr
+        _ = self.parent.gettext
         not_started = _("Auto-touch not started")
         wiz = self.parent.workflow.wizard
         probes = wiz is not None and type(wiz).controller_job in POSE_CHECKS    # its poses are probed in the pool
@@ -269,7 +269,7 @@ class WizardStepsView:
             raise ValueError(out.message)
         wiz = self.parent.workflow.wizard
         self._auto_line = (self._auto_where(),       # the poses are kept alive: their ids stay unique
-                           escape_markdown(out.message) + " " + self.parent.tr("Operator error σ {sigma} mm.").format(
+                           escape_markdown(out.message) + " " + self.parent.gettext("Operator error σ {sigma} mm.").format(
                                sigma=f"{request.sigma_mm:.2f}"),
                            None if wiz is None else wiz.recorded_poses)
 
@@ -352,7 +352,7 @@ class WizardStepsView:
         if not variants:
             self.variant.visible = False
             return
-        tr = self.parent.tr
+        tr = self.parent.gettext
         labels = tuple(tr(label) for _v, label in variants)
         label = next(tr(lab) for v, lab in variants if v == wiz.variant)
         if tuple(self.variant.options) != labels:    # our own assignments: the on_update
