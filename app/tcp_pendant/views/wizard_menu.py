@@ -398,7 +398,7 @@ class CalibrateView:
         if session.closed or getattr(event, "client", None) is None:
             return
         upload = event.target.value
-        name = str(upload.name or "The file")
+        name = str(upload.name or self.gettext("The file"))
         content = upload.content
         if self._loading_record:
             session.notify(self.gettext(RECORD_REFUSED), self.gettext(
@@ -443,7 +443,7 @@ class CalibrateView:
         try:
             check_record_size(size_bytes)
         except SessionRecordError as exc:
-            self._refuse_record(filename or "The file", exc)
+            self._refuse_record(filename or self.gettext("The file"), exc)
 
     # ------------------------------------------------------------ library and motion
     def refresh_library(self, *, render: bool = True) -> None:

@@ -164,7 +164,8 @@ class WizardResultView:
         estimators (``Wizard.result_extras``), as one command of the session."""
         def edit(wiz: Wizard) -> object:
             if "estimators" not in type(wiz).result_extras:
-                raise WizardStateError(f"The {wiz.title} result has no estimators to choose.")
+                raise WizardStateError(self.parent.gettext("The {title} result has no estimators to choose.").format(
+                    title=self.parent.gettext(wiz.title)))
             return fn(cast("Xyz4Wizard", wiz))       # the 4-point's, the one that offers them
         self.parent.session.wizard_commands.edit_result(edit)
 
