@@ -293,3 +293,23 @@ def test_the_meter_speaks_the_translator_it_is_given(gain: CandidateGain) -> Non
     assert meter_markdown(CandidateGain(0.8, 0.5, 0.375, 50.0, False, ""), None, 0.5) == (
         "**Pose diversity** (if you recorded here, operator error 0.5 mm):\n\n✔ Good pose: predicted TCP RMS "
         "error 0.80 mm → **0.50 mm** (-38 %).\n\nNearest recorded orientation: 50° away.")
+
+
+def test_the_menu_keeps_its_choice_across_a_switch_and_reads_a_click_in_the_old_language(page) -> None:
+    p = page()
+    v, s = p.view, p.session
+    titles = {c.kind: c.title for c in wizard_classes()}
+    p.choose(v.method, titles["tcp-zx"])
+    assert v.method.label == "Method"
+    with s.lock:
+        s.set_language(PSEUDO_LANGUAGE)
+    assert v.method.label == QPS.gettext("Method") != "Method"
+    assert v.method.value == QPS.gettext(titles["tcp-zx"])            # the choice kept, in the new words
+    assert tuple(v.method.options) == tuple(QPS.gettext(c.title) for c in wizard_classes())
+    assert v.start.label == QPS.gettext("Start") and v.record_folder.label == QPS.gettext("Session record")
+    assert v.library_tool is not None and v.library_tool.value == QPS.gettext("(library empty)")
+    # a click sent before the browser saw the switch names the method in English: still read
+    p.choose(v.method, titles["xyz4"])
+    p.click(v.start)
+    assert v.workflow.wizard is not None and v.workflow.wizard.kind == "xyz4"
+    assert _untranslated(s, v, s.views["dock"]) == []
