@@ -18,6 +18,10 @@ changes it only through the session's commands (``session.wizard_commands``: ``r
 change signal with ``wizard`` (as the Calibrate tab's clicks), so the Calibrate tab, the scene
 and the classroom recorder see it too. Every text from a wizard goes through the escaping
 ``calibrate.text`` helpers.
+
+Language: the dock's words are the session's (``session.translator``); a ``language`` change
+relabels its handles (``views.gui_words``) and re-renders the step; a Step click is read in the
+language it was shown in or in English (a click that crossed a switch).
 """
 
 from __future__ import annotations

@@ -29,6 +29,13 @@ the only way a click changes it; every click goes through :meth:`CalibrateView.a
 (``SessionLoop.on_loop``: the event loop, the session's lock and error notifications) inside
 ``Session.batch``, so a click ends in one change signal; the tab re-renders from the workflow's
 state on that signal (:meth:`CalibrateView.on_change`), as the scene and the Tool tab do.
+
+Language: every word of the tab is the session's (``session.translator``): the fixed labels and
+hints through ``views.gui_words``, the wizard classes' titles, blurbs, options and variants (``N_``
+msgids of ``tcp_pendant.wizards``) translated where shown, the composed texts by
+``calibrate.text`` with ``tr``. A ``language`` change relabels everything and re-renders the
+tab (:meth:`CalibrateView.relabel`), the chosen method and options kept; a dropdown's value is
+read in the session's language, in the one it was shown in, or in English.
 """
 
 from __future__ import annotations
