@@ -22,7 +22,7 @@ ACCENTED = str.maketrans(
     "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ",
     "åƀçðéƒĝĥîĵķļɱñöþǫŕšţûṽŵẋýžÅƁÇÐÉƑĜĤÎĴĶĻṀÑÖÞǪŔŠŢÛṼŴẊÝŽ")
 """Each ASCII letter to an accented look-alike (still readable, never ASCII)."""
-KEEP = re.compile(r"\{[^{}]*\}|%(?:\([^)]*\))?[-+ #0]*\d*(?:\.\d+)?[sdifgeEr%]|`[^`]*`|<[^<>]*>|&\w+;")
+KEEP = re.compile(r"\{[^{}]*\}|%(?:\([^)]*\))?[-+ #0]*\d*(?:\.\d+)?[sdifgeEcr%]|`[^`]*`|<[^<>]*>|&\w+;")
 """What stays as it is: format placeholders, code spans, HTML tags and entities."""
 OPEN, CLOSE = "⟦", "⟧"
 

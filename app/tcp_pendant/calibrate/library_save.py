@@ -9,6 +9,7 @@ It never sets the library's active slot: which tool is active is the session's (
 from __future__ import annotations
 
 from tcp_pendant.calibrate.pendant_rules import UNRESTRICTED, LibraryRights
+from tcp_pendant.translation import ENGLISH, Translator
 from tcp_pendant.wizards import Wizard, WizardStateError
 from tcpcal.library import ToolLibrary
 from tcpcal.tool import Tool
@@ -17,7 +18,7 @@ __all__ = ["save_result"]
 
 
 def save_result(wizard: Wizard, library: ToolLibrary, name: str, slot: int | None = None,
-                rights: LibraryRights = UNRESTRICTED) -> tuple[int, Tool]:
+                rights: LibraryRights = UNRESTRICTED, *, tr: Translator = ENGLISH) -> tuple[int, Tool]:
     """Store ``wizard.to_tool(name)`` in ``slot`` of ``library``.
 
     Args:
@@ -28,6 +29,7 @@ def save_result(wizard: Wizard, library: ToolLibrary, name: str, slot: int | Non
             free one.
         rights: whose save it is (a class's trainee: their own or a free slot, within their
             quota, checked by the library under its lock; ``calibrate.pendant_rules``).
+        tr: the language of the refusals (they reach the trainee's notification).
 
     Returns:
         (slot, tool) as saved.
@@ -42,11 +44,11 @@ def save_result(wizard: Wizard, library: ToolLibrary, name: str, slot: int | Non
     if slot is None:
         found = library.find(name)
         if found is not None and not rights.mine(library.owners(), found[0]):
-            raise WizardStateError(f"The name {name!r} is taken by slot {found[0]}, a tool that is not yours: "
-                                   "choose another name.")
+            raise WizardStateError(tr.gettext("The name {name!r} is taken by slot {slot}, a tool that is not yours: "
+                                              "choose another name.").format(name=name, slot=found[0]))
         slot = found[0] if found is not None else library.first_free_slot()
         if slot is None:
-            raise WizardStateError("The tool library is full: pick a slot to overwrite.")
+            raise WizardStateError(tr.gettext("The tool library is full: pick a slot to overwrite."))
     with rights.in_words():
         library.save(slot, tool, activate=False, **kwargs)
     return slot, tool

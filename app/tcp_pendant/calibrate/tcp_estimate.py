@@ -28,6 +28,7 @@ from typing import Any
 
 import numpy as np
 
+from tcp_pendant.translation import ENGLISH, Translator
 from tcpcal.tool import Tool
 
 __all__ = ["ESTIMATE_NAME", "MIN_TOUCHES", "TcpEstimate", "tcp_estimate"]
@@ -35,7 +36,8 @@ __all__ = ["ESTIMATE_NAME", "MIN_TOUCHES", "TcpEstimate", "tcp_estimate"]
 MIN_TOUCHES = 2
 """Touches (in different orientations) an estimate needs."""
 ESTIMATE_NAME = "Estimate, {n} touches"
-"""The tool data's name: the readout says whose numbers are active."""
+"""The tool data's name in English (:meth:`TcpEstimate.tool` names it in the session's
+language): the readout says whose numbers are active."""
 _MIN_TURN = 1e-3
 """Touches whose flange orientations differ by less than this (``|R_i - R_1|``, ~0.06°) say
 nothing about ``t``."""
@@ -53,9 +55,11 @@ class TcpEstimate:
     tcp_mm: tuple[float, float, float]
     touches: int
 
-    def tool(self) -> Tool:
-        """As tool data to activate (orientation A = B = C = 0: the flange's)."""
-        return Tool(name=ESTIMATE_NAME.format(n=self.touches), tcp_mm=self.tcp_mm)
+    def tool(self, *, tr: Translator = ENGLISH) -> Tool:
+        """As tool data to activate (orientation A = B = C = 0: the flange's), named in ``tr``'s
+        language (:data:`ESTIMATE_NAME` in English)."""
+        name = tr.ngettext("Estimate, {n} touch", "Estimate, {n} touches", self.touches).format(n=self.touches)
+        return Tool(name=name, tcp_mm=self.tcp_mm)
 
 
 def tcp_estimate(wizard: Any) -> TcpEstimate | None:

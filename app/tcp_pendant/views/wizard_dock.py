@@ -18,6 +18,10 @@ changes it only through the session's commands (``session.wizard_commands``: ``r
 change signal with ``wizard`` (as the Calibrate tab's clicks), so the Calibrate tab, the scene
 and the classroom recorder see it too. Every text from a wizard goes through the escaping
 ``calibrate.text`` helpers.
+
+Language: the dock's words are the session's (``session.translator``); a ``language`` change
+relabels its handles (``views.gui_words``) and re-renders the step; a Step click is read in the
+language it was shown in or in English (a click that crossed a switch).
 """
 
 from __future__ import annotations
@@ -36,7 +40,9 @@ from tcp_pendant.pendant.record_check import RecordCheck
 from tcp_pendant.pendant.tilts import reachable_line
 from tcp_pendant.pendant.touch_feedback import touch_feedback
 from tcp_pendant.session import Session, SessionChange
+from tcp_pendant.translation import N_
 from tcp_pendant.views.gui_util import ButtonEvent, ButtonGroupEvent, set_content, set_value, target_of
+from tcp_pendant.views.gui_words import GuiWords
 
 if TYPE_CHECKING:
     from tcp_pendant.calibrate import CalibrationWorkflow
@@ -49,7 +55,9 @@ _E = TypeVar("_E")
 
 log = logging.getLogger(__name__)
 
-BACK, NEXT, FINISH, CANCEL, CLOSE = "◀ Back", "Next ▶", "Finish ▶", "Cancel", "Close"
+BACK, NEXT, FINISH, CANCEL, CLOSE = N_("◀ Back"), N_("Next ▶"), N_("Finish ▶"), N_("Cancel"), N_("Close")
+"""The Step row's buttons (msgids: shown in the session's language; a click is read in any
+language it may come in)."""
 
 
 TILT_LINE_STYLE = "min-height:4.2em;line-height:1.4em;white-space:normal;font-size:0.875em;padding:0 0.75em"
@@ -65,11 +73,11 @@ def tilt_line_html(hint: str | None, reachable: str = "") -> str:
     return f'<div style="{TILT_LINE_STYLE}">{"<br>".join(parts) or "&nbsp;"}</div>'
 
 
-PIVOT_LABEL = "Tilt about the wizard's estimate"
-PIVOT_HINT = ("Make the TCP your touches so far give (the wizard's estimate, never the truth) the active "
-              "tool data: the A, B, C keys then turn about it, so a tilt keeps the tip near the "
-              "reference tip. Offered from two touches in different orientations; press again after "
-              "a touch for a better estimate.")
+PIVOT_LABEL = N_("Tilt about the wizard's estimate")
+PIVOT_HINT = N_("Make the TCP your touches so far give (the wizard's estimate, never the truth) the active "
+                "tool data: the A, B, C keys then turn about it, so a tilt keeps the tip near the "
+                "reference tip. Offered from two touches in different orientations; press again after "
+                "a touch for a better estimate.")
 """The dock's button of ``WizardCommands.pivot_on_estimate``: shown through an XYZ 4-point's
 steps, enabled while it has an estimate to offer. It takes the row of the meter's bar (the
 meter's line says the same in words), so the jog keys stay above the fold at 1024x768 and do not
@@ -86,21 +94,24 @@ class WizardDock:
         self._note = ""                       # the last click's line, for this run and step only
         self._note_at: tuple[int, int, int] | None = None
         gui = target_of(session).gui
-        self.folder = gui.add_folder("Calibration step", visible=False)
+        self.words = GuiWords(session.translator)     # the fixed labels and hints, relabelled per language
+        self._shown_in = session.translator           # the language of the Step options on show
+        keep, _ = self.words.keep, session.translator.gettext
+        self.folder = keep(gui.add_folder(N_("Calibration step"), visible=False))
         with self.folder:
             self.step_md = gui.add_markdown("")
             self.note_md = gui.add_markdown("", visible=False)
-            self.mount = gui.add_button("Mount the tool", color="orange", visible=False,
-                                        hint="The tool change this step asks for (the app swaps the tool).")
-            self.record = gui.add_button("Record", color="green",
-                                         hint="Record this step at the current pose (a touch farther than "
-                                              "0.5 mm asks first, unless the distance is hidden); key R.")
-            self.nav = gui.add_button_group("Step", (BACK, NEXT, CANCEL),
-                                            hint="Keys: N Next (Finish on the last step), B Back.")
+            self.mount = keep(gui.add_button(N_("Mount the tool"), color="orange", visible=False,
+                                             hint=N_("The tool change this step asks for (the app swaps the tool).")))
+            self.record = keep(gui.add_button(N_("Record"), color="green",
+                                              hint=N_("Record this step at the current pose (a touch farther than "
+                                                      "0.5 mm asks first, unless the distance is hidden); key R.")))
+            self.nav = keep(gui.add_button_group(N_("Step"), (_(BACK), _(NEXT), _(CANCEL)),
+                                                 hint=N_("Keys: N Next (Finish on the last step), B Back.")))
             self.meter_bar = gui.add_progress_bar(0.0, color="gray", visible=False)
             self.meter_md = gui.add_markdown("", visible=False)
             self.tilt_html = gui.add_html(tilt_line_html(None), visible=False)
-            self.pivot = gui.add_button(PIVOT_LABEL, visible=False, hint=PIVOT_HINT)
+            self.pivot = keep(gui.add_button(PIVOT_LABEL, visible=False, hint=PIVOT_HINT))
         self.record.on_click(self._action(self._on_record))
         self.nav.on_click(self._on_nav_click)
         self.mount.on_click(self._action(lambda _e: self.session.wizard_commands.mount_required_tool(), sync=True))
@@ -132,6 +143,14 @@ class WizardDock:
     def _say(self, text: str) -> None:
         self._note, self._note_at = text, self._where()
 
+    def _command(self, value: str) -> str | None:
+        """The Step command (:data:`BACK`, ...) a click's ``value`` names, in the session's
+        language, in the one the buttons were shown in (a click that crossed a switch) or in
+        English; None for none."""
+        tr = self.session.translator
+        return next((c for c in (BACK, NEXT, FINISH, CANCEL, CLOSE)
+                     if value in (c, tr.gettext(c), self._shown_in.gettext(c))), None)
+
     # ------------------------------------------------------------ callbacks
     def _on_record(self, _event: ButtonEvent) -> None:
         wf = self.session.workflow
@@ -154,7 +173,7 @@ class WizardDock:
         """Back and Cancel as every click; Next / Finish through ``WizardCommands.next_step_in_pool``
         (a controller job runs in the job pool), its errors one notification."""
         s = self.session
-        if str(event.target.value) not in (NEXT, FINISH):
+        if self._command(str(event.target.value)) not in (NEXT, FINISH):
             await self._action(self._on_nav)(event)
             return
         if s.closed:
@@ -163,14 +182,15 @@ class WizardDock:
         try:
             await s.wizard_commands.next_step_in_pool()
         except ValueError as exc:          # the wizard's words, or the pool's (JobRefused)
-            s.notify("Not done", str(exc), kind="warning")
+            s.notify(s.translator.gettext("Not done"), str(exc), kind="warning")
         except Exception as exc:           # a browser's click must never kill the server
             log.exception("Next / Finish failed")
-            s.notify("Internal error", f"{type(exc).__name__}: {exc}", kind="error")
+            s.notify(s.translator.gettext("Internal error"), f"{type(exc).__name__}: {exc}", kind="error")
 
     def _on_nav(self, event: ButtonGroupEvent) -> None:
         s = self.session
-        choice = str(event.target.value)
+        _ = s.translator.gettext
+        choice = self._command(str(event.target.value))
         self.check.clear()
         if choice == BACK:
             s.wizard_commands.back()
@@ -178,16 +198,20 @@ class WizardDock:
             s.wizard_commands.next_step()
         elif choice in (CANCEL, CLOSE):
             if s.wizard_commands.cancel():
-                self.session.notify("Calibration cancelled",
-                                    "Nothing recorded is lost: Resume it from the Calibrate menu.")
+                self.session.notify(_("Calibration cancelled"),
+                                    _("Nothing recorded is lost: Resume it from the Calibrate menu."))
         else:
-            raise ValueError(f"Unknown step command {choice!r}; use {BACK}, {NEXT} or {CANCEL}.")
+            raise ValueError(_("Unknown step command {choice!r}; use {back}, {next} or {cancel}.").format(
+                choice=str(event.target.value), back=_(BACK), next=_(NEXT), cancel=_(CANCEL)))
 
     # ------------------------------------------------------------ render
     def on_change(self, change: SessionChange) -> None:
-        """The change signal: the whole dock after a wizard, tool or touches change; the meter
-        after a move."""
-        if change.wizard or change.tool or change.touches:
+        """The change signal: the whole dock after a wizard, tool or touches change (and every
+        label after a ``language`` change); the meter after a move."""
+        if change.language:
+            self.words.relabel(self.session.translator)
+            self._note, self._note_at = "", None      # said in the old language
+        if change.wizard or change.tool or change.touches or change.language:
             self.render()
         elif change.pose and self.folder.visible:
             self.update_meter()
@@ -203,11 +227,13 @@ class WizardDock:
         if wf is None or wiz is None or not open_:
             self._note, self._note_at = "", None
             return
-        set_content(self.step_md, step_markdown(wiz))
+        tr = self.session.translator
+        _ = tr.gettext
+        set_content(self.step_md, step_markdown(wiz, tr=tr))
         note = self._note if self._note_at == self._where() else ""
         failure = wf.finish_failure
         if failure is not None:                  # Finish could not compute: why, and what to do
-            note = f"⚠ Finish not possible: {escape_markdown(failure)}" + (f"\n\n{note}" if note else "")
+            note = _("⚠ Finish not possible: {why}").format(why=escape_markdown(failure)) + (f"\n\n{note}" if note else "")
         self.note_md.visible = bool(note)
         if note:
             set_content(self.note_md, note)
@@ -215,7 +241,7 @@ class WizardDock:
         needed = wf.required_tool() if stepping else None
         self.mount.visible = needed is not None
         if needed is not None:
-            self.mount.label = f"Mount the {needed.label.lower()}"
+            self.mount.label = _("Mount the {tool}").format(tool=needed.label.lower())
         self.record.visible = stepping and not wiz.auto_role(wiz.step).by_controller   # a scan: no Record
         self.record.disabled = not wiz.can_record
         # the button keeps its row through the whole XYZ 4-point (disabled until two touches give
@@ -224,11 +250,12 @@ class WizardDock:
         self.pivot.disabled = self.session.wizard_commands.estimate_offer() is None
         options: tuple[str, ...]
         if stepping:
-            options = (BACK, FINISH if wiz.on_last_step else NEXT, CANCEL)
+            options = (_(BACK), _(FINISH) if wiz.on_last_step else _(NEXT), _(CANCEL))
         else:
-            options = (BACK, CLOSE)
+            options = (_(BACK), _(CLOSE))
         if tuple(self.nav.options) != options:
             self.nav.options = options
+        self._shown_in = tr
         self.update_meter()
 
     def update_meter(self) -> None:
@@ -248,15 +275,18 @@ class WizardDock:
         set_value(self.meter_bar, round(value, 1))
         self.meter_bar.color = color
         angle = gain.angle_to_nearest_deg
+        _ = self.session.translator.gettext
         if math.isinf(angle):
-            text = "Pose diversity: first touch, any orientation."
+            text = _("Pose diversity: first touch, any orientation.")
         elif gain.too_close:
-            text = f"Pose diversity: ⚠ **too close**, {angle:.0f}°: tilt further."
+            text = _("Pose diversity: ⚠ **too close**, {angle}°: tilt further.").format(angle=f"{angle:.0f}")
         elif math.isinf(gain.predicted_after):
-            text = f"Pose diversity: {angle:.0f}° from the nearest touch; not yet determinable."
+            text = _("Pose diversity: {angle}° from the nearest touch; not yet determinable.").format(
+                angle=f"{angle:.0f}")
         else:
-            text = (f"Pose diversity: {angle:.0f}° from the nearest touch; predicted TCP error "
-                    f"{gain.predicted_after:.2f} mm if recorded here ({meter.basis}).")
+            text = _("Pose diversity: {angle}° from the nearest touch; predicted TCP error {error} mm if "
+                     "recorded here ({basis}).").format(angle=f"{angle:.0f}", error=f"{gain.predicted_after:.2f}",
+                                                        basis=meter.basis)
         set_content(self.meter_md, text)              # numbers and our words only
         s = self.session
         others = wiz.other_rotations()

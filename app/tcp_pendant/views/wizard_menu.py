@@ -29,6 +29,13 @@ the only way a click changes it; every click goes through :meth:`CalibrateView.a
 (``SessionLoop.on_loop``: the event loop, the session's lock and error notifications) inside
 ``Session.batch``, so a click ends in one change signal; the tab re-renders from the workflow's
 state on that signal (:meth:`CalibrateView.on_change`), as the scene and the Tool tab do.
+
+Language: every word of the tab is the session's (``session.translator``): the fixed labels and
+hints through ``views.gui_words``, the wizard classes' titles, blurbs, options and variants (``N_``
+msgids of ``tcp_pendant.wizards``) translated where shown, the composed texts by
+``calibrate.text`` with ``tr``. A ``language`` change relabels everything and re-renders the
+tab (:meth:`CalibrateView.relabel`), the chosen method and options kept; a dropdown's value is
+read in the session's language, in the one it was shown in, or in English.
 """
 
 from __future__ import annotations
@@ -61,7 +68,9 @@ from tcp_pendant.views.gui_util import (
     slot_option,
     target_of,
 )
+from tcp_pendant.translation import N_
 from tcp_pendant.views.beam_replay import ScanPlayer
+from tcp_pendant.views.gui_words import GuiWords
 from tcp_pendant.views.math_panel import MathView
 from tcp_pendant.views.upload_guard import limit_upload_size
 from tcp_pendant.views.wizard_result import WizardResultView
@@ -81,9 +90,10 @@ from tcpcal.tool import Tool
 
 __all__ = ["NO_LIBRARY_TOOL", "SESSION_FILENAME", "CalibrateView"]
 
-NO_LIBRARY_TOOL = "(library empty)"
+NO_LIBRARY_TOOL = N_("(library empty)")
+"""The library dropdown's only option while the library is empty (shown translated)."""
 SESSION_FILENAME = "tcp-pendant-session.json"
-RECORD_REFUSED = "Session record not loaded"
+RECORD_REFUSED = N_("Session record not loaded")
 """Title of the one notification a refused session record gets."""
 
 log = logging.getLogger(__name__)
@@ -113,15 +123,18 @@ class CalibrateView:
         gui = target_of(session).gui
         tools = self.workflow.tools
         self._physical = {t.label: key for key, t in tools.items()}
+        self.words = GuiWords(session.translator)     # the fixed labels and hints, relabelled per language
+        self._shown_in = session.translator           # the language the options on show are in
+        keep = self.words.keep
 
-        self.training = gui.add_checkbox(
-            "Training mode", True,
-            hint="Reveals the true TOOL frame after a result, with the error against it, and offers Auto-touch.")
+        self.training = keep(gui.add_checkbox(
+            N_("Training mode"), True,
+            hint=N_("Reveals the true TOOL frame after a result, with the error against it, and offers Auto-touch.")))
         self._classes: dict[str, type[Wizard]] = {c.title: c for c in wizard_classes()}
-        self.menu_folder = gui.add_folder("Calibrate")
+        self.menu_folder = keep(gui.add_folder(N_("Calibrate")))
         with self.menu_folder:
-            labels = tuple(self._classes)
-            self.method = gui.add_dropdown("Method", labels, initial_value=labels[0])
+            labels = self._method_labels(tuple(self._classes))
+            self.method = keep(gui.add_dropdown(N_("Method"), labels, initial_value=labels[0]))
             self.method_md = gui.add_markdown("")
             self.option_widgets: dict[str, OptionWidget] = {}
             self._option_specs: dict[str, WizardOption] = {}
@@ -131,12 +144,12 @@ class CalibrateView:
                         self._option_specs[opt.name] = opt
                         self.option_widgets[opt.name] = self._add_option_widget(gui, opt)
             self.menu_md = gui.add_markdown("")
-            self.start = gui.add_button("Start", color="green")
+            self.start = keep(gui.add_button(N_("Start"), color="green"))
             self.start_from_points = gui.add_button(
                 "Start from the recorded points", color="blue", visible=False,
-                hint="XYZ 4-point from the touches of the Jog tab's Record point: they become its first steps.")
-            self.resume_list = gui.add_dropdown("To resume", ("-",), visible=False,
-                                                hint="Calibrations you left: where, and when they started.")
+                hint=N_("XYZ 4-point from the touches of the Jog tab's Record point: they become its first steps."))
+            self.resume_list = keep(gui.add_dropdown(N_("To resume"), ("-",), visible=False,
+                                                     hint=N_("Calibrations you left: where, and when they started.")))
             self.resume = gui.add_button("Resume", color="blue", visible=False)
         widgets = self.option_widgets
         self._slot_widgets = [cast("viser.GuiDropdownHandle[str]", widgets[n])    # a library slot: a dropdown
@@ -150,10 +163,11 @@ class CalibrateView:
         self.steps = WizardStepsView(self)
         self.result = WizardResultView(self)
         self.math = MathView(session)          # renders itself on the session's wizard signal
-        with gui.add_folder("Session record", expand_by_default=False):
-            self.export = gui.add_button("Export session (JSON)",
-                                         hint="Touches, calibrations, results and errors, for grading.")
-            self.load = gui.add_upload_button("Load session (JSON)", mime_type="application/json")
+        self.record_folder = keep(gui.add_folder(N_("Session record"), expand_by_default=False))
+        with self.record_folder:
+            self.export = keep(gui.add_button(N_("Export session (JSON)"),
+                                              hint=N_("Touches, calibrations, results and errors, for grading.")))
+            self.load = keep(gui.add_upload_button(N_("Load session (JSON)"), mime_type="application/json"))
             self.record_md = gui.add_markdown("")
         self.scene = WizardSceneView(session, self.workflow, player)
 
@@ -179,55 +193,111 @@ class CalibrateView:
 
     def _add_option_widget(self, gui: viser.GuiApi, opt: WizardOption) -> OptionWidget:
         """The menu widget of a declared start option (hidden until a method that takes it is
-        chosen)."""
+        chosen); its label and hint are the option's msgids (the wizard class's ``N_``)."""
         hint = opt.hint or None
         if opt.kind == "int":
             lo, hi = int(opt.minimum if opt.minimum is not None else 0), int(opt.maximum if opt.maximum is not None else 100)
-            return gui.add_slider(opt.label, min=lo, max=hi, step=1,
-                                  initial_value=int(opt.default if opt.default is not None else lo), hint=hint)
+            return self.words.keep(gui.add_slider(opt.label, min=lo, max=hi, step=1,
+                                   initial_value=int(opt.default if opt.default is not None else lo), hint=hint))
         if opt.kind == "choice":
-            labels = tuple(label for _, label in opt.choices)
-            initial = next((label for v, label in opt.choices if v == opt.default), labels[0])
-            return gui.add_dropdown(opt.label, labels, initial_value=initial, hint=hint)
+            labels = self._choice_labels(opt)
+            initial = next((self.gettext(label) for v, label in opt.choices if v == opt.default), labels[0])
+            return self.words.keep(gui.add_dropdown(opt.label, labels, initial_value=initial, hint=hint))
         if opt.kind == "library_slot":
-            return gui.add_dropdown(opt.label, (NO_LIBRARY_TOOL,), initial_value=NO_LIBRARY_TOOL, hint=hint)
+            empty = self.gettext(NO_LIBRARY_TOOL)
+            return self.words.keep(gui.add_dropdown(opt.label, (empty,), initial_value=empty, hint=hint))
         physical = tuple(self._physical)
         mounted = self.session.controller.mounted_tool.label
         initial = mounted if mounted in physical else physical[0]
         if opt.default == "other":
             initial = next((p for p in physical if p != initial), physical[0])
-        return gui.add_dropdown(opt.label, physical, initial_value=initial, hint=hint)
+        return self.words.keep(gui.add_dropdown(opt.label, physical, initial_value=initial, hint=hint))
+
+    def gettext(self, message: str) -> str:
+        """``message`` (an English msgid) in the session's language."""
+        return self.session.translator.gettext(message)
+
+    def _method_labels(self, titles: tuple[str, ...]) -> tuple[str, ...]:
+        """The Method dropdown's options: the wizard classes' titles in the session's language."""
+        return tuple(self.gettext(t) for t in titles)
+
+    def _choice_labels(self, opt: WizardOption) -> tuple[str, ...]:
+        return tuple(self.gettext(label) for _, label in opt.choices)
+
+    def said_as(self, message: str) -> set[str]:
+        """The ways an option ``message`` may come back from the browser: in the session's
+        language, in the language the options were shown in (a click that crossed a switch) or
+        in English."""
+        return {message, self.gettext(message), self._shown_in.gettext(message)}
 
     def _option_value(self, opt: WizardOption) -> object:
-        """The value of ``opt`` as chosen in its widget (checked by the wizard class at Start)."""
+        """The value of ``opt`` as chosen in its widget (checked by the wizard class at Start);
+        a choice is read in any language it may come in (:meth:`said_as`)."""
         widget = self.option_widgets[opt.name]
         if opt.kind == "int":
             return int(widget.value)
         if opt.kind == "choice":
-            values = {label: v for v, label in self._option_specs[opt.name].choices}
+            choices = self._option_specs[opt.name].choices
+            values = {said: v for v, label in choices for said in self.said_as(label)}
             if widget.value not in values:
-                raise ValueError(f"{opt.label}: unknown choice {widget.value!r}.")
+                raise ValueError(self.gettext("{option}: unknown choice {value!r}.").format(
+                    option=self.gettext(opt.label), value=widget.value))
             return values[widget.value]
         if opt.kind == "library_slot":
             return self._selected_slot(widget)
         if widget.value not in self._physical:
-            raise ValueError(f"{opt.label}: unknown physical tool {widget.value!r}.")
+            raise ValueError(self.gettext("{option}: unknown physical tool {value!r}.").format(
+                option=self.gettext(opt.label), value=widget.value))
         return self._physical[widget.value]
 
+    def _class_of(self, label: str) -> type[Wizard] | None:
+        """The wizard class a Method option names (its title in the session's language or in
+        English)."""
+        return next((c for t, c in self._classes.items() if label in self.said_as(t)), None)
+
     def _chosen_class(self) -> type[Wizard]:
-        return self._classes.get(str(self.method.value), next(iter(self._classes.values())))
+        return self._class_of(str(self.method.value)) or next(iter(self._classes.values()))
+
+    def _is_empty_library(self, value: object) -> bool:
+        return value in self.said_as(NO_LIBRARY_TOOL)
+
+    def relabel(self) -> None:
+        """A ``language`` change: the fixed labels and hints, the options of the Method and of
+        the choices, then the whole tab in the new language."""
+        self.words.relabel(self.session.translator)
+        chosen = self._chosen_class()
+        self.method.options = self._method_labels(tuple(self._classes))     # _render_menu narrows them
+        set_value(self.method, self.gettext(chosen.title))
+        for name, opt in self._option_specs.items():
+            widget = self.option_widgets[name]
+            if opt.kind == "choice":
+                value = self._option_value(opt)
+                labels = self._choice_labels(opt)
+                set_options(cast("viser.GuiDropdownHandle[str]", widget), labels,
+                            keep=next(self.gettext(lab) for v, lab in opt.choices if v == value))
+        if not self._library:
+            for widget in self._slot_widgets:
+                set_options(widget, (self.gettext(NO_LIBRARY_TOOL),))
+        hint = self.gettext("XYZ 4-point from the touches of the Jog tab's Record point: they become its first steps.")
+        if self.start_from_points.hint != hint:
+            self.start_from_points.hint = hint
+        self._shown_in = self.session.translator
+        self.result.relabel()
+        self.steps.relabel()
 
     def on_change(self, change: SessionChange) -> None:
         """The change signal: the live parts after a move; the library list when it was
         re-read; the whole tab after a Calibrate click or a tool change (the open wizard is
-        told which tool is mounted first)."""
+        told which tool is mounted first); every text after a ``language`` change."""
+        if change.language:
+            self.relabel()
         if change.library:
             self.refresh_library(render=False)
         if change.pose:
             self.on_motion()
         if change.touches and not (change.wizard or change.tool or change.library):
             self._render_menu()                # "Start from the N recorded points"
-        if change.wizard or change.tool or change.library:
+        if change.wizard or change.tool or change.library or change.language:
             self.render()
 
     # ------------------------------------------------------------ plumbing
@@ -262,7 +332,8 @@ class CalibrateView:
 
     def saved(self, slot: int, tool: Tool) -> None:
         """After "Save to tool library" (the session made it the active tool)."""
-        self.session.notify("Tool saved", f"Slot {slot}: {tool.name} is now the active tool.", kind="success")
+        self.session.notify(self.gettext("Tool saved"), self.gettext("Slot {slot}: {name} is now the active tool.").format(
+            slot=slot, name=tool.name), kind="success")
 
     # ------------------------------------------------------------ callbacks
     def _on_training(self, event: CheckboxEvent) -> None:
@@ -287,12 +358,12 @@ class CalibrateView:
         picked = widget or self.library_tool                     # None: the library is empty
         slot = None if picked is None else number_of_option(str(picked.value))
         if slot is None:
-            raise ValueError("The tool library is empty: calibrate the TCP first (XYZ 4-point) and save it.")
+            raise ValueError(self.gettext("The tool library is empty: calibrate the TCP first (XYZ 4-point) and save it."))
         return slot
 
     def _on_start(self, _event: ButtonEvent) -> None:
-        if str(self.method.value) not in self._classes:
-            raise ValueError(f"Unknown calibration method {self.method.value!r}.")
+        if self._class_of(str(self.method.value)) is None:
+            raise ValueError(self.gettext("Unknown calibration method {value!r}.").format(value=self.method.value))
         cls = self._chosen_class()
         self.session.wizard_commands.start(cls.kind, **{opt.name: self._option_value(opt) for opt in cls.options})
 
@@ -300,7 +371,7 @@ class CalibrateView:
         """XYZ 4-point from the free touches (``CalibrationWorkflow.start_from_touches``)."""
         cls = self._chosen_class()
         if cls.kind != "xyz4":
-            raise ValueError("Only the XYZ 4-point method starts from the recorded points; choose it first.")
+            raise ValueError(self.gettext("Only the XYZ 4-point method starts from the recorded points; choose it first."))
         spec = self._option_specs.get("estimator")
         estimator = "lstsq" if spec is None else str(self._option_value(spec))
         self.session.wizard_commands.start_from_touches(estimator=estimator)
@@ -308,10 +379,10 @@ class CalibrateView:
     def _on_resume(self, _event: ButtonEvent) -> None:
         number = number_of_option(self.resume_list.value)
         if number is None:
-            raise ValueError("There is no calibration to resume.")
+            raise ValueError(self.gettext("There is no calibration to resume."))
         if number - 1 not in {i for i, _ in self.workflow.resumable()}:
-            raise ValueError(f"Calibration {number} is not waiting to be resumed any more; choose one in "
-                             "'To resume'.")
+            raise ValueError(self.gettext("Calibration {number} is not waiting to be resumed any more; choose one in "
+                                     "'To resume'.").format(number=number))
         self.session.wizard_commands.resume(number - 1)
 
     def _on_export(self, event: ButtonEvent) -> None:
@@ -319,7 +390,10 @@ class CalibrateView:
         # to the browser that clicked (in --shared mode the session is every browser's)
         target = getattr(event, "client", None) or client_of(self.session) or target_of(self.session)
         target.send_file_download(SESSION_FILENAME, data, save_immediately=True)
-        set_content(self.record_md, f"Exported {len(self.workflow.runs)} calibration(s) as {SESSION_FILENAME}.")
+        n = len(self.workflow.runs)
+        set_content(self.record_md, self.session.translator.ngettext(
+            "Exported {n} calibration as {file}.", "Exported {n} calibrations as {file}.", n).format(
+                n=n, file=SESSION_FILENAME))
 
     async def _on_upload(self, event: UploadEvent) -> None:
         """"Load session (JSON)": the size is checked at once, parsing and replay run in
@@ -331,11 +405,12 @@ class CalibrateView:
         if session.closed or getattr(event, "client", None) is None:
             return
         upload = event.target.value
-        name = str(upload.name or "The file")
+        name = str(upload.name or self.gettext("The file"))
         content = upload.content
         if self._loading_record:
-            session.notify(RECORD_REFUSED, f"{name}: another session record is still being loaded here; "
-                           "wait until it is shown, then load this one.", kind="warning")
+            session.notify(self.gettext(RECORD_REFUSED), self.gettext(
+                "{file}: another session record is still being loaded here; wait until it is shown, then "
+                "load this one.").format(file=name), kind="warning")
             return
         try:
             check_record_size(len(content))
@@ -345,7 +420,7 @@ class CalibrateView:
         self._loading_record = True
         try:
             with session.lock:
-                set_content(self.record_md, f"Loading {escape_markdown(name)} ...")
+                set_content(self.record_md, self.gettext("Loading {file} ...").format(file=escape_markdown(name)))
             data = bytes(content)
             loaded = await session.loop.run_job(lambda: load_and_replay(data), what="a session record's load")
         except (SessionRecordError, JobRefused) as exc:
@@ -353,7 +428,7 @@ class CalibrateView:
             return
         except Exception as exc:  # never let an upload kill the server
             log.exception("loading the session record %r failed", name)
-            session.notify("Internal error", f"{type(exc).__name__}: {exc}", kind="error")
+            session.notify(self.gettext("Internal error"), f"{type(exc).__name__}: {exc}", kind="error")
             return
         finally:
             self._loading_record = False
@@ -361,20 +436,21 @@ class CalibrateView:
 
     def _show_loaded(self, name: str, loaded: LoadedRecord) -> None:
         checks = self.session.wizard_commands.load_record(loaded)
-        set_content(self.record_md, f"**Loaded {escape_markdown(name)}**\n\n" + replay_markdown(checks))
+        set_content(self.record_md, self.gettext("**Loaded {file}**").format(file=escape_markdown(name)) + "\n\n"
+                    + replay_markdown(checks, tr=self.session.translator))
 
     def _refuse_record(self, name: str, exc: Exception) -> None:
         if not self.session.closed:
             with self.session.lock:
                 set_content(self.record_md, "")
-            self.session.notify(RECORD_REFUSED, f"{name}: {exc}", kind="warning")
+            self.session.notify(self.gettext(RECORD_REFUSED), f"{name}: {exc}", kind="warning")
 
     def _upload_refused(self, filename: str, size_bytes: int) -> None:
         """``upload_guard``: a transfer above the size limit was dropped as it started."""
         try:
             check_record_size(size_bytes)
         except SessionRecordError as exc:
-            self._refuse_record(filename or "The file", exc)
+            self._refuse_record(filename or self.gettext("The file"), exc)
 
     # ------------------------------------------------------------ library and motion
     def refresh_library(self, *, render: bool = True) -> None:
@@ -382,7 +458,7 @@ class CalibrateView:
         the file is not read here). Called on the session's ``library`` change."""
         tools = self.session.tools.library_tools
         self._library = dict(tools)
-        options = tuple(slot_option(s, t.name) for s, t in sorted(tools.items())) or (NO_LIBRARY_TOOL,)
+        options = tuple(slot_option(s, t.name) for s, t in sorted(tools.items())) or (self.gettext(NO_LIBRARY_TOOL),)
         for widget in self._slot_widgets:
             set_options(widget, options, keep=self._library_option(options))
         self.result.refresh_slots(tools)
@@ -416,9 +492,9 @@ class CalibrateView:
         self._menu_mounted_key = self.session.controller.mounted_tool.key
         rules = self.session.rules                # an exercise may offer some methods only
         offered = tuple(t for t, c in self._classes.items() if rules.allows_method(c.kind)) or tuple(self._classes)
-        set_options(self.method, offered)
+        set_options(self.method, self._method_labels(offered))
         cls = self._chosen_class()
-        set_content(self.method_md, cls.blurb)
+        set_content(self.method_md, self.gettext(cls.blurb))
         taken = {o.name for o in cls.options}
         for name, widget in self.option_widgets.items():
             widget.visible = name in taken
@@ -428,18 +504,19 @@ class CalibrateView:
             wanted = self._library_option(tuple(widget.options))
             if wanted is not None and widget.value != wanted and wanted in widget.options:
                 set_value(widget, wanted)
-        empty = library_widget is None or library_widget.value == NO_LIBRARY_TOOL
+        empty = library_widget is None or self._is_empty_library(library_widget.value)
         physical = [self.option_widgets[o.name].value for o in cls.options if o.kind == "physical_tool"]
         mounted = self.session.controller.mounted_tool.label
         set_content(self.menu_md, menu_markdown(
             cls.kind, library_tool=None if empty else str(library_widget.value),   # type: ignore[union-attr]
             reference_tool=str(physical[0]) if physical else mounted,
             new_tool=str(physical[1]) if len(physical) > 1 else mounted,
-            mounted_tool=mounted))
+            mounted_tool=mounted, tr=self.session.translator))
         self.start.disabled = needs_tool and empty
         n_points = len(self.session.touches)
         self.start_from_points.visible = cls.kind == "xyz4" and n_points >= 1
-        label = f"Start from the {n_points} recorded point{'' if n_points == 1 else 's'}"
+        label = self.session.translator.ngettext("Start from the {n} recorded point", "Start from the {n} recorded points",
+                                                 n_points).format(n=n_points)
         if n_points and self.start_from_points.label != label:
             self.start_from_points.label = label
         self.menu_folder.visible = not self.workflow.is_open     # a pendant shows the wizard alone
@@ -455,6 +532,7 @@ class CalibrateView:
             set_options(self.resume_list, tuple(label for _, label in waiting), keep=keep or waiting[0][1])
             number = number_of_option(self.resume_list.value)
             chosen = next((label for i, label in waiting if number == i + 1), waiting[0][1])
-            label = f"Resume {chosen.split(', started')[0]}"      # names what the click brings back
+            # names what the click brings back (the list's label without its last part, the start time)
+            label = self.gettext("Resume {calibration}").format(calibration=chosen.rsplit(", ", 1)[0])
             if self.resume.label != label:
                 self.resume.label = label

@@ -36,6 +36,7 @@ from tcp_pendant.job_pool import JobRefused
 from tcp_pendant.pendant.guidance import tip_offset_mm
 from tcp_pendant.pendant.touch_feedback import touch_feedback
 from tcp_pendant.text_escape import escape_markdown
+from tcp_pendant.translation import N_
 from tcp_pendant.views.gui_util import ButtonEvent, DropdownEvent, set_content, set_value, target_of
 from tcp_pendant.views.touches_export import TouchesExport
 from tcp_pendant.wizards import Wizard, WizardStateError
@@ -48,7 +49,8 @@ if TYPE_CHECKING:
 
 __all__ = ["RANDOM", "WizardStepsView"]
 
-RANDOM, CHOSEN = "random", "chosen (tilt, azimuth)"
+RANDOM, CHOSEN = N_("random"), N_("chosen (tilt, azimuth)")
+"""Auto-touch's directions (msgids; the dropdown shows them translated)."""
 log = logging.getLogger(__name__)
 
 
@@ -59,37 +61,44 @@ class WizardStepsView:
         self.advisor = TiltAdvisor()          # the tilt hint given on this tab
         self.parent = parent
         gui = target_of(parent.session).gui
-        self.folder = gui.add_folder("Wizard", visible=False)
+        keep = parent.words.keep                  # the tab's fixed words, relabelled per language
+        _ = parent.gettext
+        self.folder = keep(gui.add_folder(N_("Wizard"), visible=False))
         with self.folder:
             self.head_md = gui.add_markdown("")
             self.progress = gui.add_progress_bar(0.0, color="blue")
             self.steps_md = gui.add_markdown("")
-            self.variant = gui.add_dropdown("Variant", ("-",), visible=False)
+            self.variant = keep(gui.add_dropdown(N_("Variant"), ("-",), visible=False))
             self.blocked_md = gui.add_markdown("", visible=False)
-            self.mount = gui.add_button("Mount the tool", color="orange", visible=False,
-                                        hint="The tool change this step asks for (the app swaps the tool).")
-            self.record = gui.add_button("Record", color="green", hint="Store the current flange pose for this step.")
+            self.mount = gui.add_button(N_("Mount the tool"), color="orange", visible=False,
+                                        hint=N_("The tool change this step asks for (the app swaps the tool)."))
+            keep(self.mount)            # its label is set per step (the tool's name), its hint kept
+            self.record = keep(gui.add_button(N_("Record"), color="green",
+                                              hint=N_("Store the current flange pose for this step.")))
             self.record_md = gui.add_markdown("")
-            self.next = gui.add_button("Next", color="blue")
-            self.back = gui.add_button("Back", color="gray")
-            self.add_point = gui.add_button("Add point", visible=False,
-                                            hint="One more touch (up to 20): more touches, smaller error.")
-            self.cancel = gui.add_button("Cancel", color="red",
-                                         hint="Leave the wizard; nothing recorded is lost, Resume brings it back.")
+            self.next = gui.add_button(_("Next"), color="blue")
+            self.back = keep(gui.add_button(N_("Back"), color="gray"))
+            self.add_point = keep(gui.add_button(N_("Add point"), visible=False,
+                                                 hint=N_("One more touch (up to 20): more touches, smaller error.")))
+            self.cancel = gui.add_button(N_("Cancel"), color="red",
+                                         hint=N_("Leave the wizard; nothing recorded is lost, Resume brings it back."))
+            keep(self.cancel)           # its label is set per state (Cancel, Close), its hint kept
             self.export = TouchesExport(parent)          # "Export touches (CSV)" for tcpcal solve
             self.meter_bar = gui.add_progress_bar(0.0, color="gray", visible=False)
             self.meter_md = gui.add_markdown("", visible=False)
-            self.auto_folder = gui.add_folder("Auto-touch (training)", expand_by_default=True)
+            self.auto_folder = keep(gui.add_folder(N_("Auto-touch (training)"), expand_by_default=True))
             with self.auto_folder:
-                self.auto_direction = gui.add_dropdown("Direction", (RANDOM, CHOSEN), initial_value=RANDOM)
-                self.auto_tilt = gui.add_slider("Tilt (deg)", min=0.0, max=60.0, step=1.0, initial_value=35.0,
-                                                visible=False)
-                self.auto_azimuth = gui.add_slider("Azimuth (deg)", min=0.0, max=355.0, step=5.0,
-                                                   initial_value=0.0, visible=False)
-                self.auto_sigma = gui.add_slider("Operator error σ (mm)", min=0.0, max=AUTO_SIGMA_MAX_MM,
-                                                 step=0.05, initial_value=0.0)
-                self.auto_touch = gui.add_button("Auto-touch", color="violet",
-                                                 hint="The robot performs this step itself, with the operator error σ.")
+                directions = (_(RANDOM), _(CHOSEN))
+                self.auto_direction = keep(gui.add_dropdown(N_("Direction"), directions, initial_value=directions[0]))
+                self.auto_tilt = keep(gui.add_slider(N_("Tilt (deg)"), min=0.0, max=60.0, step=1.0,
+                                                     initial_value=35.0, visible=False))
+                self.auto_azimuth = keep(gui.add_slider(N_("Azimuth (deg)"), min=0.0, max=355.0, step=5.0,
+                                                        initial_value=0.0, visible=False))
+                self.auto_sigma = keep(gui.add_slider(N_("Operator error σ (mm)"), min=0.0, max=AUTO_SIGMA_MAX_MM,
+                                                      step=0.05, initial_value=0.0))
+                self.auto_touch = keep(gui.add_button(
+                    N_("Auto-touch"), color="violet",
+                    hint=N_("The robot performs this step itself, with the operator error σ.")))
                 self.auto_md = gui.add_markdown("")
         act = parent.action
         session = parent.session
@@ -108,6 +117,23 @@ class WizardStepsView:
         self._auto_line: tuple[tuple[object, ...], str, object] | None = None  # (where it belongs, text, poses)
         self._record_line: tuple[tuple[object, ...], str, object] | None = None  # the same, for Record
 
+    def relabel(self) -> None:
+        """A ``language`` change (the tab relabelled the kept handles): the Direction options
+        in the new language, the chosen one kept; the lines of the last clicks are dropped (they
+        were said in the old language); ``render`` shows the rest."""
+        chosen = self._direction()
+        _ = self.parent.gettext
+        options = (_(RANDOM), _(CHOSEN))
+        if tuple(self.auto_direction.options) != options:
+            self.auto_direction.options = options
+        set_value(self.auto_direction, _(chosen))
+        self._auto_line = self._record_line = None
+
+    def _direction(self) -> str:
+        """The Auto-touch direction chosen (:data:`RANDOM` or :data:`CHOSEN`), read in any
+        language the option may come in."""
+        return CHOSEN if str(self.auto_direction.value) in self.parent.said_as(CHOSEN) else RANDOM
+
     # ------------------------------------------------------------ callbacks
     def _on_record(self, _event: ButtonEvent) -> None:
         """Record the step. In free practice with the distance hidden the line below says how
@@ -122,14 +148,15 @@ class WizardStepsView:
         if s.hide_distance and not s.rules.in_exercise:
             wiz = self.parent.workflow.wizard
             self._record_line = (self._auto_where(),
-                                 f"✔ Step {index + 1 if index is not None else '?'} recorded: "
-                                 f"{touch_feedback(delta, frame)}.",
+                                 self.parent.gettext("✔ Step {n} recorded: {feedback}.").format(
+                                     n=index + 1 if index is not None else "?", feedback=touch_feedback(delta, frame)),
                                  None if wiz is None else wiz.recorded_poses)
 
     def _on_cancel(self, _event: ButtonEvent) -> None:
         if self.parent.session.wizard_commands.cancel():
-            self.parent.session.notify("Calibration cancelled",
-                                       "Nothing recorded is lost: Resume it from the Calibrate menu.")
+            _ = self.parent.gettext
+            self.parent.session.notify(_("Calibration cancelled"),
+                                       _("Nothing recorded is lost: Resume it from the Calibrate menu."))
 
     async def _on_next(self, event: ButtonEvent) -> None:
         """Next / Finish. A wizard waiting for its controller job (a TCP check's rotations, a
@@ -138,11 +165,12 @@ class WizardStepsView:
         beam scan of 3 to 5 orientations well under a second), its outcome handed to the wizard
         on the loop; one job at a time."""
         session, act = self.parent.session, self.parent.action
+        _ = self.parent.gettext
         jobs: list[ControllerJob] = []
 
         def take(_e: ButtonEvent) -> None:
             if self._checking:
-                raise WizardStateError("The controller is still at work; wait for its result.")
+                raise WizardStateError(_("The controller is still at work; wait for its result."))
             job = session.wizard_commands.take_controller_job()
             if job is None:
                 session.wizard_commands.next_step()
@@ -155,17 +183,19 @@ class WizardStepsView:
         if not jobs:
             return
         title = jobs[0].wizard.title
+        shown = _(title)
         try:
             result = await session.loop.run_job(jobs[0].run, what=f"the {title} wizard's controller job")
         except Exception as exc:  # a browser's click must never kill the server
             self._checking = False
             if isinstance(exc, JobRefused):            # another job of this session, or a full queue
-                self.parent.session.notify(f"{title}: not started", str(exc), kind="warning")
+                self.parent.session.notify(_("{title}: not started").format(title=shown), str(exc), kind="warning")
             elif isinstance(exc, ValueError):            # the controller's words (ControllerError)
-                self.parent.session.notify(f"{title}: not possible", str(exc), kind="error")
+                self.parent.session.notify(_("{title}: not possible").format(title=shown), str(exc), kind="error")
             else:
                 log.exception("%s: controller job failed", title)
-                self.parent.session.notify(f"{title} failed", f"{type(exc).__name__}: {exc}", kind="error")
+                self.parent.session.notify(_("{title} failed").format(title=shown), f"{type(exc).__name__}: {exc}",
+                                           kind="error")
             await act(lambda _e: None)(event)          # re-render the step as it was
             return
         finally:
@@ -178,15 +208,15 @@ class WizardStepsView:
     def _on_variant(self, event: DropdownEvent) -> None:
         wiz = self.parent.workflow.wizard
         label = str(event.target.value)
-        values = {} if wiz is None else {lab: v for v, lab in type(wiz).variants}
+        values = {} if wiz is None else {said: v for v, lab in type(wiz).variants for said in self.parent.said_as(lab)}
         if wiz is None or label not in values:
-            raise ValueError(f"Unknown variant {label!r}.")
+            raise ValueError(self.parent.gettext("Unknown variant {label!r}.").format(label=label))
         self.parent.session.wizard_commands.set_variant(values[label])
 
     def auto_request(self) -> AutoTouchRequest:
         """The Auto-touch settings as a request (random or chosen direction, operator error)."""
         sigma = float(self.auto_sigma.value)
-        if self.auto_direction.value == CHOSEN:
+        if self._direction() == CHOSEN:
             return AutoTouchRequest(float(self.auto_tilt.value), float(self.auto_azimuth.value), sigma)
         return AutoTouchRequest(sigma_mm=sigma)
 
@@ -198,36 +228,38 @@ class WizardStepsView:
         session = self.parent.session
         if session.closed:
             return
+        _ = self.parent.gettext
+        not_started = _("Auto-touch not started")
         wiz = self.parent.workflow.wizard
         probes = wiz is not None and type(wiz).controller_job in POSE_CHECKS    # its poses are probed in the pool
         running = session.jobs.pending(session) if probes else None
         if self._auto_touching or running is not None:
-            what = "Auto-touch" if self._auto_touching else running
-            session.notify_refusal("Auto-touch not started", f"{str(what)[:1].upper()}{str(what)[1:]} is still "
-                                   "running here; wait for its result, then try again.")
+            what = _("Auto-touch") if self._auto_touching else str(running)
+            session.notify_refusal(not_started, _("{job} is still running here; wait for its result, then try "
+                                                  "again.").format(job=f"{what[:1].upper()}{what[1:]}"))
             return
         try:                                    # refused at once, before anything moves
             session.loop.admit_job()
         except JobRefused as exc:
-            session.notify_refusal("Auto-touch not started", str(exc))
+            session.notify_refusal(not_started, str(exc))
             return
         try:
             request = self.auto_request()
         except ValueError as exc:
-            session.notify("Not done", str(exc), kind="warning")
+            session.notify(_("Not done"), str(exc), kind="warning")
             return
         self._auto_touching = True
         try:
             await session.wizard_commands.auto_touch_in_pool(request, shown=lambda out: self._show_auto_touch(out, request))
         except JobRefused as exc:
-            session.notify_refusal("Auto-touch not started", str(exc))
+            session.notify_refusal(not_started, str(exc))
             return
         except ValueError as exc:               # the wizard's words
-            session.notify_refusal("Not done", str(exc))
+            session.notify_refusal(_("Not done"), str(exc))
             return
         except Exception as exc:                # a browser's click must never kill the server
             log.exception("Auto-touch failed")
-            session.notify("Internal error", f"{type(exc).__name__}: {exc}", kind="error")
+            session.notify(_("Internal error"), f"{type(exc).__name__}: {exc}", kind="error")
             return
         finally:
             self._auto_touching = False
@@ -237,7 +269,8 @@ class WizardStepsView:
             raise ValueError(out.message)
         wiz = self.parent.workflow.wizard
         self._auto_line = (self._auto_where(),       # the poses are kept alive: their ids stay unique
-                           f"{escape_markdown(out.message)} Operator error σ {request.sigma_mm:.2f} mm.",
+                           escape_markdown(out.message) + " " + self.parent.gettext("Operator error σ {sigma} mm.").format(
+                               sigma=f"{request.sigma_mm:.2f}"),
                            None if wiz is None else wiz.recorded_poses)
 
     def _auto_where(self) -> tuple[object, ...]:
@@ -269,17 +302,20 @@ class WizardStepsView:
         self.folder.visible = wf.is_open
         if wiz is None or not wf.is_open:
             return
-        where = where_to_jog_markdown(wiz)
-        set_content(self.head_md, step_markdown(wiz) + (f"\n\n{where}" if where else "")
+        tr = self.parent.session.translator
+        _ = tr.gettext
+        where = where_to_jog_markdown(wiz, tr=tr)
+        set_content(self.head_md, step_markdown(wiz, tr=tr) + (f"\n\n{where}" if where else "")
                     + (f"\n\n{self._busy_text}" if self._checking else ""))
         set_value(self.progress, round(100.0 * wiz.progress, 1))
-        set_content(self.steps_md, steps_list_markdown(wiz))
+        set_content(self.steps_md, steps_list_markdown(wiz, tr=tr))
         self._render_variant(wiz)
         needed = wf.required_tool()
         reason = wiz.blocked_reason if not wiz.is_complete and not wiz.auto_role(wiz.step).by_controller else None
         failure = wf.finish_failure
         if failure is not None:                  # Finish could not compute: why, and what to do
-            reason = f"Finish not possible: {failure}" if reason is None else f"{reason}\n\n{failure}"
+            reason = (_("Finish not possible: {why}").format(why=failure) if reason is None
+                      else f"{reason}\n\n{failure}")
         short = self.parent.session.wizard_commands.finish_refusal()   # the exercise asks for more touches
         if short is not None:
             reason = short if reason is None else f"{reason}\n\n{short}"
@@ -288,21 +324,25 @@ class WizardStepsView:
             set_content(self.blocked_md, f"⚠ {escape_markdown(reason)}")
         self.mount.visible = needed is not None
         if needed is not None:
-            self.mount.label = f"Mount the {needed.label.lower()}"
+            self.mount.label = _("Mount the {tool}").format(tool=needed.label.lower())
         stepping = not wiz.is_complete           # on the result only Back, Add point and Close remain
         by_controller = stepping and wiz.auto_role(wiz.step).by_controller   # no Record, no Auto-touch
         self.record.visible = stepping and not by_controller
         self.next.visible = stepping
         self.record.disabled = not wiz.can_record
         self.next.disabled = not wiz.can_next or self._checking
-        self.next.label = "Finish" if wiz.on_last_step else "Next"
+        next_label = _("Finish") if wiz.on_last_step else _("Next")
+        if self.next.label != next_label:
+            self.next.label = next_label
         self.back.disabled = not wiz.can_back
-        self.cancel.label = "Cancel" if stepping else ("Close" if wf.result_saved else "Close (not saved)")
+        cancel_label = _("Cancel") if stepping else (_("Close") if wf.result_saved else _("Close (not saved)"))
+        if self.cancel.label != cancel_label:
+            self.cancel.label = cancel_label
         self.add_point.visible = wiz.supports_add_point
         self.export.render(wiz)
         self.add_point.disabled = not wiz.can_add_point
         self.auto_folder.visible = wf.auto_touch_allowed and stepping and not by_controller
-        chosen = self.auto_direction.value == CHOSEN
+        chosen = self._direction() == CHOSEN
         self.auto_tilt.visible = self.auto_azimuth.visible = chosen
         self._render_auto_line()
         self.update_meter()
@@ -312,8 +352,9 @@ class WizardStepsView:
         if not variants:
             self.variant.visible = False
             return
-        labels = tuple(label for _, label in variants)
-        label = next(lab for v, lab in variants if v == wiz.variant)
+        tr = self.parent.gettext
+        labels = tuple(tr(label) for _v, label in variants)
+        label = next(tr(lab) for v, lab in variants if v == wiz.variant)
         if tuple(self.variant.options) != labels:    # our own assignments: the on_update
             self.variant.options = labels            # they fire has no client and is ignored
         if self.variant.value != label:
@@ -342,4 +383,5 @@ class WizardStepsView:
         s = self.parent.session
         tilt = self.advisor.advise(wiz.other_rotations(), T_world_flange[:3, :3], s.jogger, meter.sigma_mm)
         set_content(self.meter_md, meter_markdown(gain, None, meter.sigma_mm, advice,
-                                                  None if tilt is None else tilt.text, measured=meter.source))
+                                                  None if tilt is None else tilt.text, measured=meter.source,
+                                                  tr=s.translator))
