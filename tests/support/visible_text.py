@@ -28,7 +28,7 @@ TEXTS_JS = """() => {
     let block = parent;
     while (block.parentElement && block !== document.body && inline(block)) block = block.parentElement;
     const text = parent.closest('code, pre') ? ' ' : t.textContent;
-    blocks.set(block, (blocks.get(block) || '') + text);
+    blocks.set(block, (blocks.get(block) || '') + ' ' + text);   // a space: <br> and inline boxes part words
   }
   for (const text of blocks.values()) if (text.trim()) out.push(text.replace(/\\s+/g, ' ').trim());
   for (const e of document.querySelectorAll('[placeholder], [title]')) {
