@@ -7,7 +7,8 @@ For each language a pendant starts with that class default (``AppConfig.language
 touch auto-touched on the server (as the Calibrate tab's Start and Auto-touch do), so the Jog
 tab shows the wizard's step in its dock, the jog keys, and the 3D labels (WORLD, FLANGE, TOOL,
 reference tip, beam sensor) in the scene. One PNG per language and size:
-``<out-dir>/pendant_<language>_<width>x<height>.png``.
+``<out-dir>/pendant_<language>_<width>x<height>.png``; and ``pendant_<language>_languages.png``
+with the language selector opened (every language's name in its own script).
 
     .venv/bin/python scripts/language_screens.py [--out-dir build/language-screens] [--small] [de ru ...]
 """
@@ -65,10 +66,26 @@ def shoot(browser: Any, language: str, sizes: tuple[tuple[int, int], ...], out_d
                 out = out_dir / f"pendant_{language}_{width}x{height}.png"
                 page.screenshot(path=str(out))
                 written.append(out)
+            written.append(shoot_language_list(page, language, out_dir))
             page.close()
         finally:
             app.stop()
     return written
+
+
+def shoot_language_list(page: Any, language: str, out_dir: Path) -> Path:
+    """``pendant_<language>_languages.png``: the View folder's language selector opened, every
+    language named in its own script (Cyrillic, Devanagari, Chinese, Japanese) in the panel."""
+    row = page.locator(".mantine-Flex-root").filter(has=page.locator("label", has_text="Language")).last
+    box = row.locator("input").first
+    box.scroll_into_view_if_needed()
+    box.click()
+    page.get_by_role("option").first.wait_for()
+    page.wait_for_timeout(500)
+    out = out_dir / f"pendant_{language}_languages.png"
+    page.screenshot(path=str(out))
+    page.keyboard.press("Escape")
+    return out
 
 
 def main() -> None:
