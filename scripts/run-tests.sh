@@ -115,11 +115,12 @@ fi
 # (Devanagari, 0.2 MB), fonts-noto-cjk (Chinese and Japanese, 90 MB installed; fontconfig picks
 # its Japanese or Chinese shapes by the page's language). Where they cannot be installed, a loud
 # line says so and the font test fails; under CI=true the run fails here.
+# FC_LIST (fontconfig's fc-list, default the one on PATH) points the check at another copy.
 font_langs=(ru hi zh-cn ja)
 fonts_missing() {                  # the languages (fontconfig :lang=) no installed font covers
-  local lang out=()
-  command -v fc-list >/dev/null 2>&1 || { echo "${font_langs[*]}"; return; }
-  for lang in "${font_langs[@]}"; do [ -n "$(fc-list ":lang=$lang" family)" ] || out+=("$lang"); done
+  local lang out=() fc="${FC_LIST:-fc-list}"
+  command -v "$fc" >/dev/null 2>&1 || { echo "${font_langs[*]}"; return; }
+  for lang in "${font_langs[@]}"; do [ -n "$("$fc" ":lang=$lang" family 2>/dev/null)" ] || out+=("$lang"); done
   echo "${out[*]}"
 }
 if [ -n "$(fonts_missing)" ]; then
