@@ -6,10 +6,13 @@ trainee page and one trainer page; at each state the test waits for the page to 
 everything the server sent (``support.page_barrier``), then collects what a person reads
 (``support.visible_text``): the visible text of the DOM, placeholders and titles, the 3D labels
 (canvas-drawn: read from the session's label handles), the notifications sent, and the hints of
-the GUI's controls. Each text is listed once, under the first state that showed it. The states: the name prompt; each tab (Jog, Tool, Calibrate); every wizard of
-the Calibrate menu, started as the menu starts it, each of its steps (Auto-touch, a tool change
-where the method needs one, Finish where the controller runs the step) and its result; presenter
-mode with a wizard running; the trainer's dashboard with the trainee's calibration replayed in 3D.
+the GUI's controls. Each text is listed once, under the first state that showed it.
+
+The states: the name prompt; each tab (Jog, Tool, Calibrate); every wizard of the Calibrate menu,
+started as the menu starts it, each of its steps (Auto-touch, a tool change where the method
+needs one, Finish where the controller runs the step) and its result; presenter mode with a
+wizard running, and its math board ("The math" over the whole screen); the trainer's dashboard
+with the trainee's calibration replayed in 3D.
 The server-side commands (``session.wizard_commands``) reach the states quickly; the page then
 shows them, and its texts are what is checked.
 
@@ -175,8 +178,12 @@ def test_every_text_of_the_app_is_from_the_catalogs(app_factory, new_page: Calla
     choose(s.views["presenter"].toggle, True, s.client)
     s.wizard_commands.start("xyz4")
     walk.look("presenter mode: XYZ 4-point step 1", page, s, barrier)
+    for _ in range(2):
+        s.wizard_commands.auto_touch(AutoTouchRequest())      # touches for the board and the dashboard
+    choose(s.views["presenter"].board.toggle, True, s.client)
+    walk.look("presenter mode: the math board, XYZ 4-point step 3", page, s, barrier)
+    choose(s.views["presenter"].board.toggle, False, s.client)
     choose(s.views["presenter"].toggle, False, s.client)
-    s.wizard_commands.auto_touch(AutoTouchRequest())          # a touch the dashboard can show
 
     # the trainer's dashboard, the trainee's calibration replayed in 3D
     trainer_page = new_page(app.trainer_url, wait_for="")
