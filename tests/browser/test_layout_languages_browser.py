@@ -20,7 +20,7 @@ from typing import Any
 import pytest
 import viser
 
-from support.page_barrier import Barrier
+from support.page_barrier import NEXT_FRAMES_JS, Barrier, show_tab
 from support.pendant_page import wait_until
 
 pytestmark = pytest.mark.browser
@@ -103,15 +103,12 @@ def split_rows(page: Any, session: Any) -> list[str]:
 def measure_tabs(page: Any, where: str) -> list[str]:
     """Cut labels and split rows on each tab in turn (``where``: the state, for the messages)."""
     problems = []
-    tabs = page.get_by_role("tab")
-    for i in range(tabs.count()):
-        tab = tabs.nth(i)
-        tab.click()
-        page.wait_for_timeout(200)                     # the tab's panel is laid out
+    for i in range(page.locator("[role=tab]").filter(visible=True).count()):
+        show_tab(page, i)
         out = page.evaluate(CUT_JS)
         assert out["checked"] >= 5, f"{where}, tab {i + 1}: only {out['checked']} buttons and labels found"
         problems += [f"{where}, tab {i + 1}: {c}" for c in out["cut"]]
-    tabs.first.click()
+    show_tab(page, 0)
     return problems
 
 
@@ -130,7 +127,8 @@ def test_long_languages_cut_no_label_and_wrap_no_jog_row(app_factory, new_page: 
             barrier.sync(page)
             for width, height in SIZES:
                 page.set_viewport_size({"width": width, "height": height})
-                page.wait_for_timeout(300)             # the panel re-laid out at the new size
+                page.wait_for_function(f"window.innerWidth === {width} && window.innerHeight === {height}")
+                page.evaluate(NEXT_FRAMES_JS)          # the panel re-laid out at the new size
                 where = f"{language} {width}x{height} {state}"
                 problems += [f"{where}: {p}" for p in split_rows(page, s)]
                 problems += measure_tabs(page, where)

@@ -34,7 +34,7 @@ import pytest
 
 from support.app_page import truth_tool
 from support.guiclick import choose, click
-from support.page_barrier import Barrier
+from support.page_barrier import Barrier, show_tab
 from support.pendant_page import wait_until
 from support.pseudo_text import untranslated_words
 from support.visible_text import TEXTS_JS, gui_hints, record_notifications, scene_labels
@@ -109,10 +109,6 @@ class Walk:
         self.check("hints (tooltips) of the GUI's controls, all states", [("hint", h) for h in sorted(self.hints)])
         return "\n".join(f"== {state}\n" + "\n".join(f"  {e}" for e in entries)
                          for state, entries in self.found.items() if entries)
-
-
-def show_tab(page: Any, index: int) -> None:
-    page.locator("[role=tab]").filter(visible=True).nth(index).click()
 
 
 WIZARD_OPTIONS: dict[str, dict[str, object]] = {

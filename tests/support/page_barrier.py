@@ -14,9 +14,21 @@ from __future__ import annotations
 import itertools
 from typing import Any
 
-__all__ = ["Barrier"]
+__all__ = ["NEXT_FRAMES_JS", "Barrier", "show_tab"]
 
 TIMEOUT_MS = 60_000
+NEXT_FRAMES_JS = "() => new Promise((done) => requestAnimationFrame(() => requestAnimationFrame(done)))"
+"""Resolves after the browser has drawn two more frames (React's updates and the layout done)."""
+
+
+def show_tab(page: Any, index: int) -> None:
+    """Click the page's ``index``-th visible tab and wait until it is selected and drawn (a
+    tab's panel is the browser's own business: no server message to wait for)."""
+    tab = page.locator("[role=tab]").filter(visible=True).nth(index)
+    tab.click()
+    page.wait_for_function("e => e.getAttribute('aria-selected') === 'true'", arg=tab.element_handle(),
+                           timeout=TIMEOUT_MS)
+    page.evaluate(NEXT_FRAMES_JS)
 
 
 class Barrier:
