@@ -6,7 +6,7 @@ trainee page and one trainer page; at each state the test waits for the page to 
 everything the server sent (``support.page_barrier``), then collects what a person reads
 (``support.visible_text``): the visible text of the DOM, placeholders and titles, the 3D labels
 (canvas-drawn: read from the session's label handles), the notifications sent, and the hints of
-the GUI's controls. Each text is listed once, under the first state that showed it.
+the GUI's controls and the options of its dropdowns. Each text is listed once, under the first state that showed it.
 
 The states: the name prompt; each tab (Jog, Tool, Calibrate); every wizard of the Calibrate menu,
 started as the menu starts it, each of its steps (Auto-touch, a tool change where the method
@@ -79,7 +79,7 @@ class Walk:
     def __init__(self) -> None:
         self.found: dict[str, list[str]] = {}
         self.notes: dict[int, list[str]] = {}
-        self.hints: set[str] = set()
+        self.hints: set[tuple[str, str]] = set()
         self.seen: set[str] = set()
 
     def check(self, state: str, texts: list[tuple[str, str]]) -> None:
@@ -106,7 +106,7 @@ class Walk:
         self.check(state, texts)
 
     def report(self) -> str:
-        self.check("hints (tooltips) of the GUI's controls, all states", [("hint", h) for h in sorted(self.hints)])
+        self.check("hints (tooltips) and dropdown options of the GUI's controls, all states", sorted(self.hints))
         return "\n".join(f"== {state}\n" + "\n".join(f"  {e}" for e in entries)
                          for state, entries in self.found.items() if entries)
 

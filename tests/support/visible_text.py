@@ -2,7 +2,7 @@
 (one entry per block element, code and pre left out as ``support.pseudo_text.untranslated_words``
 leaves out backticks), the placeholders and titles of visible elements, the 3D labels of a
 session's scene (drawn on a canvas: read from the server's label handles), the hints of its GUI
-controls (shown on hover) and the notifications it was sent.
+controls (shown on hover), the options of its dropdowns, and the notifications it was sent.
 """
 
 from __future__ import annotations
@@ -48,12 +48,18 @@ def scene_labels(session: Any) -> list[str]:
     return [h.text for h in handles if isinstance(h, viser.LabelHandle) and h.visible and h.text]
 
 
-def gui_hints(session: Any) -> Iterator[str]:
-    """The hints (tooltips) of ``session``'s visible GUI controls."""
+def gui_hints(session: Any) -> Iterator[tuple[str, str]]:
+    """("hint", text) for the hints (tooltips, shown on hover) and ("option", text) for the
+    options of the dropdowns and button groups (a dropdown's list opens on a click) of
+    ``session``'s visible GUI controls."""
     for handle in list(session.target.gui._gui_input_handle_from_uuid.values()):
+        if not getattr(handle, "visible", True):
+            continue
         hint = getattr(handle, "hint", None)
-        if getattr(handle, "visible", True) and isinstance(hint, str) and hint:
-            yield hint
+        if isinstance(hint, str) and hint:
+            yield "hint", hint
+        if isinstance(handle, viser.GuiDropdownHandle):
+            yield from (("option", str(o)) for o in handle.options)
 
 
 def record_notifications(session: Any, into: list[str]) -> None:
