@@ -12,7 +12,7 @@ The states: the name prompt; each tab (Jog, Tool, Calibrate); every wizard of th
 started as the menu starts it, each of its steps (Auto-touch, a tool change where the method
 needs one, Finish where the controller runs the step) and its result; presenter mode with a
 wizard running, and its math board ("The math" over the whole screen); the trainer's dashboard
-with the trainee's calibration replayed in 3D.
+with the trainee's calibration replayed in 3D, and a message it sends on the trainee's screen.
 The server-side commands (``session.wizard_commands``) reach the states quickly; the page then
 shows them, and its texts are what is checked.
 
@@ -195,6 +195,15 @@ def test_every_text_of_the_app_is_from_the_catalogs(app_factory, new_page: Calla
     walk.look("trainer dashboard: trainee chosen", trainer_page, trainer, trainer_barrier)
     click(dash.replay_button, trainer.client)
     walk.look("trainer dashboard: replay in 3D", trainer_page, trainer, trainer_barrier)
+
+    # a message from the trainer to the class, on the trainee's screen (its text is the trainer's:
+    # written in the pseudo-locale's brackets, so only the app's words around it count)
+    messages = next(x for x in dash.class_extras if hasattr(x, "send") and hasattr(x, "text"))
+    choose(messages.text, "⟦message 1⟧", trainer.client)
+    click(messages.send, trainer.client)
+    walk.look("trainer dashboard: message sent", trainer_page, trainer, trainer_barrier)
+    page.get_by_text("⟦message 1⟧").first.wait_for(timeout=60_000)    # delivered to the trainee's screen
+    walk.look("trainee: the trainer's message", page, s, barrier)
 
     report = walk.report()
     (tmp_path / "leftovers.txt").write_text(report + "\n", encoding="utf-8")
