@@ -59,7 +59,7 @@ MATH_SYMBOL = re.compile(r"[A-Za-z]|[A-Za-z]\d+|sin|cos|tan|R[xyz]")
 number (touch ``P1``, joint ``A6``), a function, KUKA's rotations ``Rz(A) Ry(B) Rx(C)``."""
 NAMES = {
     *"X Y Z A B C".split(), *(f"A{i}" for i in range(1, 7)), *(f"J{i}" for i in range(1, 7)),
-    "WORLD", "BASE", "TOOL", "FLANGE", "TCP", "mm", "deg", "rad", "s", "ms",
+    "WORLD", "BASE", "TOOL", "FLANGE", "TCP", "UTC", "mm", "deg", "rad", "s", "ms",
     "Shift", "Ctrl", "Esc", "Enter", "Space",                 # key names
     *(w for name in LANGUAGE_NAMES.values() for w in re.findall(r"[A-Za-z]+", name)),
     "KUKA", "KR", "R900", "sixx", "Yaskawa", "GP12", "ABB", "FANUC", "UR",   # robots and vendors
