@@ -9,6 +9,8 @@
 # when it is missing it is installed with apt-get as root (or through sudo). A user who can do
 # neither gets a one-line hint, every other test runs, and a last loud line says that the
 # browser tests did not run. Under CI=true a missing chromium fails the run (exit 1).
+# Debian's fonts for Cyrillic, Devanagari, Chinese and Japanese are installed the same way (the
+# pendant's languages; a missing one fails the font test, and under CI=true the run).
 # Debian's postgresql and nginx (the PostgreSQL gradebook and front-end tests) are installed
 # the same way; their tests are skipped where they are missing, and fail under CI=true.
 # Without arguments (the README's command, CI) pytest runs twice: the tests not marked serial on
@@ -106,6 +108,36 @@ elif ! command -v chromium >/dev/null 2>&1; then
     chromium_missing="chromium is missing and 'apt-get install chromium' failed (exit $rc): install it by hand, or set CHROMIUM=/path/to/chromium"
   fi
 fi
+# The fonts of the pendant's scripts: viser draws the panel and the 3D labels (a canvas) with the
+# system font stack, so Cyrillic, Devanagari and Chinese/Japanese show only where the machine
+# has fonts for them (else boxes: tofu; tests/browser/test_fonts_browser.py fails). Debian's
+# packages, installed like chromium: fonts-dejavu-core (Latin, Cyrillic), fonts-lohit-deva
+# (Devanagari, 0.2 MB), fonts-noto-cjk (Chinese and Japanese, 90 MB installed; fontconfig picks
+# its Japanese or Chinese shapes by the page's language). Where they cannot be installed, a loud
+# line says so and the font test fails; under CI=true the run fails here.
+# FC_LIST (fontconfig's fc-list, default the one on PATH) points the check at another copy.
+font_langs=(ru hi zh-cn ja)
+fonts_missing() {                  # the languages (fontconfig :lang=) no installed font covers
+  local lang out=() fc="${FC_LIST:-fc-list}"
+  command -v "$fc" >/dev/null 2>&1 || { echo "${font_langs[*]}"; return; }
+  for lang in "${font_langs[@]}"; do [ -n "$("$fc" ":lang=$lang" family 2>/dev/null)" ] || out+=("$lang"); done
+  echo "${out[*]}"
+}
+if [ -n "$(fonts_missing)" ]; then
+  rc=0
+  apt_install fontconfig fonts-dejavu-core fonts-lohit-deva fonts-noto-cjk || rc=$?
+  missing_fonts="$(fonts_missing)"
+  if [ -n "$missing_fonts" ]; then
+    echo "!!!!!!!! run-tests.sh: no font for $missing_fonts (apt-get exit $rc$([ "$rc" = 2 ] && echo ': neither root nor sudo')):" \
+         "the pendant shows boxes for those scripts and the font test fails;" \
+         "install them by hand: apt-get install fonts-dejavu-core fonts-lohit-deva fonts-noto-cjk !!!!!!!!" >&2
+    if [ "${CI:-}" = true ]; then
+      echo "run-tests.sh: CI=true: failing the run because the fonts are missing; no test ran." >&2
+      exit 1
+    fi
+  fi
+fi
+
 # run_suite MARKER [ARGS...]: the whole suite (of MARKER, e.g. "not browser"; empty: all) in two
 # runs, each with ARGS: the tests not marked serial on 2 xdist workers, then the serial ones in one
 # process (header comment).

@@ -10,7 +10,8 @@ The fake ``.venv/bin/python`` logs every call to ``calls.log`` and answers ``-m 
 ``PATH`` holds only the tools the scripts need
 (bash, coreutils), a fake ``id`` printing ``$FAKE_UID``, and whatever a test adds (``sudo``,
 ``apt-get``, ``chromium``): without them the machine has no root, no sudo and no chromium.
-``PG_BIN`` and ``NGINX`` point at a fake PostgreSQL and nginx (present unless a test removes them).
+``PG_BIN`` and ``NGINX`` point at a fake PostgreSQL and nginx, ``FC_LIST`` at a fake fontconfig
+``fc-list`` that finds a font for every language (present unless a test removes them).
 """
 
 from __future__ import annotations
@@ -69,6 +70,7 @@ echo "${{FAKE_LINT_OUT:-Contracts: 3 kept, 0 broken.}}"; exit "${{FAKE_LINT_RC:-
     (tmp_path / "pg").mkdir()
     _write_exe(tmp_path / "pg" / "pg_ctl", "#!/bin/sh\n")
     _write_exe(tmp_path / "nginx", "#!/bin/sh\n")
+    _write_exe(tmp_path / "fc-list", "#!/bin/sh\necho 'Noto Sans CJK JP'\n")     # a font for every :lang=
     return r
 
 
@@ -78,7 +80,7 @@ def sha(repo: Path) -> str:
 
 def run(repo: Path, script: str, *args: str, **env: str) -> subprocess.CompletedProcess[str]:
     base = {"PATH": str(repo.parent / "bin"), "HOME": str(repo.parent), "PG_BIN": str(repo.parent / "pg"),
-            "NGINX": str(repo.parent / "nginx")}
+            "NGINX": str(repo.parent / "nginx"), "FC_LIST": str(repo.parent / "fc-list")}
     return subprocess.run(["bash", str(repo / "scripts" / script), *args], env={**base, **env},
                           capture_output=True, text=True, timeout=60)
 
@@ -458,3 +460,34 @@ def test_the_mypy_configuration_is_strict_on_tcpcal_and_typed_on_the_app(tmp_pat
     assert errors[1].startswith("app/tcp_pendant/__init__.py:17: error: Incompatible return value type")
     assert errors[2].startswith("app/tcp_pendant/__init__.py:8: error: Function is missing a type annotation")
     assert errors[3].startswith("src/tcpcal/__init__.py:5: error: Returning Any from function declared to return")
+
+
+def test_run_tests_as_root_installs_the_fonts_of_the_languages_with_apt(stamped: Path) -> None:
+    """Without fonts for Cyrillic, Devanagari and CJK (fc-list finds none), apt-get installs
+    Debian's font packages, as it does chromium."""
+    fc_list = stamped.parent / "fc-list"
+    _write_exe(fc_list, "#!/bin/sh\n")                                   # no font for any language
+    (stamped.parent / "bin" / "chromium").symlink_to(shutil.which("true") or "/bin/true")
+    _write_exe(stamped.parent / "bin" / "apt-get", f"""#!/bin/sh
+echo "apt-get $*" >> {stamped / 'calls.log'}
+[ "$1" = install ] && printf '#!/bin/sh\\necho Lohit\\n' > {fc_list}
+exit 0
+""")
+    p = run(stamped, "run-tests.sh", "-q", FAKE_UID="0", CI="true")
+    assert p.returncode == 0, p.stderr
+    assert "apt-get install -y -q fontconfig fonts-dejavu-core fonts-lohit-deva fonts-noto-cjk" in calls(stamped)
+    assert pytest_calls(stamped) == ["python [-m] [pytest] [-q]"]
+    assert p.stderr == ""
+
+
+def test_run_tests_without_the_fonts_says_so_and_fails_under_ci(stamped: Path) -> None:
+    (stamped.parent / "fc-list").unlink()                                 # no fontconfig, no root, no sudo
+    (stamped.parent / "bin" / "chromium").symlink_to(shutil.which("true") or "/bin/true")
+    p = run(stamped, "run-tests.sh", "-q")
+    assert p.returncode == 0                                             # the tests run; the font test fails them
+    assert pytest_calls(stamped) == ["python [-m] [pytest] [-q]"]
+    (line,) = p.stderr.strip().splitlines()
+    assert line.startswith("!!!") and "no font for ru hi zh-cn ja" in line and "fonts-noto-cjk" in line
+    p = run(stamped, "run-tests.sh", "-q", CI="true")
+    assert p.returncode == 1 and "CI=true" in p.stderr and "fonts are missing" in p.stderr
+    assert pytest_calls(stamped) == ["python [-m] [pytest] [-q]"]         # no second pytest run
