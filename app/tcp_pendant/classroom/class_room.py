@@ -100,6 +100,7 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from tcp_pendant.classroom.class_board import ClassBoard
+from tcp_pendant.classroom.class_language import kept_language
 from tcp_pendant.classroom.class_views import ClassViews, WelcomeWindow
 from tcp_pendant.classroom.dashboards import RENDER_INTERVAL_S, TICK_S, Dashboards
 from tcp_pendant.classroom.exercise_rules import DistanceAids
@@ -122,6 +123,7 @@ from tcp_pendant.classroom.trainer_pushes import TrainerPushes
 from tcp_pendant.calibrate.pendant_rules import UNRESTRICTED, ExerciseRules, LibraryRights
 from tcp_pendant.controller import ToolModel
 from tcp_pendant.session import Session, SessionChange
+from tcp_pendant.translation import ENGLISH, Translator
 
 __all__ = ["EXERCISE_IDS", "RENDER_INTERVAL_S", "TICK_S", "ClassRoom", "clean_methods"]
 
@@ -201,7 +203,7 @@ class ClassRoom:
         self.holder = self.heartbeat.holder
         """This server process's id in the gradebook's presence table (host, pid, a nonce)."""
         self.pushes = TrainerPushes(gradebook, self.setup, self.roster, self.heartbeat, tools=self.tools,
-                                    seed=self._seed, hand_to_loop=hand_to_loop)
+                                    seed=self._seed, hand_to_loop=hand_to_loop, is_trainer=self.dashboards.shows)
 
     # ------------------------------------------------------------ what the trainer set
     @property
@@ -514,6 +516,32 @@ class ClassRoom:
         ``keep``: keep the push in the gradebook for a restart and for the other server
         processes of the class (False: a push one of them made, applied here)."""
         return self.pushes.settings(exercise, tool_key, hide_distance, auto_touch, keep=keep)
+
+    @property
+    def class_language(self) -> str | None:
+        """The language the trainer pushed to the class (None: none; ``classroom.class_language``)."""
+        return kept_language(self.gradebook.settings)
+
+    def push_language(self, language: str, *, keep: bool = True) -> int:
+        """Set ``language`` (a code of ``translation.languages``) on every trainee's pendant, each
+        told in it; browsers that connect later start in it (kept in the gradebook, ``keep`` as
+        for :meth:`push_settings`). A trainee may switch back. Returns how many named trainees of
+        this process.
+
+        Raises:
+            ValueError: an unknown code.
+        """
+        return self.pushes.language(language, keep=keep)
+
+    def push_language_to(self, name: str, language: str, *, forward: bool = True, tr: Translator = ENGLISH) -> str:
+        """Set ``language`` on the one trainee ``name``'s pendant (until their browser reconnects),
+        told in it; returns what happened, in words for the trainer (``forward`` as for
+        :meth:`reset_wizard`; ``tr``: the trainer's language).
+
+        Raises:
+            ValueError: an unknown code.
+        """
+        return self.pushes.language_to(name, language, forward=forward, tr=tr)
 
     def push_brief(self, instructions: str, allowed_methods: Sequence[str] | str | None,
                    min_touches: int, *, keep: bool = True) -> int:

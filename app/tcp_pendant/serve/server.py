@@ -431,9 +431,13 @@ class PendantApp:
         return session
 
     def start_language(self, client: viser.ClientHandle | None) -> str:
-        """The language a session starts in: ``--language`` when it names one; with ``auto`` (the
+        """The language a session starts in: the language the trainer pushed to the class
+        (``ClassRoom.class_language``), else ``--language`` when it names one; with ``auto`` (the
         default) the best of the browser's ``Accept-Language`` the pendant offers
         (``translation.negotiate``), else English (the ``--shared`` session: English)."""
+        pushed = None if self.classroom is None or client is None else self.classroom.class_language
+        if pushed is not None:
+            return pushed
         if self.config.language != "auto":
             return self.config.language
         return negotiate(None if client is None else viser_adapter.accept_language(client))
