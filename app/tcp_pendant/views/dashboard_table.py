@@ -71,7 +71,8 @@ def trainees_html(rows: Sequence[DashboardRow], *, tr: Translator = ENGLISH) -> 
     every text escaped."""
     _ = tr.gettext
     if not rows:
-        return f'<div style="font-size:{FONT_PX}px"><i>{escape_html(_("No trainee has given a name yet."))}</i></div>'
+        empty = escape_html(_("No trainee has given a name yet."))
+        return f'<div style="font-size:{FONT_PX}px"><i>{empty}</i></div>'
     body = []
     for r in rows:
         style = (f"background:{STUCK_BACKGROUND};font-weight:600" if r.stuck else
@@ -102,7 +103,8 @@ def in_progress_html(runs: Sequence[OpenRun], *, tr: Translator = ENGLISH) -> st
     """The calibrations in progress (oldest first) in ``tr``'s language; every text escaped."""
     _ = tr.gettext
     if not runs:
-        return f'<div style="font-size:{FONT_PX}px"><i>{escape_html(_("No calibration in progress."))}</i></div>'
+        empty = escape_html(_("No calibration in progress."))
+        return f'<div style="font-size:{FONT_PX}px"><i>{empty}</i></div>'
     body = []
     for r in runs:
         cells = (str(r.calibration_id), _cut(r.trainee, 11), _ON if r.connected else _OFF,
