@@ -21,6 +21,7 @@ from tcp_pendant.classroom.class_language import LANGUAGE_PUSHED_BODY, LANGUAGE_
 from tcp_pendant.session import Session
 from tcp_pendant.translation import LANGUAGE_NAMES, PSEUDO_LANGUAGE, translator
 from tcp_pendant.views.dashboard import TrainerDashboard
+from tcp_pendant.wizards import wizard_classes
 
 TOKEN = "trainer-token-of-16"
 
@@ -71,9 +72,9 @@ def test_a_pushed_language_reaches_the_class_or_one_trainee_and_the_selector_onl
         t_client = clients[2]
 
         # the dashboard's own selector, as the browser sends it: the dashboard in German, nobody else
-        wait_until(lambda: "Language" in [label for _, label, _ in t_client.inputs.values()], what="the selector")
-        t_client.send({"type": "GuiUpdateMessage", "uuid": t_client.uuid_of("Language"),
-                       "updates": {"value": "Deutsch"}})
+        selector = dash.language.dropdown._impl.uuid                   # not the welcome window's pendant's
+        wait_until(lambda: selector in t_client.inputs, what="the dashboard's selector")
+        t_client.send({"type": "GuiUpdateMessage", "uuid": selector, "updates": {"value": "Deutsch"}})
         wait_until(lambda: trainer.language == "de", what="the dashboard in German")
         with trainer.lock:                                # the change signal ran to its end
             assert dash.language.dropdown.label == "Sprache (Language)"
@@ -105,10 +106,7 @@ def test_a_pushed_language_reaches_the_class_or_one_trainee_and_the_selector_onl
         assert app.gradebook.settings.get(LANGUAGE_SETTING) == "ru"
 
         # Anna switches back with her own selector: only hers
-        anna_selector = anna.views["pendant"].language.dropdown
-        wait_until(lambda: any(props.get("label") == anna_selector.label for _, _, props in clients[0].inputs.values()),
-                   what="Anna's selector in Russian")
-        clients[0].send({"type": "GuiUpdateMessage", "uuid": clients[0].uuid_of(anna_selector.label),
+        clients[0].send({"type": "GuiUpdateMessage", "uuid": anna.views["pendant"].language.dropdown._impl.uuid,
                          "updates": {"value": "English"}})
         wait_until(lambda: anna.language == "en", what="Anna back in English")
         assert ben.language == "ru"
@@ -153,13 +151,19 @@ def _dashboard_handles(dash: TrainerDashboard) -> list[tuple[str, object]]:
     handles = [(name, h) for name, h in vars(dash).items() if isinstance(h, kinds)]
     handles += [(f"folder {title}", f) for title, f in dash.folders.items()]
     handles.append(("language", dash.language.dropdown))
+    for extra in dash.class_extras:                       # the brief's and the message box's controls
+        for name, value in vars(extra).items():
+            for item in value.values() if isinstance(value, dict) else (value,):
+                if isinstance(item, kinds | viser.GuiTextHandle | viser.GuiCheckboxHandle):
+                    handles.append((f"{type(extra).__name__}.{name}", item))
+        handles += [(f"{type(extra).__name__} words", h) for h, _ in extra.words._texts]   # its folder, its line
     return handles
 
 
 def test_with_the_pseudo_locale_every_text_of_the_dashboard_is_from_the_catalogs(app_factory: Any,
                                                                                  tmp_path: Path) -> None:
     """Labels, hints, options, markdown and tables of every handle the dashboard builds (its
-    own folders; the brief, the message box and the tool library are their owners' views, and
+    own folders, the brief's and the message box's; the tool library is its owner's view, and
     so are the replay's touch choices, ``views.replay_touches``),
     with two trainees in the table, after a push to all, a push to one and a push of a
     language; names only outside ``⟦ ⟧``: trainee and tool names, language names, units and
@@ -174,7 +178,10 @@ def test_with_the_pseudo_locale_every_text_of_the_dashboard_is_from_the_catalogs
         trainer = _connect(app, clients)
         dash = _dashboard(trainer)
         assert trainer.language == PSEUDO_LANGUAGE
-        names = ({"Anna", "Ben", "Language", "mm", "TCP", "CSV", "JSON"}
+        qps = translator(PSEUDO_LANGUAGE)
+        unmarked_titles = {w for c in wizard_classes() if qps.gettext(c.title) == c.title   # marked by the wizards'
+                           for w in WORD.findall(c.title)}                                   # owner (N_), not here
+        names = ({"Anna", "Ben", "Language", "mm", "TCP", "CSV", "JSON", "XYZ", "Z", "X"} | unmarked_titles
                  | {w for n in LANGUAGE_NAMES.values() for w in WORD.findall(n)}
                  | {w for key in dash.control.tool_keys for w in WORD.findall(key)})
 

@@ -89,3 +89,9 @@ class DashboardWords:
             self._show(handle, messages)
         for entry, english in chosen:
             self._show_choices(entry, english)
+
+    def follow(self) -> None:
+        """:meth:`relabel` when the session's language is not the one shown (a view re-rendered
+        with the dashboard calls it at each render)."""
+        if self._shown_in is not self.session.translator:
+            self.relabel()
