@@ -17,6 +17,7 @@ from support.guiclick import choose, click
 from support.pseudo_text import WORD, gui_texts, untranslated_words
 from support.wsclient import InputsClient, wait_until
 
+from tcp_pendant.classroom.push_words import PUSH_TITLE, push_words
 from tcp_pendant.classroom.class_language import LANGUAGE_PUSHED_BODY, LANGUAGE_PUSHED_TITLE, LANGUAGE_SETTING
 from tcp_pendant.session import Session
 from tcp_pendant.translation import LANGUAGE_NAMES, PSEUDO_LANGUAGE, translator
@@ -202,10 +203,25 @@ def test_with_the_pseudo_locale_every_text_of_the_dashboard_is_from_the_catalogs
         click(dash.push_one, trainer.client)                           # nobody chosen: "choose a trainee"
         check("nobody chosen")
         choose(dash.trainee, "Anna", trainer.client)
+        click(dash.reset, trainer.client)                              # no wizard running
+        check("reset")
+        click(dash.push_one, trainer.client)
+        check("pushed to one")
         click(dash.push_language_one, trainer.client)
         check("language pushed to one")
         click(dash.push_language, trainer.client)
         check("language pushed to all")
+        choose(dash.trainee, "Ben", trainer.client)
+        click(dash.release, trainer.client)
+        check("released")
     finally:
         for c in clients:
             c.ws.close()
+
+
+def test_what_a_push_tells_the_trainee_is_from_the_catalogs() -> None:
+    qps = translator(PSEUDO_LANGUAGE)
+    for exercise, tool, aids, auto in ((False, None, "locked", False), (None, "Torch", "shown", True),
+                                       ("mystery", None, "hidden", None), (False, None, None, None)):
+        assert untranslated_words(push_words(exercise, tool, aids, auto, tr=qps), {"Torch"}) == []
+    assert untranslated_words(qps.gettext(PUSH_TITLE), set()) == []

@@ -123,15 +123,15 @@ from tcp_pendant.classroom.trainer_pushes import TrainerPushes
 from tcp_pendant.calibrate.pendant_rules import UNRESTRICTED, ExerciseRules, LibraryRights
 from tcp_pendant.controller import ToolModel
 from tcp_pendant.session import Session, SessionChange
-from tcp_pendant.translation import ENGLISH, Translator
+from tcp_pendant.translation import ENGLISH, N_, Translator
 
 __all__ = ["EXERCISE_IDS", "RENDER_INTERVAL_S", "TICK_S", "ClassRoom", "clean_methods"]
 
 log = logging.getLogger(__name__)
 
-_RELEASED = "The trainer released the name {name}: this browser left the class. Join under your own name."
-_OTHER_TAB = ("{name} joined from another tab or window of this browser, so this one left the class. Close it, "
-              "or join here again (the other one then leaves).")
+_RELEASED = N_("The trainer released the name {name}: this browser left the class. Join under your own name.")
+_OTHER_TAB = N_("{name} joined from another tab or window of this browser, so this one left the class. Close "
+                "it, or join here again (the other one then leaves).")
 
 
 class ClassRoom:
@@ -298,7 +298,7 @@ class ClassRoom:
                                        "name or ask the trainer to release it.")
             join = self.gradebook.trainees.join(clean, key)
             if holder is not None:         # the same browser (its key): the newer tab takes the name
-                self._leave(holder, _OTHER_TAB.format(name=clean), forget=False)
+                self._leave(holder, _OTHER_TAB, forget=False)
             self._start(session, join)
         self.refresh_trainers()
         return join
@@ -350,8 +350,10 @@ class ClassRoom:
 
     def _leave(self, seat: Seat, message: str, *, forget: bool) -> None:
         """The session of ``seat`` is no longer its trainee: its gradebook session ends, its row
-        moves to those who left, and its welcome window opens again with ``message``."""
+        moves to those who left, and its welcome window opens again with ``message`` (an English
+        msgid with ``{name}``: shown in the trainee's language, with the seat's name)."""
         session = seat.session
+        message = session.translator.gettext(message).format(name=seat.name)
         if not self.roster.holds(seat):
             return
         prompt = self.roster.prompt(session)
@@ -362,10 +364,11 @@ class ClassRoom:
         if prompt is not None:         # on the loop, after this callback: no two sessions' locks at once
             self._hand_to_loop(session.loop.guard(lambda: prompt.reopen(message, forget=forget)))
 
-    def release(self, name: str) -> str:
+    def release(self, name: str, *, tr: Translator = ENGLISH) -> str:
         """The trainer releases ``name``: the gradebook forgets its browser key and a browser
         connected under it leaves the class (its welcome window opens again and its page script
-        forgets the name). Returns what happened, in words for the trainer (plain text)."""
+        forgets the name). Returns what happened, in words for the trainer (plain text, in
+        ``tr``'s language)."""
         if not isinstance(name, str):
             raise ValueError("Choose the name to release.")
         with self._join_lock:
@@ -374,12 +377,15 @@ class ClassRoom:
             holders = self.roster.all_named(name)
             for seat in holders:
                 self.roster.note_released(seat.session, name)
-                self._leave(seat, _RELEASED.format(name=name), forget=True)
+                self._leave(seat, _RELEASED, forget=True)
         self.refresh_trainers()
         if not held and not holders and not elsewhere:
-            return f"{name} was not held by any browser."
-        where = " and its browser left the class" if holders or elsewhere else ""
-        return f"Released {name}{where}: the next browser that joins as {name} gets the trainee's records."
+            return tr.gettext("{name} was not held by any browser.").format(name=name)
+        if holders or elsewhere:
+            return tr.gettext("Released {name} and its browser left the class: the next browser that joins as "
+                              "{name} gets the trainee's records.").format(name=name)
+        return tr.gettext("Released {name}: the next browser that joins as {name} gets the trainee's "
+                          "records.").format(name=name)
 
     def held_names(self) -> list[str]:
         """Names a browser holds (the trainer view's "Release a name" choices)."""
@@ -428,9 +434,9 @@ class ClassRoom:
         for seat, released in lost:
             if released:
                 self.roster.note_released(seat.session, seat.name)
-                self._leave(seat, _RELEASED.format(name=seat.name), forget=True)
+                self._leave(seat, _RELEASED, forget=True)
             else:
-                self._leave(seat, _OTHER_TAB.format(name=seat.name), forget=False)
+                self._leave(seat, _OTHER_TAB, forget=False)
         self.refresh_trainers()
 
     # ------------------------------------------------------------ trainer
@@ -472,23 +478,24 @@ class ClassRoom:
         cid = self.gradebook.records.last_calibration(name)
         return None if cid is None else calibration_replay(self.gradebook, cid)
 
-    def reset_wizard(self, name: str, *, forward: bool = True) -> str:
+    def reset_wizard(self, name: str, *, forward: bool = True, tr: Translator = ENGLISH) -> str:
         """Cancel the running wizard of the trainee ``name`` (``Session.cancel_wizard`` on their
         session only; kept, resumable; the gradebook records the cancel) and tell them. Returns
         what happened, in words for the trainer (plain text). A trainee connected on another
         server process of the class gets it there at its next beat (``forward``; False: a
         request from there, applied here only)."""
-        return self.pushes.reset(name, forward=forward)
+        return self.pushes.reset(name, forward=forward, tr=tr)
 
     def push_to(self, name: str, exercise: str | None | bool = False, tool_key: str | None = None,
-                hide_distance: str | None = None, auto_touch: bool | None = None, *, forward: bool = True) -> str:
+                hide_distance: str | None = None, auto_touch: bool | None = None, *, forward: bool = True,
+                tr: Translator = ENGLISH) -> str:
         """Push settings to the one trainee ``name``: ``exercise`` (False: keep; None: free
         practice; "mystery": their mystery tool), ``tool_key`` (None: keep; ignored with the
         mystery exercise), distance aids ``hide_distance`` ("locked" / "hidden" / "shown", None:
         keep) and Auto-touch (None: keep). Only that trainee's session is changed; until their
         next reconnect or the next push to all. Returns what happened (plain text). A trainee
         connected on another server process gets it there (``forward``, as :meth:`reset_wizard`)."""
-        return self.pushes.to_one(name, exercise, tool_key, hide_distance, auto_touch, forward=forward)
+        return self.pushes.to_one(name, exercise, tool_key, hide_distance, auto_touch, forward=forward, tr=tr)
 
     def trainee_statuses(self) -> list[TraineeStatus]:
         """Rows of the live table: this process's connected trainees in order of arrival, those

@@ -96,24 +96,27 @@ class TrainerPushes:
             seat.session.loop.guard(seat.session.set_rules)(rules)
         return len(seats)
 
-    def reset(self, name: str, *, forward: bool) -> str:
-        """``ClassRoom.reset_wizard``; returns what happened, in words for the trainer."""
+    def reset(self, name: str, *, forward: bool, tr: Translator = ENGLISH) -> str:
+        """``ClassRoom.reset_wizard``; returns what happened, in words for the trainer (in ``tr``'s
+        language)."""
+        _ = tr.gettext
         seat = self._roster.by_name(name) if isinstance(name, str) else None
         if seat is None and forward and self._heartbeat.on_another_process(name):
             self._forward({"kind": "reset", "name": name})
-            return f"Reset {name}'s running wizard (on another server process of the class)."
+            return _("Reset {name}'s running wizard (on another server process of the class).").format(name=name)
         if seat is None:
-            return f"{name} is not connected: there is no running wizard to reset."
+            return _("{name} is not connected: there is no running wizard to reset.").format(name=name)
         session = seat.session
         if not session.workflow.is_open:
-            return f"{name} has no wizard running."
+            return _("{name} has no wizard running.").format(name=name)
         # after the trainer's callback: one session's lock at a time
         self._hand_to_loop(session.loop.guard(lambda: reset_wizard(session)))
-        return f"Reset {name}'s running wizard."
+        return _("Reset {name}'s running wizard.").format(name=name)
 
     def to_one(self, name: str, exercise: str | None | bool, tool_key: str | None, hide_distance: str | None,
-               auto_touch: bool | None, *, forward: bool) -> str:
-        """``ClassRoom.push_to``; returns what happened, in words for the trainer.
+               auto_touch: bool | None, *, forward: bool, tr: Translator = ENGLISH) -> str:
+        """``ClassRoom.push_to``; returns what happened, in words for the trainer (in ``tr``'s
+        language).
 
         Raises:
             ValueError: an unknown exercise or tool.
@@ -126,9 +129,9 @@ class TrainerPushes:
         if seat is None and forward and self._heartbeat.on_another_process(name):
             self._forward({"kind": "push_to", "name": name, "exercise": exercise, "tool_key": tool_key,
                            "hide_distance": hide_distance, "auto_touch": auto_touch})
-            return f"Pushed to {name} (on another server process of the class)."
+            return tr.gettext("Pushed to {name} (on another server process of the class).").format(name=name)
         if seat is None:
-            return f"{name} is not connected: nothing pushed."
+            return tr.gettext("{name} is not connected: nothing pushed.").format(name=name)
         setup = self._setup
         ex = setup.exercise if exercise is False else cast("str | None", exercise)
         rules = class_rules(ex, cast("DistanceAids | None", hide_distance) or setup.distance_aids,
@@ -137,7 +140,7 @@ class TrainerPushes:
         self._hand_to_loop(seat.session.loop.guard(lambda: apply_push_to(
             seat.session, seat.recorder, seat.name, ex, tool_key, rules, hide_distance,
             sets_exercise=exercise is not False, seed=seed, tools=self._tools, auto_touch=auto_touch)))
-        return f"Pushed to {seat.name}."
+        return tr.gettext("Pushed to {name}.").format(name=seat.name)
 
     def language(self, language: str, *, keep: bool) -> int:
         """``ClassRoom.push_language``: ``language`` on every trainee's pendant of this process

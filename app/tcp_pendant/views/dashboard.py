@@ -49,7 +49,7 @@ from tcp_pendant.classroom.replay import CalibrationReplay
 from tcp_pendant.job_pool import JobRefused
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.text_escape import escape_markdown
-from tcp_pendant.translation import N_
+from tcp_pendant.translation import ENGLISH, N_, Translator
 from tcp_pendant.views.dashboard_language import LanguageControl, language_folder
 from tcp_pendant.views.dashboard_replay import ReplayScene
 from tcp_pendant.views.dashboard_words import DashboardWords
@@ -102,10 +102,11 @@ class DashboardControl(ClassControl, LanguageControl, Protocol):
 
     def replay(self, name: str) -> CalibrationReplay | None: ...
 
-    def reset_wizard(self, name: str) -> str: ...
+    def reset_wizard(self, name: str, *, tr: Translator = ENGLISH) -> str: ...
 
     def push_to(self, name: str, exercise: str | None | bool = False, tool_key: str | None = None,
-                hide_distance: str | None = None, auto_touch: bool | None = None) -> str: ...
+                hide_distance: str | None = None, auto_touch: bool | None = None, *,
+                tr: Translator = ENGLISH) -> str: ...
 
 
 def chart_points(rows: Sequence[DashboardRow]) -> tuple[np.ndarray, np.ndarray]:
@@ -282,7 +283,7 @@ class TrainerDashboard:
     def _reset(self, _event: ButtonEvent | None = None) -> None:
         name = self._need_trainee()
         if name is not None:
-            self._say(self.control.reset_wizard(name))
+            self._say(self.control.reset_wizard(name, tr=self.session.translator))
 
     def _push_one(self, _event: ButtonEvent | None = None) -> None:
         name = self._need_trainee()
@@ -297,12 +298,12 @@ class TrainerDashboard:
         if tool is not None and tool not in self.control.tool_keys:
             raise ValueError(f"Unknown tool {tool!r}; choose one of {', '.join(self.control.tool_keys)}.")
         self._say(self.control.push_to(name, ONE_EXERCISE[ex_label], tool, HIDE_DISTANCE[aids_label],
-                                       AUTO_TOUCH[auto_label]))
+                                       AUTO_TOUCH[auto_label], tr=self.session.translator))
 
     def _release(self, _event: ButtonEvent | None = None) -> None:
         name = self._need_trainee()
         if name is not None:
-            self._say(self.control.release(name))
+            self._say(self.control.release(name, tr=self.session.translator))
             self.render()
 
     def _replay(self, _event: ButtonEvent | None = None) -> None:
