@@ -225,3 +225,47 @@ def test_what_a_push_tells_the_trainee_is_from_the_catalogs() -> None:
                                        ("mystery", None, "hidden", None), (False, None, None, None)):
         assert untranslated_words(push_words(exercise, tool, aids, auto, tr=qps), {"Torch"}) == []
     assert untranslated_words(qps.gettext(PUSH_TITLE), set()) == []
+
+
+def test_the_welcome_window_and_the_trainers_message_follow_the_language(app_factory: Any, tmp_path: Path) -> None:
+    """In the pseudo-locale: the welcome window's labels, hints and warnings, the banner, the
+    page script's hidden labels, and the trainer's message box; a switch to English re-renders
+    them (what was typed kept)."""
+    app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token=TOKEN, seed=11, language=PSEUDO_LANGUAGE)
+    clients: list[InputsClient] = []
+    try:
+        anna = _connect(app, clients)
+        prompt = anna.views["identity"]
+        choose(prompt.token_field, "wrong-token-of-16", anna.client)
+        click(prompt.open_trainer, anna.client)                     # a wrong token: the warning
+        welcome = (prompt.name_field, prompt.key_field, prompt.start, prompt.message, prompt.token_field,
+                   prompt.open_trainer)
+        for handle in welcome:
+            for text in gui_texts(handle):
+                assert untranslated_words(text, set()) == [], text
+        assert 'data-join="⟦' in prompt.labels_html.content
+        choose(prompt.name_field, "Anna", anna.client)
+        anna.set_language("en")                                      # the window again, in English, "Anna" kept
+        assert (prompt.name_field.label, prompt.start.label) == ("Your name", "Join the class")
+        assert prompt.name_field.value == "Anna"
+        assert prompt.message.content == "⚠ That trainer token is not right; type the token the server printed."
+        assert 'data-join="Join the class"' in prompt.labels_html.content
+        anna.set_language(PSEUDO_LANGUAGE)
+        click(prompt.start, anna.client)
+        assert prompt.name == "Anna"
+        assert untranslated_words(prompt.banner.content, {"Anna"}) == []
+
+        app.classroom.send_message("Hello", to=None)
+        notices = anna.views["notices"]
+        wait_until(lambda: notices.shown is not None, what="the message on show")
+        with anna.lock:
+            for handle in (notices.box, notices.message_md, notices.dismiss):
+                for text in gui_texts(handle):
+                    assert untranslated_words(text, {"Hello", "UTC"}) == [], text
+        anna.set_language("en")
+        with anna.lock:
+            assert notices.message_md.content.startswith("**Message from the trainer** to the class, ")
+            assert notices.dismiss.label == "Dismiss"
+    finally:
+        for c in clients:
+            c.ws.close()
