@@ -211,6 +211,10 @@ def test_with_the_pseudo_locale_every_text_of_the_dashboard_is_from_the_catalogs
         check("language pushed to one")
         click(dash.push_language, trainer.client)
         check("language pushed to all")
+        messages = next(extra for extra in dash.class_extras if hasattr(extra, "send"))
+        choose(messages.text, "Hello", trainer.client)
+        click(messages.send, trainer.client)
+        assert untranslated_words(messages.status.content, names) == [], messages.status.content
         choose(dash.trainee, "Ben", trainer.client)
         click(dash.release, trainer.client)
         check("released")

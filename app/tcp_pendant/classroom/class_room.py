@@ -571,7 +571,7 @@ class ClassRoom:
         by name (the presence table); the one place the dashboard learns who is connected."""
         return self.heartbeat.connected_names()
 
-    def send_message(self, text: str, to: str | None = None) -> str:
+    def send_message(self, text: str, to: str | None = None, *, tr: Translator = ENGLISH) -> str:
         """Send ``text`` (plain text) to every connected trainee of the class (``to`` None) or
         to the trainee named ``to`` (connected, or one who left: it waits until they join
         again). It is kept in the gradebook for each of them until they dismiss it
@@ -582,4 +582,4 @@ class ClassRoom:
         Raises:
             ValueError: an empty or too long text; ``to`` is no trainee of this class.
         """
-        return self.messages.send(text, to, self.connected_names())
+        return self.messages.send(text, to, self.connected_names(), tr=tr)

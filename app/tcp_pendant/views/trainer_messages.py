@@ -18,7 +18,7 @@ import viser
 from tcp_pendant.classroom.class_messages import MAX_MESSAGE_CHARS
 from tcp_pendant.session import Session
 from tcp_pendant.text_escape import escape_markdown
-from tcp_pendant.translation import N_
+from tcp_pendant.translation import ENGLISH, N_, Translator
 from tcp_pendant.views.dashboard_words import DashboardWords
 from tcp_pendant.views.gui_util import ButtonEvent, set_options, set_value
 
@@ -37,7 +37,7 @@ class MessageControl(Protocol):
 
     def connected_names(self) -> list[str]: ...
 
-    def send_message(self, text: str, to: str | None = None) -> str: ...
+    def send_message(self, text: str, to: str | None = None, *, tr: Translator = ENGLISH) -> str: ...
 
 
 @dataclass(eq=False)
@@ -76,7 +76,7 @@ class MessageControls:
             raise ValueError("The message must be text.")
         picked = str(self.to.value)
         to = None if picked in (TO_ALL, self._to_all()) else picked
-        self.status.content = escape_markdown(self.control.send_message(text, to))
+        self.status.content = escape_markdown(self.control.send_message(text, to, tr=self.session.translator))
         set_value(self.text, "")
 
 
