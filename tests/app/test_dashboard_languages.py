@@ -248,11 +248,15 @@ def test_the_welcome_window_and_the_trainers_message_follow_the_language(app_fac
             for text in gui_texts(handle):
                 assert untranslated_words(text, set()) == [], text
         assert 'data-join="⟦' in prompt.labels_html.content
+        choose(prompt.name_field, "x" * 41, anna.client)
+        click(prompt.start, anna.client)                            # refused: too long, said in the catalogs' words
+        assert prompt.name is None
+        assert untranslated_words(prompt.message.content, set()) == [], prompt.message.content
         choose(prompt.name_field, "Anna", anna.client)
         anna.set_language("en")                                      # the window again, in English, "Anna" kept
         assert (prompt.name_field.label, prompt.start.label) == ("Your name", "Join the class")
         assert prompt.name_field.value == "Anna"
-        assert prompt.message.content == "⚠ That trainer token is not right; type the token the server printed."
+        assert prompt.message.content == "⚠ your name has 41 characters; shorten it to at most 40."
         assert 'data-join="Join the class"' in prompt.labels_html.content
         anna.set_language(PSEUDO_LANGUAGE)
         click(prompt.start, anna.client)

@@ -289,13 +289,13 @@ class ClassRoom:
         clean = validate_trainee_name(name)
         with self._join_lock:
             if self.roster.released(session) == clean:
-                raise TraineeNameError(f"The trainer released the name {clean} from this browser; join "
-                                       "under your own name.")
+                raise TraineeNameError(N_("The trainer released the name {name} from this browser; join "
+                                          "under your own name."), name=clean)
             holder = self.roster.by_name(clean, other_than=session)
             elsewhere = self.heartbeat.held_elsewhere(clean)
             if (holder is not None or elsewhere) and not self.gradebook.trainees.holds_key(clean, key):
-                raise TraineeNameError(f"{clean} is already connected in another browser; pick another "
-                                       "name or ask the trainer to release it.")
+                raise TraineeNameError(N_("{name} is already connected in another browser; pick another "
+                                          "name or ask the trainer to release it."), name=clean)
             join = self.gradebook.trainees.join(clean, key)
             if holder is not None:         # the same browser (its key): the newer tab takes the name
                 self._leave(holder, _OTHER_TAB, forget=False)

@@ -174,7 +174,10 @@ class IdentityPrompt:
         key = str(self.key_field.value or "")[:_MAX_KEY_CHARS]
         try:
             name, new_key = self._on_name(self.name_field.value, key)
-        except (TraineeNameError, ValueError) as exc:
+        except TraineeNameError as exc:
+            self._say(exc.message, **exc.values)
+            return
+        except ValueError as exc:
             self._say("", text=str(exc))
             return
         set_value(self.key_field, "")
