@@ -10,7 +10,7 @@ from typing import Any, Callable
 
 import pytest
 
-from support.pendant_page import TIMEOUT_MS, type_text, wait_text, wait_until
+from support.pendant_page import TIMEOUT_MS, assert_not_blank, type_text, wait_text, wait_until
 
 from tcp_pendant.serve.server import PendantApp
 from tcp_pendant.translation import PSEUDO_LANGUAGE, translator
@@ -21,19 +21,19 @@ pytestmark = pytest.mark.browser
 TOKEN = "trainer-secret-4242"
 
 
-def _open(app: PendantApp, new_page: Callable[..., Any], url: str | None = None) -> tuple[Any, Any]:
+def _open(app: PendantApp, new_page: Callable[..., Any], url: str | None = None, **kw: Any) -> tuple[Any, Any]:
     n = len(app.sessions)
-    page = new_page(url or app.url)
+    page = new_page(url or app.url, **kw)
     page.wait_for_function("document.documentElement.dataset.tcpPendantScript === '1'", timeout=TIMEOUT_MS)
     wait_until(lambda: len(app.sessions) > n, "the page's session")
     return page, list(app.sessions.values())[-1]
 
 
 def test_in_another_language_the_name_joins_again_after_a_reload_and_the_trainer_address_opens_the_dashboard(
-        app_factory: Any, new_page: Callable[..., Any], tmp_path: Path) -> None:
+        app_factory: Any, new_page: Callable[..., Any], shot: Callable[[Any, str], Path], tmp_path: Path) -> None:
     qps = translator(PSEUDO_LANGUAGE)
     app = app_factory(class_db=tmp_path / "class.sqlite3", trainer_token=TOKEN, language=PSEUDO_LANGUAGE)
-    page, s = _open(app, new_page)
+    page, s = _open(app, new_page, wait_for=qps.gettext(JOIN_LABEL))
     assert qps.gettext(NAME_LABEL) != NAME_LABEL
     type_text(page, qps.gettext(NAME_LABEL), "Anna")
     wait_until(lambda: s.views["identity"].name_field.value == "Anna", "the typed name on the server")
@@ -48,6 +48,9 @@ def test_in_another_language_the_name_joins_again_after_a_reload_and_the_trainer
                "the reloaded page joined by itself")
     wait_text(page, f"{banner} Anna")
     # the trainer address: the token typed into the pseudo-locale's field, the dashboard opens
-    _page, trainer = _open(app, new_page, app.trainer_url)
+    dash_page, trainer = _open(app, new_page, app.trainer_url, width=1024, height=768,
+                               wait_for=qps.gettext("Download grades (CSV)"))
     wait_until(lambda: "trainer" in trainer.views, "the dashboard")
     assert trainer.language == PSEUDO_LANGUAGE
+    wait_text(dash_page, qps.gettext("Push language to all trainees"))
+    assert_not_blank(shot(dash_page, "dashboard_pseudo_1024x768"), min_colors=50)

@@ -327,7 +327,8 @@ class TrainerDashboard:
         self._say(_("Replay of {name}'s calibration {id} ({method}, {status}): {touches}{error}{grade}. "
                     "The robot as it was at the touch chosen in 'Robot at touch'; triads: the flange at each "
                     "touch; lines: the tool to its tip (blue by hand, orange Auto-touch); frames: result and "
-                    "true TOOL frame.").format(name=name, id=replay.calibration_id, method=_(replay.method) if replay.method else "-",
+                    "true TOOL frame.").format(name=name, id=replay.calibration_id,
+                                               method=_(replay.method) if replay.method else "-",
                                                status=replay.status.replace('_', ' '), touches=touches,
                                                error=err, grade=grade))
 

@@ -59,11 +59,14 @@ def _table(headers: Sequence[tuple[str, str]], body: list[str], cls: str, tr: Tr
 
 TRAINEE_HEADERS: tuple[tuple[str, str], ...] = (
     ("#", N_("the trainee's mark on the chart")), (N_("Trainee"), N_("name")), (N_("On"), N_("connected now")),
-    (N_("Method"), N_("the latest calibration")), (N_("Step"), N_("where it is")), (N_("On step"), N_("time on the step, or idle for (m:ss)")),
-    (N_("Last touch"), N_("time since the last touch (m:ss)")), (N_("Touches"), N_("touches recorded in the latest calibration")),
+    (N_("Method"), N_("the latest calibration")), (N_("Step"), N_("where it is")),
+    (N_("On step"), N_("time on the step, or idle for (m:ss)")),
+    (N_("Last touch"), N_("time since the last touch (m:ss)")),
+    (N_("Touches"), N_("touches recorded in the latest calibration")),
     (N_("Crashes"), N_("crashes in the latest calibration")),
     (N_("Err mm"), N_("position error of the last finished calibration against the true TOOL frame")),
     (N_("Grade"), N_("of the last finished calibration")))
+"""The live table's headers and their tooltips (English msgids; ``#`` as it is)."""
 
 
 def trainees_html(rows: Sequence[DashboardRow], *, tr: Translator = ENGLISH) -> str:
