@@ -469,14 +469,10 @@ def trainee_folder(dash: TrainerDashboard) -> None:
         dash.replay_touch = words(gui.add_dropdown("", (NO_TOUCH,), initial_value=NO_TOUCH, visible=False),
                                   label=N_("Robot at touch"),
                                   hint=N_("The robot of the replay, posed as it was at that touch."))
-        dash.one_exercise = words.choices(words(gui.add_dropdown("", ("",)), label=N_("Exercise for this trainee")),
-                                          tuple(ONE_EXERCISE))
-        dash.one_tool = words.choices(words(gui.add_dropdown("", ("",)), label=N_("Tool for this trainee")),
-                                      (KEEP,), dash.control.tool_keys)
-        dash.one_hide_distance = words.choices(
-            words(gui.add_dropdown("", ("",)), label=N_("Hide distance for this trainee")), tuple(HIDE_DISTANCE))
-        dash.one_auto_touch = words.choices(
-            words(gui.add_dropdown("", ("",)), label=N_("Auto-touch for this trainee")), tuple(AUTO_TOUCH))
+        dash.one_exercise = words.dropdown(gui, N_("Exercise for this trainee"), tuple(ONE_EXERCISE))
+        dash.one_tool = words.dropdown(gui, N_("Tool for this trainee"), (KEEP,), dash.control.tool_keys)
+        dash.one_hide_distance = words.dropdown(gui, N_("Hide distance for this trainee"), tuple(HIDE_DISTANCE))
+        dash.one_auto_touch = words.dropdown(gui, N_("Auto-touch for this trainee"), tuple(AUTO_TOUCH))
         dash.push_one = words(gui.add_button("", color="blue"), label=N_("Push to this trainee"))
         dash.release = words(gui.add_button(""), label=N_("Release name"),
                              hint=N_("A name stays with the browser it joined from. Release it so that the "
@@ -496,19 +492,15 @@ def exercise_folder(dash: TrainerDashboard) -> None:
     gui, control, words = dash.gui, dash.control, dash.words
     with dash.folder(N_("Exercise")):
         current = next((label for label, ex in EXERCISES.items() if ex == control.exercise), "Free practice")
-        dash.exercise = words.choices(words(gui.add_dropdown("", ("",)), label=N_("Exercise")), tuple(EXERCISES),
-                                      value=current)
-        dash.tool = words.choices(words(gui.add_dropdown("", ("",)), label=N_("Tool for all")), (KEEP,),
-                                  control.tool_keys)
-        dash.hide_distance = words.choices(words(
-            gui.add_dropdown("", ("",)), label=N_("Hide distance for all"),
+        dash.exercise = words.dropdown(gui, N_("Exercise"), tuple(EXERCISES), value=current)
+        dash.tool = words.dropdown(gui, N_("Tool for all"), (KEEP,), control.tool_keys)
+        dash.hide_distance = words.dropdown(
+            gui, N_("Hide distance for all"), tuple(HIDE_DISTANCE),
             hint=N_("on: trainees judge the touch by eye (no distance, no Δ line, no close-up, no stop "
-                    "at the tip); locked: they cannot show it (the default in an exercise); off: shown.")),
-            tuple(HIDE_DISTANCE))
-        dash.auto_touch = words.choices(words(
-            gui.add_dropdown("", ("",)), label=N_("Auto-touch for all"),
-            hint=N_("allowed: trainees may let the robot touch for them (off by default in an exercise).")),
-            tuple(AUTO_TOUCH))
+                    "at the tip); locked: they cannot show it (the default in an exercise); off: shown."))
+        dash.auto_touch = words.dropdown(
+            gui, N_("Auto-touch for all"), tuple(AUTO_TOUCH),
+            hint=N_("allowed: trainees may let the robot touch for them (off by default in an exercise)."))
         dash.push = words(gui.add_button("", color="blue"), label=N_("Push to all trainees"))
         dash.push_md = gui.add_markdown("")
         dash.class_extras.append(build_exercise_controls(gui, control, dash.session))   # "Exercise brief"

@@ -55,10 +55,9 @@ def language_folder(dash: TrainerDashboard) -> None:
     kept = control.class_language
     choices = language_choices(kept if kept is not None else dash.session.language)
     with dash.folder(N_("Language of the trainees")):
-        dash.language_choice = words.choices(
-            words(gui.add_dropdown("", ("",)), label=N_("Language to push"),
-                  hint=N_("Each trainee may switch back with the Language selector of their pendant.")),
-            (), choices, value=language_name(kept) if kept is not None else choices[0])
+        dash.language_choice = words.dropdown(
+            gui, N_("Language to push"), (), choices, value=language_name(kept) if kept is not None else choices[0],
+            hint=N_("Each trainee may switch back with the Language selector of their pendant."))
         dash.push_language = words(gui.add_button("", color="blue"), label=N_("Push language to all trainees"),
                                    hint=N_("Trainees who join later start in it too."))
         dash.push_language_one = words(gui.add_button(""), label=N_("Push language to this trainee"),

@@ -1,9 +1,9 @@
 """The trainer dashboard's fixed words in the dashboard browser's own language.
 
 Each folder builder of ``views.dashboard`` hands a handle over with the English messages of its
-label, hint or content (``words(handle, label=N_("Reset wizard"), hint=N_(...))``) and a
-dropdown with the English messages of its choices (:meth:`DashboardWords.choices`; names such as
-tool keys stay as they are). :meth:`DashboardWords.relabel` shows them all again in the
+label, hint or content (``words(handle, label=N_("Reset wizard"), hint=N_(...))``), and makes
+its dropdowns with the English messages of their choices (:meth:`DashboardWords.dropdown`;
+names such as tool keys stay as they are). :meth:`DashboardWords.relabel` shows them all again in the
 session's language at a ``language`` change; a dropdown keeps its choice across the change.
 A choice is read back in English (:meth:`DashboardWords.english`) whether the browser sent it in
 the language it was shown in or in English.
@@ -55,13 +55,20 @@ class DashboardWords:
             if getattr(handle, attribute) != text:
                 setattr(handle, attribute, text)
 
-    def choices(self, dropdown: viser.GuiDropdownHandle[str], messages: Sequence[str], names: Sequence[str] = (),
-                value: str | None = None) -> viser.GuiDropdownHandle[str]:
-        """``dropdown``'s options: ``messages`` (English msgids) translated, then ``names`` as
-        they are; its value ``value`` (English or a name; default: the first)."""
-        entry = (dropdown, tuple(messages), tuple(names))
-        self._choices[id(dropdown)] = entry
-        self._show_choices(entry, messages[0] if value is None else value)
+    def dropdown(self, gui: viser.GuiApi, label: str, messages: Sequence[str], names: Sequence[str] = (),
+                 value: str | None = None, hint: str | None = None) -> viser.GuiDropdownHandle[str]:
+        """A new dropdown in ``gui`` made in the session's language at once: its options
+        ``messages`` (English msgids) translated, then ``names`` as they are; its value ``value``
+        (English or a name; default: the first); ``label`` and ``hint`` English msgids; all
+        re-rendered at :meth:`relabel`."""
+        _ = self._shown_in.gettext
+        options = tuple(_(m) for m in messages) + tuple(names)
+        english = (tuple(messages) + tuple(names))[0] if value is None else value
+        dropdown = gui.add_dropdown(_(label), options, initial_value=_(english) if english in messages else english,
+                                    hint=None if hint is None else _(hint))
+        texts = {"label": label} if hint is None else {"label": label, "hint": hint}
+        self._texts.append((dropdown, texts))
+        self._choices[id(dropdown)] = (dropdown, tuple(messages), tuple(names))
         return dropdown
 
     def _show_choices(self, entry: _Choice, english: str) -> None:

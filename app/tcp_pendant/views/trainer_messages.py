@@ -86,7 +86,8 @@ def build_message_controls(gui: viser.GuiApi, class_control: MessageControl, ses
     words = DashboardWords(session)
     with words(gui.add_folder(""), label=N_("Message to trainees")):
         text = words(gui.add_text("", "", multiline=True), label=N_("Message"))
-        to = words(gui.add_dropdown("", (TO_ALL,), initial_value=TO_ALL), label=N_("To"))
+        to_all = session.translator.gettext(TO_ALL_WORDS) + " "
+        to = words(gui.add_dropdown("", (to_all,), initial_value=to_all), label=N_("To"))
         send = words(gui.add_button("", color="blue"), label=N_("Send"))
         status = gui.add_markdown("")
     controls = MessageControls(session, class_control, text, to, send, status, words)
