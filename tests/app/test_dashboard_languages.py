@@ -218,6 +218,18 @@ def test_with_the_pseudo_locale_every_text_of_the_dashboard_is_from_the_catalogs
         choose(dash.trainee, "Ben", trainer.client)
         click(dash.release, trainer.client)
         check("released")
+
+        # the dashboard back in English: every word again, the choices kept
+        choose(dash.hide_distance, qps.gettext("on, locked"), trainer.client)
+        trainer.set_language("en")
+        with trainer.lock:
+            assert (dash.push.label, dash.folders["Trainee"].label) == ("Push to all trainees", "Trainee")
+            assert tuple(dash.hide_distance.options) == ("(keep)", "on, locked", "on", "off")
+            assert dash.hide_distance.value == "on, locked"
+            assert dash.chart.title == "Last position error per trainee (mm)"
+            assert "<th" in dash.table_html.content and ">Trainee</th>" in dash.table_html.content
+            assert dash.trainee.options[0] == "(choose a trainee) "
+            assert messages.send.label == "Send" and messages.to.options[0] == "(all trainees) "
     finally:
         for c in clients:
             c.ws.close()
