@@ -72,7 +72,7 @@ def test_the_dashboard_replaces_the_pendant_and_survives_a_restart(app_factory, 
         trainer = _connect(app, clients, 2)
         dash = _dashboard(trainer)
         assert set(trainer.views) == {"trainer", "tools"}          # no pendant left: the dashboard and its library
-        assert trainer._subscribers == [trainer.views["tools"].on_change]
+        assert trainer._subscribers == [dash.language.on_change, trainer.views["tools"].on_change, dash.on_change]
         assert [(r.name, r.connected, r.step, r.touches) for r in dash.rows] == \
             [("Anna", True, "result", 4), ("Ben", True, "Step 3 of 4", 2)]
         assert dash.rows[0].grade and dash.rows[0].position_error_mm is not None

@@ -105,7 +105,7 @@ def test_kr16_with_missing_meshes_is_drawn_and_says_so(app_factory, tmp_path, mo
         wait_until(lambda: notifications(client), what="the start notice")
         ((title, body),) = notifications(client)
         assert title == "Robot meshes not found"
-        assert body.startswith("7 mesh(es) of the robot were not found (base_link.dae, link_1.dae")
+        assert body.startswith("7 meshes of the robot were not found (base_link.dae, link_1.dae")
     finally:
         client.close()
 

@@ -259,11 +259,12 @@ CAMERA = dict(type="ViewerCameraMessage", wxyz=[1.0, 0.0, 0.0, 0.0], position=[2
 class InputsClient:
     """A raw viser websocket that records the GUI inputs the server creates (uuid -> kind,
     label, props), the GUI updates and every message it gets, and sends whatever it is given (a msgpack mapping, raw bytes or a text
-    frame), as a hostile browser could. ``closed`` is set when the server closed it."""
+    frame), as a hostile browser could. ``closed`` is set when the server closed it. ``headers``:
+    extra request headers of the upgrade (a browser's ``Accept-Language``)."""
 
-    def __init__(self, port: int) -> None:
+    def __init__(self, port: int, headers: dict[str, str] | None = None) -> None:
         self.ws = connect(f"ws://127.0.0.1:{port}", subprotocols=[f"viser-v{viser.__version__}"],  # type: ignore[list-item]
-                          max_size=None, open_timeout=20)
+                          max_size=None, open_timeout=20, additional_headers=headers)
         self.inputs: dict[str, tuple[str, str, dict[str, Any]]] = {}
         self.updates: list[tuple[str, dict[str, Any]]] = []     # (uuid, updates) the server sent
         self.messages: list[dict[str, Any]] = []                # every message the server sent, decoded

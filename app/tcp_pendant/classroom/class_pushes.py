@@ -1,6 +1,7 @@
 """The trainer's pushes of class settings, kept in order (table ``class_pushes``) so every server
 process of the class applies the ones it has not seen (``ClassRoom.beat``). A push is a JSON
-object (its ``kind``: settings, brief, reset, push_to); ids grow."""
+object (its ``kind``: settings, brief, reset, push_to, language,
+language_to); ids grow."""
 
 from __future__ import annotations
 

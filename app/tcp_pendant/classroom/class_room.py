@@ -100,6 +100,7 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from tcp_pendant.classroom.class_board import ClassBoard
+from tcp_pendant.classroom.class_language import kept_language
 from tcp_pendant.classroom.class_views import ClassViews, WelcomeWindow
 from tcp_pendant.classroom.dashboards import RENDER_INTERVAL_S, TICK_S, Dashboards
 from tcp_pendant.classroom.exercise_rules import DistanceAids
@@ -122,14 +123,15 @@ from tcp_pendant.classroom.trainer_pushes import TrainerPushes
 from tcp_pendant.calibrate.pendant_rules import UNRESTRICTED, ExerciseRules, LibraryRights
 from tcp_pendant.controller import ToolModel
 from tcp_pendant.session import Session, SessionChange
+from tcp_pendant.translation import ENGLISH, N_, Translator
 
 __all__ = ["EXERCISE_IDS", "RENDER_INTERVAL_S", "TICK_S", "ClassRoom", "clean_methods"]
 
 log = logging.getLogger(__name__)
 
-_RELEASED = "The trainer released the name {name}: this browser left the class. Join under your own name."
-_OTHER_TAB = ("{name} joined from another tab or window of this browser, so this one left the class. Close it, "
-              "or join here again (the other one then leaves).")
+_RELEASED = N_("The trainer released the name {name}: this browser left the class. Join under your own name.")
+_OTHER_TAB = N_("{name} joined from another tab or window of this browser, so this one left the class. Close "
+                "it, or join here again (the other one then leaves).")
 
 
 class ClassRoom:
@@ -201,7 +203,7 @@ class ClassRoom:
         self.holder = self.heartbeat.holder
         """This server process's id in the gradebook's presence table (host, pid, a nonce)."""
         self.pushes = TrainerPushes(gradebook, self.setup, self.roster, self.heartbeat, tools=self.tools,
-                                    seed=self._seed, hand_to_loop=hand_to_loop)
+                                    seed=self._seed, hand_to_loop=hand_to_loop, is_trainer=self.dashboards.shows)
 
     # ------------------------------------------------------------ what the trainer set
     @property
@@ -287,16 +289,16 @@ class ClassRoom:
         clean = validate_trainee_name(name)
         with self._join_lock:
             if self.roster.released(session) == clean:
-                raise TraineeNameError(f"The trainer released the name {clean} from this browser; join "
-                                       "under your own name.")
+                raise TraineeNameError(N_("The trainer released the name {name} from this browser; join "
+                                          "under your own name."), name=clean)
             holder = self.roster.by_name(clean, other_than=session)
             elsewhere = self.heartbeat.held_elsewhere(clean)
             if (holder is not None or elsewhere) and not self.gradebook.trainees.holds_key(clean, key):
-                raise TraineeNameError(f"{clean} is already connected in another browser; pick another "
-                                       "name or ask the trainer to release it.")
+                raise TraineeNameError(N_("{name} is already connected in another browser; pick another "
+                                          "name or ask the trainer to release it."), name=clean)
             join = self.gradebook.trainees.join(clean, key)
             if holder is not None:         # the same browser (its key): the newer tab takes the name
-                self._leave(holder, _OTHER_TAB.format(name=clean), forget=False)
+                self._leave(holder, _OTHER_TAB, forget=False)
             self._start(session, join)
         self.refresh_trainers()
         return join
@@ -348,8 +350,10 @@ class ClassRoom:
 
     def _leave(self, seat: Seat, message: str, *, forget: bool) -> None:
         """The session of ``seat`` is no longer its trainee: its gradebook session ends, its row
-        moves to those who left, and its welcome window opens again with ``message``."""
+        moves to those who left, and its welcome window opens again with ``message`` (an English
+        msgid with ``{name}``: shown in the trainee's language, with the seat's name)."""
         session = seat.session
+        message = session.translator.gettext(message).format(name=seat.name)
         if not self.roster.holds(seat):
             return
         prompt = self.roster.prompt(session)
@@ -360,10 +364,11 @@ class ClassRoom:
         if prompt is not None:         # on the loop, after this callback: no two sessions' locks at once
             self._hand_to_loop(session.loop.guard(lambda: prompt.reopen(message, forget=forget)))
 
-    def release(self, name: str) -> str:
+    def release(self, name: str, *, tr: Translator = ENGLISH) -> str:
         """The trainer releases ``name``: the gradebook forgets its browser key and a browser
         connected under it leaves the class (its welcome window opens again and its page script
-        forgets the name). Returns what happened, in words for the trainer (plain text)."""
+        forgets the name). Returns what happened, in words for the trainer (plain text, in
+        ``tr``'s language)."""
         if not isinstance(name, str):
             raise ValueError("Choose the name to release.")
         with self._join_lock:
@@ -372,12 +377,15 @@ class ClassRoom:
             holders = self.roster.all_named(name)
             for seat in holders:
                 self.roster.note_released(seat.session, name)
-                self._leave(seat, _RELEASED.format(name=name), forget=True)
+                self._leave(seat, _RELEASED, forget=True)
         self.refresh_trainers()
         if not held and not holders and not elsewhere:
-            return f"{name} was not held by any browser."
-        where = " and its browser left the class" if holders or elsewhere else ""
-        return f"Released {name}{where}: the next browser that joins as {name} gets the trainee's records."
+            return tr.gettext("{name} was not held by any browser.").format(name=name)
+        if holders or elsewhere:
+            return tr.gettext("Released {name} and its browser left the class: the next browser that joins as "
+                              "{name} gets the trainee's records.").format(name=name)
+        return tr.gettext("Released {name}: the next browser that joins as {name} gets the trainee's "
+                          "records.").format(name=name)
 
     def held_names(self) -> list[str]:
         """Names a browser holds (the trainer view's "Release a name" choices)."""
@@ -426,9 +434,9 @@ class ClassRoom:
         for seat, released in lost:
             if released:
                 self.roster.note_released(seat.session, seat.name)
-                self._leave(seat, _RELEASED.format(name=seat.name), forget=True)
+                self._leave(seat, _RELEASED, forget=True)
             else:
-                self._leave(seat, _OTHER_TAB.format(name=seat.name), forget=False)
+                self._leave(seat, _OTHER_TAB, forget=False)
         self.refresh_trainers()
 
     # ------------------------------------------------------------ trainer
@@ -470,23 +478,24 @@ class ClassRoom:
         cid = self.gradebook.records.last_calibration(name)
         return None if cid is None else calibration_replay(self.gradebook, cid)
 
-    def reset_wizard(self, name: str, *, forward: bool = True) -> str:
+    def reset_wizard(self, name: str, *, forward: bool = True, tr: Translator = ENGLISH) -> str:
         """Cancel the running wizard of the trainee ``name`` (``Session.cancel_wizard`` on their
         session only; kept, resumable; the gradebook records the cancel) and tell them. Returns
         what happened, in words for the trainer (plain text). A trainee connected on another
         server process of the class gets it there at its next beat (``forward``; False: a
         request from there, applied here only)."""
-        return self.pushes.reset(name, forward=forward)
+        return self.pushes.reset(name, forward=forward, tr=tr)
 
     def push_to(self, name: str, exercise: str | None | bool = False, tool_key: str | None = None,
-                hide_distance: str | None = None, auto_touch: bool | None = None, *, forward: bool = True) -> str:
+                hide_distance: str | None = None, auto_touch: bool | None = None, *, forward: bool = True,
+                tr: Translator = ENGLISH) -> str:
         """Push settings to the one trainee ``name``: ``exercise`` (False: keep; None: free
         practice; "mystery": their mystery tool), ``tool_key`` (None: keep; ignored with the
         mystery exercise), distance aids ``hide_distance`` ("locked" / "hidden" / "shown", None:
         keep) and Auto-touch (None: keep). Only that trainee's session is changed; until their
         next reconnect or the next push to all. Returns what happened (plain text). A trainee
         connected on another server process gets it there (``forward``, as :meth:`reset_wizard`)."""
-        return self.pushes.to_one(name, exercise, tool_key, hide_distance, auto_touch, forward=forward)
+        return self.pushes.to_one(name, exercise, tool_key, hide_distance, auto_touch, forward=forward, tr=tr)
 
     def trainee_statuses(self) -> list[TraineeStatus]:
         """Rows of the live table: this process's connected trainees in order of arrival, those
@@ -515,6 +524,32 @@ class ClassRoom:
         processes of the class (False: a push one of them made, applied here)."""
         return self.pushes.settings(exercise, tool_key, hide_distance, auto_touch, keep=keep)
 
+    @property
+    def class_language(self) -> str | None:
+        """The language the trainer pushed to the class (None: none; ``classroom.class_language``)."""
+        return kept_language(self.gradebook.settings)
+
+    def push_language(self, language: str, *, keep: bool = True) -> int:
+        """Set ``language`` (a code of ``translation.languages``) on every trainee's pendant, each
+        told in it; browsers that connect later start in it (kept in the gradebook, ``keep`` as
+        for :meth:`push_settings`). A trainee may switch back. Returns how many named trainees of
+        this process.
+
+        Raises:
+            ValueError: an unknown code.
+        """
+        return self.pushes.language(language, keep=keep)
+
+    def push_language_to(self, name: str, language: str, *, forward: bool = True, tr: Translator = ENGLISH) -> str:
+        """Set ``language`` on the one trainee ``name``'s pendant (until their browser reconnects),
+        told in it; returns what happened, in words for the trainer (``forward`` as for
+        :meth:`reset_wizard`; ``tr``: the trainer's language).
+
+        Raises:
+            ValueError: an unknown code.
+        """
+        return self.pushes.language_to(name, language, forward=forward, tr=tr)
+
     def push_brief(self, instructions: str, allowed_methods: Sequence[str] | str | None,
                    min_touches: int, *, keep: bool = True) -> int:
         """Set the exercise's brief: ``instructions`` (plain text, at most
@@ -536,7 +571,7 @@ class ClassRoom:
         by name (the presence table); the one place the dashboard learns who is connected."""
         return self.heartbeat.connected_names()
 
-    def send_message(self, text: str, to: str | None = None) -> str:
+    def send_message(self, text: str, to: str | None = None, *, tr: Translator = ENGLISH) -> str:
         """Send ``text`` (plain text) to every connected trainee of the class (``to`` None) or
         to the trainee named ``to`` (connected, or one who left: it waits until they join
         again). It is kept in the gradebook for each of them until they dismiss it
@@ -547,4 +582,4 @@ class ClassRoom:
         Raises:
             ValueError: an empty or too long text; ``to`` is no trainee of this class.
         """
-        return self.messages.send(text, to, self.connected_names())
+        return self.messages.send(text, to, self.connected_names(), tr=tr)

@@ -20,6 +20,7 @@ from tcp_pendant.classroom.gradebook import Gradebook
 from tcp_pendant.classroom.gradebook_store import GradebookError
 from tcp_pendant.classroom.roster import Roster, Seat
 from tcp_pendant.session import ClassMessage, Session
+from tcp_pendant.translation import ENGLISH, Translator
 
 __all__ = ["MessageDelivery"]
 
@@ -57,9 +58,10 @@ class MessageDelivery:
             self._on_screen.pop(id(session), None)
             self._handed.pop(id(session), None)
 
-    def send(self, text: str, to: str | None, connected: list[str]) -> str:
+    def send(self, text: str, to: str | None, connected: list[str], *, tr: Translator = ENGLISH) -> str:
         """``ClassRoom.send_message``: ``connected`` are the names connected now on every
-        process of the class. Returns what happened, in words for the trainer (plain text).
+        process of the class. Returns what happened, in words for the trainer (plain text, in
+        ``tr``'s language).
 
         Raises:
             ValueError: an empty or too long text; ``to`` is no trainee of this class.
@@ -81,8 +83,11 @@ class MessageDelivery:
         self.deliver_kept(self._roster.by_names(names))
         if to is None:
             n = len(names)
-            return f"Sent to {n} trainee{'s' if n != 1 else ''}." if n else "No trainee is connected: nobody got it."
-        return f"Sent to {to}." if to in connected else f"{to} is not connected: the message waits until they join again."
+            return (tr.ngettext("Sent to {n} trainee.", "Sent to {n} trainees.", n).format(n=n) if n
+                    else tr.gettext("No trainee is connected: nobody got it."))
+        if to in connected:
+            return tr.gettext("Sent to {name}.").format(name=to)
+        return tr.gettext("{name} is not connected: the message waits until they join again.").format(name=to)
 
     def _kept_messages(self, name: str) -> list[ClassMessage]:
         """The messages the gradebook keeps for ``name`` (not dismissed), oldest first."""

@@ -82,6 +82,8 @@ from functools import lru_cache
 import regex
 from confusable_homoglyphs import confusables
 
+from tcp_pendant.translation import ENGLISH, N_, Translator
+
 __all__ = ["MAX_TRAINEE_NAME_LENGTH", "TraineeNameError", "looks_alike", "name_keys", "skeleton",
            "validate_trainee_name"]
 
@@ -104,7 +106,22 @@ _SPACES = re.compile(" {2,}")
 
 
 class TraineeNameError(ValueError):
-    """A name the pendant does not accept; the message says why and what to type instead."""
+    """A name the pendant does not accept; the message says why and what to type instead.
+
+    Args:
+        message: the English msgid (``N_``) with named placeholders; ``str(error)`` is it filled
+            in English.
+        values: the placeholders' values (plain text: names, numbers).
+    """
+
+    def __init__(self, message: str, **values: object) -> None:
+        self.message = message
+        self.values = {key: str(value) for key, value in values.items()}
+        super().__init__(message.format(**self.values))
+
+    def words(self, tr: Translator = ENGLISH) -> str:
+        """The message in ``tr``'s language (plain text)."""
+        return tr.gettext(self.message).format(**self.values)
 
 
 def validate_trainee_name(text: object) -> str:
@@ -122,7 +139,7 @@ def validate_trainee_name(text: object) -> str:
             a default-ignorable code point but for a joiner in a UAX #31 context (module docstring).
     """
     if not isinstance(text, str):
-        raise TraineeNameError(f"a name must be text, got {type(text).__name__}; type your name.")
+        raise TraineeNameError(N_("a name must be text, got {kind}; type your name."), kind=type(text).__name__)
     name = _SPACES.sub(" ", unicodedata.normalize("NFC", text).strip())
     for i, ch in enumerate(name):
         if ch in "\u200c\u200d" and _KEPT_JOINER.match(name, i):
@@ -130,14 +147,14 @@ def validate_trainee_name(text: object) -> str:
         if not ch.isprintable() or ch in _BLANK_SYMBOLS or _DEFAULT_IGNORABLE.match(ch):
             what = unicodedata.name(ch, unicodedata.category(ch))
             raise TraineeNameError(
-                f"your name contains an invisible or control character, U+{ord(ch):04X} ({what}); "
-                "type it again with visible letters only.")
+                N_("your name contains an invisible or control character, {code} ({what}); "
+                   "type it again with visible letters only."), code=f"U+{ord(ch):04X}", what=what)
     if not name:
-        raise TraineeNameError("your name is empty; type the name your trainer should see "
-                               f"(1 to {MAX_TRAINEE_NAME_LENGTH} characters).")
+        raise TraineeNameError(N_("your name is empty; type the name your trainer should see "
+                                  "(1 to {most} characters)."), most=MAX_TRAINEE_NAME_LENGTH)
     if len(name) > MAX_TRAINEE_NAME_LENGTH:
-        raise TraineeNameError(f"your name has {len(name)} characters; shorten it to at most "
-                               f"{MAX_TRAINEE_NAME_LENGTH}.")
+        raise TraineeNameError(N_("your name has {n} characters; shorten it to at most {most}."),
+                               n=len(name), most=MAX_TRAINEE_NAME_LENGTH)
     return name
 
 

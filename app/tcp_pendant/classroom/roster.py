@@ -39,6 +39,7 @@ class Roster:
         self._seats: dict[int, Seat] = {}               # id(session) -> its trainee's seat
         self._followed: set[int] = set()                # id(session) of sessions whose changes we follow
         self._prompts: dict[int, WelcomeWindow] = {}    # id(session) -> its welcome window
+        self._welcomed: dict[int, Session] = {}         # id(session) -> the session of that window
         self._released: dict[int, str] = {}             # id(session) -> the name the trainer released there
 
     def seat(self, session: Session) -> Seat | None:
@@ -98,6 +99,12 @@ class Roster:
         """Keep the welcome window shown in ``session``."""
         with self.lock:
             self._prompts[id(session)] = prompt
+            self._welcomed[id(session)] = session
+
+    def unnamed(self) -> list[Session]:
+        """The sessions showing a welcome window whose browser has not joined under a name yet."""
+        with self.lock:
+            return [s for key, s in self._welcomed.items() if key not in self._seats]
 
     def prompt(self, session: Session) -> WelcomeWindow | None:
         """The welcome window of ``session`` (None: none shown)."""
@@ -120,6 +127,7 @@ class Roster:
         key = id(session)
         with self.lock:
             self._prompts.pop(key, None)
+            self._welcomed.pop(key, None)
             self._released.pop(key, None)
             self._followed.discard(key)
             return self._seats.get(key)

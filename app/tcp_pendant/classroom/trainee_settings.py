@@ -97,15 +97,18 @@ def apply_push_to(session: Session, recorder: TraineeRecorder, name: str, exerci
             session.set_hide_distance(True)
         session.set_rules(rules)
         session.changed(wizard=True)
-    session.notify(PUSH_TITLE, push_words(exercise if sets_exercise else False,
-                                          None if tool_key is None else tools[tool_key].label,
-                                          hide_distance, auto_touch), kind="warning")
+    tr = session.translator
+    label = None if tool_key is None else tools[tool_key].label
+    tool_name = tr.gettext(label) if label else label       # a built-in tool's label may be a msgid
+    session.notify(tr.gettext(PUSH_TITLE), push_words(exercise if sets_exercise else False, tool_name,
+                                                      hide_distance, auto_touch, tr=tr), kind="warning")
 
 
 def reset_wizard(session: Session) -> None:
     """The trainer's reset: cancel the running wizard (kept, resumable) and tell the trainee."""
     if session.workflow.is_open:
         session.wizard_commands.cancel()
-        session.notify("The trainer reset your calibration",
-                       "Your trainer closed the wizard; start it again (your touches are kept: "
-                       "Resume brings them back).", kind="warning")
+        _ = session.translator.gettext
+        session.notify(_("The trainer reset your calibration"),
+                       _("Your trainer closed the wizard; start it again (your touches are kept: "
+                         "Resume brings them back)."), kind="warning")

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 from tcp_pendant.classroom.gradebook_store import GradebookError, GradebookStore
 from tcp_pendant.classroom.gradebook_values import utc_now
 from tcp_pendant.classroom.names import TraineeNameError, looks_alike, validate_trainee_name
+from tcp_pendant.translation import N_
 
 __all__ = ["BROWSER_KEY_BYTES", "MAX_BROWSER_KEY_CHARS", "TraineeJoin", "Trainees"]
 
@@ -115,9 +116,9 @@ class Trainees:
                 if digest is not None:
                     if shown is None or not secrets.compare_digest(_key_digest(shown), str(digest)):
                         raise TraineeNameError(
-                            f"{clean} is already a trainee of this class, joined from another browser; "
-                            "use that browser, or ask the trainer to release the name; if you are "
-                            "someone else, pick another name.")
+                            N_("{name} is already a trainee of this class, joined from another browser; "
+                               "use that browser, or ask the trainer to release the name; if you are "
+                               "someone else, pick another name."), name=clean)
                     return TraineeJoin(tid, clean, None)
                 new_key = secrets.token_urlsafe(BROWSER_KEY_BYTES)
                 db.execute("UPDATE trainees SET key_sha256 = ? WHERE id = ?", (_key_digest(new_key), tid))
@@ -125,9 +126,9 @@ class Trainees:
             for (other,) in db.execute("SELECT name FROM trainees"):
                 if looks_alike(clean, other):
                     raise TraineeNameError(
-                        f"{clean} looks like {other}, a name already in this class: if you are "
-                        f"{other}, type your name exactly as before; otherwise pick a name that "
-                        "looks different (add an initial or your surname).")
+                        N_("{name} looks like {other}, a name already in this class: if you are "
+                           "{other}, type your name exactly as before; otherwise pick a name that "
+                           "looks different (add an initial or your surname)."), name=clean, other=other)
             new_key = secrets.token_urlsafe(BROWSER_KEY_BYTES)
             tid = db.insert("INSERT INTO trainees (name, created_at, key_sha256) VALUES (?, ?, ?)",
                             (clean, utc_now(), _key_digest(new_key)))

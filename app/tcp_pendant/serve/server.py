@@ -62,7 +62,7 @@ from tcp_pendant.controller.placement import (
 )
 from tcp_pendant.controller.scenarios import Scenario
 from tcp_pendant.session import GuiTarget, Session
-from tcp_pendant.translation import PSEUDO_LANGUAGE, languages, negotiate
+from tcp_pendant.translation import ENGLISH, PSEUDO_LANGUAGE, Translator, languages, negotiate
 from tcp_pendant.views import session_view_steps, viser_adapter
 from tcp_pendant.views.dashboard import open_dashboard
 from tcp_pendant.views.gui_util import target_of
@@ -431,9 +431,13 @@ class PendantApp:
         return session
 
     def start_language(self, client: viser.ClientHandle | None) -> str:
-        """The language a session starts in: ``--language`` when it names one; with ``auto`` (the
+        """The language a session starts in: the language the trainer pushed to the class
+        (``ClassRoom.class_language``), else ``--language`` when it names one; with ``auto`` (the
         default) the best of the browser's ``Accept-Language`` the pendant offers
         (``translation.negotiate``), else English (the ``--shared`` session: English)."""
+        pushed = None if self.classroom is None or client is None else self.classroom.class_language
+        if pushed is not None:
+            return pushed
         if self.config.language != "auto":
             return self.config.language
         return negotiate(None if client is None else viser_adapter.accept_language(client))
@@ -518,24 +522,32 @@ class PendantApp:
         except Exception:
             log.debug("camera of a leaving client", exc_info=True)
 
-    def start_notices(self) -> list[tuple[str, str]]:
+    def start_notices(self, *, tr: Translator = ENGLISH) -> list[tuple[str, str]]:
         """(title, body) of the notifications every browser gets when it connects: the start
-        warnings (:attr:`warnings`) in plain text (viser shows them as text)."""
+        warnings (:attr:`warnings`) in plain text (viser shows them as text), in ``tr``'s
+        language (the reach check's words as it composed them)."""
         out = []
         missing = [m for m in self.kinematics.description.missing_meshes if m.kind == "visual"]
         if missing:
             names = ", ".join(Path(m.uri).name for m in missing[:6]) + (" ..." if len(missing) > 6 else "")
-            out.append(("Robot meshes not found",
-                        f"{len(missing)} mesh(es) of the robot were not found ({names}): those links are drawn "
-                        "from their collision geometry or as simple shapes. The terminal that started the "
-                        "pendant says where each was looked for (--package-path, ROS_PACKAGE_PATH)."))
+            n = len(missing)
+            out.append((tr.gettext("Robot meshes not found"),
+                        tr.ngettext("{n} mesh of the robot was not found ({names}): those links are drawn "
+                                    "from their collision geometry or as simple shapes. The terminal that started "
+                                    "the pendant says where each was looked for (--package-path, ROS_PACKAGE_PATH).",
+                                    "{n} meshes of the robot were not found ({names}): those links are drawn "
+                                    "from their collision geometry or as simple shapes. The terminal that started "
+                                    "the pendant says where each was looked for (--package-path, ROS_PACKAGE_PATH).",
+                                    n).format(n=n, names=names)))
         if self.tip_warning is not None:
-            out.append(("Reference tip out of reach", self.tip_warning))
+            out.append((tr.gettext("Reference tip out of reach"), self.tip_warning))
         return out
 
     def show_start_notices(self, client: viser.ClientHandle) -> None:
-        """Show :meth:`start_notices` in ``client``'s browser (they stay until closed)."""
-        for title, body in self.start_notices():
+        """Show :meth:`start_notices` in ``client``'s browser (they stay until closed), in its
+        session's language."""
+        session = self.sessions.get(client.client_id)
+        for title, body in self.start_notices(tr=ENGLISH if session is None else session.translator):
             client.add_notification(title, body, color="yellow", with_close_button=True,
                                     auto_close_seconds=None)
 

@@ -27,29 +27,39 @@ from tcp_pendant.calibrate.exercise_brief import default_instructions_markdown
 from tcp_pendant.session import ClassMessage
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.text_escape import escape_markdown, escape_markdown_lines
+from tcp_pendant.translation import ENGLISH, N_, Translator
 from tcp_pendant.views.gui_util import ButtonEvent, set_content, target_of
 
 __all__ = ["PIN_CLASS", "TOAST_TITLE", "ClassNoticeView", "instructions_markdown", "message_markdown"]
 
 PIN_CLASS = "trainer-message"
 """The class of the empty marker in the message's folder: the page script pins the folder."""
-TOAST_TITLE = "Message from the trainer"
+TOAST_TITLE = N_("Message from the trainer")
+MESSAGE_FOLDER = N_("Message")
+DISMISS = N_("Dismiss")
+DISMISS_HINT = N_("The message goes; the next one, if any, shows.")
 BANNER_ORDER = -1100.0
 """The instructions' place: above every other element of the panel (the identity banner is -1000)."""
 
 
-def instructions_markdown(instructions: str) -> str:
-    """The banner's markdown for the exercise's ``instructions`` (plain text, escaped)."""
-    return f"**Exercise**\n\n{escape_markdown_lines(instructions)}"
+def instructions_markdown(instructions: str, *, tr: Translator = ENGLISH) -> str:
+    """The banner's markdown for the exercise's ``instructions`` (plain text, escaped), its
+    heading in ``tr``'s language."""
+    heading = tr.gettext("**Exercise**")
+    return f"{heading}\n\n{escape_markdown_lines(instructions)}"
 
 
-def message_markdown(message: ClassMessage, waiting: int) -> str:
-    """The message box's markdown: who it was for, when (UTC), the text (escaped) and how many
-    more messages wait after it."""
-    to = "the class" if message.to is None else f"you ({escape_markdown(message.to)})"
+def message_markdown(message: ClassMessage, waiting: int, *, tr: Translator = ENGLISH) -> str:
+    """The message box's markdown in ``tr``'s language: who it was for, when (UTC), the text
+    (escaped, as the trainer typed it) and how many more messages wait after it."""
+    _ = tr.gettext
     when = message.sent_at_utc[11:16]
-    more = f"\n\n*{waiting} more message{'s' if waiting != 1 else ''} after this one.*" if waiting else ""
-    return f"**Message from the trainer** to {to}, {when} UTC\n\n{escape_markdown_lines(message.text)}{more}"
+    head = (_("**Message from the trainer** to the class, {time} UTC").format(time=when) if message.to is None
+            else _("**Message from the trainer** to you ({name}), {time} UTC").format(
+                name=escape_markdown(message.to), time=when))
+    more = ("\n\n" + tr.ngettext("*{n} more message after this one.*", "*{n} more messages after this one.*",
+                                  waiting).format(n=waiting)) if waiting else ""
+    return f"{head}\n\n{escape_markdown_lines(message.text)}{more}"
 
 
 class ClassNoticeView:
@@ -64,11 +74,12 @@ class ClassNoticeView:
         self.session = session
         gui = target_of(session).gui
         self.banner = gui.add_markdown("", order=BANNER_ORDER, visible=False)
-        self.box = gui.add_folder("Message", order=BANNER_ORDER + 1, visible=False)
+        _ = session.translator.gettext
+        self.box = gui.add_folder(_(MESSAGE_FOLDER), order=BANNER_ORDER + 1, visible=False)
         with self.box:
             gui.add_html(f'<span class="{PIN_CLASS}"></span>')    # a constant: the page script pins the folder
             self.message_md = gui.add_markdown("")
-            self.dismiss = gui.add_button("Dismiss", hint="The message goes; the next one, if any, shows.")
+            self.dismiss = gui.add_button(_(DISMISS), hint=_(DISMISS_HINT))
         self.shown: ClassMessage | None = None
         self._toasted: set[int] = set()
         self.dismiss.on_click(session.loop.on_loop(self._on_dismiss))
@@ -76,7 +87,10 @@ class ClassNoticeView:
         self.render()
 
     def on_change(self, change: SessionChange) -> None:
-        if change.notice:
+        if change.language:
+            _ = self.session.translator.gettext
+            self.box.label, self.dismiss.label, self.dismiss.hint = _(MESSAGE_FOLDER), _(DISMISS), _(DISMISS_HINT)
+        if change.notice or change.language:
             self.render()
 
     def _on_dismiss(self, _event: ButtonEvent | None = None) -> None:
@@ -87,18 +101,19 @@ class ClassNoticeView:
         """The banner and the message box from the session's rules and messages."""
         if self.session.closed:
             return
-        rules = self.session.rules
-        text = (instructions_markdown(rules.instructions) if rules.instructions
-                else f"**Exercise**\n\n{default_instructions_markdown(rules)}" if rules.exercise is not None else "")
+        rules, tr = self.session.rules, self.session.translator
+        text = (instructions_markdown(rules.instructions, tr=tr) if rules.instructions
+                else tr.gettext("**Exercise**") + f"\n\n{default_instructions_markdown(rules)}"
+                if rules.exercise is not None else "")
         if text:
             set_content(self.banner, text)
         self.banner.visible = bool(text)
         messages = self.session.messages
         self.shown = messages[0] if messages else None
         if self.shown is not None:
-            set_content(self.message_md, message_markdown(self.shown, len(messages) - 1))
+            set_content(self.message_md, message_markdown(self.shown, len(messages) - 1, tr=tr))
         self.box.visible = self.message_md.visible = self.dismiss.visible = self.shown is not None
         for m in messages:                  # a toast for each message new to this browser's view
             if m.message_id not in self._toasted:
                 self._toasted.add(m.message_id)
-                self.session.notify(TOAST_TITLE, m.text)
+                self.session.notify(tr.gettext(TOAST_TITLE), m.text)

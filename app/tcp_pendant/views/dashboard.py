@@ -47,9 +47,12 @@ from tcp_pendant.classroom.class_board import ClassBoard
 from tcp_pendant.classroom.grading import grade_record
 from tcp_pendant.classroom.replay import CalibrationReplay
 from tcp_pendant.job_pool import JobRefused
-from tcp_pendant.session import Session
+from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.text_escape import escape_markdown
+from tcp_pendant.translation import ENGLISH, N_, Translator
+from tcp_pendant.views.dashboard_language import LanguageControl, language_folder
 from tcp_pendant.views.dashboard_replay import ReplayScene
+from tcp_pendant.views.dashboard_words import DashboardWords
 from tcp_pendant.views.dashboard_table import in_progress_html, trainees_html
 from tcp_pendant.views.gui_util import (
     CHART_LEGEND,
@@ -60,11 +63,12 @@ from tcp_pendant.views.gui_util import (
     set_options,
     target_of,
 )
+from tcp_pendant.views.language_selector import LanguageSelector
 from tcp_pendant.views.tool_panel import ToolPanel
 from tcp_pendant.views.trainer_exercise import build_exercise_controls
 from tcp_pendant.views.trainer_messages import build_message_controls
 from tcp_pendant.views.trainer_view import (
-    AUTO_TOUCH, EXERCISES, HIDE_DISTANCE, ClassControl, grades_markdown, record_grades_markdown,
+    AUTO_TOUCH, EXERCISES, HIDE_DISTANCE, KEEP, ClassControl, grades_markdown, record_grades_markdown,
     rules_words,
 )
 from tcp_pendant.views.replay_robot import ReplayRobot
@@ -81,23 +85,28 @@ FULL_WIDTH_PX = 4000
 """The panel's width asked for: wider than any projector, the browser keeps it to its window."""
 REPLAY_PANEL_PX = 560
 """The panel's width while a replay is on show (the 3D scene beside it)."""
-NO_TRAINEE = "(choose a trainee) "
-"""The first choice of "Trainee" (acts on nobody; the trailing space keeps it apart from names)."""
-ONE_EXERCISE: dict[str, str | None | bool] = {"(keep)": False, "Free practice": None, "Mystery tool": "mystery"}
+PANEL_LABEL = N_("TCP Pendant · trainer")
+"""The dashboard browser's panel title."""
+NO_TRAINEE_WORDS = N_("(choose a trainee)")
+NO_TRAINEE = NO_TRAINEE_WORDS + " "
+"""The first choice of "Trainee" (acts on nobody; the trailing space keeps it apart from names),
+in English; shown in the dashboard's language."""
+ONE_EXERCISE: dict[str, str | None | bool] = {KEEP: False, N_("Free practice"): None, N_("Mystery tool"): "mystery"}
 """'Exercise' choices for one trainee (False: keep)."""
 
 
-class DashboardControl(ClassControl, Protocol):
+class DashboardControl(ClassControl, LanguageControl, Protocol):
     """What the dashboard needs of the class room, beyond the class-wide controls."""
 
     def board(self) -> ClassBoard: ...
 
     def replay(self, name: str) -> CalibrationReplay | None: ...
 
-    def reset_wizard(self, name: str) -> str: ...
+    def reset_wizard(self, name: str, *, tr: Translator = ENGLISH) -> str: ...
 
     def push_to(self, name: str, exercise: str | None | bool = False, tool_key: str | None = None,
-                hide_distance: str | None = None, auto_touch: bool | None = None) -> str: ...
+                hide_distance: str | None = None, auto_touch: bool | None = None, *,
+                tr: Translator = ENGLISH) -> str: ...
 
 
 def chart_points(rows: Sequence[DashboardRow]) -> tuple[np.ndarray, np.ndarray]:
@@ -131,6 +140,11 @@ class TrainerDashboard:
     """
 
     # the widgets, set by the folder builders (viser handles)
+    language: LanguageSelector
+    language_choice: viser.GuiDropdownHandle[str]
+    push_language: viser.GuiButtonHandle
+    push_language_one: viser.GuiButtonHandle
+    language_md: viser.GuiMarkdownHandle
     tool_panel: ToolPanel
     rules_md: viser.GuiMarkdownHandle
     stuck_min: viser.GuiNumberHandle[float]
@@ -165,6 +179,8 @@ class TrainerDashboard:
         self.session = session
         self.control = control
         self.gui = target_of(session).gui
+        self.words = DashboardWords(session)
+        """The fixed words of the folders, in the dashboard browser's language."""
         self.rows: list[DashboardRow] = []
         self.folders: dict[str, viser.GuiFolderHandle] = {}
         self.class_extras: list[_Rendered] = []
@@ -177,10 +193,27 @@ class TrainerDashboard:
                                         ReplayRobot(target_of(session).scene, session.controller.kinematics))
 
     def folder(self, title: str, *, expand_by_default: bool = True) -> viser.GuiFolderHandle:
-        """A folder of the dashboard, kept in :attr:`folders`."""
-        f = self.gui.add_folder(title, expand_by_default=expand_by_default)
+        """A folder of the dashboard titled ``title`` (an English msgid, shown translated), kept in
+        :attr:`folders` by its English title."""
+        f = self.words(self.gui.add_folder(self.session.translator.gettext(title), expand_by_default=expand_by_default),
+                       label=title)
         self.folders[title] = f
         return f
+
+    @property
+    def no_trainee(self) -> str:
+        """The first choice of "Trainee" in the dashboard's language."""
+        return self.session.translator.gettext(NO_TRAINEE_WORDS) + " "
+
+    def on_change(self, change: SessionChange) -> None:
+        """The dashboard browser's language changed: every text again in it (the class too)."""
+        if not change.language:
+            return
+        self.words.relabel()
+        label_chart(self)
+        self.gui.set_panel_label(self.session.translator.gettext(PANEL_LABEL))
+        self._results_shown = None
+        self.render()
 
     # ------------------------------------------------------------ rendering
     def stuck_after_s(self) -> float:
@@ -206,15 +239,18 @@ class TrainerDashboard:
         connected = set(self.control.connected_names()) if connected is None else connected
         now = datetime.now(timezone.utc)
         self.rows = dashboard_rows(board, connected, now, self.stuck_after_s(), self.idle_after_s())
-        set_content(self.table_html, trainees_html(self.rows))
-        set_content(self.runs_html, in_progress_html(open_runs(board, connected, now)))
+        tr = self.session.translator
+        set_content(self.table_html, trainees_html(self.rows, tr=tr))
+        set_content(self.runs_html, in_progress_html(open_runs(board, connected, now), tr=tr))
         self._render_chart()
-        set_options(self.trainee, (NO_TRAINEE, *dict.fromkeys(r.name for r in self.rows)))   # option text, not markdown
+        no_trainee = self.no_trainee
+        keep = None if self.chosen() is not None else no_trainee
+        set_options(self.trainee, (no_trainee, *dict.fromkeys(r.name for r in self.rows)), keep)   # option text
         results = tuple((t.result_calibration_id, t.position_error_mm, t.grade) for t in board.trainees)
         if results != self._results_shown:       # the gradebook table (all rows: the costly read) on a new result only
             self._results_shown = results
-            set_content(self.grades_md, grades_markdown(self.control.grade_rows()))
-        set_content(self.rules_md, escape_markdown(rules_words(self.control.rules)))
+            set_content(self.grades_md, grades_markdown(self.control.grade_rows(), tr=tr))
+        set_content(self.rules_md, escape_markdown(rules_words(self.control.rules, tr=tr)))
         for extra in self.class_extras:
             extra.render()
 
@@ -233,7 +269,7 @@ class TrainerDashboard:
     # ------------------------------------------------------------ actions
     def chosen(self) -> str | None:
         name = str(self.trainee.value)
-        return None if name == NO_TRAINEE or name not in {r.name for r in self.rows} else name
+        return None if name in (NO_TRAINEE, self.no_trainee) or name not in {r.name for r in self.rows} else name
 
     def _say(self, text: str) -> None:
         set_content(self.action_md, escape_markdown(text))
@@ -241,32 +277,33 @@ class TrainerDashboard:
     def _need_trainee(self) -> str | None:
         name = self.chosen()
         if name is None:
-            self._say("Choose a trainee first.")
+            self._say(self.session.translator.gettext("Choose a trainee first."))
         return name
 
     def _reset(self, _event: ButtonEvent | None = None) -> None:
         name = self._need_trainee()
         if name is not None:
-            self._say(self.control.reset_wizard(name))
+            self._say(self.control.reset_wizard(name, tr=self.session.translator))
 
     def _push_one(self, _event: ButtonEvent | None = None) -> None:
         name = self._need_trainee()
         if name is None:
             return
-        ex_label, aids_label, auto_label = (str(self.one_exercise.value), str(self.one_hide_distance.value),
-                                            str(self.one_auto_touch.value))
+        english = self.words.english
+        ex_label, aids_label, auto_label = (english(self.one_exercise), english(self.one_hide_distance),
+                                            english(self.one_auto_touch))
         if ex_label not in ONE_EXERCISE or aids_label not in HIDE_DISTANCE or auto_label not in AUTO_TOUCH:
             raise ValueError("Choose the exercise, Hide distance and Auto-touch from their lists.")
-        tool = None if self.one_tool.value == "(keep)" else str(self.one_tool.value)
+        tool = None if english(self.one_tool) == KEEP else str(self.one_tool.value)
         if tool is not None and tool not in self.control.tool_keys:
             raise ValueError(f"Unknown tool {tool!r}; choose one of {', '.join(self.control.tool_keys)}.")
         self._say(self.control.push_to(name, ONE_EXERCISE[ex_label], tool, HIDE_DISTANCE[aids_label],
-                                       AUTO_TOUCH[auto_label]))
+                                       AUTO_TOUCH[auto_label], tr=self.session.translator))
 
     def _release(self, _event: ButtonEvent | None = None) -> None:
         name = self._need_trainee()
         if name is not None:
-            self._say(self.control.release(name))
+            self._say(self.control.release(name, tr=self.session.translator))
             self.render()
 
     def _replay(self, _event: ButtonEvent | None = None) -> None:
@@ -274,19 +311,26 @@ class TrainerDashboard:
         if name is None:
             return
         replay = self.control.replay(name)
+        _ = self.session.translator.gettext
         if replay is None:
-            self._say(f"{name} has no calibration with a touch yet.")
+            self._say(_("{name} has no calibration with a touch yet.").format(name=name))
             return
         self.replay_scene.show(replay)
         self.gui.main_panel.set_width(REPLAY_PANEL_PX)
         self.close_replay.visible = True
         set_replay_touches(self.replay_touch, replay, self.replay_scene.touch_shown)
-        err = "" if replay.position_error_mm is None else f", error {replay.position_error_mm:.2f} mm"
+        err = "" if replay.position_error_mm is None else _(", error {error} mm").format(
+            error=f"{replay.position_error_mm:.2f}")
         grade = "" if replay.grade is None else f", {replay.grade}"
-        self._say(f"Replay of {name}'s calibration {replay.calibration_id} ({replay.method}, "
-                  f"{replay.status.replace('_', ' ')}): {len(replay.touches)} touches{err}{grade}. "
-                  "The robot as it was at the touch chosen in 'Robot at touch'; triads: the flange at each touch; lines: the tool to its tip (blue by hand, orange "
-                  "Auto-touch); frames: result and true TOOL frame.")
+        n = len(replay.touches)
+        touches = self.session.translator.ngettext("{n} touch", "{n} touches", n).format(n=n)
+        self._say(_("Replay of {name}'s calibration {id} ({method}, {status}): {touches}{error}{grade}. "
+                    "The robot as it was at the touch chosen in 'Robot at touch'; triads: the flange at each "
+                    "touch; lines: the tool to its tip (blue by hand, orange Auto-touch); frames: result and "
+                    "true TOOL frame.").format(name=name, id=replay.calibration_id,
+                                               method=_(replay.method) if replay.method else "-",
+                                               status=replay.status.replace('_', ' '), touches=touches,
+                                               error=err, grade=grade))
 
     def _close_replay(self, _event: ButtonEvent | None = None) -> None:
         self.replay_scene.clear()
@@ -294,17 +338,20 @@ class TrainerDashboard:
         self.close_replay.visible = self.replay_touch.visible = False
 
     def _push_all(self, _event: ButtonEvent | None = None) -> None:
-        exercise = EXERCISES.get(str(self.exercise.value))
-        tool = None if self.tool.value == "(keep)" else str(self.tool.value)
+        english = self.words.english
+        exercise = EXERCISES.get(english(self.exercise))
+        tool = None if english(self.tool) == KEEP else str(self.tool.value)
         if tool is not None and tool not in self.control.tool_keys:
             raise ValueError(f"Unknown tool {tool!r}; choose one of {', '.join(self.control.tool_keys)}.")
-        label, auto = str(self.hide_distance.value), str(self.auto_touch.value)
+        label, auto = english(self.hide_distance), english(self.auto_touch)
         if label not in HIDE_DISTANCE:
             raise ValueError(f"Unknown Hide distance choice {label!r}; choose one of {', '.join(HIDE_DISTANCE)}.")
         if auto not in AUTO_TOUCH:
             raise ValueError(f"Unknown Auto-touch choice {auto!r}; choose one of {', '.join(AUTO_TOUCH)}.")
         n = self.control.push_settings(exercise, tool, HIDE_DISTANCE[label], AUTO_TOUCH[auto])
-        self.push_md.content = f"Pushed to {n} trainee{'s' if n != 1 else ''}. {rules_words(self.control.rules)}"
+        tr = self.session.translator
+        pushed = tr.ngettext("Pushed to {n} trainee.", "Pushed to {n} trainees.", n).format(n=n)
+        self.push_md.content = f"{pushed} {rules_words(self.control.rules, tr=tr)}"
         self.render()
 
     def _download(self, _event: ButtonEvent | None = None) -> None:
@@ -313,8 +360,10 @@ class TrainerDashboard:
             client.send_file_download("grades.csv", self.control.grades_csv().encode("utf-8"))
 
     def _refused(self, filename: str, size_bytes: int) -> None:
-        self.session.notify("Record not graded", f"{filename or 'The file'}: {size_bytes} bytes is more than "
-                            f"{MAX_RECORD_BYTES} bytes; a session record is far smaller.", kind="warning")
+        _ = self.session.translator.gettext
+        self.session.notify(_("Record not graded"), _("{file}: {size} bytes is more than {limit} bytes; a session "
+                                                      "record is far smaller.").format(
+            file=filename or _("The file"), size=size_bytes, limit=MAX_RECORD_BYTES), kind="warning")
 
     async def _on_grade_upload(self, event: UploadEvent) -> None:
         """The record's bytes are parsed, replayed and graded in the server's job pool (off the loop)."""
@@ -329,33 +378,37 @@ class TrainerDashboard:
             grades = await self.session.loop.run_job(lambda: grade_record(load_and_replay(data), book),
                                                 what="a record's grading")
         except (SessionRecordError, JobRefused) as exc:
-            self.session.notify("Record not graded", f"{name}: {exc}", kind="warning")
+            self.session.notify(self.session.translator.gettext("Record not graded"), f"{name}: {exc}", kind="warning")
             return
         except Exception as exc:  # never let an upload kill the server
             log.exception("grading the record %r failed", name)
-            self.session.notify("Internal error", f"{type(exc).__name__}: {exc}", kind="error")
+            self.session.notify(self.session.translator.gettext("Internal error"), f"{type(exc).__name__}: {exc}",
+                                kind="error")
             return
         finally:
             self._grading = False
-        self.session.loop.guard(lambda: setattr(self.grade_md, "content", record_grades_markdown(name, grades)))()
+        self.session.loop.guard(lambda: setattr(self.grade_md, "content", record_grades_markdown(
+            name, grades, tr=self.session.translator)))()
 
 
 # ---------------------------------------------------------------- the folders
 def class_folder(dash: TrainerDashboard) -> None:
     """The stuck and idle thresholds (as kept in the gradebook), the live table and the
     calibrations in progress."""
-    gui, settings = dash.gui, dash.control.gradebook.settings
-    with dash.folder("Class"):
-        dash.stuck_min = gui.add_number("Stuck after (min)", kept_minutes(settings, STUCK_SETTING), min=MIN_MINUTES,
-                                        max=MAX_MINUTES, step=0.5,
-                                        hint="A trainee with no touch and no new step for this long in a "
-                                             "calibration is highlighted (the server's downtime not counted).")
-        dash.idle_min = gui.add_number("Idle after (min)", kept_minutes(settings, IDLE_SETTING), min=MIN_MINUTES,
-                                       max=MAX_MINUTES, step=0.5,
-                                       hint="A trainee who joined and has no calibration in progress or finished, "
-                                            "with no step and no touch for this long, is marked idle.")
+    gui, settings, words = dash.gui, dash.control.gradebook.settings, dash.words
+    with dash.folder(N_("Class")):
+        dash.stuck_min = words(gui.add_number("", kept_minutes(settings, STUCK_SETTING), min=MIN_MINUTES,
+                                              max=MAX_MINUTES, step=0.5),
+                               label=N_("Stuck after (min)"),
+                               hint=N_("A trainee with no touch and no new step for this long in a "
+                                       "calibration is highlighted (the server's downtime not counted)."))
+        dash.idle_min = words(gui.add_number("", kept_minutes(settings, IDLE_SETTING), min=MIN_MINUTES,
+                                             max=MAX_MINUTES, step=0.5),
+                              label=N_("Idle after (min)"),
+                              hint=N_("A trainee who joined and has no calibration in progress or finished, "
+                                      "with no step and no touch for this long, is marked idle."))
         dash.table_html = gui.add_html("")
-        gui.add_markdown("**Calibrations in progress**")
+        words(gui.add_markdown(""), content=N_("**Calibrations in progress**"))
         dash.runs_html = gui.add_html("")
     dash.stuck_min.on_update(dash.session.loop.on_loop(_on_threshold(dash, STUCK_SETTING)))
     dash.idle_min.on_update(dash.session.loop.on_loop(_on_threshold(dash, IDLE_SETTING)))
@@ -369,44 +422,62 @@ def _on_threshold(dash: TrainerDashboard, key: str) -> Callable[[viser.GuiEvent[
     return changed
 
 
+CHART_TITLE = N_("Last position error per trainee (mm)")
+CHART_X = N_("trainee #")
+CHART_Y = N_("position error (mm)")
+
+
+def label_chart(dash: TrainerDashboard) -> None:
+    """The chart's title, series and axis labels in the dashboard's language."""
+    _ = dash.session.translator.gettext
+    chart = dash.chart
+    if chart.title != _(CHART_TITLE):
+        chart.title = _(CHART_TITLE)
+        x, y = chart.series
+        chart.series = ({**x, "label": _(CHART_X)}, {**y, "label": _(CHART_Y)})
+        ax, ay = chart.axes or ({}, {})
+        chart.axes = ({**ax, "label": _(CHART_X)}, ay)
+
+
 def chart_folder(dash: TrainerDashboard) -> None:
     """The class's position errors, one mark per trainee."""
     gui = dash.gui
-    with dash.folder("Position errors"):
+    _ = dash.session.translator.gettext
+    with dash.folder(N_("Position errors")):
         dash.chart = gui.add_uplot(
             (np.zeros(0), np.zeros(0)),
-            ({"label": "trainee #"},
-             {"label": "position error (mm)", "stroke": "#3b6fd6", "width": 0,
+            ({"label": _(CHART_X)},
+             {"label": _(CHART_Y), "stroke": "#3b6fd6", "width": 0,
               "points": {"show": True, "size": 12, "fill": "#3b6fd6", "stroke": "#1b3f96", "width": 2}}),
-            title="Last position error per trainee (mm)", height=200,
+            title=_(CHART_TITLE), height=200,
             scales={"x": {"time": False, "range": (0.5, 1.5)}, "y": {"range": (0.0, 1.0)}},
-            axes=({"label": "trainee #", "incrs": (1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0)}, {"label": "mm"}),
+            axes=({"label": _(CHART_X), "incrs": (1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0)}, {"label": "mm"}),
             legend=CHART_LEGEND)
 
 
 def trainee_folder(dash: TrainerDashboard) -> None:
     """Choose a trainee; reset, push to, release, replay."""
-    gui, on_loop = dash.gui, dash.session.loop.on_loop
-    with dash.folder("Trainee"):
-        dash.trainee = gui.add_dropdown("Trainee", (NO_TRAINEE,), initial_value=NO_TRAINEE)
-        dash.reset = gui.add_button("Reset wizard", color="red",
-                                    hint="Close this trainee's running wizard (kept: they can resume it).")
-        dash.replay_button = gui.add_button("Replay in 3D",
-                                            hint="Draw this trainee's last calibration from the gradebook.")
-        dash.close_replay = gui.add_button("Close replay", visible=False)
-        dash.replay_touch = gui.add_dropdown("Robot at touch", (NO_TOUCH,), initial_value=NO_TOUCH, visible=False,
-                                             hint="The robot of the replay, posed as it was at that touch.")
-        dash.one_exercise = gui.add_dropdown("Exercise for this trainee", tuple(ONE_EXERCISE), initial_value="(keep)")
-        tools = ("(keep)", *dash.control.tool_keys)
-        dash.one_tool = gui.add_dropdown("Tool for this trainee", tools, initial_value=tools[0])
-        dash.one_hide_distance = gui.add_dropdown("Hide distance for this trainee", tuple(HIDE_DISTANCE),
-                                                  initial_value="(keep)")
-        dash.one_auto_touch = gui.add_dropdown("Auto-touch for this trainee", tuple(AUTO_TOUCH), initial_value="(keep)")
-        dash.push_one = gui.add_button("Push to this trainee", color="blue")
-        dash.release = gui.add_button("Release name",
-                                      hint="A name stays with the browser it joined from. Release it so that the "
-                                           "trainee can join from another browser, or to send a browser that took "
-                                           "it back to the welcome window.")
+    gui, on_loop, words = dash.gui, dash.session.loop.on_loop, dash.words
+    with dash.folder(N_("Trainee")):
+        dash.trainee = words(gui.add_dropdown("", (dash.no_trainee,), initial_value=dash.no_trainee),
+                             label=N_("Trainee"))
+        dash.reset = words(gui.add_button("", color="red"), label=N_("Reset wizard"),
+                           hint=N_("Close this trainee's running wizard (kept: they can resume it)."))
+        dash.replay_button = words(gui.add_button(""), label=N_("Replay in 3D"),
+                                   hint=N_("Draw this trainee's last calibration from the gradebook."))
+        dash.close_replay = words(gui.add_button("", visible=False), label=N_("Close replay"))
+        dash.replay_touch = words(gui.add_dropdown("", (NO_TOUCH,), initial_value=NO_TOUCH, visible=False),
+                                  label=N_("Robot at touch"),
+                                  hint=N_("The robot of the replay, posed as it was at that touch."))
+        dash.one_exercise = words.dropdown(gui, N_("Exercise for this trainee"), tuple(ONE_EXERCISE))
+        dash.one_tool = words.dropdown(gui, N_("Tool for this trainee"), (KEEP,), dash.control.tool_keys)
+        dash.one_hide_distance = words.dropdown(gui, N_("Hide distance for this trainee"), tuple(HIDE_DISTANCE))
+        dash.one_auto_touch = words.dropdown(gui, N_("Auto-touch for this trainee"), tuple(AUTO_TOUCH))
+        dash.push_one = words(gui.add_button("", color="blue"), label=N_("Push to this trainee"))
+        dash.release = words(gui.add_button(""), label=N_("Release name"),
+                             hint=N_("A name stays with the browser it joined from. Release it so that the "
+                                     "trainee can join from another browser, or to send a browser that took "
+                                     "it back to the welcome window."))
         dash.action_md = gui.add_markdown("")
     dash.reset.on_click(on_loop(dash._reset))
     dash.replay_button.on_click(on_loop(dash._replay))
@@ -418,20 +489,19 @@ def trainee_folder(dash: TrainerDashboard) -> None:
 
 def exercise_folder(dash: TrainerDashboard) -> None:
     """The class's settings, pushed to every trainee."""
-    gui, control = dash.gui, dash.control
-    with dash.folder("Exercise"):
+    gui, control, words = dash.gui, dash.control, dash.words
+    with dash.folder(N_("Exercise")):
         current = next((label for label, ex in EXERCISES.items() if ex == control.exercise), "Free practice")
-        dash.exercise = gui.add_dropdown("Exercise", tuple(EXERCISES), initial_value=current)
-        tools = ("(keep)", *control.tool_keys)
-        dash.tool = gui.add_dropdown("Tool for all", tools, initial_value=tools[0])
-        dash.hide_distance = gui.add_dropdown(
-            "Hide distance for all", tuple(HIDE_DISTANCE), initial_value="(keep)",
-            hint="on: trainees judge the touch by eye (no distance, no Δ line, no close-up, no stop "
-                 "at the tip); locked: they cannot show it (the default in an exercise); off: shown.")
-        dash.auto_touch = gui.add_dropdown(
-            "Auto-touch for all", tuple(AUTO_TOUCH), initial_value="(keep)",
-            hint="allowed: trainees may let the robot touch for them (off by default in an exercise).")
-        dash.push = gui.add_button("Push to all trainees", color="blue")
+        dash.exercise = words.dropdown(gui, N_("Exercise"), tuple(EXERCISES), value=current)
+        dash.tool = words.dropdown(gui, N_("Tool for all"), (KEEP,), control.tool_keys)
+        dash.hide_distance = words.dropdown(
+            gui, N_("Hide distance for all"), tuple(HIDE_DISTANCE),
+            hint=N_("on: trainees judge the touch by eye (no distance, no Δ line, no close-up, no stop "
+                    "at the tip); locked: they cannot show it (the default in an exercise); off: shown."))
+        dash.auto_touch = words.dropdown(
+            gui, N_("Auto-touch for all"), tuple(AUTO_TOUCH),
+            hint=N_("allowed: trainees may let the robot touch for them (off by default in an exercise)."))
+        dash.push = words(gui.add_button("", color="blue"), label=N_("Push to all trainees"))
         dash.push_md = gui.add_markdown("")
         dash.class_extras.append(build_exercise_controls(gui, control, dash.session))   # "Exercise brief"
     dash.push.on_click(dash.session.loop.on_loop(dash._push_all))
@@ -444,14 +514,14 @@ def message_folder(dash: TrainerDashboard) -> None:
 
 def gradebook_folder(dash: TrainerDashboard) -> None:
     """The finished calibrations, the CSV, grading an uploaded record."""
-    gui = dash.gui
-    with dash.folder("Gradebook"):
+    gui, words = dash.gui, dash.words
+    with dash.folder(N_("Gradebook")):
         dash.grades_md = gui.add_markdown("")
-        dash.download = gui.add_button("Download grades (CSV)")
-        dash.grade_upload = gui.add_upload_button(
-            "Grade a trainee's record (JSON)", mime_type="application/json",
-            hint="A trainee's exported session: each calibration is replayed and graded against "
-                 "the truth this gradebook keeps (by its record id).")
+        dash.download = words(gui.add_button(""), label=N_("Download grades (CSV)"))
+        dash.grade_upload = words(gui.add_upload_button("", mime_type="application/json"),
+                                  label=N_("Grade a trainee's record (JSON)"),
+                                  hint=N_("A trainee's exported session: each calibration is replayed and graded "
+                                          "against the truth this gradebook keeps (by its record id)."))
         dash.grade_md = gui.add_markdown("")
     dash.download.on_click(dash.session.loop.on_loop(dash._download))
     dash.grade_upload.on_upload(dash._on_grade_upload)
@@ -461,26 +531,30 @@ def gradebook_folder(dash: TrainerDashboard) -> None:
 def tool_library_folder(dash: TrainerDashboard) -> None:
     """The shared tool library as the pendant's Tool tab shows it (``views.tool_panel``), with the
     trainer's rights: rename and delete any trainee's slot (``session.views["tools"]``)."""
-    with dash.folder("Tool library (trainer)", expand_by_default=False):
+    with dash.folder(N_("Tool library (trainer)"), expand_by_default=False):
         dash.tool_panel = ToolPanel(dash.session)
     dash.session.views["tools"] = dash.tool_panel
 
 
 FOLDERS: list[Callable[[TrainerDashboard], None]] = [class_folder, chart_folder, trainee_folder, exercise_folder,
-                                                     message_folder, gradebook_folder, tool_library_folder]
+                                                     language_folder, message_folder, gradebook_folder,
+                                                     tool_library_folder]
 """The dashboard's folders, top to bottom, each built by one function."""
 
 
 def build_dashboard(session: Session, control: DashboardControl) -> TrainerDashboard:
-    """Lay the dashboard out in ``session``'s GUI (:data:`FOLDERS`) and show the class."""
+    """Lay the dashboard out in ``session``'s GUI (:data:`FOLDERS`) and show the class; the
+    dashboard browser's own Language selector under its title (it changes this browser only)."""
     dash = TrainerDashboard(session, control)
     gui = dash.gui
     with session.lock, target_of(session).atomic():
-        gui.add_markdown("### Trainer dashboard")
+        dash.words(gui.add_markdown(""), content=N_("### Trainer dashboard"))
+        dash.language = LanguageSelector(session)
         dash.rules_md = gui.add_markdown("")
         for build in FOLDERS:
             build(dash)
         dash.render()
+        session.subscribe(dash.on_change)
     return dash
 
 
@@ -492,6 +566,6 @@ def open_dashboard(session: Session, control: DashboardControl) -> TrainerDashbo
         session.drop_views()
         target.gui.reset()
         target.scene.reset()
-        target.gui.set_panel_label("TCP Pendant · trainer")
+        target.gui.set_panel_label(session.translator.gettext(PANEL_LABEL))
         target.gui.main_panel.set_width(FULL_WIDTH_PX)
     return build_dashboard(session, control)

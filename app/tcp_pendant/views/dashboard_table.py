@@ -20,6 +20,7 @@ from collections.abc import Sequence
 
 from tcp_pendant.classroom.board import DashboardRow, OpenRun, format_duration
 from tcp_pendant.text_escape import escape_html
+from tcp_pendant.translation import ENGLISH, N_, Translator
 
 __all__ = ["FONT_PX", "IDLE_BACKGROUND", "STUCK_BACKGROUND", "in_progress_html", "short_step", "trainees_html"]
 
@@ -47,27 +48,34 @@ def _cut(text: str, em: int) -> str:
     return f'<span title="{safe}" style="{_CUT.format(em=em)}">{safe}</span>'
 
 
-def _table(headers: Sequence[tuple[str, str]], body: list[str], cls: str) -> str:
-    head = "".join(f'<th title="{escape_html(tip)}" style="{_CELL};text-align:left;border-bottom:2px solid #888">'
-                   f"{escape_html(h)}</th>" for h, tip in headers)
+def _table(headers: Sequence[tuple[str, str]], body: list[str], cls: str, tr: Translator) -> str:
+    _ = tr.gettext
+    head = "".join(f'<th title="{escape_html(_(tip))}" style="{_CELL};text-align:left;border-bottom:2px solid #888">'
+                   f"{escape_html(h if h == '#' else _(h))}</th>" for h, tip in headers)
     return (f'<div class="{cls}" style="font-size:{FONT_PX}px;line-height:1.35;overflow-x:auto">'
             f'<table style="border-collapse:collapse;width:100%"><thead><tr>{head}</tr></thead>'
             f"<tbody>{''.join(body)}</tbody></table></div>")
 
 
 TRAINEE_HEADERS: tuple[tuple[str, str], ...] = (
-    ("#", "the trainee's mark on the chart"), ("Trainee", "name"), ("On", "connected now"),
-    ("Method", "the latest calibration"), ("Step", "where it is"), ("On step", "time on the step, or idle for (m:ss)"),
-    ("Last touch", "time since the last touch (m:ss)"), ("Touches", "touches recorded in the latest calibration"),
-    ("Crashes", "crashes in the latest calibration"),
-    ("Err mm", "position error of the last finished calibration against the true TOOL frame"),
-    ("Grade", "of the last finished calibration"))
+    ("#", N_("the trainee's mark on the chart")), (N_("Trainee"), N_("name")), (N_("On"), N_("connected now")),
+    (N_("Method"), N_("the latest calibration")), (N_("Step"), N_("where it is")),
+    (N_("On step"), N_("time on the step, or idle for (m:ss)")),
+    (N_("Last touch"), N_("time since the last touch (m:ss)")),
+    (N_("Touches"), N_("touches recorded in the latest calibration")),
+    (N_("Crashes"), N_("crashes in the latest calibration")),
+    (N_("Err mm"), N_("position error of the last finished calibration against the true TOOL frame")),
+    (N_("Grade"), N_("of the last finished calibration")))
+"""The live table's headers and their tooltips (English msgids; ``#`` as it is)."""
 
 
-def trainees_html(rows: Sequence[DashboardRow]) -> str:
-    """The live table (module docstring); every text escaped."""
+def trainees_html(rows: Sequence[DashboardRow], *, tr: Translator = ENGLISH) -> str:
+    """The live table (module docstring) in ``tr``'s language (a method by its translated name);
+    every text escaped."""
+    _ = tr.gettext
     if not rows:
-        return f'<div style="font-size:{FONT_PX}px"><i>No trainee has given a name yet.</i></div>'
+        empty = escape_html(_("No trainee has given a name yet."))
+        return f'<div style="font-size:{FONT_PX}px"><i>{empty}</i></div>'
     body = []
     for r in rows:
         style = (f"background:{STUCK_BACKGROUND};font-weight:600" if r.stuck else
@@ -77,31 +85,35 @@ def trainees_html(rows: Sequence[DashboardRow]) -> str:
             tcp = ", ".join(f"{v:.1f}" for v in r.tcp_mm)
             err = f'<span title="TCP {escape_html(tcp)} mm">{err}</span>'
         name = ("⚠ " if r.stuck else "◔ " if r.idle else "") + r.name
-        step = "idle" if r.idle and not r.step else short_step(r.step)
-        cells = (escape_html(str(r.number)), _cut(name, 11), _ON if r.connected else _OFF, _cut(r.method or "-", 10),
+        step = _("idle") if r.idle and not r.step else short_step(r.step)
+        cells = (escape_html(str(r.number)), _cut(name, 11), _ON if r.connected else _OFF,
+                 _cut(_(r.method) if r.method else "-", 10),
                  escape_html(step or "-"), format_duration(r.step_s if r.in_progress else r.quiet_s if r.idle else None),
                  format_duration(r.touch_s), str(r.touches), str(r.crashes), err, escape_html(r.grade or "-"))
         tds = "".join(f'<td style="{_CELL}">{c}</td>' for c in cells)
         kind = "stuck" if r.stuck else "idle" if r.idle else "trainee"
         body.append(f'<tr class="{kind}" style="{style}">{tds}</tr>')
-    return _table(TRAINEE_HEADERS, body, "tcp-dashboard-trainees")
+    return _table(TRAINEE_HEADERS, body, "tcp-dashboard-trainees", tr)
 
 
 RUN_HEADERS: tuple[tuple[str, str], ...] = (
-    ("Cal.", "calibration id in the gradebook"), ("Trainee", "name"), ("On", "connected now"),
-    ("Method", "wizard"), ("Step", "where it is"), ("On step", "time on the step (m:ss)"),
-    ("Started", "time since it started (m:ss)"), ("Touches", "touches that count"))
+    (N_("Cal."), N_("calibration id in the gradebook")), (N_("Trainee"), N_("name")), (N_("On"), N_("connected now")),
+    (N_("Method"), N_("wizard")), (N_("Step"), N_("where it is")), (N_("On step"), N_("time on the step (m:ss)")),
+    (N_("Started"), N_("time since it started (m:ss)")), (N_("Touches"), N_("touches that count")))
 
 
-def in_progress_html(runs: Sequence[OpenRun]) -> str:
-    """The calibrations in progress (oldest first); every text escaped."""
+def in_progress_html(runs: Sequence[OpenRun], *, tr: Translator = ENGLISH) -> str:
+    """The calibrations in progress (oldest first) in ``tr``'s language; every text escaped."""
+    _ = tr.gettext
     if not runs:
-        return f'<div style="font-size:{FONT_PX}px"><i>No calibration in progress.</i></div>'
+        empty = escape_html(_("No calibration in progress."))
+        return f'<div style="font-size:{FONT_PX}px"><i>{empty}</i></div>'
     body = []
     for r in runs:
-        cells = (str(r.calibration_id), _cut(r.trainee, 11), _ON if r.connected else _OFF, _cut(r.method or "-", 10),
+        cells = (str(r.calibration_id), _cut(r.trainee, 11), _ON if r.connected else _OFF,
+                 _cut(_(r.method) if r.method else "-", 10),
                  escape_html(short_step(r.step) or "-"), format_duration(r.step_s), format_duration(r.started_s),
                  str(r.touches))
         style = "" if r.connected else "color:#888"
         body.append(f'<tr style="{style}">' + "".join(f'<td style="{_CELL}">{c}</td>' for c in cells) + "</tr>")
-    return _table(RUN_HEADERS, body, "tcp-dashboard-runs")
+    return _table(RUN_HEADERS, body, "tcp-dashboard-runs", tr)

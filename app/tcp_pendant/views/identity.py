@@ -38,16 +38,26 @@ from collections.abc import Callable
 import viser
 
 from tcp_pendant.classroom.names import TraineeNameError
-from tcp_pendant.session import Session
-from tcp_pendant.text_escape import escape_markdown
+from tcp_pendant.session import Session, SessionChange
+from tcp_pendant.text_escape import escape_html, escape_markdown
+from tcp_pendant.translation import N_, Translator
 from tcp_pendant.views.gui_util import ButtonEvent, set_content, set_value, target_of
 
-__all__ = ["HOLD_ATTRIBUTE", "FORGET_ATTRIBUTE", "IdentityPrompt", "KEY_ATTRIBUTE", "KEY_LABEL", "NAME_LABEL",
-           "TOKEN_LABEL"]
+__all__ = ["HOLD_ATTRIBUTE", "FORGET_ATTRIBUTE", "IdentityPrompt", "KEY_ATTRIBUTE", "KEY_LABEL", "LABELS_ATTRIBUTE",
+           "NAME_LABEL", "TOKEN_LABEL", "labels_html"]
 
-NAME_LABEL = "Your name"
-KEY_LABEL = "Browser key"
-TOKEN_LABEL = "Trainer token"
+NAME_LABEL = N_("Your name")
+KEY_LABEL = N_("Browser key")
+TOKEN_LABEL = N_("Trainer token")
+JOIN_LABEL = N_("Join the class")
+OPEN_TRAINER_LABEL = N_("Open trainer view")
+TRAINER_LINE = N_("*Trainer:* open the trainer address the server printed (/?trainer=...), or open /?trainer and "
+                  "type the token here.")
+BANNER = N_("Trainee: **{name}**")
+LABELS_ATTRIBUTE = "data-tcp-pendant-labels"
+"""The hidden element that hands the page script the welcome window's labels in the session's
+language (``data-name``, ``data-key``, ``data-join``, ``data-token``, ``data-open-trainer``,
+``data-trainer-line``, ``data-banner``; the script looks for them by their text)."""
 KEY_ATTRIBUTE = "data-tcp-pendant-key"
 """The hidden element that hands a new browser key to the page script."""
 HOLD_ATTRIBUTE = "data-tcp-pendant-hold"
@@ -57,6 +67,18 @@ FORGET_ATTRIBUTE = "data-tcp-pendant-forget"
 _MAX_TOKEN_CHARS = 200
 _MAX_KEY_CHARS = 200
 _KEY_SHAPE = re.compile(r"[A-Za-z0-9_-]{1,200}")
+
+
+def labels_html(tr: Translator) -> str:
+    """The hidden element of :data:`LABELS_ATTRIBUTE`: the welcome window's labels in ``tr``'s
+    language (escaped attribute values; the banner's text before the name)."""
+    _ = tr.gettext
+    labels = {"name": _(NAME_LABEL), "key": _(KEY_LABEL), "join": _(JOIN_LABEL), "token": _(TOKEN_LABEL),
+              "open-trainer": _(OPEN_TRAINER_LABEL),
+              "trainer-line": _(TRAINER_LINE).replace("*", "").split(" ", 1)[0],
+              "banner": _(BANNER).split("**", 1)[0].strip()}
+    attributes = " ".join(f'data-{key}="{escape_html(value)}"' for key, value in labels.items())
+    return f"<div hidden {LABELS_ATTRIBUTE} {attributes}></div>"
 
 
 class IdentityPrompt:
@@ -86,26 +108,62 @@ class IdentityPrompt:
         self._on_token = on_token
         gui = target_of(session).gui
         self.banner = gui.add_markdown("", order=-1000.0, visible=False)
+        self.labels_html = gui.add_html(labels_html(session.translator), order=-1002.0)
         self.key_html: viser.GuiHtmlHandle | None = None
         self.marker_html: viser.GuiHtmlHandle | None = None
+        self._marker = ""
+        self._message: tuple[str, dict[str, str]] | None = None    # the modal's warning: msgid, values
         self._build("")
+        session.subscribe(self.on_change)
+
+    def on_change(self, change: SessionChange) -> None:
+        """The session's language changed: the welcome window (rebuilt, what was typed kept), its
+        banner and the labels the page script looks for, in it."""
+        if not change.language:
+            return
+        tr = self.session.translator
+        set_content(self.labels_html, labels_html(tr))
+        if self.name is not None:
+            set_content(self.banner, tr.gettext(BANNER).format(name=escape_markdown(self.name)))
+        if self._modal_open:
+            typed = (self.name_field.value, self.key_field.value, self.token_field.value)
+            self._close_modal()
+            self._build(self._marker)
+            set_value(self.name_field, typed[0])
+            set_value(self.key_field, typed[1])
+            set_value(self.token_field, typed[2])
+            self._show_message()
+
+    def _say(self, message: str, **values: str) -> None:
+        """A warning in the modal: ``message`` (an English msgid) with ``values`` (plain text,
+        escaped here), in the session's language (again after a language change)."""
+        self._message = (message, values)
+        self._show_message()
+
+    def _show_message(self) -> None:
+        if self._message is None:
+            return
+        message, values = self._message
+        text = self.session.translator.gettext(message) if message else "{text}"
+        set_content(self.message, "⚠ " + text.format(**{k: escape_markdown(v) for k, v in values.items()}))
 
     def _build(self, marker: str) -> None:
         gui = target_of(self.session).gui
-        self.modal = gui.add_modal("Welcome to the TCP Pendant")
+        _ = self.session.translator.gettext
+        self._marker = marker
+        self.modal = gui.add_modal(_("Welcome to the TCP Pendant"))
         with self.modal:
-            gui.add_markdown("Type the name your trainer should see in the class list "
-                             "(this browser remembers it for reconnects).")
-            self.name_field = gui.add_text(NAME_LABEL, "")
-            self.key_field = gui.add_text(KEY_LABEL, "", hint="Filled in by this page for a browser that "
-                                          "joined before; leave it empty.")
-            self.start = gui.add_button("Join the class", color="green")
+            gui.add_markdown(_("Type the name your trainer should see in the class list "
+                               "(this browser remembers it for reconnects)."))
+            self.name_field = gui.add_text(_(NAME_LABEL), "")
+            self.key_field = gui.add_text(_(KEY_LABEL), "", hint=_("Filled in by this page for a browser that "
+                                                                   "joined before; leave it empty."))
+            self.start = gui.add_button(_(JOIN_LABEL), color="green")
             self.message = gui.add_markdown("")
             self.marker_html = gui.add_html(f"<div hidden {marker}></div>") if marker else None
-            gui.add_markdown("*Trainer:* open the trainer address the server printed (/?trainer=...), "
-                             "or open /?trainer and type the token here.")
-            self.token_field = gui.add_text(TOKEN_LABEL, "")
-            self.open_trainer = gui.add_button("Open trainer view")
+            gui.add_markdown(_(TRAINER_LINE))
+            self.token_field = gui.add_text(_(TOKEN_LABEL), "")
+            self.open_trainer = gui.add_button(_(OPEN_TRAINER_LABEL))
         self._modal_open = True
         self.start.on_click(self.session.loop.on_loop(self._start))
         self.open_trainer.on_click(self.session.loop.on_loop(self._trainer))
@@ -116,8 +174,11 @@ class IdentityPrompt:
         key = str(self.key_field.value or "")[:_MAX_KEY_CHARS]
         try:
             name, new_key = self._on_name(self.name_field.value, key)
-        except (TraineeNameError, ValueError) as exc:
-            self.message.content = f"⚠ {escape_markdown(str(exc))}"
+        except TraineeNameError as exc:
+            self._say(exc.message, **exc.values)
+            return
+        except ValueError as exc:
+            self._say("", text=str(exc))
             return
         set_value(self.key_field, "")
         self.accepted(name, new_key)
@@ -126,8 +187,9 @@ class IdentityPrompt:
         """The class took the browser as ``name``: close the modal, show the banner, and hand a
         newly issued key to the page script."""
         self.name = name
+        self._message = None
         self._close_modal()
-        self.banner.content = f"Trainee: **{escape_markdown(name)}**"
+        self.banner.content = self.session.translator.gettext(BANNER).format(name=escape_markdown(name))
         self.banner.visible = True
         if new_key is not None:
             if not _KEY_SHAPE.fullmatch(new_key):        # ours, but it goes into HTML: check anyway
@@ -147,7 +209,7 @@ class IdentityPrompt:
             self.key_html = None
         self._close_modal()
         self._build(FORGET_ATTRIBUTE if forget else HOLD_ATTRIBUTE)
-        self.message.content = f"⚠ {escape_markdown(message)}"
+        self._say("", text=message)
 
     def _trainer(self, _event: ButtonEvent | None = None) -> None:
         token = str(self.token_field.value)[:_MAX_TOKEN_CHARS]
@@ -155,10 +217,10 @@ class IdentityPrompt:
         try:
             opened = self._on_token(token)
         except ValueError as exc:                  # too many wrong tokens: wait
-            set_content(self.message, f"⚠ {escape_markdown(str(exc))}")
+            self._say("", text=str(exc))
             return
         if not opened:
-            self.message.content = "⚠ That trainer token is not right; type the token the server printed."
+            self._say(N_("That trainer token is not right; type the token the server printed."))
             return
         if self.session.views.get("identity") is self:    # else the dashboard cleared the GUI, this modal too
             self._close_modal()

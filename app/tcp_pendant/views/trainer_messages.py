@@ -18,13 +18,18 @@ import viser
 from tcp_pendant.classroom.class_messages import MAX_MESSAGE_CHARS
 from tcp_pendant.session import Session
 from tcp_pendant.text_escape import escape_markdown
+from tcp_pendant.translation import ENGLISH, N_, Translator
+from tcp_pendant.views.dashboard_words import DashboardWords
 from tcp_pendant.views.gui_util import ButtonEvent, set_options, set_value
 
 __all__ = ["TO_ALL", "MessageControl", "MessageControls", "build_message_controls"]
 
-TO_ALL = "(all trainees) "
+MESSAGE_HINT = N_("Plain text, at most {n} characters; it stays on the trainee's screen until they dismiss it.")
+"""The message box's hint (``{n}``: the most characters)."""
+TO_ALL_WORDS = N_("(all trainees)")
+TO_ALL = TO_ALL_WORDS + " "
 """The first "To" choice (its trailing space keeps it apart from every trainee's name, which is
-stripped)."""
+stripped), in English; shown in the dashboard's language."""
 
 
 class MessageControl(Protocol):
@@ -32,7 +37,7 @@ class MessageControl(Protocol):
 
     def connected_names(self) -> list[str]: ...
 
-    def send_message(self, text: str, to: str | None = None) -> str: ...
+    def send_message(self, text: str, to: str | None = None, *, tr: Translator = ENGLISH) -> str: ...
 
 
 @dataclass(eq=False)
@@ -49,32 +54,43 @@ class MessageControls:
     to: viser.GuiDropdownHandle[str]
     send: viser.GuiButtonHandle
     status: viser.GuiMarkdownHandle
+    words: DashboardWords
+
+    def _to_all(self) -> str:
+        return self.session.translator.gettext(TO_ALL_WORDS) + " "
 
     def render(self) -> None:
-        """Re-list the connected trainees in "To" (the choice kept while its trainee is there)."""
-        set_options(self.to, (TO_ALL, *self.control.connected_names()))
+        """Re-list the connected trainees in "To" (the choice kept while its trainee is there),
+        the words in the dashboard's language."""
+        self.words.follow()
+        hint = self.session.translator.gettext(MESSAGE_HINT).format(n=MAX_MESSAGE_CHARS)
+        if self.text.hint != hint:
+            self.text.hint = hint
+        to_all = self._to_all()
+        keep = to_all if str(self.to.value).endswith(" ") else None       # "(all trainees) " in any language
+        set_options(self.to, (to_all, *self.control.connected_names()), keep)
 
     def _send(self, _event: ButtonEvent | None = None) -> None:
         text = self.text.value
         if not isinstance(text, str):
             raise ValueError("The message must be text.")
         picked = str(self.to.value)
-        to = None if picked == TO_ALL else picked
-        self.status.content = escape_markdown(self.control.send_message(text, to))
+        to = None if picked in (TO_ALL, self._to_all()) else picked
+        self.status.content = escape_markdown(self.control.send_message(text, to, tr=self.session.translator))
         set_value(self.text, "")
 
 
 def build_message_controls(gui: viser.GuiApi, class_control: MessageControl, session: Session) -> MessageControls:
     """Add the message box to ``gui`` (in the container open where it is called) for the
     trainer's ``session``; Send goes to ``class_control``."""
-    with gui.add_folder("Message to trainees"):
-        text = gui.add_text("Message", "", multiline=True,
-                            hint=f"Plain text, at most {MAX_MESSAGE_CHARS} characters; it stays on the "
-                                 "trainee's screen until they dismiss it.")
-        to = gui.add_dropdown("To", (TO_ALL,), initial_value=TO_ALL)
-        send = gui.add_button("Send", color="blue")
+    words = DashboardWords(session)
+    with words(gui.add_folder(""), label=N_("Message to trainees")):
+        text = words(gui.add_text("", "", multiline=True), label=N_("Message"))
+        to_all = session.translator.gettext(TO_ALL_WORDS) + " "
+        to = words(gui.add_dropdown("", (to_all,), initial_value=to_all), label=N_("To"))
+        send = words(gui.add_button("", color="blue"), label=N_("Send"))
         status = gui.add_markdown("")
-    controls = MessageControls(session, class_control, text, to, send, status)
+    controls = MessageControls(session, class_control, text, to, send, status, words)
     send.on_click(session.loop.on_loop(controls._send))
     controls.render()
     return controls

@@ -83,7 +83,10 @@
  * 10. Languages: the labels this script looks for (Increment, its "Cont." button, Shadows, the keys
  *     line's first word) are read in the pendant's language from the hidden
  *     <div data-tcp-pendant-labels data-increment=... data-cont=... data-shadows=... data-keys-line=...>
- *     below the keys line (views/pendant_panel.py), English when it is absent. The jog keys' labels
+ *     below the keys line (views/pendant_panel.py), and the welcome window's (Your name, Browser
+ *     key, Join the class, Trainer token, Open trainer view, the trainer line's and the banner's
+ *     first word) from its own <div data-tcp-pendant-labels data-name=... data-join=...>
+ *     (views/identity.py); English when they are absent. The jog keys' labels
  *     ("X +", "A1 −") are the same in every language.
  */
 (function () {
@@ -128,10 +131,13 @@
     }
     return null;
   }
-  function label(key) {                     // a label in the pendant's language (views/pendant_panel.py
-    var el = document.querySelector("[data-tcp-pendant-labels]");   // hands them over), else English
-    var v = el && el.getAttribute("data-" + key);
-    return v || L[{ "increment": "increment", "cont": "cont", "shadows": "shadows", "keys-line": "keysLine" }[key]];
+  var LABEL_KEYS = { "increment": "increment", "cont": "cont", "shadows": "shadows", "keys-line": "keysLine",
+    "name": "name", "key": "key", "join": "join", "token": "token", "open-trainer": "openTrainer",
+    "trainer-line": "trainerLine", "banner": "banner" };
+  function label(key) {                     // a label in the session's language (views/pendant_panel.py and
+    var el = document.querySelector("[data-tcp-pendant-labels][data-" + key + "]");   // views/identity.py
+    var v = el && el.getAttribute("data-" + key);                                    // hand them over)
+    return v || L[LABEL_KEYS[key]];                                                  // else English
   }
   function field(name) { var row = labelled(name); return row ? row.querySelector("input, textarea") : null; }
   var NOT_TEXT = /^(checkbox|radio|range|button|submit|reset|color|file|image)$/i;
@@ -447,15 +453,15 @@
   var joining = null;                       // {value, input, at}: "Join the class" clicked, not yet accepted
   document.addEventListener("click", function (e) {
     var b = e.target && e.target.closest ? e.target.closest("button") : null;
-    if (!b || text(b) !== L.join) return;
-    var input = field(L.name);
+    if (!b || text(b) !== label("join")) return;
+    var input = field(label("name"));
     if (input) joining = { value: String(input.value), input: input, at: Date.now() };
   }, true);
 
   function bannerShown() {                  // "Trainee: NAME" appears once the server took the name
     var ps = document.querySelectorAll("p, div, span");
     for (var i = 0; i < ps.length; i++) {
-      if (ps[i].children.length <= 2 && text(ps[i]).indexOf(L.banner) === 0) return true;
+      if (ps[i].children.length <= 2 && text(ps[i]).indexOf(label("banner")) === 0) return true;
     }
     return false;
   }
@@ -492,17 +498,17 @@
 
   function hide(el) { if (el && el.style.display !== "none") el.style.display = "none"; }
   function hideTrainerRows() {              // the token row, its button and the trainer's line
-    hide(labelled(L.token));
-    buttonsNamed(L.openTrainer).forEach(hide);
+    hide(labelled(label("token")));
+    buttonsNamed(label("open-trainer")).forEach(hide);
     var ps = document.querySelectorAll("p");
-    for (var i = 0; i < ps.length; i++) if (text(ps[i]).indexOf(L.trainerLine) === 0) hide(ps[i]);
+    for (var i = 0; i < ps.length; i++) if (text(ps[i]).indexOf(label("trainer-line")) === 0) hide(ps[i]);
   }
 
   function scan() {
     browserKey();
     var forget = document.querySelector("[data-tcp-pendant-forget]");
     if (first(forget)) { forgetAll(); joining = null; }
-    var keyRow = labelled(L.key);
+    var keyRow = labelled(label("key"));
     if (keyRow && keyRow.style.display !== "none") keyRow.style.display = "none";   // the script's own field
     if (!trainerPage) hideTrainerRows();    // a trainee's welcome window: no trainer token
     if (!joining && !trainerToken && storedName() === null && storedKey() === null) return;
@@ -510,14 +516,14 @@
       if (bannerShown()) { rememberName(joining.value); joining = null; }
       else if (Date.now() - joining.at > 30000) joining = null;
     }
-    var tokenInput = trainerToken ? field(L.token) : null;
+    var tokenInput = trainerToken ? field(label("token")) : null;
     if (tokenInput) {
-      if (once(tokenInput)) fillAndPress(tokenInput, trainerToken, L.openTrainer);
+      if (once(tokenInput)) fillAndPress(tokenInput, trainerToken, label("open-trainer"));
       return;                               // the trainer's page: no trainee name
     }
-    var nameInput = field(L.name);
+    var nameInput = field(label("name"));
     if (!nameInput || !once(nameInput)) return;
-    var keyInput = field(L.key);
+    var keyInput = field(label("key"));
     var key = storedKey();
     var held = document.querySelector("[data-tcp-pendant-hold], [data-tcp-pendant-forget]");
     var name = storedName();
@@ -525,7 +531,7 @@
       if (keyInput && key) typeInto(keyInput, key);
       return;
     }
-    fillAndPress(nameInput, name, L.join, keyInput, key);
+    fillAndPress(nameInput, name, label("join"), keyInput, key);
   }
 
   // viser 1.1 shows the hint of a button group as a tooltip, not a single button's: name the key
