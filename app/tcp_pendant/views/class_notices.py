@@ -103,7 +103,7 @@ class ClassNoticeView:
             return
         rules, tr = self.session.rules, self.session.translator
         text = (instructions_markdown(rules.instructions, tr=tr) if rules.instructions
-                else tr.gettext("**Exercise**") + f"\n\n{default_instructions_markdown(rules)}"
+                else tr.gettext("**Exercise**") + f"\n\n{default_instructions_markdown(rules, tr=tr)}"
                 if rules.exercise is not None else "")
         if text:
             set_content(self.banner, text)
