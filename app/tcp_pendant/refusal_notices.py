@@ -19,6 +19,10 @@ QUIET_S = 2.0
 """At most one refusal notice per session within this many seconds."""
 
 
+def _more_in_english(n: int) -> str:
+    return f"({n} more {'click was' if n == 1 else 'clicks were'} refused meanwhile.)"
+
+
 class RefusalNotices:
     """Decides which refusals of one session are shown (module docstring).
 
@@ -38,8 +42,10 @@ class RefusalNotices:
         self.shown = 0
         self.suppressed = 0
 
-    def body(self, body: str) -> str | None:
-        """The body to show for a refusal with ``body`` now, or None when it is not shown."""
+    def body(self, body: str, more_words: Callable[[int], str] | None = None) -> str | None:
+        """The body to show for a refusal with ``body`` now, or None when it is not shown;
+        ``more_words(n)`` says how many were left out since the last one shown (the session's
+        language; English when None)."""
         now = self._clock()
         if self._last_s is not None and now - self._last_s < self.quiet_s:
             self._pending += 1
@@ -49,5 +55,6 @@ class RefusalNotices:
         more, self._pending = self._pending, 0
         self.shown += 1
         if more:
-            body = f"{body} ({more} more {'click was' if more == 1 else 'clicks were'} refused meanwhile.)"
+            said = (more_words or _more_in_english)(more)
+            body = f"{body} {said}"
         return body

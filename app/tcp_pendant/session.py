@@ -515,7 +515,10 @@ class Session:
     def notify_refusal(self, title: str, body: str) -> None:
         """A click refused at once, as a warning; coalesced per session (``refusal_notices``:
         at most one every 2 s, the ones left out counted in the next)."""
-        shown = self.refusals.body(body)
+        tr = self.translator
+        shown = self.refusals.body(body, lambda n: tr.ngettext("({n} more click was refused meanwhile.)",
+                                                               "({n} more clicks were refused meanwhile.)",
+                                                               n).format(n=n))
         if shown is not None:
             self.notify(title, shown, kind="warning")
 

@@ -79,8 +79,9 @@
  *    (cloneNode: no HTML parsed here) covers the whole page, with a "Back to the pendant" button
  *    that unticks "Math board" (as a click on it would); the original is hidden in the panel.
  * 10. Languages: the labels this script looks for (Increment, its "Cont." button, Shadows, the keys
- *     line's first word) are read in the pendant's language from the hidden
- *     <div data-tcp-pendant-labels data-increment=... data-cont=... data-shadows=... data-keys-line=...>
+ *     line's first word, the tip views' caption's first words) are read in the pendant's language from the hidden
+ *     <div data-tcp-pendant-labels data-increment=... data-cont=... data-shadows=... data-keys-line=...
+ *     data-tip-views=... data-record-point=...>
  *     below the keys line (views/pendant_panel.py), English when it is absent. The jog keys' labels
  *     ("X +", "A1 −") are the same in every language.
  */
@@ -129,7 +130,8 @@
   function label(key) {                     // a label in the pendant's language (views/pendant_panel.py
     var el = document.querySelector("[data-tcp-pendant-labels]");   // hands them over), else English
     var v = el && el.getAttribute("data-" + key);
-    return v || L[{ "increment": "increment", "cont": "cont", "shadows": "shadows", "keys-line": "keysLine" }[key]];
+    return v || L[{ "increment": "increment", "cont": "cont", "shadows": "shadows", "keys-line": "keysLine",
+                   "tip-views": "tipViews", "record-point": "recordPoint" }[key]];
   }
   function field(name) { var row = labelled(name); return row ? row.querySelector("input, textarea") : null; }
   var NOT_TEXT = /^(checkbox|radio|range|button|submit|reset|color|file|image)$/i;
@@ -303,7 +305,7 @@
   }
 
   function record() {
-    var free = buttonsNamed(L.recordPoint);          // shown outside a wizard only
+    var free = buttonsNamed(label("record-point"));         // shown outside a wizard only
     var b = free.length ? pick(free) : pick(buttonsNamed(L.record));
     if (b) b.click();
   }
@@ -535,7 +537,7 @@
       setTitle(r.plus, "Key " + (i + 1));
       setTitle(r.minus, "Key Shift+" + (i + 1));
     });
-    buttonsNamed(L.record).concat(buttonsNamed(L.recordPoint)).forEach(function (b) { setTitle(b, "Key R"); });
+    buttonsNamed(L.record).concat(buttonsNamed(label("record-point"))).forEach(function (b) { setTitle(b, "Key R"); });
     buttonsNamed(L.next).concat(buttonsNamed(L.finish)).forEach(function (b) { setTitle(b, "Key N"); });
     buttonsNamed(L.back).forEach(function (b) { setTitle(b, "Key B"); });
   }
@@ -677,7 +679,7 @@
   function markScreens() {
     allButtons().forEach(function (b) {     // the keys a finger holds: no pan, no selection, no menu
       var t = text(b);
-      if ((JOG_RE.test(t) || t === L.record || t === L.recordPoint) && !b.hasAttribute("data-tcp-pendant-touch")) {
+      if ((JOG_RE.test(t) || t === L.record || t === label("record-point")) && !b.hasAttribute("data-tcp-pendant-touch")) {
         b.setAttribute("data-tcp-pendant-touch", "1");
       }
     });
@@ -691,7 +693,7 @@
     for (var j = 0; j < imgs.length; j++) {
       var box = imgs[j].parentElement && imgs[j].parentElement.parentElement;   // label + image (viser's image)
       if (!box || box.hasAttribute("data-tcp-pendant-tipviews")) continue;
-      if (text(box).indexOf(L.tipViews) === 0) box.setAttribute("data-tcp-pendant-tipviews", "1");
+      if (text(box).indexOf(label("tip-views")) === 0) box.setAttribute("data-tcp-pendant-tipviews", "1");
     }
   }
 
