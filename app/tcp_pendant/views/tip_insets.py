@@ -27,20 +27,20 @@ if TYPE_CHECKING:
 __all__ = ["CAPTION", "CAPTION_ZOOMED", "TipInsets", "caption_for", "caption_text", "tip_views_title"]
 
 def tip_views_title(tr: Translator = ENGLISH) -> str:
-    """The caption's first words ("Tip close-up"): the page's script finds the views by them
-    (handed over in the pendant panel's hidden labels, ``data-tip-views``)."""
+    """The caption's title ("Tip close-up"): the page's script finds the views by it (handed
+    over in the pendant panel's hidden labels, ``data-tip-views``)."""
     return tr.gettext("Tip close-up")
 
 
 def caption_text(zoomed: bool, tr: Translator = ENGLISH) -> str:
-    """The image's label in ``tr``'s language: zoomed out (``ZOOM_OUT``×) or not; it starts
-    with :func:`tip_views_title`."""
+    """The image's label in ``tr``'s language: zoomed out (``ZOOM_OUT``×) or not; it holds
+    :func:`tip_views_title`."""
     _ = tr.gettext
     if not zoomed:
-        # TRANSLATORS: {title} is "Tip close-up" translated; keep it first (the page finds the views by it)
+        # TRANSLATORS: {title} is "Tip close-up" translated (the page finds the views by it)
         return _("{title} · left: front (X→, Z↑) · right: side (Y→, Z↑) · grid and bar 1 mm · "
                  "magenta: the tool tip").format(title=tip_views_title(tr))
-    # TRANSLATORS: {title} is "Tip close-up" translated; keep it first (the page finds the views by it)
+    # TRANSLATORS: {title} is "Tip close-up" translated (the page finds the views by it)
     return _("{title}, zoomed out {zoom}× (orange frame) · left: front (X→, Z↑) · right: side (Y→, Z↑) · "
              "grid and bar {zoom} mm · magenta: the tool tip, or an arrow the way to it").format(
                  title=tip_views_title(tr), zoom=ZOOM_OUT)
@@ -49,7 +49,7 @@ def caption_text(zoomed: bool, tr: Translator = ENGLISH) -> str:
 CAPTION = caption_text(False)
 CAPTION_ZOOMED = caption_text(True)
 """The image's label in English (:data:`CAPTION_ZOOMED` while zoomed out); the page's script
-(``serve/static/pendant.js``) finds the views by its first words (:func:`tip_views_title`) and
+(``serve/static/pendant.js``) finds the views by its title (:func:`tip_views_title`) and
 floats them over the 3D view's corner, out of the panel's way."""
 
 FAR_MARGIN_MM = 1e-6

@@ -693,7 +693,7 @@
     for (var j = 0; j < imgs.length; j++) {
       var box = imgs[j].parentElement && imgs[j].parentElement.parentElement;   // label + image (viser's image)
       if (!box || box.hasAttribute("data-tcp-pendant-tipviews")) continue;
-      if (text(box).indexOf(label("tip-views")) === 0) box.setAttribute("data-tcp-pendant-tipviews", "1");
+      if (text(box).indexOf(label("tip-views")) >= 0) box.setAttribute("data-tcp-pendant-tipviews", "1");
     }
   }
 
