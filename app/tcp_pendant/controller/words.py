@@ -11,12 +11,15 @@ numbers go in already formatted (``f"{deg:.1f}"``: the readouts' decimal point).
 A string built from :class:`Words` by concatenation or an f-string is a plain ``str`` again
 (English): compose with another :class:`Words` instead (``Words(N_("{stop}. {advice}"), ...)``).
 
-The message ids are marked ``N_()`` where they are written, so Babel extracts them.
+The message ids are marked ``N_()`` where they are written, so Babel extracts them. A message
+with a count (plural forms) is made by :meth:`Words.by` from a function of the translator
+(``Words.by(lambda tr: tr.ngettext(singular, plural, n).format(n=n))``).
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 from tcp_pendant.job_pool import JobRefused, OverShare, PoolFull, SessionBusy
 from tcp_pendant.translation import ENGLISH, Translator
@@ -34,6 +37,7 @@ class Words(str):
 
     msgid: str
     values: dict[str, object]
+    _say: Callable[[Translator], str] | None = None
 
     def __new__(cls, msgid: str, /, **values: object) -> Words:
         self = super().__new__(cls, _render(msgid, values, ENGLISH))
@@ -41,9 +45,21 @@ class Words(str):
         self.values = values
         return self
 
+    @classmethod
+    def by(cls, say: Callable[[Translator], str]) -> Words:
+        """The words ``say(tr)`` composes (a count's plural forms: ``tr.ngettext``)."""
+        english = say(ENGLISH)
+        self = super().__new__(cls, english)
+        self.msgid, self.values, self._say = english, {}, say
+        return self
+
     def text(self, tr: Translator = ENGLISH) -> str:
         """The message in ``tr``'s language (each :class:`Words` value translated too)."""
-        return _render(self.msgid, self.values, tr)
+        return self._say(tr) if self._say is not None else _render(self.msgid, self.values, tr)
+
+    def __reduce__(self) -> tuple[type[str], tuple[str]]:
+        """Pickled (an exception sent to another process) as its English text."""
+        return str, (str(self),)
 
 
 def _render(msgid: str, values: dict[str, object], tr: Translator) -> str:
