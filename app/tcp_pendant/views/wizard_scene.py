@@ -45,7 +45,8 @@ import viser
 from tcp_pendant.calibrate import CalibrationWorkflow
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.session_views import SceneLabel
-from tcp_pendant.translation import ENGLISH, Translator
+from tcp_pendant.controller.words import Words
+from tcp_pendant.translation import ENGLISH, N_, Translator
 from tcp_pendant.views.beam_replay import ScanPlayer, beam_view_direction, scan_spheres
 from tcp_pendant.views.framing import VIEW_DIRECTION, Framing, spread_labels
 from tcp_pendant.views.scene import frame_cameras, wxyz_xyz
@@ -123,13 +124,16 @@ class WizardSceneView:
         session.subscribe(self.on_change)
 
     def on_change(self, change: SessionChange) -> None:
-        """A ``language`` change relabels the triads and the ABC target (their places stay)."""
+        """A ``language`` change relabels the triads and the ABC target; labels moved apart for
+        a result are moved apart again (their boxes' widths changed with the words)."""
         if change.language:
             tr = self.session.translator
             for label, text in ((self.computed_label, computed_label_text(tr)), (self.true_label, true_label_text(tr)),
                                 (self.abc_label, target_label_text(tr))):
                 if label.text != text:
                     label.text = text
+            if self._labels_moved:
+                self.layout_labels()
 
     # ------------------------------------------------------------ result
     def _has_sphere(self) -> bool:
@@ -181,7 +185,7 @@ class WizardSceneView:
         """"Replay scan": the result's scan again, from its first move."""
         scan = getattr(self.workflow.result, "scan", None)
         if scan is None:
-            raise ValueError("This result has no beam scan to replay.")
+            raise ValueError(Words(N_("This result has no beam scan to replay.")))
         self.player.play(scan, owner=self, points=self._scan_points(self.workflow.result))
 
     @property
