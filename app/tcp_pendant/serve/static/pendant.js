@@ -81,7 +81,8 @@
  * 10. Languages: the labels this script looks for (Increment, its "Cont." button, Shadows, the keys
  *     line's first word, the tip views' caption's first words) are read in the pendant's language from the hidden
  *     <div data-tcp-pendant-labels data-increment=... data-cont=... data-shadows=... data-keys-line=...
- *     data-tip-views=... data-record-point=...>
+ *     data-tip-views=... data-record-point=...> (and data-record, data-next, data-finish, data-back for
+ *     the wizard's buttons once their owner hands them over)
  *     below the keys line (views/pendant_panel.py), English when it is absent. The jog keys' labels
  *     ("X +", "A1 −") are the same in every language.
  */
@@ -131,7 +132,8 @@
     var el = document.querySelector("[data-tcp-pendant-labels]");   // hands them over), else English
     var v = el && el.getAttribute("data-" + key);
     return v || L[{ "increment": "increment", "cont": "cont", "shadows": "shadows", "keys-line": "keysLine",
-                   "tip-views": "tipViews", "record-point": "recordPoint" }[key]];
+                   "tip-views": "tipViews", "record-point": "recordPoint", "record": "record", "next": "next",
+                   "finish": "finish", "back": "back" }[key]];
   }
   function field(name) { var row = labelled(name); return row ? row.querySelector("input, textarea") : null; }
   var NOT_TEXT = /^(checkbox|radio|range|button|submit|reset|color|file|image)$/i;
@@ -306,7 +308,7 @@
 
   function record() {
     var free = buttonsNamed(label("record-point"));         // shown outside a wizard only
-    var b = free.length ? pick(free) : pick(buttonsNamed(L.record));
+    var b = free.length ? pick(free) : pick(buttonsNamed(label("record")));
     if (b) b.click();
   }
 
@@ -359,10 +361,10 @@
       if (!e.repeat) record();
     } else if (key === "n" || key === "N") {
       e.preventDefault();
-      if (!e.repeat) step([L.next, L.finish]);
+      if (!e.repeat) step([label("next"), label("finish")]);
     } else if (key === "b" || key === "B") {
       e.preventDefault();
-      if (!e.repeat) step([L.back]);
+      if (!e.repeat) step([label("back")]);
     }
   }
   document.addEventListener("keydown", onKeyDown);
@@ -537,9 +539,9 @@
       setTitle(r.plus, "Key " + (i + 1));
       setTitle(r.minus, "Key Shift+" + (i + 1));
     });
-    buttonsNamed(L.record).concat(buttonsNamed(label("record-point"))).forEach(function (b) { setTitle(b, "Key R"); });
-    buttonsNamed(L.next).concat(buttonsNamed(L.finish)).forEach(function (b) { setTitle(b, "Key N"); });
-    buttonsNamed(L.back).forEach(function (b) { setTitle(b, "Key B"); });
+    buttonsNamed(label("record")).concat(buttonsNamed(label("record-point"))).forEach(function (b) { setTitle(b, "Key R"); });
+    buttonsNamed(label("next")).concat(buttonsNamed(label("finish"))).forEach(function (b) { setTitle(b, "Key N"); });
+    buttonsNamed(label("back")).forEach(function (b) { setTitle(b, "Key B"); });
   }
 
   // the trainer's message (class "trainer-message", views/class_notices.py) above the presenter's
@@ -679,7 +681,7 @@
   function markScreens() {
     allButtons().forEach(function (b) {     // the keys a finger holds: no pan, no selection, no menu
       var t = text(b);
-      if ((JOG_RE.test(t) || t === L.record || t === label("record-point")) && !b.hasAttribute("data-tcp-pendant-touch")) {
+      if ((JOG_RE.test(t) || t === label("record") || t === label("record-point")) && !b.hasAttribute("data-tcp-pendant-touch")) {
         b.setAttribute("data-tcp-pendant-touch", "1");
       }
     });
