@@ -58,7 +58,7 @@ def test_a_german_browser_gets_the_jog_tab_in_german_and_its_keys_work(app_facto
 
 
 def test_in_the_pseudo_locale_the_tabs_follow_a_live_switch_and_the_record_key_finds_record_point(
-        app_factory, new_page: Callable[..., Any]) -> None:
+        app_factory, new_page: Callable[..., Any], shot) -> None:
     """The tabs' titles come from the catalogs and change with the session's language (viser
     cannot retitle a tab by its public API: ``viser_adapter.set_tab_label``), and the R key
     finds "Record point" by its label in the session's language (the panel's hidden labels)."""
@@ -73,6 +73,8 @@ def test_in_the_pseudo_locale_the_tabs_follow_a_live_switch_and_the_record_key_f
     assert page.get_by_role("tab", name="Calibrate", exact=True).count() == 0
     page.keyboard.press("r")
     wait_until(lambda: len(s.touches) == 1, "a free touch by the R key")
+    page.get_by_role("button", name=qps.gettext("Delete P{n}").format(n=1)).first.wait_for(timeout=TIMEOUT_MS)
+    assert_not_blank(shot(page, "pseudo_tabs_and_labels"), min_colors=200)   # the tabs and the 3D labels
     with s.lock:
         s.set_language("en")
     for title in ("Jog", "Tool", "Calibrate"):
