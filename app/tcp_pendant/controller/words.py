@@ -30,9 +30,9 @@ __all__ = ["Words", "error_text", "in_language"]
 class Words(str):
     """English text (the ``str`` value) that can be said in another language (:meth:`text`).
 
-    Args:
-        msgid: the English message with named ``{placeholders}`` (marked ``N_()``).
-        values: the placeholders' values: text (names, formatted numbers) or :class:`Words`.
+    ``Words(msgid, **values)``: ``msgid`` is the English message with named ``{placeholders}``
+    (marked ``N_()``), ``values`` the placeholders' values: text (names, formatted numbers) or
+    :class:`Words`.
     """
 
     msgid: str
