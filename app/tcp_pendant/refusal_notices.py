@@ -34,8 +34,11 @@ class RefusalNotices:
         shown, suppressed: refusals shown, and not shown, so far.
     """
 
-    def __init__(self, quiet_s: float = QUIET_S, clock: Callable[[], float] = time.monotonic) -> None:
+    def __init__(self, quiet_s: float = QUIET_S, clock: Callable[[], float] = time.monotonic,
+                 more_words: Callable[[int], str] | None = None) -> None:
         self.quiet_s = float(quiet_s)
+        self.more_words = more_words
+        """How many refusals were left out, in words (the session's language); None: English."""
         self._clock = clock
         self._last_s: float | None = None
         self._pending = 0
@@ -44,8 +47,8 @@ class RefusalNotices:
 
     def body(self, body: str, more_words: Callable[[int], str] | None = None) -> str | None:
         """The body to show for a refusal with ``body`` now, or None when it is not shown;
-        ``more_words(n)`` says how many were left out since the last one shown (the session's
-        language; English when None)."""
+        ``more_words(n)`` (else the notices' own :attr:`more_words`, else English) says how
+        many were left out since the last one shown."""
         now = self._clock()
         if self._last_s is not None and now - self._last_s < self.quiet_s:
             self._pending += 1
@@ -55,6 +58,6 @@ class RefusalNotices:
         more, self._pending = self._pending, 0
         self.shown += 1
         if more:
-            said = (more_words or _more_in_english)(more)
+            said = (more_words or self.more_words or _more_in_english)(more)
             body = f"{body} {said}"
         return body

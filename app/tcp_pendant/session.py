@@ -275,7 +275,7 @@ class Session:
         self.jogger.stop_at_contact = not self.hide_distance
         self.loop = SessionLoop(self)
         self.views = ViewRegistry()
-        self.refusals = RefusalNotices()
+        self.refusals = RefusalNotices(more_words=self._refusals_left_out)
         self.scenario_player = ScenarioPlayer(self.controller, self._records_total)
         self.tools = SessionTools(self)
         self.workflow.state = self.tools        # the workflow mounts tools and sets data through them
@@ -516,12 +516,14 @@ class Session:
     def notify_refusal(self, title: str, body: str) -> None:
         """A click refused at once, as a warning; coalesced per session (``refusal_notices``:
         at most one every 2 s, the ones left out counted in the next)."""
-        tr = self.translator
-        shown = self.refusals.body(body, lambda n: tr.ngettext("({n} more click was refused meanwhile.)",
-                                                               "({n} more clicks were refused meanwhile.)",
-                                                               n).format(n=n))
+        shown = self.refusals.body(body)
         if shown is not None:
             self.notify(title, shown, kind="warning")
+
+    def _refusals_left_out(self, n: int) -> str:
+        """The count of refusals a notice left out, in this session's language."""
+        return self.translator.ngettext("({n} more click was refused meanwhile.)",
+                                        "({n} more clicks were refused meanwhile.)", n).format(n=n)
 
     def clients(self) -> list[Browser]:
         """The browser(s) that show this session: its own, or every browser of the shared GUI."""

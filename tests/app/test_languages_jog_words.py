@@ -5,9 +5,11 @@ from the catalogs, in English they are what they were."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
-from support.calib_helpers import make_controller
+from support.calib_helpers import make_controller, make_session
 from support.pseudo_text import untranslated_words
 
 from tcp_pendant.controller.jog import singularity_message
@@ -120,3 +122,14 @@ def test_the_servers_refusals_and_the_count_of_refusals_left_out_in_the_pseudo_l
     assert notices.body("No.") == "No. (1 more click was refused meanwhile.)"   # English by default
     clock[0] = 15.0
     assert notices.body("No.", more) == "No."              # nothing left out: no count
+
+
+def test_a_sessions_refusal_notices_count_the_left_out_ones_in_its_language(tmp_path: Path) -> None:
+    s = make_session(tmp_path / "tools.json")
+    clock = [0.0]
+    s.refusals = RefusalNotices(quiet_s=2.0, clock=lambda: clock[0], more_words=s.refusals.more_words)
+    assert s.refusals.body("No.") == "No." and s.refusals.body("No.") is None
+    s.set_language(PSEUDO_LANGUAGE)
+    clock[0] = 5.0
+    assert s.refusals.body("No.") == "No. " + QPS.ngettext("({n} more click was refused meanwhile.)",
+                                                          "({n} more clicks were refused meanwhile.)", 1).format(n=1)
