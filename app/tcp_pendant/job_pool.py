@@ -125,11 +125,19 @@ class JobRefused(ValueError):
 
 
 class SessionBusy(JobRefused):
-    """The session already has a job queued or running."""
+    """The session already has a job queued or running (``what``: that job, as its caller named it)."""
+
+    def __init__(self, message: str, what: str = "") -> None:
+        super().__init__(message)
+        self.what = what
 
 
 class PoolFull(JobRefused):
-    """The queue is full."""
+    """The queue is full (``waiting``: the jobs waiting)."""
+
+    def __init__(self, message: str, waiting: int = 0) -> None:
+        super().__init__(message)
+        self.waiting = waiting
 
 
 class OverShare(JobRefused):
@@ -248,7 +256,7 @@ class JobPool:
             busy = last is not None and now - last < self.rest_s
             waiting = len(self._queue)
             if waiting >= (self.max_queued if busy else 2 * self.max_queued):
-                raise PoolFull(f"The server is busy: {waiting} jobs are waiting. Try again in a moment.")
+                raise PoolFull(f"The server is busy: {waiting} jobs are waiting. Try again in a moment.", waiting)
             job = _Job(owner, fn, what, future, now, busy)
             self._pending[id(owner)] = job
             heapq.heappush(self._queue, (now + (self.busy_delay_s if busy else 0.0), next(self._order), job))
@@ -273,7 +281,7 @@ class JobPool:
         running = self._pending.get(id(owner))
         if running is not None:
             raise SessionBusy(f"{running.what[:1].upper()}{running.what[1:]} is still running here; "
-                              "wait for its result, then try again.")
+                              "wait for its result, then try again.", running.what)
         retry_in_s = self._retry_in_s(owner, now)
         if retry_in_s > 0.0:
             wait = max(1, math.ceil(retry_in_s))

@@ -19,6 +19,10 @@ QUIET_S = 2.0
 """At most one refusal notice per session within this many seconds."""
 
 
+def _more_in_english(n: int) -> str:
+    return f"({n} more {'click was' if n == 1 else 'clicks were'} refused meanwhile.)"
+
+
 class RefusalNotices:
     """Decides which refusals of one session are shown (module docstring).
 
@@ -30,16 +34,21 @@ class RefusalNotices:
         shown, suppressed: refusals shown, and not shown, so far.
     """
 
-    def __init__(self, quiet_s: float = QUIET_S, clock: Callable[[], float] = time.monotonic) -> None:
+    def __init__(self, quiet_s: float = QUIET_S, clock: Callable[[], float] = time.monotonic,
+                 more_words: Callable[[int], str] | None = None) -> None:
         self.quiet_s = float(quiet_s)
+        self.more_words = more_words
+        """How many refusals were left out, in words (the session's language); None: English."""
         self._clock = clock
         self._last_s: float | None = None
         self._pending = 0
         self.shown = 0
         self.suppressed = 0
 
-    def body(self, body: str) -> str | None:
-        """The body to show for a refusal with ``body`` now, or None when it is not shown."""
+    def body(self, body: str, more_words: Callable[[int], str] | None = None) -> str | None:
+        """The body to show for a refusal with ``body`` now, or None when it is not shown;
+        ``more_words(n)`` (else the notices' own :attr:`more_words`, else English) says how
+        many were left out since the last one shown."""
         now = self._clock()
         if self._last_s is not None and now - self._last_s < self.quiet_s:
             self._pending += 1
@@ -49,5 +58,6 @@ class RefusalNotices:
         more, self._pending = self._pending, 0
         self.shown += 1
         if more:
-            body = f"{body} ({more} more {'click was' if more == 1 else 'clicks were'} refused meanwhile.)"
+            said = (more_words or self.more_words or _more_in_english)(more)
+            body = f"{body} {said}"
         return body

@@ -63,6 +63,7 @@ from tcp_pendant.calibrate.workflow import CalibrationWorkflow, ControllerToolSt
 from tcp_pendant.controller import ControllerError, JogResult, VirtualController
 from tcp_pendant.controller.pose_state import PoseState, pose_state, pose_state_key
 from tcp_pendant.controller.scenarios import ScenarioWorld
+from tcp_pendant.controller.words import Words
 from tcp_pendant.events import Crash, SessionEvent
 from tcp_pendant.job_pool import JobPool, default_pool
 from tcp_pendant.pendant import Jogger, touch_label
@@ -274,7 +275,7 @@ class Session:
         self.jogger.stop_at_contact = not self.hide_distance
         self.loop = SessionLoop(self)
         self.views = ViewRegistry()
-        self.refusals = RefusalNotices()
+        self.refusals = RefusalNotices(more_words=self._refusals_left_out)
         self.scenario_player = ScenarioPlayer(self.controller, self._records_total)
         self.tools = SessionTools(self)
         self.workflow.state = self.tools        # the workflow mounts tools and sets data through them
@@ -519,6 +520,11 @@ class Session:
         if shown is not None:
             self.notify(title, shown, kind="warning")
 
+    def _refusals_left_out(self, n: int) -> str:
+        """The count of refusals a notice left out, in this session's language."""
+        return self.translator.ngettext("({n} more click was refused meanwhile.)",
+                                        "({n} more clicks were refused meanwhile.)", n).format(n=n)
+
     def clients(self) -> list[Browser]:
         """The browser(s) that show this session: its own, or every browser of the shared GUI."""
         if self.client is not None:
@@ -564,8 +570,11 @@ class Session:
         """
         with self.lock:
             if isinstance(index, bool) or not isinstance(index, int) or not 0 <= index < len(self.touches):
-                raise ControllerError(f"There is no touch P{index + 1 if isinstance(index, int) else index}; "
-                                      f"{len(self.touches)} recorded.")
+                name = f"P{index + 1 if isinstance(index, int) else index}"
+                count = len(self.touches)
+                raise ControllerError(Words.by(lambda tr: tr.ngettext(
+                    "There is no touch {name}; {n} recorded.", "There is no touch {name}; {n} recorded.",
+                    count).format(name=name, n=count)))
             del self.touches[index]
             self.touches[:] = [Touch(t.T_world_flange, touch_label(i, t.T_world_flange), t.distance_mm,
                                      t.joints_deg, t.tool_key) for i, t in enumerate(self.touches)]

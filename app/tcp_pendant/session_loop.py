@@ -26,7 +26,9 @@ from collections.abc import Callable, Coroutine, Iterator
 from contextlib import contextmanager
 from typing import Any, ParamSpec, Protocol, TypeVar
 
+from tcp_pendant.controller.words import error_text
 from tcp_pendant.job_pool import JobPool
+from tcp_pendant.translation import Translator
 
 __all__ = ["LoopHost", "SessionLoop", "running_loop"]
 
@@ -41,6 +43,7 @@ class LoopHost(Protocol):
     lock: threading.RLock
     closed: bool
     jobs: JobPool
+    translator: Translator
 
     def notify(self, title: str, body: str, *, kind: str = "info") -> None: ...
 
@@ -73,10 +76,11 @@ class SessionLoop:
                         return None
                     return fn(*args, **kwargs)
             except ValueError as exc:  # our packages' errors are ValueErrors with clear messages
-                host.notify("Not done", str(exc), kind="warning")
+                tr = host.translator
+                host.notify(tr.gettext("Not done"), error_text(exc, tr), kind="warning")
             except Exception as exc:  # never let a browser event kill the server
                 log.exception("callback %s failed", getattr(fn, "__name__", fn))
-                host.notify("Internal error", f"{type(exc).__name__}: {exc}", kind="error")
+                host.notify(host.translator.gettext("Internal error"), f"{type(exc).__name__}: {exc}", kind="error")
             return None
 
         return wrapper

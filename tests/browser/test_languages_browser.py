@@ -12,6 +12,8 @@ import pytest
 
 from support.pendant_page import TIMEOUT_MS, assert_not_blank, wait_text, wait_until
 
+from tcp_pendant.translation import PSEUDO_LANGUAGE, translator
+
 pytestmark = pytest.mark.browser
 
 
@@ -53,3 +55,30 @@ def test_a_german_browser_gets_the_jog_tab_in_german_and_its_keys_work(app_facto
     selector.scroll_into_view_if_needed(timeout=TIMEOUT_MS)
     page.wait_for_timeout(300)
     assert_not_blank(shot(page, "jog_tab_de_view_folder"), min_colors=200)
+
+
+def test_in_the_pseudo_locale_the_tabs_follow_a_live_switch_and_the_record_key_finds_record_point(
+        app_factory, new_page: Callable[..., Any], shot) -> None:
+    """The tabs' titles come from the catalogs and change with the session's language (viser
+    cannot retitle a tab by its public API: ``viser_adapter.set_tab_label``), and the R key
+    finds "Record point" by its label in the session's language (the panel's hidden labels)."""
+    qps = translator(PSEUDO_LANGUAGE)
+    app = app_factory(language=PSEUDO_LANGUAGE)
+    page = new_page(app.url, wait_for=qps.gettext("Record point"))
+    page.wait_for_function("document.documentElement.dataset.tcpPendantScript === '1'", timeout=TIMEOUT_MS)
+    wait_until(lambda: len(app.sessions) == 1, "the page's session")
+    (s,) = app.sessions.values()
+    for title in ("Jog", "Tool", "Calibrate"):
+        page.get_by_role("tab", name=qps.pgettext("tab", title)).first.wait_for(timeout=TIMEOUT_MS)
+    assert page.get_by_role("tab", name="Calibrate", exact=True).count() == 0
+    page.keyboard.press("r")
+    wait_until(lambda: len(s.touches) == 1, "a free touch by the R key")
+    page.get_by_role("button", name=qps.gettext("Delete P{n}").format(n=1)).first.wait_for(timeout=TIMEOUT_MS)
+    assert_not_blank(shot(page, "pseudo_tabs_and_labels"), min_colors=200)   # the tabs and the 3D labels
+    with s.lock:
+        s.set_language("en")
+    for title in ("Jog", "Tool", "Calibrate"):
+        page.get_by_role("tab", name=title, exact=True).first.wait_for(timeout=TIMEOUT_MS)
+    page.get_by_role("button", name="Record point").first.wait_for(timeout=TIMEOUT_MS)
+    page.keyboard.press("r")
+    wait_until(lambda: len(s.touches) == 2, "a free touch by the R key, in English")

@@ -51,6 +51,8 @@ from typing import TypedDict
 
 from tcpcal.library import OwnerQuotaError, SlotOwnedError, ToolLibraryError
 from tcp_pendant.controller.errors import ControllerError
+from tcp_pendant.controller.words import Words
+from tcp_pendant.translation import N_
 
 __all__ = [
     "AUTO_TOUCH_REFUSED",
@@ -65,16 +67,18 @@ __all__ = [
     "check_tool_change",
 ]
 
-DISTANCE_LOCKED = ("The trainer has locked the distance aids for this exercise: judge the touch by eye, "
-                   "as on a real robot (the distance, the Δ line and the stop at the tip stay off).")
-AUTO_TOUCH_REFUSED = ("Auto-touch is off in this exercise: the robot would touch for you. Jog the tool tip "
-                      "onto the reference tip and press Record (the trainer can allow Auto-touch).")
+DISTANCE_LOCKED = N_("The trainer has locked the distance aids for this exercise: judge the touch by eye, "
+                     "as on a real robot (the distance, the Δ line and the stop at the tip stay off).")
+AUTO_TOUCH_REFUSED = N_("Auto-touch is off in this exercise: the robot would touch for you. Jog the tool tip "
+                        "onto the reference tip and press Record (the trainer can allow Auto-touch).")
 TOOL_LOCKED_WORDS = "This exercise keeps your own tool mounted"
 """The start of the refusal of a tool change in an exercise (:func:`check_tool_change`)."""
 
 
 class RuleRefusal(ControllerError):
-    """A command the exercise forbids (a ``ValueError``: the session shows it as a warning)."""
+    """A command the exercise forbids (a ``ValueError``: the session shows it as a warning); its
+    message is :class:`~tcp_pendant.controller.words.Words` (``words.error_text`` says it in the
+    session's language)."""
 
 
 def check_tool_change(held_key: str, held_label: str, wanted_key: str, wanted_label: str) -> None:
@@ -86,9 +90,10 @@ def check_tool_change(held_key: str, held_label: str, wanted_key: str, wanted_la
     """
     if wanted_key == held_key:
         return
-    raise RuleRefusal(f"{TOOL_LOCKED_WORDS} (the {held_label.lower()}): the trainer gave it to you to "
-                      f"calibrate, so the {wanted_label.lower()} cannot be mounted. (The XYZ reference method "
-                      "mounts its reference tool for its first touch by itself, with its Mount the tool button.)")
+    raise RuleRefusal(Words(N_("This exercise keeps your own tool mounted (the {held}): the trainer gave it to you "
+                               "to calibrate, so the {wanted} cannot be mounted. (The XYZ reference method mounts "
+                               "its reference tool for its first touch by itself, with its Mount the tool button.)"),
+                            held=held_label.lower(), wanted=wanted_label.lower()))
 
 
 def check_calibrated_tool(held_key: str, held_label: str, calibrated_key: str | None, method_title: str) -> None:
@@ -100,9 +105,9 @@ def check_calibrated_tool(held_key: str, held_label: str, calibrated_key: str | 
     """
     if calibrated_key is None or calibrated_key == held_key:
         return
-    raise RuleRefusal(f"This exercise calibrates your own tool (the {held_label.lower()}): the {method_title} "
-                      f"method can only measure it. Choose the {held_label.lower()} as the tool to calibrate "
-                      "(the XYZ reference method: as its New tool).")
+    raise RuleRefusal(Words(N_("This exercise calibrates your own tool (the {held}): the {method} method can only "
+                               "measure it. Choose the {held} as the tool to calibrate (the XYZ reference method: "
+                               "as its New tool)."), held=held_label.lower(), method=Words(method_title)))
 
 
 @dataclass(frozen=True)
@@ -142,20 +147,23 @@ class ExerciseRules:
         """
         if self.allows_method(kind):
             return
-        allowed = [titles.get(k, k) for k in self.allowed_methods or ()]
-        raise RuleRefusal(f"This exercise does not use the {titles.get(kind, kind)} method: choose "
-                          f"{' or '.join(allowed)} (the trainer chose the methods).")
+        allowed: str = ""
+        for k in self.allowed_methods or ():           # "A or B or C", each title in the reader's language
+            title = Words(titles.get(k, k))
+            allowed = Words(N_("{first} or {second}"), first=allowed, second=title) if allowed else title
+        raise RuleRefusal(Words(N_("This exercise does not use the {method} method: choose {methods} (the trainer "
+                                   "chose the methods)."), method=Words(titles.get(kind, kind)), methods=allowed))
 
     def touches_refusal(self, n_touches: int, *, can_add_point: bool) -> str | None:
         """Why a Finish with ``n_touches`` touches is refused (None: it is not), for a method
-        whose touch count the trainee chooses."""
+        whose touch count the trainee chooses (:class:`~tcp_pendant.controller.words.Words`)."""
         missing = self.min_touches - int(n_touches)
         if missing <= 0:
             return None
-        how = ("press Add point for another touch step" if can_add_point else
-               f"start it again with {self.min_touches} touches or more")
-        return (f"This exercise asks for at least {self.min_touches} touches: record {missing} more "
-                f"({how}).")
+        how = (Words(N_("press Add point for another touch step")) if can_add_point else
+               Words(N_("start it again with {n} touches or more"), n=self.min_touches))
+        return Words(N_("This exercise asks for at least {n} touches: record {missing} more ({how})."),
+                     n=self.min_touches, missing=missing, how=how)
 
     @property
     def in_exercise(self) -> bool:
@@ -168,7 +176,7 @@ class ExerciseRules:
             RuleRefusal: ``hide`` is False and the distance aids are locked.
         """
         if self.distance_locked and not hide:
-            raise RuleRefusal(DISTANCE_LOCKED)
+            raise RuleRefusal(Words(DISTANCE_LOCKED))
 
     def check_auto_touch(self) -> None:
         """Refuse Auto-touch where the exercise forbids it.
@@ -177,7 +185,7 @@ class ExerciseRules:
             RuleRefusal: Auto-touch is not allowed.
         """
         if not self.auto_touch_allowed:
-            raise RuleRefusal(AUTO_TOUCH_REFUSED)
+            raise RuleRefusal(Words(AUTO_TOUCH_REFUSED))
 
 
 FREE_PRACTICE = ExerciseRules()
@@ -219,8 +227,8 @@ class LibraryRights:
         if not self.restricted:
             return OwnerKwargs()
         if self.owner is None:
-            raise ToolLibraryError("Join the class with your name first: in a class each library slot "
-                                   "belongs to the trainee who saved it.")
+            raise ToolLibraryError(Words(N_("Join the class with your name first: in a class each library slot "
+                                            "belongs to the trainee who saved it.")))
         return OwnerKwargs(owner=self.owner)
 
     def save_kwargs(self) -> SaveKwargs:
@@ -240,18 +248,20 @@ class LibraryRights:
         try:
             yield
         except SlotOwnedError as exc:
-            whose = ("belongs to another trainee" if exc.owner is not None
-                     else "is the trainer's (saved without an owner)")
-            raise ToolLibraryError(
-                f"Slot {exc.slot} {whose}: you can activate and check it, not change it. Save into a "
-                "free slot or one of your own, or ask the trainer.") from None
+            whose = (Words(N_("Slot {slot} belongs to another trainee"), slot=exc.slot) if exc.owner is not None
+                     else Words(N_("Slot {slot} is the trainer's (saved without an owner)"), slot=exc.slot))
+            raise ToolLibraryError(Words(N_("{whose}: you can activate and check it, not change it. Save into a "
+                                            "free slot or one of your own, or ask the trainer."), whose=whose)) from None
         except OwnerQuotaError as exc:
             slots = ", ".join(map(str, exc.owned))
             n = len(exc.owned)
-            raise ToolLibraryError(
-                f"You have {n} tool{'s' if n != 1 else ''} in the library (slot{'s' if n != 1 else ''} "
-                f"{slots}), the most a trainee may keep ({exc.quota}): delete one of yours first, "
-                "or save into one of your slots to replace it.") from None
+            quota = exc.quota
+            raise ToolLibraryError(Words.by(lambda tr: tr.ngettext(
+                "You have {n} tool in the library (slot {slots}), the most a trainee may keep ({quota}): delete "
+                "one of yours first, or save into one of your slots to replace it.",
+                "You have {n} tools in the library (slots {slots}), the most a trainee may keep ({quota}): delete "
+                "one of yours first, or save into one of your slots to replace it.", n).format(
+                    n=n, slots=slots, quota=quota))) from None
 
 
 UNRESTRICTED = LibraryRights()

@@ -42,6 +42,7 @@ from tcpcal.pose_quality import CandidateGain, candidate_gain
 from tcp_pendant.calibrate.diversity import MIN_TILT_DEG, least_observed
 from tcp_pendant.pendant.jogging import JOG_FRAMES, Jogger, JogMode
 from tcp_pendant.pendant.tilts import TILT_DEG, TiltOption, key_label, keyboard_key
+from tcp_pendant.translation import ENGLISH, Translator
 
 __all__ = ["MIN_MEASURED_SIGMA_MM", "MeterGain", "TiltAdvice", "TiltAdvisor", "meter_gain", "measured_sigma_mm"]
 
@@ -88,11 +89,16 @@ class MeterGain:
     @property
     def basis(self) -> str:
         """"your touches scatter 0.21 mm", "your last calibration scattered 0.21 mm" or
-        "assuming 0.5 mm per touch"."""
+        "assuming 0.5 mm per touch" (English: :meth:`basis_words`)."""
+        return self.basis_words()
+
+    def basis_words(self, tr: Translator = ENGLISH) -> str:
+        """:attr:`basis` in ``tr``'s language."""
         if not self.measured:
-            return f"assuming {self.sigma_mm:g} mm per touch"
-        verb = "scatter" if self.source == "your touches" else "scattered"
-        return f"{self.source} {verb} {self.sigma_mm:.2f} mm"
+            return tr.gettext("assuming {sigma} mm per touch").format(sigma=f"{self.sigma_mm:g}")
+        if self.source == "your touches":
+            return tr.gettext("your touches scatter {sigma} mm").format(sigma=f"{self.sigma_mm:.2f}")
+        return tr.gettext("your last calibration scattered {sigma} mm").format(sigma=f"{self.sigma_mm:.2f}")
 
 
 def _last_scatter(earlier: Sequence[Any]) -> float | None:
@@ -161,9 +167,10 @@ class TiltAdvisor:
         self._skip_R: np.ndarray | None = None
 
     def advise(self, recorded: np.ndarray, R_world_flange: np.ndarray, jogger: Jogger,
-               sigma_mm: float) -> TiltAdvice | None:
+               sigma_mm: float, *, tr: Translator = ENGLISH) -> TiltAdvice | None:
         """The hint for the touches ``recorded`` ((N, 3, 3) ``R_world_flange``) at the flange
-        orientation now; None before the first touch."""
+        orientation now, in ``tr``'s language; None before the first touch."""
+        _ = tr.gettext
         rots = np.asarray(recorded, dtype=float).reshape(-1, 3, 3)
         R_wf = np.asarray(R_world_flange, dtype=float).reshape(3, 3)
         if rots.shape[0] == 0:
@@ -173,8 +180,8 @@ class TiltAdvisor:
         skip = (self._skip if self._skip_R is not None and _angle_deg(self._skip_R, R_wf) < 20.0 else None)
         now = _score(rots, R_wf, sigma_mm)
         nearest = min(_angle_deg(R, R_wf) for R in rots)
-        good = TiltAdvice(None, "", "✔ This orientation is a good one for the next touch: bring the "
-                                    "tips together and Record.")
+        good = TiltAdvice(None, "", _("✔ This orientation is a good one for the next touch: bring the "
+                                      "tips together and Record."))
         active = jogger.settings.frame
         for frame in (active,) + tuple(f for f in JOG_FRAMES if f != active):
             best = self._best(rots, R_wf, jogger.tilts.options(frame), sigma_mm, skip)
@@ -187,11 +194,11 @@ class TiltAdvisor:
             if given != self._last:
                 self._last, self._last_R = given, R_wf
             return TiltAdvice(option, "" if frame == active else frame,
-                              _words(option, score, frame, active, jogger.settings.mode is JogMode.JOINT))
+                              _words(option, score, frame, active, jogger.settings.mode is JogMode.JOINT, tr))
         if nearest >= 0.9 * MIN_TILT_DEG:
             return good
-        return TiltAdvice(None, "", "No 45° tilt is reachable from here with the tip held: press "
-                                    "Ready pose and tilt from there.")
+        return TiltAdvice(None, "", _("No 45° tilt is reachable from here with the tip held: press "
+                                      "Ready pose and tilt from there."))
 
     @staticmethod
     def _best(rots: np.ndarray, R_wf: np.ndarray, options: tuple[TiltOption, ...], sigma_mm: float,
@@ -210,15 +217,22 @@ class TiltAdvisor:
         return best
 
 
-def _words(option: TiltOption, score: tuple[float, float], frame: str, active: str, joint_mode: bool) -> str:
+def _words(option: TiltOption, score: tuple[float, float], frame: str, active: str, joint_mode: bool,
+           tr: Translator = ENGLISH) -> str:
+    """"Tilt next: [set Mode to Cartesian, ][set Jog frame to TOOL, then ]**B −** 45°[ in WORLD]
+    (key Shift+5)[ → predicted TCP error **0.80 mm**].", one message per form (word order)."""
+    _ = tr.gettext
     r = option.reach
-    steps = []
-    if joint_mode:
-        steps.append("set Mode to Cartesian")
-    if frame != active:
-        steps.append(f"set Jog frame to {frame}")
-    how = f"{', '.join(steps)}, then " if steps else ""
-    where = "" if steps else f" in {frame}"
-    tail = f" → predicted TCP error **{score[0]:.2f} mm**" if math.isfinite(score[0]) else ""
-    return (f"Tilt next: {how}**{key_label(r.key, r.sign)}** {r.angle_deg:.0f}°{where} "
-            f"(key {keyboard_key(r.key, r.sign)}){tail}.")
+    tilt = dict(tilt=f"**{key_label(r.key, r.sign)}** {r.angle_deg:.0f}°", key=keyboard_key(r.key, r.sign),
+                frame=frame)
+    if joint_mode and frame != active:
+        text = _("Tilt next: set Mode to Cartesian, set Jog frame to {frame}, then {tilt} (key {key})").format(**tilt)
+    elif joint_mode:
+        text = _("Tilt next: set Mode to Cartesian, then {tilt} (key {key})").format(**tilt)
+    elif frame != active:
+        text = _("Tilt next: set Jog frame to {frame}, then {tilt} (key {key})").format(**tilt)
+    else:
+        text = _("Tilt next: {tilt} in {frame} (key {key})").format(**tilt)
+    if math.isfinite(score[0]):
+        return _("{advice} → predicted TCP error **{error} mm**.").format(advice=text, error=f"{score[0]:.2f}")
+    return _("{advice}.").format(advice=text)

@@ -50,6 +50,8 @@ from tcp_pendant.controller.kinematics import RobotKinematics
 from tcp_pendant.controller.readout import PoseReadout, readout_in_frame
 from tcp_pendant.controller.tools import T_flange_tool_m, ToolModel
 from tcp_pendant.controller.touch import TouchGeometry, touch_geometry
+from tcp_pendant.controller.words import Words
+from tcp_pendant.translation import N_
 
 __all__ = ["VirtualController"]
 
@@ -463,18 +465,19 @@ class VirtualController:
         Fails with ``stopped_by="unreachable"`` and leaves the robot where it was.
         """
         T = check_pose(T_world_tooltrue_target, "T_world_tooltrue_target")
-        return self._ik_move(T, "That pose of the true TOOL frame")
+        return self._ik_move(T, Words(N_("That pose of the true TOOL frame")))
 
-    def _ik_move(self, T_world_tooltrue: np.ndarray, what: str) -> JogResult:
+    def _ik_move(self, T_world_tooltrue: np.ndarray, what: Words) -> JogResult:
         sol = solve_ik(self._true_kin, T_world_tooltrue, self._q,
                        T_flange_tcp=self._tool.T_flange_tool_true)
         if not sol.ok:
             p = T_world_tooltrue[:3, 3] * 1000.0
             return JogResult(False, 0.0, "unreachable",
-                             f"{what} cannot be reached at ({p[0]:.1f}, {p[1]:.1f}, {p[2]:.1f}) mm: "
-                             f"no configuration within the joint limits gets there (closest: "
-                             f"{sol.position_error_m * 1000:.1f} mm, "
-                             f"{math.degrees(sol.rotation_error_rad):.1f} deg away).")
+                             Words(N_("{what} cannot be reached at ({x}, {y}, {z}) mm: no configuration within "
+                                      "the joint limits gets there (closest: {mm} mm, {deg} deg away)."),
+                                   what=what, x=f"{p[0]:.1f}", y=f"{p[1]:.1f}", z=f"{p[2]:.1f}",
+                                   mm=f"{sol.position_error_m * 1000:.1f}",
+                                   deg=f"{math.degrees(sol.rotation_error_rad):.1f}"))
         self._q, self._state = sol.q_rad, None
         return JogResult(True, 1.0, None, "")
 
@@ -505,12 +508,14 @@ class VirtualController:
             noise = (np.random.default_rng() if rng is None else rng).normal(0.0, sigma, 3)
         T = approach_pose(self._tip, tilt_deg=tilt, azimuth_deg=az, spin_deg=spin,
                           tip_offset_tool_mm=offset, noise_world_mm=noise)
-        res = self._ik_move(T, f"The reference tip (with the {self._tool.label.lower()} at tilt "
-                               f"{tilt:.1f} deg, azimuth {az:.1f} deg, spin {spin:.1f} deg)")
+        res = self._ik_move(T, Words(N_("The reference tip (with the {tool} at tilt {tilt} deg, azimuth {azimuth} "
+                                        "deg, spin {spin} deg)"), tool=self._tool.label.lower(),
+                                     tilt=f"{tilt:.1f}", azimuth=f"{az:.1f}", spin=f"{spin:.1f}"))
         if res.ok:
             return res
-        return JogResult(False, 0.0, "unreachable", res.message + " Try a smaller tilt or another azimuth, "
-                         "or move the reference tip closer to the robot.")
+        return JogResult(False, 0.0, "unreachable",
+                         Words(N_("{stop} Try a smaller tilt or another azimuth, or move the reference tip closer "
+                                  "to the robot."), stop=res.message))
 
     # ----------------------------------------------------------------- readouts
     def readout(self, frame: Literal["WORLD", "BASE"] = "WORLD") -> PoseReadout:

@@ -97,6 +97,8 @@ import pinocchio as pin
 from scipy.linalg import lapack
 
 from tcp_pendant.controller.kinematics import RobotKinematics
+from tcp_pendant.controller.words import Words
+from tcp_pendant.translation import N_
 
 __all__ = [
     "JogFrame",
@@ -297,13 +299,20 @@ def singularity_message(kin: RobotKinematics, q_rad: np.ndarray,
     v = np.abs(vt[min(Js.shape) - 1]) if Js.shape[1] >= 6 else np.abs(vt[-1])
     if len(names) != 6:
         moving = [names[i] for i in np.nonzero(v > 0.3)[0]]
-        return f"near a singularity: {' and '.join(moving) or 'the joints'} cannot move the TCP freely"
+        if not moving:
+            return Words(N_("near a singularity: the joints cannot move the TCP freely"))
+        joints: str = moving[0]
+        for name in moving[1:]:                            # "A1 and A2 and A3"
+            joints = Words(N_("{first} and {second}"), first=joints, second=name)
+        return Words(N_("near a singularity: {joints} cannot move the TCP freely"), joints=joints)
     deg = np.degrees(q_rad)
     if v[0] > 0.3:
-        return f"wrist centre near the {names[0]} axis: shoulder singularity"
+        return Words(N_("wrist centre near the {joint} axis: shoulder singularity"), joint=names[0])
     if v[1] + v[2] > 0.3:
-        return f"{names[2]} near {deg[2]:.1f} deg: arm stretched (elbow singularity)"
-    return f"{names[4]} near {deg[4]:.1f} deg: wrist singularity ({names[3]} and {names[5]} aligned)"
+        return Words(N_("{joint} near {angle} deg: arm stretched (elbow singularity)"), joint=names[2],
+                     angle=f"{deg[2]:.1f}")
+    return Words(N_("{joint} near {angle} deg: wrist singularity ({first} and {second} aligned)"),
+                 joint=names[4], angle=f"{deg[4]:.1f}", first=names[3], second=names[5])
 
 
 def _skew(v: np.ndarray) -> np.ndarray:
@@ -534,11 +543,11 @@ def _checked(kin: RobotKinematics, q_start: np.ndarray, sigma_start: float, nt: 
         if sigma_start < 2.0 * eps:
             return _Attempt(q_start, sigma_start, "singularity", singularity_message(kin, q_start, settings))
         if not converged:
-            why = "target out of reach: no joint angles put the TCP on the path there"
+            why = Words(N_("target out of reach: no joint angles put the TCP on the path there"))
         else:
             name = kin.joint_names[int(np.argmax(np.abs(q - q_start)))]
-            why = (f"{name} would have to turn too fast: the path runs into the edge of the reach "
-                   "or a singularity")
+            why = Words(N_("{joint} would have to turn too fast: the path runs into the edge of the reach "
+                           "or a singularity"), joint=name)
         return _Attempt(q_start, sigma_start, "unreachable", why)
     viol = kin.limit_violation(q)
     if viol is not None:

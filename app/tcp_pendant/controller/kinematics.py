@@ -23,6 +23,8 @@ import pinocchio as pin
 
 from tcp_pendant.controller.description import RobotDescription, load_description
 from tcp_pendant.controller.errors import ControllerError
+from tcp_pendant.controller.words import Words
+from tcp_pendant.translation import N_
 
 __all__ = ["KNOWN_HOMES_DEG", "RobotKinematics", "default_flange_link", "urdf_links_and_tree"]
 
@@ -300,9 +302,11 @@ class RobotKinematics:
         return f"{value:+.3f} m"
 
     def limit_message(self, index: int, side: str) -> str:
-        """E.g. "A5 at its limit +120.0 deg"."""
+        """E.g. "A5 at its limit +120.0 deg" (:class:`~tcp_pendant.controller.words.Words`: a
+        view says it in its language)."""
         value = self.upper_rad[index] if side == "upper" else self.lower_rad[index]
-        return f"{self.joint_names[index]} at its limit {self.format_joint(index, value)}"
+        return Words(N_("{joint} at its limit {value}"), joint=self.joint_names[index],
+                     value=self.format_joint(index, value))
 
     def T_world_flange(self, q_rad: np.ndarray) -> np.ndarray:
         """FLANGE pose in WORLD (the root-link frame), (4,4), metres (pinocchio frame placement)."""

@@ -35,6 +35,8 @@ from tcp_pendant.controller.jog import (
     singularity_message,
     smallest_singular_value,
 )
+from tcp_pendant.controller.words import Words
+from tcp_pendant.translation import N_
 
 __all__ = ["CHECK_SETTINGS", "LIMIT_MARGIN_DEG", "ROTATION_KEYS", "WRIST_MARGIN_SIGMA", "TiltReach",
            "frame_axes", "tilt_reach"]
@@ -84,14 +86,14 @@ def _margin_problem(controller: VirtualController, q: np.ndarray) -> str:
     """"" when ``q`` keeps the margins of the module docstring, else what is too close."""
     kin = controller.kinematics
     if smallest_singular_value(kin, q) < WRIST_MARGIN_SIGMA:
-        return "too close to a singularity there (" + singularity_message(kin, q) + ")"
+        return Words(N_("too close to a singularity there ({why})"), why=singularity_message(kin, q))
     margin = math.radians(LIMIT_MARGIN_DEG)
     for i in range(kin.n_joints):
         if not kin.revolute[i]:
             continue
         if q[i] - kin.lower_rad[i] < margin or kin.upper_rad[i] - q[i] < margin:
             side = "lower" if q[i] - kin.lower_rad[i] < margin else "upper"
-            return f"{kin.limit_message(i, side)} there"
+            return Words(N_("{limit} there"), limit=kin.limit_message(i, side))
     return ""
 
 
@@ -118,6 +120,7 @@ def tilt_reach(controller: VirtualController, frame: str, key: str, sign: int,
                        CHECK_SETTINGS, q_rest=controller.rest_q_rad)
     if back.stopped_by is not None:
         return TiltReach(frame, key, sign, angle_deg, False,
-                         f"after {name} the reference tip is out of reach ({back.message})")
+                         Words(N_("after {key} the reference tip is out of reach ({why})"), key=name,
+                               why=back.message))
     problem = _margin_problem(controller, back.q_rad)
     return TiltReach(frame, key, sign, angle_deg, not problem, problem)

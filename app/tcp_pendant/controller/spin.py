@@ -42,6 +42,8 @@ from tcp_pendant.controller.checks import check_pose
 from tcp_pendant.controller.errors import ControllerError
 from tcp_pendant.controller.jog import DEFAULT_SETTINGS, CartesianPath, JogSettings, follow_path
 from tcp_pendant.controller.kinematics import RobotKinematics
+from tcp_pendant.controller.words import in_language
+from tcp_pendant.translation import ENGLISH, Translator
 
 if TYPE_CHECKING:
     from tcp_pendant.controller.controller import VirtualController
@@ -127,22 +129,25 @@ class SpinCheckResult:
         """Every rotation was carried out completely."""
         return all(r.reached for r in self.rotations)
 
-    def summary(self) -> str:
-        """Plain words (escape before putting them into markdown)."""
+    def summary(self, tr: Translator = ENGLISH) -> str:
+        """Plain words in ``tr``'s language (escape before putting them into markdown)."""
+        _ = tr.gettext
         lines = []
         for r in self.rotations:
             if r.reached:
-                lines.append(f"{r.label}: the tip moved {r.deviation_mm:.3f} mm")
+                lines.append(_("{rotation}: the tip moved {deviation} mm").format(
+                    rotation=r.label, deviation=f"{r.deviation_mm:.3f}"))
             else:
-                lines.append(f"{r.label}: not reached ({r.message or r.stopped_by}); "
-                             f"{r.moved * 100:.0f} % done, the tip moved {r.deviation_mm:.3f} mm")
+                lines.append(_("{rotation}: not reached ({why}); {done} % done, the tip moved {deviation} mm").format(
+                    rotation=r.label, why=in_language(r.message, tr) or r.stopped_by, done=f"{r.moved * 100:.0f}",
+                    deviation=f"{r.deviation_mm:.3f}"))
         if self.implied_tcp_error_mm is None:
-            lines.append("The reached rotations do not determine the TCP error: at least two of A, B, C "
-                         "must be reached; move the robot away from its joint limits and singularities "
-                         "and check again.")
+            lines.append(_("The reached rotations do not determine the TCP error: at least two of A, B, C "
+                           "must be reached; move the robot away from its joint limits and singularities "
+                           "and check again."))
         else:
-            lines.append(f"Largest deviation {self.max_deviation_mm:.3f} mm; implied TCP error "
-                         f"{self.implied_tcp_error_mm:.3f} mm.")
+            lines.append(_("Largest deviation {deviation} mm; implied TCP error {error} mm.").format(
+                deviation=f"{self.max_deviation_mm:.3f}", error=f"{self.implied_tcp_error_mm:.3f}"))
         return "\n".join(lines)
 
 

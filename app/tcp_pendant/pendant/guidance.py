@@ -27,6 +27,7 @@ import numpy as np
 
 from tcp_pendant.controller.pose_state import PoseState
 from tcp_pendant.controller.touch import CRASH_DEPTH_MM, CRASH_RADIUS_MM, TOUCH_TOLERANCE_MM
+from tcp_pendant.translation import ENGLISH, Translator
 
 __all__ = [
     "CLOSEUP_WITHIN_MM",
@@ -98,10 +99,11 @@ _OFFSETS = {(fx, fy, fz): f"{fx}  ΔY {fy}  ΔZ {fz}"
 """The three numbers of the Δ line in one template per choice of decimals (two under 100 mm)."""
 
 
-def offset_markdown(delta_mm: np.ndarray | tuple[float, float, float], frame: str) -> str:
+def offset_markdown(delta_mm: np.ndarray | tuple[float, float, float], frame: str, *,
+                    tr: Translator = ENGLISH) -> str:
     """``ΔX +1.20  ΔY -0.40  ΔZ -3.00 mm`` to the tip (TOOL): the jog along each axis of the jog
     frame that brings the tool tip onto the reference tip (two decimals with the sign, one from
-    100 mm on; a zero as ``0.00``)."""
+    100 mm on; a zero as ``0.00``); the words in ``tr``'s language, the numbers as they are."""
     x, y, z = delta_mm                       # floats or numpy floats: the same text
     # the numbers in one pass (each "%+.2f" under 100 mm, else "%+.1f"); a zero is then
     # "+0.00" or "-0.00", which can only be a whole number of this text (a sign starts each
@@ -110,7 +112,7 @@ def offset_markdown(delta_mm: np.ndarray | tuple[float, float, float], frame: st
                       "%+.2f" if abs(z) < 100 else "%+.1f")] % (x, y, z))
     if "0.00" in text:
         text = text.replace("+0.00", "0.00").replace("-0.00", "0.00")
-    return f"`ΔX {text} mm` to the tip ({frame})"
+    return tr.gettext("{offsets} to the tip ({frame})").format(offsets=f"`ΔX {text} mm`", frame=frame)
 
 
 def direction_words(delta_mm: np.ndarray, frame: str) -> str:

@@ -49,8 +49,10 @@ from typing import Literal
 import numpy as np
 
 from tcp_pendant.controller import ControllerError, JogFrame, JogResult, VirtualController
+from tcp_pendant.controller.words import Words
 from tcp_pendant.pendant.guidance import CONTACT_RADIUS_MM, collision_stop, contact_stop
 from tcp_pendant.pendant.tilts import TiltOptions, keyboard_key, key_label, stopped_advice
+from tcp_pendant.translation import N_
 
 __all__ = [
     "CARTESIAN_AXES",
@@ -267,8 +269,9 @@ class Jogger:
         if isinstance(axis, int) and not isinstance(axis, bool):
             res = self.controller.jog_joint(axis, sign * s.step_amount(rotational=True, joint=True, dt_s=dt))
             if res.stopped_by == "joint_limit" and axis < 9:          # the way back: the other key of the row
-                back = f"key {axis + 1}" if sign < 0 else f"Shift+{axis + 1}"
-                res = replace(res, message=f"{res.message}. The other key of that row ({back}) turns it back.")
+                back = Words(N_("key {n}"), n=axis + 1) if sign < 0 else f"Shift+{axis + 1}"
+                res = replace(res, message=Words(N_("{stop}. The other key of that row ({back}) turns it back."),
+                                                 stop=res.message, back=back))
             return res
         ax = str(axis).upper()
         if ax not in CARTESIAN_AXES:
@@ -289,8 +292,9 @@ class Jogger:
         if ax in "ABC":
             advice = stopped_advice(self.tilts.options(self.settings.frame), ax, sign)
         else:
-            advice = f"{key_label(ax, -sign)} ({keyboard_key(ax, -sign)}) goes back."
-        return replace(res, message=f"{res.message}. {advice}")
+            advice = Words(N_("{key} ({keyboard}) goes back."), key=key_label(ax, -sign),
+                           keyboard=keyboard_key(ax, -sign))
+        return replace(res, message=Words(N_("{stop}. {advice}"), stop=res.message, advice=advice))
 
     def frame_rotation(self) -> np.ndarray:
         """``R_world_frame`` of the selected jog frame now (the axes the X/Y/Z keys move along)."""
@@ -338,8 +342,9 @@ class Jogger:
         if not res.ok:
             return res
         return JogResult(False, stop.fraction, "contact",
-                         f"Stopped at the reference tip after {abs(amount_mm) * stop.fraction:.2f} of "
-                         f"{abs(amount_mm):g} mm (touch-up: the tool tip touches it). Press again to go on.")
+                         Words(N_("Stopped at the reference tip after {moved} of {step} mm (touch-up: the tool "
+                                  "tip touches it). Press again to go on."),
+                               moved=f"{abs(amount_mm) * stop.fraction:.2f}", step=f"{abs(amount_mm):g}"))
 
     def _collide(self, ax: CartesianAxis, amount_mm: float, fraction: float) -> JogResult:
         """"Hide distance": the press would run into the reference tip at ``fraction`` of its
@@ -350,10 +355,11 @@ class Jogger:
             return res
         sign = 1 if amount_mm > 0 else -1
         return JogResult(False, fraction, "collision",
-                         f"COLLISION: the tool ran into the reference tip and the robot stopped "
-                         f"(recorded as a crash). Back off with {key_label(ax, -sign)} "
-                         f"({keyboard_key(ax, -sign)}, {self.settings.frame} frame); pressing "
-                         f"{key_label(ax, sign)} again drives the tool through the tip.")
+                         Words(N_("COLLISION: the tool ran into the reference tip and the robot stopped "
+                                  "(recorded as a crash). Back off with {back} ({keyboard}, {frame} frame); "
+                                  "pressing {key} again drives the tool through the tip."),
+                               back=key_label(ax, -sign), keyboard=keyboard_key(ax, -sign),
+                               frame=f"{self.settings.frame}", key=key_label(ax, sign)))
 
     def release(self) -> None:
         """Forget the hold timing and a stop at contact (key released)."""

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tcp_pendant.controller.touch import TOUCH_TOLERANCE_MM
+from tcp_pendant.translation import ENGLISH, Translator
 
 __all__ = ["CONFIRM_WINDOW_S", "RecordCheck", "RecordDecision"]
 
@@ -45,7 +46,8 @@ class RecordCheck:
         self._clock = clock
         self._pending: tuple[float, tuple[float, ...]] | None = None
 
-    def decide(self, distance_mm: float, *, hidden: bool, q_rad: np.ndarray, where: str) -> RecordDecision:
+    def decide(self, distance_mm: float, *, hidden: bool, q_rad: np.ndarray, where: str,
+               tr: Translator = ENGLISH) -> RecordDecision:
         """Record now, or ask first.
 
         Args:
@@ -53,6 +55,7 @@ class RecordCheck:
             hidden: "Hide distance" is on (record without asking).
             q_rad: the joint angles now (a confirmation counts only at the same pose).
             where: the offset in words (e.g. ``"2.10 mm −X (WORLD)"``) for the question.
+            tr: the question's language.
         """
         if hidden or not np.isfinite(distance_mm) or distance_mm <= TOUCH_TOLERANCE_MM:
             self._pending = None
@@ -63,10 +66,11 @@ class RecordCheck:
             self._pending = None
             return RecordDecision(True)
         self._pending = (now, key)
-        return RecordDecision(False, (
-            f"⚠ The tool tip is **{distance_mm:.2f} mm** from the reference tip (more than "
-            f"{TOUCH_TOLERANCE_MM} mm): the reference tip is {where} from it. Jog closer, or press "
-            f"**Record** again within {CONFIRM_WINDOW_S:.0f} s to record this touch anyway."))
+        return RecordDecision(False, tr.gettext(
+            "⚠ The tool tip is **{distance} mm** from the reference tip (more than {tolerance} mm): the reference "
+            "tip is {where} from it. Jog closer, or press **Record** again within {seconds} s to record this touch "
+            "anyway.").format(distance=f"{distance_mm:.2f}", tolerance=TOUCH_TOLERANCE_MM, where=where,
+                              seconds=f"{CONFIRM_WINDOW_S:.0f}"))
 
     def clear(self) -> None:
         """Forget a pending confirmation (the robot moved, the step changed)."""

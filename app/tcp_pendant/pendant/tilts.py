@@ -24,6 +24,8 @@ import numpy as np
 
 from tcp_pendant.controller import VirtualController
 from tcp_pendant.controller.reach import ROTATION_KEYS, TiltReach, frame_axes, tilt_reach
+from tcp_pendant.controller.words import Words, in_language
+from tcp_pendant.translation import ENGLISH, N_, Translator
 
 __all__ = ["OWN_AXIS_DEG", "REUSE_DEG", "REUSE_MM", "ROW_OF_KEY", "TILT_DEG", "TiltOption", "TiltOptions", "keyboard_key", "key_label",
            "reachable_line", "stopped_advice"]
@@ -119,7 +121,7 @@ class TiltOptions:
                 axis = np.array(axes[:, ROTATION_KEYS[k]], dtype=float)
                 own = abs(float(axis @ flange_z)) >= _OWN_AXIS_COS
                 for sign in (1, -1):
-                    reach = (TiltReach(frame, k, sign, angle_deg, False, "a turn about the tool's own length")
+                    reach = (TiltReach(frame, k, sign, angle_deg, False, Words(N_("a turn about the tool's own length")))
                              if own else tilt_reach(c, frame, k, sign, angle_deg))
                     out.append(TiltOption(reach, axis, own))
             found = self._cache[(frame, angle_deg)] = tuple(out)
@@ -127,11 +129,13 @@ class TiltOptions:
         return found
 
 
-def reachable_line(options: tuple[TiltOption, ...], *, frame: str, joint_mode: bool) -> str:
+def reachable_line(options: tuple[TiltOption, ...], *, frame: str, joint_mode: bool,
+                   tr: Translator = ENGLISH) -> str:
     """The dock's line of the tilts reachable from here (markdown, our words only), both ways of
     a key in one, the blocked ones grouped by their reason (:func:`_short`), e.g. "Reachable 45°
     tilts, tip held (WORLD): **B −** (Shift+5), **C ±** (6, Shift+6). Not: A (own axis); B +
-    (A5 limit)."."""
+    (A5 limit)." (in ``tr``'s language; key and axis names as they are)."""
+    _ = tr.gettext
     if not options:
         return ""
     angle = options[0].reach.angle_deg
@@ -146,39 +150,51 @@ def reachable_line(options: tuple[TiltOption, ...], *, frame: str, joint_mode: b
     blocked: dict[str, list[str]] = {}
     for o in options:
         if not o.own_axis and not o.reach.reachable:
-            blocked.setdefault(_short(o.reach.why), []).append(key_label(o.reach.key, o.reach.sign))
-    head = f"Reachable {angle:.0f}° tilts, tip held ({frame}): "
-    head += ", ".join(ok) + "." if ok else "none in this frame: change the Jog frame or press Ready pose."
-    nots = ([f"{' '.join(own)} (own axis)"] if own else []) + [f"{', '.join(keys)} ({why})"
-                                                               for why, keys in blocked.items()]
-    text = head + (" Not: " + "; ".join(nots) + "." if nots else "")
+            blocked.setdefault(_short(o.reach.why, tr), []).append(key_label(o.reach.key, o.reach.sign))
+    if ok:
+        head = _("Reachable {angle}° tilts, tip held ({frame}): {keys}.").format(
+            angle=f"{angle:.0f}", frame=frame, keys=", ".join(ok))
+    else:
+        head = _("Reachable {angle}° tilts, tip held ({frame}): none in this frame: change the Jog frame or "
+                 "press Ready pose.").format(angle=f"{angle:.0f}", frame=frame)
+    nots = ([_("{keys} (own axis)").format(keys=" ".join(own))] if own else []) + [
+        f"{', '.join(keys)} ({why})" for why, keys in blocked.items()]
+    text = head + (" " + _("Not: {tilts}.").format(tilts="; ".join(nots)) if nots else "")
     if joint_mode:
-        text += " (Set Mode to Cartesian: the keys are joints now.)"
+        text += " " + _("(Set Mode to Cartesian: the keys are joints now.)")
     return text
 
 
-def _short(why: str) -> str:
+_SINGULARITY_KINDS = {"wrist": N_("wrist singularity"), "elbow": N_("elbow singularity"),
+                      "shoulder": N_("shoulder singularity")}
+
+
+def _short(why: str, tr: Translator = ENGLISH) -> str:
     """A blocked tilt's reason in two or three words: "wrist singularity", "A5 limit", "tip out
-    of reach" (the whole reason is in a stopped jog's message)."""
+    of reach" (the whole reason is in a stopped jog's message), read from its English text."""
+    _ = tr.gettext
     if "out of reach" in why:
-        return "tip out of reach"
+        return _("tip out of reach")
     if "singularity" in why:
-        for kind in ("wrist", "elbow", "shoulder"):
+        for kind, words in _SINGULARITY_KINDS.items():
             if kind in why:
-                return f"{kind} singularity"
-        return "singularity"
+                return _(words)
+        return _("singularity")
     if "limit" in why:
-        return f"{why.split()[0]} limit"
-    return why
+        return _("{joint} limit").format(joint=why.split()[0])
+    return in_language(why, tr)
 
 
-def stopped_advice(options: tuple[TiltOption, ...], stopped_key: str, stopped_sign: int) -> str:
+def stopped_advice(options: tuple[TiltOption, ...], stopped_key: str, stopped_sign: int) -> Words:
     """What to press instead after rotation key ``stopped_key`` stopped at a limit or a
     singularity: the reachable tilts (checked from the stop), and the opposite key, which turns
     back the way it came."""
     others = [o.words for o in options if o.usable
               and (o.reach.key, o.reach.sign) != (stopped_key, stopped_sign)]
-    back = f"{key_label(stopped_key, -stopped_sign)} ({keyboard_key(stopped_key, -stopped_sign)}) turns back"
+    back = Words(N_("{key} ({keyboard}) turns back"), key=key_label(stopped_key, -stopped_sign),
+                 keyboard=keyboard_key(stopped_key, -stopped_sign))
     if others:
-        return f"Instead tilt with {', '.join(others)} (reachable from here with the tip held); {back}."
-    return f"No tilt of 45° is reachable from here in this frame (try another Jog frame); {back}."
+        return Words(N_("Instead tilt with {tilts} (reachable from here with the tip held); {back}."),
+                     tilts=", ".join(others), back=back)
+    return Words(N_("No tilt of 45° is reachable from here in this frame (try another Jog frame); {back}."),
+                 back=back)

@@ -12,11 +12,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from tcp_pendant.translation import ENGLISH, Translator
+
 __all__ = ["touch_feedback"]
 
 
-def touch_feedback(tip_offset_mm: np.ndarray, frame: str) -> str:
-    """The words for one recorded touch (plain text, our own words).
+def touch_feedback(tip_offset_mm: np.ndarray, frame: str, *, tr: Translator = ENGLISH) -> str:
+    """The words for one recorded touch (plain text, our own words, in ``tr``'s language).
 
     Args:
         tip_offset_mm: (3,) the reference tip relative to the tool tip along the jog frame's
@@ -26,10 +28,11 @@ def touch_feedback(tip_offset_mm: np.ndarray, frame: str) -> str:
     off = -np.asarray(tip_offset_mm, dtype=float)      # the tool tip relative to the reference tip
     dist = float(np.linalg.norm(off))
     if not np.isfinite(dist):
-        return "how far the touch was is not known"
+        return tr.gettext("how far the touch was is not known")
     if dist < 0.05:
-        return "the touch was spot on (0.0 mm off)"
+        return tr.gettext("the touch was spot on (0.0 mm off)")
     i = int(np.argmax(np.abs(off)))
     way = f"{'+' if off[i] > 0 else '−'}{'XYZ'[i]}"
-    return (f"{dist:.1f} mm off, mostly {way} ({frame}): the tool tip was {abs(off[i]):.1f} mm {way} "
-            "of the reference tip")
+    return tr.gettext("{distance} mm off, mostly {way} ({frame}): the tool tip was {along} mm {way} "
+                      "of the reference tip").format(distance=f"{dist:.1f}", way=way, frame=frame,
+                                                     along=f"{abs(off[i]):.1f}")

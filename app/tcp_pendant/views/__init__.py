@@ -22,6 +22,7 @@ from tcp_pendant.views.class_notices import ClassNoticeView
 from tcp_pendant.views.pendant_panel import PendantPanel
 from tcp_pendant.views.scenario_panel import ScenarioPanel
 from tcp_pendant.views.scene import SceneView
+from tcp_pendant.views.tab_titles import TabTitles, tab_title
 from tcp_pendant.views.tool_panel import ToolPanel
 from tcp_pendant.views.touch_list import TouchListView
 from tcp_pendant.views.wizard_dock import WizardDock
@@ -73,19 +74,24 @@ def session_view_steps(session: Session, *, title: str = "TCP Pendant") -> Itera
         session.views["notices"] = ClassNoticeView(session)   # the exercise's banner, the trainer's messages
         gui.add_markdown(f"#### {escape_markdown(title)}")   # one line in the panel: room for the keys
         tabs = gui.add_tab_group()
-        with tabs.add_tab("Jog"):
+        tr = session.translator
+        jog_tab = tabs.add_tab(tab_title("jog", tr))
+        with jog_tab:
             session.views["dock"] = WizardDock(session)      # the running wizard's step, on top
             session.views["pendant"] = PendantPanel(session)
             session.views["touches"] = TouchListView(session)
         yield "jog"
-        with tabs.add_tab("Tool"):
+        tool_tab = tabs.add_tab(tab_title("tool", tr))
+        with tool_tab:
             session.views["tools"] = ToolPanel(session)
             session.views["beam_check"] = BeamCheckView(session, player)   # TCP service with the beam sensor
         yield "tool"
-        calibrate_tab = tabs.add_tab("Calibrate")
+        calibrate_tab = tabs.add_tab(tab_title("calibrate", tr))
         session.views["calibrate"] = build_calibrate_tab(session, calibrate_tab, player)
         with calibrate_tab:
             session.views["scenario"] = ScenarioPanel(session)
         session.views["tabs"] = tabs
+        session.views["tab_titles"] = TabTitles(session, {"jog": jog_tab, "tool": tool_tab,
+                                                          "calibrate": calibrate_tab})
         yield "calibrate"
     session.changed(pose=True, tool=True)

@@ -19,6 +19,7 @@ Units: WORLD metres, angles in radians where viser uses them (``fov``), pixels o
 from __future__ import annotations
 
 import math
+import unicodedata
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
@@ -33,6 +34,7 @@ __all__ = [
     "frame_spheres",
     "label_box_px",
     "spread_labels",
+    "text_columns",
 ]
 
 VIEW_DIRECTION = np.array([1.15, -1.25, 0.55]) / np.linalg.norm([1.15, -1.25, 0.55])
@@ -47,11 +49,18 @@ LABEL_GAP_PX = 6.0
 _WORLD_UP = np.array([0.0, 0.0, 1.0])
 
 
+def text_columns(text: str) -> int:
+    """Columns ``text`` takes: a wide character (CJK, Unicode's East Asian Width W or F) two,
+    any other one."""
+    return sum(2 if unicodedata.east_asian_width(ch) in "WF" else 1 for ch in text)
+
+
 def label_box_px(text: str, font_scale: float = 1.0) -> tuple[float, float]:
     """(width, height) of a label's box on screen, pixels, at viser's ``font_screen_scale``
-    ``font_scale`` (the box grows with the font)."""
+    ``font_scale`` (the box grows with the font; a wide character counts two columns:
+    :func:`text_columns`)."""
     s = float(font_scale)
-    return (CHAR_WIDTH_PX * len(text) + _LABEL_PAD_PX) * s, LABEL_HEIGHT_PX * s
+    return (CHAR_WIDTH_PX * text_columns(text) + _LABEL_PAD_PX) * s, LABEL_HEIGHT_PX * s
 
 
 @dataclass(frozen=True)

@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING, Protocol, TypeVar, cast
 import viser
 from viser.uplot import Legend
 
+from tcp_pendant.controller.words import error_text
 from tcp_pendant.job_pool import JobRefused
 
 if TYPE_CHECKING:
@@ -68,7 +69,7 @@ def refused_before_job(session: Session, *, running: bool, what: str, not_starte
     try:
         session.loop.admit_job()
     except JobRefused as exc:
-        session.notify_refusal(not_started, str(exc))
+        session.notify_refusal(not_started, error_text(exc, session.translator))
         return True
     return False
 

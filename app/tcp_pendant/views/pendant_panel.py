@@ -58,6 +58,7 @@ import numpy as np
 import viser
 
 from tcp_pendant.controller import JogResult
+from tcp_pendant.controller.words import in_language
 from tcp_pendant.pendant import (
     CARTESIAN_AXES,
     dropped_presses_text,
@@ -78,7 +79,8 @@ from tcp_pendant.views import arrival
 from tcp_pendant.views.scene import closeup_camera, overview_camera
 from tcp_pendant.views.gui_util import ButtonEvent, ButtonGroupEvent, CheckboxEvent, set_value, target_of
 from tcp_pendant.views.language_selector import LanguageSelector
-from tcp_pendant.views.tip_insets import TipInsets
+from tcp_pendant.views.tip_insets import TipInsets, tip_views_title
+from tcp_pendant.views.touch_list import RECORD_POINT
 from tcp_pendant.views.viser_adapter import queue_markdown
 
 if TYPE_CHECKING:
@@ -367,12 +369,14 @@ class PendantPanel:
     def _keys_markdown(self) -> str:
         """The keys line and, hidden below it, the labels the page's script looks for in this
         language (``<div hidden data-tcp-pendant-labels data-increment=... data-cont=...
-        data-shadows=... data-keys-line=...>``, attributes escaped): it finds the Increment row,
-        continuous mode, the Shadows checkbox and the keys line by them."""
+        data-shadows=... data-keys-line=... data-tip-views=... data-record-point=...>``, attributes escaped): it finds
+        the Increment row, continuous mode, the Shadows checkbox, the keys line, the tip views and
+        "Record point" by them."""
         tr = self.session.translator
         _ = tr.gettext
         labels = {"increment": _("Increment"), "cont": increment_word(CONTINUOUS, tr),
-                  "shadows": _(SHADOWS_LABEL), "keys-line": _(KEYS_LINE).split(" ", 1)[0]}
+                  "shadows": _(SHADOWS_LABEL), "keys-line": _(KEYS_LINE).split(" ", 1)[0],
+                  "tip-views": tip_views_title(tr), "record-point": _(RECORD_POINT)}
         attrs = " ".join(f'data-{k}="{html.escape(v, quote=True)}"' for k, v in labels.items())
         return f"{_(KEYS_LINE)}\n\n<div hidden data-tcp-pendant-labels {attrs}></div>"
 
@@ -589,10 +593,12 @@ class PendantPanel:
         """Status line: the stop message of a jog (limit, singularity, unreachable), else clear."""
         if res.ok and not self._last_stop and self._last_text.get("status") == "":
             return                                   # a clear line stays clear: nothing to send or note
-        text = "" if res.ok else f"⚠ {res.message}"
+        tr = self.session.translator
+        said = "" if res.ok else in_language(res.message, tr)   # the controller's Words in this language
+        text = "" if res.ok else f"⚠ {said}"
         self._set_md(self.status_md, "status", text)
         if text and text != self._last_stop:
-            self.session.notify(self.session.translator.gettext("Jog stopped"), res.message, kind="warning")
+            self.session.notify(tr.gettext("Jog stopped"), said, kind="warning")
         self._last_stop = text
 
     def _set_md(self, handle: viser.GuiMarkdownHandle, key: str, text: str) -> None:
@@ -623,7 +629,7 @@ class PendantPanel:
         if not hide:
             jf = s.jogger.settings.frame
             delta = tip_offset_xyz_mm(state, s.controller.reference_tip_world_m, jf)
-            touch += "\n\n" + offset_markdown(delta, jf)
+            touch += "\n\n" + offset_markdown(delta, jf, tr=tr)
             if state.touch.distance_mm <= CLOSEUP_WITHIN_MM:
                 closeup = side_view_markdown(delta, jf)
         self._set_md(self.touch_md, "touch", touch)

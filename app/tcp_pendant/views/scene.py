@@ -47,6 +47,7 @@ from tcp_pendant.controller.description import RobotDescription
 from tcp_pendant.controller.kinematics import urdf_links_and_tree
 from tcp_pendant.controller.rotations import quaternion_wxyz, quaternions_wxyz
 from tcp_pendant.session import Session, SessionChange
+from tcp_pendant.translation import ENGLISH, Translator
 from tcp_pendant.views.beam_replay import ScanPlayer
 from tcp_pendant.views.beam_stand import BeamStandNodes
 from tcp_pendant.views.framing import VIEW_DIRECTION, Framing, frame_spheres
@@ -291,16 +292,23 @@ def _add_parts(scene: viser.SceneApi, parent: str, parts: tuple[MeshPart, ...], 
     return out
 
 
-def tool_label_text(active: Tool | None, mounted: ToolModel, activated_on: ToolModel | None = None) -> str:
+def tool_label_text(active: Tool | None, mounted: ToolModel, activated_on: ToolModel | None = None, *,
+                    tr: Translator = ENGLISH) -> str:
     """The TOOL triad's label: the active tool data's name and, when the physical tool on the
     flange is another than the one that was on when the data was made active (a wizard bolted
     the new tool on while the reference tool's data is still active), the tool that is on now:
-    the triad sits where that data puts the TCP, which on another tool is not its tip."""
+    the triad sits where that data puts the TCP, which on another tool is not its tip (the
+    frame name TOOL and the names stay as they are in every language)."""
     if active is None:
         return "TOOL"
     if activated_on is None or activated_on.key == mounted.key:
         return f"TOOL {active.name}"
-    return f"TOOL {active.name} · on {mounted.label}"
+    return tr.gettext("TOOL {tool} · on {mounted}").format(tool=active.name, mounted=mounted.label)
+
+
+def reference_tip_label_text(tr: Translator = ENGLISH) -> str:
+    """The reference tip's 3D label in ``tr``'s language."""
+    return tr.gettext("reference tip")
 
 
 class SceneView:
@@ -374,7 +382,7 @@ class SceneView:
         self._shown_tip = np.array(c.reference_tip_world_m, dtype=float)
         self._shown_tip_bytes = self._shown_tip.tobytes()
         _add_parts(scene, "/reference_tip", rigid_meshes(tip.urdf_path))
-        self._tip_label = scene.add_label("/reference_tip_label", "reference tip",
+        self._tip_label = scene.add_label("/reference_tip_label", reference_tip_label_text(session.translator),
                                           position=tuple(c.reference_tip_world_m + [0.0, 0.0, -0.06]))
         labels = session.views.labels                       # the wizards' scene moves them apart
         labels.flange, labels.tool, labels.tip = self._flange_label, self._active_label, self._tip_label
@@ -391,7 +399,11 @@ class SceneView:
 
     def on_change(self, change: SessionChange) -> None:
         """The change signal: reconcile the tool meshes and the TOOL triad (``tool``), pose the
-        links and the gizmo (``pose``), from the session's state."""
+        links and the gizmo (``pose``), from the session's state; a ``language`` change relabels
+        the TOOL triad and the reference tip."""
+        if change.language:
+            self._tip_label.text = reference_tip_label_text(self.session.translator)
+            self.update_active_tool()
         if change.tool:
             self.reconcile_tools()
         c = self.session.controller
@@ -487,7 +499,9 @@ class SceneView:
         self._active_axes.position = xyz
         tool = c.active_tool
         self._active_axes.visible = tool is not None and not self._aside   # no tool data: TOOL = FLANGE
-        self._active_label.text = tool_label_text(tool, c.mounted_tool, self._data_on)
+        text = tool_label_text(tool, c.mounted_tool, self._data_on, tr=self.session.translator)
+        if self._active_label.text != text:
+            self._active_label.text = text
 
     def update_reference_tip(self) -> None:
         """Re-place the stand after the reference tip moved (:meth:`on_change` calls it)."""

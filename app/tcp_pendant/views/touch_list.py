@@ -15,9 +15,14 @@ from tcp_pendant.calibrate.text import empty_touches_markdown
 from tcp_pendant.pendant.guidance import tip_offset_mm
 from tcp_pendant.pendant.touch_feedback import touch_feedback
 from tcp_pendant.session import Session, SessionChange, Touch
+from tcp_pendant.translation import N_
 from tcp_pendant.views.gui_util import ButtonEvent, client_of, set_content, target_of
 
-__all__ = ["TOUCHES_FILENAME", "TouchListView", "touches_csv_text"]
+__all__ = ["RECORD_POINT", "TOUCHES_FILENAME", "TouchListView", "touches_csv_text"]
+
+RECORD_POINT = N_("Record point")
+"""The button's English label; the page's script finds it in the session's language by the
+pendant panel's hidden labels (``data-record-point``)."""
 
 TOUCHES_FILENAME = "touches.csv"
 
@@ -51,21 +56,37 @@ class TouchListView:
     def __init__(self, session: Session) -> None:
         self.session = session
         gui = target_of(session).gui
-        self.record = gui.add_button("Record point", color="green", icon=None,
-                                     hint="Store the current flange pose as a touch; key R.")
+        self.record = gui.add_button(RECORD_POINT, color="green", icon=None)
         self.folder = gui.add_folder("Touches")
         with self.folder:
             self.empty_md = gui.add_markdown("*No touch recorded.*")
-            self.export_csv = gui.add_button("Export CSV", hint="The touches as POSES.csv with joint values "
-                                             "(tcpcal solve xyz4), sent to this browser.")
+            self.export_csv = gui.add_button("Export CSV")
         self._rows: list[viser.GuiMarkdownHandle | viser.GuiButtonHandle] = []
+        self._delete_buttons: list[viser.GuiButtonHandle] = []
+        self._relabel()
         self.record.on_click(session.loop.on_loop(self._on_record))
         self.export_csv.on_click(session.loop.on_loop(self._on_export_csv))
         session.subscribe(self.on_change)
 
+    def _relabel(self) -> None:
+        """Every label and hint in the session's language (the touches' own lines are names
+        and numbers: P1, X, Y, Z, mm)."""
+        _ = self.session.translator.gettext
+        self.record.label = _(RECORD_POINT)
+        self.record.hint = _("Store the current flange pose as a touch; key R.")
+        self.folder.label = _("Touches")
+        self.export_csv.label = _("Export CSV")
+        self.export_csv.hint = _("The touches as POSES.csv with joint values (tcpcal solve xyz4), sent to this browser.")
+        for i, b in enumerate(self._delete_buttons):
+            b.label = _("Delete P{n}").format(n=i + 1)
+
     def on_change(self, change: SessionChange) -> None:
         """The change signal: redraw the rows when the touches changed; "Record point" is
-        hidden while a wizard is open (one Record concept: the wizard dock's Record then)."""
+        hidden while a wizard is open (one Record concept: the wizard dock's Record then);
+        a ``language`` change relabels the view."""
+        if change.language:
+            self._relabel()
+            self._render_empty()
         if change.touches:
             self.rebuild()
         if change.wizard:
@@ -84,10 +105,12 @@ class TouchListView:
         s = self.session
         t = s.record_touch()
         said = t.label
+        tr = s.translator
         if s.hide_distance and not s.rules.in_exercise:     # free practice by eye: how far it was
             frame = s.jogger.settings.frame
-            said += f": {touch_feedback(tip_offset_mm(s.pose_state(), s.controller.reference_tip_world_m, frame), frame)}"
-        s.notify("Point recorded", said, kind="success")
+            offset = tip_offset_mm(s.pose_state(), s.controller.reference_tip_world_m, frame)
+            said += f": {touch_feedback(offset, frame, tr=tr)}"
+        s.notify(tr.gettext("Point recorded"), said, kind="success")
 
     def _on_export_csv(self, event: ButtonEvent) -> None:
         data = touches_csv_text(self.session.touches).encode("utf-8")
@@ -109,11 +132,14 @@ class TouchListView:
         for h in self._rows:
             h.remove()
         self._rows = []
+        self._delete_buttons = []
+        _ = self.session.translator.gettext
         touches = list(self.session.touches)
         self.empty_md.visible = not touches
         with self.folder:
             for i, t in enumerate(touches):
                 self._rows.append(gui.add_markdown(f"`{t.label}`"))
-                b = gui.add_button(f"Delete P{i + 1}", color="red")
+                b = gui.add_button(_("Delete P{n}").format(n=i + 1), color="red")
                 b.on_click(self._delete_cb(i, t.label))
                 self._rows.append(b)
+                self._delete_buttons.append(b)

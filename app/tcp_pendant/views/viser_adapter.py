@@ -49,6 +49,10 @@ network. What this module reaches into, and why:
   which ``serve`` hands to ``loop.create_server``), so the server processes of
   ``tcp-pendant --workers N`` listen on the same port and the kernel spreads the connections
   over them.
+* **A tab's title** (:func:`set_tab_label`): viser 1.1's ``GuiTabHandle`` has no label setter
+  (only ``icon``); the title is its ``_label``, sent in its group's tab tuples, which
+  ``_rebuild_tab_props()`` recomputes from the tabs (as the ``icon`` setter does). The tab
+  titles follow a switch of the session's language that way.
 
 Moving viser up a minor version: run ``tests/security`` and ``tests/app/test_viser_adapter.py``
 (their conftest sets ``TCP_PENDANT_STRICT_VISER=1``: a fallback fails the test), then re-read in
@@ -57,6 +61,7 @@ viser's source each name used here: ``_GuiHandleState`` (``uuid``, ``value``, ``
 ``_current_file_upload_states`` / ``_websock_interface``, ``SceneApi._queue_scene_message`` (what
 it stamps: ``_owner_id``) / ``_websock_interface``, ``Message.redundancy_key`` (its
 ``_cached_redundancy_key``),
+``GuiTabHandle._label`` / ``_parent._rebuild_tab_props``,
 the scene handle's ``_impl`` (``name``, ``wxyz``, ``position``, ``api``),
 ``WebsockMessageHandler._handle_incoming_message`` / ``_incoming_handlers``,
 ``infra._infra._message_consumer`` (its signature and its ``deserialize`` call), websockets'
@@ -121,7 +126,7 @@ if TYPE_CHECKING:                        # viser's and websockets' private types
 __all__ = ["LOG_VALUE_CHARS", "MAX_ABS_NUMBER", "MAX_TEXT_CHARS", "UploadHook", "UploadLimits",
            "ViserInternalsChanged", "gui_value_refusal", "install", "listen_reuse_port", "message_refusal", "path_counts",
            "queue_markdown", "PoseQueue", "pose_queue",
-           "message_counts", "queue_pose", "reset_path_counts", "short", "upload_hook", "upload_limits",
+           "message_counts", "queue_pose", "reset_path_counts", "set_tab_label", "short", "upload_hook", "upload_limits",
            "uploads_in_flight"]
 
 log = logging.getLogger(__name__)
@@ -962,3 +967,19 @@ def accept_language(client: viser.ClientHandle) -> str | None:
         return None                                   # the client left
     value = headers.get("Accept-Language")
     return None if value is None else str(value)
+
+
+def set_tab_label(tab: viser.GuiTabHandle, label: str) -> bool:
+    """Retitle ``tab`` (the session's language changed): viser 1.1 lets a tab's icon change but
+    not its label; this sets the handle's ``_label`` and rebuilds its group's tab tuples as the
+    ``icon`` setter does, which sends them. Returns False (title unchanged, a warning logged,
+    raising under ``TCP_PENDANT_STRICT_VISER=1``) when viser's internals differ."""
+    if getattr(tab, "_label", None) == label:
+        return True
+    try:
+        rebuild = tab._parent._rebuild_tab_props
+        tab._label = label
+        rebuild()
+    except AttributeError as exc:
+        return _fallback("tab_label", exc)
+    return True

@@ -43,15 +43,17 @@ import numpy as np
 import viser
 
 from tcp_pendant.calibrate import CalibrationWorkflow
-from tcp_pendant.session import Session
+from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.session_views import SceneLabel
+from tcp_pendant.controller.words import Words
+from tcp_pendant.translation import ENGLISH, N_, Translator
 from tcp_pendant.views.beam_replay import ScanPlayer, beam_view_direction, scan_spheres
 from tcp_pendant.views.framing import VIEW_DIRECTION, Framing, spread_labels
 from tcp_pendant.views.scene import frame_cameras, wxyz_xyz
 from tcp_pendant.wizards import WizardResult, Xyz4Result
 from tcp_pendant.views.gui_util import clients_of, target_of
 
-__all__ = ["WizardSceneView"]
+__all__ = ["WizardSceneView", "computed_label_text", "target_label_text", "true_label_text"]
 
 log = logging.getLogger(__name__)
 MM_TO_M = 1e-3
@@ -61,6 +63,21 @@ _POINT_RGB = np.array([30, 30, 30], dtype=np.uint8)
 _OUTLIER_RGB = np.array([220, 30, 30], dtype=np.uint8)
 _DROPPED_RGB = np.array([170, 170, 170], dtype=np.uint8)
 _APPROACH_RGB = np.array([60, 110, 220], dtype=np.uint8)
+
+
+def computed_label_text(tr: Translator = ENGLISH) -> str:
+    """The computed TOOL triad's 3D label."""
+    return tr.gettext("COMPUTED")
+
+
+def true_label_text(tr: Translator = ENGLISH) -> str:
+    """The true tool's ghost triad's 3D label (shown only where the truth may be shown)."""
+    return tr.gettext("TRUE")
+
+
+def target_label_text(tr: Translator = ENGLISH) -> str:
+    """The ABC wizard's target frame's 3D label (X is the frame's axis name)."""
+    return tr.gettext("TARGET (X down)")
 
 
 class WizardSceneView:
@@ -74,18 +91,19 @@ class WizardSceneView:
         self.scene = scene
         self.computed = scene.add_frame("/calibration/computed_tool", axes_length=0.10, axes_radius=0.0045,
                                         visible=False)
-        self.computed_label = scene.add_label("/calibration/computed_tool/label", "COMPUTED",
+        tr = session.translator
+        self.computed_label = scene.add_label("/calibration/computed_tool/label", computed_label_text(tr),
                                               position=(0.0, 0.0, -0.03), visible=False)
         self.true_tool = scene.add_frame("/calibration/true_tool", axes_length=0.16, axes_radius=0.0015,
                                          origin_color=(245, 245, 245), visible=False)
-        self.true_label = scene.add_label("/calibration/true_tool/label", "TRUE", position=(0.0, -0.03, 0.0),
+        self.true_label = scene.add_label("/calibration/true_tool/label", true_label_text(tr), position=(0.0, -0.03, 0.0),
                                           visible=False)
         self.sphere = scene.add_icosphere("/calibration/sphere", radius=1.0, color=(90, 140, 230),
                                           subdivisions=3, wireframe=True, opacity=0.35, visible=False,
                                           cast_shadow=False, receive_shadow=False)
         self.abc_target = scene.add_frame("/calibration/abc_target", axes_length=0.13, axes_radius=0.003,
                                           origin_color=(255, 255, 255), visible=False)
-        self.abc_label = scene.add_label("/calibration/abc_target/label", "TARGET (X down)",
+        self.abc_label = scene.add_label("/calibration/abc_target/label", target_label_text(tr),
                                          position=(0.0, 0.03, 0.0), visible=False)
         self._points: viser.PointCloudHandle | None = None
         self._lines: viser.LineSegmentsHandle | None = None
@@ -103,6 +121,19 @@ class WizardSceneView:
         # mode: larger) reaches these; the boxes are spread at the size they are drawn
         labels = session.views.labels
         labels.computed, labels.true, labels.target = self.computed_label, self.true_label, self.abc_label
+        session.subscribe(self.on_change)
+
+    def on_change(self, change: SessionChange) -> None:
+        """A ``language`` change relabels the triads and the ABC target; labels moved apart for
+        a result are moved apart again (their boxes' widths changed with the words)."""
+        if change.language:
+            tr = self.session.translator
+            for label, text in ((self.computed_label, computed_label_text(tr)), (self.true_label, true_label_text(tr)),
+                                (self.abc_label, target_label_text(tr))):
+                if label.text != text:
+                    label.text = text
+            if self._labels_moved:
+                self.layout_labels()
 
     # ------------------------------------------------------------ result
     def _has_sphere(self) -> bool:
@@ -154,7 +185,7 @@ class WizardSceneView:
         """"Replay scan": the result's scan again, from its first move."""
         scan = getattr(self.workflow.result, "scan", None)
         if scan is None:
-            raise ValueError("This result has no beam scan to replay.")
+            raise ValueError(Words(N_("This result has no beam scan to replay.")))
         self.player.play(scan, owner=self, points=self._scan_points(self.workflow.result))
 
     @property

@@ -81,12 +81,14 @@
  *    Both words come in the pendant's language from the board's data-toggle and data-back
  *    attributes (calibrate/math_board.py), English when they are absent.
  * 10. Languages: the labels this script looks for (Increment, its "Cont." button, Shadows, the keys
- *     line's first word) are read in the pendant's language from the hidden
- *     <div data-tcp-pendant-labels data-increment=... data-cont=... data-shadows=... data-keys-line=...>
- *     below the keys line (views/pendant_panel.py), and the welcome window's (Your name, Browser
- *     key, Join the class, Trainer token, Open trainer view, the trainer line's and the banner's
- *     first word) from its own <div data-tcp-pendant-labels data-name=... data-join=...>
- *     (views/identity.py); English when they are absent. The jog keys' labels
+ *     line's first word, the tip views' caption's first words, Record point, and the wizard's
+ *     Record, Next, Finish and Back once their owner hands them over) are read in the pendant's
+ *     language from the hidden <div data-tcp-pendant-labels data-increment=... data-cont=...
+ *     data-shadows=... data-keys-line=... data-tip-views=... data-record-point=...> below the keys
+ *     line (views/pendant_panel.py), and the welcome window's (Your name, Browser key, Join the
+ *     class, Trainer token, Open trainer view, the trainer line's and the banner's first word)
+ *     from its own <div data-tcp-pendant-labels data-name=... data-join=...> (views/identity.py);
+ *     English when they are absent. The jog keys' labels
  *     ("X +", "A1 −") are the same in every language.
  */
 (function () {
@@ -133,7 +135,8 @@
   }
   var LABEL_KEYS = { "increment": "increment", "cont": "cont", "shadows": "shadows", "keys-line": "keysLine",
     "name": "name", "key": "key", "join": "join", "token": "token", "open-trainer": "openTrainer",
-    "trainer-line": "trainerLine", "banner": "banner" };
+    "trainer-line": "trainerLine", "banner": "banner", "tip-views": "tipViews", "record-point": "recordPoint",
+    "record": "record", "next": "next", "finish": "finish", "back": "back" };
   function label(key) {                     // a label in the session's language (views/pendant_panel.py and
     var el = document.querySelector("[data-tcp-pendant-labels][data-" + key + "]");   // views/identity.py
     var v = el && el.getAttribute("data-" + key);                                    // hand them over)
@@ -311,8 +314,8 @@
   }
 
   function record() {
-    var free = buttonsNamed(L.recordPoint);          // shown outside a wizard only
-    var b = free.length ? pick(free) : pick(buttonsNamed(L.record));
+    var free = buttonsNamed(label("record-point"));         // shown outside a wizard only
+    var b = free.length ? pick(free) : pick(buttonsNamed(label("record")));
     if (b) b.click();
   }
 
@@ -365,10 +368,10 @@
       if (!e.repeat) record();
     } else if (key === "n" || key === "N") {
       e.preventDefault();
-      if (!e.repeat) step([L.next, L.finish]);
+      if (!e.repeat) step([label("next"), label("finish")]);
     } else if (key === "b" || key === "B") {
       e.preventDefault();
-      if (!e.repeat) step([L.back]);
+      if (!e.repeat) step([label("back")]);
     }
   }
   document.addEventListener("keydown", onKeyDown);
@@ -543,9 +546,9 @@
       setTitle(r.plus, "Key " + (i + 1));
       setTitle(r.minus, "Key Shift+" + (i + 1));
     });
-    buttonsNamed(L.record).concat(buttonsNamed(L.recordPoint)).forEach(function (b) { setTitle(b, "Key R"); });
-    buttonsNamed(L.next).concat(buttonsNamed(L.finish)).forEach(function (b) { setTitle(b, "Key N"); });
-    buttonsNamed(L.back).forEach(function (b) { setTitle(b, "Key B"); });
+    buttonsNamed(label("record")).concat(buttonsNamed(label("record-point"))).forEach(function (b) { setTitle(b, "Key R"); });
+    buttonsNamed(label("next")).concat(buttonsNamed(label("finish"))).forEach(function (b) { setTitle(b, "Key N"); });
+    buttonsNamed(label("back")).forEach(function (b) { setTitle(b, "Key B"); });
   }
 
   // the trainer's message (class "trainer-message", views/class_notices.py) above the presenter's
@@ -691,7 +694,7 @@
   function markScreens() {
     allButtons().forEach(function (b) {     // the keys a finger holds: no pan, no selection, no menu
       var t = text(b);
-      if ((JOG_RE.test(t) || t === L.record || t === L.recordPoint) && !b.hasAttribute("data-tcp-pendant-touch")) {
+      if ((JOG_RE.test(t) || t === label("record") || t === label("record-point")) && !b.hasAttribute("data-tcp-pendant-touch")) {
         b.setAttribute("data-tcp-pendant-touch", "1");
       }
     });
@@ -705,7 +708,7 @@
     for (var j = 0; j < imgs.length; j++) {
       var box = imgs[j].parentElement && imgs[j].parentElement.parentElement;   // label + image (viser's image)
       if (!box || box.hasAttribute("data-tcp-pendant-tipviews")) continue;
-      if (text(box).indexOf(L.tipViews) === 0) box.setAttribute("data-tcp-pendant-tipviews", "1");
+      if (text(box).indexOf(label("tip-views")) >= 0) box.setAttribute("data-tcp-pendant-tipviews", "1");
     }
   }
 
