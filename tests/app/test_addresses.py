@@ -9,6 +9,8 @@ from tcp_pendant.serve import addresses
 from tcp_pendant.serve.addresses import interface_addresses, network_urls, usable_address
 from tcp_pendant.serve.cli import ready_urls
 
+pytestmark = pytest.mark.shares_cpu  # asserts no time, latency or load (tests/conftest.py)
+
 MACHINE = ["127.0.0.1", "192.168.1.20", "fe80::1%eth0", "::1", "2001:db8::5", "10.0.0.7", "169.254.3.3",
            "0.0.0.0"]
 

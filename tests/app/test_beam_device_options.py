@@ -16,6 +16,8 @@ from tcp_pendant.controller import BeamDevice, ControllerError
 from tcp_pendant.serve.server import AppConfig, PendantApp
 from tcpcal.tool import Tool
 
+pytestmark = pytest.mark.shares_cpu  # asserts no time, latency or load (tests/conftest.py)
+
 
 def test_options_default_to_one_half_millimetre_beam_of_20_microns() -> None:
     args = build_parser().parse_args([])

@@ -13,6 +13,8 @@ import pytest
 from tcp_pendant.controller.beam import BeamSensor, ToolShape, crossing_events, tip_on_beam
 from tcp_pendant.views.beam_replay import replay_frames
 
+pytestmark = pytest.mark.shares_cpu  # asserts no time, latency or load (tests/conftest.py)
+
 SENSOR = BeamSensor(point=(0.6, 0.0, 0.3), direction=(0.0, 1.0, 0.0))
 SHAPE = ToolShape(np.array([[0.0, 0.0, -1.0, 0.0], [0.0, 1.0, 0.0, 0.0], [1.0, 0.0, 0.0, 0.15],
                             [0.0, 0.0, 0.0, 1.0]]))                  # tool X = flange +Z, tip 150 mm out

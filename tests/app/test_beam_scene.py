@@ -13,6 +13,8 @@ from support.app_page import AppPage
 from tcp_pendant.controller.beam import BeamSensor
 from tcp_pendant.views.scene import overview_pose
 
+pytestmark = pytest.mark.shares_cpu  # asserts no time, latency or load (tests/conftest.py)
+
 
 def beam_on_screen(p: AppPage) -> np.ndarray:
     return np.asarray(p.session.views["scene"].beam_stand.beam_handle.points, dtype=float)

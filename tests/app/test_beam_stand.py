@@ -20,6 +20,8 @@ from tcp_pendant.views.beam_stand import (
     stand_geometry,
 )
 
+pytestmark = pytest.mark.shares_cpu  # asserts no time, latency or load (tests/conftest.py)
+
 
 def _box_contains(box, points: np.ndarray, margin: float = 0.0) -> np.ndarray:
     local = (points - box.centre) @ box.R_world_box          # rows: box coordinates

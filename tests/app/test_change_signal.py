@@ -21,6 +21,8 @@ from tcpcal.library import ToolLibrary
 from support.app_page import true_tip_at
 from support.wsclient import DrainingClient, wait_until
 
+pytestmark = pytest.mark.shares_cpu  # asserts no time, latency or load (tests/conftest.py)
+
 FLAGS = ("pose", "tool", "touches", "wizard", "library", "notice")
 
 

@@ -18,6 +18,8 @@ from tcp_pendant.classroom.names import TraineeNameError
 from tcp_pendant.classroom.trainer_token import TrainerTokenLocked
 from tcp_pendant.text_escape import escape_markdown, escape_markdown_lines
 
+pytestmark = pytest.mark.shares_cpu  # asserts no time, latency or load (tests/conftest.py)
+
 TOKEN = "trainer-token-for-tests-0001"
 
 

@@ -10,6 +10,8 @@ from tcp_pendant.classroom.gradebook import Gradebook
 from tcp_pendant.classroom.grades_csv import CSV_COLUMNS
 from tcp_pendant.serve.cli import build_parser, main
 
+pytestmark = pytest.mark.shares_cpu  # asserts no time, latency or load (tests/conftest.py)
+
 
 def _book_with_one_row(path: Path) -> None:
     with Gradebook(path, synchronous="NORMAL") as g:

@@ -17,6 +17,8 @@ from tcp_pendant.controller.kinematics import RobotKinematics
 from tcp_pendant.pendant.guidance import CONTACT_RADIUS_MM
 from tcp_pendant.pendant.jogging import Jogger
 
+pytestmark = pytest.mark.shares_cpu  # asserts no time, latency or load (tests/conftest.py)
+
 _KIN: list[RobotKinematics] = []
 
 

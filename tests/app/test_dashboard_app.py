@@ -8,12 +8,16 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+import pytest
+
 import numpy as np
 
 from tcp_pendant.controller.kinematics import RobotKinematics
 
 from support.guiclick import choose, click
 from support.wsclient import DrainingClient, wait_until
+
+pytestmark = pytest.mark.shares_cpu  # asserts no time, latency or load (tests/conftest.py)
 
 TOKEN = "trainer-token-of-16"
 

@@ -6,10 +6,14 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
+
 from support.guiclick import choose, click
 from support.wsclient import DrainingClient, wait_until
 
 from tcp_pendant.classroom.dashboard_settings import IDLE_SETTING, STUCK_SETTING, kept_minutes
+
+pytestmark = pytest.mark.shares_cpu  # asserts no time, latency or load (tests/conftest.py)
 
 TOKEN = "trainer-token-attendance-1"
 

@@ -10,6 +10,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+import pytest
+
 import numpy as np
 import viser
 
@@ -23,6 +25,8 @@ from tcp_pendant.session import Session
 from tcp_pendant.translation import LANGUAGE_NAMES, PSEUDO_LANGUAGE, translator
 from tcp_pendant.views.dashboard import TrainerDashboard
 from tcp_pendant.wizards import wizard_classes
+
+pytestmark = pytest.mark.shares_cpu  # asserts no time, latency or load (tests/conftest.py)
 
 TOKEN = "trainer-token-of-16"
 

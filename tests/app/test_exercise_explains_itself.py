@@ -5,12 +5,16 @@ as one on the tip (no ✔, no distance). Real class server, one websocket browse
 
 from __future__ import annotations
 
+import pytest
+
 from support.app_page import join_as_the_only_trainee, true_tip_at
 from support.guiclick import choose, click
 from support.wsclient import DrainingClient
 
 from tcp_pendant.calibrate.record_words import EXERCISE_RECORDED
 from tcp_pendant.views.wizard_dock import NEXT
+
+pytestmark = pytest.mark.shares_cpu  # asserts no time, latency or load (tests/conftest.py)
 
 
 def test_an_exercise_without_instructions_shows_the_default_brief_and_records_neutrally(app_factory, tmp_path) -> None:

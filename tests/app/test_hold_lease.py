@@ -19,6 +19,8 @@ from tcp_pendant.pendant.hold import HOLD_PERIOD_S, LEASE_S, HoldDriver
 
 from support.jogging import FakeClock, FakeScheduler
 
+pytestmark = pytest.mark.shares_cpu  # asserts no time, latency or load (tests/conftest.py)
+
 
 def _driver() -> tuple[HoldDriver, FakeClock, FakeScheduler, list[float], list[object]]:
     clock = FakeClock()

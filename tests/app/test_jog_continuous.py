@@ -20,6 +20,8 @@ from tcp_pendant.pendant.jogging import LINEAR_SPEED_MM_S, MAX_TICK_S
 
 from support.jogging import FakeClock, FakeScheduler, away_from_singularity
 
+pytestmark = pytest.mark.shares_cpu  # asserts no time, latency or load (tests/conftest.py)
+
 
 def _x_mm(c: VirtualController) -> float:
     return float(c.T_world_tcp()[0, 3]) * 1000.0

@@ -23,6 +23,8 @@ from tcp_pendant.session import Session
 from tcp_pendant.translation import LANGUAGE_NAMES, PSEUDO_LANGUAGE, translator
 from tcp_pendant.views.pendant_panel import PendantPanel
 
+pytestmark = pytest.mark.shares_cpu  # asserts no time, latency or load (tests/conftest.py)
+
 
 def _session(app: PendantApp, n: int) -> list[Session]:
     wait_until(lambda: len(app.sessions) == n, what=f"{n} sessions")

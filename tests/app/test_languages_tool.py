@@ -55,7 +55,7 @@ class Page(AppPage):
         return self.tools, self.beam, self.scenario
 
 
-pytestmark = pytest.mark.app_page(cls=Page, seed=7)
+pytestmark = [pytest.mark.app_page(cls=Page, seed=7), pytest.mark.shares_cpu]  # asserts no time, latency or load (tests/conftest.py)
 
 TOOLS = {1: truth_tool("pointer", "Pointer"), 2: truth_tool("pointer", "Skewed", (0.0, 1.0, 0.0))}
 NAMES = ({"X", "Y", "Z", "A", "B", "C", "mm", "deg", "TCP", "FLANGE", "RMS", "Pointer", "Skewed", "Mine",

@@ -99,7 +99,7 @@ class Page(AppPage):
         self.pendant = self.session.views["pendant"]
 
 
-pytestmark = pytest.mark.app_page(cls=Page, seed=3)
+pytestmark = [pytest.mark.app_page(cls=Page, seed=3), pytest.mark.shares_cpu]  # asserts no time, latency or load (tests/conftest.py)
 
 
 def test_the_close_up_and_the_status_line_follow_every_change(page) -> None:

@@ -19,6 +19,8 @@ from tcp_pendant.controller.pose_state import pose_state
 
 from support.jogging import FakeClock
 
+pytestmark = pytest.mark.shares_cpu  # asserts no time, latency or load (tests/conftest.py)
+
 
 def _grid(md: str) -> list[str]:
     body = md.split("```")[1].strip("\n").splitlines()

@@ -27,6 +27,8 @@ from tcp_pendant.pendant.jogging import LINEAR_SPEED_MM_S, MAX_TICK_S
 
 from support.jogging import FakeClock, away_from_singularity
 
+pytestmark = pytest.mark.shares_cpu  # asserts no time, latency or load (tests/conftest.py)
+
 
 # ------------------------------------------------------------------ settings
 def test_settings_validate_and_clamp_override() -> None:

@@ -20,6 +20,8 @@ from tcp_pendant.controller.rotations import GIMBAL_LOCK_COS_B, kuka_abc_deg, qu
 from support.wsclient import wait_until
 from support.wsclient import DrainingClient
 
+pytestmark = pytest.mark.shares_cpu  # asserts no time, latency or load (tests/conftest.py)
+
 
 def _angle_diff_deg(a: float, b: float) -> float:
     return abs((a - b + 180.0) % 360.0 - 180.0)

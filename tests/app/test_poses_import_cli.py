@@ -14,6 +14,8 @@ from scipy.spatial.transform import Rotation
 from tcp_pendant.serve.cli import main
 from tcpcal.cli import main as tcpcal_main
 
+pytestmark = pytest.mark.shares_cpu  # asserts no time, latency or load (tests/conftest.py)
+
 DATA = Path(__file__).resolve().parents[1] / "data" / "controller_files"
 
 # joint: (parent, child, origin xyz m, axis)

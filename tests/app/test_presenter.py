@@ -24,6 +24,8 @@ from tcp_pendant.views.presenter import (
     presenter_steps_markdown,
 )
 
+pytestmark = pytest.mark.shares_cpu  # asserts no time, latency or load (tests/conftest.py)
+
 
 def _session(app):
     wait_until(lambda: len(app.sessions) == 1 and "presenter" in next(iter(app.sessions.values())).views,

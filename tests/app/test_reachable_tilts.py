@@ -23,6 +23,8 @@ from tcp_pendant.pendant.jogging import Jogger
 from tcp_pendant.pendant.tilts import TiltOptions, reachable_line
 from tcp_pendant.serve.server import default_reference_tip_mm, ready_configuration
 
+pytestmark = pytest.mark.shares_cpu  # asserts no time, latency or load (tests/conftest.py)
+
 
 def _controller(robot: str, tmp: Path) -> VirtualController:
     if robot != "kr16":

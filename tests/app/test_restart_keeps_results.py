@@ -9,12 +9,16 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
+
 import numpy as np
 
 from support.guiclick import choose, click
 from support.wsclient import DrainingClient, wait_until
 
 from tcp_pendant.classroom.gradebook import Gradebook
+
+pytestmark = pytest.mark.shares_cpu  # asserts no time, latency or load (tests/conftest.py)
 
 TOKEN = "trainer-token-for-tests-0002"
 

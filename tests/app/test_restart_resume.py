@@ -16,6 +16,8 @@ import pytest
 from tcp_pendant.classroom.gradebook import Gradebook
 from tcp_pendant.classroom.trainer_token import TrainerTokenLocked
 
+pytestmark = pytest.mark.shares_cpu  # asserts no time, latency or load (tests/conftest.py)
+
 TOKEN = "trainer-token-for-tests-0001"
 
 

@@ -3,11 +3,14 @@ poses the scene sends for a jog step chained back to the pose state's ``T_world_
 
 from __future__ import annotations
 
-
 import numpy as np
 from scipy.spatial.transform import Rotation
+
+import pytest
 from tcp_pendant.views.scene import relative_poses
 from support.wsclient import DrainingClient, wait_until
+
+pytestmark = pytest.mark.shares_cpu  # asserts no time, latency or load (tests/conftest.py)
 
 
 def _rigid(rng: np.random.Generator, n: int) -> np.ndarray:

@@ -17,6 +17,8 @@ from tcpcal.tool import Tool
 from support.wsclient import wait_until
 from support.wsclient import DrainingClient
 
+pytestmark = pytest.mark.shares_cpu  # asserts no time, latency or load (tests/conftest.py)
+
 
 def _connect(app, n_before: int) -> DrainingClient:
     c = DrainingClient(app.port)

@@ -6,7 +6,11 @@ from __future__ import annotations
 import gc
 import weakref
 
+import pytest
+
 from tcp_pendant.serve.cli import set_apart_startup_objects
+
+pytestmark = pytest.mark.shares_cpu  # asserts no time, latency or load (tests/conftest.py)
 
 
 def test_start_up_objects_are_frozen_and_garbage_is_collected_first() -> None:

@@ -19,6 +19,8 @@ from tcp_pendant.calibrate.tcp_estimate import TcpEstimate, tcp_estimate
 from tcp_pendant.controller import builtin_tools
 from tcp_pendant.wizards import WizardStateError
 
+pytestmark = pytest.mark.shares_cpu  # asserts no time, latency or load (tests/conftest.py)
+
 R_DOWN = np.diag([1.0, -1.0, -1.0])                    # flange Z pointing down (WORLD)
 
 

@@ -27,6 +27,8 @@ from tcp_pendant.pendant.tip_insets import (
     view_pixel,
 )
 
+pytestmark = pytest.mark.shares_cpu  # asserts no time, latency or load (tests/conftest.py)
+
 REF_M = np.array([0.5, 0.0, 0.4])
 W = int(round(VIEW_W_MM * PX_PER_MM))
 

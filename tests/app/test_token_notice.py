@@ -7,11 +7,15 @@ import stat
 from pathlib import Path
 from types import SimpleNamespace
 
+import pytest
+
 from tcp_pendant.classroom.class_room import ClassRoom
 from tcp_pendant.classroom.gradebook import Gradebook
 from tcp_pendant.classroom.trainer_token import TOKEN_ENV, resolve_trainer_token
 from tcp_pendant.serve.cli import _class_lines, build_parser
 from tcp_pendant.serve.token_notice import token_source
+
+pytestmark = pytest.mark.shares_cpu  # asserts no time, latency or load (tests/conftest.py)
 
 URL = "http://127.0.0.1:8080"
 

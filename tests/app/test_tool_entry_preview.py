@@ -2,8 +2,12 @@
 
 from __future__ import annotations
 
+import pytest
+
 from tcp_pendant.pendant.tool_entry import FIELDS, ToolEntry, entry_preview_markdown
 from tcp_pendant.text_escape import escape_markdown
+
+pytestmark = pytest.mark.shares_cpu  # asserts no time, latency or load (tests/conftest.py)
 
 
 def _entry(name: str = "Pen", **vals: str) -> ToolEntry:

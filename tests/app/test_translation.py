@@ -25,6 +25,8 @@ from tcp_pendant.translation import (
     translator,
 )
 
+pytestmark = pytest.mark.shares_cpu  # asserts no time, latency or load (tests/conftest.py)
+
 ROOT = Path(__file__).resolve().parents[2]
 KEYWORDS = {"_": None, "gettext": None, "N_": None, "ngettext": (1, 2), "pgettext": ((1, "c"), 2)}
 """What scripts/i18n.sh extracts (its -k options plus Babel's defaults that the code uses)."""

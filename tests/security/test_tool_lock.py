@@ -11,12 +11,16 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+import pytest
+
 from support.app_page import join_as_the_only_trainee
 from support.guiclick import choose, click
 from support.wsclient import InputsClient, wait_until
 
 from tcp_pendant.calibrate.pendant_rules import TOOL_LOCKED_WORDS
 from tcp_pendant.views.tool_panel import TOOL_LOCKED_LINE
+
+pytestmark = pytest.mark.shares_cpu  # asserts no time, latency or load (tests/conftest.py)
 
 TOKEN = "trainer-token-toollock-01"
 
