@@ -88,8 +88,10 @@ class WizardCommands:
         if counted and not cls.supports_add_point and options is not None and rules.min_touches:
             n_points = int(cls.parse_options(options)["n_points"])
             if rules.touches_refusal(n_points, can_add_point=False) is not None:
-                raise RuleRefusal(f"This exercise asks for at least {rules.min_touches} touches: set "
-                                  f"Touches to {rules.min_touches} or more for the {cls.title} method.")
+                _ = self._host.workflow.translator.gettext
+                raise RuleRefusal(_("This exercise asks for at least {n} touches: set "
+                                    "Touches to {n} or more for the {method} method.").format(
+                                        n=rules.min_touches, method=_(cls.title)))
 
     def finish_refusal(self) -> str | None:
         """Why Finish of the wizard on show is refused by the exercise (too few touches for a
@@ -174,7 +176,7 @@ class WizardCommands:
             while probe is not None:
                 answer = await host.loop.run_job(probe, what="Auto-touch's check of the pose it reached")
                 if host.closed:
-                    raise WizardStateError("The session was closed.")
+                    raise WizardStateError(host.workflow.translator.gettext("The session was closed."))
                 probe, out = advance(answer, False)
         finally:
             steps.close()
@@ -279,8 +281,9 @@ class WizardCommands:
             wf = self._host.workflow
             est = tcp_estimate(wf.wizard) if wf.is_open else None
             if est is None:
-                raise WizardStateError("The wizard estimates the TCP from two touches in different "
-                                       "orientations of an XYZ 4-point: record them first.")
+                raise WizardStateError(wf.translator.gettext(
+                    "The wizard estimates the TCP from two touches in different "
+                    "orientations of an XYZ 4-point: record them first."))
             self._host.tools.set_active_data(est.tool())
             return est
 

@@ -109,7 +109,8 @@ class RunLog:
     def failed(self, exc: CalibrationFailedError) -> CalibrationFailedError:
         """tcpcal's failure of the run on show in the trainee's words
         (``finish_checks.failure_in_trainee_words``), kept as :attr:`finish_failure`."""
-        out = failure_in_trainee_words(exc, self._run_list.wizard, self._controller.T_world_flange()[:3, :3])
+        out = failure_in_trainee_words(exc, self._run_list.wizard, self._controller.T_world_flange()[:3, :3],
+                                       tr=self._run_list.translator)
         if self._run_list.current is not None:
             self._failure = (self._run_list.current, str(out))
         return out

@@ -30,23 +30,33 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable, Sequence
 
+from tcp_pendant.translation import ENGLISH, N_, Translator
+
 __all__ = ["CHECK_READING_MM", "NOT_AT_TIP", "READING_NOTE", "READ_WITHIN_MM", "check_readable", "read_mm",
-           "reading_verdict"]
+           "reading_note", "reading_verdict"]
 
 CHECK_READING_MM = 0.5
 """Resolution a technician reads the tip's swing to, by eye against a spike (mm)."""
-READING_NOTE = ("*In the exercise the check shows what a technician sees on a real robot: how far the "
-                f"tip swung off the reference tip, read to {CHECK_READING_MM:g} mm by eye; no TCP error, no "
-                "correction.*")
+
+
+def reading_note(*, tr: Translator = ENGLISH) -> str:
+    """The note under an exercise's check (markdown): it shows only what a technician sees."""
+    return tr.gettext("*In the exercise the check shows what a technician sees on a real robot: how far the "
+                      "tip swung off the reference tip, read to {mm} mm by eye; no TCP error, no "
+                      "correction.*").format(mm=f"{CHECK_READING_MM:g}")
+
+
+READING_NOTE = reading_note()
+"""The note in English (:func:`reading_note` in a session's language)."""
 
 
 READ_WITHIN_MM = 5.0
 """In an exercise the Check is read against the reference tip: the tool tip must be this close (mm)."""
-NOT_AT_TIP = ("In the exercise the Check is read against the reference tip, as on a real robot: bring the "
+NOT_AT_TIP = N_("In the exercise the Check is read against the reference tip, as on a real robot: bring the "
               "tool tip to the reference tip first (within a few millimetres), then check.")
 
 
-def check_readable(distance_mm: float) -> None:
+def check_readable(distance_mm: float, *, tr: Translator = ENGLISH) -> None:
     """Refuse an exercise's Check that has no reference tip to read the swing against.
 
     Args:
@@ -56,7 +66,7 @@ def check_readable(distance_mm: float) -> None:
         ValueError: farther than :data:`READ_WITHIN_MM` (or not finite).
     """
     if not math.isfinite(float(distance_mm)) or float(distance_mm) > READ_WITHIN_MM:
-        raise ValueError(NOT_AT_TIP)
+        raise ValueError(tr.gettext(NOT_AT_TIP))
 
 
 def read_mm(value_mm: float) -> float:
@@ -68,15 +78,18 @@ def read_mm(value_mm: float) -> float:
     return round(v / CHECK_READING_MM) * CHECK_READING_MM + 0.0        # + 0.0: no "-0.0"
 
 
-def reading_verdict(readings: Iterable[tuple[bool, float]], angle_deg: float) -> str:
+def reading_verdict(readings: Iterable[tuple[bool, float]], angle_deg: float, *,
+                    tr: Translator = ENGLISH) -> str:
     """One line from the readings ``(reached, read_mm)`` of the rotations (plain text)."""
+    _ = tr.gettext
     reached: Sequence[float] = [d for ok, d in readings if ok]
     if not reached:
-        return ("Not determined: no rotation was reached; move away from the joint limits and singularities "
-                "and check again.")
+        return _("Not determined: no rotation was reached; move away from the joint limits and singularities "
+                 "and check again.")
     worst = max(reached)
     if worst < CHECK_READING_MM:
-        return (f"The tip stayed on the reference tip to the eye in every rotation of ±{angle_deg:g}° "
-                f"(under {CHECK_READING_MM / 2:g} mm): the TCP looks good.")
-    return (f"The tip swung up to {worst:.1f} mm off the reference tip at ±{angle_deg:g}°: the TCP is off; "
-            "calibrate the tool again.")
+        return _("The tip stayed on the reference tip to the eye in every rotation of ±{angle}° "
+                 "(under {mm} mm): the TCP looks good.").format(angle=f"{angle_deg:g}",
+                                                               mm=f"{CHECK_READING_MM / 2:g}")
+    return _("The tip swung up to {mm} mm off the reference tip at ±{angle}°: the TCP is off; "
+             "calibrate the tool again.").format(mm=f"{worst:.1f}", angle=f"{angle_deg:g}")
