@@ -264,3 +264,16 @@ def test_a_wizard_started_after_the_switch_speaks_the_language(tmp_path) -> None
     assert wiz.translator is s.translator
     for step in wiz.steps:
         assert_pseudo(step.instruction)
+
+
+def test_the_verdict_against_the_truth_in_the_language(synth) -> None:
+    from tcp_pendant.wizards.truth import compare_with_truth
+
+    tool = synth.tools["torch"]
+    wiz = AbcWorldWizard(library_tool(tool.tcp_mm + 0.3), variant="6d")
+    wiz.record(synth.flange_pose_m(tool, synth.tool_orientation(0.0, 0.0, 0.0)))
+    res = wiz.next()
+    cmp = compare_with_truth(res, tool.T_flange_tool_true_m)
+    assert cmp.verdict == cmp.verdict_in(ENGLISH) and cmp.verdict.startswith("good: orientation error ")
+    assert "(TCP used is 0.52 mm off the true one)" in cmp.verdict
+    assert_pseudo(cmp.verdict_in(QPS))
