@@ -277,3 +277,20 @@ def test_the_verdict_against_the_truth_in_the_language(synth) -> None:
     assert cmp.verdict == cmp.verdict_in(ENGLISH) and cmp.verdict.startswith("good: orientation error ")
     assert "(TCP used is 0.52 mm off the true one)" in cmp.verdict
     assert_pseudo(cmp.verdict_in(QPS))
+
+
+def test_the_session_record_keeps_english_words(synth) -> None:
+    from tcp_pendant.wizards.session_record import run_entry
+
+    truth = synth.tools["torch"]
+    wiz = AbcWorldWizard(library_tool(truth.tcp_mm), variant="5d")
+    wiz.record(synth.flange_pose_m(truth, synth.tool_orientation(0.0, 0.0, 0.0)))
+    wiz.next()
+    english = run_entry(WizardRun(wiz))
+    wiz.set_translator(QPS)
+    shown = wiz.result
+    assert shown is not None and any("⟦" in w for w in shown.warnings)
+    entry = run_entry(WizardRun(wiz))
+    assert entry["result"] == english["result"]
+    assert any(w.startswith("5D: only the tool X direction was calibrated") for w in entry["result"]["warnings"])
+    assert wiz.result is shown                     # the record's English words leave the shown result alone

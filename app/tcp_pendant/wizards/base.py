@@ -499,13 +499,18 @@ class Wizard(abc.ABC):
         res = self.finished_result
         if res is None or tr is self._tr:
             return res
+        cached = getattr(self, "_result_in", None)
+        if cached is not None and cached[0] is res and cached[1] is tr:
+            return cached[2]
         mine = self._tr
         self._tr = tr
         try:
             again = self._recomposed_result()
         finally:
             self._tr = mine
-        return res if again is None else again
+        out = res if again is None else again
+        self._result_in: tuple[WizardResult, Translator, WizardResult] = (res, tr, out)
+        return out
 
     # ----- to be provided by each wizard --------------------------------------------------
     @abc.abstractmethod
