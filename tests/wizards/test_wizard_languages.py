@@ -60,12 +60,9 @@ def every_wizard() -> list[Wizard]:
 
 
 def own_warnings(res) -> list[str]:
-    """The result's warnings the wizard composed (tcpcal's own come first, in English: the
-    solver knows no language)."""
-    solver = set()
-    for part in (res.tcp_result, res.orientation_result):
-        solver |= set(getattr(part, "warnings", ()))
-    return [w for w in res.warnings if w not in solver]
+    """The result's warnings: tcpcal's first (said again from the catalogs,
+    ``wizards.solver_words``), then the wizard's."""
+    return list(res.warnings)
 
 
 def assert_pseudo(text: str | None, names: set[str] = NAMES) -> None:
@@ -294,3 +291,28 @@ def test_the_session_record_keeps_english_words(synth) -> None:
     assert entry["result"] == english["result"]
     assert any(w.startswith("5D: only the tool X direction was calibrated") for w in entry["result"]["warnings"])
     assert wiz.result is shown                     # the record's English words leave the shown result alone
+
+
+def test_tcpcals_remarks_are_said_again_from_the_catalogs(synth) -> None:
+    from tcp_pendant.wizards.solver_words import solver_warning
+
+    tool = synth.tools["pointer"]
+    wiz = Xyz4Wizard(n_points=4)
+    for d in synth.directions[:4]:
+        wiz.record(synth.flange_pose_m(tool, synth.tool_orientation(*d)))
+        wiz.next()
+    res = wiz.result
+    assert res is not None and res.tcp_result is not None
+    solver = res.tcp_result.warnings
+    assert any(w.startswith("with only 4 touches") for w in solver) and res.warnings[:len(solver)] == solver
+    wiz.set_translator(QPS)
+    assert wiz.result is not None
+    for text in wiz.result.warnings:
+        assert_pseudo(text)
+    weak = ("the TCP along flange [0.00, -0.71, 0.71] is 12 times less certain than across it: the touches "
+            "tilt little about a second axis; add a touch tilted about another axis.")
+    said = solver_warning(weak, tr=QPS)
+    assert_pseudo(said)
+    assert "[0.00, -0.71, 0.71]" in said and " 12 " in said
+    assert solver_warning(weak) == weak
+    assert solver_warning("a remark no table knows", tr=QPS) == "a remark no table knows"

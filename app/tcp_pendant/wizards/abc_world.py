@@ -29,6 +29,7 @@ from tcp_pendant.wizards.base import (
     StepInfo,
     mm3,
 )
+from tcp_pendant.wizards.solver_words import solver_warnings
 from tcp_pendant.wizards.describe import (
     ALIGN_WORLD,
     AutoRole,
@@ -139,7 +140,7 @@ class AbcWorldWizard(Wizard):
         res = solve_abc_world(T[:3, :3], variant=self._variant,
                               current_rotation=self.tool.rotation if self._variant == "5d" else None)
         rot = np.asarray(res.rotation, dtype=float)
-        warnings = list(res.warnings)
+        warnings = solver_warnings(res.warnings, tr=self._tr)
         if self._variant == "5d":
             warnings.append(self._tr.gettext("5D: only the tool X direction was calibrated; the rotation "
                                              "about X is kept from '{tool}'.").format(tool=self.tool.name))

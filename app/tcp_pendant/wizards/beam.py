@@ -59,6 +59,7 @@ from tcp_pendant.wizards.base import (
     finite_number,
     mm3,
 )
+from tcp_pendant.wizards.solver_words import solver_warnings
 from tcp_pendant.wizards.describe import BY_CONTROLLER, StepRole, WizardOption, WizardStart
 
 if TYPE_CHECKING:
@@ -615,13 +616,13 @@ class BeamWizard(Wizard):
                     np.array([events[i].beam_dir for i in idx]))
 
         res = solve_beam(*arrays(tips))
-        warnings = list(res.warnings)
+        warnings = solver_warnings(res.warnings, tr=self._tr)
         axes = tuple(i for i, e in enumerate(events) if e.kind == "axis" and e.on_shaft)
         axis_res: BeamAxisResult | None = None
         if len(axes) >= 2:
             try:
                 axis_res = solve_beam_axis(*arrays(axes), res.tcp)
-                warnings.extend(axis_res.warnings)
+                warnings.extend(solver_warnings(axis_res.warnings, tr=self._tr))
             except TcpcalError as exc:
                 warnings.append(_("The tool direction could not be measured: {reason}").format(reason=exc))
         else:

@@ -17,6 +17,7 @@ from tcpcal.tool import Tool
 from tcp_pendant.json_shapes import JsonRecord
 from tcp_pendant.translation import N_
 from tcp_pendant.wizards.base import StartContext, StepSpec, Wizard, WizardError, WizardResult, mm3
+from tcp_pendant.wizards.solver_words import solver_warnings
 from tcp_pendant.wizards.describe import TOUCH, StepRole, WizardOption, WizardStart
 
 ERRORS_ADD_UP = N_(
@@ -126,9 +127,9 @@ class ReferenceWizard(Wizard):
         res = solve_reference(np.asarray(self.reference_tool.tcp_mm, dtype=float),
                               T1[:3, :3], T1[:3, 3] * 1000.0,   # metres -> mm for tcpcal
                               T2[:3, :3], T2[:3, 3] * 1000.0, sigma=self.assumed_sigma_mm)
-        warnings = list(res.warnings)
+        warnings = solver_warnings(res.warnings, tr=self._tr)
         _ = self._tr.gettext
-        if not any("sum of" in w or "add up" in w for w in warnings):
+        if not any("sum of" in w or "add up" in w for w in res.warnings):
             warnings.append(_(ERRORS_ADD_UP))
         cal = self.reference_tool.calibration
         if cal is None:

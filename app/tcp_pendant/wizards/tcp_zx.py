@@ -31,6 +31,7 @@ from tcp_pendant.wizards.base import (
     check_pose_m,
     mm3,
 )
+from tcp_pendant.wizards.solver_words import solver_warnings
 from tcp_pendant.wizards.describe import (
     AHEAD_PLUS_X,
     AHEAD_PLUS_Z,
@@ -144,7 +145,7 @@ class TcpZxWizard(Wizard):
         f_mm = np.array([T[:3, 3] for T in poses]) * 1000.0      # metres -> mm for tcpcal
         res = solve_tcp_zx(R, f_mm, self._roles(), min_distance=MIN_AXIS_DISTANCE_MM)
         origin = res.origin
-        warnings = list(res.warnings)
+        warnings = solver_warnings(res.warnings, tr=self._tr)
         if origin.outliers:
             warnings.append(outlier_warning([res.touch_rows[i] + 1 for i in origin.outliers], "re-record",
                                             tr=self._tr))

@@ -25,6 +25,7 @@ from tcp_pendant.wizards.base import (
     WizardStateError,
     mm3,
 )
+from tcp_pendant.wizards.solver_words import solver_warnings
 from tcp_pendant.wizards.describe import (
     IN_PLUS_Y_HALF,
     ON_MINUS_X,
@@ -147,7 +148,7 @@ class ThreePointWizard(Wizard):
         # tcpcal warns about every displacement shorter than MIN_DISPLACEMENT_MM (mm here).
         res = solve_three_point(R, f_mm, tcp, variant=self._variant,
                                 min_displacement=MIN_DISPLACEMENT_MM)
-        warnings = list(res.warnings)
+        warnings = solver_warnings(res.warnings, tr=self._tr)
         if self.tool.calibration is None:
             warnings.append(self._tr.gettext("The TCP of '{tool}' has no calibration record; the "
                                              "orientation is only as good as that TCP.").format(tool=self.tool.name))

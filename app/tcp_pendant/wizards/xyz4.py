@@ -32,6 +32,7 @@ from tcp_pendant.wizards.base import (
     mm3,
     rotation_and_position_mm,
 )
+from tcp_pendant.wizards.solver_words import solver_warnings
 from tcp_pendant.wizards.describe import TOUCH, StepRole, WizardOption, WizardStart
 
 Estimator = Literal["lstsq", "sphere", "pairwise"]
@@ -356,7 +357,7 @@ class Xyz4Wizard(Wizard):
         radius = float(np.linalg.norm(t))
         directions = (R_all @ t) / radius if radius > 0 else np.zeros((len(poses), 3))
         outliers = tuple(used[i] for i in chosen.outliers)
-        warnings = list(chosen.warnings)
+        warnings = solver_warnings(chosen.warnings, tr=self._tr)
         if outliers:
             warnings.append(outlier_warning([i + 1 for i in outliers], "drop", tr=self._tr))
         if self._excluded:
