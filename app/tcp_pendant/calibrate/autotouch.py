@@ -178,15 +178,14 @@ def auto_touch_steps(wizard: Wizard, controller: VirtualController, *,
             direction is tried (``calibrate.jobs.POSE_CHECKS``). When the robot moved or the
             wizard's step changed while the probe ran, nothing is recorded (the outcome says so).
     """
-    _ = wizard.translator.gettext
     if wizard.status != "in_progress":
-        raise WizardStateError(_("Cannot auto-touch: {reason}").format(reason=wizard.blocked_reason))
+        raise _cannot(wizard)
     angle_sigma_deg = _angle_sigma_deg(sigma_mm, angle_sigma_deg)
     rng = np.random.default_rng() if rng is None else rng
     step = wizard.step
     _ensure_mounted(wizard, controller, step, tools, mount)
     if not wizard.can_record:
-        raise WizardStateError(_("Cannot auto-touch: {reason}").format(reason=wizard.blocked_reason))
+        raise _cannot(wizard)
     role = wizard.auto_role(step)
     if role.align_world:
         return _align_with_world(wizard, controller, step, role, sigma_mm=sigma_mm, angle_sigma_deg=angle_sigma_deg,
@@ -207,8 +206,8 @@ def auto_touch_steps(wizard: Wizard, controller: VirtualController, *,
                 q_reached = controller.q_rad.copy()
                 refused = yield pose_check()
                 if _moved(controller, q_reached, wizard, step):
-                    return AutoTouchOutcome(False, step.index, step.role, None, None, None,
-                                            _(MOVED_DURING_PROBE), attempts)
+                    moved = wizard.translator.gettext(MOVED_DURING_PROBE)
+                    return AutoTouchOutcome(False, step.index, step.role, None, None, None, moved, attempts)
             if refused is not None:            # reached, but unfit for what the step is for
                 last_message = refused
                 continue
@@ -217,11 +216,21 @@ def auto_touch_steps(wizard: Wizard, controller: VirtualController, *,
                 return _touched(step, (tilt, azimuth, spin), d_mm, distance_mm, attempts,
                                 redrawn=fixed is not None and not use_fixed, tr=wizard.translator)
             last_message = res.message
+    return _failed(step, attempts, last_message, wizard.translator)
+
+
+def _failed(step: StepInfo, attempts: int, reason: str, tr: Translator) -> AutoTouchOutcome:
+    """No approach of ``attempts`` reached the step; ``reason``: the controller's last words."""
+    words = tr.ngettext("Auto-touch failed after {n} attempt: {reason}",
+                        "Auto-touch failed after {n} attempts: {reason}", attempts)
     return AutoTouchOutcome(False, step.index, step.role, None, None, None,
-                            wizard.translator.ngettext("Auto-touch failed after {n} attempt: {reason}",
-                                                       "Auto-touch failed after {n} attempts: {reason}",
-                                                       attempts).format(n=attempts, reason=last_message),
-                            attempts)
+                            words.format(n=attempts, reason=reason), attempts)
+
+
+def _cannot(wizard: Wizard) -> WizardStateError:
+    """Auto-touch refused: why Record is disabled (``Wizard.blocked_reason``), in the wizard's language."""
+    return WizardStateError(wizard.translator.gettext("Cannot auto-touch: {reason}").format(
+        reason=wizard.blocked_reason))
 
 
 def _angle_sigma_deg(sigma_mm: float, angle_sigma_deg: float | None) -> float:

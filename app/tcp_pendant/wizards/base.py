@@ -25,6 +25,7 @@ import abc
 import dataclasses
 import datetime as _dt
 import math
+import weakref
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import ClassVar, Literal, Protocol
@@ -292,7 +293,61 @@ class WizardResult:
         }
 
 
-class Wizard(abc.ABC):
+class _ComposedTexts(abc.ABC):
+    """The language a :class:`Wizard` composes its per-instance texts in, and its refusals in
+    words (the part of a wizard that knows languages; ``Wizard`` is the state machine)."""
+
+    _tr: Translator
+    _result: WizardResult | None
+    _status: Status
+
+    @property
+    @abc.abstractmethod
+    def finished_result(self) -> WizardResult | None: ...
+
+    @property
+    @abc.abstractmethod
+    def blocked_reason(self) -> str | None: ...
+
+    @abc.abstractmethod
+    def _recompute(self) -> WizardResult | None: ...
+
+    # ----- language of the texts it composes (module functions below) ----------------------
+    @property
+    def translator(self) -> Translator:
+        """The language of the texts it composes: steps, :attr:`blocked_reason`, refusals, the
+        result's warnings and notes (English until :meth:`set_translator`)."""
+        return self._tr
+
+    def set_translator(self, tr: Translator) -> None:
+        """Compose the texts in ``tr``'s language from now on (the session's): the steps are
+        composed when read; a result on hand is recomposed (:func:`recomposed_result`)."""
+        if tr is not self._tr:
+            self._tr = tr
+            self._result = recomposed_result(self) or self._result
+
+    def result_in(self, tr: Translator) -> WizardResult | None:
+        """:attr:`finished_result` with its texts in ``tr``'s language (:func:`result_in`)."""
+        return result_in(self, tr)
+
+    def _refuse_blocked(self) -> None:
+        """Raises WizardStateError naming :attr:`blocked_reason` when Record is disabled."""
+        reason = self.blocked_reason
+        if reason is not None:
+            raise WizardStateError(self._tr.gettext("Cannot record now: {reason}").format(reason=reason))
+
+    def _cancelled_refusal(self) -> WizardStateError:
+        return WizardStateError(self._tr.gettext("The wizard was cancelled; resume it first."))
+
+    def _next_refusal(self) -> WizardStateError:
+        """Next refused: the wizard is not in progress (finished or cancelled)."""
+        _ = self._tr.gettext
+        if self._status == "complete":
+            return WizardStateError(_("Next is not possible: the wizard is complete."))
+        return WizardStateError(_("Next is not possible: the wizard is cancelled."))
+
+
+class Wizard(_ComposedTexts):
     """Base state machine of a calibration wizard (see the module docstring for the life cycle).
 
     Subclasses define ``_step_specs()``, ``_compute()``, ``_params()``, ``_from_params()`` and
@@ -454,63 +509,12 @@ class Wizard(abc.ABC):
         self._tr: Translator = ENGLISH
         self.started_at = utc_now_iso()
 
-    # ----- language of the texts it composes ------------------------------------------------
-    @property
-    def translator(self) -> Translator:
-        """The language of the texts this wizard composes per instance: :attr:`step` and
-        :attr:`steps` (heading, title, instruction), :attr:`blocked_reason`, the refusals it
-        raises and its result's warnings and notes (English until :meth:`set_translator`)."""
-        return self._tr
-
-    def set_translator(self, tr: Translator) -> None:
-        """Compose the texts in ``tr``'s language from now on (the session's, set at start and
-        on every language switch): the steps are composed when read, so the step on show reads
-        in the new language at once; a result on hand is recomposed (same figures, same
-        ``computed_at``)."""
-        if tr is self._tr:
-            return
-        self._tr = tr
-        if self._result is not None:
-            again = self._recomposed_result()
-            if again is not None:
-                self._result = again
-
-    def _recomposed_result(self) -> WizardResult | None:
-        """The result on hand composed again in the current language (None: it cannot be)."""
-        old = self._result
-        if old is None:
-            return None
-        try:
-            new = self._recompute()
-        except (WizardError, TcpcalError):
-            return None
-        return None if new is None else dataclasses.replace(new, computed_at=old.computed_at)
-
     def _recompute(self) -> WizardResult | None:
-        """The result computed again from what is recorded (a wizard whose result does not come
-        from its recorded poses overrides this)."""
+        """The result computed again from the recorded poses (None: not all recorded); a wizard
+        whose result does not come from its poses overrides this."""
         if any(i not in self._poses for i in range(self.n_steps)):
             return None
         return self._compute([self._poses[i].T_world_flange_m for i in range(self.n_steps)])
-
-    def result_in(self, tr: Translator) -> WizardResult | None:
-        """The finished result (:attr:`finished_result`) with its texts in ``tr``'s language:
-        a session record keeps English words whatever the trainee reads."""
-        res = self.finished_result
-        if res is None or tr is self._tr:
-            return res
-        cached = getattr(self, "_result_in", None)
-        if cached is not None and cached[0] is res and cached[1] is tr:
-            return cached[2]
-        mine = self._tr
-        self._tr = tr
-        try:
-            again = self._recomposed_result()
-        finally:
-            self._tr = mine
-        out = res if again is None else again
-        self._result_in: tuple[WizardResult, Translator, WizardResult] = (res, tr, out)
-        return out
 
     # ----- to be provided by each wizard --------------------------------------------------
     @abc.abstractmethod
@@ -660,15 +664,6 @@ class Wizard(abc.ABC):
         self._poses[self._index] = RecordedPose(T, utc_now_iso())
         return self.step
 
-    def _refuse_blocked(self) -> None:
-        """Raises WizardStateError naming :attr:`blocked_reason` when Record is disabled."""
-        reason = self.blocked_reason
-        if reason is not None:
-            raise WizardStateError(self._tr.gettext("Cannot record now: {reason}").format(reason=reason))
-
-    def _cancelled_refusal(self) -> WizardStateError:
-        return WizardStateError(self._tr.gettext("The wizard was cancelled; resume it first."))
-
     def prefill(self, poses_m: Sequence[npt.ArrayLike]) -> StepInfo:
         """Record ``poses_m`` (4x4 flange poses in WORLD, metres) as the first steps of a wizard
         just started, then stand on the first step left to record (the last step when all are).
@@ -719,13 +714,6 @@ class Wizard(abc.ABC):
             self._index += 1
             return self.step
         return self.finish()
-
-    def _next_refusal(self) -> WizardStateError:
-        """Next refused: the wizard is not in progress (finished or cancelled)."""
-        _ = self._tr.gettext
-        if self._status == "complete":
-            return WizardStateError(_("Next is not possible: the wizard is complete."))
-        return WizardStateError(_("Next is not possible: the wizard is cancelled."))
 
     def finish(self) -> WizardResult:
         """Compute the result from all steps (each must be recorded) and mark the wizard complete."""
@@ -849,6 +837,43 @@ class Wizard(abc.ABC):
             self._status = "in_progress"
         if d.get("status") == "cancelled":
             self.cancel()
+
+
+def recomposed_result(wizard: _ComposedTexts) -> WizardResult | None:
+    """``wizard``'s result on hand composed again in its current language: the same figures and
+    ``computed_at`` (None: no result, or it cannot be recomputed)."""
+    old = wizard._result
+    if old is None:
+        return None
+    try:
+        new = wizard._recompute()
+    except (WizardError, TcpcalError):
+        return None
+    return None if new is None else dataclasses.replace(new, computed_at=old.computed_at)
+
+
+_RESULTS_IN: "weakref.WeakKeyDictionary[_ComposedTexts, tuple[WizardResult, Translator, WizardResult]]" = \
+    weakref.WeakKeyDictionary()
+
+
+def result_in(wizard: _ComposedTexts, tr: Translator) -> WizardResult | None:
+    """``wizard.finished_result`` with its texts in ``tr``'s language (a session record keeps
+    English words whatever the trainee reads); kept until the result changes."""
+    res = wizard.finished_result
+    if res is None or tr is wizard._tr:
+        return res
+    cached = _RESULTS_IN.get(wizard)
+    if cached is not None and cached[0] is res and cached[1] is tr:
+        return cached[2]
+    mine = wizard._tr
+    wizard._tr = tr
+    try:
+        again = recomposed_result(wizard)
+    finally:
+        wizard._tr = mine
+    out = res if again is None else again
+    _RESULTS_IN[wizard] = (res, tr, out)
+    return out
 
 
 def mm3(v: Sequence[float] | np.ndarray) -> tuple[float, float, float]:
