@@ -174,7 +174,8 @@ class WizardCommands:
         probe, out = advance(None, True)
         try:
             while probe is not None:
-                answer = await host.loop.run_job(probe, what="Auto-touch's check of the pose it reached")
+                answer = await host.loop.run_job(probe, what=host.workflow.translator.gettext(
+                    "Auto-touch's check of the pose it reached"))
                 if host.closed:
                     raise WizardStateError(host.workflow.translator.gettext("The session was closed."))
                 probe, out = advance(answer, False)
@@ -221,7 +222,9 @@ class WizardCommands:
         job = self.take_controller_job()
         if job is None:
             return self.next_step()
-        outcome = await self._host.loop.run_job(job.run, what=f"the {job.wizard.title} wizard's controller job")
+        _ = self._host.workflow.translator.gettext
+        outcome = await self._host.loop.run_job(job.run, what=_("the {method} wizard's controller job").format(
+            method=_(job.wizard.title)))
         if self._host.closed:
             return None
         return self.hand_in_controller_job(job, outcome)

@@ -316,3 +316,24 @@ def test_tcpcals_remarks_are_said_again_from_the_catalogs(synth) -> None:
     assert "[0.00, -0.71, 0.71]" in said and " 12 " in said
     assert solver_warning(weak) == weak
     assert solver_warning("a remark no table knows", tr=QPS) == "a remark no table knows"
+
+
+def test_tcpcals_refusal_of_the_touches_reaches_the_trainee_in_the_language(synth) -> None:
+    from tcp_pendant.calibrate.finish_checks import failure_in_trainee_words
+    from tcp_pendant.wizards import CalibrationFailedError
+
+    tool = synth.tools["pointer"]
+    wiz = Xyz4Wizard(n_points=4)
+    R = synth.tool_orientation(20.0, 30.0, 0.0)
+    for k in range(4):                        # one orientation, four places: nothing to solve
+        wiz.record(synth.flange_pose_m(tool, R, offset_tool_mm=(0.0, 10.0 * k, 0.0)))
+        if k < 3:
+            wiz.next()
+    with pytest.raises(CalibrationFailedError) as failed:
+        wiz.next()
+    english = str(failed.value)
+    assert english.startswith("all 4 touches have the same orientation")
+    said = failure_in_trainee_words(failed.value, wiz, np.eye(3), tr=QPS)
+    assert_pseudo(str(said))
+    assert said.cause is failed.value.cause
+    assert failure_in_trainee_words(failed.value, wiz, np.eye(3)) is failed.value    # English: as tcpcal said

@@ -19,6 +19,7 @@ from tcp_pendant.controller import ToolModel
 from tcp_pendant.translation import ENGLISH, Translator
 from tcp_pendant.wizards import CalibrationFailedError, Wizard
 from tcp_pendant.wizards.session_record import WizardRun
+from tcp_pendant.wizards.solver_words import solver_warning
 
 __all__ = ["failure_in_trainee_words", "touches_short", "wrong_tool_touch"]
 
@@ -104,4 +105,5 @@ def failure_in_trainee_words(exc: CalibrationFailedError, wizard: Wizard | None,
         return CalibrationFailedError(
             tr.gettext("{failure} Go Back to a step and record it tilted about that axis.").format(
                 failure=failure_in_words(str(exc), axis, R_world_flange)), cause)
-    return exc
+    said = solver_warning(str(exc), tr=tr)       # tcpcal's words from the catalogs, when it knows them
+    return exc if said == str(exc) else CalibrationFailedError(said, cause)

@@ -1,4 +1,4 @@
-"""tcpcal's warnings in the session's language (no viser).
+"""tcpcal's warnings and refusals in the session's language (no viser).
 
 tcpcal is a solver with no user interface and no language: its results carry plain English
 remarks (``TcpResult.warnings``, ``OrientationResult.warnings``, ...). A wizard shows them to a
@@ -139,6 +139,31 @@ _TABLE: tuple[tuple[re.Pattern[str], str], ...] = tuple((re.compile(pattern), ms
      r"estimated; cross the beam at a third orientation or give sigma\.",
      N_("{k} axis events determine the direction exactly, without redundancy: its uncertainty cannot be "
         "estimated; cross the beam at a third orientation or give sigma.")),
+    # tcpcal's refusals of touches that cannot give a result (DegenerateTouchesError)
+    (rf"all (?P<n>\d+) touches have the same orientation \(at most (?P<deg>{_NUM}) deg apart\), so the TCP "
+     r"cannot be determined; the 4-point method needs clearly different orientations: tilt the tool 30-60 deg "
+     r"between touches, about two different axes\.",
+     N_("all {n} touches have the same orientation (at most {deg} deg apart), so the TCP cannot be determined; "
+        "the 4-point method needs clearly different orientations: tilt the tool 30-60 deg between touches, "
+        "about two different axes.")),
+    (rf"the flange positions are coplanar, so the sphere fit cannot locate the reference \(thickness / extent = "
+     rf"(?P<ratio>{_NUM})\); use method 'lstsq', or touch from orientations that move the flange out of that "
+     r"plane\.",
+     N_("the flange positions are coplanar, so the sphere fit cannot locate the reference (thickness / extent = "
+        "{ratio}); use method 'lstsq', or touch from orientations that move the flange out of that plane.")),
+    (rf"touch (?P<n>\d+) \((?P<what>.*)\): the reference tip is still at the TCP \(\|Delta\| = "
+     rf"(?P<length>{_NUM})\); move the tool so that the tip lies on (?P<what2>.*), clearly away from the TCP "
+     r"\(e\.g\. 50 mm or more\), then record again\.",
+     N_("touch {n} ({what}): the reference tip is still at the TCP (|Delta| = {length}); move the tool so that "
+        "the tip lies on {what2}, clearly away from the TCP (e.g. 50 mm or more), then record again.")),
+    (r"touch (?P<n>\d+) \((?P<what>.*)\): the reference tip lies on the tool X axis, so tool Y is undefined; "
+     r"move the tool sideways so that the tip lies on the tool's \+Y side\.",
+     N_("touch {n} ({what}): the reference tip lies on the tool X axis, so tool Y is undefined; move the tool "
+        "sideways so that the tip lies on the tool's +Y side.")),
+    (r"every \+Y point lies on the tool X axis, so tool Y is undefined; move the tool sideways so that the tip "
+     r"lies on the tool's \+Y side\.",
+     N_("every +Y point lies on the tool X axis, so tool Y is undefined; move the tool sideways so that the tip "
+        "lies on the tool's +Y side.")),
     (rf"axis event (?P<i>\d+): the beam met the tool axis (?P<d>{_NUM}) ahead of the TCP, beyond the tip; the "
      r"crossings should be on the shaft behind the tip\.",
      N_("axis event {i}: the beam met the tool axis {d} ahead of the TCP, beyond the tip; the crossings should "
@@ -154,7 +179,7 @@ def solver_warning(text: str, *, tr: Translator = ENGLISH) -> str:
     for pattern, msgid in _TABLE:
         m = pattern.fullmatch(text)
         if m is not None:
-            values = {k: (tr.gettext(_WHAT[v]) if k in ("what", "label") and v in _WHAT else v)
+            values = {k: (tr.gettext(_WHAT[v]) if k in ("what", "what2", "label") and v in _WHAT else v)
                       for k, v in m.groupdict().items()}
             return tr.gettext(msgid).format(**values)
     return text
