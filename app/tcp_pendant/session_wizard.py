@@ -86,7 +86,7 @@ class WizardCommands:
         rules.check_method(kind, {c.kind: c.title for c in wizard_classes()})
         counted = any(o.name == "n_points" for o in cls.options)
         if counted and not cls.supports_add_point and options is not None and rules.min_touches:
-            n_points = int(cls.parse_options(options)["n_points"])
+            n_points = int(cls.parse_options(options, tr=self._host.workflow.translator)["n_points"])
             if rules.touches_refusal(n_points, can_add_point=False) is not None:
                 _ = self._host.workflow.translator.gettext
                 raise RuleRefusal(_("This exercise asks for at least {n} touches: set "

@@ -337,3 +337,16 @@ def test_tcpcals_refusal_of_the_touches_reaches_the_trainee_in_the_language(synt
     assert_pseudo(str(said))
     assert said.cause is failed.value.cause
     assert failure_in_trainee_words(failed.value, wiz, np.eye(3)) is failed.value    # English: as tcpcal said
+
+
+def test_start_options_are_refused_in_the_language(tmp_path) -> None:
+    s = make_session(tmp_path / "tools.json")
+    s.set_language(PSEUDO_LANGUAGE)
+    for kind, options in (("xyz4", {"colour": 1}), ("xyz4", {"n_points": 2.5}), ("xyz4", {"n_points": 99}),
+                          ("xyz4", {"estimator": "median"}), ("three-point", {"variant": 3, "slot": 1}),
+                          ("three-point", {}), ("three-point", {"slot": 7})):
+        with pytest.raises(WizardError) as refused:
+            s.wizard_commands.start(kind, **options)
+        assert_pseudo(str(refused.value), {"colour", "median", "estimator", "n", "points", "slot", "variant", "lstsq", "sphere", "pairwise"})
+    with pytest.raises(WizardError, match=r"^Touches: 99 is out of range 4\.\.20\.$"):
+        Xyz4Wizard.parse_options({"n_points": 99})

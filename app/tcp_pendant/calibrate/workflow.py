@@ -324,7 +324,7 @@ class CalibrationWorkflow:
             _ = self.translator.gettext
             raise WizardError(_(EXERCISE_REFUSAL).format(
                 what=_("The {method} wizard").format(method=_(cls.title))))
-        started = cls.start(_StartContext(self), cls.parse_options(options))
+        started = cls.start(_StartContext(self), cls.parse_options(options, tr=self.translator))
         held = getattr(self.state, "exercise_tool", None)     # the session's exercise tool, when it has one
         if held is not None:
             check_calibrated_tool(held.key, held.label, getattr(started.true_tool, "key", None), cls.title)
@@ -673,5 +673,6 @@ class _StartContext:
     def library_tool(self, slot: int) -> Tool:
         tool = self._workflow.library.get(int(slot))
         if tool is None:
-            raise WizardError(f"Slot {slot} of the tool library is empty; pick a calibrated tool.")
+            raise WizardError(self._workflow.translator.gettext(
+                "Slot {slot} of the tool library is empty; pick a calibrated tool.").format(slot=slot))
         return tool

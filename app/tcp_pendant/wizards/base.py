@@ -420,35 +420,38 @@ class Wizard(_ComposedTexts):
         return type(self).step_role(step.role).auto
 
     @classmethod
-    def parse_options(cls, options: JsonRecord) -> JsonRecord:
+    def parse_options(cls, options: JsonRecord, *, tr: Translator = ENGLISH) -> JsonRecord:
         """The start options checked against :attr:`options` (and ``variant`` against
         :attr:`variants`); defaults filled in.
 
         Raises:
-            WizardError: an unknown option, a value out of its choices, a missing required one.
+            WizardError: an unknown option, a value out of its choices, a missing required one
+                (in ``tr``'s language).
         """
+        _ = tr.gettext
         declared = {o.name: o for o in cls.options}
         allowed = set(declared) | ({"variant"} if cls.variants else set())
         unknown = sorted(set(options) - allowed)
         if unknown:
-            raise WizardError(f"The {cls.title} wizard takes no option {', '.join(unknown)}; "
-                              f"it takes {', '.join(sorted(allowed)) or 'none'}.")
+            raise WizardError(_("The {method} wizard takes no option {unknown}; it takes {allowed}.").format(
+                method=_(cls.title), unknown=", ".join(unknown), allowed=", ".join(sorted(allowed)) or _("none")))
         out: dict[str, object] = {}
         try:
             for name, opt in declared.items():
                 if name in options and options[name] is not None:
-                    out[name] = opt.parse(options[name])
+                    out[name] = opt.parse(options[name], tr=tr)
                 elif opt.required:
-                    raise OptionError(f"{opt.label}: choose one before Start.")
+                    raise OptionError(_("{option}: choose one before Start.").format(option=_(opt.label)))
                 else:
                     out[name] = opt.default
         except OptionError as exc:
             raise WizardError(str(exc)) from None
         if cls.variants:
-            values = [v for v, _ in cls.variants]
+            values = [v for v, _label in cls.variants]
             variant = options.get("variant", values[0])
             if variant not in values:
-                raise WizardError(f"The {cls.title} variant is one of {values}, got {variant!r}.")
+                raise WizardError(_("The {method} variant is one of {values}, got {variant}.").format(
+                    method=_(cls.title), values=values, variant=repr(variant)))
             out["variant"] = variant
         return out
 
