@@ -347,6 +347,7 @@ def test_start_options_are_refused_in_the_language(tmp_path) -> None:
                           ("three-point", {}), ("three-point", {"slot": 7})):
         with pytest.raises(WizardError) as refused:
             s.wizard_commands.start(kind, **options)
-        assert_pseudo(str(refused.value), {"colour", "median", "estimator", "n", "points", "slot", "variant", "lstsq", "sphere", "pairwise"})
+        option_keys = {"colour", "median", "estimator", "n", "points", "slot", "variant", "lstsq", "sphere", "pairwise"}
+        assert_pseudo(str(refused.value), option_keys)
     with pytest.raises(WizardError, match=r"^Touches: 99 is out of range 4\.\.20\.$"):
         Xyz4Wizard.parse_options({"n_points": 99})
