@@ -351,3 +351,20 @@ def test_start_options_are_refused_in_the_language(tmp_path) -> None:
         assert_pseudo(str(refused.value), option_keys)
     with pytest.raises(WizardError, match=r"^Touches: 99 is out of range 4\.\.20\.$"):
         Xyz4Wizard.parse_options({"n_points": 99})
+
+
+def test_a_failed_finish_is_told_again_in_the_new_language(tmp_path) -> None:
+    s = make_session(tmp_path / "tools.json")
+    s.wizard_commands.start("xyz4")
+    for k in range(4):                        # four records without moving: one orientation
+        s.wizard_commands.record_step()
+        if k < 3:
+            s.wizard_commands.next_step()
+    with pytest.raises(WizardError):
+        s.wizard_commands.next_step()
+    english = s.workflow.finish_failure
+    assert english is not None and english.startswith("all 4 touches have the same orientation")
+    s.set_language(PSEUDO_LANGUAGE)
+    assert_pseudo(s.workflow.finish_failure)
+    s.set_language("en")
+    assert s.workflow.finish_failure == english
