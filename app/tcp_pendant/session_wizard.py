@@ -83,7 +83,8 @@ class WizardCommands:
         """
         rules = self._host.rules
         cls = wizard_class(kind)
-        rules.check_method(kind, {c.kind: c.title for c in wizard_classes()})
+        tr = self._host.workflow.translator             # the methods named as the trainee reads them
+        rules.check_method(kind, {c.kind: tr.gettext(c.title) for c in wizard_classes()})
         counted = any(o.name == "n_points" for o in cls.options)
         if counted and not cls.supports_add_point and options is not None and rules.min_touches:
             n_points = int(cls.parse_options(options, tr=self._host.workflow.translator)["n_points"])

@@ -32,7 +32,7 @@ from tcp_pendant.wizards.base import (
     mm3,
     rotation_and_position_mm,
 )
-from tcp_pendant.wizards.solver_words import solver_warnings
+from tcp_pendant.wizards.solver_words import solver_warning, solver_warnings
 from tcp_pendant.wizards.describe import TOUCH, StepRole, WizardOption, WizardStart
 
 Estimator = Literal["lstsq", "sphere", "pairwise"]
@@ -352,7 +352,7 @@ class Xyz4Wizard(Wizard):
             try:
                 estimators[name] = solve_xyz4(R, f, method=name)
             except TcpcalError as exc:
-                errors[name] = str(exc)
+                errors[name] = solver_warning(str(exc), tr=self._tr)
         t = np.asarray(chosen.tcp, dtype=float)
         radius = float(np.linalg.norm(t))
         directions = (R_all @ t) / radius if radius > 0 else np.zeros((len(poses), 3))
