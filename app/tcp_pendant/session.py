@@ -266,6 +266,7 @@ class Session:
 
     def __post_init__(self) -> None:
         self.translator = translator(self.language)     # raises on an unknown code
+        self.workflow.set_translator(self.translator)   # the wizards' steps, warnings and refusals
         if self.target is None:
             self.target = self.client
         if self.workflow.controller is not self.controller:
@@ -437,7 +438,9 @@ class Session:
     def set_language(self, language: str) -> None:
         """This session's language (a code of ``translation.languages`` or the pseudo-locale):
         the views re-render their texts (a ``language`` change); the pose, the touches and the
-        wizard stay as they are. Another session's language never changes.
+        wizard stay as they are, the wizards' texts (the step on show, a result's warnings) now
+        composed in the new language (``CalibrationWorkflow.set_translator``). Another session's
+        language never changes.
 
         Raises:
             ValueError: an unknown code (naming the known ones).
@@ -447,7 +450,8 @@ class Session:
             if new.language == self.language:
                 return
             self.language, self.translator = new.language, new
-            self.changed(language=True)
+            self.workflow.set_translator(new)
+            self.changed(language=True, wizard=True)
 
     def set_rules(self, rules: ExerciseRules) -> None:
         """The exercise's rules (the classroom sets them): locked distance aids switch "Hide

@@ -83,13 +83,16 @@ class WizardCommands:
         """
         rules = self._host.rules
         cls = wizard_class(kind)
-        rules.check_method(kind, {c.kind: c.title for c in wizard_classes()})
+        tr = self._host.workflow.translator             # the methods named as the trainee reads them
+        rules.check_method(kind, {c.kind: tr.gettext(c.title) for c in wizard_classes()})
         counted = any(o.name == "n_points" for o in cls.options)
         if counted and not cls.supports_add_point and options is not None and rules.min_touches:
-            n_points = int(cls.parse_options(options)["n_points"])
+            n_points = int(cls.parse_options(options, tr=self._host.workflow.translator)["n_points"])
             if rules.touches_refusal(n_points, can_add_point=False) is not None:
-                raise RuleRefusal(f"This exercise asks for at least {rules.min_touches} touches: set "
-                                  f"Touches to {rules.min_touches} or more for the {cls.title} method.")
+                _ = self._host.workflow.translator.gettext
+                raise RuleRefusal(_("This exercise asks for at least {n} touches: set "
+                                    "Touches to {n} or more for the {method} method.").format(
+                                        n=rules.min_touches, method=_(cls.title)))
 
     def finish_refusal(self) -> str | None:
         """Why Finish of the wizard on show is refused by the exercise (too few touches for a
@@ -172,9 +175,10 @@ class WizardCommands:
         probe, out = advance(None, True)
         try:
             while probe is not None:
-                answer = await host.loop.run_job(probe, what="Auto-touch's check of the pose it reached")
+                answer = await host.loop.run_job(probe, what=host.workflow.translator.gettext(
+                    "Auto-touch's check of the pose it reached"))
                 if host.closed:
-                    raise WizardStateError("The session was closed.")
+                    raise WizardStateError(host.workflow.translator.gettext("The session was closed."))
                 probe, out = advance(answer, False)
         finally:
             steps.close()
@@ -219,7 +223,9 @@ class WizardCommands:
         job = self.take_controller_job()
         if job is None:
             return self.next_step()
-        outcome = await self._host.loop.run_job(job.run, what=f"the {job.wizard.title} wizard's controller job")
+        _ = self._host.workflow.translator.gettext
+        outcome = await self._host.loop.run_job(job.run, what=_("the {method} wizard's controller job").format(
+            method=_(job.wizard.title)))
         if self._host.closed:
             return None
         return self.hand_in_controller_job(job, outcome)
@@ -279,8 +285,9 @@ class WizardCommands:
             wf = self._host.workflow
             est = tcp_estimate(wf.wizard) if wf.is_open else None
             if est is None:
-                raise WizardStateError("The wizard estimates the TCP from two touches in different "
-                                       "orientations of an XYZ 4-point: record them first.")
+                raise WizardStateError(wf.translator.gettext(
+                    "The wizard estimates the TCP from two touches in different "
+                    "orientations of an XYZ 4-point: record them first."))
             self._host.tools.set_active_data(est.tool())
             return est
 

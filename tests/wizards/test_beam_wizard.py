@@ -210,7 +210,7 @@ def test_too_few_tip_events_fail_in_words() -> None:
     keep = [e for e in scan.events if e.kind == "axis"][:4] + [e for e in scan.events if e.kind == "tip"][:1]
     wiz = BeamWizard()
     wiz.give_scan(FakeScan(tuple(keep), (0,) * len(keep), skipped=scan.skipped), R_flange_tool_base=np.eye(3))
-    with pytest.raises(WizardError, match=r"1 tip event\(s\).*out of reach"):
+    with pytest.raises(WizardError, match=r"1 tip event;.*out of reach"):
         wiz.finish()
     assert wiz.status == "in_progress"
 

@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING
 
 from tcp_pendant.calibrate.autotouch import AutoTouchOutcome, PoseProbe, auto_touch_steps
 from tcp_pendant.calibrate.jobs import POSE_CHECKS
+from tcp_pendant.translation import N_
 from tcp_pendant.wizards import CalibrationFailedError, WizardStateError
 
 if TYPE_CHECKING:
@@ -22,7 +23,7 @@ if TYPE_CHECKING:
 
 __all__ = ["AutoTouchDriver"]
 
-_TRAINING_ONLY = "Auto-touch is a training-mode tool; switch training mode on."
+_TRAINING_ONLY = N_("Auto-touch is a training-mode tool; switch training mode on.")
 
 
 class AutoTouchDriver:
@@ -39,8 +40,9 @@ class AutoTouchDriver:
 
     def refusal(self) -> str | None:
         """``CalibrationWorkflow.auto_touch_refusal``: why Auto-touch is refused as things are."""
+        _ = self._workflow.translator.gettext
         if not self._workflow.training:
-            return _TRAINING_ONLY
+            return _(_TRAINING_ONLY)
         rules = getattr(self._workflow.state, "rules", None)
         if rules is not None:
             try:
@@ -49,7 +51,7 @@ class AutoTouchDriver:
                 return None
         w = self._workflow.wizard
         if w is not None and w.status != "in_progress":
-            return f"Cannot auto-touch: {w.blocked_reason}"
+            return _("Cannot auto-touch: {reason}").format(reason=w.blocked_reason)
         return None
 
     def steps(self, request: AutoTouchRequest) -> Generator[PoseProbe, str | None, AutoTouchOutcome]:
@@ -62,15 +64,16 @@ class AutoTouchDriver:
             CalibrationFailedError: the touches cannot determine the result.
         """
         wf = self._workflow
+        _ = wf.translator.gettext
         if not wf.training:
-            raise WizardStateError(_TRAINING_ONLY)
+            raise WizardStateError(_(_TRAINING_ONLY))
         rules = getattr(wf.state, "rules", None)     # the session's exercise rules, when it has them
         if rules is not None:
             rules.check_auto_touch()
         w = wf.require_wizard()
         if w.status == "in_progress" and w.auto_role(w.step).by_controller:
-            raise WizardStateError(f"The {w.title} wizard has nothing to touch: the controller runs this "
-                                   "step itself; press Finish.")
+            raise WizardStateError(_("The {method} wizard has nothing to touch: the controller runs this "
+                                     "step itself; press Finish.").format(method=_(w.title)))
         run_index = wf.run_index
         wf.note_mounted_tool()
         had_pose = set(w.recorded_poses) if w.status == "in_progress" else set()
@@ -86,8 +89,8 @@ class AutoTouchDriver:
                 answer = yield probe
                 if wf.wizard is not w or wf.run_index != run_index:   # left while the probe ran
                     steps.close()
-                    raise WizardStateError("The calibration on show changed while Auto-touch checked the pose "
-                                           "it reached; nothing was recorded.")
+                    raise WizardStateError(_("The calibration on show changed while Auto-touch checked the pose "
+                                             "it reached; nothing was recorded."))
                 probe = steps.send(answer)
         except StopIteration as stop:
             out: AutoTouchOutcome = stop.value

@@ -42,6 +42,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from tcp_pendant.controller import ToolModel, VirtualController, builtin_tools
+from tcp_pendant.translation import ENGLISH, N_, Translator
 from tcp_pendant.wizards.abc_world import R_WORLD_TOOL_TARGET
 from tcp_pendant.wizards.base import StepInfo, Wizard, WizardError, WizardStateError
 from tcp_pendant.wizards.describe import AutoRole
@@ -114,7 +115,7 @@ answers and returns the outcome."""
 
 R = TypeVar("R")
 P = ParamSpec("P")
-MOVED_DURING_PROBE = ("The robot was moved while Auto-touch checked the pose it reached; nothing was "
+MOVED_DURING_PROBE = N_("The robot was moved while Auto-touch checked the pose it reached; nothing was "
                       "recorded. Press Auto-touch again.")
 
 
@@ -178,13 +179,13 @@ def auto_touch_steps(wizard: Wizard, controller: VirtualController, *,
             wizard's step changed while the probe ran, nothing is recorded (the outcome says so).
     """
     if wizard.status != "in_progress":
-        raise WizardStateError(f"Cannot auto-touch: {wizard.blocked_reason}")
+        raise _cannot(wizard)
     angle_sigma_deg = _angle_sigma_deg(sigma_mm, angle_sigma_deg)
     rng = np.random.default_rng() if rng is None else rng
     step = wizard.step
     _ensure_mounted(wizard, controller, step, tools, mount)
     if not wizard.can_record:
-        raise WizardStateError(f"Cannot auto-touch: {wizard.blocked_reason}")
+        raise _cannot(wizard)
     role = wizard.auto_role(step)
     if role.align_world:
         return _align_with_world(wizard, controller, step, role, sigma_mm=sigma_mm, angle_sigma_deg=angle_sigma_deg,
@@ -195,7 +196,7 @@ def auto_touch_steps(wizard: Wizard, controller: VirtualController, *,
     last_message = ""
     for d_mm, use_fixed in _approach_plan(role, distance_mm, fixed, chosen=direction_deg is not None):
         offset = role.reference_in_tool_mm(d_mm)
-        for _ in range(1 if use_fixed else max_attempts):
+        for _attempt in range(1 if use_fixed else max_attempts):
             attempts += 1
             tilt, azimuth, spin = _direction_deg(fixed if use_fixed else None, role, rng)
             res = controller.auto_approach(tilt_deg=tilt, azimuth_deg=azimuth, spin_deg=spin,
@@ -205,18 +206,31 @@ def auto_touch_steps(wizard: Wizard, controller: VirtualController, *,
                 q_reached = controller.q_rad.copy()
                 refused = yield pose_check()
                 if _moved(controller, q_reached, wizard, step):
-                    return AutoTouchOutcome(False, step.index, step.role, None, None, None, MOVED_DURING_PROBE,
-                                            attempts)
+                    moved = wizard.translator.gettext(MOVED_DURING_PROBE)
+                    return AutoTouchOutcome(False, step.index, step.role, None, None, None, moved, attempts)
             if refused is not None:            # reached, but unfit for what the step is for
                 last_message = refused
                 continue
             if res.ok:
                 _record(wizard, controller, advance)
                 return _touched(step, (tilt, azimuth, spin), d_mm, distance_mm, attempts,
-                                redrawn=fixed is not None and not use_fixed)
+                                redrawn=fixed is not None and not use_fixed, tr=wizard.translator)
             last_message = res.message
+    return _failed(step, attempts, last_message, wizard.translator)
+
+
+def _failed(step: StepInfo, attempts: int, reason: str, tr: Translator) -> AutoTouchOutcome:
+    """No approach of ``attempts`` reached the step; ``reason``: the controller's last words."""
+    words = tr.ngettext("Auto-touch failed after {n} attempt: {reason}",
+                        "Auto-touch failed after {n} attempts: {reason}", attempts)
     return AutoTouchOutcome(False, step.index, step.role, None, None, None,
-                            f"Auto-touch failed after {attempts} attempt(s): {last_message}", attempts)
+                            words.format(n=attempts, reason=reason), attempts)
+
+
+def _cannot(wizard: Wizard) -> WizardStateError:
+    """Auto-touch refused: why Record is disabled (``Wizard.blocked_reason``), in the wizard's language."""
+    return WizardStateError(wizard.translator.gettext("Cannot auto-touch: {reason}").format(
+        reason=wizard.blocked_reason))
 
 
 def _angle_sigma_deg(sigma_mm: float, angle_sigma_deg: float | None) -> float:
@@ -245,17 +259,20 @@ def _direction_deg(fixed: tuple[float, float, float] | None, role: AutoRole,
 
 
 def _touched(step: StepInfo, direction_deg: tuple[float, float, float], d_mm: float, distance_mm: float,
-             attempts: int, *, redrawn: bool) -> AutoTouchOutcome:
+             attempts: int, *, redrawn: bool, tr: Translator = ENGLISH) -> AutoTouchOutcome:
     """The outcome of a step recorded from ``direction_deg`` with the reference ``d_mm`` off the
     tip (shorter than the ``distance_mm`` asked: it was out of reach; ``redrawn``: the previous
     orientation was, and a new one was drawn)."""
+    _ = tr.gettext
     tilt, azimuth, spin = direction_deg
-    shorter = (f" The reference is {d_mm:g} mm off the tip: {distance_mm:g} mm was out of "
-               f"reach." if d_mm != distance_mm else
-               " The previous orientation was out of reach: a new one was drawn." if redrawn else "")
-    return AutoTouchOutcome(True, step.index, step.role, tilt, azimuth, spin,
-                            f"Step {step.index + 1} recorded: {step.title} (tilt {tilt:.0f}°, "
-                            f"azimuth {azimuth:.0f}°).{shorter}", attempts)
+    words = _("Step {k} recorded: {title} (tilt {tilt}°, azimuth {azimuth}°).").format(
+        k=step.index + 1, title=step.title, tilt=f"{tilt:.0f}", azimuth=f"{azimuth:.0f}")
+    if d_mm != distance_mm:
+        words += " " + _("The reference is {d} mm off the tip: {distance} mm was out of reach.").format(
+            d=f"{d_mm:g}", distance=f"{distance_mm:g}")
+    elif redrawn:
+        words += " " + _("The previous orientation was out of reach: a new one was drawn.")
+    return AutoTouchOutcome(True, step.index, step.role, tilt, azimuth, spin, words, attempts)
 
 
 def _moved(controller: VirtualController, q_reached: np.ndarray, wizard: Wizard, step: StepInfo) -> bool:
@@ -309,16 +326,18 @@ def _align_with_world(wizard: Wizard, controller: VirtualController, step: StepI
     T = np.eye(4)
     T[:3, :3] = R
     T[:3, 3] = np.asarray(controller.reference_tip_world_m, dtype=float) + [0.0, 0.0, hover_mm / 1000.0]
+    _ = wizard.translator.gettext
     res = controller.move_true_tool_to(T)
     if not res.ok:
         return AutoTouchOutcome(False, step.index, step.role, None, None, None,
-                                f"Could not align the tool with WORLD: {res.message}", 1)
+                                _("Could not align the tool with WORLD: {reason}").format(reason=res.message), 1)
     _record(wizard, controller, advance)
-    how = ("exactly" if angle_sigma_deg == 0.0 else
-           f"by eye, {misalignment_deg:.2f}° off (σ {angle_sigma_deg:.2f}° per axis = operator error "
-           f"{sigma_mm:g} mm over {ANGLE_LEVER_MM:.0f} mm)")
-    return AutoTouchOutcome(True, step.index, step.role, None, None, None,
-                            f"Tool aligned with WORLD {how} and recorded.", 1)
+    words = (_("Tool aligned with WORLD exactly and recorded.") if angle_sigma_deg == 0.0 else
+             _("Tool aligned with WORLD by eye, {off}° off (σ {sigma_deg}° per axis = operator error "
+               "{sigma_mm} mm over {lever} mm) and recorded.").format(
+                 off=f"{misalignment_deg:.2f}", sigma_deg=f"{angle_sigma_deg:.2f}", sigma_mm=f"{sigma_mm:g}",
+                 lever=f"{ANGLE_LEVER_MM:.0f}"))
+    return AutoTouchOutcome(True, step.index, step.role, None, None, None, words, 1)
 
 
 auto_touch = in_place(auto_touch_steps)

@@ -16,8 +16,10 @@ import numpy as np
 from tcp_pendant.calibrate.diversity import failure_in_words
 from tcp_pendant.calibrate.pendant_rules import ExerciseRules
 from tcp_pendant.controller import ToolModel
+from tcp_pendant.translation import ENGLISH, Translator
 from tcp_pendant.wizards import CalibrationFailedError, Wizard
 from tcp_pendant.wizards.session_record import WizardRun
+from tcp_pendant.wizards.solver_words import solver_warning
 
 __all__ = ["failure_in_trainee_words", "touches_short", "wrong_tool_touch"]
 
@@ -41,7 +43,8 @@ def touches_short(rules: ExerciseRules | None, wizard: Wizard | None) -> str | N
     return refusal
 
 
-def wrong_tool_touch(run: WizardRun | None, tools: Mapping[str, ToolModel]) -> str | None:
+def wrong_tool_touch(run: WizardRun | None, tools: Mapping[str, ToolModel], *,
+                     tr: Translator = ENGLISH) -> str | None:
     """Why ``run`` cannot be filed as it is: a touch recorded with another physical tool than
     the one its step measures (the step's tool change, else the tool the run calibrates), in
     words with what to do; None when every touch whose tool is known was made with the right
@@ -61,14 +64,15 @@ def wrong_tool_touch(run: WizardRun | None, tools: Mapping[str, ToolModel]) -> s
         need = run.true_tool_key if spec is None or spec.mount_tool_key is None else spec.mount_tool_key
         if used is None or used == need:
             continue
-        return (f"Step {step + 1} was recorded with the {label(used)}, but it measures the {label(need)}: "
-                f"a calibration is filed under the tool it measured. Mount the {label(need)} and record "
-                f"step {step + 1} again (or start a new calibration for the {label(used)}).")
+        return tr.gettext("Step {k} was recorded with the {used}, but it measures the {needed}: "
+                          "a calibration is filed under the tool it measured. Mount the {needed} and record "
+                          "step {k} again (or start a new calibration for the {used}).").format(
+                              k=step + 1, used=label(used), needed=label(need))
     return None
 
 
 def failure_in_trainee_words(exc: CalibrationFailedError, wizard: Wizard | None,
-                             R_world_flange: np.ndarray) -> CalibrationFailedError:
+                             R_world_flange: np.ndarray, *, tr: Translator = ENGLISH) -> CalibrationFailedError:
     """tcpcal's failure of ``wizard``'s Finish in the trainee's words, with what to do: the
     touches it is about as step numbers (two with the same orientation: go back to the later
     one), or its unobservable FLANGE axis in words (the robot's ``R_world_flange`` now, 3x3);
@@ -79,14 +83,27 @@ def failure_in_trainee_words(exc: CalibrationFailedError, wizard: Wizard | None,
     steps = () if w is None else w.solver_touch_steps()
     if len(pair) == 2 and all(0 <= k < len(steps) for k in pair):
         a, b = (steps[k] + 1 for k in pair)
+        _ = tr.gettext
         angle = _ANGLE_APART.search(str(exc))
-        apart = f" ({angle.group(1)}° apart)" if angle else ""
-        todo = (f"record step {b} again" if w is not None and w.step_index == b - 1
-                else f"go Back to step {b} and record it again")
-        text = (f"Touches {a} and {b} have the same orientation{apart}: the method needs clearly "
-                f"different orientations. Tilt the tool 30-60° about another axis and {todo}.")
+        here = w is not None and w.step_index == b - 1
+        if angle:
+            text = (_("Touches {a} and {b} have the same orientation ({angle}° apart): the method needs clearly "
+                      "different orientations. Tilt the tool 30-60° about another axis and record step {b} again.")
+                    if here else
+                    _("Touches {a} and {b} have the same orientation ({angle}° apart): the method needs clearly "
+                      "different orientations. Tilt the tool 30-60° about another axis and go Back to step {b} "
+                      "and record it again.")).format(a=a, b=b, angle=angle.group(1))
+        else:
+            text = (_("Touches {a} and {b} have the same orientation: the method needs clearly "
+                      "different orientations. Tilt the tool 30-60° about another axis and record step {b} again.")
+                    if here else
+                    _("Touches {a} and {b} have the same orientation: the method needs clearly "
+                      "different orientations. Tilt the tool 30-60° about another axis and go Back to step {b} "
+                      "and record it again.")).format(a=a, b=b)
         return CalibrationFailedError(text, cause)
     if axis is not None:
-        return CalibrationFailedError(failure_in_words(str(exc), axis, R_world_flange) +
-                                      " Go Back to a step and record it tilted about that axis.", cause)
-    return exc
+        return CalibrationFailedError(
+            tr.gettext("{failure} Go Back to a step and record it tilted about that axis.").format(
+                failure=failure_in_words(str(exc), axis, R_world_flange)), cause)
+    said = solver_warning(str(exc), tr=tr)       # tcpcal's words from the catalogs, when it knows them
+    return exc if said == str(exc) else CalibrationFailedError(said, cause)

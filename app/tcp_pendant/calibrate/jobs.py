@@ -21,6 +21,7 @@ import numpy as np
 from tcp_pendant.calibrate.autotouch import PoseProbe
 from tcp_pendant.controller import RobotKinematics, T_flange_tool_m, builtin_tools
 from tcp_pendant.controller.beam import BeamSensor, ToolShape
+from tcp_pendant.translation import N_
 from tcp_pendant.controller.beam_scan import BeamScan, BeamScanConfig, run_beam_scan, tool_shape
 from tcp_pendant.controller.errors import ControllerError
 from tcp_pendant.controller.jog import JogSettings
@@ -43,7 +44,7 @@ if TYPE_CHECKING:
 __all__ = ["EXERCISE_REFUSAL", "JOBS", "POSE_CHECKS", "BeamScanJob", "ControllerJob", "TcpCheckJob",
            "beam_scan_job", "spin_check_job", "spin_clearance"]
 
-EXERCISE_REFUSAL = ("{what} is off during the trainer's exercise: the beam sensor would measure the "
+EXERCISE_REFUSAL = N_("{what} is off during the trainer's exercise: the beam sensor would measure the "
                     "exercise's tool for you. Calibrate it by touching the reference tip (XYZ 4-point, "
                     "XYZ reference or TCP & Z, X).")
 """Why a method that measures the tool by itself is refused in an exercise (``hide_truth``)."""
@@ -176,15 +177,17 @@ def spin_check_job(workflow: CalibrationWorkflow, wizard: Wizard) -> TcpCheckJob
     if q is None and np.allclose(c.T_world_flange(), pose.T_world_flange_m, atol=1e-7):
         q = c.q_rad.copy()
     if q is None:
-        raise WizardStateError("The robot is not at the recorded touch any more: press Record again "
-                               "with the tool tip on the reference tip, then Finish.")
+        raise WizardStateError(workflow.translator.gettext(
+            "The robot is not at the recorded touch any more: press Record again "
+            "with the tool tip on the reference tip, then Finish."))
     nominal, physical = c.kinematics_for_worker()
     if workflow.hide_truth:                   # an exercise: read against the reference tip
         tip = (physical.T_world_flange(q) @ np.asarray(c.mounted_tool.T_flange_tool_true))[:3, 3]
         try:
-            check_readable(float(np.linalg.norm(tip - c.reference_tip_world_m)) * 1000.0)
+            check_readable(float(np.linalg.norm(tip - c.reference_tip_world_m)) * 1000.0, tr=workflow.translator)
         except ValueError as exc:
-            raise WizardStateError(f"{exc} Record the touch there, then Finish.") from None
+            raise WizardStateError(workflow.translator.gettext("{reason} Record the touch there, then Finish.").format(
+                reason=exc)) from None
     return TcpCheckJob(check, pose, nominal, physical, np.array(q, dtype=float), T_flange_tool_m(check.tool),
                        np.array(c.mounted_tool.T_flange_tool_true, dtype=float), c.settings,
                        reading_only=workflow.hide_truth)
@@ -206,22 +209,25 @@ def beam_scan_job(workflow: CalibrationWorkflow, wizard: Wizard) -> BeamScanJob 
     if not beam.scan_pending:
         return None
     if workflow.hide_truth:     # an exercise began after the wizard was opened
-        raise WizardStateError(EXERCISE_REFUSAL.format(what="The Automatic (beam) scan"))
+        _ = workflow.translator.gettext
+        raise WizardStateError(_(EXERCISE_REFUSAL).format(what=_("The Automatic (beam) scan")))
     c = workflow.controller
     mounted = c.mounted_tool
     try:
         shape = tool_shape(mounted)
     except ControllerError as exc:
-        raise WizardStateError(f"{exc} Mount the pointer or the torch on the Tool tab.") from exc
+        raise WizardStateError(workflow.translator.gettext(
+            "{reason} Mount the pointer or the torch on the Tool tab.").format(reason=exc)) from exc
     catalogue = builtin_tools().get(mounted.key)
     if catalogue is not None:
         T_plan = np.array(catalogue.T_flange_tool_true, dtype=float)
     elif c.active_tool is not None:
         T_plan = T_flange_tool_m(c.active_tool)
     else:
-        raise WizardStateError(f"The controller needs approximate tool data of the {mounted.label.lower()} "
-                               "to plan the scan: calibrate it by hand or enter its data on the Tool tab, "
-                               "make it active, then press Finish again.")
+        raise WizardStateError(workflow.translator.gettext(
+            "The controller needs approximate tool data of the {tool} "
+            "to plan the scan: calibrate it by hand or enter its data on the Tool tab, "
+            "make it active, then press Finish again.").format(tool=mounted.label.lower()))
     nominal, physical = c.kinematics_for_worker()
     try:
         config = BeamScanConfig(n_orientations=beam.n_orientations, scan_speed_mm_s=beam.scan_speed_mm_s)

@@ -5,7 +5,7 @@ A :class:`RunList` is the workflow's list of runs (``runs``: each a
 back by the classroom after a restart), the index of the run on show (``current``; None: none),
 and which result of each run was saved to the tool library. It answers what the Resume list
 offers (:meth:`RunList.resumable`). Nothing in it is ever deleted: a run left is cancelled and
-kept.
+kept. Every wizard in it composes its texts in the list's language (:meth:`RunList.set_translator`).
 """
 
 from __future__ import annotations
@@ -15,6 +15,7 @@ from datetime import datetime
 
 import numpy as np
 
+from tcp_pendant.translation import ENGLISH, Translator
 from tcp_pendant.wizards import Wizard, WizardResult, WizardStateError
 from tcp_pendant.wizards.session_record import LoadedRecord, WizardRun, step_distances
 
@@ -37,6 +38,18 @@ class RunList:
         self.current: int | None = None
         """The index in :attr:`runs` of the run on show (None: none)."""
         self._saved_results: dict[int, WizardResult] = {}    # run index -> the result saved from it
+        self.translator: Translator = ENGLISH
+        """The language of the runs' texts (the session's; :meth:`set_translator`)."""
+
+    def set_translator(self, tr: Translator) -> None:
+        """Every run's wizard, and every run added later, composes its texts in ``tr``'s language
+        (``Wizard.set_translator``); a result saved keeps counting as saved."""
+        self.translator = tr
+        for i, run in enumerate(self.runs):
+            was_saved = self.is_saved(i)
+            run.wizard.set_translator(tr)
+            if was_saved and i in self._saved_results and run.wizard.finished_result is not None:
+                self._saved_results[i] = run.wizard.finished_result
 
     @property
     def run(self) -> WizardRun | None:
@@ -54,6 +67,7 @@ class RunList:
 
     def add(self, run: WizardRun) -> int:
         """Append ``run`` and put it on show; returns its index."""
+        run.wizard.set_translator(self.translator)
         self.runs.append(run)
         self.current = len(self.runs) - 1
         return self.current
@@ -75,6 +89,7 @@ class RunList:
     def resumable(self) -> list[tuple[int, str]]:
         """``CalibrationWorkflow.resumable``: cancelled runs still to be done, newest first,
         with their labels."""
+        _ = self.translator.gettext
         out = []
         for i in range(len(self.runs) - 1, -1, -1):
             w = self.runs[i].wizard
@@ -82,11 +97,12 @@ class RunList:
                 continue
             started = _clock(w.started_at)
             if w.finished_result is not None:
-                out.append((i, f"{i + 1}: {w.title}, result not saved, started {started}"))
+                out.append((i, _("{n}: {method}, result not saved, started {time}").format(
+                    n=i + 1, method=_(w.title), time=started)))
             else:
                 done = sum(1 for s in w.steps if s.recorded)
-                out.append((i, f"{i + 1}: {w.title}, at step {w.step_index + 1} of {w.n_steps} "
-                               f"({done} recorded), started {started}"))
+                out.append((i, _("{n}: {method}, at step {k} of {count} ({done} recorded), started {time}").format(
+                    n=i + 1, method=_(w.title), k=w.step_index + 1, count=w.n_steps, done=done, time=started)))
         return out
 
     def to_resume(self, index: int | None) -> int:
@@ -99,11 +115,12 @@ class RunList:
         if index is None:
             options = self.resumable()
             if not options:
-                raise WizardStateError("There is no calibration left half-way to resume.")
+                raise WizardStateError(self.translator.gettext("There is no calibration left half-way to resume."))
             return options[0][0]
         i = int(index)
         if not (0 <= i < len(self.runs) and self.runs[i].wizard.status == "cancelled"):
-            raise WizardStateError(f"Calibration {i + 1} is not waiting to be resumed.")
+            raise WizardStateError(self.translator.gettext("Calibration {n} is not waiting to be resumed.").format(
+                n=i + 1))
         return i
 
     def put_back(self, runs: Sequence[WizardRun]) -> list[int]:
@@ -124,6 +141,7 @@ class RunList:
         for check, entry in zip(loaded.checks, loaded.record.get("wizards", [])):
             true_tool = entry.get("true_tool") or {}
             T_true = true_tool.get("T_flange_tcp_true_m")
+            check.wizard.set_translator(self.translator)
             self.runs.append(WizardRun(check.wizard, true_tool.get("key"),
                                        None if T_true is None else np.array(T_true, dtype=float),
                                        distance_mm=step_distances(entry)))

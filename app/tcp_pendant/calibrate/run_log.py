@@ -14,6 +14,8 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+
+import numpy as np
 from typing import Any
 
 from tcp_pendant.calibrate.finish_checks import failure_in_trainee_words
@@ -34,7 +36,8 @@ class RunLog:
         self._run_list = run_list
         self._touches = touches
         self._events: list[SessionEvent] = []
-        self._failure: tuple[int, str] | None = None   # (run, why its Finish failed); dropped on a change
+        # (run, tcpcal's failure, R_world_flange then): why its Finish failed, dropped on a change
+        self._failure: tuple[int, CalibrationFailedError, np.ndarray] | None = None
 
     def add(self, event: SessionEvent) -> None:
         """Note ``event`` (in order)."""
@@ -109,9 +112,10 @@ class RunLog:
     def failed(self, exc: CalibrationFailedError) -> CalibrationFailedError:
         """tcpcal's failure of the run on show in the trainee's words
         (``finish_checks.failure_in_trainee_words``), kept as :attr:`finish_failure`."""
-        out = failure_in_trainee_words(exc, self._run_list.wizard, self._controller.T_world_flange()[:3, :3])
+        R_world_flange = self._controller.T_world_flange()[:3, :3].copy()
+        out = failure_in_trainee_words(exc, self._run_list.wizard, R_world_flange, tr=self._run_list.translator)
         if self._run_list.current is not None:
-            self._failure = (self._run_list.current, str(out))
+            self._failure = (self._run_list.current, exc, R_world_flange)
         return out
 
     def forget_failure(self) -> None:
@@ -121,8 +125,9 @@ class RunLog:
     @property
     def finish_failure(self) -> str | None:
         """Why the last Finish of the run on show could not compute, and what to do (plain
-        text), while the run is still where it failed; else None."""
+        text in the runs' language now, the robot's orientation as it was then), while the run is
+        still where it failed; else None."""
         failure, w = self._failure, self._run_list.wizard
         if failure is None or failure[0] != self._run_list.current or w is None or w.status != "in_progress":
             return None
-        return failure[1]
+        return str(failure_in_trainee_words(failure[1], w, failure[2], tr=self._run_list.translator))

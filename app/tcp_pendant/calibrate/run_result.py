@@ -102,14 +102,16 @@ class RunResult:
                 library full.
             tcpcal.TcpcalError: the library refused (the name is used by another slot, ...).
         """
+        _ = self._run_list.translator.gettext
         w = self._run_list.wizard
         if w is None:
-            raise WizardStateError("No calibration is open: choose a method and press Start.")
+            raise WizardStateError(_("No calibration is open: choose a method and press Start."))
         if not w.saves_to_library:
-            raise WizardStateError(f"The {w.title} saves nothing to the library: it only checks the tool data.")
+            raise WizardStateError(_("The {method} saves nothing to the library: it only checks the tool data.").format(
+                method=_(w.title)))
         name = str(name).strip()
         if not name:
-            raise WizardStateError("Type a name for the tool before saving.")
+            raise WizardStateError(_("Type a name for the tool before saving."))
         slot_tool = save_result(w, self._library, name, slot, rights)
         if w.result is not None:
             self._run_list.mark_saved(w.result)

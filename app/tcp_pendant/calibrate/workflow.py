@@ -72,6 +72,7 @@ from tcp_pendant.wizards.session_record import (
     load_and_replay,
     session_from_controller,
 )
+from tcp_pendant.translation import ENGLISH, Translator
 from tcp_pendant.wizards.truth import TruthComparison
 from tcpcal.library import ToolLibrary
 from tcpcal.tool import Tool
@@ -198,6 +199,19 @@ class CalibrationWorkflow:
         self.results = RunResult(self.run_list, self.tools, library, self.log)
         """The result of the run on show, its truth and its Save."""
 
+    # ------------------------------------------------------------ language
+    @property
+    def translator(self) -> Translator:
+        """The language of the texts the wizards compose (steps, warnings, refusals): the
+        session's (:meth:`set_translator`), English until set."""
+        return self.run_list.translator
+
+    def set_translator(self, tr: Translator) -> None:
+        """Compose every text in ``tr``'s language from now on: every run's wizard (the step on
+        show reads in it at once, a result's warnings are recomposed) and the workflow's own
+        refusals. The session calls it at start and on every language switch."""
+        self.run_list.set_translator(tr)
+
     # ------------------------------------------------------------ events
     def take_events(self) -> tuple[SessionEvent, ...]:
         """The events of the commands since the last call, in order (``tcp_pendant.events``);
@@ -307,8 +321,10 @@ class CalibrationWorkflow:
         """
         cls = wizard_class(kind)
         if self.hide_truth and not cls.in_exercises:
-            raise WizardError(EXERCISE_REFUSAL.format(what=f"The {cls.title} wizard"))
-        started = cls.start(_StartContext(self), cls.parse_options(options))
+            _ = self.translator.gettext
+            raise WizardError(_(EXERCISE_REFUSAL).format(
+                what=_("The {method} wizard").format(method=_(cls.title))))
+        started = cls.start(_StartContext(self), cls.parse_options(options, tr=self.translator))
         held = getattr(self.state, "exercise_tool", None)     # the session's exercise tool, when it has one
         if held is not None:
             check_calibrated_tool(held.key, held.label, getattr(started.true_tool, "key", None), cls.title)
@@ -334,11 +350,12 @@ class CalibrationWorkflow:
         """
         touches = list(touches)
         n_max = Xyz4Wizard.MAX_POINTS
+        _ = self.translator.gettext
         if not touches:
-            raise WizardStateError("There are no recorded points: press Record point on the Jog tab first.")
+            raise WizardStateError(_("There are no recorded points: press Record point on the Jog tab first."))
         if len(touches) > n_max:
-            raise WizardStateError(f"{len(touches)} points are recorded; the XYZ 4-point wizard takes at most "
-                                   f"{n_max}: delete some in the touch list first.")
+            raise WizardStateError(_("{n} points are recorded; the XYZ 4-point wizard takes at most "
+                                     "{max}: delete some in the touch list first.").format(n=len(touches), max=n_max))
         poses = [np.asarray(getattr(t, "T_world_flange", t), dtype=float) for t in touches]
         Xyz4Wizard(n_points=max(Xyz4Wizard.MIN_POINTS, len(poses))).prefill(poses)   # checked before opening
         w = self.start("xyz4", n_points=max(Xyz4Wizard.MIN_POINTS, len(poses)), estimator=estimator)
@@ -356,7 +373,7 @@ class CalibrationWorkflow:
         """
         w = self.wizard
         if w is None:
-            raise WizardStateError("No calibration is open: choose a method and press Start.")
+            raise WizardStateError(self.translator.gettext("No calibration is open: choose a method and press Start."))
         return w
 
     def cancel(self) -> None:
@@ -391,7 +408,7 @@ class CalibrationWorkflow:
         """The tool change of the current step: mount the tool it needs (the app swaps the model)."""
         tool = self.required_tool()
         if tool is None:
-            raise WizardStateError("This step needs no tool change.")
+            raise WizardStateError(self.translator.gettext("This step needs no tool change."))
         self.state.mount_step_tool(tool)
         mounted = self.controller.mounted_tool          # a scenario may mount a bent version
         run = self.run
@@ -419,7 +436,7 @@ class CalibrationWorkflow:
     def wrong_tool_touch(self) -> str | None:
         """Why the run on show cannot be filed as it is: a touch recorded with another physical
         tool than its step measures (``finish_checks.wrong_tool_touch``); None: none was."""
-        return wrong_tool_touch(self.run, self.tools)
+        return wrong_tool_touch(self.run, self.tools, tr=self.translator)
 
     def next(self) -> WizardResult | None:
         """Next step; on the last step compute the result (returned).
@@ -566,7 +583,7 @@ class CalibrationWorkflow:
         """
         job = self.controller_job() if job is None else job
         if job is None:
-            raise WizardStateError("Nothing is waiting for the controller: record the step first.")
+            raise WizardStateError(self.translator.gettext("Nothing is waiting for the controller: record the step first."))
         try:
             outcome = job.run()
         except ControllerError as exc:
@@ -656,5 +673,6 @@ class _StartContext:
     def library_tool(self, slot: int) -> Tool:
         tool = self._workflow.library.get(int(slot))
         if tool is None:
-            raise WizardError(f"Slot {slot} of the tool library is empty; pick a calibrated tool.")
+            raise WizardError(self._workflow.translator.gettext(
+                "Slot {slot} of the tool library is empty; pick a calibrated tool.").format(slot=slot))
         return tool

@@ -19,6 +19,7 @@ from tcpcal.orientation import R_WORLD_TOOL_PARALLEL, solve_abc_world
 from tcpcal.tool import Tool
 
 from tcp_pendant.json_shapes import JsonRecord
+from tcp_pendant.translation import N_
 from tcp_pendant.wizards.base import (
     StepSpec,
     Wizard,
@@ -28,6 +29,7 @@ from tcp_pendant.wizards.base import (
     StepInfo,
     mm3,
 )
+from tcp_pendant.wizards.solver_words import solver_warnings
 from tcp_pendant.wizards.describe import (
     ALIGN_WORLD,
     AutoRole,
@@ -51,16 +53,16 @@ class AbcWorldWizard(Wizard):
     """
 
     kind: ClassVar[str] = "abc-world"
-    title: ClassVar[str] = "ABC world (parallel axes)"
-    blurb: ClassVar[str] = ("Calibrates the **orientation** (A, B, C): align the tool with WORLD (X down, Y "
+    title: ClassVar[str] = N_("ABC world (parallel axes)")
+    blurb: ClassVar[str] = N_("Calibrates the **orientation** (A, B, C): align the tool with WORLD (X down, Y "
                             "along WORLD Y, Z along WORLD X) and record once. 5D: tool X only.")
-    calibrates: ClassVar[str] = "the orientation"
+    calibrates: ClassVar[str] = N_("the orientation")
     rank: ClassVar[int] = 50
     math_view: ClassVar[str | None] = "abc_world"
-    step_roles = (StepRole("parallel", "the tool axes parallel to WORLD as (PA-1) prescribes", ALIGN_WORLD),)
-    options = (WizardOption("slot", "Tool data", "library_slot",
-                            hint="A tool of the library whose TCP is calibrated."),)
-    variants = (("6d", "6D: X down, Y along WORLD Y"), ("5d", "5D: tool X down only"))
+    step_roles = (StepRole("parallel", N_("the tool axes parallel to WORLD as (PA-1) prescribes"), ALIGN_WORLD),)
+    options = (WizardOption("slot", N_("Tool data"), "library_slot",
+                            hint=N_("A tool of the library whose TCP is calibrated.")),)
+    variants = (("6d", N_("6D: X down, Y along WORLD Y")), ("5d", N_("5D: tool X down only")))
     needs_tool = "library"
 
     @classmethod
@@ -113,15 +115,16 @@ class AbcWorldWizard(Wizard):
             self.finish()
 
     def _step_specs(self) -> list[StepSpec]:
+        _ = self._tr.gettext
         if self._variant == "6d":
-            text = ("Jog (rotations A, B, C in WORLD) until the tool's working direction (tool X) "
+            text = _("Jog (rotations A, B, C in WORLD) until the tool's working direction (tool X) "
                     "points straight down, tool Y along WORLD +Y and tool Z along WORLD +X, as the "
                     "target triad shows; then press Record.")
         else:
-            text = ("Jog (rotations in WORLD) until the tool's working direction (tool X) points "
+            text = _("Jog (rotations in WORLD) until the tool's working direction (tool X) points "
                     "straight down, along WORLD -Z, as the target triad shows; the rotation about "
                     "it does not matter. Then press Record.")
-        return [StepSpec(role="parallel", title="Align the tool with WORLD", instruction=text)]
+        return [StepSpec(role="parallel", title=_("Align the tool with WORLD"), instruction=text)]
 
     def target_T_world_tool_m(self, T_world_flange_m: npt.ArrayLike) -> np.ndarray:
         """Pose of the target triad for the scene (4x4, metres): the prescribed orientation
@@ -137,10 +140,10 @@ class AbcWorldWizard(Wizard):
         res = solve_abc_world(T[:3, :3], variant=self._variant,
                               current_rotation=self.tool.rotation if self._variant == "5d" else None)
         rot = np.asarray(res.rotation, dtype=float)
-        warnings = list(res.warnings)
+        warnings = solver_warnings(res.warnings, tr=self._tr)
         if self._variant == "5d":
-            warnings.append("5D: only the tool X direction was calibrated; the rotation about X "
-                            f"is kept from '{self.tool.name}'.")
+            warnings.append(self._tr.gettext("5D: only the tool X direction was calibrated; the rotation "
+                                             "about X is kept from '{tool}'.").format(tool=self.tool.name))
         return WizardResult(
             wizard=self.kind, method=f"abc-world-{self._variant}",
             tcp_mm=mm3(self.tool.tcp_mm), abc_deg=mm3(res.kuka_abc_deg), rotation=rot,

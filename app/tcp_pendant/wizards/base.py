@@ -22,8 +22,10 @@ where it was so the user can re-record); ``back()`` moves back without deleting 
 from __future__ import annotations
 
 import abc
+import dataclasses
 import datetime as _dt
 import math
+import weakref
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import ClassVar, Literal, Protocol
@@ -38,6 +40,7 @@ from tcpcal.pose_quality import CandidateGain
 from tcpcal.tool import Calibration, Tool
 
 from tcp_pendant.json_shapes import JsonRecord
+from tcp_pendant.translation import ENGLISH, N_, Translator
 from tcp_pendant.wizards.describe import (
     AutoRole,
     OptionError,
@@ -290,7 +293,61 @@ class WizardResult:
         }
 
 
-class Wizard(abc.ABC):
+class _ComposedTexts(abc.ABC):
+    """The language a :class:`Wizard` composes its per-instance texts in, and its refusals in
+    words (the part of a wizard that knows languages; ``Wizard`` is the state machine)."""
+
+    _tr: Translator
+    _result: WizardResult | None
+    _status: Status
+
+    @property
+    @abc.abstractmethod
+    def finished_result(self) -> WizardResult | None: ...
+
+    @property
+    @abc.abstractmethod
+    def blocked_reason(self) -> str | None: ...
+
+    @abc.abstractmethod
+    def _recompute(self) -> WizardResult | None: ...
+
+    # ----- language of the texts it composes (module functions below) ----------------------
+    @property
+    def translator(self) -> Translator:
+        """The language of the texts it composes: steps, :attr:`blocked_reason`, refusals, the
+        result's warnings and notes (English until :meth:`set_translator`)."""
+        return self._tr
+
+    def set_translator(self, tr: Translator) -> None:
+        """Compose the texts in ``tr``'s language from now on (the session's): the steps are
+        composed when read; a result on hand is recomposed (:func:`recomposed_result`)."""
+        if tr is not self._tr:
+            self._tr = tr
+            self._result = recomposed_result(self) or self._result
+
+    def result_in(self, tr: Translator) -> WizardResult | None:
+        """:attr:`finished_result` with its texts in ``tr``'s language (:func:`result_in`)."""
+        return result_in(self, tr)
+
+    def _refuse_blocked(self) -> None:
+        """Raises WizardStateError naming :attr:`blocked_reason` when Record is disabled."""
+        reason = self.blocked_reason
+        if reason is not None:
+            raise WizardStateError(self._tr.gettext("Cannot record now: {reason}").format(reason=reason))
+
+    def _cancelled_refusal(self) -> WizardStateError:
+        return WizardStateError(self._tr.gettext("The wizard was cancelled; resume it first."))
+
+    def _next_refusal(self) -> WizardStateError:
+        """Next refused: the wizard is not in progress (finished or cancelled)."""
+        _ = self._tr.gettext
+        if self._status == "complete":
+            return WizardStateError(_("Next is not possible: the wizard is complete."))
+        return WizardStateError(_("Next is not possible: the wizard is cancelled."))
+
+
+class Wizard(_ComposedTexts):
     """Base state machine of a calibration wizard (see the module docstring for the life cycle).
 
     Subclasses define ``_step_specs()``, ``_compute()``, ``_params()``, ``_from_params()`` and
@@ -334,7 +391,7 @@ class Wizard(abc.ABC):
     kind: ClassVar[str]
     title: ClassVar[str]
     blurb: ClassVar[str] = ""
-    calibrates: ClassVar[str] = "the TCP"
+    calibrates: ClassVar[str] = N_("the TCP")
     rank: ClassVar[int] = 100
     step_roles: ClassVar[tuple[StepRole, ...]] = ()
     options: ClassVar[tuple[WizardOption, ...]] = ()
@@ -363,35 +420,38 @@ class Wizard(abc.ABC):
         return type(self).step_role(step.role).auto
 
     @classmethod
-    def parse_options(cls, options: JsonRecord) -> JsonRecord:
+    def parse_options(cls, options: JsonRecord, *, tr: Translator = ENGLISH) -> JsonRecord:
         """The start options checked against :attr:`options` (and ``variant`` against
         :attr:`variants`); defaults filled in.
 
         Raises:
-            WizardError: an unknown option, a value out of its choices, a missing required one.
+            WizardError: an unknown option, a value out of its choices, a missing required one
+                (in ``tr``'s language).
         """
+        _ = tr.gettext
         declared = {o.name: o for o in cls.options}
         allowed = set(declared) | ({"variant"} if cls.variants else set())
         unknown = sorted(set(options) - allowed)
         if unknown:
-            raise WizardError(f"The {cls.title} wizard takes no option {', '.join(unknown)}; "
-                              f"it takes {', '.join(sorted(allowed)) or 'none'}.")
+            raise WizardError(_("The {method} wizard takes no option {unknown}; it takes {allowed}.").format(
+                method=_(cls.title), unknown=", ".join(unknown), allowed=", ".join(sorted(allowed)) or _("none")))
         out: dict[str, object] = {}
         try:
             for name, opt in declared.items():
                 if name in options and options[name] is not None:
-                    out[name] = opt.parse(options[name])
+                    out[name] = opt.parse(options[name], tr=tr)
                 elif opt.required:
-                    raise OptionError(f"{opt.label}: choose one before Start.")
+                    raise OptionError(_("{option}: choose one before Start.").format(option=_(opt.label)))
                 else:
                     out[name] = opt.default
         except OptionError as exc:
             raise WizardError(str(exc)) from None
         if cls.variants:
-            values = [v for v, _ in cls.variants]
+            values = [v for v, _label in cls.variants]
             variant = options.get("variant", values[0])
             if variant not in values:
-                raise WizardError(f"The {cls.title} variant is one of {values}, got {variant!r}.")
+                raise WizardError(_("The {method} variant is one of {values}, got {variant}.").format(
+                    method=_(cls.title), values=values, variant=repr(variant)))
             out["variant"] = variant
         return out
 
@@ -408,7 +468,8 @@ class Wizard(abc.ABC):
 
     def set_variant(self, variant: int | str) -> None:
         """Switch the variant (wizards with :attr:`variants` override this)."""
-        raise WizardStateError(f"The {self.title} wizard has no variants.")
+        raise WizardStateError(self._tr.gettext("The {method} wizard has no variants.").format(
+            method=self._tr.gettext(self.title)))
 
     @property
     def can_add_point(self) -> bool:
@@ -422,7 +483,8 @@ class Wizard(abc.ABC):
 
     def add_point(self) -> None:
         """Add one touch step (only wizards with ``supports_add_point``)."""
-        raise WizardStateError(f"Add point is not part of the {self.title} wizard.")
+        raise WizardStateError(self._tr.gettext("Add point is not part of the {method} wizard.").format(
+            method=self._tr.gettext(self.title)))
 
     @property
     def meter_active(self) -> bool:
@@ -447,7 +509,15 @@ class Wizard(abc.ABC):
         self._result: WizardResult | None = None
         self._mounted_tool_key: str | None = None
         self._tool_labels: dict[str, str] = {}
+        self._tr: Translator = ENGLISH
         self.started_at = utc_now_iso()
+
+    def _recompute(self) -> WizardResult | None:
+        """The result computed again from the recorded poses (None: not all recorded); a wizard
+        whose result does not come from its poses overrides this."""
+        if any(i not in self._poses for i in range(self.n_steps)):
+            return None
+        return self._compute([self._poses[i].T_world_flange_m for i in range(self.n_steps)])
 
     # ----- to be provided by each wizard --------------------------------------------------
     @abc.abstractmethod
@@ -494,7 +564,8 @@ class Wizard(abc.ABC):
         return self._info(self._index, specs[self._index], len(specs))
 
     def _info(self, i: int, spec: StepSpec, n: int) -> StepInfo:
-        return StepInfo(index=i, count=n, heading=f"Step {i + 1} of {n}", title=spec.title,
+        heading = self._tr.gettext("Step {k} of {n}").format(k=i + 1, n=n)
+        return StepInfo(index=i, count=n, heading=heading, title=spec.title,
                         instruction=spec.instruction, role=spec.role,
                         mount_tool_key=spec.mount_tool_key, recorded=i in self._poses)
 
@@ -548,16 +619,18 @@ class Wizard(abc.ABC):
     @property
     def blocked_reason(self) -> str | None:
         """Why Record is disabled right now, in words; None when it is enabled."""
+        _ = self._tr.gettext
         if self._status == "cancelled":
-            return "The wizard was cancelled; resume it to continue."
+            return _("The wizard was cancelled; resume it to continue.")
         if self._status == "complete":
-            return "The calibration is finished; go back to change a step."
+            return _("The calibration is finished; go back to change a step.")
         spec = self._step_specs()[self._index]
         if (spec.mount_tool_key is not None and self._mounted_tool_key is not None
                 and self._mounted_tool_key != spec.mount_tool_key):
             need = self._tool_labels.get(spec.mount_tool_key, spec.mount_tool_key)
             now = self._tool_labels.get(self._mounted_tool_key, self._mounted_tool_key)
-            return f"Mount the {need.lower()} first: the {now.lower()} is mounted now."
+            return _("Mount the {needed} first: the {mounted} is mounted now.").format(
+                needed=need.lower(), mounted=now.lower())
         return None
 
     @property
@@ -589,9 +662,7 @@ class Wizard(abc.ABC):
             WizardStateError: Record is disabled (see ``blocked_reason``).
             InvalidPoseError: the pose is not a rigid transform.
         """
-        reason = self.blocked_reason
-        if reason is not None:
-            raise WizardStateError(f"Cannot record now: {reason}")
+        self._refuse_blocked()
         T = check_pose_m(T_world_flange_m)
         self._poses[self._index] = RecordedPose(T, utc_now_iso())
         return self.step
@@ -606,14 +677,16 @@ class Wizard(abc.ABC):
                 poses than steps, or a step that cannot be recorded now (``blocked_reason``).
             InvalidPoseError: a pose is not a rigid transform (names which one).
         """
+        _ = self._tr.gettext
         if self._status != "in_progress" or self._poses:
-            raise WizardStateError("Only a wizard just started, with nothing recorded, takes touches recorded before.")
+            raise WizardStateError(_("Only a wizard just started, with nothing recorded, takes touches recorded before."))
         if len(poses_m) > self.n_steps:
-            raise WizardStateError(f"{len(poses_m)} touches do not fit the {self.n_steps} steps of this wizard.")
+            raise WizardStateError(self._tr.ngettext(
+                "{n} touches do not fit the {count} step of this wizard.",
+                "{n} touches do not fit the {count} steps of this wizard.", self.n_steps,
+            ).format(n=len(poses_m), count=self.n_steps))
         checked = [check_pose_m(T, what=f"flange pose of touch {i + 1}") for i, T in enumerate(poses_m)]
-        reason = self.blocked_reason
-        if reason is not None:
-            raise WizardStateError(f"Cannot record now: {reason}")
+        self._refuse_blocked()
         now = utc_now_iso()
         self._poses = {i: RecordedPose(T, now) for i, T in enumerate(checked)}
         self._index = min(len(checked), self.n_steps - 1)
@@ -622,7 +695,7 @@ class Wizard(abc.ABC):
     def clear_step(self) -> None:
         """Forget the pose of the current step (only while in progress)."""
         if self._status != "in_progress":
-            raise WizardStateError("Only a wizard in progress can clear a step; go back first.")
+            raise WizardStateError(self._tr.gettext("Only a wizard in progress can clear a step; go back first."))
         self._poses.pop(self._index, None)
 
     def next(self) -> StepInfo | WizardResult:
@@ -637,9 +710,9 @@ class Wizard(abc.ABC):
                 wizard stays on the last step so the user can re-record or add points.
         """
         if self._status != "in_progress":
-            raise WizardStateError(f"Next is not possible: the wizard is {self._status.replace('_', ' ')}.")
+            raise self._next_refusal()
         if self._index not in self._poses:
-            raise WizardStateError(f"Record step {self._index + 1} before going on.")
+            raise WizardStateError(self._tr.gettext("Record step {k} before going on.").format(k=self._index + 1))
         if not self.on_last_step:
             self._index += 1
             return self.step
@@ -648,10 +721,12 @@ class Wizard(abc.ABC):
     def finish(self) -> WizardResult:
         """Compute the result from all steps (each must be recorded) and mark the wizard complete."""
         if self._status == "cancelled":
-            raise WizardStateError("The wizard was cancelled; resume it first.")
+            raise self._cancelled_refusal()
         missing = [i + 1 for i in range(self.n_steps) if i not in self._poses]
         if missing:
-            raise WizardStateError(f"Steps {missing} are not recorded yet.")
+            raise WizardStateError(self._tr.ngettext(
+                "Step {steps} is not recorded yet.", "Steps {steps} are not recorded yet.", len(missing),
+            ).format(steps=missing))
         poses = [self._poses[i].T_world_flange_m for i in range(self.n_steps)]
         try:
             result = self._compute(poses)
@@ -669,19 +744,20 @@ class Wizard(abc.ABC):
             self._result = None
             return self.step
         if self._status != "in_progress" or self._index == 0:
-            raise WizardStateError("There is no step before this one." if self._index == 0
-                                   else "The wizard was cancelled; resume it first.")
+            raise (WizardStateError(self._tr.gettext("There is no step before this one."))
+                   if self._index == 0 else self._cancelled_refusal())
         self._index -= 1
         return self.step
 
     def go_to(self, index: int) -> StepInfo:
         """Jump to step ``index`` (0-based) if every step before it is recorded."""
+        _ = self._tr.gettext
         if self._status == "cancelled":
-            raise WizardStateError("The wizard was cancelled; resume it first.")
+            raise self._cancelled_refusal()
         if not 0 <= index < self.n_steps:
-            raise WizardStateError(f"There is no step {index + 1}; the wizard has {self.n_steps}.")
+            raise WizardStateError(_("There is no step {k}; the wizard has {n}.").format(k=index + 1, n=self.n_steps))
         if any(i not in self._poses for i in range(index)):
-            raise WizardStateError("Record the earlier steps first.")
+            raise WizardStateError(_("Record the earlier steps first."))
         self._status = "in_progress"
         self._result = None
         self._index = index
@@ -697,7 +773,7 @@ class Wizard(abc.ABC):
     def resume(self) -> StepInfo | WizardResult:
         """Return to where the user was before ``cancel()``."""
         if self._status != "cancelled":
-            raise WizardStateError("Only a cancelled wizard can be resumed.")
+            raise WizardStateError(self._tr.gettext("Only a cancelled wizard can be resumed."))
         self._status = getattr(self, "_cancelled_from", "in_progress")
         return self._result if self._status == "complete" and self._result is not None else self.step
 
@@ -712,7 +788,7 @@ class Wizard(abc.ABC):
 
     def _require_result(self) -> WizardResult:
         if self.result is None:
-            raise WizardStateError("Finish the wizard before saving the tool.")
+            raise WizardStateError(self._tr.gettext("Finish the wizard before saving the tool."))
         return self.result
 
     # ----- serialisation (resume, session record) -----------------------------------------
@@ -764,6 +840,43 @@ class Wizard(abc.ABC):
             self._status = "in_progress"
         if d.get("status") == "cancelled":
             self.cancel()
+
+
+def recomposed_result(wizard: _ComposedTexts) -> WizardResult | None:
+    """``wizard``'s result on hand composed again in its current language: the same figures and
+    ``computed_at`` (None: no result, or it cannot be recomputed)."""
+    old = wizard._result
+    if old is None:
+        return None
+    try:
+        new = wizard._recompute()
+    except (WizardError, TcpcalError):
+        return None
+    return None if new is None else dataclasses.replace(new, computed_at=old.computed_at)
+
+
+_RESULTS_IN: "weakref.WeakKeyDictionary[_ComposedTexts, tuple[WizardResult, Translator, WizardResult]]" = \
+    weakref.WeakKeyDictionary()
+
+
+def result_in(wizard: _ComposedTexts, tr: Translator) -> WizardResult | None:
+    """``wizard.finished_result`` with its texts in ``tr``'s language (a session record keeps
+    English words whatever the trainee reads); kept until the result changes."""
+    res = wizard.finished_result
+    if res is None or tr is wizard._tr:
+        return res
+    cached = _RESULTS_IN.get(wizard)
+    if cached is not None and cached[0] is res and cached[1] is tr:
+        return cached[2]
+    mine = wizard._tr
+    wizard._tr = tr
+    try:
+        again = recomposed_result(wizard)
+    finally:
+        wizard._tr = mine
+    out = res if again is None else again
+    _RESULTS_IN[wizard] = (res, tr, out)
+    return out
 
 
 def mm3(v: Sequence[float] | np.ndarray) -> tuple[float, float, float]:

@@ -44,6 +44,7 @@ from tcpcal.tool import Tool, abc_deg_from_rotation
 from tcpcal.validation import read_only_array
 
 from tcp_pendant.json_shapes import JsonRecord
+from tcp_pendant.translation import N_
 from tcp_pendant.wizards.base import (
     M_TO_MM,
     CalibrationFailedError,
@@ -58,6 +59,7 @@ from tcp_pendant.wizards.base import (
     finite_number,
     mm3,
 )
+from tcp_pendant.wizards.solver_words import solver_warnings
 from tcp_pendant.wizards.describe import BY_CONTROLLER, StepRole, WizardOption, WizardStart
 
 if TYPE_CHECKING:
@@ -418,13 +420,13 @@ class BeamWizard(Wizard):
     """
 
     kind: ClassVar[str] = "beam"
-    title: ClassVar[str] = "Automatic (beam)"
-    blurb: ClassVar[str] = ("Calibrates the **TCP and the tool direction** automatically, as BullsEye / "
+    title: ClassVar[str] = N_("Automatic (beam)")
+    blurb: ClassVar[str] = N_("Calibrates the **TCP and the tool direction** automatically, as BullsEye / "
                             "TRACC: the controller moves the tool through a light beam at 3 to 5 "
                             "orientations and records the flange pose at every beam break. Shows the "
                             "events, the time the scan takes on a real robot and your manual "
                             "calibration of the same tool side by side.")
-    calibrates: ClassVar[str] = "the TCP and the tool direction"
+    calibrates: ClassVar[str] = N_("the TCP and the tool direction")
     rank: ClassVar[int] = 60
     math_view: ClassVar[str | None] = "beam"
     in_exercises: ClassVar[bool] = False
@@ -433,13 +435,13 @@ class BeamWizard(Wizard):
     """The scan measures the tool by itself: refused in a classroom exercise."""
     MIN_ORIENTATIONS: ClassVar[int] = 3
     MAX_ORIENTATIONS: ClassVar[int] = 5
-    step_roles = (StepRole("scan", "the controller runs the beam scan itself", BY_CONTROLLER),)
+    step_roles = (StepRole("scan", N_("the controller runs the beam scan itself"), BY_CONTROLLER),)
     options = (
-        WizardOption("n_orientations", "Scan orientations", "int", default=4, minimum=MIN_ORIENTATIONS,
+        WizardOption("n_orientations", N_("Scan orientations"), "int", default=4, minimum=MIN_ORIENTATIONS,
                      maximum=MAX_ORIENTATIONS,
-                     hint="Tool orientations the scan runs (each: two sideways passes and one tip approach)."),
-        WizardOption("scan_speed_mm_s", "Scan speed (mm/s)", "int", default=50, minimum=5, maximum=250,
-                     hint="Speed of the measuring motions through the beam (real devices: 20-100 mm/s)."),
+                     hint=N_("Tool orientations the scan runs (each: two sideways passes and one tip approach).")),
+        WizardOption("scan_speed_mm_s", N_("Scan speed (mm/s)"), "int", default=50, minimum=5, maximum=250,
+                     hint=N_("Speed of the measuring motions through the beam (real devices: 20-100 mm/s).")),
     )
     needs_tool = "mounted"
 
@@ -468,12 +470,14 @@ class BeamWizard(Wizard):
 
     # ----- the one step: the controller's ----------------------------------------------------
     def _step_specs(self) -> list[StepSpec]:
-        return [StepSpec(role="scan", title="Beam scan",
-                         instruction=(f"Nothing to touch: press Finish and the controller runs the scan "
-                                      f"itself. At {self.n_orientations} tool orientations it passes the "
-                                      "shaft sideways through the beam twice and approaches until the tip "
-                                      "breaks it, recording the flange pose at every event "
-                                      f"(measuring motions at {self.scan_speed_mm_s:g} mm/s)."))]
+        _ = self._tr.gettext
+        return [StepSpec(role="scan", title=_("Beam scan"),
+                         instruction=_("Nothing to touch: press Finish and the controller runs the scan "
+                                       "itself. At {n} tool orientations it passes the "
+                                       "shaft sideways through the beam twice and approaches until the tip "
+                                       "breaks it, recording the flange pose at every event "
+                                       "(measuring motions at {speed} mm/s).").format(
+                                           n=self.n_orientations, speed=f"{self.scan_speed_mm_s:g}"))]
 
     @property
     def blocked_reason(self) -> str | None:
@@ -481,7 +485,8 @@ class BeamWizard(Wizard):
         base = super().blocked_reason
         if base is not None or self._status != "in_progress":
             return base
-        return "The controller runs this step itself: press Finish to run the scan (nothing to record by hand)."
+        return self._tr.gettext("The controller runs this step itself: press Finish to run the scan "
+                                "(nothing to record by hand).")
 
     @property
     def can_next(self) -> bool:
@@ -523,7 +528,7 @@ class BeamWizard(Wizard):
             WizardError: a malformed scan (names what).
         """
         if self.finished_result is not None:
-            raise WizardStateError("The beam wizard is finished already; press Back to scan again.")
+            raise WizardStateError(self._tr.gettext("The beam wizard is finished already; press Back to scan again."))
         recorded = RecordedScan.of(scan)
         R = _rotation(R_flange_tool_base, "planning tool orientation")
         if manual is not None and not isinstance(manual, ManualComparison):
@@ -543,7 +548,7 @@ class BeamWizard(Wizard):
     def next(self) -> StepInfo | WizardResult:
         """Finish (the only step); refused with words before a scan was handed in."""
         if self._status != "in_progress":
-            raise WizardStateError(f"Next is not possible: the wizard is {self._status.replace('_', ' ')}.")
+            raise self._next_refusal()
         return self.finish()
 
     def finish(self) -> WizardResult:
@@ -554,10 +559,9 @@ class BeamWizard(Wizard):
             CalibrationFailedError: the events cannot give a TCP (the wizard stays on its step).
         """
         if self._status == "cancelled":
-            raise WizardStateError("The wizard was cancelled; resume it first.")
+            raise self._cancelled_refusal()
         if self._scan is None:
-            raise WizardStateError("Run the scan first: press Finish (the controller moves the tool "
-                                   "through the beam).")
+            raise self._no_scan_refusal()
         try:
             result = self._compute([])
         except TcpcalError as exc:
@@ -579,20 +583,32 @@ class BeamWizard(Wizard):
             self.clear_step()
         return step
 
+    def _no_scan_refusal(self) -> WizardStateError:
+        return WizardStateError(self._tr.gettext("Run the scan first: press Finish (the controller moves the tool "
+                                                 "through the beam)."))
+
     # ----- result -------------------------------------------------------------------------
+    def _recompute(self) -> WizardResult | None:
+        """The result from the scan handed in (no recorded poses)."""
+        return None if self._scan is None else self._compute([])
+
     def _compute(self, poses: list[np.ndarray]) -> WizardResult:
         scan, R_base = self._scan, self._R_base
         if scan is None or R_base is None:
-            raise WizardStateError("Run the scan first: press Finish (the controller moves the tool "
-                                   "through the beam).")
+            raise self._no_scan_refusal()
+        _, n_ = self._tr.gettext, self._tr.ngettext
         events = scan.events
         tips = tuple(i for i, e in enumerate(events) if e.kind == "tip")
         if len(tips) < 2:
             skipped = "; ".join(scan.skipped)
-            raise CalibrationFailedError(
-                f"The scan gave {len(tips)} tip event(s); the TCP needs at least 2 at orientations turned "
-                "about the tool axis. Move the robot so the beam device is within reach and scan again"
-                + (f" (skipped: {skipped})." if skipped else "."))
+            few = n_("The scan gave {n} tip event; the TCP needs at least 2 at orientations turned "
+                     "about the tool axis. Move the robot so the beam device is within reach and scan again.",
+                     "The scan gave {n} tip events; the TCP needs at least 2 at orientations turned "
+                     "about the tool axis. Move the robot so the beam device is within reach and scan again.",
+                     len(tips)).format(n=len(tips))
+            if skipped:
+                few = _("{words} (skipped: {skipped})").format(words=few.removesuffix("."), skipped=skipped)
+            raise CalibrationFailedError(few)
 
         def arrays(idx: Sequence[int]) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
             T = np.array([events[i].T_world_flange for i in idx])
@@ -600,20 +616,22 @@ class BeamWizard(Wizard):
                     np.array([events[i].beam_dir for i in idx]))
 
         res = solve_beam(*arrays(tips))
-        warnings = list(res.warnings)
+        warnings = solver_warnings(res.warnings, tr=self._tr)
         axes = tuple(i for i, e in enumerate(events) if e.kind == "axis" and e.on_shaft)
         axis_res: BeamAxisResult | None = None
         if len(axes) >= 2:
             try:
                 axis_res = solve_beam_axis(*arrays(axes), res.tcp)
-                warnings.extend(axis_res.warnings)
+                warnings.extend(solver_warnings(axis_res.warnings, tr=self._tr))
             except TcpcalError as exc:
-                warnings.append(f"The tool direction could not be measured: {exc}")
+                warnings.append(_("The tool direction could not be measured: {reason}").format(reason=exc))
         else:
-            warnings.append(f"The scan gave {len(axes)} usable sideways crossing(s); the tool direction "
-                            "needs 2 at orientations turned about the tool axis.")
+            warnings.append(n_("The scan gave {n} usable sideways crossing; the tool direction "
+                               "needs 2 at orientations turned about the tool axis.",
+                               "The scan gave {n} usable sideways crossings; the tool direction "
+                               "needs 2 at orientations turned about the tool axis.", len(axes)).format(n=len(axes)))
         for reason in scan.skipped:
-            warnings.append(f"Skipped: {reason}")
+            warnings.append(_("Skipped: {reason}").format(reason=reason))
         R_new, turn = R_base, None
         direction = ci_deg = None
         if axis_res is not None:
@@ -622,10 +640,12 @@ class BeamWizard(Wizard):
             R_new = _minimal_turn(x0, d).as_matrix() @ R_base
             turn = float(np.degrees(math.atan2(float(np.linalg.norm(np.cross(x0, d))), float(x0 @ d))))
             direction, ci_deg = mm3(d), float(axis_res.ci95_angle_deg)
-        notes = ("The beam measures the TCP and the tool direction (TOOL X), not the turn about it: the "
-                 "TOOL frame to save is the planning orientation turned "
-                 + ("by the smallest rotation that puts its X on the measured direction." if turn is not None
-                    else "by nothing (the direction was not measured)."),)
+        notes = ((_("The beam measures the TCP and the tool direction (TOOL X), not the turn about it: the "
+                    "TOOL frame to save is the planning orientation turned by the smallest rotation that "
+                    "puts its X on the measured direction.") if turn is not None else
+                  _("The beam measures the TCP and the tool direction (TOOL X), not the turn about it: the "
+                    "TOOL frame to save is the planning orientation turned by nothing (the direction was "
+                    "not measured).")),)
         scan_obj = self._live_scan if self._live_scan is not None else scan
         return BeamWizardResult(
             wizard=self.kind, method="beam", tcp_mm=mm3(res.tcp),

@@ -14,6 +14,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Literal, Protocol
 
+from tcp_pendant.translation import ENGLISH, Translator
+
 if TYPE_CHECKING:
     from tcp_pendant.controller.tools import ToolModel
     from tcp_pendant.wizards.base import Wizard
@@ -128,32 +130,37 @@ class WizardOption:
         """The start needs a value (no default to fall back on)."""
         return self.kind in ("library_slot", "physical_tool")
 
-    def parse(self, value: object) -> object:
+    def parse(self, value: object, *, tr: Translator = ENGLISH) -> object:
         """``value`` checked against the option's kind and choices.
 
         Raises:
-            OptionError: naming the option, the value and what is allowed.
+            OptionError: naming the option, the value and what is allowed (in ``tr``'s language).
         """
+        _, label = tr.gettext, tr.gettext(self.label)
         if self.kind in ("int", "library_slot"):
             try:
                 number = float(value)  # type: ignore[arg-type]  # any value: what float() refuses is refused
             except (TypeError, ValueError):
-                raise OptionError(f"{self.label}: {value!r} is not a whole number.") from None
+                raise OptionError(_("{option}: {value} is not a whole number.").format(
+                    option=label, value=repr(value))) from None
             if not math.isfinite(number) or number != int(number):
-                raise OptionError(f"{self.label}: {value!r} is not a whole number.")
+                raise OptionError(_("{option}: {value} is not a whole number.").format(option=label, value=repr(value)))
             n = int(number)
             lo = 1 if self.kind == "library_slot" else self.minimum
             hi = self.maximum
             if (lo is not None and n < lo) or (hi is not None and n > hi):
-                raise OptionError(f"{self.label}: {n} is out of range {lo}..{hi}.")
+                raise OptionError(_("{option}: {n} is out of range {low}..{high}.").format(
+                    option=label, n=n, low=lo, high=hi))
             return n
         if self.kind == "choice":
-            values = [v for v, _ in self.choices]
+            values = [v for v, _choice in self.choices]
             if value not in values:
-                raise OptionError(f"{self.label}: {value!r} is not one of {values}.")
+                raise OptionError(_("{option}: {value} is not one of {values}.").format(
+                    option=label, value=repr(value), values=values))
             return value
         if not isinstance(value, str) or not value:
-            raise OptionError(f"{self.label}: give the key of a physical tool, got {value!r}.")
+            raise OptionError(_("{option}: give the key of a physical tool, got {value}.").format(
+                option=label, value=repr(value)))
         return value
 
 

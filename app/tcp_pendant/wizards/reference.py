@@ -15,10 +15,12 @@ from tcpcal.origin import solve_reference
 from tcpcal.tool import Tool
 
 from tcp_pendant.json_shapes import JsonRecord
+from tcp_pendant.translation import N_
 from tcp_pendant.wizards.base import StartContext, StepSpec, Wizard, WizardError, WizardResult, mm3
+from tcp_pendant.wizards.solver_words import solver_warnings
 from tcp_pendant.wizards.describe import TOUCH, StepRole, WizardOption, WizardStart
 
-ERRORS_ADD_UP = (
+ERRORS_ADD_UP = N_(
     "The reference method uses one touch per tool: the new TCP carries the error of both "
     "touches plus the reference tool's own calibration error. Check it, or use the 4-point "
     "method for a tool that matters."
@@ -40,20 +42,20 @@ class ReferenceWizard(Wizard):
     """
 
     kind: ClassVar[str] = "reference"
-    title: ClassVar[str] = "XYZ reference"
-    blurb: ClassVar[str] = ("Calibrates the **TCP** of a new tool from one touch with an already calibrated "
+    title: ClassVar[str] = N_("XYZ reference")
+    blurb: ClassVar[str] = N_("Calibrates the **TCP** of a new tool from one touch with an already calibrated "
                             "tool and one with the new tool. Fast; errors add up.")
-    calibrates: ClassVar[str] = "the TCP of the new tool"
+    calibrates: ClassVar[str] = N_("the TCP of the new tool")
     rank: ClassVar[int] = 20
     math_view: ClassVar[str | None] = "reference"
-    step_roles = (StepRole("touch", "the tool tip on the reference tip", TOUCH),)
+    step_roles = (StepRole("touch", N_("the tool tip on the reference tip"), TOUCH),)
     options = (
-        WizardOption("slot", "Tool data", "library_slot",
-                     hint="A tool of the library whose TCP is calibrated."),
-        WizardOption("reference_tool_key", "Its physical tool", "physical_tool", default="mounted",
-                     hint="The tool that the reference data belongs to: it is mounted for the first touch."),
-        WizardOption("new_tool_key", "New tool", "physical_tool", default="other",
-                     hint="The tool to calibrate: it is mounted for the second touch."),
+        WizardOption("slot", N_("Tool data"), "library_slot",
+                     hint=N_("A tool of the library whose TCP is calibrated.")),
+        WizardOption("reference_tool_key", N_("Its physical tool"), "physical_tool", default="mounted",
+                     hint=N_("The tool that the reference data belongs to: it is mounted for the first touch.")),
+        WizardOption("new_tool_key", N_("New tool"), "physical_tool", default="other",
+                     hint=N_("The tool to calibrate: it is mounted for the second touch.")),
     )
     needs_tool = "library"
 
@@ -90,18 +92,30 @@ class ReferenceWizard(Wizard):
         self.new_tool_label = new_tool_label or new_tool_key or "the new tool"
 
     def _step_specs(self) -> list[StepSpec]:
+        _ = self._tr.gettext
         ref = self.reference_tool.name
         return [
-            StepSpec(role="touch", title="Touch with the reference tool",
-                     instruction=(f"With the reference tool '{ref}' mounted and active, jog its tip "
-                                  "onto the reference tip, from any direction; then press Record. "
-                                  "Do not move the reference tip afterwards."),
+            StepSpec(role="touch", title=_("Touch with the reference tool"),
+                     instruction=_("With the reference tool '{tool}' mounted and active, jog its tip "
+                                   "onto the reference tip, from any direction; then press Record. "
+                                   "Do not move the reference tip afterwards.").format(tool=ref),
                      mount_tool_key=self.reference_tool_key),
-            StepSpec(role="touch", title="Touch with the new tool",
-                     instruction=(f"Change the tool: mount {self.new_tool_label}. Jog its tip onto "
-                                  "the same reference tip, from any direction; then press Record."),
+            StepSpec(role="touch", title=_("Touch with the new tool"),
+                     instruction=_("Change the tool: mount {tool}. Jog its tip onto "
+                                   "the same reference tip, from any direction; then press Record.").format(
+                                       tool=self._new_tool_words()),
                      mount_tool_key=self.new_tool_key),
         ]
+
+    def _new_tool_words(self) -> str:
+        """The new tool as the instruction names it: its label (a name, not translated) after the
+        article the start gave it ("the pointed tool"), in the wizard's language."""
+        label = self.new_tool_label
+        if label == "the new tool":
+            return self._tr.gettext("the new tool")
+        if label.startswith("the "):
+            return self._tr.gettext("the {tool}").format(tool=label[4:])
+        return label
 
     @property
     def tool_to_mount(self) -> str | None:
@@ -113,16 +127,18 @@ class ReferenceWizard(Wizard):
         res = solve_reference(np.asarray(self.reference_tool.tcp_mm, dtype=float),
                               T1[:3, :3], T1[:3, 3] * 1000.0,   # metres -> mm for tcpcal
                               T2[:3, :3], T2[:3, 3] * 1000.0, sigma=self.assumed_sigma_mm)
-        warnings = list(res.warnings)
-        if not any("sum of" in w or "add up" in w for w in warnings):
-            warnings.append(ERRORS_ADD_UP)
+        warnings = solver_warnings(res.warnings, tr=self._tr)
+        _ = self._tr.gettext
+        if not any("sum of" in w or "add up" in w for w in res.warnings):
+            warnings.append(_(ERRORS_ADD_UP))
         cal = self.reference_tool.calibration
         if cal is None:
-            warnings.append(f"The reference tool '{self.reference_tool.name}' has no calibration "
-                            "record: its TCP may never have been measured.")
+            warnings.append(_("The reference tool '{tool}' has no calibration "
+                              "record: its TCP may never have been measured.").format(tool=self.reference_tool.name))
         elif "ci95_mm" in cal.figures:
-            warnings.append(f"The reference tool's own TCP is uncertain by about "
-                            f"{float(cal.figures['ci95_mm']):.2f} mm (95 %); the new TCP inherits it.")
+            warnings.append(_("The reference tool's own TCP is uncertain by about "
+                              "{ci95} mm (95 %); the new TCP inherits it.").format(
+                                  ci95=f"{float(cal.figures['ci95_mm']):.2f}"))
         return WizardResult(
             wizard=self.kind, method="reference", tcp_mm=mm3(res.tcp), tcp_result=res,
             per_touch_error_mm=tuple(float(e) for e in res.residuals),
@@ -131,8 +147,8 @@ class ReferenceWizard(Wizard):
             ci95_mm=float(res.ci95_radius) if np.isfinite(res.ci95_radius) else None,
             warnings=tuple(warnings),
             notes=(() if self.assumed_sigma_mm is None else
-                   (f"The 95 % radius is predicted from an assumed touch error of "
-                    f"{self.assumed_sigma_mm:g} mm per axis, not measured.",)),
+                   (_("The 95 % radius is predicted from an assumed touch error of "
+                      "{sigma} mm per axis, not measured.").format(sigma=f"{self.assumed_sigma_mm:g}"),)),
         )
 
     def to_tool(self, name: str) -> Tool:

@@ -104,6 +104,7 @@ from typing import TYPE_CHECKING, Protocol
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from tcp_pendant.translation import ENGLISH
 from tcp_pendant.json_shapes import JsonRecord
 from tcp_pendant.wizards.base import Wizard, WizardError, check_pose_m, utc_now_iso
 from tcp_pendant.wizards.truth import TruthComparison, compare_with_truth
@@ -293,7 +294,8 @@ def _without_truth(state: dict[str, object]) -> dict[str, object]:
 
 def _run_entry(run: WizardRun, honest: bool, record_id: int | None) -> dict[str, object]:
     wiz = run.wizard
-    res = wiz.finished_result          # a finished wizard closed to resume later keeps its result
+    res = wiz.result_in(ENGLISH)       # a finished wizard closed to resume later keeps its result; the
+                                       # record's words are English whatever the trainee reads
     truth = None
     true_tool = None
     if honest:                         # a trainee's homework: no answer key (graded by the gradebook)

@@ -29,8 +29,9 @@ import numpy as np
 from tcpcal.tool import Tool
 
 from tcp_pendant.json_shapes import JsonRecord
+from tcp_pendant.translation import ENGLISH, N_, Translator
 from tcp_pendant.text_escape import escape_markdown
-from tcp_pendant.wizards.check_reading import CHECK_READING_MM, READING_NOTE, read_mm, reading_verdict
+from tcp_pendant.wizards.check_reading import CHECK_READING_MM, read_mm, reading_note, reading_verdict
 from tcp_pendant.wizards.base import (
     RecordedPose,
     StartContext,
@@ -113,24 +114,32 @@ class CheckFigures:
 
     @property
     def verdict(self) -> str:
-        """One line: good / off by how much / not determined (plain text). "Good" needs every
+        """The verdict in English (:meth:`verdict_in`)."""
+        return self.verdict_in(ENGLISH)
+
+    def verdict_in(self, tr: Translator) -> str:
+        """One line: good / off by how much / not determined (plain text, in ``tr``'s language).
+        "Good" needs every
         rotation: one that could not be made proves nothing about its axis, so the verdict stays
         open (an error already found among the others stands); an exercise's reading says what
         the readings say (``check_reading.reading_verdict``)."""
+        _ = tr.gettext
         if self.read_to_mm is not None:
-            return reading_verdict(((r.reached, r.deviation_mm) for r in self.rows), self.angle_deg)
+            return reading_verdict(((r.reached, r.deviation_mm) for r in self.rows), self.angle_deg, tr=tr)
         err = self.implied_tcp_error_mm
         missing = [r.label for r in self.rows if not r.reached]
         if err is not None and err > GOOD_CHECK_MM:
-            return f"TCP off by {err:.3f} mm: calibrate the tool again (or it is bent)."
+            return _("TCP off by {mm} mm: calibrate the tool again (or it is bent).").format(mm=f"{err:.3f}")
         if missing:
-            return (f"Not determined: {', '.join(missing)} could not be made from this pose (joint limit or "
-                    "singularity), so the check proves nothing about them. Touch the reference tip from "
-                    "an orientation farther from the joint limits, record again and check again.")
+            return _("Not determined: {rotations} could not be made from this pose (joint limit or "
+                     "singularity), so the check proves nothing about them. Touch the reference tip from "
+                     "an orientation farther from the joint limits, record again and check again.").format(
+                         rotations=", ".join(missing))
         if err is None:
-            return ("Not determined: fewer than two of A, B, C were reached; move away from the joint "
-                    "limits, record again and check again.")
-        return f"TCP good: implied error {err:.3f} mm (at most {GOOD_CHECK_MM:g} mm)."
+            return _("Not determined: fewer than two of A, B, C were reached; move away from the joint "
+                     "limits, record again and check again.")
+        return _("TCP good: implied error {mm} mm (at most {good} mm).").format(
+            mm=f"{err:.3f}", good=f"{GOOD_CHECK_MM:g}")
 
     def to_dict(self) -> dict[str, object]:
         d: dict[str, object] = {
@@ -196,19 +205,19 @@ class TcpCheckWizard(Wizard):
     """
 
     kind: ClassVar[str] = "tcp-check"
-    title: ClassVar[str] = "TCP check (spin test)"
-    blurb: ClassVar[str] = ("**Checks** a tool's TCP as a technician does: with the tip on the reference "
+    title: ClassVar[str] = N_("TCP check (spin test)")
+    blurb: ClassVar[str] = N_("**Checks** a tool's TCP as a technician does: with the tip on the reference "
                             "tip the controller turns the tool about its TCP by ±A, ±B, ±C; a correct TCP "
                             "stays put. Shows how far the true tip moves per rotation (mm), the implied "
                             "TCP error and the correction. Calibrates nothing, saves nothing.")
-    calibrates: ClassVar[str] = "nothing (it checks the TCP)"
+    calibrates: ClassVar[str] = N_("nothing (it checks the TCP)")
     rank: ClassVar[int] = 90
     math_view: ClassVar[str | None] = "spin_check"
-    step_roles = (StepRole("touch", "the tool tip on the reference tip", TOUCH),)
+    step_roles = (StepRole("touch", N_("the tool tip on the reference tip"), TOUCH),)
     options = (
-        WizardOption("slot", "Tool data", "library_slot", hint="The library tool whose TCP is checked."),
-        WizardOption("angle_deg", "Check angle (deg)", "int", default=30, minimum=1, maximum=90,
-                     hint="How far each of ±A, ±B, ±C turns (technicians use 10-45)."),
+        WizardOption("slot", N_("Tool data"), "library_slot", hint=N_("The library tool whose TCP is checked.")),
+        WizardOption("angle_deg", N_("Check angle (deg)"), "int", default=30, minimum=1, maximum=90,
+                     hint=N_("How far each of ±A, ±B, ±C turns (technicians use 10-45).")),
     )
     needs_tool = "library"
     saves_to_library: ClassVar[bool] = False
@@ -244,11 +253,13 @@ class TcpCheckWizard(Wizard):
 
     # ----- steps --------------------------------------------------------------------------
     def _step_specs(self) -> list[StepSpec]:
-        return [StepSpec(role="touch", title="Tip on the reference tip",
-                         instruction=("Jog the tool tip onto the reference tip (any orientation clear of "
-                                      "the joint limits), then press Record. Finish runs the check: the "
-                                      f"controller turns the tool ±{self.angle_deg:g}° about A, B and C "
-                                      "around the active TCP and measures how far the tip moves."))]
+        _ = self._tr.gettext
+        return [StepSpec(role="touch", title=_("Tip on the reference tip"),
+                         instruction=_("Jog the tool tip onto the reference tip (any orientation clear of "
+                                       "the joint limits), then press Record. Finish runs the check: the "
+                                       "controller turns the tool ±{angle}° about A, B and C "
+                                       "around the active TCP and measures how far the tip moves.").format(
+                                           angle=f"{self.angle_deg:g}"))]
 
     # ----- the check, run by the caller ---------------------------------------------------
     @property
@@ -278,31 +289,35 @@ class TcpCheckWizard(Wizard):
         """
         current = self.recorded_pose
         if current is None:
-            raise WizardStateError("Record the touch before running the check.")
+            raise WizardStateError(self._tr.gettext("Record the touch before running the check."))
         if pose is not None and pose is not current:
-            raise WizardStateError("The touch was recorded again while the check ran; press Finish again.")
+            raise WizardStateError(self._tr.gettext(
+                "The touch was recorded again while the check ran; press Finish again."))
         self._check = spin if isinstance(spin, CheckFigures) else CheckFigures.of(spin)
         self._checked_pose = current
 
     # ----- result -------------------------------------------------------------------------
     def _compute(self, poses: list[np.ndarray]) -> WizardResult:
+        _ = self._tr.gettext
         check = self.check
         if check is None:
-            raise WizardStateError("Run the check first: press Finish (the controller turns the tool).")
+            raise WizardStateError(_("Run the check first: press Finish (the controller turns the tool)."))
         off = check.correction_flange_mm
-        notes = ("A check changes no tool data. To correct it, calibrate the tool again "
-                 "(or add the correction to its TCP on the Tool tab).",)
+        notes = (_("A check changes no tool data. To correct it, calibrate the tool again "
+                   "(or add the correction to its TCP on the Tool tab)."),)
         return TcpCheckResult(
             wizard=self.kind, method="tcp-check", tcp_mm=mm3(self.tool.tcp_mm),
             max_error_mm=check.max_deviation_mm,
             per_touch_error_mm=tuple(r.deviation_mm for r in check.rows),
-            warnings=tuple(f"{r.label} not reached: {r.message}" for r in check.rows if not r.reached),
+            warnings=tuple(_("{rotation} not reached: {reason}").format(rotation=r.label, reason=r.message)
+                           for r in check.rows if not r.reached),
             notes=notes if off is not None and (check.implied_tcp_error_mm or 0.0) > GOOD_CHECK_MM else (),
             check=check, tool_name=self.tool.name, slot=self.slot)
 
     def to_tool(self, name: str) -> Tool:
         """A check saves nothing."""
-        raise WizardStateError("A TCP check saves nothing to the library: it only checks the tool data.")
+        raise WizardStateError(self._tr.gettext(
+            "A TCP check saves nothing to the library: it only checks the tool data."))
 
     # ----- serialisation ------------------------------------------------------------------
     def _params(self) -> dict[str, object]:
@@ -331,27 +346,35 @@ class TcpCheckWizard(Wizard):
             self.cancel()
 
 
-def tcp_check_markdown(result: TcpCheckResult) -> str:
+def tcp_check_markdown(result: TcpCheckResult, *, tr: Translator = ENGLISH) -> str:
     """The check's result as markdown: per rotation the tip's deviation (mm), the implied TCP
-    error, the correction (FLANGE, mm) and the verdict (the tool's name escaped)."""
+    error, the correction (FLANGE, mm) and the verdict (the tool's name escaped), in ``tr``'s language."""
+    _ = tr.gettext
     c = result.check
-    where = "" if result.slot is None else f"slot {result.slot}: "
+    name = escape_markdown(result.tool_name)
     reading = c.read_to_mm is not None
-    lines = [f"**TCP check of {escape_markdown(where + result.tool_name)}** at ±{c.angle_deg:g}°", "",
-             f"| Rotation | Tip moved (mm{', by eye' if reading else ''}) | |", "|---|---:|---|"]
+    heading = (_("**TCP check of {tool}** at ±{angle}°").format(tool=name, angle=f"{c.angle_deg:g}")
+               if result.slot is None else
+               _("**TCP check of slot {slot}: {tool}** at ±{angle}°").format(
+                   slot=result.slot, tool=name, angle=f"{c.angle_deg:g}"))
+    columns = (_("| Rotation | Tip moved (mm, by eye) | |") if reading else _("| Rotation | Tip moved (mm) | |"))
+    lines = [heading, "", columns, "|---|---:|---|"]
     for r in c.rows:
         if r.reached:
             lines.append(f"| {escape_markdown(r.label)} | {r.deviation_mm:.{1 if reading else 3}f} | ✔ |")
         else:                                   # no figure: the rotation was not made
-            lines.append(f"| {escape_markdown(r.label)} | not made | stopped: {escape_markdown(r.message)} |")
+            lines.append(_("| {rotation} | not made | stopped: {reason} |").format(
+                rotation=escape_markdown(r.label), reason=escape_markdown(r.message)))
     lines.append("")
     if reading:
-        lines += [READING_NOTE, ""]
+        lines += [reading_note(tr=tr), ""]
     if c.implied_tcp_error_mm is not None and c.correction_flange_mm is not None:
         dx, dy, dz = (0.0 if abs(v) < 5e-4 else v for v in c.correction_flange_mm)
-        lines.append(f"**Implied TCP error: {c.implied_tcp_error_mm:.3f} mm** · suggested correction "
-                     f"(add to the TCP, FLANGE): X {dx:+.3f} · Y {dy:+.3f} · Z {dz:+.3f} mm · "
-                     f"what no TCP explains: {c.fit_rms_mm or 0.0:.3f} mm RMS")
+        lines.append(_("**Implied TCP error: {error} mm** · suggested correction "
+                       "(add to the TCP, FLANGE): X {dx} · Y {dy} · Z {dz} mm · "
+                       "what no TCP explains: {rms} mm RMS").format(
+                           error=f"{c.implied_tcp_error_mm:.3f}", dx=f"{dx:+.3f}", dy=f"{dy:+.3f}",
+                           dz=f"{dz:+.3f}", rms=f"{c.fit_rms_mm or 0.0:.3f}"))
         lines.append("")
-    lines.append(f"**{c.verdict}**")
+    lines.append(f"**{c.verdict_in(tr)}**")
     return "\n".join(lines)

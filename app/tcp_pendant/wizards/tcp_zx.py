@@ -21,6 +21,7 @@ from tcpcal.tcp_zx import solve_tcp_zx
 from tcpcal.tool import Tool
 
 from tcp_pendant.json_shapes import JsonRecord
+from tcp_pendant.translation import N_
 from tcp_pendant.wizards.base import (
     StartContext,
     StepSpec,
@@ -30,6 +31,7 @@ from tcp_pendant.wizards.base import (
     check_pose_m,
     mm3,
 )
+from tcp_pendant.wizards.solver_words import solver_warnings
 from tcp_pendant.wizards.describe import (
     AHEAD_PLUS_X,
     AHEAD_PLUS_Z,
@@ -38,7 +40,7 @@ from tcp_pendant.wizards.describe import (
     WizardOption,
     WizardStart,
 )
-from tcp_pendant.wizards.xyz4 import RESIDUAL_CAVEAT
+from tcp_pendant.wizards.xyz4 import RESIDUAL_CAVEAT, outlier_warning
 
 __all__ = ["MIN_AXIS_DISTANCE_MM", "TcpZxWizard"]
 
@@ -56,22 +58,22 @@ class TcpZxWizard(Wizard):
     """
 
     kind: ClassVar[str] = "tcp-zx"
-    title: ClassVar[str] = "TCP & Z, X (ABB)"
-    blurb: ClassVar[str] = ("Calibrates the **TCP and the orientation** (X, Y, Z, A, B, C) in one go, as "
+    title: ClassVar[str] = N_("TCP & Z, X (ABB)")
+    blurb: ClassVar[str] = N_("Calibrates the **TCP and the orientation** (X, Y, Z, A, B, C) in one go, as "
                             "ABB's TCP & Z, X: 4 to 20 touches, then the reference tip on the tool's +Z "
                             "axis ahead of the TCP, then on its +X axis.")
-    calibrates: ClassVar[str] = "the TCP and the orientation"
+    calibrates: ClassVar[str] = N_("the TCP and the orientation")
     rank: ClassVar[int] = 30
     math_view: ClassVar[str | None] = "tcp_zx"
     MIN_POINTS: ClassVar[int] = 4
     MAX_POINTS: ClassVar[int] = 20
     step_roles = (
-        StepRole("touch", "the tool tip on the reference tip", TOUCH),
-        StepRole("z", "the reference tip on the tool's +Z axis, ahead of the TCP", AHEAD_PLUS_Z),
-        StepRole("x", "the reference tip on the tool's +X axis, ahead of the TCP", AHEAD_PLUS_X),
+        StepRole("touch", N_("the tool tip on the reference tip"), TOUCH),
+        StepRole("z", N_("the reference tip on the tool's +Z axis, ahead of the TCP"), AHEAD_PLUS_Z),
+        StepRole("x", N_("the reference tip on the tool's +X axis, ahead of the TCP"), AHEAD_PLUS_X),
     )
-    options = (WizardOption("n_points", "Touches", "int", default=4, minimum=MIN_POINTS, maximum=MAX_POINTS,
-                            hint="Touches of the reference tip before the Z and X poses."),)
+    options = (WizardOption("n_points", N_("Touches"), "int", default=4, minimum=MIN_POINTS, maximum=MAX_POINTS,
+                            hint=N_("Touches of the reference tip before the Z and X poses.")),)
     needs_tool = "mounted"
     diversity_meter = True
 
@@ -95,25 +97,26 @@ class TcpZxWizard(Wizard):
 
     # ----- steps --------------------------------------------------------------------------
     def _step_specs(self) -> list[StepSpec]:
+        _ = self._tr.gettext
         specs = []
         for i in range(self._n_points):
-            text = ("Jog the tool tip onto the reference tip, approaching from any direction; then "
-                    "press Record." if i == 0 else
-                    "Back off, tilt 45 to 60° about A, B or C (\"Reachable 45° tilts\" below names "
-                    "those that work from here) and touch the reference tip again (touch 2); then "
-                    "Record." if i == 1 else
-                    f"Back off, tilt 45 to 60° about another axis than for the earlier touches and touch "
-                    f"the reference tip again (touch {i + 1}); then Record.")
-            specs.append(StepSpec(role="touch", title=f"Touch {i + 1}", instruction=text))
+            text = (_("Jog the tool tip onto the reference tip, approaching from any direction; then "
+                      "press Record.") if i == 0 else
+                    _("Back off, tilt 45 to 60° about A, B or C (\"Reachable 45° tilts\" below names "
+                      "those that work from here) and touch the reference tip again (touch 2); then "
+                      "Record.") if i == 1 else
+                    _("Back off, tilt 45 to 60° about another axis than for the earlier touches and touch "
+                      "the reference tip again (touch {k}); then Record.").format(k=i + 1))
+            specs.append(StepSpec(role="touch", title=_("Touch {k}").format(k=i + 1), instruction=text))
         specs.append(StepSpec(
-            role="z", title="Reference on the tool's +Z axis",
-            instruction=("From the last touch keep the orientation and back off straight along the "
+            role="z", title=_("Reference on the tool's +Z axis"),
+            instruction=_("From the last touch keep the orientation and back off straight along the "
                          "tool's Z axis (jog along tool -Z only, at least 20 mm, more is better), so "
                          "that the reference tip lies on the tool's +Z axis ahead of the TCP; then "
                          "press Record.")))
         specs.append(StepSpec(
-            role="x", title="Reference on the tool's +X axis",
-            instruction=("Go back to the touch and jog along tool -X only (at least 20 mm), so that "
+            role="x", title=_("Reference on the tool's +X axis"),
+            instruction=_("Go back to the touch and jog along tool -X only (at least 20 mm), so that "
                          "the reference tip lies on the tool's +X axis ahead of the TCP; then press "
                          "Record.")))
         return specs
@@ -142,10 +145,10 @@ class TcpZxWizard(Wizard):
         f_mm = np.array([T[:3, 3] for T in poses]) * 1000.0      # metres -> mm for tcpcal
         res = solve_tcp_zx(R, f_mm, self._roles(), min_distance=MIN_AXIS_DISTANCE_MM)
         origin = res.origin
-        warnings = list(res.warnings)
+        warnings = solver_warnings(res.warnings, tr=self._tr)
         if origin.outliers:
-            warnings.append("Touch(es) " + ", ".join(str(res.touch_rows[i] + 1) for i in origin.outliers)
-                            + " stand out from the others (outliers): re-record them.")
+            warnings.append(outlier_warning([res.touch_rows[i] + 1 for i in origin.outliers], "re-record",
+                                            tr=self._tr))
         rot = np.asarray(res.rotation, dtype=float)
         return WizardResult(
             wizard=self.kind, method="tcp-zx", tcp_mm=mm3(res.tcp), abc_deg=mm3(res.kuka_abc_deg),
@@ -155,7 +158,7 @@ class TcpZxWizard(Wizard):
             rms_error_mm=float(origin.rms_error), ci95_mm=float(origin.ci95_radius),
             orthogonality_defect_deg=float(res.orthogonality_defect_deg),
             displacements_mm=tuple(float(d) for d in (*res.z_distances, *res.x_distances)),
-            warnings=tuple(warnings), notes=(RESIDUAL_CAVEAT,),
+            warnings=tuple(warnings), notes=(self._tr.gettext(RESIDUAL_CAVEAT),),
         )
 
     def to_tool(self, name: str) -> Tool:

@@ -16,6 +16,7 @@ from tcpcal.orientation import solve_three_point
 from tcpcal.tool import Tool
 
 from tcp_pendant.json_shapes import JsonRecord
+from tcp_pendant.translation import N_
 from tcp_pendant.wizards.base import (
     StepSpec,
     Wizard,
@@ -24,6 +25,7 @@ from tcp_pendant.wizards.base import (
     WizardStateError,
     mm3,
 )
+from tcp_pendant.wizards.solver_words import solver_warnings
 from tcp_pendant.wizards.describe import (
     IN_PLUS_Y_HALF,
     ON_MINUS_X,
@@ -50,21 +52,21 @@ class ThreePointWizard(Wizard):
     """
 
     kind: ClassVar[str] = "three-point"
-    title: ClassVar[str] = "Three-point orientation"
-    blurb: ClassVar[str] = ("Calibrates the **orientation** (A, B, C) of a tool whose TCP is calibrated: "
+    title: ClassVar[str] = N_("Three-point orientation")
+    blurb: ClassVar[str] = N_("Calibrates the **orientation** (A, B, C) of a tool whose TCP is calibrated: "
                             "a touch, then the tip on the tool's -X axis and on its +Y side.")
-    calibrates: ClassVar[str] = "the orientation"
+    calibrates: ClassVar[str] = N_("the orientation")
     rank: ClassVar[int] = 40
     math_view: ClassVar[str | None] = "three_point"
     step_roles = (
-        StepRole("touch", "the tool tip on the reference tip", TOUCH_KEEP_ORIENTATION),
-        StepRole("minus_x", "the reference tip on the tool's -X axis", ON_MINUS_X),
-        StepRole("plus_y", "the reference tip on the tool's +Y axis", ON_PLUS_Y),
-        StepRole("plus_y_half", "the reference tip in the +Y half of the tool XY plane", IN_PLUS_Y_HALF),
+        StepRole("touch", N_("the tool tip on the reference tip"), TOUCH_KEEP_ORIENTATION),
+        StepRole("minus_x", N_("the reference tip on the tool's -X axis"), ON_MINUS_X),
+        StepRole("plus_y", N_("the reference tip on the tool's +Y axis"), ON_PLUS_Y),
+        StepRole("plus_y_half", N_("the reference tip in the +Y half of the tool XY plane"), IN_PLUS_Y_HALF),
     )
-    options = (WizardOption("slot", "Tool data", "library_slot",
-                            hint="A tool of the library whose TCP is calibrated."),)
-    variants = ((1, "Variant 1: tip on the +Y axis"), (2, "Variant 2: tip in the +Y half-plane"))
+    options = (WizardOption("slot", N_("Tool data"), "library_slot",
+                            hint=N_("A tool of the library whose TCP is calibrated.")),)
+    variants = ((1, N_("Variant 1: tip on the +Y axis")), (2, N_("Variant 2: tip in the +Y half-plane")))
     needs_tool = "library"
 
     @classmethod
@@ -105,7 +107,7 @@ class ThreePointWizard(Wizard):
         to variant 1 (a point in the half-plane is not on the +Y axis); a finished wizard reopens."""
         variant = self._check_variant(variant)
         if self.status == "cancelled":
-            raise WizardStateError("The wizard was cancelled; resume it first.")
+            raise self._cancelled_refusal()
         if variant == self._variant:
             return
         if self._variant == 2 and variant == 1:
@@ -116,23 +118,24 @@ class ThreePointWizard(Wizard):
             self._result = None
 
     def _step_specs(self) -> list[StepSpec]:
+        _ = self._tr.gettext
         name = self.tool.name
-        step3 = (StepSpec(role="plus_y", title="Tip on the tool's +Y axis",
-                          instruction=("Go back to the touch, then jog along tool -Y (at least 20 mm, "
+        step3 = (StepSpec(role="plus_y", title=_("Tip on the tool's +Y axis"),
+                          instruction=_("Go back to the touch, then jog along tool -Y (at least 20 mm, "
                                        "more is better) so that the reference tip lies on the tool's "
                                        "positive Y axis; then press Record."))
                  if self._variant == 1 else
-                 StepSpec(role="plus_y_half", title="Tip in the tool's +Y half-plane",
-                          instruction=("Jog in the tool's XY plane (no tool Z motion) so that the "
+                 StepSpec(role="plus_y_half", title=_("Tip in the tool's +Y half-plane"),
+                          instruction=_("Jog in the tool's XY plane (no tool Z motion) so that the "
                                        "reference tip lies on the +Y side of the tool X axis, at "
                                        "least 20 mm from it; then press Record.")))
         return [
-            StepSpec(role="touch", title="Touch the reference tip",
-                     instruction=(f"With '{name}' active, jog its TCP onto the reference tip from "
-                                  "a comfortable orientation; then press Record. Keep this "
-                                  "orientation for the next steps."),),
-            StepSpec(role="minus_x", title="Tip on the tool's -X axis",
-                     instruction=("Jog along tool +X only (at least 20 mm, more is better) so that "
+            StepSpec(role="touch", title=_("Touch the reference tip"),
+                     instruction=_("With '{tool}' active, jog its TCP onto the reference tip from "
+                                   "a comfortable orientation; then press Record. Keep this "
+                                   "orientation for the next steps.").format(tool=name),),
+            StepSpec(role="minus_x", title=_("Tip on the tool's -X axis"),
+                     instruction=_("Jog along tool +X only (at least 20 mm, more is better) so that "
                                   "the reference tip lies on the tool's negative X axis; then press "
                                   "Record.")),
             step3,
@@ -145,10 +148,10 @@ class ThreePointWizard(Wizard):
         # tcpcal warns about every displacement shorter than MIN_DISPLACEMENT_MM (mm here).
         res = solve_three_point(R, f_mm, tcp, variant=self._variant,
                                 min_displacement=MIN_DISPLACEMENT_MM)
-        warnings = list(res.warnings)
+        warnings = solver_warnings(res.warnings, tr=self._tr)
         if self.tool.calibration is None:
-            warnings.append(f"The TCP of '{self.tool.name}' has no calibration record; the "
-                            "orientation is only as good as that TCP.")
+            warnings.append(self._tr.gettext("The TCP of '{tool}' has no calibration record; the "
+                                             "orientation is only as good as that TCP.").format(tool=self.tool.name))
         rot = np.asarray(res.rotation, dtype=float)
         return WizardResult(
             wizard=self.kind, method=f"three-point-{self._variant}", tcp_mm=mm3(tcp),

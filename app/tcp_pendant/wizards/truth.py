@@ -26,6 +26,7 @@ import numpy as np
 import numpy.typing as npt
 from scipy.spatial.transform import Rotation
 
+from tcp_pendant.translation import ENGLISH, N_, Translator
 from tcp_pendant.wizards.base import WizardError, WizardResult, check_pose_m
 
 Grade = Literal["good", "fair", "poor"]
@@ -48,7 +49,8 @@ class TruthComparison:
             the result has no 95 % radius).
         graded: which figures the grade is based on ("position", "orientation", "x_axis").
         grade: "good" | "fair" | "poor".
-        verdict: short words, e.g. "good: position error 0.21 mm < 0.5 mm".
+        verdict: short words in English (the record's), e.g. "good: position error 0.21 mm < 0.5 mm";
+            :meth:`verdict_in` says them in a session's language.
     """
 
     position_error_mm: float
@@ -59,6 +61,11 @@ class TruthComparison:
     graded: tuple[str, ...]
     grade: Grade
     verdict: str
+
+    def verdict_in(self, tr: Translator) -> str:
+        """:attr:`verdict` in ``tr``'s language (the same figures and grade)."""
+        return _verdict(self.graded, self.position_error_mm, self.orientation_error_deg, self.x_axis_error_deg,
+                        tr=tr)[1]
 
     def to_dict(self) -> dict[str, object]:
         return {"position_error_mm": self.position_error_mm,
@@ -72,12 +79,40 @@ def _grade(value: float, thresholds: tuple[float, float]) -> Grade:
     return "good" if value < thresholds[0] else "fair" if value < thresholds[1] else "poor"
 
 
-def _phrase(grade: Grade, what: str, value: float, unit: str, thresholds: tuple[float, float]) -> str:
-    if grade == "good":
-        return f"{what} {value:.2f} {unit} < {thresholds[0]:g} {unit}"
-    if grade == "fair":
-        return f"{what} {value:.2f} {unit} < {thresholds[1]:g} {unit}"
-    return f"{what} {value:.2f} {unit} >= {thresholds[1]:g} {unit}"
+GRADE_WORDS: dict[str, str] = {"good": N_("good"), "fair": N_("fair"), "poor": N_("poor")}
+"""The grades in words (English msgids; ``tr.gettext(GRADE_WORDS[grade])``)."""
+
+_BELOW = {"position": N_("position error {value} mm < {limit} mm"),
+          "x_axis": N_("tool X error {value} deg < {limit} deg"),
+          "orientation": N_("orientation error {value} deg < {limit} deg")}
+_NOT_BELOW = {"position": N_("position error {value} mm >= {limit} mm"),
+              "x_axis": N_("tool X error {value} deg >= {limit} deg"),
+              "orientation": N_("orientation error {value} deg >= {limit} deg")}
+
+
+def _phrase(grade: Grade, figure: str, value: float, thresholds: tuple[float, float], tr: Translator) -> str:
+    limit = thresholds[0] if grade == "good" else thresholds[1]
+    words = _NOT_BELOW[figure] if grade == "poor" else _BELOW[figure]
+    return tr.gettext(words).format(value=f"{value:.2f}", limit=f"{limit:g}")
+
+
+def _verdict(graded: tuple[str, ...], pos_err: float, ori_err: float | None, x_err: float | None, *,
+             tr: Translator = ENGLISH) -> tuple[Grade, str]:
+    """The grade and the verdict of the ``graded`` figures (position mm, orientation and tool X deg)."""
+    parts: list[tuple[Grade, str]] = []
+    for figure in graded:
+        value, thresholds = ((pos_err, POSITION_THRESHOLDS_MM) if figure == "position" else
+                             (x_err if figure == "x_axis" else ori_err, ORIENTATION_THRESHOLDS_DEG))
+        assert value is not None
+        g = _grade(value, thresholds)
+        parts.append((g, _phrase(g, figure, value, thresholds, tr)))
+    grade = max((g for g, _ in parts), key=_ORDER.__getitem__)
+    verdict = tr.gettext("{grade}: {errors}").format(grade=tr.gettext(GRADE_WORDS[grade]),
+                                                      errors="; ".join(p for _, p in parts))
+    if "position" not in graded:
+        verdict = tr.gettext("{verdict} (TCP used is {mm} mm off the true one)").format(
+            verdict=verdict, mm=f"{pos_err:.2f}")
+    return grade, verdict
 
 
 X_AXIS_METHODS: frozenset[str] = frozenset({"abc-world-5d", "beam"})
@@ -110,29 +145,17 @@ def compare_with_truth(result: WizardResult, T_flange_tool_true_m: npt.ArrayLike
     # within numerical noise (exact touches: a 95 % radius and an error of ~1e-12 mm) is inside
     inside = None if result.ci95_mm is None else bool(pos_err <= result.ci95_mm + NUMERICAL_NOISE_MM)
 
-    parts: list[tuple[Grade, str]] = []
     graded: list[str] = []
     calibrates_tcp = result.tcp_result is not None or not result.orientation_calibrated
     if calibrates_tcp:          # XYZ wizards, and TCP & Z, X (TCP and orientation both graded)
-        g = _grade(pos_err, POSITION_THRESHOLDS_MM)
-        parts.append((g, _phrase(g, "position error", pos_err, "mm", POSITION_THRESHOLDS_MM)))
         graded.append("position")
     if not result.orientation_calibrated:
         pass
     elif result.method in X_AXIS_METHODS:
-        assert x_err is not None
-        g = _grade(x_err, ORIENTATION_THRESHOLDS_DEG)
-        parts.append((g, _phrase(g, "tool X error", x_err, "deg", ORIENTATION_THRESHOLDS_DEG)))
         graded.append("x_axis")
     else:
-        assert ori_err is not None
-        g = _grade(ori_err, ORIENTATION_THRESHOLDS_DEG)
-        parts.append((g, _phrase(g, "orientation error", ori_err, "deg", ORIENTATION_THRESHOLDS_DEG)))
         graded.append("orientation")
-    grade = max((g for g, _ in parts), key=_ORDER.__getitem__)
-    verdict = f"{grade}: " + "; ".join(p for _, p in parts)
-    if result.orientation_calibrated and not calibrates_tcp:
-        verdict += f" (TCP used is {pos_err:.2f} mm off the true one)"
+    grade, verdict = _verdict(tuple(graded), pos_err, ori_err, x_err)
     return TruthComparison(position_error_mm=pos_err,
                            position_error_vector_mm=(float(dvec[0]), float(dvec[1]), float(dvec[2])),
                            orientation_error_deg=ori_err, x_axis_error_deg=x_err,

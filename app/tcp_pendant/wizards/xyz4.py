@@ -20,6 +20,7 @@ from tcpcal.pose_quality import CandidateGain, PoseQuality, assess_touches, cand
 from tcpcal.tool import Tool
 
 from tcp_pendant.json_shapes import JsonRecord
+from tcp_pendant.translation import N_, Translator
 from tcp_pendant.wizards.base import (
     StartContext,
     StepSpec,
@@ -31,22 +32,39 @@ from tcp_pendant.wizards.base import (
     mm3,
     rotation_and_position_mm,
 )
+from tcp_pendant.wizards.solver_words import solver_warning, solver_warnings
 from tcp_pendant.wizards.describe import TOUCH, StepRole, WizardOption, WizardStart
 
 Estimator = Literal["lstsq", "sphere", "pairwise"]
 ESTIMATORS: tuple[Estimator, ...] = ("lstsq", "sphere", "pairwise")
 ESTIMATOR_LABELS: dict[Estimator, str] = {
-    "lstsq": "joint least squares (default)",
-    "sphere": "best-fit sphere",
-    "pairwise": "pairwise differences",
+    "lstsq": N_("joint least squares (default)"),
+    "sphere": N_("best-fit sphere"),
+    "pairwise": N_("pairwise differences"),
 }
-"""The estimators in words for the trainee's Calibrate tab; their equations, (4P-3), (4P-1a) and
+"""The estimators in words for the trainee's Calibrate tab (English msgids: the views show
+``tr.gettext(label)``); their equations, (4P-3), (4P-1a) and
 (4P-2) of methods.md, are shown in "The math" (``calibrate.math_view``)."""
 
-RESIDUAL_CAVEAT = (
+RESIDUAL_CAVEAT = N_(
     "A small residual does not prove an accurate TCP: systematic errors (a bent tip, a "
     "reference that moved, a wrong robot model) hide in it. Check the TCP by rotating about it."
 )
+"""A result's standing note (an English msgid; the wizards add it as ``tr.gettext(RESIDUAL_CAVEAT)``)."""
+
+
+def outlier_warning(touches: list[int], advice: str, *, tr: Translator) -> str:
+    """The words that ``touches`` (1-based numbers) stand out from the others as outliers;
+    ``advice`` "drop" (recompute without them) or "re-record"."""
+    listed = ", ".join(str(n) for n in touches)
+    if advice == "drop":
+        return tr.ngettext(
+            "Touch {touches} stands out from the others (outlier): drop it to recompute without it.",
+            "Touches {touches} stand out from the others (outliers): drop them to recompute without them.",
+            len(touches)).format(touches=listed)
+    return tr.ngettext("Touch {touches} stands out from the others (outlier): re-record it.",
+                       "Touches {touches} stand out from the others (outliers): re-record them.",
+                       len(touches)).format(touches=listed)
 
 
 class EstimatorRow(TypedDict, total=False):
@@ -125,20 +143,20 @@ class Xyz4Wizard(Wizard):
     """
 
     kind: ClassVar[str] = "xyz4"
-    title: ClassVar[str] = "XYZ 4-point"
-    blurb: ClassVar[str] = ("Calibrates the **TCP** (X, Y, Z): touch the reference tip with the tool tip "
+    title: ClassVar[str] = N_("XYZ 4-point")
+    blurb: ClassVar[str] = N_("Calibrates the **TCP** (X, Y, Z): touch the reference tip with the tool tip "
                             "from 4 to 20 clearly different orientations.")
-    calibrates: ClassVar[str] = "the TCP"
+    calibrates: ClassVar[str] = N_("the TCP")
     rank: ClassVar[int] = 10
     result_extras: ClassVar[frozenset[str]] = frozenset({"estimators", "sphere"})
     math_view: ClassVar[str | None] = "xyz4"
     MIN_POINTS: ClassVar[int] = 4
     MAX_POINTS: ClassVar[int] = 20
-    step_roles = (StepRole("touch", "the tool tip on the reference tip", TOUCH),)
+    step_roles = (StepRole("touch", N_("the tool tip on the reference tip"), TOUCH),)
     options = (
-        WizardOption("n_points", "Touches", "int", default=4, minimum=MIN_POINTS, maximum=MAX_POINTS,
-                     hint="Touches to start with; Add point adds more (up to 20)."),
-        WizardOption("estimator", "Estimator", "choice", default="lstsq",
+        WizardOption("n_points", N_("Touches"), "int", default=4, minimum=MIN_POINTS, maximum=MAX_POINTS,
+                     hint=N_("Touches to start with; Add point adds more (up to 20).")),
+        WizardOption("estimator", N_("Estimator"), "choice", default="lstsq",
                      choices=tuple(ESTIMATOR_LABELS.items())),
     )
     needs_tool = "mounted"
@@ -172,25 +190,26 @@ class Xyz4Wizard(Wizard):
 
     # ----- steps --------------------------------------------------------------------------
     def _step_specs(self) -> list[StepSpec]:
+        _ = self._tr.gettext
         specs = []
         for i in range(self._n_points):
             if i == 0:
-                text = ("Jog the tool tip onto the reference tip, approaching from any direction; "
+                text = _("Jog the tool tip onto the reference tip, approaching from any direction; "
                         "then press Record.")
             elif i == 1:
-                text = ("Back off, tilt 45 to 60° about A, B or C (\"Reachable 45° tilts\" below names "
+                text = _("Back off, tilt 45 to 60° about A, B or C (\"Reachable 45° tilts\" below names "
                         "those that work from here) and touch the reference tip again (touch 2); then "
                         "Record.")
             elif i == 2:
-                text = ("Back off, tilt 45 to 60° about another axis than for touch 2 and touch the "
+                text = _("Back off, tilt 45 to 60° about another axis than for touch 2 and touch the "
                         "reference tip again (touch 3); then Record.")
             elif i == 3:
-                text = ("Back off and touch the reference tip from an orientation 45 to 60° away from all "
+                text = _("Back off and touch the reference tip from an orientation 45 to 60° away from all "
                         "three earlier ones, e.g. tilted the other way than touch 2 (touch 4); then Record.")
             else:
-                text = (f"Extra touch {i + 1}: touch the reference tip from an orientation unlike "
-                        f"the earlier ones (watch the pose-diversity meter); then press Record.")
-            specs.append(StepSpec(role="touch", title=f"Touch {i + 1}", instruction=text))
+                text = _("Extra touch {k}: touch the reference tip from an orientation unlike "
+                         "the earlier ones (watch the pose-diversity meter); then press Record.").format(k=i + 1)
+            specs.append(StepSpec(role="touch", title=_("Touch {k}").format(k=i + 1), instruction=text))
         return specs
 
     @property
@@ -204,8 +223,9 @@ class Xyz4Wizard(Wizard):
     def add_point(self) -> None:
         """Add one touch step at the end (up to 20) and go to it (a finished wizard reopens)."""
         if not self.can_add_point:
-            raise WizardStateError(f"At most {self.MAX_POINTS} touches." if self.status != "cancelled"
-                                   else "The wizard was cancelled; resume it first.")
+            if self.status == "cancelled":
+                raise self._cancelled_refusal()
+            raise WizardStateError(self._tr.gettext("At most {n} touches.").format(n=self.MAX_POINTS))
         self._n_points += 1
         self._status = "in_progress"
         self._result = None
@@ -214,12 +234,13 @@ class Xyz4Wizard(Wizard):
 
     def remove_point(self, index: int) -> None:
         """Delete touch ``index`` (0-based) and its step, keeping at least 4 steps."""
+        _ = self._tr.gettext
         if self.status == "cancelled":
-            raise WizardStateError("The wizard was cancelled; resume it first.")
+            raise self._cancelled_refusal()
         if self._n_points <= self.MIN_POINTS:
-            raise WizardStateError(f"At least {self.MIN_POINTS} touches are needed; re-record instead.")
+            raise WizardStateError(_("At least {n} touches are needed; re-record instead.").format(n=self.MIN_POINTS))
         if not 0 <= index < self._n_points:
-            raise WizardStateError(f"There is no touch {index + 1}.")
+            raise WizardStateError(_("There is no touch {k}.").format(k=index + 1))
         self._poses = {(i if i < index else i - 1): p for i, p in self._poses.items() if i != index}
         self._n_points -= 1
         self._excluded = ()
@@ -250,11 +271,15 @@ class Xyz4Wizard(Wizard):
     def set_excluded(self, indices: Iterable[int]) -> WizardResult | None:
         """Leave these touches out (0-based); recompute if finished. At least 4 must remain."""
         idx = tuple(sorted({int(i) for i in indices}))
+        _ = self._tr.gettext
         if any(not 0 <= i < self._n_points for i in idx):
-            raise WizardError(f"Touch indices {list(idx)} out of range 0..{self._n_points - 1}.")
+            raise WizardError(_("Touch indices {indices} out of range 0..{last}.").format(
+                indices=list(idx), last=self._n_points - 1))
         if self._n_points - len(idx) < self.MIN_POINTS:
-            raise WizardError(f"Dropping {len(idx)} touches leaves fewer than {self.MIN_POINTS}; "
-                              "add points first.")
+            raise WizardError(self._tr.ngettext(
+                "Dropping {n} touch leaves fewer than {min}; add points first.",
+                "Dropping {n} touches leaves fewer than {min}; add points first.", len(idx),
+            ).format(n=len(idx), min=self.MIN_POINTS))
         old = self._excluded
         self._excluded = idx
         if self.is_complete:
@@ -270,9 +295,9 @@ class Xyz4Wizard(Wizard):
         """Exclude the touches flagged as outliers in the current result and recompute."""
         res = self.result
         if not isinstance(res, Xyz4Result):
-            raise WizardStateError("Finish the wizard first.")
+            raise WizardStateError(self._tr.gettext("Finish the wizard first."))
         if not res.outliers:
-            raise WizardStateError("No touch is flagged as an outlier.")
+            raise WizardStateError(self._tr.gettext("No touch is flagged as an outlier."))
         out = self.set_excluded(set(self._excluded) | set(res.outliers))
         assert out is not None
         return out
@@ -327,26 +352,26 @@ class Xyz4Wizard(Wizard):
             try:
                 estimators[name] = solve_xyz4(R, f, method=name)
             except TcpcalError as exc:
-                errors[name] = str(exc)
+                errors[name] = solver_warning(str(exc), tr=self._tr)
         t = np.asarray(chosen.tcp, dtype=float)
         radius = float(np.linalg.norm(t))
         directions = (R_all @ t) / radius if radius > 0 else np.zeros((len(poses), 3))
         outliers = tuple(used[i] for i in chosen.outliers)
-        warnings = list(chosen.warnings)
+        warnings = solver_warnings(chosen.warnings, tr=self._tr)
         if outliers:
-            warnings.append(
-                "Touch(es) " + ", ".join(str(i + 1) for i in outliers)
-                + " stand out from the others (outliers): drop them to recompute without them.")
+            warnings.append(outlier_warning([i + 1 for i in outliers], "drop", tr=self._tr))
         if self._excluded:
-            warnings.append("Touch(es) " + ", ".join(str(i + 1) for i in self._excluded)
-                            + " were dropped by you and are not used.")
+            warnings.append(self._tr.ngettext(
+                "Touch {touches} was dropped by you and is not used.",
+                "Touches {touches} were dropped by you and are not used.", len(self._excluded),
+            ).format(touches=", ".join(str(i + 1) for i in self._excluded)))
         return Xyz4Result(
             wizard=self.kind, method=f"xyz4-{self._estimator}", tcp_mm=mm3(t),
             tcp_result=chosen,
             per_touch_error_mm=tuple(float(e) for e in chosen.residuals),
             mean_error_mm=float(chosen.mean_error), max_error_mm=float(chosen.max_error),
             rms_error_mm=float(chosen.rms_error), ci95_mm=float(chosen.ci95_radius),
-            warnings=tuple(warnings), notes=(RESIDUAL_CAVEAT,),
+            warnings=tuple(warnings), notes=(self._tr.gettext(RESIDUAL_CAVEAT),),
             estimator=self._estimator, used_indices=used, excluded=self._excluded,
             outliers=outliers, sphere_centre_mm=mm3(chosen.reference), sphere_radius_mm=radius,
             flange_positions_mm=f_all_mm, approach_directions_world=directions,
