@@ -255,7 +255,7 @@ def result_markdown(result: WizardResult, truth: TruthComparison | None = None, 
     """
     view = wizard_class(result.wizard).result_view
     if view == "spin_check":
-        return tcp_check_markdown(result)  # type: ignore[arg-type]  # its wizard's result type
+        return tcp_check_markdown(result, tr=tr)  # type: ignore[arg-type]  # its wizard's result type
     if view == "beam_scan":
         return beam_result_markdown(result, truth, tr=tr)  # type: ignore[arg-type]  # its wizard's result type
     return touches_result_markdown(result, tr=tr)
@@ -464,7 +464,7 @@ def truth_markdown(cmp: TruthComparison, *, tr: Translator = ENGLISH) -> str:
     verdict's words are ``wizards.truth``'s)."""
     _ = tr.gettext
     icon = {"good": "✔", "fair": "●", "poor": "✘"}[cmp.grade]
-    lines = [_("{icon} **Against the true TOOL frame: {verdict}**").format(icon=icon, verdict=cmp.verdict),
+    lines = [_("{icon} **Against the true TOOL frame: {verdict}**").format(icon=icon, verdict=cmp.verdict_in(tr)),
              _("Position error of the TCP: **{error}**").format(error=_mm(cmp.position_error_mm, 3))]
     if cmp.orientation_error_deg is not None:
         lines.append(_("Orientation error: **{error}** (tool X: {x_error})").format(
@@ -492,7 +492,7 @@ def replay_markdown(checks: Sequence[ReplayCheck], *, tr: Translator = ENGLISH) 
     head = _("| # | calibration | replay | against truth |") + "\n|---|---|---|---|"
     rows = []
     for c in checks:
-        truth = "–" if c.truth is None else _esc(c.truth.verdict)
+        truth = "–" if c.truth is None else _esc(c.truth.verdict_in(tr))
         ok = "✔ " if c.matches else "✘ "
         rows.append(f"| {c.index + 1} | {_esc(_(c.wizard.title))} | {ok}{_esc(c.message)} | {truth} |")
     return head + "\n" + "\n".join(rows)
