@@ -50,6 +50,7 @@ __all__ = [
     "menu_markdown",
     "meter_level",
     "meter_markdown",
+    "method_words",
     "replay_markdown",
     "result_markdown",
     "save_markdown",
@@ -267,6 +268,21 @@ def _figures_table(rows: Sequence[tuple[str, str]], tr: Translator) -> str:
     return head + "\n|---|---|\n" + "\n".join(f"| {k} | {v} |" for k, v in rows)
 
 
+def method_words(result: WizardResult, *, tr: Translator = ENGLISH) -> str:
+    """The method of ``result`` in words: its wizard's title, and the estimator or variant its
+    method id names (``xyz4-lstsq`` → "XYZ 4-point · joint least squares (default)"); the id
+    itself only for a method the wizard does not describe."""
+    cls = wizard_class(result.wizard)
+    title = tr.gettext(cls.title)
+    suffix = result.method.removeprefix(f"{result.wizard}-") if result.method != result.wizard else ""
+    if result.wizard == "xyz4" and suffix in ESTIMATOR_LABELS:
+        return f"{title} · {tr.gettext(ESTIMATOR_LABELS[suffix])}"
+    variant = next((label for value, label in cls.variants if str(value) == suffix), None)
+    if variant is not None:
+        return f"{title} · {tr.gettext(variant)}"
+    return title if not suffix or result.method == cls.kind else f"{title} ({result.method})"
+
+
 def touches_result_markdown(result: WizardResult, *, tr: Translator = ENGLISH) -> str:
     """A result computed from recorded touches: the TCP (and orientation) with its figures."""
     _ = tr.gettext
@@ -275,7 +291,7 @@ def touches_result_markdown(result: WizardResult, *, tr: Translator = ENGLISH) -
     if result.abc_deg is not None:
         a, b, c = (fmt_num(v) for v in result.abc_deg)
         lines.append(_("**Orientation** A {a} · B {b} · C {c}° (KUKA: Rz(A) Ry(B) Rx(C))").format(a=a, b=b, c=c))
-    rows: list[tuple[str, str]] = [(_("method"), _esc(_(result.method)))]
+    rows: list[tuple[str, str]] = [(_("method"), _esc(method_words(result, tr=tr)))]
     tcp = result.tcp_result
     if tcp is not None:
         n = len(result.per_touch_error_mm)
@@ -348,7 +364,7 @@ def beam_result_markdown(result: BeamWizardResult, truth: TruthComparison | None
                       "the beam does not see the turn about the tool's X, which is kept from the planning data.")
         lines.append(frame.format(a=a, b=b, c=c, turn=_deg(result.direction_turn_deg, 3)))
     beam = result.beam_result
-    rows = [(_("method"), _esc(_(result.method))),
+    rows = [(_("method"), _esc(method_words(result, tr=tr))),
             (_("tip events (TCP)"), str(len(result.tip_event_indices))),
             (_("sideways crossings used (direction)"), str(len(result.axis_event_indices))),
             (_("mean error (tip off the beam line)"), _mm(result.mean_error_mm, 3)),
