@@ -53,7 +53,7 @@ from tcp_pendant.translation import ENGLISH, N_, Translator
 from tcp_pendant.views.dashboard_language import LanguageControl, language_folder
 from tcp_pendant.views.dashboard_replay import ReplayScene
 from tcp_pendant.views.dashboard_words import DashboardWords
-from tcp_pendant.views.dashboard_table import in_progress_html, trainees_html
+from tcp_pendant.views.dashboard_table import in_progress_html, method_name, trainees_html
 from tcp_pendant.views.gui_util import (
     CHART_LEGEND,
     ButtonEvent,
@@ -75,11 +75,15 @@ from tcp_pendant.views.replay_robot import ReplayRobot
 from tcp_pendant.views.replay_touches import NO_TOUCH, pose_replay_touch, set_replay_touches
 from tcp_pendant.views.upload_guard import limit_upload_size
 from tcp_pendant.wizards.session_record import MAX_RECORD_BYTES, SessionRecordError, check_record_size, load_and_replay
+from tcp_pendant.wizards.truth import GRADE_WORDS
 
 log = logging.getLogger(__name__)
 
 __all__ = ["FOLDERS", "DashboardControl", "FULL_WIDTH_PX", "NO_TRAINEE", "ONE_EXERCISE", "REPLAY_PANEL_PX",
            "TrainerDashboard", "build_dashboard", "chart_points", "message_folder", "open_dashboard"]
+
+RUN_STATUS_WORDS = {"in_progress": N_("in progress"), "finished": N_("finished"), "cancelled": N_("cancelled")}
+"""A calibration's status in the gradebook in words (English msgids)."""
 
 FULL_WIDTH_PX = 4000
 """The panel's width asked for: wider than any projector, the browser keeps it to its window."""
@@ -311,25 +315,26 @@ class TrainerDashboard:
         if name is None:
             return
         replay = self.control.replay(name)
-        _ = self.session.translator.gettext
+        tr = self.session.translator
+        _ = tr.gettext
         if replay is None:
             self._say(_("{name} has no calibration with a touch yet.").format(name=name))
             return
-        self.replay_scene.show(replay)
+        self.replay_scene.show(replay, tr=tr)
         self.gui.main_panel.set_width(REPLAY_PANEL_PX)
         self.close_replay.visible = True
         set_replay_touches(self.replay_touch, replay, self.replay_scene.touch_shown)
         err = "" if replay.position_error_mm is None else _(", error {error} mm").format(
             error=f"{replay.position_error_mm:.2f}")
-        grade = "" if replay.grade is None else f", {replay.grade}"
+        grade = "" if replay.grade is None else f", {_(GRADE_WORDS.get(replay.grade, replay.grade))}"
         n = len(replay.touches)
         touches = self.session.translator.ngettext("{n} touch", "{n} touches", n).format(n=n)
         self._say(_("Replay of {name}'s calibration {id} ({method}, {status}): {touches}{error}{grade}. "
                     "The robot as it was at the touch chosen in 'Robot at touch'; triads: the flange at each "
                     "touch; lines: the tool to its tip (blue by hand, orange Auto-touch); frames: result and "
                     "true TOOL frame.").format(name=name, id=replay.calibration_id,
-                                               method=_(replay.method) if replay.method else "-",
-                                               status=replay.status.replace('_', ' '), touches=touches,
+                                               method=method_name(replay.method, tr) if replay.method else "-",
+                                               status=_(RUN_STATUS_WORDS.get(replay.status, replay.status)), touches=touches,
                                                error=err, grade=grade))
 
     def _close_replay(self, _event: ButtonEvent | None = None) -> None:

@@ -17,6 +17,7 @@ import viser
 from scipy.spatial.transform import Rotation
 
 from tcp_pendant.classroom.replay import CalibrationReplay
+from tcp_pendant.translation import ENGLISH, N_, Translator
 from tcp_pendant.views.replay_robot import ReplayRobot
 
 __all__ = ["ReplayScene", "wxyz"]
@@ -32,6 +33,10 @@ def wxyz(R: np.ndarray) -> tuple[float, float, float, float]:
     """viser's quaternion (w, x, y, z) of a rotation matrix."""
     x, y, z, w = Rotation.from_matrix(np.asarray(R, dtype=float)[:3, :3]).as_quat()
     return (float(w), float(x), float(y), float(z))
+
+
+FRAME_WORDS = {"result": N_("result"), "true": N_("true")}
+"""The replay's two TOOL frames' labels (English msgids): the computed one and the true one."""
 
 
 class ReplayScene:
@@ -63,8 +68,9 @@ class ReplayScene:
         if self.robot is not None:
             self.robot.clear()
 
-    def show(self, replay: CalibrationReplay) -> None:
-        """Draw ``replay`` (the previous one removed) and look at its reference tip."""
+    def show(self, replay: CalibrationReplay, *, tr: Translator = ENGLISH) -> None:
+        """Draw ``replay`` (the previous one removed) and look at its reference tip; the frames'
+        labels in ``tr``'s language."""
         self.clear()
         sc = self.scene
         add = self.handles.append
@@ -94,7 +100,8 @@ class ReplayScene:
                 length = RESULT_AXES_M if name == "result" else RESULT_AXES_M * 0.7
                 add(sc.add_frame(f"{ROOT}/{name}", wxyz=wxyz(T), position=tuple(T[:3, 3]), axes_length=length,
                                  axes_radius=length / 30.0))
-                add(sc.add_label(f"{ROOT}/{name}_label", name, position=tuple(T[:3, 3] + T[:3, 0] * length)))
+                add(sc.add_label(f"{ROOT}/{name}_label", tr.gettext(FRAME_WORDS[name]),
+                                 position=tuple(T[:3, 3] + T[:3, 0] * length)))
         self.shown = replay
         if counted:
             self.show_touch(replay.touches.index(counted[-1]))

@@ -21,6 +21,8 @@ from collections.abc import Sequence
 from tcp_pendant.classroom.board import DashboardRow, OpenRun, format_duration
 from tcp_pendant.text_escape import escape_html
 from tcp_pendant.translation import ENGLISH, N_, Translator
+from tcp_pendant.wizards.registry import WIZARD_TYPES
+from tcp_pendant.wizards.truth import GRADE_WORDS
 
 __all__ = ["FONT_PX", "IDLE_BACKGROUND", "STUCK_BACKGROUND", "in_progress_html", "short_step", "trainees_html"]
 
@@ -69,6 +71,13 @@ TRAINEE_HEADERS: tuple[tuple[str, str], ...] = (
 """The live table's headers and their tooltips (English msgids; ``#`` as it is)."""
 
 
+def method_name(method: str, tr: Translator) -> str:
+    """A calibration's method as the board has it (a wizard's English title, or its kind when
+    the title is unknown: ``xyz4``) in ``tr``'s language: the wizard's translated title."""
+    cls = WIZARD_TYPES.get(method)
+    return tr.gettext(cls.title if cls is not None else method)
+
+
 def trainees_html(rows: Sequence[DashboardRow], *, tr: Translator = ENGLISH) -> str:
     """The live table (module docstring) in ``tr``'s language (a method by its translated name);
     every text escaped."""
@@ -87,9 +96,9 @@ def trainees_html(rows: Sequence[DashboardRow], *, tr: Translator = ENGLISH) -> 
         name = ("⚠ " if r.stuck else "◔ " if r.idle else "") + r.name
         step = _("idle") if r.idle and not r.step else short_step(r.step)
         cells = (escape_html(str(r.number)), _cut(name, 11), _ON if r.connected else _OFF,
-                 _cut(_(r.method) if r.method else "-", 10),
+                 _cut(method_name(r.method, tr) if r.method else "-", 10),
                  escape_html(step or "-"), format_duration(r.step_s if r.in_progress else r.quiet_s if r.idle else None),
-                 format_duration(r.touch_s), str(r.touches), str(r.crashes), err, escape_html(r.grade or "-"))
+                 format_duration(r.touch_s), str(r.touches), str(r.crashes), err, escape_html(_(GRADE_WORDS[r.grade]) if r.grade in GRADE_WORDS else r.grade or "-"))
         tds = "".join(f'<td style="{_CELL}">{c}</td>' for c in cells)
         kind = "stuck" if r.stuck else "idle" if r.idle else "trainee"
         body.append(f'<tr class="{kind}" style="{style}">{tds}</tr>')
@@ -111,7 +120,7 @@ def in_progress_html(runs: Sequence[OpenRun], *, tr: Translator = ENGLISH) -> st
     body = []
     for r in runs:
         cells = (str(r.calibration_id), _cut(r.trainee, 11), _ON if r.connected else _OFF,
-                 _cut(_(r.method) if r.method else "-", 10),
+                 _cut(method_name(r.method, tr) if r.method else "-", 10),
                  escape_html(short_step(r.step) or "-"), format_duration(r.step_s), format_duration(r.started_s),
                  str(r.touches))
         style = "" if r.connected else "color:#888"
