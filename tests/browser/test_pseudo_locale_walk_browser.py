@@ -17,8 +17,9 @@ The server-side commands (``session.wizard_commands``) reach the states quickly;
 shows them, and its texts are what is checked.
 
 Exempt (``NAMES``): names that stay untranslated by design (axis, joint and frame names, TCP,
-units, key names, language names, robot and tool names), the trainee's name, numbers and file
-names; and viser's own client chrome (``VISER_CHROME``: its connection badge and canvas buttons,
+units, key names, language names, robot and tool names, the HOME position), the trainee's name,
+numbers and file names, the product's name and the selector's English word "(Language)"
+(``BY_DESIGN``); and viser's own client chrome (``VISER_CHROME``: its connection badge and canvas buttons,
 not the app's texts). Every other word fails the test, listed by state; the list is also written
 to the test's folder (``leftovers.txt``).
 """
@@ -52,6 +53,9 @@ TRAINEE = "Ada Trainee"
 TOOL_NAME = "Walker7"
 """The tool data in slot 1 (user text: stays as typed)."""
 FILE_NAME = re.compile(r"\b[\w.-]+\.(?:json|csv|urdf|xacro|xml|dat|src|mod|tp|ls|jbi|sqlite3|png|txt)\b", re.I)
+BY_DESIGN = re.compile(r"\bTCP Pendant\b|\(Language\)")
+"""The product's name, and the English word the language selector keeps beside its translated
+label ("⟦Ļåñĝûåĝé⟧ (Language)": a trainee shown a language they cannot read finds the way back)."""
 EQUATION_TAG = re.compile(r"\b[A-Z]{2,}-\d+\b")
 """An equation's tag from docs/methods.md ("(ZX-1)", "(BEAM-2)"): a name, as in the docs."""
 MATH_SYMBOL = re.compile(r"[A-Za-z]|[A-Za-z]\d+|sin|cos|tan|R[xyz]")
@@ -59,7 +63,7 @@ MATH_SYMBOL = re.compile(r"[A-Za-z]|[A-Za-z]\d+|sin|cos|tan|R[xyz]")
 number (touch ``P1``, joint ``A6``), a function, KUKA's rotations ``Rz(A) Ry(B) Rx(C)``."""
 NAMES = {
     *"X Y Z A B C".split(), *(f"A{i}" for i in range(1, 7)), *(f"J{i}" for i in range(1, 7)),
-    "WORLD", "BASE", "TOOL", "FLANGE", "TCP", "UTC", "mm", "deg", "rad", "s", "ms",
+    "WORLD", "BASE", "TOOL", "FLANGE", "TCP", "HOME", "UTC", "mm", "deg", "rad", "s", "ms",
     "Shift", "Ctrl", "Esc", "Enter", "Space",                 # key names
     *(w for name in LANGUAGE_NAMES.values() for w in re.findall(r"[A-Za-z]+", name)),
     "KUKA", "KR", "R900", "sixx", "Yaskawa", "GP12", "ABB", "FANUC", "UR",   # robots and vendors
@@ -88,7 +92,8 @@ class Walk:
         for where, text in dict.fromkeys(texts):
             if text in VISER_CHROME:
                 continue
-            words = [w for w in untranslated_words(EQUATION_TAG.sub(" ", FILE_NAME.sub(" ", text)), NAMES)
+            plain = BY_DESIGN.sub(" ", EQUATION_TAG.sub(" ", FILE_NAME.sub(" ", text)))
+            words = [w for w in untranslated_words(plain, NAMES)
                      if not MATH_SYMBOL.fullmatch(w)]
             entry = f"{where}: {' '.join(dict.fromkeys(words))}  <=  {text[:160]!r}"
             if words and entry not in self.seen:
