@@ -73,13 +73,23 @@ def test_german_plural_forms_come_from_the_catalog() -> None:
     assert dropped_presses_text(5) == "5 jog presses dropped: the server was busy"
 
 
-def test_plural_rules_of_the_empty_catalogs_are_the_languages_own() -> None:
-    """Russian has three forms, Japanese and Chinese one: the .po headers say so (so a
-    translator fills the right number of msgstr[n]); untranslated, the English text shows."""
-    for code, n in (("ru", 3), ("ja", 1), ("zh_Hans", 1), ("de", 2), ("hi", 2)):
+def test_plural_rules_are_the_languages_own() -> None:
+    """Russian has three forms (1, 21: one; 2-4: few; 5-20: many), Hindi two (0 and 1 the
+    singular), Japanese and Chinese one: the .po headers say so, and the forms come out by them."""
+    for code, n in (("ru", 3), ("ja", 1), ("zh_Hans", 1), ("de", 2), ("hi", 2), ("es", 3)):
         with (LOCALE_DIR / code / "LC_MESSAGES" / "tcp_pendant.po").open("rb") as f:
             assert read_po(f).num_plurals == n, code
-    assert dropped_presses_text(3, translator("ru")) == "3 jog presses dropped: the server was busy"
+    ru = translator("ru")
+    assert dropped_presses_text(1, ru) == "1 команда перемещения отброшена: сервер был занят"
+    assert dropped_presses_text(3, ru) == "3 команды перемещения отброшены: сервер был занят"
+    assert dropped_presses_text(5, ru) == "5 команд перемещения отброшено: сервер был занят"
+    assert dropped_presses_text(21, ru) == "21 команда перемещения отброшена: сервер был занят"
+    hi = translator("hi")
+    assert dropped_presses_text(1, hi) == "1 जॉग प्रेस छूटा: सर्वर व्यस्त था"
+    assert dropped_presses_text(3, hi) == "3 जॉग प्रेस छूटे: सर्वर व्यस्त था"
+    ja = translator("ja")
+    assert dropped_presses_text(1, ja) == "ジョグ操作 1 回を取りこぼしました：サーバがビジーでした"
+    assert dropped_presses_text(3, ja) == "ジョグ操作 3 回を取りこぼしました：サーバがビジーでした"
 
 
 def test_context_separates_the_continuous_increment() -> None:
