@@ -5,6 +5,8 @@ text of the Jog panel is in the catalogs except names and numbers."""
 
 from __future__ import annotations
 
+import html
+import re
 from collections.abc import Iterator
 from typing import Any
 
@@ -159,5 +161,37 @@ def test_with_the_pseudo_locale_every_text_of_the_jog_panel_is_from_the_catalogs
                             (TouchGeometry(distance_mm=0.0, touching=True, crashed=True, penetration_mm=1.5), True)):
             assert untranslated_words(touch_indicator_markdown(touch, hide_distance=hide, tr=qps), set()) == []
         assert untranslated_words(dropped_presses_text(3, qps), set()) == []
+    finally:
+        c.close()
+
+
+def _hidden_labels(markdown: str) -> dict[str, str]:
+    """The ``data-*`` attributes of the panel's hidden labels div (what the page's script reads)."""
+    (div,) = re.findall(r"<div hidden data-tcp-pendant-labels ([^>]*)></div>", markdown)
+    return {k: html.unescape(v) for k, v in re.findall(r'data-([a-z-]+)="([^"]*)"', div)}
+
+
+def test_in_the_pseudo_locale_the_hidden_labels_name_the_wizards_record_next_finish_and_back(app_factory: Any) -> None:
+    """The R, N and B keys (serve/static/pendant.js) find the wizard's buttons by the labels the
+    panel hands over: in every language they are the labels the Calibration step folder shows,
+    before and after a live switch."""
+    app = app_factory(language=PSEUDO_LANGUAGE)
+    c = DrainingClient(app.port)
+    try:
+        (s,) = _session(app, 1)
+        panel, dock = s.views["pendant"], s.views["dock"]
+        with s.lock:
+            s.wizard_commands.start("xyz4")
+        for language in (PSEUDO_LANGUAGE, "de", "en"):
+            with s.lock:
+                s.set_language(language)
+                labels = _hidden_labels(panel.keys_md.content)
+                assert labels["record"] == dock.record.label
+                assert labels["next"] in dock.nav.options and labels["back"] in dock.nav.options
+                assert labels["finish"] == translator(language).gettext("Finish ▶")
+                if language == PSEUDO_LANGUAGE:
+                    for key in ("record", "next", "finish", "back"):
+                        assert labels[key].startswith("⟦"), (key, labels[key])
+        assert _hidden_labels(panel.keys_md.content)["next"] == "Next ▶"
     finally:
         c.close()

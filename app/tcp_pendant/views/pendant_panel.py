@@ -82,6 +82,7 @@ from tcp_pendant.views.language_selector import LanguageSelector
 from tcp_pendant.views.tip_insets import TipInsets, tip_views_title
 from tcp_pendant.views.touch_list import RECORD_POINT
 from tcp_pendant.views.viser_adapter import queue_markdown
+from tcp_pendant.views.wizard_dock import BACK, FINISH, NEXT, RECORD
 
 if TYPE_CHECKING:
     from tcp_pendant.controller.pose_state import PoseState
@@ -369,14 +370,16 @@ class PendantPanel:
     def _keys_markdown(self) -> str:
         """The keys line and, hidden below it, the labels the page's script looks for in this
         language (``<div hidden data-tcp-pendant-labels data-increment=... data-cont=...
-        data-shadows=... data-keys-line=... data-tip-views=... data-record-point=...>``, attributes escaped): it finds
-        the Increment row, continuous mode, the Shadows checkbox, the keys line, the tip views and
-        "Record point" by them."""
+        data-shadows=... data-keys-line=... data-tip-views=... data-record-point=... data-record=...
+        data-next=... data-finish=... data-back=...>``, attributes escaped): it finds the Increment row,
+        continuous mode, the Shadows checkbox, the keys line, the tip views, "Record point" and the
+        wizard's Record, Next, Finish and Back buttons (keys R, N, B) by them."""
         tr = self.session.translator
         _ = tr.gettext
         labels = {"increment": _("Increment"), "cont": increment_word(CONTINUOUS, tr),
                   "shadows": _(SHADOWS_LABEL), "keys-line": _(KEYS_LINE).split(" ", 1)[0],
-                  "tip-views": tip_views_title(tr), "record-point": _(RECORD_POINT)}
+                  "tip-views": tip_views_title(tr), "record-point": _(RECORD_POINT),
+                  "record": _(RECORD), "next": _(NEXT), "finish": _(FINISH), "back": _(BACK)}
         attrs = " ".join(f'data-{k}="{html.escape(v, quote=True)}"' for k, v in labels.items())
         return f"{_(KEYS_LINE)}\n\n<div hidden data-tcp-pendant-labels {attrs}></div>"
 

@@ -48,7 +48,7 @@ if TYPE_CHECKING:
     from tcp_pendant.calibrate import CalibrationWorkflow
     from tcp_pendant.wizards.base import MeterWizard
 
-__all__ = ["BACK", "CANCEL", "CLOSE", "FINISH", "NEXT", "WizardDock", "tilt_line_html"]
+__all__ = ["BACK", "CANCEL", "CLOSE", "FINISH", "NEXT", "RECORD", "WizardDock", "tilt_line_html"]
 
 _E = TypeVar("_E")
 """The event a dock action's callback takes (viser's, of the widget it is attached to)."""
@@ -58,6 +58,8 @@ log = logging.getLogger(__name__)
 BACK, NEXT, FINISH, CANCEL, CLOSE = N_("◀ Back"), N_("Next ▶"), N_("Finish ▶"), N_("Cancel"), N_("Close")
 """The Step row's buttons (msgids: shown in the session's language; a click is read in any
 language it may come in)."""
+RECORD = N_("Record")
+"""The wizard step's Record button (key R: the page's script finds it by this label)."""
 
 
 TILT_LINE_STYLE = "min-height:4.2em;line-height:1.4em;white-space:normal;font-size:0.875em;padding:0 0.75em"
@@ -103,7 +105,7 @@ class WizardDock:
             self.note_md = gui.add_markdown("", visible=False)
             self.mount = keep(gui.add_button(N_("Mount the tool"), color="orange", visible=False,
                                              hint=N_("The tool change this step asks for (the app swaps the tool).")))
-            self.record = keep(gui.add_button(N_("Record"), color="green",
+            self.record = keep(gui.add_button(RECORD, color="green",
                                               hint=N_("Record this step at the current pose (a touch farther than "
                                                       "0.5 mm asks first, unless the distance is hidden); key R.")))
             self.nav = keep(gui.add_button_group(N_("Step"), (_(BACK), _(NEXT), _(CANCEL)),
