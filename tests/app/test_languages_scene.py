@@ -122,3 +122,20 @@ def test_the_tool_triads_label_and_the_tip_views_caption_in_english_and_the_pseu
     said = tool_label_text(tool, now_on, data_on, tr=qps)
     assert said != f"TOOL T7 · on {now_on.label}" and now_on.label in said
     assert untranslated_words(said, NAMES | {"T7"} | set(now_on.label.split())) == [], said
+
+
+def test_with_the_pseudo_locale_the_touch_lists_empty_line_is_from_the_catalogs(app_factory: Any) -> None:
+    """"No touch recorded" (and, while a wizard has its touches, where they are) in the session's
+    language, and again in English after a switch back."""
+    app = app_factory(language=PSEUDO_LANGUAGE)
+    c = DrainingClient(app.port)
+    try:
+        s = _session(app)
+        qps = translator(PSEUDO_LANGUAGE)
+        view = s.views["touches"]
+        with s.lock:
+            assert view.empty_md.content == qps.gettext("*No touch recorded.*")
+            s.set_language("en")
+            assert view.empty_md.content == "*No touch recorded.*"
+    finally:
+        c.close()

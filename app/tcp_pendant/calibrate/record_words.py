@@ -10,20 +10,24 @@ exercise hides the distance of, near or far, so the words give nothing away.
 
 from __future__ import annotations
 
+from tcp_pendant.translation import ENGLISH, N_, Translator
+
 __all__ = ["EXERCISE_RECORDED", "recorded_words"]
 
-EXERCISE_RECORDED = ("Step {n} recorded as a touch. The distance stays hidden in this exercise, "
-                     "so every Record counts as a touch wherever the tips are: your result shows "
-                     "how close they were.")
+EXERCISE_RECORDED = N_("Step {n} recorded as a touch. The distance stays hidden in this exercise, "
+                       "so every Record counts as a touch wherever the tips are: your result shows "
+                       "how close they were.")
 
 
 def recorded_words(index: int | None, distance_mm: float, *, hidden: bool, in_exercise: bool,
-                   feedback: str) -> str:
+                   feedback: str, tr: Translator = ENGLISH) -> str:
     """The line after Record of step ``index`` (0-based; None: unknown) at ``distance_mm`` (mm)
-    from the reference tip; ``feedback`` is ``touch_feedback``'s words for the touch."""
+    from the reference tip, in ``tr``'s language; ``feedback`` is ``touch_feedback``'s words for
+    the touch (in that language)."""
+    _ = tr.gettext
     n = "?" if index is None else str(index + 1)
     if not hidden:
-        return f"✔ Step {n} recorded, {distance_mm:.2f} mm from the tip."
+        return _("✔ Step {n} recorded, {distance} mm from the tip.").format(n=n, distance=f"{distance_mm:.2f}")
     if in_exercise:
-        return EXERCISE_RECORDED.format(n=n)
-    return f"✔ Step {n} recorded: {feedback}."
+        return _(EXERCISE_RECORDED).format(n=n)
+    return _("✔ Step {n} recorded: {feedback}.").format(n=n, feedback=feedback)

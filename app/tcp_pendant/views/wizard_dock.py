@@ -161,7 +161,7 @@ class WizardDock:
         frame = s.jogger.settings.frame
         delta = tip_offset_mm(state, s.controller.reference_tip_world_m, frame)
         decision = self.check.decide(state.touch.distance_mm, hidden=s.hide_distance, q_rad=state.q_rad,
-                                     where=direction_words(delta, frame))
+                                     where=direction_words(delta, frame), tr=s.translator)
         if not decision.record:
             self._say(decision.message)
             return
@@ -169,7 +169,8 @@ class WizardDock:
         index = None if wiz is None else wiz.step.index
         s.wizard_commands.record_step()
         self._say(recorded_words(index, state.touch.distance_mm, hidden=s.hide_distance,
-                                 in_exercise=s.rules.in_exercise, feedback=touch_feedback(delta, frame)))
+                                 in_exercise=s.rules.in_exercise,
+                                 feedback=touch_feedback(delta, frame, tr=s.translator), tr=s.translator))
 
     async def _on_nav_click(self, event: ButtonGroupEvent) -> None:
         """Back and Cancel as every click; Next / Finish through ``WizardCommands.next_step_in_pool``
@@ -288,14 +289,14 @@ class WizardDock:
         else:
             text = _("Pose diversity: {angle}° from the nearest touch; predicted TCP error {error} mm if "
                      "recorded here ({basis}).").format(angle=f"{angle:.0f}", error=f"{gain.predicted_after:.2f}",
-                                                        basis=meter.basis)
+                                                        basis=meter.basis_words(self.session.translator))
         set_content(self.meter_md, text)              # numbers and our words only
         s = self.session
         others = wiz.other_rotations()
-        advice = self.advisor.advise(others, T_world_flange[:3, :3], s.jogger, meter.sigma_mm)
+        advice = self.advisor.advise(others, T_world_flange[:3, :3], s.jogger, meter.sigma_mm, tr=s.translator)
         reach = ""
         if len(others):
             from_mode = s.jogger.settings.mode.value == "Joint"
             reach = reachable_line(s.jogger.tilts.options(s.jogger.settings.frame),
-                                   frame=s.jogger.settings.frame, joint_mode=from_mode)
+                                   frame=s.jogger.settings.frame, joint_mode=from_mode, tr=s.translator)
         set_content(self.tilt_html, tilt_line_html(None if advice is None else advice.text, reach))

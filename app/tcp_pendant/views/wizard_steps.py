@@ -149,7 +149,7 @@ class WizardStepsView:
             wiz = self.parent.workflow.wizard
             self._record_line = (self._auto_where(),
                                  self.parent.gettext("✔ Step {n} recorded: {feedback}.").format(
-                                     n=index + 1 if index is not None else "?", feedback=touch_feedback(delta, frame)),
+                                     n=index + 1 if index is not None else "?", feedback=touch_feedback(delta, frame, tr=s.translator)),
                                  None if wiz is None else wiz.recorded_poses)
 
     def _on_cancel(self, _event: ButtonEvent) -> None:
@@ -378,10 +378,12 @@ class WizardStepsView:
         value, color = meter_level(gain)
         set_value(self.meter_bar, round(value, 1))
         self.meter_bar.color = color
-        advice = (diversity_advice(wiz.other_rotations(), T_world_flange[:3, :3], gain.angle_to_nearest_deg)
-                  if math.isinf(gain.predicted_after) else None)               # only then shown
         s = self.parent.session
-        tilt = self.advisor.advise(wiz.other_rotations(), T_world_flange[:3, :3], s.jogger, meter.sigma_mm)
+        advice = (diversity_advice(wiz.other_rotations(), T_world_flange[:3, :3], gain.angle_to_nearest_deg,
+                                   tr=s.translator)
+                  if math.isinf(gain.predicted_after) else None)               # only then shown
+        tilt = self.advisor.advise(wiz.other_rotations(), T_world_flange[:3, :3], s.jogger, meter.sigma_mm,
+                                   tr=s.translator)
         set_content(self.meter_md, meter_markdown(gain, None, meter.sigma_mm, advice,
                                                   None if tilt is None else tilt.text, measured=meter.source,
                                                   tr=s.translator))
