@@ -9,6 +9,7 @@ language. In-process server, headless websocket clients as browsers (``guiclick`
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Iterator
 from typing import Any
 
@@ -26,6 +27,7 @@ from tcp_pendant.classroom.exercise_rules import class_rules
 from tcp_pendant.controller import builtin_tools
 from tcp_pendant.controller.scenarios import SCENARIO_KINDS, Scenario, explain
 from tcp_pendant.pendant.tool_entry import ToolEntry, entry_preview_markdown, parse_tool_entry
+from tcp_pendant.job_pool import JobPool
 from tcp_pendant.translation import PSEUDO_LANGUAGE, languages, translator
 from tcpcal.controllers import CONTROLLER_FORMATS
 from tcpcal.formats import FORMATS, text_format
@@ -340,3 +342,24 @@ def test_the_touches_export_speaks_the_pseudo_locale_and_its_csv_is_the_same_in_
         s.set_language("en")
     assert export.button.label == "Export touches (CSV)"
     assert all(data == sent["en"] for data in sent.values()) and sent["en"][1].startswith(b"# tcpcal solve")
+
+
+def test_with_the_pseudo_locale_a_check_refused_by_the_job_pool_is_said_in_the_catalogs_words(page) -> None:
+    """The TCP check while this session's other job runs: the job pool's refusal (its data,
+    worded by ``controller.words.error_text``) in the session's language, not its English text."""
+    p = page(TOOLS, language=PSEUDO_LANGUAGE)
+    s = p.session
+    s.tools.activate(1)
+    gate = threading.Event()
+    s.jobs = pool = JobPool()
+    running = pool.submit(s, lambda: gate.wait(10), what="a beam check")
+    try:
+        p.click(p.tools.check_active)
+        assert p.notes == [(QPS.gettext("Check not started"),
+                            QPS.gettext("{what} is still running here; wait for its result, then try again.").format(
+                                what="A beam check"))]
+        assert untranslated_words(p.notes[0][1], NAMES) == [] and p.tools.last_check is None
+    finally:
+        gate.set()
+    assert running.result(10) is True
+    pool.shutdown()

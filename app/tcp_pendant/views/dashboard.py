@@ -39,6 +39,7 @@ import numpy as np
 import viser
 from viser.uplot import Scale
 
+from tcp_pendant.controller.words import error_text
 from tcp_pendant.classroom.board import DEFAULT_IDLE_MIN, DEFAULT_STUCK_MIN, DashboardRow, dashboard_rows, open_runs
 from tcp_pendant.classroom.dashboard_settings import (
     IDLE_SETTING, MAX_MINUTES, MIN_MINUTES, STUCK_SETTING, keep_minutes, kept_minutes,
@@ -378,7 +379,8 @@ class TrainerDashboard:
             grades = await self.session.loop.run_job(lambda: grade_record(load_and_replay(data), book),
                                                 what="a record's grading")
         except (SessionRecordError, JobRefused) as exc:
-            self.session.notify(self.session.translator.gettext("Record not graded"), f"{name}: {exc}", kind="warning")
+            tr = self.session.translator
+            self.session.notify(tr.gettext("Record not graded"), f"{name}: {error_text(exc, tr)}", kind="warning")
             return
         except Exception as exc:  # never let an upload kill the server
             log.exception("grading the record %r failed", name)

@@ -37,6 +37,7 @@ from typing import Protocol, cast
 
 import viser
 
+from tcp_pendant.controller.words import error_text
 from tcp_pendant.controller import builtin_tools
 from tcp_pendant.pendant import FIELDS, ToolEntry, parse_tool_entry, tool_data_markdown
 from tcp_pendant.pendant.tool_entry import entry_preview_markdown
@@ -415,7 +416,7 @@ class ToolPanel:
         try:
             filename, text = controller_file(tool, slot, str(self.file_fmt.value))
         except (TcpcalError, ValueError) as exc:
-            self.session.notify(self.tr.gettext(CONTROLLER_FILE_REFUSED), str(exc), kind="warning")
+            self.session.notify(self.tr.gettext(CONTROLLER_FILE_REFUSED), error_text(exc, self.tr), kind="warning")
             return
         # to the browser that clicked (in --shared mode the session is every browser's)
         target = event.client or client_of(self.session) or target_of(self.session)
@@ -463,7 +464,7 @@ class ToolPanel:
                 shown = self.check_md.content
                 self.check_md.content = _("Checking {title} ...").format(title=escape_markdown(title))
         except ValueError as exc:
-            s.notify(_("Not done"), str(exc), kind="warning")
+            s.notify(_("Not done"), error_text(exc, self.tr), kind="warning")
             return
         self._checking = True
         try:
@@ -471,7 +472,7 @@ class ToolPanel:
         except JobRefused as exc:      # this session's other job, or a full queue: nothing ran
             with s.lock:
                 self.check_md.content = shown
-            s.notify_refusal(self.tr.gettext("Check not started"), str(exc))
+            s.notify_refusal(self.tr.gettext("Check not started"), error_text(exc, self.tr))
             return
         except Exception as exc:  # a browser's click must never kill the server
             log.exception("TCP check failed")
@@ -536,8 +537,9 @@ class ToolPanel:
         try:
             self.session.tools.store_tool(slot, tool)
         except ValueError as exc:       # e.g. another trainee's slot, a full quota: said here too
-            why = escape_markdown(str(exc))
-            self._entry_said = lambda tr: ({}, tr.gettext("⚠ Not saved: {why}").format(why=why))
+            refused = exc
+            self._entry_said = lambda tr: ({}, tr.gettext("⚠ Not saved: {why}").format(
+                why=escape_markdown(error_text(refused, tr))))
             self._show_entry_outcome()
             raise
         self._entry_said = lambda tr: ({}, tr.gettext("✔ Saved **{name}** in slot {slot}.").format(

@@ -31,6 +31,7 @@ import math
 from collections.abc import Callable, Coroutine
 from typing import TYPE_CHECKING, TypeVar, cast
 
+from tcp_pendant.controller.words import error_text
 from tcp_pendant.calibrate.record_words import recorded_words
 from tcp_pendant.calibrate.tilt_advice import TiltAdvisor, meter_gain
 from tcp_pendant.calibrate.text import meter_level, step_markdown
@@ -185,7 +186,7 @@ class WizardDock:
         try:
             await s.wizard_commands.next_step_in_pool()
         except ValueError as exc:          # the wizard's words, or the pool's (JobRefused)
-            s.notify(s.translator.gettext("Not done"), str(exc), kind="warning")
+            s.notify(s.translator.gettext("Not done"), error_text(exc, s.translator), kind="warning")
         except Exception as exc:           # a browser's click must never kill the server
             log.exception("Next / Finish failed")
             s.notify(s.translator.gettext("Internal error"), f"{type(exc).__name__}: {exc}", kind="error")

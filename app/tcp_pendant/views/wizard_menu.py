@@ -46,6 +46,7 @@ from typing import TypeVar, cast
 
 import viser
 
+from tcp_pendant.controller.words import error_text
 from tcp_pendant.calibrate import CalibrationWorkflow
 from tcp_pendant.calibrate.library_choice import default_library_slot
 from tcp_pendant.calibrate.text import (
@@ -443,7 +444,8 @@ class CalibrateView:
         if not self.session.closed:
             with self.session.lock:
                 set_content(self.record_md, "")
-            self.session.notify(self.gettext(RECORD_REFUSED), f"{name}: {exc}", kind="warning")
+            self.session.notify(self.gettext(RECORD_REFUSED), f"{name}: {error_text(exc, self.session.translator)}",
+                                kind="warning")
 
     def _upload_refused(self, filename: str, size_bytes: int) -> None:
         """``upload_guard``: a transfer above the size limit was dropped as it started."""

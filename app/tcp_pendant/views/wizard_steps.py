@@ -21,6 +21,7 @@ import logging
 import math
 from typing import TYPE_CHECKING, cast
 
+from tcp_pendant.controller.words import error_text
 from tcp_pendant.calibrate import AUTO_SIGMA_MAX_MM, AutoTouchRequest
 from tcp_pendant.calibrate.diversity import diversity_advice
 from tcp_pendant.calibrate.tilt_advice import TiltAdvisor, meter_gain
@@ -189,9 +190,11 @@ class WizardStepsView:
         except Exception as exc:  # a browser's click must never kill the server
             self._checking = False
             if isinstance(exc, JobRefused):            # another job of this session, or a full queue
-                self.parent.session.notify(_("{title}: not started").format(title=shown), str(exc), kind="warning")
+                self.parent.session.notify(_("{title}: not started").format(title=shown),
+                                           error_text(exc, session.translator), kind="warning")
             elif isinstance(exc, ValueError):            # the controller's words (ControllerError)
-                self.parent.session.notify(_("{title}: not possible").format(title=shown), str(exc), kind="error")
+                self.parent.session.notify(_("{title}: not possible").format(title=shown),
+                                           error_text(exc, session.translator), kind="error")
             else:
                 log.exception("%s: controller job failed", title)
                 self.parent.session.notify(_("{title} failed").format(title=shown), f"{type(exc).__name__}: {exc}",
@@ -241,21 +244,21 @@ class WizardStepsView:
         try:                                    # refused at once, before anything moves
             session.loop.admit_job()
         except JobRefused as exc:
-            session.notify_refusal(not_started, str(exc))
+            session.notify_refusal(not_started, error_text(exc, session.translator))
             return
         try:
             request = self.auto_request()
         except ValueError as exc:
-            session.notify(_("Not done"), str(exc), kind="warning")
+            session.notify(_("Not done"), error_text(exc, session.translator), kind="warning")
             return
         self._auto_touching = True
         try:
             await session.wizard_commands.auto_touch_in_pool(request, shown=lambda out: self._show_auto_touch(out, request))
         except JobRefused as exc:
-            session.notify_refusal(not_started, str(exc))
+            session.notify_refusal(not_started, error_text(exc, session.translator))
             return
         except ValueError as exc:               # the wizard's words
-            session.notify_refusal(_("Not done"), str(exc))
+            session.notify_refusal(_("Not done"), error_text(exc, session.translator))
             return
         except Exception as exc:                # a browser's click must never kill the server
             log.exception("Auto-touch failed")
