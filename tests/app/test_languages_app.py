@@ -171,10 +171,12 @@ def _hidden_labels(markdown: str) -> dict[str, str]:
     return {k: html.unescape(v) for k, v in re.findall(r'data-([a-z-]+)="([^"]*)"', div)}
 
 
-def test_in_the_pseudo_locale_the_hidden_labels_name_the_wizards_record_next_finish_and_back(app_factory: Any) -> None:
+def test_in_the_pseudo_locale_the_hidden_labels_name_the_wizards_buttons_and_the_scripts_own_words(
+        app_factory: Any) -> None:
     """The R, N and B keys (serve/static/pendant.js) find the wizard's buttons by the labels the
     panel hands over: in every language they are the labels the Calibration step folder shows,
-    before and after a live switch."""
+    before and after a live switch; the script's own words (the lost-connection notice, its
+    button, the keys' tooltips) come the same way."""
     app = app_factory(language=PSEUDO_LANGUAGE)
     c = DrainingClient(app.port)
     try:
@@ -189,9 +191,14 @@ def test_in_the_pseudo_locale_the_hidden_labels_name_the_wizards_record_next_fin
                 assert labels["record"] == dock.record.label
                 assert labels["next"] in dock.nav.options and labels["back"] in dock.nav.options
                 assert labels["finish"] == translator(language).gettext("Finish ▶")
+                assert labels["key-r"] == translator(language).gettext("Key {key}").format(key="R")
+                assert labels["reload"] == translator(language).gettext("Reload the page")
                 if language == PSEUDO_LANGUAGE:
-                    for key in ("record", "next", "finish", "back"):
+                    for key in ("record", "next", "finish", "back", "lost", "reload", "key-r", "key-n", "key-b"):
                         assert labels[key].startswith("⟦"), (key, labels[key])
-        assert _hidden_labels(panel.keys_md.content)["next"] == "Next ▶"
+        english = _hidden_labels(panel.keys_md.content)
+        assert english["next"] == "Next ▶" and english["key-b"] == "Key B"
+        assert english["lost"] == ("This page cannot reach the pendant server (it is still trying). Your name and "
+                                   "your recorded touches are kept on the server: reload the page to join again.")
     finally:
         c.close()

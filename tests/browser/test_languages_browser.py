@@ -88,7 +88,8 @@ def test_in_the_pseudo_locale_the_tabs_follow_a_live_switch_and_the_record_key_f
 def test_in_the_pseudo_locale_the_r_n_and_b_keys_drive_a_wizard(app_factory, new_page: Callable[..., Any]) -> None:
     """The page's script finds the wizard's Record, Next and Back buttons by the labels the Jog
     panel hands over in the session's language (views/pendant_panel.py's hidden labels): in the
-    pseudo-locale R records step 1, N goes on to step 2, B back to step 1 and N on again."""
+    pseudo-locale R records step 1, N goes on to step 2, B back to step 1 and N on again; the
+    Record button's tooltip names its key in the language too."""
     qps = translator(PSEUDO_LANGUAGE)
     app = app_factory(language=PSEUDO_LANGUAGE)
     page = new_page(app.url, wait_for=qps.gettext("Record point"))
@@ -101,6 +102,9 @@ def test_in_the_pseudo_locale_the_r_n_and_b_keys_drive_a_wizard(app_factory, new
     page.get_by_role("button", name=qps.gettext("Record"), exact=True).first.wait_for(timeout=TIMEOUT_MS)
     wizard = s.workflow.wizard
     assert wizard is not None and wizard.step_index == 0
+    record = page.get_by_role("button", name=qps.gettext("Record"), exact=True).first
+    page.wait_for_function("b => b.getAttribute('title') === " + repr(qps.gettext("Key {key}").format(key="R")),
+                           arg=record.element_handle(), timeout=TIMEOUT_MS)     # its tooltip, in the language too
     page.keyboard.press("r")
     wait_until(lambda: 0 in wizard.recorded_poses, "step 1 recorded by the R key")
     page.keyboard.press("n")
