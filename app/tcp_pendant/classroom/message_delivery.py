@@ -80,8 +80,8 @@ class MessageDelivery:
                 self._gradebook.messages.add(clean, names, to_all=to is None, sent_at=sent)
             except GradebookError as exc:
                 log.error("a message was not kept: %s", exc)
-                raise ValueError("The class gradebook cannot be written now, so the message was not sent; "
-                                 "try again in a moment.") from None
+                raise ValueError(Words(N_("The class gradebook cannot be written now, so the message was not sent; "
+                                          "try again in a moment."))) from None
         self.deliver_kept(self._roster.by_names(names))
         if to is None:
             n = len(names)
