@@ -57,6 +57,7 @@ from typing import TYPE_CHECKING, TypeVar
 import numpy as np
 import viser
 
+from tcp_pendant.controller.tools import shown_tool_label
 from tcp_pendant.controller import JogResult
 from tcp_pendant.controller.words import in_language
 from tcp_pendant.pendant import (
@@ -627,7 +628,7 @@ class PendantPanel:
         tool = s.controller.active_tool
         tr = s.translator
         self._set_md(self.tcp_md, "tcp", tcp_readout_markdown(state.readout(self._readout), None if tool is None
-                                                              else tool.name, s.controller.mounted_tool.label, tr))
+                                                              else tool.name, shown_tool_label(s.controller.mounted_tool.label, tr), tr))
         hide = s.hide_distance
         if bool(self.hide_distance.value) != hide:
             set_value(self.hide_distance, hide)

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from tcp_pendant.controller.tools import shown_tool_label
 from tcp_pendant.controller import RobotKinematics, T_flange_tool_m, VirtualController
 from tcp_pendant.controller.jog import JogSettings
 from tcp_pendant.controller.words import in_language
@@ -104,7 +105,7 @@ def check_markdown(job: CheckJob, result: SpinCheckResult, *, reading: bool = Fa
     _ = tr.gettext
     lines = [_("**TCP check of {title}** at ±{angle}° (mounted: {mounted})").format(
                  title=escape_markdown(job.title), angle=f"{result.angle_deg:g}",
-                 mounted=escape_markdown(job.mounted_label)), "",
+                 mounted=escape_markdown(shown_tool_label(job.mounted_label, tr))), "",
              "| {rotation} | {moved} | |".format(rotation=_("Rotation"),
                                                  moved=_("Tip moved (mm, by eye)") if reading else _("Tip moved (mm)")),
              "|---|---:|---|"]

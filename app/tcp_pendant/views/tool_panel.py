@@ -37,6 +37,7 @@ from typing import Protocol, cast
 
 import viser
 
+from tcp_pendant.controller.tools import shown_tool_label
 from tcp_pendant.controller.words import error_text
 from tcp_pendant.controller import builtin_tools
 from tcp_pendant.pendant import FIELDS, ToolEntry, parse_tool_entry, tool_data_markdown
@@ -337,20 +338,29 @@ class ToolPanel:
         return ""
 
     def _choices(self) -> dict[str, str]:
-        """Mounted tool's choices, label -> key: the built-in tools and the exercise's tool."""
+        """Mounted tool's choices, label in the session's language -> key: the built-in tools and
+        the exercise's tool."""
         held = self.session.tools.exercise_tool
-        return self._tool_key_by_label if held is None else {**self._tool_key_by_label, held.label: held.key}
+        english = self._tool_key_by_label if held is None else {**self._tool_key_by_label, held.label: held.key}
+        return {shown_tool_label(label, self.tr): key for label, key in english.items()}
+
+    def _key_of(self, label: str) -> str | None:
+        """The tool a Mounted tool ``label`` names: in the session's language, or in English (a
+        click that crossed a language switch)."""
+        held = self.session.tools.exercise_tool
+        english = self._tool_key_by_label if held is None else {**self._tool_key_by_label, held.label: held.key}
+        return self._choices().get(label, english.get(label))
 
     def _show_mounted(self) -> None:
         """The mounted tool; in an exercise that holds its tool, the dropdown locked with why."""
         held = self.session.tools.exercise_tool
-        label = self.session.controller.mounted_tool.label
+        label = shown_tool_label(self.session.controller.mounted_tool.label, self.tr)
         options = tuple(self._choices())
         if label in options:
             set_options(self.mounted, options, keep=label)   # its own handler then sees no change
         self.mounted.disabled = held is not None
         set_content(self.mounted_lock_md, "" if held is None else self.tr.gettext(_LOCKED_TEXT).format(
-            tool=escape_markdown(held.label.lower())))
+            tool=escape_markdown(shown_tool_label(held.label, self.tr, in_sentence=True))))
         self.mounted_lock_md.visible = held is not None
 
     def _show_active(self) -> None:
@@ -361,7 +371,7 @@ class ToolPanel:
     def _on_mount(self, event: DropdownEvent) -> None:
         """Mount the tool chosen (``SessionTools.mount_tool``); a refused change (the exercise holds
         its tool) puts the dropdown back on the tool mounted."""
-        key = self._choices().get(str(event.target.value))
+        key = self._key_of(str(event.target.value))
         if key is None:
             self._show_mounted()
             raise ValueError(self.tr.gettext("Unknown tool {name}; choose one of the list.").format(

@@ -31,6 +31,7 @@ import math
 from collections.abc import Callable, Coroutine
 from typing import TYPE_CHECKING, TypeVar, cast
 
+from tcp_pendant.controller.tools import shown_tool_label
 from tcp_pendant.controller.words import error_text
 from tcp_pendant.calibrate.record_words import recorded_words
 from tcp_pendant.calibrate.tilt_advice import TiltAdvisor, meter_gain
@@ -245,7 +246,8 @@ class WizardDock:
         needed = wf.required_tool() if stepping else None
         self.mount.visible = needed is not None
         if needed is not None:
-            self.mount.label = _("Mount the {tool}").format(tool=needed.label.lower())
+            self.mount.label = _("Mount the {tool}").format(
+                tool=shown_tool_label(needed.label, self.session.translator, in_sentence=True))
         self.record.visible = stepping and not wiz.auto_role(wiz.step).by_controller   # a scan: no Record
         self.record.disabled = not wiz.can_record
         # the button keeps its row through the whole XYZ 4-point (disabled until two touches give

@@ -21,6 +21,7 @@ import logging
 import math
 from typing import TYPE_CHECKING, cast
 
+from tcp_pendant.controller.tools import shown_tool_label
 from tcp_pendant.controller.words import error_text
 from tcp_pendant.calibrate import AUTO_SIGMA_MAX_MM, AutoTouchRequest
 from tcp_pendant.calibrate.diversity import diversity_advice
@@ -327,7 +328,8 @@ class WizardStepsView:
             set_content(self.blocked_md, f"⚠ {escape_markdown(reason)}")
         self.mount.visible = needed is not None
         if needed is not None:
-            self.mount.label = _("Mount the {tool}").format(tool=needed.label.lower())
+            self.mount.label = _("Mount the {tool}").format(
+                tool=shown_tool_label(needed.label, self.parent.session.translator, in_sentence=True))
         stepping = not wiz.is_complete           # on the result only Back, Add point and Close remain
         by_controller = stepping and wiz.auto_role(wiz.step).by_controller   # no Record, no Auto-touch
         self.record.visible = stepping and not by_controller
