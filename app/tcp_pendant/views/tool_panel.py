@@ -47,6 +47,7 @@ from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.translation import N_, SOURCE_LANGUAGE, Translator
 from tcp_pendant.controller.spin import DEFAULT_SPIN_ANGLE_DEG, MAX_SPIN_ANGLE_DEG, SpinCheckResult
+from tcp_pendant.views.library_words import recovery_summary
 from tcp_pendant.views.gui_util import (
     ButtonEvent,
     DropdownEvent,
@@ -306,7 +307,7 @@ class ToolPanel:
         for rec in recoveries[self._recoveries_told:]:
             title = (self.tr.gettext("Tool library moved aside") if rec.whole_file
                      else self.tr.gettext("Tool library: bad entries set aside"))
-            self.session.notify(title, rec.summary(), kind="warning")
+            self.session.notify(title, recovery_summary(rec, self.tr), kind="warning")
         self._recoveries_told = len(recoveries)
 
     def _selected(self) -> tuple[int, Tool]:
