@@ -34,6 +34,7 @@ from tcp_pendant.calibrate.text import (
     save_preview_markdown,
     scene_legend_markdown,
 )
+from tcp_pendant.controller import builtin_tools
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.translation import ENGLISH, PSEUDO_LANGUAGE, translator
 from tcp_pendant.views.wizard_dock import WizardDock
@@ -82,12 +83,13 @@ def _foreign(session: object, wiz: Wizard | None) -> set[str]:
             pieces.add(f" {escape_markdown(res.method)} |")      # the method's key in the figures table
             if type(wiz).result_view == "spin_check":          # the TCP check's own words (its module's)
                 pieces.add(tcp_check_markdown(res))  # type: ignore[arg-type]
+    if wiz is not None and wiz.is_complete:                  # the default save name: the tool's label as data
+        pieces.add(session.controller.mounted_tool.label)    # type: ignore[attr-defined]
     wf = session.workflow                                    # type: ignore[attr-defined]
     truth = wf.truth() if wf.result is not None else None
     if truth is not None:
         pieces.add(truth.verdict)
     pieces |= {part for _i, label in wf.resumable() for part in (label, label.rsplit(", ", 1)[0])}
-    pieces |= {session.controller.mounted_tool.label, session.controller.mounted_tool.label.lower()}  # type: ignore[attr-defined]
     return {p for p in pieces if p} | {escape_markdown(p) for p in pieces if p}
 
 
@@ -115,7 +117,7 @@ _OTHERS = {"WizardStepsView.auto_md"}
 def _untranslated(session: object, view: CalibrateView, dock: WizardDock) -> list[tuple[str, list[str]]]:
     wiz = view.workflow.wizard
     foreign = _foreign(session, wiz)
-    names = NAMES | {w for t in view._physical for w in WORD.findall(t)}
+    names = set(NAMES)
     names |= {w for t in view._library.values() for w in WORD.findall(str(t.name))}
     bad = []
     shown = [o for o in (view.steps, view.result, dock) if o.folder.visible]   # a hidden panel: not on screen
@@ -343,3 +345,20 @@ def test_with_the_pseudo_locale_the_docks_record_lines_tilt_line_and_meter_are_f
     for note in notes:
         assert note.count("⟦") >= 1 and english_words(note, NAMES) == [], note
     assert _untranslated(s, v, dock) == []
+
+
+def test_the_physical_tool_choices_are_in_the_sessions_words_and_kept_across_a_switch(page) -> None:
+    """The reference method's physical tools (built-in models' labels) in the pseudo-locale; a
+    choice made there is the same tool after a switch to English, and read as its key."""
+    p = page(language=PSEUDO_LANGUAGE)
+    v, s = p.view, p.session
+    new = v.new_physical
+    assert new is not None
+    labels = {t.key: t.label for t in builtin_tools().values()}
+    assert set(new.options) == {QPS.gettext(label) for label in labels.values()}
+    p.choose(new, QPS.gettext(labels["torch"]))
+    assert v._physical_key(labels["gripper"]) == "gripper"                  # English is read too
+    with s.lock:
+        s.set_language("en")
+    assert new.value == labels["torch"] and set(new.options) == set(labels.values())
+    assert v._physical_key(str(new.value)) == "torch"
