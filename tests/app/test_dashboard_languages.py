@@ -168,8 +168,8 @@ def _dashboard_handles(dash: TrainerDashboard) -> list[tuple[str, object]]:
 def test_with_the_pseudo_locale_every_text_of_the_dashboard_is_from_the_catalogs(app_factory: Any,
                                                                                  tmp_path: Path) -> None:
     """Labels, hints, options, markdown and tables of every handle the dashboard builds (its
-    own folders, the brief's and the message box's; the tool library is its owner's view, and
-    so are the replay's touch choices, ``views.replay_touches``),
+    own folders, the brief's and the message box's, the replay's touch choices; the tool library
+    is its owner's view),
     with two trainees in the table, after a push to all, a push to one and a push of a
     language; names only outside ``⟦ ⟧``: trainee and tool names, language names, units and
     the English word "Language" the selector keeps."""
@@ -193,8 +193,7 @@ def test_with_the_pseudo_locale_every_text_of_the_dashboard_is_from_the_catalogs
         def check(state: str) -> None:
             with trainer.lock:
                 for name, handle in _dashboard_handles(dash):
-                    texts = gui_texts(handle) if name != "replay_touch" else (handle.label, handle.hint or "")
-                    for text in texts:
+                    for text in gui_texts(handle):
                         assert untranslated_words(text, names) == [], (state, name, text)
                 chart = dash.chart
                 for text in (chart.title or "", *(str(s.get("label", "")) for s in chart.series),
@@ -233,6 +232,7 @@ def test_with_the_pseudo_locale_every_text_of_the_dashboard_is_from_the_catalogs
             assert dash.chart.title == "Last position error per trainee (mm)"
             assert "<th" in dash.table_html.content and ">Trainee</th>" in dash.table_html.content
             assert dash.trainee.options[0] == "(choose a trainee) "
+            assert tuple(dash.replay_touch.options) == ("(no replay) ",)
             assert messages.send.label == "Send" and messages.to.options[0] == "(all trainees) "
     finally:
         for c in clients:

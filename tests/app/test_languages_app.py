@@ -5,6 +5,8 @@ text of the Jog panel is in the catalogs except names and numbers."""
 
 from __future__ import annotations
 
+import html
+import re
 from collections.abc import Iterator
 from typing import Any
 
@@ -141,8 +143,7 @@ def test_with_the_pseudo_locale_every_text_of_the_jog_panel_is_from_the_catalogs
         joints = set(s.controller.kinematics.joint_names)
         names = (set("XYZABC") | joints | set(JOG_FRAMES) | {"WORLD", "BASE", "HOME", "mm", "deg", "TOOL",
                  "FLANGE", "TCP", "KR", "Shift", "A5", "Language"}
-                 | {w for n in LANGUAGE_NAMES.values() for w in WORD.findall(n)} | {w for n in (s.controller.mounted_tool.label,)
-                                                          for w in WORD.findall(n or "")})
+                 | {w for n in LANGUAGE_NAMES.values() for w in WORD.findall(n)})
         for mode, increment in (("Cartesian", "10"), ("Joint", "10"), ("Joint", "Cont."), ("Cartesian", "Cont.")):
             with s.lock:
                 s.motion.set_jog_setting("mode", JogMode(mode))
@@ -159,5 +160,44 @@ def test_with_the_pseudo_locale_every_text_of_the_jog_panel_is_from_the_catalogs
                             (TouchGeometry(distance_mm=0.0, touching=True, crashed=True, penetration_mm=1.5), True)):
             assert untranslated_words(touch_indicator_markdown(touch, hide_distance=hide, tr=qps), set()) == []
         assert untranslated_words(dropped_presses_text(3, qps), set()) == []
+    finally:
+        c.close()
+
+
+def _hidden_labels(markdown: str) -> dict[str, str]:
+    """The ``data-*`` attributes of the panel's hidden labels div (what the page's script reads)."""
+    (div,) = re.findall(r"<div hidden data-tcp-pendant-labels ([^>]*)></div>", markdown)
+    return {k: html.unescape(v) for k, v in re.findall(r'data-([a-z-]+)="([^"]*)"', div)}
+
+
+def test_in_the_pseudo_locale_the_hidden_labels_name_the_wizards_buttons_and_the_scripts_own_words(
+        app_factory: Any) -> None:
+    """The R, N and B keys (serve/static/pendant.js) find the wizard's buttons by the labels the
+    panel hands over: in every language they are the labels the Calibration step folder shows,
+    before and after a live switch; the script's own words (the lost-connection notice, its
+    button, the keys' tooltips) come the same way."""
+    app = app_factory(language=PSEUDO_LANGUAGE)
+    c = DrainingClient(app.port)
+    try:
+        (s,) = _session(app, 1)
+        panel, dock = s.views["pendant"], s.views["dock"]
+        with s.lock:
+            s.wizard_commands.start("xyz4")
+        for language in (PSEUDO_LANGUAGE, "de", "en"):
+            with s.lock:
+                s.set_language(language)
+                labels = _hidden_labels(panel.keys_md.content)
+                assert labels["record"] == dock.record.label
+                assert labels["next"] in dock.nav.options and labels["back"] in dock.nav.options
+                assert labels["finish"] == translator(language).gettext("Finish ▶")
+                assert labels["key-r"] == translator(language).gettext("Key {key}").format(key="R")
+                assert labels["reload"] == translator(language).gettext("Reload the page")
+                if language == PSEUDO_LANGUAGE:
+                    for key in ("record", "next", "finish", "back", "lost", "reload", "key-r", "key-n", "key-b"):
+                        assert labels[key].startswith("⟦"), (key, labels[key])
+        english = _hidden_labels(panel.keys_md.content)
+        assert english["next"] == "Next ▶" and english["key-b"] == "Key B"
+        assert english["lost"] == ("This page cannot reach the pendant server (it is still trying). Your name and "
+                                   "your recorded touches are kept on the server: reload the page to join again.")
     finally:
         c.close()

@@ -8,7 +8,7 @@ from typing import Any
 
 import viser
 
-from support.pseudo_text import gui_texts, untranslated_words
+from support.pseudo_text import english_words, gui_texts, untranslated_words
 from support.wsclient import DrainingClient, wait_until
 
 from tcp_pendant.controller.tools import builtin_tools
@@ -120,5 +120,22 @@ def test_the_tool_triads_label_and_the_tip_views_caption_in_english_and_the_pseu
     assert tool_label_text(tool, now_on, data_on) == f"TOOL T7 · on {now_on.label}"
     assert tool_label_text(tool, data_on, data_on, tr=qps) == "TOOL T7"          # a name and a frame
     said = tool_label_text(tool, now_on, data_on, tr=qps)
-    assert said != f"TOOL T7 · on {now_on.label}" and now_on.label in said
-    assert untranslated_words(said, NAMES | {"T7"} | set(now_on.label.split())) == [], said
+    assert said != f"TOOL T7 · on {now_on.label}" and qps.gettext(now_on.label) in said   # the model's label too
+    assert now_on.label not in said and english_words(said, NAMES | {"T7"}) == [], said
+
+
+def test_with_the_pseudo_locale_the_touch_lists_empty_line_is_from_the_catalogs(app_factory: Any) -> None:
+    """"No touch recorded" (and, while a wizard has its touches, where they are) in the session's
+    language, and again in English after a switch back."""
+    app = app_factory(language=PSEUDO_LANGUAGE)
+    c = DrainingClient(app.port)
+    try:
+        s = _session(app)
+        qps = translator(PSEUDO_LANGUAGE)
+        view = s.views["touches"]
+        with s.lock:
+            assert view.empty_md.content == qps.gettext("*No touch recorded.*")
+            s.set_language("en")
+            assert view.empty_md.content == "*No touch recorded.*"
+    finally:
+        c.close()

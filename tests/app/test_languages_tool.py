@@ -9,6 +9,7 @@ language. In-process server, headless websocket clients as browsers (``guiclick`
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Iterator
 from typing import Any
 
@@ -26,6 +27,7 @@ from tcp_pendant.classroom.exercise_rules import class_rules
 from tcp_pendant.controller import builtin_tools
 from tcp_pendant.controller.scenarios import SCENARIO_KINDS, Scenario, explain
 from tcp_pendant.pendant.tool_entry import ToolEntry, entry_preview_markdown, parse_tool_entry
+from tcp_pendant.job_pool import JobPool
 from tcp_pendant.translation import PSEUDO_LANGUAGE, languages, translator
 from tcpcal.controllers import CONTROLLER_FORMATS
 from tcpcal.formats import FORMATS, text_format
@@ -61,10 +63,9 @@ TOOLS = {1: truth_tool("pointer", "Pointer"), 2: truth_tool("pointer", "Skewed",
 NAMES = ({"X", "Y", "Z", "A", "B", "C", "mm", "deg", "TCP", "FLANGE", "RMS", "Pointer", "Skewed", "Mine",
           "numeric", "beam"}
          | {w for f in FORMATS for w in WORD.findall(text_format(f).label)}
-         | {w for f in CONTROLLER_FORMATS.values() for w in WORD.findall(f.label)}
-         | {w for t in builtin_tools().values() for w in WORD.findall(t.label) + WORD.findall(t.label.lower())})
-"""What stays as it is in every language: axis names, units, frame names, tool names (the test's
-and the built-in tools'), controller formats, calibration methods (the tool file's values)."""
+         | {w for f in CONTROLLER_FORMATS.values() for w in WORD.findall(f.label)})
+"""What stays as it is in every language: axis names, units, frame names, tool names (the test's;
+the built-in tool models' labels are translated), controller formats, calibration methods (the tool file's values)."""
 
 
 def _handles(view: object) -> Iterator[tuple[str, object]]:
@@ -340,3 +341,43 @@ def test_the_touches_export_speaks_the_pseudo_locale_and_its_csv_is_the_same_in_
         s.set_language("en")
     assert export.button.label == "Export touches (CSV)"
     assert all(data == sent["en"] for data in sent.values()) and sent["en"][1].startswith(b"# tcpcal solve")
+
+
+def test_with_the_pseudo_locale_a_check_refused_by_the_job_pool_is_said_in_the_catalogs_words(page) -> None:
+    """The TCP check while this session's other job runs: the job pool's refusal (its data,
+    worded by ``controller.words.error_text``) in the session's language, not its English text."""
+    p = page(TOOLS, language=PSEUDO_LANGUAGE)
+    s = p.session
+    s.tools.activate(1)
+    gate = threading.Event()
+    s.jobs = pool = JobPool()
+    running = pool.submit(s, lambda: gate.wait(10), what="a beam check")
+    try:
+        p.click(p.tools.check_active)
+        assert p.notes == [(QPS.gettext("Check not started"),
+                            QPS.gettext("{what} is still running here; wait for its result, then try again.").format(
+                                what="A beam check"))]
+        assert untranslated_words(p.notes[0][1], NAMES) == [] and p.tools.last_check is None
+    finally:
+        gate.set()
+    assert running.result(10) is True
+    pool.shutdown()
+
+
+def test_with_the_pseudo_locale_the_mounted_tool_is_chosen_by_its_translated_label(page) -> None:
+    """The built-in tools' labels are translated in the Mounted tool dropdown (a tool library's
+    saved names are not: data); a choice in the session's words mounts that tool, and a click
+    in English (one that crossed a switch) still does."""
+    p = page(TOOLS, language=PSEUDO_LANGUAGE)
+    s = p.session
+    models = builtin_tools()
+    assert tuple(p.tools.mounted.options) == tuple(QPS.gettext(t.label) for t in models.values())
+    p.choose(p.tools.mounted, QPS.gettext(models["torch"].label))
+    assert s.controller.mounted_tool.key == "torch"
+    assert p.tools.mounted.value == QPS.gettext(models["torch"].label)
+    p.choose(p.tools.mounted, models["pointer"].label)
+    assert s.controller.mounted_tool.key == "pointer"
+    with s.lock:
+        s.set_language("en")
+    assert tuple(p.tools.mounted.options) == tuple(t.label for t in models.values())
+    assert p.tools.mounted.value == "Straight pointer"

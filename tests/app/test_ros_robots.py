@@ -20,6 +20,7 @@ from tcp_pendant.calibrate import AutoTouchRequest
 from tcp_pendant.controller import JogFrame, builtin_tools
 from tcp_pendant.controller.jog import DEFAULT_SETTINGS, smallest_singular_value
 from tcp_pendant.controller.placement import READY_HOVER_M
+from tcp_pendant.translation import PSEUDO_LANGUAGE, translator
 from tcp_pendant.views.meshes import SHAPE_RGB, link_meshes
 
 from support.wsclient import wait_until
@@ -135,6 +136,9 @@ def test_unreachable_reference_tip_is_said_at_start_and_on_the_pendant(app_facto
         assert ("Reference tip out of reach", app.tip_warning) in notifications(client)
     finally:
         client.close()
+    qps = translator(PSEUDO_LANGUAGE)                  # a pendant in another language: its words
+    said = dict(app.start_notices(tr=qps))[qps.gettext("Reference tip out of reach")]
+    assert said == app.tip_warning.text(qps) and said.startswith("⟦") and "out of reach" not in said
     reachable = app_factory(robot="kr6", reference_tip_mm=(525.0, 0.0, 445.0))
     assert reachable.tip_warning is None and reachable.warnings == []
 

@@ -10,6 +10,7 @@ from typing import Any
 
 import pytest
 
+from support.app_page import true_tip_at
 from support.pendant_page import TIMEOUT_MS, assert_not_blank, wait_text, wait_until
 
 from tcp_pendant.translation import PSEUDO_LANGUAGE, translator
@@ -82,3 +83,34 @@ def test_in_the_pseudo_locale_the_tabs_follow_a_live_switch_and_the_record_key_f
     page.get_by_role("button", name="Record point").first.wait_for(timeout=TIMEOUT_MS)
     page.keyboard.press("r")
     wait_until(lambda: len(s.touches) == 2, "a free touch by the R key, in English")
+
+
+def test_in_the_pseudo_locale_the_r_n_and_b_keys_drive_a_wizard(app_factory, new_page: Callable[..., Any]) -> None:
+    """The page's script finds the wizard's Record, Next and Back buttons by the labels the Jog
+    panel hands over in the session's language (views/pendant_panel.py's hidden labels): in the
+    pseudo-locale R records step 1, N goes on to step 2, B back to step 1 and N on again; the
+    Record button's tooltip names its key in the language too."""
+    qps = translator(PSEUDO_LANGUAGE)
+    app = app_factory(language=PSEUDO_LANGUAGE)
+    page = new_page(app.url, wait_for=qps.gettext("Record point"))
+    page.wait_for_function("document.documentElement.dataset.tcpPendantScript === '1'", timeout=TIMEOUT_MS)
+    wait_until(lambda: len(app.sessions) == 1, "the page's session")
+    (s,) = app.sessions.values()
+    with s.lock:
+        s.wizard_commands.start("xyz4")
+    true_tip_at(s, (0.0, 0.0, 0.2))            # touching: Record asks nothing first
+    page.get_by_role("button", name=qps.gettext("Record"), exact=True).first.wait_for(timeout=TIMEOUT_MS)
+    wizard = s.workflow.wizard
+    assert wizard is not None and wizard.step_index == 0
+    record = page.get_by_role("button", name=qps.gettext("Record"), exact=True).first
+    page.wait_for_function("b => b.getAttribute('title') === " + repr(qps.gettext("Key {key}").format(key="R")),
+                           arg=record.element_handle(), timeout=TIMEOUT_MS)     # its tooltip, in the language too
+    page.keyboard.press("r")
+    wait_until(lambda: 0 in wizard.recorded_poses, "step 1 recorded by the R key")
+    page.keyboard.press("n")
+    wait_until(lambda: wizard.step_index == 1, "on to step 2 by the N key")
+    page.keyboard.press("b")
+    wait_until(lambda: wizard.step_index == 0, "back to step 1 by the B key")
+    page.keyboard.press("n")
+    wait_until(lambda: wizard.step_index == 1, "on to step 2 again by the N key")
+    assert sorted(wizard.recorded_poses) == [0]

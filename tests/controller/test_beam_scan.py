@@ -10,6 +10,8 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
+from support.pseudo_text import english_words
+
 from tcpcal import solve_beam, solve_beam_axis
 from tcp_pendant.controller import (
     BeamScanConfig,
@@ -23,6 +25,8 @@ from tcp_pendant.controller import (
     tool_shape,
 )
 from tcp_pendant.controller.approach import solve_ik
+from tcp_pendant.controller.words import in_language
+from tcp_pendant.translation import PSEUDO_LANGUAGE, translator
 from tcp_pendant.controller.beam_scan import scan_arrays_mm
 from tcp_pendant.controller.scenarios import Scenario, draw_kinematic_errors, perturbed_kinematics
 
@@ -242,6 +246,10 @@ def test_an_unreachable_orientation_is_skipped_with_words():
     assert all("skipped" in s and "out of reach" in s and "tried tilts of" in s for s in scan.skipped)
     assert scan.skipped[0].startswith("Orientation 3 (turned 180 deg about the tool axis) was skipped: ")
     assert scan.skipped[1].startswith("Orientation 4 (turned 270 deg about the tool axis) was skipped: ")
+    qps = translator(PSEUDO_LANGUAGE)                    # said again in the reader's language
+    for why in scan.skipped:
+        said = in_language(why, qps)
+        assert said.startswith("⟦") and english_words(said, {"TCP", "mm", "deg"}) == [], said
     assert set(scan.orientation_index) == {0, 1} and scan.n_orientations_done == 2
     # the skipped orientations left no moves or events behind; the motion stays continuous
     assert {mv.orientation for mv in scan.moves} == {0, 1}

@@ -10,6 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from support.pseudo_text import english_words
+
 from tcp_pendant.controller import JogFrame, RobotKinematics, VirtualController, builtin_tools
 from tcp_pendant.controller.jog import DEFAULT_SETTINGS, JogSettings, smallest_singular_value
 from tcp_pendant.controller.placement import (
@@ -19,6 +21,7 @@ from tcp_pendant.controller.placement import (
     XYZ4_DIRECTIONS,
     unreachable_directions,
 )
+from tcp_pendant.translation import PSEUDO_LANGUAGE, translator
 from tcp_pendant.serve.server import default_reference_tip_mm, ready_configuration, tip_reach_warning
 
 from support.ros_layouts import acme7_workspace, kr16_2_urdf
@@ -80,6 +83,9 @@ def test_all_zero_kr16_would_have_been_out_of_reach(tmp_path: Path) -> None:
     assert failed is not None and int(failed.group(1)) >= 4, text
     default = ",".join(f"{v:.0f}" for v in default_reference_tip_mm(kin, POINTER))
     assert text.endswith(f"--reference-tip {default} (this robot's default).")
+    said = text.text(translator(PSEUDO_LANGUAGE))                    # every pendant's notice, in its language
+    assert said.startswith("⟦") and english_words(said, {"kuka", "kr16", "straight", "pointer"}) == [], said
+    assert default in said and "(1768, 0, 320)" in said
     assert tip_reach_warning(kin, np.asarray(default_reference_tip_mm(kin, POINTER)) / 1000, POINTER,
                              "kuka_kr16_2", "Straight pointer") is None
 

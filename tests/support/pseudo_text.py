@@ -11,7 +11,7 @@ from collections.abc import Iterator
 
 import viser
 
-__all__ = ["WORD", "gui_texts", "untranslated_words"]
+__all__ = ["WORD", "english_words", "gui_texts", "untranslated_words"]
 
 PSEUDO_SPAN = re.compile(r"⟦[^⟦⟧]*⟧")
 CODE_SPAN = re.compile(r"`[^`]*`|```.*?```", re.S)
@@ -24,6 +24,14 @@ def untranslated_words(text: str, names: set[str]) -> list[str]:
     (the readouts' fixed tables and key names) and HTML tags (hidden markup, not shown) that
     are not ``names``."""
     rest = CODE_SPAN.sub(" ", PSEUDO_SPAN.sub(" ", TAG.sub(" ", text)))
+    return [w for w in WORD.findall(rest) if w not in names]
+
+
+def english_words(text: str, names: set[str]) -> list[str]:
+    """The ASCII words of ``text`` inside the pseudo-locale's spans too (a placeholder's value
+    left in English: ``⟦Ŕéçöŕðéð: your touches⟧``), outside code blocks and HTML tags, that are
+    not ``names``: the pseudo-locale accents every letter of a translated message."""
+    rest = CODE_SPAN.sub(" ", TAG.sub(" ", text)).replace("⟦", " ").replace("⟧", " ")
     return [w for w in WORD.findall(rest) if w not in names]
 
 

@@ -23,6 +23,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from tcp_pendant.controller.words import in_language
 from tcp_pendant.controller import RobotKinematics, T_flange_tool_m, VirtualController
 from tcp_pendant.controller.beam import BeamSensor, ToolShape
 from tcp_pendant.controller.beam_scan import BeamScan, BeamScanConfig, run_beam_scan, scan_arrays_mm, tool_shape
@@ -193,7 +194,7 @@ def evaluate_check(tool: Tool, slot: int | None, scan: BeamScan, seed: int = 0, 
                         "The beam check found too few tip events for a TCP: {n} of {count} orientations could "
                         "be scanned, at least 2 are needed.",
                         scan.n_orientations_planned).format(n=len(ti), count=scan.n_orientations_planned),
-            *scan.skipped,
+            *(in_language(why, tr) for why in scan.skipped),
             tr.gettext("Place the beam sensor where the robot reaches it with the tool turned about its own axis "
                        "(nearer the robot, or lower), or start from another pose."))))
     try:
@@ -323,7 +324,7 @@ def beam_check_markdown(check: BeamCheck, *, tr: Translator = ENGLISH) -> str:
         tips=len(s.tip_indices), axes=len(s.axis_indices), n=s.n_orientations_done, seconds=f"{s.duration_s:.1f}",
         path=f"{s.path_length_m * 1000.0:.0f}"))
     for reason in s.skipped:
-        lines.append(f"- {escape_markdown(reason)}")
+        lines.append(f"- {escape_markdown(in_language(reason, tr))}")
     verdict = check.verdict if tr.language == ENGLISH.language else beam_verdict(check, tr=tr)
     lines += ["", ("✔ " if check.good else "⚠ ") + escape_markdown(verdict)]
     return "\n".join(lines)

@@ -215,12 +215,12 @@ def meter_markdown(gain: CandidateGain, quality: PoseQuality | None, sigma_mm: f
     ``advice_before_determinable`` (``tcp_pendant.calibrate.diversity``: the angle to the
     nearest touch and the axis still missing, in words) or else ``quality.message`` (tcpcal's).
     ``tilt_hint`` (``tilt_advice.TiltAdvice.text``: which way to tilt for the next touch) ends it.
-    ``measured``: whose scatter ``sigma_mm`` is ("your touches", "your last calibration"; ""
+    ``measured``: whose scatter ``sigma_mm`` is (msgids "your touches", "your last calibration"; ""
     assumed)."""
     _ = tr.gettext
     if measured:
         head = _("**Pose diversity** (if you recorded here, {whose}: scatter {sigma} mm):").format(
-            whose=measured, sigma=fmt_num(sigma_mm, 2))
+            whose=_(measured), sigma=fmt_num(sigma_mm, 2))
     else:
         head = _("**Pose diversity** (if you recorded here, operator error {sigma} mm):").format(
             sigma=fmt_num(sigma_mm, 1))

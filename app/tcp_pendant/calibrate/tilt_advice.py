@@ -42,7 +42,7 @@ from tcpcal.pose_quality import CandidateGain, candidate_gain
 from tcp_pendant.calibrate.diversity import MIN_TILT_DEG, least_observed
 from tcp_pendant.pendant.jogging import JOG_FRAMES, Jogger, JogMode
 from tcp_pendant.pendant.tilts import TILT_DEG, TiltOption, key_label, keyboard_key
-from tcp_pendant.translation import ENGLISH, Translator
+from tcp_pendant.translation import ENGLISH, N_, Translator
 
 __all__ = ["MIN_MEASURED_SIGMA_MM", "MeterGain", "TiltAdvice", "TiltAdvisor", "meter_gain", "measured_sigma_mm"]
 
@@ -116,9 +116,9 @@ def meter_gain(wizard: Any, R_world_flange: np.ndarray, earlier: Sequence[Any] =
     """``candidate_gain`` of the wizard's other touches and ``R_world_flange`` for the trainee's
     measured scatter (this run's touches, else the last finished calibration among ``earlier``
     wizards of the session), else the wizard's assumed error (as ``wizard.preview``)."""
-    sigma, source = measured_sigma_mm(wizard), "your touches"
+    sigma, source = measured_sigma_mm(wizard), N_("your touches")
     if sigma is None:
-        sigma, source = _last_scatter([w for w in earlier if w is not wizard]), "your last calibration"
+        sigma, source = _last_scatter([w for w in earlier if w is not wizard]), N_("your last calibration")
     measured = sigma is not None
     sigma_mm = float(wizard.assumed_sigma_mm) if sigma is None else sigma
     gain = candidate_gain(wizard.other_rotations(), np.asarray(R_world_flange, dtype=float), sigma=sigma_mm)

@@ -14,6 +14,9 @@ escaped where it is shown.
 
 from __future__ import annotations
 
+from tcp_pendant.controller.words import Words
+from tcp_pendant.translation import N_
+
 __all__ = ["MAX_MESSAGE_CHARS", "clean_message_text"]
 
 MAX_MESSAGE_CHARS = 1000
@@ -28,11 +31,12 @@ def clean_message_text(text: object) -> str:
         ValueError: not text, empty, or longer than :data:`MAX_MESSAGE_CHARS` (says how long).
     """
     if not isinstance(text, str):
-        raise ValueError(f"A message must be text, got {type(text).__name__}.")
+        raise ValueError(Words(N_("A message must be text, got {kind}."), kind=type(text).__name__))
     text = text.replace("\r\n", "\n").replace("\r", "\n")
     text = "".join(ch for ch in text if ch in "\n\t" or ch.isprintable()).strip()
     if not text:
-        raise ValueError("The message is empty: type what the trainees should read, then Send.")
+        raise ValueError(Words(N_("The message is empty: type what the trainees should read, then Send.")))
     if len(text) > MAX_MESSAGE_CHARS:
-        raise ValueError(f"The message is {len(text)} characters long; shorten it to at most {MAX_MESSAGE_CHARS}.")
+        raise ValueError(Words(N_("The message is {n} characters long; shorten it to at most {most}."),
+                               n=str(len(text)), most=str(MAX_MESSAGE_CHARS)))
     return text

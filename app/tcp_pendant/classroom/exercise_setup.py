@@ -17,6 +17,8 @@ from tcp_pendant.classroom.class_settings import ClassSettings
 from tcp_pendant.classroom.exercise_rules import DistanceAids, class_rules, clean_instructions, clean_min_touches
 from tcp_pendant.calibrate.pendant_rules import ExerciseRules
 from tcp_pendant.wizards import WIZARD_TYPES, wizard_classes
+from tcp_pendant.controller.words import Words
+from tcp_pendant.translation import N_
 
 __all__ = ["EXERCISE_IDS", "PUSHED_SETTING", "ExerciseSetup", "check_exercise", "clean_methods"]
 
@@ -125,7 +127,8 @@ class ExerciseSetup:
         """
         check_exercise(exercise)
         if tool_key is not None and tool_key not in self._tool_keys:
-            raise ValueError(f"Unknown tool {tool_key!r}; use one of {', '.join(self._tool_keys)}.")
+            raise ValueError(Words(N_("Unknown tool {tool}; use one of {tools}."), tool=repr(tool_key),
+                                   tools=", ".join(self._tool_keys)))
         named = {True: "hidden", False: "shown"}[hide_distance] if isinstance(hide_distance, bool) else hide_distance
         class_rules(exercise, named, auto_touch)        # type: ignore[arg-type]  # ValueError: unknown aids
         aids = cast("DistanceAids | None", named)

@@ -20,7 +20,8 @@ from tcp_pendant.classroom.gradebook import Gradebook
 from tcp_pendant.classroom.gradebook_store import GradebookError
 from tcp_pendant.classroom.roster import Roster, Seat
 from tcp_pendant.session import ClassMessage, Session
-from tcp_pendant.translation import ENGLISH, Translator
+from tcp_pendant.controller.words import Words
+from tcp_pendant.translation import ENGLISH, N_, Translator
 
 __all__ = ["MessageDelivery"]
 
@@ -68,9 +69,10 @@ class MessageDelivery:
         """
         clean = clean_message_text(text)
         if to is not None and not isinstance(to, str):
-            raise ValueError("Choose whom to send the message to.")
+            raise ValueError(Words(N_("Choose whom to send the message to.")))
         if to is not None and to not in connected and to not in self._gradebook.trainees.names():
-            raise ValueError(f"{to:.60} is not in the class; choose a trainee in the list, or all trainees.")
+            raise ValueError(Words(N_("{name} is not in the class; choose a trainee in the list, or all trainees."),
+                                   name=f"{to:.60}"))
         names = connected if to is None else [to]
         sent = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
         if names:
@@ -78,8 +80,8 @@ class MessageDelivery:
                 self._gradebook.messages.add(clean, names, to_all=to is None, sent_at=sent)
             except GradebookError as exc:
                 log.error("a message was not kept: %s", exc)
-                raise ValueError("The class gradebook cannot be written now, so the message was not sent; "
-                                 "try again in a moment.") from None
+                raise ValueError(Words(N_("The class gradebook cannot be written now, so the message was not sent; "
+                                          "try again in a moment."))) from None
         self.deliver_kept(self._roster.by_names(names))
         if to is None:
             n = len(names)

@@ -16,6 +16,8 @@ import secrets
 from tcp_pendant.classroom.gradebook import Gradebook
 from tcp_pendant.classroom.gradebook_store import GradebookError
 from tcp_pendant.classroom.trainer_token import FORGET_S, lock_s, locked, log_failure, validate_trainer_token
+from tcp_pendant.controller.words import Words
+from tcp_pendant.translation import N_
 
 __all__ = ["TOKEN_SETTING", "TrainerLogin"]
 
@@ -70,8 +72,8 @@ class TrainerLogin:
             wait, count, counted = failures.try_token(source, now=now, forget_s=FORGET_S, lock_s=lock_s)
         except GradebookError as exc:
             log.error("a trainer token was not tried: %s", exc)
-            raise ValueError("The class gradebook cannot be read now, so no trainer token is tried; "
-                             "try again in a moment.") from None
+            raise ValueError(Words(N_("The class gradebook cannot be read now, so no trainer token is tried; "
+                                      "try again in a moment."))) from None
         if not counted:
             raise locked(wait)
         if not secrets.compare_digest(_token_digest(token), self._sha256):

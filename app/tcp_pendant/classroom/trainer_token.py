@@ -26,6 +26,9 @@ import os
 from collections.abc import Mapping
 from pathlib import Path
 
+from tcp_pendant.controller.words import Words
+from tcp_pendant.translation import N_
+
 __all__ = ["FORGET_S", "FREE_TRIES", "MAX_LOCK_S", "MAX_TOKEN_CHARS", "MIN_TOKEN_CHARS", "TOKEN_ENV",
            "TrainerTokenError", "TrainerTokenLocked", "lock_s", "locked", "log_failure", "resolve_trainer_token",
            "validate_trainer_token"]
@@ -100,8 +103,8 @@ def lock_s(failures: int) -> float:
 
 def locked(wait_s: float) -> TrainerTokenLocked:
     """The refusal of a try ``wait_s`` seconds before the lock ends (the trainee's words)."""
-    return TrainerTokenLocked(f"Too many wrong trainer tokens from this browser: try again in "
-                              f"{max(1, round(wait_s))} s.")
+    return TrainerTokenLocked(Words(N_("Too many wrong trainer tokens from this browser: try again in {seconds} s."),
+                                    seconds=str(max(1, round(wait_s)))))
 
 
 def log_failure(who: str, failures: int, typed: str) -> None:

@@ -101,6 +101,8 @@ from tcp_pendant.controller.beam import (
 from tcp_pendant.controller.errors import ControllerError
 from tcp_pendant.controller.kinematics import RobotKinematics
 from tcp_pendant.controller.tools import ToolModel
+from tcp_pendant.controller.words import Words
+from tcp_pendant.translation import N_, Translator
 
 __all__ = [
     "BEAM_TOOL_SHAPES",
@@ -453,7 +455,7 @@ class _Skip(Exception):
     """An orientation cannot be run (message in plain words); ``reach``: a pose out of reach,
     which another tilt or turn may avoid."""
 
-    def __init__(self, message: str, *, reach: bool = False) -> None:
+    def __init__(self, message: Words, *, reach: bool = False) -> None:
         super().__init__(message)
         self.reach = reach
 
@@ -479,13 +481,13 @@ class _Planner:
     def ik(self, T_target: np.ndarray, what: str) -> np.ndarray:
         sol = solve_ik(self.kin, T_target, self.q)
         p = (T_target[:3, :3] @ self.T_ft_plan[:3, 3] + T_target[:3, 3]) * 1000.0
-        where = f"TCP at {p[0]:.0f}, {p[1]:.0f}, {p[2]:.0f} mm"
+        where = Words(N_("TCP at {x}, {y}, {z} mm"), x=f"{p[0]:.0f}", y=f"{p[1]:.0f}", z=f"{p[2]:.0f}")
         if not sol.ok:
-            raise _Skip(f"{what} is out of reach ({where}: no configuration within the joint "
-                        "limits gets there)", reach=True)
+            raise _Skip(Words(N_("{what} is out of reach ({where}: no configuration within the joint "
+                                 "limits gets there)"), what=Words(what), where=where), reach=True)
         if self.moves and float(np.abs(sol.q_rad[:3] - self.q[:3]).max()) > math.radians(MAX_ARM_SWING_DEG):
-            raise _Skip(f"{what} is out of reach without swinging the arm into another "
-                        f"configuration ({where})", reach=True)
+            raise _Skip(Words(N_("{what} is out of reach without swinging the arm into another "
+                                 "configuration ({where})"), what=Words(what), where=where), reach=True)
         return sol.q_rad
 
     def tcp(self, T: np.ndarray) -> np.ndarray:
@@ -575,7 +577,8 @@ class _Planner:
         """IK of a straight pass / approach end; refuses a configuration flip on the way."""
         q_end = self.ik(T_end, what)
         if float(np.abs(q_end - self.q).max()) > math.radians(MAX_JOINT_STEP_DEG):
-            raise _Skip(f"{what} would flip the arm's configuration on the way", reach=True)
+            raise _Skip(Words(N_("{what} would flip the arm's configuration on the way"), what=Words(what)),
+                        reach=True)
         return q_end
 
 
@@ -645,8 +648,8 @@ def _scan_orientation(P: _Planner, k: int, spin: float, tilt: float, F: _ScanFra
         return _pose(R_tool, tip) @ F.T_ft_inv
 
     lift = F.clear + F.h2  # above everything of the beam device the tool may meet
-    P.move_to(flange(b - F.W * F.a - lift * x_w), k, "The pose above the beam")
-    P.move_to(flange(b + F.h1 * x_w - F.W * F.a), k, "The start of the first pass")
+    P.move_to(flange(b - F.W * F.a - lift * x_w), k, N_("The pose above the beam"))
+    P.move_to(flange(b + F.h1 * x_w - F.W * F.a), k, N_("The start of the first pass"))
     f_axis, f_second = _passes(P, k, flange, x_w, F)
     # the line of flange positions that keeps the tool axis on the beam:
     # f(h) = f1 + (h - h1) / (h2 - h1) (f2 - f1)
@@ -654,17 +657,17 @@ def _scan_orientation(P: _Planner, k: int, spin: float, tilt: float, F: _ScanFra
     g = (f2 - f1) / (F.h2 - F.h1)  # flange motion per unit of forward travel
     glen = float(np.linalg.norm(g))
     if glen < 0.5:
-        raise _Skip("the passes put the tool axis along the beam")
+        raise _Skip(Words(N_("the passes put the tool axis along the beam")))
     m = g / glen
     f_start = f1 + (-F.clear - F.h1) * g
     if len(f_second) == 2:
         f_start, m = _aim_at_crossing(f1, f2, f_second[0], f_second[1], sensor, f_start, m)
     # retract beside the beam, then over to the approach start
-    P.move_to(flange(b - F.W * F.a - F.clear * x_w), k, "The retract after the passes")
+    P.move_to(flange(b - F.W * F.a - F.clear * x_w), k, N_("The retract after the passes"))
     T_start = P.T.copy()
     T_start[:3, 3] = f_start
     T_start[:3, :3] = R_tool @ F.T_ft_inv[:3, :3]
-    P.move_to(T_start, k, "The approach start")
+    P.move_to(T_start, k, N_("The approach start"))
     _approach(P, k, T_start, m, max_travel=2.0 * F.clear * glen)
 
 
@@ -679,26 +682,29 @@ def _passes(P: _Planner, k: int, flange: Callable[[np.ndarray], np.ndarray], x_w
     f_second: list[np.ndarray] = []  # the second beam's axis events (crossed beams)
     for j, (h, sgn) in enumerate(((F.h1, 1.0), (F.h2, -1.0))):
         if j == 1:
-            P.move_to(flange(b + h * x_w + W * a), k, "The start of the second pass")
+            P.move_to(flange(b + h * x_w + W * a), k, N_("The start of the second pass"))
         m = sgn * a
         T0 = P.T.copy()
         T_end = T0.copy()
         T_end[:3, 3] += 2.0 * W * m
-        q_end = P.straight("pass", T_end, k, f"The {'first' if j == 0 else 'second'} pass")
+        q_end = P.straight("pass", T_end, k, N_("The first pass") if j == 0 else N_("The second pass"))
         try:
             found = crossing_events(*P.physical_line(P.q, T0, m, 0.0), sensor, shape, max_travel=2.0 * W)
             found = tuple(P.refine(ev, P.q, T0, m, _same_beam(ev.beam, crossing_events, sensor, shape, 2.0 * W))
                           for ev in found)
         except ControllerError as exc:
-            raise _Skip(f"the {'first' if j == 0 else 'second'} pass did not "
-                        f"cross the beam cleanly ({exc})") from None
+            raise _Skip(Words(N_("the first pass did not cross the beam cleanly ({why})") if j == 0 else
+                              N_("the second pass did not cross the beam cleanly ({why})"), why=_said(exc))) from None
         mine = [ev for ev in found if ev.beam == 0]
         found = tuple(ev for ev in found if ev.on_shaft)  # a crossing beyond the shaft is no axis event
         if not mine or not mine[0].on_shaft:
-            raise _Skip(f"the {'first' if j == 0 else 'second'} pass "
-                        + ("did not break the beam: the tool data is too far off for a "
-                           "pass margin of " f"{c.pass_margin_mm:g} mm" if not mine else
-                           "crossed the beam beyond the tool's shaft"))
+            raise _Skip(Words((N_("the first pass did not break the beam: the tool data is too far off for a "
+                                  "pass margin of {margin} mm") if j == 0 else
+                               N_("the second pass did not break the beam: the tool data is too far off for a "
+                                  "pass margin of {margin} mm")) if not mine else
+                              (N_("the first pass crossed the beam beyond the tool's shaft") if j == 0 else
+                               N_("the second pass crossed the beam beyond the tool's shaft")),
+                              margin=f"{c.pass_margin_mm:g}"))
         idx = tuple(P.record(ev, T0, m, k) for ev in found)
         for i in idx:
             (f_axis if P.events[i].beam == 0 else f_second).append(P.events[i].T_world_flange[:3, 3].copy())
@@ -715,10 +721,10 @@ def _approach(P: _Planner, k: int, T_start: np.ndarray, m: np.ndarray, *, max_tr
         if ev is not None:
             ev = P.refine(ev, P.q, T_start, m, _same_beam(ev.beam, tip_on_beam, sensor, shape, max_travel))
     except ControllerError as exc:
-        raise _Skip(f"the approach could not start clear of the beam ({exc})") from None
+        raise _Skip(Words(N_("the approach could not start clear of the beam ({why})"), why=_said(exc))) from None
     if ev is None:
-        raise _Skip(f"the tip did not reach the beam on the approach: the tool "
-                    f"data is more than {c.clearance_mm:g} mm off along the tool axis")
+        raise _Skip(Words(N_("the tip did not reach the beam on the approach: the tool "
+                             "data is more than {clearance} mm off along the tool axis"), clearance=f"{c.clearance_mm:g}"))
     tips = [ev]
     if sensor.second_direction is not None:
         # crossed beams: the tip aimed at the crossing point breaks the other beam too; the
@@ -737,13 +743,31 @@ def _approach(P: _Planner, k: int, T_start: np.ndarray, m: np.ndarray, *, max_tr
     T_ev = T_start.copy()
     travel = max(e.travel for e in tips)  # the robot stops when the last beam broke
     T_ev[:3, 3] += travel * m
-    q_ev = P.straight("approach", T_ev, k, "The approach")
+    q_ev = P.straight("approach", T_ev, k, N_("The approach"))
     idx = tuple(P.record(e, T_start, m, k) for e in sorted(tips, key=lambda e: e.travel))
     P.add_move("approach", T_ev, q_ev, k, length=travel, events=idx)
-    P.move_to(T_start, k, "The retract after the approach")
+    P.move_to(T_start, k, N_("The retract after the approach"))
 
 
-def _scan_or_skip(P: _Planner, k: int, F: _ScanFrame) -> str | None:
+_NOTHING = Words.by(lambda tr: "")
+"""No words (an empty msgid would say the catalog's header)."""
+
+
+def _said(exc: BaseException) -> str:
+    """An exception's words, :class:`Words` kept (said again in the reader's language)."""
+    return exc.args[0] if len(exc.args) == 1 and isinstance(exc.args[0], Words) else str(exc)
+
+
+def _lower_first(words: Words) -> Words:
+    """``words`` starting in lower case inside a sentence, as English writes it; a translation
+    as its translator wrote it."""
+    def say(tr: Translator) -> str:
+        said = words.text(tr)
+        return said[:1].lower() + said[1:] if said == str(words) else said
+    return Words.by(say)
+
+
+def _scan_or_skip(P: _Planner, k: int, F: _ScanFrame) -> Words | None:
     """Scan orientation ``k``: None when done, else why it was skipped (a sentence); the moves
     and events of a try that failed are dropped. The tilt about the beam observes nothing
     (module docstring) and the turns only need to differ: when a pose of this orientation is
@@ -752,12 +776,11 @@ def _scan_or_skip(P: _Planner, k: int, F: _ScanFrame) -> str | None:
     c, n = P.config, P.config.n_orientations
     spin = 360.0 * k / n
     sign = 1.0 if k % 2 == 0 else -1.0
-    label = f"orientation {k + 1} (turned {spin:.0f} deg about the tool axis)"
     tilts = (sign * c.tilt_deg, -sign * c.tilt_deg, 0.0) if c.tilt_deg > 0.0 else (0.0,)
     step = 120.0 / n
     tries = [(tilt, spin) for tilt in tilts] + [(0.0, spin + step), (0.0, spin - step)]
     saved = (P.q.copy(), P.T.copy(), len(P.moves), len(P.events))
-    first_reason = ""
+    first_reason = _NOTHING
     for tilt, turn in tries:
         try:
             _scan_orientation(P, k, turn, tilt, F)
@@ -767,14 +790,16 @@ def _scan_or_skip(P: _Planner, k: int, F: _ScanFrame) -> str | None:
             del P.moves[saved[2]:]
             del P.events[saved[3]:], P.points[saved[3]:], P.orient[saved[3]:]
             if not exc.reach:  # the tool data or the beam: another pose does not help
-                first_reason = str(exc)
+                first_reason = exc.args[0]
                 break
-            first_reason = first_reason or str(exc)
+            first_reason = first_reason or exc.args[0]
     tried = ", ".join(f"{t:+.0f}" for t in tilts)
-    more = (f" (tried tilts of {tried} deg about the beam and turns of {spin - step:.0f} and "
-            f"{spin + step:.0f} deg)") if "out of reach" in first_reason else ""
-    return (f"{label[0].upper()}{label[1:]} was skipped: {first_reason[0].lower()}"
-            f"{first_reason[1:]}{more}.")
+    more = Words.by(lambda tr: " " + tr.gettext("(tried tilts of {tilts} deg about the beam and turns of {turn_a} and "
+                                                "{turn_b} deg)").format(tilts=tried, turn_a=f"{spin - step:.0f}",
+                                                                        turn_b=f"{spin + step:.0f}")
+                    ) if "out of reach" in first_reason else _NOTHING
+    return Words(N_("Orientation {n} (turned {spin} deg about the tool axis) was skipped: {reason}{more}."),
+                 n=str(k + 1), spin=f"{spin:.0f}", reason=_lower_first(first_reason), more=more)
 
 
 def _checked_scan(kinematics: RobotKinematics, q_start_rad: np.ndarray, sensor: BeamSensor,
@@ -838,9 +863,9 @@ def run_beam_scan(kinematics: RobotKinematics, q_start_rad: np.ndarray, sensor: 
     n = config.n_orientations
     skipped = [why for why in (_scan_or_skip(P, k, F) for k in range(n)) if why is not None]
     if not P.events:
-        raise ControllerError("The beam scan could not run at any tool orientation: "
-                              + " ".join(skipped) + " Move the beam sensor closer to the robot or "
-                              "check the tool data.")
+        raise ControllerError(Words.by(lambda tr: " ".join((
+            tr.gettext("The beam scan could not run at any tool orientation:"), *(why.text(tr) for why in skipped),
+            tr.gettext("Move the beam sensor closer to the robot or check the tool data.")))))
     length = float(sum(mv.length_m for mv in P.moves))
     duration = float(sum(mv.duration_s for mv in P.moves))
     return BeamScan(

@@ -22,6 +22,7 @@ import yourdfpy
 
 from tcp_pendant.controller.assets import REFERENCE_TIP_URDF, ROBOT_URDFS, TOOL_URDFS, asset_path, robots_dir
 from tcp_pendant.controller.errors import ControllerError
+from tcp_pendant.translation import ENGLISH, N_, Translator
 from tcpcal.tool import Tool
 from tcpcal.validation import read_only_array
 
@@ -34,17 +35,28 @@ __all__ = [
     "builtin_tools",
     "load_tool",
     "reference_tip_model",
+    "shown_tool_label",
     "urdf_transform",
 ]
 
 TOOL_LABELS: dict[str, str] = {
-    "pointer": "Straight pointer",
-    "torch": "Bent-neck welding torch",
-    "gripper": "Two-finger gripper",
+    "pointer": N_("Straight pointer"),
+    "torch": N_("Bent-neck welding torch"),
+    "gripper": N_("Two-finger gripper"),
 }
 """The built-in tools' labels. A label is also the name a calibration of that tool is saved
 under by default, so each one passes ``tcpcal.tool``'s name check (at most
-``tcpcal.tool.MAX_NAME_LENGTH`` = 24 characters, no double quote)."""
+``tcpcal.tool.MAX_NAME_LENGTH`` = 24 characters, no double quote). English: shown in the reader's
+language by :func:`shown_tool_label`; a saved name stays as it was saved (data)."""
+
+
+def shown_tool_label(label: str, tr: Translator = ENGLISH, *, in_sentence: bool = False) -> str:
+    """A tool model's ``label`` as a pendant shows it, in ``tr``'s language (a label the
+    catalogs do not hold, e.g. a tool file's own, as it is). ``in_sentence``: inside a sentence
+    ("Mount the straight pointer"): an untranslated label in lower case, as English writes it;
+    a translation as its translator wrote it (German nouns keep their capital)."""
+    said = tr.gettext(label)
+    return said.lower() if in_sentence and said == label else said
 
 
 def T_flange_tool_m(tool: Tool) -> np.ndarray:

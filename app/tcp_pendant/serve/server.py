@@ -61,8 +61,9 @@ from tcp_pendant.controller.placement import (
     unreachable_directions,
 )
 from tcp_pendant.controller.scenarios import Scenario
+from tcp_pendant.controller.words import Words
 from tcp_pendant.session import GuiTarget, Session
-from tcp_pendant.translation import ENGLISH, PSEUDO_LANGUAGE, Translator, languages, negotiate
+from tcp_pendant.translation import ENGLISH, N_, PSEUDO_LANGUAGE, Translator, languages, negotiate
 from tcp_pendant.views import session_view_steps, viser_adapter
 from tcp_pendant.views.dashboard import open_dashboard
 from tcp_pendant.views.gui_util import target_of
@@ -296,26 +297,34 @@ def ready_configuration(kinematics: RobotKinematics, tip_world_m: np.ndarray | N
 
 
 def tip_reach_warning(kinematics: RobotKinematics, tip_world_m: np.ndarray, T_flange_tool: np.ndarray,
-                      robot_label: str, tool_label: str) -> str | None:
+                      robot_label: str, tool_label: str) -> Words | None:
     """The start warning for a ``--reference-tip`` the mounted tool cannot reach from the XYZ
-    4-point's directions (``placement.unreachable_directions``), or None when it can."""
+    4-point's directions (``placement.unreachable_directions``), or None when it can: English
+    (stderr) that every pendant says again in its language (:class:`~tcp_pendant.controller.words.Words`)."""
     # a few seeds per direction (the hover pose's and home first): the start stays within about
     # a second when the tip is far out of reach
     reach = unreachable_directions(kinematics, tip_world_m, T_flange_tool, n_random_seeds=8, max_iterations=100)
     if reach.ok:
         return None
     tip = ", ".join(f"{v:.0f}" for v in np.asarray(tip_world_m) * 1000.0)
-    what = []
+    what: list[Words] = []
     if not reach.hover_ok:
-        what.append(f"the flange cannot hover pointing down {READY_HOVER_M * 1000:.0f} mm above it")
+        what.append(Words(N_("the flange cannot hover pointing down {distance} mm above it"),
+                          distance=f"{READY_HOVER_M * 1000:.0f}"))
     if reach.failed:
-        dirs = ", ".join(f"tilt {t:.0f}° azimuth {a:.0f}°" for t, a in reach.failed)
-        what.append(f"the {tool_label.lower()} cannot touch it from {len(reach.failed)} of "
-                    f"{len(XYZ4_DIRECTIONS)} test directions ({dirs})")
+        failed = tuple(reach.failed)
+        dirs = Words.by(lambda tr: ", ".join(tr.gettext("tilt {tilt}° azimuth {azimuth}°").format(
+            tilt=f"{t:.0f}", azimuth=f"{a:.0f}") for t, a in failed))
+        what.append(Words.by(lambda tr: tr.ngettext(
+            "the {tool} cannot touch it from {n} of {count} test direction ({directions})",
+            "the {tool} cannot touch it from {n} of {count} test directions ({directions})",
+            len(XYZ4_DIRECTIONS)).format(tool=tool_label.lower(), n=len(failed), count=len(XYZ4_DIRECTIONS),
+                                         directions=dirs.text(tr))))
     default = ",".join(f"{v:.0f}" for v in default_reference_tip_mm(kinematics, T_flange_tool))
-    return (f"the reference tip ({tip}) mm is out of reach of the {robot_label}: {'; '.join(what)}. "
-            f"Auto-touch and touch-ups there will fail; give a nearer --reference-tip, e.g. "
-            f"--reference-tip {default} (this robot's default).")
+    return Words(N_("the reference tip ({tip}) mm is out of reach of the {robot}: {what}. Auto-touch and "
+                    "touch-ups there will fail; give a nearer --reference-tip, e.g. --reference-tip {default} "
+                    "(this robot's default)."), tip=tip, robot=robot_label,
+                 what=Words.by(lambda tr: "; ".join(w.text(tr) for w in what)), default=default)
 
 
 class PendantApp:
@@ -342,7 +351,7 @@ class PendantApp:
         if config.language != "auto" and config.language not in languages(include_pseudo=True):
             raise ValueError(f"Unknown language {config.language!r}; use auto or one of "
                              f"{', '.join(languages())} ({PSEUDO_LANGUAGE}: the tests' pseudo-locale).")
-        self.tip_warning: str | None = None
+        self.tip_warning: Words | None = None
         """:func:`tip_reach_warning` of a ``--reference-tip`` given (None: reachable, or the default)."""
         T_flange_tool = np.asarray(self.tool.T_flange_tool_true, dtype=float)
         tip = config.reference_tip_mm or default_reference_tip_mm(self.kinematics, T_flange_tool)
@@ -540,7 +549,7 @@ class PendantApp:
                                     "the pendant says where each was looked for (--package-path, ROS_PACKAGE_PATH).",
                                     n).format(n=n, names=names)))
         if self.tip_warning is not None:
-            out.append((tr.gettext("Reference tip out of reach"), self.tip_warning))
+            out.append((tr.gettext("Reference tip out of reach"), self.tip_warning.text(tr)))
         return out
 
     def show_start_notices(self, client: viser.ClientHandle) -> None:

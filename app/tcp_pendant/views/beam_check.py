@@ -29,6 +29,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from tcp_pendant.controller.words import error_text
 from tcp_pendant.calibrate.beam_service import (
     BeamCheck,
     beam_check_job,
@@ -187,15 +188,15 @@ class BeamCheckView:
                 self._say(lambda tr: tr.gettext("Scanning **{name}** with the beam sensor ...").format(name=name))
                 self._render_buttons()
         except ValueError as exc:          # ControllerError and tcpcal's errors are ValueErrors
-            s.notify(_("Not done"), str(exc), kind="warning")
+            s.notify(_("Not done"), error_text(exc, self.tr), kind="warning")
             return
         try:
             check = await s.loop.run_job(job.run, what="a beam check")
         except JobRefused as exc:          # another job of this session, or a full queue: nothing ran
-            self._failed(N_("Beam check not started"), str(exc), kind="warning")
+            self._failed(N_("Beam check not started"), error_text(exc, self.tr), kind="warning")
             return
         except ValueError as exc:          # nothing could be scanned: plain words from the controller
-            self._failed(N_("Beam check not done"), str(exc), kind="warning")
+            self._failed(N_("Beam check not done"), error_text(exc, self.tr), kind="warning")
             return
         except Exception as exc:           # a browser's click must never kill the server
             log.exception("beam check failed")

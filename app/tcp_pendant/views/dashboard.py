@@ -39,6 +39,7 @@ import numpy as np
 import viser
 from viser.uplot import Scale
 
+from tcp_pendant.controller.words import error_text
 from tcp_pendant.classroom.board import DEFAULT_IDLE_MIN, DEFAULT_STUCK_MIN, DashboardRow, dashboard_rows, open_runs
 from tcp_pendant.classroom.dashboard_settings import (
     IDLE_SETTING, MAX_MINUTES, MIN_MINUTES, STUCK_SETTING, keep_minutes, kept_minutes,
@@ -214,6 +215,7 @@ class TrainerDashboard:
         if not change.language:
             return
         self.words.relabel()
+        self._relabel_replay_touches()
         label_chart(self)
         self.gui.set_panel_label(self.session.translator.gettext(PANEL_LABEL))
         self._results_shown = None
@@ -323,7 +325,7 @@ class TrainerDashboard:
         self.replay_scene.show(replay, tr=tr)
         self.gui.main_panel.set_width(REPLAY_PANEL_PX)
         self.close_replay.visible = True
-        set_replay_touches(self.replay_touch, replay, self.replay_scene.touch_shown)
+        set_replay_touches(self.replay_touch, replay, self.replay_scene.touch_shown, tr=self.session.translator)
         err = "" if replay.position_error_mm is None else _(", error {error} mm").format(
             error=f"{replay.position_error_mm:.2f}")
         grade = "" if replay.grade is None else f", {_(GRADE_WORDS.get(replay.grade, replay.grade))}"
@@ -336,6 +338,14 @@ class TrainerDashboard:
                                                method=method_name(replay.method, tr) if replay.method else "-",
                                                status=_(RUN_STATUS_WORDS.get(replay.status, replay.status)), touches=touches,
                                                error=err, grade=grade))
+
+    def _relabel_replay_touches(self) -> None:
+        """The "Robot at touch" options in the session's language (the touch on show kept)."""
+        tr, replay = self.session.translator, self.replay_scene.shown
+        if replay is not None:
+            set_replay_touches(self.replay_touch, replay, self.replay_scene.touch_shown, tr=tr)
+        else:
+            set_options(self.replay_touch, (tr.gettext(NO_TOUCH),), tr.gettext(NO_TOUCH))
 
     def _close_replay(self, _event: ButtonEvent | None = None) -> None:
         self.replay_scene.clear()
@@ -383,7 +393,8 @@ class TrainerDashboard:
             grades = await self.session.loop.run_job(lambda: grade_record(load_and_replay(data), book),
                                                 what="a record's grading")
         except (SessionRecordError, JobRefused) as exc:
-            self.session.notify(self.session.translator.gettext("Record not graded"), f"{name}: {exc}", kind="warning")
+            tr = self.session.translator
+            self.session.notify(tr.gettext("Record not graded"), f"{name}: {error_text(exc, tr)}", kind="warning")
             return
         except Exception as exc:  # never let an upload kill the server
             log.exception("grading the record %r failed", name)
@@ -471,7 +482,8 @@ def trainee_folder(dash: TrainerDashboard) -> None:
         dash.replay_button = words(gui.add_button(""), label=N_("Replay in 3D"),
                                    hint=N_("Draw this trainee's last calibration from the gradebook."))
         dash.close_replay = words(gui.add_button("", visible=False), label=N_("Close replay"))
-        dash.replay_touch = words(gui.add_dropdown("", (NO_TOUCH,), initial_value=NO_TOUCH, visible=False),
+        no_touch = dash.session.translator.gettext(NO_TOUCH)
+        dash.replay_touch = words(gui.add_dropdown("", (no_touch,), initial_value=no_touch, visible=False),
                                   label=N_("Robot at touch"),
                                   hint=N_("The robot of the replay, posed as it was at that touch."))
         dash.one_exercise = words.dropdown(gui, N_("Exercise for this trainee"), tuple(ONE_EXERCISE))

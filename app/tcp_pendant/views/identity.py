@@ -37,6 +37,7 @@ from collections.abc import Callable
 
 import viser
 
+from tcp_pendant.controller.words import error_text
 from tcp_pendant.classroom.names import TraineeNameError
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.text_escape import escape_html, escape_markdown
@@ -178,7 +179,7 @@ class IdentityPrompt:
             self._say(exc.message, **exc.values)
             return
         except ValueError as exc:
-            self._say("", text=str(exc))
+            self._say("", text=error_text(exc, self.session.translator))
             return
         set_value(self.key_field, "")
         self.accepted(name, new_key)
@@ -217,7 +218,7 @@ class IdentityPrompt:
         try:
             opened = self._on_token(token)
         except ValueError as exc:                  # too many wrong tokens: wait
-            self._say("", text=str(exc))
+            self._say("", text=error_text(exc, self.session.translator))
             return
         if not opened:
             self._say(N_("That trainer token is not right; type the token the server printed."))

@@ -57,6 +57,7 @@ from typing import TYPE_CHECKING, TypeVar
 import numpy as np
 import viser
 
+from tcp_pendant.controller.tools import shown_tool_label
 from tcp_pendant.controller import JogResult
 from tcp_pendant.controller.words import in_language
 from tcp_pendant.pendant import (
@@ -82,6 +83,7 @@ from tcp_pendant.views.language_selector import LanguageSelector
 from tcp_pendant.views.tip_insets import TipInsets, tip_views_title
 from tcp_pendant.views.touch_list import RECORD_POINT
 from tcp_pendant.views.viser_adapter import queue_markdown
+from tcp_pendant.views.wizard_dock import BACK, FINISH, NEXT, RECORD
 
 if TYPE_CHECKING:
     from tcp_pendant.controller.pose_state import PoseState
@@ -109,6 +111,9 @@ _MODE_WORDS = {JogMode.CARTESIAN: N_("Cartesian"), JogMode.JOINT: N_("Joint")}
 MARK = "✓ "
 """Prefix of the selected option of a button group."""
 
+CONNECTION_LOST = N_("This page cannot reach the pendant server (it is still trying). Your name and your "
+                     "recorded touches are kept on the server: reload the page to join again.")
+"""The page script's notice when the server stays unreachable (serve/static/pendant.js, 8.)."""
 KEYS_LINE = N_("Keys: `1`…`6` jog **+** on the rows above, `Shift`+`1`…`6` jog **−**, "
              "`[` `]` smaller / larger increment, `R` Record, `N` Next / Finish, `B` Back")
 """The keyboard shortcuts (``serve/static/pendant.js``), shown below the jog keys (hidden by the
@@ -369,14 +374,20 @@ class PendantPanel:
     def _keys_markdown(self) -> str:
         """The keys line and, hidden below it, the labels the page's script looks for in this
         language (``<div hidden data-tcp-pendant-labels data-increment=... data-cont=...
-        data-shadows=... data-keys-line=... data-tip-views=... data-record-point=...>``, attributes escaped): it finds
-        the Increment row, continuous mode, the Shadows checkbox, the keys line, the tip views and
-        "Record point" by them."""
+        data-shadows=... data-keys-line=... data-tip-views=... data-record-point=... data-record=...
+        data-next=... data-finish=... data-back=... data-lost=... data-reload=... data-key-r=...>``,
+        attributes escaped): it finds the Increment row, continuous mode, the Shadows checkbox, the
+        keys line, the tip views, "Record point" and the wizard's Record, Next, Finish and Back
+        buttons (keys R, N, B) by them, and writes the lost-connection notice, its button and the
+        keys' tooltips ("Key R") with them."""
         tr = self.session.translator
         _ = tr.gettext
         labels = {"increment": _("Increment"), "cont": increment_word(CONTINUOUS, tr),
                   "shadows": _(SHADOWS_LABEL), "keys-line": _(KEYS_LINE).split(" ", 1)[0],
-                  "tip-views": tip_views_title(tr), "record-point": _(RECORD_POINT)}
+                  "tip-views": tip_views_title(tr), "record-point": _(RECORD_POINT),
+                  "record": _(RECORD), "next": _(NEXT), "finish": _(FINISH), "back": _(BACK),
+                  "lost": _(CONNECTION_LOST), "reload": _("Reload the page"),
+                  **{f"key-{k.lower()}": _("Key {key}").format(key=k) for k in "RNB"}}
         attrs = " ".join(f'data-{k}="{html.escape(v, quote=True)}"' for k, v in labels.items())
         return f"{_(KEYS_LINE)}\n\n<div hidden data-tcp-pendant-labels {attrs}></div>"
 
@@ -617,7 +628,7 @@ class PendantPanel:
         tool = s.controller.active_tool
         tr = s.translator
         self._set_md(self.tcp_md, "tcp", tcp_readout_markdown(state.readout(self._readout), None if tool is None
-                                                              else tool.name, s.controller.mounted_tool.label, tr))
+                                                              else tool.name, shown_tool_label(s.controller.mounted_tool.label, tr), tr))
         hide = s.hide_distance
         if bool(self.hide_distance.value) != hide:
             set_value(self.hide_distance, hide)

@@ -42,6 +42,7 @@ import numpy as np
 import viser
 from scipy.spatial.transform import Rotation
 
+from tcp_pendant.controller.tools import shown_tool_label
 from tcp_pendant.controller import ToolModel, reference_tip_model
 from tcp_pendant.controller.description import RobotDescription
 from tcp_pendant.controller.kinematics import urdf_links_and_tree
@@ -303,7 +304,7 @@ def tool_label_text(active: Tool | None, mounted: ToolModel, activated_on: ToolM
         return "TOOL"
     if activated_on is None or activated_on.key == mounted.key:
         return f"TOOL {active.name}"
-    return tr.gettext("TOOL {tool} · on {mounted}").format(tool=active.name, mounted=mounted.label)
+    return tr.gettext("TOOL {tool} · on {mounted}").format(tool=active.name, mounted=shown_tool_label(mounted.label, tr))
 
 
 def reference_tip_label_text(tr: Translator = ENGLISH) -> str:

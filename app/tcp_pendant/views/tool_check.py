@@ -15,8 +15,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from tcp_pendant.controller.tools import shown_tool_label
 from tcp_pendant.controller import RobotKinematics, T_flange_tool_m, VirtualController
 from tcp_pendant.controller.jog import JogSettings
+from tcp_pendant.controller.words import in_language
 from tcp_pendant.controller.spin import MAX_SPIN_ANGLE_DEG, SpinCheckResult, spin_check
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.translation import ENGLISH, Translator
@@ -103,13 +105,13 @@ def check_markdown(job: CheckJob, result: SpinCheckResult, *, reading: bool = Fa
     _ = tr.gettext
     lines = [_("**TCP check of {title}** at ±{angle}° (mounted: {mounted})").format(
                  title=escape_markdown(job.title), angle=f"{result.angle_deg:g}",
-                 mounted=escape_markdown(job.mounted_label)), "",
+                 mounted=escape_markdown(shown_tool_label(job.mounted_label, tr))), "",
              "| {rotation} | {moved} | |".format(rotation=_("Rotation"),
                                                  moved=_("Tip moved (mm, by eye)") if reading else _("Tip moved (mm)")),
              "|---|---:|---|"]
     readings = []
     for r in result.rotations:
-        status = "✔" if r.reached else _("stopped: {why}").format(why=escape_markdown(r.message or str(r.stopped_by)))
+        status = "✔" if r.reached else _("stopped: {why}").format(why=escape_markdown(in_language(r.message, tr) or str(r.stopped_by)))
         moved = f"{read_mm(r.deviation_mm):.1f}" if reading else f"{r.deviation_mm:.3f}"
         readings.append((r.reached, read_mm(r.deviation_mm)))
         lines.append(f"| {r.label} | {moved} | {status} |")

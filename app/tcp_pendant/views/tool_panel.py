@@ -37,6 +37,8 @@ from typing import Protocol, cast
 
 import viser
 
+from tcp_pendant.controller.tools import shown_tool_label
+from tcp_pendant.controller.words import error_text
 from tcp_pendant.controller import builtin_tools
 from tcp_pendant.pendant import FIELDS, ToolEntry, parse_tool_entry, tool_data_markdown
 from tcp_pendant.pendant.tool_entry import entry_preview_markdown
@@ -45,6 +47,7 @@ from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.translation import N_, SOURCE_LANGUAGE, Translator
 from tcp_pendant.controller.spin import DEFAULT_SPIN_ANGLE_DEG, MAX_SPIN_ANGLE_DEG, SpinCheckResult
+from tcp_pendant.views.library_words import recovery_summary
 from tcp_pendant.views.gui_util import (
     ButtonEvent,
     DropdownEvent,
@@ -304,7 +307,7 @@ class ToolPanel:
         for rec in recoveries[self._recoveries_told:]:
             title = (self.tr.gettext("Tool library moved aside") if rec.whole_file
                      else self.tr.gettext("Tool library: bad entries set aside"))
-            self.session.notify(title, rec.summary(), kind="warning")
+            self.session.notify(title, recovery_summary(rec, self.tr), kind="warning")
         self._recoveries_told = len(recoveries)
 
     def _selected(self) -> tuple[int, Tool]:
@@ -336,20 +339,29 @@ class ToolPanel:
         return ""
 
     def _choices(self) -> dict[str, str]:
-        """Mounted tool's choices, label -> key: the built-in tools and the exercise's tool."""
+        """Mounted tool's choices, label in the session's language -> key: the built-in tools and
+        the exercise's tool."""
         held = self.session.tools.exercise_tool
-        return self._tool_key_by_label if held is None else {**self._tool_key_by_label, held.label: held.key}
+        english = self._tool_key_by_label if held is None else {**self._tool_key_by_label, held.label: held.key}
+        return {shown_tool_label(label, self.tr): key for label, key in english.items()}
+
+    def _key_of(self, label: str) -> str | None:
+        """The tool a Mounted tool ``label`` names: in the session's language, or in English (a
+        click that crossed a language switch)."""
+        held = self.session.tools.exercise_tool
+        english = self._tool_key_by_label if held is None else {**self._tool_key_by_label, held.label: held.key}
+        return self._choices().get(label, english.get(label))
 
     def _show_mounted(self) -> None:
         """The mounted tool; in an exercise that holds its tool, the dropdown locked with why."""
         held = self.session.tools.exercise_tool
-        label = self.session.controller.mounted_tool.label
+        label = shown_tool_label(self.session.controller.mounted_tool.label, self.tr)
         options = tuple(self._choices())
         if label in options:
             set_options(self.mounted, options, keep=label)   # its own handler then sees no change
         self.mounted.disabled = held is not None
         set_content(self.mounted_lock_md, "" if held is None else self.tr.gettext(_LOCKED_TEXT).format(
-            tool=escape_markdown(held.label.lower())))
+            tool=escape_markdown(shown_tool_label(held.label, self.tr, in_sentence=True))))
         self.mounted_lock_md.visible = held is not None
 
     def _show_active(self) -> None:
@@ -360,7 +372,7 @@ class ToolPanel:
     def _on_mount(self, event: DropdownEvent) -> None:
         """Mount the tool chosen (``SessionTools.mount_tool``); a refused change (the exercise holds
         its tool) puts the dropdown back on the tool mounted."""
-        key = self._choices().get(str(event.target.value))
+        key = self._key_of(str(event.target.value))
         if key is None:
             self._show_mounted()
             raise ValueError(self.tr.gettext("Unknown tool {name}; choose one of the list.").format(
@@ -415,7 +427,7 @@ class ToolPanel:
         try:
             filename, text = controller_file(tool, slot, str(self.file_fmt.value))
         except (TcpcalError, ValueError) as exc:
-            self.session.notify(self.tr.gettext(CONTROLLER_FILE_REFUSED), str(exc), kind="warning")
+            self.session.notify(self.tr.gettext(CONTROLLER_FILE_REFUSED), error_text(exc, self.tr), kind="warning")
             return
         # to the browser that clicked (in --shared mode the session is every browser's)
         target = event.client or client_of(self.session) or target_of(self.session)
@@ -463,7 +475,7 @@ class ToolPanel:
                 shown = self.check_md.content
                 self.check_md.content = _("Checking {title} ...").format(title=escape_markdown(title))
         except ValueError as exc:
-            s.notify(_("Not done"), str(exc), kind="warning")
+            s.notify(_("Not done"), error_text(exc, self.tr), kind="warning")
             return
         self._checking = True
         try:
@@ -471,7 +483,7 @@ class ToolPanel:
         except JobRefused as exc:      # this session's other job, or a full queue: nothing ran
             with s.lock:
                 self.check_md.content = shown
-            s.notify_refusal(self.tr.gettext("Check not started"), str(exc))
+            s.notify_refusal(self.tr.gettext("Check not started"), error_text(exc, self.tr))
             return
         except Exception as exc:  # a browser's click must never kill the server
             log.exception("TCP check failed")
@@ -536,8 +548,9 @@ class ToolPanel:
         try:
             self.session.tools.store_tool(slot, tool)
         except ValueError as exc:       # e.g. another trainee's slot, a full quota: said here too
-            why = escape_markdown(str(exc))
-            self._entry_said = lambda tr: ({}, tr.gettext("⚠ Not saved: {why}").format(why=why))
+            refused = exc
+            self._entry_said = lambda tr: ({}, tr.gettext("⚠ Not saved: {why}").format(
+                why=escape_markdown(error_text(refused, tr))))
             self._show_entry_outcome()
             raise
         self._entry_said = lambda tr: ({}, tr.gettext("✔ Saved **{name}** in slot {slot}.").format(

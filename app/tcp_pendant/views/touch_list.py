@@ -59,7 +59,7 @@ class TouchListView:
         self.record = gui.add_button(RECORD_POINT, color="green", icon=None)
         self.folder = gui.add_folder("Touches")
         with self.folder:
-            self.empty_md = gui.add_markdown("*No touch recorded.*")
+            self.empty_md = gui.add_markdown(empty_touches_markdown(None, tr=session.translator))
             self.export_csv = gui.add_button("Export CSV")
         self._rows: list[viser.GuiMarkdownHandle | viser.GuiButtonHandle] = []
         self._delete_buttons: list[viser.GuiButtonHandle] = []
@@ -99,7 +99,7 @@ class TouchListView:
         they are (its step list), not "No touch recorded"."""
         if self.session.touches:
             return
-        set_content(self.empty_md, empty_touches_markdown(self.session.workflow.wizard))
+        set_content(self.empty_md, empty_touches_markdown(self.session.workflow.wizard, tr=self.session.translator))
 
     def _on_record(self, _event: ButtonEvent) -> None:
         s = self.session

@@ -31,6 +31,8 @@ import math
 from collections.abc import Callable, Coroutine
 from typing import TYPE_CHECKING, TypeVar, cast
 
+from tcp_pendant.controller.tools import shown_tool_label
+from tcp_pendant.controller.words import error_text
 from tcp_pendant.calibrate.record_words import recorded_words
 from tcp_pendant.calibrate.tilt_advice import TiltAdvisor, meter_gain
 from tcp_pendant.calibrate.text import meter_level, step_markdown
@@ -48,7 +50,7 @@ if TYPE_CHECKING:
     from tcp_pendant.calibrate import CalibrationWorkflow
     from tcp_pendant.wizards.base import MeterWizard
 
-__all__ = ["BACK", "CANCEL", "CLOSE", "FINISH", "NEXT", "WizardDock", "tilt_line_html"]
+__all__ = ["BACK", "CANCEL", "CLOSE", "FINISH", "NEXT", "RECORD", "WizardDock", "tilt_line_html"]
 
 _E = TypeVar("_E")
 """The event a dock action's callback takes (viser's, of the widget it is attached to)."""
@@ -58,6 +60,8 @@ log = logging.getLogger(__name__)
 BACK, NEXT, FINISH, CANCEL, CLOSE = N_("◀ Back"), N_("Next ▶"), N_("Finish ▶"), N_("Cancel"), N_("Close")
 """The Step row's buttons (msgids: shown in the session's language; a click is read in any
 language it may come in)."""
+RECORD = N_("Record")
+"""The wizard step's Record button (key R: the page's script finds it by this label)."""
 
 
 TILT_LINE_STYLE = "min-height:4.2em;line-height:1.4em;white-space:normal;font-size:0.875em;padding:0 0.75em"
@@ -103,7 +107,7 @@ class WizardDock:
             self.note_md = gui.add_markdown("", visible=False)
             self.mount = keep(gui.add_button(N_("Mount the tool"), color="orange", visible=False,
                                              hint=N_("The tool change this step asks for (the app swaps the tool).")))
-            self.record = keep(gui.add_button(N_("Record"), color="green",
+            self.record = keep(gui.add_button(RECORD, color="green",
                                               hint=N_("Record this step at the current pose (a touch farther than "
                                                       "0.5 mm asks first, unless the distance is hidden); key R.")))
             self.nav = keep(gui.add_button_group(N_("Step"), (_(BACK), _(NEXT), _(CANCEL)),
@@ -159,7 +163,7 @@ class WizardDock:
         frame = s.jogger.settings.frame
         delta = tip_offset_mm(state, s.controller.reference_tip_world_m, frame)
         decision = self.check.decide(state.touch.distance_mm, hidden=s.hide_distance, q_rad=state.q_rad,
-                                     where=direction_words(delta, frame))
+                                     where=direction_words(delta, frame), tr=s.translator)
         if not decision.record:
             self._say(decision.message)
             return
@@ -167,7 +171,8 @@ class WizardDock:
         index = None if wiz is None else wiz.step.index
         s.wizard_commands.record_step()
         self._say(recorded_words(index, state.touch.distance_mm, hidden=s.hide_distance,
-                                 in_exercise=s.rules.in_exercise, feedback=touch_feedback(delta, frame)))
+                                 in_exercise=s.rules.in_exercise,
+                                 feedback=touch_feedback(delta, frame, tr=s.translator), tr=s.translator))
 
     async def _on_nav_click(self, event: ButtonGroupEvent) -> None:
         """Back and Cancel as every click; Next / Finish through ``WizardCommands.next_step_in_pool``
@@ -182,7 +187,7 @@ class WizardDock:
         try:
             await s.wizard_commands.next_step_in_pool()
         except ValueError as exc:          # the wizard's words, or the pool's (JobRefused)
-            s.notify(s.translator.gettext("Not done"), str(exc), kind="warning")
+            s.notify(s.translator.gettext("Not done"), error_text(exc, s.translator), kind="warning")
         except Exception as exc:           # a browser's click must never kill the server
             log.exception("Next / Finish failed")
             s.notify(s.translator.gettext("Internal error"), f"{type(exc).__name__}: {exc}", kind="error")
@@ -241,7 +246,8 @@ class WizardDock:
         needed = wf.required_tool() if stepping else None
         self.mount.visible = needed is not None
         if needed is not None:
-            self.mount.label = _("Mount the {tool}").format(tool=needed.label.lower())
+            self.mount.label = _("Mount the {tool}").format(
+                tool=shown_tool_label(needed.label, self.session.translator, in_sentence=True))
         self.record.visible = stepping and not wiz.auto_role(wiz.step).by_controller   # a scan: no Record
         self.record.disabled = not wiz.can_record
         # the button keeps its row through the whole XYZ 4-point (disabled until two touches give
@@ -286,14 +292,14 @@ class WizardDock:
         else:
             text = _("Pose diversity: {angle}° from the nearest touch; predicted TCP error {error} mm if "
                      "recorded here ({basis}).").format(angle=f"{angle:.0f}", error=f"{gain.predicted_after:.2f}",
-                                                        basis=meter.basis)
+                                                        basis=meter.basis_words(self.session.translator))
         set_content(self.meter_md, text)              # numbers and our words only
         s = self.session
         others = wiz.other_rotations()
-        advice = self.advisor.advise(others, T_world_flange[:3, :3], s.jogger, meter.sigma_mm)
+        advice = self.advisor.advise(others, T_world_flange[:3, :3], s.jogger, meter.sigma_mm, tr=s.translator)
         reach = ""
         if len(others):
             from_mode = s.jogger.settings.mode.value == "Joint"
             reach = reachable_line(s.jogger.tilts.options(s.jogger.settings.frame),
-                                   frame=s.jogger.settings.frame, joint_mode=from_mode)
+                                   frame=s.jogger.settings.frame, joint_mode=from_mode, tr=s.translator)
         set_content(self.tilt_html, tilt_line_html(None if advice is None else advice.text, reach))

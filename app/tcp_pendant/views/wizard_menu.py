@@ -46,6 +46,8 @@ from typing import TypeVar, cast
 
 import viser
 
+from tcp_pendant.controller.tools import shown_tool_label
+from tcp_pendant.controller.words import error_text
 from tcp_pendant.calibrate import CalibrationWorkflow
 from tcp_pendant.calibrate.library_choice import default_library_slot
 from tcp_pendant.calibrate.text import (
@@ -68,7 +70,7 @@ from tcp_pendant.views.gui_util import (
     slot_option,
     target_of,
 )
-from tcp_pendant.translation import N_
+from tcp_pendant.translation import ENGLISH, N_
 from tcp_pendant.views.beam_replay import ScanPlayer
 from tcp_pendant.views.gui_words import GuiWords
 from tcp_pendant.views.math_panel import MathView
@@ -206,8 +208,8 @@ class CalibrateView:
         if opt.kind == "library_slot":
             empty = self.gettext(NO_LIBRARY_TOOL)
             return self.words.keep(gui.add_dropdown(opt.label, (empty,), initial_value=empty, hint=hint))
-        physical = tuple(self._physical)
-        mounted = self.session.controller.mounted_tool.label
+        physical = self._physical_labels()
+        mounted = shown_tool_label(self.session.controller.mounted_tool.label, self.session.translator)
         initial = mounted if mounted in physical else physical[0]
         if opt.default == "other":
             initial = next((p for p in physical if p != initial), physical[0])
@@ -245,10 +247,24 @@ class CalibrateView:
             return values[widget.value]
         if opt.kind == "library_slot":
             return self._selected_slot(widget)
-        if widget.value not in self._physical:
+        key = self._physical_key(str(widget.value))
+        if key is None:
             raise ValueError(self.gettext("{option}: unknown physical tool {value!r}.").format(
                 option=self.gettext(opt.label), value=widget.value))
-        return self._physical[widget.value]
+        return key
+
+    def _physical_labels(self) -> tuple[str, ...]:
+        """The physical tools' labels in the session's language (a physical-tool option's choices)."""
+        return tuple(shown_tool_label(label, self.session.translator) for label in self._physical)
+
+    def _physical_key(self, said: str) -> str | None:
+        """The physical tool ``said`` names: in the session's language, the one the options on
+        show are in, or English; None for none."""
+        for tr in (self.session.translator, self._shown_in, ENGLISH):
+            key = next((k for label, k in self._physical.items() if shown_tool_label(label, tr) == said), None)
+            if key is not None:
+                return key
+        return None
 
     def _class_of(self, label: str) -> type[Wizard] | None:
         """The wizard class a Method option names (its title in the session's language or in
@@ -275,6 +291,11 @@ class CalibrateView:
                 labels = self._choice_labels(opt)
                 set_options(cast("viser.GuiDropdownHandle[str]", widget), labels,
                             keep=next(self.gettext(lab) for v, lab in opt.choices if v == value))
+            elif opt.kind == "physical_tool":
+                key = self._physical_key(str(widget.value))
+                label = next((lab for lab, k in self._physical.items() if k == key), None)
+                set_options(cast("viser.GuiDropdownHandle[str]", widget), self._physical_labels(),
+                            keep=None if label is None else shown_tool_label(label, self.session.translator))
         if not self._library:
             for widget in self._slot_widgets:
                 set_options(widget, (self.gettext(NO_LIBRARY_TOOL),))
@@ -443,7 +464,8 @@ class CalibrateView:
         if not self.session.closed:
             with self.session.lock:
                 set_content(self.record_md, "")
-            self.session.notify(self.gettext(RECORD_REFUSED), f"{name}: {exc}", kind="warning")
+            self.session.notify(self.gettext(RECORD_REFUSED), f"{name}: {error_text(exc, self.session.translator)}",
+                                kind="warning")
 
     def _upload_refused(self, filename: str, size_bytes: int) -> None:
         """``upload_guard``: a transfer above the size limit was dropped as it started."""
@@ -506,7 +528,7 @@ class CalibrateView:
                 set_value(widget, wanted)
         empty = library_widget is None or self._is_empty_library(library_widget.value)
         physical = [self.option_widgets[o.name].value for o in cls.options if o.kind == "physical_tool"]
-        mounted = self.session.controller.mounted_tool.label
+        mounted = shown_tool_label(self.session.controller.mounted_tool.label, self.session.translator)
         set_content(self.menu_md, menu_markdown(
             cls.kind, library_tool=None if empty else str(library_widget.value),   # type: ignore[union-attr]
             reference_tool=str(physical[0]) if physical else mounted,

@@ -18,6 +18,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import TYPE_CHECKING, cast
 
+from tcp_pendant.controller.words import error_text
 from tcp_pendant.calibrate.chart import error_axis_top_mm, error_bars
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.calibrate.text import (
@@ -190,7 +191,7 @@ class WizardResultView:
             slot, tool = self.parent.session.wizard_commands.save_result(str(self.save_name.value),
                                                          number_of_option(self.save_slot.value))
         except ValueError as exc:
-            self._refused = (run, str(exc))
+            self._refused = (run, error_text(exc, self.parent.session.translator))
             raise
         self._refused = None
         self.parent.saved(slot, tool)

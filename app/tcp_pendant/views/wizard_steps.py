@@ -21,6 +21,8 @@ import logging
 import math
 from typing import TYPE_CHECKING, cast
 
+from tcp_pendant.controller.tools import shown_tool_label
+from tcp_pendant.controller.words import error_text
 from tcp_pendant.calibrate import AUTO_SIGMA_MAX_MM, AutoTouchRequest
 from tcp_pendant.calibrate.diversity import diversity_advice
 from tcp_pendant.calibrate.tilt_advice import TiltAdvisor, meter_gain
@@ -149,7 +151,7 @@ class WizardStepsView:
             wiz = self.parent.workflow.wizard
             self._record_line = (self._auto_where(),
                                  self.parent.gettext("✔ Step {n} recorded: {feedback}.").format(
-                                     n=index + 1 if index is not None else "?", feedback=touch_feedback(delta, frame)),
+                                     n=index + 1 if index is not None else "?", feedback=touch_feedback(delta, frame, tr=s.translator)),
                                  None if wiz is None else wiz.recorded_poses)
 
     def _on_cancel(self, _event: ButtonEvent) -> None:
@@ -189,9 +191,11 @@ class WizardStepsView:
         except Exception as exc:  # a browser's click must never kill the server
             self._checking = False
             if isinstance(exc, JobRefused):            # another job of this session, or a full queue
-                self.parent.session.notify(_("{title}: not started").format(title=shown), str(exc), kind="warning")
+                self.parent.session.notify(_("{title}: not started").format(title=shown),
+                                           error_text(exc, session.translator), kind="warning")
             elif isinstance(exc, ValueError):            # the controller's words (ControllerError)
-                self.parent.session.notify(_("{title}: not possible").format(title=shown), str(exc), kind="error")
+                self.parent.session.notify(_("{title}: not possible").format(title=shown),
+                                           error_text(exc, session.translator), kind="error")
             else:
                 log.exception("%s: controller job failed", title)
                 self.parent.session.notify(_("{title} failed").format(title=shown), f"{type(exc).__name__}: {exc}",
@@ -241,21 +245,21 @@ class WizardStepsView:
         try:                                    # refused at once, before anything moves
             session.loop.admit_job()
         except JobRefused as exc:
-            session.notify_refusal(not_started, str(exc))
+            session.notify_refusal(not_started, error_text(exc, session.translator))
             return
         try:
             request = self.auto_request()
         except ValueError as exc:
-            session.notify(_("Not done"), str(exc), kind="warning")
+            session.notify(_("Not done"), error_text(exc, session.translator), kind="warning")
             return
         self._auto_touching = True
         try:
             await session.wizard_commands.auto_touch_in_pool(request, shown=lambda out: self._show_auto_touch(out, request))
         except JobRefused as exc:
-            session.notify_refusal(not_started, str(exc))
+            session.notify_refusal(not_started, error_text(exc, session.translator))
             return
         except ValueError as exc:               # the wizard's words
-            session.notify_refusal(_("Not done"), str(exc))
+            session.notify_refusal(_("Not done"), error_text(exc, session.translator))
             return
         except Exception as exc:                # a browser's click must never kill the server
             log.exception("Auto-touch failed")
@@ -324,7 +328,8 @@ class WizardStepsView:
             set_content(self.blocked_md, f"⚠ {escape_markdown(reason)}")
         self.mount.visible = needed is not None
         if needed is not None:
-            self.mount.label = _("Mount the {tool}").format(tool=needed.label.lower())
+            self.mount.label = _("Mount the {tool}").format(
+                tool=shown_tool_label(needed.label, self.parent.session.translator, in_sentence=True))
         stepping = not wiz.is_complete           # on the result only Back, Add point and Close remain
         by_controller = stepping and wiz.auto_role(wiz.step).by_controller   # no Record, no Auto-touch
         self.record.visible = stepping and not by_controller
@@ -378,10 +383,12 @@ class WizardStepsView:
         value, color = meter_level(gain)
         set_value(self.meter_bar, round(value, 1))
         self.meter_bar.color = color
-        advice = (diversity_advice(wiz.other_rotations(), T_world_flange[:3, :3], gain.angle_to_nearest_deg)
-                  if math.isinf(gain.predicted_after) else None)               # only then shown
         s = self.parent.session
-        tilt = self.advisor.advise(wiz.other_rotations(), T_world_flange[:3, :3], s.jogger, meter.sigma_mm)
+        advice = (diversity_advice(wiz.other_rotations(), T_world_flange[:3, :3], gain.angle_to_nearest_deg,
+                                   tr=s.translator)
+                  if math.isinf(gain.predicted_after) else None)               # only then shown
+        tilt = self.advisor.advise(wiz.other_rotations(), T_world_flange[:3, :3], s.jogger, meter.sigma_mm,
+                                   tr=s.translator)
         set_content(self.meter_md, meter_markdown(gain, None, meter.sigma_mm, advice,
                                                   None if tilt is None else tilt.text, measured=meter.source,
                                                   tr=s.translator))

@@ -81,11 +81,13 @@
  *    Both words come in the pendant's language from the board's data-toggle and data-back
  *    attributes (calibrate/math_board.py), English when they are absent.
  * 10. Languages: the labels this script looks for (Increment, its "Cont." button, Shadows, the keys
- *     line's first word, the tip views' caption's first words, Record point, and the wizard's
- *     Record, Next, Finish and Back once their owner hands them over) are read in the pendant's
- *     language from the hidden <div data-tcp-pendant-labels data-increment=... data-cont=...
- *     data-shadows=... data-keys-line=... data-tip-views=... data-record-point=...> below the keys
- *     line (views/pendant_panel.py), and the welcome window's (Your name, Browser key, Join the
+ *     line's first word, the tip views' caption's first words, Record point, the wizard's
+ *     Record, Next, Finish and Back) and the words it writes itself (the lost-connection notice and
+ *     its "Reload the page" button, the tooltips "Key R", "Key N", "Key B") are read in the
+ *     pendant's language from the hidden <div data-tcp-pendant-labels data-increment=... data-cont=...
+ *     data-shadows=... data-keys-line=... data-tip-views=... data-record-point=... data-record=...
+ *     data-next=... data-finish=... data-back=... data-lost=... data-reload=... data-key-r=...
+ *     data-key-n=... data-key-b=...> below the keys line (views/pendant_panel.py), and the welcome window's (Your name, Browser key, Join the
  *     class, Trainer token, Open trainer view, the trainer line's and the banner's first word)
  *     from its own <div data-tcp-pendant-labels data-name=... data-join=...> (views/identity.py);
  *     English when they are absent. The jog keys' labels
@@ -103,7 +105,10 @@
     openTrainer: "Open trainer view", trainerLine: "Trainer: open",
     increment: "Increment", record: "Record", recordPoint: "Record point", banner: "Trainee:",
     shadows: "Shadows", next: "Next \u25b6", finish: "Finish \u25b6", back: "\u25c0 Back",
-    keysLine: "Keys:", tipViews: "Tip close-up", cont: "Cont."
+    keysLine: "Keys:", tipViews: "Tip close-up", cont: "Cont.",
+    lost: "This page cannot reach the pendant server (it is still trying). " +
+      "Your name and your recorded touches are kept on the server: reload the page to join again.",
+    reload: "Reload the page", keyR: "Key R", keyN: "Key N", keyB: "Key B"
   };
   var SOFTWARE_RE = /swiftshader|llvmpipe|softpipe|software|basic render/i;
   var CARTESIAN = ["X", "Y", "Z", "A", "B", "C"];
@@ -136,7 +141,8 @@
   var LABEL_KEYS = { "increment": "increment", "cont": "cont", "shadows": "shadows", "keys-line": "keysLine",
     "name": "name", "key": "key", "join": "join", "token": "token", "open-trainer": "openTrainer",
     "trainer-line": "trainerLine", "banner": "banner", "tip-views": "tipViews", "record-point": "recordPoint",
-    "record": "record", "next": "next", "finish": "finish", "back": "back" };
+    "record": "record", "next": "next", "finish": "finish", "back": "back", "lost": "lost", "reload": "reload",
+    "key-r": "keyR", "key-n": "keyN", "key-b": "keyB" };
   function label(key) {                     // a label in the session's language (views/pendant_panel.py and
     var el = document.querySelector("[data-tcp-pendant-labels][data-" + key + "]");   // views/identity.py
     var v = el && el.getAttribute("data-" + key);                                    // hand them over)
@@ -197,11 +203,10 @@
       "border:2px solid #e8590c;box-shadow:0 4px 16px rgba(0,0,0,.3);font:16px/1.4 sans-serif";
     var p = document.createElement("p");
     p.style.margin = "0 0 10px 0";
-    p.textContent = "This page cannot reach the pendant server (it is still trying). " +
-      "Your name and your recorded touches are kept on the server: reload the page to join again.";
+    p.textContent = label("lost");
     var b = document.createElement("button");
     b.type = "button";
-    b.textContent = "Reload the page";
+    b.textContent = label("reload");
     b.style.cssText = "font:600 16px sans-serif;padding:6px 14px;border-radius:6px;border:0;" +
       "background:#e8590c;color:#fff;cursor:pointer";
     b.addEventListener("click", function () { window.location.reload(); });
@@ -546,9 +551,9 @@
       setTitle(r.plus, "Key " + (i + 1));
       setTitle(r.minus, "Key Shift+" + (i + 1));
     });
-    buttonsNamed(label("record")).concat(buttonsNamed(label("record-point"))).forEach(function (b) { setTitle(b, "Key R"); });
-    buttonsNamed(label("next")).concat(buttonsNamed(label("finish"))).forEach(function (b) { setTitle(b, "Key N"); });
-    buttonsNamed(label("back")).forEach(function (b) { setTitle(b, "Key B"); });
+    buttonsNamed(label("record")).concat(buttonsNamed(label("record-point"))).forEach(function (b) { setTitle(b, label("key-r")); });
+    buttonsNamed(label("next")).concat(buttonsNamed(label("finish"))).forEach(function (b) { setTitle(b, label("key-n")); });
+    buttonsNamed(label("back")).forEach(function (b) { setTitle(b, label("key-b")); });
   }
 
   // the trainer's message (class "trainer-message", views/class_notices.py) above the presenter's
