@@ -20,7 +20,9 @@ from tcp_pendant.calibrate.pendant_rules import LibraryRights
 from tcp_pendant.calibrate.run_list import RunList
 from tcp_pendant.calibrate.run_log import RunLog
 from tcp_pendant.controller import T_flange_tool_m, ToolModel
+from tcp_pendant.controller.tools import shown_tool_label
 from tcp_pendant.events import ToolSaved
+from tcp_pendant.translation import ENGLISH, Translator
 from tcp_pendant.wizards import WizardResult, WizardStateError
 from tcp_pendant.wizards.truth import TruthComparison, compare_with_truth
 from tcpcal.library import ToolLibrary
@@ -75,14 +77,15 @@ class RunResult:
         tool = self.preview_tool()
         return None if tool is None else T_flange_tool_m(tool)
 
-    def default_save_name(self) -> str:
-        """The calibrated tool's own name, else its physical tool's label, else "Tool"."""
+    def default_save_name(self, *, tr: Translator = ENGLISH) -> str:
+        """The calibrated tool's own name, else its physical tool's label in ``tr``'s language,
+        else "Tool" in it (the name offered: the trainee may type another)."""
         w = self._run_list.wizard
         if w is not None and w.library_tool_name is not None:
             return w.library_tool_name
         run = self._run_list.run
         tool = None if run is None or run.true_tool_key is None else self._tools.get(run.true_tool_key)
-        return "Tool" if tool is None else tool.label
+        return tr.gettext("Tool") if tool is None else shown_tool_label(tool.label, tr)
 
     def distances_shown(self, hide_truth: bool) -> tuple[dict[int, float], set[int]]:
         """The run on show's distance-at-record of its touch steps (mm, by 0-based step) and the

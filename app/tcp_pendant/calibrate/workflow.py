@@ -529,9 +529,10 @@ class CalibrationWorkflow:
         orientation is not calibrated, the orientation the saved tool will have."""
         return self.results.T_flange_tool_computed_m()
 
-    def default_save_name(self) -> str:
-        """Name offered by "Save to tool library": the calibrated tool's own name or its label."""
-        return self.results.default_save_name()
+    def default_save_name(self, *, tr: Translator = ENGLISH) -> str:
+        """Name offered by "Save to tool library": the calibrated tool's own name or its label
+        (in ``tr``'s language)."""
+        return self.results.default_save_name(tr=tr)
 
     def save(self, name: str, slot: int | None = None) -> tuple[int, Tool]:
         """"Save to tool library": store the calibrated tool (slot None: the slot holding that name,

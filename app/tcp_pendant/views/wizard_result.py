@@ -222,7 +222,7 @@ class WizardResultView:
         self.check_tcp.visible = saves and wf.last_save is not None and wf.result_saved
         if wf.run is not self._named_run:              # another calibration: its name, no old message
             self._named_run = wf.run
-            set_value(self.save_name, wf.default_save_name())
+            set_value(self.save_name, wf.default_save_name(tr=tr))
             set_content(self.save_md, "")
         truth = None if wf.hide_truth else wf.truth()   # an exercise: no answer shown
         set_content(self.result_md, result_markdown(res, truth, tr=tr))   # a beam result: errors of both vs truth
