@@ -21,7 +21,7 @@ pytestmark = pytest.mark.browser
 def test_a_german_browser_gets_the_jog_tab_in_german_and_its_keys_work(app_factory, new_page: Callable[..., Any],
                                                                        shot) -> None:
     app = app_factory()
-    page = new_page(app.url, locale="de-DE", wait_for="Record point")
+    page = new_page(app.url, locale="de-DE", wait_for=translator("de").gettext("Record point"))
     page.wait_for_function("document.documentElement.dataset.tcpPendantScript === '1'", timeout=TIMEOUT_MS)
     wait_until(lambda: len(app.sessions) == 1, "the page's session")
     (s,) = app.sessions.values()
