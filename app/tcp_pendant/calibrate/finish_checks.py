@@ -16,6 +16,7 @@ import numpy as np
 from tcp_pendant.calibrate.diversity import failure_in_words
 from tcp_pendant.calibrate.pendant_rules import ExerciseRules
 from tcp_pendant.controller import ToolModel
+from tcp_pendant.controller.tools import shown_tool_label
 from tcp_pendant.translation import ENGLISH, Translator
 from tcp_pendant.wizards import CalibrationFailedError, Wizard
 from tcp_pendant.wizards.session_record import WizardRun
@@ -55,7 +56,7 @@ def wrong_tool_touch(run: WizardRun | None, tools: Mapping[str, ToolModel], *,
 
     def label(key: str) -> str:
         tool = tools.get(key)
-        return (key if tool is None else tool.label).lower()
+        return shown_tool_label(key if tool is None else tool.label, tr, in_sentence=True)
 
     w = run.wizard
     for step in sorted(w.recorded_poses):

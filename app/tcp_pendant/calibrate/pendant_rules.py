@@ -51,6 +51,7 @@ from typing import TypedDict
 
 from tcpcal.library import OwnerQuotaError, SlotOwnedError, ToolLibraryError
 from tcp_pendant.controller.errors import ControllerError
+from tcp_pendant.controller.tools import shown_tool_label
 from tcp_pendant.controller.words import Words
 from tcp_pendant.translation import N_
 
@@ -93,7 +94,13 @@ def check_tool_change(held_key: str, held_label: str, wanted_key: str, wanted_la
     raise RuleRefusal(Words(N_("This exercise keeps your own tool mounted (the {held}): the trainer gave it to you "
                                "to calibrate, so the {wanted} cannot be mounted. (The XYZ reference method mounts "
                                "its reference tool for its first touch by itself, with its Mount the tool button.)"),
-                            held=held_label.lower(), wanted=wanted_label.lower()))
+                            held=_tool_words(held_label), wanted=_tool_words(wanted_label)))
+
+
+def _tool_words(label: str) -> Words:
+    """A tool model's label inside a sentence, said in the reader's language (English: in
+    lower case, "the straight pointer")."""
+    return Words.by(lambda tr: shown_tool_label(label, tr, in_sentence=True))
 
 
 def check_calibrated_tool(held_key: str, held_label: str, calibrated_key: str | None, method_title: str) -> None:
@@ -107,7 +114,7 @@ def check_calibrated_tool(held_key: str, held_label: str, calibrated_key: str | 
         return
     raise RuleRefusal(Words(N_("This exercise calibrates your own tool (the {held}): the {method} method can only "
                                "measure it. Choose the {held} as the tool to calibrate (the XYZ reference method: "
-                               "as its New tool)."), held=held_label.lower(), method=Words(method_title)))
+                               "as its New tool)."), held=_tool_words(held_label), method=Words(method_title)))
 
 
 @dataclass(frozen=True)

@@ -133,8 +133,8 @@ def step_markdown(wizard: Wizard, *, tr: Translator = ENGLISH) -> str:
         return _("**{title}** · Result\n\nThe check is done: see *Result* below.").format(title=title)
     step = wizard.step
     mark = _(" ✔ recorded") if step.recorded else ""
-    return (f"**{title}** · {_esc(step.heading)}: {_esc(step.title)}{mark}\n\n"
-            f"{_esc(step.instruction)}")
+    head = _("**{title}** · {heading}: {step}").format(title=title, heading=_esc(step.heading), step=_esc(step.title))
+    return f"{head}{mark}\n\n{_esc(step.instruction)}"
 
 
 def where_to_jog_markdown(wizard: Wizard, *, tr: Translator = ENGLISH) -> str:

@@ -481,7 +481,7 @@ class PendantPanel:
         if n:
             _ = self.session.translator.gettext
             text = dropped_presses_text(n, self.session.translator)
-            self._set_md(self.status_md, "status", f"⚠ {text}.")
+            self._set_md(self.status_md, "status", "⚠ " + _("{sentence}.").format(sentence=text))
             self.session.notify(_("Jog presses dropped"), _("{what}; press again.").format(what=text), kind="warning")
             self.render()                            # a dropped slider move: the slider shows the joint
 

@@ -45,7 +45,7 @@ from tcp_pendant.pendant.tool_entry import entry_preview_markdown
 from tcp_pendant.job_pool import JobRefused
 from tcp_pendant.session import Session, SessionChange
 from tcp_pendant.text_escape import escape_markdown
-from tcp_pendant.translation import N_, SOURCE_LANGUAGE, Translator
+from tcp_pendant.translation import N_, SOURCE_LANGUAGE, Translator, languages, translator
 from tcp_pendant.controller.spin import DEFAULT_SPIN_ANGLE_DEG, MAX_SPIN_ANGLE_DEG, SpinCheckResult
 from tcp_pendant.views.library_words import recovery_summary
 from tcp_pendant.views.gui_util import (
@@ -86,6 +86,10 @@ class _Labelled(Protocol):
 
     label: str
 
+
+MATRIX_FORMAT = N_("Matrix")
+"""The export format that is no vendor's (a 4x4 matrix): the one option said in the trainee's
+language."""
 
 class _Hinted(Protocol):
     """A handle with a hint (viser's inputs and buttons)."""
@@ -138,7 +142,7 @@ class ToolPanel:
             self.delete = gui.add_button("Delete", color="red")
         self.export_folder = gui.add_folder("Export", expand_by_default=False)
         with self.export_folder:
-            self.export_fmt = gui.add_dropdown("Format", [text_format(f).label for f in FORMATS], initial_value="KUKA")
+            self.export_fmt = gui.add_dropdown("Format", self._format_options(), initial_value="KUKA")
             self.export = gui.add_button("Export")
             self.export_text = gui.add_text("Controller text", "", multiline=True,
                                             hint="Select and copy into the controller.")
@@ -249,9 +253,30 @@ class ToolPanel:
             (self.entry_save, N_("Save to library"), None),
         ]
 
+    def _format_option(self, fmt: str) -> str:
+        """An export format as the dropdown offers it: a vendor's name as it is, the generic
+        matrix in the session's language."""
+        label = text_format(fmt).label
+        return self.tr.gettext(MATRIX_FORMAT) if label == MATRIX_FORMAT else label
+
+    @staticmethod
+    def _format_of(option: str) -> str | None:
+        """The export format an option names, in any language (a click sent just before a
+        language switch names it in the old one); None for no format."""
+        said = {translator(code).gettext(MATRIX_FORMAT) for code in languages(include_pseudo=True)}
+        return next((f for f in FORMATS if option == text_format(f).label
+                     or (text_format(f).label == MATRIX_FORMAT and option in said)), None)
+
+    def _format_options(self) -> list[str]:
+        return [self._format_option(f) for f in FORMATS]
+
     def relabel(self) -> None:
         """Every label, hint, option and text in the session's language (a ``language`` change)."""
         _ = self.tr.gettext
+        chosen = self._format_of(str(self.export_fmt.value)) or FORMATS[0]
+        if tuple(self.export_fmt.options) != tuple(self._format_options()):
+            self.export_fmt.options = self._format_options()
+        set_value(self.export_fmt, self._format_option(chosen))
         for handle, label, hint in self._labels():
             cast(_Labelled, handle).label = _(label)
             if hint is not None:
@@ -415,7 +440,7 @@ class ToolPanel:
     def _on_export(self, _event: ButtonEvent) -> None:
         slot, tool = self._selected()
         label = str(self.export_fmt.value)
-        fmt = next((f for f in FORMATS if text_format(f).label == label), None)
+        fmt = self._format_of(label)
         if fmt is None:
             raise ValueError(self.tr.gettext("Unknown export format {name}.").format(name=repr(label)))
         number = text_format(fmt).slot_for(slot)  # the controller's tool numbers, else its default

@@ -39,6 +39,7 @@ from tcpcal.orientation import OrientationResult
 from tcpcal.pose_quality import CandidateGain
 from tcpcal.tool import Calibration, Tool
 
+from tcp_pendant.controller.tools import shown_tool_label
 from tcp_pendant.json_shapes import JsonRecord
 from tcp_pendant.translation import ENGLISH, N_, Translator
 from tcp_pendant.wizards.describe import (
@@ -630,7 +631,8 @@ class Wizard(_ComposedTexts):
             need = self._tool_labels.get(spec.mount_tool_key, spec.mount_tool_key)
             now = self._tool_labels.get(self._mounted_tool_key, self._mounted_tool_key)
             return _("Mount the {needed} first: the {mounted} is mounted now.").format(
-                needed=need.lower(), mounted=now.lower())
+                needed=shown_tool_label(need, self._tr, in_sentence=True),
+                mounted=shown_tool_label(now, self._tr, in_sentence=True))
         return None
 
     @property
