@@ -125,7 +125,7 @@ def test_trainer_view_needs_the_token_and_shows_the_class_escaped(app_factory, t
         wait_until(lambda: view.rows[0].touches == 1 and view.rows[0].crashes == 0
                    and view.rows[0].step == "Step 2 of 4", what="the touch in the trainer's table")
         # push the torch to every trainee
-        choose(view.tool, "torch", trainer.client)
+        choose(view.tool, "Bent-neck welding torch", trainer.client)
         click(view.push, trainer.client)
         assert trainee.controller.mounted_tool.key == "torch"
         assert "1 trainee" in view.push_md.content

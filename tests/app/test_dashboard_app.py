@@ -136,7 +136,7 @@ def test_reset_and_push_act_on_the_chosen_trainee_only(app_factory, tmp_path: Pa
         # push the torch and hidden distances to Ben only
         tool_anna = anna.controller.mounted_tool.key
         choose(dash.trainee, "Ben", trainer.client)
-        choose(dash.one_tool, "torch", trainer.client)
+        choose(dash.one_tool, "Bent-neck welding torch", trainer.client)
         choose(dash.one_hide_distance, "on", trainer.client)
         click(dash.push_one, trainer.client)
         wait_until(lambda: ben.controller.mounted_tool.key == "torch" and ben.hide_distance, what="Ben's push")

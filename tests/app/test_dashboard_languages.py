@@ -187,8 +187,7 @@ def test_with_the_pseudo_locale_every_text_of_the_dashboard_is_from_the_catalogs
         unmarked_titles = {w for c in wizard_classes() if qps.gettext(c.title) == c.title   # marked by the wizards'
                            for w in WORD.findall(c.title)}                                   # owner (N_), not here
         names = ({"Anna", "Ben", "Language", "mm", "TCP", "CSV", "JSON", "XYZ", "Z", "X"} | unmarked_titles
-                 | {w for n in LANGUAGE_NAMES.values() for w in WORD.findall(n)}
-                 | {w for key in dash.control.tool_keys for w in WORD.findall(key)})
+                 | {w for n in LANGUAGE_NAMES.values() for w in WORD.findall(n)})
 
         def check(state: str) -> None:
             with trainer.lock:

@@ -58,9 +58,10 @@ BY_DESIGN = re.compile(r"\bTCP Pendant\b|\(Language\)")
 label ("⟦Ļåñĝûåĝé⟧ (Language)": a trainee shown a language they cannot read finds the way back)."""
 EQUATION_TAG = re.compile(r"\b[A-Z]{2,}-\d+\b")
 """An equation's tag from docs/methods.md ("(ZX-1)", "(BEAM-2)"): a name, as in the docs."""
-MATH_SYMBOL = re.compile(r"[A-Za-z]|[A-Za-z]\d+|sin|cos|tan|R[xyz]")
+MATH_SYMBOL = re.compile(r"[A-Za-z]|[A-Za-z]\d+|sin|cos|tan|pinv|R[xyz]")
 """A symbol of an equation or a name with a number: one letter (``t``, ``R_i``), a letter and a
-number (touch ``P1``, joint ``A6``), a function, KUKA's rotations ``Rz(A) Ry(B) Rx(C)``."""
+number (touch ``P1``, joint ``A6``), a function, the pseudo-inverse's subscript (``t_pinv``), KUKA's
+rotations ``Rz(A) Ry(B) Rx(C)``."""
 NAMES = {
     *"X Y Z A B C".split(), *(f"A{i}" for i in range(1, 7)), *(f"J{i}" for i in range(1, 7)),
     "WORLD", "BASE", "TOOL", "FLANGE", "TCP", "HOME", "UTC", "mm", "deg", "rad", "s", "ms",

@@ -39,6 +39,7 @@ import numpy as np
 import viser
 from viser.uplot import Scale
 
+from tcp_pendant.controller.tools import builtin_tools
 from tcp_pendant.controller.words import error_text
 from tcp_pendant.classroom.board import DEFAULT_IDLE_MIN, DEFAULT_STUCK_MIN, DashboardRow, dashboard_rows, open_runs
 from tcp_pendant.classroom.dashboard_settings import (
@@ -112,6 +113,14 @@ class DashboardControl(ClassControl, LanguageControl, Protocol):
     def push_to(self, name: str, exercise: str | None | bool = False, tool_key: str | None = None,
                 hide_distance: str | None = None, auto_touch: bool | None = None, *,
                 tr: Translator = ENGLISH) -> str: ...
+
+
+def tool_choices(keys: Sequence[str]) -> dict[str, str]:
+    """The tools a push may mount, as the tool dropdowns offer them: English label → key (a
+    built-in tool by its model's label, which the dropdown says in the trainer's language;
+    another by its key)."""
+    models = builtin_tools()
+    return {(models[k].label if k in models else k): k for k in keys}
 
 
 def chart_points(rows: Sequence[DashboardRow]) -> tuple[np.ndarray, np.ndarray]:
@@ -300,9 +309,7 @@ class TrainerDashboard:
                                             english(self.one_auto_touch))
         if ex_label not in ONE_EXERCISE or aids_label not in HIDE_DISTANCE or auto_label not in AUTO_TOUCH:
             raise ValueError("Choose the exercise, Hide distance and Auto-touch from their lists.")
-        tool = None if english(self.one_tool) == KEEP else str(self.one_tool.value)
-        if tool is not None and tool not in self.control.tool_keys:
-            raise ValueError(f"Unknown tool {tool!r}; choose one of {', '.join(self.control.tool_keys)}.")
+        tool = self._tool_key(english(self.one_tool))
         self._say(self.control.push_to(name, ONE_EXERCISE[ex_label], tool, HIDE_DISTANCE[aids_label],
                                        AUTO_TOUCH[auto_label], tr=self.session.translator))
 
@@ -352,12 +359,20 @@ class TrainerDashboard:
         self.gui.main_panel.set_width(FULL_WIDTH_PX)
         self.close_replay.visible = self.replay_touch.visible = False
 
+    def _tool_key(self, label: str) -> str | None:
+        """The tool a tool dropdown's choice names (its English label: :func:`tool_choices`),
+        None for "keep"."""
+        if label == KEEP:
+            return None
+        key = tool_choices(self.control.tool_keys).get(label)
+        if key is None:
+            raise ValueError(f"Unknown tool {label!r}; choose one of {', '.join(self.control.tool_keys)}.")
+        return key
+
     def _push_all(self, _event: ButtonEvent | None = None) -> None:
         english = self.words.english
         exercise = EXERCISES.get(english(self.exercise))
-        tool = None if english(self.tool) == KEEP else str(self.tool.value)
-        if tool is not None and tool not in self.control.tool_keys:
-            raise ValueError(f"Unknown tool {tool!r}; choose one of {', '.join(self.control.tool_keys)}.")
+        tool = self._tool_key(english(self.tool))
         label, auto = english(self.hide_distance), english(self.auto_touch)
         if label not in HIDE_DISTANCE:
             raise ValueError(f"Unknown Hide distance choice {label!r}; choose one of {', '.join(HIDE_DISTANCE)}.")
@@ -487,7 +502,7 @@ def trainee_folder(dash: TrainerDashboard) -> None:
                                   label=N_("Robot at touch"),
                                   hint=N_("The robot of the replay, posed as it was at that touch."))
         dash.one_exercise = words.dropdown(gui, N_("Exercise for this trainee"), tuple(ONE_EXERCISE))
-        dash.one_tool = words.dropdown(gui, N_("Tool for this trainee"), (KEEP,), dash.control.tool_keys)
+        dash.one_tool = words.dropdown(gui, N_("Tool for this trainee"), (KEEP, *tool_choices(dash.control.tool_keys)))
         dash.one_hide_distance = words.dropdown(gui, N_("Hide distance for this trainee"), tuple(HIDE_DISTANCE))
         dash.one_auto_touch = words.dropdown(gui, N_("Auto-touch for this trainee"), tuple(AUTO_TOUCH))
         dash.push_one = words(gui.add_button("", color="blue"), label=N_("Push to this trainee"))
@@ -510,7 +525,7 @@ def exercise_folder(dash: TrainerDashboard) -> None:
     with dash.folder(N_("Exercise")):
         current = next((label for label, ex in EXERCISES.items() if ex == control.exercise), "Free practice")
         dash.exercise = words.dropdown(gui, N_("Exercise"), tuple(EXERCISES), value=current)
-        dash.tool = words.dropdown(gui, N_("Tool for all"), (KEEP,), control.tool_keys)
+        dash.tool = words.dropdown(gui, N_("Tool for all"), (KEEP, *tool_choices(control.tool_keys)))
         dash.hide_distance = words.dropdown(
             gui, N_("Hide distance for all"), tuple(HIDE_DISTANCE),
             hint=N_("on: trainees judge the touch by eye (no distance, no Δ line, no close-up, no stop "

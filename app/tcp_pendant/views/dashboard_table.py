@@ -24,7 +24,8 @@ from tcp_pendant.translation import ENGLISH, N_, Translator
 from tcp_pendant.wizards.registry import WIZARD_TYPES
 from tcp_pendant.wizards.truth import GRADE_WORDS
 
-__all__ = ["FONT_PX", "IDLE_BACKGROUND", "STUCK_BACKGROUND", "in_progress_html", "short_step", "trainees_html"]
+__all__ = ["FONT_PX", "IDLE_BACKGROUND", "STUCK_BACKGROUND", "grade_word", "in_progress_html", "method_name",
+           "short_step", "trainees_html"]
 
 FONT_PX = 15
 """Table text size, pixels (readable from the back of a room on a 1024x768 projector)."""
@@ -78,6 +79,12 @@ def method_name(method: str, tr: Translator) -> str:
     return tr.gettext(cls.title if cls is not None else method)
 
 
+def grade_word(grade: str | None, tr: Translator) -> str:
+    """A stored grade ("good", "fair", "poor") in ``tr``'s language; another as it is, "" for
+    none."""
+    return tr.gettext(GRADE_WORDS[grade]) if grade in GRADE_WORDS else grade or ""
+
+
 def trainees_html(rows: Sequence[DashboardRow], *, tr: Translator = ENGLISH) -> str:
     """The live table (module docstring) in ``tr``'s language (a method by its translated name);
     every text escaped."""
@@ -98,7 +105,7 @@ def trainees_html(rows: Sequence[DashboardRow], *, tr: Translator = ENGLISH) -> 
         cells = (escape_html(str(r.number)), _cut(name, 11), _ON if r.connected else _OFF,
                  _cut(method_name(r.method, tr) if r.method else "-", 10),
                  escape_html(step or "-"), format_duration(r.step_s if r.in_progress else r.quiet_s if r.idle else None),
-                 format_duration(r.touch_s), str(r.touches), str(r.crashes), err, escape_html(_(GRADE_WORDS[r.grade]) if r.grade in GRADE_WORDS else r.grade or "-"))
+                 format_duration(r.touch_s), str(r.touches), str(r.crashes), err, escape_html(grade_word(r.grade, tr) or "-"))
         tds = "".join(f'<td style="{_CELL}">{c}</td>' for c in cells)
         kind = "stuck" if r.stuck else "idle" if r.idle else "trainee"
         body.append(f'<tr class="{kind}" style="{style}">{tds}</tr>')

@@ -22,6 +22,7 @@ from tcp_pendant.classroom.recorder import TraineeStatus
 from tcp_pendant.calibrate.pendant_rules import ExerciseRules
 from tcp_pendant.text_escape import escape_markdown
 from tcp_pendant.translation import ENGLISH, N_, Translator
+from tcp_pendant.views.dashboard_table import grade_word, method_name
 from tcp_pendant.views.trainer_exercise import BriefControl
 from tcp_pendant.views.trainer_messages import MessageControl
 
@@ -95,8 +96,9 @@ def grades_markdown(rows: Sequence[GradeRow], *, tr: Translator = ENGLISH) -> st
              "|---|---|---|---|---|---|---|"]
     for r in shown:
         err = "-" if r.position_error_mm is None else f"{r.position_error_mm:.2f}"
-        lines.append(f"| {r.calibration_id} | {_cell(r.trainee)} | {_cell(_(r.method) if r.method else '')} | "
-                     f"{r.touches} ({r.hand}/{r.auto}) | {r.crashes} | {err} | {_cell(r.grade or '')} |")
+        method = method_name(r.method, tr) if r.method else ""
+        lines.append(f"| {r.calibration_id} | {_cell(r.trainee)} | {_cell(method)} | "
+                     f"{r.touches} ({r.hand}/{r.auto}) | {r.crashes} | {err} | {_cell(grade_word(r.grade, tr))} |")
     if len(rows) > len(shown):
         older = len(rows) - len(shown)
         lines.append("\n" + tr.ngettext("*{n} older row in the CSV.*", "*{n} older rows in the CSV.*", older).format(n=older))
@@ -111,7 +113,8 @@ def record_grades_markdown(name: str, grades: Sequence[RecordGrade], *, tr: Tran
     for g in grades:
         err = "-" if g.position_error_mm is None else f"{g.position_error_mm:.3f}"
         lines.append(f"| {g.index + 1} | {g.record_id if g.record_id is not None else '-'} | {_cell(g.trainee)} | "
-                     f"{_cell(g.method)} | {err} | {_cell(g.grade or '')} | {_cell(g.message)} |")
+                     f"{_cell(method_name(g.method, tr))} | {err} | {_cell(grade_word(g.grade, tr))} | "
+                     f"{_cell(g.message)} |")
     if not grades:
         lines.append("| - | - | - | - | - | - | " + _("the record holds no calibration") + " |")
     return "\n".join(lines)
