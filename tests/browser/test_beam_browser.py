@@ -31,9 +31,10 @@ from tcpcal.tool import Tool
 pytestmark = pytest.mark.browser
 
 
-def row_text(page, first_cell: str) -> str:
-    """Inner text of the visible table row whose text starts with ``first_cell``."""
-    row = page.get_by_role("row").filter(has_text=first_cell).filter(visible=True).first
+def row_text(page, first_cell: str, *, also: str = "") -> str:
+    """Inner text of the visible table row whose text starts with ``first_cell`` (and holds
+    ``also``: the result's "method" row names the method too)."""
+    row = page.get_by_role("row").filter(has_text=first_cell).filter(has_text=also).filter(visible=True).first
     return str(row.inner_text(timeout=60_000))
 
 
@@ -58,7 +59,7 @@ def test_automatic_beam_wizard_next_to_the_manual_calibration(server, new_page, 
     assert page.get_by_role("cell", name="shaft crossed sideways", exact=True).filter(visible=True).count() == 8
     # the real-robot time, and automatic vs by hand with the errors of both against the truth
     assert re.search(r"scan on a real robot\s+\d+\.\d s \(path", row_text(page, "scan on a real robot"))
-    beam_row = row_text(page, "Automatic (beam)")
+    beam_row = row_text(page, "Automatic (beam)", also="on a real robot")
     m = re.search(r"(\d+\.\d+) s on a real robot\s+(\d+\.\d+) mm", beam_row)
     assert m, beam_row
     assert 5.0 < float(m.group(1)) < 60.0                     # seconds, as a BullsEye takes

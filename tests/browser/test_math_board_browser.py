@@ -105,7 +105,7 @@ def test_in_another_language_the_board_and_its_button_speak_it_and_the_button_st
     9.): the pseudo-locale, whose words are nothing like English."""
     qps = translator(PSEUDO_LANGUAGE)
     server = pendant_server("--shared", "--presenter", "--language", PSEUDO_LANGUAGE)
-    page = new_page(server.url, width=1024, height=768)
+    page = new_page(server.url, width=1024, height=768, wait_for=qps.gettext("Record point"))
     page.get_by_label(qps.gettext("Math board")).first.check()
     board = page.locator("#tcp-pendant-board")
     board.wait_for(state="visible", timeout=TIMEOUT_MS)
