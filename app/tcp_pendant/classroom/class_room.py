@@ -401,7 +401,8 @@ class ClassRoom:
         indices = session.wizard_commands.restore_runs([r.run for r in restored])
         for index, r in zip(indices, restored):
             recorder.adopt(index, r.calibration_id, r.touch_ids)
-        session.notify("Calibration restored", restored_words(restored), kind="info")
+        tr = session.translator
+        session.notify(tr.gettext("Calibration restored"), restored_words(restored, tr=tr), kind="info")
 
     def detach(self, session: Session) -> None:
         """The session closed (its browser left)."""

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tcp_pendant.classroom.gradebook import Gradebook
+from tcp_pendant.translation import ENGLISH, Translator
 from tcp_pendant.wizards import Wizard, WizardError
 from tcp_pendant.wizards.session_record import WizardRun, step_distances, step_joints
 
@@ -77,18 +78,19 @@ def runs_to_restore(gradebook: Gradebook, trainee: str) -> list[RestoredRun]:
     return out
 
 
-def restored_words(restored: list[RestoredRun]) -> str:
+def restored_words(restored: list[RestoredRun], *, tr: Translator = ENGLISH) -> str:
     """What the trainee is told about ``restored`` (plain text), e.g. "1 calibration you had in
     progress came back, at its step with its touches. Your XYZ 4-point result not saved yet came
-    back: save it to the tool library or close it." """
+    back: save it to the tool library or close it."), in ``tr``'s language."""
     open_ = [r for r in restored if not r.finished]
     results = [r for r in restored if r.finished]
     parts = []
     if open_:
         n = len(open_)
-        parts.append(f"{n} calibration{'s' if n != 1 else ''} you had in progress came back, "
-                     f"{'each ' if n != 1 else ''}at its step with its touches.")
+        parts.append(tr.ngettext("{n} calibration you had in progress came back, at its step with its touches.",
+                                 "{n} calibrations you had in progress came back, each at its step with its "
+                                 "touches.", n).format(n=n))
     for r in results:
-        parts.append(f"Your {r.run.wizard.title} result not saved yet came back: save it to the tool library "
-                     "or close it.")
+        parts.append(tr.gettext("Your {method} result not saved yet came back: save it to the tool library "
+                                "or close it.").format(method=tr.gettext(r.run.wizard.title)))
     return " ".join(parts)
