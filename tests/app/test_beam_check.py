@@ -36,7 +36,7 @@ class Page(AppPage):
 
 # seeded: the beam's repeatability noise (about 0.02 mm per axis) comes from the session's
 # randomness, and the checks below allow 0.05 mm
-pytestmark = pytest.mark.app_page(cls=Page, seed=7)
+pytestmark = [pytest.mark.app_page(cls=Page, seed=7), pytest.mark.shares_cpu]  # asserts no time, latency or load (tests/conftest.py)
 
 
 def test_check_with_beam_needs_an_active_tool(page) -> None:

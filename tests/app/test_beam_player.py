@@ -29,7 +29,7 @@ class Page(AppPage):
         return asyncio.run_coroutine_threadsafe(call(), loop).result(timeout=30)
 
 
-pytestmark = pytest.mark.app_page(cls=Page)
+pytestmark = [pytest.mark.app_page(cls=Page), pytest.mark.shares_cpu]  # asserts no time, latency or load (tests/conftest.py)
 
 
 def fake_scan(p: Page) -> SimpleNamespace:

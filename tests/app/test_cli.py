@@ -7,6 +7,8 @@ import pytest
 from tcp_pendant.serve.cli import build_parser, main
 from tcp_pendant.serve.server import is_loopback, parse_xyz_mm, ready_configuration
 
+pytestmark = pytest.mark.shares_cpu  # asserts no time, latency or load (tests/conftest.py)
+
 
 def test_defaults() -> None:
     a = build_parser().parse_args([])

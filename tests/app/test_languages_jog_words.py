@@ -8,6 +8,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from support.calib_helpers import make_controller, make_session
 from support.pseudo_text import untranslated_words
@@ -21,6 +22,8 @@ from tcp_pendant.pendant.tilts import TiltOptions, reachable_line, stopped_advic
 from tcp_pendant.pendant.touch_feedback import touch_feedback
 from tcp_pendant.refusal_notices import RefusalNotices
 from tcp_pendant.translation import ENGLISH, PSEUDO_LANGUAGE, translator
+
+pytestmark = pytest.mark.shares_cpu  # asserts no time, latency or load (tests/conftest.py)
 
 QPS = translator(PSEUDO_LANGUAGE)
 NAMES = {"A1", "A2", "A3", "A4", "A5", "A6", "X", "Y", "Z", "A", "B", "C", "WORLD", "TOOL", "TCP", "mm", "deg",

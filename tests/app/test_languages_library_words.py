@@ -14,6 +14,8 @@ from tcp_pendant.translation import PSEUDO_LANGUAGE, translator
 from tcp_pendant.views.library_words import recovery_summary
 from tcpcal.library import LibraryRecovery
 
+pytestmark = pytest.mark.shares_cpu  # asserts no time, latency or load (tests/conftest.py)
+
 PROBLEMS = tuple(f"slot {i}: tcp_mm[0] must be a finite number, got nan." for i in range(1, 8))
 
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from typing import Any
 
+import pytest
 import viser
 
 from support.pseudo_text import english_words, gui_texts, untranslated_words
@@ -18,6 +19,8 @@ from tcp_pendant.translation import PSEUDO_LANGUAGE, translator
 from tcp_pendant.views.scene import tool_label_text
 from tcp_pendant.views.tip_insets import CAPTION, CAPTION_ZOOMED, caption_text
 from tcpcal.tool import Tool
+
+pytestmark = pytest.mark.shares_cpu  # asserts no time, latency or load (tests/conftest.py)
 
 NAMES = {"P1", "P2", "X", "Y", "Z", "mm", "TOOL", "WORLD", "FLANGE", "TCP", "CSV", "POSES", "R",
          "tcpcal", "xyz4"}

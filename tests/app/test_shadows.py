@@ -4,10 +4,13 @@ shadows of viser's default lights for the browser that clicked it only (every br
 
 from __future__ import annotations
 
+import pytest
 
 from support.wsclient import InputsClient, wait_until
 
 from tcp_pendant.views.pendant_panel import SHADOWS_LABEL, SHARED_SHADOWS_LABEL
+
+pytestmark = pytest.mark.shares_cpu  # asserts no time, latency or load (tests/conftest.py)
 
 
 def _lights(c: InputsClient) -> list[tuple[bool, bool]]:

@@ -7,10 +7,13 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+import pytest
 
 from support.wsclient import DrainingClient, wait_until
 from tcp_pendant.text_escape import escape_markdown as _esc
 from tcp_pendant.translation import PSEUDO_LANGUAGE
+
+pytestmark = pytest.mark.shares_cpu  # asserts no time, latency or load (tests/conftest.py)
 
 
 def test_the_dock_shows_the_step_in_the_new_language_after_a_switch(app_factory: Any) -> None:

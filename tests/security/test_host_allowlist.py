@@ -18,6 +18,8 @@ from tcp_pendant.serve.origin_check import LOOPBACK_HOSTS, host_refusal, served_
 from tcp_pendant.serve.server import AppConfig, PendantApp
 from websockets.datastructures import Headers
 
+pytestmark = pytest.mark.shares_cpu  # asserts no time, latency or load (tests/conftest.py)
+
 PROXY = "https://pendant.school.example"
 
 

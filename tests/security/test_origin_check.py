@@ -20,6 +20,8 @@ from websockets.sync.client import ClientConnection, connect
 
 from support.wsclient import wait_until
 
+pytestmark = pytest.mark.shares_cpu  # asserts no time, latency or load (tests/conftest.py)
+
 PROXY = "https://pendant.school.example"
 CAMERA = _messages.ViewerCameraMessage(wxyz=(1.0, 0.0, 0.0, 0.0), position=(2.0, -2.0, 1.0), fov=1.0, near=0.01,
                                        far=100.0, image_height=720, image_width=1280, look_at=(0.0, 0.0, 0.5),
