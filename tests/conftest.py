@@ -224,9 +224,8 @@ _TESTS = Path(__file__).resolve().parent
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     """Mark ``serial`` every test of :data:`SERIAL_FOLDERS` and every ``browser`` test, but
-    not a module marked ``shares_cpu`` (it asserts no time, latency or load: a unit test of an
-    app module, a benchmark's smoke run that checks what it prints, a browser test that only
-    waits on conditions the page shows). Mark
+    not a module of those folders marked ``shares_cpu`` (it asserts no time, latency or load:
+    a unit test of an app module, a benchmark's smoke run that checks what it prints). Mark
     ``slow`` every ``browser`` test too: chromium draws WebGL in software here, 7-35 s a test,
     about 9 of the full run's minutes on two cores, so the quick lane (``run-tests.sh
     --quick``: ``-m "not slow"``) leaves them to the full run and ``-m browser``."""
@@ -237,7 +236,7 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
             folder = item.path.resolve().relative_to(_TESTS).parts[0]
         except ValueError:                      # a test outside tests/ (given on the command line)
             folder = ""
-        if item.get_closest_marker("shares_cpu") is not None:
+        if item.get_closest_marker("shares_cpu") is not None and item.get_closest_marker("browser") is None:
             continue
         if folder in SERIAL_FOLDERS or item.get_closest_marker("browser") is not None:
             item.add_marker(pytest.mark.serial)

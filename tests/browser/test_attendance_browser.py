@@ -18,7 +18,7 @@ from support.pendant_page import TIMEOUT_MS, assert_not_blank, wait_text
 from support.wizard_page import open_calibrate, press
 from support.wsclient import DrainingClient, wait_until
 
-pytestmark = [pytest.mark.browser, pytest.mark.shares_cpu]  # asserts no time, latency or load (tests/conftest.py)
+pytestmark = pytest.mark.browser
 
 TOKEN = "trainer-secret-attend-42"
 

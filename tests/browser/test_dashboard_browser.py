@@ -15,7 +15,7 @@ from support.guiclick import choose, click
 from support.pendant_page import TIMEOUT_MS, assert_not_blank, wait_text
 from support.wsclient import DrainingClient, wait_until
 
-pytestmark = [pytest.mark.browser, pytest.mark.shares_cpu]  # asserts no time, latency or load (tests/conftest.py)
+pytestmark = pytest.mark.browser
 
 TOKEN = "trainer-secret-4242"
 NAMES = ("Anna", "Ben <b>B</b>", "Chiara Maria Long-Surname")

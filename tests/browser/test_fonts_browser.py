@@ -23,7 +23,7 @@ import viser
 
 from support.catalog_text import catalog_chars
 
-pytestmark = [pytest.mark.browser, pytest.mark.shares_cpu]  # asserts no time, latency or load (tests/conftest.py)
+pytestmark = pytest.mark.browser
 
 LANGUAGES = ("de", "es", "ru", "hi", "zh_Hans", "ja", "qps")
 NO_FONT_CODEPOINT = "\U0010FFFD"

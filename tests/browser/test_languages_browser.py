@@ -15,7 +15,7 @@ from support.pendant_page import TIMEOUT_MS, assert_not_blank, wait_text, wait_u
 
 from tcp_pendant.translation import PSEUDO_LANGUAGE, translator
 
-pytestmark = [pytest.mark.browser, pytest.mark.shares_cpu]  # asserts no time, latency or load (tests/conftest.py)
+pytestmark = pytest.mark.browser
 
 
 def test_a_german_browser_gets_the_jog_tab_in_german_and_its_keys_work(app_factory, new_page: Callable[..., Any],

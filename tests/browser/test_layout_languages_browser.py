@@ -23,7 +23,7 @@ import viser
 from support.page_barrier import NEXT_FRAMES_JS, Barrier, show_tab
 from support.pendant_page import wait_until
 
-pytestmark = [pytest.mark.browser, pytest.mark.shares_cpu]  # asserts no time, latency or load (tests/conftest.py)
+pytestmark = pytest.mark.browser
 
 LANGUAGES = ("de", "ru", "qps")
 SIZES = ((1400, 900), (1024, 768))

@@ -20,7 +20,7 @@ from support.calib_helpers import true_frame
 from support.pendant_page import TIMEOUT_MS, choose
 from support.wizard_page import auto_touch_to_result, open_calibrate, press, wait_text
 
-pytestmark = [pytest.mark.browser, pytest.mark.timeout(1200), pytest.mark.shares_cpu]  # asserts no time, latency or load (tests/conftest.py)
+pytestmark = [pytest.mark.browser, pytest.mark.timeout(1200)]
 
 MIN_FONT_PX = 20.0
 

@@ -12,7 +12,7 @@ from support.wizard_page import wait_text as wait_visible_text
 
 from tcp_pendant.calibrate import AutoTouchRequest
 
-pytestmark = [pytest.mark.browser, pytest.mark.shares_cpu]  # asserts no time, latency or load (tests/conftest.py)
+pytestmark = pytest.mark.browser
 
 
 def _canvas_width(page) -> float:

@@ -46,7 +46,7 @@ from tcp_pendant.translation import LANGUAGE_NAMES
 from tcp_pendant.wizards.base import WizardError
 from tcp_pendant.wizards.registry import wizard_classes
 
-pytestmark = [pytest.mark.browser, pytest.mark.shares_cpu]  # asserts no time, latency or load (tests/conftest.py)
+pytestmark = pytest.mark.browser
 
 TOKEN = "trainer-walk-token-4242"
 TRAINEE = "Ada Trainee"

@@ -39,7 +39,7 @@ from tcp_pendant.serve.server import PendantApp
 from support.app_page import true_tip_at
 from support.pendant_page import TIMEOUT_MS, assert_not_blank, wait_until
 
-pytestmark = [pytest.mark.browser, pytest.mark.shares_cpu]  # asserts no time, latency or load (tests/conftest.py)
+pytestmark = pytest.mark.browser
 
 SIZES = ((1024, 768), (1400, 900))
 JOG_KEYS = tuple(f"{ax} {s}" for ax in "XYZABC" for s in ("−", "+"))

@@ -15,7 +15,7 @@ from tcp_pendant.controller import builtin_tools
 from tcpcal.library import ToolLibrary
 from tcpcal.tool import Tool
 
-pytestmark = [pytest.mark.browser, pytest.mark.shares_cpu]  # asserts no time, latency or load (tests/conftest.py)
+pytestmark = pytest.mark.browser
 LABELS = ("+A 30°", "-A 30°", "+B 30°", "-B 30°", "+C 30°", "-C 30°")
 
 

@@ -10,7 +10,7 @@ from support.pendant_page import TIMEOUT_MS, wait_until
 
 from tcp_pendant.calibrate import AutoTouchRequest
 
-pytestmark = [pytest.mark.browser, pytest.mark.shares_cpu]  # asserts no time, latency or load (tests/conftest.py)
+pytestmark = pytest.mark.browser
 
 _BOX = """() => {
   const el = [...document.querySelectorAll('div')].find(d => d.children.length <= 1 && d.innerText

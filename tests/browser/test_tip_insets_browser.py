@@ -24,7 +24,7 @@ from tcp_pendant.pendant.tip_insets import GAP_PX, PX_PER_MM, TOOL_COLOR, VIEW_W
 from support.app_page import true_tip_at
 from support.pendant_page import TIMEOUT_MS, wait_until
 
-pytestmark = [pytest.mark.browser, pytest.mark.shares_cpu]  # asserts no time, latency or load (tests/conftest.py)
+pytestmark = pytest.mark.browser
 
 MIN_PX = 5.0
 """What must hold: 0.5 mm is at least this many screen pixels, in every direction."""

@@ -17,7 +17,7 @@ from tcpcal.controllers import parse_tool_file
 from tcpcal.library import ToolLibrary
 from tcpcal.tool import Tool
 
-pytestmark = [pytest.mark.browser, pytest.mark.shares_cpu]  # asserts no time, latency or load (tests/conftest.py)
+pytestmark = pytest.mark.browser
 
 
 def test_check_a_saved_tool_download_its_abb_file_and_pick_a_scenario(server, new_page, shot) -> None:

@@ -14,7 +14,7 @@ from support.pendant_page import TIMEOUT_MS, assert_not_blank, wait_text
 
 from tcp_pendant.translation import PSEUDO_LANGUAGE, translator
 
-pytestmark = [pytest.mark.browser, pytest.mark.shares_cpu]  # asserts no time, latency or load (tests/conftest.py)
+pytestmark = pytest.mark.browser
 
 QPS = translator(PSEUDO_LANGUAGE)
 

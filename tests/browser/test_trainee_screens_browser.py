@@ -43,7 +43,7 @@ from support import chromium_session
 from support.app_page import true_tip_at
 from support.pendant_page import TIMEOUT_MS, assert_not_blank, choose, field, wait_until
 
-pytestmark = [pytest.mark.browser, pytest.mark.shares_cpu]  # asserts no time, latency or load (tests/conftest.py)
+pytestmark = pytest.mark.browser
 
 DESKTOP = ((1400, 900), (1024, 768))
 TOUCH = ((820, 1180), (390, 844))

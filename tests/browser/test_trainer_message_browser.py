@@ -15,7 +15,7 @@ from support.pendant_page import TIMEOUT_MS, join_class, press, wait_enabled
 from support.trainer_socket import TrainerSocket
 from support.wsclient import wait_until
 
-pytestmark = [pytest.mark.browser, pytest.mark.shares_cpu]  # asserts no time, latency or load (tests/conftest.py)
+pytestmark = pytest.mark.browser
 
 TOKEN = "trainer-message-token-2026"
 

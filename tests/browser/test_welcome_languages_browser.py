@@ -16,7 +16,7 @@ from tcp_pendant.serve.server import PendantApp
 from tcp_pendant.translation import PSEUDO_LANGUAGE, translator
 from tcp_pendant.views.identity import BANNER, JOIN_LABEL, NAME_LABEL
 
-pytestmark = [pytest.mark.browser, pytest.mark.shares_cpu]  # asserts no time, latency or load (tests/conftest.py)
+pytestmark = pytest.mark.browser
 
 TOKEN = "trainer-secret-4242"
 

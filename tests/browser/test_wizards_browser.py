@@ -31,7 +31,7 @@ from support.wizard_page import (
     wait_text,
 )
 
-pytestmark = [pytest.mark.browser, pytest.mark.shares_cpu]  # asserts no time, latency or load (tests/conftest.py)
+pytestmark = pytest.mark.browser
 
 DISPLAY_TOL = 0.006     # the pendant shows two decimals
 
